@@ -1,0 +1,7 @@
+"""``python -m robokin``."""
+
+import sys
+
+from robokin.cli import main
+
+sys.exit(main())

@@ -1,0 +1,67 @@
+"""The robokin exception hierarchy: every error robokin raises derives from RobokinError."""
+
+from __future__ import annotations
+
+__all__ = [
+    "InputError",
+    "MissingExtraError",
+    "ModelError",
+    "RobokinError",
+    "UnreachableError",
+]
+
+
+class RobokinError(Exception):
+    """Root of every error robokin raises."""
+
+
+class ModelError(RobokinError, ValueError):
+    """A bad robot or scene file, or an inconsistent model definition.
+
+    Attributes:
+        file: The file the problem was found in, or None for in-memory models.
+        field: The field path inside the file, e.g. ``joints[2].limits``, or None.
+        reason: What is wrong.
+    """
+
+    def __init__(self, reason: str, *, file: object = None, field: str | None = None):
+        self.file = None if file is None else str(file)
+        self.field = field
+        self.reason = reason
+        where = []
+        if self.file is not None:
+            where.append(self.file)
+        if field:
+            where.append(field)
+        prefix = ": ".join(where)
+        super().__init__(f"{prefix}: {reason}" if prefix else reason)
+
+
+class InputError(RobokinError, ValueError):
+    """A bad argument to a public function (wrong shape, NaN, out of range).
+
+    Attributes:
+        argument: The name of the offending argument.
+        reason: What is wrong, stating expected vs got.
+    """
+
+    def __init__(self, argument: str, reason: str):
+        self.argument = argument
+        self.reason = reason
+        super().__init__(f"argument '{argument}': {reason}")
+
+
+class UnreachableError(RobokinError):
+    """Raised only where the caller asked for exactly one IK answer and none exists."""
+
+
+class MissingExtraError(RobokinError, ImportError):
+    """An optional dependency is missing; the message names the extra to install."""
+
+    def __init__(self, package: str, extra: str):
+        self.package = package
+        self.extra = extra
+        super().__init__(
+            f"this feature needs the '{package}' package: "
+            f"pip install 'robokin[{extra}]'"
+        )

@@ -1,0 +1,1 @@
+"""What an arm DOES: forward kinematics, Jacobians, inverse kinematics."""

@@ -1,0 +1,91 @@
+"""Batch forward kinematics on the canonical chain.
+
+``q`` has shape ``(..., n)`` (independent joint coordinates, SI units); results keep
+the leading shape. The compiled kernels load on first use.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from robokin._validation import check_finite, check_joints
+from robokin.exceptions import InputError
+from robokin.model.chain import Chain
+
+__all__ = ["forward_kinematics", "forward_kinematics_all", "link_frames"]
+
+# Below this many configurations one thread beats the parallel launch overhead.
+_PARALLEL_MIN = 2048
+
+
+def _kernels():
+    from robokin.kinematics import _kernels
+
+    return _kernels
+
+
+def _chain_values(chain: Chain, q: np.ndarray) -> np.ndarray:
+    qc = chain.coupling.apply(q)
+    return np.ascontiguousarray(qc.reshape(-1, chain.n_chain))
+
+
+def _raise_nonfinite(q: np.ndarray, name: str) -> None:
+    check_finite(q, name)
+    raise InputError(name, "produced a non-finite chain joint value")  # pragma: no cover
+
+
+def forward_kinematics(chain: Chain, q: npt.ArrayLike, *, name: str = "q") -> np.ndarray:
+    """Tool pose in the world frame.
+
+    Args:
+        chain: The canonical chain.
+        q: Joint coordinates [rad or m], shape (..., n).
+        name: The argument name used in error messages.
+
+    Returns:
+        Poses (..., 4, 4).
+
+    Raises:
+        InputError: wrong shape or a non-finite value.
+    """
+    q = check_joints(q, chain.n, name)
+    qc = _chain_values(chain, q)
+    out = np.empty((qc.shape[0], 4, 4))
+    k = _kernels()
+    fn = k.fk_parallel if qc.shape[0] >= _PARALLEL_MIN else k.fk_serial
+    if not fn(qc, chain._consts, chain._kind, chain._sign, chain._offset, out):
+        _raise_nonfinite(q, name)
+    return out.reshape(q.shape[:-1] + (4, 4))
+
+
+def link_frames(chain: Chain, q: npt.ArrayLike, *, name: str = "q") -> np.ndarray:
+    """Base, every link frame and the tool pose: (..., n_chain + 2, 4, 4)."""
+    q = check_joints(q, chain.n, name)
+    qc = _chain_values(chain, q)
+    nc = chain.n_chain
+    out = np.empty((qc.shape[0], nc + 2, 4, 4))
+    first = chain.base @ chain.head
+    ok = _kernels().fk_all_serial(
+        qc, first, chain.frame_offsets, chain.link_offsets, chain.tool,
+        chain._kind, chain._sign, chain._offset, out,
+    )
+    if not ok:
+        _raise_nonfinite(q, name)
+    out[:, 0] = chain.base
+    return out.reshape(q.shape[:-1] + (nc + 2, 4, 4))
+
+
+def forward_kinematics_all(chain: Chain, q: npt.ArrayLike, *, name: str = "q") -> np.ndarray:
+    """The base frame, then the link frame of every chain joint.
+
+    Args:
+        chain: The canonical chain.
+        q: Joint coordinates, shape (..., n).
+        name: The argument name used in error messages.
+
+    Returns:
+        Frames (..., n_chain + 1, 4, 4). For arms without dependent joints
+        ``n_chain == n``. The tool pose is :func:`forward_kinematics`.
+    """
+    return link_frames(chain, q, name=name)[..., :-1, :, :]

@@ -1,0 +1,49 @@
+"""Choose the IK solver for a robot: its closed form when one applies, else numeric."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy.typing as npt
+
+from robokin._validation import check_joints, check_transform, check_finite
+from robokin.exceptions import InputError
+from robokin.kinematics.ik.solutions import SolutionSet
+
+__all__ = ["solve"]
+
+_METHODS = ("auto", "analytic", "numeric")
+
+
+def solve(
+    robot: Any,
+    T: npt.ArrayLike,
+    *,
+    q_near: npt.ArrayLike | None = None,
+    method: str = "auto",
+    **options: Any,
+) -> SolutionSet:
+    """Every solution for target poses ``T`` (..., 4, 4); see ``Robot.ik``.
+
+    Raises:
+        InputError: bad pose or ``q_near``, unknown method, or ``method="analytic"``
+            for an arm without a closed form (the message says why).
+    """
+    if method not in _METHODS:
+        raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
+    T = check_transform(T, "T")
+    if q_near is not None:
+        q_near = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
+    if method in ("auto", "analytic"):
+        from robokin.kinematics.ik.analytic.detect import detect
+
+        fam = detect(robot)
+        if fam.solver is not None:
+            return fam.solver(robot, T, q_near=q_near, **options)
+        if method == "analytic":
+            raise InputError(
+                "method", f"no closed form for robot '{robot.name}': {fam.reason}"
+            )
+    from robokin.kinematics.ik.numeric import solve_all
+
+    return solve_all(robot, T, q_near=q_near, **options)

@@ -1,0 +1,288 @@
+"""The IK solution set: every solution for every pose, with flags and labels.
+
+A :class:`SolutionSet` for target poses of leading shape ``(...)`` holds up to ``k``
+candidate rows per pose: ``q`` ``(..., k, n)`` and a ``valid`` mask ``(..., k)``
+(batches have a different count per pose). Rows that are not valid hold finite
+filler values and must be ignored. Per-pose ``status`` says why a pose has no
+solution.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robokin._validation import check_finite, check_joints
+from robokin.exceptions import UnreachableError
+
+__all__ = ["SolutionSet", "wrap_angle"]
+
+STATUS_OK = "ok"
+
+
+def wrap_angle(a: npt.ArrayLike) -> np.ndarray:
+    """Wrap angles [rad] into [-pi, pi)."""
+    a = np.asarray(a, dtype=np.float64)
+    return (a + np.pi) % (2.0 * np.pi) - np.pi
+
+
+@dataclass(frozen=True, eq=False)
+class SolutionSet:
+    """Every IK solution found for a batch of target poses.
+
+    Attributes:
+        q: Joint solutions (..., k, n) [rad, m]; rows where ``valid`` is False are
+            filler.
+        valid: (..., k) bool, which rows are real solutions.
+        is_revolute: (n,) bool, which coordinates are angles (wrap) vs lengths.
+        limits: (n, 2) joint limits [rad, m].
+        flags: Per-solution boolean arrays (..., k), e.g. ``"within_limits"``,
+            ``"singular"`` (the wrist singularity: one of infinitely many
+            solutions), ``"polished"`` (near-family Newton polish applied).
+        branches: Per-solution integer labels (..., k) by name, e.g.
+            ``"shoulder"`` (+1 right / -1 left), ``"elbow"`` (+1 up / -1 down),
+            ``"wrist"`` (+1 / -1 flip); SCARA: ``"elbow"`` (+1 right-handed / -1 left).
+        status: (...) str array: ``"ok"`` or why there is no solution ("out of
+            reach", "orientation not achievable", "outside joint limits: ...").
+        method: Which solver produced the set (e.g. ``"analytic:three_parallel"``).
+        error: (..., k) FK error of each solution (position [m] + rotation [rad]
+            norm), where the solver computed it.
+        info: Extra solver facts (e.g. the near-family residual).
+    """
+
+    q: np.ndarray
+    valid: np.ndarray
+    is_revolute: np.ndarray
+    limits: np.ndarray
+    flags: dict[str, np.ndarray] = field(default_factory=dict)
+    branches: dict[str, np.ndarray] = field(default_factory=dict)
+    status: np.ndarray | None = None
+    method: str = ""
+    error: np.ndarray | None = None
+    info: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        q = np.asarray(self.q, dtype=np.float64)
+        valid = np.asarray(self.valid, dtype=bool)
+        if q.shape[:-1] != valid.shape:
+            raise ValueError(f"q {q.shape} and valid {valid.shape} disagree")
+        object.__setattr__(self, "q", q)
+        object.__setattr__(self, "valid", valid)
+        object.__setattr__(self, "is_revolute", np.asarray(self.is_revolute, dtype=bool))
+        object.__setattr__(self, "limits", np.asarray(self.limits, dtype=np.float64))
+        if "within_limits" not in self.flags:
+            lim = self.limits
+            inside = ((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9)).all(axis=-1)
+            self.flags["within_limits"] = inside
+        if self.status is None:
+            st = np.where(valid.any(axis=-1), STATUS_OK, "no solution")
+            object.__setattr__(self, "status", np.asarray(st, dtype=object))
+
+    # ------------------------------------------------------------------ basics
+    @classmethod
+    def empty(cls, lead: tuple[int, ...], n: int, is_revolute, limits, status: str,
+              method: str = "") -> SolutionSet:
+        """A set with no solution for any of the poses, all with ``status``."""
+        st = np.empty(lead, dtype=object)
+        st[...] = status
+        return cls(np.zeros(lead + (0, n)), np.zeros(lead + (0,), bool), is_revolute,
+                   limits, status=st, method=method)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """Leading (pose batch) shape."""
+        return self.valid.shape[:-1]
+
+    @property
+    def n(self) -> int:
+        """Number of joint coordinates."""
+        return self.q.shape[-1]
+
+    @property
+    def count(self) -> np.ndarray:
+        """(...) number of valid solutions per pose."""
+        return self.valid.sum(axis=-1)
+
+    @property
+    def singular(self) -> np.ndarray:
+        """(..., k) bool, solutions at a singularity (one of infinitely many)."""
+        return self.flags.get("singular", np.zeros_like(self.valid))
+
+    @property
+    def within_limits_mask(self) -> np.ndarray:
+        """(..., k) bool, solutions inside every joint limit."""
+        return self.flags["within_limits"]
+
+    def __len__(self) -> int:
+        """Number of valid solutions (single pose only)."""
+        if self.shape:
+            raise TypeError("len() of a batched SolutionSet; use .count")
+        return int(self.count)
+
+    def solutions(self) -> np.ndarray:
+        """The valid solutions of a single pose, (count, n)."""
+        if self.shape:
+            raise TypeError("solutions() needs a single pose; index the batch first")
+        return self.q[self.valid]
+
+    def __getitem__(self, index: Any) -> SolutionSet:
+        """Index the pose batch (not the solutions): ``sols[3]``, ``sols[2:5]``."""
+        if not isinstance(index, tuple):
+            index = (index,)
+        if len(index) > len(self.shape):
+            raise IndexError("SolutionSet indexes the pose batch only")
+        return replace(
+            self,
+            q=self.q[index],
+            valid=self.valid[index],
+            flags={k: v[index] for k, v in self.flags.items()},
+            branches={k: v[index] for k, v in self.branches.items()},
+            status=np.asarray(self.status[index], dtype=object),
+            error=None if self.error is None else self.error[index],
+        )
+
+    def _masked(self, keep: np.ndarray, reason: str | None = None) -> SolutionSet:
+        valid = self.valid & keep
+        status = self.status.copy()
+        lost = self.valid.any(axis=-1) & ~valid.any(axis=-1)
+        if reason is not None and lost.any():
+            status[lost] = reason
+        return replace(self, valid=valid, status=status)
+
+    def within_limits(self) -> SolutionSet:
+        """Only the solutions inside every joint limit.
+
+        Poses whose every solution is outside the limits get a status naming the
+        joint and limit that rejected the first of them.
+        """
+        inside = self.flags["within_limits"]
+        out = self._masked(inside)
+        lost = self.valid.any(axis=-1) & ~out.valid.any(axis=-1)
+        if lost.any():
+            status = out.status.copy()
+            for idx in zip(*np.nonzero(lost)) if lost.ndim else [()]:
+                k = int(np.flatnonzero(self.valid[idx])[0])
+                status[idx] = self._limit_reason(self.q[idx][k])
+            out = replace(out, status=status)
+        return out
+
+    def _limit_reason(self, q: np.ndarray) -> str:
+        lim = self.limits
+        for j in range(q.shape[0]):
+            if q[j] < lim[j, 0] - 1e-9:
+                return (f"outside joint limits: joint {j + 1} at {q[j]:.6g} "
+                        f"< lower limit {lim[j, 0]:.6g}")
+            if q[j] > lim[j, 1] + 1e-9:
+                return (f"outside joint limits: joint {j + 1} at {q[j]:.6g} "
+                        f"> upper limit {lim[j, 1]:.6g}")
+        return "outside joint limits"
+
+    def distance(self, q_current: npt.ArrayLike) -> np.ndarray:
+        """(..., k) joint-space distance from ``q_current`` (..., n) to every row.
+
+        Revolute differences are wrapped into [-pi, pi); prismatic ones never are.
+        Invalid rows get +inf.
+        """
+        qc = check_finite(check_joints(q_current, self.n, "q_current"), "q_current")
+        diff = self.q - qc[..., None, :]
+        diff = np.where(self.is_revolute, wrap_angle(diff), diff)
+        d = np.linalg.norm(diff, axis=-1)
+        return np.where(self.valid, d, np.inf)
+
+    def nearest(self, q_current: npt.ArrayLike) -> np.ndarray:
+        """The valid solution nearest ``q_current`` for every pose, (..., n).
+
+        Distance wraps revolute joints; the returned angles are the 2*pi-equivalents
+        closest to ``q_current`` that stay inside the joint limits (so a path of
+        nearest solutions is continuous).
+
+        Raises:
+            UnreachableError: a pose has no valid solution (its status is named).
+        """
+        qc = check_finite(check_joints(q_current, self.n, "q_current"), "q_current")
+        empty = ~self.valid.any(axis=-1)
+        if empty.any():
+            idx = np.argwhere(empty)
+            first = tuple(idx[0]) if idx.size else ()
+            raise UnreachableError(
+                f"{int(empty.sum())} pose(s) have no solution; first at index {first}: "
+                f"{self.status[first]}"
+            )
+        d = self.distance(qc)
+        k = np.argmin(d, axis=-1)
+        best = np.take_along_axis(self.q, k[..., None, None], axis=-2)[..., 0, :]
+        qcb = np.broadcast_to(qc, best.shape)
+        shifted = qcb + wrap_angle(best - qcb)
+        lim = self.limits
+        ok = (shifted >= lim[:, 0] - 1e-12) & (shifted <= lim[:, 1] + 1e-12) & self.is_revolute
+        return np.where(ok, shifted, best)
+
+    def expand_turns(self) -> SolutionSet:
+        """Add every 2*pi-equivalent of revolute joints whose range exceeds 2*pi.
+
+        E.g. a UR joint with limits +-360 deg has two values for each angle. New
+        rows inherit the flags and branch labels of their source row; rows outside
+        the limits are dropped (marked invalid).
+        """
+        lim = self.limits
+        span = lim[:, 1] - lim[:, 0]
+        wide = self.is_revolute & (span > 2 * np.pi - 1e-12)
+        if not wide.any():
+            return self
+        shifts_per_joint = []
+        for j in range(self.n):
+            if not wide[j] or not np.isfinite(span[j]):
+                shifts_per_joint.append(np.array([0.0]))
+                continue
+            m = int(np.ceil(span[j] / (2 * np.pi))) + 1
+            shifts_per_joint.append(2 * np.pi * np.arange(-m, m + 1))
+        grids = np.meshgrid(*shifts_per_joint, indexing="ij")
+        shifts = np.stack([g.ravel() for g in grids], axis=-1)  # (s, n)
+        base = wrap_angle(self.q)
+        base = np.where(self.is_revolute, base, self.q)
+        q = base[..., :, None, :] + shifts  # (..., k, s, n)
+        inside = ((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9)).all(axis=-1)
+        valid = self.valid[..., :, None] & inside
+        lead = self.shape
+        k, s = q.shape[-3], q.shape[-2]
+        flat = lambda a: a.reshape(lead + (k * s,) + a.shape[len(lead) + 2:])  # noqa: E731
+        rep = lambda a: flat(np.broadcast_to(a[..., :, None], lead + (k, s)))  # noqa: E731
+        flags = {key: rep(v) for key, v in self.flags.items()}
+        flags["within_limits"] = flat(inside)
+        # Keep only columns that are valid somewhere, to bound the size.
+        V = flat(valid)
+        keep = V.reshape(-1, k * s).any(axis=0)
+        sel = lambda a: a[..., keep] if a.ndim == len(lead) + 1 else a[..., keep, :]  # noqa: E731
+        return replace(
+            self,
+            q=sel(flat(q)),
+            valid=sel(V),
+            flags={key: sel(v) for key, v in flags.items()},
+            branches={key: sel(rep(v)) for key, v in self.branches.items()},
+            error=None if self.error is None else sel(rep(self.error)),
+        )
+
+    def to_actuator_space(self, robot: Any) -> SolutionSet:
+        """The same set in motor coordinates (limits checked in both spaces)."""
+        if robot.actuators is None:
+            return self
+        phi = robot.actuators.inverse(self.q, what=f"actuator map of '{robot.name}'")
+        lim = robot.actuator_limits
+        inside = self.flags["within_limits"] & (
+            (phi >= lim[:, 0] - 1e-9) & (phi <= lim[:, 1] + 1e-9)
+        ).all(axis=-1)
+        flags = dict(self.flags)
+        flags["within_limits"] = inside
+        flags["joint_within_limits"] = self.flags["within_limits"]
+        is_rev = np.ones(phi.shape[-1], bool)
+        return replace(self, q=phi, flags=flags, is_revolute=is_rev, limits=lim,
+                       info={**self.info, "space": "actuator"})
+
+    def __repr__(self) -> str:
+        if not self.shape:
+            return (f"SolutionSet({int(self.count)} solution(s), method={self.method!r}, "
+                    f"status={self.status.item()!r})")
+        return f"SolutionSet(shape={self.shape}, counts={self.count.tolist()!r:.80})"

@@ -1,0 +1,93 @@
+"""Geometric Jacobians, manipulability and singularity tests.
+
+A Jacobian has shape ``(..., 6, n)``: rows ``[v; w]`` (linear velocity of the tool
+point [m/s], then angular velocity [rad/s]) per unit joint rate, columns the robot's
+independent coordinates (dependent joints folded in through ``M``).
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from robokin._validation import check_joints
+from robokin.exceptions import InputError
+from robokin.kinematics.forward import _chain_values, _kernels, _raise_nonfinite
+from robokin.model.chain import Chain
+
+__all__ = [
+    "jacobian",
+    "jacobian_and_pose",
+    "is_singular",
+    "manipulability",
+    "min_singular_value",
+]
+
+
+def jacobian_and_pose(
+    chain: Chain, q: npt.ArrayLike, *, name: str = "q"
+) -> tuple[np.ndarray, np.ndarray]:
+    """Base-frame Jacobian (..., 6, n) and tool pose (..., 4, 4) in one pass."""
+    q = check_joints(q, chain.n, name)
+    qc = _chain_values(chain, q)
+    N, nc = qc.shape
+    J = np.empty((N, 6, nc))
+    T = np.empty((N, 4, 4))
+    if not _kernels().jacobian_batch(qc, chain._consts, chain._kind, chain._sign,
+                                     chain._offset, J, T):
+        _raise_nonfinite(q, name)
+    if not chain.coupling.is_identity:
+        J = J @ chain.coupling.matrix
+    lead = q.shape[:-1]
+    return J.reshape(lead + (6, chain.n)), T.reshape(lead + (4, 4))
+
+
+def jacobian(
+    chain: Chain,
+    q: npt.ArrayLike,
+    *,
+    frame: Literal["base", "tool"] = "base",
+    name: str = "q",
+) -> np.ndarray:
+    """Geometric Jacobian of the tool point.
+
+    Args:
+        chain: The canonical chain.
+        q: Joint coordinates, shape (..., n).
+        frame: ``"base"``: velocities in base (world) coordinates; ``"tool"``: the
+            same velocities expressed in the tool frame.
+        name: The argument name used in error messages.
+
+    Returns:
+        Shape (..., 6, n).
+    """
+    if frame not in ("base", "tool"):
+        raise InputError("frame", f"expected 'base' or 'tool', got {frame!r}")
+    J, T = jacobian_and_pose(chain, q, name=name)
+    if frame == "tool":
+        Rt = np.swapaxes(T[..., :3, :3], -1, -2)
+        J = np.concatenate([Rt @ J[..., :3, :], Rt @ J[..., 3:, :]], axis=-2)
+    return J
+
+
+def manipulability(chain: Chain, q: npt.ArrayLike) -> np.ndarray:
+    """Yoshikawa's measure ``sqrt(det(J J^T))`` (for n < 6: ``sqrt(det(J^T J))``), (...)."""
+    J = jacobian(chain, q)
+    G = J @ np.swapaxes(J, -1, -2) if J.shape[-1] >= 6 else np.swapaxes(J, -1, -2) @ J
+    return np.sqrt(np.clip(np.linalg.det(G), 0.0, None))
+
+
+def min_singular_value(chain: Chain, q: npt.ArrayLike) -> np.ndarray:
+    """Smallest singular value of the Jacobian, (...)."""
+    return np.linalg.svd(jacobian(chain, q), compute_uv=False)[..., -1]
+
+
+def is_singular(chain: Chain, q: npt.ArrayLike, tol: float = 1e-6) -> np.ndarray:
+    """True where the Jacobian loses rank: smallest singular value below ``tol``, (...).
+
+    Uses ``min(6, n)`` singular values, so a 4-axis arm is singular only when it
+    loses one of its own degrees of freedom.
+    """
+    return min_singular_value(chain, q) < tol

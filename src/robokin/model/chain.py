@@ -1,0 +1,241 @@
+"""The canonical kinematic chain every robot model compiles to.
+
+.. math::
+
+    T(q) = B \\cdot L_0 \\cdot J_1 F_1 G_1 \\cdot J_2 F_2 G_2 \\cdots J_n F_n G_n \\cdot T_{tool}
+
+``J_k`` is a rotation about (revolute) or translation along (prismatic) the local z
+axis by ``sign_k * q_chain_k + offset_k``. ``F_k`` places the frame of link k
+after joint k (the frame that ``fk_all`` reports); ``G_k`` carries on to just
+before the next joint (virtual frames and the next row's leading constants).
+``q_chain = M q + c`` (:class:`~robokin.model.coupling.AffineMap`) derives every
+chain joint from the robot's independent coordinates ``q``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from robokin.exceptions import ModelError
+from robokin.model.coupling import AffineMap
+
+__all__ = ["Chain", "ChainBuilder", "Joint", "JointKind"]
+
+JointKind = Literal["revolute", "prismatic"]
+
+
+@dataclass(frozen=True)
+class Joint:
+    """One joint (or independent coordinate) of a chain.
+
+    Attributes:
+        name: Unique name.
+        kind: ``"revolute"`` (value in rad) or ``"prismatic"`` (value in m).
+        limits: ``(lower, upper)`` in SI units; ``(-inf, inf)`` when unlimited.
+        sign: +1, or -1 for a reversed axis.
+        offset: The chain value at zero joint coordinate [rad or m].
+    """
+
+    name: str
+    kind: JointKind = "revolute"
+    limits: tuple[float, float] = (-math.inf, math.inf)
+    sign: float = 1.0
+    offset: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("revolute", "prismatic"):
+            raise ModelError(
+                f"joint '{self.name}': kind must be 'revolute' or 'prismatic', got {self.kind!r}"
+            )
+        if self.sign not in (1.0, -1.0):
+            raise ModelError(f"joint '{self.name}': sign must be +1 or -1, got {self.sign}")
+        lo, hi = (float(v) for v in self.limits)
+        if math.isnan(lo) or math.isnan(hi) or lo > hi:
+            raise ModelError(
+                f"joint '{self.name}': limits must be [lower, upper] with lower <= upper, "
+                f"got {list(self.limits)}"
+            )
+        object.__setattr__(self, "limits", (lo, hi))
+        object.__setattr__(self, "sign", float(self.sign))
+        object.__setattr__(self, "offset", float(self.offset))
+
+
+def _ro(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class Chain:
+    """An immutable canonical chain (see the module docstring).
+
+    Attributes:
+        joints: The chain joints, in order (n_chain).
+        head: ``L_0``, (4, 4).
+        frame_offsets: ``F_k``, (n_chain, 4, 4).
+        link_offsets: ``G_k``, (n_chain, 4, 4).
+        base: The base transform ``B``, (4, 4).
+        tool: The tool transform, (4, 4).
+        coordinates: The independent coordinates (n) with their limits.
+        coupling: ``q_chain = M q + c``, an AffineMap (n_chain x n).
+    """
+
+    joints: tuple[Joint, ...]
+    head: np.ndarray
+    frame_offsets: np.ndarray
+    link_offsets: np.ndarray
+    base: np.ndarray = field(default_factory=lambda: np.eye(4))
+    tool: np.ndarray = field(default_factory=lambda: np.eye(4))
+    coordinates: tuple[Joint, ...] | None = None
+    coupling: AffineMap | None = None
+
+    def __post_init__(self) -> None:
+        nc = len(self.joints)
+        names = [j.name for j in self.joints]
+        if len(set(names)) != nc:
+            dup = sorted({x for x in names if names.count(x) > 1})
+            raise ModelError(f"joint names must be unique, repeated: {dup}")
+        for attr, shape in (
+            ("head", (4, 4)),
+            ("frame_offsets", (nc, 4, 4)),
+            ("link_offsets", (nc, 4, 4)),
+            ("base", (4, 4)),
+            ("tool", (4, 4)),
+        ):
+            arr = np.asarray(getattr(self, attr), dtype=np.float64)
+            if arr.shape != shape:
+                raise ModelError(f"{attr} must have shape {shape}, got {arr.shape}")
+            if not np.isfinite(arr).all():
+                raise ModelError(f"{attr} holds a non-finite value")
+            object.__setattr__(self, attr, _ro(arr))
+        if self.coordinates is None:
+            object.__setattr__(self, "coordinates", tuple(self.joints))
+        n = len(self.coordinates)
+        if self.coupling is None:
+            if n != nc:
+                raise ModelError("a chain whose coordinates differ from its joints needs a coupling")
+            object.__setattr__(self, "coupling", AffineMap.identity(nc))
+        if self.coupling.matrix.shape != (nc, n):
+            raise ModelError(
+                f"coupling matrix must have shape ({nc}, {n}), got {self.coupling.matrix.shape}"
+            )
+        # Derived arrays for the compiled kernels.
+        consts = np.empty((nc + 1, 4, 4))
+        consts[0] = self.base @ self.head
+        for k in range(nc):
+            consts[k + 1] = self.frame_offsets[k] @ self.link_offsets[k]
+        consts[nc] = consts[nc] @ self.tool if nc else consts[0] @ self.tool
+        object.__setattr__(self, "_consts", _ro(consts))
+        object.__setattr__(
+            self, "_kind", _ro(np.array([j.kind == "prismatic" for j in self.joints], np.float64))
+        )
+        object.__setattr__(self, "_sign", _ro(np.array([j.sign for j in self.joints])))
+        object.__setattr__(self, "_offset", _ro(np.array([j.offset for j in self.joints])))
+        lim = np.array([c.limits for c in self.coordinates], dtype=np.float64).reshape(n, 2)
+        object.__setattr__(self, "_limits", _ro(lim))
+
+    @property
+    def n(self) -> int:
+        """Number of independent joint coordinates."""
+        return len(self.coordinates)
+
+    @property
+    def n_chain(self) -> int:
+        """Number of chain joints (independent plus dependent)."""
+        return len(self.joints)
+
+    @property
+    def limits(self) -> np.ndarray:
+        """Limits of the independent coordinates, (n, 2), SI units (read-only)."""
+        return self._limits
+
+    @property
+    def is_revolute(self) -> np.ndarray:
+        """Boolean (n,): which independent coordinates are angles."""
+        return np.array([c.kind == "revolute" for c in self.coordinates])
+
+    def chain_values(self, q: np.ndarray) -> np.ndarray:
+        """Chain joint values ``M q + c``: (..., n) -> (..., n_chain)."""
+        return self.coupling.apply(q)
+
+    def replace(self, **changes) -> Chain:
+        """A copy with some fields replaced (e.g. ``base=`` or ``tool=``)."""
+        kw = {
+            "joints": self.joints,
+            "head": self.head,
+            "frame_offsets": self.frame_offsets,
+            "link_offsets": self.link_offsets,
+            "base": self.base,
+            "tool": self.tool,
+            "coordinates": self.coordinates,
+            "coupling": self.coupling,
+        }
+        kw.update(changes)
+        return Chain(**kw)
+
+
+class ChainBuilder:
+    """Assemble a Chain from constants and joints in order.
+
+    Call :meth:`constant` for fixed transforms, :meth:`joint` for a joint, and
+    :meth:`frame` to mark where the link frame of the last joint sits (by default it
+    is marked right before the next joint, or at the end).
+    """
+
+    def __init__(self) -> None:
+        self._head = np.eye(4)
+        self._joints: list[Joint] = []
+        self._F: list[np.ndarray] = []
+        self._G: list[np.ndarray] = []
+        self._marked = True  # no joint yet: constants go to the head
+
+    def constant(self, T: np.ndarray) -> ChainBuilder:
+        """Append a constant transform (4, 4)."""
+        T = np.asarray(T, dtype=np.float64)
+        if not self._joints:
+            self._head = self._head @ T
+        elif not self._marked:
+            self._F[-1] = self._F[-1] @ T
+        else:
+            self._G[-1] = self._G[-1] @ T
+        return self
+
+    def joint(self, joint: Joint) -> ChainBuilder:
+        """Append a joint moving about / along the current local z axis."""
+        self._marked = False
+        self._joints.append(joint)
+        self._F.append(np.eye(4))
+        self._G.append(np.eye(4))
+        return self
+
+    def frame(self) -> ChainBuilder:
+        """Mark the current position as the link frame of the last joint."""
+        self._marked = True
+        return self
+
+    def build(
+        self,
+        *,
+        base: np.ndarray | None = None,
+        tool: np.ndarray | None = None,
+        coordinates: tuple[Joint, ...] | None = None,
+        coupling: AffineMap | None = None,
+    ) -> Chain:
+        """The finished chain."""
+        if not self._joints:
+            raise ModelError("a robot needs at least one joint")
+        return Chain(
+            joints=tuple(self._joints),
+            head=self._head,
+            frame_offsets=np.array(self._F),
+            link_offsets=np.array(self._G),
+            base=np.eye(4) if base is None else base,
+            tool=np.eye(4) if tool is None else tool,
+            coordinates=coordinates,
+            coupling=coupling,
+        )

@@ -1,0 +1,317 @@
+"""The Robot: a canonical chain plus its name, source, actuators and geometry.
+
+A Robot is immutable; ``with_tool`` / ``with_base`` / ``replace`` return new ones.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from robokin._validation import check_transform
+from robokin.exceptions import InputError
+from robokin.kinematics import forward, jacobian as _jac
+from robokin.model.chain import Chain
+from robokin.model.coupling import AffineMap
+
+if TYPE_CHECKING:
+    from robokin.kinematics.ik.solutions import SolutionSet
+
+__all__ = ["Robot"]
+
+Space = Literal["joint", "actuator"]
+
+
+class Robot:
+    """A serial manipulator.
+
+    Attributes:
+        chain: The canonical chain (:class:`robokin.model.chain.Chain`).
+        name: The robot's name.
+        source: Where its parameters come from (citation), may be empty.
+        actuators: ``q = A phi + b`` from motor to joint coordinates, or None.
+        actuator_names: Names of the motor coordinates (m), or None.
+        actuator_limits: Motor limits (m, 2), SI units, or None.
+        geometry: Link and tool shapes (see ``robokin.model.geometry``), or None.
+        path: The robot file it was loaded from, or None.
+        meta: Free-form extra fields from the robot file (read-only use).
+    """
+
+    def __init__(
+        self,
+        chain: Chain,
+        *,
+        name: str = "robot",
+        source: str = "",
+        actuators: AffineMap | None = None,
+        actuator_names: Sequence[str] | None = None,
+        actuator_limits: npt.ArrayLike | None = None,
+        geometry: Any = None,
+        path: str | Path | None = None,
+        meta: Mapping[str, Any] | None = None,
+    ) -> None:
+        self.chain = chain
+        self.name = name
+        self.source = source
+        if actuators is not None and actuators.n_out != chain.n:
+            raise InputError(
+                "actuators",
+                f"maps {actuators.n_in} motors to {actuators.n_out} joints, "
+                f"but the robot has {chain.n} joints",
+            )
+        self.actuators = actuators
+        m = None if actuators is None else actuators.n_in
+        self.actuator_names = (
+            None if actuators is None
+            else tuple(actuator_names or (f"motor{i + 1}" for i in range(m)))
+        )
+        if actuator_limits is not None:
+            lim = np.array(actuator_limits, dtype=float).reshape(-1, 2)
+            lim.setflags(write=False)
+            actuator_limits = lim
+        elif actuators is not None:
+            actuator_limits = np.tile([-np.inf, np.inf], (m, 1))
+        self.actuator_limits = actuator_limits
+        self.geometry = geometry
+        self.path = None if path is None else Path(path)
+        self.meta = dict(meta or {})
+
+    # ------------------------------------------------------------------ building
+    @classmethod
+    def from_dh(
+        cls,
+        rows: Sequence[Mapping[str, Any]],
+        convention: Literal["standard", "modified"] = "standard",
+        *,
+        base: npt.ArrayLike | None = None,
+        tool: npt.ArrayLike | None = None,
+        name: str = "robot",
+        coordinates: Sequence[Mapping[str, Any]] | None = None,
+    ) -> Robot:
+        """Build from a DH table in SI units (see :mod:`robokin.model.dh`)."""
+        from robokin.model.dh import chain_from_dh
+
+        base = None if base is None else check_transform(base, "base")
+        tool = None if tool is None else check_transform(tool, "tool")
+        chain = chain_from_dh(rows, convention, base=base, tool=tool, coordinates=coordinates)
+        return cls(chain, name=name)
+
+    @classmethod
+    def from_elementary(
+        cls,
+        ops: Sequence[Mapping[str, Any]],
+        *,
+        base: npt.ArrayLike | None = None,
+        tool: npt.ArrayLike | None = None,
+        name: str = "robot",
+        coordinates: Sequence[Mapping[str, Any]] | None = None,
+    ) -> Robot:
+        """Build from elementary Rot/Trans operators (see :mod:`robokin.model.dh`)."""
+        from robokin.model.dh import chain_from_elementary
+
+        base = None if base is None else check_transform(base, "base")
+        tool = None if tool is None else check_transform(tool, "tool")
+        chain = chain_from_elementary(ops, base=base, tool=tool, coordinates=coordinates)
+        return cls(chain, name=name)
+
+    @classmethod
+    def from_urdf(
+        cls, path: str | Path, base_link: str | None = None, tip_link: str | None = None,
+        **kwargs: Any,
+    ) -> Robot:
+        """Load the serial chain of a URDF file (needs ``robokin[urdf]``)."""
+        from robokin.model.urdf import robot_from_urdf
+
+        return robot_from_urdf(path, base_link=base_link, tip_link=tip_link, **kwargs)
+
+    def to_urdf(self, **kwargs: Any) -> str:
+        """A URDF string with the same FK, limits and geometry."""
+        from robokin.model.urdf import urdf_from_robot
+
+        return urdf_from_robot(self, **kwargs)
+
+    def replace(self, **changes: Any) -> Robot:
+        """A copy with some attributes replaced (``chain``, ``name``, ``geometry``, ...)."""
+        kw = {
+            "chain": self.chain,
+            "name": self.name,
+            "source": self.source,
+            "actuators": self.actuators,
+            "actuator_names": self.actuator_names,
+            "actuator_limits": self.actuator_limits,
+            "geometry": self.geometry,
+            "path": self.path,
+            "meta": self.meta,
+        }
+        kw.update(changes)
+        chain = kw.pop("chain")
+        return Robot(chain, **kw)
+
+    def with_tool(self, tool: npt.ArrayLike) -> Robot:
+        """A copy with the tool transform (4, 4) [m] replaced."""
+        return self.replace(chain=self.chain.replace(tool=check_transform(tool, "tool")))
+
+    def with_base(self, base: npt.ArrayLike) -> Robot:
+        """A copy with the base transform (4, 4) [m] replaced."""
+        return self.replace(chain=self.chain.replace(base=check_transform(base, "base")))
+
+    # ---------------------------------------------------------------- properties
+    @property
+    def n(self) -> int:
+        """Number of independent joint coordinates."""
+        return self.chain.n
+
+    @property
+    def n_chain(self) -> int:
+        """Number of chain joints, dependent ones included."""
+        return self.chain.n_chain
+
+    @property
+    def limits(self) -> np.ndarray:
+        """Joint limits (n, 2) in SI units."""
+        return self.chain.limits
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Names of the independent joint coordinates."""
+        return tuple(c.name for c in self.chain.coordinates)
+
+    @property
+    def is_revolute(self) -> np.ndarray:
+        """(n,) bool: which coordinates are angles (wrap) rather than lengths."""
+        return self.chain.is_revolute
+
+    @property
+    def base(self) -> np.ndarray:
+        """Base transform (4, 4)."""
+        return self.chain.base
+
+    @property
+    def tool(self) -> np.ndarray:
+        """Tool transform (4, 4)."""
+        return self.chain.tool
+
+    def __repr__(self) -> str:
+        return f"Robot(name={self.name!r}, n={self.n})"
+
+    # --------------------------------------------------------------- kinematics
+    def _to_joints(self, q: npt.ArrayLike, space: Space, name: str) -> npt.ArrayLike:
+        if space == "joint":
+            return q
+        if space != "actuator":
+            raise InputError("space", f"expected 'joint' or 'actuator', got {space!r}")
+        return self.joints_from_actuators(q)
+
+    def fk(self, q: npt.ArrayLike, *, space: Space = "joint") -> np.ndarray:
+        """Tool pose in the world frame.
+
+        Args:
+            q: Joint coordinates [rad, m], shape (..., n); motor coordinates
+                (..., m) when ``space="actuator"``.
+            space: ``"joint"`` or ``"actuator"``.
+
+        Returns:
+            Poses (..., 4, 4).
+        """
+        if space == "joint":  # fast path
+            return forward.forward_kinematics(self.chain, q)
+        return forward.forward_kinematics(self.chain, self._to_joints(q, space, "phi"))
+
+    def fk_all(self, q: npt.ArrayLike, *, space: Space = "joint") -> np.ndarray:
+        """Base frame then every link frame, (..., n_chain + 1, 4, 4)."""
+        return forward.forward_kinematics_all(self.chain, self._to_joints(q, space, "phi"))
+
+    def jacobian(
+        self, q: npt.ArrayLike, *, frame: Literal["base", "tool"] = "base",
+        space: Space = "joint",
+    ) -> np.ndarray:
+        """Geometric Jacobian (..., 6, n) ``[v; w]``; (..., 6, m) in actuator space."""
+        if space == "actuator":
+            J = _jac.jacobian(self.chain, self.joints_from_actuators(q), frame=frame)
+            return J @ self.actuators.matrix
+        return _jac.jacobian(self.chain, self._to_joints(q, space, "q"), frame=frame)
+
+    def manipulability(self, q: npt.ArrayLike) -> np.ndarray:
+        """Yoshikawa manipulability, (...)."""
+        return _jac.manipulability(self.chain, q)
+
+    def is_singular(self, q: npt.ArrayLike, tol: float = 1e-6) -> np.ndarray:
+        """True where the smallest Jacobian singular value is below ``tol``, (...)."""
+        return _jac.is_singular(self.chain, q, tol)
+
+    def ik(
+        self,
+        T: npt.ArrayLike,
+        q_near: npt.ArrayLike | None = None,
+        method: Literal["auto", "analytic", "numeric"] = "auto",
+        *,
+        space: Space = "joint",
+        **options: Any,
+    ) -> SolutionSet:
+        """Every joint solution that puts the tool at ``T``.
+
+        Args:
+            T: Target poses (..., 4, 4) in the world frame.
+            q_near: The current configuration (..., n), used for the wrist
+                singularity and by ``.nearest``; optional.
+            method: ``"auto"`` (closed form when the arm has one, else numeric),
+                ``"analytic"`` or ``"numeric"``.
+            space: ``"actuator"`` returns motor coordinates (and takes ``q_near``
+                in motor coordinates).
+            **options: Passed to the solver.
+
+        Returns:
+            A :class:`~robokin.kinematics.ik.solutions.SolutionSet`.
+        """
+        from robokin.kinematics.ik import solve
+
+        if space == "actuator":
+            if q_near is not None:
+                q_near = self.joints_from_actuators(q_near)
+            sols = solve(self, T, q_near=q_near, method=method, **options)
+            return sols.to_actuator_space(self)
+        if space != "joint":
+            raise InputError("space", f"expected 'joint' or 'actuator', got {space!r}")
+        return solve(self, T, q_near=q_near, method=method, **options)
+
+    # ---------------------------------------------------------------- actuators
+    def actuators_from_joints(self, q: npt.ArrayLike) -> np.ndarray:
+        """Motor coordinates ``phi = A^+ (q - b)``: (..., n) -> (..., m).
+
+        The identity when the robot has no actuator map.
+        """
+        from robokin._validation import check_finite, check_joints
+
+        q = check_finite(check_joints(q, self.n, "q"), "q")
+        if self.actuators is None:
+            return q.copy()
+        return self.actuators.inverse(q, what=f"actuator map of '{self.name}'")
+
+    def joints_from_actuators(self, phi: npt.ArrayLike) -> np.ndarray:
+        """Joint coordinates ``q = A phi + b``: (..., m) -> (..., n)."""
+        from robokin._validation import check_finite, check_joints
+
+        m = self.n if self.actuators is None else self.actuators.n_in
+        phi = check_finite(check_joints(phi, m, "phi"), "phi")
+        if self.actuators is None:
+            return phi.copy()
+        return self.actuators.apply(phi)
+
+    # ------------------------------------------------------------------- checks
+    def within_limits(self, q: npt.ArrayLike, tol: float = 1e-9) -> np.ndarray:
+        """(...) bool: every coordinate inside its limits (with tolerance ``tol``)."""
+        from robokin._validation import check_joints
+
+        q = check_joints(q, self.n, "q")
+        lim = self.limits
+        return ((q >= lim[:, 0] - tol) & (q <= lim[:, 1] + tol)).all(axis=-1)
+
+    def plot(self, q: npt.ArrayLike, **kwargs: Any):
+        """Draw the arm at ``q`` as a 3D stick-and-frame figure (matplotlib)."""
+        from robokin.viz.plots import plot_robot
+
+        return plot_robot(self, q, **kwargs)

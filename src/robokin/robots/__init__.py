@@ -1,0 +1,38 @@
+"""The built-in robot library: one robot file per arm in this folder."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from robokin.exceptions import ModelError
+
+__all__ = ["load", "names", "path"]
+
+_HERE = Path(__file__).parent
+
+
+def names() -> list[str]:
+    """Names of the built-in robots, sorted."""
+    return sorted(p.stem for p in _HERE.glob("*.yaml"))
+
+
+def path(name: str) -> Path:
+    """The robot file of a built-in robot.
+
+    Raises:
+        ModelError: unknown name; the message lists the known ones.
+    """
+    p = _HERE / f"{name}.yaml"
+    if not p.is_file():
+        raise ModelError(f"unknown robot {name!r}; built-in robots: {', '.join(names())}")
+    return p
+
+
+def load(name_or_path):
+    """Load a built-in robot by name, or a robot file by path."""
+    from robokin.model.files import load_robot
+
+    s = str(name_or_path)
+    if isinstance(name_or_path, Path) or s.endswith((".yaml", ".yml")) or "/" in s:
+        return load_robot(Path(name_or_path))
+    return load_robot(path(s))

@@ -1,0 +1,197 @@
+"""SE(3) helpers on batches of 4x4 homogeneous transforms.
+
+Every function takes any leading batch shape ``(...)`` and returns the same leading
+shape. Angles are radians, lengths metres. Rotation conversions go through
+``scipy.spatial.transform.Rotation`` (imported lazily). Conventions are listed in
+``docs/conventions.md``: RPY is roll about x, then pitch about y, then yaw about z,
+all about the fixed (base) axes, i.e. ``R = Rz(yaw) @ Ry(pitch) @ Rx(roll)``;
+quaternions are ``(w, x, y, z)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "axis_angle_from_matrix",
+    "invert",
+    "matrix_from_axis_angle",
+    "matrix_from_quaternion",
+    "matrix_from_rpy",
+    "pose_error",
+    "pose_from_xyz_rpy",
+    "quaternion_from_matrix",
+    "rotx",
+    "roty",
+    "rotz",
+    "rpy_from_matrix",
+    "trans",
+    "xyz_rpy_from_pose",
+]
+
+
+def _rot(angle: npt.ArrayLike, i: int, j: int) -> np.ndarray:
+    a = np.asarray(angle, dtype=np.float64)
+    T = np.zeros(a.shape + (4, 4))
+    c, s = np.cos(a), np.sin(a)
+    k = 3 - i - j
+    T[..., k, k] = 1.0
+    T[..., 3, 3] = 1.0
+    T[..., i, i] = c
+    T[..., j, j] = c
+    T[..., i, j] = -s
+    T[..., j, i] = s
+    return T
+
+
+def rotx(angle: npt.ArrayLike) -> np.ndarray:
+    """Rotation about x by ``angle`` [rad], shape (...) -> (..., 4, 4)."""
+    return _rot(angle, 1, 2)
+
+
+def roty(angle: npt.ArrayLike) -> np.ndarray:
+    """Rotation about y by ``angle`` [rad], shape (...) -> (..., 4, 4)."""
+    return _rot(angle, 2, 0)
+
+
+def rotz(angle: npt.ArrayLike) -> np.ndarray:
+    """Rotation about z by ``angle`` [rad], shape (...) -> (..., 4, 4)."""
+    return _rot(angle, 0, 1)
+
+
+def trans(x: npt.ArrayLike, y: npt.ArrayLike = 0.0, z: npt.ArrayLike = 0.0) -> np.ndarray:
+    """Pure translation [m].
+
+    Args:
+        x: Either the x offset, shape (...), or a vector ``(..., 3)`` when y and z
+            are omitted.
+        y: The y offset, shape (...).
+        z: The z offset, shape (...).
+
+    Returns:
+        Transforms of shape (..., 4, 4).
+    """
+    x = np.asarray(x, dtype=np.float64)
+    if x.ndim >= 1 and x.shape[-1] == 3 and np.ndim(y) == 0 and np.ndim(z) == 0 and (
+        y == 0.0 and z == 0.0
+    ):
+        xyz = x
+    else:
+        xyz = np.stack(np.broadcast_arrays(x, np.asarray(y, float), np.asarray(z, float)), -1)
+    T = np.zeros(xyz.shape[:-1] + (4, 4))
+    T[..., 0, 0] = T[..., 1, 1] = T[..., 2, 2] = T[..., 3, 3] = 1.0
+    T[..., :3, 3] = xyz
+    return T
+
+
+def invert(T: npt.ArrayLike) -> np.ndarray:
+    """Inverse of rigid transforms, (..., 4, 4) -> (..., 4, 4), using R^T."""
+    T = np.asarray(T, dtype=np.float64)
+    out = np.zeros_like(T)
+    Rt = np.swapaxes(T[..., :3, :3], -1, -2)
+    out[..., :3, :3] = Rt
+    out[..., :3, 3] = -np.einsum("...ij,...j->...i", Rt, T[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def _rotation():
+    from scipy.spatial.transform import Rotation
+
+    return Rotation
+
+
+def _from_R(R: np.ndarray) -> np.ndarray:
+    T = np.zeros(R.shape[:-2] + (4, 4))
+    T[..., :3, :3] = R
+    T[..., 3, 3] = 1.0
+    return T
+
+
+def _apply(fn, x: np.ndarray, width: int) -> np.ndarray:
+    """Run a scipy Rotation constructor on a batch of any leading shape."""
+    lead = x.shape[:-1]
+    R = fn(x.reshape(-1, width)).as_matrix().reshape(lead + (3, 3))
+    return _from_R(R)
+
+
+def _as(fn_name: str, T: np.ndarray, **kw) -> np.ndarray:
+    T = np.asarray(T, dtype=np.float64)
+    lead = T.shape[:-2]
+    rot = _rotation().from_matrix(T[..., :3, :3].reshape(-1, 3, 3))
+    out = getattr(rot, fn_name)(**kw)
+    return out.reshape(lead + out.shape[1:])
+
+
+def matrix_from_rpy(rpy: npt.ArrayLike) -> np.ndarray:
+    """Rotation ``Rz(yaw) Ry(pitch) Rx(roll)`` as a transform; (..., 3) -> (..., 4, 4)."""
+    rpy = np.asarray(rpy, dtype=np.float64)
+    return _apply(lambda x: _rotation().from_euler("xyz", x), rpy, 3)
+
+
+def rpy_from_matrix(T: npt.ArrayLike) -> np.ndarray:
+    """Roll, pitch, yaw [rad] of the rotation block; (..., 4, 4) -> (..., 3)."""
+    import warnings
+
+    with warnings.catch_warnings():  # gimbal lock: scipy warns and sets roll = 0
+        warnings.simplefilter("ignore", UserWarning)
+        return _as("as_euler", T, seq="xyz")
+
+
+def pose_from_xyz_rpy(xyz: npt.ArrayLike, rpy: npt.ArrayLike) -> np.ndarray:
+    """Pose from a position [m] (..., 3) and roll-pitch-yaw [rad] (..., 3)."""
+    T = matrix_from_rpy(rpy)
+    xyz = np.asarray(xyz, dtype=np.float64)
+    T, xyz = np.broadcast_to(T, np.broadcast_shapes(T.shape, xyz.shape[:-1] + (4, 4))).copy(), xyz
+    T[..., :3, 3] = xyz
+    return T
+
+
+def xyz_rpy_from_pose(T: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """Position (..., 3) [m] and roll-pitch-yaw (..., 3) [rad] of a pose."""
+    T = np.asarray(T, dtype=np.float64)
+    return T[..., :3, 3].copy(), rpy_from_matrix(T)
+
+
+def matrix_from_quaternion(wxyz: npt.ArrayLike) -> np.ndarray:
+    """Rotation from unit quaternions ``(w, x, y, z)``; (..., 4) -> (..., 4, 4)."""
+    q = np.asarray(wxyz, dtype=np.float64)
+    return _apply(lambda x: _rotation().from_quat(x[:, [1, 2, 3, 0]]), q, 4)
+
+
+def quaternion_from_matrix(T: npt.ArrayLike) -> np.ndarray:
+    """Unit quaternion ``(w, x, y, z)`` with w >= 0; (..., 4, 4) -> (..., 4)."""
+    xyzw = _as("as_quat", T, canonical=True)
+    return xyzw[..., [3, 0, 1, 2]]
+
+
+def matrix_from_axis_angle(rotvec: npt.ArrayLike) -> np.ndarray:
+    """Rotation from a rotation vector (axis times angle [rad]); (..., 3) -> (..., 4, 4)."""
+    v = np.asarray(rotvec, dtype=np.float64)
+    return _apply(lambda x: _rotation().from_rotvec(x), v, 3)
+
+
+def axis_angle_from_matrix(T: npt.ArrayLike) -> np.ndarray:
+    """Rotation vector (axis times angle [rad], angle in [0, pi]); (..., 4, 4) -> (..., 3)."""
+    return _as("as_rotvec", T)
+
+
+def pose_error(current: npt.ArrayLike, target: npt.ArrayLike) -> np.ndarray:
+    """The 6-vector that takes ``current`` to ``target``, both expressed in the base frame.
+
+    Args:
+        current: Poses (..., 4, 4).
+        target: Poses (..., 4, 4), broadcast against ``current``.
+
+    Returns:
+        ``(..., 6)``: position difference ``p_target - p_current`` [m], then the
+        rotation vector of ``R_target @ R_current.T`` [rad] (base frame).
+    """
+    current = np.asarray(current, dtype=np.float64)
+    target = np.asarray(target, dtype=np.float64)
+    dp = target[..., :3, 3] - current[..., :3, 3]
+    dR = target[..., :3, :3] @ np.swapaxes(current[..., :3, :3], -1, -2)
+    lead = dR.shape[:-2]
+    w = _rotation().from_matrix(dR.reshape(-1, 3, 3)).as_rotvec().reshape(lead + (3,))
+    return np.concatenate([np.broadcast_to(dp, lead + (3,)), w], axis=-1)
