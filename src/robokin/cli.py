@@ -169,7 +169,8 @@ def _register_extra_commands() -> None:
     import importlib
 
     for mod in ("robokin.cli_ik", "robokin.cli_motion", "robokin.cli_urdf",
-                "robokin.cli_collision", "robokin.cli_view"):
+                "robokin.cli_collision", "robokin.cli_view", "robokin.cli_actuators",
+                "robokin.cli_workspace"):
         try:
             importlib.import_module(mod)
         except ModuleNotFoundError as exc:
