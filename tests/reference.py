@@ -1,0 +1,51 @@
+"""Independent reference implementations for the tests (plain numpy, no robokin)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def dh_standard(rows, q):
+    """Hand-written standard DH product: rows of (theta0, d, a, alpha, kind)."""
+    T = np.eye(4)
+    qi = iter(q)
+    for theta, d, a, alpha, kind in rows:
+        if kind == "r":
+            theta = theta + next(qi)
+        elif kind == "p":
+            d = d + next(qi)
+        ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
+        A = np.array([
+            [ct, -st * ca, st * sa, a * ct],
+            [st, ct * ca, -ct * sa, a * st],
+            [0, sa, ca, d],
+            [0, 0, 0, 1.0],
+        ])
+        T = T @ A
+    return T
+
+
+def dh_modified(rows, q):
+    """Hand-written modified (Craig) DH product: rows of (alpha_prev, a_prev, theta0, d, kind)."""
+    T = np.eye(4)
+    qi = iter(q)
+    for alpha, a, theta, d, kind in rows:
+        if kind == "r":
+            theta = theta + next(qi)
+        elif kind == "p":
+            d = d + next(qi)
+        ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
+        A = np.array([
+            [ct, -st, 0, a],
+            [st * ca, ct * ca, -sa, -sa * d],
+            [st * sa, ct * sa, ca, ca * d],
+            [0, 0, 0, 1.0],
+        ])
+        T = T @ A
+    return T
+
+
+def random_q(robot, rng, size=()):
+    """Random configurations inside the limits (unlimited angles drawn in +-pi)."""
+    lim = np.where(np.isfinite(robot.limits), robot.limits, np.clip(robot.limits, -np.pi, np.pi))
+    return rng.uniform(lim[:, 0], lim[:, 1], size=tuple(np.atleast_1d(size)) + (robot.n,))

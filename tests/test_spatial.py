@@ -1,0 +1,69 @@
+"""spatial.py against scipy and against closed-form values."""
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from robokin import spatial as sp
+
+
+def test_elementary_rotations_match_closed_form():
+    a = 0.3
+    c, s = np.cos(a), np.sin(a)
+    np.testing.assert_allclose(sp.rotz(a)[:3, :3], [[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    np.testing.assert_allclose(sp.rotx(a)[:3, :3], [[1, 0, 0], [0, c, -s], [0, s, c]])
+    np.testing.assert_allclose(sp.roty(a)[:3, :3], [[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+
+@pytest.mark.parametrize("shape", [(), (7,), (3, 5)])
+def test_batch_shapes(shape, rng):
+    a = rng.uniform(-3, 3, shape)
+    assert sp.rotx(a).shape == shape + (4, 4)
+    xyz = rng.normal(size=shape + (3,))
+    T = sp.trans(xyz)
+    assert T.shape == shape + (4, 4)
+    np.testing.assert_array_equal(T[..., :3, 3], xyz)
+    rpy = rng.uniform(-1, 1, shape + (3,))
+    P = sp.pose_from_xyz_rpy(xyz, rpy)
+    assert P.shape == shape + (4, 4)
+    Pi = sp.invert(P)
+    np.testing.assert_allclose(P @ Pi, np.broadcast_to(np.eye(4), shape + (4, 4)), atol=1e-12)
+
+
+def test_rpy_is_fixed_axis_xyz(rng):
+    rpy = rng.uniform(-1, 1, (20, 3))
+    T = sp.matrix_from_rpy(rpy)
+    expected = sp.rotz(rpy[:, 2]) @ sp.roty(rpy[:, 1]) @ sp.rotx(rpy[:, 0])
+    np.testing.assert_allclose(T, expected, atol=1e-12)
+    np.testing.assert_allclose(sp.rpy_from_matrix(T), rpy, atol=1e-12)
+
+
+def test_quaternion_is_wxyz_and_round_trips(rng):
+    q = rng.normal(size=(10, 4))
+    q /= np.linalg.norm(q, axis=-1, keepdims=True)
+    q[q[:, 0] < 0] *= -1
+    T = sp.matrix_from_quaternion(q)
+    R = Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_matrix()
+    np.testing.assert_allclose(T[:, :3, :3], R, atol=1e-12)
+    np.testing.assert_allclose(sp.quaternion_from_matrix(T), q, atol=1e-12)
+    np.testing.assert_allclose(sp.quaternion_from_matrix(np.eye(4)), [1, 0, 0, 0])
+
+
+def test_axis_angle_round_trip(rng):
+    v = rng.normal(size=(10, 3))
+    v *= (rng.uniform(0, np.pi - 1e-3, 10) / np.linalg.norm(v, axis=-1))[:, None]
+    np.testing.assert_allclose(sp.axis_angle_from_matrix(sp.matrix_from_axis_angle(v)), v,
+                               atol=1e-12)
+    np.testing.assert_allclose(sp.matrix_from_axis_angle([0, 0, 0.5]), sp.rotz(0.5), atol=1e-15)
+
+
+def test_pose_error_known_values():
+    A = sp.trans(1.0, 2.0, 3.0)
+    B = sp.trans(1.5, 2.0, 2.0) @ sp.rotz(0.25)
+    e = sp.pose_error(A, B)
+    np.testing.assert_allclose(e, [0.5, 0.0, -1.0, 0.0, 0.0, 0.25], atol=1e-15)
+    # the rotation part is in the base frame: rotate both by a base rotation
+    R = sp.rotx(0.7)
+    e2 = sp.pose_error(R @ A, R @ B)
+    np.testing.assert_allclose(e2[3:], R[:3, :3] @ [0, 0, 0.25], atol=1e-12)
+    assert sp.pose_error(np.stack([A, B]), B).shape == (2, 6)
