@@ -73,10 +73,12 @@ def jacobian(
 
 
 def manipulability(chain: Chain, q: npt.ArrayLike) -> np.ndarray:
-    """Yoshikawa's measure ``sqrt(det(J J^T))`` (for n < 6: ``sqrt(det(J^T J))``), (...)."""
-    J = jacobian(chain, q)
-    G = J @ np.swapaxes(J, -1, -2) if J.shape[-1] >= 6 else np.swapaxes(J, -1, -2) @ J
-    return np.sqrt(np.clip(np.linalg.det(G), 0.0, None))
+    """Yoshikawa's measure ``sqrt(det(J J^T))`` (for n < 6: ``sqrt(det(J^T J))``), (...).
+
+    Computed as the product of the ``min(6, n)`` singular values, which equals the
+    determinant form and stays accurate near singularities.
+    """
+    return np.prod(np.linalg.svd(jacobian(chain, q), compute_uv=False), axis=-1)
 
 
 def min_singular_value(chain: Chain, q: npt.ArrayLike) -> np.ndarray:

@@ -35,7 +35,7 @@ Convention = Literal["standard", "modified"]
 _DH_KEYS = {"a", "alpha", "d", "theta", "joint", "limits", "sign", "name", "depends",
             "depends_offset"}
 _ELEM_KEYS = {"op", "value", "joint", "limits", "sign", "name", "depends", "depends_offset"}
-_OPS = {"rx", "ry", "rz", "tx", "ty", "tz"}
+_OPS = {"rx", "ry", "rz", "tx", "ty", "tz", "frame"}
 
 
 def _num(row: Mapping, key: str, where: str, default: float | None = 0.0) -> float:
@@ -251,7 +251,8 @@ def chain_from_elementary(
     Each op is ``{"op": "rx"|"ry"|"rz"|"tx"|"ty"|"tz", "value": v}`` for a constant,
     or ``{"op": ..., "joint": "revolute"|"prismatic", "name", "limits", "sign",
     "value"}`` for a joint (``value`` is then its zero offset). Rotations are about
-    the current (moving) axes. A joint's link frame is the frame right after it.
+    the current (moving) axes. A joint's link frame is the frame right after it,
+    unless a ``{"op": "frame"}`` marker before the next joint places it there.
 
     Raises:
         ModelError: naming ``ops[i].field`` and the reason.
@@ -260,12 +261,23 @@ def chain_from_elementary(
         raise ModelError("the elementary sequence must be a list of operations", field="ops")
     asm = _Assembler(coordinates, "ops")
     b = asm.builder
+    # Joints followed by an explicit frame marker get their link frame there.
+    explicit_frame: set[int] = set()
+    last_joint = None
+    for i, op in enumerate(ops):
+        if isinstance(op, Mapping) and op.get("joint", "fixed") != "fixed":
+            last_joint = i
+        elif isinstance(op, Mapping) and op.get("op") == "frame" and last_joint is not None:
+            explicit_frame.add(last_joint)
     for i, op in enumerate(ops):
         where = f"joints[{i}]"
         op = _check_row(op, where, _ELEM_KEYS)
         name = op.get("op")
         if name not in _OPS:
             raise ModelError(f"op must be one of {sorted(_OPS)}, got {name!r}", field=f"{where}.op")
+        if name == "frame":
+            b.frame()
+            continue
         value = _num(op, "value", where)
         axis = name[1]
         is_rot = name[0] == "r"
@@ -286,5 +298,7 @@ def chain_from_elementary(
         A = _TO_AXIS[axis]
         b.constant(A)
         asm.add_joint(op, kind, value, where, i)
-        b.constant(A.T.copy()).frame()
+        b.constant(A.T.copy())
+        if i not in explicit_frame:
+            b.frame()
     return asm.build(base, tool)

@@ -86,7 +86,7 @@ def _schema():
         _lim = field_validator("limits")(_check_limits)
 
     class Op(Strict):
-        op: Literal["rx", "ry", "rz", "tx", "ty", "tz"]
+        op: Literal["rx", "ry", "rz", "tx", "ty", "tz", "frame"]
         value: float = 0.0
         name: str | None = None
         joint: Literal["revolute", "prismatic", "fixed"] = "fixed"
@@ -198,6 +198,9 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
         if elementary:
             is_rot = r.op[0] == "r"
             d["value"] = r.value * (A if is_rot else L)
+            if r.op == "frame":
+                si_rows.append({"op": "frame"})
+                continue
         else:
             for key, s in (("a", L), ("d", L), ("alpha", A), ("theta", A)):
                 d[key] = getattr(r, key) * s
@@ -347,7 +350,11 @@ def _elementary_document(robot: Robot) -> dict[str, Any]:
         elif all(np.isfinite(j.limits)):
             op["limits"] = list(j.limits)
         ops.append(op)
-        ops += const_ops(chain.frame_offsets[k] @ chain.link_offsets[k])
+        F = chain.frame_offsets[k]
+        if np.allclose(F, np.eye(4), atol=1e-15):
+            ops += const_ops(chain.link_offsets[k])
+        else:
+            ops += const_ops(F) + [{"op": "frame"}] + const_ops(chain.link_offsets[k])
     doc: dict[str, Any] = {
         "name": robot.name,
         "source": robot.source,

@@ -1,0 +1,76 @@
+"""Batch forward kinematics: shapes, batch == loop, serial == parallel, input errors."""
+
+import numpy as np
+import pytest
+from reference import random_q
+
+import robokin
+from robokin.kinematics.forward import _PARALLEL_MIN, link_frames
+
+
+@pytest.mark.parametrize("shape", [(), (7,), (3, 5)])
+@pytest.mark.parametrize("name", ["ur5", "qfmd010", "improved_dh_arm"])
+def test_batch_shapes_and_batch_equals_loop(name, shape, rng):
+    robot = robokin.load(name)
+    q = random_q(robot, rng, shape) if shape else random_q(robot, rng)
+    T = robot.fk(q)
+    assert T.shape == shape + (4, 4)
+    F = robot.fk_all(q)
+    assert F.shape == shape + (robot.n_chain + 1, 4, 4)
+    flat_q = q.reshape(-1, robot.n)
+    loop = np.array([robot.fk(x) for x in flat_q]).reshape(T.shape)
+    np.testing.assert_array_equal(T, loop)
+    np.testing.assert_allclose(link_frames(robot.chain, q)[..., -1, :, :], T, atol=1e-15)
+    np.testing.assert_allclose(F[..., 0, :, :], np.broadcast_to(robot.base, shape + (4, 4)))
+
+
+def test_parallel_kernel_equals_serial(rng):
+    robot = robokin.load("panda")
+    q = random_q(robot, rng, _PARALLEL_MIN + 3)
+    big = robot.fk(q)
+    small = np.concatenate([robot.fk(q[i:i + 100]) for i in range(0, len(q), 100)])
+    np.testing.assert_array_equal(big, small)
+
+
+def test_lists_are_accepted():
+    robot = robokin.load("ur5")
+    np.testing.assert_array_equal(robot.fk([0, 0, 0, 0, 0, 0]), robot.fk(np.zeros(6)))
+    assert robot.fk([[0] * 6, [0.1] * 6]).shape == (2, 4, 4)
+
+
+@pytest.mark.parametrize(
+    ("q", "match"),
+    [
+        (np.zeros(5), r"argument 'q'.*\(\.\.\., 6\).*\(5,\)"),
+        (np.zeros((2, 7)), r"argument 'q'.*\(2, 7\)"),
+        (3.0, r"argument 'q'"),
+        ([0, 0, 0, np.nan, 0, 0], r"argument 'q'.*non-finite.*index \(3,\)"),
+        ([[0] * 6, [0, 0, 0, 0, 0, np.inf]], r"argument 'q'.*non-finite.*\(1, 5\)"),
+        (["a"] * 6, r"argument 'q'.*numbers"),
+    ],
+)
+def test_bad_q_gives_a_clear_error(q, match):
+    robot = robokin.load("ur5")
+    with pytest.raises(robokin.InputError, match=match):
+        robot.fk(q)
+    with pytest.raises(robokin.InputError, match=match):
+        robot.fk_all(q)
+    with pytest.raises(robokin.InputError, match=match):
+        robot.jacobian(q)
+
+
+def test_large_batch_nan_is_reported(rng):
+    robot = robokin.load("ur5")
+    q = random_q(robot, rng, 5000)
+    q[4321, 2] = np.nan
+    with pytest.raises(robokin.InputError, match=r"\(4321, 2\)"):
+        robot.fk(q)
+
+
+def test_fk_does_not_modify_its_input(rng):
+    robot = robokin.load("qfmd010")
+    q = random_q(robot, rng, 4)
+    before = q.copy()
+    robot.fk(q)
+    robot.jacobian(q)
+    np.testing.assert_array_equal(q, before)
