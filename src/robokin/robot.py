@@ -24,6 +24,8 @@ if TYPE_CHECKING:
 __all__ = ["Robot"]
 
 Space = Literal["joint", "actuator"]
+_F64 = np.dtype(np.float64)
+_SINGLE_FK: list = []  # the compiled single-configuration FK, loaded on first use
 
 
 class Robot:
@@ -217,9 +219,18 @@ class Robot:
         Returns:
             Poses (..., 4, 4).
         """
-        if space == "joint":  # fast path
-            return forward.forward_kinematics(self.chain, q)
-        return forward.forward_kinematics(self.chain, self._to_joints(q, space, "phi"))
+        chain = self.chain
+        if (space == "joint" and type(q) is np.ndarray and q.shape == chain._single_shape
+                and q.dtype is _F64):
+            # One configuration: the kernel's finiteness test is the validation.
+            if not _SINGLE_FK:
+                _SINGLE_FK.append(forward.single_kernel())
+            T = np.empty((4, 4))
+            if _SINGLE_FK[0](q, chain._packed, T):
+                return T
+        if space == "joint":
+            return forward.forward_kinematics(chain, q)
+        return forward.forward_kinematics(chain, self._to_joints(q, space, "phi"))
 
     def fk_all(self, q: npt.ArrayLike, *, space: Space = "joint") -> np.ndarray:
         """Base frame then every link frame, (..., n_chain + 1, 4, 4)."""

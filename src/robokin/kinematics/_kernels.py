@@ -3,7 +3,10 @@ to import, and ``import robokin`` must stay fast.
 
 Chain arrays (see :class:`robokin.model.chain.Chain`):
 ``consts`` (n_chain + 1, 4, 4) = ``[B L0, F1 G1, ..., Fn Gn T_tool]``;
-``kind`` (n_chain,) 1.0 for prismatic; ``sign``, ``offset`` (n_chain,).
+``xform`` (n_chain + 1, 6): ``[1, cos a, sin a, tx, ty, tz]`` when the constant is
+``Trans(tx, ty, tz) Rx(a)`` (every standard and modified DH row is), which halves
+the multiplications, else all zeros;
+``joints`` (3, n_chain): rows kind (1.0 = prismatic), sign, offset.
 A transform under construction is kept as its top 3x4 block.
 """
 
@@ -46,19 +49,39 @@ def _const_right(T, C):
 
 
 @njit(cache=True, inline="always")
-def _fk_one(q, consts, kind, sign, offset, T):
+def _const_x(T, C, P):
+    """T <- T @ C, using the Trans(tx, ty, tz) Rx(a) structure when P[0] == 1."""
+    if P[0] == 1.0:
+        ca = P[1]
+        sa = P[2]
+        tx = P[3]
+        ty = P[4]
+        tz = P[5]
+        for r in range(3):
+            a0 = T[r, 0]
+            a1 = T[r, 1]
+            a2 = T[r, 2]
+            T[r, 3] += a0 * tx + a1 * ty + a2 * tz
+            T[r, 1] = ca * a1 + sa * a2
+            T[r, 2] = ca * a2 - sa * a1
+    else:
+        _const_right(T, C)
+
+
+@njit(cache=True, inline="always")
+def _fk_one(q, consts, xform, joints, T):
     """Write FK of one chain configuration into T (4x4). Returns False on NaN/inf."""
     ok = True
     C0 = consts[0]
     for r in range(3):
         for c in range(4):
             T[r, c] = C0[r, c]
-    for k in range(kind.shape[0]):
-        v = sign[k] * q[k] + offset[k]
+    for k in range(joints.shape[1]):
+        v = joints[1, k] * q[k] + joints[2, k]
         if not math.isfinite(v):
             ok = False
-        _joint_right(T, kind[k], v)
-        _const_right(T, consts[k + 1])
+        _joint_right(T, joints[0, k], v)
+        _const_x(T, consts[k + 1], xform[k + 1])
     T[3, 0] = 0.0
     T[3, 1] = 0.0
     T[3, 2] = 0.0
@@ -66,44 +89,60 @@ def _fk_one(q, consts, kind, sign, offset, T):
     return ok
 
 
+@njit("b1(f8[:], f8[::1], f8[:, ::1])", cache=True)
+def fk_packed(q, p, T):
+    """FK of one configuration into T (4, 4) from packed chain arrays; False on NaN/inf.
+
+    One flat parameter array keeps the call overhead from Python small: a single
+    configuration is dominated by argument unboxing, not arithmetic.
+    """
+    nc = int(p[0])
+    consts = p[1:1 + (nc + 1) * 16].reshape((nc + 1, 4, 4))
+    o = 1 + (nc + 1) * 16
+    xform = p[o:o + (nc + 1) * 6].reshape((nc + 1, 6))
+    o += (nc + 1) * 6
+    joints = p[o:o + 3 * nc].reshape((3, nc))
+    return _fk_one(q, consts, xform, joints, T)
+
+
 @njit(cache=True)
-def fk_serial(qc, consts, kind, sign, offset, out):
+def fk_serial(qc, consts, xform, joints, out):
     """FK of a batch (N, n_chain) into out (N, 4, 4), one thread. Returns all-finite."""
     ok = True
     for i in range(qc.shape[0]):
-        ok &= _fk_one(qc[i], consts, kind, sign, offset, out[i])
+        ok &= _fk_one(qc[i], consts, xform, joints, out[i])
     return ok
 
 
 @njit(cache=True, parallel=True)
-def fk_parallel(qc, consts, kind, sign, offset, out):
+def fk_parallel(qc, consts, xform, joints, out):
     """FK of a batch (N, n_chain) into out (N, 4, 4), all threads. Returns all-finite."""
     n = qc.shape[0]
     flags = np.ones(n, dtype=np.bool_)
     for i in prange(n):
-        flags[i] = _fk_one(qc[i], consts, kind, sign, offset, out[i])
+        flags[i] = _fk_one(qc[i], consts, xform, joints, out[i])
     return flags.all()
 
 
 @njit(cache=True)
-def fk_all_serial(qc, first, frame_off, link_off, tool, kind, sign, offset, out):
+def fk_all_serial(qc, first, frame_off, link_off, tool, joints, out):
     """Every link frame: out (N, n_chain + 2, 4, 4) = base, frames 1..n, flange.
 
     ``first`` is ``B L0``; frame k is ``... J_k F_k``; the last slot is the tool pose.
     Returns all-finite.
     """
     ok = True
-    nc = kind.shape[0]
+    nc = joints.shape[1]
     T = np.empty((4, 4))
     for i in range(qc.shape[0]):
         for r in range(4):
             for c in range(4):
                 T[r, c] = first[r, c]
         for k in range(nc):
-            v = sign[k] * qc[i, k] + offset[k]
+            v = joints[1, k] * qc[i, k] + joints[2, k]
             if not math.isfinite(v):
                 ok = False
-            _joint_right(T, kind[k], v)
+            _joint_right(T, joints[0, k], v)
             _const_right(T, frame_off[k])
             out[i, k + 1] = T
             _const_right(T, link_off[k])
@@ -113,30 +152,30 @@ def fk_all_serial(qc, first, frame_off, link_off, tool, kind, sign, offset, out)
 
 
 @njit(cache=True, inline="always")
-def _jac_one(q, consts, kind, sign, offset, J, T):
-    """Chain Jacobian (6, n_chain) in the base frame at the flange+tool point."""
-    nc = kind.shape[0]
+def _jac_one(q, consts, xform, joints, J, T):
+    """Chain Jacobian (6, n_chain) in the base frame at the tool point; pose into T."""
+    nc = joints.shape[1]
     ok = True
     C0 = consts[0]
     for r in range(3):
         for c in range(4):
             T[r, c] = C0[r, c]
-    # store axis z_k and origin p_k of each joint frame in J temporarily
+    # store origin p_k and axis z_k of each joint frame in J first
     for k in range(nc):
-        v = sign[k] * q[k] + offset[k]
+        v = joints[1, k] * q[k] + joints[2, k]
         if not math.isfinite(v):
             ok = False
-        _joint_right(T, kind[k], v)
+        _joint_right(T, joints[0, k], v)
         for r in range(3):
             J[r, k] = T[r, 3]
             J[3 + r, k] = T[r, 2]
-        _const_right(T, consts[k + 1])
+        _const_x(T, consts[k + 1], xform[k + 1])
     for k in range(nc):
         zx = J[3, k]
         zy = J[4, k]
         zz = J[5, k]
-        s = sign[k]
-        if kind[k] == 0.0:
+        s = joints[1, k]
+        if joints[0, k] == 0.0:
             dx = T[0, 3] - J[0, k]
             dy = T[1, 3] - J[1, k]
             dz = T[2, 3] - J[2, k]
@@ -153,18 +192,27 @@ def _jac_one(q, consts, kind, sign, offset, J, T):
             J[3, k] = 0.0
             J[4, k] = 0.0
             J[5, k] = 0.0
+    T[3, 0] = 0.0
+    T[3, 1] = 0.0
+    T[3, 2] = 0.0
+    T[3, 3] = 1.0
     return ok
 
 
 @njit(cache=True, parallel=True)
-def jacobian_batch(qc, consts, kind, sign, offset, out, poses):
+def jacobian_batch(qc, consts, xform, joints, out, poses):
     """Chain Jacobians (N, 6, n_chain) and poses (N, 4, 4). Returns all-finite."""
     n = qc.shape[0]
     flags = np.ones(n, dtype=np.bool_)
     for i in prange(n):
-        flags[i] = _jac_one(qc[i], consts, kind, sign, offset, out[i], poses[i])
-        poses[i, 3, 0] = 0.0
-        poses[i, 3, 1] = 0.0
-        poses[i, 3, 2] = 0.0
-        poses[i, 3, 3] = 1.0
+        flags[i] = _jac_one(qc[i], consts, xform, joints, out[i], poses[i])
     return flags.all()
+
+
+@njit(cache=True)
+def jacobian_serial(qc, consts, xform, joints, out, poses):
+    """As :func:`jacobian_batch`, one thread (small batches)."""
+    ok = True
+    for i in range(qc.shape[0]):
+        ok &= _jac_one(qc[i], consts, xform, joints, out[i], poses[i])
+    return ok

@@ -19,10 +19,33 @@ __all__ = ["forward_kinematics", "forward_kinematics_all", "link_frames"]
 _PARALLEL_MIN = 2048
 
 
-def _kernels():
-    from robokin.kinematics import _kernels
+_KERNELS: list = []
+_SINGLE: list = []
+_F64 = np.dtype(np.float64)
 
-    return _kernels
+
+def single_kernel():
+    """The compiled single-configuration FK ``fn(q, packed, T_out) -> bool``.
+
+    Calls the compiled entry point directly (skipping numba's type dispatch: the
+    signature is fixed), falling back to the dispatcher if numba hides it.
+    """
+    if not _SINGLE:
+        disp = _kernels().fk_packed
+        try:
+            fn = next(iter(disp.overloads.values())).entry_point
+        except (AttributeError, StopIteration):  # pragma: no cover - numba internals
+            fn = disp
+        _SINGLE.append(fn)
+    return _SINGLE[0]
+
+
+def _kernels():
+    if not _KERNELS:
+        from robokin.kinematics import _kernels
+
+        _KERNELS.append(_kernels)
+    return _KERNELS[0]
 
 
 def _chain_values(chain: Chain, q: np.ndarray) -> np.ndarray:
@@ -49,12 +72,17 @@ def forward_kinematics(chain: Chain, q: npt.ArrayLike, *, name: str = "q") -> np
     Raises:
         InputError: wrong shape or a non-finite value.
     """
+    if (type(q) is np.ndarray and q.shape == chain._single_shape and q.dtype is _F64):
+        # One configuration: validation is the kernel's own finiteness test.
+        T = np.empty((4, 4))
+        if single_kernel()(q, chain._packed, T):
+            return T
     q = check_joints(q, chain.n, name)
     qc = _chain_values(chain, q)
     out = np.empty((qc.shape[0], 4, 4))
     k = _kernels()
     fn = k.fk_parallel if qc.shape[0] >= _PARALLEL_MIN else k.fk_serial
-    if not fn(qc, chain._consts, chain._kind, chain._sign, chain._offset, out):
+    if not fn(qc, chain._consts, chain._xform, chain._joints, out):
         _raise_nonfinite(q, name)
     return out.reshape(q.shape[:-1] + (4, 4))
 
@@ -67,8 +95,7 @@ def link_frames(chain: Chain, q: npt.ArrayLike, *, name: str = "q") -> np.ndarra
     out = np.empty((qc.shape[0], nc + 2, 4, 4))
     first = chain.base @ chain.head
     ok = _kernels().fk_all_serial(
-        qc, first, chain.frame_offsets, chain.link_offsets, chain.tool,
-        chain._kind, chain._sign, chain._offset, out,
+        qc, first, chain.frame_offsets, chain.link_offsets, chain.tool, chain._joints, out
     )
     if not ok:
         _raise_nonfinite(q, name)

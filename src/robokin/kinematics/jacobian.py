@@ -35,8 +35,9 @@ def jacobian_and_pose(
     N, nc = qc.shape
     J = np.empty((N, 6, nc))
     T = np.empty((N, 4, 4))
-    if not _kernels().jacobian_batch(qc, chain._consts, chain._kind, chain._sign,
-                                     chain._offset, J, T):
+    k = _kernels()
+    fn = k.jacobian_batch if N >= 256 else k.jacobian_serial
+    if not fn(qc, chain._consts, chain._xform, chain._joints, J, T):
         _raise_nonfinite(q, name)
     if not chain.coupling.is_identity:
         J = J @ chain.coupling.matrix

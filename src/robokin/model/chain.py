@@ -64,6 +64,22 @@ class Joint:
         object.__setattr__(self, "offset", float(self.offset))
 
 
+def _xform_params(consts: np.ndarray) -> np.ndarray:
+    """Per constant ``[1, cos a, sin a, tx, ty, tz]`` when it is ``Trans(t) Rx(a)``, else 0.
+
+    Every standard and modified DH row's constant has this form; the kernels then
+    skip the multiplications by its zeros and ones.
+    """
+    P = np.zeros((consts.shape[0], 6))
+    for k, C in enumerate(consts):
+        R = C[:3, :3]
+        ca, sa = R[1, 1], R[2, 1]
+        if (R[0, 0] == 1.0 and R[0, 1] == 0.0 and R[0, 2] == 0.0 and R[1, 0] == 0.0
+                and R[2, 0] == 0.0 and R[1, 2] == -sa and R[2, 2] == ca):
+            P[k] = (1.0, ca, sa, C[0, 3], C[1, 3], C[2, 3])
+    return P
+
+
 def _ro(a: np.ndarray) -> np.ndarray:
     a = np.ascontiguousarray(a, dtype=np.float64)
     a.setflags(write=False)
@@ -136,6 +152,14 @@ class Chain:
         )
         object.__setattr__(self, "_sign", _ro(np.array([j.sign for j in self.joints])))
         object.__setattr__(self, "_offset", _ro(np.array([j.offset for j in self.joints])))
+        object.__setattr__(self, "_joints", _ro(np.stack([self._kind, self._sign, self._offset])))
+        object.__setattr__(self, "_xform", _ro(_xform_params(consts)))
+        packed = np.concatenate([[float(nc)], consts.ravel(), self._xform.ravel(),
+                                 self._joints.ravel()])
+        object.__setattr__(self, "_packed", _ro(packed))
+        # Shape of a single configuration the fast FK path takes (None: no fast path).
+        object.__setattr__(self, "_single_shape",
+                           (nc,) if self.coupling.is_identity else None)
         lim = np.array([c.limits for c in self.coordinates], dtype=np.float64).reshape(n, 2)
         object.__setattr__(self, "_limits", _ro(lim))
 
