@@ -17,8 +17,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-import robokin  # noqa: E402
 from peers import pinocchio_model, rtb_ets  # noqa: E402
+
+import robokin  # noqa: E402
 
 
 def _median_call(fn, repeats=2000, inner=20):
@@ -59,7 +60,9 @@ def main(n_batch: int = 100_000) -> None:
         # agreement first
         ours = robot.fk(Q[:200])
         np.testing.assert_allclose(ets.eval(Q[:200]), ours, atol=1e-9)
-        np.testing.assert_allclose(np.array([pin_pose(q) for q in Q[:200]]), ours, atol=1e-9)
+        np.testing.assert_allclose(
+            np.array([pin_pose(q) for q in Q[:200]]), ours, atol=1e-9
+        )
 
         q0 = Q[0].copy()
         robot.fk(q0)
@@ -67,7 +70,8 @@ def main(n_batch: int = 100_000) -> None:
             "robokin fk(q)": _median_call(lambda: robot.fk(q0)),
             "pinocchio forwardKinematics+frame": _median_call(lambda: pin_pose(q0)),
             "pinocchio forwardKinematics only": _median_call(
-                lambda: pin.forwardKinematics(model, data, q0)),
+                lambda: pin.forwardKinematics(model, data, q0)
+            ),
             "rtb ets.eval(q)": _median_call(lambda: ets.eval(q0)),
         }
         robot.fk(Q[:5000])
@@ -77,12 +81,30 @@ def main(n_batch: int = 100_000) -> None:
             "rtb ets.eval(Q) batch": _best(lambda: ets.eval(Q)),
         }
         for k, v in single.items():
-            rows.append((name, "single", k, v * 1e6, "us/call",
-                         single["robokin fk(q)"] and v / single["robokin fk(q)"]))
+            rows.append(
+                (
+                    name,
+                    "single",
+                    k,
+                    v * 1e6,
+                    "us/call",
+                    single["robokin fk(q)"] and v / single["robokin fk(q)"],
+                )
+            )
         for k, v in batch.items():
-            rows.append((name, f"batch {n_batch}", k, n_batch / v / 1e6, "M configs/s",
-                         batch[k] and v / batch["robokin fk(Q) batch"]))
-    print(f"{'robot':6} {'case':13} {'library':36} {'value':>10} {'unit':12} {'robokin x':>9}")
+            rows.append(
+                (
+                    name,
+                    f"batch {n_batch}",
+                    k,
+                    n_batch / v / 1e6,
+                    "M configs/s",
+                    batch[k] and v / batch["robokin fk(Q) batch"],
+                )
+            )
+    print(
+        f"{'robot':6} {'case':13} {'library':36} {'value':>10} {'unit':12} {'robokin x':>9}"
+    )
     for r in rows:
         print(f"{r[0]:6} {r[1]:13} {r[2]:36} {r[3]:10.3f} {r[4]:12} {r[5]:9.2f}")
     print("('robokin x' = how many times faster robokin is; time ratio peer / robokin)")

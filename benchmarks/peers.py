@@ -55,12 +55,25 @@ def pinocchio_model(robot):
     for P, j in zip(placements, robot.chain.joints):
         axis = np.array([0.0, 0.0, j.sign])
         if j.kind == "revolute":
-            jm = pin.JointModelRZ() if j.sign > 0 else pin.JointModelRevoluteUnaligned(axis)
+            jm = (
+                pin.JointModelRZ()
+                if j.sign > 0
+                else pin.JointModelRevoluteUnaligned(axis)
+            )
         else:
-            jm = pin.JointModelPZ() if j.sign > 0 else pin.JointModelPrismaticUnaligned(axis)
+            jm = (
+                pin.JointModelPZ()
+                if j.sign > 0
+                else pin.JointModelPrismaticUnaligned(axis)
+            )
         placement = pin.SE3(P[:3, :3].copy(), P[:3, 3].copy())
         parent = model.addJoint(parent, jm, placement, j.name)
-    tool = pin.Frame("tool", parent, 0, pin.SE3(last[:3, :3].copy(), last[:3, 3].copy()),
-                     pin.FrameType.OP_FRAME)
+    tool = pin.Frame(
+        "tool",
+        parent,
+        0,
+        pin.SE3(last[:3, :3].copy(), last[:3, 3].copy()),
+        pin.FrameType.OP_FRAME,
+    )
     fid = model.addFrame(tool)
     return model, model.createData(), fid

@@ -15,12 +15,14 @@ def dh_standard(rows, q):
         elif kind == "p":
             d = d + next(qi)
         ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
-        A = np.array([
-            [ct, -st * ca, st * sa, a * ct],
-            [st, ct * ca, -ct * sa, a * st],
-            [0, sa, ca, d],
-            [0, 0, 0, 1.0],
-        ])
+        A = np.array(
+            [
+                [ct, -st * ca, st * sa, a * ct],
+                [st, ct * ca, -ct * sa, a * st],
+                [0, sa, ca, d],
+                [0, 0, 0, 1.0],
+            ]
+        )
         T = T @ A
     return T
 
@@ -35,17 +37,23 @@ def dh_modified(rows, q):
         elif kind == "p":
             d = d + next(qi)
         ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
-        A = np.array([
-            [ct, -st, 0, a],
-            [st * ca, ct * ca, -sa, -sa * d],
-            [st * sa, ct * sa, ca, ca * d],
-            [0, 0, 0, 1.0],
-        ])
+        A = np.array(
+            [
+                [ct, -st, 0, a],
+                [st * ca, ct * ca, -sa, -sa * d],
+                [st * sa, ct * sa, ca, ca * d],
+                [0, 0, 0, 1.0],
+            ]
+        )
         T = T @ A
     return T
 
 
 def random_q(robot, rng, size=()):
     """Random configurations inside the limits (unlimited angles drawn in +-pi)."""
-    lim = np.where(np.isfinite(robot.limits), robot.limits, np.clip(robot.limits, -np.pi, np.pi))
-    return rng.uniform(lim[:, 0], lim[:, 1], size=tuple(np.atleast_1d(size)) + (robot.n,))
+    lim = np.where(
+        np.isfinite(robot.limits), robot.limits, np.clip(robot.limits, -np.pi, np.pi)
+    )
+    return rng.uniform(
+        lim[:, 0], lim[:, 1], size=tuple(np.atleast_1d(size)) + (robot.n,)
+    )

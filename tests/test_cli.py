@@ -31,7 +31,9 @@ def test_show_prints_the_table_and_limits(capsys):
 
 
 def test_fk_json_matches_the_library(capsys):
-    code, out, _ = run(capsys, "fk", "ur5", "0", "-90", "0", "-90", "0", "0", "--deg", "--json")
+    code, out, _ = run(
+        capsys, "fk", "ur5", "0", "-90", "0", "-90", "0", "0", "--deg", "--json"
+    )
     assert code == 0
     doc = json.loads(out)
     T = robokin.load("ur5").fk(np.radians([0, -90, 0, -90, 0, 0]))
@@ -41,7 +43,9 @@ def test_fk_json_matches_the_library(capsys):
 
 
 def test_fk_mm_units_for_the_prismatic_joint(capsys):
-    code, out, _ = run(capsys, "fk", "scara", "0", "0", "0", "100", "--deg", "--mm", "--json")
+    code, out, _ = run(
+        capsys, "fk", "scara", "0", "0", "0", "100", "--deg", "--mm", "--json"
+    )
     assert code == 0
     # z = c1 + c4 + l4 = 400 - 150 + 100 mm; x = c2 + c3 = 600 mm
     np.testing.assert_allclose(json.loads(out)["xyz"], [600, 0, 350], atol=1e-9)
@@ -65,8 +69,26 @@ def test_errors_are_one_line_with_exit_codes(capsys, args, code, match):
 
 
 def test_console_script_runs():
-    res = subprocess.run([sys.executable, "-m", "robokin", "fk", "puma560", "0", "0", "0", "0",
-                          "0", "0", "--json"], capture_output=True, text=True, timeout=120)
+    res = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "robokin",
+            "fk",
+            "puma560",
+            "0",
+            "0",
+            "0",
+            "0",
+            "0",
+            "0",
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert res.returncode == 0, res.stderr
-    np.testing.assert_allclose(json.loads(res.stdout)["xyz"], [0.4521, -0.15005, 0.4318],
-                               atol=1e-12)
+    np.testing.assert_allclose(
+        json.loads(res.stdout)["xyz"], [0.4521, -0.15005, 0.4318], atol=1e-12
+    )

@@ -8,7 +8,9 @@ import robokin
 def test_every_all_name_imports():
     for name in robokin.__all__:
         assert getattr(robokin, name) is not None, name
-    assert robokin.__all__ == sorted(robokin.__all__, key=str.lower) or set(robokin.__all__)
+    assert robokin.__all__ == sorted(robokin.__all__, key=str.lower) or set(
+        robokin.__all__
+    )
 
 
 def test_lazy_subpackages_resolve():
@@ -17,15 +19,27 @@ def test_lazy_subpackages_resolve():
 
 
 def test_errors_share_one_root():
-    for exc in (robokin.ModelError, robokin.InputError, robokin.UnreachableError,
-                robokin.MissingExtraError):
+    for exc in (
+        robokin.ModelError,
+        robokin.InputError,
+        robokin.UnreachableError,
+        robokin.MissingExtraError,
+    ):
         assert issubclass(exc, robokin.RobokinError)
     assert issubclass(robokin.ModelError, ValueError)
     assert issubclass(robokin.MissingExtraError, ImportError)
 
 
 def test_builtin_names_match_design():
-    assert robokin.robots.names() == sorted([
-        "ur5", "aubo_i5", "puma560", "puma560_modified", "panda", "scara", "qfmd010",
-        "improved_dh_arm",
-    ])
+    assert robokin.robots.names() == sorted(
+        [
+            "ur5",
+            "aubo_i5",
+            "puma560",
+            "puma560_modified",
+            "panda",
+            "scara",
+            "qfmd010",
+            "improved_dh_arm",
+        ]
+    )

@@ -27,7 +27,9 @@ def test_batch_shapes(shape, rng):
     P = sp.pose_from_xyz_rpy(xyz, rpy)
     assert P.shape == shape + (4, 4)
     Pi = sp.invert(P)
-    np.testing.assert_allclose(P @ Pi, np.broadcast_to(np.eye(4), shape + (4, 4)), atol=1e-12)
+    np.testing.assert_allclose(
+        P @ Pi, np.broadcast_to(np.eye(4), shape + (4, 4)), atol=1e-12
+    )
 
 
 def test_rpy_is_fixed_axis_xyz(rng):
@@ -52,9 +54,12 @@ def test_quaternion_is_wxyz_and_round_trips(rng):
 def test_axis_angle_round_trip(rng):
     v = rng.normal(size=(10, 3))
     v *= (rng.uniform(0, np.pi - 1e-3, 10) / np.linalg.norm(v, axis=-1))[:, None]
-    np.testing.assert_allclose(sp.axis_angle_from_matrix(sp.matrix_from_axis_angle(v)), v,
-                               atol=1e-12)
-    np.testing.assert_allclose(sp.matrix_from_axis_angle([0, 0, 0.5]), sp.rotz(0.5), atol=1e-15)
+    np.testing.assert_allclose(
+        sp.axis_angle_from_matrix(sp.matrix_from_axis_angle(v)), v, atol=1e-12
+    )
+    np.testing.assert_allclose(
+        sp.matrix_from_axis_angle([0, 0, 0.5]), sp.rotz(0.5), atol=1e-15
+    )
 
 
 def test_pose_error_known_values():

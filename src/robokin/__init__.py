@@ -65,6 +65,14 @@ def __getattr__(name: str) -> Any:
 
     if name == "ik":
         return importlib.import_module("robokin.kinematics.ik")
-    if name in ("trajectory", "collision", "robots", "spatial", "viz", "kinematics", "model"):
+    if name in (
+        "trajectory",
+        "collision",
+        "robots",
+        "spatial",
+        "viz",
+        "kinematics",
+        "model",
+    ):
         return importlib.import_module(f"robokin.{name}")
     raise AttributeError(f"module 'robokin' has no attribute {name!r}")

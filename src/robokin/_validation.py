@@ -32,7 +32,9 @@ def check_finite(x: np.ndarray, name: str) -> np.ndarray:
     """Raise InputError naming ``name`` if ``x`` holds NaN or infinity."""
     if not np.isfinite(x).all():
         bad = np.argwhere(~np.isfinite(x))[0]
-        raise InputError(name, f"holds a non-finite value at index {tuple(int(i) for i in bad)}")
+        raise InputError(
+            name, f"holds a non-finite value at index {tuple(int(i) for i in bad)}"
+        )
     return x
 
 
@@ -51,7 +53,9 @@ def check_transform(T: npt.ArrayLike, name: str = "T") -> np.ndarray:
         raise InputError(name, f"expected shape (..., 4, 4), got {T.shape}")
     check_finite(T, name)
     if not np.allclose(T[..., 3, :], [0.0, 0.0, 0.0, 1.0], atol=1e-9):
-        raise InputError(name, "the last row of a homogeneous transform must be 0 0 0 1")
+        raise InputError(
+            name, "the last row of a homogeneous transform must be 0 0 0 1"
+        )
     R = T[..., :3, :3]
     err = np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)).max(initial=0.0)
     if err > 1e-6:

@@ -11,7 +11,7 @@ import json
 import math
 import sys
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 
@@ -65,7 +65,9 @@ def robots() -> None:
 
 
 @app.command()
-def show(name: Annotated[str, typer.Argument(help="Built-in name or robot file.")]) -> None:
+def show(
+    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+) -> None:
     """Show a robot: its joints, limits and the canonical chain's tool pose at zero."""
     import numpy as np
     from rich.table import Table
@@ -75,8 +77,10 @@ def show(name: Annotated[str, typer.Argument(help="Built-in name or robot file."
     r = _load(name)
     doc = document_from_robot(r)
     units = doc.get("units", {})
-    table = Table(title=f"{r.name}: {doc.get('convention', '?')} "
-                        f"({units.get('length', 'm')}, {units.get('angle', 'rad')})")
+    table = Table(
+        title=f"{r.name}: {doc.get('convention', '?')} "
+        f"({units.get('length', 'm')}, {units.get('angle', 'rad')})"
+    )
     rows = doc["joints"]
     keys = []
     for row in rows:
@@ -116,7 +120,9 @@ def fk(
     q: Annotated[list[float], typer.Argument(help="Joint values (rad, m).")],
     deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
     mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Machine-readable output.")
+    ] = False,
 ) -> None:
     """Forward kinematics: the tool pose as a matrix, position and RPY."""
     import numpy as np
@@ -137,40 +143,63 @@ def fk(
     L = 1000.0 if mm else 1.0
     A = 180 / math.pi if deg else 1.0
     if as_json:
-        print(json.dumps({"pose": T.tolist(), "xyz": (T[:3, 3] * L).tolist(),
-                          "rpy": (rpy * A).tolist()}))
+        print(
+            json.dumps(
+                {
+                    "pose": T.tolist(),
+                    "xyz": (T[:3, 3] * L).tolist(),
+                    "rpy": (rpy * A).tolist(),
+                }
+            )
+        )
         return
     con = _console()
     con.print(np.array2string(T, precision=6, suppress_small=True))
     lu, au = ("mm" if mm else "m"), ("deg" if deg else "rad")
-    con.print(f"xyz [{lu}]: " + "  ".join(f"{v:.6f}" for v in T[:3, 3] * L), markup=False)
+    con.print(
+        f"xyz [{lu}]: " + "  ".join(f"{v:.6f}" for v in T[:3, 3] * L), markup=False
+    )
     con.print(f"rpy [{au}]: " + "  ".join(f"{v:.6f}" for v in rpy * A), markup=False)
 
 
 @app.command()
 def demo(
-    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("robokin-demo"),
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path(
+        "robokin-demo"
+    ),
     clearance: Annotated[float, typer.Option(help="Required clearance [mm].")] = 4.0,
-    view: Annotated[bool, typer.Option("--view", help="Open the viewer after.")] = False,
+    view: Annotated[
+        bool, typer.Option("--view", help="Open the viewer after.")
+    ] = False,
 ) -> None:
     """The main job: the AUBO-i5 loads a press (plan, check, report)."""
     try:
         from robokin.demo import run_demo
     except ImportError:
-        _console().print("robokin demo: coming soon (the press-loading scenario is being built)")
+        _console().print(
+            "robokin demo: coming soon (the press-loading scenario is being built)"
+        )
         return
     ok = run_demo(out=out, clearance_mm=clearance, view=view)
     if not ok:
-        raise DomainFailure("the plan is not collision-free with the required clearance")
+        raise DomainFailure(
+            "the plan is not collision-free with the required clearance"
+        )
 
 
 def _register_extra_commands() -> None:
     """Commands defined in other modules register themselves on ``app``."""
     import importlib
 
-    for mod in ("robokin.cli_ik", "robokin.cli_motion", "robokin.cli_urdf",
-                "robokin.cli_collision", "robokin.cli_view", "robokin.cli_actuators",
-                "robokin.cli_workspace"):
+    for mod in (
+        "robokin.cli_ik",
+        "robokin.cli_motion",
+        "robokin.cli_urdf",
+        "robokin.cli_collision",
+        "robokin.cli_view",
+        "robokin.cli_actuators",
+        "robokin.cli_workspace",
+    ):
         try:
             importlib.import_module(mod)
         except ModuleNotFoundError as exc:
@@ -178,7 +207,7 @@ def _register_extra_commands() -> None:
                 raise
 
 
-def main(argv: Optional[list[str]] = None) -> int:
+def main(argv: list[str] | None = None) -> int:
     """Entry point: run the app, map errors to one stderr line and an exit code."""
     from robokin.exceptions import RobokinError
 

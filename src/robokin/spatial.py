@@ -60,7 +60,9 @@ def rotz(angle: npt.ArrayLike) -> np.ndarray:
     return _rot(angle, 0, 1)
 
 
-def trans(x: npt.ArrayLike, y: npt.ArrayLike = 0.0, z: npt.ArrayLike = 0.0) -> np.ndarray:
+def trans(
+    x: npt.ArrayLike, y: npt.ArrayLike = 0.0, z: npt.ArrayLike = 0.0
+) -> np.ndarray:
     """Pure translation [m].
 
     Args:
@@ -73,12 +75,18 @@ def trans(x: npt.ArrayLike, y: npt.ArrayLike = 0.0, z: npt.ArrayLike = 0.0) -> n
         Transforms of shape (..., 4, 4).
     """
     x = np.asarray(x, dtype=np.float64)
-    if x.ndim >= 1 and x.shape[-1] == 3 and np.ndim(y) == 0 and np.ndim(z) == 0 and (
-        y == 0.0 and z == 0.0
+    if (
+        x.ndim >= 1
+        and x.shape[-1] == 3
+        and np.ndim(y) == 0
+        and np.ndim(z) == 0
+        and (y == 0.0 and z == 0.0)
     ):
         xyz = x
     else:
-        xyz = np.stack(np.broadcast_arrays(x, np.asarray(y, float), np.asarray(z, float)), -1)
+        xyz = np.stack(
+            np.broadcast_arrays(x, np.asarray(y, float), np.asarray(z, float)), -1
+        )
     T = np.zeros(xyz.shape[:-1] + (4, 4))
     T[..., 0, 0] = T[..., 1, 1] = T[..., 2, 2] = T[..., 3, 3] = 1.0
     T[..., :3, 3] = xyz
@@ -143,7 +151,12 @@ def pose_from_xyz_rpy(xyz: npt.ArrayLike, rpy: npt.ArrayLike) -> np.ndarray:
     """Pose from a position [m] (..., 3) and roll-pitch-yaw [rad] (..., 3)."""
     T = matrix_from_rpy(rpy)
     xyz = np.asarray(xyz, dtype=np.float64)
-    T, xyz = np.broadcast_to(T, np.broadcast_shapes(T.shape, xyz.shape[:-1] + (4, 4))).copy(), xyz
+    T, xyz = (
+        np.broadcast_to(
+            T, np.broadcast_shapes(T.shape, xyz.shape[:-1] + (4, 4))
+        ).copy(),
+        xyz,
+    )
     T[..., :3, 3] = xyz
     return T
 

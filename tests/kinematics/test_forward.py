@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
-from reference import random_q
 
 import robokin
+from reference import random_q
 from robokin.kinematics.forward import _PARALLEL_MIN, link_frames
 
 
@@ -20,15 +20,19 @@ def test_batch_shapes_and_batch_equals_loop(name, shape, rng):
     flat_q = q.reshape(-1, robot.n)
     loop = np.array([robot.fk(x) for x in flat_q]).reshape(T.shape)
     np.testing.assert_array_equal(T, loop)
-    np.testing.assert_allclose(link_frames(robot.chain, q)[..., -1, :, :], T, atol=1e-15)
-    np.testing.assert_allclose(F[..., 0, :, :], np.broadcast_to(robot.base, shape + (4, 4)))
+    np.testing.assert_allclose(
+        link_frames(robot.chain, q)[..., -1, :, :], T, atol=1e-15
+    )
+    np.testing.assert_allclose(
+        F[..., 0, :, :], np.broadcast_to(robot.base, shape + (4, 4))
+    )
 
 
 def test_parallel_kernel_equals_serial(rng):
     robot = robokin.load("panda")
     q = random_q(robot, rng, _PARALLEL_MIN + 3)
     big = robot.fk(q)
-    small = np.concatenate([robot.fk(q[i:i + 100]) for i in range(0, len(q), 100)])
+    small = np.concatenate([robot.fk(q[i : i + 100]) for i in range(0, len(q), 100)])
     np.testing.assert_array_equal(big, small)
 
 

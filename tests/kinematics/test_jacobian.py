@@ -2,10 +2,10 @@
 
 import numpy as np
 import pytest
-from reference import random_q
 from scipy.spatial.transform import Rotation
 
 import robokin
+from reference import random_q
 
 
 def _finite_difference_jacobian(robot, q, h=1e-6):
@@ -26,15 +26,17 @@ def _finite_difference_jacobian(robot, q, h=1e-6):
 def test_jacobian_matches_finite_differences(name, rng):
     robot = robokin.load(name)
     for q in random_q(robot, rng, 10):
-        np.testing.assert_allclose(robot.jacobian(q), _finite_difference_jacobian(robot, q),
-                                   atol=2e-8)
+        np.testing.assert_allclose(
+            robot.jacobian(q), _finite_difference_jacobian(robot, q), atol=2e-8
+        )
 
 
 def test_prismatic_columns_are_pure_translation(rng):
     robot = robokin.load("scara")
     J = robot.jacobian(random_q(robot, rng, 5))
-    np.testing.assert_allclose(J[:, :, 3], np.broadcast_to([0, 0, 1, 0, 0, 0], (5, 6)),
-                               atol=1e-15)
+    np.testing.assert_allclose(
+        J[:, :, 3], np.broadcast_to([0, 0, 1, 0, 0, 0], (5, 6)), atol=1e-15
+    )
 
 
 def test_tool_frame_jacobian_is_the_rotated_base_one(rng):
@@ -67,10 +69,13 @@ def test_ur5_singularities_and_manipulability():
     elbow[2] = 0.0  # elbow stretched out
     assert not robot.is_singular(generic)
     assert robot.is_singular(wrist) and robot.is_singular(elbow)
-    np.testing.assert_allclose(robot.manipulability(np.stack([wrist, elbow])), 0, atol=1e-12)
+    np.testing.assert_allclose(
+        robot.manipulability(np.stack([wrist, elbow])), 0, atol=1e-12
+    )
     J = robot.jacobian(generic)
-    np.testing.assert_allclose(robot.manipulability(generic), np.sqrt(np.linalg.det(J @ J.T)),
-                               rtol=1e-9)
+    np.testing.assert_allclose(
+        robot.manipulability(generic), np.sqrt(np.linalg.det(J @ J.T)), rtol=1e-9
+    )
     assert robot.manipulability(generic) > 1e-3
 
 

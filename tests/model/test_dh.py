@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
-from reference import dh_modified, dh_standard, random_q
 
 import robokin
+from reference import dh_modified, dh_standard, random_q
 from robokin import Robot
 from robokin.spatial import rotx, roty, rotz, trans
 
@@ -19,8 +19,16 @@ def test_standard_rows_match_hand_product(rng):
         {"a": 0.0, "alpha": 0.3, "d": 0.1, "theta": 0.0},
     ]
     robot = Robot.from_dh(rows)
-    ref = [(r["theta"], r["d"], r["a"], r["alpha"], "p" if r.get("joint") == "prismatic"
-            else "r") for r in rows]
+    ref = [
+        (
+            r["theta"],
+            r["d"],
+            r["a"],
+            r["alpha"],
+            "p" if r.get("joint") == "prismatic" else "r",
+        )
+        for r in rows
+    ]
     for _ in range(20):
         q = rng.uniform(-2, 2, 4)
         np.testing.assert_allclose(robot.fk(q), dh_standard(ref, q), atol=1e-14)
@@ -35,8 +43,16 @@ def test_modified_rows_match_hand_product(rng):
         {"alpha": PI / 2, "a": 0.088, "theta": 0.3, "d": 0.0},
     ]
     robot = Robot.from_dh(rows, convention="modified")
-    ref = [(r["alpha"], r["a"], r["theta"], r["d"],
-            {"prismatic": "p", "fixed": "f"}.get(r.get("joint"), "r")) for r in rows]
+    ref = [
+        (
+            r["alpha"],
+            r["a"],
+            r["theta"],
+            r["d"],
+            {"prismatic": "p", "fixed": "f"}.get(r.get("joint"), "r"),
+        )
+        for r in rows
+    ]
     assert robot.n == 4
     for _ in range(20):
         q = rng.uniform(-2, 2, 4)
@@ -55,14 +71,23 @@ def test_base_and_tool_wrap_the_chain(rng):
     base = trans(0.1, 0.2, 0.3) @ rotz(0.5)
     tool = trans(0, 0, 0.15) @ rotx(PI)
     plain = robokin.load("ur5")
-    robot = Robot.from_dh([{"a": 0, "alpha": PI / 2, "d": 0.089159},
-                           {"a": -0.425}, {"a": -0.39225},
-                           {"d": 0.10915, "alpha": PI / 2}, {"d": 0.09465, "alpha": -PI / 2},
-                           {"d": 0.0823}], base=base, tool=tool)
+    robot = Robot.from_dh(
+        [
+            {"a": 0, "alpha": PI / 2, "d": 0.089159},
+            {"a": -0.425},
+            {"a": -0.39225},
+            {"d": 0.10915, "alpha": PI / 2},
+            {"d": 0.09465, "alpha": -PI / 2},
+            {"d": 0.0823},
+        ],
+        base=base,
+        tool=tool,
+    )
     q = random_q(plain, rng, 5)
     np.testing.assert_allclose(robot.fk(q), base @ plain.fk(q) @ tool, atol=1e-13)
-    np.testing.assert_allclose(plain.with_tool(tool).with_base(base).fk(q), robot.fk(q),
-                               atol=1e-13)
+    np.testing.assert_allclose(
+        plain.with_tool(tool).with_base(base).fk(q), robot.fk(q), atol=1e-13
+    )
 
 
 def test_puma_standard_and_modified_agree(rng):
@@ -109,7 +134,9 @@ def test_dropping_the_virtual_frames_gives_a_wrong_pose(rng):
 
     robot = robokin.load("improved_dh_arm")
     doc = robot.meta["document"]
-    without = dict(doc, joints=[r for r in doc["joints"] if not r["name"].startswith("frame_")])
+    without = dict(
+        doc, joints=[r for r in doc["joints"] if not r["name"].startswith("frame_")]
+    )
     wrong = robot_from_document(without)
     q = random_q(robot, rng, 20)
     err = np.abs(wrong.fk(q)[..., :3, 3] - robot.fk(q)[..., :3, 3]).max(axis=-1)
@@ -128,7 +155,14 @@ def test_elementary_sequence_with_joints_about_x_and_y(rng):
     robot = Robot.from_elementary(ops)
     for _ in range(10):
         a, b, c = rng.uniform(-1, 1, 3)
-        ref = trans(0, 0, 0.2) @ rotx(a) @ trans(0, 0.3, 0) @ roty(b + 0.1) @ trans(c, 0, 0) @ rotz(0.4)
+        ref = (
+            trans(0, 0, 0.2)
+            @ rotx(a)
+            @ trans(0, 0.3, 0)
+            @ roty(b + 0.1)
+            @ trans(c, 0, 0)
+            @ rotz(0.4)
+        )
         np.testing.assert_allclose(robot.fk([a, b, c]), ref, atol=1e-14)
         frames = robot.fk_all([a, b, c])
         np.testing.assert_allclose(frames[1], trans(0, 0, 0.2) @ rotx(a), atol=1e-14)
@@ -138,14 +172,20 @@ def test_dependent_joints_follow_the_coordinates(rng):
     ops = [
         {"op": "rz", "joint": "revolute", "name": "a"},
         {"op": "tx", "value": 1.0},
-        {"op": "rz", "joint": "revolute", "name": "b", "depends": {"a": -2.0},
-         "depends_offset": 0.1},
+        {
+            "op": "rz",
+            "joint": "revolute",
+            "name": "b",
+            "depends": {"a": -2.0},
+            "depends_offset": 0.1,
+        },
     ]
     robot = Robot.from_elementary(ops)
     assert robot.n == 1 and robot.n_chain == 2
     a = 0.3
-    np.testing.assert_allclose(robot.fk([a]), rotz(a) @ trans(1, 0, 0) @ rotz(-2 * a + 0.1),
-                               atol=1e-14)
+    np.testing.assert_allclose(
+        robot.fk([a]), rotz(a) @ trans(1, 0, 0) @ rotz(-2 * a + 0.1), atol=1e-14
+    )
     assert robot.fk_all(np.zeros((4, 1))).shape == (4, 3, 4, 4)
 
 

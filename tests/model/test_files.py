@@ -6,9 +6,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from reference import random_q
 
 import robokin
+from reference import random_q
 from robokin.model.files import document_from_robot, load_robot, save_robot
 
 GOOD = """\
@@ -35,13 +35,18 @@ def test_units_are_converted_once_at_the_edge(tmp_path):
     T = robot.fk([0.0, 0.02])
     # j1: Rz(0) Tz(0.1) Tx(0.3); j2: Rz(90 deg) Tz(0.05 + 0.02); tool Tz(0.1) Rx(180 deg)
     np.testing.assert_allclose(T[:3, 3], [0.3, 0.0, 0.1 + 0.07 + 0.1], atol=1e-12)
-    np.testing.assert_allclose(T[:3, :3], [[0, 1, 0], [1, 0, 0], [0, 0, -1]], atol=1e-12)
+    np.testing.assert_allclose(
+        T[:3, :3], [[0, 1, 0], [1, 0, 0], [0, 0, -1]], atol=1e-12
+    )
 
 
 CASES = [
     ("name: x\njoints: []\n", r"robot\.yaml: joints"),
     ("joints:\n  - {a: 1}\n", r"robot\.yaml: name: missing required field"),
-    (GOOD.replace("limits: [-90, 90]", "limits: [90, -90]"), r"joints\[0\]\.limits.*reversed"),
+    (
+        GOOD.replace("limits: [-90, 90]", "limits: [90, -90]"),
+        r"joints\[0\]\.limits.*reversed",
+    ),
     (GOOD.replace("limits: [-90, 90]", "limits: 5"), r"joints\[0\]\.limits"),
     (GOOD.replace("a: 300", "a: three"), r"joints\[0\]\.a"),
     (GOOD.replace("a: 300", "a: .nan"), r"joints\[0\]\.a"),
@@ -50,7 +55,10 @@ CASES = [
     (GOOD.replace("convention: standard", "convention: craig"), r"convention"),
     (GOOD.replace("joint: prismatic", "joint: ball"), r"joints\[1\]\.joint"),
     (GOOD.replace("  - {name: j2", "  - 7\n  - {name: j2"), r"joints\[1\]"),
-    (GOOD.replace("theta: 90,", "theta: 90, colour: red,"), r"joints\[1\]\.colour: unknown"),
+    (
+        GOOD.replace("theta: 90,", "theta: 90, colour: red,"),
+        r"joints\[1\]\.colour: unknown",
+    ),
     (GOOD.replace("rpy: [180, 0, 0]", "rpy: [180, 0]"), r"tool\.rpy"),
     (GOOD + "wheels: 4\n", r"wheels: unknown field"),
     ("- just\n- a list\n", r"robot\.yaml: a robot file must be a mapping"),
@@ -128,5 +136,7 @@ joints:
     # total rotation 0.25 - 0.25 + 90 deg
     np.testing.assert_allclose(T[:3, 0], [0, 1, 0], atol=1e-12)
     bad = text.replace("depends: {a: -1}", "depends: {zz: -1}")
-    with pytest.raises(robokin.ModelError, match=r"joints\[2\]\.depends.*unknown coordinate 'zz'"):
+    with pytest.raises(
+        robokin.ModelError, match=r"joints\[2\]\.depends.*unknown coordinate 'zz'"
+    ):
         load_robot(_write(tmp_path, bad))

@@ -97,11 +97,11 @@ def fk_packed(q, p, T):
     configuration is dominated by argument unboxing, not arithmetic.
     """
     nc = int(p[0])
-    consts = p[1:1 + (nc + 1) * 16].reshape((nc + 1, 4, 4))
+    consts = p[1 : 1 + (nc + 1) * 16].reshape((nc + 1, 4, 4))
     o = 1 + (nc + 1) * 16
-    xform = p[o:o + (nc + 1) * 6].reshape((nc + 1, 6))
+    xform = p[o : o + (nc + 1) * 6].reshape((nc + 1, 6))
     o += (nc + 1) * 6
-    joints = p[o:o + 3 * nc].reshape((3, nc))
+    joints = p[o : o + 3 * nc].reshape((3, nc))
     return _fk_one(q, consts, xform, joints, T)
 
 

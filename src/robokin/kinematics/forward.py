@@ -55,10 +55,14 @@ def _chain_values(chain: Chain, q: np.ndarray) -> np.ndarray:
 
 def _raise_nonfinite(q: np.ndarray, name: str) -> None:
     check_finite(q, name)
-    raise InputError(name, "produced a non-finite chain joint value")  # pragma: no cover
+    raise InputError(
+        name, "produced a non-finite chain joint value"
+    )  # pragma: no cover
 
 
-def forward_kinematics(chain: Chain, q: npt.ArrayLike, *, name: str = "q") -> np.ndarray:
+def forward_kinematics(
+    chain: Chain, q: npt.ArrayLike, *, name: str = "q"
+) -> np.ndarray:
     """Tool pose in the world frame.
 
     Args:
@@ -72,7 +76,7 @@ def forward_kinematics(chain: Chain, q: npt.ArrayLike, *, name: str = "q") -> np
     Raises:
         InputError: wrong shape or a non-finite value.
     """
-    if (type(q) is np.ndarray and q.shape == chain._single_shape and q.dtype is _F64):
+    if type(q) is np.ndarray and q.shape == chain._single_shape and q.dtype is _F64:
         # One configuration: validation is the kernel's own finiteness test.
         T = np.empty((4, 4))
         if single_kernel()(q, chain._packed, T):
@@ -95,7 +99,13 @@ def link_frames(chain: Chain, q: npt.ArrayLike, *, name: str = "q") -> np.ndarra
     out = np.empty((qc.shape[0], nc + 2, 4, 4))
     first = chain.base @ chain.head
     ok = _kernels().fk_all_serial(
-        qc, first, chain.frame_offsets, chain.link_offsets, chain.tool, chain._joints, out
+        qc,
+        first,
+        chain.frame_offsets,
+        chain.link_offsets,
+        chain.tool,
+        chain._joints,
+        out,
     )
     if not ok:
         _raise_nonfinite(q, name)
@@ -103,7 +113,9 @@ def link_frames(chain: Chain, q: npt.ArrayLike, *, name: str = "q") -> np.ndarra
     return out.reshape(q.shape[:-1] + (nc + 2, 4, 4))
 
 
-def forward_kinematics_all(chain: Chain, q: npt.ArrayLike, *, name: str = "q") -> np.ndarray:
+def forward_kinematics_all(
+    chain: Chain, q: npt.ArrayLike, *, name: str = "q"
+) -> np.ndarray:
     """The base frame, then the link frame of every chain joint.
 
     Args:

@@ -52,7 +52,9 @@ class Joint:
                 f"joint '{self.name}': kind must be 'revolute' or 'prismatic', got {self.kind!r}"
             )
         if self.sign not in (1.0, -1.0):
-            raise ModelError(f"joint '{self.name}': sign must be +1 or -1, got {self.sign}")
+            raise ModelError(
+                f"joint '{self.name}': sign must be +1 or -1, got {self.sign}"
+            )
         lo, hi = (float(v) for v in self.limits)
         if math.isnan(lo) or math.isnan(hi) or lo > hi:
             raise ModelError(
@@ -74,8 +76,15 @@ def _xform_params(consts: np.ndarray) -> np.ndarray:
     for k, C in enumerate(consts):
         R = C[:3, :3]
         ca, sa = R[1, 1], R[2, 1]
-        if (R[0, 0] == 1.0 and R[0, 1] == 0.0 and R[0, 2] == 0.0 and R[1, 0] == 0.0
-                and R[2, 0] == 0.0 and R[1, 2] == -sa and R[2, 2] == ca):
+        if (
+            R[0, 0] == 1.0
+            and R[0, 1] == 0.0
+            and R[0, 2] == 0.0
+            and R[1, 0] == 0.0
+            and R[2, 0] == 0.0
+            and R[1, 2] == -sa
+            and R[2, 2] == ca
+        ):
             P[k] = (1.0, ca, sa, C[0, 3], C[1, 3], C[2, 3])
     return P
 
@@ -134,7 +143,9 @@ class Chain:
         n = len(self.coordinates)
         if self.coupling is None:
             if n != nc:
-                raise ModelError("a chain whose coordinates differ from its joints needs a coupling")
+                raise ModelError(
+                    "a chain whose coordinates differ from its joints needs a coupling"
+                )
             object.__setattr__(self, "coupling", AffineMap.identity(nc))
         if self.coupling.matrix.shape != (nc, n):
             raise ModelError(
@@ -148,19 +159,29 @@ class Chain:
         consts[nc] = consts[nc] @ self.tool if nc else consts[0] @ self.tool
         object.__setattr__(self, "_consts", _ro(consts))
         object.__setattr__(
-            self, "_kind", _ro(np.array([j.kind == "prismatic" for j in self.joints], np.float64))
+            self,
+            "_kind",
+            _ro(np.array([j.kind == "prismatic" for j in self.joints], np.float64)),
         )
         object.__setattr__(self, "_sign", _ro(np.array([j.sign for j in self.joints])))
-        object.__setattr__(self, "_offset", _ro(np.array([j.offset for j in self.joints])))
-        object.__setattr__(self, "_joints", _ro(np.stack([self._kind, self._sign, self._offset])))
+        object.__setattr__(
+            self, "_offset", _ro(np.array([j.offset for j in self.joints]))
+        )
+        object.__setattr__(
+            self, "_joints", _ro(np.stack([self._kind, self._sign, self._offset]))
+        )
         object.__setattr__(self, "_xform", _ro(_xform_params(consts)))
-        packed = np.concatenate([[float(nc)], consts.ravel(), self._xform.ravel(),
-                                 self._joints.ravel()])
+        packed = np.concatenate(
+            [[float(nc)], consts.ravel(), self._xform.ravel(), self._joints.ravel()]
+        )
         object.__setattr__(self, "_packed", _ro(packed))
         # Shape of a single configuration the fast FK path takes (None: no fast path).
-        object.__setattr__(self, "_single_shape",
-                           (nc,) if self.coupling.is_identity else None)
-        lim = np.array([c.limits for c in self.coordinates], dtype=np.float64).reshape(n, 2)
+        object.__setattr__(
+            self, "_single_shape", (nc,) if self.coupling.is_identity else None
+        )
+        lim = np.array([c.limits for c in self.coordinates], dtype=np.float64).reshape(
+            n, 2
+        )
         object.__setattr__(self, "_limits", _ro(lim))
 
     @property

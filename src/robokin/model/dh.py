@@ -32,9 +32,28 @@ __all__ = ["chain_from_dh", "chain_from_elementary", "Convention"]
 
 Convention = Literal["standard", "modified"]
 
-_DH_KEYS = {"a", "alpha", "d", "theta", "joint", "limits", "sign", "name", "depends",
-            "depends_offset"}
-_ELEM_KEYS = {"op", "value", "joint", "limits", "sign", "name", "depends", "depends_offset"}
+_DH_KEYS = {
+    "a",
+    "alpha",
+    "d",
+    "theta",
+    "joint",
+    "limits",
+    "sign",
+    "name",
+    "depends",
+    "depends_offset",
+}
+_ELEM_KEYS = {
+    "op",
+    "value",
+    "joint",
+    "limits",
+    "sign",
+    "name",
+    "depends",
+    "depends_offset",
+}
 _OPS = {"rx", "ry", "rz", "tx", "ty", "tz", "frame"}
 
 
@@ -57,15 +76,21 @@ def _limits(row: Mapping, where: str) -> tuple[float, float]:
     if lim is None:
         return (-math.inf, math.inf)
     if not isinstance(lim, (list, tuple, np.ndarray)) or len(lim) != 2:
-        raise ModelError(f"limits must be [lower, upper], got {lim!r}", field=f"{where}.limits")
+        raise ModelError(
+            f"limits must be [lower, upper], got {lim!r}", field=f"{where}.limits"
+        )
     try:
         lo, hi = float(lim[0]), float(lim[1])
     except (TypeError, ValueError):
-        raise ModelError(f"limits must be numbers, got {lim!r}", field=f"{where}.limits") from None
+        raise ModelError(
+            f"limits must be numbers, got {lim!r}", field=f"{where}.limits"
+        ) from None
     if math.isnan(lo) or math.isnan(hi):
         raise ModelError("limits must not be NaN", field=f"{where}.limits")
     if lo > hi:
-        raise ModelError(f"limits reversed: lower {lo} > upper {hi}", field=f"{where}.limits")
+        raise ModelError(
+            f"limits reversed: lower {lo} > upper {hi}", field=f"{where}.limits"
+        )
     return (lo, hi)
 
 
@@ -88,8 +113,9 @@ def _sign(row: Mapping, where: str) -> float:
 
 def _check_row(row: Any, where: str, keys: set[str]) -> Mapping:
     if not isinstance(row, Mapping):
-        raise ModelError(f"a row must be a mapping of fields, got {type(row).__name__}",
-                         field=where)
+        raise ModelError(
+            f"a row must be a mapping of fields, got {type(row).__name__}", field=where
+        )
     unknown = set(row) - keys
     if unknown:
         raise ModelError(
@@ -115,15 +141,21 @@ class _Assembler:
                     raise ModelError("missing required field 'name'", field=where)
                 kind = _kind(c, where)
                 if kind == "fixed":
-                    raise ModelError("a coordinate cannot be 'fixed'", field=f"{where}.joint")
+                    raise ModelError(
+                        "a coordinate cannot be 'fixed'", field=f"{where}.joint"
+                    )
                 self.explicit.append(Joint(str(c["name"]), kind, _limits(c, where)))
 
-    def add_joint(self, row: Mapping, kind: str, offset: float, where: str, index: int) -> None:
+    def add_joint(
+        self, row: Mapping, kind: str, offset: float, where: str, index: int
+    ) -> None:
         name = str(row.get("name", f"joint{len(self.rows) + 1}"))
         depends = row.get("depends")
         if depends is not None and not isinstance(depends, Mapping):
-            raise ModelError("depends must map coordinate names to coefficients",
-                             field=f"{where}.depends")
+            raise ModelError(
+                "depends must map coordinate names to coefficients",
+                field=f"{where}.depends",
+            )
         joint = Joint(name, kind, _limits(row, where), _sign(row, where), offset)
         dep_offset = _num(row, "depends_offset", where) if depends is not None else 0.0
         self.rows.append((joint, depends, dep_offset, where))
@@ -145,17 +177,22 @@ class _Assembler:
                 if joint.name not in index:
                     raise ModelError(
                         f"joint '{joint.name}' is neither a declared coordinate nor "
-                        f"dependent; coordinates: {sorted(index)}", field=where)
+                        f"dependent; coordinates: {sorted(index)}",
+                        field=where,
+                    )
                 M[k, index[joint.name]] = 1.0
                 continue
             for other, coeff in dep.items():
                 if other not in index:
                     raise ModelError(
                         f"depends on unknown coordinate '{other}'; known: {sorted(index)}",
-                        field=f"{where}.depends")
+                        field=f"{where}.depends",
+                    )
                 if isinstance(coeff, bool) or not isinstance(coeff, (int, float)):
-                    raise ModelError(f"coefficient of '{other}' must be a number",
-                                     field=f"{where}.depends.{other}")
+                    raise ModelError(
+                        f"coefficient of '{other}' must be a number",
+                        field=f"{where}.depends.{other}",
+                    )
                 M[k, index[other]] = float(coeff)
             c[k] = dep_off
         coupling = None
@@ -164,8 +201,9 @@ class _Assembler:
             coordinates = tuple(coords)
         else:
             coordinates = None
-        return self.builder.build(base=base, tool=tool, coordinates=coordinates,
-                                  coupling=coupling)
+        return self.builder.build(
+            base=base, tool=tool, coordinates=coordinates, coupling=coupling
+        )
 
 
 def chain_from_dh(
@@ -194,8 +232,10 @@ def chain_from_dh(
         ModelError: naming ``rows[i].field`` and the reason.
     """
     if convention not in ("standard", "modified"):
-        raise ModelError(f"convention must be 'standard' or 'modified', got {convention!r}",
-                         field="convention")
+        raise ModelError(
+            f"convention must be 'standard' or 'modified', got {convention!r}",
+            field="convention",
+        )
     if isinstance(rows, (str, bytes)) or not isinstance(rows, Sequence):
         raise ModelError("rows must be a list of DH rows", field="rows")
     asm = _Assembler(coordinates, "rows")
@@ -258,7 +298,9 @@ def chain_from_elementary(
         ModelError: naming ``ops[i].field`` and the reason.
     """
     if isinstance(ops, (str, bytes)) or not isinstance(ops, Sequence):
-        raise ModelError("the elementary sequence must be a list of operations", field="ops")
+        raise ModelError(
+            "the elementary sequence must be a list of operations", field="ops"
+        )
     asm = _Assembler(coordinates, "ops")
     b = asm.builder
     # Joints followed by an explicit frame marker get their link frame there.
@@ -267,14 +309,20 @@ def chain_from_elementary(
     for i, op in enumerate(ops):
         if isinstance(op, Mapping) and op.get("joint", "fixed") != "fixed":
             last_joint = i
-        elif isinstance(op, Mapping) and op.get("op") == "frame" and last_joint is not None:
+        elif (
+            isinstance(op, Mapping)
+            and op.get("op") == "frame"
+            and last_joint is not None
+        ):
             explicit_frame.add(last_joint)
     for i, op in enumerate(ops):
         where = f"joints[{i}]"
         op = _check_row(op, where, _ELEM_KEYS)
         name = op.get("op")
         if name not in _OPS:
-            raise ModelError(f"op must be one of {sorted(_OPS)}, got {name!r}", field=f"{where}.op")
+            raise ModelError(
+                f"op must be one of {sorted(_OPS)}, got {name!r}", field=f"{where}.op"
+            )
         if name == "frame":
             b.frame()
             continue
@@ -294,7 +342,9 @@ def chain_from_elementary(
         if (kind == "revolute") != is_rot:
             raise ModelError(
                 f"a {kind} joint needs a {'rotation' if kind == 'revolute' else 'translation'}"
-                f" op, got {name!r}", field=f"{where}.op")
+                f" op, got {name!r}",
+                field=f"{where}.op",
+            )
         A = _TO_AXIS[axis]
         b.constant(A)
         asm.add_joint(op, kind, value, where, i)

@@ -168,7 +168,8 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
 
     if not isinstance(doc, Mapping):
         raise ModelError(
-            f"a robot file must be a mapping of fields, got {type(doc).__name__}", file=file
+            f"a robot file must be a mapping of fields, got {type(doc).__name__}",
+            file=file,
         )
     RobotFile, Row, Op = _schema()
     spec = _validate(RobotFile, doc, file)
@@ -186,7 +187,10 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
     else:
         for i, r in enumerate(rows):
             if r.joint != "fixed" and r.depends is None:
-                kind_of[r.name or f"joint{sum(1 for x in rows[:i] if x.joint != 'fixed') + 1}"] = r.joint
+                kind_of[
+                    r.name
+                    or f"joint{sum(1 for x in rows[:i] if x.joint != 'fixed') + 1}"
+                ] = r.joint
 
     def scale(kind: str) -> float:
         return L if kind == "prismatic" else A
@@ -208,7 +212,8 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
             d["limits"] = [v * scale(kind) for v in r.limits]
         if r.depends is not None:
             d["depends"] = {
-                k: v * scale(kind) / scale(kind_of.get(k, kind)) for k, v in r.depends.items()
+                k: v * scale(kind) / scale(kind_of.get(k, kind))
+                for k, v in r.depends.items()
             }
             d["depends_offset"] = r.depends_offset * scale(kind)
         else:
@@ -229,15 +234,23 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
     tool = _placement(spec.tool, L, A)
     try:
         if elementary:
-            chain = chain_from_elementary(si_rows, base=base, tool=tool, coordinates=coords)
+            chain = chain_from_elementary(
+                si_rows, base=base, tool=tool, coordinates=coords
+            )
         else:
-            chain = chain_from_dh(si_rows, spec.convention, base=base, tool=tool,
-                                  coordinates=coords)
+            chain = chain_from_dh(
+                si_rows, spec.convention, base=base, tool=tool, coordinates=coords
+            )
     except ModelError as exc:
         field = (exc.field or "").replace("rows[", "joints[").replace("ops[", "joints[")
         raise ModelError(exc.reason, file=file, field=field or None) from None
-    robot = Robot(chain, name=spec.name, source=spec.source, path=file,
-                  meta={"document": copy.deepcopy(dict(doc))})
+    robot = Robot(
+        chain,
+        name=spec.name,
+        source=spec.source,
+        path=file,
+        meta={"document": copy.deepcopy(dict(doc))},
+    )
     for key in ("actuators", "geometry", "collision"):
         value = getattr(spec, key)
         if value is None:
@@ -247,7 +260,9 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
             _load_section_module(key)
             handler = _SECTIONS.get(key)
         if handler is None:
-            raise ModelError(f"section '{key}' is not supported yet", file=file, field=key)
+            raise ModelError(
+                f"section '{key}' is not supported yet", file=file, field=key
+            )
         robot = handler(robot, value, file, spec.units)
     return robot
 
@@ -255,9 +270,11 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
 def _load_section_module(key: str) -> None:
     import importlib
 
-    module = {"actuators": "robokin.model.coupling_files",
-              "geometry": "robokin.model.geometry",
-              "collision": "robokin.model.geometry"}.get(key)
+    module = {
+        "actuators": "robokin.model.coupling_files",
+        "geometry": "robokin.model.geometry",
+        "collision": "robokin.model.geometry",
+    }.get(key)
     if module is None:
         return
     try:
@@ -289,8 +306,9 @@ def load_robot(path: str | Path) -> Robot:
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        raise ModelError(f"not valid YAML{where}: {getattr(exc, 'problem', exc)}",
-                         file=path) from None
+        raise ModelError(
+            f"not valid YAML{where}: {getattr(exc, 'problem', exc)}", file=path
+        ) from None
     return robot_from_document(doc, file=path)
 
 
@@ -341,11 +359,15 @@ def _elementary_document(robot: Robot) -> dict[str, Any]:
             op["sign"] = -1
         if explicit:
             row = M[k]
-            is_self = j.name in coord_names and row[coord_names.index(j.name)] == 1.0 and (
-                np.count_nonzero(row) == 1 and c[k] == 0.0
+            is_self = (
+                j.name in coord_names
+                and row[coord_names.index(j.name)] == 1.0
+                and (np.count_nonzero(row) == 1 and c[k] == 0.0)
             )
             if not is_self:
-                op["depends"] = {coord_names[i]: float(row[i]) for i in np.flatnonzero(row)}
+                op["depends"] = {
+                    coord_names[i]: float(row[i]) for i in np.flatnonzero(row)
+                }
                 op["depends_offset"] = float(c[k])
         elif all(np.isfinite(j.limits)):
             op["limits"] = list(j.limits)
@@ -364,14 +386,19 @@ def _elementary_document(robot: Robot) -> dict[str, Any]:
     }
     if explicit:
         doc["coordinates"] = [
-            {"name": x.name, "joint": x.kind,
-             **({"limits": list(x.limits)} if all(np.isfinite(x.limits)) else {})}
+            {
+                "name": x.name,
+                "joint": x.kind,
+                **({"limits": list(x.limits)} if all(np.isfinite(x.limits)) else {}),
+            }
             for x in chain.coordinates
         ]
     for key, T in (("base", chain.base), ("tool", chain.tool)):
         if not np.allclose(T, np.eye(4), atol=1e-15):
-            doc[key] = {"xyz": [float(v) for v in T[:3, 3]],
-                        "rpy": [float(v) for v in rpy_from_matrix(T)]}
+            doc[key] = {
+                "xyz": [float(v) for v in T[:3, 3]],
+                "rpy": [float(v) for v in rpy_from_matrix(T)],
+            }
     return doc
 
 
@@ -384,7 +411,9 @@ def save_robot(robot: Robot, path: str | Path) -> Path:
     import yaml
 
     path = Path(path)
-    text = yaml.safe_dump(document_from_robot(robot), sort_keys=False, default_flow_style=None)
+    text = yaml.safe_dump(
+        document_from_robot(robot), sort_keys=False, default_flow_style=None
+    )
     directory = path.parent if str(path.parent) else Path(".")
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
     try:

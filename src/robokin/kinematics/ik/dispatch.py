@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy.typing as npt
 
-from robokin._validation import check_joints, check_transform, check_finite
+from robokin._validation import check_finite, check_joints, check_transform
 from robokin.exceptions import InputError
 from robokin.kinematics.ik.solutions import SolutionSet
 
