@@ -1,0 +1,560 @@
+"""Compiled (numba) inner loops of the numeric IK solver.
+
+Imported lazily by :mod:`robokin.kinematics.ik.numeric` (numba is slow to import).
+The FK / Jacobian evaluation is a private copy of the ideas in
+``robokin.kinematics._kernels`` (numba's cache does not track functions inlined
+from another module, so sharing them would risk stale caches).
+
+Packed inputs (built once per chain by ``numeric._ChainData``):
+
+* ``consts`` (n_chain + 1, 4, 4): the chain's constant transforms.
+* ``jdat`` (3, n_chain): rows kind (1.0 = prismatic), sign, offset.
+* ``Mc`` (n_chain, n + 1): the coupling ``q_chain = M q + c`` as ``[M | c]``.
+* ``cdat`` (5, n): rows lower limit, upper limit, seed lower, seed upper bound,
+  and 1.0 where a coordinate may be shifted by 2*pi without changing the pose.
+* ``opts`` (N_OPTS,): see the ``O_*`` indices below.
+
+Outputs per target (``out`` rows): q (n), then ``R_*`` columns.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+# opts indices
+O_W = 0  # 6 task weights, 0 = masked out
+O_TOL_P = 6
+O_TOL_R = 7
+O_MAX_ITER = 8  # iterations per attempt
+O_IDENT = 9  # 1.0 when the coupling is the identity
+O_USE_Q0 = 10  # 1.0: first attempt from q0
+O_MAX_STEP = 11  # largest joint step per iteration [rad or m]
+O_MU0 = 12
+O_N_SEEDS = 13  # random restarts available (<= seeds.shape[1])
+O_PATH_MAX_JUMP = 14  # ik_path: largest accepted joint change per sample
+N_OPTS = 16
+
+# result columns after q
+R_ERR = 0  # combined residual norm (masked, unweighted) [m, rad]
+R_EP = 1  # position residual norm [m]
+R_ER = 2  # rotation residual norm [rad]
+R_ITERS = 3
+R_RESTARTS = 4
+R_CODE = 5
+N_RES = 6
+
+CODE_OK = 0
+CODE_ITER = 1  # iteration budget of the last attempt ran out
+CODE_STALL = 2  # stuck in a local minimum / at a joint limit
+CODE_BAD_TARGET = 3  # non-finite or not a rigid transform
+CODE_JUMP = 4  # ik_path: joint jump larger than allowed
+CODE_NOT_RUN = 5  # ik_path: after an earlier failure
+
+_MU_MAX = 1e9
+_MU_MIN = 1e-9
+
+
+@njit(cache=True, inline="always")
+def _joint_right(T, kind, v):
+    """T <- T @ J(v): rotation about / translation along local z."""
+    if kind == 0.0:
+        c = math.cos(v)
+        s = math.sin(v)
+        for r in range(3):
+            x0 = T[r, 0]
+            x1 = T[r, 1]
+            T[r, 0] = c * x0 + s * x1
+            T[r, 1] = c * x1 - s * x0
+    else:
+        for r in range(3):
+            T[r, 3] += T[r, 2] * v
+
+
+@njit(cache=True, inline="always")
+def _const_right(T, C):
+    """T <- T @ C for an affine C (last row 0 0 0 1)."""
+    for r in range(3):
+        a0 = T[r, 0]
+        a1 = T[r, 1]
+        a2 = T[r, 2]
+        a3 = T[r, 3]
+        T[r, 0] = a0 * C[0, 0] + a1 * C[1, 0] + a2 * C[2, 0]
+        T[r, 1] = a0 * C[0, 1] + a1 * C[1, 1] + a2 * C[2, 1]
+        T[r, 2] = a0 * C[0, 2] + a1 * C[1, 2] + a2 * C[2, 2]
+        T[r, 3] = a0 * C[0, 3] + a1 * C[1, 3] + a2 * C[2, 3] + a3
+
+
+@njit(cache=True)
+def _pose_jac(q, Mc, ident, consts, jdat, qc, Jc, J, T):
+    """Pose (top 3x4 of T) and Jacobian J (6, n) w.r.t. the independent q."""
+    nc = jdat.shape[1]
+    n = q.shape[0]
+    if ident:
+        for i in range(nc):
+            qc[i] = q[i]
+    else:
+        for i in range(nc):
+            s = Mc[i, n]
+            for j in range(n):
+                s += Mc[i, j] * q[j]
+            qc[i] = s
+    C0 = consts[0]
+    for r in range(3):
+        for c in range(4):
+            T[r, c] = C0[r, c]
+    for k in range(nc):
+        _joint_right(T, jdat[0, k], jdat[1, k] * qc[k] + jdat[2, k])
+        for r in range(3):
+            Jc[r, k] = T[r, 3]
+            Jc[3 + r, k] = T[r, 2]
+        _const_right(T, consts[k + 1])
+    px = T[0, 3]
+    py = T[1, 3]
+    pz = T[2, 3]
+    for k in range(nc):
+        zx = Jc[3, k]
+        zy = Jc[4, k]
+        zz = Jc[5, k]
+        s = jdat[1, k]
+        if jdat[0, k] == 0.0:
+            dx = px - Jc[0, k]
+            dy = py - Jc[1, k]
+            dz = pz - Jc[2, k]
+            Jc[0, k] = s * (zy * dz - zz * dy)
+            Jc[1, k] = s * (zz * dx - zx * dz)
+            Jc[2, k] = s * (zx * dy - zy * dx)
+            Jc[3, k] = s * zx
+            Jc[4, k] = s * zy
+            Jc[5, k] = s * zz
+        else:
+            Jc[0, k] = s * zx
+            Jc[1, k] = s * zy
+            Jc[2, k] = s * zz
+            Jc[3, k] = 0.0
+            Jc[4, k] = 0.0
+            Jc[5, k] = 0.0
+    if ident:
+        for r in range(6):
+            for j in range(n):
+                J[r, j] = Jc[r, j]
+    else:
+        for r in range(6):
+            for j in range(n):
+                s = 0.0
+                for i in range(nc):
+                    s += Jc[r, i] * Mc[i, j]
+                J[r, j] = s
+
+
+@njit(cache=True)
+def _residual(T, Tt, e):
+    """Task error e (6,) = [p_t - p; log(R_t R^T)] in the base frame."""
+    for r in range(3):
+        e[r] = Tt[r, 3] - T[r, 3]
+    # Re = Rt @ R^T
+    r00 = Tt[0, 0] * T[0, 0] + Tt[0, 1] * T[0, 1] + Tt[0, 2] * T[0, 2]
+    r01 = Tt[0, 0] * T[1, 0] + Tt[0, 1] * T[1, 1] + Tt[0, 2] * T[1, 2]
+    r02 = Tt[0, 0] * T[2, 0] + Tt[0, 1] * T[2, 1] + Tt[0, 2] * T[2, 2]
+    r10 = Tt[1, 0] * T[0, 0] + Tt[1, 1] * T[0, 1] + Tt[1, 2] * T[0, 2]
+    r11 = Tt[1, 0] * T[1, 0] + Tt[1, 1] * T[1, 1] + Tt[1, 2] * T[1, 2]
+    r12 = Tt[1, 0] * T[2, 0] + Tt[1, 1] * T[2, 1] + Tt[1, 2] * T[2, 2]
+    r20 = Tt[2, 0] * T[0, 0] + Tt[2, 1] * T[0, 1] + Tt[2, 2] * T[0, 2]
+    r21 = Tt[2, 0] * T[1, 0] + Tt[2, 1] * T[1, 1] + Tt[2, 2] * T[1, 2]
+    r22 = Tt[2, 0] * T[2, 0] + Tt[2, 1] * T[2, 1] + Tt[2, 2] * T[2, 2]
+    vx = 0.5 * (r21 - r12)
+    vy = 0.5 * (r02 - r20)
+    vz = 0.5 * (r10 - r01)
+    s = math.sqrt(vx * vx + vy * vy + vz * vz)
+    c = 0.5 * (r00 + r11 + r22 - 1.0)
+    if c > -0.9:
+        th = math.atan2(s, c)
+        f = th / s if s > 1e-10 else 1.0 + s * s / 6.0
+        e[3] = f * vx
+        e[4] = f * vy
+        e[5] = f * vz
+    else:
+        # near pi: axis from the symmetric part B = (1 - c) a a^T
+        th = math.atan2(s, c)
+        omc = 1.0 - c
+        b00 = r00 - c
+        b11 = r11 - c
+        b22 = r22 - c
+        if b00 >= b11 and b00 >= b22:
+            d = math.sqrt(max(b00 * omc, 1e-300))
+            ax = b00 / d
+            ay = 0.5 * (r01 + r10) / d
+            az = 0.5 * (r02 + r20) / d
+        elif b11 >= b22:
+            d = math.sqrt(max(b11 * omc, 1e-300))
+            ax = 0.5 * (r01 + r10) / d
+            ay = b11 / d
+            az = 0.5 * (r12 + r21) / d
+        else:
+            d = math.sqrt(max(b22 * omc, 1e-300))
+            ax = 0.5 * (r02 + r20) / d
+            ay = 0.5 * (r12 + r21) / d
+            az = b22 / d
+        if ax * vx + ay * vy + az * vz < 0.0:
+            ax = -ax
+            ay = -ay
+            az = -az
+        e[3] = th * ax
+        e[4] = th * ay
+        e[5] = th * az
+
+
+@njit(cache=True, inline="always")
+def _errors(e, w):
+    """(weighted cost E, position norm, rotation norm) over the unmasked rows."""
+    E = 0.0
+    ep = 0.0
+    er = 0.0
+    for i in range(3):
+        if w[i] > 0.0:
+            E += w[i] * e[i] * e[i]
+            ep += e[i] * e[i]
+    for i in range(3, 6):
+        if w[i] > 0.0:
+            E += w[i] * e[i] * e[i]
+            er += e[i] * e[i]
+    return E, math.sqrt(ep), math.sqrt(er)
+
+
+@njit(cache=True)
+def _chol_solve(A, b, m):
+    """Solve A x = b in place (x into b) for SPD A (m x m); False if not SPD."""
+    for j in range(m):
+        s = A[j, j]
+        for k in range(j):
+            s -= A[j, k] * A[j, k]
+        if not s > 0.0:
+            return False
+        d = math.sqrt(s)
+        A[j, j] = d
+        for i in range(j + 1, m):
+            t = A[i, j]
+            for k in range(j):
+                t -= A[i, k] * A[j, k]
+            A[i, j] = t / d
+    for i in range(m):
+        t = b[i]
+        for k in range(i):
+            t -= A[i, k] * b[k]
+        b[i] = t / A[i, i]
+    for i in range(m - 1, -1, -1):
+        t = b[i]
+        for k in range(i + 1, m):
+            t -= A[k, i] * b[k]
+        b[i] = t / A[i, i]
+    return True
+
+
+@njit(cache=True, inline="always")
+def _project(q, cdat):
+    """Shift 2*pi-periodic coordinates into their limits where possible, then clamp."""
+    tp = 2.0 * math.pi
+    for j in range(q.shape[0]):
+        lo = cdat[0, j]
+        hi = cdat[1, j]
+        v = q[j]
+        if cdat[4, j] == 1.0:
+            if v > hi:
+                k = math.ceil((v - hi) / tp)
+                if v - k * tp >= lo:
+                    v -= k * tp
+            elif v < lo:
+                k = math.ceil((lo - v) / tp)
+                if v + k * tp <= hi:
+                    v += k * tp
+        if v > hi:
+            v = hi
+        elif v < lo:
+            v = lo
+        q[j] = v
+
+
+@njit(cache=True)
+def _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw, max_iter,
+             qc, Jc, J, T, e, qn, Jn, Tn, en, Jw, A, g, y, dq, free):
+    """One damped least-squares (Levenberg-Marquardt) descent from q (updated in place).
+
+    Returns (code, iterations, ep, er, E).
+    """
+    n = q.shape[0]
+    m = rows.shape[0]
+    ident = opts[O_IDENT] == 1.0
+    tol_p = opts[O_TOL_P]
+    tol_r = opts[O_TOL_R]
+    max_step = opts[O_MAX_STEP]
+    w = opts[O_W:O_W + 6]
+    _project(q, cdat)
+    _pose_jac(q, Mc, ident, consts, jdat, qc, Jc, J, T)
+    _residual(T, Tt, e)
+    E, ep, er = _errors(e, w)
+    if not math.isfinite(E):
+        return CODE_STALL, 0, ep, er, E
+    mu = opts[O_MU0]
+    it = 0
+    while True:
+        if ep <= tol_p and er <= tol_r:
+            return CODE_OK, it, ep, er, E
+        if it >= max_iter:
+            return CODE_ITER, it, ep, er, E
+        # weighted task rows and the gradient J^T W e; freeze joints pushed into a limit
+        for a in range(m):
+            r = rows[a]
+            for j in range(n):
+                Jw[a, j] = sw[a] * J[r, j]
+        nfree = 0
+        for j in range(n):
+            gj = 0.0
+            for a in range(m):
+                gj += Jw[a, j] * sw[a] * e[rows[a]]
+            g[j] = gj
+            f = True
+            if q[j] >= cdat[1, j] and gj > 0.0 and cdat[4, j] == 0.0:
+                f = False
+            elif q[j] <= cdat[0, j] and gj < 0.0 and cdat[4, j] == 0.0:
+                f = False
+            free[j] = f
+            if f:
+                nfree += 1
+            else:
+                for a in range(m):
+                    Jw[a, j] = 0.0
+        if nfree == 0:
+            return CODE_STALL, it, ep, er, E
+        accepted = False
+        while not accepted:
+            it += 1
+            lam = mu * E + 1e-14
+            if m <= nfree:
+                # task space: (Jw Jw^T + lam I) y = W^1/2 e ; dq = Jw^T y
+                for a in range(m):
+                    for b in range(a + 1):
+                        s = 0.0
+                        for j in range(n):
+                            s += Jw[a, j] * Jw[b, j]
+                        A[a, b] = s
+                        A[b, a] = s
+                    A[a, a] += lam
+                    y[a] = sw[a] * e[rows[a]]
+                okc = _chol_solve(A, y, m)
+                for j in range(n):
+                    s = 0.0
+                    for a in range(m):
+                        s += Jw[a, j] * y[a]
+                    dq[j] = s
+            else:
+                # joint space: (Jw^T Jw + lam I) dq = g
+                for i in range(n):
+                    for k in range(i + 1):
+                        s = 0.0
+                        for a in range(m):
+                            s += Jw[a, i] * Jw[a, k]
+                        A[i, k] = s
+                        A[k, i] = s
+                    A[i, i] += lam
+                    dq[i] = g[i] if free[i] else 0.0
+                okc = _chol_solve(A, dq, n)
+            if okc:
+                big = 0.0
+                for j in range(n):
+                    if abs(dq[j]) > big:
+                        big = abs(dq[j])
+                scale = max_step / big if big > max_step else 1.0
+                for j in range(n):
+                    qn[j] = q[j] + scale * dq[j]
+                _project(qn, cdat)
+                _pose_jac(qn, Mc, ident, consts, jdat, qc, Jc, Jn, Tn)
+                _residual(Tn, Tt, en)
+                En, epn, ern = _errors(en, w)
+                if En < E:
+                    accepted = True
+                    for j in range(n):
+                        q[j] = qn[j]
+                        for r in range(6):
+                            J[r, j] = Jn[r, j]
+                    for r in range(6):
+                        e[r] = en[r]
+                    E = En
+                    ep = epn
+                    er = ern
+                    mu = max(mu * 0.25, _MU_MIN)
+                    break
+            mu *= 8.0
+            if mu > _MU_MAX:
+                return CODE_STALL, it, ep, er, E
+            if it >= max_iter:
+                return CODE_ITER, it, ep, er, E
+    return CODE_ITER, it, ep, er, E  # pragma: no cover
+
+
+@njit(cache=True)
+def _check_target(Tt):
+    """True when Tt is finite, has last row 0 0 0 1 and an orthonormal rotation."""
+    for r in range(4):
+        for c in range(4):
+            if not math.isfinite(Tt[r, c]):
+                return False
+    if Tt[3, 0] != 0.0 or Tt[3, 1] != 0.0 or Tt[3, 2] != 0.0 or Tt[3, 3] != 1.0:
+        return False
+    for a in range(3):
+        for b in range(3):
+            s = Tt[0, a] * Tt[0, b] + Tt[1, a] * Tt[1, b] + Tt[2, a] * Tt[2, b]
+            if abs(s - (1.0 if a == b else 0.0)) > 1e-6:
+                return False
+    det = (Tt[0, 0] * (Tt[1, 1] * Tt[2, 2] - Tt[1, 2] * Tt[2, 1])
+           - Tt[0, 1] * (Tt[1, 0] * Tt[2, 2] - Tt[1, 2] * Tt[2, 0])
+           + Tt[0, 2] * (Tt[1, 0] * Tt[2, 1] - Tt[1, 1] * Tt[2, 0]))
+    return det > 0.0
+
+
+@njit(cache=True)
+def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out):
+    """Attempt from q0 (if asked) then from each seed until converged.
+
+    ``seeds`` (R, n) are uniform [0, 1) numbers mapped into the seed ranges. ``out``
+    gets the best q, then the result columns.
+    """
+    n = q0.shape[0]
+    nc = jdat.shape[1]
+    if not _check_target(Tt):
+        for j in range(n):
+            out[j] = q0[j]
+        out[n + R_ERR] = np.inf
+        out[n + R_EP] = np.inf
+        out[n + R_ER] = np.inf
+        out[n + R_ITERS] = 0
+        out[n + R_RESTARTS] = 0
+        out[n + R_CODE] = CODE_BAD_TARGET
+        return
+    w = opts[O_W:O_W + 6]
+    m = 0
+    for i in range(6):
+        if w[i] > 0.0:
+            m += 1
+    rows = np.empty(m, np.int64)
+    sw = np.empty(m)
+    m = 0
+    for i in range(6):
+        if w[i] > 0.0:
+            rows[m] = i
+            sw[m] = math.sqrt(w[i])
+            m += 1
+    nd = max(m, n)
+    qc = np.empty(nc)
+    Jc = np.empty((6, nc))
+    J = np.empty((6, n))
+    T = np.empty((4, 4))
+    e = np.empty(6)
+    qn = np.empty(n)
+    Jn = np.empty((6, n))
+    Tn = np.empty((4, 4))
+    en = np.empty(6)
+    Jw = np.empty((m, n))
+    A = np.empty((nd, nd))
+    g = np.empty(n)
+    y = np.empty(nd)
+    dq = np.empty(n)
+    free = np.empty(n, np.bool_)
+    q = np.empty(n)
+    best = np.empty(n)
+    bestE = np.inf
+    bep = np.inf
+    ber = np.inf
+    max_iter = int(opts[O_MAX_ITER])
+    n_seeds = min(int(opts[O_N_SEEDS]), seeds.shape[0])
+    total = 0
+    restarts = 0
+    code = CODE_STALL
+    start = 0 if opts[O_USE_Q0] == 1.0 else 1
+    for a in range(start, n_seeds + 1):
+        if a == 0:
+            for j in range(n):
+                q[j] = q0[j]
+        else:
+            for j in range(n):
+                q[j] = cdat[2, j] + seeds[a - 1, j] * (cdat[3, j] - cdat[2, j])
+            if a > 1 or start == 0:
+                restarts += 1
+        code, it, ep, er, E = _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw,
+                                       max_iter, qc, Jc, J, T, e, qn, Jn, Tn, en, Jw, A,
+                                       g, y, dq, free)
+        total += it
+        if E < bestE or code == CODE_OK or a == start:
+            bestE = E
+            bep = ep
+            ber = er
+            for j in range(n):
+                best[j] = q[j]
+        if code == CODE_OK:
+            break
+    for j in range(n):
+        out[j] = best[j]
+    out[n + R_ERR] = math.sqrt(bep * bep + ber * ber)
+    out[n + R_EP] = bep
+    out[n + R_ER] = ber
+    out[n + R_ITERS] = total
+    out[n + R_RESTARTS] = restarts
+    out[n + R_CODE] = code
+
+
+@njit(cache=True)
+def solve_serial(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out):
+    """Solve a batch: targets (N, 4, 4), q0 (N, n), seeds (N, R, n) -> out (N, n + N_RES)."""
+    for i in range(targets.shape[0]):
+        _solve_target(targets[i], q0[i], seeds[i], consts, jdat, Mc, cdat, opts, out[i])
+
+
+@njit(cache=True, parallel=True)
+def solve_parallel(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out):
+    """As :func:`solve_serial`, over all threads."""
+    for i in prange(targets.shape[0]):
+        _solve_target(targets[i], q0[i], seeds[i], consts, jdat, Mc, cdat, opts, out[i])
+
+
+@njit(cache=True)
+def solve_path(targets, q_start, consts, jdat, Mc, cdat, opts, out):
+    """Warm-started path: target i starts from the solution of i - 1.
+
+    Stops at the first failure (non-convergence, or a joint change larger than
+    ``opts[O_PATH_MAX_JUMP]`` from the previous sample); later rows get the last good
+    q and ``CODE_NOT_RUN``. Returns the index of the first failure, or -1.
+    """
+    N = targets.shape[0]
+    n = q_start.shape[0]
+    prev = q_start.copy()
+    no_seeds = np.empty((0, n))
+    max_jump = opts[O_PATH_MAX_JUMP]
+    first = -1
+    for i in range(N):
+        if first >= 0:
+            for j in range(n):
+                out[i, j] = prev[j]
+            out[i, n + R_ERR] = np.inf
+            out[i, n + R_EP] = np.inf
+            out[i, n + R_ER] = np.inf
+            out[i, n + R_ITERS] = 0
+            out[i, n + R_RESTARTS] = 0
+            out[i, n + R_CODE] = CODE_NOT_RUN
+            continue
+        _solve_target(targets[i], prev, no_seeds, consts, jdat, Mc, cdat, opts, out[i])
+        if out[i, n + R_CODE] != CODE_OK:
+            first = i
+            continue
+        jump = 0.0
+        for j in range(n):
+            d = abs(out[i, j] - prev[j])
+            if d > jump:
+                jump = d
+        if jump > max_jump:
+            out[i, n + R_CODE] = CODE_JUMP
+            first = i
+            continue
+        for j in range(n):
+            prev[j] = out[i, j]
+    return first

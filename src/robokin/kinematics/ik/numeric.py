@@ -1,0 +1,713 @@
+"""Numeric inverse kinematics for any chain: damped least squares with limits and restarts.
+
+The solver works on the canonical chain (:mod:`robokin.model.chain`), so every arm
+gets it: revolute and prismatic joints, reversed axes, dependent joints
+(``q_chain = M q + c``). One descent is Levenberg-Marquardt on the task error
+
+.. math::
+
+    e = \\begin{bmatrix} p_t - p(q) \\\\ \\log(R_t R(q)^T)^\\vee \\end{bmatrix},
+    \\qquad
+    \\Delta q = J_w^T (J_w J_w^T + \\lambda I)^{-1} W^{1/2} e
+
+(or the joint-space form when fewer joints than task rows), with
+``J_w = W^{1/2} J`` restricted to the selected task rows, ``lambda = mu * E``
+(``E = e^T W e``) and ``mu`` adapted by accepting steps that lower ``E`` and
+rejecting the others. Joint limits are kept during the iteration: every trial
+point is projected into the limits (2*pi-periodic joints are first shifted by whole
+turns), and joints pressed against a limit by the gradient leave the active set.
+A descent that stalls (a local minimum, or pinned at limits) or runs out of
+iterations restarts from a random seed inside the limits until the target is
+reached or the budget (restarts, wall time) is spent.
+
+The inner loop is compiled (numba, ``cache=True``): see ``_numeric_kernels``.
+
+References:
+    Sugihara, T. "Solvability-unconcerned inverse kinematics by the
+    Levenberg-Marquardt method", IEEE Trans. Robotics 27(5), 2011 (the
+    error-scaled damping ``lambda = E + ...``, eq. 20).
+    Nocedal, J. and Wright, S. "Numerical Optimization", 2nd ed., ch. 10.3
+    (Levenberg-Marquardt) and 16.7 (active sets for bounds).
+"""
+
+from __future__ import annotations
+
+import time
+import weakref
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robokin._validation import check_finite, check_joints
+from robokin.exceptions import InputError
+
+__all__ = ["IKPathResult", "IKResult", "ik_path", "parse_mask", "solve", "solve_all"]
+
+_AXES = ("x", "y", "z", "rx", "ry", "rz")
+_PARALLEL_MIN = 64  # below this many targets one thread beats the parallel launch
+_FIRST_ROUND_RESTARTS = 4
+_ROUND_RESTARTS = 16
+
+
+def _kernels():
+    from robokin.kinematics.ik import _numeric_kernels
+
+    return _numeric_kernels
+
+
+# --------------------------------------------------------------------------- records
+@dataclass(frozen=True, eq=False)
+class IKResult:
+    """The outcome of :func:`solve` for a batch of targets of leading shape (...).
+
+    Attributes:
+        q: Joint coordinates [rad, m], shape (..., n): the solution where
+            ``success``, else the best configuration found (always within limits).
+        success: (...) bool, converged to the tolerance.
+        error: (...) final residual [m, rad]: the norm of the selected task error
+            rows (position and rotation together).
+        position_error: (...) norm of the selected position rows [m].
+        rotation_error: (...) norm of the selected rotation rows [rad].
+        iterations: (...) int, iterations used over all attempts.
+        restarts: (...) int, random restarts used.
+        reason: (...) str, ``"converged"`` or why not (with the error reached).
+    """
+
+    q: np.ndarray
+    success: np.ndarray
+    error: np.ndarray
+    iterations: np.ndarray
+    restarts: np.ndarray
+    reason: np.ndarray
+    position_error: np.ndarray
+    rotation_error: np.ndarray
+
+    def __bool__(self) -> bool:
+        """True when every target converged."""
+        return bool(np.all(self.success))
+
+
+@dataclass(frozen=True, eq=False)
+class IKPathResult:
+    """The outcome of :func:`ik_path` for a path of m poses.
+
+    Attributes:
+        q: Joint path (m, n) [rad, m]; after ``first_failure`` the rows repeat the
+            last good configuration.
+        success: (m,) bool.
+        error: (m,) residual reached per sample [m, rad] (inf where not run).
+        first_failure: Index of the first failed sample, or None.
+        reason: ``"converged"`` or why the path stops.
+    """
+
+    q: np.ndarray
+    success: np.ndarray
+    error: np.ndarray
+    first_failure: int | None
+    reason: str
+
+    def __bool__(self) -> bool:
+        """True when every sample converged."""
+        return self.first_failure is None
+
+
+# ------------------------------------------------------------------ per-chain data
+class _ChainData:
+    """Packed kernel arrays of one chain (see ``_numeric_kernels``)."""
+
+    __slots__ = ("consts", "jdat", "Mc", "cdat", "ident", "n", "mid", "is_revolute",
+                 "wrap")
+
+    def __init__(self, chain: Any) -> None:
+        n = chain.n
+        self.n = n
+        self.consts = np.ascontiguousarray(chain._consts, dtype=np.float64)
+        self.jdat = np.ascontiguousarray(
+            np.stack([chain._kind, chain._sign, chain._offset]), dtype=np.float64
+        )
+        M = np.asarray(chain.coupling.matrix, dtype=np.float64)
+        c = np.asarray(chain.coupling.offset, dtype=np.float64)
+        self.Mc = np.ascontiguousarray(np.concatenate([M, c[:, None]], axis=1))
+        self.ident = bool(chain.coupling.is_identity)
+        is_rev = np.asarray(chain.is_revolute, dtype=bool)
+        self.is_revolute = is_rev
+        lim = np.asarray(chain.limits, dtype=np.float64)
+        chain_rev = chain._kind == 0.0
+        # a whole turn of coordinate j must be whole turns of every chain joint it drives
+        wrap = np.zeros(n, dtype=bool)
+        for j in range(n):
+            col = M[:, j]
+            used = col != 0.0
+            wrap[j] = bool(
+                is_rev[j]
+                and np.all(chain_rev[used])
+                and np.allclose(col[used], np.round(col[used]))
+            )
+        self.wrap = wrap
+        slo = np.where(is_rev, np.maximum(lim[:, 0], -np.pi), np.maximum(lim[:, 0], -1.0))
+        shi = np.where(is_rev, np.minimum(lim[:, 1], np.pi), np.minimum(lim[:, 1], 1.0))
+        # a limit range that misses [-pi, pi] (or [-1, 1] m) entirely: seed inside it
+        bad = slo >= shi
+        slo = np.where(bad, lim[:, 0], slo)
+        shi = np.where(bad, lim[:, 1], shi)
+        slo = np.where(np.isfinite(slo), slo, np.where(np.isfinite(shi), shi - 1.0, -1.0))
+        shi = np.where(np.isfinite(shi), shi, slo + 1.0)
+        self.cdat = np.ascontiguousarray(
+            np.stack([lim[:, 0], lim[:, 1], slo, shi, wrap.astype(np.float64)])
+        )
+        self.mid = 0.5 * (slo + shi)
+
+
+_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _chain_data(robot: Any) -> _ChainData:
+    chain = robot.chain
+    try:
+        return _CACHE[chain]
+    except KeyError:
+        data = _CACHE[chain] = _ChainData(chain)
+        return data
+
+
+_DEFAULT_RNG: list[np.random.Generator] = []
+
+
+def _rng(rng: np.random.Generator | None) -> np.random.Generator:
+    if rng is not None:
+        if not isinstance(rng, np.random.Generator):
+            raise InputError("rng", f"expected a numpy.random.Generator, got {rng!r:.60}")
+        return rng
+    if not _DEFAULT_RNG:
+        _DEFAULT_RNG.append(np.random.default_rng())
+    return _DEFAULT_RNG[0]
+
+
+# --------------------------------------------------------------------- the options
+_MASK_CACHE: dict[Any, np.ndarray] = {}
+
+
+def parse_mask(mask: Any) -> np.ndarray:
+    """The task mask as a (6,) bool array over ``(x, y, z, rx, ry, rz)``.
+
+    Args:
+        mask: None (the full pose); a sequence of 6 booleans; a string or sequence of
+            axis names (``"xyz"``, ``"x y z rz"``, ``["x", "y", "z", "rz"]``); or the
+            shorthands ``"pose"``, ``"position"``. Rotation rows are the components
+            of the rotation error vector in the base frame, so ``"rz"`` is the yaw
+            about the base z axis (a SCARA's or palletizer's tool angle).
+
+    Raises:
+        InputError: an unknown axis name, a wrong length, or no axis selected.
+    """
+    if mask is None:
+        return np.ones(6, dtype=bool)
+    key = mask if isinstance(mask, str) else None
+    if key is not None and key in _MASK_CACHE:
+        return _MASK_CACHE[key]
+    if isinstance(mask, str):
+        s = mask.strip().lower()
+        if s in ("pose", "full", "all"):
+            out = np.ones(6, dtype=bool)
+        elif s in ("position", "pos"):
+            out = np.array([1, 1, 1, 0, 0, 0], dtype=bool)
+        else:
+            names = s.replace(",", " ").split()
+            tokens: list[str] = []
+            for word in names:  # "xyzrz" -> x y z rz
+                i = 0
+                while i < len(word):
+                    if word[i] == "r" and i + 1 < len(word):
+                        tokens.append(word[i:i + 2])
+                        i += 2
+                    else:
+                        tokens.append(word[i])
+                        i += 1
+            out = _mask_from_names(tokens, mask)
+        _MASK_CACHE[key] = out
+        return out
+    arr = np.asarray(mask)
+    if arr.dtype.kind in "US" or (arr.dtype == object and arr.size and isinstance(
+            arr.flat[0], str)):
+        return _mask_from_names([str(a).lower() for a in arr.ravel()], mask)
+    if arr.shape != (6,) or arr.dtype.kind not in "biuf":
+        raise InputError(
+            "mask", f"expected 6 booleans over (x, y, z, rx, ry, rz) or axis names, "
+            f"got {mask!r:.80}"
+        )
+    out = arr.astype(bool)
+    if not out.any():
+        raise InputError("mask", "selects no task axis")
+    return out
+
+
+def _mask_from_names(tokens: Sequence[str], original: Any) -> np.ndarray:
+    out = np.zeros(6, dtype=bool)
+    for t in tokens:
+        if t not in _AXES:
+            raise InputError(
+                "mask", f"unknown axis {t!r} in {original!r:.60}; expected names from "
+                f"{list(_AXES)}, 'pose' or 'position'"
+            )
+        out[_AXES.index(t)] = True
+    if not out.any():
+        raise InputError("mask", "selects no task axis")
+    return out
+
+
+def _opts(mask: Any, weights: Any, tol: Any, tol_rotation: Any, max_iterations: Any,
+          max_step: Any) -> np.ndarray:
+    K = _kernels()
+    m = parse_mask(mask)
+    if weights is None:
+        w = np.ones(6)
+    else:
+        w = np.asarray(weights, dtype=np.float64)
+        if w.shape == (2,):
+            w = np.repeat(w, 3)
+        if w.shape != (6,) or not np.all(np.isfinite(w)) or np.any(w <= 0):
+            raise InputError(
+                "weights", "expected 6 positive weights over (x, y, z, rx, ry, rz) "
+                f"or 2 (position [1/m^2], rotation [1/rad^2]), got {weights!r:.80}"
+            )
+    tol_p = _positive(tol, "tol")
+    tol_r = tol_p if tol_rotation is None else _positive(tol_rotation, "tol_rotation")
+    opts = np.zeros(K.N_OPTS)
+    opts[K.O_W:K.O_W + 6] = np.where(m, w, 0.0)
+    opts[K.O_TOL_P] = tol_p
+    opts[K.O_TOL_R] = tol_r
+    opts[K.O_MAX_ITER] = _count(max_iterations, "max_iterations", minimum=1)
+    opts[K.O_MAX_STEP] = _positive(max_step, "max_step")
+    opts[K.O_MU0] = 1e-3
+    opts[K.O_PATH_MAX_JUMP] = np.inf
+    return opts
+
+
+def _positive(x: Any, name: str) -> float:
+    try:
+        v = float(x)
+    except (TypeError, ValueError) as exc:
+        raise InputError(name, f"expected a positive number, got {x!r:.60}") from exc
+    if not v > 0.0:
+        raise InputError(name, f"expected a positive number, got {x!r:.60}")
+    return v
+
+
+def _count(x: Any, name: str, minimum: int = 0) -> int:
+    if isinstance(x, bool | np.bool_) or not isinstance(x, int | np.integer):
+        raise InputError(name, f"expected an integer >= {minimum}, got {x!r:.60}")
+    if x < minimum:
+        raise InputError(name, f"expected an integer >= {minimum}, got {x}")
+    return int(x)
+
+
+def _targets(T: npt.ArrayLike) -> tuple[np.ndarray, tuple[int, ...]]:
+    if type(T) is not np.ndarray or T.dtype != np.float64:
+        try:
+            T = np.asarray(T, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise InputError("T", f"expected a 4x4 matrix, got {T!r:.80}") from exc
+    if T.ndim < 2 or T.shape[-2:] != (4, 4):
+        raise InputError("T", f"expected shape (..., 4, 4), got {T.shape}")
+    lead = T.shape[:-2]
+    return np.ascontiguousarray(T.reshape(-1, 4, 4)), lead
+
+
+def _bad_target(Tf: np.ndarray, lead: tuple[int, ...], i: int) -> InputError:
+    idx = np.unravel_index(i, lead) if lead else ()
+    T = Tf[i]
+    if not np.isfinite(T).all():
+        why = "holds a non-finite value"
+    elif not np.array_equal(T[3], [0.0, 0.0, 0.0, 1.0]):
+        why = "the last row of a homogeneous transform must be 0 0 0 1"
+    else:
+        why = "the rotation block is not a proper rotation (orthonormal, det +1) to 1e-6"
+    where = f" at index {tuple(int(k) for k in idx)}" if lead else ""
+    return InputError("T", f"target{where}: {why}")
+
+
+# ------------------------------------------------------------------------- solve
+def solve(
+    robot: Any,
+    T: npt.ArrayLike,
+    *,
+    q0: npt.ArrayLike | None = None,
+    mask: Any = None,
+    weights: npt.ArrayLike | None = None,
+    tol: float = 1e-9,
+    tol_rotation: float | None = None,
+    max_iterations: int = 100,
+    max_restarts: int = 50,
+    max_time: float | None = None,
+    max_step: float = 1.0,
+    parallel: bool | None = None,
+    rng: np.random.Generator | None = None,
+) -> IKResult:
+    """One joint solution per target pose, by damped least squares with restarts.
+
+    Args:
+        robot: The :class:`~robokin.robot.Robot`.
+        T: Target tool poses in the world frame, shape (..., 4, 4) [m].
+        q0: Initial guess (..., n) or (n,) [rad, m]; default the middle of the
+            limits (angles clipped to [-pi, pi]).
+        mask: Which task rows to meet, see :func:`parse_mask` (e.g. ``"xyz"`` for
+            position only, ``"xyz rz"`` for position + yaw); default the full pose.
+        weights: Task weights, 6 values over (x, y, z, rx, ry, rz) or 2 (position,
+            rotation): the exchange rate between metres and radians in the cost
+            ``e^T W e``. Default all ones.
+        tol: Convergence tolerance on the position error norm [m] (and on the
+            rotation error norm [rad] unless ``tol_rotation`` is given).
+        tol_rotation: Tolerance on the rotation error norm [rad].
+        max_iterations: Iterations per descent (restarts get their own).
+        max_restarts: Random restarts per target after the first descent.
+        max_time: Wall-time budget per target [s] (a batch gets ``N * max_time``);
+            None for no limit. Checked between rounds of restarts.
+        max_step: Largest joint change per iteration [rad or m].
+        parallel: Use all threads (default: for 64 targets or more).
+        rng: Random generator for the restart seeds (default a module-level one).
+
+    Returns:
+        An :class:`IKResult` with leading shape (...). Failure is reported, never
+        raised: ``success`` False, the best ``q`` found and the error reached.
+
+    Raises:
+        InputError: a bad pose (wrong shape, non-finite, not a rigid transform), a
+            bad ``q0`` or option.
+    """
+    K = _kernels()
+    data = _chain_data(robot)
+    n = data.n
+    Tf, lead = _targets(T)
+    N = Tf.shape[0]
+    opts = _opts(mask, weights, tol, tol_rotation, max_iterations, max_step)
+    max_restarts = _count(max_restarts, "max_restarts")
+    if max_time is not None:
+        max_time = _positive(max_time, "max_time")
+    gen = _rng(rng)
+    t_start = time.perf_counter()
+    if q0 is None:
+        Q0 = np.broadcast_to(data.mid, (N, n))
+    else:
+        q0 = check_finite(check_joints(q0, n, "q0"), "q0")
+        try:
+            Q0 = np.broadcast_to(q0, lead + (n,)).reshape(N, n)
+        except ValueError as exc:
+            raise InputError(
+                "q0", f"shape {q0.shape} does not broadcast to the targets' {lead + (n,)}"
+            ) from exc
+    Q0 = np.ascontiguousarray(Q0)
+    out = np.empty((N, n + K.N_RES))
+    if N == 0:
+        return _result(out, lead, n, np.zeros(0, bool), K)
+    use_par = N >= _PARALLEL_MIN if parallel is None else bool(parallel)
+    kern = K.solve_parallel if use_par else K.solve_serial
+    R = min(max_restarts, _FIRST_ROUND_RESTARTS)
+    opts[K.O_USE_Q0] = 1.0
+    opts[K.O_N_SEEDS] = R
+    seeds = gen.random((N, max(R, 1), n))
+    kern(Tf, Q0, seeds, data.consts, data.jdat, data.Mc, data.cdat, opts, out)
+    code = out[:, n + K.R_CODE]
+    if (code == K.CODE_BAD_TARGET).any():
+        raise _bad_target(Tf, lead, int(np.flatnonzero(code == K.CODE_BAD_TARGET)[0]))
+    timed_out = np.zeros(N, dtype=bool)
+    used = out[:, n + K.R_RESTARTS].copy()
+    todo = np.flatnonzero(code != K.CODE_OK)
+    if todo.size and max_restarts > R:
+        deadline = None if max_time is None else t_start + max_time * N
+        opts[K.O_USE_Q0] = 0.0
+        while todo.size:
+            if deadline is not None and time.perf_counter() >= deadline:
+                timed_out[todo] = True
+                break
+            left = max_restarts - int(used[todo[0]])
+            if left <= 0:
+                break
+            R = min(left, _ROUND_RESTARTS)
+            opts[K.O_N_SEEDS] = R
+            sub = np.empty((todo.size, n + K.N_RES))
+            kern2 = K.solve_parallel if (parallel is None and todo.size >= _PARALLEL_MIN) \
+                or parallel else K.solve_serial
+            kern2(Tf[todo], Q0[todo], gen.random((todo.size, R, n)), data.consts,
+                  data.jdat, data.Mc, data.cdat, opts, sub)
+            attempts = sub[:, n + K.R_RESTARTS] + 1
+            used[todo] += attempts
+            out[todo, n + K.R_ITERS] += sub[:, n + K.R_ITERS]
+            better = (sub[:, n + K.R_CODE] == K.CODE_OK) | (
+                sub[:, n + K.R_ERR] < out[todo, n + K.R_ERR])
+            rows = todo[better]
+            keep_iters = out[rows, n + K.R_ITERS].copy()
+            out[rows] = sub[better]
+            out[rows, n + K.R_ITERS] = keep_iters
+            todo = todo[out[todo, n + K.R_CODE] != K.CODE_OK]
+    out[:, n + K.R_RESTARTS] = used
+    return _result(out, lead, n, timed_out, K)
+
+
+def _result(out: np.ndarray, lead: tuple[int, ...], n: int, timed_out: np.ndarray,
+            K: Any) -> IKResult:
+    code = out[:, n + K.R_CODE]
+    success = code == K.CODE_OK
+    reason = np.empty(out.shape[0], dtype=object)
+    reason[:] = "converged"
+    for i in np.flatnonzero(~success):
+        why = ("time budget exhausted" if timed_out[i] else
+               "restart budget exhausted")
+        last = "stalled in a local minimum or at joint limits" \
+            if code[i] == K.CODE_STALL else "iteration budget of the last descent spent"
+        reason[i] = (
+            f"not converged: error {out[i, n + K.R_ERR]:.3g} (position "
+            f"{out[i, n + K.R_EP]:.3g} m, rotation {out[i, n + K.R_ER]:.3g} rad) after "
+            f"{int(out[i, n + K.R_RESTARTS])} restart(s); {why} ({last})"
+        )
+    return IKResult(
+        q=out[:, :n].reshape(lead + (n,)),
+        success=success.reshape(lead),
+        error=out[:, n + K.R_ERR].reshape(lead),
+        iterations=out[:, n + K.R_ITERS].astype(np.int64).reshape(lead),
+        restarts=out[:, n + K.R_RESTARTS].astype(np.int64).reshape(lead),
+        reason=reason.reshape(lead),
+        position_error=out[:, n + K.R_EP].reshape(lead),
+        rotation_error=out[:, n + K.R_ER].reshape(lead),
+    )
+
+
+# --------------------------------------------------------------------- solve_all
+_SOLVE_ALL_OPTIONS = frozenset(
+    {"mask", "weights", "tol", "tol_rotation", "max_iterations", "max_restarts",
+     "max_time", "max_step", "parallel", "rng", "dedupe_tol"}
+)
+
+
+def solve_all(
+    robot: Any,
+    T: npt.ArrayLike,
+    *,
+    q_near: npt.ArrayLike | None = None,
+    n_seeds: int = 16,
+    **options: Any,
+):
+    """The distinct solutions that descents from many seeds find, as a SolutionSet.
+
+    Every target gets ``n_seeds`` independent descents (from ``q_near`` first when
+    given, then random seeds inside the limits); converged results are
+    deduplicated with revolute angles compared modulo 2*pi (``dedupe_tol``,
+    default 1e-6). A target none of them reaches gets up to ``max_restarts`` more
+    random restarts. Solutions are ordered by distance to ``q_near`` when given.
+    Periodic angles are reported in [-pi, pi) when that stays inside the limits.
+
+    For a redundant arm (more joints than task rows) the solutions form a
+    continuum: the set is a sample of it.
+
+    Args:
+        robot: The :class:`~robokin.robot.Robot`.
+        T: Target poses (..., 4, 4) [m].
+        q_near: Current configuration (..., n) or (n,), the first seed.
+        n_seeds: Descents per target.
+        **options: ``mask``, ``weights``, ``tol``, ``tol_rotation``,
+            ``max_iterations``, ``max_restarts`` (default 50), ``max_time``,
+            ``max_step``, ``parallel``, ``rng`` as in :func:`solve`, and
+            ``dedupe_tol`` [rad, m].
+
+    Returns:
+        A :class:`~robokin.kinematics.ik.solutions.SolutionSet` with
+        ``method="numeric"``; per-pose ``status`` says why a pose has none.
+
+    Raises:
+        InputError: an unknown option (the message lists the accepted ones), a bad
+            pose, ``q_near`` or option value.
+    """
+    from robokin.kinematics.ik.solutions import SolutionSet, wrap_angle
+
+    unknown = sorted(set(options) - _SOLVE_ALL_OPTIONS)
+    if unknown:
+        raise InputError(
+            "options", f"unknown option(s) {unknown} for the numeric IK solver; accepted: "
+            f"n_seeds, q_near, {', '.join(sorted(_SOLVE_ALL_OPTIONS))}"
+        )
+    K = _kernels()
+    data = _chain_data(robot)
+    n = data.n
+    n_seeds = _count(n_seeds, "n_seeds", minimum=1)
+    dedupe_tol = _positive(options.pop("dedupe_tol", 1e-6), "dedupe_tol")
+    max_restarts = _count(options.get("max_restarts", 50), "max_restarts")
+    Tf, lead = _targets(T)
+    N = Tf.shape[0]
+    gen = _rng(options.get("rng"))
+    opts = _opts(options.get("mask"), options.get("weights"), options.get("tol", 1e-9),
+                 options.get("tol_rotation"), options.get("max_iterations", 100),
+                 options.get("max_step", 1.0))
+    lim = np.asarray(robot.limits, dtype=np.float64)
+    is_rev = data.is_revolute
+    if N == 0:
+        return SolutionSet.empty(lead, n, is_rev, lim, "no solution", method="numeric")
+    S = n_seeds
+    cd = data.cdat
+    seeds = cd[2] + gen.random((N, S, n)) * (cd[3] - cd[2])
+    if q_near is not None:
+        qn = check_finite(check_joints(q_near, n, "q_near"), "q_near")
+        try:
+            seeds[:, 0] = np.broadcast_to(qn, lead + (n,)).reshape(N, n)
+        except ValueError as exc:
+            raise InputError(
+                "q_near", f"shape {qn.shape} does not broadcast to the targets' "
+                f"{lead + (n,)}"
+            ) from exc
+    flatT = np.ascontiguousarray(np.repeat(Tf, S, axis=0))
+    flatQ = np.ascontiguousarray(seeds.reshape(N * S, n))
+    opts[K.O_USE_Q0] = 1.0
+    opts[K.O_N_SEEDS] = 0
+    out = np.empty((N * S, n + K.N_RES))
+    par = options.get("parallel")
+    use_par = N * S >= _PARALLEL_MIN if par is None else bool(par)
+    kern = K.solve_parallel if use_par else K.solve_serial
+    kern(flatT, flatQ, np.empty((N * S, 1, n)), data.consts, data.jdat, data.Mc, cd, opts,
+         out)
+    code = out[:, n + K.R_CODE]
+    if (code == K.CODE_BAD_TARGET).any():
+        raise _bad_target(Tf, lead, int(np.flatnonzero(code == K.CODE_BAD_TARGET)[0]) // S)
+    out = out.reshape(N, S, n + K.N_RES)
+    q = out[..., :n].copy()
+    ok = out[..., n + K.R_CODE] == K.CODE_OK
+    err = out[..., n + K.R_ERR].copy()
+    # rescue targets no seed reached with the restarting solver
+    none = np.flatnonzero(~ok.any(axis=1))
+    best_err = err.min(axis=1)
+    if none.size and max_restarts > 0:
+        res = solve(robot, Tf[none], q0=q[none, np.argmin(err[none], axis=1)], mask=None
+                    if options.get("mask") is None else options["mask"],
+                    weights=options.get("weights"), tol=options.get("tol", 1e-9),
+                    tol_rotation=options.get("tol_rotation"),
+                    max_iterations=options.get("max_iterations", 100),
+                    max_restarts=max_restarts, max_time=options.get("max_time"),
+                    max_step=options.get("max_step", 1.0), parallel=par, rng=gen)
+        q[none, 0] = res.q
+        ok[none, 0] = res.success
+        err[none, 0] = res.error
+        best_err[none] = np.minimum(best_err[none], res.error)
+    # report periodic angles in [-pi, pi) where that stays inside the limits
+    wrapped = wrap_angle(q)
+    inside = (wrapped >= lim[:, 0]) & (wrapped <= lim[:, 1])
+    q = np.where(data.wrap & inside, wrapped, q)
+    # deduplicate: row j is a copy if an earlier valid row is within dedupe_tol
+    diff = q[:, :, None, :] - q[:, None, :, :]
+    diff = np.where(data.wrap, wrap_angle(diff), diff)
+    close = np.abs(diff).max(axis=-1) <= dedupe_tol
+    earlier = np.tril(np.ones((S, S), dtype=bool), k=-1)
+    dup = (close & earlier & ok[:, None, :]).any(axis=-1)
+    keep = ok & ~dup
+    if q_near is not None:
+        d = q - seeds[:, :1]
+        d = np.where(data.wrap, wrap_angle(d), d)
+        key = np.where(keep, np.linalg.norm(d, axis=-1), np.inf)
+    else:
+        key = np.where(keep, np.arange(S, dtype=np.float64), np.inf)
+    order = np.argsort(key, axis=1, kind="stable")
+    k = max(int(keep.sum(axis=1).max()), 1)
+    order = order[:, :k]
+    q = np.take_along_axis(q, order[..., None], axis=1)
+    valid = np.take_along_axis(keep, order, axis=1)
+    err = np.take_along_axis(err, order, axis=1)
+    q = np.where(valid[..., None], q, 0.0)
+    status = np.empty(N, dtype=object)
+    status[:] = "ok"
+    for i in np.flatnonzero(~valid.any(axis=1)):
+        status[i] = (f"no solution found from {S} seeds and {max_restarts} restarts "
+                     f"(best error {best_err[i]:.3g})")
+    info = {"n_seeds": S, "mask": _mask_names(opts), "tol": float(opts[K.O_TOL_P])}
+    return SolutionSet(
+        q.reshape(lead + (k, n)), valid.reshape(lead + (k,)), is_rev, lim,
+        status=status.reshape(lead), method="numeric", error=err.reshape(lead + (k,)),
+        info=info,
+    )
+
+
+def _mask_names(opts: np.ndarray) -> str:
+    return " ".join(a for a, w in zip(_AXES, opts[:6], strict=True) if w > 0)
+
+
+# -------------------------------------------------------------------------- ik_path
+def ik_path(
+    robot: Any,
+    T_path: npt.ArrayLike,
+    q_start: npt.ArrayLike,
+    *,
+    mask: Any = None,
+    weights: npt.ArrayLike | None = None,
+    tol: float = 1e-9,
+    tol_rotation: float | None = None,
+    max_iterations: int = 200,
+    max_step: float = 0.2,
+    max_jump: float = 0.5,
+) -> IKPathResult:
+    """Joint path through a sequence of poses, each solve warm-started from the last.
+
+    No random restarts: every sample starts from the previous solution (the first
+    from ``q_start``) with a small step cap, so the solver stays on the branch it
+    started on and a Cartesian line becomes a continuous joint motion. The path
+    stops at the first sample that does not converge or whose joints move more
+    than ``max_jump`` from the previous sample (a branch jump, or a path sampled
+    too coarsely near a singularity).
+
+    Args:
+        robot: The :class:`~robokin.robot.Robot`.
+        T_path: Poses (m, 4, 4) [m].
+        q_start: Configuration (n,) the path starts from [rad, m].
+        mask: Task rows, see :func:`parse_mask`.
+        weights: Task weights, as in :func:`solve`.
+        tol: Position tolerance [m] (and rotation [rad] unless ``tol_rotation``).
+        tol_rotation: Rotation tolerance [rad].
+        max_iterations: Iterations per sample.
+        max_step: Largest joint change per iteration [rad or m].
+        max_jump: Largest joint change between consecutive samples [rad or m].
+
+    Returns:
+        An :class:`IKPathResult`.
+
+    Raises:
+        InputError: bad poses (shape (m, 4, 4), rigid), ``q_start`` or options.
+    """
+    K = _kernels()
+    data = _chain_data(robot)
+    n = data.n
+    Tf, lead = _targets(T_path)
+    if len(lead) != 1:
+        raise InputError("T_path", f"expected shape (m, 4, 4), got {lead + (4, 4)}")
+    q_start = check_finite(check_joints(q_start, n, "q_start"), "q_start")
+    if q_start.shape != (n,):
+        raise InputError("q_start", f"expected shape ({n},), got {q_start.shape}")
+    opts = _opts(mask, weights, tol, tol_rotation, max_iterations, max_step)
+    opts[K.O_USE_Q0] = 1.0
+    opts[K.O_N_SEEDS] = 0
+    opts[K.O_PATH_MAX_JUMP] = _positive(max_jump, "max_jump")
+    m = Tf.shape[0]
+    out = np.empty((m, n + K.N_RES))
+    first = int(K.solve_path(Tf, np.ascontiguousarray(q_start), data.consts, data.jdat,
+                             data.Mc, data.cdat, opts, out)) if m else -1
+    code = out[:, n + K.R_CODE]
+    if first >= 0 and code[first] == K.CODE_BAD_TARGET:
+        raise _bad_target(Tf, lead, first)
+    success = code == K.CODE_OK
+    if first < 0:
+        reason = "converged"
+    elif code[first] == K.CODE_JUMP:
+        prev = q_start if first == 0 else out[first - 1, :n]
+        d = np.abs(out[first, :n] - prev)
+        j = int(np.argmax(d))
+        reason = (f"sample {first}: joint {j + 1} would move {d[j]:.3g} "
+                  f"(max_jump {max_jump:g}): a branch jump or a path sampled too "
+                  "coarsely; sample it more finely or raise max_jump")
+    else:
+        reason = (f"sample {first}: not converged (error {out[first, n + K.R_ERR]:.3g}) "
+                  f"warm-started from sample {first - 1}" if first else
+                  f"sample 0: not converged from q_start (error "
+                  f"{out[first, n + K.R_ERR]:.3g})")
+    return IKPathResult(
+        q=out[:, :n].copy(),
+        success=success,
+        error=out[:, n + K.R_ERR].copy(),
+        first_failure=None if first < 0 else first,
+        reason=reason,
+    )
