@@ -1,0 +1,73 @@
+"""``robokin workspace``: Monte-Carlo workspace of a robot, with plots."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from robokin.cli import app
+
+__all__ = ["workspace"]
+
+
+@app.command()
+def workspace(
+    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    samples: Annotated[int, typer.Option("--samples", "-n", help="Joint samples.")] = 1_000_000,
+    out: Annotated[Path, typer.Option("--out", help="Output folder for the plots.")] = Path(
+        "robokin-workspace"
+    ),
+    voxel_mm: Annotated[
+        float, typer.Option("--voxel", help="Voxel edge [mm] (default: extent / 100).")
+    ] = 0.0,
+    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+) -> None:
+    """Sample the reachable workspace: bounds, volume, XY/XZ sections, manipulability."""
+    import numpy as np
+    from rich.console import Console
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+    from rich.table import Table
+
+    import robokin
+    from robokin.kinematics.workspace import sample_workspace, save_workspace_plots
+
+    if samples < 1:
+        raise typer.BadParameter(f"--samples must be >= 1, got {samples}")
+    robot = robokin.load(name)
+    con = Console(stderr=as_json)
+    with Progress(
+        TextColumn("[bold]sampling[/bold] {task.completed:,.0f}/{task.total:,.0f}"),
+        BarColumn(),
+        TimeRemainingColumn(),
+        console=con,
+        transient=as_json,
+    ) as bar:
+        task = bar.add_task("fk", total=samples)
+        ws = sample_workspace(
+            robot,
+            samples,
+            rng=np.random.default_rng(seed),
+            voxel_size=voxel_mm / 1000.0 if voxel_mm > 0 else None,
+            progress=lambda done, total: bar.update(task, completed=done),
+        )
+    paths = save_workspace_plots(ws, out)
+    summary = ws.summary()
+    summary["plots"] = [str(p) for p in paths]
+    (Path(out) / f"{robot.name}_workspace.json").write_text(json.dumps(summary, indent=2))
+    if as_json:
+        print(json.dumps(summary))
+        return
+    table = Table(title=f"{robot.name}: workspace of the tool point ({ws.n_samples:,} samples)")
+    for col in ("", "x \\[mm]", "y \\[mm]", "z \\[mm]"):
+        table.add_column(col, justify="right")
+    for label, row in (("min", ws.bounds[0]), ("max", ws.bounds[1]), ("extent", ws.extent)):
+        table.add_row(label, *(f"{v * 1000:.1f}" for v in row))
+    con.print(table)
+    con.print(f"volume ≈ {ws.volume:.4f} m³ ({ws.occupied_voxels:,} voxels of "
+              f"{ws.voxel_size * 1000:.1f} mm)")
+    for p in paths:
+        con.print(f"wrote {p}")
