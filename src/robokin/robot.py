@@ -240,9 +240,15 @@ class Robot:
         self, q: npt.ArrayLike, *, frame: Literal["base", "tool"] = "base",
         space: Space = "joint",
     ) -> np.ndarray:
-        """Geometric Jacobian (..., 6, n) ``[v; w]``; (..., 6, m) in actuator space."""
+        """Geometric Jacobian (..., 6, n) ``[v; w]``; (..., 6, m) in actuator space.
+
+        In actuator space ``q`` holds motor coordinates (..., m) and the result is
+        ``J(A phi + b) @ A``: tool twist per unit motor rate.
+        """
         if space == "actuator":
             J = _jac.jacobian(self.chain, self.joints_from_actuators(q), frame=frame)
+            if self.actuators is None:
+                return J
             return J @ self.actuators.matrix
         return _jac.jacobian(self.chain, self._to_joints(q, space, "q"), frame=frame)
 
@@ -293,14 +299,35 @@ class Robot:
     def actuators_from_joints(self, q: npt.ArrayLike) -> np.ndarray:
         """Motor coordinates ``phi = A^+ (q - b)``: (..., n) -> (..., m).
 
-        The identity when the robot has no actuator map.
+        The identity when the robot has no actuator map. When there are fewer
+        motors than joints (passive joints driven through ``A``), ``q`` must be a
+        configuration the motors can produce.
+
+        Raises:
+            InputError: ``q`` has the wrong shape, is not finite, or (fewer motors
+                than joints) is not reachable through the actuator map.
+            ModelError: the actuator matrix cannot be inverted.
         """
         from robokin._validation import check_finite, check_joints
 
         q = check_finite(check_joints(q, self.n, "q"), "q")
         if self.actuators is None:
             return q.copy()
-        return self.actuators.inverse(q, what=f"actuator map of '{self.name}'")
+        what = f"actuator map of '{self.name}'"
+        phi = self.actuators.inverse(q, what=what)
+        if self.actuators.n_in < self.actuators.n_out:
+            back = self.actuators.apply(phi)
+            err = np.abs(back - q)
+            tol = 1e-9 * (1.0 + np.abs(q))
+            if (err > tol).any():
+                idx = np.argwhere(err > tol)[0]
+                raise InputError(
+                    "q",
+                    f"not reachable through the {what}: joint "
+                    f"{self.joint_names[idx[-1]]!r} would be {back[tuple(idx)]:.9g}, "
+                    f"got {q[tuple(idx)]:.9g} (passive joints follow the motors)",
+                )
+        return phi
 
     def joints_from_actuators(self, phi: npt.ArrayLike) -> np.ndarray:
         """Joint coordinates ``q = A phi + b``: (..., m) -> (..., n)."""
@@ -311,6 +338,15 @@ class Robot:
         if self.actuators is None:
             return phi.copy()
         return self.actuators.apply(phi)
+
+    def within_actuator_limits(self, phi: npt.ArrayLike, tol: float = 1e-9) -> np.ndarray:
+        """(...) bool: every motor coordinate (..., m) inside its limits (tolerance ``tol``)."""
+        from robokin._validation import check_joints
+
+        m = self.n if self.actuators is None else self.actuators.n_in
+        phi = check_joints(phi, m, "phi")
+        lim = self.limits if self.actuators is None else self.actuator_limits
+        return ((phi >= lim[:, 0] - tol) & (phi <= lim[:, 1] + tol)).all(axis=-1)
 
     # ------------------------------------------------------------------- checks
     def within_limits(self, q: npt.ArrayLike, tol: float = 1e-9) -> np.ndarray:
