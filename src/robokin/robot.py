@@ -290,7 +290,14 @@ class Robot:
             if q_near is not None:
                 q_near = self.joints_from_actuators(q_near)
             sols = solve(self, T, q_near=q_near, method=method, **options)
-            return sols.to_actuator_space(self)
+            out = sols.to_actuator_space(self)
+            if self.actuators is not None and out.is_revolute.any():
+                # Motor angles never wrap: a motor turn through a reduction is not a
+                # whole joint turn, so 2*pi-shifted motor values are other poses.
+                from dataclasses import replace as _replace
+
+                out = _replace(out, is_revolute=np.zeros(out.n, bool))
+            return out
         if space != "joint":
             raise InputError("space", f"expected 'joint' or 'actuator', got {space!r}")
         return solve(self, T, q_near=q_near, method=method, **options)
@@ -320,7 +327,8 @@ class Robot:
             err = np.abs(back - q)
             tol = 1e-9 * (1.0 + np.abs(q))
             if (err > tol).any():
-                idx = np.argwhere(err > tol)[0]
+                first = tuple(np.argwhere((err > tol).any(axis=-1))[0]) if q.ndim > 1 else ()
+                idx = first + (int(np.argmax(err[first])),)
                 raise InputError(
                     "q",
                     f"not reachable through the {what}: joint "

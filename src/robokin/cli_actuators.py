@@ -1,0 +1,109 @@
+"""``robokin motors`` and ``robokin joints``: convert between joint and motor space.
+
+Radians and metres unless ``--deg`` / ``--mm`` is given (``--deg`` applies to
+revolute joints and rotary motors, ``--mm`` to prismatic joints and linear motors).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from robokin.cli import _NUMERIC_ARGS, _console, _load, app
+
+__all__ = ["joints", "motors"]
+
+_DEG = math.pi / 180.0
+
+
+def _motor_kinds(robot) -> list[str]:
+    if robot.actuators is None:
+        return ["rotary" if r else "linear" for r in robot.is_revolute]
+    kinds = robot.meta.get("actuator_kinds")
+    return list(kinds) if kinds else ["rotary"] * robot.actuators.n_in
+
+
+def _scales(angular: np.ndarray, deg: bool, mm: bool) -> np.ndarray:
+    """Display units per SI unit, per coordinate."""
+    return np.where(angular, 1.0 / _DEG if deg else 1.0, 1000.0 if mm else 1.0)
+
+
+def _units(angular: np.ndarray, deg: bool, mm: bool) -> list[str]:
+    return [("deg" if deg else "rad") if a else ("mm" if mm else "m") for a in angular]
+
+
+def _motor_names(robot) -> list[str]:
+    if robot.actuators is None:
+        return list(robot.joint_names)
+    return list(robot.actuator_names)
+
+
+def _report(title: str, names: list[str], values: np.ndarray, units: list[str],
+            inside: np.ndarray, as_json: bool, key: str) -> None:
+    if as_json:
+        print(json.dumps({key: values.tolist(), "names": names, "units": units,
+                          "within_limits": inside.tolist()}))
+        return
+    from rich.table import Table
+
+    table = Table(title=title)
+    for col in ("name", "value", "unit", "within limits"):
+        table.add_column(col)
+    for nm, v, u, ok in zip(names, values, units, inside):
+        table.add_row(nm, f"{v:.9g}", u, "yes" if ok else "[red]no[/red]")
+    _console().print(table)
+
+
+def _inside(values: np.ndarray, limits: np.ndarray | None) -> np.ndarray:
+    if limits is None:
+        return np.ones(values.shape, bool)
+    return (values >= limits[:, 0] - 1e-9) & (values <= limits[:, 1] + 1e-9)
+
+
+@app.command(context_settings=_NUMERIC_ARGS)
+def motors(
+    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    q: Annotated[list[float], typer.Argument(help="Joint values (rad, m).")],
+    deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
+    mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+) -> None:
+    """Motor coordinates from joint coordinates: phi = A^+ (q - b)."""
+    r = _load(name)
+    if len(q) != r.n:
+        raise typer.BadParameter(f"{r.name} has {r.n} joints, got {len(q)} values")
+    rev = r.is_revolute
+    qv = np.array(q, dtype=float) / _scales(rev, deg, mm)
+    phi = r.actuators_from_joints(qv)
+    angular = np.array([k == "rotary" for k in _motor_kinds(r)])
+    lim = r.limits if r.actuators is None else r.actuator_limits
+    _report(f"{r.name}: motor coordinates", _motor_names(r),
+            phi * _scales(angular, deg, mm), _units(angular, deg, mm),
+            _inside(phi, lim), as_json, "phi")
+    if not as_json and r.actuators is None:
+        _console().print("[dim]no actuator map: motors drive the joints one to one[/dim]")
+
+
+@app.command(context_settings=_NUMERIC_ARGS)
+def joints(
+    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    phi: Annotated[list[float], typer.Argument(help="Motor values (rad, m).")],
+    deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
+    mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+) -> None:
+    """Joint coordinates from motor coordinates: q = A phi + b."""
+    r = _load(name)
+    angular = np.array([k == "rotary" for k in _motor_kinds(r)])
+    if len(phi) != angular.size:
+        raise typer.BadParameter(
+            f"{r.name} has {angular.size} motors, got {len(phi)} values")
+    pv = np.array(phi, dtype=float) / _scales(angular, deg, mm)
+    q = r.joints_from_actuators(pv)
+    rev = r.is_revolute
+    _report(f"{r.name}: joint coordinates", list(r.joint_names), q * _scales(rev, deg, mm),
+            _units(rev, deg, mm), _inside(q, r.limits), as_json, "q")
