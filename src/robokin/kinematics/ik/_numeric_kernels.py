@@ -35,7 +35,9 @@ O_MAX_STEP = 11  # largest joint step per iteration [rad or m]
 O_MU0 = 12
 O_N_SEEDS = 13  # random restarts available (<= seeds.shape[1])
 O_PATH_MAX_JUMP = 14  # ik_path: largest accepted joint change per sample
-N_OPTS = 16
+O_STALL_EVERY = 15  # check progress every this many iterations ...
+O_STALL_RATIO = 16  # ... and give up unless the cost fell below ratio * before
+N_OPTS = 20
 
 # result columns after q
 R_ERR = 0  # combined residual norm (masked, unweighted) [m, rad]
@@ -52,6 +54,7 @@ CODE_STALL = 2  # stuck in a local minimum / at a joint limit
 CODE_BAD_TARGET = 3  # non-finite or not a rigid transform
 CODE_JUMP = 4  # ik_path: joint jump larger than allowed
 CODE_NOT_RUN = 5  # ik_path: after an earlier failure
+CODE_BAD_Q0 = 6  # the initial guess holds NaN / inf
 
 _MU_MAX = 1e9
 _MU_MIN = 1e-9
@@ -298,11 +301,21 @@ def _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw, max_iter,
         return CODE_STALL, 0, ep, er, E
     mu = opts[O_MU0]
     it = 0
+    check_every = int(opts[O_STALL_EVERY])
+    stall_ratio = opts[O_STALL_RATIO]
+    next_check = check_every
+    E_ref = E
     while True:
         if ep <= tol_p and er <= tol_r:
             return CODE_OK, it, ep, er, E
         if it >= max_iter:
             return CODE_ITER, it, ep, er, E
+        if it >= next_check:
+            # too little progress: a (limit-constrained) local minimum; restart
+            if E > stall_ratio * E_ref:
+                return CODE_STALL, it, ep, er, E
+            E_ref = E
+            next_check = it + check_every
         # weighted task rows and the gradient J^T W e; freeze joints pushed into a limit
         for a in range(m):
             r = rows[a]
@@ -422,15 +435,22 @@ def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out):
     """
     n = q0.shape[0]
     nc = jdat.shape[1]
+    bad = 0
     if not _check_target(Tt):
+        bad = CODE_BAD_TARGET
+    elif opts[O_USE_Q0] == 1.0:
         for j in range(n):
-            out[j] = q0[j]
+            if not math.isfinite(q0[j]):
+                bad = CODE_BAD_Q0
+    if bad:
+        for j in range(n):
+            out[j] = 0.0
         out[n + R_ERR] = np.inf
         out[n + R_EP] = np.inf
         out[n + R_ER] = np.inf
         out[n + R_ITERS] = 0
         out[n + R_RESTARTS] = 0
-        out[n + R_CODE] = CODE_BAD_TARGET
+        out[n + R_CODE] = bad
         return
     w = opts[O_W:O_W + 6]
     m = 0
@@ -463,7 +483,7 @@ def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out):
     free = np.empty(n, np.bool_)
     q = np.empty(n)
     best = np.empty(n)
-    bestE = np.inf
+    best_cost = np.inf
     bep = np.inf
     ber = np.inf
     max_iter = int(opts[O_MAX_ITER])
@@ -485,8 +505,8 @@ def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out):
                                        max_iter, qc, Jc, J, T, e, qn, Jn, Tn, en, Jw, A,
                                        g, y, dq, free)
         total += it
-        if E < bestE or code == CODE_OK or a == start:
-            bestE = E
+        if E < best_cost or code == CODE_OK or a == start:
+            best_cost = E
             bep = ep
             ber = er
             for j in range(n):
@@ -504,10 +524,28 @@ def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out):
 
 
 @njit(cache=True)
+def _summary(out, n):
+    """(number not converged, index of the first bad input or -1)."""
+    fails = 0
+    first_bad = -1
+    for i in range(out.shape[0]):
+        c = out[i, n + R_CODE]
+        if c != CODE_OK:
+            fails += 1
+            if first_bad < 0 and (c == CODE_BAD_TARGET or c == CODE_BAD_Q0):
+                first_bad = i
+    return fails, first_bad
+
+
+@njit(cache=True)
 def solve_serial(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out):
-    """Solve a batch: targets (N, 4, 4), q0 (N, n), seeds (N, R, n) -> out (N, n + N_RES)."""
+    """Solve a batch: targets (N, 4, 4), q0 (N, n), seeds (N, R, n) -> out (N, n + N_RES).
+
+    Returns (number not converged, index of the first bad target / q0 or -1).
+    """
     for i in range(targets.shape[0]):
         _solve_target(targets[i], q0[i], seeds[i], consts, jdat, Mc, cdat, opts, out[i])
+    return _summary(out, q0.shape[1])
 
 
 @njit(cache=True, parallel=True)
@@ -515,6 +553,7 @@ def solve_parallel(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out):
     """As :func:`solve_serial`, over all threads."""
     for i in prange(targets.shape[0]):
         _solve_target(targets[i], q0[i], seeds[i], consts, jdat, Mc, cdat, opts, out[i])
+    return _summary(out, q0.shape[1])
 
 
 @njit(cache=True)

@@ -50,12 +50,19 @@ _AXES = ("x", "y", "z", "rx", "ry", "rz")
 _PARALLEL_MIN = 64  # below this many targets one thread beats the parallel launch
 _FIRST_ROUND_RESTARTS = 4
 _ROUND_RESTARTS = 16
+_STALL_EVERY = 10
+_STALL_RATIO = 0.5
 
 
-def _kernels():
-    from robokin.kinematics.ik import _numeric_kernels
+_K: list[Any] = []
 
-    return _numeric_kernels
+
+def _kernels() -> Any:
+    if not _K:
+        from robokin.kinematics.ik import _numeric_kernels
+
+        _K.append(_numeric_kernels)
+    return _K[0]
 
 
 # --------------------------------------------------------------------------- records
@@ -258,8 +265,29 @@ def _mask_from_names(tokens: Sequence[str], original: Any) -> np.ndarray:
     return out
 
 
+_OPTS_CACHE: dict[Any, np.ndarray] = {}
+
+
 def _opts(mask: Any, weights: Any, tol: Any, tol_rotation: Any, max_iterations: Any,
           max_step: Any) -> np.ndarray:
+    """The kernel option vector (a fresh copy; cached for hashable arguments)."""
+    key = None
+    if weights is None and (mask is None or isinstance(mask, str)):
+        key = (mask, tol, tol_rotation, max_iterations, max_step)
+        try:
+            hit = _OPTS_CACHE.get(key)
+        except TypeError:
+            key = hit = None
+        if hit is not None:
+            return hit.copy()
+    opts = _make_opts(mask, weights, tol, tol_rotation, max_iterations, max_step)
+    if key is not None and len(_OPTS_CACHE) < 256:
+        _OPTS_CACHE[key] = opts.copy()
+    return opts
+
+
+def _make_opts(mask: Any, weights: Any, tol: Any, tol_rotation: Any,
+               max_iterations: Any, max_step: Any) -> np.ndarray:
     K = _kernels()
     m = parse_mask(mask)
     if weights is None:
@@ -283,6 +311,8 @@ def _opts(mask: Any, weights: Any, tol: Any, tol_rotation: Any, max_iterations: 
     opts[K.O_MAX_STEP] = _positive(max_step, "max_step")
     opts[K.O_MU0] = 1e-3
     opts[K.O_PATH_MAX_JUMP] = np.inf
+    opts[K.O_STALL_EVERY] = _STALL_EVERY
+    opts[K.O_STALL_RATIO] = _STALL_RATIO
     return opts
 
 
@@ -314,6 +344,13 @@ def _targets(T: npt.ArrayLike) -> tuple[np.ndarray, tuple[int, ...]]:
         raise InputError("T", f"expected shape (..., 4, 4), got {T.shape}")
     lead = T.shape[:-2]
     return np.ascontiguousarray(T.reshape(-1, 4, 4)), lead
+
+
+def _bad_input(out: np.ndarray, n: int, K: Any, Tf: np.ndarray, Q0: np.ndarray,
+               lead: tuple[int, ...], i: int, per: int = 1) -> InputError:
+    if out[i, n + K.R_CODE] == K.CODE_BAD_Q0:
+        return check_finite(Q0, "q0")  # raises, naming the index
+    return _bad_target(Tf, lead, i // per)
 
 
 def _bad_target(Tf: np.ndarray, lead: tuple[int, ...], i: int) -> InputError:
@@ -391,30 +428,33 @@ def solve(
     if q0 is None:
         Q0 = np.broadcast_to(data.mid, (N, n))
     else:
-        q0 = check_finite(check_joints(q0, n, "q0"), "q0")
+        q0 = check_joints(q0, n, "q0")  # finiteness: checked by the kernel
         try:
-            Q0 = np.broadcast_to(q0, lead + (n,)).reshape(N, n)
+            Q0 = q0.reshape(1, n) if q0.shape == (n,) and N == 1 else \
+                np.broadcast_to(q0, lead + (n,)).reshape(N, n)
         except ValueError as exc:
             raise InputError(
                 "q0", f"shape {q0.shape} does not broadcast to the targets' {lead + (n,)}"
             ) from exc
-    Q0 = np.ascontiguousarray(Q0)
+    if not Q0.flags.c_contiguous:
+        Q0 = np.ascontiguousarray(Q0)
     out = np.empty((N, n + K.N_RES))
     if N == 0:
-        return _result(out, lead, n, np.zeros(0, bool), K)
+        return _result(out, lead, n, None, K)
     use_par = N >= _PARALLEL_MIN if parallel is None else bool(parallel)
     kern = K.solve_parallel if use_par else K.solve_serial
     R = min(max_restarts, _FIRST_ROUND_RESTARTS)
     opts[K.O_USE_Q0] = 1.0
     opts[K.O_N_SEEDS] = R
     seeds = gen.random((N, max(R, 1), n))
-    kern(Tf, Q0, seeds, data.consts, data.jdat, data.Mc, data.cdat, opts, out)
-    code = out[:, n + K.R_CODE]
-    if (code == K.CODE_BAD_TARGET).any():
-        raise _bad_target(Tf, lead, int(np.flatnonzero(code == K.CODE_BAD_TARGET)[0]))
+    fails, bad = kern(Tf, Q0, seeds, data.consts, data.jdat, data.Mc, data.cdat, opts, out)
+    if bad >= 0:
+        raise _bad_input(out, n, K, Tf, Q0, lead, bad)
+    if fails == 0:
+        return _result(out, lead, n, None, K)
     timed_out = np.zeros(N, dtype=bool)
     used = out[:, n + K.R_RESTARTS].copy()
-    todo = np.flatnonzero(code != K.CODE_OK)
+    todo = np.flatnonzero(out[:, n + K.R_CODE] != K.CODE_OK)
     if todo.size and max_restarts > R:
         deadline = None if max_time is None else t_start + max_time * N
         opts[K.O_USE_Q0] = 0.0
@@ -446,14 +486,21 @@ def solve(
     return _result(out, lead, n, timed_out, K)
 
 
-def _result(out: np.ndarray, lead: tuple[int, ...], n: int, timed_out: np.ndarray,
-            K: Any) -> IKResult:
+def _result(out: np.ndarray, lead: tuple[int, ...], n: int,
+            timed_out: np.ndarray | None, K: Any) -> IKResult:
+    if not lead and out[0, n + K.R_CODE] == K.CODE_OK:
+        row = out[0, n:].tolist()
+        return IKResult(
+            q=out[0, :n], success=np.True_, error=row[K.R_ERR],
+            iterations=int(row[K.R_ITERS]), restarts=int(row[K.R_RESTARTS]),
+            reason="converged", position_error=row[K.R_EP], rotation_error=row[K.R_ER],
+        )
     code = out[:, n + K.R_CODE]
     success = code == K.CODE_OK
     reason = np.empty(out.shape[0], dtype=object)
     reason[:] = "converged"
     for i in np.flatnonzero(~success):
-        why = ("time budget exhausted" if timed_out[i] else
+        why = ("time budget exhausted" if timed_out is not None and timed_out[i] else
                "restart budget exhausted")
         last = "stalled in a local minimum or at joint limits" \
             if code[i] == K.CODE_STALL else "iteration budget of the last descent spent"
@@ -563,11 +610,10 @@ def solve_all(
     par = options.get("parallel")
     use_par = N * S >= _PARALLEL_MIN if par is None else bool(par)
     kern = K.solve_parallel if use_par else K.solve_serial
-    kern(flatT, flatQ, np.empty((N * S, 1, n)), data.consts, data.jdat, data.Mc, cd, opts,
-         out)
-    code = out[:, n + K.R_CODE]
-    if (code == K.CODE_BAD_TARGET).any():
-        raise _bad_target(Tf, lead, int(np.flatnonzero(code == K.CODE_BAD_TARGET)[0]) // S)
+    _, bad = kern(flatT, flatQ, np.empty((N * S, 1, n)), data.consts, data.jdat, data.Mc,
+                  cd, opts, out)
+    if bad >= 0:
+        raise _bad_input(out, n, K, Tf, flatQ, lead, bad, per=S)
     out = out.reshape(N, S, n + K.N_RES)
     q = out[..., :n].copy()
     ok = out[..., n + K.R_CODE] == K.CODE_OK
