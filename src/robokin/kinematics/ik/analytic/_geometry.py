@@ -1,0 +1,95 @@
+"""The chain as a product of exponentials: joint axes and points at zero joint value.
+
+With every chain joint value ``v_k = 0`` (``J_k`` the identity) the frame just before
+joint ``k`` is ``P_k = C_0 C_1 ... C_{k-1}``; its z axis is the joint's unit axis
+``h_k`` and its origin a point ``o_k`` on it (base frame). Then
+
+.. math::
+
+    T(v) = e^{\\hat\\xi_1 v_1} \\cdots e^{\\hat\\xi_n v_n} M, \\qquad M = T(v = 0),
+
+so a revolute joint rotates everything after it about the line ``(o_k, h_k)`` and a
+prismatic one translates it along ``h_k``. Base and tool transforms are inside ``C_0``
+and ``C_n`` (hence inside ``M``), so the closed forms never see them.
+
+References:
+    Lynch and Park, *Modern Robotics*, ch. 4 (product of exponentials);
+    Elias and Wen, "IK-Geo: unified robot inverse kinematics using subproblem
+    decomposition", arXiv:2211.05737 (2022).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robokin.model.chain import Chain
+
+__all__ = ["Poe", "angle_between_axes", "line_distance", "closest_point", "poe_from_chain"]
+
+
+@dataclass(frozen=True, eq=False)
+class Poe:
+    """Zero-configuration screw description of a chain.
+
+    Attributes:
+        h: Unit joint axes (n_chain, 3), base frame.
+        o: A point on each axis (n_chain, 3) [m], base frame.
+        prismatic: (n_chain,) bool.
+        M: Tool pose at chain values 0, (4, 4).
+    """
+
+    h: np.ndarray
+    o: np.ndarray
+    prismatic: np.ndarray
+    M: np.ndarray
+
+
+def poe_from_chain(chain: Chain) -> Poe:
+    """The chain's axes and points at ``v = 0`` (see the module docstring)."""
+    consts = chain._consts
+    nc = chain.n_chain
+    P = consts[0].copy()
+    h = np.empty((nc, 3))
+    o = np.empty((nc, 3))
+    for k in range(nc):
+        h[k] = P[:3, 2] / np.linalg.norm(P[:3, 2])
+        o[k] = P[:3, 3]
+        P = P @ consts[k + 1]
+    return Poe(h, o, np.asarray(chain._kind, dtype=bool).copy(), P)
+
+
+def angle_between_axes(a: np.ndarray, b: np.ndarray) -> float:
+    """Angle [rad] between two lines' directions, ignoring orientation (0..pi/2)."""
+    s = np.linalg.norm(np.cross(a, b))
+    c = abs(float(np.dot(a, b)))
+    return float(np.arctan2(s, c))
+
+
+def line_distance(o1: np.ndarray, h1: np.ndarray, o2: np.ndarray, h2: np.ndarray) -> float:
+    """Shortest distance [m] between the lines ``o1 + t h1`` and ``o2 + s h2``."""
+    n = np.cross(h1, h2)
+    nn = np.linalg.norm(n)
+    d = o2 - o1
+    if nn < 1e-12:  # parallel lines
+        return float(np.linalg.norm(d - np.dot(d, h1) * h1))
+    return float(abs(np.dot(d, n)) / nn)
+
+
+def closest_point(origins: np.ndarray, axes: np.ndarray) -> np.ndarray:
+    """The point with the least summed squared distance to several lines, (3,)."""
+    A = np.zeros((3, 3))
+    b = np.zeros(3)
+    for o, h in zip(origins, axes):
+        P = np.eye(3) - np.outer(h, h)
+        A += P
+        b += P @ o
+    return np.linalg.lstsq(A, b, rcond=None)[0]
+
+
+def unit_perpendicular(h: np.ndarray) -> np.ndarray:
+    """A unit vector perpendicular to ``h``."""
+    e = np.eye(3)[int(np.argmin(np.abs(h)))]
+    v = e - np.dot(e, h) * h
+    return v / np.linalg.norm(v)

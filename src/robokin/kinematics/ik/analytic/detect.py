@@ -1,0 +1,199 @@
+"""Pick the closed-form family of an arm from its canonical chain's geometry.
+
+The chain's joint axes and points at zero chain values (its product-of-exponentials
+description, ``_geometry.poe_from_chain``) are tested for the structures the closed
+forms need: parallel axes (angle between directions) and axes that meet (distance
+between lines). An arm within ``tol`` is solved exactly by its family; one within
+the near tolerances (a calibrated arm: 1e-4 rad, a fraction of a millimetre) is
+solved by the nominal family's closed form and then polished by Newton steps on the
+true chain (``near.polish``); the detector reports what it measured.
+
+Families, tried in this order:
+
+* ``three_parallel``: 6R, axes 2-4 parallel, axes 5/6 meet (UR, AUBO, Doosan);
+* ``spherical_wrist``: 6R, axes 2/3 parallel, axes 4-6 meet (Puma, KUKA, ABB...);
+* ``scara``: 3 revolute + 1 prismatic, all axes parallel;
+* ``palletizer``: 4 coordinates on 5 revolute chain joints, a parallelogram keeping
+  the tool level (QFMD010).
+
+Detection is cached per chain (chains are immutable).
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from robokin.kinematics.ik.analytic import palletizer as _pal
+from robokin.kinematics.ik.analytic import scara as _scara
+from robokin.kinematics.ik.analytic import spherical_wrist as _sw
+from robokin.kinematics.ik.analytic import three_parallel as _tp
+from robokin.kinematics.ik.analytic._geometry import poe_from_chain
+
+__all__ = ["Family", "detect"]
+
+EXACT_TOL = 1e-9
+NEAR_ANGLE = 5e-3
+NEAR_DISTANCE = 5e-3
+
+
+@dataclass(frozen=True, eq=False)
+class Family:
+    """The closed-form family of an arm.
+
+    Attributes:
+        name: ``"three_parallel"``, ``"spherical_wrist"``, ``"scara"``,
+            ``"palletizer"``, or ``"none"``.
+        solver: ``solver(robot, T, q_near=None, **options) -> SolutionSet``, or
+            None when no closed form applies.
+        reason: Why no closed form applies ("" when one does).
+        measured: What the detector measured, e.g. "axes 2-4 parallel within
+            3.0e-04 rad; axes 5, 6 meet within 2.1e-05 m".
+        near: True when the arm matches only within the near tolerances (the result
+            is polished by Newton steps on the true chain).
+        deviation: The largest measured angle [rad] / distance [m] from the family.
+        details: Every family's measurement (name -> text).
+    """
+
+    name: str
+    solver: Callable[..., Any] | None
+    reason: str = ""
+    measured: str = ""
+    near: bool = False
+    deviation: float = 0.0
+    details: dict[str, str] = field(default_factory=dict)
+
+    def __str__(self) -> str:
+        if self.solver is None:
+            return f"none: {self.reason}"
+        tag = " (near family: closed form + Newton polish)" if self.near else ""
+        return f"{self.name}{tag}: {self.measured}"
+
+
+_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def detect(robot: Any, *, tol: float = EXACT_TOL, near_angle: float = NEAR_ANGLE,
+           near_distance: float = NEAR_DISTANCE) -> Family:
+    """The closed-form family of ``robot`` (a Robot or a Chain).
+
+    Args:
+        robot: The arm.
+        tol: Angle [rad] / distance [m] within which the structure is exact.
+        near_angle: Angle [rad] within which the arm is a near-family member.
+        near_distance: Distance [m] within which axes count as nearly meeting.
+
+    Returns:
+        A :class:`Family`.
+    """
+    chain = getattr(robot, "chain", robot)
+    key = (tol, near_angle, near_distance)
+    per_chain = _CACHE.setdefault(chain, {})
+    fam = per_chain.get(key)
+    if fam is None:
+        fam = _detect(chain, tol, near_angle, near_distance)
+        per_chain[key] = fam
+    return fam
+
+
+def _none(reason: str, details: dict[str, str] | None = None) -> Family:
+    return Family("none", None, reason=reason, details=dict(details or {}))
+
+
+def _grade(ang: float, dist: float, tol: float, near_angle: float,
+           near_distance: float) -> str | None:
+    if ang <= tol and dist <= tol:
+        return "exact"
+    if ang <= near_angle and dist <= near_distance:
+        return "near"
+    return None
+
+
+def _detect(chain: Any, tol: float, near_angle: float, near_distance: float) -> Family:
+    nc, n = chain.n_chain, chain.n
+    poe = poe_from_chain(chain)
+    n_pri = int(poe.prismatic.sum())
+    if nc == 6 and n == 6:
+        if n_pri:
+            return _none("a 6-joint arm with a prismatic joint: no closed form here")
+        if not chain.coupling.is_identity:
+            return _none("a 6R arm with dependent joints: no closed form here")
+        found = []
+        details = {}
+        for mod in (_tp, _sw):
+            ang, dist, text, why = mod.measure(poe)
+            details[mod.NAME] = text
+            if why:
+                details[mod.NAME] += f" ({why})"
+                continue
+            grade = _grade(ang, dist, tol, near_angle, near_distance)
+            if grade is not None:
+                found.append((grade != "exact", max(ang, dist), mod, text))
+        if not found:
+            return _none(
+                "6R arm without three parallel axes (2-4) with meeting axes 5, 6, and "
+                "without a spherical wrist with parallel axes 2, 3: "
+                + "; ".join(f"{k}: {v}" for k, v in details.items()), details)
+        found.sort(key=lambda f: (f[0], f[1]))
+        is_near, dev, mod, text = found[0]
+        return _six_r_family(chain, poe, mod.NAME, text, is_near, dev, details)
+    if nc == 4 and n == 4:
+        if n_pri != 1 or not chain.coupling.is_identity:
+            return _none(f"a 4-joint arm with {n_pri} prismatic joint(s): the SCARA "
+                         "closed form needs 3 revolute and 1 prismatic")
+        ang, _, text, why = _scara.measure(poe)
+        if why or ang > tol:
+            return _none(f"not a SCARA: {text}" + (f" ({why})" if why else ""),
+                         {"scara": text})
+        g = _scara.geometry(poe)
+
+        def scara_solver(robot, T, q_near=None, **options):
+            return _scara.solve_geometry(robot, g, T, **options)
+
+        return Family("scara", scara_solver, measured=text, deviation=ang,
+                      details={"scara": text})
+    if n == 4 and nc == 5:
+        if n_pri:
+            return _none("a 4-axis arm on 5 chain joints with a prismatic joint")
+        ang, _, text, why = _pal.measure(chain, poe)
+        if why or ang > tol:
+            return _none(f"not a level-tool palletizer: {text}"
+                         + (f" ({why})" if why else ""), {"palletizer": text})
+        g = _pal.geometry(chain, poe)
+
+        def pal_solver(robot, T, q_near=None, **options):
+            return _pal.solve_geometry(robot, g, T, **options)
+
+        return Family("palletizer", pal_solver, measured=text, deviation=ang,
+                      details={"palletizer": text})
+    return _none(
+        f"{n} joint coordinates on {nc} chain joints: the closed forms cover 6R arms "
+        "(three parallel axes, spherical wrist), 4-axis SCARA (R-R-R-P) and the "
+        "4-axis level-tool palletizer"
+    )
+
+
+def _six_r_family(chain: Any, poe: Any, name: str, text: str, near: bool, dev: float,
+                  details: dict[str, str]) -> Family:
+    from robokin.kinematics.ik.analytic._six_r import pack, solve_six_r
+
+    params_cache: dict[tuple[float, float], np.ndarray] = {}
+    method = f"analytic:{name}" + ("+newton" if near else "")
+    info = {"family": name, "measured": text, "near_family": near}
+
+    def solver(robot, T, q_near=None, *, singular_tol: float = 1e-9,
+               compute_error: bool = False, **options):
+        key = (singular_tol, 1e-12)
+        P = params_cache.get(key)
+        if P is None:
+            P = pack(chain, name, singular_tol=singular_tol, poe=poe)
+            params_cache[key] = P
+        return solve_six_r(robot, T, q_near, kind=name, params=P, method=method,
+                           info=info, near=near, compute_error=compute_error, **options)
+
+    solver.params = lambda: pack(chain, name, poe=poe)  # type: ignore[attr-defined]
+    return Family(name, solver, measured=text, near=near, deviation=dev, details=details)
