@@ -56,7 +56,7 @@ _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 
 
 def _schema():
-    from typing import Annotated, Literal, Union
+    from typing import Annotated, Literal
 
     from pydantic import BaseModel, ConfigDict, Field
 
@@ -88,7 +88,7 @@ def _schema():
         j: float = 1.0
         lift_sign: Literal[1, -1] = 1
 
-    Drive = Annotated[Union[Direct, Gear, Screw, BallScrewSpline],
+    Drive = Annotated[Direct | Gear | Screw | BallScrewSpline,
                       Field(discriminator="type")]
 
     class Section(Strict):
