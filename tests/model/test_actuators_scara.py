@@ -229,3 +229,29 @@ def test_ik_in_actuator_space(scara, rng):
     s2 = tight.ik(T[:1], space="actuator")
     assert not s2.flags["within_limits"][0][s2.valid[0]].any()
     assert "joint_within_limits" in s2.flags
+
+
+def test_paper_motion_as_a_trajectory_in_motor_space(scara):
+    """Motor positions, velocities and accelerations of the paper's first test motion
+    (theta3 = 36 t deg, l4 = t^2 mm): phi3 = 36t - 18t^2, phi3' = 36 - 36t, phi3'' = -36,
+    phi4 = 540 t, phi4' = 540, phi4'' = 0 (deg, s)."""
+    samples = pytest.importorskip("robokin.trajectory.samples")
+    if not hasattr(samples.Trajectory, "to_actuator_space"):
+        pytest.skip("trajectory actuator space not built yet")
+    t = T_PAPER
+    z = np.zeros_like(t)
+    d = np.radians
+    q = np.stack([z, z, d(36 * t), t**2 / 1000], axis=-1)
+    qd = np.stack([z, z, d(36 + z), 2 * t / 1000], axis=-1)
+    qdd = np.stack([z, z, z, 2 / 1000 + z], axis=-1)
+    tr = samples.Trajectory(t, q, qd, qdd).to_actuator_space(scara)
+    assert tr.space == "actuator"
+    np.testing.assert_allclose(np.degrees(tr.q[:, 2]), 36 * t - 18 * t**2, atol=1e-9)
+    np.testing.assert_allclose(np.degrees(tr.qd[:, 2]), 36 - 36 * t, atol=1e-9)
+    np.testing.assert_allclose(np.degrees(tr.qdd[:, 2]), -36 + z, atol=1e-9)
+    np.testing.assert_allclose(np.degrees(tr.q[:, 3]), 540 * t, atol=1e-9)
+    np.testing.assert_allclose(np.degrees(tr.qd[:, 3]), 540 + z, atol=1e-9)
+    np.testing.assert_allclose(np.degrees(tr.qdd[:, 3]), z, atol=1e-9)
+    back = tr.to_joint_space(scara)
+    np.testing.assert_allclose(back.q, q, atol=1e-12)
+    np.testing.assert_allclose(back.qd, qd, atol=1e-12)
