@@ -5,6 +5,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import robokin
 from robokin.exceptions import ModelError
@@ -290,3 +292,18 @@ def test_parallelogram_options_and_errors():
         parallelogram([])
     with pytest.raises(ModelError, match="2 pitch coordinate"):
         parallelogram(["a", "b"], relative=["x"])
+
+
+nonzero = st.floats(0.05, 50.0) | st.floats(-50.0, -0.05)
+
+
+@settings(max_examples=60, deadline=None)
+@given(lead=st.floats(0.001, 0.1), i=nonzero, j=nonzero, sign=st.sampled_from([1, -1]),
+       phi=st.tuples(st.floats(-1e3, 1e3), st.floats(-1e3, 1e3)))
+def test_ball_screw_spline_round_trip_property(lead, i, j, sign, phi):
+    shaft = BallScrewSpline(lead, i, j, lift_sign=sign)
+    phi = np.array(phi)
+    q = shaft.shaft_from_motors(phi)
+    np.testing.assert_allclose(shaft.affine_map().apply(phi), q, rtol=1e-12, atol=1e-12)
+    back = shaft.motors_from_shaft(q[0], q[1])
+    np.testing.assert_allclose(back, phi, rtol=1e-9, atol=1e-9 * (1 + abs(phi).max()))
