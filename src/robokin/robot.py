@@ -14,7 +14,8 @@ import numpy.typing as npt
 
 from robokin._validation import check_transform
 from robokin.exceptions import InputError
-from robokin.kinematics import forward, jacobian as _jac
+from robokin.kinematics import forward
+from robokin.kinematics import jacobian as _jac
 from robokin.model.chain import Chain
 from robokin.model.coupling import AffineMap
 

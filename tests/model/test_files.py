@@ -140,3 +140,13 @@ joints:
         robokin.ModelError, match=r"joints\[2\]\.depends.*unknown coordinate 'zz'"
     ):
         load_robot(_write(tmp_path, bad))
+
+
+def test_code_built_robot_keeps_its_actuators_when_saved(tmp_path, rng):
+    scara = robokin.load("scara")
+    robot = scara.replace(meta={})
+    again = robokin.load(save_robot(robot, tmp_path / "scara.yaml"))
+    q = random_q(scara, rng, 10)
+    np.testing.assert_allclose(
+        again.actuators_from_joints(q), scara.actuators_from_joints(q), atol=1e-12
+    )

@@ -393,6 +393,10 @@ def _elementary_document(robot: Robot) -> dict[str, Any]:
             }
             for x in chain.coordinates
         ]
+    if robot.actuators is not None:
+        from robokin.model.coupling_files import section_from_robot
+
+        doc["actuators"] = section_from_robot(robot)
     for key, T in (("base", chain.base), ("tool", chain.tool)):
         if not np.allclose(T, np.eye(4), atol=1e-15):
             doc[key] = {
