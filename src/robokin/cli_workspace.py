@@ -16,15 +16,19 @@ __all__ = ["workspace"]
 @app.command()
 def workspace(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
-    samples: Annotated[int, typer.Option("--samples", "-n", help="Joint samples.")] = 1_000_000,
-    out: Annotated[Path, typer.Option("--out", help="Output folder for the plots.")] = Path(
-        "robokin-workspace"
-    ),
+    samples: Annotated[
+        int, typer.Option("--samples", "-n", help="Joint samples.")
+    ] = 1_000_000,
+    out: Annotated[
+        Path, typer.Option("--out", help="Output folder for the plots.")
+    ] = Path("robokin-workspace"),
     voxel_mm: Annotated[
         float, typer.Option("--voxel", help="Voxel edge [mm] (default: extent / 100).")
     ] = 0.0,
     seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
-    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Machine-readable output.")
+    ] = False,
 ) -> None:
     """Sample the reachable workspace: bounds, volume, XY/XZ sections, manipulability."""
     import numpy as np
@@ -57,17 +61,27 @@ def workspace(
     paths = save_workspace_plots(ws, out)
     summary = ws.summary()
     summary["plots"] = [str(p) for p in paths]
-    (Path(out) / f"{robot.name}_workspace.json").write_text(json.dumps(summary, indent=2))
+    (Path(out) / f"{robot.name}_workspace.json").write_text(
+        json.dumps(summary, indent=2)
+    )
     if as_json:
         print(json.dumps(summary))
         return
-    table = Table(title=f"{robot.name}: workspace of the tool point ({ws.n_samples:,} samples)")
+    table = Table(
+        title=f"{robot.name}: workspace of the tool point ({ws.n_samples:,} samples)"
+    )
     for col in ("", "x \\[mm]", "y \\[mm]", "z \\[mm]"):
         table.add_column(col, justify="right")
-    for label, row in (("min", ws.bounds[0]), ("max", ws.bounds[1]), ("extent", ws.extent)):
+    for label, row in (
+        ("min", ws.bounds[0]),
+        ("max", ws.bounds[1]),
+        ("extent", ws.extent),
+    ):
         table.add_row(label, *(f"{v * 1000:.1f}" for v in row))
     con.print(table)
-    con.print(f"volume ≈ {ws.volume:.4f} m³ ({ws.occupied_voxels:,} voxels of "
-              f"{ws.voxel_size * 1000:.1f} mm)")
+    con.print(
+        f"volume ≈ {ws.volume:.4f} m³ ({ws.occupied_voxels:,} voxels of "
+        f"{ws.voxel_size * 1000:.1f} mm)"
+    )
     for p in paths:
         con.print(f"wrote {p}")

@@ -86,11 +86,30 @@ def test_ur5_bounds_within_link_length_sum_and_reach():
 def test_voxel_volume_of_a_cartesian_gantry_is_its_box():
     # Three orthogonal prismatic axes: the workspace is a 0.5 x 0.3 x 0.2 m box.
     rows = [
-        {"joint": "prismatic", "a": 0, "alpha": -math.pi / 2, "d": 0, "theta": 0,
-         "limits": [0.0, 0.5]},
-        {"joint": "prismatic", "a": 0, "alpha": -math.pi / 2, "d": 0,
-         "theta": -math.pi / 2, "limits": [0.0, 0.3]},
-        {"joint": "prismatic", "a": 0, "alpha": 0, "d": 0, "theta": 0, "limits": [0.0, 0.2]},
+        {
+            "joint": "prismatic",
+            "a": 0,
+            "alpha": -math.pi / 2,
+            "d": 0,
+            "theta": 0,
+            "limits": [0.0, 0.5],
+        },
+        {
+            "joint": "prismatic",
+            "a": 0,
+            "alpha": -math.pi / 2,
+            "d": 0,
+            "theta": -math.pi / 2,
+            "limits": [0.0, 0.3],
+        },
+        {
+            "joint": "prismatic",
+            "a": 0,
+            "alpha": 0,
+            "d": 0,
+            "theta": 0,
+            "limits": [0.0, 0.2],
+        },
     ]
     robot = robokin.Robot.from_dh(rows, name="gantry")
     ws = sample_workspace(robot, 400_000, rng=np.random.default_rng(0), voxel_size=0.02)
@@ -119,14 +138,21 @@ def test_random_joints_stay_inside_limits(rng):
 
 def test_manipulability_subset_matches_jacobian():
     robot = robokin.load("ur5")
-    ws = sample_workspace(robot, 5_000, rng=np.random.default_rng(1), keep_q=True,
-                          manipulability_samples=200)
+    ws = sample_workspace(
+        robot,
+        5_000,
+        rng=np.random.default_rng(1),
+        keep_q=True,
+        manipulability_samples=200,
+    )
     assert ws.manipulability.shape == (200,)
     q = ws.q[ws.manipulability_index]
     J = robot.jacobian(q)
     ref = np.sqrt(np.abs(np.linalg.det(J @ np.swapaxes(J, -1, -2))))
     np.testing.assert_allclose(ws.manipulability, ref, rtol=1e-6, atol=1e-9)
-    np.testing.assert_allclose(robot.fk(q)[:, :3, 3], ws.points[ws.manipulability_index])
+    np.testing.assert_allclose(
+        robot.fk(q)[:, :3, 3], ws.points[ws.manipulability_index]
+    )
 
 
 def test_progress_and_errors():
@@ -136,8 +162,18 @@ def test_progress_and_errors():
     assert calls == [(300, 1000), (600, 1000), (900, 1000), (1000, 1000)]
     with pytest.raises(InputError, match="n_samples"):
         sample_workspace(robot, 0)
-    slider = robokin.Robot.from_dh([{"joint": "prismatic", "a": 0, "alpha": 0, "d": 0,
-                                     "theta": 0, "name": "slide"}])
+    slider = robokin.Robot.from_dh(
+        [
+            {
+                "joint": "prismatic",
+                "a": 0,
+                "alpha": 0,
+                "d": 0,
+                "theta": 0,
+                "name": "slide",
+            }
+        ]
+    )
     with pytest.raises(InputError, match="slide"):
         sample_workspace(slider, 10)
 
@@ -148,7 +184,10 @@ def test_plots_written(tmp_path):
     matplotlib.use("Agg")
     ws = sample_workspace(robokin.load("scara"), 20_000, rng=np.random.default_rng(2))
     paths = save_workspace_plots(ws, tmp_path)
-    assert [p.name for p in paths] == ["scara_workspace_xy.png", "scara_workspace_xz.png"]
+    assert [p.name for p in paths] == [
+        "scara_workspace_xy.png",
+        "scara_workspace_xz.png",
+    ]
     for p in paths:
         assert p.stat().st_size > 10_000
     ax = plot_cross_section(ws, "xz", color_by="density")
@@ -160,7 +199,9 @@ def test_plots_written(tmp_path):
 def test_cli_workspace(tmp_path):
     from robokin.cli import main
 
-    rc = main(["workspace", "scara", "--samples", "20000", "--out", str(tmp_path), "--json"])
+    rc = main(
+        ["workspace", "scara", "--samples", "20000", "--out", str(tmp_path), "--json"]
+    )
     assert rc == 0
     summary = json.loads((tmp_path / "scara_workspace.json").read_text())
     assert summary["samples"] == 20000

@@ -94,7 +94,8 @@ class Workspace:
             "occupied_voxels": self.occupied_voxels,
             "volume_m3": self.volume,
             "manipulability_max": float(self.manipulability.max())
-            if self.manipulability.size else 0.0,
+            if self.manipulability.size
+            else 0.0,
         }
 
 
@@ -106,7 +107,11 @@ def _sampling_limits(robot: Robot) -> np.ndarray:
         if rev[i]:
             # A revolute joint never needs more than one turn to cover its positions.
             if not math.isfinite(lo) or not math.isfinite(hi) or hi - lo > 2 * math.pi:
-                mid = 0.0 if not (math.isfinite(lo) and math.isfinite(hi)) else 0.5 * (lo + hi)
+                mid = (
+                    0.0
+                    if not (math.isfinite(lo) and math.isfinite(hi))
+                    else 0.5 * (lo + hi)
+                )
                 lim[i] = (mid - math.pi, mid + math.pi)
         elif not (math.isfinite(lo) and math.isfinite(hi)):
             name = robot.joint_names[i]
@@ -133,7 +138,9 @@ def random_joints(
     """
     lim = np.asarray(limits, dtype=float)
     if lim.ndim != 2 or lim.shape[1] != 2 or not np.isfinite(lim).all():
-        raise InputError("limits", f"expected finite limits of shape (n, 2), got {lim.shape}")
+        raise InputError(
+            "limits", f"expected finite limits of shape (n, 2), got {lim.shape}"
+        )
     u = rng.random((int(count), lim.shape[0]))
     return lim[:, 0] + u * (lim[:, 1] - lim[:, 0])
 
@@ -155,8 +162,11 @@ def voxel_volume(points: npt.ArrayLike, voxel_size: float) -> tuple[float, int]:
         return 0.0, 0
     idx = np.floor((p - p.min(axis=0)) / voxel_size).astype(np.int64)
     dims = idx.max(axis=0) + 1
-    flat = np.ravel_multi_index(idx.T, tuple(int(d) for d in dims)) if np.prod(
-        dims.astype(float)) < 2**62 else idx[:, 0] * 2**42 + idx[:, 1] * 2**21 + idx[:, 2]
+    flat = (
+        np.ravel_multi_index(idx.T, tuple(int(d) for d in dims))
+        if np.prod(dims.astype(float)) < 2**62
+        else idx[:, 0] * 2**42 + idx[:, 1] * 2**21 + idx[:, 2]
+    )
     count = int(np.unique(flat).size)
     return count * voxel_size**3, count
 
@@ -214,11 +224,11 @@ def sample_workspace(
         m = min(chunk, n_samples - done)
         q = random_joints(rng, lim, m)
         T = forward.forward_kinematics(robot.chain, q)
-        points[done:done + m] = T[:, :3, 3]
+        points[done : done + m] = T[:, :3, 3]
         if q_all is not None:
-            q_all[done:done + m] = q
+            q_all[done : done + m] = q
         if done < k:
-            q_sub[done:min(k, done + m)] = q[:k - done]
+            q_sub[done : min(k, done + m)] = q[: k - done]
         done += m
         if progress is not None:
             progress(done, n_samples)
@@ -291,8 +301,14 @@ def plot_cross_section(
         sel = np.abs(pts[:, c] - at) <= 0.5 * thickness
         if not sel.any():  # a thin arm (e.g. planar): fall back to all of the subset
             sel = np.ones(len(pts), dtype=bool)
-        sc = ax.scatter(pts[sel, a], pts[sel, b], c=ws.manipulability[sel], s=2,
-                        cmap="viridis", linewidths=0)
+        sc = ax.scatter(
+            pts[sel, a],
+            pts[sel, b],
+            c=ws.manipulability[sel],
+            s=2,
+            cmap="viridis",
+            linewidths=0,
+        )
         ax.figure.colorbar(sc, ax=ax, label="manipulability")
     elif color_by in ("density", "manipulability"):
         pts = ws.points
@@ -302,12 +318,16 @@ def plot_cross_section(
         h = ax.hist2d(pts[sel, a], pts[sel, b], bins=120, cmin=1, cmap="magma")
         ax.figure.colorbar(h[3], ax=ax, label="samples")
     else:
-        raise InputError("color_by", f"expected 'manipulability' or 'density', got {color_by!r}")
+        raise InputError(
+            "color_by", f"expected 'manipulability' or 'density', got {color_by!r}"
+        )
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(f"{names[a]} [m]")
     ax.set_ylabel(f"{names[b]} [m]")
-    ax.set_title(f"{ws.robot_name}: {plane.upper()} section, "
-                 f"{names[c]} = {at:.3f} ± {0.5 * thickness:.3f} m")
+    ax.set_title(
+        f"{ws.robot_name}: {plane.upper()} section, "
+        f"{names[c]} = {at:.3f} ± {0.5 * thickness:.3f} m"
+    )
     ax.grid(True, alpha=0.3)
     return ax
 

@@ -1,0 +1,420 @@
+"""What the viewers draw, independent of how: the robot's shapes over time, the
+scene's bodies, and the per-sample facts of a collision report.
+
+Both the live viewer (:mod:`robokin.viz.viewer`) and the standalone HTML file
+(:mod:`robokin.viz.html`) build on these plain arrays.
+
+The robot is drawn from its geometry when it has one; otherwise every link is a
+capsule along the chain's path: from each joint's axis frame (the frame the
+joint turns or slides in) to the link frame that follows it (an L through the
+foot of the common normal, so a DH row's ``d`` runs along the joint axis and its
+``a`` along the link), on to the next joint, and finally to the tool frame.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robokin._validation import check_joints
+from robokin.exceptions import InputError
+from robokin.kinematics.forward import link_frames
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
+__all__ = [
+    "Motion",
+    "ReportArrays",
+    "SceneShape",
+    "Skeleton",
+    "motion_from",
+    "report_arrays",
+    "robot_shapes",
+    "scene_shapes",
+    "skeleton",
+]
+
+LINK_COLOR = (232, 142, 48)
+JOINT_COLOR = (58, 62, 74)
+SCENE_COLOR = (150, 170, 195)
+COLLISION_COLOR = (225, 30, 30)
+DISTANCE_COLOR = (20, 160, 230)
+
+
+@dataclass(frozen=True)
+class Motion:
+    """Joint samples over time.
+
+    Attributes:
+        t: Times [s], shape (m,).
+        q: Joint coordinates [rad, m], shape (m, n).
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+
+
+def motion_from(robot: Robot, trajectory: Any = None, *, dt: float = 0.005) -> Motion:
+    """Normalise a trajectory argument.
+
+    Args:
+        robot: The robot (for n and the default configuration).
+        trajectory: None (one sample at zero, clipped into the limits), a
+            configuration (n,), joint samples (m, n), or an object with ``.t``
+            (m,) and ``.q`` (m, n) (e.g. ``robokin.trajectory.Trajectory``).
+        dt: Sample period [s] used when ``trajectory`` carries no times.
+
+    Returns:
+        The :class:`Motion`.
+
+    Raises:
+        InputError: wrong shapes or non-increasing times.
+    """
+    if trajectory is None:
+        lim = robot.limits
+        q = np.clip(np.zeros(robot.n), lim[:, 0], lim[:, 1])[None, :]
+        return Motion(np.zeros(1), q)
+    if hasattr(trajectory, "q"):
+        q = check_joints(trajectory.q, robot.n, "trajectory.q")
+        t = getattr(trajectory, "t", None)
+    else:
+        q = check_joints(trajectory, robot.n, "trajectory")
+        t = None
+    q = np.atleast_2d(q)
+    if q.ndim != 2:
+        raise InputError(
+            "trajectory", f"expected joint samples (m, {robot.n}), got {q.shape}"
+        )
+    if not np.isfinite(q).all():
+        raise InputError("trajectory", "holds a non-finite joint value")
+    if t is None:
+        t = np.arange(q.shape[0]) * float(dt)
+    t = np.asarray(t, dtype=float).reshape(-1)
+    if t.shape[0] != q.shape[0]:
+        raise InputError(
+            "trajectory.t", f"has {t.shape[0]} times for {q.shape[0]} samples"
+        )
+    if t.shape[0] > 1 and not np.all(np.diff(t) > 0):
+        raise InputError("trajectory.t", "times must increase strictly")
+    return Motion(t, q)
+
+
+@dataclass(frozen=True)
+class Skeleton:
+    """The chain-path drawing of a robot over m samples.
+
+    Attributes:
+        points: Key points [m], shape (m, P, 3).
+        links: Capsules as index pairs into ``points``, shape (L, 2).
+        radius: Capsule radius [m].
+        joint_frames: Joint axis frames, shape (m, n_chain, 4, 4): each
+            joint turns about / slides along the local z axis at the origin.
+        joint_kinds: ``"revolute"`` / ``"prismatic"`` per chain joint.
+        base: Base frames, shape (m, 4, 4).
+        tool: Tool poses, shape (m, 4, 4).
+    """
+
+    points: np.ndarray
+    links: np.ndarray
+    radius: float
+    joint_frames: np.ndarray
+    joint_kinds: tuple[str, ...]
+    base: np.ndarray
+    tool: np.ndarray
+
+    @property
+    def scale(self) -> float:
+        """A length typical of the robot [m] (its chain path at the first sample)."""
+        p = self.points[0]
+        return float(
+            np.linalg.norm(p[self.links[:, 1]] - p[self.links[:, 0]], axis=1).sum()
+        )
+
+
+def skeleton(robot: Robot, q: npt.ArrayLike) -> Skeleton:
+    """The chain path of ``robot`` at joint samples ``q`` (m, n)."""
+    chain = robot.chain
+    q = np.atleast_2d(check_joints(q, robot.n, "q"))
+    F = link_frames(chain, q)  # (m, nc + 2, 4, 4): base, link frames, tool
+    m, nc = q.shape[0], chain.n_chain
+    # Joint k's axis frame: base·head for the first, then link frame·G for the rest.
+    P = np.empty((m, nc, 4, 4))
+    if nc:
+        P[:, 0] = chain.base @ chain.head
+        if nc > 1:
+            P[:, 1:] = F[:, 1:nc] @ chain.link_offsets[: nc - 1]
+    pts = [F[:, 0, :3, 3]]
+    for k in range(nc):
+        o, z = P[:, k, :3, 3], P[:, k, :3, 2]
+        nxt = F[:, k + 1, :3, 3]
+        foot = o + np.sum((nxt - o) * z, axis=-1, keepdims=True) * z
+        pts += [o, foot, nxt]
+    pts.append(F[:, -1, :3, 3])
+    points = np.stack(pts, axis=1)
+    seg = np.linalg.norm(np.diff(points, axis=1), axis=-1).max(axis=0)
+    links = np.array(
+        [(i, i + 1) for i in range(points.shape[1] - 1) if seg[i] > 1e-6],
+        dtype=np.int64,
+    ).reshape(-1, 2)
+    length = float(np.linalg.norm(np.diff(points[0], axis=0), axis=-1).sum())
+    radius = float(np.clip(0.03 * length, 0.006, 0.06))
+    return Skeleton(
+        points=points,
+        links=links,
+        radius=radius,
+        joint_frames=P,
+        joint_kinds=tuple(j.kind for j in chain.joints),
+        base=F[:, 0],
+        tool=F[:, -1],
+    )
+
+
+@dataclass(frozen=True)
+class SceneShape:
+    """One primitive body, placed in the world.
+
+    Attributes:
+        name: Body name.
+        kind: ``"box"``, ``"cylinder"`` (axis z), ``"capsule"`` (axis z),
+            ``"sphere"`` or ``"mesh"``.
+        size: Box edges (3,), or ``(radius, length)`` for cylinders and
+            capsules, ``(radius,)`` for spheres [m].
+        pose: Pose in the world (4, 4).
+        color: RGB 0-255.
+        vertices: Mesh vertices (V, 3) in the body frame, for meshes.
+        faces: Mesh triangles (F, 3), for meshes.
+    """
+
+    name: str
+    kind: str
+    size: tuple[float, ...]
+    pose: np.ndarray
+    color: tuple[int, int, int] = SCENE_COLOR
+    vertices: np.ndarray | None = None
+    faces: np.ndarray | None = None
+
+
+def _first_attr(obj: Any, names: Iterable[str]) -> Any:
+    for name in names:
+        if isinstance(obj, Mapping) and name in obj:
+            return obj[name]
+        if hasattr(obj, name):
+            return getattr(obj, name)
+    return None
+
+
+def _shape_from_record(name: str, rec: Any, pose: Any = None) -> SceneShape | None:
+    """Read one body record (dataclass, dict, trimesh or coal-like) duck-typed."""
+    if pose is None:
+        pose = _first_attr(rec, ("pose", "transform", "origin", "T"))
+    pose = np.eye(4) if pose is None else np.asarray(pose, dtype=float).reshape(4, 4)
+    geom = _first_attr(rec, ("shape", "geometry"))
+    if geom is not None and not isinstance(geom, str):
+        inner = _shape_from_record(name, geom, pose)
+        if inner is not None:
+            return inner
+    kind = _first_attr(rec, ("kind", "type", "shape"))
+    kind = str(kind).lower() if kind is not None else ""
+    size = _first_attr(rec, ("size", "extents", "half_extents", "dims"))
+    radius = _first_attr(rec, ("radius",))
+    length = _first_attr(rec, ("length", "height"))
+    verts = _first_attr(rec, ("vertices",))
+    faces = _first_attr(rec, ("faces",))
+    if verts is not None and faces is not None and "box" not in kind:
+        return SceneShape(
+            name,
+            "mesh",
+            (),
+            pose,
+            vertices=np.asarray(verts, float),
+            faces=np.asarray(faces, np.int64),
+        )
+    if "box" in kind or (size is not None and np.size(size) == 3 and radius is None):
+        s = np.asarray(size, dtype=float).reshape(3)
+        if hasattr(rec, "half_extents") and not hasattr(rec, "size"):
+            s = 2 * s
+        return SceneShape(name, "box", tuple(s), pose)
+    if "sphere" in kind and radius is not None:
+        return SceneShape(name, "sphere", (float(radius),), pose)
+    if radius is not None and length is not None:
+        return SceneShape(
+            name,
+            "capsule" if "capsule" in kind else "cylinder",
+            (float(radius), float(length)),
+            pose,
+        )
+    if size is not None and np.size(size) == 2:
+        r, h = (float(v) for v in np.asarray(size).reshape(2))
+        return SceneShape(
+            name, "capsule" if "capsule" in kind else "cylinder", (r, h), pose
+        )
+    if size is not None and np.size(size) == 1 and "sphere" in kind:
+        return SceneShape(
+            name, "sphere", (float(np.asarray(size).reshape(-1)[0]),), pose
+        )
+    return None
+
+
+def scene_shapes(scene: Any) -> list[SceneShape]:
+    """The bodies of a ``robokin.collision.Scene`` (or None) as primitives.
+
+    Reads the scene duck-typed: a ``shapes()`` / ``primitives()`` method, or a
+    ``bodies`` / ``objects`` collection (a mapping name -> record or a list of
+    records with a ``name``), where each record has a kind, its dimensions
+    and a world pose. Bodies it cannot read are skipped.
+    """
+    if scene is None:
+        return []
+    for meth in ("shapes", "primitives"):
+        fn = getattr(scene, meth, None)
+        if callable(fn):
+            try:
+                items = fn()
+            except TypeError:
+                continue
+            return _records(items)
+    for attr in ("bodies", "objects", "obstacles", "items"):
+        items = getattr(scene, attr, None)
+        if items is not None and not callable(items):
+            return _records(items)
+    if isinstance(scene, (list, tuple, Mapping)):
+        return _records(scene)
+    return []
+
+
+def _records(items: Any) -> list[SceneShape]:
+    out = []
+    if isinstance(items, Mapping):
+        pairs = list(items.items())
+    else:
+        pairs = [
+            (str(_first_attr(r, ("name",)) or f"body{i}"), r)
+            for i, r in enumerate(items)
+        ]
+    for name, rec in pairs:
+        if isinstance(rec, SceneShape):
+            out.append(rec)
+            continue
+        s = _shape_from_record(str(name), rec)
+        if s is not None:
+            out.append(s)
+    return out
+
+
+def robot_shapes(robot: Robot) -> list[tuple[int, SceneShape]] | None:
+    """The robot's own geometry as ``(frame index, shape in that frame)`` pairs.
+
+    Frame index ``i`` refers to ``link_frames`` (0 the base, ``k`` the link
+    frame of chain joint k, ``n_chain + 1`` the tool). None when the robot has
+    no geometry (or none this reader understands): draw the skeleton instead.
+    """
+    geom = getattr(robot, "geometry", None)
+    if geom is None:
+        return None
+    nc = robot.chain.n_chain
+    names = {"base": 0, "tool": nc + 1, "flange": nc + 1}
+    for k, j in enumerate(robot.chain.joints, start=1):
+        names[j.name] = k
+    items = None
+    for attr in ("shapes", "links", "bodies"):
+        items = getattr(geom, attr, None)
+        if callable(items):
+            try:
+                items = items()
+            except TypeError:
+                items = None
+        if items is not None:
+            break
+    if items is None:
+        items = geom if isinstance(geom, (list, tuple, Mapping)) else None
+    if items is None:
+        return None
+    pairs = (
+        list(items.items())
+        if isinstance(items, Mapping)
+        else [(None, r) for r in items]
+    )
+    out = []
+    for key, rec in pairs:
+        recs = rec if isinstance(rec, (list, tuple)) else [rec]
+        for r in recs:
+            link = (
+                _first_attr(r, ("link", "frame", "parent", "index"))
+                if key is None
+                else key
+            )
+            if isinstance(link, str):
+                idx = names.get(link)
+            elif isinstance(link, (int, np.integer)):
+                idx = int(link)
+            else:
+                idx = None
+            if idx is None or not 0 <= idx <= nc + 1:
+                continue
+            s = _shape_from_record(str(_first_attr(r, ("name",)) or f"link{idx}"), r)
+            if s is not None:
+                out.append((idx, s))
+    return out or None
+
+
+@dataclass(frozen=True)
+class ReportArrays:
+    """Per-sample facts of a collision report, aligned with the motion.
+
+    Attributes:
+        distance: Minimum distance per sample [m], shape (m,), or None.
+        closest: Closest point pairs per sample [m], shape (m, 2, 3), or None.
+        colliding: Per-sample collision flag, shape (m,).
+        bodies: Names of the bodies in collision per interval.
+        min_distance: The report's minimum distance [m], or None.
+    """
+
+    distance: np.ndarray | None
+    closest: np.ndarray | None
+    colliding: np.ndarray
+    bodies: list[tuple[int, int, str, str]] = field(default_factory=list)
+    min_distance: float | None = None
+
+
+def report_arrays(report: Any, m: int) -> ReportArrays:
+    """Read a collision report (``robokin.collision.check``'s) duck-typed.
+
+    Uses ``collisions`` [(first, last, body_a, body_b), ...] for the flags, and
+    the first of ``distances`` / ``distance`` / ``min_distances`` (m,) and
+    ``closest_points`` / ``witness_points`` / ``points`` (m, 2, 3) found.
+    """
+    colliding = np.zeros(m, dtype=bool)
+    if report is None:
+        return ReportArrays(None, None, colliding)
+    bodies = []
+    for item in getattr(report, "collisions", None) or []:
+        try:
+            first, last = int(item[0]), int(item[1])
+        except (TypeError, ValueError, IndexError):
+            continue
+        colliding[max(first, 0) : min(last, m - 1) + 1] = True
+        names = tuple(str(x) for x in item[2:4]) if len(item) >= 4 else ("", "")
+        bodies.append((first, last, *names))
+    mask = getattr(report, "colliding", None)
+    if mask is not None and np.shape(mask) == (m,):
+        colliding |= np.asarray(mask, dtype=bool)
+    dist = None
+    for name in ("distances", "distance", "min_distances", "clearance"):
+        d = getattr(report, name, None)
+        if d is not None and np.shape(d) == (m,):
+            dist = np.asarray(d, dtype=float)
+            break
+    closest = None
+    for name in ("closest_points", "witness_points", "nearest_points", "points"):
+        c = getattr(report, name, None)
+        if c is not None and np.shape(c) == (m, 2, 3):
+            closest = np.asarray(c, dtype=float)
+            break
+    md = getattr(report, "min_distance", None)
+    md = None if md is None else float(md)
+    return ReportArrays(dist, closest, colliding, bodies, md)

@@ -1,0 +1,133 @@
+"""The standalone HTML animation: self-contained, loads, plays, shows the robot."""
+
+from __future__ import annotations
+
+import json
+import re
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+import robokin
+from browser_shots import (
+    orange_fraction,
+    read_png,
+    red_fraction,
+    require_chromium,
+    run_chromium,
+)
+from robokin.exceptions import InputError
+from robokin.viz.html import animation_html, write_html
+
+
+def _embedded(text: str) -> dict:
+    m = re.search(
+        r'<script id="robokin-data" type="application/json">(.*?)</script>', text, re.S
+    )
+    assert m is not None
+    return json.loads(m.group(1))
+
+
+def _ur5_motion(m: int = 300) -> np.ndarray:
+    s = np.linspace(0.0, 1.0, m)[:, None]
+    q0 = np.array([0.0, -1.2, 1.4, -1.8, -1.57, 0.0])
+    q1 = np.array([1.2, -0.8, 1.0, -1.6, -1.57, 0.5])
+    return q0 + s * (q1 - q0)
+
+
+def _scene():
+    table = {
+        "kind": "box",
+        "size": (0.6, 0.8, 0.05),
+        "pose": np.array(
+            [[1, 0, 0, 0.5], [0, 1, 0, 0.2], [0, 0, 1, -0.1], [0, 0, 0, 1.0]]
+        ),
+    }
+    return SimpleNamespace(bodies={"table": table})
+
+
+def test_page_is_self_contained_and_carries_the_motion():
+    robot = robokin.load("ur5")
+    q = _ur5_motion(300)
+    text = animation_html(
+        robot, SimpleNamespace(t=np.arange(300) * 0.01, q=q), scene=_scene()
+    )
+    # No server, no network: nothing is fetched from anywhere.
+    assert re.search(r"https?://", text) is None
+    assert re.search(r"<script[^>]*\bsrc=", text) is None
+    assert "<link" not in text
+    data = _embedded(text)
+    assert len(data["t"]) == 300
+    assert data["t"][-1] == pytest.approx(2.99)
+    assert [s["name"] for s in data["scene"]] == ["table"]
+    # The key points are the FK frames: the last one is the tool position.
+    import base64
+
+    pts = np.frombuffer(base64.b64decode(data["points"]), dtype="<f4").reshape(
+        300, -1, 3
+    )
+    np.testing.assert_allclose(pts[:, -1], robot.fk(q)[:, :3, 3], atol=1e-6)
+    np.testing.assert_allclose(pts[:, 0], 0.0, atol=1e-7)
+
+
+def test_long_motions_are_thinned_but_keep_the_closest_sample():
+    robot = robokin.load("scara")
+    m = 5000
+    q = np.zeros((m, 4))
+    q[:, 0] = np.linspace(-1, 1, m)
+    dist = np.abs(np.linspace(-1, 1, m) - 0.3123) + 0.01
+    rep = SimpleNamespace(
+        min_distance=float(dist.min()),
+        collisions=[(4321, 4322, "link2", "post")],
+        distances=dist,
+    )
+    data = _embedded(animation_html(robot, q, report=rep, max_frames=500))
+    assert 500 <= len(data["t"]) <= 505
+    assert min(data["distance"]) == pytest.approx(dist.min(), abs=1e-7)
+    assert sum(data["colliding"]) >= 1
+    assert data["collisions"] == [[4321, 4322, "link2", "post"]]
+    assert data["t"][1] == pytest.approx(0.05)  # stride 10 of 5 ms samples
+
+
+def test_bad_trajectory_is_named():
+    robot = robokin.load("ur5")
+    with pytest.raises(InputError, match="trajectory"):
+        animation_html(robot, np.zeros((10, 5)))
+    with pytest.raises(InputError, match="increase"):
+        animation_html(robot, SimpleNamespace(t=np.zeros(3), q=np.zeros((3, 6))))
+
+
+def test_page_loads_and_shows_the_robot_in_chromium(tmp_path):
+    require_chromium()
+    robot = robokin.load("ur5")
+    path = write_html(
+        tmp_path / "anim.html", robot, _ur5_motion(200), scene=_scene(), autoplay=False
+    )
+    dom = run_chromium(path.as_uri(), tmp_path / "profile")
+    # The script ran to the end: it marks the body with the frame count.
+    assert 'data-rendered="200"' in dom
+    assert "robokin-rendered frames=200" in dom
+    shot = tmp_path / "anim.png"
+    run_chromium(path.as_uri(), tmp_path / "profile", screenshot=shot, size=(900, 600))
+    img = read_png(shot)
+    assert img.shape == (600, 900, 3)
+    canvas = img[60:540]
+    assert canvas.std() > 10.0  # not blank
+    assert orange_fraction(canvas) > 0.002  # the arm's links
+    assert red_fraction(canvas) < 0.005  # no collision shown (the tool's x axis is red)
+
+
+def test_colliding_samples_are_drawn_red(tmp_path):
+    require_chromium()
+    robot = robokin.load("ur5")
+    q = _ur5_motion(50)
+    rep = SimpleNamespace(min_distance=0.0, collisions=[(0, 49, "wrist", "table")])
+    path = write_html(
+        tmp_path / "red.html", robot, q, scene=_scene(), report=rep, autoplay=False
+    )
+    shot = tmp_path / "red.png"
+    run_chromium(path.as_uri(), tmp_path / "profile", screenshot=shot)
+    img = read_png(shot)[60:540]
+    assert red_fraction(img) > 0.02  # the arm and the table it hits
+    assert orange_fraction(img) < 5e-4
