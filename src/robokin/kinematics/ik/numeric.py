@@ -81,6 +81,9 @@ class IKResult:
         iterations: (...) int, iterations used over all attempts.
         restarts: (...) int, random restarts used.
         reason: (...) str, ``"converged"`` or why not (with the error reached).
+
+    For a single target (``T`` of shape (4, 4)) the fields are scalars (``q`` is
+    (n,), ``reason`` a str, ``iterations`` an int).
     """
 
     q: np.ndarray
@@ -508,6 +511,13 @@ def _result(out: np.ndarray, lead: tuple[int, ...], n: int,
             f"not converged: error {out[i, n + K.R_ERR]:.3g} (position "
             f"{out[i, n + K.R_EP]:.3g} m, rotation {out[i, n + K.R_ER]:.3g} rad) after "
             f"{int(out[i, n + K.R_RESTARTS])} restart(s); {why} ({last})"
+        )
+    if not lead:
+        row = out[0, n:].tolist()
+        return IKResult(
+            q=out[0, :n], success=np.bool_(success[0]), error=row[K.R_ERR],
+            iterations=int(row[K.R_ITERS]), restarts=int(row[K.R_RESTARTS]),
+            reason=reason[0], position_error=row[K.R_EP], rotation_error=row[K.R_ER],
         )
     return IKResult(
         q=out[:, :n].reshape(lead + (n,)),
