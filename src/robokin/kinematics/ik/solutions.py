@@ -164,8 +164,11 @@ class SolutionSet:
         if lost.any():
             status = out.status.copy()
             for idx in zip(*np.nonzero(lost)) if lost.ndim else [()]:
-                k = int(np.flatnonzero(self.valid[idx])[0])
-                status[idx] = self._limit_reason(self.q[idx][k])
+                reasons = [
+                    f"solution {k + 1}: {self._limit_reason(self.q[idx][k])[22:]}"
+                    for k in np.flatnonzero(self.valid[idx])
+                ]
+                status[idx] = "outside joint limits: " + "; ".join(reasons)
             out = replace(out, status=status)
         return out
 
@@ -192,17 +195,20 @@ class SolutionSet:
         d = np.linalg.norm(diff, axis=-1)
         return np.where(self.valid, d, np.inf)
 
-    def nearest(self, q_current: npt.ArrayLike) -> np.ndarray:
+    def nearest(self, q_current: npt.ArrayLike, *, respect_limits: bool = True) -> np.ndarray:
         """The valid solution nearest ``q_current`` for every pose, (..., n).
 
         Distance wraps revolute joints; the returned angles are the 2*pi-equivalents
         closest to ``q_current`` that stay inside the joint limits (so a path of
-        nearest solutions is continuous).
+        nearest solutions is continuous). With ``respect_limits`` (default) only
+        solutions inside the joint limits are candidates.
 
         Raises:
             UnreachableError: a pose has no valid solution (its status is named).
         """
         qc = check_finite(check_joints(q_current, self.n, "q_current"), "q_current")
+        if respect_limits and "within_limits" in self.flags:
+            return self.within_limits().nearest(qc, respect_limits=False)
         empty = ~self.valid.any(axis=-1)
         if empty.any():
             idx = np.argwhere(empty)
@@ -283,6 +289,7 @@ class SolutionSet:
 
     def __repr__(self) -> str:
         if not self.shape:
+            st = self.status.item() if isinstance(self.status, np.ndarray) else self.status
             return (f"SolutionSet({int(self.count)} solution(s), method={self.method!r}, "
-                    f"status={self.status.item()!r})")
+                    f"status={st!r})")
         return f"SolutionSet(shape={self.shape}, counts={self.count.tolist()!r:.80})"

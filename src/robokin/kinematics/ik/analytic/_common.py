@@ -78,7 +78,7 @@ def make_set(
     """Assemble a SolutionSet from (..., k, n) slots."""
     if inside is None:
         inside = inside_limits(q, robot.limits)
-    status = STATUS_TEXT[status_codes]
+    status = np.asarray(STATUS_TEXT[status_codes], dtype=object)
     return SolutionSet(
         q, valid, robot.is_revolute, robot.limits,
         flags={"within_limits": inside & valid, "singular": singular & valid},

@@ -14,6 +14,7 @@ vec 16    unit vector e perpendicular to the 'sum' axis (h2 or h4)
 51..56    joint signs; 57..62 joint offsets; 63..68 / 69..74 lower / upper limits
 75, 76    s3 = h3.h2, s4 = h4.h2 (three parallel)
 77, 78    singular tolerance, discriminant tolerance
+79        1.0: mirror seeds past a boundary (near-family), else 0.0
 ========  ==========================================================
 
 Each pose yields 8 slots, ``slot = 4 * shoulder + 2 * elbow + wrist`` with
@@ -40,8 +41,8 @@ from robokin.kinematics.ik.analytic._subproblems import (
     vec,
 )
 
-SIGN, OFFSET, LO, HI, S3, S4, SING_TOL, DISC_TOL = 51, 57, 63, 69, 75, 76, 77, 78
-N_PARAMS = 79
+SIGN, OFFSET, LO, HI, S3, S4, SING_TOL, DISC_TOL, MIRROR = 51, 57, 63, 69, 75, 76, 77, 78, 79
+N_PARAMS = 80
 
 
 @njit(cache=True, inline="always")
@@ -109,6 +110,7 @@ def three_parallel_one(T, P, qn, Q, valid, sing, inside):
     s4 = P[S4]
     stol = P[SING_TOL]
     dtol = P[DISC_TOL]
+    mir = P[MIRROR] != 0.0
     for k in range(8):
         valid[k] = False
         sing[k] = False
@@ -119,7 +121,7 @@ def three_parallel_one(T, P, qn, Q, valid, sing, inside):
     pp = sub(sub(p, _mv(r0, r1, r2, sub(t, ow))), o1)
     A, B, C = sp4_coeffs(pp, h1, h2)
     rhs = dot(h2, sub(ow, o1)) - C
-    t1p, t1m, n1, bd1 = two_roots(A, B, rhs, A * A + B * B - rhs * rhs, dtol)
+    t1p, t1m, n1, bd1 = two_roots(A, B, rhs, A * A + B * B - rhs * rhs, dtol, mir)
     if n1 == 0:
         return 1
     g6 = _mv(r0, r1, r2, h6)
@@ -139,7 +141,7 @@ def three_parallel_one(T, P, qn, Q, valid, sing, inside):
         d5 = dot(h2, x)
         xp = sub(x, scale(h2, d5))
         t5p, t5m, n5, _ = two_roots(A5, B5, d5 - C5, _wrist_disc(A5, B5, C5, d5, dot(xp, xp)),
-                                   dtol)
+                                   dtol, mir)
         if n5 == 0:
             continue
         any_wrist = True
@@ -164,7 +166,7 @@ def three_parallel_one(T, P, qn, Q, valid, sing, inside):
             th234 = sp1(h2, e, w)
             d = sub(pl, rot(h2, math.cos(th234), math.sin(th234), sub(ow, o4)))
             rhs3 = 0.5 * (dot(d, d) - aa - bb) - C3
-            t3p, t3m, n3, bd3 = two_roots(A3, B3, rhs3, A3 * A3 + B3 * B3 - rhs3 * rhs3, dtol)
+            t3p, t3m, n3, bd3 = two_roots(A3, B3, rhs3, A3 * A3 + B3 * B3 - rhs3 * rhs3, dtol, mir)
             for i3 in range(n3):
                 th3 = t3p if i3 == 0 else t3m
                 u = add(a, rot(h3, math.cos(th3), math.sin(th3), b))
@@ -197,6 +199,7 @@ def spherical_one(T, P, qn, Q, valid, sing, inside):
     e = vec(P, 16)
     stol = P[SING_TOL]
     dtol = P[DISC_TOL]
+    mir = P[MIRROR] != 0.0
     for k in range(8):
         valid[k] = False
         sing[k] = False
@@ -207,7 +210,7 @@ def spherical_one(T, P, qn, Q, valid, sing, inside):
     pw = sub(sub(p, _mv(r0, r1, r2, sub(t, ow))), o1)
     A, B, C = sp4_coeffs(pw, h1, h2)
     rhs = dot(h2, sub(ow, o1)) - C
-    t1p, t1m, n1, bd1 = two_roots(A, B, rhs, A * A + B * B - rhs * rhs, dtol)
+    t1p, t1m, n1, bd1 = two_roots(A, B, rhs, A * A + B * B - rhs * rhs, dtol, mir)
     if n1 == 0:
         return 1
     g6 = _mv(r0, r1, r2, h6)
@@ -225,7 +228,7 @@ def spherical_one(T, P, qn, Q, valid, sing, inside):
         s1 = math.sin(th1)
         d = sub(rot(h1, c1, -s1, pw), sub(o2, o1))
         rhs3 = 0.5 * (dot(d, d) - aa - bb) - C3
-        t3p, t3m, n3, bd3 = two_roots(A3, B3, rhs3, A3 * A3 + B3 * B3 - rhs3 * rhs3, dtol)
+        t3p, t3m, n3, bd3 = two_roots(A3, B3, rhs3, A3 * A3 + B3 * B3 - rhs3 * rhs3, dtol, mir)
         for i3 in range(n3):
             any_pos = True
             th3 = t3p if i3 == 0 else t3m
@@ -239,7 +242,7 @@ def spherical_one(T, P, qn, Q, valid, sing, inside):
             d5 = dot(h4, x)
             xp = sub(x, scale(h4, d5))
             t5p, t5m, n5, _ = two_roots(
-                A5, B5, d5 - C5, _wrist_disc(A5, B5, C5, d5, dot(xp, xp)), dtol
+                A5, B5, d5 - C5, _wrist_disc(A5, B5, C5, d5, dot(xp, xp)), dtol, mir
             )
             y = _mtv(r0, r1, r2, rot(h1, c1, s1, rot(h2, c2, s2, rot(h3, c3, s3, h4))))
             yp = sub(y, scale(h6, dot(y, h6)))

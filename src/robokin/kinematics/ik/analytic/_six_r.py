@@ -36,7 +36,8 @@ _PARALLEL_MIN = 512
 
 
 def pack(chain: Any, kind: Kind, *, singular_tol: float = 1e-9,
-         disc_tol: float = 1e-12, poe: Poe | None = None) -> np.ndarray:
+         disc_tol: float = 1e-12, mirror: bool = False,
+         poe: Poe | None = None) -> np.ndarray:
     """The kernel parameter vector of a 6R chain (layout in ``_kernels6r``)."""
     from robokin.kinematics.ik.analytic import _kernels6r as K
 
@@ -73,6 +74,7 @@ def pack(chain: Any, kind: Kind, *, singular_tol: float = 1e-9,
     P[K.S3], P[K.S4] = s3, s4
     P[K.SING_TOL] = singular_tol
     P[K.DISC_TOL] = disc_tol
+    P[K.MIRROR] = 1.0 if mirror else 0.0
     P.setflags(write=False)
     return P
 
@@ -136,8 +138,11 @@ def solve_six_r(
     elif compute_error:
         dp, dr = fk_error(robot.chain, Q, T)
         error = np.where(valid, np.hypot(dp, dr), np.inf)
-    return make_set(
+    out = make_set(
         robot, Q, valid, inside=inside, singular=sing,
         branches=branch_labels(lead, _LABELS), status_codes=status,
         method=method, info=info, error=error,
     )
+    if near:
+        out.flags["polished"] = valid.copy()
+    return out

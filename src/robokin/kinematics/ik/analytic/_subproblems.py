@@ -81,19 +81,24 @@ def sp4_coeffs(h, k, p):
 
 
 @njit(**_NJ)
-def two_roots(A, B, rhs, disc, tol):
+def two_roots(A, B, rhs, disc, tol, mirror):
     """Roots of ``A cos t + B sin t = rhs`` given ``disc = A^2 + B^2 - rhs^2``.
 
     Returns ``(t_plus, t_minus, n, boundary)``: ``n`` roots (0, 1 or 2);
     ``boundary`` is True when ``disc`` was clamped to zero within ``tol`` (a double
-    root: the pose is on a singular boundary).
+    root: the pose is on a singular boundary). With ``mirror`` (near-family seeds), a
+    slightly negative ``disc`` gives two seeds mirrored about the double root instead.
     """
     phi = math.atan2(B, A)
     r2 = A * A + B * B
     if disc < 0.0:
         if disc < -tol * r2:
             return 0.0, 0.0, 0, False
-        return phi, phi, 1, True
+        base = phi + math.atan2(0.0, rhs)  # the double root: phi (rhs > 0) or phi + pi
+        if mirror:
+            g = math.atan2(math.sqrt(-disc), abs(rhs))
+            return base + g, base - g, 2, True
+        return base, base, 1, True
     g = math.atan2(math.sqrt(disc), rhs)
     if disc <= tol * r2 * 1e-3:
         return phi + g, phi - g, 1, True

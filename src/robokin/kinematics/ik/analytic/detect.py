@@ -190,7 +190,11 @@ def _six_r_family(chain: Any, poe: Any, name: str, text: str, near: bool, dev: f
         key = (singular_tol, 1e-12)
         P = params_cache.get(key)
         if P is None:
-            P = pack(chain, name, singular_tol=singular_tol, poe=poe)
+            if near:  # seeds past a boundary the nominal geometry moved: mirror them
+                P = pack(chain, name, singular_tol=singular_tol, poe=poe,
+                         disc_tol=min(0.5, 100.0 * dev), mirror=True)
+            else:
+                P = pack(chain, name, singular_tol=singular_tol, poe=poe)
             params_cache[key] = P
         return solve_six_r(robot, T, q_near, kind=name, params=P, method=method,
                            info=info, near=near, compute_error=compute_error, **options)
