@@ -1,0 +1,103 @@
+"""``robokin ik``: every joint solution for a pose, as a table with flags and FK errors."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Annotated, Optional
+
+import typer
+
+from robokin.cli import DomainFailure, _console, _load, app
+
+__all__ = ["ik"]
+
+
+@app.command(context_settings={"ignore_unknown_options": True})
+def ik(
+    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    x: Annotated[float, typer.Argument(help="Tool position x.")],
+    y: Annotated[float, typer.Argument(help="Tool position y.")],
+    z: Annotated[float, typer.Argument(help="Tool position z.")],
+    roll: Annotated[float, typer.Argument(help="Roll (about x).")],
+    pitch: Annotated[float, typer.Argument(help="Pitch (about y).")],
+    yaw: Annotated[float, typer.Argument(help="Yaw (about z).")],
+    deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
+    mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
+    near: Annotated[Optional[str], typer.Option(
+        "--near", help="Current joint values, comma or space separated (rad/m, or "
+                       "deg/mm with --deg/--mm).")] = None,
+    method: Annotated[str, typer.Option(help="auto | analytic | numeric")] = "auto",
+    limits: Annotated[bool, typer.Option("--limits", help="Only solutions inside the "
+                                                            "joint limits.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+) -> None:
+    """Inverse kinematics: every solution for the pose x y z roll pitch yaw."""
+    import numpy as np
+    from rich.table import Table
+
+    from robokin.kinematics.ik.analytic._common import fk_error
+    from robokin.spatial import pose_from_xyz_rpy
+
+    r = _load(name)
+    L = 1000.0 if mm else 1.0
+    A = 180.0 / math.pi if deg else 1.0
+    T = pose_from_xyz_rpy(np.array([x, y, z]) / L, np.array([roll, pitch, yaw]) / A)
+    rev = r.is_revolute
+    q_near = None
+    if near is not None:
+        vals = [float(v) for v in near.replace(",", " ").split()]
+        if len(vals) != r.n:
+            raise typer.BadParameter(f"--near needs {r.n} values, got {len(vals)}")
+        q_near = np.where(rev, np.array(vals) / A, np.array(vals) / L)
+    sols = r.ik(T, q_near=q_near, method=method)
+    if limits:
+        sols = sols.within_limits()
+    q = sols.q[sols.valid]
+    dp, dr = fk_error(r.chain, q, T) if len(q) else (np.zeros(0), np.zeros(0))
+    flags = {k: v[sols.valid] for k, v in sols.flags.items()}
+    branches = {k: np.asarray(v)[sols.valid] for k, v in sols.branches.items()}
+    order = np.arange(len(q))
+    if q_near is not None and len(q):
+        order = np.argsort(sols.distance(q_near)[sols.valid], kind="stable")
+    disp = np.where(rev, q * A, q * L)
+    status = str(sols.status.item() if isinstance(sols.status, np.ndarray) else sols.status)
+    if as_json:
+        print(json.dumps({
+            "method": sols.method, "status": status,
+            "solutions": [
+                {"q": disp[i].tolist(),
+                 "flags": {k: bool(v[i]) for k, v in flags.items()},
+                 "branches": {k: int(v[i]) for k, v in branches.items()},
+                 "position_error_m": float(dp[i]), "rotation_error_rad": float(dr[i])}
+                for i in order],
+        }))
+    else:
+        con = _console()
+        au, lu = ("deg" if deg else "rad"), ("mm" if mm else "m")
+        table = Table(title=f"{r.name}: {len(q)} solution(s) [{sols.method}]; "
+                            f"angles {au}, lengths {lu}")
+        table.add_column("#")
+        for j in range(r.n):
+            table.add_column(f"q{j + 1}", justify="right")
+        table.add_column("branch")
+        table.add_column("flags")
+        table.add_column("FK err", justify="right")
+        for rank, i in enumerate(order, 1):
+            fl = [k for k, v in flags.items() if k != "within_limits" and v[i]]
+            if not flags.get("within_limits", np.ones(len(q), bool))[i]:
+                fl.append("LIMITS")
+            br = "".join(f"{k[0].upper()}{'+' if v[i] > 0 else '-'}"
+                          for k, v in branches.items())
+            table.add_row(
+                str(rank), *[f"{v:.3f}" for v in disp[i]], br or "-",
+                ",".join(fl) or "-", f"{max(dp[i], dr[i]):.0e}",
+            )
+        if len(q):
+            con.print(table)
+        if len(q):
+            con.print("FK err: max of position [m] and rotation [rad] error"
+                      + ("; sorted by distance from --near" if q_near is not None else ""),
+                      markup=False)
+    if not len(q):
+        raise DomainFailure(f"no IK solution: {status}")
