@@ -89,6 +89,16 @@ def make_set(
 
 def branch_labels(lead: tuple[int, ...], table: dict[str, list[int]]) -> dict[str, np.ndarray]:
     """Per-slot constant labels broadcast over the pose batch (read-only views)."""
-    k = len(next(iter(table.values())))
-    return {name: np.broadcast_to(np.asarray(v, dtype=np.int8), lead + (k,))
-            for name, v in table.items()}
+    key = (lead, id(table))
+    out = _LABEL_CACHE.get(key)
+    if out is None:
+        k = len(next(iter(table.values())))
+        out = {name: np.broadcast_to(np.asarray(v, dtype=np.int8), lead + (k,))
+               for name, v in table.items()}
+        if len(_LABEL_CACHE) > 64:
+            _LABEL_CACHE.clear()
+        _LABEL_CACHE[key] = out
+    return dict(out)
+
+
+_LABEL_CACHE: dict = {}
