@@ -822,11 +822,14 @@ def urdf_from_robot(
     """
     chain = robot.chain
     root = ET.Element("robot", {"name": name or robot.name})
-    root.append(ET.Comment(
-        f" written by robokin from '{robot.name}'"
-        + (f" ({robot.source})" if robot.source else "").replace("--", "-")
-        + "; <limit velocity/effort> are placeholders "
-    ))
+    note = (
+        f"written by robokin from '{robot.name}'"
+        + (f" ({robot.source})" if robot.source else "")
+        + "; <limit velocity/effort> are placeholders"
+    )
+    while "--" in note:
+        note = note.replace("--", "-")
+    root.append(ET.Comment(f" {note} "))
     link_names: set[str] = set()
     joint_names: set[str] = set()
 
