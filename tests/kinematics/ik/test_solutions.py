@@ -1,0 +1,73 @@
+"""The SolutionSet: limits, nearest with wrapping, turn expansion, reasons."""
+
+import numpy as np
+import pytest
+
+import robokin
+from robokin.exceptions import UnreachableError
+from robokin.kinematics.ik.solutions import SolutionSet
+
+
+def _set(q, valid, limits, is_rev=None):
+    q = np.asarray(q, float)
+    n = q.shape[-1]
+    return SolutionSet(q, valid, np.ones(n, bool) if is_rev is None else is_rev,
+                       np.asarray(limits, float))
+
+
+def test_nearest_wraps_revolute_but_not_prismatic():
+    s = _set([[3.1, 0.5], [-3.0, 0.0]], [True, True], [[-4, 4], [-1, 1]],
+             is_rev=np.array([True, False]))
+    # -3.1 is 0.083 from 3.1 across the wrap: row 0 wins despite the prismatic gap
+    np.testing.assert_allclose(s.distance([-3.1, 0.5]), [2 * np.pi - 6.2, np.hypot(0.1, 0.5)])
+    best = s.nearest([-3.1, 0.5])
+    np.testing.assert_allclose(best, [3.1 - 2 * np.pi, 0.5])  # equivalent nearest q_current
+
+
+def test_nearest_respects_limits_and_names_them():
+    s = _set([[0.0, 2.0], [1.0, 0.5]], [True, True], [[-1, 1], [-1, 1]])
+    np.testing.assert_allclose(s.nearest([0.0, 2.0]), [1.0, 0.5])
+    np.testing.assert_allclose(s.nearest([0.0, 2.0], respect_limits=False), [0.0, 2.0])
+    out = _set([[0.0, 2.0]], [True], [[-1, 1], [-1, 1]])
+    with pytest.raises(UnreachableError, match="joint 2 at 2 > upper limit 1"):
+        out.nearest([0.0, 0.0])
+
+
+def test_within_limits_reason_names_every_candidate():
+    s = _set([[0.0, 2.0], [-3.0, 0.0]], [True, True], [[-1, 1], [-1, 1]]).within_limits()
+    st = s.status.item()
+    assert st.startswith("outside joint limits")
+    assert "solution 1: joint 2 at 2 > upper limit 1" in st
+    assert "solution 2: joint 1 at -3 < lower limit -1" in st
+
+
+def test_expand_turns_ur_360():
+    robot = robokin.load("ur5")
+    q0 = np.array([0.1, -1.0, 1.0, -1.0, 1.0, 2.0])
+    s = robot.ik(robot.fk(q0))
+    e = s.expand_turns()
+    # every joint has two equivalents inside +-360 deg: 2**6 per solution
+    assert int(e.count) == 64 * int(s.count)
+    Q = e.q[e.valid]
+    assert (np.abs(Q) <= 2 * np.pi + 1e-9).all()
+    assert np.abs(robot.fk(Q) - robot.fk(q0)).max() < 1e-9
+    assert np.any(np.all(np.abs(Q - (q0 - [0, 0, 0, 0, 0, 2 * np.pi])) < 1e-9, axis=1))
+    # branch labels follow their source rows
+    assert set(e.branches) == {"shoulder", "elbow", "wrist"}
+
+
+def test_empty_and_batched_repr():
+    e = SolutionSet.empty((2,), 6, np.ones(6, bool), np.tile([-1, 1], (6, 1)), "out of reach")
+    assert e.count.tolist() == [0, 0]
+    assert "shape=(2,)" in repr(e)
+    one = e[0]
+    assert "out of reach" in repr(one)
+
+
+def test_limits_choose_turn_inside_range():
+    # Puma's shoulder limit [-45, 225] deg: a solution at 200 deg must not wrap to -160
+    robot = robokin.load("puma560")
+    q0 = np.radians([10.0, 200.0, -100.0, 20.0, 30.0, 40.0])
+    s = robot.ik(robot.fk(q0))
+    assert np.any(np.all(np.abs(s.q[s.valid] - q0) < 1e-9, axis=1))
+    assert s.within_limits_mask[s.valid][np.argmin(s.distance(q0)[s.valid])]
