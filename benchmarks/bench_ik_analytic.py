@@ -54,7 +54,7 @@ def _dh(robot_name: str):
 
     from robokin.robots import path as robot_path
 
-    doc = yaml.safe_load(open(robot_path(robot_name)))
+    doc = yaml.safe_load(robot_path(robot_name).read_text())
     L = 1e-3 if doc["units"]["length"] == "mm" else 1.0
     rows = doc["joints"]
     return (np.radians([r["alpha"] for r in rows]), np.array([r["a"] for r in rows]) * L,
@@ -139,7 +139,8 @@ def bench_ik_geo(robot, T_single, T_batch) -> None:
     RM = poe.M[:3, :3]
 
     def one(T):
-        return bot.get_ik((T[:3, :3] @ RM.T).tolist(), T[:3, 3].tolist())
+        # ik-geo reads the rotation column by column
+        return bot.get_ik((T[:3, :3] @ RM.T).T.tolist(), T[:3, 3].tolist())
 
     s = _best(lambda: one(T_single), number=2000)
     t0 = time.perf_counter()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 import math
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 
@@ -24,7 +24,7 @@ def ik(
     yaw: Annotated[float, typer.Argument(help="Yaw (about z).")],
     deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
     mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
-    near: Annotated[Optional[str], typer.Option(
+    near: Annotated[str | None, typer.Option(
         "--near", help="Current joint values, comma or space separated (rad/m, or "
                        "deg/mm with --deg/--mm).")] = None,
     method: Annotated[str, typer.Option(help="auto | analytic | numeric")] = "auto",

@@ -12,7 +12,12 @@ from typing import Any, Literal
 
 import numpy as np
 
-from robokin.kinematics.ik.analytic._common import branch_labels, fk_error, make_set, q_near_rows
+from robokin.kinematics.ik.analytic._common import (
+    branch_labels,
+    fk_error,
+    make_set,
+    q_near_rows,
+)
 from robokin.kinematics.ik.analytic._geometry import (
     Poe,
     closest_point,
