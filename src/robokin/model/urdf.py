@@ -626,16 +626,42 @@ def _geometry_of(
     return out
 
 
-def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]]) -> Robot:
-    """Put the shapes on the geometry layer when it exists, else keep them in meta."""
-    try:
-        from robokin.model import geometry as geo
-    except ImportError:
-        geo = None
-    builder = getattr(geo, "geometry_from_urdf_shapes", None) if geo else None
-    if builder is not None:
-        return robot.replace(geometry=builder(robot, shapes))
-    return robot
+def _attach_geometry(
+    robot: Robot, shapes: list[dict[str, Any]], file: Path | None,
+    missing_mesh: MissingMesh,
+) -> Robot:
+    """Put the collision shapes on the geometry layer (visual ones where a link has
+    no collision shape)."""
+    from robokin.model import geometry as geo
+
+    names = geo.link_names(robot)
+    with_collision = {e["link"] for e in shapes if e["role"] == "collision"}
+    per_link: dict[str, list[Any]] = {}
+    for e in shapes:
+        if e["role"] == "visual" and e["link"] in with_collision:
+            continue
+        pose, label = e["pose"], e.get("name") or ""
+        t = e["type"]
+        if t == "box":
+            shape = geo.box(e["size"], pose, name=label)
+        elif t == "cylinder":
+            shape = geo.cylinder(e["radius"], e["length"], pose, name=label)
+        elif t == "sphere":
+            shape = geo.sphere(e["radius"], pose, name=label)
+        else:
+            sc = e["scale"]
+            if not (sc[0] == sc[1] == sc[2]):
+                msg = (f"link '{e['link']}' mesh '{e['uri']}': non-uniform scale "
+                       f"{list(sc)} is not supported")
+                if missing_mesh == "error":
+                    raise ModelError(msg, file=file, field=f"link[{e['link']}]")
+                if missing_mesh == "warn":
+                    warnings.warn(f"{msg}; shape skipped", UserWarning, stacklevel=4)
+                continue
+            shape = geo.mesh(e["filename"], pose, scale=sc[0], name=label,
+                             owner=e["link"])
+        per_link.setdefault(names[e["frame"]], []).append(shape)
+    return robot.replace(geometry=geo.RobotGeometry.from_mapping(robot, per_link))
 
 
 # ------------------------------------------------------------------------ public
@@ -695,7 +721,7 @@ def robot_from_urdf(
         meta={"urdf": info, "urdf_shapes": shapes},
     )
     if shapes:
-        robot = _attach_geometry(robot, shapes)
+        robot = _attach_geometry(robot, shapes, file, missing_mesh)
     return robot
 
 
@@ -773,6 +799,51 @@ def rpy_of(R: np.ndarray) -> tuple[float, float, float]:
     return r, p, y
 
 
+def _clean(v: float) -> float:
+    return 0.0 if abs(v) < 1e-15 else float(v)
+
+
+def _shape_geometry(parent: ET.Element, shape: Any, mesh_uri: Any) -> None:
+    g = ET.SubElement(parent, "geometry")
+    k, size = shape.kind, shape.size
+    if k == "box":
+        ET.SubElement(g, "box", {"size": " ".join(_fmt(v) for v in size)})
+    elif k == "sphere":
+        ET.SubElement(g, "sphere", {"radius": _fmt(size[0])})
+    elif k == "cylinder":
+        ET.SubElement(g, "cylinder", {"radius": _fmt(size[0]), "length": _fmt(size[1])})
+    else:
+        path = str(shape.file)
+        uri = mesh_uri(path) if mesh_uri is not None else path
+        ET.SubElement(g, "mesh", {"filename": uri,
+                                  "scale": " ".join([_fmt(shape.scale)] * 3)})
+
+
+def _write_shapes(root: ET.Element, geometry: Any, targets: list, mesh_uri: Any) -> None:
+    """Visual and collision elements; a capsule is a cylinder and two spheres."""
+    links = {el.get("name"): el for el in root.findall("link")}
+    for (link, T), shapes in zip(targets, geometry.shapes):
+        el = links[link]
+        for shape in shapes:
+            pieces = [(shape, shape.placement)]
+            if shape.kind == "capsule":
+                from robokin.model.geometry import cylinder, sphere
+
+                r, L = shape.size
+                P = np.asarray(shape.placement)
+                pieces = [(cylinder(r, L) if L > 0 else sphere(r), P)]
+                for z in (-L / 2, L / 2):
+                    Tz = np.eye(4)
+                    Tz[2, 3] = z
+                    pieces.append((sphere(r), P @ Tz))
+            for piece, pose in pieces:
+                for role in ("visual", "collision"):
+                    attrib = {"name": shape.name} if shape.name else {}
+                    item = ET.SubElement(el, role, attrib)
+                    _origin_el(item, T @ pose)
+                    _shape_geometry(item, piece, mesh_uri)
+
+
 def _origin_el(parent: ET.Element, T: np.ndarray) -> None:
     if np.array_equal(T, np.eye(4)):
         return
@@ -846,7 +917,8 @@ def urdf_from_robot(
         return lname
 
     def add_joint(jname: str, jtype: str, parent: str, child: str, T: np.ndarray,
-                  *, sign: float = 1.0, limits: tuple[float, float] | None = None,
+                  *, axis: np.ndarray | None = None,
+                  limits: tuple[float, float] | None = None,
                   mimic_of: tuple[str, float, float] | None = None,
                   exact: bool = False) -> str:
         jname = jname if exact else unique(jname, joint_names)
@@ -855,7 +927,7 @@ def urdf_from_robot(
         ET.SubElement(el, "child", {"link": child})
         _origin_el(el, T)
         if jtype != "fixed":
-            ET.SubElement(el, "axis", {"xyz": "0 0 1" if sign > 0 else "0 0 -1"})
+            ET.SubElement(el, "axis", {"xyz": " ".join(_fmt(_clean(v)) for v in axis)})
             lim = {"effort": _fmt(effort), "velocity": _fmt(velocity)}
             if limits is not None and jtype != "continuous":
                 lim["lower"], lim["upper"] = _fmt(limits[0]), _fmt(limits[1])
@@ -919,17 +991,21 @@ def urdf_from_robot(
 
     parent = base
     pending = chain.head.copy()
+    # Where each fk_all frame's shapes go: (URDF link, pose of the frame in it).
+    targets: list[tuple[str, np.ndarray]] = [(base, np.eye(4))]
     for kk, j in enumerate(chain.joints):
         child_name = info.child_links[kk] if imported else f"{j.name}_link"
         kind = j.kind
         row = M[kk]
         nz = [int(i) for i in np.flatnonzero(row)]
+        F = chain.frame_offsets[kk]
         if j.name in is_self:
             parts = [(j.name, None, coords[cnames.index(j.name)].limits)]
         elif not nz:
             # A constant joint: its value folds into the constants.
-            pending = pending @ _rz_or_tz(kind, j.sign * c[kk] + j.offset)
-            pending = pending @ chain.frame_offsets[kk] @ chain.link_offsets[kk]
+            pending = pending @ _rz_or_tz(kind, j.sign * c[kk] + j.offset) @ F
+            targets.append((parent, pending.copy()))
+            pending = pending @ chain.link_offsets[kk]
             continue
         else:
             parts = []
@@ -940,25 +1016,39 @@ def urdf_from_robot(
                     math.isfinite(v) for v in (lo, hi)) else (-math.inf, math.inf)
                 pname = j.name if len(nz) == 1 else f"{j.name}_{cnames[i]}"
                 parts.append((pname, (i, float(row[i]), off), lim))
+        # Fold F into the joint when the moved axis still passes through the child
+        # origin (F^-1 Rz F is then a rotation about F^-1 z): the URDF child link
+        # frame is then the robokin link frame.
+        fold = kind == "prismatic" or (abs(F[0, 3]) < 1e-15 and abs(F[1, 3]) < 1e-15)
         T = pending @ _rz_or_tz(kind, j.offset)
         for p_i, (pname, mim, lim) in enumerate(parts):
             last = p_i == len(parts) - 1
             child = add_link(child_name if last else f"{child_name}_{p_i + 1}")
             jtype, lim = joint_type(kind, lim)
             mimic_of = None if mim is None else (master(mim[0]), mim[1], mim[2])
-            add_joint(pname, jtype, parent, child, T, sign=j.sign, limits=lim,
+            axis = np.array([0.0, 0.0, j.sign])
+            if last and fold:
+                T = T @ F
+                axis = F[:3, :3].T @ axis
+            add_joint(pname, jtype, parent, child, T, axis=axis, limits=lim,
                       mimic_of=mimic_of)
             parent, T = child, np.eye(4)
-        pending = chain.frame_offsets[kk] @ chain.link_offsets[kk]
+        rest = np.eye(4) if fold else F.copy()
+        targets.append((parent, rest))
+        pending = rest @ chain.link_offsets[kk]
     tool_name = info.tip_link if imported and info.tip_link not in link_names \
         else "tool0"
     tool = add_link(tool_name)
     add_joint(f"{parent}_to_{tool}", "fixed", parent, tool, pending @ chain.tool)
+    targets.append((tool, np.eye(4)))
     # Masters that are no chain joint: a zero-length joint on a leaf link.
     for i, jname in coordinate_joints:
         leaf = add_link(f"{jname}_coordinate")
         jtype, lim = joint_type(coords[i].kind, coords[i].limits)
-        add_joint(jname, jtype, base, leaf, np.eye(4), limits=lim, exact=True)
+        add_joint(jname, jtype, base, leaf, np.eye(4), axis=np.array([0.0, 0, 1]),
+                  limits=lim, exact=True)
+    if robot.geometry is not None and hasattr(robot.geometry, "shapes"):
+        _write_shapes(root, robot.geometry, targets, mesh_uri)
     ET.indent(root, space="  ")
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
