@@ -35,7 +35,9 @@ __all__ = [
     "motion_from",
     "report_arrays",
     "robot_shapes",
+    "has_link_shapes",
     "scene_shapes",
+    "shape_from",
     "skeleton",
 ]
 
@@ -203,163 +205,110 @@ def _first_attr(obj: Any, names: Iterable[str]) -> Any:
     for name in names:
         if isinstance(obj, Mapping) and name in obj:
             return obj[name]
-        if hasattr(obj, name):
+        if not isinstance(obj, Mapping) and hasattr(obj, name):
             return getattr(obj, name)
     return None
 
 
-def _shape_from_record(name: str, rec: Any, pose: Any = None) -> SceneShape | None:
-    """Read one body record (dataclass, dict, trimesh or coal-like) duck-typed."""
+def shape_from(
+    name: str,
+    shape: Any,
+    pose: npt.ArrayLike | None = None,
+    color: tuple[int, int, int] = SCENE_COLOR,
+) -> SceneShape | None:
+    """A :class:`SceneShape` from a ``robokin.model.geometry.Shape`` (or a dict like one).
+
+    Args:
+        name: Label.
+        shape: Has ``kind``, ``size`` and ``placement`` (or ``pose``); meshes are
+            read through ``shape.trimesh()`` (or carry ``vertices``/``faces``).
+        pose: Placement to use instead of the shape's own (4, 4).
+        color: RGB 0-255.
+
+    Returns:
+        The primitive, or None when the record cannot be read.
+    """
+    if isinstance(shape, SceneShape):
+        return shape
+    kind = _first_attr(shape, ("kind", "type"))
+    if kind is None:
+        return None
+    kind = str(kind).lower()
     if pose is None:
-        pose = _first_attr(rec, ("pose", "transform", "origin", "T"))
+        pose = _first_attr(shape, ("placement", "pose"))
     pose = np.eye(4) if pose is None else np.asarray(pose, dtype=float).reshape(4, 4)
-    geom = _first_attr(rec, ("shape", "geometry"))
-    if geom is not None and not isinstance(geom, str):
-        inner = _shape_from_record(name, geom, pose)
-        if inner is not None:
-            return inner
-    kind = _first_attr(rec, ("kind", "type", "shape"))
-    kind = str(kind).lower() if kind is not None else ""
-    size = _first_attr(rec, ("size", "extents", "half_extents", "dims"))
-    radius = _first_attr(rec, ("radius",))
-    length = _first_attr(rec, ("length", "height"))
-    verts = _first_attr(rec, ("vertices",))
-    faces = _first_attr(rec, ("faces",))
-    if verts is not None and faces is not None and "box" not in kind:
+    if kind == "mesh":
+        verts = _first_attr(shape, ("vertices",))
+        faces = _first_attr(shape, ("faces",))
+        if verts is None and callable(getattr(shape, "trimesh", None)):
+            m = shape.trimesh()
+            verts, faces = m.vertices, m.faces
+        if verts is None or faces is None:
+            return None
         return SceneShape(
             name,
             "mesh",
             (),
             pose,
-            vertices=np.asarray(verts, float),
-            faces=np.asarray(faces, np.int64),
+            color,
+            np.asarray(verts, dtype=float),
+            np.asarray(faces, dtype=np.int64),
         )
-    if "box" in kind or (size is not None and np.size(size) == 3 and radius is None):
-        s = np.asarray(size, dtype=float).reshape(3)
-        if hasattr(rec, "half_extents") and not hasattr(rec, "size"):
-            s = 2 * s
-        return SceneShape(name, "box", tuple(s), pose)
-    if "sphere" in kind and radius is not None:
-        return SceneShape(name, "sphere", (float(radius),), pose)
-    if radius is not None and length is not None:
-        return SceneShape(
-            name,
-            "capsule" if "capsule" in kind else "cylinder",
-            (float(radius), float(length)),
-            pose,
-        )
-    if size is not None and np.size(size) == 2:
-        r, h = (float(v) for v in np.asarray(size).reshape(2))
-        return SceneShape(
-            name, "capsule" if "capsule" in kind else "cylinder", (r, h), pose
-        )
-    if size is not None and np.size(size) == 1 and "sphere" in kind:
-        return SceneShape(
-            name, "sphere", (float(np.asarray(size).reshape(-1)[0]),), pose
-        )
-    return None
+    size = _first_attr(shape, ("size",))
+    if size is None:
+        return None
+    return SceneShape(name, kind, tuple(float(v) for v in np.ravel(size)), pose, color)
 
 
 def scene_shapes(scene: Any) -> list[SceneShape]:
-    """The bodies of a ``robokin.collision.Scene`` (or None) as primitives.
+    """The objects of a ``robokin.collision.Scene`` (or None) as primitives.
 
-    Reads the scene duck-typed: a ``shapes()`` / ``primitives()`` method, or a
-    ``bodies`` / ``objects`` collection (a mapping name -> record or a list of
-    records with a ``name``), where each record has a kind, its dimensions
-    and a world pose. Bodies it cannot read are skipped.
+    Each scene object has a ``name`` and a ``shape`` whose placement is its
+    pose in the world; objects this reader cannot draw are skipped.
     """
     if scene is None:
         return []
-    for meth in ("shapes", "primitives"):
-        fn = getattr(scene, meth, None)
-        if callable(fn):
-            try:
-                items = fn()
-            except TypeError:
-                continue
-            return _records(items)
-    for attr in ("bodies", "objects", "obstacles", "items"):
-        items = getattr(scene, attr, None)
-        if items is not None and not callable(items):
-            return _records(items)
-    if isinstance(scene, (list, tuple, Mapping)):
-        return _records(scene)
-    return []
-
-
-def _records(items: Any) -> list[SceneShape]:
+    objects = getattr(scene, "objects", scene)
+    if isinstance(objects, Mapping):
+        objects = [{"name": k, "shape": v} for k, v in objects.items()]
     out = []
-    if isinstance(items, Mapping):
-        pairs = list(items.items())
-    else:
-        pairs = [
-            (str(_first_attr(r, ("name",)) or f"body{i}"), r)
-            for i, r in enumerate(items)
-        ]
-    for name, rec in pairs:
-        if isinstance(rec, SceneShape):
-            out.append(rec)
-            continue
-        s = _shape_from_record(str(name), rec)
+    for i, obj in enumerate(objects):
+        name = str(_first_attr(obj, ("name",)) or f"object{i}")
+        shape = _first_attr(obj, ("shape",))
+        s = shape_from(name, shape if shape is not None else obj)
         if s is not None:
             out.append(s)
     return out
 
 
-def robot_shapes(robot: Robot) -> list[tuple[int, SceneShape]] | None:
+def robot_shapes(robot: Robot) -> list[tuple[int, SceneShape]]:
     """The robot's own geometry as ``(frame index, shape in that frame)`` pairs.
 
-    Frame index ``i`` refers to ``link_frames`` (0 the base, ``k`` the link
-    frame of chain joint k, ``n_chain + 1`` the tool). None when the robot has
-    no geometry (or none this reader understands): draw the skeleton instead.
+    Frame index ``i`` follows :func:`robokin.kinematics.forward.link_frames`
+    (and ``robot.geometry.names``): 0 the base, ``k`` the link of chain joint
+    k, ``n_chain + 1`` the tool frame. Empty when the robot has no geometry.
     """
-    geom = getattr(robot, "geometry", None)
-    if geom is None:
-        return None
+    geo = getattr(robot, "geometry", None)
+    per_link = getattr(geo, "shapes", None)
+    if geo is None or per_link is None:
+        return []
     nc = robot.chain.n_chain
-    names = {"base": 0, "tool": nc + 1, "flange": nc + 1}
-    for k, j in enumerate(robot.chain.joints, start=1):
-        names[j.name] = k
-    items = None
-    for attr in ("shapes", "links", "bodies"):
-        items = getattr(geom, attr, None)
-        if callable(items):
-            try:
-                items = items()
-            except TypeError:
-                items = None
-        if items is not None:
-            break
-    if items is None:
-        items = geom if isinstance(geom, (list, tuple, Mapping)) else None
-    if items is None:
-        return None
-    pairs = (
-        list(items.items())
-        if isinstance(items, Mapping)
-        else [(None, r) for r in items]
-    )
     out = []
-    for key, rec in pairs:
-        recs = rec if isinstance(rec, (list, tuple)) else [rec]
-        for r in recs:
-            link = (
-                _first_attr(r, ("link", "frame", "parent", "index"))
-                if key is None
-                else key
-            )
-            if isinstance(link, str):
-                idx = names.get(link)
-            elif isinstance(link, (int, np.integer)):
-                idx = int(link)
-            else:
-                idx = None
-            if idx is None or not 0 <= idx <= nc + 1:
-                continue
-            s = _shape_from_record(str(_first_attr(r, ("name",)) or f"link{idx}"), r)
+    for i, shapes in enumerate(per_link):
+        if i > nc + 1:
+            break
+        color = JOINT_COLOR if i in (0, nc + 1) else LINK_COLOR
+        for j, shape in enumerate(shapes):
+            s = shape_from(f"{geo.names[i]}_{j}", shape, color=color)
             if s is not None:
-                out.append((idx, s))
-    return out or None
+                out.append((i, s))
+    return out
+
+
+def has_link_shapes(shapes: list[tuple[int, SceneShape]], robot: Robot) -> bool:
+    """True when some shape sits on a moving link (not only base and tool)."""
+    nc = robot.chain.n_chain
+    return any(0 < i <= nc for i, _ in shapes)
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,7 @@ from robokin.viz._common import (
     DISTANCE_COLOR,
     JOINT_COLOR,
     LINK_COLOR,
+    has_link_shapes,
     motion_from,
     report_arrays,
     robot_shapes,
@@ -144,6 +145,7 @@ def animation_html(
         "closest": None if rep.closest is None else _b64(rep.closest[idx]),
         "minDistance": rep.min_distance,
     }
+    data["skeleton"] = not has_link_shapes(shapes, robot)
     if shapes:
         from robokin.kinematics.forward import link_frames
 
@@ -469,7 +471,8 @@ _SCRIPT = r"""
                    f[9], f[10], f[11], 1];
         shape(s, compose(M, s.pose), red ? C.collision : s.color, 1);
       }
-    } else {
+    }
+    if (D.skeleton) {
       for (const [i, j] of D.links) capsule(pt(frame, i), pt(frame, j), r, linkC);
       for (let k = 0; k < NJ; k++) {
         const o = pt(frame, D.jointOrigins[k]), a = (frame * NJ + k) * 3;

@@ -1,0 +1,128 @@
+"""The live viser viewer: scene contents, playback, IK snapping, and a real browser."""
+
+from __future__ import annotations
+
+import inspect
+import urllib.request
+
+import numpy as np
+import pytest
+
+import robokin
+from browser_shots import orange_fraction, read_png, require_chromium, run_chromium
+
+viewer_mod = pytest.importorskip("robokin.viz.viewer")
+pytest.importorskip("viser")
+RobotViewer = viewer_mod.RobotViewer
+
+
+class _Report:
+    """A collision report shaped like ``collision.check``'s, for 50 samples."""
+
+    def __init__(self, tool: np.ndarray):
+        self.min_distance = 0.0
+        self.collides = True
+        self.collisions = [(20, 29, "wrist_3", "table")]
+        self.distances = np.linspace(0.2, 0.0, 50)
+        self.closest_points = np.stack([tool, tool + [0.0, 0.0, -0.1]], axis=1)
+
+
+def _motion(m: int = 50) -> np.ndarray:
+    s = np.linspace(0.0, 1.0, m)[:, None]
+    return np.array([0.0, -1.2, 1.4, -1.8, -1.57, 0.0]) + s * np.array(
+        [1.2, 0.4, -0.4, 0.2, 0, 0.5]
+    )
+
+
+@pytest.fixture
+def ur5():
+    return robokin.load("ur5")
+
+
+def test_binds_to_loopback_by_default(ur5):
+    assert inspect.signature(RobotViewer).parameters["host"].default == "127.0.0.1"
+    with RobotViewer(ur5, port=0) as v:
+        assert v.url == f"http://127.0.0.1:{v.port}"
+        page = urllib.request.urlopen(v.url, timeout=10).read()
+        assert b"<html" in page.lower()
+
+
+def test_free_robot_sliders_and_tool_pose(ur5):
+    with RobotViewer(ur5, port=0) as v:
+        assert v.free
+        q = np.array([0.3, -1.0, 1.2, -0.5, 0.4, 0.2])
+        v.set_configuration(q, move_target=True)
+        T = ur5.fk(q)
+        np.testing.assert_allclose(v._tool.position, T[:3, 3], atol=1e-9)
+        np.testing.assert_allclose(v._target.position, T[:3, 3], atol=1e-9)
+        slider_q = v._slider_q()
+        np.testing.assert_allclose(slider_q, q, atol=1e-9)
+        assert f"{T[0, 3] * 1000:.1f}" in v._pose_md.content
+        # The drawn links end at the tool: the last capsule's far end is the tool point.
+        seg = v._segments[-1]
+        d = np.asarray(seg.position) - T[:3, 3]
+        assert np.linalg.norm(d) == pytest.approx(0.5 * seg.height, abs=1e-9)
+
+
+def test_dragging_the_target_snaps_to_the_nearest_ik_solution(ur5):
+    q_goal = np.array([0.5, -1.1, 1.3, -0.9, 0.7, 0.3])
+    T = ur5.fk(q_goal)
+    try:
+        sols = ur5.ik(T)
+    except Exception as exc:  # closed-form IK not landed for this arm yet
+        pytest.skip(f"IK not available: {exc}")
+    assert np.any(sols.valid)
+    with RobotViewer(ur5, port=0) as v:
+        v.set_configuration(q_goal + 0.05)
+        assert v.snap_to_target(T)
+        np.testing.assert_allclose(ur5.fk(v.q), T, atol=1e-8)
+        # Nearest to where the arm was: the branch it started on.
+        np.testing.assert_allclose(v.q, q_goal, atol=1e-6)
+        far = np.eye(4)
+        far[:3, 3] = [5.0, 0.0, 0.0]
+        q_before = v.q.copy()
+        assert not v.snap_to_target(far)
+        np.testing.assert_array_equal(v.q, q_before)
+        assert "IK" in v._status.content
+
+
+def test_playback_shows_collisions_and_closest_segment(ur5):
+    q = _motion(50)
+    rep = _Report(ur5.fk(q)[:, :3, 3])
+    with RobotViewer(ur5, q, report=rep, port=0) as v:
+        assert not v.free
+        v.show_frame(10)
+        np.testing.assert_allclose(v.q, q[10])
+        assert tuple(v._segments[0].color) != (225, 30, 30)
+        np.testing.assert_allclose(v._closest.points[0], rep.closest_points[10])
+        assert f"distance {rep.distances[10] * 1000:.1f} mm" in v._status.content
+        v.show_frame(25)
+        assert all(tuple(h.color) == (225, 30, 30) for h, _ in v._link_nodes)
+        assert "COLLISION" in v._status.content and "table" in v._status.content
+        v.show_time(0.005 * 40 + 1e-9)
+        assert v.frame == 40
+        assert tuple(v._segments[0].color) != (225, 30, 30)
+
+
+def test_viewer_page_renders_the_robot_in_chromium(ur5, tmp_path):
+    require_chromium()
+    with RobotViewer(ur5, _motion(50), port=0) as v:
+        v.show_frame(25)
+        clients = []
+        v.server.on_client_connect(lambda client: clients.append(client.client_id))
+        shot = tmp_path / "viewer.png"
+        run_chromium(
+            v.url,
+            tmp_path / "profile",
+            screenshot=shot,
+            size=(1000, 700),
+            budget_ms=5000,
+            webgl=True,
+        )
+        # The page loaded its script and connected back over the websocket.
+        assert len(clients) >= 1
+    img = read_png(shot)
+    assert img.shape == (700, 1000, 3)
+    view3d = img[150:700, 0:650]  # left of the GUI panel, below the notices
+    assert view3d.std() > 8.0  # not a blank canvas
+    assert orange_fraction(view3d) > 5e-4  # the arm's links
