@@ -216,3 +216,34 @@ def jacobian_serial(qc, consts, xform, joints, out, poses):
     for i in range(qc.shape[0]):
         ok &= _jac_one(qc[i], consts, xform, joints, out[i], poses[i])
     return ok
+
+
+@njit(cache=True)
+def check_poses(T, tol):
+    """Validate rigid transforms T (N, 4, 4). Returns (code, index).
+
+    code 0: all fine; 1: a non-finite entry; 2: last row is not 0 0 0 1; 3: the
+    rotation block is not orthonormal within ``tol``; 4: it is a reflection.
+    """
+    for i in range(T.shape[0]):
+        A = T[i]
+        for r in range(4):
+            for c in range(4):
+                if not math.isfinite(A[r, c]):
+                    return 1, i
+        if (abs(A[3, 0]) > 1e-9 or abs(A[3, 1]) > 1e-9 or abs(A[3, 2]) > 1e-9
+                or abs(A[3, 3] - 1.0) > 1e-9):
+            return 2, i
+        for r in range(3):
+            for s in range(3):
+                d = A[r, 0] * A[s, 0] + A[r, 1] * A[s, 1] + A[r, 2] * A[s, 2]
+                if r == s:
+                    d -= 1.0
+                if abs(d) > tol:
+                    return 3, i
+        det = (A[0, 0] * (A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1])
+               - A[0, 1] * (A[1, 0] * A[2, 2] - A[1, 2] * A[2, 0])
+               + A[0, 2] * (A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]))
+        if det < 0.0:
+            return 4, i
+    return 0, -1

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy.typing as npt
 
-from robokin._validation import check_finite, check_joints, check_transform
+from robokin._validation import check_finite, check_joints, check_poses_fast
 from robokin.exceptions import InputError
 from robokin.kinematics.ik.solutions import SolutionSet
 
@@ -31,7 +31,7 @@ def solve(
     """
     if method not in _METHODS:
         raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
-    T = check_transform(T, "T")
+    T = check_poses_fast(T, "T")
     if q_near is not None:
         q_near = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
     if method in ("auto", "analytic"):

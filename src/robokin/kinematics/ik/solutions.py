@@ -283,7 +283,7 @@ class SolutionSet:
         flags = dict(self.flags)
         flags["within_limits"] = inside
         flags["joint_within_limits"] = self.flags["within_limits"]
-        is_rev = np.ones(phi.shape[-1], bool)
+        is_rev = np.zeros(phi.shape[-1], bool)  # motor angles are multi-turn: never wrap
         return replace(self, q=phi, flags=flags, is_revolute=is_rev, limits=lim,
                        info={**self.info, "space": "actuator"})
 

@@ -21,7 +21,6 @@ Detection is cached per chain (chains are immutable).
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -74,7 +73,6 @@ class Family:
         return f"{self.name}{tag}: {self.measured}"
 
 
-_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def detect(robot: Any, *, tol: float = EXACT_TOL, near_angle: float = NEAR_ANGLE,
@@ -92,7 +90,11 @@ def detect(robot: Any, *, tol: float = EXACT_TOL, near_angle: float = NEAR_ANGLE
     """
     chain = getattr(robot, "chain", robot)
     key = (tol, near_angle, near_distance)
-    per_chain = _CACHE.setdefault(chain, {})
+    # Cached on the (immutable) chain itself: a weak-key dict lookup costs ~10 us.
+    per_chain = chain.__dict__.get("_ik_families")
+    if per_chain is None:
+        per_chain = {}
+        object.__setattr__(chain, "_ik_families", per_chain)
     fam = per_chain.get(key)
     if fam is None:
         fam = _detect(chain, tol, near_angle, near_distance)
