@@ -37,14 +37,12 @@ def _ur5_motion(m: int = 300) -> np.ndarray:
 
 
 def _scene():
-    table = {
-        "kind": "box",
-        "size": (0.6, 0.8, 0.05),
-        "pose": np.array(
-            [[1, 0, 0, 0.5], [0, 1, 0, 0.2], [0, 0, 1, -0.1], [0, 0, 0, 1.0]]
-        ),
-    }
-    return SimpleNamespace(bodies={"table": table})
+    scene_mod = pytest.importorskip("robokin.collision.scene")
+    scene = scene_mod.Scene("cell")
+    pose = np.eye(4)
+    pose[:3, 3] = [0.5, 0.2, -0.1]
+    scene.add_box("table", size=(0.6, 0.8, 0.05), pose=pose)
+    return scene
 
 
 def test_page_is_self_contained_and_carries_the_motion():
