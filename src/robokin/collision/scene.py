@@ -1,0 +1,407 @@
+"""Scenes: named static objects in the world, the robot's base placement and its tool.
+
+A scene file (YAML) declares its units once; everything is SI inside:
+
+.. code-block:: yaml
+
+    name: press cell
+    units: {length: mm, angle: deg}
+    robot: {name: aubo_i5, base: {xyz: [0, 0, 0], rpy: [0, 0, 0]}}
+    tool:                              # mounted on the robot's tool frame (flange)
+      name: gripper
+      tcp: {xyz: [0, 0, 150]}          # flange -> TCP: the new tool transform
+      shapes:                          # in the flange frame
+        - {type: box, size: [60, 110, 40], xyz: [0, 0, 20]}
+    objects:
+      - {name: table, type: box, size: [600, 800, 20], xyz: [0, 500, 390]}
+      - {name: post, type: cylinder, radius: 50, length: 400, xyz: [1, 0, 200]}
+      - {name: housing, type: mesh, file: housing.stl, units: mm, xyz: [0, 0, 0]}
+    exclude: [[base, table]]           # robot link / object pairs never checked
+    poses:                             # named TCP poses in the world
+      pick: {xyz: [0, 500, 450], rpy: [180, 0, 0], q: [0, 10, 90, 0, 90, 0]}
+
+Object shapes use the keys of robot-file geometry (``type``, ``size``,
+``radius``, ``length``, ``from``/``to``, ``file``, ``units``, ``xyz``, ``rpy``);
+their ``xyz``/``rpy`` place them in the world. ``q`` in a pose is an optional
+joint configuration (file angle units) that reaches it, a seed for IK.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from robokin._validation import check_transform
+from robokin.exceptions import InputError, ModelError
+from robokin.model import geometry as _geo
+from robokin.model.geometry import Shape
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
+__all__ = ["Scene", "SceneObject", "Tool"]
+
+_LENGTH = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
+_ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
+
+
+def _pose(T: npt.ArrayLike | None, name: str) -> np.ndarray:
+    if T is None:
+        return np.eye(4)
+    T = check_transform(T, name)
+    if T.shape != (4, 4):
+        raise InputError(name, f"expected one pose (4, 4), got {T.shape}")
+    out = np.array(T)
+    out.setflags(write=False)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class SceneObject:
+    """A named static object: one shape placed in the world.
+
+    Attributes:
+        name: Unique name in the scene.
+        shape: The shape; its placement is its pose in the world (4, 4) [m].
+    """
+
+    name: str
+    shape: Shape
+
+    @property
+    def pose(self) -> np.ndarray:
+        """Pose in the world, (4, 4) [m]."""
+        return self.shape.placement
+
+
+@dataclass(frozen=True, eq=False)
+class Tool:
+    """A tool (gripper) mounted on the robot's tool frame.
+
+    Attributes:
+        name: The tool's name.
+        tcp: Mount (robot tool frame) to TCP, (4, 4) [m]; appended to the robot's
+            tool transform.
+        shapes: Shapes placed in the mount frame.
+    """
+
+    name: str = "tool"
+    tcp: np.ndarray = field(default_factory=lambda: np.eye(4))
+    shapes: tuple[Shape, ...] = ()
+
+
+class Scene:
+    """Static objects in the world, where the robot stands and what it holds.
+
+    Attributes:
+        name: The scene's name.
+        objects: The static objects, in insertion order.
+        base: Pose of the robot's base frame in the world (4, 4) [m].
+        tool: The tool (gripper), or None.
+        exclude: (robot link, object) name pairs never checked.
+        poses: Named TCP poses in the world, ``{name: (4, 4)}``.
+        pose_joints: Joint configurations reaching ``poses`` (when given), ``{name: (n,)}``.
+        robot_name: The robot the scene was built for (built-in name or file), or None.
+        path: The scene file, or None.
+    """
+
+    def __init__(self, name: str = "scene") -> None:
+        self.name = name
+        self._objects: dict[str, SceneObject] = {}
+        self.base = np.eye(4)
+        self.tool: Tool | None = None
+        self.exclude: set[frozenset[str]] = set()
+        self.poses: dict[str, np.ndarray] = {}
+        self.pose_joints: dict[str, np.ndarray] = {}
+        self.robot_name: str | None = None
+        self.path: Path | None = None
+        self._version = 0
+
+    def __repr__(self) -> str:
+        return f"Scene(name={self.name!r}, objects={list(self._objects)})"
+
+    # ---------------------------------------------------------------- objects
+    @property
+    def objects(self) -> tuple[SceneObject, ...]:
+        """The static objects."""
+        return tuple(self._objects.values())
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Names of the static objects."""
+        return tuple(self._objects)
+
+    def __getitem__(self, name: str) -> SceneObject:
+        """The object called ``name``."""
+        try:
+            return self._objects[name]
+        except KeyError:
+            raise InputError(
+                "name", f"no object {name!r} in the scene; objects: {list(self._objects)}"
+            ) from None
+
+    def __len__(self) -> int:
+        return len(self._objects)
+
+    def add(self, name: str, shape: Shape) -> SceneObject:
+        """Add a shape whose placement is its world pose; returns the object."""
+        if not isinstance(name, str) or not name:
+            raise InputError("name", f"expected a non-empty string, got {name!r}")
+        if name in self._objects:
+            raise InputError("name", f"the scene already has an object {name!r}")
+        obj = SceneObject(name, shape.with_owner(name))
+        self._objects[name] = obj
+        self._version += 1
+        return obj
+
+    def remove(self, name: str) -> None:
+        """Remove an object."""
+        self[name]
+        del self._objects[name]
+        self._version += 1
+
+    def add_box(
+        self, name: str, size: Sequence[float], pose: npt.ArrayLike | None = None
+    ) -> SceneObject:
+        """Add a box of full sizes ``(sx, sy, sz)`` [m] centred at ``pose`` (4, 4)."""
+        return self.add(name, _geo.box(size, _pose(pose, "pose")))
+
+    def add_cylinder(
+        self, name: str, radius: float, length: float, pose: npt.ArrayLike | None = None
+    ) -> SceneObject:
+        """Add a cylinder [m] along the local z axis of ``pose``, centred there."""
+        return self.add(name, _geo.cylinder(radius, length, _pose(pose, "pose")))
+
+    def add_sphere(
+        self, name: str, radius: float, pose: npt.ArrayLike | None = None
+    ) -> SceneObject:
+        """Add a sphere of ``radius`` [m] centred at ``pose``."""
+        return self.add(name, _geo.sphere(radius, _pose(pose, "pose")))
+
+    def add_capsule(
+        self, name: str, radius: float, length: float, pose: npt.ArrayLike | None = None
+    ) -> SceneObject:
+        """Add a capsule [m] along the local z axis of ``pose``, centred there."""
+        return self.add(name, _geo.capsule(radius, length, _pose(pose, "pose")))
+
+    def add_mesh(
+        self,
+        name: str,
+        file: str | Path,
+        pose: npt.ArrayLike | None = None,
+        *,
+        units: Literal["m", "mm", "cm"] = "m",
+        scale: float = 1.0,
+    ) -> SceneObject:
+        """Add a mesh file (STL, OBJ, DAE, PLY) in ``units``, placed at ``pose``.
+
+        Raises:
+            ModelError: the file is missing or unreadable (names file and object).
+        """
+        shape = _geo.mesh(file, _pose(pose, "pose"), units=units, scale=scale, owner=name)
+        shape.check_file()
+        return self.add(name, shape)
+
+    # ------------------------------------------------------------ robot side
+    def set_base(self, pose: npt.ArrayLike) -> None:
+        """Place the robot's base frame in the world (4, 4) [m]."""
+        self.base = _pose(pose, "pose")
+        self._version += 1
+
+    def set_tool(
+        self,
+        shapes: Iterable[Shape] = (),
+        tcp: npt.ArrayLike | None = None,
+        *,
+        name: str = "tool",
+    ) -> None:
+        """Mount a tool: ``shapes`` in the mount frame, ``tcp`` mount -> TCP (4, 4)."""
+        self.tool = Tool(name, _pose(tcp, "tcp"), tuple(s.with_owner("tool") for s in shapes))
+        self._version += 1
+
+    def exclude_pair(self, link: str, obj: str) -> None:
+        """Never check robot link ``link`` against object ``obj``."""
+        self[obj]
+        self.exclude.add(frozenset((link, obj)))
+        self._version += 1
+
+    def attach(self, robot: Robot) -> Robot:
+        """The robot as placed in this scene: base, tool transform and tool shapes.
+
+        The robot's base becomes ``scene.base @ robot.base``; its tool transform
+        ``robot.tool @ tool.tcp``; the tool's shapes join the robot's tool link.
+        """
+        from robokin.model.geometry import RobotGeometry
+
+        geo = robot.geometry if isinstance(robot.geometry, RobotGeometry) else None
+        if geo is None:
+            geo = RobotGeometry.empty(robot)
+        out = robot
+        if not np.array_equal(self.base, np.eye(4)):
+            out = out.with_base(self.base @ robot.base)
+        if self.tool is not None:
+            out = out.with_tool(robot.tool @ self.tool.tcp)
+            geo = geo.retool(self.tool.tcp, self.tool.shapes)
+        return out.replace(geometry=geo)
+
+    def tcp_pose(self, name: str) -> np.ndarray:
+        """A named pose (4, 4) [m] of the TCP in the world."""
+        try:
+            return self.poses[name]
+        except KeyError:
+            raise InputError(
+                "name", f"no pose {name!r} in the scene; poses: {list(self.poses)}"
+            ) from None
+
+    # ------------------------------------------------------------------ files
+    @classmethod
+    def load(cls, path: str | Path) -> Scene:
+        """Load a scene file (YAML).
+
+        Raises:
+            ModelError: missing file, bad YAML, a bad field (names the file, the
+                field path and the reason) or a bad mesh.
+        """
+        import yaml
+
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise ModelError("no such file", file=path) from None
+        except OSError as exc:
+            raise ModelError(f"cannot read: {exc.strerror}", file=path) from None
+        try:
+            doc = yaml.safe_load(text)
+        except yaml.YAMLError as exc:
+            mark = getattr(exc, "problem_mark", None)
+            where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+            raise ModelError(f"not valid YAML{where}", file=path) from None
+        return cls.from_document(doc, file=path)
+
+    @classmethod
+    def from_document(cls, doc: Any, file: str | Path | None = None) -> Scene:
+        """Build a scene from a parsed scene document (see the module docstring)."""
+        from robokin.spatial import pose_from_xyz_rpy
+
+        if not isinstance(doc, Mapping):
+            raise ModelError("a scene file must be a mapping of fields", file=file)
+        allowed = {"name", "source", "units", "robot", "tool", "objects", "exclude", "poses"}
+        for key in doc:
+            if key not in allowed:
+                raise ModelError(f"unknown field (allowed: {sorted(allowed)})", file=file,
+                                 field=str(key))
+        units = doc.get("units") or {}
+        if not isinstance(units, Mapping):
+            raise ModelError("expected {length: m|mm, angle: rad|deg}", file=file,
+                             field="units")
+        lu, au = units.get("length", "m"), units.get("angle", "rad")
+        if lu not in _LENGTH:
+            raise ModelError(f"expected one of {list(_LENGTH)}, got {lu!r}", file=file,
+                             field="units.length")
+        if au not in _ANGLE:
+            raise ModelError(f"expected one of {list(_ANGLE)}, got {au!r}", file=file,
+                             field="units.angle")
+        L, A = _LENGTH[lu], _ANGLE[au]
+        base_dir = Path(file).parent if file is not None else None
+        scene = cls(str(doc.get("name", Path(file).stem if file else "scene")))
+        scene.path = None if file is None else Path(file)
+
+        def placement(p: Any, where: str) -> np.ndarray:
+            if p is None:
+                return np.eye(4)
+            if not isinstance(p, Mapping) or set(p) - {"xyz", "rpy"}:
+                raise ModelError("expected {xyz: [x, y, z], rpy: [r, p, y]}", file=file,
+                                 field=where)
+            try:
+                xyz = np.asarray(p.get("xyz", (0, 0, 0)), dtype=float)
+                rpy = np.asarray(p.get("rpy", (0, 0, 0)), dtype=float)
+                if xyz.shape != (3,) or rpy.shape != (3,) or not (
+                    np.isfinite(xyz).all() and np.isfinite(rpy).all()
+                ):
+                    raise ValueError
+            except (TypeError, ValueError):
+                raise ModelError("xyz and rpy need 3 finite numbers each", file=file,
+                                 field=where) from None
+            return pose_from_xyz_rpy(xyz * L, rpy * A)
+
+        rob = doc.get("robot")
+        if rob is not None:
+            if not isinstance(rob, Mapping) or set(rob) - {"name", "base"}:
+                raise ModelError("expected {name: ..., base: {xyz, rpy}}", file=file,
+                                 field="robot")
+            scene.robot_name = None if rob.get("name") is None else str(rob["name"])
+            scene.base = placement(rob.get("base"), "robot.base")
+        tool = doc.get("tool")
+        if tool is not None:
+            if not isinstance(tool, Mapping) or set(tool) - {"name", "tcp", "shapes"}:
+                raise ModelError("expected {name, tcp: {xyz, rpy}, shapes: [...]}",
+                                 file=file, field="tool")
+            shapes = tool.get("shapes") or []
+            if not isinstance(shapes, list):
+                raise ModelError("expected a list of shapes", file=file, field="tool.shapes")
+            scene.set_tool(
+                [
+                    _geo.shape_from_spec(s, length=L, angle=A, base_dir=base_dir, file=file,
+                                         where=f"tool.shapes[{i}]", owner="tool")
+                    for i, s in enumerate(shapes)
+                ],
+                placement(tool.get("tcp"), "tool.tcp"),
+                name=str(tool.get("name", "tool")),
+            )
+        objects = doc.get("objects") or []
+        if not isinstance(objects, list):
+            raise ModelError("expected a list of objects", file=file, field="objects")
+        for i, spec in enumerate(objects):
+            where = f"objects[{i}]"
+            if not isinstance(spec, Mapping) or "name" not in spec:
+                raise ModelError("an object needs a 'name'", file=file, field=where)
+            name = str(spec["name"])
+            if name in scene._objects:
+                raise ModelError(f"duplicate object name {name!r}", file=file,
+                                 field=f"{where}.name")
+            shape = _geo.shape_from_spec(
+                {k: v for k, v in spec.items() if k != "name"}, length=L, angle=A,
+                base_dir=base_dir, file=file, where=where, owner=name,
+            )
+            if shape.kind == "mesh":
+                try:
+                    shape.check_file()
+                except ModelError as exc:
+                    raise ModelError(exc.reason, file=file, field=f"{where}.file") from None
+            scene.add(name, shape)
+        excl = doc.get("exclude") or []
+        if not isinstance(excl, list):
+            raise ModelError("expected a list of [link, object] pairs", file=file,
+                             field="exclude")
+        for i, p in enumerate(excl):
+            if not (isinstance(p, list | tuple) and len(p) == 2):
+                raise ModelError("expected a pair [link, object]", file=file,
+                                 field=f"exclude[{i}]")
+            scene.exclude.add(frozenset(str(x) for x in p))
+        poses = doc.get("poses") or {}
+        if not isinstance(poses, Mapping):
+            raise ModelError("expected {name: {xyz, rpy, q}}", file=file, field="poses")
+        for pname, spec in poses.items():
+            where = f"poses.{pname}"
+            if not isinstance(spec, Mapping):
+                raise ModelError("expected {xyz, rpy, q}", file=file, field=where)
+            scene.poses[str(pname)] = placement(
+                {k: v for k, v in spec.items() if k != "q"}, where
+            )
+            if "q" in spec:
+                try:
+                    q = np.asarray(spec["q"], dtype=float)
+                    if q.ndim != 1 or not np.isfinite(q).all():
+                        raise ValueError
+                except (TypeError, ValueError):
+                    raise ModelError("expected a list of joint values", file=file,
+                                     field=f"{where}.q") from None
+                scene.pose_joints[str(pname)] = q * A
+        return scene
