@@ -58,6 +58,13 @@ _HEADER = re.compile(r"^\s*(?P<name>.*?)\s*(?:\[(?P<unit>[^\]]*)\])?\s*$")
 
 
 # ------------------------------------------------------------------ atomic writes
+def file_mode() -> int:
+    """Permissions of a new file under the current umask (mkstemp makes 0600)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def write_text_atomic(path: str | Path, text: str, *, overwrite: bool = False) -> Path:
     """Write ``text`` to ``path`` through a temporary file and a rename.
 
@@ -75,6 +82,7 @@ def write_text_atomic(path: str | Path, text: str, *, overwrite: bool = False) -
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
             fh.write(text)
+        os.chmod(tmp, file_mode())
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):

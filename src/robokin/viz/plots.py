@@ -1,0 +1,292 @@
+"""Matplotlib figures: joint motion, tool position, tool path, plan vs run, the arm.
+
+Figures are built with :class:`matplotlib.figure.Figure` directly (no pyplot
+state), so they render headless with the Agg canvas and never open a window;
+:func:`save_figure` writes PNG, SVG or PDF (by suffix) through a temporary file.
+Angles are drawn in degrees and lengths in millimetres unless asked otherwise.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robokin.exceptions import InputError
+from robokin.trajectory.io import file_mode
+
+__all__ = [
+    "plot_comparison",
+    "plot_joints",
+    "plot_robot",
+    "plot_tool_path",
+    "plot_tool_position",
+    "save_figure",
+]
+
+_FORMATS = (".png", ".svg", ".pdf")
+
+
+def _figure(figsize=(9.0, 7.0)):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def save_figure(fig: Any, path: str | Path, *, overwrite: bool = False,
+                dpi: int = 120) -> Path:
+    """Save ``fig`` as PNG, SVG or PDF (chosen by the suffix), atomically.
+
+    Raises:
+        InputError: unknown suffix, or the file exists and ``overwrite`` is False.
+    """
+    path = Path(path)
+    if path.suffix.lower() not in _FORMATS:
+        raise InputError("path", f"expected a {', '.join(_FORMATS)} file, got {path.name}")
+    if path.exists() and not overwrite:
+        raise InputError("path", f"{path} exists; pass overwrite=True to replace it")
+    folder = path.parent if str(path.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=folder)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=dpi, format=path.suffix[1:].lower())
+        os.chmod(tmp, file_mode())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def _finish(fig, path, overwrite):
+    if path is not None:
+        save_figure(fig, path, overwrite=overwrite)
+    return fig
+
+
+def _scales(traj, degrees: bool):
+    rev = traj.revolute()
+    ang = 180.0 / np.pi if degrees else 1.0
+    au = "deg" if degrees else "rad"
+    lu = "mm" if degrees else "m"
+    s = np.where(rev, ang, 1000.0 if degrees else 1.0)
+    mixed = rev.any() and not rev.all()
+    unit = f"{au} | {lu}" if mixed else (au if rev.all() else lu)
+    return s, unit
+
+
+def plot_joints(traj: Any, *, path: str | Path | None = None, degrees: bool = True,
+                via: bool = True, title: str | None = None,
+                overwrite: bool = False) -> Any:
+    """Joint position, velocity and acceleration over time: three panels, a line per joint.
+
+    Via points (``traj.via_times``) are marked by dotted vertical lines and dots
+    on the position curves.
+
+    Args:
+        traj: A :class:`~robokin.trajectory.Trajectory`.
+        path: Save to this PNG/SVG/PDF file too.
+        degrees: Angles in degrees (lengths in mm), else rad and m.
+        via: Mark the via points.
+        title: Figure title.
+        overwrite: Replace an existing file.
+
+    Returns:
+        The matplotlib Figure.
+    """
+    fig = _figure((10.0, 8.0))
+    axes = fig.subplots(3, 1, sharex=True)
+    s, unit = _scales(traj, degrees)
+    names = traj.names()
+    for ax, data, lab in ((axes[0], traj.q, unit), (axes[1], traj.qd, f"{unit}/s"),
+                          (axes[2], traj.qdd, f"{unit}/s²")):
+        for j in range(traj.n):
+            ax.plot(traj.t, data[:, j] * s[j], label=names[j], linewidth=1.2)
+        ax.set_ylabel(lab)
+        ax.grid(True, alpha=0.3)
+    axes[0].set_title("position")
+    axes[1].set_title("velocity")
+    axes[2].set_title("acceleration")
+    axes[2].set_xlabel("time [s]")
+    if via and traj.via_times.size:
+        vt = traj.via_times
+        qv = traj.at(vt) * s
+        for ax in axes:
+            for v in vt:
+                ax.axvline(v, color="0.6", linestyle=":", linewidth=0.8)
+        for j in range(traj.n):
+            axes[0].plot(vt, qv[:, j], "o", color="k", markersize=3,
+                         label="via points" if j == 0 else None)
+    axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
+    fig.suptitle(title or f"joint motion: {traj.duration:.3g} s, {len(traj)} samples")
+    return _finish(fig, path, overwrite)
+
+
+def _positions(traj: Any, robot: Any) -> np.ndarray:
+    if traj.pose is None and robot is None:
+        raise InputError("robot", "the trajectory has no tool poses: pass the robot")
+    return traj.tool_poses(robot)[:, :3, 3]
+
+
+def plot_tool_position(traj: Any, robot: Any = None, *, path: str | Path | None = None,
+                       mm: bool = True, relative: bool = False,
+                       title: str | None = None, overwrite: bool = False) -> Any:
+    """Tool position x, y, z over time (one line each).
+
+    Args:
+        traj: The trajectory (its ``pose`` is used when set).
+        robot: Computes the tool poses when the trajectory has none.
+        path: Save to a file too.
+        mm: Millimetres (else metres).
+        relative: Plot the displacement from the start.
+        title: Figure title.
+        overwrite: Replace an existing file.
+    """
+    p = _positions(traj, robot)
+    if relative:
+        p = p - p[0]
+    k = 1000.0 if mm else 1.0
+    fig = _figure((9.0, 4.5))
+    ax = fig.subplots()
+    for i, axis in enumerate("xyz"):
+        ax.plot(traj.t, p[:, i] * k, label=axis)
+    ax.set_xlabel("time [s]")
+    word = "displacement" if relative else "position"
+    ax.set_ylabel(f"tool {word} [{'mm' if mm else 'm'}]")
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    fig.suptitle(title or f"tool {word} over time")
+    return _finish(fig, path, overwrite)
+
+
+def plot_tool_path(traj: Any, robot: Any = None, *, path: str | Path | None = None,
+                   mm: bool = True, title: str | None = None,
+                   overwrite: bool = False) -> Any:
+    """Tool path in 3D, with its projections onto the XY, XZ and YZ planes.
+
+    The 3D panel shows the path and its shadows on the three walls; three 2D
+    panels show each projection with equal axes. Via points are marked.
+    """
+    p = _positions(traj, robot) * (1000.0 if mm else 1.0)
+    u = "mm" if mm else "m"
+    fig = _figure((10.0, 8.5))
+    ax3 = fig.add_subplot(2, 2, 1, projection="3d")
+    ax3.plot(p[:, 0], p[:, 1], p[:, 2], color="C0", linewidth=1.6, label="tool path")
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    pad = 0.05 * max(float((hi - lo).max()), 1e-9)
+    lo, hi = lo - pad, hi + pad
+    shadow = {"color": "0.55", "linewidth": 0.8, "linestyle": "--"}
+    ax3.plot(p[:, 0], p[:, 1], np.full(len(p), lo[2]), **shadow)
+    ax3.plot(p[:, 0], np.full(len(p), hi[1]), p[:, 2], **shadow)
+    ax3.plot(np.full(len(p), lo[0]), p[:, 1], p[:, 2], **shadow)
+    ax3.set_xlim(lo[0], hi[0])
+    ax3.set_ylim(lo[1], hi[1])
+    ax3.set_zlim(lo[2], hi[2])
+    ax3.set_xlabel(f"x [{u}]")
+    ax3.set_ylabel(f"y [{u}]")
+    ax3.set_zlabel(f"z [{u}]")
+    vt = traj.via_times
+    vi = np.unique(np.clip(np.searchsorted(traj.t, vt - 1e-9), 0, len(traj) - 1))
+    ax3.scatter(p[vi, 0], p[vi, 1], p[vi, 2], color="k", s=10)
+    for k, (a, b, name) in enumerate(((0, 1, "XY"), (0, 2, "XZ"), (1, 2, "YZ")),
+                                     start=2):
+        ax = fig.add_subplot(2, 2, k)
+        ax.plot(p[:, a], p[:, b], color="C0", linewidth=1.4)
+        ax.plot(p[vi, a], p[vi, b], "o", color="k", markersize=3)
+        ax.plot(p[0, a], p[0, b], "s", color="C2", markersize=6, label="start")
+        ax.plot(p[-1, a], p[-1, b], "^", color="C3", markersize=6, label="end")
+        ax.set_xlabel(f"{'xyz'[a]} [{u}]")
+        ax.set_ylabel(f"{'xyz'[b]} [{u}]")
+        ax.set_title(f"{name} projection")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, alpha=0.3)
+        if k == 2:
+            ax.legend(fontsize="small")
+    fig.suptitle(title or "tool path")
+    return _finish(fig, path, overwrite)
+
+
+def plot_comparison(cmp: Any, *, path: str | Path | None = None, degrees: bool = True,
+                    title: str | None = None, overwrite: bool = False) -> Any:
+    """Plan vs real run: per-joint error over time, and the plan's acceleration."""
+    rev = np.asarray(cmp.is_revolute, bool)
+    s = np.where(rev, 180.0 / np.pi if degrees else 1.0, 1000.0 if degrees else 1.0)
+    unit = ("deg" if degrees else "rad") if rev.all() else (
+        ("mm" if degrees else "m") if not rev.any() else "deg | mm")
+    fig = _figure((10.0, 7.0))
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
+    for j, name in enumerate(cmp.joint_names):
+        ax1.plot(cmp.t, cmp.error[:, j] * s[j],
+                 label=f"{name} (max {cmp.max_abs[j] * s[j]:.3g})", linewidth=1.0)
+        ax2.plot(cmp.t, cmp.plan_qdd[:, j] * s[j], linewidth=1.0)
+    ax1.set_ylabel(f"error real − plan [{unit}]")
+    ax1.grid(True, alpha=0.3)
+    ax1.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
+    ax2.set_ylabel(f"planned acceleration [{unit}/s²]")
+    ax2.set_xlabel("time [s]")
+    ax2.grid(True, alpha=0.3)
+    fig.suptitle(title or "tracking error: logged run vs plan")
+    return _finish(fig, path, overwrite)
+
+
+def plot_robot(robot: Any, q: npt.ArrayLike, ax: Any = None, frames: bool = True, *,
+               path: str | Path | None = None, frame_size: float | None = None,
+               color: str = "C0", overwrite: bool = False) -> Any:
+    """The arm at ``q`` as a 3D stick figure: link frames joined, joints dotted.
+
+    Args:
+        robot: The :class:`~robokin.robot.Robot`.
+        q: One configuration (n,) [rad, m].
+        ax: A 3D matplotlib axes to draw into (a new figure when None).
+        frames: Draw each frame's x/y/z axes (red, green, blue).
+        path: Save the figure too.
+        frame_size: Length of the frame axes [m] (default 8 % of the arm's size).
+        color: Colour of the links.
+        overwrite: Replace an existing file.
+
+    Returns:
+        The Figure (of ``ax`` when given).
+    """
+    qv = np.asarray(q, dtype=np.float64)
+    if qv.shape != (robot.n,):
+        raise InputError("q", f"expected one configuration ({robot.n},), got {qv.shape}")
+    F = robot.fk_all(qv)
+    T_tool = robot.fk(qv)
+    if not np.allclose(F[-1], T_tool, atol=1e-12):
+        F = np.concatenate([F, T_tool[None]], axis=0)
+    P = F[:, :3, 3]
+    if ax is None:
+        fig = _figure((7.0, 7.0))
+        ax = fig.add_subplot(projection="3d")
+    else:
+        fig = ax.figure
+    ax.plot(P[:, 0], P[:, 1], P[:, 2], "-", color=color, linewidth=3, label=robot.name)
+    ax.scatter(P[:-1, 0], P[:-1, 1], P[:-1, 2], color="k", s=18)
+    ax.scatter(*P[-1], color="C3", s=30, marker="^")
+    span = float(np.ptp(P, axis=0).max()) or 0.1
+    size = frame_size if frame_size is not None else 0.08 * span
+    if frames:
+        for T in F:
+            o = T[:3, 3]
+            for c, col in enumerate(("r", "g", "b")):
+                e = o + size * T[:3, c]
+                ax.plot([o[0], e[0]], [o[1], e[1]], [o[2], e[2]], color=col,
+                        linewidth=1.0)
+    mid = 0.5 * (P.max(axis=0) + P.min(axis=0))
+    half = 0.55 * span + size
+    ax.set_xlim(mid[0] - half, mid[0] + half)
+    ax.set_ylim(mid[1] - half, mid[1] + half)
+    ax.set_zlim(mid[2] - half, mid[2] + half)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    ax.set_title(f"{robot.name}")
+    return _finish(fig, path, overwrite)
