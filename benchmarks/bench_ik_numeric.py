@@ -29,8 +29,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-import robokin  # noqa: E402
 from peers import _constants, pinocchio_model, rtb_ets  # noqa: E402
+
+import robokin  # noqa: E402
 from robokin.kinematics.ik import numeric  # noqa: E402
 
 ROBOTS = ("ur5", "panda", "improved_dh_arm")

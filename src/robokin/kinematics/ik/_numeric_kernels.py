@@ -37,6 +37,8 @@ O_N_SEEDS = 13  # random restarts available (<= seeds.shape[1])
 O_PATH_MAX_JUMP = 14  # ik_path: largest accepted joint change per sample
 O_STALL_EVERY = 15  # check progress every this many iterations ...
 O_STALL_RATIO = 16  # ... and give up unless the cost fell below ratio * before
+O_MU_DOWN = 17  # damping factor after an accepted step
+O_MU_UP = 18  # damping factor after a rejected step
 N_OPTS = 20
 
 # result columns after q
@@ -211,19 +213,19 @@ def _residual(T, Tt, e):
 
 @njit(cache=True, inline="always")
 def _errors(e, w):
-    """(weighted cost E, position norm, rotation norm) over the unmasked rows."""
-    E = 0.0
+    """(weighted cost, position norm, rotation norm) over the unmasked rows."""
+    cost = 0.0
     ep = 0.0
     er = 0.0
     for i in range(3):
         if w[i] > 0.0:
-            E += w[i] * e[i] * e[i]
+            cost += w[i] * e[i] * e[i]
             ep += e[i] * e[i]
     for i in range(3, 6):
         if w[i] > 0.0:
-            E += w[i] * e[i] * e[i]
+            cost += w[i] * e[i] * e[i]
             er += e[i] * e[i]
-    return E, math.sqrt(ep), math.sqrt(er)
+    return cost, math.sqrt(ep), math.sqrt(er)
 
 
 @njit(cache=True)
@@ -284,7 +286,7 @@ def _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw, max_iter,
              qc, Jc, J, T, e, qn, Jn, Tn, en, Jw, A, g, y, dq, free):
     """One damped least-squares (Levenberg-Marquardt) descent from q (updated in place).
 
-    Returns (code, iterations, ep, er, E).
+    Returns (code, iterations, ep, er, cost).
     """
     n = q.shape[0]
     m = rows.shape[0]
@@ -296,25 +298,27 @@ def _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw, max_iter,
     _project(q, cdat)
     _pose_jac(q, Mc, ident, consts, jdat, qc, Jc, J, T)
     _residual(T, Tt, e)
-    E, ep, er = _errors(e, w)
-    if not math.isfinite(E):
-        return CODE_STALL, 0, ep, er, E
+    cost, ep, er = _errors(e, w)
+    if not math.isfinite(cost):
+        return CODE_STALL, 0, ep, er, cost
     mu = opts[O_MU0]
+    mu_down = opts[O_MU_DOWN]
+    mu_up = opts[O_MU_UP]
     it = 0
     check_every = int(opts[O_STALL_EVERY])
     stall_ratio = opts[O_STALL_RATIO]
     next_check = check_every
-    E_ref = E
+    cost_ref = cost
     while True:
         if ep <= tol_p and er <= tol_r:
-            return CODE_OK, it, ep, er, E
+            return CODE_OK, it, ep, er, cost
         if it >= max_iter:
-            return CODE_ITER, it, ep, er, E
+            return CODE_ITER, it, ep, er, cost
         if it >= next_check:
             # too little progress: a (limit-constrained) local minimum; restart
-            if E > stall_ratio * E_ref:
-                return CODE_STALL, it, ep, er, E
-            E_ref = E
+            if cost > stall_ratio * cost_ref:
+                return CODE_STALL, it, ep, er, cost
+            cost_ref = cost
             next_check = it + check_every
         # weighted task rows and the gradient J^T W e; freeze joints pushed into a limit
         for a in range(m):
@@ -327,23 +331,21 @@ def _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw, max_iter,
             for a in range(m):
                 gj += Jw[a, j] * sw[a] * e[rows[a]]
             g[j] = gj
-            f = True
-            if q[j] >= cdat[1, j] and gj > 0.0 and cdat[4, j] == 0.0:
-                f = False
-            elif q[j] <= cdat[0, j] and gj < 0.0 and cdat[4, j] == 0.0:
-                f = False
-            free[j] = f
+            pinned = cdat[4, j] == 0.0 and (
+                (q[j] >= cdat[1, j] and gj > 0.0) or (q[j] <= cdat[0, j] and gj < 0.0))
+            f = not pinned
+            free[j] = 1.0 if f else 0.0
             if f:
                 nfree += 1
             else:
                 for a in range(m):
                     Jw[a, j] = 0.0
         if nfree == 0:
-            return CODE_STALL, it, ep, er, E
+            return CODE_STALL, it, ep, er, cost
         accepted = False
         while not accepted:
             it += 1
-            lam = mu * E + 1e-14
+            lam = mu * cost + 1e-14
             if m <= nfree:
                 # task space: (Jw Jw^T + lam I) y = W^1/2 e ; dq = Jw^T y
                 for a in range(m):
@@ -371,7 +373,7 @@ def _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw, max_iter,
                         A[i, k] = s
                         A[k, i] = s
                     A[i, i] += lam
-                    dq[i] = g[i] if free[i] else 0.0
+                    dq[i] = g[i] if free[i] == 1.0 else 0.0
                 okc = _chol_solve(A, dq, n)
             if okc:
                 big = 0.0
@@ -384,26 +386,25 @@ def _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw, max_iter,
                 _project(qn, cdat)
                 _pose_jac(qn, Mc, ident, consts, jdat, qc, Jc, Jn, Tn)
                 _residual(Tn, Tt, en)
-                En, epn, ern = _errors(en, w)
-                if En < E:
+                cost_n, epn, ern = _errors(en, w)
+                if cost_n < cost:
                     accepted = True
                     for j in range(n):
                         q[j] = qn[j]
-                        for r in range(6):
-                            J[r, j] = Jn[r, j]
+                    J, Jn = Jn, J
                     for r in range(6):
                         e[r] = en[r]
-                    E = En
+                    cost = cost_n
                     ep = epn
                     er = ern
-                    mu = max(mu * 0.25, _MU_MIN)
+                    mu = max(mu * mu_down, _MU_MIN)
                     break
-            mu *= 8.0
+            mu *= mu_up
             if mu > _MU_MAX:
-                return CODE_STALL, it, ep, er, E
+                return CODE_STALL, it, ep, er, cost
             if it >= max_iter:
-                return CODE_ITER, it, ep, er, E
-    return CODE_ITER, it, ep, er, E  # pragma: no cover
+                return CODE_ITER, it, ep, er, cost
+    return CODE_ITER, it, ep, er, cost  # pragma: no cover
 
 
 @njit(cache=True)
@@ -427,7 +428,14 @@ def _check_target(Tt):
 
 
 @njit(cache=True)
-def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out):
+def work_size(n, nc):
+    """Length of the float work buffer of :func:`_solve_target`."""
+    nd = max(6, n)
+    return 6 + 7 * nc + 18 * n + 44 + nd * nd + nd + 6 * n
+
+
+@njit(cache=True)
+def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out, work, iwork):
     """Attempt from q0 (if asked) then from each seed until converged.
 
     ``seeds`` (R, n) are uniform [0, 1) numbers mapped into the seed ranges. ``out``
@@ -457,8 +465,8 @@ def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out):
     for i in range(6):
         if w[i] > 0.0:
             m += 1
-    rows = np.empty(m, np.int64)
-    sw = np.empty(m)
+    rows = iwork[:m]
+    sw = work[:m]
     m = 0
     for i in range(6):
         if w[i] > 0.0:
@@ -466,23 +474,41 @@ def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out):
             sw[m] = math.sqrt(w[i])
             m += 1
     nd = max(m, n)
-    qc = np.empty(nc)
-    Jc = np.empty((6, nc))
-    J = np.empty((6, n))
-    T = np.empty((4, 4))
-    e = np.empty(6)
-    qn = np.empty(n)
-    Jn = np.empty((6, n))
-    Tn = np.empty((4, 4))
-    en = np.empty(6)
-    Jw = np.empty((m, n))
-    A = np.empty((nd, nd))
-    g = np.empty(n)
-    y = np.empty(nd)
-    dq = np.empty(n)
-    free = np.empty(n, np.bool_)
-    q = np.empty(n)
-    best = np.empty(n)
+    # views into the one work buffer (see work_size)
+    o = 6
+    qc = work[o:o + nc]
+    o += nc
+    Jc = work[o:o + 6 * nc].reshape((6, nc))
+    o += 6 * nc
+    J = work[o:o + 6 * n].reshape((6, n))
+    o += 6 * n
+    Jn = work[o:o + 6 * n].reshape((6, n))
+    o += 6 * n
+    Jw = work[o:o + m * n].reshape((m, n))
+    o += 6 * n
+    T = work[o:o + 16].reshape((4, 4))
+    o += 16
+    Tn = work[o:o + 16].reshape((4, 4))
+    o += 16
+    e = work[o:o + 6]
+    o += 6
+    en = work[o:o + 6]
+    o += 6
+    A = work[o:o + nd * nd].reshape((nd, nd))
+    o += nd * nd
+    y = work[o:o + nd]
+    o += nd
+    qn = work[o:o + n]
+    o += n
+    g = work[o:o + n]
+    o += n
+    dq = work[o:o + n]
+    o += n
+    free = work[o:o + n]
+    o += n
+    q = work[o:o + n]
+    o += n
+    best = work[o:o + n]
     best_cost = np.inf
     bep = np.inf
     ber = np.inf
@@ -501,12 +527,12 @@ def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out):
                 q[j] = cdat[2, j] + seeds[a - 1, j] * (cdat[3, j] - cdat[2, j])
             if a > 1 or start == 0:
                 restarts += 1
-        code, it, ep, er, E = _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw,
+        code, it, ep, er, cost = _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw,
                                        max_iter, qc, Jc, J, T, e, qn, Jn, Tn, en, Jw, A,
                                        g, y, dq, free)
         total += it
-        if E < best_cost or code == CODE_OK or a == start:
-            best_cost = E
+        if cost < best_cost or code == CODE_OK or a == start:
+            best_cost = cost
             bep = ep
             ber = er
             for j in range(n):
@@ -532,7 +558,7 @@ def _summary(out, n):
         c = out[i, n + R_CODE]
         if c != CODE_OK:
             fails += 1
-            if first_bad < 0 and (c == CODE_BAD_TARGET or c == CODE_BAD_Q0):
+            if first_bad < 0 and c in (CODE_BAD_TARGET, CODE_BAD_Q0):
                 first_bad = i
     return fails, first_bad
 
@@ -543,17 +569,29 @@ def solve_serial(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out):
 
     Returns (number not converged, index of the first bad target / q0 or -1).
     """
+    n = q0.shape[1]
+    work = np.empty(work_size(n, jdat.shape[1]))
+    iwork = np.empty(6, np.int64)
     for i in range(targets.shape[0]):
-        _solve_target(targets[i], q0[i], seeds[i], consts, jdat, Mc, cdat, opts, out[i])
-    return _summary(out, q0.shape[1])
+        _solve_target(targets[i], q0[i], seeds[i], consts, jdat, Mc, cdat, opts, out[i],
+                      work, iwork)
+    return _summary(out, n)
 
 
 @njit(cache=True, parallel=True)
 def solve_parallel(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out):
-    """As :func:`solve_serial`, over all threads."""
-    for i in prange(targets.shape[0]):
-        _solve_target(targets[i], q0[i], seeds[i], consts, jdat, Mc, cdat, opts, out[i])
-    return _summary(out, q0.shape[1])
+    """As :func:`solve_serial`, over all threads (one work buffer per chunk)."""
+    N = targets.shape[0]
+    n = q0.shape[1]
+    size = work_size(n, jdat.shape[1])
+    chunks = min(N, 64)
+    for c in prange(chunks):
+        work = np.empty(size)
+        iwork = np.empty(6, np.int64)
+        for i in range(c * N // chunks, (c + 1) * N // chunks):
+            _solve_target(targets[i], q0[i], seeds[i], consts, jdat, Mc, cdat, opts,
+                          out[i], work, iwork)
+    return _summary(out, n)
 
 
 @njit(cache=True)
@@ -569,6 +607,8 @@ def solve_path(targets, q_start, consts, jdat, Mc, cdat, opts, out):
     prev = q_start.copy()
     no_seeds = np.empty((0, n))
     max_jump = opts[O_PATH_MAX_JUMP]
+    work = np.empty(work_size(n, jdat.shape[1]))
+    iwork = np.empty(6, np.int64)
     first = -1
     for i in range(N):
         if first >= 0:
@@ -581,7 +621,8 @@ def solve_path(targets, q_start, consts, jdat, Mc, cdat, opts, out):
             out[i, n + R_RESTARTS] = 0
             out[i, n + R_CODE] = CODE_NOT_RUN
             continue
-        _solve_target(targets[i], prev, no_seeds, consts, jdat, Mc, cdat, opts, out[i])
+        _solve_target(targets[i], prev, no_seeds, consts, jdat, Mc, cdat, opts, out[i],
+                      work, iwork)
         if out[i, n + R_CODE] != CODE_OK:
             first = i
             continue

@@ -50,8 +50,11 @@ _AXES = ("x", "y", "z", "rx", "ry", "rz")
 _PARALLEL_MIN = 64  # below this many targets one thread beats the parallel launch
 _FIRST_ROUND_RESTARTS = 4
 _ROUND_RESTARTS = 16
-_STALL_EVERY = 10
+_STALL_EVERY = 6
 _STALL_RATIO = 0.5
+_MU0 = 1e-2  # initial damping, lambda = mu * E
+_MU_DOWN = 0.5
+_MU_UP = 16.0
 
 
 _K: list[Any] = []
@@ -312,10 +315,12 @@ def _make_opts(mask: Any, weights: Any, tol: Any, tol_rotation: Any,
     opts[K.O_TOL_R] = tol_r
     opts[K.O_MAX_ITER] = _count(max_iterations, "max_iterations", minimum=1)
     opts[K.O_MAX_STEP] = _positive(max_step, "max_step")
-    opts[K.O_MU0] = 1e-3
     opts[K.O_PATH_MAX_JUMP] = np.inf
     opts[K.O_STALL_EVERY] = _STALL_EVERY
     opts[K.O_STALL_RATIO] = _STALL_RATIO
+    opts[K.O_MU0] = _MU0
+    opts[K.O_MU_DOWN] = _MU_DOWN
+    opts[K.O_MU_UP] = _MU_UP
     return opts
 
 
