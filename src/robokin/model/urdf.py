@@ -296,7 +296,10 @@ class _Tree:
 
     def default_tip(self, base: str) -> str:
         """The leaf below ``base`` whose path has the most movable joints."""
-        leaves = [n for n in self._descendants(base) if not self.children[n]]
+        top = base  # a base hanging by fixed joints (ROS-I 'base') looks from above
+        while top in self.parent_joint and self.parent_joint[top].type == "fixed":
+            top = self.parent_joint[top].parent
+        leaves = [n for n in self._descendants(top) if not self.children[n]]
         counts = {
             leaf: sum(s.joint.type in _MOVABLE for s in self.path(base, leaf))
             for leaf in leaves

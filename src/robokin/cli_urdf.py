@@ -1,0 +1,144 @@
+"""``robokin import``, ``robokin export`` and ``robokin dh``: URDF in and out.
+
+Files are written only where ``-o`` names them; without ``-o`` the result goes to
+standard output.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from robokin.cli import _console, _load, app
+
+__all__ = ["dh", "export_urdf", "import_urdf"]
+
+
+@app.command("import")
+def import_urdf(
+    file: Annotated[Path, typer.Argument(help="The URDF file.")],
+    base: Annotated[str | None, typer.Option("--base", help="Base link.")] = None,
+    tip: Annotated[str | None, typer.Option("--tip", help="Tip link.")] = None,
+    out: Annotated[
+        Path | None, typer.Option("-o", "--out", help="Robot file to write (YAML).")
+    ] = None,
+    package: Annotated[
+        list[str] | None,
+        typer.Option("--package", help="NAME=DIR for package:// meshes (repeatable)."),
+    ] = None,
+) -> None:
+    """Read a URDF's serial chain and write it as a robokin robot file."""
+    import yaml
+
+    from robokin.model.files import document_from_robot, save_robot
+    from robokin.model.urdf import robot_from_urdf
+
+    pmap = {}
+    for item in package or []:
+        name, sep, directory = item.partition("=")
+        if not sep or not name:
+            raise typer.BadParameter(f"--package expects NAME=DIR, got {item!r}")
+        pmap[name] = directory
+    robot = robot_from_urdf(file, base_link=base, tip_link=tip, package_map=pmap,
+                            missing_mesh="ignore")
+    info = robot.meta["urdf"]
+    if out is None:
+        print(yaml.safe_dump(document_from_robot(robot), sort_keys=False,
+                             default_flow_style=None), end="")
+        return
+    save_robot(robot, out)
+    _console().print(
+        f"{robot.name}: {robot.n} joints, {info.base_link} -> {info.tip_link}; "
+        f"wrote {out}", markup=False,
+    )
+
+
+@app.command("export")
+def export_urdf(
+    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    out: Annotated[
+        Path | None, typer.Option("-o", "--out", help="URDF file to write.")
+    ] = None,
+) -> None:
+    """Write a robot as a URDF with the same FK and limits."""
+    from robokin.model.urdf import urdf_from_robot, write_urdf
+
+    robot = _load(name)
+    if out is None:
+        print(urdf_from_robot(robot), end="")
+        return
+    write_urdf(robot, out)
+    _console().print(f"{robot.name}: wrote {out}", markup=False)
+
+
+@app.command("dh")
+def dh(
+    file: Annotated[Path, typer.Argument(help="The URDF file.")],
+    base: Annotated[str | None, typer.Option("--base", help="Base link.")] = None,
+    tip: Annotated[str | None, typer.Option("--tip", help="Tip link.")] = None,
+    modified: Annotated[
+        bool, typer.Option("--modified", help="Modified (Craig) DH.")
+    ] = False,
+    reference: Annotated[
+        str | None,
+        typer.Option("--reference", help="Link whose frame guides DH frame 0."),
+    ] = None,
+    virtual: Annotated[
+        bool,
+        typer.Option("--virtual-frames", help="Fold base/tool into fixed rows."),
+    ] = False,
+    mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable.")] = False,
+) -> None:
+    """Derive the DH table of a URDF arm (degrees; metres unless --mm)."""
+    from rich.table import Table
+
+    from robokin.model.dh_extract import describe
+    from robokin.model.urdf import dh_from_urdf
+
+    ext = dh_from_urdf(
+        file, base, tip, convention="modified" if modified else "standard",
+        reference_link=reference, virtual_frames=virtual,
+    )
+    doc = describe(ext, deg=True)
+    L = 1000.0 if mm else 1.0
+    for r in doc["rows"]:
+        r["a"] *= L
+        r["d"] *= L
+        if r["joint"] == "prismatic" and "limits" in r:
+            r["limits"] = [v * L for v in r["limits"]]
+    for key in ("base", "tool"):
+        doc[key]["xyz"] = [v * L for v in doc[key]["xyz"]]
+    doc["units"] = {"length": "mm" if mm else "m", "angle": "deg"}
+    if as_json:
+        print(json.dumps(doc))
+        return
+    lu = "mm" if mm else "m"
+    cols = (("alpha", "deg"), ("a", lu), ("theta", "deg"), ("d", lu)) if modified \
+        else (("theta", "deg"), ("d", lu), ("a", lu), ("alpha", "deg"))
+    table = Table(title=f"{doc['convention']} DH of {file.name}")
+    table.add_column("joint")
+    table.add_column("kind")
+    for c, u in cols:
+        table.add_column(f"{c} [{u}]")
+    for r in doc["rows"]:
+        table.add_row(r["name"], r["joint"], *(f"{r[c]:.6g}" for c, _ in cols))
+    con = _console()
+    con.print(table)
+    for key in ("base", "tool"):
+        p = doc[key]
+        con.print(
+            f"{key} transform: xyz [{lu}] "
+            + " ".join(f"{v:.6g}" for v in p["xyz"])
+            + "  rpy [deg] " + " ".join(f"{v:.6g}" for v in p["rpy"]),
+            markup=False,
+        )
+    if ext.needs_virtual_frames and not virtual:
+        con.print("this arm needs virtual frames to stand as a table alone "
+                  "(a base or tool transform remains); --virtual-frames emits them",
+                  markup=False)
+    for note in doc["notes"]:
+        con.print(f"note: {note}", markup=False)
