@@ -362,3 +362,15 @@ def test_ik_path_reports_first_failure():
         numeric.ik_path(robot, path, np.zeros(5))
     with pytest.raises(InputError, match="argument 'T_path'"):
         numeric.ik_path(robot, path[None], q_start)
+
+
+def test_ik_path_patent_arm_with_slides_position_only():
+    robot = robokin.load("improved_dh_arm")  # two prismatic coordinates
+    q_start = np.array([0.2, 0.3, 0.35, 0.1, 0.2, 0.15, 0.4])
+    T0 = robot.fk(q_start)
+    path = _line(T0, T0[:3, 3] + [-0.05, 0.08, 0.04], 40)
+    res = numeric.ik_path(robot, path, q_start, mask="xyz")
+    assert res.success.all(), res.reason
+    np.testing.assert_allclose(robot.fk(res.q)[:, :3, 3], path[:, :3, 3], atol=1e-9)
+    assert robot.within_limits(res.q, tol=0.0).all()
+    assert np.abs(np.diff(np.vstack([q_start, res.q]), axis=0)).max() < 0.05

@@ -385,7 +385,7 @@ def solve(
     tol: float = 1e-9,
     tol_rotation: float | None = None,
     max_iterations: int = 100,
-    max_restarts: int = 50,
+    max_restarts: int = 200,
     max_time: float | None = None,
     max_step: float = 1.0,
     parallel: bool | None = None,
@@ -569,7 +569,7 @@ def solve_all(
         q_near: Current configuration (..., n) or (n,), the first seed.
         n_seeds: Descents per target.
         **options: ``mask``, ``weights``, ``tol``, ``tol_rotation``,
-            ``max_iterations``, ``max_restarts`` (default 50), ``max_time``,
+            ``max_iterations``, ``max_restarts`` (default 200), ``max_time``,
             ``max_step``, ``parallel``, ``rng`` as in :func:`solve`, and
             ``dedupe_tol`` [rad, m].
 
@@ -594,7 +594,7 @@ def solve_all(
     n = data.n
     n_seeds = _count(n_seeds, "n_seeds", minimum=1)
     dedupe_tol = _positive(options.pop("dedupe_tol", 1e-6), "dedupe_tol")
-    max_restarts = _count(options.get("max_restarts", 50), "max_restarts")
+    max_restarts = _count(options.get("max_restarts", 200), "max_restarts")
     Tf, lead = _targets(T)
     N = Tf.shape[0]
     gen = _rng(options.get("rng"))
