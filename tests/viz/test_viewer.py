@@ -48,7 +48,10 @@ def test_binds_to_loopback_by_default(ur5):
 
 
 def test_free_robot_sliders_and_tool_pose(ur5):
-    with RobotViewer(ur5, port=0) as v:
+    bare = ur5.replace(
+        geometry=None
+    )  # no shapes: links drawn as capsules along the chain
+    with RobotViewer(bare, port=0) as v:
         assert v.free
         q = np.array([0.3, -1.0, 1.2, -0.5, 0.4, 0.2])
         v.set_configuration(q, move_target=True)
@@ -62,6 +65,19 @@ def test_free_robot_sliders_and_tool_pose(ur5):
         seg = v._segments[-1]
         d = np.asarray(seg.position) - T[:3, 3]
         assert np.linalg.norm(d) == pytest.approx(0.5 * seg.height, abs=1e-9)
+
+
+def test_geometry_shapes_follow_the_link_frames(ur5):
+    assert ur5.geometry is not None
+    q = np.array([0.3, -1.0, 1.2, -0.5, 0.4, 0.2])
+    with RobotViewer(ur5, port=0) as v:
+        v.set_configuration(q)
+        assert v._segments == []  # drawn from the geometry, not the chain capsules
+        frames = ur5.fk_all(q)
+        for i, node in v._frame_nodes.items():
+            if i < frames.shape[0]:
+                np.testing.assert_allclose(node.position, frames[i, :3, 3], atol=1e-9)
+        assert len(v._frame_nodes) >= ur5.n
 
 
 def test_dragging_the_target_snaps_to_the_nearest_ik_solution(ur5):
@@ -93,7 +109,7 @@ def test_playback_shows_collisions_and_closest_segment(ur5):
         assert not v.free
         v.show_frame(10)
         np.testing.assert_allclose(v.q, q[10])
-        assert tuple(v._segments[0].color) != (225, 30, 30)
+        assert tuple(v._link_nodes[0][0].color) != (225, 30, 30)
         np.testing.assert_allclose(v._closest.points[0], rep.closest_points[10])
         assert f"distance {rep.distances[10] * 1000:.1f} mm" in v._status.content
         v.show_frame(25)
@@ -101,7 +117,7 @@ def test_playback_shows_collisions_and_closest_segment(ur5):
         assert "COLLISION" in v._status.content and "table" in v._status.content
         v.show_time(0.005 * 40 + 1e-9)
         assert v.frame == 40
-        assert tuple(v._segments[0].color) != (225, 30, 30)
+        assert tuple(v._link_nodes[0][0].color) != (225, 30, 30)
 
 
 def test_viewer_page_renders_the_robot_in_chromium(ur5, tmp_path):

@@ -13,7 +13,7 @@ foot of the common normal, so a DH row's ``d`` runs along the joint axis and its
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -328,6 +328,29 @@ class ReportArrays:
     colliding: np.ndarray
     bodies: list[tuple[int, int, str, str]] = field(default_factory=list)
     min_distance: float | None = None
+    track: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None
+
+    def closest_at(self, idx: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray] | None:
+        """Distance (k,) [m] and closest point pairs (k, 2, 3) at samples ``idx``.
+
+        None when the report cannot tell.
+        """
+        idx = np.asarray(idx, dtype=np.int64).reshape(-1)
+        if self.closest is not None:
+            d = (
+                self.distance[idx]
+                if self.distance is not None
+                else np.linalg.norm(
+                    self.closest[idx, 1] - self.closest[idx, 0], axis=-1
+                )
+            )
+            return d, self.closest[idx]
+        if self.track is not None:
+            try:
+                return self.track(idx)
+            except Exception:  # a report we cannot query: draw no segment
+                return None
+        return None
 
 
 def report_arrays(report: Any, m: int) -> ReportArrays:
@@ -366,4 +389,50 @@ def report_arrays(report: Any, m: int) -> ReportArrays:
             break
     md = getattr(report, "min_distance", None)
     md = None if md is None else float(md)
-    return ReportArrays(dist, closest, colliding, bodies, md)
+    track = None if closest is not None else _pair_tracker(report)
+    return ReportArrays(dist, closest, colliding, bodies, md, track)
+
+
+def _pair_tracker(
+    report: Any, max_pairs: int = 8
+) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None:
+    """Closest points per sample from a ``robokin.collision.CollisionReport``.
+
+    Uses the report's public ``closest_at(idx)`` when it has one; otherwise asks
+    its distance problem for the nearest points of the ``max_pairs`` body pairs
+    that came closest over the motion (``report.pairs``), at each sample.
+    """
+    fn = getattr(report, "closest_at", None)
+    if callable(fn):
+
+        def public(idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            d, pa, pb = fn(idx)[:3]
+            return np.asarray(d, dtype=float), np.stack([pa, pb], axis=-2)
+
+        return public
+    prob, q = getattr(report, "_problem", None), getattr(report, "_q", None)
+    pairs = getattr(report, "pairs", None)
+    if prob is None or q is None or not pairs or not hasattr(prob, "nearest"):
+        return None
+    wanted = {frozenset((p.body_a, p.body_b)) for p in list(pairs)[:max_pairs]}
+    plist = [
+        p
+        for p in range(prob.P)
+        if frozenset((prob.body_a[p], prob.body_b[p])) in wanted
+    ]
+    if not plist:
+        return None
+    q = np.asarray(q, dtype=float)
+
+    def track(idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        frames = prob.frames(q[idx])
+        dist = np.full(idx.size, np.inf)
+        pts = np.zeros((idx.size, 2, 3))
+        for i in range(idx.size):
+            for p in plist:
+                d, a, b = prob.nearest(p, frames[i])
+                if d < dist[i]:
+                    dist[i], pts[i, 0], pts[i, 1] = d, a, b
+        return dist, pts
+
+    return track

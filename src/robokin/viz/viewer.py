@@ -278,7 +278,7 @@ class RobotViewer:
         L = 0.12 * self._scale
         self._tool = sc.add_frame("/tool", axes_length=L, axes_radius=0.06 * L)
         self._closest = None
-        if self.report.closest is not None:
+        if self.report.closest is not None or self.report.track is not None:
             self._closest = sc.add_line_segments(
                 "/closest",
                 points=np.zeros((1, 2, 3)),
@@ -445,13 +445,20 @@ class RobotViewer:
         red = bool(rep.colliding[i])
         bodies = {n for a, b, x, y in rep.bodies if a <= i <= b for n in (x, y)}
         self._set_red(red, bodies)
+        dist = None if rep.distance is None else float(rep.distance[i])
         if self._closest is not None:
-            self._closest.points = rep.closest[i][None]
-            color = COLLISION_COLOR if red else DISTANCE_COLOR
-            self._closest.colors = np.tile(np.array(color, dtype=np.uint8), (1, 2, 1))
+            found = rep.closest_at([i])
+            self._closest.visible = found is not None
+            if found is not None:
+                dist = float(found[0][0])
+                self._closest.points = found[1][:1]
+                color = COLLISION_COLOR if red else DISTANCE_COLOR
+                self._closest.colors = np.tile(
+                    np.array(color, dtype=np.uint8), (1, 2, 1)
+                )
         parts = [f"t = {self.motion.t[i]:.3f} s (sample {i + 1}/{m})"]
-        if rep.distance is not None:
-            parts.append(f"distance {rep.distance[i] * 1000:.1f} mm")
+        if dist is not None:
+            parts.append(f"distance {dist * 1000:.1f} mm")
         if red:
             parts.append("**COLLISION** " + ", ".join(sorted(bodies)))
         self._status.content = "  \n".join(parts)
