@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import robokin
-from robokin.spatial import rotx, trans
 from robokin.model.urdf import urdf_from_robot
+from robokin.spatial import rotx, trans
 
 pytest.importorskip("yourdfpy")
 from robokin.model.urdf import robot_from_urdf  # noqa: E402
