@@ -113,8 +113,8 @@ def test_dependent_joints_keep_their_coupling(rng):
 
 @pytest.mark.parametrize("convention", ["standard", "modified"])
 def test_virtual_frame_rows_for_any_transform(convention, rng):
-    from robokin.model.dh import chain_from_dh
     from robokin.kinematics.forward import forward_kinematics
+    from robokin.model.dh import chain_from_dh
 
     for T, count in [
         (np.eye(4), 0),
