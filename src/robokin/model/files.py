@@ -336,11 +336,11 @@ def _elementary_document(robot: Robot) -> dict[str, Any]:
         if np.allclose(T, np.eye(4), atol=1e-15):
             return ops
         for ax, v in zip("xyz", T[:3, 3]):
-            if v != 0.0:
+            if abs(v) > 1e-15:
                 ops.append({"op": f"t{ax}", "value": float(v)})
         r, p, y = (float(v) for v in rpy_from_matrix(T))
         for ax, v in (("z", y), ("y", p), ("x", r)):
-            if v != 0.0:
+            if abs(v) > 1e-15:
                 ops.append({"op": f"r{ax}", "value": v})
         return ops
 
