@@ -129,3 +129,57 @@ def test_colliding_samples_are_drawn_red(tmp_path):
     img = read_png(shot)[60:540]
     assert red_fraction(img) > 0.02  # the arm and the table it hits
     assert orange_fraction(img) < 5e-4
+
+
+SCENE_YAML = """
+name: test cell
+units: {length: mm, angle: deg}
+objects:
+  - {name: table, type: box, size: [600, 800, 40], xyz: [450, 0, -100]}
+  - {name: post, type: cylinder, radius: 40, length: 600, xyz: [0, 550, 300]}
+"""
+
+
+def test_cli_view_writes_html_with_scene_and_collision_check(tmp_path):
+    pytest.importorskip("coal")
+    from robokin import trajectory
+    from robokin.cli import main
+    from robokin.trajectory.io import write_csv
+
+    robot = robokin.load("ur5")
+    q0 = np.array([0.0, -1.2, 1.4, -1.8, -1.57, 0.0])
+    q1 = np.array([1.2, -0.8, 1.0, -1.6, -1.57, 0.5])
+    tr = trajectory.quintic(q0, q1, 1.0, dt=0.01)
+    csv = write_csv(tr, tmp_path / "motion.csv", robot.joint_names)
+    (tmp_path / "cell.yaml").write_text(SCENE_YAML)
+    out = tmp_path / "view.html"
+    rc = main(
+        [
+            "view",
+            "ur5",
+            "--traj",
+            str(csv),
+            "--scene",
+            str(tmp_path / "cell.yaml"),
+            "--html",
+            str(out),
+        ]
+    )
+    assert rc == 0
+    data = _embedded(out.read_text())
+    assert len(data["t"]) == tr.t.size
+    assert sorted(s["name"] for s in data["scene"]) == ["post", "table"]
+    # The distances shown are the checker's, sample by sample.
+    from robokin import collision
+
+    scene = collision.Scene.load(tmp_path / "cell.yaml")
+    rep = collision.check(scene.attach(robot), scene, tr)
+    assert data["distance"] is not None and data["closest"] is not None
+    assert min(data["distance"]) == pytest.approx(rep.sample_min_distance, abs=1e-6)
+    import base64
+
+    seg = np.frombuffer(base64.b64decode(data["closest"]), dtype="<f4").reshape(
+        -1, 2, 3
+    )
+    lengths = np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1)
+    np.testing.assert_allclose(lengths, np.maximum(data["distance"], 0.0), atol=1e-5)

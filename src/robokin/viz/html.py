@@ -145,10 +145,8 @@ def animation_html(
         "colliding": rep.colliding[idx].astype(int).tolist(),
         "collisions": [[int(a), int(b), x, y] for a, b, x, y in rep.bodies],
         "redBodies": _red_bodies(idx, rep.bodies),
-        "distance": None
-        if rep.distance is None
-        else rep.distance[idx].round(7).tolist(),
-        "closest": None if rep.closest is None else _b64(rep.closest[idx]),
+        "distance": None if track is None else np.round(track[0], 7).tolist(),
+        "closest": None if track is None or track[1] is None else _b64(track[1]),
         "minDistance": rep.min_distance,
     }
     data["skeleton"] = not has_link_shapes(shapes, robot)

@@ -1,0 +1,93 @@
+"""``robokin view``: the 3D viewer (live, viser) or a standalone HTML animation."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from robokin.cli import app
+
+__all__ = ["view"]
+
+
+def _load_scene(spec: str):
+    """A scene file, or the name of a bundled scene (``press``)."""
+    from robokin import collision
+
+    path = Path(spec)
+    if not path.exists() and not spec.endswith((".yaml", ".yml")):
+        path = collision.scene_path(spec)
+    return collision.Scene.load(path)
+
+
+@app.command()
+def view(
+    name: Annotated[str, typer.Argument(help="Built-in robot name or robot file.")],
+    traj: Annotated[
+        Path | None, typer.Option("--traj", help="Trajectory CSV to play.")
+    ] = None,
+    scene: Annotated[
+        str | None,
+        typer.Option("--scene", help="Scene file (or bundled scene name)."),
+    ] = None,
+    html: Annotated[
+        Path | None,
+        typer.Option(
+            "--html", help="Write a standalone HTML animation here instead of serving."
+        ),
+    ] = None,
+    check: Annotated[
+        bool,
+        typer.Option("--check/--no-check", help="Run the collision check to show it."),
+    ] = True,
+    host: Annotated[
+        str, typer.Option(help="Interface to bind the live viewer to.")
+    ] = "127.0.0.1",
+    port: Annotated[
+        int, typer.Option(help="Port of the live viewer (0: any free one).")
+    ] = 8080,
+) -> None:
+    """Show a robot (free, with joint sliders and an IK target) or play a trajectory.
+
+    With --scene the robot stands in the scene (its base and tool) and, with a
+    trajectory, collisions and the closest-distance segment are shown.
+    """
+    import robokin
+
+    robot = robokin.load(name)
+    sc = None
+    if scene is not None:
+        sc = _load_scene(scene)
+        robot = sc.attach(robot)
+    motion = None
+    if traj is not None:
+        from robokin.trajectory.io import read_csv
+
+        motion = read_csv(traj, is_revolute=robot.is_revolute)
+        if motion.q.shape[-1] != robot.n:
+            raise typer.BadParameter(
+                f"{traj} has {motion.q.shape[-1]} joint columns, {robot.name} has {robot.n} joints"
+            )
+    report = None
+    if sc is not None and motion is not None and check:
+        from robokin import collision
+
+        report = collision.check(robot, sc, motion)
+    if html is not None:
+        from robokin.viz.html import write_html
+
+        out = write_html(
+            html,
+            robot,
+            motion,
+            scene=sc,
+            report=report,
+            title=f"{robot.name}" + (f" in {sc.name}" if sc is not None else ""),
+        )
+        typer.echo(f"wrote {out}")
+        return
+    from robokin.viz.viewer import view as serve
+
+    serve(robot, motion, scene=sc, report=report, host=host, port=port, block=True)
