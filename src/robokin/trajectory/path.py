@@ -258,7 +258,7 @@ class PathBuilder:
         parts = []
         for i, seg in enumerate(segs):
             if seg.kind == "line":
-                parts.append(seg.line)
+                parts.append(seg.line.replace(labels=(seg.label,), pose=None))
             else:
                 t = time_grid(seg.duration, self.dt)
                 if seg.kind == "dwell":
