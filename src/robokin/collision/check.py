@@ -302,6 +302,8 @@ class _Problem:
         if S:
             np.maximum.at(self.rho, self.sph_owner,
                           np.linalg.norm(self.sph_c, axis=1) + self.sph_r)
+        self.spins = np.array([self._spins(s, k, placed.chain) for s, k in zip(shapes, link)],
+                              dtype=bool)
         # Scene objects: oriented boxes for the broad phase, fixed coal transforms.
         objects = list(scene.objects)
         self.objects = objects
@@ -389,12 +391,66 @@ class _Problem:
             mesh = sa.kind == "mesh" or sb.kind == "mesh"
             self.has_mesh[p] = mesh
             self.fn_hull.append(functor(sa.coal_convex(), sb.coal_convex()) if mesh else None)
+        # Capsule/sphere pairs have a closed-form distance: computed for all samples
+        # at once (segment-segment distance minus the radii).
+        def segment(sh):
+            if sh.kind == "sphere":
+                c = sh.placement[:3, 3]
+                return np.stack([c, c]), sh.size[0]
+            if sh.kind == "capsule":
+                h = sh.size[1] / 2 * sh.placement[:3, 2]
+                c = sh.placement[:3, 3]
+                return np.stack([c - h, c + h]), sh.size[0]
+            return None, 0.0
+
+        self.seg_local = np.zeros((S, 2, 3))
+        self.seg_r = np.zeros(S)
+        seg_ok = np.zeros(S, dtype=bool)
+        for i, sh in enumerate(shapes):
+            seg, rad = segment(sh)
+            if seg is not None:
+                self.seg_local[i], self.seg_r[i], seg_ok[i] = seg, rad, True
+        ob_seg = [segment(ob.shape) for ob in objects]
+        self.analytic = np.zeros(P, dtype=bool)
+        for p in range(P):
+            if not seg_ok[pa[p]]:
+                continue
+            self.analytic[p] = seg_ok[pb[p]] if is_self[p] else ob_seg[pb[p]][0] is not None
+        self.ob_seg = np.array([sg if sg is not None else np.zeros((2, 3)) for sg, _ in ob_seg])
+        self.ob_seg = self.ob_seg.reshape(O, 2, 3)
+        self.ob_seg_r = np.array([rad for _, rad in ob_seg]) if O else np.zeros(0)
         self.req = coal.DistanceRequest()
         self.res = coal.DistanceResult()
         # Constants for the motion bounds.
         self._static_chain_lengths()
 
     # ------------------------------------------------------------ motion bounds
+    @staticmethod
+    def _spins(shape, k: int, chain) -> bool:
+        """True when the last joint moving link k turns ``shape`` onto itself.
+
+        A sphere centred on that revolute joint's axis, or a cylinder or capsule
+        along it, does not move when the joint turns.
+        """
+        nc = chain.n_chain
+        kk = min(k, nc)
+        if kk == 0 or chain.joints[kk - 1].kind != "revolute":
+            return False
+        if shape.kind not in ("sphere", "cylinder", "capsule"):
+            return False
+        T = chain.frame_offsets[kk - 1]
+        if k == nc + 1:
+            T = T @ chain.link_offsets[nc - 1] @ chain.tool
+        inv = np.linalg.inv(T)  # the joint's axis in the link frame
+        p0, axis = inv[:3, 3], inv[:3, 2]
+        c = shape.placement[:3, 3]
+        off = (c - p0) - np.dot(c - p0, axis) * axis
+        if np.linalg.norm(off) > 1e-9:
+            return False
+        if shape.kind == "sphere":
+            return True
+        return bool(np.linalg.norm(np.cross(shape.placement[:3, 2], axis)) < 1e-9)
+
     def _static_chain_lengths(self) -> None:
         ch = self.chain
         nc = self.nc
@@ -440,10 +496,12 @@ class _Problem:
         qc = self.chain.coupling.apply(q)
         dq = np.abs(np.diff(qc, axis=0))  # (m-1, nc)
         Rst = self._static_R(qc)  # (nc, S)
-        # Joint origins in the world at every sample (m, nc, 3).
+        # Joint axes in the world at every sample: origin and direction (m, nc, 3).
         F = frames[:, :nc]  # frame before joint j is frames[j-1] @ pre_j
         o = np.einsum("mjab,jb->mja", F[..., :3, :3], self.pre[:, :3, 3]) + F[..., :3, 3]
-        # Actual reach from each joint origin, per shape, at the start of each interval.
+        z = np.einsum("mjab,jb->mja", F[..., :3, :3], self.pre[:, :3, 2])
+        # Per shape and joint, the reach from the joint's axis at the start of each
+        # interval, grown by what the joints after it can move within the interval.
         W = np.zeros((m - 1, S, nc))
         for s in range(S):
             k = self.link[s]
@@ -453,13 +511,17 @@ class _Problem:
             sl = slice(self.sph_start[s], self.sph_start[s] + int(np.sum(self.sph_owner == s)))
             c = sph_w[: m - 1, sl]  # (m-1, ks, 3)
             r = self.sph_r[sl]
-            dist = np.linalg.norm(c[:, :, None, :] - o[: m - 1, None, :kk, :], axis=-1)
+            rel = c[:, :, None, :] - o[: m - 1, None, :kk, :]
+            along = np.einsum("mqja,mja->mqj", rel, z[: m - 1, :kk])
+            perp = np.einsum("mqja,mqja->mqj", rel, rel) - along**2
+            dist = np.sqrt(np.maximum(perp, 0.0))
             f = (dist + r[None, :, None]).max(axis=1)  # (m-1, kk)
-            # growth of that reach within the interval from the joints after j
             moved = dq[:, :kk] * np.where(self.prismatic[:kk], 1.0, Rst[:kk, s])
             after = np.cumsum(moved[:, ::-1], axis=1)[:, ::-1] - moved  # sum over l > j
             R = np.minimum(Rst[:kk, s][None, :], f + after)
             W[:, s, :kk] = np.where(self.prismatic[:kk], 1.0, R)
+            if self.spins[s]:
+                W[:, s, kk - 1] = 0.0  # symmetric about its own joint's axis
         Ms = np.zeros((P, m - 1))
         op = self.obj_pairs
         if len(op):
@@ -501,6 +563,30 @@ class _Problem:
                 d = np.sqrt(np.einsum("mki,mki->mk", diff, diff)) - self.self_rr
                 LB[sp, lo:hi] = np.minimum.reduceat(d, self.self_start, axis=1).T
         return LB
+
+    # -------------------------------------------------------------- analytic
+    def analytic_distances(self, frames: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+        """Closed-form distances of capsule/sphere pairs at every sample, (len(pairs), m)."""
+        a = self.pa[pairs]
+        Fa = frames[:, self.link[a]]  # (m, k, 4, 4)
+        sa = np.einsum("mkab,ksb->mksa", Fa[..., :3, :3], self.seg_local[a]) + Fa[:, :, None, :3, 3]
+        ra = self.seg_r[a]
+        b = self.pb[pairs]
+        selfp = self.is_self[pairs]
+        sb = np.empty_like(sa)
+        rb = np.empty(len(pairs))
+        if selfp.any():
+            bs = b[selfp]
+            Fb = frames[:, self.link[bs]]
+            sb[:, selfp] = (np.einsum("mkab,ksb->mksa", Fb[..., :3, :3], self.seg_local[bs])
+                            + Fb[:, :, None, :3, 3])
+            rb[selfp] = self.seg_r[bs]
+        if (~selfp).any():
+            bo = b[~selfp]
+            sb[:, ~selfp] = self.ob_seg[bo][None]
+            rb[~selfp] = self.ob_seg_r[bo]
+        d = _segment_distance(sa[:, :, 0], sa[:, :, 1], sb[:, :, 0], sb[:, :, 1])
+        return (d - ra - rb).T
 
     # ----------------------------------------------------------------- exact
     def _T3(self, frame: np.ndarray, s: int):
@@ -558,6 +644,11 @@ class _Problem:
         done = np.zeros((P, m), dtype=bool)  # exact known
         hulled = np.zeros((P, m), dtype=bool)
         self.queries = 0
+        an = np.flatnonzero(self.analytic)
+        if len(an):
+            D[an] = self.analytic_distances(frames, an)
+            done[an] = True
+            LB[an] = D[an]
 
         def evaluate(ps: np.ndarray, idx: np.ndarray, force_exact: bool) -> None:
             for p, i in zip(ps.tolist(), idx.tolist()):
@@ -583,14 +674,29 @@ class _Problem:
             bwd = (np.maximum.accumulate((known - Cr)[:, ::-1], axis=1)[:, ::-1]) + Cr
             LB[rows] = np.maximum(Lr, np.maximum(fwd, bwd))
 
-        # 1. Every sample whose bound does not clear the threshold is classified.
+        # 1. Exact queries where they decide something: a sample whose bound does
+        #    not clear the threshold (to classify it), or lies below its pair's best
+        #    so far (to find the pair's minimum). Each round queries a strided
+        #    subset plus each pair's lowest bound, then spreads the new values to
+        #    the neighbours through the motion bounds; the stride halves per round.
+        cols = np.arange(m)
+        stride = 0  # first round: only each pair's lowest bound
         while True:
-            need = (LB <= clearance) & ~done
-            if not need.any():
+            best = np.where(done, D, np.inf).min(axis=1)
+            need = ~done & ((LB <= clearance) | (LB < best[:, None]))
+            rows = np.flatnonzero(need.any(axis=1))
+            if not len(rows):
                 break
-            ps, idx = np.nonzero(need)
-            evaluate(ps, idx, force_exact=False)
-        propagate(np.arange(P))
+            sub = need[rows]
+            pick = np.zeros_like(sub)
+            if stride:
+                pick |= sub & ((cols % stride) == 0)[None, :]
+            work = np.where(sub, LB[rows], np.inf)
+            pick[np.arange(len(rows)), np.argmin(work, axis=1)] = True
+            ps, idx = np.nonzero(pick)
+            evaluate(rows[ps], idx, force_exact=False)
+            propagate(rows)
+            stride = max(m // 8, 1) if stride == 0 else max(stride // 2, 1)
         # 2. Subdivision: intervals whose ends do not clear the motion between.
         between: dict[tuple[int, int], tuple[float, float]] = {}
         self.subdivisions = 0
@@ -610,20 +716,6 @@ class _Problem:
                                          Ms[p, i], clearance, tol)
                     if found is not None:
                         between[(p, i)] = found
-                propagate(np.unique(ps))
-        # 3. Per pair minimum over the samples: best-first with bound propagation.
-        rows = np.arange(P)
-        while len(rows):
-            work = np.where(done[rows], np.inf, LB[rows])
-            cand = np.argmin(work, axis=1)
-            cval = work[np.arange(len(rows)), cand]
-            best = np.where(done[rows], D[rows], np.inf).min(axis=1)
-            active = cval < best
-            rows, cand = rows[active], cand[active]
-            if not len(rows):
-                break
-            evaluate(rows, cand, force_exact=False)
-            propagate(rows)
         return self._report(q, times, frames, D, between, clearance)
 
     def _bisect(self, p, q0, q1, d0, d1, M, thr, tol):
@@ -743,6 +835,36 @@ class _Problem:
             for p in plist:
                 out[i] = min(out[i], self.exact(p, frames[i]))
         return out
+
+
+def _segment_distance(p1, q1, p2, q2) -> np.ndarray:
+    """Distance between segments [p1, q1] and [p2, q2], (..., 3) -> (...).
+
+    Closest points of two segments with clamping [Ericson, Real-Time Collision
+    Detection, 2005, sec. 5.1.9], vectorised, degenerate (point) segments included.
+    """
+    eps = 1e-18
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a = np.einsum("...i,...i->...", d1, d1)
+    e = np.einsum("...i,...i->...", d2, d2)
+    f = np.einsum("...i,...i->...", d2, r)
+    c = np.einsum("...i,...i->...", d1, r)
+    b = np.einsum("...i,...i->...", d1, d2)
+    denom = a * e - b * b
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = np.where(denom > eps * np.maximum(a * e, eps), np.clip((b * f - c * e) / denom, 0, 1), 0.0)
+        t = np.where(e > eps, (b * s + f) / e, 0.0)
+        s = np.where(t < 0, np.where(a > eps, np.clip(-c / a, 0, 1), 0.0), s)
+        s = np.where(t > 1, np.where(a > eps, np.clip((b - c) / a, 0, 1), 0.0), s)
+        t = np.clip(t, 0, 1)
+        # first segment a point: s = 0, t from projection
+        t = np.where(a <= eps, np.where(e > eps, np.clip(f / e, 0, 1), 0.0), t)
+        s = np.where(a <= eps, 0.0, s)
+        # second segment a point: t = 0
+        s = np.where((e <= eps) & (a > eps), np.clip(-c / a, 0, 1), s)
+        t = np.where(e <= eps, 0.0, t)
+    diff = (p1 + d1 * s[..., None]) - (p2 + d2 * t[..., None])
+    return np.sqrt(np.einsum("...i,...i->...", diff, diff))
 
 
 def _runs(mask, bmask, bfrac, per_sample, ba, bb, t_at) -> list[Interval]:

@@ -210,10 +210,12 @@ class Shape:
             return cache["spheres"]
         if self.kind == "capsule":
             r, L = self.size
+            # k + 1 centres on the axis, ends included: a point within r of the
+            # axis lies within hypot(r, L / 2k) of the nearest centre.
             k = int(min(8, max(1, math.ceil(L / (1.5 * r)))))
-            z = (np.arange(k) + 0.5) / k * L - L / 2
-            centres = np.stack([np.zeros(k), np.zeros(k), z], axis=1)
-            radii = np.full(k, math.hypot(r, L / (2 * k)))
+            z = np.linspace(-L / 2, L / 2, k + 1)
+            centres = np.stack([np.zeros(k + 1), np.zeros(k + 1), z], axis=1)
+            radii = np.full(k + 1, math.hypot(r, L / (2 * k)))
         elif self.kind == "sphere":
             centres, radii = np.zeros((1, 3)), np.array([self.size[0]])
         else:
