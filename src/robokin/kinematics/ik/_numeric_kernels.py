@@ -92,7 +92,7 @@ def _const_right(T, C):
         T[r, 3] = a0 * C[0, 3] + a1 * C[1, 3] + a2 * C[2, 3] + a3
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _pose_jac(q, Mc, ident, consts, jdat, qc, Jc, J, T):
     """Pose (top 3x4 of T) and Jacobian J (6, n) w.r.t. the independent q."""
     nc = jdat.shape[1]
@@ -154,7 +154,7 @@ def _pose_jac(q, Mc, ident, consts, jdat, qc, Jc, J, T):
                 J[r, j] = s
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _residual(T, Tt, e):
     """Task error e (6,) = [p_t - p; log(R_t R^T)] in the base frame."""
     for r in range(3):
@@ -228,7 +228,7 @@ def _errors(e, w):
     return cost, math.sqrt(ep), math.sqrt(er)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _chol_solve(A, b, m):
     """Solve A x = b in place (x into b) for SPD A (m x m); False if not SPD."""
     for j in range(m):
