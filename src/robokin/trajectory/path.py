@@ -22,7 +22,8 @@ acceleration at the junction (``J^+ [v; w]``), so the junction is continuous too
 
 Durations are given per segment or derived from joint velocity and acceleration
 limits (``v_max``, ``a_max``) and rounded up to whole samples; a smoothed run
-whose spline overshoots the limits is stretched until it keeps them.
+whose spline overshoots the limits has its derived (never its given) durations
+stretched until it keeps them.
 """
 
 from __future__ import annotations
@@ -65,6 +66,7 @@ class Segment:
         speed_in: Line start speed [m/s].
         speed_out: Line end speed [m/s].
         line: The sampled line (set while building).
+        given: The duration was given (never stretched to meet limits).
     """
 
     kind: Kind
@@ -77,6 +79,7 @@ class Segment:
     speed_in: float = 0.0
     speed_out: float = 0.0
     line: Trajectory | None = field(default=None, repr=False)
+    given: bool = False
 
 
 class PathBuilder:
@@ -142,7 +145,8 @@ class PathBuilder:
         if qv.shape != (n,):
             raise InputError("q", f"expected shape ({n},), got {qv.shape}")
         self.segments.append(Segment("joint", qv.copy(), self._duration(duration),
-                                     get_profile(profile), stop, label or "joint"))
+                                     get_profile(profile), stop, label or "joint",
+                                     given=duration is not None))
         return self
 
     def pose(self, T: npt.ArrayLike, duration: float | None = None, *,
@@ -333,9 +337,10 @@ class PathBuilder:
                     worst = max(worst, float((np.abs(qd) / self.v_max).max()))
                 if self.a_max is not None:
                     worst = max(worst, math.sqrt(float((np.abs(qdd) / self.a_max).max())))
-            if worst <= 1.0 + 1e-9:
+            free = [r for r in run if not segs[r].given]
+            if worst <= 1.0 + 1e-9 or not free:
                 return
-            for r in run:  # stretch the run's durations and refit
+            for r in free:  # stretch the derived durations and refit
                 segs[r].duration = max(self.dt, math.ceil(
                     segs[r].duration * worst * 1.02 / self.dt - 1e-9) * self.dt)
 
