@@ -39,6 +39,7 @@ O_STALL_EVERY = 15  # check progress every this many iterations ...
 O_STALL_RATIO = 16  # ... and give up unless the cost fell below ratio * before
 O_MU_DOWN = 17  # damping factor after an accepted step
 O_MU_UP = 18  # damping factor after a rejected step
+O_SEED_SHRINK = 19  # odd restarts seed in [lo + f span, hi - f span]
 N_OPTS = 20
 
 # result columns after q
@@ -523,8 +524,16 @@ def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out, work, iwork)
             for j in range(n):
                 q[j] = q0[j]
         else:
+            # alternate seeds from the central part of the range (descents from
+            # there meet limits less often) with seeds from the whole range
+            lo_f = 0.0
+            span_f = 1.0
+            if a % 2 == 1:
+                lo_f = opts[O_SEED_SHRINK]
+                span_f = 1.0 - 2.0 * lo_f
             for j in range(n):
-                q[j] = cdat[2, j] + seeds[a - 1, j] * (cdat[3, j] - cdat[2, j])
+                u = lo_f + span_f * seeds[a - 1, j]
+                q[j] = cdat[2, j] + u * (cdat[3, j] - cdat[2, j])
             if a > 1 or start == 0:
                 restarts += 1
         code, it, ep, er, cost = _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw,

@@ -55,6 +55,7 @@ _STALL_RATIO = 0.5
 _MU0 = 1e-2  # initial damping, lambda = mu * E
 _MU_DOWN = 0.5
 _MU_UP = 16.0
+_SEED_SHRINK = 0.25
 
 
 _K: list[Any] = []
@@ -321,6 +322,7 @@ def _make_opts(mask: Any, weights: Any, tol: Any, tol_rotation: Any,
     opts[K.O_MU0] = _MU0
     opts[K.O_MU_DOWN] = _MU_DOWN
     opts[K.O_MU_UP] = _MU_UP
+    opts[K.O_SEED_SHRINK] = _SEED_SHRINK
     return opts
 
 
