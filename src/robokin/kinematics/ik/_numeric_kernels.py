@@ -8,7 +8,9 @@ from another module, so sharing them would risk stale caches).
 Packed inputs (built once per chain by ``numeric._ChainData``):
 
 * ``consts`` (n_chain + 1, 4, 4): the chain's constant transforms.
-* ``jdat`` (3, n_chain): rows kind (1.0 = prismatic), sign, offset.
+* ``jdat`` (9, n_chain): rows kind (1.0 = prismatic), sign, offset, then
+  ``[1, cos a, sin a, tx, ty, tz]`` when ``consts[k + 1]`` is ``Trans(t) Rx(a)``
+  (zeros otherwise).
 * ``Mc`` (n_chain, n + 1): the coupling ``q_chain = M q + c`` as ``[M | c]``.
 * ``cdat`` (5, n): rows lower limit, upper limit, seed lower, seed upper bound,
   and 1.0 where a coordinate may be shifted by 2*pi without changing the pose.
@@ -116,7 +118,22 @@ def _pose_jac(q, Mc, ident, consts, jdat, qc, Jc, J, T):
         for r in range(3):
             Jc[r, k] = T[r, 3]
             Jc[3 + r, k] = T[r, 2]
-        _const_right(T, consts[k + 1])
+        if jdat[3, k] == 1.0:
+            # consts[k + 1] is Trans(tx, ty, tz) Rx(a) (every DH row): fewer products
+            ca = jdat[4, k]
+            sa = jdat[5, k]
+            tx = jdat[6, k]
+            ty = jdat[7, k]
+            tz = jdat[8, k]
+            for r in range(3):
+                a0 = T[r, 0]
+                a1 = T[r, 1]
+                a2 = T[r, 2]
+                T[r, 3] += a0 * tx + a1 * ty + a2 * tz
+                T[r, 1] = ca * a1 + sa * a2
+                T[r, 2] = ca * a2 - sa * a1
+        else:
+            _const_right(T, consts[k + 1])
     px = T[0, 3]
     py = T[1, 3]
     pz = T[2, 3]

@@ -139,8 +139,16 @@ class _ChainData:
         n = chain.n
         self.n = n
         self.consts = np.ascontiguousarray(chain._consts, dtype=np.float64)
+        nc = len(chain._kind)
+        xform = np.zeros((6, nc))
+        for k in range(nc):
+            C = chain._consts[k + 1]
+            ca, sa = C[1, 1], C[2, 1]
+            if (C[0, 0] == 1.0 and C[0, 1] == 0.0 and C[0, 2] == 0.0 and C[1, 0] == 0.0
+                    and C[2, 0] == 0.0 and C[1, 2] == -sa and C[2, 2] == ca):
+                xform[:, k] = (1.0, ca, sa, C[0, 3], C[1, 3], C[2, 3])
         self.jdat = np.ascontiguousarray(
-            np.stack([chain._kind, chain._sign, chain._offset]), dtype=np.float64
+            np.vstack([chain._kind, chain._sign, chain._offset, xform]), dtype=np.float64
         )
         M = np.asarray(chain.coupling.matrix, dtype=np.float64)
         c = np.asarray(chain.coupling.offset, dtype=np.float64)
