@@ -225,13 +225,13 @@ def follow_poses(
     for k in range(m):
         Tt = Tp[k]
         q = q_prev + step if seeds is None else seeds[k]
-        best, q_best = np.inf, q
+        best, q_best, J_best = np.inf, q, None
         stalled = 0
         for _ in range(max_iterations):
             J, T = jacobian_and_pose(chain, q)
             size = _err(T, Tt, e)
             if size < best:
-                best, q_best = size, q
+                best, q_best, J_best = size, q, J
                 stalled = 0
             else:
                 stalled += 1
@@ -279,10 +279,14 @@ def follow_poses(
                           f"[{lim[j, 0]:.6g}, {lim[j, 1]:.6g}]")
                 first = k
                 break
-        if singular_tol > 0:
-            J = jacobian_and_pose(chain, q)[0]
-            sv_min = np.linalg.svd(J, compute_uv=False)[-1]
-            if sv_min < singular_tol and min(n, 6) == 6:
+        if singular_tol > 0 and n >= 6:
+            J = J_best
+            # sigma_min >= |det J| / ||J||_F^5 for a 6x6 J: skip the SVD when that
+            # bound already clears the tolerance (nearly always).
+            clear = n == 6 and (abs(np.linalg.det(J)) >
+                                singular_tol * float((J * J).sum()) ** 2.5)
+            sv_min = np.inf if clear else np.linalg.svd(J, compute_uv=False)[-1]
+            if sv_min < singular_tol:
                 kind = "singularity"
                 reason = (f"singularity: smallest Jacobian singular value {sv_min:.2g} "
                           f"< {singular_tol:g}")
