@@ -117,6 +117,7 @@ def _schema():
         actuators: Any = None
         geometry: Any = None
         collision: Any = None
+        controller: Any = None  # a controller profile (robokin.trajectory.io), kept raw
 
     return RobotFile, Row, Op
 
@@ -244,13 +245,11 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
     except ModelError as exc:
         field = (exc.field or "").replace("rows[", "joints[").replace("ops[", "joints[")
         raise ModelError(exc.reason, file=file, field=field or None) from None
-    robot = Robot(
-        chain,
-        name=spec.name,
-        source=spec.source,
-        path=file,
-        meta={"document": copy.deepcopy(dict(doc))},
-    )
+    meta: dict[str, Any] = {"document": copy.deepcopy(dict(doc))}
+    if spec.controller is not None:
+        # Validated where it is used: robokin.trajectory.io.ControllerProfile.
+        meta["controller"] = copy.deepcopy(spec.controller)
+    robot = Robot(chain, name=spec.name, source=spec.source, path=file, meta=meta)
     for key in ("actuators", "geometry", "collision"):
         value = getattr(spec, key)
         if value is None:
