@@ -72,3 +72,21 @@ def test_pose_error_known_values():
     e2 = sp.pose_error(R @ A, R @ B)
     np.testing.assert_allclose(e2[3:], R[:3, :3] @ [0, 0, 0.25], atol=1e-12)
     assert sp.pose_error(np.stack([A, B]), B).shape == (2, 6)
+
+
+@pytest.mark.parametrize(
+    "angle", [0.0, 1e-9, 1e-5, 0.3, 2.0, np.pi - 1e-2, np.pi - 1e-5, np.pi]
+)
+def test_pose_error_rotation_matches_scipy_across_angles(angle, rng):
+    axes = rng.normal(size=(20, 3))
+    axes /= np.linalg.norm(axes, axis=-1, keepdims=True)
+    R = Rotation.from_rotvec(axes * angle)
+    T = np.zeros((20, 4, 4))
+    T[:, :3, :3] = R.as_matrix()
+    T[:, 3, 3] = 1.0
+    e = sp.pose_error(np.eye(4), T)[:, 3:]
+    ref = Rotation.from_matrix(T[:, :3, :3]).as_rotvec()
+    # at exactly pi the sign of the axis is ambiguous: compare up to sign there
+    if angle == np.pi:
+        e = np.where((e * ref).sum(-1, keepdims=True) < 0, -e, e)
+    np.testing.assert_allclose(e, ref, atol=1e-12)

@@ -190,6 +190,34 @@ def axis_angle_from_matrix(T: npt.ArrayLike) -> np.ndarray:
     return _as("as_rotvec", T)
 
 
+def _log_rotation(R: np.ndarray) -> np.ndarray:
+    """Rotation vectors of rotation matrices (..., 3, 3) -> (..., 3), numpy only.
+
+    Uses ``theta / (2 sin theta) * vee(R - R^T)``; a series near 0 and scipy for the
+    few rotations within 1e-3 rad of pi, where that formula loses precision.
+    """
+    tr = R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2]
+    theta = np.arccos(np.clip((tr - 1.0) * 0.5, -1.0, 1.0))
+    w = np.stack(
+        [
+            R[..., 2, 1] - R[..., 1, 2],
+            R[..., 0, 2] - R[..., 2, 0],
+            R[..., 1, 0] - R[..., 0, 1],
+        ],
+        axis=-1,
+    )
+    small = theta < 1e-4
+    sin = np.sin(theta)
+    factor = np.where(
+        small, 0.5 + theta**2 / 12.0, theta / (2.0 * np.where(small, 1.0, sin))
+    )
+    out = w * factor[..., None]
+    near_pi = theta > np.pi - 1e-3
+    if near_pi.any():
+        out[near_pi] = _rotation().from_matrix(R[near_pi]).as_rotvec()
+    return out
+
+
 def pose_error(current: npt.ArrayLike, target: npt.ArrayLike) -> np.ndarray:
     """The 6-vector that takes ``current`` to ``target``, both expressed in the base frame.
 
@@ -206,5 +234,5 @@ def pose_error(current: npt.ArrayLike, target: npt.ArrayLike) -> np.ndarray:
     dp = target[..., :3, 3] - current[..., :3, 3]
     dR = target[..., :3, :3] @ np.swapaxes(current[..., :3, :3], -1, -2)
     lead = dR.shape[:-2]
-    w = _rotation().from_matrix(dR.reshape(-1, 3, 3)).as_rotvec().reshape(lead + (3,))
+    w = _log_rotation(dR)
     return np.concatenate([np.broadcast_to(dp, lead + (3,)), w], axis=-1)
