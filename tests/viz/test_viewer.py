@@ -126,19 +126,24 @@ def test_viewer_page_renders_the_robot_in_chromium(ur5, tmp_path):
         v.show_frame(25)
         clients = []
         v.server.on_client_connect(lambda client: clients.append(client.client_id))
-        shot = tmp_path / "viewer.png"
-        run_chromium(
-            v.url,
-            tmp_path / "profile",
-            screenshot=shot,
-            size=(1000, 700),
-            budget_ms=5000,
-            webgl=True,
-        )
-        # The page loaded its script and connected back over the websocket.
-        assert len(clients) >= 1
-    img = read_png(shot)
+        # Software WebGL on a busy machine can be slow: give a second, longer try.
+        for attempt, budget in enumerate((6000, 20000)):
+            shot = tmp_path / f"viewer{attempt}.png"
+            run_chromium(
+                v.url,
+                tmp_path / "profile",
+                screenshot=shot,
+                size=(1000, 700),
+                budget_ms=budget,
+                webgl=True,
+                timeout=180,
+            )
+            img = read_png(shot)
+            view3d = img[150:700, 0:650]  # left of the GUI panel, below the notices
+            if clients and orange_fraction(view3d) > 5e-4:
+                break
+    # The page loaded its script and connected back over the websocket.
+    assert len(clients) >= 1
     assert img.shape == (700, 1000, 3)
-    view3d = img[150:700, 0:650]  # left of the GUI panel, below the notices
     assert view3d.std() > 8.0  # not a blank canvas
     assert orange_fraction(view3d) > 5e-4  # the arm's links
