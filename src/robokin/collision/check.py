@@ -54,7 +54,7 @@ __all__ = [
     "check",
 ]
 
-_CHUNK = 1024  # samples per broad-phase block (bounds memory)
+_TIE = 1e-9  # [m] pair minima are exact to this (bounds within it of the best stop)
 
 
 class Collision(NamedTuple):
@@ -208,6 +208,7 @@ def check(
     self_collision: bool = True,
     subdivide: bool = True,
     tolerance: float = 1e-6,
+    pair_tolerance: float = 1e-3,
 ) -> CollisionReport:
     """Collision and minimum distance of a joint trajectory in a scene.
 
@@ -225,6 +226,10 @@ def check(
         subdivide: Guarantee no collision is missed between samples.
         tolerance: Motion [m] below which subdivision stops (grazing contact
             closer than this between samples counts as clear).
+        pair_tolerance: Each pair's minimum over time is within this [m] of
+            its exact minimum over the samples (it is always a real sampled
+            distance, never below the exact one). The global minimum, and every
+            sample at or below ``clearance``, are exact regardless.
 
     Returns:
         A :class:`CollisionReport`.
@@ -237,7 +242,8 @@ def check(
         raise InputError("clearance", f"expected a finite number >= 0 [m], got {clearance!r}")
     q, tt = _as_samples(q_samples, robot.n, t)
     problem = _problem_for(robot, scene, self_collision)
-    return problem.run(q, tt, float(clearance), subdivide, float(tolerance))
+    return problem.run(q, tt, float(clearance), subdivide, float(tolerance),
+                       max(float(pair_tolerance), _TIE))
 
 
 def _problem_for(robot: Robot, scene: Scene, self_collision: bool) -> _Problem:
@@ -419,6 +425,26 @@ class _Problem:
         self.ob_seg = np.array([sg if sg is not None else np.zeros((2, 3)) for sg, _ in ob_seg])
         self.ob_seg = self.ob_seg.reshape(O, 2, 3)
         self.ob_seg_r = np.array([rad for _, rad in ob_seg]) if O else np.zeros(0)
+        # Rounded bounding boxes (pose in the parent frame, half sizes, radius).
+        def rounded_box(sh):
+            k, sz = sh.kind, sh.size
+            T = np.array(sh.placement)
+            if k == "capsule":
+                return T, np.array([0.0, 0.0, sz[1] / 2]), sz[0]
+            if k == "sphere":
+                return T, np.zeros(3), sz[0]
+            c, h = sh.local_box()
+            T[:3, 3] = T[:3, :3] @ c + T[:3, 3]
+            return T, np.array(h, dtype=float), 0.0
+
+        rbs = [rounded_box(sh) for sh in shapes]
+        self.rb_local = np.array([x[0] for x in rbs]).reshape(S, 4, 4)
+        self.rb_h = np.array([x[1] for x in rbs]).reshape(S, 3)
+        self.rb_r = np.array([x[2] for x in rbs]).reshape(S)
+        obs = [rounded_box(ob.shape) for ob in objects]
+        self.ob_rb_pose = np.array([x[0] for x in obs]).reshape(O, 4, 4)
+        self.ob_rb_h = np.array([x[1] for x in obs]).reshape(O, 3)
+        self.ob_rb_r = np.array([x[2] for x in obs]).reshape(O)
         self.req = coal.DistanceRequest()
         self.res = coal.DistanceResult()
         # Constants for the motion bounds.
@@ -498,8 +524,8 @@ class _Problem:
         Rst = self._static_R(qc)  # (nc, S)
         # Joint axes in the world at every sample: origin and direction (m, nc, 3).
         F = frames[:, :nc]  # frame before joint j is frames[j-1] @ pre_j
-        o = np.einsum("mjab,jb->mja", F[..., :3, :3], self.pre[:, :3, 3]) + F[..., :3, 3]
-        z = np.einsum("mjab,jb->mja", F[..., :3, :3], self.pre[:, :3, 2])
+        o = (F[..., :3, :3] @ self.pre[:, :3, 3, None])[..., 0] + F[..., :3, 3]
+        z = (F[..., :3, :3] @ self.pre[:, :3, 2, None])[..., 0]
         # Per shape and joint, the reach from the joint's axis at the start of each
         # interval, grown by what the joints after it can move within the interval.
         W = np.zeros((m - 1, S, nc))
@@ -512,8 +538,8 @@ class _Problem:
             c = sph_w[: m - 1, sl]  # (m-1, ks, 3)
             r = self.sph_r[sl]
             rel = c[:, :, None, :] - o[: m - 1, None, :kk, :]
-            along = np.einsum("mqja,mja->mqj", rel, z[: m - 1, :kk])
-            perp = np.einsum("mqja,mqja->mqj", rel, rel) - along**2
+            along = _dot(rel, z[: m - 1, None, :kk])
+            perp = _dot(rel, rel) - along**2
             dist = np.sqrt(np.maximum(perp, 0.0))
             f = (dist + r[None, :, None]).max(axis=1)  # (m-1, kk)
             moved = dq[:, :kk] * np.where(self.prismatic[:kk], 1.0, Rst[:kk, s])
@@ -540,36 +566,31 @@ class _Problem:
     def sphere_world(self, frames: np.ndarray) -> np.ndarray:
         """World centres of the bounding spheres, (m, Q, 3)."""
         F = frames[:, self.sph_link]  # (m, Q, 4, 4)
-        return np.einsum("mqab,qb->mqa", F[..., :3, :3], self.sph_c) + F[..., :3, 3]
+        return (F[..., :3, :3] @ self.sph_c[:, :, None])[..., 0] + F[..., :3, 3]
 
-    def lower_bounds(self, sph_w: np.ndarray) -> np.ndarray:
-        """Broad-phase lower bounds on every pair's distance, (P, m)."""
-        m = sph_w.shape[0]
-        LB = np.empty((self.P, m))
-        op, sp = self.obj_pairs, self.self_pairs
-        for lo in range(0, m, _CHUNK):
-            hi = min(m, lo + _CHUNK)
-            c = sph_w[lo:hi]
-            if len(op):
-                # point to oriented box distance, (mb, Q, O)
-                rel = c[:, :, None, :] - self.ob_t[None, None]
-                loc = np.einsum("oab,mqoa->mqob", self.ob_R, rel)
-                ex = np.maximum(np.abs(loc) - self.ob_h, 0.0)
-                d = np.sqrt(np.einsum("mqoi,mqoi->mqo", ex, ex)) - self.sph_r[None, :, None]
-                ds = np.minimum.reduceat(d, self.sph_start, axis=1)  # (mb, S, O)
-                LB[op, lo:hi] = ds[:, self.pa[op], self.pb[op]].T
-            if len(sp):
-                diff = c[:, self.self_c1] - c[:, self.self_c2]
-                d = np.sqrt(np.einsum("mki,mki->mk", diff, diff)) - self.self_rr
-                LB[sp, lo:hi] = np.minimum.reduceat(d, self.self_start, axis=1).T
-        return LB
+    def lower_bounds(self, frames: np.ndarray) -> np.ndarray:
+        """Broad-phase lower bounds on every pair's distance, (P, m).
+
+        Separating-axis gaps between rounded bounding boxes (compiled kernel).
+        """
+        from robokin.collision._kernels import rounded_box_bounds
+
+        m = frames.shape[0]
+        out = np.full((self.P, m), -np.inf)
+        rounded_box_bounds(
+            np.ascontiguousarray(frames), self.link, self.rb_local, self.rb_h, self.rb_r,
+            self.ob_rb_pose, self.ob_rb_h, self.ob_rb_r, self.pa, self.pb, self.is_self,
+            self.analytic, out,
+        )
+        return out
 
     # -------------------------------------------------------------- analytic
     def analytic_distances(self, frames: np.ndarray, pairs: np.ndarray) -> np.ndarray:
         """Closed-form distances of capsule/sphere pairs at every sample, (len(pairs), m)."""
         a = self.pa[pairs]
         Fa = frames[:, self.link[a]]  # (m, k, 4, 4)
-        sa = np.einsum("mkab,ksb->mksa", Fa[..., :3, :3], self.seg_local[a]) + Fa[:, :, None, :3, 3]
+        sa = (Fa[:, :, None, :3, :3] @ self.seg_local[a][None, :, :, :, None])[..., 0]
+        sa += Fa[:, :, None, :3, 3]
         ra = self.seg_r[a]
         b = self.pb[pairs]
         selfp = self.is_self[pairs]
@@ -578,7 +599,7 @@ class _Problem:
         if selfp.any():
             bs = b[selfp]
             Fb = frames[:, self.link[bs]]
-            sb[:, selfp] = (np.einsum("mkab,ksb->mksa", Fb[..., :3, :3], self.seg_local[bs])
+            sb[:, selfp] = ((Fb[:, :, None, :3, :3] @ self.seg_local[bs][None, :, :, :, None])[..., 0]
                             + Fb[:, :, None, :3, 3])
             rb[selfp] = self.seg_r[bs]
         if (~selfp).any():
@@ -627,7 +648,7 @@ class _Problem:
 
         return link_frames(self.chain, q)
 
-    def run(self, q, t, clearance, subdivide, tol) -> CollisionReport:
+    def run(self, q, t, clearance, subdivide, tol, pair_tol) -> CollisionReport:
         m = q.shape[0]
         times = np.arange(m, dtype=float) if t is None else t
         P = self.P
@@ -636,7 +657,7 @@ class _Problem:
             return CollisionReport(math.inf, False, [], [], [], None, [], clearance, times,
                                    _problem=self, _q=q)
         sph_w = self.sphere_world(frames)
-        LB = self.lower_bounds(sph_w)
+        LB = self.lower_bounds(frames)
         Ms = self.motion(q, frames, sph_w)  # (P, m-1)
         C = np.zeros((P, m))
         np.cumsum(Ms, axis=1, out=C[:, 1:])
@@ -679,14 +700,23 @@ class _Problem:
         #    so far (to find the pair's minimum). Each round queries a strided
         #    subset plus each pair's lowest bound, then spreads the new values to
         #    the neighbours through the motion bounds; the stride halves per round.
+        #    Pair minima are settled to ``pair_tolerance``; a last pass settles
+        #    the global minimum exactly.
         cols = np.arange(m)
         stride = 0  # first round: only each pair's lowest bound
+        final = False
         while True:
             best = np.where(done, D, np.inf).min(axis=1)
-            need = ~done & ((LB <= clearance) | (LB < best[:, None]))
+            if final:
+                need = ~done & (LB < best.min() - _TIE)
+            else:
+                need = ~done & ((LB <= clearance) | (LB < best[:, None] - pair_tol))
             rows = np.flatnonzero(need.any(axis=1))
             if not len(rows):
-                break
+                if final or pair_tol <= _TIE:
+                    break
+                final = True
+                continue
             sub = need[rows]
             pick = np.zeros_like(sub)
             if stride:
@@ -837,6 +867,11 @@ class _Problem:
         return out
 
 
+def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Dot product over the last axis (of length 3), broadcasting."""
+    return x[..., 0] * y[..., 0] + x[..., 1] * y[..., 1] + x[..., 2] * y[..., 2]
+
+
 def _segment_distance(p1, q1, p2, q2) -> np.ndarray:
     """Distance between segments [p1, q1] and [p2, q2], (..., 3) -> (...).
 
@@ -845,11 +880,7 @@ def _segment_distance(p1, q1, p2, q2) -> np.ndarray:
     """
     eps = 1e-18
     d1, d2, r = q1 - p1, q2 - p2, p1 - p2
-    a = np.einsum("...i,...i->...", d1, d1)
-    e = np.einsum("...i,...i->...", d2, d2)
-    f = np.einsum("...i,...i->...", d2, r)
-    c = np.einsum("...i,...i->...", d1, r)
-    b = np.einsum("...i,...i->...", d1, d2)
+    a, e, f, c, b = _dot(d1, d1), _dot(d2, d2), _dot(d2, r), _dot(d1, r), _dot(d1, d2)
     denom = a * e - b * b
     with np.errstate(divide="ignore", invalid="ignore"):
         s = np.where(denom > eps * np.maximum(a * e, eps), np.clip((b * f - c * e) / denom, 0, 1), 0.0)
@@ -864,7 +895,7 @@ def _segment_distance(p1, q1, p2, q2) -> np.ndarray:
         s = np.where((e <= eps) & (a > eps), np.clip(-c / a, 0, 1), s)
         t = np.where(e <= eps, 0.0, t)
     diff = (p1 + d1 * s[..., None]) - (p2 + d2 * t[..., None])
-    return np.sqrt(np.einsum("...i,...i->...", diff, diff))
+    return np.sqrt(_dot(diff, diff))
 
 
 def _runs(mask, bmask, bfrac, per_sample, ba, bb, t_at) -> list[Interval]:
