@@ -374,3 +374,40 @@ def test_ik_path_patent_arm_with_slides_position_only():
     np.testing.assert_allclose(robot.fk(res.q)[:, :3, 3], path[:, :3, 3], atol=1e-9)
     assert robot.within_limits(res.q, tol=0.0).all()
     assert np.abs(np.diff(np.vstack([q_start, res.q]), axis=0)).max() < 0.05
+
+
+def test_round_trip_property_panda():
+    hyp = pytest.importorskip("hypothesis")
+    st = pytest.importorskip("hypothesis.strategies")
+    robot = robokin.load("panda")
+    lim = robot.limits
+
+    # inside the limits by a margin: see test_solution_in_a_corner_of_the_limits
+    @hyp.settings(max_examples=40, deadline=None, derandomize=True)
+    @hyp.given(st.lists(st.floats(0.01, 0.99), min_size=7, max_size=7))
+    def check(u):
+        q = lim[:, 0] + np.asarray(u) * (lim[:, 1] - lim[:, 0])
+        T = robot.fk(q)
+        res = numeric.solve(robot, T, rng=np.random.default_rng(0))
+        assert res.success, res.reason
+        assert_pose_close(robot.fk(res.q), T, 1e-9)
+        assert robot.within_limits(res.q, tol=0.0)
+
+    check()
+
+
+def test_solution_in_a_corner_of_the_limits():
+    # Found by hypothesis: every Panda joint at a limit. The only solution inside the
+    # limits is (near) that corner, whose basin is tiny: the default 200 restarts may
+    # miss it (then the failure is reported), a bigger budget finds it.
+    robot = robokin.load("panda")
+    lim = robot.limits
+    q = lim[:, 0].copy()
+    q[5] = lim[5, 1]
+    T = robot.fk(q)
+    res = numeric.solve(robot, T, max_restarts=5000, rng=np.random.default_rng(0))
+    assert res.success and res.restarts > 50
+    assert_pose_close(robot.fk(res.q), T, 1e-9)
+    assert robot.within_limits(res.q, tol=0.0)
+    short = numeric.solve(robot, T, max_restarts=5, rng=np.random.default_rng(0))
+    assert not short.success and short.error > 1e-3

@@ -16,9 +16,17 @@ gets it: revolute and prismatic joints, reversed axes, dependent joints
 rejecting the others. Joint limits are kept during the iteration: every trial
 point is projected into the limits (2*pi-periodic joints are first shifted by whole
 turns), and joints pressed against a limit by the gradient leave the active set.
-A descent that stalls (a local minimum, or pinned at limits) or runs out of
-iterations restarts from a random seed inside the limits until the target is
-reached or the budget (restarts, wall time) is spent.
+A descent that stalls (the cost has not halved in 6 iterations: a local minimum,
+or pinned at limits) or runs out of iterations restarts from a random seed inside
+the limits (alternately from the central half of each joint range, where descents
+meet limits less often, and from the whole range) until the target is reached or
+the budget (restarts, wall time) is spent. Results are always inside the limits;
+a target that is not reached comes back with ``success=False``, the best
+configuration found and the error it leaves, never an exception.
+
+Convergence means the norm of the selected position rows is at most ``tol`` [m]
+and that of the selected rotation rows at most ``tol_rotation`` [rad] (default
+``tol``), both 1e-9 by default.
 
 The inner loop is compiled (numba, ``cache=True``): see ``_numeric_kernels``.
 
