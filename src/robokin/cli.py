@@ -164,27 +164,25 @@ def fk(
 
 @app.command()
 def demo(
-    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path(
-        "robokin-demo"
-    ),
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("robokin-demo"),
     clearance: Annotated[float, typer.Option(help="Required clearance [mm].")] = 4.0,
-    view: Annotated[
-        bool, typer.Option("--view", help="Open the viewer after.")
+    view: Annotated[bool, typer.Option("--view", help="Open the 3D viewer after.")] = False,
+    force: Annotated[
+        bool, typer.Option("--force", help="Write into a folder holding other files.")
     ] = False,
 ) -> None:
-    """The main job: the AUBO-i5 loads a press (plan, check, report)."""
-    try:
-        from robokin.demo import run_demo
-    except ImportError:
-        _console().print(
-            "robokin demo: coming soon (the press-loading scenario is being built)"
-        )
-        return
-    ok = run_demo(out=out, clearance_mm=clearance, view=view)
-    if not ok:
-        raise DomainFailure(
-            "the plan is not collision-free with the required clearance"
-        )
+    """The main job: the AUBO-i5 loads a press (plan, check, plots, HTML report).
+
+    Exits 0 only when the plan is collision-free with at least the required
+    clearance and inside the joint limits.
+    """
+    from robokin.demo import run_demo
+
+    result = run_demo(out=out, clearance_mm=clearance, view=view, force=force,
+                      console=_console())
+    if not result.ok:
+        raise DomainFailure("the plan is not collision-free with the required clearance "
+                            "(see the report)")
 
 
 def _register_extra_commands() -> None:
