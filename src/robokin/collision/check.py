@@ -209,6 +209,7 @@ def check(
     subdivide: bool = True,
     tolerance: float = 1e-6,
     pair_tolerance: float = 1e-3,
+    pair_rtol: float = 0.01,
 ) -> CollisionReport:
     """Collision and minimum distance of a joint trajectory in a scene.
 
@@ -226,10 +227,12 @@ def check(
         subdivide: Guarantee no collision is missed between samples.
         tolerance: Motion [m] below which subdivision stops (grazing contact
             closer than this between samples counts as clear).
-        pair_tolerance: Each pair's minimum over time is within this [m] of
-            its exact minimum over the samples (it is always a real sampled
-            distance, never below the exact one). The global minimum, and every
-            sample at or below ``clearance``, are exact regardless.
+        pair_tolerance: Each pair's minimum over time is within
+            ``max(pair_tolerance, pair_rtol * distance)`` [m] of its exact minimum
+            over the samples (it is always a real sampled distance, never below
+            the exact one). The global minimum, and the classification of every
+            sample against ``clearance`` and contact, are exact regardless.
+        pair_rtol: Relative part of that tolerance (0.01: 1 %).
 
     Returns:
         A :class:`CollisionReport`.
@@ -243,7 +246,7 @@ def check(
     q, tt = _as_samples(q_samples, robot.n, t)
     problem = _problem_for(robot, scene, self_collision)
     return problem.run(q, tt, float(clearance), subdivide, float(tolerance),
-                       max(float(pair_tolerance), _TIE))
+                       max(float(pair_tolerance), _TIE), max(float(pair_rtol), 0.0))
 
 
 def _problem_for(robot: Robot, scene: Scene, self_collision: bool) -> _Problem:
@@ -513,7 +516,7 @@ class _Problem:
                 Rst[j - 1, s] = total + self.rho[s]
         return Rst
 
-    def motion(self, q: np.ndarray, frames: np.ndarray, sph_w: np.ndarray) -> np.ndarray:
+    def motion(self, q: np.ndarray, frames: np.ndarray) -> np.ndarray:
         """Per interval and pair, the bound on the motion closing the distance, (P, m-1)."""
         m = q.shape[0]
         S, nc, P = len(self.shapes), self.nc, self.P
@@ -522,44 +525,14 @@ class _Problem:
         qc = self.chain.coupling.apply(q)
         dq = np.abs(np.diff(qc, axis=0))  # (m-1, nc)
         Rst = self._static_R(qc)  # (nc, S)
-        # Joint axes in the world at every sample: origin and direction (m, nc, 3).
-        F = frames[:, :nc]  # frame before joint j is frames[j-1] @ pre_j
-        o = (F[..., :3, :3] @ self.pre[:, :3, 3, None])[..., 0] + F[..., :3, 3]
-        z = (F[..., :3, :3] @ self.pre[:, :3, 2, None])[..., 0]
-        # Per shape and joint, the reach from the joint's axis at the start of each
-        # interval, grown by what the joints after it can move within the interval.
-        W = np.zeros((m - 1, S, nc))
-        for s in range(S):
-            k = self.link[s]
-            kk = min(k, nc)
-            if kk == 0:
-                continue
-            sl = slice(self.sph_start[s], self.sph_start[s] + int(np.sum(self.sph_owner == s)))
-            c = sph_w[: m - 1, sl]  # (m-1, ks, 3)
-            r = self.sph_r[sl]
-            rel = c[:, :, None, :] - o[: m - 1, None, :kk, :]
-            along = _dot(rel, z[: m - 1, None, :kk])
-            perp = _dot(rel, rel) - along**2
-            dist = np.sqrt(np.maximum(perp, 0.0))
-            f = (dist + r[None, :, None]).max(axis=1)  # (m-1, kk)
-            moved = dq[:, :kk] * np.where(self.prismatic[:kk], 1.0, Rst[:kk, s])
-            after = np.cumsum(moved[:, ::-1], axis=1)[:, ::-1] - moved  # sum over l > j
-            R = np.minimum(Rst[:kk, s][None, :], f + after)
-            W[:, s, :kk] = np.where(self.prismatic[:kk], 1.0, R)
-            if self.spins[s]:
-                W[:, s, kk - 1] = 0.0  # symmetric about its own joint's axis
-        Ms = np.zeros((P, m - 1))
-        op = self.obj_pairs
-        if len(op):
-            # world motion of robot shape
-            Mworld = np.einsum("isj,ij->si", W, dq)  # (S, m-1)
-            Ms[op] = Mworld[self.pa[op]]
-        for p in self.self_pairs:
-            a, b = self.link[self.pa[p]], self.link[self.pb[p]]
-            lo, hi = min(a, b), min(max(a, b), nc)
-            s2 = self.pb[p] if self.link[self.pb[p]] >= self.link[self.pa[p]] else self.pa[p]
-            if hi > lo:
-                Ms[p] = np.einsum("ij,ij->i", W[:, s2, lo:hi], dq[:, lo:hi])
+        from robokin.collision._kernels import motion_bounds
+
+        Ms = np.empty((P, m - 1))
+        counts = np.bincount(self.sph_owner, minlength=S).astype(np.int64)
+        motion_bounds(np.ascontiguousarray(frames), np.ascontiguousarray(self.pre), self.link,
+                      self.sph_c, self.sph_r, self.sph_start.astype(np.int64), counts,
+                      np.ascontiguousarray(Rst), self.prismatic, self.spins,
+                      np.ascontiguousarray(dq), self.pa, self.pb, self.is_self, Ms)
         return Ms
 
     # ---------------------------------------------------------------- bounds
@@ -587,27 +560,13 @@ class _Problem:
     # -------------------------------------------------------------- analytic
     def analytic_distances(self, frames: np.ndarray, pairs: np.ndarray) -> np.ndarray:
         """Closed-form distances of capsule/sphere pairs at every sample, (len(pairs), m)."""
-        a = self.pa[pairs]
-        Fa = frames[:, self.link[a]]  # (m, k, 4, 4)
-        sa = (Fa[:, :, None, :3, :3] @ self.seg_local[a][None, :, :, :, None])[..., 0]
-        sa += Fa[:, :, None, :3, 3]
-        ra = self.seg_r[a]
-        b = self.pb[pairs]
-        selfp = self.is_self[pairs]
-        sb = np.empty_like(sa)
-        rb = np.empty(len(pairs))
-        if selfp.any():
-            bs = b[selfp]
-            Fb = frames[:, self.link[bs]]
-            sb[:, selfp] = ((Fb[:, :, None, :3, :3] @ self.seg_local[bs][None, :, :, :, None])[..., 0]
-                            + Fb[:, :, None, :3, 3])
-            rb[selfp] = self.seg_r[bs]
-        if (~selfp).any():
-            bo = b[~selfp]
-            sb[:, ~selfp] = self.ob_seg[bo][None]
-            rb[~selfp] = self.ob_seg_r[bo]
-        d = _segment_distance(sa[:, :, 0], sa[:, :, 1], sb[:, :, 0], sb[:, :, 1])
-        return (d - ra - rb).T
+        from robokin.collision._kernels import capsule_distances
+
+        out = np.empty((len(pairs), frames.shape[0]))
+        capsule_distances(np.ascontiguousarray(frames), self.link, self.seg_local, self.seg_r,
+                          self.ob_seg, self.ob_seg_r, self.pa, self.pb, self.is_self,
+                          np.ascontiguousarray(pairs), out)
+        return out
 
     # ----------------------------------------------------------------- exact
     def _T3(self, frame: np.ndarray, s: int):
@@ -648,7 +607,7 @@ class _Problem:
 
         return link_frames(self.chain, q)
 
-    def run(self, q, t, clearance, subdivide, tol, pair_tol) -> CollisionReport:
+    def run(self, q, t, clearance, subdivide, tol, pair_tol, pair_rtol) -> CollisionReport:
         m = q.shape[0]
         times = np.arange(m, dtype=float) if t is None else t
         P = self.P
@@ -656,9 +615,8 @@ class _Problem:
         if P == 0:
             return CollisionReport(math.inf, False, [], [], [], None, [], clearance, times,
                                    _problem=self, _q=q)
-        sph_w = self.sphere_world(frames)
         LB = self.lower_bounds(frames)
-        Ms = self.motion(q, frames, sph_w)  # (P, m-1)
+        Ms = self.motion(q, frames)  # (P, m-1)
         C = np.zeros((P, m))
         np.cumsum(Ms, axis=1, out=C[:, 1:])
         D = np.full((P, m), np.nan)
@@ -686,14 +644,11 @@ class _Problem:
                 LB[p, i] = v
                 done[p, i] = True
 
+        from robokin.collision._kernels import propagate_bounds
+
         def propagate(rows: np.ndarray) -> None:
-            if len(rows) == 0 or m < 2:
-                return
-            Lr, Cr = LB[rows], C[rows]
-            known = np.where(done[rows] | hulled[rows], Lr, -np.inf)
-            fwd = np.maximum.accumulate(known + Cr, axis=1) - Cr
-            bwd = (np.maximum.accumulate((known - Cr)[:, ::-1], axis=1)[:, ::-1]) + Cr
-            LB[rows] = np.maximum(Lr, np.maximum(fwd, bwd))
+            if len(rows) and m >= 2:
+                propagate_bounds(LB, done | hulled, C, np.ascontiguousarray(rows, dtype=np.int64))
 
         # 1. Exact queries where they decide something: a sample whose bound does
         #    not clear the threshold (to classify it), or lies below its pair's best
@@ -705,27 +660,38 @@ class _Problem:
         cols = np.arange(m)
         stride = 0  # first round: only each pair's lowest bound
         final = False
+        best = np.where(done, D, np.inf).min(axis=1)
+        active = np.arange(P)
         while True:
-            best = np.where(done, D, np.inf).min(axis=1)
             if final:
-                need = ~done & (LB < best.min() - _TIE)
+                g = best.min()
+                cand = np.flatnonzero(np.where(done, np.inf, LB).min(axis=1) < g - _TIE)
+                need = ~done[cand] & (LB[cand] < g - _TIE)
             else:
-                need = ~done & ((LB <= clearance) | (LB < best[:, None] - pair_tol))
-            rows = np.flatnonzero(need.any(axis=1))
+                cand = active
+                Lc = LB[cand]
+                bc = best[cand]
+                rel = pair_rtol * np.abs(np.where(np.isfinite(bc), bc, 0.0))
+                slack = np.maximum(pair_tol, rel)[:, None]
+                need = ~done[cand] & ((Lc <= clearance) | (Lc < best[cand, None] - slack))
+            keep = need.any(axis=1)
+            rows, need = cand[keep], need[keep]
+            if not final:
+                active = rows
             if not len(rows):
                 if final or pair_tol <= _TIE:
                     break
                 final = True
                 continue
-            sub = need[rows]
-            pick = np.zeros_like(sub)
+            pick = np.zeros_like(need)
             if stride:
-                pick |= sub & ((cols % stride) == 0)[None, :]
-            work = np.where(sub, LB[rows], np.inf)
+                pick |= need & ((cols % stride) == 0)[None, :]
+            work = np.where(need, LB[rows], np.inf)
             pick[np.arange(len(rows)), np.argmin(work, axis=1)] = True
             ps, idx = np.nonzero(pick)
             evaluate(rows[ps], idx, force_exact=False)
             propagate(rows)
+            best[rows] = np.where(done[rows], D[rows], np.inf).min(axis=1)
             stride = max(m // 8, 1) if stride == 0 else max(stride // 2, 1)
         # 2. Subdivision: intervals whose ends do not clear the motion between.
         between: dict[tuple[int, int], tuple[float, float]] = {}
@@ -865,37 +831,6 @@ class _Problem:
             for p in plist:
                 out[i] = min(out[i], self.exact(p, frames[i]))
         return out
-
-
-def _dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Dot product over the last axis (of length 3), broadcasting."""
-    return x[..., 0] * y[..., 0] + x[..., 1] * y[..., 1] + x[..., 2] * y[..., 2]
-
-
-def _segment_distance(p1, q1, p2, q2) -> np.ndarray:
-    """Distance between segments [p1, q1] and [p2, q2], (..., 3) -> (...).
-
-    Closest points of two segments with clamping [Ericson, Real-Time Collision
-    Detection, 2005, sec. 5.1.9], vectorised, degenerate (point) segments included.
-    """
-    eps = 1e-18
-    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
-    a, e, f, c, b = _dot(d1, d1), _dot(d2, d2), _dot(d2, r), _dot(d1, r), _dot(d1, d2)
-    denom = a * e - b * b
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = np.where(denom > eps * np.maximum(a * e, eps), np.clip((b * f - c * e) / denom, 0, 1), 0.0)
-        t = np.where(e > eps, (b * s + f) / e, 0.0)
-        s = np.where(t < 0, np.where(a > eps, np.clip(-c / a, 0, 1), 0.0), s)
-        s = np.where(t > 1, np.where(a > eps, np.clip((b - c) / a, 0, 1), 0.0), s)
-        t = np.clip(t, 0, 1)
-        # first segment a point: s = 0, t from projection
-        t = np.where(a <= eps, np.where(e > eps, np.clip(f / e, 0, 1), 0.0), t)
-        s = np.where(a <= eps, 0.0, s)
-        # second segment a point: t = 0
-        s = np.where((e <= eps) & (a > eps), np.clip(-c / a, 0, 1), s)
-        t = np.where(e <= eps, 0.0, t)
-    diff = (p1 + d1 * s[..., None]) - (p2 + d2 * t[..., None])
-    return np.sqrt(_dot(diff, diff))
 
 
 def _runs(mask, bmask, bfrac, per_sample, ba, bb, t_at) -> list[Interval]:
