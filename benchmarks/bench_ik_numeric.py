@@ -76,23 +76,56 @@ def score(robot, q, times, targets, tol):
     }
 
 
+def _rpy(P):
+    """Roll, pitch, yaw (ikpy's convention: R = Rz(yaw) Ry(pitch) Rx(roll))."""
+    import warnings
+
+    from scipy.spatial.transform import Rotation
+
+    with warnings.catch_warnings():  # gimbal lock is exact here (third angle 0)
+        warnings.simplefilter("ignore", UserWarning)
+        return Rotation.from_matrix(P[:3, :3]).as_euler("xyz")
+
+
 def ikpy_chain(robot):
     from ikpy.chain import Chain
     from ikpy.link import OriginLink, URDFLink
-    from scipy.spatial.transform import Rotation
 
     placements, last = _constants(robot)
     links = [OriginLink()]
     for P, j in zip(placements, robot.chain.joints, strict=True):
-        rpy = Rotation.from_matrix(P[:3, :3]).as_euler("xyz")
+        rpy = _rpy(P)
         axis = [0.0, 0.0, j.sign]
         kw = {"rotation": axis} if j.kind == "revolute" else {
             "translation": axis, "joint_type": "prismatic"}
         links.append(URDFLink(j.name, P[:3, 3], rpy, bounds=tuple(j.limits), **kw))
-    rpy = Rotation.from_matrix(last[:3, :3]).as_euler("xyz")
+    rpy = _rpy(last)
     links.append(URDFLink("tool", last[:3, 3], rpy, joint_type="fixed"))
     mask = [False] + [True] * robot.n + [False]
     return Chain(links, active_links_mask=mask)
+
+
+def check_models(robot, rng, m=20):
+    """The peers' FK must match robokin's to 1e-9 before anything is timed."""
+    import pinocchio as pin
+
+    box = np.clip(robot.limits, -np.pi, np.pi)
+    Q = rng.uniform(box[:, 0], box[:, 1], (m, robot.n))
+    ours = robot.fk(Q)
+    ets = rtb_ets(robot)
+    model, data, fid = pinocchio_model(robot)
+    chain = ikpy_chain(robot)
+    worst = {"rtb": 0.0, "pinocchio": 0.0, "ikpy": 0.0}
+    for q, T in zip(Q, ours, strict=True):
+        worst["rtb"] = max(worst["rtb"], np.abs(ets.fkine(q).A - T).max())
+        pin.forwardKinematics(model, data, q)
+        Tp = pin.updateFramePlacement(model, data, fid).homogeneous
+        worst["pinocchio"] = max(worst["pinocchio"], np.abs(Tp - T).max())
+        Ti = chain.forward_kinematics(np.concatenate([[0.0], q, [0.0]]))
+        worst["ikpy"] = max(worst["ikpy"], np.abs(Ti - T).max())
+    bad = {k: v for k, v in worst.items() if v > 1e-9}
+    if bad:
+        raise SystemExit(f"{robot.name}: peer FK disagrees with robokin: {bad}")
 
 
 def solvers(robot, tol):
@@ -175,6 +208,7 @@ def main() -> None:
         targets = robot.fk(Q)
         fixed = np.tile(numeric._chain_data(robot).mid, (args.n, 1))
         rand = rng.uniform(box[:, 0], box[:, 1], (args.n, robot.n))
+        check_models(robot, rng)
         fns = solvers(robot, args.tol)
         # warm the compiled kernels and the peers
         for f in fns.values():
