@@ -20,7 +20,8 @@ Outputs in ``--out`` (default ``./robokin-demo``): ``trajectory.csv`` (time and
 joints), ``waypoints.csv`` (controller waypoints in degrees) and
 ``program.script`` (a URScript ``servoj`` listing), ``joints.png``,
 ``tool_path.png`` (3D with projections), ``press_views.png`` (the tool path inside
-the press, side and top views), ``distance.png``, ``animation.html`` (the
+the press, side and top views), ``distance.csv`` and ``distance.png`` (the closest
+body pairs over time), ``animation.html`` (the
 motion, self-contained), ``report.html`` (one page with all of it) and
 ``summary.json``. The command exits 0 only when the plan is collision-free with at
 least the required clearance.
@@ -75,8 +76,9 @@ class DemoResult:
     report: Any = None
 
 
-def plan_press_loading(robot: Any, scene: Any, *, dt: float = DT,
-                       progress: Any = None) -> tuple[Any, list[dict[str, Any]]]:
+def plan_press_loading(
+    robot: Any, scene: Any, *, dt: float = DT, progress: Any = None
+) -> tuple[Any, list[dict[str, Any]]]:
     """Plan the press-loading motion.
 
     Args:
@@ -96,8 +98,9 @@ def plan_press_loading(robot: Any, scene: Any, *, dt: float = DT,
     from robokin.exceptions import UnreachableError
 
     q0 = np.zeros(robot.n)
-    path = trajectory.PathBuilder(robot, q0, dt=dt, v_max=V_MAX, a_max=A_MAX,
-                                  ik="analytic")
+    path = trajectory.PathBuilder(
+        robot, q0, dt=dt, v_max=V_MAX, a_max=A_MAX, ik="analytic"
+    )
     via: list[dict[str, Any]] = []
     for label, kind, pose, duration in PLAN:
         if kind == "dwell":
@@ -106,8 +109,14 @@ def plan_press_loading(robot: Any, scene: Any, *, dt: float = DT,
         T = scene.tcp_pose(pose)
         if kind == "line":
             path.line(T, duration, label=label)
-            via.append({"label": label, "pose": pose, "kind": "line",
-                        "q_deg": np.degrees(path.q_end).round(4).tolist()})
+            via.append(
+                {
+                    "label": label,
+                    "pose": pose,
+                    "kind": "line",
+                    "q_deg": np.degrees(path.q_end).round(4).tolist(),
+                }
+            )
             continue
         sols = robot.ik(T, q_near=path.q_end).within_limits()
         hint = scene.pose_joints.get(pose, path.q_end)
@@ -117,9 +126,16 @@ def plan_press_loading(robot: Any, scene: Any, *, dt: float = DT,
             raise UnreachableError(f"via point '{label}' ({pose}): {exc}") from None
         k = int(np.argmin(sols.distance(q)))
         branch = {name: int(v[k]) for name, v in sols.branches.items()}
-        via.append({"label": label, "pose": pose, "kind": "joint",
-                    "solutions": int(sols.count), "branch": branch,
-                    "q_deg": np.degrees(q).round(4).tolist()})
+        via.append(
+            {
+                "label": label,
+                "pose": pose,
+                "kind": "joint",
+                "solutions": int(sols.count),
+                "branch": branch,
+                "q_deg": np.degrees(q).round(4).tolist(),
+            }
+        )
         path.joint(q, duration, label=label)
     traj = path.build(progress=progress)
     return traj, via
@@ -128,7 +144,12 @@ def plan_press_loading(robot: Any, scene: Any, *, dt: float = DT,
 def _check_out_dir(out: Path, force: bool) -> None:
     if out.exists() and not out.is_dir():
         raise InputError("out", f"{out} exists and is not a folder")
-    if out.is_dir() and any(out.iterdir()) and not (out / MARKER).exists() and not force:
+    if (
+        out.is_dir()
+        and any(out.iterdir())
+        and not (out / MARKER).exists()
+        and not force
+    ):
         raise InputError(
             "out",
             f"{out} holds files the demo did not write; choose another --out "
@@ -141,22 +162,45 @@ def _png_data(path: Path) -> str:
     return base64.b64encode(path.read_bytes()).decode("ascii")
 
 
-def _plot_distance(report: Any, traj: Any, clearance: float, path: Path) -> Path:
+def _closest_pair_distances(report: Any, k: int = 6) -> dict[str, np.ndarray]:
+    """Exact distance at every sample [m] of the ``k`` closest body pairs."""
+    out = {}
+    for pair in report.pairs[:k]:
+        out[f"{pair.body_a}-{pair.body_b}"] = report.distances(pair.body_a, pair.body_b)
+    return out
+
+
+def _write_distance_csv(traj: Any, dist: dict[str, np.ndarray], path: Path) -> Path:
+    """Time, the closest pairs' distances and their minimum, in mm."""
+    from robokin.trajectory.io import write_text_atomic
+
+    names = list(dist)
+    D = np.column_stack([dist[n] for n in names]) * 1000.0
+    table = np.column_stack([traj.t, D, D.min(axis=1)])
+    header = ",".join(["t [s]"] + [f"{n} [mm]" for n in names] + ["min [mm]"])
+    lines = [header] + [",".join(f"{v:.6f}" for v in row) for row in table]
+    return write_text_atomic(path, "\n".join(lines) + "\n", overwrite=True)
+
+
+def _plot_distance(
+    report: Any, traj: Any, dist: dict[str, np.ndarray], clearance: float, path: Path
+) -> Path:
     """Distance over time of the closest body pairs, with the clearance marked."""
     from robokin.viz.plots import _figure, save_figure
 
     fig = _figure((9.0, 4.5))
     ax = fig.add_subplot(1, 1, 1)
-    shown = 0
-    for pair in report.pairs:
-        if pair.kind != "object" or shown >= 5:
-            continue
-        d = report.distances(pair.body_a, pair.body_b)
-        ax.plot(traj.t, d * 1000.0, lw=1.2,
-                label=f"{pair.body_a} - {pair.body_b} (min {pair.distance * 1000:.1f} mm)")
-        shown += 1
-    ax.axhline(clearance * 1000.0, color="red", ls="--", lw=1.0,
-               label=f"required clearance {clearance * 1000:.0f} mm")
+    for name, d in dist.items():
+        ax.plot(
+            traj.t, d * 1000.0, lw=1.2, label=f"{name} (min {d.min() * 1000:.1f} mm)"
+        )
+    ax.axhline(
+        clearance * 1000.0,
+        color="red",
+        ls="--",
+        lw=1.0,
+        label=f"required clearance {clearance * 1000:.0f} mm",
+    )
     c = report.closest
     if c is not None:
         ax.plot([c.t], [c.distance * 1000.0], "v", color="red", ms=8)
@@ -187,12 +231,27 @@ def _plot_press_views(traj: Any, scene: Any, report: Any, path: Path) -> Path:
             c = obj.pose[:3, 3] * 1000.0
             s = np.abs(obj.pose[:3, :3]) @ (np.asarray(box) * 1000.0)
             press = obj.name in ("lower_die", "upper_die")
-            ax.add_patch(Rectangle((c[i] - s[i] / 2, c[j] - s[j] / 2), s[i], s[j],
-                                   fc="tab:orange" if press else "0.85",
-                                   ec="0.3", alpha=0.6 if press else 0.35, lw=0.8))
+            ax.add_patch(
+                Rectangle(
+                    (c[i] - s[i] / 2, c[j] - s[j] / 2),
+                    s[i],
+                    s[j],
+                    fc="tab:orange" if press else "0.85",
+                    ec="0.3",
+                    alpha=0.6 if press else 0.35,
+                    lw=0.8,
+                )
+            )
             if press or k == 0:
-                ax.text(c[i], c[j], obj.name, fontsize=6, ha="center", va="center",
-                        clip_on=True)
+                ax.text(
+                    c[i],
+                    c[j],
+                    obj.name,
+                    fontsize=6,
+                    ha="center",
+                    va="center",
+                    clip_on=True,
+                )
         ax.plot(p[:, i], p[:, j], color="tab:blue", lw=1.4, label="TCP path")
         for tv in traj.via_times:
             m = min(int(round(tv / traj.dt)), len(p) - 1) if traj.dt else 0
@@ -200,8 +259,13 @@ def _plot_press_views(traj: Any, scene: Any, report: Any, path: Path) -> Path:
         if report is not None and report.closest is not None:
             cpt = report.closest
             a, b = cpt.point_a * 1000.0, cpt.point_b * 1000.0
-            ax.plot([a[i], b[i]], [a[j], b[j]], color="red", lw=2,
-                    label=f"closest: {cpt.distance * 1000:.1f} mm at {cpt.t:.2f} s")
+            ax.plot(
+                [a[i], b[i]],
+                [a[j], b[j]],
+                color="red",
+                lw=2,
+                label=f"closest: {cpt.distance * 1000:.1f} mm at {cpt.t:.2f} s",
+            )
         ax.set_xlim(300, 900)
         ax.set_ylim((200, 800) if j == 2 else (-450, 450))
         ax.set_aspect("equal")
@@ -214,8 +278,15 @@ def _plot_press_views(traj: Any, scene: Any, report: Any, path: Path) -> Path:
     return save_figure(fig, path, overwrite=True)
 
 
-def _summary(robot: Any, traj: Any, report: Any, limits: Any, via: list, clearance: float,
-             timings: dict[str, float]) -> dict[str, Any]:
+def _summary(
+    robot: Any,
+    traj: Any,
+    report: Any,
+    limits: Any,
+    via: list,
+    clearance: float,
+    timings: dict[str, float],
+) -> dict[str, Any]:
     qd = np.abs(traj.qd)
     qdd = np.abs(traj.qdd)
     c = report.closest
@@ -231,7 +302,11 @@ def _summary(robot: Any, traj: Any, report: Any, limits: Any, via: list, clearan
             "point_robot_mm": (c.point_a * 1000.0).round(2).tolist(),
             "point_scene_mm": (c.point_b * 1000.0).round(2).tolist(),
         }
-    ok = (not report.collides) and report.min_distance >= clearance and not limits.violations
+    ok = (
+        (not report.collides)
+        and report.min_distance >= clearance
+        and not limits.violations
+    )
     return {
         "robot": robot.name,
         "ok": bool(ok),
@@ -249,9 +324,14 @@ def _summary(robot: Any, traj: Any, report: Any, limits: Any, via: list, clearan
         "min_clearance_mm": round(float(report.min_distance) * 1000.0, 3),
         "closest": closest,
         "collisions": [
-            {"first_sample": iv.first_index, "last_sample": iv.last_index,
-             "robot_body": iv.body_a, "scene_body": iv.body_b,
-             "t_start_s": round(float(iv.t_start), 3), "t_end_s": round(float(iv.t_end), 3)}
+            {
+                "first_sample": iv.first_index,
+                "last_sample": iv.last_index,
+                "robot_body": iv.body_a,
+                "scene_body": iv.body_b,
+                "t_start_s": round(float(iv.t_start), 3),
+                "t_end_s": round(float(iv.t_end), 3),
+            }
             for iv in report.intervals
         ],
         "exact_distance_queries": int(report.queries),
@@ -262,39 +342,60 @@ def _summary(robot: Any, traj: Any, report: Any, limits: Any, via: list, clearan
 def _report_html(summary: dict[str, Any], images: dict[str, Path]) -> str:
     s = summary
     c = s["closest"] or {}
-    verdict = ("PASS: collision-free with the required clearance" if s["ok"]
-               else "FAIL: the plan collides, violates a limit or is closer than required")
+    verdict = (
+        "PASS: collision-free with the required clearance"
+        if s["ok"]
+        else "FAIL: the plan collides, violates a limit or is closer than required"
+    )
     colour = "#1a7f37" if s["ok"] else "#cf222e"
     rows = [
         ("duration", f"{s['duration_s']:.2f} s"),
         ("samples", f"{s['samples']} at {s['dt_s'] * 1000:.0f} ms"),
-        ("peak joint speed", ", ".join(f"{v:.1f}" for v in s["peak_joint_speed_deg_s"])
-         + f" deg/s (limit {s['joint_speed_limit_deg_s']:.0f})"),
-        ("peak joint acceleration",
-         ", ".join(f"{v:.1f}" for v in s["peak_joint_acceleration_deg_s2"])
-         + f" deg/s² (cap {s['joint_acceleration_limit_deg_s2']:.0f})"),
+        (
+            "peak joint speed",
+            ", ".join(f"{v:.1f}" for v in s["peak_joint_speed_deg_s"])
+            + f" deg/s (limit {s['joint_speed_limit_deg_s']:.0f})",
+        ),
+        (
+            "peak joint acceleration",
+            ", ".join(f"{v:.1f}" for v in s["peak_joint_acceleration_deg_s2"])
+            + f" deg/s² (cap {s['joint_acceleration_limit_deg_s2']:.0f})",
+        ),
         ("joint limit violations", str(len(s["limit_violations"])) or "none"),
-        ("minimum clearance",
-         f"{s['min_clearance_mm']:.1f} mm between {c.get('robot_body', '?')} and "
-         f"{c.get('scene_body', '?')} at t = {c.get('time_s', float('nan')):.2f} s "
-         f"(sample {c.get('sample', '?')}, robot point {c.get('point_robot_mm')} mm)"),
+        (
+            "minimum clearance",
+            f"{s['min_clearance_mm']:.1f} mm between {c.get('robot_body', '?')} and "
+            f"{c.get('scene_body', '?')} at t = {c.get('time_s', float('nan')):.2f} s "
+            f"(sample {c.get('sample', '?')}, robot point {c.get('point_robot_mm')} mm)",
+        ),
         ("required clearance", f"{s['required_clearance_mm']:.1f} mm"),
-        ("collisions", "none" if not s["collisions"] else
-         "; ".join(f"{x['robot_body']}–{x['scene_body']} {x['t_start_s']:.2f}–"
-                   f"{x['t_end_s']:.2f} s" for x in s["collisions"])),
+        (
+            "collisions",
+            "none"
+            if not s["collisions"]
+            else "; ".join(
+                f"{x['robot_body']}–{x['scene_body']} {x['t_start_s']:.2f}–"
+                f"{x['t_end_s']:.2f} s"
+                for x in s["collisions"]
+            ),
+        ),
     ]
-    table = "\n".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>"
-                      for k, v in rows)
+    table = "\n".join(
+        f"<tr><th>{html.escape(k)}</th><td>{html.escape(str(v))}</td></tr>"
+        for k, v in rows
+    )
     vias = "\n".join(
         f"<tr><td>{html.escape(v['label'])}</td><td>{v['kind']}</td>"
         f"<td>{v.get('solutions', '')}</td>"
         f"<td>{html.escape(' '.join(f'{k}={b:+d}' for k, b in v.get('branch', {}).items()))}</td>"
         f"<td>{' '.join(f'{a:.2f}' for a in v['q_deg'])}</td></tr>"
-        for v in s["via_points"])
+        for v in s["via_points"]
+    )
     figs = "\n".join(
         f"<figure><img alt='{html.escape(k)}' src='data:image/png;base64,{_png_data(p)}'>"
         f"<figcaption>{html.escape(k)}</figcaption></figure>"
-        for k, p in images.items())
+        for k, p in images.items()
+    )
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <title>robokin demo: AUBO-i5 loads a press</title>
@@ -324,15 +425,22 @@ against the press cell. The motion plays in <a href="animation.html">animation.h
 {figs}
 <p style="font-size:0.8em;color:#57606a">Files: trajectory.csv (time and joints),
 waypoints.csv (controller waypoints, degrees), program.script (URScript servoj),
-summary.json. Joint speed limit: AUBO-i5 published 150 deg/s; the acceleration cap
+distance.csv (closest body pairs over time, mm), summary.json. The workpiece rides
+between the fingers inside the gripper's envelope and is not a separate body. Joint speed limit: AUBO-i5 published 150 deg/s; the acceleration cap
 is the demo's choice.</p>
 </body></html>
 """
 
 
-def run_demo(out: str | Path = "robokin-demo", *, clearance_mm: float = 4.0,
-             view: bool = False, force: bool = False, console: Any = None,
-             html_animation: bool = True) -> DemoResult:
+def run_demo(
+    out: str | Path = "robokin-demo",
+    *,
+    clearance_mm: float = 4.0,
+    view: bool = False,
+    force: bool = False,
+    console: Any = None,
+    html_animation: bool = True,
+) -> DemoResult:
     """Run the press-loading demo end to end and write its outputs.
 
     Args:
@@ -357,9 +465,14 @@ def run_demo(out: str | Path = "robokin-demo", *, clearance_mm: float = 4.0,
     from robokin.trajectory import io
     from robokin.viz import plots
 
-    if not (isinstance(clearance_mm, int | float) and math.isfinite(clearance_mm)
-            and clearance_mm >= 0):
-        raise InputError("clearance", f"expected a distance >= 0 [mm], got {clearance_mm!r}")
+    if not (
+        isinstance(clearance_mm, int | float)
+        and math.isfinite(clearance_mm)
+        and clearance_mm >= 0
+    ):
+        raise InputError(
+            "clearance", f"expected a distance >= 0 [mm], got {clearance_mm!r}"
+        )
     clearance = clearance_mm / 1000.0
     out = Path(out)
     _check_out_dir(out, force)
@@ -369,98 +482,185 @@ def run_demo(out: str | Path = "robokin-demo", *, clearance_mm: float = 4.0,
     t_start = time.perf_counter()
 
     scene = collision.Scene.load(collision.scene_path("press"))
-    robot = scene.attach(robokin.load("aubo_i5"))
-    columns = (TextColumn("{task.description:<28}"), BarColumn(), TextColumn(
-        "{task.completed}/{task.total}"), TimeElapsedColumn())
+    bare = robokin.load("aubo_i5")
+    robot = scene.attach(bare)  # base placement, gripper TCP and gripper shapes
+    columns = (
+        TextColumn("{task.description:<28}"),
+        BarColumn(),
+        TextColumn("{task.completed}/{task.total}"),
+        TimeElapsedColumn(),
+    )
     with Progress(*columns, console=con, transient=False) as bar:
         t = time.perf_counter()
         task = bar.add_task("planning the motion", total=len(PLAN))
         traj, via = plan_press_loading(
-            robot, scene, progress=lambda done, total: bar.update(task, completed=done))
+            robot, scene, progress=lambda done, total: bar.update(task, completed=done)
+        )
         timings["plan"] = time.perf_counter() - t
 
         t = time.perf_counter()
         task = bar.add_task("checking limits and clearance", total=2)
         limits = traj.check_limits(robot, velocity=V_MAX, acceleration=A_MAX)
         bar.update(task, advance=1)
-        report = collision.check(robot, scene, traj, clearance=clearance)
+        report = collision.check(
+            bare, scene, traj, clearance=clearance
+        )  # attaches itself
         bar.update(task, advance=1)
         timings["check"] = time.perf_counter() - t
 
         t = time.perf_counter()
-        outputs = ["trajectory.csv", "waypoints.csv", "program.script", "joints.png",
-                   "tool_path.png", "press_views.png", "distance.png", "animation.html",
-                   "report.html"]
+        outputs = [
+            "trajectory.csv",
+            "waypoints.csv",
+            "program.script",
+            "joints.png",
+            "tool_path.png",
+            "press_views.png",
+            "distance.csv",
+            "distance.png",
+            "animation.html",
+            "report.html",
+        ]
         task = bar.add_task("writing the outputs", total=len(outputs))
 
         def done(name: str, path: Path) -> None:
             files[name] = path
             bar.update(task, advance=1)
 
-        done("trajectory.csv", io.write_csv(traj, out / "trajectory.csv", precision=9,
-                                            overwrite=True))
+        done(
+            "trajectory.csv",
+            io.write_csv(traj, out / "trajectory.csv", precision=9, overwrite=True),
+        )
         from robokin.trajectory import Trajectory
 
-        idx = np.unique(np.clip(np.rint((traj.via_times - traj.t[0]) / DT).astype(int), 0,
-                                len(traj.t) - 1))
-        waypoints = Trajectory(traj.t[idx], traj.q[idx], traj.qd[idx], traj.qdd[idx],
-                               joint_names=traj.joint_names, is_revolute=traj.is_revolute)
+        idx = np.unique(
+            np.clip(
+                np.rint((traj.via_times - traj.t[0]) / DT).astype(int),
+                0,
+                len(traj.t) - 1,
+            )
+        )
+        waypoints = Trajectory(
+            traj.t[idx],
+            traj.q[idx],
+            traj.qd[idx],
+            traj.qdd[idx],
+            joint_names=traj.joint_names,
+            is_revolute=traj.is_revolute,
+        )
         deg = io.ControllerProfile(name="aubo_i5 (degrees)", angle_unit="deg")
-        done("waypoints.csv", io.write_csv(waypoints, out / "waypoints.csv",
-                                           profile=deg, precision=6, overwrite=True))
-        done("program.script", io.write_ur_script(traj, out / "program.script",
-                                                  overwrite=True, program="press_loading"))
-        plots.plot_joints(traj, path=out / "joints.png", overwrite=True,
-                          title="AUBO-i5 press loading: joints")
+        done(
+            "waypoints.csv",
+            io.write_csv(
+                waypoints,
+                out / "waypoints.csv",
+                profile=deg,
+                precision=10,
+                overwrite=True,
+            ),
+        )
+        done(
+            "program.script",
+            io.write_ur_script(
+                traj, out / "program.script", overwrite=True, program="press_loading"
+            ),
+        )
+        plots.plot_joints(
+            traj,
+            path=out / "joints.png",
+            overwrite=True,
+            title="AUBO-i5 press loading: joints",
+        )
         done("joints.png", out / "joints.png")
-        plots.plot_tool_path(traj, robot, path=out / "tool_path.png", overwrite=True,
-                             title="tool path with projections")
+        plots.plot_tool_path(
+            traj,
+            robot,
+            path=out / "tool_path.png",
+            overwrite=True,
+            title="tool path with projections",
+        )
         done("tool_path.png", out / "tool_path.png")
-        done("press_views.png", _plot_press_views(traj, scene, report,
-                                                  out / "press_views.png"))
-        done("distance.png", _plot_distance(report, traj, clearance, out / "distance.png"))
+        done(
+            "press_views.png",
+            _plot_press_views(traj, scene, report, out / "press_views.png"),
+        )
+        dist = _closest_pair_distances(report)
+        done("distance.csv", _write_distance_csv(traj, dist, out / "distance.csv"))
+        done(
+            "distance.png",
+            _plot_distance(report, traj, dist, clearance, out / "distance.png"),
+        )
         if html_animation:
             from robokin.viz.html import write_html
 
-            done("animation.html", write_html(out / "animation.html", robot, traj,
-                                              scene=scene, report=report,
-                                              title="AUBO-i5 loads a press"))
+            done(
+                "animation.html",
+                write_html(
+                    out / "animation.html",
+                    robot,
+                    traj,
+                    scene=scene,
+                    report=report,
+                    title="AUBO-i5 loads a press",
+                ),
+            )
         else:
             bar.update(task, advance=1)
         timings["write"] = time.perf_counter() - t
         timings["total"] = time.perf_counter() - t_start
         summary = _summary(robot, traj, report, limits, via, clearance, timings)
-        images = {k: files[k] for k in ("joints.png", "press_views.png", "distance.png",
-                                        "tool_path.png")}
+        images = {
+            k: files[k]
+            for k in ("joints.png", "press_views.png", "distance.png", "tool_path.png")
+        }
         report_path = out / "report.html"
         io.write_text_atomic(report_path, _report_html(summary, images), overwrite=True)
         done("report.html", report_path)
-    io.write_text_atomic(out / MARKER, json.dumps(summary, indent=2) + "\n", overwrite=True)
+    io.write_text_atomic(
+        out / MARKER, json.dumps(summary, indent=2) + "\n", overwrite=True
+    )
     files["summary.json"] = out / MARKER
 
     table = Table(title="robokin demo: AUBO-i5 loads a press", show_header=False)
     table.add_column(style="bold")
     table.add_column()
     c = summary["closest"] or {}
-    table.add_row("duration", f"{summary['duration_s']:.2f} s, {summary['samples']} samples "
-                              f"at {DT * 1000:.0f} ms")
-    table.add_row("peak joint speed", "  ".join(
-        f"{v:.1f}" for v in summary["peak_joint_speed_deg_s"]) + " deg/s")
-    table.add_row("peak joint acceleration", "  ".join(
-        f"{v:.1f}" for v in summary["peak_joint_acceleration_deg_s2"]) + " deg/s²")
+    table.add_row(
+        "duration",
+        f"{summary['duration_s']:.2f} s, {summary['samples']} samples "
+        f"at {DT * 1000:.0f} ms",
+    )
+    table.add_row(
+        "peak joint speed",
+        "  ".join(f"{v:.1f}" for v in summary["peak_joint_speed_deg_s"]) + " deg/s",
+    )
+    table.add_row(
+        "peak joint acceleration",
+        "  ".join(f"{v:.1f}" for v in summary["peak_joint_acceleration_deg_s2"])
+        + " deg/s²",
+    )
     table.add_row("joint limit violations", str(len(summary["limit_violations"])))
-    table.add_row("minimum clearance",
-                  f"{summary['min_clearance_mm']:.1f} mm ({c.get('robot_body')} – "
-                  f"{c.get('scene_body')}, t = {c.get('time_s', float('nan')):.2f} s)")
+    table.add_row(
+        "minimum clearance",
+        f"{summary['min_clearance_mm']:.1f} mm ({c.get('robot_body')} – "
+        f"{c.get('scene_body')}, t = {c.get('time_s', float('nan')):.2f} s)",
+    )
     table.add_row("required clearance", f"{summary['required_clearance_mm']:.1f} mm")
-    table.add_row("collisions", "none" if not summary["collisions"] else str(
-        len(summary["collisions"])))
-    table.add_row("time", f"{timings['total']:.1f} s (plan {timings['plan']:.2f}, "
-                          f"check {timings['check']:.2f}, write {timings['write']:.2f})")
+    table.add_row(
+        "collisions",
+        "none" if not summary["collisions"] else str(len(summary["collisions"])),
+    )
+    table.add_row(
+        "time",
+        f"{timings['total']:.1f} s (plan {timings['plan']:.2f}, "
+        f"check {timings['check']:.2f}, write {timings['write']:.2f})",
+    )
     table.add_row("report", str(report_path))
     con.print(table)
-    con.print(("[bold green]PASS[/]" if summary["ok"] else "[bold red]FAIL[/]")
-              + f": outputs in {out}")
+    con.print(
+        ("[bold green]PASS[/]" if summary["ok"] else "[bold red]FAIL[/]")
+        + f": outputs in {out}"
+    )
     if view:
         from robokin.viz.viewer import view as open_viewer
 
