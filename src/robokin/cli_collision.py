@@ -1,0 +1,173 @@
+"""``robokin check``: a joint trajectory against a scene (collision, clearance).
+
+Prints the closest pairs and every collision with its times, optionally writes a
+distance-over-time plot, and exits 1 when the trajectory collides or comes closer
+than ``--clearance`` (useful in scripts and CI).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from robokin.cli import DomainFailure, app
+
+__all__ = ["read_trajectory_csv"]
+
+
+def read_trajectory_csv(path: str | Path, robot: Any = None) -> tuple[Any, Any]:
+    """Times (m,) [s] and joints (m, n) [SI] from a trajectory CSV.
+
+    Uses :func:`robokin.trajectory.io.read_csv` when available; otherwise reads
+    the simple format ``t [s],<joint> [rad|deg|m|mm]...`` itself.
+
+    Raises:
+        ModelError: missing or malformed file (names the file and line).
+    """
+    try:
+        from robokin.trajectory.io import read_csv
+    except ImportError:
+        read_csv = None
+    if read_csv is not None:
+        kw = {}
+        if robot is not None:
+            kw["is_revolute"] = robot.is_revolute
+        tr = read_csv(path, **kw)
+        return tr.t, tr.q
+    return _read_simple_csv(Path(path))
+
+
+def _read_simple_csv(path: Path):
+    import re
+
+    import numpy as np
+
+    from robokin.exceptions import ModelError
+
+    scale = {"s": 1.0, "ms": 1e-3, "rad": 1.0, "deg": math.pi / 180, "m": 1.0, "mm": 1e-3,
+             None: 1.0}
+    try:
+        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip()]
+    except FileNotFoundError:
+        raise ModelError("no such file", file=path) from None
+    if len(lines) < 2:
+        raise ModelError("expected a header line and at least one row", file=path)
+    factors = []
+    for col in lines[0].split(","):
+        m = re.match(r"^\s*(.*?)\s*(?:\[([^\]]*)\])?\s*$", col)
+        unit = m.group(2) if m else None
+        if unit not in scale:
+            raise ModelError(f"unknown unit [{unit}]", file=path, field=col.strip())
+        factors.append(scale[unit])
+    rows = []
+    for k, ln in enumerate(lines[1:], start=2):
+        try:
+            vals = [float(v) for v in ln.split(",")]
+        except ValueError:
+            raise ModelError("non-numeric value", file=path, field=f"line {k}") from None
+        if len(vals) != len(factors):
+            raise ModelError(f"expected {len(factors)} values, got {len(vals)}", file=path,
+                             field=f"line {k}")
+        rows.append(vals)
+    data = np.array(rows) * np.array(factors)
+    return data[:, 0], data[:, 1:]
+
+
+@app.command("check", context_settings={"ignore_unknown_options": True})
+def check_command(
+    scene: Annotated[Path, typer.Argument(help="Scene file (YAML), or a bundled name.")],
+    trajectory: Annotated[Path, typer.Argument(help="Trajectory CSV: t [s],<joint> [rad]...")],
+    robot: Annotated[
+        str | None, typer.Option("--robot", help="Built-in name or robot file (default: the scene's).")
+    ] = None,
+    clearance: Annotated[float, typer.Option(help="Required clearance [mm].")] = 0.0,
+    plot: Annotated[
+        Path | None, typer.Option("--plot", help="Write a distance-over-time plot here.")
+    ] = None,
+    top: Annotated[int, typer.Option(help="How many closest pairs to list.")] = 8,
+    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+) -> None:
+    """Check a joint trajectory against a scene: minimum distances and collisions."""
+    import robokin
+    from robokin import collision
+    from robokin.exceptions import InputError
+
+    if not math.isfinite(clearance) or clearance < 0:
+        raise InputError("--clearance", f"expected a number >= 0 [mm], got {clearance}")
+    if not scene.exists() and scene.suffix == "":
+        scene = collision.scene_path(str(scene))
+    sc = collision.Scene.load(scene)
+    name = robot or sc.robot_name
+    if name is None:
+        raise InputError("--robot", "the scene names no robot; pass --robot")
+    rob = robokin.load(name)
+    t, q = read_trajectory_csv(trajectory, rob)
+    rep = collision.check(rob, sc, q, t=t, clearance=clearance * 1e-3)
+    violated = rep.collides or rep.min_distance <= clearance * 1e-3
+    if plot is not None:
+        from robokin.collision.plots import plot_distance
+
+        plot_distance(rep, out=plot)
+    if as_json:
+        c = rep.closest
+        print(json.dumps({
+            "min_distance_m": None if c is None else rep.min_distance,
+            "closest": None if c is None else {
+                "body_a": c.body_a, "body_b": c.body_b, "t": c.t, "index": c.index,
+                "point_a": list(map(float, c.point_a)), "point_b": list(map(float, c.point_b)),
+                "between_samples": c.between_samples},
+            "collides": rep.collides,
+            "clearance_m": rep.clearance,
+            "violated": violated,
+            "collisions": [iv._asdict() for iv in rep.intervals],
+            "pairs": [p._asdict() for p in rep.pairs[:top]],
+        }, indent=2, default=float))
+    else:
+        _print_report(rep, clearance, violated, q.shape[0], plot)
+    if violated:
+        what = "collides" if rep.collides else (
+            f"comes within {rep.min_distance * 1e3:.2f} mm (clearance {clearance:g} mm)")
+        raise DomainFailure(f"the trajectory {what}")
+
+
+def _print_report(rep, clearance_mm: float, violated: bool, m: int, plot) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    from rich.markup import escape
+
+    con = Console()
+    table = Table(title=f"closest pairs ({m} samples)")
+    for col in ("body", "body", "min distance [mm]", "t [s]", "sample"):
+        table.add_column(escape(col), justify="right" if "[" in col or col == "sample" else "left")
+    for p in rep.pairs[:8]:
+        style = "red" if p.distance <= max(clearance_mm * 1e-3, 0.0) else None
+        table.add_row(p.body_a, p.body_b, f"{p.distance * 1e3:.2f}", f"{p.t:.3f}",
+                      str(p.index), style=style)
+    con.print(table)
+    if rep.intervals:
+        ct = Table(title="collisions")
+        for col in ("body", "body", "first", "last", "t start [s]", "t end [s]", "depth [mm]"):
+            ct.add_column(escape(col))
+        for iv in rep.intervals:
+            ct.add_row(iv.body_a, iv.body_b, str(iv.first_index), str(iv.last_index),
+                       f"{iv.t_start:.3f}", f"{iv.t_end:.3f}",
+                       f"{-iv.min_distance * 1e3:.2f}" + (" (between samples)"
+                                                         if iv.between_samples else ""),
+                       style="red")
+        con.print(ct)
+    c = rep.closest
+    if c is not None:
+        pa = ", ".join(f"{v * 1e3:.1f}" for v in c.point_a)
+        pb = ", ".join(f"{v * 1e3:.1f}" for v in c.point_b)
+        con.print(f"minimum {c.distance * 1e3:.2f} mm between {c.body_a} and {c.body_b} "
+                  f"at t = {c.t:.3f} s (sample {c.index}); nearest points [mm] "
+                  f"({pa}) and ({pb})", markup=False)
+    verdict = "[red]VIOLATED[/red]" if violated else "[green]OK[/green]"
+    con.print(f"clearance {clearance_mm:g} mm: {verdict}")
+    if plot is not None:
+        con.print(f"plot: {plot}", markup=False)
