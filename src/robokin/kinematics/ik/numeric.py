@@ -16,7 +16,7 @@ gets it: revolute and prismatic joints, reversed axes, dependent joints
 rejecting the others. Joint limits are kept during the iteration: every trial
 point is projected into the limits (2*pi-periodic joints are first shifted by whole
 turns), and joints pressed against a limit by the gradient leave the active set.
-A descent that stalls (the cost has not halved in 6 iterations: a local minimum,
+A descent that stalls (the cost has not halved in 4 iterations: a local minimum,
 or pinned at limits) or runs out of iterations restarts from a random seed inside
 the limits (alternately from the central half of each joint range, where descents
 meet limits less often, and from the whole range) until the target is reached or
@@ -58,7 +58,7 @@ _AXES = ("x", "y", "z", "rx", "ry", "rz")
 _PARALLEL_MIN = 64  # below this many targets one thread beats the parallel launch
 _FIRST_ROUND_RESTARTS = 4
 _ROUND_RESTARTS = 16
-_STALL_EVERY = 6
+_STALL_EVERY = 4
 _STALL_RATIO = 0.5
 _MU0 = 1e-2  # initial damping, lambda = mu * E
 _MU_DOWN = 0.5
