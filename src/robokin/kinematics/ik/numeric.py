@@ -671,11 +671,12 @@ def solve_all(
     inside = (wrapped >= lim[:, 0]) & (wrapped <= lim[:, 1])
     q = np.where(data.wrap & inside, wrapped, q)
     # deduplicate: row j is a copy if an earlier valid row is within dedupe_tol
-    diff = q[:, :, None, :] - q[:, None, :, :]
-    diff = np.where(data.wrap, wrap_angle(diff), diff)
-    close = np.abs(diff).max(axis=-1) <= dedupe_tol
-    earlier = np.tril(np.ones((S, S), dtype=bool), k=-1)
-    dup = (close & earlier & ok[:, None, :]).any(axis=-1)
+    # (one seed at a time: memory O(N S n), not O(N S^2 n))
+    dup = np.zeros((N, S), dtype=bool)
+    for j in range(1, S):
+        diff = q[:, :j] - q[:, j:j + 1]
+        diff = np.where(data.wrap, wrap_angle(diff), diff)
+        dup[:, j] = ((np.abs(diff).max(axis=-1) <= dedupe_tol) & ok[:, :j]).any(axis=1)
     keep = ok & ~dup
     if q_near is not None:
         d = q - seeds[:, :1]
