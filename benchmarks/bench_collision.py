@@ -36,9 +36,14 @@ def press_cycle(robot: robokin.Robot, scene: Scene, samples: int) -> np.ndarray:
     pj = scene.pose_joints
     line_T0, line_T1 = scene.poses["press_approach"], scene.poses["press_place"]
     # segment lengths as fractions of the whole cycle
-    parts = [("pick_approach", "pick", 0.12), ("pick", "pick_approach", 0.12),
-             ("pick_approach", "press_approach", 0.26), ("line", None, 0.15),
-             ("line_back", None, 0.15), ("press_approach", "pick_approach", 0.20)]
+    parts = [
+        ("pick_approach", "pick", 0.12),
+        ("pick", "pick_approach", 0.12),
+        ("pick_approach", "press_approach", 0.26),
+        ("line", None, 0.15),
+        ("line_back", None, 0.15),
+        ("press_approach", "pick_approach", 0.20),
+    ]
     counts = [int(round(f * samples)) for *_, f in parts]
     counts[-1] = samples - sum(counts[:-1])
     out = []
@@ -75,11 +80,29 @@ def naive(problem, q: np.ndarray) -> float:
         a = problem.pa[p]
         b = problem.pb[p]
         if problem.is_self[p]:
-            pairs.append((ga, gb, problem.link[a], problem.place[a],
-                          problem.link[b], problem.place[b], None))
+            pairs.append(
+                (
+                    ga,
+                    gb,
+                    problem.link[a],
+                    problem.place[a],
+                    problem.link[b],
+                    problem.place[b],
+                    None,
+                )
+            )
         else:
-            pairs.append((ga, gb, problem.link[a], problem.place[a], None, None,
-                          problem.ob_T3[b]))
+            pairs.append(
+                (
+                    ga,
+                    gb,
+                    problem.link[a],
+                    problem.place[a],
+                    None,
+                    None,
+                    problem.ob_T3[b],
+                )
+            )
     best = np.inf
     for i in range(q.shape[0]):
         F = frames[i]
@@ -88,7 +111,9 @@ def naive(problem, q: np.ndarray) -> float:
             Ta = coal.Transform3s(np.ascontiguousarray(Wa[:3, :3]), Wa[:3, 3].copy())
             if Tb is None:
                 Wb = F[lb] @ Pb
-                Tb_ = coal.Transform3s(np.ascontiguousarray(Wb[:3, :3]), Wb[:3, 3].copy())
+                Tb_ = coal.Transform3s(
+                    np.ascontiguousarray(Wb[:3, :3]), Wb[:3, 3].copy()
+                )
             else:
                 Tb_ = Tb
             res = coal.DistanceResult()
@@ -117,10 +142,14 @@ def main(samples: int = 5000) -> int:
     t_naive = time.perf_counter() - t0
 
     c = rep.closest
-    print(f"AUBO-i5 + gripper, press scene: {samples} samples, {problem.P} shape pairs "
-          f"({len(problem.obj_pairs)} link-object, {len(problem.self_pairs)} self)")
-    print(f"  closest: {c.body_a} - {c.body_b} {c.distance * 1e3:.3f} mm at t = {c.t:.3f} s "
-          f"(sample {c.index}); collides: {rep.collides}")
+    print(
+        f"AUBO-i5 + gripper, press scene: {samples} samples, {problem.P} shape pairs "
+        f"({len(problem.obj_pairs)} link-object, {len(problem.self_pairs)} self)"
+    )
+    print(
+        f"  closest: {c.body_a} - {c.body_b} {c.distance * 1e3:.3f} mm at t = {c.t:.3f} s "
+        f"(sample {c.index}); collides: {rep.collides}"
+    )
     print(f"  exact coal queries: robokin {rep.queries}, naive {problem.P * samples}")
     print(f"  naive coal loop     {t_naive:8.3f} s   min {ref:.9f} m")
     print(f"  robokin check cold  {cold:8.3f} s   (includes building coal objects)")
@@ -129,7 +158,9 @@ def main(samples: int = 5000) -> int:
     diff = abs(ref - rep.min_distance)
     print(f"  |min difference| = {diff:.2e} m")
     ok = diff <= 1e-6 and warm < 2.0 and t_naive / warm >= 20.0
-    print("  targets (< 2 s, >= 20x, same minimum to 1e-6 m):", "met" if ok else "MISSED")
+    print(
+        "  targets (< 2 s, >= 20x, same minimum to 1e-6 m):", "met" if ok else "MISSED"
+    )
     return 0 if ok else 1
 
 

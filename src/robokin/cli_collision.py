@@ -48,10 +48,19 @@ def _read_simple_csv(path: Path):
 
     from robokin.exceptions import ModelError
 
-    scale = {"s": 1.0, "ms": 1e-3, "rad": 1.0, "deg": math.pi / 180, "m": 1.0, "mm": 1e-3,
-             None: 1.0}
+    scale = {
+        "s": 1.0,
+        "ms": 1e-3,
+        "rad": 1.0,
+        "deg": math.pi / 180,
+        "m": 1.0,
+        "mm": 1e-3,
+        None: 1.0,
+    }
     try:
-        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip()]
+        lines = [
+            ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip()
+        ]
     except FileNotFoundError:
         raise ModelError("no such file", file=path) from None
     if len(lines) < 2:
@@ -68,10 +77,15 @@ def _read_simple_csv(path: Path):
         try:
             vals = [float(v) for v in ln.split(",")]
         except ValueError:
-            raise ModelError("non-numeric value", file=path, field=f"line {k}") from None
+            raise ModelError(
+                "non-numeric value", file=path, field=f"line {k}"
+            ) from None
         if len(vals) != len(factors):
-            raise ModelError(f"expected {len(factors)} values, got {len(vals)}", file=path,
-                             field=f"line {k}")
+            raise ModelError(
+                f"expected {len(factors)} values, got {len(vals)}",
+                file=path,
+                field=f"line {k}",
+            )
         rows.append(vals)
     data = np.array(rows) * np.array(factors)
     return data[:, 0], data[:, 1:]
@@ -79,17 +93,27 @@ def _read_simple_csv(path: Path):
 
 @app.command("check", context_settings={"ignore_unknown_options": True})
 def check_command(
-    scene: Annotated[Path, typer.Argument(help="Scene file (YAML), or a bundled name.")],
-    trajectory: Annotated[Path, typer.Argument(help="Trajectory CSV: t [s],<joint> [rad]...")],
+    scene: Annotated[
+        Path, typer.Argument(help="Scene file (YAML), or a bundled name.")
+    ],
+    trajectory: Annotated[
+        Path, typer.Argument(help="Trajectory CSV: t [s],<joint> [rad]...")
+    ],
     robot: Annotated[
-        str | None, typer.Option("--robot", help="Built-in name or robot file (default: the scene's).")
+        str | None,
+        typer.Option(
+            "--robot", help="Built-in name or robot file (default: the scene's)."
+        ),
     ] = None,
     clearance: Annotated[float, typer.Option(help="Required clearance [mm].")] = 0.0,
     plot: Annotated[
-        Path | None, typer.Option("--plot", help="Write a distance-over-time plot here.")
+        Path | None,
+        typer.Option("--plot", help="Write a distance-over-time plot here."),
     ] = None,
     top: Annotated[int, typer.Option(help="How many closest pairs to list.")] = 8,
-    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Machine-readable output.")
+    ] = False,
 ) -> None:
     """Check a joint trajectory against a scene: minimum distances and collisions."""
     import robokin
@@ -114,59 +138,101 @@ def check_command(
         plot_distance(rep, out=plot)
     if as_json:
         c = rep.closest
-        print(json.dumps({
-            "min_distance_m": None if c is None else rep.min_distance,
-            "closest": None if c is None else {
-                "body_a": c.body_a, "body_b": c.body_b, "t": c.t, "index": c.index,
-                "point_a": list(map(float, c.point_a)), "point_b": list(map(float, c.point_b)),
-                "between_samples": c.between_samples},
-            "collides": rep.collides,
-            "clearance_m": rep.clearance,
-            "violated": violated,
-            "collisions": [iv._asdict() for iv in rep.intervals],
-            "pairs": [p._asdict() for p in rep.pairs[:top]],
-        }, indent=2, default=float))
+        print(
+            json.dumps(
+                {
+                    "min_distance_m": None if c is None else rep.min_distance,
+                    "closest": None
+                    if c is None
+                    else {
+                        "body_a": c.body_a,
+                        "body_b": c.body_b,
+                        "t": c.t,
+                        "index": c.index,
+                        "point_a": list(map(float, c.point_a)),
+                        "point_b": list(map(float, c.point_b)),
+                        "between_samples": c.between_samples,
+                    },
+                    "collides": rep.collides,
+                    "clearance_m": rep.clearance,
+                    "violated": violated,
+                    "collisions": [iv._asdict() for iv in rep.intervals],
+                    "pairs": [p._asdict() for p in rep.pairs[:top]],
+                },
+                indent=2,
+                default=float,
+            )
+        )
     else:
         _print_report(rep, clearance, violated, q.shape[0], plot)
     if violated:
-        what = "collides" if rep.collides else (
-            f"comes within {rep.min_distance * 1e3:.2f} mm (clearance {clearance:g} mm)")
+        what = (
+            "collides"
+            if rep.collides
+            else (
+                f"comes within {rep.min_distance * 1e3:.2f} mm (clearance {clearance:g} mm)"
+            )
+        )
         raise DomainFailure(f"the trajectory {what}")
 
 
 def _print_report(rep, clearance_mm: float, violated: bool, m: int, plot) -> None:
     from rich.console import Console
-    from rich.table import Table
-
     from rich.markup import escape
+    from rich.table import Table
 
     con = Console()
     table = Table(title=f"closest pairs ({m} samples)")
     for col in ("body", "body", "min distance [mm]", "t [s]", "sample"):
-        table.add_column(escape(col), justify="right" if "[" in col or col == "sample" else "left")
+        table.add_column(
+            escape(col), justify="right" if "[" in col or col == "sample" else "left"
+        )
     for p in rep.pairs[:8]:
         style = "red" if p.distance <= max(clearance_mm * 1e-3, 0.0) else None
-        table.add_row(p.body_a, p.body_b, f"{p.distance * 1e3:.2f}", f"{p.t:.3f}",
-                      str(p.index), style=style)
+        table.add_row(
+            p.body_a,
+            p.body_b,
+            f"{p.distance * 1e3:.2f}",
+            f"{p.t:.3f}",
+            str(p.index),
+            style=style,
+        )
     con.print(table)
     if rep.intervals:
         ct = Table(title="collisions")
-        for col in ("body", "body", "first", "last", "t start [s]", "t end [s]", "depth [mm]"):
+        for col in (
+            "body",
+            "body",
+            "first",
+            "last",
+            "t start [s]",
+            "t end [s]",
+            "depth [mm]",
+        ):
             ct.add_column(escape(col))
         for iv in rep.intervals:
-            ct.add_row(iv.body_a, iv.body_b, str(iv.first_index), str(iv.last_index),
-                       f"{iv.t_start:.3f}", f"{iv.t_end:.3f}",
-                       f"{-iv.min_distance * 1e3:.2f}" + (" (between samples)"
-                                                         if iv.between_samples else ""),
-                       style="red")
+            ct.add_row(
+                iv.body_a,
+                iv.body_b,
+                str(iv.first_index),
+                str(iv.last_index),
+                f"{iv.t_start:.3f}",
+                f"{iv.t_end:.3f}",
+                f"{-iv.min_distance * 1e3:.2f}"
+                + (" (between samples)" if iv.between_samples else ""),
+                style="red",
+            )
         con.print(ct)
     c = rep.closest
     if c is not None:
         pa = ", ".join(f"{v * 1e3:.1f}" for v in c.point_a)
         pb = ", ".join(f"{v * 1e3:.1f}" for v in c.point_b)
-        con.print(f"minimum {c.distance * 1e3:.2f} mm between {c.body_a} and {c.body_b} "
-                  f"at t = {c.t:.3f} s (sample {c.index}); nearest points [mm] "
-                  f"({pa}) and ({pb})", markup=False)
+        con.print(
+            f"minimum {c.distance * 1e3:.2f} mm between {c.body_a} and {c.body_b} "
+            f"at t = {c.t:.3f} s (sample {c.index}); nearest points [mm] "
+            f"({pa}) and ({pb})",
+            markup=False,
+        )
     verdict = "[red]VIOLATED[/red]" if violated else "[green]OK[/green]"
     con.print(f"clearance {clearance_mm:g} mm: {verdict}")
     if plot is not None:

@@ -14,8 +14,9 @@ pytest.importorskip("coal")
 
 def _write_csv(path, t, q, names, unit="rad", scale=1.0):
     header = "t [s]," + ",".join(f"{n} [{unit}]" for n in names)
-    np.savetxt(path, np.column_stack([t, q * scale]), delimiter=",", header=header,
-               comments="")
+    np.savetxt(
+        path, np.column_stack([t, q * scale]), delimiter=",", header=header, comments=""
+    )
 
 
 @pytest.fixture(scope="module")
@@ -35,8 +36,17 @@ def press_motion(tmp_path_factory):
 def test_check_prints_the_closest_pairs_and_passes(press_motion, capsys, tmp_path):
     path, ref = press_motion
     png = tmp_path / "dist.png"
-    code = main(["check", str(scene_path("press")), str(path), "--clearance", "4",
-                 "--plot", str(png)])
+    code = main(
+        [
+            "check",
+            str(scene_path("press")),
+            str(path),
+            "--clearance",
+            "4",
+            "--plot",
+            str(png),
+        ]
+    )
     out, err = capsys.readouterr()
     assert code == 0, err
     assert "tool" in out and "fixture" in out

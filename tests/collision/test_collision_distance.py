@@ -28,11 +28,13 @@ def Rz(a):
 
 def gantry(shapes):
     """An x-y-z gantry (three prismatic joints) carrying ``shapes`` on its last link."""
-    r = robokin.Robot.from_elementary([
-        {"op": "tx", "joint": "prismatic", "name": "x"},
-        {"op": "ty", "joint": "prismatic", "name": "y"},
-        {"op": "tz", "joint": "prismatic", "name": "z"},
-    ])
+    r = robokin.Robot.from_elementary(
+        [
+            {"op": "tx", "joint": "prismatic", "name": "x"},
+            {"op": "ty", "joint": "prismatic", "name": "y"},
+            {"op": "tz", "joint": "prismatic", "name": "z"},
+        ]
+    )
     return r.replace(geometry=RobotGeometry.from_mapping(r, {"z": shapes}))
 
 
@@ -40,12 +42,14 @@ def test_sphere_to_box_face_edge_and_corner_closed_form():
     r = gantry([geo.sphere(0.1)])
     sc = Scene()
     sc.add_box("block", size=(0.4, 0.6, 0.2), pose=T(1.0, 0.0, 0.0))  # x 0.8..1.2
-    q = np.array([
-        [0.5, 0.0, 0.0],    # in front of the x face
-        [0.5, 0.5, 0.0],    # beyond the x-y edge
-        [0.5, 0.5, 0.3],    # beyond a corner
-        [1.0, 0.0, 0.15],   # overlapping the top face by 0.05
-    ])
+    q = np.array(
+        [
+            [0.5, 0.0, 0.0],  # in front of the x face
+            [0.5, 0.5, 0.0],  # beyond the x-y edge
+            [0.5, 0.5, 0.3],  # beyond a corner
+            [1.0, 0.0, 0.15],  # overlapping the top face by 0.05
+        ]
+    )
     want = [
         0.8 - 0.5 - 0.1,
         math.hypot(0.3, 0.2) - 0.1,
@@ -64,8 +68,12 @@ def test_capsule_pairs_use_the_segment_distance():
     cap = geo.capsule(0.05, 0.4)  # axis z from -0.2 to 0.2
     r = gantry([cap])
     sc = Scene()
-    sc.add_capsule("bar", 0.03, 1.0, pose=T(0.0, 0.0, 0.5, R=np.array(
-        [[1, 0, 0], [0, 0, -1], [0, 1, 0.0]])))  # axis along y at z = 0.5
+    sc.add_capsule(
+        "bar",
+        0.03,
+        1.0,
+        pose=T(0.0, 0.0, 0.5, R=np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0.0]])),
+    )  # axis along y at z = 0.5
     zs = np.array([0.0, 0.1, 0.25, 0.4])
     q = np.column_stack([np.full(4, 0.3), np.zeros(4), zs])
     rep = check(r, sc, q, subdivide=False)
@@ -84,7 +92,9 @@ def test_mesh_box_and_primitive_box_agree(tmp_path, rng):
     prim, mesh = Scene(), Scene()
     prim.add_box("block", size=(0.3, 0.2, 0.1), pose=pose)
     mesh.add_mesh("block", stl, pose=pose, units="mm")
-    r = gantry([geo.capsule(0.04, 0.3, T(R=np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0.0]])))])
+    r = gantry(
+        [geo.capsule(0.04, 0.3, T(R=np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0.0]])))]
+    )
     q = rng.uniform([0.0, -0.6, -0.3], [1.4, 0.4, 0.6], size=(60, 3))
     a = check(r, prim, q, subdivide=False).distances("z", "block")
     b = check(r, mesh, q, subdivide=False).distances("z", "block")
@@ -101,8 +111,12 @@ def test_rounded_box_bounds_never_exceed_the_coal_distance(rng):
     from robokin.collision._kernels import rounded_box_bounds
     from robokin.spatial import matrix_from_rpy
 
-    kinds = [("box", (0.3, 0.1, 0.2)), ("capsule", (0.05, 0.4)), ("sphere", (0.08,)),
-             ("cylinder", (0.06, 0.3))]
+    kinds = [
+        ("box", (0.3, 0.1, 0.2)),
+        ("capsule", (0.05, 0.4)),
+        ("sphere", (0.08,)),
+        ("cylinder", (0.06, 0.3)),
+    ]
     shapes, poses = [], []
     for _ in range(40):
         k, size = kinds[rng.integers(len(kinds))]
@@ -132,18 +146,28 @@ def test_rounded_box_bounds_never_exceed_the_coal_distance(rng):
     pb = np.tile(np.arange(len(B)), len(A))
     out = np.empty((P, 1))
     rounded_box_bounds(
-        frames, np.zeros(len(A), dtype=np.int64), np.array([x[0] for x in A]),
-        np.array([x[1] for x in A]), np.array([x[2] for x in A]),
-        np.array([x[0] for x in B]), np.array([x[1] for x in B]),
-        np.array([x[2] for x in B]), pa, pb, np.zeros(P, bool), np.zeros(P, bool), out,
+        frames,
+        np.zeros(len(A), dtype=np.int64),
+        np.array([x[0] for x in A]),
+        np.array([x[1] for x in A]),
+        np.array([x[2] for x in A]),
+        np.array([x[0] for x in B]),
+        np.array([x[1] for x in B]),
+        np.array([x[2] for x in B]),
+        pa,
+        pb,
+        np.zeros(P, bool),
+        np.zeros(P, bool),
+        out,
     )
     req = coal.DistanceRequest()
     for p in range(P):
         sa, sb = robot_like[pa[p]], objects[pb[p]]
         ta = coal.Transform3s(sa.placement[:3, :3].copy(), sa.placement[:3, 3].copy())
         tb = coal.Transform3s(sb.placement[:3, :3].copy(), sb.placement[:3, 3].copy())
-        d = coal.distance(sa.coal_geometry(), ta, sb.coal_geometry(), tb, req,
-                          coal.DistanceResult())
+        d = coal.distance(
+            sa.coal_geometry(), ta, sb.coal_geometry(), tb, req, coal.DistanceResult()
+        )
         if d > 0:
             assert out[p, 0] <= d + 1e-9, (sa, sb, out[p, 0], d)
 
@@ -160,12 +184,17 @@ def test_capsule_kernel_matches_coal_on_random_segments(rng):
             q1 = p1.copy()  # a point
         if rng.random() < 0.1:
             q2 = p2 + 1e-3 * (q1 - p1)  # nearly parallel, short
-        a = geo.capsule_between(p1, q1, 0.01) if np.any(p1 != q1) else geo.sphere(0.01, T(*p1))
+        a = (
+            geo.capsule_between(p1, q1, 0.01)
+            if np.any(p1 != q1)
+            else geo.sphere(0.01, T(*p1))
+        )
         b = geo.capsule_between(p2, q2, 0.01)
         ta = coal.Transform3s(a.placement[:3, :3].copy(), a.placement[:3, 3].copy())
         tb = coal.Transform3s(b.placement[:3, :3].copy(), b.placement[:3, 3].copy())
-        d = coal.distance(a.coal_geometry(), ta, b.coal_geometry(), tb, req,
-                          coal.DistanceResult())
+        d = coal.distance(
+            a.coal_geometry(), ta, b.coal_geometry(), tb, req, coal.DistanceResult()
+        )
         assert _seg_seg(p1, q1, p2, q2) - 0.02 == pytest.approx(d, abs=1e-9)
 
 

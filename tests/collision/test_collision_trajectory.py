@@ -24,10 +24,12 @@ def T(x=0.0, y=0.0, z=0.0):
 
 
 def gantry(shapes):
-    r = robokin.Robot.from_elementary([
-        {"op": "tx", "joint": "prismatic", "name": "x"},
-        {"op": "ty", "joint": "prismatic", "name": "y"},
-    ])
+    r = robokin.Robot.from_elementary(
+        [
+            {"op": "tx", "joint": "prismatic", "name": "x"},
+            {"op": "ty", "joint": "prismatic", "name": "y"},
+        ]
+    )
     return r.replace(geometry=RobotGeometry.from_mapping(r, {"y": shapes}))
 
 
@@ -73,8 +75,11 @@ def test_a_fast_jump_over_a_thin_plate_is_caught_by_subdivision():
 def test_a_fast_revolute_sweep_through_a_thin_plate_is_caught():
     # one revolute link 0.5 m long sweeping +-0.6 rad in a single step
     r = robokin.Robot.from_dh([{"a": 0.5, "alpha": 0.0, "d": 0.0, "theta": 0.0}])
-    r = r.replace(geometry=RobotGeometry.from_mapping(
-        r, {"joint1": [geo.capsule_between([-0.5, 0, 0], [0, 0, 0], 0.01)]}))
+    r = r.replace(
+        geometry=RobotGeometry.from_mapping(
+            r, {"joint1": [geo.capsule_between([-0.5, 0, 0], [0, 0, 0], 0.01)]}
+        )
+    )
     sc = Scene()
     sc.add_box("plate", size=(0.2, 0.003, 0.2), pose=T(0.4, 0.0, 0.0))  # on the x axis
     q = np.array([[-0.6], [0.6]])
@@ -86,7 +91,9 @@ def test_a_fast_revolute_sweep_through_a_thin_plate_is_caught():
 def test_clearance_violations_are_reported_and_exact():
     r = gantry([geo.sphere(0.05)])
     sc = Scene()
-    sc.add_box("wall", size=(0.1, 1.0, 1.0), pose=T(1.003, 0.0, 0.0))  # face at x = 0.953
+    sc.add_box(
+        "wall", size=(0.1, 1.0, 1.0), pose=T(1.003, 0.0, 0.0)
+    )  # face at x = 0.953
     x = np.linspace(0.0, 0.9, 91)
     q = np.column_stack([x, np.zeros_like(x)])
     rep = check(r, sc, q, clearance=0.004)
@@ -106,9 +113,30 @@ def _planar_3r(exclude=None):
             {"name": "j3", "a": 0.3},
         ],
         "geometry": {
-            "j1": [{"type": "capsule", "radius": 0.03, "from": [-0.4, 0, 0], "to": [0, 0, 0]}],
-            "j2": [{"type": "capsule", "radius": 0.03, "from": [-0.4, 0, 0], "to": [0, 0, 0]}],
-            "j3": [{"type": "capsule", "radius": 0.03, "from": [-0.3, 0, 0], "to": [0, 0, 0]}],
+            "j1": [
+                {
+                    "type": "capsule",
+                    "radius": 0.03,
+                    "from": [-0.4, 0, 0],
+                    "to": [0, 0, 0],
+                }
+            ],
+            "j2": [
+                {
+                    "type": "capsule",
+                    "radius": 0.03,
+                    "from": [-0.4, 0, 0],
+                    "to": [0, 0, 0],
+                }
+            ],
+            "j3": [
+                {
+                    "type": "capsule",
+                    "radius": 0.03,
+                    "from": [-0.3, 0, 0],
+                    "to": [0, 0, 0],
+                }
+            ],
         },
     }
     if exclude is not None:
@@ -136,7 +164,9 @@ def test_trajectory_objects_and_times_are_accepted():
     sc = Scene()
     sc.add_sphere("ball", 0.05, pose=T(0.5, 0.3, 0.0))
     x = np.linspace(0.0, 1.0, 11)
-    tr = SimpleNamespace(t=np.linspace(0.0, 2.0, 11), q=np.column_stack([x, np.zeros(11)]))
+    tr = SimpleNamespace(
+        t=np.linspace(0.0, 2.0, 11), q=np.column_stack([x, np.zeros(11)])
+    )
     rep = check(r, sc, tr)
     assert rep.closest.index == 5 and rep.closest.t == pytest.approx(1.0)
     assert rep.min_distance == pytest.approx(0.3 - 0.1, abs=1e-12)
@@ -201,10 +231,17 @@ def test_agrees_with_a_brute_force_loop_on_the_aubo(rng):
     for (a, b), plist in groups.items():
         mask = D[plist].min(axis=0) <= 0
         edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(int), [0]])))
-        want += [(int(s0), int(e0) - 1, a, b) for s0, e0 in zip(edges[::2], edges[1::2])]
-    got = [c for c in rep.collisions if not any(
-        iv.between_samples and (iv.first_index, iv.last_index) == (c[0], c[1])
-        for iv in rep.intervals)]
+        want += [
+            (int(s0), int(e0) - 1, a, b) for s0, e0 in zip(edges[::2], edges[1::2])
+        ]
+    got = [
+        c
+        for c in rep.collisions
+        if not any(
+            iv.between_samples and (iv.first_index, iv.last_index) == (c[0], c[1])
+            for iv in rep.intervals
+        )
+    ]
     assert sorted(got) == sorted(want)
     assert rep.collides == bool(want) or any(iv.between_samples for iv in rep.intervals)
     assert rep.queries < D.size / 4  # the bounds spared most of the queries
@@ -224,6 +261,6 @@ def test_motion_bounds_hold_between_samples(rng):
     D = _brute_force(pr, fine)
     Dc = D[:, ::20]  # the samples
     for i in range(20):
-        seg = D[:, 20 * i: 20 * i + 21]
-        assert np.all(np.abs(seg - Dc[:, i:i + 1]) <= M[:, i:i + 1] + 1e-9)
+        seg = D[:, 20 * i : 20 * i + 21]
+        assert np.all(np.abs(seg - Dc[:, i : i + 1]) <= M[:, i : i + 1] + 1e-9)
     assert math.isfinite(rep.min_distance)

@@ -28,7 +28,9 @@ def test_add_objects_and_errors():
     assert sc["plate"].shape.size == (0.1, 0.2, 0.3)
     with pytest.raises(InputError, match="already has an object 'plate'"):
         sc.add_box("plate", size=(1, 1, 1))
-    with pytest.raises(InputError, match=r"no object 'nope'.*objects: \['plate', 'post', 'ball'\]"):
+    with pytest.raises(
+        InputError, match=r"no object 'nope'.*objects: \['plate', 'post', 'ball'\]"
+    ):
         sc["nope"]
     bad = np.eye(4)
     bad[0, 0] = 2.0
@@ -42,27 +44,52 @@ def test_scene_file_units_placement_and_errors(tmp_path):
     doc = {
         "units": {"length": "mm", "angle": "deg"},
         "robot": {"name": "ur5", "base": {"xyz": [100, 0, 500], "rpy": [0, 0, 90]}},
-        "objects": [{"name": "plate", "type": "box", "size": [400, 300, 10],
-                     "xyz": [500, 0, 200], "rpy": [0, 0, 30]}],
-        "poses": {"home": {"xyz": [400, 0, 300], "rpy": [180, 0, 0], "q": [0, -90, 0, 0, 0, 0]}},
+        "objects": [
+            {
+                "name": "plate",
+                "type": "box",
+                "size": [400, 300, 10],
+                "xyz": [500, 0, 200],
+                "rpy": [0, 0, 30],
+            }
+        ],
+        "poses": {
+            "home": {
+                "xyz": [400, 0, 300],
+                "rpy": [180, 0, 0],
+                "q": [0, -90, 0, 0, 0, 0],
+            }
+        },
     }
     path = tmp_path / "cell.yaml"
     path.write_text(yaml.safe_dump(doc))
     sc = Scene.load(path)
     assert sc.robot_name == "ur5"
-    np.testing.assert_allclose(sc.base, pose_from_xyz_rpy([0.1, 0, 0.5], [0, 0, math.pi / 2]))
+    np.testing.assert_allclose(
+        sc.base, pose_from_xyz_rpy([0.1, 0, 0.5], [0, 0, math.pi / 2])
+    )
     plate = sc["plate"]
     assert plate.shape.size == pytest.approx((0.4, 0.3, 0.01))
-    np.testing.assert_allclose(plate.pose, pose_from_xyz_rpy([0.5, 0, 0.2], [0, 0, math.pi / 6]))
+    np.testing.assert_allclose(
+        plate.pose, pose_from_xyz_rpy([0.5, 0, 0.2], [0, 0, math.pi / 6])
+    )
     np.testing.assert_allclose(sc.pose_joints["home"], [0, -math.pi / 2, 0, 0, 0, 0])
     for bad, match in [
         ({**doc, "lights": 3}, "lights: unknown field"),
-        ({**doc, "objects": [{"type": "box", "size": [1, 1, 1]}]}, r"objects\[0\]: an object needs a 'name'"),
-        ({**doc, "objects": [{"name": "a", "type": "box", "size": [1, 1]}]}, r"objects\[0\]\.size"),
+        (
+            {**doc, "objects": [{"type": "box", "size": [1, 1, 1]}]},
+            r"objects\[0\]: an object needs a 'name'",
+        ),
+        (
+            {**doc, "objects": [{"name": "a", "type": "box", "size": [1, 1]}]},
+            r"objects\[0\]\.size",
+        ),
         ({**doc, "units": {"length": "inch"}}, "units.length"),
         ({**doc, "poses": {"p": {"xyz": [1, 2]}}}, r"poses\.p: xyz and rpy need 3"),
-        ({**doc, "objects": [{"name": "m", "type": "mesh", "file": "gone.stl"}]},
-         r"objects\[0\]\.file: mesh file not found"),
+        (
+            {**doc, "objects": [{"name": "m", "type": "mesh", "file": "gone.stl"}]},
+            r"objects\[0\]\.file: mesh file not found",
+        ),
     ]:
         path.write_text(yaml.safe_dump(bad))
         with pytest.raises(ModelError, match=match) as exc:
@@ -78,14 +105,18 @@ def test_attach_places_base_tool_and_gripper():
     base = pose_from_xyz_rpy([0.2, 0.1, 0.7], [0.0, 0.0, 0.5])
     tcp = pose_from_xyz_rpy([0.0, 0.0, 0.15], [0.0, 0.0, 0.0])
     sc.set_base(base)
-    sc.set_tool([geo.box((0.05, 0.05, 0.1), pose_from_xyz_rpy([0, 0, 0.05], [0, 0, 0]))], tcp)
+    sc.set_tool(
+        [geo.box((0.05, 0.05, 0.1), pose_from_xyz_rpy([0, 0, 0.05], [0, 0, 0]))], tcp
+    )
     placed = sc.attach(r)
     q = np.array([0.3, -1.0, 1.2, -0.5, 1.1, 0.2])
     np.testing.assert_allclose(placed.fk(q), base @ r.fk(q) @ tcp, atol=1e-12)
     (box,) = placed.geometry.tool
     np.testing.assert_allclose(box.placement[:3, 3], [0, 0, -0.10], atol=1e-12)
     # the robot's own link shapes are unchanged
-    for a, b in zip(placed.geometry.link("elbow"), r.geometry.link("elbow"), strict=True):
+    for a, b in zip(
+        placed.geometry.link("elbow"), r.geometry.link("elbow"), strict=True
+    ):
         assert a.size == b.size
         np.testing.assert_array_equal(a.placement, b.placement)
 
@@ -125,7 +156,9 @@ def test_press_place_fits_the_die_opening_with_a_few_cm(press):
     # the gripper is really inside the opening (its tip is past the die front at x = 0.5)
     tip = sc.poses["press_place"][0, 3]
     assert tip > 0.5 + 0.1
-    assert rep.closest.body_a == "tool" and rep.closest.distance == pytest.approx(0.03, abs=1e-4)
+    assert rep.closest.body_a == "tool" and rep.closest.distance == pytest.approx(
+        0.03, abs=1e-4
+    )
     pick = check(r, sc, sc.pose_joints["pick"][None])
     assert not pick.collides
     assert pick.closest.body_b == "fixture"

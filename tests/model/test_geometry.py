@@ -30,7 +30,9 @@ def _doc(geometry=None, collision=None, length="mm"):
 def _surface_points(shape, rng, n=400):
     """Random points on the shape's surface, in its parent frame."""
     m = shape.trimesh()
-    pts, _ = __import__("trimesh").sample.sample_surface(m, n, seed=int(rng.integers(1 << 30)))
+    pts, _ = __import__("trimesh").sample.sample_surface(
+        m, n, seed=int(rng.integers(1 << 30))
+    )
     P = shape.placement
     return np.asarray(pts) @ P[:3, :3].T + P[:3, 3]
 
@@ -75,11 +77,29 @@ def test_shape_validation_names_the_argument():
 
 
 def test_geometry_section_scales_mm_and_degrees():
-    r = robot_from_document(_doc({
-        "j1": [{"type": "capsule", "radius": 50, "from": [-400, 0, 0], "to": [0, 0, 0]}],
-        "j2": [{"type": "box", "size": [100, 40, 20], "xyz": [-150, 0, 0], "rpy": [0, 0, 90]}],
-        "tool": [{"type": "sphere", "radius": 25}],
-    }))
+    r = robot_from_document(
+        _doc(
+            {
+                "j1": [
+                    {
+                        "type": "capsule",
+                        "radius": 50,
+                        "from": [-400, 0, 0],
+                        "to": [0, 0, 0],
+                    }
+                ],
+                "j2": [
+                    {
+                        "type": "box",
+                        "size": [100, 40, 20],
+                        "xyz": [-150, 0, 0],
+                        "rpy": [0, 0, 90],
+                    }
+                ],
+                "tool": [{"type": "sphere", "radius": 25}],
+            }
+        )
+    )
     g = r.geometry
     assert g.names == ("base", "j1", "j2", "tool")
     (cap,) = g.link("j1")
@@ -97,32 +117,52 @@ def test_geometry_section_scales_mm_and_degrees():
 def test_geometry_section_errors_name_the_field():
     with pytest.raises(ModelError, match=r"geometry\.elbow: unknown link 'elbow'"):
         robot_from_document(_doc({"elbow": [{"type": "sphere", "radius": 1}]}))
-    with pytest.raises(ModelError, match=r"geometry\.j1\[0\]\.radius: missing required"):
+    with pytest.raises(
+        ModelError, match=r"geometry\.j1\[0\]\.radius: missing required"
+    ):
         robot_from_document(_doc({"j1": [{"type": "capsule", "length": 3}]}))
-    with pytest.raises(ModelError, match=r"geometry\.j1\[0\]\.type: 'type' must be one of"):
+    with pytest.raises(
+        ModelError, match=r"geometry\.j1\[0\]\.type: 'type' must be one of"
+    ):
         robot_from_document(_doc({"j1": [{"type": "cone"}]}))
     with pytest.raises(ModelError, match=r"geometry\.j1\[0\]\.colour: unknown field"):
-        robot_from_document(_doc({"j1": [{"type": "sphere", "radius": 1, "colour": "red"}]}))
+        robot_from_document(
+            _doc({"j1": [{"type": "sphere", "radius": 1, "colour": "red"}]})
+        )
     with pytest.raises(ModelError, match=r"geometry\.j1\[0\]\.size: expected 3 finite"):
         robot_from_document(_doc({"j1": [{"type": "box", "size": [1, 2]}]}))
 
 
 def test_collision_section_exclusions_and_adjacency():
-    r = robot_from_document(_doc(
-        {"base": [{"type": "sphere", "radius": 10}], "j2": [{"type": "sphere", "radius": 10}],
-         "j1": [{"type": "sphere", "radius": 10}]},
-        {"exclude": [["base", "j2"]]},
-    ))
+    r = robot_from_document(
+        _doc(
+            {
+                "base": [{"type": "sphere", "radius": 10}],
+                "j2": [{"type": "sphere", "radius": 10}],
+                "j1": [{"type": "sphere", "radius": 10}],
+            },
+            {"exclude": [["base", "j2"]]},
+        )
+    )
     g = r.geometry
     assert g.is_excluded("base", "j2") and g.is_excluded("j2", "base")
     assert g.is_excluded("base", "j1")  # adjacent
-    assert not g.is_excluded("j1", "tool")  # not adjacent... tool carries nothing though
+    assert not g.is_excluded(
+        "j1", "tool"
+    )  # not adjacent... tool carries nothing though
     assert g.self_pairs() == []
-    r2 = robot_from_document(_doc(
-        {"base": [{"type": "sphere", "radius": 10}], "j2": [{"type": "sphere", "radius": 10}]},
-    ))
+    r2 = robot_from_document(
+        _doc(
+            {
+                "base": [{"type": "sphere", "radius": 10}],
+                "j2": [{"type": "sphere", "radius": 10}],
+            },
+        )
+    )
     assert r2.geometry.self_pairs() == [(0, 2)]
-    with pytest.raises(ModelError, match=r"collision\.exclude\[0\]: unknown link 'hand'"):
+    with pytest.raises(
+        ModelError, match=r"collision\.exclude\[0\]: unknown link 'hand'"
+    ):
         robot_from_document(_doc(None, {"exclude": [["base", "hand"]]}))
 
 
@@ -137,8 +177,18 @@ def test_mesh_in_mm_is_scaled_and_resolved_relative_to_the_robot_file(tmp_path):
 
     (tmp_path / "meshes").mkdir()
     _write_box_stl(tmp_path / "meshes" / "link.stl", (200.0, 60.0, 40.0))
-    doc = _doc({"j1": [{"type": "mesh", "file": "meshes/link.stl", "units": "mm",
-                        "xyz": [-200, 0, 0]}]})
+    doc = _doc(
+        {
+            "j1": [
+                {
+                    "type": "mesh",
+                    "file": "meshes/link.stl",
+                    "units": "mm",
+                    "xyz": [-200, 0, 0],
+                }
+            ]
+        }
+    )
     path = tmp_path / "arm.yaml"
     path.write_text(yaml.safe_dump(doc))
     r = robokin.load(path)
@@ -157,7 +207,9 @@ def test_missing_mesh_names_the_file_and_the_link(tmp_path):
     import yaml
 
     path = tmp_path / "arm.yaml"
-    path.write_text(yaml.safe_dump(_doc({"j2": [{"type": "mesh", "file": "nowhere.stl"}]})))
+    path.write_text(
+        yaml.safe_dump(_doc({"j2": [{"type": "mesh", "file": "nowhere.stl"}]}))
+    )
     with pytest.raises(ModelError) as exc:
         robokin.load(path)
     msg = str(exc.value)
@@ -171,7 +223,9 @@ def test_corrupt_mesh_names_the_file_and_the_link(tmp_path):
     bad = tmp_path / "broken.stl"
     bad.write_bytes(b"solid nonsense\n this is not an STL at all \x00\x01\x02")
     path = tmp_path / "arm.yaml"
-    path.write_text(yaml.safe_dump(_doc({"j1": [{"type": "mesh", "file": "broken.stl"}]})))
+    path.write_text(
+        yaml.safe_dump(_doc({"j1": [{"type": "mesh", "file": "broken.stl"}]}))
+    )
     r = robokin.load(path)  # meshes load lazily ...
     with pytest.raises(ModelError) as exc:  # ... and fail clearly on first use
         r.geometry.check_files()
@@ -183,7 +237,8 @@ def test_unsupported_mesh_format_is_refused(tmp_path):
     (tmp_path / "part.step").write_text("ISO-10303-21;")
     with pytest.raises(ModelError, match="unsupported mesh format"):
         robot_from_document(
-            _doc({"j1": [{"type": "mesh", "file": "part.step"}]}), file=tmp_path / "a.yaml"
+            _doc({"j1": [{"type": "mesh", "file": "part.step"}]}),
+            file=tmp_path / "a.yaml",
         )
 
 
@@ -194,7 +249,9 @@ def test_every_builtin_arm_carries_geometry_clear_of_itself_at_a_safe_pose(name)
     r = robokin.load(name)
     g = r.geometry
     assert isinstance(g, geo.RobotGeometry)
-    assert sum(len(s) for s in g.shapes) >= r.n_chain  # something on (nearly) every link
+    assert (
+        sum(len(s) for s in g.shapes) >= r.n_chain
+    )  # something on (nearly) every link
     for pair in g.exclude:
         assert all(n in g.names for n in pair)
     q = np.clip(np.zeros(r.n), r.limits[:, 0], r.limits[:, 1])

@@ -34,12 +34,21 @@ def _sat(Ra, ca, ha, ra, Rb, cb, hb, rb):
     rr = ra + rb
     best = -np.inf
     for i in range(3):  # A's face normals
-        g = abs(T[i]) - ha[i] - (hb[0] * A[i, 0] + hb[1] * A[i, 1] + hb[2] * A[i, 2]) - rr
+        g = (
+            abs(T[i])
+            - ha[i]
+            - (hb[0] * A[i, 0] + hb[1] * A[i, 1] + hb[2] * A[i, 2])
+            - rr
+        )
         if g > best:
             best = g
     for j in range(3):  # B's face normals
-        g = (abs(T[0] * R[0, j] + T[1] * R[1, j] + T[2] * R[2, j])
-             - (ha[0] * A[0, j] + ha[1] * A[1, j] + ha[2] * A[2, j]) - hb[j] - rr)
+        g = (
+            abs(T[0] * R[0, j] + T[1] * R[1, j] + T[2] * R[2, j])
+            - (ha[0] * A[0, j] + ha[1] * A[1, j] + ha[2] * A[2, j])
+            - hb[j]
+            - rr
+        )
         if g > best:
             best = g
     for i in range(3):  # edge-edge axes e_i x R[:, j]
@@ -116,8 +125,16 @@ def rounded_box_bounds(
             if is_self[p]:
                 out[p, i] = _sat(Rw[a], cw[a], h[a], r[a], Rw[b], cw[b], h[b], r[b])
             else:
-                out[p, i] = _sat(Rw[a], cw[a], h[a], r[a], ob_pose[b, :3, :3],
-                                 ob_pose[b, :3, 3], ob_h[b], ob_r[b])
+                out[p, i] = _sat(
+                    Rw[a],
+                    cw[a],
+                    h[a],
+                    r[a],
+                    ob_pose[b, :3, :3],
+                    ob_pose[b, :3, 3],
+                    ob_h[b],
+                    ob_r[b],
+                )
     return out
 
 
@@ -163,7 +180,9 @@ def _seg_seg(p1, q1, p2, q2):
 
 
 @njit(cache=True, parallel=True)
-def capsule_distances(frames, link, seg, seg_r, ob_seg, ob_r, pa, pb, is_self, pairs, out):
+def capsule_distances(
+    frames, link, seg, seg_r, ob_seg, ob_r, pa, pb, is_self, pairs, out
+):
     """Exact distances of capsule/sphere pairs at every sample.
 
     Args:
@@ -184,8 +203,12 @@ def capsule_distances(frames, link, seg, seg_r, ob_seg, ob_r, pa, pb, is_self, p
             F = frames[i, link[s]]
             for e in range(2):
                 for a in range(3):
-                    w[s, e, a] = (F[a, 0] * seg[s, e, 0] + F[a, 1] * seg[s, e, 1]
-                                  + F[a, 2] * seg[s, e, 2] + F[a, 3])
+                    w[s, e, a] = (
+                        F[a, 0] * seg[s, e, 0]
+                        + F[a, 1] * seg[s, e, 1]
+                        + F[a, 2] * seg[s, e, 2]
+                        + F[a, 3]
+                    )
         for k in range(pairs.shape[0]):
             p = pairs[k]
             a = pa[p]
@@ -193,7 +216,11 @@ def capsule_distances(frames, link, seg, seg_r, ob_seg, ob_r, pa, pb, is_self, p
             if is_self[p]:
                 d = _seg_seg(w[a, 0], w[a, 1], w[b, 0], w[b, 1]) - seg_r[a] - seg_r[b]
             else:
-                d = _seg_seg(w[a, 0], w[a, 1], ob_seg[b, 0], ob_seg[b, 1]) - seg_r[a] - ob_r[b]
+                d = (
+                    _seg_seg(w[a, 0], w[a, 1], ob_seg[b, 0], ob_seg[b, 1])
+                    - seg_r[a]
+                    - ob_r[b]
+                )
             out[k, i] = d
     return out
 
@@ -229,8 +256,23 @@ def propagate_bounds(LB, known, C, rows):
 
 
 @njit(cache=True, parallel=True)
-def motion_bounds(frames, pre, link, sph_c, sph_r, sph_start, sph_count, Rst, prismatic,
-                  spins, dq, pa, pb, is_self, out):
+def motion_bounds(
+    frames,
+    pre,
+    link,
+    sph_c,
+    sph_r,
+    sph_start,
+    sph_count,
+    Rst,
+    prismatic,
+    spins,
+    dq,
+    pa,
+    pb,
+    is_self,
+    out,
+):
     """Bound on how much each pair's distance can change over each interval.
 
     A point of a shape on link k moves at most ``sum_j W_j |dq_j|`` between two
@@ -261,9 +303,17 @@ def motion_bounds(frames, pre, link, sph_c, sph_r, sph_start, sph_count, Rst, pr
         for j in range(nc):
             F = frames[i, j]
             for a in range(3):
-                o[j, a] = (F[a, 0] * pre[j, 0, 3] + F[a, 1] * pre[j, 1, 3]
-                           + F[a, 2] * pre[j, 2, 3] + F[a, 3])
-                z[j, a] = F[a, 0] * pre[j, 0, 2] + F[a, 1] * pre[j, 1, 2] + F[a, 2] * pre[j, 2, 2]
+                o[j, a] = (
+                    F[a, 0] * pre[j, 0, 3]
+                    + F[a, 1] * pre[j, 1, 3]
+                    + F[a, 2] * pre[j, 2, 3]
+                    + F[a, 3]
+                )
+                z[j, a] = (
+                    F[a, 0] * pre[j, 0, 2]
+                    + F[a, 1] * pre[j, 1, 2]
+                    + F[a, 2] * pre[j, 2, 2]
+                )
         for s in range(S):
             kk = min(link[s], nc)
             if kk == 0:
@@ -276,9 +326,24 @@ def motion_bounds(frames, pre, link, sph_c, sph_r, sph_start, sph_count, Rst, pr
                 else:
                     f = 0.0
                     for q in range(sph_start[s], sph_start[s] + sph_count[s]):
-                        c0 = F[0, 0] * sph_c[q, 0] + F[0, 1] * sph_c[q, 1] + F[0, 2] * sph_c[q, 2] + F[0, 3]
-                        c1 = F[1, 0] * sph_c[q, 0] + F[1, 1] * sph_c[q, 1] + F[1, 2] * sph_c[q, 2] + F[1, 3]
-                        c2 = F[2, 0] * sph_c[q, 0] + F[2, 1] * sph_c[q, 1] + F[2, 2] * sph_c[q, 2] + F[2, 3]
+                        c0 = (
+                            F[0, 0] * sph_c[q, 0]
+                            + F[0, 1] * sph_c[q, 1]
+                            + F[0, 2] * sph_c[q, 2]
+                            + F[0, 3]
+                        )
+                        c1 = (
+                            F[1, 0] * sph_c[q, 0]
+                            + F[1, 1] * sph_c[q, 1]
+                            + F[1, 2] * sph_c[q, 2]
+                            + F[1, 3]
+                        )
+                        c2 = (
+                            F[2, 0] * sph_c[q, 0]
+                            + F[2, 1] * sph_c[q, 1]
+                            + F[2, 2] * sph_c[q, 2]
+                            + F[2, 3]
+                        )
                         r0 = c0 - o[j, 0]
                         r1 = c1 - o[j, 1]
                         r2 = c2 - o[j, 2]

@@ -32,7 +32,6 @@ How it stays fast (coal queries are the expensive part):
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -172,7 +171,9 @@ class CollisionReport:
         return self._problem.profile(self._q, body_a, body_b)
 
 
-def _as_samples(q_samples: Any, n: int, t: npt.ArrayLike | None) -> tuple[np.ndarray, np.ndarray | None]:
+def _as_samples(
+    q_samples: Any, n: int, t: npt.ArrayLike | None
+) -> tuple[np.ndarray, np.ndarray | None]:
     if hasattr(q_samples, "q") and not isinstance(q_samples, np.ndarray):
         tt = getattr(q_samples, "t", None)
         q = q_samples.q
@@ -183,18 +184,24 @@ def _as_samples(q_samples: Any, n: int, t: npt.ArrayLike | None) -> tuple[np.nda
     try:
         q = np.array(q, dtype=np.float64)
     except (TypeError, ValueError):
-        raise InputError("q_samples", f"expected numbers, got {q_samples!r:.60}") from None
+        raise InputError(
+            "q_samples", f"expected numbers, got {q_samples!r:.60}"
+        ) from None
     if q.ndim == 1:
         q = q[None, :]
     if q.ndim != 2 or q.shape[1] != n or q.shape[0] == 0:
-        raise InputError("q_samples", f"expected shape (m, {n}) with m >= 1, got {q.shape}")
+        raise InputError(
+            "q_samples", f"expected shape (m, {n}) with m >= 1, got {q.shape}"
+        )
     if not np.isfinite(q).all():
         bad = np.argwhere(~np.isfinite(q))[0]
         raise InputError("q_samples", f"holds a non-finite value at index {tuple(bad)}")
     if t is not None:
         t = np.asarray(t, dtype=np.float64).reshape(-1)
         if t.shape != (q.shape[0],) or not np.isfinite(t).all():
-            raise InputError("t", f"expected {q.shape[0]} finite times, got shape {t.shape}")
+            raise InputError(
+                "t", f"expected {q.shape[0]} finite times, got shape {t.shape}"
+            )
     return q, t
 
 
@@ -241,12 +248,25 @@ def check(
         InputError: bad samples, times or clearance.
         MissingExtraError: coal (or trimesh for meshes) is not installed.
     """
-    if not (isinstance(clearance, int | float) and math.isfinite(clearance) and clearance >= 0):
-        raise InputError("clearance", f"expected a finite number >= 0 [m], got {clearance!r}")
+    if not (
+        isinstance(clearance, int | float)
+        and math.isfinite(clearance)
+        and clearance >= 0
+    ):
+        raise InputError(
+            "clearance", f"expected a finite number >= 0 [m], got {clearance!r}"
+        )
     q, tt = _as_samples(q_samples, robot.n, t)
     problem = _problem_for(robot, scene, self_collision)
-    return problem.run(q, tt, float(clearance), subdivide, float(tolerance),
-                       max(float(pair_tolerance), _TIE), max(float(pair_rtol), 0.0))
+    return problem.run(
+        q,
+        tt,
+        float(clearance),
+        subdivide,
+        float(tolerance),
+        max(float(pair_tolerance), _TIE),
+        max(float(pair_rtol), 0.0),
+    )
 
 
 def _problem_for(robot: Robot, scene: Scene, self_collision: bool) -> _Problem:
@@ -309,10 +329,14 @@ class _Problem:
         # Largest reach of each shape from its link frame origin.
         self.rho = np.zeros(S)
         if S:
-            np.maximum.at(self.rho, self.sph_owner,
-                          np.linalg.norm(self.sph_c, axis=1) + self.sph_r)
-        self.spins = np.array([self._spins(s, k, placed.chain) for s, k in zip(shapes, link)],
-                              dtype=bool)
+            np.maximum.at(
+                self.rho,
+                self.sph_owner,
+                np.linalg.norm(self.sph_c, axis=1) + self.sph_r,
+            )
+        self.spins = np.array(
+            [self._spins(s, k, placed.chain) for s, k in zip(shapes, link)], dtype=bool
+        )
         # Scene objects: oriented boxes for the broad phase, fixed coal transforms.
         objects = list(scene.objects)
         self.objects = objects
@@ -327,8 +351,11 @@ class _Problem:
             self.ob_R[j] = P[:3, :3]
             self.ob_t[j] = P[:3, :3] @ c + P[:3, 3]
             self.ob_h[j] = h
-            self.ob_T3.append(coal.Transform3s(np.ascontiguousarray(P[:3, :3]),
-                                               np.ascontiguousarray(P[:3, 3])))
+            self.ob_T3.append(
+                coal.Transform3s(
+                    np.ascontiguousarray(P[:3, :3]), np.ascontiguousarray(P[:3, 3])
+                )
+            )
         # Pairs at shape level: (robot shape, object) then (robot shape, robot shape).
         names = geo.names
         pa, pb, is_self = [], [], []
@@ -365,8 +392,12 @@ class _Problem:
         c1, c2, grp = [], [], []
         for g, p in enumerate(self.self_pairs):
             i, j = pa[p], pb[p]
-            a = np.arange(self.sph_start[i], self.sph_start[i] + np.sum(self.sph_owner == i))
-            b = np.arange(self.sph_start[j], self.sph_start[j] + np.sum(self.sph_owner == j))
+            a = np.arange(
+                self.sph_start[i], self.sph_start[i] + np.sum(self.sph_owner == i)
+            )
+            b = np.arange(
+                self.sph_start[j], self.sph_start[j] + np.sum(self.sph_owner == j)
+            )
             A_, B_ = np.meshgrid(a, b, indexing="ij")
             c1.append(A_.ravel())
             c2.append(B_.ravel())
@@ -375,7 +406,9 @@ class _Problem:
         self.self_c2 = np.concatenate(c2) if c2 else np.zeros(0, int)
         grp_arr = np.concatenate(grp) if grp else np.zeros(0, int)
         self.self_start = np.searchsorted(grp_arr, np.arange(len(self.self_pairs)))
-        self.self_rr = self.sph_r[self.self_c1] + self.sph_r[self.self_c2] if c1 else np.zeros(0)
+        self.self_rr = (
+            self.sph_r[self.self_c1] + self.sph_r[self.self_c2] if c1 else np.zeros(0)
+        )
         # Exact geometry: distance functors (meshes: exact BVH and convex hull).
         self.has_mesh = np.zeros(P, dtype=bool)
         self.fn_exact: list[Any] = []
@@ -399,7 +432,10 @@ class _Problem:
             self.fn_exact.append(functor(ga, gb))
             mesh = sa.kind == "mesh" or sb.kind == "mesh"
             self.has_mesh[p] = mesh
-            self.fn_hull.append(functor(sa.coal_convex(), sb.coal_convex()) if mesh else None)
+            self.fn_hull.append(
+                functor(sa.coal_convex(), sb.coal_convex()) if mesh else None
+            )
+
         # Capsule/sphere pairs have a closed-form distance: computed for all samples
         # at once (segment-segment distance minus the radii).
         def segment(sh):
@@ -424,10 +460,15 @@ class _Problem:
         for p in range(P):
             if not seg_ok[pa[p]]:
                 continue
-            self.analytic[p] = seg_ok[pb[p]] if is_self[p] else ob_seg[pb[p]][0] is not None
-        self.ob_seg = np.array([sg if sg is not None else np.zeros((2, 3)) for sg, _ in ob_seg])
+            self.analytic[p] = (
+                seg_ok[pb[p]] if is_self[p] else ob_seg[pb[p]][0] is not None
+            )
+        self.ob_seg = np.array(
+            [sg if sg is not None else np.zeros((2, 3)) for sg, _ in ob_seg]
+        )
         self.ob_seg = self.ob_seg.reshape(O, 2, 3)
         self.ob_seg_r = np.array([rad for _, rad in ob_seg]) if O else np.zeros(0)
+
         # Rounded bounding boxes (pose in the parent frame, half sizes, radius).
         def rounded_box(sh):
             k, sz = sh.kind, sh.size
@@ -483,10 +524,16 @@ class _Problem:
     def _static_chain_lengths(self) -> None:
         ch = self.chain
         nc = self.nc
-        self.a_len = np.linalg.norm(ch.frame_offsets[:, :3, 3], axis=1) if nc else np.zeros(0)
-        self.b_len = np.linalg.norm(ch.link_offsets[:, :3, 3], axis=1) if nc else np.zeros(0)
+        self.a_len = (
+            np.linalg.norm(ch.frame_offsets[:, :3, 3], axis=1) if nc else np.zeros(0)
+        )
+        self.b_len = (
+            np.linalg.norm(ch.link_offsets[:, :3, 3], axis=1) if nc else np.zeros(0)
+        )
         self.tool_len = float(np.linalg.norm(ch.tool[:3, 3]))
-        self.prismatic = np.array([j.kind == "prismatic" for j in ch.joints], dtype=bool)
+        self.prismatic = np.array(
+            [j.kind == "prismatic" for j in ch.joints], dtype=bool
+        )
         # pre_j: constant from the frame reported for link j-1 to joint j.
         pre = np.empty((nc, 4, 4))
         if nc:
@@ -509,7 +556,9 @@ class _Problem:
             for j in range(1, min(k, nc) + 1):  # joints 1..k move link k
                 # constants after J_j up to frame k
                 top = min(k, nc)
-                total = self.a_len[j - 1 : top].sum() + self.b_len[j - 1 : top - 1].sum()
+                total = (
+                    self.a_len[j - 1 : top].sum() + self.b_len[j - 1 : top - 1].sum()
+                )
                 total += ext[j:top].sum()
                 if k == nc + 1:  # tool: F_nc G_nc tool after the last joint
                     total += self.b_len[nc - 1] + self.tool_len
@@ -519,7 +568,7 @@ class _Problem:
     def motion(self, q: np.ndarray, frames: np.ndarray) -> np.ndarray:
         """Per interval and pair, the bound on the motion closing the distance, (P, m-1)."""
         m = q.shape[0]
-        S, nc, P = len(self.shapes), self.nc, self.P
+        S, P = len(self.shapes), self.P
         if m < 2 or P == 0:
             return np.zeros((P, max(m - 1, 0)))
         qc = self.chain.coupling.apply(q)
@@ -529,10 +578,23 @@ class _Problem:
 
         Ms = np.empty((P, m - 1))
         counts = np.bincount(self.sph_owner, minlength=S).astype(np.int64)
-        motion_bounds(np.ascontiguousarray(frames), np.ascontiguousarray(self.pre), self.link,
-                      self.sph_c, self.sph_r, self.sph_start.astype(np.int64), counts,
-                      np.ascontiguousarray(Rst), self.prismatic, self.spins,
-                      np.ascontiguousarray(dq), self.pa, self.pb, self.is_self, Ms)
+        motion_bounds(
+            np.ascontiguousarray(frames),
+            np.ascontiguousarray(self.pre),
+            self.link,
+            self.sph_c,
+            self.sph_r,
+            self.sph_start.astype(np.int64),
+            counts,
+            np.ascontiguousarray(Rst),
+            self.prismatic,
+            self.spins,
+            np.ascontiguousarray(dq),
+            self.pa,
+            self.pb,
+            self.is_self,
+            Ms,
+        )
         return Ms
 
     # ---------------------------------------------------------------- bounds
@@ -551,9 +613,19 @@ class _Problem:
         m = frames.shape[0]
         out = np.full((self.P, m), -np.inf)
         rounded_box_bounds(
-            np.ascontiguousarray(frames), self.link, self.rb_local, self.rb_h, self.rb_r,
-            self.ob_rb_pose, self.ob_rb_h, self.ob_rb_r, self.pa, self.pb, self.is_self,
-            self.analytic, out,
+            np.ascontiguousarray(frames),
+            self.link,
+            self.rb_local,
+            self.rb_h,
+            self.rb_r,
+            self.ob_rb_pose,
+            self.ob_rb_h,
+            self.ob_rb_r,
+            self.pa,
+            self.pb,
+            self.is_self,
+            self.analytic,
+            out,
         )
         return out
 
@@ -563,9 +635,19 @@ class _Problem:
         from robokin.collision._kernels import capsule_distances
 
         out = np.empty((len(pairs), frames.shape[0]))
-        capsule_distances(np.ascontiguousarray(frames), self.link, self.seg_local, self.seg_r,
-                          self.ob_seg, self.ob_seg_r, self.pa, self.pb, self.is_self,
-                          np.ascontiguousarray(pairs), out)
+        capsule_distances(
+            np.ascontiguousarray(frames),
+            self.link,
+            self.seg_local,
+            self.seg_r,
+            self.ob_seg,
+            self.ob_seg_r,
+            self.pa,
+            self.pb,
+            self.is_self,
+            np.ascontiguousarray(pairs),
+            out,
+        )
         return out
 
     # ----------------------------------------------------------------- exact
@@ -587,7 +669,9 @@ class _Problem:
         res.clear()  # coal keeps the minimum over calls otherwise
         return float(fn(Ta, Tb, self.req, res))
 
-    def nearest(self, p: int, frames_i: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    def nearest(
+        self, p: int, frames_i: np.ndarray
+    ) -> tuple[float, np.ndarray, np.ndarray]:
         """Distance and nearest points (world) of pair p at one configuration."""
         a = self.pa[p]
         Ta = self._T3(frames_i[self.link[a]], a)
@@ -599,7 +683,11 @@ class _Problem:
         res = self.coal.DistanceResult()
         ga, gb = self.geoms[p]
         d = self.coal.distance(ga, Ta, gb, Tb, self.req, res)
-        return float(d), np.array(res.getNearestPoint1()), np.array(res.getNearestPoint2())
+        return (
+            float(d),
+            np.array(res.getNearestPoint1()),
+            np.array(res.getNearestPoint2()),
+        )
 
     # ------------------------------------------------------------------- run
     def frames(self, q: np.ndarray) -> np.ndarray:
@@ -607,14 +695,27 @@ class _Problem:
 
         return link_frames(self.chain, q)
 
-    def run(self, q, t, clearance, subdivide, tol, pair_tol, pair_rtol) -> CollisionReport:
+    def run(
+        self, q, t, clearance, subdivide, tol, pair_tol, pair_rtol
+    ) -> CollisionReport:
         m = q.shape[0]
         times = np.arange(m, dtype=float) if t is None else t
         P = self.P
         frames = self.frames(q)
         if P == 0:
-            return CollisionReport(math.inf, False, [], [], [], None, [], clearance, times,
-                                   _problem=self, _q=q)
+            return CollisionReport(
+                math.inf,
+                False,
+                [],
+                [],
+                [],
+                None,
+                [],
+                clearance,
+                times,
+                _problem=self,
+                _q=q,
+            )
         LB = self.lower_bounds(frames)
         Ms = self.motion(q, frames)  # (P, m-1)
         C = np.zeros((P, m))
@@ -648,7 +749,9 @@ class _Problem:
 
         def propagate(rows: np.ndarray) -> None:
             if len(rows) and m >= 2:
-                propagate_bounds(LB, done | hulled, C, np.ascontiguousarray(rows, dtype=np.int64))
+                propagate_bounds(
+                    LB, done | hulled, C, np.ascontiguousarray(rows, dtype=np.int64)
+                )
 
         # 1. Exact queries where they decide something: a sample whose bound does
         #    not clear the threshold (to classify it), or lies below its pair's best
@@ -673,7 +776,9 @@ class _Problem:
                 bc = best[cand]
                 rel = pair_rtol * np.abs(np.where(np.isfinite(bc), bc, 0.0))
                 slack = np.maximum(pair_tol, rel)[:, None]
-                need = ~done[cand] & ((Lc <= clearance) | (Lc < best[cand, None] - slack))
+                need = ~done[cand] & (
+                    (Lc <= clearance) | (Lc < best[cand, None] - slack)
+                )
             keep = need.any(axis=1)
             rows, need = cand[keep], need[keep]
             if not final:
@@ -705,11 +810,19 @@ class _Problem:
                 for off in (0, 1):
                     sel = ~done[ps, idx + off]
                     evaluate(ps[sel], idx[sel] + off, force_exact=True)
-                still = (D[ps, idx] + D[ps, idx + 1] <= Ms[ps, idx] + 2 * clearance)
+                still = D[ps, idx] + D[ps, idx + 1] <= Ms[ps, idx] + 2 * clearance
                 still &= (D[ps, idx] > clearance) & (D[ps, idx + 1] > clearance)
                 for p, i in zip(ps[still].tolist(), idx[still].tolist()):
-                    found = self._bisect(p, q[i], q[i + 1], D[p, i], D[p, i + 1],
-                                         Ms[p, i], clearance, tol)
+                    found = self._bisect(
+                        p,
+                        q[i],
+                        q[i + 1],
+                        D[p, i],
+                        D[p, i + 1],
+                        Ms[p, i],
+                        clearance,
+                        tol,
+                    )
                     if found is not None:
                         between[(p, i)] = found
         return self._report(q, times, frames, D, between, clearance)
@@ -731,9 +844,8 @@ class _Problem:
             evals += 1
             self.queries += 1
             self.subdivisions += 1
-            if found is None or d < found[1]:
-                if d <= target or (found is not None and d < found[1]):
-                    found = (mid, d)
+            if (found is None and d <= target) or (found is not None and d < found[1]):
+                found = (mid, d)
             if d <= 0.0:
                 found = (mid, d)
                 break
@@ -768,7 +880,9 @@ class _Problem:
             per_sample = np.nanmin(np.where(np.isnan(sub), np.inf, sub), axis=0)
             i = int(np.argmin(per_sample))
             dmin = float(per_sample[i])
-            p_best = plist[int(np.nanargmin(np.where(np.isnan(sub[:, i]), np.inf, sub[:, i])))]
+            p_best = plist[
+                int(np.nanargmin(np.where(np.isnan(sub[:, i]), np.inf, sub[:, i])))
+            ]
             kind = "self" if self.is_self[plist[0]] else "object"
             pairs.append(PairMinimum(ba, bb, dmin, i, t_at(i), kind))
             cand = (dmin, p_best, i, 0.0, False)
@@ -794,15 +908,29 @@ class _Problem:
         min_distance = math.inf
         if best_overall is not None:
             dmin, p, i, frac, btw_flag = best_overall
-            fr = frames[i] if not btw_flag else self.frames(q[i] + frac * (q[i + 1] - q[i]))
+            fr = (
+                frames[i]
+                if not btw_flag
+                else self.frames(q[i] + frac * (q[i + 1] - q[i]))
+            )
             d, pa_, pb_ = self.nearest(p, fr)
             min_distance = float(dmin)
-            closest = Closest(float(dmin), int(i), t_at(i, frac), self.body_a[p],
-                              self.body_b[p], pa_, pb_, btw_flag)
+            closest = Closest(
+                float(dmin),
+                int(i),
+                t_at(i, frac),
+                self.body_a[p],
+                self.body_b[p],
+                pa_,
+                pb_,
+                btw_flag,
+            )
         intervals.sort(key=lambda r: (r.first_index, r.body_a, r.body_b))
         violations.sort(key=lambda r: (r.first_index, r.body_a, r.body_b))
-        collisions = [Collision(r.first_index, r.last_index, r.body_a, r.body_b)
-                      for r in intervals]
+        collisions = [
+            Collision(r.first_index, r.last_index, r.body_a, r.body_b)
+            for r in intervals
+        ]
         return CollisionReport(
             min_distance=min_distance,
             collides=bool(intervals),
@@ -821,8 +949,11 @@ class _Problem:
 
     def profile(self, q: np.ndarray, body_a: str, body_b: str) -> np.ndarray:
         """Exact distance of one body pair at every sample, (m,)."""
-        plist = [p for p in range(self.P)
-                 if {self.body_a[p], self.body_b[p]} == {body_a, body_b}]
+        plist = [
+            p
+            for p in range(self.P)
+            if {self.body_a[p], self.body_b[p]} == {body_a, body_b}
+        ]
         if not plist:
             raise InputError("pair", f"({body_a!r}, {body_b!r}) is not a checked pair")
         frames = self.frames(q)
@@ -848,9 +979,13 @@ def _runs(mask, bmask, bfrac, per_sample, ba, bb, t_at) -> list[Interval]:
     for s, e in zip(edges[0::2], edges[1::2] - 1):
         s, e = int(s), int(e)
         dvals = [float(per_sample[k // 2]) for k in range(s, e + 1) if k % 2 == 0]
-        dvals += [bfrac[k // 2][1] for k in range(s, e + 1) if k % 2 and (k // 2) in bfrac]
+        dvals += [
+            bfrac[k // 2][1] for k in range(s, e + 1) if k % 2 and (k // 2) in bfrac
+        ]
         t0 = t_at(s // 2) if s % 2 == 0 else t_at(s // 2, bfrac[s // 2][0])
         t1 = t_at(e // 2) if e % 2 == 0 else t_at(e // 2, bfrac[e // 2][0])
         only_between = s == e and s % 2 == 1
-        out.append(Interval(s // 2, (e + 1) // 2, ba, bb, t0, t1, min(dvals), only_between))
+        out.append(
+            Interval(s // 2, (e + 1) // 2, ba, bb, t0, t1, min(dvals), only_between)
+        )
     return out

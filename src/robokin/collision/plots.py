@@ -58,15 +58,28 @@ def plot_distance(
         lowest = min(lowest, float(d.min()))
         ax.plot(t, d * 1e3, lw=1.4, label=f"{a} – {b}")
     for iv in report.intervals:
-        ax.axvspan(iv.t_start, max(iv.t_end, iv.t_start + 1e-9), color="tab:red", alpha=0.15)
+        ax.axvspan(
+            iv.t_start, max(iv.t_end, iv.t_start + 1e-9), color="tab:red", alpha=0.15
+        )
     ax.axhline(0.0, color="k", lw=0.8)
     if thr > 0:
-        ax.axhline(thr * 1e3, color="tab:red", ls="--", lw=1.2,
-                   label=f"clearance {thr * 1e3:g} mm")
+        ax.axhline(
+            thr * 1e3,
+            color="tab:red",
+            ls="--",
+            lw=1.2,
+            label=f"clearance {thr * 1e3:g} mm",
+        )
     c = report.closest
     if c is not None:
-        ax.plot([c.t], [c.distance * 1e3], "o", color="tab:red", ms=6,
-                label=f"min {c.distance * 1e3:.2f} mm ({c.body_a} – {c.body_b})")
+        ax.plot(
+            [c.t],
+            [c.distance * 1e3],
+            "o",
+            color="tab:red",
+            ms=6,
+            label=f"min {c.distance * 1e3:.2f} mm ({c.body_a} – {c.body_b})",
+        )
     ax.set_xlabel("time [s]")
     ax.set_ylabel("distance [mm]")
     ax.set_title("minimum distance over time")

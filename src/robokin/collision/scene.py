@@ -143,7 +143,8 @@ class Scene:
             return self._objects[name]
         except KeyError:
             raise InputError(
-                "name", f"no object {name!r} in the scene; objects: {list(self._objects)}"
+                "name",
+                f"no object {name!r} in the scene; objects: {list(self._objects)}",
             ) from None
 
     def __len__(self) -> int:
@@ -204,7 +205,9 @@ class Scene:
         Raises:
             ModelError: the file is missing or unreadable (names file and object).
         """
-        shape = _geo.mesh(file, _pose(pose, "pose"), units=units, scale=scale, owner=name)
+        shape = _geo.mesh(
+            file, _pose(pose, "pose"), units=units, scale=scale, owner=name
+        )
         shape.check_file()
         return self.add(name, shape)
 
@@ -222,7 +225,9 @@ class Scene:
         name: str = "tool",
     ) -> None:
         """Mount a tool: ``shapes`` in the mount frame, ``tcp`` mount -> TCP (4, 4)."""
-        self.tool = Tool(name, _pose(tcp, "tcp"), tuple(s.with_owner("tool") for s in shapes))
+        self.tool = Tool(
+            name, _pose(tcp, "tcp"), tuple(s.with_owner("tool") for s in shapes)
+        )
         self._version += 1
 
     def exclude_pair(self, link: str, obj: str) -> None:
@@ -281,7 +286,9 @@ class Scene:
             doc = yaml.safe_load(text)
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
-            where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+            where = (
+                f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+            )
             raise ModelError(f"not valid YAML{where}", file=path) from None
         return cls.from_document(doc, file=path)
 
@@ -292,22 +299,41 @@ class Scene:
 
         if not isinstance(doc, Mapping):
             raise ModelError("a scene file must be a mapping of fields", file=file)
-        allowed = {"name", "source", "units", "robot", "tool", "objects", "exclude", "poses"}
+        allowed = {
+            "name",
+            "source",
+            "units",
+            "robot",
+            "tool",
+            "objects",
+            "exclude",
+            "poses",
+        }
         for key in doc:
             if key not in allowed:
-                raise ModelError(f"unknown field (allowed: {sorted(allowed)})", file=file,
-                                 field=str(key))
+                raise ModelError(
+                    f"unknown field (allowed: {sorted(allowed)})",
+                    file=file,
+                    field=str(key),
+                )
         units = doc.get("units") or {}
         if not isinstance(units, Mapping):
-            raise ModelError("expected {length: m|mm, angle: rad|deg}", file=file,
-                             field="units")
+            raise ModelError(
+                "expected {length: m|mm, angle: rad|deg}", file=file, field="units"
+            )
         lu, au = units.get("length", "m"), units.get("angle", "rad")
         if lu not in _LENGTH:
-            raise ModelError(f"expected one of {list(_LENGTH)}, got {lu!r}", file=file,
-                             field="units.length")
+            raise ModelError(
+                f"expected one of {list(_LENGTH)}, got {lu!r}",
+                file=file,
+                field="units.length",
+            )
         if au not in _ANGLE:
-            raise ModelError(f"expected one of {list(_ANGLE)}, got {au!r}", file=file,
-                             field="units.angle")
+            raise ModelError(
+                f"expected one of {list(_ANGLE)}, got {au!r}",
+                file=file,
+                field="units.angle",
+            )
         L, A = _LENGTH[lu], _ANGLE[au]
         base_dir = Path(file).parent if file is not None else None
         scene = cls(str(doc.get("name", Path(file).stem if file else "scene")))
@@ -317,39 +343,56 @@ class Scene:
             if p is None:
                 return np.eye(4)
             if not isinstance(p, Mapping) or set(p) - {"xyz", "rpy"}:
-                raise ModelError("expected {xyz: [x, y, z], rpy: [r, p, y]}", file=file,
-                                 field=where)
+                raise ModelError(
+                    "expected {xyz: [x, y, z], rpy: [r, p, y]}", file=file, field=where
+                )
             try:
                 xyz = np.asarray(p.get("xyz", (0, 0, 0)), dtype=float)
                 rpy = np.asarray(p.get("rpy", (0, 0, 0)), dtype=float)
-                if xyz.shape != (3,) or rpy.shape != (3,) or not (
-                    np.isfinite(xyz).all() and np.isfinite(rpy).all()
+                if (
+                    xyz.shape != (3,)
+                    or rpy.shape != (3,)
+                    or not (np.isfinite(xyz).all() and np.isfinite(rpy).all())
                 ):
                     raise ValueError
             except (TypeError, ValueError):
-                raise ModelError("xyz and rpy need 3 finite numbers each", file=file,
-                                 field=where) from None
+                raise ModelError(
+                    "xyz and rpy need 3 finite numbers each", file=file, field=where
+                ) from None
             return pose_from_xyz_rpy(xyz * L, rpy * A)
 
         rob = doc.get("robot")
         if rob is not None:
             if not isinstance(rob, Mapping) or set(rob) - {"name", "base"}:
-                raise ModelError("expected {name: ..., base: {xyz, rpy}}", file=file,
-                                 field="robot")
+                raise ModelError(
+                    "expected {name: ..., base: {xyz, rpy}}", file=file, field="robot"
+                )
             scene.robot_name = None if rob.get("name") is None else str(rob["name"])
             scene.base = placement(rob.get("base"), "robot.base")
         tool = doc.get("tool")
         if tool is not None:
             if not isinstance(tool, Mapping) or set(tool) - {"name", "tcp", "shapes"}:
-                raise ModelError("expected {name, tcp: {xyz, rpy}, shapes: [...]}",
-                                 file=file, field="tool")
+                raise ModelError(
+                    "expected {name, tcp: {xyz, rpy}, shapes: [...]}",
+                    file=file,
+                    field="tool",
+                )
             shapes = tool.get("shapes") or []
             if not isinstance(shapes, list):
-                raise ModelError("expected a list of shapes", file=file, field="tool.shapes")
+                raise ModelError(
+                    "expected a list of shapes", file=file, field="tool.shapes"
+                )
             scene.set_tool(
                 [
-                    _geo.shape_from_spec(s, length=L, angle=A, base_dir=base_dir, file=file,
-                                         where=f"tool.shapes[{i}]", owner="tool")
+                    _geo.shape_from_spec(
+                        s,
+                        length=L,
+                        angle=A,
+                        base_dir=base_dir,
+                        file=file,
+                        where=f"tool.shapes[{i}]",
+                        owner="tool",
+                    )
                     for i, s in enumerate(shapes)
                 ],
                 placement(tool.get("tcp"), "tool.tcp"),
@@ -364,26 +407,36 @@ class Scene:
                 raise ModelError("an object needs a 'name'", file=file, field=where)
             name = str(spec["name"])
             if name in scene._objects:
-                raise ModelError(f"duplicate object name {name!r}", file=file,
-                                 field=f"{where}.name")
+                raise ModelError(
+                    f"duplicate object name {name!r}", file=file, field=f"{where}.name"
+                )
             shape = _geo.shape_from_spec(
-                {k: v for k, v in spec.items() if k != "name"}, length=L, angle=A,
-                base_dir=base_dir, file=file, where=where, owner=name,
+                {k: v for k, v in spec.items() if k != "name"},
+                length=L,
+                angle=A,
+                base_dir=base_dir,
+                file=file,
+                where=where,
+                owner=name,
             )
             if shape.kind == "mesh":
                 try:
                     shape.check_file()
                 except ModelError as exc:
-                    raise ModelError(exc.reason, file=file, field=f"{where}.file") from None
+                    raise ModelError(
+                        exc.reason, file=file, field=f"{where}.file"
+                    ) from None
             scene.add(name, shape)
         excl = doc.get("exclude") or []
         if not isinstance(excl, list):
-            raise ModelError("expected a list of [link, object] pairs", file=file,
-                             field="exclude")
+            raise ModelError(
+                "expected a list of [link, object] pairs", file=file, field="exclude"
+            )
         for i, p in enumerate(excl):
             if not (isinstance(p, list | tuple) and len(p) == 2):
-                raise ModelError("expected a pair [link, object]", file=file,
-                                 field=f"exclude[{i}]")
+                raise ModelError(
+                    "expected a pair [link, object]", file=file, field=f"exclude[{i}]"
+                )
             scene.exclude.add(frozenset(str(x) for x in p))
         poses = doc.get("poses") or {}
         if not isinstance(poses, Mapping):
@@ -401,7 +454,8 @@ class Scene:
                     if q.ndim != 1 or not np.isfinite(q).all():
                         raise ValueError
                 except (TypeError, ValueError):
-                    raise ModelError("expected a list of joint values", file=file,
-                                     field=f"{where}.q") from None
+                    raise ModelError(
+                        "expected a list of joint values", file=file, field=f"{where}.q"
+                    ) from None
                 scene.pose_joints[str(pname)] = q * A
         return scene

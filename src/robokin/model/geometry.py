@@ -106,17 +106,25 @@ class Shape:
 
     def __post_init__(self) -> None:
         if self.kind not in _KINDS:
-            raise InputError("kind", f"expected one of {list(_KINDS)}, got {self.kind!r}")
-        need = {"box": 3, "cylinder": 2, "capsule": 2, "sphere": 1, "mesh": 0}[self.kind]
+            raise InputError(
+                "kind", f"expected one of {list(_KINDS)}, got {self.kind!r}"
+            )
+        need = {"box": 3, "cylinder": 2, "capsule": 2, "sphere": 1, "mesh": 0}[
+            self.kind
+        ]
         size = tuple(float(v) for v in self.size)
         if len(size) != need:
-            raise InputError("size", f"a {self.kind} needs {need} sizes, got {len(size)}")
+            raise InputError(
+                "size", f"a {self.kind} needs {need} sizes, got {len(size)}"
+            )
         if any(not math.isfinite(v) or v < 0.0 for v in size):
             raise InputError("size", f"sizes must be finite and >= 0, got {size}")
         if self.kind in ("box", "sphere") and any(v <= 0 for v in size):
             raise InputError("size", f"a {self.kind} needs positive sizes, got {size}")
         if self.kind in ("cylinder", "capsule") and size[0] <= 0:
-            raise InputError("size", f"a {self.kind} needs a positive radius, got {size}")
+            raise InputError(
+                "size", f"a {self.kind} needs a positive radius, got {size}"
+            )
         if self.kind == "cylinder" and size[1] <= 0:
             raise InputError("size", f"a cylinder needs a positive length, got {size}")
         object.__setattr__(self, "size", size)
@@ -224,9 +232,7 @@ class Shape:
             counts = np.minimum(np.ceil(h / sub - 1e-9).astype(int), 6)
             counts = np.maximum(counts, 1)
             hs = h / counts
-            axes = [
-                (np.arange(n) + 0.5) / n * 2 * hh - hh for n, hh in zip(counts, h)
-            ]
+            axes = [(np.arange(n) + 0.5) / n * 2 * hh - hh for n, hh in zip(counts, h)]
             g = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
             centres = g + c
             radii = np.full(len(centres), float(np.linalg.norm(hs)))
@@ -315,7 +321,9 @@ def _load_mesh(path: Path | None, scale: float, owner: str):
         )
     if not np.isfinite(np.asarray(vertices)).all():
         raise ModelError(
-            f"mesh file holds non-finite vertices{where}", file=path, field=owner or None
+            f"mesh file holds non-finite vertices{where}",
+            file=path,
+            field=owner or None,
         )
     m = trimesh.Trimesh(
         vertices=np.asarray(vertices, dtype=np.float64) * scale,
@@ -333,7 +341,9 @@ def box(
     return Shape("box", tuple(size), _placement(placement), name=name)
 
 
-def sphere(radius: float, placement: npt.ArrayLike | None = None, *, name: str = "") -> Shape:
+def sphere(
+    radius: float, placement: npt.ArrayLike | None = None, *, name: str = ""
+) -> Shape:
     """A sphere of ``radius`` [m] centred on ``placement``."""
     return Shape("sphere", (radius,), _placement(placement), name=name)
 
@@ -369,7 +379,9 @@ def _segment_pose(p0: npt.ArrayLike, p1: npt.ArrayLike) -> tuple[np.ndarray, flo
     T[:3, 3] = (p0 + p1) / 2
     if L > 1e-12:
         z = axis / L
-        helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        helper = (
+            np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        )
         x = np.cross(helper, z)
         x /= np.linalg.norm(x)
         T[:3, :3] = np.stack([x, np.cross(z, x), z], axis=1)
@@ -445,11 +457,16 @@ class RobotGeometry:
     def __post_init__(self) -> None:
         if len(self.shapes) != len(self.names):
             raise InputError(
-                "shapes", f"expected one entry per link ({len(self.names)}), got {len(self.shapes)}"
+                "shapes",
+                f"expected one entry per link ({len(self.names)}), got {len(self.shapes)}",
             )
         object.__setattr__(
-            self, "shapes", tuple(tuple(s.with_owner(n) for s in ss)
-                                  for n, ss in zip(self.names, self.shapes))
+            self,
+            "shapes",
+            tuple(
+                tuple(s.with_owner(n) for s in ss)
+                for n, ss in zip(self.names, self.shapes)
+            ),
         )
         for pair in self.exclude:
             for n in pair:
@@ -528,13 +545,17 @@ class RobotGeometry:
         out = []
         for i in range(len(self.names)):
             for j in range(i + 1, len(self.names)):
-                if self.shapes[i] and self.shapes[j] and not self.is_excluded(
-                    self.names[i], self.names[j]
+                if (
+                    self.shapes[i]
+                    and self.shapes[j]
+                    and not self.is_excluded(self.names[i], self.names[j])
                 ):
                     out.append((i, j))
         return out
 
-    def retool(self, tcp: npt.ArrayLike, tool_shapes: Iterable[Shape] = ()) -> RobotGeometry:
+    def retool(
+        self, tcp: npt.ArrayLike, tool_shapes: Iterable[Shape] = ()
+    ) -> RobotGeometry:
         """Geometry after appending ``tcp`` to the tool transform.
 
         The current tool shapes and ``tool_shapes`` are both given in the old tool
@@ -566,7 +587,9 @@ _FIELDS = {
 }
 
 
-def _num(spec: Mapping[str, Any], key: str, where: str, file: Any, count: int | None = None):
+def _num(
+    spec: Mapping[str, Any], key: str, where: str, file: Any, count: int | None = None
+):
     v = spec[key]
     try:
         if count is None:
@@ -582,8 +605,9 @@ def _num(spec: Mapping[str, Any], key: str, where: str, file: Any, count: int | 
         return arr
     except (TypeError, ValueError):
         what = "a finite number" if count is None else f"{count} finite numbers"
-        raise ModelError(f"expected {what}, got {v!r:.60}", file=file,
-                         field=f"{where}.{key}") from None
+        raise ModelError(
+            f"expected {what}, got {v!r:.60}", file=file, field=f"{where}.{key}"
+        ) from None
 
 
 def shape_from_spec(
@@ -613,11 +637,14 @@ def shape_from_spec(
     from robokin.spatial import pose_from_xyz_rpy
 
     if not isinstance(spec, Mapping):
-        raise ModelError(f"a shape must be a mapping, got {spec!r:.60}", file=file, field=where)
+        raise ModelError(
+            f"a shape must be a mapping, got {spec!r:.60}", file=file, field=where
+        )
     kind = spec.get("type")
     if kind not in _KINDS:
         raise ModelError(
-            f"'type' must be one of {list(_KINDS)}, got {kind!r}", file=file,
+            f"'type' must be one of {list(_KINDS)}, got {kind!r}",
+            file=file,
             field=f"{where}.type",
         )
     allowed = _COMMON | _FIELDS[kind]
@@ -625,7 +652,8 @@ def shape_from_spec(
         if key not in allowed:
             raise ModelError(
                 f"unknown field for a {kind} (allowed: {sorted(allowed)})",
-                file=file, field=f"{where}.{key}",
+                file=file,
+                field=f"{where}.{key}",
             )
     xyz = _num(spec, "xyz", where, file, 3) * length if "xyz" in spec else np.zeros(3)
     rpy = _num(spec, "rpy", where, file, 3) * angle if "rpy" in spec else np.zeros(3)
@@ -634,17 +662,29 @@ def shape_from_spec(
 
     def need(key: str) -> None:
         if key not in spec:
-            raise ModelError("missing required field", file=file, field=f"{where}.{key}")
+            raise ModelError(
+                "missing required field", file=file, field=f"{where}.{key}"
+            )
 
     try:
         if kind == "box":
             need("size")
-            return Shape("box", tuple(_num(spec, "size", where, file, 3) * length), T,
-                         name=name, owner=owner)
+            return Shape(
+                "box",
+                tuple(_num(spec, "size", where, file, 3) * length),
+                T,
+                name=name,
+                owner=owner,
+            )
         if kind == "sphere":
             need("radius")
-            return Shape("sphere", (_num(spec, "radius", where, file) * length,), T,
-                         name=name, owner=owner)
+            return Shape(
+                "sphere",
+                (_num(spec, "radius", where, file) * length,),
+                T,
+                name=name,
+                owner=owner,
+            )
         if kind in ("cylinder", "capsule"):
             need("radius")
             r = _num(spec, "radius", where, file) * length
@@ -652,8 +692,11 @@ def shape_from_spec(
                 need("from")
                 need("to")
                 if "length" in spec:
-                    raise ModelError("give either 'length' or 'from'/'to', not both",
-                                     file=file, field=f"{where}.length")
+                    raise ModelError(
+                        "give either 'length' or 'from'/'to', not both",
+                        file=file,
+                        field=f"{where}.length",
+                    )
                 p0 = _num(spec, "from", where, file, 3) * length
                 p1 = _num(spec, "to", where, file, 3) * length
                 S, L = _segment_pose(p0, p1)
@@ -668,8 +711,11 @@ def shape_from_spec(
         elif units in _LENGTH:
             scale = _LENGTH[units]
         else:
-            raise ModelError(f"expected one of {list(_LENGTH)}, got {units!r}",
-                             file=file, field=f"{where}.units")
+            raise ModelError(
+                f"expected one of {list(_LENGTH)}, got {units!r}",
+                file=file,
+                field=f"{where}.units",
+            )
         if "scale" in spec:
             scale *= _num(spec, "scale", where, file)
         path = Path(str(spec["file"])).expanduser()
@@ -677,17 +723,22 @@ def shape_from_spec(
             path = base_dir / path
         if not path.is_file():
             raise ModelError(
-                f"mesh file not found: {path}" + (f" (link '{owner}')" if owner else ""),
-                file=file, field=f"{where}.file",
+                f"mesh file not found: {path}"
+                + (f" (link '{owner}')" if owner else ""),
+                file=file,
+                field=f"{where}.file",
             )
         if path.suffix.lower() not in _MESH_SUFFIXES:
             raise ModelError(
                 f"unsupported mesh format {path.suffix!r} (use {list(_MESH_SUFFIXES)})",
-                file=file, field=f"{where}.file",
+                file=file,
+                field=f"{where}.file",
             )
         return Shape("mesh", (), T, name=name, file=path, scale=scale, owner=owner)
     except InputError as exc:
-        raise ModelError(exc.reason, file=file, field=f"{where}.{exc.argument}") from None
+        raise ModelError(
+            exc.reason, file=file, field=f"{where}.{exc.argument}"
+        ) from None
 
 
 def _units(units: Any) -> tuple[float, float]:
@@ -700,20 +751,32 @@ def _geometry_section(robot: Robot, value: Any, file: Any, units: Any) -> Robot:
     L, A = _units(units)
     names = link_names(robot)
     if not isinstance(value, Mapping):
-        raise ModelError("expected a mapping {link name: [shapes]}", file=file,
-                         field="geometry")
+        raise ModelError(
+            "expected a mapping {link name: [shapes]}", file=file, field="geometry"
+        )
     base_dir = Path(file).parent if file is not None else None
     per_link: dict[str, list[Shape]] = {}
     for key, items in value.items():
         if key not in names:
-            raise ModelError(_unknown_link(key, names), file=file, field=f"geometry.{key}")
+            raise ModelError(
+                _unknown_link(key, names), file=file, field=f"geometry.{key}"
+            )
         if isinstance(items, Mapping):
             items = [items]
         if not isinstance(items, list):
-            raise ModelError("expected a list of shapes", file=file, field=f"geometry.{key}")
+            raise ModelError(
+                "expected a list of shapes", file=file, field=f"geometry.{key}"
+            )
         per_link[key] = [
-            shape_from_spec(s, length=L, angle=A, base_dir=base_dir, file=file,
-                            where=f"geometry.{key}[{i}]", owner=key)
+            shape_from_spec(
+                s,
+                length=L,
+                angle=A,
+                base_dir=base_dir,
+                file=file,
+                where=f"geometry.{key}[{i}]",
+                owner=key,
+            )
             for i, s in enumerate(items)
         ]
     old = robot.geometry if isinstance(robot.geometry, RobotGeometry) else None
@@ -726,29 +789,44 @@ def _geometry_section(robot: Robot, value: Any, file: Any, units: Any) -> Robot:
 def _collision_section(robot: Robot, value: Any, file: Any, units: Any) -> Robot:
     names = link_names(robot)
     if not isinstance(value, Mapping):
-        raise ModelError("expected a mapping with 'exclude'", file=file, field="collision")
+        raise ModelError(
+            "expected a mapping with 'exclude'", file=file, field="collision"
+        )
     for key in value:
         if key not in ("exclude", "exclude_adjacent"):
-            raise ModelError("unknown field (allowed: exclude, exclude_adjacent)",
-                             file=file, field=f"collision.{key}")
+            raise ModelError(
+                "unknown field (allowed: exclude, exclude_adjacent)",
+                file=file,
+                field=f"collision.{key}",
+            )
     pairs = value.get("exclude", []) or []
     if not isinstance(pairs, list):
-        raise ModelError("expected a list of [link, link] pairs", file=file,
-                         field="collision.exclude")
+        raise ModelError(
+            "expected a list of [link, link] pairs",
+            file=file,
+            field="collision.exclude",
+        )
     out = []
     for i, p in enumerate(pairs):
         if not (isinstance(p, list | tuple) and len(p) == 2):
-            raise ModelError(f"expected a pair [link, link], got {p!r:.60}", file=file,
-                             field=f"collision.exclude[{i}]")
+            raise ModelError(
+                f"expected a pair [link, link], got {p!r:.60}",
+                file=file,
+                field=f"collision.exclude[{i}]",
+            )
         for n in p:
             if n not in names:
-                raise ModelError(_unknown_link(n, names), file=file,
-                                 field=f"collision.exclude[{i}]")
+                raise ModelError(
+                    _unknown_link(n, names), file=file, field=f"collision.exclude[{i}]"
+                )
         out.append(tuple(p))
     adjacent = value.get("exclude_adjacent", True)
     if not isinstance(adjacent, bool):
-        raise ModelError(f"expected true or false, got {adjacent!r}", file=file,
-                         field="collision.exclude_adjacent")
+        raise ModelError(
+            f"expected true or false, got {adjacent!r}",
+            file=file,
+            field="collision.exclude_adjacent",
+        )
     geo = robot.geometry if isinstance(robot.geometry, RobotGeometry) else None
     if geo is None:
         geo = RobotGeometry.empty(robot)
