@@ -163,3 +163,19 @@ def test_press_place_fits_the_die_opening_with_a_few_cm(press):
     assert not pick.collides
     assert pick.closest.body_b == "fixture"
     assert pick.closest.distance == pytest.approx(0.020, abs=1e-4)
+
+
+def test_changing_the_scene_after_a_check_is_seen_by_the_next_check():
+    r = robokin.load("ur5")
+    sc = Scene()
+    sc.add_box("block", size=(0.2, 0.2, 0.2))  # around the robot's base
+    q = np.zeros((1, 6))
+    first = check(r, sc, q)
+    assert first.distances("base", "block")[0] < 0
+    sc.base = pose_from_xyz_rpy([0.0, 0.0, 1.0], [0, 0, 0])  # plain assignment
+    lifted = check(r, sc, q)
+    # the base capsule (r 75 mm, axis z -100..5 mm) now ends 0.825 m up; block top 0.1
+    assert lifted.distances("base", "block")[0] == pytest.approx(0.725, abs=1e-9)
+    sc.exclude.add(frozenset(("base", "block")))
+    sc.exclude.add(frozenset(("shoulder_pan", "block")))
+    assert all("base" != p.body_a or p.body_b != "block" for p in check(r, sc, q).pairs)

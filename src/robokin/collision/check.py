@@ -271,7 +271,7 @@ def check(
 
 def _problem_for(robot: Robot, scene: Scene, self_collision: bool) -> _Problem:
     cache = scene.__dict__.setdefault("_check_cache", {})
-    key = (id(robot), scene._version, self_collision)
+    key = (id(robot), scene._fingerprint(), self_collision)
     hit = cache.get(key)
     if hit is not None and hit[0] is robot:
         return hit[1]

@@ -255,6 +255,17 @@ class Scene:
             geo = geo.retool(self.tool.tcp, self.tool.shapes)
         return out.replace(geometry=geo)
 
+    def _fingerprint(self) -> tuple:
+        """What the compiled check depends on (attributes may be assigned directly)."""
+        base = np.asarray(self.base, dtype=float)
+        return (
+            self._version,
+            base.tobytes(),
+            id(self.tool),
+            frozenset(self.exclude),
+            tuple(id(o) for o in self._objects.values()),
+        )
+
     def tcp_pose(self, name: str) -> np.ndarray:
         """A named pose (4, 4) [m] of the TCP in the world."""
         try:
