@@ -15,6 +15,9 @@ vec 16    unit vector e perpendicular to the 'sum' axis (h2 or h4)
 75, 76    s3 = h3.h2, s4 = h4.h2 (three parallel)
 77, 78    singular tolerance, discriminant tolerance
 79        1.0: mirror seeds past a boundary (near-family), else 0.0
+80..85    theta3 subproblem 4: A, B, C, atan2(B, A), its cosine, sine
+86..91    theta5 subproblem 4: A, B, C, atan2(B, A), its cosine, sine
+92, 93    |a|^2, |b|^2 of the two-link (elbow) problem
 ========  ==========================================================
 
 Each pose yields 8 slots, ``slot = 4 * shoulder + 2 * elbow + wrist`` with
@@ -30,19 +33,28 @@ from numba import njit, prange
 
 from robokin.kinematics.ik.analytic._subproblems import (
     add,
+    cross,
     dot,
     rot,
     scale,
     sp1,
     sp4_coeffs,
     sub,
-    to_joint,
-    two_roots,
     vec,
 )
 
 SIGN, OFFSET, LO, HI, S3, S4, SING_TOL, DISC_TOL, MIRROR = 51, 57, 63, 69, 75, 76, 77, 78, 79
-N_PARAMS = 80
+# Pose-independent constants derived by ``pack`` (per family, see the kernels):
+# subproblem-4 coefficients and their phase for theta3 and theta5, |a|^2, |b|^2.
+A3, B3, C3, PHI3, CPHI3, SPHI3 = 80, 81, 82, 83, 84, 85
+A5, B5, C5, PHI5, CPHI5, SPHI5 = 86, 87, 88, 89, 90, 91
+AA, BB = 92, 93
+N_PARAMS = 94
+
+_TWO_PI = 2.0 * math.pi
+# Status codes >= BAD_POSE: the pose failed validation (code - BAD_POSE is the
+# ``check_poses`` code); nothing was solved.
+BAD_POSE = 16
 
 
 @njit(cache=True, inline="always")
@@ -75,11 +87,37 @@ def _target(T, P):
 
 
 @njit(cache=True, inline="always")
+def _joint(v, sign, offset, lo, hi):
+    """Chain angle ``v`` to the joint coordinate, wrapped to [-pi, pi) and moved by
+    whole turns into ``[lo, hi]`` when it fits. Returns (q, inside).
+
+    Same result as ``_subproblems.to_joint`` without the float modulo (the values
+    here are within a few turns)."""
+    q = sign * (v - offset)
+    if q >= math.pi or q < -math.pi:
+        q -= _TWO_PI * math.floor((q + math.pi) / _TWO_PI)
+        if q >= math.pi:
+            q -= _TWO_PI
+        elif q < -math.pi:
+            q += _TWO_PI
+    eps = 1e-9
+    if q < lo - eps:
+        q2 = q + _TWO_PI * math.ceil((lo - eps - q) / _TWO_PI)
+        if q2 <= hi + eps:
+            q = q2
+    elif q > hi + eps:
+        q2 = q - _TWO_PI * math.ceil((q - hi - eps) / _TWO_PI)
+        if q2 >= lo - eps:
+            q = q2
+    return q, (q >= lo - eps) and (q <= hi + eps)
+
+
+@njit(cache=True, inline="always")
 def _write(P, Q, inside, slot, v1, v2, v3, v4, v5, v6):
     ok = True
     vals = (v1, v2, v3, v4, v5, v6)
     for j in range(6):
-        q, ins = to_joint(vals[j], P[SIGN + j], P[OFFSET + j], P[LO + j], P[HI + j])
+        q, ins = _joint(vals[j], P[SIGN + j], P[OFFSET + j], P[LO + j], P[HI + j])
         Q[slot, j] = q
         ok = ok and ins
     inside[slot] = ok
@@ -91,9 +129,99 @@ def _wrist_disc(A, B, C, d, xperp2):
     return A * A + B * B - C * C - 1.0 + xperp2 + 2.0 * d * C
 
 
+@njit(cache=True, inline="always")
+def _unit2(y, x):
+    """(cos, sin) of ``atan2(y, x)`` without the trigonometry."""
+    r = math.sqrt(x * x + y * y)
+    if r > 0.0:
+        return x / r, y / r
+    return 1.0, 0.0
+
+
+@njit(cache=True, inline="always")
+def _roots(A, B, rhs, disc, tol, mirror, phi, cphi, sphi):
+    """``two_roots`` (see ``_subproblems``) with the phase ``phi = atan2(B, A)``
+    given, also returning the cosine and sine of each root.
+
+    Returns ``(n, boundary, t+, c+, s+, t-, c-, s-)``.
+    """
+    r2 = A * A + B * B
+    if disc < 0.0:
+        if disc < -tol * r2:
+            return 0, False, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0
+        base = phi + math.atan2(0.0, rhs)
+        if mirror:
+            g = math.atan2(math.sqrt(-disc), abs(rhs))
+            tp = base + g
+            tm = base - g
+            return 2, True, tp, math.cos(tp), math.sin(tp), tm, math.cos(tm), math.sin(tm)
+        cb = math.cos(base)
+        sb = math.sin(base)
+        return 1, True, base, cb, sb, base, cb, sb
+    sq = math.sqrt(disc)
+    g = math.atan2(sq, rhs)
+    cg, sg = _unit2(sq, rhs)
+    cp = cphi * cg - sphi * sg
+    sp = sphi * cg + cphi * sg
+    cm = cphi * cg + sphi * sg
+    sm = sphi * cg - cphi * sg
+    n = 1 if disc <= tol * r2 * 1e-3 else 2
+    return n, n == 1, phi + g, cp, sp, phi - g, cm, sm
+
+
+@njit(cache=True, inline="always")
+def _sp1_cs(k, p, q):
+    """Subproblem 1 (``sp1``): the angle and its cosine and sine."""
+    kp = dot(k, p)
+    y = dot(q, cross(k, p))
+    x = dot(q, p) - kp * dot(k, q)
+    c, s = _unit2(y, x)
+    return math.atan2(y, x), c, s
+
+
+@njit(cache=True, inline="always")
+def _clear(Q, valid, sing, inside):
+    for k in range(8):
+        valid[k] = False
+        sing[k] = False
+        inside[k] = False
+        for j in range(6):
+            Q[k, j] = 0.0
+
+
 @njit(cache=True)
-def three_parallel_one(T, P, qn, Q, valid, sing, inside):
-    """All solutions of one pose, axes 2, 3, 4 parallel and axes 5, 6 meeting."""
+def pose_code(T):
+    """0 for a rigid transform T (4, 4), else the ``check_poses`` problem code
+    (1 non-finite, 2 last row, 3 rotation not orthonormal within 1e-6, 4 reflection);
+    the same tests as ``robokin.kinematics._kernels.check_poses``."""
+    for r in range(4):
+        for c in range(4):
+            if not math.isfinite(T[r, c]):
+                return 1
+    if (abs(T[3, 0]) > 1e-9 or abs(T[3, 1]) > 1e-9 or abs(T[3, 2]) > 1e-9
+            or abs(T[3, 3] - 1.0) > 1e-9):
+        return 2
+    for r in range(3):
+        for s in range(3):
+            d = T[r, 0] * T[s, 0] + T[r, 1] * T[s, 1] + T[r, 2] * T[s, 2]
+            if r == s:
+                d -= 1.0
+            if abs(d) > 1e-6:
+                return 3
+    det = (T[0, 0] * (T[1, 1] * T[2, 2] - T[1, 2] * T[2, 1])
+           - T[0, 1] * (T[1, 0] * T[2, 2] - T[1, 2] * T[2, 0])
+           + T[0, 2] * (T[1, 0] * T[2, 1] - T[1, 1] * T[2, 0]))
+    if det < 0.0:
+        return 4
+    return 0
+
+
+@njit(cache=True)
+def three_parallel_one(T, P, q6, Q, valid, sing, inside):
+    """All solutions of one pose, axes 2, 3, 4 parallel and axes 5, 6 meeting.
+
+    ``q6``: joint 6 value kept at the wrist singularity.
+    """
     h1 = vec(P, 0)
     h2 = vec(P, 1)
     h3 = vec(P, 2)
@@ -111,37 +239,43 @@ def three_parallel_one(T, P, qn, Q, valid, sing, inside):
     stol = P[SING_TOL]
     dtol = P[DISC_TOL]
     mir = P[MIRROR] != 0.0
-    for k in range(8):
-        valid[k] = False
-        sing[k] = False
-        inside[k] = False
-        for j in range(6):
-            Q[k, j] = 0.0
+    A3_ = P[A3]
+    B3_ = P[B3]
+    C3_ = P[C3]
+    A5_ = P[A5]
+    B5_ = P[B5]
+    C5_ = P[C5]
+    aa = P[AA]
+    bb = P[BB]
+    _clear(Q, valid, sing, inside)
     r0, r1, r2, p = _target(T, P)
     pp = sub(sub(p, _mv(r0, r1, r2, sub(t, ow))), o1)
     A, B, C = sp4_coeffs(pp, h1, h2)
     rhs = dot(h2, sub(ow, o1)) - C
-    t1p, t1m, n1, bd1 = two_roots(A, B, rhs, A * A + B * B - rhs * rhs, dtol, mir)
+    phi1 = math.atan2(B, A)
+    cphi1, sphi1 = _unit2(B, A)
+    n1, bd1, t1p, c1p, s1p, t1m, c1m, s1m = _roots(
+        A, B, rhs, A * A + B * B - rhs * rhs, dtol, mir, phi1, cphi1, sphi1)
     if n1 == 0:
         return 1
     g6 = _mv(r0, r1, r2, h6)
-    A5, B5, C5 = sp4_coeffs(h2, h5, h6)
     a = sub(o3, o2)
     b = sub(o4, o3)
-    A3, B3, C3 = sp4_coeffs(a, h3, b)
-    aa = dot(a, a)
-    bb = dot(b, b)
+    o21 = sub(o2, o1)
+    w4 = sub(ow, o4)
     any_wrist = False
     any_ok = False
     for i1 in range(n1):
-        th1 = t1p if i1 == 0 else t1m
-        c1 = math.cos(th1)
-        s1 = math.sin(th1)
+        if i1 == 0:
+            th1, c1, s1 = t1p, c1p, s1p
+        else:
+            th1, c1, s1 = t1m, c1m, s1m
         x = rot(h1, c1, -s1, g6)  # R1^T R06 h6
         d5 = dot(h2, x)
         xp = sub(x, scale(h2, d5))
-        t5p, t5m, n5, _ = two_roots(A5, B5, d5 - C5, _wrist_disc(A5, B5, C5, d5, dot(xp, xp)),
-                                   dtol, mir)
+        n5, _b5, t5p, c5p, s5p, t5m, c5m, s5m = _roots(
+            A5_, B5_, d5 - C5_, _wrist_disc(A5_, B5_, C5_, d5, dot(xp, xp)), dtol, mir,
+            P[PHI5], P[CPHI5], P[SPHI5])
         if n5 == 0:
             continue
         any_wrist = True
@@ -150,26 +284,33 @@ def three_parallel_one(T, P, qn, Q, valid, sing, inside):
         singular = math.sqrt(dot(yp, yp)) < stol
         if singular:
             n5 = 1
-        pl = sub(rot(h1, c1, -s1, pp), sub(o2, o1))  # R1^T pp - (o2 - o1)
+        pl = sub(rot(h1, c1, -s1, pp), o21)  # R1^T pp - (o2 - o1)
         for i5 in range(n5):
-            th5 = t5p if i5 == 0 else t5m
-            c5 = math.cos(th5)
-            s5 = math.sin(th5)
-            if singular:
-                th6 = P[SIGN + 5] * qn[5] + P[OFFSET + 5]
+            if i5 == 0:
+                th5, c5, s5 = t5p, c5p, s5p
             else:
-                th6 = sp1(h6, y, rot(h5, c5, -s5, h2))
-            c6 = math.cos(th6)
-            s6 = math.sin(th6)
+                th5, c5, s5 = t5m, c5m, s5m
+            r5h2 = rot(h5, c5, -s5, h2)
+            if singular:
+                th6 = P[SIGN + 5] * q6 + P[OFFSET + 5]
+                c6 = math.cos(th6)
+                s6 = math.sin(th6)
+            else:
+                th6, c6, s6 = _sp1_cs(h6, y, r5h2)
             w = rot(h6, c6, -s6, rot(h5, c5, -s5, e))
             w = rot(h1, c1, -s1, _mv(r0, r1, r2, w))
-            th234 = sp1(h2, e, w)
-            d = sub(pl, rot(h2, math.cos(th234), math.sin(th234), sub(ow, o4)))
-            rhs3 = 0.5 * (dot(d, d) - aa - bb) - C3
-            t3p, t3m, n3, bd3 = two_roots(A3, B3, rhs3, A3 * A3 + B3 * B3 - rhs3 * rhs3, dtol, mir)
+            th234, c234, s234 = _sp1_cs(h2, e, w)
+            d = sub(pl, rot(h2, c234, s234, w4))
+            rhs3 = 0.5 * (dot(d, d) - aa - bb) - C3_
+            n3, bd3, t3p, c3p, s3p, t3m, c3m, s3m = _roots(
+                A3_, B3_, rhs3, A3_ * A3_ + B3_ * B3_ - rhs3 * rhs3, dtol, mir,
+                P[PHI3], P[CPHI3], P[SPHI3])
             for i3 in range(n3):
-                th3 = t3p if i3 == 0 else t3m
-                u = add(a, rot(h3, math.cos(th3), math.sin(th3), b))
+                if i3 == 0:
+                    th3, c3, sn3 = t3p, c3p, s3p
+                else:
+                    th3, c3, sn3 = t3m, c3m, s3m
+                u = add(a, rot(h3, c3, sn3, b))
                 th2 = sp1(h2, u, d)
                 th4 = s4 * (th234 - th2 - s3 * th3)
                 slot = 4 * i1 + 2 * i3 + i5
@@ -183,8 +324,11 @@ def three_parallel_one(T, P, qn, Q, valid, sing, inside):
 
 
 @njit(cache=True)
-def spherical_one(T, P, qn, Q, valid, sing, inside):
-    """All solutions of one pose, axes 2, 3 parallel and axes 4, 5, 6 meeting."""
+def spherical_one(T, P, q6, Q, valid, sing, inside):
+    """All solutions of one pose, axes 2, 3 parallel and axes 4, 5, 6 meeting.
+
+    ``q6``: joint 6 value kept at the wrist singularity.
+    """
     h1 = vec(P, 0)
     h2 = vec(P, 1)
     h3 = vec(P, 2)
@@ -200,64 +344,73 @@ def spherical_one(T, P, qn, Q, valid, sing, inside):
     stol = P[SING_TOL]
     dtol = P[DISC_TOL]
     mir = P[MIRROR] != 0.0
-    for k in range(8):
-        valid[k] = False
-        sing[k] = False
-        inside[k] = False
-        for j in range(6):
-            Q[k, j] = 0.0
+    A3_ = P[A3]
+    B3_ = P[B3]
+    C3_ = P[C3]
+    A5_ = P[A5]
+    B5_ = P[B5]
+    C5_ = P[C5]
+    aa = P[AA]
+    bb = P[BB]
+    _clear(Q, valid, sing, inside)
     r0, r1, r2, p = _target(T, P)
     pw = sub(sub(p, _mv(r0, r1, r2, sub(t, ow))), o1)
     A, B, C = sp4_coeffs(pw, h1, h2)
     rhs = dot(h2, sub(ow, o1)) - C
-    t1p, t1m, n1, bd1 = two_roots(A, B, rhs, A * A + B * B - rhs * rhs, dtol, mir)
+    phi1 = math.atan2(B, A)
+    cphi1, sphi1 = _unit2(B, A)
+    n1, bd1, t1p, c1p, s1p, t1m, c1m, s1m = _roots(
+        A, B, rhs, A * A + B * B - rhs * rhs, dtol, mir, phi1, cphi1, sphi1)
     if n1 == 0:
         return 1
     g6 = _mv(r0, r1, r2, h6)
     a = sub(o3, o2)
     b = sub(ow, o3)
-    A3, B3, C3 = sp4_coeffs(a, h3, b)
-    A5, B5, C5 = sp4_coeffs(h4, h5, h6)
-    aa = dot(a, a)
-    bb = dot(b, b)
+    o21 = sub(o2, o1)
     any_pos = False
     any_ok = False
     for i1 in range(n1):
-        th1 = t1p if i1 == 0 else t1m
-        c1 = math.cos(th1)
-        s1 = math.sin(th1)
-        d = sub(rot(h1, c1, -s1, pw), sub(o2, o1))
-        rhs3 = 0.5 * (dot(d, d) - aa - bb) - C3
-        t3p, t3m, n3, bd3 = two_roots(A3, B3, rhs3, A3 * A3 + B3 * B3 - rhs3 * rhs3, dtol, mir)
+        if i1 == 0:
+            th1, c1, s1 = t1p, c1p, s1p
+        else:
+            th1, c1, s1 = t1m, c1m, s1m
+        d = sub(rot(h1, c1, -s1, pw), o21)
+        rhs3 = 0.5 * (dot(d, d) - aa - bb) - C3_
+        n3, bd3, t3p, c3p, s3p, t3m, c3m, s3m = _roots(
+            A3_, B3_, rhs3, A3_ * A3_ + B3_ * B3_ - rhs3 * rhs3, dtol, mir,
+            P[PHI3], P[CPHI3], P[SPHI3])
+        g61 = rot(h1, c1, -s1, g6)
         for i3 in range(n3):
             any_pos = True
-            th3 = t3p if i3 == 0 else t3m
-            c3 = math.cos(th3)
-            s3 = math.sin(th3)
+            if i3 == 0:
+                th3, c3, s3 = t3p, c3p, s3p
+            else:
+                th3, c3, s3 = t3m, c3m, s3m
             u = add(a, rot(h3, c3, s3, b))
-            th2 = sp1(h2, u, d)
-            c2 = math.cos(th2)
-            s2 = math.sin(th2)
-            x = rot(h3, c3, -s3, rot(h2, c2, -s2, rot(h1, c1, -s1, g6)))  # Rw h6
+            th2, c2, s2 = _sp1_cs(h2, u, d)
+            x = rot(h3, c3, -s3, rot(h2, c2, -s2, g61))  # Rw h6
             d5 = dot(h4, x)
             xp = sub(x, scale(h4, d5))
-            t5p, t5m, n5, _ = two_roots(
-                A5, B5, d5 - C5, _wrist_disc(A5, B5, C5, d5, dot(xp, xp)), dtol, mir
-            )
+            n5, _b5, t5p, c5p, s5p, t5m, c5m, s5m = _roots(
+                A5_, B5_, d5 - C5_, _wrist_disc(A5_, B5_, C5_, d5, dot(xp, xp)), dtol,
+                mir, P[PHI5], P[CPHI5], P[SPHI5])
             y = _mtv(r0, r1, r2, rot(h1, c1, s1, rot(h2, c2, s2, rot(h3, c3, s3, h4))))
             yp = sub(y, scale(h6, dot(y, h6)))
             singular = math.sqrt(dot(yp, yp)) < stol
             if singular and n5 > 1:
                 n5 = 1
             for i5 in range(n5):
-                th5 = t5p if i5 == 0 else t5m
-                c5 = math.cos(th5)
-                s5 = math.sin(th5)
-                if singular:
-                    th6 = P[SIGN + 5] * qn[5] + P[OFFSET + 5]
+                if i5 == 0:
+                    th5, c5, s5 = t5p, c5p, s5p
                 else:
-                    th6 = sp1(h6, y, rot(h5, c5, -s5, h4))
-                w = rot(h6, math.cos(th6), -math.sin(th6), rot(h5, c5, -s5, e))
+                    th5, c5, s5 = t5m, c5m, s5m
+                if singular:
+                    th6 = P[SIGN + 5] * q6 + P[OFFSET + 5]
+                    c6 = math.cos(th6)
+                    s6 = math.sin(th6)
+                else:
+                    th6, c6, s6 = _sp1_cs(h6, y, rot(h5, c5, -s5, h4))
+                w = rot(h6, c6, -s6, rot(h5, c5, -s5, e))
                 w = rot(h1, c1, -s1, _mv(r0, r1, r2, w))
                 w = rot(h3, c3, -s3, rot(h2, c2, -s2, w))
                 th4 = sp1(h4, e, w)
@@ -276,7 +429,7 @@ def three_parallel_serial(T, P, qn, Q, valid, sing, inside, status):
     """Batch (N, 4, 4) -> slots (N, 8, 6), one thread."""
     m = qn.shape[0]
     for i in range(T.shape[0]):
-        status[i] = three_parallel_one(T[i], P, qn[i % m], Q[i], valid[i], sing[i], inside[i])
+        status[i] = three_parallel_one(T[i], P, qn[i % m, 5], Q[i], valid[i], sing[i], inside[i])
 
 
 @njit(cache=True, parallel=True)
@@ -284,7 +437,7 @@ def three_parallel_parallel(T, P, qn, Q, valid, sing, inside, status):
     """Batch (N, 4, 4) -> slots (N, 8, 6), all threads."""
     m = qn.shape[0]
     for i in prange(T.shape[0]):
-        status[i] = three_parallel_one(T[i], P, qn[i % m], Q[i], valid[i], sing[i], inside[i])
+        status[i] = three_parallel_one(T[i], P, qn[i % m, 5], Q[i], valid[i], sing[i], inside[i])
 
 
 @njit(cache=True)
@@ -292,7 +445,7 @@ def spherical_serial(T, P, qn, Q, valid, sing, inside, status):
     """Batch (N, 4, 4) -> slots (N, 8, 6), one thread."""
     m = qn.shape[0]
     for i in range(T.shape[0]):
-        status[i] = spherical_one(T[i], P, qn[i % m], Q[i], valid[i], sing[i], inside[i])
+        status[i] = spherical_one(T[i], P, qn[i % m, 5], Q[i], valid[i], sing[i], inside[i])
 
 
 @njit(cache=True, parallel=True)
@@ -300,5 +453,5 @@ def spherical_parallel(T, P, qn, Q, valid, sing, inside, status):
     """Batch (N, 4, 4) -> slots (N, 8, 6), all threads."""
     m = qn.shape[0]
     for i in prange(T.shape[0]):
-        status[i] = spherical_one(T[i], P, qn[i % m], Q[i], valid[i], sing[i], inside[i])
+        status[i] = spherical_one(T[i], P, qn[i % m, 5], Q[i], valid[i], sing[i], inside[i])
 

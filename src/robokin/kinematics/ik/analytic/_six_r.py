@@ -80,6 +80,24 @@ def pack(chain: Any, kind: Kind, *, singular_tol: float = 1e-9,
     P[K.SING_TOL] = singular_tol
     P[K.DISC_TOL] = disc_tol
     P[K.MIRROR] = 1.0 if mirror else 0.0
+    # pose-independent subproblem coefficients (theta3: |a + rot(h3, t) b|,
+    # theta5: h . rot(h5, t) h6 with h = h2 (three parallel) or h4 (spherical))
+    a = V[8] - V[7]
+    b = (V[9] if kind == "three_parallel" else V[10]) - V[8]
+    hw = V[1] if kind == "three_parallel" else V[3]
+    for (ia, ib, ic, iphi), (hh, kk, pp) in (
+        ((K.A3, K.B3, K.C3, K.PHI3), (a, V[2], b)),
+        ((K.A5, K.B5, K.C5, K.PHI5), (hw, V[4], V[5])),
+    ):
+        kp = kk @ pp
+        hk = hh @ kk
+        A, B, C = hh @ pp - hk * kp, hh @ np.cross(kk, pp), hk * kp
+        r = np.hypot(A, B)
+        P[ia], P[ib], P[ic] = A, B, C
+        P[iphi] = np.arctan2(B, A)
+        P[iphi + 1], P[iphi + 2] = (A / r, B / r) if r > 0 else (1.0, 0.0)
+    P[K.AA] = a @ a
+    P[K.BB] = b @ b
     P.setflags(write=False)
     return P
 
