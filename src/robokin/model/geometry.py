@@ -657,7 +657,11 @@ def shape_from_spec(
             )
     xyz = _num(spec, "xyz", where, file, 3) * length if "xyz" in spec else np.zeros(3)
     rpy = _num(spec, "rpy", where, file, 3) * angle if "rpy" in spec else np.zeros(3)
-    T = pose_from_xyz_rpy(xyz, rpy)
+    if np.any(rpy):
+        T = pose_from_xyz_rpy(xyz, rpy)
+    else:  # no rotation: skip importing scipy for the common case
+        T = np.eye(4)
+        T[:3, 3] = xyz
     name = str(spec.get("name", ""))
 
     def need(key: str) -> None:
