@@ -797,7 +797,7 @@ class _Problem:
             evaluate(rows[ps], idx, force_exact=False)
             propagate(rows)
             best[rows] = np.where(done[rows], D[rows], np.inf).min(axis=1)
-            stride = max(m // 8, 1) if stride == 0 else max(stride // 2, 1)
+            stride = max(m // 32, 1) if stride == 0 else max(stride // 4, 1)
         # 2. Subdivision: intervals whose ends do not clear the motion between.
         between: dict[tuple[int, int], tuple[float, float]] = {}
         self.subdivisions = 0
