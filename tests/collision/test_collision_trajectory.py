@@ -264,3 +264,26 @@ def test_motion_bounds_hold_between_samples(rng):
         seg = D[:, 20 * i : 20 * i + 21]
         assert np.all(np.abs(seg - Dc[:, i : i + 1]) <= M[:, i : i + 1] + 1e-9)
     assert math.isfinite(rep.min_distance)
+
+
+def test_non_convex_mesh_links_are_exact_through_the_hull_bound(tmp_path, rng):
+    import trimesh
+
+    # an L-shaped part: its convex hull fills the corner the part itself leaves open
+    a = trimesh.creation.box(extents=(0.4, 0.1, 0.1))
+    a.apply_translation((0.15, 0.0, 0.0))
+    b = trimesh.creation.box(extents=(0.1, 0.4, 0.1))
+    b.apply_translation((0.0, 0.15, 0.0))
+    path = tmp_path / "ell.stl"
+    trimesh.util.concatenate([a, b]).export(path)
+    r = gantry([geo.mesh(path, owner="y")])
+    sc = Scene()
+    sc.add_sphere("ball", 0.03, pose=T(0.2, 0.2, 0.0))  # sits in the L's open corner
+    x = np.linspace(-0.3, 0.3, 61)
+    q = np.column_stack([x, 0.5 * x])
+    rep = check(r, sc, q)
+    D = _brute_force(rep._problem, q)
+    assert rep.min_distance == pytest.approx(D.min(), abs=1e-9)
+    assert rep.collides == bool((D <= 0).any())
+    hull = rep._problem.exact(0, rep._problem.frames(q)[30], hull=True)
+    assert hull < D[0, 30] - 0.05  # the hull bound really is looser here
