@@ -2,16 +2,10 @@
 
 from __future__ import annotations
 
-from typing import Any
+# ``solve`` is the dispatcher itself: no wrapper frame (single poses take a few us).
+from robokin.kinematics.ik.dispatch import solve
 
 __all__ = ["family", "solve"]
-
-
-def solve(robot, T, *, q_near=None, method: str = "auto", **options: Any):
-    """Every joint solution for target poses ``T`` (..., 4, 4); see ``Robot.ik``."""
-    from robokin.kinematics.ik.dispatch import solve as _solve
-
-    return _solve(robot, T, q_near=q_near, method=method, **options)
 
 
 def family(robot):

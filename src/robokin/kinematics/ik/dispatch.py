@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 import numpy.typing as npt
 
 from robokin._validation import check_finite, check_joints, check_poses_fast
@@ -29,11 +30,20 @@ def solve(
         InputError: bad pose or ``q_near``, unknown method, or ``method="analytic"``
             for an arm without a closed form (the message says why).
     """
+    if q_near is not None:
+        q_near = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
+    if (not options and type(T) is np.ndarray and T.shape == (4, 4)
+            and T.dtype == np.float64 and (method == "auto" or method == "analytic")):
+        # hot path: one pose, a 6R closed form, default options (one compiled call
+        # validates the pose and solves it)
+        single = _single_solver(robot)
+        if single is not None and (q_near is None or q_near.shape == (6,)):
+            out = single(T, 0.0 if q_near is None else float(q_near[5]))
+            if out is not None:
+                return out
     if method not in _METHODS:
         raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
     T = check_poses_fast(T, "T")
-    if q_near is not None:
-        q_near = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
     if method in ("auto", "analytic"):
         from robokin.kinematics.ik.analytic.detect import detect
 
@@ -47,3 +57,17 @@ def solve(
     from robokin.kinematics.ik.numeric import solve_all
 
     return solve_all(robot, T, q_near=q_near, **options)
+
+
+def _single_solver(robot: Any) -> Any:
+    """The family's single-pose hot path (``_six_r.make_single``), or None; cached
+    on the (immutable) chain."""
+    chain = robot.chain
+    single = chain.__dict__.get("_ik_single", False)
+    if single is False:
+        from robokin.kinematics.ik.analytic.detect import detect
+
+        fam = detect(robot)
+        single = getattr(fam.solver, "single", None)
+        object.__setattr__(chain, "_ik_single", single)
+    return single

@@ -81,6 +81,21 @@ class SolutionSet:
             st = np.where(valid.any(axis=-1), STATUS_OK, "no solution")
             object.__setattr__(self, "status", np.asarray(st, dtype=object))
 
+    @classmethod
+    def _trusted(cls, q: np.ndarray, valid: np.ndarray, is_revolute: np.ndarray,
+                 limits: np.ndarray, flags: dict[str, np.ndarray],
+                 branches: dict[str, np.ndarray], status: np.ndarray, method: str,
+                 error: np.ndarray | None, info: dict[str, Any]) -> SolutionSet:
+        """Build a set from arrays already in final form (float64 ``q``, bool masks,
+        a ``within_limits`` flag, an object ``status``) without conversions or
+        checks: the hot path of the closed forms. Callers pass fresh arrays (or
+        read-only shared ones), never buffers they reuse."""
+        self = object.__new__(cls)
+        self.__dict__.update(q=q, valid=valid, is_revolute=is_revolute, limits=limits,
+                             flags=flags, branches=branches, status=status,
+                             method=method, error=error, info=info)
+        return self
+
     # ------------------------------------------------------------------ basics
     @classmethod
     def empty(cls, lead: tuple[int, ...], n: int, is_revolute, limits, status: str,

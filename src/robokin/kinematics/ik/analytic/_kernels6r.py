@@ -455,3 +455,22 @@ def spherical_parallel(T, P, qn, Q, valid, sing, inside, status):
     for i in prange(T.shape[0]):
         status[i] = spherical_one(T[i], P, qn[i % m, 5], Q[i], valid[i], sing[i], inside[i])
 
+
+
+@njit(cache=True)
+def three_parallel_checked(T, P, q6, Q, valid, sing, inside):
+    """One pose T (4, 4), validated first: ``BAD_POSE + code`` when it is not a
+    rigid transform (nothing solved), else the status of ``three_parallel_one``."""
+    code = pose_code(T)
+    if code:
+        return BAD_POSE + code
+    return three_parallel_one(T, P, q6, Q, valid, sing, inside)
+
+
+@njit(cache=True)
+def spherical_checked(T, P, q6, Q, valid, sing, inside):
+    """One pose T (4, 4), validated first (see ``three_parallel_checked``)."""
+    code = pose_code(T)
+    if code:
+        return BAD_POSE + code
+    return spherical_one(T, P, q6, Q, valid, sing, inside)

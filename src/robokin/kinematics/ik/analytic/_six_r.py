@@ -13,6 +13,7 @@ from typing import Any, Literal
 import numpy as np
 
 from robokin.kinematics.ik.analytic._common import (
+    STATUS_TEXT,
     branch_labels,
     fk_error,
     make_set,
@@ -26,7 +27,7 @@ from robokin.kinematics.ik.analytic._geometry import (
 )
 from robokin.kinematics.ik.solutions import SolutionSet
 
-__all__ = ["pack", "solve_six_r"]
+__all__ = ["make_single", "pack", "raw_solve", "solve_six_r"]
 
 Kind = Literal["three_parallel", "spherical_wrist"]
 
@@ -105,7 +106,11 @@ def pack(chain: Any, kind: Kind, *, singular_tol: float = 1e-9,
 def raw_solve(kind: Kind, params: np.ndarray, T: np.ndarray,
               qn: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
     """The bare kernel call: T (N, 4, 4) contiguous float64 -> (Q (N, 8, 6), valid,
-    singular, within_limits (N, 8), status (N,) int8). No input checks."""
+    singular, within_limits (N, 8), status (N,) int8). No input checks.
+
+    ``singular`` and ``within_limits`` are False on rows that are not valid.
+    Batches of ``_PARALLEL_MIN`` poses or more run on every thread.
+    """
     from robokin.kinematics.ik.analytic import _kernels6r as K
 
     N = T.shape[0]
@@ -115,13 +120,82 @@ def raw_solve(kind: Kind, params: np.ndarray, T: np.ndarray,
     inside = np.empty((N, 8), np.bool_)
     status = np.empty(N, np.int8)
     if qn is None:
-        qn = np.zeros((1, 6))
+        qn = _NO_Q_NEAR
     if kind == "three_parallel":
         fn = K.three_parallel_parallel if N >= _PARALLEL_MIN else K.three_parallel_serial
     else:
         fn = K.spherical_parallel if N >= _PARALLEL_MIN else K.spherical_serial
     fn(T, params, qn, Q, valid, sing, inside, status)
     return Q, valid, sing, inside, status
+
+
+_NO_Q_NEAR = np.zeros((1, 6))
+_NO_Q_NEAR.setflags(write=False)
+
+
+def _entry_point(kern: Any, args: tuple) -> Any:
+    """The compiled overload of ``kern`` for exactly the types of ``args``, called
+    without numba's per-call type dispatch (a third of a microsecond); ``kern``
+    itself if that overload cannot be found. Callers must pass arguments of the
+    same types (C-contiguous arrays of the same dtypes and dimensions)."""
+    import numba
+
+    kern(*args)  # compile or load from the cache
+    try:
+        sig = tuple(numba.typeof(a) for a in args)
+        return kern.overloads[sig].entry_point
+    except (AttributeError, KeyError, TypeError):
+        return kern
+
+
+def make_single(chain: Any, kind: Kind, params: np.ndarray, *, method: str,
+                info: dict[str, Any]) -> Any:
+    """The single-pose hot path of an exact (not near-family) 6R arm.
+
+    Returns ``single(T, q6) -> SolutionSet | None`` for one pose ``T`` (4, 4)
+    float64 and the joint-6 value ``q6`` kept at the wrist singularity. The pose is
+    validated inside the same compiled call; ``None`` means it is not a rigid
+    transform (the caller re-checks it to raise the detailed error). Every call
+    returns freshly allocated arrays; only the read-only joint kinds, limits and
+    branch labels are shared between results.
+    """
+    from robokin.kinematics.ik.analytic import _kernels6r as K
+
+    kern = K.three_parallel_checked if kind == "three_parallel" else K.spherical_checked
+    direct = _entry_point(kern, (np.eye(4), params, 0.0, np.empty((8, 6)),
+                                 np.empty(8, np.bool_), np.empty(8, np.bool_),
+                                 np.empty(8, np.bool_)))
+    is_rev = np.array(chain.is_revolute, dtype=bool)
+    is_rev.setflags(write=False)
+    limits = np.asarray(chain.limits, dtype=np.float64)
+    if limits.flags.writeable:
+        limits = limits.copy()
+        limits.setflags(write=False)
+    labels = branch_labels((), _LABELS)
+    bad = K.BAD_POSE
+    texts = tuple(STATUS_TEXT)
+    empty = np.empty
+    b1 = np.bool_
+    obj = object
+    array = np.array
+    trusted = SolutionSet._trusted
+
+    def single(T: np.ndarray, q6: float) -> SolutionSet | None:
+        Q = empty((8, 6))
+        valid = empty(8, b1)
+        sing = empty(8, b1)
+        inside = empty(8, b1)
+        if T.flags.c_contiguous:
+            code = direct(T, params, q6, Q, valid, sing, inside)
+        else:
+            code = kern(T, params, q6, Q, valid, sing, inside)
+        if code >= bad:
+            return None
+        return trusted(Q, valid, is_rev, limits,
+                       {"within_limits": inside, "singular": sing}, dict(labels),
+                       array(texts[code], dtype=obj), method, None, dict(info))
+
+    return single
 
 
 def solve_six_r(
@@ -161,11 +235,17 @@ def solve_six_r(
     elif compute_error:
         dp, dr = fk_error(robot.chain, Q, T)
         error = np.where(valid, np.hypot(dp, dr), np.inf)
-    out = make_set(
-        robot, Q, valid, inside=inside, singular=sing,
-        branches=branch_labels(lead, _LABELS), status_codes=status,
-        method=method, info=info, error=error,
-    )
     if near:
+        out = make_set(
+            robot, Q, valid, inside=inside, singular=sing,
+            branches=branch_labels(lead, _LABELS), status_codes=status,
+            method=method, info=info, error=error,
+        )
         out.flags["polished"] = valid.copy()
-    return out
+        return out
+    # the kernel leaves 'singular' and 'within_limits' False on invalid rows
+    st = np.asarray(STATUS_TEXT[status], dtype=object)
+    return SolutionSet._trusted(
+        Q, valid, np.array(robot.is_revolute, dtype=bool), robot.limits,
+        {"within_limits": inside, "singular": sing}, branch_labels(lead, _LABELS),
+        st, method, error, info)

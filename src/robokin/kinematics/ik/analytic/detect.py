@@ -181,7 +181,7 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float) -> 
 
 def _six_r_family(chain: Any, poe: Any, name: str, text: str, near: bool, dev: float,
                   details: dict[str, str]) -> Family:
-    from robokin.kinematics.ik.analytic._six_r import pack, solve_six_r
+    from robokin.kinematics.ik.analytic._six_r import make_single, pack, solve_six_r
 
     params_cache: dict[tuple[float, float], np.ndarray] = {}
     method = f"analytic:{name}" + ("+newton" if near else "")
@@ -202,4 +202,7 @@ def _six_r_family(chain: Any, poe: Any, name: str, text: str, near: bool, dev: f
                            info=info, near=near, compute_error=compute_error, **options)
 
     solver.params = lambda: pack(chain, name, poe=poe)  # type: ignore[attr-defined]
+    # the single-pose hot path (default options, exact family only)
+    solver.single = None if near else make_single(  # type: ignore[attr-defined]
+        chain, name, pack(chain, name, poe=poe), method=method, info=info)
     return Family(name, solver, measured=text, near=near, deviation=dev, details=details)
