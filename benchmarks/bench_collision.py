@@ -1,6 +1,6 @@
 """Trajectory collision check: robokin vs the naive loop of coal distance calls.
 
-Run: ``python benchmarks/bench_collision.py [--samples 5000]``.
+Run: ``python benchmarks/bench_collision.py [--samples 5000] [--meshes]``.
 
 The AUBO-i5 with the parallel gripper in the bundled press scene follows a
 press-loading cycle of ``--samples`` joint samples (pick approach, pick, lift,
@@ -181,8 +181,39 @@ def pinocchio_min_distance(robot, problem, q: np.ndarray) -> tuple[float, float]
     return best, time.perf_counter() - t0
 
 
-def main(samples: int = 5000) -> int:
+def with_mesh_links(robot: robokin.Robot, folder) -> robokin.Robot:
+    """The robot with every capsule replaced by a ~3,800-triangle mesh of it (STL)."""
+    import trimesh
+
+    from robokin.model import geometry as geo
+
+    g = robot.geometry
+    shapes = {}
+    for name, ss in zip(g.names, g.shapes):
+        out = []
+        for k, s in enumerate(ss):
+            if s.kind != "capsule":
+                out.append(s)
+                continue
+            path = folder / f"{name}_{k}.stl"
+            trimesh.creation.capsule(
+                height=s.size[1], radius=s.size[0], count=[48, 40]
+            ).export(path)
+            out.append(geo.mesh(path, s.placement, owner=name))
+        shapes[name] = out
+    new = geo.RobotGeometry.from_mapping(
+        robot, shapes, exclude=[tuple(p) for p in g.exclude]
+    )
+    return robot.replace(geometry=new)
+
+
+def main(samples: int = 5000, meshes: bool = False) -> int:
     robot = robokin.load("aubo_i5")
+    if meshes:
+        import tempfile
+        from pathlib import Path
+
+        robot = with_mesh_links(robot, Path(tempfile.mkdtemp()))
     scene = Scene.load(scene_path("press"))
     q = press_cycle(robot, scene, samples)
     t = np.linspace(0.0, 12.0, samples)
@@ -206,9 +237,10 @@ def main(samples: int = 5000) -> int:
         pin_min, t_pin = None, None
 
     c = rep.closest
+    what = "mesh links, 3,840 triangles each" if meshes else "capsule links"
     print(
-        f"AUBO-i5 + gripper, press scene: {samples} samples, {problem.P} shape pairs "
-        f"({len(problem.obj_pairs)} link-object, {len(problem.self_pairs)} self)"
+        f"AUBO-i5 ({what}) + gripper, press scene: {samples} samples, {problem.P} "
+        f"shape pairs ({len(problem.obj_pairs)} link-object, {len(problem.self_pairs)} self)"
     )
     print(
         f"  closest: {c.body_a} - {c.body_b} {c.distance * 1e3:.3f} mm at t = {c.t:.3f} s "
@@ -233,4 +265,10 @@ def main(samples: int = 5000) -> int:
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=5000)
-    sys.exit(main(parser.parse_args().samples))
+    parser.add_argument(
+        "--meshes",
+        action="store_true",
+        help="replace the link capsules by triangle meshes of them",
+    )
+    args = parser.parse_args()
+    sys.exit(main(args.samples, args.meshes))
