@@ -35,6 +35,7 @@ from robokin.kinematics.ik.analytic._subproblems import (
     add,
     cross,
     dot,
+    fatan2,
     rot,
     scale,
     sp1,
@@ -159,7 +160,7 @@ def _roots(A, B, rhs, disc, tol, mirror, phi, cphi, sphi):
         sb = math.sin(base)
         return 1, True, base, cb, sb, base, cb, sb
     sq = math.sqrt(disc)
-    g = math.atan2(sq, rhs)
+    g = fatan2(sq, rhs)
     cg, sg = _unit2(sq, rhs)
     cp = cphi * cg - sphi * sg
     sp = sphi * cg + cphi * sg
@@ -176,7 +177,7 @@ def _sp1_cs(k, p, q):
     y = dot(q, cross(k, p))
     x = dot(q, p) - kp * dot(k, q)
     c, s = _unit2(y, x)
-    return math.atan2(y, x), c, s
+    return fatan2(y, x), c, s
 
 
 @njit(cache=True, inline="always")
@@ -252,7 +253,7 @@ def three_parallel_one(T, P, q6, Q, valid, sing, inside):
     pp = sub(sub(p, _mv(r0, r1, r2, sub(t, ow))), o1)
     A, B, C = sp4_coeffs(pp, h1, h2)
     rhs = dot(h2, sub(ow, o1)) - C
-    phi1 = math.atan2(B, A)
+    phi1 = fatan2(B, A)
     cphi1, sphi1 = _unit2(B, A)
     n1, bd1, t1p, c1p, s1p, t1m, c1m, s1m = _roots(
         A, B, rhs, A * A + B * B - rhs * rhs, dtol, mir, phi1, cphi1, sphi1)
@@ -357,7 +358,7 @@ def spherical_one(T, P, q6, Q, valid, sing, inside):
     pw = sub(sub(p, _mv(r0, r1, r2, sub(t, ow))), o1)
     A, B, C = sp4_coeffs(pw, h1, h2)
     rhs = dot(h2, sub(ow, o1)) - C
-    phi1 = math.atan2(B, A)
+    phi1 = fatan2(B, A)
     cphi1, sphi1 = _unit2(B, A)
     n1, bd1, t1p, c1p, s1p, t1m, c1m, s1m = _roots(
         A, B, rhs, A * A + B * B - rhs * rhs, dtol, mir, phi1, cphi1, sphi1)
