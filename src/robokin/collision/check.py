@@ -730,20 +730,45 @@ class _Problem:
             done[an] = True
             LB[an] = D[an]
 
+        # Per-run caches: shape poses as coal transforms, pair data as Python values.
+        T3 = self.coal.Transform3s
+        tcache: dict[tuple[int, int], Any] = {}
+        place, link_l = self.place, self.link.tolist()
+        pa_l, pb_l, self_l = self.pa.tolist(), self.pb.tolist(), self.is_self.tolist()
+        mesh_l, fn_e, fn_h = self.has_mesh.tolist(), self.fn_exact, self.fn_hull
+        ob_T3, req, res = self.ob_T3, self.req, self.res
+
+        def pose(i: int, s: int):
+            key = (i, s)
+            T = tcache.get(key)
+            if T is None:
+                W = frames[i, link_l[s]] @ place[s]
+                T = tcache[key] = T3(np.ascontiguousarray(W[:3, :3]), W[:3, 3].copy())
+            return T
+
+        def query(fn, p: int, i: int) -> float:
+            Ta = pose(i, pa_l[p])
+            Tb = pose(i, pb_l[p]) if self_l[p] else ob_T3[pb_l[p]]
+            res.clear()  # coal keeps the minimum over calls otherwise
+            return float(fn(Ta, Tb, req, res))
+
         def evaluate(ps: np.ndarray, idx: np.ndarray, force_exact: bool) -> None:
+            n = 0
             for p, i in zip(ps.tolist(), idx.tolist()):
-                if self.has_mesh[p] and not hulled[p, i] and not force_exact:
-                    v = self.exact(p, frames[i], hull=True)
-                    self.queries += 1
+                if mesh_l[p] and not force_exact and not hulled[p, i]:
+                    v = query(fn_h[p], p, i)
+                    n += 1
                     hulled[p, i] = True
-                    LB[p, i] = max(LB[p, i], v)
+                    if v > LB[p, i]:
+                        LB[p, i] = v
                     if v > clearance:
                         continue
-                v = self.exact(p, frames[i])
-                self.queries += 1
+                v = query(fn_e[p], p, i)
+                n += 1
                 D[p, i] = v
                 LB[p, i] = v
                 done[p, i] = True
+            self.queries += n
 
         from robokin.collision._kernels import propagate_bounds
 
