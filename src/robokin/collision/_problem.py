@@ -1,0 +1,758 @@
+"""The compiled collision check behind :func:`robokin.collision.check`.
+
+Shapes, bounding volumes, pairs and coal functors are built once per (robot,
+scene) and reused; :meth:`_Problem.run` does one trajectory (see the algorithm in
+:mod:`robokin.collision.check`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from robokin.collision.check import (
+    Closest,
+    Collision,
+    CollisionReport,
+    Interval,
+    PairMinimum,
+)
+from robokin.exceptions import InputError
+
+if TYPE_CHECKING:
+    from robokin.collision.scene import Scene
+    from robokin.robot import Robot
+
+_TIE = 1e-9  # [m] pair minima are exact to this (bounds within it of the best stop)
+
+
+def _coal():
+    from robokin.model.geometry import _coal
+
+    return _coal()
+
+
+class _Problem:
+    """The compiled check: shapes, bounding spheres, pairs, coal functors."""
+
+    def __init__(self, robot: Robot, scene: Scene, self_collision: bool) -> None:
+        from robokin.model.geometry import RobotGeometry
+
+        coal = _coal()
+        self.coal = coal
+        placed = scene.attach(robot)
+        self.robot = placed
+        geo: RobotGeometry = placed.geometry
+        self.geo = geo
+        chain = placed.chain
+        self.chain = chain
+        nc = chain.n_chain
+        self.nc = nc
+        # Robot shapes, frame index = link index (0 base .. nc + 1 tool).
+        shapes, link = [], []
+        for k, ss in enumerate(geo.shapes):
+            for s in ss:
+                if s.kind == "mesh":
+                    s.check_file()
+                shapes.append(s)
+                link.append(k)
+        self.shapes = shapes
+        self.link = np.array(link, dtype=int)
+        S = len(shapes)
+        self.place = np.array([s.placement for s in shapes]).reshape(S, 4, 4)
+        cs, rs, owner = [], [], []
+        for i, s in enumerate(shapes):
+            c, r = s.bounding_spheres()
+            cs.append(c)
+            rs.append(r)
+            owner.append(np.full(len(r), i))
+        self.sph_c = np.concatenate(cs) if cs else np.zeros((0, 3))
+        self.sph_r = np.concatenate(rs) if rs else np.zeros(0)
+        self.sph_owner = np.concatenate(owner) if owner else np.zeros(0, int)
+        self.sph_link = self.link[self.sph_owner] if S else np.zeros(0, int)
+        self.sph_start = np.searchsorted(self.sph_owner, np.arange(S))
+        # Largest reach of each shape from its link frame origin.
+        self.rho = np.zeros(S)
+        if S:
+            np.maximum.at(
+                self.rho,
+                self.sph_owner,
+                np.linalg.norm(self.sph_c, axis=1) + self.sph_r,
+            )
+        self.spins = np.array(
+            [self._spins(s, k, placed.chain) for s, k in zip(shapes, link)], dtype=bool
+        )
+        # Scene objects: oriented boxes for the broad phase, fixed coal transforms.
+        objects = list(scene.objects)
+        self.objects = objects
+        O = len(objects)
+        self.ob_R = np.zeros((O, 3, 3))
+        self.ob_t = np.zeros((O, 3))
+        self.ob_h = np.zeros((O, 3))
+        self.ob_T3 = []
+        for j, ob in enumerate(objects):
+            c, h = ob.shape.local_box()
+            P = ob.shape.placement
+            self.ob_R[j] = P[:3, :3]
+            self.ob_t[j] = P[:3, :3] @ c + P[:3, 3]
+            self.ob_h[j] = h
+            self.ob_T3.append(
+                coal.Transform3s(
+                    np.ascontiguousarray(P[:3, :3]), np.ascontiguousarray(P[:3, 3])
+                )
+            )
+        # Pairs at shape level: (robot shape, object) then (robot shape, robot shape).
+        names = geo.names
+        pa, pb, is_self = [], [], []
+        for i in range(S):
+            for j, ob in enumerate(objects):
+                if frozenset((names[link[i]], ob.name)) in scene.exclude:
+                    continue
+                pa.append(i)
+                pb.append(j)
+                is_self.append(False)
+        if self_collision:
+            checked = set(geo.self_pairs())
+            for i in range(S):
+                for j in range(i + 1, S):
+                    a, b = link[i], link[j]
+                    if (min(a, b), max(a, b)) in checked:
+                        pa.append(i)
+                        pb.append(j)
+                        is_self.append(True)
+        self.pa = np.array(pa, dtype=int)
+        self.pb = np.array(pb, dtype=int)
+        self.is_self = np.array(is_self, dtype=bool)
+        P = len(pa)
+        self.P = P
+        self.body_a = [names[link[i]] for i in pa]
+        self.body_b = [
+            names[link[j]] if s else objects[j].name for j, s in zip(pb, is_self)
+        ]
+        # Self pairs are ordered with body_a the lower link (j > i within shapes
+        # sorted by link, so link[pa] <= link[pb]).
+        self.obj_pairs = np.flatnonzero(~self.is_self)
+        self.self_pairs = np.flatnonzero(self.is_self)
+        # Sphere combinations for self pairs (grouped by pair).
+        c1, c2, grp = [], [], []
+        for g, p in enumerate(self.self_pairs):
+            i, j = pa[p], pb[p]
+            a = np.arange(
+                self.sph_start[i], self.sph_start[i] + np.sum(self.sph_owner == i)
+            )
+            b = np.arange(
+                self.sph_start[j], self.sph_start[j] + np.sum(self.sph_owner == j)
+            )
+            A_, B_ = np.meshgrid(a, b, indexing="ij")
+            c1.append(A_.ravel())
+            c2.append(B_.ravel())
+            grp.append(np.full(A_.size, g))
+        self.self_c1 = np.concatenate(c1) if c1 else np.zeros(0, int)
+        self.self_c2 = np.concatenate(c2) if c2 else np.zeros(0, int)
+        grp_arr = np.concatenate(grp) if grp else np.zeros(0, int)
+        self.self_start = np.searchsorted(grp_arr, np.arange(len(self.self_pairs)))
+        self.self_rr = (
+            self.sph_r[self.self_c1] + self.sph_r[self.self_c2] if c1 else np.zeros(0)
+        )
+        # Exact geometry: distance functors (meshes: exact BVH and convex hull).
+        self.has_mesh = np.zeros(P, dtype=bool)
+        self.fn_exact: list[Any] = []
+        self.fn_hull: list[Any] = []
+        self.geoms: list[tuple[Any, Any]] = []
+        cache: dict[tuple[int, int, bool], Any] = {}
+
+        def functor(g1, g2):
+            key = (id(g1), id(g2))
+            f = cache.get(key)
+            if f is None:
+                f = coal.ComputeDistance(g1, g2)
+                cache[key] = f
+            return f
+
+        for p in range(P):
+            sa = shapes[pa[p]]
+            sb = shapes[pb[p]] if is_self[p] else objects[pb[p]].shape
+            ga, gb = sa.coal_geometry(), sb.coal_geometry()
+            self.geoms.append((ga, gb))
+            self.fn_exact.append(functor(ga, gb))
+            mesh = sa.kind == "mesh" or sb.kind == "mesh"
+            self.has_mesh[p] = mesh
+            self.fn_hull.append(
+                functor(sa.coal_convex(), sb.coal_convex()) if mesh else None
+            )
+
+        # Capsule/sphere pairs have a closed-form distance: computed for all samples
+        # at once (segment-segment distance minus the radii).
+        def segment(sh):
+            if sh.kind == "sphere":
+                c = sh.placement[:3, 3]
+                return np.stack([c, c]), sh.size[0]
+            if sh.kind == "capsule":
+                h = sh.size[1] / 2 * sh.placement[:3, 2]
+                c = sh.placement[:3, 3]
+                return np.stack([c - h, c + h]), sh.size[0]
+            return None, 0.0
+
+        self.seg_local = np.zeros((S, 2, 3))
+        self.seg_r = np.zeros(S)
+        seg_ok = np.zeros(S, dtype=bool)
+        for i, sh in enumerate(shapes):
+            seg, rad = segment(sh)
+            if seg is not None:
+                self.seg_local[i], self.seg_r[i], seg_ok[i] = seg, rad, True
+        ob_seg = [segment(ob.shape) for ob in objects]
+        self.analytic = np.zeros(P, dtype=bool)
+        for p in range(P):
+            if not seg_ok[pa[p]]:
+                continue
+            self.analytic[p] = (
+                seg_ok[pb[p]] if is_self[p] else ob_seg[pb[p]][0] is not None
+            )
+        self.ob_seg = np.array(
+            [sg if sg is not None else np.zeros((2, 3)) for sg, _ in ob_seg]
+        )
+        self.ob_seg = self.ob_seg.reshape(O, 2, 3)
+        self.ob_seg_r = np.array([rad for _, rad in ob_seg]) if O else np.zeros(0)
+
+        # Rounded bounding boxes (pose in the parent frame, half sizes, radius).
+        def rounded_box(sh):
+            k, sz = sh.kind, sh.size
+            T = np.array(sh.placement)
+            if k == "capsule":
+                return T, np.array([0.0, 0.0, sz[1] / 2]), sz[0]
+            if k == "sphere":
+                return T, np.zeros(3), sz[0]
+            c, h = sh.local_box()
+            T[:3, 3] = T[:3, :3] @ c + T[:3, 3]
+            return T, np.array(h, dtype=float), 0.0
+
+        rbs = [rounded_box(sh) for sh in shapes]
+        self.rb_local = np.array([x[0] for x in rbs]).reshape(S, 4, 4)
+        self.rb_h = np.array([x[1] for x in rbs]).reshape(S, 3)
+        self.rb_r = np.array([x[2] for x in rbs]).reshape(S)
+        obs = [rounded_box(ob.shape) for ob in objects]
+        self.ob_rb_pose = np.array([x[0] for x in obs]).reshape(O, 4, 4)
+        self.ob_rb_h = np.array([x[1] for x in obs]).reshape(O, 3)
+        self.ob_rb_r = np.array([x[2] for x in obs]).reshape(O)
+        self.req = coal.DistanceRequest()
+        self.res = coal.DistanceResult()
+        # Constants for the motion bounds.
+        self._static_chain_lengths()
+
+    # ------------------------------------------------------------ motion bounds
+    @staticmethod
+    def _spins(shape, k: int, chain) -> bool:
+        """True when the last joint moving link k turns ``shape`` onto itself.
+
+        A sphere centred on that revolute joint's axis, or a cylinder or capsule
+        along it, does not move when the joint turns.
+        """
+        nc = chain.n_chain
+        kk = min(k, nc)
+        if kk == 0 or chain.joints[kk - 1].kind != "revolute":
+            return False
+        if shape.kind not in ("sphere", "cylinder", "capsule"):
+            return False
+        T = chain.frame_offsets[kk - 1]
+        if k == nc + 1:
+            T = T @ chain.link_offsets[nc - 1] @ chain.tool
+        inv = np.linalg.inv(T)  # the joint's axis in the link frame
+        p0, axis = inv[:3, 3], inv[:3, 2]
+        c = shape.placement[:3, 3]
+        off = (c - p0) - np.dot(c - p0, axis) * axis
+        if np.linalg.norm(off) > 1e-9:
+            return False
+        if shape.kind == "sphere":
+            return True
+        return bool(np.linalg.norm(np.cross(shape.placement[:3, 2], axis)) < 1e-9)
+
+    def _static_chain_lengths(self) -> None:
+        ch = self.chain
+        nc = self.nc
+        self.a_len = (
+            np.linalg.norm(ch.frame_offsets[:, :3, 3], axis=1) if nc else np.zeros(0)
+        )
+        self.b_len = (
+            np.linalg.norm(ch.link_offsets[:, :3, 3], axis=1) if nc else np.zeros(0)
+        )
+        self.tool_len = float(np.linalg.norm(ch.tool[:3, 3]))
+        self.prismatic = np.array(
+            [j.kind == "prismatic" for j in ch.joints], dtype=bool
+        )
+        # pre_j: constant from the frame reported for link j-1 to joint j.
+        pre = np.empty((nc, 4, 4))
+        if nc:
+            pre[0] = ch.head
+            pre[1:] = ch.link_offsets[:-1]
+        self.pre = pre
+
+    def _static_R(self, qc: np.ndarray) -> np.ndarray:
+        """Rst (nc, S): bound on the distance from joint j's origin to shape s."""
+        nc, S = self.nc, len(self.shapes)
+        ext = np.zeros(nc)
+        if self.prismatic.any():
+            sign = self.chain._sign
+            off = self.chain._offset
+            vals = np.abs(qc * sign + off).max(axis=0)
+            ext[self.prismatic] = vals[self.prismatic]
+        Rst = np.zeros((nc, S))
+        for s in range(S):
+            k = self.link[s]
+            for j in range(1, min(k, nc) + 1):  # joints 1..k move link k
+                # constants after J_j up to frame k
+                top = min(k, nc)
+                total = (
+                    self.a_len[j - 1 : top].sum() + self.b_len[j - 1 : top - 1].sum()
+                )
+                total += ext[j:top].sum()
+                if k == nc + 1:  # tool: F_nc G_nc tool after the last joint
+                    total += self.b_len[nc - 1] + self.tool_len
+                Rst[j - 1, s] = total + self.rho[s]
+        return Rst
+
+    def motion(self, q: np.ndarray, frames: np.ndarray) -> np.ndarray:
+        """Per interval and pair, the bound on the motion closing the distance, (P, m-1)."""
+        m = q.shape[0]
+        S, P = len(self.shapes), self.P
+        if m < 2 or P == 0:
+            return np.zeros((P, max(m - 1, 0)))
+        qc = self.chain.coupling.apply(q)
+        dq = np.abs(np.diff(qc, axis=0))  # (m-1, nc)
+        Rst = self._static_R(qc)  # (nc, S)
+        from robokin.collision._kernels import motion_bounds
+
+        Ms = np.empty((P, m - 1))
+        counts = np.bincount(self.sph_owner, minlength=S).astype(np.int64)
+        motion_bounds(
+            np.ascontiguousarray(frames),
+            np.ascontiguousarray(self.pre),
+            self.link,
+            self.sph_c,
+            self.sph_r,
+            self.sph_start.astype(np.int64),
+            counts,
+            np.ascontiguousarray(Rst),
+            self.prismatic,
+            self.spins,
+            np.ascontiguousarray(dq),
+            self.pa,
+            self.pb,
+            self.is_self,
+            Ms,
+        )
+        return Ms
+
+    # ---------------------------------------------------------------- bounds
+    def lower_bounds(self, frames: np.ndarray) -> np.ndarray:
+        """Broad-phase lower bounds on every pair's distance, (P, m).
+
+        Separating-axis gaps between rounded bounding boxes (compiled kernel).
+        """
+        from robokin.collision._kernels import rounded_box_bounds
+
+        m = frames.shape[0]
+        out = np.full((self.P, m), -np.inf)
+        rounded_box_bounds(
+            np.ascontiguousarray(frames),
+            self.link,
+            self.rb_local,
+            self.rb_h,
+            self.rb_r,
+            self.ob_rb_pose,
+            self.ob_rb_h,
+            self.ob_rb_r,
+            self.pa,
+            self.pb,
+            self.is_self,
+            self.analytic,
+            out,
+        )
+        return out
+
+    # -------------------------------------------------------------- analytic
+    def analytic_distances(self, frames: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+        """Closed-form distances of capsule/sphere pairs at every sample, (len(pairs), m)."""
+        from robokin.collision._kernels import capsule_distances
+
+        out = np.empty((len(pairs), frames.shape[0]))
+        capsule_distances(
+            np.ascontiguousarray(frames),
+            self.link,
+            self.seg_local,
+            self.seg_r,
+            self.ob_seg,
+            self.ob_seg_r,
+            self.pa,
+            self.pb,
+            self.is_self,
+            np.ascontiguousarray(pairs),
+            out,
+        )
+        return out
+
+    # ----------------------------------------------------------------- exact
+    def _T3(self, frame: np.ndarray, s: int):
+        W = frame @ self.place[s]
+        return self.coal.Transform3s(np.ascontiguousarray(W[:3, :3]), W[:3, 3].copy())
+
+    def exact(self, p: int, frames_i: np.ndarray, hull: bool = False) -> float:
+        """Exact (or convex-hull lower-bound) distance of pair p at one configuration."""
+        a = self.pa[p]
+        Ta = self._T3(frames_i[self.link[a]], a)
+        if self.is_self[p]:
+            b = self.pb[p]
+            Tb = self._T3(frames_i[self.link[b]], b)
+        else:
+            Tb = self.ob_T3[self.pb[p]]
+        fn = self.fn_hull[p] if hull else self.fn_exact[p]
+        res = self.res
+        res.clear()  # coal keeps the minimum over calls otherwise
+        return float(fn(Ta, Tb, self.req, res))
+
+    def nearest(
+        self, p: int, frames_i: np.ndarray
+    ) -> tuple[float, np.ndarray, np.ndarray]:
+        """Distance and nearest points (world) of pair p at one configuration."""
+        a = self.pa[p]
+        Ta = self._T3(frames_i[self.link[a]], a)
+        if self.is_self[p]:
+            b = self.pb[p]
+            Tb = self._T3(frames_i[self.link[b]], b)
+        else:
+            Tb = self.ob_T3[self.pb[p]]
+        res = self.coal.DistanceResult()
+        ga, gb = self.geoms[p]
+        d = self.coal.distance(ga, Ta, gb, Tb, self.req, res)
+        return (
+            float(d),
+            np.array(res.getNearestPoint1()),
+            np.array(res.getNearestPoint2()),
+        )
+
+    # ------------------------------------------------------------------- run
+    def frames(self, q: np.ndarray) -> np.ndarray:
+        from robokin.kinematics.forward import link_frames
+
+        return link_frames(self.chain, q)
+
+    def run(
+        self, q, t, clearance, subdivide, tol, pair_tol, pair_rtol
+    ) -> CollisionReport:
+        m = q.shape[0]
+        times = np.arange(m, dtype=float) if t is None else t
+        P = self.P
+        frames = self.frames(q)
+        if P == 0:
+            return CollisionReport(
+                math.inf,
+                False,
+                [],
+                [],
+                [],
+                None,
+                [],
+                clearance,
+                times,
+                _problem=self,
+                _q=q,
+            )
+        LB = self.lower_bounds(frames)
+        Ms = self.motion(q, frames)  # (P, m-1)
+        C = np.zeros((P, m))
+        np.cumsum(Ms, axis=1, out=C[:, 1:])
+        D = np.full((P, m), np.nan)
+        done = np.zeros((P, m), dtype=bool)  # exact known
+        hulled = np.zeros((P, m), dtype=bool)
+        self.queries = 0
+        an = np.flatnonzero(self.analytic)
+        if len(an):
+            D[an] = self.analytic_distances(frames, an)
+            done[an] = True
+            LB[an] = D[an]
+
+        # Per-run caches: shape poses as coal transforms, pair data as Python values.
+        T3 = self.coal.Transform3s
+        tcache: dict[tuple[int, int], Any] = {}
+        place, link_l = self.place, self.link.tolist()
+        pa_l, pb_l, self_l = self.pa.tolist(), self.pb.tolist(), self.is_self.tolist()
+        mesh_l, fn_e, fn_h = self.has_mesh.tolist(), self.fn_exact, self.fn_hull
+        ob_T3, req, res = self.ob_T3, self.req, self.res
+
+        def pose(i: int, s: int):
+            key = (i, s)
+            T = tcache.get(key)
+            if T is None:
+                W = frames[i, link_l[s]] @ place[s]
+                T = tcache[key] = T3(np.ascontiguousarray(W[:3, :3]), W[:3, 3].copy())
+            return T
+
+        def query(fn, p: int, i: int) -> float:
+            Ta = pose(i, pa_l[p])
+            Tb = pose(i, pb_l[p]) if self_l[p] else ob_T3[pb_l[p]]
+            res.clear()  # coal keeps the minimum over calls otherwise
+            return float(fn(Ta, Tb, req, res))
+
+        def evaluate(ps: np.ndarray, idx: np.ndarray, force_exact: bool) -> None:
+            n = 0
+            for p, i in zip(ps.tolist(), idx.tolist()):
+                if mesh_l[p] and not force_exact and not hulled[p, i]:
+                    v = query(fn_h[p], p, i)
+                    n += 1
+                    hulled[p, i] = True
+                    if v > LB[p, i]:
+                        LB[p, i] = v
+                    if v > clearance:
+                        continue
+                v = query(fn_e[p], p, i)
+                n += 1
+                D[p, i] = v
+                LB[p, i] = v
+                done[p, i] = True
+            self.queries += n
+
+        from robokin.collision._kernels import propagate_bounds
+
+        def propagate(rows: np.ndarray) -> None:
+            if len(rows) and m >= 2:
+                propagate_bounds(
+                    LB, done | hulled, C, np.ascontiguousarray(rows, dtype=np.int64)
+                )
+
+        # 1. Exact queries where they decide something: a sample whose bound does
+        #    not clear the threshold (to classify it), or lies below its pair's best
+        #    so far (to find the pair's minimum). Each round queries a strided
+        #    subset plus each pair's lowest bound, then spreads the new values to
+        #    the neighbours through the motion bounds; the stride halves per round.
+        #    Pair minima are settled to ``pair_tolerance``; a last pass settles
+        #    the global minimum exactly.
+        cols = np.arange(m)
+        stride = 0  # first round: only each pair's lowest bound
+        final = False
+        best = np.where(done, D, np.inf).min(axis=1)
+        active = np.arange(P)
+        while True:
+            if final:
+                g = best.min()
+                cand = np.flatnonzero(np.where(done, np.inf, LB).min(axis=1) < g - _TIE)
+                need = ~done[cand] & (LB[cand] < g - _TIE)
+            else:
+                cand = active
+                Lc = LB[cand]
+                bc = best[cand]
+                rel = pair_rtol * np.abs(np.where(np.isfinite(bc), bc, 0.0))
+                slack = np.maximum(pair_tol, rel)[:, None]
+                need = ~done[cand] & (
+                    (Lc <= clearance) | (Lc < best[cand, None] - slack)
+                )
+            keep = need.any(axis=1)
+            rows, need = cand[keep], need[keep]
+            if not final:
+                active = rows
+            if not len(rows):
+                if final or pair_tol <= _TIE:
+                    break
+                final = True
+                continue
+            pick = np.zeros_like(need)
+            if stride:
+                pick |= need & ((cols % stride) == 0)[None, :]
+            work = np.where(need, LB[rows], np.inf)
+            pick[np.arange(len(rows)), np.argmin(work, axis=1)] = True
+            ps, idx = np.nonzero(pick)
+            evaluate(rows[ps], idx, force_exact=False)
+            propagate(rows)
+            best[rows] = np.where(done[rows], D[rows], np.inf).min(axis=1)
+            stride = max(m // 32, 1) if stride == 0 else max(stride // 4, 1)
+        # 2. Subdivision: intervals whose ends do not clear the motion between.
+        between: dict[tuple[int, int], tuple[float, float]] = {}
+        self.subdivisions = 0
+        if subdivide and m >= 2:
+            bad = (LB[:, :-1] + LB[:, 1:] <= Ms + 2 * clearance) & (Ms > tol)
+            viol = (D[:, :-1] <= clearance) | (D[:, 1:] <= clearance)
+            bad &= ~viol
+            if bad.any():
+                ps, idx = np.nonzero(bad)
+                for off in (0, 1):
+                    sel = ~done[ps, idx + off]
+                    evaluate(ps[sel], idx[sel] + off, force_exact=True)
+                still = D[ps, idx] + D[ps, idx + 1] <= Ms[ps, idx] + 2 * clearance
+                still &= (D[ps, idx] > clearance) & (D[ps, idx + 1] > clearance)
+                for p, i in zip(ps[still].tolist(), idx[still].tolist()):
+                    found = self._bisect(
+                        p,
+                        q[i],
+                        q[i + 1],
+                        D[p, i],
+                        D[p, i + 1],
+                        Ms[p, i],
+                        clearance,
+                        tol,
+                    )
+                    if found is not None:
+                        between[(p, i)] = found
+        return self._report(q, times, frames, D, between, clearance)
+
+    def _bisect(self, p, q0, q1, d0, d1, M, thr, tol):
+        """Search an interval for a configuration at or below ``thr``; (fraction, d) or None."""
+        stack = [(0.0, 1.0, d0, d1)]
+        found = None
+        target = thr
+        evals = 0
+        while stack and evals < 4096:
+            a, b, da, db = stack.pop()
+            Mab = M * (b - a)
+            if da + db > Mab + 2 * target or Mab <= tol:
+                continue
+            mid = 0.5 * (a + b)
+            fr = self.frames(q0 + mid * (q1 - q0))
+            d = self.exact(p, fr)
+            evals += 1
+            self.queries += 1
+            self.subdivisions += 1
+            if (found is None and d <= target) or (found is not None and d < found[1]):
+                found = (mid, d)
+            if d <= 0.0:
+                found = (mid, d)
+                break
+            if d <= target:
+                target = 0.0  # a violation is known; keep looking for a collision
+            stack.append((mid, b, d, db))
+            stack.append((a, mid, da, d))
+        return found
+
+    # ---------------------------------------------------------------- report
+    def _groups(self):
+        groups: dict[tuple[str, str], list[int]] = {}
+        for p in range(self.P):
+            groups.setdefault((self.body_a[p], self.body_b[p]), []).append(p)
+        return groups
+
+    def _report(self, q, times, frames, D, between, clearance) -> CollisionReport:
+        m = q.shape[0]
+        groups = self._groups()
+
+        def t_at(i: int, frac: float = 0.0) -> float:
+            if frac == 0.0 or i + 1 >= m:
+                return float(times[i])
+            return float(times[i] + frac * (times[i + 1] - times[i]))
+
+        pairs: list[PairMinimum] = []
+        best_overall = None  # (d, p, i, frac, between)
+        intervals: list[Interval] = []
+        violations: list[Interval] = []
+        for (ba, bb), plist in groups.items():
+            sub = D[plist]  # (k, m)
+            per_sample = np.nanmin(np.where(np.isnan(sub), np.inf, sub), axis=0)
+            i = int(np.argmin(per_sample))
+            dmin = float(per_sample[i])
+            p_best = plist[
+                int(np.nanargmin(np.where(np.isnan(sub[:, i]), np.inf, sub[:, i])))
+            ]
+            kind = "self" if self.is_self[plist[0]] else "object"
+            pairs.append(PairMinimum(ba, bb, dmin, i, t_at(i), kind))
+            cand = (dmin, p_best, i, 0.0, False)
+            if best_overall is None or cand[0] < best_overall[0]:
+                best_overall = cand
+            btw = {i0: v for (p, i0), v in between.items() if p in plist}
+            for (p, i0), (frac, dv) in between.items():
+                if p in plist and (best_overall is None or dv < best_overall[0]):
+                    best_overall = (dv, p, i0, frac, True)
+            for thr, out in ((0.0, intervals), (clearance, violations)):
+                if out is violations and clearance <= 0.0:
+                    continue
+                mask = per_sample <= thr
+                bmask = np.zeros(max(m - 1, 0), dtype=bool)
+                bfrac: dict[int, tuple[float, float]] = {}
+                for i0, (frac, dv) in btw.items():
+                    if dv <= thr:
+                        bmask[i0] = True
+                        bfrac[i0] = (frac, dv)
+                out.extend(_runs(mask, bmask, bfrac, per_sample, ba, bb, t_at))
+        pairs.sort(key=lambda r: r.distance)
+        closest = None
+        min_distance = math.inf
+        if best_overall is not None:
+            dmin, p, i, frac, btw_flag = best_overall
+            fr = (
+                frames[i]
+                if not btw_flag
+                else self.frames(q[i] + frac * (q[i + 1] - q[i]))
+            )
+            d, pa_, pb_ = self.nearest(p, fr)
+            min_distance = float(dmin)
+            closest = Closest(
+                float(dmin),
+                int(i),
+                t_at(i, frac),
+                self.body_a[p],
+                self.body_b[p],
+                pa_,
+                pb_,
+                btw_flag,
+            )
+        intervals.sort(key=lambda r: (r.first_index, r.body_a, r.body_b))
+        violations.sort(key=lambda r: (r.first_index, r.body_a, r.body_b))
+        collisions = [
+            Collision(r.first_index, r.last_index, r.body_a, r.body_b)
+            for r in intervals
+        ]
+        return CollisionReport(
+            min_distance=min_distance,
+            collides=bool(intervals),
+            collisions=collisions,
+            intervals=intervals,
+            violations=violations,
+            closest=closest,
+            pairs=pairs,
+            clearance=clearance,
+            t=times,
+            queries=self.queries,
+            subdivisions=self.subdivisions,
+            _problem=self,
+            _q=q,
+        )
+
+    def profile(self, q: np.ndarray, body_a: str, body_b: str) -> np.ndarray:
+        """Exact distance of one body pair at every sample, (m,)."""
+        plist = [
+            p
+            for p in range(self.P)
+            if {self.body_a[p], self.body_b[p]} == {body_a, body_b}
+        ]
+        if not plist:
+            raise InputError("pair", f"({body_a!r}, {body_b!r}) is not a checked pair")
+        frames = self.frames(q)
+        out = np.full(q.shape[0], np.inf)
+        for i in range(q.shape[0]):
+            for p in plist:
+                out[i] = min(out[i], self.exact(p, frames[i]))
+        return out
+
+
+def _runs(mask, bmask, bfrac, per_sample, ba, bb, t_at) -> list[Interval]:
+    """Group colliding samples and between-sample hits into intervals.
+
+    Positions 2i are samples, 2i + 1 the motion from sample i to i + 1.
+    """
+    m = len(mask)
+    seq = np.zeros(2 * m - 1, dtype=bool)
+    seq[0::2] = mask
+    if m > 1:
+        seq[1::2] = bmask | (mask[:-1] & mask[1:])
+    out: list[Interval] = []
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], seq.astype(np.int8), [0]])))
+    for s, e in zip(edges[0::2], edges[1::2] - 1):
+        s, e = int(s), int(e)
+        dvals = [float(per_sample[k // 2]) for k in range(s, e + 1) if k % 2 == 0]
+        dvals += [
+            bfrac[k // 2][1] for k in range(s, e + 1) if k % 2 and (k // 2) in bfrac
+        ]
+        t0 = t_at(s // 2) if s % 2 == 0 else t_at(s // 2, bfrac[s // 2][0])
+        t1 = t_at(e // 2) if e % 2 == 0 else t_at(e // 2, bfrac[e // 2][0])
+        only_between = s == e and s % 2 == 1
+        out.append(
+            Interval(s // 2, (e + 1) // 2, ba, bb, t0, t1, min(dvals), only_between)
+        )
+    return out
