@@ -245,6 +245,10 @@ def test_agrees_with_a_brute_force_loop_on_the_aubo(rng):
     assert sorted(got) == sorted(want)
     assert rep.collides == bool(want) or any(iv.between_samples for iv in rep.intervals)
     assert rep.queries < D.size / 4  # the bounds spared most of the queries
+    exact = check(r, sc, q, clearance=0.01, pair_tolerance=0.0, pair_rtol=0.0)
+    for pm in exact.pairs:
+        ref = D[groups[(pm.body_a, pm.body_b)]].min()
+        assert pm.distance == pytest.approx(ref, abs=1e-9)
 
 
 def test_motion_bounds_hold_between_samples(rng):
