@@ -190,6 +190,7 @@ def _brute_force(problem, q):
     """Every pair at every sample, one coal.distance call each."""
     frames = problem.frames(q)
     req = coal.DistanceRequest()
+    req.gjk_tolerance = 1e-9  # as robokin's queries (coal's default is 1e-6)
     D = np.empty((problem.P, q.shape[0]))
     for i in range(q.shape[0]):
         for p in range(problem.P):

@@ -237,6 +237,7 @@ class _Problem:
         self.ob_rb_h = np.array([x[1] for x in obs]).reshape(O, 3)
         self.ob_rb_r = np.array([x[2] for x in obs]).reshape(O)
         self.req = coal.DistanceRequest()
+        self.req.gjk_tolerance = 1e-9  # [m] (coal: 1e-6) distances exact to ~1e-9
         self.res = coal.DistanceResult()
         # Constants for the motion bounds.
         self._static_chain_lengths()
