@@ -179,7 +179,7 @@ def _seg_seg(p1, q1, p2, q2):
     return np.sqrt(dx * dx + dy * dy + dz * dz)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def capsule_distances(
     frames, link, seg, seg_r, ob_seg, ob_r, pa, pb, is_self, pairs, out
 ):
@@ -197,7 +197,7 @@ def capsule_distances(
     """
     m = frames.shape[0]
     S = link.shape[0]
-    for i in prange(m):
+    for i in range(m):
         w = np.empty((S, 2, 3))
         for s in range(S):
             F = frames[i, link[s]]
@@ -255,7 +255,7 @@ def propagate_bounds(LB, known, C, rows):
                 LB[p, j] = g
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def motion_bounds(
     frames,
     pre,
@@ -296,7 +296,7 @@ def motion_bounds(
     nc = dq.shape[1]
     S = link.shape[0]
     P = pa.shape[0]
-    for i in prange(m1):
+    for i in range(m1):
         W = np.zeros((S, nc))
         o = np.empty((nc, 3))
         z = np.empty((nc, 3))
