@@ -23,7 +23,9 @@ A robot file's ``geometry:`` section lists shapes per link, in the file's units:
 
 Link keys are ``base``, the chain joint names (link k moves with joint k) and
 ``tool``. ``from``/``to`` give a cylinder's or capsule's axis end points instead of
-``length``/``xyz``/``rpy``. Mesh files resolve relative to the robot file.
+``length``/``xyz``/``rpy``. Mesh files resolve relative to the robot file; a mesh's
+``units`` (m, cm, mm; default: the file's length unit) and optional ``scale``
+convert its vertices to metres. See ``docs/collision.md``.
 """
 
 from __future__ import annotations
