@@ -292,3 +292,30 @@ def test_non_convex_mesh_links_are_exact_through_the_hull_bound(tmp_path, rng):
     assert rep.collides == bool((D <= 0).any())
     hull = rep._problem.exact(0, rep._problem.frames(q)[30], hull=True)
     assert hull < D[0, 30] - 0.05  # the hull bound really is looser here
+
+
+def test_subdivision_never_misses_what_dense_sampling_finds(rng):
+    """Two clear samples with contact in between: subdivision always reports it."""
+    r = robokin.load("ur5")
+    sc = Scene()
+    sc.add_box("plate", (0.01, 1.2, 1.2), T(0.35, 0.0, 0.3))
+    sc.add_box("slab", (1.5, 1.5, 0.01), T(0.0, 0.0, 0.0))
+    sc.add_cylinder("pole", 0.02, 1.0, T(-0.3, 0.35, 0.5))
+    for link in ("base", "shoulder_pan"):
+        sc.exclude_pair(link, "slab")
+    between = clear = 0
+    for _ in range(150):
+        q0 = rng.uniform(-2.0, 2.0, 6)
+        q1 = q0 + rng.uniform(-2.0, 2.0, 6)
+        ends = np.stack([q0, q1])
+        if check(r, sc, ends, self_collision=False, subdivide=False).collides:
+            continue  # only motions whose samples are both clear
+        dense = q0 + np.linspace(0.0, 1.0, 400)[:, None] * (q1 - q0)
+        touched = check(r, sc, dense, self_collision=False, subdivide=False).collides
+        rep = check(r, sc, ends, self_collision=False)
+        if touched:
+            between += 1
+            assert rep.collides and all(iv.between_samples for iv in rep.intervals)
+        elif not rep.collides:
+            clear += 1
+    assert between >= 3 and clear >= 3  # both outcomes were exercised
