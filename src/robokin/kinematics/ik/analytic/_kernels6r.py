@@ -53,6 +53,7 @@ AA, BB = 92, 93
 N_PARAMS = 94
 
 _TWO_PI = 2.0 * math.pi
+_INV_TWO_PI = 1.0 / _TWO_PI
 # Status codes >= BAD_POSE: the pose failed validation (code - BAD_POSE is the
 # ``check_poses`` code); nothing was solved.
 BAD_POSE = 16
@@ -89,39 +90,41 @@ def _target(T, P):
 
 @njit(cache=True, inline="always")
 def _joint(v, sign, offset, lo, hi):
-    """Chain angle ``v`` to the joint coordinate, wrapped to [-pi, pi) and moved by
+    """Chain angle ``v`` to the joint coordinate, wrapped to [-pi, pi] and moved by
     whole turns into ``[lo, hi]`` when it fits. Returns (q, inside).
 
-    Same result as ``_subproblems.to_joint`` without the float modulo (the values
-    here are within a few turns)."""
+    ``_subproblems.to_joint`` without the float modulo and with few branches."""
     q = sign * (v - offset)
-    if q >= math.pi or q < -math.pi:
-        q -= _TWO_PI * math.floor((q + math.pi) / _TWO_PI)
-        if q >= math.pi:
-            q -= _TWO_PI
-        elif q < -math.pi:
-            q += _TWO_PI
-    eps = 1e-9
-    if q < lo - eps:
-        q2 = q + _TWO_PI * math.ceil((lo - eps - q) / _TWO_PI)
-        if q2 <= hi + eps:
+    q -= _TWO_PI * math.floor((q + math.pi) * _INV_TWO_PI)
+    lo_e = lo - 1e-9
+    hi_e = hi + 1e-9
+    if q < lo_e:
+        q2 = q + _TWO_PI * math.ceil((lo_e - q) * _INV_TWO_PI)
+        if q2 <= hi_e:
             q = q2
-    elif q > hi + eps:
-        q2 = q - _TWO_PI * math.ceil((q - hi - eps) / _TWO_PI)
-        if q2 >= lo - eps:
+    elif q > hi_e:
+        q2 = q - _TWO_PI * math.ceil((q - hi_e) * _INV_TWO_PI)
+        if q2 >= lo_e:
             q = q2
-    return q, (q >= lo - eps) and (q <= hi + eps)
+    return q, (q >= lo_e) & (q <= hi_e)
 
 
 @njit(cache=True, inline="always")
 def _write(P, Q, inside, slot, v1, v2, v3, v4, v5, v6):
-    ok = True
-    vals = (v1, v2, v3, v4, v5, v6)
-    for j in range(6):
-        q, ins = _joint(vals[j], P[SIGN + j], P[OFFSET + j], P[LO + j], P[HI + j])
-        Q[slot, j] = q
-        ok = ok and ins
-    inside[slot] = ok
+    # unrolled: a loop over a tuple indexed by the loop variable is much slower
+    q1, k1 = _joint(v1, P[SIGN], P[OFFSET], P[LO], P[HI])
+    q2, k2 = _joint(v2, P[SIGN + 1], P[OFFSET + 1], P[LO + 1], P[HI + 1])
+    q3, k3 = _joint(v3, P[SIGN + 2], P[OFFSET + 2], P[LO + 2], P[HI + 2])
+    q4, k4 = _joint(v4, P[SIGN + 3], P[OFFSET + 3], P[LO + 3], P[HI + 3])
+    q5, k5 = _joint(v5, P[SIGN + 4], P[OFFSET + 4], P[LO + 4], P[HI + 4])
+    q6, k6 = _joint(v6, P[SIGN + 5], P[OFFSET + 5], P[LO + 5], P[HI + 5])
+    Q[slot, 0] = q1
+    Q[slot, 1] = q2
+    Q[slot, 2] = q3
+    Q[slot, 3] = q4
+    Q[slot, 4] = q5
+    Q[slot, 5] = q6
+    inside[slot] = k1 & k2 & k3 & k4 & k5 & k6
 
 
 @njit(cache=True, inline="always")
