@@ -284,23 +284,10 @@ class Scene:
             ModelError: missing file, bad YAML, a bad field (names the file, the
                 field path and the reason) or a bad mesh.
         """
-        import yaml
+        from robokin.model.files import read_yaml
 
         path = Path(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise ModelError("no such file", file=path) from None
-        except OSError as exc:
-            raise ModelError(f"cannot read: {exc.strerror}", file=path) from None
-        try:
-            doc = yaml.safe_load(text)
-        except yaml.YAMLError as exc:
-            mark = getattr(exc, "problem_mark", None)
-            where = (
-                f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-            )
-            raise ModelError(f"not valid YAML{where}", file=path) from None
+        doc = read_yaml(path)
         return cls.from_document(doc, file=path)
 
     @classmethod

@@ -33,7 +33,13 @@ from robokin.exceptions import ModelError
 if TYPE_CHECKING:
     from robokin.robot import Robot
 
-__all__ = ["load_robot", "robot_from_document", "save_robot", "document_from_robot"]
+__all__ = [
+    "document_from_robot",
+    "load_robot",
+    "read_yaml",
+    "robot_from_document",
+    "save_robot",
+]
 
 _LENGTH = {"m": 1.0, "mm": 1e-3}
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
@@ -284,12 +290,12 @@ def _load_section_module(key: str) -> None:
         raise
 
 
-def load_robot(path: str | Path) -> Robot:
-    """Load and validate a robot file.
+def read_yaml(path: str | Path) -> Any:
+    """Read a YAML file with ``yaml.safe_load``.
 
     Raises:
-        ModelError: the file is missing, not YAML, or fails validation (the message
-            names the file, the field path and the reason).
+        ModelError: the file is missing or unreadable, or not valid YAML (with the
+            line and column), naming the file.
     """
     import yaml
 
@@ -301,14 +307,24 @@ def load_robot(path: str | Path) -> Robot:
     except OSError as exc:
         raise ModelError(f"cannot read: {exc.strerror}", file=path) from None
     try:
-        doc = yaml.safe_load(text)
+        return yaml.safe_load(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         raise ModelError(
             f"not valid YAML{where}: {getattr(exc, 'problem', exc)}", file=path
         ) from None
-    return robot_from_document(doc, file=path)
+
+
+def load_robot(path: str | Path) -> Robot:
+    """Load and validate a robot file.
+
+    Raises:
+        ModelError: the file is missing, not YAML, or fails validation (the message
+            names the file, the field path and the reason).
+    """
+    path = Path(path)
+    return robot_from_document(read_yaml(path), file=path)
 
 
 def document_from_robot(robot: Robot) -> dict[str, Any]:
