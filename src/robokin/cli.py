@@ -107,6 +107,10 @@ def show(
         for row_a, b in zip(r.actuators.matrix, r.actuators.offset):
             act.add_row(np.array2string(row_a, precision=6), f"{b:.6g}")
         con.print(act)
+    T0 = r.fk(np.zeros(r.n))
+    con.print(
+        "tool at q = 0 [m]: " + "  ".join(f"{v:.6f}" for v in T0[:3, 3]), markup=False
+    )
     if r.source:
         con.print(f"[dim]source: {r.source}[/dim]")
 
