@@ -150,3 +150,18 @@ def test_code_built_robot_keeps_its_actuators_when_saved(tmp_path, rng):
     np.testing.assert_allclose(
         again.actuators_from_joints(q), scara.actuators_from_joints(q), atol=1e-12
     )
+
+
+@pytest.mark.parametrize("name", ["aubo_i5", "scara"])
+def test_code_built_robot_keeps_its_geometry_when_saved(tmp_path, name):
+    original = robokin.load(name)
+    robot = original.replace(meta={})
+    again = robokin.load(save_robot(robot, tmp_path / f"{name}.yaml"))
+    geo, ref = again.geometry, original.geometry
+    assert geo.names == ref.names
+    assert geo.exclude == ref.exclude and geo.exclude_adjacent == ref.exclude_adjacent
+    for a_shapes, b_shapes in zip(geo.shapes, ref.shapes):
+        assert [s.kind for s in a_shapes] == [s.kind for s in b_shapes]
+        for a, b in zip(a_shapes, b_shapes):
+            np.testing.assert_allclose(a.size, b.size)
+            np.testing.assert_allclose(a.placement, b.placement, atol=1e-12)

@@ -412,6 +412,11 @@ def _elementary_document(robot: Robot) -> dict[str, Any]:
         from robokin.model.coupling_files import section_from_robot
 
         doc["actuators"] = section_from_robot(robot)
+    if robot.geometry is not None:
+        from robokin.model.geometry import RobotGeometry, sections_from_geometry
+
+        if isinstance(robot.geometry, RobotGeometry):
+            doc.update(sections_from_geometry(robot.geometry))
     for key, T in (("base", chain.base), ("tool", chain.tool)):
         if not np.allclose(T, np.eye(4), atol=1e-15):
             doc[key] = {

@@ -840,6 +840,54 @@ def _collision_section(robot: Robot, value: Any, file: Any, units: Any) -> Robot
     return robot.replace(geometry=geo)
 
 
+def sections_from_geometry(geometry: RobotGeometry) -> dict[str, Any]:
+    """The ``geometry:`` and ``collision:`` robot-file sections (SI units).
+
+    The inverse of the section parsers, for writing robots built in memory (e.g.
+    imported from URDF): shapes as ``{type, name, xyz, rpy, size | radius + length
+    | file + scale}`` per link, mesh paths absolute.
+    """
+    from robokin.spatial import rpy_from_matrix
+
+    out: dict[str, Any] = {}
+    per_link: dict[str, list[dict[str, Any]]] = {}
+    for name, shapes in zip(geometry.names, geometry.shapes):
+        specs = []
+        for sh in shapes:
+            spec: dict[str, Any] = {"type": sh.kind}
+            if sh.name:
+                spec["name"] = sh.name
+            P = sh.placement
+            if np.any(P[:3, 3]):
+                spec["xyz"] = [float(v) for v in P[:3, 3]]
+            if not np.allclose(P[:3, :3], np.eye(3), atol=1e-15):
+                spec["rpy"] = [float(v) for v in rpy_from_matrix(P)]
+            if sh.kind == "box":
+                spec["size"] = list(sh.size)
+            elif sh.kind == "sphere":
+                spec["radius"] = sh.size[0]
+            elif sh.kind in ("cylinder", "capsule"):
+                spec["radius"], spec["length"] = sh.size
+            else:
+                spec["file"] = str(Path(sh.file).resolve())
+                spec["units"] = "m"
+                if sh.scale != 1.0:
+                    spec["scale"] = float(sh.scale)
+            specs.append(spec)
+        if specs:
+            per_link[name] = specs
+    if per_link:
+        out["geometry"] = per_link
+    collision: dict[str, Any] = {}
+    if geometry.exclude:
+        collision["exclude"] = sorted(sorted(p) for p in geometry.exclude if len(p) == 2)
+    if not geometry.exclude_adjacent:
+        collision["exclude_adjacent"] = False
+    if collision:
+        out["collision"] = collision
+    return out
+
+
 def _register() -> None:
     from robokin.model.files import register_section
 
