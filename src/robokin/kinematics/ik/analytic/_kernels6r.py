@@ -228,7 +228,6 @@ def three_parallel_one(T, P, q6, Q, valid, sing, inside):
     """
     h1 = vec(P, 0)
     h2 = vec(P, 1)
-    h3 = vec(P, 2)
     h5 = vec(P, 4)
     h6 = vec(P, 5)
     o1 = vec(P, 6)
@@ -267,6 +266,16 @@ def three_parallel_one(T, P, q6, Q, valid, sing, inside):
     b = sub(o4, o3)
     o21 = sub(o2, o1)
     w4 = sub(ow, o4)
+    # the planar part (axes 2-4 parallel): coordinates in the plane normal to h2,
+    # basis (e, e2 = h2 x e); rotations about h2 are 2D rotations there
+    e2 = cross(h2, e)
+    a1 = dot(a, e)
+    a2 = dot(a, e2)
+    b1 = dot(b, e)
+    b2 = dot(b, e2)
+    w41 = dot(w4, e)
+    w42 = dot(w4, e2)
+    w4h = dot(w4, h2)
     any_wrist = False
     any_ok = False
     for i1 in range(n1):
@@ -289,6 +298,9 @@ def three_parallel_one(T, P, q6, Q, valid, sing, inside):
         if singular:
             n5 = 1
         pl = sub(rot(h1, c1, -s1, pp), o21)  # R1^T pp - (o2 - o1)
+        pl1 = dot(pl, e)
+        pl2 = dot(pl, e2)
+        dh = dot(pl, h2) - w4h  # d's component along h2
         for i5 in range(n5):
             if i5 == 0:
                 th5, c5, s5 = t5p, c5p, s5p
@@ -304,8 +316,9 @@ def three_parallel_one(T, P, q6, Q, valid, sing, inside):
             w = rot(h6, c6, -s6, rot(h5, c5, -s5, e))
             w = rot(h1, c1, -s1, _mv(r0, r1, r2, w))
             th234, c234, s234 = _sp1_cs(h2, e, w)
-            d = sub(pl, rot(h2, c234, s234, w4))
-            rhs3 = 0.5 * (dot(d, d) - aa - bb) - C3_
+            d1 = pl1 - (c234 * w41 - s234 * w42)  # d = pl - rot(h2, th234) w4
+            d2 = pl2 - (s234 * w41 + c234 * w42)
+            rhs3 = 0.5 * (d1 * d1 + d2 * d2 + dh * dh - aa - bb) - C3_
             n3, bd3, t3p, c3p, s3p, t3m, c3m, s3m = _roots(
                 A3_, B3_, rhs3, A3_ * A3_ + B3_ * B3_ - rhs3 * rhs3, dtol, mir,
                 P[PHI3], P[CPHI3], P[SPHI3])
@@ -314,8 +327,10 @@ def three_parallel_one(T, P, q6, Q, valid, sing, inside):
                     th3, c3, sn3 = t3p, c3p, s3p
                 else:
                     th3, c3, sn3 = t3m, c3m, s3m
-                u = add(a, rot(h3, c3, sn3, b))
-                th2 = sp1(h2, u, d)
+                sg = s3 * sn3  # rot(h3, th3) = rot(h2, s3 th3)
+                u1 = a1 + c3 * b1 - sg * b2  # u = a + rot(h3, th3) b
+                u2 = a2 + sg * b1 + c3 * b2
+                th2 = fatan2(u1 * d2 - u2 * d1, u1 * d1 + u2 * d2)  # rot(h2, th2) u = d
                 th4 = s4 * (th234 - th2 - s3 * th3)
                 slot = 4 * i1 + 2 * i3 + i5
                 _write(P, Q, inside, slot, th1, th2, th3, th4, th5, th6)
