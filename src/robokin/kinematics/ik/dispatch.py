@@ -30,10 +30,12 @@ def solve(
         InputError: bad pose or ``q_near``, unknown method, or ``method="analytic"``
             for an arm without a closed form (the message says why).
     """
+    if method not in _METHODS:
+        raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
     if q_near is not None:
         q_near = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
     if (not options and type(T) is np.ndarray and T.shape == (4, 4)
-            and T.dtype == np.float64 and (method == "auto" or method == "analytic")):
+            and T.dtype == np.float64 and method != "numeric"):
         # hot path: one pose, a 6R closed form, default options (one compiled call
         # validates the pose and solves it)
         single = _single_solver(robot)
@@ -41,8 +43,6 @@ def solve(
             out = single(T, 0.0 if q_near is None else float(q_near[5]))
             if out is not None:
                 return out
-    if method not in _METHODS:
-        raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
     T = check_poses_fast(T, "T")
     if method in ("auto", "analytic"):
         from robokin.kinematics.ik.analytic.detect import detect
