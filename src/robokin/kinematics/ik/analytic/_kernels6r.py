@@ -360,6 +360,7 @@ def spherical_one(T, P, q6, Q, valid, sing, inside):
     ow = vec(P, 10)
     t = vec(P, 12)
     e = vec(P, 16)
+    sign3 = P[S3]
     stol = P[SING_TOL]
     dtol = P[DISC_TOL]
     mir = P[MIRROR] != 0.0
@@ -407,13 +408,17 @@ def spherical_one(T, P, q6, Q, valid, sing, inside):
                 th3, c3, s3 = t3m, c3m, s3m
             u = add(a, rot(h3, c3, s3, b))
             th2, c2, s2 = _sp1_cs(h2, u, d)
-            x = rot(h3, c3, -s3, rot(h2, c2, -s2, g61))  # Rw h6
+            # h3 = sign3 h2 (snapped): rot(h2, th2) rot(h3, th3) = rot(h2, th2 + sign3 th3)
+            sg = sign3 * s3
+            c23 = c2 * c3 - s2 * sg
+            s23 = s2 * c3 + c2 * sg
+            x = rot(h2, c23, -s23, g61)  # Rw h6
             d5 = dot(h4, x)
             xp = sub(x, scale(h4, d5))
             n5, _b5, t5p, c5p, s5p, t5m, c5m, s5m = _roots(
                 A5_, B5_, d5 - C5_, _wrist_disc(A5_, B5_, C5_, d5, dot(xp, xp)), dtol,
                 mir, P[PHI5], P[CPHI5], P[SPHI5])
-            y = _mtv(r0, r1, r2, rot(h1, c1, s1, rot(h2, c2, s2, rot(h3, c3, s3, h4))))
+            y = _mtv(r0, r1, r2, rot(h1, c1, s1, rot(h2, c23, s23, h4)))
             yp = sub(y, scale(h6, dot(y, h6)))
             singular = math.sqrt(dot(yp, yp)) < stol
             if singular and n5 > 1:
@@ -431,7 +436,7 @@ def spherical_one(T, P, q6, Q, valid, sing, inside):
                     th6, c6, s6 = _sp1_cs(h6, y, rot(h5, c5, -s5, h4))
                 w = rot(h6, c6, -s6, rot(h5, c5, -s5, e))
                 w = rot(h1, c1, -s1, _mv(r0, r1, r2, w))
-                w = rot(h3, c3, -s3, rot(h2, c2, -s2, w))
+                w = rot(h2, c23, -s23, w)
                 th4 = sp1(h4, e, w)
                 slot = 4 * i1 + 2 * i3 + i5
                 _write(P, Q, inside, slot, th1, th2, th3, th4, th5, th6)
