@@ -123,3 +123,16 @@ def test_parallel_batch_equals_serial_chunks(name):
     np.testing.assert_array_equal(whole.flags["within_limits"],
                                   np.concatenate([p.flags["within_limits"] for p in parts]))
     np.testing.assert_array_equal(whole.status, np.concatenate([p.status for p in parts]))
+
+
+@pytest.mark.parametrize(
+    ("q_near", "match"),
+    [(np.array([0.0, 0.0, 0.0, 0.0, 0.0, np.nan]), r"non-finite value at index \(5,\)"),
+     (np.array([np.inf, -np.inf, 0.0, 0.0, 0.0, 0.0]), r"non-finite value at index \(0,\)"),
+     (np.zeros(5), r"expected shape \(\.\.\., 6\)")],
+)
+def test_single_pose_q_near_still_validated(q_near, match):
+    robot = robokin.load("ur5")
+    T = robot.fk(np.array([0.3, -1.0, 1.2, 0.4, 0.9, -0.5]))
+    with pytest.raises(InputError, match=match):
+        robot.ik(T, q_near=q_near)

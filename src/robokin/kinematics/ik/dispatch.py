@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -32,7 +33,7 @@ def solve(
     """
     if method not in _METHODS:
         raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
-    if q_near is not None:
+    if q_near is not None and not _plain_joints(q_near, robot.n):
         q_near = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
     if (not options and type(T) is np.ndarray and T.shape == (4, 4)
             and T.dtype == np.float64 and method != "numeric"):
@@ -71,3 +72,11 @@ def _single_solver(robot: Any) -> Any:
         single = getattr(fam.solver, "single", None)
         object.__setattr__(chain, "_ik_single", single)
     return single
+
+
+def _plain_joints(q: Any, n: int) -> bool:
+    """True for a float64 array of shape (n,) with finite values: what the full
+    ``check_joints`` / ``check_finite`` would return unchanged (a cheap test for the
+    single-pose path; anything else gets the full checks)."""
+    return (type(q) is np.ndarray and q.shape == (n,) and q.dtype == np.float64
+            and math.isfinite(sum(q.tolist())))
