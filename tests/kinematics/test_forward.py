@@ -78,3 +78,21 @@ def test_fk_does_not_modify_its_input(rng):
     robot.fk(q)
     robot.jacobian(q)
     np.testing.assert_array_equal(q, before)
+
+
+def test_compiled_sincos_is_within_one_ulp_of_libm(rng):
+    from robokin.kinematics import _kernels
+
+    x = np.concatenate(
+        [
+            rng.uniform(-7, 7, 200_000),
+            rng.uniform(-2e3, 2e3, 50_000),
+            [0.0, np.pi / 2, np.pi, -np.pi, 2 * np.pi, 1e5, 3e5, np.inf, np.nan],
+        ]
+    )
+    s, c = np.empty_like(x), np.empty_like(x)
+    _kernels.sincos_array(x, s, c)
+    ok = np.isfinite(x)
+    np.testing.assert_allclose(s[ok], np.sin(x[ok]), rtol=0, atol=2.3e-16)
+    np.testing.assert_allclose(c[ok], np.cos(x[ok]), rtol=0, atol=2.3e-16)
+    assert np.isnan(s[~ok]).all() and np.isnan(c[~ok]).all()
