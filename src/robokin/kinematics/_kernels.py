@@ -17,7 +17,6 @@ import math
 import numpy as np
 from numba import njit, prange
 
-
 # sincos: Cody-Waite reduction by pi/2 and the fdlibm/musl kernel polynomials
 # (__kernel_sin, __kernel_cos), < 1 ulp on the reduced range. One reduction serves
 # both values, about twice as fast as two libm calls; FK is bound by them.
