@@ -182,37 +182,6 @@ def _write_distance_csv(traj: Any, dist: dict[str, np.ndarray], path: Path) -> P
     return write_text_atomic(path, "\n".join(lines) + "\n", overwrite=True)
 
 
-def _plot_distance(
-    report: Any, traj: Any, dist: dict[str, np.ndarray], clearance: float, path: Path
-) -> Path:
-    """Distance over time of the closest body pairs, with the clearance marked."""
-    from robokin.viz.plots import _figure, save_figure
-
-    fig = _figure((9.0, 4.5))
-    ax = fig.add_subplot(1, 1, 1)
-    for name, d in dist.items():
-        ax.plot(
-            traj.t, d * 1000.0, lw=1.2, label=f"{name} (min {d.min() * 1000:.1f} mm)"
-        )
-    ax.axhline(
-        clearance * 1000.0,
-        color="red",
-        ls="--",
-        lw=1.0,
-        label=f"required clearance {clearance * 1000:.0f} mm",
-    )
-    c = report.closest
-    if c is not None:
-        ax.plot([c.t], [c.distance * 1000.0], "v", color="red", ms=8)
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("distance [mm]")
-    ax.set_ylim(bottom=0.0, top=min(400.0, ax.get_ylim()[1]))
-    ax.set_title("closest approach to the press cell, per body pair")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="upper right")
-    return save_figure(fig, path, overwrite=True)
-
-
 def _plot_press_views(traj: Any, scene: Any, report: Any, path: Path) -> Path:
     """The tool path inside the press: side view (x-z) and top view (x-y)."""
     from matplotlib.patches import Rectangle
@@ -586,10 +555,11 @@ def run_demo(
         )
         dist = _closest_pair_distances(report)
         done("distance.csv", _write_distance_csv(traj, dist, out / "distance.csv"))
-        done(
-            "distance.png",
-            _plot_distance(report, traj, dist, clearance, out / "distance.png"),
-        )
+        from robokin.collision.plots import plot_distance
+
+        pairs = [(p.body_a, p.body_b) for p in report.pairs[: len(dist)]]
+        plot_distance(report, pairs, clearance=clearance, out=out / "distance.png")
+        done("distance.png", out / "distance.png")
         if html_animation:
             from robokin.viz.html import write_html
 
