@@ -43,3 +43,15 @@ def test_builtin_names_match_design():
             "improved_dh_arm",
         ]
     )
+
+
+def test_actuator_limits_must_match_the_motors():
+    import numpy as np
+    import pytest
+
+    scara = robokin.load("scara")
+    with pytest.raises(robokin.InputError, match=r"actuator_limits.*\(4, 2\)"):
+        scara.replace(actuator_limits=np.zeros((3, 2)))
+    ur5 = robokin.load("ur5")
+    with pytest.raises(robokin.InputError, match="without an actuator map"):
+        ur5.replace(actuator_limits=np.zeros((6, 2)))

@@ -73,7 +73,14 @@ class Robot:
             else tuple(actuator_names or (f"motor{i + 1}" for i in range(m)))
         )
         if actuator_limits is not None:
-            lim = np.array(actuator_limits, dtype=float).reshape(-1, 2)
+            lim = np.array(actuator_limits, dtype=float)
+            if actuators is None or lim.shape != (m, 2) or np.isnan(lim).any():
+                raise InputError(
+                    "actuator_limits",
+                    f"expected shape ({m}, 2) without NaN for {m} motors, got {lim.shape}"
+                    if actuators is not None
+                    else "given without an actuator map",
+                )
             lim.setflags(write=False)
             actuator_limits = lim
         elif actuators is not None:
