@@ -45,6 +45,8 @@ def solve(
             if out is not None:
                 return out
     T = check_poses_fast(T, "T")
+    if q_near is not None and q_near.ndim > 1:
+        _check_q_near_batch(q_near, T.shape[:-2] + (robot.n,))
     if method in ("auto", "analytic"):
         from robokin.kinematics.ik.analytic.detect import detect
 
@@ -58,6 +60,19 @@ def solve(
     from robokin.kinematics.ik.numeric import solve_all
 
     return solve_all(robot, T, q_near=q_near, **options)
+
+
+def _check_q_near_batch(q_near: np.ndarray, target: tuple[int, ...]) -> None:
+    """Raise InputError unless a batched ``q_near`` broadcasts to ``target``
+    (the pose batch + (n,)) without growing it: every solver reads it that way."""
+    try:
+        ok = np.broadcast_shapes(q_near.shape, target) == target
+    except ValueError:
+        ok = False
+    if not ok:
+        raise InputError(
+            "q_near", f"shape {q_near.shape} does not broadcast to the targets' {target}"
+        )
 
 
 def _single_solver(robot: Any) -> Any:

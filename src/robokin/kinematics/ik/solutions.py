@@ -16,7 +16,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin._validation import check_finite, check_joints
-from robokin.exceptions import UnreachableError
+from robokin.exceptions import InputError, UnreachableError
 
 __all__ = ["SolutionSet", "wrap_angle"]
 
@@ -198,13 +198,26 @@ class SolutionSet:
                         f"> upper limit {lim[j, 1]:.6g}")
         return "outside joint limits"
 
+    def _q_current(self, q_current: npt.ArrayLike) -> np.ndarray:
+        """``q_current`` checked: finite, (..., n), broadcasting to the pose batch."""
+        qc = check_finite(check_joints(q_current, self.n, "q_current"), "q_current")
+        target = self.shape + (self.n,)
+        try:
+            ok = np.broadcast_shapes(qc.shape, target) == target
+        except ValueError:
+            ok = False
+        if not ok:
+            raise InputError("q_current", f"shape {qc.shape} does not broadcast to the "
+                                          f"pose batch + joints {target}")
+        return qc
+
     def distance(self, q_current: npt.ArrayLike) -> np.ndarray:
         """(..., k) joint-space distance from ``q_current`` (..., n) to every row.
 
         Revolute differences are wrapped into [-pi, pi); prismatic ones never are.
         Invalid rows get +inf.
         """
-        qc = check_finite(check_joints(q_current, self.n, "q_current"), "q_current")
+        qc = self._q_current(q_current)
         diff = self.q - qc[..., None, :]
         diff = np.where(self.is_revolute, wrap_angle(diff), diff)
         d = np.linalg.norm(diff, axis=-1)
@@ -221,7 +234,7 @@ class SolutionSet:
         Raises:
             UnreachableError: a pose has no valid solution (its status is named).
         """
-        qc = check_finite(check_joints(q_current, self.n, "q_current"), "q_current")
+        qc = self._q_current(q_current)
         if respect_limits and "within_limits" in self.flags:
             return self.within_limits().nearest(qc, respect_limits=False)
         empty = ~self.valid.any(axis=-1)
@@ -232,6 +245,8 @@ class SolutionSet:
                 f"{int(empty.sum())} pose(s) have no solution; first at index {first}: "
                 f"{self.status[first]}"
             )
+        if self.valid.shape[-1] == 0:  # no pose at all (an empty batch)
+            return np.zeros(self.shape + (self.n,))
         d = self.distance(qc)
         k = np.argmin(d, axis=-1)
         best = np.take_along_axis(self.q, k[..., None, None], axis=-2)[..., 0, :]
