@@ -46,7 +46,11 @@ def ik(
     rev = r.is_revolute
     q_near = None
     if near is not None:
-        vals = [float(v) for v in near.replace(",", " ").split()]
+        try:
+            vals = [float(v) for v in near.replace(",", " ").split()]
+        except ValueError:
+            raise typer.BadParameter(f"expected {r.n} numbers, got {near!r}",
+                                     param_hint="--near") from None
         if len(vals) != r.n:
             raise typer.BadParameter(f"--near needs {r.n} values, got {len(vals)}")
         q_near = np.where(rev, np.array(vals) / A, np.array(vals) / L)

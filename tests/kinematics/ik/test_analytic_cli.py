@@ -28,3 +28,10 @@ def test_cli_ik_table_and_near(capsys):
 def test_cli_ik_unreachable(capsys):
     assert main(["ik", "ur5", "3", "0", "0", "0", "0", "0"]) == 1
     assert "out of reach" in capsys.readouterr().err
+
+
+def test_cli_ik_near_not_numbers_names_the_option(capsys):
+    code = main(["ik", "ur5", "0.4", "0.1", "0.3", "0", "3.14159", "0", "--near", "a b"])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "--near" in err and "expected 6 numbers" in err
