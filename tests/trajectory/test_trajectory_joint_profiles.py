@@ -128,3 +128,28 @@ def test_bad_inputs_name_the_argument():
         get_profile("trapezoidal", blend=0.7)
     with pytest.raises(InputError, match="duration"):
         trajectory.cycloidal([0.0], [1.0])
+
+
+@pytest.mark.parametrize("fn", [trajectory.quintic, trajectory.cycloidal,
+                                trajectory.trapezoidal])
+@pytest.mark.parametrize(("kw", "match"), [
+    ({"v_max": -1.0, "a_max": 2.0}, "v_max.*positive"),
+    ({"v_max": 1.0, "a_max": 0.0}, "a_max.*positive"),
+    ({"v_max": float("nan"), "a_max": 2.0}, "v_max.*positive"),
+    ({"v_max": [1.0, 2.0, 3.0], "a_max": 2.0}, r"v_max.*shape \(2,\)"),
+    ({"v_max": "fast", "a_max": 2.0}, "v_max"),
+])
+def test_bad_limits_are_rejected_not_turned_into_a_one_step_jump(fn, kw, match):
+    # A negative v_max used to give a "minimum duration" of 0: the whole move in
+    # one dt with zero velocity at both samples.
+    if fn is trajectory.quintic:
+        fn = lambda q0, q1, **k: trajectory.profile_motion(q0, q1, profile="quintic", **k)  # noqa: E731
+    with pytest.raises(InputError, match=match):
+        fn([0.0, 0.0], [1.0, 2.0], **kw)
+
+
+def test_time_grid_rejects_non_numbers_by_name():
+    with pytest.raises(InputError, match="dt"):
+        trajectory.quintic([0.0], [1.0], 1.0, dt="fast")
+    with pytest.raises(InputError, match="duration"):
+        trajectory.time_grid("long", 0.01)

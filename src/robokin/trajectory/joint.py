@@ -42,6 +42,11 @@ def time_grid(duration: float, dt: float, *, t0: float = 0.0) -> np.ndarray:
     Raises:
         InputError: ``dt`` not positive or ``duration`` negative.
     """
+    try:
+        dt, duration = float(dt), float(duration)
+    except (TypeError, ValueError):
+        bad = "dt" if not isinstance(dt, (int, float, np.number)) else "duration"
+        raise InputError(bad, f"expected seconds, got {locals()[bad]!r:.80}") from None
     if not np.isfinite(dt) or dt <= 0:
         raise InputError("dt", f"must be a positive time step [s], got {dt!r}")
     if not np.isfinite(duration) or duration < 0:

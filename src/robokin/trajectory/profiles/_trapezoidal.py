@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from robokin.exceptions import InputError
-from robokin.trajectory.profiles.base import Profile
+from robokin.trajectory.profiles.base import Profile, positive_limits
 
 __all__ = ["TrapezoidalProfile", "lspb_timing"]
 
@@ -61,10 +61,8 @@ def lspb_timing(distance, v_max, a_max) -> tuple[float, float]:
         a_max: Acceleration limits, scalar or (n,) > 0.
     """
     d = np.abs(np.asarray(distance, dtype=np.float64)).reshape(-1)
-    v = np.broadcast_to(np.asarray(v_max, dtype=np.float64), d.shape)
-    a = np.broadcast_to(np.asarray(a_max, dtype=np.float64), d.shape)
-    if (v <= 0).any() or (a <= 0).any():
-        raise InputError("v_max/a_max", "limits must be positive")
+    v = positive_limits(v_max, d.shape[0], "v_max")
+    a = positive_limits(a_max, d.shape[0], "a_max")
     if not d.any():
         return 0.0, 0.5
     # Per coordinate: T >= D/(v(1-f)) and T >= sqrt(D/(a f(1-f))). The first grows

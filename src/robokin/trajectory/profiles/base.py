@@ -28,7 +28,26 @@ import numpy.typing as npt
 
 from robokin.exceptions import InputError
 
-__all__ = ["Profile"]
+__all__ = ["Profile", "positive_limits"]
+
+
+def positive_limits(x: npt.ArrayLike, n: int, name: str) -> np.ndarray:
+    """A speed / acceleration limit, scalar or (n,), as (n,) positive floats
+    (``inf`` allowed: no limit).
+
+    Raises:
+        InputError: not numbers, wrong length, NaN, zero or negative.
+    """
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InputError(name, f"expected a number or {n} numbers, got {x!r:.80}") from None
+    if a.ndim > 1 or (a.ndim == 1 and a.shape[0] != n):
+        raise InputError(name, f"expected a scalar or shape ({n},), got {a.shape}")
+    a = np.broadcast_to(a, (n,))
+    if not (a > 0).all():  # also catches NaN
+        raise InputError(name, f"limits must be positive, got {a.tolist()}")
+    return a
 
 
 class Profile(ABC):
@@ -76,17 +95,19 @@ class Profile(ABC):
             v_max: Largest speed, scalar or (n,).
             a_max: Largest acceleration, scalar or (n,).
         """
-        d = np.abs(np.asarray(distance, dtype=np.float64))
+        d = np.abs(np.asarray(distance, dtype=np.float64)).reshape(-1)
         T = 0.0
         if v_max is not None:
-            T = max(T, float(np.max(self.peak_velocity * d / np.asarray(v_max, float),
-                                    initial=0.0)))
+            v = positive_limits(v_max, d.shape[0], "v_max")
+            T = max(T, float(np.max(self.peak_velocity * d / v, initial=0.0)))
+        if a_max is not None:
+            a_max = positive_limits(a_max, d.shape[0], "a_max")
         if a_max is not None and self.peak_acceleration > 0:
             if np.isinf(self.peak_acceleration) and d.any():
                 raise InputError("a_max", f"the {self.name} profile has velocity steps "
                                  "(infinite acceleration) at its ends")
-            T = max(T, float(np.sqrt(np.max(self.peak_acceleration * d /
-                                             np.asarray(a_max, float), initial=0.0))))
+            T = max(T, float(np.sqrt(np.max(self.peak_acceleration * d / a_max,
+                                            initial=0.0))))
         return T
 
     def __repr__(self) -> str:
