@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import json
 import math
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -125,14 +126,34 @@ def plan_from_document(spec: Any, file: Path, progress: Any = None) -> tuple[Any
     import numpy as np
 
     import robokin
-    from robokin.exceptions import ModelError
+    from robokin.exceptions import InputError, ModelError
     from robokin.spatial import matrix_from_rpy
     from robokin.trajectory import PathBuilder
 
+    # the builder's argument names -> the motion file's fields
+    top = {"v_max": "limits.velocity", "a_max": "limits.acceleration",
+           "tool_speed": "tool_speed", "tool_acceleration": "tool_acceleration",
+           "dt": "dt", "ik": "ik", "q_start": "start"}
+
+    @contextmanager
+    def fields(where: str | None):
+        """Re-raise a builder's InputError as a ModelError naming the file's field."""
+        try:
+            yield
+        except InputError as exc:
+            field = top.get(exc.argument) or (
+                f"{where}.{exc.argument}" if where else exc.argument)
+            raise ModelError(exc.reason, file=file, field=field) from None
+
     name = spec.robot
     candidate = file.parent / name
-    robot = robokin.load(candidate if candidate.suffix in (".yaml", ".yml")
-                         and candidate.exists() else name)
+    try:
+        robot = robokin.load(candidate if candidate.suffix in (".yaml", ".yml")
+                             and candidate.exists() else name)
+    except ModelError as exc:
+        if exc.file is not None:
+            raise
+        raise ModelError(exc.reason, file=file, field="robot") from None
     L = 1e-3 if spec.units.length == "mm" else 1.0
     A = math.pi / 180.0 if spec.units.angle == "deg" else 1.0
     rev = robot.is_revolute
@@ -153,13 +174,14 @@ def plan_from_document(spec: Any, file: Path, progress: Any = None) -> tuple[Any
             raise ModelError(f"expected one value or {robot.n}", file=file, field=field)
         return arr * jscale
 
-    pb = PathBuilder(robot, joints(spec.start, "start"), dt=spec.dt,
-                     v_max=per_joint(spec.limits.velocity, "limits.velocity"),
-                     a_max=per_joint(spec.limits.acceleration, "limits.acceleration"),
-                     tool_speed=None if spec.tool_speed is None else spec.tool_speed * L,
-                     tool_acceleration=None if spec.tool_acceleration is None
-                     else spec.tool_acceleration * L,
-                     smooth=spec.smooth, ik=spec.ik)
+    with fields(None):
+        pb = PathBuilder(robot, joints(spec.start, "start"), dt=spec.dt,
+                         v_max=per_joint(spec.limits.velocity, "limits.velocity"),
+                         a_max=per_joint(spec.limits.acceleration, "limits.acceleration"),
+                         tool_speed=None if spec.tool_speed is None else spec.tool_speed * L,
+                         tool_acceleration=None if spec.tool_acceleration is None
+                         else spec.tool_acceleration * L,
+                         smooth=spec.smooth, ik=spec.ik)
 
     def pose(target, field):
         T = robot.fk(pb.q_end).copy()
@@ -181,23 +203,31 @@ def plan_from_document(spec: Any, file: Path, progress: Any = None) -> tuple[Any
             raise ModelError("needs exactly one of joint, pose, line, dwell", file=file,
                              field=field)
         common = {"label": st.label or f"{kinds[0]} {i + 1}"}
-        if st.joint is not None:
-            pb.joint(joints(st.joint, f"{field}.joint"), st.duration,
-                     profile=st.profile, stop=st.stop, **common)
-        elif st.pose is not None:
-            pb.pose(pose(st.pose, f"{field}.pose"), st.duration, profile=st.profile,
-                    stop=st.stop, **common)
-        elif st.line is not None:
-            pb.line(pose(st.line, f"{field}.line"), st.duration, profile=st.profile,
-                    speed_in=st.speed_in * L, speed_out=st.speed_out * L, **common)
-        else:
-            pb.dwell(st.dwell, **common)
+        with fields(field):
+            _add_step(pb, st, joints, pose, field, L, common)
         if progress is not None:
             progress(i + 1, total + 1)
-    traj = pb.build()
+    with fields("segments"):
+        traj = pb.build()
     if progress is not None:
         progress(total + 1, total + 1)
     return robot, traj
+
+
+def _add_step(pb: Any, st: Any, joints: Any, pose: Any, field: str, L: float,
+              common: dict[str, Any]) -> None:
+    """Add one validated motion-file step to the path builder."""
+    if st.joint is not None:
+        pb.joint(joints(st.joint, f"{field}.joint"), st.duration,
+                 profile=st.profile, stop=st.stop, **common)
+    elif st.pose is not None:
+        pb.pose(pose(st.pose, f"{field}.pose"), st.duration, profile=st.profile,
+                stop=st.stop, **common)
+    elif st.line is not None:
+        pb.line(pose(st.line, f"{field}.line"), st.duration, profile=st.profile,
+                speed_in=st.speed_in * L, speed_out=st.speed_out * L, **common)
+    else:
+        pb.dwell(st.dwell, **common)
 
 
 def _default_out(path: Path | None, fallback: Path, explicit: bool) -> tuple[Path, bool]:

@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 
 from robokin.cli import main
 from robokin.trajectory.io import read_csv
@@ -82,3 +83,18 @@ def test_compare_prints_the_error_table(tmp_path, capsys):
     for r in rows:
         assert abs(r["max"] - 0.25) < 1e-9 and abs(r["rms"] - 0.25) < 1e-9
     assert (tmp_path / "log_vs_plan.png").exists()
+
+
+@pytest.mark.parametrize(("old", "new", "field", "reason"), [
+    ("velocity: 90", "velocity: -90", "limits.velocity", "positive"),
+    ("  - dwell: 0.5\n", "  - dwell: 0.5\n  - joint: [0, 0, 90, 0, 90, 0]\n"
+     "    profile: bogus\n", "segments[3].profile", "unknown profile"),
+    ("robot: aubo_i5", "robot: no_such_arm", "robot", "unknown robot"),
+])
+def test_traj_builder_errors_name_the_file_field(tmp_path, capsys, old, new, field, reason):
+    assert old in MOTION
+    f = tmp_path / "bad.yaml"
+    f.write_text(MOTION.replace(old, new, 1))
+    code, _, err = run(capsys, "traj", str(f), "--no-plot")
+    assert code == 2
+    assert f"bad.yaml: {field}:" in err and reason in err
