@@ -71,3 +71,13 @@ def test_limits_choose_turn_inside_range():
     s = robot.ik(robot.fk(q0))
     assert np.any(np.all(np.abs(s.q[s.valid] - q0) < 1e-9, axis=1))
     assert s.within_limits_mask[s.valid][np.argmin(s.distance(q0)[s.valid])]
+
+
+@pytest.mark.parametrize("lead", [(), (2,), (0,)])
+def test_expand_turns_of_a_set_without_rows(lead):
+    # the numeric solver returns sets with k = 0 rows for unreachable poses
+    e = SolutionSet.empty(lead, 2, np.ones(2, bool), np.tile([-7.0, 7.0], (2, 1)),
+                          "out of reach")
+    x = e.expand_turns()
+    assert x.q.shape == lead + (0, 2) and x.count.shape == lead
+    assert (np.asarray(x.status) == "out of reach").all()

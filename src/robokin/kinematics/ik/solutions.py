@@ -266,7 +266,7 @@ class SolutionSet:
         lim = self.limits
         span = lim[:, 1] - lim[:, 0]
         wide = self.is_revolute & (span > 2 * np.pi - 1e-12)
-        if not wide.any():
+        if not wide.any() or self.valid.shape[-1] == 0:  # nothing to expand
             return self
         shifts_per_joint = []
         for j in range(self.n):
