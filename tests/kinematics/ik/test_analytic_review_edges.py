@@ -51,3 +51,27 @@ def test_nearest_on_an_empty_batch_is_empty(name):
     assert sols.shape == (0,)
     out = sols.nearest(np.zeros(robot.n))
     assert out.shape == (0, robot.n)
+
+
+@pytest.mark.parametrize("name", ["ur5", "aubo_i5", "puma560"])
+def test_branch_labels_follow_the_arm_geometry(name):
+    # Independent of the kernels' slot order: the elbow label is the side of the
+    # forearm (elbow -> wrist centre) relative to the upper arm about the
+    # shoulder-pitch axis, the wrist label the sign of sin(q5), the shoulder label
+    # the side of frame 5's origin in joint 1's frame. Each must agree with its
+    # geometric sign on every solution (one fixed convention per arm).
+    robot = robokin.load(name)
+    q = np.random.default_rng(1).uniform(-np.pi, np.pi, (400, 6))
+    sols = robot.ik(robot.fk(q))
+    Q = sols.q[sols.valid]
+    F = robot.fk_all(Q)
+    o1, o2, ow = F[:, 1, :3, 3], F[:, 2, :3, 3], F[:, 4, :3, 3]
+    elbow_geo = np.sign(np.einsum("ni,ni->n", np.cross(o2 - o1, ow - o2), F[:, 1, :3, 2]))
+    wrist_geo = np.sign(np.sin(Q[:, 4]))
+    T1 = F[:, 1]
+    o5 = F[:, 5, :3, 3]
+    shoulder_geo = np.sign(np.einsum("nji,nj->ni", T1[:, :3, :3], o5 - T1[:, :3, 3])[:, 0])
+    for label, geo in (("elbow", elbow_geo), ("wrist", wrist_geo),
+                       ("shoulder", shoulder_geo)):
+        prod = sols.branches[label][sols.valid] * geo
+        assert np.unique(prod).size == 1 and abs(prod[0]) == 1, label
