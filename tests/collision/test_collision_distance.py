@@ -209,3 +209,38 @@ def test_nearest_points_are_on_the_bodies_and_as_far_apart_as_the_minimum():
     assert c.distance == pytest.approx(0.5 - 0.05 - 0.25, abs=1e-9)
     np.testing.assert_allclose(c.point_a, [0.25, c.point_a[1], c.point_a[2]], atol=1e-9)
     assert np.linalg.norm(c.point_b - c.point_a) == pytest.approx(c.distance, abs=1e-9)
+
+
+def test_closest_at_gives_the_closest_pair_and_its_points_in_closed_form():
+    # sphere r = 0.1 on the gantry; a box (x 0.8..1.2, y -0.3..0.3, z -0.1..0.1)
+    # and a ball r = 0.2 at (0, 1, 0): the closest body changes with the sample.
+    r = gantry([geo.sphere(0.1)])
+    sc = Scene()
+    sc.add_box("block", size=(0.4, 0.6, 0.2), pose=T(1.0, 0.0, 0.0))
+    sc.add_sphere("ball", 0.2, pose=T(0.0, 1.0, 0.0))
+    p = np.array([[0.5, 0.0, 0.0], [0.0, 0.6, 0.0], [0.5, 0.5, 0.3]])
+    rep = check(r, sc, p, subdivide=False)
+    corner = np.array([0.8, 0.3, 0.1])
+    u = (corner - p[2]) / np.linalg.norm(corner - p[2])
+    want_d = [0.8 - 0.5 - 0.1, 0.4 - 0.1 - 0.2, math.sqrt(0.17) - 0.1]
+    want_a = [[0.6, 0.0, 0.0], [0.0, 0.7, 0.0], p[2] + 0.1 * u]
+    want_b = [[0.8, 0.0, 0.0], [0.0, 0.8, 0.0], corner]
+    d, pa, pb = rep.closest_at([0, 1, 2])
+    assert d.shape == (3,) and pa.shape == (3, 3) and pb.shape == (3, 3)
+    np.testing.assert_allclose(d, want_d, atol=1e-9)
+    np.testing.assert_allclose(pa, want_a, atol=1e-7)
+    np.testing.assert_allclose(pb, want_b, atol=1e-7)
+    # any order, repeats and negative indices
+    d2, pa2, _ = rep.closest_at(np.array([-1, 1, 1]))
+    np.testing.assert_allclose(d2, [want_d[2], want_d[1], want_d[1]], atol=1e-9)
+    np.testing.assert_allclose(pa2[0], want_a[2], atol=1e-7)
+    with pytest.raises(robokin.InputError, match="indices"):
+        rep.closest_at([3])
+    with pytest.raises(robokin.InputError, match="integer"):
+        rep.closest_at([0.5])
+
+
+def test_closest_at_with_nothing_to_check_is_inf_and_nan():
+    rep = check(gantry([geo.sphere(0.1)]), Scene(), np.zeros((2, 3)))
+    d, pa, pb = rep.closest_at([0, 1])
+    assert np.isinf(d).all() and np.isnan(pa).all() and np.isnan(pb).all()

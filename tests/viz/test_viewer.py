@@ -147,3 +147,37 @@ def test_viewer_page_renders_the_robot_in_chromium(ur5, tmp_path):
     assert img.shape == (700, 1000, 3)
     assert view3d.std() > 8.0  # not a blank canvas
     assert orange_fraction(view3d) > 5e-4  # the arm's links
+
+
+BALL_SCENE_YAML = """
+name: ball cell
+units: {length: mm, angle: deg}
+tool:
+  tcp: {xyz: [0, 0, 100]}
+  shapes:
+    - {name: tip, type: sphere, radius: 20, xyz: [0, 0, 100]}
+objects:
+  - {name: ball, type: sphere, radius: 10, xyz: [%f, %f, %f]}
+"""
+
+
+def test_playback_draws_the_real_reports_closest_segment(ur5, tmp_path):
+    # Tool sphere (r 20 mm) at the TCP, a ball (r 10 mm) 60 mm beyond it along
+    # the tool axis: the closest segment is 30 mm long and ends on the ball.
+    pytest.importorskip("coal")
+    from robokin import collision
+
+    q = _motion(5)
+    flange = ur5.fk(q[2])
+    c = flange[:3, 3] + 0.16 * flange[:3, 2]
+    (tmp_path / "cell.yaml").write_text(BALL_SCENE_YAML % tuple(1000 * c))
+    sc = collision.Scene.load(tmp_path / "cell.yaml")
+    rep = collision.check(ur5, sc, q)
+    with RobotViewer(sc.attach(ur5), q, scene=sc, report=rep, port=0) as v:
+        v.show_frame(2)
+        a, b = np.asarray(v._closest.points[0], dtype=float)
+        assert np.linalg.norm(b - a) == pytest.approx(0.03, abs=1e-5)
+        assert np.linalg.norm(b - c) == pytest.approx(0.01, abs=1e-5)
+        assert "distance 30.0 mm" in v._status.content
+    with pytest.raises(robokin.InputError, match="report"):
+        RobotViewer(sc.attach(ur5), q[:3], scene=sc, report=rep, port=0)

@@ -715,6 +715,34 @@ class _Problem:
             _q=q,
         )
 
+    def closest_at(
+        self, q: np.ndarray, idx: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The closest pair's distance and nearest points at samples ``idx``.
+
+        Pairs are queried in increasing lower-bound order (broad phase, and the
+        closed form for capsule/sphere pairs) until no bound is below the best.
+        """
+        k = idx.size
+        dist = np.full(k, np.inf)
+        pa = np.full((k, 3), np.nan)
+        pb = np.full((k, 3), np.nan)
+        if k == 0 or self.P == 0:
+            return dist, pa, pb
+        frames = self.frames(q[idx])
+        lb = self.lower_bounds(frames)  # (P, k); -inf where not bounded
+        an = np.flatnonzero(self.analytic)
+        if an.size:
+            lb[an] = self.analytic_distances(frames, an) - _TIE
+        for i in range(k):
+            for p in np.argsort(lb[:, i], kind="stable"):
+                if lb[p, i] >= dist[i]:
+                    break
+                d, a, b = self.nearest(int(p), frames[i])
+                if d < dist[i]:
+                    dist[i], pa[i], pb[i] = d, a, b
+        return dist, pa, pb
+
     def profile(self, q: np.ndarray, body_a: str, body_b: str) -> np.ndarray:
         """Exact distance of one body pair at every sample, (m,)."""
         plist = [

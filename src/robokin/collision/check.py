@@ -170,6 +170,44 @@ class CollisionReport:
         """
         return self._problem.profile(self._q, body_a, body_b)
 
+    def closest_at(
+        self, indices: npt.ArrayLike
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The closest body pair at the given samples (exact, over all checked pairs).
+
+        Args:
+            indices: Sample indices (k,) into the checked trajectory (negative
+                indices count from the end).
+
+        Returns:
+            ``(distance, point_a, point_b)``: the minimum distance over every
+            checked pair at each sample (k,) [m] (<= 0 when colliding; inf with
+            nothing to check), and the nearest points (k, 3) [m] in the world on
+            the robot link and on the other body (NaN with nothing to check).
+
+        Raises:
+            InputError: an index is not an integer or out of range.
+        """
+        m = self.t.shape[0]
+        try:
+            raw = np.asarray(indices)
+            idx = raw.astype(np.int64).reshape(-1)
+        except (TypeError, ValueError):
+            raise InputError(
+                "indices", f"expected sample indices, got {indices!r:.60}"
+            ) from None
+        if raw.size and not np.array_equal(raw.reshape(-1), idx):
+            raise InputError("indices", "expected integer sample indices")
+        if idx.size and (idx.min() < -m or idx.max() >= m):
+            raise InputError(
+                "indices", f"expected indices in [-{m}, {m - 1}] ({m} samples)"
+            )
+        idx = np.where(idx < 0, idx + m, idx)
+        if self._problem is None:
+            k = idx.size
+            return np.full(k, np.inf), np.full((k, 3), np.nan), np.full((k, 3), np.nan)
+        return self._problem.closest_at(self._q, idx)
+
 
 def _as_samples(
     q_samples: Any, n: int, t: npt.ArrayLike | None

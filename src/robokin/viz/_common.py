@@ -21,7 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin._validation import check_joints
-from robokin.exceptions import InputError
+from robokin.exceptions import InputError, RobokinError
 from robokin.kinematics.forward import link_frames
 
 if TYPE_CHECKING:
@@ -348,7 +348,7 @@ class ReportArrays:
         if self.track is not None:
             try:
                 return self.track(idx)
-            except Exception:  # a report we cannot query: draw no segment
+            except RobokinError:  # a report that cannot tell: draw no segment
                 return None
         return None
 
@@ -363,6 +363,13 @@ def report_arrays(report: Any, m: int) -> ReportArrays:
     colliding = np.zeros(m, dtype=bool)
     if report is None:
         return ReportArrays(None, None, colliding)
+    t = getattr(report, "t", None)
+    if isinstance(t, np.ndarray) and t.ndim == 1 and t.shape[0] != m:
+        raise InputError(
+            "report",
+            f"checks {t.shape[0]} samples but the trajectory has {m}: "
+            "pass the report of this trajectory",
+        )
     bodies = []
     for item in getattr(report, "collisions", None) or []:
         try:
@@ -394,45 +401,20 @@ def report_arrays(report: Any, m: int) -> ReportArrays:
 
 
 def _pair_tracker(
-    report: Any, max_pairs: int = 8
+    report: Any,
 ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None:
-    """Closest points per sample from a ``robokin.collision.CollisionReport``.
+    """Closest points per sample from the report's public ``closest_at(idx)``.
 
-    Uses the report's public ``closest_at(idx)`` when it has one; otherwise asks
-    its distance problem for the nearest points of the ``max_pairs`` body pairs
-    that came closest over the motion (``report.pairs``), at each sample.
+    ``closest_at`` returns ``(distance (k,), point_a (k, 3), point_b (k, 3))``
+    (:meth:`robokin.collision.CollisionReport.closest_at`); None when the report
+    has no such method.
     """
     fn = getattr(report, "closest_at", None)
-    if callable(fn):
-
-        def public(idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            d, pa, pb = fn(idx)[:3]
-            return np.asarray(d, dtype=float), np.stack([pa, pb], axis=-2)
-
-        return public
-    prob, q = getattr(report, "_problem", None), getattr(report, "_q", None)
-    pairs = getattr(report, "pairs", None)
-    if prob is None or q is None or not pairs or not hasattr(prob, "nearest"):
+    if not callable(fn):
         return None
-    wanted = {frozenset((p.body_a, p.body_b)) for p in list(pairs)[:max_pairs]}
-    plist = [
-        p
-        for p in range(prob.P)
-        if frozenset((prob.body_a[p], prob.body_b[p])) in wanted
-    ]
-    if not plist:
-        return None
-    q = np.asarray(q, dtype=float)
 
-    def track(idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        frames = prob.frames(q[idx])
-        dist = np.full(idx.size, np.inf)
-        pts = np.zeros((idx.size, 2, 3))
-        for i in range(idx.size):
-            for p in plist:
-                d, a, b = prob.nearest(p, frames[i])
-                if d < dist[i]:
-                    dist[i], pts[i, 0], pts[i, 1] = d, a, b
-        return dist, pts
+    def public(idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        d, pa, pb = fn(idx)[:3]
+        return np.asarray(d, dtype=float), np.stack([pa, pb], axis=-2)
 
-    return track
+    return public
