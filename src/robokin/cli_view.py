@@ -56,11 +56,11 @@ def view(
     """
     import robokin
 
-    robot = robokin.load(name)
+    bare = robot = robokin.load(name)
     sc = None
     if scene is not None:
         sc = _load_scene(scene)
-        robot = sc.attach(robot)
+        robot = sc.attach(bare)  # drawn as placed; check() places it itself
     motion = None
     if traj is not None:
         from robokin.trajectory.io import read_csv
@@ -74,7 +74,7 @@ def view(
     if sc is not None and motion is not None and check:
         from robokin import collision
 
-        report = collision.check(robot, sc, motion)
+        report = collision.check(bare, sc, motion)
     if html is not None:
         from robokin.viz.html import write_html
 

@@ -173,7 +173,7 @@ def test_cli_view_writes_html_with_scene_and_collision_check(tmp_path):
     from robokin import collision
 
     scene = collision.Scene.load(tmp_path / "cell.yaml")
-    rep = collision.check(scene.attach(robot), scene, tr)
+    rep = collision.check(robot, scene, tr)
     assert data["distance"] is not None and data["closest"] is not None
     assert min(data["distance"]) == pytest.approx(rep.sample_min_distance, abs=1e-6)
     import base64
@@ -183,3 +183,41 @@ def test_cli_view_writes_html_with_scene_and_collision_check(tmp_path):
     )
     lengths = np.linalg.norm(seg[:, 1] - seg[:, 0], axis=-1)
     np.testing.assert_allclose(lengths, np.maximum(data["distance"], 0.0), atol=1e-5)
+
+
+TOOL_SCENE_YAML = """
+name: tool cell
+units: {length: mm, angle: deg}
+tool:
+  tcp: {xyz: [0, 0, 100]}
+  shapes:
+    - {name: tip, type: sphere, radius: 20, xyz: [0, 0, 100]}
+objects:
+  - {name: ball, type: sphere, radius: 10, xyz: [%f, %f, %f]}
+"""
+
+
+def test_cli_view_checks_the_robot_with_the_scene_tool_attached_once(tmp_path):
+    # A tool sphere (r 20 mm) at a 100 mm TCP and a ball (r 10 mm) 60 mm beyond
+    # the TCP along the tool axis: 30 mm apart. Attaching the tool twice (a TCP
+    # 200 mm out) would put the tip through the ball.
+    pytest.importorskip("coal")
+    from robokin.cli import main
+    from robokin.trajectory import Trajectory
+    from robokin.trajectory.io import write_csv
+
+    robot = robokin.load("ur5")
+    q = np.array([0.0, -1.2, 1.4, -1.8, -1.57, 0.0])
+    flange = robot.fk(q)
+    tcp = flange[:3, 3] + 0.1 * flange[:3, 2]
+    c = (tcp + 0.06 * flange[:3, 2]) * 1000.0
+    (tmp_path / "cell.yaml").write_text(TOOL_SCENE_YAML % tuple(c))
+    z = np.zeros((2, 6))
+    tr = Trajectory(np.array([0.0, 0.1]), np.stack([q, q]), z, z)
+    csv = write_csv(tr, tmp_path / "motion.csv", robot.joint_names)
+    out = tmp_path / "view.html"
+    argv = ["view", "ur5", "--traj", str(csv), "--scene", str(tmp_path / "cell.yaml")]
+    assert main([*argv, "--html", str(out)]) == 0
+    data = _embedded(out.read_text())
+    np.testing.assert_allclose(data["distance"], [0.03, 0.03], atol=1e-6)
+    assert data["colliding"] == [0, 0]
