@@ -81,3 +81,16 @@ def test_expand_turns_of_a_set_without_rows(lead):
     x = e.expand_turns()
     assert x.q.shape == lead + (0, 2) and x.count.shape == lead
     assert (np.asarray(x.status) == "out of reach").all()
+
+
+def test_an_unknown_option_is_named_not_a_type_error():
+    import numpy as np
+    import pytest
+
+    import robokin
+
+    for name in ("ur5", "scara", "qfmd010"):
+        robot = robokin.load(name)
+        T = robot.fk(np.full(robot.n, 0.1))
+        with pytest.raises(robokin.InputError, match=r"options.*'foo'"):
+            robot.ik(T, foo=1)

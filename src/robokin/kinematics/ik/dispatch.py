@@ -52,7 +52,18 @@ def solve(
 
         fam = detect(robot)
         if fam.solver is not None:
-            return fam.solver(robot, T, q_near=q_near, **options)
+            try:
+                return fam.solver(robot, T, q_near=q_near, **options)
+            except TypeError as exc:
+                # an option the closed form does not take: name it, never a TypeError
+                if "unexpected keyword argument" not in str(exc):
+                    raise
+                bad = str(exc).split("argument", 1)[1].strip()
+                raise InputError(
+                    "options",
+                    f"the {fam.name} closed form does not take the option {bad} "
+                    "(pass method='numeric' for the numeric solver's options)",
+                ) from None
         if method == "analytic":
             raise InputError(
                 "method", f"no closed form for robot '{robot.name}': {fam.reason}"
