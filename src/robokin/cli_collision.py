@@ -33,12 +33,31 @@ def read_trajectory_csv(path: str | Path, robot: Any = None) -> tuple[Any, Any]:
     except ImportError:
         read_csv = None
     if read_csv is not None:
-        kw = {}
-        if robot is not None:
-            kw["is_revolute"] = robot.is_revolute
-        tr = read_csv(path, **kw)
+        from robokin.exceptions import InputError, ModelError
+
+        if robot is None:
+            tr = read_csv(path)
+            return tr.t, tr.q
+        try:
+            tr = read_csv(path, is_revolute=robot.is_revolute)
+        except InputError as exc:
+            if exc.argument != "is_revolute":
+                raise
+            k = read_csv(path).q.shape[-1]
+            raise ModelError(
+                f"has {k} joint columns, {robot.name} has {robot.n} joints",
+                file=path,
+            ) from None
         return tr.t, tr.q
-    return _read_simple_csv(Path(path))
+    t, q = _read_simple_csv(Path(path))
+    if robot is not None and q.shape[-1] != robot.n:
+        from robokin.exceptions import ModelError
+
+        raise ModelError(
+            f"has {q.shape[-1]} joint columns, {robot.name} has {robot.n} joints",
+            file=path,
+        )
+    return t, q
 
 
 def _read_simple_csv(path: Path):
@@ -97,7 +116,7 @@ def check_command(
         Path, typer.Argument(help="Scene file (YAML), or a bundled name.")
     ],
     trajectory: Annotated[
-        Path, typer.Argument(help="Trajectory CSV: t [s],<joint> [rad]...")
+        Path, typer.Argument(help="Trajectory CSV: t \\[s],<joint> \\[rad]...")
     ],
     robot: Annotated[
         str | None,
@@ -105,7 +124,7 @@ def check_command(
             "--robot", help="Built-in name or robot file (default: the scene's)."
         ),
     ] = None,
-    clearance: Annotated[float, typer.Option(help="Required clearance [mm].")] = 0.0,
+    clearance: Annotated[float, typer.Option(help="Required clearance \\[mm].")] = 0.0,
     plot: Annotated[
         Path | None,
         typer.Option("--plot", help="Write a distance-over-time plot here."),
@@ -120,6 +139,8 @@ def check_command(
     from robokin import collision
     from robokin.exceptions import InputError
 
+    if top < 0:
+        raise InputError("--top", f"expected a count >= 0, got {top}")
     if not math.isfinite(clearance) or clearance < 0:
         raise InputError("--clearance", f"expected a number >= 0 [mm], got {clearance}")
     if not scene.exists() and scene.suffix == "":
@@ -168,7 +189,7 @@ def check_command(
             )
         )
     else:
-        _print_report(rep, clearance, violated, q.shape[0], plot)
+        _print_report(rep, clearance, violated, q.shape[0], plot, top)
     if violated:
         what = (
             "collides"
@@ -180,7 +201,9 @@ def check_command(
         raise DomainFailure(f"the trajectory {what}")
 
 
-def _print_report(rep, clearance_mm: float, violated: bool, m: int, plot) -> None:
+def _print_report(
+    rep, clearance_mm: float, violated: bool, m: int, plot, top: int = 8
+) -> None:
     from rich.console import Console
     from rich.markup import escape
     from rich.table import Table
@@ -191,7 +214,7 @@ def _print_report(rep, clearance_mm: float, violated: bool, m: int, plot) -> Non
         table.add_column(
             escape(col), justify="right" if "[" in col or col == "sample" else "left"
         )
-    for p in rep.pairs[:8]:
+    for p in rep.pairs[:top]:
         style = "red" if p.distance <= max(clearance_mm * 1e-3, 0.0) else None
         table.add_row(
             p.body_a,

@@ -114,3 +114,21 @@ def test_fallback_csv_reader_converts_units(tmp_path):
     path.write_text("t [s],a [furlong]\n0,1\n")
     with pytest.raises(robokin.ModelError, match="unknown unit"):
         _read_simple_csv(path)
+
+
+def test_check_top_limits_the_table_and_bad_inputs_name_the_argument(
+    press_motion, capsys, tmp_path
+):
+    path, ref = press_motion
+    assert main(["check", "press", str(path), "--top", "2"]) == 0
+    out, _ = capsys.readouterr()
+    rows = [ln for ln in out.splitlines() if ln.startswith("│")]
+    assert len(rows) == 2
+    assert main(["check", "press", str(path), "--top", "-1"]) == 2
+    assert "--top" in capsys.readouterr().err
+    # a CSV for another arm: names the file and both counts
+    bad = tmp_path / "two.csv"
+    _write_csv(bad, [0.0, 0.1], np.zeros((2, 2)), ["a", "b"])
+    assert main(["check", "press", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "two.csv" in err and "2 joint columns" in err and "6 joints" in err
