@@ -118,3 +118,17 @@ def test_duration_from_limits(aubo):
     tr2 = trajectory.cartesian_line(aubo, Q0, T1, tool_speed=0.05)
     L = np.linalg.norm([0.1, 0.1, -0.1])
     assert tr2.duration == pytest.approx(1.875 * L / 0.05, abs=0.005)
+
+def test_a_line_to_an_unreachable_goal_says_so():
+    import numpy as np
+    import pytest
+
+    import robokin
+    from robokin import trajectory
+
+    robot = robokin.load("ur5")
+    q0 = np.radians([0, -90, 90, -90, -90, 0])
+    goal = robot.fk(q0)
+    goal[0, 3] = 5.0  # 5 m away: far beyond the UR5's 0.95 m reach
+    with pytest.raises(trajectory.PathError, match="goal itself is unreachable: out of reach"):
+        trajectory.cartesian_line(robot, q0, goal, 2.0)

@@ -417,6 +417,23 @@ def line_min_duration(
 
 
 # -------------------------------------------------------------------- the segment
+def _goal_unreachable(robot: Any, T_goal: np.ndarray) -> str | None:
+    """Why the goal pose has no closed-form solution inside the limits, or None.
+
+    Only for arms with a closed form (cheap and complete); None otherwise.
+    """
+    from robokin.exceptions import RobokinError
+    from robokin.kinematics.ik.analytic.detect import detect
+
+    if detect(robot).solver is None:
+        return None
+    try:
+        sols = robot.ik(T_goal).within_limits()
+    except RobokinError:
+        return None
+    return None if int(sols.count) else str(sols.status.item())
+
+
 def cartesian_line(
     robot: Any,
     q_start: npt.ArrayLike,
@@ -497,6 +514,13 @@ def cartesian_line(
     Tp = line_poses(T0, T1, s)
     res = _follow(robot, Tp, q0, t, ik, max_jump=max_jump, singular_tol=singular_tol)
     if not res:
+        hint = _goal_unreachable(robot, T1)
+        if hint:
+            import dataclasses
+
+            res = dataclasses.replace(
+                res, reason=f"{res.reason}; the goal itself is unreachable: {hint}"
+            )
         raise PathError(res, "the Cartesian line")
     w_base = T0[:3, :3] @ _rotvec(T0[:3, :3].T @ T1[:3, :3])
     axis = np.concatenate([dp, w_base])
