@@ -42,6 +42,9 @@ def ik(
     r = _load(name)
     L = 1000.0 if mm else 1.0
     A = 180.0 / math.pi if deg else 1.0
+    for label, v in zip(("x", "y", "z", "roll", "pitch", "yaw"), (x, y, z, roll, pitch, yaw)):
+        if not np.isfinite(v):
+            raise typer.BadParameter(f"{label} must be a finite number, got {v}")
     T = pose_from_xyz_rpy(np.array([x, y, z]) / L, np.array([roll, pitch, yaw]) / A)
     rev = r.is_revolute
     q_near = None

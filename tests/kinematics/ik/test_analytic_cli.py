@@ -35,3 +35,13 @@ def test_cli_ik_near_not_numbers_names_the_option(capsys):
     assert code == 2
     err = capsys.readouterr().err
     assert "--near" in err and "expected 6 numbers" in err
+
+
+def test_a_non_finite_coordinate_is_named(capsys):
+    from robokin.cli import main
+
+    code = main(["ik", "ur5", "0.3", "nan", "0.2", "0", "0", "0"])
+    out, err = capsys.readouterr()
+    assert code == 2
+    assert "y must be a finite number" in out + err
+    assert "Traceback" not in out + err
