@@ -17,13 +17,22 @@ from robokin.cli import _console, _load, app
 __all__ = ["dh", "export_urdf", "import_urdf"]
 
 
+def _not_the_input(out: Path, source: str | Path) -> None:
+    """Refuse to write over the file being read (it would be lost)."""
+    from robokin.exceptions import InputError
+
+    src = Path(source)
+    if src.is_file() and out.exists() and out.resolve() == src.resolve():
+        raise InputError("--out", f"{out} is the input file; choose another name")
+
+
 @app.command("import")
 def import_urdf(
     file: Annotated[Path, typer.Argument(help="The URDF file.")],
     base: Annotated[str | None, typer.Option("--base", help="Base link.")] = None,
     tip: Annotated[str | None, typer.Option("--tip", help="Tip link.")] = None,
     out: Annotated[
-        Path | None, typer.Option("-o", "--out", help="Robot file to write (YAML).")
+        Path | None, typer.Option("-o", "--out", help="Robot file to write (YAML; replaced if it exists).")
     ] = None,
     package: Annotated[
         list[str] | None,
@@ -42,6 +51,8 @@ def import_urdf(
         if not sep or not name:
             raise typer.BadParameter(f"--package expects NAME=DIR, got {item!r}")
         pmap[name] = directory
+    if out is not None:
+        _not_the_input(out, file)
     robot = robot_from_urdf(file, base_link=base, tip_link=tip, package_map=pmap,
                             missing_mesh="ignore")
     info = robot.meta["urdf"]
@@ -60,12 +71,14 @@ def import_urdf(
 def export_urdf(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     out: Annotated[
-        Path | None, typer.Option("-o", "--out", help="URDF file to write.")
+        Path | None, typer.Option("-o", "--out", help="URDF file to write (replaced if it exists).")
     ] = None,
 ) -> None:
     """Write a robot as a URDF with the same FK and limits."""
     from robokin.model.urdf import urdf_from_robot, write_urdf
 
+    if out is not None:
+        _not_the_input(out, name)
     robot = _load(name)
     if out is None:
         print(urdf_from_robot(robot), end="")

@@ -75,3 +75,36 @@ def test_errors_are_one_line(capsys, tmp_path):
     assert code == 2 and "ambiguous tip link" in err
     code, _, err = run(capsys, "import", str(DATA / "ur5.urdf"), "--package", "bad")
     assert code == 2
+
+
+def test_o_never_writes_over_the_file_being_read(capsys, tmp_path):
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text((DATA / "ur5.urdf").read_text())
+    before = urdf.read_bytes()
+    code, _, err = run(capsys, "import", str(urdf), "-o", str(urdf))
+    assert code == 2 and "--out" in err and "input file" in err
+    assert urdf.read_bytes() == before
+    robot_file = tmp_path / "arm.yaml"
+    assert run(capsys, "import", str(urdf), "-o", str(robot_file))[0] == 0
+    before = robot_file.read_bytes()
+    code, _, err = run(capsys, "export", str(robot_file), "-o", str(robot_file))
+    assert code == 2 and "input file" in err
+    assert robot_file.read_bytes() == before
+
+
+def test_export_into_a_missing_folder_names_it_and_files_get_normal_permissions(
+    capsys, tmp_path
+):
+    missing = tmp_path / "nope" / "ur5.urdf"
+    code, _, err = run(capsys, "export", "ur5", "-o", str(missing))
+    assert code == 2 and str(tmp_path / "nope") in err and ".tmp" not in err
+    import os
+
+    umask = os.umask(0)
+    os.umask(umask)
+    out = tmp_path / "ur5.urdf"
+    assert run(capsys, "export", "ur5", "-o", str(out))[0] == 0
+    assert out.stat().st_mode & 0o777 == 0o666 & ~umask  # not mkstemp's 0600
+    out.chmod(0o640)
+    assert run(capsys, "export", "ur5", "-o", str(out))[0] == 0
+    assert out.stat().st_mode & 0o777 == 0o640  # a replaced file keeps its mode

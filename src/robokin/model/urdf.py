@@ -60,7 +60,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
-from robokin.exceptions import MissingExtraError, ModelError
+from robokin.exceptions import InputError, MissingExtraError, ModelError
 from robokin.model.chain import Chain, ChainBuilder, Joint
 from robokin.model.coupling import Dependency, coupling_from_dependencies, mimic
 
@@ -1057,14 +1057,33 @@ def urdf_from_robot(
 
 
 def write_urdf(robot: Robot, path: str | Path, **kwargs: Any) -> Path:
-    """Write :func:`urdf_from_robot` to ``path`` atomically; returns the path."""
+    """Write :func:`urdf_from_robot` to ``path`` atomically; returns the path.
+
+    An existing file is replaced (keeping its permissions) only once the new
+    content is complete; a new file gets the usual permissions (0666 less the
+    umask).
+
+    Raises:
+        InputError: the folder of ``path`` does not exist, or ``path`` is a folder.
+    """
     import tempfile
 
     path = Path(path)
     text = urdf_from_robot(robot, **kwargs)
     directory = path.parent if str(path.parent) else Path(".")
+    if not directory.is_dir():
+        raise InputError("path", f"{path}: the folder {directory} does not exist")
+    if path.is_dir():
+        raise InputError("path", f"{path} is a folder, expected a file name")
+    if path.exists():
+        mode = path.stat().st_mode & 0o7777
+    else:
+        umask = os.umask(0)
+        os.umask(umask)
+        mode = 0o666 & ~umask
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
     try:
+        os.chmod(tmp, mode)
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             f.write(text)
         os.replace(tmp, path)
