@@ -23,7 +23,7 @@ def workspace(
         Path, typer.Option("--out", help="Output folder for the plots.")
     ] = Path("robokin-workspace"),
     voxel_mm: Annotated[
-        float, typer.Option("--voxel", help="Voxel edge [mm] (default: extent / 100).")
+        float, typer.Option("--voxel", help="Voxel edge \\[mm] (0: the longest extent / 100).")
     ] = 0.0,
     seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
     as_json: Annotated[
@@ -41,6 +41,10 @@ def workspace(
 
     if samples < 1:
         raise typer.BadParameter(f"--samples must be >= 1, got {samples}")
+    if not (voxel_mm >= 0 and np.isfinite(voxel_mm)):
+        raise typer.BadParameter(f"--voxel must be >= 0 [mm] (0: auto), got {voxel_mm}")
+    if out.exists() and not out.is_dir():
+        raise typer.BadParameter(f"--out {out} is a file, expected a folder")
     robot = robokin.load(name)
     con = Console(stderr=as_json)
     with Progress(
@@ -61,9 +65,8 @@ def workspace(
     paths = save_workspace_plots(ws, out)
     summary = ws.summary()
     summary["plots"] = [str(p) for p in paths]
-    (Path(out) / f"{robot.name}_workspace.json").write_text(
-        json.dumps(summary, indent=2)
-    )
+    summary_path = Path(out) / f"{robot.name}_workspace.json"
+    summary_path.write_text(json.dumps(summary, indent=2))
     if as_json:
         print(json.dumps(summary))
         return
@@ -83,5 +86,5 @@ def workspace(
         f"volume ≈ {ws.volume:.4f} m³ ({ws.occupied_voxels:,} voxels of "
         f"{ws.voxel_size * 1000:.1f} mm)"
     )
-    for p in paths:
-        con.print(f"wrote {p}")
+    for p in [*paths, summary_path]:
+        con.print(f"wrote {p}", markup=False)

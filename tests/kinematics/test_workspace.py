@@ -207,3 +207,32 @@ def test_cli_workspace(tmp_path):
     assert summary["samples"] == 20000
     assert summary["bounds_max_m"][2] == pytest.approx(C1 + C4 + 0.2, abs=2e-3)
     assert (tmp_path / "scara_workspace_xy.png").is_file()
+
+
+def test_voxel_volume_is_exact_when_the_grid_overflows_an_int64_index():
+    # 2**22 cells per axis (more than 2**62 in all): the old packed fallback
+    # (x * 2**42 + y * 2**21 + z) mapped (0, 1, 0) and (0, 0, 2**21) together.
+    h = 1e-3
+    pts = np.array([[0, 1, 0], [0, 0, 2**21], [2**22, 2**22, 2**22], [0, 1, 0.5]])
+    vol, n = voxel_volume((pts + 0.5) * h, h)
+    assert n == 3
+    assert vol == pytest.approx(3 * h**3)
+    for bad in (float("nan"), float("inf"), -1.0):
+        with pytest.raises(InputError, match="voxel_size"):
+            voxel_volume(pts, bad)
+
+
+def test_cli_workspace_rejects_bad_voxel_and_a_file_as_out_before_sampling(
+    tmp_path, capsys
+):
+    from robokin.cli import main
+
+    assert main(["workspace", "scara", "-n", "10", "--voxel", "-1"]) == 2
+    assert "--voxel" in capsys.readouterr().err
+    f = tmp_path / "notes.txt"
+    f.write_text("mine")
+    assert main(["workspace", "scara", "-n", "10", "--out", str(f)]) == 2
+    assert "--out" in capsys.readouterr().err and f.read_text() == "mine"
+    ws = sample_workspace(robokin.load("scara"), 10, manipulability_samples=0)
+    with pytest.raises(InputError, match="out_dir"):
+        save_workspace_plots(ws, f)

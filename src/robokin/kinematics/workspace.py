@@ -155,19 +155,18 @@ def voxel_volume(points: npt.ArrayLike, voxel_size: float) -> tuple[float, int]:
     Returns:
         ``(volume [m^3], occupied voxel count)``.
     """
-    if not voxel_size > 0:
-        raise InputError("voxel_size", f"must be > 0, got {voxel_size}")
+    if not (voxel_size > 0 and math.isfinite(voxel_size)):
+        raise InputError("voxel_size", f"must be finite and > 0 [m], got {voxel_size}")
     p = np.asarray(points, dtype=float).reshape(-1, 3)
     if p.shape[0] == 0:
         return 0.0, 0
     idx = np.floor((p - p.min(axis=0)) / voxel_size).astype(np.int64)
     dims = idx.max(axis=0) + 1
-    flat = (
-        np.ravel_multi_index(idx.T, tuple(int(d) for d in dims))
-        if np.prod(dims.astype(float)) < 2**62
-        else idx[:, 0] * 2**42 + idx[:, 1] * 2**21 + idx[:, 2]
-    )
-    count = int(np.unique(flat).size)
+    if np.prod(dims.astype(float)) < 2**62:
+        flat = np.ravel_multi_index(idx.T, tuple(int(d) for d in dims))
+        count = int(np.unique(flat).size)
+    else:  # too many cells for one int64 index: unique rows (slower, exact)
+        count = int(np.unique(idx, axis=0).shape[0])
     return count * voxel_size**3, count
 
 
@@ -348,6 +347,8 @@ def save_workspace_plots(ws: Workspace, out_dir: str | Path) -> list[Path]:
     import matplotlib.pyplot as plt
 
     out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise InputError("out_dir", f"{out} is a file, expected a folder")
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for plane in ("xy", "xz"):
