@@ -74,7 +74,14 @@ def view(
     if sc is not None and motion is not None and check:
         from robokin import collision
 
-        report = collision.check(bare, sc, motion)
+        from robokin.exceptions import InputError
+
+        try:
+            report = collision.check(bare, sc, motion)
+        except InputError as exc:
+            if exc.argument != "robot":
+                raise
+            typer.echo(f"no collision check: {exc.reason}", err=True)
     if html is not None:
         from robokin.viz.html import write_html
 

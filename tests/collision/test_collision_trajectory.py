@@ -319,3 +319,11 @@ def test_subdivision_never_misses_what_dense_sampling_finds(rng):
         elif not rep.collides:
             clear += 1
     assert between >= 3 and clear >= 3  # both outcomes were exercised
+
+
+def test_a_robot_without_any_shapes_is_an_error_not_a_clear_report():
+    r = gantry([geo.sphere(0.05)]).replace(geometry=None)
+    sc = Scene()
+    sc.add_box("block", size=(0.2, 0.2, 0.2))  # the robot's origin is inside it
+    with pytest.raises(InputError, match="no collision geometry"):
+        check(r, sc, np.zeros((2, 2)))

@@ -221,3 +221,30 @@ def test_cli_view_checks_the_robot_with_the_scene_tool_attached_once(tmp_path):
     data = _embedded(out.read_text())
     np.testing.assert_allclose(data["distance"], [0.03, 0.03], atol=1e-6)
     assert data["colliding"] == [0, 0]
+
+
+def test_cli_view_of_a_robot_without_geometry_still_draws_and_says_why(
+    tmp_path, capsys
+):
+    pytest.importorskip("coal")
+    import yaml
+
+    from robokin.cli import main
+
+    doc = yaml.safe_load(robokin.load("ur5").path.read_text())
+    doc.pop("geometry", None)
+    doc.pop("collision", None)
+    (tmp_path / "bare.yaml").write_text(yaml.safe_dump(doc))
+    (tmp_path / "cell.yaml").write_text(SCENE_YAML)
+    q = _ur5_motion(5)
+    csv = tmp_path / "m.csv"
+    header = "t [s]," + ",".join(f"j{k} [rad]" for k in range(6))
+    rows = np.column_stack([np.arange(5) * 0.1, q])
+    np.savetxt(csv, rows, delimiter=",", header=header, comments="")
+    out = tmp_path / "v.html"
+    argv = ["view", str(tmp_path / "bare.yaml"), "--traj", str(csv)]
+    argv += ["--scene", str(tmp_path / "cell.yaml"), "--html", str(out)]
+    assert main(argv) == 0
+    assert "no collision geometry" in capsys.readouterr().err
+    data = _embedded(out.read_text())
+    assert len(data["t"]) == 5 and data["distance"] is None

@@ -58,6 +58,13 @@ class _Problem:
                     s.check_file()
                 shapes.append(s)
                 link.append(k)
+        if not shapes:
+            raise InputError(
+                "robot",
+                f"{robot.name} has no collision geometry (no shapes on its links "
+                "or tool), so nothing can be checked: give it a geometry: section "
+                "or the scene a tool with shapes",
+            )
         self.shapes = shapes
         self.link = np.array(link, dtype=int)
         S = len(shapes)

@@ -283,7 +283,8 @@ def check(
         A :class:`CollisionReport`.
 
     Raises:
-        InputError: bad samples, times or clearance.
+        InputError: bad samples, times or clearance, or a robot without any
+            shapes (neither its own geometry nor the scene's tool).
         MissingExtraError: coal (or trimesh for meshes) is not installed.
     """
     if not (
