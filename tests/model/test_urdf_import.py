@@ -246,3 +246,35 @@ def test_missing_yourdfpy_names_the_extra(monkeypatch):
     monkeypatch.setattr(builtins, "__import__", fake)
     with pytest.raises(ImportError, match=r"robokin\[urdf\]"):
         robot_from_urdf(DATA / "ur5.urdf")
+
+
+@pytest.mark.parametrize(
+    ("joint_xml", "message"),
+    [
+        ('<axis xyz="0 0 x"/>', r"joint\[j\]\.axis\.xyz.*line 1.*3 numbers"),
+        ('<origin xyz="1 2"/>', r"joint\[j\]\.origin\.xyz.*3 numbers"),
+        ('<axis xyz="0 0 0"/>', r"arm\.urdf: joint\[j\]\.axis: .*non-zero"),
+    ],
+)
+def test_malformed_numbers_name_the_file_joint_and_attribute(
+    tmp_path, joint_xml, message
+):
+    path = tmp_path / "arm.urdf"
+    path.write_text(
+        '<robot name="r"><link name="a"/><link name="b"/>'
+        '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+        f'{joint_xml}<limit lower="0" upper="1"/></joint></robot>'
+    )
+    with pytest.raises(robokin.ModelError, match=message):
+        robokin.Robot.from_urdf(path)
+
+
+def test_a_non_numeric_limit_names_the_attribute(tmp_path):
+    path = tmp_path / "arm.urdf"
+    path.write_text(
+        '<robot name="r"><link name="a"/><link name="b"/>'
+        '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+        '<limit lower="zero" upper="1"/></joint></robot>'
+    )
+    with pytest.raises(robokin.ModelError, match=r"joint\[j\]\.limit\.lower"):
+        robokin.Robot.from_urdf(path)

@@ -165,6 +165,47 @@ def _check_xml(data: bytes, file: Path | None) -> None:
         for geom in el.iter("geometry"):
             if len(geom) == 0:
                 raise ModelError("empty <geometry>", file=file, field=where)
+    _check_numbers(root, file)
+
+
+def _check_numbers(root: Any, file: Path | None) -> None:
+    """Vectors (xyz, rpy) hold 3 numbers and limits numbers, naming the line."""
+    def field(el: Any, key: str) -> str:
+        for up in el.iterancestors():
+            if up.tag in ("joint", "link") and up.get("name") is not None:
+                return f"{up.tag}[{up.get('name')}].{el.tag}.{key}"
+        return f"{el.tag}.{key}"
+
+    for el in root.iter():
+        if not isinstance(el.tag, str):
+            continue  # comments, processing instructions
+        for key in ("xyz", "rpy"):
+            text = el.get(key)
+            if text is None:
+                continue
+            try:
+                ok = len([float(v) for v in text.split()]) == 3
+            except ValueError:
+                ok = False
+            if not ok:
+                raise ModelError(
+                    f"<{el.tag} {key}=\"{text}\"> at line {el.sourceline}: "
+                    "expected 3 numbers",
+                    file=file, field=field(el, key),
+                )
+        if el.tag == "limit":
+            for key in ("lower", "upper", "effort", "velocity"):
+                text = el.get(key)
+                if text is None:
+                    continue
+                try:
+                    float(text)
+                except ValueError:
+                    raise ModelError(
+                        f"<limit {key}=\"{text}\"> at line {el.sourceline}: "
+                        "expected a number",
+                        file=file, field=field(el, key),
+                    ) from None
 
 
 def parse_urdf(source: str | Path | bytes) -> tuple[Any, Path | None]:
@@ -345,7 +386,7 @@ def axis_frame(axis: Sequence[float], *, where: str = "axis") -> tuple[np.ndarra
     u = np.asarray(axis, dtype=np.float64).reshape(-1)
     norm = float(np.linalg.norm(u)) if u.shape == (3,) else 0.0
     if u.shape != (3,) or not np.isfinite(u).all() or norm < 1e-12:
-        raise ModelError(f"the joint axis must be a non-zero 3-vector, got {axis!r}",
+        raise ModelError(f"the joint axis must be a non-zero 3-vector, got {u.tolist()}",
                          field=where)
     u = u / norm
     nz = np.flatnonzero(np.abs(u) > 1e-15)
@@ -502,7 +543,10 @@ def chain_from_urdf_model(
             T_rel = T_rel @ O
             frames[j.child] = (k, T_rel.copy())
             continue
-        A, sign = axis_frame(j.axis, where=f"joint[{j.name}].axis")
+        try:
+            A, sign = axis_frame(j.axis, where=f"joint[{j.name}].axis")
+        except ModelError as exc:
+            raise ModelError(exc.reason, file=file, field=exc.field) from None
         kind = _kind(j)
         if j.mimic is None:
             add_coordinate(j)
