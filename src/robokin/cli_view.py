@@ -55,7 +55,18 @@ def view(
     trajectory, collisions and the closest-distance segment are shown.
     """
     import robokin
+    from robokin.exceptions import InputError
 
+    if html is not None:
+        if html.is_dir():
+            raise InputError("--html", f"{html} is a folder, expected a file name")
+        for given in (name, traj, scene):
+            src = Path(given) if given is not None else None
+            if src is not None and src.is_file() and html.exists():
+                if html.resolve() == src.resolve():
+                    raise InputError(
+                        "--html", f"{html} is an input file; choose another name"
+                    )
     bare = robot = robokin.load(name)
     sc = None
     if scene is not None:
@@ -73,8 +84,6 @@ def view(
     report = None
     if sc is not None and motion is not None and check:
         from robokin import collision
-
-        from robokin.exceptions import InputError
 
         try:
             report = collision.check(bare, sc, motion)

@@ -248,3 +248,18 @@ def test_cli_view_of_a_robot_without_geometry_still_draws_and_says_why(
     assert "no collision geometry" in capsys.readouterr().err
     data = _embedded(out.read_text())
     assert len(data["t"]) == 5 and data["distance"] is None
+
+
+def test_cli_view_html_never_writes_over_an_input_file(tmp_path, capsys):
+    from robokin.cli import main
+
+    csv = tmp_path / "m.csv"
+    header = "t [s]," + ",".join(f"j{k} [rad]" for k in range(6))
+    rows = np.column_stack([np.arange(3) * 0.1, _ur5_motion(3)])
+    np.savetxt(csv, rows, delimiter=",", header=header, comments="")
+    before = csv.read_bytes()
+    assert main(["view", "ur5", "--traj", str(csv), "--html", str(csv)]) == 2
+    assert "--html" in capsys.readouterr().err
+    assert csv.read_bytes() == before
+    assert main(["view", "ur5", "--html", str(tmp_path)]) == 2
+    assert "folder" in capsys.readouterr().err
