@@ -119,6 +119,23 @@ def test_attach_places_base_tool_and_gripper():
     ):
         assert a.size == b.size
         np.testing.assert_array_equal(a.placement, b.placement)
+    # placing an already placed robot again does not stack base and tool twice
+    again = sc.attach(placed)
+    np.testing.assert_allclose(again.fk(q), base @ r.fk(q) @ tcp, atol=1e-12)
+    assert len(again.geometry.tool) == 1
+    # ... and the scene's current base is used when it changed in between
+    sc.set_base(np.eye(4))
+    np.testing.assert_allclose(sc.attach(placed).fk(q), r.fk(q) @ tcp, atol=1e-12)
+    sc.set_base(base)
+    # a placed robot changed afterwards is a new robot: placed on top of it
+    moved = placed.with_tool(placed.chain.tool @ tcp)
+    np.testing.assert_allclose(
+        sc.attach(moved).fk(q), base @ base @ r.fk(q) @ tcp @ tcp @ tcp, atol=1e-12
+    )
+    # check() gives the same answer for the robot and the placed robot
+    qs = np.stack([q, q + 0.1])
+    sc.add_box("block", (0.2, 0.2, 0.2), pose_from_xyz_rpy([0.5, 0, 0.5], [0, 0, 0]))
+    assert check(placed, sc, qs).min_distance == check(r, sc, qs).min_distance
 
 
 @pytest.fixture(scope="module")

@@ -49,6 +49,7 @@ __all__ = ["Scene", "SceneObject", "Tool"]
 
 _LENGTH = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
+_PLACED = "_robokin_scene_placement"  # meta key: (scene, chain, geometry, unplaced robot)
 
 
 def _pose(T: npt.ArrayLike | None, name: str) -> np.ndarray:
@@ -241,9 +242,21 @@ class Scene:
 
         The robot's base becomes ``scene.base @ robot.base``; its tool transform
         ``robot.tool @ tool.tcp``; the tool's shapes join the robot's tool link.
+        A robot this scene already placed (and not changed since) is placed
+        afresh from its unplaced original, never twice, so ``check`` and the
+        viewers accept either.
         """
         from robokin.model.geometry import RobotGeometry
 
+        placed = robot.meta.get(_PLACED)
+        if (
+            placed is not None
+            and placed[0] is self
+            and placed[1] is robot.chain
+            and placed[2] is robot.geometry
+        ):
+            robot = placed[3]
+        bare = robot
         geo = robot.geometry if isinstance(robot.geometry, RobotGeometry) else None
         if geo is None:
             geo = RobotGeometry.empty(robot)
@@ -253,7 +266,9 @@ class Scene:
         if self.tool is not None:
             out = out.with_tool(robot.tool @ self.tool.tcp)
             geo = geo.retool(self.tool.tcp, self.tool.shapes)
-        return out.replace(geometry=geo)
+        out = out.replace(geometry=geo)
+        out.meta[_PLACED] = (self, out.chain, out.geometry, bare)
+        return out
 
     def _fingerprint(self) -> tuple:
         """What the compiled check depends on (attributes may be assigned directly)."""
