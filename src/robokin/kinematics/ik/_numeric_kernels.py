@@ -65,12 +65,64 @@ _MU_MAX = 1e9
 _MU_MIN = 1e-9
 
 
+# sincos: a private copy of ``robokin.kinematics._kernels.sincos`` (numba's cache does
+# not track functions inlined from another module). Cody-Waite reduction by pi/2 and
+# the fdlibm kernel polynomials, < 1 ulp; one reduction for both values.
+_INV_PIO2 = 6.36619772367581382433e-01
+_PIO2_1 = 1.57079632673412561417e00
+_PIO2_2 = 6.07710050630396597660e-11
+_PIO2_3 = 2.02226624871116645580e-21
+_S1, _S2, _S3 = (
+    -1.66666666666666324348e-01,
+    8.33333333332248946124e-03,
+    -1.98412698298579493134e-04,
+)
+_S4, _S5, _S6 = (
+    2.75573137070700676789e-06,
+    -2.50507602534068634195e-08,
+    1.58969099521155010221e-10,
+)
+_C1, _C2, _C3 = (
+    4.16666666666666019037e-02,
+    -1.38888888888741095749e-03,
+    2.48015872894767294178e-05,
+)
+_C4, _C5, _C6 = (
+    -2.75573143513906633035e-07,
+    2.08757232129817482790e-09,
+    -1.13596475577881948265e-11,
+)
+
+
+@njit(cache=True, inline="always")
+def _sincos(x):
+    """(sin x, cos x) for float x; libm beyond |x| = 1e5 and for NaN / inf."""
+    if not abs(x) < 1e5:
+        return math.sin(x), math.cos(x)
+    n = math.floor(x * _INV_PIO2 + 0.5)
+    y = ((x - n * _PIO2_1) - n * _PIO2_2) - n * _PIO2_3
+    z = y * y
+    r = _S2 + z * (_S3 + z * (_S4 + z * (_S5 + z * _S6)))
+    sy = y + z * y * (_S1 + z * r)
+    rc = z * (_C1 + z * (_C2 + z * (_C3 + z * (_C4 + z * (_C5 + z * _C6)))))
+    hz = 0.5 * z
+    w = 1.0 - hz
+    cy = w + (((1.0 - w) - hz) + z * rc)
+    k = int(n) & 3
+    if k == 0:
+        return sy, cy
+    if k == 1:
+        return cy, -sy
+    if k == 2:
+        return -sy, -cy
+    return -cy, sy
+
+
 @njit(cache=True, inline="always")
 def _joint_right(T, kind, v):
     """T <- T @ J(v): rotation about / translation along local z."""
     if kind == 0.0:
-        c = math.cos(v)
-        s = math.sin(v)
+        s, c = _sincos(v)
         for r in range(3):
             x0 = T[r, 0]
             x1 = T[r, 1]
@@ -109,15 +161,43 @@ def _pose_jac(q, Mc, ident, consts, jdat, qc, Jc, J, T):
             for j in range(n):
                 s += Mc[i, j] * q[j]
             qc[i] = s
+    # the running transform in scalars (no aliasing with the arrays written below)
     C0 = consts[0]
-    for r in range(3):
-        for c in range(4):
-            T[r, c] = C0[r, c]
+    t00 = C0[0, 0]
+    t01 = C0[0, 1]
+    t02 = C0[0, 2]
+    t03 = C0[0, 3]
+    t10 = C0[1, 0]
+    t11 = C0[1, 1]
+    t12 = C0[1, 2]
+    t13 = C0[1, 3]
+    t20 = C0[2, 0]
+    t21 = C0[2, 1]
+    t22 = C0[2, 2]
+    t23 = C0[2, 3]
     for k in range(nc):
-        _joint_right(T, jdat[0, k], jdat[1, k] * qc[k] + jdat[2, k])
-        for r in range(3):
-            Jc[r, k] = T[r, 3]
-            Jc[3 + r, k] = T[r, 2]
+        if jdat[0, k] == 0.0:
+            sk, ck = _sincos(jdat[1, k] * qc[k] + jdat[2, k])
+            x0 = t00
+            t00 = ck * x0 + sk * t01
+            t01 = ck * t01 - sk * x0
+            x0 = t10
+            t10 = ck * x0 + sk * t11
+            t11 = ck * t11 - sk * x0
+            x0 = t20
+            t20 = ck * x0 + sk * t21
+            t21 = ck * t21 - sk * x0
+        else:
+            v = jdat[1, k] * qc[k] + jdat[2, k]
+            t03 += t02 * v
+            t13 += t12 * v
+            t23 += t22 * v
+        Jc[0, k] = t03
+        Jc[1, k] = t13
+        Jc[2, k] = t23
+        Jc[3, k] = t02
+        Jc[4, k] = t12
+        Jc[5, k] = t22
         if jdat[3, k] == 1.0:
             # consts[k + 1] is Trans(tx, ty, tz) Rx(a) (every DH row): fewer products
             ca = jdat[4, k]
@@ -125,18 +205,68 @@ def _pose_jac(q, Mc, ident, consts, jdat, qc, Jc, J, T):
             tx = jdat[6, k]
             ty = jdat[7, k]
             tz = jdat[8, k]
-            for r in range(3):
-                a0 = T[r, 0]
-                a1 = T[r, 1]
-                a2 = T[r, 2]
-                T[r, 3] += a0 * tx + a1 * ty + a2 * tz
-                T[r, 1] = ca * a1 + sa * a2
-                T[r, 2] = ca * a2 - sa * a1
+            t03 += t00 * tx + t01 * ty + t02 * tz
+            t13 += t10 * tx + t11 * ty + t12 * tz
+            t23 += t20 * tx + t21 * ty + t22 * tz
+            a1 = t01
+            t01 = ca * a1 + sa * t02
+            t02 = ca * t02 - sa * a1
+            a1 = t11
+            t11 = ca * a1 + sa * t12
+            t12 = ca * t12 - sa * a1
+            a1 = t21
+            t21 = ca * a1 + sa * t22
+            t22 = ca * t22 - sa * a1
         else:
-            _const_right(T, consts[k + 1])
-    px = T[0, 3]
-    py = T[1, 3]
-    pz = T[2, 3]
+            C = consts[k + 1]
+            c00 = C[0, 0]
+            c01 = C[0, 1]
+            c02 = C[0, 2]
+            c10 = C[1, 0]
+            c11 = C[1, 1]
+            c12 = C[1, 2]
+            c20 = C[2, 0]
+            c21 = C[2, 1]
+            c22 = C[2, 2]
+            c03 = C[0, 3]
+            c13 = C[1, 3]
+            c23 = C[2, 3]
+            a0 = t00
+            a1 = t01
+            a2 = t02
+            t00 = a0 * c00 + a1 * c10 + a2 * c20
+            t01 = a0 * c01 + a1 * c11 + a2 * c21
+            t02 = a0 * c02 + a1 * c12 + a2 * c22
+            t03 += a0 * c03 + a1 * c13 + a2 * c23
+            a0 = t10
+            a1 = t11
+            a2 = t12
+            t10 = a0 * c00 + a1 * c10 + a2 * c20
+            t11 = a0 * c01 + a1 * c11 + a2 * c21
+            t12 = a0 * c02 + a1 * c12 + a2 * c22
+            t13 += a0 * c03 + a1 * c13 + a2 * c23
+            a0 = t20
+            a1 = t21
+            a2 = t22
+            t20 = a0 * c00 + a1 * c10 + a2 * c20
+            t21 = a0 * c01 + a1 * c11 + a2 * c21
+            t22 = a0 * c02 + a1 * c12 + a2 * c22
+            t23 += a0 * c03 + a1 * c13 + a2 * c23
+    T[0, 0] = t00
+    T[0, 1] = t01
+    T[0, 2] = t02
+    T[0, 3] = t03
+    T[1, 0] = t10
+    T[1, 1] = t11
+    T[1, 2] = t12
+    T[1, 3] = t13
+    T[2, 0] = t20
+    T[2, 1] = t21
+    T[2, 2] = t22
+    T[2, 3] = t23
+    px = t03
+    py = t13
+    pz = t23
     for k in range(nc):
         zx = Jc[3, k]
         zy = Jc[4, k]
@@ -274,6 +404,35 @@ def _chol_solve(A, b, m):
         b[i] = t / A[i, i]
     return True
 
+@njit(cache=True, inline="always")
+def _chol_solve6(A, b):
+    """As :func:`_chol_solve` for m = 6, reading only the lower triangle of A."""
+    for j in range(6):
+        s = A[j, j]
+        for k in range(j):
+            s -= A[j, k] * A[j, k]
+        if not s > 0.0:
+            return False
+        d = math.sqrt(s)
+        A[j, j] = d
+        inv = 1.0 / d
+        for i in range(j + 1, 6):
+            t = A[i, j]
+            for k in range(j):
+                t -= A[i, k] * A[j, k]
+            A[i, j] = t * inv
+    for i in range(6):
+        t = b[i]
+        for k in range(i):
+            t -= A[i, k] * b[k]
+        b[i] = t / A[i, i]
+    for i in range(5, -1, -1):
+        t = b[i]
+        for k in range(i + 1, 6):
+            t -= A[k, i] * b[k]
+        b[i] = t / A[i, i]
+    return True
+
 
 @njit(cache=True, inline="always")
 def _project(q, cdat):
@@ -319,6 +478,8 @@ def _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw, max_iter,
     cost, ep, er = _errors(e, w)
     if not math.isfinite(cost):
         return CODE_STALL, 0, ep, er, cost
+    A6 = np.empty((6, 6))
+    y6 = np.empty(6)
     mu = opts[O_MU0]
     mu_down = opts[O_MU_DOWN]
     mu_up = opts[O_MU_UP]
@@ -364,7 +525,23 @@ def _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw, max_iter,
         while not accepted:
             it += 1
             lam = mu * cost + 1e-14
-            if m <= nfree:
+            if m == 6 and nfree >= 6:
+                # full pose, task space, fixed size 6 (unrolled by the compiler)
+                for a in range(6):
+                    for b in range(a + 1):
+                        s = 0.0
+                        for j in range(n):
+                            s += Jw[a, j] * Jw[b, j]
+                        A6[a, b] = s
+                    A6[a, a] += lam
+                    y6[a] = sw[a] * e[a]
+                okc = _chol_solve6(A6, y6)
+                for j in range(n):
+                    s = 0.0
+                    for a in range(6):
+                        s += Jw[a, j] * y6[a]
+                    dq[j] = s
+            elif m <= nfree:
                 # task space: (Jw Jw^T + lam I) y = W^1/2 e ; dq = Jw^T y
                 for a in range(m):
                     for b in range(a + 1):
@@ -409,7 +586,11 @@ def _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw, max_iter,
                     accepted = True
                     for j in range(n):
                         q[j] = qn[j]
-                    J, Jn = Jn, J
+                    # a copy, not a swap: reassigning array variables costs
+                    # reference-count calls on every iteration
+                    for r in range(6):
+                        for j in range(n):
+                            J[r, j] = Jn[r, j]
                     for r in range(6):
                         e[r] = en[r]
                     cost = cost_n
