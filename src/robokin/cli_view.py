@@ -62,11 +62,15 @@ def view(
             raise InputError("--html", f"{html} is a folder, expected a file name")
         for given in (name, traj, scene):
             src = Path(given) if given is not None else None
-            if src is not None and src.is_file() and html.exists():
-                if html.resolve() == src.resolve():
-                    raise InputError(
-                        "--html", f"{html} is an input file; choose another name"
-                    )
+            if (
+                src is not None
+                and src.is_file()
+                and html.exists()
+                and html.resolve() == src.resolve()
+            ):
+                raise InputError(
+                    "--html", f"{html} is an input file; choose another name"
+                )
     bare = robot = robokin.load(name)
     sc = None
     if scene is not None:
