@@ -16,10 +16,11 @@ gets it: revolute and prismatic joints, reversed axes, dependent joints
 rejecting the others. Joint limits are kept during the iteration: every trial
 point is projected into the limits (2*pi-periodic joints are first shifted by whole
 turns), and joints pressed against a limit by the gradient leave the active set.
-A descent that stalls (the cost has not halved in 4 iterations: a local minimum,
-or pinned at limits) or runs out of iterations restarts from a random seed inside
-the limits (alternately from the central half of each joint range, where descents
-meet limits less often, and from the whole range) until the target is reached or
+A descent that stalls (the cost has not fallen to 0.3 times its value of 3
+iterations before: a local minimum, or pinned at limits) or runs out of iterations
+restarts from a random seed inside the limits (alternately from the central 80 %
+of each joint range, where descents meet limits less often, and from the whole
+range) until the target is reached or
 the budget (restarts, wall time) is spent. Results are always inside the limits;
 a target that is not reached comes back with ``success=False``, the best
 configuration found and the error it leaves, never an exception.
@@ -58,12 +59,12 @@ _AXES = ("x", "y", "z", "rx", "ry", "rz")
 _PARALLEL_MIN = 64  # below this many targets one thread beats the parallel launch
 _FIRST_ROUND_RESTARTS = 4
 _ROUND_RESTARTS = 16
-_STALL_EVERY = 4
-_STALL_RATIO = 0.5
+_STALL_EVERY = 3
+_STALL_RATIO = 0.3
 _MU0 = 1e-2  # initial damping, lambda = mu * E
-_MU_DOWN = 0.5
+_MU_DOWN = 0.7
 _MU_UP = 16.0
-_SEED_SHRINK = 0.25
+_SEED_SHRINK = 0.1
 
 
 _K: list[Any] = []
