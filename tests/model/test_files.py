@@ -165,3 +165,33 @@ def test_code_built_robot_keeps_its_geometry_when_saved(tmp_path, name):
         for a, b in zip(a_shapes, b_shapes):
             np.testing.assert_allclose(a.size, b.size)
             np.testing.assert_allclose(a.placement, b.placement, atol=1e-12)
+
+
+def test_a_changed_loaded_robot_saves_its_changes(tmp_path, rng):
+    from robokin.spatial import trans
+
+    ur5 = robokin.load("ur5")
+    tooled = ur5.with_tool(trans(0, 0, 0.2))
+    again = robokin.load(save_robot(tooled, tmp_path / "tooled.yaml"))
+    q = random_q(ur5, rng, 10)
+    np.testing.assert_allclose(again.fk(q), tooled.fk(q), atol=1e-12)
+    bare = robokin.load(save_robot(ur5.replace(geometry=None), tmp_path / "bare.yaml"))
+    assert bare.geometry is None
+    renamed = robokin.load(save_robot(ur5.replace(name="ur5_cell_3"), tmp_path / "r.yaml"))
+    assert renamed.name == "ur5_cell_3"
+    # an unchanged robot keeps its file's own document (units and DH rows)
+    same = yaml.safe_load(save_robot(ur5, tmp_path / "same.yaml").read_text())
+    assert same["convention"] == "standard" and same["units"]["length"] == "mm"
+
+
+def test_save_gives_normal_permissions_and_keeps_existing_ones(tmp_path):
+    robot = robokin.load("scara")
+    new = save_robot(robot, tmp_path / "new.yaml")
+    mask = os.umask(0)
+    os.umask(mask)
+    assert new.stat().st_mode & 0o777 == 0o666 & ~mask
+    existing = tmp_path / "existing.yaml"
+    existing.write_text("x")
+    existing.chmod(0o640)
+    save_robot(robot, existing)
+    assert existing.stat().st_mode & 0o777 == 0o640

@@ -269,7 +269,24 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
                 f"section '{key}' is not supported yet", file=file, field=key
             )
         robot = handler(robot, value, file, spec.units)
+    # The file's document describes exactly this state; a changed copy (with_tool,
+    # replace(...)) no longer matches it and is written from its model instead.
+    robot.meta["document_state"] = _state(robot)
     return robot
+
+
+def _state(robot: Robot) -> tuple:
+    """What a stored document must still describe: the same objects, by identity."""
+    return (robot.chain, robot.geometry, robot.actuators, robot.name, robot.source,
+            robot.actuator_names, robot.actuator_limits)
+
+
+def _document_matches(robot: Robot) -> bool:
+    state = robot.meta.get("document_state")
+    if state is None:
+        return False
+    now = _state(robot)
+    return all(a is b or (isinstance(a, str) and a == b) for a, b in zip(state, now))
 
 
 def _load_section_module(key: str) -> None:
@@ -330,12 +347,14 @@ def load_robot(path: str | Path) -> Robot:
 def document_from_robot(robot: Robot) -> dict[str, Any]:
     """The robot-file document of a robot.
 
-    Robots loaded from a file return that file's document unchanged (units kept).
-    Others are written as an elementary sequence in SI units that reproduces their
-    canonical chain exactly.
+    Robots loaded from a file, and not changed since, return that file's document
+    unchanged (units kept). Others (built in code, or changed with ``with_tool``,
+    ``with_base`` or ``replace``) are written as an elementary sequence in SI units
+    that reproduces their canonical chain exactly, with their actuators and
+    geometry.
     """
     doc = robot.meta.get("document")
-    if doc is not None:
+    if doc is not None and _document_matches(robot):
         return copy.deepcopy(doc)
     return _elementary_document(robot)
 
@@ -445,6 +464,14 @@ def save_robot(robot: Robot, path: str | Path) -> Path:
             f.write(text)
             f.flush()
             os.fsync(f.fileno())
+        # mkstemp makes 0600: keep an existing file's mode, else the umask's default
+        if path.exists():
+            mode = path.stat().st_mode & 0o7777
+        else:
+            mask = os.umask(0)
+            os.umask(mask)
+            mode = 0o666 & ~mask
+        os.chmod(tmp, mode)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
