@@ -36,7 +36,7 @@ from robokin.kinematics.ik.analytic._geometry import (
     angle_between_axes,
     unit_perpendicular,
 )
-from robokin.kinematics.ik.analytic.scara import _rot
+from robokin.kinematics.ik.analytic.scara import _align_angle, _elbow_angles, _rot
 
 __all__ = ["measure", "pose_from_position_yaw", "solve"]
 
@@ -163,21 +163,10 @@ def solve_geometry(robot: Any, g: PalletizerGeometry, T: np.ndarray, *,
     a = o[2] - o[1]
     b = o[3] - o[2]
     h3 = h[2]
-    kb = h3 @ b
-    A3 = a @ b - (a @ h3) * kb
-    B3 = a @ np.cross(h3, b)
-    C3 = (a @ h3) * kb
-    rhs3 = 0.5 * (np.einsum("...i,...i", d, d) - a @ a - b @ b) - C3
-    r3 = A3 * A3 + B3 * B3
-    disc3 = r3 - rhs3 * rhs3
+    v3, disc3, r3 = _elbow_angles(h3, a, b, d)  # (..., 2, 2): [waist, elbow]
     reach3 = disc3 >= -1e-12 * r3
-    gam3 = np.arctan2(np.sqrt(np.maximum(disc3, 0.0)), rhs3)
-    phi3 = np.arctan2(B3, A3)
-    v3 = np.stack([phi3 + gam3, phi3 - gam3], axis=-1)  # (..., 2, 2): [waist, elbow]
     u = a + _rot(h3, v3, b)  # (..., 2, 2, 3)
-    dd = d[..., :, None, :]
-    v2 = np.arctan2(np.einsum("...i,...i", dd, np.cross(h2, u)),
-                    np.einsum("...i,...i", dd, u) - (u @ h2) * (dd @ h2))
+    v2 = _align_angle(h2, u, d[..., :, None, :])
     v1b = np.broadcast_to(v1[..., :, None], v2.shape)
     v4 = g.s4 * (g.theta_c - v2 - g.s3 * v3)
     v5 = g.s5 * (psi[..., None, None] - v1b)

@@ -72,6 +72,35 @@ def _rot(h: np.ndarray, ang: np.ndarray, v: np.ndarray) -> np.ndarray:
     return v * c + np.cross(h, v) * s + h * (v @ h)[..., None] * (1.0 - c)
 
 
+def _elbow_angles(h, a, b, d):
+    """Paden-Kahan subproblem 3: angles v with |a + rot(h, v) b| = |d|.
+
+    Args:
+        h: Unit axis (3,). a, b: Link vectors (3,). d: Targets (..., 3).
+
+    Returns:
+        ``(v (..., 2), disc (...), r2)``: both roots (equal when ``disc`` = 0),
+        the discriminant (< 0: out of reach) and its scale ``r2``.
+    """
+    kb = h @ b
+    A = a @ b - (a @ h) * kb
+    B = a @ np.cross(h, b)
+    C = (a @ h) * kb
+    rhs = 0.5 * (np.einsum("...i,...i", d, d) - a @ a - b @ b) - C
+    r2 = A * A + B * B
+    disc = r2 - rhs * rhs
+    gam = np.arctan2(np.sqrt(np.maximum(disc, 0.0)), rhs)
+    phi = np.arctan2(B, A)
+    return np.stack([phi + gam, phi - gam], axis=-1), disc, r2
+
+
+def _align_angle(h, u, d):
+    """Paden-Kahan subproblem 1: the angle about ``h`` taking ``u`` onto ``d``'s
+    direction (components along ``h`` ignored); broadcasts over leading axes."""
+    return np.arctan2(np.einsum("...i,...i", d, np.cross(h, u)),
+                      np.einsum("...i,...i", d, u) - (u @ h) * (d @ h))
+
+
 def solve_geometry(robot: Any, g: ScaraGeometry, T: np.ndarray, *,
                    orientation_tol: float = 1e-9, compute_error: bool = False,
                    method: str = "analytic:scara", info: dict | None = None):
@@ -96,22 +125,10 @@ def solve_geometry(robot: Any, g: ScaraGeometry, T: np.ndarray, *,
     a = o[b_] - o[a_]
     b = o[c_] - o[b_]
     # subproblem 3 -> 4: a . rot(h, vb) b = (|d|^2 - |a|^2 - |b|^2) / 2
-    kb = h @ b
-    A = a @ b - (a @ h) * kb
-    B = a @ np.cross(h, b)
-    C = (a @ h) * kb
-    rhs = 0.5 * (np.einsum("...i,...i", d, d) - a @ a - b @ b) - C
-    r2 = A * A + B * B
-    disc = r2 - rhs * rhs
+    vb, disc, r2 = _elbow_angles(h, a, b, d)  # (..., 2)
     reach = disc >= -1e-12 * r2
-    gam = np.arctan2(np.sqrt(np.maximum(disc, 0.0)), rhs)
-    phi = np.arctan2(B, A)
-    vb = np.stack([phi + gam, phi - gam], axis=-1)  # (..., 2)
     u = a + _rot(h, vb, b)  # (..., 2, 3)
-    dd = d[..., None, :]
-    kx = np.cross(h, u)
-    va = np.arctan2(np.einsum("...i,...i", dd, kx),
-                    np.einsum("...i,...i", dd, u) - (u @ h) * (dd @ h))
+    va = _align_angle(h, u, d[..., None, :])
     vc = s[c_] * (psi[..., None] - s[a_] * va - s[b_] * vb)
     v = np.empty(lead + (2, 4))
     v[..., a_] = va
