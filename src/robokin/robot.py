@@ -27,6 +27,7 @@ __all__ = ["Robot"]
 Space = Literal["joint", "actuator"]
 _F64 = np.dtype(np.float64)
 _SINGLE_FK: list = []  # the compiled single-configuration FK, loaded on first use
+_FK_C = forward.fk_single_c  # its C version, None when it was not built
 
 
 class Robot:
@@ -228,7 +229,12 @@ class Robot:
             Poses (..., 4, 4).
         """
         chain = self.chain
-        if (space == "joint" and type(q) is np.ndarray and q.shape == chain._single_shape
+        if _FK_C is not None and space == "joint" and chain._single_shape is not None:
+            # One configuration (C): None unless q is a finite float64 (n,) array.
+            T = _FK_C(q, chain._packed)
+            if T is not None:
+                return T
+        elif (space == "joint" and type(q) is np.ndarray and q.shape == chain._single_shape
                 and q.dtype is _F64):
             # One configuration: the kernel's finiteness test is the validation.
             if not _SINGLE_FK:

@@ -23,6 +23,11 @@ _KERNELS: list = []
 _SINGLE: list = []
 _F64 = np.dtype(np.float64)
 
+try:  # the optional C accelerator for one configuration (setup.py builds it)
+    from robokin.kinematics._fk_single import fk as fk_single_c
+except ImportError:  # no C compiler at install time: the numba kernel serves
+    fk_single_c = None
+
 
 def single_kernel():
     """The compiled single-configuration FK ``fn(q, packed, T_out) -> bool``.
@@ -76,7 +81,12 @@ def forward_kinematics(
     Raises:
         InputError: wrong shape or a non-finite value.
     """
-    if type(q) is np.ndarray and q.shape == chain._single_shape and q.dtype is _F64:
+    if fk_single_c is not None and chain._single_shape is not None:
+        # One configuration: None unless q is a float64 (n,) array of finite values.
+        T = fk_single_c(q, chain._packed)
+        if T is not None:
+            return T
+    elif type(q) is np.ndarray and q.shape == chain._single_shape and q.dtype is _F64:
         # One configuration: validation is the kernel's own finiteness test.
         T = np.empty((4, 4))
         if single_kernel()(q, chain._packed, T):
