@@ -32,6 +32,19 @@ def _median_call(fn, repeats=2000, inner=20):
     return statistics.median(samples)
 
 
+def _median_numba(robot, q):
+    """robot.fk(q) as it runs when the optional C extension was not built."""
+    import robokin.robot as robot_module
+
+    saved = robot_module._FK_C
+    robot_module._FK_C = None
+    try:
+        robot.fk(q)
+        return _median_call(lambda: robot.fk(q))
+    finally:
+        robot_module._FK_C = saved
+
+
 def _best(fn, repeats=3):
     best = np.inf
     for _ in range(repeats):
@@ -68,6 +81,7 @@ def main(n_batch: int = 100_000) -> None:
         robot.fk(q0)
         single = {
             "robokin fk(q)": _median_call(lambda: robot.fk(q0)),
+            "robokin fk(q), numba path (no C)": _median_numba(robot, q0),
             "pinocchio forwardKinematics+frame": _median_call(lambda: pin_pose(q0)),
             "pinocchio forwardKinematics only": _median_call(
                 lambda: pin.forwardKinematics(model, data, q0)
