@@ -42,7 +42,15 @@ O_STALL_RATIO = 16  # ... and give up unless the cost fell below ratio * before
 O_MU_DOWN = 17  # damping factor after an accepted step
 O_MU_UP = 18  # damping factor after a rejected step
 O_SEED_SHRINK = 19  # odd restarts seed in [lo + f span, hi - f span]
-N_OPTS = 20
+O_N_TABLE = 20  # the first restarts start from this many seed-table entries
+O_TABLE_ROT = 21  # squared length [m^2] per unit squared rotation distance, 0: position only
+N_OPTS = 22
+
+# seed table (built once per chain by ``numeric._ChainData.seed_table``): ``tab`` (M,
+# 12 + n) rows [p (3), R row-major (9), q (n)] sorted by grid cell of p; ``cstart``
+# (G^3 + 1) first row of each cell; ``gdat`` (7,) grid origin (3), inverse cell size
+# (3) and G.
+TAB_K_MAX = 8  # most table seeds per target
 
 # result columns after q
 R_ERR = 0  # combined residual norm (masked, unweighted) [m, rad]
@@ -643,19 +651,97 @@ def _check_target(Tt):
     return det > 0.0
 
 
+@njit(cache=True, inline="always")
+def _table_nearest(Tt, tab, cstart, gdat, k, rot_w, idx, dist):
+    """Indices (into idx) of the k table rows nearest the target pose; returns the count.
+
+    Distance ``|p - p_t|^2 + rot_w |R - R_t|_F^2``, searched over the grid cells within
+    Chebyshev radius 1 of the target's cell (wider until k rows are found).
+    """
+    G = int(gdat[6])
+    cx = int(math.floor((Tt[0, 3] - gdat[0]) * gdat[3]))
+    cy = int(math.floor((Tt[1, 3] - gdat[1]) * gdat[4]))
+    cz = int(math.floor((Tt[2, 3] - gdat[2]) * gdat[5]))
+    cx = min(max(cx, 0), G - 1)
+    cy = min(max(cy, 0), G - 1)
+    cz = min(max(cz, 0), G - 1)
+    found = 0
+    r = 1
+    r_prev = -1
+    while True:
+        for ix in range(max(cx - r, 0), min(cx + r, G - 1) + 1):
+            for iy in range(max(cy - r, 0), min(cy + r, G - 1) + 1):
+                for iz in range(max(cz - r, 0), min(cz + r, G - 1) + 1):
+                    if (abs(ix - cx) <= r_prev and abs(iy - cy) <= r_prev
+                            and abs(iz - cz) <= r_prev):
+                        continue  # scanned at the smaller radius
+                    cell = (ix * G + iy) * G + iz
+                    for row in range(cstart[cell], cstart[cell + 1]):
+                        dx = tab[row, 0] - Tt[0, 3]
+                        dy = tab[row, 1] - Tt[1, 3]
+                        dz = tab[row, 2] - Tt[2, 3]
+                        d = dx * dx + dy * dy + dz * dz
+                        if rot_w > 0.0:
+                            sr = 0.0
+                            for a in range(3):
+                                for b in range(3):
+                                    t = tab[row, 3 + 3 * a + b] - Tt[a, b]
+                                    sr += t * t
+                            d += rot_w * sr
+                        # insert into the sorted best-k list
+                        if found < k:
+                            pos = found
+                            found += 1
+                        elif d < dist[k - 1]:
+                            pos = k - 1
+                        else:
+                            continue
+                        while pos > 0 and dist[pos - 1] > d:
+                            dist[pos] = dist[pos - 1]
+                            idx[pos] = idx[pos - 1]
+                            pos -= 1
+                        dist[pos] = d
+                        idx[pos] = row
+        if found >= k or r >= G:
+            return found
+        r_prev = r
+        r += 1
+
+
+@njit(cache=True)
+def table_poses(Q, consts, jdat, Mc, ident, out):
+    """Poses of the configurations Q (M, n) as rows [p (3), R row-major (9)] of out."""
+    n = Q.shape[1]
+    nc = jdat.shape[1]
+    qc = np.empty(nc)
+    Jc = np.empty((6, nc))
+    J = np.empty((6, n))
+    T = np.zeros((4, 4))
+    for i in range(Q.shape[0]):
+        _pose_jac(Q[i], Mc, ident, consts, jdat, qc, Jc, J, T)
+        for a in range(3):
+            out[i, a] = T[a, 3]
+            for b in range(3):
+                out[i, 3 + 3 * a + b] = T[a, b]
+
+
 @njit(cache=True)
 def work_size(n, nc):
     """Length of the float work buffer of :func:`_solve_target`."""
     nd = max(6, n)
-    return 6 + 7 * nc + 18 * n + 44 + nd * nd + nd + 6 * n + 48
+    return 6 + 7 * nc + 18 * n + 44 + nd * nd + nd + 6 * n + 48 + TAB_K_MAX
 
 
 @njit(cache=True, _nrt=False)
-def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out, work, iwork):
+def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out, work, iwork, tab,
+                  cstart, gdat):
     """Attempt from q0 (if asked) then from each seed until converged.
 
-    ``seeds`` (R, n) are uniform [0, 1) numbers mapped into the seed ranges. ``out``
-    gets the best q, then the result columns.
+    The first ``opts[O_N_TABLE]`` restarts start from the seed-table configurations
+    whose poses are nearest the target (searched only once q0 has failed), the
+    others from ``seeds`` (R, n): uniform [0, 1) numbers mapped into the seed
+    ranges. ``out`` gets the best q, then the result columns. ``iwork`` holds
+    6 + TAB_K_MAX integers.
     """
     n = q0.shape[0]
     nc = jdat.shape[1]
@@ -731,6 +817,11 @@ def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out, work, iwork)
     y6 = work[o:o + 6]
     o += 6
     d6 = work[o:o + 6]
+    o += 6
+    tdist = work[o:o + TAB_K_MAX]
+    tidx = iwork[6:6 + TAB_K_MAX]
+    n_tab = min(int(opts[O_N_TABLE]), TAB_K_MAX) if tab.shape[0] > 0 else 0
+    tab_found = -1
     best_cost = np.inf
     bep = np.inf
     ber = np.inf
@@ -744,6 +835,20 @@ def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out, work, iwork)
         if a == 0:
             for j in range(n):
                 q[j] = q0[j]
+        elif a <= n_tab and tab_found != 0:
+            if tab_found < 0:
+                tab_found = _table_nearest(Tt, tab, cstart, gdat, n_tab, opts[O_TABLE_ROT],
+                                           tidx, tdist)
+            if a > tab_found:
+                # fewer table rows than asked for: this restart is a random one
+                for j in range(n):
+                    q[j] = cdat[2, j] + seeds[a - 1, j] * (cdat[3, j] - cdat[2, j])
+            else:
+                row = tidx[a - 1]
+                for j in range(n):
+                    q[j] = tab[row, 12 + j]
+            if a > 1 or start == 0:
+                restarts += 1
         else:
             # alternate seeds from the central part of the range (descents from
             # there meet limits less often) with seeds from the whole range
@@ -794,22 +899,24 @@ def _summary(out, n):
 
 
 @njit(cache=True)
-def solve_serial(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out):
+def solve_serial(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out, tab, cstart,
+                 gdat):
     """Solve a batch: targets (N, 4, 4), q0 (N, n), seeds (N, R, n) -> out (N, n + N_RES).
 
     Returns (number not converged, index of the first bad target / q0 or -1).
     """
     n = q0.shape[1]
     work = np.empty(work_size(n, jdat.shape[1]))
-    iwork = np.empty(6, np.int64)
+    iwork = np.empty(6 + TAB_K_MAX, np.int64)
     for i in range(targets.shape[0]):
         _solve_target(targets[i], q0[i], seeds[i], consts, jdat, Mc, cdat, opts, out[i],
-                      work, iwork)
+                      work, iwork, tab, cstart, gdat)
     return _summary(out, n)
 
 
 @njit(cache=True, parallel=True)
-def solve_parallel(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out):
+def solve_parallel(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out, tab, cstart,
+                   gdat):
     """As :func:`solve_serial`, over all threads (one work buffer per chunk)."""
     N = targets.shape[0]
     n = q0.shape[1]
@@ -817,10 +924,10 @@ def solve_parallel(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out):
     chunks = min(N, 64)
     for c in prange(chunks):
         work = np.empty(size)
-        iwork = np.empty(6, np.int64)
+        iwork = np.empty(6 + TAB_K_MAX, np.int64)
         for i in range(c * N // chunks, (c + 1) * N // chunks):
             _solve_target(targets[i], q0[i], seeds[i], consts, jdat, Mc, cdat, opts,
-                          out[i], work, iwork)
+                          out[i], work, iwork, tab, cstart, gdat)
     return _summary(out, n)
 
 
@@ -836,9 +943,12 @@ def solve_path(targets, q_start, consts, jdat, Mc, cdat, opts, out):
     n = q_start.shape[0]
     prev = q_start.copy()
     no_seeds = np.empty((0, n))
+    no_tab = np.empty((0, 12 + n))
+    no_cstart = np.zeros(1, np.int64)
+    no_gdat = np.zeros(7)
     max_jump = opts[O_PATH_MAX_JUMP]
     work = np.empty(work_size(n, jdat.shape[1]))
-    iwork = np.empty(6, np.int64)
+    iwork = np.empty(6 + TAB_K_MAX, np.int64)
     first = -1
     for i in range(N):
         if first >= 0:
@@ -852,7 +962,7 @@ def solve_path(targets, q_start, consts, jdat, Mc, cdat, opts, out):
             out[i, n + R_CODE] = CODE_NOT_RUN
             continue
         _solve_target(targets[i], prev, no_seeds, consts, jdat, Mc, cdat, opts, out[i],
-                      work, iwork)
+                      work, iwork, no_tab, no_cstart, no_gdat)
         if out[i, n + R_CODE] != CODE_OK:
             first = i
             continue

@@ -18,9 +18,11 @@ point is projected into the limits (2*pi-periodic joints are first shifted by wh
 turns), and joints pressed against a limit by the gradient leave the active set.
 A descent that stalls (the cost has not fallen to 0.3 times its value of 3
 iterations before: a local minimum, or pinned at limits) or runs out of iterations
-restarts from a random seed inside the limits (alternately from the central 80 %
-of each joint range, where descents meet limits less often, and from the whole
-range) until the target is reached or
+restarts: first from the configurations of a per-chain seed table (2,048 fixed
+samples of the central 80 % of the joint ranges with their tool poses) whose poses
+are nearest the target, then from random seeds inside the limits (alternately from
+the central 80 % of each joint range, where descents meet limits less often, and
+from the whole range) until the target is reached or
 the budget (restarts, wall time) is spent. Results are always inside the limits;
 a target that is not reached comes back with ``success=False``, the best
 configuration found and the error it leaves, never an exception.
@@ -65,6 +67,10 @@ _MU0 = 1e-2  # initial damping, lambda = mu * E
 _MU_DOWN = 0.7
 _MU_UP = 16.0
 _SEED_SHRINK = 0.1
+_TABLE_SIZE = 2048  # seed-table configurations per chain
+_TABLE_SEEDS = 4  # first-round restarts from the table rows nearest the target
+_TABLE_ROT = 0.15**2  # [m^2] per unit squared Frobenius rotation distance
+_TABLE_PER_CELL = 2.5  # mean rows per occupied grid cell
 
 
 _K: list[Any] = []
@@ -92,7 +98,7 @@ class IKResult:
         position_error: (...) norm of the selected position rows [m].
         rotation_error: (...) norm of the selected rotation rows [rad].
         iterations: (...) int, iterations used over all attempts.
-        restarts: (...) int, random restarts used.
+        restarts: (...) int, restarts used (seed-table and random).
         reason: (...) str, ``"converged"`` or why not (with the error reached).
 
     For a single target (``T`` of shape (4, 4)) the fields are scalars (``q`` is
@@ -142,7 +148,7 @@ class _ChainData:
     """Packed kernel arrays of one chain (see ``_numeric_kernels``)."""
 
     __slots__ = ("consts", "jdat", "Mc", "cdat", "ident", "n", "mid", "is_revolute",
-                 "wrap")
+                 "wrap", "_table")
 
     def __init__(self, chain: Any) -> None:
         n = chain.n
@@ -190,9 +196,57 @@ class _ChainData:
             np.stack([lim[:, 0], lim[:, 1], slo, shi, wrap.astype(np.float64)])
         )
         self.mid = 0.5 * (slo + shi)
+        self._table: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+
+    def seed_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The restart seed table ``(tab, cstart, gdat)`` (see ``_numeric_kernels``).
+
+        ``_TABLE_SIZE`` configurations drawn once (a fixed seed: the same table every
+        time) from the central 80 % of the seed ranges, with their tool poses, bucketed
+        by position on a grid of G^3 cells (G chosen for about ``_TABLE_PER_CELL`` rows
+        per occupied cell) so a target's nearest rows are found by scanning the cells
+        around it.
+        """
+        if self._table is None:
+            K = _kernels()
+            n = self.n
+            lo = self.cdat[2] + _SEED_SHRINK * (self.cdat[3] - self.cdat[2])
+            hi = self.cdat[3] - _SEED_SHRINK * (self.cdat[3] - self.cdat[2])
+            Q = lo + np.random.default_rng(0).random((_TABLE_SIZE, n)) * (hi - lo)
+            poses = np.empty((_TABLE_SIZE, 12))
+            K.table_poses(Q, self.consts, self.jdat, self.Mc, self.ident, poses)
+            ok = np.isfinite(poses).all(axis=1)
+            Q, poses = Q[ok], poses[ok]
+            p = poses[:, :3]
+            origin = p.min(axis=0) - 1e-9
+            span = np.maximum(p.max(axis=0) + 1e-9 - origin, 1e-6)
+            G = 1
+            while G < 64:
+                cells = _grid_cells(p, origin, G / span, G)
+                if len(p) <= _TABLE_PER_CELL * len(np.unique(cells)):
+                    break
+                G += 1
+            cells = _grid_cells(p, origin, G / span, G)
+            order = np.argsort(cells, kind="stable")
+            tab = np.ascontiguousarray(np.concatenate([poses, Q], axis=1)[order])
+            cstart = np.zeros(G**3 + 1, dtype=np.int64)
+            cstart[1:] = np.cumsum(np.bincount(cells, minlength=G**3))
+            gdat = np.concatenate([origin, G / span, [G]]).astype(np.float64)
+            for a in (tab, cstart, gdat):
+                a.setflags(write=False)
+            self._table = (tab, cstart, gdat)
+        return self._table
+
+
+def _grid_cells(p: np.ndarray, origin: np.ndarray, inv: np.ndarray, G: int) -> np.ndarray:
+    c = np.clip(np.floor((p - origin) * inv).astype(np.int64), 0, G - 1)
+    return (c[:, 0] * G + c[:, 1]) * G + c[:, 2]
 
 
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+# kernel arguments for "no seed table" (rows [p, R, q]: 12 + n columns; a 0-row table
+# of any width will do)
+_NO_TABLE = (np.empty((0, 12)), np.zeros(1, dtype=np.int64), np.zeros(7))
 
 
 def _chain_data(robot: Any) -> _ChainData:
@@ -340,6 +394,9 @@ def _make_opts(mask: Any, weights: Any, tol: Any, tol_rotation: Any,
     opts[K.O_MU_DOWN] = _MU_DOWN
     opts[K.O_MU_UP] = _MU_UP
     opts[K.O_SEED_SHRINK] = _SEED_SHRINK
+    # the seed table is searched by position (and rotation when all of it is asked)
+    opts[K.O_TABLE_ROT] = -1.0 if not m[:3].all() else (_TABLE_ROT if m[3:].all() else 0.0)
+    opts[K.O_N_TABLE] = 0
     return opts
 
 
@@ -426,7 +483,9 @@ def solve(
             rotation error norm [rad] unless ``tol_rotation`` is given).
         tol_rotation: Tolerance on the rotation error norm [rad].
         max_iterations: Iterations per descent (restarts get their own).
-        max_restarts: Random restarts per target after the first descent.
+        max_restarts: Restarts per target after the first descent (the first 4
+            from the seed-table configurations nearest the target when the mask
+            selects all of x, y, z; then random seeds).
         max_time: Wall-time budget per target [s] (a batch gets ``N * max_time``);
             None for no limit. Checked between rounds of restarts.
         max_step: Largest joint change per iteration [rad or m].
@@ -473,8 +532,14 @@ def solve(
     R = min(max_restarts, _FIRST_ROUND_RESTARTS)
     opts[K.O_USE_Q0] = 1.0
     opts[K.O_N_SEEDS] = R
+    if R and opts[K.O_TABLE_ROT] >= 0.0:
+        opts[K.O_N_TABLE] = _TABLE_SEEDS
+        tab = data.seed_table()
+    else:
+        tab = _NO_TABLE
     seeds = gen.random((N, max(R, 1), n))
-    fails, bad = kern(Tf, Q0, seeds, data.consts, data.jdat, data.Mc, data.cdat, opts, out)
+    fails, bad = kern(Tf, Q0, seeds, data.consts, data.jdat, data.Mc, data.cdat, opts, out,
+                      *tab)
     if bad >= 0:
         raise _bad_input(out, n, K, Tf, Q0, lead, bad)
     if fails == 0:
@@ -485,6 +550,7 @@ def solve(
     if todo.size and max_restarts > R:
         deadline = None if max_time is None else t_start + max_time * N
         opts[K.O_USE_Q0] = 0.0
+        opts[K.O_N_TABLE] = 0
         while todo.size:
             if deadline is not None and time.perf_counter() >= deadline:
                 timed_out[todo] = True
@@ -498,7 +564,7 @@ def solve(
             kern2 = K.solve_parallel if (parallel is None and todo.size >= _PARALLEL_MIN) \
                 or parallel else K.solve_serial
             kern2(Tf[todo], Q0[todo], gen.random((todo.size, R, n)), data.consts,
-                  data.jdat, data.Mc, data.cdat, opts, sub)
+                  data.jdat, data.Mc, data.cdat, opts, sub, *_NO_TABLE)
             attempts = sub[:, n + K.R_RESTARTS] + 1
             used[todo] += attempts
             out[todo, n + K.R_ITERS] += sub[:, n + K.R_ITERS]
@@ -645,7 +711,7 @@ def solve_all(
     use_par = N * S >= _PARALLEL_MIN if par is None else bool(par)
     kern = K.solve_parallel if use_par else K.solve_serial
     _, bad = kern(flatT, flatQ, np.empty((N * S, 1, n)), data.consts, data.jdat, data.Mc,
-                  cd, opts, out)
+                  cd, opts, out, *_NO_TABLE)
     if bad >= 0:
         raise _bad_input(out, n, K, Tf, flatQ, lead, bad, per=S)
     out = out.reshape(N, S, n + K.N_RES)

@@ -1,0 +1,158 @@
+"""Numeric IK restart seed table: its rows are FK of in-limit configurations, the grid
+search finds the nearest rows, and restarts from it give exact, in-limit solutions."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robokin
+from robokin.kinematics.ik import numeric
+
+ARMS = ("ur5", "aubo_i5", "puma560", "panda", "scara", "qfmd010", "improved_dh_arm")
+
+
+def random_q(robot, rng, m):
+    box = np.clip(robot.limits, -np.pi, np.pi)
+    return rng.uniform(box[:, 0], box[:, 1], (m, robot.n))
+
+
+def pose_errors(T, Tt):
+    dp = np.linalg.norm(T[..., :3, 3] - Tt[..., :3, 3], axis=-1)
+    R = np.swapaxes(T[..., :3, :3], -1, -2) @ Tt[..., :3, :3]
+    c = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1) / 2, -1, 1)
+    s = np.linalg.norm(
+        np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
+                  R[..., 1, 0] - R[..., 0, 1]], -1), axis=-1) / 2
+    return dp, np.arctan2(s, c)
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_table_rows_are_fk_of_in_limit_configurations_bucketed_by_cell(name):
+    robot = robokin.load(name)
+    data = numeric._chain_data(robot)
+    tab, cstart, gdat = data.seed_table()
+    n = robot.n
+    assert tab.shape == (numeric._TABLE_SIZE, 12 + n)
+    q = tab[:, 12:]
+    assert robot.within_limits(q, tol=0.0).all()
+    T = robot.fk(q)
+    np.testing.assert_allclose(tab[:, :3], T[:, :3, 3], atol=1e-12, rtol=0)
+    np.testing.assert_allclose(tab[:, 3:12], T[:, :3, :3].reshape(-1, 9), atol=1e-12,
+                               rtol=0)
+    G = int(gdat[6])
+    assert cstart.shape == (G**3 + 1,) and cstart[0] == 0 and cstart[-1] == len(tab)
+    assert np.all(np.diff(cstart) >= 0)
+    cells = numeric._grid_cells(tab[:, :3], gdat[:3], gdat[3:6], G)
+    for c in np.flatnonzero(np.diff(cstart)):
+        assert (cells[cstart[c]:cstart[c + 1]] == c).all()
+    # the same table every time (a fixed sampling seed), read-only
+    again = numeric._ChainData(robot.chain).seed_table()
+    for a, b in zip((tab, cstart, gdat), again, strict=True):
+        np.testing.assert_array_equal(a, b)
+        assert not a.flags.writeable
+
+
+@pytest.mark.parametrize("rot_w", [0.0, numeric._TABLE_ROT])
+def test_grid_search_finds_the_nearest_rows_of_the_cells_it_scans(rot_w):
+    from robokin.kinematics.ik import _numeric_kernels as K
+
+    robot = robokin.load("panda")
+    tab, cstart, gdat = numeric._chain_data(robot).seed_table()
+    G = int(gdat[6])
+    cells = np.clip(np.floor((tab[:, :3] - gdat[:3]) * gdat[3:6]).astype(int), 0, G - 1)
+    rng = np.random.default_rng(3)
+    T = robot.fk(random_q(robot, rng, 30))
+    T[:5, :3, 3] += 5.0  # outside the table's box: the search widens
+    k = 4
+    for Tt in T:
+        idx = np.empty(K.TAB_K_MAX, np.int64)
+        dist = np.empty(K.TAB_K_MAX)
+        found = K._table_nearest(Tt, tab, cstart, gdat, k, rot_w, idx, dist)
+        assert found == k
+        d = (np.sum((tab[:, :3] - Tt[:3, 3]) ** 2, axis=1)
+             + rot_w * np.sum((tab[:, 3:12] - Tt[:3, :3].ravel()) ** 2, axis=1))
+        c = np.clip(np.floor((Tt[:3, 3] - gdat[:3]) * gdat[3:6]).astype(int), 0, G - 1)
+        cheb = np.abs(cells - c).max(axis=1)
+        r = 1
+        while (cheb <= r).sum() < k:
+            r += 1
+        scanned = np.flatnonzero(cheb <= r)
+        want = scanned[np.argsort(d[scanned], kind="stable")[:k]]
+        np.testing.assert_allclose(dist[:k], d[want], rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(d[idx[:k]], d[want], rtol=1e-12, atol=1e-15)
+    # a table pose is its own nearest row
+    row = 123
+    Tt = np.eye(4)
+    Tt[:3, 3] = tab[row, :3]
+    Tt[:3, :3] = tab[row, 3:12].reshape(3, 3)
+    idx = np.empty(K.TAB_K_MAX, np.int64)
+    dist = np.empty(K.TAB_K_MAX)
+    K._table_nearest(Tt, tab, cstart, gdat, 1, rot_w, idx, dist)
+    assert dist[0] == 0.0
+    assert (rot_w == 0.0 and np.allclose(tab[idx[0], :3], tab[row, :3])) or idx[0] == row
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda", "improved_dh_arm"])
+def test_table_restarts_round_trip_to_1e9_inside_limits_independent_of_rng(name):
+    robot = robokin.load(name)
+    rng = np.random.default_rng(11)
+    T = robot.fk(random_q(robot, rng, 200))
+    mid = numeric._chain_data(robot).mid
+    # max_restarts=4: q0 (the middle of the limits), then only table seeds
+    a = numeric.solve(robot, T, q0=mid, max_restarts=4, rng=np.random.default_rng(1))
+    b = numeric.solve(robot, T, q0=mid, max_restarts=4, rng=np.random.default_rng(2))
+    used = a.restarts > 0
+    assert used.sum() > 20  # the first descent fails often enough to exercise it
+    assert a.success[used].mean() > 0.85
+    np.testing.assert_array_equal(a.q, b.q)
+    np.testing.assert_array_equal(a.iterations, b.iterations)
+    ok = a.success
+    dp, dr = pose_errors(robot.fk(a.q[ok]), T[ok])
+    assert (dp <= 1e-9).all() and (dr <= 1e-9 * 1.5).all()
+    assert robot.within_limits(a.q, tol=0.0).all()
+    # one target at a time gives the same answers
+    for i in np.flatnonzero(used)[:10]:
+        one = numeric.solve(robot, T[i], q0=mid, max_restarts=4)
+        np.testing.assert_array_equal(one.q, a.q[i])
+        assert one.restarts == a.restarts[i]
+
+
+def test_results_deterministic_for_a_seeded_rng_with_table_and_random_restarts():
+    robot = robokin.load("improved_dh_arm")
+    T = robot.fk(random_q(robot, np.random.default_rng(5), 300))
+    r1 = numeric.solve(robot, T, q0=numeric._chain_data(robot).mid,
+                       rng=np.random.default_rng(9))
+    r2 = numeric.solve(robot, T, q0=numeric._chain_data(robot).mid,
+                       rng=np.random.default_rng(9))
+    assert r1.success.all()
+    assert (r1.restarts > numeric._TABLE_SEEDS).any()  # random seeds were used too
+    np.testing.assert_array_equal(r1.q, r2.q)
+    np.testing.assert_array_equal(r1.restarts, r2.restarts)
+    assert robot.within_limits(r1.q, tol=0.0).all()
+
+
+def test_masks_choose_the_table_metric():
+    K = numeric._kernels()
+    full = numeric._opts(None, None, 1e-9, None, 100, 1.0)
+    assert full[K.O_TABLE_ROT] == numeric._TABLE_ROT
+    assert numeric._opts("xyz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] == 0.0
+    assert numeric._opts("xyz rz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] == 0.0
+    assert numeric._opts("rx ry rz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] < 0.0
+    assert numeric._opts("x y rz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] < 0.0
+
+
+@pytest.mark.parametrize("mask", ["xyz", "rx ry rz"])
+def test_masked_solves_with_restarts_converge_inside_limits(mask):
+    robot = robokin.load("panda")
+    rng = np.random.default_rng(4)
+    Q = random_q(robot, rng, 60)
+    T = robot.fk(Q)
+    res = numeric.solve(robot, T, mask=mask, q0=numeric._chain_data(robot).mid, rng=rng)
+    assert res.success.all()
+    assert robot.within_limits(res.q, tol=0.0).all()
+    dp, dr = pose_errors(robot.fk(res.q), T)
+    if mask == "xyz":
+        assert (dp <= 1e-9).all()
+    else:
+        assert (dr <= 1.5e-9).all()
