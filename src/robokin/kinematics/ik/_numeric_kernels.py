@@ -169,6 +169,14 @@ def _pose_jac(q, Mc, ident, consts, jdat, qc, Jc, J, T):
             for j in range(n):
                 s += Mc[i, j] * q[j]
             qc[i] = s
+    # sines and cosines first, in a loop of independent iterations (the polynomials of
+    # all joints overlap instead of each waiting for the transform before it); parked
+    # in rows 0 and 1 of Jc, which the loop below reads before it overwrites them
+    for k in range(nc):
+        if jdat[0, k] == 0.0:
+            sk, ck = _sincos(jdat[1, k] * qc[k] + jdat[2, k])
+            Jc[0, k] = sk
+            Jc[1, k] = ck
     # the running transform in scalars (no aliasing with the arrays written below)
     C0 = consts[0]
     t00 = C0[0, 0]
@@ -185,7 +193,8 @@ def _pose_jac(q, Mc, ident, consts, jdat, qc, Jc, J, T):
     t23 = C0[2, 3]
     for k in range(nc):
         if jdat[0, k] == 0.0:
-            sk, ck = _sincos(jdat[1, k] * qc[k] + jdat[2, k])
+            sk = Jc[0, k]
+            ck = Jc[1, k]
             x0 = t00
             t00 = ck * x0 + sk * t01
             t01 = ck * t01 - sk * x0

@@ -58,7 +58,10 @@ from robokin.exceptions import InputError
 __all__ = ["IKPathResult", "IKResult", "ik_path", "parse_mask", "solve", "solve_all"]
 
 _AXES = ("x", "y", "z", "rx", "ry", "rz")
-_PARALLEL_MIN = 64  # below this many targets one thread beats the parallel launch
+# below this many targets one thread beats the parallel launch (~3 us; a first
+# descent costs ~5 us, a round of 16 restarts ~100 us)
+_PARALLEL_MIN = 8
+_PARALLEL_MIN_RESTARTS = 2
 _FIRST_ROUND_RESTARTS = 4
 _ROUND_RESTARTS = 16
 _STALL_EVERY = 3
@@ -245,8 +248,11 @@ def _grid_cells(p: np.ndarray, origin: np.ndarray, inv: np.ndarray, G: int) -> n
 
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 # kernel arguments for "no seed table" (rows [p, R, q]: 12 + n columns; a 0-row table
-# of any width will do)
+# of any width will do), read-only like a real table's arrays so that one compiled
+# specialisation serves both
 _NO_TABLE = (np.empty((0, 12)), np.zeros(1, dtype=np.int64), np.zeros(7))
+for _a in _NO_TABLE:
+    _a.setflags(write=False)
 
 
 def _chain_data(robot: Any) -> _ChainData:
@@ -489,7 +495,8 @@ def solve(
         max_time: Wall-time budget per target [s] (a batch gets ``N * max_time``);
             None for no limit. Checked between rounds of restarts.
         max_step: Largest joint change per iteration [rad or m].
-        parallel: Use all threads (default: for 64 targets or more).
+        parallel: Use all threads (default: for 8 targets or more, and for rounds
+            of restarts of 2 targets or more).
         rng: Random generator for the restart seeds (default a module-level one).
 
     Returns:
@@ -561,8 +568,9 @@ def solve(
             R = min(left, _ROUND_RESTARTS)
             opts[K.O_N_SEEDS] = R
             sub = np.empty((todo.size, n + K.N_RES))
-            kern2 = K.solve_parallel if (parallel is None and todo.size >= _PARALLEL_MIN) \
-                or parallel else K.solve_serial
+            kern2 = K.solve_parallel if (
+                parallel is None and todo.size >= _PARALLEL_MIN_RESTARTS) or parallel \
+                else K.solve_serial
             kern2(Tf[todo], Q0[todo], gen.random((todo.size, R, n)), data.consts,
                   data.jdat, data.Mc, data.cdat, opts, sub, *_NO_TABLE)
             attempts = sub[:, n + K.R_RESTARTS] + 1
