@@ -339,7 +339,18 @@ def _residual(T, Tt, e):
     vz = 0.5 * (r10 - r01)
     s = math.sqrt(vx * vx + vy * vy + vz * vz)
     c = 0.5 * (r00 + r11 + r22 - 1.0)
-    if c > -0.9:
+    if c > 0.0 and s < 0.1 * c:
+        # small angles (every descent's last iterations): th / s = atan(x) / (x c) with
+        # x = s / c < 0.1, by its Maclaurin series to x^14 (next term < 1e-17): no atan2
+        ic = 1.0 / c
+        x = s * ic
+        z = x * x
+        f = ic * (1.0 + z * (-1.0 / 3.0 + z * (1.0 / 5.0 + z * (-1.0 / 7.0 + z * (
+            1.0 / 9.0 + z * (-1.0 / 11.0 + z * (1.0 / 13.0 + z * (-1.0 / 15.0))))))))
+        e[3] = f * vx
+        e[4] = f * vy
+        e[5] = f * vz
+    elif c > -0.9:
         th = math.atan2(s, c)
         f = th / s if s > 1e-10 else 1.0 + s * s / 6.0
         e[3] = f * vx
