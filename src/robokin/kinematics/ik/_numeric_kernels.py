@@ -494,7 +494,10 @@ def _project(q, cdat):
 # _nrt=False: no reference counting in the two per-target functions. They allocate
 # nothing (every buffer is a view into the caller's work array), and the
 # atomic increments and decrements for the ~30 views per target cost ~0.3 us.
-@njit(cache=True, _nrt=False)
+# fastmath={"contract"} only: a * b + c may become one fused multiply-add (one
+# rounding instead of two, shorter dependency chains: ~7% per iteration); no other
+# fast-math licence (NaN / inf checks and the order of sums stay as written).
+@njit(cache=True, _nrt=False, fastmath={"contract"})
 def _attempt(q, Tt, consts, jdat, Mc, cdat, opts, rows, sw, max_iter,
              qc, Jc, J, T, e, qn, Jn, Tn, en, Jw, A, g, y, dq, free, A6, y6, d6):
     """One damped least-squares (Levenberg-Marquardt) descent from q (updated in place).
@@ -752,7 +755,7 @@ def work_size(n, nc):
     return 6 + 7 * nc + 18 * n + 44 + nd * nd + nd + 6 * n + 48 + TAB_K_MAX
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, fastmath={"contract"})
 def _solve_target(Tt, q0, seeds, consts, jdat, Mc, cdat, opts, out, work, iwork, tab,
                   cstart, gdat):
     """Attempt from q0 (if asked) then from each seed until converged.
