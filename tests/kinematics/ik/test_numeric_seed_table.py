@@ -156,3 +156,25 @@ def test_masked_solves_with_restarts_converge_inside_limits(mask):
         assert (dp <= 1e-9).all()
     else:
         assert (dr <= 1.5e-9).all()
+
+
+def test_small_angle_rotation_error_matches_scipy():
+    # angles below atan(0.1) take the series branch of the residual's log map
+    from scipy.spatial.transform import Rotation
+
+    from robokin.kinematics.ik import _numeric_kernels as K
+
+    rng = np.random.default_rng(8)
+    angles = np.concatenate([np.logspace(-9, -1.1, 40), rng.uniform(0.05, 0.2, 20)])
+    for th in angles:
+        a = rng.normal(size=3)
+        a /= np.linalg.norm(a)
+        R0 = Rotation.random(random_state=int(rng.integers(1 << 30))).as_matrix()
+        T = np.eye(4)
+        T[:3, :3] = R0
+        Tt = np.eye(4)
+        Tt[:3, :3] = Rotation.from_rotvec(a * th).as_matrix() @ R0
+        e = np.empty(6)
+        K._residual(T, Tt, e)
+        np.testing.assert_allclose(e[3:], a * th, rtol=1e-9 if th > 1e-6 else 1e-4,
+                                   atol=1e-15)
