@@ -544,7 +544,9 @@ def solve(
         tab = data.seed_table()
     else:
         tab = _NO_TABLE
-    seeds = gen.random((N, max(R, 1), n))
+    # random numbers only when some restart of this round is not a table one (the
+    # table always has more rows than _TABLE_SEEDS)
+    seeds = gen.random((N, R, n)) if opts[K.O_N_TABLE] < R else np.zeros((N, max(R, 1), n))
     fails, bad = kern(Tf, Q0, seeds, data.consts, data.jdat, data.Mc, data.cdat, opts, out,
                       *tab)
     if bad >= 0:
