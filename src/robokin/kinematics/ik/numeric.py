@@ -253,6 +253,7 @@ _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _NO_TABLE = (np.empty((0, 12)), np.zeros(1, dtype=np.int64), np.zeros(7))
 for _a in _NO_TABLE:
     _a.setflags(write=False)
+del _a
 
 
 def _chain_data(robot: Any) -> _ChainData:
