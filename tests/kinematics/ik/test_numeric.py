@@ -3,6 +3,8 @@ solution sets, warm-started paths, agreement with the closed forms."""
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -184,6 +186,30 @@ def test_time_budget_is_reported():
     assert not res.success
     assert "time budget" in res.reason
     assert res.restarts < 10_000
+
+
+def test_a_kernels_first_call_is_not_charged_to_the_time_budget(monkeypatch):
+    # A cold numba cache compiles the kernel inside the first call; that must not
+    # use up max_time (it once failed whole batches after the first round).
+    robot = robokin.load("panda")
+    T = np.eye(4)
+    T[:3, 3] = [2.0, 0.0, 0.5]  # out of reach: every round fails
+    K = numeric._kernels()
+    real = K.solve_serial
+
+    def compiling(*args):  # a new kernel object, "compiling" for 0.3 s when first called
+        if not calls:
+            time.sleep(0.3)
+        calls.append(1)
+        return real(*args)
+
+    calls: list = []
+    monkeypatch.setattr(K, "solve_serial", compiling)
+    res = numeric.solve(robot, T, max_restarts=10_000, max_time=0.05, parallel=False,
+                        rng=np.random.default_rng(0))
+    assert "time budget" in res.reason
+    # rounds of restarts ran after the first round (4 restarts), within ~0.05 s
+    assert len(calls) > 1 and res.restarts > numeric._FIRST_ROUND_RESTARTS
 
 
 def test_bad_inputs_raise_input_errors():

@@ -79,6 +79,18 @@ _TABLE_PER_CELL = 2.5  # mean rows per occupied grid cell
 _K: list[Any] = []
 
 
+_WARM: set = set()  # kernels called before in this process (compiled or loaded)
+
+
+def _charged(kern: Any) -> bool:
+    """False on a kernel's first call in this process: the seconds numba spends
+    compiling it or loading it from its cache are not the targets' time budget."""
+    if kern in _WARM:
+        return True
+    _WARM.add(kern)
+    return False
+
+
 def _kernels() -> Any:
     if not _K:
         from robokin.kinematics.ik import _numeric_kernels
@@ -494,7 +506,9 @@ def solve(
             from the seed-table configurations nearest the target when the mask
             selects all of x, y, z; then random seeds).
         max_time: Wall-time budget per target [s] (a batch gets ``N * max_time``);
-            None for no limit. Checked between rounds of restarts.
+            None for no limit. Checked between rounds of restarts. A kernel's
+            first call in the process (numba compiling it, or loading it from its
+            cache) is not charged to it.
         max_step: Largest joint change per iteration [rad or m].
         parallel: Use all threads (default: for 8 targets or more, and for rounds
             of restarts of 2 targets or more).
@@ -548,8 +562,11 @@ def solve(
     # random numbers only when some restart of this round is not a table one (the
     # table always has more rows than _TABLE_SEEDS)
     seeds = gen.random((N, R, n)) if opts[K.O_N_TABLE] < R else np.zeros((N, max(R, 1), n))
+    charged, t_call = _charged(kern), time.perf_counter()
     fails, bad = kern(Tf, Q0, seeds, data.consts, data.jdat, data.Mc, data.cdat, opts, out,
                       *tab)
+    if not charged:
+        t_start += time.perf_counter() - t_call
     if bad >= 0:
         raise _bad_input(out, n, K, Tf, Q0, lead, bad)
     if fails == 0:
@@ -574,8 +591,11 @@ def solve(
             kern2 = K.solve_parallel if (
                 parallel is None and todo.size >= _PARALLEL_MIN_RESTARTS) or parallel \
                 else K.solve_serial
+            charged, t_call = _charged(kern2), time.perf_counter()
             kern2(Tf[todo], Q0[todo], gen.random((todo.size, R, n)), data.consts,
                   data.jdat, data.Mc, data.cdat, opts, sub, *_NO_TABLE)
+            if not charged and deadline is not None:
+                deadline += time.perf_counter() - t_call
             attempts = sub[:, n + K.R_RESTARTS] + 1
             used[todo] += attempts
             out[todo, n + K.R_ITERS] += sub[:, n + K.R_ITERS]
