@@ -127,18 +127,40 @@ def _const_x(T, C, P):
 
 
 @njit(cache=True, inline="always")
-def _fk_one(q, consts, xform, joints, T):
-    """Write FK of one chain configuration into T (4x4). Returns False on NaN/inf."""
+def _fk_one(q, consts, xform, joints, T, sc):
+    """Write FK of one chain configuration into T (4x4). Returns False on NaN/inf.
+
+    ``sc`` (2, n_chain) is scratch: every joint's sine and cosine are computed first,
+    in a loop of independent iterations the CPU overlaps, then the transform chain
+    (the serial part) uses them. The order changes no result.
+    """
     ok = True
+    nc = joints.shape[1]
+    for k in range(nc):
+        v = joints[1, k] * q[k] + joints[2, k]
+        if not math.isfinite(v):
+            ok = False
+        if joints[0, k] == 0.0:
+            sc[0, k], sc[1, k] = sincos(v)
+        else:
+            sc[0, k] = v
     C0 = consts[0]
     for r in range(3):
         for c in range(4):
             T[r, c] = C0[r, c]
-    for k in range(joints.shape[1]):
-        v = joints[1, k] * q[k] + joints[2, k]
-        if not math.isfinite(v):
-            ok = False
-        _joint_right(T, joints[0, k], v)
+    for k in range(nc):
+        if joints[0, k] == 0.0:
+            s = sc[0, k]
+            c = sc[1, k]
+            for r in range(3):
+                x0 = T[r, 0]
+                x1 = T[r, 1]
+                T[r, 0] = c * x0 + s * x1
+                T[r, 1] = c * x1 - s * x0
+        else:
+            v = sc[0, k]
+            for r in range(3):
+                T[r, 3] += T[r, 2] * v
         _const_x(T, consts[k + 1], xform[k + 1])
     T[3, 0] = 0.0
     T[3, 1] = 0.0
@@ -152,7 +174,8 @@ def fk_packed(q, p, T):
     """FK of one configuration into T (4, 4) from packed chain arrays; False on NaN/inf.
 
     One flat parameter array keeps the call overhead from Python small: a single
-    configuration is dominated by argument unboxing, not arithmetic.
+    configuration is dominated by argument unboxing, not arithmetic. (Without the
+    optional C extension ``_fk_single`` this is the single-configuration path.)
     """
     nc = int(p[0])
     consts = p[1 : 1 + (nc + 1) * 16].reshape((nc + 1, 4, 4))
@@ -160,25 +183,34 @@ def fk_packed(q, p, T):
     xform = p[o : o + (nc + 1) * 6].reshape((nc + 1, 6))
     o += (nc + 1) * 6
     joints = p[o : o + 3 * nc].reshape((3, nc))
-    return _fk_one(q, consts, xform, joints, T)
+    return _fk_one(q, consts, xform, joints, T, np.empty((2, nc)))
 
 
 @njit(cache=True)
 def fk_serial(qc, consts, xform, joints, out):
     """FK of a batch (N, n_chain) into out (N, 4, 4), one thread. Returns all-finite."""
     ok = True
+    sc = np.empty((2, joints.shape[1]))
     for i in range(qc.shape[0]):
-        ok &= _fk_one(qc[i], consts, xform, joints, out[i])
+        ok &= _fk_one(qc[i], consts, xform, joints, out[i], sc)
     return ok
+
+
+_CHUNKS = 64  # parallel work units (each with its own scratch)
 
 
 @njit(cache=True, parallel=True)
 def fk_parallel(qc, consts, xform, joints, out):
     """FK of a batch (N, n_chain) into out (N, 4, 4), all threads. Returns all-finite."""
     n = qc.shape[0]
-    flags = np.ones(n, dtype=np.bool_)
-    for i in prange(n):
-        flags[i] = _fk_one(qc[i], consts, xform, joints, out[i])
+    size = (n + _CHUNKS - 1) // _CHUNKS
+    flags = np.ones(_CHUNKS, dtype=np.bool_)
+    for c in prange(_CHUNKS):
+        sc = np.empty((2, joints.shape[1]))
+        ok = True
+        for i in range(c * size, min(n, (c + 1) * size)):
+            ok &= _fk_one(qc[i], consts, xform, joints, out[i], sc)
+        flags[c] = ok
     return flags.all()
 
 
