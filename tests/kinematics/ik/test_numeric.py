@@ -205,7 +205,7 @@ def test_a_kernels_first_call_is_not_charged_to_the_time_budget(monkeypatch):
 
     calls: list = []
     monkeypatch.setattr(K, "solve_serial", compiling)
-    res = numeric.solve(robot, T, max_restarts=10_000, max_time=0.05, parallel=False,
+    res = numeric.solve(robot, T, max_restarts=10**7, max_time=0.05, parallel=False,
                         rng=np.random.default_rng(0))
     assert "time budget" in res.reason
     # rounds of restarts ran after the first round (4 restarts), within ~0.05 s
