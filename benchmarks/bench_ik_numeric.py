@@ -229,9 +229,9 @@ def main() -> None:
             q, t = run(strict, targets, seeds)
             rows.append((name, seed_name, "robokin @1e-9", score(robot, q, t, targets,
                                                                  1e-9)))
-        # batch vs per-target loop (strict tolerance, fixed seed), best of 3 each
+        # batch vs per-target loop (strict tolerance, fixed seed), best of 7 each
         t_batch = t_loop = np.inf
-        for _ in range(3):
+        for _ in range(7):
             t = time.perf_counter()
             res = numeric.solve(robot, targets, q0=fixed, tol=1e-9, max_time=0.01,
                                 max_restarts=BUDGET)
