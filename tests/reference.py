@@ -57,3 +57,14 @@ def random_q(robot, rng, size=()):
     return rng.uniform(
         lim[:, 0], lim[:, 1], size=tuple(np.atleast_1d(size)) + (robot.n,)
     )
+
+
+def pose_errors(T, Tt):
+    """Position distance [m] and rotation angle [rad] between poses (..., 4, 4)."""
+    dp = np.linalg.norm(T[..., :3, 3] - Tt[..., :3, 3], axis=-1)
+    R = np.swapaxes(T[..., :3, :3], -1, -2) @ Tt[..., :3, :3]
+    c = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1) / 2, -1, 1)
+    s = np.linalg.norm(
+        np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
+                  R[..., 1, 0] - R[..., 0, 1]], -1), axis=-1) / 2
+    return dp, np.arctan2(s, c)

@@ -7,24 +7,10 @@ import numpy as np
 import pytest
 
 import robokin
+from reference import pose_errors, random_q
 from robokin.kinematics.ik import numeric
 
 ARMS = ("ur5", "aubo_i5", "puma560", "panda", "scara", "qfmd010", "improved_dh_arm")
-
-
-def random_q(robot, rng, m):
-    box = np.clip(robot.limits, -np.pi, np.pi)
-    return rng.uniform(box[:, 0], box[:, 1], (m, robot.n))
-
-
-def pose_errors(T, Tt):
-    dp = np.linalg.norm(T[..., :3, 3] - Tt[..., :3, 3], axis=-1)
-    R = np.swapaxes(T[..., :3, :3], -1, -2) @ Tt[..., :3, :3]
-    c = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1) / 2, -1, 1)
-    s = np.linalg.norm(
-        np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
-                  R[..., 1, 0] - R[..., 0, 1]], -1), axis=-1) / 2
-    return dp, np.arctan2(s, c)
 
 
 @pytest.mark.parametrize("name", ARMS)
