@@ -1,9 +1,15 @@
-"""Build step for the one C extension; all metadata lives in pyproject.toml.
+"""Build step for the C extensions; all metadata lives in pyproject.toml.
 
-``robokin.kinematics._fk_single`` (single-configuration FK from Python, see the
-comment at the top of its source) is optional: without a C compiler the build
-skips it and robokin uses its numba kernel instead.
+Both are optional: without a C compiler the build skips them and robokin uses its
+numba kernels instead (see the comment at the top of each source).
+
+* ``robokin.kinematics._fk_single``: single-configuration FK from Python.
+* ``robokin.kinematics.ik._lm_lanes``: batch numeric IK, several targets per
+  vector register.
 """
+
+import sys
+
 
 import numpy
 from setuptools import Extension, setup
@@ -17,6 +23,16 @@ setup(
             # no fused multiply-add: the same roundings as the numba kernels
             extra_compile_args=["-O3", "-ffp-contract=off"],
             optional=True,
-        )
+        ),
+        Extension(
+            "robokin.kinematics.ik._lm_lanes",
+            ["src/robokin/kinematics/ik/_lm_lanes.c"],
+            depends=["src/robokin/kinematics/ik/_lm_lanes_body.h"],
+            include_dirs=[numpy.get_include()],
+            extra_compile_args=[] if sys.platform == "win32" else
+            ["-O3", "-fno-math-errno", "-Wno-psabi"],
+            libraries=[] if sys.platform == "win32" else ["pthread"],
+            optional=True,
+        ),
     ]
 )

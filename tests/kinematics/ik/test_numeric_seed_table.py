@@ -97,10 +97,11 @@ def test_table_restarts_round_trip_to_1e9_inside_limits_independent_of_rng(name)
     dp, dr = pose_errors(robot.fk(a.q[ok]), T[ok])
     assert (dp <= 1e-9).all() and (dr <= 1e-9 * 1.5).all()
     assert robot.within_limits(a.q, tol=0.0).all()
-    # one target at a time gives the same answers
+    # one target at a time gives the same answers (to rounding: see
+    # test_batch_equals_per_target_when_the_first_descent_converges)
     for i in np.flatnonzero(used)[:10]:
         one = numeric.solve(robot, T[i], q0=mid, max_restarts=4)
-        np.testing.assert_array_equal(one.q, a.q[i])
+        np.testing.assert_allclose(one.q, a.q[i], rtol=0, atol=1e-12)
         assert one.restarts == a.restarts[i]
 
 

@@ -78,6 +78,12 @@ _TABLE_PER_CELL = 2.5  # mean rows per occupied grid cell
 
 _K: list[Any] = []
 
+try:  # the vector-lane batch kernel (C, optional: numba serves without it)
+    from robokin.kinematics.ik import _lm_lanes
+except ImportError:  # pragma: no cover - not built (no C compiler at install time)
+    _lm_lanes = None
+_LANES_MIN = 8  # batches from this many targets go to _lm_lanes when it applies
+
 
 _WARM: set = set()  # kernels called before in this process (compiled or loaded)
 
@@ -85,10 +91,44 @@ _WARM: set = set()  # kernels called before in this process (compiled or loaded)
 def _charged(kern: Any) -> bool:
     """False on a kernel's first call in this process: the seconds numba spends
     compiling it or loading it from its cache are not the targets' time budget."""
-    if kern in _WARM:
+    if kern in _WARM or isinstance(kern, _LanesKernel):
         return True
     _WARM.add(kern)
     return False
+
+
+class _LanesKernel:
+    """``_lm_lanes.solve`` behind the signature of the numba batch kernels."""
+
+    def __init__(self, parallel: bool) -> None:
+        self.parallel = parallel
+
+    def __call__(self, targets: np.ndarray, q0: np.ndarray, seeds: np.ndarray,
+                 consts: np.ndarray, jdat: np.ndarray, Mc: np.ndarray, cdat: np.ndarray,
+                 opts: np.ndarray, out: np.ndarray, tab: np.ndarray, cstart: np.ndarray,
+                 gdat: np.ndarray) -> tuple[int, int]:
+        threads = 1
+        if self.parallel:
+            import numba
+
+            threads = numba.get_num_threads()
+        return _lm_lanes.solve(targets, q0, seeds, consts, jdat, cdat, opts, out, tab,
+                               cstart, gdat, threads)
+
+
+_LANES = (_LanesKernel(False), _LanesKernel(True))
+
+
+def _batch_kernel(data: _ChainData, opts: np.ndarray, count: int, parallel: bool) -> Any:
+    """The kernel for `count` targets: numba (serial or over all threads), or the C
+    lanes for a batch of a full-pose task on a chain of 6 to ``_lm_lanes.NMAX``
+    independent joints (fewer joints than task rows need the joint-space solve,
+    which only the numba kernel has)."""
+    K = _kernels()
+    if (_lm_lanes is not None and count >= _LANES_MIN and data.ident
+            and 6 <= data.n <= _lm_lanes.NMAX and np.all(opts[K.O_W:K.O_W + 6] > 0.0)):
+        return _LANES[parallel]
+    return K.solve_parallel if parallel else K.solve_serial
 
 
 def _kernels() -> Any:
@@ -528,6 +568,7 @@ def solve(
     Tf, lead = _targets(T)
     N = Tf.shape[0]
     opts = _opts(mask, weights, tol, tol_rotation, max_iterations, max_step)
+    opts[K.O_IDENT] = data.ident
     max_restarts = _count(max_restarts, "max_restarts")
     if max_time is not None:
         max_time = _positive(max_time, "max_time")
@@ -550,7 +591,7 @@ def solve(
     if N == 0:
         return _result(out, lead, n, None, K)
     use_par = N >= _PARALLEL_MIN if parallel is None else bool(parallel)
-    kern = K.solve_parallel if use_par else K.solve_serial
+    kern = _batch_kernel(data, opts, N, use_par)
     R = min(max_restarts, _FIRST_ROUND_RESTARTS)
     opts[K.O_USE_Q0] = 1.0
     opts[K.O_N_SEEDS] = R
@@ -588,9 +629,8 @@ def solve(
             R = min(left, _ROUND_RESTARTS)
             opts[K.O_N_SEEDS] = R
             sub = np.empty((todo.size, n + K.N_RES))
-            kern2 = K.solve_parallel if (
-                parallel is None and todo.size >= _PARALLEL_MIN_RESTARTS) or parallel \
-                else K.solve_serial
+            kern2 = _batch_kernel(data, opts, todo.size, bool(
+                (parallel is None and todo.size >= _PARALLEL_MIN_RESTARTS) or parallel))
             charged, t_call = _charged(kern2), time.perf_counter()
             kern2(Tf[todo], Q0[todo], gen.random((todo.size, R, n)), data.consts,
                   data.jdat, data.Mc, data.cdat, opts, sub, *_NO_TABLE)
@@ -717,6 +757,7 @@ def solve_all(
     opts = _opts(options.get("mask"), options.get("weights"), options.get("tol", 1e-9),
                  options.get("tol_rotation"), options.get("max_iterations", 100),
                  options.get("max_step", 1.0))
+    opts[K.O_IDENT] = data.ident
     lim = np.asarray(robot.limits, dtype=np.float64)
     is_rev = data.is_revolute
     if N == 0:
@@ -740,7 +781,7 @@ def solve_all(
     out = np.empty((N * S, n + K.N_RES))
     par = options.get("parallel")
     use_par = N * S >= _PARALLEL_MIN if par is None else bool(par)
-    kern = K.solve_parallel if use_par else K.solve_serial
+    kern = _batch_kernel(data, opts, N * S, use_par)
     _, bad = kern(flatT, flatQ, np.empty((N * S, 1, n)), data.consts, data.jdat, data.Mc,
                   cd, opts, out, *_NO_TABLE)
     if bad >= 0:
@@ -857,6 +898,7 @@ def ik_path(
     if q_start.shape != (n,):
         raise InputError("q_start", f"expected shape ({n},), got {q_start.shape}")
     opts = _opts(mask, weights, tol, tol_rotation, max_iterations, max_step)
+    opts[K.O_IDENT] = data.ident
     opts[K.O_USE_Q0] = 1.0
     opts[K.O_N_SEEDS] = 0
     opts[K.O_PATH_MAX_JUMP] = _positive(max_jump, "max_jump")
