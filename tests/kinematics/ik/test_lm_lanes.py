@@ -131,3 +131,21 @@ def test_joint_angles_beyond_the_polynomial_range_use_libm():
     assert res.success.mean() >= 0.95
     dp, dr = pose_errors(robot.fk(res.q[res.success]), T[res.success])
     assert dp.max() <= 1e-9 and dr.max() <= 1.5e-9
+
+
+@needs_lanes
+def test_the_baseline_copy_solves_like_the_avx2_copy():
+    # CPUs without AVX2 + FMA load the baseline copy (then numba is used instead,
+    # being faster); it is the same source, so it must solve the same way
+    robot = robokin.load("panda")
+    T, q0 = _batch(robot, 200, 13)
+    fast = numeric.solve(robot, T, q0=q0, rng=np.random.default_rng(4))
+    assert LANES.select_isa("baseline") == "baseline"
+    try:
+        base = numeric.solve(robot, T, q0=q0, rng=np.random.default_rng(4))
+    finally:
+        LANES.select_isa(LANES.ISA)
+    assert base.success.all() and fast.success.all()
+    same = (base.iterations == fast.iterations) & (base.restarts == fast.restarts)
+    assert same.mean() >= 0.98
+    np.testing.assert_allclose(base.q[same], fast.q[same], rtol=0, atol=1e-9)

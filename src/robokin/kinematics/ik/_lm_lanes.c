@@ -449,7 +449,28 @@ static PyObject *py_solve(PyObject *self, PyObject *args)
     return Py_BuildValue("(ll)", fails, first_bad);
 }
 
+/* select_isa("baseline" | "avx2+fma") -> the one in use; for tests of the copy this
+ * CPU would not pick. ValueError when the CPU (or build) lacks it. */
+static PyObject *py_select_isa(PyObject *self, PyObject *args)
+{
+    const char *name;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "s", &name))
+        return NULL;
+    if (strcmp(name, "baseline") == 0)
+        WORKER = worker_base;
+    else if (strcmp(name, "avx2+fma") == 0 && pick_worker() != worker_base)
+        WORKER = pick_worker();
+    else {
+        PyErr_Format(PyExc_ValueError, "select_isa: %s is not available here", name);
+        return NULL;
+    }
+    return PyUnicode_FromString(WORKER == worker_base ? "baseline" : "avx2+fma");
+}
+
 static PyMethodDef methods[] = {
+    {"select_isa", py_select_isa, METH_VARARGS,
+     "select_isa(name) -> name: run the 'baseline' or the 'avx2+fma' copy."},
     {"solve", py_solve, METH_VARARGS,
      "solve(targets, q0, seeds, consts, jdat, cdat, opts, out, tab, cstart, gdat, "
      "n_threads) -> (fails, first_bad): batch IK, W targets per vector."},

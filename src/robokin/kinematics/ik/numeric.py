@@ -82,6 +82,10 @@ try:  # the vector-lane batch kernel (C, optional: numba serves without it)
     from robokin.kinematics.ik import _lm_lanes
 except ImportError:  # pragma: no cover - not built (no C compiler at install time)
     _lm_lanes = None
+# only its AVX2 + FMA copy beats numba (its baseline SSE2 copy takes 1.5x numba's
+# time); elsewhere numba serves
+if _lm_lanes is not None and _lm_lanes.ISA == "baseline":  # pragma: no cover
+    _lm_lanes = None
 _LANES_MIN = 8  # batches from this many targets go to _lm_lanes when it applies
 
 
