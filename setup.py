@@ -19,6 +19,7 @@ setup(
         Extension(
             "robokin.kinematics._fk_single",
             ["src/robokin/kinematics/_fk_single.c"],
+            depends=["src/robokin/kinematics/_sincos_consts.h"],
             include_dirs=[numpy.get_include()],
             # no fused multiply-add: the same roundings as the numba kernels
             extra_compile_args=["-O3", "-ffp-contract=off"],
@@ -27,7 +28,8 @@ setup(
         Extension(
             "robokin.kinematics.ik._lm_lanes",
             ["src/robokin/kinematics/ik/_lm_lanes.c"],
-            depends=["src/robokin/kinematics/ik/_lm_lanes_body.h"],
+            depends=["src/robokin/kinematics/ik/_lm_lanes_body.h",
+                     "src/robokin/kinematics/_sincos_consts.h"],
             include_dirs=[numpy.get_include()],
             extra_compile_args=[] if sys.platform == "win32" else
             ["-O3", "-fno-math-errno", "-Wno-psabi"],
