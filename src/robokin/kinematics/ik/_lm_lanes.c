@@ -9,14 +9,15 @@
  * GCC/clang vector extension, compiled twice (baseline, and AVX2 + FMA chosen at
  * run time when the CPU has them).
  *
- * It solves exactly what _numeric_kernels.solve_serial / solve_parallel solve, for
- * the common case: a full-pose task (all six rows, any weights), an identity
- * coupling, 1 to NMAX joints. The per-lane logic (seeds, the seed table, limits,
+ * It solves what _numeric_kernels.solve_serial / solve_parallel solve (any task
+ * mask and weights) for chains of 1 to NMAX joints without dependent joints (an
+ * identity coupling). The per-lane logic (seeds, the seed table, limits,
  * acceptance, stall and iteration tests, the best result) is the same as
- * _attempt / _solve_target; the arithmetic order differs (fused multiply-adds,
- * the task-space solve also when a joint is frozen), so results agree to the
- * tolerance, not to the bit. numeric.py calls it for large batches and falls back
- * to numba when it was not built or the case is not covered.
+ * _attempt / _solve_target. The arithmetic order differs (fused multiply-adds;
+ * the task-space solve also when frozen joints leave fewer free joints than task
+ * rows, the same step in exact arithmetic), so results agree to rounding, not to
+ * the bit. numeric.py calls it for batches and falls back to numba when it was not
+ * built or the chain has dependent joints.
  *
  * solve(targets (N,4,4), q0 (N,n), seeds (N,R,n), consts (n+1,4,4), jdat (9,n),
  *       cdat (5,n), opts (N_OPTS,), out (N,n+N_RES), tab (M,12+n), cstart (G^3+1,)
@@ -377,12 +378,13 @@ static PyObject *py_solve(PyObject *self, PyObject *args)
         return NULL;
     }
     const double *opts = (const double *)PyArray_DATA(a[6]);
+    int m = 0;
     for (int i = 0; i < 6; i++)
-        if (!(opts[O_W + i] > 0.0)) {
-            PyErr_SetString(PyExc_ValueError,
-                            "_lm_lanes.solve: every task row must be selected");
-            return NULL;
-        }
+        m += opts[O_W + i] > 0.0;
+    if (m == 0) {
+        PyErr_SetString(PyExc_ValueError, "_lm_lanes.solve: no task row selected");
+        return NULL;
+    }
     if (opts[O_IDENT] != 1.0) {
         PyErr_SetString(PyExc_ValueError, "_lm_lanes.solve: identity coupling only");
         return NULL;

@@ -361,15 +361,57 @@ static inline void FN(lane_top)(Ctx *cx, Lanes *L, int l)
     }
 }
 
+/* Solve the k x k system A x = b in place (x into b) for SPD A (lower triangle
+ * read, overwritten with L D) by L D L^T, per lane; lanes where A is not SPD get
+ * 0 in the returned mask. */
+static inline __attribute__((always_inline)) vl FN(ldl_solve)(vd (*A)[NMAX], vd *b, int k)
+{
+    vd dinv[NMAX];
+    vl ok = ONES_L;
+    for (int j = 0; j < k; j++) {
+        vd s = A[j][j];
+        for (int i = 0; i < j; i++)
+            s -= A[j][i] * A[j][i] * dinv[i];
+        ok &= (s > 0.0);
+        dinv[j] = 1.0 / FN(vsel)(s > 0.0, s, ONE);
+        for (int i = j + 1; i < k; i++) {
+            vd t = A[i][j];
+            for (int r = 0; r < j; r++)
+                t -= A[i][r] * A[j][r] * dinv[r];
+            A[i][j] = t;
+        }
+    }
+    for (int i = 0; i < k; i++) {
+        vd t = b[i];
+        for (int r = 0; r < i; r++)
+            t -= A[i][r] * dinv[r] * b[r];
+        b[i] = t;
+    }
+    for (int i = k - 1; i >= 0; i--) {
+        vd di = dinv[i];
+        vd t = b[i] * di;
+        for (int r = i + 1; r < k; r++)
+            t -= A[r][i] * di * b[r];
+        b[i] = t;
+    }
+    return ok;
+}
+
 static void FN(worker)(Ctx *cx)
 {
     const int n = cx->ch.n;
     const double *opts = cx->opts;
     const double *cdat = cx->cdat;
-    double sw[6], w[6];
+    /* the selected task rows (weight > 0) and their square-root weights */
+    double w[6], sw[6];
+    int rows[6], m = 0;
     for (int a = 0; a < 6; a++) {
         w[a] = opts[O_W + a];
-        sw[a] = sqrt(w[a]);
+        if (w[a] > 0.0) {
+            rows[m] = a;
+            sw[m] = sqrt(w[a]);
+            m++;
+        }
     }
     const double max_step = opts[O_MAX_STEP], mu0 = opts[O_MU0];
     const double mu_down = opts[O_MU_DOWN], mu_up = opts[O_MU_UP];
@@ -383,18 +425,21 @@ static void FN(worker)(Ctx *cx)
         }
         FN(lane_load)(cx, &L, l);
     }
-    vd Jn[6 * NMAX], Tn[12], en[6], Jw[6][NMAX], qn[NMAX];
+    vd Jn[6 * NMAX], Tn[12], en[6], Jw[6][NMAX], qn[NMAX], ye[6];
     for (;;) {
         int busy = 0;
         for (int l = 0; l < W; l++)
             busy |= (L.mode[l] != MODE_IDLE);
         if (!busy)
             return;
-        /* weighted rows; joints pushed into a limit by the gradient leave the set */
+        /* weighted task rows; joints pushed into a limit by the gradient Jw^T ye
+         * leave the active set */
         vl nfree = (vl)ZERO_L;
-        for (int a = 0; a < 6; a++)
+        for (int a = 0; a < m; a++) {
+            ye[a] = sw[a] * L.e[rows[a]];
             for (int j = 0; j < n; j++)
-                Jw[a][j] = sw[a] * L.J[a * NMAX + j];
+                Jw[a][j] = sw[a] * L.J[rows[a] * NMAX + j];
+        }
         for (int j = 0; j < n; j++) {
             if (cdat[4 * n + j] == 0.0) {
                 vl hi = L.q[j] >= cdat[n + j];
@@ -405,10 +450,10 @@ static void FN(worker)(Ctx *cx)
                     any |= (at[l] != 0);
                 if (any) {
                     vd gj = ZERO;
-                    for (int a = 0; a < 6; a++)
-                        gj += Jw[a][j] * (sw[a] * L.e[a]);
+                    for (int a = 0; a < m; a++)
+                        gj += Jw[a][j] * ye[a];
                     vl frz = (hi & (gj > 0.0)) | (lo & (gj < 0.0));
-                    for (int a = 0; a < 6; a++)
+                    for (int a = 0; a < m; a++)
                         Jw[a][j] = FN(vsel)(frz, ZERO, Jw[a][j]);
                     nfree += 1 + frz; /* frz is -1 where frozen */
                     continue;
@@ -419,54 +464,98 @@ static void FN(worker)(Ctx *cx)
         for (int l = 0; l < W; l++)
             if (L.mode[l] == MODE_RUN && nfree[l] == 0)
                 FN(lane_end_attempt)(cx, &L, l, CODE_STALL, L.it[l]);
-        /* (Jw Jw^T + lam I) y = W^1/2 e ; dq = Jw^T y, by L D L^T */
         vd lam = L.mu * L.cost + 1e-14;
-        vd A[6][6], y[6], dinv[6];
-        for (int a = 0; a < 6; a++) {
-            for (int b = 0; b <= a; b++) {
-                vd s = ZERO;
-                for (int j = 0; j < n; j++)
-                    s += Jw[a][j] * Jw[b][j];
-                A[a][b] = s;
+        vd dq[NMAX];
+        vl ok;
+        if (m == 6 && n >= 6) {
+            /* full pose, task space, fixed size 6 (unrolled by the compiler):
+             * (Jw Jw^T + lam I) y = W^1/2 e ; dq = Jw^T y */
+            vd A[6][6], y[6], dinv[6];
+            for (int a = 0; a < 6; a++) {
+                for (int b = 0; b <= a; b++) {
+                    vd s = ZERO;
+                    for (int j = 0; j < n; j++)
+                        s += Jw[a][j] * Jw[b][j];
+                    A[a][b] = s;
+                }
+                A[a][a] += lam;
+                y[a] = ye[a];
             }
-            A[a][a] += lam;
-            y[a] = sw[a] * L.e[a];
-        }
-        vl ok = (vl)ONES_L;
-        for (int j = 0; j < 6; j++) {
-            vd s = A[j][j];
-            for (int k = 0; k < j; k++)
-                s -= A[j][k] * A[j][k] * dinv[k];
-            ok &= (s > 0.0);
-            dinv[j] = 1.0 / FN(vsel)(s > 0.0, s, ONE);
-            for (int i = j + 1; i < 6; i++) {
-                vd t = A[i][j];
+            ok = (vl)ONES_L;
+            for (int j = 0; j < 6; j++) {
+                vd s = A[j][j];
                 for (int k = 0; k < j; k++)
-                    t -= A[i][k] * A[j][k] * dinv[k];
-                A[i][j] = t;
+                    s -= A[j][k] * A[j][k] * dinv[k];
+                ok &= (s > 0.0);
+                dinv[j] = 1.0 / FN(vsel)(s > 0.0, s, ONE);
+                for (int i = j + 1; i < 6; i++) {
+                    vd t = A[i][j];
+                    for (int k = 0; k < j; k++)
+                        t -= A[i][k] * A[j][k] * dinv[k];
+                    A[i][j] = t;
+                }
             }
-        }
-        for (int i = 0; i < 6; i++) {
-            vd t = y[i];
-            for (int k = 0; k < i; k++)
-                t -= A[i][k] * dinv[k] * y[k];
-            y[i] = t;
-        }
-        for (int i = 5; i >= 0; i--) {
-            vd di = dinv[i];
-            vd t = y[i] * di;
-            for (int k = i + 1; k < 6; k++)
-                t -= A[k][i] * di * y[k];
-            y[i] = t;
+            for (int i = 0; i < 6; i++) {
+                vd t = y[i];
+                for (int k = 0; k < i; k++)
+                    t -= A[i][k] * dinv[k] * y[k];
+                y[i] = t;
+            }
+            for (int i = 5; i >= 0; i--) {
+                vd di = dinv[i];
+                vd t = y[i] * di;
+                for (int k = i + 1; k < 6; k++)
+                    t -= A[k][i] * di * y[k];
+                y[i] = t;
+            }
+            for (int j = 0; j < n; j++) {
+                vd s = ZERO;
+                for (int a = 0; a < 6; a++)
+                    s += Jw[a][j] * y[a];
+                dq[j] = s;
+            }
+        } else if (m <= n) {
+            /* task space, m x m (frozen columns are zero: the same step as the
+             * joint-space form the numba kernel takes when fewer joints are free) */
+            vd A[NMAX][NMAX], y[6];
+            for (int a = 0; a < m; a++) {
+                for (int b = 0; b <= a; b++) {
+                    vd s = ZERO;
+                    for (int j = 0; j < n; j++)
+                        s += Jw[a][j] * Jw[b][j];
+                    A[a][b] = s;
+                }
+                A[a][a] += lam;
+                y[a] = ye[a];
+            }
+            ok = FN(ldl_solve)(A, y, m);
+            for (int j = 0; j < n; j++) {
+                vd s = ZERO;
+                for (int a = 0; a < m; a++)
+                    s += Jw[a][j] * y[a];
+                dq[j] = s;
+            }
+        } else {
+            /* joint space (more task rows than joints): (Jw^T Jw + lam I) dq = Jw^T ye */
+            vd A[NMAX][NMAX];
+            for (int i = 0; i < n; i++) {
+                for (int k = 0; k <= i; k++) {
+                    vd s = ZERO;
+                    for (int a = 0; a < m; a++)
+                        s += Jw[a][i] * Jw[a][k];
+                    A[i][k] = s;
+                }
+                A[i][i] += lam;
+                vd g = ZERO;
+                for (int a = 0; a < m; a++)
+                    g += Jw[a][i] * ye[a];
+                dq[i] = g;
+            }
+            ok = FN(ldl_solve)(A, dq, n);
         }
         vd big = ZERO;
-        vd dq[NMAX];
         for (int j = 0; j < n; j++) {
-            vd s = ZERO;
-            for (int a = 0; a < 6; a++)
-                s += Jw[a][j] * y[a];
-            dq[j] = s;
-            vd ad = FN(vabs)(s);
+            vd ad = FN(vabs)(dq[j]);
             big = FN(vsel)(ad > big, ad, big);
         }
         vd scale = FN(vsel)(big > max_step, max_step / FN(vsel)(big > max_step, big, ONE),
@@ -498,15 +587,18 @@ static void FN(worker)(Ctx *cx)
         }
         FN(pose_jac)(&cx->ch, qn, Jn, Tn);
         FN(residual)(Tn, L.Tt, en, running | fresh);
+        /* (as _errors: over the selected rows only) */
         vd cost_n = ZERO, ep2 = ZERO, er2 = ZERO;
-        for (int a = 0; a < 3; a++) {
-            cost_n += w[a] * en[a] * en[a];
-            ep2 += en[a] * en[a];
-        }
-        for (int a = 3; a < 6; a++) {
-            cost_n += w[a] * en[a] * en[a];
-            er2 += en[a] * en[a];
-        }
+        for (int a = 0; a < 3; a++)
+            if (w[a] > 0.0) {
+                cost_n += w[a] * en[a] * en[a];
+                ep2 += en[a] * en[a];
+            }
+        for (int a = 3; a < 6; a++)
+            if (w[a] > 0.0) {
+                cost_n += w[a] * en[a] * en[a];
+                er2 += en[a] * en[a];
+            }
         vl acc = fresh | (running & ok & (cost_n < L.cost));
         for (int j = 0; j < n; j++)
             L.q[j] = FN(vsel)(acc, qn[j], L.q[j]);

@@ -32,7 +32,7 @@ and that of the selected rotation rows at most ``tol_rotation`` [rad] (default
 ``tol``), both 1e-9 by default.
 
 The inner loop is compiled (numba, ``cache=True``): see ``_numeric_kernels``. A
-batch of 8 or more full-pose targets on a chain of 6 to 12 independent joints runs
+batch of 8 or more targets on a chain of at most 12 independent joints runs
 instead in ``_lm_lanes`` (C, optional), which advances 4 targets per AVX2 vector
 with the same steps: results equal the numba kernel's to rounding (~1e-12), with
 the same iterations and restarts.
@@ -128,13 +128,11 @@ _LANES = (_LanesKernel(False), _LanesKernel(True))
 
 
 def _batch_kernel(data: _ChainData, opts: np.ndarray, count: int, parallel: bool) -> Any:
-    """The kernel for `count` targets: numba (serial or over all threads), or the C
-    lanes for a batch of a full-pose task on a chain of 6 to ``_lm_lanes.NMAX``
-    independent joints (fewer joints than task rows need the joint-space solve,
-    which only the numba kernel has)."""
+    """The kernel for `count` targets: the C lanes for a batch on a chain of at most
+    ``_lm_lanes.NMAX`` independent joints, else numba (serial or over all threads)."""
     K = _kernels()
     if (_lm_lanes is not None and count >= _LANES_MIN and data.ident
-            and 6 <= data.n <= _lm_lanes.NMAX and np.all(opts[K.O_W:K.O_W + 6] > 0.0)):
+            and data.n <= _lm_lanes.NMAX):
         return _LANES[parallel]
     return K.solve_parallel if parallel else K.solve_serial
 
