@@ -47,6 +47,8 @@ CASES = [(name, None, None) for name in ARMS] + [
     ("scara", "x y z rz", None),  # as many task rows as joints
     ("scara", None, None),  # more task rows than joints: the joint-space solve
     ("panda", None, (1.0, 0.25)),  # weights
+    ("qfmd010", "xyz", None),  # a dependent joint: q_chain = M q (5 from 4)
+    ("qfmd010", "x y z rz", None),
 ]
 
 
@@ -111,14 +113,11 @@ def test_unreachable_targets_in_a_lane_batch_fail_with_their_error():
 
 
 @needs_lanes
-def test_what_the_lanes_do_not_cover_goes_to_numba():
+def test_single_targets_and_long_chains_go_to_numba():
     full = numeric._opts(None, None, 1e-9, None, 100, 1.0)
     ur5 = numeric._chain_data(robokin.load("ur5"))
     assert isinstance(numeric._batch_kernel(ur5, full, 100, False), numeric._LanesKernel)
     assert numeric._batch_kernel(ur5, full, 1, False) is K.solve_serial  # one target
-    qfmd = numeric._chain_data(robokin.load("qfmd010"))  # a dependent joint
-    assert not qfmd.ident
-    assert numeric._batch_kernel(qfmd, full, 100, True) is K.solve_parallel
     rows = [{"joint": "revolute", "d": 0.1, "a": 0.05, "alpha": np.pi / 2}] * 13
     long = numeric._chain_data(robokin.Robot.from_dh(rows))
     assert numeric._batch_kernel(long, full, 100, True) is K.solve_parallel
@@ -158,3 +157,28 @@ def test_the_baseline_copy_solves_like_the_avx2_copy():
     same = (base.iterations == fast.iterations) & (base.restarts == fast.restarts)
     assert same.mean() >= 0.98
     np.testing.assert_allclose(base.q[same], fast.q[same], rtol=0, atol=1e-9)
+
+
+@needs_lanes
+def test_inconsistent_arrays_are_refused_not_read_out_of_bounds():
+    robot = robokin.load("ur5")
+    d = numeric._chain_data(robot)
+    q = random_q(robot, np.random.default_rng(14), 8)
+    T, q0 = robot.fk(q), q + 1e-3  # one descent from nearby each
+    opts = numeric._opts(None, None, 1e-9, None, 100, 1.0)
+    opts[K.O_IDENT] = 1.0
+    opts[K.O_USE_Q0] = 1.0
+    tab, cstart, gdat = numeric._NO_TABLE
+    args = [T, q0, np.zeros((8, 1, 6)), d.consts, d.jdat, d.Mc, d.cdat, opts,
+            np.empty((8, 6 + K.N_RES)), tab, cstart, gdat, 1]
+    assert LANES.solve(*args) == (0, -1)  # consistent: all eight solved
+    for k, bad in [(8, np.empty((7, 6 + K.N_RES))), (1, q0[:, :5].copy()),
+                   (5, d.Mc[:, :3].copy()), (7, opts[:10].copy())]:
+        wrong = list(args)
+        wrong[k] = bad
+        with pytest.raises(ValueError, match="shapes"):
+            LANES.solve(*wrong)
+    wrong = list(args)
+    wrong[1] = q0.astype(np.float32)
+    with pytest.raises(ValueError, match="q0"):
+        LANES.solve(*wrong)

@@ -10,18 +10,18 @@
  * run time when the CPU has them).
  *
  * It solves what _numeric_kernels.solve_serial / solve_parallel solve (any task
- * mask and weights) for chains of 1 to NMAX joints without dependent joints (an
- * identity coupling). The per-lane logic (seeds, the seed table, limits,
+ * mask and weights, dependent joints through q_chain = M q + c) for chains of 1 to
+ * NMAX joints. The per-lane logic (seeds, the seed table, limits,
  * acceptance, stall and iteration tests, the best result) is the same as
  * _attempt / _solve_target. The arithmetic order differs (fused multiply-adds;
  * the task-space solve also when frozen joints leave fewer free joints than task
  * rows, the same step in exact arithmetic), so results agree to rounding, not to
  * the bit. numeric.py calls it for batches and falls back to numba when it was not
- * built or the chain has dependent joints.
+ * built or the chain is longer.
  *
- * solve(targets (N,4,4), q0 (N,n), seeds (N,R,n), consts (n+1,4,4), jdat (9,n),
- *       cdat (5,n), opts (N_OPTS,), out (N,n+N_RES), tab (M,12+n), cstart (G^3+1,)
- *       int64, gdat (7,), n_threads) -> (fails, first_bad)
+ * solve(targets (N,4,4), q0 (N,n), seeds (N,R,n), consts (nc+1,4,4), jdat (9,nc),
+ *       Mc (nc,n+1), cdat (5,n), opts (N_OPTS,), out (N,n+N_RES), tab (M,12+n),
+ *       cstart (G^3+1,) int64, gdat (7,), n_threads) -> (fails, first_bad)
  * Targets are shared out through an atomic counter among n_threads threads; the
  * GIL is released meanwhile.
  */
@@ -72,9 +72,12 @@ static const vl SIGN_BIT = REP((long long)0x8000000000000000ULL);
 #include "../_sincos_consts.h"
 
 typedef struct {
-    int n;
-    const double *consts; /* (n + 1) x 16 */
-    const double *jdat;   /* 9 x n */
+    int n;                /* independent coordinates */
+    int nc;               /* chain joints */
+    int ident;            /* 1: q_chain = q */
+    const double *consts; /* (nc + 1) x 16 */
+    const double *jdat;   /* 9 x nc */
+    const double *Mc;     /* nc x (n + 1): q_chain = M q + c as [M | c] */
 } Chain;
 
 typedef struct {
@@ -347,37 +350,41 @@ static PyArrayObject *arg_array(PyObject *o, const char *name, int typenum, int 
 
 static PyObject *py_solve(PyObject *self, PyObject *args)
 {
-    PyObject *o[11];
+    PyObject *o[12];
     int n_threads;
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOi", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
-                          &o[6], &o[7], &o[8], &o[9], &o[10], &n_threads))
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOi", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
+                          &o[6], &o[7], &o[8], &o[9], &o[10], &o[11], &n_threads))
         return NULL;
-    static const char *names[11] = {"targets", "q0", "seeds", "consts", "jdat", "cdat",
-                                    "opts", "out", "tab", "cstart", "gdat"};
-    static const int ndims[11] = {3, 2, 3, 3, 2, 2, 1, 2, 2, 1, 1};
-    PyArrayObject *a[11];
-    for (int i = 0; i < 11; i++) {
-        a[i] = arg_array(o[i], names[i], i == 9 ? NPY_INT64 : NPY_DOUBLE, ndims[i]);
+    static const char *names[12] = {"targets", "q0", "seeds", "consts", "jdat", "Mc",
+                                    "cdat", "opts", "out", "tab", "cstart", "gdat"};
+    static const int ndims[12] = {3, 2, 3, 3, 2, 2, 2, 1, 2, 2, 1, 1};
+    PyArrayObject *a[12];
+    for (int i = 0; i < 12; i++) {
+        a[i] = arg_array(o[i], names[i], i == 10 ? NPY_INT64 : NPY_DOUBLE, ndims[i]);
         if (a[i] == NULL)
             return NULL;
     }
-    npy_intp *ts = PyArray_DIMS(a[0]), *qs = PyArray_DIMS(a[1]), *ss = PyArray_DIMS(a[2]);
-    npy_intp N = ts[0];
-    int n = (int)qs[1];
-    npy_intp M = PyArray_DIMS(a[8])[0];
-    int ok = ts[1] == 4 && ts[2] == 4 && qs[0] == N && ss[0] == N && ss[2] == n &&
-             ss[1] >= 1 && n >= 1 && n <= NMAX && PyArray_DIMS(a[3])[0] == n + 1 &&
-             PyArray_DIMS(a[4])[0] == 9 && PyArray_DIMS(a[4])[1] == n &&
-             PyArray_DIMS(a[5])[0] == 5 && PyArray_DIMS(a[5])[1] == n &&
-             PyArray_DIMS(a[6])[0] == N_OPTS && PyArray_DIMS(a[7])[0] == N &&
-             PyArray_DIMS(a[7])[1] == n + N_RES && (M == 0 || PyArray_DIMS(a[8])[1] == 12 + n) &&
-             PyArray_DIMS(a[10])[0] == 7 && PyArray_ISWRITEABLE(a[7]);
+    enum { A_T, A_Q0, A_SEEDS, A_CONSTS, A_JDAT, A_MC, A_CDAT, A_OPTS, A_OUT, A_TAB,
+           A_CSTART, A_GDAT };
+#define DIM(k, d) PyArray_DIMS(a[k])[d]
+    npy_intp N = DIM(A_T, 0), M = DIM(A_TAB, 0);
+    int n = (int)DIM(A_Q0, 1), nc = (int)DIM(A_JDAT, 1);
+    const double *opts = (const double *)PyArray_DATA(a[A_OPTS]);
+    int ident = DIM(A_OPTS, 0) == N_OPTS && opts[O_IDENT] == 1.0;
+    int ok = DIM(A_T, 1) == 4 && DIM(A_T, 2) == 4 && DIM(A_Q0, 0) == N &&
+             DIM(A_SEEDS, 0) == N && DIM(A_SEEDS, 1) >= 1 && DIM(A_SEEDS, 2) == n &&
+             n >= 1 && n <= NMAX && nc >= 1 && nc <= NMAX && (!ident || nc == n) &&
+             DIM(A_CONSTS, 0) == nc + 1 && DIM(A_CONSTS, 1) == 4 && DIM(A_CONSTS, 2) == 4 &&
+             DIM(A_JDAT, 0) == 9 && DIM(A_MC, 0) == nc && DIM(A_MC, 1) == n + 1 &&
+             DIM(A_CDAT, 0) == 5 && DIM(A_CDAT, 1) == n && DIM(A_OPTS, 0) == N_OPTS &&
+             DIM(A_OUT, 0) == N && DIM(A_OUT, 1) == n + N_RES &&
+             (M == 0 || DIM(A_TAB, 1) == 12 + n) && DIM(A_GDAT, 0) == 7 &&
+             PyArray_ISWRITEABLE(a[A_OUT]);
     if (!ok) {
         PyErr_SetString(PyExc_ValueError, "_lm_lanes.solve: inconsistent array shapes");
         return NULL;
     }
-    const double *opts = (const double *)PyArray_DATA(a[6]);
     int m = 0;
     for (int i = 0; i < 6; i++)
         m += opts[O_W + i] > 0.0;
@@ -385,37 +392,37 @@ static PyObject *py_solve(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, "_lm_lanes.solve: no task row selected");
         return NULL;
     }
-    if (opts[O_IDENT] != 1.0) {
-        PyErr_SetString(PyExc_ValueError, "_lm_lanes.solve: identity coupling only");
-        return NULL;
-    }
     Ctx cx;
     memset(&cx, 0, sizeof(cx));
     cx.ch.n = n;
-    cx.ch.consts = (const double *)PyArray_DATA(a[3]);
-    cx.ch.jdat = (const double *)PyArray_DATA(a[4]);
-    cx.targets = (const double *)PyArray_DATA(a[0]);
-    cx.q0 = (const double *)PyArray_DATA(a[1]);
-    cx.seeds = (const double *)PyArray_DATA(a[2]);
-    cx.cdat = (const double *)PyArray_DATA(a[5]);
+    cx.ch.nc = nc;
+    cx.ch.ident = ident;
+    cx.ch.consts = (const double *)PyArray_DATA(a[A_CONSTS]);
+    cx.ch.jdat = (const double *)PyArray_DATA(a[A_JDAT]);
+    cx.ch.Mc = (const double *)PyArray_DATA(a[A_MC]);
+    cx.targets = (const double *)PyArray_DATA(a[A_T]);
+    cx.q0 = (const double *)PyArray_DATA(a[A_Q0]);
+    cx.seeds = (const double *)PyArray_DATA(a[A_SEEDS]);
+    cx.cdat = (const double *)PyArray_DATA(a[A_CDAT]);
     cx.opts = opts;
-    cx.out = (double *)PyArray_DATA(a[7]);
-    cx.tab = (const double *)PyArray_DATA(a[8]);
-    cx.cstart = (const long long *)PyArray_DATA(a[9]);
-    cx.gdat = (const double *)PyArray_DATA(a[10]);
+    cx.out = (double *)PyArray_DATA(a[A_OUT]);
+    cx.tab = (const double *)PyArray_DATA(a[A_TAB]);
+    cx.cstart = (const long long *)PyArray_DATA(a[A_CSTART]);
+    cx.gdat = (const double *)PyArray_DATA(a[A_GDAT]);
     cx.N = (long)N;
-    cx.R = (long)ss[1];
+    cx.R = (long)DIM(A_SEEDS, 1);
     cx.tab_cols = 12 + n;
     cx.n_seeds = (int)(opts[O_N_SEEDS] < (double)cx.R ? opts[O_N_SEEDS] : (double)cx.R);
     int nt = (int)opts[O_N_TABLE];
     cx.n_tab = M > 0 ? (nt < TAB_K_MAX ? nt : TAB_K_MAX) : 0;
     if (cx.n_tab > 0) {
         long G = (long)cx.gdat[6];
-        if (G < 1 || PyArray_DIMS(a[9])[0] != G * G * G + 1) {
+        if (G < 1 || DIM(A_CSTART, 0) != G * G * G + 1) {
             PyErr_SetString(PyExc_ValueError, "_lm_lanes.solve: cstart does not match gdat");
             return NULL;
         }
     }
+#undef DIM
     cx.max_iter = (int)opts[O_MAX_ITER];
     cx.check_every = (int)opts[O_STALL_EVERY];
     for (int j = 0; j < n; j++)
@@ -465,8 +472,8 @@ static PyMethodDef methods[] = {
     {"select_isa", py_select_isa, METH_VARARGS,
      "select_isa(name) -> name: run the 'baseline' or the 'avx2+fma' copy."},
     {"solve", py_solve, METH_VARARGS,
-     "solve(targets, q0, seeds, consts, jdat, cdat, opts, out, tab, cstart, gdat, "
-     "n_threads) -> (fails, first_bad): batch IK, W targets per vector."},
+     "solve(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out, tab, cstart, "
+     "gdat, n_threads) -> (fails, first_bad): batch IK, W targets per vector."},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_lm_lanes",

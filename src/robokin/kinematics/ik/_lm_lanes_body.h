@@ -58,13 +58,28 @@ static inline __attribute__((always_inline)) void FN(vsincos)(vd x, vd *s, vd *c
     }
 }
 
-/* Pose (T: 12 vectors, rows of the top 3x4) and Jacobian (J[6][n]) at q, for an
- * identity coupling (q is the chain's joint vector). Mirrors _pose_jac. */
+/* Pose (T: 12 vectors, rows of the top 3x4) and Jacobian (J[6][n]) with respect
+ * to the independent coordinates q (n); through the coupling q_chain = M q + c
+ * unless it is the identity. Mirrors _pose_jac. */
 static inline __attribute__((always_inline)) void FN(pose_jac)(const Chain *ch, const vd *q,
                                                              vd *J, vd *T)
 {
-    const int n = ch->n;
+    const int n = ch->nc; /* from here on: chain joints */
     const double *jd = ch->jdat;
+    vd qcb[NMAX], Jcb[6 * NMAX];
+    vd *Jc = J;
+    if (!ch->ident) {
+        const int ni = ch->n;
+        const double *Mc = ch->Mc;
+        for (int k = 0; k < n; k++) {
+            vd s = BR(Mc[k * (ni + 1) + ni]);
+            for (int j = 0; j < ni; j++)
+                s += Mc[k * (ni + 1) + j] * q[j];
+            qcb[k] = s;
+        }
+        q = qcb;
+        Jc = Jcb;
+    }
     vd sn[NMAX], cs[NMAX], o[3][NMAX], zz[3][NMAX];
     for (int k = 0; k < n; k++)
         if (jd[k] == 0.0)
@@ -141,20 +156,32 @@ static inline __attribute__((always_inline)) void FN(pose_jac)(const Chain *ch, 
         vd zx = zz[0][k], zy = zz[1][k], zq = zz[2][k];
         if (jd[k] == 0.0) {
             vd dx = t03 - o[0][k], dy = t13 - o[1][k], dz = t23 - o[2][k];
-            J[0 * NMAX + k] = s * (zy * dz - zq * dy);
-            J[1 * NMAX + k] = s * (zq * dx - zx * dz);
-            J[2 * NMAX + k] = s * (zx * dy - zy * dx);
-            J[3 * NMAX + k] = s * zx;
-            J[4 * NMAX + k] = s * zy;
-            J[5 * NMAX + k] = s * zq;
+            Jc[0 * NMAX + k] = s * (zy * dz - zq * dy);
+            Jc[1 * NMAX + k] = s * (zq * dx - zx * dz);
+            Jc[2 * NMAX + k] = s * (zx * dy - zy * dx);
+            Jc[3 * NMAX + k] = s * zx;
+            Jc[4 * NMAX + k] = s * zy;
+            Jc[5 * NMAX + k] = s * zq;
         } else {
-            J[0 * NMAX + k] = s * zx;
-            J[1 * NMAX + k] = s * zy;
-            J[2 * NMAX + k] = s * zq;
-            J[3 * NMAX + k] = ZERO;
-            J[4 * NMAX + k] = ZERO;
-            J[5 * NMAX + k] = ZERO;
+            Jc[0 * NMAX + k] = s * zx;
+            Jc[1 * NMAX + k] = s * zy;
+            Jc[2 * NMAX + k] = s * zq;
+            Jc[3 * NMAX + k] = ZERO;
+            Jc[4 * NMAX + k] = ZERO;
+            Jc[5 * NMAX + k] = ZERO;
         }
+    }
+    if (!ch->ident) {
+        /* J = Jc M */
+        const int ni = ch->n;
+        const double *Mc = ch->Mc;
+        for (int r = 0; r < 6; r++)
+            for (int j = 0; j < ni; j++) {
+                vd s = ZERO;
+                for (int k = 0; k < n; k++)
+                    s += Jc[r * NMAX + k] * Mc[k * (ni + 1) + j];
+                J[r * NMAX + j] = s;
+            }
     }
 }
 

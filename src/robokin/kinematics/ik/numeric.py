@@ -32,7 +32,7 @@ and that of the selected rotation rows at most ``tol_rotation`` [rad] (default
 ``tol``), both 1e-9 by default.
 
 The inner loop is compiled (numba, ``cache=True``): see ``_numeric_kernels``. A
-batch of 8 or more targets on a chain of at most 12 independent joints runs
+batch of 8 or more targets on a chain of at most 12 joints runs
 instead in ``_lm_lanes`` (C, optional), which advances 4 targets per AVX2 vector
 with the same steps: results equal the numba kernel's to rounding (~1e-12), with
 the same iterations and restarts.
@@ -120,8 +120,8 @@ class _LanesKernel:
             import numba
 
             threads = numba.get_num_threads()
-        return _lm_lanes.solve(targets, q0, seeds, consts, jdat, cdat, opts, out, tab,
-                               cstart, gdat, threads)
+        return _lm_lanes.solve(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out,
+                               tab, cstart, gdat, threads)
 
 
 _LANES = (_LanesKernel(False), _LanesKernel(True))
@@ -129,10 +129,10 @@ _LANES = (_LanesKernel(False), _LanesKernel(True))
 
 def _batch_kernel(data: _ChainData, opts: np.ndarray, count: int, parallel: bool) -> Any:
     """The kernel for `count` targets: the C lanes for a batch on a chain of at most
-    ``_lm_lanes.NMAX`` independent joints, else numba (serial or over all threads)."""
+    ``_lm_lanes.NMAX`` joints, else numba (serial or over all threads)."""
     K = _kernels()
-    if (_lm_lanes is not None and count >= _LANES_MIN and data.ident
-            and data.n <= _lm_lanes.NMAX):
+    if (_lm_lanes is not None and count >= _LANES_MIN
+            and max(data.n, data.jdat.shape[1]) <= _lm_lanes.NMAX):
         return _LANES[parallel]
     return K.solve_parallel if parallel else K.solve_serial
 
