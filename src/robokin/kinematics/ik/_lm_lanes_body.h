@@ -337,6 +337,8 @@ static inline void FN(lane_load)(Ctx *cx, Lanes *L, int l)
         L->total[l] = 0;
         L->restarts[l] = 0;
         L->code[l] = CODE_STALL;
+        for (int j = 0; j < n; j++)
+            L->best[l][j] = cx->mid[j]; /* reported only if no attempt runs */
         L->attempt[l] = L->start - 1;
         if (FN(lane_next_attempt)(cx, L, l))
             return;
