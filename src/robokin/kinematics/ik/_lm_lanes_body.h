@@ -426,6 +426,34 @@ static inline __attribute__((always_inline)) vl FN(ldl_solve)(vd (*A)[NMAX], vd 
     return ok;
 }
 
+/* The task-space step dq = Jw^T (Jw Jw^T + lam I)^-1 ye for m task rows, per lane.
+ * Frozen joints have zero columns, so this is also the step of the joint-space
+ * form the numba kernel takes when fewer joints than task rows are free. */
+static inline __attribute__((always_inline)) vl FN(task_space_step)(vd (*Jw)[NMAX],
+                                                                  const vd *ye, vd lam,
+                                                                  int n, int m, vd *dq)
+{
+    vd A[NMAX][NMAX], y[6];
+    for (int a = 0; a < m; a++) {
+        for (int b = 0; b <= a; b++) {
+            vd s = ZERO;
+            for (int j = 0; j < n; j++)
+                s += Jw[a][j] * Jw[b][j];
+            A[a][b] = s;
+        }
+        A[a][a] += lam;
+        y[a] = ye[a];
+    }
+    vl ok = FN(ldl_solve)(A, y, m);
+    for (int j = 0; j < n; j++) {
+        vd s = ZERO;
+        for (int a = 0; a < m; a++)
+            s += Jw[a][j] * y[a];
+        dq[j] = s;
+    }
+    return ok;
+}
+
 static void FN(worker)(Ctx *cx)
 {
     const int n = cx->ch.n;
@@ -496,74 +524,12 @@ static void FN(worker)(Ctx *cx)
         vd lam = L.mu * L.cost + 1e-14;
         vd dq[NMAX];
         vl ok;
-        if (m == 6 && n >= 6) {
-            /* full pose, task space, fixed size 6 (unrolled by the compiler):
-             * (Jw Jw^T + lam I) y = W^1/2 e ; dq = Jw^T y */
-            vd A[6][6], y[6], dinv[6];
-            for (int a = 0; a < 6; a++) {
-                for (int b = 0; b <= a; b++) {
-                    vd s = ZERO;
-                    for (int j = 0; j < n; j++)
-                        s += Jw[a][j] * Jw[b][j];
-                    A[a][b] = s;
-                }
-                A[a][a] += lam;
-                y[a] = ye[a];
-            }
-            ok = (vl)ONES_L;
-            for (int j = 0; j < 6; j++) {
-                vd s = A[j][j];
-                for (int k = 0; k < j; k++)
-                    s -= A[j][k] * A[j][k] * dinv[k];
-                ok &= (s > 0.0);
-                dinv[j] = 1.0 / FN(vsel)(s > 0.0, s, ONE);
-                for (int i = j + 1; i < 6; i++) {
-                    vd t = A[i][j];
-                    for (int k = 0; k < j; k++)
-                        t -= A[i][k] * A[j][k] * dinv[k];
-                    A[i][j] = t;
-                }
-            }
-            for (int i = 0; i < 6; i++) {
-                vd t = y[i];
-                for (int k = 0; k < i; k++)
-                    t -= A[i][k] * dinv[k] * y[k];
-                y[i] = t;
-            }
-            for (int i = 5; i >= 0; i--) {
-                vd di = dinv[i];
-                vd t = y[i] * di;
-                for (int k = i + 1; k < 6; k++)
-                    t -= A[k][i] * di * y[k];
-                y[i] = t;
-            }
-            for (int j = 0; j < n; j++) {
-                vd s = ZERO;
-                for (int a = 0; a < 6; a++)
-                    s += Jw[a][j] * y[a];
-                dq[j] = s;
-            }
-        } else if (m <= n) {
-            /* task space, m x m (frozen columns are zero: the same step as the
-             * joint-space form the numba kernel takes when fewer joints are free) */
-            vd A[NMAX][NMAX], y[6];
-            for (int a = 0; a < m; a++) {
-                for (int b = 0; b <= a; b++) {
-                    vd s = ZERO;
-                    for (int j = 0; j < n; j++)
-                        s += Jw[a][j] * Jw[b][j];
-                    A[a][b] = s;
-                }
-                A[a][a] += lam;
-                y[a] = ye[a];
-            }
-            ok = FN(ldl_solve)(A, y, m);
-            for (int j = 0; j < n; j++) {
-                vd s = ZERO;
-                for (int a = 0; a < m; a++)
-                    s += Jw[a][j] * y[a];
-                dq[j] = s;
-            }
+        if (m <= n) {
+            /* (a constant 6 lets the compiler unroll the full-pose case) */
+            if (m == 6)
+                ok = FN(task_space_step)(Jw, ye, lam, n, 6, dq);
+            else
+                ok = FN(task_space_step)(Jw, ye, lam, n, m, dq);
         } else {
             /* joint space (more task rows than joints): (Jw^T Jw + lam I) dq = Jw^T ye */
             vd A[NMAX][NMAX];
