@@ -190,6 +190,32 @@ def solvers(robot, tol):
     return out
 
 
+def one_thread_kernels(robot, targets, q0) -> dict:
+    """Per-target time of a one-thread batch in each kernel robokin has here: numba,
+    and the C lane kernel's AVX2 and baseline copies when built."""
+    lanes = numeric._lm_lanes
+    kernels = ["numba"] + ([] if lanes is None else ["avx2+fma", "baseline"])
+    times = {}
+    try:
+        for k in kernels:
+            numeric._lm_lanes = None if k == "numba" else lanes
+            if k != "numba":
+                lanes.select_isa(k)
+            numeric.solve(robot, targets, q0=q0, parallel=False)
+            best = np.inf
+            for _ in range(5):
+                t = time.perf_counter()
+                numeric.solve(robot, targets, q0=q0, parallel=False,
+                              rng=np.random.default_rng(1))
+                best = min(best, time.perf_counter() - t)
+            times[k] = best * 1e6 / len(targets)
+    finally:
+        numeric._lm_lanes = lanes
+        if lanes is not None:
+            lanes.select_isa(lanes.ISA)
+    return times
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=1000, help="targets per robot")
@@ -200,6 +226,7 @@ def main() -> None:
     rng = np.random.default_rng(2024)
     rows = []
     batch_rows = []
+    kernel_rows = []
     for name in args.robots.split(","):
         robot = robokin.load(name)
         lim = robot.limits
@@ -244,6 +271,7 @@ def main() -> None:
                                   max_time=0.01, max_restarts=BUDGET)
                 t_loop = min(t_loop, time.perf_counter() - t)
             batch_rows.append((name, mask or "pose", res.success.mean(), t_batch, t_loop))
+        kernel_rows.append((name, one_thread_kernels(robot, targets, fixed)))
 
     print(f"\n{args.n} random reachable targets per robot (ikpy: {args.ikpy_n}); "
           f"success = FK within {args.tol:g} m / {args.tol:g} rad and inside the limits")
@@ -263,6 +291,9 @@ def main() -> None:
               f"{tb * 1e6 / args.n:7.1f} "
               f"us/target  loop {tl * 1e6 / args.n:7.1f} us/target  speed-up "
               f"{tl / tb:4.1f}x")
+    print("\nrobokin batch on one thread, by kernel (us/target, best of 5):")
+    for name, times in kernel_rows:
+        print(f"  {name:16s} " + "  ".join(f"{k} {v:6.2f}" for k, v in times.items()))
 
 
 if __name__ == "__main__":
