@@ -1,40 +1,39 @@
-"""Build step for the C extensions; all metadata lives in pyproject.toml.
+"""Build step for robokin's compiled kernels; all metadata lives in pyproject.toml.
 
-Both are optional: without a C compiler the build skips them and robokin uses its
-numba kernels instead (see the comment at the top of each source).
-
-* ``robokin.kinematics._fk_single``: single-configuration FK from Python.
-* ``robokin.kinematics.ik._lm_lanes``: batch numeric IK, several targets per
-  vector register.
+One C source (``src/robokin/_native/csrc``) is compiled twice, as two extension
+modules: ``robokin._native._base`` for the compiler's baseline target and
+``robokin._native._avx2`` with AVX2 + FMA (x86-64, GCC or clang). At import
+``robokin._native`` picks the copy the CPU runs. Nothing is compiled at run time.
 """
 
+import platform
 import sys
-
 
 import numpy
 from setuptools import Extension, setup
 
-setup(
-    ext_modules=[
-        Extension(
-            "robokin.kinematics._fk_single",
-            ["src/robokin/kinematics/_fk_single.c"],
-            depends=["src/robokin/kinematics/_sincos_consts.h"],
-            include_dirs=[numpy.get_include()],
-            # no fused multiply-add: the same roundings as the numba kernels
-            extra_compile_args=["-O3", "-ffp-contract=off"],
-            optional=True,
-        ),
-        Extension(
-            "robokin.kinematics.ik._lm_lanes",
-            ["src/robokin/kinematics/ik/_lm_lanes.c"],
-            depends=["src/robokin/kinematics/ik/_lm_lanes_body.h",
-                     "src/robokin/kinematics/_sincos_consts.h"],
-            include_dirs=[numpy.get_include()],
-            extra_compile_args=[] if sys.platform == "win32" else
-            ["-O3", "-fno-math-errno", "-Wno-psabi"],
-            libraries=[] if sys.platform == "win32" else ["pthread"],
-            optional=True,
-        ),
-    ]
-)
+CSRC = "src/robokin/_native/csrc"
+HEADERS = [f"{CSRC}/{h}" for h in ("lanes.h", "chain.h", "pool.h", "pool.c", "fk.c",
+                                     "lm.c", "module.c")]
+UNIX = sys.platform != "win32"
+# -fno-math-errno: sqrt inlines (and vectorises); no other fast-math licence
+FLAGS = ["-O3", "-fno-math-errno", "-Wno-psabi"] if UNIX else ["/O2"]
+LIBS = ["pthread"] if UNIX else []
+
+
+def extension(name: str, source: str, extra: list[str]) -> Extension:
+    return Extension(
+        f"robokin._native.{name}",
+        [f"{CSRC}/{source}"],
+        depends=HEADERS,
+        include_dirs=[numpy.get_include(), CSRC],
+        extra_compile_args=FLAGS + extra,
+        libraries=LIBS,
+    )
+
+
+modules = [extension("_base", "build_base.c", [])]
+if UNIX and platform.machine().lower() in ("x86_64", "amd64"):
+    modules.append(extension("_avx2", "build_avx2.c", ["-mavx2", "-mfma"]))
+
+setup(ext_modules=modules)

@@ -86,10 +86,10 @@ def check_poses_fast(T: npt.ArrayLike, name: str = "T") -> np.ndarray:
             raise InputError(name, f"expected a 4x4 matrix, got {T!r:.80}") from exc
     if T.ndim < 2 or T.shape[-2:] != (4, 4):
         raise InputError(name, f"expected shape (..., 4, 4), got {T.shape}")
-    from robokin.kinematics.forward import _kernels
+    from robokin._native import kernels
 
     flat = np.ascontiguousarray(T).reshape(-1, 4, 4)
-    code, index = _kernels().check_poses(flat, 1e-6)
+    code, index = kernels.check_poses(flat, 1e-6)
     if code:
         where = np.unravel_index(index, T.shape[:-2]) if T.ndim > 2 else ()
         at = f" (pose {tuple(int(i) for i in where)})" if where else ""

@@ -25,9 +25,7 @@ if TYPE_CHECKING:
 __all__ = ["Robot"]
 
 Space = Literal["joint", "actuator"]
-_F64 = np.dtype(np.float64)
-_SINGLE_FK: list = []  # the compiled single-configuration FK, loaded on first use
-_FK_C = forward.fk_single_c  # its C version, None when it was not built
+_FK_SINGLE = forward.fk_single  # one configuration, or None for the general path
 
 
 class Robot:
@@ -229,20 +227,11 @@ class Robot:
             Poses (..., 4, 4).
         """
         chain = self.chain
-        if _FK_C is not None and space == "joint" and chain._single_shape is not None:
-            # One configuration (C): None unless q is a finite float64 (n,) array.
-            T = _FK_C(q, chain._packed)
+        if space == "joint":
+            # One configuration: None unless q is a finite float64 (n,) array.
+            T = _FK_SINGLE(q, chain.arrays.packed)
             if T is not None:
                 return T
-        elif (space == "joint" and type(q) is np.ndarray and q.shape == chain._single_shape
-                and q.dtype is _F64):
-            # One configuration: the kernel's finiteness test is the validation.
-            if not _SINGLE_FK:
-                _SINGLE_FK.append(forward.single_kernel())
-            T = np.empty((4, 4))
-            if _SINGLE_FK[0](q, chain._packed, T):
-                return T
-        if space == "joint":
             return forward.forward_kinematics(chain, q)
         return forward.forward_kinematics(chain, self._to_joints(q, space, "phi"))
 

@@ -190,34 +190,6 @@ def axis_angle_from_matrix(T: npt.ArrayLike) -> np.ndarray:
     return _as("as_rotvec", T)
 
 
-def _log_rotation(R: np.ndarray) -> np.ndarray:
-    """Rotation vectors of rotation matrices (..., 3, 3) -> (..., 3), numpy only.
-
-    Uses ``theta / (2 sin theta) * vee(R - R^T)``; a series near 0 and scipy for the
-    few rotations within 1e-3 rad of pi, where that formula loses precision.
-    """
-    tr = R[..., 0, 0] + R[..., 1, 1] + R[..., 2, 2]
-    theta = np.arccos(np.clip((tr - 1.0) * 0.5, -1.0, 1.0))
-    w = np.stack(
-        [
-            R[..., 2, 1] - R[..., 1, 2],
-            R[..., 0, 2] - R[..., 2, 0],
-            R[..., 1, 0] - R[..., 0, 1],
-        ],
-        axis=-1,
-    )
-    small = theta < 1e-4
-    sin = np.sin(theta)
-    factor = np.where(
-        small, 0.5 + theta**2 / 12.0, theta / (2.0 * np.where(small, 1.0, sin))
-    )
-    out = w * factor[..., None]
-    near_pi = theta > np.pi - 1e-3
-    if near_pi.any():
-        out[near_pi] = _rotation().from_matrix(R[near_pi]).as_rotvec()
-    return out
-
-
 def pose_error(current: npt.ArrayLike, target: npt.ArrayLike) -> np.ndarray:
     """The 6-vector that takes ``current`` to ``target``, both expressed in the base frame.
 
@@ -227,12 +199,17 @@ def pose_error(current: npt.ArrayLike, target: npt.ArrayLike) -> np.ndarray:
 
     Returns:
         ``(..., 6)``: position difference ``p_target - p_current`` [m], then the
-        rotation vector of ``R_target @ R_current.T`` [rad] (base frame).
+        rotation vector of ``R_target @ R_current.T`` [rad] (base frame): the
+        residual the numeric IK descends on (one compiled formula, ``chain.h``
+        ``pose_residual``).
     """
+    from robokin._native import kernels
+
     current = np.asarray(current, dtype=np.float64)
     target = np.asarray(target, dtype=np.float64)
-    dp = target[..., :3, 3] - current[..., :3, 3]
-    dR = target[..., :3, :3] @ np.swapaxes(current[..., :3, :3], -1, -2)
-    lead = dR.shape[:-2]
-    w = _log_rotation(dR)
-    return np.concatenate([np.broadcast_to(dp, lead + (3,)), w], axis=-1)
+    lead = np.broadcast_shapes(current.shape[:-2], target.shape[:-2])
+    a = np.ascontiguousarray(np.broadcast_to(current, lead + (4, 4))).reshape(-1, 4, 4)
+    b = np.ascontiguousarray(np.broadcast_to(target, lead + (4, 4))).reshape(-1, 4, 4)
+    out = np.empty((a.shape[0], 6))
+    kernels.pose_error(a, b, out)
+    return out.reshape(lead + (6,))

@@ -5,7 +5,8 @@ import pytest
 
 import robokin
 from reference import random_q
-from robokin.kinematics.forward import _PARALLEL_MIN, link_frames
+from robokin._native import kernels
+from robokin.kinematics.forward import link_frames
 
 
 @pytest.mark.parametrize("shape", [(), (7,), (3, 5)])
@@ -30,7 +31,7 @@ def test_batch_shapes_and_batch_equals_loop(name, shape, rng):
 
 def test_parallel_kernel_equals_serial(rng):
     robot = robokin.load("panda")
-    q = random_q(robot, rng, _PARALLEL_MIN + 3)
+    q = random_q(robot, rng, kernels.FK_PARALLEL_MIN + 3)
     big = robot.fk(q)
     small = np.concatenate([robot.fk(q[i : i + 100]) for i in range(0, len(q), 100)])
     np.testing.assert_array_equal(big, small)
@@ -81,8 +82,6 @@ def test_fk_does_not_modify_its_input(rng):
 
 
 def test_compiled_sincos_is_within_one_ulp_of_libm(rng):
-    from robokin.kinematics import _kernels
-
     x = np.concatenate(
         [
             rng.uniform(-7, 7, 200_000),
@@ -91,7 +90,7 @@ def test_compiled_sincos_is_within_one_ulp_of_libm(rng):
         ]
     )
     s, c = np.empty_like(x), np.empty_like(x)
-    _kernels.sincos_array(x, s, c)
+    kernels.sincos(x, s, c)
     ok = np.isfinite(x)
     np.testing.assert_allclose(s[ok], np.sin(x[ok]), rtol=0, atol=2.3e-16)
     np.testing.assert_allclose(c[ok], np.cos(x[ok]), rtol=0, atol=2.3e-16)

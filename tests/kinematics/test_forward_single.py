@@ -1,11 +1,9 @@
-"""One configuration through the C accelerator (``_fk_single``) and its numba fallback.
+"""One configuration through the compiled single-configuration entry point (``fk1``).
 
-The C function mirrors the numba kernel operation for operation, so both must give
-the same bits; anything it does not take (lists, other dtypes, NaN) must reach the
-general path and its clear errors.
+It runs the batch kernel's code in one lane, so a single configuration and the same
+configuration inside a batch must give the same bits; anything it does not take
+(lists, other dtypes, NaN) must reach the general path and its clear errors.
 """
-
-import shutil
 
 import numpy as np
 import pytest
@@ -15,33 +13,23 @@ from reference import random_q
 from robokin.exceptions import InputError
 from robokin.kinematics import forward
 
-SINGLE = [n for n in robokin.robots.names() if robokin.load(n).chain._single_shape]
+ALL = robokin.robots.names()
 
 
-@pytest.mark.skipif(shutil.which("cc") is None, reason="no C compiler on this machine")
-def test_the_c_accelerator_was_built():
-    assert forward.fk_single_c is not None, "setup.py did not build _fk_single"
-
-
-needs_c = pytest.mark.skipif(forward.fk_single_c is None, reason="_fk_single not built")
-
-
-@needs_c
-@pytest.mark.parametrize("name", SINGLE)
-def test_c_single_equals_the_batch_kernel_bit_for_bit(name, rng):
+@pytest.mark.parametrize("name", ALL)
+def test_single_equals_the_batch_kernel_bit_for_bit(name, rng):
     robot = robokin.load(name)
     chain = robot.chain
     Q = random_q(robot, rng, 500)
     Q[:50] *= 40.0  # large angles: several turns of the reduction
     Q[50:55] = 3e5  # beyond the polynomial's range: libm
-    batch = forward.forward_kinematics(chain, Q)  # 2-D input: never the C path
-    single = np.array([forward.fk_single_c(q, chain._packed) for q in Q])
+    batch = forward.forward_kinematics(chain, Q)  # 2-D input: the batch kernel
+    single = np.array([forward.fk_single(q, chain.arrays.packed) for q in Q])
     np.testing.assert_array_equal(single, batch)
     np.testing.assert_array_equal(np.array([robot.fk(q) for q in Q]), batch)
 
 
-@needs_c
-def test_c_single_reads_strided_input_and_returns_a_fresh_array(rng):
+def test_single_reads_strided_input_and_returns_a_fresh_array(rng):
     robot = robokin.load("panda")
     wide = random_q(robot, rng, 2).T.copy()  # (7, 2): a column is strided
     q = wide[:, 1]
@@ -53,7 +41,6 @@ def test_c_single_reads_strided_input_and_returns_a_fresh_array(rng):
     np.testing.assert_array_equal(T1[3], [0.0, 0.0, 0.0, 1.0])
 
 
-@needs_c
 @pytest.mark.parametrize(
     "q",
     [
@@ -67,18 +54,29 @@ def test_c_single_reads_strided_input_and_returns_a_fresh_array(rng):
         np.zeros(6).astype(">f8"),  # byte-swapped
     ],
 )
-def test_c_single_declines_what_it_does_not_take(q):
+def test_single_declines_what_it_does_not_take(q):
     chain = robokin.load("ur5").chain
-    assert forward.fk_single_c(q, chain._packed) is None
+    assert forward.fk_single(q, chain.arrays.packed) is None
 
 
-@needs_c
-def test_c_single_declines_a_packed_array_of_the_wrong_size():
-    chain = robokin.load("ur5").chain
-    assert forward.fk_single_c(np.zeros(6), chain._packed[:-1].copy()) is None
-    assert forward.fk_single_c(np.zeros(6), chain._packed[::2]) is None
+def test_single_declines_a_packed_array_that_is_not_a_layout():
+    packed = robokin.load("ur5").chain.arrays.packed
+    assert forward.fk_single(np.zeros(6), packed[:-1].copy()) is None
+    assert forward.fk_single(np.zeros(6), packed[::2]) is None
+    wrong_tag = packed.copy()
+    wrong_tag[0] += 1.0
+    assert forward.fk_single(np.zeros(6), wrong_tag) is None
     with pytest.raises(TypeError, match="2 arguments"):
-        forward.fk_single_c(np.zeros(6))
+        forward.fk_single(np.zeros(6))
+
+
+def test_dependent_joints_take_the_single_path_too(rng):
+    robot = robokin.load("qfmd010")  # q_chain = M q + c: 5 chain joints from 4
+    assert not robot.chain.arrays.identity
+    q = random_q(robot, rng)
+    T = forward.fk_single(q, robot.chain.arrays.packed)
+    assert T is not None
+    np.testing.assert_array_equal(T, robot.fk(q[None])[0])
 
 
 @pytest.mark.parametrize(
@@ -100,21 +98,3 @@ def test_non_finite_single_configuration_names_the_argument(bad):
         robot.fk(q)
     with pytest.raises(InputError, match=r"'q'.*non-finite.*\(2,\)"):
         forward.forward_kinematics(robot.chain, q)
-
-
-def test_without_the_c_accelerator_the_numba_kernel_gives_the_same_bits(rng, monkeypatch):
-    import robokin.robot as robot_module
-
-    robot = robokin.load("aubo_i5")
-    Q = random_q(robot, rng, 50)
-    with_c = np.array([robot.fk(q) for q in Q])
-    monkeypatch.setattr(robot_module, "_FK_C", None)
-    monkeypatch.setattr(forward, "fk_single_c", None)
-    np.testing.assert_array_equal(np.array([robot.fk(q) for q in Q]), with_c)
-    np.testing.assert_array_equal(
-        np.array([forward.forward_kinematics(robot.chain, q) for q in Q]), with_c
-    )
-    q = Q[0].copy()
-    q[4] = np.nan
-    with pytest.raises(InputError, match="non-finite"):
-        robot.fk(q)

@@ -301,8 +301,8 @@ class _Problem:
         nc, S = self.nc, len(self.shapes)
         ext = np.zeros(nc)
         if self.prismatic.any():
-            sign = self.chain._sign
-            off = self.chain._offset
+            sign = self.chain.arrays.sign
+            off = self.chain.arrays.offset
             vals = np.abs(qc * sign + off).max(axis=0)
             ext[self.prismatic] = vals[self.prismatic]
         Rst = np.zeros((nc, S))

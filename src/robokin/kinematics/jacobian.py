@@ -12,9 +12,9 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
-from robokin._validation import check_joints
 from robokin.exceptions import InputError
-from robokin.kinematics.forward import _chain_values, _kernels, _raise_nonfinite
+from robokin._native import kernels as _k
+from robokin.kinematics.forward import chain_batch, raise_nonfinite
 from robokin.model.chain import Chain
 
 __all__ = [
@@ -30,17 +30,12 @@ def jacobian_and_pose(
     chain: Chain, q: npt.ArrayLike, *, name: str = "q"
 ) -> tuple[np.ndarray, np.ndarray]:
     """Base-frame Jacobian (..., 6, n) and tool pose (..., 4, 4) in one pass."""
-    q = check_joints(q, chain.n, name)
-    qc = _chain_values(chain, q)
-    N, nc = qc.shape
-    J = np.empty((N, 6, nc))
+    q, flat = chain_batch(chain, q, name)
+    N = flat.shape[0]
+    J = np.empty((N, 6, chain.n))
     T = np.empty((N, 4, 4))
-    k = _kernels()
-    fn = k.jacobian_batch if N >= 256 else k.jacobian_serial
-    if not fn(qc, chain._consts, chain._xform, chain._joints, J, T):
-        _raise_nonfinite(q, name)
-    if not chain.coupling.is_identity:
-        J = J @ chain.coupling.matrix
+    if not _k.jacobian(chain.arrays.packed, flat, J, T):
+        raise_nonfinite(q, name)
     lead = q.shape[:-1]
     return J.reshape(lead + (6, chain.n)), T.reshape(lead + (4, 4))
 

@@ -21,6 +21,7 @@ from typing import Literal
 import numpy as np
 
 from robokin.exceptions import ModelError
+from robokin.model.chain_arrays import MAX_JOINTS, ChainArrays, chain_arrays_from_chain
 from robokin.model.coupling import AffineMap
 
 __all__ = ["Chain", "ChainBuilder", "Joint", "JointKind"]
@@ -66,29 +67,6 @@ class Joint:
         object.__setattr__(self, "offset", float(self.offset))
 
 
-def _xform_params(consts: np.ndarray) -> np.ndarray:
-    """Per constant ``[1, cos a, sin a, tx, ty, tz]`` when it is ``Trans(t) Rx(a)``, else 0.
-
-    Every standard and modified DH row's constant has this form; the kernels then
-    skip the multiplications by its zeros and ones.
-    """
-    P = np.zeros((consts.shape[0], 6))
-    for k, C in enumerate(consts):
-        R = C[:3, :3]
-        ca, sa = R[1, 1], R[2, 1]
-        if (
-            R[0, 0] == 1.0
-            and R[0, 1] == 0.0
-            and R[0, 2] == 0.0
-            and R[1, 0] == 0.0
-            and R[2, 0] == 0.0
-            and R[1, 2] == -sa
-            and R[2, 2] == ca
-        ):
-            P[k] = (1.0, ca, sa, C[0, 3], C[1, 3], C[2, 3])
-    return P
-
-
 def _ro(a: np.ndarray) -> np.ndarray:
     a = np.ascontiguousarray(a, dtype=np.float64)
     a.setflags(write=False)
@@ -108,6 +86,8 @@ class Chain:
         tool: The tool transform, (4, 4).
         coordinates: The independent coordinates (n) with their limits.
         coupling: ``q_chain = M q + c``, an AffineMap (n_chain x n).
+        arrays: What the compiled kernels read (built here, see
+            :mod:`robokin.model.chain_arrays`).
     """
 
     joints: tuple[Joint, ...]
@@ -118,6 +98,7 @@ class Chain:
     tool: np.ndarray = field(default_factory=lambda: np.eye(4))
     coordinates: tuple[Joint, ...] | None = None
     coupling: AffineMap | None = None
+    arrays: ChainArrays = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         nc = len(self.joints)
@@ -151,38 +132,12 @@ class Chain:
             raise ModelError(
                 f"coupling matrix must have shape ({nc}, {n}), got {self.coupling.matrix.shape}"
             )
-        # Derived arrays for the compiled kernels.
-        consts = np.empty((nc + 1, 4, 4))
-        consts[0] = self.base @ self.head
-        for k in range(nc):
-            consts[k + 1] = self.frame_offsets[k] @ self.link_offsets[k]
-        consts[nc] = consts[nc] @ self.tool if nc else consts[0] @ self.tool
-        object.__setattr__(self, "_consts", _ro(consts))
-        object.__setattr__(
-            self,
-            "_kind",
-            _ro(np.array([j.kind == "prismatic" for j in self.joints], np.float64)),
-        )
-        object.__setattr__(self, "_sign", _ro(np.array([j.sign for j in self.joints])))
-        object.__setattr__(
-            self, "_offset", _ro(np.array([j.offset for j in self.joints]))
-        )
-        object.__setattr__(
-            self, "_joints", _ro(np.stack([self._kind, self._sign, self._offset]))
-        )
-        object.__setattr__(self, "_xform", _ro(_xform_params(consts)))
-        packed = np.concatenate(
-            [[float(nc)], consts.ravel(), self._xform.ravel(), self._joints.ravel()]
-        )
-        object.__setattr__(self, "_packed", _ro(packed))
-        # Shape of a single configuration the fast FK path takes (None: no fast path).
-        object.__setattr__(
-            self, "_single_shape", (nc,) if self.coupling.is_identity else None
-        )
-        lim = np.array([c.limits for c in self.coordinates], dtype=np.float64).reshape(
-            n, 2
-        )
-        object.__setattr__(self, "_limits", _ro(lim))
+        if nc > MAX_JOINTS or n > MAX_JOINTS:
+            raise ModelError(
+                f"a chain of {nc} joints and {n} coordinates: robokin takes at most "
+                f"{MAX_JOINTS} of each"
+            )
+        object.__setattr__(self, "arrays", chain_arrays_from_chain(self))
 
     @property
     def n(self) -> int:
@@ -197,7 +152,7 @@ class Chain:
     @property
     def limits(self) -> np.ndarray:
         """Limits of the independent coordinates, (n, 2), SI units (read-only)."""
-        return self._limits
+        return self.arrays.limits
 
     @property
     def is_revolute(self) -> np.ndarray:

@@ -16,8 +16,7 @@ ARMS = ("ur5", "aubo_i5", "puma560", "panda", "scara", "qfmd010", "improved_dh_a
 @pytest.mark.parametrize("name", ARMS)
 def test_table_rows_are_fk_of_in_limit_configurations_bucketed_by_cell(name):
     robot = robokin.load(name)
-    data = numeric._chain_data(robot)
-    tab, cstart, gdat = data.seed_table()
+    tab, cstart, gdat = numeric.seed_table(robot.chain).kernel_args()
     n = robot.n
     assert tab.shape == (numeric._TABLE_SIZE, 12 + n)
     q = tab[:, 12:]
@@ -33,7 +32,7 @@ def test_table_rows_are_fk_of_in_limit_configurations_bucketed_by_cell(name):
     for c in np.flatnonzero(np.diff(cstart)):
         assert (cells[cstart[c]:cstart[c + 1]] == c).all()
     # the same table every time (a fixed sampling seed), read-only
-    again = numeric._ChainData(robot.chain).seed_table()
+    again = numeric._build_seed_table(robot.chain).kernel_args()
     for a, b in zip((tab, cstart, gdat), again, strict=True):
         np.testing.assert_array_equal(a, b)
         assert not a.flags.writeable
@@ -41,10 +40,10 @@ def test_table_rows_are_fk_of_in_limit_configurations_bucketed_by_cell(name):
 
 @pytest.mark.parametrize("rot_w", [0.0, numeric._TABLE_ROT])
 def test_grid_search_finds_the_nearest_rows_of_the_cells_it_scans(rot_w):
-    from robokin.kinematics.ik import _numeric_kernels as K
+    from robokin._native import kernels as K
 
     robot = robokin.load("panda")
-    tab, cstart, gdat = numeric._chain_data(robot).seed_table()
+    tab, cstart, gdat = numeric.seed_table(robot.chain).kernel_args()
     G = int(gdat[6])
     cells = np.clip(np.floor((tab[:, :3] - gdat[:3]) * gdat[3:6]).astype(int), 0, G - 1)
     rng = np.random.default_rng(3)
@@ -52,9 +51,8 @@ def test_grid_search_finds_the_nearest_rows_of_the_cells_it_scans(rot_w):
     T[:5, :3, 3] += 5.0  # outside the table's box: the search widens
     k = 4
     for Tt in T:
-        idx = np.empty(K.TAB_K_MAX, np.int64)
-        dist = np.empty(K.TAB_K_MAX)
-        found = K._table_nearest(Tt, tab, cstart, gdat, k, rot_w, idx, dist)
+        idx = K.table_nearest(tab, cstart, gdat, Tt, k, rot_w)
+        found = len(idx)
         assert found == k
         d = (np.sum((tab[:, :3] - Tt[:3, 3]) ** 2, axis=1)
              + rot_w * np.sum((tab[:, 3:12] - Tt[:3, :3].ravel()) ** 2, axis=1))
@@ -65,17 +63,16 @@ def test_grid_search_finds_the_nearest_rows_of_the_cells_it_scans(rot_w):
             r += 1
         scanned = np.flatnonzero(cheb <= r)
         want = scanned[np.argsort(d[scanned], kind="stable")[:k]]
-        np.testing.assert_allclose(dist[:k], d[want], rtol=1e-12, atol=1e-15)
-        np.testing.assert_allclose(d[idx[:k]], d[want], rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(d[idx], d[want], rtol=1e-12, atol=1e-15)
     # a table pose is its own nearest row
     row = 123
     Tt = np.eye(4)
     Tt[:3, 3] = tab[row, :3]
     Tt[:3, :3] = tab[row, 3:12].reshape(3, 3)
-    idx = np.empty(K.TAB_K_MAX, np.int64)
-    dist = np.empty(K.TAB_K_MAX)
-    K._table_nearest(Tt, tab, cstart, gdat, 1, rot_w, idx, dist)
-    assert dist[0] == 0.0
+    idx = K.table_nearest(tab, cstart, gdat, Tt, 1, rot_w)
+    d0 = (np.sum((tab[idx[0], :3] - Tt[:3, 3]) ** 2)
+          + rot_w * np.sum((tab[idx[0], 3:12] - Tt[:3, :3].ravel()) ** 2))
+    assert d0 == 0.0
     assert (rot_w == 0.0 and np.allclose(tab[idx[0], :3], tab[row, :3])) or idx[0] == row
 
 
@@ -84,7 +81,7 @@ def test_table_restarts_round_trip_to_1e9_inside_limits_independent_of_rng(name)
     robot = robokin.load(name)
     rng = np.random.default_rng(11)
     T = robot.fk(random_q(robot, rng, 200))
-    mid = numeric._chain_data(robot).mid
+    mid = numeric._middle(robot.chain)
     # max_restarts=4: q0 (the middle of the limits), then only table seeds
     a = numeric.solve(robot, T, q0=mid, max_restarts=4, rng=np.random.default_rng(1))
     b = numeric.solve(robot, T, q0=mid, max_restarts=4, rng=np.random.default_rng(2))
@@ -108,9 +105,9 @@ def test_table_restarts_round_trip_to_1e9_inside_limits_independent_of_rng(name)
 def test_results_deterministic_for_a_seeded_rng_with_table_and_random_restarts():
     robot = robokin.load("improved_dh_arm")
     T = robot.fk(random_q(robot, np.random.default_rng(5), 300))
-    r1 = numeric.solve(robot, T, q0=numeric._chain_data(robot).mid,
+    r1 = numeric.solve(robot, T, q0=numeric._middle(robot.chain),
                        rng=np.random.default_rng(9))
-    r2 = numeric.solve(robot, T, q0=numeric._chain_data(robot).mid,
+    r2 = numeric.solve(robot, T, q0=numeric._middle(robot.chain),
                        rng=np.random.default_rng(9))
     assert r1.success.all()
     assert (r1.restarts > numeric._TABLE_SEEDS).any()  # random seeds were used too
@@ -120,7 +117,7 @@ def test_results_deterministic_for_a_seeded_rng_with_table_and_random_restarts()
 
 
 def test_masks_choose_the_table_metric():
-    K = numeric._kernels()
+    K = numeric.K
     full = numeric._opts(None, None, 1e-9, None, 100, 1.0)
     assert full[K.O_TABLE_ROT] == numeric._TABLE_ROT
     assert numeric._opts("xyz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] == 0.0
@@ -135,7 +132,7 @@ def test_masked_solves_with_restarts_converge_inside_limits(mask):
     rng = np.random.default_rng(4)
     Q = random_q(robot, rng, 60)
     T = robot.fk(Q)
-    res = numeric.solve(robot, T, mask=mask, q0=numeric._chain_data(robot).mid, rng=rng)
+    res = numeric.solve(robot, T, mask=mask, q0=numeric._middle(robot.chain), rng=rng)
     assert res.success.all()
     assert robot.within_limits(res.q, tol=0.0).all()
     dp, dr = pose_errors(robot.fk(res.q), T)
@@ -149,7 +146,7 @@ def test_small_angle_rotation_error_matches_scipy():
     # angles below atan(0.1) take the series branch of the residual's log map
     from scipy.spatial.transform import Rotation
 
-    from robokin.kinematics.ik import _numeric_kernels as K
+    from robokin.spatial import pose_error
 
     rng = np.random.default_rng(8)
     angles = np.concatenate([np.logspace(-9, -1.1, 40), rng.uniform(0.05, 0.2, 20)])
@@ -161,7 +158,6 @@ def test_small_angle_rotation_error_matches_scipy():
         T[:3, :3] = R0
         Tt = np.eye(4)
         Tt[:3, :3] = Rotation.from_rotvec(a * th).as_matrix() @ R0
-        e = np.empty(6)
-        K._residual(T, Tt, e)
+        e = pose_error(T, Tt)
         np.testing.assert_allclose(e[3:], a * th, rtol=1e-9 if th > 1e-6 else 1e-4,
                                    atol=1e-15)

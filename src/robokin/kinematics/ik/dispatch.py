@@ -11,6 +11,7 @@ import numpy.typing as npt
 from robokin._validation import check_finite, check_joints, check_poses_fast
 from robokin.exceptions import InputError
 from robokin.kinematics.ik.solutions import SolutionSet
+from robokin.kinematics.per_chain import cached
 
 __all__ = ["solve"]
 
@@ -88,16 +89,13 @@ def _check_q_near_batch(q_near: np.ndarray, target: tuple[int, ...]) -> None:
 
 def _single_solver(robot: Any) -> Any:
     """The family's single-pose hot path (``_six_r.make_single``), or None; cached
-    on the (immutable) chain."""
-    chain = robot.chain
-    single = chain.__dict__.get("_ik_single", False)
-    if single is False:
+    per chain."""
+    def build() -> Any:
         from robokin.kinematics.ik.analytic.detect import detect
 
-        fam = detect(robot)
-        single = getattr(fam.solver, "single", None)
-        object.__setattr__(chain, "_ik_single", single)
-    return single
+        return getattr(detect(robot).solver, "single", None)
+
+    return cached(robot.chain, "ik_single", build)
 
 
 def _plain_joints(q: Any, n: int) -> bool:

@@ -31,11 +31,8 @@ Convergence means the norm of the selected position rows is at most ``tol`` [m]
 and that of the selected rotation rows at most ``tol_rotation`` [rad] (default
 ``tol``), both 1e-9 by default.
 
-The inner loop is compiled (numba, ``cache=True``): see ``_numeric_kernels``. A
-batch of 8 or more targets on a chain of at most 12 joints runs
-instead in ``_lm_lanes`` (C, optional), which advances 4 targets per AVX2 vector
-with the same steps: results equal the numba kernel's to rounding (~1e-12), with
-the same iterations and restarts.
+The descents run compiled (``robokin/_native/csrc/lm.c``), four targets per vector,
+on every thread for batches; a single target runs the same code in one lane.
 
 References:
     Sugihara, T. "Solvability-unconcerned inverse kinematics by the
@@ -48,7 +45,6 @@ References:
 from __future__ import annotations
 
 import time
-import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -56,8 +52,11 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from robokin import _native
 from robokin._validation import check_finite, check_joints
 from robokin.exceptions import InputError
+from robokin.kinematics.per_chain import cached
+from robokin.model.chain import Chain
 
 __all__ = ["IKPathResult", "IKResult", "ik_path", "parse_mask", "solve", "solve_all"]
 
@@ -80,70 +79,8 @@ _TABLE_ROT = 0.15**2  # [m^2] per unit squared Frobenius rotation distance
 _TABLE_PER_CELL = 2.5  # mean rows per occupied grid cell
 
 
-_K: list[Any] = []
-
-try:  # the vector-lane batch kernel (C, optional: numba serves without it)
-    from robokin.kinematics.ik import _lm_lanes
-except ImportError:  # pragma: no cover - not built (no C compiler at install time)
-    _lm_lanes = None
-# only its AVX2 + FMA copy beats numba (one thread, UR5 to the patent arm: 2.6-4.8 vs
-# 6.1-10.9 us per target; the baseline SSE2 copy 7.0-12.9 us); elsewhere numba serves
-if _lm_lanes is not None and _lm_lanes.ISA == "baseline":  # pragma: no cover
-    _lm_lanes = None
-_LANES_MIN = 8  # batches from this many targets go to _lm_lanes when it applies
-
-
-_WARM: set = set()  # kernels called before in this process (compiled or loaded)
-
-
-def _charged(kern: Any) -> bool:
-    """False on a kernel's first call in this process: the seconds numba spends
-    compiling it or loading it from its cache are not the targets' time budget."""
-    if kern in _WARM or isinstance(kern, _LanesKernel):
-        return True
-    _WARM.add(kern)
-    return False
-
-
-class _LanesKernel:
-    """``_lm_lanes.solve`` behind the signature of the numba batch kernels."""
-
-    def __init__(self, parallel: bool) -> None:
-        self.parallel = parallel
-
-    def __call__(self, targets: np.ndarray, q0: np.ndarray, seeds: np.ndarray,
-                 consts: np.ndarray, jdat: np.ndarray, Mc: np.ndarray, cdat: np.ndarray,
-                 opts: np.ndarray, out: np.ndarray, tab: np.ndarray, cstart: np.ndarray,
-                 gdat: np.ndarray) -> tuple[int, int]:
-        threads = 1
-        if self.parallel:
-            import numba
-
-            threads = numba.get_num_threads()
-        return _lm_lanes.solve(targets, q0, seeds, consts, jdat, Mc, cdat, opts, out,
-                               tab, cstart, gdat, threads)
-
-
-_LANES = (_LanesKernel(False), _LanesKernel(True))
-
-
-def _batch_kernel(data: _ChainData, opts: np.ndarray, count: int, parallel: bool) -> Any:
-    """The kernel for `count` targets: the C lanes for a batch on a chain of at most
-    ``_lm_lanes.NMAX`` joints, else numba (serial or over all threads)."""
-    K = _kernels()
-    if (_lm_lanes is not None and count >= _LANES_MIN
-            and max(data.n, data.jdat.shape[1]) <= _lm_lanes.NMAX):
-        return _LANES[parallel]
-    return K.solve_parallel if parallel else K.solve_serial
-
-
-def _kernels() -> Any:
-    if not _K:
-        from robokin.kinematics.ik import _numeric_kernels
-
-        _K.append(_numeric_kernels)
-    return _K[0]
-
+K = _native.kernels  # the compiled solver, its option indices and result columns
+_clock = time.perf_counter  # the clock max_time is measured on (tests replace it)
 
 # --------------------------------------------------------------------------- records
 @dataclass(frozen=True, eq=False)
@@ -205,98 +142,65 @@ class IKPathResult:
 
 
 # ------------------------------------------------------------------ per-chain data
-class _ChainData:
-    """Packed kernel arrays of one chain (see ``_numeric_kernels``)."""
+@dataclass(frozen=True, eq=False)
+class SeedTable:
+    """Restart seeds of one chain, bucketed by the position of their tool pose.
 
-    __slots__ = ("consts", "jdat", "Mc", "cdat", "ident", "n", "mid", "is_revolute",
-                 "wrap", "_table")
+    ``_TABLE_SIZE`` configurations drawn once (a fixed seed: the same table every
+    time) from the central 80 % of the seed ranges, with their tool poses, sorted
+    into a grid of G^3 cells (G chosen for about ``_TABLE_PER_CELL`` rows per
+    occupied cell) so a target's nearest rows are found by scanning the cells
+    around it.
 
-    def __init__(self, chain: Any) -> None:
-        n = chain.n
-        self.n = n
-        self.consts = np.ascontiguousarray(chain._consts, dtype=np.float64)
-        nc = len(chain._kind)
-        xform = np.zeros((6, nc))
-        for k in range(nc):
-            C = chain._consts[k + 1]
-            ca, sa = C[1, 1], C[2, 1]
-            if (C[0, 0] == 1.0 and C[0, 1] == 0.0 and C[0, 2] == 0.0 and C[1, 0] == 0.0
-                    and C[2, 0] == 0.0 and C[1, 2] == -sa and C[2, 2] == ca):
-                xform[:, k] = (1.0, ca, sa, C[0, 3], C[1, 3], C[2, 3])
-        self.jdat = np.ascontiguousarray(
-            np.vstack([chain._kind, chain._sign, chain._offset, xform]), dtype=np.float64
-        )
-        M = np.asarray(chain.coupling.matrix, dtype=np.float64)
-        c = np.asarray(chain.coupling.offset, dtype=np.float64)
-        self.Mc = np.ascontiguousarray(np.concatenate([M, c[:, None]], axis=1))
-        self.ident = bool(chain.coupling.is_identity)
-        is_rev = np.asarray(chain.is_revolute, dtype=bool)
-        self.is_revolute = is_rev
-        lim = np.asarray(chain.limits, dtype=np.float64)
-        chain_rev = chain._kind == 0.0
-        # a whole turn of coordinate j must be whole turns of every chain joint it drives
-        wrap = np.zeros(n, dtype=bool)
-        for j in range(n):
-            col = M[:, j]
-            used = col != 0.0
-            wrap[j] = bool(
-                is_rev[j]
-                and np.all(chain_rev[used])
-                and np.allclose(col[used], np.round(col[used]))
-            )
-        self.wrap = wrap
-        slo = np.where(is_rev, np.maximum(lim[:, 0], -np.pi), np.maximum(lim[:, 0], -1.0))
-        shi = np.where(is_rev, np.minimum(lim[:, 1], np.pi), np.minimum(lim[:, 1], 1.0))
-        # a limit range that misses [-pi, pi] (or [-1, 1] m) entirely: seed inside it
-        bad = slo >= shi
-        slo = np.where(bad, lim[:, 0], slo)
-        shi = np.where(bad, lim[:, 1], shi)
-        slo = np.where(np.isfinite(slo), slo, np.where(np.isfinite(shi), shi - 1.0, -1.0))
-        shi = np.where(np.isfinite(shi), shi, slo + 1.0)
-        self.cdat = np.ascontiguousarray(
-            np.stack([lim[:, 0], lim[:, 1], slo, shi, wrap.astype(np.float64)])
-        )
-        self.mid = 0.5 * (slo + shi)
-        self._table: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    Attributes:
+        rows: (M, 12 + n): tool position (3), rotation row-major (9), q (n),
+            sorted by cell.
+        cell_start: (G^3 + 1,) int64: first row of each cell.
+        grid: (7,): grid origin (3) [m], inverse cell size (3) [1/m], G.
+    """
 
-    def seed_table(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The restart seed table ``(tab, cstart, gdat)`` (see ``_numeric_kernels``).
+    rows: np.ndarray
+    cell_start: np.ndarray
+    grid: np.ndarray
 
-        ``_TABLE_SIZE`` configurations drawn once (a fixed seed: the same table every
-        time) from the central 80 % of the seed ranges, with their tool poses, bucketed
-        by position on a grid of G^3 cells (G chosen for about ``_TABLE_PER_CELL`` rows
-        per occupied cell) so a target's nearest rows are found by scanning the cells
-        around it.
-        """
-        if self._table is None:
-            K = _kernels()
-            n = self.n
-            lo = self.cdat[2] + _SEED_SHRINK * (self.cdat[3] - self.cdat[2])
-            hi = self.cdat[3] - _SEED_SHRINK * (self.cdat[3] - self.cdat[2])
-            Q = lo + np.random.default_rng(0).random((_TABLE_SIZE, n)) * (hi - lo)
-            poses = np.empty((_TABLE_SIZE, 12))
-            K.table_poses(Q, self.consts, self.jdat, self.Mc, self.ident, poses)
-            ok = np.isfinite(poses).all(axis=1)
-            Q, poses = Q[ok], poses[ok]
-            p = poses[:, :3]
-            origin = p.min(axis=0) - 1e-9
-            span = np.maximum(p.max(axis=0) + 1e-9 - origin, 1e-6)
-            G = 1
-            while G < 64:
-                cells = _grid_cells(p, origin, G / span, G)
-                if len(p) <= _TABLE_PER_CELL * len(np.unique(cells)):
-                    break
-                G += 1
-            cells = _grid_cells(p, origin, G / span, G)
-            order = np.argsort(cells, kind="stable")
-            tab = np.ascontiguousarray(np.concatenate([poses, Q], axis=1)[order])
-            cstart = np.zeros(G**3 + 1, dtype=np.int64)
-            cstart[1:] = np.cumsum(np.bincount(cells, minlength=G**3))
-            gdat = np.concatenate([origin, G / span, [G]]).astype(np.float64)
-            for a in (tab, cstart, gdat):
-                a.setflags(write=False)
-            self._table = (tab, cstart, gdat)
-        return self._table
+    def kernel_args(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(rows, cell_start, grid)`` as the compiled solver takes them."""
+        return self.rows, self.cell_start, self.grid
+
+
+def seed_table(chain: Chain) -> SeedTable:
+    """The chain's :class:`SeedTable` (built on first use, then cached)."""
+    return cached(chain, "numeric_seed_table", lambda: _build_seed_table(chain))
+
+
+def _build_seed_table(chain: Chain) -> SeedTable:
+    from robokin.kinematics.forward import forward_kinematics
+
+    arr = chain.arrays
+    span = arr.seed_upper - arr.seed_lower
+    lo = arr.seed_lower + _SEED_SHRINK * span
+    hi = arr.seed_upper - _SEED_SHRINK * span
+    Q = lo + np.random.default_rng(0).random((_TABLE_SIZE, chain.n)) * (hi - lo)
+    T = forward_kinematics(chain, Q)
+    poses = np.concatenate([T[:, :3, 3], T[:, :3, :3].reshape(-1, 9)], axis=1)
+    p = poses[:, :3]
+    origin = p.min(axis=0) - 1e-9
+    extent = np.maximum(p.max(axis=0) + 1e-9 - origin, 1e-6)
+    G = 1
+    while G < 64:
+        cells = _grid_cells(p, origin, G / extent, G)
+        if len(p) <= _TABLE_PER_CELL * len(np.unique(cells)):
+            break
+        G += 1
+    cells = _grid_cells(p, origin, G / extent, G)
+    order = np.argsort(cells, kind="stable")
+    rows = np.ascontiguousarray(np.concatenate([poses, Q], axis=1)[order])
+    cstart = np.zeros(G**3 + 1, dtype=np.int64)
+    cstart[1:] = np.cumsum(np.bincount(cells, minlength=G**3))
+    grid = np.concatenate([origin, G / extent, [G]]).astype(np.float64)
+    for a in (rows, cstart, grid):
+        a.setflags(write=False)
+    return SeedTable(rows, cstart, grid)
 
 
 def _grid_cells(p: np.ndarray, origin: np.ndarray, inv: np.ndarray, G: int) -> np.ndarray:
@@ -304,23 +208,17 @@ def _grid_cells(p: np.ndarray, origin: np.ndarray, inv: np.ndarray, G: int) -> n
     return (c[:, 0] * G + c[:, 1]) * G + c[:, 2]
 
 
-_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-# kernel arguments for "no seed table" (rows [p, R, q]: 12 + n columns; a 0-row table
-# of any width will do), read-only like a real table's arrays so that one compiled
-# specialisation serves both
+# kernel arguments for "no seed table" (a 0-row table)
 _NO_TABLE = (np.empty((0, 12)), np.zeros(1, dtype=np.int64), np.zeros(7))
 for _a in _NO_TABLE:
     _a.setflags(write=False)
 del _a
 
 
-def _chain_data(robot: Any) -> _ChainData:
-    chain = robot.chain
-    try:
-        return _CACHE[chain]
-    except KeyError:
-        data = _CACHE[chain] = _ChainData(chain)
-        return data
+def _middle(chain: Chain) -> np.ndarray:
+    """The default first guess: the middle of the seed ranges, (n,)."""
+    arr = chain.arrays
+    return 0.5 * (arr.seed_lower + arr.seed_upper)
 
 
 _DEFAULT_RNG: list[np.random.Generator] = []
@@ -431,7 +329,6 @@ def _opts(mask: Any, weights: Any, tol: Any, tol_rotation: Any, max_iterations: 
 
 def _make_opts(mask: Any, weights: Any, tol: Any, tol_rotation: Any,
                max_iterations: Any, max_step: Any) -> np.ndarray:
-    K = _kernels()
     m = parse_mask(mask)
     if weights is None:
         w = np.ones(6)
@@ -495,7 +392,7 @@ def _targets(T: npt.ArrayLike) -> tuple[np.ndarray, tuple[int, ...]]:
     return np.ascontiguousarray(T.reshape(-1, 4, 4)), lead
 
 
-def _bad_input(out: np.ndarray, n: int, K: Any, Tf: np.ndarray, Q0: np.ndarray,
+def _bad_input(out: np.ndarray, n: int, Tf: np.ndarray, Q0: np.ndarray,
                lead: tuple[int, ...], i: int, per: int = 1) -> InputError:
     if out[i, n + K.R_CODE] == K.CODE_BAD_Q0:
         return check_finite(Q0, "q0")  # raises, naming the index
@@ -552,9 +449,7 @@ def solve(
             from the seed-table configurations nearest the target when the mask
             selects all of x, y, z; then random seeds).
         max_time: Wall-time budget per target [s] (a batch gets ``N * max_time``);
-            None for no limit. Checked between rounds of restarts. A kernel's
-            first call in the process (numba compiling it, or loading it from its
-            cache) is not charged to it.
+            None for no limit. Checked between rounds of restarts.
         max_step: Largest joint change per iteration [rad or m].
         parallel: Use all threads (default: for 8 targets or more, and for rounds
             of restarts of 2 targets or more).
@@ -568,20 +463,19 @@ def solve(
         InputError: a bad pose (wrong shape, non-finite, not a rigid transform), a
             bad ``q0`` or option.
     """
-    K = _kernels()
-    data = _chain_data(robot)
-    n = data.n
+    chain = robot.chain
+    packed = chain.arrays.packed
+    n = chain.n
     Tf, lead = _targets(T)
     N = Tf.shape[0]
     opts = _opts(mask, weights, tol, tol_rotation, max_iterations, max_step)
-    opts[K.O_IDENT] = data.ident
     max_restarts = _count(max_restarts, "max_restarts")
     if max_time is not None:
         max_time = _positive(max_time, "max_time")
     gen = _rng(rng)
-    t_start = time.perf_counter()
+    t_start = _clock()
     if q0 is None:
-        Q0 = np.broadcast_to(data.mid, (N, n))
+        Q0 = np.broadcast_to(_middle(chain), (N, n))
     else:
         q0 = check_joints(q0, n, "q0")  # finiteness: checked by the kernel
         try:
@@ -595,29 +489,24 @@ def solve(
         Q0 = np.ascontiguousarray(Q0)
     out = np.empty((N, n + K.N_RES))
     if N == 0:
-        return _result(out, lead, n, None, K)
+        return _result(out, lead, n, None)
     use_par = N >= _PARALLEL_MIN if parallel is None else bool(parallel)
-    kern = _batch_kernel(data, opts, N, use_par)
     R = min(max_restarts, _FIRST_ROUND_RESTARTS)
     opts[K.O_USE_Q0] = 1.0
     opts[K.O_N_SEEDS] = R
     if R and opts[K.O_TABLE_ROT] >= 0.0:
         opts[K.O_N_TABLE] = _TABLE_SEEDS
-        tab = data.seed_table()
+        tab = seed_table(chain).kernel_args()
     else:
         tab = _NO_TABLE
     # random numbers only when some restart of this round is not a table one (the
     # table always has more rows than _TABLE_SEEDS)
     seeds = gen.random((N, R, n)) if opts[K.O_N_TABLE] < R else np.zeros((N, max(R, 1), n))
-    charged, t_call = _charged(kern), time.perf_counter()
-    fails, bad = kern(Tf, Q0, seeds, data.consts, data.jdat, data.Mc, data.cdat, opts, out,
-                      *tab)
-    if not charged:
-        t_start += time.perf_counter() - t_call
+    fails, bad = K.lm_solve(packed, Tf, Q0, seeds, opts, out, *tab, use_par)
     if bad >= 0:
-        raise _bad_input(out, n, K, Tf, Q0, lead, bad)
+        raise _bad_input(out, n, Tf, Q0, lead, bad)
     if fails == 0:
-        return _result(out, lead, n, None, K)
+        return _result(out, lead, n, None)
     timed_out = np.zeros(N, dtype=bool)
     used = out[:, n + K.R_RESTARTS].copy()
     todo = np.flatnonzero(out[:, n + K.R_CODE] != K.CODE_OK)
@@ -626,7 +515,7 @@ def solve(
         opts[K.O_USE_Q0] = 0.0
         opts[K.O_N_TABLE] = 0
         while todo.size:
-            if deadline is not None and time.perf_counter() >= deadline:
+            if deadline is not None and _clock() >= deadline:
                 timed_out[todo] = True
                 break
             left = max_restarts - int(used[todo[0]])
@@ -635,13 +524,10 @@ def solve(
             R = min(left, _ROUND_RESTARTS)
             opts[K.O_N_SEEDS] = R
             sub = np.empty((todo.size, n + K.N_RES))
-            kern2 = _batch_kernel(data, opts, todo.size, bool(
-                (parallel is None and todo.size >= _PARALLEL_MIN_RESTARTS) or parallel))
-            charged, t_call = _charged(kern2), time.perf_counter()
-            kern2(Tf[todo], Q0[todo], gen.random((todo.size, R, n)), data.consts,
-                  data.jdat, data.Mc, data.cdat, opts, sub, *_NO_TABLE)
-            if not charged and deadline is not None:
-                deadline += time.perf_counter() - t_call
+            par = bool((parallel is None and todo.size >= _PARALLEL_MIN_RESTARTS)
+                       or parallel)
+            K.lm_solve(packed, Tf[todo], Q0[todo], gen.random((todo.size, R, n)), opts,
+                       sub, *_NO_TABLE, par)
             attempts = sub[:, n + K.R_RESTARTS] + 1
             used[todo] += attempts
             out[todo, n + K.R_ITERS] += sub[:, n + K.R_ITERS]
@@ -653,11 +539,11 @@ def solve(
             out[rows, n + K.R_ITERS] = keep_iters
             todo = todo[out[todo, n + K.R_CODE] != K.CODE_OK]
     out[:, n + K.R_RESTARTS] = used
-    return _result(out, lead, n, timed_out, K)
+    return _result(out, lead, n, timed_out)
 
 
 def _result(out: np.ndarray, lead: tuple[int, ...], n: int,
-            timed_out: np.ndarray | None, K: Any) -> IKResult:
+            timed_out: np.ndarray | None) -> IKResult:
     if not lead and out[0, n + K.R_CODE] == K.CODE_OK:
         row = out[0, n:].tolist()
         return IKResult(
@@ -751,9 +637,10 @@ def solve_all(
             "options", f"unknown option(s) {unknown} for the numeric IK solver; accepted: "
             f"n_seeds, q_near, {', '.join(sorted(_SOLVE_ALL_OPTIONS))}"
         )
-    K = _kernels()
-    data = _chain_data(robot)
-    n = data.n
+    chain = robot.chain
+    arr = chain.arrays
+    n = chain.n
+    wrap = arr.wrap == 1.0
     n_seeds = _count(n_seeds, "n_seeds", minimum=1)
     dedupe_tol = _positive(options.pop("dedupe_tol", 1e-6), "dedupe_tol")
     max_restarts = _count(options.get("max_restarts", 200), "max_restarts")
@@ -763,14 +650,12 @@ def solve_all(
     opts = _opts(options.get("mask"), options.get("weights"), options.get("tol", 1e-9),
                  options.get("tol_rotation"), options.get("max_iterations", 100),
                  options.get("max_step", 1.0))
-    opts[K.O_IDENT] = data.ident
-    lim = np.asarray(robot.limits, dtype=np.float64)
-    is_rev = data.is_revolute
+    lim = arr.limits
+    is_rev = np.asarray(chain.is_revolute, dtype=bool)
     if N == 0:
         return SolutionSet.empty(lead, n, is_rev, lim, "no solution", method="numeric")
     S = n_seeds
-    cd = data.cdat
-    seeds = cd[2] + gen.random((N, S, n)) * (cd[3] - cd[2])
+    seeds = arr.seed_lower + gen.random((N, S, n)) * (arr.seed_upper - arr.seed_lower)
     if q_near is not None:
         qn = check_finite(check_joints(q_near, n, "q_near"), "q_near")
         try:
@@ -787,11 +672,10 @@ def solve_all(
     out = np.empty((N * S, n + K.N_RES))
     par = options.get("parallel")
     use_par = N * S >= _PARALLEL_MIN if par is None else bool(par)
-    kern = _batch_kernel(data, opts, N * S, use_par)
-    _, bad = kern(flatT, flatQ, np.empty((N * S, 1, n)), data.consts, data.jdat, data.Mc,
-                  cd, opts, out, *_NO_TABLE)
+    _, bad = K.lm_solve(arr.packed, flatT, flatQ, np.empty((N * S, 1, n)), opts, out,
+                        *_NO_TABLE, use_par)
     if bad >= 0:
-        raise _bad_input(out, n, K, Tf, flatQ, lead, bad, per=S)
+        raise _bad_input(out, n, Tf, flatQ, lead, bad, per=S)
     out = out.reshape(N, S, n + K.N_RES)
     q = out[..., :n].copy()
     ok = out[..., n + K.R_CODE] == K.CODE_OK
@@ -814,18 +698,18 @@ def solve_all(
     # report periodic angles in [-pi, pi) where that stays inside the limits
     wrapped = wrap_angle(q)
     inside = (wrapped >= lim[:, 0]) & (wrapped <= lim[:, 1])
-    q = np.where(data.wrap & inside, wrapped, q)
+    q = np.where(wrap & inside, wrapped, q)
     # deduplicate: row j is a copy if an earlier valid row is within dedupe_tol
     # (one seed at a time: memory O(N S n), not O(N S^2 n))
     dup = np.zeros((N, S), dtype=bool)
     for j in range(1, S):
         diff = q[:, :j] - q[:, j:j + 1]
-        diff = np.where(data.wrap, wrap_angle(diff), diff)
+        diff = np.where(wrap, wrap_angle(diff), diff)
         dup[:, j] = ((np.abs(diff).max(axis=-1) <= dedupe_tol) & ok[:, :j]).any(axis=1)
     keep = ok & ~dup
     if q_near is not None:
         d = q - seeds[:, :1]
-        d = np.where(data.wrap, wrap_angle(d), d)
+        d = np.where(wrap, wrap_angle(d), d)
         key = np.where(keep, np.linalg.norm(d, axis=-1), np.inf)
     else:
         key = np.where(keep, np.arange(S, dtype=np.float64), np.inf)
@@ -894,9 +778,8 @@ def ik_path(
     Raises:
         InputError: bad poses (shape (m, 4, 4), rigid), ``q_start`` or options.
     """
-    K = _kernels()
-    data = _chain_data(robot)
-    n = data.n
+    chain = robot.chain
+    n = chain.n
     Tf, lead = _targets(T_path)
     if len(lead) != 1:
         raise InputError("T_path", f"expected shape (m, 4, 4), got {lead + (4, 4)}")
@@ -904,14 +787,13 @@ def ik_path(
     if q_start.shape != (n,):
         raise InputError("q_start", f"expected shape ({n},), got {q_start.shape}")
     opts = _opts(mask, weights, tol, tol_rotation, max_iterations, max_step)
-    opts[K.O_IDENT] = data.ident
     opts[K.O_USE_Q0] = 1.0
     opts[K.O_N_SEEDS] = 0
     opts[K.O_PATH_MAX_JUMP] = _positive(max_jump, "max_jump")
     m = Tf.shape[0]
     out = np.empty((m, n + K.N_RES))
-    first = int(K.solve_path(Tf, np.ascontiguousarray(q_start), data.consts, data.jdat,
-                             data.Mc, data.cdat, opts, out)) if m else -1
+    first = int(K.lm_path(chain.arrays.packed, Tf, np.ascontiguousarray(q_start), opts,
+                          out)) if m else -1
     code = out[:, n + K.R_CODE]
     if first >= 0 and code[first] == K.CODE_BAD_TARGET:
         raise _bad_target(Tf, lead, first)

@@ -48,7 +48,7 @@ class Poe:
 
 def poe_from_chain(chain: Chain) -> Poe:
     """The chain's axes and points at ``v = 0`` (see the module docstring)."""
-    consts = chain._consts
+    consts = chain.arrays.consts
     nc = chain.n_chain
     P = consts[0].copy()
     h = np.empty((nc, 3))
@@ -57,7 +57,7 @@ def poe_from_chain(chain: Chain) -> Poe:
         h[k] = P[:3, 2] / np.linalg.norm(P[:3, 2])
         o[k] = P[:3, 3]
         P = P @ consts[k + 1]
-    return Poe(h, o, np.asarray(chain._kind, dtype=bool).copy(), P)
+    return Poe(h, o, np.asarray(chain.arrays.kind, dtype=bool).copy(), P)
 
 
 def angle_between_axes(a: np.ndarray, b: np.ndarray) -> float:

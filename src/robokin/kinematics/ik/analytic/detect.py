@@ -32,6 +32,7 @@ from robokin.kinematics.ik.analytic import scara as _scara
 from robokin.kinematics.ik.analytic import spherical_wrist as _sw
 from robokin.kinematics.ik.analytic import three_parallel as _tp
 from robokin.kinematics.ik.analytic._geometry import poe_from_chain
+from robokin.kinematics.per_chain import cached
 
 __all__ = ["Family", "detect"]
 
@@ -89,17 +90,8 @@ def detect(robot: Any, *, tol: float = EXACT_TOL, near_angle: float = NEAR_ANGLE
         A :class:`Family`.
     """
     chain = getattr(robot, "chain", robot)
-    key = (tol, near_angle, near_distance)
-    # Cached on the (immutable) chain itself: a weak-key dict lookup costs ~10 us.
-    per_chain = chain.__dict__.get("_ik_families")
-    if per_chain is None:
-        per_chain = {}
-        object.__setattr__(chain, "_ik_families", per_chain)
-    fam = per_chain.get(key)
-    if fam is None:
-        fam = _detect(chain, tol, near_angle, near_distance)
-        per_chain[key] = fam
-    return fam
+    return cached(chain, ("ik_family", tol, near_angle, near_distance),
+                  lambda: _detect(chain, tol, near_angle, near_distance))
 
 
 def _none(reason: str, details: dict[str, str] | None = None) -> Family:

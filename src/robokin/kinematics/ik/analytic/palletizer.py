@@ -61,7 +61,7 @@ class PalletizerGeometry:
 
 def _analyse(chain: Any, poe: Poe) -> tuple[PalletizerGeometry | None, float, str, str]:
     h, o = poe.h, poe.o
-    sign, off = chain._sign, chain._offset
+    sign, off = chain.arrays.sign, chain.arrays.offset
     Mc, c = chain.coupling.matrix, chain.coupling.offset
     s3 = 1.0 if h[1] @ h[2] >= 0 else -1.0
     s4 = 1.0 if h[1] @ h[3] >= 0 else -1.0
@@ -171,7 +171,7 @@ def solve_geometry(robot: Any, g: PalletizerGeometry, T: np.ndarray, *,
     v4 = g.s4 * (g.theta_c - v2 - g.s3 * v3)
     v5 = g.s5 * (psi[..., None, None] - v1b)
     v = np.stack([v1b, v2, v3, v4, v5], axis=-1).reshape(lead + (4, 5))
-    qc = chain._sign * (v - chain._offset)
+    qc = chain.arrays.sign * (v - chain.arrays.offset)
     q = (qc - chain.coupling.offset) @ g.back.T
     q = fit_turns(q, chain.is_revolute, chain.limits)
     level = tilt <= level_tol

@@ -135,7 +135,7 @@ def solve_geometry(robot: Any, g: ScaraGeometry, T: np.ndarray, *,
     v[..., b_] = vb
     v[..., c_] = vc
     v[..., g.pri] = vp[..., None]
-    q = chain._sign * (v - chain._offset)
+    q = chain.arrays.sign * (v - chain.arrays.offset)
     q = fit_turns(q, chain.is_revolute, chain.limits)
     ok_orient = tilt <= orientation_tol
     valid = (reach & ok_orient)[..., None] & np.array([True, True])

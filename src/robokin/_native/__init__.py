@@ -1,0 +1,56 @@
+"""robokin's compiled kernels: the one C source under ``csrc/``, built at install.
+
+``setup.py`` compiles it twice: ``_base`` (the compiler's baseline target) and
+``_avx2`` (AVX2 + FMA, x86-64 with GCC or clang). :data:`kernels` is the copy this
+CPU runs; set ``ROBOKIN_ISA=baseline`` to force the baseline one. Nothing is
+compiled at run time. ``ROBOKIN_NUM_THREADS`` (or :func:`set_num_threads`) sets
+how many threads the batch kernels use (default: the CPUs this process may use).
+
+The kernels read a chain's :class:`~robokin.model.chain_arrays.ChainArrays`
+``packed`` vector and C-contiguous float64 buffers; the layers above validate what
+users pass. See ``csrc/module.c`` for the entry points.
+"""
+
+from __future__ import annotations
+
+import os
+from types import ModuleType
+
+__all__ = ["ISA", "kernels", "num_threads", "set_num_threads"]
+
+try:
+    from robokin._native import _base
+except ImportError as exc:  # pragma: no cover - a broken install
+    raise ImportError(
+        "robokin's compiled kernels (robokin._native._base) are missing: robokin was "
+        "installed without building its C extension. Reinstall it where a C compiler "
+        "is available (pip install --force-reinstall --no-binary robokin robokin), "
+        f"or use a wheel. ({exc})"
+    ) from exc
+
+
+def _pick() -> ModuleType:
+    wanted = os.environ.get("ROBOKIN_ISA", "").strip().lower()
+    if wanted in ("baseline", "base"):
+        return _base
+    if _base.cpu_has_avx2_fma():
+        try:
+            from robokin._native import _avx2
+        except ImportError:  # pragma: no cover - built without the AVX2 copy
+            return _base
+        return _avx2
+    return _base
+
+
+kernels: ModuleType = _pick()
+ISA: str = kernels.ISA
+
+
+def num_threads() -> int:
+    """Threads the batch kernels use."""
+    return int(kernels.num_threads())
+
+
+def set_num_threads(k: int) -> int:
+    """Set the threads of the batch kernels (1 to 64); returns the number in use."""
+    return int(kernels.set_num_threads(int(k)))

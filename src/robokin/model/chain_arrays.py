@@ -1,0 +1,178 @@
+"""The arrays robokin's compiled kernels read, declared once per chain.
+
+A :class:`ChainArrays` is built by :class:`~robokin.model.chain.Chain` when the chain
+is made (it is the chain's ``arrays`` field) and is the only thing the kernels
+receive: they read its :attr:`ChainArrays.packed` vector, whose layout is below and
+in ``robokin/_native/csrc/chain.h`` (``chain_view``; a test parses it back). All
+arrays are float64 and read-only; SI units.
+
+``packed`` layout (``nc`` chain joints, ``n`` independent coordinates)::
+
+    [LAYOUT_TAG, nc, n, identity]          4
+    consts      C_0 .. C_nc                (nc + 1) * 16
+    xform       per constant               (nc + 1) * 6
+    kind, sign, offset                     3 * nc
+    M (row-major), c                       nc * n + nc
+    base                                   16
+    frame  F_k, link  G_k (last * tool)    2 * nc * 16
+    lower, upper, seed_lower, seed_upper   4 * n
+    wrap                                   n
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+
+if TYPE_CHECKING:
+    from robokin.model.chain import Chain
+
+__all__ = ["LAYOUT_TAG", "MAX_JOINTS", "ChainArrays", "chain_arrays_from_chain"]
+
+LAYOUT_TAG = 7391.0  # packed[0]; chain.h PACKED_TAG
+MAX_JOINTS = 32  # chain joints and coordinates the kernels take; chain.h MAXJ
+
+F64 = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class ChainArrays:
+    """The canonical chain as the compiled kernels read it.
+
+    .. math::
+
+        T(q) = C_0 \\, J_1(v_1) C_1 \\cdots J_{n_c}(v_{n_c}) C_{n_c}, \\qquad
+        v = \\mathrm{sign} \\odot (M q + c) + \\mathrm{offset}
+
+    Attributes:
+        n_chain: Chain joints ``nc``.
+        n: Independent coordinates.
+        identity: True when ``q_chain = q`` (no dependent joints).
+        consts: ``C_0 = B L_0``, ``C_k = F_k G_k`` (``C_nc`` times the tool),
+            shape (nc + 1, 4, 4) [m].
+        xform: Per constant ``[1, cos a, sin a, tx, ty, tz]`` when it is
+            ``Trans(t) Rx(a)`` (every DH row's is), else zeros; (nc + 1, 6).
+        kind: 1.0 for a prismatic chain joint, 0.0 for a revolute one; (nc,).
+        sign: +1 or -1 per chain joint; (nc,).
+        offset: Chain value at zero coordinate [rad or m]; (nc,).
+        M: Coupling matrix, (nc, n).
+        c: Coupling offset [rad or m], (nc,).
+        base: Base transform (4, 4).
+        frame: ``F_k``, the link frame after joint k, (nc, 4, 4).
+        link: ``G_k`` on to the next joint; the last one carries the tool, (nc, 4, 4).
+        lower, upper: Limits of the coordinates [rad or m], (n,).
+        seed_lower, seed_upper: Finite range random IK restarts are drawn from:
+            the limits cut to [-pi, pi] (revolute) or [-1, 1] m (prismatic), (n,).
+        wrap: 1.0 where a whole turn of the coordinate is whole turns of every
+            chain joint it drives (it may be shifted by 2 pi), else 0.0; (n,).
+        limits: ``[lower, upper]`` as one (n, 2) array.
+        packed: Everything above in one vector (layout in the module docstring).
+    """
+
+    n_chain: int
+    n: int
+    identity: bool
+    consts: F64
+    xform: F64
+    kind: F64
+    sign: F64
+    offset: F64
+    M: F64
+    c: F64
+    base: F64
+    frame: F64
+    link: F64
+    lower: F64
+    upper: F64
+    seed_lower: F64
+    seed_upper: F64
+    wrap: F64
+    limits: F64
+    packed: F64
+
+
+def _xform_params(consts: np.ndarray) -> np.ndarray:
+    """Per constant ``[1, cos a, sin a, tx, ty, tz]`` when it is ``Trans(t) Rx(a)``."""
+    P = np.zeros((consts.shape[0], 6))
+    R = consts[:, :3, :3]
+    ca, sa = R[:, 1, 1], R[:, 2, 1]
+    is_tx = (
+        (R[:, 0, 0] == 1.0) & (R[:, 0, 1] == 0.0) & (R[:, 0, 2] == 0.0)
+        & (R[:, 1, 0] == 0.0) & (R[:, 2, 0] == 0.0) & (R[:, 1, 2] == -sa)
+        & (R[:, 2, 2] == ca)
+    )
+    P[is_tx] = np.column_stack([np.ones_like(ca), ca, sa, consts[:, :3, 3]])[is_tx]
+    return P
+
+
+def _seed_range(lower: np.ndarray, upper: np.ndarray,
+                is_revolute: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The limits cut to one turn (revolute) or [-1, 1] m (prismatic), finite."""
+    slo = np.where(is_revolute, np.maximum(lower, -math.pi), np.maximum(lower, -1.0))
+    shi = np.where(is_revolute, np.minimum(upper, math.pi), np.minimum(upper, 1.0))
+    # a limit range that misses [-pi, pi] (or [-1, 1] m) entirely: seed inside it
+    bad = slo >= shi
+    slo = np.where(bad, lower, slo)
+    shi = np.where(bad, upper, shi)
+    slo = np.where(np.isfinite(slo), slo, np.where(np.isfinite(shi), shi - 1.0, -1.0))
+    shi = np.where(np.isfinite(shi), shi, slo + 1.0)
+    return slo, shi
+
+
+def _wrap_flags(M: np.ndarray, kind: np.ndarray, is_revolute: np.ndarray) -> np.ndarray:
+    """Coordinates whose whole turns are whole turns of every chain joint they drive."""
+    wrap = np.zeros(M.shape[1])
+    for j in range(M.shape[1]):
+        col = M[:, j]
+        used = col != 0.0
+        wrap[j] = float(
+            is_revolute[j]
+            and np.all(kind[used] == 0.0)
+            and np.allclose(col[used], np.round(col[used]))
+        )
+    return wrap
+
+
+def _ro(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    a.setflags(write=False)
+    return a
+
+
+def chain_arrays_from_chain(chain: Chain) -> ChainArrays:
+    """The kernel arrays of ``chain`` (its joints, constants, coupling and limits)."""
+    nc, n = chain.n_chain, chain.n
+    consts = np.empty((nc + 1, 4, 4))
+    consts[0] = chain.base @ chain.head
+    consts[1:] = chain.frame_offsets @ chain.link_offsets
+    consts[nc] = consts[nc] @ chain.tool
+    link = chain.link_offsets.copy()
+    link[nc - 1] = link[nc - 1] @ chain.tool
+    kind = np.array([j.kind == "prismatic" for j in chain.joints], dtype=np.float64)
+    sign = np.array([j.sign for j in chain.joints], dtype=np.float64)
+    offset = np.array([j.offset for j in chain.joints], dtype=np.float64)
+    M = np.asarray(chain.coupling.matrix, dtype=np.float64).reshape(nc, n)
+    c = np.asarray(chain.coupling.offset, dtype=np.float64).reshape(nc)
+    lim = np.array([co.limits for co in chain.coordinates], dtype=np.float64).reshape(n, 2)
+    is_rev = np.array([co.kind == "revolute" for co in chain.coordinates])
+    seed_lo, seed_hi = _seed_range(lim[:, 0], lim[:, 1], is_rev)
+    wrap = _wrap_flags(M, kind, is_rev)
+    identity = bool(chain.coupling.is_identity)
+    parts = {
+        "consts": consts, "xform": _xform_params(consts), "kind": kind, "sign": sign,
+        "offset": offset, "M": M, "c": c, "base": np.asarray(chain.base),
+        "frame": np.asarray(chain.frame_offsets), "link": link,
+        "lower": lim[:, 0], "upper": lim[:, 1], "seed_lower": seed_lo,
+        "seed_upper": seed_hi, "wrap": wrap,
+    }
+    packed = np.concatenate(
+        [[LAYOUT_TAG, nc, n, float(identity)]] + [np.ravel(v) for v in parts.values()]
+    )
+    return ChainArrays(
+        n_chain=nc, n=n, identity=identity, packed=_ro(packed), limits=_ro(lim),
+        **{k: _ro(v) for k, v in parts.items()},
+    )
