@@ -15,6 +15,8 @@
 #include "pool.c"
 #include "fk.c"
 #include "lm.c"
+#include "six_r.c"
+#include "broadphase.c"
 
 /* ---------------------------------------------------------------- arguments */
 
@@ -507,6 +509,8 @@ static PyMethodDef methods[] = {
      "set_num_threads(k) -> k: threads of the pool (1 to 64)."},
     {"cpu_has_avx2_fma", py_cpu_has_avx2_fma, METH_NOARGS,
      "cpu_has_avx2_fma() -> bool: whether this CPU runs the AVX2 + FMA copy."},
+    SIX_R_METHODS
+    BROADPHASE_METHODS
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, MODULE_NAME,
@@ -537,5 +541,9 @@ PyMODINIT_FUNC MODULE_INIT(void)
     for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
         PyModule_AddIntConstant(m, ints[i].name, ints[i].value);
     PyModule_AddObject(m, "LAYOUT_TAG", PyFloat_FromDouble(PACKED_TAG));
+    if (six_r_constants(m) < 0 || broadphase_constants(m) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
     return m;
 }
