@@ -20,6 +20,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from peers import pinocchio_model, rtb_ets  # noqa: E402
 
 import robokin  # noqa: E402
+import robokin._native  # noqa: E402
 
 
 def _median_call(fn, repeats=2000, inner=20):
@@ -32,17 +33,12 @@ def _median_call(fn, repeats=2000, inner=20):
     return statistics.median(samples)
 
 
-def _median_numba(robot, q):
-    """robot.fk(q) as it runs when the optional C extension was not built."""
-    import robokin.robot as robot_module
+def _median_baseline(robot, q):
+    """robot.fk(q) through the baseline (non-AVX2) copy of the compiled kernels."""
+    from robokin._native import _base
 
-    saved = robot_module._FK_C
-    robot_module._FK_C = None
-    try:
-        robot.fk(q)
-        return _median_call(lambda: robot.fk(q))
-    finally:
-        robot_module._FK_C = saved
+    packed = robot.chain.arrays.packed
+    return _median_call(lambda: _base.fk1(q, packed))
 
 
 def _best(fn, repeats=3):
@@ -81,7 +77,7 @@ def main(n_batch: int = 100_000) -> None:
         robot.fk(q0)
         single = {
             "robokin fk(q)": _median_call(lambda: robot.fk(q0)),
-            "robokin fk(q), numba path (no C)": _median_numba(robot, q0),
+            "robokin fk(q), baseline copy": _median_baseline(robot, q0),
             "pinocchio forwardKinematics+frame": _median_call(lambda: pin_pose(q0)),
             "pinocchio forwardKinematics only": _median_call(
                 lambda: pin.forwardKinematics(model, data, q0)
@@ -89,8 +85,13 @@ def main(n_batch: int = 100_000) -> None:
             "rtb ets.eval(q)": _median_call(lambda: ets.eval(q0)),
         }
         robot.fk(Q[:5000])
+        threads = robokin._native.num_threads()
+        robokin._native.set_num_threads(1)
+        one_thread = _best(lambda: robot.fk(Q))
+        robokin._native.set_num_threads(threads)
         batch = {
             "robokin fk(Q) batch": _best(lambda: robot.fk(Q)),
+            "robokin fk(Q) batch, one thread": one_thread,
             "pinocchio loop": _best(lambda: [pin_pose(q) for q in Q], repeats=1),
             "rtb ets.eval(Q) batch": _best(lambda: ets.eval(Q)),
         }

@@ -191,16 +191,18 @@ def solvers(robot, tol):
 
 
 def one_thread_kernels(robot, targets, q0) -> dict:
-    """Per-target time of a one-thread batch in each kernel robokin has here: numba,
-    and the C lane kernel's AVX2 and baseline copies when built."""
-    lanes = numeric._lm_lanes
-    kernels = ["numba"] + ([] if lanes is None else ["avx2+fma", "baseline"])
+    """Per-target time of a one-thread batch in each copy of the compiled kernel
+    this CPU runs: the AVX2 + FMA copy (when it runs here) and the baseline copy."""
+    from robokin._native import _base, kernels
+
+    copies = {kernels.ISA: kernels}
+    copies.setdefault(_base.ISA, _base)
+    threads = kernels.num_threads()
     times = {}
     try:
-        for k in kernels:
-            numeric._lm_lanes = None if k == "numba" else lanes
-            if k != "numba":
-                lanes.select_isa(k)
+        for isa, mod in copies.items():
+            numeric.K = mod
+            mod.set_num_threads(1)
             numeric.solve(robot, targets, q0=q0, parallel=False)
             best = np.inf
             for _ in range(5):
@@ -208,11 +210,11 @@ def one_thread_kernels(robot, targets, q0) -> dict:
                 numeric.solve(robot, targets, q0=q0, parallel=False,
                               rng=np.random.default_rng(1))
                 best = min(best, time.perf_counter() - t)
-            times[k] = best * 1e6 / len(targets)
+            times[isa] = best * 1e6 / len(targets)
     finally:
-        numeric._lm_lanes = lanes
-        if lanes is not None:
-            lanes.select_isa(lanes.ISA)
+        numeric.K = kernels
+        for mod in copies.values():
+            mod.set_num_threads(threads)
     return times
 
 
@@ -233,7 +235,7 @@ def main() -> None:
         box = np.clip(lim, -np.pi, np.pi)
         Q = rng.uniform(box[:, 0], box[:, 1], (args.n, robot.n))
         targets = robot.fk(Q)
-        fixed = np.tile(numeric._chain_data(robot).mid, (args.n, 1))
+        fixed = np.tile(numeric._middle(robot.chain), (args.n, 1))
         rand = rng.uniform(box[:, 0], box[:, 1], (args.n, robot.n))
         check_models(robot, rng)
         fns = solvers(robot, args.tol)
@@ -291,7 +293,7 @@ def main() -> None:
               f"{tb * 1e6 / args.n:7.1f} "
               f"us/target  loop {tl * 1e6 / args.n:7.1f} us/target  speed-up "
               f"{tl / tb:4.1f}x")
-    print("\nrobokin batch on one thread, by kernel (us/target, best of 5):")
+    print("\nrobokin batch on one thread, by copy of the kernel (us/target, best of 5):")
     for name, times in kernel_rows:
         print(f"  {name:16s} " + "  ".join(f"{k} {v:6.2f}" for k, v in times.items()))
 

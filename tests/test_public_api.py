@@ -8,9 +8,8 @@ import robokin
 def test_every_all_name_imports():
     for name in robokin.__all__:
         assert getattr(robokin, name) is not None, name
-    assert robokin.__all__ == sorted(robokin.__all__, key=str.lower) or set(
-        robokin.__all__
-    )
+    assert robokin.__all__ == sorted(robokin.__all__), "keep __all__ sorted"
+    assert len(set(robokin.__all__)) == len(robokin.__all__), "no name twice"
 
 
 def test_lazy_subpackages_resolve():

@@ -83,6 +83,7 @@ static int chain_view(const double *p, long len, Chain *ch)
 /* Cody-Waite reduction by pi/2 and the fdlibm / musl kernel polynomials
  * (__kernel_sin, __kernel_cos), < 1 ulp on the reduced range; one reduction serves
  * both values. Lanes with |x| >= 1e5, NaN or inf take libm. */
+#define ROUND_MAGIC 6755399441055744.0 /* 1.5 * 2^52 */
 #define INV_PIO2 6.36619772367581382433e-01
 #define PIO2_1 1.57079632673412561417e00  /* first 33 bits of pi/2 */
 #define PIO2_2 6.07710050630396597660e-11 /* next 33 bits */
@@ -103,22 +104,24 @@ static int chain_view(const double *p, long len, Chain *ch)
 ALWAYS_INLINE void vsincos(vd x, vd *s, vd *c)
 {
     vl big = ~(vabs(x) < 1e5);
-    vd xs = vsel(big, BR(0.0), x); /* keep the integer conversion in range */
-    vd t = xs * INV_PIO2 + 0.5;
-    vd n = __builtin_convertvector(__builtin_convertvector(t, vl), vd);
-    n += __builtin_convertvector(n > t, vd); /* floor: -1.0 where the cast rounded up */
-    vd y = ((xs - n * PIO2_1) - n * PIO2_2) - n * PIO2_3;
+    vd xs = vsel(big, BR(0.0), x);
+    /* n = the integer nearest x / (pi / 2), by adding 1.5 * 2^52 (the sum's low
+     * mantissa bits are then n mod 2^51: its quadrant is the low two bits); no
+     * float-to-integer conversion, which vector units below AVX-512 lack */
+    vd r = xs * INV_PIO2 + ROUND_MAGIC;
+    vd n = r - ROUND_MAGIC;
+    vl k = (vl)r;
+    vd y = ((xs - n * PIO2_1) - n * PIO2_2) - n * PIO2_3; /* |y| <= pi / 4 */
     vd z = y * y;
-    vd r = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
-    vd sy = y + z * y * (S1 + z * r);
+    vd rs = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
+    vd sy = y + z * y * (S1 + z * rs);
     vd rc = z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
     vd hz = 0.5 * z;
     vd w = 1.0 - hz;
     vd cy = w + (((1.0 - w) - hz) + z * rc);
-    vl k = __builtin_convertvector(n, vl);
     vl odd = -(k & 1);
-    vl neg_s = -((k >> 1) & 1) & BRL(0x8000000000000000ULL);
-    vl neg_c = -(((k + 1) >> 1) & 1) & BRL(0x8000000000000000ULL);
+    vl neg_s = (k << 62) & BRL(0x8000000000000000ULL);       /* quadrants 2, 3 */
+    vl neg_c = ((k + 1) << 62) & BRL(0x8000000000000000ULL); /* quadrants 1, 2 */
     vd ss = vsel(odd, cy, sy);
     vd cc = vsel(odd, sy, cy);
     *s = (vd)((vl)ss ^ neg_s);

@@ -9,14 +9,20 @@
  * scalar speed without a second, scalar copy of the formulas.
  *
  * The translation unit is compiled once per instruction set (module.c): baseline
- * x86-64 (two SSE2 halves per vector) and AVX2 + FMA (one register).
+ * (2 lanes: one SSE2 / NEON register) and AVX2 + FMA (4 lanes: one register).
  */
 #ifndef ROBOKIN_LANES_H
 #define ROBOKIN_LANES_H
 
 #include <math.h>
 
-#define W 4 /* lanes per vector */
+#ifndef W
+#if defined(__AVX__)
+#define W 4 /* one 256-bit register */
+#else
+#define W 2 /* one 128-bit register (SSE2, NEON): wider vectors would be split */
+#endif
+#endif
 
 typedef double vd __attribute__((vector_size(8 * W)));
 typedef long long vl __attribute__((vector_size(8 * W)));

@@ -314,7 +314,7 @@ static PyObject *py_pose_error(PyObject *self, PyObject *args)
     double *o = F64(out);
     Py_BEGIN_ALLOW_THREADS
     for (npy_intp i = 0; i < N; i += W) {
-        vd a[12], b[12], e[6];
+        vd a[12] = {ZERO}, b[12] = {ZERO}, e[6];
         for (int r = 0; r < 12; r++)
             for (int l = 0; l < W; l++) {
                 npy_intp k = i + l < N ? i + l : i;
