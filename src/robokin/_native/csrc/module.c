@@ -17,6 +17,7 @@
 #include "lm.c"
 #include "six_r.c"
 #include "broadphase.c"
+#include "general6r.c"
 
 /* ---------------------------------------------------------------- arguments */
 
@@ -511,6 +512,7 @@ static PyMethodDef methods[] = {
      "cpu_has_avx2_fma() -> bool: whether this CPU runs the AVX2 + FMA copy."},
     SIX_R_METHODS
     BROADPHASE_METHODS
+    GENERAL6R_METHODS
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, MODULE_NAME,
@@ -541,7 +543,8 @@ PyMODINIT_FUNC MODULE_INIT(void)
     for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
         PyModule_AddIntConstant(m, ints[i].name, ints[i].value);
     PyModule_AddObject(m, "LAYOUT_TAG", PyFloat_FromDouble(PACKED_TAG));
-    if (six_r_constants(m) < 0 || broadphase_constants(m) < 0) {
+    if (six_r_constants(m) < 0 || broadphase_constants(m) < 0 ||
+        general6r_constants(m) < 0) {
         Py_DECREF(m);
         return NULL;
     }
