@@ -59,7 +59,7 @@ def ik(
         q_near = np.where(rev, np.array(vals) / A, np.array(vals) / L)
     sols = r.ik(T, q_near=q_near, method=method)
     if limits:
-        sols = sols.within_limits()
+        sols = sols.keep_within_limits()
     q = sols.q[sols.valid]
     dp, dr = fk_error(r.chain, q, T) if len(q) else (np.zeros(0), np.zeros(0))
     flags = {k: v[sols.valid] for k, v in sols.flags.items()}

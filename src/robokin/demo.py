@@ -118,7 +118,7 @@ def plan_press_loading(
                 }
             )
             continue
-        sols = robot.ik(T, q_near=path.q_end).within_limits()
+        sols = robot.ik(T, q_near=path.q_end).keep_within_limits()
         hint = scene.pose_joints.get(pose, path.q_end)
         try:
             q = sols.nearest(hint)

@@ -428,7 +428,7 @@ def _goal_unreachable(robot: Any, T_goal: np.ndarray) -> str | None:
     if detect(robot).solver is None:
         return None
     try:
-        sols = robot.ik(T_goal).within_limits()
+        sols = robot.ik(T_goal).keep_within_limits()
     except RobokinError:
         return None
     return None if int(sols.count) else str(sols.status.item())

@@ -44,7 +44,8 @@ def test_round_trip_and_completeness(name, family, max_count):
     assert sols.method == f"analytic:{family}"
     assert sols.q.shape == (2000, max_count, robot.n)
     assert np.all(sols.status == "ok")
-    assert np.isfinite(sols.q).all()
+    assert np.isfinite(sols.q[sols.valid]).all()
+    assert np.isnan(sols.q[~sols.valid]).all()  # rows that are not solutions
     _check_round_trip(robot, q, sols)
 
 
@@ -155,12 +156,12 @@ def test_palletizer_joint_ranges_remove_extra_solutions():
     sols = robot.ik(T)
     assert len(sols) == 4  # two waist branches x two elbows
     assert np.abs(robot.fk(sols.solutions()) - T).max() < 1e-12
-    inside = sols.within_limits()
+    inside = sols.keep_within_limits()
     assert len(inside) == 1
     np.testing.assert_allclose(inside.solutions()[0], q0, atol=1e-12)
     # a pose only the out-of-range candidates reach names the joint and limit
     q_bad = np.radians([30.0, 40.0, -5.0, 20.0])
-    rep = robot.ik(robot.fk(q_bad)).within_limits()
+    rep = robot.ik(robot.fk(q_bad)).keep_within_limits()
     assert len(rep) == 0
     assert "joint 2" in rep.status.item() and "upper limit 0.436332" in rep.status.item()
 

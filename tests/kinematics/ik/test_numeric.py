@@ -290,7 +290,7 @@ def test_solve_all_batch_q_near_first_and_status():
     # ordered by distance to q_near: the first is the seed's own solution
     np.testing.assert_allclose(sols.q[:3, 0], Q, atol=1e-7)
     np.testing.assert_allclose(sols[0].nearest(Q[0]), Q[0], atol=1e-7)
-    assert sols.within_limits().count[:3].min() >= 1
+    assert sols.keep_within_limits().count[:3].min() >= 1
 
 
 def test_solve_all_rejects_unknown_options():

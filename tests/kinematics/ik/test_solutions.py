@@ -34,7 +34,7 @@ def test_nearest_respects_limits_and_names_them():
 
 
 def test_within_limits_reason_names_every_candidate():
-    s = _set([[0.0, 2.0], [-3.0, 0.0]], [True, True], [[-1, 1], [-1, 1]]).within_limits()
+    s = _set([[0.0, 2.0], [-3.0, 0.0]], [True, True], [[-1, 1], [-1, 1]]).keep_within_limits()
     st = s.status.item()
     assert st.startswith("outside joint limits")
     assert "solution 1: joint 2 at 2 > upper limit 1" in st
@@ -70,7 +70,7 @@ def test_limits_choose_turn_inside_range():
     q0 = np.radians([10.0, 200.0, -100.0, 20.0, 30.0, 40.0])
     s = robot.ik(robot.fk(q0))
     assert np.any(np.all(np.abs(s.q[s.valid] - q0) < 1e-9, axis=1))
-    assert s.within_limits_mask[s.valid][np.argmin(s.distance(q0)[s.valid])]
+    assert s.within_limits[s.valid][np.argmin(s.distance(q0)[s.valid])]
 
 
 @pytest.mark.parametrize("lead", [(), (2,), (0,)])
@@ -94,3 +94,56 @@ def test_an_unknown_option_is_named_not_a_type_error():
         T = robot.fk(np.full(robot.n, 0.1))
         with pytest.raises(robokin.InputError, match=r"options.*'foo'"):
             robot.ik(T, foo=1)
+
+
+# ------------------------------------------------------------ a collection (issue 20)
+def test_one_pose_iterates_lists_and_counts_its_valid_solutions(rng):
+    robot = robokin.load("ur5")
+    q0 = np.array([0.3, -1.1, 1.4, -0.6, 0.9, 0.2])
+    sols = robot.ik(robot.fk(q0))
+    rows = sols.q[sols.valid]
+    assert len(sols) == len(rows) == int(sols.count) == 8
+    listed = list(sols)
+    assert len(listed) == 8
+    np.testing.assert_array_equal(np.array(listed), rows)
+    for q in sols:
+        assert q.shape == (6,)
+        np.testing.assert_allclose(robot.fk(q), robot.fk(q0), atol=1e-9)
+    assert any(np.allclose(q, q0, atol=1e-9) for q in sols)
+
+
+def test_rows_that_are_not_solutions_are_nan_not_a_configuration():
+    robot = robokin.load("ur5")
+    T = robot.fk(np.array([0.1, -0.3, 0.2, 0.4, 0.0, 0.5]))
+    T[:3, 3] *= 3.0  # beyond the reach: no solution at all
+    far = robot.ik(np.stack([T, robot.fk(np.full(6, 0.2))]))
+    assert not far.valid[0].any() and far.valid[1].any()
+    assert np.isnan(far.q[~far.valid]).all()
+    assert np.isfinite(far.q[far.valid]).all()
+    assert list(far[0]) == [] and len(far[0]) == 0
+    # filtering by the limits makes the dropped rows NaN as well
+    s = _set([[0.0, 2.0], [0.5, 0.5]], [True, True], [[-1, 1], [-1, 1]])
+    kept = s.keep_within_limits()
+    assert kept.valid.tolist() == [False, True]
+    assert np.isnan(kept.q[0]).all()
+    np.testing.assert_array_equal(kept.q[1], [0.5, 0.5])
+
+
+def test_a_batch_iterates_and_counts_its_poses():
+    robot = robokin.load("ur5")
+    q = np.array([[0.1, -1.0, 1.0, 0.2, 0.7, 0.1], [0.4, -0.8, 0.6, -0.3, 1.1, 0.9]])
+    sols = robot.ik(robot.fk(q))
+    assert len(sols) == 2
+    per_pose = list(sols)
+    assert [len(s) for s in per_pose] == sols.count.tolist()
+    for s, qi in zip(per_pose, q, strict=True):
+        assert s.shape == ()
+        assert any(np.allclose(x, qi, atol=1e-9) for x in s)
+
+
+def test_within_limits_is_a_mask_like_valid_and_singular():
+    s = _set([[0.0, 2.0], [0.5, 0.5], [0.1, 0.1]], [True, True, False],
+             [[-1, 1], [-1, 1]])
+    assert s.within_limits.tolist() == [False, True, False]  # invalid rows: False
+    assert s.singular.tolist() == [False, False, False]
+    assert s.valid.tolist() == [True, True, False]

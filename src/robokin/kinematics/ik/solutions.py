@@ -2,13 +2,22 @@
 
 A :class:`SolutionSet` for target poses of leading shape ``(...)`` holds up to ``k``
 candidate rows per pose: ``q`` ``(..., k, n)`` and a ``valid`` mask ``(..., k)``
-(batches have a different count per pose). Rows that are not valid hold finite
-filler values and must be ignored. Per-pose ``status`` says why a pose has no
-solution.
+(batches have a different count per pose). Rows that are not solutions are NaN.
+Per-pose ``status`` says why a pose has no solution.
+
+For one pose the set behaves like a collection of its valid solutions::
+
+    sols = robot.ik(T)
+    len(sols)          # how many
+    for q in sols: ... # each (n,)
+    list(sols)         # [q1, q2, ...]
+
+A batch iterates (and ``len`` counts) its poses, each a one-pose set.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -35,7 +44,7 @@ class SolutionSet:
 
     Attributes:
         q: Joint solutions (..., k, n) [rad, m]; rows where ``valid`` is False are
-            filler.
+            NaN.
         valid: (..., k) bool, which rows are real solutions.
         is_revolute: (n,) bool, which coordinates are angles (wrap) vs lengths.
         limits: (n, 2) joint limits [rad, m].
@@ -69,6 +78,8 @@ class SolutionSet:
         valid = np.asarray(self.valid, dtype=bool)
         if q.shape[:-1] != valid.shape:
             raise ValueError(f"q {q.shape} and valid {valid.shape} disagree")
+        if not valid.all():
+            q = np.where(valid[..., None], q, np.nan)
         object.__setattr__(self, "q", q)
         object.__setattr__(self, "valid", valid)
         object.__setattr__(self, "is_revolute", np.asarray(self.is_revolute, dtype=bool))
@@ -89,7 +100,9 @@ class SolutionSet:
         """Build a set from arrays already in final form (float64 ``q``, bool masks,
         a ``within_limits`` flag, an object ``status``) without conversions or
         checks: the hot path of the closed forms. Callers pass fresh arrays (or
-        read-only shared ones), never buffers they reuse."""
+        read-only shared ones), never buffers they reuse; rows of ``q`` that are
+        not valid are set to NaN here (in place)."""
+        q[~valid] = np.nan
         self = object.__new__(cls)
         self.__dict__.update(q=q, valid=valid, is_revolute=is_revolute, limits=limits,
                              flags=flags, branches=branches, status=status,
@@ -127,15 +140,22 @@ class SolutionSet:
         return self.flags.get("singular", np.zeros_like(self.valid))
 
     @property
-    def within_limits_mask(self) -> np.ndarray:
-        """(..., k) bool, solutions inside every joint limit."""
-        return self.flags["within_limits"]
+    def within_limits(self) -> np.ndarray:
+        """(..., k) bool, solutions inside every joint limit (see
+        :meth:`keep_within_limits` for the set of those alone)."""
+        return self.flags["within_limits"] & self.valid
 
     def __len__(self) -> int:
-        """Number of valid solutions (single pose only)."""
+        """One pose: the number of valid solutions; a batch: its first dimension."""
         if self.shape:
-            raise TypeError("len() of a batched SolutionSet; use .count")
+            return self.shape[0]
         return int(self.count)
+
+    def __iter__(self) -> Iterator[Any]:
+        """One pose: each valid solution (n,); a batch: each pose's set."""
+        if self.shape:
+            return (self[i] for i in range(self.shape[0]))
+        return iter(list(self.q[self.valid]))
 
     def solutions(self) -> np.ndarray:
         """The valid solutions of a single pose, (count, n)."""
@@ -165,9 +185,10 @@ class SolutionSet:
         lost = self.valid.any(axis=-1) & ~valid.any(axis=-1)
         if reason is not None and lost.any():
             status[lost] = reason
-        return replace(self, valid=valid, status=status)
+        q = np.where(valid[..., None], self.q, np.nan)
+        return replace(self, q=q, valid=valid, status=status)
 
-    def within_limits(self) -> SolutionSet:
+    def keep_within_limits(self) -> SolutionSet:
         """Only the solutions inside every joint limit.
 
         Poses whose every solution is outside the limits get a status naming the
@@ -236,7 +257,7 @@ class SolutionSet:
         """
         qc = self._q_current(q_current)
         if respect_limits and "within_limits" in self.flags:
-            return self.within_limits().nearest(qc, respect_limits=False)
+            return self.keep_within_limits().nearest(qc, respect_limits=False)
         empty = ~self.valid.any(axis=-1)
         if empty.any():
             idx = np.argwhere(empty)

@@ -48,18 +48,26 @@ def q_near_rows(q_near: Any, lead: tuple[int, ...], n: int) -> np.ndarray:
 
 
 def fk_error(chain: Any, q: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Position [m] and rotation [rad] error of FK(q) against T; q (..., k, n), T (..., 4, 4)."""
-    from robokin.kinematics.forward import forward_kinematics
+    """Position [m] and rotation [rad] error of FK(q) against T.
 
-    F = forward_kinematics(chain, q)
-    Tb = T[..., None, :, :]
-    dp = np.linalg.norm(F[..., :3, 3] - Tb[..., :3, 3], axis=-1)
-    dR = np.swapaxes(Tb[..., :3, :3], -1, -2) @ F[..., :3, :3]
-    tr = np.clip((np.trace(dR, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
-    skew = np.stack([dR[..., 2, 1] - dR[..., 1, 2], dR[..., 0, 2] - dR[..., 2, 0],
-                     dR[..., 1, 0] - dR[..., 0, 1]], axis=-1)
-    ang = np.arctan2(0.5 * np.linalg.norm(skew, axis=-1), tr)
-    return dp, ang
+    Args:
+        chain: The canonical chain.
+        q: Configurations (..., k, n); rows holding NaN (not solutions) get NaN.
+        T: Target poses (..., 4, 4).
+
+    Returns:
+        ``(dp, dr)``, each (..., k): the norms of the two halves of
+        :func:`robokin.spatial.pose_error`.
+    """
+    from robokin.kinematics.forward import forward_kinematics
+    from robokin.spatial import pose_error
+
+    rows = np.isfinite(q).all(axis=-1)
+    F = forward_kinematics(chain, np.where(rows[..., None], q, 0.0))
+    e = pose_error(F, T[..., None, :, :])
+    dp = np.where(rows, np.linalg.norm(e[..., :3], axis=-1), np.nan)
+    dr = np.where(rows, np.linalg.norm(e[..., 3:], axis=-1), np.nan)
+    return dp, dr
 
 
 def make_set(

@@ -13,7 +13,7 @@ orientation is ``rot(h1, v1 + s5 v5) R_c R_M`` (a yaw only) and:
 * the planar two-link problem: subproblem 3 for the forearm (two roots), subproblem 1
   for the upper arm. That gives the paper's four candidate (theta2, theta3) pairs
   over the two waist branches; the joint ranges then keep the real ones
-  (``SolutionSet.within_limits``).
+  (``SolutionSet.keep_within_limits``).
 * the yaw joint from the target yaw.
 
 The coordinates are recovered from the chain values through the coupling
