@@ -20,6 +20,7 @@ from robokin.model.chain import Chain
 from robokin.model.coupling import AffineMap
 
 if TYPE_CHECKING:
+    from robokin.kinematics.ik.numeric import IKResult
     from robokin.kinematics.ik.solutions import SolutionSet
 
 __all__ = ["Robot"]
@@ -304,6 +305,34 @@ class Robot:
         if space != "joint":
             raise InputError("space", f"expected 'joint' or 'actuator', got {space!r}")
         return solve(self, T, q_near=q_near, method=method, **options)
+
+    def ik_near(
+        self,
+        T: npt.ArrayLike,
+        q_near: npt.ArrayLike,
+        *,
+        method: Literal["auto", "analytic", "numeric"] = "auto",
+        **options: Any,
+    ) -> IKResult:
+        """One solution per target: the one nearest ``q_near`` (streaming to a controller).
+
+        The closed form's nearest solution inside the limits where the arm has one,
+        else one numeric descent from ``q_near`` (see
+        :func:`robokin.kinematics.ik.nearest.solve_near`).
+
+        Args:
+            T: Target poses (..., 4, 4) in the world frame [m].
+            q_near: Current configuration (n,) or (..., n) [rad, m].
+            method: ``"auto"``, ``"analytic"`` or ``"numeric"``.
+            **options: Numeric-solver options (``mask``, ``tol``, ...).
+
+        Returns:
+            An :class:`~robokin.kinematics.ik.numeric.IKResult`: ``.q`` (..., n),
+            ``.success`` (...), ``.reason``.
+        """
+        from robokin.kinematics.ik.nearest import solve_near
+
+        return solve_near(self, T, q_near, method=method, **options)
 
     # ---------------------------------------------------------------- actuators
     def actuators_from_joints(self, q: npt.ArrayLike) -> np.ndarray:

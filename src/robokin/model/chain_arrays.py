@@ -70,6 +70,7 @@ class ChainArrays:
         wrap: 1.0 where a whole turn of the coordinate is whole turns of every
             chain joint it drives (it may be shifted by 2 pi), else 0.0; (n,).
         limits: ``[lower, upper]`` as one (n, 2) array.
+        is_revolute: (n,) bool: which coordinates are angles.
         packed: Everything above in one vector (layout in the module docstring).
     """
 
@@ -92,6 +93,7 @@ class ChainArrays:
     seed_upper: F64
     wrap: F64
     limits: F64
+    is_revolute: npt.NDArray[np.bool_]
     packed: F64
 
 
@@ -143,6 +145,12 @@ def _ro(a: np.ndarray) -> np.ndarray:
     return a
 
 
+def _ro_bool(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a, dtype=bool)
+    a.setflags(write=False)
+    return a
+
+
 def chain_arrays_from_chain(chain: Chain) -> ChainArrays:
     """The kernel arrays of ``chain`` (its joints, constants, coupling and limits)."""
     nc, n = chain.n_chain, chain.n
@@ -174,5 +182,6 @@ def chain_arrays_from_chain(chain: Chain) -> ChainArrays:
     )
     return ChainArrays(
         n_chain=nc, n=n, identity=identity, packed=_ro(packed), limits=_ro(lim),
+        is_revolute=_ro_bool(is_rev),
         **{k: _ro(v) for k, v in parts.items()},
     )

@@ -15,6 +15,7 @@
 #include "pool.c"
 #include "fk.c"
 #include "lm.c"
+#include "nearest.c"
 #include "six_r.c"
 #include "broadphase.c"
 #include "general6r.c"
@@ -315,13 +316,17 @@ static PyObject *py_pose_error(PyObject *self, PyObject *args)
     double *o = F64(out);
     Py_BEGIN_ALLOW_THREADS
     for (npy_intp i = 0; i < N; i += W) {
-        vd a[12] = {ZERO}, b[12] = {ZERO}, e[6];
-        for (int r = 0; r < 12; r++)
+        vd a[12], b[12], e[6];
+        for (int r = 0; r < 12; r++) {
+            double ar[W], br[W];
             for (int l = 0; l < W; l++) {
                 npy_intp k = i + l < N ? i + l : i;
-                a[r][l] = c[16 * k + r];
-                b[r][l] = t[16 * k + r];
+                ar[l] = c[16 * k + r];
+                br[l] = t[16 * k + r];
             }
+            memcpy(&a[r], ar, sizeof(ar));
+            memcpy(&b[r], br, sizeof(br));
+        }
         pose_residual(a, b, e, BRL(-1));
         for (int l = 0; l < W && i + l < N; l++)
             for (int r = 0; r < 6; r++)
@@ -363,6 +368,41 @@ static PyObject *py_table_nearest(PyObject *self, PyObject *args)
         for (int i = 0; i < found; i++)
             ((long long *)PyArray_DATA((PyArrayObject *)out))[i] = idx[i];
     return out;
+}
+
+/* nearest(packed, Q (N, k, n), ok (N, k) bool, qn (N, n), is_rev (n,) bool,
+ *         T (N, 4, 4), q (N, n), err (N, 2), found (N,) bool) */
+static PyObject *py_nearest(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 9) {
+        PyErr_SetString(PyExc_TypeError, "nearest takes 9 arguments");
+        return NULL;
+    }
+    Chain ch;
+    PyArrayObject *Q, *ok, *qn, *rev, *T, *q, *err, *found;
+    if (!chain_arg(args[0], &ch) || !(Q = array_arg(args[1], "Q", NPY_DOUBLE, 3, 0)) ||
+        !(ok = array_arg(args[2], "ok", NPY_BOOL, 2, 0)) ||
+        !(qn = array_arg(args[3], "qn", NPY_DOUBLE, 2, 0)) ||
+        !(rev = array_arg(args[4], "is_rev", NPY_BOOL, 1, 0)) ||
+        !(T = array_arg(args[5], "T", NPY_DOUBLE, 3, 0)) ||
+        !(q = array_arg(args[6], "q", NPY_DOUBLE, 2, 1)) ||
+        !(err = array_arg(args[7], "err", NPY_DOUBLE, 2, 1)) ||
+        !(found = array_arg(args[8], "found", NPY_BOOL, 1, 1)))
+        return NULL;
+    npy_intp N = DIM(Q, 0), k = DIM(Q, 1);
+    int n = ch.n;
+    if (DIM(Q, 2) != n || DIM(ok, 0) != N || DIM(ok, 1) != k || DIM(qn, 0) != N ||
+        DIM(qn, 1) != n || DIM(rev, 0) != n || DIM(T, 0) != N || DIM(T, 1) != 4 ||
+        DIM(T, 2) != 4 || DIM(q, 0) != N || DIM(q, 1) != n || DIM(err, 0) != N ||
+        DIM(err, 1) != 2 || DIM(found, 0) != N) {
+        PyErr_SetString(PyExc_ValueError, "robokin._native.nearest: inconsistent shapes");
+        return NULL;
+    }
+    nearest_rows(&ch, F64(Q), (const unsigned char *)PyArray_DATA(ok), F64(qn),
+                 (const unsigned char *)PyArray_DATA(rev), F64(T), (long)N, (int)k, F64(q),
+                 F64(err), (unsigned char *)PyArray_DATA(found));
+    Py_RETURN_NONE;
 }
 
 /* check_poses(T (N, 4, 4), tol) -> (code, index): the first pose that is not a
@@ -501,6 +541,8 @@ static PyMethodDef methods[] = {
      "pose_error(current, target, out): [p_t - p; log(R_t R^T)] per pose."},
     {"table_nearest", py_table_nearest, METH_VARARGS,
      "table_nearest(rows, cstart, grid, T, k, rot_w) -> the nearest seed-table rows."},
+    {"nearest", (PyCFunction)(void (*)(void))py_nearest, METH_FASTCALL,
+     "nearest(packed, Q, ok, qn, is_rev, T, q, err, found): the row nearest qn."},
     {"check_poses", py_check_poses, METH_VARARGS,
      "check_poses(T, tol) -> (code, index) of the first non-rigid pose."},
     {"sincos", py_sincos, METH_VARARGS, "sincos(x, s, c): the kernels' sin and cos."},

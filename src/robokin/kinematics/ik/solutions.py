@@ -255,27 +255,49 @@ class SolutionSet:
         Raises:
             UnreachableError: a pose has no valid solution (its status is named).
         """
-        qc = self._q_current(q_current)
-        if respect_limits and "within_limits" in self.flags:
-            return self.keep_within_limits().nearest(qc, respect_limits=False)
-        empty = ~self.valid.any(axis=-1)
-        if empty.any():
-            idx = np.argwhere(empty)
-            first = tuple(idx[0]) if idx.size else ()
+        q, found, status = self.nearest_each(q_current, respect_limits=respect_limits)
+        if not found.all():
+            idx = np.argwhere(~found)
+            first = tuple(int(i) for i in idx[0]) if idx.size else ()
             raise UnreachableError(
-                f"{int(empty.sum())} pose(s) have no solution; first at index {first}: "
-                f"{self.status[first]}"
+                f"{int((~found).sum())} pose(s) have no solution; first at index "
+                f"{first}: {status[first]}"
             )
-        if self.valid.shape[-1] == 0:  # no pose at all (an empty batch)
-            return np.zeros(self.shape + (self.n,))
-        d = self.distance(qc)
-        k = np.argmin(d, axis=-1)
-        best = np.take_along_axis(self.q, k[..., None, None], axis=-2)[..., 0, :]
+        return q
+
+    def nearest_each(
+        self, q_current: npt.ArrayLike, *, respect_limits: bool = True
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Like :meth:`nearest`, without raising for poses that have no solution.
+
+        Returns:
+            ``(q, found, status)``: ``q`` (..., n) the nearest solution where
+            ``found`` (...) is True and NaN elsewhere; ``status`` (...) why a pose
+            has none (``"ok"`` where found).
+        """
+        qc = self._q_current(q_current)
+        ok = self.within_limits if respect_limits else self.valid
+        found = ok.any(axis=-1)
+        status = self.status
+        if not found.all() and respect_limits and (self.valid.any(axis=-1) & ~found).any():
+            status = self.keep_within_limits().status  # names the limits that rejected
+        if ok.shape[-1] == 0:  # no candidate row at all
+            return np.full(self.shape + (self.n,), np.nan), found, status
+        diff = self.q - qc[..., None, :]
+        diff = np.where(self.is_revolute, wrap_angle(diff), diff)
+        d = np.where(ok, np.einsum("...i,...i->...", diff, diff), np.inf)
+        k = np.argmin(d, axis=-1)[..., None, None]
+        best = np.take_along_axis(self.q, k, axis=-2)[..., 0, :]
+        step = np.take_along_axis(diff, k, axis=-2)[..., 0, :]
         qcb = np.broadcast_to(qc, best.shape)
-        shifted = qcb + wrap_angle(best - qcb)
+        shifted = qcb + step  # the 2 pi equivalent nearest q_current
         lim = self.limits
-        ok = (shifted >= lim[:, 0] - 1e-12) & (shifted <= lim[:, 1] + 1e-12) & self.is_revolute
-        return np.where(ok, shifted, best)
+        keep = ((shifted >= lim[:, 0] - 1e-12) & (shifted <= lim[:, 1] + 1e-12)
+                & self.is_revolute)
+        q = np.where(keep, shifted, best)
+        if not found.all():
+            q = np.where(found[..., None], q, np.nan)
+        return q, found, status
 
     def expand_turns(self) -> SolutionSet:
         """Add every 2*pi-equivalent of revolute joints whose range exceeds 2*pi.

@@ -1,0 +1,124 @@
+"""One IK solution per target, the one nearest the current configuration.
+
+:func:`solve_near` (``Robot.ik_near``) is the streaming case: a controller at
+``q_near`` wants the joint target for the next pose at the lowest latency. Where
+the arm has a closed form, every solution is computed and the nearest one inside
+the limits is returned (the 2 pi equivalent closest to ``q_near``); otherwise one
+Levenberg-Marquardt descent starts from ``q_near`` (restarting elsewhere only when
+it fails). Failure is a status with a reason, never an exception.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robokin._validation import check_finite, check_joints
+from robokin.exceptions import InputError
+from robokin.kinematics.ik.numeric import IKResult
+
+__all__ = ["solve_near"]
+
+_METHODS = ("auto", "analytic", "numeric")
+
+
+def solve_near(
+    robot: Any,
+    T: npt.ArrayLike,
+    q_near: npt.ArrayLike,
+    *,
+    method: str = "auto",
+    **options: Any,
+) -> IKResult:
+    """The solution nearest ``q_near`` for every target pose.
+
+    Args:
+        robot: The :class:`~robokin.robot.Robot`.
+        T: Target tool poses (..., 4, 4) [m] in the world frame.
+        q_near: Current configuration [rad, m], (n,) or (..., n) broadcasting to
+            the targets.
+        method: ``"auto"`` (the closed form where the arm has one, else numeric),
+            ``"analytic"`` or ``"numeric"``.
+        **options: Options of the numeric solver
+            (:func:`robokin.kinematics.ik.numeric.solve`, e.g. ``mask``, ``tol``,
+            ``max_restarts``); giving any selects it.
+
+    Returns:
+        An :class:`~robokin.kinematics.ik.numeric.IKResult` of leading shape (...):
+        ``q`` the nearest solution inside the limits where ``success``, ``reason``
+        why not elsewhere (then ``q`` is the numeric solver's best configuration,
+        or NaN for a closed form that has no solution).
+
+    Raises:
+        InputError: a bad pose, ``q_near``, method or option.
+    """
+    from robokin.kinematics.ik import numeric
+
+    if method not in _METHODS:
+        raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
+    q_near = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
+    if method == "numeric" or options:
+        if method == "analytic":
+            raise InputError("options", f"{sorted(options)} are numeric-solver options; "
+                                        "the closed form takes none")
+        return numeric.solve(robot, T, q0=q_near, **options)
+    from robokin.kinematics.ik.analytic.detect import detect
+
+    fam = detect(robot)
+    if fam.solver is None:
+        if method == "analytic":
+            raise InputError("method", f"no closed form for robot '{robot.name}': "
+                                       f"{fam.reason}")
+        return numeric.solve(robot, T, q0=q_near)
+    sols = robot.ik(T, q_near=q_near, method="analytic")
+    return _nearest(robot, sols, T, q_near)
+
+
+def _nearest(robot: Any, sols: Any, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
+    """The row of ``sols`` nearest ``q_near`` per pose, inside the limits, as a result."""
+    from robokin._native import kernels
+
+    lead, n = sols.shape, robot.n
+    k = sols.q.shape[-2]
+    if not lead and q_near.shape == (n,):  # one pose: no reshaping copies
+        N = 1
+        Q = sols.q[None]
+        ok = (sols.valid & sols.flags["within_limits"])[None]
+        qn = q_near[None]
+        Tf = np.asarray(T, dtype=np.float64)[None]
+        if not (Q.flags.c_contiguous and qn.flags.c_contiguous and Tf.flags.c_contiguous):
+            Q, qn, Tf = (np.ascontiguousarray(a) for a in (Q, qn, Tf))
+    else:
+        N = int(np.prod(lead, dtype=np.int64))
+        Q = np.ascontiguousarray(sols.q.reshape(N, k, n))
+        ok = np.ascontiguousarray((sols.valid & sols.flags["within_limits"]).reshape(N, k))
+        qn = np.ascontiguousarray(np.broadcast_to(q_near, lead + (n,)).reshape(N, n))
+        Tf = np.ascontiguousarray(np.asarray(T, dtype=np.float64).reshape(N, 4, 4))
+    q = np.empty((N, n))
+    err = np.empty((N, 2))
+    found = np.empty(N, dtype=bool)
+    arrays = robot.chain.arrays
+    kernels.nearest(arrays.packed, Q, ok, qn, arrays.is_revolute, Tf, q, err, found)
+    if not lead:
+        if found[0]:
+            return IKResult(q=q[0], success=np.True_, error=float(np.hypot(*err[0])),
+                            iterations=0, restarts=0, reason="converged",
+                            position_error=float(err[0, 0]),
+                            rotation_error=float(err[0, 1]))
+        return IKResult(q=q[0], success=np.False_, error=np.nan, iterations=0,
+                        restarts=0, reason=str(_why(sols).item()),
+                        position_error=np.nan, rotation_error=np.nan)
+    reason = np.where(found, "converged", _why(sols).reshape(N)).astype(object)
+    zeros = np.zeros(lead, dtype=np.int64)
+    return IKResult(q=q.reshape(lead + (n,)), success=found.reshape(lead),
+                    error=np.hypot(err[:, 0], err[:, 1]).reshape(lead),
+                    iterations=zeros, restarts=zeros, reason=reason.reshape(lead),
+                    position_error=err[:, 0].reshape(lead),
+                    rotation_error=err[:, 1].reshape(lead))
+
+
+def _why(sols: Any) -> np.ndarray:
+    """Per pose: why it has no solution inside the limits (its status)."""
+    return np.asarray(sols.keep_within_limits().status, dtype=object)
