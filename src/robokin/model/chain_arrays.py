@@ -66,7 +66,8 @@ class ChainArrays:
         link: ``G_k`` on to the next joint; the last one carries the tool, (nc, 4, 4).
         lower, upper: Limits of the coordinates [rad or m], (n,).
         seed_lower, seed_upper: Finite range random IK restarts are drawn from:
-            the limits cut to [-pi, pi] (revolute) or [-1, 1] m (prismatic), (n,).
+            the limits where they span at most a turn (revolute) or 2 m
+            (prismatic), else a turn / 2 m centred in them, (n,).
         wrap: 1.0 where a whole turn of the coordinate is whole turns of every
             chain joint it drives (it may be shifted by 2 pi), else 0.0; (n,).
         limits: ``[lower, upper]`` as one (n, 2) array.
@@ -113,15 +114,19 @@ def _xform_params(consts: np.ndarray) -> np.ndarray:
 
 def _seed_range(lower: np.ndarray, upper: np.ndarray,
                 is_revolute: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The limits cut to one turn (revolute) or [-1, 1] m (prismatic), finite."""
-    slo = np.where(is_revolute, np.maximum(lower, -math.pi), np.maximum(lower, -1.0))
-    shi = np.where(is_revolute, np.minimum(upper, math.pi), np.minimum(upper, 1.0))
-    # a limit range that misses [-pi, pi] (or [-1, 1] m) entirely: seed inside it
-    bad = slo >= shi
-    slo = np.where(bad, lower, slo)
-    shi = np.where(bad, upper, shi)
-    slo = np.where(np.isfinite(slo), slo, np.where(np.isfinite(shi), shi - 1.0, -1.0))
-    shi = np.where(np.isfinite(shi), shi, slo + 1.0)
+    """Where random restarts are drawn: the limits where they span at most one turn
+    (revolute) or [-1, 1] m (prismatic), else one turn / 2 m centred in them
+    (``[-pi, pi]`` or ``[-1, 1]`` when that lies inside); always finite."""
+    width = np.where(is_revolute, 2.0 * math.pi, 2.0)
+    lo = np.where(np.isfinite(lower), lower, -np.inf)
+    hi = np.where(np.isfinite(upper), upper, np.inf)
+    centred = (lo <= -0.5 * width) & (hi >= 0.5 * width)
+    mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi),
+                   np.where(np.isfinite(lo), lo + 0.5 * width,
+                            np.where(np.isfinite(hi), hi - 0.5 * width, 0.0)))
+    mid = np.where(centred, 0.0, mid)
+    slo = np.maximum(lo, mid - 0.5 * width)
+    shi = np.minimum(hi, mid + 0.5 * width)
     return slo, shi
 
 

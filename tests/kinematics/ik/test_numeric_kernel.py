@@ -43,14 +43,19 @@ def test_the_baseline_copy_solves_the_same_batch_alike(name, mask, weights, monk
     robot = robokin.load(name)
     T, q0 = _batch(robot, 300, 7)
     kw = dict(q0=q0, mask=mask, weights=weights)
+    # one descent each: the same steps, other roundings (fused multiply-adds)
+    fast1 = numeric.solve(robot, T, max_restarts=0, **kw)
     fast = numeric.solve(robot, T, rng=np.random.default_rng(3), **kw)
     monkeypatch.setattr(numeric, "K", _base)
+    base1 = numeric.solve(robot, T, max_restarts=0, **kw)
     base = numeric.solve(robot, T, rng=np.random.default_rng(3), **kw)
+    assert (fast1.success == base1.success).mean() >= 0.98
+    same = (fast1.iterations == base1.iterations) & fast1.success & base1.success
+    assert same.sum() >= 0.95 * (fast1.success & base1.success).sum()
+    np.testing.assert_allclose(fast1.q[same], base1.q[same], rtol=0, atol=1e-9)
+    # with restarts (which amplify rounding differences) both solve everything
     assert fast.success.all() and base.success.all()
     assert (base.restarts > 0).sum() > 10  # restarts are exercised
-    same = (fast.iterations == base.iterations) & (fast.restarts == base.restarts)
-    assert same.mean() >= 0.98
-    np.testing.assert_allclose(fast.q[same], base.q[same], rtol=0, atol=1e-9)
     for res in (fast, base):
         dp, dr = pose_errors(robot.fk(res.q), T)
         assert dp.max() <= 1e-9  # every case selects x, y, z

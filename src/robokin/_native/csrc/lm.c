@@ -230,13 +230,20 @@ static inline int lane_next_attempt(const Ctx *cx, Lanes *L, int l)
         if (a > 1 || L->start == 0)
             L->restarts[l]++;
     } else {
+        /* three seed distributions in turn: the central part of the seed range
+         * (descents from there meet limits less often), all of it uniformly, and
+         * the arcsine law (most of its mass near the ends: solutions with joints
+         * pressed against their limits, which descents from inside the range
+         * often stall short of) */
         double lo_f = 0.0, span_f = 1.0;
-        if (a % 2 == 1) {
+        int edges = a % 3 == 0;
+        if (a % 3 == 1) {
             lo_f = cx->opts[O_SEED_SHRINK];
             span_f = 1.0 - 2.0 * lo_f;
         }
         for (int j = 0; j < n; j++) {
-            double u = lo_f + span_f * seeds[(size_t)(a - 1) * n + j];
+            double v = seeds[(size_t)(a - 1) * n + j];
+            double u = edges ? 0.5 - 0.5 * cos(M_PI * v) : lo_f + span_f * v;
             q[j] = cx->ch->seed_lo[j] + u * (cx->ch->seed_hi[j] - cx->ch->seed_lo[j]);
         }
         if (a > 1 || L->start == 0)
@@ -457,7 +464,9 @@ static void lm_worker(Ctx *cx)
                 Jw[a][j] = sw[a] * L.J[rows[a] * NMAX + j];
         }
         for (int j = 0; j < n; j++) {
-            if (ch->wrap[j] == 0.0) {
+            /* a joint whose range is a whole turn or more passes a limit by
+             * wrapping (project); any other stops there */
+            if (ch->wrap[j] == 0.0 || ch->hi[j] - ch->lo[j] < 2.0 * M_PI) {
                 vl hi = L.q[j] >= ch->hi[j];
                 vl lo = L.q[j] <= ch->lo[j];
                 vl at = hi | lo;
