@@ -15,6 +15,7 @@ chain joint from the robot's independent coordinates ``q``.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -162,6 +163,59 @@ class Chain:
     def chain_values(self, q: np.ndarray) -> np.ndarray:
         """Chain joint values ``M q + c``: (..., n) -> (..., n_chain)."""
         return self.coupling.apply(q)
+
+    def with_fixed(self, values: Mapping[int, float]) -> Chain:
+        """The chain with some independent coordinates held at given values.
+
+        Args:
+            values: Coordinate index -> value [rad or m].
+
+        Returns:
+            A chain of the remaining coordinates (their order kept): each fixed
+            value folds into the coupling offset, and a chain joint left driven by
+            fixed coordinates alone becomes a constant transform (its link frame
+            goes with it). Base and tool are unchanged.
+
+        Raises:
+            ModelError: an index out of range, a non-finite value, or no coordinate
+                left.
+        """
+        n = self.n
+        fixed = {}
+        for j, v in values.items():
+            if not 0 <= int(j) < n:
+                raise ModelError(f"coordinate index {j} out of range for {n} coordinates")
+            if not math.isfinite(float(v)):
+                raise ModelError(f"fixed value of coordinate {j} is not finite: {v!r}")
+            fixed[int(j)] = float(v)
+        keep = [j for j in range(n) if j not in fixed]
+        if not keep:
+            raise ModelError("every coordinate is fixed: nothing left to solve for")
+        M = self.coupling.matrix
+        c = self.coupling.offset + sum(M[:, j] * v for j, v in fixed.items())
+        Mk = M[:, keep]
+        builder = ChainBuilder()
+        builder.constant(self.head)
+        rows = []
+        for k, joint in enumerate(self.joints):
+            if Mk[k].any():
+                builder.joint(joint)
+                builder.constant(self.frame_offsets[k])
+                builder.frame()
+                builder.constant(self.link_offsets[k])
+                rows.append(k)
+                continue
+            v = joint.sign * c[k] + joint.offset
+            move = np.eye(4)
+            if joint.kind == "revolute":
+                move[:2, :2] = [[math.cos(v), -math.sin(v)], [math.sin(v), math.cos(v)]]
+            else:
+                move[2, 3] = v
+            builder.constant(move @ self.frame_offsets[k] @ self.link_offsets[k])
+        coordinates = tuple(self.coordinates[j] for j in keep)
+        coupling = AffineMap(Mk[rows], c[rows])
+        return builder.build(base=self.base, tool=self.tool, coordinates=coordinates,
+                             coupling=None if coupling.is_identity else coupling)
 
     def replace(self, **changes) -> Chain:
         """A copy with some fields replaced (e.g. ``base=`` or ``tool=``)."""

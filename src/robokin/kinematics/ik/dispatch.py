@@ -34,6 +34,11 @@ def solve(
     """
     if method not in _METHODS:
         raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
+    if "fixed" in options:
+        from robokin.kinematics.ik.fixed import solve_fixed
+
+        return solve_fixed(robot, T, options.pop("fixed"), q_near=q_near, method=method,
+                           **options)
     if q_near is not None and not _plain_joints(q_near, robot.n):
         q_near = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
     if (not options and type(T) is np.ndarray and T.shape == (4, 4)

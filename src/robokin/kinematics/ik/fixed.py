@@ -1,0 +1,181 @@
+"""IK with some joints given: every solution of the remaining chain.
+
+A 7R arm such as the Panda has infinitely many solutions for a pose; with one joint
+held at a chosen value the remaining 6R chain has finitely many, and the general 6R
+solver finds them all. ``robot.ik(T, fixed={"joint7": 0.3})`` does that; an array
+of values (broadcasting with the poses) sweeps the redundancy parameter, e.g. the
+self-motion manifold of one pose as a batch.
+
+When the held joint is the first or the last of a chain without dependent joints,
+the remaining chain does not depend on its value: one reduced chain (value 0)
+serves every value, the targets moving instead
+(``T' = T C_n^{-1} J(-s v) C_n`` for the last joint, ``C_0 J(-s v) C_0^{-1} T`` for
+the first). Otherwise each distinct value gets its own reduced chain (cached).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robokin._validation import check_finite, check_poses_fast
+from robokin.exceptions import InputError
+from robokin.kinematics.ik.solutions import SolutionSet
+from robokin.kinematics.per_chain import cached
+
+__all__ = ["solve_fixed"]
+
+
+def solve_fixed(
+    robot: Any,
+    T: npt.ArrayLike,
+    fixed: Mapping[str, npt.ArrayLike],
+    *,
+    q_near: npt.ArrayLike | None = None,
+    method: str = "auto",
+    **options: Any,
+) -> SolutionSet:
+    """Every solution for poses ``T`` with the joints named in ``fixed`` held.
+
+    Args:
+        robot: The :class:`~robokin.robot.Robot`.
+        T: Target poses (..., 4, 4) [m].
+        fixed: Joint name -> value [rad or m]: a number, or an array broadcasting
+            with the poses' leading shape (a sweep).
+        q_near: Current configuration (..., n) of the whole arm, optional.
+        method: As in ``Robot.ik``, for the remaining chain.
+        **options: Passed to the solver of the remaining chain.
+
+    Returns:
+        A :class:`SolutionSet` of the whole arm (the held joints' columns hold their
+        values), of the poses and values' broadcast leading shape; ``method`` says
+        what solved the remaining chain and which joints were held.
+
+    Raises:
+        InputError: an unknown joint name (the message lists them), a non-finite
+            value, values that do not broadcast with the poses, or every joint held.
+    """
+    names = list(robot.joint_names)
+    if not isinstance(fixed, Mapping) or not fixed:
+        raise InputError("fixed", f"expected a mapping of joint names to values, e.g. "
+                                  f"{{{names[-1]!r}: 0.0}}, got {fixed!r:.60}")
+    idx = []
+    for name in fixed:
+        if name not in names:
+            raise InputError("fixed", f"unknown joint {name!r}; joints: {', '.join(names)}")
+        idx.append(names.index(name))
+    if len(idx) == robot.n:
+        raise InputError("fixed", "every joint is held: nothing left to solve for")
+    T = check_poses_fast(T, "T")
+    values = [check_finite(np.asarray(v, dtype=np.float64), "fixed") for v in fixed.values()]
+    try:
+        lead = np.broadcast_shapes(T.shape[:-2], *(v.shape for v in values))
+    except ValueError as exc:
+        raise InputError("fixed", f"value shapes {[v.shape for v in values]} do not "
+                                  f"broadcast with the poses' {T.shape[:-2]}") from exc
+    Tb = np.broadcast_to(T, lead + (4, 4)).reshape(-1, 4, 4)
+    V = np.stack([np.broadcast_to(v, lead).ravel() for v in values], axis=-1)  # (N, f)
+    keep = [j for j in range(robot.n) if j not in idx]
+    qn = None
+    if q_near is not None:
+        qn = np.broadcast_to(np.asarray(q_near, dtype=np.float64), lead + (robot.n,))
+        qn = qn.reshape(-1, robot.n)[:, keep]
+    end = _end_joint(robot, idx)
+    if end is not None:
+        reduced = _reduced(robot, idx, (0.0,))
+        Tm = _moved_targets(robot, end, Tb, V[:, 0])
+        sols = reduced.ik(Tm, q_near=qn, method=method, **options)
+        parts = [(np.arange(len(Tb)), sols)]
+    else:
+        parts = []
+        uniq, inverse = np.unique(V, axis=0, return_inverse=True)
+        for g, vals in enumerate(uniq):
+            rows = np.flatnonzero(inverse.ravel() == g)
+            reduced = _reduced(robot, idx, tuple(float(x) for x in vals))
+            sols = reduced.ik(Tb[rows], q_near=None if qn is None else qn[rows],
+                              method=method, **options)
+            parts.append((rows, sols))
+    return _assemble(robot, lead, idx, keep, V, parts, dict(zip(fixed, values)))
+
+
+def _end_joint(robot: Any, idx: list[int]) -> str | None:
+    """"first" / "last" when one held coordinate is the chain's first / last joint."""
+    chain = robot.chain
+    if len(idx) != 1 or not chain.coupling.is_identity:
+        return None
+    if idx[0] == chain.n - 1:
+        return "last"
+    if idx[0] == 0:
+        return "first"
+    return None
+
+
+def _joint_move(robot: Any, j: int, v: np.ndarray) -> np.ndarray:
+    """J_j(sign * v) for values v (N,): (N, 4, 4)."""
+    joint = robot.chain.joints[j]
+    x = joint.sign * v
+    out = np.broadcast_to(np.eye(4), v.shape + (4, 4)).copy()
+    if joint.kind == "revolute":
+        c, s = np.cos(x), np.sin(x)
+        out[:, 0, 0], out[:, 0, 1], out[:, 1, 0], out[:, 1, 1] = c, -s, s, c
+    else:
+        out[:, 2, 3] = x
+    return out
+
+
+def _moved_targets(robot: Any, end: str, T: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The targets of the reduced chain (held value 0) that equal T at value v."""
+    C = robot.chain.arrays.consts
+    if end == "last":
+        j = robot.n - 1
+        Cn = C[-1]
+        return T @ np.linalg.inv(Cn) @ _joint_move(robot, j, -v) @ Cn
+    C0 = C[0]
+    return C0 @ _joint_move(robot, 0, -v) @ np.linalg.inv(C0) @ T
+
+
+def _reduced(robot: Any, idx: list[int], values: tuple[float, ...]) -> Any:
+    """The robot of the remaining coordinates (cached per chain and held values)."""
+    key = ("fixed", tuple(idx), values)
+
+    def build() -> Any:
+        held = ", ".join(f"{robot.joint_names[j]}={v:g}" for j, v in zip(idx, values,
+                                                                          strict=True))
+        chain = robot.chain.with_fixed(dict(zip(idx, values, strict=True)))
+        return type(robot)(chain, name=f"{robot.name} ({held} held)")
+
+    return cached(robot.chain, key, build)
+
+
+def _assemble(robot: Any, lead: tuple[int, ...], idx: list[int], keep: list[int],
+              V: np.ndarray, parts: list[tuple[np.ndarray, SolutionSet]],
+              fixed: dict[str, np.ndarray]) -> SolutionSet:
+    N = V.shape[0]
+    k = max((s.q.shape[-2] for _, s in parts), default=0)
+    n = robot.n
+    q = np.full((N, k, n), np.nan)
+    valid = np.zeros((N, k), dtype=bool)
+    singular = np.zeros((N, k), dtype=bool)
+    status = np.empty(N, dtype=object)
+    methods = set()
+    for rows, s in parts:
+        kk = s.q.shape[-2]
+        sq = s.q.reshape(-1, kk, len(keep))
+        q[rows[:, None, None], np.arange(kk)[None, :, None], np.array(keep)] = sq
+        for c, j in enumerate(idx):
+            q[rows, :kk, j] = V[rows, c][:, None]
+        valid[rows, :kk] = s.valid.reshape(-1, kk)
+        singular[rows, :kk] = s.singular.reshape(-1, kk)
+        status[rows] = s.status.reshape(-1)
+        methods.add(s.method)
+    held = ", ".join(fixed)
+    method = f"{'/'.join(sorted(methods))} ({held} held)"
+    return SolutionSet(
+        q.reshape(lead + (k, n)), valid.reshape(lead + (k,)), robot.is_revolute,
+        robot.limits, flags={"singular": singular.reshape(lead + (k,))},
+        status=status.reshape(lead), method=method,
+        info={"held": {name: v for name, v in fixed.items()}},
+    )

@@ -1,0 +1,99 @@
+"""IK with joints held at given values (issue 20, item 2): the Panda's redundancy."""
+
+import numpy as np
+import pytest
+
+import robokin
+from reference import pose_errors
+from robokin.exceptions import InputError
+from robokin.kinematics.ik import fixed as fixed_ik
+
+Q0 = np.array([0.3, -0.5, 0.2, -2.0, 0.4, 1.6, 0.7])
+
+
+def test_held_last_joint_solutions_reproduce_the_pose_and_hold_the_value():
+    robot = robokin.load("panda")
+    T = robot.fk(Q0)
+    sols = robot.ik(T, fixed={"joint7": Q0[6]})
+    assert "joint7 held" in sols.method
+    assert len(sols) >= 1
+    for q in sols:
+        assert q[6] == Q0[6]
+        dp, dr = pose_errors(robot.fk(q), T)
+        assert dp < 1e-9 and dr < 1e-9
+    assert any(np.allclose(q, Q0, atol=1e-6) for q in sols)
+
+
+def test_a_sweep_of_the_held_value_is_a_batch():
+    robot = robokin.load("panda")
+    T = robot.fk(Q0)
+    values = np.linspace(-2.5, 2.5, 9)
+    sweep = robot.ik(T, fixed={"joint7": values})
+    assert sweep.shape == (9,)
+    ok = sweep.valid
+    assert ok.any(axis=-1).sum() >= 3
+    dp, dr = pose_errors(robot.fk(sweep.q[ok]), T)
+    assert dp.max() < 1e-9 and dr.max() < 1e-9
+    held = np.broadcast_to(values[:, None], ok.shape)[ok]
+    np.testing.assert_array_equal(sweep.q[ok][:, 6], held)
+    # the sweep equals held-value calls one at a time
+    for i in (2, 6):
+        one = robot.ik(T, fixed={"joint7": values[i]})
+        assert one.count == sweep[i].count
+
+
+def test_the_end_joint_shortcut_equals_a_reduced_chain_per_value():
+    robot = robokin.load("panda")
+    T = robot.fk(Q0)
+    v = 0.9
+    moved = fixed_ik._moved_targets(robot, "last", T[None], np.array([v]))[0]
+    reduced0 = fixed_ik._reduced(robot, [6], (0.0,))
+    reduced_v = fixed_ik._reduced(robot, [6], (v,))
+    q6 = np.array([0.1, 0.2, -0.3, -1.5, 0.5, 1.2])
+    # the chain held at v reaches T_v(q6); the chain held at 0 reaches the moved target
+    T_v = reduced_v.fk(q6)
+    np.testing.assert_allclose(
+        fixed_ik._moved_targets(robot, "last", T_v[None], np.array([v]))[0],
+        reduced0.fk(q6), atol=1e-12)
+    assert moved.shape == (4, 4)
+
+
+def test_a_middle_joint_held():
+    robot = robokin.load("panda")
+    T = robot.fk(Q0)
+    sols = robot.ik(T, fixed={"joint3": Q0[2]})
+    assert len(sols) >= 1
+    for q in sols:
+        assert q[2] == Q0[2]
+        dp, dr = pose_errors(robot.fk(q), T)
+        assert dp < 1e-9 and dr < 1e-9
+
+
+def test_with_fixed_folds_constant_joints_and_keeps_fk(rng):
+    robot = robokin.load("panda")
+    chain = robot.chain.with_fixed({2: 0.4, 6: -1.1})
+    assert chain.n == chain.n_chain == 5
+    q = rng.uniform(-1, 1, (20, 5))
+    full = np.insert(np.insert(q, 2, 0.4, axis=1), 6, -1.1, axis=1)
+    reduced = robokin.Robot(chain)
+    np.testing.assert_allclose(reduced.fk(q), robot.fk(full), atol=1e-12)
+    qf = robokin.load("qfmd010")  # dependent joints: the held value enters the offset
+    red = qf.chain.with_fixed({0: 0.3})
+    q3 = rng.uniform(-0.3, 0.3, (10, 3))
+    np.testing.assert_allclose(robokin.Robot(red).fk(q3),
+                               qf.fk(np.insert(q3, 0, 0.3, axis=1)), atol=1e-12)
+
+
+def test_bad_held_joints_are_named():
+    robot = robokin.load("panda")
+    T = robot.fk(Q0)
+    with pytest.raises(InputError, match="unknown joint 'j7'; joints: joint1"):
+        robot.ik(T, fixed={"j7": 0.0})
+    with pytest.raises(InputError, match="every joint is held"):
+        robot.ik(T, fixed={n: 0.0 for n in robot.joint_names})
+    with pytest.raises(InputError, match="fixed.*non-finite"):
+        robot.ik(T, fixed={"joint7": np.nan})
+    with pytest.raises(InputError, match="do not broadcast"):
+        robot.ik(np.stack([T, T, T]), fixed={"joint7": [0.1, 0.2]})
+    with pytest.raises(InputError, match="mapping"):
+        robot.ik(T, fixed=["joint7"])
