@@ -17,7 +17,7 @@ def _constants(robot):
     chain = robot.chain
     if not chain.coupling.is_identity:
         raise ValueError("peer models need a chain without dependent joints")
-    consts = chain._consts
+    consts = chain.arrays.consts
     placements = []
     for k, j in enumerate(chain.joints):
         P = consts[k].copy()
