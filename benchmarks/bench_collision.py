@@ -138,7 +138,7 @@ def pinocchio_min_distance(robot, problem, q: np.ndarray) -> tuple[float, float]
     model, data, _ = pinocchio_model(placed)
     gmodel = pin.GeometryModel()
     nc = chain.n_chain
-    last = chain._consts[-1]
+    last = chain.arrays.consts[-1]
     ids = []
     for s, shape in enumerate(problem.shapes):
         k = int(problem.link[s])

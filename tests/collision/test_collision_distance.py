@@ -108,7 +108,7 @@ def test_mesh_box_and_primitive_box_agree(tmp_path, rng):
 def test_rounded_box_bounds_never_exceed_the_coal_distance(rng):
     import coal
 
-    from robokin.collision._kernels import rounded_box_bounds
+    from robokin._native import kernels as _k
     from robokin.spatial import matrix_from_rpy
 
     kinds = [
@@ -145,7 +145,7 @@ def test_rounded_box_bounds_never_exceed_the_coal_distance(rng):
     pa = np.repeat(np.arange(len(A)), len(B))
     pb = np.tile(np.arange(len(B)), len(A))
     out = np.empty((P, 1))
-    rounded_box_bounds(
+    _k.rounded_box_bounds(
         frames,
         np.zeros(len(A), dtype=np.int64),
         np.array([x[0] for x in A]),
@@ -154,8 +154,8 @@ def test_rounded_box_bounds_never_exceed_the_coal_distance(rng):
         np.array([x[0] for x in B]),
         np.array([x[1] for x in B]),
         np.array([x[2] for x in B]),
-        pa,
-        pb,
+        pa.astype(np.int64),
+        pb.astype(np.int64),
         np.zeros(P, bool),
         np.zeros(P, bool),
         out,
@@ -175,7 +175,12 @@ def test_rounded_box_bounds_never_exceed_the_coal_distance(rng):
 def test_capsule_kernel_matches_coal_on_random_segments(rng):
     import coal
 
-    from robokin.collision._kernels import _seg_seg
+    from robokin._native import kernels as _k
+
+    def seg_seg(p1, q1, p2, q2):
+        out = np.empty(1)
+        _k.seg_seg(np.array([[p1, q1, p2, q2]]), out)
+        return out[0]
 
     req = coal.DistanceRequest()
     for _ in range(200):
@@ -195,7 +200,7 @@ def test_capsule_kernel_matches_coal_on_random_segments(rng):
         d = coal.distance(
             a.coal_geometry(), ta, b.coal_geometry(), tb, req, coal.DistanceResult()
         )
-        assert _seg_seg(p1, q1, p2, q2) - 0.02 == pytest.approx(d, abs=1e-9)
+        assert seg_seg(p1, q1, p2, q2) - 0.02 == pytest.approx(d, abs=1e-9)
 
 
 def test_nearest_points_are_on_the_bodies_and_as_far_apart_as_the_minimum():

@@ -252,13 +252,19 @@ def test_agrees_with_a_brute_force_loop_on_the_aubo(rng):
         assert pm.distance == pytest.approx(ref, abs=1e-9)
 
 
-def test_motion_bounds_hold_between_samples(rng):
-    """|d(t) - d(t_i)| never exceeds the motion bound over the interval."""
-    r = robokin.load("ur5")
+@pytest.mark.parametrize("name", ["ur5", "scara", "improved_dh_arm"])
+def test_motion_bounds_hold_between_samples(rng, name):
+    """|d(t) - d(t_i)| never exceeds the motion bound over the interval.
+
+    The SCARA's lift and the improved-DH arm's slides are prismatic joints (the
+    SCARA's driven through its coupling), whose travel lengthens the reach.
+    """
+    r = robokin.load(name)
     sc = Scene()
     sc.add_box("box", (0.3, 0.3, 0.3), T(0.4, 0.2, 0.3))
-    q0 = rng.uniform(-2, 2, 6)
-    q = q0 + np.linspace(0, 1, 21)[:, None] * rng.uniform(-0.4, 0.4, 6)
+    lo, hi = r.chain.arrays.seed_lower, r.chain.arrays.seed_upper
+    q0 = rng.uniform(lo, hi)
+    q = q0 + np.linspace(0, 1, 21)[:, None] * 0.2 * rng.uniform(-1, 1, r.n) * (hi - lo)
     rep = check(r, sc, q)
     pr = rep._problem
     M = pr.motion(q, pr.frames(q))
@@ -269,6 +275,29 @@ def test_motion_bounds_hold_between_samples(rng):
         seg = D[:, 20 * i : 20 * i + 21]
         assert np.all(np.abs(seg - Dc[:, i : i + 1]) <= M[:, i : i + 1] + 1e-9)
     assert math.isfinite(rep.min_distance)
+
+
+def test_motion_bounds_count_the_travel_of_a_slide_after_a_turn():
+    """A slide extending 1 m while the joint before it turns: the lever of the
+    turn is the slide's travel, not the arm's constant lengths (0 here)."""
+    r = robokin.Robot.from_elementary(
+        [
+            {"op": "rz", "joint": "revolute", "name": "turn"},
+            {"op": "tx", "joint": "prismatic", "name": "slide"},
+        ]
+    )
+    r = r.replace(geometry=RobotGeometry.from_mapping(r, {"slide": [geo.sphere(0.05)]}))
+    sc = Scene()
+    sc.add_box("box", (0.2, 0.2, 0.2), T(0.6, 0.9, 0.0))
+    q = np.column_stack([np.linspace(0.0, 0.8, 5), np.linspace(0.2, 1.0, 5)])
+    rep = check(r, sc, q)
+    pr = rep._problem
+    M = pr.motion(q, pr.frames(q))
+    fine = q[0] + np.linspace(0, 1, 401)[:, None] * (q[-1] - q[0])
+    D = _brute_force(pr, fine)[0]
+    for i in range(4):
+        seg = D[100 * i : 100 * i + 101]
+        assert np.all(np.abs(seg - seg[0]) <= M[0, i] + 1e-9)
 
 
 def test_non_convex_mesh_links_are_exact_through_the_hull_bound(tmp_path, rng):

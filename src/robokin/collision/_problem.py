@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from robokin._native import kernels as _k
 from robokin.collision.check import (
     Closest,
     Collision,
@@ -66,7 +67,7 @@ class _Problem:
                 "or the scene a tool with shapes",
             )
         self.shapes = shapes
-        self.link = np.array(link, dtype=int)
+        self.link = np.array(link, dtype=np.int64)
         S = len(shapes)
         self.place = np.array([s.placement for s in shapes]).reshape(S, 4, 4)
         cs, rs, owner = [], [], []
@@ -79,7 +80,8 @@ class _Problem:
         self.sph_r = np.concatenate(rs) if rs else np.zeros(0)
         self.sph_owner = np.concatenate(owner) if owner else np.zeros(0, int)
         self.sph_link = self.link[self.sph_owner] if S else np.zeros(0, int)
-        self.sph_start = np.searchsorted(self.sph_owner, np.arange(S))
+        self.sph_start = np.searchsorted(self.sph_owner, np.arange(S)).astype(np.int64)
+        self.sph_count = np.bincount(self.sph_owner, minlength=S).astype(np.int64)
         # Largest reach of each shape from its link frame origin.
         self.rho = np.zeros(S)
         if S:
@@ -129,8 +131,8 @@ class _Problem:
                         pa.append(i)
                         pb.append(j)
                         is_self.append(True)
-        self.pa = np.array(pa, dtype=int)
-        self.pb = np.array(pb, dtype=int)
+        self.pa = np.array(pa, dtype=np.int64)
+        self.pb = np.array(pb, dtype=np.int64)
         self.is_self = np.array(is_self, dtype=bool)
         P = len(pa)
         self.P = P
@@ -247,7 +249,7 @@ class _Problem:
         self.req.gjk_tolerance = 1e-9  # [m] (coal: 1e-6) distances exact to ~1e-9
         self.res = coal.DistanceResult()
         # Constants for the motion bounds.
-        self._static_chain_lengths()
+        self.reach = self._static_reach()
 
     # ------------------------------------------------------------ motion bounds
     @staticmethod
@@ -276,75 +278,51 @@ class _Problem:
             return True
         return bool(np.linalg.norm(np.cross(shape.placement[:3, 2], axis)) < 1e-9)
 
-    def _static_chain_lengths(self) -> None:
-        ch = self.chain
-        nc = self.nc
-        self.a_len = (
-            np.linalg.norm(ch.frame_offsets[:, :3, 3], axis=1) if nc else np.zeros(0)
-        )
-        self.b_len = (
-            np.linalg.norm(ch.link_offsets[:, :3, 3], axis=1) if nc else np.zeros(0)
-        )
-        self.tool_len = float(np.linalg.norm(ch.tool[:3, 3]))
-        self.prismatic = np.array(
-            [j.kind == "prismatic" for j in ch.joints], dtype=bool
-        )
-        # pre_j: constant from the frame reported for link j-1 to joint j.
-        pre = np.empty((nc, 4, 4))
-        if nc:
-            pre[0] = ch.head
-            pre[1:] = ch.link_offsets[:-1]
-        self.pre = pre
+    def _static_reach(self) -> np.ndarray:
+        """(nc, S): bound on the distance from joint j's origin to shape s.
 
-    def _static_R(self, qc: np.ndarray) -> np.ndarray:
-        """Rst (nc, S): bound on the distance from joint j's origin to shape s."""
-        nc, S = self.nc, len(self.shapes)
-        ext = np.zeros(nc)
-        if self.prismatic.any():
-            sign = self.chain.arrays.sign
-            off = self.chain.arrays.offset
-            vals = np.abs(qc * sign + off).max(axis=0)
-            ext[self.prismatic] = vals[self.prismatic]
-        Rst = np.zeros((nc, S))
+        The lengths of the constants after joint j up to the shape's link frame,
+        plus the shape's reach from that frame; prismatic joints in between count at
+        zero travel (``motion_bounds`` adds their largest travel along the
+        trajectory). Rows of joints that do not move the shape stay 0.
+        """
+        ch, nc, S = self.chain, self.nc, len(self.shapes)
+        a_len = np.linalg.norm(ch.frame_offsets[:, :3, 3], axis=1)
+        b_len = np.linalg.norm(ch.link_offsets[:, :3, 3], axis=1)
+        tool_len = float(np.linalg.norm(ch.tool[:3, 3]))
+        reach = np.zeros((nc, S))
         for s in range(S):
             k = self.link[s]
-            for j in range(1, min(k, nc) + 1):  # joints 1..k move link k
+            top = min(k, nc)
+            for j in range(1, top + 1):  # joints 1..k move link k
                 # constants after J_j up to frame k
-                top = min(k, nc)
-                total = (
-                    self.a_len[j - 1 : top].sum() + self.b_len[j - 1 : top - 1].sum()
-                )
-                total += ext[j:top].sum()
+                total = a_len[j - 1 : top].sum() + b_len[j - 1 : top - 1].sum()
                 if k == nc + 1:  # tool: F_nc G_nc tool after the last joint
-                    total += self.b_len[nc - 1] + self.tool_len
-                Rst[j - 1, s] = total + self.rho[s]
-        return Rst
+                    total += b_len[nc - 1] + tool_len
+                reach[j - 1, s] = total + self.rho[s]
+        return reach
 
     def motion(self, q: np.ndarray, frames: np.ndarray) -> np.ndarray:
-        """Per interval and pair, the bound on the motion closing the distance, (P, m-1)."""
+        """Per interval and pair, the bound on the motion closing the distance, (P, m-1).
+
+        ``frames`` are the link frames of ``q`` (:meth:`frames`).
+        """
         m = q.shape[0]
-        S, P = len(self.shapes), self.P
+        P = self.P
         if m < 2 or P == 0:
             return np.zeros((P, max(m - 1, 0)))
-        qc = self.chain.coupling.apply(q)
-        dq = np.abs(np.diff(qc, axis=0))  # (m-1, nc)
-        Rst = self._static_R(qc)  # (nc, S)
-        from robokin.collision._kernels import motion_bounds
-
         Ms = np.empty((P, m - 1))
-        counts = np.bincount(self.sph_owner, minlength=S).astype(np.int64)
-        motion_bounds(
+        _k.motion_bounds(
+            self.chain.arrays.packed,
+            np.ascontiguousarray(q, dtype=np.float64),
             np.ascontiguousarray(frames),
-            np.ascontiguousarray(self.pre),
             self.link,
             self.sph_c,
             self.sph_r,
-            self.sph_start.astype(np.int64),
-            counts,
-            np.ascontiguousarray(Rst),
-            self.prismatic,
+            self.sph_start,
+            self.sph_count,
+            self.reach,
             self.spins,
-            np.ascontiguousarray(dq),
             self.pa,
             self.pb,
             self.is_self,
@@ -358,11 +336,9 @@ class _Problem:
 
         Separating-axis gaps between rounded bounding boxes (compiled kernel).
         """
-        from robokin.collision._kernels import rounded_box_bounds
-
         m = frames.shape[0]
         out = np.full((self.P, m), -np.inf)
-        rounded_box_bounds(
+        _k.rounded_box_bounds(
             np.ascontiguousarray(frames),
             self.link,
             self.rb_local,
@@ -382,10 +358,8 @@ class _Problem:
     # -------------------------------------------------------------- analytic
     def analytic_distances(self, frames: np.ndarray, pairs: np.ndarray) -> np.ndarray:
         """Closed-form distances of capsule/sphere pairs at every sample, (len(pairs), m)."""
-        from robokin.collision._kernels import capsule_distances
-
         out = np.empty((len(pairs), frames.shape[0]))
-        capsule_distances(
+        _k.capsule_distances(
             np.ascontiguousarray(frames),
             self.link,
             self.seg_local,
@@ -395,7 +369,7 @@ class _Problem:
             self.pa,
             self.pb,
             self.is_self,
-            np.ascontiguousarray(pairs),
+            np.ascontiguousarray(pairs, dtype=np.int64),
             out,
         )
         return out
@@ -520,11 +494,9 @@ class _Problem:
                 done[p, i] = True
             self.queries += n
 
-        from robokin.collision._kernels import propagate_bounds
-
         def propagate(rows: np.ndarray) -> None:
             if len(rows) and m >= 2:
-                propagate_bounds(
+                _k.propagate_bounds(
                     LB, done | hulled, C, np.ascontiguousarray(rows, dtype=np.int64)
                 )
 
