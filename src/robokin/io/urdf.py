@@ -1,0 +1,875 @@
+"""URDF in (URDF out is :mod:`robokin.io.urdf_export`).
+
+* :func:`robot_from_urdf` reads a URDF (file or XML string, parsed with
+  ``yourdfpy``, the ``robokin[urdf]`` extra) and compiles the serial chain from a
+  base link to a tip link to the canonical chain.
+* :func:`dh_from_urdf` derives standard and modified DH tables from a URDF arm
+  (see :mod:`robokin.io.dh_extract`).
+
+Import rules (documented in ``docs/urdf.md``):
+
+* **Chain.** From ``base_link`` (default: the tree's root) to ``tip_link``
+  (default: the leaf below the base whose path has the most movable joints; on a
+  tie a leaf named ``tool0`` wins, the ROS-Industrial tool frame; otherwise a
+  :class:`~robokin.exceptions.ModelError` lists the candidates). The base link
+  may sit below the chain's branch point (ROS-Industrial's ``base`` frame): fixed
+  joints may be walked backwards, movable ones may not.
+* **Frames.** Constants before the first movable joint form the chain's head
+  (``robot.base`` stays the identity: the base link frame is the world frame);
+  constants after the last one form ``robot.tool``. The frame that
+  ``fk_all`` reports for each joint is the URDF frame of the joint's child link.
+* **Joints.** ``revolute``, ``continuous`` (unlimited) and ``prismatic`` joints
+  about any axis; the axis is folded into the constants (a joint about ``-z``,
+  ``-x`` or ``-y`` becomes a reversed joint, ``sign = -1``). ``floating`` and
+  ``planar`` joints on the chain are refused.
+* **Mimic.** A ``<mimic>`` joint is a dependent chain joint
+  ``value = multiplier * q[master] + offset`` (chains of mimics are resolved). Its
+  master becomes an independent coordinate even when it is not on the chain (a
+  gripper's finger that mimics the other finger). Independent coordinates are
+  ordered by first use along the chain.
+* **Errors.** Malformed XML, a missing ``name``/``parent``/``child``, a revolute or
+  prismatic joint without ``<limit>``, a link with two parents, a loop, several
+  roots, an unknown base or tip: :class:`~robokin.exceptions.ModelError` naming the
+  file, the element and the reason.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+
+from robokin._text import short_repr
+from robokin.exceptions import MissingExtraError, ModelError
+from robokin.io.text_files import read_file_bytes
+from robokin.model.chain import Chain, ChainBuilder, Joint
+from robokin.model.coupling import Dependency, coupling_from_dependencies, mimic
+from robokin.model.geometry import MESH_SUFFIXES
+
+if TYPE_CHECKING:
+    from robokin.io.dh_extract import DHExtraction
+    from robokin.robot import Robot
+
+__all__ = [
+    "UrdfChain",
+    "dh_from_robot",
+    "dh_from_urdf",
+    "parse_urdf",
+    "robot_from_urdf",
+]
+
+MissingMesh = Literal["warn", "error", "ignore"]
+_SCHEME = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]*)://")
+
+_MOVABLE = ("revolute", "continuous", "prismatic")
+_KNOWN = (*_MOVABLE, "fixed", "floating", "planar")
+# Exact rotations that take the local z axis onto +x / +y (no cos(pi/2) residue).
+_Z_TO_X = np.array([[0.0, 0, 1, 0], [0, 1, 0, 0], [-1, 0, 0, 0], [0, 0, 0, 1]])
+_Z_TO_Y = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]])
+
+
+def _yourdfpy():
+    try:
+        import yourdfpy
+    except ImportError:
+        raise MissingExtraError("yourdfpy", "urdf") from None
+    return yourdfpy
+
+
+def _read_source(source: str | Path | bytes) -> tuple[bytes, Path | None]:
+    """The XML bytes and the file they came from (None for a string)."""
+    if isinstance(source, bytes):
+        return source, None
+    if isinstance(source, str) and source.lstrip().startswith("<"):
+        return source.encode("utf-8"), None
+    path = Path(source)
+    return read_file_bytes(path), path
+
+
+def _xml_parser() -> Any:
+    """lxml's parser with every fetch and expansion switched off, explicitly (not
+    left to the version's defaults): no entities, no DTD, no network, no huge
+    trees."""
+    from lxml import etree
+
+    return etree.XMLParser(remove_blank_text=True, resolve_entities=False,
+                           no_network=True, load_dtd=False, dtd_validation=False,
+                           huge_tree=False)
+
+
+def _check_xml(data: bytes, file: Path | None) -> None:
+    """Strict XML parse (yourdfpy silently 'recovers' broken XML) and structure."""
+    from lxml import etree
+
+    try:
+        tree = etree.ElementTree(etree.fromstring(data, parser=_xml_parser()))
+    except etree.XMLSyntaxError as exc:
+        raise ModelError(f"not valid XML: {exc.msg}"[:300], file=file,
+                         line=getattr(exc, "lineno", None)) from None
+    if tree.docinfo.doctype or tree.docinfo.internalDTD is not None:
+        raise ModelError("a <!DOCTYPE> (a DTD, entity declarations) is not allowed "
+                         "in a URDF", file=file, line=1)
+    root = tree.getroot()
+    if root.tag != "robot":
+        raise ModelError(f"the root element must be <robot>, got "
+                         f"<{short_repr(root.tag, 40)}>", file=file,
+                         line=root.sourceline)
+    if "name" not in root.attrib:
+        raise ModelError("<robot> has no 'name' attribute", file=file,
+                         line=root.sourceline)
+    for el in root.findall("link"):
+        if "name" not in el.attrib:
+            raise ModelError("<link> has no 'name' attribute", file=file,
+                             line=el.sourceline)
+    for el in root.findall("joint"):
+        _check_joint_element(el, file)
+    for el in root.iter("geometry"):
+        if len(el) == 0:
+            raise ModelError("empty <geometry>", file=file, field=_field(el, None),
+                             line=el.sourceline)
+    _check_numbers(root, file)
+
+
+def _check_joint_element(el: Any, file: Path | None) -> None:
+    name = el.get("name")
+    if name is None:
+        raise ModelError("<joint> has no 'name' attribute", file=file,
+                         line=el.sourceline)
+    where = f"joint[{name}]"
+    jtype = el.get("type")
+    if jtype not in _KNOWN:
+        raise ModelError(
+            f"type must be one of {list(_KNOWN)}, got {short_repr(jtype)}",
+            file=file, field=f"{where}.type", line=el.sourceline,
+        )
+    for tag in ("parent", "child"):
+        sub = el.find(tag)
+        if sub is None or sub.get("link") is None:
+            raise ModelError(f"missing <{tag} link=...>", file=file,
+                             field=f"{where}.{tag}", line=el.sourceline)
+    if jtype in ("revolute", "prismatic") and el.find("limit") is None:
+        raise ModelError(f"a {jtype} joint needs <limit lower=... upper=...>",
+                         file=file, field=f"{where}.limit", line=el.sourceline)
+    mim = el.find("mimic")
+    if mim is not None and mim.get("joint") is None:
+        raise ModelError("<mimic> has no 'joint' attribute", file=file,
+                         field=f"{where}.mimic", line=mim.sourceline)
+
+
+def _field(el: Any, key: str | None) -> str:
+    """``joint[name].origin.xyz``: the element's owner, tag and attribute."""
+    tail = el.tag if key is None else f"{el.tag}.{key}"
+    for up in el.iterancestors():
+        if up.tag in ("joint", "link") and up.get("name") is not None:
+            return f"{up.tag}[{up.get('name')}].{tail}"
+    if el.tag in ("joint", "link") and el.get("name") is not None and key is not None:
+        return f"{el.tag}[{el.get('name')}].{key}"
+    return tail
+
+
+# Attributes holding numbers: (tag, attribute) -> (count or None for 1 or 3,
+# positive required).
+_NUMBERS: dict[tuple[str, str], tuple[int | None, bool]] = {
+    ("*", "xyz"): (3, False),
+    ("*", "rpy"): (3, False),
+    ("limit", "lower"): (1, False),
+    ("limit", "upper"): (1, False),
+    ("limit", "effort"): (1, False),
+    ("limit", "velocity"): (1, False),
+    ("mimic", "multiplier"): (1, False),
+    ("mimic", "offset"): (1, False),
+    ("box", "size"): (3, True),
+    ("cylinder", "radius"): (1, True),
+    ("cylinder", "length"): (1, True),
+    ("sphere", "radius"): (1, True),
+    ("mesh", "scale"): (None, True),
+}
+_REQUIRED = {"box": ("size",), "cylinder": ("radius", "length"),
+             "sphere": ("radius",), "mesh": ("filename",)}
+
+
+def _check_numbers(root: Any, file: Path | None) -> None:
+    """Numeric attributes hold the right count of finite numbers (positive sizes),
+    shapes their required attributes; errors name the element, field and line."""
+    for el in root.iter():
+        if not isinstance(el.tag, str):
+            continue  # comments, processing instructions
+        for key in _REQUIRED.get(el.tag, ()):
+            if el.get(key) is None and el.getparent() is not None \
+                    and el.getparent().tag == "geometry":
+                raise ModelError(f"<{el.tag}> needs a '{key}' attribute", file=file,
+                                 field=_field(el, key), line=el.sourceline)
+        for key, text in el.attrib.items():
+            spec = _NUMBERS.get((el.tag, key)) or _NUMBERS.get(("*", key))
+            if spec is not None:
+                _check_number_text(el, key, text, spec, file)
+
+
+def _check_number_text(el: Any, key: str, text: str, spec: tuple[int | None, bool],
+                       file: Path | None) -> None:
+    count, positive = spec
+    try:
+        values = [float(v) for v in text.split()]
+    except ValueError:
+        values = None
+    expected = (f"{count} number{'s' if count != 1 else ''}" if count
+                else "1 or 3 numbers")
+    problem = None
+    if values is None or (count and len(values) != count) or \
+            (count is None and len(values) not in (1, 3)):
+        problem = f"expected {expected}"
+    elif not all(math.isfinite(v) for v in values):
+        problem = f"expected {expected}, finite (no NaN or infinity)"
+    elif positive and not all(v > 0 for v in values):
+        problem = "expected positive sizes"
+    if problem:
+        raise ModelError(f"<{el.tag} {key}={short_repr(text)}>: {problem}", file=file,
+                         field=_field(el, key), line=el.sourceline)
+
+
+def parse_urdf(source: str | Path | bytes) -> tuple[Any, Path | None]:
+    """Parse a URDF file or XML string with yourdfpy, strictly.
+
+    The XML is first parsed by lxml with entities, DTDs and the network off
+    (:func:`_xml_parser`); a document with a ``<!DOCTYPE>`` is refused, so
+    yourdfpy's own parse of the same bytes has nothing to expand or fetch.
+
+    Returns:
+        ``(yourdfpy.Robot, path or None)``.
+
+    Raises:
+        ModelError: unreadable or too large file, malformed XML, a DTD, a
+            non-finite or malformed number, or a structural error (naming the
+            file, the element and the line).
+        MissingExtraError: yourdfpy is not installed.
+    """
+    data, file = _read_source(source)
+    _check_xml(data, file)
+    yourdfpy = _yourdfpy()
+    try:
+        urdf = yourdfpy.URDF.load(
+            io.BytesIO(data),
+            build_scene_graph=False,
+            build_collision_scene_graph=False,
+            load_meshes=False,
+            load_collision_meshes=False,
+        )
+    except (KeyError, AttributeError, ValueError, TypeError, IndexError) as exc:
+        raise ModelError(f"malformed URDF: {short_repr(str(exc), 200)}",
+                         file=file) from None
+    return urdf.robot, file
+
+
+@dataclass(frozen=True)
+class _Step:
+    """One URDF joint on the path, walked forwards or (fixed joints only) backwards."""
+
+    joint: Any
+    reverse: bool
+
+
+class _Tree:
+    """The link/joint tree of a parsed URDF with checks and path queries."""
+
+    def __init__(self, robot: Any, file: Path | None) -> None:
+        self.file = file
+        self.links: dict[str, Any] = {}
+        for link in robot.links:
+            if link.name in self.links:
+                raise ModelError(f"link '{link.name}' is defined twice", file=file)
+            self.links[link.name] = link
+        self.joints: dict[str, Any] = {}
+        self.parent_joint: dict[str, Any] = {}
+        self.children: dict[str, list[Any]] = {name: [] for name in self.links}
+        for j in robot.joints:
+            where = f"joint[{j.name}]"
+            if j.name in self.joints:
+                raise ModelError("joint defined twice", file=file, field=where)
+            for role in ("parent", "child"):
+                link = getattr(j, role)
+                if link not in self.links:
+                    raise ModelError(
+                        f"{role} link '{link}' is not defined", file=file,
+                        field=f"{where}.{role}",
+                    )
+            if j.child in self.parent_joint:
+                raise ModelError(
+                    f"link '{j.child}' has two parent joints "
+                    f"('{self.parent_joint[j.child].name}' and '{j.name}'): "
+                    "a URDF must be a tree",
+                    file=file, field=where,
+                )
+            self.joints[j.name] = j
+            self.parent_joint[j.child] = j
+            self.children[j.parent].append(j)
+        roots = [n for n in self.links if n not in self.parent_joint]
+        if not roots:
+            raise ModelError("the joints form a loop: no root link", file=file)
+        if len(roots) > 1:
+            raise ModelError(
+                f"several root links {roots}: a URDF must be one connected tree",
+                file=file,
+            )
+        self.root = roots[0]
+        # Every link must be reachable from the root (no loop elsewhere).
+        seen = set(self._descendants(self.root))
+        if len(seen) != len(self.links):
+            loop = sorted(set(self.links) - seen)
+            raise ModelError(f"links {loop} form a loop", file=file)
+
+    def _descendants(self, link: str) -> list[str]:
+        out, stack = [], [link]
+        while stack:
+            cur = stack.pop()
+            out.append(cur)
+            stack.extend(j.child for j in self.children[cur])
+        return out
+
+    def ancestors(self, link: str) -> list[str]:
+        """The link, its parent link, ..., the root."""
+        out = [link]
+        while out[-1] in self.parent_joint:
+            out.append(self.parent_joint[out[-1]].parent)
+        return out
+
+    def check_link(self, name: str, role: str) -> None:
+        if name not in self.links:
+            names = sorted(self.links)
+            shown = ", ".join(names[:30]) + (" ..." if len(names) > 30 else "")
+            raise ModelError(
+                f"unknown {role} link '{name}'; links: {shown}", file=self.file,
+                field=f"{role}_link",
+            )
+
+    def path(self, base: str, tip: str) -> list[_Step]:
+        """The joints from ``base`` to ``tip``."""
+        up = self.ancestors(base)
+        down = self.ancestors(tip)
+        common = next((a for a in up if a in set(down)), None)
+        steps = []
+        for link in up[: up.index(common)]:
+            j = self.parent_joint[link]
+            if j.type != "fixed":
+                raise ModelError(
+                    f"the base link '{base}' hangs below the movable joint '{j.name}' "
+                    f"that is not between it and the tip '{tip}'; choose a base link "
+                    f"above it (e.g. '{self.root}')",
+                    file=self.file, field="base_link",
+                )
+            steps.append(_Step(j, True))
+        for link in reversed(down[: down.index(common)]):
+            steps.append(_Step(self.parent_joint[link], False))
+        return steps
+
+    def default_tip(self, base: str) -> str:
+        """The leaf below ``base`` whose path has the most movable joints."""
+        top = base  # a base hanging by fixed joints (ROS-I 'base') looks from above
+        while top in self.parent_joint and self.parent_joint[top].type == "fixed":
+            top = self.parent_joint[top].parent
+        leaves = [n for n in self._descendants(top) if not self.children[n]]
+        counts = {
+            leaf: sum(s.joint.type in _MOVABLE for s in self.path(base, leaf))
+            for leaf in leaves
+        }
+        best = max(counts.values())
+        if best == 0:
+            raise ModelError(
+                f"no movable joint below the base link '{base}'", file=self.file,
+                field="tip_link",
+            )
+        cands = sorted(leaf for leaf, c in counts.items() if c == best)
+        if len(cands) == 1:
+            return cands[0]
+        if "tool0" in cands:
+            return "tool0"
+        raise ModelError(
+            f"ambiguous tip link: {len(cands)} leaves {cands} are each {best} movable "
+            f"joints from '{base}'; pass tip_link= (CLI: --tip) to choose one",
+            file=self.file, field="tip_link",
+        )
+
+
+def _origin(j: Any) -> np.ndarray:
+    return np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=np.float64)
+
+
+def _invert(T: np.ndarray) -> np.ndarray:
+    out = np.eye(4)
+    out[:3, :3] = T[:3, :3].T
+    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
+    return out
+
+
+def axis_frame(axis: Sequence[float], *, where: str = "axis") -> tuple[np.ndarray, float]:
+    """A rotation ``A`` (4, 4) and sign with ``A @ Rz(sign q) @ A.T`` = rotation about ``axis``.
+
+    Axis-aligned axes give exact matrices; a negative axis (``-x``, ``-y``, ``-z``,
+    or any axis with a negative z component) gives ``sign = -1``.
+
+    Raises:
+        ModelError: a zero or non-finite axis.
+    """
+    u = np.asarray(axis, dtype=np.float64).reshape(-1)
+    norm = float(np.linalg.norm(u)) if u.shape == (3,) else 0.0
+    if u.shape != (3,) or not np.isfinite(u).all() or norm < 1e-12:
+        raise ModelError(f"the joint axis must be a non-zero 3-vector, got {u.tolist()}",
+                         field=where)
+    u = u / norm
+    nz = np.flatnonzero(np.abs(u) > 1e-15)
+    if len(nz) == 1:
+        i = int(nz[0])
+        sign = 1.0 if u[i] > 0 else -1.0
+        return ((_Z_TO_X, _Z_TO_Y, np.eye(4))[i]).copy(), sign
+    sign = 1.0
+    if u[2] < 0:
+        u, sign = -u, -1.0
+    # Minimal rotation taking z onto u (Rodrigues, 1 + cos >= 1 here).
+    v = np.array([-u[1], u[0], 0.0])
+    c = u[2]
+    K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    A = np.eye(4)
+    A[:3, :3] = np.eye(3) + K + K @ K / (1.0 + c)
+    return A, sign
+
+
+@dataclass(frozen=True)
+class UrdfChain:
+    """What :func:`robot_from_urdf` made of the URDF, besides the chain.
+
+    Attributes:
+        base_link: The chosen base link.
+        tip_link: The chosen tip link.
+        child_links: The URDF child link of every chain joint (n_chain).
+        link_frames: Every URDF link rigidly attached to the chain:
+            ``name -> (k, T)``, the link's pose ``T`` (4, 4) in the frame ``k`` of
+            ``fk_all`` (0: the base link; k: chain joint k's child link).
+        dropped_links: Links not rigidly attached to the chain (they move with
+            joints off the chain), sorted.
+    """
+
+    base_link: str
+    tip_link: str
+    child_links: tuple[str, ...]
+    link_frames: Mapping[str, tuple[int, np.ndarray]]
+    dropped_links: tuple[str, ...]
+
+
+def _limits(j: Any, file: Path | None) -> tuple[float, float]:
+    if j.type == "continuous":
+        return (-math.inf, math.inf)
+    lim = j.limit
+    lo = 0.0 if lim is None or lim.lower is None else float(lim.lower)
+    hi = 0.0 if lim is None or lim.upper is None else float(lim.upper)
+    if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
+        raise ModelError(
+            f"limits must be finite with lower <= upper, got [{lo}, {hi}]",
+            file=file, field=f"joint[{j.name}].limit",
+        )
+    return (lo, hi)
+
+
+def _kind(j: Any) -> str:
+    return "prismatic" if j.type == "prismatic" else "revolute"
+
+
+def _resolve_mimic(tree: _Tree, j: Any) -> tuple[Any, float, float]:
+    """The independent master of a mimic joint, with the composed multiplier/offset."""
+    mult, off, seen = 1.0, 0.0, {j.name}
+    cur = j
+    while cur.mimic is not None:
+        name = cur.mimic.joint
+        master = tree.joints.get(name)
+        where = f"joint[{cur.name}].mimic"
+        if master is None:
+            raise ModelError(f"mimics unknown joint '{name}'", file=tree.file, field=where)
+        if master.type not in _MOVABLE:
+            raise ModelError(
+                f"mimics the {master.type} joint '{name}'", file=tree.file, field=where
+            )
+        if name in seen:
+            raise ModelError("mimic joints form a loop", file=tree.file, field=where)
+        seen.add(name)
+        m = 1.0 if cur.mimic.multiplier is None else float(cur.mimic.multiplier)
+        o = 0.0 if cur.mimic.offset is None else float(cur.mimic.offset)
+        mult, off = mult * m, mult * o + off
+        cur = master
+    return cur, mult, off
+
+
+def chain_from_urdf_model(
+    robot: Any,
+    *,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    file: Path | None = None,
+) -> tuple[Chain, UrdfChain]:
+    """Compile the chain ``base_link`` -> ``tip_link`` of a parsed URDF model.
+
+    Args:
+        robot: A ``yourdfpy.Robot`` (``yourdfpy.URDF(...).robot``).
+        base_link: Base link name (default: the root).
+        tip_link: Tip link name (default: see the module docstring).
+        file: The file, for error messages.
+
+    Returns:
+        The canonical chain and the :class:`UrdfChain` bookkeeping.
+    """
+    tree = _Tree(robot, file)
+    base = tree.root if base_link is None else str(base_link)
+    tree.check_link(base, "base")
+    if tip_link is None:
+        tip = tree.default_tip(base)
+    else:
+        tip = str(tip_link)
+        tree.check_link(tip, "tip")
+    if tip == base:
+        raise ModelError("the base and tip links are the same", file=file,
+                         field="tip_link")
+    steps = tree.path(base, tip)
+    for s in steps:
+        if s.joint.type in ("floating", "planar"):
+            raise ModelError(
+                f"{s.joint.type} joints are not supported on a serial chain",
+                file=file, field=f"joint[{s.joint.name}].type",
+            )
+    movable = [i for i, s in enumerate(steps) if s.joint.type in _MOVABLE]
+    if not movable:
+        raise ModelError(
+            f"no movable joint between '{base}' and '{tip}'", file=file, field="tip_link"
+        )
+    last = movable[-1]
+    builder = ChainBuilder()
+    tool = np.eye(4)
+    coords: list[Joint] = []
+    deps: dict[str, Dependency] = {}
+    names: list[str] = []
+    child_links: list[str] = []
+    # Pose of every path link in its fk_all frame: (k, T).
+    frames: dict[str, tuple[int, np.ndarray]] = {base: (0, np.eye(4))}
+    k, T_rel = 0, np.eye(4)
+
+    def add_coordinate(j: Any) -> None:
+        if all(c.name != j.name for c in coords):
+            coords.append(Joint(j.name, _kind(j), _limits(j, file)))
+
+    for i, s in enumerate(steps):
+        j = s.joint
+        if s.reverse:  # fixed, walked from child to parent
+            C = _invert(_origin(j))
+            builder.constant(C)
+            T_rel = T_rel @ C
+            frames[j.parent] = (k, T_rel.copy())
+            continue
+        O = _origin(j)
+        if j.type == "fixed":
+            if i > last:
+                tool = tool @ O
+            else:
+                builder.constant(O)
+            T_rel = T_rel @ O
+            frames[j.child] = (k, T_rel.copy())
+            continue
+        try:
+            A, sign = axis_frame(j.axis, where=f"joint[{j.name}].axis")
+        except ModelError as exc:
+            raise ModelError(exc.reason, file=file, field=exc.field) from None
+        kind = _kind(j)
+        if j.mimic is None:
+            add_coordinate(j)
+            joint = Joint(j.name, kind, _limits(j, file), sign)
+        else:
+            master, mult, off = _resolve_mimic(tree, j)
+            add_coordinate(master)
+            deps[j.name] = mimic(master.name, mult, off)
+            lim = (-math.inf, math.inf) if j.limit is None else _limits(j, file)
+            joint = Joint(j.name, kind, lim, sign)
+        builder.constant(O @ A).joint(joint).constant(A.T.copy()).frame()
+        names.append(j.name)
+        child_links.append(j.child)
+        k, T_rel = k + 1, np.eye(4)
+        frames[j.child] = (k, T_rel.copy())
+    coupling = coordinates = None
+    if deps:
+        coupling = coupling_from_dependencies(names, [c.name for c in coords], deps)
+        coordinates = tuple(coords)
+    chain = builder.build(tool=tool, coordinates=coordinates, coupling=coupling)
+    # Links hanging off the path by fixed joints move with it.
+    on_path = set(frames)
+    stack = list(on_path)
+    while stack:
+        link = stack.pop()
+        kk, T = frames[link]
+        for j in tree.children[link]:
+            if j.child in frames or j.type != "fixed":
+                continue
+            frames[j.child] = (kk, T @ _origin(j))
+            stack.append(j.child)
+    dropped = tuple(sorted(set(tree.links) - set(frames)))
+    info = UrdfChain(
+        base_link=base,
+        tip_link=tip,
+        child_links=tuple(child_links),
+        link_frames=frames,
+        dropped_links=dropped,
+    )
+    return chain, info
+
+
+# ---------------------------------------------------------------------- geometry
+def _resolve_mesh(
+    filename: str, file: Path | None, package_map: Mapping[str, str | Path] | None
+) -> tuple[Path | None, str]:
+    """Resolve a mesh reference to a path; ``(None, reason)`` when it cannot be."""
+    if filename.startswith("package://"):
+        rest = filename[len("package://"):]
+        pkg, _, sub = rest.partition("/")
+        root = (package_map or {}).get(pkg)
+        if root is None:
+            return None, (
+                f"package '{pkg}' is not in the package map "
+                f"(pass package_map={{'{pkg}': '/path/to/{pkg}'}})"
+            )
+        return _mesh_file(Path(root) / sub)
+    if filename.startswith("file://"):
+        return _mesh_file(Path(filename[len("file://"):]))
+    scheme = _SCHEME.match(filename)
+    if scheme:
+        return None, f"a remote mesh ({scheme.group(1)}://) is not fetched"
+    p = Path(filename)
+    if not p.is_absolute():
+        if file is None:
+            return None, "a relative mesh path in a URDF string has no directory"
+        p = file.parent / p
+    return _mesh_file(p)
+
+
+def _mesh_file(p: Path) -> tuple[Path | None, str]:
+    """``p`` when it names an existing mesh file robokin reads, else the reason."""
+    if p.suffix.lower() not in MESH_SUFFIXES:
+        return None, (f"not a mesh file (suffix {short_repr(p.suffix)}; robokin "
+                      f"reads {', '.join(MESH_SUFFIXES)})")
+    if not p.is_file():
+        return None, f"no such file {p}"
+    return p, ""
+
+
+class _Drops:
+    """Shapes left out of the import: raised, warned or only recorded."""
+
+    def __init__(self, mode: MissingMesh, file: Path | None) -> None:
+        self.mode, self.file = mode, file
+        self.messages: list[str] = []
+
+    def drop(self, link: str, role: str, uri: str, why: str) -> None:
+        msg = f"link '{link}' {role} mesh {short_repr(uri, 200)}: {why}"
+        if self.mode == "error":
+            raise ModelError(msg, file=self.file, field=f"link[{link}].{role}")
+        if self.mode == "warn":
+            warnings.warn(f"{msg}; shape skipped", UserWarning, stacklevel=4)
+        self.messages.append(msg)
+
+
+def _geometry_of(
+    urdf_robot: Any,
+    info: UrdfChain,
+    file: Path | None,
+    package_map: Mapping[str, str | Path] | None,
+    drops: _Drops,
+) -> list[dict[str, Any]]:
+    """Every visual and collision shape of the chain's links, placed in fk_all frames.
+
+    Each entry: ``{"link": URDF link, "frame": k, "role": "visual"|"collision",
+    "pose": (4, 4) in frame k, "type": "box"|"cylinder"|"sphere"|"mesh",
+    "size"|"radius"|"length"|"filename"|"scale": ...}``.
+    """
+    out: list[dict[str, Any]] = []
+    for link in urdf_robot.links:
+        if link.name not in info.link_frames:
+            continue
+        k, T = info.link_frames[link.name]
+        for role, items in (("visual", link.visuals), ("collision", link.collisions)):
+            for item in items:
+                g = item.geometry
+                pose = T @ (np.eye(4) if item.origin is None else item.origin)
+                entry: dict[str, Any] = {
+                    "link": link.name, "frame": k, "role": role, "pose": pose,
+                    "name": item.name,
+                }
+                if g.box is not None:
+                    entry.update(type="box", size=tuple(float(v) for v in g.box.size))
+                elif g.cylinder is not None:
+                    entry.update(type="cylinder", radius=float(g.cylinder.radius),
+                                 length=float(g.cylinder.length))
+                elif g.sphere is not None:
+                    entry.update(type="sphere", radius=float(g.sphere.radius))
+                elif g.mesh is not None:
+                    path, why = _resolve_mesh(g.mesh.filename, file, package_map)
+                    if path is None:
+                        drops.drop(link.name, role, g.mesh.filename, why)
+                        continue
+                    scale = g.mesh.scale
+                    scale = (1.0, 1.0, 1.0) if scale is None else tuple(
+                        float(v) for v in np.broadcast_to(scale, (3,))
+                    )
+                    entry.update(type="mesh", filename=str(path), scale=scale,
+                                 uri=g.mesh.filename)
+                else:  # pragma: no cover - _check_xml refuses empty geometry
+                    continue
+                out.append(entry)
+    return out
+
+
+def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]], drops: _Drops
+                     ) -> Robot:
+    """Put the collision shapes on the geometry layer (visual ones where a link has
+    no collision shape)."""
+    from robokin.model import geometry as geo
+
+    names = geo.link_names(robot)
+    with_collision = {e["link"] for e in shapes if e["role"] == "collision"}
+    per_link: dict[str, list[Any]] = {}
+    for e in shapes:
+        if e["role"] == "visual" and e["link"] in with_collision:
+            continue
+        pose, label = e["pose"], e.get("name") or ""
+        t = e["type"]
+        if t == "box":
+            shape = geo.box(e["size"], pose, name=label)
+        elif t == "cylinder":
+            shape = geo.cylinder(e["radius"], e["length"], pose, name=label)
+        elif t == "sphere":
+            shape = geo.sphere(e["radius"], pose, name=label)
+        else:
+            sc = e["scale"]
+            if not (sc[0] == sc[1] == sc[2]):
+                drops.drop(e["link"], e["role"], e["uri"],
+                           f"non-uniform scale {list(sc)} is not supported")
+                continue
+            shape = geo.mesh(e["filename"], pose, scale=sc[0], name=label,
+                             owner=e["link"])
+        per_link.setdefault(names[e["frame"]], []).append(shape)
+    return robot.replace(geometry=geo.RobotGeometry.from_mapping(robot, per_link))
+
+
+# ------------------------------------------------------------------------ public
+def robot_from_urdf(
+    path_or_string: str | Path | bytes,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    package_map: Mapping[str, str | Path] | None = None,
+    *,
+    geometry: bool = True,
+    missing_mesh: MissingMesh = "warn",
+    name: str | None = None,
+) -> Robot:
+    """Load the serial chain of a URDF as a robot (needs ``robokin[urdf]``).
+
+    Args:
+        path_or_string: A URDF file path, or the XML itself (a string starting
+            with ``<``, or bytes).
+        base_link: The link the chain starts at (default: the root link).
+        tip_link: The link it ends at (default: the leaf with the most movable
+            joints below the base; ``tool0`` wins a tie).
+        package_map: ``{package: directory}`` to resolve ``package://`` meshes.
+        geometry: Read visual and collision shapes (False: kinematics only).
+        missing_mesh: A mesh that cannot be used (missing file, remote URI, a
+            file that is not a mesh, a non-uniform scale): ``"warn"`` (default:
+            a UserWarning naming the link and file, the shape is skipped),
+            ``"error"`` (ModelError) or ``"ignore"`` (skipped silently; still
+            listed in ``meta["urdf_dropped_shapes"]``).
+        name: The robot's name (default: the URDF's ``<robot name>``).
+
+    Returns:
+        A :class:`~robokin.robot.Robot` with ``robot.meta["urdf"]`` holding the
+        :class:`UrdfChain`, ``robot.meta["urdf_shapes"]`` the shapes and
+        ``robot.meta["urdf_dropped_shapes"]`` one message per shape left out.
+
+    Raises:
+        ModelError: a bad file (naming the file, element and reason).
+        MissingExtraError: yourdfpy is not installed.
+    """
+    from robokin.robot import Robot
+
+    if missing_mesh not in ("warn", "error", "ignore"):
+        raise ModelError(
+            "missing_mesh must be 'warn', 'error' or 'ignore', got "
+            f"{short_repr(missing_mesh)}",
+            field="missing_mesh",
+        )
+    urdf_robot, file = parse_urdf(path_or_string)
+    chain, info = chain_from_urdf_model(
+        urdf_robot, base_link=base_link, tip_link=tip_link, file=file
+    )
+    drops = _Drops(missing_mesh, file)
+    shapes = _geometry_of(urdf_robot, info, file, package_map, drops) if geometry \
+        else []
+    source = f"URDF {file}" if file is not None else "URDF string"
+    robot = Robot(
+        chain,
+        name=name or urdf_robot.name,
+        source=f"{source}, chain {info.base_link} -> {info.tip_link}",
+        meta={"urdf": info, "urdf_shapes": shapes},
+    )
+    if shapes:
+        robot = _attach_geometry(robot, shapes, drops)
+    return robot.replace(meta={**robot.meta,
+                               "urdf_dropped_shapes": tuple(drops.messages)})
+
+
+def dh_from_urdf(
+    path_or_string: str | Path | bytes,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    *,
+    convention: Literal["standard", "modified"] = "standard",
+    reference_link: str | None = None,
+    virtual_frames: bool = False,
+) -> DHExtraction:
+    """DH table of a URDF arm (see :func:`robokin.io.dh_extract.dh_from_robot`).
+
+    Args:
+        path_or_string: URDF file or XML string.
+        base_link: Chain start (default: the root).
+        tip_link: Chain end (default as in :func:`robot_from_urdf`).
+        convention: ``"standard"`` or ``"modified"``.
+        reference_link: The link whose frame guides the choice of DH frame 0 (its
+            x axis and origin). Default: the ROS-Industrial ``base`` link when the
+            URDF has one rigidly attached to the base (it is the controller's
+            base frame, which vendors' DH tables use), else the base link.
+        virtual_frames: Fold the remaining base and tool transforms into fixed
+            rows (virtual frames) so the table alone reproduces the robot.
+
+    Returns:
+        A :class:`~robokin.io.dh_extract.DHExtraction`.
+    """
+    from robokin.io.dh_extract import dh_from_robot as _dh
+
+    robot = robot_from_urdf(path_or_string, base_link, tip_link, geometry=False)
+    info: UrdfChain = robot.meta["urdf"]
+    ref = reference_link
+    if ref is None and "base" in info.link_frames and info.link_frames["base"][0] == 0:
+        ref = "base"
+    reference = None
+    if ref is not None:
+        if ref not in info.link_frames or info.link_frames[ref][0] != 0:
+            raise ModelError(
+                f"reference link '{ref}' is not rigidly attached to the base link "
+                f"'{info.base_link}'", field="reference_link",
+            )
+        reference = info.link_frames[ref][1]
+    return _dh(robot, convention=convention, reference=reference,
+               virtual_frames=virtual_frames)
+
+
+def dh_from_robot(robot: Robot, convention: str = "standard", **kwargs: Any) -> DHExtraction:
+    """See :func:`robokin.io.dh_extract.dh_from_robot`."""
+    from robokin.io.dh_extract import dh_from_robot as _dh
+
+    return _dh(robot, convention=convention, **kwargs)

@@ -1,0 +1,197 @@
+"""Robot files: units, validation with field paths, atomic save, round trips."""
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+import robokin
+from reference import random_q
+from robokin.io.robot_files import document_from_robot, load_robot, save_robot
+
+GOOD = """\
+name: two_link
+source: a test arm
+units: {length: mm, angle: deg}
+convention: standard
+joints:
+  - {name: j1, joint: revolute, a: 300, alpha: 0, d: 100, theta: 0, limits: [-90, 90]}
+  - {name: j2, joint: prismatic, a: 0, alpha: 0, d: 50, theta: 90, limits: [0, 200]}
+tool: {xyz: [0, 0, 100], rpy: [180, 0, 0]}
+"""
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    p = tmp_path / "robot.yaml"
+    p.write_text(text)
+    return p
+
+
+def test_units_are_converted_once_at_the_edge(tmp_path):
+    robot = load_robot(_write(tmp_path, GOOD))
+    np.testing.assert_allclose(robot.limits, [[-np.pi / 2, np.pi / 2], [0.0, 0.2]])
+    T = robot.fk([0.0, 0.02])
+    # j1: Rz(0) Tz(0.1) Tx(0.3); j2: Rz(90 deg) Tz(0.05 + 0.02); tool Tz(0.1) Rx(180 deg)
+    np.testing.assert_allclose(T[:3, 3], [0.3, 0.0, 0.1 + 0.07 + 0.1], atol=1e-12)
+    np.testing.assert_allclose(
+        T[:3, :3], [[0, 1, 0], [1, 0, 0], [0, 0, -1]], atol=1e-12
+    )
+
+
+CASES = [
+    ("name: x\njoints: []\n", r"robot\.yaml:2: joints"),
+    ("joints:\n  - {a: 1}\n", r"robot\.yaml: name: missing required field"),
+    (
+        GOOD.replace("limits: [-90, 90]", "limits: [90, -90]"),
+        r"joints\[0\]\.limits.*reversed",
+    ),
+    (GOOD.replace("limits: [-90, 90]", "limits: 5"), r"joints\[0\]\.limits"),
+    (GOOD.replace("a: 300", "a: three"), r"joints\[0\]\.a"),
+    (GOOD.replace("a: 300", "a: .nan"), r"joints\[0\]\.a"),
+    (GOOD.replace("length: mm", "length: inch"), r"units\.length"),
+    (GOOD.replace("angle: deg", "angle: grad"), r"units\.angle"),
+    (GOOD.replace("convention: standard", "convention: craig"), r"convention"),
+    (GOOD.replace("joint: prismatic", "joint: ball"), r"joints\[1\]\.joint"),
+    (GOOD.replace("  - {name: j2", "  - 7\n  - {name: j2"), r"joints\[1\]"),
+    (
+        GOOD.replace("theta: 90,", "theta: 90, colour: red,"),
+        r"joints\[1\]\.colour: unknown",
+    ),
+    (GOOD.replace("rpy: [180, 0, 0]", "rpy: [180, 0]"), r"tool\.rpy"),
+    (GOOD + "wheels: 4\n", r"wheels: unknown field"),
+    ("- just\n- a list\n", r"robot\.yaml: a robot file must be a mapping"),
+    ("name: [unclosed\n", r"robot\.yaml:2: not valid YAML, column"),
+    (GOOD.replace("name: j2", "name: j1"), r"unique"),
+]
+
+
+@pytest.mark.parametrize(("text", "match"), CASES)
+def test_malformed_files_name_the_file_and_field(tmp_path, text, match):
+    with pytest.raises(robokin.ModelError, match=match):
+        load_robot(_write(tmp_path, text))
+
+
+def test_missing_file_is_a_model_error(tmp_path):
+    with pytest.raises(robokin.ModelError, match="no such file"):
+        robokin.load(tmp_path / "nope.yaml")
+
+
+def test_unknown_builtin_lists_the_names():
+    with pytest.raises(robokin.ModelError, match="aubo_i5.*ur5"):
+        robokin.load("ur6")
+
+
+def test_save_round_trips_a_loaded_file(tmp_path):
+    robot = load_robot(_write(tmp_path, GOOD))
+    out = save_robot(robot, tmp_path / "copy.yaml")
+    assert yaml.safe_load(out.read_text()) == yaml.safe_load(GOOD)
+    again = load_robot(out)
+    np.testing.assert_array_equal(again.fk([0.3, 0.1]), robot.fk([0.3, 0.1]))
+
+
+@pytest.mark.parametrize("name", ["panda", "qfmd010", "improved_dh_arm"])
+def test_code_built_robots_save_as_exact_elementary_files(tmp_path, name, rng):
+    original = robokin.load(name)
+    robot = original.replace(meta={})  # forget the source document
+    doc = document_from_robot(robot)
+    assert doc["convention"] == "elementary"
+    again = robokin.load(save_robot(robot, tmp_path / f"{name}.yaml"))
+    q = random_q(original, rng, 20)
+    np.testing.assert_allclose(again.fk(q), original.fk(q), atol=1e-12)
+    np.testing.assert_allclose(again.limits, original.limits)
+    np.testing.assert_allclose(again.fk_all(q), original.fk_all(q), atol=1e-12)
+
+
+def test_failed_save_keeps_the_old_file(tmp_path, monkeypatch):
+    target = tmp_path / "robot.yaml"
+    target.write_text(GOOD)
+    robot = load_robot(target)
+
+    def boom(*args, **kwargs):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(os, "fsync", boom)
+    with pytest.raises(robokin.InputError, match=r"robot\.yaml: cannot write: disk full"):
+        save_robot(robot, target)
+    assert target.read_text() == GOOD
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["robot.yaml"]  # no temp left
+
+
+def test_dependent_joint_units_are_converted(tmp_path):
+    text = """\
+name: dep
+units: {length: mm, angle: deg}
+convention: elementary
+joints:
+  - {op: rz, joint: revolute, name: a, limits: [-90, 90]}
+  - {op: tx, value: 1000}
+  - {op: rz, joint: revolute, name: b, depends: {a: -1}, depends_offset: 90}
+"""
+    robot = load_robot(_write(tmp_path, text))
+    assert robot.n == 1
+    T = robot.fk([0.25])
+    np.testing.assert_allclose(T[:3, 3], [np.cos(0.25), np.sin(0.25), 0], atol=1e-12)
+    # total rotation 0.25 - 0.25 + 90 deg
+    np.testing.assert_allclose(T[:3, 0], [0, 1, 0], atol=1e-12)
+    bad = text.replace("depends: {a: -1}", "depends: {zz: -1}")
+    with pytest.raises(
+        robokin.ModelError, match=r"joints\[2\]\.depends.*unknown coordinate 'zz'"
+    ):
+        load_robot(_write(tmp_path, bad))
+
+
+def test_code_built_robot_keeps_its_actuators_when_saved(tmp_path, rng):
+    scara = robokin.load("scara")
+    robot = scara.replace(meta={})
+    again = robokin.load(save_robot(robot, tmp_path / "scara.yaml"))
+    q = random_q(scara, rng, 10)
+    np.testing.assert_allclose(
+        again.actuators_from_joints(q), scara.actuators_from_joints(q), atol=1e-12
+    )
+
+
+@pytest.mark.parametrize("name", ["aubo_i5", "scara"])
+def test_code_built_robot_keeps_its_geometry_when_saved(tmp_path, name):
+    original = robokin.load(name)
+    robot = original.replace(meta={})
+    again = robokin.load(save_robot(robot, tmp_path / f"{name}.yaml"))
+    geo, ref = again.geometry, original.geometry
+    assert geo.names == ref.names
+    assert geo.exclude == ref.exclude and geo.exclude_adjacent == ref.exclude_adjacent
+    for a_shapes, b_shapes in zip(geo.shapes, ref.shapes):
+        assert [s.kind for s in a_shapes] == [s.kind for s in b_shapes]
+        for a, b in zip(a_shapes, b_shapes):
+            np.testing.assert_allclose(a.size, b.size)
+            np.testing.assert_allclose(a.placement, b.placement, atol=1e-12)
+
+
+def test_a_changed_loaded_robot_saves_its_changes(tmp_path, rng):
+    from robokin.spatial import trans
+
+    ur5 = robokin.load("ur5")
+    tooled = ur5.with_tool(trans(0, 0, 0.2))
+    again = robokin.load(save_robot(tooled, tmp_path / "tooled.yaml"))
+    q = random_q(ur5, rng, 10)
+    np.testing.assert_allclose(again.fk(q), tooled.fk(q), atol=1e-12)
+    bare = robokin.load(save_robot(ur5.replace(geometry=None), tmp_path / "bare.yaml"))
+    assert bare.geometry is None
+    renamed = robokin.load(save_robot(ur5.replace(name="ur5_cell_3"), tmp_path / "r.yaml"))
+    assert renamed.name == "ur5_cell_3"
+    # an unchanged robot keeps its file's own document (units and DH rows)
+    same = yaml.safe_load(save_robot(ur5, tmp_path / "same.yaml").read_text())
+    assert same["convention"] == "standard" and same["units"]["length"] == "mm"
+
+
+def test_save_gives_normal_permissions_and_keeps_existing_ones(tmp_path):
+    robot = robokin.load("scara")
+    new = save_robot(robot, tmp_path / "new.yaml")
+    mask = os.umask(0)
+    os.umask(mask)
+    assert new.stat().st_mode & 0o777 == 0o666 & ~mask
+    existing = tmp_path / "existing.yaml"
+    existing.write_text("x")
+    existing.chmod(0o640)
+    save_robot(robot, existing)
+    assert existing.stat().st_mode & 0o777 == 0o640

@@ -1,0 +1,280 @@
+"""URDF import: FK against pinocchio's parser, the vendor arms against their DH
+models, axes, prismatic and mimic joints, tip choice, geometry and error paths."""
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import robokin
+from robokin.exceptions import ModelError
+from robokin.spatial import rotz
+
+pytest.importorskip("yourdfpy")
+from robokin.io.urdf import axis_frame, robot_from_urdf  # noqa: E402
+
+DATA = Path(__file__).parent.parent / "data" / "urdf"
+
+
+def pin_fk(xml: str, frame: str, values: dict[str, float]) -> np.ndarray:
+    """Pose of ``frame`` from pinocchio's own URDF parser (continuous: cos/sin)."""
+    pin = pytest.importorskip("pinocchio")
+    model = pin.buildModelFromXML(xml)
+    data = model.createData()
+    q = pin.neutral(model)
+    for name, v in values.items():
+        j = model.joints[model.getJointId(name)]
+        if j.nq == 1:
+            q[j.idx_q] = v
+        else:
+            q[j.idx_q], q[j.idx_q + 1] = math.cos(v), math.sin(v)
+    pin.framesForwardKinematics(model, data, q)
+    return data.oMf[model.getFrameId(frame)].homogeneous
+
+
+def random_q(robot, rng, m=20):
+    lim = np.clip(robot.limits, -3.0, 3.0)
+    return rng.uniform(lim[:, 0], lim[:, 1], (m, robot.n))
+
+
+def test_industrial_arm_matches_pinocchio(rng):
+    xml = (DATA / "industrial6.urdf").read_text()
+    robot = robot_from_urdf(DATA / "industrial6.urdf")
+    assert robot.meta["urdf"].tip_link == "tool0"  # not the fixed 'base' leaf
+    assert robot.joint_names == tuple(f"joint_{i}" for i in range(1, 7))
+    # negative axes become reversed joints; continuous joints are unlimited
+    assert [j.sign for j in robot.chain.joints] == [1, 1, -1, -1, 1, -1]
+    assert np.isinf(robot.limits[5]).all()
+    np.testing.assert_allclose(robot.limits[2], [-2.443, 3.316])
+    q = random_q(robot, rng)
+    T = robot.fk(q)
+    for qi, Ti in zip(q, T):
+        ref = pin_fk(xml, "tool0", dict(zip(robot.joint_names, qi)))
+        np.testing.assert_allclose(Ti, ref, atol=1e-12)
+
+
+def test_link_frames_are_the_urdf_child_link_frames(rng):
+    xml = (DATA / "industrial6.urdf").read_text()
+    robot = robot_from_urdf(xml)  # the XML string works as well as the path
+    q = random_q(robot, rng, 5)
+    frames = robot.fk_all(q)
+    for qi, Fi in zip(q, frames):
+        vals = dict(zip(robot.joint_names, qi))
+        for k, link in enumerate(robot.meta["urdf"].child_links, start=1):
+            np.testing.assert_allclose(Fi[k], pin_fk(xml, link, vals), atol=1e-12)
+    # a fixed link between movable joints keeps its pose on the previous link
+    k, T = robot.meta["urdf"].link_frames["link_3_housing"]
+    assert k == 3
+    ref = pin_fk(xml, "link_3_housing", dict(zip(robot.joint_names, q[0])))
+    np.testing.assert_allclose(frames[0, 3] @ T, ref, atol=1e-12)
+
+
+def test_tilted_axes_prismatic_and_mimic_match_pinocchio(rng):
+    text = (DATA / "tilted_prismatic.urdf").read_text()
+    robot = robot_from_urdf(DATA / "tilted_prismatic.urdf")
+    assert robot.n == 4 and robot.n_chain == 5
+    assert robot.joint_names == ("joint_a", "joint_b", "joint_d", "joint_e")
+    assert robot.chain.joints[1].kind == "prismatic"
+    np.testing.assert_allclose(robot.limits[1], [-0.1, 0.4])
+    # without the mimic element joint_c is free: pinocchio evaluates it there
+    free = re.sub(r"<mimic[^>]*/>", "", text)
+    q = random_q(robot, rng)
+    for qi, Ti in zip(q, robot.fk(q)):
+        vals = dict(zip(robot.joint_names, qi))
+        vals["joint_c"] = -2.0 * vals["joint_a"] + 0.1
+        np.testing.assert_allclose(Ti, pin_fk(free, "tip", vals), atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "axis", [(0, 0, 1), (0, 0, -1), (1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -2, 0),
+             (0.6, 0, 0.8), (0.3, -0.4, -0.2), (1, 1, 1e-9)]
+)
+def test_axis_frame_rotates_about_the_axis(axis):
+    A, sign = axis_frame(axis)
+    u = np.array(axis, float) / np.linalg.norm(axis)
+    q = 0.7
+    R = (A @ rotz(sign * q) @ A.T)[:3, :3]
+    K = np.array([[0, -u[2], u[1]], [u[2], 0, -u[0]], [-u[1], u[0], 0]])
+    rodrigues = np.eye(3) + math.sin(q) * K + (1 - math.cos(q)) * K @ K
+    np.testing.assert_allclose(R, rodrigues, atol=1e-15)
+    np.testing.assert_allclose(A[:3, :3] @ A[:3, :3].T, np.eye(3), atol=1e-15)
+
+
+def test_ur5_urdf_is_the_dh_model_turned_by_pi(rng):
+    urdf = robot_from_urdf(DATA / "ur5.urdf", missing_mesh="ignore")
+    dh = robokin.load("ur5")
+    q = random_q(dh, rng)
+    # ROS-Industrial base_link is REP-103: the controller's 'base' turned by pi
+    np.testing.assert_allclose(urdf.fk(q), rotz(math.pi) @ dh.fk(q), atol=1e-12)
+    # from the 'base' frame (a fixed leaf walked backwards) the two are identical
+    from_base = robot_from_urdf(DATA / "ur5.urdf", base_link="base", geometry=False)
+    np.testing.assert_allclose(from_base.fk(q), dh.fk(q), atol=1e-12)
+    np.testing.assert_allclose(urdf.limits[2], [-math.pi, math.pi])
+
+
+def test_panda_urdf_is_the_modified_dh_model(rng):
+    arm = robot_from_urdf(DATA / "panda.urdf", tip_link="panda_link8")
+    dh = robokin.load("panda")
+    q = random_q(dh, rng)
+    np.testing.assert_allclose(arm.fk(q), dh.fk(q), atol=1e-12)
+    np.testing.assert_allclose(arm.limits, dh.limits)
+    # with the hand: the known -45 deg turn and the finger offset
+    hand = robot_from_urdf(DATA / "panda.urdf", tip_link="panda_hand")
+    np.testing.assert_allclose(hand.fk(q), dh.fk(q) @ rotz(-math.pi / 4), atol=1e-12)
+
+
+def test_mimic_master_off_the_chain_becomes_a_coordinate(rng):
+    right = robot_from_urdf(DATA / "panda.urdf", tip_link="panda_rightfinger")
+    left = robot_from_urdf(DATA / "panda.urdf", tip_link="panda_leftfinger")
+    assert right.n == 8 and right.joint_names[-1] == "panda_finger_joint1"
+    assert [j.name for j in right.chain.joints][-1] == "panda_finger_joint2"
+    np.testing.assert_allclose(right.limits[-1], [0.0, 0.04])
+    q = random_q(right, rng)
+    # the fingers open symmetrically: they sit 2 * q8 apart along the hand's y
+    gap = right.fk(q)[:, :3, 3] - left.fk(q)[:, :3, 3]
+    np.testing.assert_allclose(np.linalg.norm(gap, axis=-1), 2 * q[:, 7], atol=1e-12)
+
+
+def test_ambiguous_tip_lists_candidates_and_explicit_tip_works(rng):
+    with pytest.raises(ModelError, match=r"ambiguous tip.*left_tool.*right_tool"):
+        robot_from_urdf(DATA / "branched.urdf")
+    with pytest.raises(ModelError, match=r"ambiguous tip.*panda_leftfinger"):
+        robot_from_urdf(DATA / "panda.urdf")
+    left = robot_from_urdf(DATA / "branched.urdf", tip_link="left_tool")
+    assert left.joint_names == ("waist", "left_shoulder", "left_elbow")
+    q = np.array([0.3, 0.4, -0.5])
+    # planar check: shoulder at (0, 0.2, 0.8) in the chest, two links of 0.3/0.25
+    c, s = math.cos, math.sin
+    x = -0.3 * s(0.4) - 0.25 * s(0.4 - 0.5)
+    z = 0.8 - 0.3 * c(0.4) - 0.25 * c(0.4 - 0.5)
+    p = rotz(0.3)[:3, :3] @ np.array([x, 0.2, z])
+    np.testing.assert_allclose(left.fk(q)[:3, 3], p, atol=1e-12)
+    # a base below a movable joint that is not on the way to the tip
+    with pytest.raises(ModelError, match="hangs below the movable joint 'left_shoulder'"):
+        robot_from_urdf(DATA / "branched.urdf", base_link="left_1", tip_link="right_tool")
+    with pytest.raises(ModelError, match="unknown tip link 'nose'; links: chest"):
+        robot_from_urdf(DATA / "branched.urdf", tip_link="nose")
+
+
+def test_geometry_meshes_package_map_and_missing_mesh():
+    pytest.importorskip("trimesh")
+    with pytest.warns(UserWarning, match=r"link 'arm' collision mesh 'meshes/not_there.stl'"):
+        robot = robot_from_urdf(DATA / "meshes_arm.urdf",
+                                package_map={"meshy_description": str(DATA)})
+    geo = robot.geometry
+    assert geo.names == ("base", "j1", "tool")
+    (base_mesh,) = geo.link("base")
+    assert base_mesh.kind == "mesh" and base_mesh.scale == 0.5
+    assert base_mesh.file == DATA / "meshes" / "cube.stl"
+    np.testing.assert_allclose(base_mesh.placement[:3, 3], [0, 0, 0.05])
+    (arm_box,) = geo.link("j1")  # collision shapes win over visual ones
+    assert arm_box.kind == "box" and arm_box.size == (0.2, 0.05, 0.05)
+    np.testing.assert_allclose(base_mesh.trimesh().extents, [0.05] * 3, atol=1e-12)
+    with pytest.raises(ModelError, match=r"not_there.stl.*no such file"):
+        robot_from_urdf(DATA / "meshes_arm.urdf", missing_mesh="error",
+                        package_map={"meshy_description": DATA})
+    # the package map resolves package:// (here: the visual mesh)
+    shapes = robot_from_urdf(
+        DATA / "meshes_arm.urdf", missing_mesh="ignore",
+        package_map={"meshy_description": DATA},
+    ).meta["urdf_shapes"]
+    visual = [s for s in shapes if s["role"] == "visual"]
+    assert visual[0]["filename"] == str(DATA / "meshes" / "cube.stl")
+    with pytest.raises(ModelError, match="package 'meshy_description' is not in the package map"):
+        robot_from_urdf(DATA / "meshes_arm.urdf", missing_mesh="error",
+                        package_map={})
+    # kinematics only: no geometry read, no warning
+    assert robot_from_urdf(DATA / "meshes_arm.urdf", geometry=False).geometry is None
+
+
+@pytest.mark.parametrize(
+    ("xml", "match"),
+    [
+        ("<robot name='r'><link name='a'/>", "line 1: not valid XML"),
+        ("<robt name='r'/>", "root element must be <robot>"),
+        ("<robot name='r'><link name='a'/><link name='b'/><joint name='j' type='revolute'>"
+         "<parent link='a'/><child link='b'/></joint></robot>", r"joint\[j\].limit"),
+        ("<robot name='r'><link name='a'/><link name='b'/><joint name='j' type='fixed'>"
+         "<parent link='a'/><child link='c'/></joint></robot>",
+         r"child link 'c' is not defined"),
+        ("<robot name='r'><link name='a'/><link name='b'/><joint name='j' type='hinge'>"
+         "<parent link='a'/><child link='b'/></joint></robot>", "type must be one of"),
+        ("<robot name='r'><link name='a'/><link name='b'/></robot>", "several root links"),
+        ("<robot name='r'><link name='a'/><link name='b'/><link name='c'/>"
+         "<joint name='j' type='floating'><parent link='a'/><child link='b'/></joint>"
+         "<joint name='k' type='continuous'><parent link='b'/><child link='c'/></joint>"
+         "</robot>",
+         "floating joints are not supported"),
+        ("<robot name='r'><link name='a'/><link name='b'/><joint name='j' type='revolute'>"
+         "<parent link='a'/><child link='b'/><axis xyz='0 0 0'/>"
+         "<limit lower='0' upper='1' effort='1' velocity='1'/></joint></robot>",
+         "non-zero 3-vector"),
+        ("<robot name='r'><link name='a'/><link name='b'/><joint name='j' type='revolute'>"
+         "<parent link='a'/><child link='b'/>"
+         "<limit lower='1' upper='0' effort='1' velocity='1'/></joint></robot>",
+         "lower <= upper"),
+        ("<robot name='r'><link name='a'/><link name='b'/><joint name='j' type='revolute'>"
+         "<parent link='a'/><child link='b'/><mimic joint='zz'/>"
+         "<limit lower='0' upper='1' effort='1' velocity='1'/></joint></robot>",
+         "mimics unknown joint 'zz'"),
+    ],
+)
+def test_bad_urdf_raises_model_error(xml, match):
+    with pytest.raises(ModelError, match=match):
+        robot_from_urdf(xml)
+
+
+def test_malformed_file_and_missing_file_name_the_file():
+    with pytest.raises(ModelError, match=r"malformed.urdf:\d+: not valid XML"):
+        robot_from_urdf(DATA / "malformed.urdf")
+    with pytest.raises(ModelError, match="nope.urdf: no such file"):
+        robot_from_urdf(DATA / "nope.urdf")
+
+
+def test_missing_yourdfpy_names_the_extra(monkeypatch):
+    import builtins
+
+    real = builtins.__import__
+
+    def fake(name, *args, **kwargs):
+        if name == "yourdfpy":
+            raise ImportError("no yourdfpy")
+        return real(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", fake)
+    with pytest.raises(ImportError, match=r"robokin\[urdf\]"):
+        robot_from_urdf(DATA / "ur5.urdf")
+
+
+@pytest.mark.parametrize(
+    ("joint_xml", "message"),
+    [
+        ('<axis xyz="0 0 x"/>', r"arm\.urdf:1: joint\[j\]\.axis\.xyz.*3 numbers"),
+        ('<origin xyz="1 2"/>', r"joint\[j\]\.origin\.xyz.*3 numbers"),
+        ('<axis xyz="0 0 0"/>', r"arm\.urdf: joint\[j\]\.axis: .*non-zero"),
+    ],
+)
+def test_malformed_numbers_name_the_file_joint_and_attribute(
+    tmp_path, joint_xml, message
+):
+    path = tmp_path / "arm.urdf"
+    path.write_text(
+        '<robot name="r"><link name="a"/><link name="b"/>'
+        '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+        f'{joint_xml}<limit lower="0" upper="1"/></joint></robot>'
+    )
+    with pytest.raises(robokin.ModelError, match=message):
+        robokin.Robot.from_urdf(path)
+
+
+def test_a_non_numeric_limit_names_the_attribute(tmp_path):
+    path = tmp_path / "arm.urdf"
+    path.write_text(
+        '<robot name="r"><link name="a"/><link name="b"/>'
+        '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+        '<limit lower="zero" upper="1"/></joint></robot>'
+    )
+    with pytest.raises(robokin.ModelError, match=r"joint\[j\]\.limit\.lower"):
+        robokin.Robot.from_urdf(path)
