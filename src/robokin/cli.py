@@ -72,7 +72,7 @@ def show(
     import numpy as np
     from rich.table import Table
 
-    from robokin.model.files import document_from_robot
+    from robokin.io.robot_files import document_from_robot
 
     r = _load(name)
     doc = document_from_robot(r)

@@ -42,8 +42,8 @@ def import_urdf(
     """Read a URDF's serial chain and write it as a robokin robot file."""
     import yaml
 
-    from robokin.model.files import document_from_robot, save_robot
-    from robokin.model.urdf import robot_from_urdf
+    from robokin.io.robot_files import document_from_robot, save_robot
+    from robokin.io.urdf import robot_from_urdf
 
     pmap = {}
     for item in package or []:
@@ -75,7 +75,7 @@ def export_urdf(
     ] = None,
 ) -> None:
     """Write a robot as a URDF with the same FK and limits."""
-    from robokin.model.urdf import urdf_from_robot, write_urdf
+    from robokin.io.urdf_export import urdf_from_robot, write_urdf
 
     if out is not None:
         _not_the_input(out, name)
@@ -109,8 +109,8 @@ def dh(
     """Derive the DH table of a URDF arm (degrees; metres unless --mm)."""
     from rich.table import Table
 
-    from robokin.model.dh_extract import describe
-    from robokin.model.urdf import dh_from_urdf
+    from robokin.io.dh_extract import describe
+    from robokin.io.urdf import dh_from_urdf
 
     ext = dh_from_urdf(
         file, base, tip, convention="modified" if modified else "standard",

@@ -130,7 +130,7 @@ def test_virtual_frames_equal_the_patent_composition(rng):
 
 
 def test_dropping_the_virtual_frames_gives_a_wrong_pose(rng):
-    from robokin.model.files import robot_from_document
+    from robokin.io.robot_files import robot_from_document
 
     robot = robokin.load("improved_dh_arm")
     doc = robot.meta["document"]

@@ -8,8 +8,8 @@ import pytest
 import robokin
 from robokin import ModelError
 from robokin.exceptions import InputError
+from robokin.io.robot_files import robot_from_document
 from robokin.model import geometry as geo
-from robokin.model.files import robot_from_document
 
 ROW = {"name": "j1", "joint": "revolute", "a": 400, "alpha": 0, "d": 0, "theta": 0}
 
@@ -129,7 +129,7 @@ def test_geometry_section_errors_name_the_field():
         robot_from_document(
             _doc({"j1": [{"type": "sphere", "radius": 1, "colour": "red"}]})
         )
-    with pytest.raises(ModelError, match=r"geometry\.j1\[0\]\.size: expected 3 finite"):
+    with pytest.raises(ModelError, match=r"geometry\.j1\[0\]\.size: expected 3 numbers"):
         robot_from_document(_doc({"j1": [{"type": "box", "size": [1, 2]}]}))
 
 
