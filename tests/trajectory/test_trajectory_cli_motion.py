@@ -74,7 +74,8 @@ def test_compare_prints_the_error_table(tmp_path, capsys):
     plan = read_csv(tmp_path / "press.csv")
     q = plan.q + np.radians(0.25)
     log = tmp_path / "log.csv"
-    log.write_text("t [s]," + ",".join(f"j{i} [deg]" for i in range(6)) + "\n" + "\n".join(
+    # a log labels its columns with the robot's joint names (matched by name)
+    log.write_text("t [s]," + ",".join(f"{n} [deg]" for n in plan.names()) + "\n" + "\n".join(
         ",".join(repr(float(v)) for v in [t, *np.degrees(r)]) for t, r in zip(plan.t, q)))
     code, out, _ = run(capsys, "compare", str(tmp_path / "press.csv"), str(log), "--json")
     assert code == 0

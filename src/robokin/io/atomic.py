@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import stat
 import tempfile
 from collections.abc import Callable
@@ -25,9 +26,17 @@ from typing import IO, Any
 
 from robokin.exceptions import InputError
 
-__all__ = ["new_file_mode", "save_figure_atomic", "write_atomic"]
+__all__ = ["file_stem", "new_file_mode", "save_figure_atomic", "write_atomic"]
 
 Content = str | bytes | Callable[[IO[bytes]], Any]
+
+
+def file_stem(name: str, limit: int = 80) -> str:
+    """A file-name stem made from a name (a robot's, from a file): letters, digits,
+    ``.``, ``-`` and ``_`` kept, anything else (``/``, ``..``) becomes ``_``, at
+    most ``limit`` characters; never empty or hidden."""
+    stem = re.sub(r"[^A-Za-z0-9._-]", "_", str(name))[:limit].lstrip(".")
+    return stem or "robot"
 
 
 def new_file_mode() -> int:
