@@ -400,12 +400,15 @@ def _document_matches(robot: Robot) -> bool:
     return all(a is b or (isinstance(a, str) and a == b) for a, b in zip(state, now))
 
 
-def load_robot(path: str | Path, *, max_bytes: int = MAX_TEXT_BYTES) -> Robot:
+def load_robot(path: str | Path, *, max_bytes: int = MAX_TEXT_BYTES,
+               max_nodes: int | None = None) -> Robot:
     """Load and validate a robot file.
 
     Args:
         path: The robot file (YAML).
         max_bytes: The largest file accepted [bytes].
+        max_nodes: The most YAML values accepted, aliases expanded (default: see
+            :func:`robokin.io.yaml_reader.parse_yaml`).
 
     Raises:
         ModelError: the file is missing, too large, binary, not YAML, or fails
@@ -413,7 +416,7 @@ def load_robot(path: str | Path, *, max_bytes: int = MAX_TEXT_BYTES) -> Robot:
             and the reason).
     """
     path = Path(path)
-    ydoc = read_yaml_document(path, max_bytes=max_bytes)
+    ydoc = read_yaml_document(path, max_bytes=max_bytes, max_nodes=max_nodes)
     try:
         return robot_from_document(ydoc.data, file=path)
     except ModelError as exc:

@@ -34,6 +34,7 @@ from robokin.io.text_files import MAX_TEXT_BYTES, read_text_file
 
 __all__ = [
     "MAX_DEPTH",
+    "MAX_NODES",
     "NODES_BASE",
     "NODES_PER_BYTE",
     "YamlDocument",
@@ -45,10 +46,13 @@ __all__ = [
 
 #: Deepest nesting of mappings and sequences accepted.
 MAX_DEPTH = 64
-#: Expanded node budget: ``NODES_BASE + NODES_PER_BYTE * len(text)`` (a plain
-#: document has at most about one node per two bytes).
+#: Expanded node budget: ``min(NODES_BASE + NODES_PER_BYTE * len(text),
+#: MAX_NODES)`` (a plain document has at most about one node per two bytes; PyYAML
+#: builds about 150 000 nodes a second, so the absolute cap keeps any file to
+#: well under a second).
 NODES_BASE = 10_000
 NODES_PER_BYTE = 4
+MAX_NODES = 100_000
 
 _Base: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 _FLOAT_12 = re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$")
@@ -190,8 +194,10 @@ def _budget(text: str, file: Any, max_depth: int, max_nodes: int | None) -> None
     alias adds the expanded size of the subtree its anchor names, so the count
     is the size of the document as a tree, computed without building it.
     """
-    limit = NODES_BASE + NODES_PER_BYTE * len(text) if max_nodes is None else max_nodes
+    limit = (min(NODES_BASE + NODES_PER_BYTE * len(text), MAX_NODES)
+             if max_nodes is None else max_nodes)
     loader = _Base(text)
+    aliases = False
     sizes: dict[str, int] = {}
     open_anchors: list[tuple[str | None, int]] = []  # per open collection
     total = 0
@@ -199,6 +205,7 @@ def _budget(text: str, file: Any, max_depth: int, max_nodes: int | None) -> None
         while loader.check_event():
             ev = loader.get_event()
             if isinstance(ev, yaml.AliasEvent):
+                aliases = True
                 if ev.anchor in sizes:
                     total += sizes[ev.anchor]
                 elif any(a == ev.anchor for a, _ in open_anchors):
@@ -224,10 +231,11 @@ def _budget(text: str, file: Any, max_depth: int, max_nodes: int | None) -> None
             else:
                 continue
             if total > limit:
-                raise ModelError(
-                    f"expands to more than {limit:,} nodes from {len(text):,} "
-                    "characters (aliases repeating aliases); refused",
-                    file=file, line=ev.start_mark.line + 1)
+                what = (f"expands to more than {limit:,} values from {len(text):,} "
+                        "characters (aliases repeating aliases)" if aliases
+                        else f"holds more than {limit:,} values")
+                raise ModelError(f"{what}; refused (pass max_nodes= to raise the cap)",
+                                 file=file, line=ev.start_mark.line + 1)
     except yaml.YAMLError as exc:
         raise _yaml_error(exc, file) from None
     finally:
@@ -254,8 +262,8 @@ def parse_yaml(
         text: The YAML text.
         file: The file it came from, for messages.
         max_depth: Deepest nesting accepted.
-        max_nodes: Expanded node budget (default ``NODES_BASE + NODES_PER_BYTE *
-            len(text)``).
+        max_nodes: Expanded node budget (default ``min(NODES_BASE +
+            NODES_PER_BYTE * len(text), MAX_NODES)``).
 
     Returns:
         The :class:`YamlDocument`.

@@ -43,6 +43,7 @@ from typing import TYPE_CHECKING, Literal, Protocol
 import numpy as np
 import numpy.typing as npt
 
+from robokin._text import short_repr
 from robokin.exceptions import InputError, MissingExtraError, ModelError
 
 if TYPE_CHECKING:
@@ -127,7 +128,7 @@ class Shape:
     def __post_init__(self) -> None:
         if self.kind not in SHAPE_KINDS:
             raise InputError(
-                "kind", f"expected one of {list(SHAPE_KINDS)}, got {self.kind!r}"
+                "kind", f"expected one of {list(SHAPE_KINDS)}, got {short_repr(self.kind)}"
             )
         need = {"box": 3, "cylinder": 2, "capsule": 2, "sphere": 1, "mesh": 0}[
             self.kind
@@ -438,7 +439,7 @@ def mesh(
 ) -> Shape:
     """A mesh file (loaded on first use), in ``units`` times ``scale``."""
     if units not in LENGTH_UNITS:
-        raise InputError("units", f"expected one of {list(LENGTH_UNITS)}, got {units!r}")
+        raise InputError("units", f"expected one of {list(LENGTH_UNITS)}, got {short_repr(units)}")
     return Shape(
         "mesh",
         (),

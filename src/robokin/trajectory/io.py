@@ -97,10 +97,10 @@ class ControllerProfile:
 
     def __post_init__(self) -> None:
         if self.angle_unit not in _ANGLE:
-            raise ModelError(f"angle_unit must be 'rad' or 'deg', got {self.angle_unit!r}",
+            raise ModelError(f"angle_unit must be 'rad' or 'deg', got {short_repr(self.angle_unit)}",
                              field="angle_unit")
         if self.length_unit not in _LENGTH:
-            raise ModelError(f"length_unit must be 'm' or 'mm', got {self.length_unit!r}",
+            raise ModelError(f"length_unit must be 'm' or 'mm', got {short_repr(self.length_unit)}",
                              field="length_unit")
         if self.signs is not None and any(s not in (1, -1) for s in self.signs):
             raise ModelError(f"signs must be +1 or -1, got {list(self.signs)}",
@@ -269,7 +269,7 @@ def csv_text(traj: Trajectory, joint_names: Sequence[str] | None = None, *,
     data = np.hstack(blocks)
     for h in header:
         if "," in h:
-            raise InputError("joint_names", f"a name may not hold a comma: {h!r}")
+            raise InputError("joint_names", f"a name may not hold a comma: {short_repr(h)}")
     fmt = "%r" if precision is None else f"%.{int(precision)}g"
     lines = [",".join(header)]
     lines += [",".join(fmt % v for v in row) for row in data.tolist()]
@@ -620,7 +620,7 @@ def ur_script(
         InputError: unknown mode, or a trajectory in actuator space.
     """
     if mode not in ("servoj", "movej"):
-        raise InputError("mode", f"expected 'servoj' or 'movej', got {mode!r}")
+        raise InputError("mode", f"expected 'servoj' or 'movej', got {short_repr(mode)}")
     if traj.space != "joint":
         raise InputError("traj", "URScript takes joint angles: convert to joint space")
     prof = profile or ControllerProfile()
