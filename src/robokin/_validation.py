@@ -47,6 +47,11 @@ def _real_array(x: npt.ArrayLike, name: str, expected: str) -> np.ndarray:
     if kind not in "fiuO":
         raise InputError(name, f"expected {expected}, got {a.dtype} values "
                          f"({short_repr(x)})")
+    if kind == "O" and not all(isinstance(v, (int, float, np.integer, np.floating))
+                               and not isinstance(v, (bool, np.bool_))
+                               for v in a.flat):
+        # None would become NaN, a bool 1.0, a complex number lose its imaginary part
+        raise InputError(name, f"expected {expected}, got {short_repr(x)}")
     try:
         return np.asarray(a, dtype=np.float64)
     except (TypeError, ValueError) as exc:

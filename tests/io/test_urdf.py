@@ -278,3 +278,82 @@ def test_a_non_numeric_limit_names_the_attribute(tmp_path):
     )
     with pytest.raises(robokin.ModelError, match=r"joint\[j\]\.limit\.lower"):
         robokin.Robot.from_urdf(path)
+
+
+# ------------------------------------------------------ issue 15: hostile URDFs
+ARM = ('<robot name="r"><link name="a"/><link name="b">{link}</link>'
+       '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+       '{joint}<limit lower="0" upper="1"/></joint></robot>')
+
+
+@pytest.mark.parametrize("dtd", [
+    # the XML billion laughs: entities of entities
+    '<!DOCTYPE robot [<!ENTITY a "lol"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;">'
+    '<!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;">]>',
+    # an external entity: a local file, and one on the network
+    '<!DOCTYPE robot [<!ENTITY x SYSTEM "file:///etc/passwd">]>',
+    '<!DOCTYPE robot [<!ENTITY x SYSTEM "http://127.0.0.1:9/robot.dtd">]>',
+    '<!DOCTYPE robot SYSTEM "http://127.0.0.1:9/robot.dtd">',
+])
+def test_dtds_and_entities_are_refused(tmp_path, dtd):
+    path = tmp_path / "evil.urdf"
+    path.write_text('<?xml version="1.0"?>' + dtd
+                    + ARM.format(link="", joint='<origin xyz="0 0 0"/>')
+                    .replace('name="r"', 'name="&c;"' if "&b;" in dtd else 'name="r"'))
+    with pytest.raises(ModelError, match=r"evil\.urdf:1: a <!DOCTYPE>"):
+        robot_from_urdf(path)
+
+
+@pytest.mark.parametrize(("link", "joint", "message"), [
+    ("", '<origin xyz="0 nan 0"/>',
+     r"arm\.urdf:1: joint\[j\]\.origin\.xyz: .*finite"),
+    ("", '<origin rpy="0 0 inf"/>', r"joint\[j\]\.origin\.rpy: .*finite"),
+    ("", '<axis xyz="0 0 NaN"/>', r"joint\[j\]\.axis\.xyz: .*finite"),
+    ('<collision><geometry><box size="1 -2 1"/></geometry></collision>', "",
+     r"arm\.urdf:1: link\[b\]\.box\.size: .*positive"),
+    ('<visual><geometry><cylinder radius="0.1"/></geometry></visual>', "",
+     r"link\[b\]\.cylinder\.length: <cylinder> needs a 'length'"),
+    ('<visual><geometry><sphere radius="nan"/></geometry></visual>', "",
+     r"link\[b\]\.sphere\.radius"),
+])
+def test_non_finite_origins_and_bad_shapes_name_file_element_and_line(
+        tmp_path, link, joint, message):
+    path = tmp_path / "arm.urdf"
+    path.write_text(ARM.format(link=link, joint=joint))
+    with pytest.raises(ModelError, match=message):
+        robot_from_urdf(path)
+
+
+def test_lines_are_those_of_the_element(tmp_path):
+    path = tmp_path / "arm.urdf"
+    path.write_text(ARM.format(link="", joint='\n\n<origin xyz="1 2 x"/>')
+                    .replace("><", ">\n<"))
+    with pytest.raises(ModelError) as exc:
+        robot_from_urdf(path)
+    line = exc.value.line
+    assert 'xyz="1 2 x"' in path.read_text().splitlines()[line - 1]
+
+
+def test_every_left_out_shape_is_listed_and_no_non_mesh_path_is_kept(tmp_path):
+    (tmp_path / "notes.txt").write_text("not a mesh")
+    (tmp_path / "folder.stl").mkdir()
+    shapes = "".join(
+        f'<collision><geometry><mesh filename="{f}"/></geometry></collision>'
+        for f in ("gone.stl", "http://example.com/arm.stl", "notes.txt",
+                  "package://nopkg/arm.stl", "folder.stl"))
+    path = tmp_path / "arm.urdf"
+    path.write_text(ARM.format(link=shapes + '<collision><geometry><box size="1 1 1"/>'
+                                             '</geometry></collision>', joint=""))
+    robot = robot_from_urdf(path, missing_mesh="ignore")
+    dropped = robot.meta["urdf_dropped_shapes"]
+    assert len(dropped) == 5
+    for word in ("no such file", "remote mesh (http://)", "not a mesh file",
+                 "package 'nopkg'", "folder.stl"):
+        assert any(word in d for d in dropped), word
+    kinds = [s.kind for ss in robot.geometry.shapes for s in ss]
+    assert kinds == ["box"]
+    with pytest.warns(UserWarning) as record:
+        robot_from_urdf(path)
+    assert len(record) == 5
+    with pytest.raises(ModelError, match="gone.stl"):
+        robot_from_urdf(path, missing_mesh="error")

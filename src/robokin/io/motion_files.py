@@ -60,6 +60,7 @@ def _schema():
         BaseModel,
         ConfigDict,
         Field,
+        PrivateAttr,
         StrictBool,
         StrictFloat,
         StrictStr,
@@ -108,6 +109,7 @@ def _schema():
         smooth: StrictBool = True
         ik: Literal["follow", "analytic", "numeric"] = "follow"
         segments: list[Step] = Field(min_length=1, max_length=MAX_SEGMENTS)
+        _source: Any = PrivateAttr(default=None)  # the YamlDocument, for lines
 
     return Motion
 
@@ -133,10 +135,12 @@ def load_motion_file(path: str | Path, *, max_bytes: int = MAX_TEXT_BYTES
         if not isinstance(ydoc.data, dict):
             raise ModelError("a motion file must be a mapping of fields", file=path)
         # a union's member types appear in pydantic's locations: not fields
-        return validate_document(_schema(), ydoc.data, file=path,
-                                 drop=("float", "list[float]")), path
+        spec = validate_document(_schema(), ydoc.data, file=path,
+                                 drop=("float", "list[float]"))
     except ModelError as exc:
         raise ydoc.locate(exc) from None
+    spec._source = ydoc
+    return spec, path
 
 
 def _check_budget(spec: Any, file: Path, max_samples: int) -> None:
@@ -186,6 +190,14 @@ def plan_from_document(
         PathError: a line that cannot be followed.
         UnreachableError: a pose with no IK solution.
     """
+    source = getattr(spec, "_source", None)
+    try:
+        return _plan(spec, file, progress, max_samples)
+    except ModelError as exc:
+        raise (exc if source is None else source.locate(exc)) from None
+
+
+def _plan(spec: Any, file: Path, progress: Any, max_samples: int) -> tuple[Any, Any]:
     import numpy as np
 
     from robokin.trajectory import PathBuilder
