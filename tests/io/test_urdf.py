@@ -357,3 +357,25 @@ def test_every_left_out_shape_is_listed_and_no_non_mesh_path_is_kept(tmp_path):
     assert len(record) == 5
     with pytest.raises(ModelError, match="gone.stl"):
         robot_from_urdf(path, missing_mesh="error")
+
+
+def _chain_urdf(n: int) -> str:
+    parts = ['<robot name="r">'] + [f'<link name="l{i}"/>' for i in range(n + 1)]
+    parts += [f'<joint name="j{i}" type="continuous"><parent link="l{i}"/>'
+              f'<child link="l{i + 1}"/><origin xyz="0 0 0.01"/></joint>'
+              for i in range(n)]
+    return "\n".join(parts) + "</robot>"
+
+
+def test_a_urdf_of_thousands_of_joints_is_refused_before_it_is_built(tmp_path):
+    from robokin.io.urdf import MAX_URDF_JOINTS
+
+    path = tmp_path / "long.urdf"
+    path.write_text(_chain_urdf(MAX_URDF_JOINTS + 1))
+    with pytest.raises(ModelError, match=r"long\.urdf:1: 1,001 <joint> elements; "
+                                         r"robokin reads at most 1,000"):
+        robot_from_urdf(path)
+    path.write_text(_chain_urdf(MAX_URDF_JOINTS))  # at the cap: read
+    robot = robot_from_urdf(path, geometry=False)
+    assert robot.n == MAX_URDF_JOINTS
+    assert robot.fk(np.zeros(robot.n))[2, 3] == pytest.approx(10.0)

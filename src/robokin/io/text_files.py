@@ -17,8 +17,9 @@ __all__ = ["MAX_CSV_BYTES", "MAX_TEXT_BYTES", "read_file_bytes", "read_text_file
 
 #: Default cap for robot, scene, motion, profile and URDF files [bytes] (16 MiB).
 MAX_TEXT_BYTES = 16 * 2**20
-#: Default cap for CSV trajectories and logs [bytes] (256 MiB).
-MAX_CSV_BYTES = 256 * 2**20
+#: Default cap for CSV trajectories and logs [bytes] (64 MiB: about a million rows;
+#: the reader keeps every value as a Python float while it parses).
+MAX_CSV_BYTES = 64 * 2**20
 
 
 def read_file_bytes(path: str | Path, *, max_bytes: int = MAX_TEXT_BYTES) -> bytes:

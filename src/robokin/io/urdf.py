@@ -58,6 +58,7 @@ if TYPE_CHECKING:
     from robokin.robot import Robot
 
 __all__ = [
+    "MAX_URDF_JOINTS",
     "UrdfChain",
     "dh_from_robot",
     "dh_from_urdf",
@@ -66,6 +67,8 @@ __all__ = [
 ]
 
 MissingMesh = Literal["warn", "error", "ignore"]
+#: Most joints a URDF may hold (a tree of at most this many joints plus one links).
+MAX_URDF_JOINTS = 1000
 _SCHEME = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]*)://")
 
 _MOVABLE = ("revolute", "continuous", "prismatic")
@@ -124,6 +127,11 @@ def _check_xml(data: bytes, file: Path | None) -> None:
     if "name" not in root.attrib:
         raise ModelError("<robot> has no 'name' attribute", file=file,
                          line=root.sourceline)
+    for tag, cap in (("joint", MAX_URDF_JOINTS), ("link", MAX_URDF_JOINTS + 1)):
+        count = len(root.findall(tag))
+        if count > cap:
+            raise ModelError(f"{count:,} <{tag}> elements; robokin reads at most "
+                             f"{cap:,}", file=file, line=root.sourceline)
     for el in root.findall("link"):
         if "name" not in el.attrib:
             raise ModelError("<link> has no 'name' attribute", file=file,
@@ -352,7 +360,8 @@ class _Tree:
         """The joints from ``base`` to ``tip``."""
         up = self.ancestors(base)
         down = self.ancestors(tip)
-        common = next((a for a in up if a in set(down)), None)
+        down_set = set(down)
+        common = next((a for a in up if a in down_set), None)
         steps = []
         for link in up[: up.index(common)]:
             j = self.parent_joint[link]
@@ -555,8 +564,11 @@ def chain_from_urdf_model(
     frames: dict[str, tuple[int, np.ndarray]] = {base: (0, np.eye(4))}
     k, T_rel = 0, np.eye(4)
 
+    coord_names: set[str] = set()
+
     def add_coordinate(j: Any) -> None:
-        if all(c.name != j.name for c in coords):
+        if j.name not in coord_names:  # a set: linear in the number of joints
+            coord_names.add(j.name)
             coords.append(Joint(j.name, _kind(j), _limits(j, file)))
 
     for i, s in enumerate(steps):

@@ -559,15 +559,15 @@ def write_json(
     return write_atomic(path, json.dumps(doc) + "\n", overwrite=overwrite)
 
 
-def read_json(path: str | Path) -> Trajectory:
-    """Read a trajectory written by :func:`write_json`.
+def read_json(path: str | Path, *, max_bytes: int = MAX_CSV_BYTES) -> Trajectory:
+    """Read a trajectory written by :func:`write_json` (at most ``max_bytes``).
 
     Raises:
         ModelError: missing file, not JSON, or missing / inconsistent fields.
     """
     path = Path(path)
     try:
-        doc = json.loads(read_text_file(path, max_bytes=MAX_CSV_BYTES))
+        doc = json.loads(read_text_file(path, max_bytes=max_bytes))
     except json.JSONDecodeError as exc:
         raise ModelError(f"not valid JSON: {exc.msg}", file=path,
                          line=exc.lineno) from None
