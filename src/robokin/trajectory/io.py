@@ -125,9 +125,16 @@ class ControllerProfile:
         if extra:
             raise ModelError(f"unknown key(s) {extra}; known: {sorted(known)}",
                              file=file, field=extra[0])
-        order = doc.get("order")
+        order = _list_field(doc, "order", (int, str), file)
+        signs = _list_field(doc, "signs", (int, float), file)
+        offsets = _list_field(doc, "offsets", (int, float), file)
+        names = _list_field(doc, "names", (str,), file)
+        for key in ("name", "angle_unit", "length_unit", "offset_unit"):
+            if key in doc and not isinstance(doc[key], str):
+                raise ModelError(f"expected text, got {short_repr(doc[key])}",
+                                 file=file, field=key)
         if order is not None and any(isinstance(o, str) for o in order):
-            joints = doc.get("joints")
+            joints = _list_field(doc, "joints", (str,), file)
             if not joints:
                 raise ModelError("order by name needs 'joints' (the model's names)",
                                  file=file, field="order")
@@ -137,14 +144,13 @@ class ControllerProfile:
             except ValueError as exc:
                 raise ModelError(f"{exc}; joints: {list(joints)}", file=file,
                                  field="order") from None
-        offsets = doc.get("offsets")
         if offsets is not None and doc.get("offset_unit", doc.get("angle_unit")) == "deg":
             offsets = [math.radians(o) for o in offsets]
         try:
-            return cls(name=str(doc.get("name", "default")), order=order,
-                       signs=doc.get("signs"), offsets=offsets,
+            return cls(name=doc.get("name", "default"), order=order,
+                       signs=signs, offsets=offsets,
                        angle_unit=doc.get("angle_unit", "rad"),
-                       length_unit=doc.get("length_unit", "m"), names=doc.get("names"))
+                       length_unit=doc.get("length_unit", "m"), names=names)
         except ModelError as exc:
             raise ModelError(exc.reason, file=file, field=exc.field) from None
 
@@ -184,6 +190,26 @@ class ControllerProfile:
         """Revolute flags in controller order."""
         order, _, _ = self._parts(len(is_revolute))
         return np.asarray(is_revolute, bool)[order]
+
+
+def _list_field(doc: Mapping[str, Any], key: str, kinds: tuple[type, ...],
+                file: Any) -> list[Any] | None:
+    """``doc[key]``: None, or a list whose items are of ``kinds`` (no booleans,
+    finite numbers); a ModelError naming the field otherwise."""
+    value = doc.get(key)
+    if value is None:
+        return None
+
+    def ok(v: Any) -> bool:
+        if isinstance(v, bool) or not isinstance(v, kinds):
+            return False
+        return not isinstance(v, float) or math.isfinite(v)
+
+    if not isinstance(value, (list, tuple)) or not all(ok(v) for v in value):
+        what = " or ".join(k.__name__ for k in kinds)
+        raise ModelError(f"expected a list of {what}, got {short_repr(value)}",
+                         file=file, field=key)
+    return list(value)
 
 
 def load_profile(path: str | Path) -> ControllerProfile:
