@@ -38,16 +38,17 @@ class DomainFailure(Exception):
     """A command ran but its answer is 'no' (exit code 1)."""
 
 
-def cell(value: Any, limit: int = 60) -> str:
+def cell(value: Any, limit: int = 60, *, markup: bool = True) -> str:
     """Text for a table cell or a line of output: at most ``limit`` characters,
-    rich markup escaped (a name or a source from a file is never markup, and
-    never a megabyte for rich to wrap)."""
+    rich markup escaped unless ``markup=False`` (for ``print(..., markup=False)``):
+    a name or a source from a file is never markup, and never a megabyte for rich
+    to wrap."""
     from rich.markup import escape
 
     text = str(value)
     if len(text) > limit:
         text = text[: limit - 1] + "…"
-    return escape(text)
+    return escape(text) if markup else text
 
 
 @app.callback()

@@ -109,7 +109,7 @@ def traj(
         from rich.table import Table
 
         con = Console()
-        con.print(f"{robot.name}: {len(tr.labels)} segments, {tr.duration:.3f} s, "
+        con.print(f"{cell(robot.name, markup=False)}: {len(tr.labels)} segments, {tr.duration:.3f} s, "
                   f"{len(tr)} samples at {spec.dt * 1000:g} ms", markup=False)
         table = Table(title="peaks per joint")
         for col in ("joint", "unit", "min", "max", "peak |vel| /s", "peak |acc| /s²"):

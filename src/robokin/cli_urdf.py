@@ -67,7 +67,8 @@ def import_urdf(
         return
     save_robot(robot, out)
     _console().print(
-        f"{robot.name}: {robot.n} joints, {info.base_link} -> {info.tip_link}; "
+        f"{cell(robot.name, markup=False)}: {robot.n} joints, "
+        f"{cell(info.base_link, markup=False)} -> {cell(info.tip_link, markup=False)}; "
         f"wrote {out}", markup=False,
     )
 
@@ -89,7 +90,7 @@ def export_urdf(
         print(urdf_from_robot(robot), end="")
         return
     write_urdf(robot, out)
-    _console().print(f"{cell(robot.name)}: wrote {out}", markup=False)
+    _console().print(f"{cell(robot.name, markup=False)}: wrote {out}", markup=False)
 
 
 @app.command("dh")

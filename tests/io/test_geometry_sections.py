@@ -190,3 +190,13 @@ def test_unsupported_mesh_format_is_refused(tmp_path):
             file=tmp_path / "a.yaml",
         )
 
+
+
+def test_an_oversized_mesh_is_refused_before_trimesh_reads_it(tmp_path, monkeypatch):
+    pytest.importorskip("trimesh")
+    _write_box_stl(tmp_path / "big.stl", (10.0, 10.0, 10.0))
+    monkeypatch.setattr(geo, "MAX_MESH_BYTES", 100)
+    shape = geo.mesh(tmp_path / "big.stl", owner="j1")
+    with pytest.raises(ModelError, match=r"big\.stl: j1: mesh file of \d+ bytes "
+                                         r"\(link 'j1'\), more than the 100"):
+        shape.trimesh()

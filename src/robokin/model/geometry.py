@@ -52,6 +52,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "LENGTH_UNITS",
+    "MAX_MESH_BYTES",
     "MESH_SUFFIXES",
     "SHAPE_KINDS",
     "HasChain",
@@ -73,6 +74,8 @@ ShapeKind = Literal["box", "cylinder", "sphere", "capsule", "mesh"]
 SHAPE_KINDS = ("box", "cylinder", "sphere", "capsule", "mesh")
 MESH_SUFFIXES = (".stl", ".obj", ".dae", ".ply", ".off", ".glb", ".gltf")
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
+#: Largest mesh file loaded [bytes] (256 MiB).
+MAX_MESH_BYTES = 256 * 2**20
 
 
 class HasChain(Protocol):
@@ -326,6 +329,11 @@ def _load_mesh(path: Path | None, scale: float, owner: str):
     where = f" (link '{owner}')" if owner else ""
     if path is None or not Path(path).is_file():
         raise ModelError(f"mesh file not found{where}", file=path, field=owner or None)
+    size = Path(path).stat().st_size
+    if size > MAX_MESH_BYTES:
+        raise ModelError(f"mesh file of {size:,} bytes{where}, more than the "
+                         f"{MAX_MESH_BYTES:,} robokin loads (robokin.model.geometry."
+                         "MAX_MESH_BYTES)", file=path, field=owner or None)
     try:
         loaded = trimesh.load(str(path), force="mesh")
     except Exception as exc:  # trimesh raises many kinds on a bad file
