@@ -52,11 +52,8 @@ def _row(name: str, single_us: float, rate: float, nsol: float, err: float) -> N
 
 
 def _dh(robot_name: str):
-    import yaml
-
-    from robokin.robots import path as robot_path
-
-    doc = yaml.safe_load(robot_path(robot_name).read_text())
+    # the robot file's own document (read once, by robokin's YAML reader)
+    doc = robokin.load(robot_name).meta["document"]
     L = 1e-3 if doc["units"]["length"] == "mm" else 1.0
     rows = doc["joints"]
     return (np.radians([r["alpha"] for r in rows]), np.array([r["a"] for r in rows]) * L,

@@ -92,3 +92,85 @@ def test_console_script_runs():
     np.testing.assert_allclose(
         json.loads(res.stdout)["xyz"], [0.4521, -0.15005, 0.4318], atol=1e-12
     )
+
+
+# ------------------------------------------- issue 15: exit codes, one line, JSON
+def _one_line(err: str) -> None:
+    assert err.count("\n") == 1 and err.startswith("robokin: "), err
+
+
+@pytest.mark.parametrize("args", [
+    ["fk", "ur5", "0", "0", "--bogus-option"],
+    ["ik", "ur5"],
+    ["traj"],
+    ["fk", "ur5", "x", "0", "0", "0", "0", "0"],
+])
+def test_usage_errors_are_one_line_with_exit_code_2(capsys, args):
+    code, out, err = run(capsys, *args)
+    assert code == 2
+    _one_line(err)
+    assert "Usage:" not in out + err and "╭" not in err
+
+
+def test_input_files_that_are_not_robot_files_exit_2(capsys, tmp_path):
+    binary = tmp_path / "robot.yaml"
+    binary.write_bytes(b"\x7fELF\x02\x01\x01\x00\x00\x00")
+    big = tmp_path / "big.yaml"
+    big.write_text("name: x\nsource: " + "a" * (17 * 2**20) + "\n")
+    for path, why in ((binary, "binary"), (tmp_path, "is a folder"),
+                      (big, "more than the 16,777,216 bytes")):
+        code, _, err = run(capsys, "show", str(path))
+        assert code == 2, err
+        _one_line(err)
+        assert why in err
+
+
+def test_no_ik_solution_exits_1_and_bad_input_exits_2(capsys):
+    code, _, err = run(capsys, "ik", "ur5", "5", "0", "0", "0", "0", "0")
+    assert code == 1 and "no IK solution" in err
+    _one_line(err)
+    code, _, err = run(capsys, "ik", "ur5", "1e300", "0", "0", "0", "0", "0")
+    assert code == 2 and "beyond the 1e+06 m" in err
+    _one_line(err)
+
+
+def test_debug_is_accepted_after_the_subcommand(capsys):
+    code, out, _ = run(capsys, "fk", "ur5", "0", "0", "0", "0", "0", "0", "--json",
+                       "--debug")
+    assert code == 0 and "pose" in json.loads(out)
+    with pytest.raises(robokin.ModelError):  # --debug: the traceback, not one line
+        main(["show", "ur7", "--debug"])
+
+
+def test_warnings_are_one_line(capsys, tmp_path):
+    p = tmp_path / "arm.yaml"
+    p.write_text("name: arm\njoints:\n  - {a: 0, alpha: 0, d: 89.159}\n"
+                 "  - {a: 425, alpha: 0, d: 0}\n")
+    code, _, err = run(capsys, "show", str(p))
+    assert code == 0
+    assert err.startswith("robokin: warning: ") and err.count("\n") == 1
+    assert "425 m" in err and "units: {length: mm}" in err
+
+
+def test_json_output_is_strict_json_with_nulls_explained(capsys, tmp_path):
+    robot = robokin.load("ur5")
+    from robokin.trajectory import io, quintic
+
+    tr = quintic(np.zeros(6), np.full(6, 0.5), 1.0, dt=0.01)
+    plan = io.write_csv(tr, tmp_path / "plan.csv", robot.joint_names)
+    # the run followed the plan exactly: a zero error has no correlation (NaN)
+    log = io.write_csv(tr, tmp_path / "log.csv", robot.joint_names)
+    code, out, _ = run(capsys, "compare", str(plan), str(log), "--json", "--no-plot")
+    assert code == 0
+    doc = json.loads(out, parse_constant=lambda c: pytest.fail(f"{c} in the JSON"))
+    assert doc["joints"][0]["corr_acc"] is None
+    assert doc["nulls"]["joints[0].corr_acc"].startswith("NaN")
+
+
+def test_show_never_hands_rich_an_unbounded_word(capsys):
+    r = robokin.load("ur5")
+    long = r.replace(source="x" * 1_000_000, name="[bold red]ur5[/]")
+    from robokin.cli import cell
+
+    assert len(cell(long.source, 300)) <= 300
+    assert cell(long.name) == "\\[bold red]ur5\\[/]"

@@ -53,8 +53,8 @@ def load(name_or_path: str | Path) -> Robot:
 
 
 def save(robot: Robot, path: str | Path) -> Path:
-    """Write a robot file atomically (see :func:`robokin.model.files.save_robot`)."""
-    from robokin.model.files import save_robot
+    """Write a robot file atomically (see :func:`robokin.io.robot_files.save_robot`)."""
+    from robokin.io.robot_files import save_robot
 
     return save_robot(robot, path)
 

@@ -1,19 +1,28 @@
 """The ``robokin`` command. It only parses, calls the library and formats.
 
 Radians and metres unless ``--deg`` / ``--mm`` is given. Errors are one line on
-stderr (traceback with ``--debug``). Exit codes: 0 success, 1 domain failure (IK
-found nothing, collision, clearance violated), 2 usage error.
+stderr (the traceback with ``--debug``, accepted anywhere on the command line);
+warnings and notes are one line each, ``robokin: warning: ...``. ``--json``
+output is strict JSON: a NaN or infinite number is written ``null`` and listed
+with its reason under ``"nulls"``.
+
+Exit codes: 0 success; 1 only for a "no" answer (no IK solution, a collision, a
+violated clearance or joint limit); 2 for usage and input errors (a bad option, a
+missing, binary, oversized or malformed file, a folder given as a file, a file
+that cannot be written); 3 for an internal error (a bug: please report it).
 """
 
 from __future__ import annotations
 
-import json
 import math
 import sys
+import warnings
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
+
+from robokin.io.strict_json import strict_json as json_text
 
 app = typer.Typer(
     add_completion=False,
@@ -27,6 +36,19 @@ _DEBUG = {"on": False}
 
 class DomainFailure(Exception):
     """A command ran but its answer is 'no' (exit code 1)."""
+
+
+def cell(value: Any, limit: int = 60, *, markup: bool = True) -> str:
+    """Text for a table cell or a line of output: at most ``limit`` characters,
+    rich markup escaped unless ``markup=False`` (for ``print(..., markup=False)``):
+    a name or a source from a file is never markup, and never a megabyte for rich
+    to wrap."""
+    from rich.markup import escape
+
+    text = str(value)
+    if len(text) > limit:
+        text = text[: limit - 1] + "…"
+    return escape(text) if markup else text
 
 
 @app.callback()
@@ -60,7 +82,7 @@ def robots() -> None:
         table.add_column(col)
     for name in lib.names():
         r = _load(name)
-        table.add_row(name, str(r.n), (r.source or "")[:70])
+        table.add_row(cell(name), str(r.n), cell(r.source or "", 70))
     _console().print(table)
 
 
@@ -72,14 +94,14 @@ def show(
     import numpy as np
     from rich.table import Table
 
-    from robokin.model.files import document_from_robot
+    from robokin.io.robot_files import document_from_robot
 
     r = _load(name)
     doc = document_from_robot(r)
     units = doc.get("units", {})
     table = Table(
-        title=f"{r.name}: {doc.get('convention', '?')} "
-        f"({units.get('length', 'm')}, {units.get('angle', 'rad')})"
+        title=f"{cell(r.name)}: {cell(doc.get('convention', '?'))} "
+        f"({cell(units.get('length', 'm'))}, {cell(units.get('angle', 'rad'))})"
     )
     rows = doc["joints"]
     keys = []
@@ -88,9 +110,9 @@ def show(
             if k not in keys:
                 keys.append(k)
     for k in keys:
-        table.add_column(k)
+        table.add_column(cell(k))
     for row in rows:
-        table.add_row(*[str(row.get(k, "")) for k in keys])
+        table.add_row(*[cell(row.get(k, "")) for k in keys])
     con = _console()
     con.print(table)
     lim = Table(title="joint limits (deg / mm)")
@@ -98,7 +120,7 @@ def show(
         lim.add_column(col)
     for c, (lo, hi) in zip(r.chain.coordinates, r.limits):
         s = 180 / math.pi if c.kind == "revolute" else 1000.0
-        lim.add_row(c.name, c.kind, f"{lo * s:.6g}", f"{hi * s:.6g}")
+        lim.add_row(cell(c.name), c.kind, f"{lo * s:.6g}", f"{hi * s:.6g}")
     con.print(lim)
     if r.actuators is not None:
         act = Table(title="actuators: q = A phi + b")
@@ -112,7 +134,7 @@ def show(
         "tool at q = 0 [m]: " + "  ".join(f"{v:.6f}" for v in T0[:3, 3]), markup=False
     )
     if r.source:
-        con.print(f"[dim]source: {r.source}[/dim]")
+        con.print(f"[dim]source: {cell(r.source, 300)}[/dim]")
 
 
 _NUMERIC_ARGS = {"ignore_unknown_options": True}
@@ -148,7 +170,7 @@ def fk(
     A = 180 / math.pi if deg else 1.0
     if as_json:
         print(
-            json.dumps(
+            json_text(
                 {
                     "pose": T.tolist(),
                     "xyz": (T[:3, 3] * L).tolist(),
@@ -209,36 +231,86 @@ def _register_extra_commands() -> None:
                 raise
 
 
+def _split_debug(args: list[str]) -> tuple[list[str], bool]:
+    """Remove ``--debug`` wherever it stands (before a ``--`` separator)."""
+    end = args.index("--") if "--" in args else len(args)
+    head = [a for a in args[:end] if a != "--debug"]
+    return head + args[end:], len(head) != end
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def _show_warning(message: Any, category: type, filename: str, lineno: int,
+                  file: Any = None, line: Any = None) -> None:
+    print(f"robokin: warning: {_one_line(message)}", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point: run the app, map errors to one stderr line and an exit code."""
-    from robokin.exceptions import RobokinError
+    """Entry point: run the app, map errors to one stderr line and an exit code.
+
+    Exit codes: 0 success, 1 a "no" answer (:class:`DomainFailure`, an
+    :class:`~robokin.exceptions.UnreachableError`), 2 usage and input errors, 3
+    an internal error.
+    """
+    from robokin.exceptions import RobokinError, UnreachableError
+
+    # click's classes as this typer raises them (recent typer vendors click)
+    mro = typer.BadParameter.__mro__
+    click_error = next(c for c in mro if c.__name__ == "ClickException")
+    usage_error = next(c for c in mro if c.__name__ == "UsageError")
 
     _register_extra_commands()
-    args = sys.argv[1:] if argv is None else argv
-    debug = "--debug" in args
-    try:
-        app(args=args, standalone_mode=False)
-    except DomainFailure as exc:
-        print(f"robokin: {exc}", file=sys.stderr)
-        return 1
-    except RobokinError as exc:
-        if debug:
-            raise
-        print(f"robokin: error: {exc}", file=sys.stderr)
-        return 2 if isinstance(exc, (ValueError, ImportError)) else 1
-    except typer.Exit as exc:
-        return exc.exit_code
-    except typer.Abort:
-        print("robokin: aborted", file=sys.stderr)
-        return 1
-    except Exception as exc:  # usage errors (click's, vendored by typer) and the rest
-        if hasattr(exc, "show") and hasattr(exc, "exit_code"):
-            exc.show()
-            return int(exc.exit_code)
-        if debug:
-            raise
-        print(f"robokin: error: {type(exc).__name__}: {exc}", file=sys.stderr)
-        return 1
+    args, debug = _split_debug(list(sys.argv[1:] if argv is None else argv))
+    _DEBUG["on"] = debug
+    with warnings.catch_warnings():
+        warnings.showwarning = _show_warning
+        try:
+            app(args=args, standalone_mode=False)
+        except DomainFailure as exc:
+            print(f"robokin: {_one_line(exc)}", file=sys.stderr)
+            return 1
+        except UnreachableError as exc:
+            if debug:
+                raise
+            print(f"robokin: {_one_line(exc)}", file=sys.stderr)
+            return 1
+        except RobokinError as exc:
+            if debug:
+                raise
+            print(f"robokin: error: {_one_line(exc)}", file=sys.stderr)
+            return 2
+        except typer.Exit as exc:
+            return exc.exit_code
+        except typer.Abort:
+            print("robokin: aborted", file=sys.stderr)
+            return 2
+        except click_error as exc:  # usage errors: one line, not click's block
+            if debug:
+                raise
+            if type(exc).__name__ == "NoArgsIsHelpError":
+                return 2  # the help was printed: nothing to add
+            hint = ""
+            if isinstance(exc, usage_error) and getattr(exc, "ctx", None) is not None:
+                hint = f" (see: {exc.ctx.command_path} --help)"
+            print(f"robokin: error: {_one_line(exc.format_message())}{hint}",
+                  file=sys.stderr)
+            return 2
+        except OSError as exc:
+            if debug:
+                raise
+            where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+            print(f"robokin: error: {where}{_one_line(exc.strerror or exc)}",
+                  file=sys.stderr)
+            return 2
+        except Exception as exc:  # a bug: say so, in one line
+            if debug:
+                raise
+            print(f"robokin: internal error: {type(exc).__name__}: "
+                  f"{_one_line(exc)[:300]} (run with --debug for the traceback)",
+                  file=sys.stderr)
+            return 3
     return 0
 
 

@@ -6,14 +6,13 @@ revolute joints and rotary motors, ``--mm`` to prismatic joints and linear motor
 
 from __future__ import annotations
 
-import json
 import math
 from typing import Annotated
 
 import numpy as np
 import typer
 
-from robokin.cli import _NUMERIC_ARGS, _console, _load, app
+from robokin.cli import _NUMERIC_ARGS, _console, _load, app, cell, json_text
 
 __all__ = ["joints", "motors"]
 
@@ -45,7 +44,7 @@ def _motor_names(robot) -> list[str]:
 def _report(title: str, names: list[str], values: np.ndarray, units: list[str],
             inside: np.ndarray, as_json: bool, key: str) -> None:
     if as_json:
-        print(json.dumps({key: values.tolist(), "names": names, "units": units,
+        print(json_text({key: values.tolist(), "names": names, "units": units,
                           "within_limits": inside.tolist()}))
         return
     from rich.table import Table
@@ -54,7 +53,7 @@ def _report(title: str, names: list[str], values: np.ndarray, units: list[str],
     for col in ("name", "value", "unit", "within limits"):
         table.add_column(col)
     for nm, v, u, ok in zip(names, values, units, inside):
-        table.add_row(nm, f"{v:.9g}", u, "yes" if ok else "[red]no[/red]")
+        table.add_row(cell(nm), f"{v:.9g}", u, "yes" if ok else "[red]no[/red]")
     _console().print(table)
 
 

@@ -7,14 +7,13 @@ than ``--clearance`` (useful in scripts and CI).
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 
-from robokin.cli import DomainFailure, app
+from robokin.cli import DomainFailure, app, cell, json_text
 
 __all__ = ["read_trajectory_csv"]
 
@@ -22,92 +21,21 @@ __all__ = ["read_trajectory_csv"]
 def read_trajectory_csv(path: str | Path, robot: Any = None) -> tuple[Any, Any]:
     """Times (m,) [s] and joints (m, n) [SI] from a trajectory CSV.
 
-    Uses :func:`robokin.trajectory.io.read_csv` when available; otherwise reads
-    the simple format ``t [s],<joint> [rad|deg|m|mm]...`` itself.
+    With ``robot`` the joint columns are matched to its joint names by header
+    (any order; see :func:`robokin.trajectory.io.read_csv`).
 
     Raises:
-        ModelError: missing or malformed file (names the file and line).
+        ModelError: missing or malformed file, or joint columns that do not match
+            the robot (names the file, the line and the expected names).
     """
-    try:
-        from robokin.trajectory.io import read_csv
-    except ImportError:
-        read_csv = None
-    if read_csv is not None:
-        from robokin.exceptions import InputError, ModelError
+    from robokin.trajectory.io import read_csv
 
-        if robot is None:
-            tr = read_csv(path)
-            return tr.t, tr.q
-        try:
-            tr = read_csv(path, is_revolute=robot.is_revolute)
-        except InputError as exc:
-            if exc.argument != "is_revolute":
-                raise
-            k = read_csv(path).q.shape[-1]
-            raise ModelError(
-                f"has {k} joint columns, {robot.name} has {robot.n} joints",
-                file=path,
-            ) from None
-        return tr.t, tr.q
-    t, q = _read_simple_csv(Path(path))
-    if robot is not None and q.shape[-1] != robot.n:
-        from robokin.exceptions import ModelError
-
-        raise ModelError(
-            f"has {q.shape[-1]} joint columns, {robot.name} has {robot.n} joints",
-            file=path,
-        )
-    return t, q
-
-
-def _read_simple_csv(path: Path):
-    import re
-
-    import numpy as np
-
-    from robokin.exceptions import ModelError
-
-    scale = {
-        "s": 1.0,
-        "ms": 1e-3,
-        "rad": 1.0,
-        "deg": math.pi / 180,
-        "m": 1.0,
-        "mm": 1e-3,
-        None: 1.0,
-    }
-    try:
-        lines = [
-            ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip()
-        ]
-    except FileNotFoundError:
-        raise ModelError("no such file", file=path) from None
-    if len(lines) < 2:
-        raise ModelError("expected a header line and at least one row", file=path)
-    factors = []
-    for col in lines[0].split(","):
-        m = re.match(r"^\s*(.*?)\s*(?:\[([^\]]*)\])?\s*$", col)
-        unit = m.group(2) if m else None
-        if unit not in scale:
-            raise ModelError(f"unknown unit [{unit}]", file=path, field=col.strip())
-        factors.append(scale[unit])
-    rows = []
-    for k, ln in enumerate(lines[1:], start=2):
-        try:
-            vals = [float(v) for v in ln.split(",")]
-        except ValueError:
-            raise ModelError(
-                "non-numeric value", file=path, field=f"line {k}"
-            ) from None
-        if len(vals) != len(factors):
-            raise ModelError(
-                f"expected {len(factors)} values, got {len(vals)}",
-                file=path,
-                field=f"line {k}",
-            )
-        rows.append(vals)
-    data = np.array(rows) * np.array(factors)
-    return data[:, 0], data[:, 1:]
+    if robot is None:
+        tr = read_csv(path)
+    else:
+        tr = read_csv(path, joint_names=robot.joint_names,
+                      is_revolute=robot.is_revolute)
+    return tr.t, tr.q
 
 
 @app.command("check", context_settings={"ignore_unknown_options": True})
@@ -164,7 +92,7 @@ def check_command(
     if as_json:
         c = rep.closest
         print(
-            json.dumps(
+            json_text(
                 {
                     "min_distance_m": None if c is None else rep.min_distance,
                     "closest": None
@@ -184,8 +112,6 @@ def check_command(
                     "collisions": [iv._asdict() for iv in rep.intervals],
                     "pairs": [p._asdict() for p in rep.pairs[:top]],
                 },
-                indent=2,
-                default=float,
             )
         )
     else:
@@ -217,8 +143,8 @@ def _print_report(
     for p in rep.pairs[:top]:
         style = "red" if p.distance <= max(clearance_mm * 1e-3, 0.0) else None
         table.add_row(
-            p.body_a,
-            p.body_b,
+            cell(p.body_a),
+            cell(p.body_b),
             f"{p.distance * 1e3:.2f}",
             f"{p.t:.3f}",
             str(p.index),
@@ -239,8 +165,8 @@ def _print_report(
             ct.add_column(escape(col))
         for iv in rep.intervals:
             ct.add_row(
-                iv.body_a,
-                iv.body_b,
+                cell(iv.body_a),
+                cell(iv.body_b),
                 str(iv.first_index),
                 str(iv.last_index),
                 f"{iv.t_start:.3f}",

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import json
 import math
 from typing import Annotated
 
 import typer
 
-from robokin.cli import DomainFailure, _console, _load, app
+from robokin.cli import DomainFailure, _console, _load, app, cell, json_text
 
 __all__ = ["ik"]
 
@@ -70,7 +69,7 @@ def ik(
     disp = np.where(rev, q * A, q * L)
     status = str(sols.status.item() if isinstance(sols.status, np.ndarray) else sols.status)
     if as_json:
-        print(json.dumps({
+        print(json_text({
             "method": sols.method, "status": status,
             "solutions": [
                 {"q": disp[i].tolist(),
@@ -82,7 +81,8 @@ def ik(
     else:
         con = _console()
         au, lu = ("deg" if deg else "rad"), ("mm" if mm else "m")
-        table = Table(title=f"{r.name}: {len(q)} solution(s) [{sols.method}]; "
+        table = Table(title=f"{cell(r.name)}: {len(q)} solution(s) "
+                            f"{cell('[' + sols.method + ']')}; "
                             f"angles {au}, lengths {lu}")
         table.add_column("#")
         for j in range(r.n):

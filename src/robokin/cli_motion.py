@@ -1,233 +1,26 @@
 """``robokin traj`` and ``robokin compare``: plan a motion from a file, check a real run.
 
-A motion file (YAML) names a robot and its via points::
-
-    robot: aubo_i5                    # built-in name or robot file
-    units: {length: mm, angle: deg}   # of this file (default m, rad)
-    dt: 0.005                         # [s]
-    start: [0, 10, 80, 0, 90, 0]      # joint configuration
-    limits: {velocity: 90, acceleration: 180}   # per second (scalar or per joint)
-    tool_speed: 250                   # [length/s] on lines (optional)
-    smooth: true                      # pass through joint via points
-    segments:
-      - joint: [-40, 20, 90, -20, 90, 0]
-      - line: {dxyz: [0, 0, -100]}    # relative straight move (base axes)
-        duration: 1.0
-      - dwell: 0.5
-      - line: {xyz: [400, -120, 600], rpy: [180, 0, 90]}
-      - pose: {xyz: [300, 300, 500]}  # joint move to a pose (rpy kept if omitted)
-
-Segment keys besides the target: ``duration`` [s], ``profile``, ``stop``,
-``label``, ``speed_in`` / ``speed_out`` (lines, [length/s]).
+The motion-file format is described in :mod:`robokin.io.motion_files`.
 """
 
 from __future__ import annotations
 
-import json
 import math
-from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 
-from robokin.cli import DomainFailure, app
+from robokin.cli import DomainFailure, app, cell, json_text
+from robokin.io.motion_files import (
+    MAX_MOTION_SAMPLES,
+    load_motion_file,
+    plan_from_document,
+)
 
-__all__ = ["load_motion_file", "plan_from_document"]
+__all__ = ["compare", "traj"]
 
 _NUMERIC_ARGS = {"ignore_unknown_options": True}
-
-
-# ------------------------------------------------------------------ motion files
-def _schema():
-    from typing import Literal
-
-    from pydantic import BaseModel, ConfigDict, Field
-
-    class Units(BaseModel):
-        model_config = ConfigDict(extra="forbid")
-        length: Literal["m", "mm"] = "m"
-        angle: Literal["rad", "deg"] = "rad"
-
-    class Limits(BaseModel):
-        model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-        velocity: float | list[float] | None = None
-        acceleration: float | list[float] | None = None
-
-    class Target(BaseModel):
-        model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-        xyz: list[float] | None = Field(default=None, min_length=3, max_length=3)
-        dxyz: list[float] | None = Field(default=None, min_length=3, max_length=3)
-        rpy: list[float] | None = Field(default=None, min_length=3, max_length=3)
-
-    class Step(BaseModel):
-        model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-        joint: list[float] | None = None
-        pose: Target | None = None
-        line: Target | None = None
-        dwell: float | None = Field(default=None, gt=0)
-        duration: float | None = Field(default=None, gt=0)
-        profile: str = "quintic"
-        stop: bool = False
-        label: str = ""
-        speed_in: float = 0.0
-        speed_out: float = 0.0
-
-    class Motion(BaseModel):
-        model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-        robot: str
-        units: Units = Units()
-        dt: float = Field(default=0.005, gt=0)
-        start: list[float]
-        limits: Limits = Limits()
-        tool_speed: float | None = Field(default=None, gt=0)
-        tool_acceleration: float | None = Field(default=None, gt=0)
-        smooth: bool = True
-        ik: Literal["follow", "analytic", "numeric"] = "follow"
-        segments: list[Step] = Field(min_length=1)
-
-    return Motion
-
-
-def load_motion_file(path: str | Path) -> tuple[Any, Path]:
-    """Read and validate a motion file.
-
-    Raises:
-        ModelError: missing file, bad YAML, or a bad field (file and field path named).
-    """
-    import yaml
-    from pydantic import ValidationError
-
-    from robokin.exceptions import ModelError
-
-    path = Path(path)
-    try:
-        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ModelError("no such file", file=path) from None
-    except yaml.YAMLError as exc:
-        raise ModelError(f"not valid YAML: {exc}", file=path) from None
-    try:
-        return _schema().model_validate(doc), path
-    except ValidationError as exc:
-        err = exc.errors()[0]
-        field = ".".join(str(p) if not isinstance(p, int) else f"[{p}]"
-                         for p in err["loc"]).replace(".[", "[")
-        raise ModelError(err["msg"], file=path, field=field) from None
-
-
-def plan_from_document(spec: Any, file: Path, progress: Any = None) -> tuple[Any, Any]:
-    """Build the trajectory a validated motion file describes: ``(robot, traj)``.
-
-    Raises:
-        ModelError: a field that does not fit the robot (file and field named).
-        PathError: a line that cannot be followed.
-    """
-    import numpy as np
-
-    import robokin
-    from robokin.exceptions import InputError, ModelError
-    from robokin.spatial import matrix_from_rpy
-    from robokin.trajectory import PathBuilder
-
-    # the builder's argument names -> the motion file's fields
-    top = {"v_max": "limits.velocity", "a_max": "limits.acceleration",
-           "tool_speed": "tool_speed", "tool_acceleration": "tool_acceleration",
-           "dt": "dt", "ik": "ik", "q_start": "start"}
-
-    @contextmanager
-    def fields(where: str | None):
-        """Re-raise a builder's InputError as a ModelError naming the file's field."""
-        try:
-            yield
-        except InputError as exc:
-            field = top.get(exc.argument) or (
-                f"{where}.{exc.argument}" if where else exc.argument)
-            raise ModelError(exc.reason, file=file, field=field) from None
-
-    name = spec.robot
-    candidate = file.parent / name
-    try:
-        robot = robokin.load(candidate if candidate.suffix in (".yaml", ".yml")
-                             and candidate.exists() else name)
-    except ModelError as exc:
-        if exc.file is not None:
-            raise
-        raise ModelError(exc.reason, file=file, field="robot") from None
-    L = 1e-3 if spec.units.length == "mm" else 1.0
-    A = math.pi / 180.0 if spec.units.angle == "deg" else 1.0
-    rev = robot.is_revolute
-    jscale = np.where(rev, A, L)
-
-    def joints(values, field):
-        if len(values) != robot.n:
-            raise ModelError(f"{robot.name} has {robot.n} joints, got {len(values)} "
-                             "values", file=file, field=field)
-        return np.asarray(values, float) * jscale
-
-    def per_joint(v, field):
-        if v is None:
-            return None
-        arr = np.broadcast_to(np.asarray(v, float), (robot.n,)) if np.ndim(v) == 0 \
-            else np.asarray(v, float)
-        if arr.shape != (robot.n,):
-            raise ModelError(f"expected one value or {robot.n}", file=file, field=field)
-        return arr * jscale
-
-    with fields(None):
-        pb = PathBuilder(robot, joints(spec.start, "start"), dt=spec.dt,
-                         v_max=per_joint(spec.limits.velocity, "limits.velocity"),
-                         a_max=per_joint(spec.limits.acceleration, "limits.acceleration"),
-                         tool_speed=None if spec.tool_speed is None else spec.tool_speed * L,
-                         tool_acceleration=None if spec.tool_acceleration is None
-                         else spec.tool_acceleration * L,
-                         smooth=spec.smooth, ik=spec.ik)
-
-    def pose(target, field):
-        T = robot.fk(pb.q_end).copy()
-        if target.xyz is not None and target.dxyz is not None:
-            raise ModelError("give xyz or dxyz, not both", file=file, field=field)
-        if target.rpy is not None:
-            T[:3, :3] = matrix_from_rpy(np.asarray(target.rpy) * A)[:3, :3]
-        if target.xyz is not None:
-            T[:3, 3] = np.asarray(target.xyz) * L
-        elif target.dxyz is not None:
-            T[:3, 3] += np.asarray(target.dxyz) * L
-        return T
-
-    total = len(spec.segments)
-    for i, st in enumerate(spec.segments):
-        field = f"segments[{i}]"
-        kinds = [k for k in ("joint", "pose", "line", "dwell") if getattr(st, k) is not None]
-        if len(kinds) != 1:
-            raise ModelError("needs exactly one of joint, pose, line, dwell", file=file,
-                             field=field)
-        common = {"label": st.label or f"{kinds[0]} {i + 1}"}
-        with fields(field):
-            _add_step(pb, st, joints, pose, field, L, common)
-        if progress is not None:
-            progress(i + 1, total + 1)
-    with fields("segments"):
-        traj = pb.build()
-    if progress is not None:
-        progress(total + 1, total + 1)
-    return robot, traj
-
-
-def _add_step(pb: Any, st: Any, joints: Any, pose: Any, field: str, L: float,
-              common: dict[str, Any]) -> None:
-    """Add one validated motion-file step to the path builder."""
-    if st.joint is not None:
-        pb.joint(joints(st.joint, f"{field}.joint"), st.duration,
-                 profile=st.profile, stop=st.stop, **common)
-    elif st.pose is not None:
-        pb.pose(pose(st.pose, f"{field}.pose"), st.duration, profile=st.profile,
-                stop=st.stop, **common)
-    elif st.line is not None:
-        pb.line(pose(st.line, f"{field}.line"), st.duration, profile=st.profile,
-                speed_in=st.speed_in * L, speed_out=st.speed_out * L, **common)
-    else:
-        pb.dwell(st.dwell, **common)
 
 
 def _default_out(path: Path | None, fallback: Path, explicit: bool) -> tuple[Path, bool]:
@@ -249,6 +42,9 @@ def traj(
         "--rates", help="Also write velocity and acceleration columns.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Machine-readable summary.")
                        ] = False,
+    max_samples: Annotated[int, typer.Option(
+        "--max-samples", help="Most samples the motion may hold (refused above).")
+    ] = MAX_MOTION_SAMPLES,
 ) -> None:
     """Plan a motion through via points: write the samples (CSV) and a plot, print a summary.
 
@@ -263,15 +59,18 @@ def traj(
     from robokin.trajectory import PathError
     from robokin.trajectory.io import write_csv
 
+    if max_samples < 1:
+        raise InputError("--max-samples", f"expected a count >= 1, got {max_samples}")
     spec, path = load_motion_file(file)
     try:
         if as_json:
-            robot, tr = plan_from_document(spec, path)
+            robot, tr = plan_from_document(spec, path, max_samples=max_samples)
         else:
             with Progress(transient=True) as bar:
                 task = bar.add_task("planning", total=len(spec.segments) + 1)
                 robot, tr = plan_from_document(
-                    spec, path, lambda d, t: bar.update(task, completed=d))
+                    spec, path, lambda d, t: bar.update(task, completed=d),
+                    max_samples=max_samples)
     except PathError as exc:
         raise DomainFailure(str(exc)) from None
     csv_path, csv_over = _default_out(output, path.with_suffix(".csv"), True)
@@ -283,7 +82,7 @@ def traj(
 
             png, png_over = _default_out(plot, path.with_suffix(".png"), True)
             plot_joints(tr, path=png, overwrite=png_over,
-                        title=f"{robot.name}: {path.name}")
+                        title=f"{robot.name}: {path.name}"[:200])
     except InputError as exc:
         raise InputError(exc.argument, exc.reason + " (or give -o / --plot)") from None
     L = 1e-3 if spec.units.length == "mm" else 1.0
@@ -297,7 +96,7 @@ def traj(
     peaks = tr.peaks()
     su = np.where(robot.is_revolute, 180 / math.pi, 1000.0)
     if as_json:
-        print(json.dumps({
+        print(json_text({
             "robot": robot.name, "duration": tr.duration, "samples": len(tr),
             "dt": spec.dt, "csv": str(csv_path), "plot": None if png is None else str(png),
             "joints": list(robot.joint_names),
@@ -310,13 +109,13 @@ def traj(
         from rich.table import Table
 
         con = Console()
-        con.print(f"{robot.name}: {len(tr.labels)} segments, {tr.duration:.3f} s, "
+        con.print(f"{cell(robot.name, markup=False)}: {len(tr.labels)} segments, {tr.duration:.3f} s, "
                   f"{len(tr)} samples at {spec.dt * 1000:g} ms", markup=False)
         table = Table(title="peaks per joint")
         for col in ("joint", "unit", "min", "max", "peak |vel| /s", "peak |acc| /s²"):
             table.add_column(col)
         for j, name in enumerate(robot.joint_names):
-            table.add_row(name, "deg" if robot.is_revolute[j] else "mm",
+            table.add_row(cell(name), "deg" if robot.is_revolute[j] else "mm",
                           f"{peaks['min'][j] * su[j]:.3f}", f"{peaks['max'][j] * su[j]:.3f}",
                           f"{peaks['velocity'][j] * su[j]:.3f}",
                           f"{peaks['acceleration'][j] * su[j]:.3f}")
@@ -355,7 +154,8 @@ def compare(
     from robokin.trajectory.io import read_csv, read_log
 
     p = read_csv(plan)
-    r = read_log(log)
+    # the log's joint columns are matched to the plan's by name (any order)
+    r = read_log(log, joint_names=p.joint_names, is_revolute=p.revolute())
     cmp = run_compare(p, r, time_shift=time_shift)
     rows = cmp.table(degrees=not radians)
     png = None
@@ -365,18 +165,18 @@ def compare(
         png, over = _default_out(plot, log.with_name(log.stem + "_vs_plan.png"), True)
         plot_comparison(cmp, path=png, overwrite=over, degrees=not radians)
     if as_json:
-        print(json.dumps({"joints": rows, "plot": None if png is None else str(png)},
-                         default=float))
+        print(json_text({"joints": rows, "plot": None if png is None else str(png)}))
         return
     from rich.console import Console
     from rich.table import Table
 
-    table = Table(title=f"{log.name} vs {plan.name}: {len(cmp.t)} samples compared")
+    table = Table(title=f"{cell(log.name)} vs {cell(plan.name)}: {len(cmp.t)} samples "
+                        "compared")
     for col in ("joint", "unit", "max |error|", "at t [s]", "RMS", "mean",
                 "corr(|error|, |acc|)"):
         table.add_column(col)
     for row in rows:
-        table.add_row(row["joint"], row["unit"], f"{row['max']:.4f}",
+        table.add_row(cell(row["joint"]), row["unit"], f"{row['max']:.4f}",
                       f"{row['t_max']:.3f}", f"{row['rms']:.4f}", f"{row['mean']:.4f}",
                       f"{row['corr_acc']:.2f}")
     con = Console()

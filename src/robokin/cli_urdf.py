@@ -6,13 +6,12 @@ standard output.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from robokin.cli import _console, _load, app
+from robokin.cli import _console, _load, app, cell, json_text
 
 __all__ = ["dh", "export_urdf", "import_urdf"]
 
@@ -39,11 +38,15 @@ def import_urdf(
         typer.Option("--package", help="NAME=DIR for package:// meshes (repeatable)."),
     ] = None,
 ) -> None:
-    """Read a URDF's serial chain and write it as a robokin robot file."""
+    """Read a URDF's serial chain and write it as a robokin robot file.
+
+    Every visual or collision shape left out (a missing, remote or unsupported
+    mesh, a non-uniform scale) is reported on stderr, one line each.
+    """
     import yaml
 
-    from robokin.model.files import document_from_robot, save_robot
-    from robokin.model.urdf import robot_from_urdf
+    from robokin.io.robot_files import document_from_robot, save_robot
+    from robokin.io.urdf import robot_from_urdf
 
     pmap = {}
     for item in package or []:
@@ -56,13 +59,16 @@ def import_urdf(
     robot = robot_from_urdf(file, base_link=base, tip_link=tip, package_map=pmap,
                             missing_mesh="ignore")
     info = robot.meta["urdf"]
+    for msg in robot.meta.get("urdf_dropped_shapes", ()):
+        typer.echo(f"robokin: note: left out {msg}", err=True)
     if out is None:
         print(yaml.safe_dump(document_from_robot(robot), sort_keys=False,
                              default_flow_style=None), end="")
         return
     save_robot(robot, out)
     _console().print(
-        f"{robot.name}: {robot.n} joints, {info.base_link} -> {info.tip_link}; "
+        f"{cell(robot.name, markup=False)}: {robot.n} joints, "
+        f"{cell(info.base_link, markup=False)} -> {cell(info.tip_link, markup=False)}; "
         f"wrote {out}", markup=False,
     )
 
@@ -75,7 +81,7 @@ def export_urdf(
     ] = None,
 ) -> None:
     """Write a robot as a URDF with the same FK and limits."""
-    from robokin.model.urdf import urdf_from_robot, write_urdf
+    from robokin.io.urdf_export import urdf_from_robot, write_urdf
 
     if out is not None:
         _not_the_input(out, name)
@@ -84,7 +90,7 @@ def export_urdf(
         print(urdf_from_robot(robot), end="")
         return
     write_urdf(robot, out)
-    _console().print(f"{robot.name}: wrote {out}", markup=False)
+    _console().print(f"{cell(robot.name, markup=False)}: wrote {out}", markup=False)
 
 
 @app.command("dh")
@@ -109,8 +115,8 @@ def dh(
     """Derive the DH table of a URDF arm (degrees; metres unless --mm)."""
     from rich.table import Table
 
-    from robokin.model.dh_extract import describe
-    from robokin.model.urdf import dh_from_urdf
+    from robokin.io.dh_extract import describe
+    from robokin.io.urdf import dh_from_urdf
 
     ext = dh_from_urdf(
         file, base, tip, convention="modified" if modified else "standard",
@@ -127,18 +133,18 @@ def dh(
         doc[key]["xyz"] = [v * L for v in doc[key]["xyz"]]
     doc["units"] = {"length": "mm" if mm else "m", "angle": "deg"}
     if as_json:
-        print(json.dumps(doc))
+        print(json_text(doc))
         return
     lu = "mm" if mm else "m"
     cols = (("alpha", "deg"), ("a", lu), ("theta", "deg"), ("d", lu)) if modified \
         else (("theta", "deg"), ("d", lu), ("a", lu), ("alpha", "deg"))
-    table = Table(title=f"{doc['convention']} DH of {file.name}")
+    table = Table(title=f"{doc['convention']} DH of {cell(file.name)}")
     table.add_column("joint")
     table.add_column("kind")
     for c, u in cols:
         table.add_column(f"{c} [{u}]")
     for r in doc["rows"]:
-        table.add_row(r["name"], r["joint"], *(f"{r[c]:.6g}" for c, _ in cols))
+        table.add_row(cell(r["name"]), r["joint"], *(f"{r[c]:.6g}" for c, _ in cols))
     con = _console()
     con.print(table)
     for key in ("base", "tool"):

@@ -80,11 +80,9 @@ def view(
     if traj is not None:
         from robokin.trajectory.io import read_csv
 
-        motion = read_csv(traj, is_revolute=robot.is_revolute)
-        if motion.q.shape[-1] != robot.n:
-            raise typer.BadParameter(
-                f"{traj} has {motion.q.shape[-1]} joint columns, {robot.name} has {robot.n} joints"
-            )
+        # joint columns matched to the robot's joints by name (any order)
+        motion = read_csv(traj, joint_names=robot.joint_names,
+                          is_revolute=robot.is_revolute)
     report = None
     if sc is not None and motion is not None and check:
         from robokin import collision

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from robokin.cli import app
+from robokin.cli import app, cell, json_text
 
 __all__ = ["workspace"]
 
@@ -37,7 +36,9 @@ def workspace(
     from rich.table import Table
 
     import robokin
-    from robokin.kinematics.workspace import sample_workspace, save_workspace_plots
+    from robokin.io.atomic import file_stem, write_atomic
+    from robokin.kinematics.workspace import sample_workspace
+    from robokin.viz.plots import save_workspace_plots
 
     if samples < 1:
         raise typer.BadParameter(f"--samples must be >= 1, got {samples}")
@@ -45,6 +46,8 @@ def workspace(
         raise typer.BadParameter(f"--voxel must be >= 0 [mm] (0: auto), got {voxel_mm}")
     if out.exists() and not out.is_dir():
         raise typer.BadParameter(f"--out {out} is a file, expected a folder")
+    if not out.parent.is_dir():
+        raise typer.BadParameter(f"--out {out}: the folder {out.parent} does not exist")
     robot = robokin.load(name)
     con = Console(stderr=as_json)
     with Progress(
@@ -62,16 +65,17 @@ def workspace(
             voxel_size=voxel_mm / 1000.0 if voxel_mm > 0 else None,
             progress=lambda done, total: bar.update(task, completed=done),
         )
+    out.mkdir(exist_ok=True)
     paths = save_workspace_plots(ws, out)
     summary = ws.summary()
     summary["plots"] = [str(p) for p in paths]
-    summary_path = Path(out) / f"{robot.name}_workspace.json"
-    summary_path.write_text(json.dumps(summary, indent=2))
+    summary_path = Path(out) / f"{file_stem(robot.name)}_workspace.json"
+    write_atomic(summary_path, json_text(summary) + "\n", argument="--out")
     if as_json:
-        print(json.dumps(summary))
+        print(json_text(summary))
         return
     table = Table(
-        title=f"{robot.name}: workspace of the tool point ({ws.n_samples:,} samples)"
+        title=f"{cell(robot.name)}: workspace of the tool point ({ws.n_samples:,} samples)"
     )
     for col in ("", "x \\[mm]", "y \\[mm]", "z \\[mm]"):
         table.add_column(col, justify="right")

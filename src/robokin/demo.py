@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import base64
 import html
-import json
 import math
 import time
 from dataclasses import dataclass, field
@@ -172,14 +171,14 @@ def _closest_pair_distances(report: Any, k: int = 6) -> dict[str, np.ndarray]:
 
 def _write_distance_csv(traj: Any, dist: dict[str, np.ndarray], path: Path) -> Path:
     """Time, the closest pairs' distances and their minimum, in mm."""
-    from robokin.trajectory.io import write_text_atomic
+    from robokin.io.atomic import write_atomic
 
     names = list(dist)
     D = np.column_stack([dist[n] for n in names]) * 1000.0
     table = np.column_stack([traj.t, D, D.min(axis=1)])
     header = ",".join(["t [s]"] + [f"{n} [mm]" for n in names] + ["min [mm]"])
     lines = [header] + [",".join(f"{v:.6f}" for v in row) for row in table]
-    return write_text_atomic(path, "\n".join(lines) + "\n", overwrite=True)
+    return write_atomic(path, "\n".join(lines) + "\n")
 
 
 def _plot_press_views(traj: Any, scene: Any, report: Any, path: Path) -> Path:
@@ -431,6 +430,8 @@ def run_demo(
 
     import robokin
     from robokin import collision
+    from robokin.io.atomic import write_atomic
+    from robokin.io.strict_json import strict_json
     from robokin.trajectory import io
     from robokin.viz import plots
 
@@ -584,11 +585,9 @@ def run_demo(
             for k in ("joints.png", "press_views.png", "distance.png", "tool_path.png")
         }
         report_path = out / "report.html"
-        io.write_text_atomic(report_path, _report_html(summary, images), overwrite=True)
+        write_atomic(report_path, _report_html(summary, images))
         done("report.html", report_path)
-    io.write_text_atomic(
-        out / MARKER, json.dumps(summary, indent=2) + "\n", overwrite=True
-    )
+    write_atomic(out / MARKER, strict_json(summary, indent=2) + "\n")
     files["summary.json"] = out / MARKER
 
     table = Table(title="robokin demo: AUBO-i5 loads a press", show_header=False)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 __all__ = [
+    "FrozenError",
     "InputError",
     "MissingExtraError",
     "ModelError",
@@ -22,19 +23,37 @@ class ModelError(RobokinError, ValueError):
         file: The file the problem was found in, or None for in-memory models.
         field: The field path inside the file, e.g. ``joints[2].limits``, or None.
         reason: What is wrong.
+        line: The line in the file (1-based), or None when unknown. The message
+            then starts ``FILE:LINE:``, the form editors jump to.
     """
 
-    def __init__(self, reason: str, *, file: object = None, field: str | None = None):
+    def __init__(
+        self,
+        reason: str,
+        *,
+        file: object = None,
+        field: str | None = None,
+        line: int | None = None,
+    ):
         self.file = None if file is None else str(file)
         self.field = field
         self.reason = reason
+        self.line = None if line is None else int(line)
         where = []
         if self.file is not None:
-            where.append(self.file)
+            where.append(self.file if self.line is None else f"{self.file}:{self.line}")
+        elif self.line is not None:
+            where.append(f"line {self.line}")
         if field:
             where.append(field)
         prefix = ": ".join(where)
         super().__init__(f"{prefix}: {reason}" if prefix else reason)
+
+    def at_line(self, line: int | None) -> ModelError:
+        """The same error with ``line`` set (a no-op when it is None or known)."""
+        if line is None or self.line is not None:
+            return self
+        return ModelError(self.reason, file=self.file, field=self.field, line=line)
 
 
 class InputError(RobokinError, ValueError):
@@ -49,6 +68,19 @@ class InputError(RobokinError, ValueError):
         self.argument = argument
         self.reason = reason
         super().__init__(f"argument '{argument}': {reason}")
+
+
+class FrozenError(RobokinError, AttributeError):
+    """An attempt to change an immutable object (a Robot); the message says what to
+    call instead.
+
+    Attributes:
+        name: The attribute that was to be set or deleted.
+    """
+
+    def __init__(self, owner: str, name: str, hint: str):
+        self.name = name
+        super().__init__(f"{owner} is immutable: cannot change '{name}'; {hint}")
 
 
 class UnreachableError(RobokinError):

@@ -1,19 +1,22 @@
 """The Robot: a canonical chain plus its name, source, actuators and geometry.
 
-A Robot is immutable; ``with_tool`` / ``with_base`` / ``replace`` return new ones.
+A Robot is immutable: assigning or deleting an attribute raises
+:class:`~robokin.exceptions.FrozenError`, its arrays are read-only and ``meta`` is
+a read-only mapping; ``with_tool`` / ``with_base`` / ``replace`` return new ones.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
 
-from robokin._validation import check_transform
-from robokin.exceptions import InputError
+from robokin._validation import check_pose_magnitude, check_transform
+from robokin.exceptions import FrozenError, InputError
 from robokin.kinematics import forward
 from robokin.kinematics import jacobian as _jac
 from robokin.model.chain import Chain
@@ -27,6 +30,14 @@ __all__ = ["Robot"]
 
 Space = Literal["joint", "actuator"]
 _FK_SINGLE = forward.fk_single  # one configuration, or None for the general path
+_HOW_TO_CHANGE = ("make a changed copy with robot.replace(...), robot.with_tool(T) or "
+                  "robot.with_base(T)")
+
+
+def _is_frozen_limits(lim: Any, m: int | None) -> bool:
+    """True for limits a Robot already checked and froze (kept, not copied)."""
+    return (type(lim) is np.ndarray and lim.dtype == np.float64 and not lim.flags.writeable
+            and lim.shape == (m, 2) and not np.isnan(lim).any())
 
 
 class Robot:
@@ -41,8 +52,27 @@ class Robot:
         actuator_limits: Motor limits (m, 2), SI units, or None.
         geometry: Link and tool shapes (see ``robokin.model.geometry``), or None.
         path: The robot file it was loaded from, or None.
-        meta: Free-form extra fields from the robot file (read-only use).
+        meta: Free-form extra fields from the robot file (a read-only mapping).
     """
+
+    __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain",
+                 "geometry", "meta", "name", "path", "source", "__weakref__")
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise FrozenError("Robot", name, _HOW_TO_CHANGE)
+
+    def __delattr__(self, name: str) -> None:
+        raise FrozenError("Robot", name, _HOW_TO_CHANGE)
+
+    def __reduce__(self) -> tuple:
+        # pickle and copy rebuild through __init__ (slots cannot be set directly)
+        return (_rebuild, (self.chain, self._fields()))
+
+    def _fields(self) -> dict[str, Any]:
+        return {"name": self.name, "source": self.source, "actuators": self.actuators,
+                "actuator_names": self.actuator_names,
+                "actuator_limits": self.actuator_limits, "geometry": self.geometry,
+                "path": self.path, "meta": dict(self.meta)}
 
     def __init__(
         self,
@@ -57,22 +87,26 @@ class Robot:
         path: str | Path | None = None,
         meta: Mapping[str, Any] | None = None,
     ) -> None:
-        self.chain = chain
-        self.name = name
-        self.source = source
+        init = object.__setattr__
+        init(self, "chain", chain)
+        init(self, "name", name)
+        init(self, "source", source)
         if actuators is not None and actuators.n_out != chain.n:
             raise InputError(
                 "actuators",
                 f"maps {actuators.n_in} motors to {actuators.n_out} joints, "
                 f"but the robot has {chain.n} joints",
             )
-        self.actuators = actuators
+        init(self, "actuators", actuators)
         m = None if actuators is None else actuators.n_in
-        self.actuator_names = (
+        init(self, "actuator_names", (
             None if actuators is None
             else tuple(actuator_names or (f"motor{i + 1}" for i in range(m)))
-        )
-        if actuator_limits is not None:
+        ))
+        if actuator_limits is None and actuators is not None:
+            actuator_limits = np.tile([-np.inf, np.inf], (m, 1))
+            actuator_limits.setflags(write=False)
+        elif actuator_limits is not None and not _is_frozen_limits(actuator_limits, m):
             lim = np.array(actuator_limits, dtype=float)
             if actuators is None or lim.shape != (m, 2) or np.isnan(lim).any():
                 raise InputError(
@@ -83,12 +117,10 @@ class Robot:
                 )
             lim.setflags(write=False)
             actuator_limits = lim
-        elif actuators is not None:
-            actuator_limits = np.tile([-np.inf, np.inf], (m, 1))
-        self.actuator_limits = actuator_limits
-        self.geometry = geometry
-        self.path = None if path is None else Path(path)
-        self.meta = dict(meta or {})
+        init(self, "actuator_limits", actuator_limits)
+        init(self, "geometry", geometry)
+        init(self, "path", None if path is None else Path(path))
+        init(self, "meta", MappingProxyType(dict(meta or {})))
 
     # ------------------------------------------------------------------ building
     @classmethod
@@ -102,7 +134,17 @@ class Robot:
         name: str = "robot",
         coordinates: Sequence[Mapping[str, Any]] | None = None,
     ) -> Robot:
-        """Build from a DH table in SI units (see :mod:`robokin.model.dh`)."""
+        """Build from a DH table in SI units (see :mod:`robokin.model.dh`).
+
+        A row may leave out ``a``, ``alpha``, ``d`` and ``theta``: a missing one is
+        0 (a joint offset or length the arm does not have). This is safe because
+        a row with any other key is refused, so a misspelt key (``alpah``) is an
+        error, never a silent zero. ``joint`` defaults to ``"revolute"``.
+
+        Raises:
+            ModelError: a row that is not a mapping, an unknown key, a value that
+                is not a finite number, reversed limits (naming ``rows[i].key``).
+        """
         from robokin.model.dh import chain_from_dh
 
         base = None if base is None else check_transform(base, "base")
@@ -134,29 +176,23 @@ class Robot:
         **kwargs: Any,
     ) -> Robot:
         """Load the serial chain of a URDF file (needs ``robokin[urdf]``)."""
-        from robokin.model.urdf import robot_from_urdf
+        from robokin.io.urdf import robot_from_urdf
 
         return robot_from_urdf(path, base_link=base_link, tip_link=tip_link, **kwargs)
 
     def to_urdf(self, **kwargs: Any) -> str:
         """A URDF string with the same FK, limits and geometry."""
-        from robokin.model.urdf import urdf_from_robot
+        from robokin.io.urdf_export import urdf_from_robot
 
         return urdf_from_robot(self, **kwargs)
 
     def replace(self, **changes: Any) -> Robot:
         """A copy with some attributes replaced (``chain``, ``name``, ``geometry``, ...)."""
-        kw = {
-            "chain": self.chain,
-            "name": self.name,
-            "source": self.source,
-            "actuators": self.actuators,
-            "actuator_names": self.actuator_names,
-            "actuator_limits": self.actuator_limits,
-            "geometry": self.geometry,
-            "path": self.path,
-            "meta": self.meta,
-        }
+        kw = {"chain": self.chain, **self._fields()}
+        unknown = sorted(set(changes) - set(kw))
+        if unknown:
+            raise InputError(unknown[0], f"not a Robot attribute; replace() takes "
+                             f"{sorted(kw)}")
         kw.update(changes)
         chain = kw.pop("chain")
         return Robot(chain, **kw)
@@ -290,6 +326,8 @@ class Robot:
         """
         from robokin.kinematics.ik import solve
 
+        if type(T) is np.ndarray and T.dtype == _F64 and T.shape[-2:] == (4, 4):
+            check_pose_magnitude(T, "T")  # before any compiled solver sees it
         if space == "actuator":
             if q_near is not None:
                 q_near = self.joints_from_actuators(q_near)
@@ -402,3 +440,8 @@ class Robot:
         from robokin.viz.plots import plot_robot
 
         return plot_robot(self, q, **kwargs)
+
+
+def _rebuild(chain: Chain, fields: dict[str, Any]) -> Robot:
+    """Unpickle a Robot (see ``Robot.__reduce__``)."""
+    return Robot(chain, **fields)

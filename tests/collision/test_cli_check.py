@@ -103,17 +103,17 @@ def test_plot_distance_draws_the_pairs_and_the_clearance(press_motion, tmp_path)
     assert out.read_text().lstrip().startswith("<?xml")
 
 
-def test_fallback_csv_reader_converts_units(tmp_path):
-    from robokin.cli_collision import _read_simple_csv
+def test_trajectory_csv_reader_converts_units(tmp_path):
+    from robokin.cli_collision import read_trajectory_csv
 
     path = tmp_path / "t.csv"
     path.write_text("t [ms],a [deg],b [mm]\n0,90,1000\n500,180,-20\n")
-    t, q = _read_simple_csv(path)
+    t, q = read_trajectory_csv(path)
     np.testing.assert_allclose(t, [0.0, 0.5])
     np.testing.assert_allclose(q, [[np.pi / 2, 1.0], [np.pi, -0.02]])
     path.write_text("t [s],a [furlong]\n0,1\n")
     with pytest.raises(robokin.ModelError, match="unknown unit"):
-        _read_simple_csv(path)
+        read_trajectory_csv(path)
 
 
 def test_check_top_limits_the_table_and_bad_inputs_name_the_argument(

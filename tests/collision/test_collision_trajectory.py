@@ -10,8 +10,8 @@ import pytest
 import robokin
 from robokin.collision import Scene, check
 from robokin.exceptions import InputError
+from robokin.io.robot_files import robot_from_document
 from robokin.model import geometry as geo
-from robokin.model.files import robot_from_document
 from robokin.model.geometry import RobotGeometry
 
 coal = pytest.importorskip("coal")

@@ -85,7 +85,7 @@ def test_scene_file_units_placement_and_errors(tmp_path):
             r"objects\[0\]\.size",
         ),
         ({**doc, "units": {"length": "inch"}}, "units.length"),
-        ({**doc, "poses": {"p": {"xyz": [1, 2]}}}, r"poses\.p: xyz and rpy need 3"),
+        ({**doc, "poses": {"p": {"xyz": [1, 2]}}}, r"poses\.p\.xyz: expected 3 numbers"),
         (
             {**doc, "objects": [{"name": "m", "type": "mesh", "file": "gone.stl"}]},
             r"objects\[0\]\.file: mesh file not found",

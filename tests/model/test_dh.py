@@ -130,7 +130,7 @@ def test_virtual_frames_equal_the_patent_composition(rng):
 
 
 def test_dropping_the_virtual_frames_gives_a_wrong_pose(rng):
-    from robokin.model.files import robot_from_document
+    from robokin.io.robot_files import robot_from_document
 
     robot = robokin.load("improved_dh_arm")
     doc = robot.meta["document"]
@@ -212,3 +212,17 @@ def test_bad_rows_name_the_field(rows, match):
 def test_bad_convention_is_rejected():
     with pytest.raises(robokin.ModelError, match="convention"):
         Robot.from_dh([{"a": 0}], convention="craig")
+
+
+def test_missing_dh_keys_default_to_zero_and_misspelt_ones_are_refused():
+    # decided in issue 15: a, alpha, d, theta default to 0 (documented in
+    # Robot.from_dh); safe because any other key is refused
+    rows = [{"a": 0.3}, {"d": 0.2, "joint": "prismatic"}, {"alpha": 0.5, "theta": 0.1}]
+    full = [{"a": 0.0, "alpha": 0.0, "d": 0.0, "theta": 0.0, **r} for r in rows]
+    q = np.array([0.4, 0.05, -0.3])
+    np.testing.assert_array_equal(robokin.Robot.from_dh(rows).fk(q),
+                                  robokin.Robot.from_dh(full).fk(q))
+    with pytest.raises(robokin.ModelError, match=r"rows\[0\].*unknown field.*'alpah'"):
+        robokin.Robot.from_dh([{"a": 0.3, "alpah": 0.5}])
+    with pytest.raises(robokin.ModelError, match=r"rows\[0\]\.limits.*numbers"):
+        robokin.Robot.from_dh([{"a": 0.3, "limits": ["0", "1"]}])

@@ -1,4 +1,4 @@
-"""Link and tool geometry: shapes, bounding volumes, the robot-file sections, meshes."""
+"""Link and tool shapes: construction, bounding volumes, meshes, retooling."""
 
 import math
 
@@ -6,25 +6,8 @@ import numpy as np
 import pytest
 
 import robokin
-from robokin import ModelError
 from robokin.exceptions import InputError
 from robokin.model import geometry as geo
-from robokin.model.files import robot_from_document
-
-ROW = {"name": "j1", "joint": "revolute", "a": 400, "alpha": 0, "d": 0, "theta": 0}
-
-
-def _doc(geometry=None, collision=None, length="mm"):
-    doc = {
-        "name": "two_link",
-        "units": {"length": length, "angle": "deg"},
-        "joints": [ROW, {**ROW, "name": "j2", "a": 300}],
-    }
-    if geometry is not None:
-        doc["geometry"] = geometry
-    if collision is not None:
-        doc["collision"] = collision
-    return doc
 
 
 def _surface_points(shape, rng, n=400):
@@ -74,172 +57,6 @@ def test_shape_validation_names_the_argument():
         geo.capsule(0.0, 1.0)
     with pytest.raises(InputError, match="expected one of"):
         geo.Shape("cone", ())
-
-
-def test_geometry_section_scales_mm_and_degrees():
-    r = robot_from_document(
-        _doc(
-            {
-                "j1": [
-                    {
-                        "type": "capsule",
-                        "radius": 50,
-                        "from": [-400, 0, 0],
-                        "to": [0, 0, 0],
-                    }
-                ],
-                "j2": [
-                    {
-                        "type": "box",
-                        "size": [100, 40, 20],
-                        "xyz": [-150, 0, 0],
-                        "rpy": [0, 0, 90],
-                    }
-                ],
-                "tool": [{"type": "sphere", "radius": 25}],
-            }
-        )
-    )
-    g = r.geometry
-    assert g.names == ("base", "j1", "j2", "tool")
-    (cap,) = g.link("j1")
-    assert cap.size == pytest.approx((0.05, 0.4))
-    np.testing.assert_allclose(cap.placement[:3, 3], [-0.2, 0, 0], atol=1e-12)
-    (box,) = g.link("j2")
-    assert box.size == pytest.approx((0.1, 0.04, 0.02))
-    # rpy 90 deg about z: the box's x axis is the link's y axis
-    np.testing.assert_allclose(box.placement[:3, 0], [0, 1, 0], atol=1e-12)
-    np.testing.assert_allclose(box.placement[:3, 3], [-0.15, 0, 0], atol=1e-12)
-    assert g.tool[0].size == pytest.approx((0.025,))
-    assert g.link("base") == ()
-
-
-def test_geometry_section_errors_name_the_field():
-    with pytest.raises(ModelError, match=r"geometry\.elbow: unknown link 'elbow'"):
-        robot_from_document(_doc({"elbow": [{"type": "sphere", "radius": 1}]}))
-    with pytest.raises(
-        ModelError, match=r"geometry\.j1\[0\]\.radius: missing required"
-    ):
-        robot_from_document(_doc({"j1": [{"type": "capsule", "length": 3}]}))
-    with pytest.raises(
-        ModelError, match=r"geometry\.j1\[0\]\.type: 'type' must be one of"
-    ):
-        robot_from_document(_doc({"j1": [{"type": "cone"}]}))
-    with pytest.raises(ModelError, match=r"geometry\.j1\[0\]\.colour: unknown field"):
-        robot_from_document(
-            _doc({"j1": [{"type": "sphere", "radius": 1, "colour": "red"}]})
-        )
-    with pytest.raises(ModelError, match=r"geometry\.j1\[0\]\.size: expected 3 finite"):
-        robot_from_document(_doc({"j1": [{"type": "box", "size": [1, 2]}]}))
-
-
-def test_collision_section_exclusions_and_adjacency():
-    r = robot_from_document(
-        _doc(
-            {
-                "base": [{"type": "sphere", "radius": 10}],
-                "j2": [{"type": "sphere", "radius": 10}],
-                "j1": [{"type": "sphere", "radius": 10}],
-            },
-            {"exclude": [["base", "j2"]]},
-        )
-    )
-    g = r.geometry
-    assert g.is_excluded("base", "j2") and g.is_excluded("j2", "base")
-    assert g.is_excluded("base", "j1")  # adjacent
-    assert not g.is_excluded(
-        "j1", "tool"
-    )  # not adjacent... tool carries nothing though
-    assert g.self_pairs() == []
-    r2 = robot_from_document(
-        _doc(
-            {
-                "base": [{"type": "sphere", "radius": 10}],
-                "j2": [{"type": "sphere", "radius": 10}],
-            },
-        )
-    )
-    assert r2.geometry.self_pairs() == [(0, 2)]
-    with pytest.raises(
-        ModelError, match=r"collision\.exclude\[0\]: unknown link 'hand'"
-    ):
-        robot_from_document(_doc(None, {"exclude": [["base", "hand"]]}))
-
-
-def _write_box_stl(path, size_mm):
-    import trimesh
-
-    trimesh.creation.box(extents=size_mm).export(path)
-
-
-def test_mesh_in_mm_is_scaled_and_resolved_relative_to_the_robot_file(tmp_path):
-    import yaml
-
-    (tmp_path / "meshes").mkdir()
-    _write_box_stl(tmp_path / "meshes" / "link.stl", (200.0, 60.0, 40.0))
-    doc = _doc(
-        {
-            "j1": [
-                {
-                    "type": "mesh",
-                    "file": "meshes/link.stl",
-                    "units": "mm",
-                    "xyz": [-200, 0, 0],
-                }
-            ]
-        }
-    )
-    path = tmp_path / "arm.yaml"
-    path.write_text(yaml.safe_dump(doc))
-    r = robokin.load(path)
-    (shape,) = r.geometry.link("j1")
-    assert shape.file == tmp_path / "meshes" / "link.stl"
-    ext = shape.trimesh().extents
-    np.testing.assert_allclose(ext, [0.2, 0.06, 0.04], rtol=1e-12)
-    c, h = shape.local_box()
-    np.testing.assert_allclose(h, [0.1, 0.03, 0.02], rtol=1e-12)
-    # a metre mesh given with a scale factor
-    shape_m = geo.mesh(tmp_path / "meshes" / "link.stl", units="m", scale=0.5)
-    np.testing.assert_allclose(shape_m.trimesh().extents, [100, 30, 20], rtol=1e-12)
-
-
-def test_missing_mesh_names_the_file_and_the_link(tmp_path):
-    import yaml
-
-    path = tmp_path / "arm.yaml"
-    path.write_text(
-        yaml.safe_dump(_doc({"j2": [{"type": "mesh", "file": "nowhere.stl"}]}))
-    )
-    with pytest.raises(ModelError) as exc:
-        robokin.load(path)
-    msg = str(exc.value)
-    assert "nowhere.stl" in msg and "j2" in msg and "not found" in msg
-    assert str(path) in msg
-
-
-def test_corrupt_mesh_names_the_file_and_the_link(tmp_path):
-    import yaml
-
-    bad = tmp_path / "broken.stl"
-    bad.write_bytes(b"solid nonsense\n this is not an STL at all \x00\x01\x02")
-    path = tmp_path / "arm.yaml"
-    path.write_text(
-        yaml.safe_dump(_doc({"j1": [{"type": "mesh", "file": "broken.stl"}]}))
-    )
-    r = robokin.load(path)  # meshes load lazily ...
-    with pytest.raises(ModelError) as exc:  # ... and fail clearly on first use
-        r.geometry.check_files()
-    msg = str(exc.value)
-    assert "broken.stl" in msg and "'j1'" in msg
-
-
-def test_unsupported_mesh_format_is_refused(tmp_path):
-    (tmp_path / "part.step").write_text("ISO-10303-21;")
-    with pytest.raises(ModelError, match="unsupported mesh format"):
-        robot_from_document(
-            _doc({"j1": [{"type": "mesh", "file": "part.step"}]}),
-            file=tmp_path / "a.yaml",
-        )
 
 
 @pytest.mark.parametrize("name", robokin.robots.names())

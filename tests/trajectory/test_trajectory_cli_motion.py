@@ -1,6 +1,7 @@
 """``robokin traj`` and ``robokin compare``: files written, summary, exit codes, errors."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -74,7 +75,8 @@ def test_compare_prints_the_error_table(tmp_path, capsys):
     plan = read_csv(tmp_path / "press.csv")
     q = plan.q + np.radians(0.25)
     log = tmp_path / "log.csv"
-    log.write_text("t [s]," + ",".join(f"j{i} [deg]" for i in range(6)) + "\n" + "\n".join(
+    # a log labels its columns with the robot's joint names (matched by name)
+    log.write_text("t [s]," + ",".join(f"{n} [deg]" for n in plan.names()) + "\n" + "\n".join(
         ",".join(repr(float(v)) for v in [t, *np.degrees(r)]) for t, r in zip(plan.t, q)))
     code, out, _ = run(capsys, "compare", str(tmp_path / "press.csv"), str(log), "--json")
     assert code == 0
@@ -97,4 +99,5 @@ def test_traj_builder_errors_name_the_file_field(tmp_path, capsys, old, new, fie
     f.write_text(MOTION.replace(old, new, 1))
     code, _, err = run(capsys, "traj", str(f), "--no-plot")
     assert code == 2
-    assert f"bad.yaml: {field}:" in err and reason in err
+    # the message names the file, the line of the field and the field
+    assert re.search(rf"bad\.yaml:\d+: {re.escape(field)}:", err) and reason in err

@@ -238,7 +238,9 @@ def test_cli_view_of_a_robot_without_geometry_still_draws_and_says_why(
     (tmp_path / "cell.yaml").write_text(SCENE_YAML)
     q = _ur5_motion(5)
     csv = tmp_path / "m.csv"
-    header = "t [s]," + ",".join(f"j{k} [rad]" for k in range(6))
+    # columns are matched to the robot's joints by name (issue 15)
+    names = robokin.load("ur5").joint_names
+    header = "t [s]," + ",".join(f"{n} [rad]" for n in names)
     rows = np.column_stack([np.arange(5) * 0.1, q])
     np.savetxt(csv, rows, delimiter=",", header=header, comments="")
     out = tmp_path / "v.html"

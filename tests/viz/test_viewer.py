@@ -181,3 +181,57 @@ def test_playback_draws_the_real_reports_closest_segment(ur5, tmp_path):
         assert "distance 30.0 mm" in v._status.content
     with pytest.raises(robokin.InputError, match="report"):
         RobotViewer(sc.attach(ur5), q[:3], scene=sc, report=rep, port=0)
+
+
+# ---------------------------------------------------- issue 15: the websocket Origin
+def _connect(url: str, origin: str | None):
+    """Open the viewer's websocket as a browser page at ``origin`` would."""
+    import viser
+    from websockets.sync.client import connect
+
+    return connect(url.replace("http://", "ws://"), origin=origin, open_timeout=10,
+                   subprotocols=[f"viser-v{viser.__version__}"], proxy=None)
+
+
+def test_a_page_from_another_origin_cannot_connect(ur5):
+    from websockets.exceptions import InvalidStatus
+
+    with RobotViewer(ur5, port=0) as v:
+        for origin in ("http://evil.example", f"http://evil.example:{v.port}",
+                       f"http://127.0.0.1:{v.port + 1}", "null",
+                       f"https://attacker.test:{v.port}"):
+            with pytest.raises(InvalidStatus) as exc:
+                _connect(v.url, origin)
+            assert exc.value.response.status_code == 403, origin
+
+
+def test_the_viewers_own_page_and_local_programs_connect_and_receive_the_scene(ur5):
+    with RobotViewer(ur5, port=0) as v:
+        for origin in (v.url, f"http://localhost:{v.port}", None):
+            with _connect(v.url, origin) as ws:
+                assert len(ws.recv(timeout=10)) > 0  # the scene starts streaming
+
+
+def test_origin_rule():
+    from robokin.viz._origin_guard import origin_allowed
+
+    assert origin_allowed(None, "127.0.0.1", 8080)
+    assert origin_allowed("http://127.0.0.1:8080", "127.0.0.1", 8080)
+    assert origin_allowed("http://[::1]:8080", "::1", 8080)
+    assert origin_allowed("http://192.168.1.5:8080", "192.168.1.5", 8080)
+    assert origin_allowed("http://cell-pc:8080", "192.168.1.5", 8080, ["cell-pc"])
+    for bad in ("http://evil.example:8080", "http://127.0.0.1:8081", "null",
+                "file://", "http://127.0.0.1.evil.example:8080", "ws://127.0.0.1:8080",
+                "http://127.0.0.1:99999"):
+        assert not origin_allowed(bad, "127.0.0.1", 8080), bad
+
+
+def test_other_viser_servers_in_the_process_are_left_alone():
+    import viser
+
+    server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    try:
+        with _connect(f"http://127.0.0.1:{server.get_port()}", "http://elsewhere.test"):
+            pass
+    finally:
+        server.stop()

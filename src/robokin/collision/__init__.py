@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from robokin._text import short_repr
 from robokin.collision.check import (
     Closest,
     Collision,
@@ -45,5 +46,5 @@ def scene_path(name: str) -> Path:
     path = here / f"{name}.yaml"
     if not path.is_file():
         names = sorted(p.stem for p in here.glob("*.yaml"))
-        raise InputError("name", f"no bundled scene {name!r}; scenes: {names}")
+        raise InputError("name", f"no bundled scene {short_repr(name)}; scenes: {names}")
     return path

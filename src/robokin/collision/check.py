@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from robokin._text import short_repr
 from robokin.exceptions import InputError
 
 if TYPE_CHECKING:
@@ -194,7 +195,7 @@ class CollisionReport:
             idx = raw.astype(np.int64).reshape(-1)
         except (TypeError, ValueError):
             raise InputError(
-                "indices", f"expected sample indices, got {indices!r:.60}"
+                "indices", f"expected sample indices, got {short_repr(indices)}"
             ) from None
         if raw.size and not np.array_equal(raw.reshape(-1), idx):
             raise InputError("indices", "expected integer sample indices")
@@ -223,7 +224,7 @@ def _as_samples(
         q = np.array(q, dtype=np.float64)
     except (TypeError, ValueError):
         raise InputError(
-            "q_samples", f"expected numbers, got {q_samples!r:.60}"
+            "q_samples", f"expected numbers, got {short_repr(q_samples)}"
         ) from None
     if q.ndim == 1:
         q = q[None, :]
@@ -293,7 +294,7 @@ def check(
         and clearance >= 0
     ):
         raise InputError(
-            "clearance", f"expected a finite number >= 0 [m], got {clearance!r}"
+            "clearance", f"expected a finite number >= 0 [m], got {short_repr(clearance)}"
         )
     q, tt = _as_samples(q_samples, robot.n, t)
     problem = _problem_for(robot, scene, self_collision)

@@ -32,7 +32,8 @@ def plot_distance(
         count: How many pairs by default.
         clearance: Threshold [m] to mark; default ``report.clearance`` (drawn
             when > 0). Contact (0) is always marked.
-        out: Save the figure here (PNG, SVG, PDF by suffix) and close it.
+        out: Save the figure here (PNG, SVG, PDF by suffix; atomically, see
+            :func:`robokin.io.atomic.write_atomic`) and close it.
         ax: Draw into this matplotlib Axes instead of a new figure.
 
     Returns:
@@ -89,6 +90,10 @@ def plot_distance(
         top = ax.get_ylim()[1]
         ax.set_ylim(min(lowest * 1e3, 0.0) - 0.05 * max(top, 1.0), top)
     if out is not None:
-        fig.savefig(out, dpi=120)
-        plt.close(fig)
+        from robokin.io.atomic import save_figure_atomic
+
+        try:
+            save_figure_atomic(fig, out, argument="out", dpi=120)
+        finally:
+            plt.close(fig)
     return fig

@@ -37,8 +37,10 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from robokin._text import short_repr
 from robokin._validation import check_transform
 from robokin.exceptions import InputError, ModelError
+from robokin.io.geometry_sections import number_field, shape_from_spec
 from robokin.model import geometry as _geo
 from robokin.model.geometry import Shape
 
@@ -50,6 +52,14 @@ __all__ = ["Scene", "SceneObject", "Tool"]
 _LENGTH = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 _PLACED = "_robokin_scene_placement"  # meta key: (scene, chain, geometry, unplaced robot)
+
+
+def _text(value: Any, file: Any, field: str) -> str:
+    """A name from a scene file: text of at most 200 characters."""
+    if not isinstance(value, str) or len(value) > 200:
+        raise ModelError(f"expected a name (text, at most 200 characters), got "
+                         f"{short_repr(value)}", file=file, field=field)
+    return value
 
 
 def _pose(T: npt.ArrayLike | None, name: str) -> np.ndarray:
@@ -145,7 +155,7 @@ class Scene:
         except KeyError:
             raise InputError(
                 "name",
-                f"no object {name!r} in the scene; objects: {list(self._objects)}",
+                f"no object {short_repr(name)} in the scene; objects: {list(self._objects)}",
             ) from None
 
     def __len__(self) -> int:
@@ -154,9 +164,9 @@ class Scene:
     def add(self, name: str, shape: Shape) -> SceneObject:
         """Add a shape whose placement is its world pose; returns the object."""
         if not isinstance(name, str) or not name:
-            raise InputError("name", f"expected a non-empty string, got {name!r}")
+            raise InputError("name", f"expected a non-empty string, got {short_repr(name)}")
         if name in self._objects:
-            raise InputError("name", f"the scene already has an object {name!r}")
+            raise InputError("name", f"the scene already has an object {short_repr(name)}")
         obj = SceneObject(name, shape.with_owner(name))
         self._objects[name] = obj
         self._version += 1
@@ -267,8 +277,8 @@ class Scene:
             out = out.with_tool(robot.tool @ self.tool.tcp)
             geo = geo.retool(self.tool.tcp, self.tool.shapes)
         out = out.replace(geometry=geo)
-        out.meta[_PLACED] = (self, out.chain, out.geometry, bare)
-        return out
+        return out.replace(meta={**out.meta,
+                                 _PLACED: (self, out.chain, out.geometry, bare)})
 
     def _fingerprint(self) -> tuple:
         """What the compiled check depends on (attributes may be assigned directly)."""
@@ -287,7 +297,7 @@ class Scene:
             return self.poses[name]
         except KeyError:
             raise InputError(
-                "name", f"no pose {name!r} in the scene; poses: {list(self.poses)}"
+                "name", f"no pose {short_repr(name)} in the scene; poses: {list(self.poses)}"
             ) from None
 
     # ------------------------------------------------------------------ files
@@ -299,11 +309,14 @@ class Scene:
             ModelError: missing file, bad YAML, a bad field (names the file, the
                 field path and the reason) or a bad mesh.
         """
-        from robokin.model.files import read_yaml
+        from robokin.io.yaml_reader import read_yaml_document
 
         path = Path(path)
-        doc = read_yaml(path)
-        return cls.from_document(doc, file=path)
+        ydoc = read_yaml_document(path)
+        try:
+            return cls.from_document(ydoc.data, file=path)
+        except ModelError as exc:
+            raise ydoc.locate(exc) from None
 
     @classmethod
     def from_document(cls, doc: Any, file: str | Path | None = None) -> Scene:
@@ -335,21 +348,22 @@ class Scene:
                 "expected {length: m|mm, angle: rad|deg}", file=file, field="units"
             )
         lu, au = units.get("length", "m"), units.get("angle", "rad")
-        if lu not in _LENGTH:
+        if not isinstance(lu, str) or lu not in _LENGTH:
             raise ModelError(
-                f"expected one of {list(_LENGTH)}, got {lu!r}",
+                f"expected one of {list(_LENGTH)}, got {short_repr(lu)}",
                 file=file,
                 field="units.length",
             )
-        if au not in _ANGLE:
+        if not isinstance(au, str) or au not in _ANGLE:
             raise ModelError(
-                f"expected one of {list(_ANGLE)}, got {au!r}",
+                f"expected one of {list(_ANGLE)}, got {short_repr(au)}",
                 file=file,
                 field="units.angle",
             )
         L, A = _LENGTH[lu], _ANGLE[au]
         base_dir = Path(file).parent if file is not None else None
-        scene = cls(str(doc.get("name", Path(file).stem if file else "scene")))
+        scene = cls(_text(doc.get("name", Path(file).stem if file else "scene"),
+                          file, "name"))
         scene.path = None if file is None else Path(file)
 
         def placement(p: Any, where: str) -> np.ndarray:
@@ -359,19 +373,8 @@ class Scene:
                 raise ModelError(
                     "expected {xyz: [x, y, z], rpy: [r, p, y]}", file=file, field=where
                 )
-            try:
-                xyz = np.asarray(p.get("xyz", (0, 0, 0)), dtype=float)
-                rpy = np.asarray(p.get("rpy", (0, 0, 0)), dtype=float)
-                if (
-                    xyz.shape != (3,)
-                    or rpy.shape != (3,)
-                    or not (np.isfinite(xyz).all() and np.isfinite(rpy).all())
-                ):
-                    raise ValueError
-            except (TypeError, ValueError):
-                raise ModelError(
-                    "xyz and rpy need 3 finite numbers each", file=file, field=where
-                ) from None
+            xyz = number_field(p, "xyz", where, file, 3) if "xyz" in p else np.zeros(3)
+            rpy = number_field(p, "rpy", where, file, 3) if "rpy" in p else np.zeros(3)
             return pose_from_xyz_rpy(xyz * L, rpy * A)
 
         rob = doc.get("robot")
@@ -380,7 +383,8 @@ class Scene:
                 raise ModelError(
                     "expected {name: ..., base: {xyz, rpy}}", file=file, field="robot"
                 )
-            scene.robot_name = None if rob.get("name") is None else str(rob["name"])
+            scene.robot_name = (None if rob.get("name") is None
+                                else _text(rob["name"], file, "robot.name"))
             scene.base = placement(rob.get("base"), "robot.base")
         tool = doc.get("tool")
         if tool is not None:
@@ -397,7 +401,7 @@ class Scene:
                 )
             scene.set_tool(
                 [
-                    _geo.shape_from_spec(
+                    shape_from_spec(
                         s,
                         length=L,
                         angle=A,
@@ -409,7 +413,7 @@ class Scene:
                     for i, s in enumerate(shapes)
                 ],
                 placement(tool.get("tcp"), "tool.tcp"),
-                name=str(tool.get("name", "tool")),
+                name=_text(tool.get("name", "tool"), file, "tool.name"),
             )
         objects = doc.get("objects") or []
         if not isinstance(objects, list):
@@ -418,12 +422,12 @@ class Scene:
             where = f"objects[{i}]"
             if not isinstance(spec, Mapping) or "name" not in spec:
                 raise ModelError("an object needs a 'name'", file=file, field=where)
-            name = str(spec["name"])
+            name = _text(spec["name"], file, f"{where}.name")
             if name in scene._objects:
                 raise ModelError(
-                    f"duplicate object name {name!r}", file=file, field=f"{where}.name"
+                    f"duplicate object name {short_repr(name)}", file=file, field=f"{where}.name"
                 )
-            shape = _geo.shape_from_spec(
+            shape = shape_from_spec(
                 {k: v for k, v in spec.items() if k != "name"},
                 length=L,
                 angle=A,
@@ -450,25 +454,21 @@ class Scene:
                 raise ModelError(
                     "expected a pair [link, object]", file=file, field=f"exclude[{i}]"
                 )
-            scene.exclude.add(frozenset(str(x) for x in p))
+            scene.exclude.add(frozenset(_text(x, file, f"exclude[{i}]") for x in p))
         poses = doc.get("poses") or {}
         if not isinstance(poses, Mapping):
             raise ModelError("expected {name: {xyz, rpy, q}}", file=file, field="poses")
         for pname, spec in poses.items():
+            pname = _text(pname, file, "poses")
             where = f"poses.{pname}"
             if not isinstance(spec, Mapping):
                 raise ModelError("expected {xyz, rpy, q}", file=file, field=where)
-            scene.poses[str(pname)] = placement(
+            scene.poses[pname] = placement(
                 {k: v for k, v in spec.items() if k != "q"}, where
             )
             if "q" in spec:
-                try:
-                    q = np.asarray(spec["q"], dtype=float)
-                    if q.ndim != 1 or not np.isfinite(q).all():
-                        raise ValueError
-                except (TypeError, ValueError):
-                    raise ModelError(
-                        "expected a list of joint values", file=file, field=f"{where}.q"
-                    ) from None
-                scene.pose_joints[str(pname)] = q * A
+                q = spec["q"]
+                count = len(q) if isinstance(q, list) and q else 1
+                scene.pose_joints[pname] = number_field(spec, "q", where, file,
+                                                        count) * A
         return scene

@@ -31,6 +31,7 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
+from robokin._text import short_repr
 from robokin.exceptions import ModelError
 
 __all__ = [
@@ -208,7 +209,7 @@ def _number(value: float, name: str, *, nonzero: bool = False) -> float:
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise ModelError(f"{name} must be a number, got {value!r}") from None
+        raise ModelError(f"{name} must be a number, got {short_repr(value)}") from None
     if not math.isfinite(v):
         raise ModelError(f"{name} must be finite, got {v}")
     if nonzero and v == 0.0:
@@ -324,7 +325,7 @@ class BallScrewSpline:
         object.__setattr__(self, "i", _number(self.i, "i", nonzero=True))
         object.__setattr__(self, "j", _number(self.j, "j", nonzero=True))
         if self.lift_sign not in (1, -1, 1.0, -1.0) or isinstance(self.lift_sign, bool):
-            raise ModelError(f"lift_sign must be +1 or -1, got {self.lift_sign!r}")
+            raise ModelError(f"lift_sign must be +1 or -1, got {short_repr(self.lift_sign)}")
         object.__setattr__(self, "lift_sign", float(self.lift_sign))
 
     @property
@@ -467,9 +468,9 @@ def actuator_map(
                 f"{amap.n_out} output(s)")
         for r, nm in enumerate(joints):
             if nm not in index:
-                raise ModelError(f"drive {d}: unknown joint {nm!r}; joints: {names}")
+                raise ModelError(f"drive {d}: unknown joint {short_repr(nm)}; joints: {names}")
             if nm in owner:
-                raise ModelError(f"drive {d}: joint {nm!r} is already driven by drive "
+                raise ModelError(f"drive {d}: joint {short_repr(nm)} is already driven by drive "
                                  f"{owner[nm]}")
             owner[nm] = d
             A[index[nm], col:col + amap.n_in] = amap.matrix[r]
@@ -498,7 +499,7 @@ class Dependency:
     offset: float = 0.0
 
     def __post_init__(self) -> None:
-        coeffs = {str(k): _number(v, f"coefficient of {k!r}")
+        coeffs = {str(k): _number(v, f"coefficient of {short_repr(k)}")
                   for k, v in dict(self.coefficients).items()}
         object.__setattr__(self, "coefficients", coeffs)
         object.__setattr__(self, "offset", _number(self.offset, "offset"))
@@ -610,14 +611,14 @@ def coupling_from_dependencies(
         if dep is None:
             if name not in index:
                 raise ModelError(
-                    f"joint {name!r} is neither a coordinate nor dependent; "
+                    f"joint {short_repr(name)} is neither a coordinate nor dependent; "
                     f"coordinates: {coords}")
             M[k, index[name]] = 1.0
             continue
         for other, coeff in dep.coefficients.items():
             if other not in index:
                 raise ModelError(
-                    f"joint {name!r} depends on unknown coordinate {other!r}; "
+                    f"joint {short_repr(name)} depends on unknown coordinate {short_repr(other)}; "
                     f"coordinates: {coords}")
             M[k, index[other]] += coeff
         c[k] = dep.offset

@@ -23,6 +23,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from robokin._text import short_repr
 from robokin.exceptions import ModelError
 from robokin.model.chain import Chain, ChainBuilder, Joint
 from robokin.model.coupling import AffineMap
@@ -64,7 +65,7 @@ def _num(row: Mapping, key: str, where: str, default: float | None = 0.0) -> flo
         return default
     v = row[key]
     if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
-        raise ModelError(f"'{key}' must be a number, got {v!r}", field=f"{where}.{key}")
+        raise ModelError(f"'{key}' must be a number, got {short_repr(v)}", field=f"{where}.{key}")
     v = float(v)
     if not math.isfinite(v):
         raise ModelError(f"'{key}' must be finite, got {v}", field=f"{where}.{key}")
@@ -77,14 +78,14 @@ def _limits(row: Mapping, where: str) -> tuple[float, float]:
         return (-math.inf, math.inf)
     if not isinstance(lim, (list, tuple, np.ndarray)) or len(lim) != 2:
         raise ModelError(
-            f"limits must be [lower, upper], got {lim!r}", field=f"{where}.limits"
+            f"limits must be [lower, upper], got {short_repr(lim)}", field=f"{where}.limits"
         )
-    try:
-        lo, hi = float(lim[0]), float(lim[1])
-    except (TypeError, ValueError):
+    if any(isinstance(v, bool) or not isinstance(v, (int, float, np.floating,
+                                                      np.integer)) for v in lim):
         raise ModelError(
-            f"limits must be numbers, got {lim!r}", field=f"{where}.limits"
-        ) from None
+            f"limits must be numbers, got {short_repr(lim)}", field=f"{where}.limits"
+        )
+    lo, hi = float(lim[0]), float(lim[1])
     if math.isnan(lo) or math.isnan(hi):
         raise ModelError("limits must not be NaN", field=f"{where}.limits")
     if lo > hi:
@@ -98,7 +99,7 @@ def _kind(row: Mapping, where: str, default: str = "revolute") -> str:
     kind = row.get("joint", default)
     if kind not in ("revolute", "prismatic", "fixed"):
         raise ModelError(
-            f"joint must be 'revolute', 'prismatic' or 'fixed', got {kind!r}",
+            f"joint must be 'revolute', 'prismatic' or 'fixed', got {short_repr(kind)}",
             field=f"{where}.joint",
         )
     return kind
@@ -107,7 +108,7 @@ def _kind(row: Mapping, where: str, default: str = "revolute") -> str:
 def _sign(row: Mapping, where: str) -> float:
     s = row.get("sign", 1)
     if s not in (1, -1, 1.0, -1.0) or isinstance(s, bool):
-        raise ModelError(f"sign must be +1 or -1, got {s!r}", field=f"{where}.sign")
+        raise ModelError(f"sign must be +1 or -1, got {short_repr(s)}", field=f"{where}.sign")
     return float(s)
 
 
@@ -233,7 +234,7 @@ def chain_from_dh(
     """
     if convention not in ("standard", "modified"):
         raise ModelError(
-            f"convention must be 'standard' or 'modified', got {convention!r}",
+            f"convention must be 'standard' or 'modified', got {short_repr(convention)}",
             field="convention",
         )
     if isinstance(rows, (str, bytes)) or not isinstance(rows, Sequence):
@@ -321,7 +322,7 @@ def chain_from_elementary(
         name = op.get("op")
         if name not in _OPS:
             raise ModelError(
-                f"op must be one of {sorted(_OPS)}, got {name!r}", field=f"{where}.op"
+                f"op must be one of {sorted(_OPS)}, got {short_repr(name)}", field=f"{where}.op"
             )
         if name == "frame":
             b.frame()
@@ -342,7 +343,7 @@ def chain_from_elementary(
         if (kind == "revolute") != is_rot:
             raise ModelError(
                 f"a {kind} joint needs a {'rotation' if kind == 'revolute' else 'translation'}"
-                f" op, got {name!r}",
+                f" op, got {short_repr(name)}",
                 field=f"{where}.op",
             )
         A = _TO_AXIS[axis]

@@ -6,7 +6,8 @@ in the tool frame). Cylinders and capsules run along their local z axis and are
 centred on their placement's origin (as in coal). Meshes (STL, OBJ, DAE, PLY) are
 loaded with trimesh on first use and scaled to metres from their declared units.
 
-A robot file's ``geometry:`` section lists shapes per link, in the file's units:
+A robot file's ``geometry:`` section lists shapes per link, in the file's units
+(read and written by :mod:`robokin.io.geometry_sections`):
 
 .. code-block:: yaml
 
@@ -26,6 +27,9 @@ Link keys are ``base``, the chain joint names (link k moves with joint k) and
 ``length``/``xyz``/``rpy``. Mesh files resolve relative to the robot file; a mesh's
 ``units`` (m, cm, mm; default: the file's length unit) and optional ``scale``
 convert its vertices to metres. See ``docs/collision.md``.
+
+This module holds the shape data only; it builds no robot and reads no file but
+the meshes themselves.
 """
 
 from __future__ import annotations
@@ -34,17 +38,24 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Literal, Protocol
 
 import numpy as np
 import numpy.typing as npt
 
+from robokin._text import short_repr
 from robokin.exceptions import InputError, MissingExtraError, ModelError
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.model.chain import Chain
+
 
 __all__ = [
+    "LENGTH_UNITS",
+    "MAX_MESH_BYTES",
+    "MESH_SUFFIXES",
+    "SHAPE_KINDS",
+    "HasChain",
     "RobotGeometry",
     "Shape",
     "ShapeKind",
@@ -55,14 +66,25 @@ __all__ = [
     "cylinder_between",
     "link_names",
     "mesh",
-    "shape_from_spec",
+    "segment_pose",
     "sphere",
 ]
 
 ShapeKind = Literal["box", "cylinder", "sphere", "capsule", "mesh"]
-_KINDS = ("box", "cylinder", "sphere", "capsule", "mesh")
-_MESH_SUFFIXES = (".stl", ".obj", ".dae", ".ply", ".off", ".glb", ".gltf")
-_LENGTH = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
+SHAPE_KINDS = ("box", "cylinder", "sphere", "capsule", "mesh")
+MESH_SUFFIXES = (".stl", ".obj", ".dae", ".ply", ".off", ".glb", ".gltf")
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
+#: Largest mesh file loaded [bytes] (256 MiB).
+MAX_MESH_BYTES = 256 * 2**20
+
+
+class HasChain(Protocol):
+    """Anything with a canonical chain (a :class:`~robokin.robot.Robot`)."""
+
+    @property
+    def chain(self) -> Chain:
+        """The canonical chain."""
+        ...
 
 
 def _ro(a: np.ndarray) -> np.ndarray:
@@ -107,9 +129,9 @@ class Shape:
     owner: str = ""
 
     def __post_init__(self) -> None:
-        if self.kind not in _KINDS:
+        if self.kind not in SHAPE_KINDS:
             raise InputError(
-                "kind", f"expected one of {list(_KINDS)}, got {self.kind!r}"
+                "kind", f"expected one of {list(SHAPE_KINDS)}, got {short_repr(self.kind)}"
             )
         need = {"box": 3, "cylinder": 2, "capsule": 2, "sphere": 1, "mesh": 0}[
             self.kind
@@ -307,6 +329,11 @@ def _load_mesh(path: Path | None, scale: float, owner: str):
     where = f" (link '{owner}')" if owner else ""
     if path is None or not Path(path).is_file():
         raise ModelError(f"mesh file not found{where}", file=path, field=owner or None)
+    size = Path(path).stat().st_size
+    if size > MAX_MESH_BYTES:
+        raise ModelError(f"mesh file of {size:,} bytes{where}, more than the "
+                         f"{MAX_MESH_BYTES:,} robokin loads (robokin.model.geometry."
+                         "MAX_MESH_BYTES)", file=path, field=owner or None)
     try:
         loaded = trimesh.load(str(path), force="mesh")
     except Exception as exc:  # trimesh raises many kinds on a bad file
@@ -372,7 +399,8 @@ def capsule(
     return Shape("capsule", (radius, length), _placement(placement), name=name)
 
 
-def _segment_pose(p0: npt.ArrayLike, p1: npt.ArrayLike) -> tuple[np.ndarray, float]:
+def segment_pose(p0: npt.ArrayLike, p1: npt.ArrayLike) -> tuple[np.ndarray, float]:
+    """The pose (4, 4) of a segment's midpoint with z along it, and its length [m]."""
     p0 = np.asarray(p0, dtype=float).reshape(3)
     p1 = np.asarray(p1, dtype=float).reshape(3)
     axis = p1 - p0
@@ -394,7 +422,7 @@ def capsule_between(
     p0: npt.ArrayLike, p1: npt.ArrayLike, radius: float, *, name: str = ""
 ) -> Shape:
     """A capsule whose axis runs from ``p0`` to ``p1`` (3,) [m]."""
-    T, L = _segment_pose(p0, p1)
+    T, L = segment_pose(p0, p1)
     return Shape("capsule", (radius, L), T, name=name)
 
 
@@ -402,7 +430,7 @@ def cylinder_between(
     p0: npt.ArrayLike, p1: npt.ArrayLike, radius: float, *, name: str = ""
 ) -> Shape:
     """A cylinder whose axis runs from ``p0`` to ``p1`` (3,) [m]."""
-    T, L = _segment_pose(p0, p1)
+    T, L = segment_pose(p0, p1)
     if L <= 0:
         raise InputError("p1", "a cylinder's end points must differ")
     return Shape("cylinder", (radius, L), T, name=name)
@@ -418,21 +446,21 @@ def mesh(
     owner: str = "",
 ) -> Shape:
     """A mesh file (loaded on first use), in ``units`` times ``scale``."""
-    if units not in _LENGTH:
-        raise InputError("units", f"expected one of {list(_LENGTH)}, got {units!r}")
+    if units not in LENGTH_UNITS:
+        raise InputError("units", f"expected one of {list(LENGTH_UNITS)}, got {short_repr(units)}")
     return Shape(
         "mesh",
         (),
         _placement(placement),
         name=name,
         file=Path(file),
-        scale=_LENGTH[units] * float(scale),
+        scale=LENGTH_UNITS[units] * float(scale),
         owner=owner,
     )
 
 
 # ---------------------------------------------------------------- robot geometry
-def link_names(robot: Robot) -> tuple[str, ...]:
+def link_names(robot: HasChain) -> tuple[str, ...]:
     """Names of the links that carry shapes: ``base``, the chain joints, ``tool``."""
     return ("base", *(j.name for j in robot.chain.joints), "tool")
 
@@ -476,7 +504,7 @@ class RobotGeometry:
                     raise InputError("exclude", _unknown_link(n, self.names))
 
     @classmethod
-    def empty(cls, robot: Robot) -> RobotGeometry:
+    def empty(cls, robot: HasChain) -> RobotGeometry:
         """No shapes on any link."""
         names = link_names(robot)
         return cls(names, tuple(() for _ in names))
@@ -484,7 +512,7 @@ class RobotGeometry:
     @classmethod
     def from_mapping(
         cls,
-        robot: Robot,
+        robot: HasChain,
         shapes: Mapping[str, Iterable[Shape]],
         *,
         exclude: Iterable[Sequence[str]] = (),
@@ -576,323 +604,3 @@ class RobotGeometry:
 
 def _unknown_link(name: str, names: Sequence[str]) -> str:
     return f"unknown link {name!r}; the links are {list(names)}"
-
-
-# ----------------------------------------------------------------- file section
-_COMMON = {"type", "name", "xyz", "rpy"}
-_FIELDS = {
-    "box": {"size"},
-    "sphere": {"radius"},
-    "cylinder": {"radius", "length", "from", "to"},
-    "capsule": {"radius", "length", "from", "to"},
-    "mesh": {"file", "units", "scale"},
-}
-
-
-def _num(
-    spec: Mapping[str, Any], key: str, where: str, file: Any, count: int | None = None
-):
-    v = spec[key]
-    try:
-        if count is None:
-            if isinstance(v, bool):
-                raise TypeError
-            out = float(v)
-            if not math.isfinite(out):
-                raise ValueError
-            return out
-        arr = np.asarray(v, dtype=float)
-        if arr.shape != (count,) or not np.isfinite(arr).all():
-            raise ValueError
-        return arr
-    except (TypeError, ValueError):
-        what = "a finite number" if count is None else f"{count} finite numbers"
-        raise ModelError(
-            f"expected {what}, got {v!r:.60}", file=file, field=f"{where}.{key}"
-        ) from None
-
-
-def shape_from_spec(
-    spec: Any,
-    *,
-    length: float = 1.0,
-    angle: float = 1.0,
-    base_dir: Path | None = None,
-    file: Any = None,
-    where: str = "shape",
-    owner: str = "",
-) -> Shape:
-    """Build a Shape from a file entry (a mapping in file units).
-
-    Args:
-        spec: ``{type: box|cylinder|sphere|capsule|mesh, ...}`` (see module docstring).
-        length: File length unit in metres (1e-3 for mm).
-        angle: File angle unit in radians.
-        base_dir: Where relative mesh paths start.
-        file: The file, for error messages.
-        where: The field path, for error messages.
-        owner: The link or object name, for error messages.
-
-    Raises:
-        ModelError: naming the file, the field path and the reason.
-    """
-    from robokin.spatial import pose_from_xyz_rpy
-
-    if not isinstance(spec, Mapping):
-        raise ModelError(
-            f"a shape must be a mapping, got {spec!r:.60}", file=file, field=where
-        )
-    kind = spec.get("type")
-    if kind not in _KINDS:
-        raise ModelError(
-            f"'type' must be one of {list(_KINDS)}, got {kind!r}",
-            file=file,
-            field=f"{where}.type",
-        )
-    allowed = _COMMON | _FIELDS[kind]
-    for key in spec:
-        if key not in allowed:
-            raise ModelError(
-                f"unknown field for a {kind} (allowed: {sorted(allowed)})",
-                file=file,
-                field=f"{where}.{key}",
-            )
-    xyz = _num(spec, "xyz", where, file, 3) * length if "xyz" in spec else np.zeros(3)
-    rpy = _num(spec, "rpy", where, file, 3) * angle if "rpy" in spec else np.zeros(3)
-    if np.any(rpy):
-        T = pose_from_xyz_rpy(xyz, rpy)
-    else:  # no rotation: skip importing scipy for the common case
-        T = np.eye(4)
-        T[:3, 3] = xyz
-    name = str(spec.get("name", ""))
-
-    def need(key: str) -> None:
-        if key not in spec:
-            raise ModelError(
-                "missing required field", file=file, field=f"{where}.{key}"
-            )
-
-    try:
-        if kind == "box":
-            need("size")
-            return Shape(
-                "box",
-                tuple(_num(spec, "size", where, file, 3) * length),
-                T,
-                name=name,
-                owner=owner,
-            )
-        if kind == "sphere":
-            need("radius")
-            return Shape(
-                "sphere",
-                (_num(spec, "radius", where, file) * length,),
-                T,
-                name=name,
-                owner=owner,
-            )
-        if kind in ("cylinder", "capsule"):
-            need("radius")
-            r = _num(spec, "radius", where, file) * length
-            if "from" in spec or "to" in spec:
-                need("from")
-                need("to")
-                if "length" in spec:
-                    raise ModelError(
-                        "give either 'length' or 'from'/'to', not both",
-                        file=file,
-                        field=f"{where}.length",
-                    )
-                p0 = _num(spec, "from", where, file, 3) * length
-                p1 = _num(spec, "to", where, file, 3) * length
-                S, L = _segment_pose(p0, p1)
-                return Shape(kind, (r, L), T @ S, name=name, owner=owner)
-            need("length")
-            L = _num(spec, "length", where, file) * length
-            return Shape(kind, (r, L), T, name=name, owner=owner)
-        need("file")
-        units = spec.get("units")
-        if units is None:
-            scale = length
-        elif units in _LENGTH:
-            scale = _LENGTH[units]
-        else:
-            raise ModelError(
-                f"expected one of {list(_LENGTH)}, got {units!r}",
-                file=file,
-                field=f"{where}.units",
-            )
-        if "scale" in spec:
-            scale *= _num(spec, "scale", where, file)
-        path = Path(str(spec["file"])).expanduser()
-        if not path.is_absolute() and base_dir is not None:
-            path = base_dir / path
-        if not path.is_file():
-            raise ModelError(
-                f"mesh file not found: {path}"
-                + (f" (link '{owner}')" if owner else ""),
-                file=file,
-                field=f"{where}.file",
-            )
-        if path.suffix.lower() not in _MESH_SUFFIXES:
-            raise ModelError(
-                f"unsupported mesh format {path.suffix!r} (use {list(_MESH_SUFFIXES)})",
-                file=file,
-                field=f"{where}.file",
-            )
-        return Shape("mesh", (), T, name=name, file=path, scale=scale, owner=owner)
-    except InputError as exc:
-        raise ModelError(
-            exc.reason, file=file, field=f"{where}.{exc.argument}"
-        ) from None
-
-
-def _units(units: Any) -> tuple[float, float]:
-    length = getattr(units, "length", None) or (units or {}).get("length", "m")
-    angle = getattr(units, "angle", None) or (units or {}).get("angle", "rad")
-    return _LENGTH[length], (1.0 if angle == "rad" else math.pi / 180.0)
-
-
-def _geometry_section(robot: Robot, value: Any, file: Any, units: Any) -> Robot:
-    L, A = _units(units)
-    names = link_names(robot)
-    if not isinstance(value, Mapping):
-        raise ModelError(
-            "expected a mapping {link name: [shapes]}", file=file, field="geometry"
-        )
-    base_dir = Path(file).parent if file is not None else None
-    per_link: dict[str, list[Shape]] = {}
-    for key, items in value.items():
-        if key not in names:
-            raise ModelError(
-                _unknown_link(key, names), file=file, field=f"geometry.{key}"
-            )
-        if isinstance(items, Mapping):
-            items = [items]
-        if not isinstance(items, list):
-            raise ModelError(
-                "expected a list of shapes", file=file, field=f"geometry.{key}"
-            )
-        per_link[key] = [
-            shape_from_spec(
-                s,
-                length=L,
-                angle=A,
-                base_dir=base_dir,
-                file=file,
-                where=f"geometry.{key}[{i}]",
-                owner=key,
-            )
-            for i, s in enumerate(items)
-        ]
-    old = robot.geometry if isinstance(robot.geometry, RobotGeometry) else None
-    geo = RobotGeometry.from_mapping(robot, per_link)
-    if old is not None:
-        geo = replace(geo, exclude=old.exclude, exclude_adjacent=old.exclude_adjacent)
-    return robot.replace(geometry=geo)
-
-
-def _collision_section(robot: Robot, value: Any, file: Any, units: Any) -> Robot:
-    names = link_names(robot)
-    if not isinstance(value, Mapping):
-        raise ModelError(
-            "expected a mapping with 'exclude'", file=file, field="collision"
-        )
-    for key in value:
-        if key not in ("exclude", "exclude_adjacent"):
-            raise ModelError(
-                "unknown field (allowed: exclude, exclude_adjacent)",
-                file=file,
-                field=f"collision.{key}",
-            )
-    pairs = value.get("exclude", []) or []
-    if not isinstance(pairs, list):
-        raise ModelError(
-            "expected a list of [link, link] pairs",
-            file=file,
-            field="collision.exclude",
-        )
-    out = []
-    for i, p in enumerate(pairs):
-        if not (isinstance(p, list | tuple) and len(p) == 2):
-            raise ModelError(
-                f"expected a pair [link, link], got {p!r:.60}",
-                file=file,
-                field=f"collision.exclude[{i}]",
-            )
-        for n in p:
-            if n not in names:
-                raise ModelError(
-                    _unknown_link(n, names), file=file, field=f"collision.exclude[{i}]"
-                )
-        out.append(tuple(p))
-    adjacent = value.get("exclude_adjacent", True)
-    if not isinstance(adjacent, bool):
-        raise ModelError(
-            f"expected true or false, got {adjacent!r}",
-            file=file,
-            field="collision.exclude_adjacent",
-        )
-    geo = robot.geometry if isinstance(robot.geometry, RobotGeometry) else None
-    if geo is None:
-        geo = RobotGeometry.empty(robot)
-    geo = replace(geo.with_exclusions(out), exclude_adjacent=adjacent)
-    return robot.replace(geometry=geo)
-
-
-def sections_from_geometry(geometry: RobotGeometry) -> dict[str, Any]:
-    """The ``geometry:`` and ``collision:`` robot-file sections (SI units).
-
-    The inverse of the section parsers, for writing robots built in memory (e.g.
-    imported from URDF): shapes as ``{type, name, xyz, rpy, size | radius + length
-    | file + scale}`` per link, mesh paths absolute.
-    """
-    from robokin.spatial import rpy_from_matrix
-
-    out: dict[str, Any] = {}
-    per_link: dict[str, list[dict[str, Any]]] = {}
-    for name, shapes in zip(geometry.names, geometry.shapes):
-        specs = []
-        for sh in shapes:
-            spec: dict[str, Any] = {"type": sh.kind}
-            if sh.name:
-                spec["name"] = sh.name
-            P = sh.placement
-            if np.any(P[:3, 3]):
-                spec["xyz"] = [float(v) for v in P[:3, 3]]
-            if not np.allclose(P[:3, :3], np.eye(3), atol=1e-15):
-                spec["rpy"] = [float(v) for v in rpy_from_matrix(P)]
-            if sh.kind == "box":
-                spec["size"] = list(sh.size)
-            elif sh.kind == "sphere":
-                spec["radius"] = sh.size[0]
-            elif sh.kind in ("cylinder", "capsule"):
-                spec["radius"], spec["length"] = sh.size
-            else:
-                spec["file"] = str(Path(sh.file).resolve())
-                spec["units"] = "m"
-                if sh.scale != 1.0:
-                    spec["scale"] = float(sh.scale)
-            specs.append(spec)
-        if specs:
-            per_link[name] = specs
-    if per_link:
-        out["geometry"] = per_link
-    collision: dict[str, Any] = {}
-    if geometry.exclude:
-        collision["exclude"] = sorted(sorted(p) for p in geometry.exclude if len(p) == 2)
-    if not geometry.exclude_adjacent:
-        collision["exclude_adjacent"] = False
-    if collision:
-        out["collision"] = collision
-    return out
-
-
-def _register() -> None:
-    from robokin.model.files import register_section
-
-    register_section("geometry", _geometry_section)
-    register_section("collision", _collision_section)
-
-
-_register()

@@ -30,7 +30,7 @@ def path(name: str) -> Path:
 
 def load(name_or_path):
     """Load a built-in robot by name, or a robot file by path."""
-    from robokin.model.files import load_robot
+    from robokin.io.robot_files import load_robot
 
     s = str(name_or_path)
     if isinstance(name_or_path, Path) or s.endswith((".yaml", ".yml")) or "/" in s:

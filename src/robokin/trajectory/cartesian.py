@@ -451,6 +451,7 @@ def cartesian_line(
     ik: IKMode = "follow",
     max_jump: float = 0.3,
     singular_tol: float = 1e-5,
+    max_samples: int | None = None,
 ) -> Trajectory:
     """Straight tool line from ``robot.fk(q_start)`` to ``T_goal``.
 
@@ -475,6 +476,8 @@ def cartesian_line(
             polished) or ``"numeric"`` (``robokin.kinematics.ik.numeric.ik_path``).
         max_jump: Largest joint change between samples [rad or m].
         singular_tol: Smallest Jacobian singular value allowed on the path.
+        max_samples: Most samples accepted (default
+            :data:`robokin.trajectory.joint.MAX_SAMPLES`), checked before sampling.
 
     Returns:
         The :class:`Trajectory`, with ``pose`` set to the line's poses.
@@ -506,7 +509,7 @@ def cartesian_line(
         T = float(duration)
         if not T > 0:
             raise InputError("duration", f"must be positive [s], got {duration!r}")
-    t = time_grid(T, dt)
+    t = time_grid(T, dt, max_samples=max_samples)
     if moving_ends:
         s, sd, sdd = _scalar_quintic(T, speed_in / L, speed_out / L, t)
     else:

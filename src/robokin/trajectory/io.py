@@ -17,17 +17,25 @@ signs, zero offsets between the model's zero and the controller's, degrees or
 radians, mm or m); :func:`write_csv` applies it and :func:`read_csv` undoes it, so
 the file a controller reads is right the first time.
 
-Every writer writes a temporary file next to the target and renames it; an
-existing file is replaced only with ``overwrite=True``.
+Every writer goes through :func:`robokin.io.atomic.write_atomic` (a temporary
+file next to the target, fsynced, renamed); an existing file is replaced only with
+``overwrite=True``.
+
+Reading: joint columns are matched to the robot's joints by their header names
+when ``joint_names=`` is given (any column order; unknown, missing or extra
+names are refused, listing the expected ones); a file without a header line is
+read by position, with a warning saying so. Times must increase: a log whose time
+goes backwards is refused, never sorted. Files are read through
+:func:`robokin.io.text_files.read_text_file` (at most
+:data:`~robokin.io.text_files.MAX_CSV_BYTES`).
 """
 
 from __future__ import annotations
 
 import json
 import math
-import os
 import re
-import tempfile
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,7 +44,10 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from robokin._text import short_repr
 from robokin.exceptions import InputError, ModelError
+from robokin.io.atomic import write_atomic
+from robokin.io.text_files import MAX_CSV_BYTES, read_text_file
 from robokin.trajectory.samples import Trajectory
 
 __all__ = [
@@ -55,40 +66,6 @@ _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 _LENGTH = {"m": 1.0, "mm": 1e-3}
 _TIME = {"s": 1.0, "ms": 1e-3}
 _HEADER = re.compile(r"^\s*(?P<name>.*?)\s*(?:\[(?P<unit>[^\]]*)\])?\s*$")
-
-
-# ------------------------------------------------------------------ atomic writes
-def file_mode() -> int:
-    """Permissions of a new file under the current umask (mkstemp makes 0600)."""
-    mask = os.umask(0)
-    os.umask(mask)
-    return 0o666 & ~mask
-
-
-def write_text_atomic(path: str | Path, text: str, *, overwrite: bool = False) -> Path:
-    """Write ``text`` to ``path`` through a temporary file and a rename.
-
-    Raises:
-        InputError: ``path`` exists and ``overwrite`` is False, or its folder
-            does not exist.
-    """
-    path = Path(path)
-    if path.exists() and not overwrite:
-        raise InputError("path", f"{path} exists; pass overwrite=True to replace it")
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise InputError("path", f"folder {folder} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(text)
-        os.chmod(tmp, file_mode())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
 
 
 # ------------------------------------------------------------- controller profile
@@ -120,10 +97,10 @@ class ControllerProfile:
 
     def __post_init__(self) -> None:
         if self.angle_unit not in _ANGLE:
-            raise ModelError(f"angle_unit must be 'rad' or 'deg', got {self.angle_unit!r}",
+            raise ModelError(f"angle_unit must be 'rad' or 'deg', got {short_repr(self.angle_unit)}",
                              field="angle_unit")
         if self.length_unit not in _LENGTH:
-            raise ModelError(f"length_unit must be 'm' or 'mm', got {self.length_unit!r}",
+            raise ModelError(f"length_unit must be 'm' or 'mm', got {short_repr(self.length_unit)}",
                              field="length_unit")
         if self.signs is not None and any(s not in (1, -1) for s in self.signs):
             raise ModelError(f"signs must be +1 or -1, got {list(self.signs)}",
@@ -148,9 +125,16 @@ class ControllerProfile:
         if extra:
             raise ModelError(f"unknown key(s) {extra}; known: {sorted(known)}",
                              file=file, field=extra[0])
-        order = doc.get("order")
+        order = _list_field(doc, "order", (int, str), file)
+        signs = _list_field(doc, "signs", (int, float), file)
+        offsets = _list_field(doc, "offsets", (int, float), file)
+        names = _list_field(doc, "names", (str,), file)
+        for key in ("name", "angle_unit", "length_unit", "offset_unit"):
+            if key in doc and not isinstance(doc[key], str):
+                raise ModelError(f"expected text, got {short_repr(doc[key])}",
+                                 file=file, field=key)
         if order is not None and any(isinstance(o, str) for o in order):
-            joints = doc.get("joints")
+            joints = _list_field(doc, "joints", (str,), file)
             if not joints:
                 raise ModelError("order by name needs 'joints' (the model's names)",
                                  file=file, field="order")
@@ -160,14 +144,13 @@ class ControllerProfile:
             except ValueError as exc:
                 raise ModelError(f"{exc}; joints: {list(joints)}", file=file,
                                  field="order") from None
-        offsets = doc.get("offsets")
         if offsets is not None and doc.get("offset_unit", doc.get("angle_unit")) == "deg":
             offsets = [math.radians(o) for o in offsets]
         try:
-            return cls(name=str(doc.get("name", "default")), order=order,
-                       signs=doc.get("signs"), offsets=offsets,
+            return cls(name=doc.get("name", "default"), order=order,
+                       signs=signs, offsets=offsets,
                        angle_unit=doc.get("angle_unit", "rad"),
-                       length_unit=doc.get("length_unit", "m"), names=doc.get("names"))
+                       length_unit=doc.get("length_unit", "m"), names=names)
         except ModelError as exc:
             raise ModelError(exc.reason, file=file, field=exc.field) from None
 
@@ -209,24 +192,43 @@ class ControllerProfile:
         return np.asarray(is_revolute, bool)[order]
 
 
+def _list_field(doc: Mapping[str, Any], key: str, kinds: tuple[type, ...],
+                file: Any) -> list[Any] | None:
+    """``doc[key]``: None, or a list whose items are of ``kinds`` (no booleans,
+    finite numbers); a ModelError naming the field otherwise."""
+    value = doc.get(key)
+    if value is None:
+        return None
+
+    def ok(v: Any) -> bool:
+        if isinstance(v, bool) or not isinstance(v, kinds):
+            return False
+        return not isinstance(v, float) or math.isfinite(v)
+
+    if not isinstance(value, (list, tuple)) or not all(ok(v) for v in value):
+        what = " or ".join(k.__name__ for k in kinds)
+        raise ModelError(f"expected a list of {what}, got {short_repr(value)}",
+                         file=file, field=key)
+    return list(value)
+
+
 def load_profile(path: str | Path) -> ControllerProfile:
     """Read a controller profile from a YAML or JSON file.
 
     Raises:
         ModelError: missing file, bad syntax or bad fields (naming the file).
     """
-    import yaml
+    from robokin.io.yaml_reader import read_yaml_document
 
     path = Path(path)
-    try:
-        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ModelError("no such file", file=path) from None
-    except yaml.YAMLError as exc:
-        raise ModelError(f"not valid YAML: {exc}", file=path) from None
+    ydoc = read_yaml_document(path)  # JSON is YAML
+    doc = ydoc.data
     if not isinstance(doc, Mapping):
         raise ModelError("expected a mapping at the top level", file=path)
-    return ControllerProfile.from_dict(doc.get("controller", doc), file=path)
+    try:
+        return ControllerProfile.from_dict(doc.get("controller", doc), file=path)
+    except ModelError as exc:
+        raise ydoc.locate(exc) from None
 
 
 # ------------------------------------------------------------------------- CSV
@@ -264,7 +266,7 @@ def write_csv(
         InputError: wrong number of names, or the file exists and ``overwrite``
             is False.
     """
-    return write_text_atomic(path, csv_text(traj, joint_names, rates=rates,
+    return write_atomic(path, csv_text(traj, joint_names, rates=rates,
                                             profile=profile, precision=precision),
                              overwrite=overwrite)
 
@@ -293,14 +295,14 @@ def csv_text(traj: Trajectory, joint_names: Sequence[str] | None = None, *,
     data = np.hstack(blocks)
     for h in header:
         if "," in h:
-            raise InputError("joint_names", f"a name may not hold a comma: {h!r}")
+            raise InputError("joint_names", f"a name may not hold a comma: {short_repr(h)}")
     fmt = "%r" if precision is None else f"%.{int(precision)}g"
     lines = [",".join(header)]
     lines += [",".join(fmt % v for v in row) for row in data.tolist()]
     return "\n".join(lines) + "\n"
 
 
-def _parse_header(cols: list[str], file: Any) -> list[tuple[str, str | None]]:
+def _parse_header(cols: list[str]) -> list[tuple[str, str | None]]:
     out = []
     for c in cols:
         m = _HEADER.match(c)
@@ -308,35 +310,49 @@ def _parse_header(cols: list[str], file: Any) -> list[tuple[str, str | None]]:
     return out
 
 
-def _load_table(path: Path) -> tuple[list[str], np.ndarray]:
+def _is_number(text: str) -> bool:
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ModelError("no such file", file=path) from None
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    if not lines:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _load_table(path: Path, max_bytes: int) -> tuple[list[str] | None, np.ndarray, int]:
+    """The header (None when the file has none), the numbers, and the line of the
+    first data row (for messages)."""
+    text = read_text_file(path, max_bytes=max_bytes)
+    numbered = [(k, ln) for k, ln in enumerate(text.splitlines(), start=1)
+                if ln.strip() and not ln.lstrip().startswith("#")]
+    if not numbered:
         raise ModelError("empty file", file=path)
-    sep = ";" if lines[0].count(";") > lines[0].count(",") else ","
-    header = [h.strip() for h in lines[0].split(sep)]
+    first = numbered[0][1]
+    sep = ";" if first.count(";") > first.count(",") else ","
+    fields = [h.strip() for h in first.split(sep)]
+    header: list[str] | None = fields
+    if all(_is_number(f) for f in fields):
+        header = None  # no header line: the first line is data
+    else:
+        numbered = numbered[1:]
+    width = len(fields)
     rows = []
-    for k, ln in enumerate(lines[1:], start=2):
+    for k, ln in numbered:
         parts = ln.split(sep)
-        if len(parts) != len(header):
-            raise ModelError(f"line {k} has {len(parts)} values, the header "
-                             f"{len(header)}", file=path, field=f"line {k}")
+        if len(parts) != width:
+            raise ModelError(f"{len(parts)} values, the {'header' if header else 'first line'}"
+                             f" has {width}", file=path, line=k)
         try:
             rows.append([float(p) for p in parts])
         except ValueError:
-            raise ModelError(f"line {k} holds a value that is not a number",
-                             file=path, field=f"line {k}") from None
+            raise ModelError("holds a value that is not a number", file=path,
+                             line=k) from None
     if not rows:
         raise ModelError("no data rows", file=path)
     data = np.array(rows)
     if not np.isfinite(data).all():
-        bad = int(np.argwhere(~np.isfinite(data))[0, 0]) + 2
-        raise ModelError(f"line {bad} holds a non-finite value", file=path,
-                         field=f"line {bad}")
-    return header, data
+        bad = numbered[int(np.argwhere(~np.isfinite(data))[0, 0])][0]
+        raise ModelError("holds a non-finite value", file=path, line=bad)
+    return header, data, numbered[0][0]
 
 
 def _differentiate(t: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -345,58 +361,81 @@ def _differentiate(t: np.ndarray, x: np.ndarray) -> np.ndarray:
     return np.gradient(x, t, axis=0, edge_order=2 if len(t) > 2 else 1)
 
 
-def read_csv(
-    path: str | Path,
-    *,
-    profile: ControllerProfile | None = None,
-    is_revolute: npt.ArrayLike | None = None,
-) -> Trajectory:
-    """Read a trajectory CSV (the :func:`write_csv` format, or a logged run).
-
-    The first column is time; the others are joints, optionally followed by
-    ``.vel`` and ``.acc`` columns. Units in brackets are converted to SI;
-    a column without a unit is taken as SI. Velocities and accelerations missing
-    from the file are differentiated from the positions.
-
-    Args:
-        path: The file.
-        profile: The controller profile the file was written with (undone here).
-        is_revolute: (n,) flags when the header has no units (default: angles).
-
-    Returns:
-        A :class:`~robokin.trajectory.samples.Trajectory` in model order and SI.
-
-    Raises:
-        ModelError: missing file, ragged or non-numeric rows, unknown units,
-            times that do not increase (naming the file and line).
-    """
-    path = Path(path)
-    header, data = _load_table(path)
-    cols = _parse_header(header, path)
-    tname, tunit = cols[0]
-    if tunit is not None and tunit not in _TIME:
-        raise ModelError(f"unknown time unit [{tunit}]; use [s] or [ms]", file=path,
-                         field=header[0])
-    t = data[:, 0] * _TIME.get(tunit or "s")
-    pos, vel, acc = [], [], []
-    for k, (name, unit) in enumerate(cols[1:], start=1):
-        kind = pos
-        if name.endswith(".vel"):
-            kind, name = vel, name[:-4]
-        elif name.endswith(".acc"):
-            kind, name = acc, name[:-4]
-        kind.append((name, unit, k))
-    n = len(pos)
-    if n == 0:
+def _columns(header: list[str] | None, width: int, path: Path,
+             joint_names: Sequence[str] | None
+             ) -> tuple[list[tuple[str, str | None]], list[list[int]]]:
+    """Parsed header cells and the column indices of positions, rates and
+    accelerations, ordered as ``joint_names`` when given."""
+    if header is None:
+        n = width - 1
+        if n == 0:
+            raise ModelError("no joint columns after the time column", file=path)
+        if joint_names is not None and n != len(joint_names):
+            raise ModelError(f"has {n} joint columns and no header, the robot "
+                             f"{len(joint_names)} joints: {list(joint_names)}",
+                             file=path)
+        names = list(joint_names) if joint_names is not None else \
+            [f"q{i + 1}" for i in range(n)]
+        warnings.warn(f"{path} has no header line: its columns are read by position "
+                      f"(time [s], then {', '.join(names[:8])}"
+                      f"{' ...' if len(names) > 8 else ''} in SI units)", UserWarning,
+                      stacklevel=4)
+        cells = [("t", None)] + [(nm, None) for nm in names]
+        return cells, [list(range(1, len(names) + 1)), [], []]
+    cells = _parse_header(header)
+    groups: list[dict[str, int]] = [{}, {}, {}]
+    for k, (name, _unit) in enumerate(cells[1:], start=1):
+        rate = 1 if name.endswith(".vel") else 2 if name.endswith(".acc") else 0
+        base = name[:-4] if rate else name
+        if base in groups[rate]:
+            raise ModelError(f"column {short_repr(header[k])} repeats the joint "
+                             f"{short_repr(base)}", file=path, line=1)
+        groups[rate][base] = k
+    pos = groups[0]
+    if not pos:
         raise ModelError("no joint columns after the time column", file=path)
+    if joint_names is None:
+        order = list(pos)
+    else:
+        order = list(joint_names)
+        unknown = [nm for nm in pos if nm not in order]
+        missing = [nm for nm in order if nm not in pos]
+        if unknown or missing:
+            what = []
+            if unknown:
+                what.append(f"unknown {short_repr(unknown, 120)}")
+            if missing:
+                what.append(f"missing {short_repr(missing, 120)}")
+            raise ModelError(
+                f"{len(pos)} joint columns do not match the {len(order)} joints: "
+                f"{'; '.join(what)}; expected the names {list(order)} (any order, "
+                "optionally with units such as [rad])", file=path, line=1)
+    index = [[g[nm] for nm in order] if all(nm in g for nm in order) else []
+             for g in groups]
+    return cells, index
+
+
+def _trajectory_from_table(header: list[str] | None, data: np.ndarray, path: Path,
+                           profile: ControllerProfile | None,
+                           is_revolute: npt.ArrayLike | None,
+                           joint_names: Sequence[str] | None) -> Trajectory:
+    cells, (pos, vel, acc) = _columns(header, data.shape[1], path,
+                                      None if profile is not None else joint_names)
+    tunit = cells[0][1]
+    if tunit is not None and tunit not in _TIME:
+        raise ModelError(f"unknown time unit [{short_repr(tunit, 20)}]; use [s] or "
+                         "[ms]", file=path, line=1)
+    t = data[:, 0] * _TIME.get(tunit or "s")
+    n = len(pos)
     rev_given = None if is_revolute is None else np.asarray(is_revolute, bool).reshape(-1)
     if rev_given is not None and rev_given.shape != (n,):
         raise InputError("is_revolute", f"expected {n} flags, got {rev_given.shape}")
 
-    def convert(group, rate: int) -> tuple[np.ndarray, np.ndarray]:
-        out = np.empty((len(t), len(group)))
-        rev = np.ones(len(group), bool)
-        for i, (_name, unit, k) in enumerate(group):
+    def convert(cols: list[int]) -> tuple[np.ndarray, np.ndarray]:
+        out = np.empty((len(t), len(cols)))
+        rev = np.ones(len(cols), bool)
+        for i, k in enumerate(cols):
+            unit = cells[k][1]
             base = None if unit is None else unit.split("/")[0]
             if base is None:
                 rev[i] = True if rev_given is None else rev_given[i]
@@ -406,19 +445,16 @@ def read_csv(
             elif base in _LENGTH:
                 rev[i], scale = False, _LENGTH[base]
             else:
-                raise ModelError(f"unknown unit [{unit}] in column {header[k]!r}; "
-                                 "use rad, deg, m or mm", file=path, field=header[k])
+                raise ModelError(f"unknown unit [{short_repr(unit, 20)}] in column "
+                                 f"{short_repr(cells[k][0])}; use rad, deg, m or mm",
+                                 file=path, line=1)
             out[:, i] = data[:, k] * scale
         return out, rev
 
-    q, rev = convert(pos, 0)
-    names = [p[0] for p in pos]
-    if len(t) > 1 and not (np.diff(t) > 0).all():
-        k = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 3
-        raise ModelError(f"time does not increase at line {k}", file=path,
-                         field=f"line {k}")
-    qd = convert(vel, 1)[0] if len(vel) == n else None
-    qdd = convert(acc, 2)[0] if len(acc) == n else None
+    q, rev = convert(pos)
+    names = [cells[k][0] for k in pos]
+    qd = convert(vel)[0] if vel else None
+    qdd = convert(acc)[0] if acc else None
     if profile is not None:
         q = profile.undo(q)
         qd = None if qd is None else profile.undo(qd, rates=True)
@@ -434,8 +470,67 @@ def read_csv(
         qd = _differentiate(t, q)
     if qdd is None:
         qdd = _differentiate(t, qd)
-    return Trajectory(t, q, qd, qdd, joint_names=tuple(names), is_revolute=rev,
-                      via_times=np.array([t[0], t[-1]]))
+    return Trajectory(t, q, qd, qdd,
+                      joint_names=None if header is None and joint_names is None
+                      else tuple(names),
+                      is_revolute=rev, via_times=np.array([t[0], t[-1]]))
+
+
+def _check_times(t: np.ndarray, path: Path, first_line: int, *,
+                 allow_repeats: bool) -> np.ndarray:
+    """Rows to keep: refuses time going backwards (naming the line), and repeated
+    time stamps unless ``allow_repeats`` (then the first of each is kept)."""
+    step = np.diff(t)
+    back = np.flatnonzero(step < 0 if allow_repeats else step <= 0)
+    if back.size:
+        k = int(back[0]) + 1
+        what = "goes backwards" if step[k - 1] < 0 else "does not increase"
+        raise ModelError(f"time {what} ({t[k - 1]:g} s, then {t[k]:g} s); robokin "
+                         "refuses it rather than reorder the samples",
+                         file=path, line=first_line + k)
+    return np.concatenate([[True], step > 0])
+
+
+def read_csv(
+    path: str | Path,
+    *,
+    profile: ControllerProfile | None = None,
+    is_revolute: npt.ArrayLike | None = None,
+    joint_names: Sequence[str] | None = None,
+    max_bytes: int = MAX_CSV_BYTES,
+) -> Trajectory:
+    """Read a trajectory CSV (the :func:`write_csv` format, or a logged run).
+
+    The first column is time; the others are joints, optionally followed by
+    ``.vel`` and ``.acc`` columns. Units in brackets are converted to SI;
+    a column without a unit is taken as SI. Velocities and accelerations missing
+    from the file are differentiated from the positions.
+
+    Args:
+        path: The file.
+        profile: The controller profile the file was written with (undone here;
+            columns are then taken in the profile's order, not by name).
+        is_revolute: (n,) flags for columns without units (default: angles), in
+            the order of ``joint_names`` when given.
+        joint_names: The robot's joint names: columns are matched by header
+            name, in any order, and returned in this order. A file without a
+            header is read by position (with a warning).
+        max_bytes: The largest file accepted [bytes].
+
+    Returns:
+        A :class:`~robokin.trajectory.samples.Trajectory` in model order and SI.
+
+    Raises:
+        ModelError: missing, binary or too large file, ragged or non-numeric
+            rows, unknown units, joint columns that do not match
+            ``joint_names``, times that do not increase (naming the file and
+            line).
+    """
+    path = Path(path)
+    header, data, first = _load_table(path, max_bytes)
+    _check_times(data[:, 0], path, first, allow_repeats=False)
+    return _trajectory_from_table(header, data, path, profile, is_revolute,
+                                  joint_names)
 
 
 def read_log(
@@ -443,34 +538,23 @@ def read_log(
     *,
     profile: ControllerProfile | None = None,
     is_revolute: npt.ArrayLike | None = None,
+    joint_names: Sequence[str] | None = None,
+    max_bytes: int = MAX_CSV_BYTES,
 ) -> Trajectory:
     """Read a logged real run (CSV of time + joint angles) as a Trajectory.
 
     Like :func:`read_csv`, but tolerant of what loggers write: repeated time
     stamps are dropped (the first is kept) and the start time is kept as logged.
+    Time going backwards is refused: a reordered log is a broken log.
 
     Raises:
         ModelError: as :func:`read_csv`.
     """
     path = Path(path)
-    header, data = _load_table(path)
-    t = data[:, 0]
-    keep = np.concatenate([[True], np.diff(t) > 0])
-    if not keep.all():
-        order = np.argsort(t, kind="stable")
-        data = data[order]
-        t = data[:, 0]
-        keep = np.concatenate([[True], np.diff(t) > 0])
-        data = data[keep]
-        fd, tmp = tempfile.mkstemp(suffix=".csv")
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as fh:
-                fh.write(",".join(header) + "\n")
-                np.savetxt(fh, data, delimiter=",", fmt="%.17g")
-            return read_csv(tmp, profile=profile, is_revolute=is_revolute)
-        finally:
-            os.unlink(tmp)
-    return read_csv(path, profile=profile, is_revolute=is_revolute)
+    header, data, first = _load_table(path, max_bytes)
+    keep = _check_times(data[:, 0], path, first, allow_repeats=True)
+    return _trajectory_from_table(header, data[keep], path, profile, is_revolute,
+                                  joint_names)
 
 
 # ------------------------------------------------------------------------ JSON
@@ -498,22 +582,23 @@ def write_json(
         "qd": traj.qd.tolist(),
         "qdd": traj.qdd.tolist(),
     }
-    return write_text_atomic(path, json.dumps(doc) + "\n", overwrite=overwrite)
+    return write_atomic(path, json.dumps(doc) + "\n", overwrite=overwrite)
 
 
-def read_json(path: str | Path) -> Trajectory:
-    """Read a trajectory written by :func:`write_json`.
+def read_json(path: str | Path, *, max_bytes: int = MAX_CSV_BYTES) -> Trajectory:
+    """Read a trajectory written by :func:`write_json` (at most ``max_bytes``).
 
     Raises:
         ModelError: missing file, not JSON, or missing / inconsistent fields.
     """
     path = Path(path)
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ModelError("no such file", file=path) from None
+        doc = json.loads(read_text_file(path, max_bytes=max_bytes))
     except json.JSONDecodeError as exc:
-        raise ModelError(f"not valid JSON: {exc}", file=path) from None
+        raise ModelError(f"not valid JSON: {exc.msg}", file=path,
+                         line=exc.lineno) from None
+    if not isinstance(doc, Mapping):
+        raise ModelError("expected a JSON object at the top level", file=path)
     for key in ("t", "q", "qd", "qdd"):
         if key not in doc:
             raise ModelError(f"missing field '{key}'", file=path, field=key)
@@ -561,7 +646,7 @@ def ur_script(
         InputError: unknown mode, or a trajectory in actuator space.
     """
     if mode not in ("servoj", "movej"):
-        raise InputError("mode", f"expected 'servoj' or 'movej', got {mode!r}")
+        raise InputError("mode", f"expected 'servoj' or 'movej', got {short_repr(mode)}")
     if traj.space != "joint":
         raise InputError("traj", "URScript takes joint angles: convert to joint space")
     prof = profile or ControllerProfile()
@@ -598,5 +683,5 @@ def write_ur_script(traj: Trajectory, path: str | Path, *, overwrite: bool = Fal
     Raises:
         InputError: the file exists and ``overwrite`` is False.
     """
-    return write_text_atomic(path, ur_script(traj, **options), overwrite=overwrite)
+    return write_atomic(path, ur_script(traj, **options), overwrite=overwrite)
 

@@ -13,11 +13,14 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from robokin._text import short_repr
 from robokin.exceptions import InputError
 from robokin.trajectory.profiles import Profile, get_profile, lspb_timing
 from robokin.trajectory.samples import Trajectory
 
 __all__ = [
+    "MAX_SAMPLES",
+    "check_sample_count",
     "constant_velocity",
     "cubic",
     "cubic_coefficients",
@@ -32,25 +35,41 @@ __all__ = [
     "trapezoidal",
 ]
 
+#: Most samples one time grid may hold unless ``max_samples=`` says otherwise: a
+#: backstop so that an absurd ``duration`` / ``dt`` is refused before anything is
+#: allocated (10 million samples of a 6-joint arm are about 1.4 GB of q, qd, qdd).
+MAX_SAMPLES = 10_000_000
 
-def time_grid(duration: float, dt: float, *, t0: float = 0.0) -> np.ndarray:
+
+def time_grid(duration: float, dt: float, *, t0: float = 0.0,
+              max_samples: int | None = None) -> np.ndarray:
     """Times ``t0, t0 + dt, ...`` up to ``t0 + duration``, the end always included.
 
     When ``duration`` is a multiple of ``dt`` (to 1e-9 of a step) the grid is
     uniform; otherwise the last step is shorter.
 
+    Args:
+        duration: Length of the grid [s], >= 0.
+        dt: Step [s], > 0.
+        t0: First time [s].
+        max_samples: Most samples accepted (default :data:`MAX_SAMPLES`); checked
+            before the grid is allocated.
+
     Raises:
-        InputError: ``dt`` not positive or ``duration`` negative.
+        InputError: ``dt`` not positive, ``duration`` negative, or more than
+            ``max_samples`` samples (naming both and the limit).
     """
     try:
         dt, duration = float(dt), float(duration)
     except (TypeError, ValueError):
         bad = "dt" if not isinstance(dt, (int, float, np.number)) else "duration"
-        raise InputError(bad, f"expected seconds, got {locals()[bad]!r:.80}") from None
+        raise InputError(bad, f"expected seconds, got "
+                         f"{short_repr(locals()[bad])}") from None
     if not np.isfinite(dt) or dt <= 0:
         raise InputError("dt", f"must be a positive time step [s], got {dt!r}")
     if not np.isfinite(duration) or duration < 0:
         raise InputError("duration", f"must be >= 0 [s], got {duration!r}")
+    check_sample_count(duration, dt, max_samples)
     k = duration / dt
     steps = int(np.floor(k + 1e-9))
     t = np.arange(steps + 1) * dt
@@ -61,11 +80,36 @@ def time_grid(duration: float, dt: float, *, t0: float = 0.0) -> np.ndarray:
     return t0 + t
 
 
+def check_sample_count(duration: float, dt: float, max_samples: int | None = None,
+                       *, argument: str = "duration") -> int:
+    """The number of samples of a grid ``duration`` / ``dt``, refused above the cap.
+
+    Args:
+        duration: Time span [s].
+        dt: Step [s].
+        max_samples: The cap (default :data:`MAX_SAMPLES`).
+        argument: The argument to name in the error.
+
+    Returns:
+        The sample count (end included).
+
+    Raises:
+        InputError: more than ``max_samples`` samples.
+    """
+    cap = MAX_SAMPLES if max_samples is None else int(max_samples)
+    count = duration / dt + 2.0
+    if count > cap:
+        raise InputError(argument, f"{duration:g} s at dt {dt:g} s is {count:,.0f} "
+                         f"samples, more than the limit of {cap:,} (pass "
+                         "max_samples= to raise it)")
+    return int(count)
+
+
 def _vec(x: npt.ArrayLike, n: int | None, name: str) -> np.ndarray:
     try:
         a = np.array(x, dtype=np.float64)
     except (TypeError, ValueError) as exc:
-        raise InputError(name, f"expected numbers, got {x!r:.80}") from exc
+        raise InputError(name, f"expected numbers, got {short_repr(x)}") from exc
     if n is not None:
         if a.ndim == 0:
             a = np.full(n, float(a))
@@ -82,7 +126,8 @@ def _duration(duration: Any) -> float:
     try:
         T = float(duration)
     except (TypeError, ValueError):
-        raise InputError("duration", f"expected seconds, got {duration!r}") from None
+        raise InputError("duration", f"expected seconds, got {short_repr(duration)}"
+                         ) from None
     if not np.isfinite(T) or T <= 0:
         raise InputError("duration", f"must be positive [s], got {duration!r}")
     return T

@@ -39,6 +39,7 @@ from robokin._validation import check_finite, check_joints, check_transform
 from robokin.exceptions import InputError, UnreachableError
 from robokin.trajectory.cartesian import PathError, cartesian_line
 from robokin.trajectory.joint import (
+    MAX_SAMPLES,
     evaluate_polynomial,
     quintic_coefficients,
     time_grid,
@@ -95,13 +96,16 @@ class PathBuilder:
         tool_acceleration: Largest tool acceleration on lines [m/s^2].
         smooth: Pass through joint via points without stopping.
         ik: Path-following mode of lines (see :func:`cartesian_line`).
+        max_samples: Most samples the whole path may hold (default
+            :data:`robokin.trajectory.joint.MAX_SAMPLES`), checked before any
+            segment is sampled.
     """
 
     def __init__(
         self, robot: Any, q_start: npt.ArrayLike, *, dt: float = 0.005,
         v_max: npt.ArrayLike | None = None, a_max: npt.ArrayLike | None = None,
         tool_speed: float | None = None, tool_acceleration: float | None = None,
-        smooth: bool = True, ik: str = "follow",
+        smooth: bool = True, ik: str = "follow", max_samples: int | None = None,
     ) -> None:
         self.robot = robot
         n = robot.n
@@ -120,6 +124,7 @@ class PathBuilder:
         self.tool_acceleration = tool_acceleration
         self.smooth = smooth
         self.ik = ik
+        self.max_samples = max_samples
         self.segments: list[Segment] = []
 
     # ----------------------------------------------------------------- adding
@@ -185,7 +190,8 @@ class PathBuilder:
                 self.robot, self.q_end, T1, self._duration(duration), self.dt,
                 profile=profile, speed_in=speed_in, speed_out=speed_out,
                 v_max=self.v_max, a_max=self.a_max, tool_speed=self.tool_speed,
-                tool_acceleration=self.tool_acceleration, ik=self.ik)
+                tool_acceleration=self.tool_acceleration, ik=self.ik,
+                max_samples=self.max_samples)
         except PathError as exc:
             exc.args = (f"segment {seg_no} ({label or 'line'}): {exc.args[0]} "
                         "(time from the segment start)",)
@@ -242,6 +248,7 @@ class PathBuilder:
         for seg, q_from in zip(segs, starts):
             if seg.duration is None:
                 seg.duration = self._rest_duration(seg, q_from)
+        self._check_samples(segs)
         # Boundary conditions per junction: (qd, qdd) or None (free: via point).
         n = self.robot.n
         zero = np.zeros(n)
@@ -264,7 +271,7 @@ class PathBuilder:
             if seg.kind == "line":
                 parts.append(seg.line.replace(labels=(seg.label,), pose=None))
             else:
-                t = time_grid(seg.duration, self.dt)
+                t = time_grid(seg.duration, self.dt, max_samples=self.max_samples)
                 if seg.kind == "dwell":
                     m = t.size
                     q = np.broadcast_to(seg.q_end, (m, n))
@@ -285,6 +292,19 @@ class PathBuilder:
         return traj.replace(joint_names=self.robot.joint_names,
                             is_revolute=self.robot.is_revolute,
                             pose=self.robot.fk(traj.q))
+
+    def _check_samples(self, segs: list[Segment]) -> None:
+        """Refuse a path of more than ``max_samples`` samples before sampling it."""
+        cap = MAX_SAMPLES if self.max_samples is None else int(self.max_samples)
+        total = 0.0
+        for i, seg in enumerate(segs):
+            total += seg.duration / self.dt + 1.0
+            if total > cap:
+                raise InputError(
+                    "max_samples",
+                    f"the path reaches {total:,.0f} samples at dt {self.dt:g} s by "
+                    f"segment {i + 1} ('{seg.label}', {seg.duration:g} s), more "
+                    f"than the limit of {cap:,} (pass max_samples= to raise it)")
 
     def _joint_coefficients(self, segs, starts, bc) -> list[np.ndarray | None]:
         """Quintic coefficients of every joint segment (None: plain profile move)."""

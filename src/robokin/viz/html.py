@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from robokin.io.atomic import write_atomic
 from robokin.viz._common import (
     COLLISION_COLOR,
     DISTANCE_COLOR,
@@ -196,10 +197,13 @@ def write_html(
         autoplay: Start playing when the page opens.
 
     Returns:
-        The path written.
+        The path written (atomically: a temporary file in the same folder,
+        renamed; see :func:`robokin.io.atomic.write_atomic`).
+
+    Raises:
+        InputError: the folder is missing or read-only, or ``path`` is a folder.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     text = animation_html(
         robot,
         trajectory,
@@ -210,10 +214,7 @@ def write_html(
         max_frames=max_frames,
         autoplay=autoplay,
     )
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(path)
-    return path
+    return write_atomic(path, text)
 
 
 _TEMPLATE = """<!DOCTYPE html>

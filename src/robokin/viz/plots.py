@@ -8,8 +8,6 @@ Angles are drawn in degrees and lengths in millimetres unless asked otherwise.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -17,7 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin.exceptions import InputError
-from robokin.trajectory.io import file_mode
+from robokin.io.atomic import file_stem, save_figure_atomic
 
 __all__ = [
     "plot_comparison",
@@ -26,6 +24,7 @@ __all__ = [
     "plot_tool_path",
     "plot_tool_position",
     "save_figure",
+    "save_workspace_plots",
 ]
 
 _FORMATS = (".png", ".svg", ".pdf")
@@ -50,20 +49,40 @@ def save_figure(fig: Any, path: str | Path, *, overwrite: bool = False,
     path = Path(path)
     if path.suffix.lower() not in _FORMATS:
         raise InputError("path", f"expected a {', '.join(_FORMATS)} file, got {path.name}")
-    if path.exists() and not overwrite:
-        raise InputError("path", f"{path} exists; pass overwrite=True to replace it")
-    folder = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=folder)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=dpi, format=path.suffix[1:].lower())
-        os.chmod(tmp, file_mode())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
+    return save_figure_atomic(fig, path, overwrite=overwrite, dpi=dpi)
+
+
+def save_workspace_plots(ws: Any, out_dir: str | Path) -> list[Path]:
+    """Write the XY / XZ cross sections (manipulability and density) as PNG files.
+
+    The figures of :func:`robokin.kinematics.workspace.plot_cross_section`, each
+    written atomically (an existing file is replaced only once the new one is
+    complete).
+
+    Args:
+        ws: The sampled workspace (:func:`robokin.kinematics.workspace.sample_workspace`).
+        out_dir: An existing folder.
+
+    Returns:
+        The paths written.
+
+    Raises:
+        InputError: ``out_dir`` is not a folder, or a file cannot be written.
+    """
+    from robokin.kinematics.workspace import plot_cross_section
+
+    out = Path(out_dir)
+    if not out.is_dir():
+        raise InputError("out_dir", f"{out} is not a folder")
+    written = []
+    for plane in ("xy", "xz"):
+        fig = _figure(figsize=(12.0, 5.5))
+        axes = fig.subplots(1, 2)
+        plot_cross_section(ws, plane, color_by="manipulability", ax=axes[0])
+        plot_cross_section(ws, plane, color_by="density", ax=axes[1])
+        name = f"{file_stem(ws.robot_name)}_workspace_{plane}.png"
+        written.append(save_figure(fig, out / name, overwrite=True, dpi=110))
+    return written
 
 
 def _finish(fig, path, overwrite):

@@ -17,7 +17,9 @@ the scene's objects, the tool frame, and:
   and a draggable tool target that snaps the arm to the nearest IK solution.
 
 The server binds to 127.0.0.1 unless told otherwise: it has no authentication.
-Needs ``robokin[viewer]`` (viser).
+It refuses websocket connections from other web pages (an ``Origin`` other than
+its own page: see :mod:`robokin.viz._origin_guard`), so a site open in the
+browser cannot read the scene. Needs ``robokin[viewer]`` (viser).
 """
 
 from __future__ import annotations
@@ -98,6 +100,9 @@ class RobotViewer:
         port: TCP port; 0 picks a free one.
         dt: Sample period [s] when the trajectory has no times.
         verbose: Let viser print its banner.
+        allowed_hosts: Host names whose pages may connect besides the loopback
+            names and the bound address (e.g. this machine's name when bound
+            to a LAN interface).
 
     Attributes:
         server: The ``viser.ViserServer``.
@@ -116,6 +121,7 @@ class RobotViewer:
         port: int = 8080,
         dt: float = 0.005,
         verbose: bool = False,
+        allowed_hosts: tuple[str, ...] = (),
     ) -> None:
         viser = _viser()
         self.robot = robot
@@ -128,7 +134,10 @@ class RobotViewer:
         self.report = report_arrays(report, m)
         if port == 0:
             port = _free_port(host)
-        self.server = viser.ViserServer(host=host, port=port, verbose=verbose)
+        from robokin.viz._origin_guard import guarded_start
+
+        with guarded_start(allowed_hosts):
+            self.server = viser.ViserServer(host=host, port=port, verbose=verbose)
         self.host, self.port = host, int(self.server.get_port())
         self._lock = threading.RLock()
         self._busy = False

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from robokin._text import short_repr
 from robokin.exceptions import InputError
 from robokin.trajectory.profiles._constant_velocity import ConstantVelocityProfile
 from robokin.trajectory.profiles._cycloidal import CycloidalProfile
@@ -59,9 +60,9 @@ def get_profile(profile: str | Profile, **params: Any) -> Profile:
         return profile
     cls = PROFILES.get(str(profile).lower().replace("-", "_").replace(" ", "_"))
     if cls is None:
-        raise InputError("profile", f"unknown profile {profile!r}; known: "
+        raise InputError("profile", f"unknown profile {short_repr(profile)}; known: "
                          f"{sorted(PROFILES)}")
     try:
         return cls(**params)
     except TypeError as exc:
-        raise InputError("profile", f"{profile!r}: {exc}") from None
+        raise InputError("profile", f"{short_repr(profile)}: {exc}") from None

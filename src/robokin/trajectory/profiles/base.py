@@ -26,6 +26,7 @@ from typing import ClassVar
 import numpy as np
 import numpy.typing as npt
 
+from robokin._text import short_repr
 from robokin.exceptions import InputError
 
 __all__ = ["Profile", "positive_limits"]
@@ -41,7 +42,7 @@ def positive_limits(x: npt.ArrayLike, n: int, name: str) -> np.ndarray:
     try:
         a = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError):
-        raise InputError(name, f"expected a number or {n} numbers, got {x!r:.80}") from None
+        raise InputError(name, f"expected a number or {n} numbers, got {short_repr(x)}") from None
     if a.ndim > 1 or (a.ndim == 1 and a.shape[0] != n):
         raise InputError(name, f"expected a scalar or shape ({n},), got {a.shape}")
     a = np.broadcast_to(a, (n,))
@@ -82,7 +83,7 @@ class Profile(ABC):
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``s(t), ds/dt [1/s], d2s/dt2 [1/s^2]`` for a motion of ``duration`` [s]."""
         if not duration > 0:
-            raise InputError("duration", f"must be positive, got {duration!r}")
+            raise InputError("duration", f"must be positive, got {short_repr(duration)}")
         s, sd, sdd = self.evaluate(np.asarray(t, dtype=np.float64) / duration)
         return s, sd / duration, sdd / duration**2
 

@@ -20,7 +20,7 @@ Choices where DH leaves freedom (documented in ``docs/urdf.md``):
 * z_i points along the joint's positive direction, so every row has ``sign = +1``;
 * frame 0: origin at the foot of the reference frame's origin on joint 1's axis,
   x0 the reference x axis projected onto the plane normal to z0 (the reference is
-  ``robot.base`` unless given; :func:`robokin.model.urdf.dh_from_urdf` uses the
+  ``robot.base`` unless given; :func:`robokin.io.urdf.dh_from_urdf` uses the
   ROS-Industrial ``base`` frame, the vendor's DH frame 0);
 * x_i along the common normal, its sense the one closer to x_(i-1) (joint offsets
   ``theta`` stay within +-90 deg, zero where the arm allows — this reproduces

@@ -13,7 +13,7 @@ from robokin.exceptions import ModelError
 from robokin.spatial import rotz
 
 pytest.importorskip("yourdfpy")
-from robokin.model.urdf import axis_frame, robot_from_urdf  # noqa: E402
+from robokin.io.urdf import axis_frame, robot_from_urdf  # noqa: E402
 
 DATA = Path(__file__).parent.parent / "data" / "urdf"
 
@@ -192,7 +192,7 @@ def test_geometry_meshes_package_map_and_missing_mesh():
 @pytest.mark.parametrize(
     ("xml", "match"),
     [
-        ("<robot name='r'><link name='a'/>", "not valid XML at line 1"),
+        ("<robot name='r'><link name='a'/>", "line 1: not valid XML"),
         ("<robt name='r'/>", "root element must be <robot>"),
         ("<robot name='r'><link name='a'/><link name='b'/><joint name='j' type='revolute'>"
          "<parent link='a'/><child link='b'/></joint></robot>", r"joint\[j\].limit"),
@@ -227,7 +227,7 @@ def test_bad_urdf_raises_model_error(xml, match):
 
 
 def test_malformed_file_and_missing_file_name_the_file():
-    with pytest.raises(ModelError, match=r"malformed.urdf: not valid XML at line \d+"):
+    with pytest.raises(ModelError, match=r"malformed.urdf:\d+: not valid XML"):
         robot_from_urdf(DATA / "malformed.urdf")
     with pytest.raises(ModelError, match="nope.urdf: no such file"):
         robot_from_urdf(DATA / "nope.urdf")
@@ -251,7 +251,7 @@ def test_missing_yourdfpy_names_the_extra(monkeypatch):
 @pytest.mark.parametrize(
     ("joint_xml", "message"),
     [
-        ('<axis xyz="0 0 x"/>', r"joint\[j\]\.axis\.xyz.*line 1.*3 numbers"),
+        ('<axis xyz="0 0 x"/>', r"arm\.urdf:1: joint\[j\]\.axis\.xyz.*3 numbers"),
         ('<origin xyz="1 2"/>', r"joint\[j\]\.origin\.xyz.*3 numbers"),
         ('<axis xyz="0 0 0"/>', r"arm\.urdf: joint\[j\]\.axis: .*non-zero"),
     ],
@@ -278,3 +278,104 @@ def test_a_non_numeric_limit_names_the_attribute(tmp_path):
     )
     with pytest.raises(robokin.ModelError, match=r"joint\[j\]\.limit\.lower"):
         robokin.Robot.from_urdf(path)
+
+
+# ------------------------------------------------------ issue 15: hostile URDFs
+ARM = ('<robot name="r"><link name="a"/><link name="b">{link}</link>'
+       '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+       '{joint}<limit lower="0" upper="1"/></joint></robot>')
+
+
+@pytest.mark.parametrize("dtd", [
+    # the XML billion laughs: entities of entities
+    '<!DOCTYPE robot [<!ENTITY a "lol"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;">'
+    '<!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;">]>',
+    # an external entity: a local file, and one on the network
+    '<!DOCTYPE robot [<!ENTITY x SYSTEM "file:///etc/passwd">]>',
+    '<!DOCTYPE robot [<!ENTITY x SYSTEM "http://127.0.0.1:9/robot.dtd">]>',
+    '<!DOCTYPE robot SYSTEM "http://127.0.0.1:9/robot.dtd">',
+])
+def test_dtds_and_entities_are_refused(tmp_path, dtd):
+    path = tmp_path / "evil.urdf"
+    path.write_text('<?xml version="1.0"?>' + dtd
+                    + ARM.format(link="", joint='<origin xyz="0 0 0"/>')
+                    .replace('name="r"', 'name="&c;"' if "&b;" in dtd else 'name="r"'))
+    with pytest.raises(ModelError, match=r"evil\.urdf:1: a <!DOCTYPE>"):
+        robot_from_urdf(path)
+
+
+@pytest.mark.parametrize(("link", "joint", "message"), [
+    ("", '<origin xyz="0 nan 0"/>',
+     r"arm\.urdf:1: joint\[j\]\.origin\.xyz: .*finite"),
+    ("", '<origin rpy="0 0 inf"/>', r"joint\[j\]\.origin\.rpy: .*finite"),
+    ("", '<axis xyz="0 0 NaN"/>', r"joint\[j\]\.axis\.xyz: .*finite"),
+    ('<collision><geometry><box size="1 -2 1"/></geometry></collision>', "",
+     r"arm\.urdf:1: link\[b\]\.box\.size: .*positive"),
+    ('<visual><geometry><cylinder radius="0.1"/></geometry></visual>', "",
+     r"link\[b\]\.cylinder\.length: <cylinder> needs a 'length'"),
+    ('<visual><geometry><sphere radius="nan"/></geometry></visual>', "",
+     r"link\[b\]\.sphere\.radius"),
+])
+def test_non_finite_origins_and_bad_shapes_name_file_element_and_line(
+        tmp_path, link, joint, message):
+    path = tmp_path / "arm.urdf"
+    path.write_text(ARM.format(link=link, joint=joint))
+    with pytest.raises(ModelError, match=message):
+        robot_from_urdf(path)
+
+
+def test_lines_are_those_of_the_element(tmp_path):
+    path = tmp_path / "arm.urdf"
+    path.write_text(ARM.format(link="", joint='\n\n<origin xyz="1 2 x"/>')
+                    .replace("><", ">\n<"))
+    with pytest.raises(ModelError) as exc:
+        robot_from_urdf(path)
+    line = exc.value.line
+    assert 'xyz="1 2 x"' in path.read_text().splitlines()[line - 1]
+
+
+def test_every_left_out_shape_is_listed_and_no_non_mesh_path_is_kept(tmp_path):
+    (tmp_path / "notes.txt").write_text("not a mesh")
+    (tmp_path / "folder.stl").mkdir()
+    shapes = "".join(
+        f'<collision><geometry><mesh filename="{f}"/></geometry></collision>'
+        for f in ("gone.stl", "http://example.com/arm.stl", "notes.txt",
+                  "package://nopkg/arm.stl", "folder.stl"))
+    path = tmp_path / "arm.urdf"
+    path.write_text(ARM.format(link=shapes + '<collision><geometry><box size="1 1 1"/>'
+                                             '</geometry></collision>', joint=""))
+    robot = robot_from_urdf(path, missing_mesh="ignore")
+    dropped = robot.meta["urdf_dropped_shapes"]
+    assert len(dropped) == 5
+    for word in ("no such file", "remote mesh (http://)", "not a mesh file",
+                 "package 'nopkg'", "folder.stl"):
+        assert any(word in d for d in dropped), word
+    kinds = [s.kind for ss in robot.geometry.shapes for s in ss]
+    assert kinds == ["box"]
+    with pytest.warns(UserWarning) as record:
+        robot_from_urdf(path)
+    assert len(record) == 5
+    with pytest.raises(ModelError, match="gone.stl"):
+        robot_from_urdf(path, missing_mesh="error")
+
+
+def _chain_urdf(n: int) -> str:
+    parts = ['<robot name="r">'] + [f'<link name="l{i}"/>' for i in range(n + 1)]
+    parts += [f'<joint name="j{i}" type="continuous"><parent link="l{i}"/>'
+              f'<child link="l{i + 1}"/><origin xyz="0 0 0.01"/></joint>'
+              for i in range(n)]
+    return "\n".join(parts) + "</robot>"
+
+
+def test_a_urdf_of_thousands_of_joints_is_refused_before_it_is_built(tmp_path):
+    from robokin.io.urdf import MAX_URDF_JOINTS
+
+    path = tmp_path / "long.urdf"
+    path.write_text(_chain_urdf(MAX_URDF_JOINTS + 1))
+    with pytest.raises(ModelError, match=r"long\.urdf:1: 1,001 <joint> elements; "
+                                         r"robokin reads at most 1,000"):
+        robot_from_urdf(path)
+    path.write_text(_chain_urdf(MAX_URDF_JOINTS))  # at the cap: read
+    robot = robot_from_urdf(path, geometry=False)
+    assert robot.n == MAX_URDF_JOINTS
+    assert robot.fk(np.zeros(robot.n))[2, 3] == pytest.approx(10.0)

@@ -125,7 +125,7 @@ def test_bad_actuator_sections_name_the_file_and_field(tmp_path, section, field,
 def test_section_from_robot_round_trips_through_a_file(tmp_path):
     import yaml
 
-    from robokin.model.coupling_files import section_from_robot
+    from robokin.io.actuator_section import section_from_robot
 
     r = robokin.load("scara")
     sec = section_from_robot(r)

@@ -11,7 +11,7 @@ from robokin.cli import main
 
 pytest.importorskip("yourdfpy")
 
-DATA = Path(__file__).parent.parent / "data" / "urdf"
+DATA = Path(__file__).parent / "data" / "urdf"
 
 
 def run(capsys, *args):
@@ -108,3 +108,23 @@ def test_export_into_a_missing_folder_names_it_and_files_get_normal_permissions(
     out.chmod(0o640)
     assert run(capsys, "export", "ur5", "-o", str(out))[0] == 0
     assert out.stat().st_mode & 0o777 == 0o640  # a replaced file keeps its mode
+
+
+def test_import_reports_every_shape_it_leaves_out(tmp_path, capsys):
+    (tmp_path / "notes.txt").write_text("not a mesh")
+    meshes = "".join(
+        f'<collision><geometry><mesh filename="{f}"/></geometry></collision>'
+        for f in ("gone.stl", "https://example.com/arm.stl", "notes.txt"))
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(
+        '<robot name="r"><link name="a"/><link name="b">' + meshes + '</link>'
+        '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+        '<limit lower="0" upper="1"/></joint></robot>')
+    out = tmp_path / "arm.yaml"
+    code, _, err = run(capsys, "import", str(urdf), "-o", str(out))
+    assert code == 0
+    notes = [ln for ln in err.splitlines() if ln.startswith("robokin: note: left out")]
+    assert len(notes) == 3
+    assert "gone.stl" in notes[0] and "remote" in notes[1] and "notes.txt" in notes[2]
+    text = out.read_text()
+    assert "notes.txt" not in text and ".stl" not in text and "geometry" not in text

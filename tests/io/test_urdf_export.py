@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 import robokin
-from robokin.model.urdf import urdf_from_robot
+from robokin.io.urdf_export import urdf_from_robot
 from robokin.spatial import rotx, trans
 
 pytest.importorskip("yourdfpy")
-from robokin.model.urdf import robot_from_urdf  # noqa: E402
+from robokin.io.urdf import robot_from_urdf  # noqa: E402
 
 DATA = Path(__file__).parent.parent / "data" / "urdf"
 

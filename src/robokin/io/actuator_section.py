@@ -24,8 +24,9 @@ or named drives, motors numbered in drive order:
         - {type: screw, joint: z, lead: 5, ratio: 1}            # lead in length units/rev
         - {type: ball_screw_spline, joints: [rotate, lift], lead: 20, i: 1, j: 15}
 
-See :mod:`robokin.model.coupling` for the maps. Importing this module registers the
-section with :func:`robokin.model.files.register_section`.
+See :mod:`robokin.model.coupling` for the maps. The robot-file reader applies the
+section through its table (:data:`robokin.io.robot_files.SECTIONS`). Numbers must
+be numbers (``ratio: "100"`` is refused).
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from robokin.exceptions import ModelError
-from robokin.model import files as _files
+from robokin.io.validate import validate_document
 from robokin.model.coupling import (
     AffineMap,
     actuator_map,
@@ -58,73 +59,61 @@ _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 def _schema():
     from typing import Annotated, Literal
 
-    from pydantic import BaseModel, ConfigDict, Field
+    from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictStr
+
+    Num = StrictFloat  # numbers must be numbers: "100" and yes are refused
+    Name = StrictStr
 
     class Strict(BaseModel):
         model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     class Direct(Strict):
         type: Literal["direct"]
-        joints: list[str] = Field(min_length=1)
+        joints: list[Name] = Field(min_length=1)
 
     class Gear(Strict):
         type: Literal["gear"]
-        joint: str
-        ratio: float
-        offset: float = 0.0
+        joint: Name
+        ratio: Num
+        offset: Num = 0.0
 
     class Screw(Strict):
         type: Literal["screw"]
-        joint: str
-        lead: float
-        ratio: float = 1.0
-        offset: float = 0.0
+        joint: Name
+        lead: Num
+        ratio: Num = 1.0
+        offset: Num = 0.0
 
     class BallScrewSpline(Strict):
         type: Literal["ball_screw_spline"]
-        joints: tuple[str, str]
-        lead: float
-        i: float = 1.0
-        j: float = 1.0
+        joints: tuple[Name, Name]
+        lead: Num
+        i: Num = 1.0
+        j: Num = 1.0
         lift_sign: Literal[1, -1] = 1
 
     Drive = Annotated[Direct | Gear | Screw | BallScrewSpline,
                       Field(discriminator="type")]
 
     class Section(Strict):
-        names: list[str] | None = None
+        names: list[Name] | None = None
         kinds: list[Literal["rotary", "linear"]] | None = None
-        limits: list[tuple[float, float]] | None = None
-        matrix: list[list[float]] | None = None
-        offset: list[float] | None = None
+        limits: list[tuple[Num, Num]] | None = None
+        matrix: list[list[Num]] | None = None
+        offset: list[Num] | None = None
         drives: list[Drive] | None = None
 
     return Section
 
 
 def _validate(value: Any, file: Any):
-    from pydantic import ValidationError
-
     Section = _schema()
     if not isinstance(value, dict):
         raise ModelError(f"must be a mapping of fields, got {type(value).__name__}",
                          file=file, field="actuators")
-    try:
-        return Section.model_validate(value)
-    except ValidationError as exc:
-        err = exc.errors()[0]
-        loc = ("actuators",) + tuple(err["loc"])
-        # A discriminated union adds the tag to the location: drop it.
-        loc = tuple(p for p in loc if p not in ("direct", "gear", "screw",
-                                                 "ball_screw_spline"))
-        msg = err["msg"]
-        if err["type"] == "missing":
-            msg = "missing required field"
-        elif err["type"] == "extra_forbidden":
-            msg = "unknown field"
-        elif "input" in err:
-            msg = f"{msg} (got {err['input']!r:.60})"
-        raise ModelError(msg, file=file, field=_files._field_path(loc)) from None
+    # A discriminated union adds the tag to the location: dropped.
+    return validate_document(Section, value, file=file, prefix=("actuators",),
+                             drop=("direct", "gear", "screw", "ball_screw_spline"))
 
 
 def actuators_from_section(
@@ -270,7 +259,7 @@ def actuators_from_section(
 
 
 def apply_actuators_section(robot: Robot, value: Any, file: Any, units: Any) -> Robot:
-    """The ``files.register_section`` handler: a copy of ``robot`` with its actuators."""
+    """The section reader: a copy of ``robot`` with its actuators (file units)."""
     chain = robot.chain
     amap, names, limits, kinds = actuators_from_section(
         value, list(robot.joint_names), [c.kind for c in chain.coordinates], file, units)
@@ -298,5 +287,3 @@ def section_from_robot(robot: Robot) -> dict[str, Any] | None:
         out["limits"] = lim.tolist()
     return out
 
-
-_files.register_section("actuators", apply_actuators_section)

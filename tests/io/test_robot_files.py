@@ -9,7 +9,7 @@ import yaml
 
 import robokin
 from reference import random_q
-from robokin.model.files import document_from_robot, load_robot, save_robot
+from robokin.io.robot_files import document_from_robot, load_robot, save_robot
 
 GOOD = """\
 name: two_link
@@ -41,7 +41,7 @@ def test_units_are_converted_once_at_the_edge(tmp_path):
 
 
 CASES = [
-    ("name: x\njoints: []\n", r"robot\.yaml: joints"),
+    ("name: x\njoints: []\n", r"robot\.yaml:2: joints"),
     ("joints:\n  - {a: 1}\n", r"robot\.yaml: name: missing required field"),
     (
         GOOD.replace("limits: [-90, 90]", "limits: [90, -90]"),
@@ -62,7 +62,7 @@ CASES = [
     (GOOD.replace("rpy: [180, 0, 0]", "rpy: [180, 0]"), r"tool\.rpy"),
     (GOOD + "wheels: 4\n", r"wheels: unknown field"),
     ("- just\n- a list\n", r"robot\.yaml: a robot file must be a mapping"),
-    ("name: [unclosed\n", r"robot\.yaml: not valid YAML at line"),
+    ("name: [unclosed\n", r"robot\.yaml:2: not valid YAML, column"),
     (GOOD.replace("name: j2", "name: j1"), r"unique"),
 ]
 
@@ -113,7 +113,7 @@ def test_failed_save_keeps_the_old_file(tmp_path, monkeypatch):
         raise OSError("disk full")
 
     monkeypatch.setattr(os, "fsync", boom)
-    with pytest.raises(OSError, match="disk full"):
+    with pytest.raises(robokin.InputError, match=r"robot\.yaml: cannot write: disk full"):
         save_robot(robot, target)
     assert target.read_text() == GOOD
     assert sorted(p.name for p in tmp_path.iterdir()) == ["robot.yaml"]  # no temp left
@@ -195,3 +195,58 @@ def test_save_gives_normal_permissions_and_keeps_existing_ones(tmp_path):
     existing.chmod(0o640)
     save_robot(robot, existing)
     assert existing.stat().st_mode & 0o777 == 0o640
+
+
+# ------------------------------------------------------- issue 15: strict numbers
+@pytest.mark.parametrize(("old", "new", "message"), [
+    ("a: 300", 'a: "300"', r"robot\.yaml:6: joints\[0\]\.a: Input should be a valid "
+                           r"number \(got '300'\)"),
+    ("alpha: 0, d: 100", "alpha: yes, d: 100", r":6: joints\[0\]\.alpha: .*got True"),
+    ("limits: [-90, 90]", "limits: [-90, '90']", r":6: joints\[0\]\.limits\[1\]: .*got '90'"),
+    ("xyz: [0, 0, 100]", "xyz: [0, 0, '100']", r":8: tool\.xyz\[2\]: .*got '100'"),
+    ("a: 300, alpha: 0", "a: 300, alpha: 0, a: 301", r":6: duplicate key 'a'"),
+    ("a: 300", "a: 3.0e10", r":6: joints\[0\]\.a: 3e\+07 m is beyond the 1e\+06 m"),
+    ("name: j1,", "name: " + "n" * 201 + ",", r"joints\[0\]\.name: String should have "
+                                                "at most 200 characters"),
+])
+def test_numbers_must_be_numbers_and_errors_name_the_line(tmp_path, old, new, message):
+    assert old in GOOD
+    with pytest.raises(robokin.ModelError, match=message):
+        load_robot(_write(tmp_path, GOOD.replace(old, new, 1)))
+
+
+def test_too_many_joint_rows_are_refused_before_validation(tmp_path):
+    rows = "".join("  - {a: 0.1}\n" for _ in range(1001))
+    with pytest.raises(robokin.ModelError, match=r"joints: 1,001 rows; a robot file "
+                                                 r"holds at most 1,000"):
+        load_robot(_write(tmp_path, "name: long\njoints:\n" + rows))
+
+
+def test_a_file_without_units_that_reads_as_an_89_m_arm_warns(tmp_path):
+    ur5_mm = "name: ur5\njoints:\n  - {a: 0, alpha: 1.5707963, d: 89.159}\n" \
+             "  - {a: -425, alpha: 0, d: 0}\n"
+    with pytest.warns(UserWarning, match=r"no 'units:'.*-425 m \(joints\[1\]\.a\) "
+                                         r"suggests millimetres"):
+        robot = load_robot(_write(tmp_path, ur5_mm))
+    assert robot.fk(np.zeros(2))[2, 3] == pytest.approx(89.159)  # read as asked
+    deg = "name: d\njoints:\n  - {a: 0.4, alpha: 90}\n"
+    with pytest.warns(UserWarning, match=r"90 rad \(joints\[0\]\.alpha\) suggests "
+                                         "degrees"):
+        load_robot(_write(tmp_path, deg))
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        load_robot(_write(tmp_path, GOOD))  # units given: no warning
+        load_robot(_write(tmp_path, "name: m\njoints:\n  - {a: 0.425, alpha: 1.57}\n"))
+        for name in robokin.robots.names():
+            robokin.load(name)
+
+
+def test_sections_are_an_explicit_table():
+    from robokin.io import robot_files
+
+    assert set(robot_files.SECTIONS) == {"actuators", "geometry", "collision"}
+    assert not hasattr(robot_files, "register_section")
+    for section in robot_files.SECTIONS.values():
+        assert callable(section.read) and callable(section.write)

@@ -8,7 +8,7 @@ import pytest
 
 import robokin
 from robokin.exceptions import InputError
-from robokin.model.dh_extract import dh_from_robot, dh_rows_for_transform
+from robokin.io.dh_extract import dh_from_robot, dh_rows_for_transform
 from robokin.spatial import rotx, roty, rotz, trans
 
 DATA = Path(__file__).parent.parent / "data" / "urdf"
@@ -21,7 +21,7 @@ def random_q(robot, rng, m=30):
 
 def test_ur5_urdf_gives_urs_published_table():
     pytest.importorskip("yourdfpy")
-    from robokin.model.urdf import dh_from_urdf
+    from robokin.io.urdf import dh_from_urdf
 
     ext = dh_from_urdf(DATA / "ur5.urdf")
     # Universal Robots' table, as in src/robokin/robots/ur5.yaml (mm, deg there)
@@ -43,7 +43,7 @@ def test_ur5_urdf_gives_urs_published_table():
 
 def test_modified_table_of_the_ur5_urdf_is_the_shifted_standard_one(rng):
     pytest.importorskip("yourdfpy")
-    from robokin.model.urdf import dh_from_urdf, robot_from_urdf
+    from robokin.io.urdf import dh_from_urdf, robot_from_urdf
 
     std = dh_from_urdf(DATA / "ur5.urdf")
     mod = dh_from_urdf(DATA / "ur5.urdf", convention="modified")
@@ -58,7 +58,7 @@ def test_modified_table_of_the_ur5_urdf_is_the_shifted_standard_one(rng):
 
 def test_panda_urdf_gives_frankas_modified_table():
     pytest.importorskip("yourdfpy")
-    from robokin.model.urdf import dh_from_urdf
+    from robokin.io.urdf import dh_from_urdf
 
     ext = dh_from_urdf(DATA / "panda.urdf", tip_link="panda_link8",
                        convention="modified")

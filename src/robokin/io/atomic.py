@@ -1,0 +1,157 @@
+"""The one atomic writer: every file robokin writes goes through :func:`write_atomic`.
+
+A file is written to a temporary file made with :func:`tempfile.mkstemp` in the
+target's folder (a fresh random name, opened with ``O_EXCL``: a planted file or
+symlink is never followed), flushed and fsynced, given the permissions an
+ordinary new file would have (or the replaced file's), then renamed over the
+target. A reader sees the old content or the new, never a half-written file; a
+crash or a kill leaves the old file intact; on any failure the temporary file
+is removed. A symlink at the target itself is replaced, not written through.
+
+Errors are :class:`~robokin.exceptions.InputError` naming the user's path (never
+the temporary one), one line: a missing folder, a folder given as the file, a
+read-only folder, a full disk.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+import stat
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import IO, Any
+
+from robokin.exceptions import InputError
+
+__all__ = ["file_stem", "new_file_mode", "save_figure_atomic", "write_atomic"]
+
+Content = str | bytes | Callable[[IO[bytes]], Any]
+
+
+def file_stem(name: str, limit: int = 80) -> str:
+    """A file-name stem made from a name (a robot's, from a file): letters, digits,
+    ``.``, ``-`` and ``_`` kept, anything else (``/``, ``..``) becomes ``_``, at
+    most ``limit`` characters; never empty or hidden."""
+    stem = re.sub(r"[^A-Za-z0-9._-]", "_", str(name))[:limit].lstrip(".")
+    return stem or "robot"
+
+
+def new_file_mode() -> int:
+    """Permissions of a new file under the current umask (mkstemp makes 0600)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+def _check_target(path: Path, overwrite: bool, argument: str) -> Path:
+    folder = path.parent if str(path.parent) else Path(".")
+    if path.is_dir():
+        raise InputError(argument, f"{path} is a folder, expected a file name")
+    if not folder.is_dir():
+        raise InputError(argument, f"{path}: the folder {folder} does not exist")
+    if not overwrite and os.path.lexists(path):
+        raise InputError(argument, f"{path} exists; pass overwrite=True to replace it")
+    return folder
+
+
+def _target_mode(path: Path) -> int:
+    try:
+        st = os.lstat(path)
+    except OSError:
+        return new_file_mode()
+    return stat.S_IMODE(st.st_mode) if stat.S_ISREG(st.st_mode) else new_file_mode()
+
+
+def write_atomic(
+    path: str | Path, content: Content, *, overwrite: bool = True,
+    argument: str = "path", encoding: str = "utf-8",
+) -> Path:
+    """Write ``content`` to ``path`` atomically (see the module docstring).
+
+    Args:
+        path: The target file.
+        content: Text (written in ``encoding``, newlines as given), bytes, or a
+            function ``write(fh)`` that writes to a binary file object (e.g.
+            ``fig.savefig``).
+        overwrite: Replace an existing file (False: refuse).
+        argument: The argument or option name used in error messages.
+        encoding: Encoding of text content.
+
+    Returns:
+        ``path``.
+
+    Raises:
+        InputError: the folder is missing or read-only, ``path`` is a folder, it
+            exists and ``overwrite`` is False, or the write fails (naming
+            ``path``).
+    """
+    path = Path(path)
+    folder = _check_target(path, overwrite, argument)
+    mode = _target_mode(path)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    except OSError as exc:
+        raise InputError(argument, f"{path}: cannot write in {folder}: "
+                         f"{exc.strerror or exc}") from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            if callable(content):
+                content(fh)
+            else:
+                fh.write(content.encode(encoding) if isinstance(content, str)
+                         else content)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, mode)
+        os.replace(tmp, path)
+    except BaseException as exc:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise InputError(argument, f"{path}: cannot write: "
+                             f"{exc.strerror or exc}") from None
+        raise
+    _sync_folder(folder)
+    return path
+
+
+def _sync_folder(folder: Path) -> None:
+    """Make the rename durable (best effort: not every system can open a folder)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def save_figure_atomic(
+    fig: Any, path: str | Path, *, overwrite: bool = True, argument: str = "path",
+    **savefig: Any,
+) -> Path:
+    """Save a matplotlib figure through :func:`write_atomic`.
+
+    The format comes from the suffix of ``path`` (``savefig(format=...)``), since
+    the temporary file's name ends in ``.tmp``.
+
+    Args:
+        fig: A matplotlib ``Figure``.
+        path: The target file (``.png``, ``.svg``, ``.pdf``, ...).
+        overwrite: Replace an existing file.
+        argument: The argument or option name used in error messages.
+        **savefig: Passed to ``fig.savefig`` (``dpi``, ...).
+
+    Raises:
+        InputError: as :func:`write_atomic`.
+    """
+    path = Path(path)
+    fmt = savefig.pop("format", None) or path.suffix[1:].lower() or "png"
+    return write_atomic(path, lambda fh: fig.savefig(fh, format=fmt, **savefig),
+                        overwrite=overwrite, argument=argument)

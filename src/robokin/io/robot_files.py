@@ -1,0 +1,536 @@
+"""Robot files (YAML): load, validate field by field, save atomically.
+
+A robot file declares its units once; everything is converted to SI here, at the
+edge. The schema (pydantic, imported lazily) is below; see ``docs/robot-files.md``.
+
+.. code-block:: yaml
+
+    name: ur5
+    source: Universal Robots' published DH parameters
+    units: {length: mm, angle: deg}
+    convention: standard            # standard | modified | elementary
+    joints:
+      - {name: shoulder_pan, joint: revolute, a: 0, alpha: 90, d: 89.159, theta: 0,
+         limits: [-360, 360]}
+    base: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # optional
+    tool: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # optional
+
+Sections besides the chain (``actuators``, ``geometry``, ``collision``) are read
+and written by the functions of :data:`SECTIONS`, an explicit table.
+
+Numbers must be numbers (``a: "12"`` and ``alpha: yes`` are refused), a file holds
+at most :data:`MAX_JOINTS` rows, names are at most :data:`MAX_NAME` characters and
+``source`` :data:`MAX_SOURCE`. A file without ``units:`` whose lengths only make
+sense in millimetres (or angles in degrees) loads, with a warning naming the
+likely unit. Errors name the file, the line and the field path.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import warnings
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from robokin._validation import MAX_TRANSLATION
+from robokin.exceptions import ModelError
+from robokin.io import actuator_section, geometry_sections
+from robokin.io.atomic import write_atomic
+from robokin.io.text_files import MAX_TEXT_BYTES
+from robokin.io.validate import validate_document
+from robokin.io.yaml_reader import read_yaml_document
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
+__all__ = [
+    "MAX_JOINTS",
+    "MAX_NAME",
+    "MAX_SOURCE",
+    "SECTIONS",
+    "SectionIO",
+    "document_from_robot",
+    "load_robot",
+    "robot_from_document",
+    "save_robot",
+]
+
+_LENGTH = {"m": 1.0, "mm": 1e-3}
+_ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
+#: Most joint rows (or elementary operations) a robot file may hold.
+MAX_JOINTS = 1000
+#: Longest name (robot, joint, coordinate) [characters].
+MAX_NAME = 200
+#: Longest ``source`` text [characters].
+MAX_SOURCE = 4096
+# Beyond these a length read as metres (an angle read as radians) is implausible.
+_PLAUSIBLE_LENGTH = 20.0
+_PLAUSIBLE_ANGLE = 2 * math.pi + 1e-9
+
+
+@dataclass(frozen=True)
+class SectionIO:
+    """How one optional robot-file section is read and written.
+
+    Attributes:
+        read: ``read(robot, value, file, units) -> Robot``: a copy of the robot
+            with the section applied (``units`` the file's); raises ModelError
+            naming the field path.
+        write: ``write(robot) -> value or None``: the section (SI units) of a
+            robot built in memory, None when it has nothing to write.
+    """
+
+    read: Callable[[Any, Any, Any, Any], Any]
+    write: Callable[[Any], Any]
+
+
+#: The optional sections, in the order they are applied.
+SECTIONS: dict[str, SectionIO] = {
+    "actuators": SectionIO(actuator_section.apply_actuators_section,
+                           actuator_section.section_from_robot),
+    "geometry": SectionIO(geometry_sections.apply_geometry_section,
+                          geometry_sections.geometry_section),
+    "collision": SectionIO(geometry_sections.apply_collision_section,
+                           geometry_sections.collision_section),
+}
+
+
+def _schema():
+    from typing import Annotated, Literal
+
+    from pydantic import (
+        BaseModel,
+        ConfigDict,
+        Field,
+        StrictFloat,
+        StrictInt,
+        StrictStr,
+        field_validator,
+    )
+
+    Name = Annotated[StrictStr, Field(max_length=MAX_NAME)]
+    Num = StrictFloat
+    Sign = Literal[1, -1]
+
+    class Strict(BaseModel):
+        model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+    class Units(Strict):
+        length: Literal["m", "mm"] = "m"
+        angle: Literal["rad", "deg"] = "rad"
+
+    class Placement(Strict):
+        xyz: tuple[Num, Num, Num] = (0.0, 0.0, 0.0)
+        rpy: tuple[Num, Num, Num] = (0.0, 0.0, 0.0)
+
+    def _check_limits(v):
+        if v is not None and v[0] > v[1]:
+            raise ValueError(f"limits reversed: lower {v[0]} > upper {v[1]}")
+        return v
+
+    def _check_sign(v):
+        if isinstance(v, bool):
+            raise ValueError("sign must be 1 or -1, got a boolean")
+        return v
+
+    class Row(Strict):
+        name: Name | None = None
+        joint: Literal["revolute", "prismatic", "fixed"] = "revolute"
+        a: Num = 0.0
+        alpha: Num = 0.0
+        d: Num = 0.0
+        theta: Num = 0.0
+        limits: tuple[Num, Num] | None = None
+        sign: Annotated[Sign, StrictInt] = 1
+        depends: dict[Name, Num] | None = None
+        depends_offset: Num = 0.0
+
+        _lim = field_validator("limits")(_check_limits)
+        _sgn = field_validator("sign", mode="before")(_check_sign)
+
+    class Op(Strict):
+        op: Literal["rx", "ry", "rz", "tx", "ty", "tz", "frame"]
+        value: Num = 0.0
+        name: Name | None = None
+        joint: Literal["revolute", "prismatic", "fixed"] = "fixed"
+        limits: tuple[Num, Num] | None = None
+        sign: Annotated[Sign, StrictInt] = 1
+        depends: dict[Name, Num] | None = None
+        depends_offset: Num = 0.0
+
+        _lim = field_validator("limits")(_check_limits)
+        _sgn = field_validator("sign", mode="before")(_check_sign)
+
+    class Coordinate(Strict):
+        name: Name
+        joint: Literal["revolute", "prismatic"] = "revolute"
+        limits: tuple[Num, Num] | None = None
+
+        _lim = field_validator("limits")(_check_limits)
+
+    class RobotFile(Strict):
+        name: Name
+        source: Annotated[StrictStr, Field(max_length=MAX_SOURCE)] = ""
+        units: Units = Field(default_factory=Units)
+        convention: Literal["standard", "modified", "elementary"] = "standard"
+        joints: list[dict[str, Any]] = Field(min_length=1, max_length=MAX_JOINTS)
+        coordinates: list[Coordinate] | None = Field(default=None,
+                                                     max_length=MAX_JOINTS)
+        base: Placement | None = None
+        tool: Placement | None = None
+        actuators: Any = None
+        geometry: Any = None
+        collision: Any = None
+        controller: Any = None  # a controller profile (robokin.trajectory.io), kept raw
+
+    return RobotFile, Row, Op
+
+
+def _placement(p, L: float, A: float) -> np.ndarray | None:
+    if p is None:
+        return None
+    from robokin.spatial import pose_from_xyz_rpy
+
+    return pose_from_xyz_rpy(np.array(p.xyz) * L, np.array(p.rpy) * A)
+
+
+def _validated(doc: Any, file: Any) -> tuple[Any, list[Any]]:
+    """The validated top level and joint rows (still in file units)."""
+    if not isinstance(doc, Mapping):
+        raise ModelError(
+            f"a robot file must be a mapping of fields, got {type(doc).__name__}",
+            file=file,
+        )
+    RobotFile, Row, Op = _schema()
+    joints = doc.get("joints")
+    if isinstance(joints, list) and len(joints) > MAX_JOINTS:
+        raise ModelError(f"{len(joints):,} rows; a robot file holds at most "
+                         f"{MAX_JOINTS:,}", file=file, field="joints")
+    spec = validate_document(RobotFile, doc, file=file)
+    row_model = Op if spec.convention == "elementary" else Row
+    rows = [validate_document(row_model, r, file=file, prefix=("joints", i))
+            for i, r in enumerate(spec.joints)]
+    return spec, rows
+
+
+def _coordinate_kinds(spec: Any, rows: list[Any]) -> dict[str, str]:
+    """Kinds of the independent coordinates, for unit conversion of 'depends'."""
+    if spec.coordinates is not None:
+        return {c.name: c.joint for c in spec.coordinates}
+    kind_of: dict[str, str] = {}
+    k = 0
+    for r in rows:
+        if r.joint == "fixed":
+            continue
+        k += 1
+        if r.depends is None:
+            kind_of[r.name or f"joint{k}"] = r.joint
+    return kind_of
+
+
+def _si_rows(spec: Any, rows: list[Any], L: float, A: float) -> list[dict[str, Any]]:
+    """The joint rows in SI units, as ``chain_from_dh`` / ``chain_from_elementary``
+    take them."""
+    elementary = spec.convention == "elementary"
+    kind_of = _coordinate_kinds(spec, rows)
+
+    def scale(kind: str) -> float:
+        return L if kind == "prismatic" else A
+
+    out = []
+    for r in rows:
+        d = r.model_dump(exclude_none=True)
+        kind = r.joint
+        if elementary:
+            if r.op == "frame":
+                out.append({"op": "frame"})
+                continue
+            d["value"] = r.value * (A if r.op[0] == "r" else L)
+        else:
+            for key, s in (("a", L), ("d", L), ("alpha", A), ("theta", A)):
+                d[key] = getattr(r, key) * s
+        if r.limits is not None:
+            d["limits"] = [v * scale(kind) for v in r.limits]
+        if r.depends is not None:
+            d["depends"] = {
+                k: v * scale(kind) / scale(kind_of.get(k, kind))
+                for k, v in r.depends.items()
+            }
+            d["depends_offset"] = r.depends_offset * scale(kind)
+        else:
+            d.pop("depends_offset", None)
+        if elementary and kind == "fixed":
+            for key in ("sign", "limits"):
+                d.pop(key, None)
+        out.append(d)
+    return out
+
+
+def _lengths(spec: Any, si_rows: list[dict[str, Any]], L: float
+             ) -> list[tuple[str, float]]:
+    """Every length of the file (field path, value in metres)."""
+    out: list[tuple[str, float]] = []
+    for i, d in enumerate(si_rows):
+        where = f"joints[{i}]"
+        if "op" in d:
+            if d["op"][0] == "t":
+                out.append((f"{where}.value", d["value"]))
+        else:
+            out += [(f"{where}.a", d["a"]), (f"{where}.d", d["d"])]
+        if d.get("joint") == "prismatic" and "limits" in d:
+            out += [(f"{where}.limits", v) for v in d["limits"]]
+    for key in ("base", "tool"):
+        p = getattr(spec, key)
+        if p is not None:
+            out += [(f"{key}.xyz", v * L) for v in p.xyz]
+    return out
+
+
+def _angles(spec: Any, si_rows: list[dict[str, Any]]) -> list[tuple[str, float]]:
+    """Every angle of the chain rows (field path, value in radians)."""
+    out: list[tuple[str, float]] = []
+    for i, d in enumerate(si_rows):
+        where = f"joints[{i}]"
+        if "op" in d:
+            if d["op"][0] == "r":
+                out.append((f"{where}.value", d["value"]))
+        else:
+            out += [(f"{where}.alpha", d["alpha"]), (f"{where}.theta", d["theta"])]
+    return out
+
+
+def _check_lengths(lengths: list[tuple[str, float]], file: Any) -> None:
+    for where, v in lengths:
+        if abs(v) > MAX_TRANSLATION:
+            raise ModelError(f"{v:g} m is beyond the {MAX_TRANSLATION:g} m robokin "
+                             "accepts for a length", file=file, field=where)
+
+
+def _warn_units(doc: Mapping, lengths: list[tuple[str, float]],
+                angles: list[tuple[str, float]], file: Any) -> None:
+    """Without ``units:``, warn when the numbers only make sense in mm or degrees."""
+    if "units" in doc:
+        return
+    hints = []
+    if lengths:
+        where, v = max(lengths, key=lambda wv: abs(wv[1]))
+        if abs(v) > _PLAUSIBLE_LENGTH:
+            hints.append(f"a length of {v:g} m ({where}) suggests millimetres: "
+                         "add 'units: {length: mm}'")
+    if angles:
+        where, v = max(angles, key=lambda wv: abs(wv[1]))
+        if abs(v) > _PLAUSIBLE_ANGLE:
+            hints.append(f"an angle of {v:g} rad ({where}) suggests degrees: "
+                         "add 'units: {angle: deg}'")
+    if hints:
+        name = "the robot file" if file is None else str(file)
+        warnings.warn(f"{name} has no 'units:', so it is read in metres and "
+                      f"radians; {'; '.join(hints)}", UserWarning, stacklevel=4)
+
+
+def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
+    """Build a Robot from a parsed robot-file document (a dict in file units).
+
+    Raises:
+        ModelError: naming ``file``, the field path and the reason.
+    """
+    from robokin.model.dh import chain_from_dh, chain_from_elementary
+    from robokin.robot import Robot
+
+    spec, rows = _validated(doc, file)
+    L = _LENGTH[spec.units.length]
+    A = _ANGLE[spec.units.angle]
+    si_rows = _si_rows(spec, rows, L, A)
+    lengths = _lengths(spec, si_rows, L)
+    _check_lengths(lengths, file)
+    _warn_units(doc, lengths, _angles(spec, si_rows), file)
+    coords = None
+    if spec.coordinates is not None:
+        coords = []
+        for c in spec.coordinates:
+            cd: dict[str, Any] = {"name": c.name, "joint": c.joint}
+            if c.limits is not None:
+                s = L if c.joint == "prismatic" else A
+                cd["limits"] = [v * s for v in c.limits]
+            coords.append(cd)
+    base = _placement(spec.base, L, A)
+    tool = _placement(spec.tool, L, A)
+    try:
+        if spec.convention == "elementary":
+            chain = chain_from_elementary(
+                si_rows, base=base, tool=tool, coordinates=coords
+            )
+        else:
+            chain = chain_from_dh(
+                si_rows, spec.convention, base=base, tool=tool, coordinates=coords
+            )
+    except ModelError as exc:
+        field = (exc.field or "").replace("rows[", "joints[").replace("ops[", "joints[")
+        raise ModelError(exc.reason, file=file, field=field or None) from None
+    meta: dict[str, Any] = {"document": copy.deepcopy(dict(doc))}
+    if spec.controller is not None:
+        # Validated where it is used: robokin.trajectory.io.ControllerProfile.
+        meta["controller"] = copy.deepcopy(spec.controller)
+    robot = Robot(chain, name=spec.name, source=spec.source, path=file, meta=meta)
+    for key, section in SECTIONS.items():
+        value = getattr(spec, key)
+        if value is not None:
+            robot = section.read(robot, value, file, spec.units)
+    # The file's document describes exactly this state; a changed copy (with_tool,
+    # replace(...)) no longer matches it and is written from its model instead.
+    return robot.replace(meta={**robot.meta, "document_state": _state(robot)})
+
+
+def _state(robot: Robot) -> tuple:
+    """What a stored document must still describe: the same objects, by identity."""
+    return (robot.chain, robot.geometry, robot.actuators, robot.name, robot.source,
+            robot.actuator_names, robot.actuator_limits)
+
+
+def _document_matches(robot: Robot) -> bool:
+    state = robot.meta.get("document_state")
+    if state is None:
+        return False
+    now = _state(robot)
+    return all(a is b or (isinstance(a, str) and a == b) for a, b in zip(state, now))
+
+
+def load_robot(path: str | Path, *, max_bytes: int = MAX_TEXT_BYTES,
+               max_nodes: int | None = None) -> Robot:
+    """Load and validate a robot file.
+
+    Args:
+        path: The robot file (YAML).
+        max_bytes: The largest file accepted [bytes].
+        max_nodes: The most YAML values accepted, aliases expanded (default: see
+            :func:`robokin.io.yaml_reader.parse_yaml`).
+
+    Raises:
+        ModelError: the file is missing, too large, binary, not YAML, or fails
+            validation (the message names the file, the line, the field path
+            and the reason).
+    """
+    path = Path(path)
+    ydoc = read_yaml_document(path, max_bytes=max_bytes, max_nodes=max_nodes)
+    try:
+        return robot_from_document(ydoc.data, file=path)
+    except ModelError as exc:
+        raise ydoc.locate(exc) from None
+
+
+def document_from_robot(robot: Robot) -> dict[str, Any]:
+    """The robot-file document of a robot.
+
+    Robots loaded from a file, and not changed since, return that file's document
+    unchanged (units kept). Others (built in code, or changed with ``with_tool``,
+    ``with_base`` or ``replace``) are written as an elementary sequence in SI units
+    that reproduces their canonical chain exactly, with their actuators and
+    geometry.
+    """
+    doc = robot.meta.get("document")
+    if doc is not None and _document_matches(robot):
+        return copy.deepcopy(doc)
+    return _elementary_document(robot)
+
+
+def _elementary_document(robot: Robot) -> dict[str, Any]:
+    """Write any chain as elementary ops (translation xyz then rpy for each constant)."""
+    from robokin.spatial import rpy_from_matrix
+
+    chain = robot.chain
+
+    def const_ops(T: np.ndarray) -> list[dict[str, Any]]:
+        ops: list[dict[str, Any]] = []
+        if np.allclose(T, np.eye(4), atol=1e-15):
+            return ops
+        for ax, v in zip("xyz", T[:3, 3]):
+            if abs(v) > 1e-15:
+                ops.append({"op": f"t{ax}", "value": float(v)})
+        r, p, y = (float(v) for v in rpy_from_matrix(T))
+        for ax, v in (("z", y), ("y", p), ("x", r)):
+            if abs(v) > 1e-15:
+                ops.append({"op": f"r{ax}", "value": v})
+        return ops
+
+    ops: list[dict[str, Any]] = const_ops(chain.head)
+    M, c = chain.coupling.matrix, chain.coupling.offset
+    coord_names = [x.name for x in chain.coordinates]
+    explicit = not chain.coupling.is_identity
+    for k, j in enumerate(chain.joints):
+        op: dict[str, Any] = {
+            "op": "rz" if j.kind == "revolute" else "tz",
+            "joint": j.kind,
+            "name": j.name,
+            "value": j.offset,
+        }
+        if j.sign != 1.0:
+            op["sign"] = -1
+        if explicit:
+            row = M[k]
+            is_self = (
+                j.name in coord_names
+                and row[coord_names.index(j.name)] == 1.0
+                and (np.count_nonzero(row) == 1 and c[k] == 0.0)
+            )
+            if not is_self:
+                op["depends"] = {
+                    coord_names[i]: float(row[i]) for i in np.flatnonzero(row)
+                }
+                op["depends_offset"] = float(c[k])
+        elif all(np.isfinite(j.limits)):
+            op["limits"] = list(j.limits)
+        ops.append(op)
+        F = chain.frame_offsets[k]
+        if np.allclose(F, np.eye(4), atol=1e-15):
+            ops += const_ops(chain.link_offsets[k])
+        else:
+            ops += const_ops(F) + [{"op": "frame"}] + const_ops(chain.link_offsets[k])
+    doc: dict[str, Any] = {
+        "name": robot.name,
+        "source": robot.source,
+        "units": {"length": "m", "angle": "rad"},
+        "convention": "elementary",
+        "joints": ops,
+    }
+    if explicit:
+        doc["coordinates"] = [
+            {
+                "name": x.name,
+                "joint": x.kind,
+                **({"limits": list(x.limits)} if all(np.isfinite(x.limits)) else {}),
+            }
+            for x in chain.coordinates
+        ]
+    for key, section in SECTIONS.items():
+        value = section.write(robot)
+        if value is not None:
+            doc[key] = value
+    for key, T in (("base", chain.base), ("tool", chain.tool)):
+        if not np.allclose(T, np.eye(4), atol=1e-15):
+            doc[key] = {
+                "xyz": [float(v) for v in T[:3, 3]],
+                "rpy": [float(v) for v in rpy_from_matrix(T)],
+            }
+    return doc
+
+
+def save_robot(robot: Robot, path: str | Path) -> Path:
+    """Write the robot file atomically (see :func:`robokin.io.atomic.write_atomic`).
+
+    A failure never leaves a half-written file, and an existing file is replaced
+    only once the new content is complete on disk.
+
+    Raises:
+        InputError: the folder is missing or read-only, or ``path`` is a folder.
+    """
+    import yaml
+
+    text = yaml.safe_dump(
+        document_from_robot(robot), sort_keys=False, default_flow_style=None
+    )
+    return write_atomic(path, text)
