@@ -30,6 +30,7 @@ __all__ = ["Robot"]
 
 Space = Literal["joint", "actuator"]
 _FK_SINGLE = forward.fk_single  # one configuration, or None for the general path
+_F64 = np.dtype(np.float64)
 _HOW_TO_CHANGE = ("make a changed copy with robot.replace(...), robot.with_tool(T) or "
                   "robot.with_base(T)")
 

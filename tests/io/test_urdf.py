@@ -369,13 +369,17 @@ def _chain_urdf(n: int) -> str:
 
 def test_a_urdf_of_thousands_of_joints_is_refused_before_it_is_built(tmp_path):
     from robokin.io.urdf import MAX_URDF_JOINTS
+    from robokin.model.chain_arrays import MAX_JOINTS
 
     path = tmp_path / "long.urdf"
     path.write_text(_chain_urdf(MAX_URDF_JOINTS + 1))
     with pytest.raises(ModelError, match=r"long\.urdf:1: 1,001 <joint> elements; "
                                          r"robokin reads at most 1,000"):
         robot_from_urdf(path)
-    path.write_text(_chain_urdf(MAX_URDF_JOINTS))  # at the cap: read
+    path.write_text(_chain_urdf(MAX_URDF_JOINTS))  # at the cap: read, but a serial
+    with pytest.raises(ModelError, match="1000 joints.*at most 32"):  # chain that long
+        robot_from_urdf(path, geometry=False)  # is more than the kernels take
+    path.write_text(_chain_urdf(MAX_JOINTS))
     robot = robot_from_urdf(path, geometry=False)
-    assert robot.n == MAX_URDF_JOINTS
-    assert robot.fk(np.zeros(robot.n))[2, 3] == pytest.approx(10.0)
+    assert robot.n == MAX_JOINTS
+    assert robot.fk(np.zeros(robot.n))[2, 3] == pytest.approx(10.0 * MAX_JOINTS / 1000)

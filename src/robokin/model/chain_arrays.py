@@ -118,15 +118,15 @@ def _seed_range(lower: np.ndarray, upper: np.ndarray,
     (revolute) or [-1, 1] m (prismatic), else one turn / 2 m centred in them
     (``[-pi, pi]`` or ``[-1, 1]`` when that lies inside); always finite."""
     width = np.where(is_revolute, 2.0 * math.pi, 2.0)
-    lo = np.where(np.isfinite(lower), lower, -np.inf)
-    hi = np.where(np.isfinite(upper), upper, np.inf)
-    centred = (lo <= -0.5 * width) & (hi >= 0.5 * width)
-    mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi),
-                   np.where(np.isfinite(lo), lo + 0.5 * width,
-                            np.where(np.isfinite(hi), hi - 0.5 * width, 0.0)))
+    lo_ok, hi_ok = np.isfinite(lower), np.isfinite(upper)
+    lo = np.where(lo_ok, lower, 0.0)
+    hi = np.where(hi_ok, upper, 0.0)
+    centred = (~lo_ok | (lo <= -0.5 * width)) & (~hi_ok | (hi >= 0.5 * width))
+    mid = np.where(lo_ok & hi_ok, 0.5 * (lo + hi),
+                   np.where(lo_ok, lo + 0.5 * width, np.where(hi_ok, hi - 0.5 * width, 0.0)))
     mid = np.where(centred, 0.0, mid)
-    slo = np.maximum(lo, mid - 0.5 * width)
-    shi = np.minimum(hi, mid + 0.5 * width)
+    slo = np.where(lo_ok, np.maximum(lo, mid - 0.5 * width), mid - 0.5 * width)
+    shi = np.where(hi_ok, np.minimum(hi, mid + 0.5 * width), mid + 0.5 * width)
     return slo, shi
 
 
