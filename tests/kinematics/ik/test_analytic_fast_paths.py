@@ -7,9 +7,18 @@ import numpy as np
 import pytest
 
 import robokin
+from robokin._native import kernels
 from robokin.exceptions import InputError
 from robokin.kinematics.ik.analytic._six_r import _PARALLEL_MIN
-from robokin.kinematics.ik.analytic._subproblems import fatan2
+
+
+def fatan2(y, x):
+    """The 6R kernels' atan2 (csrc/six_r.c) on arrays."""
+    y = np.ascontiguousarray(y, dtype=np.float64)
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    out = np.empty_like(y)
+    kernels.atan2(y, x, out)
+    return out
 
 SIX_R = ["ur5", "aubo_i5", "puma560", "puma560_modified"]
 
@@ -22,8 +31,7 @@ def test_fatan2_matches_libm_to_a_few_ulp():
     # exact octant boundaries and the tan(pi/8) switch point too
     y = np.concatenate([y, [1.0, -1.0, 1.0, math.tan(math.pi / 8), 3.0, -2.0]])
     x = np.concatenate([x, [1.0, 1.0, -1.0, 1.0, 0.0, -0.0]])
-    got = np.array([fatan2(a, b) for a, b in zip(y, x)])
-    assert np.abs(got - np.arctan2(y, x)).max() < 1e-15
+    assert np.abs(fatan2(y, x) - np.arctan2(y, x)).max() < 1e-15
 
 
 @pytest.mark.parametrize(
@@ -32,7 +40,7 @@ def test_fatan2_matches_libm_to_a_few_ulp():
      (math.inf, 1.0), (1.0, -math.inf), (math.nan, 1.0), (1.0, math.nan), (0.0, math.nan)],
 )
 def test_fatan2_special_values_like_libm(y, x):
-    got, want = fatan2(y, x), math.atan2(y, x)
+    got, want = float(fatan2([y], [x])[0]), math.atan2(y, x)
     if math.isnan(want):
         assert math.isnan(got)
     else:
@@ -136,3 +144,83 @@ def test_single_pose_q_near_still_validated(q_near, match):
     T = robot.fk(np.array([0.3, -1.0, 1.2, 0.4, 0.9, -0.5]))
     with pytest.raises(InputError, match=match):
         robot.ik(T, q_near=q_near)
+
+
+@pytest.mark.parametrize(("name", "family"), [("ur5", "THREE_PARALLEL"),
+                                              ("puma560", "SPHERICAL_WRIST")])
+def test_kernel_constants_index_what_pack_writes(name, family):
+    from robokin.kinematics.ik.analytic._geometry import poe_from_chain
+    from robokin.kinematics.ik.analytic._six_r import pack
+
+    K = kernels
+    chain = robokin.load(name).chain
+    kind = "three_parallel" if family == "THREE_PARALLEL" else "spherical_wrist"
+    P = pack(chain, kind, singular_tol=3e-9, disc_tol=7e-12, mirror=True)
+    poe = poe_from_chain(chain)
+    assert P.shape == (K.N_PARAMS,)
+    # the sections tile the vector without overlap
+    sizes = {"AXES": 18, "POINTS": 12, "WRIST": 3, "TOOL_T": 3, "TOOL_R": 9, "PERP": 3,
+             "SIGN": 6, "OFFSET": 6, "LO": 6, "HI": 6}
+    scalars = ["S3", "S4", "SING_TOL", "DISC_TOL", "MIRROR", "A3", "B3", "C3", "PHI3",
+               "CPHI3", "SPHI3", "A5", "B5", "C5", "PHI5", "CPHI5", "SPHI5", "AA", "BB",
+               "FAMILY"]
+    used = np.zeros(K.N_PARAMS, int)
+    for key, size in list(sizes.items()) + [(k, 1) for k in scalars]:
+        used[getattr(K, key):getattr(K, key) + size] += 1
+    assert used.max() == 1 and used[3 * 11:3 * 12].sum() == 0  # 33-35 unused
+    assert used.sum() == K.N_PARAMS - 3
+    # what sits at each index
+    assert P[K.FAMILY] == getattr(K, family)
+    assert (P[K.SING_TOL], P[K.DISC_TOL], P[K.MIRROR]) == (3e-9, 7e-12, 1.0)
+    np.testing.assert_array_equal(P[K.SIGN:K.SIGN + 6], chain.arrays.sign)
+    np.testing.assert_array_equal(P[K.OFFSET:K.OFFSET + 6], chain.arrays.offset)
+    np.testing.assert_array_equal(P[K.LO:K.LO + 6], chain.limits[:, 0])
+    np.testing.assert_array_equal(P[K.HI:K.HI + 6], chain.limits[:, 1])
+    np.testing.assert_array_equal(P[K.POINTS:K.POINTS + 12], poe.o[:4].ravel())
+    np.testing.assert_array_equal(P[K.TOOL_T:K.TOOL_T + 3], poe.M[:3, 3])
+    np.testing.assert_array_equal(P[K.TOOL_R:K.TOOL_R + 9], poe.M[:3, :3].ravel())
+    h = P[K.AXES:K.AXES + 18].reshape(6, 3)
+    np.testing.assert_allclose(np.linalg.norm(h, axis=1), 1.0, atol=1e-15)
+    np.testing.assert_allclose(np.abs(np.einsum("ij,ij->i", h, poe.h)), 1.0, atol=1e-12)
+    assert abs(P[K.PERP:K.PERP + 3] @ h[1 if family == "THREE_PARALLEL" else 3]) < 1e-15
+    assert P[K.S3] == np.sign(h[1] @ h[2]) and abs(P[K.S4]) == 1.0
+    o = P[K.POINTS:K.POINTS + 12].reshape(4, 3)
+    a = o[2] - o[1]
+    b = (o[3] if family == "THREE_PARALLEL" else P[K.WRIST:K.WRIST + 3]) - o[2]
+    assert (P[K.AA], P[K.BB]) == (a @ a, b @ b)
+    for A, B, PHI in ((K.A3, K.B3, K.PHI3), (K.A5, K.B5, K.PHI5)):
+        assert P[PHI] == np.arctan2(P[B], P[A])
+        np.testing.assert_allclose(P[PHI + 1:PHI + 3], [np.cos(P[PHI]), np.sin(P[PHI])],
+                                   atol=1e-15)
+    # the kernel reads the family from the vector: the other family's code is refused
+    bad = P.copy()
+    bad[K.FAMILY] = 2.0
+    with pytest.raises(ValueError, match="6R parameter vector"):
+        kernels.six_r_ik(bad, np.eye(4)[None], np.zeros((1, 6)))
+    assert max(K.STATUS_OK, K.STATUS_OUT_OF_REACH, K.STATUS_NO_ORIENTATION) < K.BAD_POSE
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560"])
+def test_batch_results_do_not_depend_on_thread_count(name):
+    import robokin._native as native
+
+    robot = robokin.load(name)
+    rng = np.random.default_rng(3)
+    q = rng.uniform(-np.pi, np.pi, (3 * _PARALLEL_MIN, 6))
+    q[::7, 4] = 0.0  # wrist singular rows (theta6 from q_near)
+    T = robot.fk(q)
+    before = native.num_threads()
+    try:
+        runs = []
+        for k in (1, 2):
+            assert native.set_num_threads(k) == k
+            runs.append(robot.ik(T, q_near=q))
+    finally:
+        native.set_num_threads(before)
+    one, two = runs
+    assert one.singular.any()
+    np.testing.assert_array_equal(one.q, two.q)
+    np.testing.assert_array_equal(one.valid, two.valid)
+    np.testing.assert_array_equal(one.status, two.status)
+    for flag in ("within_limits", "singular"):
+        np.testing.assert_array_equal(one.flags[flag], two.flags[flag])

@@ -6,16 +6,21 @@ from typing import Any
 
 import numpy as np
 
+from robokin._native import kernels as _K
 from robokin.kinematics.ik.solutions import SolutionSet
 
 __all__ = ["STATUS_TEXT", "fit_turns", "fk_error", "make_set", "q_near_rows"]
 
-STATUS_TEXT = np.array(
-    ["ok", "out of reach", "orientation not achievable",
-     "not reachable: tool cannot tilt",
-     "near-family Newton polish did not converge"],
-    dtype=object,
-)
+# Status code -> text. Codes 0-2 are those the 6R kernels return (csrc/six_r.c);
+# the SCARA and palletizer closed forms use them too. 3: palletizer, 4: near.polish.
+_STATUS = {
+    _K.STATUS_OK: "ok",
+    _K.STATUS_OUT_OF_REACH: "out of reach",
+    _K.STATUS_NO_ORIENTATION: "orientation not achievable",
+    3: "not reachable: tool cannot tilt",
+    4: "near-family Newton polish did not converge",
+}
+STATUS_TEXT = np.array([_STATUS[k] for k in range(len(_STATUS))], dtype=object)
 
 
 def fit_turns(q: np.ndarray, is_revolute: np.ndarray, limits: np.ndarray) -> np.ndarray:

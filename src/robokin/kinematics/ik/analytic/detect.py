@@ -190,11 +190,11 @@ def _six_r_family(chain: Any, poe: Any, name: str, text: str, near: bool, dev: f
             else:
                 P = pack(chain, name, singular_tol=singular_tol, poe=poe)
             params_cache[key] = P
-        return solve_six_r(robot, T, q_near, kind=name, params=P, method=method,
+        return solve_six_r(robot, T, q_near, params=P, method=method,
                            info=info, near=near, compute_error=compute_error, **options)
 
     solver.params = lambda: pack(chain, name, poe=poe)  # type: ignore[attr-defined]
     # the single-pose hot path (default options, exact family only)
     solver.single = None if near else make_single(  # type: ignore[attr-defined]
-        chain, name, pack(chain, name, poe=poe), method=method, info=info)
+        chain, pack(chain, name, poe=poe), method=method, info=info)
     return Family(name, solver, measured=text, near=near, deviation=dev, details=details)
