@@ -1,9 +1,10 @@
 """Build step for robokin's compiled kernels; all metadata lives in pyproject.toml.
 
-One C source (``src/robokin/_native/csrc``) is compiled twice, as two extension
-modules: ``robokin._native._base`` for the compiler's baseline target and
-``robokin._native._avx2`` with AVX2 + FMA (x86-64, GCC or clang). At import
-``robokin._native`` picks the copy the CPU runs. Nothing is compiled at run time.
+One C source (``src/robokin/_native/csrc``) is compiled once per instruction set,
+as separate extension modules: ``robokin._native._base`` for the compiler's
+baseline target and, on x86-64 with GCC or clang, ``_avx2`` (AVX2 + FMA) and
+``_avx512`` (AVX-512 F/DQ/VL). At import ``robokin._native`` picks the copy the CPU
+runs. Nothing is compiled at run time.
 """
 
 import platform
@@ -36,5 +37,7 @@ def extension(name: str, source: str, extra: list[str]) -> Extension:
 modules = [extension("_base", "build_base.c", [])]
 if UNIX and platform.machine().lower() in ("x86_64", "amd64"):
     modules.append(extension("_avx2", "build_avx2.c", ["-mavx2", "-mfma"]))
+    modules.append(extension("_avx512", "build_avx512.c",
+                             ["-mavx512f", "-mavx512dq", "-mavx512vl", "-mavx2", "-mfma"]))
 
 setup(ext_modules=modules)

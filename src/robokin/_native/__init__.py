@@ -1,9 +1,9 @@
 """robokin's compiled kernels: the one C source under ``csrc/``, built at install.
 
-``setup.py`` compiles it twice: ``_base`` (the compiler's baseline target) and
-``_avx2`` (AVX2 + FMA, x86-64 with GCC or clang). :data:`kernels` is the copy this
-CPU runs; set ``ROBOKIN_ISA=baseline`` to force the baseline one. Nothing is
-compiled at run time. ``ROBOKIN_NUM_THREADS`` (or :func:`set_num_threads`) sets
+``setup.py`` compiles it once per instruction set: ``_base`` (the compiler's
+baseline target), ``_avx2`` (AVX2 + FMA) and ``_avx512`` (AVX-512; both x86-64 with
+GCC or clang). :data:`kernels` is the best copy this CPU runs; set ``ROBOKIN_ISA``
+to ``baseline`` or ``avx2`` to force a lesser one. Nothing is compiled at run time. ``ROBOKIN_NUM_THREADS`` (or :func:`set_num_threads`) sets
 how many threads the batch kernels use (default: the CPUs this process may use).
 
 The kernels read a chain's :class:`~robokin.model.chain_arrays.ChainArrays`
@@ -33,6 +33,13 @@ def _pick() -> ModuleType:
     wanted = os.environ.get("ROBOKIN_ISA", "").strip().lower()
     if wanted in ("baseline", "base"):
         return _base
+    if _base.cpu_has_avx512() and wanted not in ("avx2", "avx2+fma"):
+        try:
+            from robokin._native import _avx512
+        except ImportError:  # pragma: no cover - built without the AVX-512 copy
+            pass
+        else:
+            return _avx512
     if _base.cpu_has_avx2_fma():
         try:
             from robokin._native import _avx2

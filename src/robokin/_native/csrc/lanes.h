@@ -9,7 +9,7 @@
  * scalar speed without a second, scalar copy of the formulas.
  *
  * The translation unit is compiled once per instruction set (module.c): baseline
- * (2 lanes: one SSE2 / NEON register) and AVX2 + FMA (4 lanes: one register).
+ * (2 lanes: one SSE2 / NEON register), AVX2 + FMA (4 lanes) and AVX-512 (8 lanes).
  */
 #ifndef ROBOKIN_LANES_H
 #define ROBOKIN_LANES_H
@@ -17,7 +17,9 @@
 #include <math.h>
 
 #ifndef W
-#if defined(__AVX__)
+#if defined(__AVX512F__)
+#define W 8 /* one 512-bit register */
+#elif defined(__AVX__)
 #define W 4 /* one 256-bit register */
 #else
 #define W 2 /* one 128-bit register (SSE2, NEON): wider vectors would be split */

@@ -524,6 +524,21 @@ static PyObject *py_cpu_has_avx2_fma(PyObject *self, PyObject *args)
 #endif
 }
 
+static PyObject *py_cpu_has_avx512(PyObject *self, PyObject *args)
+{
+    (void)self;
+    (void)args;
+#if defined(__GNUC__) && defined(__x86_64__)
+    __builtin_cpu_init();
+    return PyBool_FromLong(__builtin_cpu_supports("avx512f") &&
+                           __builtin_cpu_supports("avx512dq") &&
+                           __builtin_cpu_supports("avx512vl") &&
+                           __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"));
+#else
+    Py_RETURN_FALSE;
+#endif
+}
+
 static PyMethodDef methods[] = {
     {"fk1", (PyCFunction)(void (*)(void))py_fk1, METH_FASTCALL,
      "fk1(q, packed) -> (4, 4) pose, or None when q needs the general path."},
@@ -552,6 +567,8 @@ static PyMethodDef methods[] = {
      "set_num_threads(k) -> k: threads of the pool (1 to 64)."},
     {"cpu_has_avx2_fma", py_cpu_has_avx2_fma, METH_NOARGS,
      "cpu_has_avx2_fma() -> bool: whether this CPU runs the AVX2 + FMA copy."},
+    {"cpu_has_avx512", py_cpu_has_avx512, METH_NOARGS,
+     "cpu_has_avx512() -> bool: whether this CPU runs the AVX-512 copy."},
     SIX_R_METHODS
     BROADPHASE_METHODS
     GENERAL6R_METHODS

@@ -1,0 +1,140 @@
+"""robokin._native: the one compiled source, its copies per instruction set, threads.
+
+Mirrors ``src/robokin/_native``: the packed chain layout parses back to the
+ChainArrays fields, every copy this CPU can run computes the same kinematics (to
+rounding: the copies differ in fused multiply-adds), results do not depend on the
+thread count, and the pool survives a fork.
+"""
+
+from __future__ import annotations
+
+import importlib
+import multiprocessing
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import robokin
+from reference import random_q
+from robokin import _native
+
+ARMS = robokin.robots.names()
+
+
+def _copies():
+    """Every copy of the kernels this CPU can run (name -> module)."""
+    out = {"baseline": _native._base}
+    if _native._base.cpu_has_avx2_fma():
+        out["avx2+fma"] = importlib.import_module("robokin._native._avx2")
+    if _native._base.cpu_has_avx512():
+        out["avx512"] = importlib.import_module("robokin._native._avx512")
+    return out
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_the_packed_layout_parses_back_to_the_chain_arrays(name):
+    arrays = robokin.load(name).chain.arrays
+    parsed = _native.kernels.layout(arrays.packed)
+    assert parsed.pop("n_chain") == arrays.n_chain and parsed.pop("n") == arrays.n
+    assert parsed.pop("identity") == arrays.identity
+    for key, value in parsed.items():
+        np.testing.assert_array_equal(value, getattr(arrays, key), err_msg=key)
+
+
+def test_a_corrupted_layout_is_refused_not_read():
+    packed = robokin.load("panda").chain.arrays.packed
+    bad = packed.copy()
+    bad[1] = 40.0  # more joints than the buffer holds
+    with pytest.raises(ValueError, match="packed"):
+        _native.kernels.layout(bad)
+    with pytest.raises(ValueError, match="packed"):
+        _native.kernels.fk(bad, np.zeros((1, 7)), np.empty((1, 4, 4)))
+
+
+def test_the_best_copy_the_cpu_runs_is_the_one_in_use():
+    copies = _copies()
+    best = list(copies)[-1]
+    assert _native.ISA == best
+    assert copies[best].LANES >= copies["baseline"].LANES
+
+
+@pytest.mark.parametrize("isa", ["baseline", "avx2"])
+def test_robokin_isa_forces_a_lesser_copy(isa):
+    code = "import robokin._native as n; print(n.ISA)"
+    env = dict(os.environ, ROBOKIN_ISA=isa)
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                         text=True, check=True).stdout.strip()
+    expect = {"baseline": "baseline",
+              "avx2": "avx2+fma" if "avx2+fma" in _copies() else "baseline"}[isa]
+    assert out == expect
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_every_copy_computes_the_same_fk_and_jacobians(name, rng):
+    robot = robokin.load(name)
+    Q = np.ascontiguousarray(random_q(robot, rng, 257))  # not a multiple of any W
+    packed = robot.chain.arrays.packed
+    results = {}
+    for isa, mod in _copies().items():
+        T = np.empty((257, 4, 4))
+        J = np.empty((257, 6, robot.n))
+        T2 = np.empty((257, 4, 4))
+        assert mod.fk(packed, Q, T) and mod.jacobian(packed, Q, J, T2)
+        results[isa] = (T, J)
+        np.testing.assert_array_equal(T, T2)  # one chain walk for both
+    ref_T, ref_J = results["baseline"]
+    for T, J in results.values():
+        np.testing.assert_allclose(T, ref_T, rtol=0, atol=1e-14)
+        np.testing.assert_allclose(J, ref_J, rtol=0, atol=1e-13)
+
+
+def test_thread_count_changes_no_bit():
+    robot = robokin.load("panda")
+    Q = random_q(robot, np.random.default_rng(5), 20_000)
+    k = _native.kernels
+    threads = k.num_threads()
+    try:
+        k.set_num_threads(1)
+        one = robot.fk(Q), robot.jacobian(Q[:3000])
+        k.set_num_threads(2)
+        two = robot.fk(Q), robot.jacobian(Q[:3000])
+    finally:
+        k.set_num_threads(threads)
+    np.testing.assert_array_equal(one[0], two[0])
+    np.testing.assert_array_equal(one[1], two[1])
+
+
+def _child_fk(conn):
+    robot = robokin.load("ur5")
+    Q = np.random.default_rng(0).uniform(-1, 1, (50_000, 6))
+    conn.send(float(robot.fk(Q)[:, 0, 3].sum()))
+    conn.close()
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="fork")
+def test_the_thread_pool_survives_a_fork():
+    robot = robokin.load("ur5")
+    Q = np.random.default_rng(0).uniform(-1, 1, (50_000, 6))
+    expect = float(robot.fk(Q)[:, 0, 3].sum())  # the parent's pool has run
+    ctx = multiprocessing.get_context("fork")
+    parent, child = ctx.Pipe()
+    proc = ctx.Process(target=_child_fk, args=(child,))
+    proc.start()
+    assert parent.poll(60), "the forked child did not finish its batch"
+    assert parent.recv() == expect
+    proc.join(10)
+    assert proc.exitcode == 0
+
+
+def test_set_num_threads_clamps_and_reports():
+    k = _native.kernels
+    threads = k.num_threads()
+    try:
+        assert _native.set_num_threads(0) == 1
+        assert _native.set_num_threads(1000) == 64
+        assert _native.set_num_threads(2) == 2 == _native.num_threads()
+    finally:
+        k.set_num_threads(threads)
