@@ -4,7 +4,7 @@ Model an arm (DH, modified DH, virtual frames, elementary sequences, URDF), comp
 where it is, find every way to reach a pose, plan smooth motion, check it against the
 machine it works in, look at it, and hand it to a real controller.
 
-Heavy parts (numba kernels, scipy, pydantic, the optional extras) load lazily, so
+Heavy parts (scipy, pydantic, the optional extras) load lazily, so
 ``import robokin`` stays fast.
 """
 
