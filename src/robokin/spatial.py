@@ -22,11 +22,14 @@ __all__ = [
     "pose_error",
     "pose_from_xyz_rpy",
     "quaternion_from_matrix",
+    "rotation_from_rotvec",
+    "rotvec_from_rotation",
     "rotx",
     "roty",
     "rotz",
     "rpy_from_matrix",
     "trans",
+    "wrap_angle",
     "xyz_rpy_from_pose",
 ]
 
@@ -185,9 +188,34 @@ def matrix_from_axis_angle(rotvec: npt.ArrayLike) -> np.ndarray:
     return _apply(lambda x: _rotation().from_rotvec(x), v, 3)
 
 
+def rotvec_from_rotation(R: npt.ArrayLike) -> np.ndarray:
+    """Rotation vectors (axis times angle [rad], angle in [0, pi]) of rotation
+    matrices; (..., 3, 3) -> (..., 3)."""
+    R = np.asarray(R, dtype=np.float64)
+    lead = R.shape[:-2]
+    if R.size == 0:
+        return np.zeros(lead + (3,))
+    return _rotation().from_matrix(R.reshape(-1, 3, 3)).as_rotvec().reshape(lead + (3,))
+
+
+def rotation_from_rotvec(w: npt.ArrayLike) -> np.ndarray:
+    """Rotation matrices of rotation vectors [rad]; (..., 3) -> (..., 3, 3)."""
+    w = np.asarray(w, dtype=np.float64)
+    lead = w.shape[:-1]
+    if w.size == 0:
+        return np.zeros(lead + (3, 3))
+    return _rotation().from_rotvec(w.reshape(-1, 3)).as_matrix().reshape(lead + (3, 3))
+
+
 def axis_angle_from_matrix(T: npt.ArrayLike) -> np.ndarray:
     """Rotation vector (axis times angle [rad], angle in [0, pi]); (..., 4, 4) -> (..., 3)."""
     return _as("as_rotvec", T)
+
+
+def wrap_angle(a: npt.ArrayLike) -> np.ndarray:
+    """Angles [rad] wrapped into [-pi, pi), same shape."""
+    a = np.asarray(a, dtype=np.float64)
+    return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 
 def pose_error(current: npt.ArrayLike, target: npt.ArrayLike) -> np.ndarray:

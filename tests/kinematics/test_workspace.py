@@ -11,12 +11,11 @@ import pytest
 import robokin
 from robokin.exceptions import InputError
 from robokin.kinematics.workspace import (
-    plot_cross_section,
     random_joints,
     sample_workspace,
-    save_workspace_plots,
     voxel_volume,
 )
+from robokin.viz.plots import plot_cross_section, save_workspace_plots
 
 # SCARA (robot file / its paper): x = c2 cos q1 + c3 cos(q1 + q2), z = c1 + c4 + l4.
 C1, C2, C3, C4 = 0.400, 0.325, 0.275, -0.150

@@ -46,7 +46,6 @@ class _Problem:
         placed = scene.attach(robot)
         self.robot = placed
         geo: RobotGeometry = placed.geometry
-        self.geo = geo
         chain = placed.chain
         self.chain = chain
         nc = chain.n_chain
@@ -79,7 +78,6 @@ class _Problem:
         self.sph_c = np.concatenate(cs) if cs else np.zeros((0, 3))
         self.sph_r = np.concatenate(rs) if rs else np.zeros(0)
         self.sph_owner = np.concatenate(owner) if owner else np.zeros(0, int)
-        self.sph_link = self.link[self.sph_owner] if S else np.zeros(0, int)
         self.sph_start = np.searchsorted(self.sph_owner, np.arange(S)).astype(np.int64)
         self.sph_count = np.bincount(self.sph_owner, minlength=S).astype(np.int64)
         # Largest reach of each shape from its link frame origin.
@@ -142,11 +140,10 @@ class _Problem:
         ]
         # Self pairs are ordered with body_a the lower link (j > i within shapes
         # sorted by link, so link[pa] <= link[pb]).
-        self.obj_pairs = np.flatnonzero(~self.is_self)
         self.self_pairs = np.flatnonzero(self.is_self)
         # Sphere combinations for self pairs (grouped by pair).
-        c1, c2, grp = [], [], []
-        for g, p in enumerate(self.self_pairs):
+        c1, c2 = [], []
+        for p in self.self_pairs:
             i, j = pa[p], pb[p]
             a = np.arange(
                 self.sph_start[i], self.sph_start[i] + np.sum(self.sph_owner == i)
@@ -157,14 +154,8 @@ class _Problem:
             A_, B_ = np.meshgrid(a, b, indexing="ij")
             c1.append(A_.ravel())
             c2.append(B_.ravel())
-            grp.append(np.full(A_.size, g))
         self.self_c1 = np.concatenate(c1) if c1 else np.zeros(0, int)
         self.self_c2 = np.concatenate(c2) if c2 else np.zeros(0, int)
-        grp_arr = np.concatenate(grp) if grp else np.zeros(0, int)
-        self.self_start = np.searchsorted(grp_arr, np.arange(len(self.self_pairs)))
-        self.self_rr = (
-            self.sph_r[self.self_c1] + self.sph_r[self.self_c2] if c1 else np.zeros(0)
-        )
         # Exact geometry: distance functors (meshes: exact BVH and convex hull).
         self.has_mesh = np.zeros(P, dtype=bool)
         self.fn_exact: list[Any] = []

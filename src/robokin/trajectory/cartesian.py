@@ -25,6 +25,12 @@ import numpy.typing as npt
 
 from robokin._validation import check_finite, check_joints, check_transform
 from robokin.exceptions import InputError, RobokinError
+from robokin.spatial import (
+    pose_error,
+    rotation_from_rotvec,
+    rotvec_from_rotation,
+    wrap_angle,
+)
 from robokin.trajectory.joint import time_grid
 from robokin.trajectory.profiles import Profile, get_profile
 from robokin.trajectory.samples import Trajectory
@@ -89,28 +95,6 @@ class PathFollowResult:
 
 
 # ------------------------------------------------------------------ line geometry
-def _rotvec(R: np.ndarray) -> np.ndarray:
-    """Rotation vector (..., 3) of rotation matrices (..., 3, 3), angle in [0, pi]."""
-    from scipy.spatial.transform import Rotation
-
-    lead = R.shape[:-2]
-    return Rotation.from_matrix(R.reshape(-1, 3, 3)).as_rotvec().reshape(lead + (3,))
-
-
-def _exp(w: np.ndarray) -> np.ndarray:
-    """Rotation matrices (..., 3, 3) of rotation vectors (..., 3) (Rodrigues)."""
-    th = np.linalg.norm(w, axis=-1)[..., None, None]
-    K = np.zeros(w.shape[:-1] + (3, 3))
-    K[..., 0, 1], K[..., 0, 2] = -w[..., 2], w[..., 1]
-    K[..., 1, 0], K[..., 1, 2] = w[..., 2], -w[..., 0]
-    K[..., 2, 0], K[..., 2, 1] = -w[..., 1], w[..., 0]
-    small = th < 1e-8
-    ths = np.where(small, 1.0, th)
-    a = np.where(small, 1.0 - th**2 / 6.0, np.sin(ths) / ths)
-    b = np.where(small, 0.5 - th**2 / 24.0, (1.0 - np.cos(ths)) / ths**2)
-    return np.eye(3) + a * K + b * (K @ K)
-
-
 def line_poses(T_start: npt.ArrayLike, T_goal: npt.ArrayLike, s: npt.ArrayLike
                ) -> np.ndarray:
     """Poses along a straight line: position linear in ``s``, orientation by slerp.
@@ -126,9 +110,9 @@ def line_poses(T_start: npt.ArrayLike, T_goal: npt.ArrayLike, s: npt.ArrayLike
     T0 = check_transform(T_start, "T_start")
     T1 = check_transform(T_goal, "T_goal")
     s = np.asarray(s, dtype=np.float64).reshape(-1)
-    w = _rotvec(T0[:3, :3].T @ T1[:3, :3])  # body-frame rotation vector
+    w = rotvec_from_rotation(T0[:3, :3].T @ T1[:3, :3])  # body-frame rotation vector
     out = np.zeros((s.size, 4, 4))
-    out[:, :3, :3] = T0[:3, :3] @ _exp(s[:, None] * w)
+    out[:, :3, :3] = T0[:3, :3] @ rotation_from_rotvec(s[:, None] * w)
     out[:, :3, 3] = T0[:3, 3] + s[:, None] * (T1[:3, 3] - T0[:3, 3])
     out[:, 3, 3] = 1.0
     return out
@@ -136,21 +120,10 @@ def line_poses(T_start: npt.ArrayLike, T_goal: npt.ArrayLike, s: npt.ArrayLike
 
 # --------------------------------------------------------------- path following
 def _err(T: np.ndarray, Tt: np.ndarray, e: np.ndarray) -> float:
-    """Fill ``e`` (6,) with the base-frame pose error current -> target; return its size."""
-    e[:3] = Tt[:3, 3] - T[:3, 3]
-    dR = Tt[:3, :3] @ T[:3, :3].T
-    wx = 0.5 * (dR[2, 1] - dR[1, 2])
-    wy = 0.5 * (dR[0, 2] - dR[2, 0])
-    wz = 0.5 * (dR[1, 0] - dR[0, 1])
-    sn = math.sqrt(wx * wx + wy * wy + wz * wz)
-    c = 0.5 * (dR[0, 0] + dR[1, 1] + dR[2, 2] - 1.0)
-    if c < -0.99:  # near pi: the skew part loses the axis
-        e[3:] = _rotvec(dR)
-    else:
-        th = math.atan2(sn, c)
-        k = 1.0 + th * th / 6.0 if sn < 1e-8 else th / sn
-        e[3], e[4], e[5] = wx * k, wy * k, wz * k
-    return max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]), abs(e[5]))
+    """Fill ``e`` (6,) with the base-frame pose error current -> target
+    (:func:`robokin.spatial.pose_error`); return its largest component."""
+    e[:] = pose_error(T, Tt)
+    return float(np.abs(e).max())
 
 
 def follow_poses(
@@ -328,7 +301,7 @@ def _follow_analytic(robot: Any, Tp: np.ndarray, q0: np.ndarray, times, **kw
                                     f"out of reach: no closed-form solution "
                                     f"({sols.status[k]})", "out_of_reach")
         d = sols.q[k] - prev
-        d = np.where(rev, (d + np.pi) % (2 * np.pi) - np.pi, d)
+        d = np.where(rev, wrap_angle(d), d)
         dn = np.where(valid, np.linalg.norm(d, axis=-1), np.inf)
         Q[k] = prev + d[int(np.argmin(dn))]
         prev = Q[k]
@@ -525,7 +498,7 @@ def cartesian_line(
                 res, reason=f"{res.reason}; the goal itself is unreachable: {hint}"
             )
         raise PathError(res, "the Cartesian line")
-    w_base = T0[:3, :3] @ _rotvec(T0[:3, :3].T @ T1[:3, :3])
+    w_base = T0[:3, :3] @ rotvec_from_rotation(T0[:3, :3].T @ T1[:3, :3])
     axis = np.concatenate([dp, w_base])
     qd, qdd = _rates(robot, res.q, sd[:, None] * axis, sdd[:, None] * axis)
     return Trajectory(t, res.q, qd, qdd, joint_names=robot.joint_names, pose=Tp,

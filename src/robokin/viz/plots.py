@@ -9,7 +9,7 @@ Angles are drawn in degrees and lengths in millimetres unless asked otherwise.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -24,6 +24,7 @@ __all__ = [
     "plot_tool_path",
     "plot_tool_position",
     "save_figure",
+    "plot_cross_section",
     "save_workspace_plots",
 ]
 
@@ -52,10 +53,92 @@ def save_figure(fig: Any, path: str | Path, *, overwrite: bool = False,
     return save_figure_atomic(fig, path, overwrite=overwrite, dpi=dpi)
 
 
+Plane = Literal["xy", "xz", "yz"]
+_AXES = {"x": 0, "y": 1, "z": 2}
+
+
+def _plane_axes(plane: str) -> tuple[int, int, int]:
+    if plane not in ("xy", "xz", "yz"):
+        raise InputError("plane", f"expected 'xy', 'xz' or 'yz', got {plane!r}")
+    a, b = _AXES[plane[0]], _AXES[plane[1]]
+    return a, b, 3 - a - b
+
+
+def plot_cross_section(
+    ws: Any,
+    plane: Plane = "xy",
+    *,
+    at: float | None = None,
+    thickness: float | None = None,
+    color_by: Literal["manipulability", "density"] = "manipulability",
+    ax: Any = None,
+) -> Any:
+    """Plot a slab of the point cloud in a coordinate plane.
+
+    Args:
+        ws: The sampled workspace.
+        plane: ``"xy"`` (top view), ``"xz"`` or ``"yz"`` (side views).
+        at: Position of the slab along the third axis [m]; default the middle
+            of the bounds.
+        thickness: Slab thickness [m]; default 5 % of the extent along the
+            third axis (at least one voxel).
+        color_by: ``"manipulability"`` colours the subset with known
+            manipulability; ``"density"`` draws a 2D histogram of all samples.
+        ax: A matplotlib Axes to draw in; a new figure when None.
+
+    Returns:
+        The matplotlib Axes.
+    """
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots(figsize=(6, 5.5))
+    a, b, c = _plane_axes(plane)
+    lo, hi = ws.bounds[0, c], ws.bounds[1, c]
+    at = 0.5 * (lo + hi) if at is None else float(at)
+    if thickness is None:
+        thickness = max(0.05 * (hi - lo), ws.voxel_size)
+    names = "xyz"
+    if color_by == "manipulability" and ws.manipulability.size:
+        pts = ws.points[ws.manipulability_index]
+        sel = np.abs(pts[:, c] - at) <= 0.5 * thickness
+        if not sel.any():  # a thin arm (e.g. planar): fall back to all of the subset
+            sel = np.ones(len(pts), dtype=bool)
+        sc = ax.scatter(
+            pts[sel, a],
+            pts[sel, b],
+            c=ws.manipulability[sel],
+            s=2,
+            cmap="viridis",
+            linewidths=0,
+        )
+        ax.figure.colorbar(sc, ax=ax, label="manipulability")
+    elif color_by in ("density", "manipulability"):
+        pts = ws.points
+        sel = np.abs(pts[:, c] - at) <= 0.5 * thickness
+        if not sel.any():
+            sel = np.ones(len(pts), dtype=bool)
+        h = ax.hist2d(pts[sel, a], pts[sel, b], bins=120, cmin=1, cmap="magma")
+        ax.figure.colorbar(h[3], ax=ax, label="samples")
+    else:
+        raise InputError(
+            "color_by", f"expected 'manipulability' or 'density', got {color_by!r}"
+        )
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel(f"{names[a]} [m]")
+    ax.set_ylabel(f"{names[b]} [m]")
+    ax.set_title(
+        f"{ws.robot_name}: {plane.upper()} section, "
+        f"{names[c]} = {at:.3f} ± {0.5 * thickness:.3f} m"
+    )
+    ax.grid(True, alpha=0.3)
+    return ax
+
+
 def save_workspace_plots(ws: Any, out_dir: str | Path) -> list[Path]:
     """Write the XY / XZ cross sections (manipulability and density) as PNG files.
 
-    The figures of :func:`robokin.kinematics.workspace.plot_cross_section`, each
+    The figures of :func:`plot_cross_section`, each
     written atomically (an existing file is replaced only once the new one is
     complete).
 
@@ -69,8 +152,6 @@ def save_workspace_plots(ws: Any, out_dir: str | Path) -> list[Path]:
     Raises:
         InputError: ``out_dir`` is not a folder, or a file cannot be written.
     """
-    from robokin.kinematics.workspace import plot_cross_section
-
     out = Path(out_dir)
     if not out.is_dir():
         raise InputError("out_dir", f"{out} is not a folder")

@@ -134,6 +134,12 @@ ALWAYS_INLINE void vsincos(vd x, vd *s, vd *c)
             }
 }
 
+/* An angle wrapped into [-pi, pi) (the one wrap of the C code). */
+static inline double wrap_pi(double x)
+{
+    return x - 2.0 * M_PI * floor((x + M_PI) * (0.5 / M_PI));
+}
+
 /* ---------------------------------------------------------- the chain product */
 
 /* t <- t J(v): rotation by (s, c) about local z, or translation v along it. */

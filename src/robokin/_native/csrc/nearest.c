@@ -15,7 +15,6 @@ static void nearest_rows(const Chain *ch, const double *Q, const unsigned char *
                          long N, int k, double *q, double *err, unsigned char *found)
 {
     const int n = ch->n;
-    const double two_pi = 2.0 * M_PI;
     for (long i = 0; i < N; i++) {
         const double *Qi = Q + (size_t)i * k * n, *qni = qn + (size_t)i * n;
         double *qi = q + (size_t)i * n;
@@ -28,7 +27,7 @@ static void nearest_rows(const Chain *ch, const double *Q, const unsigned char *
             for (int j = 0; j < n; j++) {
                 double x = Qi[r * n + j] - qni[j];
                 if (is_rev[j])
-                    x -= two_pi * floor((x + M_PI) / two_pi);
+                    x = wrap_pi(x);
                 d += x * x;
             }
             if (d < best_d) {
@@ -46,8 +45,7 @@ static void nearest_rows(const Chain *ch, const double *Q, const unsigned char *
         for (int j = 0; j < n; j++) {
             double v = Qi[best * n + j];
             if (is_rev[j]) {
-                double x = v - qni[j];
-                double s = qni[j] + (x - two_pi * floor((x + M_PI) / two_pi));
+                double s = qni[j] + wrap_pi(v - qni[j]);
                 if (s >= ch->lo[j] - 1e-12 && s <= ch->hi[j] + 1e-12)
                     v = s;
             }

@@ -183,8 +183,7 @@ static inline void unit2(double y, double x, double *c, double *s)
 static inline double joint_value(double v, double sign, double offset, double lo,
                                  double hi, int *inside)
 {
-    double q = sign * (v - offset);
-    q -= SR_TWO_PI * floor((q + M_PI) * SR_INV_TWO_PI);
+    double q = wrap_pi(sign * (v - offset));
     double lo_e = lo - 1e-9, hi_e = hi + 1e-9;
     if (q < lo_e || q > hi_e) /* rare: spares the common case wrap_into's division */
         q = wrap_into(q, lo_e, hi_e);

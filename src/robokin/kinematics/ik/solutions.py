@@ -26,16 +26,11 @@ import numpy.typing as npt
 
 from robokin._validation import check_finite, check_joints
 from robokin.exceptions import InputError, UnreachableError
+from robokin.spatial import wrap_angle
 
 __all__ = ["SolutionSet", "wrap_angle"]
 
 STATUS_OK = "ok"
-
-
-def wrap_angle(a: npt.ArrayLike) -> np.ndarray:
-    """Wrap angles [rad] into [-pi, pi)."""
-    a = np.asarray(a, dtype=np.float64)
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
 
 
 @dataclass(frozen=True, eq=False)

@@ -16,18 +16,9 @@ from typing import Any
 import numpy as np
 
 from robokin.kinematics.ik.analytic._common import fit_turns, fk_error, inside_limits
+from robokin.spatial import pose_error, wrap_angle
 
 __all__ = ["polish"]
-
-
-def _rotvec(dR: np.ndarray) -> np.ndarray:
-    """log of rotation matrices (..., 3, 3) -> (..., 3), via scipy."""
-    from scipy.spatial.transform import Rotation
-
-    lead = dR.shape[:-2]
-    if dR.size == 0:
-        return np.zeros(lead + (3,))
-    return Rotation.from_matrix(dR.reshape(-1, 3, 3)).as_rotvec().reshape(lead + (3,))
 
 
 def polish(
@@ -63,9 +54,7 @@ def polish(
         if q.shape[0] == 0:
             break
         J, F = jacobian_and_pose(chain, q)
-        e = np.concatenate(
-            [Tt[:, :3, 3] - F[:, :3, 3],
-             _rotvec(Tt[:, :3, :3] @ np.swapaxes(F[:, :3, :3], -1, -2))], axis=-1)
+        e = pose_error(F, Tt)
         if np.abs(e).max() < 1e-14:
             break
         if n == 6:
@@ -83,7 +72,7 @@ def polish(
     ok = valid & (dp <= tol) & (dr <= tol)
     # merge seeds that converged to the same solution
     diff = Q[..., :, None, :] - Q[..., None, :, :]
-    diff = np.where(chain.is_revolute, (diff + np.pi) % (2 * np.pi) - np.pi, diff)
+    diff = np.where(chain.is_revolute, wrap_angle(diff), diff)
     same = (np.abs(diff).max(axis=-1) < 1e-7) & ok[..., None, :]
     earlier = np.tril(np.ones((k, k), bool), -1)
     dup = (same & earlier).any(axis=-1)

@@ -38,7 +38,7 @@ from robokin.kinematics.ik.analytic._geometry import (
 )
 from robokin.kinematics.ik.analytic.scara import _align_angle, _elbow_angles, _rot
 
-__all__ = ["measure", "pose_from_position_yaw", "solve"]
+__all__ = ["measure", "pose_from_position_yaw"]
 
 NAME = "palletizer"
 
@@ -195,14 +195,3 @@ def solve_geometry(robot: Any, g: PalletizerGeometry, T: np.ndarray, *,
                     status_codes=status, method=method,
                     info=dict(info or {}, level_tolerance=level_tol), error=error)
 
-
-def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, **options: Any):
-    """Every solution for poses T (..., 4, 4); see :func:`robokin.ik.family`."""
-    from robokin.kinematics.ik.analytic.detect import detect
-
-    fam = detect(robot)
-    if fam.name != NAME:
-        from robokin.exceptions import InputError
-
-        raise InputError("robot", f"'{robot.name}' is not a {NAME} arm: {fam.reason}")
-    return fam.solver(robot, T, q_near=q_near, **options)

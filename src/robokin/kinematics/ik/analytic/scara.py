@@ -27,7 +27,7 @@ from robokin.kinematics.ik.analytic._geometry import (
     unit_perpendicular,
 )
 
-__all__ = ["measure", "solve"]
+__all__ = ["measure"]
 
 NAME = "scara"
 
@@ -152,14 +152,3 @@ def solve_geometry(robot: Any, g: ScaraGeometry, T: np.ndarray, *,
                     method=method, info=dict(info or {}, tilt_tolerance=orientation_tol),
                     error=error)
 
-
-def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, **options: Any):
-    """Every solution for poses T (..., 4, 4); see :func:`robokin.ik.family`."""
-    from robokin.kinematics.ik.analytic.detect import detect
-
-    fam = detect(robot)
-    if fam.name != NAME:
-        from robokin.exceptions import InputError
-
-        raise InputError("robot", f"'{robot.name}' is not a {NAME} arm: {fam.reason}")
-    return fam.solver(robot, T, q_near=q_near, **options)

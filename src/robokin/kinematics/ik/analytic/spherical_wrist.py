@@ -20,7 +20,6 @@ References:
 
 from __future__ import annotations
 
-from typing import Any
 
 import numpy as np
 
@@ -30,7 +29,7 @@ from robokin.kinematics.ik.analytic._geometry import (
     closest_point,
 )
 
-__all__ = ["measure", "solve"]
+__all__ = ["measure"]
 
 NAME = "spherical_wrist"
 
@@ -51,17 +50,4 @@ def measure(poe: Poe) -> tuple[float, float, str, str]:
     if angle_between_axes(h[3], h[4]) < 0.1 or angle_between_axes(h[4], h[5]) < 0.1:
         degenerate.append("wrist axes are parallel")
     return ang, dist, text, "; ".join(degenerate)
-
-
-def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None,
-          **options: Any):
-    """Every solution for poses T (..., 4, 4); see :func:`robokin.ik.family`."""
-    from robokin.kinematics.ik.analytic.detect import detect
-
-    fam = detect(robot)
-    if fam.name != NAME:
-        from robokin.exceptions import InputError
-
-        raise InputError("robot", f"'{robot.name}' is not a {NAME} arm: {fam.reason}")
-    return fam.solver(robot, T, q_near=q_near, **options)
 

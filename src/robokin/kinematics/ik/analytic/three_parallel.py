@@ -22,9 +22,7 @@ References:
 
 from __future__ import annotations
 
-from typing import Any
 
-import numpy as np
 
 from robokin.kinematics.ik.analytic._geometry import (
     Poe,
@@ -32,7 +30,7 @@ from robokin.kinematics.ik.analytic._geometry import (
     line_distance,
 )
 
-__all__ = ["measure", "solve"]
+__all__ = ["measure"]
 
 NAME = "three_parallel"
 
@@ -52,15 +50,3 @@ def measure(poe: Poe) -> tuple[float, float, str, str]:
         degenerate.append("axis 5 is parallel to axis 2")
     return ang, dist, text, "; ".join(degenerate)
 
-
-def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None,
-          **options: Any):
-    """Every solution for poses T (..., 4, 4); see :func:`robokin.ik.family`."""
-    from robokin.kinematics.ik.analytic.detect import detect
-
-    fam = detect(robot)
-    if fam.name != NAME:
-        from robokin.exceptions import InputError
-
-        raise InputError("robot", f"'{robot.name}' is not a {NAME} arm: {fam.reason}")
-    return fam.solver(robot, T, q_near=q_near, **options)
