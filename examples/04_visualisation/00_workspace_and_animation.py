@@ -24,7 +24,8 @@ import numpy as np  # noqa: E402
 
 import robokin  # noqa: E402
 from robokin import trajectory  # noqa: E402
-from robokin.kinematics.workspace import sample_workspace, save_workspace_plots  # noqa: E402
+from robokin.kinematics.workspace import sample_workspace  # noqa: E402
+from robokin.viz.plots import save_workspace_plots  # noqa: E402
 from robokin.viz.html import write_html  # noqa: E402
 
 
@@ -37,6 +38,7 @@ def main(out_dir: Path = Path("robokin-examples") / "visualisation") -> None:
         f"SCARA workspace: x {lo[0]:.0f}..{hi[0]:.0f}, y {lo[1]:.0f}..{hi[1]:.0f}, "
         f"z {lo[2]:.0f}..{hi[2]:.0f} mm; volume about {ws.volume:.3f} m^3"
     )
+    out_dir.mkdir(parents=True, exist_ok=True)
     for path in save_workspace_plots(ws, out_dir):
         print("wrote", path)
 

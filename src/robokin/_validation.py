@@ -14,6 +14,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from robokin import _native
 from robokin._text import short_repr
 from robokin.exceptions import InputError
 
@@ -21,14 +22,13 @@ __all__ = [
     "MAX_TRANSLATION",
     "check_finite",
     "check_joints",
-    "check_pose_magnitude",
     "check_transform",
     "check_vector",
 ]
 
-#: Largest translation accepted in a pose, and largest length in a robot file [m].
-#: (1000 km: float64 then still resolves 0.1 nm.)
-MAX_TRANSLATION = 1.0e6
+#: Largest translation accepted in a pose, and largest length in a robot file [m]
+#: (1000 km: float64 then still resolves 0.1 nm). The compiled pose check's bound.
+MAX_TRANSLATION: float = _native.kernels.MAX_TRANSLATION
 
 
 def _real_array(x: npt.ArrayLike, name: str, expected: str) -> np.ndarray:
@@ -90,83 +90,54 @@ def check_finite(x: np.ndarray, name: str) -> np.ndarray:
 def check_transform(T: npt.ArrayLike, name: str = "T") -> np.ndarray:
     """Return ``T`` as a float64 array of shape ``(..., 4, 4)`` holding rigid transforms.
 
+    The test is the compiled one every IK target passes (``chain.h``
+    ``pose_problem``): finite entries, a translation within
+    :data:`MAX_TRANSLATION`, a last row ``[0, 0, 0, 1]`` (to 1e-9), an orthonormal
+    rotation block (to 1e-6) that is not a reflection.
+
     Raises:
-        InputError: not real numbers, wrong shape, non-finite entries, a
-            translation beyond :data:`MAX_TRANSLATION`, a last row other than
-            ``[0, 0, 0, 1]``, or a rotation block that is not orthonormal (1e-6).
-    """
-    T = _real_array(T, name, "a 4x4 matrix")
-    if T.ndim < 2 or T.shape[-2:] != (4, 4):
-        raise InputError(name, f"expected shape (..., 4, 4), got {T.shape}")
-    check_finite(T, name)
-    check_pose_magnitude(T, name)
-    if not np.allclose(T[..., 3, :], [0.0, 0.0, 0.0, 1.0], atol=1e-9):
-        raise InputError(
-            name, "the last row of a homogeneous transform must be 0 0 0 1"
-        )
-    R = T[..., :3, :3]
-    err = np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)).max(initial=0.0)
-    if err > 1e-6:
-        raise InputError(name, f"rotation block is not orthonormal (error {err:.2e})")
-    if (np.linalg.det(R) < 0).any():
-        raise InputError(name, "rotation block is a reflection (determinant -1)")
-    return T
-
-
-_POSE_PROBLEMS = {
-    1: "holds a non-finite value",
-    2: "the last row of a homogeneous transform must be 0 0 0 1",
-    3: "rotation block is not orthonormal (tolerance 1e-6)",
-    4: "rotation block is a reflection (determinant -1)",
-}
-
-
-def check_poses_fast(T: npt.ArrayLike, name: str = "T") -> np.ndarray:
-    """:func:`check_transform` through a compiled kernel, for hot paths (IK).
-
-    Same checks and error messages (naming the offending pose's batch index), at a
-    fraction of the cost for small batches.
+        InputError: not real numbers, a wrong shape, or the first pose that fails
+            the test: what is wrong and the pose's batch index.
     """
     if type(T) is not np.ndarray or T.dtype != np.float64:
         T = _real_array(T, name, "a 4x4 matrix")
     if T.ndim < 2 or T.shape[-2:] != (4, 4):
         raise InputError(name, f"expected shape (..., 4, 4), got {T.shape}")
-    from robokin._native import kernels
-
     flat = np.ascontiguousarray(T).reshape(-1, 4, 4)
-    code, index = kernels.check_poses(flat, 1e-6)
+    code, index = _native.kernels.check_poses(flat, 1e-6)
     if code:
-        where = np.unravel_index(index, T.shape[:-2]) if T.ndim > 2 else ()
-        at = f" (pose {tuple(int(i) for i in where)})" if where else ""
-        raise InputError(name, _POSE_PROBLEMS[int(code)] + at)
-    return check_pose_magnitude(T, name)
-
-
-def check_pose_magnitude(T: np.ndarray, name: str = "T") -> np.ndarray:
-    """Refuse a pose (..., 4, 4) whose translation is finite but beyond
-    :data:`MAX_TRANSLATION` [m]; returns ``T`` (NaN and infinity are left to the
-    finiteness checks, which name them as such).
-
-    Cheap on one pose (three Python floats), so it runs before the compiled
-    single-pose IK.
-
-    Raises:
-        InputError: naming ``name``, the value, the bound and the pose's index.
-    """
-    if T.shape == (4, 4):
-        worst = max(abs(v) if abs(v) != math.inf else 0.0 for v in T[:3, 3].tolist())
-        if worst > MAX_TRANSLATION:
-            raise InputError(name, f"translation {worst:.3g} m is beyond the "
-                             f"{MAX_TRANSLATION:g} m robokin accepts")
-        return T
-    t = np.abs(T[..., :3, 3])
-    bad = (t > MAX_TRANSLATION) & np.isfinite(t)
-    if bad.any():
-        idx = tuple(int(i) for i in np.argwhere(bad)[0][:-1])
-        at = f" (pose {idx})" if idx else ""
-        raise InputError(name, f"translation {float(t[bad].max()):.3g} m is beyond "
-                         f"the {MAX_TRANSLATION:g} m robokin accepts{at}")
+        raise _pose_problem(T, flat[index], name, int(code), int(index))
     return T
+
+
+#: The fast name IK code uses; the same check.
+check_poses_fast = check_transform
+
+
+def _pose_problem(T: np.ndarray, pose: np.ndarray, name: str, code: int,
+                  index: int) -> InputError:
+    """The error for the pose at flat ``index`` that failed with ``code``."""
+    where = np.unravel_index(index, T.shape[:-2]) if T.ndim > 2 else ()
+    at = f" (pose {tuple(int(i) for i in where)})" if where else ""
+    if code == 1:
+        check_finite(T, name)  # raises, naming the entry
+    if code == 5:
+        worst = float(np.abs(pose[:3, 3]).max())
+        return InputError(name, f"translation {worst:.3g} m is beyond the "
+                                f"{MAX_TRANSLATION:g} m robokin accepts{at}")
+    if code == 3:
+        R = pose[:3, :3]
+        err = float(np.abs(R @ R.T - np.eye(3)).max())
+        return InputError(name, f"rotation block is not orthonormal (error {err:.2e}, "
+                                f"tolerance 1e-6){at}")
+    return InputError(name, _POSE_PROBLEMS[code] + at)
+
+
+_POSE_PROBLEMS = {
+    1: "holds a non-finite value",
+    2: "the last row of a homogeneous transform must be 0 0 0 1",
+    4: "rotation block is a reflection (determinant -1)",
+}
 
 
 def check_vector(x: npt.ArrayLike, size: int, name: str) -> np.ndarray:

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-from robokin._validation import check_pose_magnitude, check_transform
+from robokin._validation import check_transform
 from robokin.exceptions import FrozenError, InputError
 from robokin.kinematics import forward
 from robokin.kinematics import jacobian as _jac
@@ -30,7 +30,6 @@ __all__ = ["Robot"]
 
 Space = Literal["joint", "actuator"]
 _FK_SINGLE = forward.fk_single  # one configuration, or None for the general path
-_F64 = np.dtype(np.float64)
 _HOW_TO_CHANGE = ("make a changed copy with robot.replace(...), robot.with_tool(T) or "
                   "robot.with_base(T)")
 
@@ -327,8 +326,6 @@ class Robot:
         """
         from robokin.kinematics.ik import solve
 
-        if type(T) is np.ndarray and T.dtype == _F64 and T.shape[-2:] == (4, 4):
-            check_pose_magnitude(T, "T")  # before any compiled solver sees it
         if space == "actuator":
             if q_near is not None:
                 q_near = self.joints_from_actuators(q_near)

@@ -27,9 +27,9 @@ def test_held_last_joint_solutions_reproduce_the_pose_and_hold_the_value():
 def test_a_sweep_of_the_held_value_is_a_batch():
     robot = robokin.load("panda")
     T = robot.fk(Q0)
-    values = np.linspace(-2.5, 2.5, 9)
+    values = Q0[6] + np.linspace(-0.3, 0.3, 7)  # the self-motion near Q0
     sweep = robot.ik(T, fixed={"joint7": values})
-    assert sweep.shape == (9,)
+    assert sweep.shape == (7,)
     ok = sweep.valid
     assert ok.any(axis=-1).sum() >= 3
     dp, dr = pose_errors(robot.fk(sweep.q[ok]), T)
@@ -37,7 +37,7 @@ def test_a_sweep_of_the_held_value_is_a_batch():
     held = np.broadcast_to(values[:, None], ok.shape)[ok]
     np.testing.assert_array_equal(sweep.q[ok][:, 6], held)
     # the sweep equals held-value calls one at a time
-    for i in (2, 6):
+    for i in (2, 5):
         one = robot.ik(T, fixed={"joint7": values[i]})
         assert one.count == sweep[i].count
 

@@ -372,14 +372,21 @@ ALWAYS_INLINE void pose_residual(const vd *t, const vd *tt, vd *e, vl active)
 
 /* ------------------------------------------------------------ pose checks */
 
+/* Largest translation [m] a pose may have: beyond it float64 kinematics lose every
+ * digit of a sub-millimetre result (robokin._validation.MAX_TRANSLATION reads it). */
+#define MAX_TRANSLATION 1.0e6
+
 /* 0 when T (4x4 row-major) is a rigid transform: 1 a non-finite entry, 2 a last
  * row other than 0 0 0 1 (within row_tol), 3 a rotation block not orthonormal
- * within orth_tol, 4 a reflection. */
+ * within orth_tol, 4 a reflection, 5 a translation beyond MAX_TRANSLATION. */
 static int pose_problem(const double *T, double row_tol, double orth_tol)
 {
     for (int i = 0; i < 16; i++)
         if (!isfinite(T[i]))
             return 1;
+    if (fabs(T[3]) > MAX_TRANSLATION || fabs(T[7]) > MAX_TRANSLATION ||
+        fabs(T[11]) > MAX_TRANSLATION)
+        return 5;
     if (fabs(T[12]) > row_tol || fabs(T[13]) > row_tol || fabs(T[14]) > row_tol ||
         fabs(T[15] - 1.0) > row_tol)
         return 2;

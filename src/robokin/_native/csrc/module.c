@@ -602,6 +602,7 @@ PyMODINIT_FUNC MODULE_INIT(void)
     for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
         PyModule_AddIntConstant(m, ints[i].name, ints[i].value);
     PyModule_AddObject(m, "LAYOUT_TAG", PyFloat_FromDouble(PACKED_TAG));
+    PyModule_AddObject(m, "MAX_TRANSLATION", PyFloat_FromDouble(MAX_TRANSLATION));
     if (six_r_constants(m) < 0 || broadphase_constants(m) < 0 ||
         general6r_constants(m) < 0) {
         Py_DECREF(m);

@@ -53,7 +53,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin import _native
-from robokin._validation import check_finite, check_joints
+from robokin._validation import check_finite, check_joints, check_transform
 from robokin.exceptions import InputError
 from robokin.kinematics.per_chain import cached
 from robokin.model.chain import Chain
@@ -400,16 +400,12 @@ def _bad_input(out: np.ndarray, n: int, Tf: np.ndarray, Q0: np.ndarray,
 
 
 def _bad_target(Tf: np.ndarray, lead: tuple[int, ...], i: int) -> InputError:
-    idx = np.unravel_index(i, lead) if lead else ()
-    T = Tf[i]
-    if not np.isfinite(T).all():
-        why = "holds a non-finite value"
-    elif not np.array_equal(T[3], [0.0, 0.0, 0.0, 1.0]):
-        why = "the last row of a homogeneous transform must be 0 0 0 1"
-    else:
-        why = "the rotation block is not a proper rotation (orthonormal, det +1) to 1e-6"
-    where = f" at index {tuple(int(k) for k in idx)}" if lead else ""
-    return InputError("T", f"target{where}: {why}")
+    """The error naming target ``i`` (flat) the compiled solver refused."""
+    try:
+        check_transform(Tf.reshape(lead + (4, 4)) if lead else Tf[0], "T")
+    except InputError as exc:
+        return exc
+    return InputError("T", f"target {i} is not a rigid transform")  # pragma: no cover
 
 
 # ------------------------------------------------------------------------- solve
