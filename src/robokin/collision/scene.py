@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -60,6 +60,11 @@ def _text(value: Any, file: Any, field: str) -> str:
         raise ModelError(f"expected a name (text, at most 200 characters), got "
                          f"{short_repr(value)}", file=file, field=field)
     return value
+
+
+def _fresh(shape: Shape) -> Shape:
+    """The same declared shape without its caches (coal objects stay behind)."""
+    return replace(shape)
 
 
 def _pose(T: npt.ArrayLike | None, name: str) -> np.ndarray:
@@ -136,6 +141,56 @@ class Scene:
 
     def __repr__(self) -> str:
         return f"Scene(name={self.name!r}, objects={list(self._objects)})"
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickle state: the declared fields, rebuilt from the shapes' declarations.
+
+        The compiled check (coal objects) and the shapes' caches stay behind, so a
+        scene travels to another process (a Dask worker) and compiles afresh there.
+        """
+        state = {k: v for k, v in self.__dict__.items() if k != "_check_cache"}
+        state["_objects"] = {
+            name: SceneObject(obj.name, _fresh(obj.shape))
+            for name, obj in self._objects.items()
+        }
+        if self.tool is not None:
+            state["tool"] = Tool(
+                self.tool.name, self.tool.tcp, tuple(_fresh(s) for s in self.tool.shapes)
+            )
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """Restore a pickled scene (see :meth:`__getstate__`)."""
+        self.__dict__.update(state)
+
+    def with_base(self, pose: npt.ArrayLike) -> Scene:
+        """A copy of the scene with the robot's base frame placed at ``pose`` (4, 4) [m].
+
+        The objects, tool, exclusions and poses are shared (they are immutable);
+        the compiled check is not.
+        """
+        out = Scene.__new__(Scene)
+        out.__dict__.update(
+            {k: v for k, v in self.__dict__.items() if k != "_check_cache"}
+        )
+        out._objects = dict(self._objects)
+        out.exclude = set(self.exclude)
+        out.poses = dict(self.poses)
+        out.pose_joints = dict(self.pose_joints)
+        out.base = _pose(pose, "pose")
+        return out
+
+    def unplaced(self, robot: Robot) -> Robot:
+        """The robot as it was before this scene placed it (itself if it was not)."""
+        placed = robot.meta.get(_PLACED)
+        if (
+            placed is not None
+            and placed[0] is self
+            and placed[1] is robot.chain
+            and placed[2] is robot.geometry
+        ):
+            return placed[3]
+        return robot
 
     # ---------------------------------------------------------------- objects
     @property
@@ -258,14 +313,7 @@ class Scene:
         """
         from robokin.model.geometry import RobotGeometry
 
-        placed = robot.meta.get(_PLACED)
-        if (
-            placed is not None
-            and placed[0] is self
-            and placed[1] is robot.chain
-            and placed[2] is robot.geometry
-        ):
-            robot = placed[3]
+        robot = self.unplaced(robot)
         bare = robot
         geo = robot.geometry if isinstance(robot.geometry, RobotGeometry) else None
         if geo is None:
