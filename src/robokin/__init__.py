@@ -60,12 +60,14 @@ def save(robot: Robot, path: str | Path) -> Path:
 
 
 def __getattr__(name: str) -> Any:
-    # Lazy subpackages: ``robokin.ik``, ``robokin.trajectory``, ``robokin.collision``.
+    # Lazy subpackages: ``robokin.ik``, ``robokin.trajectory``, ``robokin.collision``,
+    # ``robokin.cell``.
     import importlib
 
     if name == "ik":
         return importlib.import_module("robokin.kinematics.ik")
     if name in (
+        "cell",
         "trajectory",
         "collision",
         "robots",

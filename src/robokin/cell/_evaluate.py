@@ -1,0 +1,201 @@
+"""What one Dask task of a reachability map computes: a chunk of voxels.
+
+Everything here is a function of the voxel numbers and the job alone (no state,
+no randomness, nothing that depends on which other voxels share the chunk), so
+a map is the same bit for bit whatever the chunking and wherever it runs:
+
+* the target poses are copied, not computed, from the voxel centres and the
+  orientations;
+* the closed-form IK kernel and the numeric solver give each target the result
+  it gets alone (``tests/native``; the numeric solver is given no random
+  restarts: only its deterministic seed-table restarts);
+* the manipulability is a per-solution determinant and the per-voxel results
+  are maxima and integer sums, which do not depend on order.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from robokin.cell.grid import VoxelGrid
+
+if TYPE_CHECKING:
+    from robokin.collision.scene import Scene
+    from robokin.model.chain import Chain
+    from robokin.robot import Robot
+
+__all__ = ["ReachChunk", "ReachJob", "evaluate_reach", "manipulability", "solve_poses"]
+
+NUMERIC_RESTARTS = 4  # the numeric solver's seed-table restarts (no random ones)
+
+
+@dataclass(frozen=True, eq=False)
+class ReachJob:
+    """What every chunk of a map shares (pickled once into the Dask graph).
+
+    Attributes:
+        robot: The robot as placed in the world (IK targets are world poses).
+        bare: The robot before the scene placed it (for the collision check), or
+            None without a scene.
+        scene: The scene whose objects make a solution invalid, or None.
+        grid: The voxel grid.
+        orientations: Tool orientations (K, 3, 3) in the world.
+        numeric: Solve numerically (one solution per target) instead of in
+            closed form (every solution).
+        with_manipulability: Compute the best manipulability per voxel.
+        store: Path of the Zarr store the chunk writes into, or None to return
+            the arrays.
+    """
+
+    robot: Robot
+    bare: Robot | None
+    scene: Scene | None
+    grid: VoxelGrid
+    orientations: np.ndarray
+    numeric: bool
+    with_manipulability: bool
+    store: str | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class ReachChunk:
+    """The result of one chunk of B voxels.
+
+    Attributes:
+        start: First voxel number.
+        stop: One past the last.
+        counts: Solutions per voxel and orientation (B, K) uint8, or None when
+            written to the store.
+        index: Reachability index per voxel (B,), or None (written).
+        solutions: Solutions per voxel, summed over orientations (B,) int32, or
+            None (written).
+        manipulability: Best manipulability per voxel (B,), or None.
+        reachable_voxels: Voxels with an index above 0.
+    """
+
+    start: int
+    stop: int
+    counts: np.ndarray | None
+    index: np.ndarray | None
+    solutions: np.ndarray | None
+    manipulability: np.ndarray | None
+    reachable_voxels: int
+
+
+def manipulability(chain: Chain, q: np.ndarray) -> np.ndarray:
+    r"""Yoshikawa's manipulability of configurations q (P, n), shape (P,).
+
+    .. math::
+
+        w = \sqrt{\det(J J^T)} = |\det J| \quad (n = 6),
+
+    with :math:`J^T J` in place of :math:`J J^T` for n < 6 (Yoshikawa,
+    "Manipulability of robotic mechanisms", IJRR 4(2), 1985, eq. 9). The
+    determinant form equals :meth:`robokin.Robot.manipulability` (the product
+    of singular values) to rounding at about a sixth of its cost (one LU per
+    matrix instead of an SVD); each row is computed on its own, so chunking
+    changes no bit.
+    """
+    from robokin.kinematics.jacobian import jacobian
+
+    if q.shape[0] == 0:
+        return np.zeros(0)
+    J = jacobian(chain, q)
+    n = J.shape[-1]
+    if n == 6:
+        return np.abs(np.linalg.det(J))
+    Jt = np.swapaxes(J, -1, -2)
+    G = Jt @ J if n < 6 else J @ Jt
+    return np.sqrt(np.maximum(np.linalg.det(G), 0.0))
+
+
+def solve_poses(robot: Robot, T: np.ndarray, numeric: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Every IK solution of poses T (M, 4, 4) inside the joint limits.
+
+    Args:
+        robot: The robot (world frame).
+        T: Target poses (M, 4, 4) [m].
+        numeric: One numeric solution per target (seed-table restarts only)
+            instead of every closed-form solution.
+
+    Returns:
+        ``q`` (M, k, n) [rad, m] and ``ok`` (M, k) bool: a valid solution inside
+        every joint limit (k = 1 for the numeric solver).
+    """
+    if numeric:
+        from robokin.kinematics.ik.numeric import solve
+
+        res = solve(robot, T, max_restarts=NUMERIC_RESTARTS)
+        q = np.asarray(res.q, dtype=np.float64).reshape(T.shape[0], 1, robot.n)
+        ok = np.asarray(res.success, dtype=bool).reshape(-1, 1)
+        ok &= robot.within_limits(q)
+        return q, ok
+    sols = robot.ik(T, method="analytic")
+    return sols.q, sols.within_limits
+
+
+def collision_free(bare: Robot, scene: Scene, q: np.ndarray) -> np.ndarray:
+    """Which configurations touch nothing in the scene (nor the robot itself).
+
+    Each of q (P, n) [rad, m] is judged on its own (no motion between them);
+    returns (P,) bool.
+    """
+    from robokin.collision import check
+
+    free = np.ones(q.shape[0], dtype=bool)
+    if q.shape[0] == 0:
+        return free
+    rep = check(bare, scene, q, subdivide=False)
+    for c in rep.collisions:
+        free[c.first_index : c.last_index + 1] = False
+    return free
+
+
+def poses(job: ReachJob, start: int, stop: int) -> np.ndarray:
+    """Target poses of voxels ``start .. stop - 1`` (B * K, 4, 4): voxel-major."""
+    c = job.grid.centers(start, stop)
+    R = job.orientations
+    B, K = c.shape[0], R.shape[0]
+    T = np.zeros((B, K, 4, 4))
+    T[:, :, :3, :3] = R[None]
+    T[:, :, :3, 3] = c[:, None]
+    T[:, :, 3, 3] = 1.0
+    return T.reshape(B * K, 4, 4)
+
+
+def evaluate_reach(job: ReachJob, start: int, stop: int) -> ReachChunk:
+    """Reachability of voxels ``start .. stop - 1`` in every orientation.
+
+    Returns:
+        A :class:`ReachChunk`; with ``job.store`` its arrays are written into
+        the store (one Zarr chunk each) and left out of the result.
+    """
+    K = job.orientations.shape[0]
+    B = stop - start
+    q, ok = solve_poses(job.robot, poses(job, start, stop), job.numeric)
+    if job.scene is not None and job.bare is not None and ok.any():
+        ok[ok] = collision_free(job.bare, job.scene, q[ok])
+    counts = ok.sum(axis=-1).astype(np.uint8).reshape(B, K)
+    solutions = counts.sum(axis=-1, dtype=np.int32)
+    index = (counts > 0).sum(axis=-1) / K
+    best = None
+    if job.with_manipulability:
+        w = np.zeros(ok.shape)
+        w[ok] = manipulability(job.robot.chain, q[ok])
+        best = w.reshape(B, -1).max(axis=-1)
+    reachable = int(np.count_nonzero(index))
+    if job.store is None:
+        return ReachChunk(start, stop, counts, index, solutions, best, reachable)
+    _write(job.store, start, stop, counts, index, solutions, best)
+    return ReachChunk(start, stop, None, None, None, None, reachable)
+
+
+def _write(store: str, start: int, stop: int, counts: np.ndarray, index: np.ndarray,
+           solutions: np.ndarray, best: np.ndarray | None) -> None:
+    from robokin.cell._store import write_chunk
+
+    write_chunk(store, start, stop, {"counts": counts, "index": index,
+                                     "solutions": solutions, "manipulability": best})

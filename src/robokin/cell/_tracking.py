@@ -1,0 +1,128 @@
+"""Following IK branches along a task, for every candidate base of a chunk at once.
+
+A task is an ordered sequence of N tool poses. A branch is continuous when the
+joint configuration can follow it pose after pose with no step larger than
+``max_step`` and never outside the joint limits. From every solution of the
+first pose one track starts; at each next pose it moves to the solution (of the
+closed form's k) whose nearest equivalent (revolute joints shifted by whole
+turns towards the current value) is closest in the largest joint change, inside
+the limits. A track dies where that step exceeds ``max_step`` (a branch flip,
+a singularity crossed, a limit in the way) or no solution is left.
+
+Arms without a closed form get one track per candidate: a numeric solution of
+the first pose (seed-table restarts), then one damped-least-squares descent per
+pose from the previous configuration (no restarts, so it cannot jump branches).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from robokin.cell._evaluate import NUMERIC_RESTARTS, solve_poses
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
+__all__ = ["Tracks", "track"]
+
+
+@dataclass(frozen=True, eq=False)
+class Tracks:
+    """Branches followed along a task for C candidates, k tracks each.
+
+    Attributes:
+        q: Joint path of every track (C, k, N, n) [rad, m] (NaN where it never
+            started).
+        alive: (C, k) bool: the track reaches the last pose.
+        died_at: (C, k) int: the pose index where the track died (N if alive,
+            0 if it never started).
+        unreached: (C,) int: the first pose without any solution inside the
+            limits (-1 when every pose has one).
+    """
+
+    q: np.ndarray
+    alive: np.ndarray
+    died_at: np.ndarray
+    unreached: np.ndarray
+
+
+def track(robot: Robot, T: np.ndarray, max_step: float, numeric: bool) -> Tracks:
+    """Follow every branch of poses T (C, N, 4, 4) in the robot's world frame.
+
+    Args:
+        robot: The robot (its base at the world origin of ``T``).
+        T: Task poses per candidate (C, N, 4, 4) [m].
+        max_step: Largest joint change between consecutive poses [rad, m].
+        numeric: Follow one numeric track instead of the closed form's branches.
+
+    Returns:
+        The :class:`Tracks`.
+    """
+    if numeric:
+        return _track_numeric(robot, T, max_step)
+    C, N = T.shape[:2]
+    q, ok = solve_poses(robot, np.ascontiguousarray(T.reshape(C * N, 4, 4)), False)
+    k, n = q.shape[-2:]
+    q = q.reshape(C, N, k, n)
+    ok = ok.reshape(C, N, k)
+    unreached = _first_false(np.asarray(ok.any(axis=-1)))
+    rev = np.asarray(robot.is_revolute, dtype=bool)
+    lim = np.asarray(robot.limits)
+    paths = np.full((C, k, N, n), np.nan)
+    cur = q[:, 0].copy()
+    alive = ok[:, 0].copy()
+    died = np.where(alive, N, 0)
+    paths[:, :, 0] = cur
+    for i in range(1, N):
+        # candidate solutions s (C, 1, k, n) against current track values (C, k, 1, n)
+        d = q[:, i][:, None] - cur[:, :, None]
+        d[..., rev] = (d[..., rev] + np.pi) % (2.0 * np.pi) - np.pi
+        s = cur[:, :, None] + d
+        inside = ok[:, i][:, None] & ((s >= lim[:, 0]) & (s <= lim[:, 1])).all(axis=-1)
+        step = np.where(inside, np.abs(d).max(axis=-1), np.inf)
+        j = np.argmin(step, axis=-1)
+        best = np.take_along_axis(step, j[..., None], axis=-1)[..., 0]
+        nxt = np.take_along_axis(s, j[..., None, None], axis=2)[:, :, 0]
+        still = alive & (best <= max_step)
+        died[alive & ~still] = i
+        alive = still
+        cur = np.where(alive[..., None], nxt, cur)
+        paths[:, :, i] = np.where(alive[..., None], cur, np.nan)
+    return Tracks(paths, alive, died, unreached)
+
+
+def _track_numeric(robot: Robot, T: np.ndarray, max_step: float) -> Tracks:
+    from robokin.kinematics.ik.numeric import solve
+
+    C, N = T.shape[:2]
+    n = robot.n
+    paths = np.full((C, 1, N, n), np.nan)
+    first = solve(robot, np.ascontiguousarray(T[:, 0]), max_restarts=NUMERIC_RESTARTS)
+    cur = np.asarray(first.q, dtype=np.float64).reshape(C, n)
+    alive = np.asarray(first.success, dtype=bool).reshape(C) & np.asarray(
+        robot.within_limits(cur))
+    died = np.where(alive, N, 0)
+    unreached = np.where(alive, -1, 0)
+    paths[:, 0, 0] = np.where(alive[:, None], cur, np.nan)
+    for i in range(1, N):
+        if not alive.any():
+            break
+        res = solve(robot, np.ascontiguousarray(T[:, i]), q0=cur, max_restarts=0)
+        q = np.asarray(res.q, dtype=np.float64).reshape(C, n)
+        ok = (np.asarray(res.success, dtype=bool).reshape(C) & robot.within_limits(q)
+              & (np.abs(q - cur).max(axis=-1) <= max_step))
+        still = alive & ok
+        died[alive & ~still] = i
+        alive = still
+        cur = np.where(alive[:, None], q, cur)
+        paths[:, 0, i] = np.where(alive[:, None], cur, np.nan)
+    return Tracks(paths, alive[:, None], died[:, None], unreached)
+
+
+def _first_false(mask: np.ndarray) -> np.ndarray:
+    """(C,) index of the first False along the last axis of (C, N), -1 if none."""
+    bad = ~mask
+    return np.where(bad.any(axis=-1), np.argmax(bad, axis=-1), -1)

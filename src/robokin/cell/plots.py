@@ -1,0 +1,234 @@
+"""Cell-design figures: sections through a reachability map, placements on the floor.
+
+Sections are the classic capability-map picture (Zacharias et al., IROS 2007):
+a plane of voxels coloured by reachability index from blue (few orientations)
+to red (every orientation), unreachable voxels left blank. The floor map shows
+each candidate base position coloured by its placement score, infeasible ones
+in grey by reason. Lengths are drawn in millimetres.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+
+from robokin.exceptions import InputError
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from robokin.cell.placement import Placement
+    from robokin.cell.reach_map import ReachMap
+
+__all__ = ["plot_floor", "plot_sections"]
+
+_LABELS = {
+    "index": "reachability index",
+    "manipulability": "best manipulability",
+    "solutions": "IK solutions in the voxel",
+}
+
+
+def _figure(size: tuple[float, float]) -> Figure:
+    from robokin.viz.plots import _figure as figure
+
+    fig: Figure = figure(size)
+    return fig
+
+
+def _densest_layer(m: ReachMap, k: int) -> float:
+    """Coordinate [m] of the layer normal to axis k with the largest summed index."""
+    cube = m.as_grid(np.asarray(m.index[...]))
+    other = tuple(i for i in range(3) if i != k)
+    return float(m.grid.axis(k)[int(np.argmax(cube.sum(axis=other)))])
+
+
+def plot_sections(
+    m: ReachMap,
+    *,
+    path: str | Path | None = None,
+    quantity: Literal["index", "manipulability", "solutions"] = "index",
+    sections: Sequence[tuple[str, float]] | None = None,
+    overwrite: bool = True,
+) -> Figure:
+    """Sections through a reachability map as heatmaps.
+
+    Args:
+        m: The map.
+        path: Save the figure here (``.png``, ``.svg``, ``.pdf``), atomically.
+        quantity: ``"index"``, ``"manipulability"`` or ``"solutions"``.
+        sections: ``[(axis, at [m]), ...]`` planes normal to ``axis``; default
+            the x-z plane through the robot's base and the x-y plane through
+            the layer with the most reachability.
+        overwrite: Replace an existing file at ``path``.
+
+    Returns:
+        The matplotlib figure.
+
+    Raises:
+        InputError: an unknown quantity or axis, or no manipulability in the map.
+    """
+    if sections is None:
+        y = float(m.base[1, 3]) if m.base is not None else _densest_layer(m, 1)
+        sections = [("y", y), ("z", _densest_layer(m, 2))]
+    if not sections:
+        raise InputError("sections", "expected at least one (axis, at) pair")
+    fig = _figure((5.2 * len(sections) + 1.0, 5.0))
+    label = _LABELS.get(quantity, quantity)
+    vmax = 1.0 if quantity == "index" else None
+    image = None
+    for i, (axis, at) in enumerate(sections):
+        values, ext = m.section(axis, float(at), quantity)  # type: ignore[arg-type]
+        shown = np.ma.masked_less_equal(values.T.astype(float), 0.0)
+        ax = fig.add_subplot(1, len(sections), i + 1)
+        u, v = [c for c in "xyz" if c != axis]
+        image = ax.imshow(
+            shown,
+            origin="lower",
+            extent=(ext[0, 0] * 1e3, ext[1, 0] * 1e3, ext[0, 1] * 1e3, ext[1, 1] * 1e3),
+            cmap="jet",
+            vmin=0.0,
+            vmax=vmax,
+            interpolation="nearest",
+        )
+        ax.set_facecolor("0.93")
+        ax.set_xlabel(f"{u} [mm]")
+        ax.set_ylabel(f"{v} [mm]")
+        ax.set_aspect("equal")
+        ax.set_title(f"{axis} = {float(at) * 1e3:.0f} mm")
+    if image is not None:
+        fig.colorbar(image, ax=fig.axes, label=label, shrink=0.85)
+    fig.suptitle(
+        f"{m.robot_name}: {label}, {m.grid.voxel * 1e3:g} mm voxels, "
+        f"{m.orientations.shape[0]} orientations"
+    )
+    if path is not None:
+        from robokin.viz.plots import save_figure
+
+        save_figure(fig, path, overwrite=overwrite)
+    return fig
+
+
+_REASON_COLOURS = {
+    "out of reach": "0.80",
+    "no continuous branch": "0.62",
+    "collision": "#e8a3a3",
+    "clearance": "#f2cf9b",
+    "manipulability": "#c9c3e6",
+}
+
+
+def _category(reason: str) -> str:
+    for key in _REASON_COLOURS:
+        if reason.startswith(key):
+            return key
+    return "out of reach"
+
+
+def plot_floor(
+    pl: Placement,
+    *,
+    path: str | Path | None = None,
+    scene: Any = None,
+    mark: Any = None,
+    overwrite: bool = True,
+) -> Figure:
+    """The candidate bases seen from above, coloured by placement score.
+
+    Each (x, y) cell shows the best candidate standing there (over heights and
+    yaws): feasible ones coloured by score, infeasible ones in grey tones by
+    reason. The best placement is starred.
+
+    Args:
+        pl: The placement search result.
+        path: Save the figure here (``.png``, ``.svg``, ``.pdf``), atomically.
+        scene: Draw the footprints of this scene's boxes.
+        mark: An extra base pose (4, 4) to mark with a ring (e.g. the cell's
+            current placement).
+        overwrite: Replace an existing file at ``path``.
+
+    Returns:
+        The matplotlib figure.
+    """
+    from matplotlib.colors import Normalize
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Rectangle
+
+    xy = pl.candidates[:, :2, 3]
+    keys = np.round(xy, 9)
+    cells, inverse = np.unique(keys, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    order = np.lexsort((-pl.score, ~pl.feasible))  # feasible first, best score first
+    pick = np.full(len(cells), -1)
+    for c in order[::-1]:
+        pick[inverse[c]] = c
+    step = _grid_step(cells)
+    fig = _figure((7.5, 6.2))
+    ax = fig.add_subplot(1, 1, 1)
+    feasible_scores = pl.score[pl.feasible]
+    norm = Normalize(0.0, float(feasible_scores.max()) if feasible_scores.size else 1.0)
+    import matplotlib as mpl
+
+    cmap = mpl.colormaps["viridis"]
+    for cell, c in zip(cells, pick):
+        colour = (cmap(norm(pl.score[c])) if pl.feasible[c]
+                  else _REASON_COLOURS[_category(str(pl.reason[c]))])
+        ax.add_patch(Rectangle(((cell[0] - step / 2) * 1e3, (cell[1] - step / 2) * 1e3),
+                               step * 1e3, step * 1e3, fc=colour, ec="white", lw=0.5))
+    if scene is not None:
+        _draw_footprints(ax, scene)
+    handles = [Line2D([], [], ls="", marker="s", ms=9, color=col, label=key)
+               for key, col in _REASON_COLOURS.items()]
+    if pl.best_index is not None:
+        b = pl.candidates[pl.best_index, :2, 3] * 1e3
+        ax.plot(b[0], b[1], marker="*", ms=16, color="gold", mec="black", ls="")
+        handles.append(Line2D([], [], ls="", marker="*", ms=12, color="gold", mec="black",
+                              label="best"))
+    if mark is not None:
+        p = np.asarray(mark, dtype=float)[:2, 3] * 1e3
+        ax.plot(p[0], p[1], marker="o", ms=14, mfc="none", mec="red", mew=2, ls="")
+        handles.append(Line2D([], [], ls="", marker="o", ms=10, mfc="none", mec="red",
+                              label="current base"))
+    lo, hi = cells.min(axis=0) - step, cells.max(axis=0) + step
+    ax.set_xlim(lo[0] * 1e3, hi[0] * 1e3)
+    ax.set_ylim(lo[1] * 1e3, hi[1] * 1e3)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm]")
+    sm = mpl.cm.ScalarMappable(norm=norm, cmap=cmap)
+    fig.colorbar(sm, ax=ax, label="score: smallest manipulability along the task",
+                 shrink=0.85)
+    ax.legend(handles=handles, fontsize=7, loc="upper left", framealpha=0.85)
+    n_ok = int(pl.feasible.sum())
+    ax.set_title(f"robot bases: {n_ok} of {len(pl.feasible)} feasible")
+    if path is not None:
+        from robokin.viz.plots import save_figure
+
+        save_figure(fig, path, overwrite=overwrite)
+    return fig
+
+
+def _grid_step(cells: np.ndarray) -> float:
+    steps = []
+    for k in range(2):
+        u = np.unique(cells[:, k])
+        if u.size > 1:
+            steps.append(float(np.min(np.diff(u))))
+    return min(steps) if steps else 0.1
+
+
+def _draw_footprints(ax: Any, scene: Any) -> None:
+    from matplotlib.patches import Rectangle
+
+    for obj in scene.objects:
+        if obj.shape.kind != "box":
+            continue
+        c = obj.pose[:3, 3] * 1e3
+        s = np.abs(obj.pose[:3, :3]) @ (np.asarray(obj.shape.size) * 1e3)
+        ax.add_patch(Rectangle((c[0] - s[0] / 2, c[1] - s[1] / 2), s[0], s[1],
+                               fc="none", ec="0.3", lw=0.8, ls="--"))
+        ax.text(c[0], c[1], obj.name[:24], fontsize=6, ha="center",
+                va="center", color="0.3", clip_on=True)

@@ -1,0 +1,165 @@
+"""Placement search: the demo's base is feasible, bad bases are rejected for the
+right reason, the best one gets the full check, bad input is named (issue 16)."""
+
+import math
+
+import numpy as np
+import pytest
+
+import robokin
+from robokin import cell
+from robokin.exceptions import InputError, UnreachableError
+
+pytest.importorskip("dask")
+pytest.importorskip("coal")
+
+
+def assert_same(x, y, what):
+    """Equal bit for bit (NaN where NaN)."""
+    assert x.dtype == y.dtype and np.array_equal(x, y, equal_nan=x.dtype.kind == "f"), what
+
+
+@pytest.fixture(scope="module")
+def press():
+    from robokin import collision
+    from robokin.demo import placement_task, plan_press_loading
+
+    scene = collision.Scene.load(collision.scene_path("press"))
+    bare = robokin.load("aubo_i5")
+    traj, _ = plan_press_loading(scene.attach(bare), scene)
+    return bare, scene, placement_task(traj, every=20)
+
+
+@pytest.fixture(scope="module")
+def three_bases(press):
+    bare, scene, task = press
+    # the demo's base; far behind the robot (the press out of reach); against the
+    # pick table (the base inside it)
+    cand = cell.base_grid([0.0], [0.0])
+    cand = np.concatenate([cand, cell.base_grid([-1.2], [0.0]), cell.base_grid([0.0], [0.3])])
+    return cell.place(bare, task, cand, scene=scene, clearance=0.004)
+
+
+def test_the_demos_own_placement_is_feasible(press, three_bases):
+    pl = three_bases
+    assert pl.feasible[0] and pl.reason[0] == "ok"
+    assert pl.clearance[0] >= 0.004 and pl.score[0] == pl.manipulability[0] > 0
+    assert pl.best_index == 0
+    np.testing.assert_array_equal(pl.best, np.eye(4))
+    # the full check: subdivision between samples, along the chosen branch
+    rep = pl.best_report
+    assert rep is not None and not rep.collides and rep.min_distance >= 0.004
+    bare, scene, task = press
+    np.testing.assert_allclose(scene.attach(bare).fk(pl.best_q), task, atol=1e-9)
+
+
+def test_a_base_that_puts_the_press_out_of_reach_is_rejected(three_bases):
+    pl = three_bases
+    assert not pl.feasible[1] and not pl.reachable[1]
+    assert pl.reason[1].startswith("out of reach: task pose")
+    assert pl.score[1] == 0 and math.isnan(pl.clearance[1])
+
+
+def test_a_base_in_collision_is_rejected(three_bases):
+    pl = three_bases
+    assert pl.reachable[2] and not pl.feasible[2]
+    assert pl.reason[2].startswith("collision: base–table")
+    assert pl.clearance[2] <= 0
+
+
+def test_a_larger_clearance_than_the_cell_has_rejects_the_base(press):
+    bare, scene, task = press
+    pl = cell.place(bare, task, np.eye(4), scene=scene, clearance=0.05)
+    assert not pl.feasible[0] and pl.reason[0].startswith("clearance:")
+    with pytest.raises(UnreachableError, match="no feasible placement among 1"):
+        _ = pl.best
+
+
+def test_ranking_output_and_chunking(press, tmp_path):
+    bare, scene, task = press
+    cand = cell.base_grid([-0.2, -0.1, 0.0], [0.0, 0.1, 0.2])
+    a = cell.place(bare, task, cand, scene=scene, clearance=0.004)
+    b = cell.place(bare, task, cand, scene=scene, clearance=0.004, chunk=1,
+                   scheduler="synchronous")
+    for f in ("feasible", "score", "reachable", "clearance", "manipulability", "branch"):
+        assert_same(getattr(a, f), getattr(b, f), f)
+    r = a.ranking
+    assert r.size == a.feasible.sum() >= 3 and r[0] == a.best_index
+    assert (np.diff(a.score[r]) <= 0).all()
+    a.write_csv(tmp_path / "p.csv")
+    rows = (tmp_path / "p.csv").read_text().splitlines()
+    assert len(rows) == 1 + len(cand) and rows[1].startswith("1,")
+    a.plot_floor(tmp_path / "floor.png", scene=scene, mark=np.eye(4))
+    assert (tmp_path / "floor.png").stat().st_size > 10_000
+    s = a.summary()
+    assert s["feasible"] == r.size and s["best"]["index"] == a.best_index
+
+
+def test_without_a_scene_only_reach_and_manipulability_count():
+    ur5 = robokin.load("ur5")
+    q = np.radians([[0, -60, 80, -20, 90, 0], [5, -55, 75, -20, 90, 0],
+                    [10, -50, 70, -20, 90, 0]])
+    task = ur5.fk(q)
+    pl = cell.place(ur5, task, cell.base_grid([0.0, 0.05], [0.0]))
+    assert pl.feasible.all() and np.isinf(pl.clearance).all()
+    # from the robot's own base, the branch that produced the task is among those found
+    assert pl.manipulability[0] >= ur5.manipulability(q).min() - 1e-12
+    strict = cell.place(ur5, task, np.eye(4), min_manipulability=10.0)
+    assert strict.reason[0].startswith("manipulability:")
+
+
+def test_a_branch_flip_is_not_a_continuous_branch():
+    ur5 = robokin.load("ur5")
+    up = np.radians([0, -60, 80, -20, 90, 0])
+    down = ur5.ik(ur5.fk(up)).q  # every branch of the same pose
+    flip = next(qb for qb in down if np.abs(qb - up).max() > 1.0)
+    T = ur5.fk(np.array([up, up, flip]))  # the same pose three times
+    pl = cell.place(ur5, T, np.eye(4))
+    assert pl.feasible[0]  # one branch holds still: no flip needed
+    far = ur5.fk(np.radians([[0, -60, 80, -20, 90, 0], [120, -100, 30, 60, 10, 90]]))
+    jump = cell.place(ur5, far, np.eye(4), max_step=math.radians(5))
+    assert not jump.feasible[0] and jump.reason[0].startswith("no continuous branch")
+    assert cell.place(ur5, far, np.eye(4), max_step=math.inf).feasible[0]  # a set of poses
+
+
+def test_an_unreachable_task_names_the_task(press):
+    bare, scene, task = press
+    far = task.copy()
+    far[-1, 2, 3] += 5.0  # one pose 5 m up: no base spans it
+    with pytest.raises(InputError, match="argument 'task'.*more than twice the arm's reach"):
+        cell.place(bare, far, np.eye(4), scene=scene)
+    high = task[:3].copy()
+    high[:, 2, 3] += 1.2  # within the span, but from none of these bases
+    with pytest.raises(InputError, match="argument 'task'.*no candidate base reaches every.*pose 0"):
+        cell.place(bare, high, cell.base_grid([0.0, 0.1], [0.0]), scene=scene)
+
+
+@pytest.mark.parametrize(("kwargs", "argument"), [
+    ({"candidates": np.zeros((0, 4, 4))}, "candidates"),
+    ({"candidates": np.ones((2, 3))}, "candidates"),
+    ({"clearance": -0.001}, "clearance"),
+    ({"clearance": math.nan}, "clearance"),
+    ({"max_step": 0.0}, "max_step"),
+    ({"min_manipulability": -1.0}, "min_manipulability"),
+    ({"task": np.zeros((0, 4, 4))}, "task"),
+    ({"task": np.ones((2, 4, 4))}, "task"),
+    ({"scheduler": 42}, "scheduler"),
+])
+def test_bad_input_names_the_argument(kwargs, argument):
+    ur5 = robokin.load("ur5")
+    args = {"task": ur5.fk(np.zeros(6)), "candidates": np.eye(4), **kwargs}
+    with pytest.raises(InputError, match=f"argument '{argument}'"):
+        cell.place(ur5, **args)
+
+
+def test_base_grid_combines_every_axis():
+    g = cell.base_grid([0.0, 1.0], [2.0, 3.0, 4.0], z=0.5, yaw=[0.0, math.pi / 2])
+    assert g.shape == (12, 4, 4)
+    np.testing.assert_allclose(g[1, :3, 3], [0.0, 2.0, 0.5])
+    np.testing.assert_allclose(g[1, :3, :3], [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-15)
+    np.testing.assert_allclose(g[-1, :3, 3], [1.0, 4.0, 0.5])
+    with pytest.raises(InputError, match="argument 'y'"):
+        cell.base_grid([0.0], [])
+    rows = cell.place(robokin.load("ur5"), robokin.load("ur5").fk(np.zeros(6)),
+                      [[0.0, 0.0, 0.0, 0.0]])
+    assert rows.feasible[0]
