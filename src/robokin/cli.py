@@ -196,6 +196,12 @@ def demo(
     force: Annotated[
         bool, typer.Option("--force", help="Write into a folder holding other files.")
     ] = False,
+    place: Annotated[
+        bool, typer.Option("--place", help="Also map the feasible robot bases (robokin[scale]).")
+    ] = False,
+    scheduler: Annotated[
+        str | None, typer.Option(help="Dask scheduler address for --place (default: this machine).")
+    ] = None,
 ) -> None:
     """The main job: the AUBO-i5 loads a press (plan, check, plots, HTML report).
 
@@ -205,7 +211,7 @@ def demo(
     from robokin.demo import run_demo
 
     result = run_demo(out=out, clearance_mm=clearance, view=view, force=force,
-                      console=_console())
+                      console=_console(), place=place, scheduler=scheduler)
     if not result.ok:
         raise DomainFailure("the plan is not collision-free with the required clearance "
                             "(see the report)")
@@ -223,6 +229,7 @@ def _register_extra_commands() -> None:
         "robokin.cli_view",
         "robokin.cli_actuators",
         "robokin.cli_workspace",
+        "robokin.cli_cell",
     ):
         try:
             importlib.import_module(mod)

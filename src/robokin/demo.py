@@ -25,6 +25,12 @@ body pairs over time), ``animation.html`` (the
 motion, self-contained), ``report.html`` (one page with all of it) and
 ``summary.json``. The command exits 0 only when the plan is collision-free with at
 least the required clearance.
+
+With ``--place`` it also asks where else the arm could stand: robot bases on a
+100 mm floor grid within 400 mm of the cell's base are scored for the same motion
+(:func:`robokin.cell.place`: one continuous IK branch, joint limits, clearance,
+manipulability) and ``placement.png`` maps the feasible ones (``placement.csv``
+lists them all); the cell's own base must come out feasible.
 """
 
 from __future__ import annotations
@@ -138,6 +144,49 @@ def plan_press_loading(
         path.joint(q, duration, label=label)
     traj = path.build(progress=progress)
     return traj, via
+
+
+# Placement search (``--place``): candidate bases every PLACE_STEP within
+# PLACE_SPAN of the cell's base in x and y; the task is the motion after the first
+# move (from home, a configuration and not a task pose), every PLACE_EVERY-th sample.
+PLACE_SPAN = 0.4  # [m]
+PLACE_STEP = 0.1  # [m]
+PLACE_EVERY = 10  # samples (50 ms)
+
+
+def placement_task(traj: Any, every: int = PLACE_EVERY) -> np.ndarray:
+    """The tool poses (N, 4, 4) [m] the arm must reach wherever it stands.
+
+    The press-loading motion from the end of its first move (from home) on, every
+    ``every``-th sample.
+    """
+    first = traj.via_times[1] if len(traj.via_times) > 1 else traj.t[0]
+    return np.ascontiguousarray(traj.pose[traj.t >= first - 1e-9][::every])
+
+
+def search_placement(bare: Any, scene: Any, traj: Any, *, clearance: float,
+                     scheduler: Any = None, progress: Any = None) -> Any:
+    """Score robot bases on a floor grid around the cell's base for the motion.
+
+    Returns:
+        A :class:`robokin.cell.Placement`; the cell's own base is a candidate.
+    """
+    from robokin import cell
+
+    offsets = np.arange(-PLACE_SPAN, PLACE_SPAN + 1e-9, PLACE_STEP)
+    base = scene.base
+    yaw = math.atan2(base[1, 0], base[0, 0])
+    candidates = cell.base_grid(base[0, 3] + offsets, base[1, 3] + offsets, base[2, 3], yaw)
+    return cell.place(bare, placement_task(traj), candidates, scene=scene,
+                      clearance=clearance, scheduler=scheduler, progress=progress)
+
+
+def _placement_summary(pl: Any, scene: Any) -> dict[str, Any]:
+    own = int(np.argmin(np.linalg.norm(pl.candidates[:, :3, 3] - scene.base[:3, 3],
+                                       axis=1)))
+    return {**pl.summary(), "cell_base_feasible": bool(pl.feasible[own]),
+            "cell_base_reason": str(pl.reason[own]),
+            "cell_base_score": float(pl.score[own])}
 
 
 def _check_out_dir(out: Path, force: bool) -> None:
@@ -408,6 +457,8 @@ def run_demo(
     force: bool = False,
     console: Any = None,
     html_animation: bool = True,
+    place: bool = False,
+    scheduler: Any = None,
 ) -> DemoResult:
     """Run the press-loading demo end to end and write its outputs.
 
@@ -419,6 +470,11 @@ def run_demo(
         force: Write into a folder that holds other files.
         console: A rich Console for the terminal summary (default: a new one).
         html_animation: Also write ``animation.html``.
+        place: Also search the floor around the cell's base for robot placements
+            that run the same task (``placement.png``: the map of feasible bases,
+            ``placement.csv``; needs ``robokin[scale]``).
+        scheduler: Where the placement search runs (None: this machine; a Dask
+            scheduler address or client).
 
     Returns:
         A :class:`DemoResult`; ``ok`` is True only when the plan is collision-free
@@ -477,6 +533,18 @@ def run_demo(
         )  # attaches itself
         bar.update(task, advance=1)
         timings["check"] = time.perf_counter() - t
+
+        placement = None
+        if place:
+            t = time.perf_counter()
+            task = bar.add_task("scoring robot placements", total=None)
+            placement = search_placement(
+                bare, scene, traj, clearance=clearance, scheduler=scheduler,
+                progress=lambda d, n: bar.update(task, completed=d, total=n))
+            placement.plot_floor(out / "placement.png", scene=scene, mark=scene.base)
+            files["placement.png"] = out / "placement.png"
+            files["placement.csv"] = placement.write_csv(out / "placement.csv")
+            timings["place"] = time.perf_counter() - t
 
         t = time.perf_counter()
         outputs = [
@@ -580,10 +648,11 @@ def run_demo(
         timings["write"] = time.perf_counter() - t
         timings["total"] = time.perf_counter() - t_start
         summary = _summary(robot, traj, report, limits, via, clearance, timings)
-        images = {
-            k: files[k]
-            for k in ("joints.png", "press_views.png", "distance.png", "tool_path.png")
-        }
+        if placement is not None:
+            summary["placement"] = _placement_summary(placement, scene)
+        shown = ("joints.png", "press_views.png", "distance.png", "tool_path.png",
+                 "placement.png")
+        images: dict[str, Path] = {k: files[k] for k in shown if k in files}
         report_path = out / "report.html"
         write_atomic(report_path, _report_html(summary, images))
         done("report.html", report_path)
@@ -624,6 +693,13 @@ def run_demo(
         f"{timings['total']:.1f} s (plan {timings['plan']:.2f}, "
         f"check {timings['check']:.2f}, write {timings['write']:.2f})",
     )
+    if placement is not None:
+        ps = summary["placement"]
+        table.add_row(
+            "placement",
+            f"{ps['feasible']} of {ps['candidates']} bases feasible; this cell's base "
+            + ("feasible" if ps["cell_base_feasible"] else f"not: {ps['cell_base_reason']}"),
+        )
     table.add_row("report", str(report_path))
     con.print(table)
     con.print(

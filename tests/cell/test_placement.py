@@ -120,6 +120,11 @@ def test_a_branch_flip_is_not_a_continuous_branch():
     jump = cell.place(ur5, far, np.eye(4), max_step=math.radians(5))
     assert not jump.feasible[0] and jump.reason[0].startswith("no continuous branch")
     assert cell.place(ur5, far, np.eye(4), max_step=math.inf).feasible[0]  # a set of poses
+    # in a set, a pose out of reach from one base is out of reach, whatever the step
+    moved = cell.base_grid([0.0, 0.6], [0.0])
+    pl = cell.place(ur5, far, moved, max_step=math.inf)
+    assert pl.feasible[0] and not pl.reachable[1]
+    assert pl.reason[1].startswith("out of reach: task pose")
 
 
 def test_an_unreachable_task_names_the_task(press):

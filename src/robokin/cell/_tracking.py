@@ -86,7 +86,7 @@ def track(robot: Robot, T: np.ndarray, max_step: float, numeric: bool) -> Tracks
         j = np.argmin(step, axis=-1)
         best = np.take_along_axis(step, j[..., None], axis=-1)[..., 0]
         nxt = np.take_along_axis(s, j[..., None, None], axis=2)[:, :, 0]
-        still = alive & (best <= max_step)
+        still = alive & (best <= max_step) & np.isfinite(best)
         died[alive & ~still] = i
         alive = still
         cur = np.where(alive[..., None], nxt, cur)

@@ -162,7 +162,7 @@ class Placement:
 
     def reasons_text(self) -> str:
         """How many candidates failed for which reason, most common first."""
-        return _count_reasons(self.reason)
+        return _count_reasons(self.reason[~self.feasible]) or "none"
 
     def summary(self) -> dict[str, Any]:
         """Plain numbers for reports and JSON."""
@@ -476,7 +476,7 @@ def _count_reasons(reason: np.ndarray) -> str:
 
 
 def _full_check(job: PlaceJob, c: int) -> tuple[np.ndarray | None, Any, str]:
-    """Re-derive candidate c's branch and check it with subdivision."""
+    """Re-derive candidate c's branch and check it in full (between samples too)."""
     one = evaluate_place(job, c, c + 1, keep_path=True)
     q = one.path
     if q is None or one.reason[0] != OK:
@@ -485,9 +485,12 @@ def _full_check(job: PlaceJob, c: int) -> tuple[np.ndarray | None, Any, str]:
         return q, None, OK
     from robokin.collision import check
 
+    # a motion is checked between its samples too; a set of poses (no order, no
+    # motion between them) pose by pose, as when it was scored
+    motion = math.isfinite(job.max_step)
     report = check(job.bare, job.scene.with_base(job.candidates[c]), q,
-                   clearance=job.clearance)
-    return q, report, _collision_reason(report, job.clearance, between=True)
+                   clearance=job.clearance, subdivide=motion)
+    return q, report, _collision_reason(report, job.clearance, between=motion)
 
 
 def _collision_reason(report: Any, clearance: float, *, between: bool = False) -> str:
