@@ -26,9 +26,10 @@ def assert_same(x, y, what):
 
 @pytest.fixture(scope="module")
 def client():
+    # not the default client: an address must work without one (as from the CLI)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as lc, \
-            distributed.Client(lc) as c:
+            distributed.Client(lc, set_as_default=False) as c:
         yield c
 
 

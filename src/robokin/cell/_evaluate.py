@@ -30,6 +30,7 @@ if TYPE_CHECKING:
 __all__ = ["ReachChunk", "ReachJob", "evaluate_reach", "manipulability", "solve_poses"]
 
 NUMERIC_RESTARTS = 4  # the numeric solver's seed-table restarts (no random ones)
+_MANIPULABILITY_BATCH = 16384  # Jacobians at a time (16384 x 6 x 6 x 8 B = 4.7 MB)
 
 
 @dataclass(frozen=True, eq=False)
@@ -101,15 +102,18 @@ def manipulability(chain: Chain, q: np.ndarray) -> np.ndarray:
     """
     from robokin.kinematics.jacobian import jacobian
 
-    if q.shape[0] == 0:
-        return np.zeros(0)
-    J = jacobian(chain, q)
-    n = J.shape[-1]
-    if n == 6:
-        return np.abs(np.linalg.det(J))
-    Jt = np.swapaxes(J, -1, -2)
-    G = Jt @ J if n < 6 else J @ Jt
-    return np.sqrt(np.maximum(np.linalg.det(G), 0.0))
+    out = np.empty(q.shape[0])
+    for a in range(0, q.shape[0], _MANIPULABILITY_BATCH):  # bounded temporaries
+        J = jacobian(chain, q[a : a + _MANIPULABILITY_BATCH])
+        n = J.shape[-1]
+        if n == 6:
+            w = np.abs(np.linalg.det(J))
+        else:
+            Jt = np.swapaxes(J, -1, -2)
+            G = Jt @ J if n < 6 else J @ Jt
+            w = np.sqrt(np.maximum(np.linalg.det(G), 0.0))
+        out[a : a + J.shape[0]] = w
+    return out
 
 
 def solve_poses(robot: Robot, T: np.ndarray, numeric: bool) -> tuple[np.ndarray, np.ndarray]:

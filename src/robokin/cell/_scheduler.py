@@ -223,7 +223,7 @@ def _run_distributed(
     futures = client.compute(tasks)
     done = 0
     try:
-        for fut in as_completed(futures):
+        for fut in as_completed(futures, loop=client.loop):
             # result() waits for a recomputation when the worker holding the
             # result died after it finished (Dask recomputes lost keys)
             result = fut.result()

@@ -412,7 +412,7 @@ def place(
     def on_result(i: int, r: PlaceChunk) -> None:
         parts[i] = r
 
-    with _progress(progress, len(ranges), f"{robot.name}: placement", scheduler) as tick:
+    with _progress(progress, len(ranges), "placement", scheduler) as tick:
         run_chunks(evaluate_place, job, ranges, scheduler=scheduler,
                    on_result=on_result, progress=tick, name="robokin-place")
     done = [p for p in parts if p is not None]
