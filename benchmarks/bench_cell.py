@@ -19,7 +19,9 @@ workspace bounds), after checking correctness:
    * the map's work without Dask: every chunk's evaluation in this process, in a
      loop, kernels on every core;
    * ``reach_map`` on a LocalCluster of 2 workers x 1 thread (one per core),
-     without and with manipulability, in memory and streaming into Zarr;
+     without and with manipulability, in memory and streaming into Zarr; again
+     with glibc's malloc told to keep freed memory (``MALLOC_TUNED``: Dask's
+     workers otherwise get fresh pages for every array of every task);
    * the same on 1 worker (1 core): the per-core rate;
    * ``reach_map`` with ``scheduler=None`` (local threads).
 3. **Projection**: the 5 mm, 200-orientation UR5 map on a 100-core cluster,
@@ -77,8 +79,27 @@ def measure(fn, pids: list[int]) -> tuple[float, float]:
 
 
 def cluster_pids(client) -> list[int]:
-    """This process and the worker and nanny processes of a LocalCluster."""
-    return [os.getpid(), *client.run(os.getpid).values(), *client.run(os.getppid).values()]
+    """This process (a LocalCluster's scheduler and nannies live in it) and the
+    cluster's worker processes."""
+    return sorted({os.getpid(), *client.run(os.getpid).values()})
+
+
+# glibc keeps freed memory for reuse unless told otherwise; Dask's nanny sets
+# MALLOC_TRIM_THRESHOLD_=65536 in its workers, which also fixes the mmap threshold
+# at 128 KiB, so every array of a task is fresh pages (page faults, system time).
+MALLOC_TUNED = {"MALLOC_MMAP_THRESHOLD_": 2**26, "MALLOC_TRIM_THRESHOLD_": 2**28}
+
+
+def local_cluster(n: int, tuned: bool = False):
+    import dask
+    from distributed import LocalCluster
+
+    env = dict(dask.config.get("distributed.nanny.pre-spawn-environ"))
+    if tuned:
+        env.update(MALLOC_TUNED)
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": env}):
+        return LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                            dashboard_address=None)
 
 
 def bare_ik(robot, T: np.ndarray, batch: int) -> float:
@@ -196,7 +217,7 @@ def main() -> None:
     ap.add_argument("--sweep", action="store_true", help="also time chunk sizes")
     args = ap.parse_args()
 
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
     robot = robokin.load("ur5")
     cores = len(os.sched_getaffinity(0))
@@ -216,15 +237,15 @@ def main() -> None:
     T = np.concatenate([poses(job[False], a, b) for a, b in ranges])
     all_threads = num_threads()
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as lc2, Client(lc2) as c2, \
-            LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
-                         dashboard_address=None) as lc1, Client(lc1) as c1, \
+    with local_cluster(2) as lc2, Client(lc2) as c2, \
+            local_cluster(2, tuned=True) as lc2t, Client(lc2t) as c2t, \
+            local_cluster(1) as lc1, Client(lc1) as c1, \
             tempfile.TemporaryDirectory() as tmp:
         check_correctness(robot, {**kw, "voxel": args.voxel * 2}, c2, args.samples, rng)
         wall: dict[str, list[float]] = {}
         cpu: dict[str, list[float]] = {}
         here, pids2, pids1 = [os.getpid()], cluster_pids(c2), cluster_pids(c1)
+        pids2t = cluster_pids(c2t)
         runs = iter(range(10**6))
 
         def fresh_store() -> str:
@@ -243,6 +264,10 @@ def main() -> None:
                 robot, **kw, scheduler=c2), pids2),
             "LocalCluster 2x1, w on, Zarr": (lambda: cell.reach_map(
                 robot, **kw, scheduler=c2, store=fresh_store()), pids2),
+            "LocalCluster 2x1 tuned, w off": (lambda: cell.reach_map(
+                robot, **kw, scheduler=c2t, manipulability=False), pids2t),
+            "LocalCluster 2x1 tuned, w on": (lambda: cell.reach_map(
+                robot, **kw, scheduler=c2t), pids2t),
             "LocalCluster 1x1, w off": (lambda: cell.reach_map(
                 robot, **kw, scheduler=c1, manipulability=False), pids1),
             "LocalCluster 1x1, w on": (lambda: cell.reach_map(

@@ -49,6 +49,8 @@ class ReachJob:
         with_manipulability: Compute the best manipulability per voxel.
         store: Path of the Zarr store the chunk writes into, or None to return
             the arrays.
+        store_token: Names the run writing the store (see
+            :func:`robokin.cell._store.write_chunk`).
     """
 
     robot: Robot
@@ -59,6 +61,7 @@ class ReachJob:
     numeric: bool
     with_manipulability: bool
     store: str | None = None
+    store_token: str = ""
 
 
 @dataclass(frozen=True, eq=False)
@@ -193,13 +196,9 @@ def evaluate_reach(job: ReachJob, start: int, stop: int) -> ReachChunk:
     reachable = int(np.count_nonzero(index))
     if job.store is None:
         return ReachChunk(start, stop, counts, index, solutions, best, reachable)
-    _write(job.store, start, stop, counts, index, solutions, best)
-    return ReachChunk(start, stop, None, None, None, None, reachable)
-
-
-def _write(store: str, start: int, stop: int, counts: np.ndarray, index: np.ndarray,
-           solutions: np.ndarray, best: np.ndarray | None) -> None:
     from robokin.cell._store import write_chunk
 
-    write_chunk(store, start, stop, {"counts": counts, "index": index,
-                                     "solutions": solutions, "manipulability": best})
+    write_chunk(job.store, start, stop, {"counts": counts, "index": index,
+                                         "solutions": solutions, "manipulability": best},
+                job.store_token)
+    return ReachChunk(start, stop, None, None, None, None, reachable)

@@ -222,18 +222,21 @@ def _run_distributed(
     total = len(keys)
     futures = client.compute(tasks)
     done = 0
+    # results are fetched on the client's event loop as tasks finish, all at once
+    # (one round trip each in this thread would bound the run by the latency);
+    # a result lost with its worker before it was fetched is recomputed by Dask
+    # and fetched when ready
+    finished = as_completed(futures, loop=client.loop, with_results=True)
     try:
-        for fut in as_completed(futures, loop=client.loop):
-            # result() waits for a recomputation when the worker holding the
-            # result died after it finished (Dask recomputes lost keys)
-            result = fut.result()
-            i = index[fut.key]
-            futures[i] = None
-            fut.release()
-            on_result(i, result)
-            done += 1
-            if progress is not None:
-                progress(done, total)
+        for batch in finished.batches():
+            for fut, result in batch:
+                i = index[fut.key]
+                futures[i] = None
+                fut.release()
+                on_result(i, result)
+                done += 1
+                if progress is not None:
+                    progress(done, total)
     finally:
         live = [f for f in futures if f is not None]
         if live:

@@ -82,14 +82,33 @@ def create(path: str | Path, attrs: Mapping[str, Any], *, voxels: int,
 
 
 def write_chunk(path: str, start: int, stop: int,
-                arrays: Mapping[str, np.ndarray | None]) -> None:
-    """Write one task's voxels ``start .. stop - 1`` (whole Zarr chunks)."""
-    zarr = _zarr()
+                arrays: Mapping[str, np.ndarray | None], token: str = "") -> None:
+    """Write one task's voxels ``start .. stop - 1`` (whole Zarr chunks).
+
+    The opened arrays are kept per process under ``(path, name, token)`` (opening
+    costs more than writing a chunk); ``token`` names one run writing the store,
+    so a store replaced at the same path by another run is opened afresh.
+    """
     for name, data in arrays.items():
-        if data is None:
-            continue
+        if data is not None:
+            _open_array(path, name, token)[start:stop] = data
+
+
+def _open_array(path: str, name: str, token: str) -> Any:
+    key = (path, name, token)
+    arr = _OPENED.get(key)
+    if arr is None or not token:
+        zarr = _zarr()
         arr = zarr.open_array(store=path, path=name, mode="r+")
-        arr[start:stop] = data
+        if token:
+            while len(_OPENED) >= _OPENED_MAX:
+                _OPENED.pop(next(iter(_OPENED)), None)
+            _OPENED[key] = arr
+    return arr
+
+
+_OPENED: dict[tuple[str, str, str], Any] = {}
+_OPENED_MAX = 32
 
 
 def mark_done(path: str | Path, chunks: Iterable[int]) -> None:

@@ -439,13 +439,14 @@ def _run_in_memory(job: ReachJob, shell: ReachMap, ranges: list[tuple[int, int]]
 def _run_into_store(job: ReachJob, shell: ReachMap, ranges: list[tuple[int, int]],
                     path: Path, fingerprint: str, scheduler: Any, progress: Progress,
                     overwrite: bool) -> ReachMap:
+    import uuid
     from dataclasses import replace
 
     B = ranges[0][1] - ranges[0][0]
     done = _prepare_store(path, shell, job, B, fingerprint, overwrite)
     todo = [i for i in range(len(ranges)) if not done[i]]
     path = path.resolve()
-    job = replace(job, store=str(path))
+    job = replace(job, store=str(path), store_token=uuid.uuid4().hex)
     finished: list[int] = []
 
     def record() -> None:
