@@ -45,7 +45,7 @@ def parse_axis(text: str, option: str, scale: float) -> list[float]:
         ) from None
     if not values or not all(math.isfinite(v) for v in values):
         raise InputError(option, f"expected finite numbers, got {text!r}")
-    return [v * scale for v in values]
+    return [round(v * scale, 12) for v in values]
 
 
 def _scene(name: str | None) -> Any:

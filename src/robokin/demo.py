@@ -173,7 +173,7 @@ def search_placement(bare: Any, scene: Any, traj: Any, *, clearance: float,
     """
     from robokin import cell
 
-    offsets = np.arange(-PLACE_SPAN, PLACE_SPAN + 1e-9, PLACE_STEP)
+    offsets = np.round(np.arange(-PLACE_SPAN, PLACE_SPAN + 1e-9, PLACE_STEP), 9)
     base = scene.base
     yaw = math.atan2(base[1, 0], base[0, 0])
     candidates = cell.base_grid(base[0, 3] + offsets, base[1, 3] + offsets, base[2, 3], yaw)

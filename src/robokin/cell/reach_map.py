@@ -53,8 +53,12 @@ if TYPE_CHECKING:
 __all__ = ["ReachMap", "reach_map"]
 
 Progress = bool | Callable[[int, int], None] | None
-_POSES_PER_TASK = 65536  # ~0.05-0.1 s of closed-form IK per task on one core, ~50 MB
-_MAX_TASKS = 250_000
+# Per task: ~0.1-0.3 s of closed-form IK on one core and ~100 MB of temporaries
+# (benchmarks/bench_cell.py --sweep: 8,192 targets a task run at 72 % of 131,072's
+# rate, 524,288 at 103 %); at most 50,000 tasks, so a scheduler spends about a
+# minute on a map of any size.
+_POSES_PER_TASK = 131072
+_MAX_TASKS = 50_000
 _REGION_SAMPLES = 200_000
 _REGION_MARGIN = 0.05  # of the extent, on each side
 
@@ -365,7 +369,8 @@ def reach_map(
             deterministic seed-table restarts), ``"analytic"`` or ``"numeric"``.
         manipulability: Compute the best manipulability per voxel (about as
             costly again as the IK: one Jacobian and determinant per solution).
-        chunk: Voxels per Dask task (default: about 65,000 IK targets).
+        chunk: Voxels per Dask task (default: about 131,000 IK targets, and at
+            most 50,000 tasks).
         progress: True for a progress bar on stderr, or ``progress(done, total)``
             called after each task.
         overwrite: Replace a store that holds a different map.
