@@ -1,0 +1,358 @@
+"""General 6R arms: every IK solution by Raghavan-Roth elimination.
+
+Any arm of six revolute joints without dependent joints is solved completely, up
+to 16 solutions, by the compiled kernel in ``robokin/_native/csrc/general6r.c``
+(its header gives the elimination step by step): the loop-closure equations of a
+split of the chain into three joints and the inverse of the other three give 14
+equations (Raghavan & Roth 1993); eliminating two angles leaves a 12 x 12 matrix
+``Sigma(theta_a)`` whose determinant, a trigonometric polynomial of degree 8, has
+the solutions' ``theta_a`` as real roots (Manocha & Canny 1994). Every root is
+back-substituted, polished by Newton steps on the true chain and kept only when it
+reproduces the pose to ``1e-9`` (m and rad).
+
+This module does the per-arm set-up, once per chain (cached with the chain):
+
+* **fit**: the left side of each split is linear in 27 pose-independent monomials;
+  their coefficients are fitted by least squares from rows the kernel computes
+  (``general6r_fit_rows``), no symbolic derivation;
+* **variant choice**: a variant is a split ``a`` in {1, 2, 3}, the chain or its
+  reversal (the IK of ``T^-1`` on the reversed chain) and the dialytic multiplier
+  (``x_b`` or ``x_c``), 12 in all. Arms with special geometry make some variants
+  degenerate (a UR arm: only the split with the three parallel axes on the left
+  works) or miss solutions that share ``theta_a`` (a wrist flip: a 2-D null space).
+  Every variant runs on ``SETUP_POSES`` deterministic poses (from random joint
+  values); the union of their validated solutions plus the generating
+  configurations is the reference; the chosen pair (primary, secondary) finds all
+  of it, the primary alone where it reports no trouble, with the smallest DFT tail.
+  Per pose, the kernel runs the secondary when the primary's determinant is
+  degenerate or one of its roots has a 2-D null space, and merges.
+
+Arms with a prismatic joint or dependent joints are not offered this family (the
+elimination is written for revolute joints), nor arms no variant pair solves.
+
+References:
+    Raghavan, M. and Roth, B. "Inverse kinematics of the general 6R manipulator and
+    related linkages", J. Mech. Design 115(3):502-508, 1993.
+    Manocha, D. and Canny, J. "Efficient inverse kinematics for general 6R
+    manipulators", IEEE Trans. Robotics and Automation 10(5):648-657, 1994.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from robokin import _native
+from robokin.kinematics.ik.analytic._common import fit_turns, fk_error, make_set
+from robokin.kinematics.per_chain import cached
+
+__all__ = ["NAME", "General6R", "Variant", "raw_solve", "setup", "solve", "why_not"]
+
+NAME = "general_6r"
+K = _native.kernels
+MAX_SOLUTIONS = 16
+SETUP_POSES = 20  # deterministic poses the variant choice is measured on
+SETUP_SEED = 20_241_993
+FIT_SAMPLES = 64  # rows per least-squares fit (27 unknowns)
+FIT_TOL = 1e-9  # largest relative residual of a fit
+TAIL_TOL = 1e-6  # largest relative DFT tail above degree 8 of a usable determinant
+NULL_TOL = 1e-7  # Sigma's second-smallest / largest pivot below: 2-D null space
+IMAG_TOL = 5e-2  # imaginary part of theta_a [rad] still tried as a real root
+SOLUTION_TOL = 1e-9  # position [m] and rotation [rad] error of a solution
+DEDUPE_TOL = 1e-6  # [rad] solutions closer than this are one
+NEWTON_ITERATIONS = 12
+_PARALLEL_MIN = 32  # below this many poses one thread (the kernel's own threshold)
+_STATUS = {0: 0, 1: 1, 2: 5, 3: 1}  # kernel status -> _common.STATUS_TEXT code
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One elimination variant.
+
+    Attributes:
+        reversed: Solve ``T^-1`` on the reversed chain.
+        split: ``a``: joints a, a+1, a+2 of the (reversed) chain on the left.
+        multiplier: 0: the dialytic rows are multiplied by ``x_b`` (joint a+1),
+            1: by ``x_c`` (joint a+2).
+    """
+
+    reversed: bool
+    split: int
+    multiplier: int
+
+    def __str__(self) -> str:
+        return (f"split {self.split}{' reversed' if self.reversed else ''}, "
+                f"x_{'bc'[self.multiplier]}")
+
+
+@dataclass(frozen=True, eq=False)
+class General6R:
+    """The per-arm set-up of the general 6R solver.
+
+    Attributes:
+        params: The kernel's parameter vector (read-only), or None when the family
+            does not apply.
+        primary: The variant run for every pose.
+        secondary: The variant run where the primary reports trouble, or None.
+        reason: Why the family does not apply ("" when it does).
+        measured: What the set-up measured (for ``Family.measured``).
+        tail: The primary's largest relative DFT tail on the set-up poses.
+    """
+
+    params: np.ndarray | None
+    primary: Variant | None = None
+    secondary: Variant | None = None
+    reason: str = ""
+    measured: str = ""
+    tail: float = float("nan")
+
+
+def why_not(chain: Any) -> str:
+    """Why the general 6R solver does not take ``chain`` ("" when it does)."""
+    if chain.n_chain != 6 or chain.n != 6:
+        return (f"{chain.n} joint coordinates on {chain.n_chain} chain joints: the general "
+                "6R solver takes six joints")
+    if (chain.arrays.kind != 0.0).any():
+        return ("a prismatic joint: the general 6R elimination (Raghavan-Roth) is written "
+                "for six revolute joints")
+    if not chain.coupling.is_identity:
+        return "dependent joints: the general 6R solver takes independent joints only"
+    return ""
+
+
+def setup(chain: Any) -> General6R:
+    """The set-up of ``chain`` (fits and variant choice), computed once per chain."""
+    return cached(chain, ("general_6r", SETUP_POSES), lambda: _setup(chain))
+
+
+# ----------------------------------------------------------------- the fit
+
+
+def _rigid_inverse(T: np.ndarray) -> np.ndarray:
+    out = np.zeros_like(T)
+    R = T[..., :3, :3]
+    out[..., :3, :3] = np.swapaxes(R, -1, -2)
+    out[..., :3, 3] = -np.einsum("...ji,...j->...i", R, T[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def _direction_consts(chain: Any, reverse: bool) -> np.ndarray:
+    """C'_0 .. C'_6 of the chain (or of its reversal, C'_k = C_{6-k}^-1), (7, 4, 4)."""
+    C = np.array(chain.arrays.consts, dtype=np.float64)
+    return np.ascontiguousarray(_rigid_inverse(C[::-1]) if reverse else C)
+
+
+def _fit(consts: np.ndarray, a: int, rng: np.random.Generator) -> tuple[np.ndarray, float]:
+    """P_s, P_c, P_1 (3, 14, 9) of split ``a`` and the fit's relative residual."""
+    angles = np.column_stack([
+        rng.uniform(-np.pi, np.pi, FIT_SAMPLES),
+        rng.uniform(-2.0, 2.0, (FIT_SAMPLES, 2)),  # |tan(t / 2)| < 1.6: well conditioned
+    ])
+    X = np.empty((FIT_SAMPLES, 27))
+    Y = np.empty((FIT_SAMPLES, 14))
+    K.general6r_fit_rows(consts, a, np.ascontiguousarray(angles), X, Y)
+    coef = np.linalg.lstsq(X, Y, rcond=None)[0]  # (27, 14)
+    resid = np.abs(X @ coef - Y).max() / max(np.abs(Y).max(), 1e-300)
+    P = np.ascontiguousarray(coef.T.reshape(14, 3, 9).transpose(1, 0, 2))
+    return P, float(resid)
+
+
+def _header(n_variants: int) -> np.ndarray:
+    h = np.zeros(K.GP_HEAD)
+    h[K.GP_NVAR] = n_variants
+    h[K.GP_TAIL_TOL] = TAIL_TOL
+    h[K.GP_NULL_TOL] = NULL_TOL
+    h[K.GP_IMAG_TOL] = IMAG_TOL
+    h[K.GP_TOL] = SOLUTION_TOL
+    h[K.GP_DEDUPE] = DEDUPE_TOL
+    h[K.GP_MAX_ITER] = NEWTON_ITERATIONS
+    return h
+
+
+def _block(v: Variant, consts: np.ndarray, P: np.ndarray) -> np.ndarray:
+    b = np.zeros(K.VB_SIZE)
+    b[K.VB_DIR] = float(v.reversed)
+    b[K.VB_A] = v.split
+    b[K.VB_MULT] = v.multiplier
+    b[K.VB_C:K.VB_C + 112] = consts.ravel()
+    b[K.VB_CI:K.VB_CI + 112] = _rigid_inverse(consts).ravel()
+    b[K.VB_P:K.VB_P + 378] = P.ravel()
+    return b
+
+
+def _params(blocks: list[np.ndarray]) -> np.ndarray:
+    P = np.concatenate([_header(len(blocks))] + blocks)
+    P.setflags(write=False)
+    return P
+
+
+# -------------------------------------------------------------- the kernel
+
+
+def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
+              parallel: bool | None = None) -> tuple[np.ndarray, ...]:
+    """The bare kernel call: T (N, 4, 4) C-contiguous float64 -> (q (N, 16, 6) [rad]
+    in [-pi, pi) (NaN rows are not solutions), valid (N, 16), sigma (N, 16) the
+    Jacobian's smallest singular value, status (N,) int64 (kernel codes), diag (N,)
+    int64 (kernel flags), tail (N,) the primary's relative DFT tail). No input checks.
+    """
+    N = T.shape[0]
+    Q = np.empty((N, MAX_SOLUTIONS, 6))
+    valid = np.empty((N, MAX_SOLUTIONS), np.bool_)
+    sigma = np.empty((N, MAX_SOLUTIONS))
+    status = np.empty(N, np.int64)
+    diag = np.empty(N, np.int64)
+    tail = np.empty(N)
+    par = N >= _PARALLEL_MIN if parallel is None else bool(parallel)
+    K.general6r_solve(chain.arrays.packed, params, T, Q, valid, sigma, status, diag, tail,
+                      par)
+    return Q, valid, sigma, status, diag, tail
+
+
+# -------------------------------------------------------- variant choice
+
+
+def _all_variants() -> list[Variant]:
+    return [Variant(rev, a, m) for rev in (False, True) for a in (1, 2, 3) for m in (0, 1)]
+
+
+def _same(x: np.ndarray, y: np.ndarray) -> bool:
+    d = (x - y + np.pi) % (2 * np.pi) - np.pi
+    return bool(np.abs(d).max() < 1e-6)
+
+
+def _union(sets: list[list[np.ndarray]]) -> list[np.ndarray]:
+    out: list[np.ndarray] = []
+    for s in sets:
+        for x in s:
+            if not any(_same(x, y) for y in out):
+                out.append(x)
+    return out
+
+
+def _covers(found: list[np.ndarray], ref: list[np.ndarray]) -> bool:
+    return all(any(_same(r, x) for x in found) for r in ref)
+
+
+def _setup(chain: Any) -> General6R:
+    reason = why_not(chain)
+    if reason:
+        return General6R(None, reason=reason)
+    from robokin.kinematics.forward import forward_kinematics
+
+    rng = np.random.default_rng(SETUP_SEED)
+    fits = {}
+    worst_fit = 0.0
+    for rev in (False, True):
+        consts = _direction_consts(chain, rev)
+        for a in (1, 2, 3):
+            P, resid = _fit(consts, a, rng)
+            fits[rev, a] = (consts, P)
+            worst_fit = max(worst_fit, resid)
+    if worst_fit > FIT_TOL:  # pragma: no cover - the left side is linear by construction
+        return General6R(None, reason=f"the left-side fit failed (residual {worst_fit:.1e})")
+    variants = _all_variants()
+    blocks = {v: _block(v, *fits[v.reversed, v.split]) for v in variants}
+    q = rng.uniform(-np.pi, np.pi, (SETUP_POSES, 6))
+    T = np.ascontiguousarray(forward_kinematics(chain, q))
+    qgen = fit_turns(q, np.ones(6, bool), np.tile([-np.pi, np.pi], (6, 1)))
+    found, trouble, tails = {}, {}, {}
+    for v in variants:
+        Q, valid, _, _, diag, tail = raw_solve(chain, _params([blocks[v]]), T, parallel=False)
+        found[v] = [list(Q[i][valid[i]]) for i in range(SETUP_POSES)]
+        trouble[v] = (diag & (K.G6F_DEGENERATE | K.G6F_AMBIGUOUS)) != 0
+        tails[v] = float(np.max(np.where(np.isfinite(tail), tail, 1.0)))
+    ref = [_union([[qgen[i]]] + [found[v][i] for v in variants]) for i in range(SETUP_POSES)]
+    n_ref = sum(len(r) for r in ref)
+    best = None
+    for p in variants:
+        for s in variants:
+            if s == p:
+                continue
+            ok = all(
+                _covers(found[p][i] + (found[s][i] if trouble[p][i] else []), ref[i])
+                for i in range(SETUP_POSES))
+            if not ok:
+                continue
+            key = (int(trouble[p].sum()), tails[p], tails[s])
+            if best is None or key < best[0]:
+                best = (key, p, s)
+    if best is None:
+        alone = max(variants, key=lambda v: sum(
+            sum(1 for r in ref[i] if any(_same(r, x) for x in found[v][i]))
+            for i in range(SETUP_POSES)))
+        n_alone = sum(sum(1 for r in ref[i] if any(_same(r, x) for x in found[alone][i]))
+                      for i in range(SETUP_POSES))
+        return General6R(None, reason=(
+            f"no elimination variant finds every solution on {SETUP_POSES} test poses "
+            f"(best: {alone}, {n_alone} of {n_ref})"))
+    (n_trouble, tail_p, _), p, s = best
+    measured = (f"Raghavan-Roth elimination, {p} (secondary {s} on {n_trouble} of "
+                f"{SETUP_POSES} test poses); all {n_ref} solutions of the test poses "
+                f"found; DFT tail {tail_p:.1e}")
+    return General6R(_params([blocks[p], blocks[s]]), p, s, measured=measured, tail=tail_p)
+
+
+# -------------------------------------------------------------- the solver
+
+
+def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
+          singular_tol: float = 1e-6, compute_error: bool = False,
+          parallel: bool | None = None) -> Any:
+    """Every solution of a general 6R arm for poses T (..., 4, 4) (already checked).
+
+    Args:
+        robot: The arm (six revolute joints, no dependent joints).
+        T: Target poses (..., 4, 4) [m], rigid transforms.
+        q_near: Joint values (..., 6) or (6,) [rad]; when given, the solutions of
+            each pose are ordered by (wrapped) distance to it.
+        singular_tol: A solution is flagged ``singular`` when the smallest singular
+            value of its Jacobian is below this.
+        compute_error: Fill ``error`` with each solution's FK error.
+        parallel: Use every thread of the pool (default: for 32 poses or more).
+
+    Returns:
+        A :class:`~robokin.kinematics.ik.solutions.SolutionSet` with
+        ``method="general_6r"``, at most 16 solutions per pose.
+    """
+    chain = robot.chain
+    g = setup(chain)
+    if g.params is None:
+        from robokin.exceptions import InputError
+
+        raise InputError("robot", f"'{robot.name}' is not solved by {NAME}: {g.reason}")
+    T = np.asarray(T, dtype=np.float64)
+    lead = T.shape[:-2]
+    Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
+    Q, valid, sigma, status, diag, tail = raw_solve(chain, g.params, Tf, parallel)
+    Q = fit_turns(np.where(valid[..., None], Q, 0.0), chain.is_revolute, chain.limits)
+    if q_near is not None:
+        Q, valid, sigma = _order_by(Q, valid, sigma, np.asarray(q_near, dtype=np.float64),
+                                    lead)
+    n = Q.shape[1]
+    Q = Q.reshape(lead + (n, 6))
+    valid = valid.reshape(lead + (n,))
+    sing = (sigma < singular_tol).reshape(lead + (n,))
+    codes = np.vectorize(_STATUS.get, otypes=[np.int8])(status).reshape(lead)
+    error = None
+    if compute_error:
+        dp, dr = fk_error(chain, Q, T)
+        error = np.where(valid, np.hypot(dp, dr), np.inf)
+    info = {"family": NAME, "variant": str(g.primary), "secondary": str(g.secondary),
+            "secondary_runs": int(((diag & K.G6F_SECONDARY) != 0).sum())}
+    return make_set(robot, Q, valid, inside=None, singular=sing, branches={},
+                    status_codes=codes, method=NAME, info=info, error=error)
+
+
+def _order_by(Q: np.ndarray, valid: np.ndarray, sigma: np.ndarray, q_near: np.ndarray,
+              lead: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    qn = np.broadcast_to(q_near, lead + (6,)).reshape(-1, 1, 6)
+    d = (Q - qn + np.pi) % (2 * np.pi) - np.pi
+    key = np.where(valid, np.linalg.norm(d, axis=-1), np.inf)
+    order = np.argsort(key, axis=1, kind="stable")
+    return (np.take_along_axis(Q, order[..., None], axis=1),
+            np.take_along_axis(valid, order, axis=1),
+            np.take_along_axis(sigma, order, axis=1))
