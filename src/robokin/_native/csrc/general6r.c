@@ -281,9 +281,10 @@ static void det12_lanes(const double (*S)[144], int k0, double *out)
 
 /* Null vectors of Sigma(theta_l) = s_l S[0] + c_l S[1] + S[2] (12 x 12 row-major),
  * one angle per lane, by Householder QR with column pivoting of Sigma^T:
- * Sigma^T P = U R, the null vector U e_12 (|Sigma y| = |r_12|); r: |diagonal of R|,
- * non-increasing (Golub & Van Loan 5.4.2, with downdated column norms). */
-static void null_vector12_lanes(const double (*S)[144], vd sv, vd cv, vd *y, vd *r)
+ * Sigma^T P = U R, the null vector y = U e_12 (|Sigma y| = |r_12|) and y2 = U e_11,
+ * the next (with y, the null space where two singular values are small); r:
+ * |diagonal of R|, non-increasing (Golub & Van Loan 5.4.2, downdated column norms). */
+static void null_vector12_lanes(const double (*S)[144], vd sv, vd cv, vd *y, vd *y2, vd *r)
 {
     vd A[144], V[11][12], beta[11], n2[12], n2ref[12];
     /* column j of A = Sigma^T is row j of Sigma: A[12 j + i] */
@@ -356,15 +357,22 @@ static void null_vector12_lanes(const double (*S)[144], vd sv, vd cv, vd *y, vd 
             }
         }
     }
-    for (int i = 0; i < 12; i++)
+    for (int i = 0; i < 12; i++) {
         y[i] = BR(i == 11 ? 1.0 : 0.0);
+        y2[i] = BR(i == 10 ? 1.0 : 0.0);
+    }
     for (int k = 10; k >= 0; k--) {
-        vd t = BR(0.0);
-        for (int i = k; i < 12; i++)
+        vd t = BR(0.0), t2 = BR(0.0);
+        for (int i = k; i < 12; i++) {
             t += V[k][i] * y[i];
+            t2 += V[k][i] * y2[i];
+        }
         t *= beta[k];
-        for (int i = k; i < 12; i++)
+        t2 *= beta[k];
+        for (int i = k; i < 12; i++) {
             y[i] -= t * V[k][i];
+            y2[i] -= t2 * V[k][i];
+        }
     }
 }
 
@@ -616,6 +624,104 @@ static int poly_roots(const double *c, int deg, double *wr, double *wi)
     return hqr(A, deg, wr, wi);
 }
 
+/* p(x) and p'(x) of c[0] + ... + c[deg] x^deg (Horner) */
+static double poly_eval(const double *c, int deg, double x, double *dp)
+{
+    double p = c[deg], d = 0.0;
+    for (int j = deg - 1; j >= 0; j--) {
+        d = d * x + p;
+        p = p * x + c[j];
+    }
+    *dp = d;
+    return p;
+}
+
+/* The root of c in [a, b] where p(a), p(b) have opposite signs: Newton steps kept
+ * inside the shrinking bracket, bisection where they leave it. */
+static double bracketed_root(const double *c, int deg, double a, double b, double pa)
+{
+    double x = 0.5 * (a + b);
+    for (int it = 0; it < 100; it++) {
+        double d, p = poly_eval(c, deg, x, &d);
+        if (p == 0.0)
+            return x;
+        if ((p < 0.0) == (pa < 0.0))
+            a = x, pa = p;
+        else
+            b = x;
+        double xn = d != 0.0 ? x - p / d : 0.5 * (a + b);
+        if (!(xn > fmin(a, b) && xn < fmax(a, b)))
+            xn = 0.5 * (a + b);
+        if (fabs(xn - x) <= 4.0 * DBL_EPSILON * fabs(x) || fabs(b - a) <= 4.0 * DBL_EPSILON * fabs(x))
+            return xn;
+        x = xn;
+    }
+    return x;
+}
+
+/* Divide c (degree deg) by (x - r) in place (degree deg - 1): composite deflation,
+ * the forward recurrence for the high coefficients and the backward one for the
+ * low ones, joined at the dominant term of p(r) (Peters & Wilkinson 1971). */
+static void deflate(double *c, int deg, double r)
+{
+    double qf[G6_MAXDEG], qb[G6_MAXDEG];
+    qf[deg - 1] = c[deg];
+    for (int j = deg - 1; j >= 1; j--)
+        qf[j - 1] = c[j] + r * qf[j];
+    int split = 0; /* q_j from the forward recurrence for j >= split */
+    if (r != 0.0) {
+        double best = -1.0, rp = 1.0;
+        for (int j = 0; j <= deg; j++) {
+            double t = fabs(c[j]) * rp;
+            if (t > best) {
+                best = t;
+                split = j;
+            }
+            rp *= fabs(r);
+        }
+        if (split > deg - 1)
+            split = deg - 1;
+        qb[0] = -c[0] / r;
+        for (int j = 1; j < split; j++)
+            qb[j] = (qb[j - 1] - c[j]) / r;
+    }
+    for (int j = 0; j < deg; j++)
+        c[j] = j < split ? qb[j] : qf[j];
+    c[deg] = 0.0;
+}
+
+/* All 16 roots (wr + i wi) of the degree-16 polynomial c in x = tan((theta - phi)/2)
+ * from the sampled determinant (phi + pi = sample jbest): the real roots the 24
+ * sample points bracket (a sign change of p between neighbouring samples) by
+ * safeguarded Newton steps, deflated; the rest as the eigenvalues of the deflated
+ * polynomial's balanced companion matrix (hqr), a smaller matrix for every root
+ * already found. Returns 0 when hqr fails. */
+static int all_roots16(const double *c, int jbest, double *wr, double *wi)
+{
+    double xs[G6_NSAMP], ps[G6_NSAMP], d, work[17];
+    for (int m = 1; m < G6_NSAMP; m++) { /* sample jbest + m, x increasing with m */
+        xs[m] = tan(0.5 * (G6_TWO_PI * m / G6_NSAMP - G6_PI));
+        ps[m] = poly_eval(c, 16, xs[m], &d);
+    }
+    memcpy(work, c, sizeof(work));
+    int nf = 0, deg = 16;
+    for (int m = 1; m < G6_NSAMP && deg > 1; m++) {
+        double r;
+        if (ps[m] == 0.0)
+            r = xs[m];
+        else if (m + 1 < G6_NSAMP && ps[m + 1] != 0.0 && (ps[m] < 0.0) != (ps[m + 1] < 0.0))
+            r = bracketed_root(c, 16, xs[m], xs[m + 1], ps[m]);
+        else
+            continue;
+        wr[nf] = r;
+        wi[nf] = 0.0;
+        nf++;
+        deflate(work, deg, r);
+        deg--;
+    }
+    return poly_roots(work, deg, wr + nf, wi + nf);
+}
+
 /* -------------------------------------------------------- the elimination */
 
 typedef struct {
@@ -723,17 +829,165 @@ static void g6_rot_span(const double *vb, const double *v, int first_const, int 
     }
 }
 
+#define PAIR_GAP 0.05 /* [rad] roots closer than this may share a 2-D null space */
+
+/* Two solutions (t_b, t_c) in the span of y, y2 (Sigma's two smallest singular
+ * vectors at a root two solutions (nearly) share): the combinations c with the
+ * monomial structure, shift(c) = tan(t/2) c along b or c, from the 2 x 2 pencil
+ * the shifted rows make (the eigenvector structure of a multiple root, Manocha &
+ * Canny 1994, section 5.2), along the direction where the two differ more.
+ * Returns how many (1 or 2) went to tb, tc. */
+static int g6_two_solutions(const double *y, const double *y2, int mult, double *tb,
+                            double *tc)
+{
+    int ni = mult == 0 ? 4 : 3, nj = mult == 0 ? 3 : 4;
+    double best_sep = -1.0, psi_best[2] = {0.0, 0.0}, A0b[4] = {0}, A1b[4] = {0};
+    for (int along_b = 1; along_b >= 0; along_b--) {
+        /* A0 = P^T B_dn, A1 = P^T B_up with P = B_dn + B_up (2 x 2, row-major) */
+        double A0[4] = {0}, A1[4] = {0};
+        for (int i = 0; i < ni; i++)
+            for (int j = 0; j < nj; j++) {
+                int i2 = i + along_b, j2 = j + !along_b;
+                if (i2 >= ni || j2 >= nj)
+                    continue;
+                double dn[2] = {y[nj * i + j], y2[nj * i + j]};
+                double up[2] = {y[nj * i2 + j2], y2[nj * i2 + j2]};
+                for (int r = 0; r < 2; r++)
+                    for (int c = 0; c < 2; c++) {
+                        A0[2 * r + c] += (dn[r] + up[r]) * dn[c];
+                        A1[2 * r + c] += (dn[r] + up[r]) * up[c];
+                    }
+            }
+        /* det(cos(psi) A1 - sin(psi) A0) = ca cos^2 + cb cos sin + cc sin^2 = 0 */
+        double ca = A1[0] * A1[3] - A1[1] * A1[2], cc = A0[0] * A0[3] - A0[1] * A0[2];
+        double cb = -(A1[0] * A0[3] + A0[0] * A1[3] - A1[1] * A0[2] - A0[1] * A1[2]);
+        /* the two angles: a quadratic in tan (or cot) psi, the discriminant clamped */
+        double disc = cb * cb - 4.0 * ca * cc, sq = sqrt(disc > 0.0 ? disc : 0.0), psi[2];
+        if (fabs(cc) >= fabs(ca)) { /* cc tan^2 + cb tan + ca = 0 */
+            double qq = -0.5 * (cb + (cb >= 0.0 ? sq : -sq));
+            psi[0] = atan2(qq, cc);
+            psi[1] = qq != 0.0 ? atan2(ca, qq) : psi[0];
+        } else { /* ca cot^2 + cb cot + cc = 0 */
+            double qq = -0.5 * (cb + (cb >= 0.0 ? sq : -sq));
+            psi[0] = atan2(ca, qq);
+            psi[1] = qq != 0.0 ? atan2(qq, cc) : psi[0];
+        }
+        double sep = fabs(sin(psi[0] - psi[1]));
+        if (sep > best_sep) {
+            best_sep = sep;
+            psi_best[0] = psi[0];
+            psi_best[1] = psi[1];
+            memcpy(A0b, A0, sizeof(A0));
+            memcpy(A1b, A1, sizeof(A1));
+        }
+    }
+    int n = best_sep > 1e-12 ? 2 : 1;
+    for (int k = 0; k < n; k++) {
+        double cs = cos(psi_best[k]), sn = sin(psi_best[k]), Mx[4];
+        for (int i = 0; i < 4; i++)
+            Mx[i] = cs * A1b[i] - sn * A0b[i];
+        /* c: the null vector of the 2 x 2 Mx, from its larger row */
+        double c0, c1;
+        if (Mx[0] * Mx[0] + Mx[1] * Mx[1] >= Mx[2] * Mx[2] + Mx[3] * Mx[3]) {
+            c0 = -Mx[1];
+            c1 = Mx[0];
+        } else {
+            c0 = -Mx[3];
+            c1 = Mx[2];
+        }
+        double z[12];
+        for (int i = 0; i < 12; i++)
+            z[i] = c0 * y[i] + c1 * y2[i];
+        tb[k] = g6_half_angle(z, mult, 1);
+        tc[k] = g6_half_angle(z, mult, 0);
+    }
+    return n;
+}
+
+/* What the back-substitution of one variant and pose needs. */
+typedef struct {
+    const double *vb, *Tp, *Q, *V8, *beta8, *A8;
+    int a, dir;
+} G6Back;
+
+/* The candidate of root theta (sin s, cos c) with joints a+1, a+2 at tb, tc: u, w
+ * by least squares on Q's block, P'(theta) e(t_b) (x) e(t_c) = Q_8 y; joint a+3
+ * from the orientation; into o in the original joint order. Returns 1, or 0 when
+ * a value is not finite. */
+static int g6_candidate(const G6Back *G, double th, double s, double c, double tb,
+                    double tc, G6Cand *o)
+{
+    const double *Pm = G->vb + VB_P, *Q = G->Q, *A8 = G->A8;
+    const int a = G->a;
+    /* u, w: least squares on Q's block, P'(theta) e(t_b) (x) e(t_c) = Q_8 y */
+    double eb[3] = {0.5 * (1.0 + cos(tb)), 0.5 * sin(tb), 0.5 * (1.0 - cos(tb))};
+    double ec[3] = {0.5 * (1.0 + cos(tc)), 0.5 * sin(tc), 0.5 * (1.0 - cos(tc))};
+    double mono[9], rhs[14];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            mono[3 * i + j] = eb[i] * ec[j];
+    for (int e = 0; e < 14; e++) {
+        double acc = -Q[9 * e + 8];
+        for (int m = 0; m < 9; m++)
+            acc += (s * Pm[9 * e + m] + c * Pm[126 + 9 * e + m] + Pm[252 + 9 * e + m]) *
+                   mono[m];
+        rhs[e] = acc;
+    }
+    house_apply_t(G->V8, G->beta8, 14, 8, rhs);
+    double yu[8];
+    for (int i = 7; i >= 0; i--) {
+        double acc = rhs[i];
+        for (int j = i + 1; j < 8; j++)
+            acc -= A8[14 * j + i] * yu[j];
+        yu[i] = acc / A8[14 * i + i];
+    }
+    double u = atan2(yu[4], yu[5]), w = atan2(yu[6], yu[7]);
+    /* the direction's chain values; joint a+3 from the orientation */
+    double v[6];
+    v[a - 1] = th;
+    v[a] = tb;
+    v[a + 1] = tc;
+    int j3 = g6_idx(a + 3);
+    v[g6_idx(a + 4) - 1] = u;
+    v[g6_idx(a + 5) - 1] = w;
+    v[j3 - 1] = 0.0;
+    double RL[9], RR[9], Rm[9];
+    g6_rot_span(G->vb, v, 0, 1, j3, RL);  /* C'_0 ... Rz(v_{j3-1}) C'_{j3-1} */
+    g6_rot_span(G->vb, v, j3, j3 + 1, 7, RR); /* C'_{j3} Rz(v_{j3+1}) ... C'_6 */
+    /* Rz(v_j3) = RL^T R_T' RR^T */
+    for (int r = 0; r < 3; r++)
+        for (int cc = 0; cc < 3; cc++) {
+            double acc = 0.0;
+            for (int i = 0; i < 3; i++)
+                for (int j = 0; j < 3; j++)
+                    acc += RL[3 * i + r] * G->Tp[4 * i + j] * RR[3 * cc + j];
+            Rm[3 * r + cc] = acc;
+        }
+    v[j3 - 1] = atan2(Rm[3] - Rm[1], Rm[0] + Rm[4]);
+    for (int k2 = 0; k2 < 6; k2++)
+        o->v[k2] = G->dir ? -v[5 - k2] : v[k2];
+    int ok = 1;
+    for (int k2 = 0; k2 < 6; k2++)
+        ok &= isfinite(o->v[k2]);
+    return ok;
+}
+
 /* Candidate chain values of one variant for the pose T (4x4 row-major): appended
- * to cand (at most G6_MAXROOT); flags get G6F_DEGENERATE / G6F_AMBIGUOUS; *tail
- * the relative DFT tail. Returns the number of candidates. */
+ * to cand (at most 2 G6_MAXROOT); flags get G6F_DEGENERATE / G6F_AMBIGUOUS; stats[0]
+ * the relative DFT tail, stats[1] the margin (the smallest ratio of Sigma's
+ * second-smallest to largest pivot over the roots tried), stats[2] how many roots
+ * were close to another (two solutions nearly sharing theta_a: both taken from a
+ * 2-D null space). Returns the number of candidates. */
 static int g6_variant(const double *P, const double *vb, const double *T, G6Cand *cand,
-                      int *flags, double *tail)
+                      int *flags, double *stats)
 {
     const int dir = (int)vb[VB_DIR], a = (int)vb[VB_A], mult = (int)vb[VB_MULT];
     const double tail_tol = P[GP_TAIL_TOL], null_tol = P[GP_NULL_TOL];
     const double imag_tol = P[GP_IMAG_TOL];
     double Tp[16], k6inv[16], tmp[16];
-    *tail = INFINITY;
+    double *tail = stats;
+    stats[0] = stats[1] = INFINITY;
+    stats[2] = 0.0;
     if (dir)
         rigid_inv(T, Tp);
     else
@@ -862,91 +1116,61 @@ static int g6_variant(const double *P, const double *vb, const double *T, G6Cand
         cpoly[j] = acc;
     }
     double wr[16], wi[16];
-    if (!poly_roots(cpoly, 16, wr, wi)) {
+    if (!all_roots16(cpoly, jbest, wr, wi)) {
         *flags |= G6F_DEGENERATE;
         return 0;
     }
-    /* the accepted roots (a complex pair counts once) */
+    /* the accepted roots (a complex pair counts once, as a possible pair of close
+     * real roots; so do roots within PAIR_GAP of another) */
     double ths[16];
-    int nr = 0;
+    int nr = 0, pair[16];
     for (int k = 0; k < 16; k++) {
         if (wi[k] < 0.0)
             continue; /* the conjugate's twin */
         double z2 = wr[k] * wr[k] + wi[k] * wi[k];
-        if (2.0 * fabs(wi[k]) / (1.0 + z2) <= imag_tol)
+        if (2.0 * fabs(wi[k]) / (1.0 + z2) <= imag_tol) {
+            pair[nr] = wi[k] != 0.0;
             ths[nr++] = phi + 2.0 * atan(wr[k]);
+        }
     }
+    for (int i = 0; i < nr; i++)
+        for (int j = i + 1; j < nr; j++)
+            if (fabs(wrap_pi(ths[i] - ths[j])) < PAIR_GAP)
+                pair[i] = pair[j] = 1;
+    G6Back G = {vb, Tp, Q, V8, beta8, A8, a, dir};
     /* back-substitution, W roots at a time for the null vectors */
     int nc = 0;
     for (int k0 = 0; k0 < nr; k0 += W) {
-        vd sv, cv, yv[12], rv[12];
+        vd sv, cv, yv[12], yv2[12], rv[12];
         for (int l = 0; l < W; l++) {
             double th = ths[k0 + l < nr ? k0 + l : k0];
             sv[l] = sin(th);
             cv[l] = cos(th);
         }
-        null_vector12_lanes((const double (*)[144])S, sv, cv, yv, rv);
+        null_vector12_lanes((const double (*)[144])S, sv, cv, yv, yv2, rv);
         for (int l = 0; l < W && k0 + l < nr; l++) {
-        double th = ths[k0 + l], s = sv[l], c = cv[l];
-        double y[12];
-        for (int i = 0; i < 12; i++)
-            y[i] = yv[i][l];
-        if (rv[10][l] <= null_tol * rv[0][l])
-            *flags |= G6F_AMBIGUOUS;
-        double tb = g6_half_angle(y, mult, 1), tc = g6_half_angle(y, mult, 0);
-        /* u, w: least squares on Q's block, P'(theta) e(t_b) (x) e(t_c) = Q_8 y */
-        double eb[3] = {0.5 * (1.0 + cos(tb)), 0.5 * sin(tb), 0.5 * (1.0 - cos(tb))};
-        double ec[3] = {0.5 * (1.0 + cos(tc)), 0.5 * sin(tc), 0.5 * (1.0 - cos(tc))};
-        double mono[9], rhs[14];
-        for (int i = 0; i < 3; i++)
-            for (int j = 0; j < 3; j++)
-                mono[3 * i + j] = eb[i] * ec[j];
-        for (int e = 0; e < 14; e++) {
-            double acc = -Q[9 * e + 8];
-            for (int m = 0; m < 9; m++)
-                acc += (s * Pm[9 * e + m] + c * Pm[126 + 9 * e + m] + Pm[252 + 9 * e + m]) *
-                       mono[m];
-            rhs[e] = acc;
-        }
-        house_apply_t(V8, beta8, 14, 8, rhs);
-        double yu[8];
-        for (int i = 7; i >= 0; i--) {
-            double acc = rhs[i];
-            for (int j = i + 1; j < 8; j++)
-                acc -= A8[14 * j + i] * yu[j];
-            yu[i] = acc / A8[14 * i + i];
-        }
-        double u = atan2(yu[4], yu[5]), w = atan2(yu[6], yu[7]);
-        /* the direction's chain values; joint a+3 from the orientation */
-        double v[6];
-        v[a - 1] = th;
-        v[a] = tb;
-        v[a + 1] = tc;
-        int j3 = g6_idx(a + 3);
-        v[g6_idx(a + 4) - 1] = u;
-        v[g6_idx(a + 5) - 1] = w;
-        v[j3 - 1] = 0.0;
-        double RL[9], RR[9], Rm[9];
-        g6_rot_span(vb, v, 0, 1, j3, RL);  /* C'_0 ... Rz(v_{j3-1}) C'_{j3-1} */
-        g6_rot_span(vb, v, j3, j3 + 1, 7, RR); /* C'_{j3} Rz(v_{j3+1}) ... C'_6 */
-        /* Rz(v_j3) = RL^T R_T' RR^T */
-        for (int r = 0; r < 3; r++)
-            for (int cc = 0; cc < 3; cc++) {
-                double acc = 0.0;
-                for (int i = 0; i < 3; i++)
-                    for (int j = 0; j < 3; j++)
-                        acc += RL[3 * i + r] * Tp[4 * i + j] * RR[3 * cc + j];
-                Rm[3 * r + cc] = acc;
+            double th = ths[k0 + l], s = sv[l], c = cv[l];
+            double y[12];
+            for (int i = 0; i < 12; i++)
+                y[i] = yv[i][l];
+            double margin = rv[10][l] / rv[0][l];
+            stats[1] = margin < stats[1] ? margin : stats[1];
+            if (!(margin > null_tol))
+                *flags |= G6F_AMBIGUOUS;
+            double tb[2], tc[2];
+            int np = 1;
+            if (pair[k0 + l] || !(margin > null_tol)) { /* two solutions may share theta */
+                stats[2] += 1.0;
+                double y2[12];
+                for (int i = 0; i < 12; i++)
+                    y2[i] = yv2[i][l];
+                np = g6_two_solutions(y, y2, mult, tb, tc);
+            } else {
+                tb[0] = g6_half_angle(y, mult, 1);
+                tc[0] = g6_half_angle(y, mult, 0);
             }
-        v[j3 - 1] = atan2(Rm[3] - Rm[1], Rm[0] + Rm[4]);
-        G6Cand *o = cand + nc;
-        for (int k2 = 0; k2 < 6; k2++)
-            o->v[k2] = dir ? -v[5 - k2] : v[k2];
-        int ok = 1;
-        for (int k2 = 0; k2 < 6; k2++)
-            ok &= isfinite(o->v[k2]);
-        if (ok)
-            nc++;
+            for (int k = 0; k < np; k++)
+                nc += g6_candidate(&G, th, s, c, tb[k], tc[k], cand + nc);
         }
     }
     return nc;
@@ -1054,7 +1278,9 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
                 double m = 0.0;
                 for (int r = 0; r < 6; r++)
                     m = fabs(e[r][l]) > m ? fabs(e[r][l]) : m;
-                if (!(m > 1e-14) || !isfinite(m))
+                /* converged, or a spurious root: Newton from a true one converges
+                 * quadratically, so an error still above 1e-4 after 4 steps gives up */
+                if (!(m > 1e-14) || !isfinite(m) || (it >= 4 && m > 1e-4))
                     done[l] = -1;
                 all &= done[l] != 0;
             }
@@ -1112,20 +1338,21 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
 /* --------------------------------------------------------------- per pose */
 
 static int g6_pose(const Chain *ch, const double *P, const double *T, double *q, double *sig,
-                   long long *diag, double *tail)
+                   long long *diag, double *stats)
 {
     for (int i = 0; i < 16; i++)
         if (!isfinite(T[i])) {
             *diag = 0;
-            *tail = INFINITY;
+            stats[0] = stats[1] = INFINITY;
+            stats[2] = 0.0;
             return -1;
         }
-    G6Cand cand[2 * G6_MAXROOT];
+    G6Cand cand[4 * G6_MAXROOT]; /* two variants, up to two per root */
     int flags = 0, f2 = 0;
-    double t2;
-    int nc = g6_variant(P, P + GP_HEAD, T, cand, &flags, tail);
+    double st2[3];
+    int nc = g6_variant(P, P + GP_HEAD, T, cand, &flags, stats);
     if ((int)P[GP_NVAR] > 1 && (flags & (G6F_DEGENERATE | G6F_AMBIGUOUS))) {
-        nc += g6_variant(P, P + GP_HEAD + VB_SIZE, T, cand + nc, &f2, &t2);
+        nc += g6_variant(P, P + GP_HEAD + VB_SIZE, T, cand + nc, &f2, st2);
         flags |= G6F_SECONDARY;
         if (f2 & G6F_DEGENERATE)
             flags |= G6F_SEC_DEGENERATE;
@@ -1143,7 +1370,7 @@ static int g6_pose(const Chain *ch, const double *P, const double *T, double *q,
 typedef struct {
     const Chain *ch;
     const double *P, *T;
-    double *Q, *sig, *tail;
+    double *Q, *sig, *stats;
     npy_bool *valid;
     long long *status, *diag;
 } G6Job;
@@ -1154,7 +1381,7 @@ static void g6_range(void *ctx, long b, long e)
     for (long i = b; i < e; i++) {
         double q[6 * G6_MAXSOL], sig[G6_MAXSOL];
         int ns = g6_pose(job->ch, job->P, job->T + 16 * i, q, sig, job->diag + i,
-                         job->tail + i);
+                         job->stats + 3 * i);
         job->status[i] = ns == -1 ? G6_BAD_POSE : ns == -2 ? G6_DEGENERATE
                          : ns == 0 ? G6_NONE : G6_OK;
         ns = ns < 0 ? 0 : ns;
@@ -1207,7 +1434,7 @@ static int g6_params_ok(const double *P, long len)
 }
 
 /* general6r_solve(packed, params, T (N, 4, 4), Q (N, 16, 6), valid (N, 16) bool,
- *                 sigma (N, 16), status (N,) int64, diag (N,) int64, tail (N,),
+ *                 sigma (N, 16), status (N,) int64, diag (N,) int64, stats (N, 3),
  *                 parallel) */
 static PyObject *py_general6r_solve(PyObject *self, PyObject *args)
 {
@@ -1245,7 +1472,7 @@ static PyObject *py_general6r_solve(PyObject *self, PyObject *args)
     if (T == NULL)
         return NULL;
     npy_intp N = PyArray_DIMS(T)[0];
-    PyArrayObject *Q, *valid, *sig, *status, *diag, *tail;
+    PyArrayObject *Q, *valid, *sig, *status, *diag, *stats;
     if (!g6_shape(T, "T", N, 4, 4) ||
         !(Q = array_arg(o[3], "Q", NPY_DOUBLE, 3, 1)) || !g6_shape(Q, "Q", N, 16, 6) ||
         !(valid = array_arg(o[4], "valid", NPY_BOOL, 2, 1)) ||
@@ -1256,12 +1483,12 @@ static PyObject *py_general6r_solve(PyObject *self, PyObject *args)
         !g6_shape(status, "status", N, 0, 0) ||
         !(diag = array_arg(o[7], "diag", NPY_INT64, 1, 1)) ||
         !g6_shape(diag, "diag", N, 0, 0) ||
-        !(tail = array_arg(o[8], "tail", NPY_DOUBLE, 1, 1)) ||
-        !g6_shape(tail, "tail", N, 0, 0))
+        !(stats = array_arg(o[8], "stats", NPY_DOUBLE, 2, 1)) ||
+        !g6_shape(stats, "stats", N, 3, 0))
         return NULL;
     G6Job job = {&ch, (const double *)PyArray_DATA(P), (const double *)PyArray_DATA(T),
                  (double *)PyArray_DATA(Q), (double *)PyArray_DATA(sig),
-                 (double *)PyArray_DATA(tail), (npy_bool *)PyArray_DATA(valid),
+                 (double *)PyArray_DATA(stats), (npy_bool *)PyArray_DATA(valid),
                  (long long *)PyArray_DATA(status), (long long *)PyArray_DATA(diag)};
     Py_BEGIN_ALLOW_THREADS
     if (parallel && N >= G6_PARALLEL_MIN)
@@ -1357,7 +1584,7 @@ static PyObject *py_general6r_roots(PyObject *self, PyObject *args)
 
 #define GENERAL6R_METHODS                                                                  \
     {"general6r_solve", py_general6r_solve, METH_VARARGS,                                  \
-     "general6r_solve(packed, params, T, Q, valid, sigma, status, diag, tail, parallel): " \
+     "general6r_solve(packed, params, T, Q, valid, sigma, status, diag, stats, parallel): " \
      "every IK solution of a general 6R chain."},                                          \
     {"general6r_fit_rows", py_general6r_fit_rows, METH_VARARGS,                            \
      "general6r_fit_rows(consts, a, angles, X, Y): the left side's fitting rows."},        \

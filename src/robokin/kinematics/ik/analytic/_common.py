@@ -13,7 +13,8 @@ __all__ = ["STATUS_TEXT", "fit_turns", "fk_error", "make_set", "q_near_rows"]
 STATUS_TEXT = np.array(
     ["ok", "out of reach", "orientation not achievable",
      "not reachable: tool cannot tilt",
-     "near-family Newton polish did not converge"],
+     "near-family Newton polish did not converge",
+     "no solution: the general 6R elimination is degenerate at this pose"],
     dtype=object,
 )
 

@@ -82,6 +82,11 @@ class Variant:
     split: int
     multiplier: int
 
+    @property
+    def hidden_joint(self) -> int:
+        """The joint (1-based, original order) whose angle the determinant's roots give."""
+        return 7 - self.split if self.reversed else self.split
+
     def __str__(self) -> str:
         return (f"split {self.split}{' reversed' if self.reversed else ''}, "
                 f"x_{'bc'[self.multiplier]}")
@@ -197,7 +202,9 @@ def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
     """The bare kernel call: T (N, 4, 4) C-contiguous float64 -> (q (N, 16, 6) [rad]
     in [-pi, pi) (NaN rows are not solutions), valid (N, 16), sigma (N, 16) the
     Jacobian's smallest singular value, status (N,) int64 (kernel codes), diag (N,)
-    int64 (kernel flags), tail (N,) the primary's relative DFT tail). No input checks.
+    int64 (kernel flags; >> G6_DIAG_CAND_SHIFT the roots tried), stats (N, 3): the
+    primary's relative DFT tail, null-space margin and roots taken as close pairs).
+    No input checks.
     """
     N = T.shape[0]
     Q = np.empty((N, MAX_SOLUTIONS, 6))
@@ -205,11 +212,11 @@ def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
     sigma = np.empty((N, MAX_SOLUTIONS))
     status = np.empty(N, np.int64)
     diag = np.empty(N, np.int64)
-    tail = np.empty(N)
+    stats = np.empty((N, 3))
     par = N >= _PARALLEL_MIN if parallel is None else bool(parallel)
-    K.general6r_solve(chain.arrays.packed, params, T, Q, valid, sigma, status, diag, tail,
+    K.general6r_solve(chain.arrays.packed, params, T, Q, valid, sigma, status, diag, stats,
                       par)
-    return Q, valid, sigma, status, diag, tail
+    return Q, valid, sigma, status, diag, stats
 
 
 # -------------------------------------------------------- variant choice
@@ -219,22 +226,16 @@ def _all_variants() -> list[Variant]:
     return [Variant(rev, a, m) for rev in (False, True) for a in (1, 2, 3) for m in (0, 1)]
 
 
-def _same(x: np.ndarray, y: np.ndarray) -> bool:
-    d = (x - y + np.pi) % (2 * np.pi) - np.pi
-    return bool(np.abs(d).max() < 1e-6)
+def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(len(a), len(b)) bool: configurations equal modulo 2 pi within DEDUPE_TOL."""
+    d = (a[:, None, :] - b[None, :, :] + np.pi) % (2 * np.pi) - np.pi
+    return np.abs(d).max(axis=-1) < 10 * DEDUPE_TOL
 
 
-def _union(sets: list[list[np.ndarray]]) -> list[np.ndarray]:
-    out: list[np.ndarray] = []
-    for s in sets:
-        for x in s:
-            if not any(_same(x, y) for y in out):
-                out.append(x)
-    return out
-
-
-def _covers(found: list[np.ndarray], ref: list[np.ndarray]) -> bool:
-    return all(any(_same(r, x) for x in found) for r in ref)
+def _distinct(q: np.ndarray) -> np.ndarray:
+    """The rows of q (k, 6) without repeats (modulo 2 pi), in order."""
+    same = _close(q, q) & np.tri(len(q), k=-1, dtype=bool)
+    return q[~same.any(axis=1)]
 
 
 def _setup(chain: Any) -> General6R:
@@ -258,38 +259,45 @@ def _setup(chain: Any) -> General6R:
     blocks = {v: _block(v, *fits[v.reversed, v.split]) for v in variants}
     q = rng.uniform(-np.pi, np.pi, (SETUP_POSES, 6))
     T = np.ascontiguousarray(forward_kinematics(chain, q))
-    qgen = fit_turns(q, np.ones(6, bool), np.tile([-np.pi, np.pi], (6, 1)))
-    found, trouble, tails = {}, {}, {}
-    for v in variants:
-        Q, valid, _, _, diag, tail = raw_solve(chain, _params([blocks[v]]), T, parallel=False)
-        found[v] = [list(Q[i][valid[i]]) for i in range(SETUP_POSES)]
-        trouble[v] = (diag & (K.G6F_DEGENERATE | K.G6F_AMBIGUOUS)) != 0
-        tails[v] = float(np.max(np.where(np.isfinite(tail), tail, 1.0)))
-    ref = [_union([[qgen[i]]] + [found[v][i] for v in variants]) for i in range(SETUP_POSES)]
+    runs = {v: raw_solve(chain, _params([blocks[v]]), T, parallel=False) for v in variants}
+    # the reference: every validated solution of any variant, and the generating q
+    ref = [_distinct(np.concatenate([q[i:i + 1]] + [r[0][i][r[1][i]] for r in runs.values()]))
+           for i in range(SETUP_POSES)]
     n_ref = sum(len(r) for r in ref)
+    # covered[v]: per pose, which reference solutions variant v found alone
+    covered = {v: [_close(ref[i], r[0][i][r[1][i]]).any(axis=1) for i in range(SETUP_POSES)]
+               for v, r in runs.items()}
+    trouble = {v: (r[4] & (K.G6F_DEGENERATE | K.G6F_AMBIGUOUS)) != 0 for v, r in runs.items()}
+    tails = {v: float(np.max(np.where(np.isfinite(r[5][:, 0]), r[5][:, 0], 1.0)))
+             for v, r in runs.items()}
+    pairs = {v: int(r[5][:, 2].sum()) for v, r in runs.items()}
+    missed = {v: n_ref - sum(int(c.sum()) for c in covered[v]) for v in variants}
+    degenerate = {v: int(((r[4] & K.G6F_DEGENERATE) != 0).sum()) for v, r in runs.items()}
+    # the expected work and fragility of a variant: a pose sent to the secondary costs
+    # about one variant (8 roots), a root sharing a 2-D null space with another one
+    cost = {v: 8 * int(trouble[v].sum()) + pairs[v] for v in variants}
     best = None
     for p in variants:
+        if 2 * degenerate[p] > SETUP_POSES:  # it would merely hand poses on
+            continue
         for s in variants:
             if s == p:
                 continue
-            ok = all(
-                _covers(found[p][i] + (found[s][i] if trouble[p][i] else []), ref[i])
-                for i in range(SETUP_POSES))
-            if not ok:
-                continue
-            key = (int(trouble[p].sum()), tails[p], tails[s])
-            if best is None or key < best[0]:
+            complete = all((covered[p][i] | (trouble[p][i] & covered[s][i])).all()
+                           for i in range(SETUP_POSES))
+            # a secondary with the primary's hidden joint meets the same double roots
+            key = (cost[p], tails[p], p.hidden_joint == s.hidden_joint, missed[s],
+                   cost[s], tails[s])
+            if complete and (best is None or key < best[0]):
                 best = (key, p, s)
     if best is None:
-        alone = max(variants, key=lambda v: sum(
-            sum(1 for r in ref[i] if any(_same(r, x) for x in found[v][i]))
-            for i in range(SETUP_POSES)))
-        n_alone = sum(sum(1 for r in ref[i] if any(_same(r, x) for x in found[alone][i]))
-                      for i in range(SETUP_POSES))
+        alone = min(variants, key=missed.__getitem__)
         return General6R(None, reason=(
             f"no elimination variant finds every solution on {SETUP_POSES} test poses "
-            f"(best: {alone}, {n_alone} of {n_ref})"))
-    (n_trouble, tail_p, _), p, s = best
+            f"(best: {alone}, {n_ref - missed[alone]} of {n_ref})"))
+    _, tail_p, *_ = best[0]
+    p, s = best[1], best[2]
+    n_trouble = int(trouble[p].sum())
     measured = (f"Raghavan-Roth elimination, {p} (secondary {s} on {n_trouble} of "
                 f"{SETUP_POSES} test poses); all {n_ref} solutions of the test poses "
                 f"found; DFT tail {tail_p:.1e}")
@@ -327,7 +335,7 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
     T = np.asarray(T, dtype=np.float64)
     lead = T.shape[:-2]
     Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
-    Q, valid, sigma, status, diag, tail = raw_solve(chain, g.params, Tf, parallel)
+    Q, valid, sigma, status, diag, _ = raw_solve(chain, g.params, Tf, parallel)
     Q = fit_turns(np.where(valid[..., None], Q, 0.0), chain.is_revolute, chain.limits)
     if q_near is not None:
         Q, valid, sigma = _order_by(Q, valid, sigma, np.asarray(q_near, dtype=np.float64),
