@@ -308,6 +308,14 @@ def test_bad_pose_and_option_raise_input_errors():
         robot.ik(bad)
     with pytest.raises(InputError, match="banana"):
         robot.ik(np.eye(4), banana=1)
+    # the module's own entry checks what it is given too
+    with pytest.raises(InputError, match="T"):
+        general_6r.solve(robot, bad)
+    T = robot.fk(np.zeros((3, 6)))
+    with pytest.raises(InputError, match="q_near"):
+        general_6r.solve(robot, T, q_near=np.zeros((2, 6)))
+    with pytest.raises(InputError, match="q_near"):
+        general_6r.solve(robot, T, q_near=np.full(6, np.nan))
 
 
 def test_kernel_rejects_inconsistent_arguments():

@@ -64,7 +64,8 @@ SOLUTION_TOL = 1e-9  # position [m] and rotation [rad] error of a solution
 DEDUPE_TOL = 1e-6  # [rad] solutions closer than this are one
 NEWTON_ITERATIONS = 12
 _PARALLEL_MIN = 32  # below this many poses one thread (the kernel's own threshold)
-_STATUS = {0: 0, 1: 1, 2: 5, 3: 1}  # kernel status -> _common.STATUS_TEXT code
+# kernel status (ok, none, degenerate, bad pose) -> _common.STATUS_TEXT code
+_STATUS = np.array([0, 1, 5, 1], dtype=np.int8)
 
 
 @dataclass(frozen=True)
@@ -222,10 +223,6 @@ def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
 # -------------------------------------------------------- variant choice
 
 
-def _all_variants() -> list[Variant]:
-    return [Variant(rev, a, m) for rev in (False, True) for a in (1, 2, 3) for m in (0, 1)]
-
-
 def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(len(a), len(b)) bool: configurations equal modulo 2 pi within DEDUPE_TOL."""
     d = (a[:, None, :] - b[None, :, :] + np.pi) % (2 * np.pi) - np.pi
@@ -238,70 +235,116 @@ def _distinct(q: np.ndarray) -> np.ndarray:
     return q[~same.any(axis=1)]
 
 
-def _setup(chain: Any) -> General6R:
-    reason = why_not(chain)
-    if reason:
-        return General6R(None, reason=reason)
-    from robokin.kinematics.forward import forward_kinematics
+@dataclass(frozen=True, eq=False)
+class _Trial:
+    """One variant run alone on the set-up poses.
 
-    rng = np.random.default_rng(SETUP_SEED)
-    fits = {}
-    worst_fit = 0.0
+    Attributes:
+        covered: Per pose, which reference solutions it found, (k_i,) bool each.
+        trouble: (poses,) bool, where it would hand the pose to the secondary
+            (degenerate determinant or a 2-D null space).
+        degenerate: Poses with a degenerate determinant.
+        tail: Its largest relative DFT tail.
+        pairs: Roots it took as close pairs (from a 2-D null space).
+    """
+
+    covered: list[np.ndarray]
+    trouble: np.ndarray
+    degenerate: int
+    tail: float
+    pairs: int
+
+    @property
+    def missed(self) -> int:
+        """Reference solutions it does not find alone."""
+        return sum(int((~c).sum()) for c in self.covered)
+
+    @property
+    def cost(self) -> int:
+        """Expected work and fragility: a pose sent to the secondary costs about one
+        variant (8 roots), each root taken from a 2-D null space one."""
+        return 8 * int(self.trouble.sum()) + self.pairs
+
+
+def _fits(chain: Any, rng: np.random.Generator) -> dict[Variant, np.ndarray] | str:
+    """Every variant's kernel block, or why the fit failed."""
+    blocks = {}
     for rev in (False, True):
         consts = _direction_consts(chain, rev)
         for a in (1, 2, 3):
             P, resid = _fit(consts, a, rng)
-            fits[rev, a] = (consts, P)
-            worst_fit = max(worst_fit, resid)
-    if worst_fit > FIT_TOL:  # pragma: no cover - the left side is linear by construction
-        return General6R(None, reason=f"the left-side fit failed (residual {worst_fit:.1e})")
-    variants = _all_variants()
-    blocks = {v: _block(v, *fits[v.reversed, v.split]) for v in variants}
-    q = rng.uniform(-np.pi, np.pi, (SETUP_POSES, 6))
+            if resid > FIT_TOL:  # pragma: no cover - linear by construction
+                return f"the left-side fit of split {a} failed (residual {resid:.1e})"
+            for m in (0, 1):
+                v = Variant(rev, a, m)
+                blocks[v] = _block(v, consts, P)
+    return blocks
+
+
+def _trials(chain: Any, blocks: dict[Variant, np.ndarray], q: np.ndarray
+            ) -> tuple[dict[Variant, _Trial], int]:
+    """Each variant alone on the poses of q, against the reference: the union of
+    every variant's validated solutions and the generating configurations."""
+    from robokin.kinematics.forward import forward_kinematics
+
     T = np.ascontiguousarray(forward_kinematics(chain, q))
-    runs = {v: raw_solve(chain, _params([blocks[v]]), T, parallel=False) for v in variants}
-    # the reference: every validated solution of any variant, and the generating q
-    ref = [_distinct(np.concatenate([q[i:i + 1]] + [r[0][i][r[1][i]] for r in runs.values()]))
-           for i in range(SETUP_POSES)]
-    n_ref = sum(len(r) for r in ref)
-    # covered[v]: per pose, which reference solutions variant v found alone
-    covered = {v: [_close(ref[i], r[0][i][r[1][i]]).any(axis=1) for i in range(SETUP_POSES)]
-               for v, r in runs.items()}
-    trouble = {v: (r[4] & (K.G6F_DEGENERATE | K.G6F_AMBIGUOUS)) != 0 for v, r in runs.items()}
-    tails = {v: float(np.max(np.where(np.isfinite(r[5][:, 0]), r[5][:, 0], 1.0)))
-             for v, r in runs.items()}
-    pairs = {v: int(r[5][:, 2].sum()) for v, r in runs.items()}
-    missed = {v: n_ref - sum(int(c.sum()) for c in covered[v]) for v in variants}
-    degenerate = {v: int(((r[4] & K.G6F_DEGENERATE) != 0).sum()) for v, r in runs.items()}
-    # the expected work and fragility of a variant: a pose sent to the secondary costs
-    # about one variant (8 roots), a root sharing a 2-D null space with another one
-    cost = {v: 8 * int(trouble[v].sum()) + pairs[v] for v in variants}
+    runs = {v: raw_solve(chain, _params([b]), T, parallel=False) for v, b in blocks.items()}
+    found = {v: [r[0][i][r[1][i]] for i in range(len(q))] for v, r in runs.items()}
+    ref = [_distinct(np.concatenate([q[i:i + 1]] + [f[i] for f in found.values()]))
+           for i in range(len(q))]
+    trials = {}
+    for v, (_, _, _, _, diag, stats) in runs.items():
+        tail = stats[:, 0]
+        trials[v] = _Trial(
+            covered=[_close(ref[i], found[v][i]).any(axis=1) for i in range(len(q))],
+            trouble=(diag & (K.G6F_DEGENERATE | K.G6F_AMBIGUOUS)) != 0,
+            degenerate=int(((diag & K.G6F_DEGENERATE) != 0).sum()),
+            tail=float(np.max(np.where(np.isfinite(tail), tail, 1.0))),
+            pairs=int(stats[:, 2].sum()))
+    return trials, sum(len(r) for r in ref)
+
+
+def _choose(trials: dict[Variant, _Trial], poses: int) -> tuple[Variant, Variant] | None:
+    """The (primary, secondary) pair that finds every reference solution (the
+    secondary where the primary reports trouble), of the least primary cost, then
+    tail; None when no pair does."""
     best = None
-    for p in variants:
-        if 2 * degenerate[p] > SETUP_POSES:  # it would merely hand poses on
+    for p, tp in trials.items():
+        if 2 * tp.degenerate > poses:  # it would merely hand poses on
             continue
-        for s in variants:
-            if s == p:
+        for s, ts in trials.items():
+            if s == p or not all((cp | (tp.trouble[i] & cs)).all() for i, (cp, cs)
+                                 in enumerate(zip(tp.covered, ts.covered, strict=True))):
                 continue
-            complete = all((covered[p][i] | (trouble[p][i] & covered[s][i])).all()
-                           for i in range(SETUP_POSES))
             # a secondary with the primary's hidden joint meets the same double roots
-            key = (cost[p], tails[p], p.hidden_joint == s.hidden_joint, missed[s],
-                   cost[s], tails[s])
-            if complete and (best is None or key < best[0]):
+            key = (tp.cost, tp.tail, p.hidden_joint == s.hidden_joint, ts.missed, ts.cost,
+                   ts.tail)
+            if best is None or key < best[0]:
                 best = (key, p, s)
-    if best is None:
-        alone = min(variants, key=missed.__getitem__)
+    return None if best is None else (best[1], best[2])
+
+
+def _setup(chain: Any) -> General6R:
+    reason = why_not(chain)
+    if reason:
+        return General6R(None, reason=reason)
+    rng = np.random.default_rng(SETUP_SEED)
+    blocks = _fits(chain, rng)
+    if isinstance(blocks, str):  # pragma: no cover
+        return General6R(None, reason=blocks)
+    trials, n_ref = _trials(chain, blocks, rng.uniform(-np.pi, np.pi, (SETUP_POSES, 6)))
+    pair = _choose(trials, SETUP_POSES)
+    if pair is None:
+        alone = min(trials, key=lambda v: trials[v].missed)
         return General6R(None, reason=(
             f"no elimination variant finds every solution on {SETUP_POSES} test poses "
-            f"(best: {alone}, {n_ref - missed[alone]} of {n_ref})"))
-    _, tail_p, *_ = best[0]
-    p, s = best[1], best[2]
-    n_trouble = int(trouble[p].sum())
-    measured = (f"Raghavan-Roth elimination, {p} (secondary {s} on {n_trouble} of "
-                f"{SETUP_POSES} test poses); all {n_ref} solutions of the test poses "
-                f"found; DFT tail {tail_p:.1e}")
-    return General6R(_params([blocks[p], blocks[s]]), p, s, measured=measured, tail=tail_p)
+            f"(best: {alone}, {n_ref - trials[alone].missed} of {n_ref})"))
+    p, s = pair
+    tail = trials[p].tail
+    measured = (f"Raghavan-Roth elimination, {p} (secondary {s} on "
+                f"{int(trials[p].trouble.sum())} of {SETUP_POSES} test poses); all "
+                f"{n_ref} solutions of the test poses found; DFT tail {tail:.1e}")
+    return General6R(_params([blocks[p], blocks[s]]), p, s, measured=measured, tail=tail)
 
 
 # -------------------------------------------------------------- the solver
@@ -310,7 +353,7 @@ def _setup(chain: Any) -> General6R:
 def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
           singular_tol: float = 1e-6, compute_error: bool = False,
           parallel: bool | None = None) -> Any:
-    """Every solution of a general 6R arm for poses T (..., 4, 4) (already checked).
+    """Every solution of a general 6R arm for poses T (..., 4, 4).
 
     Args:
         robot: The arm (six revolute joints, no dependent joints).
@@ -324,27 +367,39 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
 
     Returns:
         A :class:`~robokin.kinematics.ik.solutions.SolutionSet` with
-        ``method="general_6r"``, at most 16 solutions per pose.
+        ``method="general_6r"``, at most 16 solutions per pose (rows that are not
+        solutions hold zeros).
+
+    Raises:
+        InputError: ``robot`` is not solved by this family (the message says why),
+            a pose is not a rigid transform, or ``q_near`` is not finite joint
+            values that broadcast to the poses.
     """
+    from robokin._validation import check_finite, check_joints, check_poses_fast
+    from robokin.exceptions import InputError
+
     chain = robot.chain
     g = setup(chain)
     if g.params is None:
-        from robokin.exceptions import InputError
-
         raise InputError("robot", f"'{robot.name}' is not solved by {NAME}: {g.reason}")
-    T = np.asarray(T, dtype=np.float64)
+    T = check_poses_fast(T, "T")
     lead = T.shape[:-2]
     Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
     Q, valid, sigma, status, diag, _ = raw_solve(chain, g.params, Tf, parallel)
     Q = fit_turns(np.where(valid[..., None], Q, 0.0), chain.is_revolute, chain.limits)
     if q_near is not None:
-        Q, valid, sigma = _order_by(Q, valid, sigma, np.asarray(q_near, dtype=np.float64),
-                                    lead)
+        qn = check_finite(check_joints(q_near, 6, "q_near"), "q_near")
+        try:
+            qn = np.broadcast_to(qn, lead + (6,)).reshape(-1, 1, 6)
+        except ValueError as exc:
+            raise InputError("q_near", f"shape {qn.shape} does not broadcast to the "
+                                       f"targets' {lead + (6,)}") from exc
+        Q, valid, sigma = _order_by(Q, valid, sigma, qn)
     n = Q.shape[1]
     Q = Q.reshape(lead + (n, 6))
     valid = valid.reshape(lead + (n,))
     sing = (sigma < singular_tol).reshape(lead + (n,))
-    codes = np.vectorize(_STATUS.get, otypes=[np.int8])(status).reshape(lead)
+    codes = _STATUS[status].reshape(lead)
     error = None
     if compute_error:
         dp, dr = fk_error(chain, Q, T)
@@ -355,9 +410,9 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
                     status_codes=codes, method=NAME, info=info, error=error)
 
 
-def _order_by(Q: np.ndarray, valid: np.ndarray, sigma: np.ndarray, q_near: np.ndarray,
-              lead: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    qn = np.broadcast_to(q_near, lead + (6,)).reshape(-1, 1, 6)
+def _order_by(Q: np.ndarray, valid: np.ndarray, sigma: np.ndarray, qn: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Rows of each pose ordered by wrapped distance to qn (N, 1, 6), valid first."""
     d = (Q - qn + np.pi) % (2 * np.pi) - np.pi
     key = np.where(valid, np.linalg.norm(d, axis=-1), np.inf)
     order = np.argsort(key, axis=1, kind="stable")
