@@ -69,7 +69,9 @@ enum { GP_NVAR = 0 /* variants: 1 (primary) or 2 (+ secondary) */,
        GP_IMAG_TOL = 3 /* imaginary part of theta_a accepted as real */,
        GP_TOL = 4 /* position [m] and rotation [rad] error of a solution */,
        GP_DEDUPE = 5 /* solutions closer than this [rad] are one */,
-       GP_MAX_ITER = 6 /* Newton iterations */, GP_HEAD = 8 };
+       GP_MAX_ITER = 6 /* Newton iterations */,
+       GP_PAIR_GAP = 7 /* [rad] roots closer than this: both solutions from a 2-D null space */,
+       GP_HEAD = 8 };
 /* variant block: direction (0 the chain, 1 its reversal), split a, multiplier
  * (0 x_b, 1 x_c), the direction's constants C'_0..C'_6 and their inverses (4x4
  * row-major), the fitted P_s, P_c, P_1 (14 x 9 row-major each) */
@@ -726,6 +728,7 @@ static int all_roots16(const double *c, int jbest, double *wr, double *wi)
 
 typedef struct {
     double v[6]; /* chain values, original joint order */
+    int slow;    /* from a close pair: Newton may converge only linearly there */
 } G6Cand;
 
 /* The inverse of K_k (1-based k) in the direction's loop for the pose Tp. */
@@ -828,8 +831,6 @@ static void g6_rot_span(const double *vb, const double *v, int first_const, int 
         memcpy(R, tmp, sizeof(tmp));
     }
 }
-
-#define PAIR_GAP 0.05 /* [rad] roots closer than this may share a 2-D null space */
 
 /* Two solutions (t_b, t_c) in the span of y, y2 (Sigma's two smallest singular
  * vectors at a root two solutions (nearly) share): the combinations c with the
@@ -973,7 +974,7 @@ static int g6_candidate(const G6Back *G, double th, double s, double c, double t
 }
 
 /* Candidate chain values of one variant for the pose T (4x4 row-major): appended
- * to cand (at most 2 G6_MAXROOT); flags get G6F_DEGENERATE / G6F_AMBIGUOUS; stats[0]
+ * to cand (at most 3 G6_MAXROOT); flags get G6F_DEGENERATE / G6F_AMBIGUOUS; stats[0]
  * the relative DFT tail, stats[1] the margin (the smallest ratio of Sigma's
  * second-smallest to largest pivot over the roots tried), stats[2] how many roots
  * were close to another (two solutions nearly sharing theta_a: both taken from a
@@ -1121,7 +1122,8 @@ static int g6_variant(const double *P, const double *vb, const double *T, G6Cand
         return 0;
     }
     /* the accepted roots (a complex pair counts once, as a possible pair of close
-     * real roots; so do roots within PAIR_GAP of another) */
+     * real roots; so do roots within the pair gap of another) */
+    const double pair_gap = P[GP_PAIR_GAP];
     double ths[16];
     int nr = 0, pair[16];
     for (int k = 0; k < 16; k++) {
@@ -1135,7 +1137,7 @@ static int g6_variant(const double *P, const double *vb, const double *T, G6Cand
     }
     for (int i = 0; i < nr; i++)
         for (int j = i + 1; j < nr; j++)
-            if (fabs(wrap_pi(ths[i] - ths[j])) < PAIR_GAP)
+            if (fabs(wrap_pi(ths[i] - ths[j])) < pair_gap)
                 pair[i] = pair[j] = 1;
     G6Back G = {vb, Tp, Q, V8, beta8, A8, a, dir};
     /* back-substitution, W roots at a time for the null vectors */
@@ -1157,26 +1159,35 @@ static int g6_variant(const double *P, const double *vb, const double *T, G6Cand
             stats[1] = margin < stats[1] ? margin : stats[1];
             if (!(margin > null_tol))
                 *flags |= G6F_AMBIGUOUS;
-            double tb[2], tc[2];
+            /* the smallest singular vector's solution; where two solutions may share
+             * theta (a close or complex pair, a 2-D null space) also the two in the
+             * span of the two smallest (at a singular solution the pair is one
+             * solution twice and only the first is right) */
+            double tb[3], tc[3];
             int np = 1;
-            if (pair[k0 + l] || !(margin > null_tol)) { /* two solutions may share theta */
+            tb[0] = g6_half_angle(y, mult, 1);
+            tc[0] = g6_half_angle(y, mult, 0);
+            if (pair[k0 + l] || !(margin > null_tol)) {
                 stats[2] += 1.0;
                 double y2[12];
                 for (int i = 0; i < 12; i++)
                     y2[i] = yv2[i][l];
-                np = g6_two_solutions(y, y2, mult, tb, tc);
-            } else {
-                tb[0] = g6_half_angle(y, mult, 1);
-                tc[0] = g6_half_angle(y, mult, 0);
+                np += g6_two_solutions(y, y2, mult, tb + 1, tc + 1);
             }
-            for (int k = 0; k < np; k++)
+            for (int k = 0; k < np; k++) {
+                cand[nc].slow = np > 1;
                 nc += g6_candidate(&G, th, s, c, tb[k], tc[k], cand + nc);
+            }
         }
     }
     return nc;
 }
 
 /* ------------------------------------------------------------ Newton polish */
+
+#define NEWTON_RATIO 0.7 /* a step must cut the error by this factor (after 3) */
+#define SLOW_RATIO 0.9   /* ... from a close pair of roots (after SLOW_START) */
+#define SLOW_START 8
 
 /* Smallest singular value of the 6 x 6 row-major J (lane-wise): inverse iteration
  * on J^T J (Cholesky), started at the unit vector of the smallest Cholesky pivot;
@@ -1270,6 +1281,10 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
         for (int l = 0; l < W; l++)
             if (c0 + l >= ncand)
                 done[l] = -1;
+        double prev[W];
+        int slow[W];
+        for (int l = 0; l < W; l++)
+            slow[l] = c0 + l < ncand && cand[c0 + l].slow;
         for (int it = 0;; it++) {
             chain_pose_jac(ch, qv, t, J, 6);
             pose_residual(t, tt, e, BRL(-1));
@@ -1278,10 +1293,15 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
                 double m = 0.0;
                 for (int r = 0; r < 6; r++)
                     m = fabs(e[r][l]) > m ? fabs(e[r][l]) : m;
-                /* converged, or a spurious root: Newton from a true one converges
-                 * quadratically, so an error still above 1e-4 after 4 steps gives up */
-                if (!(m > 1e-14) || !isfinite(m) || (it >= 4 && m > 1e-4))
+                /* converged, or a spurious root: from a true one Newton converges
+                 * quadratically, so a lane whose error stops falling gives up; near
+                 * a singular solution (a close pair of roots) it may be linear with
+                 * ratio 1/2 after an erratic start */
+                int stalled = slow[l] ? it >= SLOW_START && m > SLOW_RATIO * prev[l]
+                                      : it >= 3 && m > NEWTON_RATIO * prev[l];
+                if (!(m > 1e-14) || !isfinite(m) || stalled)
                     done[l] = -1;
+                prev[l] = m;
                 all &= done[l] != 0;
             }
             if (all || it == max_iter)
@@ -1347,7 +1367,7 @@ static int g6_pose(const Chain *ch, const double *P, const double *T, double *q,
             stats[2] = 0.0;
             return -1;
         }
-    G6Cand cand[4 * G6_MAXROOT]; /* two variants, up to two per root */
+    G6Cand cand[6 * G6_MAXROOT]; /* two variants, up to three per root */
     int flags = 0, f2 = 0;
     double st2[3];
     int nc = g6_variant(P, P + GP_HEAD, T, cand, &flags, stats);
@@ -1597,7 +1617,8 @@ static int general6r_constants(PyObject *m)
     static const struct { const char *name; int value; } ints[] = {
         {"G6_MAXSOL", G6_MAXSOL}, {"GP_NVAR", GP_NVAR}, {"GP_TAIL_TOL", GP_TAIL_TOL},
         {"GP_NULL_TOL", GP_NULL_TOL}, {"GP_IMAG_TOL", GP_IMAG_TOL}, {"GP_TOL", GP_TOL},
-        {"GP_DEDUPE", GP_DEDUPE}, {"GP_MAX_ITER", GP_MAX_ITER}, {"GP_HEAD", GP_HEAD},
+        {"GP_DEDUPE", GP_DEDUPE}, {"GP_MAX_ITER", GP_MAX_ITER},
+        {"GP_PAIR_GAP", GP_PAIR_GAP}, {"GP_HEAD", GP_HEAD},
         {"VB_DIR", VB_DIR}, {"VB_A", VB_A}, {"VB_MULT", VB_MULT}, {"VB_C", VB_C},
         {"VB_CI", VB_CI}, {"VB_P", VB_P}, {"VB_SIZE", VB_SIZE}, {"G6_OK", G6_OK},
         {"G6_NONE", G6_NONE}, {"G6_DEGENERATE", G6_DEGENERATE},

@@ -62,7 +62,8 @@ NULL_TOL = 1e-7  # Sigma's second-smallest / largest pivot below: 2-D null space
 IMAG_TOL = 5e-2  # imaginary part of theta_a [rad] still tried as a real root
 SOLUTION_TOL = 1e-9  # position [m] and rotation [rad] error of a solution
 DEDUPE_TOL = 1e-6  # [rad] solutions closer than this are one
-NEWTON_ITERATIONS = 12
+NEWTON_ITERATIONS = 40  # most: singular solutions converge linearly
+PAIR_GAP = 1e-2  # [rad] roots closer: both solutions from a 2-D null space
 _PARALLEL_MIN = 32  # below this many poses one thread (the kernel's own threshold)
 # kernel status (ok, none, degenerate, bad pose) -> _common.STATUS_TEXT code
 _STATUS = np.array([0, 1, 5, 1], dtype=np.int8)
@@ -175,6 +176,7 @@ def _header(n_variants: int) -> np.ndarray:
     h[K.GP_TOL] = SOLUTION_TOL
     h[K.GP_DEDUPE] = DEDUPE_TOL
     h[K.GP_MAX_ITER] = NEWTON_ITERATIONS
+    h[K.GP_PAIR_GAP] = PAIR_GAP
     return h
 
 
