@@ -24,10 +24,17 @@
  * dialytic matrix Sigma(theta_a), entries linear in (s_a, c_a, 1) (Manocha & Canny
  * 1994, section 4). det Sigma(theta_a) is a trigonometric polynomial of degree 8:
  * sampled at 24 angles, its DFT gives it (the part above degree 8, the "tail",
- * must vanish), and its real roots are the eigenvalues (balanced companion matrix,
- * Francis double-shift QR as in EISPACK hqr) of the degree-16 polynomial in
- * x = tan((theta_a - phi) / 2). Each root: the null vector of Sigma gives x_b, x_c;
- * least squares on Q's block gives u, w; joint a+3 follows from the orientation.
+ * must vanish), and its real roots are those of the degree-16 polynomial in
+ * x = tan((theta_a - phi) / 2) (phi + pi the sample of largest |D|): the roots the
+ * samples bracket by safeguarded Newton steps, deflated, then the eigenvalues of
+ * the deflated polynomial's balanced companion matrix (Francis double-shift QR as
+ * in EISPACK hqr). Roots with a small imaginary part are tried too. Each root: the
+ * null vector of Sigma (pivoted QR) gives x_b, x_c; least squares on Q's block
+ * gives u, w; joint a+3 follows from the orientation. Where two roots are close or
+ * complex (two solutions nearly sharing theta_a) both solutions also come from the
+ * span of Sigma's two smallest singular vectors (a 2 x 2 pencil). Newton steps on
+ * the true chain polish every candidate; a candidate whose error stops falling is
+ * spurious and dropped, and so is one that does not reproduce the pose to 1e-9.
  *
  * An arm is solved by a variant: the split a, the chain or its reversal (the IK
  * of T^-1 on C_6^-1 Rz(-v_6) ... Rz(-v_1) C_0^-1) and the multiplier. The Python
