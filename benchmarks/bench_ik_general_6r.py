@@ -185,64 +185,55 @@ def ik_geo_sets(robot, T: np.ndarray) -> tuple[list[np.ndarray], float] | None:
 
 
 # ----------------------------------------------------------------------- main
+def _row(label: str, one: str, all_: str, counts: list[int], gen: str) -> None:
+    print(f"  {label:<26s} {one:>20s} {all_:>12s} {counts[0]:6d} {counts[1]:8d} "
+          f"{counts[2]:6d} {gen:>19s}")
+
+
 def run_group(name: str, robots: list, poses: int, sub: int, ref_seeds: int,
               geo: int, rng: np.random.Generator) -> None:
+    """Time and check every method on the arms of one group; print its table."""
     per = poses // len(robots)
     speed = {"1 thread": 0.0, "1 thread cpu": 0.0, "all threads": 0.0, "robot.ik": 0.0}
-    rows = {"robokin general_6r": [0, 0, 0, 0], "numeric, 16 seeds": [0, 0, 0, 0],
-            "ik-geo gen_six_dof": [0, 0, 0, 0], "reference": [0, 0, 0, 0]}
-    gen = {"robokin general_6r": [], "numeric, 16 seeds": []}
+    counts = {"robokin": [0, 0, 0], "numeric": [0, 0, 0], "ik-geo": [0, 0, 0]}
+    gen = {"robokin": [], "numeric": []}
     t_num = t_geo = 0.0
-    n_geo = 0
+    n_ref = n_geo = 0
     for robot in robots:
         q = rng.uniform(-np.pi, np.pi, (per, 6))
         T = robot.fk(q)
         for k, v in robokin_speed(robot, T).items():
             speed[k] += v / len(robots)
         ours = robokin_sets(robot, T)
-        gen["robokin general_6r"].append(generating_found(q, ours))
+        gen["robokin"].append(generating_found(q, ours))
         ref = [numeric.solve_all(open_limits(robot), T[i], n_seeds=ref_seeds,
                                  rng=np.random.default_rng(i)).solutions()
                for i in range(sub)]
-        rows["reference"][0] += sum(len(r) for r in ref)
-        for key, sets in (("robokin general_6r", ours[:sub]),):
-            f, m, e = compare(sets, ref)
-            rows[key][0] += f
-            rows[key][1] += m
-            rows[key][2] += e
+        n_ref += sum(len(r) for r in ref)
         num, dt = numeric_sets(open_limits(robot), T[:sub], 16, np.random.default_rng(1))
         t_num += dt / len(robots)
-        f, m, e = compare(num, ref)
-        rows["numeric, 16 seeds"][0] += f
-        rows["numeric, 16 seeds"][1] += m
-        rows["numeric, 16 seeds"][2] += e
-        gen["numeric, 16 seeds"].append(generating_found(q[:sub], num))
+        gen["numeric"].append(generating_found(q[:sub], num))
+        found = {"robokin": (ours[:sub], ref), "numeric": (num, ref)}
         g = ik_geo_sets(robot, T[:geo]) if geo else None
         if g is not None:
-            sets, dt = g
-            t_geo += dt / len(robots)
+            t_geo += g[1] / len(robots)
             n_geo += geo
-            f, m, e = compare(sets, ref[:geo])
-            rows["ik-geo gen_six_dof"][0] += f
-            rows["ik-geo gen_six_dof"][1] += m
-            rows["ik-geo gen_six_dof"][2] += e
-    nref = rows["reference"][0]
+            found["ik-geo"] = (g[0], ref[:geo])
+        for key, (sets, refs) in found.items():
+            counts[key] = [a + b for a, b in zip(counts[key], compare(sets, refs),
+                                                  strict=True)]
     print(f"\n{name}: {poses} poses ({len(robots)} arm(s)); completeness on {sub} poses "
-          f"per arm against a {ref_seeds}-start reference ({nref} solutions)")
-    print(f"  {'method':<26s} {'us/pose 1 thr (cpu)':>20s} {'us/pose all':>12s} {'found':>6s} "
-          f"{'missing':>8s} {'extra':>6s} {'generating q found':>19s}")
-    r = rows["robokin general_6r"]
-    one = f"{speed['1 thread']:.1f} ({speed['1 thread cpu']:.1f})"
-    print(f"  {'robokin general_6r':<26s} {one:>20s} {speed['all threads']:12.1f} "
-          f"{r[0]:6d} {r[1]:8d} {r[2]:6d} {100 * np.mean(gen['robokin general_6r']):18.2f}%")
+          f"per arm against a {ref_seeds}-start reference ({n_ref} solutions)")
+    print(f"  {'method':<26s} {'us/pose 1 thr (cpu)':>20s} {'us/pose all':>12s} "
+          f"{'found':>6s} {'missing':>8s} {'extra':>6s} {'generating q found':>19s}")
+    pct = {k: f"{100 * np.mean(v):.2f}%" for k, v in gen.items()}
+    _row("robokin general_6r", f"{speed['1 thread']:.1f} ({speed['1 thread cpu']:.1f})",
+         f"{speed['all threads']:.1f}", counts["robokin"], pct["robokin"])
     print(f"  {'  (robot.ik, full call)':<26s} {'':>20s} {speed['robot.ik']:12.1f}")
-    r = rows["numeric, 16 seeds"]
-    print(f"  {'numeric, 16 seeds':<26s} {'':>20s} {t_num:12.1f} {r[0]:6d} {r[1]:8d} {r[2]:6d} "
-          f"{100 * np.mean(gen['numeric, 16 seeds']):18.2f}%")
+    _row("numeric, 16 seeds", "", f"{t_num:.1f}", counts["numeric"], pct["numeric"])
     if n_geo:
-        r = rows["ik-geo gen_six_dof"]
-        print(f"  {'ik-geo gen_six_dof':<26s} {t_geo:20.0f} {'':>12s} {r[0]:6d} {r[1]:8d} "
-              f"{r[2]:6d} {'':>19s}  (first {geo} poses per arm)")
+        _row("ik-geo gen_six_dof", f"{t_geo:.0f}", "", counts["ik-geo"],
+             f"(first {geo} poses/arm)")
 
 
 def main(poses: int = 10_000, sub: int = 20, ref_seeds: int = 2000, geo: int = 3,
@@ -252,7 +243,8 @@ def main(poses: int = 10_000, sub: int = 20, ref_seeds: int = 2000, geo: int = 3
     print(f"robokin {robokin.__version__}, kernels {_native.ISA}, "
           f"{_native.num_threads()} pool threads")
     groups = [("random general 6R DH arms", [random_arm(rng, k) for k in range(n_random)]),
-              ("ABB IRB140 (rtb-data URDF)", [robokin.Robot.from_urdf(IRB140, geometry=False)]),
+              ("ABB IRB140 (rtb-data URDF)",
+               [robokin.Robot.from_urdf(IRB140, geometry=False)]),
               ("UR5, twisted forearm + offset wrist", [ur_twisted()])]
     for name, robots in groups:
         for robot in robots:

@@ -31,9 +31,9 @@ def random_dh_arm(rng, name="random_6r"):
 def ur_twisted(twist=0.05, offset=0.02):
     """UR5's DH table with a twisted forearm (alpha_3 = twist) and the wrist offset
     by ``offset`` along a_5: no closed form applies."""
-    rows = [{"d": 0.089159, "alpha": math.pi / 2}, {"a": -0.425}, {"a": -0.39225, "alpha": twist},
-            {"d": 0.10915, "alpha": math.pi / 2}, {"d": 0.09465, "a": offset, "alpha": -math.pi / 2},
-            {"d": 0.0823}]
+    rows = [{"d": 0.089159, "alpha": math.pi / 2}, {"a": -0.425},
+            {"a": -0.39225, "alpha": twist}, {"d": 0.10915, "alpha": math.pi / 2},
+            {"d": 0.09465, "a": offset, "alpha": -math.pi / 2}, {"d": 0.0823}]
     for r in rows:
         r.setdefault("a", 0.0)
         r.setdefault("d", 0.0)
@@ -148,9 +148,11 @@ def test_generating_configuration_always_found_and_round_trip():
 def test_near_family_arm_is_solved_at_least_as_completely_as_its_closed_form():
     # a calibrated UR5 (the near-family test's arm): general_6r by default; it has
     # every solution the nominal closed form + Newton finds
-    rows = [{"a": 0, "alpha": math.pi / 2, "d": 0.089159}, {"a": -0.425, "alpha": 0, "d": 0},
-            {"a": -0.39225, "alpha": 0, "d": 0}, {"a": 0, "alpha": math.pi / 2, "d": 0.10915},
-            {"a": 0, "alpha": -math.pi / 2, "d": 0.09465}, {"a": 0, "alpha": 0, "d": 0.0823}]
+    rows = [{"a": 0, "alpha": math.pi / 2, "d": 0.089159},
+            {"a": -0.425, "alpha": 0, "d": 0}, {"a": -0.39225, "alpha": 0, "d": 0},
+            {"a": 0, "alpha": math.pi / 2, "d": 0.10915},
+            {"a": 0, "alpha": -math.pi / 2, "d": 0.09465},
+            {"a": 0, "alpha": 0, "d": 0.0823}]
     rng = np.random.default_rng(5)
     for row in rows:
         row["alpha"] += rng.normal(0, 1e-3)
