@@ -217,15 +217,32 @@ def test_singular_flag_is_the_jacobians_smallest_singular_value():
     assert not sols.singular[~sols.valid].any()
 
 
-def test_q_near_orders_solutions_and_limits_are_flagged():
-    robot = irb140()
+def test_limits_q_near_and_the_single_pose_path():
+    robot = irb140()  # joints 2, 3, 5 narrower than a turn, joints 4, 6 wider
     rng = np.random.default_rng(24)
-    q = rng.uniform(-np.pi, np.pi, (5, 6))
-    sols = robot.ik(robot.fk(q), q_near=q)
-    np.testing.assert_allclose(wrapped(sols.q[:, 0] - q), 0.0, atol=1e-7)
+    q = rng.uniform(-np.pi, np.pi, (40, 6))
+    T = robot.fk(q)
+    sols = robot.ik(T)
     lim = robot.limits
     inside = ((sols.q >= lim[:, 0] - 1e-9) & (sols.q <= lim[:, 1] + 1e-9)).all(-1)
     np.testing.assert_array_equal(sols.flags["within_limits"], inside & sols.valid)
+    assert inside.any() and not inside[sols.valid].all()
+    # revolute values in [-pi, pi) unless a whole turn puts them into the limits
+    shifted = (sols.q < -np.pi) | (sols.q >= np.pi)
+    assert not (shifted & ~inside[..., None])[sols.valid].any()
+    # q_near changes nothing: the solutions are isolated (SolutionSet.nearest picks)
+    near = robot.ik(T, q_near=q)
+    np.testing.assert_array_equal(near.q, sols.q)
+    np.testing.assert_allclose(wrapped(near.nearest(q, respect_limits=False) - q), 0.0,
+                               atol=1e-7)
+    # the single-pose path gives the batch's rows
+    for i in range(0, 40, 7):
+        one = robot.ik(T[i])
+        assert one.method == "general_6r" and one.shape == ()
+        np.testing.assert_array_equal(one.q, sols.q[i])
+        np.testing.assert_array_equal(one.flags["within_limits"],
+                                      sols.flags["within_limits"][i])
+        assert one.status == sols.status[i]
 
 
 def test_unreachable_pose_has_no_solution_and_says_so():

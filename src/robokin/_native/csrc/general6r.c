@@ -1398,7 +1398,7 @@ typedef struct {
     const Chain *ch;
     const double *P, *T;
     double *Q, *sig, *stats;
-    npy_bool *valid;
+    npy_bool *valid, *inside;
     long long *status, *diag;
 } G6Job;
 
@@ -1413,12 +1413,18 @@ static void g6_range(void *ctx, long b, long e)
                          : ns == 0 ? G6_NONE : G6_OK;
         ns = ns < 0 ? 0 : ns;
         double *Qo = job->Q + (size_t)i * 6 * G6_MAXSOL;
+        const Chain *ch = job->ch;
         for (int s = 0; s < G6_MAXSOL; s++) {
-            int ok = s < ns;
+            int ok = s < ns, in = ok;
+            for (int j = 0; j < 6; j++) {
+                /* whole turns into the limits where possible (lm.c's wrap_into) */
+                double v = ok ? wrap_into(q[6 * s + j], ch->lo[j], ch->hi[j]) : 0.0;
+                in &= v >= ch->lo[j] - 1e-9 && v <= ch->hi[j] + 1e-9;
+                Qo[6 * s + j] = v;
+            }
             job->valid[i * G6_MAXSOL + s] = (npy_bool)ok;
+            job->inside[i * G6_MAXSOL + s] = (npy_bool)in;
             job->sig[i * G6_MAXSOL + s] = ok ? sig[s] : NAN;
-            for (int j = 0; j < 6; j++)
-                Qo[6 * s + j] = ok ? q[6 * s + j] : NAN;
         }
     }
 }
@@ -1461,15 +1467,20 @@ static int g6_params_ok(const double *P, long len)
 }
 
 /* general6r_solve(packed, params, T (N, 4, 4), Q (N, 16, 6), valid (N, 16) bool,
- *                 sigma (N, 16), status (N,) int64, diag (N,) int64, stats (N, 3),
- *                 parallel) */
+ *                 inside (N, 16) bool, sigma (N, 16), status (N,) int64,
+ *                 diag (N,) int64, stats (N, 3), parallel): per pose up to 16
+ * solutions (joint coordinates, revolute ones in [-pi, pi) or moved by whole turns
+ * into their limits; rows that are not solutions 0), which are solutions, which
+ * are inside the limits, the Jacobian's smallest singular value (NaN on other
+ * rows), the status (G6_OK ...), the flags (G6F_..., candidates tried above
+ * G6_DIAG_CAND_SHIFT) and the primary's tail, margin and close pairs. */
 static PyObject *py_general6r_solve(PyObject *self, PyObject *args)
 {
-    PyObject *o[9];
+    PyObject *o[10];
     int parallel;
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOp", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
-                          &o[6], &o[7], &o[8], &parallel))
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOp", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
+                          &o[6], &o[7], &o[8], &o[9], &parallel))
         return NULL;
     Chain ch;
     if (!chain_arg(o[0], &ch))
@@ -1499,24 +1510,26 @@ static PyObject *py_general6r_solve(PyObject *self, PyObject *args)
     if (T == NULL)
         return NULL;
     npy_intp N = PyArray_DIMS(T)[0];
-    PyArrayObject *Q, *valid, *sig, *status, *diag, *stats;
-    if (!g6_shape(T, "T", N, 4, 4) ||
-        !(Q = array_arg(o[3], "Q", NPY_DOUBLE, 3, 1)) || !g6_shape(Q, "Q", N, 16, 6) ||
-        !(valid = array_arg(o[4], "valid", NPY_BOOL, 2, 1)) ||
-        !g6_shape(valid, "valid", N, 16, 0) ||
-        !(sig = array_arg(o[5], "sigma", NPY_DOUBLE, 2, 1)) ||
-        !g6_shape(sig, "sigma", N, 16, 0) ||
-        !(status = array_arg(o[6], "status", NPY_INT64, 1, 1)) ||
-        !g6_shape(status, "status", N, 0, 0) ||
-        !(diag = array_arg(o[7], "diag", NPY_INT64, 1, 1)) ||
-        !g6_shape(diag, "diag", N, 0, 0) ||
-        !(stats = array_arg(o[8], "stats", NPY_DOUBLE, 2, 1)) ||
-        !g6_shape(stats, "stats", N, 3, 0))
+    if (!g6_shape(T, "T", N, 4, 4))
         return NULL;
+    enum { A_Q, A_VALID, A_INSIDE, A_SIG, A_STATUS, A_DIAG, A_STATS, N_OUT };
+    static const char *names[N_OUT] = {"Q", "valid", "inside", "sigma", "status", "diag",
+                                       "stats"};
+    static const int types[N_OUT] = {NPY_DOUBLE, NPY_BOOL, NPY_BOOL, NPY_DOUBLE, NPY_INT64,
+                                     NPY_INT64, NPY_DOUBLE};
+    static const int ndims[N_OUT] = {3, 2, 2, 2, 1, 1, 2};
+    static const npy_intp d1[N_OUT] = {16, 16, 16, 16, 0, 0, 3};
+    PyArrayObject *a[N_OUT];
+    for (int k = 0; k < N_OUT; k++)
+        if (!(a[k] = array_arg(o[3 + k], names[k], types[k], ndims[k], 1)) ||
+            !g6_shape(a[k], names[k], N, d1[k], 6))
+            return NULL;
     G6Job job = {&ch, (const double *)PyArray_DATA(P), (const double *)PyArray_DATA(T),
-                 (double *)PyArray_DATA(Q), (double *)PyArray_DATA(sig),
-                 (double *)PyArray_DATA(stats), (npy_bool *)PyArray_DATA(valid),
-                 (long long *)PyArray_DATA(status), (long long *)PyArray_DATA(diag)};
+                 (double *)PyArray_DATA(a[A_Q]), (double *)PyArray_DATA(a[A_SIG]),
+                 (double *)PyArray_DATA(a[A_STATS]), (npy_bool *)PyArray_DATA(a[A_VALID]),
+                 (npy_bool *)PyArray_DATA(a[A_INSIDE]),
+                 (long long *)PyArray_DATA(a[A_STATUS]),
+                 (long long *)PyArray_DATA(a[A_DIAG])};
     Py_BEGIN_ALLOW_THREADS
     if (parallel && N >= G6_PARALLEL_MIN)
         pool_for((long)N, G6_GRAIN, g6_range, &job);
@@ -1611,8 +1624,8 @@ static PyObject *py_general6r_roots(PyObject *self, PyObject *args)
 
 #define GENERAL6R_METHODS                                                                  \
     {"general6r_solve", py_general6r_solve, METH_VARARGS,                                  \
-     "general6r_solve(packed, params, T, Q, valid, sigma, status, diag, stats, parallel): " \
-     "every IK solution of a general 6R chain."},                                          \
+     "general6r_solve(packed, params, T, Q, valid, inside, sigma, status, diag, stats, " \
+     "parallel): every IK solution of a general 6R chain."},                              \
     {"general6r_fit_rows", py_general6r_fit_rows, METH_VARARGS,                            \
      "general6r_fit_rows(consts, a, angles, X, Y): the left side's fitting rows."},        \
     {"general6r_roots", py_general6r_roots, METH_VARARGS,                                  \

@@ -205,6 +205,7 @@ def _general_6r_family(chain: Any, details: dict[str, str]) -> Family:
     def general_solver(robot, T, q_near=None, **options):
         return _g6.solve(robot, T, q_near, **options)
 
+    general_solver.single = _g6.make_single(chain)  # type: ignore[attr-defined]
     return Family(_g6.NAME, general_solver, measured=setup.measured, details=details)
 
 

@@ -45,10 +45,11 @@ from typing import Any
 import numpy as np
 
 from robokin import _native
-from robokin.kinematics.ik.analytic._common import fit_turns, fk_error, make_set
+from robokin.kinematics.ik.analytic._common import fk_error, make_set
 from robokin.kinematics.per_chain import cached
 
-__all__ = ["NAME", "General6R", "Variant", "raw_solve", "setup", "solve", "why_not"]
+__all__ = ["NAME", "General6R", "Variant", "make_single", "raw_solve", "setup", "solve",
+           "why_not"]
 
 NAME = "general_6r"
 K = _native.kernels
@@ -202,24 +203,26 @@ def _params(blocks: list[np.ndarray]) -> np.ndarray:
 
 def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
               parallel: bool | None = None) -> tuple[np.ndarray, ...]:
-    """The bare kernel call: T (N, 4, 4) C-contiguous float64 -> (q (N, 16, 6) [rad]
-    in [-pi, pi) (NaN rows are not solutions), valid (N, 16), sigma (N, 16) the
+    """The bare kernel call: T (N, 4, 4) C-contiguous float64 -> (q (N, 16, 6) [rad],
+    valid (N, 16), inside (N, 16) the valid rows within the limits, sigma (N, 16) the
     Jacobian's smallest singular value, status (N,) int64 (kernel codes), diag (N,)
     int64 (kernel flags; >> G6_DIAG_CAND_SHIFT the roots tried), stats (N, 3): the
     primary's relative DFT tail, null-space margin and roots taken as close pairs).
-    No input checks.
+    Revolute values are in [-pi, pi), or moved by whole turns into their limits
+    where that is possible; rows that are not solutions are 0. No input checks.
     """
     N = T.shape[0]
     Q = np.empty((N, MAX_SOLUTIONS, 6))
     valid = np.empty((N, MAX_SOLUTIONS), np.bool_)
+    inside = np.empty((N, MAX_SOLUTIONS), np.bool_)
     sigma = np.empty((N, MAX_SOLUTIONS))
     status = np.empty(N, np.int64)
     diag = np.empty(N, np.int64)
     stats = np.empty((N, 3))
     par = N >= _PARALLEL_MIN if parallel is None else bool(parallel)
-    K.general6r_solve(chain.arrays.packed, params, T, Q, valid, sigma, status, diag, stats,
-                      par)
-    return Q, valid, sigma, status, diag, stats
+    K.general6r_solve(chain.arrays.packed, params, T, Q, valid, inside, sigma, status, diag,
+                      stats, par)
+    return Q, valid, inside, sigma, status, diag, stats
 
 
 # -------------------------------------------------------- variant choice
@@ -295,7 +298,7 @@ def _trials(chain: Any, blocks: dict[Variant, np.ndarray], q: np.ndarray
     ref = [_distinct(np.concatenate([q[i:i + 1]] + [f[i] for f in found.values()]))
            for i in range(len(q))]
     trials = {}
-    for v, (_, _, _, _, diag, stats) in runs.items():
+    for v, (_, _, _, _, _, diag, stats) in runs.items():
         tail = stats[:, 0]
         trials[v] = _Trial(
             covered=[_close(ref[i], found[v][i]).any(axis=1) for i in range(len(q))],
@@ -360,8 +363,9 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
     Args:
         robot: The arm (six revolute joints, no dependent joints).
         T: Target poses (..., 4, 4) [m], rigid transforms.
-        q_near: Joint values (..., 6) or (6,) [rad]; when given, the solutions of
-            each pose are ordered by (wrapped) distance to it.
+        q_near: Accepted for the solvers' common signature and checked; the
+            solutions are isolated, so it changes nothing (pick with
+            ``SolutionSet.nearest``).
         singular_tol: A solution is flagged ``singular`` when the smallest singular
             value of its Jacobian is below this.
         compute_error: Fill ``error`` with each solution's FK error.
@@ -370,12 +374,13 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
     Returns:
         A :class:`~robokin.kinematics.ik.solutions.SolutionSet` with
         ``method="general_6r"``, at most 16 solutions per pose (rows that are not
-        solutions hold zeros).
+        solutions hold zeros); revolute values in [-pi, pi), or moved by whole turns
+        into their limits where that is possible.
 
     Raises:
         InputError: ``robot`` is not solved by this family (the message says why),
             a pose is not a rigid transform, or ``q_near`` is not finite joint
-            values that broadcast to the poses.
+            values (n,) or (..., n) that broadcast to the poses.
     """
     from robokin._validation import check_finite, check_joints, check_poses_fast
     from robokin.exceptions import InputError
@@ -386,38 +391,64 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
         raise InputError("robot", f"'{robot.name}' is not solved by {NAME}: {g.reason}")
     T = check_poses_fast(T, "T")
     lead = T.shape[:-2]
-    Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
-    Q, valid, sigma, status, diag, _ = raw_solve(chain, g.params, Tf, parallel)
-    Q = fit_turns(np.where(valid[..., None], Q, 0.0), chain.is_revolute, chain.limits)
     if q_near is not None:
         qn = check_finite(check_joints(q_near, 6, "q_near"), "q_near")
         try:
-            qn = np.broadcast_to(qn, lead + (6,)).reshape(-1, 1, 6)
-        except ValueError as exc:
+            fits = np.broadcast_shapes(qn.shape, lead + (6,)) == lead + (6,)
+        except ValueError:
+            fits = False
+        if not fits:
             raise InputError("q_near", f"shape {qn.shape} does not broadcast to the "
-                                       f"targets' {lead + (6,)}") from exc
-        Q, valid, sigma = _order_by(Q, valid, sigma, qn)
-    n = Q.shape[1]
-    Q = Q.reshape(lead + (n, 6))
-    valid = valid.reshape(lead + (n,))
-    sing = (sigma < singular_tol).reshape(lead + (n,))
-    codes = _STATUS[status].reshape(lead)
+                                       f"targets' {lead + (6,)}")
+    Q, valid, inside, sigma, status, diag, _ = raw_solve(
+        chain, g.params, np.ascontiguousarray(T.reshape(-1, 4, 4)), parallel)
+    shape = lead + (MAX_SOLUTIONS,)
+    Q = Q.reshape(shape + (6,))
+    valid = valid.reshape(shape)
     error = None
     if compute_error:
         dp, dr = fk_error(chain, Q, T)
         error = np.where(valid, np.hypot(dp, dr), np.inf)
     info = {"family": NAME, "variant": str(g.primary), "secondary": str(g.secondary),
             "secondary_runs": int(((diag & K.G6F_SECONDARY) != 0).sum())}
-    return make_set(robot, Q, valid, inside=None, singular=sing, branches={},
-                    status_codes=codes, method=NAME, info=info, error=error)
+    return make_set(robot, Q, valid, inside=inside.reshape(shape),
+                    singular=(sigma < singular_tol).reshape(shape), branches={},
+                    status_codes=_STATUS[status].reshape(lead), method=NAME, info=info,
+                    error=error)
 
 
-def _order_by(Q: np.ndarray, valid: np.ndarray, sigma: np.ndarray, qn: np.ndarray
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Rows of each pose ordered by wrapped distance to qn (N, 1, 6), valid first."""
-    d = (Q - qn + np.pi) % (2 * np.pi) - np.pi
-    key = np.where(valid, np.linalg.norm(d, axis=-1), np.inf)
-    order = np.argsort(key, axis=1, kind="stable")
-    return (np.take_along_axis(Q, order[..., None], axis=1),
-            np.take_along_axis(valid, order, axis=1),
-            np.take_along_axis(sigma, order, axis=1))
+def make_single(chain: Any) -> Any:
+    """The single-pose hot path: ``single(T, q6) -> SolutionSet | None`` for one pose
+    ``T`` (4, 4) float64 with default options (``q6``, the closed forms' joint-6
+    value at a wrist singularity, is unused). None when ``T`` is not a rigid
+    transform (the caller re-checks it to raise the detailed error). Every call
+    returns fresh arrays; only the read-only joint kinds and limits are shared."""
+    from robokin.kinematics.ik.analytic._common import STATUS_TEXT
+    from robokin.kinematics.ik.solutions import SolutionSet
+
+    g = setup(chain)
+    packed, params = chain.arrays.packed, g.params
+    is_rev = np.ones(6, dtype=bool)
+    is_rev.setflags(write=False)
+    limits = chain.limits
+    info = {"family": NAME, "variant": str(g.primary), "secondary": str(g.secondary)}
+    texts = [np.array(STATUS_TEXT[c], dtype=object) for c in _STATUS]
+    check, kern, empty = K.check_poses, K.general6r_solve, np.empty
+    trusted = SolutionSet._trusted
+    b1 = np.bool_
+    secondary = K.G6F_SECONDARY
+
+    def single(T: np.ndarray, q6: float) -> Any:
+        T1 = np.ascontiguousarray(T).reshape(1, 4, 4)
+        if check(T1, 1e-6)[0]:
+            return None
+        Q = empty((1, MAX_SOLUTIONS, 6))
+        valid, inside = empty((1, MAX_SOLUTIONS), b1), empty((1, MAX_SOLUTIONS), b1)
+        sigma, status, diag = empty((1, MAX_SOLUTIONS)), empty(1, np.int64), empty(1, np.int64)
+        kern(packed, params, T1, Q, valid, inside, sigma, status, diag, empty((1, 3)), False)
+        runs = int(diag[0] & secondary != 0)
+        return trusted(Q[0], valid[0], is_rev, limits,
+                       {"within_limits": inside[0], "singular": sigma[0] < 1e-6}, {},
+                       texts[status[0]].copy(), NAME, None, dict(info, secondary_runs=runs))
+
+    return single
