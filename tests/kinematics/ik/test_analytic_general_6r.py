@@ -319,6 +319,25 @@ def test_prismatic_and_dependent_joints_are_not_offered():
     assert "six joints" in general_6r.why_not(panda.chain)
 
 
+def test_arm_no_variant_solves_is_not_offered_and_says_why():
+    # several consecutive axes meet and axes 3, 4 are parallel: every elimination
+    # has a rank-deficient right side or det Sigma = 0 (docs/ik.md, limits)
+    h = math.pi / 2
+    rows = [{"a": 0.0, "d": -0.285, "alpha": -h, "theta": 2.35},
+            {"a": -0.368, "d": 0.445, "alpha": 0.4381, "theta": -2.228},
+            {"a": 0.0, "d": 0.052, "alpha": 0.0, "theta": 2.413},
+            {"a": 0.07, "d": 0.0, "alpha": -h, "theta": -1.637},
+            {"a": 0.0, "d": -0.032, "alpha": -h, "theta": 1.579},
+            {"a": 0.0, "d": 0.0, "alpha": 0.0, "theta": -2.369}]
+    robot = robokin.Robot.from_dh(rows)
+    fam = robokin.ik.family(robot)
+    assert fam.name == "none" and fam.solver is None
+    assert "general_6r: no elimination variant finds every solution" in fam.reason
+    assert general_6r.setup(robot.chain).params is None
+    sols = robot.ik(robot.fk(np.full(6, 0.3)))  # the numeric fallback
+    assert sols.method == "numeric" and sols.count >= 1
+
+
 def test_bad_pose_and_option_raise_input_errors():
     robot = ur_twisted()
     bad = np.eye(4)

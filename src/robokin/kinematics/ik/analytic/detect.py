@@ -153,9 +153,10 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float,
             _, dev, mod, text = found[0]
             return _six_r_family(chain, poe, mod.NAME, text, True, dev, details)
         return _none(
-            "6R arm without three parallel axes (2-4) with meeting axes 5, 6, and "
-            "without a spherical wrist with parallel axes 2, 3: "
-            + "; ".join(f"{k}: {v}" for k, v in details.items()), details)
+            "6R arm without three parallel axes (2-4) with meeting axes 5, 6, without "
+            "a spherical wrist with parallel axes 2, 3, and not solved by the general "
+            "6R elimination: " + "; ".join(f"{k}: {v}" for k, v in details.items()),
+            details)
     if nc == 4 and n == 4:
         if n_pri != 1 or not chain.coupling.is_identity:
             return _none(f"a 4-joint arm with {n_pri} prismatic joint(s): the SCARA "
