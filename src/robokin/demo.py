@@ -35,11 +35,14 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robokin.exceptions import InputError
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["DemoResult", "plan_press_loading", "run_demo"]
 
@@ -76,7 +79,7 @@ class DemoResult:
 
 
 def plan_press_loading(
-    robot: Any, scene: Any, *, dt: float = DT, progress: Any = None
+    robot: Robot, scene: Any, *, dt: float = DT, progress: Any = None
 ) -> tuple[Any, list[dict[str, Any]]]:
     """Plan the press-loading motion.
 
@@ -247,7 +250,7 @@ def _plot_press_views(traj: Any, scene: Any, report: Any, path: Path) -> Path:
 
 
 def _summary(
-    robot: Any,
+    robot: Robot,
     traj: Any,
     report: Any,
     limits: Any,

@@ -32,12 +32,15 @@ from __future__ import annotations
 import math
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from robokin.exceptions import InputError, ModelError
 from robokin.io.text_files import MAX_TEXT_BYTES
 from robokin.io.validate import validate_document
 from robokin.io.yaml_reader import read_yaml_document
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = [
     "MAX_MOTION_SAMPLES",
@@ -284,7 +287,7 @@ def _robot(spec: Any, file: Path) -> Any:
         raise ModelError(exc.reason, file=file, field="robot") from None
 
 
-def _target_pose(robot: Any, q_end: Any, target: Any, L: float, A: float,
+def _target_pose(robot: Robot, q_end: Any, target: Any, L: float, A: float,
                  file: Path, field: str) -> Any:
     """The pose a ``pose:`` / ``line:`` target names (rpy kept when omitted)."""
     import numpy as np

@@ -53,7 +53,7 @@ __all__ = [
 _TWO_PI = 2.0 * math.pi
 
 
-def _frozen(a: npt.ArrayLike, ndim: int, name: str) -> np.ndarray:
+def _frozen(a: npt.ArrayLike, ndim: int, name: str) -> npt.NDArray[np.float64]:
     arr = np.array(a, dtype=np.float64)
     if arr.ndim != ndim:
         raise ModelError(f"{name} must have {ndim} dimensions, got shape {arr.shape}")
@@ -63,7 +63,7 @@ def _frozen(a: npt.ArrayLike, ndim: int, name: str) -> np.ndarray:
     return arr
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False)
 class AffineMap:
     """The affine map ``y = matrix @ x + offset``.
 
@@ -72,13 +72,23 @@ class AffineMap:
         offset: Shape (n_out,).
     """
 
-    matrix: np.ndarray
-    offset: np.ndarray
+    matrix: npt.NDArray[np.float64]
+    offset: npt.NDArray[np.float64]
     is_identity: bool = field(init=False)
 
-    def __post_init__(self) -> None:
-        A = _frozen(self.matrix, 2, "matrix")
-        b = _frozen(self.offset, 1, "offset")
+    def __init__(self, matrix: npt.ArrayLike, offset: npt.ArrayLike) -> None:
+        """Check and freeze the map.
+
+        Args:
+            matrix: Shape (n_out, n_in), finite.
+            offset: Shape (n_out,), finite.
+
+        Raises:
+            ModelError: a wrong number of dimensions, a non-finite value, or an
+                offset that does not match the matrix rows.
+        """
+        A = _frozen(matrix, 2, "matrix")
+        b = _frozen(offset, 1, "offset")
         if b.shape[0] != A.shape[0]:
             raise ModelError(
                 f"offset has {b.shape[0]} entries but the matrix has {A.shape[0]} rows"

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -34,6 +34,9 @@ from robokin.spatial import (
 from robokin.trajectory.joint import time_grid
 from robokin.trajectory.profiles import Profile, get_profile
 from robokin.trajectory.samples import Trajectory
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = [
     "PathError",
@@ -127,7 +130,7 @@ def _err(T: np.ndarray, Tt: np.ndarray, e: np.ndarray) -> float:
 
 
 def follow_poses(
-    robot: Any,
+    robot: Robot,
     T_path: npt.ArrayLike,
     q_start: npt.ArrayLike,
     *,
@@ -278,7 +281,7 @@ def follow_poses(
     return PathFollowResult(Q, success, err, first, ftime, reason, kind)
 
 
-def _follow_analytic(robot: Any, Tp: np.ndarray, q0: np.ndarray, times, **kw
+def _follow_analytic(robot: Robot, Tp: np.ndarray, q0: np.ndarray, times, **kw
                      ) -> PathFollowResult:
     """All closed-form solutions per sample, the one nearest the previous kept.
 
@@ -335,7 +338,7 @@ def _scalar_quintic(T: float, v0: float, v1: float, t: np.ndarray):
     return s[:, 0], sd[:, 0], sdd[:, 0]
 
 
-def _rates(robot: Any, q: np.ndarray, twist: np.ndarray, dtwist: np.ndarray
+def _rates(robot: Robot, q: np.ndarray, twist: np.ndarray, dtwist: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray]:
     """qd = J^+ twist, qdd = J^+ (dtwist - Jdot qd), batched over samples."""
     J = robot.jacobian(q)
@@ -350,7 +353,7 @@ def _rates(robot: Any, q: np.ndarray, twist: np.ndarray, dtwist: np.ndarray
 
 
 def line_min_duration(
-    robot: Any, q_start: np.ndarray, T_start: np.ndarray, T_goal: np.ndarray,
+    robot: Robot, q_start: np.ndarray, T_start: np.ndarray, T_goal: np.ndarray,
     profile: Profile, *, v_max: npt.ArrayLike | None = None,
     a_max: npt.ArrayLike | None = None, tool_speed: float | None = None,
     tool_acceleration: float | None = None, samples: int = 101,
@@ -390,7 +393,7 @@ def line_min_duration(
 
 
 # -------------------------------------------------------------------- the segment
-def _goal_unreachable(robot: Any, T_goal: np.ndarray) -> str | None:
+def _goal_unreachable(robot: Robot, T_goal: np.ndarray) -> str | None:
     """Why the goal pose has no closed-form solution inside the limits, or None.
 
     Only for arms with a closed form (cheap and complete); None otherwise.
@@ -408,7 +411,7 @@ def _goal_unreachable(robot: Any, T_goal: np.ndarray) -> str | None:
 
 
 def cartesian_line(
-    robot: Any,
+    robot: Robot,
     q_start: npt.ArrayLike,
     T_goal: npt.ArrayLike,
     duration: float | None = None,

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -46,6 +46,9 @@ from robokin.trajectory.joint import (
 )
 from robokin.trajectory.profiles import Profile, get_profile
 from robokin.trajectory.samples import Trajectory
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["PathBuilder", "Segment", "via_path"]
 
@@ -102,7 +105,7 @@ class PathBuilder:
     """
 
     def __init__(
-        self, robot: Any, q_start: npt.ArrayLike, *, dt: float = 0.005,
+        self, robot: Robot, q_start: npt.ArrayLike, *, dt: float = 0.005,
         v_max: npt.ArrayLike | None = None, a_max: npt.ArrayLike | None = None,
         tool_speed: float | None = None, tool_acceleration: float | None = None,
         smooth: bool = True, ik: str = "follow", max_samples: int | None = None,
@@ -366,7 +369,7 @@ class PathBuilder:
 
 
 def via_path(
-    robot: Any, q_start: npt.ArrayLike, steps: list[dict[str, Any]], *,
+    robot: Robot, q_start: npt.ArrayLike, steps: list[dict[str, Any]], *,
     dt: float = 0.005, **options: Any,
 ) -> Trajectory:
     """Build a path from a list of steps (the dict form of :class:`PathBuilder`).

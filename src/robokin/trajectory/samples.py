@@ -9,12 +9,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
 
 from robokin.exceptions import InputError
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["LimitReport", "LimitViolation", "Trajectory"]
 
@@ -148,14 +151,14 @@ class Trajectory:
         pose = self.pose
         return self.replace(t=self.t + dt, via_times=self.via_times + dt, pose=pose)
 
-    def tool_poses(self, robot: Any) -> np.ndarray:
+    def tool_poses(self, robot: Robot) -> np.ndarray:
         """Tool poses (m, 4, 4) [m]: the stored ones, or ``robot.fk(q)``."""
         if self.pose is not None:
             return self.pose
         q = self.q if self.space == "joint" else robot.joints_from_actuators(self.q)
         return robot.fk(q)
 
-    def to_actuator_space(self, robot: Any) -> Trajectory:
+    def to_actuator_space(self, robot: Robot) -> Trajectory:
         """Motor coordinates ``phi = A^+ (q - b)``, ``phid = A^+ qd``, ``phidd = A^+ qdd``.
 
         The identity (a copy relabelled ``space="actuator"``) when the robot has no
@@ -181,7 +184,7 @@ class Trajectory:
             joint_names=names, is_revolute=np.ones(A.n_in, bool),
         )
 
-    def to_joint_space(self, robot: Any) -> Trajectory:
+    def to_joint_space(self, robot: Robot) -> Trajectory:
         """Back from motor coordinates: ``q = A phi + b`` (and rates)."""
         if self.space != "actuator":
             return self
@@ -236,7 +239,7 @@ class Trajectory:
 
     def check_limits(
         self,
-        robot: Any = None,
+        robot: Robot | None = None,
         *,
         position: npt.ArrayLike | None = None,
         velocity: npt.ArrayLike | float | None = None,

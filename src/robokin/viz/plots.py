@@ -9,13 +9,16 @@ Angles are drawn in degrees and lengths in millimetres unless asked otherwise.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
 
 from robokin.exceptions import InputError
 from robokin.io.atomic import file_stem, save_figure_atomic
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = [
     "plot_comparison",
@@ -230,13 +233,13 @@ def plot_joints(traj: Any, *, path: str | Path | None = None, degrees: bool = Tr
     return _finish(fig, path, overwrite)
 
 
-def _positions(traj: Any, robot: Any) -> np.ndarray:
+def _positions(traj: Any, robot: Robot) -> np.ndarray:
     if traj.pose is None and robot is None:
         raise InputError("robot", "the trajectory has no tool poses: pass the robot")
     return traj.tool_poses(robot)[:, :3, 3]
 
 
-def plot_tool_position(traj: Any, robot: Any = None, *, path: str | Path | None = None,
+def plot_tool_position(traj: Any, robot: Robot | None = None, *, path: str | Path | None = None,
                        mm: bool = True, relative: bool = False,
                        title: str | None = None, overwrite: bool = False) -> Any:
     """Tool position x, y, z over time (one line each).
@@ -267,7 +270,7 @@ def plot_tool_position(traj: Any, robot: Any = None, *, path: str | Path | None 
     return _finish(fig, path, overwrite)
 
 
-def plot_tool_path(traj: Any, robot: Any = None, *, path: str | Path | None = None,
+def plot_tool_path(traj: Any, robot: Robot | None = None, *, path: str | Path | None = None,
                    mm: bool = True, title: str | None = None,
                    overwrite: bool = False) -> Any:
     """Tool path in 3D, with its projections onto the XY, XZ and YZ planes.
@@ -337,7 +340,7 @@ def plot_comparison(cmp: Any, *, path: str | Path | None = None, degrees: bool =
     return _finish(fig, path, overwrite)
 
 
-def plot_robot(robot: Any, q: npt.ArrayLike, ax: Any = None, frames: bool = True, *,
+def plot_robot(robot: Robot, q: npt.ArrayLike, ax: Any = None, frames: bool = True, *,
                path: str | Path | None = None, frame_size: float | None = None,
                color: str = "C0", overwrite: bool = False) -> Any:
     """The arm at ``q`` as a 3D stick figure: link frames joined, joints dotted.

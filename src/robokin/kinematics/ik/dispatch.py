@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -13,13 +13,16 @@ from robokin.exceptions import InputError
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
 
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
 __all__ = ["solve"]
 
 _METHODS = ("auto", "analytic", "numeric")
 
 
 def solve(
-    robot: Any,
+    robot: Robot,
     T: npt.ArrayLike,
     *,
     q_near: npt.ArrayLike | None = None,
@@ -92,7 +95,7 @@ def _check_q_near_batch(q_near: np.ndarray, target: tuple[int, ...]) -> None:
         )
 
 
-def _single_solver(robot: Any) -> Any:
+def _single_solver(robot: Robot) -> Any:
     """The family's single-pose hot path (``_six_r.make_single``), or None; cached
     per chain."""
     def build() -> Any:

@@ -26,7 +26,7 @@ yaw.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -37,6 +37,9 @@ from robokin.kinematics.ik.analytic._geometry import (
     unit_perpendicular,
 )
 from robokin.kinematics.ik.analytic.scara import _align_angle, _elbow_angles, _rot
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["measure", "pose_from_position_yaw"]
 
@@ -110,7 +113,7 @@ def level_rotation(g: PalletizerGeometry) -> np.ndarray:
     return g.Rc @ g.M[:3, :3]
 
 
-def pose_from_position_yaw(robot: Any, xyz: Any, yaw: Any) -> np.ndarray:
+def pose_from_position_yaw(robot: Robot, xyz: Any, yaw: Any) -> np.ndarray:
     """The level target pose(s) (..., 4, 4) at position ``xyz`` (..., 3) [m] with the
     tool turned by ``yaw`` (...) [rad] about the waist axis from its zero-yaw
     orientation."""
@@ -129,7 +132,7 @@ def pose_from_position_yaw(robot: Any, xyz: Any, yaw: Any) -> np.ndarray:
     return T
 
 
-def solve_geometry(robot: Any, g: PalletizerGeometry, T: np.ndarray, *,
+def solve_geometry(robot: Robot, g: PalletizerGeometry, T: np.ndarray, *,
                    level_tol: float = 1e-9, compute_error: bool = False,
                    method: str = "analytic:palletizer", info: dict | None = None):
     """Every solution (up to 4) for poses T (..., 4, 4)."""

@@ -16,7 +16,7 @@ from the upper arm (a right-handed arm seen along ``-h``), -1 otherwise.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -26,6 +26,9 @@ from robokin.kinematics.ik.analytic._geometry import (
     angle_between_axes,
     unit_perpendicular,
 )
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["measure"]
 
@@ -101,7 +104,7 @@ def _align_angle(h, u, d):
                       np.einsum("...i,...i", d, u) - (u @ h) * (d @ h))
 
 
-def solve_geometry(robot: Any, g: ScaraGeometry, T: np.ndarray, *,
+def solve_geometry(robot: Robot, g: ScaraGeometry, T: np.ndarray, *,
                    orientation_tol: float = 1e-9, compute_error: bool = False,
                    method: str = "analytic:scara", info: dict | None = None):
     """Every solution (up to 2) for poses T (..., 4, 4)."""
