@@ -10,6 +10,8 @@ quaternions are ``(w, x, y, z)``.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import numpy.typing as npt
 
@@ -127,7 +129,7 @@ def _apply(fn, x: np.ndarray, width: int) -> np.ndarray:
     return _from_R(R)
 
 
-def _as(fn_name: str, T: np.ndarray, **kw) -> np.ndarray:
+def _as(fn_name: str, T: npt.ArrayLike, **kw: Any) -> np.ndarray:
     T = np.asarray(T, dtype=np.float64)
     lead = T.shape[:-2]
     rot = _rotation().from_matrix(T[..., :3, :3].reshape(-1, 3, 3))

@@ -20,6 +20,7 @@ from robokin.exceptions import InputError
 from robokin.kinematics.ik.numeric import IKResult
 
 if TYPE_CHECKING:
+    from robokin.kinematics.ik.solutions import SolutionSet
     from robokin.robot import Robot
 
 __all__ = ["solve_near"]
@@ -79,7 +80,7 @@ def solve_near(
     return _nearest(robot, sols, T, q_near)
 
 
-def _nearest(robot: Robot, sols: Any, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
+def _nearest(robot: Robot, sols: SolutionSet, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
     """The row of ``sols`` nearest ``q_near`` per pose, inside the limits, as a result."""
     from robokin._native import kernels
 
@@ -122,6 +123,6 @@ def _nearest(robot: Robot, sols: Any, T: npt.ArrayLike, q_near: np.ndarray) -> I
                     rotation_error=err[:, 1].reshape(lead))
 
 
-def _why(sols: Any) -> np.ndarray:
+def _why(sols: SolutionSet) -> np.ndarray:
     """Per pose: why it has no solution inside the limits (its status)."""
     return np.asarray(sols.keep_within_limits().status, dtype=object)

@@ -384,10 +384,10 @@ class SolutionSet:
 
     def to_actuator_space(self, robot: Robot) -> SolutionSet:
         """The same set in motor coordinates (limits checked in both spaces)."""
-        if robot.actuators is None:
+        lim = robot.actuator_limits
+        if robot.actuators is None or lim is None:  # limits come with the map
             return self
         phi = robot.actuators.inverse(self.q, what=f"actuator map of '{robot.name}'")
-        lim = robot.actuator_limits
         inside = self.flags["within_limits"] & (
             (phi >= lim[:, 0] - 1e-9) & (phi <= lim[:, 1] + 1e-9)
         ).all(axis=-1)

@@ -39,6 +39,7 @@ from robokin.kinematics.ik.analytic._geometry import (
 from robokin.kinematics.ik.analytic.scara import _align_angle, _elbow_angles, _rot
 
 if TYPE_CHECKING:
+    from robokin.model.chain import Chain
     from robokin.robot import Robot
 
 __all__ = ["measure", "pose_from_position_yaw"]
@@ -62,7 +63,7 @@ class PalletizerGeometry:
     back: np.ndarray  # (n, n_chain) pseudo-inverse of the coupling matrix
 
 
-def _analyse(chain: Any, poe: Poe) -> tuple[PalletizerGeometry | None, float, str, str]:
+def _analyse(chain: Chain, poe: Poe) -> tuple[PalletizerGeometry, float, str, str]:
     h, o = poe.h, poe.o
     sign, off = chain.arrays.sign, chain.arrays.offset
     Mc, c = chain.coupling.matrix, chain.coupling.offset
@@ -97,13 +98,13 @@ def _analyse(chain: Any, poe: Poe) -> tuple[PalletizerGeometry | None, float, st
     return g, ang, text, "; ".join(why)
 
 
-def measure(chain: Any, poe: Poe) -> tuple[float, float, str, str]:
+def measure(chain: Chain, poe: Poe) -> tuple[float, float, str, str]:
     """Deviation from the family: (angle [rad], 0, text, why-not)."""
     _, ang, text, why = _analyse(chain, poe)
     return ang, 0.0, text, why
 
 
-def geometry(chain: Any, poe: Poe) -> PalletizerGeometry:
+def geometry(chain: Chain, poe: Poe) -> PalletizerGeometry:
     """The nominal palletizer geometry of a chain."""
     return _analyse(chain, poe)[0]
 

@@ -52,7 +52,7 @@ class ScaraGeometry:
 
     h: np.ndarray
     e: np.ndarray
-    rev: tuple[int, int, int]
+    rev: tuple[int, ...]  # the three revolute coordinates
     pri: int
     s: np.ndarray
     o: np.ndarray
