@@ -88,7 +88,7 @@ def _std_params(T: np.ndarray) -> tuple[tuple[float, float, float, float], float
     alpha = math.atan2(T[2, 1], T[2, 2])
     d = T[2, 3]
     a = T[0, 3] * math.cos(theta) + T[1, 3] * math.sin(theta)
-    p = tuple(_clean(v) for v in (theta, d, a, alpha))
+    p = (_clean(theta), _clean(d), _clean(a), _clean(alpha))
     return p, float(np.abs(_std(*p) - T).max())
 
 
@@ -143,7 +143,8 @@ def dh_rows_for_transform(
     if convention == "modified":
         # inv(Rz Tz Tx Rx) = Rx(-alpha) Tx(-a) Rz(-theta) Tz(-d)
         rows = dh_rows_for_transform(_inv(T), "standard")
-        return [tuple(_clean(-v) for v in r) for r in reversed(rows)]
+        return [(_clean(-t), _clean(-d), _clean(-a), _clean(-al))
+                for t, d, a, al in reversed(rows)]
     if np.allclose(T, np.eye(4), atol=1e-15, rtol=0):
         return []
     p, res = _std_params(T)
@@ -173,7 +174,7 @@ class DHExtraction:
         notes: What was chosen where DH leaves freedom, per frame.
     """
 
-    convention: str
+    convention: Literal["standard", "modified"]
     rows: tuple[dict[str, Any], ...]
     base: np.ndarray
     tool: np.ndarray
@@ -258,12 +259,13 @@ def dh_from_robot(
     # Frame 0.
     z0 = axes[0]
     o0 = points[0] + ((ref[:3, 3] - points[0]) @ z0) * z0
-    x0 = None
     for cand in (ref[:3, 0], ref[:3, 1], ref[:3, 2]):
         xp = cand - (cand @ z0) * z0
         if np.linalg.norm(xp) > 1e-6:
             x0 = xp / np.linalg.norm(xp)
             break
+    else:  # pragma: no cover - three orthonormal columns cannot all lie on z0
+        raise InputError("reference", "its axes do not span space")
     frames = [_frame(x0, z0, o0)]
     for i in range(1, n):
         F, kind = _next_frame(frames[-1], points[i], axes[i])

@@ -25,7 +25,7 @@ import re
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import yaml
 
@@ -187,6 +187,15 @@ def _parse_field_path(text: str) -> list[Any]:
             for m in _PART.finditer(text)]
 
 
+class _Mark(Protocol):
+    line: int  # 0-based, as PyYAML's pure and libyaml marks both give it
+
+
+def _line(mark: _Mark | None) -> int | None:
+    """The 1-based line of a parser position, when the parser gave one."""
+    return None if mark is None else mark.line + 1
+
+
 def _budget(text: str, file: Any, max_depth: int, max_nodes: int | None) -> None:
     """Refuse a document too deep, recursive, or whose expansion is too large.
 
@@ -211,7 +220,7 @@ def _budget(text: str, file: Any, max_depth: int, max_nodes: int | None) -> None
                 elif any(a == ev.anchor for a, _ in open_anchors):
                     raise ModelError("an alias refers to the collection it is in "
                                      f"(&{ev.anchor}): a recursive document",
-                                     file=file, line=ev.start_mark.line + 1)
+                                     file=file, line=_line(ev.start_mark))
                 else:
                     continue  # undefined: the loader reports it
             elif isinstance(ev, yaml.ScalarEvent):
@@ -223,7 +232,7 @@ def _budget(text: str, file: Any, max_depth: int, max_nodes: int | None) -> None
                 open_anchors.append((ev.anchor, total))
                 if len(open_anchors) > max_depth:
                     raise ModelError(f"nested deeper than {max_depth} levels",
-                                     file=file, line=ev.start_mark.line + 1)
+                                     file=file, line=_line(ev.start_mark))
             elif isinstance(ev, yaml.CollectionEndEvent):
                 anchor, start = open_anchors.pop()
                 if anchor is not None:
@@ -235,7 +244,7 @@ def _budget(text: str, file: Any, max_depth: int, max_nodes: int | None) -> None
                         "characters (aliases repeating aliases)" if aliases
                         else f"holds more than {limit:,} values")
                 raise ModelError(f"{what}; refused (pass max_nodes= to raise the cap)",
-                                 file=file, line=ev.start_mark.line + 1)
+                                 file=file, line=_line(ev.start_mark))
     except yaml.YAMLError as exc:
         raise _yaml_error(exc, file) from None
     finally:
