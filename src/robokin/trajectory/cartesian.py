@@ -201,7 +201,8 @@ def follow_poses(
     for k in range(m):
         Tt = Tp[k]
         q = q_prev + step if seeds is None else seeds[k]
-        best, q_best, J_best = np.inf, q, None
+        best, q_best = np.inf, q
+        J_best: np.ndarray | None = None
         stalled = 0
         for _ in range(max_iterations):
             J, T = jacobian_and_pose(chain, q)
@@ -255,7 +256,7 @@ def follow_poses(
                           f"[{lim[j, 0]:.6g}, {lim[j, 1]:.6g}]")
                 first = k
                 break
-        if singular_tol > 0 and n >= 6:
+        if singular_tol > 0 and n >= 6 and J_best is not None:
             J = J_best
             # sigma_min >= |det J| / ||J||_F^5 for a 6x6 J: skip the SVD when that
             # bound already clears the tolerance (nearly always).

@@ -36,10 +36,10 @@ import json
 import math
 import re
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -61,6 +61,8 @@ __all__ = [
     "write_json",
     "write_ur_script",
 ]
+
+_T = TypeVar("_T")
 
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 _LENGTH = {"m": 1.0, "mm": 1e-3}
@@ -147,10 +149,10 @@ class ControllerProfile:
         if offsets is not None and doc.get("offset_unit", doc.get("angle_unit")) == "deg":
             offsets = [math.radians(o) for o in offsets]
         try:
-            return cls(name=doc.get("name", "default"), order=order,
-                       signs=signs, offsets=offsets,
+            return cls(name=doc.get("name", "default"), order=_tuple(order),
+                       signs=_tuple(signs), offsets=_tuple(offsets),
                        angle_unit=doc.get("angle_unit", "rad"),
-                       length_unit=doc.get("length_unit", "m"), names=names)
+                       length_unit=doc.get("length_unit", "m"), names=_tuple(names))
         except ModelError as exc:
             raise ModelError(exc.reason, file=file, field=exc.field) from None
 
@@ -302,10 +304,16 @@ def csv_text(traj: Trajectory, joint_names: Sequence[str] | None = None, *,
     return "\n".join(lines) + "\n"
 
 
+def _tuple(values: Iterable[_T] | None) -> tuple[_T, ...] | None:
+    return None if values is None else tuple(values)
+
+
 def _parse_header(cols: list[str]) -> list[tuple[str, str | None]]:
     out = []
     for c in cols:
         m = _HEADER.match(c)
+        if m is None:  # pragma: no cover - the pattern matches any text
+            raise ModelError(f"unreadable column header {short_repr(c)}")
         out.append((m.group("name"), m.group("unit").strip() if m.group("unit") else None))
     return out
 
@@ -380,7 +388,7 @@ def _columns(header: list[str] | None, width: int, path: Path,
                       f"(time [s], then {', '.join(names[:8])}"
                       f"{' ...' if len(names) > 8 else ''} in SI units)", UserWarning,
                       stacklevel=4)
-        cells = [("t", None)] + [(nm, None) for nm in names]
+        cells: list[tuple[str, str | None]] = [(nm, None) for nm in ["t", *names]]
         return cells, [list(range(1, len(names) + 1)), [], []]
     cells = _parse_header(header)
     groups: list[dict[str, int]] = [{}, {}, {}]

@@ -24,9 +24,7 @@ __all__ = ["LimitReport", "LimitViolation", "Trajectory"]
 Space = Literal["joint", "actuator"]
 
 
-def _ro(a: npt.ArrayLike | None, ndim: int, name: str) -> np.ndarray | None:
-    if a is None:
-        return None
+def _ro(a: npt.ArrayLike, ndim: int, name: str) -> npt.NDArray[np.float64]:
     arr = np.array(a, dtype=np.float64)
     if arr.ndim != ndim:
         raise InputError(name, f"expected {ndim} dimensions, got shape {arr.shape}")
@@ -78,7 +76,7 @@ class Trajectory:
         for name, arr in (("qd", qd), ("qdd", qdd)):
             if arr.shape != (m, n):
                 raise InputError(name, f"expected shape {(m, n)}, got {arr.shape}")
-        pose = _ro(self.pose, 3, "pose")
+        pose = None if self.pose is None else _ro(self.pose, 3, "pose")
         if pose is not None and pose.shape != (m, 4, 4):
             raise InputError("pose", f"expected shape {(m, 4, 4)}, got {pose.shape}")
         names = self.joint_names
@@ -214,7 +212,7 @@ class Trajectory:
             qs.append(p.q[sl])
             qds.append(p.qd[sl])
             qdds.append(p.qdd[sl])
-            if have_pose:
+            if have_pose and p.pose is not None:
                 poses.append(p.pose[sl])
             vias.append(p.via_times + shift if p.via_times.size else
                         np.array([p.t[0] + shift, p.t[-1] + shift]))
@@ -359,7 +357,7 @@ def _stretches(kind: str, bad: np.ndarray, traj: Trajectory, values: np.ndarray,
         for s, e in zip(starts, ends):
             seg = values[s:e + 1, j]
             worst = seg.min() if below else seg.max()
-            out.append(LimitViolation(kind, int(j), names[j], int(s), int(e),
+            out.append(LimitViolation(kind, int(j), names[int(j)], int(s), int(e),
                                       float(traj.t[s]), float(traj.t[e]),
                                       float(worst), float(limit[j])))
     return out
