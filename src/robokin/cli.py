@@ -238,7 +238,7 @@ def _split_debug(args: list[str]) -> tuple[list[str], bool]:
     return head + args[end:], len(head) != end
 
 
-def _one_line(text: str) -> str:
+def _one_line(text: object) -> str:
     return " ".join(str(text).split())
 
 
@@ -257,9 +257,10 @@ def main(argv: list[str] | None = None) -> int:
     from robokin.exceptions import RobokinError, UnreachableError
 
     # click's classes as this typer raises them (recent typer vendors click)
+    # (found at run time, so their attributes are unknown to the type checker)
     mro = typer.BadParameter.__mro__
-    click_error = next(c for c in mro if c.__name__ == "ClickException")
-    usage_error = next(c for c in mro if c.__name__ == "UsageError")
+    click_error: type[Any] = next(c for c in mro if c.__name__ == "ClickException")
+    usage_error: type[Any] = next(c for c in mro if c.__name__ == "UsageError")
 
     _register_extra_commands()
     args, debug = _split_debug(list(sys.argv[1:] if argv is None else argv))

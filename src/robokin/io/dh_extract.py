@@ -34,7 +34,6 @@ Choices where DH leaves freedom (documented in ``docs/urdf.md``):
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -364,8 +363,8 @@ def _verify(robot: Robot, ext: DHExtraction) -> None:
         raise ModelError(f"internal: derived DH table misses the FK by {err:.3g}")
 
 
-def describe(ext: DHExtraction, *, deg: bool = True) -> Mapping[str, Any]:
-    """A plain, JSON-ready summary (angles in degrees when ``deg``)."""
+def describe(ext: DHExtraction, *, deg: bool = True) -> dict[str, Any]:
+    """A plain, JSON-ready summary (angles in degrees when ``deg``), a new dict."""
     A = 180.0 / math.pi if deg else 1.0
     from robokin.spatial import rpy_from_matrix
 

@@ -19,6 +19,7 @@ from robokin.io.atomic import file_stem, save_figure_atomic
 
 if TYPE_CHECKING:
     from robokin.robot import Robot
+    from robokin.trajectory.samples import Trajectory
 
 __all__ = [
     "plot_comparison",
@@ -233,8 +234,10 @@ def plot_joints(traj: Any, *, path: str | Path | None = None, degrees: bool = Tr
     return _finish(fig, path, overwrite)
 
 
-def _positions(traj: Any, robot: Robot) -> np.ndarray:
-    if traj.pose is None and robot is None:
+def _positions(traj: Trajectory, robot: Robot | None) -> np.ndarray:
+    if traj.pose is not None:
+        return traj.pose[:, :3, 3]
+    if robot is None:
         raise InputError("robot", "the trajectory has no tool poses: pass the robot")
     return traj.tool_poses(robot)[:, :3, 3]
 
