@@ -39,10 +39,12 @@ class DomainFailure(Exception):
 
 
 def cell(value: Any, limit: int = 60, *, markup: bool = True) -> str:
-    """Text for a table cell or a line of output: at most ``limit`` characters,
-    rich markup escaped unless ``markup=False`` (for ``print(..., markup=False)``):
-    a name or a source from a file is never markup, and never a megabyte for rich
-    to wrap."""
+    """Text for a table cell or a line of output, safe to print.
+
+    At most ``limit`` characters, rich markup escaped unless ``markup=False`` (for
+    ``print(..., markup=False)``): a name or a source from a file is never markup,
+    and never a megabyte for rich to wrap.
+    """
     from rich.markup import escape
 
     text = str(value)

@@ -96,13 +96,16 @@ class Robot:
     meta: Mapping[str, Any]
 
     def __setattr__(self, name: str, value: Any) -> None:
+        """Refuse: a Robot is immutable (raises FrozenError)."""
         raise FrozenError("Robot", name, _HOW_TO_CHANGE)
 
     def __delattr__(self, name: str) -> None:
+        """Refuse: a Robot is immutable (raises FrozenError)."""
         raise FrozenError("Robot", name, _HOW_TO_CHANGE)
 
     def __reduce__(self) -> tuple:
         # pickle and copy rebuild through __init__ (slots cannot be set directly)
+        """Pickle and copy rebuild through __init__ (slots cannot be set directly)."""
         return (_rebuild, (self.chain, self._fields()))
 
     def _fields(self) -> dict[str, Any]:
@@ -124,6 +127,7 @@ class Robot:
         path: str | Path | None = None,
         meta: Mapping[str, Any] | None = None,
     ) -> None:
+        """Check and freeze the parts (see the class docstring for each)."""
         init = object.__setattr__
         init(self, "chain", chain)
         init(self, "name", name)
@@ -262,6 +266,7 @@ class Robot:
         return self.chain.tool
 
     def __repr__(self) -> str:
+        """A short summary: the name and the number of joints."""
         return f"Robot(name={self.name!r}, n={self.n})"
 
     # --------------------------------------------------------------- kinematics

@@ -191,8 +191,10 @@ def matrix_from_axis_angle(rotvec: npt.ArrayLike) -> np.ndarray:
 
 
 def rotvec_from_rotation(R: npt.ArrayLike) -> np.ndarray:
-    """Rotation vectors (axis times angle [rad], angle in [0, pi]) of rotation
-    matrices; (..., 3, 3) -> (..., 3)."""
+    """Rotation vectors of rotation matrices; (..., 3, 3) -> (..., 3).
+
+    Axis times angle [rad], the angle in [0, pi].
+    """
     R = np.asarray(R, dtype=np.float64)
     lead = R.shape[:-2]
     if R.size == 0:

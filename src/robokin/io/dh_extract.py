@@ -1,4 +1,4 @@
-"""Denavit-Hartenberg tables derived from any robot's joint axes.
+r"""Denavit-Hartenberg tables derived from any robot's joint axes.
 
 Given a robot (from a URDF, an elementary sequence, another DH table), find the
 standard and modified DH tables of its joint axes, plus the base and tool
@@ -6,7 +6,7 @@ transforms that remain, so that
 
 .. math::
 
-    T(q) = B_{rem} \\cdot \\prod_i DH_i(q) \\cdot T_{rem}.
+    T(q) = B_{rem} \cdot \prod_i DH_i(q) \cdot T_{rem}.
 
 A serial chain of 1-DOF joints always has such a table: each pair of successive
 joint axes (lines in space) is related by their common normal. What a plain table
@@ -92,7 +92,7 @@ def _std_params(T: np.ndarray) -> tuple[tuple[float, float, float, float], float
 
 
 def _pick_sense(x: np.ndarray, x_prev: np.ndarray, z_prev: np.ndarray) -> np.ndarray:
-    """x or -x: the one closer to x_prev (on a tie, theta = +90 deg)."""
+    """The one of ``x`` and ``-x`` closer to ``x_prev`` (on a tie, theta = +90 deg)."""
     dot = float(x @ x_prev)
     if abs(dot) > _TOL:
         return x if dot > 0 else -x

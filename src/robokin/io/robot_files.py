@@ -233,8 +233,7 @@ def _coordinate_kinds(spec: Any, rows: list[Any]) -> dict[str, str]:
 
 
 def _si_rows(spec: Any, rows: list[Any], L: float, A: float) -> list[dict[str, Any]]:
-    """The joint rows in SI units, as ``chain_from_dh`` / ``chain_from_elementary``
-    take them."""
+    """The joint rows in SI units, as the DH and elementary chain builders take them."""
     elementary = spec.convention == "elementary"
     kind_of = _coordinate_kinds(spec, rows)
 

@@ -539,8 +539,10 @@ def _geometry_of(
 
 def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]], drops: _Drops
                      ) -> Robot:
-    """Put the collision shapes on the geometry layer (visual ones where a link has
-    no collision shape)."""
+    """Put the collision shapes on the geometry layer.
+
+    Visual shapes stand in where a link has no collision shape.
+    """
     from robokin.model import geometry as geo
 
     names = geo.link_names(robot)

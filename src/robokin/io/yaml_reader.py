@@ -137,8 +137,10 @@ class YamlDocument:
                                                           repr=False)
 
     def line(self, loc: Sequence[Any]) -> int | None:
-        """The line (1-based) of the part at ``loc`` (keys and indices), or of the
-        deepest part of it that exists; None for the whole document."""
+        """The line (1-based) of the part at ``loc`` (keys and indices).
+
+        Or of the deepest part of it that exists; None for the whole document.
+        """
         node, found = self.data, None
         for part in loc:
             entry = self._lines.get(id(node))

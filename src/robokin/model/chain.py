@@ -1,8 +1,8 @@
-"""The canonical kinematic chain every robot model compiles to.
+r"""The canonical kinematic chain every robot model compiles to.
 
 .. math::
 
-    T(q) = B \\cdot L_0 \\cdot J_1 F_1 G_1 \\cdot J_2 F_2 G_2 \\cdots J_n F_n G_n \\cdot T_{tool}
+    T(q) = B \cdot L_0 \cdot J_1 F_1 G_1 \cdot J_2 F_2 G_2 \cdots J_n F_n G_n \cdot T_{tool}
 
 ``J_k`` is a rotation about (revolute) or translation along (prismatic) the local z
 axis by ``sign_k * q_chain_k + offset_k``. ``F_k`` places the frame of link k
@@ -50,6 +50,7 @@ class Joint:
     offset: float = 0.0
 
     def __post_init__(self) -> None:
+        """Check the kind, sign and limits; store them as floats."""
         if self.kind not in ("revolute", "prismatic"):
             raise ModelError(
                 f"joint '{self.name}': kind must be 'revolute' or 'prismatic', got {self.kind!r}"
@@ -275,6 +276,7 @@ class ChainBuilder:
     """
 
     def __init__(self) -> None:
+        """An empty builder: no joint yet, the head the identity."""
         self._head = np.eye(4)
         self._joints: list[Joint] = []
         self._F: list[np.ndarray] = []

@@ -211,6 +211,7 @@ class AffineMap:
                 and np.allclose(self.offset, other.offset, rtol=0.0, atol=atol))
 
     def __repr__(self) -> str:
+        """The map as a constructor call with plain lists."""
         return f"AffineMap(matrix={self.matrix.tolist()!r}, offset={self.offset.tolist()!r})"
 
 
@@ -296,7 +297,7 @@ class ShaftMotion:
 
 @dataclass(frozen=True)
 class BallScrewSpline:
-    """A ball-screw / ball-spline shaft driven by two motors (the SCARA's axes 3-4).
+    r"""A ball-screw / ball-spline shaft driven by two motors (the SCARA's axes 3-4).
 
     The shaft carries a ball-screw groove and a spline groove. Motor 3 turns the
     screw nut through a reduction ``i``, motor 4 turns the spline nut through a
@@ -306,8 +307,8 @@ class BallScrewSpline:
 
     .. math::
 
-        \\varphi_3 = (\\theta_3 - l_4 \\cdot 360 / l) \\cdot i, \\qquad
-        \\varphi_4 = \\theta_3 \\cdot j
+        \varphi_3 = (\theta_3 - l_4 \cdot 360 / l) \cdot i, \qquad
+        \varphi_4 = \theta_3 \cdot j
 
     and back, ``theta3 = phi4 / j``, ``l4 = (phi4 / j - phi3 / i) * l / 360``. In SI
     units (rad, m) the 360 becomes 2 pi. With the nut rotations ``N1 = phi3 / i``
@@ -331,6 +332,7 @@ class BallScrewSpline:
     lift_sign: float = 1.0
 
     def __post_init__(self) -> None:
+        """Check the lead, ratios and sign."""
         object.__setattr__(self, "lead", _number(self.lead, "lead", nonzero=True))
         object.__setattr__(self, "i", _number(self.i, "i", nonzero=True))
         object.__setattr__(self, "j", _number(self.j, "j", nonzero=True))
@@ -509,6 +511,7 @@ class Dependency:
     offset: float = 0.0
 
     def __post_init__(self) -> None:
+        """Check the coefficients are finite numbers; freeze them."""
         coeffs = {str(k): _number(v, f"coefficient of {short_repr(k)}")
                   for k, v in dict(self.coefficients).items()}
         object.__setattr__(self, "coefficients", coeffs)

@@ -129,6 +129,7 @@ class Shape:
     owner: str = ""
 
     def __post_init__(self) -> None:
+        """Check the kind, size, placement and mesh file; normalise them."""
         if self.kind not in SHAPE_KINDS:
             raise InputError(
                 "kind", f"expected one of {list(SHAPE_KINDS)}, got {short_repr(self.kind)}"
@@ -162,6 +163,7 @@ class Shape:
         object.__setattr__(self, "_cache", {})
 
     def __repr__(self) -> str:
+        """A short summary: kind, size, and the file of a mesh."""
         extra = f", file={str(self.file)!r}" if self.file is not None else ""
         return f"Shape({self.kind!r}, size={self.size}{extra})"
 
@@ -485,6 +487,7 @@ class RobotGeometry:
     exclude_adjacent: bool = True
 
     def __post_init__(self) -> None:
+        """Check one name per link shape list; freeze the shapes."""
         if len(self.shapes) != len(self.names):
             raise InputError(
                 "shapes",

@@ -60,6 +60,7 @@ class PathError(RobokinError):
     """
 
     def __init__(self, result: PathFollowResult, what: str = "path"):
+        """Carry the failing sample (index, time) and the reason of ``result``."""
         self.index = result.first_failure
         self.time = result.failure_time
         self.reason = result.reason
@@ -123,8 +124,11 @@ def line_poses(T_start: npt.ArrayLike, T_goal: npt.ArrayLike, s: npt.ArrayLike
 
 # --------------------------------------------------------------- path following
 def _err(T: np.ndarray, Tt: np.ndarray, e: np.ndarray) -> float:
-    """Fill ``e`` (6,) with the base-frame pose error current -> target
-    (:func:`robokin.spatial.pose_error`); return its largest component."""
+    """Fill ``e`` (6,) with the base-frame pose error; return its largest component.
+
+    The error runs from the current pose to the target
+    (:func:`robokin.spatial.pose_error`).
+    """
     e[:] = pose_error(T, Tt)
     return float(np.abs(e).max())
 
@@ -341,7 +345,7 @@ def _scalar_quintic(T: float, v0: float, v1: float, t: np.ndarray):
 
 def _rates(robot: Robot, q: np.ndarray, twist: np.ndarray, dtwist: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray]:
-    """qd = J^+ twist, qdd = J^+ (dtwist - Jdot qd), batched over samples."""
+    """Joint rates ``qd = J^+ twist``, ``qdd = J^+ (dtwist - Jdot qd)`` per sample."""
     J = robot.jacobian(q)
     Jp = np.linalg.pinv(J, rcond=1e-10)
     qd = np.einsum("mij,mj->mi", Jp, twist)

@@ -98,6 +98,7 @@ class ControllerProfile:
     names: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
+        """Check the units and the per-column lists; store them as tuples."""
         if self.angle_unit not in _ANGLE:
             raise ModelError(f"angle_unit must be 'rad' or 'deg', got {short_repr(self.angle_unit)}",
                              field="angle_unit")
@@ -196,8 +197,10 @@ class ControllerProfile:
 
 def _list_field(doc: Mapping[str, Any], key: str, kinds: tuple[type, ...],
                 file: Any) -> list[Any] | None:
-    """``doc[key]``: None, or a list whose items are of ``kinds`` (no booleans,
-    finite numbers); a ModelError naming the field otherwise."""
+    """``doc[key]``: None, or a list whose items are of ``kinds``.
+
+    No booleans, finite numbers; a ModelError naming the field otherwise.
+    """
     value = doc.get(key)
     if value is None:
         return None
@@ -327,8 +330,10 @@ def _is_number(text: str) -> bool:
 
 
 def _load_table(path: Path, max_bytes: int) -> tuple[list[str] | None, np.ndarray, int]:
-    """The header (None when the file has none), the numbers, and the line of the
-    first data row (for messages)."""
+    """The header (None when the file has none), the numbers, the first data line.
+
+    The line number of the first data row is for messages.
+    """
     text = read_text_file(path, max_bytes=max_bytes)
     numbered = [(k, ln) for k, ln in enumerate(text.splitlines(), start=1)
                 if ln.strip() and not ln.lstrip().startswith("#")]
@@ -372,8 +377,10 @@ def _differentiate(t: np.ndarray, x: np.ndarray) -> np.ndarray:
 def _columns(header: list[str] | None, width: int, path: Path,
              joint_names: Sequence[str] | None
              ) -> tuple[list[tuple[str, str | None]], list[list[int]]]:
-    """Parsed header cells and the column indices of positions, rates and
-    accelerations, ordered as ``joint_names`` when given."""
+    """Parsed header cells and the column indices of positions, rates, accelerations.
+
+    The indices are ordered as ``joint_names`` when given.
+    """
     if header is None:
         n = width - 1
         if n == 0:
@@ -486,8 +493,11 @@ def _trajectory_from_table(header: list[str] | None, data: np.ndarray, path: Pat
 
 def _check_times(t: np.ndarray, path: Path, first_line: int, *,
                  allow_repeats: bool) -> np.ndarray:
-    """Rows to keep: refuses time going backwards (naming the line), and repeated
-    time stamps unless ``allow_repeats`` (then the first of each is kept)."""
+    """Rows to keep, refusing time that goes backwards (naming the line).
+
+    Repeated time stamps are refused too unless ``allow_repeats`` (then the first
+    of each is kept).
+    """
     step = np.diff(t)
     back = np.flatnonzero(step < 0 if allow_repeats else step <= 0)
     if back.size:

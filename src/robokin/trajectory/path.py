@@ -118,6 +118,7 @@ class PathBuilder:
         tool_speed: float | None = None, tool_acceleration: float | None = None,
         smooth: bool = True, ik: IKMode = "follow", max_samples: int | None = None,
     ) -> None:
+        """Check the start and the limits (see the class docstring)."""
         self.robot = robot
         n = robot.n
         q0 = check_finite(check_joints(q_start, n, "q_start"), "q_start")

@@ -64,6 +64,7 @@ class Trajectory:
     labels: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
+        """Check the shapes and times; freeze the arrays."""
         t = _ro(self.t, 1, "t")
         q = _ro(self.q, 2, "q")
         m, n = q.shape
@@ -131,6 +132,7 @@ class Trajectory:
         return Trajectory(**kw)
 
     def __repr__(self) -> str:
+        """A short summary: samples, joints, duration, space."""
         return (f"Trajectory(samples={len(self)}, joints={self.n}, "
                 f"duration={self.duration:.6g} s, space={self.space!r})")
 
@@ -306,6 +308,7 @@ class LimitViolation:
     limit: float
 
     def __str__(self) -> str:
+        """One line: the limit, the worst value and when."""
         return (f"{self.kind} of {self.joint_name} at {self.worst:.6g} beyond "
                 f"{self.limit:.6g} from t = {self.t_start:.4f} s to {self.t_end:.4f} s")
 
@@ -330,9 +333,11 @@ class LimitReport:
         return self.ok
 
     def __len__(self) -> int:
+        """The number of violations."""
         return len(self.violations)
 
     def __iter__(self):
+        """Each violation in turn."""
         return iter(self.violations)
 
     def first(self) -> LimitViolation | None:
@@ -340,6 +345,7 @@ class LimitReport:
         return self.violations[0] if self.violations else None
 
     def __str__(self) -> str:
+        """One line per violated limit, or that none is."""
         if not self.violations:
             return "no limit violated"
         return "\n".join(str(v) for v in self.violations)

@@ -1,5 +1,7 @@
-"""What the viewers draw, independent of how: the robot's shapes over time, the
-scene's bodies, and the per-sample facts of a collision report.
+"""What the viewers draw, independent of how.
+
+The robot's shapes over time, the scene's bodies, and the per-sample facts of a
+collision report.
 
 Both the live viewer (:mod:`robokin.viz.viewer`) and the standalone HTML file
 (:mod:`robokin.viz.html`) build on these plain arrays.

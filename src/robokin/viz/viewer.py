@@ -134,6 +134,7 @@ class RobotViewer:
         verbose: bool = False,
         allowed_hosts: tuple[str, ...] = (),
     ) -> None:
+        """Start the viewer server and draw the robot (see the class docstring)."""
         viser = _viser()
         self.robot = robot
         traj = trajectory
@@ -192,9 +193,11 @@ class RobotViewer:
             self.close()
 
     def __enter__(self) -> RobotViewer:
+        """The viewer itself."""
         return self
 
     def __exit__(self, *exc: object) -> None:
+        """Close the viewer."""
         self.close()
 
     # ----------------------------------------------------------------- scene

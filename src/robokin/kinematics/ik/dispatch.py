@@ -85,8 +85,11 @@ def solve(
 
 
 def _check_q_near_batch(q_near: np.ndarray, target: tuple[int, ...]) -> None:
-    """Raise InputError unless a batched ``q_near`` broadcasts to ``target``
-    (the pose batch + (n,)) without growing it: every solver reads it that way."""
+    """Raise InputError unless a batched ``q_near`` broadcasts to ``target``.
+
+    ``target`` is the pose batch + (n,); ``q_near`` must broadcast to it without
+    growing it: every solver reads it that way.
+    """
     try:
         ok = np.broadcast_shapes(q_near.shape, target) == target
     except ValueError:
@@ -98,8 +101,10 @@ def _check_q_near_batch(q_near: np.ndarray, target: tuple[int, ...]) -> None:
 
 
 def _single_solver(robot: Robot) -> Any:
-    """The family's single-pose hot path (``_six_r.make_single``), or None; cached
-    per chain."""
+    """The family's single-pose hot path (``_six_r.make_single``), or None.
+
+    Cached per chain.
+    """
     def build() -> Any:
         from robokin.kinematics.ik.analytic.detect import detect
 
@@ -109,8 +114,11 @@ def _single_solver(robot: Robot) -> Any:
 
 
 def _plain_joints(q: object, n: int) -> TypeGuard[npt.NDArray[np.float64]]:
-    """True for a float64 array of shape (n,) with finite values: what the full
-    ``check_joints`` / ``check_finite`` would return unchanged (a cheap test for the
-    single-pose path; anything else gets the full checks)."""
+    """True for a float64 array of shape (n,) with finite values.
+
+    That is what the full ``check_joints`` / ``check_finite`` would return
+    unchanged (a cheap test for the single-pose path; anything else gets the
+    full checks).
+    """
     return (type(q) is np.ndarray and q.shape == (n,) and q.dtype == np.float64
             and math.isfinite(sum(q.tolist())))

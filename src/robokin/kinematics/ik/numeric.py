@@ -1,4 +1,4 @@
-"""Numeric inverse kinematics for any chain: damped least squares with limits and restarts.
+r"""Numeric inverse kinematics for any chain: damped least squares with limits and restarts.
 
 The solver works on the canonical chain (:mod:`robokin.model.chain`), so every arm
 gets it: revolute and prismatic joints, reversed axes, dependent joints
@@ -6,9 +6,9 @@ gets it: revolute and prismatic joints, reversed axes, dependent joints
 
 .. math::
 
-    e = \\begin{bmatrix} p_t - p(q) \\\\ \\log(R_t R(q)^T)^\\vee \\end{bmatrix},
-    \\qquad
-    \\Delta q = J_w^T (J_w J_w^T + \\lambda I)^{-1} W^{1/2} e
+    e = \begin{bmatrix} p_t - p(q) \\ \log(R_t R(q)^T)^\vee \end{bmatrix},
+    \qquad
+    \Delta q = J_w^T (J_w J_w^T + \lambda I)^{-1} W^{1/2} e
 
 (or the joint-space form when fewer joints than task rows), with
 ``J_w = W^{1/2} J`` restricted to the selected task rows, ``lambda = mu * E``

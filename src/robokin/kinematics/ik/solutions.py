@@ -134,11 +134,13 @@ class SolutionSet:
                  limits: np.ndarray, flags: dict[str, np.ndarray],
                  branches: dict[str, np.ndarray], status: np.ndarray, method: str,
                  error: np.ndarray | None, info: dict[str, Any]) -> SolutionSet:
-        """Build a set from arrays already in final form (float64 ``q``, bool masks,
-        a ``within_limits`` flag, an object ``status``) without conversions or
-        checks: the hot path of the closed forms. Callers pass fresh arrays (or
+        """Build a set from arrays already in final form, without conversions or checks.
+
+        Final form: float64 ``q``, bool masks, a ``within_limits`` flag, an object
+        ``status``; the hot path of the closed forms. Callers pass fresh arrays (or
         read-only shared ones), never buffers they reuse; rows of ``q`` that are
-        not valid are set to NaN here (in place)."""
+        not valid are set to NaN here (in place).
+        """
         q[~valid] = np.nan
         self = object.__new__(cls)
         self.__dict__.update(q=q, valid=valid, is_revolute=is_revolute, limits=limits,
@@ -178,8 +180,10 @@ class SolutionSet:
 
     @property
     def within_limits(self) -> np.ndarray:
-        """(..., k) bool, solutions inside every joint limit (see
-        :meth:`keep_within_limits` for the set of those alone)."""
+        """(..., k) bool, solutions inside every joint limit.
+
+        See :meth:`keep_within_limits` for the set of those alone.
+        """
         return self.flags["within_limits"] & self.valid
 
     def __len__(self) -> int:
@@ -399,6 +403,7 @@ class SolutionSet:
                        info={**self.info, "space": "actuator"})
 
     def __repr__(self) -> str:
+        """A short summary: poses, solutions per pose, method."""
         if not self.shape:
             st = self.status.item() if isinstance(self.status, np.ndarray) else self.status
             return (f"SolutionSet({int(self.count)} solution(s), method={self.method!r}, "

@@ -115,9 +115,11 @@ def level_rotation(g: PalletizerGeometry) -> np.ndarray:
 
 
 def pose_from_position_yaw(robot: Robot, xyz: Any, yaw: Any) -> np.ndarray:
-    """The level target pose(s) (..., 4, 4) at position ``xyz`` (..., 3) [m] with the
-    tool turned by ``yaw`` (...) [rad] about the waist axis from its zero-yaw
-    orientation."""
+    """The level target pose(s) (..., 4, 4) at a position with a yaw.
+
+    The tool sits at ``xyz`` (..., 3) [m], turned by ``yaw`` (...) [rad] about
+    the waist axis from its zero-yaw orientation.
+    """
     from robokin.kinematics.ik.analytic._geometry import poe_from_chain
 
     g = geometry(robot.chain, poe_from_chain(robot.chain))

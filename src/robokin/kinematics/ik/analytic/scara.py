@@ -79,7 +79,10 @@ def _elbow_angles(h, a, b, d):
     """Paden-Kahan subproblem 3: angles v with |a + rot(h, v) b| = |d|.
 
     Args:
-        h: Unit axis (3,). a, b: Link vectors (3,). d: Targets (..., 3).
+        h: Unit axis, shape (3,).
+        a: First link vector [m], shape (3,).
+        b: Second link vector [m], shape (3,).
+        d: Targets [m], shape (..., 3).
 
     Returns:
         ``(v (..., 2), disc (...), r2)``: both roots (equal when ``disc`` = 0),
@@ -98,8 +101,11 @@ def _elbow_angles(h, a, b, d):
 
 
 def _align_angle(h, u, d):
-    """Paden-Kahan subproblem 1: the angle about ``h`` taking ``u`` onto ``d``'s
-    direction (components along ``h`` ignored); broadcasts over leading axes."""
+    """Paden-Kahan subproblem 1: the angle about ``h`` taking ``u`` towards ``d``.
+
+    Onto ``d``'s direction, components along ``h`` ignored; broadcasts over
+    leading axes.
+    """
     return np.arctan2(np.einsum("...i,...i", d, np.cross(h, u)),
                       np.einsum("...i,...i", d, u) - (u @ h) * (d @ h))
 
