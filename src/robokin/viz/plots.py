@@ -187,7 +187,7 @@ def _scales(traj, degrees: bool):
     return s, unit
 
 
-def plot_joints(traj: Any, *, path: str | Path | None = None, degrees: bool = True,
+def plot_joints(traj: Trajectory, *, path: str | Path | None = None, degrees: bool = True,
                 via: bool = True, title: str | None = None,
                 overwrite: bool = False) -> Any:
     """Joint position, velocity and acceleration over time: three panels, a line per joint.
@@ -242,7 +242,7 @@ def _positions(traj: Trajectory, robot: Robot | None) -> np.ndarray:
     return traj.tool_poses(robot)[:, :3, 3]
 
 
-def plot_tool_position(traj: Any, robot: Robot | None = None, *, path: str | Path | None = None,
+def plot_tool_position(traj: Trajectory, robot: Robot | None = None, *, path: str | Path | None = None,
                        mm: bool = True, relative: bool = False,
                        title: str | None = None, overwrite: bool = False) -> Any:
     """Tool position x, y, z over time (one line each).
@@ -273,7 +273,7 @@ def plot_tool_position(traj: Any, robot: Robot | None = None, *, path: str | Pat
     return _finish(fig, path, overwrite)
 
 
-def plot_tool_path(traj: Any, robot: Robot | None = None, *, path: str | Path | None = None,
+def plot_tool_path(traj: Trajectory, robot: Robot | None = None, *, path: str | Path | None = None,
                    mm: bool = True, title: str | None = None,
                    overwrite: bool = False) -> Any:
     """Tool path in 3D, with its projections onto the XY, XZ and YZ planes.
