@@ -42,7 +42,7 @@ import numpy as np
 from robokin.exceptions import InputError
 
 if TYPE_CHECKING:
-    from robokin.collision.check import CollisionReport
+    from robokin.collision.report import CollisionReport
     from robokin.collision.scene import Scene
     from robokin.robot import Robot
     from robokin.trajectory.samples import Trajectory

@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from robokin._native import kernels as _k
-from robokin.collision.check import (
+from robokin.collision.report import (
+    TIE,
     Closest,
     Collision,
     CollisionReport,
@@ -26,7 +27,6 @@ if TYPE_CHECKING:
     from robokin.collision.scene import Scene
     from robokin.robot import Robot
 
-_TIE = 1e-9  # [m] pair minima are exact to this (bounds within it of the best stop)
 
 
 def _coal():
@@ -508,8 +508,8 @@ class _Problem:
         while True:
             if final:
                 g = best.min()
-                cand = np.flatnonzero(np.where(done, np.inf, LB).min(axis=1) < g - _TIE)
-                need = ~done[cand] & (LB[cand] < g - _TIE)
+                cand = np.flatnonzero(np.where(done, np.inf, LB).min(axis=1) < g - TIE)
+                need = ~done[cand] & (LB[cand] < g - TIE)
             else:
                 cand = active
                 Lc = LB[cand]
@@ -524,7 +524,7 @@ class _Problem:
             if not final:
                 active = rows
             if not len(rows):
-                if final or pair_tol <= _TIE:
+                if final or pair_tol <= TIE:
                     break
                 final = True
                 continue
@@ -705,7 +705,7 @@ class _Problem:
         lb = self.lower_bounds(frames)  # (P, k); -inf where not bounded
         an = np.flatnonzero(self.analytic)
         if an.size:
-            lb[an] = self.analytic_distances(frames, an) - _TIE
+            lb[an] = self.analytic_distances(frames, an) - TIE
         for i in range(k):
             for p in np.argsort(lb[:, i], kind="stable"):
                 if lb[p, i] >= dist[i]:

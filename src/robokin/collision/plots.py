@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from robokin.collision.check import CollisionReport
+    from robokin.collision.report import CollisionReport
 
 __all__ = ["plot_distance"]
 

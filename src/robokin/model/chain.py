@@ -23,7 +23,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin.exceptions import ModelError
-from robokin.model.chain_arrays import MAX_JOINTS, ChainArrays, chain_arrays_from_chain
+from robokin.model.chain_arrays import MAX_JOINTS, ChainArrays, chain_arrays
 from robokin.model.coupling import AffineMap
 
 __all__ = ["Chain", "ChainBuilder", "Joint", "JointKind"]
@@ -172,7 +172,17 @@ class Chain:
                 f"a chain of {nc} joints and {n} coordinates: robokin takes at most "
                 f"{MAX_JOINTS} of each"
             )
-        init(self, "arrays", chain_arrays_from_chain(self))
+        init(self, "arrays", chain_arrays(
+            head=self.head, frame_offsets=self.frame_offsets,
+            link_offsets=self.link_offsets, base=self.base, tool=self.tool,
+            kind=np.array([j.kind == "prismatic" for j in self.joints], dtype=np.float64),
+            sign=np.array([j.sign for j in self.joints], dtype=np.float64),
+            offset=np.array([j.offset for j in self.joints], dtype=np.float64),
+            M=np.asarray(self.coupling.matrix, dtype=np.float64).reshape(nc, n),
+            c=np.asarray(self.coupling.offset, dtype=np.float64).reshape(nc),
+            limits=np.array([co.limits for co in self.coordinates], dtype=np.float64),
+            is_revolute=np.array([co.kind == "revolute" for co in self.coordinates]),
+            identity=bool(self.coupling.is_identity)))
 
     @property
     def n(self) -> int:
