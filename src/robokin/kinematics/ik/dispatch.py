@@ -14,7 +14,7 @@ from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["solve"]
 
@@ -22,7 +22,7 @@ _METHODS = ("auto", "analytic", "numeric")
 
 
 def solve(
-    robot: Robot,
+    robot: RobotLike,
     T: npt.ArrayLike,
     *,
     q_near: npt.ArrayLike | None = None,
@@ -100,7 +100,7 @@ def _check_q_near_batch(q_near: np.ndarray, target: tuple[int, ...]) -> None:
         )
 
 
-def _single_solver(robot: Robot) -> Any:
+def _single_solver(robot: RobotLike) -> Any:
     """The family's single-pose hot path (``_six_r.make_single``), or None.
 
     Cached per chain.

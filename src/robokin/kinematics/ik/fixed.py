@@ -27,13 +27,13 @@ from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["solve_fixed"]
 
 
 def solve_fixed(
-    robot: Robot,
+    robot: RobotLike,
     T: npt.ArrayLike,
     fixed: Mapping[str, npt.ArrayLike],
     *,
@@ -104,7 +104,7 @@ def solve_fixed(
     return _assemble(robot, lead, idx, keep, V, parts, dict(zip(fixed, values)))
 
 
-def _end_joint(robot: Robot, idx: list[int]) -> str | None:
+def _end_joint(robot: RobotLike, idx: list[int]) -> str | None:
     """"first" / "last" when one held coordinate is the chain's first / last joint."""
     chain = robot.chain
     if len(idx) != 1 or not chain.coupling.is_identity:
@@ -116,7 +116,7 @@ def _end_joint(robot: Robot, idx: list[int]) -> str | None:
     return None
 
 
-def _joint_move(robot: Robot, j: int, v: np.ndarray) -> np.ndarray:
+def _joint_move(robot: RobotLike, j: int, v: np.ndarray) -> np.ndarray:
     """J_j(sign * v) for values v (N,): (N, 4, 4)."""
     joint = robot.chain.joints[j]
     x = joint.sign * v
@@ -129,7 +129,7 @@ def _joint_move(robot: Robot, j: int, v: np.ndarray) -> np.ndarray:
     return out
 
 
-def _moved_targets(robot: Robot, end: str, T: np.ndarray, v: np.ndarray) -> np.ndarray:
+def _moved_targets(robot: RobotLike, end: str, T: np.ndarray, v: np.ndarray) -> np.ndarray:
     """The targets of the reduced chain (held value 0) that equal T at value v."""
     C = robot.chain.arrays.consts
     if end == "last":
@@ -140,7 +140,7 @@ def _moved_targets(robot: Robot, end: str, T: np.ndarray, v: np.ndarray) -> np.n
     return C0 @ _joint_move(robot, 0, -v) @ np.linalg.inv(C0) @ T
 
 
-def _reduced(robot: Robot, idx: list[int], values: tuple[float, ...]) -> Any:
+def _reduced(robot: RobotLike, idx: list[int], values: tuple[float, ...]) -> Any:
     """The robot of the remaining coordinates (cached per chain and held values)."""
     key = ("fixed", tuple(idx), values)
 
@@ -148,12 +148,14 @@ def _reduced(robot: Robot, idx: list[int], values: tuple[float, ...]) -> Any:
         held = ", ".join(f"{robot.joint_names[j]}={v:g}" for j, v in zip(idx, values,
                                                                           strict=True))
         chain = robot.chain.with_fixed(dict(zip(idx, values, strict=True)))
-        return type(robot)(chain, name=f"{robot.name} ({held} held)")
+        return robot.replace(chain=chain, name=f"{robot.name} ({held} held)",
+                             geometry=None, actuators=None, actuator_names=None,
+                             actuator_limits=None)
 
     return cached(robot.chain, key, build)
 
 
-def _assemble(robot: Robot, lead: tuple[int, ...], idx: list[int], keep: list[int],
+def _assemble(robot: RobotLike, lead: tuple[int, ...], idx: list[int], keep: list[int],
               V: np.ndarray, parts: list[tuple[np.ndarray, SolutionSet]],
               fixed: dict[str, np.ndarray]) -> SolutionSet:
     N = V.shape[0]

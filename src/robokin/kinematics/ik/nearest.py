@@ -21,7 +21,7 @@ from robokin.kinematics.ik.numeric import IKResult
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.solutions import SolutionSet
-    from robokin.robot import Robot
+    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["solve_near"]
 
@@ -29,7 +29,7 @@ _METHODS = ("auto", "analytic", "numeric")
 
 
 def solve_near(
-    robot: Robot,
+    robot: RobotLike,
     T: npt.ArrayLike,
     q_near: npt.ArrayLike,
     *,
@@ -80,7 +80,7 @@ def solve_near(
     return _nearest(robot, sols, T, q_near)
 
 
-def _nearest(robot: Robot, sols: SolutionSet, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
+def _nearest(robot: RobotLike, sols: SolutionSet, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
     """The row of ``sols`` nearest ``q_near`` per pose, inside the limits, as a result."""
     from robokin._native import kernels
 

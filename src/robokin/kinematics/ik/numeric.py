@@ -59,7 +59,7 @@ from robokin.kinematics.per_chain import cached
 from robokin.model.chain import Chain
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["IKPathResult", "IKResult", "ik_path", "parse_mask", "solve", "solve_all"]
 
@@ -413,7 +413,7 @@ def _bad_target(Tf: np.ndarray, lead: tuple[int, ...], i: int) -> InputError:
 
 # ------------------------------------------------------------------------- solve
 def solve(
-    robot: Robot,
+    robot: RobotLike,
     T: npt.ArrayLike,
     *,
     q0: npt.ArrayLike | None = None,
@@ -591,7 +591,7 @@ _SOLVE_ALL_OPTIONS = frozenset(
 
 
 def solve_all(
-    robot: Robot,
+    robot: RobotLike,
     T: npt.ArrayLike,
     *,
     q_near: npt.ArrayLike | None = None,
@@ -738,7 +738,7 @@ def _mask_names(opts: np.ndarray) -> str:
 
 # -------------------------------------------------------------------------- ik_path
 def ik_path(
-    robot: Robot,
+    robot: RobotLike,
     T_path: npt.ArrayLike,
     q_start: npt.ArrayLike,
     *,

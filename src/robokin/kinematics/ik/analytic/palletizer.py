@@ -39,8 +39,8 @@ from robokin.kinematics.ik.analytic._geometry import (
 from robokin.kinematics.ik.analytic.scara import _align_angle, _elbow_angles, _rot
 
 if TYPE_CHECKING:
+    from robokin.kinematics.robot_like import RobotLike
     from robokin.model.chain import Chain
-    from robokin.robot import Robot
 
 __all__ = ["measure", "pose_from_position_yaw"]
 
@@ -114,7 +114,7 @@ def level_rotation(g: PalletizerGeometry) -> np.ndarray:
     return g.Rc @ g.M[:3, :3]
 
 
-def pose_from_position_yaw(robot: Robot, xyz: Any, yaw: Any) -> np.ndarray:
+def pose_from_position_yaw(robot: RobotLike, xyz: Any, yaw: Any) -> np.ndarray:
     """The level target pose(s) (..., 4, 4) at a position with a yaw.
 
     The tool sits at ``xyz`` (..., 3) [m], turned by ``yaw`` (...) [rad] about
@@ -135,7 +135,7 @@ def pose_from_position_yaw(robot: Robot, xyz: Any, yaw: Any) -> np.ndarray:
     return T
 
 
-def solve_geometry(robot: Robot, g: PalletizerGeometry, T: np.ndarray, *,
+def solve_geometry(robot: RobotLike, g: PalletizerGeometry, T: np.ndarray, *,
                    level_tol: float = 1e-9, compute_error: bool = False,
                    method: str = "analytic:palletizer", info: dict | None = None):
     """Every solution (up to 4) for poses T (..., 4, 4)."""
