@@ -51,11 +51,13 @@ class Robot:
         actuator_names: Names of the motor coordinates (m), or None.
         actuator_limits: Motor limits (m, 2), SI units, or None.
         geometry: Link and tool shapes (see ``robokin.model.geometry``), or None.
+        dynamics: Link masses, centres of mass, inertias and joint torque limits
+            (:class:`~robokin.model.dynamics.RobotDynamics`), or None.
         path: The robot file it was loaded from, or None.
         meta: Free-form extra fields from the robot file (a read-only mapping).
     """
 
-    __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain",
+    __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain", "dynamics",
                  "geometry", "meta", "name", "path", "source", "__weakref__")
 
     def __setattr__(self, name: str, value: Any) -> None:
@@ -72,7 +74,7 @@ class Robot:
         return {"name": self.name, "source": self.source, "actuators": self.actuators,
                 "actuator_names": self.actuator_names,
                 "actuator_limits": self.actuator_limits, "geometry": self.geometry,
-                "path": self.path, "meta": dict(self.meta)}
+                "dynamics": self.dynamics, "path": self.path, "meta": dict(self.meta)}
 
     def __init__(
         self,
@@ -84,6 +86,7 @@ class Robot:
         actuator_names: Sequence[str] | None = None,
         actuator_limits: npt.ArrayLike | None = None,
         geometry: Any = None,
+        dynamics: Any = None,
         path: str | Path | None = None,
         meta: Mapping[str, Any] | None = None,
     ) -> None:
@@ -119,6 +122,11 @@ class Robot:
             actuator_limits = lim
         init(self, "actuator_limits", actuator_limits)
         init(self, "geometry", geometry)
+        if dynamics is not None and len(getattr(dynamics, "names", ())) != chain.n_chain + 2:
+            raise InputError("dynamics", f"expected data for {chain.n_chain + 2} links "
+                             "(base, the chain joints, tool); see "
+                             "robokin.model.dynamics.RobotDynamics.from_mapping")
+        init(self, "dynamics", dynamics)
         init(self, "path", None if path is None else Path(path))
         init(self, "meta", MappingProxyType(dict(meta or {})))
 
