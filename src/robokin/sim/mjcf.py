@@ -1,0 +1,720 @@
+"""MJCF export: any robokin robot (and scene) as a MuJoCo model with the same FK.
+
+The canonical chain ``T = C0 J1 C1 ... Jn Cn`` becomes a tree of bodies (see
+``docs/simulation.md``):
+
+* **Bodies.** One per link: ``base`` (at ``robot.base``, welded to the world),
+  one per chain joint (its frame is the link frame of ``robot.fk_all``, so link
+  shapes, centres of mass and inertias go in unchanged) and ``tool`` (at the tool
+  frame, welded to the last link, carrying the site ``tool``). A body's pose in
+  its parent is ``G_{k-1} J_k(constant part) F_k``: virtual frames, zero offsets
+  and the constant part of a coupled joint fold in there.
+* **Joints.** A chain joint is a hinge or a slide through the origin of
+  ``F_k^-1`` along ``sign * F_k^-1 z`` (a reversed joint points its axis the
+  other way). Each independent coordinate gets one joint named as in
+  ``robot.joint_names`` whose value is that coordinate. A dependent chain joint
+  ``sum_i M_ki q_i + c_k`` becomes one coaxial joint per coordinate it follows
+  (rotations about one axis add) tied to the coordinate's joint by an equality
+  constraint ``x = M_ki q_i``; a coordinate that moves no chain joint with
+  coefficient +-1 gets its own joint on a light leaf body.
+* **Actuators.** Position servos (:mod:`robokin.sim.servo`) per joint, or per
+  motor: a motor acts through a fixed tendon whose length is its coordinate
+  ``phi = A^+ (q - b)`` (the robot's actuator map, e.g. the SCARA's ball-screw /
+  ball-spline pair), so its force is the motor torque and ``tau_q = A^-T tau_phi``.
+  Torque limits clamp each joint's actuator torque (``actuatorfrcrange``).
+* **Collision.** Every link shape and scene object is a geom (a capsule, box,
+  sphere or cylinder as such; a mesh as its convex hull, inline). Contacts are
+  only those robokin's own check looks at: scene objects against moving links,
+  and the link pairs :meth:`~robokin.model.geometry.RobotGeometry.self_pairs`
+  lists; every other pair is excluded.
+* **Mass.** Each link's :class:`~robokin.model.dynamics.LinkInertia` (data, or
+  estimated from its shapes; see :func:`~robokin.model.dynamics.resolve_links`).
+
+MJCF text is written directly (ElementTree) rather than through ``MjSpec``: the
+text is the product (``robokin export NAME -o robot.xml``), it needs no MuJoCo to
+write it, and it stays readable and diffable; MuJoCo compiles it when simulating.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Literal
+from xml.etree import ElementTree as ET
+
+import numpy as np
+import numpy.typing as npt
+
+from robokin._text import short_repr
+from robokin.exceptions import InputError, ModelError
+from robokin.model.dynamics import LinkInertia, ResolvedLinks, resolve_links
+from robokin.sim.servo import servo_gains
+
+if TYPE_CHECKING:
+    from robokin.collision.scene import Scene
+    from robokin.model.geometry import Shape
+    from robokin.robot import Robot
+
+__all__ = ["MJCF_TIMESTEP", "JointMap", "MjcfExport", "build_mjcf", "to_mjcf",
+           "write_mjcf"]
+
+F64 = npt.NDArray[np.float64]
+ActuatorSpace = Literal["joint", "motor"]
+
+#: Default physics time step [s] (1 kHz).
+MJCF_TIMESTEP = 0.001
+# Mass [kg] and principal moment [kg m^2] given to a moving body without any mass
+# (MuJoCo refuses massless moving bodies); reported in the export's notes.
+_TINY_MASS = 1e-9
+_TINY_INERTIA = 1e-12
+# Rotor inertia [kg m^2 or kg] given to coaxial joints of one link (their mass
+# matrix is otherwise singular); small against any link's inertia.
+_ARMATURE = 1e-6
+_ROBOT_RGBA = "0.95 0.55 0.15 1"
+_SCENE_RGBA = "0.6 0.6 0.65 0.6"
+
+
+def _fmt(v: float) -> str:
+    v = float(v)
+    return "0" if v == 0.0 else repr(v)
+
+
+def _vec(values: Any) -> str:
+    return " ".join(_fmt(v) for v in np.asarray(values, dtype=float).reshape(-1))
+
+
+def _pose_attrs(T: np.ndarray) -> dict[str, str]:
+    """``pos`` and ``quat`` (w x y z) attributes of a pose, identity parts left out."""
+    from robokin.spatial import quaternion_from_matrix
+
+    out = {}
+    if np.any(T[:3, 3] != 0.0):
+        out["pos"] = _vec(T[:3, 3])
+    if not np.array_equal(T[:3, :3], np.eye(3)):
+        out["quat"] = _vec(quaternion_from_matrix(T))
+    return out
+
+
+def _rz_or_tz(kind: str, value: float) -> np.ndarray:
+    T = np.eye(4)
+    if value == 0.0:
+        return T
+    if kind == "revolute":
+        c, s = math.cos(value), math.sin(value)
+        T[:2, :2] = [[c, -s], [s, c]]
+    else:
+        T[2, 3] = value
+    return T
+
+
+@dataclass(frozen=True)
+class JointMap:
+    """How the robot's joint coordinates set the MuJoCo joints.
+
+    Every MuJoCo joint robokin writes has the value ``coefficient * q[coordinate]``
+    (the constant parts of the chain sit in the body poses).
+
+    Attributes:
+        names: The MuJoCo joints (masters and coupled parts), in tree order.
+        coordinate: Per joint, the index of the coordinate that drives it.
+        coefficient: Per joint, its value per unit of that coordinate.
+        masters: Per coordinate (n), the joint whose value it is (named as the
+            coordinate).
+    """
+
+    names: tuple[str, ...]
+    coordinate: tuple[int, ...]
+    coefficient: tuple[float, ...]
+    masters: tuple[str, ...]
+
+    def selection(self, model: Any) -> tuple[np.ndarray, np.ndarray, F64]:
+        """Addresses in a compiled model and the map ``x = S q``.
+
+        Returns:
+            ``(qpos_adr (J,), dof_adr (J,), S (nv, n))``: where each joint sits in
+            ``qpos`` and ``qvel``, and the matrix taking coordinates (and their
+            rates) to every degree of freedom.
+        """
+        mj = _mj()
+        ids = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_JOINT, nm) for nm in self.names]
+        qadr = np.array([model.jnt_qposadr[i] for i in ids], dtype=np.int64)
+        dadr = np.array([model.jnt_dofadr[i] for i in ids], dtype=np.int64)
+        S = np.zeros((model.nv, len(self.masters)))
+        for d, i, c in zip(dadr, self.coordinate, self.coefficient):
+            S[d, i] += c
+        return qadr, dadr, S
+
+    def master_qpos(self, model: Any) -> np.ndarray:
+        """``qpos`` addresses of the coordinates' joints, (n,)."""
+        mj = _mj()
+        return np.array([model.jnt_qposadr[mj.mj_name2id(model, mj.mjtObj.mjOBJ_JOINT,
+                                                         nm)] for nm in self.masters],
+                        dtype=np.int64)
+
+
+@dataclass(frozen=True, eq=False)
+class MjcfExport:
+    """The MJCF text and what a simulation needs to drive and read it.
+
+    Attributes:
+        xml: The MJCF text.
+        robot: The robot as modelled (placed in the scene when one was given).
+        joints: The :class:`JointMap`.
+        links: Every link's mass properties and where they come from.
+        actuators: ``"joint"`` (one servo per joint coordinate) or ``"motor"``
+            (one per motor, through the actuator map).
+        actuator_names: The actuators, in ``ctrl`` order.
+        kp: Servo stiffness per actuator.
+        kv: Servo damping per actuator.
+        ctrl_offset: Added to a set point to make the actuator's ``ctrl``,
+            (n_actuators,) (a motor tendon's ``A^+ b``).
+        gravity_compensation: Whether the servos compensate gravity.
+        velocity_feedforward: Whether the servos follow the set velocity.
+        torque_limits: Per joint coordinate [N m or N] (inf: none), (n,).
+        notes: What the export had to decide (estimated links, adjusted
+            inertias), one sentence each.
+        timestep: The physics time step [s].
+    """
+
+    xml: str
+    robot: Robot
+    joints: JointMap
+    links: ResolvedLinks
+    actuators: ActuatorSpace
+    actuator_names: tuple[str, ...]
+    kp: F64
+    kv: F64
+    ctrl_offset: F64
+    gravity_compensation: bool
+    velocity_feedforward: bool
+    torque_limits: F64
+    notes: tuple[str, ...]
+    timestep: float
+
+
+def _mj() -> Any:
+    from robokin.sim._mujoco import mujoco
+
+    return mujoco()
+
+
+# ----------------------------------------------------------------------- layout
+@dataclass
+class _Part:
+    """One MuJoCo joint in a chain body."""
+
+    name: str
+    coordinate: int
+    coefficient: float  # joint value per unit coordinate
+    axis_sign: float  # the joint turns the body by axis_sign * value about F^-1 z
+    master: bool
+
+
+def _masters(M: np.ndarray) -> dict[int, tuple[int, float]]:
+    """Per coordinate, the chain joint that carries its own joint, and +-1."""
+    out: dict[int, tuple[int, float]] = {}
+    nc, n = M.shape
+    for single in (True, False):  # prefer chain joints that follow one coordinate
+        for k in range(nc):
+            nz = np.flatnonzero(M[k])
+            if single and len(nz) != 1:
+                continue
+            for i in nz:
+                if int(i) not in out and abs(M[k, i]) == 1.0:
+                    out[int(i)] = (k, float(M[k, i]))
+    return out
+
+
+def _parts(robot: Robot) -> tuple[list[list[_Part]], list[int]]:
+    """The MuJoCo joints of every chain body, and the coordinates needing a leaf."""
+    chain = robot.chain
+    M = chain.coupling.matrix
+    cnames = list(robot.joint_names)
+    masters = _masters(M)
+    used = set(cnames)
+    per_body: list[list[_Part]] = []
+    for k, joint in enumerate(chain.joints):
+        parts: list[_Part] = []
+        nz = [int(i) for i in np.flatnonzero(M[k])]
+        for i in nz:
+            if masters.get(i, (-1, 0.0))[0] == k:
+                m = masters[i][1]
+                parts.append(_Part(cnames[i], i, 1.0, joint.sign * m, True))
+        others = [i for i in nz if masters.get(i, (-1, 0.0))[0] != k]
+        for i in others:
+            base = joint.name if (len(nz) == 1 and joint.name not in used) \
+                else f"{joint.name}_{cnames[i]}"
+            name, j = base, 2
+            while name in used:
+                name, j = f"{base}_{j}", j + 1
+            used.add(name)
+            parts.append(_Part(name, i, float(M[k, i]), joint.sign, False))
+        per_body.append(parts)
+    leaves = [i for i in range(len(cnames)) if i not in masters]
+    return per_body, leaves
+
+
+# ------------------------------------------------------------------------ geoms
+def _mesh_asset(asset: ET.Element, shape: Shape, name: str) -> None:
+    """The convex hull of a mesh shape, inline (MuJoCo collides convex hulls)."""
+    hull = shape.trimesh().convex_hull
+    ET.SubElement(asset, "mesh", {
+        "name": name,
+        "vertex": _vec(np.asarray(hull.vertices)),
+        "face": " ".join(str(int(v)) for v in np.asarray(hull.faces).reshape(-1)),
+    })
+
+
+def _geom(parent: ET.Element, asset: ET.Element, shape: Shape, name: str,
+          rgba: str, pose: np.ndarray | None = None) -> None:
+    P = np.asarray(shape.placement if pose is None else pose, dtype=float)
+    attrs: dict[str, str] = {"name": name, "rgba": rgba}
+    k, s = shape.kind, shape.size
+    if k == "box":
+        attrs.update(type="box", size=_vec(np.array(s) / 2))
+    elif k == "sphere":
+        attrs.update(type="sphere", size=_vec(s[:1]))
+    elif k == "cylinder":
+        attrs.update(type="cylinder", size=_vec([s[0], s[1] / 2]))
+    elif k == "capsule":
+        if s[1] > 0:
+            attrs.update(type="capsule", size=_vec([s[0], s[1] / 2]))
+        else:
+            attrs.update(type="sphere", size=_vec(s[:1]))
+    else:
+        mesh_name = f"mesh_{name}"
+        _mesh_asset(asset, shape, mesh_name)
+        attrs.update(type="mesh", mesh=mesh_name)
+    attrs.update(_pose_attrs(P))
+    ET.SubElement(parent, "geom", attrs)
+
+
+# ------------------------------------------------------------------------ mass
+def _consistent(link: LinkInertia) -> tuple[LinkInertia, str]:
+    """The link with principal moments that satisfy ``A + B >= C`` (MuJoCo's rule).
+
+    The smaller moments grow by half the shortfall each, which keeps the largest
+    (a link turning about one axis keeps its inertia about it). Returns the link
+    and a note ("" when nothing changed).
+    """
+    w, V = np.linalg.eigh(link.inertia)
+    w = np.maximum(w, 0.0)
+    order = np.argsort(w)
+    a, b, c = w[order]
+    if a + b >= c * (1 - 1e-12):
+        return link, ""
+    gap = (c - a - b) / 2.0
+    w2 = w.copy()
+    w2[order[0]] += gap
+    w2[order[1]] += gap
+    fixed = LinkInertia(link.mass, link.com, V @ np.diag(w2) @ V.T)
+    return fixed, (f"principal moments {np.round(w, 9).tolist()} kg m^2 violate "
+                   f"A + B >= C; raised to {np.round(w2, 9).tolist()}")
+
+
+def _inertial(body: ET.Element, name: str, link: LinkInertia | None, has_joint: bool,
+              notes: list[str]) -> None:
+    if link is None or link.mass <= 0.0:
+        if not has_joint:  # a welded body may be massless
+            return
+        had = "" if link is None else f" (its data: mass {link.mass:g} kg)"
+        notes.append(f"link {name!r} has no mass{had}: modelled with "
+                     f"{_TINY_MASS:g} kg so MuJoCo accepts it")
+        com = np.zeros(3) if link is None else link.com
+        tensor = np.eye(3) * _TINY_INERTIA if link is None else link.inertia
+        link = LinkInertia(_TINY_MASS, com, tensor + np.eye(3) * _TINY_INERTIA)
+    fixed, note = _consistent(link)
+    if note:
+        notes.append(f"link {name!r}: {note}")
+    I = fixed.moments
+    if np.all(I[:3] <= 0.0):
+        I = np.array([_TINY_INERTIA] * 3 + [0.0] * 3)
+    ET.SubElement(body, "inertial", {"pos": _vec(fixed.com), "mass": _fmt(fixed.mass),
+                                     "fullinertia": _vec(I)})
+
+
+# ----------------------------------------------------------------------- export
+def _check_space(actuators: Any, robot: Robot) -> ActuatorSpace:
+    if actuators not in ("joint", "motor"):
+        raise InputError("actuators", f"expected 'joint' or 'motor', got "
+                         f"{short_repr(actuators)}")
+    if actuators == "motor" and robot.actuators is None:
+        raise InputError("actuators", f"{robot.name} has no actuator map (motors); "
+                         "use actuators='joint'")
+    return actuators  # type: ignore[return-value]
+
+
+def _torque_limits(robot: Robot, torque_limits: npt.ArrayLike | None) -> F64:
+    n = robot.n
+    if torque_limits is None:
+        dyn_lim = getattr(robot.dynamics, "torque_limits", None)
+        return (np.full(n, math.inf) if dyn_lim is None
+                else np.array(dyn_lim, dtype=float))
+    try:
+        lim = np.array(torque_limits, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError("torque_limits", f"expected {n} numbers, got "
+                         f"{short_repr(torque_limits)}") from None
+    if lim.shape != (n,) or np.isnan(lim).any() or (lim <= 0).any():
+        raise InputError("torque_limits", f"expected {n} values > 0 [N m or N] (inf: "
+                         f"none), got {lim.tolist()}")
+    return lim
+
+
+class _Writer:
+    """Builds the MJCF tree of one robot (and scene)."""
+
+    def __init__(self, robot: Robot, scene: Scene | None, links: ResolvedLinks,
+                 timestep: float, gravity_compensation: bool,
+                 torque_limits: F64, contact_forces: bool) -> None:
+        self.robot, self.scene, self.links = robot, scene, links
+        self.notes: list[str] = []
+        self.root = ET.Element("mujoco", {"model": robot.name})
+        self.root.append(ET.Comment(
+            f" written by robokin from '{robot.name}': bodies are the link frames of "
+            "robot.fk_all; see docs/simulation.md ".replace("--", "-")))
+        ET.SubElement(self.root, "compiler", {"angle": "radian", "autolimits": "true",
+                                              "inertiafromgeom": "false"})
+        opt = ET.SubElement(self.root, "option", {"timestep": _fmt(timestep),
+                                                  "integrator": "implicitfast"})
+        flags = {"filterparent": "disable"}
+        if not contact_forces:
+            flags["contact"] = "disable"
+        ET.SubElement(opt, "flag", flags)
+        self.asset = ET.SubElement(self.root, "asset")
+        self.world = ET.SubElement(self.root, "worldbody")
+        self.gravcomp = gravity_compensation
+        self.torque_limits = torque_limits
+        self.joint_names: list[str] = []
+        self.joint_coord: list[int] = []
+        self.joint_coef: list[float] = []
+        self.equalities: list[tuple[str, str, float]] = []
+
+    # -- bodies
+    def _body(self, parent: ET.Element, name: str, T: np.ndarray, k: int,
+              moving: bool, has_joint: bool) -> ET.Element:
+        attrs = {"name": name, **_pose_attrs(T)}
+        if moving and self.gravcomp:
+            attrs["gravcomp"] = "1"
+        body = ET.SubElement(parent, "body", attrs)
+        _inertial(body, name, self.links.links[k], has_joint, self.notes)
+        geo = self.robot.geometry
+        if geo is not None and hasattr(geo, "shapes"):
+            for s_i, shape in enumerate(geo.shapes[k]):
+                _geom(body, self.asset, shape, f"{name}/{s_i}", _ROBOT_RGBA)
+        return body
+
+    def _joint(self, body: ET.Element, name: str, kind: str, F: np.ndarray,
+               axis_sign: float, coordinate: int, coefficient: float, master: bool,
+               armature: bool = False) -> None:
+        R, t = F[:3, :3], F[:3, 3]
+        attrs = {"name": name, "type": "hinge" if kind == "revolute" else "slide",
+                 "axis": _vec(axis_sign * R.T[:, 2])}
+        if armature:  # coaxial joints alone would make the mass matrix singular
+            attrs["armature"] = _fmt(_ARMATURE)
+        pos = -R.T @ t
+        if kind == "revolute" and np.any(pos != 0.0):
+            attrs["pos"] = _vec(pos)
+        if master:
+            lo, hi = self.robot.chain.coordinates[coordinate].limits
+            if math.isfinite(lo) and math.isfinite(hi):
+                attrs["range"] = _vec([lo, hi])
+            lim = self.torque_limits[coordinate]
+            if math.isfinite(lim):
+                attrs["actuatorfrcrange"] = _vec([-lim, lim])
+        if self.gravcomp:
+            attrs["actuatorgravcomp"] = "true"
+        ET.SubElement(body, "joint", attrs)
+        self.joint_names.append(name)
+        self.joint_coord.append(coordinate)
+        self.joint_coef.append(coefficient)
+
+    def robot_tree(self) -> None:
+        robot = self.robot
+        chain = robot.chain
+        per_body, leaves = _parts(robot)
+        c = chain.coupling.offset
+        base = self._body(self.world, "base", np.asarray(chain.base), 0, moving=False,
+                          has_joint=False)
+        parent, pending = base, np.asarray(chain.head)
+        names = [j.name for j in chain.joints]
+        for k, joint in enumerate(chain.joints):
+            F = np.asarray(chain.frame_offsets[k])
+            const = joint.sign * c[k] + joint.offset
+            T = pending @ _rz_or_tz(joint.kind, const) @ F
+            parts = per_body[k]
+            body = self._body(parent, names[k], T, k + 1, moving=True,
+                              has_joint=bool(parts))
+            for p in parts:
+                self._joint(body, p.name, joint.kind, F, p.axis_sign, p.coordinate,
+                            p.coefficient, p.master, armature=len(parts) > 1)
+            if len(parts) > 1:
+                self.notes.append(
+                    f"link {names[k]!r} follows {len(parts)} coordinates: one coaxial "
+                    f"joint each, tied by equality constraints, with a {_ARMATURE:g} "
+                    "armature each (coaxial joints alone make the mass matrix singular)")
+            parent, pending = body, np.asarray(chain.link_offsets[k])
+        tool = self._body(parent, "tool", pending @ np.asarray(chain.tool),
+                          chain.n_chain + 1, moving=True, has_joint=False)
+        ET.SubElement(tool, "site", {"name": "tool", "size": "0.005"})
+        for i in leaves:
+            self._leaf(base, i)
+        masters = {self.joint_names[j]: self.joint_coord[j]
+                   for j in range(len(self.joint_names))
+                   if self.joint_names[j] == robot.joint_names[self.joint_coord[j]]}
+        for name, i, coef in zip(self.joint_names, self.joint_coord, self.joint_coef):
+            if name not in masters:
+                self.equalities.append((name, robot.joint_names[i], coef))
+
+    def _leaf(self, base: ET.Element, i: int) -> None:
+        """A coordinate with no joint of its own: a joint on a light leaf body."""
+        coord = self.robot.chain.coordinates[i]
+        body = ET.SubElement(base, "body", {"name": f"{coord.name}_coordinate"})
+        ET.SubElement(body, "inertial", {"pos": "0 0 0", "mass": _fmt(_TINY_MASS),
+                                         "diaginertia": _vec([_TINY_INERTIA] * 3)})
+        self._joint(body, coord.name, coord.kind, np.eye(4), 1.0, i, 1.0, True,
+                    armature=True)
+        self.notes.append(f"coordinate {coord.name!r} drives no chain joint with "
+                          "coefficient +-1: it has its own joint on a massless leaf body")
+
+    def scene_bodies(self) -> None:
+        scene = self.scene
+        if scene is None:
+            return
+        taken = set(self.robot_link_names())
+        for obj in scene.objects:
+            if obj.name in taken:
+                raise ModelError(f"scene object {obj.name!r} has the name of a robot "
+                                 "link; rename it", field="scene.objects")
+            body = ET.SubElement(self.world, "body", {"name": obj.name})
+            _geom(body, self.asset, obj.shape, obj.name, _SCENE_RGBA)
+
+    def robot_link_names(self) -> tuple[str, ...]:
+        from robokin.model.geometry import link_names
+
+        return link_names(self.robot)
+
+    # -- contacts, constraints, actuators
+    def contact_filter(self) -> None:
+        from robokin.model.geometry import RobotGeometry
+
+        geo = self.robot.geometry
+        names = self.robot_link_names()
+        if not isinstance(geo, RobotGeometry):
+            geo = RobotGeometry.empty(self.robot)
+        with_shapes = [k for k, ss in enumerate(geo.shapes) if ss]
+        checked = set(geo.self_pairs())
+        contact = ET.SubElement(self.root, "contact")
+        for a_i, a in enumerate(with_shapes):
+            for b in with_shapes[a_i + 1:]:
+                if (a, b) not in checked:
+                    ET.SubElement(contact, "exclude", {"body1": names[a],
+                                                       "body2": names[b]})
+        if self.scene is not None:
+            for pair in sorted(sorted(p) for p in self.scene.exclude):
+                link = [x for x in pair if x in names]
+                obj = [x for x in pair if x in self.scene.names]
+                if link and obj:
+                    ET.SubElement(contact, "exclude", {"body1": link[0],
+                                                       "body2": obj[0]})
+
+    def equality(self, timestep: float) -> None:
+        if not self.equalities:
+            return
+        eq = ET.SubElement(self.root, "equality")
+        for part, master, coef in self.equalities:
+            ET.SubElement(eq, "joint", {
+                "joint1": part, "joint2": master, "polycoef": _vec([0, coef, 0, 0, 0]),
+                "solref": _vec([2 * timestep, 1.0]), "solimp": "0.99 0.999 0.001"})
+
+    def actuators(self, space: ActuatorSpace, kp: F64, kv: F64) -> None:
+        robot = self.robot
+        if space == "motor":
+            amap = robot.actuators
+            assert amap is not None
+            P = amap.pseudo_inverse(what="actuator")
+            tendon = ET.SubElement(self.root, "tendon")
+            for r, mname in enumerate(robot.actuator_names or ()):
+                fixed = ET.SubElement(tendon, "fixed", {"name": mname})
+                for i, jname in enumerate(robot.joint_names):
+                    if P[r, i] != 0.0:
+                        ET.SubElement(fixed, "joint", {"joint": jname,
+                                                       "coef": _fmt(P[r, i])})
+        act = ET.SubElement(self.root, "actuator")
+        targets = (list(robot.actuator_names or ()) if space == "motor"
+                   else list(robot.joint_names))
+        for r, name in enumerate(targets):
+            attrs = {"name": name, ("tendon" if space == "motor" else "joint"): name,
+                     "gainprm": _fmt(kp[r]), "biasprm": _vec([0.0, -kp[r], -kv[r]])}
+            ET.SubElement(act, "general", attrs)
+
+    def text(self) -> str:
+        if not len(self.asset):
+            self.root.remove(self.asset)
+        ET.indent(self.root, space="  ")
+        return ET.tostring(self.root, encoding="unicode") + "\n"
+
+
+def _effective_inertia(xml: str, joints: JointMap, q_ref: np.ndarray,
+                       A: np.ndarray | None) -> F64:
+    """Diagonal of the mass matrix in joint (or motor) coordinates at ``q_ref``,
+    averaged over the rows of ``q_ref`` (k, n)."""
+    from robokin.sim._mujoco import full_mass_matrix, load_model
+
+    mj = _mj()
+    model = load_model(xml)
+    data = mj.MjData(model)
+    qadr, _, S = joints.selection(model)
+    coef = np.array(joints.coefficient)
+    coord = np.array(joints.coordinate)
+    out = []
+    for q in np.atleast_2d(q_ref):
+        data.qpos[:] = model.qpos0
+        data.qpos[qadr] = coef * q[coord]
+        mj.mj_forward(model, data)
+        Mfull = full_mass_matrix(model, data)
+        Mq = S.T @ Mfull @ S
+        if A is not None:
+            Mq = A.T @ Mq @ A
+        out.append(np.diag(Mq).copy())
+    return np.mean(out, axis=0)
+
+
+def default_reference(robot: Robot) -> F64:
+    """The configuration default gains are tuned at: zero, clipped into the limits."""
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    return np.clip(np.zeros(robot.n), lo, hi)
+
+
+def build_mjcf(
+    robot: Robot,
+    scene: Scene | None = None,
+    *,
+    actuators: ActuatorSpace = "joint",
+    gains: Any = None,
+    torque_limits: npt.ArrayLike | None = None,
+    strict: bool = False,
+    density: float | None = None,
+    timestep: float = MJCF_TIMESTEP,
+    contact_forces: bool = True,
+    q_ref: npt.ArrayLike | None = None,
+) -> MjcfExport:
+    """Build the MuJoCo model of a robot (and scene): the text and its bookkeeping.
+
+    Args:
+        robot: Any robokin robot.
+        scene: A :class:`~robokin.collision.Scene`: the robot is placed in it
+            (base, tool, tool shapes) and its objects become static bodies.
+        actuators: ``"joint"``: a servo per joint coordinate; ``"motor"``: a
+            servo per motor of the robot's actuator map.
+        gains: Servo gains (:func:`~robokin.sim.servo.servo_gains`: None, a
+            :class:`~robokin.sim.servo.ServoGains` or a mapping of its fields).
+        torque_limits: Per joint coordinate [N m or N] (inf: none); default the
+            robot's ``dynamics.torque_limits``.
+        strict: Refuse to estimate missing link mass data (ModelError).
+        density: Density for estimated links [kg/m^3] (default: the robot's, else
+            :data:`~robokin.model.dynamics.DEFAULT_DENSITY`).
+        timestep: Physics step [s], > 0.
+        contact_forces: False: contacts exert no force (MuJoCo's contact
+            detection is off in the model; :func:`robokin.sim.simulate` then
+            detects them separately).
+        q_ref: Configuration(s) (n,) or (k, n) the default gains are tuned at
+            (the effective inertia is averaged over them); default
+            :func:`default_reference`.
+
+    Returns:
+        An :class:`MjcfExport`.
+
+    Raises:
+        InputError: a bad ``actuators``, ``gains``, ``torque_limits``, ``timestep``
+            or ``q_ref``.
+        ModelError: missing mass data in strict mode (naming
+            ``dynamics.links.<link>``), a scene object named like a robot link,
+            or a model MuJoCo refuses.
+        MissingExtraError: MuJoCo (``robokin[sim]``) or trimesh is not installed.
+    """
+    space = _check_space(actuators, robot)
+    servo = servo_gains(gains)
+    if not (isinstance(timestep, int | float) and math.isfinite(timestep)
+            and 0 < timestep <= 0.01):
+        raise InputError("timestep", f"expected a step in (0, 0.01] s, got "
+                         f"{short_repr(timestep)}")
+    placed = scene.attach(robot) if scene is not None else robot
+    limits = _torque_limits(placed, torque_limits)
+    links = resolve_links(placed, strict=strict, density=density)
+    writer = _Writer(placed, scene, links, float(timestep), servo.gravity_compensation,
+                     limits, contact_forces)
+    writer.robot_tree()
+    writer.scene_bodies()
+    writer.contact_filter()
+    writer.equality(float(timestep))
+    joints = JointMap(tuple(writer.joint_names), tuple(writer.joint_coord),
+                      tuple(writer.joint_coef), tuple(placed.joint_names))
+    A = placed.actuators.matrix if space == "motor" and placed.actuators else None
+    ref = default_reference(placed) if q_ref is None else _check_q_ref(q_ref, placed.n)
+    inertia = _effective_inertia(writer.text(), joints, ref, A)
+    kp, kv = servo.resolve(inertia)
+    ctrl_offset = np.zeros(placed.n)
+    names: tuple[str, ...] = tuple(placed.joint_names)
+    if space == "motor" and placed.actuators is not None:
+        P = placed.actuators.pseudo_inverse(what="actuator")
+        ctrl_offset = P @ placed.actuators.offset
+        names = tuple(placed.actuator_names or ())
+    # the text is rebuilt with actuators (ElementTree elements are not reusable
+    # after text(): a fresh writer keeps the two passes independent)
+    writer = _Writer(placed, scene, links, float(timestep), servo.gravity_compensation,
+                     limits, contact_forces)
+    writer.robot_tree()
+    writer.scene_bodies()
+    writer.contact_filter()
+    writer.equality(float(timestep))
+    writer.actuators(space, kp, kv)
+    xml = writer.text()
+    notes = [f"mass properties: {links.describe()}"] + writer.notes
+    return MjcfExport(xml, placed, joints, links, space, names, kp, kv, ctrl_offset,
+                      servo.gravity_compensation, servo.velocity_feedforward, limits,
+                      tuple(notes), float(timestep))
+
+
+def _check_q_ref(q_ref: npt.ArrayLike, n: int) -> F64:
+    try:
+        q = np.array(q_ref, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InputError("q_ref", f"expected joint values, got {short_repr(q_ref)}"
+                         ) from None
+    q = np.atleast_2d(q)
+    if q.ndim != 2 or q.shape[1] != n or not np.isfinite(q).all():
+        raise InputError("q_ref", f"expected finite (n,) or (k, n) values with n = {n}, "
+                         f"got shape {q.shape}")
+    return q
+
+
+def to_mjcf(robot: Robot, scene: Scene | None = None, **options: Any) -> str:
+    """The MJCF text of a robot (and scene): same FK, joints named as ``robot.joint_names``.
+
+    Bodies are the link frames of ``robot.fk_all``; the site ``tool`` sits at
+    the tool frame. See :func:`build_mjcf` for the options and the module
+    docstring for the rules.
+
+    Args:
+        robot: Any robokin robot.
+        scene: Optional scene (robot placement, tool, static objects).
+        **options: Keyword options of :func:`build_mjcf`.
+
+    Returns:
+        MJCF XML text.
+    """
+    return build_mjcf(robot, scene, **options).xml
+
+
+def write_mjcf(robot: Robot, path: Any, scene: Scene | None = None,
+               **options: Any) -> Any:
+    """Write :func:`to_mjcf` atomically to ``path``; returns the path.
+
+    Raises:
+        InputError: the folder is missing or read-only, or ``path`` is a folder.
+    """
+    from robokin.io.atomic import write_atomic
+
+    return write_atomic(path, to_mjcf(robot, scene, **options))
