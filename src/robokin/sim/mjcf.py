@@ -546,6 +546,7 @@ class _Writer:
                    else list(robot.joint_names))
         for r, name in enumerate(targets):
             attrs = {"name": name, ("tendon" if space == "motor" else "joint"): name,
+                     "gaintype": "fixed", "biastype": "affine",
                      "gainprm": _fmt(kp[r]), "biasprm": _vec([0.0, -kp[r], -kv[r]])}
             ET.SubElement(act, "general", attrs)
 
