@@ -1,4 +1,5 @@
-"""``robokin import``, ``robokin export`` and ``robokin dh``: URDF in and out.
+"""``robokin import``, ``robokin export`` and ``robokin dh``: URDF in and out (and
+MJCF out: ``robokin export NAME -o robot.xml`` chooses the format by the suffix).
 
 Files are written only where ``-o`` names them; without ``-o`` the result goes to
 standard output.
@@ -73,24 +74,68 @@ def import_urdf(
     )
 
 
+def _export_format(out: Path | None, fmt: str | None) -> str:
+    """``urdf`` or ``mjcf``: ``--format`` when given, else by the suffix of ``-o``."""
+    from robokin.exceptions import InputError
+
+    if fmt is not None:
+        if fmt not in ("urdf", "mjcf"):
+            raise InputError("--format", f"expected 'urdf' or 'mjcf', got {fmt!r}")
+        return fmt
+    if out is None:
+        return "urdf"
+    name = out.name.lower()
+    if name.endswith((".urdf", ".urdf.xml")):
+        return "urdf"
+    if name.endswith((".xml", ".mjcf")):
+        return "mjcf"
+    raise InputError("--out", f"cannot tell the format from {out.name!r}: use .urdf "
+                     "(URDF) or .xml / .mjcf (MuJoCo MJCF), or pass --format")
+
+
 @app.command("export")
 def export_urdf(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     out: Annotated[
-        Path | None, typer.Option("-o", "--out", help="URDF file to write (replaced if it exists).")
+        Path | None, typer.Option(
+            "-o", "--out", help="File to write (replaced if it exists): .urdf for URDF, "
+            ".xml or .mjcf for a MuJoCo model.")
+    ] = None,
+    fmt: Annotated[
+        str | None, typer.Option("--format", help="urdf or mjcf (default: by the "
+                                 "suffix of -o, else urdf).")
+    ] = None,
+    scene: Annotated[
+        str | None, typer.Option("--scene", help="MJCF only: a scene file or bundled "
+                                 "name; the robot is placed in it with its objects.")
     ] = None,
 ) -> None:
-    """Write a robot as a URDF with the same FK and limits."""
-    from robokin.io.urdf_export import urdf_from_robot, write_urdf
+    """Write a robot as a URDF, or as a MuJoCo MJCF model, with the same FK and limits."""
+    from robokin.exceptions import InputError
 
+    kind = _export_format(out, fmt)
+    if scene is not None and kind != "mjcf":
+        raise InputError("--scene", "a scene goes into an MJCF model only (-o NAME.xml)")
     if out is not None:
         _not_the_input(out, name)
     robot = _load(name)
+    if kind == "mjcf":
+        from robokin.cli_sim import load_scene
+        from robokin.sim import to_mjcf
+
+        text = to_mjcf(robot, None if scene is None else load_scene(scene))
+    else:
+        from robokin.io.urdf_export import urdf_from_robot
+
+        text = urdf_from_robot(robot)
     if out is None:
-        print(urdf_from_robot(robot), end="")
+        print(text, end="")
         return
-    write_urdf(robot, out)
-    _console().print(f"{cell(robot.name, markup=False)}: wrote {out}", markup=False)
+    from robokin.io.atomic import write_atomic
+
+    write_atomic(out, text)
+    _console().print(f"{cell(robot.name, markup=False)}: wrote {out} ({kind.upper()})",
+                     markup=False)
 
 
 @app.command("dh")
