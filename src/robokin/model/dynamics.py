@@ -315,8 +315,9 @@ class ResolvedLinks:
         none = [n for n, o in moving if o == "none"]
         parts = []
         if data:
+            src = self.source if len(self.source) <= 90 else self.source[:89] + "…"
             parts.append(f"{len(data)} link(s) from the robot's data"
-                         + (f" ({self.source})" if self.source else ""))
+                         + (f" ({src})" if src else ""))
         if est:
             parts.append(f"{', '.join(est)} ESTIMATED from the shapes at "
                          f"{self.density:g} kg/m^3")
