@@ -148,8 +148,8 @@ class SimResult:
             out.append(f"{names[j]} tracks within {self.comparison.max_abs[j] * s:.3g} {u},"
                        f" more than the {tol[j] * s:.3g} {u} allowed")
         ratio = self.torque_ratio
-        for j in np.flatnonzero(np.nan_to_num(ratio) > 1.0 + 1e-9):
-            out.append(f"{names[j]} needs {self.peak_tau[j]:.4g}, above its limit "
+        for j in np.flatnonzero(np.nan_to_num(ratio) >= 1.0 - 1e-9):
+            out.append(f"{names[j]} saturates at its torque limit "
                        f"{self.torque_limits[j]:.4g}")
         if self.contacts:
             c = self.contacts[0]
