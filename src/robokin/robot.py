@@ -25,6 +25,8 @@ from robokin.model.coupling import AffineMap
 if TYPE_CHECKING:
     from robokin.kinematics.ik.numeric import IKResult
     from robokin.kinematics.ik.solutions import SolutionSet
+    from robokin.model.dynamics import RobotDynamics
+    from robokin.model.geometry import RobotGeometry
 
 __all__ = ["Robot"]
 
@@ -59,6 +61,16 @@ class Robot:
 
     __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain", "dynamics",
                  "geometry", "meta", "name", "path", "source", "__weakref__")
+    chain: Chain
+    name: str
+    source: str
+    actuators: AffineMap | None
+    actuator_names: tuple[str, ...] | None
+    actuator_limits: npt.NDArray[np.float64] | None
+    geometry: RobotGeometry | None
+    dynamics: RobotDynamics | None
+    path: Path | None
+    meta: Mapping[str, Any]
 
     def __setattr__(self, name: str, value: Any) -> None:
         raise FrozenError("Robot", name, _HOW_TO_CHANGE)
@@ -86,7 +98,7 @@ class Robot:
         actuator_names: Sequence[str] | None = None,
         actuator_limits: npt.ArrayLike | None = None,
         geometry: Any = None,
-        dynamics: Any = None,
+        dynamics: RobotDynamics | None = None,
         path: str | Path | None = None,
         meta: Mapping[str, Any] | None = None,
     ) -> None:

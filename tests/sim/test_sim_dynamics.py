@@ -100,3 +100,16 @@ def test_motor_power_equals_joint_power():
                        np.zeros((3, 4)), np.zeros((3, 4)), joint_names=lift.joint_names)
     np.testing.assert_allclose(sim.inverse_dynamics(lift, still).tau[:, 3],
                                m_shaft * G, rtol=1e-9)
+
+
+def test_a_coupled_chain_simulates_stably_and_tracks():
+    # the QFMD010's parallelogram: forearm = theta3 - theta2 held by a tendon
+    # equality, theta3 driven through a tendon spread over the joints it moves
+    robot = robokin.load("qfmd010")
+    plan = trajectory.quintic(np.full(4, 0.1), np.array([1.0, 0.3, 0.2, 1.0]), 2.0,
+                              dt=0.005)
+    res = sim.simulate(robot, plan)
+    assert res.ok, res.reasons
+    inv = sim.inverse_dynamics(robot, plan)
+    scale = np.abs(inv.tau).max(axis=0)
+    assert np.all(np.abs(res.tau - inv.tau).max(axis=0) < 0.05 * scale + 1e-3)

@@ -29,9 +29,6 @@ def _random_q(robot, rng, m):
 def assert_fk_equal(robot, export, Q):
     model = load_model(export.xml)
     data = mujoco.MjData(model)
-    qadr, _, _ = export.joints.selection(model)
-    coef = np.array(export.joints.coefficient)
-    coord = np.array(export.joints.coordinate)
     site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "tool")
     bodies = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n)
               for n in link_names(robot)[:-1]]
@@ -39,8 +36,7 @@ def assert_fk_equal(robot, export, Q):
     frames, tool = robot.fk_all(Q), robot.fk(Q)
     worst_p = worst_r = 0.0
     for k, q in enumerate(Q):
-        data.qpos[:] = model.qpos0
-        data.qpos[qadr] = coef * q[coord]
+        data.qpos[:] = export.joints.qpos(model, q)
         mujoco.mj_kinematics(model, data)
         worst_p = max(worst_p, np.abs(data.site_xpos[site] - tool[k, :3, 3]).max(),
                       np.abs(data.xpos[bodies] - frames[k, :, :3, 3]).max())
@@ -65,13 +61,13 @@ def test_mjcf_fk_equals_robokin_fk_on_every_builtin_arm(name):
 
 
 def test_mjcf_keeps_the_coupling_of_dependent_joints():
-    # the QFMD010's forearm = theta3 - theta2 and level = -theta3: one coaxial
-    # joint per coordinate, equality constraints for the coupled parts
+    # the QFMD010's forearm = theta3 - theta2 (a tendon equality: two coordinates)
+    # and its level joint is theta3's own (coefficient -1): one joint per chain joint
     robot = robokin.load("qfmd010")
     export = sim.build_mjcf(robot)
     assert "<equality>" in export.xml
     model = load_model(export.xml)
-    assert model.neq == 2
+    assert model.neq == 1 and model.njnt == 5
     assert set(export.joints.masters) == set(robot.joint_names)
 
 
@@ -108,3 +104,17 @@ def test_mjcf_joint_limits_and_torque_limits():
     np.testing.assert_allclose(model.jnt_actfrcrange[j], [-500.0, 500.0])
     with pytest.raises(robokin.InputError, match="torque_limits"):
         sim.build_mjcf(robot, torque_limits=[50.0, 40.0, 10.0])
+
+
+def test_mjcf_coordinate_without_a_joint_of_its_own():
+    # q2 moves one chain joint at half rate: no MuJoCo joint can carry q2 itself,
+    # so it gets a joint on a light leaf body, tied to the chain joint
+    robot = robokin.Robot.from_elementary(
+        [{"op": "rz", "joint": "revolute", "name": "q1"}, {"op": "tx", "value": 0.3},
+         {"op": "rz", "joint": "revolute", "name": "b", "depends": {"q2": 0.5}},
+         {"op": "tx", "value": 0.2}],
+        coordinates=[{"name": "q1", "joint": "revolute", "limits": [-3, 3]},
+                     {"name": "q2", "joint": "revolute", "limits": [-3, 3]}])
+    export = sim.build_mjcf(robot)
+    assert any("leaf" in n for n in export.notes)
+    assert_fk_equal(robot, export, _random_q(robot, np.random.default_rng(5), 200))

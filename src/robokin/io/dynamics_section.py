@@ -49,8 +49,8 @@ def _schema() -> Any:
 
     from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictStr
 
-    Num = StrictFloat  # numbers must be numbers: "3.7" and yes are refused
-    Vec3 = tuple[Num, Num, Num]
+    # StrictFloat: numbers must be numbers ("3.7" and yes are refused)
+    Vec3 = tuple[StrictFloat, StrictFloat, StrictFloat]
 
     class Strict(BaseModel):
         model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
@@ -60,16 +60,17 @@ def _schema() -> Any:
         mass: Literal["kg", "g"] = "kg"
 
     class Link(Strict):
-        mass: Annotated[Num, Field(ge=0.0)]
+        mass: Annotated[StrictFloat, Field(ge=0.0)]
         com: Vec3 = (0.0, 0.0, 0.0)
-        inertia: tuple[Num, Num, Num, Num, Num, Num] = (0.0,) * 6
+        inertia: tuple[StrictFloat, StrictFloat, StrictFloat, StrictFloat, StrictFloat,
+                       StrictFloat] = (0.0,) * 6
         rpy: Vec3 | None = None
 
     class Section(Strict):
         source: Annotated[StrictStr, Field(max_length=4096)] = ""
         units: Units = Field(default_factory=Units)
-        density: Annotated[Num, Field(gt=0.0)] | None = None
-        torque_limits: dict[StrictStr, Annotated[Num, Field(gt=0.0)]] | None = None
+        density: Annotated[StrictFloat, Field(gt=0.0)] | None = None
+        torque_limits: dict[StrictStr, Annotated[StrictFloat, Field(gt=0.0)]] | None = None
         links: dict[StrictStr, Link] = Field(default_factory=dict)
 
     return Section
@@ -108,7 +109,7 @@ def apply_dynamics_section(robot: Robot, value: Any, file: Any, units: Any) -> R
                              file=file, field=where)
         try:
             inertia = LinkInertia.from_moments(lk.mass * M, np.array(lk.com) * L,
-                                               np.array(lk.inertia) * M * L * L)
+                                               [v * M * L * L for v in lk.inertia])
         except InputError as exc:
             raise ModelError(exc.reason, file=file, field=f"{where}.{exc.argument}"
                              ) from None

@@ -1,7 +1,6 @@
-"""URDF ``<inertial>`` and ``<limit effort>`` in and out (:mod:`robokin.io.urdf`,
-:mod:`robokin.io.urdf_export`).
+"""URDF ``<inertial>`` and ``<limit effort>`` in and out.
 
-In: each URDF link rigidly attached to the chain contributes its ``<inertial>``
+Used by :mod:`robokin.io.urdf` and :mod:`robokin.io.urdf_export`. In: each URDF link rigidly attached to the chain contributes its ``<inertial>``
 (origin, mass, inertia) to the robokin link it moves with (links joined by fixed
 joints are combined into one body); a joint's ``effort`` (> 0) becomes the torque
 limit of its coordinate. Out: each robokin link's data is written as the

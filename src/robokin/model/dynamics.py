@@ -109,7 +109,8 @@ class LinkInertia:
             raise InputError("inertia", "expected 6 numbers (ixx, iyy, izz, ixy, ixz, "
                              f"iyz), got {v.shape[0]}")
         ixx, iyy, izz, ixy, ixz, iyz = v
-        return cls(mass, com, [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        tensor = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        return cls(mass, np.asarray(com, dtype=np.float64), tensor)
 
     @property
     def moments(self) -> F64:
@@ -141,11 +142,11 @@ class LinkInertia:
         parts = list(parts)
         if not parts:
             return None
-        m = sum(p.mass for p in parts)
+        m = float(sum(p.mass for p in parts))
         if m <= 0.0:
-            return LinkInertia(0.0, np.zeros(3), sum(p.inertia for p in parts))
-        c = sum(p.mass * p.com for p in parts) / m
-        about_origin = sum(p.about_origin() for p in parts)
+            return LinkInertia(0.0, np.zeros(3), np.sum([p.inertia for p in parts], 0))
+        c = np.sum([p.mass * p.com for p in parts], axis=0) / m
+        about_origin = np.sum([p.about_origin() for p in parts], axis=0)
         inertia = about_origin - m * (float(c @ c) * np.eye(3) - np.outer(c, c))
         return LinkInertia(m, c, inertia)
 

@@ -1,5 +1,4 @@
-"""The ADAMS check of a coupled drive, in MuJoCo: do the motor commands move the joints
-as planned?
+"""The ADAMS check of a coupled drive in MuJoCo: motor commands against the joint plan.
 
 The SCARA's shaft is driven by two motors through a ball screw and a ball
 spline: turning the spline nut turns the shaft *and*, relative to the screw nut,
@@ -22,7 +21,12 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin.exceptions import InputError
-from robokin.sim.simulate import DEFAULT_TOLERANCE, SimResult, check_trajectory, simulate
+from robokin.sim.simulate import (
+    DEFAULT_TOLERANCE,
+    SimResult,
+    check_trajectory,
+    simulate,
+)
 
 if TYPE_CHECKING:
     from robokin.robot import Robot

@@ -94,8 +94,10 @@ class InverseDynamics:
 
     @property
     def energy(self) -> F64:
-        """Positive mechanical work per joint over the plan [J], (n,) (regeneration
-        not counted)."""
+        """Positive mechanical work per joint over the plan [J], (n,).
+
+        Regenerated (negative) power is not counted.
+        """
         p = np.maximum(self.power, 0.0)
         return (0.5 * (p[1:] + p[:-1]) * np.diff(self.t)[:, None]).sum(axis=0)
 
@@ -138,14 +140,13 @@ def inverse_dynamics(
     model.opt.disableflags |= int(mj.mjtDisableBit.mjDSBL_CONSTRAINT)
     data = mj.MjData(model)
     qadr, _, S = export.joints.selection(model)
-    coef = np.array(export.joints.coefficient)
-    coord = np.array(export.joints.coordinate)
+    X = export.joints.matrix
     m = len(plan)
     qfrc = np.empty((m, model.nv))
     vel, acc = plan.qd @ S.T, plan.qdd @ S.T
     for k in range(m):
         data.qpos[:] = model.qpos0
-        data.qpos[qadr] = coef * plan.q[k][coord]
+        data.qpos[qadr] = X @ plan.q[k]
         data.qvel[:] = vel[k]
         data.qacc[:] = acc[k]
         mj.mj_inverse(model, data)

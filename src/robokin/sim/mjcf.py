@@ -9,14 +9,16 @@ The canonical chain ``T = C0 J1 C1 ... Jn Cn`` becomes a tree of bodies (see
   frame, welded to the last link, carrying the site ``tool``). A body's pose in
   its parent is ``G_{k-1} J_k(constant part) F_k``: virtual frames, zero offsets
   and the constant part of a coupled joint fold in there.
-* **Joints.** A chain joint is a hinge or a slide through the origin of
+* **Joints.** A chain joint is one hinge or slide through the origin of
   ``F_k^-1`` along ``sign * F_k^-1 z`` (a reversed joint points its axis the
-  other way). Each independent coordinate gets one joint named as in
-  ``robot.joint_names`` whose value is that coordinate. A dependent chain joint
-  ``sum_i M_ki q_i + c_k`` becomes one coaxial joint per coordinate it follows
-  (rotations about one axis add) tied to the coordinate's joint by an equality
-  constraint ``x = M_ki q_i``; a coordinate that moves no chain joint with
-  coefficient +-1 gets its own joint on a light leaf body.
+  other way). A chain joint that follows one coordinate with coefficient +-1 (the
+  first such for that coordinate) is that coordinate's joint, named as in
+  ``robot.joint_names``. Every other (dependent) chain joint keeps its own name
+  and is tied to the coordinates' joints by an equality constraint
+  ``x_k = sum_i M_ki q_i``: a joint equality for one coordinate, a fixed-tendon
+  equality for several (the QFMD010's forearm, ``theta3 - theta2``). A coordinate
+  that moves no chain joint with coefficient +-1 gets its own joint on a light
+  leaf body.
 * **Actuators.** Position servos (:mod:`robokin.sim.servo`) per joint, or per
   motor: a motor acts through a fixed tendon whose length is its coordinate
   ``phi = A^+ (q - b)`` (the robot's actuator map, e.g. the SCARA's ball-screw /
@@ -68,8 +70,8 @@ MJCF_TIMESTEP = 0.001
 # (MuJoCo refuses massless moving bodies); reported in the export's notes.
 _TINY_MASS = 1e-9
 _TINY_INERTIA = 1e-12
-# Rotor inertia [kg m^2 or kg] given to coaxial joints of one link (their mass
-# matrix is otherwise singular); small against any link's inertia.
+# Rotor inertia [kg m^2 or kg] of the joint of a coordinate on a massless leaf
+# body (without it the mass matrix is singular there).
 _ARMATURE = 1e-6
 _ROBOT_RGBA = "0.95 0.55 0.15 1"
 _SCENE_RGBA = "0.6 0.6 0.65 0.6"
@@ -112,20 +114,18 @@ def _rz_or_tz(kind: str, value: float) -> np.ndarray:
 class JointMap:
     """How the robot's joint coordinates set the MuJoCo joints.
 
-    Every MuJoCo joint robokin writes has the value ``coefficient * q[coordinate]``
-    (the constant parts of the chain sit in the body poses).
+    Every MuJoCo joint robokin writes has the value ``matrix[j] @ q`` (the
+    constant parts of the chain sit in the body poses).
 
     Attributes:
-        names: The MuJoCo joints (masters and coupled parts), in tree order.
-        coordinate: Per joint, the index of the coordinate that drives it.
-        coefficient: Per joint, its value per unit of that coordinate.
+        names: The MuJoCo joints, in tree order (J).
+        matrix: (J, n): each joint's value per unit of each coordinate.
         masters: Per coordinate (n), the joint whose value it is (named as the
             coordinate).
     """
 
     names: tuple[str, ...]
-    coordinate: tuple[int, ...]
-    coefficient: tuple[float, ...]
+    matrix: F64
     masters: tuple[str, ...]
 
     def selection(self, model: Any) -> tuple[np.ndarray, np.ndarray, F64]:
@@ -141,9 +141,15 @@ class JointMap:
         qadr = np.array([model.jnt_qposadr[i] for i in ids], dtype=np.int64)
         dadr = np.array([model.jnt_dofadr[i] for i in ids], dtype=np.int64)
         S = np.zeros((model.nv, len(self.masters)))
-        for d, i, c in zip(dadr, self.coordinate, self.coefficient):
-            S[d, i] += c
+        S[dadr] = self.matrix
         return qadr, dadr, S
+
+    def qpos(self, model: Any, q: npt.ArrayLike) -> F64:
+        """A full ``qpos`` (nq,) for joint coordinates ``q`` (n,)."""
+        qadr, _, _ = self.selection(model)
+        out = np.array(model.qpos0, dtype=np.float64)
+        out[qadr] = self.matrix @ np.asarray(q, dtype=np.float64)
+        return out
 
     def master_qpos(self, model: Any) -> np.ndarray:
         """``qpos`` addresses of the coordinates' joints, (n,)."""
@@ -202,57 +208,56 @@ def _mj() -> Any:
 # ----------------------------------------------------------------------- layout
 @dataclass
 class _Part:
-    """One MuJoCo joint in a chain body."""
+    """The MuJoCo joint of one chain joint."""
 
     name: str
-    coordinate: int
-    coefficient: float  # joint value per unit coordinate
+    row: F64  # its value per unit of each coordinate (n,)
     axis_sign: float  # the joint turns the body by axis_sign * value about F^-1 z
-    master: bool
+    master: int | None  # the coordinate whose joint it is, or None (dependent)
 
 
 def _masters(M: np.ndarray) -> dict[int, tuple[int, float]]:
-    """Per coordinate, the chain joint that carries its own joint, and +-1."""
+    """Per coordinate, the chain joint that is its joint (one +-1 entry), and the sign."""
     out: dict[int, tuple[int, float]] = {}
-    nc, n = M.shape
-    for single in (True, False):  # prefer chain joints that follow one coordinate
-        for k in range(nc):
-            nz = np.flatnonzero(M[k])
-            if single and len(nz) != 1:
-                continue
-            for i in nz:
-                if int(i) not in out and abs(M[k, i]) == 1.0:
-                    out[int(i)] = (k, float(M[k, i]))
+    taken: set[int] = set()
+    for k in range(M.shape[0]):
+        nz = np.flatnonzero(M[k])
+        if len(nz) == 1 and abs(M[k, nz[0]]) == 1.0 and int(nz[0]) not in out \
+                and k not in taken:
+            out[int(nz[0])] = (k, float(M[k, nz[0]]))
+            taken.add(k)
     return out
 
 
-def _parts(robot: Robot) -> tuple[list[list[_Part]], list[int]]:
-    """The MuJoCo joints of every chain body, and the coordinates needing a leaf."""
+def _parts(robot: Robot) -> tuple[list[_Part | None], list[int]]:
+    """Per chain joint its MuJoCo joint, and the coordinates that need a leaf body.
+
+    A constant chain joint (driven by no coordinate) has no joint (None).
+    """
     chain = robot.chain
-    M = chain.coupling.matrix
+    M = chain.arrays.M
     cnames = list(robot.joint_names)
     masters = _masters(M)
+    master_of = {k: (i, m) for i, (k, m) in masters.items()}
     used = set(cnames)
-    per_body: list[list[_Part]] = []
+    out: list[_Part | None] = []
     for k, joint in enumerate(chain.joints):
-        parts: list[_Part] = []
-        nz = [int(i) for i in np.flatnonzero(M[k])]
-        for i in nz:
-            if masters.get(i, (-1, 0.0))[0] == k:
-                m = masters[i][1]
-                parts.append(_Part(cnames[i], i, 1.0, joint.sign * m, True))
-        others = [i for i in nz if masters.get(i, (-1, 0.0))[0] != k]
-        for i in others:
-            base = joint.name if (len(nz) == 1 and joint.name not in used) \
-                else f"{joint.name}_{cnames[i]}"
-            name, j = base, 2
-            while name in used:
-                name, j = f"{base}_{j}", j + 1
-            used.add(name)
-            parts.append(_Part(name, i, float(M[k, i]), joint.sign, False))
-        per_body.append(parts)
+        if not M[k].any():
+            out.append(None)
+            continue
+        if k in master_of:
+            i, m = master_of[k]
+            row = np.zeros(len(cnames))
+            row[i] = 1.0
+            out.append(_Part(cnames[i], row, joint.sign * m, i))
+            continue
+        name, j = joint.name, 2
+        while name in used:
+            name, j = f"{joint.name}_{j}", j + 1
+        used.add(name)
+        out.append(_Part(name, np.array(M[k], dtype=np.float64), joint.sign, None))
     leaves = [i for i in range(len(cnames)) if i not in masters]
-    return per_body, leaves
+    return out, leaves
 
 
 # ------------------------------------------------------------------------ geoms
@@ -342,7 +347,7 @@ def _check_space(actuators: Any, robot: Robot) -> ActuatorSpace:
     if actuators == "motor" and robot.actuators is None:
         raise InputError("actuators", f"{robot.name} has no actuator map (motors); "
                          "use actuators='joint'")
-    return actuators  # type: ignore[return-value]
+    return "motor" if actuators == "motor" else "joint"
 
 
 def _torque_limits(robot: Robot, torque_limits: npt.ArrayLike | None) -> F64:
@@ -389,9 +394,8 @@ class _Writer:
         self.gravcomp = gravity_compensation
         self.torque_limits = torque_limits
         self.joint_names: list[str] = []
-        self.joint_coord: list[int] = []
-        self.joint_coef: list[float] = []
-        self.equalities: list[tuple[str, str, float]] = []
+        self.joint_rows: list[F64] = []
+        self.dependent: list[tuple[str, F64]] = []  # (joint, its row)
 
     # -- bodies
     def _body(self, parent: ET.Element, name: str, T: np.ndarray, k: int,
@@ -408,35 +412,36 @@ class _Writer:
         return body
 
     def _joint(self, body: ET.Element, name: str, kind: str, F: np.ndarray,
-               axis_sign: float, coordinate: int, coefficient: float, master: bool,
-               armature: bool = False) -> None:
+               axis_sign: float, row: F64, master: int | None,
+               armature: float = 0.0) -> None:
         R, t = F[:3, :3], F[:3, 3]
         attrs = {"name": name, "type": "hinge" if kind == "revolute" else "slide",
                  "axis": _vec(axis_sign * R.T[:, 2])}
-        if armature:  # coaxial joints alone would make the mass matrix singular
-            attrs["armature"] = _fmt(_ARMATURE)
+        if armature:
+            attrs["armature"] = _fmt(armature)
         pos = -R.T @ t
         if kind == "revolute" and np.any(pos != 0.0):
             attrs["pos"] = _vec(pos)
-        if master:
-            lo, hi = self.robot.chain.coordinates[coordinate].limits
+        if master is not None:
+            lo, hi = self.robot.limits[master]
             if math.isfinite(lo) and math.isfinite(hi):
                 attrs["range"] = _vec([lo, hi])
-            lim = self.torque_limits[coordinate]
+            lim = self.torque_limits[master]
             if math.isfinite(lim):
                 attrs["actuatorfrcrange"] = _vec([-lim, lim])
         if self.gravcomp:
             attrs["actuatorgravcomp"] = "true"
         ET.SubElement(body, "joint", attrs)
         self.joint_names.append(name)
-        self.joint_coord.append(coordinate)
-        self.joint_coef.append(coefficient)
+        self.joint_rows.append(row)
+        if master is None:
+            self.dependent.append((name, row))
 
     def robot_tree(self) -> None:
         robot = self.robot
         chain = robot.chain
-        per_body, leaves = _parts(robot)
-        c = chain.coupling.offset
+        parts, leaves = _parts(robot)
+        c = chain.arrays.c
         base = self._body(self.world, "base", np.asarray(chain.base), 0, moving=False,
                           has_joint=False)
         parent, pending = base, np.asarray(chain.head)
@@ -445,39 +450,30 @@ class _Writer:
             F = np.asarray(chain.frame_offsets[k])
             const = joint.sign * c[k] + joint.offset
             T = pending @ _rz_or_tz(joint.kind, const) @ F
-            parts = per_body[k]
+            part = parts[k]
             body = self._body(parent, names[k], T, k + 1, moving=True,
-                              has_joint=bool(parts))
-            for p in parts:
-                self._joint(body, p.name, joint.kind, F, p.axis_sign, p.coordinate,
-                            p.coefficient, p.master, armature=len(parts) > 1)
-            if len(parts) > 1:
-                self.notes.append(
-                    f"link {names[k]!r} follows {len(parts)} coordinates: one coaxial "
-                    f"joint each, tied by equality constraints, with a {_ARMATURE:g} "
-                    "armature each (coaxial joints alone make the mass matrix singular)")
+                              has_joint=part is not None)
+            if part is not None:
+                self._joint(body, part.name, joint.kind, F, part.axis_sign, part.row,
+                            part.master)
             parent, pending = body, np.asarray(chain.link_offsets[k])
         tool = self._body(parent, "tool", pending @ np.asarray(chain.tool),
                           chain.n_chain + 1, moving=True, has_joint=False)
         ET.SubElement(tool, "site", {"name": "tool", "size": "0.005"})
         for i in leaves:
             self._leaf(base, i)
-        masters = {self.joint_names[j]: self.joint_coord[j]
-                   for j in range(len(self.joint_names))
-                   if self.joint_names[j] == robot.joint_names[self.joint_coord[j]]}
-        for name, i, coef in zip(self.joint_names, self.joint_coord, self.joint_coef):
-            if name not in masters:
-                self.equalities.append((name, robot.joint_names[i], coef))
 
     def _leaf(self, base: ET.Element, i: int) -> None:
         """A coordinate with no joint of its own: a joint on a light leaf body."""
-        coord = self.robot.chain.coordinates[i]
-        body = ET.SubElement(base, "body", {"name": f"{coord.name}_coordinate"})
+        name = self.robot.joint_names[i]
+        kind = "revolute" if self.robot.is_revolute[i] else "prismatic"
+        body = ET.SubElement(base, "body", {"name": f"{name}_coordinate"})
         ET.SubElement(body, "inertial", {"pos": "0 0 0", "mass": _fmt(_TINY_MASS),
                                          "diaginertia": _vec([_TINY_INERTIA] * 3)})
-        self._joint(body, coord.name, coord.kind, np.eye(4), 1.0, i, 1.0, True,
-                    armature=True)
-        self.notes.append(f"coordinate {coord.name!r} drives no chain joint with "
+        row = np.zeros(self.robot.n)
+        row[i] = 1.0
+        self._joint(body, name, kind, np.eye(4), 1.0, row, i, armature=_ARMATURE)
+        self.notes.append(f"coordinate {name!r} drives no chain joint with "
                           "coefficient +-1: it has its own joint on a massless leaf body")
 
     def scene_bodies(self) -> None:
@@ -522,32 +518,64 @@ class _Writer:
                                                        "body2": obj[0]})
 
     def equality(self, timestep: float) -> None:
-        if not self.equalities:
+        """Tie every dependent joint to the coordinates' joints: ``x_k = M_k q``."""
+        if not self.dependent:
             return
-        eq = ET.SubElement(self.root, "equality")
-        for part, master, coef in self.equalities:
-            ET.SubElement(eq, "joint", {
-                "joint1": part, "joint2": master, "polycoef": _vec([0, coef, 0, 0, 0]),
-                "solref": _vec([2 * timestep, 1.0]), "solimp": "0.99 0.999 0.001"})
+        masters = self.robot.joint_names
+        soft = {"solref": _vec([2 * timestep, 1.0]), "solimp": "0.99 0.999 0.001"}
+        tendons: list[tuple[str, list[tuple[str, float]]]] = []
+        eq = ET.Element("equality")
+        for name, row in self.dependent:
+            nz = np.flatnonzero(row)
+            if len(nz) == 1:
+                ET.SubElement(eq, "joint", {
+                    "joint1": name, "joint2": masters[nz[0]],
+                    "polycoef": _vec([0, row[nz[0]], 0, 0, 0]), **soft})
+                continue
+            tname = f"{name}_coupling"
+            tendons.append((tname, [(name, 1.0)]
+                            + [(masters[i], -float(row[i])) for i in nz]))
+            ET.SubElement(eq, "tendon", {"tendon1": tname, **soft})
+        if tendons:
+            tendon = ET.SubElement(self.root, "tendon")
+            for tname, terms in tendons:
+                fixed = ET.SubElement(tendon, "fixed", {"name": tname})
+                for jname, coef in terms:
+                    ET.SubElement(fixed, "joint", {"joint": jname, "coef": _fmt(coef)})
+        self.root.append(eq)
 
-    def actuators(self, space: ActuatorSpace, kp: F64, kv: F64) -> None:
+    def actuators(self, space: ActuatorSpace, kp: F64, kv: F64, weights: F64) -> None:
+        """Servos on the coordinates (or motors), through tendons where needed.
+
+        ``weights`` (n, J): the tendon of coordinate i is ``sum_j weights[i, j] x_j``
+        (its length is q_i). A coordinate that moves one joint acts on it directly.
+        """
         robot = self.robot
         if space == "motor":
             amap = robot.actuators
             assert amap is not None
-            P = amap.pseudo_inverse(what="actuator")
-            tendon = ET.SubElement(self.root, "tendon")
-            for r, mname in enumerate(robot.actuator_names or ()):
-                fixed = ET.SubElement(tendon, "fixed", {"name": mname})
-                for i, jname in enumerate(robot.joint_names):
-                    if P[r, i] != 0.0:
+            coefs = amap.pseudo_inverse(what="actuator") @ weights  # (m, J)
+            names = list(robot.actuator_names or ())
+        else:
+            coefs = weights
+            names = list(robot.joint_names)
+        direct = [space == "joint" and np.count_nonzero(row) == 1 for row in coefs]
+        if not all(direct):
+            found = self.root.find("tendon")
+            tendon = found if found is not None else ET.SubElement(self.root, "tendon")
+            for r, name in enumerate(names):
+                if direct[r]:
+                    continue
+                fixed = ET.SubElement(tendon, "fixed", {"name": name})
+                for j, jname in enumerate(self.joint_names):
+                    if coefs[r, j] != 0.0:
                         ET.SubElement(fixed, "joint", {"joint": jname,
-                                                       "coef": _fmt(P[r, i])})
+                                                       "coef": _fmt(coefs[r, j])})
         act = ET.SubElement(self.root, "actuator")
-        targets = (list(robot.actuator_names or ()) if space == "motor"
-                   else list(robot.joint_names))
-        for r, name in enumerate(targets):
-            attrs = {"name": name, ("tendon" if space == "motor" else "joint"): name,
+        for r, name in enumerate(names):
+            target = ({"joint": self.joint_names[int(np.flatnonzero(coefs[r])[0])]}
+                      if direct[r] else {"tendon": name})
+            attrs = {"name": name, **target,
                      "gaintype": "fixed", "biastype": "affine",
                      "gainprm": _fmt(kp[r]), "biasprm": _vec([0.0, -kp[r], -kv[r]])}
             ET.SubElement(act, "general", attrs)
@@ -560,28 +588,41 @@ class _Writer:
 
 
 def _effective_inertia(xml: str, joints: JointMap, q_ref: np.ndarray,
-                       A: np.ndarray | None) -> F64:
-    """Diagonal of the mass matrix in joint (or motor) coordinates at ``q_ref``,
-    averaged over the rows of ``q_ref`` (k, n)."""
+                       A: np.ndarray | None) -> tuple[F64, F64]:
+    """Effective inertias for the servos, and how to spread a coordinate's force.
+
+    Returns:
+        ``(inertia, weights)``: the diagonal of the mass matrix in joint (or
+        motor) coordinates, ``S^T M S`` (``A^T S^T M S A``), averaged over the
+        rows of ``q_ref`` (k, n); and per coordinate the tendon weights over the
+        MuJoCo joints (n, J), ``W = (X^T D X)^-1 X^T D`` (``x = X q`` the joint
+        map, ``D`` the joints' own inertias): ``W X = I`` makes each tendon's
+        length its coordinate, and its force pushes each joint in proportion to
+        that joint's inertia, so a coupled joint's equality constraint barely has
+        to act (forcing one light joint and letting a soft constraint drag the
+        rest along is unstable).
+    """
     from robokin.sim._mujoco import full_mass_matrix, load_model
 
     mj = _mj()
     model = load_model(xml)
     data = mj.MjData(model)
-    qadr, _, S = joints.selection(model)
-    coef = np.array(joints.coefficient)
-    coord = np.array(joints.coordinate)
-    out = []
+    _, dadr, S = joints.selection(model)
+    out, diag = [], []
     for q in np.atleast_2d(q_ref):
-        data.qpos[:] = model.qpos0
-        data.qpos[qadr] = coef * q[coord]
+        data.qpos[:] = joints.qpos(model, q)
         mj.mj_forward(model, data)
         Mfull = full_mass_matrix(model, data)
         Mq = S.T @ Mfull @ S
         if A is not None:
             Mq = A.T @ Mq @ A
         out.append(np.diag(Mq).copy())
-    return np.mean(out, axis=0)
+        diag.append(np.diag(Mfull)[dadr])
+    D = np.diag(np.mean(diag, axis=0))
+    X = joints.matrix  # (J, n)
+    weights = np.linalg.solve(X.T @ D @ X, X.T @ D)  # W X = I: tendon length = q
+    weights[np.abs(weights) < 1e-15] = 0.0
+    return np.mean(out, axis=0), weights
 
 
 def default_reference(robot: Robot) -> F64:
@@ -652,11 +693,11 @@ def build_mjcf(
     writer.scene_bodies()
     writer.contact_filter()
     writer.equality(float(timestep))
-    joints = JointMap(tuple(writer.joint_names), tuple(writer.joint_coord),
-                      tuple(writer.joint_coef), tuple(placed.joint_names))
+    joints = JointMap(tuple(writer.joint_names), np.array(writer.joint_rows),
+                      tuple(placed.joint_names))
     A = placed.actuators.matrix if space == "motor" and placed.actuators else None
     ref = default_reference(placed) if q_ref is None else _check_q_ref(q_ref, placed.n)
-    inertia = _effective_inertia(writer.text(), joints, ref, A)
+    inertia, weights = _effective_inertia(writer.text(), joints, ref, A)
     kp, kv = servo.resolve(inertia)
     _check_stable(kp, kv, inertia, float(timestep), names_for(placed, space))
     ctrl_offset = np.zeros(placed.n)
@@ -672,7 +713,7 @@ def build_mjcf(
     writer.scene_bodies()
     writer.contact_filter()
     writer.equality(float(timestep))
-    writer.actuators(space, kp, kv)
+    writer.actuators(space, kp, kv, weights)
     xml = writer.text()
     notes = [f"mass properties: {links.describe()}"] + writer.notes
     return MjcfExport(xml, placed, joints, links, space, names, kp, kv, ctrl_offset,

@@ -1,5 +1,6 @@
-"""Figures, tables and files of a simulated run (``robokin sim``, the demo's
-"simulated run" section).
+"""Figures, tables and files of a simulated run.
+
+Used by ``robokin sim`` and the demo's "simulated run" section:
 
 * :func:`plot_torques`: the actuator torques of the run and the inverse dynamics
   of the plan over time, with the torque limits, and the joints' power;
@@ -15,8 +16,6 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 if TYPE_CHECKING:
     from robokin.sim.inverse import InverseDynamics
     from robokin.sim.simulate import SimResult
@@ -31,8 +30,10 @@ def _unit(revolute: bool) -> tuple[str, str]:
 def plot_torques(result: SimResult, inverse: InverseDynamics | None = None, *,
                  path: str | Path | None = None, title: str | None = None,
                  overwrite: bool = False) -> Any:
-    """Torque per joint over time (simulated, and the plan's inverse dynamics
-    dashed), the limits as horizontal lines, and the joints' power.
+    """Torque per joint over time, the limits, and the joints' power.
+
+    The simulated torques are solid, the plan's inverse dynamics dashed, the
+    limits horizontal lines.
 
     Args:
         result: A :class:`~robokin.sim.simulate.SimResult`.

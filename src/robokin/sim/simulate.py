@@ -159,8 +159,10 @@ class SimResult:
 
     @property
     def ok(self) -> bool:
-        """True when the run tracks the plan within tolerance, stays inside the
-        torque limits and touches nothing."""
+        """True when the run tracks, stays inside the torque limits and touches nothing.
+
+        Tracking: every joint within ``tolerance`` of the plan.
+        """
         return not self.reasons
 
 
@@ -379,9 +381,7 @@ class _Run:
                  drive: Trajectory, dt: float, contacts: ContactMode) -> None:
         mj = _mj()
         self.mj, self.model, self.data = mj, model, data
-        qadr, dadr, S = export.joints.selection(model)
-        coef = np.array(export.joints.coefficient)
-        coord = np.array(export.joints.coordinate)
+        _, _, S = export.joints.selection(model)
         master = export.joints.master_qpos(model)
         self.S = S
         self.qadr_master = master
@@ -394,8 +394,7 @@ class _Run:
         ff = (export.kv / export.kp) if export.velocity_feedforward else 0.0
         self.ctrl = x + ff * v + export.ctrl_offset
         # initial state: the plan's first sample
-        data.qpos[:] = model.qpos0
-        data.qpos[qadr] = coef * plan.q[0][coord]
+        data.qpos[:] = export.joints.qpos(model, plan.q[0])
         data.qvel[:] = S @ plan.qd[0]
         mj.mj_forward(model, data)
         self.q = np.empty((n_steps + 1, plan.n))
