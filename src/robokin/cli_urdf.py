@@ -1,7 +1,6 @@
-"""``robokin import``, ``robokin export`` and ``robokin dh``: URDF in and out (and
-MJCF out: ``robokin export NAME -o robot.xml`` chooses the format by the suffix).
+"""``robokin import``, ``robokin export`` and ``robokin dh``: URDF in and out, MJCF out.
 
-Files are written only where ``-o`` names them; without ``-o`` the result goes to
+``robokin export NAME -o robot.xml`` chooses the format by the suffix. Files are written only where ``-o`` names them; without ``-o`` the result goes to
 standard output.
 """
 
