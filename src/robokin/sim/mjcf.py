@@ -181,6 +181,8 @@ class MjcfExport:
         notes: What the export had to decide (estimated links, adjusted
             inertias), one sentence each.
         timestep: The physics time step [s].
+        moments: Each actuator's moment arm over the MuJoCo joints of
+            ``joints.names``, (n_actuators, J) (a motor's row: ``A^+ W``).
     """
 
     xml: str
@@ -197,6 +199,7 @@ class MjcfExport:
     torque_limits: F64
     notes: tuple[str, ...]
     timestep: float
+    moments: F64
 
 
 def _mj() -> Any:
@@ -381,10 +384,10 @@ class _Writer:
             "robot.fk_all; see docs/simulation.md ".replace("--", "-")))
         ET.SubElement(self.root, "compiler", {"angle": "radian", "autolimits": "true",
                                               "inertiafromgeom": "false"})
-        # Euler (semi-implicit): the actuator force MuJoCo reports is the force it
-        # applies (an implicit integrator would damp by dt * kv * qacc on top)
+        # implicit in the servos' damping: stable for stiff, coupled servos (the
+        # force it applies is qfrc_actuator - dt D a, see robokin.sim.simulate)
         opt = ET.SubElement(self.root, "option", {"timestep": _fmt(timestep),
-                                                  "integrator": "Euler"})
+                                                  "integrator": "implicitfast"})
         flags = {"filterparent": "disable"}
         if not contact_forces:
             flags["contact"] = "disable"
@@ -544,11 +547,12 @@ class _Writer:
                     ET.SubElement(fixed, "joint", {"joint": jname, "coef": _fmt(coef)})
         self.root.append(eq)
 
-    def actuators(self, space: ActuatorSpace, kp: F64, kv: F64, weights: F64) -> None:
+    def actuators(self, space: ActuatorSpace, kp: F64, kv: F64, weights: F64) -> F64:
         """Servos on the coordinates (or motors), through tendons where needed.
 
         ``weights`` (n, J): the tendon of coordinate i is ``sum_j weights[i, j] x_j``
         (its length is q_i). A coordinate that moves one joint acts on it directly.
+        Returns each actuator's moment arms over the joints, (n_actuators, J).
         """
         robot = self.robot
         if space == "motor":
@@ -579,6 +583,7 @@ class _Writer:
                      "gaintype": "fixed", "biastype": "affine",
                      "gainprm": _fmt(kp[r]), "biasprm": _vec([0.0, -kp[r], -kv[r]])}
             ET.SubElement(act, "general", attrs)
+        return np.array(coefs, dtype=np.float64)
 
     def text(self) -> str:
         if not len(self.asset):
@@ -588,11 +593,11 @@ class _Writer:
 
 
 def _effective_inertia(xml: str, joints: JointMap, q_ref: np.ndarray,
-                       A: np.ndarray | None) -> tuple[F64, F64]:
+                       A: np.ndarray | None) -> tuple[F64, F64, F64]:
     """Effective inertias for the servos, and how to spread a coordinate's force.
 
     Returns:
-        ``(inertia, weights)``: the diagonal of the mass matrix in joint (or
+        ``(inertia, weights, matrices)``: the diagonal of the mass matrix in joint (or
         motor) coordinates, ``S^T M S`` (``A^T S^T M S A``), averaged over the
         rows of ``q_ref`` (k, n); and per coordinate the tendon weights over the
         MuJoCo joints (n, J), ``W = (X^T D X)^-1 X^T D`` (``x = X q`` the joint
@@ -600,7 +605,8 @@ def _effective_inertia(xml: str, joints: JointMap, q_ref: np.ndarray,
         length its coordinate, and its force pushes each joint in proportion to
         that joint's inertia, so a coupled joint's equality constraint barely has
         to act (forcing one light joint and letting a soft constraint drag the
-        rest along is unstable).
+        rest along is unstable); and the mass matrices in those coordinates at
+        each row of ``q_ref``, (k, n, n).
     """
     from robokin.sim._mujoco import full_mass_matrix, load_model
 
@@ -608,7 +614,7 @@ def _effective_inertia(xml: str, joints: JointMap, q_ref: np.ndarray,
     model = load_model(xml)
     data = mj.MjData(model)
     _, dadr, S = joints.selection(model)
-    out, diag = [], []
+    out, diag, mats = [], [], []
     for q in np.atleast_2d(q_ref):
         data.qpos[:] = joints.qpos(model, q)
         mj.mj_forward(model, data)
@@ -617,12 +623,14 @@ def _effective_inertia(xml: str, joints: JointMap, q_ref: np.ndarray,
         if A is not None:
             Mq = A.T @ Mq @ A
         out.append(np.diag(Mq).copy())
+        mats.append(Mq)
         diag.append(np.diag(Mfull)[dadr])
     D = np.diag(np.mean(diag, axis=0))
     X = joints.matrix  # (J, n)
     weights = np.linalg.solve(X.T @ D @ X, X.T @ D)  # W X = I: tendon length = q
-    weights[np.abs(weights) < 1e-15] = 0.0
-    return np.mean(out, axis=0), weights
+    exact = np.abs(weights - np.round(weights)) < 1e-12
+    weights[exact] = np.round(weights[exact])
+    return np.mean(out, axis=0), weights, np.array(mats)
 
 
 def default_reference(robot: Robot) -> F64:
@@ -697,9 +705,9 @@ def build_mjcf(
                       tuple(placed.joint_names))
     A = placed.actuators.matrix if space == "motor" and placed.actuators else None
     ref = default_reference(placed) if q_ref is None else _check_q_ref(q_ref, placed.n)
-    inertia, weights = _effective_inertia(writer.text(), joints, ref, A)
+    inertia, weights, mats = _effective_inertia(writer.text(), joints, ref, A)
     kp, kv = servo.resolve(inertia)
-    _check_stable(kp, kv, inertia, float(timestep), names_for(placed, space))
+    _check_stable(kp, mats, float(timestep), names_for(placed, space))
     ctrl_offset = np.zeros(placed.n)
     names = names_for(placed, space)
     if space == "motor" and placed.actuators is not None:
@@ -713,12 +721,12 @@ def build_mjcf(
     writer.scene_bodies()
     writer.contact_filter()
     writer.equality(float(timestep))
-    writer.actuators(space, kp, kv, weights)
+    moments = writer.actuators(space, kp, kv, weights)
     xml = writer.text()
     notes = [f"mass properties: {links.describe()}"] + writer.notes
     return MjcfExport(xml, placed, joints, links, space, names, kp, kv, ctrl_offset,
                       servo.gravity_compensation, servo.velocity_feedforward, limits,
-                      tuple(notes), float(timestep))
+                      tuple(notes), float(timestep), moments)
 
 
 def names_for(robot: Robot, space: ActuatorSpace) -> tuple[str, ...]:
@@ -727,24 +735,28 @@ def names_for(robot: Robot, space: ActuatorSpace) -> tuple[str, ...]:
         else tuple(robot.joint_names)
 
 
-def _check_stable(kp: F64, kv: F64, inertia: F64, dt: float,
-                  names: Sequence[str]) -> None:
-    """Refuse gains the explicit servo cannot integrate at ``dt``.
+def _check_stable(kp: F64, mats: F64, dt: float, names: Sequence[str]) -> None:
+    """Refuse servo stiffness the integrator cannot follow at ``dt``.
 
-    A servo on an inertia ``I`` is stable under semi-implicit Euler while
-    ``kp dt^2 / I`` and ``kv dt / I`` stay well inside the stability region; robokin
-    asks for ``omega dt <= 0.5`` and ``kv dt / I <= 1`` (10 Hz at 1 kHz: 0.063 and
-    0.126).
+    The servos' damping is integrated implicitly; their stiffness is not, so
+    the fastest mode of ``M^-1 K`` (``M`` the mass matrix in the actuators'
+    coordinates, at each reference configuration; ``K = diag(kp)``) must stay
+    well resolved: robokin asks for ``omega_max dt <= 0.5`` (the default 10 Hz
+    loops on the AUBO-i5 at 1 kHz: 0.25, the wrist's coupling included).
     """
-    I = np.maximum(inertia, 1e-300)
-    w_dt = np.sqrt(kp / I) * dt
-    d_dt = kv * dt / I
-    bad = np.flatnonzero((w_dt > 0.5) | (d_dt > 1.0))
-    if bad.size:
-        j = int(bad[0])
-        raise InputError("gains", f"too stiff for a {dt:g} s step at {names[j]!r} "
-                         f"(omega dt = {w_dt[j]:.3g}, kv dt / I = {d_dt[j]:.3g}; keep "
-                         "them below 0.5 and 1): lower the gains or the step")
+    worst, where = 0.0, 0
+    for M in mats:
+        lam = np.linalg.eigvals(np.linalg.solve(M, np.diag(kp)))
+        k = int(np.argmax(lam.real))
+        if lam.real[k] > worst:
+            worst = float(lam.real[k])
+            vec = np.abs(np.linalg.eig(np.linalg.solve(M, np.diag(kp)))[1][:, k])
+            where = int(np.argmax(vec))
+    w_dt = math.sqrt(max(worst, 0.0)) * dt
+    if w_dt > 0.5:
+        raise InputError("gains", f"too stiff for a {dt:g} s step: the fastest servo "
+                         f"mode (mostly {names[where]!r}) has omega dt = {w_dt:.3g}; keep "
+                         "it below 0.5 (lower the gains or the step)")
 
 
 def _check_q_ref(q_ref: npt.ArrayLike, n: int) -> F64:

@@ -381,7 +381,13 @@ class _Run:
                  drive: Trajectory, dt: float, contacts: ContactMode) -> None:
         mj = _mj()
         self.mj, self.model, self.data = mj, model, data
-        _, _, S = export.joints.selection(model)
+        _, dadr, S = export.joints.selection(model)
+        # the servos' damping matrix over the dofs: implicitfast integrates it
+        # implicitly, so the force the actuators apply is qfrc_actuator - dt D a
+        G = np.zeros((export.moments.shape[0], model.nv))
+        G[:, dadr] = export.moments
+        self.D = G.T @ (export.kv[:, None] * G)
+        self.limits = export.torque_limits
         master = export.joints.master_qpos(model)
         self.S = S
         self.qadr_master = master
@@ -415,8 +421,10 @@ class _Run:
         master, dmaster = self.qadr_master, self.dadr_master
         log, times = self.log, self.times
         qfrc = np.empty((self.n_steps, m.nv))
+        dv = np.empty((self.n_steps, m.nv))
         for k in range(self.n_steps):
             d.ctrl[:] = ctrl[k]
+            dv[k] = d.qvel
             if not self.detect:
                 mj.mj_step(m, d)
                 log.step(d, times[k])  # contacts of the state the step started from
@@ -428,6 +436,13 @@ class _Run:
                 m.opt.disableflags |= self.flag
                 log.step(d, times[k + 1])
             qfrc[k] = d.qfrc_actuator
+            dv[k] = d.qvel - dv[k]
             q[k + 1] = d.qpos[master]
             qd[k + 1] = d.qvel[dmaster]
-        tau[:] = qfrc @ S
+        tau[:] = (qfrc - dv @ self.D.T) @ S  # dv = dt a: the implicit damping
+        # A saturated servo gives its limit: MuJoCo's implicit step keeps damping it
+        # (by dt kv |a|, a numerical artefact, not motor torque), so report the limit.
+        lim = np.where(np.isfinite(self.limits), self.limits, np.inf)
+        sat = np.abs(qfrc[:, dmaster]) >= np.where(np.isfinite(lim), lim * (1 - 1e-9),
+                                                   np.inf)
+        tau[sat] = (qfrc @ S)[sat]
