@@ -74,7 +74,11 @@ def import_urdf(
 
 
 def _export_format(out: Path | None, fmt: str | None) -> str:
-    """``urdf`` or ``mjcf``: ``--format`` when given, else by the suffix of ``-o``."""
+    """``urdf`` or ``mjcf``: ``--format`` when given, else by the suffix of ``-o``.
+
+    ``.xml`` and ``.mjcf`` (but not ``.urdf.xml``) are MJCF; every other name is
+    URDF, as it was before MJCF export existed.
+    """
     from robokin.exceptions import InputError
 
     if fmt is not None:
@@ -84,12 +88,9 @@ def _export_format(out: Path | None, fmt: str | None) -> str:
     if out is None:
         return "urdf"
     name = out.name.lower()
-    if name.endswith((".urdf", ".urdf.xml")):
-        return "urdf"
-    if name.endswith((".xml", ".mjcf")):
+    if name.endswith((".xml", ".mjcf")) and not name.endswith(".urdf.xml"):
         return "mjcf"
-    raise InputError("--out", f"cannot tell the format from {out.name!r}: use .urdf "
-                     "(URDF) or .xml / .mjcf (MuJoCo MJCF), or pass --format")
+    return "urdf"  # .urdf, and any other name as before MJCF export existed
 
 
 @app.command("export")
@@ -97,8 +98,8 @@ def export_urdf(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     out: Annotated[
         Path | None, typer.Option(
-            "-o", "--out", help="File to write (replaced if it exists): .urdf for URDF, "
-            ".xml or .mjcf for a MuJoCo model.")
+            "-o", "--out", help="File to write (replaced if it exists): .xml or .mjcf "
+            "for a MuJoCo model, any other name (.urdf) for URDF.")
     ] = None,
     fmt: Annotated[
         str | None, typer.Option("--format", help="urdf or mjcf (default: by the "
@@ -112,11 +113,11 @@ def export_urdf(
     """Write a robot as a URDF, or as a MuJoCo MJCF model, with the same FK and limits."""
     from robokin.exceptions import InputError
 
+    if out is not None:
+        _not_the_input(out, name)
     kind = _export_format(out, fmt)
     if scene is not None and kind != "mjcf":
         raise InputError("--scene", "a scene goes into an MJCF model only (-o NAME.xml)")
-    if out is not None:
-        _not_the_input(out, name)
     robot = _load(name)
     if kind == "mjcf":
         from robokin.cli_sim import load_scene

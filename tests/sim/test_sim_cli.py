@@ -55,7 +55,9 @@ def test_export_chooses_the_format_by_suffix(tmp_path, capsys):
     assert main(["export", "aubo_i5", "--scene", "press", "-o",
                  str(tmp_path / "cell.xml")]) == 0
     assert 'name="lower_die"' in (tmp_path / "cell.xml").read_text()
-    assert main(["export", "scara", "-o", str(tmp_path / "scara.txt")]) == 2
+    assert main(["export", "scara", "-o", str(tmp_path / "scara.txt")]) == 0
+    assert "<robot" in (tmp_path / "scara.txt").read_text()  # URDF, as always
+    assert main(["export", "scara", "--format", "stl"]) == 2
     assert main(["export", "scara", "--scene", "press", "-o",
                  str(tmp_path / "x.urdf")]) == 2
     capsys.readouterr()
