@@ -63,3 +63,16 @@ def test_export_chooses_the_format_by_suffix(tmp_path, capsys):
     capsys.readouterr()
     assert main(["export", "scara", "--format", "mjcf"]) == 0
     assert capsys.readouterr().out.startswith("<mujoco")
+
+
+def test_sim_command_drives_motors(tmp_path, capsys):
+    robot = robokin.load("scara")
+    plan = trajectory.quintic(np.array([0.0, 0.0, 0.0, 0.05]),
+                              np.array([0.4, 0.6, 1.5, 0.12]), 1.0, dt=0.005)
+    motors = plan.to_actuator_space(robot)
+    path = io.write_csv(motors, tmp_path / "motors.csv")
+    assert main(["sim", "scara", str(path), "--motors", "--out", str(tmp_path / "m"),
+                 "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["servo"]["actuators"] == "motor" and summary["ok"]
+    assert main(["sim", "ur5", str(path), "--motors", "--out", str(tmp_path / "u")]) == 2

@@ -59,7 +59,7 @@ def test_a_trajectory_for_another_robot_is_refused(ur5_plan):
     ({"kp": [1.0] * 5, "kv": [1.0] * 5}, "5 entries"),
     ({"stiffness": 3}, "unknown field"),
     ("fast", "expected None"),
-    ({"bandwidth": 400.0}, "too stiff"),
+    ({"bandwidth": 2000.0}, "too stiff"),
 ])
 def test_bad_gains_are_refused_naming_the_argument(ur5_plan, gains, match):
     robot, plan = ur5_plan

@@ -118,3 +118,28 @@ def test_mjcf_coordinate_without_a_joint_of_its_own():
     export = sim.build_mjcf(robot)
     assert any("leaf" in n for n in export.notes)
     assert_fk_equal(robot, export, _random_q(robot, np.random.default_rng(5), 200))
+
+
+def test_mjcf_meshes_go_in_as_their_convex_hulls_and_touch_the_scene(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    from robokin import collision, trajectory
+    from robokin.model.geometry import RobotGeometry, mesh
+
+    stl = tmp_path / "blob.stl"
+    trimesh.creation.icosphere(subdivisions=1, radius=0.05).export(stl)
+    robot = robokin.load("scara")
+    robot = robot.replace(geometry=RobotGeometry.from_mapping(
+        robot, {"elbow": [mesh(stl, np.eye(4))]}))
+    scene = collision.Scene("post")
+    pose = np.eye(4)
+    pose[:3, 3] = [0.0, 0.6, 0.4]  # on the circle the elbow sweeps
+    scene.add_box("post", (0.1, 0.1, 0.8), pose)
+    export = sim.build_mjcf(robot, scene)
+    assert '<mesh name="mesh_elbow/0"' in export.xml
+    plan = trajectory.quintic(np.array([0.0, 0.0, 0.0, 0.1]),
+                              np.array([1.6, 0.0, 0.0, 0.1]), 1.0, dt=0.005)
+    rep = collision.check(robot, scene, plan)
+    res = sim.simulate(robot, plan, scene)
+    assert [(iv.body_a, iv.body_b) for iv in rep.intervals] == \
+        [(c.body_a, c.body_b) for c in res.contacts] == [("elbow", "post")]
+    assert abs(rep.intervals[0].t_start - res.contacts[0].t_start) <= 0.005 + 1e-9

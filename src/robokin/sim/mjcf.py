@@ -597,9 +597,10 @@ def _effective_inertia(xml: str, joints: JointMap, q_ref: np.ndarray,
     """Effective inertias for the servos, and how to spread a coordinate's force.
 
     Returns:
-        ``(inertia, weights, matrices)``: the diagonal of the mass matrix in joint (or
-        motor) coordinates, ``S^T M S`` (``A^T S^T M S A``), averaged over the
-        rows of ``q_ref`` (k, n); and per coordinate the tendon weights over the
+        ``(inertia, weights, matrices)``: the diagonal of the mass matrix in joint
+        (or motor) coordinates ``M = S^T M_x S`` (``A^T S^T M_x S A``): the inertia
+        each actuator moves with the other joints held, averaged over the rows of
+        ``q_ref`` (k, n); per coordinate the tendon weights over the
         MuJoCo joints (n, J), ``W = (X^T D X)^-1 X^T D`` (``x = X q`` the joint
         map, ``D`` the joints' own inertias): ``W X = I`` makes each tendon's
         length its coordinate, and its force pushes each joint in proportion to
@@ -667,7 +668,9 @@ def build_mjcf(
         strict: Refuse to estimate missing link mass data (ModelError).
         density: Density for estimated links [kg/m^3] (default: the robot's, else
             :data:`~robokin.model.dynamics.DEFAULT_DENSITY`).
-        timestep: Physics step [s], > 0.
+        timestep: Physics step [s], > 0; divided (at most
+            :data:`MAX_SUBSTEPS` times) when stiff servos need it (the export's
+            ``timestep`` and notes say so).
         contact_forces: False: contacts exert no force (MuJoCo's contact
             detection is off in the model; :func:`robokin.sim.simulate` then
             detects them separately).
@@ -707,7 +710,7 @@ def build_mjcf(
     ref = default_reference(placed) if q_ref is None else _check_q_ref(q_ref, placed.n)
     inertia, weights, mats = _effective_inertia(writer.text(), joints, ref, A)
     kp, kv = servo.resolve(inertia)
-    _check_stable(kp, mats, float(timestep), names_for(placed, space))
+    step, note = _stable_step(kp, mats, float(timestep), names_for(placed, space))
     ctrl_offset = np.zeros(placed.n)
     names = names_for(placed, space)
     if space == "motor" and placed.actuators is not None:
@@ -715,18 +718,19 @@ def build_mjcf(
         ctrl_offset = P @ placed.actuators.offset
     # the text is rebuilt with actuators (ElementTree elements are not reusable
     # after text(): a fresh writer keeps the two passes independent)
-    writer = _Writer(placed, scene, links, float(timestep), servo.gravity_compensation,
+    writer = _Writer(placed, scene, links, step, servo.gravity_compensation,
                      limits, contact_forces)
     writer.robot_tree()
     writer.scene_bodies()
     writer.contact_filter()
-    writer.equality(float(timestep))
+    writer.equality(step)
     moments = writer.actuators(space, kp, kv, weights)
     xml = writer.text()
-    notes = [f"mass properties: {links.describe()}"] + writer.notes
+    notes = [f"mass properties: {links.describe()}"] + writer.notes + ([note] if note
+                                                                        else [])
     return MjcfExport(xml, placed, joints, links, space, names, kp, kv, ctrl_offset,
                       servo.gravity_compensation, servo.velocity_feedforward, limits,
-                      tuple(notes), float(timestep), moments)
+                      tuple(notes), step, moments)
 
 
 def names_for(robot: Robot, space: ActuatorSpace) -> tuple[str, ...]:
@@ -735,28 +739,48 @@ def names_for(robot: Robot, space: ActuatorSpace) -> tuple[str, ...]:
         else tuple(robot.joint_names)
 
 
-def _check_stable(kp: F64, mats: F64, dt: float, names: Sequence[str]) -> None:
-    """Refuse servo stiffness the integrator cannot follow at ``dt``.
+#: At most this many physics steps per requested step when the servos are stiff.
+MAX_SUBSTEPS = 16
 
-    The servos' damping is integrated implicitly; their stiffness is not, so
-    the fastest mode of ``M^-1 K`` (``M`` the mass matrix in the actuators'
-    coordinates, at each reference configuration; ``K = diag(kp)``) must stay
-    well resolved: robokin asks for ``omega_max dt <= 0.5`` (the default 10 Hz
-    loops on the AUBO-i5 at 1 kHz: 0.25, the wrist's coupling included).
+
+def _stable_step(kp: F64, mats: F64, dt: float, names: Sequence[str]
+                 ) -> tuple[float, str]:
+    """The physics step: ``dt``, or a fraction of it the servos' stiffness needs.
+
+    The servos' damping is integrated implicitly; their stiffness is not, so the
+    fastest mode of ``M^-1 K`` (``M`` the mass matrix in the actuators'
+    coordinates at each reference configuration, ``K = diag(kp)``) must be well
+    resolved: ``omega_max step <= 0.5``. Gains tuned joint by joint on the
+    diagonal of ``M`` can make a coupled mode much faster than any joint's loop
+    (a heavy tip on light links); the step is then divided by the smallest
+    integer that resolves it (the default 10 Hz servos on the AUBO-i5 at 1 kHz:
+    0.25, no division).
+
+    Returns:
+        ``(step [s], note)``: the note says why the step was refined ("" if not).
+
+    Raises:
+        InputError: more than :data:`MAX_SUBSTEPS` divisions would be needed
+            (naming ``gains``).
     """
     worst, where = 0.0, 0
     for M in mats:
-        lam = np.linalg.eigvals(np.linalg.solve(M, np.diag(kp)))
+        lam, vec = np.linalg.eig(np.linalg.solve(M, np.diag(kp)))
         k = int(np.argmax(lam.real))
         if lam.real[k] > worst:
-            worst = float(lam.real[k])
-            vec = np.abs(np.linalg.eig(np.linalg.solve(M, np.diag(kp)))[1][:, k])
-            where = int(np.argmax(vec))
+            worst, where = float(lam.real[k]), int(np.argmax(np.abs(vec[:, k])))
     w_dt = math.sqrt(max(worst, 0.0)) * dt
-    if w_dt > 0.5:
+    split = max(1, math.ceil(w_dt / 0.5 - 1e-12))
+    if split > MAX_SUBSTEPS:
         raise InputError("gains", f"too stiff for a {dt:g} s step: the fastest servo "
-                         f"mode (mostly {names[where]!r}) has omega dt = {w_dt:.3g}; keep "
-                         "it below 0.5 (lower the gains or the step)")
+                         f"mode (mostly {names[where]!r}) has omega dt = {w_dt:.3g}, "
+                         f"more than {MAX_SUBSTEPS} substeps could resolve (lower the "
+                         "gains or the step)")
+    if split == 1:
+        return dt, ""
+    return dt / split, (f"physics step refined to {dt / split * 1e3:.4g} ms: the "
+                        f"servos' fastest mode (mostly {names[where]!r}) is at "
+                        f"{math.sqrt(worst) / (2 * math.pi):.3g} Hz")
 
 
 def _check_q_ref(q_ref: npt.ArrayLike, n: int) -> F64:

@@ -8,8 +8,9 @@ compensation at the measured configuration::
 
 ``kp`` and ``kv`` default to a second-order loop of natural frequency
 ``bandwidth`` [Hz] and damping ratio ``damping`` on the actuator's effective
-inertia ``I`` (the diagonal of the mass matrix in that actuator's coordinate,
-averaged over the motion): ``kp = I (2 pi f)^2``, ``kv = 2 zeta I (2 pi f)``.
+inertia ``I`` (the diagonal of the mass matrix in that actuator's coordinate: the
+inertia it moves with the other joints held, averaged over the motion):
+``kp = I (2 pi f)^2``, ``kv = 2 zeta I (2 pi f)``.
 The tracking error that remains is then ``(M qdd + C qd) / kp`` to first order:
 it grows with the joints' acceleration, as the press-loading study's
 measurements did.

@@ -228,9 +228,8 @@ def _check_tolerance(tolerance: Any) -> tuple[float, float]:
 class _ContactLog:
     """Contact intervals from per-step contact lists."""
 
-    def __init__(self, model: Any, robot_links: tuple[str, ...], dt: float) -> None:
+    def __init__(self, model: Any, robot_links: tuple[str, ...]) -> None:
         mj = _mj()
-        self.dt = dt
         body_names = [mj.mj_id2name(model, mj.mjtObj.mjOBJ_BODY, b) or ""
                       for b in range(model.nbody)]
         self.geom_body = [body_names[b] for b in model.geom_bodyid]
@@ -317,7 +316,8 @@ def simulate(
         scene: The scene (robot placement, tool, objects to touch), or None.
         gains: Servo gains (:func:`robokin.sim.servo.servo_gains`); the default
             gains are tuned at 16 configurations of the plan.
-        dt: Physics step [s], at most 1e-3 (1 kHz).
+        dt: Physics step [s], at most 1e-3 (1 kHz); divided when stiff servos
+            need it (``res.export.timestep``).
         contacts: ``"detect"`` (contacts exert no force) or ``"physical"``.
         strict: Refuse to estimate missing link mass data.
         density: Density for estimated links [kg/m^3].
@@ -351,7 +351,7 @@ def simulate(
     mj = _mj()
     model = load_model(export.xml)
     data = mj.MjData(model)
-    run = _Run(model, data, export, plan, traj if motors else plan, dt, contacts)
+    run = _Run(model, data, export, plan, traj if motors else plan, contacts)
     t0 = time.perf_counter()
     run.step_all()
     wall = time.perf_counter() - t0
@@ -378,7 +378,7 @@ class _Run:
     """One stepping loop: set points in, states, torques and contacts out."""
 
     def __init__(self, model: Any, data: Any, export: MjcfExport, plan: Trajectory,
-                 drive: Trajectory, dt: float, contacts: ContactMode) -> None:
+                 drive: Trajectory, contacts: ContactMode) -> None:
         mj = _mj()
         self.mj, self.model, self.data = mj, model, data
         _, dadr, S = export.joints.selection(model)
@@ -393,6 +393,7 @@ class _Run:
         self.qadr_master = master
         self.dadr_master = np.array([model.jnt_dofadr[np.flatnonzero(
             model.jnt_qposadr == a)[0]] for a in master], dtype=np.int64)
+        dt = export.timestep  # the requested step, or a fraction of it
         n_steps = max(1, int(round((plan.t[-1] - plan.t[0]) / dt)))
         self.n_steps = n_steps
         self.times = plan.t[0] + dt * np.arange(n_steps + 1)
@@ -410,7 +411,7 @@ class _Run:
         self.qd[0] = data.qvel[self.dadr_master]
         from robokin.model.geometry import link_names
 
-        self.log = _ContactLog(model, link_names(export.robot), dt)
+        self.log = _ContactLog(model, link_names(export.robot))
         self.detect = contacts == "detect"
         self.flag = int(mj.mjtDisableBit.mjDSBL_CONTACT)
 
