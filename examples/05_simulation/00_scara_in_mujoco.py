@@ -31,7 +31,6 @@ def main() -> None:
     q1 = np.array([0.5, 0.8, np.pi, 0.15])  # half a shaft turn, 100 mm up
     plan = trajectory.quintic(q0, q1, 2.0, dt=0.005)
     check = sim.check_decoupling(robot, plan)
-    rot, lift = check.joints
     for label, err in (("decoupled", check.decoupled_error),
                        ("naive", check.naive_error)):
         print(f"{label:9s} commands: shaft rotation off by {np.degrees(err[0]):.3f} deg,"
@@ -41,9 +40,10 @@ def main() -> None:
     inv = sim.inverse_dynamics(robot, plan)
     print("peak joint torques:", "  ".join(
         f"{n} {v:.3g}" for n, v in zip(robot.joint_names, inv.peak)))
-    print("peak motor power [W]:", "  ".join(
-        f"{n} {v:.3g}" for n, v in zip(robot.actuator_names,
-                                       np.abs(inv.motor_power).max(axis=0))))
+    if inv.motor_power is not None and inv.motor_names is not None:  # it has motors
+        peak_power = np.abs(inv.motor_power).max(axis=0)  # [W]
+        print("peak motor power [W]:", "  ".join(
+            f"{n} {v:.3g}" for n, v in zip(inv.motor_names, peak_power)))
     print(f"mass properties: {inv.links.describe()}")
     out_dir = Path("robokin-examples")
     out_dir.mkdir(exist_ok=True)

@@ -70,6 +70,7 @@ class LinkInertia:
     inertia: F64 = field(default_factory=lambda: _ro(np.zeros((3, 3))))
 
     def __post_init__(self) -> None:
+        """Check the values and freeze the arrays (raises InputError naming the field)."""
         try:
             m = float(self.mass)
         except (TypeError, ValueError):
@@ -172,6 +173,7 @@ class RobotDynamics:
     density: float | None = None
 
     def __post_init__(self) -> None:
+        """Check the per-link entries, the torque limits and the density."""
         if len(self.links) != len(self.names):
             raise InputError("links", f"expected one entry per link ({len(self.names)}),"
                              f" got {len(self.links)}")

@@ -84,6 +84,7 @@ class ServoGains:
     velocity_feedforward: bool = True
 
     def __post_init__(self) -> None:
+        """Check every gain (raises InputError naming ``gains``)."""
         object.__setattr__(self, "bandwidth", _positive(self.bandwidth, "bandwidth [Hz]"))
         object.__setattr__(self, "damping", _positive(self.damping, "damping",
                                                       zero_ok=True))
