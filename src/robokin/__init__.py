@@ -60,7 +60,8 @@ def save(robot: Robot, path: str | Path) -> Path:
 
 
 def __getattr__(name: str) -> Any:
-    # Lazy subpackages: ``robokin.ik``, ``robokin.trajectory``, ``robokin.collision``.
+    # Lazy subpackages: ``robokin.ik``, ``robokin.trajectory``, ``robokin.collision``,
+    # ``robokin.sim`` (MuJoCo, robokin[sim]).
     import importlib
 
     if name == "ik":
@@ -73,6 +74,7 @@ def __getattr__(name: str) -> Any:
         "viz",
         "kinematics",
         "model",
+        "sim",
     ):
         return importlib.import_module(f"robokin.{name}")
     raise AttributeError(f"module 'robokin' has no attribute {name!r}")

@@ -198,6 +198,9 @@ def demo(
     force: Annotated[
         bool, typer.Option("--force", help="Write into a folder holding other files.")
     ] = False,
+    sim: Annotated[
+        bool, typer.Option("--sim", help="Also run the plan in MuJoCo (robokin[sim]).")
+    ] = False,
 ) -> None:
     """The main job: the AUBO-i5 loads a press (plan, check, plots, HTML report).
 
@@ -207,7 +210,7 @@ def demo(
     from robokin.demo import run_demo
 
     result = run_demo(out=out, clearance_mm=clearance, view=view, force=force,
-                      console=_console())
+                      console=_console(), sim=sim)
     if not result.ok:
         raise DomainFailure("the plan is not collision-free with the required clearance "
                             "(see the report)")
@@ -225,6 +228,7 @@ def _register_extra_commands() -> None:
         "robokin.cli_view",
         "robokin.cli_actuators",
         "robokin.cli_workspace",
+        "robokin.cli_sim",
     ):
         try:
             importlib.import_module(mod)

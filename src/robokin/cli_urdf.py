@@ -1,6 +1,6 @@
-"""``robokin import``, ``robokin export`` and ``robokin dh``: URDF in and out.
+"""``robokin import``, ``robokin export`` and ``robokin dh``: URDF in and out, MJCF out.
 
-Files are written only where ``-o`` names them; without ``-o`` the result goes to
+``robokin export NAME -o robot.xml`` chooses the format by the suffix. Files are written only where ``-o`` names them; without ``-o`` the result goes to
 standard output.
 """
 
@@ -73,24 +73,69 @@ def import_urdf(
     )
 
 
+def _export_format(out: Path | None, fmt: str | None) -> str:
+    """``urdf`` or ``mjcf``: ``--format`` when given, else by the suffix of ``-o``.
+
+    ``.xml`` and ``.mjcf`` (but not ``.urdf.xml``) are MJCF; every other name is
+    URDF, as it was before MJCF export existed.
+    """
+    from robokin.exceptions import InputError
+
+    if fmt is not None:
+        if fmt not in ("urdf", "mjcf"):
+            raise InputError("--format", f"expected 'urdf' or 'mjcf', got {fmt!r}")
+        return fmt
+    if out is None:
+        return "urdf"
+    name = out.name.lower()
+    if name.endswith((".xml", ".mjcf")) and not name.endswith(".urdf.xml"):
+        return "mjcf"
+    return "urdf"  # .urdf, and any other name as before MJCF export existed
+
+
 @app.command("export")
 def export_urdf(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     out: Annotated[
-        Path | None, typer.Option("-o", "--out", help="URDF file to write (replaced if it exists).")
+        Path | None, typer.Option(
+            "-o", "--out", help="File to write (replaced if it exists): .xml or .mjcf "
+            "for a MuJoCo model, any other name (.urdf) for URDF.")
+    ] = None,
+    fmt: Annotated[
+        str | None, typer.Option("--format", help="urdf or mjcf (default: by the "
+                                 "suffix of -o, else urdf).")
+    ] = None,
+    scene: Annotated[
+        str | None, typer.Option("--scene", help="MJCF only: a scene file or bundled "
+                                 "name; the robot is placed in it with its objects.")
     ] = None,
 ) -> None:
-    """Write a robot as a URDF with the same FK and limits."""
-    from robokin.io.urdf_export import urdf_from_robot, write_urdf
+    """Write a robot as a URDF, or as a MuJoCo MJCF model, with the same FK and limits."""
+    from robokin.exceptions import InputError
 
     if out is not None:
         _not_the_input(out, name)
+    kind = _export_format(out, fmt)
+    if scene is not None and kind != "mjcf":
+        raise InputError("--scene", "a scene goes into an MJCF model only (-o NAME.xml)")
     robot = _load(name)
+    if kind == "mjcf":
+        from robokin.cli_sim import load_scene
+        from robokin.sim import to_mjcf
+
+        text = to_mjcf(robot, None if scene is None else load_scene(scene))
+    else:
+        from robokin.io.urdf_export import urdf_from_robot
+
+        text = urdf_from_robot(robot)
     if out is None:
-        print(urdf_from_robot(robot), end="")
+        print(text, end="")
         return
-    write_urdf(robot, out)
-    _console().print(f"{cell(robot.name, markup=False)}: wrote {out}", markup=False)
+    from robokin.io.atomic import write_atomic
+
+    write_atomic(out, text)
+    _console().print(f"{cell(robot.name, markup=False)}: wrote {out} ({kind.upper()})",
+                     markup=False)
 
 
 @app.command("dh")

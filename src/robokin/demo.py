@@ -23,8 +23,9 @@ joints), ``waypoints.csv`` (controller waypoints in degrees) and
 the press, side and top views), ``distance.csv`` and ``distance.png`` (the closest
 body pairs over time), ``animation.html`` (the
 motion, self-contained), ``report.html`` (one page with all of it) and
-``summary.json``. The command exits 0 only when the plan is collision-free with at
-least the required clearance.
+``summary.json``. With ``sim=True`` (``robokin demo --sim``) the plan also runs in
+MuJoCo: ``sim_*`` files and a "simulated run" section in the report. The command
+exits 0 only when the plan is collision-free with at least the required clearance.
 """
 
 from __future__ import annotations
@@ -316,7 +317,7 @@ def _summary(
     }
 
 
-def _report_html(summary: dict[str, Any], images: dict[str, Path]) -> str:
+def _report_html(summary: dict[str, Any], images: dict[str, Path], extra: str = "") -> str:
     s = summary
     c = s["closest"] or {}
     verdict = (
@@ -400,6 +401,7 @@ against the press cell. The motion plays in <a href="animation.html">animation.h
 <table><tr><th>step</th><th>kind</th><th>IK solutions</th><th>branch</th>
 <th>joints [deg]</th></tr>{vias}</table>
 {figs}
+{extra}
 <p style="font-size:0.8em;color:#57606a">Files: trajectory.csv (time and joints),
 waypoints.csv (controller waypoints, degrees), program.script (URScript servoj),
 distance.csv (closest body pairs over time, mm), summary.json. The workpiece rides
@@ -417,6 +419,7 @@ def run_demo(
     force: bool = False,
     console: Any = None,
     html_animation: bool = True,
+    sim: bool = False,
 ) -> DemoResult:
     """Run the press-loading demo end to end and write its outputs.
 
@@ -428,6 +431,8 @@ def run_demo(
         force: Write into a folder that holds other files.
         console: A rich Console for the terminal summary (default: a new one).
         html_animation: Also write ``animation.html``.
+        sim: Also run the plan in MuJoCo (``robokin[sim]``): ``sim_*`` files and
+            a "simulated run" report section (:mod:`robokin.sim.demo_run`).
 
     Returns:
         A :class:`DemoResult`; ``ok`` is True only when the plan is collision-free
@@ -593,8 +598,17 @@ def run_demo(
             k: files[k]
             for k in ("joints.png", "press_views.png", "distance.png", "tool_path.png")
         }
+        sim_html = ""
+        if sim:
+            from robokin.sim.demo_run import simulated_run
+
+            t = time.perf_counter()
+            summary["simulated_run"], sim_files, sim_html = simulated_run(
+                bare, scene, traj, out, report.min_distance)
+            files.update({f"sim_{k}": v for k, v in sim_files.items()})
+            summary["timings_s"]["sim"] = round(time.perf_counter() - t, 3)
         report_path = out / "report.html"
-        write_atomic(report_path, _report_html(summary, images))
+        write_atomic(report_path, _report_html(summary, images, sim_html))
         done("report.html", report_path)
     write_atomic(out / MARKER, strict_json(summary, indent=2) + "\n")
     files["summary.json"] = out / MARKER
@@ -633,6 +647,12 @@ def run_demo(
         f"{timings['total']:.1f} s (plan {timings['plan']:.2f}, "
         f"check {timings['check']:.2f}, write {timings['write']:.2f})",
     )
+    if sim:
+        sr = summary["simulated_run"]
+        table.add_row("simulated run", (
+            "max error " + "  ".join(f"{j['max_error']:.3f}" for j in sr["joints"])
+            + f" deg; {sr['timing']['real_time_factor']:.4f} x real time; "
+            + ("PASS" if sr["ok"] else "FAIL")))
     table.add_row("report", str(report_path))
     con.print(table)
     con.print(

@@ -25,6 +25,7 @@ from robokin.model.coupling import AffineMap
 if TYPE_CHECKING:
     from robokin.kinematics.ik.numeric import IKResult
     from robokin.kinematics.ik.solutions import SolutionSet
+    from robokin.model.dynamics import RobotDynamics
     from robokin.model.geometry import RobotGeometry
 
 __all__ = ["Robot"]
@@ -79,11 +80,13 @@ class Robot:
         actuator_names: Names of the motor coordinates (m), or None.
         actuator_limits: Motor limits (m, 2), SI units, or None.
         geometry: Link and tool shapes (see ``robokin.model.geometry``), or None.
+        dynamics: Link masses, centres of mass, inertias and joint torque limits
+            (:class:`~robokin.model.dynamics.RobotDynamics`), or None.
         path: The robot file it was loaded from, or None.
         meta: Free-form extra fields from the robot file (a read-only mapping).
     """
 
-    __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain",
+    __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain", "dynamics",
                  "geometry", "meta", "name", "path", "source", "__weakref__")
     chain: Chain
     name: str
@@ -92,6 +95,7 @@ class Robot:
     actuator_names: tuple[str, ...] | None
     actuator_limits: npt.NDArray[np.float64] | None
     geometry: RobotGeometry | None
+    dynamics: RobotDynamics | None
     path: Path | None
     meta: Mapping[str, Any]
 
@@ -112,7 +116,7 @@ class Robot:
         return {"name": self.name, "source": self.source, "actuators": self.actuators,
                 "actuator_names": self.actuator_names,
                 "actuator_limits": self.actuator_limits, "geometry": self.geometry,
-                "path": self.path, "meta": dict(self.meta)}
+                "dynamics": self.dynamics, "path": self.path, "meta": dict(self.meta)}
 
     def __init__(
         self,
@@ -124,6 +128,7 @@ class Robot:
         actuator_names: Sequence[str] | None = None,
         actuator_limits: npt.ArrayLike | None = None,
         geometry: RobotGeometry | None = None,
+        dynamics: RobotDynamics | None = None,
         path: str | Path | None = None,
         meta: Mapping[str, Any] | None = None,
     ) -> None:
@@ -143,6 +148,11 @@ class Robot:
         init(self, "actuator_names", names)
         init(self, "actuator_limits", limits)
         init(self, "geometry", geometry)
+        if dynamics is not None and len(getattr(dynamics, "names", ())) != chain.n_chain + 2:
+            raise InputError("dynamics", f"expected data for {chain.n_chain + 2} links "
+                             "(base, the chain joints, tool); see "
+                             "robokin.model.dynamics.RobotDynamics.from_mapping")
+        init(self, "dynamics", dynamics)
         init(self, "path", None if path is None else Path(path))
         init(self, "meta", MappingProxyType(dict(meta or {})))
 

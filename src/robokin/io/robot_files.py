@@ -15,7 +15,8 @@ edge. The schema (pydantic, imported lazily) is below; see ``docs/robot-files.md
     base: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # optional
     tool: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # optional
 
-Sections besides the chain (``actuators``, ``geometry``, ``collision``) are read
+Sections besides the chain (``actuators``, ``geometry``, ``collision``,
+``dynamics``) are read
 and written by the functions of :data:`SECTIONS`, an explicit table.
 
 Numbers must be numbers (``a: "12"`` and ``alpha: yes`` are refused), a file holds
@@ -39,7 +40,7 @@ import numpy as np
 
 from robokin._validation import MAX_TRANSLATION
 from robokin.exceptions import ModelError
-from robokin.io import actuator_section, geometry_sections
+from robokin.io import actuator_section, dynamics_section, geometry_sections
 from robokin.io.atomic import write_atomic
 from robokin.io.text_files import MAX_TEXT_BYTES
 from robokin.io.validate import validate_document
@@ -97,6 +98,8 @@ SECTIONS: dict[str, SectionIO] = {
                           geometry_sections.geometry_section),
     "collision": SectionIO(geometry_sections.apply_collision_section,
                            geometry_sections.collision_section),
+    "dynamics": SectionIO(dynamics_section.apply_dynamics_section,
+                          dynamics_section.dynamics_section),
 }
 
 
@@ -185,6 +188,7 @@ def _schema():
         actuators: Any = None
         geometry: Any = None
         collision: Any = None
+        dynamics: Any = None  # link masses and torque limits (io/dynamics_section.py)
         controller: Any = None  # a controller profile (robokin.trajectory.io), kept raw
 
     return RobotFile, Row, Op
@@ -387,7 +391,7 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
 def _state(robot: Robot) -> tuple:
     """What a stored document must still describe: the same objects, by identity."""
     return (robot.chain, robot.geometry, robot.actuators, robot.name, robot.source,
-            robot.actuator_names, robot.actuator_limits)
+            robot.actuator_names, robot.actuator_limits, robot.dynamics)
 
 
 def _document_matches(robot: Robot) -> bool:

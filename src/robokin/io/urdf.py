@@ -600,7 +600,9 @@ def robot_from_urdf(
         name: The robot's name (default: the URDF's ``<robot name>``).
 
     Returns:
-        A :class:`~robokin.robot.Robot` with ``robot.meta["urdf"]`` holding the
+        A :class:`~robokin.robot.Robot` (its ``dynamics`` from the links'
+        ``<inertial>`` and the joints' ``effort``, see
+        :mod:`robokin.io.urdf_inertial`) with ``robot.meta["urdf"]`` holding the
         :class:`UrdfChain`, ``robot.meta["urdf_shapes"]`` the shapes and
         ``robot.meta["urdf_dropped_shapes"]`` one message per shape left out.
 
@@ -632,6 +634,10 @@ def robot_from_urdf(
     )
     if shapes:
         robot = _attach_geometry(robot, shapes, drops)
+    from robokin.io.urdf_inertial import dynamics_from_urdf
+
+    robot = robot.replace(dynamics=dynamics_from_urdf(robot, urdf_robot,
+                                                      info.link_frames, file))
     return robot.replace(meta={**robot.meta,
                                "urdf_dropped_shapes": tuple(drops.messages)})
 

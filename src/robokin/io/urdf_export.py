@@ -11,7 +11,8 @@ dependent joint ``sum_i m_i q_i + c`` becomes ``<mimic>`` joints: one joint when
 single coordinate drives it, otherwise one coaxial joint per coordinate
 (rotations about one axis add). A coordinate that is no chain joint of its own
 gets a zero-length joint on a leaf link so the mimic joints have a master.
-Needs no extra.
+Link mass properties become ``<inertial>`` elements and torque limits ``effort``
+(:mod:`robokin.io.urdf_inertial`). Needs no extra.
 """
 
 from __future__ import annotations
@@ -139,7 +140,8 @@ def urdf_from_robot(
         name: The ``<robot name>`` (default: ``robot.name``).
         velocity: The ``<limit velocity>`` written on every joint [rad/s or m/s]
             (robokin does not model it; URDF requires it).
-        effort: The ``<limit effort>`` written on every joint [N m or N].
+        effort: The ``<limit effort>`` written on every joint [N m or N] whose
+            coordinate has no torque limit in ``robot.dynamics``.
         mesh_uri: Optional ``fn(path) -> str`` rewriting mesh paths (e.g. to
             ``package://`` URIs); default: the path as stored.
 
@@ -150,10 +152,13 @@ def urdf_from_robot(
     """
     chain = robot.chain
     root = ET.Element("robot", {"name": name or robot.name})
+    tl = getattr(robot.dynamics, "torque_limits", None)
+    efforts = {} if tl is None else {
+        j: float(v) for j, v in zip(robot.joint_names, tl) if math.isfinite(v)}
     note = (
         f"written by robokin from '{robot.name}'"
         + (f" ({robot.source})" if robot.source else "")
-        + "; <limit velocity/effort> are placeholders"
+        + "; <limit velocity> and an effort without a torque limit are placeholders"
     )
     while "--" in note:
         note = note.replace("--", "-")
@@ -185,7 +190,7 @@ def urdf_from_robot(
         _origin_el(el, T)
         if jtype != "fixed" and axis is not None:  # every moving joint has its axis
             ET.SubElement(el, "axis", {"xyz": " ".join(_fmt(_clean(v)) for v in axis)})
-            lim = {"effort": _fmt(effort), "velocity": _fmt(velocity)}
+            lim = {"effort": _fmt(efforts.get(jname, effort)), "velocity": _fmt(velocity)}
             if limits is not None and jtype != "continuous":
                 lim["lower"], lim["upper"] = _fmt(limits[0]), _fmt(limits[1])
             ET.SubElement(el, "limit", lim)
@@ -306,6 +311,9 @@ def urdf_from_robot(
                   limits=lim, exact=True)
     if robot.geometry is not None and hasattr(robot.geometry, "shapes"):
         _write_shapes(root, robot.geometry, targets, mesh_uri)
+    from robokin.io.urdf_inertial import write_inertials
+
+    write_inertials(root, robot, targets, _fmt)
     ET.indent(root, space="  ")
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
