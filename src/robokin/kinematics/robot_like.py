@@ -56,9 +56,6 @@ class RobotLike(Protocol):
     def joint_names(self) -> tuple[str, ...]:
         """Names of the independent joint coordinates."""
 
-    def replace(self, **changes: Any) -> RobotLike:
-        """A copy with some attributes replaced (``chain``, ``name``, ...)."""
-
     def ik(self, T: npt.ArrayLike, q_near: npt.ArrayLike | None = None,
            method: Any = "auto", **options: Any) -> SolutionSet:
         """Every IK solution for poses T (..., 4, 4)."""

@@ -148,9 +148,10 @@ def _reduced(robot: RobotLike, idx: list[int], values: tuple[float, ...]) -> Any
         held = ", ".join(f"{robot.joint_names[j]}={v:g}" for j, v in zip(idx, values,
                                                                           strict=True))
         chain = robot.chain.with_fixed(dict(zip(idx, values, strict=True)))
-        return robot.replace(chain=chain, name=f"{robot.name} ({held} held)",
-                             geometry=None, actuators=None, actuator_names=None,
-                             actuator_limits=None)
+        # a bare robot of the same class: the chain and a name, nothing per link or
+        # per joint of the whole arm (geometry, actuators, dynamics, rate limits)
+        make: Any = type(robot)
+        return make(chain, name=f"{robot.name} ({held} held)")
 
     return cached(robot.chain, key, build)
 
