@@ -1,4 +1,5 @@
-"""The Robot: a canonical chain plus its name, source, actuators and geometry.
+"""The Robot: a canonical chain plus its name, source, actuators, geometry and rate
+limits.
 
 A Robot is immutable: assigning or deleting an attribute raises
 :class:`~robokin.exceptions.FrozenError`, its arrays are read-only and ``meta`` is
@@ -21,6 +22,7 @@ from robokin.kinematics import forward
 from robokin.kinematics import jacobian as _jac
 from robokin.model.chain import Chain
 from robokin.model.coupling import AffineMap
+from robokin.model.rate_limits import RateLimits
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.numeric import IKResult
@@ -53,10 +55,13 @@ class Robot:
         geometry: Link and tool shapes (see ``robokin.model.geometry``), or None.
         path: The robot file it was loaded from, or None.
         meta: Free-form extra fields from the robot file (a read-only mapping).
+        rate_limits: Per-joint velocity / acceleration / jerk limits
+            (:class:`~robokin.model.rate_limits.RateLimits`, SI), or None.
     """
 
     __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain",
-                 "geometry", "meta", "name", "path", "source", "__weakref__")
+                 "geometry", "meta", "name", "path", "rate_limits", "source",
+                 "__weakref__")
 
     def __setattr__(self, name: str, value: Any) -> None:
         raise FrozenError("Robot", name, _HOW_TO_CHANGE)
@@ -72,7 +77,8 @@ class Robot:
         return {"name": self.name, "source": self.source, "actuators": self.actuators,
                 "actuator_names": self.actuator_names,
                 "actuator_limits": self.actuator_limits, "geometry": self.geometry,
-                "path": self.path, "meta": dict(self.meta)}
+                "path": self.path, "meta": dict(self.meta),
+                "rate_limits": self.rate_limits}
 
     def __init__(
         self,
@@ -86,6 +92,7 @@ class Robot:
         geometry: Any = None,
         path: str | Path | None = None,
         meta: Mapping[str, Any] | None = None,
+        rate_limits: RateLimits | None = None,
     ) -> None:
         init = object.__setattr__
         init(self, "chain", chain)
@@ -121,6 +128,12 @@ class Robot:
         init(self, "geometry", geometry)
         init(self, "path", None if path is None else Path(path))
         init(self, "meta", MappingProxyType(dict(meta or {})))
+        if rate_limits is not None and (not isinstance(rate_limits, RateLimits)
+                                        or rate_limits.n != chain.n):
+            raise InputError(
+                "rate_limits",
+                f"expected RateLimits for {chain.n} joints, got {rate_limits!r}")
+        init(self, "rate_limits", rate_limits)
 
     # ------------------------------------------------------------------ building
     @classmethod
