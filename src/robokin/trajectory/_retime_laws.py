@@ -26,9 +26,8 @@ constant, so ``x`` is linear in ``s`` and the time across an interval is exactly
 ``2 ds / (sd_i + sd_{i+1})``. Where the optimal profile switches from one active
 constraint to another inside a grid interval (accelerating to cruising, cruising
 to braking), the node values are exact but their chord cuts the corner; robokin
-inserts the corner itself (the intersection of the neighbouring intervals' lines)
-when both neighbours are straight, which makes a rest-to-rest move along a
-straight joint path exact to rounding whatever the grid.
+inserts the corners themselves (:func:`_insert_switches`), which makes a
+rest-to-rest move along a straight joint path exact to rounding whatever the grid.
 """
 
 from __future__ import annotations
@@ -45,8 +44,6 @@ from robokin.trajectory._retime_path import SplinePath
 __all__ = ["ConstAccelLaw", "RuckigLaw", "StretchedLaw", "TimeLaw", "jerk_limited_law",
            "topp_ra_law"]
 
-#: A kink is a change of slope this many times larger than its neighbours' own.
-_KINK_RATIO = 20.0
 
 Derivatives = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
@@ -279,58 +276,95 @@ def _stage_rows(constraints: list[Any], path: SplinePath, grid: np.ndarray
 
 
 def _forward_pass(A: np.ndarray, B: np.ndarray, C: np.ndarray, x_cap: np.ndarray,
-                  K: np.ndarray, grid: np.ndarray) -> np.ndarray:
+                  K: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Greedy forward pass (Pham & Pham 2018, Alg. 1): the largest admissible ``u``
     from each stage, clipped into the next controllable set, without a safety shave.
+
+    Returns:
+        ``x`` (N + 1,) and, per interval (N,), what set its end: 0 the largest
+        acceleration, 1 the speed cap, 2 the controllable set (braking).
     """
     n = grid.size
     ds = np.diff(grid)
     x = np.zeros(n)
+    why = np.zeros(n - 1, np.int8)
     pos, neg = A > 1e-300, A < -1e-300
     for i in range(n - 1):
         rhs = C[i] - B[i] * x[i]
         p, q = pos[i], neg[i]
         u_hi = float((rhs[p] / A[i, p]).min()) if p.any() else 1e300
         u_lo = float((rhs[q] / A[i, q]).max()) if q.any() else -1e300
-        nxt = min(x[i] + 2.0 * ds[i] * u_hi, K[i + 1, 1], x_cap[i + 1])
-        x[i + 1] = max(nxt, x[i] + 2.0 * ds[i] * u_lo, K[i + 1, 0], 0.0)
+        reach = x[i] + 2.0 * ds[i] * u_hi
+        cap = min(K[i + 1, 1], x_cap[i + 1])
+        why[i] = 0 if reach <= cap else (
+            2 if K[i + 1, 1] < x_cap[i + 1] * (1.0 - 1e-9) else 1)
+        x[i + 1] = max(min(reach, cap), x[i] + 2.0 * ds[i] * u_lo, K[i + 1, 0], 0.0)
     x[-1] = 0.0
-    return x
+    return x, why
 
 
-def _insert_corners(s: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Put the switch points of ``x(s)`` that fall inside a grid interval on a node.
+def _insert_switches(s: np.ndarray, x: np.ndarray, why: np.ndarray, A: np.ndarray,
+                     B: np.ndarray, C: np.ndarray, x_cap: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Put the switch points of ``x(s)`` that fall inside a grid interval on nodes.
 
-    Interval i (1 <= i <= N - 2) has a corner when the slope of interval i-1 is
-    larger than that of interval i+1 by :data:`_KINK_RATIO` times the change of
-    slope next to it (a bang-bang switch, not a curve): the lines through
-    ``(s_i, x_i)`` with slope i-1 and through ``(s_{i+1}, x_{i+1})`` with slope
-    i+1 then meet inside the interval, above the chord.
+    A switch (from accelerating to cruising or braking, from cruising to braking)
+    lies in the first interval whose end was set by another bound than the
+    interval before (``why``; accelerating before the first), or in the first or
+    last interval. Within it the
+    optimal ``x(s)`` is (to first order) the lowest of three lines: accelerating at
+    the largest admissible ``u`` from ``(s_i, x_i)``, braking at the most negative
+    ``u`` into ``(s_{i+1}, x_{i+1})``, and the speed cap. Each is at least the
+    chord at both ends, so their lower envelope is never below it; its corners
+    become nodes. Along a stretch that follows one constraint nothing changes.
     """
-    slope = np.diff(x) / np.diff(s)
-    n = slope.size
     add_s, add_x = [], []
-    for i in range(1, n - 1):
-        left, right = slope[i - 1], slope[i + 1]
-        jump = left - right
-        if jump <= 0:
-            continue
-        calm = (abs(slope[i - 1] - slope[i - 2]) if i >= 2 else 0.0) + (
-            abs(slope[i + 2] - slope[i + 1]) if i + 2 < n else 0.0)
-        if jump <= _KINK_RATIO * calm + 1e-12 * (abs(left) + abs(right)):
-            continue
+    switch = np.flatnonzero(why != np.concatenate([[0], why[:-1]]))
+    switch = np.union1d(switch, [0, why.size - 1])  # the ends, always
+    for i in switch:
         h = s[i + 1] - s[i]
-        d = (x[i + 1] - x[i] - right * h) / jump
-        if 0.0 < d < h:
-            xc = x[i] + left * d
-            if xc > x[i] + (x[i + 1] - x[i]) * d / h:  # above the chord
+        lines = []
+        f = 2.0 * _u_bound(A, B, C, i, x[i], True)
+        if math.isfinite(f):
+            lines.append((x[i], f))
+        b = 2.0 * _u_bound(A, B, C, i + 1, x[i + 1], False)
+        if -math.inf < b < 0.0:
+            lines.append((x[i + 1] - b * h, b))
+        if np.isfinite(x_cap[i]) and np.isfinite(x_cap[i + 1]):
+            lines.append((x_cap[i], (x_cap[i + 1] - x_cap[i]) / h))
+        ds = []
+        for k, (x0, m0) in enumerate(lines):
+            for x1, m1 in lines[k + 1:]:
+                if m0 != m1:
+                    d = (x1 - x0) / (m0 - m1)
+                    if 1e-9 * h < d < (1.0 - 1e-9) * h:
+                        ds.append(d)
+        last = -math.inf
+        for d in sorted(ds):
+            if d - last < 1e-9 * h:  # lines meeting in one point (an apex on the cap)
+                continue
+            last = d
+            env = min(x0 + m * d for x0, m in lines)
+            chord = x[i] + (x[i + 1] - x[i]) * d / h
+            if env - chord > 1e-12 * env:
                 add_s.append(s[i] + d)
-                add_x.append(xc)
+                add_x.append(env)
     if not add_s:
         return s, x
     s2 = np.concatenate([s, add_s])
     order = np.argsort(s2, kind="stable")
     return s2[order], np.concatenate([x, add_x])[order]
+
+
+def _u_bound(A: np.ndarray, B: np.ndarray, C: np.ndarray, i: int, x: float,
+             upper: bool) -> float:
+    """The largest (or smallest) admissible path acceleration at stage i and ``x``."""
+    rhs = C[i] - B[i] * x
+    sel = A[i] > 1e-300 if upper else A[i] < -1e-300
+    if not sel.any():
+        return math.inf if upper else -math.inf
+    vals = rhs[sel] / A[i, sel]
+    return float(vals.min() if upper else vals.max())
 
 
 def topp_ra_law(path: SplinePath, v_max: np.ndarray, a_max: np.ndarray, *,
@@ -371,12 +405,12 @@ def topp_ra_law(path: SplinePath, v_max: np.ndarray, a_max: np.ndarray, *,
                                       _tool_speed_bound(robot, tool_speed)))
     algo = toppra.algorithm.TOPPRA(cons, path, gridpoints=grid, solver_wrapper="seidel")
     K = algo.compute_controllable_sets(0.0, 0.0)
-    if np.isnan(K).any() or K[0, 0] > 0:
+    if np.isnan(K).any() or K[0, 0] > 1e-9 * max(1.0, float(K[:, 1].max())):
         raise RobokinError("toppra found the path not controllable (a numerical "
                            "failure); try other grid_points")
     A, B, C, x_cap = _stage_rows(cons, path, grid)
-    x = _forward_pass(A, B, C, x_cap, K, grid)
-    s, x = _insert_corners(grid, x)
+    x, why = _forward_pass(A, B, C, x_cap, K, grid)
+    s, x = _insert_switches(grid, x, why, A, B, C, x_cap)
     return ConstAccelLaw(s, x, "toppra")
 
 
