@@ -110,7 +110,7 @@ def _per_joint(value: Any, kind: str, arg: str, robot: Any, n: int,
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
         raise InputError(arg, f"every {kind} limit must be a positive finite number; "
-                         f"got {out[k]!r} for joint {names[k]}")
+                         f"got {float(out[k])!r} for joint {names[k]}")
     return out
 
 
