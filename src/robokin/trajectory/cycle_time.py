@@ -16,8 +16,10 @@ cruises, one joint is at its speed limit (or the tool at its speed). That joint
 and that limit are the *bottleneck* of the moment: raising that limit (or
 changing the path there) is the only thing that shortens the cycle there.
 :attr:`CycleTimeReport.bottlenecks` lists each stretch of samples where a joint
-is within ``active_tol`` (0.1 %) of a limit; per section, ``limiting`` names the
-one active longest. A slower cycle time stretches every move by one factor ``c``,
+is within ``active_tol`` (0.1 %) of a limit (a speed ratio, the square root of an
+acceleration ratio, the cube root of a jerk ratio, each before the section's own
+final-check slow-down, :attr:`SectionTiming.stretch`); per section, ``limiting``
+names the one active longest. A slower cycle time stretches every move by one factor ``c``,
 so every speed has the margin ``1 - 1/c``, every acceleration ``1 - 1/c^2`` and
 every jerk ``1 - 1/c^3`` to its limit at the bottleneck (and more elsewhere);
 :attr:`CycleTimeReport.margins` gives, per joint, ``1 - peak / limit``.
@@ -126,15 +128,23 @@ def _columns(ratios: dict[str, np.ndarray], names: tuple[str, ...]
 
 
 def _bottlenecks(result: RetimeResult, ratios: dict[str, np.ndarray], tol: float
-                 ) -> tuple[tuple[Bottleneck, ...], np.ndarray, list[tuple[str, int, str]]]:
-    """Stretches where a limit is active, and the dominant column per sample."""
+                 ) -> tuple[tuple[Bottleneck, ...], np.ndarray,
+                            list[tuple[str, int, str]], dict[str, np.ndarray]]:
+    """Stretches where a limit is active, the dominant column per sample, and the
+    active samples per kind (shaped as ``ratios``)."""
     tr = result.trajectory
     ratio, what = _columns(ratios, tr.names())
-    active = ratio >= 1.0 - tol
-    dominant = np.where(active.any(axis=1), np.argmax(ratio, axis=1), -1)
     section_of = np.zeros(tr.t.size, int)
     for k, s in enumerate(result.sections):
         section_of[(tr.t >= s.t_start) & (tr.t <= s.t_end)] = k
+    # Compare the time law before the final check's slow-down of its section (a
+    # stretch c lowers speeds by 1/c, accelerations by 1/c^2, jerks by 1/c^3): a
+    # section slowed by 0.1 % to clear a sample keeps its bottleneck.
+    power = np.array([{"acceleration": 2.0, "jerk": 3.0}.get(k, 1.0) for k, _, _ in what])
+    stretch = np.array([s.stretch for s in result.sections])[section_of]
+    linear = ratio ** (1.0 / power) * stretch[:, None]
+    active = linear >= 1.0 - tol
+    dominant = np.where(active.any(axis=1), np.argmax(linear, axis=1), -1)
     out = []
     for c in np.flatnonzero(active.any(axis=0)):
         col = active[:, c].astype(np.int8)
@@ -144,7 +154,13 @@ def _bottlenecks(result: RetimeResult, ratios: dict[str, np.ndarray], tol: float
             out.append(Bottleneck(kind, j, name, result.sections[section_of[a]].label,
                                   float(tr.t[a]), float(tr.t[b])))
     out.sort(key=lambda x: (x.t_start, x.joint, x.kind))
-    return tuple(out), dominant, what
+    by_kind: dict[str, np.ndarray] = {}
+    first = 0
+    for kind, r in ratios.items():
+        width = 1 if r.ndim == 1 else r.shape[1]
+        by_kind[kind] = active[:, first:first + width].reshape(r.shape)
+        first += width
+    return tuple(out), dominant, what, by_kind
 
 
 def _summaries(result: RetimeResult, slower: RetimeResult | None,
@@ -183,6 +199,7 @@ class CycleTimeReport:
         slower: The same path retimed to ``cycle_time``, or None.
         cycle_time: The cycle time asked for [s], or None.
         ratios: :func:`limit_ratios` of ``minimum``.
+        active: Per kind, where a limit is active (shaped as ``ratios``).
         bottlenecks: Every stretch where a limit is active, by time.
         sections: One :class:`SectionSummary` per move and dwell.
         margins: ``1 - peak / limit`` per kind (per joint) of ``slower``, or None.
@@ -193,6 +210,7 @@ class CycleTimeReport:
     slower: RetimeResult | None
     cycle_time: float | None
     ratios: dict[str, np.ndarray]
+    active: dict[str, np.ndarray]
     bottlenecks: tuple[Bottleneck, ...]
     sections: tuple[SectionSummary, ...]
     margins: dict[str, np.ndarray] | None
@@ -207,6 +225,14 @@ class CycleTimeReport:
     def source_duration(self) -> float | None:
         """The planned (source) duration [s], None for a bare path."""
         return self.minimum.source_duration
+
+    def with_cycle_time(self, cycle_time: float) -> CycleTimeReport:
+        """The same report with the path also retimed to ``cycle_time`` [s].
+
+        Raises:
+            InputError: ``cycle_time`` below the minimum (argument ``cycle_time``).
+        """
+        return _report(self.minimum, cycle_time, self.active_tol)
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready summary (SI units; joint names as given)."""
@@ -282,12 +308,16 @@ def cycle_time_report(
     if "round_to_dt" in retime_options:
         raise InputError("round_to_dt", "the report is about the exact minimum; "
                          "retime with round_to_dt=True separately")
-    minimum = retime_detailed(robot, traj, **retime_options)
+    return _report(retime_detailed(robot, traj, **retime_options), cycle_time,
+                   float(active_tol))
+
+
+def _report(minimum: RetimeResult, cycle_time: float | None, active_tol: float
+            ) -> CycleTimeReport:
     slower = None if cycle_time is None else minimum.slowed(cycle_time)
     ratios = limit_ratios(minimum)
-    bottlenecks, dominant, what = _bottlenecks(minimum, ratios, float(active_tol))
+    bottlenecks, dominant, what, active = _bottlenecks(minimum, ratios, active_tol)
     sections = _summaries(minimum, slower, dominant, what)
     return CycleTimeReport(minimum, slower, None if cycle_time is None else
-                           float(cycle_time), ratios, bottlenecks, sections,
-                           None if slower is None else _margins(slower),
-                           float(active_tol))
+                           float(cycle_time), ratios, active, bottlenecks, sections,
+                           None if slower is None else _margins(slower), active_tol)

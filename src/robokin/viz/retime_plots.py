@@ -72,11 +72,11 @@ def plot_bottlenecks(report: Any, *, path: str | Path | None = None,
     starts = np.array([s.t_start for s in fast.sections])
     for c, kind in enumerate(kinds):
         limit = lim.get(kind) if hasattr(lim, "get") else getattr(lim, kind)
-        ratio = report.ratios[kind]
+        active = report.active[kind]
         for j in range(n):
             ax = axes[j, c]
             s = scale[j]
-            at = ratio[:, j] >= 1.0 - report.active_tol
+            at = active[:, j]
             ax.fill_between(x_fast, 0, 1, where=at, color="tab:red", alpha=0.15,
                             transform=ax.get_xaxis_transform(), linewidth=0)
             ax.plot(x_fast, _values(fast, kind)[:, j] * s, color="tab:blue", lw=1.0,
