@@ -304,7 +304,7 @@ def _forward_pass(A: np.ndarray, B: np.ndarray, C: np.ndarray, x_cap: np.ndarray
 
 
 def _insert_switches(s: np.ndarray, x: np.ndarray, why: np.ndarray, A: np.ndarray,
-                     B: np.ndarray, C: np.ndarray, x_cap: np.ndarray
+                     B: np.ndarray, C: np.ndarray, x_cap: np.ndarray, feasible: Any
                      ) -> tuple[np.ndarray, np.ndarray]:
     """Put the switch points of ``x(s)`` that fall inside a grid interval on nodes.
 
@@ -316,12 +316,15 @@ def _insert_switches(s: np.ndarray, x: np.ndarray, why: np.ndarray, A: np.ndarra
     the largest admissible ``u`` from ``(s_i, x_i)``, braking at the most negative
     ``u`` into ``(s_{i+1}, x_{i+1})``, and the speed cap. Each is at least the
     chord at both ends, so their lower envelope is never below it; its corners
-    become nodes. Along a stretch that follows one constraint nothing changes.
+    become nodes, when every limit holds at them (``feasible(s, x, u)``, with the
+    path accelerations on both sides; on a curved path the lines are only first
+    order, and a corner that would overshoot is left out). Along a stretch that
+    follows one constraint nothing changes.
     """
     add_s, add_x = [], []
     switch = np.flatnonzero(why != np.concatenate([[0], why[:-1]]))
     switch = np.union1d(switch, [0, why.size - 1])  # the ends, always
-    for i in switch:
+    for i in switch.tolist():
         h = s[i + 1] - s[i]
         lines = []
         f = 2.0 * _u_bound(A, B, C, i, x[i], True)
@@ -337,18 +340,31 @@ def _insert_switches(s: np.ndarray, x: np.ndarray, why: np.ndarray, A: np.ndarra
             for x1, m1 in lines[k + 1:]:
                 if m0 != m1:
                     d = (x1 - x0) / (m0 - m1)
-                    if 1e-9 * h < d < (1.0 - 1e-9) * h:
+                    # a corner closer to a node gains nothing (< 1e-6 of the
+                    # interval's time) and its tiny interval would carry a
+                    # path acceleration spoilt by rounding
+                    if 1e-6 * h < d < (1.0 - 1e-6) * h:
                         ds.append(d)
         last = -math.inf
+        new_d, new_x = [], []
         for d in sorted(ds):
-            if d - last < 1e-9 * h:  # lines meeting in one point (an apex on the cap)
+            if d - last < 1e-6 * h:  # lines meeting in one point (an apex on the cap)
                 continue
             last = d
             env = min(x0 + m * d for x0, m in lines)
             chord = x[i] + (x[i + 1] - x[i]) * d / h
             if env - chord > 1e-12 * env:
-                add_s.append(s[i] + d)
-                add_x.append(env)
+                new_d.append(d)
+                new_x.append(env)
+        if not new_d:
+            continue
+        nd = np.concatenate([[0.0], new_d, [h]])
+        nx = np.concatenate([[x[i]], new_x, [x[i + 1]]])
+        u = np.diff(nx) / (2.0 * np.diff(nd))
+        ss = s[i] + nd[1:-1]
+        if feasible(ss, nx[1:-1], u[:-1]).all() and feasible(ss, nx[1:-1], u[1:]).all():
+            add_s += list(ss)
+            add_x += list(nx[1:-1])
     if not add_s:
         return s, x
     s2 = np.concatenate([s, add_s])
@@ -378,7 +394,8 @@ def topp_ra_law(path: SplinePath, v_max: np.ndarray, a_max: np.ndarray, *,
         a_max: Joint acceleration limits [rad/s^2 or m/s^2], shape (n,).
         robot: For the tool speed (its Jacobian), else None.
         tool_speed: Largest tool-point speed [m/s], or None.
-        grid_points: Grid intervals (default: one per knot, 100 .. 4000).
+        grid_points: Grid intervals, uniform (default: the spline's knots, where
+            ``q''`` peaks, and at least 100).
 
     Returns:
         A :class:`ConstAccelLaw`.
@@ -394,8 +411,12 @@ def topp_ra_law(path: SplinePath, v_max: np.ndarray, a_max: np.ndarray, *,
         Robotics 34(3), 645-659, 2018.
     """
     toppra = _toppra()
-    N = grid_points or int(np.clip(path.knots.size, 100, 4000))
-    grid = np.linspace(0.0, path.length, N + 1)
+    if grid_points:
+        grid = np.linspace(0.0, path.length, grid_points + 1)
+    else:  # the knots (where q'' peaks: it is linear between them), at least 100
+        grid = np.union1d(path.knots, np.linspace(0.0, path.length, 101))
+        grid = grid[np.concatenate([[True], np.diff(grid) > 1e-9 * path.length])]
+        grid[-1] = path.length
     tc = toppra.constraint
     cons = [_speed_constraint(toppra, path.dof, _joint_speed_bound(v_max)),
             tc.JointAccelerationConstraint(
@@ -410,7 +431,18 @@ def topp_ra_law(path: SplinePath, v_max: np.ndarray, a_max: np.ndarray, *,
                            "failure); try other grid_points")
     A, B, C, x_cap = _stage_rows(cons, path, grid)
     x, why = _forward_pass(A, B, C, x_cap, K, grid)
-    s, x = _insert_switches(grid, x, why, A, B, C, x_cap)
+    speed_bounds = [_joint_speed_bound(v_max)] + (
+        [] if tool_speed is None else [_tool_speed_bound(robot, tool_speed)])
+
+    def feasible(s: np.ndarray, x: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Every limit at path points ``s`` with ``sd^2 = x`` and ``sdd = u``."""
+        qdd = path(s, 2) * x[:, None] + path(s, 1) * u[:, None]
+        ok: np.ndarray = (np.abs(qdd) <= a_max * (1 + 1e-12)).all(axis=1)
+        for bound in speed_bounds:
+            ok &= x <= bound(path, s) * (1 + 1e-12)
+        return ok
+
+    s, x = _insert_switches(grid, x, why, A, B, C, x_cap, feasible)
     return ConstAccelLaw(s, x, "toppra")
 
 

@@ -572,8 +572,8 @@ def retime(
         round_to_dt: Stretch the motion so the duration is a whole number of
             ``dt`` (every step exactly ``dt``); default: the exact minimum time,
             with a shorter last step.
-        grid_points: TOPP-RA grid intervals per stretch (default: one per knot,
-            100 .. 4000).
+        grid_points: TOPP-RA grid intervals per stretch, uniform (default: the
+            path's spline knots, at least 100).
         max_samples: Most samples the result may hold (default
             :data:`robokin.trajectory.joint.MAX_SAMPLES`).
 
