@@ -47,8 +47,9 @@ from robokin.exceptions import InputError
 
 __all__ = ["DemoResult", "plan_press_loading", "run_demo"]
 
-# AUBO-i5 published joint speed limit (joints 1-6: 150 deg/s); the acceleration cap
-# is this demo's own choice for smooth motion, not a manufacturer figure.
+# AUBO-i5 published joint speed limit (150 deg/s on joints 1-3, 180 on 4-6: the demo
+# caps all six at 150); the acceleration cap is this demo's own choice for smooth
+# motion, not a manufacturer figure (the robot file's rate_limits hold AUBO's).
 V_MAX = math.radians(150.0)
 A_MAX = math.radians(300.0)
 DT = 0.005

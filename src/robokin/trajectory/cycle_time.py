@@ -107,7 +107,7 @@ def limit_ratios(result: RetimeResult) -> dict[str, np.ndarray]:
     if lim.jerk is not None:
         out["jerk"] = np.abs(result.jerk) / lim.jerk
     if lim.tool_speed is not None:
-        robot = result._plan.robot
+        robot = result.robot
         v = np.einsum("kij,kj->ki", robot.jacobian(tr.q)[..., :3, :], tr.qd)
         out["tool_speed"] = np.linalg.norm(v, axis=1) / lim.tool_speed
     return out

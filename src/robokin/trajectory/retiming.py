@@ -224,6 +224,11 @@ class RetimeResult:
     _plan: _Plan = field(repr=False)
 
     @property
+    def robot(self) -> Any:
+        """The robot it was retimed for."""
+        return self._plan.robot
+
+    @property
     def duration(self) -> float:
         """The cycle time [s]: the motion and the kept dwells."""
         return self.trajectory.duration
