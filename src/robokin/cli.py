@@ -39,10 +39,12 @@ class DomainFailure(Exception):
 
 
 def cell(value: Any, limit: int = 60, *, markup: bool = True) -> str:
-    """Text for a table cell or a line of output: at most ``limit`` characters,
-    rich markup escaped unless ``markup=False`` (for ``print(..., markup=False)``):
-    a name or a source from a file is never markup, and never a megabyte for rich
-    to wrap."""
+    """Text for a table cell or a line of output, safe to print.
+
+    At most ``limit`` characters, rich markup escaped unless ``markup=False`` (for
+    ``print(..., markup=False)``): a name or a source from a file is never markup,
+    and never a megabyte for rich to wrap.
+    """
     from rich.markup import escape
 
     text = str(value)
@@ -239,7 +241,7 @@ def _split_debug(args: list[str]) -> tuple[list[str], bool]:
     return head + args[end:], len(head) != end
 
 
-def _one_line(text: str) -> str:
+def _one_line(text: object) -> str:
     return " ".join(str(text).split())
 
 
@@ -258,9 +260,10 @@ def main(argv: list[str] | None = None) -> int:
     from robokin.exceptions import RobokinError, UnreachableError
 
     # click's classes as this typer raises them (recent typer vendors click)
+    # (found at run time, so their attributes are unknown to the type checker)
     mro = typer.BadParameter.__mro__
-    click_error = next(c for c in mro if c.__name__ == "ClickException")
-    usage_error = next(c for c in mro if c.__name__ == "UsageError")
+    click_error: type[Any] = next(c for c in mro if c.__name__ == "ClickException")
+    usage_error: type[Any] = next(c for c in mro if c.__name__ == "UsageError")
 
     _register_extra_commands()
     args, debug = _split_debug(list(sys.argv[1:] if argv is None else argv))

@@ -9,16 +9,19 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from robokin.cli import DomainFailure, app, cell, json_text
 
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
 __all__ = ["read_trajectory_csv"]
 
 
-def read_trajectory_csv(path: str | Path, robot: Any = None) -> tuple[Any, Any]:
+def read_trajectory_csv(path: str | Path, robot: Robot | None = None) -> tuple[Any, Any]:
     """Times (m,) [s] and joints (m, n) [SI] from a trajectory CSV.
 
     With ``robot`` the joint columns are matched to its joint names by header

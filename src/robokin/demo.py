@@ -39,11 +39,17 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robokin.exceptions import InputError
+
+if TYPE_CHECKING:
+    from robokin.collision.check import CollisionReport
+    from robokin.collision.scene import Scene
+    from robokin.robot import Robot
+    from robokin.trajectory.samples import Trajectory
 
 __all__ = ["DemoResult", "plan_press_loading", "run_demo"]
 
@@ -77,11 +83,11 @@ class DemoResult:
     summary: dict[str, Any]
     files: dict[str, Path] = field(default_factory=dict)
     trajectory: Any = None
-    report: Any = None
+    report: CollisionReport | None = None
 
 
 def plan_press_loading(
-    robot: Any, scene: Any, *, dt: float = DT, progress: Any = None
+    robot: Robot, scene: Scene, *, dt: float = DT, progress: Any = None
 ) -> tuple[Any, list[dict[str, Any]]]:
     """Plan the press-loading motion.
 
@@ -107,7 +113,7 @@ def plan_press_loading(
     )
     via: list[dict[str, Any]] = []
     for label, kind, pose, duration in PLAN:
-        if kind == "dwell":
+        if pose is None:  # a dwell: no target
             path.dwell(duration, label=label)
             continue
         T = scene.tcp_pose(pose)
@@ -187,7 +193,7 @@ def _png_data(path: Path) -> str:
     return base64.b64encode(path.read_bytes()).decode("ascii")
 
 
-def _closest_pair_distances(report: Any, k: int = 6) -> dict[str, np.ndarray]:
+def _closest_pair_distances(report: CollisionReport, k: int = 6) -> dict[str, np.ndarray]:
     """Exact distance at every sample [m] of the ``k`` closest body pairs."""
     out = {}
     for pair in report.pairs[:k]:
@@ -195,7 +201,7 @@ def _closest_pair_distances(report: Any, k: int = 6) -> dict[str, np.ndarray]:
     return out
 
 
-def _write_distance_csv(traj: Any, dist: dict[str, np.ndarray], path: Path) -> Path:
+def _write_distance_csv(traj: Trajectory, dist: dict[str, np.ndarray], path: Path) -> Path:
     """Time, the closest pairs' distances and their minimum, in mm."""
     from robokin.io.atomic import write_atomic
 
@@ -207,12 +213,15 @@ def _write_distance_csv(traj: Any, dist: dict[str, np.ndarray], path: Path) -> P
     return write_atomic(path, "\n".join(lines) + "\n")
 
 
-def _plot_press_views(traj: Any, scene: Any, report: Any, path: Path) -> Path:
+def _plot_press_views(traj: Trajectory, scene: Scene, report: CollisionReport,
+                      path: Path) -> Path:
     """The tool path inside the press: side view (x-z) and top view (x-y)."""
     from matplotlib.patches import Rectangle
 
     from robokin.viz.plots import _figure, save_figure
 
+    if traj.pose is None:  # the planner stores them: a changed plan must too
+        raise InputError("trajectory", "has no tool poses to draw")
     p = traj.pose[:, :3, 3] * 1000.0
     fig = _figure((11.0, 5.0))
     views = ((0, 2, "side view (x-z)", "z [mm]"), (0, 1, "top view (x-y)", "y [mm]"))
@@ -273,9 +282,9 @@ def _plot_press_views(traj: Any, scene: Any, report: Any, path: Path) -> Path:
 
 
 def _summary(
-    robot: Any,
-    traj: Any,
-    report: Any,
+    robot: Robot,
+    traj: Trajectory,
+    report: CollisionReport,
     limits: Any,
     via: list,
     clearance: float,

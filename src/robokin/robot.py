@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, TypeGuard
 
 import numpy as np
 import numpy.typing as npt
@@ -27,6 +27,7 @@ from robokin.model.rate_limits import RateLimits
 if TYPE_CHECKING:
     from robokin.kinematics.ik.numeric import IKResult
     from robokin.kinematics.ik.solutions import SolutionSet
+    from robokin.model.geometry import RobotGeometry
 
 __all__ = ["Robot"]
 
@@ -36,10 +37,37 @@ _HOW_TO_CHANGE = ("make a changed copy with robot.replace(...), robot.with_tool(
                   "robot.with_base(T)")
 
 
-def _is_frozen_limits(lim: Any, m: int | None) -> bool:
+def _is_frozen_limits(lim: object, m: int) -> TypeGuard[npt.NDArray[np.float64]]:
     """True for limits a Robot already checked and froze (kept, not copied)."""
     return (type(lim) is np.ndarray and lim.dtype == np.float64 and not lim.flags.writeable
             and lim.shape == (m, 2) and not np.isnan(lim).any())
+
+
+def _actuator_fields(
+    actuators: AffineMap | None,
+    names: Sequence[str] | None,
+    limits: npt.ArrayLike | None,
+) -> tuple[tuple[str, ...] | None, npt.NDArray[np.float64] | None]:
+    """The motor names and frozen motor limits (m, 2) of an actuator map, or Nones."""
+    if actuators is None:
+        if limits is not None:
+            raise InputError("actuator_limits", "given without an actuator map")
+        return None, None
+    m = actuators.n_in
+    names = tuple(names or (f"motor{i + 1}" for i in range(m)))
+    if limits is None:
+        lim = np.tile([-np.inf, np.inf], (m, 1))
+    elif _is_frozen_limits(limits, m):
+        return names, limits
+    else:
+        lim = np.array(limits, dtype=float)
+        if lim.shape != (m, 2) or np.isnan(lim).any():
+            raise InputError(
+                "actuator_limits",
+                f"expected shape ({m}, 2) without NaN for {m} motors, got {lim.shape}",
+            )
+    lim.setflags(write=False)
+    return names, lim
 
 
 class Robot:
@@ -62,15 +90,28 @@ class Robot:
     __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain",
                  "geometry", "meta", "name", "path", "rate_limits", "source",
                  "__weakref__")
+    chain: Chain
+    name: str
+    source: str
+    actuators: AffineMap | None
+    actuator_names: tuple[str, ...] | None
+    actuator_limits: npt.NDArray[np.float64] | None
+    geometry: RobotGeometry | None
+    path: Path | None
+    meta: Mapping[str, Any]
+    rate_limits: RateLimits | None
 
     def __setattr__(self, name: str, value: Any) -> None:
+        """Refuse: a Robot is immutable (raises FrozenError)."""
         raise FrozenError("Robot", name, _HOW_TO_CHANGE)
 
     def __delattr__(self, name: str) -> None:
+        """Refuse: a Robot is immutable (raises FrozenError)."""
         raise FrozenError("Robot", name, _HOW_TO_CHANGE)
 
     def __reduce__(self) -> tuple:
         # pickle and copy rebuild through __init__ (slots cannot be set directly)
+        """Pickle and copy rebuild through __init__ (slots cannot be set directly)."""
         return (_rebuild, (self.chain, self._fields()))
 
     def _fields(self) -> dict[str, Any]:
@@ -89,11 +130,12 @@ class Robot:
         actuators: AffineMap | None = None,
         actuator_names: Sequence[str] | None = None,
         actuator_limits: npt.ArrayLike | None = None,
-        geometry: Any = None,
+        geometry: RobotGeometry | None = None,
         path: str | Path | None = None,
         meta: Mapping[str, Any] | None = None,
         rate_limits: RateLimits | None = None,
     ) -> None:
+        """Check and freeze the parts (see the class docstring for each)."""
         init = object.__setattr__
         init(self, "chain", chain)
         init(self, "name", name)
@@ -105,26 +147,9 @@ class Robot:
                 f"but the robot has {chain.n} joints",
             )
         init(self, "actuators", actuators)
-        m = None if actuators is None else actuators.n_in
-        init(self, "actuator_names", (
-            None if actuators is None
-            else tuple(actuator_names or (f"motor{i + 1}" for i in range(m)))
-        ))
-        if actuator_limits is None and actuators is not None:
-            actuator_limits = np.tile([-np.inf, np.inf], (m, 1))
-            actuator_limits.setflags(write=False)
-        elif actuator_limits is not None and not _is_frozen_limits(actuator_limits, m):
-            lim = np.array(actuator_limits, dtype=float)
-            if actuators is None or lim.shape != (m, 2) or np.isnan(lim).any():
-                raise InputError(
-                    "actuator_limits",
-                    f"expected shape ({m}, 2) without NaN for {m} motors, got {lim.shape}"
-                    if actuators is not None
-                    else "given without an actuator map",
-                )
-            lim.setflags(write=False)
-            actuator_limits = lim
-        init(self, "actuator_limits", actuator_limits)
+        names, limits = _actuator_fields(actuators, actuator_names, actuator_limits)
+        init(self, "actuator_names", names)
+        init(self, "actuator_limits", limits)
         init(self, "geometry", geometry)
         init(self, "path", None if path is None else Path(path))
         init(self, "meta", MappingProxyType(dict(meta or {})))
@@ -255,6 +280,7 @@ class Robot:
         return self.chain.tool
 
     def __repr__(self) -> str:
+        """A short summary: the name and the number of joints."""
         return f"Robot(name={self.name!r}, n={self.n})"
 
     # --------------------------------------------------------------- kinematics
@@ -428,17 +454,21 @@ class Robot:
             return phi.copy()
         return self.actuators.apply(phi)
 
-    def within_actuator_limits(self, phi: npt.ArrayLike, tol: float = 1e-9) -> np.ndarray:
+    def within_actuator_limits(
+        self, phi: npt.ArrayLike, tol: float = 1e-9
+    ) -> npt.NDArray[np.bool_] | np.bool_:
         """(...) bool: every motor coordinate (..., m) inside its limits (tolerance ``tol``)."""
         from robokin._validation import check_joints
 
         m = self.n if self.actuators is None else self.actuators.n_in
         phi = check_joints(phi, m, "phi")
-        lim = self.limits if self.actuators is None else self.actuator_limits
+        lim = self.limits if self.actuator_limits is None else self.actuator_limits
         return ((phi >= lim[:, 0] - tol) & (phi <= lim[:, 1] + tol)).all(axis=-1)
 
     # ------------------------------------------------------------------- checks
-    def within_limits(self, q: npt.ArrayLike, tol: float = 1e-9) -> np.ndarray:
+    def within_limits(
+        self, q: npt.ArrayLike, tol: float = 1e-9
+    ) -> npt.NDArray[np.bool_] | np.bool_:
         """(...) bool: every coordinate inside its limits (with tolerance ``tol``)."""
         from robokin._validation import check_joints
 

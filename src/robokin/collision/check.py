@@ -90,7 +90,7 @@ class PairMinimum(NamedTuple):
     body_a: str
     body_b: str
     distance: float
-    index: int
+    index: int  # type: ignore[assignment]  # the field (public API) shadows tuple.index
     t: float
     kind: str  # "object" or "self"
 

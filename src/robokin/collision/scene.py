@@ -123,6 +123,7 @@ class Scene:
     """
 
     def __init__(self, name: str = "scene") -> None:
+        """An empty scene called ``name``."""
         self.name = name
         self._objects: dict[str, SceneObject] = {}
         self.base = np.eye(4)
@@ -135,6 +136,7 @@ class Scene:
         self._version = 0
 
     def __repr__(self) -> str:
+        """A short summary: the name and the object names."""
         return f"Scene(name={self.name!r}, objects={list(self._objects)})"
 
     # ---------------------------------------------------------------- objects
@@ -159,6 +161,7 @@ class Scene:
             ) from None
 
     def __len__(self) -> int:
+        """The number of objects."""
         return len(self._objects)
 
     def add(self, name: str, shape: Shape) -> SceneObject:

@@ -32,9 +32,11 @@ Content = str | bytes | Callable[[IO[bytes]], Any]
 
 
 def file_stem(name: str, limit: int = 80) -> str:
-    """A file-name stem made from a name (a robot's, from a file): letters, digits,
-    ``.``, ``-`` and ``_`` kept, anything else (``/``, ``..``) becomes ``_``, at
-    most ``limit`` characters; never empty or hidden."""
+    """A file-name stem made from a name (a robot's, from a file).
+
+    Letters, digits, ``.``, ``-`` and ``_`` are kept, anything else (``/``,
+    ``..``) becomes ``_``, at most ``limit`` characters; never empty or hidden.
+    """
     stem = re.sub(r"[^A-Za-z0-9._-]", "_", str(name))[:limit].lstrip(".")
     return stem or "robot"
 

@@ -393,7 +393,7 @@ def sections_from_geometry(geometry: RobotGeometry) -> dict[str, Any]:
                 spec["radius"] = sh.size[0]
             elif sh.kind in ("cylinder", "capsule"):
                 spec["radius"], spec["length"] = sh.size
-            else:
+            elif sh.file is not None:  # a mesh (the one kind with a file)
                 spec["file"] = str(Path(sh.file).resolve())
                 spec["units"] = "m"
                 if sh.scale != 1.0:

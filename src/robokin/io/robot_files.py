@@ -117,7 +117,6 @@ def _schema():
     )
 
     Name = Annotated[StrictStr, Field(max_length=MAX_NAME)]
-    Num = StrictFloat
     Sign = Literal[1, -1]
 
     class Strict(BaseModel):
@@ -128,8 +127,8 @@ def _schema():
         angle: Literal["rad", "deg"] = "rad"
 
     class Placement(Strict):
-        xyz: tuple[Num, Num, Num] = (0.0, 0.0, 0.0)
-        rpy: tuple[Num, Num, Num] = (0.0, 0.0, 0.0)
+        xyz: tuple[StrictFloat, StrictFloat, StrictFloat] = (0.0, 0.0, 0.0)
+        rpy: tuple[StrictFloat, StrictFloat, StrictFloat] = (0.0, 0.0, 0.0)
 
     def _check_limits(v):
         if v is not None and v[0] > v[1]:
@@ -144,27 +143,27 @@ def _schema():
     class Row(Strict):
         name: Name | None = None
         joint: Literal["revolute", "prismatic", "fixed"] = "revolute"
-        a: Num = 0.0
-        alpha: Num = 0.0
-        d: Num = 0.0
-        theta: Num = 0.0
-        limits: tuple[Num, Num] | None = None
+        a: StrictFloat = 0.0
+        alpha: StrictFloat = 0.0
+        d: StrictFloat = 0.0
+        theta: StrictFloat = 0.0
+        limits: tuple[StrictFloat, StrictFloat] | None = None
         sign: Annotated[Sign, StrictInt] = 1
-        depends: dict[Name, Num] | None = None
-        depends_offset: Num = 0.0
+        depends: dict[Name, StrictFloat] | None = None
+        depends_offset: StrictFloat = 0.0
 
         _lim = field_validator("limits")(_check_limits)
         _sgn = field_validator("sign", mode="before")(_check_sign)
 
     class Op(Strict):
         op: Literal["rx", "ry", "rz", "tx", "ty", "tz", "frame"]
-        value: Num = 0.0
+        value: StrictFloat = 0.0
         name: Name | None = None
         joint: Literal["revolute", "prismatic", "fixed"] = "fixed"
-        limits: tuple[Num, Num] | None = None
+        limits: tuple[StrictFloat, StrictFloat] | None = None
         sign: Annotated[Sign, StrictInt] = 1
-        depends: dict[Name, Num] | None = None
-        depends_offset: Num = 0.0
+        depends: dict[Name, StrictFloat] | None = None
+        depends_offset: StrictFloat = 0.0
 
         _lim = field_validator("limits")(_check_limits)
         _sgn = field_validator("sign", mode="before")(_check_sign)
@@ -172,7 +171,7 @@ def _schema():
     class Coordinate(Strict):
         name: Name
         joint: Literal["revolute", "prismatic"] = "revolute"
-        limits: tuple[Num, Num] | None = None
+        limits: tuple[StrictFloat, StrictFloat] | None = None
 
         _lim = field_validator("limits")(_check_limits)
 
@@ -238,8 +237,7 @@ def _coordinate_kinds(spec: Any, rows: list[Any]) -> dict[str, str]:
 
 
 def _si_rows(spec: Any, rows: list[Any], L: float, A: float) -> list[dict[str, Any]]:
-    """The joint rows in SI units, as ``chain_from_dh`` / ``chain_from_elementary``
-    take them."""
+    """The joint rows in SI units, as the DH and elementary chain builders take them."""
     elementary = spec.convention == "elementary"
     kind_of = _coordinate_kinds(spec, rows)
 

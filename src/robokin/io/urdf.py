@@ -52,7 +52,7 @@ import numpy as np
 from robokin._text import short_repr
 from robokin.exceptions import ModelError
 from robokin.io.urdf_xml import MAX_URDF_JOINTS, MOVABLE, parse_urdf
-from robokin.model.chain import Chain, ChainBuilder, Joint
+from robokin.model.chain import Chain, ChainBuilder, Joint, JointKind
 from robokin.model.coupling import Dependency, coupling_from_dependencies, mimic
 from robokin.model.geometry import MESH_SUFFIXES
 
@@ -163,7 +163,7 @@ class _Tree:
         up = self.ancestors(base)
         down = self.ancestors(tip)
         down_set = set(down)
-        common = next((a for a in up if a in down_set), None)
+        common = next(a for a in up if a in down_set)  # one tree: the root at least
         steps = []
         for link in up[: up.index(common)]:
             j = self.parent_joint[link]
@@ -306,7 +306,7 @@ def _velocity_limits(urdf_robot: Any, chain: Chain, source: str) -> Any:
     return RateLimits(velocity=out, source=f"{source}: <limit velocity>")
 
 
-def _kind(j: Any) -> str:
+def _kind(j: Any) -> JointKind:
     return "prismatic" if j.type == "prismatic" else "revolute"
 
 
@@ -562,8 +562,10 @@ def _geometry_of(
 
 def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]], drops: _Drops
                      ) -> Robot:
-    """Put the collision shapes on the geometry layer (visual ones where a link has
-    no collision shape)."""
+    """Put the collision shapes on the geometry layer.
+
+    Visual shapes stand in where a link has no collision shape.
+    """
     from robokin.model import geometry as geo
 
     names = geo.link_names(robot)
@@ -703,7 +705,9 @@ def dh_from_urdf(
                virtual_frames=virtual_frames)
 
 
-def dh_from_robot(robot: Robot, convention: str = "standard", **kwargs: Any) -> DHExtraction:
+def dh_from_robot(
+    robot: Robot, convention: Literal["standard", "modified"] = "standard", **kwargs: Any
+) -> DHExtraction:
     """See :func:`robokin.io.dh_extract.dh_from_robot`."""
     from robokin.io.dh_extract import dh_from_robot as _dh
 

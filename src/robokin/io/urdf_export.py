@@ -187,7 +187,7 @@ def urdf_from_robot(
         ET.SubElement(el, "parent", {"link": parent})
         ET.SubElement(el, "child", {"link": child})
         _origin_el(el, T)
-        if jtype != "fixed":
+        if jtype != "fixed" and axis is not None:  # every moving joint has its axis
             ET.SubElement(el, "axis", {"xyz": " ".join(_fmt(_clean(v)) for v in axis)})
             lim = {"effort": _fmt(effort),
                    "velocity": _fmt(velocity if math.isnan(speed) else speed)}
@@ -211,11 +211,10 @@ def urdf_from_robot(
         )
 
     # Link names from an imported URDF, when the chain still matches.
-    info = robot.meta.get("urdf")
-    imported = (
-        isinstance(info, UrdfChain) and len(info.child_links) == chain.n_chain
-    )
-    base_name = info.base_link if imported else "base_link"
+    urdf = robot.meta.get("urdf")
+    info = (urdf if isinstance(urdf, UrdfChain) and len(urdf.child_links) == chain.n_chain
+            else None)
+    base_name = info.base_link if info is not None else "base_link"
     if not np.array_equal(chain.base, np.eye(4)):
         world = add_link("world")
         base = add_link(base_name)
@@ -258,7 +257,7 @@ def urdf_from_robot(
     # Where each fk_all frame's shapes go: (URDF link, pose of the frame in it).
     targets: list[tuple[str, np.ndarray]] = [(base, np.eye(4))]
     for kk, j in enumerate(chain.joints):
-        child_name = info.child_links[kk] if imported else f"{j.name}_link"
+        child_name = info.child_links[kk] if info is not None else f"{j.name}_link"
         kind = j.kind
         row = M[kk]
         nz = [int(i) for i in np.flatnonzero(row)]
@@ -306,7 +305,7 @@ def urdf_from_robot(
         rest = np.eye(4) if fold else F.copy()
         targets.append((parent, rest))
         pending = rest @ chain.link_offsets[kk]
-    tool_name = info.tip_link if imported and info.tip_link not in link_names \
+    tool_name = info.tip_link if info is not None and info.tip_link not in link_names \
         else "tool0"
     tool = add_link(tool_name)
     add_joint(f"{parent}_to_{tool}", "fixed", parent, tool, pending @ chain.tool)

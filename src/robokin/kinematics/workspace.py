@@ -1,4 +1,4 @@
-"""Workspace analysis: where the tool point can go.
+r"""Workspace analysis: where the tool point can go.
 
 Monte-Carlo sampling of the joint space inside the joint limits, pushed through the
 compiled batch FK: the reachable point cloud, its bounding box, a volume estimate
@@ -7,7 +7,7 @@ colouring.
 
 .. math::
 
-    V \\approx N_{occupied} \\cdot h^3
+    V \approx N_{occupied} \cdot h^3
 
 where ``h`` is the voxel edge length. The estimate converges from below as the
 sample count grows (unvisited voxels) and from above as ``h`` shrinks (voxels cut

@@ -41,12 +41,12 @@ F64 = npt.NDArray[np.float64]
 
 @dataclass(frozen=True, eq=False)
 class ChainArrays:
-    """The canonical chain as the compiled kernels read it.
+    r"""The canonical chain as the compiled kernels read it.
 
     .. math::
 
-        T(q) = C_0 \\, J_1(v_1) C_1 \\cdots J_{n_c}(v_{n_c}) C_{n_c}, \\qquad
-        v = \\mathrm{sign} \\odot (M q + c) + \\mathrm{offset}
+        T(q) = C_0 \, J_1(v_1) C_1 \cdots J_{n_c}(v_{n_c}) C_{n_c}, \qquad
+        v = \mathrm{sign} \odot (M q + c) + \mathrm{offset}
 
     Attributes:
         n_chain: Chain joints ``nc``.
@@ -114,9 +114,12 @@ def _xform_params(consts: np.ndarray) -> np.ndarray:
 
 def _seed_range(lower: np.ndarray, upper: np.ndarray,
                 is_revolute: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Where random restarts are drawn: the limits where they span at most one turn
-    (revolute) or [-1, 1] m (prismatic), else one turn / 2 m centred in them
-    (``[-pi, pi]`` or ``[-1, 1]`` when that lies inside); always finite."""
+    """Where random restarts are drawn; always finite.
+
+    The limits where they span at most one turn (revolute) or [-1, 1] m
+    (prismatic), else one turn / 2 m centred in them (``[-pi, pi]`` or
+    ``[-1, 1]`` when that lies inside).
+    """
     width = np.where(is_revolute, 2.0 * math.pi, 2.0)
     lo_ok, hi_ok = np.isfinite(lower), np.isfinite(upper)
     lo = np.where(lo_ok, lower, 0.0)

@@ -36,10 +36,10 @@ import json
 import math
 import re
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -61,6 +61,8 @@ __all__ = [
     "write_json",
     "write_ur_script",
 ]
+
+_T = TypeVar("_T")
 
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 _LENGTH = {"m": 1.0, "mm": 1e-3}
@@ -96,6 +98,7 @@ class ControllerProfile:
     names: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
+        """Check the units and the per-column lists; store them as tuples."""
         if self.angle_unit not in _ANGLE:
             raise ModelError(f"angle_unit must be 'rad' or 'deg', got {short_repr(self.angle_unit)}",
                              field="angle_unit")
@@ -147,10 +150,10 @@ class ControllerProfile:
         if offsets is not None and doc.get("offset_unit", doc.get("angle_unit")) == "deg":
             offsets = [math.radians(o) for o in offsets]
         try:
-            return cls(name=doc.get("name", "default"), order=order,
-                       signs=signs, offsets=offsets,
+            return cls(name=doc.get("name", "default"), order=_tuple(order),
+                       signs=_tuple(signs), offsets=_tuple(offsets),
                        angle_unit=doc.get("angle_unit", "rad"),
-                       length_unit=doc.get("length_unit", "m"), names=names)
+                       length_unit=doc.get("length_unit", "m"), names=_tuple(names))
         except ModelError as exc:
             raise ModelError(exc.reason, file=file, field=exc.field) from None
 
@@ -194,8 +197,10 @@ class ControllerProfile:
 
 def _list_field(doc: Mapping[str, Any], key: str, kinds: tuple[type, ...],
                 file: Any) -> list[Any] | None:
-    """``doc[key]``: None, or a list whose items are of ``kinds`` (no booleans,
-    finite numbers); a ModelError naming the field otherwise."""
+    """``doc[key]``: None, or a list whose items are of ``kinds``.
+
+    No booleans, finite numbers; a ModelError naming the field otherwise.
+    """
     value = doc.get(key)
     if value is None:
         return None
@@ -302,10 +307,16 @@ def csv_text(traj: Trajectory, joint_names: Sequence[str] | None = None, *,
     return "\n".join(lines) + "\n"
 
 
+def _tuple(values: Iterable[_T] | None) -> tuple[_T, ...] | None:
+    return None if values is None else tuple(values)
+
+
 def _parse_header(cols: list[str]) -> list[tuple[str, str | None]]:
     out = []
     for c in cols:
         m = _HEADER.match(c)
+        if m is None:  # pragma: no cover - the pattern matches any text
+            raise ModelError(f"unreadable column header {short_repr(c)}")
         out.append((m.group("name"), m.group("unit").strip() if m.group("unit") else None))
     return out
 
@@ -319,8 +330,10 @@ def _is_number(text: str) -> bool:
 
 
 def _load_table(path: Path, max_bytes: int) -> tuple[list[str] | None, np.ndarray, int]:
-    """The header (None when the file has none), the numbers, and the line of the
-    first data row (for messages)."""
+    """The header (None when the file has none), the numbers, the first data line.
+
+    The line number of the first data row is for messages.
+    """
     text = read_text_file(path, max_bytes=max_bytes)
     numbered = [(k, ln) for k, ln in enumerate(text.splitlines(), start=1)
                 if ln.strip() and not ln.lstrip().startswith("#")]
@@ -364,8 +377,10 @@ def _differentiate(t: np.ndarray, x: np.ndarray) -> np.ndarray:
 def _columns(header: list[str] | None, width: int, path: Path,
              joint_names: Sequence[str] | None
              ) -> tuple[list[tuple[str, str | None]], list[list[int]]]:
-    """Parsed header cells and the column indices of positions, rates and
-    accelerations, ordered as ``joint_names`` when given."""
+    """Parsed header cells and the column indices of positions, rates, accelerations.
+
+    The indices are ordered as ``joint_names`` when given.
+    """
     if header is None:
         n = width - 1
         if n == 0:
@@ -380,7 +395,7 @@ def _columns(header: list[str] | None, width: int, path: Path,
                       f"(time [s], then {', '.join(names[:8])}"
                       f"{' ...' if len(names) > 8 else ''} in SI units)", UserWarning,
                       stacklevel=4)
-        cells = [("t", None)] + [(nm, None) for nm in names]
+        cells: list[tuple[str, str | None]] = [(nm, None) for nm in ["t", *names]]
         return cells, [list(range(1, len(names) + 1)), [], []]
     cells = _parse_header(header)
     groups: list[dict[str, int]] = [{}, {}, {}]
@@ -478,8 +493,11 @@ def _trajectory_from_table(header: list[str] | None, data: np.ndarray, path: Pat
 
 def _check_times(t: np.ndarray, path: Path, first_line: int, *,
                  allow_repeats: bool) -> np.ndarray:
-    """Rows to keep: refuses time going backwards (naming the line), and repeated
-    time stamps unless ``allow_repeats`` (then the first of each is kept)."""
+    """Rows to keep, refusing time that goes backwards (naming the line).
+
+    Repeated time stamps are refused too unless ``allow_repeats`` (then the first
+    of each is kept).
+    """
     step = np.diff(t)
     back = np.flatnonzero(step < 0 if allow_repeats else step <= 0)
     if back.size:

@@ -101,14 +101,14 @@ def animation_html(
     if rep.distance is not None:
         keep.append(int(np.argmin(rep.distance)))
     closest = getattr(report, "closest", None)
-    if hasattr(closest, "index"):
+    if closest is not None and hasattr(closest, "index"):
         keep.append(int(closest.index))
     for first, last, *_ in rep.bodies:
         keep += [first, last]
     idx = _frame_indices(m, max(2, int(max_frames)), keep)
     q = motion.q[idx]
     sk = skeleton(robot, q)
-    track = rep.closest_at(idx)
+    track: tuple[np.ndarray, np.ndarray | None] | None = rep.closest_at(idx)
     if track is None and rep.distance is not None:
         track = (rep.distance[idx], None)
     F = idx.size

@@ -9,13 +9,17 @@ Angles are drawn in degrees and lengths in millimetres unless asked otherwise.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
 
 from robokin.exceptions import InputError
 from robokin.io.atomic import file_stem, save_figure_atomic
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+    from robokin.trajectory.samples import Trajectory
 
 __all__ = [
     "plot_comparison",
@@ -183,7 +187,7 @@ def _scales(traj, degrees: bool):
     return s, unit
 
 
-def plot_joints(traj: Any, *, path: str | Path | None = None, degrees: bool = True,
+def plot_joints(traj: Trajectory, *, path: str | Path | None = None, degrees: bool = True,
                 via: bool = True, title: str | None = None,
                 overwrite: bool = False) -> Any:
     """Joint position, velocity and acceleration over time: three panels, a line per joint.
@@ -230,13 +234,15 @@ def plot_joints(traj: Any, *, path: str | Path | None = None, degrees: bool = Tr
     return _finish(fig, path, overwrite)
 
 
-def _positions(traj: Any, robot: Any) -> np.ndarray:
-    if traj.pose is None and robot is None:
+def _positions(traj: Trajectory, robot: Robot | None) -> np.ndarray:
+    if traj.pose is not None:
+        return traj.pose[:, :3, 3]
+    if robot is None:
         raise InputError("robot", "the trajectory has no tool poses: pass the robot")
     return traj.tool_poses(robot)[:, :3, 3]
 
 
-def plot_tool_position(traj: Any, robot: Any = None, *, path: str | Path | None = None,
+def plot_tool_position(traj: Trajectory, robot: Robot | None = None, *, path: str | Path | None = None,
                        mm: bool = True, relative: bool = False,
                        title: str | None = None, overwrite: bool = False) -> Any:
     """Tool position x, y, z over time (one line each).
@@ -267,7 +273,7 @@ def plot_tool_position(traj: Any, robot: Any = None, *, path: str | Path | None 
     return _finish(fig, path, overwrite)
 
 
-def plot_tool_path(traj: Any, robot: Any = None, *, path: str | Path | None = None,
+def plot_tool_path(traj: Trajectory, robot: Robot | None = None, *, path: str | Path | None = None,
                    mm: bool = True, title: str | None = None,
                    overwrite: bool = False) -> Any:
     """Tool path in 3D, with its projections onto the XY, XZ and YZ planes.
@@ -337,7 +343,7 @@ def plot_comparison(cmp: Any, *, path: str | Path | None = None, degrees: bool =
     return _finish(fig, path, overwrite)
 
 
-def plot_robot(robot: Any, q: npt.ArrayLike, ax: Any = None, frames: bool = True, *,
+def plot_robot(robot: Robot, q: npt.ArrayLike, ax: Any = None, frames: bool = True, *,
                path: str | Path | None = None, frame_size: float | None = None,
                color: str = "C0", overwrite: bool = False) -> Any:
     """The arm at ``q`` as a 3D stick figure: link frames joined, joints dotted.

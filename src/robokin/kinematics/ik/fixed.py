@@ -16,7 +16,7 @@ the first). Otherwise each distinct value gets its own reduced chain (cached).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -26,11 +26,14 @@ from robokin.exceptions import InputError
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
 
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
 __all__ = ["solve_fixed"]
 
 
 def solve_fixed(
-    robot: Any,
+    robot: Robot,
     T: npt.ArrayLike,
     fixed: Mapping[str, npt.ArrayLike],
     *,
@@ -101,7 +104,7 @@ def solve_fixed(
     return _assemble(robot, lead, idx, keep, V, parts, dict(zip(fixed, values)))
 
 
-def _end_joint(robot: Any, idx: list[int]) -> str | None:
+def _end_joint(robot: Robot, idx: list[int]) -> str | None:
     """"first" / "last" when one held coordinate is the chain's first / last joint."""
     chain = robot.chain
     if len(idx) != 1 or not chain.coupling.is_identity:
@@ -113,7 +116,7 @@ def _end_joint(robot: Any, idx: list[int]) -> str | None:
     return None
 
 
-def _joint_move(robot: Any, j: int, v: np.ndarray) -> np.ndarray:
+def _joint_move(robot: Robot, j: int, v: np.ndarray) -> np.ndarray:
     """J_j(sign * v) for values v (N,): (N, 4, 4)."""
     joint = robot.chain.joints[j]
     x = joint.sign * v
@@ -126,7 +129,7 @@ def _joint_move(robot: Any, j: int, v: np.ndarray) -> np.ndarray:
     return out
 
 
-def _moved_targets(robot: Any, end: str, T: np.ndarray, v: np.ndarray) -> np.ndarray:
+def _moved_targets(robot: Robot, end: str, T: np.ndarray, v: np.ndarray) -> np.ndarray:
     """The targets of the reduced chain (held value 0) that equal T at value v."""
     C = robot.chain.arrays.consts
     if end == "last":
@@ -137,7 +140,7 @@ def _moved_targets(robot: Any, end: str, T: np.ndarray, v: np.ndarray) -> np.nda
     return C0 @ _joint_move(robot, 0, -v) @ np.linalg.inv(C0) @ T
 
 
-def _reduced(robot: Any, idx: list[int], values: tuple[float, ...]) -> Any:
+def _reduced(robot: Robot, idx: list[int], values: tuple[float, ...]) -> Any:
     """The robot of the remaining coordinates (cached per chain and held values)."""
     key = ("fixed", tuple(idx), values)
 
@@ -150,7 +153,7 @@ def _reduced(robot: Any, idx: list[int], values: tuple[float, ...]) -> Any:
     return cached(robot.chain, key, build)
 
 
-def _assemble(robot: Any, lead: tuple[int, ...], idx: list[int], keep: list[int],
+def _assemble(robot: Robot, lead: tuple[int, ...], idx: list[int], keep: list[int],
               V: np.ndarray, parts: list[tuple[np.ndarray, SolutionSet]],
               fixed: dict[str, np.ndarray]) -> SolutionSet:
     N = V.shape[0]

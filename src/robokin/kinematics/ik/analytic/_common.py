@@ -12,13 +12,15 @@ from robokin.kinematics.ik.solutions import SolutionSet
 __all__ = ["STATUS_TEXT", "fit_turns", "fk_error", "make_set", "q_near_rows"]
 
 # Status code -> text. Codes 0-2 are those the 6R kernels return (csrc/six_r.c);
-# the SCARA and palletizer closed forms use them too. 3: palletizer, 4: near.polish.
+# the SCARA and palletizer closed forms use them too. 3: palletizer, 4: near.polish,
+# 5: general_6r (csrc/general6r.c).
 _STATUS = {
     _K.STATUS_OK: "ok",
     _K.STATUS_OUT_OF_REACH: "out of reach",
     _K.STATUS_NO_ORIENTATION: "orientation not achievable",
     3: "not reachable: tool cannot tilt",
     4: "near-family Newton polish did not converge",
+    5: "no solution: the general 6R elimination is degenerate at this pose",
 }
 STATUS_TEXT = np.array([_STATUS[k] for k in range(len(_STATUS))], dtype=object)
 
