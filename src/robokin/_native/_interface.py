@@ -117,6 +117,36 @@ class Kernels(Protocol):
     # ------------------------------------------------------ broadphase.c constants
     BP_CHUNK_WORK: int
 
+    # ------------------------------------------------------- general6r.c constants
+    # general6r_solve: solutions per pose, parameter-vector layout (GP_*: header
+    # fields; VB_*: one variant block of VB_SIZE values), status and flag codes
+    G6_MAXSOL: int
+    GP_NVAR: int
+    GP_TAIL_TOL: int
+    GP_NULL_TOL: int
+    GP_IMAG_TOL: int
+    GP_TOL: int
+    GP_DEDUPE: int
+    GP_MAX_ITER: int
+    GP_PAIR_GAP: int
+    GP_HEAD: int
+    VB_DIR: int
+    VB_A: int
+    VB_MULT: int
+    VB_C: int
+    VB_CI: int
+    VB_P: int
+    VB_SIZE: int
+    G6_OK: int
+    G6_NONE: int
+    G6_DEGENERATE: int
+    G6_BAD_POSE: int
+    G6F_DEGENERATE: int
+    G6F_AMBIGUOUS: int
+    G6F_SECONDARY: int
+    G6F_SEC_DEGENERATE: int
+    G6F_SEC_AMBIGUOUS: int
+    G6_DIAG_CAND_SHIFT: int
     # ---------------------------------------------------------- FK and Jacobian
     def fk1(self, q: object, packed: object, /) -> F64 | None:
         """Pose (4, 4) of one configuration q (n,), or None for the general path."""
@@ -195,6 +225,32 @@ class Kernels(Protocol):
         self, params: F64, T: F64, qn: F64, /
     ) -> tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]:
         """``(Q (N, 8, 6), valid, singular, within_limits (N, 8), status (N,))``."""
+
+    # ------------------------------------------------------------ general 6R IK
+    def general6r_solve(
+        self,
+        packed: F64,
+        params: F64,
+        T: F64,
+        Q: F64,
+        valid: Bools,
+        inside: Bools,
+        sigma: F64,
+        status: I64,
+        diag: I64,
+        stats: F64,
+        parallel: bool,
+        /,
+    ) -> None:
+        """Every solution of poses T (N, 4, 4): Q (N, 16, 6), masks (N, 16), ..."""
+
+    def general6r_fit_rows(
+        self, consts: F64, a: int, angles: F64, X: F64, Y: F64, /
+    ) -> None:
+        """The left side's fitting rows at angles (M, 3): X (M, 27), Y (M, 14)."""
+
+    def general6r_roots(self, c: F64, wr: F64, wi: F64, /) -> bool:
+        """Roots of the polynomial with coefficients c (low order first), into wr, wi."""
 
     # ----------------------------------------------------------- collision
     def rounded_box_bounds(

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from robokin._native import kernels as _K
 from robokin.kinematics.ik.solutions import SolutionSet
@@ -26,8 +27,10 @@ STATUS_TEXT = np.array([_STATUS[k] for k in range(len(_STATUS))], dtype=object)
 
 
 def fit_turns(q: np.ndarray, is_revolute: np.ndarray, limits: np.ndarray) -> np.ndarray:
-    """Wrap revolute values into [-pi, pi), then move them by whole turns into their
-    limits where that is possible (prismatic values are left alone)."""
+    """Revolute values wrapped into [-pi, pi), then by whole turns into their limits.
+
+    Prismatic values are left alone; a value no turn brings inside stays wrapped.
+    """
     tw = 2.0 * np.pi
     w = (q + np.pi) % tw - np.pi
     lo, hi = limits[:, 0], limits[:, 1]
@@ -39,9 +42,9 @@ def fit_turns(q: np.ndarray, is_revolute: np.ndarray, limits: np.ndarray) -> np.
     return np.where(is_revolute, w, q)
 
 
-def inside_limits(q: np.ndarray, limits: np.ndarray) -> np.ndarray:
+def inside_limits(q: np.ndarray, limits: np.ndarray) -> npt.NDArray[np.bool_]:
     """(..., k) bool: every coordinate within its limits (1e-9 slack)."""
-    return ((q >= limits[:, 0] - 1e-9) & (q <= limits[:, 1] + 1e-9)).all(axis=-1)
+    return np.asarray(((q >= limits[:, 0] - 1e-9) & (q <= limits[:, 1] + 1e-9)).all(axis=-1))
 
 
 def q_near_rows(q_near: Any, lead: tuple[int, ...], n: int) -> np.ndarray:

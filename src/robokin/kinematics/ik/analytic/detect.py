@@ -29,7 +29,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -40,6 +40,9 @@ from robokin.kinematics.ik.analytic import spherical_wrist as _sw
 from robokin.kinematics.ik.analytic import three_parallel as _tp
 from robokin.kinematics.ik.analytic._geometry import poe_from_chain
 from robokin.kinematics.per_chain import cached
+
+if TYPE_CHECKING:
+    from robokin.kinematics.ik.analytic._six_r import Kind
 
 __all__ = ["Family", "detect"]
 
@@ -75,6 +78,7 @@ class Family:
     details: dict[str, str] = field(default_factory=dict)
 
     def __str__(self) -> str:
+        """One line: the family and what was measured, or why there is none."""
         if self.solver is None:
             return f"none: {self.reason}"
         tag = " (near family: closed form + Newton polish)" if self.near else ""
@@ -179,10 +183,10 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float,
         if why or ang > tol:
             return _none(f"not a level-tool palletizer: {text}"
                          + (f" ({why})" if why else ""), {"palletizer": text})
-        g = _pal.geometry(chain, poe)
+        pal = _pal.geometry(chain, poe)
 
         def pal_solver(robot, T, q_near=None, **options):
-            return _pal.solve_geometry(robot, g, T, **options)
+            return _pal.solve_geometry(robot, pal, T, **options)
 
         return Family("palletizer", pal_solver, measured=text, deviation=ang,
                       details={"palletizer": text})
@@ -194,8 +198,10 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float,
 
 
 def _general_6r_family(chain: Any, details: dict[str, str]) -> Family:
-    """The general 6R solver when its set-up works for ``chain``, else a "none"
-    family whose details say why."""
+    """The general 6R solver when its set-up works for ``chain``.
+
+    Else a "none" family whose details say why.
+    """
     setup = _g6.setup(chain)
     details = dict(details)
     if setup.params is None:
@@ -210,7 +216,7 @@ def _general_6r_family(chain: Any, details: dict[str, str]) -> Family:
     return Family(_g6.NAME, general_solver, measured=setup.measured, details=details)
 
 
-def _six_r_family(chain: Any, poe: Any, name: str, text: str, near: bool, dev: float,
+def _six_r_family(chain: Any, poe: Any, name: Kind, text: str, near: bool, dev: float,
                   details: dict[str, str]) -> Family:
     from robokin.kinematics.ik.analytic._six_r import make_single, pack, solve_six_r
 

@@ -91,6 +91,7 @@ class Variant:
         return 7 - self.split if self.reversed else self.split
 
     def __str__(self) -> str:
+        """The split, its direction and the dialytic multiplier, e.g. "split 2, x_b"."""
         return (f"split {self.split}{' reversed' if self.reversed else ''}, "
                 f"x_{'bc'[self.multiplier]}")
 
@@ -203,8 +204,9 @@ def _params(blocks: list[np.ndarray]) -> np.ndarray:
 
 def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
               parallel: bool | None = None) -> tuple[np.ndarray, ...]:
-    """The bare kernel call: T (N, 4, 4) C-contiguous float64 -> (q (N, 16, 6) [rad],
-    valid (N, 16), inside (N, 16) the valid rows within the limits, sigma (N, 16) the
+    """The bare kernel call.
+
+    T (N, 4, 4) C-contiguous float64 -> (q (N, 16, 6) [rad], valid (N, 16), inside (N, 16) the valid rows within the limits, sigma (N, 16) the
     Jacobian's smallest singular value, status (N,) int64 (kernel codes), diag (N,)
     int64 (kernel flags; >> G6_DIAG_CAND_SHIFT the roots tried), stats (N, 3): the
     primary's relative DFT tail, null-space margin and roots taken as close pairs).
@@ -266,8 +268,11 @@ class _Trial:
 
     @property
     def cost(self) -> int:
-        """Expected work and fragility: a pose sent to the secondary costs about one
-        variant (8 roots), each root taken from a 2-D null space one."""
+        """Expected work and fragility of a variant as the primary.
+
+        A pose sent to the secondary costs about one variant (8 roots), each root
+        taken from a 2-D null space one.
+        """
         return 8 * int(self.trouble.sum()) + self.pairs
 
 
@@ -288,8 +293,11 @@ def _fits(chain: Any, rng: np.random.Generator) -> dict[Variant, np.ndarray] | s
 
 def _trials(chain: Any, blocks: dict[Variant, np.ndarray], q: np.ndarray
             ) -> tuple[dict[Variant, _Trial], int]:
-    """Each variant alone on the poses of q, against the reference: the union of
-    every variant's validated solutions and the generating configurations."""
+    """Each variant alone on the poses of q, against the reference.
+
+    The reference is the union of every variant's validated solutions and the
+    generating configurations.
+    """
     from robokin.kinematics.forward import forward_kinematics
 
     T = np.ascontiguousarray(forward_kinematics(chain, q))
@@ -301,7 +309,8 @@ def _trials(chain: Any, blocks: dict[Variant, np.ndarray], q: np.ndarray
     for v, (_, _, _, _, _, diag, stats) in runs.items():
         tail = stats[:, 0]
         trials[v] = _Trial(
-            covered=[_close(ref[i], found[v][i]).any(axis=1) for i in range(len(q))],
+            covered=[np.asarray(_close(ref[i], found[v][i]).any(axis=1))
+                     for i in range(len(q))],
             trouble=(diag & (K.G6F_DEGENERATE | K.G6F_AMBIGUOUS)) != 0,
             degenerate=int(((diag & K.G6F_DEGENERATE) != 0).sum()),
             tail=float(np.max(np.where(np.isfinite(tail), tail, 1.0))),
@@ -310,9 +319,11 @@ def _trials(chain: Any, blocks: dict[Variant, np.ndarray], q: np.ndarray
 
 
 def _choose(trials: dict[Variant, _Trial], poses: int) -> tuple[Variant, Variant] | None:
-    """The (primary, secondary) pair that finds every reference solution (the
-    secondary where the primary reports trouble), of the least primary cost, then
-    tail; None when no pair does."""
+    """The (primary, secondary) pair that finds every reference solution.
+
+    The secondary runs where the primary reports trouble; among the pairs that
+    work, the least primary cost wins, then the smaller tail. None when no pair does.
+    """
     best = None
     for p, tp in trials.items():
         if 2 * tp.degenerate > poses:  # it would merely hand poses on
@@ -418,16 +429,20 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
 
 
 def make_single(chain: Any) -> Any:
-    """The single-pose hot path: ``single(T, q6) -> SolutionSet | None`` for one pose
-    ``T`` (4, 4) float64 with default options (``q6``, the closed forms' joint-6
+    """The single-pose hot path: ``single(T, q6) -> SolutionSet | None``.
+
+    For one pose ``T`` (4, 4) float64 with default options (``q6``, the closed forms' joint-6
     value at a wrist singularity, is unused). None when ``T`` is not a rigid
     transform (the caller re-checks it to raise the detailed error). Every call
-    returns fresh arrays; only the read-only joint kinds and limits are shared."""
+    returns fresh arrays; only the read-only joint kinds and limits are shared.
+    """
     from robokin.kinematics.ik.analytic._common import STATUS_TEXT
     from robokin.kinematics.ik.solutions import SolutionSet
 
     g = setup(chain)
     packed, params = chain.arrays.packed, g.params
+    if params is None:
+        raise ValueError(f"general_6r is not offered for this chain: {g.reason}")
     is_rev = np.ones(6, dtype=bool)
     is_rev.setflags(write=False)
     limits = chain.limits
