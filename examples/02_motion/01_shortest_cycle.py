@@ -50,9 +50,10 @@ def main(out_dir: Path = Path("robokin-examples") / "shortest_cycle") -> None:
         print(f"  {b.t_start:6.3f} .. {b.t_end:6.3f} s: {b.joint_name} at its {b.kind} "
               f"limit ({b.section})")
     out = report.minimum.trajectory
+    margins = report.margins or {}  # set: a cycle time was asked for
     print(f"planned {planned.duration:.2f} s -> minimum {out.duration:.3f} s, "
           f"{len(out)} samples; velocity margins at 5 s: "
-          f"{np.round(report.margins['velocity'] * 100, 1)} %")
+          f"{np.round(margins['velocity'] * 100, 1)} %")
 
     out_dir.mkdir(parents=True, exist_ok=True)
     plot_bottlenecks(report, path=out_dir / "bottlenecks.png", overwrite=True)

@@ -153,8 +153,11 @@ def plan_press_loading(
 
 def _cycle_times(robot: Any, bare: Any, scene: Any, traj: Any, clearance: float
                  ) -> dict[str, Any]:
-    """The minimum cycle time of the planned path (dwells kept) under the robot
-    file's limits and under the demo's caps, and the retimed motion's clearance."""
+    """The shortest cycle of the planned path, and the retimed motion's clearance.
+
+    The minimum cycle time (dwells kept) under the robot file's limits and under the
+    demo's caps; the retimed motion is checked against the press again.
+    """
     from robokin import collision
     from robokin.exceptions import MissingExtraError
     from robokin.trajectory import retime

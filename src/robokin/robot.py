@@ -1,5 +1,4 @@
-"""The Robot: a canonical chain plus its name, source, actuators, geometry and rate
-limits.
+"""The Robot: a canonical chain plus its name, source, actuators, geometry, limits.
 
 A Robot is immutable: assigning or deleting an attribute raises
 :class:`~robokin.exceptions.FrozenError`, its arrays are read-only and ``meta`` is

@@ -323,8 +323,10 @@ def urdf_from_robot(
 
 
 def _known_velocities(robot: Robot) -> np.ndarray | None:
-    """The robot's speed limits (n,) [rad/s or m/s] with NaN where unknown, or None
-    when it knows none."""
+    """The robot's speed limits (n,) [rad/s or m/s], NaN where unknown.
+
+    None when the robot knows none.
+    """
     lim = robot.rate_limits
     v = None if lim is None else lim.velocity
     return None if v is None or np.isnan(v).all() else v

@@ -59,6 +59,7 @@ class RateLimits:
     source: str = ""
 
     def __post_init__(self) -> None:
+        """Check and freeze the arrays (one size for all kinds)."""
         n = None
         for kind in RATE_KINDS:
             arr = _frozen(getattr(self, kind), n, kind)
@@ -86,6 +87,7 @@ class RateLimits:
         return arr
 
     def __eq__(self, other: Any) -> bool:
+        """Same limits (to 1e-12 relative, NaN equal to NaN) and the same source."""
         if not isinstance(other, RateLimits):
             return NotImplemented
         for kind in RATE_KINDS:
@@ -101,6 +103,7 @@ class RateLimits:
     __hash__ = None  # type: ignore[assignment]
 
     def __repr__(self) -> str:
+        """``RateLimits(velocity=[...], ...)``, the kinds that are given."""
         parts = []
         for kind in RATE_KINDS:
             arr = self.get(kind)

@@ -205,7 +205,7 @@ def _speed_constraint(toppra: Any, dof: int, x_max: Any) -> Any:
     (0.49 becomes 0.48999998), a 4e-8 error either way; this one is exact.
     """
 
-    class SpeedBound(toppra.constraint.LinearConstraint):  # type: ignore[misc]
+    class SpeedBound(toppra.constraint.LinearConstraint):
         def __init__(self) -> None:
             super().__init__()
             self.dof = dof
@@ -277,8 +277,10 @@ def _stage_rows(constraints: list[Any], path: SplinePath, grid: np.ndarray
 
 def _forward_pass(A: np.ndarray, B: np.ndarray, C: np.ndarray, x_cap: np.ndarray,
                   K: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Greedy forward pass (Pham & Pham 2018, Alg. 1): the largest admissible ``u``
-    from each stage, clipped into the next controllable set, without a safety shave.
+    """Greedy forward pass (Pham & Pham 2018, Alg. 1), without a safety shave.
+
+    From each stage the largest admissible ``u``, clipped into the next
+    controllable set.
 
     Returns:
         ``x`` (N + 1,) and, per interval (N,), what set its end: 0 the largest
@@ -450,8 +452,9 @@ def topp_ra_law(path: SplinePath, v_max: np.ndarray, a_max: np.ndarray, *,
 def path_space_limits(path: SplinePath, v: np.ndarray, a: np.ndarray, j: np.ndarray,
                       tool_rate: float = 0.0, tool_speed: float | None = None
                       ) -> tuple[float, float, float]:
-    """Constant limits ``(V, A, J)`` on the path parameter that keep every joint
-    within its speed, acceleration and jerk limits along the whole stretch.
+    """Constant path-space limits ``(V, A, J)`` that keep every joint within its own.
+
+    They hold along the whole stretch, for speed, acceleration and jerk.
 
     With ``g1, g2, g3`` the largest ``|q'|, |q''|, |q'''|`` of a joint on the
     stretch, ``qd = q' sd``, ``qdd = q'' sd^2 + q' sdd`` and ``qddd = q''' sd^3 +

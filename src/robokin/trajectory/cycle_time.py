@@ -130,8 +130,11 @@ def _columns(ratios: dict[str, np.ndarray], names: tuple[str, ...]
 def _bottlenecks(result: RetimeResult, ratios: dict[str, np.ndarray], tol: float
                  ) -> tuple[tuple[Bottleneck, ...], np.ndarray,
                             list[tuple[str, int, str]], dict[str, np.ndarray]]:
-    """Stretches where a limit is active, the dominant column per sample, and the
-    active samples per kind (shaped as ``ratios``)."""
+    """Stretches where a limit is active, and where each limit is.
+
+    Returns the stretches, the dominant column per sample (-1: none), what each
+    column is, and the active samples per kind (shaped as ``ratios``).
+    """
     tr = result.trajectory
     ratio, what = _columns(ratios, tr.names())
     section_of = np.zeros(tr.t.size, int)
@@ -260,6 +263,7 @@ class CycleTimeReport:
         return out
 
     def __str__(self) -> str:
+        """The report as a text table: times per section, limits, margins."""
         rows = [f"minimum cycle time {self.minimum_cycle_time:.3f} s"
                 + ("" if self.source_duration is None
                    else f" (planned {self.source_duration:.3f} s)")

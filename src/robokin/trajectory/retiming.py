@@ -287,8 +287,10 @@ def _durations(plan: _Plan, laws: list[TimeLaw | None]) -> np.ndarray:
 
 
 def _time_grid(T: float, dt: float, cap: int) -> np.ndarray:
-    """``0, dt, 2 dt, ...`` and the exact end ``T`` (replacing the last multiple of
-    ``dt`` when that is within 1e-6 dt of it)."""
+    """Sample times ``0, dt, 2 dt, ...`` and the exact end ``T``.
+
+    ``T`` replaces the last multiple of ``dt`` when that is within 1e-6 dt of it.
+    """
     k = math.floor(T / dt * (1 + 1e-12))
     if k + 2 > cap:
         raise InputError("dt", f"the retimed motion of {T:.6g} s at dt {dt:g} s needs "
@@ -395,8 +397,10 @@ def _stretch_all(result: RetimeResult, factor: float) -> RetimeResult:
 
 
 def _finish(plan: _Plan, laws: list[TimeLaw | None]) -> RetimeResult:
-    """Sample, check every sample (slowing any stretch that exceeds a limit), and
-    package the result."""
+    """Sample, check every sample, and package the result.
+
+    A stretch that exceeds a limit is slowed by its ratio and checked again.
+    """
     laws = list(laws)
     for _ in range(_CHECK_ROUNDS):
         samples = _sample(plan, laws)
