@@ -229,6 +229,7 @@ def _register_extra_commands() -> None:
         "robokin.cli_actuators",
         "robokin.cli_workspace",
         "robokin.cli_sim",
+        "robokin.cli_retime",
     ):
         try:
             importlib.import_module(mod)

@@ -1,4 +1,4 @@
-"""The Robot: a canonical chain plus its name, source, actuators and geometry.
+"""The Robot: a canonical chain plus its name, source, actuators, geometry, limits.
 
 A Robot is immutable: assigning or deleting an attribute raises
 :class:`~robokin.exceptions.FrozenError`, its arrays are read-only and ``meta`` is
@@ -21,6 +21,7 @@ from robokin.kinematics import forward
 from robokin.kinematics import jacobian as _jac
 from robokin.model.chain import Chain
 from robokin.model.coupling import AffineMap
+from robokin.model.rate_limits import RateLimits
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.numeric import IKResult
@@ -84,10 +85,13 @@ class Robot:
             (:class:`~robokin.model.dynamics.RobotDynamics`), or None.
         path: The robot file it was loaded from, or None.
         meta: Free-form extra fields from the robot file (a read-only mapping).
+        rate_limits: Per-joint velocity / acceleration / jerk limits
+            (:class:`~robokin.model.rate_limits.RateLimits`, SI), or None.
     """
 
     __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain", "dynamics",
-                 "geometry", "meta", "name", "path", "source", "__weakref__")
+                 "geometry", "meta", "name", "path", "rate_limits", "source",
+                 "__weakref__")
     chain: Chain
     name: str
     source: str
@@ -98,6 +102,7 @@ class Robot:
     dynamics: RobotDynamics | None
     path: Path | None
     meta: Mapping[str, Any]
+    rate_limits: RateLimits | None
 
     def __setattr__(self, name: str, value: Any) -> None:
         """Refuse: a Robot is immutable (raises FrozenError)."""
@@ -116,7 +121,8 @@ class Robot:
         return {"name": self.name, "source": self.source, "actuators": self.actuators,
                 "actuator_names": self.actuator_names,
                 "actuator_limits": self.actuator_limits, "geometry": self.geometry,
-                "dynamics": self.dynamics, "path": self.path, "meta": dict(self.meta)}
+                "dynamics": self.dynamics, "path": self.path, "meta": dict(self.meta),
+                "rate_limits": self.rate_limits}
 
     def __init__(
         self,
@@ -131,6 +137,7 @@ class Robot:
         dynamics: RobotDynamics | None = None,
         path: str | Path | None = None,
         meta: Mapping[str, Any] | None = None,
+        rate_limits: RateLimits | None = None,
     ) -> None:
         """Check and freeze the parts (see the class docstring for each)."""
         init = object.__setattr__
@@ -155,6 +162,12 @@ class Robot:
         init(self, "dynamics", dynamics)
         init(self, "path", None if path is None else Path(path))
         init(self, "meta", MappingProxyType(dict(meta or {})))
+        if rate_limits is not None and (not isinstance(rate_limits, RateLimits)
+                                        or rate_limits.n != chain.n):
+            raise InputError(
+                "rate_limits",
+                f"expected RateLimits for {chain.n} joints, got {rate_limits!r}")
+        init(self, "rate_limits", rate_limits)
 
     # ------------------------------------------------------------------ building
     @classmethod

@@ -246,7 +246,8 @@ def test_a_file_without_units_that_reads_as_an_89_m_arm_warns(tmp_path):
 def test_sections_are_an_explicit_table():
     from robokin.io import robot_files
 
-    assert set(robot_files.SECTIONS) == {"actuators", "geometry", "collision", "dynamics"}
+    assert set(robot_files.SECTIONS) == {"actuators", "geometry", "collision", "dynamics",
+                                         "rate_limits"}
     assert not hasattr(robot_files, "register_section")
     for section in robot_files.SECTIONS.values():
         assert callable(section.read) and callable(section.write)

@@ -16,8 +16,8 @@ edge. The schema (pydantic, imported lazily) is below; see ``docs/robot-files.md
     tool: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # optional
 
 Sections besides the chain (``actuators``, ``geometry``, ``collision``,
-``dynamics``) are read
-and written by the functions of :data:`SECTIONS`, an explicit table.
+``dynamics``, ``rate_limits``) are read and written by the functions of
+:data:`SECTIONS`, an explicit table.
 
 Numbers must be numbers (``a: "12"`` and ``alpha: yes`` are refused), a file holds
 at most :data:`MAX_JOINTS` rows, names are at most :data:`MAX_NAME` characters and
@@ -40,7 +40,12 @@ import numpy as np
 
 from robokin._validation import MAX_TRANSLATION
 from robokin.exceptions import ModelError
-from robokin.io import actuator_section, dynamics_section, geometry_sections
+from robokin.io import (
+    actuator_section,
+    dynamics_section,
+    geometry_sections,
+    rate_limits_section,
+)
 from robokin.io.atomic import write_atomic
 from robokin.io.text_files import MAX_TEXT_BYTES
 from robokin.io.validate import validate_document
@@ -100,6 +105,8 @@ SECTIONS: dict[str, SectionIO] = {
                            geometry_sections.collision_section),
     "dynamics": SectionIO(dynamics_section.apply_dynamics_section,
                           dynamics_section.dynamics_section),
+    "rate_limits": SectionIO(rate_limits_section.apply_rate_limits_section,
+                             rate_limits_section.section_from_robot),
 }
 
 
@@ -189,6 +196,7 @@ def _schema():
         geometry: Any = None
         collision: Any = None
         dynamics: Any = None  # link masses and torque limits (io/dynamics_section.py)
+        rate_limits: Any = None  # per-joint speed/acceleration/jerk (io.rate_limits_section)
         controller: Any = None  # a controller profile (robokin.trajectory.io), kept raw
 
     return RobotFile, Row, Op
@@ -391,7 +399,8 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
 def _state(robot: Robot) -> tuple:
     """What a stored document must still describe: the same objects, by identity."""
     return (robot.chain, robot.geometry, robot.actuators, robot.name, robot.source,
-            robot.actuator_names, robot.actuator_limits, robot.dynamics)
+            robot.actuator_names, robot.actuator_limits, robot.dynamics,
+            robot.rate_limits)
 
 
 def _document_matches(robot: Robot) -> bool:

@@ -22,6 +22,9 @@ Import rules (documented in ``docs/urdf.md``):
   about any axis; the axis is folded into the constants (a joint about ``-z``,
   ``-x`` or ``-y`` becomes a reversed joint, ``sign = -1``). ``floating`` and
   ``planar`` joints on the chain are refused.
+* **Rate limits.** ``<limit velocity>`` of each independent joint becomes
+  ``robot.rate_limits.velocity`` (a missing or zero velocity, as many vendor URDFs
+  write, is unknown: NaN); URDF has no acceleration or jerk limits.
 * **Mimic.** A ``<mimic>`` joint is a dependent chain joint
   ``value = multiplier * q[master] + offset`` (chains of mimics are resolved). Its
   master becomes an independent coordinate even when it is not on the chain (a
@@ -281,6 +284,26 @@ def _limits(j: Any, file: Path | None) -> tuple[float, float]:
             file=file, field=f"joint[{j.name}].limit",
         )
     return (lo, hi)
+
+
+def _velocity_limits(urdf_robot: Any, chain: Chain, source: str) -> Any:
+    """``<limit velocity>`` of each independent coordinate as RateLimits, or None.
+
+    A velocity that is missing, zero (as in many vendor URDFs) or not finite is
+    unknown (NaN); None when no coordinate has one.
+    """
+    from robokin.model.rate_limits import RateLimits
+
+    by_name = {j.name: j for j in urdf_robot.joints}
+    out = np.full(chain.n, np.nan)
+    for k, c in enumerate(chain.coordinates or ()):
+        j = by_name.get(c.name)
+        v = None if j is None or j.limit is None else j.limit.velocity
+        if v is not None and math.isfinite(float(v)) and float(v) > 0:
+            out[k] = float(v)
+    if np.isnan(out).all():
+        return None
+    return RateLimits(velocity=out, source=f"{source}: <limit velocity>")
 
 
 def _kind(j: Any) -> JointKind:
@@ -631,6 +654,7 @@ def robot_from_urdf(
         name=name or urdf_robot.name,
         source=f"{source}, chain {info.base_link} -> {info.tip_link}",
         meta={"urdf": info, "urdf_shapes": shapes},
+        rate_limits=_velocity_limits(urdf_robot, chain, source),
     )
     if shapes:
         robot = _attach_geometry(robot, shapes, drops)
