@@ -28,6 +28,7 @@ import numpy as np
 
 from robokin.io.atomic import write_atomic
 from robokin.io.urdf import UrdfChain
+from robokin.model.chain import joint_motion
 
 if TYPE_CHECKING:
     from robokin.robot import Robot
@@ -112,18 +113,6 @@ def _origin_el(parent: ET.Element, T: np.ndarray) -> None:
         "xyz": " ".join(_fmt(v) for v in T[:3, 3]),
         "rpy": " ".join(_fmt(v) for v in (r, p, y)),
     })
-
-
-def _rz_or_tz(kind: str, value: float) -> np.ndarray:
-    T = np.eye(4)
-    if value == 0.0:
-        return T
-    if kind == "revolute":
-        c, s = math.cos(value), math.sin(value)
-        T[:2, :2] = [[c, -s], [s, c]]
-    else:
-        T[2, 3] = value
-    return T
 
 
 def urdf_from_robot(
@@ -278,7 +267,7 @@ def urdf_from_robot(
             parts = [(j.name, None, coords[i_self].limits, float(speeds[i_self]))]
         elif not nz:
             # A constant joint: its value folds into the constants.
-            pending = pending @ _rz_or_tz(kind, j.sign * c[kk] + j.offset) @ F
+            pending = pending @ joint_motion(kind, j.sign * c[kk] + j.offset) @ F
             targets.append((parent, pending.copy()))
             pending = pending @ chain.link_offsets[kk]
             continue
@@ -296,7 +285,7 @@ def urdf_from_robot(
         # origin (F^-1 Rz F is then a rotation about F^-1 z): the URDF child link
         # frame is then the robokin link frame.
         fold = kind == "prismatic" or (abs(F[0, 3]) < 1e-15 and abs(F[1, 3]) < 1e-15)
-        T = pending @ _rz_or_tz(kind, j.offset)
+        T = pending @ joint_motion(kind, j.offset)
         for p_i, (pname, mim, lim, speed) in enumerate(parts):
             last = p_i == len(parts) - 1
             child = add_link(child_name if last else f"{child_name}_{p_i + 1}")

@@ -26,7 +26,7 @@ from robokin.exceptions import ModelError
 from robokin.model.chain_arrays import MAX_JOINTS, ChainArrays, chain_arrays
 from robokin.model.coupling import AffineMap
 
-__all__ = ["Chain", "ChainBuilder", "Joint", "JointKind"]
+__all__ = ["Chain", "ChainBuilder", "Joint", "JointKind", "joint_motion"]
 
 JointKind = Literal["revolute", "prismatic"]
 
@@ -73,6 +73,27 @@ class Joint:
 def _ro(a: npt.ArrayLike) -> npt.NDArray[np.float64]:
     out = np.ascontiguousarray(a, dtype=np.float64)
     out.setflags(write=False)
+    return out
+
+
+def joint_motion(kind: JointKind, value: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """The joint's own transform ``J(v)``: a rotation about or translation along z.
+
+    Args:
+        kind: ``"revolute"`` or ``"prismatic"``.
+        value: Chain joint values ``v`` [rad or m], shape (...).
+
+    Returns:
+        Transforms (..., 4, 4).
+    """
+    v = np.asarray(value, dtype=np.float64)
+    out = np.zeros(v.shape + (4, 4))
+    out[..., 0, 0] = out[..., 1, 1] = out[..., 2, 2] = out[..., 3, 3] = 1.0
+    if kind == "revolute":
+        c, s = np.cos(v), np.sin(v)
+        out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1] = c, -s, s, c
+    else:
+        out[..., 2, 3] = v
     return out
 
 
@@ -249,12 +270,7 @@ class Chain:
                 builder.constant(self.link_offsets[k])
                 rows.append(k)
                 continue
-            v = joint.sign * c[k] + joint.offset
-            move = np.eye(4)
-            if joint.kind == "revolute":
-                move[:2, :2] = [[math.cos(v), -math.sin(v)], [math.sin(v), math.cos(v)]]
-            else:
-                move[2, 3] = v
+            move = joint_motion(joint.kind, joint.sign * c[k] + joint.offset)
             builder.constant(move @ self.frame_offsets[k] @ self.link_offsets[k])
         coordinates = tuple(self.coordinates[j] for j in keep)
         coupling = AffineMap(Mk[rows], c[rows])

@@ -50,6 +50,7 @@ import numpy.typing as npt
 
 from robokin._text import short_repr
 from robokin.exceptions import InputError, ModelError
+from robokin.model.chain import joint_motion
 from robokin.model.dynamics import LinkInertia, ResolvedLinks, resolve_links
 from robokin.sim.servo import servo_gains
 
@@ -96,18 +97,6 @@ def _pose_attrs(T: np.ndarray) -> dict[str, str]:
     if not np.array_equal(T[:3, :3], np.eye(3)):
         out["quat"] = _vec(quaternion_from_matrix(T))
     return out
-
-
-def _rz_or_tz(kind: str, value: float) -> np.ndarray:
-    T = np.eye(4)
-    if value == 0.0:
-        return T
-    if kind == "revolute":
-        c, s = math.cos(value), math.sin(value)
-        T[:2, :2] = [[c, -s], [s, c]]
-    else:
-        T[2, 3] = value
-    return T
 
 
 @dataclass(frozen=True)
@@ -452,7 +441,7 @@ class _Writer:
         for k, joint in enumerate(chain.joints):
             F = np.asarray(chain.frame_offsets[k])
             const = joint.sign * c[k] + joint.offset
-            T = pending @ _rz_or_tz(joint.kind, const) @ F
+            T = pending @ joint_motion(joint.kind, const) @ F
             part = parts[k]
             body = self._body(parent, names[k], T, k + 1, moving=True,
                               has_joint=part is not None)

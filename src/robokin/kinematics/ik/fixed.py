@@ -25,6 +25,7 @@ from robokin._validation import check_finite, check_poses_fast
 from robokin.exceptions import InputError
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
+from robokin.model.chain import joint_motion
 
 if TYPE_CHECKING:
     from robokin.kinematics.robot_like import RobotLike
@@ -116,28 +117,15 @@ def _end_joint(robot: RobotLike, idx: list[int]) -> str | None:
     return None
 
 
-def _joint_move(robot: RobotLike, j: int, v: np.ndarray) -> np.ndarray:
-    """J_j(sign * v) for values v (N,): (N, 4, 4)."""
-    joint = robot.chain.joints[j]
-    x = joint.sign * v
-    out = np.broadcast_to(np.eye(4), v.shape + (4, 4)).copy()
-    if joint.kind == "revolute":
-        c, s = np.cos(x), np.sin(x)
-        out[:, 0, 0], out[:, 0, 1], out[:, 1, 0], out[:, 1, 1] = c, -s, s, c
-    else:
-        out[:, 2, 3] = x
-    return out
-
-
 def _moved_targets(robot: RobotLike, end: str, T: np.ndarray, v: np.ndarray) -> np.ndarray:
     """The targets of the reduced chain (held value 0) that equal T at value v."""
     C = robot.chain.arrays.consts
     if end == "last":
         j = robot.n - 1
         Cn = C[-1]
-        return T @ np.linalg.inv(Cn) @ _joint_move(robot, j, -v) @ Cn
+        return T @ np.linalg.inv(Cn) @ joint_motion(robot.chain.joints[j].kind, -robot.chain.joints[j].sign * v) @ Cn
     C0 = C[0]
-    return C0 @ _joint_move(robot, 0, -v) @ np.linalg.inv(C0) @ T
+    return C0 @ joint_motion(robot.chain.joints[0].kind, -robot.chain.joints[0].sign * v) @ np.linalg.inv(C0) @ T
 
 
 def _reduced(robot: RobotLike, idx: list[int], values: tuple[float, ...]) -> Any:
