@@ -108,7 +108,7 @@ def export_urdf(
 
 @app.command("dh")
 def dh(
-    file: Annotated[Path, typer.Argument(help="The URDF file.")],
+    file: Annotated[Path, typer.Argument(help="The URDF or xacro file.")],
     base: Annotated[str | None, typer.Option("--base", help="Base link.")] = None,
     tip: Annotated[str | None, typer.Option("--tip", help="Tip link.")] = None,
     modified: Annotated[
@@ -124,8 +124,12 @@ def dh(
     ] = False,
     mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Machine-readable.")] = False,
+    package: Annotated[list[str] | None, typer.Option(
+        "--package", help="NAME=DIR for a xacro's $(find NAME) (repeatable).")] = None,
+    arg: Annotated[list[str] | None, typer.Option(
+        "--arg", help="NAME=VALUE for a xacro's <xacro:arg> (repeatable).")] = None,
 ) -> None:
-    """Derive the DH table of a URDF arm (degrees; metres unless --mm)."""
+    """Derive the DH table of a URDF or xacro arm (degrees; metres unless --mm)."""
     from rich.table import Table
 
     from robokin.io.dh_extract import describe
@@ -134,6 +138,7 @@ def dh(
     ext = dh_from_urdf(
         file, base, tip, convention="modified" if modified else "standard",
         reference_link=reference, virtual_frames=virtual,
+        package_map=_pairs(package, "--package"), xacro_args=_pairs(arg, "--arg"),
     )
     doc = describe(ext, deg=True)
     L = 1000.0 if mm else 1.0

@@ -238,3 +238,21 @@ def test_cli_import_xacro_notes_each_dropped_mesh(tmp_path, capsys, monkeypatch)
     code = main(["import", str(ARM), "--arg", "upper_length"])
     _, err = capsys.readouterr()
     assert code == 2 and "--arg expects NAME=VALUE" in err
+
+
+def test_cli_dh_reads_a_xacro(capsys, tmp_path):
+    import json
+
+    from robokin.cli import main
+
+    root = rtb_xacro() / "abb_irb140_description"
+    xacro = root / "urdf" / "irb140.xacro"
+    code = main(["dh", str(xacro), "--package", f"abb_irb140={root}", "--mm", "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    expanded = tmp_path / "irb140.urdf"
+    expanded.write_text(expand_xacro(xacro, package_map={"abb_irb140": root}).urdf)
+    code = main(["dh", str(expanded), "--mm", "--json"])
+    same, _ = capsys.readouterr()
+    assert code == 0 and json.loads(out)["rows"] == json.loads(same)["rows"]
+    assert len(json.loads(out)["rows"]) == 6
