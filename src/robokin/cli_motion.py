@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -17,6 +17,10 @@ from robokin.io.motion_files import (
     load_motion_file,
     plan_from_document,
 )
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+    from robokin.trajectory.samples import Trajectory
 
 __all__ = ["compare", "traj"]
 
@@ -45,12 +49,25 @@ def traj(
     max_samples: Annotated[int, typer.Option(
         "--max-samples", help="Most samples the motion may hold (refused above).")
     ] = MAX_MOTION_SAMPLES,
+    ros2: Annotated[Path | None, typer.Option(
+        "--ros2", help="Also write a ROS 2 trajectory_msgs/JointTrajectory (YAML; "
+        "replaced if it exists).")] = None,
+    ros2_goal: Annotated[bool, typer.Option(
+        "--ros2-goal", help="Write --ros2 as a FollowJointTrajectory action goal.")
+    ] = False,
+    ros2_stride: Annotated[int, typer.Option(
+        "--ros2-stride", help="Keep every N-th sample (and the last) in --ros2.")] = 1,
+    program: Annotated[Path | None, typer.Option(
+        "--program", help="Also write the program the robot's controller profile "
+        "names (URScript, ROS 2 or waypoint file; replaced if it exists).")] = None,
 ) -> None:
     """Plan a motion through via points: write the samples (CSV) and a plot, print a summary.
 
     Without -o the CSV goes next to the motion file as FILE.csv (never replacing
-    an existing file); the plot likewise as FILE.png. Exit code 1 when the
-    motion violates a joint limit (the files are still written).
+    an existing file); the plot likewise as FILE.png. --ros2 and --program use
+    the robot file's controller: section (joint names, order, signs, offsets;
+    docs/controllers.md, docs/ros2.md). Exit code 1 when the motion violates a
+    joint limit (the files are still written).
     """
     import numpy as np
     from rich.progress import Progress
@@ -85,6 +102,7 @@ def traj(
                         title=f"{robot.name}: {path.name}"[:200])
     except InputError as exc:
         raise InputError(exc.argument, exc.reason + " (or give -o / --plot)") from None
+    extra = _controller_outputs(robot, tr, ros2, ros2_goal, ros2_stride, program)
     L = 1e-3 if spec.units.length == "mm" else 1.0
     A = math.pi / 180.0 if spec.units.angle == "deg" else 1.0
     jscale = np.where(robot.is_revolute, A, L)
@@ -99,6 +117,7 @@ def traj(
         print(json_text({
             "robot": robot.name, "duration": tr.duration, "samples": len(tr),
             "dt": spec.dt, "csv": str(csv_path), "plot": None if png is None else str(png),
+            "controller_files": extra,
             "joints": list(robot.joint_names),
             "peak_velocity": peaks["velocity"].tolist(),
             "peak_acceleration": peaks["acceleration"].tolist(),
@@ -122,6 +141,8 @@ def traj(
         con.print(table)
         con.print(f"wrote {csv_path}" + ("" if png is None else f" and {png}"),
                   markup=False)
+        for line in extra:
+            con.print(line, markup=False, soft_wrap=True)
         if report.ok:
             con.print("limits: no violation")
         else:
@@ -131,10 +152,62 @@ def traj(
         raise DomainFailure(f"{len(report)} limit violation(s); first: {report.first()}")
 
 
+def _controller_outputs(robot: Robot, tr: Trajectory, ros2: Path | None, goal: bool,
+                        stride: int, program: Path | None) -> list[str]:
+    """Write --ros2 and --program; one line per file saying what it holds."""
+    from robokin.exceptions import InputError
+    from robokin.trajectory.controllers import (
+        controller_profile,
+        write_controller_program,
+    )
+    from robokin.trajectory.ros2 import write_joint_trajectory
+
+    if (goal or stride != 1) and ros2 is None:
+        raise InputError("--ros2-goal" if goal else "--ros2-stride", "needs --ros2 OUT.yaml")
+    lines = []
+    if ros2 is not None:
+        prof = controller_profile(robot)
+        write_joint_trajectory(tr, ros2, robot.joint_names, profile=prof, stride=stride,
+                               action_goal=goal, overwrite=True)
+        kind = "FollowJointTrajectory goal" if goal else "trajectory_msgs/JointTrajectory"
+        lines.append(f"wrote {ros2}: ROS 2 {kind} (YAML), controller profile "
+                     f"'{prof.name}'")
+    if program is not None:
+        prog = write_controller_program(robot, tr, program, overwrite=True)
+        lines.append(f"wrote {program}: {prog.describe()}")
+    return lines
+
+
+def _is_bag(path: Path) -> bool:
+    """A ROS 2 bag: a folder with metadata.yaml, an .mcap or a .db3 file."""
+    return path.suffix.lower() in (".mcap", ".db3") or (path / "metadata.yaml").is_file()
+
+
+def _read_run(log: Path, plan: Trajectory, topic: str | None, stamp: str
+              ) -> Trajectory:
+    """The logged run, joints matched by name to the plan's (a CSV or a bag)."""
+    from robokin.exceptions import InputError
+    from robokin.trajectory.io import read_log
+
+    if not _is_bag(log):
+        if topic is not None:
+            raise InputError("--topic", f"applies to ROS 2 bags (.mcap, .db3 or a bag "
+                             f"folder); {log} is read as CSV")
+        return read_log(log, joint_names=plan.joint_names, is_revolute=plan.revolute())
+    from robokin.trajectory.ros2 import read_bag_log
+
+    if stamp not in ("header", "receive"):
+        raise InputError("--stamp", f"expected header or receive, got {stamp!r}")
+    return read_bag_log(log, topic=topic or "/joint_states",
+                        joint_names=plan.joint_names, is_revolute=plan.revolute(),
+                        stamp="header" if stamp == "header" else "receive")
+
+
 @app.command(context_settings=_NUMERIC_ARGS)
 def compare(
     plan: Annotated[Path, typer.Argument(help="Planned trajectory CSV.")],
-    log: Annotated[Path, typer.Argument(help="Logged run CSV (time + joints).")],
+    log: Annotated[Path, typer.Argument(
+        help="Logged run: CSV (time + joints), or a ROS 2 bag (folder, .mcap or .db3).")],
     plot: Annotated[Path | None, typer.Option(
         "--plot", help="Error plot to write (replaced if it exists).")] = None,
     no_plot: Annotated[bool, typer.Option("--no-plot", help="Write no plot.")] = False,
@@ -144,18 +217,25 @@ def compare(
         "--rad", help="Report radians and metres (default degrees and mm).")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")
                        ] = False,
+    topic: Annotated[str | None, typer.Option(
+        "--topic", help="JointState topic of a ROS 2 bag log (default /joint_states).")
+    ] = None,
+    stamp: Annotated[str, typer.Option(
+        "--stamp", help="Bag log time: header (stamps) or receive (bag times).")
+    ] = "header",
 ) -> None:
     """Compare a logged real run with its plan: per-joint max and RMS error, a plot.
 
-    The plot goes to LOG_vs_plan.png next to the log unless --plot is given
-    (an existing file is replaced only when named with --plot).
+    The log is a CSV or a ROS 2 bag's sensor_msgs/JointState topic (robokin[ros]);
+    its joints are matched to the plan's by name. The plot goes to
+    LOG_vs_plan.png next to the log unless --plot is given (an existing file is
+    replaced only when named with --plot).
     """
     from robokin.trajectory.compare import compare as run_compare
-    from robokin.trajectory.io import read_csv, read_log
+    from robokin.trajectory.io import read_csv
 
     p = read_csv(plan)
-    # the log's joint columns are matched to the plan's by name (any order)
-    r = read_log(log, joint_names=p.joint_names, is_revolute=p.revolute())
+    r = _read_run(log, p, topic, stamp)
     cmp = run_compare(p, r, time_shift=time_shift)
     rows = cmp.table(degrees=not radians)
     png = None

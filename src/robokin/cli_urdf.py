@@ -25,9 +25,20 @@ def _not_the_input(out: Path, source: str | Path) -> None:
         raise InputError("--out", f"{out} is the input file; choose another name")
 
 
+def _pairs(items: list[str] | None, option: str) -> dict[str, str]:
+    """``NAME=VALUE`` options as a dict (a usage error names the option)."""
+    out: dict[str, str] = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            raise typer.BadParameter(f"{option} expects NAME=VALUE, got {item!r}")
+        out[name.strip()] = value
+    return out
+
+
 @app.command("import")
 def import_urdf(
-    file: Annotated[Path, typer.Argument(help="The URDF file.")],
+    file: Annotated[Path, typer.Argument(help="The URDF or xacro (.xacro, .urdf.xacro) file.")],
     base: Annotated[str | None, typer.Option("--base", help="Base link.")] = None,
     tip: Annotated[str | None, typer.Option("--tip", help="Tip link.")] = None,
     out: Annotated[
@@ -35,29 +46,31 @@ def import_urdf(
     ] = None,
     package: Annotated[
         list[str] | None,
-        typer.Option("--package", help="NAME=DIR for package:// meshes (repeatable)."),
+        typer.Option("--package", help="NAME=DIR for package:// and $(find NAME) "
+                     "(repeatable; searched before ROS_PACKAGE_PATH)."),
+    ] = None,
+    arg: Annotated[
+        list[str] | None,
+        typer.Option("--arg", help="NAME=VALUE for a xacro's <xacro:arg> (repeatable)."),
     ] = None,
 ) -> None:
-    """Read a URDF's serial chain and write it as a robokin robot file.
+    """Read a URDF's or xacro's serial chain and write it as a robokin robot file.
 
-    Every visual or collision shape left out (a missing, remote or unsupported
-    mesh, a non-uniform scale) is reported on stderr, one line each.
+    A xacro is expanded first (robokin[ros]; no ROS install). Every visual or
+    collision shape left out (a mesh whose package or file is not found, a
+    remote or unsupported mesh, a non-uniform scale) is reported on stderr,
+    one line each.
     """
     import yaml
 
     from robokin.io.robot_files import document_from_robot, save_robot
     from robokin.io.urdf import robot_from_urdf
 
-    pmap = {}
-    for item in package or []:
-        name, sep, directory = item.partition("=")
-        if not sep or not name:
-            raise typer.BadParameter(f"--package expects NAME=DIR, got {item!r}")
-        pmap[name] = directory
+    pmap = _pairs(package, "--package")
     if out is not None:
         _not_the_input(out, file)
     robot = robot_from_urdf(file, base_link=base, tip_link=tip, package_map=pmap,
-                            missing_mesh="ignore")
+                            xacro_args=_pairs(arg, "--arg"), missing_mesh="ignore")
     info = robot.meta["urdf"]
     for msg in robot.meta.get("urdf_dropped_shapes", ()):
         typer.echo(f"robokin: note: left out {msg}", err=True)
@@ -140,7 +153,7 @@ def export_urdf(
 
 @app.command("dh")
 def dh(
-    file: Annotated[Path, typer.Argument(help="The URDF file.")],
+    file: Annotated[Path, typer.Argument(help="The URDF or xacro file.")],
     base: Annotated[str | None, typer.Option("--base", help="Base link.")] = None,
     tip: Annotated[str | None, typer.Option("--tip", help="Tip link.")] = None,
     modified: Annotated[
@@ -156,8 +169,12 @@ def dh(
     ] = False,
     mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Machine-readable.")] = False,
+    package: Annotated[list[str] | None, typer.Option(
+        "--package", help="NAME=DIR for a xacro's $(find NAME) (repeatable).")] = None,
+    arg: Annotated[list[str] | None, typer.Option(
+        "--arg", help="NAME=VALUE for a xacro's <xacro:arg> (repeatable).")] = None,
 ) -> None:
-    """Derive the DH table of a URDF arm (degrees; metres unless --mm)."""
+    """Derive the DH table of a URDF or xacro arm (degrees; metres unless --mm)."""
     from rich.table import Table
 
     from robokin.io.dh_extract import describe
@@ -166,6 +183,7 @@ def dh(
     ext = dh_from_urdf(
         file, base, tip, convention="modified" if modified else "standard",
         reference_link=reference, virtual_frames=virtual,
+        package_map=_pairs(package, "--package"), xacro_args=_pairs(arg, "--arg"),
     )
     doc = describe(ext, deg=True)
     L = 1000.0 if mm else 1.0

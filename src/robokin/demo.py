@@ -21,8 +21,10 @@ the workpiece between the dies along a straight final approach, then retracts.
   checked against the press again.
 
 Outputs in ``--out`` (default ``./robokin-demo``): ``trajectory.csv`` (time and
-joints), ``waypoints.csv`` (controller waypoints in degrees) and
-``program.script`` (a URScript ``servoj`` listing), ``joints.png``,
+joints), ``waypoints.csv`` (the via points in degrees, for reading), the program
+the AUBO-i5's controller profile names (``program.waypoints.csv``: every sample in
+the controller's joint order and units, for AUBO's SDK waypoint calls; see
+:mod:`robokin.trajectory.controllers`), ``joints.png``,
 ``tool_path.png`` (3D with projections), ``press_views.png`` (the tool path inside
 the press, side and top views), ``distance.csv`` and ``distance.png`` (the closest
 body pairs over time), ``animation.html`` (the
@@ -444,7 +446,8 @@ against the press cell. The motion plays in <a href="animation.html">animation.h
 {figs}
 {extra}
 <p style="font-size:0.8em;color:#57606a">Files: trajectory.csv (time and joints),
-waypoints.csv (controller waypoints, degrees), program.script (URScript servoj),
+waypoints.csv (the via points, degrees), {html.escape(s["controller"]["file"])}
+({html.escape(s["controller"]["description"])}),
 distance.csv (closest body pairs over time, mm), summary.json. The workpiece rides
 between the fingers inside the gripper's envelope and is not a separate body. Joint speed limit: AUBO-i5 published 150 deg/s; the acceleration cap
 is the demo's choice.</p>
@@ -535,10 +538,14 @@ def run_demo(
         cycle = _cycle_times(robot, bare, scene, traj, clearance)
 
         t = time.perf_counter()
+        from robokin.trajectory.controllers import controller_program
+
+        program = controller_program(bare, traj)  # what the robot's controller runs
+        program_name = "program" + program.suffix
         outputs = [
             "trajectory.csv",
             "waypoints.csv",
-            "program.script",
+            program_name,
             "joints.png",
             "tool_path.png",
             "press_views.png",
@@ -585,12 +592,7 @@ def run_demo(
                 overwrite=True,
             ),
         )
-        done(
-            "program.script",
-            io.write_ur_script(
-                traj, out / "program.script", overwrite=True, program="press_loading"
-            ),
-        )
+        done(program_name, write_atomic(out / program_name, program.text))
         plots.plot_joints(
             traj,
             path=out / "joints.png",
@@ -637,6 +639,9 @@ def run_demo(
         timings["total"] = time.perf_counter() - t_start
         summary = _summary(robot, traj, report, limits, via, clearance, timings)
         summary["cycle_time"] = cycle
+        summary["controller"] = {"program": program.program, "file": program_name,
+                                 "profile": program.profile.name,
+                                 "description": program.describe()}
         images = {
             k: files[k]
             for k in ("joints.png", "press_views.png", "distance.png", "tool_path.png")
@@ -691,6 +696,7 @@ def run_demo(
         f"{timings['total']:.1f} s (plan {timings['plan']:.2f}, "
         f"check {timings['check']:.2f}, write {timings['write']:.2f})",
     )
+    table.add_row("controller program", f"{program_name}: {program.describe()}")
     if sim:
         sr = summary["simulated_run"]
         table.add_row("simulated run", (

@@ -222,7 +222,13 @@ class Robot:
         cls, path: str | Path, base_link: str | None = None, tip_link: str | None = None,
         **kwargs: Any,
     ) -> Robot:
-        """Load the serial chain of a URDF file (needs ``robokin[urdf]``)."""
+        """Load the serial chain of a URDF or xacro file (needs ``robokin[urdf]``).
+
+        A ``.xacro`` / ``.urdf.xacro`` file is expanded first (needs
+        ``robokin[ros]``): ``Robot.from_urdf("arm.urdf.xacro",
+        package_map={"pkg": "dir"}, xacro_args={"name": "value"}, tip_link=...)``.
+        Keywords as :func:`robokin.io.urdf.robot_from_urdf`.
+        """
         from robokin.io.urdf import robot_from_urdf
 
         return robot_from_urdf(path, base_link=base_link, tip_link=tip_link, **kwargs)

@@ -51,6 +51,7 @@ from robokin.io.text_files import MAX_CSV_BYTES, read_text_file
 from robokin.trajectory.samples import Trajectory
 
 __all__ = [
+    "PROGRAMS",
     "ControllerProfile",
     "load_profile",
     "read_csv",
@@ -67,6 +68,8 @@ _T = TypeVar("_T")
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 _LENGTH = {"m": 1.0, "mm": 1e-3}
 _TIME = {"s": 1.0, "ms": 1e-3}
+#: Programs a controller profile may name (robokin.trajectory.controllers).
+PROGRAMS = ("urscript", "ros2", "waypoints")
 _HEADER = re.compile(r"^\s*(?P<name>.*?)\s*(?:\[(?P<unit>[^\]]*)\])?\s*$")
 
 
@@ -87,6 +90,9 @@ class ControllerProfile:
         angle_unit: ``"rad"`` or ``"deg"``.
         length_unit: ``"m"`` or ``"mm"``.
         names: Column names for the controller (default: the model's names).
+        programs: What the controller runs, its default first: ``"urscript"``,
+            ``"ros2"``, ``"waypoints"`` (:mod:`robokin.trajectory.controllers`);
+            None: any but URScript, a waypoint file by default.
     """
 
     name: str = "default"
@@ -96,6 +102,7 @@ class ControllerProfile:
     angle_unit: Literal["rad", "deg"] = "rad"
     length_unit: Literal["m", "mm"] = "m"
     names: tuple[str, ...] | None = None
+    programs: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
         """Check the units and the per-column lists; store them as tuples."""
@@ -108,7 +115,11 @@ class ControllerProfile:
         if self.signs is not None and any(s not in (1, -1) for s in self.signs):
             raise ModelError(f"signs must be +1 or -1, got {list(self.signs)}",
                              field="signs")
-        for f in ("order", "signs", "offsets", "names"):
+        bad = [p for p in self.programs or () if p not in PROGRAMS]
+        if bad or (self.programs is not None and not self.programs):
+            raise ModelError(f"programs must be a non-empty list of {list(PROGRAMS)}, "
+                             f"got {short_repr(self.programs)}", field="programs")
+        for f in ("order", "signs", "offsets", "names", "programs"):
             v = getattr(self, f)
             if v is not None:
                 object.__setattr__(self, f, tuple(v))
@@ -119,11 +130,11 @@ class ControllerProfile:
 
         Keys: ``name``, ``order`` (indices or joint names, with ``joints`` giving the
         model's names), ``signs``, ``offsets`` (in ``offset_unit``, default the
-        profile's units), ``angle_unit``, ``length_unit``, ``names``.
+        profile's units), ``angle_unit``, ``length_unit``, ``names``, ``programs``.
         """
         doc = dict(doc)
         known = {"name", "order", "signs", "offsets", "offset_unit", "angle_unit",
-                 "length_unit", "names", "joints"}
+                 "length_unit", "names", "joints", "programs"}
         extra = sorted(set(doc) - known)
         if extra:
             raise ModelError(f"unknown key(s) {extra}; known: {sorted(known)}",
@@ -132,6 +143,7 @@ class ControllerProfile:
         signs = _list_field(doc, "signs", (int, float), file)
         offsets = _list_field(doc, "offsets", (int, float), file)
         names = _list_field(doc, "names", (str,), file)
+        programs = _list_field(doc, "programs", (str,), file)
         for key in ("name", "angle_unit", "length_unit", "offset_unit"):
             if key in doc and not isinstance(doc[key], str):
                 raise ModelError(f"expected text, got {short_repr(doc[key])}",
@@ -153,7 +165,8 @@ class ControllerProfile:
             return cls(name=doc.get("name", "default"), order=_tuple(order),
                        signs=_tuple(signs), offsets=_tuple(offsets),
                        angle_unit=doc.get("angle_unit", "rad"),
-                       length_unit=doc.get("length_unit", "m"), names=_tuple(names))
+                       length_unit=doc.get("length_unit", "m"), names=_tuple(names),
+                       programs=_tuple(programs))
         except ModelError as exc:
             raise ModelError(exc.reason, file=file, field=exc.field) from None
 
