@@ -315,6 +315,7 @@ def _register_extra_commands() -> None:
         "robokin.cli_view",
         "robokin.cli_actuators",
         "robokin.cli_workspace",
+        "robokin.cli_schema",
     ):
         try:
             importlib.import_module(mod)
