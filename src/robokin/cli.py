@@ -17,7 +17,6 @@ from __future__ import annotations
 import math
 import sys
 import warnings
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -122,52 +121,6 @@ def robots(output_format: FormatOption = None) -> None:
         emit(table, fmt)
 
 
-#: Display units of ``robokin show``: the same for every arm.
-_SHOW_LENGTH, _SHOW_ANGLE = ("mm", 1000.0), ("deg", 180.0 / math.pi)
-
-
-def _show_rows(doc: dict[str, Any]) -> tuple[list[str], list[Sequence[Any]]]:
-    """The joint rows of a robot document in mm and degrees (keys, rows)."""
-    units = doc.get("units") or {}
-    to_m = 1e-3 if units.get("length") == "mm" else 1.0
-    to_rad = math.pi / 180.0 if units.get("angle") == "deg" else 1.0
-    length = to_m * _SHOW_LENGTH[1]
-    angle = to_rad * _SHOW_ANGLE[1]
-
-    def scale(row: dict[str, Any], key: str) -> float:
-        prismatic = row.get("joint") == "prismatic"
-        if key in ("a", "d"):
-            return length
-        if key in ("alpha", "theta"):
-            return angle
-        if key == "value":
-            return angle if str(row.get("op", "r")).startswith("r") else length
-        if key in ("limits", "depends_offset"):
-            return length if prismatic else angle
-        return 1.0
-
-    keys: list[str] = []
-    for row in doc["joints"]:
-        keys += [k for k in row if k not in keys]
-    rows: list[Sequence[Any]] = []
-    for row in doc["joints"]:
-        out: list[Any] = []
-        for k in keys:
-            v = row.get(k)
-            if isinstance(v, bool) or k == "sign":
-                out.append(v)
-            elif isinstance(v, int | float):
-                out.append(float(v) * scale(row, k))
-            elif isinstance(v, list | tuple) and all(isinstance(x, int | float)
-                                                      for x in v):
-                out.append("[" + ", ".join(f"{float(x) * scale(row, k):.10g}"
-                                           for x in v) + "]")
-            else:
-                out.append(v)
-        rows.append(out)
-    return keys, rows
-
-
 @app.command()
 def show(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
@@ -190,11 +143,12 @@ def show(
         tables_json,
     )
     from robokin.io.robot_files import document_from_robot
+    from robokin.io.robot_tables import MM_PER_M, joint_rows_mm_deg
 
     fmt = resolve_format(output_format)
     r = _load(name)
     doc = document_from_robot(r)
-    keys, rows = _show_rows(doc)
+    keys, rows = joint_rows_mm_deg(doc)
     num = general(10)
     dh = OutputTable(
         f"{r.name}: {doc.get('convention', '?')} (lengths mm, angles deg)",
@@ -206,7 +160,7 @@ def show(
                       [Column("joint"), Column("kind"), Column("lower", general(10), True),
                        Column("upper", general(10), True)])
     for c, (lo, hi) in zip(r.chain.coordinates, r.limits):
-        s = _SHOW_ANGLE[1] if c.kind == "revolute" else _SHOW_LENGTH[1]
+        s = 180.0 / math.pi if c.kind == "revolute" else MM_PER_M
         lim.add_row(c.name, c.kind, float(lo * s), float(hi * s))
     tables = [dh, lim]
     if r.actuators is not None:
@@ -217,7 +171,7 @@ def show(
         for row_a, b in zip(r.actuators.matrix, r.actuators.offset):
             act.add_row(*[float(v) for v in row_a], float(b))
         tables.append(act)
-    tool = r.fk(np.zeros(r.n))[:3, 3] * _SHOW_LENGTH[1]
+    tool = r.fk(np.zeros(r.n))[:3, 3] * MM_PER_M
     if fmt == "json":
         print(json_text({"robot": r.name, "units": {"length": "mm", "angle": "deg"},
                          "tool_at_zero_mm": tool.tolist(), "source": r.source,
