@@ -97,8 +97,12 @@ def test_a_folded_cell_keeps_every_character(capsys, monkeypatch):
     assert len(lines) > 1 and "".join(lines) == repr(value)
 
 
+URDF = os.path.join(os.path.dirname(__file__), "data", "urdf", "ur5.urdf")
+
+
 @pytest.mark.parametrize("cmd", [["robots"], ["show", "panda"],
-                                 ["motors", "scara", "0", "0", "0", "0.1"]])
+                                 ["motors", "scara", "0", "0", "0", "0.1"],
+                                 ["dh", URDF, "--mm"]])
 def test_every_table_command_has_csv_and_text(capsys, cmd):
     code, out, _ = run(capsys, *cmd, "--format", "csv")
     assert code == 0 and "…" not in out
