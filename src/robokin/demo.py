@@ -597,8 +597,8 @@ def run_demo(
     files["summary.json"] = out / MARKER
 
     table = Table(title="robokin demo: AUBO-i5 loads a press", show_header=False)
-    table.add_column(style="bold")
-    table.add_column()
+    table.add_column(style="bold", overflow="fold")
+    table.add_column(overflow="fold")  # never cut a value
     c = summary["closest"] or {}
     table.add_row(
         "duration",
