@@ -11,7 +11,8 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from robokin.cli import DomainFailure, app, cell, json_text
+from robokin.cli import DomainFailure, app, json_text
+from robokin.cli_output import FormatOption, resolve_format
 from robokin.io.motion_files import (
     MAX_MOTION_SAMPLES,
     load_motion_file,
@@ -44,7 +45,7 @@ def traj(
     no_plot: Annotated[bool, typer.Option("--no-plot", help="Write no plot.")] = False,
     rates: Annotated[bool, typer.Option(
         "--rates", help="Also write velocity and acceleration columns.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable summary.")
+    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
                        ] = False,
     max_samples: Annotated[int, typer.Option(
         "--max-samples", help="Most samples the motion may hold (refused above).")
@@ -60,27 +61,33 @@ def traj(
     program: Annotated[Path | None, typer.Option(
         "--program", help="Also write the program the robot's controller profile "
         "names (URScript, ROS 2 or waypoint file; replaced if it exists).")] = None,
+    force: Annotated[bool, typer.Option(
+        "--force", help="Replace FILE.csv / FILE.png left by an earlier run.")] = False,
+    output_format: FormatOption = None,
 ) -> None:
     """Plan a motion through via points: write the samples (CSV) and a plot, print a summary.
 
-    Without -o the CSV goes next to the motion file as FILE.csv (never replacing
-    an existing file); the plot likewise as FILE.png. --ros2 and --program use
-    the robot file's controller: section (joint names, order, signs, offsets;
-    docs/controllers.md, docs/ros2.md). Exit code 1 when the motion violates a
-    joint limit (the files are still written).
+    Without -o the CSV goes next to the motion file as FILE.csv (an existing one
+    is replaced only with --force); the plot likewise as FILE.png. The CSV and the
+    plot are written all or none: nothing is written when either cannot be.
+    --ros2 and --program use the robot file's controller: section (joint names,
+    order, signs, offsets; docs/controllers.md, docs/ros2.md). Exit code 1 when the
+    motion violates a joint limit (the files are still written).
     """
     import numpy as np
     from rich.progress import Progress
 
     from robokin.exceptions import InputError
+    from robokin.io.atomic import staged_outputs
     from robokin.trajectory import PathError
     from robokin.trajectory.io import write_csv
 
+    fmt = resolve_format(output_format, as_json)
     if max_samples < 1:
         raise InputError("--max-samples", f"expected a count >= 1, got {max_samples}")
     spec, path = load_motion_file(file)
     try:
-        if as_json:
+        if fmt != "table":
             robot, tr = plan_from_document(spec, path, max_samples=max_samples)
         else:
             with Progress(transient=True) as bar:
@@ -91,17 +98,17 @@ def traj(
     except PathError as exc:
         raise DomainFailure(str(exc)) from None
     csv_path, csv_over = _default_out(output, path.with_suffix(".csv"), True)
-    try:
-        write_csv(tr, csv_path, robot.joint_names, rates=rates, overwrite=csv_over)
-        png = None
-        if not no_plot:
+    outputs = [(csv_path, "-o", csv_over or force)]
+    png = None
+    if not no_plot:
+        png, png_over = _default_out(plot, path.with_suffix(".png"), True)
+        outputs.append((png, "--plot", png_over or force))
+    with staged_outputs(outputs, how="pass --force (or give -o / --plot)") as staged:
+        write_csv(tr, staged[0], robot.joint_names, rates=rates)
+        if png is not None:
             from robokin.viz.plots import plot_joints
 
-            png, png_over = _default_out(plot, path.with_suffix(".png"), True)
-            plot_joints(tr, path=png, overwrite=png_over,
-                        title=f"{robot.name}: {path.name}"[:200])
-    except InputError as exc:
-        raise InputError(exc.argument, exc.reason + " (or give -o / --plot)") from None
+            plot_joints(tr, path=staged[1], title=f"{robot.name}: {path.name}"[:200])
     extra = _controller_outputs(robot, tr, ros2, ros2_goal, ros2_stride, program)
     L = 1e-3 if spec.units.length == "mm" else 1.0
     A = math.pi / 180.0 if spec.units.angle == "deg" else 1.0
@@ -113,7 +120,7 @@ def traj(
     report = tr.check_limits(robot, velocity=vel, acceleration=acc)
     peaks = tr.peaks()
     su = np.where(robot.is_revolute, 180 / math.pi, 1000.0)
-    if as_json:
+    if fmt == "json":
         print(json_text({
             "robot": robot.name, "duration": tr.duration, "samples": len(tr),
             "dt": spec.dt, "csv": str(csv_path), "plot": None if png is None else str(png),
@@ -124,30 +131,28 @@ def traj(
             "violations": [v.__dict__ for v in report],
         }))
     else:
-        from rich.console import Console
-        from rich.table import Table
+        from robokin.cli_output import Column, OutputTable, emit, fixed, say
 
-        con = Console()
-        con.print(f"{cell(robot.name, markup=False)}: {len(tr.labels)} segments, {tr.duration:.3f} s, "
-                  f"{len(tr)} samples at {spec.dt * 1000:g} ms", markup=False)
-        table = Table(title="peaks per joint")
-        for col in ("joint", "unit", "min", "max", "peak |vel| /s", "peak |acc| /s²"):
-            table.add_column(col)
+        say(f"{robot.name}: {len(tr.labels)} segments, {tr.duration:.3f} s, "
+            f"{len(tr)} samples at {spec.dt * 1000:g} ms", fmt)
+        f3 = fixed(3)
+        table = OutputTable("peaks per joint", [
+            Column("joint"), Column("unit"), Column("min", f3, True),
+            Column("max", f3, True), Column("peak |vel| /s", f3, True),
+            Column("peak |acc| /s²", f3, True)])
         for j, name in enumerate(robot.joint_names):
-            table.add_row(cell(name), "deg" if robot.is_revolute[j] else "mm",
-                          f"{peaks['min'][j] * su[j]:.3f}", f"{peaks['max'][j] * su[j]:.3f}",
-                          f"{peaks['velocity'][j] * su[j]:.3f}",
-                          f"{peaks['acceleration'][j] * su[j]:.3f}")
-        con.print(table)
-        con.print(f"wrote {csv_path}" + ("" if png is None else f" and {png}"),
-                  markup=False)
+            table.add_row(name, "deg" if robot.is_revolute[j] else "mm",
+                          *(float(peaks[k][j] * su[j])
+                            for k in ("min", "max", "velocity", "acceleration")))
+        emit(table, fmt)
+        say(f"wrote {csv_path}" + ("" if png is None else f" and {png}"), fmt)
         for line in extra:
-            con.print(line, markup=False, soft_wrap=True)
+            say(line, fmt)
         if report.ok:
-            con.print("limits: no violation")
+            say("limits: no violation", fmt)
         else:
             for v in report:
-                con.print(f"limit violated: {v}", markup=False)
+                say(f"limit violated: {v}", fmt)
     if not report.ok:
         raise DomainFailure(f"{len(report)} limit violation(s); first: {report.first()}")
 
@@ -215,7 +220,7 @@ def compare(
         "--time-shift", help="Added to the log's times [s].")] = 0.0,
     radians: Annotated[bool, typer.Option(
         "--rad", help="Report radians and metres (default degrees and mm).")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")
+    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
                        ] = False,
     topic: Annotated[str | None, typer.Option(
         "--topic", help="JointState topic of a ROS 2 bag log (default /joint_states).")
@@ -223,6 +228,7 @@ def compare(
     stamp: Annotated[str, typer.Option(
         "--stamp", help="Bag log time: header (stamps) or receive (bag times).")
     ] = "header",
+    output_format: FormatOption = None,
 ) -> None:
     """Compare a logged real run with its plan: per-joint max and RMS error, a plot.
 
@@ -234,6 +240,7 @@ def compare(
     from robokin.trajectory.compare import compare as run_compare
     from robokin.trajectory.io import read_csv
 
+    fmt = resolve_format(output_format, as_json)
     p = read_csv(plan)
     r = _read_run(log, p, topic, stamp)
     cmp = run_compare(p, r, time_shift=time_shift)
@@ -244,22 +251,18 @@ def compare(
 
         png, over = _default_out(plot, log.with_name(log.stem + "_vs_plan.png"), True)
         plot_comparison(cmp, path=png, overwrite=over, degrees=not radians)
-    if as_json:
+    if fmt == "json":
         print(json_text({"joints": rows, "plot": None if png is None else str(png)}))
         return
-    from rich.console import Console
-    from rich.table import Table
+    from robokin.cli_output import Column, OutputTable, emit, fixed, say
 
-    table = Table(title=f"{cell(log.name)} vs {cell(plan.name)}: {len(cmp.t)} samples "
-                        "compared")
-    for col in ("joint", "unit", "max |error|", "at t [s]", "RMS", "mean",
-                "corr(|error|, |acc|)"):
-        table.add_column(col)
+    table = OutputTable(f"{log.name} vs {plan.name}: {len(cmp.t)} samples compared", [
+        Column("joint"), Column("unit"), Column("max |error|", fixed(4), True),
+        Column("at t [s]", fixed(3), True), Column("RMS", fixed(4), True),
+        Column("mean", fixed(4), True), Column("corr(|error|, |acc|)", fixed(2), True)])
     for row in rows:
-        table.add_row(cell(row["joint"]), row["unit"], f"{row['max']:.4f}",
-                      f"{row['t_max']:.3f}", f"{row['rms']:.4f}", f"{row['mean']:.4f}",
-                      f"{row['corr_acc']:.2f}")
-    con = Console()
-    con.print(table)
+        table.add_row(row["joint"], row["unit"], row["max"], row["t_max"], row["rms"],
+                      row["mean"], row["corr_acc"])
+    emit(table, fmt)
     if png is not None:
-        con.print(f"wrote {png}", markup=False)
+        say(f"wrote {png}", fmt)

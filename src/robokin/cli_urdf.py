@@ -12,6 +12,7 @@ from typing import Annotated
 import typer
 
 from robokin.cli import _console, _load, app, cell, json_text
+from robokin.cli_output import FormatOption
 
 __all__ = ["dh", "export_urdf", "import_urdf"]
 
@@ -168,18 +169,20 @@ def dh(
         typer.Option("--virtual-frames", help="Fold base/tool into fixed rows."),
     ] = False,
     mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
+                       ] = False,
+    output_format: FormatOption = None,
     package: Annotated[list[str] | None, typer.Option(
         "--package", help="NAME=DIR for a xacro's $(find NAME) (repeatable).")] = None,
     arg: Annotated[list[str] | None, typer.Option(
         "--arg", help="NAME=VALUE for a xacro's <xacro:arg> (repeatable).")] = None,
 ) -> None:
     """Derive the DH table of a URDF or xacro arm (degrees; metres unless --mm)."""
-    from rich.table import Table
-
+    from robokin.cli_output import Column, OutputTable, emit, general, resolve_format
     from robokin.io.dh_extract import describe
     from robokin.io.urdf import dh_from_urdf
 
+    fmt = resolve_format(output_format, as_json)
     ext = dh_from_urdf(
         file, base, tip, convention="modified" if modified else "standard",
         reference_link=reference, virtual_frames=virtual,
@@ -195,32 +198,26 @@ def dh(
     for key in ("base", "tool"):
         doc[key]["xyz"] = [v * L for v in doc[key]["xyz"]]
     doc["units"] = {"length": "mm" if mm else "m", "angle": "deg"}
-    if as_json:
+    if fmt == "json":
         print(json_text(doc))
         return
     lu = "mm" if mm else "m"
     cols = (("alpha", "deg"), ("a", lu), ("theta", "deg"), ("d", lu)) if modified \
         else (("theta", "deg"), ("d", lu), ("a", lu), ("alpha", "deg"))
-    table = Table(title=f"{doc['convention']} DH of {cell(file.name)}")
-    table.add_column("joint")
-    table.add_column("kind")
-    for c, u in cols:
-        table.add_column(f"{c} [{u}]")
+    table = OutputTable(f"{doc['convention']} DH of {file.name}",
+                        [Column("joint"), Column("kind"),
+                         *(Column(f"{c} [{u}]", general(10), True) for c, u in cols)])
     for r in doc["rows"]:
-        table.add_row(cell(r["name"]), r["joint"], *(f"{r[c]:.6g}" for c, _ in cols))
-    con = _console()
-    con.print(table)
+        table.add_row(r["name"], r["joint"], *(float(r[c]) for c, _ in cols))
     for key in ("base", "tool"):
         p = doc[key]
-        con.print(
+        table.notes.append(
             f"{key} transform: xyz [{lu}] "
-            + " ".join(f"{v:.6g}" for v in p["xyz"])
-            + "  rpy [deg] " + " ".join(f"{v:.6g}" for v in p["rpy"]),
-            markup=False,
-        )
+            + " ".join(f"{v:.10g}" for v in p["xyz"])
+            + "  rpy [deg] " + " ".join(f"{v:.10g}" for v in p["rpy"]))
     if ext.needs_virtual_frames and not virtual:
-        con.print("this arm needs virtual frames to stand as a table alone "
-                  "(a base or tool transform remains); --virtual-frames emits them",
-                  markup=False)
-    for note in doc["notes"]:
-        con.print(f"note: {note}", markup=False)
+        table.notes.append("this arm needs virtual frames to stand as a table alone "
+                           "(a base or tool transform remains); --virtual-frames "
+                           "emits them")
+    table.notes += [f"note: {note}" for note in doc["notes"]]
+    emit(table, fmt)

@@ -224,15 +224,17 @@ def _plot_press_views(traj: Trajectory, scene: Scene, report: CollisionReport,
     """The tool path inside the press: side view (x-z) and top view (x-y)."""
     from matplotlib.patches import Rectangle
 
-    from robokin.viz.plots import _figure, save_figure
+    from robokin.viz.plots import _figure, place_labels, save_figure
 
     if traj.pose is None:  # the planner stores them: a changed plan must too
         raise InputError("trajectory", "has no tool poses to draw")
     p = traj.pose[:, :3, 3] * 1000.0
     fig = _figure((11.0, 5.0))
     views = ((0, 2, "side view (x-z)", "z [mm]"), (0, 1, "top view (x-y)", "y [mm]"))
+    placed: list[tuple[Any, list[tuple[float, float, str]]]] = []
     for k, (i, j, title, ylabel) in enumerate(views):
         ax = fig.add_subplot(1, 2, k + 1)
+        labels: list[tuple[float, float, str]] = []
         for obj in scene.objects:
             box = getattr(obj.shape, "size", None)
             if box is None or obj.shape.kind != "box":
@@ -252,15 +254,7 @@ def _plot_press_views(traj: Trajectory, scene: Scene, report: CollisionReport,
                 )
             )
             if press or k == 0:
-                ax.text(
-                    c[i],
-                    c[j],
-                    obj.name,
-                    fontsize=6,
-                    ha="center",
-                    va="center",
-                    clip_on=True,
-                )
+                labels.append((c[i], c[j], obj.name))
         ax.plot(p[:, i], p[:, j], color="tab:blue", lw=1.4, label="TCP path")
         for tv in traj.via_times:
             m = min(int(round(tv / traj.dt)), len(p) - 1) if traj.dt else 0
@@ -283,7 +277,10 @@ def _plot_press_views(traj: Trajectory, scene: Scene, report: CollisionReport,
         ax.set_title(title)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7, loc="upper left")
+        placed.append((ax, labels))
     fig.suptitle("the gripper's path into the press opening")
+    for ax, labels in placed:  # once the layout is final; column_left and _right
+        place_labels(ax, labels)  # share x and z: no two labels overlap
     return save_figure(fig, path, overwrite=True)
 
 
@@ -662,8 +659,8 @@ def run_demo(
     files["summary.json"] = out / MARKER
 
     table = Table(title="robokin demo: AUBO-i5 loads a press", show_header=False)
-    table.add_column(style="bold")
-    table.add_column()
+    table.add_column(style="bold", overflow="fold")
+    table.add_column(overflow="fold")  # never cut a value
     c = summary["closest"] or {}
     table.add_row(
         "duration",

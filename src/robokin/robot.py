@@ -298,6 +298,30 @@ class Robot:
         """A short summary: the name and the number of joints."""
         return f"Robot(name={self.name!r}, n={self.n})"
 
+    def _repr_html_(self) -> str:
+        """Jupyter: the joint rows (mm, degrees), the limits and the tool pose at zero.
+
+        Bounded: at most :data:`robokin._html.MAX_ROWS` rows per table.
+        """
+        from robokin import _html
+        from robokin.io.robot_files import document_from_robot
+        from robokin.io.robot_tables import MM_PER_M, joint_rows_mm_deg
+
+        doc = document_from_robot(self)
+        keys, rows = joint_rows_mm_deg(doc)
+        scale = np.where(self.is_revolute, 180.0 / np.pi, MM_PER_M)
+        limits = [(c.name, c.kind, lo * k, hi * k) for c, (lo, hi), k
+                  in zip(self.chain.coordinates, self.limits, scale)]
+        tool = self.fk(np.zeros(self.n))[:3, 3] * MM_PER_M
+        return _html.box(
+            f"Robot {self.name!r}: {self.n} joints, {doc.get('convention', '?')}",
+            _html.note("joint rows (lengths mm, angles deg)"),
+            _html.table(keys, [["" if v is None else v for v in r] for r in rows]),
+            _html.note("joint limits (deg / mm)"),
+            _html.table(["joint", "kind", "lower", "upper"], limits),
+            _html.note("tool at q = 0 [mm]: " + ", ".join(f"{v:.3f}" for v in tool)),
+            _html.note(f"source: {self.source[:300]}") if self.source else "")
+
     # --------------------------------------------------------------- kinematics
     def _to_joints(self, q: npt.ArrayLike, space: Space, name: str) -> npt.ArrayLike:
         if space == "joint":

@@ -59,7 +59,7 @@ def test_one_number_applies_to_every_joint(tmp_path):
     (("velocity: [90, 250]", "velocity: 0"), r"rate_limits\.velocity: .*got 0"),
     (("velocity: [90, 250]", "velocity: .inf"), r"rate_limits\.velocity"),
     (("velocity: [90, 250]", "velocity: [true, 1]"), r"velocity\[0\]"),
-    (("velocity: [90, 250]", "speed: [90, 250]"), r"rate_limits\.speed: unknown field"),
+    (("velocity: [90, 250]", "speed: [90, 250]"), r"rate_limits\.speed: unknown key; accepted: source, velocity, acceleration, jerk"),
 ])
 def test_bad_values_name_the_field_and_line(tmp_path, replace, match):
     with pytest.raises(ModelError, match=match) as info:

@@ -60,7 +60,7 @@ CASES = [
         r"joints\[1\]\.colour: unknown",
     ),
     (GOOD.replace("rpy: [180, 0, 0]", "rpy: [180, 0]"), r"tool\.rpy"),
-    (GOOD + "wheels: 4\n", r"wheels: unknown field"),
+    (GOOD + "wheels: 4\n", r"wheels: unknown key; accepted: name, source, units"),
     ("- just\n- a list\n", r"robot\.yaml: a robot file must be a mapping"),
     ("name: [unclosed\n", r"robot\.yaml:2: not valid YAML, column"),
     (GOOD.replace("name: j2", "name: j1"), r"unique"),

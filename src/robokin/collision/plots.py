@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -21,8 +21,8 @@ def plot_distance(
     count: int = 4,
     clearance: float | None = None,
     out: str | Path | None = None,
-    ax=None,
-):
+    ax: Any = None,
+) -> Any:
     """Distance over time of the closest body pairs, with the clearance marked.
 
     Args:

@@ -119,6 +119,40 @@ class CollisionReport:
     _problem: Any = field(default=None, repr=False)
     _q: Any = field(default=None, repr=False)
 
+    def _repr_html_(self) -> str:
+        """Jupyter: the verdict, the closest pair, collisions, pairs and a plot.
+
+        The plot is the minimum distance over every checked pair at up to 120
+        evenly spaced samples; tables are capped: bounded for any trajectory.
+        """
+        from robokin import _html
+
+        verdict = ("COLLIDES" if self.collides else
+                   "clearance VIOLATED" if self.violated else "OK")
+        parts = [_html.note(f"minimum distance {self.min_distance * 1e3:.3f} mm, "
+                            f"clearance {self.clearance * 1e3:g} mm: {verdict}")]
+        c = self.closest
+        if c is not None:
+            parts.append(_html.note(f"closest: {c.body_a} - {c.body_b} at t = "
+                                    f"{c.t:.3f} s (sample {c.index})"))
+        m = self.t.shape[0]
+        if self._problem is not None and m:
+            idx = np.unique(np.linspace(0, m - 1, min(m, 120)).round().astype(int))
+            d = self.closest_at(idx)[0]
+            parts.append(_html.line_plot(self.t[idx], d * 1e3, xlabel="t [s]",
+                                         ylabel="min distance [mm]",
+                                         hline=self.clearance * 1e3))
+        if self.intervals:
+            parts += [_html.note("collisions"), _html.table(
+                ["body", "body", "t start [s]", "t end [s]", "depth [mm]"],
+                [[iv.body_a, iv.body_b, iv.t_start, iv.t_end, -iv.min_distance * 1e3]
+                 for iv in self.intervals], max_rows=10)]
+        parts += [_html.note("closest pairs"), _html.table(
+            ["body", "body", "min distance [mm]", "t [s]", "sample"],
+            [[p.body_a, p.body_b, p.distance * 1e3, p.t, p.index] for p in self.pairs],
+            max_rows=8)]
+        return _html.box(f"CollisionReport: {m:,} samples", *parts)
+
     @property
     def violated(self) -> bool:
         """True when the minimum distance is at or below the clearance (or collides)."""

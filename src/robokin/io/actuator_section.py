@@ -50,7 +50,12 @@ from robokin.model.coupling import (
 if TYPE_CHECKING:
     from robokin.robot import Robot
 
-__all__ = ["actuators_from_section", "apply_actuators_section", "section_from_robot"]
+__all__ = [
+    "actuators_from_section",
+    "apply_actuators_section",
+    "section_from_robot",
+    "section_model",
+]
 
 _LENGTH = {"m": 1.0, "mm": 1e-3}
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
@@ -103,6 +108,11 @@ def _schema():
         drives: list[Drive] | None = None
 
     return Section
+
+
+def section_model() -> Any:
+    """The pydantic model of the ``actuators:`` section (for its JSON Schema)."""
+    return _schema()
 
 
 def _validate(value: Any, file: Any):

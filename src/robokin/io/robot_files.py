@@ -48,7 +48,7 @@ from robokin.io import (
 )
 from robokin.io.atomic import write_atomic
 from robokin.io.text_files import MAX_TEXT_BYTES
-from robokin.io.validate import validate_document
+from robokin.io.validate import list_of, union_of, validate_document
 from robokin.io.yaml_reader import read_yaml_document
 
 if TYPE_CHECKING:
@@ -61,6 +61,7 @@ __all__ = [
     "SECTIONS",
     "SectionIO",
     "document_from_robot",
+    "file_model",
     "load_robot",
     "robot_from_document",
     "save_robot",
@@ -89,20 +90,26 @@ class SectionIO:
             naming the field path.
         write: ``write(robot) -> value or None``: the section (SI units) of a
             robot built in memory, None when it has nothing to write.
+        model: ``model() -> type``: the section's pydantic model (or type), for
+            the robot file's JSON Schema (:func:`file_model`); None: any value.
     """
 
     read: Callable[[Any, Any, Any, Any], Any]
     write: Callable[[Any], Any]
+    model: Callable[[], Any] | None = None
 
 
 #: The optional sections, in the order they are applied.
 SECTIONS: dict[str, SectionIO] = {
     "actuators": SectionIO(actuator_section.apply_actuators_section,
-                           actuator_section.section_from_robot),
+                           actuator_section.section_from_robot,
+                           actuator_section.section_model),
     "geometry": SectionIO(geometry_sections.apply_geometry_section,
-                          geometry_sections.geometry_section),
+                          geometry_sections.geometry_section,
+                          geometry_sections.geometry_model),
     "collision": SectionIO(geometry_sections.apply_collision_section,
-                           geometry_sections.collision_section),
+                           geometry_sections.collision_section,
+                           geometry_sections.collision_model),
     "dynamics": SectionIO(dynamics_section.apply_dynamics_section,
                           dynamics_section.dynamics_section),
     "rate_limits": SectionIO(rate_limits_section.apply_rate_limits_section,
@@ -200,6 +207,33 @@ def _schema():
         controller: Any = None  # a controller profile (robokin.trajectory.io), kept raw
 
     return RobotFile, Row, Op
+
+
+def file_model() -> Any:
+    """The pydantic model of a whole robot file, for its JSON Schema.
+
+    The validating model with the parts it checks in a second step typed too: a
+    joint row is a DH row or (``convention: elementary``) an elementary
+    operation, and each section of :data:`SECTIONS` that declares a model has
+    it. Every other field is the validating model's own, so the schema follows
+    the reader.
+    """
+    from pydantic import Field, create_model
+
+    RobotFile, Row, Op = _schema()
+    fields: dict[str, Any] = {"joints": (
+        list_of(union_of(Row, Op)),
+        Field(min_length=1, max_length=MAX_JOINTS,
+              description="The chain, base to tool: DH rows, or elementary "
+                          "operations when convention is elementary."))}
+    for key, section in SECTIONS.items():
+        if section.model is not None and key in RobotFile.model_fields:
+            fields[key] = (union_of(section.model(), None), None)
+    Row.__doc__ = "A DH row (standard or modified): one joint or a fixed frame."
+    Op.__doc__ = "An elementary operation: rx ry rz tx ty tz, or a frame marker."
+    return create_model("RobotFile", __base__=RobotFile,
+                        __doc__="A robot file: a serial arm, in the units it declares.",
+                        **fields)
 
 
 def _placement(p, L: float, A: float) -> np.ndarray | None:

@@ -137,6 +137,30 @@ class Trajectory:
                 f"duration={self.duration:.6g} s, space={self.space!r})")
 
     # -------------------------------------------------------------- operations
+    def _repr_html_(self) -> str:
+        """Jupyter: samples, duration, a small plot of the joints and their peaks.
+
+        The plot shows at most :data:`robokin._html.MAX_POINTS` samples per
+        joint (degrees for angles, mm for lengths): bounded for any length.
+        """
+        from robokin import _html
+
+        rev = self.revolute()
+        scale = np.where(rev, 180.0 / np.pi, 1000.0)
+        peaks = self.peaks()
+        rows = [[name, "deg" if r else "mm", lo * k, hi * k, v * k, a * k]
+                for name, r, k, lo, hi, v, a in zip(
+                    self.names(), rev, scale, peaks["min"], peaks["max"],
+                    peaks["velocity"], peaks["acceleration"])]
+        unit = "deg" if rev.all() else "mm" if not rev.any() else "deg / mm"
+        return _html.box(
+            f"Trajectory: {len(self):,} samples, {self.duration:.3f} s, "
+            f"{self.n} joints, {max(len(self.via_times) - 2, 0)} via points",
+            _html.line_plot(self.t, self.q * scale, labels=self.names()[:10],
+                            xlabel="t [s]", ylabel=f"q [{unit}]"),
+            _html.table(["joint", "unit", "min", "max", "peak |vel| /s",
+                         "peak |acc| /s²"], rows))
+
     def at(self, times: npt.ArrayLike) -> np.ndarray:
         """Joint positions at arbitrary times (linear interpolation), (k,) -> (k, n).
 

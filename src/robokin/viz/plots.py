@@ -22,6 +22,7 @@ if TYPE_CHECKING:
     from robokin.trajectory.samples import Trajectory
 
 __all__ = [
+    "place_labels",
     "plot_comparison",
     "plot_joints",
     "plot_robot",
@@ -55,6 +56,47 @@ def save_figure(fig: Any, path: str | Path, *, overwrite: bool = False,
     if path.suffix.lower() not in _FORMATS:
         raise InputError("path", f"expected a {', '.join(_FORMATS)} file, got {path.name}")
     return save_figure_atomic(fig, path, overwrite=overwrite, dpi=dpi)
+
+
+def place_labels(ax: Any, labels: list[tuple[float, float, str]], *,
+                 fontsize: float = 6.0) -> list[Any]:
+    """Write text labels at data points so that no two overlap.
+
+    Each label is centred on its point (points outside the axes' view get no
+    label); one that would overlap a label already
+    placed moves up or down (alternately, a line further each time) until it
+    overlaps none. Call it once the axes' limits and aspect are final.
+
+    Args:
+        ax: A matplotlib Axes.
+        labels: ``(x, y, text)`` per label, in data coordinates, in the order to
+            place them (earlier ones keep their place).
+        fontsize: Font size [pt].
+
+    Returns:
+        The matplotlib ``Annotation`` of each label drawn.
+    """
+    fig = ax.figure
+    fig.draw_without_rendering()  # the final layout (constrained) and aspect
+    renderer = fig.canvas.get_renderer()
+    step = fontsize * 1.3  # one line [pt]
+    placed: list[Any] = []
+    texts = []
+    for x, y, text in labels:
+        if not ax.viewLim.contains(x, y):  # outside the view: not drawn
+            continue
+        note = ax.annotate(text, (x, y), xytext=(0.0, 0.0), textcoords="offset points",
+                           fontsize=fontsize, ha="center", va="center",
+                           annotation_clip=True)
+        for k in range(1, 41):
+            box = note.get_window_extent(renderer)
+            if not any(box.overlaps(other) for other in placed):
+                break
+            shift = (k + 1) // 2 * step * (1 if k % 2 else -1)
+            note.set_position((0.0, shift))
+        placed.append(note.get_window_extent(renderer))
+        texts.append(note)
+    return texts
 
 
 Plane = Literal["xy", "xz", "yz"]

@@ -59,6 +59,7 @@ from robokin.kinematics.per_chain import cached
 from robokin.model.chain import Chain
 
 if TYPE_CHECKING:
+    from robokin.kinematics.ik.solutions import SolutionSet
     from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["IKPathResult", "IKResult", "ik_path", "parse_mask", "solve", "solve_all"]
@@ -597,7 +598,7 @@ def solve_all(
     q_near: npt.ArrayLike | None = None,
     n_seeds: int = 16,
     **options: Any,
-):
+) -> SolutionSet:
     """The distinct solutions that descents from many seeds find, as a SolutionSet.
 
     Every target gets ``n_seeds`` independent descents (from ``q_near`` first when
@@ -621,7 +622,7 @@ def solve_all(
             ``dedupe_tol`` [rad, m].
 
     Returns:
-        A :class:`~robokin.kinematics.ik.solutions.SolutionSet` with
+        The solution set (:class:`~robokin.kinematics.ik.solutions.SolutionSet`),
         ``method="numeric"``; per-pose ``status`` says why a pose has none.
 
     Raises:

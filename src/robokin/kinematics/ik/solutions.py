@@ -402,6 +402,46 @@ class SolutionSet:
         return replace(self, q=phi, flags=flags, is_revolute=is_rev, limits=lim,
                        info={**self.info, "space": "actuator"})
 
+    def _repr_html_(self) -> str:
+        """Jupyter: one pose's solutions with branches and flags; a batch summarised.
+
+        One pose: a row per valid solution (degrees for angles, mm for lengths),
+        its branch labels and flags. A batch: the poses, how many have k
+        solutions, the statuses; never more than a few kilobytes.
+        """
+        from collections import Counter
+
+        from robokin import _html
+
+        title = f"SolutionSet [{self.method}]"
+        if self.shape:
+            counts = Counter(self.count.reshape(-1).tolist())
+            status = Counter(str(v) for v in np.asarray(self.status).reshape(-1))
+            return _html.box(
+                f"{title}: {int(np.prod(self.shape)):,} poses, shape {self.shape}",
+                _html.table(["solutions per pose", "poses"], sorted(counts.items())),
+                _html.table(["status", "poses"], status.most_common(),
+                            right=[False, True]))
+        q = self.q[self.valid]
+        scale = np.where(self.is_revolute, 180.0 / np.pi, 1000.0)
+        unit = ["deg" if r else "mm" for r in self.is_revolute]
+        flags = {k: v[self.valid] for k, v in self.flags.items()}
+        branches = {k: np.asarray(v)[self.valid] for k, v in self.branches.items()}
+        rows = []
+        for i in range(len(q)):
+            fl = [k for k, v in flags.items() if k != "within_limits" and v[i]]
+            if not flags.get("within_limits", np.ones(len(q), bool))[i]:
+                fl.append("outside limits")
+            rows.append([i + 1, *(q[i] * scale),
+                         " ".join(f"{k} {'+' if v[i] > 0 else '-'}"
+                                  for k, v in branches.items()) or "-",
+                         ", ".join(fl) or "-"])
+        st = self.status.item() if isinstance(self.status, np.ndarray) else self.status
+        return _html.box(
+            f"{title}: {len(q)} solution(s), status {st}",
+            _html.table(["#", *(f"q{j + 1} [{u}]" for j, u in enumerate(unit)),
+                         "branch", "flags"], rows, max_rows=32))
+
     def __repr__(self) -> str:
         """A short summary: poses, solutions per pose, method."""
         if not self.shape:
