@@ -174,6 +174,28 @@ def throughput_ratio(robot, T_batch, rounds: int = 5) -> None:
           f"(2 threads) -> robokin / eaik best: {rate['robokin'] / e:.1f}x")
 
 
+def singular_targets(n: int = 2000) -> None:
+    """Issue 20: targets from random configurations with q5 = 0 exactly (the wrist
+    singularity of a UR arm's home pose): how many are solved and flagged singular,
+    and eaik's answer on the same poses."""
+    print(f"\nwrist-singular targets (q5 = 0 exactly), {n} per arm:")
+    for name in ("ur5", "aubo_i5", "puma560"):
+        robot = robokin.load(name)
+        rng = np.random.default_rng(5)
+        lim = np.clip(robot.limits, -np.pi, np.pi)
+        q = rng.uniform(lim[:, 0], lim[:, 1], (n, 6))
+        q[:, 4] = 0.0
+        T = robot.fk(q)
+        sols = robot.ik(T)
+        solved = sols.valid.any(axis=-1)
+        flagged = (sols.valid & sols.singular).any(axis=-1)
+        ok = sols.valid
+        dp, dr = fk_error(robot.chain, sols.q, T)
+        worst = float(np.nanmax(np.where(ok, np.maximum(dp, dr), np.nan)))
+        print(f"  {name:<10s} solved {100 * solved.mean():6.2f} %  flagged singular "
+              f"{100 * flagged.mean():6.2f} %  worst FK error {worst:.1e}")
+
+
 def main(batch: int = 100_000, loop_n: int = 10_000) -> None:
     """Run every comparison and print one table."""
     rng = np.random.default_rng(0)
@@ -190,6 +212,7 @@ def main(batch: int = 100_000, loop_n: int = 10_000) -> None:
             bench_ik_geo(robot, T[0], T[:loop_n])
             if np.isfinite(eaik_rate):
                 throughput_ratio(robot, T)
+    singular_targets()
 
 
 if __name__ == "__main__":

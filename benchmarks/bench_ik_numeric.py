@@ -218,6 +218,31 @@ def one_thread_kernels(robot, targets, q0) -> dict:
     return times
 
 
+def near_limits(runs: int = 5, n: int = 2000) -> None:
+    """Issue 20: Panda targets with joints 4 and 6 within 0.05 rad of a limit (the
+    others anywhere in theirs); success per run with fresh random restarts."""
+    robot = robokin.load("panda")
+    lim = robot.limits
+    rates, median_us = [], []
+    for run in range(runs):
+        rng = np.random.default_rng(run)
+        q = rng.uniform(lim[:, 0], lim[:, 1], (n, 7))
+        q[:, 3] = lim[3, 0] + rng.uniform(0, 0.05, n)
+        q[:, 5] = lim[5, 1] - rng.uniform(0, 0.05, n)
+        T = robot.fk(q)
+        res = numeric.solve(robot, T, rng=np.random.default_rng(run + 100))
+        rates.append(res.success.mean())
+        times = []
+        for i in range(200):
+            t = time.perf_counter()
+            numeric.solve(robot, T[i], rng=np.random.default_rng(i))
+            times.append(time.perf_counter() - t)
+        median_us.append(np.median(times) * 1e6)
+    print(f"\nPanda near its joint limits ({n} targets x {runs} runs): success "
+          + ", ".join(f"{100 * r:.2f} %" for r in rates)
+          + f"; single-solve median {min(median_us):.1f}-{max(median_us):.1f} us")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=1000, help="targets per robot")
@@ -293,6 +318,7 @@ def main() -> None:
               f"{tb * 1e6 / args.n:7.1f} "
               f"us/target  loop {tl * 1e6 / args.n:7.1f} us/target  speed-up "
               f"{tl / tb:4.1f}x")
+    near_limits()
     print("\nrobokin batch on one thread, by copy of the kernel (us/target, best of 5):")
     for name, times in kernel_rows:
         print(f"  {name:16s} " + "  ".join(f"{k} {v:6.2f}" for k, v in times.items()))

@@ -9,6 +9,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -114,3 +115,83 @@ def red_fraction(img: np.ndarray) -> float:
     """Fraction of saturated red pixels (collision highlight, any shade)."""
     r, g, b = (img[..., k].astype(int) for k in range(3))
     return float(((r > 90) & (r - g > 70) & (np.abs(g - b) < 25)).mean())
+
+
+def screenshot_until(
+    url: str,
+    profile: Path,
+    done: Callable[[np.ndarray], bool],
+    *,
+    size: tuple[int, int] = (900, 600),
+    timeout: float = 120.0,
+    webgl: bool = False,
+) -> np.ndarray:
+    """Load ``url`` in headless Chromium and screenshot it until ``done(image)``.
+
+    Polls in wall time through the DevTools protocol (Page.captureScreenshot every
+    half second), so a page that waits for a server (the viewer's websocket scene)
+    is captured once it has drawn, however loaded the machine is. Returns the last
+    image (RGB uint8) when ``done`` never holds within ``timeout`` seconds.
+    """
+    import base64
+    import io
+    import json
+    import re
+    import time
+    import urllib.request
+
+    import matplotlib.image as mpimg
+    from websockets.sync.client import connect
+
+    args = [
+        str(require_chromium()), "--headless", "--no-sandbox", "--disable-gpu",
+        "--disable-quic", "--no-first-run", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync", "--disable-extensions",
+        "--hide-scrollbars", "--mute-audio", f"--user-data-dir={profile}",
+        f"--window-size={size[0]},{size[1]}", "--remote-debugging-address=127.0.0.1",
+        "--remote-debugging-port=0",
+    ]
+    if webgl:
+        args += ["--use-gl=angle", "--use-angle=swiftshader",
+                 "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist"]
+    proc = subprocess.Popen(args + [url], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        port = None
+        deadline = time.monotonic() + timeout
+        assert proc.stderr is not None
+        while port is None and time.monotonic() < deadline:
+            line = proc.stderr.readline()
+            m = re.search(r"DevTools listening on ws://127\.0\.0\.1:(\d+)/", line)
+            if m:
+                port = int(m.group(1))
+            elif not line and proc.poll() is not None:
+                raise AssertionError("chromium exited before its DevTools port opened")
+        if port is None:
+            raise AssertionError("chromium did not open its DevTools port")
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/json", timeout=30) as r:
+            pages = [t for t in json.load(r) if t.get("type") == "page"]
+        image = np.zeros((size[1], size[0], 3), dtype=np.uint8)
+        with connect(pages[0]["webSocketDebuggerUrl"], max_size=None) as ws:
+            # the viewport itself is size (the window's includes what headless omits)
+            ws.send(json.dumps({"id": -1, "method": "Emulation.setDeviceMetricsOverride",
+                                "params": {"width": size[0], "height": size[1],
+                                           "deviceScaleFactor": 1, "mobile": False}}))
+            while json.loads(ws.recv(timeout=60)).get("id") != -1:
+                pass
+            for k in range(1_000_000):
+                ws.send(json.dumps({"id": k, "method": "Page.captureScreenshot"}))
+                while True:
+                    reply = json.loads(ws.recv(timeout=60))
+                    if reply.get("id") == k:
+                        break
+                data = base64.b64decode(reply["result"]["data"])
+                rgba = mpimg.imread(io.BytesIO(data), format="png")
+                image = np.round(rgba[..., :3] * 255).astype(np.uint8)
+                if done(image) or time.monotonic() > deadline:
+                    return image
+                time.sleep(0.5)
+        return image
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()

@@ -30,7 +30,7 @@ def test_demo_passes_and_writes_every_output(demo):
     for name in (
         "trajectory.csv",
         "waypoints.csv",
-        "program.script",
+        "program.waypoints.csv",
         "joints.png",
         "tool_path.png",
         "press_views.png",
@@ -42,6 +42,7 @@ def test_demo_passes_and_writes_every_output(demo):
     ):
         assert (out / name).stat().st_size > 400, name
     assert "PASS" in text and "minimum clearance" in text
+    assert not (out / "program.script").exists()  # an AUBO controller runs no URScript
 
 
 def test_outputs_agree_with_each_other(demo):
@@ -119,3 +120,23 @@ def test_demo_refuses_a_folder_with_other_files(tmp_path, capsys):
     assert code == 2 and "did not write" in err
     assert (tmp_path / "thesis.tex").read_text() == "mine"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["thesis.tex"]
+
+
+def test_demo_writes_the_aubo_i5_waypoint_program_and_says_so(demo):
+    """Issue 19, item 3: the AUBO-i5's profile names a waypoint file, not URScript."""
+    from robokin.trajectory.controllers import controller_profile, read_waypoints
+
+    out, result, text = demo
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["controller"]["program"] == "waypoints"
+    assert summary["controller"]["file"] == "program.waypoints.csv"
+    assert summary["controller"]["profile"].startswith("AUBO-i5")
+    assert "program.waypoints.csv" in text and "waypoint file" in text
+    assert "program.waypoints.csv" in (out / "report.html").read_text()
+    aubo = robokin.load("aubo_i5")
+    back = read_waypoints(out / "program.waypoints.csv", controller_profile(aubo),
+                          aubo.joint_names)
+    np.testing.assert_allclose(back.q, result.trajectory.q, atol=1e-15)
+    np.testing.assert_allclose(back.t, result.trajectory.t, atol=1e-15)
+    header = (out / "program.waypoints.csv").read_text().splitlines()[3]
+    assert header.startswith("t [s],shoulder_joint [rad],upperArm_joint [rad]")

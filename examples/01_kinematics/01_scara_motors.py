@@ -24,13 +24,16 @@ from robokin import trajectory
 def main() -> None:
     """Plan the shaft motion in joint space and map it to the four motors."""
     robot = robokin.load("scara")
+    motors = robot.actuator_names  # None for a robot without an actuator map
+    if motors is None:
+        raise SystemExit("this example needs a robot whose joints are driven by motors")
     q0 = np.array([0.2, 0.8, 0.0, 0.0])  # [rad, rad, rad, m]
     q1 = np.array([0.2, 0.8, np.pi / 2, 0.150])  # rotate 90 deg, lift 150 mm
     tr = trajectory.quintic(q0, q1, 1.5, dt=0.005)  # .t (m,), .q (m, 4)
     phi = robot.actuators_from_joints(tr.q)  # (m, 4) motor coordinates [rad]
     back = robot.joints_from_actuators(phi)
     print(f"{len(tr.t)} samples over {tr.t[-1]:.2f} s")
-    for name, a, b in zip(robot.actuator_names, phi[0], phi[-1]):
+    for name, a, b in zip(motors, phi[0], phi[-1]):
         print(
             f"  {name}: {a:9.3f} -> {b:9.3f} rad  ({np.degrees(b - a):9.1f} deg of travel)"
         )
@@ -44,7 +47,7 @@ def main() -> None:
         dphi = robot.actuators_from_joints(q0 + np.array(dq)) - phi[0]
         moving = [
             f"{n} ({np.degrees(d):.0f} deg)"
-            for n, d in zip(robot.actuator_names, dphi)
+            for n, d in zip(motors, dphi)
             if abs(d) > 1e-9
         ]
         print(f"motors that turn for a {label}:", ", ".join(moving))

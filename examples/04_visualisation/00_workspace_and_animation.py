@@ -25,8 +25,8 @@ import numpy as np  # noqa: E402
 import robokin  # noqa: E402
 from robokin import trajectory  # noqa: E402
 from robokin.kinematics.workspace import sample_workspace  # noqa: E402
-from robokin.viz.plots import save_workspace_plots  # noqa: E402
 from robokin.viz.html import write_html  # noqa: E402
+from robokin.viz.plots import save_workspace_plots  # noqa: E402
 
 
 def main(out_dir: Path = Path("robokin-examples") / "visualisation") -> None:

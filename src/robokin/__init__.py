@@ -61,7 +61,7 @@ def save(robot: Robot, path: str | Path) -> Path:
 
 def __getattr__(name: str) -> Any:
     # Lazy subpackages: ``robokin.ik``, ``robokin.trajectory``, ``robokin.collision``,
-    # ``robokin.cell``.
+    # ``robokin.sim`` (MuJoCo, robokin[sim]), ``robokin.cell`` (Dask, robokin[scale]).
     import importlib
 
     if name == "ik":
@@ -75,6 +75,7 @@ def __getattr__(name: str) -> Any:
         "viz",
         "kinematics",
         "model",
+        "sim",
     ):
         return importlib.import_module(f"robokin.{name}")
     raise AttributeError(f"module 'robokin' has no attribute {name!r}")

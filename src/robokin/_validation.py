@@ -9,8 +9,6 @@ Jacobians and IK in float64 lose every digit of a sub-millimetre result there.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import numpy.typing as npt
 

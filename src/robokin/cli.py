@@ -21,10 +21,35 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
+import typer.core
 
+from robokin.cli_output import FormatOption
 from robokin.io.strict_json import strict_json as json_text
 
+
+def _literal_help(text: str | None) -> str | None:
+    """Help text shown as written: rich markup escaped, so ``[mm]`` stays."""
+    from rich.markup import escape
+
+    return None if text is None else escape(text.replace("\\[", "["))
+
+
+class _Group(typer.core.TyperGroup):
+    """The command group; help texts are literal (units in brackets are not markup)."""
+
+    def __init__(self, **attrs: Any) -> None:
+        """Build the group and escape every command's and parameter's help."""
+        super().__init__(**attrs)
+        for cmd in self.commands.values():
+            cmd.help = _literal_help(cmd.help)
+            cmd.short_help = _literal_help(cmd.short_help)
+            for param in cmd.params:
+                if isinstance(getattr(param, "help", None), str):
+                    param.help = _literal_help(param.help)  # type: ignore[attr-defined]
+
+
 app = typer.Typer(
+    cls=_Group,
     add_completion=False,
     no_args_is_help=True,
     help="robokin: kinematics of industrial serial manipulators.",
@@ -39,10 +64,12 @@ class DomainFailure(Exception):
 
 
 def cell(value: Any, limit: int = 60, *, markup: bool = True) -> str:
-    """Text for a table cell or a line of output: at most ``limit`` characters,
-    rich markup escaped unless ``markup=False`` (for ``print(..., markup=False)``):
-    a name or a source from a file is never markup, and never a megabyte for rich
-    to wrap."""
+    """Text for a table cell or a line of output, safe to print.
+
+    At most ``limit`` characters, rich markup escaped unless ``markup=False`` (for
+    ``print(..., markup=False)``): a name or a source from a file is never markup,
+    and never a megabyte for rich to wrap.
+    """
     from rich.markup import escape
 
     text = str(value)
@@ -71,70 +98,89 @@ def _load(name: str):
 
 
 @app.command()
-def robots() -> None:
+def robots(output_format: FormatOption = None) -> None:
     """List the built-in robots."""
-    from rich.table import Table
-
     import robokin.robots as lib
+    from robokin.cli_output import (
+        Column,
+        OutputTable,
+        emit,
+        resolve_format,
+        tables_json,
+    )
 
-    table = Table(title="built-in robots")
-    for col in ("name", "joints", "source"):
-        table.add_column(col)
+    fmt = resolve_format(output_format)
+    table = OutputTable("built-in robots", [Column("name"), Column("joints", right=True),
+                                            Column("source")])
     for name in lib.names():
         r = _load(name)
-        table.add_row(cell(name), str(r.n), cell(r.source or "", 70))
-    _console().print(table)
+        table.add_row(name, r.n, r.source or "")
+    if fmt == "json":
+        print(json_text({"tables": tables_json([table])}))
+    else:
+        emit(table, fmt)
 
 
 @app.command()
 def show(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    output_format: FormatOption = None,
 ) -> None:
-    """Show a robot: its joints, limits and the canonical chain's tool pose at zero."""
+    """Show a robot: its joints, limits and the tool pose at zero, in mm and degrees.
+
+    Every arm is shown in the same units whatever units its robot file declares:
+    lengths in mm, angles in degrees (prismatic limits in mm).
+    """
     import numpy as np
-    from rich.table import Table
 
+    from robokin.cli_output import (
+        Column,
+        OutputTable,
+        emit,
+        general,
+        resolve_format,
+        say,
+        tables_json,
+    )
     from robokin.io.robot_files import document_from_robot
+    from robokin.io.robot_tables import MM_PER_M, joint_rows_mm_deg
 
+    fmt = resolve_format(output_format)
     r = _load(name)
     doc = document_from_robot(r)
-    units = doc.get("units", {})
-    table = Table(
-        title=f"{cell(r.name)}: {cell(doc.get('convention', '?'))} "
-        f"({cell(units.get('length', 'm'))}, {cell(units.get('angle', 'rad'))})"
-    )
-    rows = doc["joints"]
-    keys = []
-    for row in rows:
-        for k in row:
-            if k not in keys:
-                keys.append(k)
-    for k in keys:
-        table.add_column(cell(k))
-    for row in rows:
-        table.add_row(*[cell(row.get(k, "")) for k in keys])
-    con = _console()
-    con.print(table)
-    lim = Table(title="joint limits (deg / mm)")
-    for col in ("joint", "kind", "lower", "upper"):
-        lim.add_column(col)
+    keys, rows = joint_rows_mm_deg(doc)
+    num = general(10)
+    dh = OutputTable(
+        f"{r.name}: {doc.get('convention', '?')} (lengths mm, angles deg)",
+        [Column(k, fmt=num if k in ("a", "alpha", "d", "theta", "value",
+                                     "depends_offset") else str,
+                right=k in ("a", "alpha", "d", "theta", "value")) for k in keys],
+        rows)
+    lim = OutputTable("joint limits (deg / mm)",
+                      [Column("joint"), Column("kind"), Column("lower", general(10), True),
+                       Column("upper", general(10), True)])
     for c, (lo, hi) in zip(r.chain.coordinates, r.limits):
-        s = 180 / math.pi if c.kind == "revolute" else 1000.0
-        lim.add_row(cell(c.name), c.kind, f"{lo * s:.6g}", f"{hi * s:.6g}")
-    con.print(lim)
+        s = 180.0 / math.pi if c.kind == "revolute" else MM_PER_M
+        lim.add_row(c.name, c.kind, float(lo * s), float(hi * s))
+    tables = [dh, lim]
     if r.actuators is not None:
-        act = Table(title="actuators: q = A phi + b")
-        act.add_column("A")
-        act.add_column("b")
+        act = OutputTable("actuators: q = A phi + b (SI units)",
+                          [Column(f"A[:, {k}]", general(10), True)
+                           for k in range(r.actuators.matrix.shape[1])]
+                          + [Column("b", general(10), True)])
         for row_a, b in zip(r.actuators.matrix, r.actuators.offset):
-            act.add_row(np.array2string(row_a, precision=6), f"{b:.6g}")
-        con.print(act)
-    T0 = r.fk(np.zeros(r.n))
-    con.print(
-        "tool at q = 0 [m]: " + "  ".join(f"{v:.6f}" for v in T0[:3, 3]), markup=False
-    )
+            act.add_row(*[float(v) for v in row_a], float(b))
+        tables.append(act)
+    tool = r.fk(np.zeros(r.n))[:3, 3] * MM_PER_M
+    if fmt == "json":
+        print(json_text({"robot": r.name, "units": {"length": "mm", "angle": "deg"},
+                         "tool_at_zero_mm": tool.tolist(), "source": r.source,
+                         "tables": tables_json(tables)}))
+        return
+    tables[-1].notes.append("tool at q = 0 [mm]: " + "  ".join(f"{v:.6f}" for v in tool))
+    emit(tables, fmt)
     if r.source:
-        con.print(f"[dim]source: {cell(r.source, 300)}[/dim]")
+        say(f"source: {r.source}", fmt)
 
 
 _NUMERIC_ARGS = {"ignore_unknown_options": True}
@@ -196,6 +242,9 @@ def demo(
     force: Annotated[
         bool, typer.Option("--force", help="Write into a folder holding other files.")
     ] = False,
+    sim: Annotated[
+        bool, typer.Option("--sim", help="Also run the plan in MuJoCo (robokin[sim]).")
+    ] = False,
     place: Annotated[
         bool, typer.Option("--place", help="Also map the feasible robot bases (robokin[scale]).")
     ] = False,
@@ -211,7 +260,7 @@ def demo(
     from robokin.demo import run_demo
 
     result = run_demo(out=out, clearance_mm=clearance, view=view, force=force,
-                      console=_console(), place=place, scheduler=scheduler)
+                      console=_console(), sim=sim, place=place, scheduler=scheduler)
     if not result.ok:
         raise DomainFailure("the plan is not collision-free with the required clearance "
                             "(see the report)")
@@ -229,6 +278,9 @@ def _register_extra_commands() -> None:
         "robokin.cli_view",
         "robokin.cli_actuators",
         "robokin.cli_workspace",
+        "robokin.cli_sim",
+        "robokin.cli_retime",
+        "robokin.cli_schema",
         "robokin.cli_cell",
     ):
         try:
@@ -245,7 +297,70 @@ def _split_debug(args: list[str]) -> tuple[list[str], bool]:
     return head + args[end:], len(head) != end
 
 
-def _one_line(text: str) -> str:
+#: Options that take as many values as the robot has joints (``--near q1 ... qn``).
+MULTI_VALUE_OPTIONS = ("--near",)
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
+
+
+def _gather_values(args: list[str]) -> list[str]:
+    """Join the values after a :data:`MULTI_VALUE_OPTIONS` option into one token.
+
+    ``--near 0 -1.5 1.5`` becomes ``--near=0,-1.5,1.5`` (click options take a fixed
+    number of values). The numbers after the option are its values, except those a
+    command's required positional arguments still need: ``ik ur5 --near q1..q6 x y z
+    r p w`` leaves the last six for the pose.
+    """
+    if not any(a in MULTI_VALUE_OPTIONS for a in args):
+        return args
+    group = typer.main.get_command(app)
+    commands: dict[str, Any] = getattr(group, "commands", {})
+    at = next((i for i, a in enumerate(args) if a in commands), None)
+    if at is None:
+        return args
+    cmd = commands[args[at]]
+    with_value = {o for p in cmd.params if p.param_type_name == "option"
+                  and not p.is_flag for o in p.opts}
+    arguments = [p for p in cmd.params if p.param_type_name == "argument"]
+    needed = None if any(p.nargs < 0 for p in arguments) else len(arguments)
+    out, gathered, positional, i = list(args[: at + 1]), [], 0, at + 1
+    while i < len(args):
+        tok = args[i]
+        if tok == "--":
+            out += args[i:]
+            break
+        if tok in MULTI_VALUE_OPTIONS:
+            j = i + 1
+            while j < len(args) and _is_number(args[j]):
+                j += 1
+            if j > i + 1:
+                gathered.append((len(out), args[i + 1: j]))
+                out.append(f"{tok}={','.join(args[i + 1: j])}")
+                i = j
+                continue
+        if tok in with_value:
+            out += args[i: i + 2]
+            i += 2
+            continue
+        if not tok.startswith("-") or _is_number(tok):
+            positional += 1
+        out.append(tok)
+        i += 1
+    if needed is not None and gathered and positional < needed:
+        where, values = gathered[-1]
+        keep = max(len(values) - (needed - positional), 1)
+        opt = out[where].split("=", 1)[0]
+        out[where: where + 1] = [f"{opt}={','.join(values[:keep])}", *values[keep:]]
+    return out
+
+
+def _one_line(text: object) -> str:
     return " ".join(str(text).split())
 
 
@@ -264,12 +379,14 @@ def main(argv: list[str] | None = None) -> int:
     from robokin.exceptions import RobokinError, UnreachableError
 
     # click's classes as this typer raises them (recent typer vendors click)
+    # (found at run time, so their attributes are unknown to the type checker)
     mro = typer.BadParameter.__mro__
-    click_error = next(c for c in mro if c.__name__ == "ClickException")
-    usage_error = next(c for c in mro if c.__name__ == "UsageError")
+    click_error: type[Any] = next(c for c in mro if c.__name__ == "ClickException")
+    usage_error: type[Any] = next(c for c in mro if c.__name__ == "UsageError")
 
     _register_extra_commands()
     args, debug = _split_debug(list(sys.argv[1:] if argv is None else argv))
+    args = _gather_values(args)
     _DEBUG["on"] = debug
     with warnings.catch_warnings():
         warnings.showwarning = _show_warning

@@ -12,7 +12,16 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from robokin.cli import _NUMERIC_ARGS, _console, _load, app, cell, json_text
+from robokin.cli import _NUMERIC_ARGS, _load, app, json_text
+from robokin.cli_output import (
+    Column,
+    FormatOption,
+    OutputTable,
+    emit,
+    general,
+    resolve_format,
+    say,
+)
 
 __all__ = ["joints", "motors"]
 
@@ -42,19 +51,17 @@ def _motor_names(robot) -> list[str]:
 
 
 def _report(title: str, names: list[str], values: np.ndarray, units: list[str],
-            inside: np.ndarray, as_json: bool, key: str) -> None:
-    if as_json:
+            inside: np.ndarray, fmt: str, key: str) -> None:
+    if fmt == "json":
         print(json_text({key: values.tolist(), "names": names, "units": units,
                           "within_limits": inside.tolist()}))
         return
-    from rich.table import Table
-
-    table = Table(title=title)
-    for col in ("name", "value", "unit", "within limits"):
-        table.add_column(col)
+    table = OutputTable(title, [Column("name"), Column("value", general(12), True),
+                                Column("unit"), Column("within limits")])
     for nm, v, u, ok in zip(names, values, units, inside):
-        table.add_row(cell(nm), f"{v:.9g}", u, "yes" if ok else "[red]no[/red]")
-    _console().print(table)
+        table.add_row(nm, float(v), u, "yes" if ok else "no",
+                      style=None if ok else "red")
+    emit(table, fmt)
 
 
 def _inside(values: np.ndarray, limits: np.ndarray | None) -> np.ndarray:
@@ -69,9 +76,12 @@ def motors(
     q: Annotated[list[float], typer.Argument(help="Joint values (rad, m).")],
     deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
     mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
+                       ] = False,
+    output_format: FormatOption = None,
 ) -> None:
     """Motor coordinates from joint coordinates: phi = A^+ (q - b)."""
+    fmt = resolve_format(output_format, as_json)
     r = _load(name)
     if len(q) != r.n:
         raise typer.BadParameter(f"{r.name} has {r.n} joints, got {len(q)} values")
@@ -82,9 +92,9 @@ def motors(
     lim = r.limits if r.actuators is None else r.actuator_limits
     _report(f"{r.name}: motor coordinates", _motor_names(r),
             phi * _scales(angular, deg, mm), _units(angular, deg, mm),
-            _inside(phi, lim), as_json, "phi")
-    if not as_json and r.actuators is None:
-        _console().print("[dim]no actuator map: motors drive the joints one to one[/dim]")
+            _inside(phi, lim), fmt, "phi")
+    if fmt != "json" and r.actuators is None:
+        say("no actuator map: motors drive the joints one to one", fmt)
 
 
 @app.command(context_settings=_NUMERIC_ARGS)
@@ -93,9 +103,12 @@ def joints(
     phi: Annotated[list[float], typer.Argument(help="Motor values (rad, m).")],
     deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
     mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
+                       ] = False,
+    output_format: FormatOption = None,
 ) -> None:
     """Joint coordinates from motor coordinates: q = A phi + b."""
+    fmt = resolve_format(output_format, as_json)
     r = _load(name)
     angular = np.array([k == "rotary" for k in _motor_kinds(r)])
     if len(phi) != angular.size:
@@ -105,4 +118,4 @@ def joints(
     q = r.joints_from_actuators(pv)
     rev = r.is_revolute
     _report(f"{r.name}: joint coordinates", list(r.joint_names), q * _scales(rev, deg, mm),
-            _units(rev, deg, mm), _inside(q, r.limits), as_json, "q")
+            _units(rev, deg, mm), _inside(q, r.limits), fmt, "q")

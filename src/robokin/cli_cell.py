@@ -15,7 +15,15 @@ from typing import Annotated, Any
 
 import typer
 
-from robokin.cli import DomainFailure, app, cell, json_text
+from robokin.cli import DomainFailure, app, json_text
+from robokin.cli_output import (
+    Column,
+    FormatOption,
+    OutputTable,
+    emit,
+    general,
+    resolve_format,
+)
 from robokin.exceptions import InputError
 
 __all__ = ["parse_axis", "place_command", "reach_command"]
@@ -71,7 +79,7 @@ def _out_dir(out: Path) -> Path:
 @app.command("reach")
 def reach_command(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
-    voxel: Annotated[float, typer.Option("--voxel", help="Voxel edge \\[mm].")] = 50.0,
+    voxel: Annotated[float, typer.Option("--voxel", help="Voxel edge [mm].")] = 50.0,
     out: Annotated[
         Path, typer.Option("--out", help="Output folder (map.zarr, sections.png, reach.json).")
     ] = Path("robokin-reach"),
@@ -81,7 +89,7 @@ def reach_command(
     rolls: Annotated[int, typer.Option(help="Rolls about each approach direction.")] = 1,
     region: Annotated[
         str | None,
-        typer.Option(help="x0,y0,z0,x1,y1,z1 \\[mm] (default: the workspace bounds)."),
+        typer.Option(help="x0,y0,z0,x1,y1,z1 [mm] (default: the workspace bounds)."),
     ] = None,
     scene: Annotated[
         str | None, typer.Option(help="Scene (file or bundled name): count collision-free "
@@ -98,20 +106,19 @@ def reach_command(
     force: Annotated[
         bool, typer.Option("--force", help="Replace a map.zarr holding another map.")
     ] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")] = False,
+    output_format: FormatOption = None,
 ) -> None:
     """Reachability map: which positions the tool reaches, in how many orientations.
 
     The map streams into OUT/map.zarr (memory stays bounded; running the same
     command again finishes an interrupted map) and OUT/sections.png shows it.
     """
-    from rich.console import Console
-    from rich.table import Table
-
     import robokin
     from robokin.cell import reach_map
     from robokin.io.atomic import write_atomic
 
+    fmt = resolve_format(output_format, as_json)
     if not (math.isfinite(voxel) and voxel > 0):
         raise InputError("--voxel", f"expected an edge length > 0 [mm], got {voxel:g}")
     box = None
@@ -131,15 +138,12 @@ def reach_command(
     m.plot_sections(path=png)
     summary = {**m.summary(), "store": str(folder / "map.zarr"), "sections": str(png)}
     write_atomic(folder / "reach.json", json_text(summary) + "\n", argument="--out")
-    if as_json:
+    if fmt == "json":
         print(json_text(summary))
         return
-    con = Console()
-    table = Table(title=f"{cell(robot.name)}: reachability map ({cell(m.method)})",
-                  show_header=False)
-    table.add_column(style="bold")
-    table.add_column()
     nx, ny, nz = m.grid.shape
+    table = OutputTable(f"{robot.name}: reachability map ({m.method})",
+                        [Column(""), Column("value")])
     table.add_row("voxels", f"{m.size:,} ({nx} x {ny} x {nz} of {voxel:g} mm)")
     table.add_row("orientations", f"{summary['orientations']} per voxel "
                   f"({summary['ik_evaluations']:,} IK targets)")
@@ -148,9 +152,8 @@ def reach_command(
     table.add_row("every orientation", f"{summary['dexterous_voxels']:,} voxels")
     if summary["manipulability_max"] is not None:
         table.add_row("best manipulability", f"{summary['manipulability_max']:.4g}")
-    con.print(table)
-    for p in (folder / "map.zarr", png, folder / "reach.json"):
-        con.print(f"wrote {p}", markup=False)
+    table.notes += [f"wrote {p}" for p in (folder / "map.zarr", png, folder / "reach.json")]
+    emit(table, fmt)
 
 
 @app.command("place")
@@ -165,15 +168,15 @@ def place_command(
                                "(the press-loading motion) or a trajectory CSV "
                                "(joints at the scene's current base).")
     ] = "poses",
-    x: Annotated[str | None, typer.Option(help="Base x \\[mm]: from:to:step or a,b,c "
+    x: Annotated[str | None, typer.Option(help="Base x [mm]: from:to:step or a,b,c "
                                                "(default: the scene's base ± 400 by 100).")] = None,
-    y: Annotated[str | None, typer.Option(help="Base y \\[mm], as --x.")] = None,
-    z: Annotated[str | None, typer.Option(help="Base z \\[mm] (default: the scene's).")] = None,
-    yaw: Annotated[str | None, typer.Option(help="Base yaw \\[deg] (default: the scene's).")] = None,
-    clearance: Annotated[float, typer.Option(help="Required clearance \\[mm].")] = 0.0,
+    y: Annotated[str | None, typer.Option(help="Base y [mm], as --x.")] = None,
+    z: Annotated[str | None, typer.Option(help="Base z [mm] (default: the scene's).")] = None,
+    yaw: Annotated[str | None, typer.Option(help="Base yaw [deg] (default: the scene's).")] = None,
+    clearance: Annotated[float, typer.Option(help="Required clearance [mm].")] = 0.0,
     max_step: Annotated[
         float | None, typer.Option(help="Largest joint step between task poses on one "
-                                        "branch \\[deg] (default 30; none for 'poses').")
+                                        "branch [deg] (default 30; none for 'poses').")
     ] = None,
     every: Annotated[int, typer.Option(help="Use every N-th sample of a motion.")] = 10,
     out: Annotated[
@@ -182,7 +185,8 @@ def place_command(
     scheduler: Annotated[
         str | None, typer.Option(help="Dask scheduler address (default: this machine).")
     ] = None,
-    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")] = False,
+    output_format: FormatOption = None,
 ) -> None:
     """Score candidate robot bases for a task: reach on one branch, clearance, manipulability.
 
@@ -195,6 +199,7 @@ def place_command(
     from robokin.cell.placement import DEFAULT_MAX_STEP
     from robokin.io.atomic import write_atomic
 
+    fmt = resolve_format(output_format, as_json)
     if not (math.isfinite(clearance) and clearance >= 0):
         raise InputError("--clearance", f"expected a distance >= 0 [mm], got {clearance:g}")
     if every < 1:
@@ -222,10 +227,10 @@ def place_command(
     summary = {**pl.summary(), "files": [str(folder / f) for f in
                                          ("placement.png", "placement.csv", "placement.json")]}
     write_atomic(folder / "placement.json", json_text(summary) + "\n", argument="--out")
-    if as_json:
+    if fmt == "json":
         print(json_text(summary))
     else:
-        _print_ranking(pl, robot.name, folder)
+        emit(_ranking_table(pl, robot.name, folder), fmt)
     if pl.best_index is None:
         raise DomainFailure(f"no feasible placement among {len(pl.feasible)} candidates: "
                             f"{pl.reasons_text()}")
@@ -253,23 +258,20 @@ def _task_poses(task: str, robot: Any, scene: Any, every: int) -> tuple[Any, boo
     return placed.fk(q[::every]), False
 
 
-def _print_ranking(pl: Any, robot_name: str, folder: Path, top: int = 10) -> None:
-    from rich.console import Console
-    from rich.table import Table
-
-    con = Console()
-    table = Table(title=f"{cell(robot_name)}: {int(pl.feasible.sum())} of "
-                        f"{len(pl.feasible)} bases feasible")
-    for col in ("rank", "x \\[mm]", "y \\[mm]", "z \\[mm]", "yaw \\[deg]", "score",
-                "clearance \\[mm]"):
-        table.add_column(col, justify="right")
+def _ranking_table(pl: Any, robot_name: str, folder: Path, top: int = 10) -> OutputTable:
+    """The best ``top`` feasible candidates, then why the others fail and the files."""
+    table = OutputTable(
+        f"{robot_name}: {int(pl.feasible.sum())} of {len(pl.feasible)} bases feasible",
+        [Column("rank", right=True), Column("x [mm]", general(6), True),
+         Column("y [mm]", general(6), True), Column("z [mm]", general(6), True),
+         Column("yaw [deg]", general(6), True), Column("score", general(4), True),
+         Column("clearance [mm]", general(4), True)])
     for r, c in enumerate(pl.ranking[:top], start=1):
         T = pl.candidates[c]
-        table.add_row(str(r), f"{T[0, 3] * 1e3:.0f}", f"{T[1, 3] * 1e3:.0f}",
-                      f"{T[2, 3] * 1e3:.0f}",
-                      f"{math.degrees(math.atan2(T[1, 0], T[0, 0])):.1f}",
-                      f"{pl.score[c]:.4g}", f"{pl.clearance[c] * 1e3:.1f}")
-    con.print(table)
-    con.print(f"infeasible: {cell(pl.reasons_text(), 300)}")
-    for f in ("placement.png", "placement.csv", "placement.json"):
-        con.print(f"wrote {folder / f}", markup=False)
+        table.add_row(r, float(T[0, 3] * 1e3), float(T[1, 3] * 1e3), float(T[2, 3] * 1e3),
+                      math.degrees(math.atan2(T[1, 0], T[0, 0])), float(pl.score[c]),
+                      float(pl.clearance[c] * 1e3))
+    table.notes.append(f"infeasible: {pl.reasons_text()}")
+    table.notes += [f"wrote {folder / f}" for f in
+                    ("placement.png", "placement.csv", "placement.json")]
+    return table

@@ -9,16 +9,20 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robokin.cli import DomainFailure, app, cell, json_text
+from robokin.cli import DomainFailure, app, json_text
+from robokin.cli_output import FormatOption, resolve_format
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["read_trajectory_csv"]
 
 
-def read_trajectory_csv(path: str | Path, robot: Any = None) -> tuple[Any, Any]:
+def read_trajectory_csv(path: str | Path, robot: Robot | None = None) -> tuple[Any, Any]:
     """Times (m,) [s] and joints (m, n) [SI] from a trajectory CSV.
 
     With ``robot`` the joint columns are matched to its joint names by header
@@ -44,7 +48,7 @@ def check_command(
         Path, typer.Argument(help="Scene file (YAML), or a bundled name.")
     ],
     trajectory: Annotated[
-        Path, typer.Argument(help="Trajectory CSV: t \\[s],<joint> \\[rad]...")
+        Path, typer.Argument(help="Trajectory CSV: t [s],<joint> [rad]...")
     ],
     robot: Annotated[
         str | None,
@@ -52,21 +56,23 @@ def check_command(
             "--robot", help="Built-in name or robot file (default: the scene's)."
         ),
     ] = None,
-    clearance: Annotated[float, typer.Option(help="Required clearance \\[mm].")] = 0.0,
+    clearance: Annotated[float, typer.Option(help="Required clearance [mm].")] = 0.0,
     plot: Annotated[
         Path | None,
         typer.Option("--plot", help="Write a distance-over-time plot here."),
     ] = None,
     top: Annotated[int, typer.Option(help="How many closest pairs to list.")] = 8,
     as_json: Annotated[
-        bool, typer.Option("--json", help="Machine-readable output.")
+        bool, typer.Option("--json", help="Same as --format json.")
     ] = False,
+    output_format: FormatOption = None,
 ) -> None:
     """Check a joint trajectory against a scene: minimum distances and collisions."""
     import robokin
     from robokin import collision
     from robokin.exceptions import InputError
 
+    fmt = resolve_format(output_format, as_json)
     if top < 0:
         raise InputError("--top", f"expected a count >= 0, got {top}")
     if not math.isfinite(clearance) or clearance < 0:
@@ -89,7 +95,7 @@ def check_command(
         from robokin.collision.plots import plot_distance
 
         plot_distance(rep, out=plot)
-    if as_json:
+    if fmt == "json":
         c = rep.closest
         print(
             json_text(
@@ -115,7 +121,7 @@ def check_command(
             )
         )
     else:
-        _print_report(rep, clearance, violated, q.shape[0], plot, top)
+        _print_report(rep, clearance, violated, q.shape[0], plot, top, fmt)
     if violated:
         what = (
             "collides"
@@ -128,65 +134,37 @@ def check_command(
 
 
 def _print_report(
-    rep, clearance_mm: float, violated: bool, m: int, plot, top: int = 8
+    rep, clearance_mm: float, violated: bool, m: int, plot, top: int, fmt: str
 ) -> None:
-    from rich.console import Console
-    from rich.markup import escape
-    from rich.table import Table
+    from robokin.cli_output import Column, OutputTable, emit, fixed, say
 
-    con = Console()
-    table = Table(title=f"closest pairs ({m} samples)")
-    for col in ("body", "body", "min distance [mm]", "t [s]", "sample"):
-        table.add_column(
-            escape(col), justify="right" if "[" in col or col == "sample" else "left"
-        )
+    limit = max(clearance_mm * 1e-3, 0.0)
+    pairs = OutputTable(f"closest pairs ({m} samples)", [
+        Column("body"), Column("body"), Column("min distance [mm]", fixed(2), True),
+        Column("t [s]", fixed(3), True), Column("sample", right=True)])
     for p in rep.pairs[:top]:
-        style = "red" if p.distance <= max(clearance_mm * 1e-3, 0.0) else None
-        table.add_row(
-            cell(p.body_a),
-            cell(p.body_b),
-            f"{p.distance * 1e3:.2f}",
-            f"{p.t:.3f}",
-            str(p.index),
-            style=style,
-        )
-    con.print(table)
+        pairs.add_row(p.body_a, p.body_b, p.distance * 1e3, p.t, p.index,
+                      style="red" if p.distance <= limit else None)
+    tables = [pairs]
     if rep.intervals:
-        ct = Table(title="collisions")
-        for col in (
-            "body",
-            "body",
-            "first",
-            "last",
-            "t start [s]",
-            "t end [s]",
-            "depth [mm]",
-        ):
-            ct.add_column(escape(col))
+        hits = OutputTable("collisions", [
+            Column("body"), Column("body"), Column("first", right=True),
+            Column("last", right=True), Column("t start [s]", fixed(3), True),
+            Column("t end [s]", fixed(3), True), Column("depth [mm]", fixed(2), True),
+            Column("between samples")])
         for iv in rep.intervals:
-            ct.add_row(
-                cell(iv.body_a),
-                cell(iv.body_b),
-                str(iv.first_index),
-                str(iv.last_index),
-                f"{iv.t_start:.3f}",
-                f"{iv.t_end:.3f}",
-                f"{-iv.min_distance * 1e3:.2f}"
-                + (" (between samples)" if iv.between_samples else ""),
-                style="red",
-            )
-        con.print(ct)
+            hits.add_row(iv.body_a, iv.body_b, iv.first_index, iv.last_index,
+                         iv.t_start, iv.t_end, -iv.min_distance * 1e3,
+                         "yes" if iv.between_samples else "no", style="red")
+        tables.append(hits)
+    emit(tables, fmt)
     c = rep.closest
     if c is not None:
         pa = ", ".join(f"{v * 1e3:.1f}" for v in c.point_a)
         pb = ", ".join(f"{v * 1e3:.1f}" for v in c.point_b)
-        con.print(
-            f"minimum {c.distance * 1e3:.2f} mm between {c.body_a} and {c.body_b} "
+        say(f"minimum {c.distance * 1e3:.2f} mm between {c.body_a} and {c.body_b} "
             f"at t = {c.t:.3f} s (sample {c.index}); nearest points [mm] "
-            f"({pa}) and ({pb})",
-            markup=False,
-        )
-    verdict = "[red]VIOLATED[/red]" if violated else "[green]OK[/green]"
-    con.print(f"clearance {clearance_mm:g} mm: {verdict}")
+            f"({pa}) and ({pb})", fmt)
+    say(f"clearance {clearance_mm:g} mm: {'VIOLATED' if violated else 'OK'}", fmt)
     if plot is not None:
-        con.print(f"plot: {plot}", markup=False)
+        say(f"plot: {plot}", fmt)

@@ -7,7 +7,8 @@ from typing import Annotated
 
 import typer
 
-from robokin.cli import DomainFailure, _console, _load, app, cell, json_text
+from robokin.cli import DomainFailure, _load, app, json_text
+from robokin.cli_output import Column, FormatOption, OutputTable, emit, resolve_format
 
 __all__ = ["ik"]
 
@@ -24,20 +25,22 @@ def ik(
     deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
     mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
     near: Annotated[str | None, typer.Option(
-        "--near", help="Current joint values, comma or space separated (rad/m, or "
-                       "deg/mm with --deg/--mm).")] = None,
+        "--near", help="Current joint values q1 ... qn, as many as the robot has "
+                       "joints (rad/m, or deg/mm with --deg/--mm).")] = None,
     method: Annotated[str, typer.Option(help="auto | analytic | numeric")] = "auto",
     limits: Annotated[bool, typer.Option("--limits", help="Only solutions inside the "
                                                             "joint limits.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable output.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
+                       ] = False,
+    output_format: FormatOption = None,
 ) -> None:
     """Inverse kinematics: every solution for the pose x y z roll pitch yaw."""
     import numpy as np
-    from rich.table import Table
 
     from robokin.kinematics.ik.analytic._common import fk_error
     from robokin.spatial import pose_from_xyz_rpy
 
+    fmt = resolve_format(output_format, as_json)
     r = _load(name)
     L = 1000.0 if mm else 1.0
     A = 180.0 / math.pi if deg else 1.0
@@ -68,7 +71,7 @@ def ik(
         order = np.argsort(sols.distance(q_near)[sols.valid], kind="stable")
     disp = np.where(rev, q * A, q * L)
     status = str(sols.status.item() if isinstance(sols.status, np.ndarray) else sols.status)
-    if as_json:
+    if fmt == "json":
         print(json_text({
             "method": sols.method, "status": status,
             "solutions": [
@@ -78,33 +81,27 @@ def ik(
                  "position_error_m": float(dp[i]), "rotation_error_rad": float(dr[i])}
                 for i in order],
         }))
-    else:
-        con = _console()
+    elif len(q):
         au, lu = ("deg" if deg else "rad"), ("mm" if mm else "m")
-        table = Table(title=f"{cell(r.name)}: {len(q)} solution(s) "
-                            f"{cell('[' + sols.method + ']')}; "
-                            f"angles {au}, lengths {lu}")
-        table.add_column("#")
-        for j in range(r.n):
-            table.add_column(f"q{j + 1}", justify="right")
-        table.add_column("branch")
-        table.add_column("flags")
-        table.add_column("FK err", justify="right")
+        units = [au if rv else lu for rv in rev]
+        table = OutputTable(
+            f"{r.name}: {len(q)} solution(s) [{sols.method}]; angles {au}, lengths {lu}",
+            [Column("#", right=True),
+             *[Column(f"q{j + 1} [{u}]", fmt=lambda v: f"{v:.6f}", right=True)
+               for j, u in enumerate(units)],
+             Column("branch"), Column("flags"),
+             Column("FK err", fmt=lambda v: f"{v:.1e}", right=True)])
         for rank, i in enumerate(order, 1):
             fl = [k for k, v in flags.items() if k != "within_limits" and v[i]]
             if not flags.get("within_limits", np.ones(len(q), bool))[i]:
                 fl.append("LIMITS")
             br = "".join(f"{k[0].upper()}{'+' if v[i] > 0 else '-'}"
                           for k, v in branches.items())
-            table.add_row(
-                str(rank), *[f"{v:.3f}" for v in disp[i]], br or "-",
-                ",".join(fl) or "-", f"{max(dp[i], dr[i]):.0e}",
-            )
-        if len(q):
-            con.print(table)
-        if len(q):
-            con.print("FK err: max of position [m] and rotation [rad] error"
-                      + ("; sorted by distance from --near" if q_near is not None else ""),
-                      markup=False)
+            table.add_row(rank, *[float(v) for v in disp[i]], br or "-",
+                          ",".join(fl) or "-", float(max(dp[i], dr[i])))
+        table.notes.append(
+            "FK err: max of position [m] and rotation [rad] error"
+            + ("; sorted by distance from --near" if q_near is not None else ""))
+        emit(table, fmt)
     if not len(q):
         raise DomainFailure(f"no IK solution: {status}")

@@ -1,6 +1,6 @@
-"""``robokin import``, ``robokin export`` and ``robokin dh``: URDF in and out.
+"""``robokin import``, ``robokin export`` and ``robokin dh``: URDF in and out, MJCF out.
 
-Files are written only where ``-o`` names them; without ``-o`` the result goes to
+``robokin export NAME -o robot.xml`` chooses the format by the suffix. Files are written only where ``-o`` names them; without ``-o`` the result goes to
 standard output.
 """
 
@@ -12,6 +12,7 @@ from typing import Annotated
 import typer
 
 from robokin.cli import _console, _load, app, cell, json_text
+from robokin.cli_output import FormatOption
 
 __all__ = ["dh", "export_urdf", "import_urdf"]
 
@@ -25,9 +26,20 @@ def _not_the_input(out: Path, source: str | Path) -> None:
         raise InputError("--out", f"{out} is the input file; choose another name")
 
 
+def _pairs(items: list[str] | None, option: str) -> dict[str, str]:
+    """``NAME=VALUE`` options as a dict (a usage error names the option)."""
+    out: dict[str, str] = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            raise typer.BadParameter(f"{option} expects NAME=VALUE, got {item!r}")
+        out[name.strip()] = value
+    return out
+
+
 @app.command("import")
 def import_urdf(
-    file: Annotated[Path, typer.Argument(help="The URDF file.")],
+    file: Annotated[Path, typer.Argument(help="The URDF or xacro (.xacro, .urdf.xacro) file.")],
     base: Annotated[str | None, typer.Option("--base", help="Base link.")] = None,
     tip: Annotated[str | None, typer.Option("--tip", help="Tip link.")] = None,
     out: Annotated[
@@ -35,29 +47,31 @@ def import_urdf(
     ] = None,
     package: Annotated[
         list[str] | None,
-        typer.Option("--package", help="NAME=DIR for package:// meshes (repeatable)."),
+        typer.Option("--package", help="NAME=DIR for package:// and $(find NAME) "
+                     "(repeatable; searched before ROS_PACKAGE_PATH)."),
+    ] = None,
+    arg: Annotated[
+        list[str] | None,
+        typer.Option("--arg", help="NAME=VALUE for a xacro's <xacro:arg> (repeatable)."),
     ] = None,
 ) -> None:
-    """Read a URDF's serial chain and write it as a robokin robot file.
+    """Read a URDF's or xacro's serial chain and write it as a robokin robot file.
 
-    Every visual or collision shape left out (a missing, remote or unsupported
-    mesh, a non-uniform scale) is reported on stderr, one line each.
+    A xacro is expanded first (robokin[ros]; no ROS install). Every visual or
+    collision shape left out (a mesh whose package or file is not found, a
+    remote or unsupported mesh, a non-uniform scale) is reported on stderr,
+    one line each.
     """
     import yaml
 
     from robokin.io.robot_files import document_from_robot, save_robot
     from robokin.io.urdf import robot_from_urdf
 
-    pmap = {}
-    for item in package or []:
-        name, sep, directory = item.partition("=")
-        if not sep or not name:
-            raise typer.BadParameter(f"--package expects NAME=DIR, got {item!r}")
-        pmap[name] = directory
+    pmap = _pairs(package, "--package")
     if out is not None:
         _not_the_input(out, file)
     robot = robot_from_urdf(file, base_link=base, tip_link=tip, package_map=pmap,
-                            missing_mesh="ignore")
+                            xacro_args=_pairs(arg, "--arg"), missing_mesh="ignore")
     info = robot.meta["urdf"]
     for msg in robot.meta.get("urdf_dropped_shapes", ()):
         typer.echo(f"robokin: note: left out {msg}", err=True)
@@ -73,29 +87,74 @@ def import_urdf(
     )
 
 
+def _export_format(out: Path | None, fmt: str | None) -> str:
+    """``urdf`` or ``mjcf``: ``--format`` when given, else by the suffix of ``-o``.
+
+    ``.xml`` and ``.mjcf`` (but not ``.urdf.xml``) are MJCF; every other name is
+    URDF, as it was before MJCF export existed.
+    """
+    from robokin.exceptions import InputError
+
+    if fmt is not None:
+        if fmt not in ("urdf", "mjcf"):
+            raise InputError("--format", f"expected 'urdf' or 'mjcf', got {fmt!r}")
+        return fmt
+    if out is None:
+        return "urdf"
+    name = out.name.lower()
+    if name.endswith((".xml", ".mjcf")) and not name.endswith(".urdf.xml"):
+        return "mjcf"
+    return "urdf"  # .urdf, and any other name as before MJCF export existed
+
+
 @app.command("export")
 def export_urdf(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     out: Annotated[
-        Path | None, typer.Option("-o", "--out", help="URDF file to write (replaced if it exists).")
+        Path | None, typer.Option(
+            "-o", "--out", help="File to write (replaced if it exists): .xml or .mjcf "
+            "for a MuJoCo model, any other name (.urdf) for URDF.")
+    ] = None,
+    fmt: Annotated[
+        str | None, typer.Option("--format", help="urdf or mjcf (default: by the "
+                                 "suffix of -o, else urdf).")
+    ] = None,
+    scene: Annotated[
+        str | None, typer.Option("--scene", help="MJCF only: a scene file or bundled "
+                                 "name; the robot is placed in it with its objects.")
     ] = None,
 ) -> None:
-    """Write a robot as a URDF with the same FK and limits."""
-    from robokin.io.urdf_export import urdf_from_robot, write_urdf
+    """Write a robot as a URDF, or as a MuJoCo MJCF model, with the same FK and limits."""
+    from robokin.exceptions import InputError
 
     if out is not None:
         _not_the_input(out, name)
+    kind = _export_format(out, fmt)
+    if scene is not None and kind != "mjcf":
+        raise InputError("--scene", "a scene goes into an MJCF model only (-o NAME.xml)")
     robot = _load(name)
+    if kind == "mjcf":
+        from robokin.cli_sim import load_scene
+        from robokin.sim import to_mjcf
+
+        text = to_mjcf(robot, None if scene is None else load_scene(scene))
+    else:
+        from robokin.io.urdf_export import urdf_from_robot
+
+        text = urdf_from_robot(robot)
     if out is None:
-        print(urdf_from_robot(robot), end="")
+        print(text, end="")
         return
-    write_urdf(robot, out)
-    _console().print(f"{cell(robot.name, markup=False)}: wrote {out}", markup=False)
+    from robokin.io.atomic import write_atomic
+
+    write_atomic(out, text)
+    _console().print(f"{cell(robot.name, markup=False)}: wrote {out} ({kind.upper()})",
+                     markup=False)
 
 
 @app.command("dh")
 def dh(
-    file: Annotated[Path, typer.Argument(help="The URDF file.")],
+    file: Annotated[Path, typer.Argument(help="The URDF or xacro file.")],
     base: Annotated[str | None, typer.Option("--base", help="Base link.")] = None,
     tip: Annotated[str | None, typer.Option("--tip", help="Tip link.")] = None,
     modified: Annotated[
@@ -110,17 +169,24 @@ def dh(
         typer.Option("--virtual-frames", help="Fold base/tool into fixed rows."),
     ] = False,
     mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Machine-readable.")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
+                       ] = False,
+    output_format: FormatOption = None,
+    package: Annotated[list[str] | None, typer.Option(
+        "--package", help="NAME=DIR for a xacro's $(find NAME) (repeatable).")] = None,
+    arg: Annotated[list[str] | None, typer.Option(
+        "--arg", help="NAME=VALUE for a xacro's <xacro:arg> (repeatable).")] = None,
 ) -> None:
-    """Derive the DH table of a URDF arm (degrees; metres unless --mm)."""
-    from rich.table import Table
-
+    """Derive the DH table of a URDF or xacro arm (degrees; metres unless --mm)."""
+    from robokin.cli_output import Column, OutputTable, emit, general, resolve_format
     from robokin.io.dh_extract import describe
     from robokin.io.urdf import dh_from_urdf
 
+    fmt = resolve_format(output_format, as_json)
     ext = dh_from_urdf(
         file, base, tip, convention="modified" if modified else "standard",
         reference_link=reference, virtual_frames=virtual,
+        package_map=_pairs(package, "--package"), xacro_args=_pairs(arg, "--arg"),
     )
     doc = describe(ext, deg=True)
     L = 1000.0 if mm else 1.0
@@ -132,32 +198,26 @@ def dh(
     for key in ("base", "tool"):
         doc[key]["xyz"] = [v * L for v in doc[key]["xyz"]]
     doc["units"] = {"length": "mm" if mm else "m", "angle": "deg"}
-    if as_json:
+    if fmt == "json":
         print(json_text(doc))
         return
     lu = "mm" if mm else "m"
     cols = (("alpha", "deg"), ("a", lu), ("theta", "deg"), ("d", lu)) if modified \
         else (("theta", "deg"), ("d", lu), ("a", lu), ("alpha", "deg"))
-    table = Table(title=f"{doc['convention']} DH of {cell(file.name)}")
-    table.add_column("joint")
-    table.add_column("kind")
-    for c, u in cols:
-        table.add_column(f"{c} [{u}]")
+    table = OutputTable(f"{doc['convention']} DH of {file.name}",
+                        [Column("joint"), Column("kind"),
+                         *(Column(f"{c} [{u}]", general(10), True) for c, u in cols)])
     for r in doc["rows"]:
-        table.add_row(cell(r["name"]), r["joint"], *(f"{r[c]:.6g}" for c, _ in cols))
-    con = _console()
-    con.print(table)
+        table.add_row(r["name"], r["joint"], *(float(r[c]) for c, _ in cols))
     for key in ("base", "tool"):
         p = doc[key]
-        con.print(
+        table.notes.append(
             f"{key} transform: xyz [{lu}] "
-            + " ".join(f"{v:.6g}" for v in p["xyz"])
-            + "  rpy [deg] " + " ".join(f"{v:.6g}" for v in p["rpy"]),
-            markup=False,
-        )
+            + " ".join(f"{v:.10g}" for v in p["xyz"])
+            + "  rpy [deg] " + " ".join(f"{v:.10g}" for v in p["rpy"]))
     if ext.needs_virtual_frames and not virtual:
-        con.print("this arm needs virtual frames to stand as a table alone "
-                  "(a base or tool transform remains); --virtual-frames emits them",
-                  markup=False)
-    for note in doc["notes"]:
-        con.print(f"note: {note}", markup=False)
+        table.notes.append("this arm needs virtual frames to stand as a table alone "
+                           "(a base or tool transform remains); --virtual-frames "
+                           "emits them")
+    table.notes += [f"note: {note}" for note in doc["notes"]]
+    emit(table, fmt)

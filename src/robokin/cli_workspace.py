@@ -7,7 +7,15 @@ from typing import Annotated
 
 import typer
 
-from robokin.cli import app, cell, json_text
+from robokin.cli import app, json_text
+from robokin.cli_output import (
+    Column,
+    FormatOption,
+    OutputTable,
+    emit,
+    fixed,
+    resolve_format,
+)
 
 __all__ = ["workspace"]
 
@@ -22,24 +30,26 @@ def workspace(
         Path, typer.Option("--out", help="Output folder for the plots.")
     ] = Path("robokin-workspace"),
     voxel_mm: Annotated[
-        float, typer.Option("--voxel", help="Voxel edge \\[mm] (0: the longest extent / 100).")
+        float, typer.Option("--voxel", help="Voxel edge [mm] (0: the longest extent / 100).")
     ] = 0.0,
     seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
     as_json: Annotated[
-        bool, typer.Option("--json", help="Machine-readable output.")
+        bool, typer.Option("--json", help="Same as --format json.")
     ] = False,
+    output_format: FormatOption = None,
 ) -> None:
     """Sample the reachable workspace: bounds, volume, XY/XZ sections, manipulability."""
     import numpy as np
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-    from rich.table import Table
 
     import robokin
     from robokin.io.atomic import file_stem, write_atomic
     from robokin.kinematics.workspace import sample_workspace
     from robokin.viz.plots import save_workspace_plots
 
+    fmt = resolve_format(output_format, as_json)
+    as_json = fmt == "json"
     if samples < 1:
         raise typer.BadParameter(f"--samples must be >= 1, got {samples}")
     if not (voxel_mm >= 0 and np.isfinite(voxel_mm)):
@@ -49,13 +59,13 @@ def workspace(
     if not out.parent.is_dir():
         raise typer.BadParameter(f"--out {out}: the folder {out.parent} does not exist")
     robot = robokin.load(name)
-    con = Console(stderr=as_json)
+    con = Console(stderr=fmt != "table")
     with Progress(
         TextColumn("[bold]sampling[/bold] {task.completed:,.0f}/{task.total:,.0f}"),
         BarColumn(),
         TimeRemainingColumn(),
         console=con,
-        transient=as_json,
+        transient=fmt != "table",
     ) as bar:
         task = bar.add_task("fk", total=samples)
         ws = sample_workspace(
@@ -74,21 +84,19 @@ def workspace(
     if as_json:
         print(json_text(summary))
         return
-    table = Table(
-        title=f"{cell(robot.name)}: workspace of the tool point ({ws.n_samples:,} samples)"
-    )
-    for col in ("", "x \\[mm]", "y \\[mm]", "z \\[mm]"):
-        table.add_column(col, justify="right")
+    f1 = fixed(1)
+    table = OutputTable(
+        f"{robot.name}: workspace of the tool point ({ws.n_samples:,} samples)",
+        [Column(""), Column("x [mm]", f1, True), Column("y [mm]", f1, True),
+         Column("z [mm]", f1, True)])
     for label, row in (
         ("min", ws.bounds[0]),
         ("max", ws.bounds[1]),
         ("extent", ws.extent),
     ):
-        table.add_row(label, *(f"{v * 1000:.1f}" for v in row))
-    con.print(table)
-    con.print(
+        table.add_row(label, *(float(v * 1000) for v in row))
+    table.notes.append(
         f"volume ≈ {ws.volume:.4f} m³ ({ws.occupied_voxels:,} voxels of "
-        f"{ws.voxel_size * 1000:.1f} mm)"
-    )
-    for p in [*paths, summary_path]:
-        con.print(f"wrote {p}", markup=False)
+        f"{ws.voxel_size * 1000:.1f} mm)")
+    table.notes += [f"wrote {p}" for p in [*paths, summary_path]]
+    emit(table, fmt)

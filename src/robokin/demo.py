@@ -15,22 +15,29 @@ the workpiece between the dies along a straight final approach, then retracts.
 * Sampled every 5 ms (about 25 s, about 5,000 samples), checked against the
   joint position, speed and acceleration limits and, link by link, against the
   press scene (collision and minimum distance, with subdivision between samples).
+* The shortest cycle of the same path (:func:`robokin.trajectory.retime`, needs
+  ``robokin[retime]``): under the AUBO-i5's limits from its robot file and under
+  the demo's own caps, side by side with the planned 24 s; the retimed motion is
+  checked against the press again.
 
 Outputs in ``--out`` (default ``./robokin-demo``): ``trajectory.csv`` (time and
-joints), ``waypoints.csv`` (controller waypoints in degrees) and
-``program.script`` (a URScript ``servoj`` listing), ``joints.png``,
+joints), ``waypoints.csv`` (the via points in degrees, for reading), the program
+the AUBO-i5's controller profile names (``program.waypoints.csv``: every sample in
+the controller's joint order and units, for AUBO's SDK waypoint calls; see
+:mod:`robokin.trajectory.controllers`), ``joints.png``,
 ``tool_path.png`` (3D with projections), ``press_views.png`` (the tool path inside
 the press, side and top views), ``distance.csv`` and ``distance.png`` (the closest
 body pairs over time), ``animation.html`` (the
 motion, self-contained), ``report.html`` (one page with all of it) and
-``summary.json``. The command exits 0 only when the plan is collision-free with at
-least the required clearance.
+``summary.json``. With ``sim=True`` (``robokin demo --sim``) the plan also runs in
+MuJoCo: ``sim_*`` files and a "simulated run" section in the report. The command
+exits 0 only when the plan is collision-free with at least the required clearance.
 
-With ``--place`` it also asks where else the arm could stand: robot bases on a
-100 mm floor grid within 400 mm of the cell's base are scored for the same motion
-(:func:`robokin.cell.place`: one continuous IK branch, joint limits, clearance,
-manipulability) and ``placement.png`` maps the feasible ones (``placement.csv``
-lists them all); the cell's own base must come out feasible.
+With ``place=True`` (``robokin demo --place``) it also asks where else the arm
+could stand: robot bases on a 100 mm floor grid within 400 mm of the cell's base are
+scored for the same motion (:func:`robokin.cell.place`: one continuous IK branch,
+joint limits, clearance, manipulability) and ``placement.png`` maps the feasible
+ones (``placement.csv`` lists them all); the cell's own base comes out feasible.
 """
 
 from __future__ import annotations
@@ -41,16 +48,23 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robokin.exceptions import InputError
 
+if TYPE_CHECKING:
+    from robokin.collision.report import CollisionReport
+    from robokin.collision.scene import Scene
+    from robokin.robot import Robot
+    from robokin.trajectory.samples import Trajectory
+
 __all__ = ["DemoResult", "plan_press_loading", "run_demo"]
 
-# AUBO-i5 published joint speed limit (joints 1-6: 150 deg/s); the acceleration cap
-# is this demo's own choice for smooth motion, not a manufacturer figure.
+# AUBO-i5 published joint speed limit (150 deg/s on joints 1-3, 180 on 4-6: the demo
+# caps all six at 150); the acceleration cap is this demo's own choice for smooth
+# motion, not a manufacturer figure (the robot file's rate_limits hold AUBO's).
 V_MAX = math.radians(150.0)
 A_MAX = math.radians(300.0)
 DT = 0.005
@@ -78,11 +92,11 @@ class DemoResult:
     summary: dict[str, Any]
     files: dict[str, Path] = field(default_factory=dict)
     trajectory: Any = None
-    report: Any = None
+    report: CollisionReport | None = None
 
 
 def plan_press_loading(
-    robot: Any, scene: Any, *, dt: float = DT, progress: Any = None
+    robot: Robot, scene: Scene, *, dt: float = DT, progress: Any = None
 ) -> tuple[Any, list[dict[str, Any]]]:
     """Plan the press-loading motion.
 
@@ -108,7 +122,7 @@ def plan_press_loading(
     )
     via: list[dict[str, Any]] = []
     for label, kind, pose, duration in PLAN:
-        if kind == "dwell":
+        if pose is None:  # a dwell: no target
             path.dwell(duration, label=label)
             continue
         T = scene.tcp_pose(pose)
@@ -189,6 +203,30 @@ def _placement_summary(pl: Any, scene: Any) -> dict[str, Any]:
             "cell_base_score": float(pl.score[own])}
 
 
+def _cycle_times(robot: Any, bare: Any, scene: Any, traj: Any, clearance: float
+                 ) -> dict[str, Any]:
+    """The shortest cycle of the planned path, and the retimed motion's clearance.
+
+    The minimum cycle time (dwells kept) under the robot file's limits and under the
+    demo's caps; the retimed motion is checked against the press again.
+    """
+    from robokin import collision
+    from robokin.exceptions import MissingExtraError
+    from robokin.trajectory import retime
+
+    try:
+        fast = retime(robot, traj)
+        capped = retime(robot, traj, v_max=V_MAX, a_max=A_MAX)
+    except MissingExtraError as exc:
+        return {"planned_s": round(traj.duration, 3), "note": str(exc)}
+    rep = collision.check(bare, scene, fast, clearance=clearance)
+    return {"planned_s": round(traj.duration, 3),
+            "minimum_s": round(fast.duration, 3),
+            "minimum_demo_caps_s": round(capped.duration, 3),
+            "retimed_collides": bool(rep.collides),
+            "retimed_min_clearance_mm": round(float(rep.min_distance) * 1000.0, 3)}
+
+
 def _check_out_dir(out: Path, force: bool) -> None:
     if out.exists() and not out.is_dir():
         raise InputError("out", f"{out} exists and is not a folder")
@@ -210,7 +248,7 @@ def _png_data(path: Path) -> str:
     return base64.b64encode(path.read_bytes()).decode("ascii")
 
 
-def _closest_pair_distances(report: Any, k: int = 6) -> dict[str, np.ndarray]:
+def _closest_pair_distances(report: CollisionReport, k: int = 6) -> dict[str, np.ndarray]:
     """Exact distance at every sample [m] of the ``k`` closest body pairs."""
     out = {}
     for pair in report.pairs[:k]:
@@ -218,7 +256,7 @@ def _closest_pair_distances(report: Any, k: int = 6) -> dict[str, np.ndarray]:
     return out
 
 
-def _write_distance_csv(traj: Any, dist: dict[str, np.ndarray], path: Path) -> Path:
+def _write_distance_csv(traj: Trajectory, dist: dict[str, np.ndarray], path: Path) -> Path:
     """Time, the closest pairs' distances and their minimum, in mm."""
     from robokin.io.atomic import write_atomic
 
@@ -230,17 +268,22 @@ def _write_distance_csv(traj: Any, dist: dict[str, np.ndarray], path: Path) -> P
     return write_atomic(path, "\n".join(lines) + "\n")
 
 
-def _plot_press_views(traj: Any, scene: Any, report: Any, path: Path) -> Path:
+def _plot_press_views(traj: Trajectory, scene: Scene, report: CollisionReport,
+                      path: Path) -> Path:
     """The tool path inside the press: side view (x-z) and top view (x-y)."""
     from matplotlib.patches import Rectangle
 
-    from robokin.viz.plots import _figure, save_figure
+    from robokin.viz.plots import _figure, place_labels, save_figure
 
+    if traj.pose is None:  # the planner stores them: a changed plan must too
+        raise InputError("trajectory", "has no tool poses to draw")
     p = traj.pose[:, :3, 3] * 1000.0
     fig = _figure((11.0, 5.0))
     views = ((0, 2, "side view (x-z)", "z [mm]"), (0, 1, "top view (x-y)", "y [mm]"))
+    placed: list[tuple[Any, list[tuple[float, float, str]]]] = []
     for k, (i, j, title, ylabel) in enumerate(views):
         ax = fig.add_subplot(1, 2, k + 1)
+        labels: list[tuple[float, float, str]] = []
         for obj in scene.objects:
             box = getattr(obj.shape, "size", None)
             if box is None or obj.shape.kind != "box":
@@ -260,15 +303,7 @@ def _plot_press_views(traj: Any, scene: Any, report: Any, path: Path) -> Path:
                 )
             )
             if press or k == 0:
-                ax.text(
-                    c[i],
-                    c[j],
-                    obj.name,
-                    fontsize=6,
-                    ha="center",
-                    va="center",
-                    clip_on=True,
-                )
+                labels.append((c[i], c[j], obj.name))
         ax.plot(p[:, i], p[:, j], color="tab:blue", lw=1.4, label="TCP path")
         for tv in traj.via_times:
             m = min(int(round(tv / traj.dt)), len(p) - 1) if traj.dt else 0
@@ -291,14 +326,17 @@ def _plot_press_views(traj: Any, scene: Any, report: Any, path: Path) -> Path:
         ax.set_title(title)
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7, loc="upper left")
+        placed.append((ax, labels))
     fig.suptitle("the gripper's path into the press opening")
+    for ax, labels in placed:  # once the layout is final; column_left and _right
+        place_labels(ax, labels)  # share x and z: no two labels overlap
     return save_figure(fig, path, overwrite=True)
 
 
 def _summary(
-    robot: Any,
-    traj: Any,
-    report: Any,
+    robot: Robot,
+    traj: Trajectory,
+    report: CollisionReport,
     limits: Any,
     via: list,
     clearance: float,
@@ -356,7 +394,18 @@ def _summary(
     }
 
 
-def _report_html(summary: dict[str, Any], images: dict[str, Path]) -> str:
+def _cycle_text(c: dict[str, Any]) -> str:
+    if "minimum_s" not in c:
+        return c.get("note", "not computed")
+    return (f"{c['minimum_s']:.2f} s under the AUBO-i5's joint limits (robot file), "
+            f"{c['minimum_demo_caps_s']:.2f} s under the demo's 150 deg/s and 300 "
+            f"deg/s² caps, against the planned {c['planned_s']:.2f} s (the same "
+            f"path, dwells kept; retimed: "
+            f"{'collides' if c['retimed_collides'] else 'collision-free'}, "
+            f"{c['retimed_min_clearance_mm']:.1f} mm clearance)")
+
+
+def _report_html(summary: dict[str, Any], images: dict[str, Path], extra: str = "") -> str:
     s = summary
     c = s["closest"] or {}
     verdict = (
@@ -367,6 +416,7 @@ def _report_html(summary: dict[str, Any], images: dict[str, Path]) -> str:
     colour = "#1a7f37" if s["ok"] else "#cf222e"
     rows = [
         ("duration", f"{s['duration_s']:.2f} s"),
+        ("shortest cycle of this path", _cycle_text(s.get("cycle_time", {}))),
         ("samples", f"{s['samples']} at {s['dt_s'] * 1000:.0f} ms"),
         (
             "peak joint speed",
@@ -440,8 +490,10 @@ against the press cell. The motion plays in <a href="animation.html">animation.h
 <table><tr><th>step</th><th>kind</th><th>IK solutions</th><th>branch</th>
 <th>joints [deg]</th></tr>{vias}</table>
 {figs}
+{extra}
 <p style="font-size:0.8em;color:#57606a">Files: trajectory.csv (time and joints),
-waypoints.csv (controller waypoints, degrees), program.script (URScript servoj),
+waypoints.csv (the via points, degrees), {html.escape(s["controller"]["file"])}
+({html.escape(s["controller"]["description"])}),
 distance.csv (closest body pairs over time, mm), summary.json. The workpiece rides
 between the fingers inside the gripper's envelope and is not a separate body. Joint speed limit: AUBO-i5 published 150 deg/s; the acceleration cap
 is the demo's choice.</p>
@@ -457,6 +509,7 @@ def run_demo(
     force: bool = False,
     console: Any = None,
     html_animation: bool = True,
+    sim: bool = False,
     place: bool = False,
     scheduler: Any = None,
 ) -> DemoResult:
@@ -470,6 +523,8 @@ def run_demo(
         force: Write into a folder that holds other files.
         console: A rich Console for the terminal summary (default: a new one).
         html_animation: Also write ``animation.html``.
+        sim: Also run the plan in MuJoCo (``robokin[sim]``): ``sim_*`` files and
+            a "simulated run" report section (:mod:`robokin.sim.demo_run`).
         place: Also search the floor around the cell's base for robot placements
             that run the same task (``placement.png``: the map of feasible bases,
             ``placement.csv``; needs ``robokin[scale]``).
@@ -533,6 +588,7 @@ def run_demo(
         )  # attaches itself
         bar.update(task, advance=1)
         timings["check"] = time.perf_counter() - t
+        cycle = _cycle_times(robot, bare, scene, traj, clearance)
 
         placement = None
         if place:
@@ -547,10 +603,14 @@ def run_demo(
             timings["place"] = time.perf_counter() - t
 
         t = time.perf_counter()
+        from robokin.trajectory.controllers import controller_program
+
+        program = controller_program(bare, traj)  # what the robot's controller runs
+        program_name = "program" + program.suffix
         outputs = [
             "trajectory.csv",
             "waypoints.csv",
-            "program.script",
+            program_name,
             "joints.png",
             "tool_path.png",
             "press_views.png",
@@ -597,12 +657,7 @@ def run_demo(
                 overwrite=True,
             ),
         )
-        done(
-            "program.script",
-            io.write_ur_script(
-                traj, out / "program.script", overwrite=True, program="press_loading"
-            ),
-        )
+        done(program_name, write_atomic(out / program_name, program.text))
         plots.plot_joints(
             traj,
             path=out / "joints.png",
@@ -650,18 +705,31 @@ def run_demo(
         summary = _summary(robot, traj, report, limits, via, clearance, timings)
         if placement is not None:
             summary["placement"] = _placement_summary(placement, scene)
+        summary["cycle_time"] = cycle
+        summary["controller"] = {"program": program.program, "file": program_name,
+                                 "profile": program.profile.name,
+                                 "description": program.describe()}
         shown = ("joints.png", "press_views.png", "distance.png", "tool_path.png",
                  "placement.png")
         images: dict[str, Path] = {k: files[k] for k in shown if k in files}
+        sim_html = ""
+        if sim:
+            from robokin.sim.demo_run import simulated_run
+
+            t = time.perf_counter()
+            summary["simulated_run"], sim_files, sim_html = simulated_run(
+                bare, scene, traj, out, report.min_distance)
+            files.update({f"sim_{k}": v for k, v in sim_files.items()})
+            summary["timings_s"]["sim"] = round(time.perf_counter() - t, 3)
         report_path = out / "report.html"
-        write_atomic(report_path, _report_html(summary, images))
+        write_atomic(report_path, _report_html(summary, images, sim_html))
         done("report.html", report_path)
     write_atomic(out / MARKER, strict_json(summary, indent=2) + "\n")
     files["summary.json"] = out / MARKER
 
     table = Table(title="robokin demo: AUBO-i5 loads a press", show_header=False)
-    table.add_column(style="bold")
-    table.add_column()
+    table.add_column(style="bold", overflow="fold")
+    table.add_column(overflow="fold")  # never cut a value
     c = summary["closest"] or {}
     table.add_row(
         "duration",
@@ -677,6 +745,7 @@ def run_demo(
         "  ".join(f"{v:.1f}" for v in summary["peak_joint_acceleration_deg_s2"])
         + " deg/s²",
     )
+    table.add_row("shortest cycle", _cycle_text(summary["cycle_time"]))
     table.add_row("joint limit violations", str(len(summary["limit_violations"])))
     table.add_row(
         "minimum clearance",
@@ -693,6 +762,13 @@ def run_demo(
         f"{timings['total']:.1f} s (plan {timings['plan']:.2f}, "
         f"check {timings['check']:.2f}, write {timings['write']:.2f})",
     )
+    table.add_row("controller program", f"{program_name}: {program.describe()}")
+    if sim:
+        sr = summary["simulated_run"]
+        table.add_row("simulated run", (
+            "max error " + "  ".join(f"{j['max_error']:.3f}" for j in sr["joints"])
+            + f" deg; {sr['timing']['real_time_factor']:.4f} x real time; "
+            + ("PASS" if sr["ok"] else "FAIL")))
     if placement is not None:
         ps = summary["placement"]
         table.add_row(

@@ -35,6 +35,7 @@ class ModelError(RobokinError, ValueError):
         field: str | None = None,
         line: int | None = None,
     ):
+        """Record the reason and where it applies (file, field, line)."""
         self.file = None if file is None else str(file)
         self.field = field
         self.reason = reason
@@ -65,20 +66,23 @@ class InputError(RobokinError, ValueError):
     """
 
     def __init__(self, argument: str, reason: str):
+        """Record the argument and why it was refused."""
         self.argument = argument
         self.reason = reason
         super().__init__(f"argument '{argument}': {reason}")
 
 
 class FrozenError(RobokinError, AttributeError):
-    """An attempt to change an immutable object (a Robot); the message says what to
-    call instead.
+    """An attempt to change an immutable object (a Robot).
+
+    The message says what to call instead.
 
     Attributes:
         name: The attribute that was to be set or deleted.
     """
 
     def __init__(self, owner: str, name: str, hint: str):
+        """Name the object and attribute, and say what to do instead."""
         self.name = name
         super().__init__(f"{owner} is immutable: cannot change '{name}'; {hint}")
 
@@ -91,6 +95,7 @@ class MissingExtraError(RobokinError, ImportError):
     """An optional dependency is missing; the message names the extra to install."""
 
     def __init__(self, package: str, extra: str):
+        """Record the package that is missing and the extra that installs it."""
         self.package = package
         self.extra = extra
         super().__init__(

@@ -1,4 +1,4 @@
-"""The Robot: a canonical chain plus its name, source, actuators and geometry.
+"""The Robot: a canonical chain plus its name, source, actuators, geometry, limits.
 
 A Robot is immutable: assigning or deleting an attribute raises
 :class:`~robokin.exceptions.FrozenError`, its arrays are read-only and ``meta`` is
@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, TypeGuard
 
 import numpy as np
 import numpy.typing as npt
@@ -21,10 +21,13 @@ from robokin.kinematics import forward
 from robokin.kinematics import jacobian as _jac
 from robokin.model.chain import Chain
 from robokin.model.coupling import AffineMap
+from robokin.model.rate_limits import RateLimits
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.numeric import IKResult
     from robokin.kinematics.ik.solutions import SolutionSet
+    from robokin.model.dynamics import RobotDynamics
+    from robokin.model.geometry import RobotGeometry
 
 __all__ = ["Robot"]
 
@@ -34,10 +37,37 @@ _HOW_TO_CHANGE = ("make a changed copy with robot.replace(...), robot.with_tool(
                   "robot.with_base(T)")
 
 
-def _is_frozen_limits(lim: Any, m: int | None) -> bool:
+def _is_frozen_limits(lim: object, m: int) -> TypeGuard[npt.NDArray[np.float64]]:
     """True for limits a Robot already checked and froze (kept, not copied)."""
     return (type(lim) is np.ndarray and lim.dtype == np.float64 and not lim.flags.writeable
             and lim.shape == (m, 2) and not np.isnan(lim).any())
+
+
+def _actuator_fields(
+    actuators: AffineMap | None,
+    names: Sequence[str] | None,
+    limits: npt.ArrayLike | None,
+) -> tuple[tuple[str, ...] | None, npt.NDArray[np.float64] | None]:
+    """The motor names and frozen motor limits (m, 2) of an actuator map, or Nones."""
+    if actuators is None:
+        if limits is not None:
+            raise InputError("actuator_limits", "given without an actuator map")
+        return None, None
+    m = actuators.n_in
+    names = tuple(names or (f"motor{i + 1}" for i in range(m)))
+    if limits is None:
+        lim = np.tile([-np.inf, np.inf], (m, 1))
+    elif _is_frozen_limits(limits, m):
+        return names, limits
+    else:
+        lim = np.array(limits, dtype=float)
+        if lim.shape != (m, 2) or np.isnan(lim).any():
+            raise InputError(
+                "actuator_limits",
+                f"expected shape ({m}, 2) without NaN for {m} motors, got {lim.shape}",
+            )
+    lim.setflags(write=False)
+    return names, lim
 
 
 class Robot:
@@ -51,28 +81,48 @@ class Robot:
         actuator_names: Names of the motor coordinates (m), or None.
         actuator_limits: Motor limits (m, 2), SI units, or None.
         geometry: Link and tool shapes (see ``robokin.model.geometry``), or None.
+        dynamics: Link masses, centres of mass, inertias and joint torque limits
+            (:class:`~robokin.model.dynamics.RobotDynamics`), or None.
         path: The robot file it was loaded from, or None.
         meta: Free-form extra fields from the robot file (a read-only mapping).
+        rate_limits: Per-joint velocity / acceleration / jerk limits
+            (:class:`~robokin.model.rate_limits.RateLimits`, SI), or None.
     """
 
-    __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain",
-                 "geometry", "meta", "name", "path", "source", "__weakref__")
+    __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain", "dynamics",
+                 "geometry", "meta", "name", "path", "rate_limits", "source",
+                 "__weakref__")
+    chain: Chain
+    name: str
+    source: str
+    actuators: AffineMap | None
+    actuator_names: tuple[str, ...] | None
+    actuator_limits: npt.NDArray[np.float64] | None
+    geometry: RobotGeometry | None
+    dynamics: RobotDynamics | None
+    path: Path | None
+    meta: Mapping[str, Any]
+    rate_limits: RateLimits | None
 
     def __setattr__(self, name: str, value: Any) -> None:
+        """Refuse: a Robot is immutable (raises FrozenError)."""
         raise FrozenError("Robot", name, _HOW_TO_CHANGE)
 
     def __delattr__(self, name: str) -> None:
+        """Refuse: a Robot is immutable (raises FrozenError)."""
         raise FrozenError("Robot", name, _HOW_TO_CHANGE)
 
     def __reduce__(self) -> tuple:
         # pickle and copy rebuild through __init__ (slots cannot be set directly)
+        """Pickle and copy rebuild through __init__ (slots cannot be set directly)."""
         return (_rebuild, (self.chain, self._fields()))
 
     def _fields(self) -> dict[str, Any]:
         return {"name": self.name, "source": self.source, "actuators": self.actuators,
                 "actuator_names": self.actuator_names,
                 "actuator_limits": self.actuator_limits, "geometry": self.geometry,
-                "path": self.path, "meta": dict(self.meta)}
+                "dynamics": self.dynamics, "path": self.path, "meta": dict(self.meta),
+                "rate_limits": self.rate_limits}
 
     def __init__(
         self,
@@ -83,10 +133,13 @@ class Robot:
         actuators: AffineMap | None = None,
         actuator_names: Sequence[str] | None = None,
         actuator_limits: npt.ArrayLike | None = None,
-        geometry: Any = None,
+        geometry: RobotGeometry | None = None,
+        dynamics: RobotDynamics | None = None,
         path: str | Path | None = None,
         meta: Mapping[str, Any] | None = None,
+        rate_limits: RateLimits | None = None,
     ) -> None:
+        """Check and freeze the parts (see the class docstring for each)."""
         init = object.__setattr__
         init(self, "chain", chain)
         init(self, "name", name)
@@ -98,29 +151,23 @@ class Robot:
                 f"but the robot has {chain.n} joints",
             )
         init(self, "actuators", actuators)
-        m = None if actuators is None else actuators.n_in
-        init(self, "actuator_names", (
-            None if actuators is None
-            else tuple(actuator_names or (f"motor{i + 1}" for i in range(m)))
-        ))
-        if actuator_limits is None and actuators is not None:
-            actuator_limits = np.tile([-np.inf, np.inf], (m, 1))
-            actuator_limits.setflags(write=False)
-        elif actuator_limits is not None and not _is_frozen_limits(actuator_limits, m):
-            lim = np.array(actuator_limits, dtype=float)
-            if actuators is None or lim.shape != (m, 2) or np.isnan(lim).any():
-                raise InputError(
-                    "actuator_limits",
-                    f"expected shape ({m}, 2) without NaN for {m} motors, got {lim.shape}"
-                    if actuators is not None
-                    else "given without an actuator map",
-                )
-            lim.setflags(write=False)
-            actuator_limits = lim
-        init(self, "actuator_limits", actuator_limits)
+        names, limits = _actuator_fields(actuators, actuator_names, actuator_limits)
+        init(self, "actuator_names", names)
+        init(self, "actuator_limits", limits)
         init(self, "geometry", geometry)
+        if dynamics is not None and len(getattr(dynamics, "names", ())) != chain.n_chain + 2:
+            raise InputError("dynamics", f"expected data for {chain.n_chain + 2} links "
+                             "(base, the chain joints, tool); see "
+                             "robokin.model.dynamics.RobotDynamics.from_mapping")
+        init(self, "dynamics", dynamics)
         init(self, "path", None if path is None else Path(path))
         init(self, "meta", MappingProxyType(dict(meta or {})))
+        if rate_limits is not None and (not isinstance(rate_limits, RateLimits)
+                                        or rate_limits.n != chain.n):
+            raise InputError(
+                "rate_limits",
+                f"expected RateLimits for {chain.n} joints, got {rate_limits!r}")
+        init(self, "rate_limits", rate_limits)
 
     # ------------------------------------------------------------------ building
     @classmethod
@@ -175,7 +222,13 @@ class Robot:
         cls, path: str | Path, base_link: str | None = None, tip_link: str | None = None,
         **kwargs: Any,
     ) -> Robot:
-        """Load the serial chain of a URDF file (needs ``robokin[urdf]``)."""
+        """Load the serial chain of a URDF or xacro file (needs ``robokin[urdf]``).
+
+        A ``.xacro`` / ``.urdf.xacro`` file is expanded first (needs
+        ``robokin[ros]``): ``Robot.from_urdf("arm.urdf.xacro",
+        package_map={"pkg": "dir"}, xacro_args={"name": "value"}, tip_link=...)``.
+        Keywords as :func:`robokin.io.urdf.robot_from_urdf`.
+        """
         from robokin.io.urdf import robot_from_urdf
 
         return robot_from_urdf(path, base_link=base_link, tip_link=tip_link, **kwargs)
@@ -242,7 +295,32 @@ class Robot:
         return self.chain.tool
 
     def __repr__(self) -> str:
+        """A short summary: the name and the number of joints."""
         return f"Robot(name={self.name!r}, n={self.n})"
+
+    def _repr_html_(self) -> str:
+        """Jupyter: the joint rows (mm, degrees), the limits and the tool pose at zero.
+
+        Bounded: at most :data:`robokin._html.MAX_ROWS` rows per table.
+        """
+        from robokin import _html
+        from robokin.io.robot_files import document_from_robot
+        from robokin.io.robot_tables import MM_PER_M, joint_rows_mm_deg
+
+        doc = document_from_robot(self)
+        keys, rows = joint_rows_mm_deg(doc)
+        scale = np.where(self.is_revolute, 180.0 / np.pi, MM_PER_M)
+        limits = [(c.name, c.kind, lo * k, hi * k) for c, (lo, hi), k
+                  in zip(self.chain.coordinates, self.limits, scale)]
+        tool = self.fk(np.zeros(self.n))[:3, 3] * MM_PER_M
+        return _html.box(
+            f"Robot {self.name!r}: {self.n} joints, {doc.get('convention', '?')}",
+            _html.note("joint rows (lengths mm, angles deg)"),
+            _html.table(keys, [["" if v is None else v for v in r] for r in rows]),
+            _html.note("joint limits (deg / mm)"),
+            _html.table(["joint", "kind", "lower", "upper"], limits),
+            _html.note("tool at q = 0 [mm]: " + ", ".join(f"{v:.3f}" for v in tool)),
+            _html.note(f"source: {self.source[:300]}") if self.source else "")
 
     # --------------------------------------------------------------- kinematics
     def _to_joints(self, q: npt.ArrayLike, space: Space, name: str) -> npt.ArrayLike:
@@ -415,17 +493,21 @@ class Robot:
             return phi.copy()
         return self.actuators.apply(phi)
 
-    def within_actuator_limits(self, phi: npt.ArrayLike, tol: float = 1e-9) -> np.ndarray:
+    def within_actuator_limits(
+        self, phi: npt.ArrayLike, tol: float = 1e-9
+    ) -> npt.NDArray[np.bool_] | np.bool_:
         """(...) bool: every motor coordinate (..., m) inside its limits (tolerance ``tol``)."""
         from robokin._validation import check_joints
 
         m = self.n if self.actuators is None else self.actuators.n_in
         phi = check_joints(phi, m, "phi")
-        lim = self.limits if self.actuators is None else self.actuator_limits
+        lim = self.limits if self.actuator_limits is None else self.actuator_limits
         return ((phi >= lim[:, 0] - tol) & (phi <= lim[:, 1] + tol)).all(axis=-1)
 
     # ------------------------------------------------------------------- checks
-    def within_limits(self, q: npt.ArrayLike, tol: float = 1e-9) -> np.ndarray:
+    def within_limits(
+        self, q: npt.ArrayLike, tol: float = 1e-9
+    ) -> npt.NDArray[np.bool_] | np.bool_:
         """(...) bool: every coordinate inside its limits (with tolerance ``tol``)."""
         from robokin._validation import check_joints
 

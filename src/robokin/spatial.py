@@ -10,6 +10,8 @@ quaternions are ``(w, x, y, z)``.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import numpy.typing as npt
 
@@ -127,7 +129,7 @@ def _apply(fn, x: np.ndarray, width: int) -> np.ndarray:
     return _from_R(R)
 
 
-def _as(fn_name: str, T: np.ndarray, **kw) -> np.ndarray:
+def _as(fn_name: str, T: npt.ArrayLike, **kw: Any) -> np.ndarray:
     T = np.asarray(T, dtype=np.float64)
     lead = T.shape[:-2]
     rot = _rotation().from_matrix(T[..., :3, :3].reshape(-1, 3, 3))
@@ -189,8 +191,10 @@ def matrix_from_axis_angle(rotvec: npt.ArrayLike) -> np.ndarray:
 
 
 def rotvec_from_rotation(R: npt.ArrayLike) -> np.ndarray:
-    """Rotation vectors (axis times angle [rad], angle in [0, pi]) of rotation
-    matrices; (..., 3, 3) -> (..., 3)."""
+    """Rotation vectors of rotation matrices; (..., 3, 3) -> (..., 3).
+
+    Axis times angle [rad], the angle in [0, pi].
+    """
     R = np.asarray(R, dtype=np.float64)
     lead = R.shape[:-2]
     if R.size == 0:

@@ -75,7 +75,7 @@ def test_scene_file_units_placement_and_errors(tmp_path):
     )
     np.testing.assert_allclose(sc.pose_joints["home"], [0, -math.pi / 2, 0, 0, 0, 0])
     for bad, match in [
-        ({**doc, "lights": 3}, "lights: unknown field"),
+        ({**doc, "lights": 3}, "lights: unknown key; accepted: name, source, units"),
         (
             {**doc, "objects": [{"type": "box", "size": [1, 1, 1]}]},
             r"objects\[0\]: an object needs a 'name'",

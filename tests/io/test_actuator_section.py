@@ -107,7 +107,7 @@ def test_scara_file_section_matches_the_named_constructor():
         ("actuators:\n  drives:\n    - {type: belt, joint: turn}\n",
          r"actuators.drives\[0\]", "does not match any of the expected tags|tag"),
         ("actuators:\n  drives:\n    - {type: gear, joint: turn, ratio: 2, speed: 3}\n",
-         r"actuators.drives\[0\].speed", "unknown field"),
+         r"actuators.drives\[0\].speed", "unknown key; accepted: type, joint, ratio, offset"),
         ("actuators: [1, 2]\n", "actuators", "must be a mapping"),
         ("actuators: {}\n", "actuators", "either 'matrix'"),
     ],

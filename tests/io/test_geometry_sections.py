@@ -74,7 +74,7 @@ def test_geometry_section_errors_name_the_field():
         ModelError, match=r"geometry\.j1\[0\]\.type: 'type' must be one of"
     ):
         robot_from_document(_doc({"j1": [{"type": "cone"}]}))
-    with pytest.raises(ModelError, match=r"geometry\.j1\[0\]\.colour: unknown field"):
+    with pytest.raises(ModelError, match=r"geometry\.j1\[0\]\.colour: unknown key; accepted: name, xyz, rpy, type"):
         robot_from_document(
             _doc({"j1": [{"type": "sphere", "radius": 1, "colour": "red"}]})
         )

@@ -60,7 +60,7 @@ CASES = [
         r"joints\[1\]\.colour: unknown",
     ),
     (GOOD.replace("rpy: [180, 0, 0]", "rpy: [180, 0]"), r"tool\.rpy"),
-    (GOOD + "wheels: 4\n", r"wheels: unknown field"),
+    (GOOD + "wheels: 4\n", r"wheels: unknown key; accepted: name, source, units"),
     ("- just\n- a list\n", r"robot\.yaml: a robot file must be a mapping"),
     ("name: [unclosed\n", r"robot\.yaml:2: not valid YAML, column"),
     (GOOD.replace("name: j2", "name: j1"), r"unique"),
@@ -246,7 +246,8 @@ def test_a_file_without_units_that_reads_as_an_89_m_arm_warns(tmp_path):
 def test_sections_are_an_explicit_table():
     from robokin.io import robot_files
 
-    assert set(robot_files.SECTIONS) == {"actuators", "geometry", "collision"}
+    assert set(robot_files.SECTIONS) == {"actuators", "geometry", "collision", "dynamics",
+                                         "rate_limits"}
     assert not hasattr(robot_files, "register_section")
     for section in robot_files.SECTIONS.values():
         assert callable(section.read) and callable(section.write)

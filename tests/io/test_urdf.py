@@ -182,7 +182,7 @@ def test_geometry_meshes_package_map_and_missing_mesh():
     ).meta["urdf_shapes"]
     visual = [s for s in shapes if s["role"] == "visual"]
     assert visual[0]["filename"] == str(DATA / "meshes" / "cube.stl")
-    with pytest.raises(ModelError, match="package 'meshy_description' is not in the package map"):
+    with pytest.raises(ModelError, match="package .meshy_description. not found; searched the package map"):
         robot_from_urdf(DATA / "meshes_arm.urdf", missing_mesh="error",
                         package_map={})
     # kinematics only: no geometry read, no warning

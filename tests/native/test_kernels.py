@@ -57,7 +57,7 @@ def test_a_corrupted_layout_is_refused_not_read():
 def test_the_best_copy_the_cpu_runs_is_the_one_in_use():
     copies = _copies()
     best = list(copies)[-1]
-    assert _native.ISA == best
+    assert best == _native.ISA
     assert copies[best].LANES >= copies["baseline"].LANES
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import robokin
-from browser_shots import orange_fraction, read_png, require_chromium, run_chromium
+from browser_shots import orange_fraction, require_chromium, screenshot_until
 
 viewer_mod = pytest.importorskip("robokin.viz.viewer")
 pytest.importorskip("viser")
@@ -126,22 +126,14 @@ def test_viewer_page_renders_the_robot_in_chromium(ur5, tmp_path):
         v.show_frame(25)
         clients = []
         v.server.on_client_connect(lambda client: clients.append(client.client_id))
-        # Software WebGL on a busy machine can be slow: give a second, longer try.
-        for attempt, budget in enumerate((6000, 20000, 20000)):
-            shot = tmp_path / f"viewer{attempt}.png"
-            run_chromium(
-                v.url,
-                tmp_path / "profile",
-                screenshot=shot,
-                size=(1000, 700),
-                budget_ms=budget,
-                webgl=True,
-                timeout=180,
-            )
-            img = read_png(shot)
-            view3d = img[150:700, 0:650]  # left of the GUI panel, below the notices
-            if clients and orange_fraction(view3d) > 5e-4:
-                break
+        # Screenshots in wall time until the links are drawn (software WebGL and a
+        # busy machine can take a while to receive and draw the scene).
+        img = screenshot_until(
+            v.url, tmp_path / "profile",
+            lambda im: orange_fraction(im[150:700, 0:650]) > 5e-4,
+            size=(1000, 700), webgl=True, timeout=150.0,
+        )
+        view3d = img[150:700, 0:650]  # left of the GUI panel, below the notices
     # The page loaded its script and connected back over the websocket.
     assert len(clients) >= 1
     assert img.shape == (700, 1000, 3)

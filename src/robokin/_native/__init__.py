@@ -8,18 +8,20 @@ how many threads the batch kernels use (default: the CPUs this process may use).
 
 The kernels read a chain's :class:`~robokin.model.chain_arrays.ChainArrays`
 ``packed`` vector and C-contiguous float64 buffers; the layers above validate what
-users pass. See ``csrc/module.c`` for the entry points.
+users pass. See ``csrc/module.c`` for the entry points and :class:`Kernels`
+(``_interface.py``) for their types.
 """
 
 from __future__ import annotations
 
 import os
-from types import ModuleType
 
-__all__ = ["ISA", "kernels", "num_threads", "set_num_threads"]
+from robokin._native._interface import Kernels
+
+__all__ = ["ISA", "Kernels", "kernels", "num_threads", "set_num_threads"]
 
 try:
-    from robokin._native import _base
+    import robokin._native._base as _base
 except ImportError as exc:  # pragma: no cover - a broken install
     raise ImportError(
         "robokin's compiled kernels (robokin._native._base) are missing: robokin was "
@@ -29,27 +31,27 @@ except ImportError as exc:  # pragma: no cover - a broken install
     ) from exc
 
 
-def _pick() -> ModuleType:
+def _pick() -> Kernels:
     wanted = os.environ.get("ROBOKIN_ISA", "").strip().lower()
     if wanted in ("baseline", "base"):
         return _base
     if _base.cpu_has_avx512() and wanted not in ("avx2", "avx2+fma"):
         try:
-            from robokin._native import _avx512
+            import robokin._native._avx512 as _avx512
         except ImportError:  # pragma: no cover - built without the AVX-512 copy
             pass
         else:
             return _avx512
     if _base.cpu_has_avx2_fma():
         try:
-            from robokin._native import _avx2
+            import robokin._native._avx2 as _avx2
         except ImportError:  # pragma: no cover - built without the AVX2 copy
             return _base
         return _avx2
     return _base
 
 
-kernels: ModuleType = _pick()
+kernels: Kernels = _pick()
 ISA: str = kernels.ISA
 
 

@@ -14,13 +14,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from robokin._text import short_repr
-from robokin.collision.check import (
+from robokin.collision.check import check
+from robokin.collision.report import (
     Closest,
     Collision,
     CollisionReport,
     Interval,
     PairMinimum,
-    check,
 )
 from robokin.collision.scene import Scene, SceneObject, Tool
 

@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from robokin._native import kernels as _k
-from robokin.collision.check import (
+from robokin.collision.report import (
+    TIE,
     Closest,
     Collision,
     CollisionReport,
@@ -26,7 +27,6 @@ if TYPE_CHECKING:
     from robokin.collision.scene import Scene
     from robokin.robot import Robot
 
-_TIE = 1e-9  # [m] pair minima are exact to this (bounds within it of the best stop)
 
 
 def _coal():
@@ -45,7 +45,9 @@ class _Problem:
         self.coal = coal
         placed = scene.attach(robot)
         self.robot = placed
-        geo: RobotGeometry = placed.geometry
+        geo = placed.geometry
+        if geo is None:  # pragma: no cover - Scene.attach always sets a geometry
+            geo = RobotGeometry.empty(placed)
         chain = placed.chain
         self.chain = chain
         nc = chain.n_chain
@@ -101,13 +103,13 @@ class _Problem:
         self.ob_T3 = []
         for j, ob in enumerate(objects):
             c, h = ob.shape.local_box()
-            P = ob.shape.placement
-            self.ob_R[j] = P[:3, :3]
-            self.ob_t[j] = P[:3, :3] @ c + P[:3, 3]
+            pose = ob.shape.placement
+            self.ob_R[j] = pose[:3, :3]
+            self.ob_t[j] = pose[:3, :3] @ c + pose[:3, 3]
             self.ob_h[j] = h
             self.ob_T3.append(
                 coal.Transform3s(
-                    np.ascontiguousarray(P[:3, :3]), np.ascontiguousarray(P[:3, 3])
+                    np.ascontiguousarray(pose[:3, :3]), np.ascontiguousarray(pose[:3, 3])
                 )
             )
         # Pairs at shape level: (robot shape, object) then (robot shape, robot shape).
@@ -143,15 +145,15 @@ class _Problem:
         self.self_pairs = np.flatnonzero(self.is_self)
         # Sphere combinations for self pairs (grouped by pair).
         c1, c2 = [], []
-        for p in self.self_pairs:
+        for p in self.self_pairs.tolist():
             i, j = pa[p], pb[p]
-            a = np.arange(
+            rows_a = np.arange(
                 self.sph_start[i], self.sph_start[i] + np.sum(self.sph_owner == i)
             )
-            b = np.arange(
+            rows_b = np.arange(
                 self.sph_start[j], self.sph_start[j] + np.sum(self.sph_owner == j)
             )
-            A_, B_ = np.meshgrid(a, b, indexing="ij")
+            A_, B_ = np.meshgrid(rows_a, rows_b, indexing="ij")
             c1.append(A_.ravel())
             c2.append(B_.ravel())
         self.self_c1 = np.concatenate(c1) if c1 else np.zeros(0, int)
@@ -161,7 +163,7 @@ class _Problem:
         self.fn_exact: list[Any] = []
         self.fn_hull: list[Any] = []
         self.geoms: list[tuple[Any, Any]] = []
-        cache: dict[tuple[int, int, bool], Any] = {}
+        cache: dict[tuple[int, int], Any] = {}
 
         def functor(g1, g2):
             key = (id(g1), id(g2))
@@ -506,8 +508,8 @@ class _Problem:
         while True:
             if final:
                 g = best.min()
-                cand = np.flatnonzero(np.where(done, np.inf, LB).min(axis=1) < g - _TIE)
-                need = ~done[cand] & (LB[cand] < g - _TIE)
+                cand = np.flatnonzero(np.where(done, np.inf, LB).min(axis=1) < g - TIE)
+                need = ~done[cand] & (LB[cand] < g - TIE)
             else:
                 cand = active
                 Lc = LB[cand]
@@ -522,7 +524,7 @@ class _Problem:
             if not final:
                 active = rows
             if not len(rows):
-                if final or pair_tol <= _TIE:
+                if final or pair_tol <= TIE:
                     break
                 final = True
                 continue
@@ -703,7 +705,7 @@ class _Problem:
         lb = self.lower_bounds(frames)  # (P, k); -inf where not bounded
         an = np.flatnonzero(self.analytic)
         if an.size:
-            lb[an] = self.analytic_distances(frames, an) - _TIE
+            lb[an] = self.analytic_distances(frames, an) - TIE
         for i in range(k):
             for p in np.argsort(lb[:, i], kind="stable"):
                 if lb[p, i] >= dist[i]:

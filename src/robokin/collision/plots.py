@@ -4,12 +4,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 if TYPE_CHECKING:
-    from robokin.collision.check import CollisionReport
+    from robokin.collision.report import CollisionReport
 
 __all__ = ["plot_distance"]
 
@@ -21,8 +21,8 @@ def plot_distance(
     count: int = 4,
     clearance: float | None = None,
     out: str | Path | None = None,
-    ax=None,
-):
+    ax: Any = None,
+) -> Any:
     """Distance over time of the closest body pairs, with the clearance marked.
 
     Args:

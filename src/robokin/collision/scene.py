@@ -128,6 +128,7 @@ class Scene:
     """
 
     def __init__(self, name: str = "scene") -> None:
+        """An empty scene called ``name``."""
         self.name = name
         self._objects: dict[str, SceneObject] = {}
         self.base = np.eye(4)
@@ -140,6 +141,7 @@ class Scene:
         self._version = 0
 
     def __repr__(self) -> str:
+        """A short summary: the name and the object names."""
         return f"Scene(name={self.name!r}, objects={list(self._objects)})"
 
     def __getstate__(self) -> dict[str, Any]:
@@ -214,6 +216,7 @@ class Scene:
             ) from None
 
     def __len__(self) -> int:
+        """The number of objects."""
         return len(self._objects)
 
     def add(self, name: str, shape: Shape) -> SceneObject:
@@ -369,27 +372,16 @@ class Scene:
     @classmethod
     def from_document(cls, doc: Any, file: str | Path | None = None) -> Scene:
         """Build a scene from a parsed scene document (see the module docstring)."""
+        from robokin.io.scene_files import scene_section_keys
+        from robokin.io.validate import unknown_key
         from robokin.spatial import pose_from_xyz_rpy
 
         if not isinstance(doc, Mapping):
             raise ModelError("a scene file must be a mapping of fields", file=file)
-        allowed = {
-            "name",
-            "source",
-            "units",
-            "robot",
-            "tool",
-            "objects",
-            "exclude",
-            "poses",
-        }
+        allowed = scene_section_keys()
         for key in doc:
             if key not in allowed:
-                raise ModelError(
-                    f"unknown field (allowed: {sorted(allowed)})",
-                    file=file,
-                    field=str(key),
-                )
+                raise ModelError(unknown_key(allowed), file=file, field=str(key))
         units = doc.get("units") or {}
         if not isinstance(units, Mapping):
             raise ModelError(
@@ -417,9 +409,11 @@ class Scene:
         def placement(p: Any, where: str) -> np.ndarray:
             if p is None:
                 return np.eye(4)
-            if not isinstance(p, Mapping) or set(p) - {"xyz", "rpy"}:
+            keys = scene_section_keys("placement")
+            if not isinstance(p, Mapping) or set(p) - set(keys):
                 raise ModelError(
-                    "expected {xyz: [x, y, z], rpy: [r, p, y]}", file=file, field=where
+                    "expected {xyz: [x, y, z], rpy: [r, p, y]}; "
+                    + unknown_key(keys), file=file, field=where
                 )
             xyz = number_field(p, "xyz", where, file, 3) if "xyz" in p else np.zeros(3)
             rpy = number_field(p, "rpy", where, file, 3) if "rpy" in p else np.zeros(3)
@@ -427,21 +421,19 @@ class Scene:
 
         rob = doc.get("robot")
         if rob is not None:
-            if not isinstance(rob, Mapping) or set(rob) - {"name", "base"}:
-                raise ModelError(
-                    "expected {name: ..., base: {xyz, rpy}}", file=file, field="robot"
-                )
+            keys = scene_section_keys("robot")
+            if not isinstance(rob, Mapping) or set(rob) - set(keys):
+                raise ModelError("expected {name: ..., base: {xyz, rpy}}; "
+                                 + unknown_key(keys), file=file, field="robot")
             scene.robot_name = (None if rob.get("name") is None
                                 else _text(rob["name"], file, "robot.name"))
             scene.base = placement(rob.get("base"), "robot.base")
         tool = doc.get("tool")
         if tool is not None:
-            if not isinstance(tool, Mapping) or set(tool) - {"name", "tcp", "shapes"}:
-                raise ModelError(
-                    "expected {name, tcp: {xyz, rpy}, shapes: [...]}",
-                    file=file,
-                    field="tool",
-                )
+            keys = scene_section_keys("tool")
+            if not isinstance(tool, Mapping) or set(tool) - set(keys):
+                raise ModelError("expected {name, tcp: {xyz, rpy}, shapes: [...]}; "
+                                 + unknown_key(keys), file=file, field="tool")
             shapes = tool.get("shapes") or []
             if not isinstance(shapes, list):
                 raise ModelError(

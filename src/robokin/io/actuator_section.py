@@ -50,7 +50,12 @@ from robokin.model.coupling import (
 if TYPE_CHECKING:
     from robokin.robot import Robot
 
-__all__ = ["actuators_from_section", "apply_actuators_section", "section_from_robot"]
+__all__ = [
+    "actuators_from_section",
+    "apply_actuators_section",
+    "section_from_robot",
+    "section_model",
+]
 
 _LENGTH = {"m": 1.0, "mm": 1e-3}
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
@@ -61,49 +66,53 @@ def _schema():
 
     from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictStr
 
-    Num = StrictFloat  # numbers must be numbers: "100" and yes are refused
-    Name = StrictStr
+    # StrictFloat and StrictStr: numbers must be numbers ("100" and yes are refused)
 
     class Strict(BaseModel):
         model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     class Direct(Strict):
         type: Literal["direct"]
-        joints: list[Name] = Field(min_length=1)
+        joints: list[StrictStr] = Field(min_length=1)
 
     class Gear(Strict):
         type: Literal["gear"]
-        joint: Name
-        ratio: Num
-        offset: Num = 0.0
+        joint: StrictStr
+        ratio: StrictFloat
+        offset: StrictFloat = 0.0
 
     class Screw(Strict):
         type: Literal["screw"]
-        joint: Name
-        lead: Num
-        ratio: Num = 1.0
-        offset: Num = 0.0
+        joint: StrictStr
+        lead: StrictFloat
+        ratio: StrictFloat = 1.0
+        offset: StrictFloat = 0.0
 
     class BallScrewSpline(Strict):
         type: Literal["ball_screw_spline"]
-        joints: tuple[Name, Name]
-        lead: Num
-        i: Num = 1.0
-        j: Num = 1.0
+        joints: tuple[StrictStr, StrictStr]
+        lead: StrictFloat
+        i: StrictFloat = 1.0
+        j: StrictFloat = 1.0
         lift_sign: Literal[1, -1] = 1
 
     Drive = Annotated[Direct | Gear | Screw | BallScrewSpline,
                       Field(discriminator="type")]
 
     class Section(Strict):
-        names: list[Name] | None = None
+        names: list[StrictStr] | None = None
         kinds: list[Literal["rotary", "linear"]] | None = None
-        limits: list[tuple[Num, Num]] | None = None
-        matrix: list[list[Num]] | None = None
-        offset: list[Num] | None = None
+        limits: list[tuple[StrictFloat, StrictFloat]] | None = None
+        matrix: list[list[StrictFloat]] | None = None
+        offset: list[StrictFloat] | None = None
         drives: list[Drive] | None = None
 
     return Section
+
+
+def section_model() -> Any:
+    """The pydantic model of the ``actuators:`` section (for its JSON Schema)."""
+    return _schema()
 
 
 def _validate(value: Any, file: Any):
@@ -273,7 +282,7 @@ def section_from_robot(robot: Robot) -> dict[str, Any] | None:
     For writing robots built in memory; files loaded from disk keep their own
     section.
     """
-    if robot.actuators is None:
+    if robot.actuators is None or robot.actuator_names is None:  # both or neither
         return None
     out: dict[str, Any] = {
         "names": list(robot.actuator_names),

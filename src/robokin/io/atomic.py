@@ -18,23 +18,32 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import shutil
 import stat
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import IO, Any
 
 from robokin.exceptions import InputError
 
-__all__ = ["file_stem", "new_file_mode", "save_figure_atomic", "write_atomic"]
+__all__ = [
+    "file_stem",
+    "new_file_mode",
+    "save_figure_atomic",
+    "staged_outputs",
+    "write_atomic",
+]
 
 Content = str | bytes | Callable[[IO[bytes]], Any]
 
 
 def file_stem(name: str, limit: int = 80) -> str:
-    """A file-name stem made from a name (a robot's, from a file): letters, digits,
-    ``.``, ``-`` and ``_`` kept, anything else (``/``, ``..``) becomes ``_``, at
-    most ``limit`` characters; never empty or hidden."""
+    """A file-name stem made from a name (a robot's, from a file).
+
+    Letters, digits, ``.``, ``-`` and ``_`` are kept, anything else (``/``,
+    ``..``) becomes ``_``, at most ``limit`` characters; never empty or hidden.
+    """
     stem = re.sub(r"[^A-Za-z0-9._-]", "_", str(name))[:limit].lstrip(".")
     return stem or "robot"
 
@@ -46,14 +55,15 @@ def new_file_mode() -> int:
     return 0o666 & ~mask
 
 
-def _check_target(path: Path, overwrite: bool, argument: str) -> Path:
+def _check_target(path: Path, overwrite: bool, argument: str,
+                  how: str = "pass overwrite=True") -> Path:
     folder = path.parent if str(path.parent) else Path(".")
     if path.is_dir():
         raise InputError(argument, f"{path} is a folder, expected a file name")
     if not folder.is_dir():
         raise InputError(argument, f"{path}: the folder {folder} does not exist")
     if not overwrite and os.path.lexists(path):
-        raise InputError(argument, f"{path} exists; pass overwrite=True to replace it")
+        raise InputError(argument, f"{path} exists; {how} to replace it")
     return folder
 
 
@@ -155,3 +165,61 @@ def save_figure_atomic(
     fmt = savefig.pop("format", None) or path.suffix[1:].lower() or "png"
     return write_atomic(path, lambda fh: fig.savefig(fh, format=fmt, **savefig),
                         overwrite=overwrite, argument=argument)
+
+
+@contextlib.contextmanager
+def staged_outputs(
+    targets: Sequence[tuple[str | Path, str, bool]], *, how: str = "pass overwrite=True"
+) -> Iterator[list[Path]]:
+    """Write several files all or none: a command's outputs are never left half-made.
+
+    Every target is checked first (its folder exists, it is not a folder, it does
+    not exist unless it may be replaced). The body writes each file to the staging
+    path yielded for it (in a fresh private folder next to the target, so the final
+    rename stays on one file system); when the body returns, every staged file is
+    renamed onto its target. If the body raises, nothing is moved and the staging
+    folders are removed: the targets are as they were.
+
+    Args:
+        targets: ``(path, argument, overwrite)`` per output: the file, the option
+            naming it in messages, and whether an existing file may be replaced.
+        how: What the user does to allow replacing (``"pass --force"``), for the
+            message of a target that exists.
+
+    Yields:
+        The staging path of each target, in order (write there, not to the target).
+
+    Raises:
+        InputError: a target cannot be written (named with its argument), or two
+            targets are the same file.
+    """
+    checked = [(Path(p), arg, over) for p, arg, over in targets]
+    seen: dict[Path, str] = {}
+    for path, arg, over in checked:
+        _check_target(path, over, arg, how)
+        key = path.parent.resolve() / path.name
+        if key in seen:
+            raise InputError(arg, f"{path} is also the output of {seen[key]}")
+        seen[key] = arg
+    stages: dict[Path, Path] = {}
+    staged: list[Path] = []
+    try:
+        for path, arg, _ in checked:
+            folder = path.parent if str(path.parent) else Path(".")
+            if folder not in stages:
+                try:
+                    stages[folder] = Path(tempfile.mkdtemp(prefix=".robokin-", dir=folder))
+                except OSError as exc:
+                    raise InputError(arg, f"{path}: cannot write in {folder}: "
+                                     f"{exc.strerror or exc}") from None
+            staged.append(stages[folder] / path.name)
+        yield staged
+        for (path, _, _), tmp in zip(checked, staged):
+            if tmp.exists():
+                os.chmod(tmp, _target_mode(path))
+                os.replace(tmp, path)
+        for folder in stages:
+            _sync_folder(folder)
+    finally:
+        for stage in stages.values():
+            shutil.rmtree(stage, ignore_errors=True)

@@ -1,4 +1,4 @@
-"""Denavit-Hartenberg tables derived from any robot's joint axes.
+r"""Denavit-Hartenberg tables derived from any robot's joint axes.
 
 Given a robot (from a URDF, an elementary sequence, another DH table), find the
 standard and modified DH tables of its joint axes, plus the base and tool
@@ -6,7 +6,7 @@ transforms that remain, so that
 
 .. math::
 
-    T(q) = B_{rem} \\cdot \\prod_i DH_i(q) \\cdot T_{rem}.
+    T(q) = B_{rem} \cdot \prod_i DH_i(q) \cdot T_{rem}.
 
 A serial chain of 1-DOF joints always has such a table: each pair of successive
 joint axes (lines in space) is related by their common normal. What a plain table
@@ -34,7 +34,6 @@ Choices where DH leaves freedom (documented in ``docs/urdf.md``):
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -88,12 +87,12 @@ def _std_params(T: np.ndarray) -> tuple[tuple[float, float, float, float], float
     alpha = math.atan2(T[2, 1], T[2, 2])
     d = T[2, 3]
     a = T[0, 3] * math.cos(theta) + T[1, 3] * math.sin(theta)
-    p = tuple(_clean(v) for v in (theta, d, a, alpha))
+    p = (_clean(theta), _clean(d), _clean(a), _clean(alpha))
     return p, float(np.abs(_std(*p) - T).max())
 
 
 def _pick_sense(x: np.ndarray, x_prev: np.ndarray, z_prev: np.ndarray) -> np.ndarray:
-    """x or -x: the one closer to x_prev (on a tie, theta = +90 deg)."""
+    """The one of ``x`` and ``-x`` closer to ``x_prev`` (on a tie, theta = +90 deg)."""
     dot = float(x @ x_prev)
     if abs(dot) > _TOL:
         return x if dot > 0 else -x
@@ -143,7 +142,8 @@ def dh_rows_for_transform(
     if convention == "modified":
         # inv(Rz Tz Tx Rx) = Rx(-alpha) Tx(-a) Rz(-theta) Tz(-d)
         rows = dh_rows_for_transform(_inv(T), "standard")
-        return [tuple(_clean(-v) for v in r) for r in reversed(rows)]
+        return [(_clean(-t), _clean(-d), _clean(-a), _clean(-al))
+                for t, d, a, al in reversed(rows)]
     if np.allclose(T, np.eye(4), atol=1e-15, rtol=0):
         return []
     p, res = _std_params(T)
@@ -173,7 +173,7 @@ class DHExtraction:
         notes: What was chosen where DH leaves freedom, per frame.
     """
 
-    convention: str
+    convention: Literal["standard", "modified"]
     rows: tuple[dict[str, Any], ...]
     base: np.ndarray
     tool: np.ndarray
@@ -258,12 +258,13 @@ def dh_from_robot(
     # Frame 0.
     z0 = axes[0]
     o0 = points[0] + ((ref[:3, 3] - points[0]) @ z0) * z0
-    x0 = None
     for cand in (ref[:3, 0], ref[:3, 1], ref[:3, 2]):
         xp = cand - (cand @ z0) * z0
         if np.linalg.norm(xp) > 1e-6:
             x0 = xp / np.linalg.norm(xp)
             break
+    else:  # pragma: no cover - three orthonormal columns cannot all lie on z0
+        raise InputError("reference", "its axes do not span space")
     frames = [_frame(x0, z0, o0)]
     for i in range(1, n):
         F, kind = _next_frame(frames[-1], points[i], axes[i])
@@ -362,8 +363,8 @@ def _verify(robot: Robot, ext: DHExtraction) -> None:
         raise ModelError(f"internal: derived DH table misses the FK by {err:.3g}")
 
 
-def describe(ext: DHExtraction, *, deg: bool = True) -> Mapping[str, Any]:
-    """A plain, JSON-ready summary (angles in degrees when ``deg``)."""
+def describe(ext: DHExtraction, *, deg: bool = True) -> dict[str, Any]:
+    """A plain, JSON-ready summary (angles in degrees when ``deg``), a new dict."""
     A = 180.0 / math.pi if deg else 1.0
     from robokin.spatial import rpy_from_matrix
 

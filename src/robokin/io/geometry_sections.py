@@ -14,6 +14,7 @@ The robot-file reader applies the two sections through its table
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
@@ -24,6 +25,7 @@ import numpy as np
 from robokin._text import short_repr
 from robokin._validation import MAX_TRANSLATION
 from robokin.exceptions import InputError, ModelError
+from robokin.io.validate import list_of, tagged_union, union_of, unknown_key
 from robokin.model.geometry import (
     LENGTH_UNITS,
     MESH_SUFFIXES,
@@ -39,21 +41,84 @@ if TYPE_CHECKING:
 __all__ = [
     "apply_collision_section",
     "apply_geometry_section",
+    "collision_model",
     "collision_section",
+    "geometry_model",
     "geometry_section",
     "number_field",
     "sections_from_geometry",
     "shape_from_spec",
+    "shape_keys",
+    "shape_models",
 ]
 
-_COMMON = {"type", "name", "xyz", "rpy"}
-_FIELDS = {
-    "box": {"size"},
-    "sphere": {"radius"},
-    "cylinder": {"radius", "length", "from", "to"},
-    "capsule": {"radius", "length", "from", "to"},
-    "mesh": {"file", "units", "scale"},
-}
+@functools.cache
+def shape_models() -> dict[str, Any]:
+    """The pydantic models of a shape entry, one per ``type`` (built once, lazily).
+
+    They are the schema of a shape (the keys each type accepts, and their
+    types) for the JSON Schemas of robot and scene files and for the key checks of
+    :func:`shape_from_spec`; numbers are in the file's units.
+    """
+    from typing import Annotated, Literal
+
+    from pydantic import BaseModel, ConfigDict, Field, StrictFloat, StrictStr
+
+    Vec3 = tuple[StrictFloat, StrictFloat, StrictFloat]
+    Positive = Annotated[StrictFloat, Field(gt=0)]
+
+    class Shape(BaseModel):
+        """A shape placed in its owner's frame (``xyz`` [length], ``rpy`` [angle])."""
+
+        model_config = ConfigDict(extra="forbid", allow_inf_nan=False,
+                                  populate_by_name=True)
+        name: StrictStr = ""
+        xyz: Vec3 = (0.0, 0.0, 0.0)
+        rpy: Vec3 = (0.0, 0.0, 0.0)
+
+    class Box(Shape):
+        """A box centred on its frame: edge lengths along x, y, z."""
+
+        type: Literal["box"]
+        size: tuple[Positive, Positive, Positive]
+
+    class Sphere(Shape):
+        """A sphere centred on its frame."""
+
+        type: Literal["sphere"]
+        radius: Positive
+
+    class Cylinder(Shape):
+        """A cylinder: along its frame's z axis (``length``), or ``from`` -> ``to``."""
+
+        type: Literal["cylinder"]
+        radius: Positive
+        length: Positive | None = None
+        from_: Vec3 | None = Field(default=None, alias="from")
+        to: Vec3 | None = None
+
+    class Capsule(Cylinder):
+        """A capsule (a cylinder with hemispherical ends), placed as a cylinder."""
+
+        type: Literal["capsule"]  # type: ignore[assignment]
+
+    class Mesh(Shape):
+        """A mesh file (STL, OBJ, DAE, PLY, OFF, GLB, glTF), relative to the file."""
+
+        type: Literal["mesh"]
+        file: StrictStr
+        units: Literal["m", "mm", "cm"] | None = None
+        scale: StrictFloat = 1.0
+
+    models = {"box": Box, "sphere": Sphere, "cylinder": Cylinder, "capsule": Capsule,
+              "mesh": Mesh}
+    return models
+
+
+def shape_keys(kind: str) -> list[str]:
+    """The keys a shape entry of ``type: kind`` accepts (from :func:`shape_models`)."""
+    model = shape_models()[kind]
+    return [f.alias or name for name, f in model.model_fields.items()]
 
 
 def _is_number(v: Any) -> bool:
@@ -136,14 +201,10 @@ def shape_from_spec(
             file=file,
             field=f"{where}.type",
         )
-    allowed = _COMMON | _FIELDS[kind]
+    allowed = shape_keys(kind)
     for key in spec:
         if key not in allowed:
-            raise ModelError(
-                f"unknown field for a {kind} (allowed: {sorted(allowed)})",
-                file=file,
-                field=f"{where}.{key}",
-            )
+            raise ModelError(unknown_key(allowed), file=file, field=f"{where}.{key}")
     xyz = number_field(spec, "xyz", where, file, 3) * length if "xyz" in spec else np.zeros(3)
     rpy = number_field(spec, "rpy", where, file, 3) * angle if "rpy" in spec else np.zeros(3)
     if np.any(rpy):
@@ -312,13 +373,10 @@ def apply_collision_section(robot: Robot, value: Any, file: Any, units: Any) -> 
         raise ModelError(
             "expected a mapping with 'exclude'", file=file, field="collision"
         )
+    accepted = list(collision_model().model_fields)
     for key in value:
-        if key not in ("exclude", "exclude_adjacent"):
-            raise ModelError(
-                "unknown field (allowed: exclude, exclude_adjacent)",
-                file=file,
-                field=f"collision.{key}",
-            )
+        if key not in accepted:
+            raise ModelError(unknown_key(accepted), file=file, field=f"collision.{key}")
     geo = robot.geometry if isinstance(robot.geometry, RobotGeometry) else None
     if geo is None:
         geo = RobotGeometry.empty(robot)
@@ -349,6 +407,29 @@ def apply_collision_section(robot: Robot, value: Any, file: Any, units: Any) -> 
         )
     geo = replace(geo.with_exclusions(out), exclude_adjacent=adjacent)
     return robot.replace(geometry=geo)
+
+
+@functools.cache
+def collision_model() -> Any:
+    """The pydantic model of the ``collision:`` section (its keys and types)."""
+    from pydantic import BaseModel, ConfigDict, StrictBool, StrictStr
+
+    class Collision(BaseModel):
+        """Link pairs never checked against each other (self-collision)."""
+
+        model_config = ConfigDict(extra="forbid")
+        exclude: list[tuple[StrictStr, StrictStr]] = []
+        exclude_adjacent: StrictBool = True
+
+    return Collision
+
+
+def geometry_model() -> Any:
+    """The type of the ``geometry:`` section: ``{link name: [shape, ...] | shape}``."""
+    from pydantic import StrictStr
+
+    one = tagged_union(*shape_models().values())
+    return dict.__class_getitem__((StrictStr, union_of(list_of(one), one)))
 
 
 def geometry_section(robot: Robot) -> dict[str, Any] | None:
@@ -393,7 +474,7 @@ def sections_from_geometry(geometry: RobotGeometry) -> dict[str, Any]:
                 spec["radius"] = sh.size[0]
             elif sh.kind in ("cylinder", "capsule"):
                 spec["radius"], spec["length"] = sh.size
-            else:
+            elif sh.file is not None:  # a mesh (the one kind with a file)
                 spec["file"] = str(Path(sh.file).resolve())
                 spec["units"] = "m"
                 if sh.scale != 1.0:

@@ -32,12 +32,15 @@ from __future__ import annotations
 import math
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from robokin.exceptions import InputError, ModelError
 from robokin.io.text_files import MAX_TEXT_BYTES
 from robokin.io.validate import validate_document
 from robokin.io.yaml_reader import read_yaml_document
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = [
     "MAX_MOTION_SAMPLES",
@@ -66,7 +69,6 @@ def _schema():
         StrictStr,
     )
 
-    Num = StrictFloat
     Text = Annotated[StrictStr, Field(max_length=200)]
     Positive = Annotated[StrictFloat, Field(gt=0)]
 
@@ -78,16 +80,16 @@ def _schema():
         angle: Literal["rad", "deg"] = "rad"
 
     class Limits(Strict):  # signs are checked by the path builder, naming the joint
-        velocity: Num | list[Num] | None = None
-        acceleration: Num | list[Num] | None = None
+        velocity: StrictFloat | list[StrictFloat] | None = None
+        acceleration: StrictFloat | list[StrictFloat] | None = None
 
     class Target(Strict):
-        xyz: list[Num] | None = Field(default=None, min_length=3, max_length=3)
-        dxyz: list[Num] | None = Field(default=None, min_length=3, max_length=3)
-        rpy: list[Num] | None = Field(default=None, min_length=3, max_length=3)
+        xyz: list[StrictFloat] | None = Field(default=None, min_length=3, max_length=3)
+        dxyz: list[StrictFloat] | None = Field(default=None, min_length=3, max_length=3)
+        rpy: list[StrictFloat] | None = Field(default=None, min_length=3, max_length=3)
 
     class Step(Strict):
-        joint: list[Num] | None = None
+        joint: list[StrictFloat] | None = None
         pose: Target | None = None
         line: Target | None = None
         dwell: Positive | None = None
@@ -95,14 +97,14 @@ def _schema():
         profile: Text = "quintic"
         stop: StrictBool = False
         label: Text = ""
-        speed_in: Num = 0.0
-        speed_out: Num = 0.0
+        speed_in: StrictFloat = 0.0
+        speed_out: StrictFloat = 0.0
 
     class Motion(Strict):
         robot: Annotated[StrictStr, Field(max_length=4096)]
         units: Units = Units()
         dt: Positive = _DEFAULT_DT
-        start: list[Num]
+        start: list[StrictFloat]
         limits: Limits = Limits()
         tool_speed: Positive | None = None
         tool_acceleration: Positive | None = None
@@ -284,7 +286,7 @@ def _robot(spec: Any, file: Path) -> Any:
         raise ModelError(exc.reason, file=file, field="robot") from None
 
 
-def _target_pose(robot: Any, q_end: Any, target: Any, L: float, A: float,
+def _target_pose(robot: Robot, q_end: Any, target: Any, L: float, A: float,
                  file: Path, field: str) -> Any:
     """The pose a ``pose:`` / ``line:`` target names (rpy kept when omitted)."""
     import numpy as np

@@ -15,8 +15,9 @@ edge. The schema (pydantic, imported lazily) is below; see ``docs/robot-files.md
     base: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # optional
     tool: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # optional
 
-Sections besides the chain (``actuators``, ``geometry``, ``collision``) are read
-and written by the functions of :data:`SECTIONS`, an explicit table.
+Sections besides the chain (``actuators``, ``geometry``, ``collision``,
+``dynamics``, ``rate_limits``) are read and written by the functions of
+:data:`SECTIONS`, an explicit table.
 
 Numbers must be numbers (``a: "12"`` and ``alpha: yes`` are refused), a file holds
 at most :data:`MAX_JOINTS` rows, names are at most :data:`MAX_NAME` characters and
@@ -39,10 +40,15 @@ import numpy as np
 
 from robokin._validation import MAX_TRANSLATION
 from robokin.exceptions import ModelError
-from robokin.io import actuator_section, geometry_sections
+from robokin.io import (
+    actuator_section,
+    dynamics_section,
+    geometry_sections,
+    rate_limits_section,
+)
 from robokin.io.atomic import write_atomic
 from robokin.io.text_files import MAX_TEXT_BYTES
-from robokin.io.validate import validate_document
+from robokin.io.validate import list_of, union_of, validate_document
 from robokin.io.yaml_reader import read_yaml_document
 
 if TYPE_CHECKING:
@@ -55,6 +61,7 @@ __all__ = [
     "SECTIONS",
     "SectionIO",
     "document_from_robot",
+    "file_model",
     "load_robot",
     "robot_from_document",
     "save_robot",
@@ -83,20 +90,30 @@ class SectionIO:
             naming the field path.
         write: ``write(robot) -> value or None``: the section (SI units) of a
             robot built in memory, None when it has nothing to write.
+        model: ``model() -> type``: the section's pydantic model (or type), for
+            the robot file's JSON Schema (:func:`file_model`); None: any value.
     """
 
     read: Callable[[Any, Any, Any, Any], Any]
     write: Callable[[Any], Any]
+    model: Callable[[], Any] | None = None
 
 
 #: The optional sections, in the order they are applied.
 SECTIONS: dict[str, SectionIO] = {
     "actuators": SectionIO(actuator_section.apply_actuators_section,
-                           actuator_section.section_from_robot),
+                           actuator_section.section_from_robot,
+                           actuator_section.section_model),
     "geometry": SectionIO(geometry_sections.apply_geometry_section,
-                          geometry_sections.geometry_section),
+                          geometry_sections.geometry_section,
+                          geometry_sections.geometry_model),
     "collision": SectionIO(geometry_sections.apply_collision_section,
-                           geometry_sections.collision_section),
+                           geometry_sections.collision_section,
+                           geometry_sections.collision_model),
+    "dynamics": SectionIO(dynamics_section.apply_dynamics_section,
+                          dynamics_section.dynamics_section),
+    "rate_limits": SectionIO(rate_limits_section.apply_rate_limits_section,
+                             rate_limits_section.section_from_robot),
 }
 
 
@@ -114,7 +131,6 @@ def _schema():
     )
 
     Name = Annotated[StrictStr, Field(max_length=MAX_NAME)]
-    Num = StrictFloat
     Sign = Literal[1, -1]
 
     class Strict(BaseModel):
@@ -125,8 +141,8 @@ def _schema():
         angle: Literal["rad", "deg"] = "rad"
 
     class Placement(Strict):
-        xyz: tuple[Num, Num, Num] = (0.0, 0.0, 0.0)
-        rpy: tuple[Num, Num, Num] = (0.0, 0.0, 0.0)
+        xyz: tuple[StrictFloat, StrictFloat, StrictFloat] = (0.0, 0.0, 0.0)
+        rpy: tuple[StrictFloat, StrictFloat, StrictFloat] = (0.0, 0.0, 0.0)
 
     def _check_limits(v):
         if v is not None and v[0] > v[1]:
@@ -141,27 +157,27 @@ def _schema():
     class Row(Strict):
         name: Name | None = None
         joint: Literal["revolute", "prismatic", "fixed"] = "revolute"
-        a: Num = 0.0
-        alpha: Num = 0.0
-        d: Num = 0.0
-        theta: Num = 0.0
-        limits: tuple[Num, Num] | None = None
+        a: StrictFloat = 0.0
+        alpha: StrictFloat = 0.0
+        d: StrictFloat = 0.0
+        theta: StrictFloat = 0.0
+        limits: tuple[StrictFloat, StrictFloat] | None = None
         sign: Annotated[Sign, StrictInt] = 1
-        depends: dict[Name, Num] | None = None
-        depends_offset: Num = 0.0
+        depends: dict[Name, StrictFloat] | None = None
+        depends_offset: StrictFloat = 0.0
 
         _lim = field_validator("limits")(_check_limits)
         _sgn = field_validator("sign", mode="before")(_check_sign)
 
     class Op(Strict):
         op: Literal["rx", "ry", "rz", "tx", "ty", "tz", "frame"]
-        value: Num = 0.0
+        value: StrictFloat = 0.0
         name: Name | None = None
         joint: Literal["revolute", "prismatic", "fixed"] = "fixed"
-        limits: tuple[Num, Num] | None = None
+        limits: tuple[StrictFloat, StrictFloat] | None = None
         sign: Annotated[Sign, StrictInt] = 1
-        depends: dict[Name, Num] | None = None
-        depends_offset: Num = 0.0
+        depends: dict[Name, StrictFloat] | None = None
+        depends_offset: StrictFloat = 0.0
 
         _lim = field_validator("limits")(_check_limits)
         _sgn = field_validator("sign", mode="before")(_check_sign)
@@ -169,7 +185,7 @@ def _schema():
     class Coordinate(Strict):
         name: Name
         joint: Literal["revolute", "prismatic"] = "revolute"
-        limits: tuple[Num, Num] | None = None
+        limits: tuple[StrictFloat, StrictFloat] | None = None
 
         _lim = field_validator("limits")(_check_limits)
 
@@ -186,9 +202,38 @@ def _schema():
         actuators: Any = None
         geometry: Any = None
         collision: Any = None
+        dynamics: Any = None  # link masses and torque limits (io/dynamics_section.py)
+        rate_limits: Any = None  # per-joint speed/acceleration/jerk (io.rate_limits_section)
         controller: Any = None  # a controller profile (robokin.trajectory.io), kept raw
 
     return RobotFile, Row, Op
+
+
+def file_model() -> Any:
+    """The pydantic model of a whole robot file, for its JSON Schema.
+
+    The validating model with the parts it checks in a second step typed too: a
+    joint row is a DH row or (``convention: elementary``) an elementary
+    operation, and each section of :data:`SECTIONS` that declares a model has
+    it. Every other field is the validating model's own, so the schema follows
+    the reader.
+    """
+    from pydantic import Field, create_model
+
+    RobotFile, Row, Op = _schema()
+    fields: dict[str, Any] = {"joints": (
+        list_of(union_of(Row, Op)),
+        Field(min_length=1, max_length=MAX_JOINTS,
+              description="The chain, base to tool: DH rows, or elementary "
+                          "operations when convention is elementary."))}
+    for key, section in SECTIONS.items():
+        if section.model is not None and key in RobotFile.model_fields:
+            fields[key] = (union_of(section.model(), None), None)
+    Row.__doc__ = "A DH row (standard or modified): one joint or a fixed frame."
+    Op.__doc__ = "An elementary operation: rx ry rz tx ty tz, or a frame marker."
+    return create_model("RobotFile", __base__=RobotFile,
+                        __doc__="A robot file: a serial arm, in the units it declares.",
+                        **fields)
 
 
 def _placement(p, L: float, A: float) -> np.ndarray | None:
@@ -234,8 +279,7 @@ def _coordinate_kinds(spec: Any, rows: list[Any]) -> dict[str, str]:
 
 
 def _si_rows(spec: Any, rows: list[Any], L: float, A: float) -> list[dict[str, Any]]:
-    """The joint rows in SI units, as ``chain_from_dh`` / ``chain_from_elementary``
-    take them."""
+    """The joint rows in SI units, as the DH and elementary chain builders take them."""
     elementary = spec.convention == "elementary"
     kind_of = _coordinate_kinds(spec, rows)
 
@@ -389,7 +433,8 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
 def _state(robot: Robot) -> tuple:
     """What a stored document must still describe: the same objects, by identity."""
     return (robot.chain, robot.geometry, robot.actuators, robot.name, robot.source,
-            robot.actuator_names, robot.actuator_limits)
+            robot.actuator_names, robot.actuator_limits, robot.dynamics,
+            robot.rate_limits)
 
 
 def _document_matches(robot: Robot) -> bool:

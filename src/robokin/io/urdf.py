@@ -22,6 +22,9 @@ Import rules (documented in ``docs/urdf.md``):
   about any axis; the axis is folded into the constants (a joint about ``-z``,
   ``-x`` or ``-y`` becomes a reversed joint, ``sign = -1``). ``floating`` and
   ``planar`` joints on the chain are refused.
+* **Rate limits.** ``<limit velocity>`` of each independent joint becomes
+  ``robot.rate_limits.velocity`` (a missing or zero velocity, as many vendor URDFs
+  write, is unknown: NaN); URDF has no acceleration or jerk limits.
 * **Mimic.** A ``<mimic>`` joint is a dependent chain joint
   ``value = multiplier * q[master] + offset`` (chains of mimics are resolved). Its
   master becomes an independent coordinate even when it is not on the chain (a
@@ -48,13 +51,15 @@ import numpy as np
 
 from robokin._text import short_repr
 from robokin.exceptions import ModelError
+from robokin.io.ros_packages import PackageFinder
 from robokin.io.urdf_xml import MAX_URDF_JOINTS, MOVABLE, parse_urdf
-from robokin.model.chain import Chain, ChainBuilder, Joint
+from robokin.model.chain import Chain, ChainBuilder, Joint, JointKind
 from robokin.model.coupling import Dependency, coupling_from_dependencies, mimic
 from robokin.model.geometry import MESH_SUFFIXES
 
 if TYPE_CHECKING:
     from robokin.io.dh_extract import DHExtraction
+    from robokin.io.xacro import XacroExpansion
     from robokin.robot import Robot
 
 __all__ = [
@@ -160,7 +165,7 @@ class _Tree:
         up = self.ancestors(base)
         down = self.ancestors(tip)
         down_set = set(down)
-        common = next((a for a in up if a in down_set), None)
+        common = next(a for a in up if a in down_set)  # one tree: the root at least
         steps = []
         for link in up[: up.index(common)]:
             j = self.parent_joint[link]
@@ -283,7 +288,27 @@ def _limits(j: Any, file: Path | None) -> tuple[float, float]:
     return (lo, hi)
 
 
-def _kind(j: Any) -> str:
+def _velocity_limits(urdf_robot: Any, chain: Chain, source: str) -> Any:
+    """``<limit velocity>`` of each independent coordinate as RateLimits, or None.
+
+    A velocity that is missing, zero (as in many vendor URDFs) or not finite is
+    unknown (NaN); None when no coordinate has one.
+    """
+    from robokin.model.rate_limits import RateLimits
+
+    by_name = {j.name: j for j in urdf_robot.joints}
+    out = np.full(chain.n, np.nan)
+    for k, c in enumerate(chain.coordinates or ()):
+        j = by_name.get(c.name)
+        v = None if j is None or j.limit is None else j.limit.velocity
+        if v is not None and math.isfinite(float(v)) and float(v) > 0:
+            out[k] = float(v)
+    if np.isnan(out).all():
+        return None
+    return RateLimits(velocity=out, source=f"{source}: <limit velocity>")
+
+
+def _kind(j: Any) -> JointKind:
     return "prismatic" if j.type == "prismatic" else "revolute"
 
 
@@ -435,19 +460,16 @@ def chain_from_urdf_model(
 
 # ---------------------------------------------------------------------- geometry
 def _resolve_mesh(
-    filename: str, file: Path | None, package_map: Mapping[str, str | Path] | None
+    filename: str, file: Path | None, packages: PackageFinder
 ) -> tuple[Path | None, str]:
     """Resolve a mesh reference to a path; ``(None, reason)`` when it cannot be."""
     if filename.startswith("package://"):
         rest = filename[len("package://"):]
         pkg, _, sub = rest.partition("/")
-        root = (package_map or {}).get(pkg)
+        root = packages.find(pkg)
         if root is None:
-            return None, (
-                f"package '{pkg}' is not in the package map "
-                f"(pass package_map={{'{pkg}': '/path/to/{pkg}'}})"
-            )
-        return _mesh_file(Path(root) / sub)
+            return None, packages.not_found(pkg)
+        return _mesh_file(root / sub)
     if filename.startswith("file://"):
         return _mesh_file(Path(filename[len("file://"):]))
     scheme = _SCHEME.match(filename)
@@ -491,7 +513,7 @@ def _geometry_of(
     urdf_robot: Any,
     info: UrdfChain,
     file: Path | None,
-    package_map: Mapping[str, str | Path] | None,
+    packages: PackageFinder,
     drops: _Drops,
 ) -> list[dict[str, Any]]:
     """Every visual and collision shape of the chain's links, placed in fk_all frames.
@@ -521,7 +543,7 @@ def _geometry_of(
                 elif g.sphere is not None:
                     entry.update(type="sphere", radius=float(g.sphere.radius))
                 elif g.mesh is not None:
-                    path, why = _resolve_mesh(g.mesh.filename, file, package_map)
+                    path, why = _resolve_mesh(g.mesh.filename, file, packages)
                     if path is None:
                         drops.drop(link.name, role, g.mesh.filename, why)
                         continue
@@ -539,8 +561,10 @@ def _geometry_of(
 
 def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]], drops: _Drops
                      ) -> Robot:
-    """Put the collision shapes on the geometry layer (visual ones where a link has
-    no collision shape)."""
+    """Put the collision shapes on the geometry layer.
+
+    Visual shapes stand in where a link has no collision shape.
+    """
     from robokin.model import geometry as geo
 
     names = geo.link_names(robot)
@@ -576,19 +600,27 @@ def robot_from_urdf(
     tip_link: str | None = None,
     package_map: Mapping[str, str | Path] | None = None,
     *,
+    xacro_args: Mapping[str, str] | None = None,
     geometry: bool = True,
     missing_mesh: MissingMesh = "warn",
     name: str | None = None,
 ) -> Robot:
-    """Load the serial chain of a URDF as a robot (needs ``robokin[urdf]``).
+    """Load the serial chain of a URDF or xacro as a robot (needs ``robokin[urdf]``).
 
     Args:
         path_or_string: A URDF file path, or the XML itself (a string starting
-            with ``<``, or bytes).
+            with ``<``, or bytes), or a xacro file (a name ending ``.xacro``:
+            expanded first by :func:`robokin.io.xacro.expand_xacro`, which
+            needs ``robokin[ros]``).
         base_link: The link the chain starts at (default: the root link).
         tip_link: The link it ends at (default: the leaf with the most movable
             joints below the base; ``tool0`` wins a tie).
-        package_map: ``{package: directory}`` to resolve ``package://`` meshes.
+        package_map: ``{package: directory}`` for ``package://`` meshes and a
+            xacro's ``$(find ...)``; searched before ``ROS_PACKAGE_PATH``,
+            ``AMENT_PREFIX_PATH`` and the folders above the file
+            (:mod:`robokin.io.ros_packages`).
+        xacro_args: ``{name: value}`` for a xacro's ``<xacro:arg>``
+            declarations (refused for a plain URDF).
         geometry: Read visual and collision shapes (False: kinematics only).
         missing_mesh: A mesh that cannot be used (missing file, remote URI, a
             file that is not a mesh, a non-uniform scale): ``"warn"`` (default:
@@ -598,13 +630,22 @@ def robot_from_urdf(
         name: The robot's name (default: the URDF's ``<robot name>``).
 
     Returns:
-        A :class:`~robokin.robot.Robot` with ``robot.meta["urdf"]`` holding the
-        :class:`UrdfChain`, ``robot.meta["urdf_shapes"]`` the shapes and
-        ``robot.meta["urdf_dropped_shapes"]`` one message per shape left out.
+        A :class:`~robokin.robot.Robot` (its ``dynamics`` from the links'
+        ``<inertial>`` and the joints' ``effort``, see
+        :mod:`robokin.io.urdf_inertial`) with ``robot.meta["urdf"]`` holding the
+        :class:`UrdfChain`, ``robot.meta["urdf_shapes"]`` the shapes,
+        ``robot.meta["urdf_dropped_shapes"]`` one message per shape left out
+        and, for a xacro, ``robot.meta["xacro"]`` the
+        :class:`~robokin.io.xacro.XacroExpansion` (its ``urdf`` is the
+        expanded text).
 
     Raises:
-        ModelError: a bad file (naming the file, element and reason).
-        MissingExtraError: yourdfpy is not installed.
+        ModelError: a bad file (naming the file, element and reason); for a
+            xacro, an error in it or a package that is not found.
+        InputError: a package map folder that does not exist; ``xacro_args``
+            for a file that is not a xacro, or naming an argument the xacro
+            does not declare.
+        MissingExtraError: yourdfpy (or, for a xacro, xacro) is not installed.
     """
     from robokin.robot import Robot
 
@@ -614,24 +655,64 @@ def robot_from_urdf(
             f"{short_repr(missing_mesh)}",
             field="missing_mesh",
         )
-    urdf_robot, file = parse_urdf(path_or_string)
+    expansion, urdf_robot, file = _parse_source(path_or_string, package_map,
+                                                xacro_args)
     chain, info = chain_from_urdf_model(
         urdf_robot, base_link=base_link, tip_link=tip_link, file=file
     )
     drops = _Drops(missing_mesh, file)
-    shapes = _geometry_of(urdf_robot, info, file, package_map, drops) if geometry \
+    packages = expansion.packages if expansion is not None else \
+        PackageFinder(package_map, near=file)
+    shapes = _geometry_of(urdf_robot, info, file, packages, drops) if geometry \
         else []
-    source = f"URDF {file}" if file is not None else "URDF string"
+    source = "URDF string" if file is None else \
+        f"{'xacro' if expansion is not None else 'URDF'} {file}"
+    meta: dict[str, Any] = {"urdf": info, "urdf_shapes": shapes}
+    if expansion is not None:
+        meta["xacro"] = expansion
+        if expansion.args:
+            source += " (" + ", ".join(f"{k}:={v}" for k, v in expansion.args.items()) + ")"
     robot = Robot(
         chain,
         name=name or urdf_robot.name,
         source=f"{source}, chain {info.base_link} -> {info.tip_link}",
-        meta={"urdf": info, "urdf_shapes": shapes},
+        meta=meta,
+        rate_limits=_velocity_limits(urdf_robot, chain, source),
     )
     if shapes:
         robot = _attach_geometry(robot, shapes, drops)
+    from robokin.io.urdf_inertial import dynamics_from_urdf
+
+    robot = robot.replace(dynamics=dynamics_from_urdf(robot, urdf_robot,
+                                                      info.link_frames, file))
     return robot.replace(meta={**robot.meta,
                                "urdf_dropped_shapes": tuple(drops.messages)})
+
+
+def _parse_source(
+    source: str | Path | bytes,
+    package_map: Mapping[str, str | Path] | None,
+    xacro_args: Mapping[str, str] | None,
+) -> tuple[XacroExpansion | None, Any, Path | None]:
+    """The xacro expansion (None for a URDF), the parsed URDF and its file."""
+    from robokin.exceptions import InputError
+    from robokin.io.xacro import expand_xacro, is_xacro
+
+    if not is_xacro(source):
+        if xacro_args:
+            raise InputError("xacro_args", "given for a URDF that is not a xacro "
+                             "file (a name ending .xacro)")
+        urdf_robot, file = parse_urdf(source)
+        return None, urdf_robot, file
+    path = Path(source)  # type: ignore[arg-type]  # is_xacro: a path
+    expansion = expand_xacro(path, args=xacro_args, package_map=package_map)
+    try:
+        urdf_robot, _ = parse_urdf(expansion.urdf)
+    except ModelError as exc:
+        where = "" if exc.line is None else \
+            f" (line {exc.line} of the URDF expanded from it)"
+        raise ModelError(exc.reason + where, file=path, field=exc.field) from None
+    return expansion, urdf_robot, path
 
 
 def dh_from_urdf(
@@ -642,11 +723,13 @@ def dh_from_urdf(
     convention: Literal["standard", "modified"] = "standard",
     reference_link: str | None = None,
     virtual_frames: bool = False,
+    package_map: Mapping[str, str | Path] | None = None,
+    xacro_args: Mapping[str, str] | None = None,
 ) -> DHExtraction:
     """DH table of a URDF arm (see :func:`robokin.io.dh_extract.dh_from_robot`).
 
     Args:
-        path_or_string: URDF file or XML string.
+        path_or_string: URDF file, XML string or xacro file.
         base_link: Chain start (default: the root).
         tip_link: Chain end (default as in :func:`robot_from_urdf`).
         convention: ``"standard"`` or ``"modified"``.
@@ -656,13 +739,16 @@ def dh_from_urdf(
             base frame, which vendors' DH tables use), else the base link.
         virtual_frames: Fold the remaining base and tool transforms into fixed
             rows (virtual frames) so the table alone reproduces the robot.
+        package_map: As in :func:`robot_from_urdf` (a xacro's ``$(find)``).
+        xacro_args: As in :func:`robot_from_urdf`.
 
     Returns:
         A :class:`~robokin.io.dh_extract.DHExtraction`.
     """
     from robokin.io.dh_extract import dh_from_robot as _dh
 
-    robot = robot_from_urdf(path_or_string, base_link, tip_link, geometry=False)
+    robot = robot_from_urdf(path_or_string, base_link, tip_link, package_map,
+                            xacro_args=xacro_args, geometry=False)
     info: UrdfChain = robot.meta["urdf"]
     ref = reference_link
     if ref is None and "base" in info.link_frames and info.link_frames["base"][0] == 0:
@@ -679,7 +765,9 @@ def dh_from_urdf(
                virtual_frames=virtual_frames)
 
 
-def dh_from_robot(robot: Robot, convention: str = "standard", **kwargs: Any) -> DHExtraction:
+def dh_from_robot(
+    robot: Robot, convention: Literal["standard", "modified"] = "standard", **kwargs: Any
+) -> DHExtraction:
     """See :func:`robokin.io.dh_extract.dh_from_robot`."""
     from robokin.io.dh_extract import dh_from_robot as _dh
 

@@ -11,7 +11,10 @@ dependent joint ``sum_i m_i q_i + c`` becomes ``<mimic>`` joints: one joint when
 single coordinate drives it, otherwise one coaxial joint per coordinate
 (rotations about one axis add). A coordinate that is no chain joint of its own
 gets a zero-length joint on a leaf link so the mimic joints have a master.
-Needs no extra.
+Link mass properties become ``<inertial>`` elements and torque limits ``effort``
+(:mod:`robokin.io.urdf_inertial`); ``<limit velocity>`` carries
+``robot.rate_limits.velocity`` where it is known (a placeholder elsewhere; URDF has
+no acceleration or jerk limits). Needs no extra.
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ import numpy as np
 
 from robokin.io.atomic import write_atomic
 from robokin.io.urdf import UrdfChain
+from robokin.model.chain import joint_motion
 
 if TYPE_CHECKING:
     from robokin.robot import Robot
@@ -111,18 +115,6 @@ def _origin_el(parent: ET.Element, T: np.ndarray) -> None:
     })
 
 
-def _rz_or_tz(kind: str, value: float) -> np.ndarray:
-    T = np.eye(4)
-    if value == 0.0:
-        return T
-    if kind == "revolute":
-        c, s = math.cos(value), math.sin(value)
-        T[:2, :2] = [[c, -s], [s, c]]
-    else:
-        T[2, 3] = value
-    return T
-
-
 def urdf_from_robot(
     robot: Robot,
     *,
@@ -137,9 +129,12 @@ def urdf_from_robot(
         robot: Any robokin robot (standard / modified DH, virtual frames,
             prismatic and dependent joints).
         name: The ``<robot name>`` (default: ``robot.name``).
-        velocity: The ``<limit velocity>`` written on every joint [rad/s or m/s]
-            (robokin does not model it; URDF requires it).
-        effort: The ``<limit effort>`` written on every joint [N m or N].
+        velocity: The ``<limit velocity>`` [rad/s or m/s] written on joints whose
+            speed limit the robot does not know (``robot.rate_limits``; URDF
+            requires a value). Known limits are written as they are (a mimic
+            joint's scaled by its multiplier).
+        effort: The ``<limit effort>`` written on every joint [N m or N] whose
+            coordinate has no torque limit in ``robot.dynamics``.
         mesh_uri: Optional ``fn(path) -> str`` rewriting mesh paths (e.g. to
             ``package://`` URIs); default: the path as stored.
 
@@ -150,10 +145,15 @@ def urdf_from_robot(
     """
     chain = robot.chain
     root = ET.Element("robot", {"name": name or robot.name})
+    tl = getattr(robot.dynamics, "torque_limits", None)
+    efforts = {} if tl is None else {
+        j: float(v) for j, v in zip(robot.joint_names, tl) if math.isfinite(v)}
     note = (
         f"written by robokin from '{robot.name}'"
         + (f" ({robot.source})" if robot.source else "")
-        + "; <limit velocity/effort> are placeholders"
+        + ("; an effort without a torque limit is a placeholder"
+           if _known_velocities(robot) is not None
+           else "; <limit velocity> and an effort without a torque limit are placeholders")
     )
     while "--" in note:
         note = note.replace("--", "-")
@@ -177,15 +177,16 @@ def urdf_from_robot(
                   *, axis: np.ndarray | None = None,
                   limits: tuple[float, float] | None = None,
                   mimic_of: tuple[str, float, float] | None = None,
-                  exact: bool = False) -> str:
+                  exact: bool = False, speed: float = math.nan) -> str:
         jname = jname if exact else unique(jname, joint_names)
         el = ET.SubElement(root, "joint", {"name": jname, "type": jtype})
         ET.SubElement(el, "parent", {"link": parent})
         ET.SubElement(el, "child", {"link": child})
         _origin_el(el, T)
-        if jtype != "fixed":
+        if jtype != "fixed" and axis is not None:  # every moving joint has its axis
             ET.SubElement(el, "axis", {"xyz": " ".join(_fmt(_clean(v)) for v in axis)})
-            lim = {"effort": _fmt(effort), "velocity": _fmt(velocity)}
+            lim = {"effort": _fmt(efforts.get(jname, effort)),
+                   "velocity": _fmt(velocity if math.isnan(speed) else speed)}
             if limits is not None and jtype != "continuous":
                 lim["lower"], lim["upper"] = _fmt(limits[0]), _fmt(limits[1])
             ET.SubElement(el, "limit", lim)
@@ -206,11 +207,10 @@ def urdf_from_robot(
         )
 
     # Link names from an imported URDF, when the chain still matches.
-    info = robot.meta.get("urdf")
-    imported = (
-        isinstance(info, UrdfChain) and len(info.child_links) == chain.n_chain
-    )
-    base_name = info.base_link if imported else "base_link"
+    urdf = robot.meta.get("urdf")
+    info = (urdf if isinstance(urdf, UrdfChain) and len(urdf.child_links) == chain.n_chain
+            else None)
+    base_name = info.base_link if info is not None else "base_link"
     if not np.array_equal(chain.base, np.eye(4)):
         world = add_link("world")
         base = add_link(base_name)
@@ -221,6 +221,8 @@ def urdf_from_robot(
     M, c = chain.coupling.matrix, chain.coupling.offset
     coords = chain.coordinates
     cnames = [x.name for x in coords]
+    vmax = _known_velocities(robot)
+    speeds = np.full(len(cnames), np.nan) if vmax is None else vmax
     # Coordinates that are a chain joint of the same name with an identity row.
     is_self = {}
     for kk, j in enumerate(chain.joints):
@@ -251,16 +253,21 @@ def urdf_from_robot(
     # Where each fk_all frame's shapes go: (URDF link, pose of the frame in it).
     targets: list[tuple[str, np.ndarray]] = [(base, np.eye(4))]
     for kk, j in enumerate(chain.joints):
-        child_name = info.child_links[kk] if imported else f"{j.name}_link"
+        child_name = info.child_links[kk] if info is not None else f"{j.name}_link"
         kind = j.kind
         row = M[kk]
         nz = [int(i) for i in np.flatnonzero(row)]
         F = chain.frame_offsets[kk]
+        # (URDF joint name, (coordinate, multiplier, offset) of a mimic or None,
+        # position limits, speed limit or NaN)
+        parts: list[tuple[str, tuple[int, float, float] | None,
+                          tuple[float, float], float]]
         if j.name in is_self:
-            parts = [(j.name, None, coords[cnames.index(j.name)].limits)]
+            i_self = cnames.index(j.name)
+            parts = [(j.name, None, coords[i_self].limits, float(speeds[i_self]))]
         elif not nz:
             # A constant joint: its value folds into the constants.
-            pending = pending @ _rz_or_tz(kind, j.sign * c[kk] + j.offset) @ F
+            pending = pending @ joint_motion(kind, j.sign * c[kk] + j.offset) @ F
             targets.append((parent, pending.copy()))
             pending = pending @ chain.link_offsets[kk]
             continue
@@ -272,13 +279,14 @@ def urdf_from_robot(
                 lim = (min(lo, hi) + off, max(lo, hi) + off) if all(
                     math.isfinite(v) for v in (lo, hi)) else (-math.inf, math.inf)
                 pname = j.name if len(nz) == 1 else f"{j.name}_{cnames[i]}"
-                parts.append((pname, (i, float(row[i]), off), lim))
+                parts.append((pname, (i, float(row[i]), off), lim,
+                              abs(float(row[i])) * float(speeds[i])))
         # Fold F into the joint when the moved axis still passes through the child
         # origin (F^-1 Rz F is then a rotation about F^-1 z): the URDF child link
         # frame is then the robokin link frame.
         fold = kind == "prismatic" or (abs(F[0, 3]) < 1e-15 and abs(F[1, 3]) < 1e-15)
-        T = pending @ _rz_or_tz(kind, j.offset)
-        for p_i, (pname, mim, lim) in enumerate(parts):
+        T = pending @ joint_motion(kind, j.offset)
+        for p_i, (pname, mim, lim, speed) in enumerate(parts):
             last = p_i == len(parts) - 1
             child = add_link(child_name if last else f"{child_name}_{p_i + 1}")
             jtype, lim = joint_type(kind, lim)
@@ -288,12 +296,12 @@ def urdf_from_robot(
                 T = T @ F
                 axis = F[:3, :3].T @ axis
             add_joint(pname, jtype, parent, child, T, axis=axis, limits=lim,
-                      mimic_of=mimic_of)
+                      mimic_of=mimic_of, speed=float(speed))
             parent, T = child, np.eye(4)
         rest = np.eye(4) if fold else F.copy()
         targets.append((parent, rest))
         pending = rest @ chain.link_offsets[kk]
-    tool_name = info.tip_link if imported and info.tip_link not in link_names \
+    tool_name = info.tip_link if info is not None and info.tip_link not in link_names \
         else "tool0"
     tool = add_link(tool_name)
     add_joint(f"{parent}_to_{tool}", "fixed", parent, tool, pending @ chain.tool)
@@ -303,11 +311,24 @@ def urdf_from_robot(
         leaf = add_link(f"{jname}_coordinate")
         jtype, lim = joint_type(coords[i].kind, coords[i].limits)
         add_joint(jname, jtype, base, leaf, np.eye(4), axis=np.array([0.0, 0, 1]),
-                  limits=lim, exact=True)
+                  limits=lim, exact=True, speed=float(speeds[i]))
     if robot.geometry is not None and hasattr(robot.geometry, "shapes"):
         _write_shapes(root, robot.geometry, targets, mesh_uri)
+    from robokin.io.urdf_inertial import write_inertials
+
+    write_inertials(root, robot, targets, _fmt)
     ET.indent(root, space="  ")
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _known_velocities(robot: Robot) -> np.ndarray | None:
+    """The robot's speed limits (n,) [rad/s or m/s], NaN where unknown.
+
+    None when the robot knows none.
+    """
+    lim = robot.rate_limits
+    v = None if lim is None else lim.velocity
+    return None if v is None or np.isnan(v).all() else v
 
 
 def write_urdf(robot: Robot, path: str | Path, **kwargs: Any) -> Path:

@@ -48,9 +48,11 @@ def _read_source(source: str | Path | bytes) -> tuple[bytes, Path | None]:
 
 
 def _xml_parser() -> Any:
-    """lxml's parser with every fetch and expansion switched off, explicitly (not
-    left to the version's defaults): no entities, no DTD, no network, no huge
-    trees."""
+    """The lxml parser with every fetch and expansion switched off.
+
+    Explicitly, not left to the version's defaults: no entities, no DTD, no
+    network, no huge trees.
+    """
     from lxml import etree
 
     return etree.XMLParser(remove_blank_text=True, resolve_entities=False,
@@ -155,8 +157,11 @@ _REQUIRED = {"box": ("size",), "cylinder": ("radius", "length"),
 
 
 def _check_numbers(root: Any, file: Path | None) -> None:
-    """Numeric attributes hold the right count of finite numbers (positive sizes),
-    shapes their required attributes; errors name the element, field and line."""
+    """Check the numeric attributes and the shapes' required attributes.
+
+    Numeric attributes hold the right count of finite numbers (positive sizes),
+    shapes their required attributes; errors name the element, field and line.
+    """
     for el in root.iter():
         if not isinstance(el.tag, str):
             continue  # comments, processing instructions

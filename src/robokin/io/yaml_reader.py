@@ -25,7 +25,7 @@ import re
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import yaml
 
@@ -137,8 +137,10 @@ class YamlDocument:
                                                           repr=False)
 
     def line(self, loc: Sequence[Any]) -> int | None:
-        """The line (1-based) of the part at ``loc`` (keys and indices), or of the
-        deepest part of it that exists; None for the whole document."""
+        """The line (1-based) of the part at ``loc`` (keys and indices).
+
+        Or of the deepest part of it that exists; None for the whole document.
+        """
         node, found = self.data, None
         for part in loc:
             entry = self._lines.get(id(node))
@@ -187,6 +189,15 @@ def _parse_field_path(text: str) -> list[Any]:
             for m in _PART.finditer(text)]
 
 
+class _Mark(Protocol):
+    line: int  # 0-based, as PyYAML's pure and libyaml marks both give it
+
+
+def _line(mark: _Mark | None) -> int | None:
+    """The 1-based line of a parser position, when the parser gave one."""
+    return None if mark is None else mark.line + 1
+
+
 def _budget(text: str, file: Any, max_depth: int, max_nodes: int | None) -> None:
     """Refuse a document too deep, recursive, or whose expansion is too large.
 
@@ -211,7 +222,7 @@ def _budget(text: str, file: Any, max_depth: int, max_nodes: int | None) -> None
                 elif any(a == ev.anchor for a, _ in open_anchors):
                     raise ModelError("an alias refers to the collection it is in "
                                      f"(&{ev.anchor}): a recursive document",
-                                     file=file, line=ev.start_mark.line + 1)
+                                     file=file, line=_line(ev.start_mark))
                 else:
                     continue  # undefined: the loader reports it
             elif isinstance(ev, yaml.ScalarEvent):
@@ -223,7 +234,7 @@ def _budget(text: str, file: Any, max_depth: int, max_nodes: int | None) -> None
                 open_anchors.append((ev.anchor, total))
                 if len(open_anchors) > max_depth:
                     raise ModelError(f"nested deeper than {max_depth} levels",
-                                     file=file, line=ev.start_mark.line + 1)
+                                     file=file, line=_line(ev.start_mark))
             elif isinstance(ev, yaml.CollectionEndEvent):
                 anchor, start = open_anchors.pop()
                 if anchor is not None:
@@ -235,7 +246,7 @@ def _budget(text: str, file: Any, max_depth: int, max_nodes: int | None) -> None
                         "characters (aliases repeating aliases)" if aliases
                         else f"holds more than {limit:,} values")
                 raise ModelError(f"{what}; refused (pass max_nodes= to raise the cap)",
-                                 file=file, line=ev.start_mark.line + 1)
+                                 file=file, line=_line(ev.start_mark))
     except yaml.YAMLError as exc:
         raise _yaml_error(exc, file) from None
     finally:

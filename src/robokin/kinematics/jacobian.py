@@ -12,8 +12,8 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
-from robokin.exceptions import InputError
 from robokin._native import kernels as _k
+from robokin.exceptions import InputError
 from robokin.kinematics.forward import chain_batch, raise_nonfinite
 from robokin.model.chain import Chain
 

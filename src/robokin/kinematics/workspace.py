@@ -1,4 +1,4 @@
-"""Workspace analysis: where the tool point can go.
+r"""Workspace analysis: where the tool point can go.
 
 Monte-Carlo sampling of the joint space inside the joint limits, pushed through the
 compiled batch FK: the reachable point cloud, its bounding box, a volume estimate
@@ -7,7 +7,7 @@ colouring.
 
 .. math::
 
-    V \\approx N_{occupied} \\cdot h^3
+    V \approx N_{occupied} \cdot h^3
 
 where ``h`` is the voxel edge length. The estimate converges from below as the
 sample count grows (unvisited voxels) and from above as ``h`` shrinks (voxels cut
@@ -29,7 +29,7 @@ from robokin.kinematics import forward
 from robokin.kinematics.jacobian import manipulability as _manipulability
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = [
     "Workspace",
@@ -94,7 +94,7 @@ class Workspace:
         }
 
 
-def _sampling_limits(robot: Robot) -> np.ndarray:
+def _sampling_limits(robot: RobotLike) -> np.ndarray:
     lim = np.array(robot.limits, dtype=float)
     rev = np.asarray(robot.is_revolute, dtype=bool)
     for i in range(lim.shape[0]):
@@ -166,7 +166,7 @@ def voxel_volume(points: npt.ArrayLike, voxel_size: float) -> tuple[float, int]:
 
 
 def sample_workspace(
-    robot: Robot,
+    robot: RobotLike,
     n_samples: int = 1_000_000,
     *,
     rng: np.random.Generator | None = None,

@@ -1,8 +1,8 @@
-"""The canonical kinematic chain every robot model compiles to.
+r"""The canonical kinematic chain every robot model compiles to.
 
 .. math::
 
-    T(q) = B \\cdot L_0 \\cdot J_1 F_1 G_1 \\cdot J_2 F_2 G_2 \\cdots J_n F_n G_n \\cdot T_{tool}
+    T(q) = B \cdot L_0 \cdot J_1 F_1 G_1 \cdot J_2 F_2 G_2 \cdots J_n F_n G_n \cdot T_{tool}
 
 ``J_k`` is a rotation about (revolute) or translation along (prismatic) the local z
 axis by ``sign_k * q_chain_k + offset_k``. ``F_k`` places the frame of link k
@@ -17,15 +17,16 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
+import numpy.typing as npt
 
 from robokin.exceptions import ModelError
-from robokin.model.chain_arrays import MAX_JOINTS, ChainArrays, chain_arrays_from_chain
+from robokin.model.chain_arrays import MAX_JOINTS, ChainArrays, chain_arrays
 from robokin.model.coupling import AffineMap
 
-__all__ = ["Chain", "ChainBuilder", "Joint", "JointKind"]
+__all__ = ["Chain", "ChainBuilder", "Joint", "JointKind", "joint_motion"]
 
 JointKind = Literal["revolute", "prismatic"]
 
@@ -49,6 +50,7 @@ class Joint:
     offset: float = 0.0
 
     def __post_init__(self) -> None:
+        """Check the kind, sign and limits; store them as floats."""
         if self.kind not in ("revolute", "prismatic"):
             raise ModelError(
                 f"joint '{self.name}': kind must be 'revolute' or 'prismatic', got {self.kind!r}"
@@ -68,13 +70,34 @@ class Joint:
         object.__setattr__(self, "offset", float(self.offset))
 
 
-def _ro(a: np.ndarray) -> np.ndarray:
-    a = np.ascontiguousarray(a, dtype=np.float64)
-    a.setflags(write=False)
-    return a
+def _ro(a: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    out = np.ascontiguousarray(a, dtype=np.float64)
+    out.setflags(write=False)
+    return out
 
 
-@dataclass(frozen=True, eq=False)
+def joint_motion(kind: JointKind, value: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """The joint's own transform ``J(v)``: a rotation about or translation along z.
+
+    Args:
+        kind: ``"revolute"`` or ``"prismatic"``.
+        value: Chain joint values ``v`` [rad or m], shape (...).
+
+    Returns:
+        Transforms (..., 4, 4).
+    """
+    v = np.asarray(value, dtype=np.float64)
+    out = np.zeros(v.shape + (4, 4))
+    out[..., 0, 0] = out[..., 1, 1] = out[..., 2, 2] = out[..., 3, 3] = 1.0
+    if kind == "revolute":
+        c, s = np.cos(v), np.sin(v)
+        out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1] = c, -s, s, c
+    else:
+        out[..., 2, 3] = v
+    return out
+
+
+@dataclass(frozen=True, eq=False, init=False)
 class Chain:
     """An immutable canonical chain (see the module docstring).
 
@@ -92,53 +115,95 @@ class Chain:
     """
 
     joints: tuple[Joint, ...]
-    head: np.ndarray
-    frame_offsets: np.ndarray
-    link_offsets: np.ndarray
-    base: np.ndarray = field(default_factory=lambda: np.eye(4))
-    tool: np.ndarray = field(default_factory=lambda: np.eye(4))
-    coordinates: tuple[Joint, ...] | None = None
-    coupling: AffineMap | None = None
+    head: npt.NDArray[np.float64]
+    frame_offsets: npt.NDArray[np.float64]
+    link_offsets: npt.NDArray[np.float64]
+    base: npt.NDArray[np.float64]
+    tool: npt.NDArray[np.float64]
+    coordinates: tuple[Joint, ...]
+    coupling: AffineMap
     arrays: ChainArrays = field(init=False, repr=False)
 
-    def __post_init__(self) -> None:
-        nc = len(self.joints)
-        names = [j.name for j in self.joints]
+    def __init__(
+        self,
+        joints: tuple[Joint, ...],
+        head: npt.ArrayLike,
+        frame_offsets: npt.ArrayLike,
+        link_offsets: npt.ArrayLike,
+        base: npt.ArrayLike | None = None,
+        tool: npt.ArrayLike | None = None,
+        coordinates: tuple[Joint, ...] | None = None,
+        coupling: AffineMap | None = None,
+    ) -> None:
+        """Check and freeze the parts; build the kernels' arrays.
+
+        Args:
+            joints: The chain joints, in order (n_chain).
+            head: ``L_0`` [m], shape (4, 4).
+            frame_offsets: ``F_k`` [m], shape (n_chain, 4, 4).
+            link_offsets: ``G_k`` [m], shape (n_chain, 4, 4).
+            base: The base transform [m], shape (4, 4); the identity if None.
+            tool: The tool transform [m], shape (4, 4); the identity if None.
+            coordinates: The independent coordinates (n); the joints if None.
+            coupling: ``q_chain = M q + c`` (n_chain x n); the identity if None
+                (then the coordinates must be as many as the joints).
+
+        Raises:
+            ModelError: repeated joint names, a part of the wrong shape or not
+                finite, a coupling that does not fit, more than
+                :data:`~robokin.model.chain_arrays.MAX_JOINTS` joints.
+        """
+        init = object.__setattr__
+        init(self, "joints", joints)
+        nc = len(joints)
+        names = [j.name for j in joints]
         if len(set(names)) != nc:
             dup = sorted({x for x in names if names.count(x) > 1})
             raise ModelError(f"joint names must be unique, repeated: {dup}")
-        for attr, shape in (
-            ("head", (4, 4)),
-            ("frame_offsets", (nc, 4, 4)),
-            ("link_offsets", (nc, 4, 4)),
-            ("base", (4, 4)),
-            ("tool", (4, 4)),
+        for attr, value, shape in (
+            ("head", head, (4, 4)),
+            ("frame_offsets", frame_offsets, (nc, 4, 4)),
+            ("link_offsets", link_offsets, (nc, 4, 4)),
+            ("base", np.eye(4) if base is None else base, (4, 4)),
+            ("tool", np.eye(4) if tool is None else tool, (4, 4)),
         ):
-            arr = np.asarray(getattr(self, attr), dtype=np.float64)
+            arr = np.asarray(value, dtype=np.float64)
             if arr.shape != shape:
                 raise ModelError(f"{attr} must have shape {shape}, got {arr.shape}")
             if not np.isfinite(arr).all():
                 raise ModelError(f"{attr} holds a non-finite value")
-            object.__setattr__(self, attr, _ro(arr))
-        if self.coordinates is None:
-            object.__setattr__(self, "coordinates", tuple(self.joints))
-        n = len(self.coordinates)
-        if self.coupling is None:
+            init(self, attr, _ro(arr))
+        if coordinates is None:
+            coordinates = tuple(joints)
+        init(self, "coordinates", coordinates)
+        n = len(coordinates)
+        if coupling is None:
             if n != nc:
                 raise ModelError(
                     "a chain whose coordinates differ from its joints needs a coupling"
                 )
-            object.__setattr__(self, "coupling", AffineMap.identity(nc))
-        if self.coupling.matrix.shape != (nc, n):
+            coupling = AffineMap.identity(nc)
+        init(self, "coupling", coupling)
+        if coupling.matrix.shape != (nc, n):
             raise ModelError(
-                f"coupling matrix must have shape ({nc}, {n}), got {self.coupling.matrix.shape}"
+                f"coupling matrix must have shape ({nc}, {n}), got {coupling.matrix.shape}"
             )
         if nc > MAX_JOINTS or n > MAX_JOINTS:
             raise ModelError(
                 f"a chain of {nc} joints and {n} coordinates: robokin takes at most "
                 f"{MAX_JOINTS} of each"
             )
-        object.__setattr__(self, "arrays", chain_arrays_from_chain(self))
+        init(self, "arrays", chain_arrays(
+            head=self.head, frame_offsets=self.frame_offsets,
+            link_offsets=self.link_offsets, base=self.base, tool=self.tool,
+            kind=np.array([j.kind == "prismatic" for j in self.joints], dtype=np.float64),
+            sign=np.array([j.sign for j in self.joints], dtype=np.float64),
+            offset=np.array([j.offset for j in self.joints], dtype=np.float64),
+            M=np.asarray(self.coupling.matrix, dtype=np.float64).reshape(nc, n),
+            c=np.asarray(self.coupling.offset, dtype=np.float64).reshape(nc),
+            limits=np.array([co.limits for co in self.coordinates], dtype=np.float64),
+            is_revolute=np.array([co.kind == "revolute" for co in self.coordinates]),
+            identity=bool(self.coupling.is_identity)))
 
     @property
     def n(self) -> int:
@@ -205,21 +270,16 @@ class Chain:
                 builder.constant(self.link_offsets[k])
                 rows.append(k)
                 continue
-            v = joint.sign * c[k] + joint.offset
-            move = np.eye(4)
-            if joint.kind == "revolute":
-                move[:2, :2] = [[math.cos(v), -math.sin(v)], [math.sin(v), math.cos(v)]]
-            else:
-                move[2, 3] = v
+            move = joint_motion(joint.kind, joint.sign * c[k] + joint.offset)
             builder.constant(move @ self.frame_offsets[k] @ self.link_offsets[k])
         coordinates = tuple(self.coordinates[j] for j in keep)
         coupling = AffineMap(Mk[rows], c[rows])
         return builder.build(base=self.base, tool=self.tool, coordinates=coordinates,
                              coupling=None if coupling.is_identity else coupling)
 
-    def replace(self, **changes) -> Chain:
+    def replace(self, **changes: Any) -> Chain:
         """A copy with some fields replaced (e.g. ``base=`` or ``tool=``)."""
-        kw = {
+        kw: dict[str, Any] = {
             "joints": self.joints,
             "head": self.head,
             "frame_offsets": self.frame_offsets,
@@ -242,6 +302,7 @@ class ChainBuilder:
     """
 
     def __init__(self) -> None:
+        """An empty builder: no joint yet, the head the identity."""
         self._head = np.eye(4)
         self._joints: list[Joint] = []
         self._F: list[np.ndarray] = []

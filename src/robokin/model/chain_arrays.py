@@ -23,15 +23,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
 
-if TYPE_CHECKING:
-    from robokin.model.chain import Chain
-
-__all__ = ["LAYOUT_TAG", "MAX_JOINTS", "ChainArrays", "chain_arrays_from_chain"]
+__all__ = ["LAYOUT_TAG", "MAX_JOINTS", "ChainArrays", "chain_arrays"]
 
 LAYOUT_TAG = 7391.0  # packed[0]; chain.h PACKED_TAG
 MAX_JOINTS = 32  # chain joints and coordinates the kernels take; chain.h MAXJ
@@ -41,12 +37,12 @@ F64 = npt.NDArray[np.float64]
 
 @dataclass(frozen=True, eq=False)
 class ChainArrays:
-    """The canonical chain as the compiled kernels read it.
+    r"""The canonical chain as the compiled kernels read it.
 
     .. math::
 
-        T(q) = C_0 \\, J_1(v_1) C_1 \\cdots J_{n_c}(v_{n_c}) C_{n_c}, \\qquad
-        v = \\mathrm{sign} \\odot (M q + c) + \\mathrm{offset}
+        T(q) = C_0 \, J_1(v_1) C_1 \cdots J_{n_c}(v_{n_c}) C_{n_c}, \qquad
+        v = \mathrm{sign} \odot (M q + c) + \mathrm{offset}
 
     Attributes:
         n_chain: Chain joints ``nc``.
@@ -114,9 +110,12 @@ def _xform_params(consts: np.ndarray) -> np.ndarray:
 
 def _seed_range(lower: np.ndarray, upper: np.ndarray,
                 is_revolute: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Where random restarts are drawn: the limits where they span at most one turn
-    (revolute) or [-1, 1] m (prismatic), else one turn / 2 m centred in them
-    (``[-pi, pi]`` or ``[-1, 1]`` when that lies inside); always finite."""
+    """Where random restarts are drawn; always finite.
+
+    The limits where they span at most one turn (revolute) or [-1, 1] m
+    (prismatic), else one turn / 2 m centred in them (``[-pi, pi]`` or
+    ``[-1, 1]`` when that lies inside).
+    """
     width = np.where(is_revolute, 2.0 * math.pi, 2.0)
     lo_ok, hi_ok = np.isfinite(lower), np.isfinite(upper)
     lo = np.where(lo_ok, lower, 0.0)
@@ -156,37 +155,63 @@ def _ro_bool(a: np.ndarray) -> np.ndarray:
     return a
 
 
-def chain_arrays_from_chain(chain: Chain) -> ChainArrays:
-    """The kernel arrays of ``chain`` (its joints, constants, coupling and limits)."""
-    nc, n = chain.n_chain, chain.n
+def chain_arrays(
+    *,
+    head: np.ndarray,
+    frame_offsets: np.ndarray,
+    link_offsets: np.ndarray,
+    base: np.ndarray,
+    tool: np.ndarray,
+    kind: np.ndarray,
+    sign: np.ndarray,
+    offset: np.ndarray,
+    M: np.ndarray,
+    c: np.ndarray,
+    limits: np.ndarray,
+    is_revolute: np.ndarray,
+    identity: bool,
+) -> ChainArrays:
+    """The kernel arrays of a canonical chain, from its parts.
+
+    Args:
+        head: ``L_0`` (4, 4).
+        frame_offsets: ``F_k`` (nc, 4, 4).
+        link_offsets: ``G_k`` (nc, 4, 4).
+        base: ``B`` (4, 4).
+        tool: The tool transform (4, 4).
+        kind: 1.0 prismatic, 0.0 revolute per chain joint, (nc,).
+        sign: +1 / -1 per chain joint, (nc,).
+        offset: Zero offsets [rad or m], (nc,).
+        M: Coupling matrix (nc, n).
+        c: Coupling offset (nc,).
+        limits: Coordinate limits (n, 2) [rad or m].
+        is_revolute: (n,) bool per coordinate.
+        identity: True when ``q_chain = q``.
+
+    Returns:
+        The :class:`ChainArrays`, every array read-only.
+    """
+    nc, n = kind.shape[0], is_revolute.shape[0]
     consts = np.empty((nc + 1, 4, 4))
-    consts[0] = chain.base @ chain.head
-    consts[1:] = chain.frame_offsets @ chain.link_offsets
-    consts[nc] = consts[nc] @ chain.tool
-    link = chain.link_offsets.copy()
-    link[nc - 1] = link[nc - 1] @ chain.tool
-    kind = np.array([j.kind == "prismatic" for j in chain.joints], dtype=np.float64)
-    sign = np.array([j.sign for j in chain.joints], dtype=np.float64)
-    offset = np.array([j.offset for j in chain.joints], dtype=np.float64)
-    M = np.asarray(chain.coupling.matrix, dtype=np.float64).reshape(nc, n)
-    c = np.asarray(chain.coupling.offset, dtype=np.float64).reshape(nc)
-    lim = np.array([co.limits for co in chain.coordinates], dtype=np.float64).reshape(n, 2)
-    is_rev = np.array([co.kind == "revolute" for co in chain.coordinates])
-    seed_lo, seed_hi = _seed_range(lim[:, 0], lim[:, 1], is_rev)
-    wrap = _wrap_flags(M, kind, is_rev)
-    identity = bool(chain.coupling.is_identity)
+    consts[0] = base @ head
+    consts[1:] = frame_offsets @ link_offsets
+    consts[nc] = consts[nc] @ tool
+    link = np.array(link_offsets, dtype=np.float64)
+    link[nc - 1] = link[nc - 1] @ tool
+    lim = np.asarray(limits, dtype=np.float64).reshape(n, 2)
+    seed_lo, seed_hi = _seed_range(lim[:, 0], lim[:, 1], is_revolute)
     parts = {
         "consts": consts, "xform": _xform_params(consts), "kind": kind, "sign": sign,
-        "offset": offset, "M": M, "c": c, "base": np.asarray(chain.base),
-        "frame": np.asarray(chain.frame_offsets), "link": link,
+        "offset": offset, "M": M, "c": c, "base": np.asarray(base),
+        "frame": np.asarray(frame_offsets), "link": link,
         "lower": lim[:, 0], "upper": lim[:, 1], "seed_lower": seed_lo,
-        "seed_upper": seed_hi, "wrap": wrap,
+        "seed_upper": seed_hi, "wrap": _wrap_flags(M, kind, is_revolute),
     }
     packed = np.concatenate(
         [[LAYOUT_TAG, nc, n, float(identity)]] + [np.ravel(v) for v in parts.values()]
     )
     return ChainArrays(
         n_chain=nc, n=n, identity=identity, packed=_ro(packed), limits=_ro(lim),
-        is_revolute=_ro_bool(is_rev),
+        is_revolute=_ro_bool(is_revolute),
         **{k: _ro(v) for k, v in parts.items()},
     )

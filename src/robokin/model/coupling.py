@@ -53,7 +53,7 @@ __all__ = [
 _TWO_PI = 2.0 * math.pi
 
 
-def _frozen(a: npt.ArrayLike, ndim: int, name: str) -> np.ndarray:
+def _frozen(a: npt.ArrayLike, ndim: int, name: str) -> npt.NDArray[np.float64]:
     arr = np.array(a, dtype=np.float64)
     if arr.ndim != ndim:
         raise ModelError(f"{name} must have {ndim} dimensions, got shape {arr.shape}")
@@ -63,7 +63,7 @@ def _frozen(a: npt.ArrayLike, ndim: int, name: str) -> np.ndarray:
     return arr
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False)
 class AffineMap:
     """The affine map ``y = matrix @ x + offset``.
 
@@ -72,13 +72,23 @@ class AffineMap:
         offset: Shape (n_out,).
     """
 
-    matrix: np.ndarray
-    offset: np.ndarray
+    matrix: npt.NDArray[np.float64]
+    offset: npt.NDArray[np.float64]
     is_identity: bool = field(init=False)
 
-    def __post_init__(self) -> None:
-        A = _frozen(self.matrix, 2, "matrix")
-        b = _frozen(self.offset, 1, "offset")
+    def __init__(self, matrix: npt.ArrayLike, offset: npt.ArrayLike) -> None:
+        """Check and freeze the map.
+
+        Args:
+            matrix: Shape (n_out, n_in), finite.
+            offset: Shape (n_out,), finite.
+
+        Raises:
+            ModelError: a wrong number of dimensions, a non-finite value, or an
+                offset that does not match the matrix rows.
+        """
+        A = _frozen(matrix, 2, "matrix")
+        b = _frozen(offset, 1, "offset")
         if b.shape[0] != A.shape[0]:
             raise ModelError(
                 f"offset has {b.shape[0]} entries but the matrix has {A.shape[0]} rows"
@@ -201,6 +211,7 @@ class AffineMap:
                 and np.allclose(self.offset, other.offset, rtol=0.0, atol=atol))
 
     def __repr__(self) -> str:
+        """The map as a constructor call with plain lists."""
         return f"AffineMap(matrix={self.matrix.tolist()!r}, offset={self.offset.tolist()!r})"
 
 
@@ -286,7 +297,7 @@ class ShaftMotion:
 
 @dataclass(frozen=True)
 class BallScrewSpline:
-    """A ball-screw / ball-spline shaft driven by two motors (the SCARA's axes 3-4).
+    r"""A ball-screw / ball-spline shaft driven by two motors (the SCARA's axes 3-4).
 
     The shaft carries a ball-screw groove and a spline groove. Motor 3 turns the
     screw nut through a reduction ``i``, motor 4 turns the spline nut through a
@@ -296,8 +307,8 @@ class BallScrewSpline:
 
     .. math::
 
-        \\varphi_3 = (\\theta_3 - l_4 \\cdot 360 / l) \\cdot i, \\qquad
-        \\varphi_4 = \\theta_3 \\cdot j
+        \varphi_3 = (\theta_3 - l_4 \cdot 360 / l) \cdot i, \qquad
+        \varphi_4 = \theta_3 \cdot j
 
     and back, ``theta3 = phi4 / j``, ``l4 = (phi4 / j - phi3 / i) * l / 360``. In SI
     units (rad, m) the 360 becomes 2 pi. With the nut rotations ``N1 = phi3 / i``
@@ -321,6 +332,7 @@ class BallScrewSpline:
     lift_sign: float = 1.0
 
     def __post_init__(self) -> None:
+        """Check the lead, ratios and sign."""
         object.__setattr__(self, "lead", _number(self.lead, "lead", nonzero=True))
         object.__setattr__(self, "i", _number(self.i, "i", nonzero=True))
         object.__setattr__(self, "j", _number(self.j, "j", nonzero=True))
@@ -499,6 +511,7 @@ class Dependency:
     offset: float = 0.0
 
     def __post_init__(self) -> None:
+        """Check the coefficients are finite numbers; freeze them."""
         coeffs = {str(k): _number(v, f"coefficient of {short_repr(k)}")
                   for k, v in dict(self.coefficients).items()}
         object.__setattr__(self, "coefficients", coeffs)

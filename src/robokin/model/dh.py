@@ -25,7 +25,7 @@ import numpy as np
 
 from robokin._text import short_repr
 from robokin.exceptions import ModelError
-from robokin.model.chain import Chain, ChainBuilder, Joint
+from robokin.model.chain import Chain, ChainBuilder, Joint, JointKind
 from robokin.model.coupling import AffineMap
 from robokin.spatial import rotx, roty, rotz, trans
 
@@ -95,14 +95,16 @@ def _limits(row: Mapping, where: str) -> tuple[float, float]:
     return (lo, hi)
 
 
-def _kind(row: Mapping, where: str, default: str = "revolute") -> str:
+def _kind(
+    row: Mapping[str, Any], where: str, default: str = "revolute"
+) -> JointKind | Literal["fixed"]:
     kind = row.get("joint", default)
-    if kind not in ("revolute", "prismatic", "fixed"):
-        raise ModelError(
-            f"joint must be 'revolute', 'prismatic' or 'fixed', got {short_repr(kind)}",
-            field=f"{where}.joint",
-        )
-    return kind
+    if kind == "revolute" or kind == "prismatic" or kind == "fixed":
+        return kind
+    raise ModelError(
+        f"joint must be 'revolute', 'prismatic' or 'fixed', got {short_repr(kind)}",
+        field=f"{where}.joint",
+    )
 
 
 def _sign(row: Mapping, where: str) -> float:
@@ -148,7 +150,8 @@ class _Assembler:
                 self.explicit.append(Joint(str(c["name"]), kind, _limits(c, where)))
 
     def add_joint(
-        self, row: Mapping, kind: str, offset: float, where: str, index: int
+        self, row: Mapping[str, Any], kind: JointKind, offset: float, where: str,
+        index: int,
     ) -> None:
         name = str(row.get("name", f"joint{len(self.rows) + 1}"))
         depends = row.get("depends")
@@ -330,7 +333,7 @@ def chain_from_elementary(
         value = _num(op, "value", where)
         axis = name[1]
         is_rot = name[0] == "r"
-        kind = op.get("joint", "fixed")
+        kind = _kind(op, where, default="fixed")
         if kind == "fixed":
             if is_rot:
                 b.constant({"x": rotx, "y": roty, "z": rotz}[axis](value))
@@ -339,7 +342,6 @@ def chain_from_elementary(
                 v["xyz".index(axis)] = value
                 b.constant(trans(*v))
             continue
-        kind = _kind(op, where)
         if (kind == "revolute") != is_rot:
             raise ModelError(
                 f"a {kind} joint needs a {'rotation' if kind == 'revolute' else 'translation'}"

@@ -38,7 +38,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Literal, Protocol
+from typing import TYPE_CHECKING, Any, Literal, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -127,8 +127,11 @@ class Shape:
     file: Path | None = None
     scale: float = 1.0
     owner: str = ""
+    # derived data (bounds, coal and trimesh objects), built on first use
+    _cache: dict[str, Any] = field(init=False, repr=False, default_factory=dict)
 
     def __post_init__(self) -> None:
+        """Check the kind, size, placement and mesh file; normalise them."""
         if self.kind not in SHAPE_KINDS:
             raise InputError(
                 "kind", f"expected one of {list(SHAPE_KINDS)}, got {short_repr(self.kind)}"
@@ -159,9 +162,9 @@ class Shape:
             object.__setattr__(self, "file", Path(self.file))
             if not (math.isfinite(self.scale) and self.scale > 0):
                 raise InputError("scale", f"must be positive, got {self.scale}")
-        object.__setattr__(self, "_cache", {})
 
     def __repr__(self) -> str:
+        """A short summary: kind, size, and the file of a mesh."""
         extra = f", file={str(self.file)!r}" if self.file is not None else ""
         return f"Shape({self.kind!r}, size={self.size}{extra})"
 
@@ -182,7 +185,7 @@ class Shape:
             ModelError: a mesh file that is missing, unreadable or empty (the
                 message names the file and the link).
         """
-        cache = self._cache  # type: ignore[attr-defined]
+        cache = self._cache
         if "trimesh" in cache:
             return cache["trimesh"]
         try:
@@ -211,7 +214,7 @@ class Shape:
     # --------------------------------------------------------- bounding volumes
     def local_box(self) -> tuple[np.ndarray, np.ndarray]:
         """An oriented bounding box in the shape's own frame: centre (3,), half sizes (3,)."""
-        cache = self._cache  # type: ignore[attr-defined]
+        cache = self._cache
         if "box" in cache:
             return cache["box"]
         k, s = self.kind, self.size
@@ -237,7 +240,7 @@ class Shape:
         Returns:
             Centres (k, 3) [m] in the parent frame (placement applied) and radii (k,).
         """
-        cache = self._cache  # type: ignore[attr-defined]
+        cache = self._cache
         if "spheres" in cache:
             return cache["spheres"]
         if self.kind == "capsule":
@@ -271,7 +274,7 @@ class Shape:
     # ------------------------------------------------------------------- coal
     def coal_geometry(self):
         """The coal collision geometry (cached; meshes as an OBBRSS BVH)."""
-        cache = self._cache  # type: ignore[attr-defined]
+        cache = self._cache
         if "coal" in cache:
             return cache["coal"]
         coal = _coal()
@@ -296,7 +299,7 @@ class Shape:
 
     def coal_convex(self):
         """A convex coal geometry containing the shape (its hull), or the primitive itself."""
-        cache = self._cache  # type: ignore[attr-defined]
+        cache = self._cache
         if "convex" in cache:
             return cache["convex"]
         if self.kind != "mesh":
@@ -485,6 +488,7 @@ class RobotGeometry:
     exclude_adjacent: bool = True
 
     def __post_init__(self) -> None:
+        """Check one name per link shape list; freeze the shapes."""
         if len(self.shapes) != len(self.names):
             raise InputError(
                 "shapes",

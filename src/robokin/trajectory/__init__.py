@@ -12,7 +12,9 @@ Every function returns a :class:`Trajectory` sampled at a fixed ``dt``: times
 
 Profiles (``get_profile(name)``): cubic, quintic, trapezoidal (LSPB), cycloidal,
 piecewise_acceleration, modified_sine, constant_velocity. Files: :mod:`.io`;
-plan vs real run: :mod:`.compare`.
+plan vs real run: :mod:`.compare`. The same path run as fast as the joint limits
+allow: :func:`retime` (:mod:`.retiming`, needs ``robokin[retime]``), and the
+cycle-time report with its bottlenecks: :mod:`.cycle_time`.
 """
 
 from __future__ import annotations
@@ -37,6 +39,13 @@ from robokin.trajectory.joint import (
 )
 from robokin.trajectory.path import PathBuilder, Segment, via_path
 from robokin.trajectory.profiles import PROFILES, Profile, get_profile
+from robokin.trajectory.retiming import (
+    RetimeLimits,
+    RetimeResult,
+    SectionTiming,
+    retime,
+    retime_detailed,
+)
 from robokin.trajectory.samples import LimitReport, LimitViolation, Trajectory
 
 __all__ = [
@@ -47,6 +56,9 @@ __all__ = [
     "PathError",
     "PathFollowResult",
     "Profile",
+    "RetimeLimits",
+    "RetimeResult",
+    "SectionTiming",
     "Segment",
     "Trajectory",
     "cartesian_line",
@@ -60,6 +72,8 @@ __all__ = [
     "piecewise_acceleration",
     "profile_motion",
     "quintic",
+    "retime",
+    "retime_detailed",
     "time_grid",
     "trapezoidal",
     "via_path",

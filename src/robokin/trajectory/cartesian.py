@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -34,6 +34,9 @@ from robokin.spatial import (
 from robokin.trajectory.joint import time_grid
 from robokin.trajectory.profiles import Profile, get_profile
 from robokin.trajectory.samples import Trajectory
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = [
     "PathError",
@@ -57,6 +60,7 @@ class PathError(RobokinError):
     """
 
     def __init__(self, result: PathFollowResult, what: str = "path"):
+        """Carry the failing sample (index, time) and the reason of ``result``."""
         self.index = result.first_failure
         self.time = result.failure_time
         self.reason = result.reason
@@ -120,14 +124,17 @@ def line_poses(T_start: npt.ArrayLike, T_goal: npt.ArrayLike, s: npt.ArrayLike
 
 # --------------------------------------------------------------- path following
 def _err(T: np.ndarray, Tt: np.ndarray, e: np.ndarray) -> float:
-    """Fill ``e`` (6,) with the base-frame pose error current -> target
-    (:func:`robokin.spatial.pose_error`); return its largest component."""
+    """Fill ``e`` (6,) with the base-frame pose error; return its largest component.
+
+    The error runs from the current pose to the target
+    (:func:`robokin.spatial.pose_error`).
+    """
     e[:] = pose_error(T, Tt)
     return float(np.abs(e).max())
 
 
 def follow_poses(
-    robot: Any,
+    robot: Robot,
     T_path: npt.ArrayLike,
     q_start: npt.ArrayLike,
     *,
@@ -198,7 +205,8 @@ def follow_poses(
     for k in range(m):
         Tt = Tp[k]
         q = q_prev + step if seeds is None else seeds[k]
-        best, q_best, J_best = np.inf, q, None
+        best, q_best = np.inf, q
+        J_best: np.ndarray | None = None
         stalled = 0
         for _ in range(max_iterations):
             J, T = jacobian_and_pose(chain, q)
@@ -252,7 +260,7 @@ def follow_poses(
                           f"[{lim[j, 0]:.6g}, {lim[j, 1]:.6g}]")
                 first = k
                 break
-        if singular_tol > 0 and n >= 6:
+        if singular_tol > 0 and n >= 6 and J_best is not None:
             J = J_best
             # sigma_min >= |det J| / ||J||_F^5 for a 6x6 J: skip the SVD when that
             # bound already clears the tolerance (nearly always).
@@ -278,7 +286,7 @@ def follow_poses(
     return PathFollowResult(Q, success, err, first, ftime, reason, kind)
 
 
-def _follow_analytic(robot: Any, Tp: np.ndarray, q0: np.ndarray, times, **kw
+def _follow_analytic(robot: Robot, Tp: np.ndarray, q0: np.ndarray, times, **kw
                      ) -> PathFollowResult:
     """All closed-form solutions per sample, the one nearest the previous kept.
 
@@ -335,9 +343,9 @@ def _scalar_quintic(T: float, v0: float, v1: float, t: np.ndarray):
     return s[:, 0], sd[:, 0], sdd[:, 0]
 
 
-def _rates(robot: Any, q: np.ndarray, twist: np.ndarray, dtwist: np.ndarray
+def _rates(robot: Robot, q: np.ndarray, twist: np.ndarray, dtwist: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray]:
-    """qd = J^+ twist, qdd = J^+ (dtwist - Jdot qd), batched over samples."""
+    """Joint rates ``qd = J^+ twist``, ``qdd = J^+ (dtwist - Jdot qd)`` per sample."""
     J = robot.jacobian(q)
     Jp = np.linalg.pinv(J, rcond=1e-10)
     qd = np.einsum("mij,mj->mi", Jp, twist)
@@ -350,7 +358,7 @@ def _rates(robot: Any, q: np.ndarray, twist: np.ndarray, dtwist: np.ndarray
 
 
 def line_min_duration(
-    robot: Any, q_start: np.ndarray, T_start: np.ndarray, T_goal: np.ndarray,
+    robot: Robot, q_start: np.ndarray, T_start: np.ndarray, T_goal: np.ndarray,
     profile: Profile, *, v_max: npt.ArrayLike | None = None,
     a_max: npt.ArrayLike | None = None, tool_speed: float | None = None,
     tool_acceleration: float | None = None, samples: int = 101,
@@ -390,7 +398,7 @@ def line_min_duration(
 
 
 # -------------------------------------------------------------------- the segment
-def _goal_unreachable(robot: Any, T_goal: np.ndarray) -> str | None:
+def _goal_unreachable(robot: Robot, T_goal: np.ndarray) -> str | None:
     """Why the goal pose has no closed-form solution inside the limits, or None.
 
     Only for arms with a closed form (cheap and complete); None otherwise.
@@ -408,7 +416,7 @@ def _goal_unreachable(robot: Any, T_goal: np.ndarray) -> str | None:
 
 
 def cartesian_line(
-    robot: Any,
+    robot: Robot,
     q_start: npt.ArrayLike,
     T_goal: npt.ArrayLike,
     duration: float | None = None,

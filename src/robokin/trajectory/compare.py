@@ -12,13 +12,26 @@ acceleration); robokin reports both.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypedDict
 
 import numpy as np
 
 from robokin.exceptions import InputError
 from robokin.trajectory.samples import Trajectory
 
-__all__ = ["Comparison", "compare"]
+__all__ = ["Comparison", "ErrorRow", "compare"]
+
+
+class ErrorRow(TypedDict):
+    """One joint's line of :meth:`Comparison.table`, in display units."""
+
+    joint: str
+    unit: str  # deg, rad, mm or m
+    max: float  # largest |error|
+    t_max: float  # [s] when it occurs
+    rms: float
+    mean: float
+    corr_acc: float  # correlation of |error| with the planned |acceleration|
 
 
 @dataclass(frozen=True, eq=False)
@@ -50,9 +63,9 @@ class Comparison:
     is_revolute: np.ndarray
     plan_qdd: np.ndarray
 
-    def table(self, *, degrees: bool = True) -> list[dict[str, float | str]]:
+    def table(self, *, degrees: bool = True) -> list[ErrorRow]:
         """One row per joint: name, unit, max, t_max, rms, mean, corr (display units)."""
-        rows = []
+        rows: list[ErrorRow] = []
         for j, name in enumerate(self.joint_names):
             rev = bool(self.is_revolute[j])
             s = (180.0 / np.pi if degrees else 1.0) if rev else (1000.0 if degrees else 1.0)

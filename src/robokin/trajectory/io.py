@@ -36,10 +36,10 @@ import json
 import math
 import re
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -51,6 +51,7 @@ from robokin.io.text_files import MAX_CSV_BYTES, read_text_file
 from robokin.trajectory.samples import Trajectory
 
 __all__ = [
+    "PROGRAMS",
     "ControllerProfile",
     "load_profile",
     "read_csv",
@@ -62,9 +63,13 @@ __all__ = [
     "write_ur_script",
 ]
 
+_T = TypeVar("_T")
+
 _ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 _LENGTH = {"m": 1.0, "mm": 1e-3}
 _TIME = {"s": 1.0, "ms": 1e-3}
+#: Programs a controller profile may name (robokin.trajectory.controllers).
+PROGRAMS = ("urscript", "ros2", "waypoints")
 _HEADER = re.compile(r"^\s*(?P<name>.*?)\s*(?:\[(?P<unit>[^\]]*)\])?\s*$")
 
 
@@ -85,6 +90,9 @@ class ControllerProfile:
         angle_unit: ``"rad"`` or ``"deg"``.
         length_unit: ``"m"`` or ``"mm"``.
         names: Column names for the controller (default: the model's names).
+        programs: What the controller runs, its default first: ``"urscript"``,
+            ``"ros2"``, ``"waypoints"`` (:mod:`robokin.trajectory.controllers`);
+            None: any but URScript, a waypoint file by default.
     """
 
     name: str = "default"
@@ -94,8 +102,10 @@ class ControllerProfile:
     angle_unit: Literal["rad", "deg"] = "rad"
     length_unit: Literal["m", "mm"] = "m"
     names: tuple[str, ...] | None = None
+    programs: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
+        """Check the units and the per-column lists; store them as tuples."""
         if self.angle_unit not in _ANGLE:
             raise ModelError(f"angle_unit must be 'rad' or 'deg', got {short_repr(self.angle_unit)}",
                              field="angle_unit")
@@ -105,7 +115,11 @@ class ControllerProfile:
         if self.signs is not None and any(s not in (1, -1) for s in self.signs):
             raise ModelError(f"signs must be +1 or -1, got {list(self.signs)}",
                              field="signs")
-        for f in ("order", "signs", "offsets", "names"):
+        bad = [p for p in self.programs or () if p not in PROGRAMS]
+        if bad or (self.programs is not None and not self.programs):
+            raise ModelError(f"programs must be a non-empty list of {list(PROGRAMS)}, "
+                             f"got {short_repr(self.programs)}", field="programs")
+        for f in ("order", "signs", "offsets", "names", "programs"):
             v = getattr(self, f)
             if v is not None:
                 object.__setattr__(self, f, tuple(v))
@@ -116,11 +130,11 @@ class ControllerProfile:
 
         Keys: ``name``, ``order`` (indices or joint names, with ``joints`` giving the
         model's names), ``signs``, ``offsets`` (in ``offset_unit``, default the
-        profile's units), ``angle_unit``, ``length_unit``, ``names``.
+        profile's units), ``angle_unit``, ``length_unit``, ``names``, ``programs``.
         """
         doc = dict(doc)
         known = {"name", "order", "signs", "offsets", "offset_unit", "angle_unit",
-                 "length_unit", "names", "joints"}
+                 "length_unit", "names", "joints", "programs"}
         extra = sorted(set(doc) - known)
         if extra:
             raise ModelError(f"unknown key(s) {extra}; known: {sorted(known)}",
@@ -129,6 +143,7 @@ class ControllerProfile:
         signs = _list_field(doc, "signs", (int, float), file)
         offsets = _list_field(doc, "offsets", (int, float), file)
         names = _list_field(doc, "names", (str,), file)
+        programs = _list_field(doc, "programs", (str,), file)
         for key in ("name", "angle_unit", "length_unit", "offset_unit"):
             if key in doc and not isinstance(doc[key], str):
                 raise ModelError(f"expected text, got {short_repr(doc[key])}",
@@ -147,10 +162,11 @@ class ControllerProfile:
         if offsets is not None and doc.get("offset_unit", doc.get("angle_unit")) == "deg":
             offsets = [math.radians(o) for o in offsets]
         try:
-            return cls(name=doc.get("name", "default"), order=order,
-                       signs=signs, offsets=offsets,
+            return cls(name=doc.get("name", "default"), order=_tuple(order),
+                       signs=_tuple(signs), offsets=_tuple(offsets),
                        angle_unit=doc.get("angle_unit", "rad"),
-                       length_unit=doc.get("length_unit", "m"), names=names)
+                       length_unit=doc.get("length_unit", "m"), names=_tuple(names),
+                       programs=_tuple(programs))
         except ModelError as exc:
             raise ModelError(exc.reason, file=file, field=exc.field) from None
 
@@ -194,8 +210,10 @@ class ControllerProfile:
 
 def _list_field(doc: Mapping[str, Any], key: str, kinds: tuple[type, ...],
                 file: Any) -> list[Any] | None:
-    """``doc[key]``: None, or a list whose items are of ``kinds`` (no booleans,
-    finite numbers); a ModelError naming the field otherwise."""
+    """``doc[key]``: None, or a list whose items are of ``kinds``.
+
+    No booleans, finite numbers; a ModelError naming the field otherwise.
+    """
     value = doc.get(key)
     if value is None:
         return None
@@ -302,10 +320,16 @@ def csv_text(traj: Trajectory, joint_names: Sequence[str] | None = None, *,
     return "\n".join(lines) + "\n"
 
 
+def _tuple(values: Iterable[_T] | None) -> tuple[_T, ...] | None:
+    return None if values is None else tuple(values)
+
+
 def _parse_header(cols: list[str]) -> list[tuple[str, str | None]]:
     out = []
     for c in cols:
         m = _HEADER.match(c)
+        if m is None:  # pragma: no cover - the pattern matches any text
+            raise ModelError(f"unreadable column header {short_repr(c)}")
         out.append((m.group("name"), m.group("unit").strip() if m.group("unit") else None))
     return out
 
@@ -319,8 +343,10 @@ def _is_number(text: str) -> bool:
 
 
 def _load_table(path: Path, max_bytes: int) -> tuple[list[str] | None, np.ndarray, int]:
-    """The header (None when the file has none), the numbers, and the line of the
-    first data row (for messages)."""
+    """The header (None when the file has none), the numbers, the first data line.
+
+    The line number of the first data row is for messages.
+    """
     text = read_text_file(path, max_bytes=max_bytes)
     numbered = [(k, ln) for k, ln in enumerate(text.splitlines(), start=1)
                 if ln.strip() and not ln.lstrip().startswith("#")]
@@ -364,8 +390,10 @@ def _differentiate(t: np.ndarray, x: np.ndarray) -> np.ndarray:
 def _columns(header: list[str] | None, width: int, path: Path,
              joint_names: Sequence[str] | None
              ) -> tuple[list[tuple[str, str | None]], list[list[int]]]:
-    """Parsed header cells and the column indices of positions, rates and
-    accelerations, ordered as ``joint_names`` when given."""
+    """Parsed header cells and the column indices of positions, rates, accelerations.
+
+    The indices are ordered as ``joint_names`` when given.
+    """
     if header is None:
         n = width - 1
         if n == 0:
@@ -380,7 +408,7 @@ def _columns(header: list[str] | None, width: int, path: Path,
                       f"(time [s], then {', '.join(names[:8])}"
                       f"{' ...' if len(names) > 8 else ''} in SI units)", UserWarning,
                       stacklevel=4)
-        cells = [("t", None)] + [(nm, None) for nm in names]
+        cells: list[tuple[str, str | None]] = [(nm, None) for nm in ["t", *names]]
         return cells, [list(range(1, len(names) + 1)), [], []]
     cells = _parse_header(header)
     groups: list[dict[str, int]] = [{}, {}, {}]
@@ -478,8 +506,11 @@ def _trajectory_from_table(header: list[str] | None, data: np.ndarray, path: Pat
 
 def _check_times(t: np.ndarray, path: Path, first_line: int, *,
                  allow_repeats: bool) -> np.ndarray:
-    """Rows to keep: refuses time going backwards (naming the line), and repeated
-    time stamps unless ``allow_repeats`` (then the first of each is kept)."""
+    """Rows to keep, refusing time that goes backwards (naming the line).
+
+    Repeated time stamps are refused too unless ``allow_repeats`` (then the first
+    of each is kept).
+    """
     step = np.diff(t)
     back = np.flatnonzero(step < 0 if allow_repeats else step <= 0)
     if back.size:

@@ -30,14 +30,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
 
 from robokin._validation import check_finite, check_joints, check_transform
 from robokin.exceptions import InputError, UnreachableError
-from robokin.trajectory.cartesian import PathError, cartesian_line
+from robokin.trajectory.cartesian import IKMode, PathError, cartesian_line
 from robokin.trajectory.joint import (
     MAX_SAMPLES,
     evaluate_polynomial,
@@ -46,6 +46,9 @@ from robokin.trajectory.joint import (
 )
 from robokin.trajectory.profiles import Profile, get_profile
 from robokin.trajectory.samples import Trajectory
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["PathBuilder", "Segment", "via_path"]
 
@@ -83,6 +86,14 @@ class Segment:
     given: bool = False
 
 
+def _profile(seg: Segment) -> Profile:
+    """The time scaling of a joint or line segment (a dwell has none)."""
+    if seg.profile is None:
+        raise InputError("profile", f"segment '{seg.label}' ({seg.kind}) has no time "
+                         "scaling")
+    return seg.profile
+
+
 class PathBuilder:
     """Collects via points and segments, then samples the whole path at ``dt``.
 
@@ -102,11 +113,12 @@ class PathBuilder:
     """
 
     def __init__(
-        self, robot: Any, q_start: npt.ArrayLike, *, dt: float = 0.005,
+        self, robot: Robot, q_start: npt.ArrayLike, *, dt: float = 0.005,
         v_max: npt.ArrayLike | None = None, a_max: npt.ArrayLike | None = None,
         tool_speed: float | None = None, tool_acceleration: float | None = None,
-        smooth: bool = True, ik: str = "follow", max_samples: int | None = None,
+        smooth: bool = True, ik: IKMode = "follow", max_samples: int | None = None,
     ) -> None:
+        """Check the start and the limits (see the class docstring)."""
         self.robot = robot
         n = robot.n
         q0 = check_finite(check_joints(q_start, n, "q_start"), "q_start")
@@ -156,7 +168,8 @@ class PathBuilder:
 
     def pose(self, T: npt.ArrayLike, duration: float | None = None, *,
              profile: str | Profile = "quintic", stop: bool = False,
-             label: str = "", method: str = "auto") -> PathBuilder:
+             label: str = "",
+             method: Literal["auto", "analytic", "numeric"] = "auto") -> PathBuilder:
         """Joint-space move to the IK solution of pose ``T`` nearest the current end.
 
         Raises:
@@ -213,15 +226,19 @@ class PathBuilder:
 
     def duration_so_far(self) -> float | None:
         """Sum of the known durations, or None while some are still to derive."""
-        ds = [s.duration for s in self.segments]
-        return None if any(d is None for d in ds) else float(sum(ds))
+        total = 0.0
+        for s in self.segments:
+            if s.duration is None:
+                return None
+            total += s.duration
+        return total
 
     # --------------------------------------------------------------- building
     def _rest_duration(self, seg: Segment, q_from: np.ndarray) -> float:
         if self.v_max is None and self.a_max is None:
             raise InputError("duration", f"segment '{seg.label}' has no duration and "
                              "the path no v_max / a_max to derive one")
-        T = seg.profile.min_duration(seg.q_end - q_from, self.v_max, self.a_max)
+        T = _profile(seg).min_duration(seg.q_end - q_from, self.v_max, self.a_max)
         return max(self.dt, math.ceil(T / self.dt - 1e-9) * self.dt)
 
     def build(self, *, progress: Any = None) -> Trajectory:
@@ -245,10 +262,12 @@ class PathBuilder:
                 raise InputError("speed_out", f"line '{a.label}' ends moving, so a "
                                  "joint segment must follow it")
         starts = [self.q_start] + [s.q_end for s in segs[:-1]]
+        durations: list[float] = []
         for seg, q_from in zip(segs, starts):
             if seg.duration is None:
                 seg.duration = self._rest_duration(seg, q_from)
-        self._check_samples(segs)
+            durations.append(seg.duration)
+        self._check_samples(segs, durations)
         # Boundary conditions per junction: (qd, qdd) or None (free: via point).
         n = self.robot.n
         zero = np.zeros(n)
@@ -256,7 +275,7 @@ class PathBuilder:
         bc: list[tuple[np.ndarray, np.ndarray] | None] = [None] * (k + 1)
         bc[0] = bc[k] = (zero, zero)
         for i, seg in enumerate(segs):
-            if seg.kind == "line":
+            if seg.line is not None:  # a line segment (sampled when added)
                 bc[i] = (seg.line.qd[0], seg.line.qdd[0])
                 bc[i + 1] = (seg.line.qd[-1], seg.line.qdd[-1])
             elif seg.kind == "dwell" or seg.stop or not self.smooth:
@@ -267,25 +286,25 @@ class PathBuilder:
             bc = [(zero, zero) if b is None else b for b in bc]
         coeffs = self._joint_coefficients(segs, starts, bc)
         parts = []
-        for i, seg in enumerate(segs):
-            if seg.kind == "line":
+        for i, (seg, dur, c) in enumerate(zip(segs, durations, coeffs)):
+            if seg.line is not None:  # a line segment
                 parts.append(seg.line.replace(labels=(seg.label,), pose=None))
             else:
-                t = time_grid(seg.duration, self.dt, max_samples=self.max_samples)
+                t = time_grid(dur, self.dt, max_samples=self.max_samples)
                 if seg.kind == "dwell":
                     m = t.size
                     q = np.broadcast_to(seg.q_end, (m, n))
                     parts.append(Trajectory(t, q, np.zeros((m, n)), np.zeros((m, n)),
                                             labels=(seg.label,)))
-                elif coeffs[i] is None:  # rest-to-rest with its own profile
-                    s, sd, sdd = seg.profile.scale(t, seg.duration)
+                elif c is None:  # rest-to-rest with its own profile
+                    s, sd, sdd = _profile(seg).scale(t, dur)
                     d = seg.q_end - starts[i]
                     parts.append(Trajectory(t, starts[i] + s[:, None] * d,
                                             sd[:, None] * d, sdd[:, None] * d,
                                             labels=(seg.label,)))
                 else:
-                    parts.append(Trajectory(t, *evaluate_polynomial(
-                        coeffs[i], t, seg.duration), labels=(seg.label,)))
+                    parts.append(Trajectory(t, *evaluate_polynomial(c, t, dur),
+                                            labels=(seg.label,)))
             if progress is not None:
                 progress(i + 1, k)
         traj = Trajectory.concatenate(parts)
@@ -293,17 +312,17 @@ class PathBuilder:
                             is_revolute=self.robot.is_revolute,
                             pose=self.robot.fk(traj.q))
 
-    def _check_samples(self, segs: list[Segment]) -> None:
+    def _check_samples(self, segs: list[Segment], durations: list[float]) -> None:
         """Refuse a path of more than ``max_samples`` samples before sampling it."""
         cap = MAX_SAMPLES if self.max_samples is None else int(self.max_samples)
         total = 0.0
-        for i, seg in enumerate(segs):
-            total += seg.duration / self.dt + 1.0
+        for i, (seg, duration) in enumerate(zip(segs, durations)):
+            total += duration / self.dt + 1.0
             if total > cap:
                 raise InputError(
                     "max_samples",
                     f"the path reaches {total:,.0f} samples at dt {self.dt:g} s by "
-                    f"segment {i + 1} ('{seg.label}', {seg.duration:g} s), more "
+                    f"segment {i + 1} ('{seg.label}', {duration:g} s), more "
                     f"than the limit of {cap:,} (pass max_samples= to raise it)")
 
     def _joint_coefficients(self, segs, starts, bc) -> list[np.ndarray | None]:
@@ -320,7 +339,7 @@ class PathBuilder:
             run = list(range(i, j + 1))
             rest = (all(b is not None and not b[0].any() and not b[1].any()
                         for b in (bc[i], bc[j + 1])) and len(run) == 1)
-            if rest and segs[i].profile.name != "quintic":
+            if rest and _profile(segs[i]).name != "quintic":
                 i = j + 1  # a single rest-to-rest move keeps its own profile
                 continue
             self._fit_run(segs, starts, bc, run, out)
@@ -366,7 +385,7 @@ class PathBuilder:
 
 
 def via_path(
-    robot: Any, q_start: npt.ArrayLike, steps: list[dict[str, Any]], *,
+    robot: Robot, q_start: npt.ArrayLike, steps: list[dict[str, Any]], *,
     dt: float = 0.005, **options: Any,
 ) -> Trajectory:
     """Build a path from a list of steps (the dict form of :class:`PathBuilder`).

@@ -9,21 +9,22 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
 
 from robokin.exceptions import InputError
 
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
 __all__ = ["LimitReport", "LimitViolation", "Trajectory"]
 
 Space = Literal["joint", "actuator"]
 
 
-def _ro(a: npt.ArrayLike | None, ndim: int, name: str) -> np.ndarray | None:
-    if a is None:
-        return None
+def _ro(a: npt.ArrayLike, ndim: int, name: str) -> npt.NDArray[np.float64]:
     arr = np.array(a, dtype=np.float64)
     if arr.ndim != ndim:
         raise InputError(name, f"expected {ndim} dimensions, got shape {arr.shape}")
@@ -63,6 +64,7 @@ class Trajectory:
     labels: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
+        """Check the shapes and times; freeze the arrays."""
         t = _ro(self.t, 1, "t")
         q = _ro(self.q, 2, "q")
         m, n = q.shape
@@ -75,7 +77,7 @@ class Trajectory:
         for name, arr in (("qd", qd), ("qdd", qdd)):
             if arr.shape != (m, n):
                 raise InputError(name, f"expected shape {(m, n)}, got {arr.shape}")
-        pose = _ro(self.pose, 3, "pose")
+        pose = None if self.pose is None else _ro(self.pose, 3, "pose")
         if pose is not None and pose.shape != (m, 4, 4):
             raise InputError("pose", f"expected shape {(m, 4, 4)}, got {pose.shape}")
         names = self.joint_names
@@ -130,10 +132,35 @@ class Trajectory:
         return Trajectory(**kw)
 
     def __repr__(self) -> str:
+        """A short summary: samples, joints, duration, space."""
         return (f"Trajectory(samples={len(self)}, joints={self.n}, "
                 f"duration={self.duration:.6g} s, space={self.space!r})")
 
     # -------------------------------------------------------------- operations
+    def _repr_html_(self) -> str:
+        """Jupyter: samples, duration, a small plot of the joints and their peaks.
+
+        The plot shows at most :data:`robokin._html.MAX_POINTS` samples per
+        joint (degrees for angles, mm for lengths): bounded for any length.
+        """
+        from robokin import _html
+
+        rev = self.revolute()
+        scale = np.where(rev, 180.0 / np.pi, 1000.0)
+        peaks = self.peaks()
+        rows = [[name, "deg" if r else "mm", lo * k, hi * k, v * k, a * k]
+                for name, r, k, lo, hi, v, a in zip(
+                    self.names(), rev, scale, peaks["min"], peaks["max"],
+                    peaks["velocity"], peaks["acceleration"])]
+        unit = "deg" if rev.all() else "mm" if not rev.any() else "deg / mm"
+        return _html.box(
+            f"Trajectory: {len(self):,} samples, {self.duration:.3f} s, "
+            f"{self.n} joints, {max(len(self.via_times) - 2, 0)} via points",
+            _html.line_plot(self.t, self.q * scale, labels=self.names()[:10],
+                            xlabel="t [s]", ylabel=f"q [{unit}]"),
+            _html.table(["joint", "unit", "min", "max", "peak |vel| /s",
+                         "peak |acc| /s²"], rows))
+
     def at(self, times: npt.ArrayLike) -> np.ndarray:
         """Joint positions at arbitrary times (linear interpolation), (k,) -> (k, n).
 
@@ -148,14 +175,14 @@ class Trajectory:
         pose = self.pose
         return self.replace(t=self.t + dt, via_times=self.via_times + dt, pose=pose)
 
-    def tool_poses(self, robot: Any) -> np.ndarray:
+    def tool_poses(self, robot: Robot) -> np.ndarray:
         """Tool poses (m, 4, 4) [m]: the stored ones, or ``robot.fk(q)``."""
         if self.pose is not None:
             return self.pose
         q = self.q if self.space == "joint" else robot.joints_from_actuators(self.q)
         return robot.fk(q)
 
-    def to_actuator_space(self, robot: Any) -> Trajectory:
+    def to_actuator_space(self, robot: Robot) -> Trajectory:
         """Motor coordinates ``phi = A^+ (q - b)``, ``phid = A^+ qd``, ``phidd = A^+ qdd``.
 
         The identity (a copy relabelled ``space="actuator"``) when the robot has no
@@ -181,7 +208,7 @@ class Trajectory:
             joint_names=names, is_revolute=np.ones(A.n_in, bool),
         )
 
-    def to_joint_space(self, robot: Any) -> Trajectory:
+    def to_joint_space(self, robot: Robot) -> Trajectory:
         """Back from motor coordinates: ``q = A phi + b`` (and rates)."""
         if self.space != "actuator":
             return self
@@ -211,7 +238,7 @@ class Trajectory:
             qs.append(p.q[sl])
             qds.append(p.qd[sl])
             qdds.append(p.qdd[sl])
-            if have_pose:
+            if have_pose and p.pose is not None:
                 poses.append(p.pose[sl])
             vias.append(p.via_times + shift if p.via_times.size else
                         np.array([p.t[0] + shift, p.t[-1] + shift]))
@@ -236,7 +263,7 @@ class Trajectory:
 
     def check_limits(
         self,
-        robot: Any = None,
+        robot: Robot | None = None,
         *,
         position: npt.ArrayLike | None = None,
         velocity: npt.ArrayLike | float | None = None,
@@ -305,6 +332,7 @@ class LimitViolation:
     limit: float
 
     def __str__(self) -> str:
+        """One line: the limit, the worst value and when."""
         return (f"{self.kind} of {self.joint_name} at {self.worst:.6g} beyond "
                 f"{self.limit:.6g} from t = {self.t_start:.4f} s to {self.t_end:.4f} s")
 
@@ -329,9 +357,11 @@ class LimitReport:
         return self.ok
 
     def __len__(self) -> int:
+        """The number of violations."""
         return len(self.violations)
 
     def __iter__(self):
+        """Each violation in turn."""
         return iter(self.violations)
 
     def first(self) -> LimitViolation | None:
@@ -339,6 +369,7 @@ class LimitReport:
         return self.violations[0] if self.violations else None
 
     def __str__(self) -> str:
+        """One line per violated limit, or that none is."""
         if not self.violations:
             return "no limit violated"
         return "\n".join(str(v) for v in self.violations)
@@ -356,7 +387,7 @@ def _stretches(kind: str, bad: np.ndarray, traj: Trajectory, values: np.ndarray,
         for s, e in zip(starts, ends):
             seg = values[s:e + 1, j]
             worst = seg.min() if below else seg.max()
-            out.append(LimitViolation(kind, int(j), names[j], int(s), int(e),
+            out.append(LimitViolation(kind, int(j), names[int(j)], int(s), int(e),
                                       float(traj.t[s]), float(traj.t[e]),
                                       float(worst), float(limit[j])))
     return out

@@ -1,5 +1,7 @@
-"""What the viewers draw, independent of how: the robot's shapes over time, the
-scene's bodies, and the per-sample facts of a collision report.
+"""What the viewers draw, independent of how.
+
+The robot's shapes over time, the scene's bodies, and the per-sample facts of a
+collision report.
 
 Both the live viewer (:mod:`robokin.viz.viewer`) and the standalone HTML file
 (:mod:`robokin.viz.html`) build on these plain arrays.
@@ -370,15 +372,15 @@ def report_arrays(report: Any, m: int) -> ReportArrays:
             f"checks {t.shape[0]} samples but the trajectory has {m}: "
             "pass the report of this trajectory",
         )
-    bodies = []
+    bodies: list[tuple[int, int, str, str]] = []
     for item in getattr(report, "collisions", None) or []:
         try:
             first, last = int(item[0]), int(item[1])
         except (TypeError, ValueError, IndexError):
             continue
         colliding[max(first, 0) : min(last, m - 1) + 1] = True
-        names = tuple(str(x) for x in item[2:4]) if len(item) >= 4 else ("", "")
-        bodies.append((first, last, *names))
+        body_a, body_b = (str(item[2]), str(item[3])) if len(item) >= 4 else ("", "")
+        bodies.append((first, last, body_a, body_b))
     mask = getattr(report, "colliding", None)
     if mask is not None and np.shape(mask) == (m,):
         colliding |= np.asarray(mask, dtype=bool)

@@ -119,7 +119,7 @@ def _install() -> None:
     ws = getattr(_infra, "websockets", None)
     real_serve = getattr(getattr(getattr(ws, "asyncio", None), "server", None),
                          "serve", None)
-    if real_serve is None:
+    if ws is None or real_serve is None:
         import viser
 
         raise RobokinError(
@@ -135,7 +135,9 @@ def _install() -> None:
         return real_serve(handler, *args, **kwargs)
 
     server = _View(ws.asyncio.server, serve=serve)
-    _infra.websockets = _View(ws, asyncio=_View(ws.asyncio, server=server))
+    # a view stands in for the module: viser reads only .asyncio.server.serve
+    _infra.websockets = _View(  # type: ignore[assignment]
+        ws, asyncio=_View(ws.asyncio, server=server))
     _STATE["installed"] = True
 
 

@@ -35,7 +35,7 @@ from robokin.viz._common import (
 if TYPE_CHECKING:
     from robokin.robot import Robot
 
-__all__ = ["animation_html", "write_html"]
+__all__ = ["NotebookView", "animation_html", "notebook_view", "write_html"]
 
 _MAX_MESH_FACES = 20_000
 
@@ -101,14 +101,14 @@ def animation_html(
     if rep.distance is not None:
         keep.append(int(np.argmin(rep.distance)))
     closest = getattr(report, "closest", None)
-    if hasattr(closest, "index"):
+    if closest is not None and hasattr(closest, "index"):
         keep.append(int(closest.index))
     for first, last, *_ in rep.bodies:
         keep += [first, last]
     idx = _frame_indices(m, max(2, int(max_frames)), keep)
     q = motion.q[idx]
     sk = skeleton(robot, q)
-    track = rep.closest_at(idx)
+    track: tuple[np.ndarray, np.ndarray | None] | None = rep.closest_at(idx)
     if track is None and rep.distance is not None:
         track = (rep.distance[idx], None)
     F = idx.size
@@ -165,6 +165,69 @@ def animation_html(
         .replace("%%DATA%%", payload)
         .replace("%%SCRIPT%%", _SCRIPT)
     )
+
+
+class NotebookView:
+    """The animation page shown in a Jupyter cell (an ``<iframe srcdoc>``).
+
+    Why the standalone page and not viser's embedding: the page is the whole
+    viewer in the cell's output (data and renderer), so it works in any notebook
+    front end (JupyterLab, classic Notebook, VS Code), on a remote kernel or
+    behind a firewall, when the notebook is executed headless in CI, and after it
+    is saved and reopened with the kernel gone. Viser's embedding needs its
+    server running in the kernel and a port the browser can reach, and shows
+    nothing once the kernel stops. The iframe is sandboxed (``allow-scripts``
+    only): the page cannot reach the notebook.
+
+    Attributes:
+        page: The HTML page (:func:`animation_html`).
+        height: The cell's height [px].
+    """
+
+    def __init__(self, page: str, height: int = 480) -> None:
+        """Hold ``page`` for display at ``height`` pixels."""
+        self.page = page
+        self.height = int(height)
+
+    def _repr_html_(self) -> str:
+        """The iframe holding the page (escaped into ``srcdoc``)."""
+        doc = _html.escape(self.page, quote=True)
+        return (f'<iframe srcdoc="{doc}" sandbox="allow-scripts" width="100%" '
+                f'height="{self.height}" style="border: 1px solid #ddd"></iframe>')
+
+    def __repr__(self) -> str:
+        """A short summary (outside notebooks)."""
+        return f"NotebookView({len(self.page):,} characters, height={self.height})"
+
+
+def notebook_view(
+    robot: Robot,
+    trajectory: Any = None,
+    *,
+    scene: Any = None,
+    report: Any = None,
+    title: str | None = None,
+    height: int = 480,
+    max_frames: int = 400,
+) -> NotebookView:
+    """The 3D animation for a notebook cell: make it the cell's last expression.
+
+    Args:
+        robot: The robot.
+        trajectory: As for :func:`write_html`.
+        scene: A scene to draw, or None.
+        report: A collision report for the same samples, or None.
+        title: The title (default: the robot's name).
+        height: The cell's height [px].
+        max_frames: Longer motions are thinned to about this many frames (the
+            cell's output stays a few hundred kilobytes).
+
+    Returns:
+        A :class:`NotebookView` (Jupyter shows it through ``_repr_html_``).
+    """
+    page = animation_html(robot, trajectory, scene=scene, report=report, title=title,
+                          max_frames=max_frames)
+    return NotebookView(page, height)
 
 
 def write_html(

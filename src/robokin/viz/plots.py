@@ -9,7 +9,7 @@ Angles are drawn in degrees and lengths in millimetres unless asked otherwise.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -17,7 +17,12 @@ import numpy.typing as npt
 from robokin.exceptions import InputError
 from robokin.io.atomic import file_stem, save_figure_atomic
 
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+    from robokin.trajectory.samples import Trajectory
+
 __all__ = [
+    "place_labels",
     "plot_comparison",
     "plot_joints",
     "plot_robot",
@@ -51,6 +56,47 @@ def save_figure(fig: Any, path: str | Path, *, overwrite: bool = False,
     if path.suffix.lower() not in _FORMATS:
         raise InputError("path", f"expected a {', '.join(_FORMATS)} file, got {path.name}")
     return save_figure_atomic(fig, path, overwrite=overwrite, dpi=dpi)
+
+
+def place_labels(ax: Any, labels: list[tuple[float, float, str]], *,
+                 fontsize: float = 6.0) -> list[Any]:
+    """Write text labels at data points so that no two overlap.
+
+    Each label is centred on its point (points outside the axes' view get no
+    label); one that would overlap a label already
+    placed moves up or down (alternately, a line further each time) until it
+    overlaps none. Call it once the axes' limits and aspect are final.
+
+    Args:
+        ax: A matplotlib Axes.
+        labels: ``(x, y, text)`` per label, in data coordinates, in the order to
+            place them (earlier ones keep their place).
+        fontsize: Font size [pt].
+
+    Returns:
+        The matplotlib ``Annotation`` of each label drawn.
+    """
+    fig = ax.figure
+    fig.draw_without_rendering()  # the final layout (constrained) and aspect
+    renderer = fig.canvas.get_renderer()
+    step = fontsize * 1.3  # one line [pt]
+    placed: list[Any] = []
+    texts = []
+    for x, y, text in labels:
+        if not ax.viewLim.contains(x, y):  # outside the view: not drawn
+            continue
+        note = ax.annotate(text, (x, y), xytext=(0.0, 0.0), textcoords="offset points",
+                           fontsize=fontsize, ha="center", va="center",
+                           annotation_clip=True)
+        for k in range(1, 41):
+            box = note.get_window_extent(renderer)
+            if not any(box.overlaps(other) for other in placed):
+                break
+            shift = (k + 1) // 2 * step * (1 if k % 2 else -1)
+            note.set_position((0.0, shift))
+        placed.append(note.get_window_extent(renderer))
+        texts.append(note)
+    return texts
 
 
 Plane = Literal["xy", "xz", "yz"]
@@ -183,7 +229,7 @@ def _scales(traj, degrees: bool):
     return s, unit
 
 
-def plot_joints(traj: Any, *, path: str | Path | None = None, degrees: bool = True,
+def plot_joints(traj: Trajectory, *, path: str | Path | None = None, degrees: bool = True,
                 via: bool = True, title: str | None = None,
                 overwrite: bool = False) -> Any:
     """Joint position, velocity and acceleration over time: three panels, a line per joint.
@@ -230,13 +276,15 @@ def plot_joints(traj: Any, *, path: str | Path | None = None, degrees: bool = Tr
     return _finish(fig, path, overwrite)
 
 
-def _positions(traj: Any, robot: Any) -> np.ndarray:
-    if traj.pose is None and robot is None:
+def _positions(traj: Trajectory, robot: Robot | None) -> np.ndarray:
+    if traj.pose is not None:
+        return traj.pose[:, :3, 3]
+    if robot is None:
         raise InputError("robot", "the trajectory has no tool poses: pass the robot")
     return traj.tool_poses(robot)[:, :3, 3]
 
 
-def plot_tool_position(traj: Any, robot: Any = None, *, path: str | Path | None = None,
+def plot_tool_position(traj: Trajectory, robot: Robot | None = None, *, path: str | Path | None = None,
                        mm: bool = True, relative: bool = False,
                        title: str | None = None, overwrite: bool = False) -> Any:
     """Tool position x, y, z over time (one line each).
@@ -267,7 +315,7 @@ def plot_tool_position(traj: Any, robot: Any = None, *, path: str | Path | None 
     return _finish(fig, path, overwrite)
 
 
-def plot_tool_path(traj: Any, robot: Any = None, *, path: str | Path | None = None,
+def plot_tool_path(traj: Trajectory, robot: Robot | None = None, *, path: str | Path | None = None,
                    mm: bool = True, title: str | None = None,
                    overwrite: bool = False) -> Any:
     """Tool path in 3D, with its projections onto the XY, XZ and YZ planes.
@@ -337,7 +385,7 @@ def plot_comparison(cmp: Any, *, path: str | Path | None = None, degrees: bool =
     return _finish(fig, path, overwrite)
 
 
-def plot_robot(robot: Any, q: npt.ArrayLike, ax: Any = None, frames: bool = True, *,
+def plot_robot(robot: Robot, q: npt.ArrayLike, ax: Any = None, frames: bool = True, *,
                path: str | Path | None = None, frame_size: float | None = None,
                color: str = "C0", overwrite: bool = False) -> Any:
     """The arm at ``q`` as a 3D stick figure: link frames joined, joints dotted.

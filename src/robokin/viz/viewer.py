@@ -86,6 +86,17 @@ def _fmt_pose(T: np.ndarray) -> str:
     )
 
 
+def _pose_of(handle: Any) -> np.ndarray:
+    """The pose (4, 4) [m] of a viser scene handle (its ``wxyz`` and ``position``)."""
+    from scipy.spatial.transform import Rotation
+
+    w, x, y, z = handle.wxyz
+    T = np.eye(4)
+    T[:3, :3] = Rotation.from_quat([x, y, z, w]).as_matrix()
+    T[:3, 3] = handle.position
+    return T
+
+
 class RobotViewer:
     """A viser server showing one robot (see the module docstring).
 
@@ -123,6 +134,7 @@ class RobotViewer:
         verbose: bool = False,
         allowed_hosts: tuple[str, ...] = (),
     ) -> None:
+        """Start the viewer server and draw the robot (see the class docstring)."""
         viser = _viser()
         self.robot = robot
         traj = trajectory
@@ -181,9 +193,11 @@ class RobotViewer:
             self.close()
 
     def __enter__(self) -> RobotViewer:
+        """The viewer itself."""
         return self
 
     def __exit__(self, *exc: object) -> None:
+        """Close the viewer."""
         self.close()
 
     # ----------------------------------------------------------------- scene
@@ -308,7 +322,7 @@ class RobotViewer:
             t = self.motion.t
             with gui.add_folder("Trajectory"):
                 self._play_button = gui.add_button("Play")
-                self._time_slider = gui.add_slider(
+                self._time_slider = slider = gui.add_slider(
                     "time [s]",
                     min=float(t[0]),
                     max=float(t[-1]),
@@ -323,10 +337,10 @@ class RobotViewer:
             def _(_: Any) -> None:
                 self.set_playing(not self._playing)
 
-            @self._time_slider.on_update
+            @slider.on_update
             def _(_: Any) -> None:
                 if not self._busy:
-                    self.show_time(self._time_slider.value)
+                    self.show_time(slider.value)
 
         self._joint_sliders = []
         lim = robot.limits
@@ -366,17 +380,17 @@ class RobotViewer:
         self._target = None
         if self.free:
             T = robot.fk(self.q)
-            self._target = self.server.scene.add_transform_controls(
+            self._target = target = self.server.scene.add_transform_controls(
                 "/target",
                 scale=0.15 * self._scale,
                 wxyz=_wxyz(T[:3, :3]),
                 position=T[:3, 3],
             )
 
-            @self._target.on_update
+            @target.on_update
             def _(_: Any) -> None:
                 if not self._busy:
-                    self.snap_to_target(self._target_pose())
+                    self.snap_to_target(_pose_of(target))
 
     def _slider_q(self) -> np.ndarray:
         return np.array(
@@ -385,15 +399,6 @@ class RobotViewer:
                 for s, rev in self._joint_sliders
             ]
         )
-
-    def _target_pose(self) -> np.ndarray:
-        from scipy.spatial.transform import Rotation
-
-        w, x, y, z = self._target.wxyz
-        T = np.eye(4)
-        T[:3, :3] = Rotation.from_quat([x, y, z, w]).as_matrix()
-        T[:3, 3] = self._target.position
-        return T
 
     # --------------------------------------------------------------- drawing
     def set_configuration(self, q: Any, *, move_target: bool = False) -> None:
@@ -413,7 +418,7 @@ class RobotViewer:
                 pts = sk.points[0]
                 for h, (a, b) in zip(self._segments, self._links):
                     d = pts[b] - pts[a]
-                    h.height = float(max(np.linalg.norm(d), 1e-6))
+                    h.height = max(float(np.linalg.norm(d)), 1e-6)
                     h.wxyz = _wxyz(_rotation_z_to(d))
                     h.position = 0.5 * (pts[a] + pts[b])
                 for h, k in zip(self._balls, self._ball_index):

@@ -36,12 +36,15 @@ def test_analytic_forced_on_arm_without_closed_form_raises():
         robot.ik(robot.fk(np.zeros(7)), method="analytic")
 
 
-def test_generic_6r_is_none_with_measurements():
+def test_generic_6r_is_general_6r_with_measurements():
+    # no closed form: the general 6R elimination (issue 20), the closed forms' misses
+    # still measured
     rows = [{"a": 0.1 * (k + 1), "alpha": 0.3 + 0.2 * k, "d": 0.05 * k, "theta": 0}
             for k in range(6)]
     fam = robokin.ik.family(robokin.Robot.from_dh(rows))
-    assert fam.name == "none"
-    assert "three_parallel" in fam.reason and "spherical_wrist" in fam.reason
+    assert fam.name == "general_6r" and not fam.near
+    assert "Raghavan-Roth" in fam.measured
+    assert {"three_parallel", "spherical_wrist", "general_6r"} <= set(fam.details)
 
 
 def test_tool_and_base_are_folded_in():

@@ -97,3 +97,27 @@ def test_bad_held_joints_are_named():
         robot.ik(np.stack([T, T, T]), fixed={"joint7": [0.1, 0.2]})
     with pytest.raises(InputError, match="mapping"):
         robot.ik(T, fixed=["joint7"])
+
+
+def test_panda_with_joint7_held_is_complete_against_a_numeric_reference():
+    # every in-limit solution a dense multi-start finds on the remaining 6R chain is
+    # among ours (general_6r), and the generating configuration always is
+    from robokin.kinematics.ik import numeric
+
+    robot = robokin.load("panda")
+    rng = np.random.default_rng(3)
+    lim = robot.limits
+    reduced = fixed_ik._reduced(robot, [6], (0.0,))
+    for _ in range(3):
+        q = rng.uniform(lim[:, 0], lim[:, 1])
+        T = robot.fk(q)
+        sols = robot.ik(T, fixed={"joint7": q[6]})
+        assert sols.method == "general_6r (joint7 held)"
+        assert any(np.allclose(x, q, atol=1e-6) for x in sols)
+        moved = fixed_ik._moved_targets(robot, "last", T[None], np.array([q[6]]))[0]
+        ref = numeric.solve_all(reduced, moved, n_seeds=1500,
+                                rng=np.random.default_rng(0))
+        ours = sols.q[sols.valid & sols.within_limits][:, :6]
+        for r in ref.q[ref.valid]:
+            assert np.abs(ours - r).max(axis=1).min() < 1e-6
+        assert len(ours) == len(ref.q[ref.valid])

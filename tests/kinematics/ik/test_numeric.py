@@ -3,8 +3,6 @@ solution sets, warm-started paths, agreement with the closed forms."""
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation

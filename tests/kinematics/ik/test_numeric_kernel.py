@@ -11,8 +11,8 @@ import pytest
 
 import robokin
 from reference import pose_errors, random_q
-from robokin.exceptions import InputError
 from robokin._native import _base, kernels
+from robokin.exceptions import InputError
 from robokin.kinematics.ik import numeric
 
 K = kernels

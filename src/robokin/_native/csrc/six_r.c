@@ -345,6 +345,71 @@ static Roots shoulder(const double *P, const m3 *R, v3 p, v3 *pw)
                      P[SR_MIRROR] != 0.0, phi, cphi, sphi);
 }
 
+/* At the wrist singularity of a three-parallel arm (axes 6 and 2-4 parallel) one
+ * combination is free: theta6 turns the tool about axis 6 while theta2 + theta3 +
+ * theta4 turns back by as much (th234 = t0 + kappa th6, kappa = +-1). The wrist
+ * point then moves with th234 (axis 5 sits off axis 4), so not every theta6 leaves
+ * the elbow (subproblem 3) solvable: its right-hand side is M - Rw cos(th234 - psi),
+ * solvable where |M - Rw cos(th234 - psi)| <= |(A3, B3)|. */
+typedef struct {
+    v3 h1, h2, h5, h6, e;
+    const m3 *R;
+    double c1, s1, c5, s5, pl1, pl2, dh, w41, w42, aa, bb, c3, a3, b3;
+} WristFree;
+
+/* th234 for a given theta6 (as three_parallel_one computes it) */
+static double wrist_th234(const WristFree *f, double th6)
+{
+    v3 w = v3_rot(f->h6, cos(th6), -sin(th6), v3_rot(f->h5, f->c5, -f->s5, f->e));
+    w = v3_rot(f->h1, f->c1, -f->s1, m3_mv(f->R, w));
+    double c, s;
+    return sp1(f->h2, f->e, w, &c, &s);
+}
+
+/* The theta6 to use at the singularity: `pref` (q_near's, or 0) when the elbow is
+ * solvable there, else the solvable value nearest it (a hair inside the boundary),
+ * so a reachable pose is never answered 'out of reach'. */
+static double singular_theta6(const WristFree *f, double pref)
+{
+    double t0 = wrist_th234(f, 0.0);
+    double kappa = wrap_pi(wrist_th234(f, 0.5 * M_PI) - t0) > 0.0 ? 1.0 : -1.0;
+    double k0 = f->pl1 * f->pl1 + f->pl2 * f->pl2 + f->w41 * f->w41 + f->w42 * f->w42;
+    double M = 0.5 * (k0 + f->dh * f->dh - f->aa - f->bb) - f->c3;
+    double cx = f->pl1 * f->w41 + f->pl2 * f->w42, sx = f->pl2 * f->w41 - f->pl1 * f->w42;
+    double Rw = sqrt(cx * cx + sx * sx), S = sqrt(f->a3 * f->a3 + f->b3 * f->b3);
+    if (Rw < 1e-12 * (S + fabs(M)) || S == 0.0)
+        return pref; /* th234 does not move the wrist point */
+    double psi = atan2(sx, cx);
+    double cl = (M - S) / Rw, ch = (M + S) / Rw; /* solvable: cos(th234 - psi) in [cl, ch] */
+    if (cl > 1.0 || ch < -1.0)
+        return pref; /* unreachable for every theta6 */
+    double x = wrap_pi(t0 + kappa * pref - psi), cxp = cos(x);
+    if (cxp >= cl && cxp <= ch)
+        return pref;
+    double margin = 1e-9 * (fmin(ch, 1.0) - fmax(cl, -1.0));
+    double ends[4];
+    int m = 0;
+    if (ch < 1.0) {
+        double a = acos(ch - margin);
+        ends[m++] = a;
+        ends[m++] = -a;
+    }
+    if (cl > -1.0) {
+        double a = acos(cl + margin);
+        ends[m++] = a;
+        ends[m++] = -a;
+    }
+    double best = x, gap = INFINITY;
+    for (int i = 0; i < m; i++) {
+        double d = fabs(wrap_pi(ends[i] - x));
+        if (d < gap) {
+            gap = d;
+            best = ends[i];
+        }
+    }
+    return pref + kappa * wrap_pi(best - x); /* th234 moves by as much as kappa th6 */
+}
+
 /* Every solution of one pose T (4 x 4, row-major) of a three-parallel arm (axes 2,
  * 3, 4 parallel, axes 5, 6 meeting; IK-Geo 'three parallel, two intersecting'):
  * theta1 (subproblem 4), theta5 (subproblem 4 on h2 . R5 h6 = h2 . R1^T R06 h6),
@@ -398,6 +463,9 @@ static int three_parallel_one(const double *T, const double *P, double q6, Slots
             double th5 = r5.t[i5], c5 = r5.c[i5], s5 = r5.s[i5], th6, c6, s6;
             if (singular) {
                 th6 = P[SR_SIGN + 5] * q6 + P[SR_OFFSET + 5];
+                WristFree wf = {h1, h2, h5, h6, e, &R, c1, s1, c5, s5, pl1, pl2, dh,
+                                w41, w42, aa, bb, c3_, a3, b3};
+                th6 = singular_theta6(&wf, th6);
                 c6 = cos(th6);
                 s6 = sin(th6);
             } else {

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeGuard
 
 import numpy as np
 import numpy.typing as npt
@@ -13,13 +13,16 @@ from robokin.exceptions import InputError
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
 
+if TYPE_CHECKING:
+    from robokin.kinematics.robot_like import RobotLike
+
 __all__ = ["solve"]
 
 _METHODS = ("auto", "analytic", "numeric")
 
 
 def solve(
-    robot: Any,
+    robot: RobotLike,
     T: npt.ArrayLike,
     *,
     q_near: npt.ArrayLike | None = None,
@@ -39,27 +42,29 @@ def solve(
 
         return solve_fixed(robot, T, options.pop("fixed"), q_near=q_near, method=method,
                            **options)
-    if q_near is not None and not _plain_joints(q_near, robot.n):
-        q_near = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
+    qn: npt.NDArray[np.float64] | None = None
+    if q_near is not None:
+        qn = (q_near if _plain_joints(q_near, robot.n)
+              else check_finite(check_joints(q_near, robot.n, "q_near"), "q_near"))
     if (not options and type(T) is np.ndarray and T.shape == (4, 4)
             and T.dtype == np.float64 and method != "numeric"):
         # hot path: one pose, a 6R closed form, default options (one compiled call
         # validates the pose and solves it)
         single = _single_solver(robot)
-        if single is not None and (q_near is None or q_near.shape == (6,)):
-            out = single(T, 0.0 if q_near is None else float(q_near[5]))
+        if single is not None and (qn is None or qn.shape == (6,)):
+            out = single(T, 0.0 if qn is None else float(qn[5]))
             if out is not None:
                 return out
     T = check_poses_fast(T, "T")
-    if q_near is not None and q_near.ndim > 1:
-        _check_q_near_batch(q_near, T.shape[:-2] + (robot.n,))
+    if qn is not None and qn.ndim > 1:
+        _check_q_near_batch(qn, T.shape[:-2] + (robot.n,))
     if method in ("auto", "analytic"):
         from robokin.kinematics.ik.analytic.detect import detect
 
         fam = detect(robot)
         if fam.solver is not None:
             try:
-                return fam.solver(robot, T, q_near=q_near, **options)
+                return fam.solver(robot, T, q_near=qn, **options)
             except TypeError as exc:
                 # an option the closed form does not take: name it, never a TypeError
                 if "unexpected keyword argument" not in str(exc):
@@ -76,12 +81,15 @@ def solve(
             )
     from robokin.kinematics.ik.numeric import solve_all
 
-    return solve_all(robot, T, q_near=q_near, **options)
+    return solve_all(robot, T, q_near=qn, **options)
 
 
 def _check_q_near_batch(q_near: np.ndarray, target: tuple[int, ...]) -> None:
-    """Raise InputError unless a batched ``q_near`` broadcasts to ``target``
-    (the pose batch + (n,)) without growing it: every solver reads it that way."""
+    """Raise InputError unless a batched ``q_near`` broadcasts to ``target``.
+
+    ``target`` is the pose batch + (n,); ``q_near`` must broadcast to it without
+    growing it: every solver reads it that way.
+    """
     try:
         ok = np.broadcast_shapes(q_near.shape, target) == target
     except ValueError:
@@ -92,9 +100,11 @@ def _check_q_near_batch(q_near: np.ndarray, target: tuple[int, ...]) -> None:
         )
 
 
-def _single_solver(robot: Any) -> Any:
-    """The family's single-pose hot path (``_six_r.make_single``), or None; cached
-    per chain."""
+def _single_solver(robot: RobotLike) -> Any:
+    """The family's single-pose hot path (``_six_r.make_single``), or None.
+
+    Cached per chain.
+    """
     def build() -> Any:
         from robokin.kinematics.ik.analytic.detect import detect
 
@@ -103,9 +113,12 @@ def _single_solver(robot: Any) -> Any:
     return cached(robot.chain, "ik_single", build)
 
 
-def _plain_joints(q: Any, n: int) -> bool:
-    """True for a float64 array of shape (n,) with finite values: what the full
-    ``check_joints`` / ``check_finite`` would return unchanged (a cheap test for the
-    single-pose path; anything else gets the full checks)."""
+def _plain_joints(q: object, n: int) -> TypeGuard[npt.NDArray[np.float64]]:
+    """True for a float64 array of shape (n,) with finite values.
+
+    That is what the full ``check_joints`` / ``check_finite`` would return
+    unchanged (a cheap test for the single-pose path; anything else gets the
+    full checks).
+    """
     return (type(q) is np.ndarray and q.shape == (n,) and q.dtype == np.float64
             and math.isfinite(sum(q.tolist())))

@@ -16,7 +16,7 @@ the first). Otherwise each distinct value gets its own reduced chain (cached).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -25,12 +25,16 @@ from robokin._validation import check_finite, check_poses_fast
 from robokin.exceptions import InputError
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
+from robokin.model.chain import joint_motion
+
+if TYPE_CHECKING:
+    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["solve_fixed"]
 
 
 def solve_fixed(
-    robot: Any,
+    robot: RobotLike,
     T: npt.ArrayLike,
     fixed: Mapping[str, npt.ArrayLike],
     *,
@@ -101,7 +105,7 @@ def solve_fixed(
     return _assemble(robot, lead, idx, keep, V, parts, dict(zip(fixed, values)))
 
 
-def _end_joint(robot: Any, idx: list[int]) -> str | None:
+def _end_joint(robot: RobotLike, idx: list[int]) -> str | None:
     """"first" / "last" when one held coordinate is the chain's first / last joint."""
     chain = robot.chain
     if len(idx) != 1 or not chain.coupling.is_identity:
@@ -113,31 +117,18 @@ def _end_joint(robot: Any, idx: list[int]) -> str | None:
     return None
 
 
-def _joint_move(robot: Any, j: int, v: np.ndarray) -> np.ndarray:
-    """J_j(sign * v) for values v (N,): (N, 4, 4)."""
-    joint = robot.chain.joints[j]
-    x = joint.sign * v
-    out = np.broadcast_to(np.eye(4), v.shape + (4, 4)).copy()
-    if joint.kind == "revolute":
-        c, s = np.cos(x), np.sin(x)
-        out[:, 0, 0], out[:, 0, 1], out[:, 1, 0], out[:, 1, 1] = c, -s, s, c
-    else:
-        out[:, 2, 3] = x
-    return out
-
-
-def _moved_targets(robot: Any, end: str, T: np.ndarray, v: np.ndarray) -> np.ndarray:
+def _moved_targets(robot: RobotLike, end: str, T: np.ndarray, v: np.ndarray) -> np.ndarray:
     """The targets of the reduced chain (held value 0) that equal T at value v."""
     C = robot.chain.arrays.consts
     if end == "last":
         j = robot.n - 1
         Cn = C[-1]
-        return T @ np.linalg.inv(Cn) @ _joint_move(robot, j, -v) @ Cn
+        return T @ np.linalg.inv(Cn) @ joint_motion(robot.chain.joints[j].kind, -robot.chain.joints[j].sign * v) @ Cn
     C0 = C[0]
-    return C0 @ _joint_move(robot, 0, -v) @ np.linalg.inv(C0) @ T
+    return C0 @ joint_motion(robot.chain.joints[0].kind, -robot.chain.joints[0].sign * v) @ np.linalg.inv(C0) @ T
 
 
-def _reduced(robot: Any, idx: list[int], values: tuple[float, ...]) -> Any:
+def _reduced(robot: RobotLike, idx: list[int], values: tuple[float, ...]) -> Any:
     """The robot of the remaining coordinates (cached per chain and held values)."""
     key = ("fixed", tuple(idx), values)
 
@@ -145,12 +136,15 @@ def _reduced(robot: Any, idx: list[int], values: tuple[float, ...]) -> Any:
         held = ", ".join(f"{robot.joint_names[j]}={v:g}" for j, v in zip(idx, values,
                                                                           strict=True))
         chain = robot.chain.with_fixed(dict(zip(idx, values, strict=True)))
-        return type(robot)(chain, name=f"{robot.name} ({held} held)")
+        # a bare robot of the same class: the chain and a name, nothing per link or
+        # per joint of the whole arm (geometry, actuators, dynamics, rate limits)
+        make: Any = type(robot)
+        return make(chain, name=f"{robot.name} ({held} held)")
 
     return cached(robot.chain, key, build)
 
 
-def _assemble(robot: Any, lead: tuple[int, ...], idx: list[int], keep: list[int],
+def _assemble(robot: RobotLike, lead: tuple[int, ...], idx: list[int], keep: list[int],
               V: np.ndarray, parts: list[tuple[np.ndarray, SolutionSet]],
               fixed: dict[str, np.ndarray]) -> SolutionSet:
     N = V.shape[0]

@@ -10,7 +10,7 @@ it fails). Failure is a status with a reason, never an exception.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -19,13 +19,17 @@ from robokin._validation import check_finite, check_joints
 from robokin.exceptions import InputError
 from robokin.kinematics.ik.numeric import IKResult
 
+if TYPE_CHECKING:
+    from robokin.kinematics.ik.solutions import SolutionSet
+    from robokin.kinematics.robot_like import RobotLike
+
 __all__ = ["solve_near"]
 
 _METHODS = ("auto", "analytic", "numeric")
 
 
 def solve_near(
-    robot: Any,
+    robot: RobotLike,
     T: npt.ArrayLike,
     q_near: npt.ArrayLike,
     *,
@@ -76,7 +80,7 @@ def solve_near(
     return _nearest(robot, sols, T, q_near)
 
 
-def _nearest(robot: Any, sols: Any, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
+def _nearest(robot: RobotLike, sols: SolutionSet, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
     """The row of ``sols`` nearest ``q_near`` per pose, inside the limits, as a result."""
     from robokin._native import kernels
 
@@ -119,6 +123,6 @@ def _nearest(robot: Any, sols: Any, T: npt.ArrayLike, q_near: np.ndarray) -> IKR
                     rotation_error=err[:, 1].reshape(lead))
 
 
-def _why(sols: Any) -> np.ndarray:
+def _why(sols: SolutionSet) -> np.ndarray:
     """Per pose: why it has no solution inside the limits (its status)."""
     return np.asarray(sols.keep_within_limits().status, dtype=object)

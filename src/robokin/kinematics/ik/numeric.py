@@ -1,4 +1,4 @@
-"""Numeric inverse kinematics for any chain: damped least squares with limits and restarts.
+r"""Numeric inverse kinematics for any chain: damped least squares with limits and restarts.
 
 The solver works on the canonical chain (:mod:`robokin.model.chain`), so every arm
 gets it: revolute and prismatic joints, reversed axes, dependent joints
@@ -6,9 +6,9 @@ gets it: revolute and prismatic joints, reversed axes, dependent joints
 
 .. math::
 
-    e = \\begin{bmatrix} p_t - p(q) \\\\ \\log(R_t R(q)^T)^\\vee \\end{bmatrix},
-    \\qquad
-    \\Delta q = J_w^T (J_w J_w^T + \\lambda I)^{-1} W^{1/2} e
+    e = \begin{bmatrix} p_t - p(q) \\ \log(R_t R(q)^T)^\vee \end{bmatrix},
+    \qquad
+    \Delta q = J_w^T (J_w J_w^T + \lambda I)^{-1} W^{1/2} e
 
 (or the joint-space form when fewer joints than task rows), with
 ``J_w = W^{1/2} J`` restricted to the selected task rows, ``lambda = mu * E``
@@ -47,7 +47,7 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -57,6 +57,10 @@ from robokin._validation import check_finite, check_joints, check_transform
 from robokin.exceptions import InputError
 from robokin.kinematics.per_chain import cached
 from robokin.model.chain import Chain
+
+if TYPE_CHECKING:
+    from robokin.kinematics.ik.solutions import SolutionSet
+    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["IKPathResult", "IKResult", "ik_path", "parse_mask", "solve", "solve_all"]
 
@@ -103,14 +107,14 @@ class IKResult:
     (n,), ``reason`` a str, ``iterations`` an int).
     """
 
-    q: np.ndarray
-    success: np.ndarray
-    error: np.ndarray
-    iterations: np.ndarray
-    restarts: np.ndarray
-    reason: np.ndarray
-    position_error: np.ndarray
-    rotation_error: np.ndarray
+    q: npt.NDArray[np.float64]
+    success: npt.NDArray[np.bool_] | np.bool_
+    error: npt.NDArray[np.float64] | float
+    iterations: npt.NDArray[np.int64] | int
+    restarts: npt.NDArray[np.int64] | int
+    reason: npt.NDArray[np.object_] | str
+    position_error: npt.NDArray[np.float64] | float
+    rotation_error: npt.NDArray[np.float64] | float
 
     def __bool__(self) -> bool:
         """True when every target converged."""
@@ -395,7 +399,7 @@ def _targets(T: npt.ArrayLike) -> tuple[np.ndarray, tuple[int, ...]]:
 def _bad_input(out: np.ndarray, n: int, Tf: np.ndarray, Q0: np.ndarray,
                lead: tuple[int, ...], i: int, per: int = 1) -> InputError:
     if out[i, n + K.R_CODE] == K.CODE_BAD_Q0:
-        return check_finite(Q0, "q0")  # raises, naming the index
+        check_finite(Q0, "q0")  # raises, naming the index
     return _bad_target(Tf, lead, i // per)
 
 
@@ -410,7 +414,7 @@ def _bad_target(Tf: np.ndarray, lead: tuple[int, ...], i: int) -> InputError:
 
 # ------------------------------------------------------------------------- solve
 def solve(
-    robot: Any,
+    robot: RobotLike,
     T: npt.ArrayLike,
     *,
     q0: npt.ArrayLike | None = None,
@@ -588,13 +592,13 @@ _SOLVE_ALL_OPTIONS = frozenset(
 
 
 def solve_all(
-    robot: Any,
+    robot: RobotLike,
     T: npt.ArrayLike,
     *,
     q_near: npt.ArrayLike | None = None,
     n_seeds: int = 16,
     **options: Any,
-):
+) -> SolutionSet:
     """The distinct solutions that descents from many seeds find, as a SolutionSet.
 
     Every target gets ``n_seeds`` independent descents (from ``q_near`` first when
@@ -618,7 +622,7 @@ def solve_all(
             ``dedupe_tol`` [rad, m].
 
     Returns:
-        A :class:`~robokin.kinematics.ik.solutions.SolutionSet` with
+        The solution set (:class:`~robokin.kinematics.ik.solutions.SolutionSet`),
         ``method="numeric"``; per-pose ``status`` says why a pose has none.
 
     Raises:
@@ -735,7 +739,7 @@ def _mask_names(opts: np.ndarray) -> str:
 
 # -------------------------------------------------------------------------- ik_path
 def ik_path(
-    robot: Any,
+    robot: RobotLike,
     T_path: npt.ArrayLike,
     q_start: npt.ArrayLike,
     *,

@@ -18,8 +18,8 @@ A batch iterates (and ``len`` counts) its poses, each a one-pose set.
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass, field, replace
-from typing import Any
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -28,12 +28,15 @@ from robokin._validation import check_finite, check_joints
 from robokin.exceptions import InputError, UnreachableError
 from robokin.spatial import wrap_angle
 
+if TYPE_CHECKING:
+    from robokin.kinematics.robot_like import RobotLike
+
 __all__ = ["SolutionSet", "wrap_angle"]
 
 STATUS_OK = "ok"
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False)
 class SolutionSet:
     """Every IK solution found for a batch of target poses.
 
@@ -57,46 +60,87 @@ class SolutionSet:
         info: Extra solver facts (e.g. the near-family residual).
     """
 
-    q: np.ndarray
-    valid: np.ndarray
-    is_revolute: np.ndarray
-    limits: np.ndarray
-    flags: dict[str, np.ndarray] = field(default_factory=dict)
-    branches: dict[str, np.ndarray] = field(default_factory=dict)
-    status: np.ndarray | None = None
-    method: str = ""
-    error: np.ndarray | None = None
-    info: dict[str, Any] = field(default_factory=dict)
+    q: npt.NDArray[np.float64]
+    valid: npt.NDArray[np.bool_]
+    is_revolute: npt.NDArray[np.bool_]
+    limits: npt.NDArray[np.float64]
+    flags: dict[str, npt.NDArray[np.bool_]]
+    branches: dict[str, npt.NDArray[np.integer[Any]]]
+    status: npt.NDArray[np.object_]
+    method: str
+    error: npt.NDArray[np.float64] | None
+    info: dict[str, Any]
 
-    def __post_init__(self) -> None:
-        q = np.asarray(self.q, dtype=np.float64)
-        valid = np.asarray(self.valid, dtype=bool)
+    def __init__(
+        self,
+        q: npt.ArrayLike,
+        valid: npt.ArrayLike,
+        is_revolute: npt.ArrayLike,
+        limits: npt.ArrayLike,
+        flags: dict[str, npt.NDArray[np.bool_]] | None = None,
+        branches: dict[str, npt.NDArray[np.integer[Any]]] | None = None,
+        status: npt.ArrayLike | None = None,
+        method: str = "",
+        error: npt.NDArray[np.float64] | None = None,
+        info: dict[str, Any] | None = None,
+    ) -> None:
+        """Check the shapes; NaN the rows that are not valid; fill in the defaults.
+
+        Args:
+            q: Joint solutions [rad, m], shape (..., k, n).
+            valid: Which rows are solutions, bool, shape (..., k).
+            is_revolute: Which coordinates are angles, bool, shape (n,).
+            limits: Joint limits [rad, m], shape (n, 2).
+            flags: Per-solution flags (..., k); ``"within_limits"`` is computed
+                (and added to this dict) when missing.
+            branches: Per-solution integer labels (..., k) by name.
+            status: Per-pose status (...); ``"ok"`` where a pose has a valid row,
+                else ``"no solution"``, when None.
+            method: Which solver produced the set.
+            error: FK error of each solution (..., k), or None.
+            info: Extra solver facts.
+
+        Raises:
+            ValueError: ``q`` and ``valid`` disagree in shape.
+        """
+        q = np.asarray(q, dtype=np.float64)
+        valid = np.asarray(valid, dtype=bool)
         if q.shape[:-1] != valid.shape:
             raise ValueError(f"q {q.shape} and valid {valid.shape} disagree")
         if not valid.all():
             q = np.where(valid[..., None], q, np.nan)
-        object.__setattr__(self, "q", q)
-        object.__setattr__(self, "valid", valid)
-        object.__setattr__(self, "is_revolute", np.asarray(self.is_revolute, dtype=bool))
-        object.__setattr__(self, "limits", np.asarray(self.limits, dtype=np.float64))
-        if "within_limits" not in self.flags:
-            lim = self.limits
-            inside = ((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9)).all(axis=-1)
-            self.flags["within_limits"] = inside
-        if self.status is None:
+        lim = np.asarray(limits, dtype=np.float64)
+        flags = {} if flags is None else flags
+        if "within_limits" not in flags:
+            inside = (q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9)
+            flags["within_limits"] = np.all(inside, axis=-1)
+        if status is None:
             st = np.where(valid.any(axis=-1), STATUS_OK, "no solution")
-            object.__setattr__(self, "status", np.asarray(st, dtype=object))
+            status = np.asarray(st, dtype=object)
+        init = object.__setattr__
+        init(self, "q", q)
+        init(self, "valid", valid)
+        init(self, "is_revolute", np.asarray(is_revolute, dtype=bool))
+        init(self, "limits", lim)
+        init(self, "flags", flags)
+        init(self, "branches", {} if branches is None else branches)
+        init(self, "status", status)
+        init(self, "method", method)
+        init(self, "error", error)
+        init(self, "info", {} if info is None else info)
 
     @classmethod
     def _trusted(cls, q: np.ndarray, valid: np.ndarray, is_revolute: np.ndarray,
                  limits: np.ndarray, flags: dict[str, np.ndarray],
                  branches: dict[str, np.ndarray], status: np.ndarray, method: str,
                  error: np.ndarray | None, info: dict[str, Any]) -> SolutionSet:
-        """Build a set from arrays already in final form (float64 ``q``, bool masks,
-        a ``within_limits`` flag, an object ``status``) without conversions or
-        checks: the hot path of the closed forms. Callers pass fresh arrays (or
+        """Build a set from arrays already in final form, without conversions or checks.
+
+        Final form: float64 ``q``, bool masks, a ``within_limits`` flag, an object
+        ``status``; the hot path of the closed forms. Callers pass fresh arrays (or
         read-only shared ones), never buffers they reuse; rows of ``q`` that are
-        not valid are set to NaN here (in place)."""
+        not valid are set to NaN here (in place).
+        """
         q[~valid] = np.nan
         self = object.__new__(cls)
         self.__dict__.update(q=q, valid=valid, is_revolute=is_revolute, limits=limits,
@@ -136,8 +180,10 @@ class SolutionSet:
 
     @property
     def within_limits(self) -> np.ndarray:
-        """(..., k) bool, solutions inside every joint limit (see
-        :meth:`keep_within_limits` for the set of those alone)."""
+        """(..., k) bool, solutions inside every joint limit.
+
+        See :meth:`keep_within_limits` for the set of those alone.
+        """
         return self.flags["within_limits"] & self.valid
 
     def __len__(self) -> int:
@@ -262,7 +308,8 @@ class SolutionSet:
 
     def nearest_each(
         self, q_current: npt.ArrayLike, *, respect_limits: bool = True
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_] | np.bool_,
+               npt.NDArray[np.object_]]:
         """Like :meth:`nearest`, without raising for poses that have no solution.
 
         Returns:
@@ -291,7 +338,7 @@ class SolutionSet:
                 & self.is_revolute)
         q = np.where(keep, shifted, best)
         if not found.all():
-            q = np.where(found[..., None], q, np.nan)
+            q = np.where(np.expand_dims(found, -1), q, np.nan)
         return q, found, status
 
     def expand_turns(self) -> SolutionSet:
@@ -339,12 +386,12 @@ class SolutionSet:
             error=None if self.error is None else sel(rep(self.error)),
         )
 
-    def to_actuator_space(self, robot: Any) -> SolutionSet:
+    def to_actuator_space(self, robot: RobotLike) -> SolutionSet:
         """The same set in motor coordinates (limits checked in both spaces)."""
-        if robot.actuators is None:
+        lim = robot.actuator_limits
+        if robot.actuators is None or lim is None:  # limits come with the map
             return self
         phi = robot.actuators.inverse(self.q, what=f"actuator map of '{robot.name}'")
-        lim = robot.actuator_limits
         inside = self.flags["within_limits"] & (
             (phi >= lim[:, 0] - 1e-9) & (phi <= lim[:, 1] + 1e-9)
         ).all(axis=-1)
@@ -355,7 +402,48 @@ class SolutionSet:
         return replace(self, q=phi, flags=flags, is_revolute=is_rev, limits=lim,
                        info={**self.info, "space": "actuator"})
 
+    def _repr_html_(self) -> str:
+        """Jupyter: one pose's solutions with branches and flags; a batch summarised.
+
+        One pose: a row per valid solution (degrees for angles, mm for lengths),
+        its branch labels and flags. A batch: the poses, how many have k
+        solutions, the statuses; never more than a few kilobytes.
+        """
+        from collections import Counter
+
+        from robokin import _html
+
+        title = f"SolutionSet [{self.method}]"
+        if self.shape:
+            counts = Counter(self.count.reshape(-1).tolist())
+            status = Counter(str(v) for v in np.asarray(self.status).reshape(-1))
+            return _html.box(
+                f"{title}: {int(np.prod(self.shape)):,} poses, shape {self.shape}",
+                _html.table(["solutions per pose", "poses"], sorted(counts.items())),
+                _html.table(["status", "poses"], status.most_common(),
+                            right=[False, True]))
+        q = self.q[self.valid]
+        scale = np.where(self.is_revolute, 180.0 / np.pi, 1000.0)
+        unit = ["deg" if r else "mm" for r in self.is_revolute]
+        flags = {k: v[self.valid] for k, v in self.flags.items()}
+        branches = {k: np.asarray(v)[self.valid] for k, v in self.branches.items()}
+        rows = []
+        for i in range(len(q)):
+            fl = [k for k, v in flags.items() if k != "within_limits" and v[i]]
+            if not flags.get("within_limits", np.ones(len(q), bool))[i]:
+                fl.append("outside limits")
+            rows.append([i + 1, *(q[i] * scale),
+                         " ".join(f"{k} {'+' if v[i] > 0 else '-'}"
+                                  for k, v in branches.items()) or "-",
+                         ", ".join(fl) or "-"])
+        st = self.status.item() if isinstance(self.status, np.ndarray) else self.status
+        return _html.box(
+            f"{title}: {len(q)} solution(s), status {st}",
+            _html.table(["#", *(f"q{j + 1} [{u}]" for j, u in enumerate(unit)),
+                         "branch", "flags"], rows, max_rows=32))
+
     def __repr__(self) -> str:
+        """A short summary: poses, solutions per pose, method."""
         if not self.shape:
             st = self.status.item() if isinstance(self.status, np.ndarray) else self.status
             return (f"SolutionSet({int(self.count)} solution(s), method={self.method!r}, "

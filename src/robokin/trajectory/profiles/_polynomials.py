@@ -1,5 +1,7 @@
-"""Cubic and quintic rest-to-rest profiles (``s = 3 tau^2 - 2 tau^3`` and
-``10 tau^3 - 15 tau^4 + 6 tau^5``)."""
+"""Cubic and quintic rest-to-rest profiles.
+
+``s = 3 tau^2 - 2 tau^3`` and ``s = 10 tau^3 - 15 tau^4 + 6 tau^5``.
+"""
 
 from __future__ import annotations
 

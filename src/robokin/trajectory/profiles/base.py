@@ -1,4 +1,4 @@
-"""The time-scaling profile: a rest-to-rest curve ``s(tau)`` from 0 to 1 on ``tau`` in [0, 1].
+r"""The time-scaling profile: a rest-to-rest curve ``s(tau)`` from 0 to 1 on ``tau`` in [0, 1].
 
 A profile shapes *when* a motion covers its path, not *where* it goes. A joint
 segment is ``q(t) = q0 + (q1 - q0) s(t / T)``; a Cartesian segment moves its tool
@@ -6,8 +6,8 @@ along a line by the same ``s``. In physical time, for a duration ``T``:
 
 .. math::
 
-    \\dot s(t) = s'(\\tau) / T, \\qquad \\ddot s(t) = s''(\\tau) / T^2,
-    \\qquad \\tau = t / T.
+    \dot s(t) = s'(\tau) / T, \qquad \ddot s(t) = s''(\tau) / T^2,
+    \qquad \tau = t / T.
 
 So a joint that travels ``D`` peaks at ``|qd| = C_v D / T`` and ``|qdd| = C_a D /
 T^2``, with the profile's coefficients ``C_v = max |s'|`` and ``C_a = max |s''|``;
@@ -33,8 +33,9 @@ __all__ = ["Profile", "positive_limits"]
 
 
 def positive_limits(x: npt.ArrayLike, n: int, name: str) -> np.ndarray:
-    """A speed / acceleration limit, scalar or (n,), as (n,) positive floats
-    (``inf`` allowed: no limit).
+    """A speed / acceleration limit, scalar or (n,), as (n,) positive floats.
+
+    ``inf`` is allowed: no limit.
 
     Raises:
         InputError: not numbers, wrong length, NaN, zero or negative.
@@ -112,12 +113,15 @@ class Profile(ABC):
         return T
 
     def __repr__(self) -> str:
+        """The class name and parameters."""
         return f"{type(self).__name__}()"
 
     def __eq__(self, other: object) -> bool:
+        """Profiles of one class with the same parameters are equal."""
         return type(self) is type(other) and repr(self) == repr(other)
 
     def __hash__(self) -> int:
+        """Hash of the representation (profiles are equal by it)."""
         return hash(repr(self))
 
 

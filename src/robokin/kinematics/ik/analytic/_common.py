@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from robokin._native import kernels as _K
 from robokin.kinematics.ik.solutions import SolutionSet
@@ -12,20 +13,24 @@ from robokin.kinematics.ik.solutions import SolutionSet
 __all__ = ["STATUS_TEXT", "fit_turns", "fk_error", "make_set", "q_near_rows"]
 
 # Status code -> text. Codes 0-2 are those the 6R kernels return (csrc/six_r.c);
-# the SCARA and palletizer closed forms use them too. 3: palletizer, 4: near.polish.
+# the SCARA and palletizer closed forms use them too. 3: palletizer, 4: near.polish,
+# 5: general_6r (csrc/general6r.c).
 _STATUS = {
     _K.STATUS_OK: "ok",
     _K.STATUS_OUT_OF_REACH: "out of reach",
     _K.STATUS_NO_ORIENTATION: "orientation not achievable",
     3: "not reachable: tool cannot tilt",
     4: "near-family Newton polish did not converge",
+    5: "no solution: the general 6R elimination is degenerate at this pose",
 }
 STATUS_TEXT = np.array([_STATUS[k] for k in range(len(_STATUS))], dtype=object)
 
 
 def fit_turns(q: np.ndarray, is_revolute: np.ndarray, limits: np.ndarray) -> np.ndarray:
-    """Wrap revolute values into [-pi, pi), then move them by whole turns into their
-    limits where that is possible (prismatic values are left alone)."""
+    """Revolute values wrapped into [-pi, pi), then by whole turns into their limits.
+
+    Prismatic values are left alone; a value no turn brings inside stays wrapped.
+    """
     tw = 2.0 * np.pi
     w = (q + np.pi) % tw - np.pi
     lo, hi = limits[:, 0], limits[:, 1]
@@ -37,9 +42,9 @@ def fit_turns(q: np.ndarray, is_revolute: np.ndarray, limits: np.ndarray) -> np.
     return np.where(is_revolute, w, q)
 
 
-def inside_limits(q: np.ndarray, limits: np.ndarray) -> np.ndarray:
+def inside_limits(q: np.ndarray, limits: np.ndarray) -> npt.NDArray[np.bool_]:
     """(..., k) bool: every coordinate within its limits (1e-9 slack)."""
-    return ((q >= limits[:, 0] - 1e-9) & (q <= limits[:, 1] + 1e-9)).all(axis=-1)
+    return np.asarray(((q >= limits[:, 0] - 1e-9) & (q <= limits[:, 1] + 1e-9)).all(axis=-1))
 
 
 def q_near_rows(q_near: Any, lead: tuple[int, ...], n: int) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""The chain as a product of exponentials: joint axes and points at zero joint value.
+r"""The chain as a product of exponentials: joint axes and points at zero joint value.
 
 With every chain joint value ``v_k = 0`` (``J_k`` the identity) the frame just before
 joint ``k`` is ``P_k = C_0 C_1 ... C_{k-1}``; its z axis is the joint's unit axis
@@ -6,7 +6,7 @@ joint ``k`` is ``P_k = C_0 C_1 ... C_{k-1}``; its z axis is the joint's unit axi
 
 .. math::
 
-    T(v) = e^{\\hat\\xi_1 v_1} \\cdots e^{\\hat\\xi_n v_n} M, \\qquad M = T(v = 0),
+    T(v) = e^{\hat\xi_1 v_1} \cdots e^{\hat\xi_n v_n} M, \qquad M = T(v = 0),
 
 so a revolute joint rotates everything after it about the line ``(o_k, h_k)`` and a
 prismatic one translates it along ``h_k``. Base and tool transforms are inside ``C_0``

@@ -111,8 +111,10 @@ def pack(chain: Any, kind: Kind, *, singular_tol: float = 1e-9,
 
 def raw_solve(params: np.ndarray, T: np.ndarray,
               qn: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
-    """The bare kernel call: T (N, 4, 4) contiguous float64 -> (Q (N, 8, 6), valid,
-    singular, within_limits (N, 8), status (N,) int8). No input checks.
+    """The bare kernel call, without input checks.
+
+    T (N, 4, 4) contiguous float64 -> (Q (N, 8, 6), valid, singular, within_limits
+    (N, 8), status (N,) int8).
 
     ``singular`` and ``within_limits`` are False on rows that are not valid.
     Batches of ``_PARALLEL_MIN`` poses or more run on the kernels' thread pool.
@@ -152,7 +154,7 @@ def make_single(chain: Any, params: np.ndarray, *, method: str,
 
     def single(T: np.ndarray, q6: float) -> SolutionSet | None:
         code, Q, valid, sing, inside = solve1(T, params, q6)
-        if code >= bad:
+        if code >= bad or Q is None or valid is None or sing is None or inside is None:
             return None
         return trusted(Q, valid, is_rev, limits,
                        {"within_limits": inside, "singular": sing}, dict(labels),

@@ -14,7 +14,13 @@ Families, tried in this order:
 * ``spherical_wrist``: 6R, axes 2/3 parallel, axes 4-6 meet (Puma, KUKA, ABB...);
 * ``scara``: 3 revolute + 1 prismatic, all axes parallel;
 * ``palletizer``: 4 coordinates on 5 revolute chain joints, a parallelogram keeping
-  the tool level (QFMD010).
+  the tool level (QFMD010);
+* ``general_6r``: every other arm of six revolute joints without dependent joints,
+  and the near-family 6R arms: Raghavan-Roth elimination (``general_6r``), taken
+  when its per-arm set-up finds an elimination variant that solves its test poses
+  completely. Near-family arms go to it rather than to the nominal closed form +
+  Newton polish because that misses solutions the calibration error moves away
+  from the nominal ones (measured in ``docs/ik.md``).
 
 Detection is cached per chain (chains are immutable).
 """
@@ -23,16 +29,20 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from robokin.kinematics.ik.analytic import general_6r as _g6
 from robokin.kinematics.ik.analytic import palletizer as _pal
 from robokin.kinematics.ik.analytic import scara as _scara
 from robokin.kinematics.ik.analytic import spherical_wrist as _sw
 from robokin.kinematics.ik.analytic import three_parallel as _tp
 from robokin.kinematics.ik.analytic._geometry import poe_from_chain
 from robokin.kinematics.per_chain import cached
+
+if TYPE_CHECKING:
+    from robokin.kinematics.ik.analytic._six_r import Kind
 
 __all__ = ["Family", "detect"]
 
@@ -47,7 +57,7 @@ class Family:
 
     Attributes:
         name: ``"three_parallel"``, ``"spherical_wrist"``, ``"scara"``,
-            ``"palletizer"``, or ``"none"``.
+            ``"palletizer"``, ``"general_6r"``, or ``"none"``.
         solver: ``solver(robot, T, q_near=None, **options) -> SolutionSet``, or
             None when no closed form applies.
         reason: Why no closed form applies ("" when one does).
@@ -68,6 +78,7 @@ class Family:
     details: dict[str, str] = field(default_factory=dict)
 
     def __str__(self) -> str:
+        """One line: the family and what was measured, or why there is none."""
         if self.solver is None:
             return f"none: {self.reason}"
         tag = " (near family: closed form + Newton polish)" if self.near else ""
@@ -77,7 +88,7 @@ class Family:
 
 
 def detect(robot: Any, *, tol: float = EXACT_TOL, near_angle: float = NEAR_ANGLE,
-           near_distance: float = NEAR_DISTANCE) -> Family:
+           near_distance: float = NEAR_DISTANCE, general_6r: bool = True) -> Family:
     """The closed-form family of ``robot`` (a Robot or a Chain).
 
     Args:
@@ -85,13 +96,16 @@ def detect(robot: Any, *, tol: float = EXACT_TOL, near_angle: float = NEAR_ANGLE
         tol: Angle [rad] / distance [m] within which the structure is exact.
         near_angle: Angle [rad] within which the arm is a near-family member.
         near_distance: Distance [m] within which axes count as nearly meeting.
+        general_6r: Offer the general 6R solver (default); False gives a
+            near-family arm its nominal closed form + Newton polish and other 6R
+            arms no family.
 
     Returns:
         A :class:`Family`.
     """
     chain = getattr(robot, "chain", robot)
-    return cached(chain, ("ik_family", tol, near_angle, near_distance),
-                  lambda: _detect(chain, tol, near_angle, near_distance))
+    return cached(chain, ("ik_family", tol, near_angle, near_distance, general_6r),
+                  lambda: _detect(chain, tol, near_angle, near_distance, general_6r))
 
 
 def _none(reason: str, details: dict[str, str] | None = None) -> Family:
@@ -107,15 +121,18 @@ def _grade(ang: float, dist: float, tol: float, near_angle: float,
     return None
 
 
-def _detect(chain: Any, tol: float, near_angle: float, near_distance: float) -> Family:
+def _detect(chain: Any, tol: float, near_angle: float, near_distance: float,
+            general_6r: bool = True) -> Family:
     nc, n = chain.n_chain, chain.n
     poe = poe_from_chain(chain)
     n_pri = int(poe.prismatic.sum())
     if nc == 6 and n == 6:
         if n_pri:
-            return _none("a 6-joint arm with a prismatic joint: no closed form here")
+            return _none("a 6-joint arm with a prismatic joint: no closed form here, and "
+                         + _g6.why_not(chain))
         if not chain.coupling.is_identity:
-            return _none("a 6R arm with dependent joints: no closed form here")
+            return _none("a 6R arm with dependent joints: no closed form here, and "
+                         + _g6.why_not(chain))
         found = []
         details = {}
         for mod in (_tp, _sw):
@@ -127,14 +144,23 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float) -> 
             grade = _grade(ang, dist, tol, near_angle, near_distance)
             if grade is not None:
                 found.append((grade != "exact", max(ang, dist), mod, text))
-        if not found:
-            return _none(
-                "6R arm without three parallel axes (2-4) with meeting axes 5, 6, and "
-                "without a spherical wrist with parallel axes 2, 3: "
-                + "; ".join(f"{k}: {v}" for k, v in details.items()), details)
         found.sort(key=lambda f: (f[0], f[1]))
-        is_near, dev, mod, text = found[0]
-        return _six_r_family(chain, poe, mod.NAME, text, is_near, dev, details)
+        if found and not found[0][0]:  # an exact closed form
+            _, dev, mod, text = found[0]
+            return _six_r_family(chain, poe, mod.NAME, text, False, dev, details)
+        if general_6r:
+            general = _general_6r_family(chain, details)
+            if general.solver is not None:
+                return general
+            details = general.details
+        if found:  # near family: the nominal closed form + Newton polish
+            _, dev, mod, text = found[0]
+            return _six_r_family(chain, poe, mod.NAME, text, True, dev, details)
+        return _none(
+            "6R arm without three parallel axes (2-4) with meeting axes 5, 6, without "
+            "a spherical wrist with parallel axes 2, 3, and not solved by the general "
+            "6R elimination: " + "; ".join(f"{k}: {v}" for k, v in details.items()),
+            details)
     if nc == 4 and n == 4:
         if n_pri != 1 or not chain.coupling.is_identity:
             return _none(f"a 4-joint arm with {n_pri} prismatic joint(s): the SCARA "
@@ -157,10 +183,10 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float) -> 
         if why or ang > tol:
             return _none(f"not a level-tool palletizer: {text}"
                          + (f" ({why})" if why else ""), {"palletizer": text})
-        g = _pal.geometry(chain, poe)
+        pal = _pal.geometry(chain, poe)
 
         def pal_solver(robot, T, q_near=None, **options):
-            return _pal.solve_geometry(robot, g, T, **options)
+            return _pal.solve_geometry(robot, pal, T, **options)
 
         return Family("palletizer", pal_solver, measured=text, deviation=ang,
                       details={"palletizer": text})
@@ -171,7 +197,26 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float) -> 
     )
 
 
-def _six_r_family(chain: Any, poe: Any, name: str, text: str, near: bool, dev: float,
+def _general_6r_family(chain: Any, details: dict[str, str]) -> Family:
+    """The general 6R solver when its set-up works for ``chain``.
+
+    Else a "none" family whose details say why.
+    """
+    setup = _g6.setup(chain)
+    details = dict(details)
+    if setup.params is None:
+        details[_g6.NAME] = setup.reason
+        return _none(setup.reason, details)
+    details[_g6.NAME] = setup.measured
+
+    def general_solver(robot, T, q_near=None, **options):
+        return _g6.solve(robot, T, q_near, **options)
+
+    general_solver.single = _g6.make_single(chain)  # type: ignore[attr-defined]
+    return Family(_g6.NAME, general_solver, measured=setup.measured, details=details)
+
+
+def _six_r_family(chain: Any, poe: Any, name: Kind, text: str, near: bool, dev: float,
                   details: dict[str, str]) -> Family:
     from robokin.kinematics.ik.analytic._six_r import make_single, pack, solve_six_r
 

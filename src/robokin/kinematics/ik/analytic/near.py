@@ -11,18 +11,21 @@ converge to the same solution are merged.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robokin.kinematics.ik.analytic._common import fit_turns, fk_error, inside_limits
 from robokin.spatial import pose_error, wrap_angle
 
+if TYPE_CHECKING:
+    from robokin.kinematics.robot_like import RobotLike
+
 __all__ = ["polish"]
 
 
 def polish(
-    robot: Any,
+    robot: RobotLike,
     T: np.ndarray,
     Q: np.ndarray,
     valid: np.ndarray,

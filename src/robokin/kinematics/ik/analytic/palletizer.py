@@ -26,7 +26,7 @@ yaw.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -37,6 +37,10 @@ from robokin.kinematics.ik.analytic._geometry import (
     unit_perpendicular,
 )
 from robokin.kinematics.ik.analytic.scara import _align_angle, _elbow_angles, _rot
+
+if TYPE_CHECKING:
+    from robokin.kinematics.robot_like import RobotLike
+    from robokin.model.chain import Chain
 
 __all__ = ["measure", "pose_from_position_yaw"]
 
@@ -59,7 +63,7 @@ class PalletizerGeometry:
     back: np.ndarray  # (n, n_chain) pseudo-inverse of the coupling matrix
 
 
-def _analyse(chain: Any, poe: Poe) -> tuple[PalletizerGeometry | None, float, str, str]:
+def _analyse(chain: Chain, poe: Poe) -> tuple[PalletizerGeometry, float, str, str]:
     h, o = poe.h, poe.o
     sign, off = chain.arrays.sign, chain.arrays.offset
     Mc, c = chain.coupling.matrix, chain.coupling.offset
@@ -94,13 +98,13 @@ def _analyse(chain: Any, poe: Poe) -> tuple[PalletizerGeometry | None, float, st
     return g, ang, text, "; ".join(why)
 
 
-def measure(chain: Any, poe: Poe) -> tuple[float, float, str, str]:
+def measure(chain: Chain, poe: Poe) -> tuple[float, float, str, str]:
     """Deviation from the family: (angle [rad], 0, text, why-not)."""
     _, ang, text, why = _analyse(chain, poe)
     return ang, 0.0, text, why
 
 
-def geometry(chain: Any, poe: Poe) -> PalletizerGeometry:
+def geometry(chain: Chain, poe: Poe) -> PalletizerGeometry:
     """The nominal palletizer geometry of a chain."""
     return _analyse(chain, poe)[0]
 
@@ -110,10 +114,12 @@ def level_rotation(g: PalletizerGeometry) -> np.ndarray:
     return g.Rc @ g.M[:3, :3]
 
 
-def pose_from_position_yaw(robot: Any, xyz: Any, yaw: Any) -> np.ndarray:
-    """The level target pose(s) (..., 4, 4) at position ``xyz`` (..., 3) [m] with the
-    tool turned by ``yaw`` (...) [rad] about the waist axis from its zero-yaw
-    orientation."""
+def pose_from_position_yaw(robot: RobotLike, xyz: Any, yaw: Any) -> np.ndarray:
+    """The level target pose(s) (..., 4, 4) at a position with a yaw.
+
+    The tool sits at ``xyz`` (..., 3) [m], turned by ``yaw`` (...) [rad] about
+    the waist axis from its zero-yaw orientation.
+    """
     from robokin.kinematics.ik.analytic._geometry import poe_from_chain
 
     g = geometry(robot.chain, poe_from_chain(robot.chain))
@@ -129,7 +135,7 @@ def pose_from_position_yaw(robot: Any, xyz: Any, yaw: Any) -> np.ndarray:
     return T
 
 
-def solve_geometry(robot: Any, g: PalletizerGeometry, T: np.ndarray, *,
+def solve_geometry(robot: RobotLike, g: PalletizerGeometry, T: np.ndarray, *,
                    level_tol: float = 1e-9, compute_error: bool = False,
                    method: str = "analytic:palletizer", info: dict | None = None):
     """Every solution (up to 4) for poses T (..., 4, 4)."""

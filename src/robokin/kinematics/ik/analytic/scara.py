@@ -16,7 +16,7 @@ from the upper arm (a right-handed arm seen along ``-h``), -1 otherwise.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -26,6 +26,9 @@ from robokin.kinematics.ik.analytic._geometry import (
     angle_between_axes,
     unit_perpendicular,
 )
+
+if TYPE_CHECKING:
+    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["measure"]
 
@@ -49,7 +52,7 @@ class ScaraGeometry:
 
     h: np.ndarray
     e: np.ndarray
-    rev: tuple[int, int, int]
+    rev: tuple[int, ...]  # the three revolute coordinates
     pri: int
     s: np.ndarray
     o: np.ndarray
@@ -76,7 +79,10 @@ def _elbow_angles(h, a, b, d):
     """Paden-Kahan subproblem 3: angles v with |a + rot(h, v) b| = |d|.
 
     Args:
-        h: Unit axis (3,). a, b: Link vectors (3,). d: Targets (..., 3).
+        h: Unit axis, shape (3,).
+        a: First link vector [m], shape (3,).
+        b: Second link vector [m], shape (3,).
+        d: Targets [m], shape (..., 3).
 
     Returns:
         ``(v (..., 2), disc (...), r2)``: both roots (equal when ``disc`` = 0),
@@ -95,13 +101,16 @@ def _elbow_angles(h, a, b, d):
 
 
 def _align_angle(h, u, d):
-    """Paden-Kahan subproblem 1: the angle about ``h`` taking ``u`` onto ``d``'s
-    direction (components along ``h`` ignored); broadcasts over leading axes."""
+    """Paden-Kahan subproblem 1: the angle about ``h`` taking ``u`` towards ``d``.
+
+    Onto ``d``'s direction, components along ``h`` ignored; broadcasts over
+    leading axes.
+    """
     return np.arctan2(np.einsum("...i,...i", d, np.cross(h, u)),
                       np.einsum("...i,...i", d, u) - (u @ h) * (d @ h))
 
 
-def solve_geometry(robot: Any, g: ScaraGeometry, T: np.ndarray, *,
+def solve_geometry(robot: RobotLike, g: ScaraGeometry, T: np.ndarray, *,
                    orientation_tol: float = 1e-9, compute_error: bool = False,
                    method: str = "analytic:scara", info: dict | None = None):
     """Every solution (up to 2) for poses T (..., 4, 4)."""

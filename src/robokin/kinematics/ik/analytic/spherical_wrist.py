@@ -20,7 +20,6 @@ References:
 
 from __future__ import annotations
 
-
 import numpy as np
 
 from robokin.kinematics.ik.analytic._geometry import (

@@ -22,8 +22,6 @@ References:
 
 from __future__ import annotations
 
-
-
 from robokin.kinematics.ik.analytic._geometry import (
     Poe,
     angle_between_axes,

@@ -1,0 +1,368 @@
+"""The general 6R solver (issue 20): completeness against an independent multi-start
+reference, FK round trips, batches, threads, the root finder, and bad input."""
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import robokin
+from robokin import _native
+from robokin.exceptions import InputError
+from robokin.kinematics.ik import numeric
+from robokin.kinematics.ik.analytic import general_6r
+from robokin.kinematics.ik.analytic.detect import detect
+
+K = _native.kernels
+IRB140 = Path(__file__).parents[2] / "data" / "urdf" / "irb140.urdf"
+MATCH_TOL = 1e-5  # [rad] same solution (a near-singular numeric one is this loose)
+
+
+# ----------------------------------------------------------------------- arms
+def random_dh_arm(rng, name="random_6r"):
+    rows = [{"joint": "revolute", "a": rng.uniform(-0.5, 0.5), "d": rng.uniform(-0.5, 0.5),
+             "alpha": rng.uniform(-np.pi, np.pi), "theta": rng.uniform(-np.pi, np.pi),
+             "limits": [-np.pi, np.pi]} for _ in range(6)]
+    return robokin.Robot.from_dh(rows, name=name)
+
+
+def ur_twisted(twist=0.05, offset=0.02):
+    """UR5's DH table with a twisted forearm (alpha_3 = twist) and the wrist offset
+    by ``offset`` along a_5: no closed form applies."""
+    rows = [{"d": 0.089159, "alpha": math.pi / 2}, {"a": -0.425},
+            {"a": -0.39225, "alpha": twist}, {"d": 0.10915, "alpha": math.pi / 2},
+            {"d": 0.09465, "a": offset, "alpha": -math.pi / 2}, {"d": 0.0823}]
+    for r in rows:
+        r.setdefault("a", 0.0)
+        r.setdefault("d", 0.0)
+        r.setdefault("alpha", 0.0)
+        r.update(joint="revolute", theta=0.0, limits=[-2 * np.pi, 2 * np.pi])
+    return robokin.Robot.from_dh(rows, name="ur5_twisted")
+
+
+def irb140():
+    return robokin.Robot.from_urdf(IRB140, geometry=False)
+
+
+def open_limits(robot):
+    """The same arm with every joint in [-pi, pi] (the reference searches all of them)."""
+    chain = robot.chain
+    joints = tuple(dataclasses.replace(j, limits=(-np.pi, np.pi)) for j in chain.joints)
+    return robot.replace(chain=chain.replace(joints=joints, coordinates=joints))
+
+
+# ------------------------------------------------------------------- helpers
+def wrapped(d):
+    return (d + np.pi) % (2 * np.pi) - np.pi
+
+
+def not_in(a, b, tol=MATCH_TOL):
+    """Rows of a (k, 6) with no row of b within tol (angles modulo 2 pi)."""
+    if len(b) == 0:
+        return a
+    d = np.abs(wrapped(a[:, None, :] - b[None, :, :])).max(axis=-1)
+    return a[(d >= tol).all(axis=1)]
+
+
+def multistart_reference(robot, T, seed, n_seeds=800):
+    """Distinct solutions that dense LM descents from random starts reach."""
+    ref = numeric.solve_all(open_limits(robot), T, n_seeds=n_seeds,
+                            rng=np.random.default_rng(seed))
+    return ref.q[ref.valid]
+
+
+def assert_round_trip(robot, T, sols, tol=1e-9):
+    """Every valid row reproduces its pose to tol (m and rad entries of the 4x4)."""
+    q = sols.q[sols.valid]
+    Tb = np.broadcast_to(T[..., None, :, :], sols.q.shape[:-1] + (4, 4))[sols.valid]
+    err = np.abs(robot.fk(q) - Tb).max(axis=(-2, -1)) if len(q) else np.zeros(0)
+    assert (err < tol).all(), err.max()
+
+
+def assert_generating_found(q, sols, tol=1e-6):
+    gap = np.where(sols.valid, np.abs(wrapped(sols.q - q[:, None, :])).max(axis=-1),
+                   np.inf).min(axis=-1)
+    assert (gap < tol).all(), np.flatnonzero(gap >= tol)
+
+
+# -------------------------------------------------------------- completeness
+@pytest.mark.parametrize(
+    ("arm", "seed"),
+    [("random", 1), ("random", 2), ("random", 3), ("irb140", 4), ("ur_twisted", 5)],
+)
+def test_every_solution_of_a_dense_multistart_and_no_other(arm, seed):
+    rng = np.random.default_rng(seed)
+    robot = {"random": lambda: random_dh_arm(rng), "irb140": irb140,
+             "ur_twisted": ur_twisted}[arm]()
+    assert robokin.ik.family(robot).name == "general_6r"
+    for k in range(2):
+        q = rng.uniform(-np.pi, np.pi, 6)
+        T = robot.fk(q)
+        sols = robot.ik(T)
+        assert sols.method == "general_6r"
+        ours = sols.solutions()
+        ref = multistart_reference(robot, T, seed=10 * seed + k)
+        assert len(ref) >= 1
+        assert len(not_in(ref, ours)) == 0, "missing solutions"
+        assert len(not_in(ours, ref)) == 0, "solutions the reference does not have"
+        assert_round_trip(robot, T, sols)
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560"])
+def test_exact_family_arms_give_the_closed_form_sets(name):
+    # an independent oracle: on arms with a closed form the elimination (forced)
+    # must give the closed form's solutions, away from the wrist singularity
+    robot = robokin.load(name)
+    rng = np.random.default_rng(8)
+    q = rng.uniform(-np.pi, np.pi, (60, 6))
+    q[:, 4] = rng.uniform(0.3, 2.8, 60) * rng.choice([-1, 1], 60)
+    T = robot.fk(q)
+    ours = general_6r.solve(robot, T)
+    closed = robot.ik(T)
+    assert closed.method.startswith("analytic:")
+    for i in range(len(q)):
+        a, b = ours.q[i][ours.valid[i]], closed.q[i][closed.valid[i]]
+        assert len(not_in(a, b)) == 0 and len(not_in(b, a)) == 0, i
+
+
+def test_generating_configuration_always_found_and_round_trip():
+    for robot in (irb140(), ur_twisted(), random_dh_arm(np.random.default_rng(11))):
+        rng = np.random.default_rng(12)
+        q = rng.uniform(-np.pi, np.pi, (400, 6))
+        T = robot.fk(q)
+        sols = robot.ik(T)
+        assert (sols.status == "ok").all()
+        assert sols.q.shape == (400, 16, 6)
+        assert (sols.count <= 16).all()
+        assert_round_trip(robot, T, sols)
+        assert_generating_found(q, sols)
+        # distinct modulo 2 pi
+        for i in range(0, 400, 37):
+            s = sols[i].solutions()
+            d = np.abs(wrapped(s[:, None] - s[None])).max(-1)
+            assert (d[~np.eye(len(s), dtype=bool)] > 1e-6).all()
+
+
+def test_near_family_arm_is_solved_at_least_as_completely_as_its_closed_form():
+    # a calibrated UR5 (the near-family test's arm): general_6r by default; it has
+    # every solution the nominal closed form + Newton finds
+    rows = [{"a": 0, "alpha": math.pi / 2, "d": 0.089159},
+            {"a": -0.425, "alpha": 0, "d": 0}, {"a": -0.39225, "alpha": 0, "d": 0},
+            {"a": 0, "alpha": math.pi / 2, "d": 0.10915},
+            {"a": 0, "alpha": -math.pi / 2, "d": 0.09465},
+            {"a": 0, "alpha": 0, "d": 0.0823}]
+    rng = np.random.default_rng(5)
+    for row in rows:
+        row["alpha"] += rng.normal(0, 1e-3)
+        row["theta"] = rng.normal(0, 1e-3)
+    robot = robokin.Robot.from_dh(rows, name="ur5_calibrated")
+    assert robokin.ik.family(robot).name == "general_6r"
+    near = detect(robot, general_6r=False)
+    assert near.near and near.name == "three_parallel"
+    q = rng.uniform(-np.pi, np.pi, (200, 6))
+    T = robot.fk(q)
+    ours, theirs = robot.ik(T), near.solver(robot, T)
+    assert_generating_found(q, ours)
+    for i in range(200):
+        assert len(not_in(theirs.q[i][theirs.valid[i]], ours.q[i][ours.valid[i]])) == 0
+
+
+# ------------------------------------------------------- batches and threads
+def test_batch_equals_loop_of_single_calls():
+    robot = irb140()
+    rng = np.random.default_rng(21)
+    q = rng.uniform(-np.pi, np.pi, (2, 20, 6))
+    T = robot.fk(q)
+    batch = robot.ik(T)
+    assert batch.shape == (2, 20)
+    for i in range(2):
+        for j in range(20):
+            one = robot.ik(T[i, j])
+            np.testing.assert_array_equal(one.valid, batch.valid[i, j])
+            np.testing.assert_array_equal(one.q, batch.q[i, j])
+            np.testing.assert_array_equal(one.singular, batch.singular[i, j])
+
+
+def test_thread_count_does_not_change_results():
+    robot = ur_twisted()
+    T = robot.fk(np.random.default_rng(22).uniform(-np.pi, np.pi, (300, 6)))
+    before = _native.num_threads()
+    try:
+        _native.set_num_threads(1)
+        one = general_6r.solve(robot, T, parallel=True)
+        _native.set_num_threads(2)
+        two = general_6r.solve(robot, T, parallel=True)
+        serial = general_6r.solve(robot, T, parallel=False)
+    finally:
+        _native.set_num_threads(before)
+    for other in (two, serial):
+        np.testing.assert_array_equal(one.valid, other.valid)
+        np.testing.assert_array_equal(one.q, other.q)
+
+
+# ---------------------------------------------------------- flags and order
+def test_singular_flag_is_the_jacobians_smallest_singular_value():
+    robot = irb140()
+    T = robot.fk(np.random.default_rng(23).uniform(-np.pi, np.pi, (100, 6)))
+    tol = 0.05  # large enough that some solutions are flagged
+    sols = general_6r.solve(robot, T, singular_tol=tol)
+    q = sols.q[sols.valid]
+    smin = np.linalg.svd(robot.jacobian(q), compute_uv=False)[:, -1]
+    flagged = sols.singular[sols.valid]
+    clear = np.abs(smin - tol) > 1e-6 * tol
+    assert flagged.any() and not flagged.all()
+    np.testing.assert_array_equal(flagged[clear], smin[clear] < tol)
+    assert not sols.singular[~sols.valid].any()
+
+
+def test_limits_q_near_and_the_single_pose_path():
+    robot = irb140()  # joints 2, 3, 5 narrower than a turn, joints 4, 6 wider
+    rng = np.random.default_rng(24)
+    q = rng.uniform(-np.pi, np.pi, (40, 6))
+    T = robot.fk(q)
+    sols = robot.ik(T)
+    lim = robot.limits
+    inside = ((sols.q >= lim[:, 0] - 1e-9) & (sols.q <= lim[:, 1] + 1e-9)).all(-1)
+    np.testing.assert_array_equal(sols.flags["within_limits"], inside & sols.valid)
+    assert inside.any() and not inside[sols.valid].all()
+    # revolute values in [-pi, pi) unless a whole turn puts them into the limits
+    shifted = (sols.q < -np.pi) | (sols.q >= np.pi)
+    assert not (shifted & ~inside[..., None])[sols.valid].any()
+    # q_near changes nothing: the solutions are isolated (SolutionSet.nearest picks)
+    near = robot.ik(T, q_near=q)
+    np.testing.assert_array_equal(near.q, sols.q)
+    np.testing.assert_allclose(wrapped(near.nearest(q, respect_limits=False) - q), 0.0,
+                               atol=1e-7)
+    # the single-pose path gives the batch's rows
+    for i in range(0, 40, 7):
+        one = robot.ik(T[i])
+        assert one.method == "general_6r" and one.shape == ()
+        np.testing.assert_array_equal(one.q, sols.q[i])
+        np.testing.assert_array_equal(one.flags["within_limits"],
+                                      sols.flags["within_limits"][i])
+        assert one.status == sols.status[i]
+
+
+def test_unreachable_pose_has_no_solution_and_says_so():
+    robot = ur_twisted()
+    far = np.eye(4)
+    far[:3, 3] = [3.0, 0.0, 0.0]
+    sols = robot.ik(np.stack([far, robot.fk(np.zeros(6))]))
+    assert sols.count[0] == 0 and sols.count[1] >= 1
+    assert sols.status[0] == "out of reach" and sols.status[1] == "ok"
+
+
+# ------------------------------------------------------------- root finder
+def _match(a, b):
+    return np.abs(a[:, None] - b[None, :]).min(axis=1).max()
+
+
+def test_polynomial_roots_agree_with_numpy():
+    rng = np.random.default_rng(31)
+    for _ in range(300):
+        deg = int(rng.integers(1, 17))
+        c = rng.normal(size=deg + 1)
+        wr, wi = np.empty(deg), np.empty(deg)
+        assert K.general6r_roots(c, wr, wi)
+        ours, ref = wr + 1j * wi, np.roots(c[::-1])
+        tol = 1e-7 * (1.0 + np.abs(ref).max())
+        assert _match(ours, ref) < tol and _match(ref, ours) < tol
+        # conjugate pairs stay pairs
+        np.testing.assert_allclose(np.sort_complex(ours), np.sort_complex(ours.conj()))
+
+
+def test_clustered_roots_as_accurate_as_numpy():
+    # a cluster of three within 1e-4 and a complex pair: ill-conditioned roots whose
+    # errors depend on rounding; over many polynomials ours are LAPACK's size
+    rng = np.random.default_rng(32)
+    ours_err, np_err = [], []
+    for _ in range(400):
+        deg = int(rng.integers(5, 17))
+        r = rng.normal(size=deg).astype(complex)
+        r[1:3] = r[0] + 1e-4 * rng.normal(size=2)
+        r[3] = complex(rng.normal(), 2.0)
+        r[4] = r[3].conjugate()
+        c = np.real(np.poly(r))[::-1].copy()
+        wr, wi = np.empty(deg), np.empty(deg)
+        assert K.general6r_roots(c, wr, wi)
+        ours, ref = wr + 1j * wi, np.roots(c[::-1])
+        ours_err.append(max(_match(r, ours), _match(ours, r)))
+        np_err.append(max(_match(r, ref), _match(ref, r)))
+    assert np.median(ours_err) < 2 * np.median(np_err)
+    assert max(ours_err) < 2 * max(np_err)
+
+
+def test_polynomial_roots_of_an_even_polynomial_with_double_roots():
+    # the determinant of a spherical-wrist arm's split: every root double and +-
+    # paired, which stalls EISPACK's original exceptional shifts
+    r = np.array([0.47, 0.55 + 0.36j, 0.55 - 0.36j, 1.14 + 0.56j, 1.14 - 0.56j, 1.8])
+    r = np.concatenate([r, -r])
+    c = np.real(np.poly(np.repeat(r, 2)))[::-1].copy()
+    wr, wi = np.empty(24), np.empty(24)
+    assert K.general6r_roots(c, wr, wi)
+    assert _match(r, wr + 1j * wi) < 1e-5
+
+
+# ------------------------------------------------------------------- errors
+def test_prismatic_and_dependent_joints_are_not_offered():
+    rows = [{"joint": "revolute", "a": 0.1, "alpha": 0.5, "d": 0.1}] * 5 + [
+        {"joint": "prismatic", "a": 0.0, "alpha": 0.0, "theta": 0.3, "limits": [0, 1]}]
+    robot = robokin.Robot.from_dh(rows)
+    fam = robokin.ik.family(robot)
+    assert fam.name == "none" and "prismatic" in fam.reason
+    assert "revolute" in general_6r.why_not(robot.chain)
+    with pytest.raises(InputError, match="robot.*prismatic"):
+        general_6r.solve(robot, robot.fk(np.full(6, 0.2)))
+    panda = robokin.load("panda")
+    assert "six joints" in general_6r.why_not(panda.chain)
+
+
+def test_arm_no_variant_solves_is_not_offered_and_says_why():
+    # several consecutive axes meet and axes 3, 4 are parallel: every elimination
+    # has a rank-deficient right side or det Sigma = 0 (docs/ik.md, limits)
+    h = math.pi / 2
+    rows = [{"a": 0.0, "d": -0.285, "alpha": -h, "theta": 2.35},
+            {"a": -0.368, "d": 0.445, "alpha": 0.4381, "theta": -2.228},
+            {"a": 0.0, "d": 0.052, "alpha": 0.0, "theta": 2.413},
+            {"a": 0.07, "d": 0.0, "alpha": -h, "theta": -1.637},
+            {"a": 0.0, "d": -0.032, "alpha": -h, "theta": 1.579},
+            {"a": 0.0, "d": 0.0, "alpha": 0.0, "theta": -2.369}]
+    robot = robokin.Robot.from_dh(rows)
+    fam = robokin.ik.family(robot)
+    assert fam.name == "none" and fam.solver is None
+    assert "general_6r: no elimination variant finds every solution" in fam.reason
+    assert general_6r.setup(robot.chain).params is None
+    sols = robot.ik(robot.fk(np.full(6, 0.3)))  # the numeric fallback
+    assert sols.method == "numeric" and sols.count >= 1
+
+
+def test_bad_pose_and_option_raise_input_errors():
+    robot = ur_twisted()
+    bad = np.eye(4)
+    bad[0, 0] = 2.0
+    with pytest.raises(InputError, match="T"):
+        robot.ik(bad)
+    with pytest.raises(InputError, match="banana"):
+        robot.ik(np.eye(4), banana=1)
+    # the module's own entry checks what it is given too
+    with pytest.raises(InputError, match="T"):
+        general_6r.solve(robot, bad)
+    T = robot.fk(np.zeros((3, 6)))
+    with pytest.raises(InputError, match="q_near"):
+        general_6r.solve(robot, T, q_near=np.zeros((2, 6)))
+    with pytest.raises(InputError, match="q_near"):
+        general_6r.solve(robot, T, q_near=np.full(6, np.nan))
+
+
+def test_kernel_rejects_inconsistent_arguments():
+    robot = ur_twisted()
+    g = general_6r.setup(robot.chain)
+    T = np.ascontiguousarray(robot.fk(np.zeros((2, 6))))
+    with pytest.raises(ValueError, match="params"):
+        general_6r.raw_solve(robot.chain, g.params[:-1], T)
+    with pytest.raises(ValueError, match="chain"):
+        general_6r.raw_solve(robokin.load("panda").chain, g.params, T)
+    with pytest.raises(ValueError, match="degree"):
+        K.general6r_roots(np.array([1.0, 0.0]), np.empty(2), np.empty(2))

@@ -1,0 +1,248 @@
+"""Issue 19, item 7: a CLI that never hides a number.
+
+Tables never cut a value: plain text when stdout is not a terminal, ``--format
+csv|json`` on request, folded (not cut) cells in a narrow terminal; units stay in
+help texts; ``--near`` takes n values; ``show`` uses one set of units for every
+arm; ``traj --force`` reruns and never leaves half its outputs; the press views'
+labels do not overlap.
+"""
+
+import csv
+import io
+import json
+import os
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import robokin
+from robokin.cli import main
+
+IK = ["ik", "ur5", "0.4", "0.1", "0.3", "0", "3.14", "0"]
+
+
+def run(capsys, *args):
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def _ik_solutions():
+    from robokin.spatial import pose_from_xyz_rpy
+
+    r = robokin.load("ur5")
+    sols = r.ik(pose_from_xyz_rpy(np.array([0.4, 0.1, 0.3]), np.array([0, 3.14, 0])))
+    return sols.q[sols.valid]
+
+
+def test_ik_in_a_narrow_pipe_prints_every_digit():
+    """The issue's example: 80 columns, a pipe: no '…', every value in full."""
+    env = {**os.environ, "COLUMNS": "80"}
+    env.pop("FORCE_COLOR", None)
+    env.pop("TTY_COMPATIBLE", None)
+    res = subprocess.run([sys.executable, "-m", "robokin", *IK], capture_output=True,
+                         text=True, timeout=120, env=env)
+    assert res.returncode == 0, res.stderr
+    assert "…" not in res.stdout and "┃" not in res.stdout
+    rows = [ln.split() for ln in res.stdout.splitlines() if ln[:1].isdigit()]
+    assert len(rows) == 8
+    shown = np.array([[float(v) for v in row[1:7]] for row in rows])
+    for q in _ik_solutions():  # each solution appears, to the printed 6 decimals
+        assert np.min(np.max(np.abs(shown - q), axis=1)) < 5e-7
+
+
+def test_ik_csv_is_full_precision_and_json_agrees(capsys):
+    code, out, _ = run(capsys, *IK, "--format", "csv")
+    assert code == 0
+    rows = list(csv.reader(io.StringIO(out)))
+    assert rows[0][:3] == ["#", "q1 [rad]", "q2 [rad]"] and len(rows) == 9
+    q_csv = np.array([[float(v) for v in row[1:7]] for row in rows[1:]])
+    code, out, _ = run(capsys, *IK, "--format", "json")
+    q_json = np.array([s["q"] for s in json.loads(out)["solutions"]])
+    np.testing.assert_array_equal(q_csv, q_json)  # repr round-trips: bit-equal
+    code, out, _ = run(capsys, *IK, "--json")
+    assert json.loads(out)["solutions"][0]["q"] == q_json[0].tolist()
+
+
+def test_json_and_another_format_contradict(capsys):
+    code, _, err = run(capsys, *IK, "--json", "--format", "csv")
+    assert code == 2 and "--format" in err
+
+
+def test_a_narrow_terminal_folds_cells_instead_of_cutting(capsys, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "60")
+    monkeypatch.setenv("TTY_COMPATIBLE", "1")  # rich: stdout is a terminal
+    monkeypatch.delenv("NO_COLOR", raising=False)
+    code, out, _ = run(capsys, *IK, "--format", "table")
+    assert code == 0
+    plain = re.sub(r"\x1b\[[0-9;]*m", "", out)
+    assert "…" not in plain
+    assert max(len(ln) for ln in plain.splitlines()) <= 60
+
+
+def test_a_folded_cell_keeps_every_character(capsys, monkeypatch):
+    from robokin.cli_output import Column, OutputTable, emit
+
+    monkeypatch.setenv("COLUMNS", "12")
+    monkeypatch.setenv("TTY_COMPATIBLE", "1")
+    monkeypatch.setenv("NO_COLOR", "1")
+    value = -1.2345678901234567
+    emit(OutputTable("", [Column("q", fmt=repr)], [[value]]), "table")
+    out = re.sub(r"\x1b\[[0-9;]*m", "", capsys.readouterr().out)
+    lines = [ln.strip() for ln in out.splitlines() if ln.strip() not in ("", "q")
+             and "─" not in ln]
+    assert len(lines) > 1 and "".join(lines) == repr(value)
+
+
+URDF = os.path.join(os.path.dirname(__file__), "data", "urdf", "ur5.urdf")
+
+
+@pytest.mark.parametrize("cmd", [["robots"], ["show", "panda"],
+                                 ["motors", "scara", "0", "0", "0", "0.1"],
+                                 ["dh", URDF, "--mm"]])
+def test_every_table_command_has_csv_and_text(capsys, cmd):
+    code, out, _ = run(capsys, *cmd, "--format", "csv")
+    assert code == 0 and "…" not in out
+    assert list(csv.reader(io.StringIO(out)))[0]
+    code, out, _ = run(capsys, *cmd)  # captured stdout: not a terminal
+    assert code == 0 and "…" not in out and "━" not in out
+
+
+def test_robots_never_cut_a_source(capsys):
+    code, out, _ = run(capsys, "robots", "--format", "csv")
+    assert code == 0
+    sources = {row[0]: row[2] for row in list(csv.reader(io.StringIO(out)))[1:]}
+    assert sources["aubo_i5"] == robokin.load("aubo_i5").source
+
+
+def test_help_keeps_units_in_brackets():
+    """rich ate '[mm]': help texts are shown as written, for every command."""
+    from typer.testing import CliRunner
+
+    from robokin.cli import _register_extra_commands, app
+
+    _register_extra_commands()
+    runner = CliRunner()
+    res = runner.invoke(app, ["demo", "--help"], env={"COLUMNS": "200"})
+    assert "Required clearance [mm]." in res.output
+    res = runner.invoke(app, ["check", "--help"], env={"COLUMNS": "200"})
+    assert "t [s],<joint> [rad]" in res.output and "\\[" not in res.output
+    import typer.main
+
+    group = typer.main.get_command(app)
+    for name, cmd in group.commands.items():
+        res = runner.invoke(app, [name, "--help"], env={"COLUMNS": "250"})
+        assert res.exit_code == 0, name
+        for p in cmd.params:
+            raw = (getattr(p, "help", None) or "").replace("\\[", "[")
+            for part in raw.split():
+                if part.startswith("[") and "]" in part:
+                    assert part.rstrip(".,);") in res.output, (name, p.name, part)
+
+
+def test_near_takes_one_value_per_joint(capsys):
+    q0 = _ik_solutions()[0]
+    near = [f"{v:.4f}" for v in q0]
+    # after the pose, before it, and as one quoted token (comma or space)
+    for args in ([*IK, "--near", *near], [*IK[:2], "--near", *near, *IK[2:]],
+                 [*IK, "--near", ",".join(near)], [*IK[:3], "--near", *near, *IK[3:]]):
+        code, out, err = run(capsys, *args, "--format", "json")
+        assert code == 0, (args, err)
+        np.testing.assert_allclose(json.loads(out)["solutions"][0]["q"], q0, atol=1e-9)
+    code, _, err = run(capsys, *IK, "--near", "0", "0")
+    assert code == 2 and "--near needs 6 values, got 2" in err
+
+
+def test_show_uses_mm_and_degrees_for_every_arm(capsys):
+    for name, row, key, value in (("panda", 1, "alpha", -90.0),
+                                  ("panda", 0, "d", 333.0),
+                                  ("ur5", 0, "d", 89.159),
+                                  ("scara", 3, "d", -150.0)):
+        code, out, _ = run(capsys, "show", name, "--format", "json")
+        assert code == 0
+        doc = json.loads(out)
+        assert doc["units"] == {"length": "mm", "angle": "deg"}
+        dh = doc["tables"][0]
+        got = dh["rows"][row][dh["columns"].index(key)]
+        assert got == pytest.approx(value, abs=1e-9), (name, key)
+    code, out, _ = run(capsys, "show", "panda")
+    assert "(lengths mm, angles deg)" in out and "1.5707963" not in out
+
+
+MOTION = """\
+robot: ur5
+units: {length: mm, angle: deg}
+start: [0, -90, 90, 0, 90, 0]
+segments:
+  - joint: [10, -80, 80, 0, 90, 0]
+    duration: 0.5
+"""
+
+
+def test_traj_rerun_needs_force_and_replaces(tmp_path, capsys):
+    f = tmp_path / "m.yaml"
+    f.write_text(MOTION)
+    assert run(capsys, "traj", str(f))[0] == 0
+    first = (tmp_path / "m.csv").read_text()
+    f.write_text(MOTION.replace("duration: 0.5", "duration: 0.25"))
+    code, _, err = run(capsys, "traj", str(f))
+    assert code == 2 and "pass --force" in err and "overwrite=True" not in err
+    assert (tmp_path / "m.csv").read_text() == first
+    code, _, err = run(capsys, "traj", str(f), "--force")
+    assert code == 0, err
+    assert (tmp_path / "m.csv").read_text() != first
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.csv", "m.png", "m.yaml"]
+
+
+def test_traj_writes_all_outputs_or_none(tmp_path, capsys):
+    f = tmp_path / "m.yaml"
+    f.write_text(MOTION)
+    # the plot cannot be written (its folder is missing): no CSV either
+    code, _, err = run(capsys, "traj", str(f), "--plot", str(tmp_path / "no" / "p.png"))
+    assert code == 2 and "--plot" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.yaml"]
+    # the plot fails while being written: the CSV is not moved in, nothing is left
+    code, _, err = run(capsys, "traj", str(f), "--plot", str(tmp_path / "p.txt"))
+    assert code == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.yaml"]
+
+
+def test_staged_outputs_refuse_one_file_twice(tmp_path):
+    from robokin.exceptions import InputError
+    from robokin.io.atomic import staged_outputs
+
+    with pytest.raises(InputError, match="also the output of -o"), staged_outputs(
+        [(tmp_path / "a.csv", "-o", True), (tmp_path / "a.csv", "--plot", True)]
+    ):
+        pass
+
+
+def test_press_views_labels_do_not_overlap(monkeypatch, tmp_path):
+    """column_left and column_right share x and z: the side view labels both apart."""
+    pytest.importorskip("coal")
+    import robokin.viz.plots as plots
+    from robokin import collision
+    from robokin.demo import _plot_press_views, plan_press_loading
+
+    scene = collision.Scene.load(collision.scene_path("press"))
+    robot = scene.attach(robokin.load("aubo_i5"))
+    traj, _ = plan_press_loading(robot, scene, dt=0.05)
+    figures = []
+    monkeypatch.setattr(plots, "save_figure",
+                        lambda fig, path, **kw: figures.append(fig) or path)
+    _plot_press_views(traj, scene, None, tmp_path / "v.png")
+    fig = figures[0]
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    for ax in fig.axes:
+        names = [t for t in ax.texts if t.get_text() in scene.names]
+        boxes = [(t.get_text(), t.get_window_extent(renderer)) for t in names]
+        assert boxes
+        for i, (a, ba) in enumerate(boxes):
+            for b, bb in boxes[i + 1:]:
+                assert not ba.overlaps(bb), (a, b)
+    side = {t.get_text() for t in fig.axes[0].texts}
+    assert {"column_left", "column_right"} <= side

@@ -1,0 +1,133 @@
+"""``robokin retime`` (issue 18): files written, the report, units, exit codes."""
+
+import json
+import math
+import re
+
+import numpy as np
+import pytest
+
+from robokin.cli import main
+from robokin.trajectory.io import read_csv, write_csv
+
+pytest.importorskip("toppra")
+
+MOTION = """\
+robot: aubo_i5
+units: {length: mm, angle: deg}
+dt: 0.005
+start: [0, 10, 80, 0, 90, 0]
+limits: {velocity: 90, acceleration: 180}
+segments:
+  - joint: [-40, 20, 90, -20, 90, 0]
+    label: swing
+  - line: {dxyz: [0, 0, -100]}
+    duration: 1.0
+    label: approach
+  - dwell: 0.5
+    label: grip
+  - joint: [0, 10, 80, 0, 90, 0]
+    label: home
+"""
+
+
+def run(capsys, *args):
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture
+def motion(tmp_path):
+    f = tmp_path / "press.yaml"
+    f.write_text(MOTION)
+    return f
+
+
+def test_motion_file_minimum_report_and_plot(motion, tmp_path, capsys):
+    out = tmp_path / "out"
+    code, text, _ = run(capsys, "retime", str(motion), "--out", str(out))
+    assert code == 0
+    assert "minimum cycle time" in text and "approach" in text and "limited by" in text
+    doc = json.loads((out / "cycle_time.json").read_text())
+    assert doc["robot"] == "aubo_i5"
+    assert doc["minimum_cycle_time_s"] < doc["planned_s"]
+    assert [s["label"] for s in doc["sections"]] == ["swing", "approach", "grip", "home"]
+    assert (out / "bottlenecks.png").stat().st_size > 20_000
+    tr = read_csv(out / "retimed.csv")
+    assert tr.duration == pytest.approx(doc["minimum_cycle_time_s"], abs=1e-9)
+
+
+def test_csv_with_a_slower_cycle_time(motion, tmp_path, capsys):
+    out = tmp_path / "a"
+    run(capsys, "retime", str(motion), "--out", str(out), "--no-plot")
+    code, text, _ = run(capsys, "retime", str(out / "retimed.csv"), "--robot",
+                        "aubo_i5", "--out", str(tmp_path / "b"), "--cycle-time", "9",
+                        "--json")
+    assert code == 0
+    doc = json.loads(text)
+    slow = read_csv(tmp_path / "b" / "retimed_9s.csv")
+    assert slow.duration == pytest.approx(9.0, abs=1e-9)
+    assert min(doc["margins"]["velocity"]) > 0
+    assert doc["cycle_time_s"] == 9.0
+
+
+def test_a_cycle_time_below_the_minimum_is_a_no(motion, tmp_path, capsys):
+    out = tmp_path / "out"
+    code, _, err = run(capsys, "retime", str(motion), "--out", str(out),
+                       "--cycle-time", "0.5", "--no-plot")
+    assert code == 1
+    assert "shorter than the minimum" in err and err.count("\n") == 1
+    assert (out / "retimed.csv").exists()  # the minimum is still written
+
+
+def test_limits_in_degrees_and_from_the_command_line(motion, tmp_path, capsys):
+    code, text, _ = run(capsys, "retime", str(motion), "--out", str(tmp_path / "o"),
+                        "--v-max", "90", "--a-max", "90,90,90,180,180,180", "--deg",
+                        "--no-plot", "--json")
+    assert code == 0
+    lim = json.loads(text)["limits"]
+    np.testing.assert_allclose(lim["velocity"], [math.pi / 2] * 6)
+    np.testing.assert_allclose(lim["acceleration"], np.radians([90] * 3 + [180] * 3))
+    assert lim["sources"]["velocity"] == "argument"
+
+
+@pytest.mark.parametrize("args, match", [
+    (["--v-max", "0"], "--v-max"),
+    (["--v-max", "1,2"], "--v-max.*expected 1 or 6"),
+    (["--a-max", "fast"], "--a-max"),
+    (["--j-max", "robot"], "--j-max.*no jerk limits"),
+    (["--tool-speed", "-1"], "--tool-speed"),
+    (["--robot", "ur5"], "--robot.*names its own robot"),
+])
+def test_bad_options_are_one_line_errors(motion, tmp_path, capsys, args, match):
+    code, _, err = run(capsys, "retime", str(motion), "--out", str(tmp_path / "o"),
+                       "--no-plot", *args)
+    assert code == 2
+    assert err.count("\n") == 1
+    assert re.search(match, err), err
+
+
+def test_csv_needs_a_robot_with_limits(motion, tmp_path, capsys):
+    from robokin import trajectory
+
+    tr = trajectory.quintic(np.zeros(6), np.full(6, 0.3), 1.0)
+    csv = write_csv(tr, tmp_path / "t.csv", [f"j{i}" for i in range(6)])
+    code, _, err = run(capsys, "retime", str(csv), "--out", str(tmp_path / "o"))
+    assert code == 2 and "needs --robot" in err
+    puma = ["waist", "shoulder", "elbow", "wrist_1", "wrist_2", "wrist_3"]
+    csv = write_csv(tr, tmp_path / "p.csv", puma)
+    code, _, err = run(capsys, "retime", str(csv), "--robot", "puma560", "--out",
+                       str(tmp_path / "o"))
+    assert code == 2 and "no velocity limits" in err and "give --v-max" in err
+
+
+def test_an_output_folder_with_other_files_is_refused(motion, tmp_path, capsys):
+    out = tmp_path / "busy"
+    out.mkdir()
+    (out / "mine.txt").write_text("keep me")
+    code, _, err = run(capsys, "retime", str(motion), "--out", str(out), "--no-plot")
+    assert code == 2 and "--force" in err
+    code, _, _ = run(capsys, "retime", str(motion), "--out", str(out), "--no-plot",
+                     "--force")
+    assert code == 0 and (out / "mine.txt").read_text() == "keep me"
