@@ -143,3 +143,24 @@ def test_mjcf_meshes_go_in_as_their_convex_hulls_and_touch_the_scene(tmp_path):
     assert [(iv.body_a, iv.body_b) for iv in rep.intervals] == \
         [(c.body_a, c.body_b) for c in res.contacts] == [("elbow", "post")]
     assert abs(rep.intervals[0].t_start - res.contacts[0].t_start) <= 0.005 + 1e-9
+
+
+def test_mujoco_warnings_become_python_warnings_not_a_log_file(tmp_path, monkeypatch):
+    # MuJoCo's default handler appends warnings to MUJOCO_LOG.TXT in the working
+    # directory; robokin routes them to Python's warnings instead
+    import warnings
+
+    from robokin.sim._mujoco import mujoco
+
+    monkeypatch.chdir(tmp_path)
+    mj = mujoco()
+    model = mj.MjModel.from_xml_string(
+        '<mujoco><worldbody><body><joint type="hinge"/><geom size=".1"/></body>'
+        "</worldbody></mujoco>")
+    data = mj.MjData(model)
+    data.qvel[0] = float("nan")  # MuJoCo warns and resets the state
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        mj.mj_step(model, data)
+    assert any("MuJoCo:" in str(w.message) for w in caught)
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()

@@ -22,7 +22,18 @@ def mujoco() -> Any:
         raise MissingExtraError("mujoco", "sim") from None
     if not hasattr(mj, "MjModel"):  # a shell without the compiled core
         raise MissingExtraError("mujoco", "sim")
+    if hasattr(mj, "set_mju_user_warning") and mj.get_mju_user_warning() is None:
+        # MuJoCo's default handler appends its warnings to MUJOCO_LOG.TXT in the
+        # working directory: a Python warning instead (nothing written behind the
+        # user's back)
+        mj.set_mju_user_warning(_warn)
     return mj
+
+
+def _warn(message: str) -> None:
+    import warnings
+
+    warnings.warn(f"MuJoCo: {message.strip()}", RuntimeWarning, stacklevel=2)
 
 
 def load_model(xml: str) -> Any:
