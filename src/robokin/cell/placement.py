@@ -37,6 +37,7 @@ import numpy.typing as npt
 
 from robokin._text import short_repr
 from robokin.cell._evaluate import manipulability as _manipulability
+from robokin.cell._inputs import ik_method, placed_robot, progress_callback
 from robokin.cell._scheduler import check_scheduler, run_chunks
 from robokin.cell._tracking import track
 from robokin.exceptions import InputError, UnreachableError
@@ -386,14 +387,12 @@ def place(
             (``robokin[collision]``, with a scene) is missing.
     """
     from robokin.cell._scheduler import require_scale
-    from robokin.cell.reach_map import _method, _placed, _progress
-
     require_scale()
     check_scheduler(scheduler)
     clearance = _number(clearance, "clearance")
     max_step = _number(max_step, "max_step", positive=True)
     min_manipulability = _number(min_manipulability, "min_manipulability")
-    world, bare = _placed(robot, scene)
+    world, bare = placed_robot(robot, scene)
     if scene is not None and bare is not None:
         tooled = scene.with_base(np.eye(4)).attach(bare)
     else:
@@ -401,7 +400,7 @@ def place(
     T = _task(task, world)
     C_poses = _candidates(candidates)
     _check_span(T, tooled)
-    numeric, _ = _method(tooled, method)
+    numeric, _ = ik_method(tooled, method)
     job = PlaceJob(tooled, bare, scene, T, C_poses, clearance, max_step,
                    min_manipulability, numeric)
     C, N = C_poses.shape[0], T.shape[0]
@@ -412,7 +411,7 @@ def place(
     def on_result(i: int, r: PlaceChunk) -> None:
         parts[i] = r
 
-    with _progress(progress, len(ranges), "placement", scheduler) as tick:
+    with progress_callback(progress, len(ranges), "placement", scheduler) as tick:
         run_chunks(evaluate_place, job, ranges, scheduler=scheduler,
                    on_result=on_result, progress=tick, name="robokin-place")
     done = [p for p in parts if p is not None]

@@ -28,8 +28,6 @@ from __future__ import annotations
 import hashlib
 import math
 import shutil
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, Protocol
@@ -40,7 +38,8 @@ import numpy.typing as npt
 from robokin._text import short_repr
 from robokin.cell import _store
 from robokin.cell._evaluate import ReachChunk, ReachJob, evaluate_reach
-from robokin.cell._scheduler import Throttle, check_scheduler, describe, run_chunks
+from robokin.cell._inputs import Progress, ik_method, placed_robot, progress_callback
+from robokin.cell._scheduler import Throttle, check_scheduler, run_chunks
 from robokin.cell.grid import VoxelGrid, tool_orientations
 from robokin.exceptions import InputError
 
@@ -52,7 +51,6 @@ if TYPE_CHECKING:
 
 __all__ = ["ReachMap", "reach_map"]
 
-Progress = bool | Callable[[int, int], None] | None
 # Per task: ~0.1-0.3 s of closed-form IK on one core and ~100 MB of temporaries
 # (benchmarks/bench_cell.py --sweep: 8,192 targets a task run at 72 % of 131,072's
 # rate, 524,288 at 103 %); at most 50,000 tasks, so a scheduler spends about a
@@ -391,14 +389,14 @@ def reach_map(
 
     require_scale()
     check_scheduler(scheduler)
-    world, bare = _placed(robot, scene)
+    world, bare = placed_robot(robot, scene)
     R = _orientations(orientations, rolls)
     if region is None:
         grid_region = default_region(world, _REGION_SAMPLES, _REGION_MARGIN)
         grid = VoxelGrid.from_region(grid_region, voxel)
     else:
         grid = VoxelGrid.from_region(region, voxel)
-    numeric, method_name = _method(world, method)
+    numeric, method_name = ik_method(world, method)
     V, K = grid.size, R.shape[0]
     B = _chunk(chunk, V, K)
     ranges = [(a, min(a + B, V)) for a in range(0, V, B)]
@@ -431,7 +429,7 @@ def _run_in_memory(job: ReachJob, shell: ReachMap, ranges: list[tuple[int, int]]
         if best is not None and r.manipulability is not None:
             best[a:b] = r.manipulability
 
-    with _progress(progress, len(ranges), "reach map", scheduler) as tick:
+    with progress_callback(progress, len(ranges), "reach map", scheduler) as tick:
         run_chunks(evaluate_reach, job, ranges, scheduler=scheduler,
                    on_result=on_result, progress=tick, name="robokin-reach")
     for arr in (counts, index, solutions, best):
@@ -464,7 +462,7 @@ def _run_into_store(job: ReachJob, shell: ReachMap, ranges: list[tuple[int, int]
         finished.append(todo[k])  # the k-th task run is chunk todo[k]
         flush()
 
-    with _progress(progress, len(todo), f"reach map -> {path.name}", scheduler) as tick:
+    with progress_callback(progress, len(todo), f"reach map -> {path.name}", scheduler) as tick:
         try:
             run_chunks(evaluate_reach, job, [ranges[i] for i in todo],
                        scheduler=scheduler, on_result=on_result, progress=tick,
@@ -504,22 +502,6 @@ def _prepare_store(path: Path, shell: ReachMap, job: ReachJob, chunk: int,
 
 
 # ------------------------------------------------------------------ helpers
-def _placed(robot: Robot, scene: Scene | None) -> tuple[Robot, Robot | None]:
-    """The robot in the world and, with a scene, the bare robot it places."""
-    from robokin.robot import Robot as _Robot
-
-    if not isinstance(robot, _Robot):
-        raise InputError("robot", f"expected a robokin.Robot, got {short_repr(robot)}")
-    if scene is None:
-        return robot, None
-    from robokin.collision.scene import Scene as _Scene
-
-    if not isinstance(scene, _Scene):
-        raise InputError("scene", f"expected a collision.Scene, got {short_repr(scene)}")
-    bare = scene.unplaced(robot)
-    return scene.attach(bare), bare
-
-
 def _orientations(orientations: int | npt.ArrayLike, rolls: int) -> np.ndarray:
     if isinstance(orientations, int | np.integer) and not isinstance(orientations, bool):
         return tool_orientations(int(orientations), rolls)
@@ -543,22 +525,6 @@ def _orientations(orientations: int | npt.ArrayLike, rolls: int) -> np.ndarray:
     check_transform(T, "orientations")
     out = np.ascontiguousarray(R)
     return out
-
-
-def _method(robot: Robot, method: str) -> tuple[bool, str]:
-    """(numeric?, the method's name) for ``method`` on this robot."""
-    from robokin.kinematics.ik.analytic.detect import detect
-
-    if method not in ("auto", "analytic", "numeric"):
-        raise InputError(
-            "method", f"expected 'auto', 'analytic' or 'numeric', got {short_repr(method)}"
-        )
-    fam = detect(robot)
-    if method == "numeric" or (method == "auto" and fam.solver is None):
-        return True, "numeric"
-    if fam.solver is None:
-        raise InputError("method", f"no closed form for robot '{robot.name}': {fam.reason}")
-    return False, f"analytic:{fam.name}"
 
 
 def _default_chunk(V: int, K: int) -> int:
@@ -594,39 +560,3 @@ def _fingerprint(job: ReachJob, chunk: int) -> str:
         h.update(part)
         h.update(b"|")
     return h.hexdigest()
-
-
-@contextmanager
-def _progress(progress: Progress, total: int, text: str,
-              scheduler: Any) -> Iterator[Callable[[int, int], None] | None]:
-    """The per-task callback: the user's, a rich bar (``progress=True``), or None."""
-    if progress is None or progress is False:
-        yield None
-        return
-    if callable(progress):
-        yield progress
-        return
-    from rich.console import Console
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
-
-    console = Console(stderr=True)
-    console.print(f"{text}: {total:,} Dask tasks on {describe(scheduler)}", markup=False,
-                  highlight=False)
-    with Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        TimeRemainingColumn(),
-        console=console,
-        transient=False,
-    ) as bar:
-        task = bar.add_task(text, total=total)
-        yield lambda done, total_: bar.update(task, completed=done)
