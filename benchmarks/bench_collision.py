@@ -240,7 +240,7 @@ def main(samples: int = 5000, meshes: bool = False) -> int:
     what = "mesh links, 3,840 triangles each" if meshes else "capsule links"
     print(
         f"AUBO-i5 ({what}) + gripper, press scene: {samples} samples, {problem.P} "
-        f"shape pairs ({len(problem.obj_pairs)} link-object, {len(problem.self_pairs)} self)"
+        f"shape pairs ({int((~problem.is_self).sum())} link-object, {len(problem.self_pairs)} self)"
     )
     print(
         f"  closest: {c.body_a} - {c.body_b} {c.distance * 1e3:.3f} mm at t = {c.t:.3f} s "

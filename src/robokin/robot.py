@@ -19,6 +19,8 @@ from robokin._validation import check_transform
 from robokin.exceptions import FrozenError, InputError
 from robokin.kinematics import forward
 from robokin.kinematics import jacobian as _jac
+from robokin.kinematics.ik.dispatch import solve as _ik_solve
+from robokin.kinematics.ik.nearest import solve_near as _solve_near
 from robokin.model.chain import Chain
 from robokin.model.coupling import AffineMap
 from robokin.model.rate_limits import RateLimits
@@ -402,12 +404,10 @@ class Robot:
         Returns:
             A :class:`~robokin.kinematics.ik.solutions.SolutionSet`.
         """
-        from robokin.kinematics.ik import solve
-
         if space == "actuator":
             if q_near is not None:
                 q_near = self.joints_from_actuators(q_near)
-            sols = solve(self, T, q_near=q_near, method=method, **options)
+            sols = _ik_solve(self, T, q_near=q_near, method=method, **options)
             out = sols.to_actuator_space(self)
             if self.actuators is not None and out.is_revolute.any():
                 # Motor angles never wrap: a motor turn through a reduction is not a
@@ -418,7 +418,7 @@ class Robot:
             return out
         if space != "joint":
             raise InputError("space", f"expected 'joint' or 'actuator', got {space!r}")
-        return solve(self, T, q_near=q_near, method=method, **options)
+        return _ik_solve(self, T, q_near=q_near, method=method, **options)
 
     def ik_near(
         self,
@@ -444,9 +444,7 @@ class Robot:
             An :class:`~robokin.kinematics.ik.numeric.IKResult`: ``.q`` (..., n),
             ``.success`` (...), ``.reason``.
         """
-        from robokin.kinematics.ik.nearest import solve_near
-
-        return solve_near(self, T, q_near, method=method, **options)
+        return _solve_near(self, T, q_near, method=method, **options)
 
     # ---------------------------------------------------------------- actuators
     def actuators_from_joints(self, q: npt.ArrayLike) -> np.ndarray:

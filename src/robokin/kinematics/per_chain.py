@@ -18,7 +18,10 @@ __all__ = ["cached"]
 
 T = TypeVar("T")
 
-_STORE: weakref.WeakKeyDictionary[Chain, dict[Any, Any]] = weakref.WeakKeyDictionary()
+# id(chain) -> that chain's values; an entry goes when its chain does (a finalizer),
+# before the id can be reused. A dict lookup by id costs a tenth of a weak-key one,
+# and the IK single-pose path looks here on every call.
+_STORE: dict[int, dict[Any, Any]] = {}
 
 
 def cached(chain: Chain, key: Any, build: Callable[[], T]) -> T:
@@ -33,9 +36,10 @@ def cached(chain: Chain, key: Any, build: Callable[[], T]) -> T:
     Returns:
         The cached value.
     """
-    per = _STORE.get(chain)
+    per = _STORE.get(id(chain))
     if per is None:
-        per = _STORE.setdefault(chain, {})
+        per = _STORE.setdefault(id(chain), {})
+        weakref.finalize(chain, _STORE.pop, id(chain), None)
     try:
         return per[key]
     except KeyError:

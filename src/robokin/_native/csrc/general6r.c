@@ -1413,7 +1413,7 @@ static void g6_range(void *ctx, long b, long e)
             int ok = s < ns, in = ok;
             for (int j = 0; j < 6; j++) {
                 /* whole turns into the limits where possible (lm.c's wrap_into) */
-                double v = ok ? wrap_into(q[6 * s + j], ch->lo[j], ch->hi[j]) : 0.0;
+                double v = ok ? wrap_into(q[6 * s + j], ch->lo[j], ch->hi[j]) : NAN;
                 in &= v >= ch->lo[j] - 1e-9 && v <= ch->hi[j] + 1e-9;
                 Qo[6 * s + j] = v;
             }

@@ -290,13 +290,14 @@ typedef struct {
     unsigned char *valid, *sing, *inside;
 } Slots;
 
-/* All slots empty: zero, invalid, not singular, not within limits. */
+/* All slots empty: NaN (rows that are not solutions), invalid, not singular, not
+ * within limits. */
 static void slots_clear(Slots o)
 {
     for (int k = 0; k < 8; k++) {
         o.valid[k] = o.sing[k] = o.inside[k] = 0;
         for (int j = 0; j < 6; j++)
-            o.Q[6 * k + j] = 0.0;
+            o.Q[6 * k + j] = NAN;
     }
 }
 

@@ -138,10 +138,9 @@ class SolutionSet:
 
         Final form: float64 ``q``, bool masks, a ``within_limits`` flag, an object
         ``status``; the hot path of the closed forms. Callers pass fresh arrays (or
-        read-only shared ones), never buffers they reuse; rows of ``q`` that are
-        not valid are set to NaN here (in place).
+        read-only shared ones), never buffers they reuse, and rows of ``q`` that are
+        not valid already NaN (the compiled closed forms write them so).
         """
-        q[~valid] = np.nan
         self = object.__new__(cls)
         self.__dict__.update(q=q, valid=valid, is_revolute=is_revolute, limits=limits,
                              flags=flags, branches=branches, status=status,
