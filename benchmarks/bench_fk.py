@@ -21,6 +21,7 @@ from peers import pinocchio_model, rtb_ets  # noqa: E402
 
 import robokin  # noqa: E402
 import robokin._native  # noqa: E402
+from robokin._native import _base  # noqa: E402
 
 
 def _median_call(fn, repeats=2000, inner=20):
@@ -33,12 +34,16 @@ def _median_call(fn, repeats=2000, inner=20):
     return statistics.median(samples)
 
 
-def _median_baseline(robot, q):
-    """robot.fk(q) through the baseline (non-AVX2) copy of the compiled kernels."""
-    from robokin._native import _base
+def _median_kernel(robot, q, copy=None):
+    """The compiled single-configuration FK call alone (no argument checks).
 
+    ``copy`` None: the copy robot.fk(q) uses; otherwise the baseline (non-AVX2) one.
+    """
+    from robokin import _native
+
+    kernels = _native.single if copy is None else copy
     packed = robot.chain.arrays.packed
-    return _median_call(lambda: _base.fk1(q, packed))
+    return _median_call(lambda: kernels.fk1(q, packed))
 
 
 def _best(fn, repeats=3):
@@ -77,7 +82,10 @@ def main(n_batch: int = 100_000) -> None:
         robot.fk(q0)
         single = {
             "robokin fk(q)": _median_call(lambda: robot.fk(q0)),
-            "robokin fk(q), baseline copy": _median_baseline(robot, q0),
+            "robokin kernel call alone": _median_kernel(robot, q0),
+            "robokin kernel call alone, baseline copy": _median_kernel(
+                robot, q0, _base
+            ),
             "pinocchio forwardKinematics+frame": _median_call(lambda: pin_pose(q0)),
             "pinocchio forwardKinematics only": _median_call(
                 lambda: pin.forwardKinematics(model, data, q0)
@@ -118,10 +126,10 @@ def main(n_batch: int = 100_000) -> None:
                 )
             )
     print(
-        f"{'robot':6} {'case':13} {'library':36} {'value':>10} {'unit':12} {'robokin x':>9}"
+        f"{'robot':6} {'case':13} {'library':42} {'value':>10} {'unit':12} {'robokin x':>9}"
     )
     for r in rows:
-        print(f"{r[0]:6} {r[1]:13} {r[2]:36} {r[3]:10.3f} {r[4]:12} {r[5]:9.2f}")
+        print(f"{r[0]:6} {r[1]:13} {r[2]:42} {r[3]:10.3f} {r[4]:12} {r[5]:9.2f}")
     print("('robokin x' = how many times faster robokin is; time ratio peer / robokin)")
 
 
