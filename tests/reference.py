@@ -1,8 +1,11 @@
-"""Independent reference implementations for the tests (plain numpy, no robokin)."""
+"""Independent reference implementations for the tests (plain numpy or a peer, no robokin)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+import pytest
 
 
 def dh_standard(rows, q):
@@ -68,3 +71,23 @@ def pose_errors(T, Tt):
         np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
                   R[..., 1, 0] - R[..., 0, 1]], -1), axis=-1) / 2
     return dp, np.arctan2(s, c)
+
+
+def pin_fk(xml: str, frame: str, values: dict[str, float]) -> np.ndarray:
+    """Pose (4, 4) of ``frame`` from pinocchio's own URDF parser (skips without it).
+
+    ``values`` maps joint names to positions [rad, m]; continuous joints are given
+    to pinocchio as (cos, sin).
+    """
+    pin = pytest.importorskip("pinocchio")
+    model = pin.buildModelFromXML(xml)
+    data = model.createData()
+    q = pin.neutral(model)
+    for name, v in values.items():
+        j = model.joints[model.getJointId(name)]
+        if j.nq == 1:
+            q[j.idx_q] = v
+        else:
+            q[j.idx_q], q[j.idx_q + 1] = math.cos(v), math.sin(v)
+    pin.framesForwardKinematics(model, data, q)
+    return data.oMf[model.getFrameId(frame)].homogeneous

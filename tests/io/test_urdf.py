@@ -13,25 +13,10 @@ from robokin.exceptions import ModelError
 from robokin.spatial import rotz
 
 pytest.importorskip("yourdfpy")
+from reference import pin_fk  # noqa: E402
 from robokin.io.urdf import axis_frame, robot_from_urdf  # noqa: E402
 
 DATA = Path(__file__).parent.parent / "data" / "urdf"
-
-
-def pin_fk(xml: str, frame: str, values: dict[str, float]) -> np.ndarray:
-    """Pose of ``frame`` from pinocchio's own URDF parser (continuous: cos/sin)."""
-    pin = pytest.importorskip("pinocchio")
-    model = pin.buildModelFromXML(xml)
-    data = model.createData()
-    q = pin.neutral(model)
-    for name, v in values.items():
-        j = model.joints[model.getJointId(name)]
-        if j.nq == 1:
-            q[j.idx_q] = v
-        else:
-            q[j.idx_q], q[j.idx_q + 1] = math.cos(v), math.sin(v)
-    pin.framesForwardKinematics(model, data, q)
-    return data.oMf[model.getFrameId(frame)].homogeneous
 
 
 def random_q(robot, rng, m=20):

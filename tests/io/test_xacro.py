@@ -2,7 +2,6 @@
 expanded URDF, xacro arguments, package resolution (package map, ROS_PACKAGE_PATH,
 AMENT_PREFIX_PATH, package.xml above the file) and the error messages."""
 
-import math
 import os
 from pathlib import Path
 
@@ -14,6 +13,7 @@ from robokin.exceptions import InputError, ModelError
 
 pytest.importorskip("yourdfpy")
 pytest.importorskip("xacro")
+from reference import pin_fk  # noqa: E402
 from robokin.io.ros_packages import PackageFinder  # noqa: E402
 from robokin.io.urdf import robot_from_urdf  # noqa: E402
 from robokin.io.xacro import expand_xacro, is_xacro  # noqa: E402
@@ -25,21 +25,6 @@ ARM = DEMO / "urdf" / "arm.urdf.xacro"
 def rtb_xacro() -> Path:
     rtbdata = pytest.importorskip("rtbdata")
     return Path(rtbdata.__file__).parent / "xacro"
-
-
-def pin_fk(xml: str, frame: str, values: dict[str, float]) -> np.ndarray:
-    pin = pytest.importorskip("pinocchio")
-    model = pin.buildModelFromXML(xml)
-    data = model.createData()
-    q = pin.neutral(model)
-    for name, v in values.items():
-        j = model.joints[model.getJointId(name)]
-        if j.nq == 1:
-            q[j.idx_q] = v
-        else:
-            q[j.idx_q], q[j.idx_q + 1] = math.cos(v), math.sin(v)
-    pin.framesForwardKinematics(model, data, q)
-    return data.oMf[model.getFrameId(frame)].homogeneous
 
 
 def assert_fk_matches_pinocchio(robot, rng, m=25):
