@@ -78,6 +78,14 @@ def test_the_public_functions_refuse_them_too(ur5):
         check_transform(np.eye(4, dtype=complex))
     with pytest.raises(InputError, match="masked"):
         ur5.ik(np.ma.masked_array(np.eye(4)))
+    # one configuration (the compiled fast path) and the numeric solver too
+    with pytest.raises(InputError, match="masked"):
+        ur5.fk(np.ma.masked_array(np.zeros(6), mask=[1, 0, 0, 0, 0, 0]))
+    T = ur5.fk(np.full(6, 0.3))
+    for bad, message in ((np.ma.masked_array(T), "masked"), (T.astype(complex), "complex"),
+                         (np.eye(4, dtype=bool), "bool")):
+        with pytest.raises(InputError, match=message):
+            ur5.ik(bad, method="numeric")
     # plain integers and float32 are still numbers
     np.testing.assert_array_equal(check_joints(np.arange(3, dtype=np.int32), 3),
                                   [0.0, 1.0, 2.0])

@@ -18,6 +18,7 @@ from robokin.exceptions import InputError
 
 __all__ = [
     "MAX_TRANSLATION",
+    "check_broadcasts",
     "check_finite",
     "check_joints",
     "check_transform",
@@ -73,6 +74,25 @@ def check_joints(q: npt.ArrayLike, n: int, name: str = "q") -> np.ndarray:
             name, f"expected shape (..., {n}) for {n} joints, got {q.shape}"
         )
     return q
+
+
+def check_broadcasts(x: np.ndarray, target: tuple[int, ...], name: str,
+                     what: str = "the targets'") -> np.ndarray:
+    """Return ``x`` if it broadcasts to the shape ``target`` without growing it.
+
+    Per-pose arguments (``q_near``, ``q0``, ``q_current``) are read this way: one row
+    for every pose, or rows that broadcast over the pose batch.
+
+    Raises:
+        InputError: naming ``name``, its shape and ``target`` (described by ``what``).
+    """
+    try:
+        ok = np.broadcast_shapes(x.shape, target) == target
+    except ValueError:
+        ok = False
+    if not ok:
+        raise InputError(name, f"shape {x.shape} does not broadcast to {what} {target}")
+    return x
 
 
 def check_finite(x: np.ndarray, name: str) -> np.ndarray:

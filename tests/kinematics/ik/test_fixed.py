@@ -97,6 +97,27 @@ def test_bad_held_joints_are_named():
         robot.ik(np.stack([T, T, T]), fixed={"joint7": [0.1, 0.2]})
     with pytest.raises(InputError, match="mapping"):
         robot.ik(T, fixed=["joint7"])
+    with pytest.raises(InputError, match=r"fixed\['joint7'\].*expected a number"):
+        robot.ik(T, fixed={"joint7": "a"})
+    with pytest.raises(InputError, match=r"q_near.*\(3,\)"):
+        robot.ik(T, fixed={"joint7": 0.7}, q_near=np.zeros(3))
+    with pytest.raises(InputError, match=r"q_near.*does not broadcast"):
+        robot.ik(T, fixed={"joint7": 0.7}, q_near=np.zeros((2, 7)))
+
+
+def test_a_sweep_keeps_only_the_last_reduced_chains():
+    robot = robokin.load("panda")
+    T = robot.fk(Q0)
+    values = Q0[2] + np.linspace(-0.2, 0.2, fixed_ik._REDUCED_KEPT + 4)
+    sols = robot.ik(np.broadcast_to(T, (len(values), 4, 4)), fixed={"joint3": values})
+    np.testing.assert_array_equal(sols.q[..., 2][sols.valid],
+                                  np.broadcast_to(values[:, None], sols.valid.shape)[sols.valid])
+    # a sweep of a middle joint builds one reduced robot per value; a bounded few stay
+    from robokin.kinematics.per_chain import cached
+
+    kept = cached(robot.chain, "fixed", dict)
+    assert len(kept) == fixed_ik._REDUCED_KEPT
+    assert list(kept)[-1] == ((2,), (float(values[-1]),))
 
 
 def test_panda_with_joint7_held_is_complete_against_a_numeric_reference():

@@ -93,6 +93,9 @@ def test_bad_inputs_name_the_argument():
         robot.ik_near(T, np.zeros(5))
     with pytest.raises(InputError, match="q_near.*non-finite"):
         robot.ik_near(T, [0, 0, np.nan, 0, 0, 0])
+    # the numeric path names q_near too (not the solver's q0)
+    with pytest.raises(InputError, match="'q_near'.*does not broadcast"):
+        robot.ik_near(np.stack([T, T]), np.zeros((3, 6)), method="numeric")
     with pytest.raises(InputError, match="method"):
         robot.ik_near(T, np.zeros(6), method="fast")
     with pytest.raises(InputError, match="options"):

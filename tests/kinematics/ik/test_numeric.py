@@ -8,6 +8,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import robokin
+from reference import pose_errors
 from robokin import InputError
 from robokin.kinematics.ik import numeric
 from robokin.kinematics.ik.solutions import SolutionSet, wrap_angle
@@ -438,3 +439,24 @@ def test_panda_targets_near_the_joint_limits_are_solved(seed):
     ok = res.success
     assert_pose_close(robot.fk(res.q[ok]), T[ok], 1e-9)
     assert robot.within_limits(res.q, tol=0.0).all()
+
+
+def test_every_solver_accepts_and_refuses_the_same_poses():
+    # one pose check (chain.h pose_problem, POSE_ROW_TOL / POSE_ORTH_TOL) for the
+    # closed form, the numeric solver and check_transform
+    robot = robokin.load("ur5")
+    q = np.array([0.3, -1.1, 1.2, -0.4, 0.9, 0.2])
+    T = robot.fk(q)
+    near = T.copy()
+    near[3, 0] = 1e-12  # a last row off by rounding: accepted
+    for method in ("analytic", "numeric"):
+        sols = robot.ik(near, method=method)
+        assert len(sols) >= 1
+        for qi in sols:
+            dp, dr = pose_errors(robot.fk(qi), T)
+            assert dp < 1e-9 and dr < 1e-9
+    off = T.copy()
+    off[3, 0] = 1e-6  # not a rigid transform: refused, naming T
+    for method in ("analytic", "numeric"):
+        with pytest.raises(InputError, match="'T'.*last row"):
+            robot.ik(off, method=method)

@@ -2,7 +2,9 @@
  * The chain maths, written once: sin/cos, the chain product, the Jacobian columns
  * and the pose residual, on W lanes (lanes.h). FK, link frames, Jacobians, the
  * numeric IK and the seed table all call these functions; nothing else in robokin
- * multiplies along a chain.
+ * multiplies along a chain, with one exception: general6r.c's g6_rot_span, the
+ * rotation part of a span of the *reversed* chain (its own constants, built once
+ * per arm, in one lane), which the elimination needs per candidate root.
  *
  *   T(q) = C_0 J_1(v_1) C_1 J_2(v_2) C_2 ... J_n(v_n) C_n,   v = sign * (M q + c) + offset
  *
@@ -370,11 +372,34 @@ ALWAYS_INLINE void pose_residual(const vd *t, const vd *tt, vd *e, vl active)
     }
 }
 
+/* A 2*pi-periodic coordinate shifted by whole turns into [lo, hi] where possible
+ * (project clamps after it). */
+static double wrap_into(double v, double lo, double hi)
+{
+    const double tp = 2.0 * M_PI;
+    if (v > hi) {
+        double k = ceil((v - hi) / tp);
+        if (v - k * tp >= lo)
+            v -= k * tp;
+    } else if (v < lo) {
+        double k = ceil((lo - v) / tp);
+        if (v + k * tp <= hi)
+            v += k * tp;
+    }
+    return v;
+}
+
 /* ------------------------------------------------------------ pose checks */
 
 /* Largest translation [m] a pose may have: beyond it float64 kinematics lose every
  * digit of a sub-millimetre result (robokin._validation.MAX_TRANSLATION reads it). */
 #define MAX_TRANSLATION 1.0e6
+
+/* The tolerances every pose check uses (robokin._validation.check_transform, the
+ * closed-form and the numeric IK): the last row to POSE_ROW_TOL, the rotation
+ * block's orthonormality to POSE_ORTH_TOL. */
+#define POSE_ROW_TOL 1e-9
+#define POSE_ORTH_TOL 1e-6
 
 /* 0 when T (4x4 row-major) is a rigid transform: 1 a non-finite entry, 2 a last
  * row other than 0 0 0 1 (within row_tol), 3 a rotation block not orthonormal

@@ -1412,7 +1412,7 @@ static void g6_range(void *ctx, long b, long e)
         for (int s = 0; s < G6_MAXSOL; s++) {
             int ok = s < ns, in = ok;
             for (int j = 0; j < 6; j++) {
-                /* whole turns into the limits where possible (lm.c's wrap_into) */
+                /* whole turns into the limits where possible (chain.h's wrap_into) */
                 double v = ok ? wrap_into(q[6 * s + j], ch->lo[j], ch->hi[j]) : NAN;
                 in &= v >= ch->lo[j] - 1e-9 && v <= ch->hi[j] + 1e-9;
                 Qo[6 * s + j] = v;

@@ -86,23 +86,6 @@ typedef struct {
     int start; /* 0: the first attempt starts from q0 */
 } Lanes;
 
-/* A 2*pi-periodic coordinate shifted by whole turns into [lo, hi] where possible
- * (project clamps after it). */
-static double wrap_into(double v, double lo, double hi)
-{
-    const double tp = 2.0 * M_PI;
-    if (v > hi) {
-        double k = ceil((v - hi) / tp);
-        if (v - k * tp >= lo)
-            v -= k * tp;
-    } else if (v < lo) {
-        double k = ceil((lo - v) / tp);
-        if (v + k * tp <= hi)
-            v += k * tp;
-    }
-    return v;
-}
-
 static void project(double *q, const Chain *ch)
 {
     for (int j = 0; j < ch->n; j++) {
@@ -273,7 +256,7 @@ static inline void lane_load(Ctx *cx, Lanes *L, int l)
         const double *Tt = cx->targets + (size_t)i * 16;
         const double *q0 = cx->q0 + (size_t)i * n;
         int bad = 0;
-        if (pose_problem(Tt, 0.0, 1e-6))
+        if (pose_problem(Tt, POSE_ROW_TOL, POSE_ORTH_TOL))
             bad = CODE_BAD_TARGET;
         else if (cx->opts[O_USE_Q0] == 1.0) {
             for (int j = 0; j < n; j++)

@@ -74,7 +74,7 @@ static PyObject *py_fk1(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
         return NULL;
     }
     PyObject *qo = args[0], *po = args[1];
-    if (!PyArray_Check(qo) || !PyArray_Check(po))
+    if (!PyArray_CheckExact(qo) || !PyArray_Check(po)) /* subclasses (masked): checked path */
         Py_RETURN_NONE;
     PyArrayObject *qa = (PyArrayObject *)qo, *pa = (PyArrayObject *)po;
     if (PyArray_TYPE(qa) != NPY_DOUBLE || PyArray_NDIM(qa) != 1 ||
@@ -423,7 +423,7 @@ static PyObject *py_check_poses(PyObject *self, PyObject *args)
     }
     const double *p = F64(T);
     for (npy_intp i = 0; i < DIM(T, 0); i++) {
-        int code = pose_problem(p + 16 * i, 1e-9, tol);
+        int code = pose_problem(p + 16 * i, POSE_ROW_TOL, tol);
         if (code)
             return Py_BuildValue("(in)", code, (Py_ssize_t)i);
     }

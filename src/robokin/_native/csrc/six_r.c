@@ -77,8 +77,6 @@ enum { SR_THREE_PARALLEL = 0, SR_SPHERICAL_WRIST = 1 };
 enum { SR_OK = 0, SR_OUT_OF_REACH = 1, SR_NO_ORIENTATION = 2, SR_BAD_POSE = 16 };
 #define SR_PARALLEL_MIN 512 /* below this many poses, one thread */
 #define SR_GRAIN 32         /* poses per pool chunk */
-#define SR_TWO_PI (2.0 * M_PI)
-#define SR_INV_TWO_PI (1.0 / (2.0 * M_PI))
 
 /* ------------------------------------------------------------------- vectors */
 
@@ -677,7 +675,7 @@ static PyObject *py_six_r_ik1(PyObject *self, PyObject *const *args, Py_ssize_t 
             for (int r = 0; r < 4; r++)
                 for (int c = 0; c < 4; c++)
                     T[4 * r + c] = *(const double *)(d + r * rs + c * cs);
-            code = pose_problem(T, 1e-9, 1e-6);
+            code = pose_problem(T, POSE_ROW_TOL, POSE_ORTH_TOL);
             code = code ? SR_BAD_POSE + code : 0;
         }
     }

@@ -8,7 +8,12 @@ from typing import TYPE_CHECKING, Any, TypeGuard
 import numpy as np
 import numpy.typing as npt
 
-from robokin._validation import check_finite, check_joints, check_poses_fast
+from robokin._validation import (
+    check_broadcasts,
+    check_finite,
+    check_joints,
+    check_poses_fast,
+)
 from robokin.exceptions import InputError
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
@@ -57,7 +62,7 @@ def solve(
                 return out
     T = check_poses_fast(T, "T")
     if qn is not None and qn.ndim > 1:
-        _check_q_near_batch(qn, T.shape[:-2] + (robot.n,))
+        check_broadcasts(qn, T.shape[:-2] + (robot.n,), "q_near")
     if method in ("auto", "analytic"):
         from robokin.kinematics.ik.analytic.detect import detect
 
@@ -82,22 +87,6 @@ def solve(
     from robokin.kinematics.ik.numeric import solve_all
 
     return solve_all(robot, T, q_near=qn, **options)
-
-
-def _check_q_near_batch(q_near: np.ndarray, target: tuple[int, ...]) -> None:
-    """Raise InputError unless a batched ``q_near`` broadcasts to ``target``.
-
-    ``target`` is the pose batch + (n,); ``q_near`` must broadcast to it without
-    growing it: every solver reads it that way.
-    """
-    try:
-        ok = np.broadcast_shapes(q_near.shape, target) == target
-    except ValueError:
-        ok = False
-    if not ok:
-        raise InputError(
-            "q_near", f"shape {q_near.shape} does not broadcast to the targets' {target}"
-        )
 
 
 def _single_solver(robot: RobotLike) -> Any:

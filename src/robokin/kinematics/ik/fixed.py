@@ -15,17 +15,25 @@ the first). Otherwise each distinct value gets its own reduced chain (cached).
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
 
-from robokin._validation import check_finite, check_poses_fast
+from robokin._validation import (
+    _real_array,
+    check_broadcasts,
+    check_finite,
+    check_joints,
+    check_poses_fast,
+)
 from robokin.exceptions import InputError
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
 from robokin.model.chain import joint_motion
+from robokin.spatial import invert
 
 if TYPE_CHECKING:
     from robokin.kinematics.robot_like import RobotLike
@@ -74,7 +82,8 @@ def solve_fixed(
     if len(idx) == robot.n:
         raise InputError("fixed", "every joint is held: nothing left to solve for")
     T = check_poses_fast(T, "T")
-    values = [check_finite(np.asarray(v, dtype=np.float64), "fixed") for v in fixed.values()]
+    values = [check_finite(_real_array(v, f"fixed[{name!r}]", "a number or numbers"),
+                           f"fixed[{name!r}]") for name, v in fixed.items()]
     try:
         lead = np.broadcast_shapes(T.shape[:-2], *(v.shape for v in values))
     except ValueError as exc:
@@ -85,8 +94,9 @@ def solve_fixed(
     keep = [j for j in range(robot.n) if j not in idx]
     qn = None
     if q_near is not None:
-        qn = np.broadcast_to(np.asarray(q_near, dtype=np.float64), lead + (robot.n,))
-        qn = qn.reshape(-1, robot.n)[:, keep]
+        qc = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
+        check_broadcasts(qc, lead + (robot.n,), "q_near", "the poses' and values'")
+        qn = np.broadcast_to(qc, lead + (robot.n,)).reshape(-1, robot.n)[:, keep]
     end = _end_joint(robot, idx)
     if end is not None:
         reduced = _reduced(robot, idx, (0.0,))
@@ -123,14 +133,23 @@ def _moved_targets(robot: RobotLike, end: str, T: np.ndarray, v: np.ndarray) -> 
     if end == "last":
         j = robot.n - 1
         Cn = C[-1]
-        return T @ np.linalg.inv(Cn) @ joint_motion(robot.chain.joints[j].kind, -robot.chain.joints[j].sign * v) @ Cn
+        return T @ invert(Cn) @ joint_motion(robot.chain.joints[j].kind, -robot.chain.joints[j].sign * v) @ Cn
     C0 = C[0]
-    return C0 @ joint_motion(robot.chain.joints[0].kind, -robot.chain.joints[0].sign * v) @ np.linalg.inv(C0) @ T
+    return C0 @ joint_motion(robot.chain.joints[0].kind, -robot.chain.joints[0].sign * v) @ invert(C0) @ T
+
+
+#: Reduced robots kept per chain: a sweep of a middle joint builds one per value
+#: (a general-6R set-up each); the most recently used ones are kept, not all.
+_REDUCED_KEPT = 16
 
 
 def _reduced(robot: RobotLike, idx: list[int], values: tuple[float, ...]) -> Any:
-    """The robot of the remaining coordinates (cached per chain and held values)."""
-    key = ("fixed", tuple(idx), values)
+    """The robot of the remaining coordinates (the last few kept per chain)."""
+    key = (tuple(idx), values)
+    kept: OrderedDict[Any, Any] = cached(robot.chain, "fixed", OrderedDict)
+    if key in kept:
+        kept.move_to_end(key)
+        return kept[key]
 
     def build() -> Any:
         held = ", ".join(f"{robot.joint_names[j]}={v:g}" for j, v in zip(idx, values,
@@ -141,7 +160,10 @@ def _reduced(robot: RobotLike, idx: list[int], values: tuple[float, ...]) -> Any
         make: Any = type(robot)
         return make(chain, name=f"{robot.name} ({held} held)")
 
-    return cached(robot.chain, key, build)
+    value = kept[key] = build()
+    while len(kept) > _REDUCED_KEPT:
+        kept.popitem(last=False)
+    return value
 
 
 def _assemble(robot: RobotLike, lead: tuple[int, ...], idx: list[int], keep: list[int],

@@ -15,7 +15,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from robokin._validation import check_finite, check_joints
+from robokin._validation import (
+    check_broadcasts,
+    check_finite,
+    check_joints,
+    check_transform,
+)
 from robokin.exceptions import InputError
 from robokin.kinematics.ik.numeric import IKResult
 
@@ -58,8 +63,6 @@ def solve_near(
     Raises:
         InputError: a bad pose, ``q_near``, method or option.
     """
-    from robokin.kinematics.ik import numeric
-
     if method not in _METHODS:
         raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
     q_near = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
@@ -67,7 +70,7 @@ def solve_near(
         if method == "analytic":
             raise InputError("options", f"{sorted(options)} are numeric-solver options; "
                                         "the closed form takes none")
-        return numeric.solve(robot, T, q0=q_near, **options)
+        return _numeric_near(robot, T, q_near, **options)
     from robokin.kinematics.ik.analytic.detect import detect
 
     fam = detect(robot)
@@ -75,9 +78,23 @@ def solve_near(
         if method == "analytic":
             raise InputError("method", f"no closed form for robot '{robot.name}': "
                                        f"{fam.reason}")
-        return numeric.solve(robot, T, q0=q_near)
+        return _numeric_near(robot, T, q_near)
     sols = robot.ik(T, q_near=q_near, method="analytic")
     return _nearest(robot, sols, T, q_near)
+
+
+def _numeric_near(robot: RobotLike, T: npt.ArrayLike, q_near: np.ndarray,
+                  **options: Any) -> IKResult:
+    """The numeric solver started at ``q_near``.
+
+    ``q_near`` is checked against the poses first, so a mismatch is reported as
+    ``q_near``, the argument the caller passed.
+    """
+    from robokin.kinematics.ik import numeric
+
+    T = check_transform(T, "T")
+    check_broadcasts(q_near, T.shape[:-2] + (robot.n,), "q_near")
+    return numeric.solve(robot, T, q0=q_near, **options)
 
 
 def _nearest(robot: RobotLike, sols: SolutionSet, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
@@ -114,7 +131,10 @@ def _nearest(robot: RobotLike, sols: SolutionSet, T: npt.ArrayLike, q_near: np.n
         return IKResult(q=q[0], success=np.False_, error=np.nan, iterations=0,
                         restarts=0, reason=str(_why(sols).item()),
                         position_error=np.nan, rotation_error=np.nan)
-    reason = np.where(found, "converged", _why(sols).reshape(N)).astype(object)
+    reason = np.full(N, "converged", dtype=object)
+    if not found.all():  # the reasons of the poses without a solution only
+        miss = np.flatnonzero(~found)
+        reason[miss] = _why(sols[np.unravel_index(miss, lead)])
     zeros = np.zeros(lead, dtype=np.int64)
     return IKResult(q=q.reshape(lead + (n,)), success=found.reshape(lead),
                     error=np.hypot(err[:, 0], err[:, 1]).reshape(lead),

@@ -53,7 +53,13 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin import _native
-from robokin._validation import check_finite, check_joints, check_transform
+from robokin._validation import (
+    _real_array,
+    check_broadcasts,
+    check_finite,
+    check_joints,
+    check_transform,
+)
 from robokin.exceptions import InputError
 from robokin.kinematics.per_chain import cached
 from robokin.model.chain import Chain
@@ -386,10 +392,7 @@ def _count(x: Any, name: str, minimum: int = 0) -> int:
 
 def _targets(T: npt.ArrayLike) -> tuple[np.ndarray, tuple[int, ...]]:
     if type(T) is not np.ndarray or T.dtype != np.float64:
-        try:
-            T = np.asarray(T, dtype=np.float64)
-        except (TypeError, ValueError) as exc:
-            raise InputError("T", f"expected a 4x4 matrix, got {T!r:.80}") from exc
+        T = _real_array(T, "T", "a 4x4 matrix")
     if T.ndim < 2 or T.shape[-2:] != (4, 4):
         raise InputError("T", f"expected shape (..., 4, 4), got {T.shape}")
     lead = T.shape[:-2]
@@ -478,13 +481,11 @@ def solve(
         Q0 = np.broadcast_to(_middle(chain), (N, n))
     else:
         q0 = check_joints(q0, n, "q0")  # finiteness: checked by the kernel
-        try:
-            Q0 = q0.reshape(1, n) if q0.shape == (n,) and N == 1 else \
-                np.broadcast_to(q0, lead + (n,)).reshape(N, n)
-        except ValueError as exc:
-            raise InputError(
-                "q0", f"shape {q0.shape} does not broadcast to the targets' {lead + (n,)}"
-            ) from exc
+        if q0.shape == (n,) and N == 1:
+            Q0 = q0.reshape(1, n)
+        else:
+            Q0 = np.broadcast_to(check_broadcasts(q0, lead + (n,), "q0"),
+                                 lead + (n,)).reshape(N, n)
     if not Q0.flags.c_contiguous:
         Q0 = np.ascontiguousarray(Q0)
     out = np.empty((N, n + K.N_RES))
@@ -658,13 +659,8 @@ def solve_all(
     seeds = arr.seed_lower + gen.random((N, S, n)) * (arr.seed_upper - arr.seed_lower)
     if q_near is not None:
         qn = check_finite(check_joints(q_near, n, "q_near"), "q_near")
-        try:
-            seeds[:, 0] = np.broadcast_to(qn, lead + (n,)).reshape(N, n)
-        except ValueError as exc:
-            raise InputError(
-                "q_near", f"shape {qn.shape} does not broadcast to the targets' "
-                f"{lead + (n,)}"
-            ) from exc
+        check_broadcasts(qn, lead + (n,), "q_near")
+        seeds[:, 0] = np.broadcast_to(qn, lead + (n,)).reshape(N, n)
     flatT = np.ascontiguousarray(np.repeat(Tf, S, axis=0))
     flatQ = np.ascontiguousarray(seeds.reshape(N * S, n))
     opts[K.O_USE_Q0] = 1.0

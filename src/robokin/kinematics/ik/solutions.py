@@ -24,8 +24,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from robokin._validation import check_finite, check_joints
-from robokin.exceptions import InputError, UnreachableError
+from robokin._validation import check_broadcasts, check_finite, check_joints
+from robokin.exceptions import UnreachableError
 from robokin.spatial import wrap_angle
 
 if TYPE_CHECKING:
@@ -239,38 +239,38 @@ class SolutionSet:
         lost = self.valid.any(axis=-1) & ~out.valid.any(axis=-1)
         if lost.any():
             status = out.status.copy()
-            for idx in zip(*np.nonzero(lost)) if lost.ndim else [()]:
-                reasons = [
-                    f"solution {k + 1}: {self._limit_reason(self.q[idx][k])[22:]}"
-                    for k in np.flatnonzero(self.valid[idx])
-                ]
-                status[idx] = "outside joint limits: " + "; ".join(reasons)
-            out = replace(out, status=status)
+            k, n = self.q.shape[-2:]
+            rows = np.flatnonzero(lost)
+            q = self.q.reshape(-1, k, n)[rows]  # (m, k, n): the poses that lost all
+            lo, hi = self.limits[:, 0] - 1e-9, self.limits[:, 1] + 1e-9
+            bad = (q < lo) | (q > hi)
+            j = bad.argmax(axis=-1)  # (m, k): the first joint outside its limits
+            qj = np.take_along_axis(q, j[..., None], axis=-1)[..., 0]
+            flat = status.reshape(-1)
+            for r, valid, out_k, j_k, q_k in zip(
+                rows.tolist(), self.valid.reshape(-1, k)[rows].tolist(),
+                bad.any(axis=-1).tolist(), j.tolist(), qj.tolist(), strict=True
+            ):
+                flat[r] = "outside joint limits: " + "; ".join(
+                    f"solution {c + 1}: "
+                    + (self._limit_reason(j_k[c], q_k[c]) if out_k[c] else "")
+                    for c in range(k) if valid[c]
+                )
+            out = replace(out, status=flat.reshape(status.shape))
         return out
 
-    def _limit_reason(self, q: np.ndarray) -> str:
-        lim = self.limits
-        for j in range(q.shape[0]):
-            if q[j] < lim[j, 0] - 1e-9:
-                return (f"outside joint limits: joint {j + 1} at {q[j]:.6g} "
-                        f"< lower limit {lim[j, 0]:.6g}")
-            if q[j] > lim[j, 1] + 1e-9:
-                return (f"outside joint limits: joint {j + 1} at {q[j]:.6g} "
-                        f"> upper limit {lim[j, 1]:.6g}")
-        return "outside joint limits"
+    def _limit_reason(self, j: int, value: float) -> str:
+        """Why joint ``j`` at ``value`` is outside its limits."""
+        lo, hi = self.limits[j]
+        if value < lo - 1e-9:
+            return f"joint {j + 1} at {value:.6g} < lower limit {lo:.6g}"
+        return f"joint {j + 1} at {value:.6g} > upper limit {hi:.6g}"
 
     def _q_current(self, q_current: npt.ArrayLike) -> np.ndarray:
         """``q_current`` checked: finite, (..., n), broadcasting to the pose batch."""
         qc = check_finite(check_joints(q_current, self.n, "q_current"), "q_current")
-        target = self.shape + (self.n,)
-        try:
-            ok = np.broadcast_shapes(qc.shape, target) == target
-        except ValueError:
-            ok = False
-        if not ok:
-            raise InputError("q_current", f"shape {qc.shape} does not broadcast to the "
-                                          f"pose batch + joints {target}")
-        return qc
+        return check_broadcasts(qc, self.shape + (self.n,), "q_current",
+                                "the pose batch + joints")
 
     def distance(self, q_current: npt.ArrayLike) -> np.ndarray:
         """(..., k) joint-space distance from ``q_current`` (..., n) to every row.

@@ -47,6 +47,7 @@ import numpy as np
 from robokin import _native
 from robokin.kinematics.ik.analytic._common import fk_error, make_set
 from robokin.kinematics.per_chain import cached
+from robokin.spatial import invert, wrap_angle
 
 __all__ = ["NAME", "General6R", "Variant", "make_single", "raw_solve", "setup", "solve",
            "why_not"]
@@ -139,19 +140,10 @@ def setup(chain: Any) -> General6R:
 # ----------------------------------------------------------------- the fit
 
 
-def _rigid_inverse(T: np.ndarray) -> np.ndarray:
-    out = np.zeros_like(T)
-    R = T[..., :3, :3]
-    out[..., :3, :3] = np.swapaxes(R, -1, -2)
-    out[..., :3, 3] = -np.einsum("...ji,...j->...i", R, T[..., :3, 3])
-    out[..., 3, 3] = 1.0
-    return out
-
-
 def _direction_consts(chain: Any, reverse: bool) -> np.ndarray:
     """C'_0 .. C'_6 of the chain (or of its reversal, C'_k = C_{6-k}^-1), (7, 4, 4)."""
     C = np.array(chain.arrays.consts, dtype=np.float64)
-    return np.ascontiguousarray(_rigid_inverse(C[::-1]) if reverse else C)
+    return np.ascontiguousarray(invert(C[::-1]) if reverse else C)
 
 
 def _fit(consts: np.ndarray, a: int, rng: np.random.Generator) -> tuple[np.ndarray, float]:
@@ -188,7 +180,7 @@ def _block(v: Variant, consts: np.ndarray, P: np.ndarray) -> np.ndarray:
     b[K.VB_A] = v.split
     b[K.VB_MULT] = v.multiplier
     b[K.VB_C:K.VB_C + 112] = consts.ravel()
-    b[K.VB_CI:K.VB_CI + 112] = _rigid_inverse(consts).ravel()
+    b[K.VB_CI:K.VB_CI + 112] = invert(consts).ravel()
     b[K.VB_P:K.VB_P + 378] = P.ravel()
     return b
 
@@ -232,7 +224,7 @@ def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
 
 def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(len(a), len(b)) bool: configurations equal modulo 2 pi within DEDUPE_TOL."""
-    d = (a[:, None, :] - b[None, :, :] + np.pi) % (2 * np.pi) - np.pi
+    d = wrap_angle(a[:, None, :] - b[None, :, :])
     return np.abs(d).max(axis=-1) < 10 * DEDUPE_TOL
 
 
@@ -393,7 +385,12 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
             a pose is not a rigid transform, or ``q_near`` is not finite joint
             values (n,) or (..., n) that broadcast to the poses.
     """
-    from robokin._validation import check_finite, check_joints, check_poses_fast
+    from robokin._validation import (
+        check_broadcasts,
+        check_finite,
+        check_joints,
+        check_poses_fast,
+    )
     from robokin.exceptions import InputError
 
     chain = robot.chain
@@ -404,13 +401,7 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
     lead = T.shape[:-2]
     if q_near is not None:
         qn = check_finite(check_joints(q_near, 6, "q_near"), "q_near")
-        try:
-            fits = np.broadcast_shapes(qn.shape, lead + (6,)) == lead + (6,)
-        except ValueError:
-            fits = False
-        if not fits:
-            raise InputError("q_near", f"shape {qn.shape} does not broadcast to the "
-                                       f"targets' {lead + (6,)}")
+        check_broadcasts(qn, lead + (6,), "q_near")
     Q, valid, inside, sigma, status, diag, _ = raw_solve(
         chain, g.params, np.ascontiguousarray(T.reshape(-1, 4, 4)), parallel)
     shape = lead + (MAX_SOLUTIONS,)
