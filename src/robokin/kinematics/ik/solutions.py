@@ -247,9 +247,10 @@ class SolutionSet:
             j = bad.argmax(axis=-1)  # (m, k): the first joint outside its limits
             qj = np.take_along_axis(q, j[..., None], axis=-1)[..., 0]
             flat = status.reshape(-1)
+            outside: list[list[bool]] = np.any(bad, axis=-1).tolist()
             for r, valid, out_k, j_k, q_k in zip(
                 rows.tolist(), self.valid.reshape(-1, k)[rows].tolist(),
-                bad.any(axis=-1).tolist(), j.tolist(), qj.tolist(), strict=True
+                outside, j.tolist(), qj.tolist(), strict=True
             ):
                 flat[r] = "outside joint limits: " + "; ".join(
                     f"solution {c + 1}: "
