@@ -5,6 +5,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from robokin import spatial as sp
+from robokin.exceptions import InputError
 
 
 def test_elementary_rotations_match_closed_form():
@@ -90,3 +91,24 @@ def test_pose_error_rotation_matches_scipy_across_angles(angle, rng):
     if angle == np.pi:
         e = np.where((e * ref).sum(-1, keepdims=True) < 0, -e, e)
     np.testing.assert_allclose(e, ref, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("call", "name"),
+    [
+        (lambda: sp.pose_error(np.eye(3), np.eye(4)), "current"),
+        (lambda: sp.pose_error(np.eye(4), np.zeros((2, 4))), "target"),
+        (lambda: sp.pose_error(np.zeros((2, 4, 4)), np.zeros((3, 4, 4))), "target"),
+        (lambda: sp.rotvec_from_rotation(np.eye(4)), "R"),
+        (lambda: sp.rotation_from_rotvec([1.0, 2.0]), "w"),
+        (lambda: sp.matrix_from_rpy([0.1, 0.2]), "rpy"),
+        (lambda: sp.matrix_from_quaternion([1.0, 0.0, 0.0]), "wxyz"),
+        (lambda: sp.matrix_from_axis_angle(np.zeros(4)), "rotvec"),
+        (lambda: sp.rpy_from_matrix(np.eye(3)), "T"),
+        (lambda: sp.quaternion_from_matrix([[1, 0], [0, 1]]), "T"),
+        (lambda: sp.rpy_from_matrix(np.eye(4, dtype=complex)), "T"),
+    ],
+)
+def test_wrong_shapes_and_types_name_the_argument(call, name):
+    with pytest.raises(InputError, match=rf"'{name}'"):
+        call()

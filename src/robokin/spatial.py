@@ -122,15 +122,28 @@ def _from_R(R: np.ndarray) -> np.ndarray:
     return T
 
 
-def _apply(fn, x: np.ndarray, width: int) -> np.ndarray:
+def _shaped(x: npt.ArrayLike, name: str, tail: tuple[int, ...]) -> np.ndarray:
+    """``x`` as float64 of shape ``(...) + tail``, or an InputError naming ``name``."""
+    from robokin._validation import _real_array
+    from robokin.exceptions import InputError
+
+    a = _real_array(x, name, "numbers")
+    if a.shape[a.ndim - len(tail):] != tail or a.ndim < len(tail):
+        want = ", ".join(map(str, tail))
+        raise InputError(name, f"expected shape (..., {want}), got {a.shape}")
+    return a
+
+
+def _apply(fn, x: npt.ArrayLike, width: int, name: str) -> np.ndarray:
     """Run a scipy Rotation constructor on a batch of any leading shape."""
+    x = _shaped(x, name, (width,))
     lead = x.shape[:-1]
     R = fn(x.reshape(-1, width)).as_matrix().reshape(lead + (3, 3))
     return _from_R(R)
 
 
 def _as(fn_name: str, T: npt.ArrayLike, **kw: Any) -> np.ndarray:
-    T = np.asarray(T, dtype=np.float64)
+    T = _shaped(T, "T", (4, 4))
     lead = T.shape[:-2]
     rot = _rotation().from_matrix(T[..., :3, :3].reshape(-1, 3, 3))
     out = getattr(rot, fn_name)(**kw)
@@ -139,8 +152,7 @@ def _as(fn_name: str, T: npt.ArrayLike, **kw: Any) -> np.ndarray:
 
 def matrix_from_rpy(rpy: npt.ArrayLike) -> np.ndarray:
     """Rotation ``Rz(yaw) Ry(pitch) Rx(roll)`` as a transform; (..., 3) -> (..., 4, 4)."""
-    rpy = np.asarray(rpy, dtype=np.float64)
-    return _apply(lambda x: _rotation().from_euler("xyz", x), rpy, 3)
+    return _apply(lambda x: _rotation().from_euler("xyz", x), rpy, 3, "rpy")
 
 
 def rpy_from_matrix(T: npt.ArrayLike) -> np.ndarray:
@@ -174,8 +186,7 @@ def xyz_rpy_from_pose(T: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
 
 def matrix_from_quaternion(wxyz: npt.ArrayLike) -> np.ndarray:
     """Rotation from unit quaternions ``(w, x, y, z)``; (..., 4) -> (..., 4, 4)."""
-    q = np.asarray(wxyz, dtype=np.float64)
-    return _apply(lambda x: _rotation().from_quat(x[:, [1, 2, 3, 0]]), q, 4)
+    return _apply(lambda x: _rotation().from_quat(x[:, [1, 2, 3, 0]]), wxyz, 4, "wxyz")
 
 
 def quaternion_from_matrix(T: npt.ArrayLike) -> np.ndarray:
@@ -186,8 +197,7 @@ def quaternion_from_matrix(T: npt.ArrayLike) -> np.ndarray:
 
 def matrix_from_axis_angle(rotvec: npt.ArrayLike) -> np.ndarray:
     """Rotation from a rotation vector (axis times angle [rad]); (..., 3) -> (..., 4, 4)."""
-    v = np.asarray(rotvec, dtype=np.float64)
-    return _apply(lambda x: _rotation().from_rotvec(x), v, 3)
+    return _apply(lambda x: _rotation().from_rotvec(x), rotvec, 3, "rotvec")
 
 
 def rotvec_from_rotation(R: npt.ArrayLike) -> np.ndarray:
@@ -195,7 +205,7 @@ def rotvec_from_rotation(R: npt.ArrayLike) -> np.ndarray:
 
     Axis times angle [rad], the angle in [0, pi].
     """
-    R = np.asarray(R, dtype=np.float64)
+    R = _shaped(R, "R", (3, 3))
     lead = R.shape[:-2]
     if R.size == 0:
         return np.zeros(lead + (3,))
@@ -204,7 +214,7 @@ def rotvec_from_rotation(R: npt.ArrayLike) -> np.ndarray:
 
 def rotation_from_rotvec(w: npt.ArrayLike) -> np.ndarray:
     """Rotation matrices of rotation vectors [rad]; (..., 3) -> (..., 3, 3)."""
-    w = np.asarray(w, dtype=np.float64)
+    w = _shaped(w, "w", (3,))
     lead = w.shape[:-1]
     if w.size == 0:
         return np.zeros(lead + (3, 3))
@@ -237,9 +247,15 @@ def pose_error(current: npt.ArrayLike, target: npt.ArrayLike) -> np.ndarray:
     """
     from robokin._native import kernels
 
-    current = np.asarray(current, dtype=np.float64)
-    target = np.asarray(target, dtype=np.float64)
-    lead = np.broadcast_shapes(current.shape[:-2], target.shape[:-2])
+    current = _shaped(current, "current", (4, 4))
+    target = _shaped(target, "target", (4, 4))
+    try:
+        lead = np.broadcast_shapes(current.shape[:-2], target.shape[:-2])
+    except ValueError as exc:
+        from robokin.exceptions import InputError
+
+        raise InputError("target", f"shape {target.shape} does not broadcast with "
+                                   f"current's {current.shape}") from exc
     a = np.ascontiguousarray(np.broadcast_to(current, lead + (4, 4))).reshape(-1, 4, 4)
     b = np.ascontiguousarray(np.broadcast_to(target, lead + (4, 4))).reshape(-1, 4, 4)
     out = np.empty((a.shape[0], 6))

@@ -226,3 +226,10 @@ def test_missing_dh_keys_default_to_zero_and_misspelt_ones_are_refused():
         robokin.Robot.from_dh([{"a": 0.3, "alpah": 0.5}])
     with pytest.raises(robokin.ModelError, match=r"rows\[0\]\.limits.*numbers"):
         robokin.Robot.from_dh([{"a": 0.3, "limits": ["0", "1"]}])
+
+
+def test_a_chain_built_directly_needs_a_joint_too():
+    from robokin.model.chain import Chain
+
+    with pytest.raises(robokin.ModelError, match="at least one joint"):
+        Chain((), np.eye(4), np.zeros((0, 4, 4)), np.zeros((0, 4, 4)))

@@ -78,3 +78,13 @@ def test_each_function_takes_the_parameters_its_c_docstring_names(name):
     for isa, module in COPIES.items():
         doc = getattr(module, name).__doc__
         assert _c_parameters(doc) == declared, (isa, doc)
+
+
+def test_the_packed_layout_constants_match_every_compiled_copy():
+    # model/ does not import the kernels (layers point one way): the constants it
+    # writes into ChainArrays.packed must equal chain.h's in every built copy
+    from robokin.model import chain_arrays
+
+    for copy in _copies().values():
+        assert copy.LAYOUT_TAG == chain_arrays.LAYOUT_TAG
+        assert copy.MAX_JOINTS == chain_arrays.MAX_JOINTS

@@ -149,13 +149,15 @@ class Chain:
                 (then the coordinates must be as many as the joints).
 
         Raises:
-            ModelError: repeated joint names, a part of the wrong shape or not
+            ModelError: no joints, repeated joint names, a part of the wrong shape or not
                 finite, a coupling that does not fit, more than
                 :data:`~robokin.model.chain_arrays.MAX_JOINTS` joints.
         """
         init = object.__setattr__
         init(self, "joints", joints)
         nc = len(joints)
+        if nc == 0:
+            raise ModelError("a robot needs at least one joint")
         names = [j.name for j in joints]
         if len(set(names)) != nc:
             dup = sorted({x for x in names if names.count(x) > 1})
