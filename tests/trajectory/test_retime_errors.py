@@ -132,6 +132,13 @@ def test_too_many_samples_are_refused_before_sampling(ur5, move):
     assert info.value.argument == "dt"
 
 
+@pytest.mark.parametrize("max_samples", ["abc", 0, 1.5, -1, True])
+def test_a_bad_max_samples_is_refused_by_its_name(ur5, move, max_samples):
+    with pytest.raises(InputError, match="max_samples") as info:
+        trajectory.retime(ur5, move, v_max=1.0, a_max=2.0, max_samples=max_samples)
+    assert info.value.argument == "max_samples"
+
+
 def test_a_missing_extra_names_it(ur5, move, monkeypatch):
     monkeypatch.setitem(sys.modules, "toppra", None)
     with pytest.raises(MissingExtraError, match=r"robokin\[retime\]"):

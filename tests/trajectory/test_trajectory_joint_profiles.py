@@ -153,3 +153,22 @@ def test_time_grid_rejects_non_numbers_by_name():
         trajectory.quintic([0.0], [1.0], 1.0, dt="fast")
     with pytest.raises(InputError, match="duration"):
         trajectory.time_grid("long", 0.01)
+
+
+@pytest.mark.parametrize(("max_samples", "match"), [
+    ("abc", "whole number"), (1.5, "whole number"), (True, "whole number"),
+    (0, ">= 1"), (-5, ">= 1"),
+])
+def test_a_bad_max_samples_is_refused_by_its_name(max_samples, match):
+    # "abc" used to raise a bare ValueError, 0 an error naming 'duration', 1.5 to be
+    # truncated to a cap of 1
+    with pytest.raises(InputError, match=match) as info:
+        trajectory.time_grid(1.0, 0.5, max_samples=max_samples)
+    assert info.value.argument == "max_samples"
+
+
+def test_max_samples_caps_a_grid_and_takes_numpy_integers():
+    assert trajectory.time_grid(1.0, 0.5, max_samples=np.int64(4)).tolist() == [0.0, 0.5, 1.0]
+    with pytest.raises(InputError, match="more than the limit of 3") as info:
+        trajectory.time_grid(1.0, 0.5, max_samples=3)
+    assert info.value.argument == "duration"

@@ -133,3 +133,21 @@ def test_six_segment_path_of_5000_samples(aubo, rng):
     assert len(tr) == 5001 and tr.duration == pytest.approx(25.0, abs=1e-9)
     for arr, tol in ((tr.qd, 1e-5), (tr.qdd, 1e-4)):
         assert _junction_jumps(tr, arr).max() < tol
+
+
+@pytest.mark.parametrize("max_samples", ["abc", 0, 1.5])
+def test_a_bad_max_samples_is_refused_when_the_builder_is_made(aubo, max_samples):
+    with pytest.raises(InputError, match="max_samples") as info:
+        trajectory.PathBuilder(aubo, Q_HOME, max_samples=max_samples)
+    assert info.value.argument == "max_samples"
+
+
+def test_max_samples_caps_the_whole_path(aubo):
+    pb = trajectory.PathBuilder(aubo, Q_HOME, dt=0.01, max_samples=150)
+    pb.joint(Q_HOME + 0.1, duration=1.0).joint(Q_HOME, duration=1.0)
+    with pytest.raises(InputError, match="by segment 2.*limit of 150") as info:
+        pb.build()
+    assert info.value.argument == "max_samples"
+    assert len(trajectory.PathBuilder(aubo, Q_HOME, dt=0.01, max_samples=300)
+               .joint(Q_HOME + 0.1, duration=1.0).joint(Q_HOME, duration=1.0)
+               .build()) == 201

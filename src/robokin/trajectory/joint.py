@@ -20,6 +20,7 @@ from robokin.trajectory.samples import Trajectory
 
 __all__ = [
     "MAX_SAMPLES",
+    "check_max_samples",
     "check_sample_count",
     "constant_velocity",
     "cubic",
@@ -80,6 +81,29 @@ def time_grid(duration: float, dt: float, *, t0: float = 0.0,
     return t0 + t
 
 
+def check_max_samples(max_samples: Any) -> int:
+    """The sample cap a ``max_samples=`` argument asks for.
+
+    Args:
+        max_samples: An integer >= 1, or None for :data:`MAX_SAMPLES`.
+
+    Returns:
+        The cap (a count of samples).
+
+    Raises:
+        InputError: not an integer (a bool, a float such as 1.5, text), or below 1
+            (naming ``max_samples``).
+    """
+    if max_samples is None:
+        return MAX_SAMPLES
+    if isinstance(max_samples, bool) or not isinstance(max_samples, int | np.integer):
+        raise InputError("max_samples", f"expected a whole number of samples >= 1, got "
+                         f"{short_repr(max_samples)}")
+    if max_samples < 1:
+        raise InputError("max_samples", f"expected a count >= 1, got {int(max_samples)}")
+    return int(max_samples)
+
+
 def check_sample_count(duration: float, dt: float, max_samples: int | None = None,
                        *, argument: str = "duration") -> int:
     """The number of samples of a grid ``duration`` / ``dt``, refused above the cap.
@@ -94,9 +118,10 @@ def check_sample_count(duration: float, dt: float, max_samples: int | None = Non
         The sample count (end included).
 
     Raises:
-        InputError: more than ``max_samples`` samples.
+        InputError: more than ``max_samples`` samples (naming ``argument``), or a
+            ``max_samples`` that is not an integer >= 1 (naming ``max_samples``).
     """
-    cap = MAX_SAMPLES if max_samples is None else int(max_samples)
+    cap = check_max_samples(max_samples)
     count = duration / dt + 2.0
     if count > cap:
         raise InputError(argument, f"{duration:g} s at dt {dt:g} s is {count:,.0f} "

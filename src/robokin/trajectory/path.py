@@ -39,7 +39,7 @@ from robokin._validation import check_finite, check_joints, check_transform
 from robokin.exceptions import InputError, UnreachableError
 from robokin.trajectory.cartesian import IKMode, PathError, cartesian_line
 from robokin.trajectory.joint import (
-    MAX_SAMPLES,
+    check_max_samples,
     evaluate_polynomial,
     quintic_coefficients,
     time_grid,
@@ -136,6 +136,7 @@ class PathBuilder:
         self.tool_acceleration = tool_acceleration
         self.smooth = smooth
         self.ik = ik
+        check_max_samples(max_samples)
         self.max_samples = max_samples
         self.segments: list[Segment] = []
 
@@ -314,7 +315,7 @@ class PathBuilder:
 
     def _check_samples(self, segs: list[Segment], durations: list[float]) -> None:
         """Refuse a path of more than ``max_samples`` samples before sampling it."""
-        cap = MAX_SAMPLES if self.max_samples is None else int(self.max_samples)
+        cap = check_max_samples(self.max_samples)
         total = 0.0
         for i, (seg, duration) in enumerate(zip(segs, durations)):
             total += duration / self.dt + 1.0

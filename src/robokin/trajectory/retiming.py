@@ -51,7 +51,7 @@ from robokin.trajectory._retime_laws import (
     topp_ra_law,
 )
 from robokin.trajectory._retime_path import Piece, source_of, split_path
-from robokin.trajectory.joint import MAX_SAMPLES
+from robokin.trajectory.joint import check_max_samples
 from robokin.trajectory.samples import Trajectory
 
 __all__ = ["RetimeLimits", "RetimeResult", "SectionTiming", "retime",
@@ -501,6 +501,7 @@ def retime_detailed(
         traj = traj.to_joint_space(robot)
     if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
         raise InputError("dt", f"must be a positive sampling period [s], got {dt!r}")
+    cap = check_max_samples(max_samples)
     if grid_points is not None and not (isinstance(grid_points, int)
                                         and 2 <= grid_points <= 1_000_000):
         raise InputError("grid_points", f"expected a count in 2 .. 1000000, got "
@@ -534,8 +535,7 @@ def retime_detailed(
     plan = _Plan(robot, pieces, laws,
                  [pc.duration if keep_dwells else 0.0 for pc in pieces], limits,
                  float(dt), t, np.asarray(via, float), tuple(labels), tuple(jn),
-                 np.asarray(rev, bool),
-                 MAX_SAMPLES if max_samples is None else int(max_samples))
+                 np.asarray(rev, bool), cap)
     result = _finish(plan, laws)
     if not round_to_dt:
         return result
@@ -595,7 +595,8 @@ def retime(
         InputError: naming the argument: a zero, negative or non-finite limit, a
             limit neither given nor in the robot file, a path that jumps (it
             would need an infinite joint velocity), a path that does not move,
-            the wrong number of joints, a bad ``dt``.
+            the wrong number of joints, a bad ``dt`` or ``max_samples``, more
+            than ``max_samples`` samples (naming ``dt``).
         MissingExtraError: toppra (or ruckig, for jerk limits) is not installed
             (``pip install 'robokin[retime]'``).
 
