@@ -2,16 +2,15 @@
 
 Random YAML structures and values, alone and grafted into valid files: whatever
 the file holds, only robokin errors come out (a ModelError, an InputError, an
-unreachable pose ...), never a TypeError, a KeyError or a crash. Each example has
-a generous deadline (seconds), so a file that makes robokin work for minutes
-fails the test; this is not a speed measurement.
+unreachable pose ...), never a TypeError, a KeyError or a crash. No wall-clock
+deadline (tests do not time robokin); bounded work from small files is tested by
+the caps' own tests (sample, joint-row and alias budgets).
 """
 
 from __future__ import annotations
 
 import copy
 import warnings
-from datetime import timedelta
 
 import yaml
 from hypothesis import HealthCheck, event, given, settings
@@ -88,7 +87,7 @@ def _write(tmp_path_factory, doc, name):
     return path
 
 
-FUZZ = settings(max_examples=120, deadline=timedelta(seconds=20),
+FUZZ = settings(max_examples=120, deadline=None,
                 suppress_health_check=[HealthCheck.function_scoped_fixture,
                                        HealthCheck.too_slow, HealthCheck.data_too_large])
 
