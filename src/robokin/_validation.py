@@ -164,3 +164,27 @@ def check_vector(x: npt.ArrayLike, size: int, name: str) -> np.ndarray:
     if x.ndim == 0 or x.shape[-1] != size:
         raise InputError(name, f"expected shape (..., {size}), got {x.shape}")
     return check_finite(x, name)
+
+
+def check_finite_number(x: object, name: str) -> float:
+    """Return ``x`` as a float: one finite real number; raise InputError if not.
+
+    Python and NumPy integers and floats (a 0-d array too) are accepted;
+    booleans, complex numbers, text, arrays of more than one value, NaN and
+    infinities are refused.
+
+    Raises:
+        InputError: naming ``name``.
+    """
+    a = None
+    if not isinstance(x, (bool, np.bool_)) and not np.ma.isMaskedArray(x):
+        try:
+            a = np.asarray(x)
+        except (TypeError, ValueError):
+            a = None
+    if a is None or a.ndim != 0 or a.dtype.kind not in "fiu":
+        raise InputError(name, f"expected a finite number, got {short_repr(x)}")
+    v = float(a)
+    if not np.isfinite(v):
+        raise InputError(name, f"expected a finite number, got {v}")
+    return v

@@ -86,3 +86,15 @@ def test_a_region_must_be_a_non_empty_box(region, match):
 def test_too_many_voxels_are_refused_before_any_work():
     with pytest.raises(InputError, match="argument 'voxel'.*more than 2\\*\\*40"):
         VoxelGrid.from_region([[0, 0, 0], [100, 100, 100]], 1e-5)
+
+
+def test_voxel_of_needs_points_of_three_coordinates():
+    g = VoxelGrid.from_region([[0, 0, 0], [1, 2, 3]], 1.0)
+    np.testing.assert_array_equal(g.voxel_of([[0.5, 1.5, 2.5], [0.5, 0.5, 0.5], [5, 0, 0]]),
+                                  [5, 0, -1])
+    assert g.voxel_of([0.5, 0.5, 1.5]) == 1
+    for bad, match in (([1, 2], r"got shape \(2,\)"), (0.5, r"got shape \(\)"),
+                       (np.zeros((4, 2)), r"got shape \(4, 2\)"), ("ab", "got 'ab'")):
+        with pytest.raises(InputError, match=rf"argument 'points': expected points "
+                           rf"\(\.\.\., 3\) \[m\], {match}"):
+            g.voxel_of(bad)

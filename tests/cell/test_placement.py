@@ -168,3 +168,23 @@ def test_base_grid_combines_every_axis():
     rows = cell.place(robokin.load("ur5"), robokin.load("ur5").fk(np.zeros(6)),
                       [[0.0, 0.0, 0.0, 0.0]])
     assert rows.feasible[0]
+
+
+def test_a_plan_in_actuator_space_places_like_the_plan():
+    from robokin import trajectory
+
+    scara = robokin.load("scara")
+    plan = trajectory.quintic(np.array([0.0, 0.3, 0.0, 0.05]),
+                              np.array([0.4, 0.9, 1.5, 0.12]), 1.0, dt=0.05)
+    motors = plan.to_actuator_space(scara)
+    assert motors.space == "actuator" and np.abs(motors.q - plan.q).max() > 1.0
+    cand = cell.base_grid([0.0, 0.05], [0.0, 0.05])
+    a = cell.place(scara, plan, cand)
+    b = cell.place(scara, motors, cand)
+    np.testing.assert_allclose(a.task, scara.fk(plan.q), atol=1e-15)
+    np.testing.assert_allclose(b.task, a.task, atol=1e-12)
+    assert a.feasible.all() and b.feasible.all()
+    assert b.best_index == a.best_index == 3
+    np.testing.assert_array_equal(b.branch, a.branch)
+    np.testing.assert_allclose(b.score, a.score, rtol=1e-9)
+    np.testing.assert_allclose(b.best_q, a.best_q, atol=1e-9)

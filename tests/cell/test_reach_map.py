@@ -211,3 +211,66 @@ def test_the_default_region_covers_the_workspace(ur5):
     assert m.manipulability is None
     assert m.index.max() > 0 and m.index[0] == 0  # a corner of the box is out of reach
     assert math.isclose(m.volume(), np.count_nonzero(m.index) * 0.4**3)
+
+
+def test_a_map_too_large_for_memory_asks_for_a_store(ur5, monkeypatch, tmp_path):
+    import importlib
+
+    rm = importlib.import_module("robokin.cell.reach_map")  # the module, not the function
+
+    def never(*args, **kwargs):
+        raise AssertionError("the in-memory map was allocated")
+
+    with monkeypatch.context() as mp:
+        mp.setattr(rm, "_run_in_memory", never)
+        # 10^9 voxels x 32 orientations: 48.4 GiB of arrays
+        with pytest.raises(InputError, match=r"argument 'store': the map \(1,000,000,000 "
+                           r"voxels x 32 orientations\) needs 48\.4 GiB in memory, more "
+                           r"than the 2 GiB limit; pass store= a folder"):
+            cell.reach_map(ur5, region=[[-0.5, -0.5, 0.0], [0.5, 0.5, 1.0]], voxel=0.001)
+    # the cap counts V x K bytes of counts and 20 (12) bytes per voxel
+    kw = dict(region=REGION, voxel=0.3, orientations=4)
+    V, K = 4 * 4 * 4, 4
+    monkeypatch.setattr(rm, "MAX_IN_MEMORY_BYTES", V * K + 20 * V)
+    assert cell.reach_map(ur5, **kw).size == V
+    monkeypatch.setattr(rm, "MAX_IN_MEMORY_BYTES", V * K + 20 * V - 1)
+    with pytest.raises(InputError, match="argument 'store'.*more than the"):
+        cell.reach_map(ur5, **kw)
+    assert cell.reach_map(ur5, manipulability=False, **kw).manipulability is None
+    assert cell.reach_map(ur5, store=tmp_path / "m.zarr", **kw).size == V
+
+
+@pytest.mark.parametrize(("at", "match"), [
+    (math.nan, "got nan"),
+    (math.inf, "got inf"),
+    ("a", "got 'a'"),
+    (True, "got True"),
+    (1j, "got 1j"),
+    ([0.1, 0.2], r"got \[0.1, 0.2\]"),
+])
+def test_a_section_needs_a_finite_coordinate(small_map, at, match):
+    with pytest.raises(InputError, match=f"argument 'at': expected a finite number, {match}"):
+        small_map.section("x", at)
+    with pytest.raises(InputError, match="argument 'sections': expected a finite number"):
+        small_map.plot_sections(sections=[("z", at)])
+
+
+def test_section_coordinates_may_be_any_real_number(small_map):
+    ref, _ = small_map.section("z", 0.3)
+    for at in (np.float32(0.3), np.array(0.3), 0.3):
+        np.testing.assert_array_equal(small_map.section("z", at)[0], ref)
+    np.testing.assert_array_equal(small_map.section("z", 0)[0], small_map.section("z", 0.0)[0])
+    with pytest.raises(InputError, match=r"argument 'sections': expected \(axis, at \[m\]\) "
+                       r"pairs, got \('z',\)"):
+        small_map.plot_sections(sections=[("z",)])
+
+
+def test_as_grid_needs_one_value_per_voxel(small_map):
+    V = small_map.size
+    cube = small_map.as_grid(np.arange(V))
+    assert cube.shape == small_map.grid.shape and cube[0, 0, 1] == 1
+    assert small_map.as_grid(np.zeros((V, 2))).shape == small_map.grid.shape + (2,)
+    for bad, shape in (([1, 2, 3], r"\(3,\)"), (5, r"\(\)"), (np.zeros(V + 1), rf"\({V + 1},\)")):
+        with pytest.raises(InputError, match=rf"argument 'values': expected one value per "
+                           rf"voxel, shape \({V}, ...\), got shape {shape}"):
+            small_map.as_grid(bad)

@@ -20,7 +20,12 @@ import pytest
 import robokin
 from robokin.cli import main
 from robokin.exceptions import InputError
-from robokin.io.atomic import file_stem, save_figure_atomic, write_atomic
+from robokin.io.atomic import (
+    file_stem,
+    publish_folder,
+    save_figure_atomic,
+    write_atomic,
+)
 
 
 def _png(path, value: float) -> bytes:
@@ -189,3 +194,73 @@ def test_file_stems_from_names_cannot_leave_the_folder():
     assert file_stem("ur5") == "ur5"
     assert file_stem("") == "robot" and file_stem("...") == "robot"
     assert len(file_stem("x" * 500)) == 80
+
+
+def _build(folder, text):
+    folder.mkdir()
+    (folder / "a.txt").write_text(text)
+
+
+def _publish_nothing(path, **kwargs):
+    with publish_folder(path, **kwargs):
+        pass
+
+
+def test_a_published_folder_appears_whole_or_not_at_all(tmp_path):
+    target = tmp_path / "store"
+    with publish_folder(target) as tmp:
+        assert not tmp.exists() and tmp.parent.parent == tmp_path
+        _build(tmp, "one")
+        assert not target.exists()
+    assert (target / "a.txt").read_text() == "one"
+    with pytest.raises(InputError, match="argument 'out'.*store exists; pass overwrite=True"):
+        _publish_nothing(target, argument="out")
+    with (pytest.raises(RuntimeError, match="half-way"),
+          publish_folder(target, overwrite=True) as tmp):
+        _build(tmp, "two")
+        raise RuntimeError("the writer failed half-way")
+    assert (target / "a.txt").read_text() == "one"
+    with publish_folder(target, overwrite=True) as tmp:
+        _build(tmp, "three")
+    assert (target / "a.txt").read_text() == "three"
+    assert [p.name for p in tmp_path.iterdir()] == ["store"]  # no temporary left
+    (tmp_path / "afile").write_text("x")
+    with pytest.raises(InputError, match="afile is a file, expected a store folder"):
+        _publish_nothing(tmp_path / "afile", overwrite=True)
+    with pytest.raises(InputError, match="the folder .*afile does not exist"):
+        _publish_nothing(tmp_path / "afile" / "m")
+
+
+def test_os_errors_publishing_a_folder_name_the_users_path(tmp_path):
+    long = tmp_path / ("n" * 300)  # too long a name, even for root
+    with pytest.raises(InputError) as exc:
+        _publish_nothing(long, argument="store")
+    msg = str(exc.value)
+    assert msg.startswith("argument 'store': ") and "File name too long" in msg
+    assert "\n" not in msg
+    with pytest.raises(InputError) as exc, publish_folder(tmp_path / "m") as tmp:
+        (tmp / "sub").mkdir()  # the body fails: its folder was never made
+    msg = str(exc.value)
+    assert msg.startswith("argument 'path': ") and "m: cannot write" in msg
+    assert ".tmp" not in msg and "No such file" in msg
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_reach_map_store_that_cannot_be_written_is_named(tmp_path):
+    pytest.importorskip("dask")
+    pytest.importorskip("zarr")
+    from robokin import cell
+
+    ur5 = robokin.load("ur5")
+    kw = dict(region=[[-0.6, -0.6, -0.3], [0.6, 0.6, 0.9]], voxel=0.6, orientations=2)
+    m = cell.reach_map(ur5, **kw)
+    long = tmp_path / ("n" * 300)
+    with pytest.raises(InputError, match="argument 'path'.*cannot write.*File name too long"):
+        m.save(long)
+    with pytest.raises(InputError, match="argument 'store'.*File name too long"):
+        cell.reach_map(ur5, store=long, **kw)
+    (tmp_path / "afile").write_text("x")
+    (tmp_path / "link").symlink_to(tmp_path / "afile" / "x")  # a link into a file
+    with pytest.raises(InputError, match="argument 'store'.*link: cannot create the store"):
+        cell.reach_map(ur5, store=tmp_path / "link", **kw)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "link"]

@@ -78,3 +78,22 @@ def test_bad_step_contacts_and_tolerance(ur5_plan):
     bad = plan.replace(q=np.where(np.arange(6) == 2, np.nan, plan.q))
     with pytest.raises(robokin.InputError, match="non-finite"):
         sim.simulate(robot, bad)
+
+
+def test_a_plan_too_long_to_step_is_refused_before_allocating(ur5_plan):
+    robot, plan = ur5_plan
+    # two samples a million seconds apart: 1e9 physics steps (7.45 GiB of step times
+    # alone) used to be allocated
+    long = robokin.trajectory.Trajectory(
+        np.array([0.0, 1e6]), plan.q[[0, -1]], np.zeros((2, 6)), np.zeros((2, 6)),
+        joint_names=robot.joint_names)
+    with pytest.raises(robokin.InputError, match=r"1e\+06 s at dt 0.001 s .*more than "
+                       r"the limit of 10,000,000") as exc:
+        sim.simulate(robot, long)
+    assert exc.value.argument == "traj"
+    with pytest.raises(robokin.InputError, match="limit of 400") as exc:
+        sim.simulate(robot, plan, max_samples=400)  # 0.5 s at 1 kHz: 502 > 400
+    assert exc.value.argument == "traj"
+    assert sim.simulate(robot, plan, max_samples=600).steps == 500
+    with pytest.raises(robokin.InputError, match="argument 'max_samples'"):
+        sim.simulate(robot, plan, max_samples=0.5)

@@ -9,8 +9,9 @@ a map is the same bit for bit whatever the chunking and wherever it runs:
 * the closed-form IK kernel and the numeric solver give each target the result
   it gets alone (``tests/native``; the numeric solver is given no random
   restarts: only its deterministic seed-table restarts);
-* the manipulability is a per-solution determinant and the per-voxel results
-  are maxima and integer sums, which do not depend on order.
+* the manipulability is computed per solution (a determinant, or a product
+  of singular values) and the per-voxel results are maxima and integer sums,
+  which do not depend on order.
 """
 
 from __future__ import annotations
@@ -90,32 +91,19 @@ class ReachChunk:
 
 
 def manipulability(chain: Chain, q: np.ndarray) -> np.ndarray:
-    r"""Yoshikawa's manipulability of configurations q (P, n), shape (P,).
+    """Yoshikawa's manipulability of configurations q (P, n) [rad, m], shape (P,).
 
-    .. math::
-
-        w = \sqrt{\det(J J^T)} = |\det J| \quad (n = 6),
-
-    with :math:`J^T J` in place of :math:`J J^T` for n < 6 (Yoshikawa,
-    "Manipulability of robotic mechanisms", IJRR 4(2), 1985, eq. 9). The
-    determinant form equals :meth:`robokin.Robot.manipulability` (the product
-    of singular values) to rounding at about a sixth of its cost (one LU per
-    matrix instead of an SVD); each row is computed on its own, so chunking
-    changes no bit.
+    :func:`robokin.kinematics.jacobian.manipulability` with ``method="det"``
+    (``|det J|`` for a 6-joint arm, the product of singular values otherwise),
+    :data:`_MANIPULABILITY_BATCH` configurations at a time so the temporaries
+    stay bounded. Each row is computed on its own, so chunking changes no bit.
     """
-    from robokin.kinematics.jacobian import jacobian
+    from robokin.kinematics.jacobian import manipulability as yoshikawa
 
     out = np.empty(q.shape[0])
     for a in range(0, q.shape[0], _MANIPULABILITY_BATCH):  # bounded temporaries
-        J = jacobian(chain, q[a : a + _MANIPULABILITY_BATCH])
-        n = J.shape[-1]
-        if n == 6:
-            w = np.abs(np.linalg.det(J))
-        else:
-            Jt = np.swapaxes(J, -1, -2)
-            G = Jt @ J if n < 6 else J @ Jt
-            w = np.sqrt(np.maximum(np.linalg.det(G), 0.0))
-        out[a : a + J.shape[0]] = w
+        b = min(a + _MANIPULABILITY_BATCH, q.shape[0])
+        out[a:b] = yoshikawa(chain, q[a:b], method="det")
     return out
 
 

@@ -38,8 +38,9 @@ def placed_robot(robot: Robot, scene: Scene | None) -> tuple[Robot, Robot | None
 def ik_method(robot: Robot, method: str) -> tuple[bool, str]:
     """(numeric?, the method's name) for ``method`` on this robot."""
     from robokin.kinematics.ik.analytic.detect import detect
+    from robokin.kinematics.ik.dispatch import _METHODS
 
-    if method not in ("auto", "analytic", "numeric"):
+    if method not in _METHODS:
         raise InputError(
             "method", f"expected 'auto', 'analytic' or 'numeric', got {short_repr(method)}"
         )

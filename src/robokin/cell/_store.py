@@ -21,9 +21,6 @@ store again computes only the chunks not marked done.
 from __future__ import annotations
 
 import contextlib
-import os
-import shutil
-import tempfile
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -58,8 +55,37 @@ def _zarr() -> Any:
 
 
 def create(path: str | Path, attrs: Mapping[str, Any], *, voxels: int,
-           orientations: np.ndarray, chunk: int, with_manipulability: bool) -> None:
-    """Create an empty map store at ``path`` (which must not exist)."""
+           orientations: np.ndarray, chunk: int, with_manipulability: bool,
+           argument: str | None = "store") -> None:
+    """Create an empty map store at ``path`` (which must not exist).
+
+    Args:
+        path: The store folder to create.
+        attrs: The map's attributes (see the module docstring).
+        voxels: Number of voxels V.
+        orientations: Tool orientations (K, 3, 3).
+        chunk: Voxels per Zarr chunk (per task).
+        with_manipulability: Add the manipulability array.
+        argument: The argument named when a file operation fails, or None to
+            let the OSError through (inside :func:`publish`, which names the
+            user's path instead of its temporary one).
+
+    Raises:
+        InputError: the store cannot be created (read-only folder, full disk,
+            a name too long...), naming ``argument`` and ``path``.
+    """
+    try:
+        _create(path, attrs, voxels=voxels, orientations=orientations, chunk=chunk,
+                with_manipulability=with_manipulability)
+    except OSError as exc:
+        if argument is None:
+            raise
+        raise InputError(argument, f"{path}: cannot create the store: "
+                         f"{exc.strerror or exc}") from None
+
+
+def _create(path: str | Path, attrs: Mapping[str, Any], *, voxels: int,
+            orientations: np.ndarray, chunk: int, with_manipulability: bool) -> None:
     zarr = _zarr()
     K = orientations.shape[0]
     n_chunks = -(-voxels // chunk)
@@ -159,31 +185,23 @@ def open_map(path: str | Path, argument: str = "path") -> Any:
     return g
 
 
-@contextlib.contextmanager
-def publish(path: str | Path, *, overwrite: bool, argument: str = "path") -> Any:
+def publish(path: str | Path, *, overwrite: bool, argument: str = "path"
+            ) -> contextlib.AbstractContextManager[Path]:
     """Write a store into a fresh folder beside ``path``, then rename it into place.
 
     Zarr writes its many files itself, so the store is built in a temporary
     folder and appears at ``path`` in one rename: a reader sees the old map or
-    the new one, never half of one; on any failure the temporary folder goes.
+    the new one, never half of one; on any failure the temporary folder goes
+    (:func:`robokin.io.atomic.publish_folder`).
 
-    Yields:
-        The temporary folder to write the store into.
+    Returns:
+        A context manager yielding the path to create the store at.
+
+    Raises:
+        InputError: the folder of ``path`` is missing, ``path`` exists (without
+            ``overwrite``) or is a file, or a file operation fails (naming
+            ``argument`` and ``path``).
     """
-    target = Path(path)
-    parent = target.parent if str(target.parent) else Path(".")
-    if not parent.is_dir():
-        raise InputError(argument, f"{target}: the folder {parent} does not exist")
-    if target.exists() and not overwrite:
-        raise InputError(argument, f"{target} exists; pass overwrite=True to replace it")
-    if target.exists() and not target.is_dir():
-        raise InputError(argument, f"{target} is a file, expected a store folder")
-    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=parent))
-    store = tmp / "store"
-    try:
-        yield store
-        if target.exists():
-            os.replace(target, tmp / "old")
-        os.replace(store, target)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+    from robokin.io.atomic import publish_folder
+
+    return publish_folder(path, overwrite=overwrite, argument=argument)

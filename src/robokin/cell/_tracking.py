@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from robokin.cell._evaluate import NUMERIC_RESTARTS, solve_poses
+from robokin.spatial import wrap_angle
 
 if TYPE_CHECKING:
     from robokin.robot import Robot
@@ -79,7 +80,7 @@ def track(robot: Robot, T: np.ndarray, max_step: float, numeric: bool) -> Tracks
     for i in range(1, N):
         # candidate solutions s (C, 1, k, n) against current track values (C, k, 1, n)
         d = q[:, i][:, None] - cur[:, :, None]
-        d[..., rev] = (d[..., rev] + np.pi) % (2.0 * np.pi) - np.pi
+        d[..., rev] = wrap_angle(d[..., rev])
         s = cur[:, :, None] + d
         inside = ok[:, i][:, None] & ((s >= lim[:, 0]) & (s <= lim[:, 1])).all(axis=-1)
         step = np.where(inside, np.abs(d).max(axis=-1), np.inf)

@@ -23,6 +23,7 @@ import numpy.typing as npt
 
 from robokin._text import short_repr
 from robokin.exceptions import InputError
+from robokin.spatial import rotz
 
 __all__ = ["VoxelGrid", "tool_orientations"]
 
@@ -105,8 +106,18 @@ class VoxelGrid:
         return self.origin + (idx + 0.5) * self.voxel
 
     def voxel_of(self, points: npt.ArrayLike) -> np.ndarray:
-        """Voxel numbers of points [m] (..., 3); -1 outside the grid, shape (...)."""
-        p = np.asarray(points, dtype=np.float64)
+        """Voxel numbers of points [m] (..., 3); -1 outside the grid, shape (...).
+
+        Raises:
+            InputError: ``points`` is not real numbers of shape (..., 3).
+        """
+        try:
+            p = np.asarray(points, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise InputError("points", f"expected points (..., 3) [m], got "
+                             f"{short_repr(points)}") from None
+        if p.ndim == 0 or p.shape[-1] != 3:
+            raise InputError("points", f"expected points (..., 3) [m], got shape {p.shape}")
         idx = np.floor((p - self.origin) / self.voxel).astype(np.int64)
         inside = ((idx >= 0) & (idx < np.array(self.shape))).all(axis=-1)
         clipped = np.clip(idx, 0, np.array(self.shape) - 1)
@@ -184,10 +195,7 @@ def tool_orientations(count: int, rolls: int = 1) -> np.ndarray:
     y = np.cross(d, x)
     base = np.stack([x, y, d], axis=-1)  # columns x, y, z
     roll = 2.0 * np.pi * np.arange(rolls) / rolls
-    c, s = np.cos(roll), np.sin(roll)
-    Rz = np.zeros((rolls, 3, 3))
-    Rz[:, 0, 0], Rz[:, 0, 1], Rz[:, 1, 0], Rz[:, 1, 1] = c, -s, s, c
-    Rz[:, 2, 2] = 1.0
+    Rz = rotz(roll)[:, :3, :3]
     out = base[:, None] @ Rz[None]
     return np.ascontiguousarray(out.reshape(count * rolls, 3, 3))
 

@@ -259,10 +259,9 @@ def base_grid(
 
 def poses_from_xyz_yaw(rows: np.ndarray) -> np.ndarray:
     """Base poses (C, 4, 4) from rows ``(x, y, z, yaw)`` (C, 4) [m, rad]."""
-    c, s = np.cos(rows[:, 3]), np.sin(rows[:, 3])
-    T = np.zeros((rows.shape[0], 4, 4))
-    T[:, 0, 0], T[:, 0, 1], T[:, 1, 0], T[:, 1, 1] = c, -s, s, c
-    T[:, 2, 2] = T[:, 3, 3] = 1.0
+    from robokin.spatial import rotz
+
+    T = rotz(rows[:, 3])
     T[:, :3, 3] = rows[:, :3]
     return T
 
@@ -293,9 +292,9 @@ def _task(task: Any, world: Robot) -> np.ndarray:
     """Task poses (N, 4, 4): given, a trajectory's poses, or FK of its joints."""
     from robokin._validation import check_transform
 
-    if hasattr(task, "q") and not isinstance(task, np.ndarray):
-        pose = getattr(task, "pose", None)
-        T = np.asarray(pose) if pose is not None else world.fk(np.asarray(task.q))
+    if not isinstance(task, np.ndarray) and (hasattr(task, "tool_poses")
+                                             or hasattr(task, "q")):
+        T = _trajectory_poses(task, world)
     else:
         try:
             T = np.asarray(task, dtype=np.float64)
@@ -308,6 +307,21 @@ def _task(task: Any, world: Robot) -> np.ndarray:
         raise InputError("task", f"expected tool poses (N, 4, 4) with N >= 1, got shape "
                          f"{T.shape}")
     return np.ascontiguousarray(check_transform(T, "task"))
+
+
+def _trajectory_poses(task: Any, world: Robot) -> np.ndarray:
+    """Tool poses of a trajectory at the robot's placement, shape (N, 4, 4) [m].
+
+    A :class:`~robokin.trajectory.Trajectory` gives its own
+    (``tool_poses(world)``: the stored poses, else FK of its joints, converted
+    from actuator space first); another object its ``pose``, else FK of its
+    ``q`` (N, n).
+    """
+    tool_poses = getattr(task, "tool_poses", None)
+    if callable(tool_poses):
+        return np.asarray(tool_poses(world))
+    pose = getattr(task, "pose", None)
+    return np.asarray(pose) if pose is not None else world.fk(np.asarray(task.q))
 
 
 def _check_span(task: np.ndarray, robot: Robot) -> None:
@@ -358,8 +372,9 @@ def place(
         robot: The robot (with a scene: as the scene would place it, or bare;
             the scene adds its tool).
         task: Tool (TCP) poses in the world (N, 4, 4) [m] in task order, or a
-            trajectory (its ``pose``, else FK of its ``q`` at the robot's
-            current placement).
+            trajectory (its ``tool_poses(robot)`` at the robot's current
+            placement: its ``pose``, else FK of its joints, a trajectory in
+            actuator space converted to joint space first).
         candidates: Base poses (C, 4, 4) [m] (see :func:`base_grid`), or rows
             ``(x, y, z, yaw)`` (C, 4) [m, rad].
         scene: A :class:`~robokin.collision.Scene`; its base placement is

@@ -46,6 +46,24 @@ def _densest_layer(m: ReachMap, k: int) -> float:
     return float(m.grid.axis(k)[int(np.argmax(cube.sum(axis=other)))])
 
 
+def _check_sections(sections: Sequence[tuple[str, float]]) -> list[tuple[str, float]]:
+    """The ``(axis, at [m])`` pairs, ``at`` a finite float, or :class:`InputError`."""
+    from robokin._text import short_repr
+    from robokin._validation import check_finite_number
+
+    out = []
+    for pair in sections:
+        try:
+            axis, at = pair
+        except (TypeError, ValueError):
+            raise InputError("sections", f"expected (axis, at [m]) pairs, got "
+                             f"{short_repr(pair)}") from None
+        out.append((axis, check_finite_number(at, "sections")))
+    if not out:
+        raise InputError("sections", "expected at least one (axis, at) pair")
+    return out
+
+
 def plot_sections(
     m: ReachMap,
     *,
@@ -69,19 +87,20 @@ def plot_sections(
         The matplotlib figure.
 
     Raises:
-        InputError: an unknown quantity or axis, or no manipulability in the map.
+        InputError: an unknown quantity or axis, a section that is not an
+            ``(axis, at)`` pair with a finite ``at``, or no manipulability in the
+            map.
     """
     if sections is None:
         y = float(m.base[1, 3]) if m.base is not None else _densest_layer(m, 1)
         sections = [("y", y), ("z", _densest_layer(m, 2))]
-    if not sections:
-        raise InputError("sections", "expected at least one (axis, at) pair")
+    sections = _check_sections(sections)
     fig = _figure((5.2 * len(sections) + 1.0, 5.0))
     label = _LABELS.get(quantity, quantity)
     vmax = 1.0 if quantity == "index" else None
     image = None
     for i, (axis, at) in enumerate(sections):
-        values, ext = m.section(axis, float(at), quantity)  # type: ignore[arg-type]
+        values, ext = m.section(axis, at, quantity)  # type: ignore[arg-type]
         shown = np.ma.masked_less_equal(values.T.astype(float), 0.0)
         ax = fig.add_subplot(1, len(sections), i + 1)
         u, v = [c for c in "xyz" if c != axis]
@@ -98,7 +117,7 @@ def plot_sections(
         ax.set_xlabel(f"{u} [mm]")
         ax.set_ylabel(f"{v} [mm]")
         ax.set_aspect("equal")
-        ax.set_title(f"{axis} = {float(at) * 1e3:.0f} mm")
+        ax.set_title(f"{axis} = {at * 1e3:.0f} mm")
     if image is not None:
         fig.colorbar(image, ax=fig.axes, label=label, shrink=0.85)
     fig.suptitle(

@@ -59,6 +59,10 @@ _POSES_PER_TASK = 131072
 _MAX_TASKS = 50_000
 _REGION_SAMPLES = 200_000
 _REGION_MARGIN = 0.05  # of the extent, on each side
+#: Largest map :func:`reach_map` builds in memory (``store=None``) [bytes]: its
+#: arrays, V x K counts (1 B each) and 20 B per voxel (12 B without
+#: manipulability). A larger map needs ``store=`` (see ``docs/scale.md``).
+MAX_IN_MEMORY_BYTES = 2 * 2**30
 
 
 class ArrayLike(Protocol):
@@ -141,8 +145,15 @@ class ReachMap:
         return float(np.count_nonzero(idx > threshold)) * self.grid.voxel**3
 
     def as_grid(self, values: npt.ArrayLike) -> np.ndarray:
-        """Per-voxel values (V, ...) arranged on the grid, (nx, ny, nz, ...)."""
+        """Per-voxel values (V, ...) arranged on the grid, (nx, ny, nz, ...).
+
+        Raises:
+            InputError: ``values`` is not V values along its first axis.
+        """
         v = np.asarray(values)
+        if v.ndim == 0 or v.shape[0] != self.size:
+            raise InputError("values", f"expected one value per voxel, shape ({self.size}, "
+                             f"...), got shape {v.shape}")
         return v.reshape(self.grid.shape + v.shape[1:])
 
     def section(
@@ -165,10 +176,14 @@ class ReachMap:
             ``[[u0, v0], [u1, v1]]`` [m] it spans.
 
         Raises:
-            InputError: an unknown axis or quantity, or no manipulability.
+            InputError: an unknown axis or quantity, no manipulability, or an
+                ``at`` that is not a finite number.
         """
+        from robokin._validation import check_finite_number
+
         if axis not in ("x", "y", "z"):
             raise InputError("axis", f"expected 'x', 'y' or 'z', got {short_repr(axis)}")
+        at = check_finite_number(at, "at")
         arr = self._quantity(quantity)
         k = "xyz".index(axis)
         layer = int(np.clip(math.floor((at - self.grid.origin[k]) / self.grid.voxel),
@@ -234,8 +249,9 @@ class ReachMap:
             ``path``.
 
         Raises:
-            InputError: ``path`` exists (without ``overwrite``), is a file, or its
-                folder does not exist.
+            InputError: ``path`` exists (without ``overwrite``), is a file, its
+                folder does not exist, or the store cannot be written there
+                (read-only folder, full disk...).
             MissingExtraError: zarr is not installed.
         """
         target = Path(path)
@@ -246,7 +262,8 @@ class ReachMap:
         attrs = self._attrs(chunk)
         with _store.publish(target, overwrite=overwrite) as tmp:
             _store.create(tmp, attrs, voxels=self.size, orientations=self.orientations,
-                          chunk=chunk, with_manipulability=self.manipulability is not None)
+                          chunk=chunk, with_manipulability=self.manipulability is not None,
+                          argument=None)
             for a in range(0, self.size, chunk):
                 b = min(a + chunk, self.size)
                 _store.write_chunk(str(tmp), a, b, {
@@ -359,14 +376,17 @@ def reach_map(
             ``docs/scale.md``).
         store: A Zarr store folder the chunks stream into (memory then stays
             bounded); the map returned reads from it lazily. An incomplete store
-            of the same map is resumed.
+            of the same map is resumed. Without one the map is built in memory,
+            at most :data:`MAX_IN_MEMORY_BYTES` (2 GiB: V x K bytes of counts
+            and 20 bytes per voxel).
         rolls: Rolls about each approach direction (with an integer
             ``orientations``).
         method: ``"auto"`` (the closed form when the arm has one, every
             solution; else the numeric solver, one solution per target from its
             deterministic seed-table restarts), ``"analytic"`` or ``"numeric"``.
         manipulability: Compute the best manipulability per voxel (about as
-            costly again as the IK: one Jacobian and determinant per solution).
+            costly again as the IK: one Jacobian and determinant per solution;
+            a singular value decomposition for an arm without 6 joints).
         chunk: Voxels per Dask task (default: about 131,000 IK targets, and at
             most 50,000 tasks).
         progress: True for a progress bar on stderr, or ``progress(done, total)``
@@ -380,7 +400,8 @@ def reach_map(
         InputError: an empty or malformed region, a voxel <= 0, bad
             orientations, an unknown method (or ``"analytic"`` for an arm
             without a closed form), a bad scheduler or one that cannot be
-            reached, a store holding another map.
+            reached, a store holding another map or that cannot be written,
+            a map larger than 2 GiB without a store (naming ``store``).
         MissingExtraError: dask, distributed or zarr is not installed (``pip
             install 'robokin[scale]'``), or coal with a scene.
     """
@@ -398,6 +419,8 @@ def reach_map(
         grid = VoxelGrid.from_region(region, voxel)
     numeric, method_name = ik_method(world, method)
     V, K = grid.size, R.shape[0]
+    if store is None:
+        _check_in_memory(V, K, bool(manipulability))
     B = _chunk(chunk, V, K)
     ranges = [(a, min(a + B, V)) for a in range(0, V, B)]
     job = ReachJob(world, bare, scene, grid, R, numeric, bool(manipulability))
@@ -409,6 +432,28 @@ def reach_map(
         return _run_in_memory(job, shell, ranges, scheduler, progress)
     return _run_into_store(job, shell, ranges, Path(store), fingerprint, scheduler,
                            progress, overwrite)
+
+
+def _in_memory_bytes(V: int, K: int, with_manipulability: bool) -> int:
+    """Bytes of a map's arrays held in memory: V voxels x K orientations.
+
+    ``counts`` (V, K) uint8, ``index`` (V,) float64, ``solutions`` (V,) int32
+    and ``manipulability`` (V,) float64.
+    """
+    return V * K + V * (8 + 4 + (8 if with_manipulability else 0))
+
+
+def _check_in_memory(V: int, K: int, with_manipulability: bool) -> None:
+    """Refuse an in-memory map above :data:`MAX_IN_MEMORY_BYTES` (before allocating)."""
+    need = _in_memory_bytes(V, K, with_manipulability)
+    if need > MAX_IN_MEMORY_BYTES:
+        raise InputError(
+            "store",
+            f"the map ({V:,} voxels x {K} orientations) needs {need / 2**30:.1f} GiB "
+            f"in memory, more than the {MAX_IN_MEMORY_BYTES / 2**30:g} GiB limit; pass "
+            "store= a folder to stream the map into Zarr (or a larger voxel, fewer "
+            "orientations, a smaller region)",
+        )
 
 
 def _run_in_memory(job: ReachJob, shell: ReachMap, ranges: list[tuple[int, int]],
@@ -476,29 +521,44 @@ def _run_into_store(job: ReachJob, shell: ReachMap, ranges: list[tuple[int, int]
 def _prepare_store(path: Path, shell: ReachMap, job: ReachJob, chunk: int,
                    fingerprint: str, overwrite: bool) -> np.ndarray:
     """The done flags of the store at ``path``: created empty, or resumed."""
-    n_chunks = -(-job.grid.size // chunk)
-    if path.exists():
-        if path.is_dir() and not any(path.iterdir()):
-            path.rmdir()
-        else:
-            g = _store.open_map(path, argument="store")
-            if g.attrs.get("fingerprint") == fingerprint:
-                return _store.read_done(path)
-            if not overwrite:
-                raise InputError(
-                    "store",
-                    f"{path} holds a different map (robot {g.attrs.get('robot')!r}, "
-                    f"voxel {float(g.attrs.get('voxel', 0)) * 1000:g} mm, grid "
-                    f"{g.attrs.get('shape')}); choose another store or pass "
-                    "overwrite=True",
-                )
-            shutil.rmtree(path)
+    try:
+        done = _resume_store(path, fingerprint, overwrite)
+    except OSError as exc:
+        raise InputError("store", f"{path}: cannot use it as a store: "
+                         f"{exc.strerror or exc}") from None
+    if done is not None:
+        return done
     if not path.parent.is_dir():
         raise InputError("store", f"{path}: the folder {path.parent} does not exist")
     _store.create(path, shell._attrs(chunk, fingerprint), voxels=job.grid.size,
                   orientations=job.orientations, chunk=chunk,
-                  with_manipulability=job.with_manipulability)
-    return np.zeros(n_chunks, dtype=bool)
+                  with_manipulability=job.with_manipulability, argument="store")
+    return np.zeros(-(-job.grid.size // chunk), dtype=bool)
+
+
+def _resume_store(path: Path, fingerprint: str, overwrite: bool) -> np.ndarray | None:
+    """The done flags of the same map at ``path``, or None once ``path`` is free.
+
+    An empty folder is removed, another map replaced (with ``overwrite``).
+    """
+    if not path.exists():
+        return None
+    if path.is_dir() and not any(path.iterdir()):
+        path.rmdir()
+        return None
+    g = _store.open_map(path, argument="store")
+    if g.attrs.get("fingerprint") == fingerprint:
+        return _store.read_done(path)
+    if not overwrite:
+        raise InputError(
+            "store",
+            f"{path} holds a different map (robot {g.attrs.get('robot')!r}, "
+            f"voxel {float(g.attrs.get('voxel', 0)) * 1000:g} mm, grid "
+            f"{g.attrs.get('shape')}); choose another store or pass "
+            "overwrite=True",
+        )
+    shutil.rmtree(path)
+    return None
 
 
 # ------------------------------------------------------------------ helpers

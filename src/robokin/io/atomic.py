@@ -8,6 +8,10 @@ target. A reader sees the old content or the new, never a half-written file; a
 crash or a kill leaves the old file intact; on any failure the temporary file
 is removed. A symlink at the target itself is replaced, not written through.
 
+A folder of many files written by another library (a Zarr store) is built in a
+fresh temporary folder beside the target and renamed into place the same way
+(:func:`publish_folder`).
+
 Errors are :class:`~robokin.exceptions.InputError` naming the user's path (never
 the temporary one), one line: a missing folder, a folder given as the file, a
 read-only folder, a full disk.
@@ -30,6 +34,7 @@ from robokin.exceptions import InputError
 __all__ = [
     "file_stem",
     "new_file_mode",
+    "publish_folder",
     "save_figure_atomic",
     "staged_outputs",
     "write_atomic",
@@ -223,3 +228,69 @@ def staged_outputs(
     finally:
         for stage in stages.values():
             shutil.rmtree(stage, ignore_errors=True)
+
+
+def _cannot_write(path: Path, argument: str, exc: OSError, folder: Path | None = None
+                  ) -> InputError:
+    """The one-line error for an OSError writing ``path`` (in ``folder``)."""
+    where = f" in {folder}" if folder is not None else ""
+    return InputError(argument, f"{path}: cannot write{where}: {exc.strerror or exc}")
+
+
+def _check_folder_target(path: Path, overwrite: bool, argument: str) -> Path:
+    """The parent folder of a folder target, after the checks of :func:`publish_folder`."""
+    parent = path.parent if str(path.parent) else Path(".")
+    if not os.path.isdir(parent):
+        raise InputError(argument, f"{path}: the folder {parent} does not exist")
+    if os.path.exists(path) and not overwrite:
+        raise InputError(argument, f"{path} exists; pass overwrite=True to replace it")
+    if os.path.exists(path) and not os.path.isdir(path):
+        raise InputError(argument, f"{path} is a file, expected a store folder")
+    return parent
+
+
+@contextlib.contextmanager
+def publish_folder(
+    path: str | Path, *, overwrite: bool = False, argument: str = "path"
+) -> Iterator[Path]:
+    """Build a folder beside ``path``, then rename it into place in one step.
+
+    For folders of many files written by another library (a Zarr store): the
+    folder is built inside a fresh private folder made with
+    :func:`tempfile.mkdtemp` next to ``path`` (the same file system), and
+    appears at ``path`` in one rename when the body returns. A reader sees the
+    old folder or the new one, never half of one; if the body raises, ``path``
+    is as it was. The temporary folder is removed in every case.
+
+    Args:
+        path: The folder to create (or replace).
+        overwrite: Replace an existing folder (False: refuse).
+        argument: The argument or option name used in error messages.
+
+    Yields:
+        The path to build the folder at (it does not exist yet; its parent
+        does).
+
+    Raises:
+        InputError: the parent folder is missing, ``path`` exists (without
+            ``overwrite``) or is a file, or a file operation fails (read-only
+            folder, full disk, name too long...), naming ``path`` (never the
+            temporary folder). Other errors of the body propagate unchanged.
+    """
+    target = Path(path)
+    parent = _check_folder_target(target, overwrite, argument)
+    try:
+        tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=parent))
+    except OSError as exc:
+        raise _cannot_write(target, argument, exc, parent) from None
+    built = tmp / "store"
+    try:
+        yield built
+        if os.path.exists(target):
+            os.replace(target, tmp / "old")
+        os.replace(built, target)
+    except OSError as exc:
+        raise _cannot_write(target, argument, exc) from None
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    _sync_folder(parent)

@@ -68,13 +68,42 @@ def jacobian(
     return J
 
 
-def manipulability(chain: Chain, q: npt.ArrayLike) -> np.ndarray:
-    """Yoshikawa's measure ``sqrt(det(J J^T))`` (for n < 6: ``sqrt(det(J^T J))``), (...).
+def manipulability(
+    chain: Chain, q: npt.ArrayLike, *, method: Literal["svd", "det"] = "svd"
+) -> np.ndarray:
+    r"""Yoshikawa's manipulability of configurations q.
 
-    Computed as the product of the ``min(6, n)`` singular values, which equals the
-    determinant form and stays accurate near singularities.
+    .. math::
+
+        w = \sqrt{\det(J J^T)} \quad (n \ge 6), \qquad
+        w = \sqrt{\det(J^T J)} \quad (n < 6)
+
+    (Yoshikawa, "Manipulability of robotic mechanisms", IJRR 4(2), 1985, eq. 9).
+
+    Args:
+        chain: The canonical chain.
+        q: Joint coordinates [rad, m], shape (..., n).
+        method: ``"svd"`` (default): the product of the ``min(6, n)``
+            singular values of the Jacobian, which for n != 6 never forms
+            ``J^T J`` or ``J J^T`` (whose determinant loses digits: the
+            condition number squared). ``"det"``: ``|det J|`` for a square
+            Jacobian (n = 6), one LU per matrix instead of an SVD; equal to the
+            SVD product to rounding relative to the largest singular values
+            (near a singularity both are noise of order 1e-16 of them). For
+            n != 6 ``"det"`` falls back to the SVD product.
+
+    Returns:
+        Shape (...).
+
+    Raises:
+        InputError: an unknown ``method``.
     """
-    return np.prod(np.linalg.svd(jacobian(chain, q), compute_uv=False), axis=-1)
+    if method not in ("svd", "det"):
+        raise InputError("method", f"expected 'svd' or 'det', got {method!r}")
+    J = jacobian(chain, q)
+    if method == "det" and J.shape[-1] == 6:
+        return np.abs(np.linalg.det(J))
+    return np.prod(np.linalg.svd(J, compute_uv=False), axis=-1)
 
 
 def min_singular_value(chain: Chain, q: npt.ArrayLike) -> np.ndarray:

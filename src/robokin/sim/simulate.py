@@ -304,6 +304,7 @@ def simulate(
     density: float | None = None,
     torque_limits: npt.ArrayLike | None = None,
     tolerance: tuple[float, float] = DEFAULT_TOLERANCE,
+    max_samples: int | None = None,
 ) -> SimResult:
     """Run a planned motion through the robot's servos in MuJoCo.
 
@@ -323,23 +324,30 @@ def simulate(
         density: Density for estimated links [kg/m^3].
         torque_limits: Per joint [N m, N]; default the robot's.
         tolerance: Largest tracking error of the verdict ``(angle [rad], length [m])``.
+        max_samples: Most physics steps the run may record (default
+            :data:`robokin.trajectory.joint.MAX_SAMPLES`), checked before any
+            array of the run is allocated.
 
     Returns:
         A :class:`SimResult` at the plan's sample times.
 
     Raises:
         InputError: a trajectory for another robot, non-finite or non-positive
-            gains, a bad ``dt``, ``contacts``, ``tolerance`` or torque limits.
+            gains, a bad ``dt``, ``contacts``, ``tolerance``, ``max_samples`` or
+            torque limits, a plan longer than ``max_samples`` physics steps
+            (naming ``traj``).
         ModelError: missing mass data in strict mode (naming the field), or a
             model MuJoCo refuses.
         MissingExtraError: MuJoCo is not installed (``robokin[sim]``).
     """
     from robokin.sim._mujoco import load_model
     from robokin.trajectory.compare import compare
+    from robokin.trajectory.joint import check_max_samples
 
     plan, motors = check_trajectory(robot, traj)
     dt = _check_dt(dt)
     tol = _check_tolerance(tolerance)
+    cap = check_max_samples(max_samples)
     if contacts not in ("detect", "physical"):
         raise InputError("contacts", f"expected 'detect' or 'physical', got "
                          f"{short_repr(contacts)}")
@@ -351,7 +359,7 @@ def simulate(
     mj = _mj()
     model = load_model(export.xml)
     data = mj.MjData(model)
-    run = _Run(model, data, export, plan, traj if motors else plan, contacts)
+    run = _Run(model, data, export, plan, traj if motors else plan, contacts, cap)
     t0 = time.perf_counter()
     run.step_all()
     wall = time.perf_counter() - t0
@@ -378,7 +386,9 @@ class _Run:
     """One stepping loop: set points in, states, torques and contacts out."""
 
     def __init__(self, model: Any, data: Any, export: MjcfExport, plan: Trajectory,
-                 drive: Trajectory, contacts: ContactMode) -> None:
+                 drive: Trajectory, contacts: ContactMode, max_samples: int) -> None:
+        from robokin.trajectory.joint import check_sample_count
+
         mj = _mj()
         self.mj, self.model, self.data = mj, model, data
         _, dadr, S = export.joints.selection(model)
@@ -394,6 +404,8 @@ class _Run:
         self.dadr_master = np.array([model.jnt_dofadr[np.flatnonzero(
             model.jnt_qposadr == a)[0]] for a in master], dtype=np.int64)
         dt = export.timestep  # the requested step, or a fraction of it
+        check_sample_count(float(plan.t[-1] - plan.t[0]), dt, max_samples,
+                           argument="traj")
         n_steps = max(1, int(round((plan.t[-1] - plan.t[0]) / dt)))
         self.n_steps = n_steps
         self.times = plan.t[0] + dt * np.arange(n_steps + 1)

@@ -1,0 +1,48 @@
+"""The cell's manipulability is robokin's one formula (review finding 2)."""
+
+import numpy as np
+import pytest
+
+import robokin
+from reference import random_q
+from robokin.cell._evaluate import manipulability as cell_manipulability
+from robokin.exceptions import InputError
+from robokin.kinematics.jacobian import manipulability
+
+
+@pytest.mark.parametrize("name", ["scara", "panda"])
+def test_the_cell_equals_robot_manipulability_without_six_joints(name, rng):
+    robot = robokin.load(name)
+    assert robot.n != 6
+    q = random_q(robot, rng, 2000)
+    np.testing.assert_allclose(cell_manipulability(robot.chain, q),
+                               robot.manipulability(q), rtol=1e-12, atol=0.0)
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560", "aubo_i5"])
+def test_the_determinant_equals_the_svd_product_on_a_6r_arm(name, rng):
+    robot = robokin.load(name)
+    q = random_q(robot, rng, 2000)
+    svd = robot.manipulability(q)
+    det = manipulability(robot.chain, q, method="det")
+    # random configurations, some near a singularity (w down to 7e-7)
+    np.testing.assert_allclose(det, svd, rtol=1e-10, atol=0.0)
+    np.testing.assert_array_equal(cell_manipulability(robot.chain, q), det)
+    np.testing.assert_array_equal(manipulability(robot.chain, q), svd)  # the default
+
+
+def test_the_cell_chunks_change_no_bit(monkeypatch, rng):
+    import robokin.cell._evaluate as ev
+
+    ur5 = robokin.load("ur5")
+    q = random_q(ur5, rng, 100)
+    whole = cell_manipulability(ur5.chain, q)
+    monkeypatch.setattr(ev, "_MANIPULABILITY_BATCH", 7)
+    np.testing.assert_array_equal(cell_manipulability(ur5.chain, q), whole)
+    assert cell_manipulability(ur5.chain, q[:0]).shape == (0,)
+
+
+def test_an_unknown_method_is_named():
+    ur5 = robokin.load("ur5")
+    with pytest.raises(InputError, match="argument 'method'.*'svd' or 'det'"):
+        manipulability(ur5.chain, np.zeros(6), method="lu")
