@@ -246,3 +246,63 @@ def test_press_views_labels_do_not_overlap(monkeypatch, tmp_path):
                 assert not ba.overlaps(bb), (a, b)
     side = {t.get_text() for t in fig.axes[0].texts}
     assert {"column_left", "column_right"} <= side
+
+
+# ------------------------------------------------ issue 25: names printed literally
+# A name holding rich markup and emoji codes, a source holding a terminal escape
+# sequence (YAML "\e" is ESC). Oracle: the text as written, ESC shown as \x1b.
+WEIRD = "arm:x:1 :warning: [red]r[/red]"
+SOURCE = "vendor \\e[2J sheet :x:"
+SOURCE_SHOWN = "vendor \\x1b[2J sheet :x:"
+
+
+@pytest.fixture
+def weird_robot(tmp_path):
+    text = (robokin.robots.path("ur5")).read_text()
+    text = re.sub(r"(?m)^name: .*$", lambda m: f'name: "{WEIRD}"', text, count=1)
+    text = re.sub(r"(?ms)^source: .*?^units:", lambda m: f'source: "{SOURCE}"\nunits:',
+                  text, count=1)
+    f = tmp_path / "weird.yaml"
+    f.write_text(text)
+    robot = robokin.load(f)
+    assert robot.name == WEIRD and robot.source == SOURCE.replace("\\e", "\x1b")
+    return f
+
+
+@pytest.mark.parametrize("fmt", ["table", "text"])
+def test_show_prints_markup_emoji_and_escapes_literally(capsys, monkeypatch,
+                                                       weird_robot, fmt):
+    monkeypatch.setenv("COLUMNS", "200")
+    code, out, _ = run(capsys, "show", str(weird_robot), "--format", fmt)
+    assert code == 0
+    assert f"{WEIRD}: standard" in out and f"source: {SOURCE_SHOWN}" in out
+    assert "\x1b" not in out and "❌" not in out and "⚠" not in out
+
+
+def test_export_and_import_lines_print_the_name_literally(capsys, tmp_path,
+                                                          weird_robot):
+    pytest.importorskip("yourdfpy")
+    urdf = tmp_path / "w.urdf"
+    code, out, _ = run(capsys, "export", str(weird_robot), "-o", str(urdf))
+    assert code == 0 and out.startswith(f"{WEIRD}: wrote ")
+    code, out, err = run(capsys, "import", str(urdf), "-o", str(tmp_path / "w.yaml"))
+    assert code == 0, err
+    assert out.startswith(f"{WEIRD}: 6 joints") and "❌" not in out
+
+
+def test_a_name_with_a_control_character_is_refused(tmp_path):
+    text = robokin.robots.path("ur5").read_text()
+    f = tmp_path / "esc.yaml"
+    f.write_text(re.sub(r"(?m)^name: .*$", lambda m: 'name: "arm\\e[2J"', text, count=1))
+    with pytest.raises(robokin.ModelError, match=r"esc.yaml:1: name: .*control "
+                                                 r"character \\x1b at position 3"):
+        robokin.load(f)
+
+
+def test_the_one_console_replaces_no_emoji():
+    from robokin.cli_output import console
+
+    con = console()
+    with con.capture() as cap:
+        con.print(":warning: :x:", markup=False)
+    assert cap.get().strip() == ":warning: :x:"

@@ -97,10 +97,11 @@ def _check_out(out: Path, force: bool) -> None:
 
 
 def _print(rep: Any, robot: Any, files: list[Path]) -> None:
-    from rich.console import Console
     from rich.table import Table
 
-    con = Console()
+    from robokin.cli_output import console
+
+    con = console()
     planned = rep.source_duration
     head = f"{cell(robot.name)}: minimum cycle time {rep.minimum_cycle_time:.3f} s"
     if planned is not None:

@@ -100,10 +100,11 @@ def sim_command(
 
 
 def _print_summary(robot: Any, summary: dict[str, Any], out: Path) -> None:
-    from rich.console import Console
     from rich.table import Table
 
-    con = Console()
+    from robokin.cli_output import console
+
+    con = console()
     table = Table(title=f"{cell(robot.name)} in MuJoCo: simulated run vs plan")
     for col in ("joint", "max |error|", "RMS", "corr(|error|, |acc|)", "peak torque",
                 "limit", "required (ID)"):

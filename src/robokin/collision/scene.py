@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-from robokin._text import short_repr
+from robokin._text import control_character, short_repr
 from robokin._validation import check_transform
 from robokin.exceptions import InputError, ModelError
 from robokin.io.geometry_sections import number_field, shape_from_spec
@@ -59,6 +59,9 @@ def _text(value: Any, file: Any, field: str) -> str:
     if not isinstance(value, str) or len(value) > 200:
         raise ModelError(f"expected a name (text, at most 200 characters), got "
                          f"{short_repr(value)}", file=file, field=field)
+    problem = control_character(value)
+    if problem is not None:
+        raise ModelError(f"{problem} ({short_repr(value)})", file=file, field=field)
     return value
 
 
