@@ -48,20 +48,20 @@ def short_repr(value: object, limit: int = 60) -> str:
 
 
 def printable(text: str) -> str:
-    """``text`` with control characters shown as ``\\xNN`` (tab and newline kept).
+    r"""``text`` with control characters shown as ``\xNN`` (tab and newline kept).
 
     For text from a file on its way to a terminal: an escape sequence in a robot
-    name (``"\\e[2J"`` in YAML) is printed as the characters ``\\x1b[2J``, not
+    name (``"\e[2J"`` in YAML) is printed as the characters ``\x1b[2J``, not
     obeyed.
     """
     return _CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
 
 
 def control_character(text: str) -> str | None:
-    """What is wrong with a name holding a control character, or None.
+    r"""What is wrong with a name holding a control character, or None.
 
     Names (robot, joint, link, object) become XML attributes, file names and
-    lines on a terminal: a control character (``\\x1b``, a NUL, a newline) has
+    lines on a terminal: a control character (``\x1b``, a NUL, a newline) has
     no place in any of them.
     """
     m = _CONTROL.search(text) or re.search(r"[\t\n]", text)

@@ -65,10 +65,10 @@ class DomainFailure(Exception):
 
 
 def cell(value: Any, limit: int = 60, *, markup: bool = True) -> str:
-    """Text for a table cell or a line of output, safe to print.
+    r"""Text for a table cell or a line of output, safe to print.
 
     At most ``limit`` characters, rich markup escaped unless ``markup=False`` (for
-    ``print(..., markup=False)``), control characters shown as ``\\xNN``: a name or
+    ``print(..., markup=False)``), control characters shown as ``\xNN``: a name or
     a source from a file is never markup or a terminal escape sequence, and never a
     megabyte for rich to wrap. Print it through :func:`robokin.cli_output.console`
     (no emoji codes).

@@ -1,4 +1,4 @@
-"""Tables of the ``robokin`` command, printed so that no number is ever hidden.
+r"""Tables of the ``robokin`` command, printed so that no number is ever hidden.
 
 A command builds :class:`OutputTable` objects (a title, columns, rows of plain
 values) and hands them to :func:`emit`, which prints them in the format asked for
@@ -18,7 +18,7 @@ data only.
 Text from files (robot, joint and link names, sources) is printed literally: rich
 markup (``[red]``) is escaped, emoji codes (``:warning:``) are not replaced (every
 console is made by :func:`console`, ``emoji=False``), and control characters
-(an escape sequence ``\\x1b[2J`` in a name) are shown as ``\\xNN``
+(an escape sequence ``\x1b[2J`` in a name) are shown as ``\xNN``
 (:func:`robokin._text.printable`), in every format but ``csv`` and ``json``
 (which carry the data as it is).
 """
