@@ -592,12 +592,27 @@ def save_robot(robot: Robot, path: str | Path) -> Path:
     A failure never leaves a half-written file, and an existing file is replaced
     only once the new content is complete on disk.
 
+    The document is read back (in memory, as :func:`load_robot` would read the
+    file) before anything is written: a robot whose file robokin would refuse
+    to load (a length beyond :data:`~robokin._validation.MAX_TRANSLATION`, a
+    name it cannot hold) is refused here, naming the field, and no file is
+    written.
+
     Raises:
         InputError: the folder is missing or read-only, or ``path`` is a folder.
+        ModelError: the file would not load back (naming ``path``, the field and
+            the reason).
     """
     import yaml
 
     text = yaml.safe_dump(
         document_from_robot(robot), sort_keys=False, default_flow_style=None
     )
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the loader's unit hints: not a refusal
+            robot_from_document(yaml.safe_load(text), file=path)
+    except ModelError as exc:
+        raise ModelError(f"{exc.reason}; robokin would refuse this robot file, so it "
+                         "is not written", file=path, field=exc.field) from None
     return write_atomic(path, text)
