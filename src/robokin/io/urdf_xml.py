@@ -209,8 +209,7 @@ def _check_number_text(el: Any, key: str, text: str, spec: tuple[int | None, boo
 
 
 def _is_length(el: Any, key: str) -> bool:
-    """Whether ``el``'s attribute ``key`` is a length: an origin, a size, a
-    prismatic joint's limit."""
+    """Whether ``el``'s attribute ``key`` is a length (an origin, a size, a limit)."""
     if (el.tag, key) in _LENGTHS:
         return True
     parent = el.getparent()
