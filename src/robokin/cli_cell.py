@@ -25,8 +25,12 @@ from robokin.cli_output import (
     resolve_format,
 )
 from robokin.exceptions import InputError
+from robokin.io.atomic import check_distinct
 
 __all__ = ["parse_axis", "place_command", "reach_command"]
+
+#: What ``robokin place`` writes into ``--out``.
+PLACE_FILES = ("placement.png", "placement.csv", "placement.json")
 
 
 def parse_axis(text: str, option: str, scale: float) -> list[float]:
@@ -129,6 +133,8 @@ def reach_command(
         box = [values[:3], values[3:]]
     robot = robokin.load(name)
     sc = _scene(scene)
+    check_distinct([(out / f, "--out") for f in ("map.zarr", "sections.png", "reach.json")],
+                   [(robot.path, "NAME"), (None if sc is None else sc.path, "--scene")])
     folder = _out_dir(out)
     m = reach_map(robot, region=box, voxel=voxel * 1e-3, orientations=orientations,
                   rolls=rolls, scene=sc, scheduler=scheduler, store=folder / "map.zarr",
@@ -218,6 +224,9 @@ def place_command(
     zs = parse_axis(z, "--z", 1e-3) if z else [base[2, 3]]
     yaws = parse_axis(yaw, "--yaw", math.pi / 180) if yaw else \
         [math.atan2(base[1, 0], base[0, 0])]
+    check_distinct([(out / f, "--out") for f in PLACE_FILES],
+                   [(robot.path, "NAME"), (None if sc is None else sc.path, "--scene"),
+                    (task if task not in ("poses", "demo") else None, "--task")])
     folder = _out_dir(out)
     pl = place(robot, poses, base_grid(xs, ys, zs, yaws), scene=sc,
                clearance=clearance * 1e-3, scheduler=scheduler, max_step=step,
