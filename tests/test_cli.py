@@ -138,8 +138,27 @@ def test_debug_is_accepted_after_the_subcommand(capsys):
     code, out, _ = run(capsys, "fk", "ur5", "0", "0", "0", "0", "0", "0", "--json",
                        "--debug")
     assert code == 0 and "pose" in json.loads(out)
-    with pytest.raises(robokin.ModelError):  # --debug: the traceback, not one line
-        main(["show", "ur7", "--debug"])
+    # --debug adds the traceback and keeps the exit code (issue 25: it was 1)
+    code, _, err = run(capsys, "show", "ur7", "--debug")
+    assert code == 2
+    assert "Traceback" in err and "robokin.exceptions.ModelError" in err
+    assert err.splitlines()[-1].startswith("robokin: error: unknown robot 'ur7'")
+
+
+@pytest.mark.parametrize("args", [
+    ["fk", "ur5", "1", "2"],                  # a usage error (BadParameter)
+    ["fk", "ur5", "0", "0", "0", "0", "0", "0", "--nosuch-option=1"],
+    ["nosuchcommand"],
+    ["show", "/nonexistent/robot.yaml"],      # an input error (ModelError)
+])
+@pytest.mark.parametrize("where", ["first", "last"])
+def test_debug_anywhere_keeps_exit_code_2(capsys, args, where):
+    """Issue 25: --debug after a subcommand turned exit 2 into exit 1."""
+    plain, _, _ = run(capsys, *args)
+    argv = ["--debug", *args] if where == "first" else [*args, "--debug"]
+    code, _, err = run(capsys, *argv)
+    assert plain == code == 2
+    assert err.splitlines()[-1].startswith("robokin: error: ")
 
 
 def test_warnings_are_one_line(capsys, tmp_path):
@@ -174,3 +193,27 @@ def test_show_never_hands_rich_an_unbounded_word(capsys):
 
     assert len(cell(long.source, 300)) <= 300
     assert cell(long.name) == "\\[bold red]ur5\\[/]"
+
+
+@pytest.mark.parametrize(
+    ("args", "note"),
+    [
+        # 90 rad: the AUBO-i5's shoulder is limited to +-175 deg (3.05433 rad)
+        (["aubo_i5", "90", "0", "0", "0", "0", "0"],
+         "joint 'shoulder' = 90 rad is outside its limits [-3.05433, 3.05433] rad "
+         "(degrees? pass --deg)"),
+        (["aubo_i5", "0", "200", "0", "0", "0", "0", "--deg"],
+         "joint 'upper_arm' = 200 deg is outside its limits [-175, 175] deg;"),
+        # the SCARA's shaft travels 0..200 mm (robots/scara.yaml)
+        (["scara", "0", "0", "0", "900", "--mm"],
+         "joint 'lift' = 900 mm is outside its limits [0, 200] mm;"),
+    ],
+)
+def test_fk_outside_the_limits_notes_the_joint_and_its_limits(capsys, args, note):
+    """Issue 25: FK outside the limits gave no note; the pose is still printed."""
+    code, out, err = run(capsys, "fk", *args, "--json")
+    assert code == 0 and "pose" in json.loads(out)
+    assert err.startswith("robokin: note: " + note), err
+    assert len(err.splitlines()) == 1
+    code, _, err = run(capsys, "fk", "aubo_i5", "3.05", "0", "0", "0", "0", "0")
+    assert code == 0 and err == ""  # inside: nothing to say

@@ -246,3 +246,158 @@ def test_press_views_labels_do_not_overlap(monkeypatch, tmp_path):
                 assert not ba.overlaps(bb), (a, b)
     side = {t.get_text() for t in fig.axes[0].texts}
     assert {"column_left", "column_right"} <= side
+
+
+# ------------------------------------------------ issue 25: names printed literally
+# A name holding rich markup and emoji codes, a source holding a terminal escape
+# sequence (YAML "\e" is ESC). Oracle: the text as written, ESC shown as \x1b.
+WEIRD = "arm:x:1 :warning: [red]r[/red]"
+SOURCE = "vendor \\e[2J sheet :x:"
+SOURCE_SHOWN = "vendor \\x1b[2J sheet :x:"
+
+
+@pytest.fixture
+def weird_robot(tmp_path):
+    text = (robokin.robots.path("ur5")).read_text()
+    text = re.sub(r"(?m)^name: .*$", lambda m: f'name: "{WEIRD}"', text, count=1)
+    text = re.sub(r"(?ms)^source: .*?^units:", lambda m: f'source: "{SOURCE}"\nunits:',
+                  text, count=1)
+    f = tmp_path / "weird.yaml"
+    f.write_text(text)
+    robot = robokin.load(f)
+    assert robot.name == WEIRD and robot.source == SOURCE.replace("\\e", "\x1b")
+    return f
+
+
+@pytest.mark.parametrize("fmt", ["table", "text"])
+def test_show_prints_markup_emoji_and_escapes_literally(capsys, monkeypatch,
+                                                       weird_robot, fmt):
+    monkeypatch.setenv("COLUMNS", "200")
+    code, out, _ = run(capsys, "show", str(weird_robot), "--format", fmt)
+    assert code == 0
+    assert f"{WEIRD}: standard" in out and f"source: {SOURCE_SHOWN}" in out
+    assert "\x1b" not in out and "❌" not in out and "⚠" not in out
+
+
+def test_export_and_import_lines_print_the_name_literally(capsys, tmp_path,
+                                                          weird_robot):
+    pytest.importorskip("yourdfpy")
+    urdf = tmp_path / "w.urdf"
+    code, out, _ = run(capsys, "export", str(weird_robot), "-o", str(urdf))
+    assert code == 0 and out.startswith(f"{WEIRD}: wrote ")
+    code, out, err = run(capsys, "import", str(urdf), "-o", str(tmp_path / "w.yaml"))
+    assert code == 0, err
+    assert out.startswith(f"{WEIRD}: 6 joints") and "❌" not in out
+
+
+def test_a_name_with_a_control_character_is_refused(tmp_path):
+    text = robokin.robots.path("ur5").read_text()
+    f = tmp_path / "esc.yaml"
+    f.write_text(re.sub(r"(?m)^name: .*$", lambda m: 'name: "arm\\e[2J"', text, count=1))
+    with pytest.raises(robokin.ModelError, match=r"esc.yaml:1: name: .*control "
+                                                 r"character \\x1b at position 3"):
+        robokin.load(f)
+
+
+def test_the_one_console_replaces_no_emoji():
+    from robokin.cli_output import console
+
+    con = console()
+    with con.capture() as cap:
+        con.print(":warning: :x:", markup=False)
+    assert cap.get().strip() == ":warning: :x:"
+
+
+# ------------------------------------ issue 25: two outputs to one path, or an input
+def _csv_plan(folder, name):
+    """A small UR5 trajectory CSV (robokin's format) at folder/name."""
+    from robokin import trajectory
+    from robokin.trajectory.io import write_csv
+
+    ur5 = robokin.load("ur5")
+    q0 = np.radians([0, -90, 90, 0, 90, 0])
+    tr = trajectory.quintic(q0, q0 + 0.1, 0.3, dt=0.01)
+    return write_csv(tr, folder / name, ur5.joint_names)
+
+
+CLASHES = [
+    # traj: every pair of its outputs (csv -o, --plot, --ros2, --program), and FILE
+    (["traj", "{m}", "-o", "{d}/X.csv", "--force", "--ros2", "{d}/X.csv"],
+     "'--ros2': {d}/X.csv is also the output of -o"),
+    (["traj", "{m}", "-o", "{d}/X.csv", "--program", "{d}/./X.csv"],
+     "'--program': {d}/X.csv is also the output of -o"),
+    (["traj", "{m}", "--plot", "{d}/p.png", "--ros2", "{d}/sub/../p.png"],
+     "'--ros2': {d}/sub/../p.png is also the output of --plot"),
+    (["traj", "{m}", "--ros2", "{d}/r.yaml", "--program", "{d}/r.yaml"],
+     "'--program': {d}/r.yaml is also the output of --ros2"),
+    (["traj", "{m}", "-o", "{m}"], "'-o': {m} is the input FILE"),
+    # a symlink to the input: writing would replace the user's link
+    (["traj", "{m}", "--ros2", "{d}/link.yaml"], "'--ros2': {d}/link.yaml is the input FILE"),
+    # folder commands: a file they write is the input they read
+    (["retime", "{d}/retimed.csv", "--robot", "ur5", "--out", "{d}"],
+     "'--out': {d}/retimed.csv is the input TRAJ"),
+    (["sim", "ur5", "{d}/simulated.csv", "--out", "{d}"],
+     "'--out': {d}/simulated.csv is the input TRAJECTORY"),
+    (["place", "ur5", "--task", "{d}/placement.csv", "--out", "{d}"],
+     "'--out': {d}/placement.csv is the input --task"),
+    (["reach", "{d}/reach.json", "--out", "{d}"], "'--out': {d}/reach.json is the input NAME"),
+    (["workspace", "{d}/ur5_workspace.json", "--out", "{d}", "-n", "10"],
+     "'--out': {d}/ur5_workspace.json is the input NAME"),
+    (["check", "press", "{d}/aubo.csv", "--robot", "aubo_i5", "--plot", "{d}/aubo.csv"],
+     "'--plot': {d}/aubo.csv is the input TRAJECTORY"),
+    (["compare", "{d}/retimed.csv", "{d}/simulated.csv", "--plot", "{d}/retimed.csv"],
+     "'--plot': {d}/retimed.csv is the input PLAN"),
+]
+
+
+@pytest.mark.parametrize(("args", "message"), CLASHES, ids=lambda a: " ".join(a[:2])
+                         if isinstance(a, list) else None)
+def test_an_output_that_is_another_output_or_an_input_is_refused(tmp_path, capsys, args,
+                                                                  message):
+    """Issue 25: ``traj m.yaml -o X.csv --force --ros2 X.csv`` exited 0 and the CSV
+    was lost (the ROS 2 YAML replaced it); an output named like an input replaced
+    the user's file. Each is refused before anything is written: the folder holds
+    exactly what it held, byte for byte."""
+    d = tmp_path
+    m = d / "m.yaml"
+    m.write_text(MOTION)
+    (d / "link.yaml").symlink_to(m)
+    for name in ("retimed.csv", "simulated.csv", "placement.csv"):
+        _csv_plan(d, name)
+    aubo = robokin.load("aubo_i5")
+    from robokin.trajectory import quintic
+    from robokin.trajectory.io import write_csv
+
+    q0 = np.radians([0, -20, 80, 0, 60, 0])
+    write_csv(quintic(q0, q0 + 0.05, 0.2, dt=0.05), d / "aubo.csv", aubo.joint_names)
+    ur5_file = robokin.robots.path("ur5").read_text()
+    (d / "reach.json").write_text(ur5_file)
+    (d / "ur5_workspace.json").write_text(ur5_file)
+    before = {p.name: p.read_bytes() for p in d.iterdir()}
+    argv = [a.format(d=d, m=m) for a in args]
+    code, _, err = run(capsys, *argv)
+    assert code == 2, err
+    assert message.format(d=d, m=m) in err
+    assert {p.name: p.read_bytes() for p in d.iterdir()} == before
+
+
+def test_check_distinct_keys_files_not_spellings(tmp_path):
+    from robokin.exceptions import InputError
+    from robokin.io.atomic import check_distinct
+
+    a = tmp_path / "a.csv"
+    a.write_text("x")
+    (tmp_path / "hard.csv").hardlink_to(a)
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "alias").symlink_to(tmp_path / "sub")
+    with pytest.raises(InputError, match="is the input IN"):
+        check_distinct([(tmp_path / "hard.csv", "-o")], [(a, "IN")])
+    with pytest.raises(InputError, match="is also the output of -o"):
+        check_distinct([(tmp_path / "sub" / "x.csv", "-o"),
+                        (tmp_path / "alias" / "x.csv", "--plot")])
+    # distinct files pass, and an input through a symlink is its target
+    check_distinct([(tmp_path / "b.csv", "-o"), (tmp_path / "c.csv", "--plot")],
+                   [(a, "IN"), (None, "--scene")])
+    with pytest.raises(InputError, match="is the input IN"):
+        check_distinct([(tmp_path / "sub" / "t.yaml", "-o")],
+                       [(tmp_path / "alias" / "t.yaml", "IN")])

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import sys
+import traceback
 import warnings
 from pathlib import Path
 from typing import Annotated, Any
@@ -64,15 +65,19 @@ class DomainFailure(Exception):
 
 
 def cell(value: Any, limit: int = 60, *, markup: bool = True) -> str:
-    """Text for a table cell or a line of output, safe to print.
+    r"""Text for a table cell or a line of output, safe to print.
 
     At most ``limit`` characters, rich markup escaped unless ``markup=False`` (for
-    ``print(..., markup=False)``): a name or a source from a file is never markup,
-    and never a megabyte for rich to wrap.
+    ``print(..., markup=False)``), control characters shown as ``\xNN``: a name or
+    a source from a file is never markup or a terminal escape sequence, and never a
+    megabyte for rich to wrap. Print it through :func:`robokin.cli_output.console`
+    (no emoji codes).
     """
     from rich.markup import escape
 
-    text = str(value)
+    from robokin._text import printable
+
+    text = printable(str(value))
     if len(text) > limit:
         text = text[: limit - 1] + "…"
     return escape(text) if markup else text
@@ -86,9 +91,9 @@ def _root(
 
 
 def _console():
-    from rich.console import Console
+    from robokin.cli_output import console
 
-    return Console()
+    return console()
 
 
 def _load(name: str):
@@ -211,6 +216,8 @@ def fk(
     if mm:
         qv = np.where(~rev, qv / 1000.0, qv)
     T = r.fk(qv)
+    for line in outside_limits_notes(r, qv, deg=deg, mm=mm):
+        print(f"robokin: note: {line}", file=sys.stderr)
     rpy = rpy_from_matrix(T)
     L = 1000.0 if mm else 1.0
     A = 180 / math.pi if deg else 1.0
@@ -232,6 +239,30 @@ def fk(
         f"xyz [{lu}]: " + "  ".join(f"{v:.6f}" for v in T[:3, 3] * L), markup=False
     )
     con.print(f"rpy [{au}]: " + "  ".join(f"{v:.6f}" for v in rpy * A), markup=False)
+
+
+def outside_limits_notes(robot: Any, q: Any, *, deg: bool = False, mm: bool = False
+                         ) -> list[str]:
+    """One line per joint of ``q`` (SI, shape (n,)) outside ``robot``'s limits.
+
+    Values and limits in the units the user typed (degrees with ``deg``,
+    millimetres with ``mm``); the joint named, its limits given.
+    """
+    import numpy as np
+
+    out = []
+    for name, rev, v, (lo, hi) in zip(robot.joint_names, robot.is_revolute,
+                                      np.asarray(q, float), robot.limits):
+        if lo - 1e-12 <= v <= hi + 1e-12:
+            continue
+        s, unit = ((180 / math.pi, "deg") if deg else (1.0, "rad")) if rev else \
+            ((1000.0, "mm") if mm else (1.0, "m"))
+        hint = " (degrees? pass --deg)" if rev and not deg and abs(v) > 2 * math.pi \
+            else ""
+        out.append(f"joint {cell(name, markup=False)!r} = {v * s:g} {unit} is outside "
+                   f"its limits [{lo * s:g}, {hi * s:g}] {unit}{hint}; the pose is "
+                   "computed anyway")
+    return out
 
 
 @app.command()
@@ -374,7 +405,8 @@ def main(argv: list[str] | None = None) -> int:
 
     Exit codes: 0 success, 1 a "no" answer (:class:`DomainFailure`, an
     :class:`~robokin.exceptions.UnreachableError`), 2 usage and input errors, 3
-    an internal error.
+    an internal error. ``--debug`` (anywhere before a ``--``) prints the
+    traceback above the one-line message; the exit code is the same.
     """
     from robokin.exceptions import RobokinError, UnreachableError
 
@@ -388,53 +420,43 @@ def main(argv: list[str] | None = None) -> int:
     args, debug = _split_debug(list(sys.argv[1:] if argv is None else argv))
     args = _gather_values(args)
     _DEBUG["on"] = debug
+
+    def fail(code: int, line: str) -> int:
+        # --debug adds the traceback; the exit code stays the one of the error
+        if debug:
+            traceback.print_exc()
+        print(line, file=sys.stderr)
+        return code
+
     with warnings.catch_warnings():
         warnings.showwarning = _show_warning
         try:
             app(args=args, standalone_mode=False)
         except DomainFailure as exc:
-            print(f"robokin: {_one_line(exc)}", file=sys.stderr)
-            return 1
+            return fail(1, f"robokin: {_one_line(exc)}")
         except UnreachableError as exc:
-            if debug:
-                raise
-            print(f"robokin: {_one_line(exc)}", file=sys.stderr)
-            return 1
+            return fail(1, f"robokin: {_one_line(exc)}")
         except RobokinError as exc:
-            if debug:
-                raise
-            print(f"robokin: error: {_one_line(exc)}", file=sys.stderr)
-            return 2
+            return fail(2, f"robokin: error: {_one_line(exc)}")
         except typer.Exit as exc:
             return exc.exit_code
         except typer.Abort:
             print("robokin: aborted", file=sys.stderr)
             return 2
         except click_error as exc:  # usage errors: one line, not click's block
-            if debug:
-                raise
             if type(exc).__name__ == "NoArgsIsHelpError":
                 return 2  # the help was printed: nothing to add
             hint = ""
             if isinstance(exc, usage_error) and getattr(exc, "ctx", None) is not None:
                 hint = f" (see: {exc.ctx.command_path} --help)"
-            print(f"robokin: error: {_one_line(exc.format_message())}{hint}",
-                  file=sys.stderr)
-            return 2
+            return fail(2, f"robokin: error: {_one_line(exc.format_message())}{hint}")
         except OSError as exc:
-            if debug:
-                raise
             where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
-            print(f"robokin: error: {where}{_one_line(exc.strerror or exc)}",
-                  file=sys.stderr)
-            return 2
+            return fail(2, f"robokin: error: {where}{_one_line(exc.strerror or exc)}")
         except Exception as exc:  # a bug: say so, in one line
-            if debug:
-                raise
-            print(f"robokin: internal error: {type(exc).__name__}: "
-                  f"{_one_line(exc)[:300]} (run with --debug for the traceback)",
-                  file=sys.stderr)
-            return 3
+            return fail(3, f"robokin: internal error: {type(exc).__name__}: "
+                        f"{_one_line(exc)[:300]}"
+                        + ("" if debug else " (run with --debug for the traceback)"))
     return 0
 
 

@@ -25,35 +25,86 @@ from robokin.cli_output import (
     resolve_format,
 )
 from robokin.exceptions import InputError
+from robokin.io.atomic import check_distinct
 
-__all__ = ["parse_axis", "place_command", "reach_command"]
+__all__ = ["MAX_AXIS_VALUES", "MAX_CANDIDATES", "parse_axis", "place_command", "reach_command"]
+
+#: ``--connect-timeout``: seconds to reach a ``--scheduler`` address.
+ConnectTimeout = Annotated[float | None, typer.Option(
+    "--connect-timeout", help="Seconds to reach the --scheduler address and hear it "
+    "answer (default 10; a closed port or an address nothing answers from ends "
+    "then, exit 2).")]
+
+#: What ``robokin place`` writes into ``--out``.
+PLACE_FILES = ("placement.png", "placement.csv", "placement.json")
+
+
+#: Most values one ``--x``/``--y``/``--z``/``--yaw`` range may give.
+MAX_AXIS_VALUES = 10_000
+#: Most candidate bases (the product of the four axes) one ``robokin place`` scores.
+MAX_CANDIDATES = 1_000_000
 
 
 def parse_axis(text: str, option: str, scale: float) -> list[float]:
     """Values from ``"a:b:step"`` (inclusive range), ``"a,b,c"`` or ``"a"``, times ``scale``.
 
     Raises:
-        InputError: not numbers, a step <= 0, or more than 10,000 values (naming
-            ``option``).
+        InputError: naming ``option`` and the real problem: not numbers, a step
+            <= 0, a range that runs backwards, more than :data:`MAX_AXIS_VALUES`
+            values (how many it would give), or a value that is not finite.
     """
-    try:
-        if ":" in text:
-            a, b, step = (float(v) for v in text.split(":"))
-            if not (step > 0 and math.isfinite(a + b + step)):
-                raise ValueError
-            count = math.floor((b - a) / step + 1e-9) + 1
-            if count < 1 or count > 10_000:
-                raise InputError(option, f"{text!r} gives {count} values (1 to 10,000)")
-            values = [a + i * step for i in range(count)]
-        else:
+    if ":" in text:
+        values = _axis_range(text, option)
+    else:
+        try:
             values = [float(v) for v in text.split(",")]
-    except ValueError:
-        raise InputError(
-            option, f"expected 'from:to:step', 'a,b,c' or a number, got {text!r}"
-        ) from None
+        except ValueError:
+            raise InputError(
+                option, f"expected 'from:to:step', 'a,b,c' or a number, got {text!r}"
+            ) from None
+        if len(values) > MAX_AXIS_VALUES:
+            raise InputError(option, f"{len(values):,} values; at most "
+                             f"{MAX_AXIS_VALUES:,}")
     if not values or not all(math.isfinite(v) for v in values):
         raise InputError(option, f"expected finite numbers, got {text!r}")
     return [round(v * scale, 12) for v in values]
+
+
+def _axis_range(text: str, option: str) -> list[float]:
+    """The values of ``"from:to:step"``, or an InputError saying what is wrong."""
+    parts = text.split(":")
+    try:
+        if len(parts) != 3:
+            raise ValueError
+        a, b, step = (float(v) for v in parts)
+    except ValueError:
+        raise InputError(option, f"expected 'from:to:step' (three numbers), got "
+                         f"{text!r}") from None
+    if not all(math.isfinite(v) for v in (a, b, step)):
+        raise InputError(option, f"expected finite numbers, got {text!r}")
+    if step <= 0:
+        raise InputError(option, f"{text!r}: the step must be > 0, got {step:g}")
+    if b < a:
+        raise InputError(option, f"{text!r} runs backwards: from {a:g} is above to "
+                         f"{b:g} (write '{b:g}:{a:g}:{step:g}')")
+    span = (b - a) / step  # finite: a, b finite and step > 0, or inf for a tiny step
+    if not span + 1 <= MAX_AXIS_VALUES:
+        many = f"{math.floor(span + 1e-9) + 1:,}" if math.isfinite(span) else "too many"
+        raise InputError(option, f"{text!r} gives {many} values, more than the "
+                         f"{MAX_AXIS_VALUES:,} a range may hold: use a larger step "
+                         "or a shorter range")
+    count = math.floor(span + 1e-9) + 1
+    return [a + i * step for i in range(count)]
+
+
+def _probe(scheduler: str | None, timeout: float | None) -> None:
+    """Up front: a --scheduler address that does not answer is exit 2 in seconds."""
+    from robokin.cell._scheduler import CONNECT_TIMEOUT, probe_scheduler
+
+    if timeout is not None and not (math.isfinite(timeout) and timeout > 0):
+        raise InputError("--connect-timeout", f"expected seconds > 0, got {timeout:g}")
+    probe_scheduler(scheduler, CONNECT_TIMEOUT if timeout is None else timeout,
+                    argument="--scheduler")
 
 
 def _scene(name: str | None) -> Any:
@@ -100,6 +151,7 @@ def reach_command(
                                       "(default: this machine).")
     ] = None,
     chunk: Annotated[int | None, typer.Option(help="Voxels per Dask task.")] = None,
+    connect_timeout: ConnectTimeout = None,
     manipulability: Annotated[
         bool, typer.Option(help="Compute the best manipulability per voxel.")
     ] = True,
@@ -116,11 +168,14 @@ def reach_command(
     """
     import robokin
     from robokin.cell import reach_map
+    from robokin.cell.grid import check_orientation_count
     from robokin.io.atomic import write_atomic
 
     fmt = resolve_format(output_format, as_json)
     if not (math.isfinite(voxel) and voxel > 0):
         raise InputError("--voxel", f"expected an edge length > 0 [mm], got {voxel:g}")
+    check_orientation_count(orientations, rolls, names=("--orientations", "--rolls"))
+    _probe(scheduler, connect_timeout)
     box = None
     if region is not None:
         values = parse_axis(region, "--region", 1e-3)
@@ -129,6 +184,8 @@ def reach_command(
         box = [values[:3], values[3:]]
     robot = robokin.load(name)
     sc = _scene(scene)
+    check_distinct([(out / f, "--out") for f in ("map.zarr", "sections.png", "reach.json")],
+                   [(robot.path, "NAME"), (None if sc is None else sc.path, "--scene")])
     folder = _out_dir(out)
     m = reach_map(robot, region=box, voxel=voxel * 1e-3, orientations=orientations,
                   rolls=rolls, scene=sc, scheduler=scheduler, store=folder / "map.zarr",
@@ -185,6 +242,7 @@ def place_command(
     scheduler: Annotated[
         str | None, typer.Option(help="Dask scheduler address (default: this machine).")
     ] = None,
+    connect_timeout: ConnectTimeout = None,
     as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")] = False,
     output_format: FormatOption = None,
 ) -> None:
@@ -204,6 +262,10 @@ def place_command(
         raise InputError("--clearance", f"expected a distance >= 0 [mm], got {clearance:g}")
     if every < 1:
         raise InputError("--every", f"expected a count >= 1, got {every}")
+    given = {opt: parse_axis(text, opt, unit) for opt, text, unit in (
+        ("--x", x, 1e-3), ("--y", y, 1e-3), ("--z", z, 1e-3), ("--yaw", yaw, math.pi / 180))
+        if text}  # up front: a bad range is said before anything is loaded
+    _probe(scheduler, connect_timeout)
     robot = robokin.load(name)
     sc = _scene(scene)
     poses, is_set = _task_poses(task, robot, sc, every)
@@ -213,11 +275,18 @@ def place_command(
         raise InputError("--max-step", f"expected an angle > 0 [deg], got {max_step}")
     base = np.eye(4) if sc is None else sc.base
     around = [v * 1e-3 for v in range(-400, 401, 100)]
-    xs = parse_axis(x, "--x", 1e-3) if x else [base[0, 3] + d for d in around]
-    ys = parse_axis(y, "--y", 1e-3) if y else [base[1, 3] + d for d in around]
-    zs = parse_axis(z, "--z", 1e-3) if z else [base[2, 3]]
-    yaws = parse_axis(yaw, "--yaw", math.pi / 180) if yaw else \
-        [math.atan2(base[1, 0], base[0, 0])]
+    xs = given.get("--x") or [base[0, 3] + d for d in around]
+    ys = given.get("--y") or [base[1, 3] + d for d in around]
+    zs = given.get("--z") or [base[2, 3]]
+    yaws = given.get("--yaw") or [math.atan2(base[1, 0], base[0, 0])]
+    count = len(xs) * len(ys) * len(zs) * len(yaws)
+    if count > MAX_CANDIDATES:
+        raise InputError("--x", f"--x, --y, --z and --yaw give {len(xs):,} x {len(ys):,} "
+                         f"x {len(zs):,} x {len(yaws):,} = {count:,} candidate bases, more "
+                         f"than the {MAX_CANDIDATES:,} robokin place scores in one run")
+    check_distinct([(out / f, "--out") for f in PLACE_FILES],
+                   [(robot.path, "NAME"), (None if sc is None else sc.path, "--scene"),
+                    (task if task not in ("poses", "demo") else None, "--task")])
     folder = _out_dir(out)
     pl = place(robot, poses, base_grid(xs, ys, zs, yaws), scene=sc,
                clearance=clearance * 1e-3, scheduler=scheduler, max_step=step,

@@ -84,6 +84,11 @@ def check_command(
     if name is None:
         raise InputError("--robot", "the scene names no robot; pass --robot")
     rob = robokin.load(name)
+    if plot is not None:
+        from robokin.io.atomic import check_distinct
+
+        check_distinct([(plot, "--plot")], [(scene, "SCENE"), (trajectory, "TRAJECTORY"),
+                                           (rob.path, "--robot")])
     t, q = read_trajectory_csv(trajectory, rob)
     # the report lists pair minima: make them exact too (the default settles them
     # to 1 mm / 1 %, which is all the global minimum needs)

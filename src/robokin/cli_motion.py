@@ -78,7 +78,7 @@ def traj(
     from rich.progress import Progress
 
     from robokin.exceptions import InputError
-    from robokin.io.atomic import staged_outputs
+    from robokin.io.atomic import check_distinct, staged_outputs
     from robokin.trajectory import PathError
     from robokin.trajectory.io import write_csv
 
@@ -103,6 +103,10 @@ def traj(
     if not no_plot:
         png, png_over = _default_out(plot, path.with_suffix(".png"), True)
         outputs.append((png, "--plot", png_over or force))
+    check_distinct([(p, arg) for p, arg, _ in outputs]
+                   + [(p, arg) for p, arg in ((ros2, "--ros2"), (program, "--program"))
+                      if p is not None],
+                   [(path, "FILE"), (robot.path, "(the motion file's robot)")])
     with staged_outputs(outputs, how="pass --force (or give -o / --plot)") as staged:
         write_csv(tr, staged[0], robot.joint_names, rates=rates)
         if png is not None:
@@ -237,10 +241,14 @@ def compare(
     LOG_vs_plan.png next to the log unless --plot is given (an existing file is
     replaced only when named with --plot).
     """
+    from robokin.io.atomic import check_distinct
     from robokin.trajectory.compare import compare as run_compare
     from robokin.trajectory.io import read_csv
 
     fmt = resolve_format(output_format, as_json)
+    if not no_plot:
+        check_distinct([(plot or log.with_name(log.stem + "_vs_plan.png"), "--plot")],
+                       [(plan, "PLAN"), (log, "LOG")])
     p = read_csv(plan)
     r = _read_run(log, p, topic, stamp)
     cmp = run_compare(p, r, time_shift=time_shift)

@@ -1,4 +1,4 @@
-"""Tables of the ``robokin`` command, printed so that no number is ever hidden.
+r"""Tables of the ``robokin`` command, printed so that no number is ever hidden.
 
 A command builds :class:`OutputTable` objects (a title, columns, rows of plain
 values) and hands them to :func:`emit`, which prints them in the format asked for
@@ -14,6 +14,13 @@ with ``--format``:
 
 Notes (one line each) follow the tables in ``table`` and ``text``; ``csv`` is
 data only.
+
+Text from files (robot, joint and link names, sources) is printed literally: rich
+markup (``[red]``) is escaped, emoji codes (``:warning:``) are not replaced (every
+console is made by :func:`console`, ``emoji=False``), and control characters
+(an escape sequence ``\x1b[2J`` in a name) are shown as ``\xNN``
+(:func:`robokin._text.printable`), in every format but ``csv`` and ``json``
+(which carry the data as it is).
 """
 
 from __future__ import annotations
@@ -28,9 +35,12 @@ from typing import Annotated, Any
 
 import typer
 
+from robokin._text import printable
+
 __all__ = [
     "FORMAT_HELP",
     "Column",
+    "console",
     "FormatOption",
     "OutputFormat",
     "OutputTable",
@@ -110,11 +120,20 @@ class OutputTable:
                 for row in self.rows]
 
 
-def is_terminal() -> bool:
-    """Whether stdout is a terminal (rich's answer: honours FORCE_COLOR and TTY_*)."""
+def console(*, stderr: bool = False) -> Any:
+    """The rich console every ``robokin`` command prints through.
+
+    ``emoji=False``: ``:warning:`` in a robot name stays those characters (rich
+    would replace emoji codes even in text printed with ``markup=False``).
+    """
     from rich.console import Console
 
-    return Console().is_terminal
+    return Console(emoji=False, stderr=stderr)
+
+
+def is_terminal() -> bool:
+    """Whether stdout is a terminal (rich's answer: honours FORCE_COLOR and TTY_*)."""
+    return bool(console().is_terminal)
 
 
 def resolve_format(fmt: OutputFormat | str | None, as_json: bool = False) -> str:
@@ -151,15 +170,16 @@ def _text(tables: Sequence[OutputTable], out: Any) -> None:
         if k:
             out.write("\n")
         if tab.title:
-            out.write(tab.title + "\n")
-        cells = [[c.name for c in tab.columns], *tab.display()]
+            out.write(printable(tab.title) + "\n")
+        cells = [[printable(v) for v in row]
+                 for row in ([c.name for c in tab.columns], *tab.display())]
         widths = [max(len(r[j]) for r in cells) for j in range(len(tab.columns))]
         for r in cells:
             parts = [s.rjust(w) if c.right else s.ljust(w)
                      for s, w, c in zip(r, widths, tab.columns)]
             out.write("  ".join(parts).rstrip() + "\n")
         for note in tab.notes:
-            out.write(note + "\n")
+            out.write(printable(note) + "\n")
 
 
 def _csv(tables: Sequence[OutputTable], out: Any) -> None:
@@ -176,11 +196,13 @@ def _csv(tables: Sequence[OutputTable], out: Any) -> None:
 
 def _rich(tables: Sequence[OutputTable]) -> None:
     from rich import box
-    from rich.console import Console
-    from rich.markup import escape
+    from rich.markup import escape as rich_escape
     from rich.table import Table
 
-    con = Console()
+    def escape(text: str) -> str:
+        return rich_escape(printable(text))
+
+    con = console()
     for tab in tables:
         table = Table(title=escape(tab.title) if tab.title else None,
                       box=box.SIMPLE_HEAD, title_justify="left", pad_edge=False)
@@ -192,7 +214,7 @@ def _rich(tables: Sequence[OutputTable]) -> None:
             table.add_row(*(escape(s) for s in row), style=style)
         con.print(table)
         for note in tab.notes:
-            con.print(note, markup=False, highlight=False)
+            con.print(printable(note), markup=False, highlight=False)
 
 
 def emit(tables: OutputTable | Sequence[OutputTable], fmt: str) -> None:
@@ -223,11 +245,9 @@ def say(text: str, fmt: str) -> None:
     if fmt == "csv":
         return
     if fmt == "table":
-        from rich.console import Console
-
-        Console().print(text, markup=False, highlight=False)
+        console().print(printable(text), markup=False, highlight=False)
     else:
-        print(text)
+        print(printable(text))
 
 
 def tables_json(tables: Sequence[OutputTable]) -> list[dict[str, Any]]:

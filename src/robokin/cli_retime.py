@@ -97,10 +97,11 @@ def _check_out(out: Path, force: bool) -> None:
 
 
 def _print(rep: Any, robot: Any, files: list[Path]) -> None:
-    from rich.console import Console
     from rich.table import Table
 
-    con = Console()
+    from robokin.cli_output import console
+
+    con = console()
     planned = rep.source_duration
     head = f"{cell(robot.name)}: minimum cycle time {rep.minimum_cycle_time:.3f} s"
     if planned is not None:
@@ -176,6 +177,13 @@ def retime_command(
                "j_max": _per_joint(j_max, "--j-max", scale),
                "tool_speed": None if tool_speed is None else tool_speed * lin,
                "dt": dt, "keep_dwells": not no_dwells}
+    from robokin.io.atomic import check_distinct
+
+    names = ["retimed.csv", MARKER] + ([] if cycle_time is None else
+                                       [f"retimed_{cycle_time:g}s.csv"])
+    names += [] if no_plot else ["bottlenecks.png"]
+    check_distinct([(out / n, "--out") for n in names],
+                   [(file, "TRAJ"), (rob.path, "--robot")])
     _check_out(out, force)
     try:
         rep = cycle_time_report(rob, traj, **options)

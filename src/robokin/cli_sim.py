@@ -82,6 +82,12 @@ def sim_command(
             raise InputError(label, f"expected a number > 0, got {v}")
     robot = robokin.load(name)
     sc = None if scene is None else load_scene(scene)
+    from robokin.io.atomic import check_distinct
+    from robokin.sim.report import RUN_FILES
+
+    check_distinct([(out / f, "--out") for f in RUN_FILES],
+                   [(trajectory, "TRAJECTORY"), (robot.path, "NAME"),
+                    (None if sc is None else sc.path, "--scene")])
     plan = _read_plan(trajectory, robot, motors)
     tol = (math.radians(tolerance_deg), tolerance_mm / 1000.0)
     res = sim.simulate(robot, plan, sc, gains={"bandwidth": bandwidth}, dt=dt,
@@ -100,10 +106,11 @@ def sim_command(
 
 
 def _print_summary(robot: Any, summary: dict[str, Any], out: Path) -> None:
-    from rich.console import Console
     from rich.table import Table
 
-    con = Console()
+    from robokin.cli_output import console
+
+    con = console()
     table = Table(title=f"{cell(robot.name)} in MuJoCo: simulated run vs plan")
     for col in ("joint", "max |error|", "RMS", "corr(|error|, |acc|)", "peak torque",
                 "limit", "required (ID)"):

@@ -44,7 +44,7 @@ def workspace(
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     import robokin
-    from robokin.io.atomic import file_stem, write_atomic
+    from robokin.io.atomic import check_distinct, file_stem, write_atomic
     from robokin.kinematics.workspace import sample_workspace
     from robokin.viz.plots import save_workspace_plots
 
@@ -59,6 +59,8 @@ def workspace(
     if not out.parent.is_dir():
         raise typer.BadParameter(f"--out {out}: the folder {out.parent} does not exist")
     robot = robokin.load(name)
+    check_distinct([(out / f"{file_stem(robot.name)}_workspace{end}", "--out")
+                    for end in ("_xy.png", "_xz.png", ".json")], [(robot.path, "NAME")])
     con = Console(stderr=fmt != "table")
     with Progress(
         TextColumn("[bold]sampling[/bold] {task.completed:,.0f}/{task.total:,.0f}"),

@@ -557,7 +557,7 @@ def run_demo(
     clearance = clearance_mm / 1000.0
     out = Path(out)
     _check_out_dir(out, force)
-    con = console or Console()
+    con = console or Console(emoji=False)
     timings: dict[str, float] = {}
     files: dict[str, Path] = {}
     t_start = time.perf_counter()

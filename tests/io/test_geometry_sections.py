@@ -166,6 +166,32 @@ def test_missing_mesh_names_the_file_and_the_link(tmp_path):
     assert str(path) in msg
 
 
+@pytest.mark.parametrize("kind", ["fifo", "dev_zero"])
+def test_a_mesh_that_is_not_a_regular_file_is_refused_unread(tmp_path, kind):
+    """Issue 25: a FIFO (reading blocks forever) or /dev/zero (never ends) named as a
+    mesh was "not found"; it is named for what it is, and never opened."""
+    import os
+    import re
+
+    import yaml
+
+    mesh = tmp_path / "m.stl"
+    if kind == "fifo":
+        os.mkfifo(mesh)
+    else:
+        mesh.symlink_to("/dev/zero")
+    path = tmp_path / "arm.yaml"
+    path.write_text(yaml.safe_dump(_doc({"j2": [{"type": "mesh", "file": "m.stl"}]})))
+    what = "a FIFO" if kind == "fifo" else "a character device (through a symlink)"
+    with pytest.raises(ModelError, match=re.escape(
+            f"geometry.j2[0].file: mesh file: {mesh} is not a regular file: {what}")):
+        robokin.load(path)
+    from robokin.model.geometry import mesh as mesh_shape
+
+    with pytest.raises(ModelError, match="is not a regular file"):
+        mesh_shape(mesh).trimesh()  # the API's loader checks it too
+
+
 def test_corrupt_mesh_names_the_file_and_the_link(tmp_path):
     import yaml
 

@@ -243,6 +243,48 @@ def test_a_file_without_units_that_reads_as_an_89_m_arm_warns(tmp_path):
             robokin.load(name)
 
 
+@pytest.mark.parametrize(
+    ("units", "row", "match"),
+    [
+        ("{angle: rad}", "{a: 0.4, alpha: 90}",
+         r"declares units: \{length: m, angle: rad\}; an angle of 90 rad "
+         r"\(joints\[0\]\.alpha\) suggests degrees: declare 'angle: deg'"),
+        ("{length: mm, angle: rad}", "{a: 400, alpha: -180, theta: 0}",
+         r"angle: rad\}; an angle of -180 rad \(joints\[0\]\.alpha\) suggests degrees"),
+        ("{length: m}", "{a: 425, alpha: 0}",
+         r"a length of 425 m \(joints\[0\]\.a\) suggests millimetres: declare "
+         r"'length: mm'"),
+    ],
+)
+def test_declared_units_whose_numbers_suggest_others_warn(tmp_path, units, row, match):
+    """Issue 25: ``units: {angle: rad}`` with ``alpha: 90`` loaded without a note."""
+    with pytest.warns(UserWarning, match=match):
+        load_robot(_write(tmp_path, f"name: a\nunits: {units}\njoints:\n  - {row}\n"))
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the same numbers in the unit they suggest
+        load_robot(_write(tmp_path, "name: a\nunits: {length: mm, angle: deg}\n"
+                                    "joints:\n  - {a: 425, alpha: 90}\n"))
+
+
+@pytest.mark.parametrize("name", ["arm.urdf", "arm.urdf.xacro", "arm.xacro"])
+def test_load_of_a_urdf_points_to_urdf_import(tmp_path, monkeypatch, name):
+    """Issue 25: load('x.urdf') said "must be a mapping of fields"."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / name).write_text('<robot name="r"><link name="a"/></robot>\n')
+    for given in (name, tmp_path / name):
+        with pytest.raises(robokin.ModelError, match=r"a URDF or xacro, not a robokin "
+                           r"robot file: read it with robokin.Robot.from_urdf\(.*\) or "
+                           r"convert it once with 'robokin import "):
+            robokin.load(given)
+    # the same XML under a robot-file name: the content gives it away
+    f = _write(tmp_path, '<robot name="r"><link name="a"/></robot>\n')
+    with pytest.raises(robokin.ModelError, match=r"robot.yaml: a robot file must be a "
+                       r"mapping of fields, got str; this looks like XML \(a URDF\?\)"):
+        robokin.load(f)
+
+
 def test_sections_are_an_explicit_table():
     from robokin.io import robot_files
 

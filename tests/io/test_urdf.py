@@ -2,6 +2,7 @@
 models, axes, prismatic and mimic joints, tip choice, geometry and error paths."""
 
 import math
+import os
 import re
 from pathlib import Path
 
@@ -368,3 +369,121 @@ def test_a_urdf_of_thousands_of_joints_is_refused_before_it_is_built(tmp_path):
     robot = robot_from_urdf(path, geometry=False)
     assert robot.n == MAX_JOINTS
     assert robot.fk(np.zeros(robot.n))[2, 3] == pytest.approx(10.0 * MAX_JOINTS / 1000)
+
+
+# ------------------------------------------------------ issue 25: hostile URDFs
+@pytest.mark.parametrize(("link", "joint", "message"), [
+    # a length beyond MAX_TRANSLATION (1e6 m) made a robot file load refused
+    ("", '<origin xyz="1e308 0 0"/>',
+     r"arm\.urdf:1: joint\[j\]\.origin\.xyz: <origin xyz='1e308 0 0'>: a length beyond "
+     r"the 1e\+06 m robokin accepts"),
+    ('<collision><origin xyz="0 -2e6 0"/><geometry><box size="1 1 1"/></geometry>'
+     '</collision>', "", r"link\[b\]\.origin\.xyz: .*a length beyond"),
+    ('<visual><geometry><sphere radius="1e7"/></geometry></visual>', "",
+     r"link\[b\]\.sphere\.radius: .*a length beyond"),
+    ('<inertial><mass value="nan"/></inertial>', "", r"link\[b\]\.mass\.value: .*finite"),
+])
+def test_absurd_lengths_are_refused_at_import_naming_the_field(tmp_path, link, joint,
+                                                               message):
+    path = tmp_path / "arm.urdf"
+    path.write_text(ARM.format(link=link, joint=joint))
+    with pytest.raises(ModelError, match=message):
+        robot_from_urdf(path)
+
+
+def test_a_prismatic_limit_is_a_length_a_revolute_one_an_angle(tmp_path):
+    path = tmp_path / "arm.urdf"
+    text = ARM.format(link="", joint="").replace('lower="0" upper="1"',
+                                                 'lower="-1e7" upper="1"')
+    path.write_text(text.replace('type="revolute"', 'type="prismatic"'))
+    with pytest.raises(ModelError, match=r"joint\[j\]\.limit\.lower: .*a length beyond"):
+        robot_from_urdf(path)
+    path.write_text(text)
+    assert robot_from_urdf(path).limits[0, 0] == -1e7  # radians: not a length
+
+
+def test_cli_import_of_a_1e308_origin_writes_nothing(tmp_path, capsys):
+    from robokin.cli import main
+
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(ARM.format(link="", joint='<origin xyz="1e308 0 0"/>'))
+    out = tmp_path / "arm.yaml"
+    code = main(["import", str(urdf), "-o", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and not out.exists()
+    assert f"{urdf}:1: joint[j].origin.xyz" in err
+
+
+def test_save_refuses_a_robot_file_that_would_not_load_back(tmp_path, capsys):
+    """The safety net under every writer: a 300-character URDF joint name imports,
+    but a robot file holds names of at most 200 characters."""
+    from robokin.cli import main
+
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(ARM.format(link="", joint="").replace('name="j"', f'name="{"j" * 300}"'))
+    out = tmp_path / "arm.yaml"
+    code = main(["import", str(urdf), "-o", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and not out.exists()
+    assert "String should have at most 200 characters" in err
+    assert "robokin would refuse this robot file, so it is not written" in err
+
+
+def _mesh_urdf(tmp_path: Path, filename: str) -> Path:
+    path = tmp_path / "desc" / "arm.urdf"
+    path.parent.mkdir(exist_ok=True)
+    path.write_text(ARM.format(
+        link=f'<collision><geometry><mesh filename="{filename}"/></geometry></collision>'
+             '<collision><geometry><box size="1 1 1"/></geometry></collision>',
+        joint=""))
+    return path
+
+
+@pytest.mark.parametrize("uri", [
+    "package://pkg/../../secret.stl",      # climbs out of the package
+    "package://pkg/meshes/../../secret.stl",
+    "package://pkg//abs/secret.stl",       # an absolute path after the package
+])
+def test_package_uris_that_leave_the_package_are_not_read(tmp_path, uri):
+    """Issue 25: they resolved outside the package root with no note."""
+    pkg = tmp_path / "pkg"
+    (pkg / "meshes").mkdir(parents=True)
+    (tmp_path / "secret.stl").write_bytes((DATA / "meshes" / "cube.stl").read_bytes())
+    path = _mesh_urdf(tmp_path, uri)
+    robot = robot_from_urdf(path, package_map={"pkg": pkg}, missing_mesh="ignore")
+    (dropped,) = robot.meta["urdf_dropped_shapes"]
+    assert f"the path leaves the package 'pkg' (its folder {pkg}" in dropped
+    assert "not read" in dropped
+    assert [s.kind for ss in robot.geometry.shapes for s in ss] == ["box"]
+    with pytest.raises(ModelError, match="leaves the package"):
+        robot_from_urdf(path, package_map={"pkg": pkg}, missing_mesh="error")
+    # inside the package, '..' that stays inside is fine
+    (pkg / "meshes" / "ok.stl").write_bytes((DATA / "meshes" / "cube.stl").read_bytes())
+    fine = robot_from_urdf(_mesh_urdf(tmp_path, "package://pkg/meshes/../meshes/ok.stl"),
+                           package_map={"pkg": pkg}, missing_mesh="error")
+    assert fine.meta["urdf_dropped_shapes"] == ()
+
+
+@pytest.mark.parametrize("kind", ["fifo", "dev_zero_link", "dev_zero_uri", "folder"])
+def test_a_mesh_that_is_not_a_regular_file_is_never_read(tmp_path, kind):
+    """Issue 25: /dev/zero, a FIFO or a symlink to one was 'no such file' (and a FIFO
+    opened for reading blocks forever, /dev/zero never ends)."""
+    target = tmp_path / "desc" / "m.stl"
+    target.parent.mkdir()
+    uri = "m.stl"
+    if kind == "fifo":
+        os.mkfifo(target)
+        what = "a FIFO (named pipe)"
+    elif kind == "dev_zero_link":
+        target.symlink_to("/dev/zero")
+        what = "a character device (through a symlink)"
+    elif kind == "dev_zero_uri":
+        (tmp_path / "desc" / "zero.stl").symlink_to("/dev/zero")
+        uri = f"file://{tmp_path / 'desc' / 'zero.stl'}"
+        what = "a character device"
+    else:
+        target.mkdir()
+        what = "a folder"
+    path = _mesh_urdf(tmp_path, uri)
+    with pytest.raises(ModelError, match=r"is not a regular file: " + re.escape(what)):
+        robot_from_urdf(path, missing_mesh="error")

@@ -32,6 +32,10 @@ def test_sim_command_writes_the_run_and_passes(tmp_path, plan_csv, capsys):
     for name in ("model.xml", "simulated.csv", "tracking.png", "torques.png",
                  "contacts.csv", "summary.json"):
         assert (out / name).stat().st_size > 40, name
+    # the names checked against the inputs before the run are the names written
+    from robokin.sim.report import RUN_FILES
+
+    assert sorted(p.name for p in out.iterdir()) == sorted(RUN_FILES)
     assert summary["joints"][1]["torque_limit"] == 150.0
 
 

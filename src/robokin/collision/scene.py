@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-from robokin._text import short_repr
+from robokin._text import control_character, short_repr
 from robokin._validation import check_transform
 from robokin.exceptions import InputError, ModelError
 from robokin.io.geometry_sections import number_field, shape_from_spec
@@ -59,7 +59,29 @@ def _text(value: Any, file: Any, field: str) -> str:
     if not isinstance(value, str) or len(value) > 200:
         raise ModelError(f"expected a name (text, at most 200 characters), got "
                          f"{short_repr(value)}", file=file, field=field)
+    problem = control_character(value)
+    if problem is not None:
+        raise ModelError(f"{problem} ({short_repr(value)})", file=file, field=field)
     return value
+
+
+def _check_pair(scene: Scene, pair: Sequence[str], file: Any, field: str) -> None:
+    """An exclusion is [robot link, object]: the object must be one of the scene's.
+
+    The link is checked when the scene meets a robot (:meth:`Scene.attach`).
+    """
+    link, obj = pair
+    objects = scene.names
+    if obj not in objects and link in objects:
+        link, obj = obj, link  # [object, link]: the order does not matter
+    if obj not in objects:
+        raise ModelError(f"no object {short_repr(obj)} in this scene; a pair is "
+                         f"[robot link, object], the objects are {list(objects)}",
+                         file=file, field=field)
+    if link in objects:
+        raise ModelError(f"{short_repr(link)} and {short_repr(obj)} are both objects; "
+                         "objects are never checked against each other, a pair is "
+                         "[robot link, object]", file=file, field=field)
 
 
 def _fresh(shape: Shape) -> Shape:
@@ -300,10 +322,40 @@ class Scene:
         self._version += 1
 
     def exclude_pair(self, link: str, obj: str) -> None:
-        """Never check robot link ``link`` against object ``obj``."""
+        """Never check robot link ``link`` against object ``obj``.
+
+        Raises:
+            InputError: ``obj`` is not an object of the scene (listing them);
+                ``link`` is checked against the robot's links when the scene
+                meets a robot (:meth:`attach`).
+        """
         self[obj]
+        if link in self.names:
+            raise InputError("link", f"{short_repr(link)} is an object; objects are "
+                             "never checked against each other")
         self.exclude.add(frozenset((link, obj)))
         self._version += 1
+
+    def check_exclusions(self, links: Sequence[str]) -> None:
+        """Raise unless every excluded pair names one of ``links`` and an object.
+
+        Args:
+            links: The robot's link names (``RobotGeometry.names``: ``base``, the
+                joints, ``tool``).
+
+        Raises:
+            ModelError: a pair whose link is not one of ``links`` (naming the
+                scene file, the pair and listing the links).
+        """
+        objects = set(self.names)
+        for pair in sorted(sorted(p) for p in self.exclude):
+            others = [x for x in pair if x not in objects] or pair[:1]
+            bad = [x for x in others if x not in links]
+            if bad:
+                raise ModelError(
+                    f"exclude {pair}: {short_repr(bad[0])} is neither a link of the "
+                    f"robot (links: {list(links)}) nor an object of the scene "
+                    f"(objects: {sorted(objects)})", file=self.path, field="exclude")
 
     def attach(self, robot: Robot) -> Robot:
         """The robot as placed in this scene: base, tool transform and tool shapes.
@@ -321,6 +373,7 @@ class Scene:
         geo = robot.geometry if isinstance(robot.geometry, RobotGeometry) else None
         if geo is None:
             geo = RobotGeometry.empty(robot)
+        self.check_exclusions(geo.names)
         out = robot
         if not np.array_equal(self.base, np.eye(4)):
             out = out.with_base(self.base @ robot.base)
@@ -494,7 +547,9 @@ class Scene:
                 raise ModelError(
                     "expected a pair [link, object]", file=file, field=f"exclude[{i}]"
                 )
-            scene.exclude.add(frozenset(_text(x, file, f"exclude[{i}]") for x in p))
+            pair = [_text(x, file, f"exclude[{i}]") for x in p]
+            _check_pair(scene, pair, file, f"exclude[{i}]")
+            scene.exclude.add(frozenset(pair))
         poses = doc.get("poses") or {}
         if not isinstance(poses, Mapping):
             raise ModelError("expected {name: {xyz, rpy, q}}", file=file, field="poses")

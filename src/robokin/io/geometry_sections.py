@@ -32,6 +32,7 @@ from robokin.model.geometry import (
     SHAPE_KINDS,
     RobotGeometry,
     Shape,
+    mesh_file_problem,
     segment_pose,
 )
 
@@ -281,9 +282,11 @@ def shape_from_spec(
         path = Path(spec["file"]).expanduser()
         if not path.is_absolute() and base_dir is not None:
             path = base_dir / path
-        if not path.is_file():
+        problem = mesh_file_problem(path)
+        if problem is not None:
             raise ModelError(
-                f"mesh file not found: {path}"
+                ("mesh file not found: " if problem.startswith("no such file") else
+                 "mesh file: ") + problem.removeprefix("no such file ")
                 + (f" (link '{owner}')" if owner else ""),
                 file=file,
                 field=f"{where}.file",

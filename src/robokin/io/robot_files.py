@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from robokin._text import control_character
 from robokin._validation import MAX_TRANSLATION
 from robokin.exceptions import ModelError
 from robokin.io import (
@@ -117,10 +118,18 @@ SECTIONS: dict[str, SectionIO] = {
 }
 
 
+def _printable(name: str) -> str:
+    problem = control_character(name)
+    if problem is not None:
+        raise ValueError(problem)
+    return name
+
+
 def _schema():
     from typing import Annotated, Literal
 
     from pydantic import (
+        AfterValidator,
         BaseModel,
         ConfigDict,
         Field,
@@ -130,7 +139,7 @@ def _schema():
         field_validator,
     )
 
-    Name = Annotated[StrictStr, Field(max_length=MAX_NAME)]
+    Name = Annotated[StrictStr, Field(max_length=MAX_NAME), AfterValidator(_printable)]
     Sign = Literal[1, -1]
 
     class Strict(BaseModel):
@@ -247,8 +256,12 @@ def _placement(p, L: float, A: float) -> np.ndarray | None:
 def _validated(doc: Any, file: Any) -> tuple[Any, list[Any]]:
     """The validated top level and joint rows (still in file units)."""
     if not isinstance(doc, Mapping):
+        hint = ""
+        if isinstance(doc, str) and doc.lstrip().startswith("<"):
+            hint = ("; this looks like XML (a URDF?): read it with "
+                    "robokin.Robot.from_urdf(path) or 'robokin import FILE -o ROBOT.yaml'")
         raise ModelError(
-            f"a robot file must be a mapping of fields, got {type(doc).__name__}",
+            f"a robot file must be a mapping of fields, got {type(doc).__name__}{hint}",
             file=file,
         )
     RobotFile, Row, Op = _schema()
@@ -357,24 +370,33 @@ def _check_lengths(lengths: list[tuple[str, float]], file: Any) -> None:
 
 def _warn_units(doc: Mapping, lengths: list[tuple[str, float]],
                 angles: list[tuple[str, float]], file: Any) -> None:
-    """Without ``units:``, warn when the numbers only make sense in mm or degrees."""
-    if "units" in doc:
-        return
+    """Warn when the numbers only make sense in mm or degrees.
+
+    Without ``units:`` the file is read in metres and radians; with ``units:
+    {angle: rad}`` (or ``length: m``) it says so itself. Either way a length
+    beyond 20 m or an angle beyond 2 pi (``alpha: 90``) is named, with the unit
+    it suggests.
+    """
+    units = doc.get("units") if isinstance(doc.get("units"), Mapping) else None
     hints = []
-    if lengths:
+    if lengths and (units is None or units.get("length", "m") == "m"):
         where, v = max(lengths, key=lambda wv: abs(wv[1]))
         if abs(v) > _PLAUSIBLE_LENGTH:
             hints.append(f"a length of {v:g} m ({where}) suggests millimetres: "
-                         "add 'units: {length: mm}'")
-    if angles:
+                         + ("add 'units: {length: mm}'" if units is None else
+                            "declare 'length: mm' in units:"))
+    if angles and (units is None or units.get("angle", "rad") == "rad"):
         where, v = max(angles, key=lambda wv: abs(wv[1]))
         if abs(v) > _PLAUSIBLE_ANGLE:
             hints.append(f"an angle of {v:g} rad ({where}) suggests degrees: "
-                         "add 'units: {angle: deg}'")
+                         + ("add 'units: {angle: deg}'" if units is None else
+                            "declare 'angle: deg' in units:"))
     if hints:
         name = "the robot file" if file is None else str(file)
-        warnings.warn(f"{name} has no 'units:', so it is read in metres and "
-                      f"radians; {'; '.join(hints)}", UserWarning, stacklevel=4)
+        said = ("has no 'units:', so it is read in metres and radians" if units is None
+                else f"declares units: {{length: {units.get('length', 'm')}, "
+                     f"angle: {units.get('angle', 'rad')}}}")
+        warnings.warn(f"{name} {said}; {'; '.join(hints)}", UserWarning, stacklevel=4)
 
 
 def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
@@ -570,12 +592,27 @@ def save_robot(robot: Robot, path: str | Path) -> Path:
     A failure never leaves a half-written file, and an existing file is replaced
     only once the new content is complete on disk.
 
+    The document is read back (in memory, as :func:`load_robot` would read the
+    file) before anything is written: a robot whose file robokin would refuse
+    to load (a length beyond :data:`~robokin._validation.MAX_TRANSLATION`, a
+    name it cannot hold) is refused here, naming the field, and no file is
+    written.
+
     Raises:
         InputError: the folder is missing or read-only, or ``path`` is a folder.
+        ModelError: the file would not load back (naming ``path``, the field and
+            the reason).
     """
     import yaml
 
     text = yaml.safe_dump(
         document_from_robot(robot), sort_keys=False, default_flow_style=None
     )
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the loader's unit hints: not a refusal
+            robot_from_document(yaml.safe_load(text), file=path)
+    except ModelError as exc:
+        raise ModelError(f"{exc.reason}; robokin would refuse this robot file, so it "
+                         "is not written", file=path, field=exc.field) from None
     return write_atomic(path, text)

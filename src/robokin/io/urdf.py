@@ -40,6 +40,7 @@ Import rules (documented in ``docs/urdf.md``):
 from __future__ import annotations
 
 import math
+import os
 import re
 import warnings
 from collections.abc import Mapping, Sequence
@@ -55,7 +56,7 @@ from robokin.io.ros_packages import PackageFinder
 from robokin.io.urdf_xml import MAX_URDF_JOINTS, MOVABLE, parse_urdf
 from robokin.model.chain import Chain, ChainBuilder, Joint, JointKind
 from robokin.model.coupling import Dependency, coupling_from_dependencies, mimic
-from robokin.model.geometry import MESH_SUFFIXES
+from robokin.model.geometry import MESH_SUFFIXES, mesh_file_problem
 
 if TYPE_CHECKING:
     from robokin.io.dh_extract import DHExtraction
@@ -469,6 +470,10 @@ def _resolve_mesh(
         root = packages.find(pkg)
         if root is None:
             return None, packages.not_found(pkg)
+        inside = os.path.normpath(sub)
+        if os.path.isabs(sub) or inside == ".." or inside.startswith(".." + os.sep):
+            return None, (f"the path leaves the package '{pkg}' (its folder {root}; "
+                          f"it resolves to {os.path.normpath(root / sub)}): not read")
         return _mesh_file(root / sub)
     if filename.startswith("file://"):
         return _mesh_file(Path(filename[len("file://"):]))
@@ -488,8 +493,9 @@ def _mesh_file(p: Path) -> tuple[Path | None, str]:
     if p.suffix.lower() not in MESH_SUFFIXES:
         return None, (f"not a mesh file (suffix {short_repr(p.suffix)}; robokin "
                       f"reads {', '.join(MESH_SUFFIXES)})")
-    if not p.is_file():
-        return None, f"no such file {p}"
+    problem = mesh_file_problem(p)
+    if problem is not None:
+        return None, problem
     return p, ""
 
 

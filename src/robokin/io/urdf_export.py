@@ -26,6 +26,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
+from robokin._text import printable
 from robokin.io.atomic import write_atomic
 from robokin.io.urdf import UrdfChain
 from robokin.model.chain import joint_motion
@@ -155,6 +156,7 @@ def urdf_from_robot(
            if _known_velocities(robot) is not None
            else "; <limit velocity> and an effort without a torque limit are placeholders")
     )
+    note = printable(note)  # XML cannot hold a control character, even escaped
     while "--" in note:
         note = note.replace("--", "-")
     root.append(ET.Comment(f" {note} "))

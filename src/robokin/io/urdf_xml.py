@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from robokin._text import short_repr
+from robokin._validation import MAX_TRANSLATION
 from robokin.exceptions import MissingExtraError, ModelError
 from robokin.io.text_files import read_file_bytes
 
@@ -151,7 +152,13 @@ _NUMBERS: dict[tuple[str, str], tuple[int | None, bool]] = {
     ("cylinder", "length"): (1, True),
     ("sphere", "radius"): (1, True),
     ("mesh", "scale"): (None, True),
+    ("mass", "value"): (1, False),
+    **{("inertia", k): (1, False) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")},
 }
+# Attributes that are lengths [m]: bounded by MAX_TRANSLATION as in robot files, so
+# an import never writes a robot file robokin refuses to load.
+_LENGTHS = {("origin", "xyz"), ("box", "size"), ("cylinder", "radius"),
+            ("cylinder", "length"), ("sphere", "radius")}
 _REQUIRED = {"box": ("size",), "cylinder": ("radius", "length"),
              "sphere": ("radius",), "mesh": ("filename",)}
 
@@ -193,9 +200,21 @@ def _check_number_text(el: Any, key: str, text: str, spec: tuple[int | None, boo
         problem = f"expected {expected}, finite (no NaN or infinity)"
     elif positive and not all(v > 0 for v in values):
         problem = "expected positive sizes"
+    elif _is_length(el, key) and max(abs(v) for v in values) > MAX_TRANSLATION:
+        problem = (f"a length beyond the {MAX_TRANSLATION:g} m robokin accepts "
+                   "(robokin._validation.MAX_TRANSLATION)")
     if problem:
         raise ModelError(f"<{el.tag} {key}={short_repr(text)}>: {problem}", file=file,
                          field=_field(el, key), line=el.sourceline)
+
+
+def _is_length(el: Any, key: str) -> bool:
+    """Whether ``el``'s attribute ``key`` is a length (an origin, a size, a limit)."""
+    if (el.tag, key) in _LENGTHS:
+        return True
+    parent = el.getparent()
+    return el.tag == "limit" and key in ("lower", "upper") and parent is not None \
+        and parent.get("type") == "prismatic"
 
 
 def parse_urdf(source: str | Path | bytes) -> tuple[Any, Path | None]:

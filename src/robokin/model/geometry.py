@@ -35,6 +35,8 @@ the meshes themselves.
 from __future__ import annotations
 
 import math
+import os
+import stat
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -66,6 +68,7 @@ __all__ = [
     "cylinder_between",
     "link_names",
     "mesh",
+    "mesh_file_problem",
     "segment_pose",
     "sphere",
 ]
@@ -326,12 +329,43 @@ def _coal():
     return coal
 
 
+_FILE_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+               (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+               (stat.S_ISSOCK, "a socket"))
+
+
+def mesh_file_problem(path: str | Path) -> str | None:
+    """Why ``path`` cannot be read as a mesh file, or None when it can.
+
+    A mesh is read only from a regular file: a folder, a FIFO, a device
+    (``/dev/zero``) or a symlink to one is reported as not a regular file (never
+    opened: a FIFO would block, ``/dev/zero`` never ends); a path that does not
+    exist as "no such file".
+    """
+    try:
+        st = os.stat(path)  # follows a symlink: its target is what would be read
+    except FileNotFoundError:
+        return f"no such file {path}"
+    except OSError as exc:
+        return f"cannot read {path}: {exc.strerror or exc}"
+    if stat.S_ISREG(st.st_mode):
+        return None
+    kind = next((k for test, k in _FILE_KINDS if test(st.st_mode)), "not a file")
+    via = " (through a symlink)" if os.path.islink(path) else ""
+    return f"{path} is not a regular file: {kind}{via}"
+
+
 def _load_mesh(path: Path | None, scale: float, owner: str):
     import trimesh
 
     where = f" (link '{owner}')" if owner else ""
-    if path is None or not Path(path).is_file():
+    if path is None:
         raise ModelError(f"mesh file not found{where}", file=path, field=owner or None)
+    problem = mesh_file_problem(path)
+    if problem is not None:
+        what = "not found" if problem.startswith("no such file") else f": {problem}"
+        raise ModelError(f"mesh file {what}{where}".replace(" :", ":"), file=path,
+                         field=owner or None)
     size = Path(path).stat().st_size
     if size > MAX_MESH_BYTES:
         raise ModelError(f"mesh file of {size:,} bytes{where}, more than the "

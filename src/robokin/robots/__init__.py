@@ -6,7 +6,7 @@ from pathlib import Path
 
 from robokin.exceptions import ModelError
 
-__all__ = ["load", "names", "path"]
+__all__ = ["URDF_SUFFIXES", "load", "names", "path"]
 
 _HERE = Path(__file__).parent
 
@@ -28,11 +28,27 @@ def path(name: str) -> Path:
     return p
 
 
+#: Names of files that are URDF or xacro, not robot files.
+URDF_SUFFIXES = (".urdf", ".xacro", ".urdf.xml")
+
+
 def load(name_or_path):
-    """Load a built-in robot by name, or a robot file by path."""
+    """Load a built-in robot by name, or a robot file by path.
+
+    Raises:
+        ModelError: an unknown name (listing the built-in ones), a bad robot
+            file, or a URDF or xacro (pointing to ``Robot.from_urdf`` and
+            ``robokin import``).
+    """
     from robokin.io.robot_files import load_robot
 
     s = str(name_or_path)
-    if isinstance(name_or_path, Path) or s.endswith((".yaml", ".yml")) or "/" in s:
+    if s.lower().endswith(URDF_SUFFIXES):
+        raise ModelError(
+            "a URDF or xacro, not a robokin robot file: read it with "
+            f"robokin.Robot.from_urdf({s!r}) or convert it once with "
+            f"'robokin import {s} -o ROBOT.yaml'", file=s)
+    if isinstance(name_or_path, Path) or s.endswith((".yaml", ".yml")) or "/" in s \
+            or Path(s).is_file():
         return load_robot(Path(name_or_path))
     return load_robot(path(s))

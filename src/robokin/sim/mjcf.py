@@ -59,8 +59,8 @@ if TYPE_CHECKING:
     from robokin.model.geometry import Shape
     from robokin.robot import Robot
 
-__all__ = ["MJCF_TIMESTEP", "JointMap", "MjcfExport", "build_mjcf", "to_mjcf",
-           "write_mjcf"]
+__all__ = ["MAX_LINK_INERTIA", "MAX_LINK_MASS", "MJCF_TIMESTEP", "TRIANGLE_SLACK",
+           "JointMap", "MjcfExport", "build_mjcf", "to_mjcf", "write_mjcf"]
 
 F64 = npt.NDArray[np.float64]
 ActuatorSpace = Literal["joint", "motor"]
@@ -74,6 +74,15 @@ _TINY_INERTIA = 1e-12
 # Rotor inertia [kg m^2 or kg] of the joint of a coordinate on a massless leaf
 # body (without it the mass matrix is singular there).
 _ARMATURE = 1e-6
+#: Largest link mass [kg] the export accepts (a 100 t link is a typo, not an arm).
+MAX_LINK_MASS = 1e5
+#: Largest principal moment of inertia [kg m^2] the export accepts (1e5 kg at a
+#: radius of gyration of 3 m).
+MAX_LINK_INERTIA = 1e6
+#: How far a tensor's principal moments may break ``A + B >= C`` and still be
+#: balanced with a note (``C <= (1 + slack) (A + B)``): published tables round
+#: (the Puma 560's elbow breaks it by 9.6 %); beyond, no rigid body has them.
+TRIANGLE_SLACK = 0.25
 _ROBOT_RGBA = "0.95 0.55 0.15 1"
 _SCENE_RGBA = "0.6 0.6 0.65 0.6"
 
@@ -310,8 +319,44 @@ def _consistent(link: LinkInertia) -> tuple[LinkInertia, str]:
                    f"A + B >= C; raised to {np.round(w2, 9).tolist()}")
 
 
+def check_link_inertia(link: LinkInertia, name: str, file: object = None) -> None:
+    """Refuse mass properties no rigid body has, before MuJoCo sees them.
+
+    Args:
+        link: The link's mass properties.
+        name: The link (as in ``dynamics.links``), for the message.
+        file: The robot file, for the message.
+
+    Raises:
+        ModelError: a mass above :data:`MAX_LINK_MASS`, a principal moment above
+            :data:`MAX_LINK_INERTIA`, or (for a link with mass) principal moments
+            that break ``A + B >= C`` by more than :data:`TRIANGLE_SLACK`, naming
+            the file and ``dynamics.links.<link>.mass`` / ``.inertia``.
+    """
+    field = f"dynamics.links.{name}"
+    if link.mass > MAX_LINK_MASS:
+        raise ModelError(f"a mass of {link.mass:g} kg, more than the {MAX_LINK_MASS:g} kg "
+                         "the MJCF export accepts (robokin.sim.mjcf.MAX_LINK_MASS)",
+                         file=file, field=f"{field}.mass")
+    w = np.sort(np.maximum(np.linalg.eigvalsh(link.inertia), 0.0))
+    if w[2] > MAX_LINK_INERTIA:
+        raise ModelError(f"a principal moment of {w[2]:g} kg m^2, more than the "
+                         f"{MAX_LINK_INERTIA:g} kg m^2 the MJCF export accepts "
+                         "(robokin.sim.mjcf.MAX_LINK_INERTIA)", file=file,
+                         field=f"{field}.inertia")
+    if link.mass > 0.0 and w[2] > (1.0 + TRIANGLE_SLACK) * (w[0] + w[1]):
+        over = f"{w[2] / (w[0] + w[1]) - 1:.0%}" if w[0] + w[1] > 0 else "all of C"
+        raise ModelError(f"principal moments {np.round(w, 9).tolist()} kg m^2 break the "
+                         f"triangle inequality A + B >= C (by {over}; up to "
+                         f"{TRIANGLE_SLACK:.0%} is balanced with a note): no rigid body "
+                         "has them; check the tensor's entries and units",
+                         file=file, field=f"{field}.inertia")
+
+
 def _inertial(body: ET.Element, name: str, link: LinkInertia | None, has_joint: bool,
-              notes: list[str]) -> None:
+              notes: list[str], file: object = None) -> None:
+    if link is not None:
+        check_link_inertia(link, name, file)
     if link is None or link.mass <= 0.0:
         if not has_joint:  # a welded body may be massless
             return
@@ -396,7 +441,8 @@ class _Writer:
         if moving and self.gravcomp:
             attrs["gravcomp"] = "1"
         body = ET.SubElement(parent, "body", attrs)
-        _inertial(body, name, self.links.links[k], has_joint, self.notes)
+        _inertial(body, name, self.links.links[k], has_joint, self.notes,
+                  self.robot.path)
         geo = self.robot.geometry
         if geo is not None and hasattr(geo, "shapes"):
             for s_i, shape in enumerate(geo.shapes[k]):

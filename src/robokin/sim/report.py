@@ -20,7 +20,7 @@ if TYPE_CHECKING:
     from robokin.sim.inverse import InverseDynamics
     from robokin.sim.simulate import SimResult
 
-__all__ = ["plot_decoupling", "plot_torques", "run_summary", "write_run"]
+__all__ = ["RUN_FILES", "plot_decoupling", "plot_torques", "run_summary", "write_run"]
 
 
 def _unit(revolute: bool) -> tuple[str, str]:
@@ -179,6 +179,11 @@ def run_summary(result: SimResult, inverse: InverseDynamics | None = None
         "mass_properties": result.export.links.describe(),
         "notes": list(result.export.notes),
     }
+
+
+#: The files :func:`write_run` writes (each after its ``prefix``).
+RUN_FILES = ("model.xml", "simulated.csv", "tracking.png", "torques.png", "contacts.csv",
+             "summary.json")
 
 
 def write_run(result: SimResult, inverse: InverseDynamics | None, out: str | Path, *,

@@ -52,7 +52,7 @@ def solve(
         qn = (q_near if _plain_joints(q_near, robot.n)
               else check_finite(check_joints(q_near, robot.n, "q_near"), "q_near"))
     if (not options and type(T) is np.ndarray and T.shape == (4, 4)
-            and T.dtype == np.float64 and method != "numeric"):
+            and T.dtype == np.float64 and T.flags.aligned and method != "numeric"):
         # hot path: one pose, a 6R closed form, default options (one compiled call
         # validates the pose and solves it)
         single = _single_solver(robot)
@@ -110,4 +110,4 @@ def _plain_joints(q: object, n: int) -> TypeGuard[npt.NDArray[np.float64]]:
     full checks).
     """
     return (type(q) is np.ndarray and q.shape == (n,) and q.dtype == np.float64
-            and math.isfinite(sum(q.tolist())))
+            and q.flags.aligned and math.isfinite(sum(q.tolist())))
