@@ -198,3 +198,28 @@ def test_changing_the_scene_after_a_check_is_seen_by_the_next_check():
     pairs = {(p.body_a, p.body_b) for p in check(r, sc, q).pairs}
     assert ("base", "block") not in pairs and ("shoulder_pan", "block") not in pairs
     assert ("elbow", "block") in pairs
+
+
+def test_a_scene_names_a_robot_file_relative_to_itself(tmp_path, monkeypatch, capsys):
+    """Issue 25: `robokin check cell/scene.yaml plan.csv` looked for the scene's
+    `robot: arm.yaml` in the current folder. Oracle: the same robot file loaded by
+    its full path; a built-in name stays a name."""
+    from robokin.cli import main
+    from robokin.trajectory import io, quintic
+
+    folder = tmp_path / "cell"
+    folder.mkdir()
+    ur5 = robokin.load("ur5")
+    robokin.save(ur5.replace(name="my_arm"), folder / "arm.yaml")
+    (folder / "scene.yaml").write_text(
+        "robot: {name: arm.yaml}\n"
+        "objects: [{name: post, type: box, size: [0.1, 0.1, 0.1], xyz: [2, 0, 0]}]\n")
+    sc = Scene.load(folder / "scene.yaml")
+    assert sc.robot_name == str(folder / "arm.yaml")
+    assert robokin.load(sc.robot_name).name == "my_arm"
+    plan = quintic(np.zeros(6), np.full(6, 0.2), 0.5).replace(joint_names=ur5.joint_names)
+    csv = io.write_csv(plan, tmp_path / "plan.csv")
+    monkeypatch.chdir(tmp_path)  # not the scene's folder
+    assert main(["check", "cell/scene.yaml", str(csv)]) == 0, capsys.readouterr().err
+    (folder / "named.yaml").write_text("robot: {name: ur5}\n")
+    assert Scene.load(folder / "named.yaml").robot_name == "ur5"
