@@ -20,6 +20,18 @@ from robokin.cli_output import (
 __all__ = ["workspace"]
 
 
+def _refuse_earlier_run(targets: list[Path], out: Path) -> None:
+    """Files an earlier run left in ``out`` are replaced only with --force."""
+    import os
+
+    from robokin.exceptions import InputError
+
+    there = [p.name for p in targets if os.path.lexists(p)]
+    if there:
+        raise InputError("--out", f"{out} holds an earlier run's {', '.join(there)}; "
+                         "pass --force to replace them, or --out to write elsewhere")
+
+
 @app.command()
 def workspace(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
@@ -33,12 +45,18 @@ def workspace(
         float, typer.Option("--voxel", help="Voxel edge [mm] (0: the longest extent / 100).")
     ] = 0.0,
     seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    force: Annotated[bool, typer.Option(
+        "--force", help="Replace the files of an earlier run in --out.")] = False,
     as_json: Annotated[
         bool, typer.Option("--json", help="Same as --format json.")
     ] = False,
     output_format: FormatOption = None,
 ) -> None:
-    """Sample the reachable workspace: bounds, volume, XY/XZ sections, manipulability."""
+    """Sample the reachable workspace: bounds, volume, XY/XZ sections, manipulability.
+
+    The plots and the summary go into --out; the files of an earlier run there are
+    replaced only with --force.
+    """
     import numpy as np
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
@@ -46,7 +64,7 @@ def workspace(
     import robokin
     from robokin.io.atomic import check_distinct, file_stem, write_atomic
     from robokin.kinematics.workspace import sample_workspace
-    from robokin.viz.plots import save_workspace_plots
+    from robokin.viz.plots import save_workspace_plots, workspace_plot_paths
 
     fmt = resolve_format(output_format, as_json)
     as_json = fmt == "json"
@@ -61,6 +79,9 @@ def workspace(
     robot = robokin.load(name)
     check_distinct([(out / f"{file_stem(robot.name)}_workspace{end}", "--out")
                     for end in ("_xy.png", "_xz.png", ".json")], [(robot.path, "NAME")])
+    summary_path = Path(out) / f"{file_stem(robot.name)}_workspace.json"
+    if not force:
+        _refuse_earlier_run([*workspace_plot_paths(robot.name, out), summary_path], out)
     con = Console(stderr=fmt != "table")
     with Progress(
         TextColumn("[bold]sampling[/bold] {task.completed:,.0f}/{task.total:,.0f}"),
@@ -81,7 +102,6 @@ def workspace(
     paths = save_workspace_plots(ws, out)
     summary = ws.summary()
     summary["plots"] = [str(p) for p in paths]
-    summary_path = Path(out) / f"{file_stem(robot.name)}_workspace.json"
     write_atomic(summary_path, json_text(summary) + "\n", argument="--out")
     if as_json:
         print(json_text(summary))

@@ -84,6 +84,21 @@ def _check_pair(scene: Scene, pair: Sequence[str], file: Any, field: str) -> Non
                          "[robot link, object]", file=file, field=field)
 
 
+def _robot_file(name: str, file: Any) -> str:
+    """A scene's robot: a robot file next to the scene file (as a path), or ``name``.
+
+    A relative ``.yaml`` / ``.yml`` name is read relative to the scene file, as a
+    motion file's ``robot:`` is; anything else (a built-in name, an absolute path)
+    is kept as written.
+    """
+    candidate = Path(name)
+    if (file is None or candidate.is_absolute()
+            or candidate.suffix.lower() not in (".yaml", ".yml")):
+        return name
+    beside = Path(file).parent / candidate
+    return str(beside) if beside.is_file() else name
+
+
 def _fresh(shape: Shape) -> Shape:
     """The same declared shape without its caches (coal objects stay behind)."""
     return replace(shape)
@@ -145,7 +160,8 @@ class Scene:
         exclude: (robot link, object) name pairs never checked.
         poses: Named TCP poses in the world, ``{name: (4, 4)}``.
         pose_joints: Joint configurations reaching ``poses`` (when given), ``{name: (n,)}``.
-        robot_name: The robot the scene was built for (built-in name or file), or None.
+        robot_name: The robot the scene was built for (built-in name or file; a
+            relative robot file is given relative to the scene file), or None.
         path: The scene file, or None.
     """
 
@@ -479,7 +495,8 @@ class Scene:
                 raise ModelError("expected {name: ..., base: {xyz, rpy}}; "
                                  + unknown_key(keys), file=file, field="robot")
             scene.robot_name = (None if rob.get("name") is None
-                                else _text(rob["name"], file, "robot.name"))
+                                else _robot_file(_text(rob["name"], file, "robot.name"),
+                                                 file))
             scene.base = placement(rob.get("base"), "robot.base")
         tool = doc.get("tool")
         if tool is not None:

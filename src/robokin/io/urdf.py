@@ -500,19 +500,47 @@ def _mesh_file(p: Path) -> tuple[Path | None, str]:
 
 
 class _Drops:
-    """Shapes left out of the import: raised, warned or only recorded."""
+    """Shapes left out of the import: raised, or recorded and reported per reason.
+
+    Shapes left out for the same reason (every mesh of one missing package) make
+    one note: :meth:`notes`, warned once each in ``"warn"`` mode by :meth:`report`.
+    """
 
     def __init__(self, mode: MissingMesh, file: Path | None) -> None:
         self.mode, self.file = mode, file
         self.messages: list[str] = []
+        self._by_reason: dict[str, list[tuple[str, str, str]]] = {}
 
     def drop(self, link: str, role: str, uri: str, why: str) -> None:
         msg = f"link '{link}' {role} mesh {short_repr(uri, 200)}: {why}"
         if self.mode == "error":
             raise ModelError(msg, file=self.file, field=f"link[{link}].{role}")
-        if self.mode == "warn":
-            warnings.warn(f"{msg}; shape skipped", UserWarning, stacklevel=4)
         self.messages.append(msg)
+        self._by_reason.setdefault(why, []).append((link, role, uri))
+
+    def notes(self) -> tuple[str, ...]:
+        """One line per reason: the shape (or how many, of which links) and why."""
+        out = []
+        for why, shapes in self._by_reason.items():
+            if len(shapes) == 1:
+                link, role, uri = shapes[0]
+                out.append(f"link '{link}' {role} mesh {short_repr(uri, 200)}: {why}")
+                continue
+            links = list(dict.fromkeys(link for link, _, _ in shapes))
+            shown = ", ".join(links[:8]) + (f" and {len(links) - 8} more"
+                                            if len(links) > 8 else "")
+            roles = " and ".join(sorted({role for _, role, _ in shapes},
+                                        reverse=True))
+            out.append(f"{len(shapes)} {roles} meshes of link"
+                       f"{'s' if len(links) > 1 else ''} {shown}: {why}")
+        return tuple(out)
+
+    def report(self, stacklevel: int) -> None:
+        """Warn once per reason (``"warn"`` mode)."""
+        if self.mode == "warn":
+            for note in self.notes():
+                warnings.warn(f"left out {note}; shapes skipped", UserWarning,
+                              stacklevel=stacklevel + 1)
 
 
 def _geometry_of(
@@ -632,7 +660,9 @@ def robot_from_urdf(
             file that is not a mesh, a non-uniform scale): ``"warn"`` (default:
             a UserWarning naming the link and file, the shape is skipped),
             ``"error"`` (ModelError) or ``"ignore"`` (skipped silently; still
-            listed in ``meta["urdf_dropped_shapes"]``).
+            listed in ``meta["urdf_dropped_shapes"]``). Shapes left out for the
+            same reason (every mesh of a package that is not found) give one
+            warning.
         name: The robot's name (default: the URDF's ``<robot name>``).
 
     Returns:
@@ -640,8 +670,9 @@ def robot_from_urdf(
         ``<inertial>`` and the joints' ``effort``, see
         :mod:`robokin.io.urdf_inertial`) with ``robot.meta["urdf"]`` holding the
         :class:`UrdfChain`, ``robot.meta["urdf_shapes"]`` the shapes,
-        ``robot.meta["urdf_dropped_shapes"]`` one message per shape left out
-        and, for a xacro, ``robot.meta["xacro"]`` the
+        ``robot.meta["urdf_dropped_shapes"]`` one message per shape left out,
+        ``robot.meta["urdf_dropped_notes"]`` one per reason (what ``robokin
+        import`` prints) and, for a xacro, ``robot.meta["xacro"]`` the
         :class:`~robokin.io.xacro.XacroExpansion` (its ``urdf`` is the
         expanded text).
 
@@ -691,8 +722,10 @@ def robot_from_urdf(
 
     robot = robot.replace(dynamics=dynamics_from_urdf(robot, urdf_robot,
                                                       info.link_frames, file))
+    drops.report(stacklevel=2)
     return robot.replace(meta={**robot.meta,
-                               "urdf_dropped_shapes": tuple(drops.messages)})
+                               "urdf_dropped_shapes": tuple(drops.messages),
+                               "urdf_dropped_notes": drops.notes()})
 
 
 def _parse_source(

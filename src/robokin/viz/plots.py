@@ -202,14 +202,20 @@ def save_workspace_plots(ws: Any, out_dir: str | Path) -> list[Path]:
     if not out.is_dir():
         raise InputError("out_dir", f"{out} is not a folder")
     written = []
+    paths = dict(zip(("xy", "xz"), workspace_plot_paths(ws.robot_name, out)))
     for plane in ("xy", "xz"):
         fig = _figure(figsize=(12.0, 5.5))
         axes = fig.subplots(1, 2)
         plot_cross_section(ws, plane, color_by="manipulability", ax=axes[0])
         plot_cross_section(ws, plane, color_by="density", ax=axes[1])
-        name = f"{file_stem(ws.robot_name)}_workspace_{plane}.png"
-        written.append(save_figure(fig, out / name, overwrite=True, dpi=110))
+        written.append(save_figure(fig, paths[plane], overwrite=True, dpi=110))
     return written
+
+
+def workspace_plot_paths(robot_name: str, out_dir: str | Path) -> list[Path]:
+    """The files :func:`save_workspace_plots` writes for ``robot_name``: XY, then XZ."""
+    return [Path(out_dir) / f"{file_stem(robot_name)}_workspace_{plane}.png"
+            for plane in ("xy", "xz")]
 
 
 def _finish(fig, path, overwrite):
