@@ -639,7 +639,9 @@ def _choose_solutions(job: PlaceJob, base: np.ndarray, ps: PoseSet,
         report = check(job.bare, scene, ps.q[c, todo, cand], clearance=job.clearance,
                        subdivide=False)
         bad = np.zeros(todo.size, dtype=bool)
-        for iv in (*report.collisions, *report.violations):
+        for col in report.collisions:
+            bad[col.first_index : col.last_index + 1] = True
+        for iv in report.violations:
             bad[iv.first_index : iv.last_index + 1] = True
         slots[todo[~bad]] = cand[~bad]
         todo = todo[bad]

@@ -140,7 +140,15 @@ class ReachMap:
         return self.grid.size
 
     def volume(self, threshold: float = 0.0) -> float:
-        """Volume [m^3] of the voxels whose index exceeds ``threshold``."""
+        """Volume [m^3] of the voxels whose index exceeds ``threshold``.
+
+        With ``threshold=0``: the voxels whose centre the tool reaches in at
+        least one of the K orientations, a midpoint cubature of the position
+        workspace whose volume
+        :func:`~robokin.kinematics.workspace.sample_workspace` estimates with
+        its uncertainty (low by the boundary voxels reachable only between the
+        K orientations; see ``docs/scale.md``).
+        """
         idx = np.asarray(self.index[...])
         return float(np.count_nonzero(idx > threshold)) * self.grid.voxel**3
 
