@@ -10,7 +10,9 @@ workspace bounds), after checking correctness:
    ``distributed.LocalCluster`` of two workers are compared array by array (bit
    for bit); random (voxel, orientation) pairs are re-solved by direct IK
    (``robot.ik`` one pose at a time) and must agree 100 %; the best
-   manipulability of random voxels is compared with ``robot.manipulability``.
+   manipulability of random voxels is compared with ``robot.manipulability``;
+   the cost of one manipulability, compiled (``|det J|``, ``manipulability.c``)
+   and the old way (a stored Jacobian and ``numpy.linalg.det``).
 2. **Throughput, in alternating rounds** (medians; the box is shared, so each
    round measures every variant back to back):
 
@@ -155,6 +157,33 @@ def check_correctness(robot, kw, client, samples: int, rng) -> None:
         raise SystemExit("the map disagrees with direct IK")
 
 
+def manipulability_cost(robot, rng, count: int = 500_000, rounds: int = 5) -> None:
+    """ns per configuration, one thread: the compiled |det J| (manipulability.c)
+    against a stored Jacobian and numpy.linalg.det (the map's path before issue 25)."""
+    from robokin.kinematics.jacobian import jacobian, manipulability
+
+    q = robot.limits[:, 0] + rng.random((count, robot.n)) * np.ptp(robot.limits, axis=1)
+    ok = rng.random(count) < 0.5  # an IK solution set's valid rows
+    before = num_threads()
+    set_num_threads(1)
+    try:
+        fused, stored = [], []
+        for _ in range(rounds):
+            t = time.perf_counter()
+            w = manipulability(robot.chain, q, method="det", where=ok)
+            fused.append((time.perf_counter() - t) / ok.sum() * 1e9)
+            t = time.perf_counter()
+            ref = np.abs(np.linalg.det(jacobian(robot.chain, q[ok])))
+            stored.append((time.perf_counter() - t) / ok.sum() * 1e9)
+    finally:
+        set_num_threads(before)
+    worst = float(np.max(np.abs(w[ok] - ref)) / ref.max())
+    print(f"manipulability per solution, one thread ({rounds} rounds, min-max): compiled "
+          f"|det J| {min(fused):.0f}-{max(fused):.0f} ns, stored Jacobian + numpy det "
+          f"{min(stored):.0f}-{max(stored):.0f} ns; largest difference / largest w "
+          f"{worst:.1e}")
+
+
 def projection(robot, per_core: dict[str, float]) -> None:
     region = default_region(robot, _REGION_SAMPLES, _REGION_MARGIN)
     g = VoxelGrid.from_region(region, 0.005)
@@ -242,6 +271,7 @@ def main() -> None:
             local_cluster(1) as lc1, Client(lc1) as c1, \
             tempfile.TemporaryDirectory() as tmp:
         check_correctness(robot, {**kw, "voxel": args.voxel * 2}, c2, args.samples, rng)
+        manipulability_cost(robot, rng)
         wall: dict[str, list[float]] = {}
         cpu: dict[str, list[float]] = {}
         here, pids2, pids1 = [os.getpid()], cluster_pids(c2), cluster_pids(c1)

@@ -224,6 +224,8 @@ def test_every_reached_point_is_proven_and_the_ball_bounds_the_arm(rng):
         position_reachable(ur5, np.zeros((4, 2)))
     with pytest.raises(InputError, match="argument 'points'"):
         position_reachable(ur5, [[0.0, np.nan, 0.0]])
+    with pytest.raises(InputError, match="argument 'seeds'.*shape \\(300, 6\\)"):
+        position_reachable(ur5, p, seeds=q[:5])
 
 
 def test_random_joints_stay_inside_limits(rng):

@@ -84,8 +84,9 @@ class VolumeEstimate:
             the misses added, see ``rescued``).
         std_error: Its standard error ``|B| sqrt(p (1 - p) / M)`` [m^3]
             (p = H / M; plus the rescue fraction's sampling error).
-        interval: 95 % Wilson score interval ``[lo, hi]`` [m^3] (meaningful
-            even when no point, or every point, is reached).
+        interval: 95 % Wilson score interval ``[lo, hi]`` [m^3] of the
+            binomial part (meaningful even when no point, or every point, is
+            reached).
         points: M, the test points drawn uniformly in the box.
         hits: H, the test points reached by the membership test.
         region: The box ``[[x0, y0, z0], [x1, y1, z1]]`` [m] in the world.
@@ -310,8 +311,13 @@ def position_reachable(
     T = np.zeros((flat.shape[0], 4, 4))
     T[:, 0, 0] = T[:, 1, 1] = T[:, 2, 2] = T[:, 3, 3] = 1.0
     T[:, :3, 3] = flat
-    q0 = None if seeds is None else np.asarray(seeds, dtype=np.float64).reshape(
-        -1, robot.n)
+    q0 = None
+    if seeds is not None:
+        q0 = np.asarray(seeds, dtype=np.float64)
+        if q0.shape != lead + (robot.n,):
+            raise InputError("seeds", f"expected one configuration per point, shape "
+                             f"{lead + (robot.n,)}, got {q0.shape}")
+        q0 = q0.reshape(-1, robot.n)
     if flat.shape[0] == 0:
         return np.zeros(lead, dtype=bool)
     res = solve(robot, T, q0=q0, mask="xyz", tol=tol, max_restarts=max_restarts,
@@ -402,7 +408,7 @@ def _estimate_volume(robot: RobotLike, points: np.ndarray, sample_q: np.ndarray,
     rescued = int(position_reachable(robot, X[sub], seeds=sample_q[seed[sub]],
                                       **_THOROUGH).sum()) if sub.size else 0
     f = rescued / sub.size if sub.size else 0.0
-    hits = hit.sum() + F * f
+    hits = float(hit.sum() + F * f)
     vol = float(np.prod(box[1] - box[0]))
     p = hits / M
     var = M * p * (1 - p) + (F * F * f * (1 - f) / sub.size if sub.size else 0.0)
