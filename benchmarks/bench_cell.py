@@ -1,7 +1,7 @@
 """Cell design at scale: reachability-map throughput on Dask against the bare batch IK.
 
 Run: ``python benchmarks/bench_cell.py [--voxel 0.05] [--orientations 32] [--rounds 3]
-[--rss-evals 1e8] [--sweep]``.
+[--rss-evals 1e8] [--sweep] [--core]``.
 
 Everything side by side in one run, on the UR5 over its default region (the
 workspace bounds), after checking correctness:
@@ -54,6 +54,8 @@ from robokin.cell.grid import VoxelGrid, tool_orientations
 from robokin.cell.reach_map import _REGION_MARGIN, _REGION_SAMPLES, _default_chunk
 
 FIELDS = ("counts", "index", "solutions", "manipulability")
+CORE = ("bare batch IK (robot.ik)", "map work, no Dask, w off", "map work, no Dask, w on",
+        "LocalCluster 2x1, w off", "LocalCluster 2x1, w on")
 
 
 def rate(n: int, seconds: float) -> float:
@@ -244,6 +246,9 @@ def main() -> None:
     ap.add_argument("--rss-evals", type=float, default=1e8, help="0 to skip")
     ap.add_argument("--rss-orientations", type=int, default=200)
     ap.add_argument("--sweep", action="store_true", help="also time chunk sizes")
+    ap.add_argument("--core", action="store_true",
+                    help="only bare IK, the work without Dask and LocalCluster 2x1 (w off, "
+                         "w on): more rounds in a quiet window")
     args = ap.parse_args()
 
     from distributed import Client
@@ -303,6 +308,8 @@ def main() -> None:
             "LocalCluster 1x1, w on": (lambda: cell.reach_map(
                 robot, **kw, scheduler=c1), pids1),
         }
+        if args.core:
+            variants = {k: v for k, v in variants.items() if k in CORE}
         for r in range(args.rounds):
             for label, (fn, pids) in variants.items():
                 set_num_threads(all_threads)
@@ -326,7 +333,14 @@ def main() -> None:
                   f"{med[label]:7.3f} {100 * med[label] / med[ref]:5.1f}%   "
                   f"{medc[label]:6.3f} {100 * medc[label] / medc[ref]:5.1f}%   "
                   + ", ".join(f"{x:.3f}" for x in wall[label]))
+        for label in ("LocalCluster 2x1, w off", "LocalCluster 2x1, w on"):
+            ratio = [100 * a / b for a, b in zip(wall[label], wall[ref])]
+            print(f"  {label} / bare batch IK, round by round (back to back): "
+                  f"{min(ratio):.0f}-{max(ratio):.0f} %, median "
+                  f"{statistics.median(ratio):.0f} %")
         for kind, m in (("wall, best", best), ("wall, median", med), ("CPU, median", medc)):
+            if args.core:
+                break
             print(f"  {kind}: LocalCluster 2 vs 1 worker "
                   f"{m['LocalCluster 2x1, w off'] / m['LocalCluster 1x1, w off']:.2f}x (w off), "
                   f"{m['LocalCluster 2x1, w on'] / m['LocalCluster 1x1, w on']:.2f}x (w on); "
@@ -342,6 +356,8 @@ def main() -> None:
                 t = min(timed_map(robot, kw, scheduler=c2, chunk=b) for _ in range(2))
                 print(f"  {b * K:>8,} targets per task ({-(-V // b)} tasks): "
                       f"{rate(N, t):.3f} M/s")
+    if args.core:
+        return
     projection(robot, {"1 worker, w off, best": best["LocalCluster 1x1, w off"],
                        "1 worker, w on, best": best["LocalCluster 1x1, w on"],
                        "2 workers / 2, w off, best": best["LocalCluster 2x1, w off"] / 2,

@@ -95,17 +95,19 @@ def manipulability(chain: Chain, q: np.ndarray, ok: np.ndarray | None = None) ->
 
     :func:`robokin.kinematics.jacobian.manipulability` with ``method="det"``
     (``|det J|`` for a 6-joint arm, computed in compiled code with the
-    Jacobian; the product of singular values otherwise), where ``ok`` (...)
-    (default everywhere; 0 elsewhere, where q is not read: NaN rows of a
-    solution set are fine), :data:`_MANIPULABILITY_BATCH` configurations at a
-    time so the temporaries stay bounded. Each row is computed on its own, so
-    chunking changes no bit.
+    Jacobian, in one call: it stores nothing but the result; the product of
+    singular values otherwise, :data:`_MANIPULABILITY_BATCH` configurations at
+    a time so the temporaries stay bounded), where ``ok`` (...) (default
+    everywhere; 0 elsewhere, where q is not read: NaN rows of a solution set
+    are fine). Each row is computed on its own, so chunking changes no bit.
     """
     from robokin.kinematics.jacobian import manipulability as yoshikawa
 
     lead = q.shape[:-1]
     flat = q.reshape(-1, q.shape[-1])
     mask = np.ones(flat.shape[0], dtype=bool) if ok is None else ok.reshape(-1)
+    if chain.n == 6:  # compiled, no temporaries: one call
+        return yoshikawa(chain, flat, method="det", where=mask).reshape(lead)
     out = np.empty(flat.shape[0])
     for a in range(0, flat.shape[0], _MANIPULABILITY_BATCH):  # bounded temporaries
         b = min(a + _MANIPULABILITY_BATCH, flat.shape[0])
