@@ -209,6 +209,13 @@ class Kernels(Protocol):
     ) -> None:
         """Per pose, the solution row of Q (N, k, n) nearest qn (N, n), into q."""
 
+    def abs_det_jacobian(self, packed: F64, q: F64, mask: Bools, out: F64, /) -> bool:
+        """``|det J|`` of q (N, 6) where mask (N,), 0 elsewhere, into out (N,).
+
+        For a 6-coordinate chain (``manipulability.c``); whether every masked row was
+        finite (unmasked rows are never read).
+        """
+
     # -------------------------------------------------------------- validation
     def check_poses(self, T: F64, tol: float, /) -> tuple[int, int]:
         """``(code, index)`` of the first non-rigid pose of T (N, 4, 4), or (0, -1)."""

@@ -19,6 +19,7 @@
 #include "six_r.c"
 #include "broadphase.c"
 #include "general6r.c"
+#include "manipulability.c"
 
 /* ---------------------------------------------------------------- arguments */
 
@@ -572,6 +573,7 @@ static PyMethodDef methods[] = {
     SIX_R_METHODS
     BROADPHASE_METHODS
     GENERAL6R_METHODS
+    MANIPULABILITY_METHODS
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, MODULE_NAME,
