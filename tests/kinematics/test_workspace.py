@@ -334,7 +334,7 @@ def test_cli_workspace_table_states_the_volume_and_its_uncertainty(tmp_path, cap
     assert "volume of the position workspace" in out and "any orientation" in out
     assert "± 1 standard error; 95 %:" in out and "of 5,000 points" in out
     assert main(["workspace", "scara", "-n", "5000", "--volume-points", "0",
-                 "--out", str(tmp_path)]) == 0
+                 "--out", str(tmp_path), "--force"]) == 0
     assert "volume" not in capsys.readouterr().out
 
 
