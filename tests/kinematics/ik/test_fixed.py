@@ -139,7 +139,7 @@ def test_panda_with_joint7_held_is_complete_against_a_numeric_reference():
         q = rng.uniform(lim[:, 0], lim[:, 1])
         T = robot.fk(q)
         sols = robot.ik(T, fixed={"joint7": q[6]})
-        assert sols.method == "general_6r (joint7 held)"
+        assert sols.method == "analytic:pieper (joint7 held)"
         assert any(np.allclose(x, q, atol=1e-6) for x in sols)
         moved = fixed_ik._moved_targets(robot, "last", T[None], np.array([q[6]]))[0]
         ref = numeric.solve_all(reduced, moved, n_seeds=1500,

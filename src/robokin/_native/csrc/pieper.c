@@ -379,7 +379,7 @@ static int trig2_roots(const Trig2 *f, double *x, int *nearly_double)
  * with its slot (0-3), singular flag and residual */
 typedef struct {
     int n;
-    double t[4][3], res[4];
+    double t[4][3], c[4][3], s[4][3], res[4];
     unsigned char slot[4], sing[4];
 } PkPos;
 
@@ -456,16 +456,17 @@ static void pk_null(v3 h, v3 v1, v3 v2, double *n)
     }
 }
 
-/* theta_b from theta_a, theta_c: rot(h_b, theta_b) (z - o_b) = y - o_b (least
- * squares), with the residual of that rotation [m] */
-static double pk_theta_b(const PkEq *e, double ta, double tc, double *res)
+/* theta_b from theta_a, theta_c (given by cosine and sine): rot(h_b, theta_b)
+ * (z - o_b) = y - o_b (least squares); its cosine, sine into cb, sb and the
+ * residual of that rotation [m] into res */
+static double pk_theta_b(const PkEq *e, double ca, double sa, double cc, double sc,
+                         double *cb, double *sb, double *res)
 {
-    v3 y = v3_add(e->oa, v3_rot(e->ha, cos(ta), -sin(ta), v3_sub(e->d, e->oa)));
-    v3 z = v3_add(e->oc, v3_rot(e->hc, cos(tc), sin(tc), v3_sub(e->p, e->oc)));
+    v3 y = v3_add(e->oa, v3_rot(e->ha, ca, -sa, v3_sub(e->d, e->oa)));
+    v3 z = v3_add(e->oc, v3_rot(e->hc, cc, sc, v3_sub(e->p, e->oc)));
     v3 zy = v3_sub(z, e->ob), yy = v3_sub(y, e->ob);
-    double c, s;
-    double tb = sp1(e->hb, zy, yy, &c, &s);
-    *res = v3_norm(v3_sub(v3_rot(e->hb, c, s, zy), yy));
+    double tb = sp1(e->hb, zy, yy, cb, sb);
+    *res = v3_norm(v3_sub(v3_rot(e->hb, *cb, *sb, zy), yy));
     return tb;
 }
 
@@ -478,13 +479,22 @@ static Roots pk_sp4(double A, double B, double C)
     return sp4_roots(A, B, C, A * A + B * B - C * C, 1e-10, 0, phi, cphi, sphi);
 }
 
-static void pk_pos_add(PkPos *out, int slot, double ta, double tb, double tc, double res,
-                       int sing)
+/* A solution (theta_a, theta_c given by angle, cosine and sine; theta_b solved) */
+static void pk_pos_add(PkPos *out, const PkEq *e, int slot, double ta, double ca, double sa,
+                       double tc, double cc, double sc, int sing)
 {
     int i = out->n++;
+    double cb, sb, res;
+    double tb = pk_theta_b(e, ca, sa, cc, sc, &cb, &sb, &res);
     out->t[i][0] = ta;
     out->t[i][1] = tb;
     out->t[i][2] = tc;
+    out->c[i][0] = ca;
+    out->s[i][0] = sa;
+    out->c[i][1] = cb;
+    out->s[i][1] = sb;
+    out->c[i][2] = cc;
+    out->s[i][2] = sc;
     out->res[i] = res;
     out->slot[i] = (unsigned char)slot;
     out->sing[i] = (unsigned char)sing;
@@ -528,19 +538,25 @@ static int pk_coplanar(const PkEq *e, int swap, double pref_a, double pref_c, Pk
         /* m . (X u_x sx - r) = -sx m . Y u_y ... written out: */
         double Xu0 = X[0][0] * cx + X[0][1] * sxn, Xu1 = X[1][0] * cx + X[1][1] * sxn;
         double Cy = m0 * (e->r[0] - sx * Xu0) + m1 * (e->r[1] - sx * Xu1);
+        Roots ry;
         if (yfree) {
             double ty = swap ? pref_a : pref_c;
-            double ta = swap ? ty : rx.t[i], tc = swap ? rx.t[i] : ty, res;
-            double tb = pk_theta_b(e, ta, tc, &res);
-            pk_pos_add(out, 2 * i, ta, tb, tc, res, 1);
-            continue;
+            ry.n = 1;
+            ry.boundary = 1;
+            ry.t[0] = ty;
+            ry.c[0] = cos(ty);
+            ry.s[0] = sin(ty);
+        } else {
+            ry = pk_sp4(Ay, By, Cy);
         }
-        Roots ry = pk_sp4(Ay, By, Cy);
         for (int j = 0; j < ry.n; j++) {
-            double ta = swap ? ry.t[j] : rx.t[i], tc = swap ? rx.t[i] : ry.t[j], res;
-            double tb = pk_theta_b(e, ta, tc, &res);
-            pk_pos_add(out, 2 * i + j, ta, tb, tc, res,
-                       xfree || rx.boundary || ry.boundary);
+            int sing = xfree || rx.boundary || ry.boundary;
+            if (swap)
+                pk_pos_add(out, e, 2 * i + j, ry.t[j], ry.c[j], ry.s[j], rx.t[i], rx.c[i],
+                           rx.s[i], sing);
+            else
+                pk_pos_add(out, e, 2 * i + j, rx.t[i], rx.c[i], rx.s[i], ry.t[j], ry.c[j],
+                           ry.s[j], sing);
         }
     }
     return out->n ? PK_OK : PK_OUT_OF_REACH;
@@ -596,11 +612,9 @@ static int pk_general(const PkEq *e, PkPos *out)
         double ny = hypot(uy0, uy1);
         if (!(fabs(ny - 1.0) < 1e-6))
             continue; /* not a root */
-        double y = fast_atan2(uy1, uy0);
-        double ta = xa ? x : y, tc = xa ? y : x, res;
-        double tb = pk_theta_b(e, ta, tc, &res);
-        if (!(res < 1e-6 * e->scale))
-            continue;
+        double y = fast_atan2(uy1, uy0), cy, sy;
+        unit2(uy1, uy0, &cy, &sy);
+        double ta = xa ? x : y, tc = xa ? y : x;
         /* the same solution twice (a double root found from both sides) */
         int dup = 0;
         for (int j = 0; j < out->n; j++)
@@ -609,7 +623,12 @@ static int pk_general(const PkEq *e, PkPos *out)
                 dup = 1;
         if (dup)
             continue;
-        pk_pos_add(out, out->n, ta, tb, tc, res, nd);
+        if (xa)
+            pk_pos_add(out, e, out->n, x, cx, sx, y, cy, sy, nd);
+        else
+            pk_pos_add(out, e, out->n, y, cy, sy, x, cx, sx, nd);
+        if (!(out->res[out->n - 1] < 1e-6 * e->scale))
+            out->n--; /* not a root after all */
     }
     return out->n ? PK_OK : PK_OUT_OF_REACH;
 }
@@ -652,61 +671,91 @@ static double pk_split(const double *P, int jx, int jz, double phi, double sigma
     return sz * best + oz; /* theta_z */
 }
 
-/* The angle [0, pi] between unit vectors a and b, accurate near 0 and pi */
-static inline double pk_angle(v3 a, v3 b)
+/* A triple's pose-independent constants: the half-angle sines and cosines of
+ * (bx - bz) / 2 and (bx + bz) / 2, bx, bz the angles of hx, hz from hy, and the
+ * azimuth t0 about hy where rot(hy, t) hz comes nearest hx (with its cosine, sine). */
+typedef struct {
+    v3 hx, hy, hz;
+    double cd, sd, cs, ss, t0, c0, s0;
+} PkTri;
+
+static void pk_tri_init(PkTri *k, v3 hx, v3 hy, v3 hz)
 {
-    return atan2(v3_norm(v3_cross(a, b)), v3_dot(a, b));
+    double bx = atan2(v3_norm(v3_cross(hy, hx)), v3_dot(hy, hx));
+    double bz = atan2(v3_norm(v3_cross(hy, hz)), v3_dot(hy, hz));
+    v3 xp = v3_sub(hx, v3_scale(hy, v3_dot(hx, hy)));
+    v3 zp = v3_sub(hz, v3_scale(hy, v3_dot(hz, hy)));
+    k->hx = hx;
+    k->hy = hy;
+    k->hz = hz;
+    k->cd = cos(0.5 * (bx - bz));
+    k->sd = sin(0.5 * (bx - bz));
+    k->cs = cos(0.5 * (bx + bz));
+    k->ss = sin(0.5 * (bx + bz));
+    k->t0 = atan2(v3_dot(hy, v3_cross(zp, xp)), v3_dot(zp, xp));
+    unit2(v3_dot(hy, v3_cross(zp, xp)), v3_dot(zp, xp), &k->c0, &k->s0);
 }
 
 /* The middle angle of a triple: ty with rot(hy, ty) hz at the angle psi from hx
- * that w = R hz makes (subproblem 4 for unit vectors, by the spherical law of
- * cosines in half-angle form so that roots near a double root keep their
- * accuracy: sin^2(D / 2) and cos^2(D / 2) as products of sines, D the turn from
- * the azimuth t0 where rot(hy, t) hz comes nearest hx). Roots t0 + D, t0 - D. */
-static Roots pk_middle(v3 hx, v3 hy, v3 hz, v3 w)
+ * that w = R hz makes. Subproblem 4 for unit vectors by the spherical law of
+ * cosines in half-angle form, so that roots next to a double root keep their
+ * accuracy: with D the turn from t0,
+ *   sin^2(D / 2) ~ sin((psi + bx - bz) / 2) sin((psi - bx + bz) / 2),
+ *   cos^2(D / 2) ~ sin((bx + bz + psi) / 2) sin((bx + bz - psi) / 2),
+ * sin, cos(psi / 2) = |hx -+ w| / 2 (no trigonometry). Roots t0 + D, t0 - D. */
+static Roots pk_middle(const PkTri *k, v3 w)
 {
     Roots r;
-    double bx = pk_angle(hy, hx), bz = pk_angle(hy, hz), psi = pk_angle(hx, w);
-    v3 xp = v3_sub(hx, v3_scale(hy, v3_dot(hx, hy)));
-    v3 zp = v3_sub(hz, v3_scale(hy, v3_dot(hz, hy)));
-    double t0 = atan2(v3_dot(hy, v3_cross(zp, xp)), v3_dot(zp, xp));
-    double S = sin(0.5 * (psi + bx - bz)) * sin(0.5 * (psi - bx + bz));
-    double C = sin(0.5 * (bx + bz + psi)) * sin(0.5 * (bx + bz - psi));
+    double sp = 0.5 * v3_norm(v3_sub(k->hx, w)), cp = 0.5 * v3_norm(v3_add(k->hx, w));
+    double a1 = sp * k->cd + cp * k->sd, a2 = sp * k->cd - cp * k->sd;
+    double b1 = k->ss * cp + k->cs * sp, b2 = k->ss * cp - k->cs * sp;
+    double S = a1 * a2, C = b1 * b2;
     r.boundary = 0;
     if (S < -1e-13 || C < -1e-13) {
         r.n = 0;
         return r;
     }
-    double D = 2.0 * atan2(sqrt(fmax(S, 0.0)), sqrt(fmax(C, 0.0)));
-    r.t[0] = t0 + D;
-    r.t[1] = t0 - D;
-    r.n = D > 0.0 && D < 2.0 * M_PI - 1e-300 ? 2 : 1;
+    S = fmax(S, 0.0);
+    C = fmax(C, 0.0);
+    double hs = sqrt(S), hc = sqrt(C);
+    double D = 2.0 * fast_atan2(hs, hc), n2 = S + C;
+    double cD = (C - S) / n2, sD = 2.0 * hs * hc / n2;
+    r.t[0] = k->t0 + D;
+    r.t[1] = k->t0 - D;
+    r.c[0] = k->c0 * cD - k->s0 * sD;
+    r.s[0] = k->s0 * cD + k->c0 * sD;
+    r.c[1] = k->c0 * cD + k->s0 * sD;
+    r.s[1] = k->s0 * cD - k->c0 * sD;
+    r.n = S > 0.0 ? 2 : 1;
     r.boundary = r.n == 1;
-    for (int i = 0; i < 2; i++) {
-        r.c[i] = cos(r.t[i]);
-        r.s[i] = sin(r.t[i]);
-    }
     return r;
 }
 
-/* rot(hx, tx) rot(hy, ty) rot(hz, tz) = R: up to two (tx, ty, tz) into t, flags
- * into sing; jx, jz: the outer joints' full-chain indices, pref_z their preferred
- * z coordinate at the singularity. */
-static int pk_triple(const double *P, v3 hx, v3 hy, v3 hz, const m3 *R, int jx, int jz,
-                     double pref_z, double stol, double t[2][3], unsigned char *sing)
+/* A triple's solutions: angles, singular flags, and whether the solution still
+ * needs checking against the pose (near the singularity the two vector residuals
+ * do not pin the rotation) */
+typedef struct {
+    int n;
+    double t[2][3];
+    unsigned char sing[2], check[2];
+} PkTrip;
+
+/* rot(hx, tx) rot(hy, ty) rot(hz, tz) = R: up to two solutions; jx, jz: the outer
+ * joints' full-chain indices, pref_z z's preferred coordinate at the singularity. */
+static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int jz,
+                      double pref_z, double stol, PkTrip *out)
 {
+    v3 hx = k->hx, hy = k->hy, hz = k->hz;
     v3 w = m3_mv(R, hz), rtx = m3_mtv(R, hx);
-    Roots ry = pk_middle(hx, hy, hz, w);
-    if (ry.n == 0)
-        return 0;
-    int n = 0;
+    Roots ry = pk_middle(k, w);
+    out->n = 0;
     for (int i = 0; i < ry.n; i++) {
         double ty = ry.t[i], cy = ry.c[i], sy = ry.s[i];
         v3 v = v3_rot(hy, cy, sy, hz);
         double sv = v3_norm(v3_cross(v, hx));
         if (sv < stol) {
-            /* at (or near) the singularity: hold the exact singular angle when it
-             * reproduces R, and split the outer angles inside the limits */
+            /* at the singularity: hold the exact singular angle where it reproduces
+             * R, and split the outer angles inside the limits */
             double sigma = v3_dot(v, hx) >= 0.0 ? 1.0 : -1.0, cs, ss;
             double tys = sp1(hy, hz, v3_scale(hx, sigma), &cs, &ss);
             v3 vs = v3_rot(hy, cs, ss, hz);
@@ -720,25 +769,31 @@ static int pk_triple(const double *P, v3 hx, v3 hy, v3 hz, const m3 *R, int jx, 
                     double cp, sp;
                     double phi = sp1(hx, e, m3_mv(&X, e), &cp, &sp);
                     double tz = pk_split(P, jx, jz, phi, sigma, pref_z);
-                    t[0][0] = phi - sigma * tz;
-                    t[0][1] = tys;
-                    t[0][2] = tz;
-                    sing[0] = 1;
-                    return 1;
+                    out->t[0][0] = phi - sigma * tz;
+                    out->t[0][1] = tys;
+                    out->t[0][2] = tz;
+                    out->sing[0] = 1;
+                    out->check[0] = 1;
+                    out->n = 1;
+                    return;
                 }
             }
         }
-        double c, s;
-        double tx = sp1(hx, v, w, &c, &s);
+        double cx, sx, cz, sz;
+        double tx = sp1(hx, v, w, &cx, &sx);
         v3 u = v3_rot(hy, cy, -sy, hx);
-        double tz = -sp1(hz, u, rtx, &c, &s);
-        t[n][0] = tx;
-        t[n][1] = ty;
-        t[n][2] = tz;
-        sing[n] = (unsigned char)(sv < 1e-7);
-        n++;
+        double tz = -sp1(hz, u, rtx, &cz, &sz);
+        int j = out->n++;
+        out->t[j][0] = tx;
+        out->t[j][1] = ty;
+        out->t[j][2] = tz;
+        out->sing[j] = (unsigned char)(sv < 1e-7);
+        /* R' hz = R hz and R'^T hx = R^T hx pin R' = R, to within the residuals
+         * divided by sv (the sine of the angle between hz and R'^T hx) */
+        double res = v3_norm(v3_sub(v3_rot(hx, cx, sx, v), w)) +
+                     v3_norm(v3_sub(v3_rot(hz, cz, sz, u), rtx));
+        out->check[j] = (unsigned char)(sv < 1e-4 || !(res < 1e-2 * PK_EXACT * sv));
     }
-    return n;
 }
 
 /* ---------------------------------------------------------------- polish */
@@ -919,16 +974,18 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
         return code;
     int any = 0;
     int jx = g.full[it], jz = g.full[it + 2];
+    PkTri tri;
+    pk_tri_init(&tri, g.h[it], g.h[it + 1], g.h[it + 2]);
+    double exact_p = PK_EXACT * fmax(1.0, g.scale);
     for (int i = 0; i < pos.n; i++) {
         if (!(pos.res[i] < 1e-6 * g.scale))
             continue;
         double th[6];
-        for (int j = 0; j < 3; j++)
-            th[ia + j] = pos.t[i][j];
         /* the other three's rotation */
         m3 Rp = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
         for (int j = 0; j < 3; j++) {
-            m3 Rj = pk_rotm(g.h[ia + j], cos(th[ia + j]), sin(th[ia + j]));
+            th[ia + j] = pos.t[i][j];
+            m3 Rj = pk_rotm(g.h[ia + j], pos.c[i][j], pos.s[i][j]);
             Rp = pk_mul(&Rp, &Rj);
         }
         m3 Rt;
@@ -940,22 +997,23 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
                       {Rp.r0.z, Rp.r1.z, Rp.r2.z}};
             Rt = pk_mul(&Rpt, &G); /* R_B = R_A^T G */
         }
-        double tt[2][3];
-        unsigned char ts[2];
-        int nt = pk_triple(P, g.h[it], g.h[it + 1], g.h[it + 2], &Rt, jx, jz, qn[jz], stol,
-                           tt, ts);
-        for (int k = 0; k < nt; k++) {
+        PkTrip tr;
+        pk_triple(P, &tri, &Rt, jx, jz, qn[jz], stol, &tr);
+        for (int k = 0; k < tr.n; k++) {
             for (int j = 0; j < 3; j++)
-                th[it + j] = tt[k][j];
-            m3 R;
-            v3 pp;
-            double ev[6];
-            pk_fk(&g, th, &R, &pp, NULL);
-            double err = pk_error(&RT, pT, &R, pp, g.scale, ev);
-            if (err > PK_EXACT)
-                err = pk_polish(&g, &RT, pT, th);
-            if (!(err <= PK_ACCEPT))
-                continue; /* not a solution to 1e-12: never returned */
+                th[it + j] = tr.t[k][j];
+            if (tr.check[k] || !(pos.res[i] < exact_p)) {
+                /* check against the pose; Newton-polish when not exact */
+                m3 R;
+                v3 pp;
+                double ev[6];
+                pk_fk(&g, th, &R, &pp, NULL);
+                double err = pk_error(&RT, pT, &R, pp, g.scale, ev);
+                if (err > PK_EXACT)
+                    err = pk_polish(&g, &RT, pT, th);
+                if (!(err <= PK_ACCEPT))
+                    continue; /* not a solution to 1e-12: never returned */
+            }
             int slot = 2 * pos.slot[i] + k;
             int all = 1;
             for (int j = 0; j < 6; j++) {
@@ -971,7 +1029,7 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
             }
             o.valid[slot] = 1;
             o.inside[slot] = (unsigned char)all;
-            o.sing[slot] = (unsigned char)(pos.sing[i] || ts[k]);
+            o.sing[slot] = (unsigned char)(pos.sing[i] || tr.sing[k]);
             any = 1;
         }
     }

@@ -15,6 +15,7 @@ from robokin._validation import (
     check_poses_fast,
 )
 from robokin.exceptions import InputError
+from robokin.kinematics.ik.fixed import solve_fixed
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
 
@@ -43,8 +44,6 @@ def solve(
     if method not in _METHODS:
         raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
     if "fixed" in options:
-        from robokin.kinematics.ik.fixed import solve_fixed
-
         return solve_fixed(robot, T, options.pop("fixed"), q_near=q_near, method=method,
                            **options)
     qn: npt.NDArray[np.float64] | None = None

@@ -78,7 +78,8 @@ from robokin.kinematics.ik.analytic._geometry import (
 )
 from robokin.kinematics.ik.solutions import SolutionSet
 
-__all__ = ["NAME", "Setup", "make_single", "measure", "raw_solve", "setup", "solve"]
+__all__ = ["NAME", "FamilySolver", "Setup", "family_solver", "make_single", "measure", "raw_solve", "setup",
+           "solve"]
 
 NAME = "pieper"
 
@@ -319,13 +320,14 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None, *, params: np.nd
 
 
 def make_single(chain: Any, params: np.ndarray, *, method: str,
-                info: dict[str, Any]) -> Any:
+                info: dict[str, Any], held: str | None = None) -> Any:
     """The single-pose hot path: ``single(T, x, qn) -> SolutionSet | None``.
 
     ``T`` (4, 4) float64 is validated inside the compiled call; ``x`` is the held
     value (ignored without a held joint), ``qn`` None or a float64 (n,) array.
-    ``None`` means T is not a rigid transform or x not finite (the caller re-checks
-    to raise the detailed error).
+    ``None`` means T is not a float64 (4, 4) rigid transform or x not finite (the
+    caller re-checks to raise the detailed error). With ``held`` (the held joint's
+    name) each set's ``info["held"]`` is ``{held: x}``.
     """
     solve1 = K.pieper_ik1
     is_rev = np.array(chain.is_revolute, dtype=bool)
@@ -347,8 +349,56 @@ def make_single(chain: Any, params: np.ndarray, *, method: str,
         code, Q, valid, sing, inside = solve1(T, params, x, qn)
         if code >= too_far or Q is None or valid is None or sing is None or inside is None:
             return None
+        out = dict(info)
+        if held is not None:
+            out["held"] = {held: x}
         return trusted(Q, valid, is_rev, limits,
                        {"within_limits": inside, "singular": sing}, dict(labels),
-                       array(texts[code], dtype=obj), method, None, dict(info))
+                       array(texts[code], dtype=obj), method, None, out)
 
     return single
+
+
+@dataclass(frozen=True, eq=False)
+class FamilySolver:
+    """The family's solver for ``detect``: ``solver(robot, T, q_near=None, **options)``.
+
+    Options: ``compute_error`` (bool). :meth:`single` is the dispatcher's
+    single-pose hot path.
+
+    Attributes:
+        params: From :func:`setup`.
+        method: The sets' ``method`` text.
+        info: The sets' ``info``.
+        one: ``make_single``'s function.
+    """
+
+    params: np.ndarray
+    method: str
+    info: dict[str, Any]
+    one: Any
+
+    def __call__(self, robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
+                 compute_error: bool = False) -> SolutionSet:
+        """Every solution for poses T (..., 4, 4); see :func:`solve`."""
+        return solve(robot, T, q_near, params=self.params, method=self.method,
+                     info=self.info, compute_error=compute_error)
+
+    def single(self, T: np.ndarray, q6: float) -> SolutionSet | None:
+        """One pose (4, 4) without ``q_near`` (``q6 == 0``), else None.
+
+        None also means T is not a rigid transform; the dispatcher then takes the
+        checked path, which passes the whole ``q_near``.
+        """
+        return self.one(T, 0.0, None) if q6 == 0.0 else None
+
+
+def family_solver(chain: Any, setup: Setup) -> FamilySolver:
+    """The :class:`FamilySolver` of a chain set up by :func:`setup`."""
+    params = setup.params
+    if params is None:
+        raise ValueError(f"no Pieper parameters: {setup.reason}")
+    method = f"analytic:{NAME}"
+    info = {"family": NAME, "measured": setup.measured, "near_family": False}
+    return FamilySolver(params, method, info,
+                        make_single(chain, params, method=method, info=info))
