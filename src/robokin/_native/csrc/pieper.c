@@ -470,13 +470,16 @@ static double pk_theta_b(const PkEq *e, double ca, double sa, double cc, double 
     return tb;
 }
 
-/* A c + B s = C: up to two roots (Roots of six_r.c); a double root within a
- * relative 1e-10 of the discriminant */
+/* A c + B s = C: up to two roots (Roots of six_r.c). A discriminant down to
+ * -1e-13 (A^2 + B^2) is a double root (rounding); any positive one gives two roots,
+ * however close: next to a double root a root's error is second order in the
+ * pose, so two accurate close roots beat one merged root (which would be off by
+ * the square root of their distance). */
 static Roots pk_sp4(double A, double B, double C)
 {
     double phi = fast_atan2(B, A), cphi, sphi;
     unit2(B, A, &cphi, &sphi);
-    return sp4_roots(A, B, C, A * A + B * B - C * C, 1e-10, 0, phi, cphi, sphi);
+    return sp4_roots(A, B, C, A * A + B * B - C * C, 1e-13, 0, phi, cphi, sphi);
 }
 
 /* A solution (theta_a, theta_c given by angle, cosine and sine; theta_b solved) */
@@ -844,8 +847,92 @@ static double pk_error(const m3 *RT, v3 pT, const m3 *R, v3 p, double scale, dou
     return fmax(fmax(pn, rn), 3.0 - (E.r0.x + E.r1.y + E.r2.z));
 }
 
-/* Newton steps on the remaining chain's angles (damped least squares, kept only
- * while they reduce the error); returns the final error (largest component) */
+/* The least-squares step J dx = e of a 6 x 6 Jacobian (rows J[r][.]): Householder
+ * QR with column pivoting, columns whose pivot falls below 1e-10 of the first
+ * left out (a singular configuration: no step along its near-null directions). */
+static void pk_lstsq(double J[6][6], const double *e, double *dx)
+{
+    double A[6][6], b[6], norms[6];
+    int perm[6], rank = 0;
+    for (int r = 0; r < 6; r++) {
+        b[r] = e[r];
+        for (int c = 0; c < 6; c++)
+            A[r][c] = J[r][c];
+    }
+    for (int c = 0; c < 6; c++) {
+        perm[c] = c;
+        double s = 0.0;
+        for (int r = 0; r < 6; r++)
+            s += A[r][c] * A[r][c];
+        norms[c] = s;
+    }
+    double first = 0.0;
+    for (int k = 0; k < 6; k++) {
+        int best = k; /* pivot: the remaining column of largest norm */
+        for (int c = k + 1; c < 6; c++)
+            if (norms[c] > norms[best])
+                best = c;
+        if (best != k) {
+            for (int r = 0; r < 6; r++) {
+                double t = A[r][k];
+                A[r][k] = A[r][best];
+                A[r][best] = t;
+            }
+            double t = norms[k];
+            norms[k] = norms[best];
+            norms[best] = t;
+            int ti = perm[k];
+            perm[k] = perm[best];
+            perm[best] = ti;
+        }
+        double nx = 0.0;
+        for (int r = k; r < 6; r++)
+            nx += A[r][k] * A[r][k];
+        nx = sqrt(nx);
+        if (k == 0)
+            first = nx;
+        if (!(nx > 1e-10 * first))
+            break;
+        double alpha = A[k][k] > 0.0 ? -nx : nx, v[6];
+        for (int r = 0; r < 6; r++)
+            v[r] = r < k ? 0.0 : A[r][k];
+        v[k] -= alpha;
+        double vv = 0.0;
+        for (int r = k; r < 6; r++)
+            vv += v[r] * v[r];
+        if (vv > 0.0) {
+            for (int c = k; c < 6; c++) {
+                double d = 0.0;
+                for (int r = k; r < 6; r++)
+                    d += v[r] * A[r][c];
+                d *= 2.0 / vv;
+                for (int r = k; r < 6; r++)
+                    A[r][c] -= d * v[r];
+            }
+            double d = 0.0;
+            for (int r = k; r < 6; r++)
+                d += v[r] * b[r];
+            d *= 2.0 / vv;
+            for (int r = k; r < 6; r++)
+                b[r] -= d * v[r];
+        }
+        for (int c = k + 1; c < 6; c++)
+            norms[c] -= A[k][c] * A[k][c];
+        rank = k + 1;
+    }
+    double y[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    for (int r = rank - 1; r >= 0; r--) {
+        double s = b[r];
+        for (int c = r + 1; c < rank; c++)
+            s -= A[r][c] * y[c];
+        y[r] = s / A[r][r];
+    }
+    for (int c = 0; c < 6; c++)
+        dx[perm[c]] = y[c];
+}
+
+/* Newton steps on the remaining chain's angles (least squares, pk_lstsq; kept only
+ * while they reduce the error); returns the final error (pk_error) */
 static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
 {
     m3 R;
@@ -853,51 +940,15 @@ static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
     double J[6][6], e[6];
     pk_fk(g, th, &R, &p, J);
     double err = pk_error(RT, pT, &R, p, g->scale, e);
-    for (int it = 0; it < 4 && err > 1e-15; it++) {
-        double N[6][7];
-        double tr = 0.0;
-        for (int i = 0; i < 6; i++) {
-            for (int j = 0; j < 6; j++) {
-                double s = 0.0;
-                for (int r = 0; r < 6; r++)
-                    s += J[r][i] * J[r][j];
-                N[i][j] = s;
-            }
-            double s = 0.0;
-            for (int r = 0; r < 6; r++)
-                s += J[r][i] * e[r];
-            N[i][6] = s;
-            tr += N[i][i];
+    for (int it = 0; it < 6 && err > 1e-16; it++) {
+        double dx[6], trial[6], big = 0.0;
+        pk_lstsq(J, e, dx);
+        for (int j = 0; j < 6; j++) {
+            trial[j] = wrap_pi(th[j] + dx[j]);
+            big = fmax(big, fabs(dx[j]));
         }
-        double lam = 1e-14 * tr;
-        for (int i = 0; i < 6; i++)
-            N[i][i] += lam;
-        /* Cholesky-free: Gaussian elimination (symmetric positive definite) */
-        int ok = 1;
-        for (int c = 0; c < 6 && ok; c++) {
-            double piv = N[c][c];
-            if (!(piv > 0.0)) {
-                ok = 0;
-                break;
-            }
-            for (int r = c + 1; r < 6; r++) {
-                double f = N[r][c] / piv;
-                for (int k = c; k < 7; k++)
-                    N[r][k] -= f * N[c][k];
-            }
-        }
-        if (!ok)
-            break;
-        double dx[6];
-        for (int r = 5; r >= 0; r--) {
-            double s = N[r][6];
-            for (int k = r + 1; k < 6; k++)
-                s -= N[r][k] * dx[k];
-            dx[r] = s / N[r][r];
-        }
-        double trial[6];
-        for (int j = 0; j < 6; j++)
-            trial[j] = th[j] + dx[j];
+        if (!(big < 0.1))
+            break; /* not a small correction: a near-null direction */
         m3 R2;
         v3 p2;
         double J2[6][6], e2[6];
@@ -970,6 +1021,12 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
         code = pk_coplanar(&e, 1, pref_a, pref_c, &pos);
     else
         code = pk_general(&e, &pos);
+#ifdef PK_DEBUG
+    fprintf(stderr, "code %d mab %.3e mbc %.3e npos %d\n", code, e.mab, e.mbc, pos.n);
+    for (int i = 0; i < pos.n; i++)
+        fprintf(stderr, "  pos %d: %.12f %.12f %.12f res %.3e sing %d\n", pos.slot[i], pos.t[i][0],
+                pos.t[i][1], pos.t[i][2], pos.res[i], pos.sing[i]);
+#endif
     if (code != PK_OK)
         return code;
     int any = 0;
@@ -999,6 +1056,9 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
         }
         PkTrip tr;
         pk_triple(P, &tri, &Rt, jx, jz, qn[jz], stol, &tr);
+#ifdef PK_DEBUG
+        fprintf(stderr, "  triple n %d\n", tr.n);
+#endif
         for (int k = 0; k < tr.n; k++) {
             for (int j = 0; j < 3; j++)
                 th[it + j] = tr.t[k][j];
@@ -1011,6 +1071,9 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
                 double err = pk_error(&RT, pT, &R, pp, g.scale, ev);
                 if (err > PK_EXACT)
                     err = pk_polish(&g, &RT, pT, th);
+#ifdef PK_DEBUG
+                fprintf(stderr, "    check slot %d err %.3e th %.17g %.17g %.17g\n", 2 * pos.slot[i] + k, err, th[0], th[1], th[2]);
+#endif
                 if (!(err <= PK_ACCEPT))
                     continue; /* not a solution to 1e-12: never returned */
             }
