@@ -262,6 +262,18 @@ static void pk_quartic(const double *cf, double *re, double *im)
         re[i] += shift;
 }
 
+/* Subproblem 1 with the components perpendicular to k taken first: t with
+ * rot(k, t) p = q (least squares), its cosine and sine. Unlike sp1's
+ * q . p - (k . p)(k . q) this keeps its accuracy when p and q lie close to the
+ * axis (a triple next to its singularity). */
+static inline double pk_sp1(v3 k, v3 p, v3 q, double *c, double *s)
+{
+    v3 pp = v3_sub(p, v3_scale(k, v3_dot(k, p))), qp = v3_sub(q, v3_scale(k, v3_dot(k, q)));
+    double y = v3_dot(k, v3_cross(pp, qp)), x = v3_dot(pp, qp);
+    unit2(y, x, c, s);
+    return fast_atan2(y, x);
+}
+
 /* ------------------------------------------------- the position problem */
 
 /* A trigonometric polynomial of degree 2: a0 + a1 cos x + b1 sin x + a2 cos 2x +
@@ -465,7 +477,7 @@ static double pk_theta_b(const PkEq *e, double ca, double sa, double cc, double 
     v3 y = v3_add(e->oa, v3_rot(e->ha, ca, -sa, v3_sub(e->d, e->oa)));
     v3 z = v3_add(e->oc, v3_rot(e->hc, cc, sc, v3_sub(e->p, e->oc)));
     v3 zy = v3_sub(z, e->ob), yy = v3_sub(y, e->ob);
-    double tb = sp1(e->hb, zy, yy, cb, sb);
+    double tb = pk_sp1(e->hb, zy, yy, cb, sb);
     *res = v3_norm(v3_sub(v3_rot(e->hb, *cb, *sb, zy), yy));
     return tb;
 }
@@ -783,9 +795,9 @@ static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int 
             }
         }
         double cx, sx, cz, sz;
-        double tx = sp1(hx, v, w, &cx, &sx);
+        double tx = pk_sp1(hx, v, w, &cx, &sx);
         v3 u = v3_rot(hy, cy, -sy, hx);
-        double tz = -sp1(hz, u, rtx, &cz, &sz);
+        double tz = -pk_sp1(hz, u, rtx, &cz, &sz);
         int j = out->n++;
         out->t[j][0] = tx;
         out->t[j][1] = ty;
