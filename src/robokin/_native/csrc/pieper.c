@@ -42,10 +42,12 @@
  *
  *   PK_N         chain joints n (6, or 7 with one held)
  *   PK_HELD      the held joint's index, or -1
- *   PK_CASE      PK_START or PK_END: which triple of the 6 remaining joints meets
+ *   PK_CASE      PK_START or PK_END: which triple of the 6 remaining joints meets;
+ *                PK_BOTH: both (the swivel case, pk_swivel)
  *   PK_SING_TOL  singular triple: |sin| of the outer axes' angle below it
  *   PK_SCALE     the arm's length scale [m] (row scaling and tolerances)
  *   PK_POINT     the triple's point at zero chain values, full chain (3)
+ *   PK_POINT2    PK_BOTH: the end triple's point (PK_POINT is the start's)
  *   PK_AXES, PK_POINTS  unit axes h_k and points o_k at zero chain values (n x 3)
  *   PK_TOOL_R, PK_TOOL_T  M: rotation rows (9), translation (3)
  *   PK_SIGN, PK_OFFSET, PK_LO, PK_HI   per joint (n each): chain value
@@ -81,10 +83,11 @@ enum {
     PK_N = 0, PK_HELD = 1, PK_CASE = 2, PK_SING_TOL = 3, PK_SCALE = 4, PK_POINT = 5,
     PK_AXES = 8, PK_POINTS = 8 + 3 * PK_MAXJ, PK_TOOL_R = 8 + 6 * PK_MAXJ,
     PK_TOOL_T = PK_TOOL_R + 9, PK_SIGN = PK_TOOL_T + 3, PK_OFFSET = PK_SIGN + PK_MAXJ,
-    PK_LO = PK_OFFSET + PK_MAXJ, PK_HI = PK_LO + PK_MAXJ, PK_TAG = PK_HI + PK_MAXJ,
+    PK_LO = PK_OFFSET + PK_MAXJ, PK_HI = PK_LO + PK_MAXJ, PK_POINT2 = PK_HI + PK_MAXJ,
+    PK_TAG = PK_POINT2 + 3,
     PK_N_PARAMS = PK_TAG + 1
 };
-enum { PK_START = 0, PK_END = 1 };
+enum { PK_START = 0, PK_END = 1, PK_BOTH = 2 };
 enum { PK_OK = 0, PK_OUT_OF_REACH = 1, PK_NO_ORIENTATION = 2, PK_DEGENERATE = 5,
        PK_BAD_POSE = 16 };
 #define PK_TAG_VALUE 1968.0625 /* Pieper's year, and a sixteenth */
@@ -129,7 +132,7 @@ static inline double v3_norm(v3 a) { return sqrt(v3_dot(a, a)); }
 /* The remaining 6R chain at zero values (PoE): axes, points, M, the triple's point,
  * and which full-chain joint each of the six is. */
 typedef struct {
-    v3 h[6], o[6], pt, tM;
+    v3 h[6], o[6], pt, pt2, tM;
     m3 RM;
     int full[6];
     int kase;
@@ -166,13 +169,16 @@ static void pk_geometry(const double *P, double x, PkGeo *g)
     g->RM = (m3){v3_at(P, PK_TOOL_R), v3_at(P, PK_TOOL_R + 3), v3_at(P, PK_TOOL_R + 6)};
     g->tM = v3_at(P, PK_TOOL_T);
     g->pt = v3_at(P, PK_POINT);
+    g->pt2 = v3_at(P, PK_POINT2);
     if (k >= 0) {
         m3 Rk = pk_rotm(hk, c, s);
         g->RM = pk_mul(&Rk, &g->RM);
         g->tM = v3_add(ok, v3_rot(hk, c, s, v3_sub(g->tM, ok)));
-        int first = g->full[g->kase == PK_START ? 0 : 3];
+        int first = g->full[g->kase == PK_END ? 3 : 0];
         if (k < first) /* the triple comes after the held joint: its point moves */
             g->pt = v3_add(ok, v3_rot(hk, c, s, v3_sub(g->pt, ok)));
+        if (k < g->full[3])
+            g->pt2 = v3_add(ok, v3_rot(hk, c, s, v3_sub(g->pt2, ok)));
     }
 }
 
@@ -798,6 +804,18 @@ static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int 
         double tx = pk_sp1(hx, v, w, &cx, &sx);
         v3 u = v3_rot(hy, cy, -sy, hx);
         double tz = -pk_sp1(hz, u, rtx, &cz, &sz);
+        if (sv < 1e-6) {
+            /* near the singularity the split of tx + sigma tz costs only sv per
+             * radian of pose: move it inside the limits when that stays exact */
+            double sigma = v3_dot(v, hx) >= 0.0 ? 1.0 : -1.0;
+            double qz = P[PK_SIGN + jz] * (tz - P[PK_OFFSET + jz]);
+            double tz2 = pk_split(P, jx, jz, tx + sigma * tz, sigma, qz);
+            double eps = wrap_pi(tz2 - tz);
+            if (fabs(eps) * sv <= 0.01 * PK_EXACT) {
+                tx -= sigma * eps;
+                tz += eps;
+            }
+        }
         int j = out->n++;
         out->t[j][0] = tx;
         out->t[j][1] = ty;
@@ -997,6 +1015,180 @@ static void pk_clear(PkOut o)
     }
 }
 
+/* The joint coordinates of chain angles th (6, remaining chain) into q (full
+ * chain, held joint at x) and their smallest margin to the limits [rad]
+ * (negative: outside) */
+static double pk_coords(const double *P, const PkGeo *g, const double *th, int held,
+                        double x, double *q)
+{
+    double margin = INFINITY;
+    for (int j = 0; j < 6; j++) {
+        int f = g->full[j], in;
+        double lo = P[PK_LO + f], hi = P[PK_HI + f];
+        q[f] = joint_value(th[j], P[PK_SIGN + f], P[PK_OFFSET + f], lo, hi, &in);
+        margin = fmin(margin, fmin(q[f] - lo, hi - q[f]));
+    }
+    if (held >= 0) {
+        q[held] = x;
+        margin = fmin(margin, fmin(x - P[PK_LO + held], P[PK_HI + held] - x));
+    }
+    return margin;
+}
+
+/* Roots psi of h . rot(u, sg psi) p = rhs (sg = +-1) appended to psi[*n] */
+static void pk_psi_roots(v3 h, v3 u, v3 p, double rhs, double sg, double *psi, int *n)
+{
+    double A, B, C;
+    sp4_coeffs(h, u, p, &A, &B, &C);
+    if (hypot(A, B) < 1e-12)
+        return;
+    Roots r = pk_sp4(A, B, rhs - C);
+    for (int i = 0; i < r.n; i++)
+        psi[(*n)++] = wrap_pi(sg * r.t[i]);
+}
+
+/* Both triples meet (an SRS arm with its elbow held): the shoulder-wrist distance
+ * is fixed, so a reachable pose has a one-parameter family of solutions, the
+ * swivel psi of the arm about the line S-W: R_A(psi) = rot(u, psi) R_A0, R_B =
+ * R_A^T G, each triple two branches. Each branch (slot 2 iA + iB) is returned at
+ * the psi where its configuration lies deepest inside the limits, among psi = 0,
+ * every psi where a joint reaches a limit (a subproblem 4 in psi per joint and
+ * limit) and the midpoints between them: a feasible stretch of the family is
+ * bounded by such psi, so a branch with any in-limit configuration gets one.
+ * Every row is flagged singular (the family is a self-motion). */
+static int pk_swivel(const double *P, const PkGeo *g, const m3 *RT, v3 pT, const m3 *G,
+                     double x, const double *qn, PkOut o)
+{
+    int held = (int)P[PK_HELD];
+    v3 S = g->pt, Wp = g->pt2;
+    v3 w = v3_add(pT, m3_mv(G, v3_sub(Wp, g->tM)));
+    v3 a = v3_sub(Wp, S), b = v3_sub(w, S);
+    double la = v3_norm(a), lb = v3_norm(b);
+    if (fabs(la - lb) > 1e-9 * fmax(1.0, g->scale))
+        return PK_OUT_OF_REACH;
+    if (la < 1e-12 * g->scale)
+        return PK_DEGENERATE;
+    a = v3_scale(a, 1.0 / la);
+    b = v3_scale(b, 1.0 / lb);
+    v3 ax = v3_cross(a, b);
+    double sn = v3_norm(ax), cs = v3_dot(a, b);
+    m3 R0;
+    if (sn > 1e-12) {
+        R0 = pk_rotm(v3_scale(ax, 1.0 / sn), cs, sn);
+    } else if (cs > 0.0) {
+        R0 = (m3){{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+    } else {
+        v3 e = fabs(a.x) < 0.9 ? (v3){1.0, 0.0, 0.0} : (v3){0.0, 1.0, 0.0};
+        e = v3_sub(e, v3_scale(a, v3_dot(e, a)));
+        R0 = pk_rotm(v3_scale(e, 1.0 / v3_norm(e)), -1.0, 0.0);
+    }
+    v3 u = b;
+    /* candidate swivel angles: 0 and where each joint reaches a limit */
+    double psi[128];
+    int np = 0;
+    psi[np++] = 0.0;
+    for (int t = 0; t < 2; t++) {
+        int o3 = 3 * t;
+        v3 hx = g->h[o3], hy = g->h[o3 + 1], hz = g->h[o3 + 2];
+        for (int jj = 0; jj < 3; jj++) {
+            int f = g->full[o3 + jj];
+            for (int side = 0; side < 2; side++) {
+                double L = P[PK_SIGN + f] * P[(side ? PK_HI : PK_LO) + f] + P[PK_OFFSET + f];
+                double cL = cos(L), sL = sin(L);
+                if (t == 0) { /* R_A = rot(u, psi) R0 */
+                    if (jj == 1)
+                        pk_psi_roots(hx, u, m3_mv(&R0, hz), v3_dot(hx, v3_rot(hy, cL, sL, hz)),
+                                     1.0, psi, &np);
+                    else if (jj == 0)
+                        pk_psi_roots(v3_rot(hx, cL, sL, hy), u, m3_mv(&R0, hz), v3_dot(hy, hz),
+                                     1.0, psi, &np);
+                    else
+                        pk_psi_roots(hx, u, m3_mv(&R0, v3_rot(hz, cL, -sL, hy)),
+                                     v3_dot(hx, hy), 1.0, psi, &np);
+                } else { /* R_B = R0^T rot(u, -psi) G */
+                    v3 gz = m3_mv(G, hz);
+                    if (jj == 1)
+                        pk_psi_roots(m3_mv(&R0, hx), u, gz, v3_dot(hx, v3_rot(hy, cL, sL, hz)),
+                                     -1.0, psi, &np);
+                    else if (jj == 0)
+                        pk_psi_roots(m3_mv(&R0, v3_rot(hx, cL, sL, hy)), u, gz, v3_dot(hy, hz),
+                                     -1.0, psi, &np);
+                    else
+                        pk_psi_roots(m3_mv(&R0, hx), u, m3_mv(G, v3_rot(hz, cL, -sL, hy)),
+                                     v3_dot(hx, hy), -1.0, psi, &np);
+                }
+            }
+        }
+    }
+    /* midpoints between consecutive candidates (around the circle) */
+    for (int i = 1; i < np; i++)
+        for (int j = i; j > 0 && psi[j] < psi[j - 1]; j--) {
+            double t = psi[j];
+            psi[j] = psi[j - 1];
+            psi[j - 1] = t;
+        }
+    int nb = np;
+    for (int i = 0; i < nb; i++) {
+        double nxt = i + 1 < nb ? psi[i + 1] : psi[0] + 2.0 * M_PI;
+        psi[np++] = 0.5 * (psi[i] + nxt);
+    }
+    PkTri ta, tb;
+    pk_tri_init(&ta, g->h[0], g->h[1], g->h[2]);
+    pk_tri_init(&tb, g->h[3], g->h[4], g->h[5]);
+    double best_m[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY}, best_th[4][6];
+    int have[4] = {0, 0, 0, 0};
+    for (int i = 0; i < np; i++) {
+        m3 Ru = pk_rotm(u, cos(psi[i]), sin(psi[i]));
+        m3 RA = pk_mul(&Ru, &R0);
+        m3 RAt = {{RA.r0.x, RA.r1.x, RA.r2.x}, {RA.r0.y, RA.r1.y, RA.r2.y},
+                  {RA.r0.z, RA.r1.z, RA.r2.z}};
+        m3 RB = pk_mul(&RAt, G);
+        PkTrip A, B;
+        pk_triple(P, &ta, &RA, g->full[0], g->full[2], qn[g->full[2]], P[PK_SING_TOL], &A);
+        pk_triple(P, &tb, &RB, g->full[3], g->full[5], qn[g->full[5]], P[PK_SING_TOL], &B);
+        for (int ka = 0; ka < A.n; ka++)
+            for (int kb = 0; kb < B.n; kb++) {
+                double th[6], q[PK_MAXJ];
+                for (int j = 0; j < 3; j++) {
+                    th[j] = A.t[ka][j];
+                    th[3 + j] = B.t[kb][j];
+                }
+                double m = pk_coords(P, g, th, held, x, q);
+                int slot = 2 * ka + kb;
+                if (!have[slot] || m > best_m[slot]) {
+                    have[slot] = 1;
+                    best_m[slot] = m;
+                    for (int j = 0; j < 6; j++)
+                        best_th[slot][j] = th[j];
+                }
+            }
+    }
+    int any = 0;
+    for (int slot = 0; slot < 4; slot++) {
+        if (!have[slot])
+            continue;
+        double *th = best_th[slot];
+        m3 R;
+        v3 pp;
+        double ev[6];
+        pk_fk(g, th, &R, &pp, NULL);
+        double err = pk_error(RT, pT, &R, pp, g->scale, ev);
+        if (err > PK_EXACT)
+            err = pk_polish(g, RT, pT, th);
+        if (!(err <= PK_ACCEPT))
+            continue;
+        double q[PK_MAXJ];
+        double m = pk_coords(P, g, th, held, x, q);
+        for (int j = 0; j < o.n; j++)
+            o.Q[o.n * slot + j] = q[j];
+        o.valid[slot] = 1;
+        o.inside[slot] = (unsigned char)(m >= -1e-9);
+        o.sing[slot] = 1;
+        any = 1;
+    }
+    return any ? PK_OK : PK_NO_ORIENTATION;
+}
+
 /* Every solution of pose T (4 x 4 row-major) with the held joint (if any) at x;
  * qn: the preferred coordinates (n) at singularities. Returns the status. */
 static int pk_one(const double *P, const double *T, double x, const double *qn, PkOut o)
@@ -1009,6 +1201,8 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
     m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
     v3 pT = {T[3], T[7], T[11]};
     m3 G = pk_mul_t(&RT, &g.RM); /* the rotation of e1 ... e6 */
+    if (g.kase == PK_BOTH)
+        return pk_swivel(P, &g, &RT, pT, &G, x, qn, o);
     int start = g.kase == PK_START, ia = start ? 3 : 0, it = start ? 0 : 3;
     v3 p, d;
     if (start) {
@@ -1335,6 +1529,7 @@ static int pieper_constants(PyObject *m)
         {"PIEPER_SIGN", PK_SIGN}, {"PIEPER_OFFSET", PK_OFFSET}, {"PIEPER_LO", PK_LO},
         {"PIEPER_HI", PK_HI}, {"PIEPER_TAG", PK_TAG}, {"PIEPER_N_PARAMS", PK_N_PARAMS},
         {"PIEPER_MAX_JOINTS", PK_MAXJ}, {"PIEPER_START", PK_START}, {"PIEPER_END", PK_END},
+        {"PIEPER_BOTH", PK_BOTH}, {"PIEPER_POINT2", PK_POINT2},
         {"PIEPER_DEGENERATE", PK_DEGENERATE}, {"PIEPER_BAD_POSE", PK_BAD_POSE}, {"PIEPER_PARALLEL_MIN", PK_PARALLEL_MIN}};
     for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
         if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)

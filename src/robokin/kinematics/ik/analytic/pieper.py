@@ -205,9 +205,7 @@ def setup(chain: Any, held: int | None = None, *, tol: float = 1e-9,
             meets[case] = (dist, point, idx)
     if not meets:
         return Setup(None, "no three consecutive axes meet: " + measure(poe, held)[1])
-    if len(meets) == 2:
-        return Setup(None, "both triples meet (axes 1-3 and 4-6): the six joints move in "
-                           "a one-parameter family at every reachable pose")
+    both = len(meets) == 2
     case, (dist, point, idx) = next(iter(meets.items()))
     h, o = _turned(poe, held, 1.2345)  # a held value where nothing lines up by chance
     for i in range(5):
@@ -217,7 +215,9 @@ def setup(chain: Any, held: int | None = None, *, tol: float = 1e-9,
     P = np.zeros(K.PIEPER_N_PARAMS)
     P[K.PIEPER_N] = n
     P[K.PIEPER_HELD] = -1 if held is None else held
-    P[K.PIEPER_CASE] = case
+    P[K.PIEPER_CASE] = K.PIEPER_BOTH if both else case
+    if both:
+        P[K.PIEPER_POINT2:K.PIEPER_POINT2 + 3] = meets[K.PIEPER_END][1]
     P[K.PIEPER_SING_TOL] = singular_tol
     P[K.PIEPER_SCALE] = scale
     P[K.PIEPER_POINT:K.PIEPER_POINT + 3] = point
@@ -233,7 +233,11 @@ def setup(chain: Any, held: int | None = None, *, tol: float = 1e-9,
     P[K.PIEPER_TAG] = K.PIEPER_TAG_VALUE
     P.setflags(write=False)
     which = "1-3" if case == K.PIEPER_START else "4-6"
-    return Setup(P, measured=f"axes {which} meet within {dist:.1e} m", held=held)
+    text = f"axes {which} meet within {dist:.1e} m"
+    if both:
+        text = (f"axes 1-3 and 4-6 meet within {max(d for d, _, _ in meets.values()):.1e}"
+                " m (a one-parameter family at every reachable pose: the swivel)")
+    return Setup(P, measured=text, held=held)
 
 
 _NO_VALUE = np.zeros(1)
