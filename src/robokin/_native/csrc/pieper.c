@@ -811,6 +811,9 @@ static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int 
             double qz = P[PK_SIGN + jz] * (tz - P[PK_OFFSET + jz]);
             double tz2 = pk_split(P, jx, jz, tx + sigma * tz, sigma, qz);
             double eps = wrap_pi(tz2 - tz);
+#ifdef PK_DEBUG
+            fprintf(stderr, "   resplit sv %.3e tz %.17g tz2 %.17g eps %.3e\n", sv, tz, tz2, eps);
+#endif
             if (fabs(eps) * sv <= 0.01 * PK_EXACT) {
                 tx -= sigma * eps;
                 tz += eps;
@@ -1013,6 +1016,41 @@ static void pk_clear(PkOut o)
         for (int j = 0; j < o.n; j++)
             o.Q[o.n * k + j] = NAN;
     }
+}
+
+/* Near a singular triple (its outer axes almost in line) only tx + sigma tz is
+ * well determined: when th (remaining chain, triple at it) lies outside the
+ * limits, move that split inside them where the pose error stays within
+ * PK_ACCEPT (checked by forward kinematics). Returns 1 when th changed. */
+static int pk_resplit(const double *P, const PkGeo *g, int it, const m3 *RT, v3 pT,
+                      double *th)
+{
+    v3 hx = g->h[it], hy = g->h[it + 1], hz = g->h[it + 2];
+    v3 v = v3_rot(hy, cos(th[it + 1]), sin(th[it + 1]), hz);
+    double sv = v3_norm(v3_cross(v, hx));
+    if (!(sv < 1e-6))
+        return 0;
+    int jx = g->full[it], jz = g->full[it + 2];
+    double sigma = v3_dot(v, hx) >= 0.0 ? 1.0 : -1.0;
+    double tx = th[it], tz = th[it + 2];
+    double qz = P[PK_SIGN + jz] * (tz - P[PK_OFFSET + jz]);
+    double eps = wrap_pi(pk_split(P, jx, jz, tx + sigma * tz, sigma, qz) - tz);
+    if (eps == 0.0 || !(fabs(eps) * sv <= 0.1 * PK_ACCEPT))
+        return 0;
+    double trial[6];
+    for (int j = 0; j < 6; j++)
+        trial[j] = th[j];
+    trial[it] = tx - sigma * eps;
+    trial[it + 2] = tz + eps;
+    m3 R;
+    v3 p;
+    double e[6];
+    pk_fk(g, trial, &R, &p, NULL);
+    if (!(pk_error(RT, pT, &R, p, g->scale, e) <= PK_ACCEPT))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        th[j] = trial[j];
+    return 1;
 }
 
 /* The joint coordinates of chain angles th (6, remaining chain) into q (full
@@ -1284,18 +1322,10 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
                     continue; /* not a solution to 1e-12: never returned */
             }
             int slot = 2 * pos.slot[i] + k;
-            int all = 1;
-            for (int j = 0; j < 6; j++) {
-                int f = g.full[j], in;
-                o.Q[o.n * slot + f] =
-                    joint_value(th[j], P[PK_SIGN + f], P[PK_OFFSET + f], P[PK_LO + f],
-                                P[PK_HI + f], &in);
-                all &= in;
-            }
-            if (held >= 0) {
-                o.Q[o.n * slot + held] = x;
-                all &= (x >= P[PK_LO + held] - 1e-9) & (x <= P[PK_HI + held] + 1e-9);
-            }
+            double *qs = o.Q + o.n * slot;
+            int all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            if (!all && pk_resplit(P, &g, it, &RT, pT, th))
+                all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
             o.valid[slot] = 1;
             o.inside[slot] = (unsigned char)all;
             o.sing[slot] = (unsigned char)(pos.sing[i] || tr.sing[k]);
