@@ -93,7 +93,7 @@ enum { PK_OK = 0, PK_OUT_OF_REACH = 1, PK_NO_ORIENTATION = 2, PK_DEGENERATE = 5,
 #define PK_TAG_VALUE 1968.0625 /* Pieper's year, and a sixteenth */
 #define PK_PARALLEL_MIN 512    /* below this many poses, one thread */
 #define PK_GRAIN 32            /* poses per pool chunk */
-#define PK_COPLANAR 1e-9       /* |mutual moment| / scale below it: coplanar axes */
+#define PK_COPLANAR 1e-13      /* |mutual moment| / scale below it: coplanar axes (rounding) */
 #define PK_EXACT 1e-13         /* pose errors below it need no Newton polish */
 #define PK_ACCEPT 4e-13        /* pose errors above it after the polish: not a solution */
 
