@@ -169,6 +169,8 @@ class Kernels(Protocol):
     PIEPER_MAX_JOINTS: int
     PIEPER_START: int
     PIEPER_END: int
+    PIEPER_BOTH: int
+    PIEPER_POINT2: int
     PIEPER_DEGENERATE: int
     PIEPER_BAD_POSE: int
     PIEPER_PARALLEL_MIN: int
