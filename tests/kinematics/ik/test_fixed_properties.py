@@ -97,12 +97,11 @@ def check_held(robot, j, q, *, singular=True):
 
 IDS = [f"{a}-joint{j + 1}" for a, j in CASES]
 
-# Known gap (docs/ik.md, "Singular configurations"): the SRS arm at full stretch
-# (q4 = 0: shoulder, elbow and wrist in line) together with other special values,
-# and with joint 2 or 6 held within 1e-6 rad of 0 (two of the six axes left nearly
-# coincide): some singular in-limit configurations get no in-limit solution (rows
+# Known gap (docs/ik.md, "Known gap"): the SRS arm with joint 2 or 6 held within
+# 1e-6 rad of 0 (two of the six axes left nearly coincide), often at full stretch
+# (q4 = 0): some singular in-limit configurations get no in-limit solution (rows
 # are dropped when the polish cannot bring them to 1e-12).
-KNOWN_GAPS = {("srs", 0), ("srs", 1), ("srs", 5)}
+KNOWN_GAPS = {("srs", 1), ("srs", 5)}
 SINGULAR_CASES = [
     pytest.param(a, j, id=i, marks=pytest.mark.xfail(
         strict=True, reason="known gap: SRS at full stretch / near-coincident axes"))

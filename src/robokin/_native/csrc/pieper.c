@@ -1053,6 +1053,64 @@ static int pk_resplit(const double *P, const PkGeo *g, int it, const m3 *RT, v3 
     return 1;
 }
 
+/* Joints on one line (a singular configuration: equal Jacobian columns up to the
+ * sign sigma) only fix th_i + sigma th_j: when th lies outside the limits, trade
+ * each such pair's split inside them (pk_split), two passes over the pairs, kept
+ * when the pose still holds to PK_ACCEPT. Returns 1 when th changed. */
+static int pk_repair(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
+{
+    double trial[6];
+    int moved = 0;
+    for (int j = 0; j < 6; j++)
+        trial[j] = th[j];
+    for (int pass = 0; pass < 2; pass++) {
+        m3 R;
+        v3 p;
+        double J[6][6];
+        pk_fk(g, trial, &R, &p, J);
+        for (int i = 0; i < 6; i++)
+            for (int j = i + 1; j < 6; j++) {
+                double dot = J[3][i] * J[3][j] + J[4][i] * J[4][j] + J[5][i] * J[5][j];
+                double sigma = dot >= 0.0 ? 1.0 : -1.0, diff = 0.0;
+                for (int r = 0; r < 6; r++)
+                    diff = fmax(diff, fabs(J[r][i] - sigma * J[r][j]));
+                if (!(diff < 1e-9))
+                    continue;
+                int fi = g->full[i], fj = g->full[j], ini, inj;
+                joint_value(trial[i], P[PK_SIGN + fi], P[PK_OFFSET + fi], P[PK_LO + fi],
+                            P[PK_HI + fi], &ini);
+                double qj = joint_value(trial[j], P[PK_SIGN + fj], P[PK_OFFSET + fj],
+                                        P[PK_LO + fj], P[PK_HI + fj], &inj);
+                if (ini && inj)
+                    continue;
+                double phi = trial[i] + sigma * trial[j];
+                double tj = pk_split(P, fi, fj, phi, sigma, qj);
+                trial[j] = tj;
+                trial[i] = phi - sigma * tj;
+                moved = 1;
+#ifdef PK_DEBUG
+                fprintf(stderr, "   repair pair %d %d sigma %g diff %.3e -> %.6f %.6f\n", i, j,
+                        sigma, diff, trial[i], trial[j]);
+#endif
+            }
+    }
+    if (!moved)
+        return 0;
+    m3 R;
+    v3 p;
+    double e[6];
+    pk_fk(g, trial, &R, &p, NULL);
+    double err = pk_error(RT, pT, &R, p, g->scale, e);
+#ifdef PK_DEBUG
+    fprintf(stderr, "   repair err %.3e\n", err);
+#endif
+    if (!(err <= PK_ACCEPT))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        th[j] = wrap_pi(trial[j]);
+    return 1;
+}
+
 /* The joint coordinates of chain angles th (6, remaining chain) into q (full
  * chain, held joint at x) and their smallest margin to the limits [rad]
  * (negative: outside) */
@@ -1304,8 +1362,11 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
         fprintf(stderr, "  triple n %d\n", tr.n);
 #endif
         for (int k = 0; k < tr.n; k++) {
-            for (int j = 0; j < 3; j++)
+            /* this solution's angles (the polish and the repairs change all six) */
+            for (int j = 0; j < 3; j++) {
+                th[ia + j] = pos.t[i][j];
                 th[it + j] = tr.t[k][j];
+            }
             if (tr.check[k] || !(pos.res[i] < exact_p)) {
                 /* check against the pose; Newton-polish when not exact */
                 m3 R;
@@ -1325,6 +1386,8 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
             double *qs = o.Q + o.n * slot;
             int all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
             if (!all && pk_resplit(P, &g, it, &RT, pT, th))
+                all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            if (!all && pk_repair(P, &g, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
             o.valid[slot] = 1;
             o.inside[slot] = (unsigned char)all;

@@ -7,7 +7,8 @@ held at a chosen value the remaining 6R chain has finitely many.
 manifold of one pose as a batch.
 
 When three consecutive axes of the six joints left meet in a point (the Panda with
-joint 4, 5, 6 or 7 held, an SRS arm with any joint but the elbow held) the
+joint 4, 5, 6 or 7 held, an SRS arm with any joint held: with the elbow held
+both triples meet and the six joints move in a swivel family) the
 ``pieper`` closed form solves them (``analytic/pieper.py``): its compiled kernel
 takes the held value with each pose and builds the remaining chain itself, so one
 set-up per (chain, held joint) serves every value, and a single pose with a number
