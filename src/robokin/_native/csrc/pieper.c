@@ -1387,7 +1387,8 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
             int all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
             if (!all && pk_resplit(P, &g, it, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
-            if (!all && pk_repair(P, &g, &RT, pT, th))
+            /* joints on one line only at a singular configuration: try there only */
+            if (!all && (pos.sing[i] || tr.sing[k]) && pk_repair(P, &g, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
             o.valid[slot] = 1;
             o.inside[slot] = (unsigned char)all;
