@@ -43,6 +43,9 @@ def solve(
     """
     if method not in _METHODS:
         raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
+    if len(options) == 1 and "fixed" in options:
+        # held joints, no other option: no re-packing of the keyword arguments
+        return solve_fixed(robot, T, options["fixed"], q_near=q_near, method=method)
     if "fixed" in options:
         return solve_fixed(robot, T, options.pop("fixed"), q_near=q_near, method=method,
                            **options)
