@@ -43,8 +43,8 @@ import math
 import os
 import re
 import warnings
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -53,6 +53,12 @@ import numpy as np
 from robokin._text import short_repr
 from robokin.exceptions import ModelError
 from robokin.io.ros_packages import PackageFinder
+from robokin.io.urdf_tool import (
+    axis_frame,
+    freeze_tool_tree,
+    link_owners,
+    resolve_mimic,
+)
 from robokin.io.urdf_xml import MAX_URDF_JOINTS, MOVABLE, parse_urdf
 from robokin.model.chain import Chain, ChainBuilder, Joint, JointKind
 from robokin.model.coupling import Dependency, coupling_from_dependencies, mimic
@@ -60,24 +66,24 @@ from robokin.model.geometry import MESH_SUFFIXES, mesh_file_problem
 
 if TYPE_CHECKING:
     from robokin.io.dh_extract import DHExtraction
+    from robokin.io.srdf import Srdf
     from robokin.io.xacro import XacroExpansion
     from robokin.robot import Robot
 
 __all__ = [
     "MAX_URDF_JOINTS",
     "UrdfChain",
+    "axis_frame",
     "dh_from_robot",
     "dh_from_urdf",
     "parse_urdf",
+    "resolve_mesh",
     "robot_from_urdf",
 ]
 
 MissingMesh = Literal["warn", "error", "ignore"]
 _SCHEME = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]*)://")
 
-# Exact rotations that take the local z axis onto +x / +y (no cos(pi/2) residue).
-_Z_TO_X = np.array([[0.0, 0, 1, 0], [0, 1, 0, 0], [-1, 0, 0, 0], [0, 0, 0, 1]])
-_Z_TO_Y = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]])
 
 
 @dataclass(frozen=True)
@@ -221,38 +227,6 @@ def _invert(T: np.ndarray) -> np.ndarray:
     return out
 
 
-def axis_frame(axis: Sequence[float], *, where: str = "axis") -> tuple[np.ndarray, float]:
-    """A rotation ``A`` (4, 4) and sign with ``A @ Rz(sign q) @ A.T`` = rotation about ``axis``.
-
-    Axis-aligned axes give exact matrices; a negative axis (``-x``, ``-y``, ``-z``,
-    or any axis with a negative z component) gives ``sign = -1``.
-
-    Raises:
-        ModelError: a zero or non-finite axis.
-    """
-    u = np.asarray(axis, dtype=np.float64).reshape(-1)
-    norm = float(np.linalg.norm(u)) if u.shape == (3,) else 0.0
-    if u.shape != (3,) or not np.isfinite(u).all() or norm < 1e-12:
-        raise ModelError(f"the joint axis must be a non-zero 3-vector, got {u.tolist()}",
-                         field=where)
-    u = u / norm
-    nz = np.flatnonzero(np.abs(u) > 1e-15)
-    if len(nz) == 1:
-        i = int(nz[0])
-        sign = 1.0 if u[i] > 0 else -1.0
-        return ((_Z_TO_X, _Z_TO_Y, np.eye(4))[i]).copy(), sign
-    sign = 1.0
-    if u[2] < 0:
-        u, sign = -u, -1.0
-    # Minimal rotation taking z onto u (Rodrigues, 1 + cos >= 1 here).
-    v = np.array([-u[1], u[0], 0.0])
-    c = u[2]
-    K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    A = np.eye(4)
-    A[:3, :3] = np.eye(3) + K + K @ K / (1.0 + c)
-    return A, sign
-
-
 @dataclass(frozen=True)
 class UrdfChain:
     """What :func:`robot_from_urdf` made of the URDF, besides the chain.
@@ -263,9 +237,15 @@ class UrdfChain:
         child_links: The URDF child link of every chain joint (n_chain).
         link_frames: Every URDF link rigidly attached to the chain:
             ``name -> (k, T)``, the link's pose ``T`` (4, 4) in the frame ``k`` of
-            ``fk_all`` (0: the base link; k: chain joint k's child link).
+            ``fk_all`` (0: the base link; k: chain joint k's child link); the
+            tool's tree (fingers at ``tool_joints``) in frame ``n_chain``.
         dropped_links: Links not rigidly attached to the chain (they move with
-            joints off the chain), sorted.
+            joints off the chain, other than the tool's), sorted.
+        owners: The robokin link each placed URDF link belongs to: ``base``, a
+            chain joint's name, or ``tool`` (see :mod:`robokin.io.urdf_tool`).
+        tool_joints: The position [rad, m] each joint of the tool's tree is
+            frozen at (mimic joints included).
+        shaped_links: The URDF links whose shapes robokin's geometry holds.
     """
 
     base_link: str
@@ -273,6 +253,18 @@ class UrdfChain:
     child_links: tuple[str, ...]
     link_frames: Mapping[str, tuple[int, np.ndarray]]
     dropped_links: tuple[str, ...]
+    owners: Mapping[str, str] = field(default_factory=dict)
+    tool_joints: Mapping[str, float] = field(default_factory=dict)
+    shaped_links: frozenset[str] = frozenset()
+
+    def parts(self) -> dict[str, tuple[str, ...]]:
+        """The URDF links with shapes each robokin link holds: ``{link: (URDF links)}``."""
+        out: dict[str, list[str]] = {}
+        for link in sorted(self.shaped_links):
+            owner = self.owners.get(link)
+            if owner is not None:
+                out.setdefault(owner, []).append(link)
+        return {k: tuple(v) for k, v in out.items()}
 
 
 def _limits(j: Any, file: Path | None) -> tuple[float, float]:
@@ -313,36 +305,13 @@ def _kind(j: Any) -> JointKind:
     return "prismatic" if j.type == "prismatic" else "revolute"
 
 
-def _resolve_mimic(tree: _Tree, j: Any) -> tuple[Any, float, float]:
-    """The independent master of a mimic joint, with the composed multiplier/offset."""
-    mult, off, seen = 1.0, 0.0, {j.name}
-    cur = j
-    while cur.mimic is not None:
-        name = cur.mimic.joint
-        master = tree.joints.get(name)
-        where = f"joint[{cur.name}].mimic"
-        if master is None:
-            raise ModelError(f"mimics unknown joint '{name}'", file=tree.file, field=where)
-        if master.type not in MOVABLE:
-            raise ModelError(
-                f"mimics the {master.type} joint '{name}'", file=tree.file, field=where
-            )
-        if name in seen:
-            raise ModelError("mimic joints form a loop", file=tree.file, field=where)
-        seen.add(name)
-        m = 1.0 if cur.mimic.multiplier is None else float(cur.mimic.multiplier)
-        o = 0.0 if cur.mimic.offset is None else float(cur.mimic.offset)
-        mult, off = mult * m, mult * o + off
-        cur = master
-    return cur, mult, off
-
-
 def chain_from_urdf_model(
     robot: Any,
     *,
     base_link: str | None = None,
     tip_link: str | None = None,
     file: Path | None = None,
+    tool_joints: Mapping[str, float] | None = None,
 ) -> tuple[Chain, UrdfChain]:
     """Compile the chain ``base_link`` -> ``tip_link`` of a parsed URDF model.
 
@@ -351,6 +320,8 @@ def chain_from_urdf_model(
         base_link: Base link name (default: the root).
         tip_link: Tip link name (default: see the module docstring).
         file: The file, for error messages.
+        tool_joints: Positions of joints in the tool's tree (default: 0 clamped
+            into their limits); see :mod:`robokin.io.urdf_tool`.
 
     Returns:
         The canonical chain and the :class:`UrdfChain` bookkeeping.
@@ -422,7 +393,7 @@ def chain_from_urdf_model(
             add_coordinate(j)
             joint = Joint(j.name, kind, _limits(j, file), sign)
         else:
-            master, mult, off = _resolve_mimic(tree, j)
+            master, mult, off = resolve_mimic(tree.joints, j, file)
             add_coordinate(master)
             deps[j.name] = mimic(master.name, mult, off)
             lim = (-math.inf, math.inf) if j.limit is None else _limits(j, file)
@@ -448,6 +419,12 @@ def chain_from_urdf_model(
                 continue
             frames[j.child] = (kk, T @ _origin(j))
             stack.append(j.child)
+    # The tool's tree: subtrees below the last link's rigid body, joints frozen.
+    positions, left_out = freeze_tool_tree(
+        tree, frames, len(names), set(names) | coord_names, tool_joints, file)
+    for msg in left_out:
+        warnings.warn(f"{file or 'URDF'}: {msg} left out: they move with the arm",
+                      UserWarning, stacklevel=3)
     dropped = tuple(sorted(set(tree.links) - set(frames)))
     info = UrdfChain(
         base_link=base,
@@ -455,15 +432,22 @@ def chain_from_urdf_model(
         child_links=tuple(child_links),
         link_frames=frames,
         dropped_links=dropped,
+        owners=link_owners(frames, names, child_links[-1]),
+        tool_joints=positions,
     )
     return chain, info
 
 
 # ---------------------------------------------------------------------- geometry
-def _resolve_mesh(
+def resolve_mesh(
     filename: str, file: Path | None, packages: PackageFinder
 ) -> tuple[Path | None, str]:
-    """Resolve a mesh reference to a path; ``(None, reason)`` when it cannot be."""
+    """Resolve a mesh reference to a path; ``(None, reason)`` when it cannot be.
+
+    ``package://PKG/...`` through ``packages``, ``file://``, a path relative to
+    ``file``'s folder; a remote URI is never fetched, a path leaving its
+    package is not read, a file that is not a mesh is named.
+    """
     if filename.startswith("package://"):
         rest = filename[len("package://"):]
         pkg, _, sub = rest.partition("/")
@@ -549,7 +533,7 @@ def _geometry_of(
                 elif g.sphere is not None:
                     entry.update(type="sphere", radius=float(g.sphere.radius))
                 elif g.mesh is not None:
-                    path, why = _resolve_mesh(g.mesh.filename, file, packages)
+                    path, why = resolve_mesh(g.mesh.filename, file, packages)
                     if path is None:
                         drops.drop(link.name, role, g.mesh.filename, why)
                         continue
@@ -565,21 +549,27 @@ def _geometry_of(
     return out
 
 
-def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]], drops: _Drops
-                     ) -> Robot:
-    """Put the collision shapes on the geometry layer.
+def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]], drops: _Drops,
+                     owners: Mapping[str, str]) -> tuple[Robot, frozenset[str]]:
+    """Put the collision shapes on the geometry layer; the URDF links that gave some.
 
-    Visual shapes stand in where a link has no collision shape.
+    Visual shapes stand in where a link has no collision shape. A shape goes to
+    the robokin link its URDF link belongs to (``owners``); the tool's shapes
+    are placed in the tool frame.
     """
     from robokin.model import geometry as geo
 
-    names = geo.link_names(robot)
+    tool_from_last = _invert(np.asarray(robot.chain.tool, dtype=float))
     with_collision = {e["link"] for e in shapes if e["role"] == "collision"}
     per_link: dict[str, list[Any]] = {}
+    shaped: set[str] = set()
     for e in shapes:
         if e["role"] == "visual" and e["link"] in with_collision:
             continue
+        owner = owners[e["link"]]
         pose, label = e["pose"], e.get("name") or ""
+        if owner == "tool":
+            pose = tool_from_last @ pose
         t = e["type"]
         if t == "box":
             shape = geo.box(e["size"], pose, name=label)
@@ -595,8 +585,10 @@ def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]], drops: _Drops
                 continue
             shape = geo.mesh(e["filename"], pose, scale=sc[0], name=label,
                              owner=e["link"])
-        per_link.setdefault(names[e["frame"]], []).append(shape)
-    return robot.replace(geometry=geo.RobotGeometry.from_mapping(robot, per_link))
+        per_link.setdefault(owner, []).append(shape)
+        shaped.add(e["link"])
+    geometry = geo.RobotGeometry.from_mapping(robot, per_link)
+    return robot.replace(geometry=geometry), frozenset(shaped)
 
 
 # ------------------------------------------------------------------------ public
@@ -610,8 +602,15 @@ def robot_from_urdf(
     geometry: bool = True,
     missing_mesh: MissingMesh = "warn",
     name: str | None = None,
+    srdf: str | Path | bytes | None = None,
+    tool_joints: Mapping[str, float] | None = None,
 ) -> Robot:
     """Load the serial chain of a URDF or xacro as a robot (needs ``robokin[urdf]``).
+
+    Links hung by fixed joints anywhere on the chain move with their link, and
+    the links below the tip (a gripper's tree, its fingers frozen at
+    ``tool_joints``) join the tool (:mod:`robokin.io.urdf_tool`); their shapes
+    become those links' geometry.
 
     Args:
         path_or_string: A URDF file path, or the XML itself (a string starting
@@ -634,13 +633,22 @@ def robot_from_urdf(
             ``"error"`` (ModelError) or ``"ignore"`` (skipped silently; still
             listed in ``meta["urdf_dropped_shapes"]``).
         name: The robot's name (default: the URDF's ``<robot name>``).
+        srdf: The robot's SRDF (a path or the XML; :mod:`robokin.io.srdf`):
+            its ``<disable_collisions>`` pairs become self-collision exclusions
+            on robokin's links (:func:`robokin.io.srdf.excluded_link_pairs`)
+            and, as in MoveIt, every other pair is checked (adjacent links are
+            no longer skipped by default); without ``tip_link`` its end
+            effector's parent link (or its chain's tip) is the tip.
+        tool_joints: ``{joint: position}`` [rad, m] for joints of the tool's
+            tree (a gripper's fingers; default: 0 clamped into the limits).
 
     Returns:
         A :class:`~robokin.robot.Robot` (its ``dynamics`` from the links'
         ``<inertial>`` and the joints' ``effort``, see
         :mod:`robokin.io.urdf_inertial`) with ``robot.meta["urdf"]`` holding the
         :class:`UrdfChain`, ``robot.meta["urdf_shapes"]`` the shapes,
-        ``robot.meta["urdf_dropped_shapes"]`` one message per shape left out
+        ``robot.meta["urdf_dropped_shapes"]`` one message per shape left out,
+        ``robot.meta["srdf"]`` the :class:`~robokin.io.srdf.Srdf` (when given)
         and, for a xacro, ``robot.meta["xacro"]`` the
         :class:`~robokin.io.xacro.XacroExpansion` (its ``urdf`` is the
         expanded text).
@@ -650,9 +658,11 @@ def robot_from_urdf(
             xacro, an error in it or a package that is not found.
         InputError: a package map folder that does not exist; ``xacro_args``
             for a file that is not a xacro, or naming an argument the xacro
-            does not declare.
+            does not declare; a ``tool_joints`` entry that is not a joint of
+            the tool's tree or is outside its limits.
         MissingExtraError: yourdfpy (or, for a xacro, xacro) is not installed.
     """
+    from robokin.io.srdf import parse_srdf
     from robokin.robot import Robot
 
     if missing_mesh not in ("warn", "error", "ignore"):
@@ -663,8 +673,15 @@ def robot_from_urdf(
         )
     expansion, urdf_robot, file = _parse_source(path_or_string, package_map,
                                                 xacro_args)
+    semantic = None if srdf is None else parse_srdf(srdf)
+    if semantic is not None:
+        links = {link.name for link in urdf_robot.links}
+        semantic.check_links(links, urdf_robot.name)
+        if tip_link is None:
+            tip_link = semantic.default_tip(links)
     chain, info = chain_from_urdf_model(
-        urdf_robot, base_link=base_link, tip_link=tip_link, file=file
+        urdf_robot, base_link=base_link, tip_link=tip_link, file=file,
+        tool_joints=tool_joints,
     )
     drops = _Drops(missing_mesh, file)
     packages = expansion.packages if expansion is not None else \
@@ -685,14 +702,32 @@ def robot_from_urdf(
         meta=meta,
         rate_limits=_velocity_limits(urdf_robot, chain, source),
     )
-    if shapes:
-        robot = _attach_geometry(robot, shapes, drops)
+    robot = _with_shapes(robot, shapes, drops, info, semantic)
     from robokin.io.urdf_inertial import dynamics_from_urdf
 
     robot = robot.replace(dynamics=dynamics_from_urdf(robot, urdf_robot,
                                                       info.link_frames, file))
     return robot.replace(meta={**robot.meta,
                                "urdf_dropped_shapes": tuple(drops.messages)})
+
+
+def _with_shapes(robot: Robot, shapes: list[dict[str, Any]], drops: _Drops,
+                 info: UrdfChain, semantic: Srdf | None) -> Robot:
+    """The robot with its geometry, the SRDF's exclusions and the final bookkeeping."""
+    from robokin.io.srdf import excluded_link_pairs
+
+    shaped: frozenset[str] = frozenset()
+    if shapes:
+        robot, shaped = _attach_geometry(robot, shapes, drops, info.owners)
+    info = replace(info, shaped_links=shaped)
+    meta = {**robot.meta, "urdf": info}
+    if semantic is not None:
+        meta["srdf"] = semantic
+        if robot.geometry is not None:
+            pairs = excluded_link_pairs(info.parts(), semantic.allowed())
+            robot = robot.replace(geometry=replace(
+                robot.geometry, exclude=frozenset(pairs), exclude_adjacent=False))
+    return robot.replace(meta=meta)
 
 
 def _parse_source(
