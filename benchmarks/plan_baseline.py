@@ -133,6 +133,9 @@ class PinCoalChecker:
     """State validity with pinocchio + coal: the URDF's collision shapes, the SRDF's
     pairs removed, the tool's joints locked, the scene's primitives.
 
+    coal's cached GJK guess, which pinocchio enables, is turned off: with it,
+    boolean collision checks miss real contacts (see ``__init__``).
+
     Args:
         urdf: The robot's URDF.
         srdf: Its SRDF (None: every pair of geometry objects on different
@@ -176,6 +179,12 @@ class PinCoalChecker:
                 self.geom.addCollisionPair(pin.CollisionPair(r, gid))
         self.data = self.model.createData()
         self.gdata = pin.GeometryData(self.geom)
+        # pinocchio turns on coal's cached GJK guess for every pair; with it,
+        # collide() missed 88 of 2100 colliding Panda states (penetrations up to
+        # 2 cm, a cylinder against a cylinder) that it finds without the cache
+        # (pin 4.1.0, coal 3.0.3; docs/benchmarks.md). Off: no miss, same speed.
+        for req in self.gdata.collisionRequests:
+            req.enable_cached_gjk_guess = False
         self.tip_frame = self.model.getFrameId(tip_link)
         self.calls = 0
 

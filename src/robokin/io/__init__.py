@@ -12,7 +12,8 @@ Two kinds of module live here:
   their section table), :mod:`~robokin.io.actuator_section`,
   :mod:`~robokin.io.geometry_sections`, :mod:`~robokin.io.urdf_xml` (safe, strict
   XML), :mod:`~robokin.io.urdf` (URDF in), :mod:`~robokin.io.urdf_tool` (the
-  links hung on the chain, the tool's tree), :mod:`~robokin.io.srdf` (SRDF in),
+  links hung on the chain, the tool's tree), :mod:`~robokin.io.urdf_geometry`
+  (their shapes), :mod:`~robokin.io.srdf` (SRDF in),
   :mod:`~robokin.io.urdf_export` (URDF out), :mod:`~robokin.io.dh_extract` and
   :mod:`~robokin.io.motion_files`;
 * the MoveIt planning-scene readers, parts for :class:`robokin.collision.Scene`:

@@ -235,7 +235,7 @@ def _mesh(r: _Reader, value: Any, where: str, base: Path | None
 def _mesh_resource(r: _Reader, m: Mapping[str, Any], where: str, base: Path | None) -> Any:
     """A robowflex mesh ``resource`` (a file) with ``dimensions`` as its scale."""
     from robokin.io.ros_packages import PackageFinder
-    from robokin.io.urdf import resolve_mesh
+    from robokin.io.urdf_geometry import resolve_mesh
 
     uri = r.text(m["resource"], f"{where}.resource")
     scale = [1.0, 1.0, 1.0]
