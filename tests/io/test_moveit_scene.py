@@ -147,3 +147,68 @@ def test_an_empty_scene_text_is_refused_and_a_scene_of_nothing_is_read():
     with pytest.raises(ModelError, match="an empty .scene file"):
         read_scene_text("")
     assert read_scene_text("empty\n.\n").objects == ()
+
+
+# ------------------------------------------------------------- round trips
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+from scipy.spatial.transform import Rotation  # noqa: E402
+
+ANGLES = st.sampled_from([0.0, math.pi / 2, -math.pi / 2, math.pi, 1e-9, 0.3, -2.1])
+SIZES = st.floats(0.001, 5.0)
+OBJECT = st.tuples(
+    st.sampled_from(["box", "cylinder", "sphere"]),
+    st.lists(SIZES, min_size=3, max_size=3),
+    st.lists(st.floats(-3, 3), min_size=3, max_size=3),
+    st.lists(ANGLES, min_size=3, max_size=3),
+    st.lists(st.floats(-1, 1), min_size=3, max_size=3),
+)
+DIMS = {"box": 3, "cylinder": 2, "sphere": 1}
+
+
+def _quat(rotvec):
+    return Rotation.from_rotvec(rotvec).as_quat()  # x y z w
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(OBJECT, min_size=1, max_size=4), st.booleans())
+def test_scene_text_round_trip(objects, yaml_form):
+    """Objects written as MoveIt would (17 digits) come back at the same poses.
+
+    Oracle: scipy's rotation of the same rotation vector; the object pose composed
+    with a shape pose by hand.
+    """
+    import yaml
+
+    lines, docs, expect = ["round trip"], [], []
+    for i, (kind, size, xyz, euler, local) in enumerate(objects):
+        dims = size[: DIMS[kind]]
+        q_obj = _quat(np.array(euler))
+        q_shape = _quat(np.array(local))
+        T_obj = pose(xyz, Rotation.from_quat(q_obj).as_matrix())
+        T_shape = pose([0.1 * i, 0.0, -0.2], Rotation.from_quat(q_shape).as_matrix())
+        expect.append((kind, tuple(dims), T_obj @ T_shape))
+        fmt = " ".join
+        lines += [f"* obj {i}", fmt(f"{v:.17g}" for v in xyz), fmt(f"{v:.17g}" for v in q_obj),
+                  "1", kind, fmt(f"{v:.17g}" for v in dims), f"{0.1 * i:.17g} 0 -0.2",
+                  fmt(f"{v:.17g}" for v in q_shape), "0 0 0 0", "0"]
+        msg_dims = dims if kind != "cylinder" else [dims[1], dims[0]]  # height, radius
+        docs.append({
+            "id": f"obj {i}", "header": {"frame_id": "world"},
+            "pose": {"position": dict(zip("xyz", map(float, xyz))),
+                     "orientation": dict(zip("xyzw", map(float, q_obj)))},
+            "primitives": [{"type": {"box": 1, "sphere": 2, "cylinder": 3}[kind],
+                            "dimensions": [float(v) for v in msg_dims]}],
+            "primitive_poses": [{"position": {"x": 0.1 * i, "y": 0.0, "z": -0.2},
+                                 "orientation": dict(zip("xyzw", map(float, q_shape)))}]})
+    if yaml_form:
+        doc = yaml.safe_load(yaml.safe_dump({"world": {"collision_objects": docs}}))
+        scene = planning_scene_from_document(doc)
+    else:
+        scene = read_scene_text("\n".join(lines + ["."]) + "\n")
+    assert [o.id for o in scene.objects] == [f"obj {i}" for i in range(len(objects))]
+    for obj, (kind, dims, T) in zip(scene.objects, expect):
+        (shape,) = obj.shapes
+        assert shape.kind == kind
+        np.testing.assert_allclose(shape.size, dims, rtol=1e-15)
+        np.testing.assert_allclose(shape.placement, T, atol=1e-12)
