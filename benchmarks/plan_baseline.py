@@ -28,6 +28,7 @@ import math
 import statistics
 import sys
 import time
+import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -183,8 +184,13 @@ class PinCoalChecker:
         # collide() missed 88 of 2100 colliding Panda states (penetrations up to
         # 2 cm, a cylinder against a cylinder) that it finds without the cache
         # (pin 4.1.0, coal 3.0.3; docs/benchmarks.md). Off: no miss, same speed.
-        for req in self.gdata.collisionRequests:
-            req.enable_cached_gjk_guess = False
+        import coal
+
+        with warnings.catch_warnings():  # the flag's setter is deprecated, not the flag
+            warnings.simplefilter("ignore", DeprecationWarning)
+            for req in self.gdata.collisionRequests:
+                req.enable_cached_gjk_guess = False
+                req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
         self.tip_frame = self.model.getFrameId(tip_link)
         self.calls = 0
 
