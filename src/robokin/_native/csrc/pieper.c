@@ -96,6 +96,9 @@ enum { PK_OK = 0, PK_OUT_OF_REACH = 1, PK_NO_ORIENTATION = 2, PK_DEGENERATE = 5,
 #define PK_COPLANAR 1e-13      /* |mutual moment| / scale below it: coplanar axes (rounding) */
 #define PK_EXACT 1e-13         /* pose errors below it need no Newton polish */
 #define PK_ACCEPT 4e-13        /* pose errors above it after the polish: not a solution */
+#define PK_NUDGE 1e-4         /* rows this far [rad] outside the limits: pk_inside tries */
+#define PK_FAMILY_SIGMA 1e-9  /* Jacobian's smallest / largest singular value below it: a family */
+#define PK_SP4_SLACK 1e-13     /* |C| - hypot(A, B) / scale below it: a double root (rounding) */
 
 /* ------------------------------------------------------------ geometry */
 
@@ -488,16 +491,21 @@ static double pk_theta_b(const PkEq *e, double ca, double sa, double cc, double 
     return tb;
 }
 
-/* A c + B s = C: up to two roots (Roots of six_r.c). A discriminant down to
- * -1e-13 (A^2 + B^2) is a double root (rounding); any positive one gives two roots,
+/* A c + B s = C: up to two roots (Roots of six_r.c). |C| above hypot(A, B) by
+ * at most `slack` (absolute, in the units of A, B, C: what rounding of the
+ * coefficients can make of a double root), or a discriminant down to -1e-13
+ * (A^2 + B^2), is a double root; any positive discriminant gives two roots,
  * however close: next to a double root a root's error is second order in the
  * pose, so two accurate close roots beat one merged root (which would be off by
  * the square root of their distance). */
-static Roots pk_sp4(double A, double B, double C)
+static Roots pk_sp4(double A, double B, double C, double slack)
 {
     double phi = fast_atan2(B, A), cphi, sphi;
     unit2(B, A, &cphi, &sphi);
-    return sp4_roots(A, B, C, A * A + B * B - C * C, 1e-13, 0, phi, cphi, sphi);
+    double disc = A * A + B * B - C * C;
+    if (disc < 0.0 && fabs(C) - hypot(A, B) <= slack)
+        disc = 0.0;
+    return sp4_roots(A, B, C, disc, 1e-13, 0, phi, cphi, sphi);
 }
 
 /* A solution (theta_a, theta_c given by angle, cosine and sine; theta_b solved) */
@@ -538,6 +546,9 @@ static int pk_coplanar(const PkEq *e, int swap, double pref_a, double pref_c, Pk
     double C = n[0] * e->r[0] + n[1] * e->r[1];
     Roots rx;
     int xfree = hypot(A, B) <= 1e-12 * L;
+#ifdef PK_DEBUG
+    fprintf(stderr, " coplanar swap %d n %.3e %.3e A %.6e B %.6e C %.6e disc %.3e xfree %d\n", swap, n[0], n[1], A, B, C, A*A+B*B-C*C, xfree);
+#endif
     if (xfree) { /* the point on axis x: theta_x free (or no solution) */
         if (fabs(C) > 1e-9 * L)
             return PK_OUT_OF_REACH;
@@ -548,7 +559,7 @@ static int pk_coplanar(const PkEq *e, int swap, double pref_a, double pref_c, Pk
         rx.c[0] = cos(tx);
         rx.s[0] = sin(tx);
     } else {
-        rx = pk_sp4(A, B, C);
+        rx = pk_sp4(A, B, C, PK_SP4_SLACK * L);
     }
     double m0 = -n[1], m1 = n[0];
     double Ay = -sx * (m0 * Y[0][0] + m1 * Y[1][0]);
@@ -568,8 +579,11 @@ static int pk_coplanar(const PkEq *e, int swap, double pref_a, double pref_c, Pk
             ry.c[0] = cos(ty);
             ry.s[0] = sin(ty);
         } else {
-            ry = pk_sp4(Ay, By, Cy);
+            ry = pk_sp4(Ay, By, Cy, PK_SP4_SLACK * L);
         }
+#ifdef PK_DEBUG
+        fprintf(stderr, "  y: Ay %.6e By %.6e Cy %.6e disc %.3e n %d\n", Ay, By, Cy, Ay*Ay+By*By-Cy*Cy, ry.n);
+#endif
         for (int j = 0; j < ry.n; j++) {
             int sing = xfree || rx.boundary || ry.boundary;
             if (swap)
@@ -965,8 +979,9 @@ static void pk_lstsq(double J[6][6], const double *e, double *dx)
 }
 
 /* Newton steps on the remaining chain's angles (least squares, pk_lstsq; kept only
- * while they reduce the error); returns the final error (pk_error) */
-static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
+ * while they reduce the error), the joints in `frozen` (bit j: angle j) held;
+ * returns the final error (pk_error) */
+static double pk_polish_held(const PkGeo *g, const m3 *RT, v3 pT, double *th, unsigned frozen)
 {
     m3 R;
     v3 p;
@@ -975,8 +990,14 @@ static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
     double err = pk_error(RT, pT, &R, p, g->scale, e);
     for (int it = 0; it < 6 && err > 1e-16; it++) {
         double dx[6], trial[6], big = 0.0;
+        for (int j = 0; j < 6; j++)
+            if (frozen >> j & 1u)
+                for (int r = 0; r < 6; r++)
+                    J[r][j] = 0.0;
         pk_lstsq(J, e, dx);
         for (int j = 0; j < 6; j++) {
+            if (frozen >> j & 1u)
+                dx[j] = 0.0;
             trial[j] = wrap_pi(th[j] + dx[j]);
             big = fmax(big, fabs(dx[j]));
         }
@@ -998,6 +1019,11 @@ static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
         }
     }
     return err;
+}
+
+static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
+{
+    return pk_polish_held(g, RT, pT, th, 0u);
 }
 
 /* ------------------------------------------------------------- one pose */
@@ -1131,6 +1157,221 @@ static double pk_coords(const double *P, const PkGeo *g, const double *th, int h
     return margin;
 }
 
+/* A row th (remaining chain, exact) just outside the limits, next to a singular
+ * configuration: the exact configurations around it form a thin set along the
+ * near-null directions, and the generating configuration may be one of them at
+ * a limit (a joint exactly at its limit reached only to rounding). Clamp the
+ * joints outside to the limit they passed, hold them there and Newton-polish the
+ * others (their least-squares step slides along the singular direction back to
+ * the pose); up to three rounds, as a polish may push another joint out. Kept
+ * when the pose holds to PK_ACCEPT and every joint is inside (1e-9 slack, as
+ * pk_coords): returns 1 when th changed. */
+static int pk_inside(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
+{
+    double trial[6];
+    unsigned frozen = 0u;
+    for (int j = 0; j < 6; j++)
+        trial[j] = th[j];
+    for (int round = 0; round < 3; round++) {
+        int moved = 0;
+        for (int j = 0; j < 6; j++) {
+            int f = g->full[j];
+            double sg = P[PK_SIGN + f], off = P[PK_OFFSET + f];
+            double lo = P[PK_LO + f], hi = P[PK_HI + f];
+            double q = wrap_pi(sg * (trial[j] - off)), best = q, gap = INFINITY;
+            for (int m = -1; m <= 1; m++) { /* the turn of q nearest [lo, hi] */
+                double qm = q + 2.0 * M_PI * m;
+                double d = qm < lo ? lo - qm : qm > hi ? qm - hi : 0.0;
+                if (d < gap) {
+                    gap = d;
+                    best = qm;
+                }
+            }
+            if (gap <= 0.0 || (frozen >> j & 1u))
+                continue;
+            if (gap > PK_NUDGE)
+                return 0; /* not a thin set's width away */
+            trial[j] = sg * (best < lo ? lo : hi) + off;
+            frozen |= 1u << j;
+            moved = 1;
+        }
+        if (!moved)
+            break;
+        double perr = pk_polish_held(g, RT, pT, trial, frozen);
+#ifdef PK_DEBUG
+        fprintf(stderr, "   inside round %d frozen %x err %.3e th %.12f %.12f %.12f %.12f %.12f %.12f\n", round, frozen, perr, trial[0], trial[1], trial[2], trial[3], trial[4], trial[5]);
+#endif
+        if (!(perr <= PK_ACCEPT))
+            return 0;
+    }
+    double q[PK_MAXJ];
+    if (!(pk_coords(P, g, trial, -1, 0.0, q) >= -1e-9))
+        return 0;
+    m3 R;
+    v3 p;
+    double e[6];
+    pk_fk(g, trial, &R, &p, NULL);
+    if (!(pk_error(RT, pT, &R, p, g->scale, e) <= PK_ACCEPT))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        th[j] = trial[j];
+    return 1;
+}
+
+/* The singular values (ascending) and right singular vectors (columns of V) of a
+ * 6 x 6 matrix A (destroyed): one-sided Jacobi (Hestenes), which keeps small
+ * singular values accurate relative to the columns (A^T A would square them into
+ * rounding). */
+static void pk_svd6(double A[6][6], double *sig, double V[6][6])
+{
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++)
+            V[i][j] = i == j ? 1.0 : 0.0;
+    for (int sweep = 0; sweep < 30; sweep++) {
+        int rotated = 0;
+        for (int p = 0; p < 5; p++)
+            for (int q = p + 1; q < 6; q++) {
+                double a = 0.0, b = 0.0, c = 0.0;
+                for (int r = 0; r < 6; r++) {
+                    a += A[r][p] * A[r][p];
+                    b += A[r][q] * A[r][q];
+                    c += A[r][p] * A[r][q];
+                }
+                if (!(fabs(c) > 1e-15 * sqrt(a * b)))
+                    continue;
+                rotated = 1;
+                double z = 0.5 * (b - a) / c;
+                double t = copysign(1.0, z) / (fabs(z) + sqrt(z * z + 1.0));
+                double cs = 1.0 / sqrt(t * t + 1.0), sn = t * cs;
+                for (int r = 0; r < 6; r++) {
+                    double x = A[r][p], y = A[r][q];
+                    A[r][p] = cs * x - sn * y;
+                    A[r][q] = sn * x + cs * y;
+                    x = V[r][p];
+                    y = V[r][q];
+                    V[r][p] = cs * x - sn * y;
+                    V[r][q] = sn * x + cs * y;
+                }
+            }
+        if (!rotated)
+            break;
+    }
+    double nrm[6];
+    int idx[6] = {0, 1, 2, 3, 4, 5};
+    for (int c = 0; c < 6; c++) {
+        double sum = 0.0;
+        for (int r = 0; r < 6; r++)
+            sum += A[r][c] * A[r][c];
+        nrm[c] = sqrt(sum);
+    }
+    for (int i = 1; i < 6; i++)
+        for (int j = i; j > 0 && nrm[idx[j]] < nrm[idx[j - 1]]; j--) {
+            int t = idx[j];
+            idx[j] = idx[j - 1];
+            idx[j - 1] = t;
+        }
+    double Vs[6][6];
+    for (int c = 0; c < 6; c++) {
+        sig[c] = nrm[idx[c]];
+        for (int r = 0; r < 6; r++)
+            Vs[r][c] = V[r][idx[c]];
+    }
+    for (int r = 0; r < 6; r++)
+        for (int c = 0; c < 6; c++)
+            V[r][c] = Vs[r][c];
+}
+
+/* How far joint coordinate q lies outside [lo, hi] at its nearest turn (0 inside),
+ * and that limit into *lim. */
+static double pk_outside(double q, double lo, double hi, double *lim)
+{
+    double gap = INFINITY;
+    *lim = lo;
+    for (int m = -1; m <= 1; m++) {
+        double qm = q + 2.0 * M_PI * m;
+        double d = qm < lo ? lo - qm : qm > hi ? qm - hi : 0.0;
+        if (d < gap) {
+            gap = d;
+            *lim = qm < lo ? lo - 2.0 * M_PI * m : hi - 2.0 * M_PI * m;
+        }
+    }
+    return gap;
+}
+
+/* A row th on a one-parameter family of exact solutions (a singular configuration
+ * whose remaining Jacobian has a null direction: smallest singular value below
+ * PK_FAMILY_SIGMA, the next one well above it) but outside the limits: slide along
+ * the family, steps of at most 0.05 rad along its null vector each followed by a
+ * Newton polish with the joint being brought in held, until that joint reaches
+ * its limit (then the next joint outside, if any). Kept when every joint ends
+ * inside and the pose holds to PK_ACCEPT: returns 1 when th changed. */
+static int pk_slide(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
+{
+    double trial[6];
+    for (int j = 0; j < 6; j++)
+        trial[j] = th[j];
+    int done = 0;
+    for (int it = 0; it < 96 && !done; it++) {
+        m3 R;
+        v3 p;
+        double J[6][6], sig[6], V[6][6];
+        pk_fk(g, trial, &R, &p, J);
+        pk_svd6(J, sig, V);
+#ifdef PK_DEBUG
+        fprintf(stderr, "   slide it %d sig %.3e %.3e %.3e v %.4f %.4f %.4f %.4f %.4f %.4f\n", it, sig[0], sig[1], sig[5], V[0][0], V[1][0], V[2][0], V[3][0], V[4][0], V[5][0]);
+#endif
+        if (!(sig[0] <= PK_FAMILY_SIGMA * sig[5]))
+            return 0; /* no one-parameter family here */
+        /* the joint farthest outside, and how the family moves it */
+        int worst = -1;
+        double wgap = 0.0, wlim = 0.0;
+        for (int j = 0; j < 6; j++) {
+            int f = g->full[j];
+            double lim, q = P[PK_SIGN + f] * (trial[j] - P[PK_OFFSET + f]);
+            double gap = pk_outside(wrap_pi(q), P[PK_LO + f], P[PK_HI + f], &lim);
+            if (gap > wgap) {
+                wgap = gap;
+                worst = j;
+                wlim = lim - wrap_pi(q) + q; /* the limit at q's turn */
+            }
+        }
+        if (worst < 0) {
+            done = 1;
+            break;
+        }
+        int f = g->full[worst];
+        double dq = P[PK_SIGN + f] * V[worst][0]; /* d q_worst / d alpha */
+        if (!(fabs(dq) > 1e-12))
+            return 0; /* the family does not move this joint */
+        double q = P[PK_SIGN + f] * (trial[worst] - P[PK_OFFSET + f]);
+        double alpha = (wlim - q) / dq, big = 0.0;
+        for (int j = 0; j < 6; j++)
+            big = fmax(big, fabs(V[j][0]));
+        double cap = 0.05 / big;
+        int last = fabs(alpha) <= cap;
+        if (!last)
+            alpha = copysign(cap, alpha);
+        for (int j = 0; j < 6; j++)
+            trial[j] += alpha * V[j][0];
+        if (last)
+            trial[worst] = P[PK_SIGN + f] * wlim + P[PK_OFFSET + f];
+        double perr = pk_polish_held(g, RT, pT, trial, last ? 1u << worst : 0u);
+#ifdef PK_DEBUG
+        fprintf(stderr, "   slide worst %d gap %.3e alpha %.3e err %.3e\n", worst, wgap, alpha, perr);
+#endif
+        if (!(perr <= PK_ACCEPT))
+            return 0;
+    }
+    if (!done)
+        return 0;
+    double q[PK_MAXJ];
+    if (!(pk_coords(P, g, trial, -1, 0.0, q) >= -1e-9))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        th[j] = wrap_pi(trial[j]);
+    return 1;
+}
+
 /* Roots psi of h . rot(u, sg psi) p = rhs (sg = +-1) appended to psi[*n] */
 static void pk_psi_roots(v3 h, v3 u, v3 p, double rhs, double sg, double *psi, int *n)
 {
@@ -1138,7 +1379,7 @@ static void pk_psi_roots(v3 h, v3 u, v3 p, double rhs, double sg, double *psi, i
     sp4_coeffs(h, u, p, &A, &B, &C);
     if (hypot(A, B) < 1e-12)
         return;
-    Roots r = pk_sp4(A, B, rhs - C);
+    Roots r = pk_sp4(A, B, rhs - C, 0.0);
     for (int i = 0; i < r.n; i++)
         psi[(*n)++] = wrap_pi(sg * r.t[i]);
 }
@@ -1389,6 +1630,10 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
             /* joints on one line only at a singular configuration: try there only */
             if (!all && (pos.sing[i] || tr.sing[k]) && pk_repair(P, &g, &RT, pT, th))
+                all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            if (!all && pk_inside(P, &g, &RT, pT, th))
+                all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            if (!all && pk_slide(P, &g, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
             o.valid[slot] = 1;
             o.inside[slot] = (unsigned char)all;
