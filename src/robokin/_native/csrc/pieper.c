@@ -1377,8 +1377,8 @@ static int pk_slide(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double
                 double a1 = (l - best) / d, a2 = (h - best) / d;
                 lo = fmax(lo, fmin(a1, a2));
                 hi = fmin(hi, fmax(a1, a2));
-            } else if (bd > 0.0) {
-                return 0; /* outside, and the family does not move it */
+            } else if (bd > 1e-10) {
+                return 0; /* outside (beyond the 1e-10 of "inside" below), the family does not move it */
             }
         }
         if (!(worst > 1e-10))
