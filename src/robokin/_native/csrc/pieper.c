@@ -1157,6 +1157,13 @@ static double pk_coords(const double *P, const PkGeo *g, const double *th, int h
     return margin;
 }
 
+/* Whether held value x (none: held < 0) lies inside its limits (1e-9 slack, as
+ * pk_coords): when it does not, no row can, and the repairs are not tried. */
+static int pk_held_inside(const double *P, int held, double x)
+{
+    return held < 0 || (x - P[PK_LO + held] >= -1e-9 && P[PK_HI + held] - x >= -1e-9);
+}
+
 /* A row th (remaining chain, exact) just outside the limits, next to a singular
  * configuration: the exact configurations around it form a thin set along the
  * near-null directions, and the generating configuration may be one of them at
@@ -1467,6 +1474,9 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
     if (code != PK_OK)
         return code;
     int any = 0;
+    unsigned lmask = 0u; /* rows outside, not flagged singular: slid only when none is inside */
+    int held_in = pk_held_inside(P, held, x); /* else no row can come inside */
+    double late[8][6];
     int jx = g.full[it], jz = g.full[it + 2];
     PkTri tri;
     pk_tri_init(&tri, g.h[it], g.h[it + 1], g.h[it + 2]);
@@ -1520,21 +1530,36 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
             int slot = 2 * pos.slot[i] + k;
             double *qs = o.Q + o.n * slot;
             int all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
-            if (!all && pk_resplit(P, &g, it, &RT, pT, th))
+            int sing = pos.sing[i] || tr.sing[k], fix = !all && held_in;
+            if (fix && pk_resplit(P, &g, it, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
             /* joints on one line only at a singular configuration: try there only */
-            if (!all && (pos.sing[i] || tr.sing[k]) && pk_repair(P, &g, &RT, pT, th))
+            if (fix && !all && sing && pk_repair(P, &g, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
-            if (!all && pk_inside(P, &g, &RT, pT, th))
+            if (fix && !all && pk_inside(P, &g, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
-            if (!all && pk_slide(P, &g, &RT, pT, th))
-                all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            /* a family to slide along: at rows the subproblems flag singular here,
+             * at the others below only when no row came inside */
+            if (fix && !all && sing) {
+                if (pk_slide(P, &g, &RT, pT, th))
+                    all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            } else if (fix && !all) {
+                for (int j = 0; j < 6; j++)
+                    late[slot][j] = th[j];
+                lmask |= 1u << slot;
+            }
             o.valid[slot] = 1;
             o.inside[slot] = (unsigned char)all;
-            o.sing[slot] = (unsigned char)(pos.sing[i] || tr.sing[k]);
+            o.sing[slot] = (unsigned char)sing;
             any = 1;
         }
     }
+    int inside = 0;
+    for (int slot = 0; slot < 8; slot++)
+        inside |= o.valid[slot] && o.inside[slot];
+    for (int slot = 0; slot < 8 && !inside; slot++)
+        if ((lmask >> slot & 1u) && pk_slide(P, &g, &RT, pT, late[slot]))
+            o.inside[slot] = pk_coords(P, &g, late[slot], held, x, o.Q + o.n * slot) >= -1e-9;
     return any ? PK_OK : PK_NO_ORIENTATION;
 }
 

@@ -325,12 +325,12 @@ static int ps_finish(const double *P, const PkGeo *g, const m3 *RT, v3 pT, const
     if (!(err <= PK_ACCEPT))
         return 0;
     double *qs = o.Q + o.n * slot;
-    int all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
-    if (!all && sing && pk_repair(P, g, RT, pT, th))
+    int all = pk_coords(P, g, th, held, x, qs) >= -1e-9, fix = pk_held_inside(P, held, x);
+    if (fix && !all && sing && pk_repair(P, g, RT, pT, th))
         all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
-    if (!all && pk_inside(P, g, RT, pT, th))
+    if (fix && !all && pk_inside(P, g, RT, pT, th))
         all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
-    if (!all && pk_slide(P, g, RT, pT, th))
+    if (fix && !all && pk_slide(P, g, RT, pT, th))
         all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
     o.valid[slot] = 1;
     o.inside[slot] = (unsigned char)all;
