@@ -18,6 +18,7 @@ PRELUDE = """
 import re, resource, sys
 import numpy, pydantic, yaml
 import robokin, robokin.cli, robokin.io.robot_files, robokin.io.motion_files
+import robokin.trajectory.motion_plan
 from robokin import collision
 robokin.load("ur5")
 robokin.cli._register_extra_commands()

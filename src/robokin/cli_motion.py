@@ -13,12 +13,8 @@ import typer
 
 from robokin.cli import DomainFailure, app, json_text
 from robokin.cli_output import FormatOption, resolve_format
-from robokin.io.motion_files import (
-    MAX_MOTION_SAMPLES,
-    load_motion_file,
-    motion_limits,
-    plan_from_document,
-)
+from robokin.io.motion_files import MAX_MOTION_SAMPLES, load_motion_file, motion_limits
+from robokin.trajectory.motion_plan import plan_from_document
 
 if TYPE_CHECKING:
     from robokin.robot import Robot

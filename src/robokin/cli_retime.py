@@ -67,12 +67,9 @@ def _load(file: Path, robot: str | None) -> tuple[Any, Any, dict[str, Any]]:
 
     suffix = file.suffix.lower()
     if suffix in (".yaml", ".yml"):
-        from robokin.io.motion_files import (
-            load_motion_file,
-            motion_limits,
-            plan_from_document,
-        )
+        from robokin.io.motion_files import load_motion_file, motion_limits
         from robokin.trajectory import PathError
+        from robokin.trajectory.motion_plan import plan_from_document
 
         if robot is not None:
             raise InputError("--robot", "a motion file names its own robot; --robot is "

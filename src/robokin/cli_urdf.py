@@ -65,12 +65,12 @@ def import_urdf(
     import yaml
 
     from robokin.io.robot_files import document_from_robot, save_robot
-    from robokin.io.urdf import robot_from_urdf
+    from robokin.io.urdf import parts_from_urdf
 
     pmap = _pairs(package, "--package")
     if out is not None:
         _not_the_input(out, file)
-    robot = robot_from_urdf(file, base_link=base, tip_link=tip, package_map=pmap,
+    robot = parts_from_urdf(file, base_link=base, tip_link=tip, package_map=pmap,
                             xacro_args=_pairs(arg, "--arg"), missing_mesh="ignore")
     info = robot.meta["urdf"]
     for note in robot.meta.get("urdf_dropped_notes", ()):
