@@ -84,7 +84,7 @@ def test_a_narrow_terminal_folds_cells_instead_of_cutting(capsys, monkeypatch):
 
 
 def test_a_folded_cell_keeps_every_character(capsys, monkeypatch):
-    from robokin.cli_output import Column, OutputTable, emit
+    from robokin.cli.output import Column, OutputTable, emit
 
     monkeypatch.setenv("COLUMNS", "12")
     monkeypatch.setenv("TTY_COMPATIBLE", "1")
@@ -122,9 +122,8 @@ def test_help_keeps_units_in_brackets():
     """rich ate '[mm]': help texts are shown as written, for every command."""
     from typer.testing import CliRunner
 
-    from robokin.cli import _register_extra_commands, app
+    from robokin.cli import app
 
-    _register_extra_commands()
     runner = CliRunner()
     res = runner.invoke(app, ["demo", "--help"], env={"COLUMNS": "200"})
     assert "Required clearance [mm]." in res.output
@@ -267,7 +266,8 @@ def test_press_views_labels_do_not_overlap(monkeypatch, tmp_path):
     pytest.importorskip("coal")
     import robokin.viz.plots as plots
     from robokin import collision
-    from robokin.demo import _plot_press_views, plan_press_loading
+    from robokin.cli.demo import plan_press_loading
+    from robokin.cli.demo_report import plot_press_views
 
     scene = collision.Scene.load(collision.scene_path("press"))
     robot = scene.attach(robokin.load("aubo_i5"))
@@ -275,7 +275,7 @@ def test_press_views_labels_do_not_overlap(monkeypatch, tmp_path):
     figures = []
     monkeypatch.setattr(plots, "save_figure",
                         lambda fig, path, **kw: figures.append(fig) or path)
-    _plot_press_views(traj, scene, None, tmp_path / "v.png")
+    plot_press_views(traj, scene, None, tmp_path / "v.png")
     fig = figures[0]
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
@@ -342,7 +342,7 @@ def test_a_name_with_a_control_character_is_refused(tmp_path):
 
 
 def test_the_one_console_replaces_no_emoji():
-    from robokin.cli_output import console
+    from robokin.cli.output import console
 
     con = console()
     with con.capture() as cap:

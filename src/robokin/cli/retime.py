@@ -27,9 +27,11 @@ from typing import Annotated, Any
 
 import typer
 
-from robokin.cli import DomainFailure, app, cell, json_text
+from robokin.cli.common import DomainFailure, cell, json_text
 
-__all__ = ["retime_command"]
+__all__ = ["commands", "retime_command"]
+
+commands = typer.Typer()
 
 MARKER = "cycle_time.json"  # a folder holding this was written by robokin retime
 _ARGS = {"v_max": "--v-max", "a_max": "--a-max", "j_max": "--j-max",
@@ -142,7 +144,7 @@ def _check_out(out: Path, force: bool) -> None:
 def _print(rep: Any, robot: Any, files: list[Path], sources: dict[str, str]) -> None:
     from rich.table import Table
 
-    from robokin.cli_output import console
+    from robokin.cli.output import console
 
     con = console()
     planned = rep.source_duration
@@ -170,7 +172,7 @@ def _print(rep: Any, robot: Any, files: list[Path], sources: dict[str, str]) -> 
     con.print("wrote " + ", ".join(str(f) for f in files), markup=False)
 
 
-@app.command("retime", context_settings={"ignore_unknown_options": True})
+@commands.command("retime", context_settings={"ignore_unknown_options": True})
 def retime_command(
     file: Annotated[Path, typer.Argument(
         help="Motion file (YAML) or trajectory CSV.", metavar="TRAJ")],

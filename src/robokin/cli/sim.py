@@ -16,9 +16,11 @@ from typing import Annotated, Any
 
 import typer
 
-from robokin.cli import DomainFailure, app, cell, json_text
+from robokin.cli.common import DomainFailure, cell, json_text
 
-__all__ = ["load_scene", "sim_command"]
+__all__ = ["commands", "load_scene", "sim_command"]
+
+commands = typer.Typer()
 
 
 def load_scene(name_or_path: str | Path) -> Any:
@@ -46,7 +48,7 @@ def _read_plan(path: Path, robot: Any, motors: bool) -> Any:
     return tr.replace(space="actuator")
 
 
-@app.command("sim", context_settings={"ignore_unknown_options": True})
+@commands.command("sim", context_settings={"ignore_unknown_options": True})
 def sim_command(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     trajectory: Annotated[Path, typer.Argument(
@@ -108,7 +110,7 @@ def sim_command(
 def _print_summary(robot: Any, summary: dict[str, Any], out: Path) -> None:
     from rich.table import Table
 
-    from robokin.cli_output import console
+    from robokin.cli.output import console
     from robokin.sim.report import speed_text
 
     con = console()
