@@ -316,7 +316,8 @@ class Robot(RobotParts):
         """
         q = check_finite(check_joints(q, self.n, "q"), "q")
         if self.actuators is None:
-            return q.copy()
+            result: np.ndarray = q.copy()
+            return result
         what = f"actuator map of '{self.name}'"
         phi = self.actuators.inverse(q, what=what)
         if self.actuators.n_in < self.actuators.n_out:
@@ -339,7 +340,8 @@ class Robot(RobotParts):
         m = self.n if self.actuators is None else self.actuators.n_in
         phi = check_finite(check_joints(phi, m, "phi"), "phi")
         if self.actuators is None:
-            return phi.copy()
+            result: np.ndarray = phi.copy()
+            return result
         return self.actuators.apply(phi)
 
     def within_actuator_limits(

@@ -49,6 +49,8 @@ from robokin._text import short_repr
 from robokin.exceptions import InputError, MissingExtraError, ModelError
 
 if TYPE_CHECKING:
+    from trimesh import Trimesh
+
     from robokin.model.chain import Chain
 
 
@@ -229,7 +231,7 @@ class Shape:
         return replace(self, owner=owner)
 
     # ------------------------------------------------------------------ meshes
-    def trimesh(self):
+    def trimesh(self) -> Trimesh:
         """The shape as a ``trimesh.Trimesh`` in its own frame (metres), cached.
 
         Raises:
@@ -239,12 +241,14 @@ class Shape:
         """
         cache = self._cache
         if "trimesh" in cache:
-            return cache["trimesh"]
+            cached: Trimesh = cache["trimesh"]
+            return cached
         try:
             import trimesh
         except ImportError:  # pragma: no cover - the extra is installed in CI
             raise MissingExtraError("trimesh", "collision") from None
         k = self.kind
+        m: Trimesh
         if k == "box":
             m = trimesh.creation.box(extents=self.size)
         elif k == "sphere":
@@ -270,7 +274,8 @@ class Shape:
         """An oriented bounding box in the shape's own frame: centre (3,), half sizes (3,)."""
         cache = self._cache
         if "box" in cache:
-            return cache["box"]
+            box: tuple[np.ndarray, np.ndarray] = cache["box"]
+            return box
         k, s = self.kind, self.size
         c = np.zeros(3)
         if k == "box":
@@ -282,7 +287,7 @@ class Shape:
         elif k == "capsule":
             h = np.array([s[0], s[0], s[1] / 2 + s[0]])
         else:
-            v = np.asarray(self.trimesh().vertices, dtype=float)
+            v = np.asarray(self.trimesh().vertices, dtype=np.float64)
             lo, hi = v.min(axis=0), v.max(axis=0)
             c, h = (lo + hi) / 2, (hi - lo) / 2
         cache["box"] = (c, h)
@@ -296,7 +301,8 @@ class Shape:
         """
         cache = self._cache
         if "spheres" in cache:
-            return cache["spheres"]
+            spheres: tuple[np.ndarray, np.ndarray] = cache["spheres"]
+            return spheres
         if self.kind == "capsule":
             r, L = self.size
             # k + 1 centres on the axis, ends included: a point within r of the
@@ -326,8 +332,8 @@ class Shape:
         return out
 
     # ------------------------------------------------------------------- coal
-    def coal_geometry(self):
-        """The coal collision geometry (cached; meshes as an OBBRSS BVH)."""
+    def coal_geometry(self) -> Any:
+        """The coal collision geometry (cached; meshes as an OBBRSS BVH; coal is untyped)."""
         cache = self._cache
         if "coal" in cache:
             return cache["coal"]
@@ -351,7 +357,7 @@ class Shape:
         cache["coal"] = g
         return g
 
-    def coal_convex(self):
+    def coal_convex(self) -> Any:
         """A convex coal geometry containing the shape (its hull), or the primitive itself."""
         cache = self._cache
         if "convex" in cache:
@@ -372,7 +378,8 @@ class Shape:
         return g
 
 
-def _coal():
+def _coal() -> Any:
+    """The coal module (untyped), or MissingExtraError naming ``robokin[collision]``."""
     try:
         import coal
     except ImportError:  # pragma: no cover - the extra is installed in CI
@@ -406,7 +413,7 @@ def mesh_file_problem(path: str | Path) -> str | None:
     return f"{path} is not a regular file: {kind}{via}"
 
 
-def _load_mesh(path: Path | None, scale: float, owner: str):
+def _load_mesh(path: Path | None, scale: float, owner: str) -> Trimesh:
     import trimesh
 
     where = f" (link '{owner}')" if owner else ""
