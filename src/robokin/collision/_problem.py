@@ -373,15 +373,18 @@ class _Problem:
         W = frame @ self.place[s]
         return self.coal.Transform3s(np.ascontiguousarray(W[:3, :3]), W[:3, 3].copy())
 
-    def exact(self, p: int, frames_i: np.ndarray, hull: bool = False) -> float:
-        """Exact (or convex-hull lower-bound) distance of pair p at one configuration."""
+    def _pair_transforms(self, p: int, frames_i: np.ndarray):
+        """The coal transforms of pair p's two shapes at one configuration."""
         a = self.pa[p]
         Ta = self._T3(frames_i[self.link[a]], a)
         if self.is_self[p]:
             b = self.pb[p]
-            Tb = self._T3(frames_i[self.link[b]], b)
-        else:
-            Tb = self.ob_T3[self.pb[p]]
+            return Ta, self._T3(frames_i[self.link[b]], b)
+        return Ta, self.ob_T3[self.pb[p]]
+
+    def exact(self, p: int, frames_i: np.ndarray, hull: bool = False) -> float:
+        """Exact (or convex-hull lower-bound) distance of pair p at one configuration."""
+        Ta, Tb = self._pair_transforms(p, frames_i)
         fn = self.fn_hull[p] if hull else self.fn_exact[p]
         res = self.res
         res.clear()  # coal keeps the minimum over calls otherwise
@@ -391,13 +394,7 @@ class _Problem:
         self, p: int, frames_i: np.ndarray
     ) -> tuple[float, np.ndarray, np.ndarray]:
         """Distance and nearest points (world) of pair p at one configuration."""
-        a = self.pa[p]
-        Ta = self._T3(frames_i[self.link[a]], a)
-        if self.is_self[p]:
-            b = self.pb[p]
-            Tb = self._T3(frames_i[self.link[b]], b)
-        else:
-            Tb = self.ob_T3[self.pb[p]]
+        Ta, Tb = self._pair_transforms(p, frames_i)
         res = self.coal.DistanceResult()
         ga, gb = self.geoms[p]
         d = self.coal.distance(ga, Ta, gb, Tb, self.req, res)
