@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -26,6 +26,9 @@ from robokin.cli.output import (
 )
 from robokin.exceptions import InputError
 from robokin.io.atomic import check_distinct
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["commands", "MAX_AXIS_VALUES", "MAX_CANDIDATES", "parse_axis", "place_command", "reach_command"]
 
@@ -308,7 +311,7 @@ def place_command(
                             f"{pl.reasons_text()}")
 
 
-def _task_poses(task: str, robot: Any, scene: Any, every: int) -> tuple[Any, bool]:
+def _task_poses(task: str, robot: Robot, scene: Any, every: int) -> tuple[Any, bool]:
     """Task poses (N, 4, 4) and whether they are a set (no order) rather than a motion."""
     import numpy as np
 

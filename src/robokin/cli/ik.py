@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -11,12 +11,15 @@ from robokin.cli.common import DomainFailure, json_text, load_robot
 from robokin.cli.output import Column, FormatOption, OutputTable, emit, resolve_format
 from robokin.exceptions import InputError
 
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
 __all__ = ["commands", "ik"]
 
 commands = typer.Typer()
 
 
-def _held_joints(robot: Any, items: list[str], A: float, L: float) -> dict[str, float]:
+def _held_joints(robot: Robot, items: list[str], A: float, L: float) -> dict[str, float]:
     """``--fixed NAME=VALUE`` options as ``{joint: value [rad, m]}``."""
     held: dict[str, float] = {}
     for item in items:
@@ -40,7 +43,7 @@ def _held_joints(robot: Any, items: list[str], A: float, L: float) -> dict[str, 
     return held
 
 
-def _continuum_note(robot: Any, sols: Any, held: dict[str, float]) -> str | None:
+def _continuum_note(robot: Robot, sols: Any, held: dict[str, float]) -> str | None:
     """The note for a redundant arm: the solutions listed are a sample of a continuum.
 
     None when the pose (and the held joints) leave finitely many solutions.

@@ -23,11 +23,14 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from robokin.cli.common import DomainFailure, cell, json_text
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["commands", "retime_command"]
 
@@ -97,7 +100,7 @@ def _load(file: Path, robot: str | None) -> tuple[Any, Any, dict[str, Any]]:
 
 
 def _choose_limits(options: dict[str, Any], own: dict[str, Any], file: Path,
-                   robot: Any) -> dict[str, str]:
+                   robot: Robot) -> dict[str, str]:
     """Fill ``options`` with the motion file's limits where no option gives one.
 
     Returns where each limit comes from, for the user: the option, the motion
@@ -141,7 +144,7 @@ def _check_out(out: Path, force: bool) -> None:
     out.mkdir(parents=True, exist_ok=True)
 
 
-def _print(rep: Any, robot: Any, files: list[Path], sources: dict[str, str]) -> None:
+def _print(rep: Any, robot: Robot, files: list[Path], sources: dict[str, str]) -> None:
     from rich.table import Table
 
     from robokin.cli.output import console

@@ -12,11 +12,14 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from robokin.cli.common import DomainFailure, cell, json_text
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["commands", "load_scene", "sim_command"]
 
@@ -33,7 +36,7 @@ def load_scene(name_or_path: str | Path) -> Any:
     return collision.Scene.load(path)
 
 
-def _read_plan(path: Path, robot: Any, motors: bool) -> Any:
+def _read_plan(path: Path, robot: Robot, motors: bool) -> Any:
     from robokin.exceptions import InputError
     from robokin.trajectory.io import read_csv
 
@@ -107,7 +110,7 @@ def sim_command(
                             + "; ".join(res.reasons))
 
 
-def _print_summary(robot: Any, summary: dict[str, Any], out: Path) -> None:
+def _print_summary(robot: Robot, summary: dict[str, Any], out: Path) -> None:
     from rich.table import Table
 
     from robokin.cli.output import console

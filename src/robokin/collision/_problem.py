@@ -458,13 +458,27 @@ class _Problem:
                     LB, done | hulled, C, np.ascontiguousarray(rows, dtype=np.int64)
                 )
 
-        # 1. Exact queries where they decide something: a sample whose bound does
-        #    not clear the threshold (to classify it), or lies below its pair's best
-        #    so far (to find the pair's minimum). Each round queries a strided
-        #    subset plus each pair's lowest bound, then spreads the new values to
-        #    the neighbours through the motion bounds; the stride halves per round.
-        #    Pair minima are settled to ``pair_tolerance``; a last pass settles
-        #    the global minimum exactly.
+        # 1. Exact queries where they decide something (see _settle).
+        self._settle(D, LB, done, evaluate, propagate, clearance, pair_tol, pair_rtol)
+        # 2. Subdivision: intervals whose ends do not clear the motion between.
+        self.subdivisions = 0
+        between = (self._subdivide(q, D, LB, Ms, done, evaluate, clearance, tol)
+                   if subdivide and m >= 2 else {})
+        return self._report(q, times, frames, D, between, clearance)
+
+    def _settle(self, D: np.ndarray, LB: np.ndarray, done: np.ndarray,
+                evaluate: Callable[..., None], propagate: Callable[[np.ndarray], None],
+                clearance: float, pair_tol: float, pair_rtol: float) -> None:
+        """Exact queries where they decide something, filling ``D`` and ``done``.
+
+        A sample whose bound does not clear the threshold is queried (to classify
+        it), or one whose bound lies below its pair's best so far (to find the
+        pair's minimum). Each round queries a strided subset plus each pair's
+        lowest bound, then spreads the new values to the neighbours through the
+        motion bounds; the stride halves per round. Pair minima are settled to
+        ``pair_tol``; a last pass settles the global minimum exactly.
+        """
+        P, m = D.shape
         cols = np.arange(m)
         stride = 0  # first round: only each pair's lowest bound
         final = False
@@ -503,11 +517,6 @@ class _Problem:
             propagate(rows)
             best[rows] = np.where(done[rows], D[rows], np.inf).min(axis=1)
             stride = max(m // 32, 1) if stride == 0 else max(stride // 4, 1)
-        # 2. Subdivision: intervals whose ends do not clear the motion between.
-        self.subdivisions = 0
-        between = (self._subdivide(q, D, LB, Ms, done, evaluate, clearance, tol)
-                   if subdivide and m >= 2 else {})
-        return self._report(q, times, frames, D, between, clearance)
 
     def _subdivide(self, q: np.ndarray, D: np.ndarray, LB: np.ndarray, Ms: np.ndarray,
                    done: np.ndarray, evaluate: Callable[..., None], clearance: float,
@@ -612,33 +621,13 @@ class _Problem:
                         bfrac[i0] = (frac, dv)
                 out.extend(collision_intervals(mask, bmask, bfrac, per_sample, ba, bb, t_at))
         pairs.sort(key=lambda r: r.distance)
-        closest = None
-        min_distance = math.inf
-        if best_overall is not None:
-            dmin, p, i, frac, btw_flag = best_overall
-            fr = (
-                frames[i]
-                if not btw_flag
-                else self.frames(q[i] + frac * (q[i + 1] - q[i]))
-            )
-            d, pa_, pb_ = self.nearest(p, fr)
-            min_distance = float(dmin)
-            closest = Closest(
-                float(dmin),
-                int(i),
-                t_at(i, frac),
-                self.body_a[p],
-                self.body_b[p],
-                pa_,
-                pb_,
-                btw_flag,
-            )
+        closest = (None if best_overall is None
+                   else self._closest(q, frames, best_overall, t_at))
+        min_distance = math.inf if closest is None else closest.distance
         intervals.sort(key=lambda r: (r.first_index, r.body_a, r.body_b))
         violations.sort(key=lambda r: (r.first_index, r.body_a, r.body_b))
-        collisions = [
-            Collision(r.first_index, r.last_index, r.body_a, r.body_b)
-            for r in intervals
-        ]
+        collisions = [Collision(r.first_index, r.last_index, r.body_a, r.body_b)
+                      for r in intervals]
         return CollisionReport(
             min_distance=min_distance,
             collides=bool(intervals),
@@ -654,6 +643,16 @@ class _Problem:
             _problem=self,
             _q=q,
         )
+
+    def _closest(self, q: np.ndarray, frames: np.ndarray,
+                 best: tuple[float, int, int, float, bool],
+                 t_at: Callable[..., float]) -> Closest:
+        """The nearest points at ``best``, the minimum (d, pair, sample, fraction, between)."""
+        dmin, p, i, frac, between = best
+        fr = self.frames(q[i] + frac * (q[i + 1] - q[i])) if between else frames[i]
+        _, point_a, point_b = self.nearest(p, fr)
+        return Closest(float(dmin), int(i), t_at(i, frac), self.body_a[p], self.body_b[p],
+                       point_a, point_b, between)
 
     def closest_at(
         self, q: np.ndarray, idx: np.ndarray

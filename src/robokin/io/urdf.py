@@ -49,7 +49,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from robokin._text import short_repr
-from robokin.exceptions import ModelError
+from robokin.exceptions import ModelError, user_stacklevel
 from robokin.io.ros_packages import PackageFinder
 from robokin.io.urdf_geometry import (
     Drops,
@@ -64,7 +64,7 @@ from robokin.io.urdf_tool import (
     link_owners,
     resolve_mimic,
 )
-from robokin.io.urdf_tree import Tree, UrdfChain
+from robokin.io.urdf_tree import Step, Tree, UrdfChain
 from robokin.io.urdf_xml import MAX_URDF_JOINTS, MOVABLE, parse_urdf
 from robokin.model.chain import Chain, ChainBuilder, Joint, JointKind
 from robokin.model.coupling import Dependency, coupling_from_dependencies, mimic
@@ -128,28 +128,14 @@ def _kind(j: Any) -> JointKind:
     return "prismatic" if j.type == "prismatic" else "revolute"
 
 
-def chain_from_urdf_model(
-    robot: Any,
-    *,
-    base_link: str | None = None,
-    tip_link: str | None = None,
-    file: Path | None = None,
-    tool_joints: Mapping[str, float] | None = None,
-) -> tuple[Chain, UrdfChain]:
-    """Compile the chain ``base_link`` -> ``tip_link`` of a parsed URDF model.
+def _path_steps(tree: Tree, base_link: str | None, tip_link: str | None,
+                file: Path | None) -> tuple[str, str, list[Step], int]:
+    """The base, the tip, the joints between them and the index of the last movable one.
 
-    Args:
-        robot: A ``yourdfpy.Robot`` (``yourdfpy.URDF(...).robot``).
-        base_link: Base link name (default: the root).
-        tip_link: Tip link name (default: see the module docstring).
-        file: The file, for error messages.
-        tool_joints: Positions of joints in the tool's tree (default: 0 clamped
-            into their limits); see :mod:`robokin.io.urdf_tool`.
-
-    Returns:
-        The canonical chain and the :class:`UrdfChain` bookkeeping.
+    Raises:
+        ModelError: an unknown link, base = tip, a floating or planar joint on the
+            path, or no movable joint (naming the file and field).
     """
-    tree = Tree(robot, file)
     base = tree.root if base_link is None else str(base_link)
     tree.check_link(base, "base")
     if tip_link is None:
@@ -172,7 +158,45 @@ def chain_from_urdf_model(
         raise ModelError(
             f"no movable joint between '{base}' and '{tip}'", file=file, field="tip_link"
         )
-    last = movable[-1]
+    return base, tip, steps, movable[-1]
+
+
+def _add_hanging_links(tree: Tree, frames: dict[str, tuple[int, np.ndarray]]) -> None:
+    """Add to ``frames`` the links hanging off the path by fixed joints (they move with it)."""
+    stack = list(frames)
+    while stack:
+        link = stack.pop()
+        kk, T = frames[link]
+        for j in tree.children[link]:
+            if j.child in frames or j.type != "fixed":
+                continue
+            frames[j.child] = (kk, T @ _origin(j))
+            stack.append(j.child)
+
+
+def chain_from_urdf_model(
+    urdf_robot: Any,
+    *,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    file: Path | None = None,
+    tool_joints: Mapping[str, float] | None = None,
+) -> tuple[Chain, UrdfChain]:
+    """Compile the chain ``base_link`` -> ``tip_link`` of a parsed URDF model.
+
+    Args:
+        urdf_robot: A ``yourdfpy.Robot`` (``yourdfpy.URDF(...).robot``).
+        base_link: Base link name (default: the root).
+        tip_link: Tip link name (default: see the module docstring).
+        file: The file, for error messages.
+        tool_joints: Positions of joints in the tool's tree (default: 0 clamped
+            into their limits); see :mod:`robokin.io.urdf_tool`.
+
+    Returns:
+        The canonical chain and the :class:`UrdfChain` bookkeeping.
+    """
+    tree = Tree(urdf_robot, file)
+    base, tip, steps, last = _path_steps(tree, base_link, tip_link, file)
     builder = ChainBuilder()
     tool = np.eye(4)
     coords: list[Joint] = []
@@ -231,23 +255,13 @@ def chain_from_urdf_model(
         coupling = coupling_from_dependencies(names, [c.name for c in coords], deps)
         coordinates = tuple(coords)
     chain = builder.build(tool=tool, coordinates=coordinates, coupling=coupling)
-    # Links hanging off the path by fixed joints move with it.
-    on_path = set(frames)
-    stack = list(on_path)
-    while stack:
-        link = stack.pop()
-        kk, T = frames[link]
-        for j in tree.children[link]:
-            if j.child in frames or j.type != "fixed":
-                continue
-            frames[j.child] = (kk, T @ _origin(j))
-            stack.append(j.child)
+    _add_hanging_links(tree, frames)
     # The tool's tree: subtrees below the last link's rigid body, joints frozen.
     positions, left_out = freeze_tool_tree(
         tree, frames, len(names), set(names) | coord_names, tool_joints, file)
     for msg in left_out:
         warnings.warn(f"{file or 'URDF'}: {msg} left out: they move with the arm",
-                      UserWarning, stacklevel=3)
+                      UserWarning, stacklevel=user_stacklevel())
     dropped = tuple(sorted(set(tree.links) - set(frames)))
     info = UrdfChain(
         base_link=base,
@@ -383,7 +397,7 @@ def parts_from_urdf(
 
     robot = robot.replace(dynamics=dynamics_from_urdf(robot, urdf_robot,
                                                       info.link_frames, file))
-    drops.report(stacklevel=2)
+    drops.report()
     return robot.replace(meta={**robot.meta,
                                "urdf_dropped_shapes": tuple(drops.messages),
                                "urdf_dropped_notes": drops.notes()})

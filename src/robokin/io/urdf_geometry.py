@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from robokin._text import short_repr
-from robokin.exceptions import ModelError
+from robokin.exceptions import ModelError, user_stacklevel
 from robokin.io.ros_packages import PackageFinder
 from robokin.model.geometry import MESH_SUFFIXES, mesh_file_problem
 from robokin.spatial import invert
@@ -119,12 +119,12 @@ class Drops:
                        f"{'s' if len(links) > 1 else ''} {shown}: {why}")
         return tuple(out)
 
-    def report(self, stacklevel: int) -> None:
-        """Warn once per reason (``"warn"`` mode)."""
+    def report(self) -> None:
+        """Warn once per reason (``"warn"`` mode), naming the caller outside robokin."""
         if self.mode == "warn":
             for note in self.notes():
                 warnings.warn(f"left out {note}; shapes skipped", UserWarning,
-                              stacklevel=stacklevel + 1)
+                              stacklevel=user_stacklevel())
 
 
 def geometry_of(

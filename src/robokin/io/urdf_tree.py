@@ -31,8 +31,8 @@ class Step:
 class Tree:
     """The link/joint tree of a parsed URDF with checks and path queries."""
 
-    def __init__(self, robot: Any, file: Path | None) -> None:
-        """Index the links and joints of ``robot`` (a ``yourdfpy.Robot``), checked.
+    def __init__(self, urdf_robot: Any, file: Path | None) -> None:
+        """Index the links and joints of ``urdf_robot`` (a ``yourdfpy.Robot``), checked.
 
         Raises:
             ModelError: a link or joint defined twice, an undefined parent or
@@ -41,14 +41,14 @@ class Tree:
         """
         self.file = file
         self.links: dict[str, Any] = {}
-        for link in robot.links:
+        for link in urdf_robot.links:
             if link.name in self.links:
                 raise ModelError(f"link '{link.name}' is defined twice", file=file)
             self.links[link.name] = link
         self.joints: dict[str, Any] = {}
         self.parent_joint: dict[str, Any] = {}
         self.children: dict[str, list[Any]] = {name: [] for name in self.links}
-        for j in robot.joints:
+        for j in urdf_robot.joints:
             where = f"joint[{j.name}]"
             if j.name in self.joints:
                 raise ModelError("joint defined twice", file=file, field=where)
