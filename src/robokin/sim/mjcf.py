@@ -59,6 +59,7 @@ from robokin.sim._mjcf_tuning import (
     _stable_step,
 )
 from robokin.sim.servo import servo_gains
+from robokin.spatial import invert
 
 if TYPE_CHECKING:
     from robokin.collision.scene import Scene
@@ -304,12 +305,12 @@ class _Writer:
     def _joint(self, body: ET.Element, name: str, kind: str, F: np.ndarray,
                axis_sign: float, row: F64, master: int | None,
                armature: float = 0.0) -> None:
-        R, t = F[:3, :3], F[:3, 3]
+        inv = invert(F)  # the joint's axis and origin in its body: F^-1 z, F^-1 origin
         attrs = {"name": name, "type": "hinge" if kind == "revolute" else "slide",
-                 "axis": _vec(axis_sign * R.T[:, 2])}
+                 "axis": _vec(axis_sign * inv[:3, 2])}
         if armature:
             attrs["armature"] = _fmt(armature)
-        pos = -R.T @ t
+        pos = inv[:3, 3]
         if kind == "revolute" and np.any(pos != 0.0):
             attrs["pos"] = _vec(pos)
         if master is not None:
