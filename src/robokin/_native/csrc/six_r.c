@@ -126,12 +126,17 @@ enum { SR_OK = 0, SR_OUT_OF_REACH = 1, SR_NO_ORIENTATION = 2, SR_BAD_POSE = 16 }
 #define SR_SPLIT_BAND 1e-4
 /* Joints are inside when within 1e-9 of their limits; the split search aims this
  * much further in, so the solution it picks passes that test after rounding. */
+/* The split search takes the elbow as solvable when its relative discriminant is
+ * above -SR_SPLIT_DISC: rounding (1.4e-15 seen at a tangency), not the kernel's
+ * 1e-12 tolerance (whose boundary root leaves up to 3e-12 m at a folded elbow). */
+#define SR_SPLIT_DISC 1e-14
 #define SR_LIMIT_SLACK 1e-9
 #define SR_LIMIT_AIM 1e-12
 #define SR_POLISH_ITERS 6
 /* A valid solution of a near-singular pose outside its limits by at most this much
- * [rad, m] gets a descent into them (sr_rescue). */
+ * [rad, m] gets a descent into them (sr_rescue), of at most SR_RESCUE_ITERS steps. */
 #define SR_RESCUE_REACH 1e-4
+#define SR_RESCUE_ITERS 40
 
 /* ------------------------------------------------------------------- vectors */
 
@@ -293,7 +298,6 @@ typedef struct {
     double ea, eb, ec, ephi, ecphi, esphi, wa, wb, wc, wphi, wcphi, wsphi, we5, aa, bb;
     double a1, a2, b1, b2, w41, w42, w4h, h12, rhs1, er2;
     int mirror, family;
-    double lm_opts[N_OPTS]; /* lm.c's options for sr_rescue */
 } SR;
 
 static void sr_read(const double *P, SR *K)
@@ -356,23 +360,6 @@ static void sr_read(const double *P, SR *K)
     K->er2 = K->ea * K->ea + K->eb * K->eb;
     K->a = v3_sub(K->o[2], K->o[1]);
     K->b = v3_sub(K->ow, K->o[2]);
-    double *op = K->lm_opts;
-    memset(op, 0, sizeof(K->lm_opts));
-    for (int r = 0; r < 6; r++)
-        op[O_W + r] = 1.0;
-    op[O_TOL_P] = 0.5 * K->tolp;
-    op[O_TOL_R] = 0.5 * K->tolr;
-    op[O_MAX_ITER] = 40;
-    op[O_USE_Q0] = 1.0;
-    op[O_MAX_STEP] = SR_RESCUE_REACH;
-    op[O_MU0] = 1e-2;
-    op[O_N_SEEDS] = 0;
-    op[O_PATH_MAX_JUMP] = INFINITY;
-    op[O_STALL_EVERY] = 3;
-    op[O_STALL_RATIO] = 0.3;
-    op[O_MU_DOWN] = 0.7;
-    op[O_MU_UP] = 16.0;
-    op[O_TABLE_ROT] = -1.0;
 }
 
 /* ------------------------------------------------------------ subproblems */
@@ -474,6 +461,25 @@ ALWAYS_INLINE vd wrist_split(const SR *K, vd sw, vd pref, vd *th6, vd *c6, vd *s
         *s6 = vsel(move, s, *s6);
     }
     return half;
+}
+
+/* Lanes where the preferred theta6 (pref, a chain angle) was not reached by the
+ * window (wrist_split's estimate, from a |y_perp| that rounding near another
+ * singularity can make 1e-12 too large) and is worth trying as it is: the solution
+ * there is kept when the chain confirms it within the split's budget. */
+ALWAYS_INLINE vl pref_untried(vd sw, vd pref, vd th6)
+{
+    return (sw < SR_SPLIT_BAND) & (pref == pref) & (vabs(vwrap_pi(pref - th6)) > 0.0);
+}
+
+/* theta5 at the wrist's double root (the singular value: phi5, or phi5 + pi) for
+ * the wrist direction x (lanes) and h = hw, with its cosine and sine. */
+ALWAYS_INLINE vd wrist_double_root(const SR *K, L3 x, v3 hw, vd *c5, vd *s5)
+{
+    vd rhs = l3_dotc(x, hw) - K->wc;
+    vd t = K->wphi + vsel(rhs < 0.0, BR(M_PI), BR(0.0));
+    vsincos(t, s5, c5);
+    return t;
 }
 
 /* theta3's subproblem 4 (the elbow) for its right-hand side */
@@ -650,61 +656,148 @@ static double split_maximum(const void *ctx, SplitEval ev, int nf, int i, double
     return best;
 }
 
-/* For each function i < nf: the point of [c - half, c + half] nearest c where
- * f_i >= 0, into x[i], found[i] = 1; found[i] = 0 where none was found (the
- * functions themselves bound any narrower window). A grid of SPLIT_GRID intervals;
- * every change of sign refined to its boundary; every grid point that is a local
- * maximum of a negative f_i searched for a narrow acceptable window (two
- * constraints nearly at odds). */
-static void split_nearest(const void *ctx, SplitEval ev, int nf, double c, double half,
-                          double *x, int *found)
+/* The search grid: SPLIT_GRID intervals over [c - half, c + half], c in the middle,
+ * and every function's values on it. */
+typedef struct {
+    const void *ctx;
+    SplitEval ev;
+    int nf, circle; /* circle: the window is the whole turn */
+    double c, h, g[SPLIT_GRID + 1], fv[SPLIT_GRID + 1][SPLIT_NF];
+} SplitGrid;
+
+static void split_grid(SplitGrid *G, const void *ctx, SplitEval ev, int nf, double c,
+                       double half)
 {
-    double g[SPLIT_GRID + 1], fv[SPLIT_GRID + 1][SPLIT_NF];
+    G->ctx = ctx;
+    G->ev = ev;
+    G->nf = nf;
+    G->c = c;
+    G->circle = half >= M_PI;
+    G->h = 2.0 * half / SPLIT_GRID;
     for (int k = 0; k <= SPLIT_GRID; k++)
-        g[k] = c - half + 2.0 * half * k / SPLIT_GRID;
-    g[SPLIT_GRID / 2] = c;
-    split_eval(ctx, ev, nf, g, SPLIT_GRID + 1, fv);
-    for (int i = 0; i < nf; i++) {
-        found[i] = 0;
-        x[i] = c;
-        if (fv[SPLIT_GRID / 2][i] >= 0.0) {
-            found[i] = 1;
-            continue;
+        G->g[k] = c - half + G->h * k;
+    G->g[SPLIT_GRID / 2] = c;
+    split_eval(ctx, ev, nf, G->g, SPLIT_GRID + 1, G->fv);
+}
+
+/* The point of the grid's window nearest c where f_i >= 0 into *x; 0 when none was
+ * found. Grid intervals are visited outward from c (stopping once nothing nearer
+ * than the best found can remain): every change of sign is refined to its
+ * boundary; every grid point that is a local maximum of a negative f_i is searched
+ * for a narrow acceptable window (two constraints nearly at odds). */
+static int split_find(const SplitGrid *G, int i, double *x)
+{
+    const int M = SPLIT_GRID / 2;
+    const double (*fv)[SPLIT_NF] = G->fv;
+    const double *g = G->g;
+    *x = G->c;
+    if (fv[M][i] >= 0.0)
+        return 1;
+    double best = INFINITY;
+    for (int j = 0; j < M && j * G->h < best; j++) {
+        /* the intervals [k, k + 1] at distance j h, and their outer grid points (the
+         * centre too, first) as local maxima */
+        int ks[2] = {M - 1 - j, M + j}, ms[3] = {M, M - 1 - j, M + j + 1};
+        double cand[6];
+        int nc = 0;
+        for (int side = 0; side < 2; side++) {
+            int k = ks[side];
+            if ((fv[k][i] >= 0.0) != (fv[k + 1][i] >= 0.0))
+                cand[nc++] = split_boundary(G->ctx, G->ev, G->nf, i, g[k], g[k + 1],
+                                            fv[k][i] >= 0.0);
         }
-        double best = INFINITY;
-        for (int k = 0; k < SPLIT_GRID; k++) {
-            int ok0 = fv[k][i] >= 0.0, ok1 = fv[k + 1][i] >= 0.0;
-            double cand[3];
-            int nc = 0;
-            if (ok0 != ok1) {
-                cand[nc++] = split_boundary(ctx, ev, nf, i, g[k], g[k + 1], ok0);
-            } else if (!ok0 && k > 0 && fv[k][i] >= fv[k - 1][i] && fv[k][i] >= fv[k + 1][i]) {
-                double fm, xm = split_maximum(ctx, ev, nf, i, g[k - 1], g[k + 1], &fm);
-                if (fm >= 0.0) {
-                    cand[nc++] = split_boundary(ctx, ev, nf, i, g[k - 1], xm, 0);
-                    cand[nc++] = split_boundary(ctx, ev, nf, i, xm, g[k + 1], 1);
-                }
+        for (int n = j ? 1 : 0; n < 3; n++) {
+            /* on the full circle the two ends are one point, between 63 and 1 */
+            int m = ms[n], wrap = G->circle && m == 0;
+            if (G->circle && m == SPLIT_GRID)
+                continue;
+            double fl = wrap ? fv[SPLIT_GRID - 1][i] : m > 0 ? fv[m - 1][i] : INFINITY;
+            double fr = m < SPLIT_GRID ? fv[m + 1][i] : INFINITY;
+            if (fv[m][i] >= 0.0 || fv[m][i] < fl || fv[m][i] < fr)
+                continue;
+            double a = wrap ? g[0] - G->h : g[m - 1], b = g[m + 1], fm;
+            double xm = split_maximum(G->ctx, G->ev, G->nf, i, a, b, &fm);
+            if (fm >= 0.0) {
+                cand[nc++] = split_boundary(G->ctx, G->ev, G->nf, i, a, xm, 0);
+                cand[nc++] = split_boundary(G->ctx, G->ev, G->nf, i, xm, b, 1);
             }
-            for (int m = 0; m < nc; m++) {
-                double d = fabs(cand[m] - c);
-                if (d < best) {
-                    best = d;
-                    x[i] = cand[m];
-                    found[i] = 1;
-                }
+        }
+        for (int n = 0; n < nc; n++) {
+            double d = fabs(remainder(cand[n] - G->c, 2.0 * M_PI));
+            if (d < best) {
+                best = d;
+                *x = cand[n];
             }
         }
     }
+    return best < INFINITY;
 }
 
 /* ------------------------------------------------------------------ polish */
 
+/* Damped Newton steps on the chain for the configurations q (joint coordinates,
+ * lanes) against the targets tt, in the lanes of `active` not yet within the
+ * kernel's tolerance (tolp, tolr): lm.c's task_space_step with the damping the
+ * squared error (so near a singular Jacobian a step stays small), a step kept only
+ * where it lowers the error. The pose (top 3x4) and Jacobian of the final q into
+ * t, J (row stride NMAX), its error into e; returns the lanes that moved. */
+ALWAYS_INLINE vl lanes_newton(const SR *K, const Chain *ch, vd *q, const vd *tt, vl active,
+                              vd *t, vd *J, vd *e)
+{
+    vd Jw[6][NMAX], dq[NMAX];
+    chain_pose_jac(ch, q, t, J, NMAX);
+    pose_residual(t, tt, e, BRL(-1));
+    vl moved = BRL(0);
+    for (int it = 0; it < SR_POLISH_ITERS; it++) {
+        vd ep = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+        vd er = e[3] * e[3] + e[4] * e[4] + e[5] * e[5];
+        vl todo = active & ~((ep <= K->tolp * K->tolp) & (er <= K->tolr * K->tolr)) &
+                  vfinite(ep + er);
+        if (!vany(todo))
+            break;
+        for (int r = 0; r < 6; r++)
+            for (int j = 0; j < 6; j++)
+                Jw[r][j] = J[r * NMAX + j];
+        vd cost = ep + er;
+        task_space_step(Jw, e, cost, 6, 6, dq);
+        vd qn[MAXJ], tn[12], Jn[6 * NMAX], en[6];
+        for (int j = 0; j < 6; j++)
+            qn[j] = q[j] + dq[j];
+        chain_pose_jac(ch, qn, tn, Jn, NMAX);
+        pose_residual(tn, tt, en, BRL(-1));
+        vd cn = en[0] * en[0] + en[1] * en[1] + en[2] * en[2] + en[3] * en[3] +
+                en[4] * en[4] + en[5] * en[5];
+        vl acc = todo & (cn < cost);
+        if (!vany(acc))
+            break;
+        moved |= acc;
+        for (int j = 0; j < 6; j++)
+            q[j] = vsel(acc, qn[j], q[j]);
+        for (int i = 0; i < 12; i++)
+            t[i] = vsel(acc, tn[i], t[i]);
+        for (int i = 0; i < 6 * NMAX; i++)
+            J[i] = vsel(acc, Jn[i], J[i]);
+        for (int r = 0; r < 6; r++)
+            e[r] = vsel(acc, en[r], e[r]);
+    }
+    return moved;
+}
+
+/* Lanes whose pose error e is within the guarantee (twice the kernel's tolerance) */
+ALWAYS_INLINE vl within_guarantee(const SR *K, const vd *e)
+{
+    vd ep = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+    vd er = e[3] * e[3] + e[4] * e[4] + e[5] * e[5];
+    return (ep <= 4.0 * K->tolp * K->tolp) & (er <= 4.0 * K->tolr * K->tolr);
+}
+
 /* Check the solutions of one pose in the slots of `mask` against the chain (their
  * pose error [m], [rad] against T, chain.h's FK and residual); polish those above
- * the tolerance by damped Newton steps (lm.c's task_space_step, damping the
- * squared error, a step kept only if it lowers the error); flag them singular
- * where the Jacobian's smallest singular value (chain.h's jac_sigma_min6, at the
- * final configuration) is below SR_SING_TOL. W slots at a time; rows rewritten. */
+ * the tolerance (lanes_newton); drop those still above the guarantee (the pose lies
+ * outside the workspace by more than that); flag the others singular where the
+ * Jacobian's smallest singular value (chain.h's jac_sigma_min6, at the final
+ * configuration, position rows per unit of the arm's size) is below SR_SING_TOL.
+ * W slots at a time; rows rewritten. */
 static void sr_check(const SR *K, const Chain *ch, const double *T, Slots o, unsigned mask)
 {
     int idx[8], m = 0;
@@ -715,43 +808,20 @@ static void sr_check(const SR *K, const Chain *ch, const double *T, Slots o, uns
     for (int i = 0; i < 12; i++)
         tt[i] = BR(T[i]);
     for (int b = 0; b < m; b += W) {
-        vd q[MAXJ], t[12], J[6 * NMAX], e[6], Jw[6][NMAX], dq[NMAX];
+        vd q[MAXJ], t[12], J[6 * NMAX], e[6];
         for (int j = 0; j < 6; j++)
             for (int l = 0; l < W; l++)
                 q[j][l] = o.Q[6 * idx[b + l < m ? b + l : b] + j];
-        chain_pose_jac(ch, q, t, J, NMAX);
-        pose_residual(t, tt, e, BRL(-1));
-        vl moved = BRL(0);
-        for (int it = 0; it < SR_POLISH_ITERS; it++) {
-            vd ep = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
-            vd er = e[3] * e[3] + e[4] * e[4] + e[5] * e[5];
-            vl todo = ~((ep <= K->tolp * K->tolp) & (er <= K->tolr * K->tolr)) &
-                      vfinite(ep + er);
-            if (!vany(todo))
-                break;
-            for (int r = 0; r < 6; r++)
+        vl moved = lanes_newton(K, ch, q, tt, BRL(-1), t, J, e);
+        vl off = ~within_guarantee(K, e);
+        for (int l = 0; l < W && b + l < m; l++)
+            if (off[l]) {
+                int k = idx[b + l];
+                o.valid[k] = o.sing[k] = o.inside[k] = 0;
                 for (int j = 0; j < 6; j++)
-                    Jw[r][j] = J[r * NMAX + j];
-            vd cost = ep + er;
-            task_space_step(Jw, e, cost, 6, 6, dq);
-            vd qn[MAXJ], tn[12], Jn[6 * NMAX], en[6];
-            for (int j = 0; j < 6; j++)
-                qn[j] = q[j] + dq[j];
-            chain_pose_jac(ch, qn, tn, Jn, NMAX);
-            pose_residual(tn, tt, en, BRL(-1));
-            vd cn = en[0] * en[0] + en[1] * en[1] + en[2] * en[2] + en[3] * en[3] +
-                    en[4] * en[4] + en[5] * en[5];
-            vl acc = todo & (cn < cost);
-            if (!vany(acc))
-                break;
-            moved |= acc;
-            for (int j = 0; j < 6; j++)
-                q[j] = vsel(acc, qn[j], q[j]);
-            for (int i = 0; i < 6 * NMAX; i++)
-                J[i] = vsel(acc, Jn[i], J[i]);
-            for (int r = 0; r < 6; r++)
-                e[r] = vsel(acc, en[r], e[r]);
-        }
+                    o.Q[6 * k + j] = NAN;
+            }
+        moved &= ~off;
         for (int i = 0; i < 3 * NMAX; i++) /* position rows per unit of the arm's size */
             J[i] *= 1.0 / K->size;
         vl sing = jac_sigma_min6(J, NMAX) < K->stol;
@@ -762,7 +832,7 @@ static void sr_check(const SR *K, const Chain *ch, const double *T, Slots o, uns
         for (int l = 0; l < W; l++) {
             dst[l].o = o;
             dst[l].slot = b + l < m && moved[l] ? idx[b + l] : -1;
-            if (b + l < m)
+            if (b + l < m && !off[l])
                 o.sing[idx[b + l]] = sing[l] != 0;
         }
         if (vany(moved))
@@ -770,33 +840,97 @@ static void sr_check(const SR *K, const Chain *ch, const double *T, Slots o, uns
     }
 }
 
+/* The lanes of `active` whose solution v (chain angles, updated) is within the
+ * split's budget on the chain after lanes_newton's steps (near another
+ * singularity rounding leaves the other joints 1e-12 off the configuration at
+ * the preferred split: a few steps move them) */
+static vl within_split(const SR *K, const Chain *ch, vd *v, const vd *tt, vl active)
+{
+    vd q[MAXJ], t[12], J[6 * NMAX], e[6];
+    for (int j = 0; j < 6; j++)
+        q[j] = K->sign[j] * (v[j] - K->off[j]);
+    lanes_newton(K, ch, q, tt, active, t, J, e);
+    for (int j = 0; j < 6; j++)
+        v[j] = K->sign[j] * q[j] + K->off[j];
+    vd ep = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+    vd er = e[3] * e[3] + e[4] * e[4] + e[5] * e[5];
+    return active & (ep <= 0.8 * 0.8 * K->tolp * K->tolp) &
+           (er <= K->split_tol * K->split_tol);
+}
+
 /* A valid solution of one pose just outside the limits, near a singularity (where
  * solutions are ill-conditioned: rounding moves them by more than the 1e-9 slack
  * of the limits, and configurations within it of each other reproduce the pose):
- * the numeric solver (lm.c: damped least squares with the joints kept inside their
- * limits, no restarts, steps of at most SR_RESCUE_REACH) from it, clamped into the
- * limits; its result replaces the row when it meets the pose tolerance. */
+ * damped Newton steps (as sr_check's: damping mu times the squared error, so they
+ * reach along the Jacobian's near-null directions; mu grows tenfold after a
+ * rejected step) from it clamped into the limits, every step clamped too and
+ * joints pressed outward at a limit held there (an active set); the result
+ * replaces the row when it meets the pose tolerance. One slot, in every lane. */
 static void sr_rescue(const SR *K, const Chain *ch, const double *T, Slots o, int slot)
 {
-    double far = 0.0, q0[MAXJ], out[6 + N_RES];
+    double far = 0.0;
+    vd q[MAXJ], t[12], J[6 * NMAX], e[6], tt[12], lo[6], hi[6];
     for (int j = 0; j < 6; j++) {
-        double q = o.Q[6 * slot + j];
-        q0[j] = q;
-        far = fmax(far, fmax(K->lo[j] - q, q - K->hi[j]));
+        double v = o.Q[6 * slot + j];
+        far = fmax(far, fmax(K->lo[j] - v, v - K->hi[j]));
+        lo[j] = BR(K->lo[j]);
+        hi[j] = BR(K->hi[j]);
+        q[j] = vmin(vmax(BR(v), lo[j]), hi[j]);
     }
     if (!(far <= SR_RESCUE_REACH))
         return;
-    Ctx cx;
-    lm_setup(&cx, ch, T, q0, q0, 1, 0, K->lm_opts, out, NULL, 0, NULL, NULL);
-    lm_worker(&cx);
-    /* kept when converged, or stalled within half the guarantee (tolp is a
-     * quarter of it): near a singularity the last digits may not come */
-    if (out[6 + R_CODE] != CODE_OK &&
-        !(out[6 + R_EP] <= 2.0 * K->tolp && out[6 + R_ER] <= 2.0 * K->tolr))
-        return;
+    for (int i = 0; i < 12; i++)
+        tt[i] = BR(T[i]);
+    chain_pose_jac(ch, q, t, J, NMAX);
+    pose_residual(t, tt, e, BRL(-1));
+    vd cost = BR(0.0);
+    for (int r = 0; r < 6; r++)
+        cost += e[r] * e[r];
+    double mu = 1.0;
+    for (int it = 0; it < SR_RESCUE_ITERS; it++) {
+        vd ep = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+        vd er = e[3] * e[3] + e[4] * e[4] + e[5] * e[5];
+        if ((ep <= K->tolp * K->tolp)[0] && (er <= K->tolr * K->tolr)[0])
+            break;
+        vd Jw[6][NMAX], dq[NMAX], qn[MAXJ], tn[12], Jn[6 * NMAX], en[6];
+        for (int j = 0; j < 6; j++) {
+            vd g = BR(0.0); /* the descent direction J^T e of joint j */
+            for (int r = 0; r < 6; r++)
+                g += J[r * NMAX + j] * e[r];
+            vl held = ((q[j] >= hi[j]) & (g > 0.0)) | ((q[j] <= lo[j]) & (g < 0.0));
+            for (int r = 0; r < 6; r++)
+                Jw[r][j] = vsel(held, BR(0.0), J[r * NMAX + j]);
+        }
+        task_space_step(Jw, e, mu * cost, 6, 6, dq);
+        for (int j = 0; j < 6; j++)
+            qn[j] = vmin(vmax(q[j] + dq[j], lo[j]), hi[j]);
+        chain_pose_jac(ch, qn, tn, Jn, NMAX);
+        pose_residual(tn, tt, en, BRL(-1));
+        vd cn = BR(0.0);
+        for (int r = 0; r < 6; r++)
+            cn += en[r] * en[r];
+        if (!(cn[0] < cost[0])) { /* rejected: more damping (Levenberg-Marquardt) */
+            mu *= 10.0;
+            if (mu > 1e8)
+                break;
+            continue;
+        }
+        mu = fmax(mu * 0.1, 1.0);
+        cost = cn;
+        for (int j = 0; j < 6; j++)
+            q[j] = qn[j];
+        for (int i = 0; i < 6 * NMAX; i++)
+            J[i] = Jn[i];
+        for (int r = 0; r < 6; r++)
+            e[r] = en[r];
+    }
+    vd ep = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+    vd er = e[3] * e[3] + e[4] * e[4] + e[5] * e[5];
+    if (!((ep <= 2.56 * K->tolp * K->tolp)[0] && (er <= 2.56 * K->tolr * K->tolr)[0]))
+        return; /* kept within 80 % of the guarantee (tolp is half of it) */
     vd v[6];
     for (int j = 0; j < 6; j++)
-        v[j] = BR(K->sign[j] * out[j] + K->off[j]);
+        v[j] = K->sign[j] * q[j] + K->off[j];
     Dest dst[W];
     for (int k = 0; k < W; k++) {
         dst[k].o = o;
@@ -806,6 +940,17 @@ static void sr_rescue(const SR *K, const Chain *ch, const double *T, Slots o, in
 }
 
 /* ------------------------------------------------------------- the target */
+
+/* The poses T[l] (4 x 4, row-major) as lanes: their top 3x4 into tt. */
+static void lanes_pose(const double *const *T, vd *tt)
+{
+    for (int i = 0; i < 12; i++) {
+        vd x = BR(0.0);
+        for (int l = 0; l < W; l++)
+            x[l] = T[l][i];
+        tt[i] = x;
+    }
+}
 
 /* Rows of R06 = R_T R_M^T and the position p of the poses T[l] (4 x 4, row-major). */
 static void lanes_target(const SR *K, const double *const *T, LM3 *R, L3 *p)
@@ -923,15 +1068,15 @@ static void tp_split_eval(const void *ctx, vd th6, vd *f)
     vsincos(th6, &s6, &c6);
     TPArm a;
     tp_arm(K, &s->c, c6, s6, &a);
-    /* the elbow's subproblem has a root within half its tolerance (the boundary
-     * root: at a tangency, the only one), two distinct ones past twice the
-     * double-root threshold */
+    /* the elbow's subproblem has a root within SR_SPLIT_DISC (the boundary root:
+     * at a tangency, the only one), two distinct ones past twice the double-root
+     * threshold */
     vd rel = a.disc * (1.0 / K->er2);
     vd fixed = vmin(limit_margin(K, 0, s->th1), limit_margin(K, 4, s->th5));
     fixed = vmin(fixed, limit_margin(K, 5, th6));
     vd win = window_margin(s->wc, s->wh, th6);
     for (int i3 = 0; i3 < 2; i3++) {
-        vd sv = i3 ? rel - 2e-3 * K->dtol : rel + 0.5 * K->dtol;
+        vd sv = i3 ? rel - 2e-3 * K->dtol : rel + SR_SPLIT_DISC;
         sv = vmin(sv, win);
         vd m = fixed;
         for (int j = 0; j < 3; j++)
@@ -963,14 +1108,18 @@ static void tp_split(const SR *K, const TPCtx *c, int l, vd th1v, vd th5v, doubl
     s.c.pl1 = BR(c->pl1[l]);
     s.c.pl2 = BR(c->pl2[l]);
     s.c.dh = BR(c->dh[l]);
-    double x[SPLIT_NF];
-    int found[SPLIT_NF];
-    split_nearest(&s, tp_split_eval, 4, th6,
-                  fmin(M_PI, half + fabs(remainder(th6 - wc, 2.0 * M_PI))), x, found);
+    /* per elbow branch: inside the limits, else only solvable */
+    SplitGrid G;
+    split_grid(&G, &s, tp_split_eval, 4, th6,
+               fmin(M_PI, half + fabs(remainder(th6 - wc, 2.0 * M_PI))));
+    int found[2];
     vd th6v = BR(th6);
-    for (int i3 = 0; i3 < 2; i3++)
-        if (found[i3] || found[2 + i3])
-            th6v[i3] = found[i3] ? x[i3] : x[2 + i3];
+    for (int i3 = 0; i3 < 2; i3++) {
+        double x;
+        found[i3] = split_find(&G, i3, &x) || split_find(&G, 2 + i3, &x);
+        if (found[i3])
+            th6v[i3] = x;
+    }
     vd c6, s6;
     vsincos(th6v, &s6, &c6);
     TPArm a;
@@ -985,7 +1134,7 @@ static void tp_split(const SR *K, const TPCtx *c, int l, vd th1v, vd th5v, doubl
         v[3][i3] = a.th[i3][2][i3];
         v[4][i3] = th5v[l];
         v[5][i3] = th6v[i3];
-        ok[i3] = (i3 ? a.r3.two[i3] : a.r3.one[i3]) && (found[i3] || found[2 + i3]) ? -1 : 0;
+        ok[i3] = (i3 ? a.r3.two[i3] : a.r3.one[i3]) && found[i3] ? -1 : 0;
         double sm = fmin(fmin(gap1, sw), a.r3.gap[i3]);
         sing[i3] = sm < K->stol ? -1 : 0;
     }
@@ -1009,12 +1158,15 @@ static void tp_split(const SR *K, const TPCtx *c, int l, vd th1v, vd th5v, doubl
  * the split at the wrist singularity, see the header), then tp_arm. Lane l's
  * outputs go to o[l] and need[l] (slots to check against the chain). Returns the
  * lanes' status via status[l]. */
-static void tp_block(const SR *K, const double *const *T, const double *q6n, Slots *o,
-                     int *status, unsigned char (*need)[8], int nl)
+static void tp_block(const SR *K, const Chain *ch, const double *const *T,
+                     const double *q6n, Slots *o, int *status, unsigned char (*need)[8],
+                     int nl)
 {
     LM3 R;
     L3 p, pw;
+    vd tt[12];
     lanes_target(K, T, &R, &p);
+    lanes_pose(T, tt);
     LRoots r1 = lanes_shoulder(K, &R, p, &pw);
     L3 g6 = lm3_mvc(&R, K->h[5]);
     vd pref = BR(0.0);
@@ -1058,26 +1210,53 @@ static void tp_block(const SR *K, const double *const *T, const double *q6n, Slo
             vd th5 = r5.t[i5], c6, s6;
             vd th6 = lsp1(K->h[5], y, l3_rotc(K->h[4], c.c5, -c.s5, K->h[1]), &c6, &s6);
             vd exact = th6, half = wrist_split(K, sw, pref, &th6, &c6, &s6);
-            TPArm a;
+            TPArm a, ap;
             tp_arm(K, &c, c6, s6, &a);
-            vl bad = ~a.r3.one;
+            /* the preferred theta6 with theta5 at its singular value (the double
+             * root: rounding near another singularity can leave it 1e-12 off) */
+            vl tryp = m5 & pref_untried(sw, pref, th6) & BRL(i5 == 0 ? -1 : 0);
+            vd th5s = BR(0.0);
+            if (vany(tryp)) {
+                TPCtx cs = c;
+                vd cp, sp;
+                th5s = wrist_double_root(K, x, K->h[1], &cs.c5, &cs.s5);
+                vsincos(pref, &sp, &cp);
+                tp_arm(K, &cs, cp, sp, &ap);
+            } else {
+                ap = a;
+            }
+            /* not acceptable: the elbow unsolvable, or solvable only within the
+             * kernel's tolerance (its boundary root leaves up to 3e-12 m at a folded
+             * elbow), or a joint outside its limits */
+            vl bad = BRL(0);
             for (int i3 = 0; i3 < 2; i3++) {
                 int slot = 4 * i1 + 2 * i3 + i5;
                 vd v[6] = {th1, a.th[i3][0], a.th[i3][1], a.th[i3][2], th5, th6};
                 vl ok = m5 & (i3 ? a.r3.two : a.r3.one);
                 vd gap = vmin(gap1, a.r3.gap);
+                vl shaky = ~a.r3.one | (a.disc < -SR_SPLIT_DISC * K->er2);
+                vl usep = tryp & (i3 ? ap.r3.two : ap.r3.one);
+                if (vany(usep)) { /* the preferred theta6 as it is, where the chain agrees */
+                    vd vp[6] = {th1, ap.th[i3][0], ap.th[i3][1], ap.th[i3][2], th5s, pref};
+                    usep = within_split(K, ch, vp, tt, usep);
+                    for (int j = 0; j < 6; j++)
+                        v[j] = vsel(usep, vp[j], v[j]);
+                    ok |= usep;
+                    shaky &= ~usep;
+                    gap = vsel(usep, vmin(gap1, ap.r3.gap), gap);
+                }
                 vl sing = gap < K->stol;
                 for (int l = 0; l < W; l++)
                     dst[l].slot = slot;
                 vl in = lanes_write(K, dst, v, ok, sing);
-                bad |= ok & ~in;
-                vl chk = ok & (check1 | ~a.r3.two | (a.r3.gap < SR_CHECK_BAND));
+                bad |= (i3 ? BRL(0) : shaky) | (ok & ~in);
+                vl chk = ok & (check1 | ~a.r3.two | (a.r3.gap < SR_CHECK_BAND) | usep);
                 for (int l = 0; l < W; l++)
                     if (chk[l])
                         need[l][slot] = 1;
+                any_ok |= ok;
             }
-            any_ok |= m5 & a.r3.one;
-            vl split = m5 & (free_ | (nearby & bad));
+            vl split = m5 & (free_ | nearby) & bad;
             if (vany(split))
                 for (int l = 0; l < nl; l++) {
                     if (!split[l])
@@ -1152,12 +1331,11 @@ static void sw_split(const SR *K, const SWCtx *c, int l, const vd *v0, double wc
     for (int j = 0; j < 5; j++)
         if (j != 3)
             s.fixed = vmin(s.fixed, limit_margin(K, j, BR(v0[j][l])));
-    double x;
-    int found;
-    double t6 = v0[5][l];
-    split_nearest(&s, sw_split_eval, 1, t6,
-                  fmin(M_PI, half + fabs(remainder(t6 - wc, 2.0 * M_PI))), &x, &found);
-    if (!found)
+    double x, t6 = v0[5][l];
+    SplitGrid G;
+    split_grid(&G, &s, sw_split_eval, 1, t6,
+               fmin(M_PI, half + fabs(remainder(t6 - wc, 2.0 * M_PI))));
+    if (!split_find(&G, 0, &x))
         return;
     vd th6 = BR(x), c6, s6;
     vsincos(th6, &s6, &c6);
@@ -1180,12 +1358,15 @@ static void sw_split(const SR *K, const SWCtx *c, int l, const vd *v0, double wc
  * theta1 (subproblem 4), theta3 (subproblem 3) and theta2 (subproblem 1); then
  * theta5 (subproblem 4), theta6 (subproblem 1; the split at the wrist singularity)
  * and theta4 (subproblem 1). As tp_block. */
-static void sw_block(const SR *K, const double *const *T, const double *q6n, Slots *o,
-                     int *status, unsigned char (*need)[8], int nl)
+static void sw_block(const SR *K, const Chain *ch, const double *const *T,
+                     const double *q6n, Slots *o, int *status, unsigned char (*need)[8],
+                     int nl)
 {
     LM3 R;
     L3 p, pw;
+    vd tt[12];
     lanes_target(K, T, &R, &p);
+    lanes_pose(T, tt);
     LRoots r1 = lanes_shoulder(K, &R, p, &pw);
     L3 g6 = lm3_mvc(&R, K->h[5]);
     vd pref = BR(0.0);
@@ -1242,13 +1423,24 @@ static void sw_block(const SR *K, const double *const *T, const double *q6n, Slo
                 vd th4 = sw_theta4(K, &c, c6, s6);
                 int slot = 4 * i1 + 2 * i3 + i5;
                 vd v[6] = {th1, th2, th3, th4, th5, th6};
+                vl usep = m5 & pref_untried(sw, pref, th6) & BRL(i5 == 0 ? -1 : 0);
+                if (vany(usep)) { /* the preferred theta6 as it is, theta5 at the double
+                                   * root, where the chain agrees */
+                    SWCtx cs = c;
+                    vd cp, sp, th5s = wrist_double_root(K, x, K->h[3], &cs.c5, &cs.s5);
+                    vsincos(pref, &sp, &cp);
+                    vd vp[6] = {th1, th2, th3, sw_theta4(K, &cs, cp, sp), th5s, pref};
+                    usep = within_split(K, ch, vp, tt, usep);
+                    for (int j = 0; j < 6; j++)
+                        v[j] = vsel(usep, vp[j], v[j]);
+                }
                 for (int l = 0; l < W; l++)
                     dst[l].slot = slot;
                 vl sing = gap < K->stol;
                 vl in = lanes_write(K, dst, v, m5, sing);
                 any_ok |= m5;
                 for (int l = 0; l < W; l++)
-                    if ((m5 & check)[l])
+                    if ((m5 & (check | usep))[l])
                         need[l][slot] = 1;
                 vl split = m5 & ~in & (free_ | nearby);
                 if (vany(split))
@@ -1287,9 +1479,9 @@ static void six_r_block(const SR *K, const Chain *ch, const double *const *T,
     memset(need, 0, sizeof(need));
     int st[W];
     if (K->family == SR_SPHERICAL_WRIST)
-        sw_block(K, T, q6n, own, st, need, nl);
+        sw_block(K, ch, T, q6n, own, st, need, nl);
     else
-        tp_block(K, T, q6n, own, st, need, nl);
+        tp_block(K, ch, T, q6n, own, st, need, nl);
     for (int l = 0; l < nl; l++) {
         status[l] = (signed char)st[l];
         if (ch == NULL || K->check < 0.0)

@@ -47,8 +47,9 @@ SINGULAR_TOL = 1e-6
 # The pose error [m] (times the arm's size when above 1 m) and [rad] every solution
 # meets (checked and polished in the kernel where the closed form may not).
 POSE_TOL = 1e-12
-# The wrist split's orientation budget [rad] (csrc/six_r.c, 'the wrist split').
-SPLIT_TOL = 1e-13
+# The wrist split's orientation budget [rad] (csrc/six_r.c, 'the wrist split'):
+# below the kernel's polish target (half of POSE_TOL), so a split is not undone.
+SPLIT_TOL = 0.4 * POSE_TOL
 
 
 def pack(chain: Any, kind: Kind, *, singular_tol: float = SINGULAR_TOL,
@@ -136,14 +137,14 @@ def pack(chain: Any, kind: Kind, *, singular_tol: float = SINGULAR_TOL,
         put(K.PLANE, [a @ e, a @ e2, b @ e, b @ e2, w4 @ e, w4 @ e2, w4 @ h[1]])
     P[K.SPLIT_TOL] = SPLIT_TOL
     # the pose error every solution meets: POSE_TOL times the arm's size L (at
-    # least 1 m) and POSE_TOL [rad]; the kernel aims at a quarter of it, so the
+    # least 1 m) and POSE_TOL [rad]; the kernel aims at half of it, so the
     # guarantee holds under any other rounding of the same measure (robot.fk and
     # spatial.pose_error)
     size = float(np.linalg.norm(o[1] - o[0]) + np.linalg.norm(o[2] - o[1])
                  + np.linalg.norm(ow - o[2]) + np.linalg.norm(poe.M[:3, 3] - ow))
     P[K.SIZE] = size
-    P[K.TOL_P] = 0.25 * POSE_TOL * max(1.0, size)
-    P[K.TOL_R] = 0.25 * POSE_TOL
+    P[K.TOL_P] = 0.5 * POSE_TOL * max(1.0, size)
+    P[K.TOL_R] = 0.5 * POSE_TOL
     P[K.CHECK] = -1.0 if mirror else (1.0 if check_all else 0.0)
     P.setflags(write=False)
     return P
