@@ -189,6 +189,15 @@ class Kernels(Protocol):
         target or q0 (-1 if none).
         """
 
+    def seed_uniforms(
+        self, targets: F64, q0: F64, key: int, base: int, out: F64, /
+    ) -> None:
+        """Restart numbers of targets (N, 4, 4) from q0 (N, n) into out (N, R, n).
+
+        Uniform in [0, 1), a stream per target keyed by its pose, its q0 and
+        ``key``; row r of out is the stream's number ``base + r``.
+        """
+
     def lm_path(
         self, packed: F64, targets: F64, q_start: F64, opts: F64, out: F64, /
     ) -> int:
