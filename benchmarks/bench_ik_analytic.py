@@ -67,9 +67,10 @@ def bench_robokin(robot, T_single, T_batch, loop_n: int) -> None:
     P = fam.solver.params()
     T1 = np.ascontiguousarray(T_single[None])
     robot.ik(T_single)
-    raw_solve(P, T1)
+    raw_solve(P, T1, packed=robot.chain.arrays.packed)
     s_api = _best(lambda: robot.ik(T_single), number=2000)
-    s_raw = _best(lambda: raw_solve(P, T1), number=2000)
+    packed = robot.chain.arrays.packed
+    s_raw = _best(lambda: raw_solve(P, T1, packed=packed), number=2000)
     robot.ik(T_batch[:1000])
     tb = _best(lambda: robot.ik(T_batch), repeat=3)
     sols = robot.ik(T_batch)
@@ -77,7 +78,7 @@ def bench_robokin(robot, T_single, T_batch, loop_n: int) -> None:
     err = float(np.max(np.where(sols.valid, np.maximum(dp, dr), 0.0)))
     n = sols.count[:loop_n].mean()  # the same poses as the peers' counts
     _row(f"robokin {robot.name} robot.ik", s_api * 1e6, len(T_batch) / tb, n, err)
-    tr = _best(lambda: raw_solve(P, np.ascontiguousarray(T_batch)), repeat=3)
+    tr = _best(lambda: raw_solve(P, np.ascontiguousarray(T_batch), packed=packed), repeat=3)
     _row(f"robokin {robot.name} kernel only", s_raw * 1e6, len(T_batch) / tr, n, err)
 
 

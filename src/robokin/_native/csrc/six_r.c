@@ -133,9 +133,13 @@ enum { SR_OK = 0, SR_OUT_OF_REACH = 1, SR_NO_ORIENTATION = 2, SR_BAD_POSE = 16 }
 #define SR_LIMIT_SLACK 1e-9
 #define SR_LIMIT_AIM 1e-12
 #define SR_POLISH_ITERS 6
-/* A valid solution of a near-singular pose outside its limits by at most this much
- * [rad, m] gets a descent into them (sr_rescue), of at most SR_RESCUE_ITERS steps. */
-#define SR_RESCUE_REACH 1e-4
+/* A valid solution outside its limits by at most this much [rad, m] gets a descent
+ * into them (sr_rescue), of at most SR_RESCUE_ITERS steps: flagged singular ones
+ * (whose solutions form a near-continuum: the split wanders with rounding) up to
+ * SR_RESCUE_REACH, the others (isolated: a descent from further out may land on
+ * another solution) up to SR_RESCUE_NEAR. */
+#define SR_RESCUE_REACH 1e-2
+#define SR_RESCUE_NEAR 1e-4
 #define SR_RESCUE_ITERS 40
 
 /* ------------------------------------------------------------------- vectors */
@@ -534,15 +538,22 @@ typedef struct {
     unsigned char *valid, *sing, *inside;
 } Slots;
 
-/* All slots empty: NaN (rows that are not solutions), invalid, not singular, not
- * within limits. */
+/* All slots empty: invalid, not singular, not within limits (their rows are
+ * filled with NaN at the end, slots_finish: written once). */
 static void slots_clear(Slots o)
 {
-    for (int k = 0; k < 8; k++) {
-        o.valid[k] = o.sing[k] = o.inside[k] = 0;
-        for (int j = 0; j < 6; j++)
-            o.Q[6 * k + j] = NAN;
-    }
+    memset(o.valid, 0, 8);
+    memset(o.sing, 0, 8);
+    memset(o.inside, 0, 8);
+}
+
+/* NaN in the rows of the slots that hold no solution (rows that are not solutions) */
+static void slots_finish(Slots o)
+{
+    for (int k = 0; k < 8; k++)
+        if (!o.valid[k])
+            for (int j = 0; j < 6; j++)
+                o.Q[6 * k + j] = NAN;
 }
 
 /* Where lane l's solution goes: its pose's outputs and slot (slot < 0: nowhere). */
@@ -713,7 +724,9 @@ static int split_find(const SplitGrid *G, int i, double *x)
                 continue;
             double fl = wrap ? fv[SPLIT_GRID - 1][i] : m > 0 ? fv[m - 1][i] : INFINITY;
             double fr = m < SPLIT_GRID ? fv[m + 1][i] : INFINITY;
-            if (fv[m][i] >= 0.0 || fv[m][i] < fl || fv[m][i] < fr)
+            /* a plateau (no solution there: f held at its floor) is no maximum */
+            if (fv[m][i] >= 0.0 || fv[m][i] < fl || fv[m][i] < fr ||
+                (fv[m][i] == fl && fv[m][i] == fr))
                 continue;
             double a = wrap ? g[0] - G->h : g[m - 1], b = g[m + 1], fm;
             double xm = split_maximum(G->ctx, G->ev, G->nf, i, a, b, &fm);
@@ -866,6 +879,29 @@ static vl within_split(const SR *K, const Chain *ch, vd *v, const vd *tt, vl act
  * rejected step) from it clamped into the limits, every step clamped too and
  * joints pressed outward at a limit held there (an active set); the result
  * replaces the row when it meets the pose tolerance. One slot, in every lane. */
+/* Whether the rescued solution v (chain angles, lane 0) is another valid slot's
+ * inside the limits (every joint within SR_SAME of it, angles modulo 2 pi): then
+ * the slot keeps its own solution, outside the limits, rather than repeat one */
+#define SR_SAME 1e-7
+static int rescue_lands_on_another(const SR *K, Slots o, int slot, const vd *v)
+{
+    double q[6];
+    for (int j = 0; j < 6; j++) {
+        vl in;
+        q[j] = ljoint(K, j, v[j], &in)[0];
+    }
+    for (int k = 0; k < 8; k++) {
+        if (k == slot || !o.valid[k] || !o.inside[k])
+            continue;
+        int same = 1;
+        for (int j = 0; j < 6 && same; j++)
+            same = fabs(remainder(q[j] - o.Q[6 * k + j], 2.0 * M_PI)) <= SR_SAME;
+        if (same)
+            return 1;
+    }
+    return 0;
+}
+
 static void sr_rescue(const SR *K, const Chain *ch, const double *T, Slots o, int slot)
 {
     double far = 0.0;
@@ -877,7 +913,7 @@ static void sr_rescue(const SR *K, const Chain *ch, const double *T, Slots o, in
         hi[j] = BR(K->hi[j]);
         q[j] = vmin(vmax(BR(v), lo[j]), hi[j]);
     }
-    if (!(far <= SR_RESCUE_REACH))
+    if (!(far <= (o.sing[slot] ? SR_RESCUE_REACH : SR_RESCUE_NEAR)))
         return;
     for (int i = 0; i < 12; i++)
         tt[i] = BR(T[i]);
@@ -931,6 +967,8 @@ static void sr_rescue(const SR *K, const Chain *ch, const double *T, Slots o, in
     vd v[6];
     for (int j = 0; j < 6; j++)
         v[j] = K->sign[j] * q[j] + K->off[j];
+    if (rescue_lands_on_another(K, o, slot, v))
+        return;
     Dest dst[W];
     for (int k = 0; k < W; k++) {
         dst[k].o = o;
@@ -1081,7 +1119,10 @@ static void tp_split_eval(const void *ctx, vd th6, vd *f)
         vd m = fixed;
         for (int j = 0; j < 3; j++)
             m = vmin(m, limit_margin(K, j + 1, a.th[i3][j]));
-        f[i3] = vsel(sv >= 0.0, vmin(m, sv), sv);
+        /* inside the limits where solvable, far below zero where not (so that a
+         * narrow acceptable window, a joint at an extremum at its limit, is a local
+         * maximum of f, not hidden by the solvability boundary next to it) */
+        f[i3] = vsel(sv >= 0.0, vmin(m, win), BR(-10.0));
         f[2 + i3] = sv;
     }
 }
@@ -1108,17 +1149,27 @@ static void tp_split(const SR *K, const TPCtx *c, int l, vd th1v, vd th5v, doubl
     s.c.pl1 = BR(c->pl1[l]);
     s.c.pl2 = BR(c->pl2[l]);
     s.c.dh = BR(c->dh[l]);
-    /* per elbow branch: inside the limits, else only solvable */
-    SplitGrid G;
-    split_grid(&G, &s, tp_split_eval, 4, th6,
-               fmin(M_PI, half + fabs(remainder(th6 - wc, 2.0 * M_PI))));
-    int found[2];
+    /* per elbow branch: inside the limits, else only solvable; where neither is
+     * found, a window 16 times wider (up to the whole turn): rounding near another
+     * singularity (a shoulder near its double root) can move the exact theta6 by
+     * more than the window, and sr_check then holds the result to the guarantee */
+    int found[2] = {0, 0};
     vd th6v = BR(th6);
-    for (int i3 = 0; i3 < 2; i3++) {
-        double x;
-        found[i3] = split_find(&G, i3, &x) || split_find(&G, 2 + i3, &x);
-        if (found[i3])
-            th6v[i3] = x;
+    for (;;) {
+        SplitGrid G;
+        split_grid(&G, &s, tp_split_eval, 4, th6,
+                   fmin(M_PI, half + fabs(remainder(th6 - wc, 2.0 * M_PI))));
+        for (int i3 = 0; i3 < 2; i3++) {
+            double x;
+            if (!found[i3] && (split_find(&G, i3, &x) || split_find(&G, 2 + i3, &x))) {
+                found[i3] = 1;
+                th6v[i3] = x;
+            }
+        }
+        if ((found[0] && found[1]) || half >= M_PI)
+            break;
+        half = fmin(M_PI, 16.0 * half);
+        s.wh = half;
     }
     vd c6, s6;
     vsincos(th6v, &s6, &c6);
@@ -1495,6 +1546,8 @@ static void six_r_block(const SR *K, const Chain *ch, const double *const *T,
             if (need[l][k] && own[l].valid[k] && !own[l].inside[k])
                 sr_rescue(K, ch, T[l], own[l], k);
     }
+    for (int l = 0; l < nl; l++)
+        slots_finish(own[l]);
 }
 
 /* --------------------------------------------------------------- entries */

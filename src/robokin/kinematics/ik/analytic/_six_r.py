@@ -14,6 +14,7 @@ from typing import Any, Literal
 import numpy as np
 
 from robokin._native import kernels as K
+from robokin._native import single as single_copy
 from robokin.kinematics.ik.analytic._common import (
     STATUS_TEXT,
     branch_labels,
@@ -53,7 +54,7 @@ SPLIT_TOL = 0.4 * POSE_TOL
 
 
 def pack(chain: Any, kind: Kind, *, singular_tol: float = SINGULAR_TOL,
-         disc_tol: float = 1e-12, mirror: bool = False, check_all: bool = False,
+         disc_tol: float = 1e-10, mirror: bool = False, check_all: bool = False,
          poe: Poe | None = None) -> np.ndarray:
     """The kernel parameter vector of a 6R chain (layout in ``csrc/six_r.c``).
 
@@ -181,7 +182,9 @@ def make_single(chain: Any, params: np.ndarray, *, method: str,
     Every call returns freshly allocated arrays; only the read-only joint kinds,
     limits and branch labels are shared between results.
     """
-    solve1 = K.six_r_ik1
+    # the copy for one pose (AVX2 on an AVX-512 CPU: 4 lanes cost less than 8 for
+    # a lone pose; both copies give the same bits, tested)
+    solve1 = single_copy.six_r_ik1
     packed = chain.arrays.packed
     is_rev = np.array(chain.is_revolute, dtype=bool)
     is_rev.setflags(write=False)
