@@ -82,6 +82,36 @@ def bench_robokin(robot, T_single, T_batch, loop_n: int) -> None:
     _row(f"robokin {robot.name} kernel only", s_raw * 1e6, len(T_batch) / tr, n, err)
 
 
+def cpu_rate(robot, T_batch) -> None:
+    """Batch throughput by wall clock and by the process's CPU time, 1 and 2 threads.
+
+    On a shared machine the wall-clock rate measures the load as much as the code;
+    poses per CPU-second (best of 5) is what one core delivers while it runs, and
+    twice that is what two free cores would. The load average is printed with it.
+    """
+    import os
+
+    import robokin._native as native
+
+    before = native.num_threads()
+    try:
+        for k in (1, 2):
+            native.set_num_threads(k)
+            robot.ik(T_batch[:1000])
+            wall = cpu = np.inf
+            for _ in range(5):
+                w0, c0 = time.perf_counter(), time.process_time()
+                robot.ik(T_batch)
+                wall = min(wall, time.perf_counter() - w0)
+                cpu = min(cpu, time.process_time() - c0)
+            n = len(T_batch)
+            print(f"  {robot.name} robot.ik, {k} thread(s): {n / wall / 1e6:.3f} M poses/s "
+                  f"wall, {n / cpu / 1e6:.3f} M poses per CPU-second "
+                  f"(load average {os.getloadavg()[0]:.1f})")
+    finally:
+        native.set_num_threads(before)
+
+
 def bench_eaik(robot, T_single, T_batch, loop_n: int) -> float:
     try:
         from eaik.IK_DH import DhRobot
@@ -207,6 +237,7 @@ def main(batch: int = 100_000, loop_n: int = 10_000) -> None:
         q = rng.uniform(-np.pi, np.pi, (batch, 6))
         T = robot.fk(q)
         bench_robokin(robot, T[0], T, loop_n)
+        cpu_rate(robot, T)
         eaik_rate = bench_eaik(robot, T[0], T, loop_n)
         if name == "ur5":
             bench_ur_analytic(robot, T[0], T[:loop_n])
