@@ -1153,7 +1153,8 @@ static void tp_split(const SR *K, const TPCtx *c, int l, vd th1v, vd th5v, doubl
      * found, a window 16 times wider (up to the whole turn): rounding near another
      * singularity (a shoulder near its double root) can move the exact theta6 by
      * more than the window, and sr_check then holds the result to the guarantee */
-    int found[2] = {0, 0};
+    int found[2] = {0, 0}, inside[2] = {0, 0};
+    double step[2] = {0.0, 0.0};
     vd th6v = BR(th6);
     for (;;) {
         SplitGrid G;
@@ -1161,15 +1162,31 @@ static void tp_split(const SR *K, const TPCtx *c, int l, vd th1v, vd th5v, doubl
                    fmin(M_PI, half + fabs(remainder(th6 - wc, 2.0 * M_PI))));
         for (int i3 = 0; i3 < 2; i3++) {
             double x;
-            if (!found[i3] && (split_find(&G, i3, &x) || split_find(&G, 2 + i3, &x))) {
+            if (found[i3])
+                continue;
+            inside[i3] = split_find(&G, i3, &x);
+            if (inside[i3] || split_find(&G, 2 + i3, &x)) {
                 found[i3] = 1;
                 th6v[i3] = x;
+                step[i3] = G.h;
             }
         }
         if ((found[0] && found[1]) || half >= M_PI)
             break;
         half = fmin(M_PI, 16.0 * half);
         s.wh = half;
+    }
+    /* only solvable: the solvable window may be narrower than the grid's step (an
+     * elbow near full stretch), and an in-limit split inside it narrower still (a
+     * joint at its limit): a grid of its own over a step either side */
+    for (int i3 = 0; i3 < 2; i3++) {
+        double x;
+        if (!found[i3] || inside[i3])
+            continue;
+        SplitGrid G;
+        split_grid(&G, &s, tp_split_eval, 4, th6v[i3], step[i3]);
+        if (split_find(&G, i3, &x))
+            th6v[i3] = x;
     }
     vd c6, s6;
     vsincos(th6v, &s6, &c6);

@@ -141,6 +141,20 @@ def test_puma_wrist_split_inside_the_limits(name):
     check_against_oracle(robot, q, T, sols)
 
 
+def test_in_limit_split_narrower_than_the_solvable_window():
+    # AUBO-i5, q5 = 0 and q2 exactly at its limit: the elbow is solvable for q6 in a
+    # window 0.02 rad wide (near full stretch), and inside it q2 stays within its limit
+    # only for q6 within about 1e-5 of the generating value. The split search found
+    # only the solvable window (q2 0.005 rad outside); oracle: FK and the limits.
+    robot = robokin.load("aubo_i5")
+    q = np.array([-1e-9, robot.limits[1, 1], -7.1244128998069201e-03, 1e-7, 0.0,
+                  -5.5681006068983940e-01])
+    T = robot.fk(q)
+    sols = robot.ik(T)
+    check_against_oracle(robot, q, T, sols)
+    assert (sols.valid & sols.within_limits & sols.singular).any()
+
+
 def test_puma_split_nearest_the_preferred_q6():
     # q4 = 150 deg, q6 = 60 deg at q5 = 0: q4 + q6 = 210 deg, so keeping q6 = 0 would
     # need q4 = 210 deg (outside [-110, 170]); the splits inside the limits nearest
