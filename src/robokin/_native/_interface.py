@@ -121,6 +121,7 @@ class Kernels(Protocol):
     # general6r_solve: solutions per pose, parameter-vector layout (GP_*: header
     # fields; VB_*: one variant block of VB_SIZE values), status and flag codes
     G6_MAXSOL: int
+    G6_MAXCAND: int
     GP_NVAR: int
     GP_TAIL_TOL: int
     GP_NULL_TOL: int
@@ -129,6 +130,9 @@ class Kernels(Protocol):
     GP_DEDUPE: int
     GP_MAX_ITER: int
     GP_PAIR_GAP: int
+    GP_SCALE: int
+    GP_FALLBACK: int
+    GP_NEAR_TAIL: int
     GP_HEAD: int
     VB_DIR: int
     VB_A: int
@@ -142,10 +146,15 @@ class Kernels(Protocol):
     G6_DEGENERATE: int
     G6_BAD_POSE: int
     G6F_DEGENERATE: int
-    G6F_AMBIGUOUS: int
+    G6F_CLUSTER: int
     G6F_SECONDARY: int
     G6F_SEC_DEGENERATE: int
-    G6F_SEC_AMBIGUOUS: int
+    G6F_SEC_CLUSTER: int
+    G6F_PROJECTED: int
+    G6F_PROJ_DEGENERATE: int
+    G6F_RESCUED: int
+    G6F_NOISY: int
+    G6F_SEC_NOISY: int
     G6_DIAG_CAND_SHIFT: int
     # ---------------------------------------------------------- FK and Jacobian
     def fk1(self, q: object, packed: object, /) -> F64 | None:
@@ -248,6 +257,9 @@ class Kernels(Protocol):
         self, consts: F64, a: int, angles: F64, X: F64, Y: F64, /
     ) -> None:
         """The left side's fitting rows at angles (M, 3): X (M, 27), Y (M, 14)."""
+
+    def general6r_candidates(self, params: F64, T: F64, out: F64, /) -> tuple[int, int]:
+        """One pose's candidates before the polish (chain values) into out; (n, flags)."""
 
     def general6r_roots(self, c: F64, wr: F64, wi: F64, /) -> bool:
         """Roots of the polynomial with coefficients c (low order first), into wr, wi."""

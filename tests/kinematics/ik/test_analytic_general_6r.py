@@ -319,9 +319,10 @@ def test_prismatic_and_dependent_joints_are_not_offered():
     assert "six joints" in general_6r.why_not(panda.chain)
 
 
-def test_arm_no_variant_solves_is_not_offered_and_says_why():
-    # several consecutive axes meet and axes 3, 4 are parallel: every elimination
-    # has a rank-deficient right side or det Sigma = 0 (docs/ik.md, limits)
+def test_degenerate_arm_is_not_offered_and_says_why():
+    # axes 3 and 4 on one line (a = 0, alpha = 0, the offset along the axis): the
+    # Jacobian has rank 5 everywhere, every pose has infinitely many solutions. The
+    # family is refused with that reason, and robot.ik says it fell back to numeric.
     h = math.pi / 2
     rows = [{"a": 0.0, "d": -0.285, "alpha": -h, "theta": 2.35},
             {"a": -0.368, "d": 0.445, "alpha": 0.4381, "theta": -2.228},
@@ -330,12 +331,17 @@ def test_arm_no_variant_solves_is_not_offered_and_says_why():
             {"a": 0.0, "d": -0.032, "alpha": -h, "theta": 1.579},
             {"a": 0.0, "d": 0.0, "alpha": 0.0, "theta": -2.369}]
     robot = robokin.Robot.from_dh(rows)
+    assert robot.is_singular(np.random.default_rng(0).uniform(-3, 3, (50, 6)), tol=1e-9).all()
     fam = robokin.ik.family(robot)
     assert fam.name == "none" and fam.solver is None
-    assert "general_6r: no elimination variant finds every solution" in fam.reason
+    assert "general_6r: a degenerate arm: its Jacobian has rank below 6" in fam.reason
     assert general_6r.setup(robot.chain).params is None
-    sols = robot.ik(robot.fk(np.full(6, 0.3)))  # the numeric fallback
+    with pytest.raises(InputError, match="degenerate arm"):
+        general_6r.solve(robot, robot.fk(np.full(6, 0.3)))
+    sols = robot.ik(robot.fk(np.full(6, 0.3)))  # the numeric fallback, and it says so
     assert sols.method == "numeric" and sols.count >= 1
+    with pytest.raises(InputError, match="degenerate arm"):
+        robot.ik(robot.fk(np.full(6, 0.3)), method="analytic")
 
 
 def test_bad_pose_and_option_raise_input_errors():
