@@ -122,6 +122,7 @@ class Kernels(Protocol):
     # fields; VB_*: one variant block of VB_SIZE values), status and flag codes
     G6_MAXSOL: int
     G6_MAXCAND: int
+    G6_MAXVAR: int
     GP_NVAR: int
     GP_TAIL_TOL: int
     GP_NULL_TOL: int
@@ -155,6 +156,7 @@ class Kernels(Protocol):
     G6F_RESCUED: int
     G6F_NOISY: int
     G6F_SEC_NOISY: int
+    G6F_EIGEN: int
     G6_DIAG_CAND_SHIFT: int
     # ---------------------------------------------------------- FK and Jacobian
     def fk1(self, q: object, packed: object, /) -> F64 | None:

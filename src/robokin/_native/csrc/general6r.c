@@ -69,8 +69,9 @@
  *
  * An arm is solved by a variant: the split a, the chain or its reversal (the IK
  * of T^-1 on C_6^-1 Rz(-v_6) ... Rz(-v_1) C_0^-1) and the multiplier. The Python
- * set-up picks a primary and a secondary one; the secondary runs for a pose when
- * the primary is degenerate there.
+ * set-up ranks a few (primary, secondary, then others with another split or
+ * direction); for a pose the next one runs while the previous is degenerate or
+ * noisy there.
  *
  * References:
  *   Raghavan, M. and Roth, B. "Inverse kinematics of the general 6R manipulator
@@ -103,13 +104,16 @@
 #define G6_DEG 8       /* its trigonometric degree */
 #define G6_MAXDEG 32   /* polynomials general6r_roots takes */
 #define G6_MAXSPLIT 8  /* largest null space split into solutions */
-#define G6_VARCAND (2 * G6_MAXROOT + 2 * G6_MAXSPLIT) /* candidates of one variant */
-#define G6_MAXCAND (4 * G6_VARCAND) /* of one pose: standard and projected, 2 variants */
+#define G6_VARCAND (3 * G6_MAXROOT + 2 * G6_MAXSPLIT) /* candidates of one variant */
+#define G6_MAXCAND (8 * G6_VARCAND) /* of one pose (the room g6_candidates fills) */
+#define G6_MAXVAR 12   /* variants a parameter vector holds */
+#define G6_MULTI_TOL 1e-4 /* a root near others whose Sigma has a second pivot below this
+                           * fraction of the largest: a spread multiple root */
 #define G6_GRAIN 8     /* poses per pool chunk */
 #define G6_PARALLEL_MIN 32
 
 /* params: a header, then G6_NVAR variant blocks (robokin's general_6r packs it) */
-enum { GP_NVAR = 0 /* variants: 1 (primary) or 2 (+ secondary) */,
+enum { GP_NVAR = 0 /* variants, in the order tried: 1 (primary) .. G6_MAXVAR */,
        GP_TAIL_TOL = 1 /* largest relative DFT tail above degree 8 */,
        GP_NULL_TOL = 2 /* pivot of Sigma below this fraction of the largest: null */,
        GP_IMAG_TOL = 3 /* imaginary part of theta_a accepted as real */,
@@ -140,7 +144,8 @@ enum { G6_OK = 0, G6_NONE = 1 /* no real solution */,
  * sample, or a simple root with a 2-D null space) */
 enum { G6F_DEGENERATE = 1, G6F_CLUSTER = 2, G6F_SECONDARY = 4, G6F_SEC_DEGENERATE = 8,
        G6F_SEC_CLUSTER = 16, G6F_PROJECTED = 32, G6F_PROJ_DEGENERATE = 64,
-       G6F_RESCUED = 128, G6F_NOISY = 256, G6F_SEC_NOISY = 512 };
+       G6F_RESCUED = 128, G6F_NOISY = 256, G6F_SEC_NOISY = 512, G6F_EIGEN = 1024,
+       G6F_MULTI = 2048 /* internal: a root with a second small pivot */ };
 #define G6_DIAG_CAND_SHIFT 16 /* diag >> 16: the candidates polished */
 
 /* the fixed direction xi (rotation, translation per GP_SCALE) poses are moved along:
@@ -856,13 +861,13 @@ static void null_basis(const double *A, int n, int k, double *Y, double *r)
     }
 }
 
-/* Reduce the n x n row-major A (n <= G6_MAXSPLIT) to upper Hessenberg form by
- * Householder similarity transformations (Golub & Van Loan 7.4.3; eigenvalues only,
- * the transformations are not kept); the entries below the subdiagonal become 0. */
+/* Reduce the n x n row-major A (n <= 24) to upper Hessenberg form by Householder
+ * similarity transformations (Golub & Van Loan 7.4.3; eigenvalues only, the
+ * transformations are not kept); the entries below the subdiagonal become 0. */
 static void hessenberg(double *A, int n)
 {
     for (int k = 0; k + 2 < n; k++) {
-        double v[G6_MAXSPLIT], nrm = 0.0;
+        double v[24], nrm = 0.0;
         for (int i = k + 1; i < n; i++)
             nrm += A[n * i + k] * A[n * i + k];
         nrm = sqrt(nrm);
@@ -961,26 +966,25 @@ static double det_small(double *A, int n)
     return d;
 }
 
-/* The pencil A + s B (12 x 12 row-major, A of rank 12 - d) near s = 0, from the LU
- * with complete pivoting Pr A Pc = L U of A (Golub & Van Loan 3.4.8), stopped after
- * m = 12 - d pivots (the trailing d x d block of U, zero to rounding, is ignored):
- *   V (d x 12): a basis of A's right null space, Pc [-U_11^-1 U_12; I];
- *   Y (d x 12): of its left null space, Pr^T L^-T [0; I];
- *   G (d x d) = Y^T B V, the Schur complement of L^-1 Pr B Pc on the null spaces;
- *   returns det(A + s B) / s^d at s = 0: sign(Pr) sign(Pc) det U_11 det G
- *   (Canny's generalized characteristic polynomial, lowest coefficient).
- * piv: |U_kk|, k < 12 - d, non-increasing in practice. V, Y or G may be NULL. */
-static double pencil_lowest(const double *A0, const double *B, int d, double *V, double *Y,
-                            double *G, double *piv)
+/* The LU factorization with complete pivoting Pr A Pc = L U of a 12 x 12 row-major
+ * A (Golub & Van Loan 3.4.8): the multipliers L (unit lower, row-major, zero above
+ * the diagonal), U (upper), the row and column orders pr, pc (row i of Pr A is row
+ * pr[i] of A), sign = sign(Pr) sign(Pc), piv = |U_kk|. An exactly zero pivot is
+ * replaced by DBL_EPSILON times the first (a rank below 12: counted as null). */
+typedef struct {
+    double L[144], U[144], piv[12];
+    int pr[12], pc[12], sign;
+} G6Lu;
+
+static void lu_complete(const double *A0, G6Lu *F)
 {
-    double A[144], L[144];
-    int pr[12], pc[12], sign = 1;
-    const int m = 12 - d;
-    memcpy(A, A0, sizeof(A));
+    double *A = F->U, *L = F->L;
+    memcpy(A, A0, sizeof(F->U));
+    memset(L, 0, sizeof(F->L));
+    F->sign = 1;
     for (int i = 0; i < 12; i++)
-        pr[i] = pc[i] = i;
-    memset(L, 0, sizeof(L));
-    for (int k = 0; k < m; k++) {
+        F->pr[i] = F->pc[i] = i;
+    for (int k = 0; k < 12; k++) {
         int bi = k, bj = k;
         double best = -1.0;
         for (int i = k; i < 12; i++)
@@ -999,10 +1003,10 @@ static double pencil_lowest(const double *A0, const double *B, int d, double *V,
                 L[12 * k + j] = L[12 * bi + j];
                 L[12 * bi + j] = t;
             }
-            int t = pr[k];
-            pr[k] = pr[bi];
-            pr[bi] = t;
-            sign = -sign;
+            int t = F->pr[k];
+            F->pr[k] = F->pr[bi];
+            F->pr[bi] = t;
+            F->sign = -F->sign;
         }
         if (bj != k) {
             for (int i = 0; i < 12; i++) {
@@ -1010,15 +1014,15 @@ static double pencil_lowest(const double *A0, const double *B, int d, double *V,
                 A[12 * i + k] = A[12 * i + bj];
                 A[12 * i + bj] = t;
             }
-            int t = pc[k];
-            pc[k] = pc[bj];
-            pc[bj] = t;
-            sign = -sign;
+            int t = F->pc[k];
+            F->pc[k] = F->pc[bj];
+            F->pc[bj] = t;
+            F->sign = -F->sign;
         }
         double p = A[12 * k + k];
-        if (p == 0.0) /* rank below m: a pivot at rounding level (counted as null) */
-            p = A[12 * k + k] = DBL_EPSILON * (k > 0 ? piv[0] : 1.0);
-        piv[k] = fabs(p);
+        if (p == 0.0)
+            p = A[12 * k + k] = DBL_EPSILON * (k > 0 ? F->piv[0] : 1.0);
+        F->piv[k] = fabs(p);
         for (int i = k + 1; i < 12; i++) {
             double f = A[12 * i + k] / p;
             L[12 * i + k] = f;
@@ -1027,43 +1031,59 @@ static double pencil_lowest(const double *A0, const double *B, int d, double *V,
                 A[12 * i + j] -= f * A[12 * k + j];
         }
     }
-    double du = sign;
+}
+
+/* The pencil A + s B (12 x 12 row-major, A of rank 12 - d, factored in F) near
+ * s = 0. With m = 12 - d, the first m steps of F are a factorization Pr A Pc =
+ * L' [U_11 U_12; 0 S] with L' = F's multipliers of those steps (identity below) and
+ * S, zero to rounding, ignored (the later steps only reorder its rows and columns):
+ *   V (d x 12): a basis of A's right null space, Pc [-U_11^-1 U_12; I];
+ *   Y (d x 12): of its left null space, Pr^T L'^-T [0; I];
+ *   G (d x d) = Y^T B V, the Schur complement of L'^-1 Pr B Pc on the null spaces;
+ *   returns det(A + s B) / s^d at s = 0: sign(Pr) sign(Pc) det U_11 det G
+ *   (Canny's generalized characteristic polynomial, lowest coefficient).
+ * V, Y or G may be NULL. */
+static double pencil_lowest(const G6Lu *F, const double *B, int d, double *V, double *Y,
+                            double *G)
+{
+    const double *U = F->U, *L = F->L;
+    const int m = 12 - d;
+    double du = F->sign;
     for (int k = 0; k < m; k++)
-        du *= A[12 * k + k];
-    /* X = -U_11^-1 U_12 (m x d): right null vectors in the pivoted order */
-    double X[12 * 12], Vl[12 * 12], Yl[12 * 12];
-    for (int c = 0; c < d; c++)
+        du *= U[12 * k + k];
+    double X[12 * 12], Vl[12 * 12], Yl[12 * 12], BV[12 * 12], Gl[144];
+    for (int c = 0; c < d; c++) /* X = -U_11^-1 U_12 (m x d) */
         for (int i = m - 1; i >= 0; i--) {
-            double acc = -A[12 * i + m + c];
+            double acc = -U[12 * i + m + c];
             for (int j = i + 1; j < m; j++)
-                acc -= A[12 * i + j] * X[d * j + c];
-            X[d * i + c] = acc / A[12 * i + i];
+                acc -= U[12 * i + j] * X[d * j + c];
+            X[d * i + c] = acc / U[12 * i + i];
         }
     for (int c = 0; c < d; c++) {
         double *v = Vl + 12 * c, *y = Yl + 12 * c, w[12];
         for (int i = 0; i < 12; i++)
-            v[pc[i]] = i < m ? X[d * i + c] : (i - m == c ? 1.0 : 0.0);
-        /* L^T w = e_{m + c}: L unit lower triangular (multipliers below the first m
-         * columns; its trailing block is the identity) */
-        for (int i = 11; i >= 0; i--) {
+            v[F->pc[i]] = i < m ? X[d * i + c] : (i - m == c ? 1.0 : 0.0);
+        for (int i = 11; i >= 0; i--) { /* L'^T w = e_{m + c} */
             double acc = i == m + c ? 1.0 : 0.0;
-            for (int j = i + 1; j < 12; j++)
-                acc -= L[12 * j + i] * w[j];
+            if (i < m)
+                for (int j = i + 1; j < 12; j++)
+                    acc -= L[12 * j + i] * w[j];
             w[i] = acc;
         }
         for (int i = 0; i < 12; i++)
-            y[pr[i]] = w[i];
+            y[F->pr[i]] = w[i];
+        for (int i = 0; i < 12; i++) { /* B v */
+            double acc = 0.0;
+            for (int j = 0; j < 12; j++)
+                acc += B[12 * i + j] * v[j];
+            BV[12 * c + i] = acc;
+        }
     }
-    double Gl[144];
     for (int r = 0; r < d; r++)
         for (int c = 0; c < d; c++) {
             double acc = 0.0;
-            for (int i = 0; i < 12; i++) {
-                double bv = 0.0;
-                for (int j = 0; j < 12; j++)
-                    bv += B[12 * i + j] * Vl[12 * c + j];
-                acc += Yl[12 * r + i] * bv;
-            }
+            for (int i = 0; i < 12; i++)
+                acc += Yl[12 * r + i] * BV[12 * c + i];
             Gl[d * r + c] = acc;
         }
     if (V != NULL)
@@ -1074,6 +1094,7 @@ static double pencil_lowest(const double *A0, const double *B, int d, double *V,
         memcpy(G, Gl, sizeof(double) * d * d);
     return du * det_small(Gl, d);
 }
+
 /* -------------------------------------------------------- the elimination */
 
 typedef struct {
@@ -1372,6 +1393,7 @@ typedef struct {
     double Q[14 * 9], A8[8 * 14], V8[8 * 14], beta8[8];
     double Nn[6][14];
     double rowscale[6]; /* the 6 equations' equilibration */
+    double rcond;       /* the right side's block: smallest / largest |R_kk| */
     double S[3][144];
 } G6Var;
 
@@ -1429,6 +1451,46 @@ static void g6_sigma_at(const double (*S)[144], double th, double *A)
         A[i] = s * S[0][i] + c * S[1][i] + S[2][i];
 }
 
+/* The reciprocal condition number of the 8 x 8 upper triangular R (column-major in
+ * a 14 x 8 array, R_ij = A[14 j + i]): its smallest singular value by three steps of
+ * inverse iteration on R^T R, over its largest column norm (the diagonal of an
+ * unpivoted QR does not reveal a near rank deficiency). */
+static double g6_rcond8(const double *A)
+{
+    double x[8], y[8], big = 0.0;
+    for (int j = 0; j < 8; j++) {
+        double c = 0.0;
+        for (int i = 0; i <= j; i++)
+            c += A[14 * j + i] * A[14 * j + i];
+        big = c > big ? c : big;
+        x[j] = 1.0 + 0.3183098861837907 * j;
+    }
+    double nrm = 0.0;
+    for (int it = 0; it < 3; it++) {
+        for (int i = 0; i < 8; i++) { /* R^T y = x */
+            double acc = x[i];
+            for (int k = 0; k < i; k++)
+                acc -= A[14 * i + k] * y[k];
+            y[i] = acc / A[14 * i + i];
+        }
+        for (int i = 7; i >= 0; i--) { /* R x = y */
+            double acc = y[i];
+            for (int k = i + 1; k < 8; k++)
+                acc -= A[14 * k + i] * x[k];
+            x[i] = acc / A[14 * i + i];
+        }
+        nrm = 0.0;
+        for (int i = 0; i < 8; i++)
+            nrm += x[i] * x[i];
+        nrm = sqrt(nrm);
+        if (!(nrm > 0.0) || !isfinite(nrm))
+            return 0.0;
+        for (int i = 0; i < 8; i++)
+            x[i] /= nrm;
+    }
+    return sqrt(1.0 / nrm) / sqrt(big); /* |(R^T R)^-1 x| -> 1 / sigma_min^2 */
+}
+
 /* Variant vb at pose T (4x4 row-major) into V; 0 when its right side's 14 x 8 block
  * is rank deficient or an equation vanishes (the elimination does not apply). */
 static int g6_prepare(const double *vb, const double *T, G6Var *V)
@@ -1457,6 +1519,7 @@ static int g6_prepare(const double *vb, const double *T, G6Var *V)
     }
     if (!(rmin > 1e-12 * rmax))
         return 0;
+    V->rcond = g6_rcond8(V->A8);
     /* the left null space N (6 x 14): rows 8..13 of Q^T, i.e. H_0 .. H_7 e_r */
     for (int r = 0; r < 6; r++) {
         double *x = V->Nn[r];
@@ -1633,19 +1696,119 @@ static int g6_trig_poly(const double *D, double *cpoly, double *phi, double *tai
 }
 
 /* The roots theta of cpoly that are real or within imag_tol of it, in [-pi, pi),
- * sorted, each with a weight: 2 for a complex pair (a possible pair of close real
- * roots, how a double root comes out of rounding), else 1. Returns how many, or -1
+ * sorted, each with a weight (2 for a complex pair: a possible pair of close real
+ * roots, how a double root comes out of rounding; else 1) and near[i]: the root may
+ * be part of a multiple root spread by rounding (by eps^(1/k) for a k-fold one): it
+ * is complex, or another root lies within gap, or a complex root close to the axis
+ * (imaginary part of theta below 0.25) lies within 0.15 rad. Returns how many, or -1
  * when the eigenvalue iteration fails. */
 static int g6_real_roots(const double *cpoly, int jbest, double phi, double imag_tol,
-                         double *ths, int *wts)
+                         double gap, double *ths, int *wts, int *near)
 {
-    double wr[16], wi[16];
+    double wr[16], wi[16], re[16];
     if (!all_roots16(cpoly, jbest, wr, wi))
         return -1;
-    int nr = 0;
+    int nn = 0, nr = 0;
+    for (int k = 0; k < 16; k++) { /* complex roots close to the axis */
+        double z2 = wr[k] * wr[k] + wi[k] * wi[k], ia = 2.0 * fabs(wi[k]) / (1.0 + z2);
+        if (wi[k] > 0.0 && ia < 0.25)
+            re[nn++] = phi + 2.0 * atan(wr[k]);
+    }
     for (int k = 0; k < 16; k++) {
         if (wi[k] < 0.0)
             continue; /* the conjugate's twin */
+        double z2 = wr[k] * wr[k] + wi[k] * wi[k];
+        if (!(2.0 * fabs(wi[k]) / (1.0 + z2) <= imag_tol))
+            continue;
+        double th = wrap_pi(phi + 2.0 * atan(wr[k]));
+        int w = wi[k] != 0.0 ? 2 : 1, i = nr++, nb = w > 1;
+        for (int j = 0; j < nn && !nb; j++) /* a complex one near, not itself */
+            nb = fabs(wrap_pi(re[j] - th)) < 0.15 && !(w > 1 && fabs(wrap_pi(re[j] - th)) < 1e-12);
+        for (; i > 0 && ths[i - 1] > th; i--) {
+            ths[i] = ths[i - 1];
+            wts[i] = wts[i - 1];
+            near[i] = near[i - 1];
+        }
+        ths[i] = th;
+        wts[i] = w;
+        near[i] = nb;
+    }
+    for (int i = 0; i < nr; i++) /* neighbours within the gap (around the circle too) */
+        for (int j = 0; j < nr; j++)
+            if (i != j && fabs(wrap_pi(ths[i] - ths[j])) < gap)
+                near[i] = 1;
+    return nr;
+}
+
+/* The same roots as eigenvalues (Manocha & Canny 1994, section 5): with t = theta -
+ * phi, x = tan(t / 2), (1 + x^2) Sigma = x^2 M2 + x M1 + M0 (M2 = Sigma(phi + pi),
+ * the best conditioned sample, invertible), and its roots are the eigenvalues of the
+ * companion matrix [[0, I], [-M2^-1 M0, -M2^-1 M1]] (24 x 24; 8 of them at x = +-i,
+ * dropped by the imaginary-part rule). Where k solutions share theta_a with a
+ * k-dimensional null space the eigenvalue is semi-simple and comes out to rounding,
+ * where the determinant's k-fold root spreads by eps^(1/k): run where the
+ * determinant's roots cluster. Sorted and weighted as g6_real_roots; -1 when M2 is
+ * singular or hqr fails. */
+static int g6_eig_roots(const double (*S)[144], double phi, double imag_tol, double *ths,
+                        int *wts)
+{
+    const double cp = cos(phi), sp = sin(phi);
+    double M2[144], R[12 * 24], E[24 * 24], wr[24], wi[24];
+    for (int i = 0; i < 144; i++) {
+        double a = cp * S[0][i] - sp * S[1][i], b = sp * S[0][i] + cp * S[1][i];
+        M2[i] = S[2][i] - b;
+        R[24 * (i / 12) + (i % 12)] = b + S[2][i]; /* M0 | M1, 12 x 24 row-major */
+        R[24 * (i / 12) + 12 + (i % 12)] = 2.0 * a;
+    }
+    /* R <- M2^-1 [M0 M1]: LU with partial pivoting, 24 right-hand sides */
+    for (int k = 0; k < 12; k++) {
+        int p = k;
+        for (int i = k + 1; i < 12; i++)
+            if (fabs(M2[12 * i + k]) > fabs(M2[12 * p + k]))
+                p = i;
+        if (M2[12 * p + k] == 0.0)
+            return -1;
+        if (p != k) {
+            for (int j = 0; j < 12; j++) {
+                double t = M2[12 * k + j];
+                M2[12 * k + j] = M2[12 * p + j];
+                M2[12 * p + j] = t;
+            }
+            for (int j = 0; j < 24; j++) {
+                double t = R[24 * k + j];
+                R[24 * k + j] = R[24 * p + j];
+                R[24 * p + j] = t;
+            }
+        }
+        for (int i = k + 1; i < 12; i++) {
+            double f = M2[12 * i + k] / M2[12 * k + k];
+            for (int j = k + 1; j < 12; j++)
+                M2[12 * i + j] -= f * M2[12 * k + j];
+            for (int j = 0; j < 24; j++)
+                R[24 * i + j] -= f * R[24 * k + j];
+        }
+    }
+    for (int k = 11; k >= 0; k--)
+        for (int j = 0; j < 24; j++) {
+            double acc = R[24 * k + j];
+            for (int c = k + 1; c < 12; c++)
+                acc -= M2[12 * k + c] * R[24 * c + j];
+            R[24 * k + j] = acc / M2[12 * k + k];
+        }
+    memset(E, 0, sizeof(E));
+    for (int i = 0; i < 12; i++) {
+        E[24 * i + 12 + i] = 1.0;
+        for (int j = 0; j < 24; j++)
+            E[24 * (12 + i) + j] = -R[24 * i + j];
+    }
+    balance(E, 24);
+    hessenberg(E, 24);
+    if (!hqr(E, 24, wr, wi))
+        return -1;
+    int nr = 0;
+    for (int k = 0; k < 24 && nr < G6_MAXROOT; k++) {
+        if (wi[k] < 0.0)
+            continue;
         double z2 = wr[k] * wr[k] + wi[k] * wi[k];
         if (!(2.0 * fabs(wi[k]) / (1.0 + z2) <= imag_tol))
             continue;
@@ -1715,15 +1878,16 @@ static int g6_nullity(const double *r, int n, int kmax, double tiny)
 static int g6_proj_basis(const G6Var *V, const G6Proj *pj, double th, int k, double null_tol,
                          double *Z)
 {
-    double A[144], B[144], piv[12], Vn[12 * 12], G[144], C[144], r[12];
+    double A[144], B[144], Vn[12 * 12], G[144], C[144], r[12];
+    G6Lu F;
     g6_sigma_at((const double (*)[144])V->S, th, A);
     g6_sigma_at((const double (*)[144])pj->Sd, th, B);
+    lu_complete(A, &F);
     int dl = pj->d;
-    pencil_lowest(A, B, dl, NULL, NULL, NULL, piv);
     for (int i = 1; i < 12 - pj->d; i++)
-        if (piv[i] < null_tol * piv[0] && dl < G6_MAXSPLIT)
+        if (F.piv[i] < null_tol * F.piv[0] && dl < G6_MAXSPLIT)
             dl++;
-    pencil_lowest(A, B, dl, Vn, NULL, G, piv);
+    pencil_lowest(&F, B, dl, Vn, NULL, G);
     int kk = k < dl ? k : dl;
     null_basis(G, dl, kk, C, r);
     for (int j = 0; j < kk; j++)
@@ -1760,13 +1924,15 @@ static int g6_from_basis(const G6Back *G, double th, const double *Z, int k, int
 }
 
 /* Back-substitution of the roots ths (sorted, weights wts) of one variant: every
- * root alone (Sigma's null vector; projected: the projection's), then every cluster
- * of roots closer than GP_PAIR_GAP (complex ones count twice) or with a null space
- * of dimension k >= 2, split at its centroid. Flags get G6F_CLUSTER; stats[1] the
+ * root alone (Sigma's null vector; projected: the projection's; where its null space
+ * has dimension k >= 2, also its split), then every cluster of roots closer than
+ * GP_PAIR_GAP (complex ones count twice) or with a null space of dimension k >= 2,
+ * split at its centroid. Flags get G6F_CLUSTER; stats[1] the
  * smallest ratio of Sigma's second-smallest to largest pivot over the roots, stats[2]
  * the clusters split. Returns the candidates appended to cand. */
 static int g6_back(const G6Var *V, const G6Proj *pj, const double *P, const double *ths,
-                   const int *wts, int nr, G6Cand *cand, int *flags, double *stats)
+                   const int *wts, const int *near, int nr, G6Cand *cand, int *flags,
+                   double *stats)
 {
     const double null_tol = P[GP_NULL_TOL], gap = P[GP_PAIR_GAP];
     G6Back G = {V->vb, V->Tp, V->Q, V->V8, V->beta8, V->A8, V->a, V->dir, V->mult};
@@ -1783,6 +1949,8 @@ static int g6_back(const G6Var *V, const G6Proj *pj, const double *P, const doub
             null_vector12_lanes((const double (*)[144])V->S, sv, cv, yv, rv);
             for (int l = 0; l < W && k0 + l < nr; l++) {
                 double y[12], margin = rv[10][l] / rv[0][l];
+                if (near[k0 + l] && margin < G6_MULTI_TOL)
+                    *flags |= G6F_MULTI; /* near others, a second small pivot */
                 for (int i = 0; i < 12; i++)
                     y[i] = yv[i][l];
                 stats[1] = margin < stats[1] ? margin : stats[1];
@@ -1791,9 +1959,15 @@ static int g6_back(const G6Var *V, const G6Proj *pj, const double *P, const doub
                     rl[i] = rv[i][l];
                 nul[k0 + l] = g6_nullity(rl, 12, G6_MAXSPLIT, null_tol);
                 nul[k0 + l] = nul[k0 + l] < 1 ? 1 : nul[k0 + l];
-                if (nul[k0 + l] > 1 && wts[k0 + l] == 1)
-                    *flags |= G6F_NOISY; /* a simple root with a 2-D null space */
                 nc += g6_from_basis(&G, ths[k0 + l], y, 1, 0, cand + nc, G6_VARCAND - nc);
+                if (nul[k0 + l] > 1) { /* solutions sharing this theta: split here too
+                                        * (a cluster's centroid may be off it) */
+                    double A[144];
+                    g6_sigma_at((const double (*)[144])V->S, ths[k0 + l], A);
+                    null_basis(A, 12, nul[k0 + l], Z, r);
+                    nc += g6_from_basis(&G, ths[k0 + l], Z, nul[k0 + l], 1, cand + nc,
+                                        G6_VARCAND - nc);
+                }
             }
         }
     } else {
@@ -1820,6 +1994,8 @@ static int g6_back(const G6Var *V, const G6Proj *pj, const double *P, const doub
                 sx += wts[i] * cos(ths[i]);
                 sy += wts[i] * sin(ths[i]);
             }
+        if (pj == NULL && weight == 1 && k > 1)
+            *flags |= G6F_NOISY; /* a simple root with a 2-D null space */
         k = weight > k ? weight : k;
         if (k < 2)
             continue;
@@ -1869,23 +2045,27 @@ static int g6_variant(const double *P, const double *vb, const double *T, int pr
         for (int k = 0; k < G6_NSAMP; k++)
             rmax = ratio[k] > rmax ? ratio[k] : rmax;
         jbest = g6_trig_poly(D, cpoly, &phi, &tail);
-        if (tail > P[GP_NEAR_TAIL] || rmax < 1e-5)
+        /* noisy: near a degenerate pose (a noisy determinant, Sigma nearly singular
+         * at every sample) or a right side nearly rank deficient (u, w badly
+         * determined by the back-substitution) */
+        if (tail > P[GP_NEAR_TAIL] || rmax < 1e-5 || V.rcond < 1e-6)
             *flags |= G6F_NOISY;
     } else {
         /* c_d at the samples, d the smallest null space seen (pivots below 1e-5 of
          * the largest: near a degenerate pose they are ~ its distance, and the
          * coefficients below d are that small, with their roots spread by rounding),
          * else the first of d - 1, d + 1, d + 2 whose polynomial has no tail */
-        double A[24][144], B[24][144], piv[12];
+        double A[144], B[G6_NSAMP][144];
+        G6Lu F[G6_NSAMP];
         int d0 = 12;
         g6_derivative(&V, P[GP_SCALE], &pj);
         for (int k = 0; k < G6_NSAMP; k++) {
             double th = G6_TWO_PI * k / G6_NSAMP;
             int dk = 0;
-            g6_sigma_at((const double (*)[144])V.S, th, A[k]);
+            g6_sigma_at((const double (*)[144])V.S, th, A);
             g6_sigma_at((const double (*)[144])pj.Sd, th, B[k]);
-            pencil_lowest(A[k], B[k], 0, NULL, NULL, NULL, piv);
-            for (int i = 11; i > 0 && piv[i] < 1e-5 * piv[0]; i--)
+            lu_complete(A, &F[k]);
+            for (int i = 11; i > 0 && F[k].piv[i] < 1e-5 * F[k].piv[0]; i--)
                 dk++;
             d0 = dk < d0 ? dk : d0;
         }
@@ -1896,7 +2076,7 @@ static int g6_variant(const double *P, const double *vb, const double *T, int pr
             if (d < 1 || d > G6_MAXSPLIT)
                 continue;
             for (int k = 0; k < G6_NSAMP; k++)
-                D[k] = pencil_lowest(A[k], B[k], d, NULL, NULL, NULL, piv);
+                D[k] = pencil_lowest(&F[k], B[k], d, NULL, NULL, NULL);
             jbest = g6_trig_poly(D, cpoly, &phi, &tail);
             pj.d = d;
             if (jbest >= 0 && tail <= tail_tol)
@@ -1910,12 +2090,30 @@ static int g6_variant(const double *P, const double *vb, const double *T, int pr
     }
     double ths[G6_MAXROOT];
     int wts[G6_MAXROOT];
-    int nr = g6_real_roots(cpoly, jbest, phi, P[GP_IMAG_TOL], ths, wts);
+    int near[G6_MAXROOT];
+    int nr = g6_real_roots(cpoly, jbest, phi, P[GP_IMAG_TOL], P[GP_PAIR_GAP], ths, wts, near);
     if (nr < 0) {
         *flags |= G6F_DEGENERATE;
         return 0;
     }
-    return g6_back(&V, project ? &pj : NULL, P, ths, wts, nr, cand, flags, stats);
+    int f = 0;
+    int nc = g6_back(&V, project ? &pj : NULL, P, ths, wts, near, nr, cand, &f, stats);
+    if ((f & G6F_MULTI) && !project) {
+        /* a multiple root (roots close together where Sigma has a second small
+         * pivot, not a pair of solutions turning complex): its eigenvalue is
+         * accurate where the determinant's roots spread; the back-substitution again
+         * from the eigenvalues */
+        int nr2 = g6_eig_roots((const double (*)[144])V.S, phi, P[GP_IMAG_TOL], ths, wts);
+        if (nr2 >= 0) {
+            f = G6F_EIGEN;
+            stats[1] = INFINITY;
+            stats[2] = 0.0;
+            memset(near, 0, sizeof(near));
+            nc = g6_back(&V, NULL, P, ths, wts, near, nr2, cand, &f, stats);
+        }
+    }
+    *flags |= f & ~G6F_MULTI;
+    return nc;
 }
 
 /* The candidates of pose T: the primary variant; where its determinant is
@@ -1929,7 +2127,7 @@ static int g6_candidates(const double *P, const double *T, G6Cand *cand, int *fl
     const int nv = (int)P[GP_NVAR];
     int nc = 0;
     double st[3];
-    for (int v = 0; v < nv; v++) {
+    for (int v = 0; v < nv && nc + 2 * G6_VARCAND <= G6_MAXCAND; v++) {
         int f = 0;
         nc += g6_variant(P, P + GP_HEAD + v * VB_SIZE, T, 0, cand + nc, &f, v ? st : stats);
         if (v == 0)
@@ -1944,7 +2142,7 @@ static int g6_candidates(const double *P, const double *T, G6Cand *cand, int *fl
     if (P[GP_FALLBACK] == 0.0)
         return nc;
     *flags |= G6F_PROJECTED;
-    for (int v = 0; v < nv; v++) {
+    for (int v = 0; v < nv && nc + G6_VARCAND <= G6_MAXCAND; v++) {
         int f = 0;
         nc += g6_variant(P, P + GP_HEAD + v * VB_SIZE, T, 1, cand + nc, &f, st);
         if (!(f & G6F_DEGENERATE))
@@ -2220,8 +2418,10 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
 /* --------------------------------------------------------------- per pose */
 
 /* A singular target (nothing found and the elimination in trouble: a continuum of
- * solutions, where det Sigma vanishes identically or has a multiple root, or a
- * near-singular solution). First the nc0 candidates again, patiently (from far a
+ * solutions, where det Sigma vanishes identically or is noisy, or a candidate came
+ * within G6_FAR: a near-singular solution). A cluster alone does not call it: it is
+ * how an unreachable pose near the workspace's boundary looks (pairs of solutions
+ * turned complex). First the nc0 candidates again, patiently (from far a
  * near-singular solution's Newton steps may fall slowly). Then, where a continuum
  * moves theta_a, every theta_a in its range has a solution, whose monomial vector
  * lies in Sigma(theta_a)'s null space: at each of the 24 sample angles of each
@@ -2262,7 +2462,7 @@ static int g6_pose(const Chain *ch, const double *P, const double *T, double *q,
     for (int i = 0; i < 16; i++)
         if (!isfinite(T[i])) {
             *diag = 0;
-            stats[0] = stats[1] = INFINITY;
+            stats[0] = stats[1] = stats[3] = INFINITY;
             stats[2] = 0.0;
             return -1;
         }
@@ -2271,9 +2471,9 @@ static int g6_pose(const Chain *ch, const double *P, const double *T, double *q,
     double best;
     int nc = g6_candidates(P, T, cand, &flags, stats);
     int ns = g6_polish(ch, P, T, cand, nc, q, sig, 0, &best, 0);
+    stats[3] = best;
     if (ns == 0 && P[GP_FALLBACK] != 0.0 &&
-        ((flags & (G6F_DEGENERATE | G6F_CLUSTER | G6F_SEC_CLUSTER | G6F_NOISY)) ||
-         best < G6_FAR * fmax(1.0, P[GP_SCALE]))) {
+        ((flags & (G6F_DEGENERATE | G6F_NOISY)) || best < G6_FAR * fmax(1.0, P[GP_SCALE]))) {
         ns = g6_rescue(ch, P, T, cand, nc, q, sig);
         flags |= G6F_RESCUED;
     }
@@ -2298,7 +2498,7 @@ static void g6_range(void *ctx, long b, long e)
     for (long i = b; i < e; i++) {
         double q[6 * G6_MAXSOL], sig[G6_MAXSOL];
         int ns = g6_pose(job->ch, job->P, job->T + 16 * i, q, sig, job->diag + i,
-                         job->stats + 3 * i);
+                         job->stats + 4 * i);
         job->status[i] = ns == -1 ? G6_BAD_POSE : ns == -2 ? G6_DEGENERATE
                          : ns == 0 ? G6_NONE : G6_OK;
         ns = ns < 0 ? 0 : ns;
@@ -2342,7 +2542,8 @@ static int g6_params_ok(const double *P, long len)
     if (len < GP_HEAD)
         return 0;
     int nv = (int)P[GP_NVAR];
-    if (!(P[GP_NVAR] == 1.0 || P[GP_NVAR] == 2.0) || len != GP_HEAD + nv * VB_SIZE)
+    if (!(P[GP_NVAR] >= 1.0 && P[GP_NVAR] <= G6_MAXVAR && P[GP_NVAR] == nv) ||
+        len != GP_HEAD + nv * VB_SIZE)
         return 0;
     if (!(P[GP_MAX_ITER] >= 0.0 && P[GP_MAX_ITER] <= 100.0) ||
         !(P[GP_SCALE] > 0.0 && P[GP_SCALE] < 1e6) ||
@@ -2360,12 +2561,13 @@ static int g6_params_ok(const double *P, long len)
 
 /* general6r_solve(packed, params, T (N, 4, 4), Q (N, 16, 6), valid (N, 16) bool,
  *                 inside (N, 16) bool, sigma (N, 16), status (N,) int64,
- *                 diag (N,) int64, stats (N, 3), parallel): per pose up to 16
+ *                 diag (N,) int64, stats (N, 4), parallel): per pose up to 16
  * solutions (joint coordinates, revolute ones in [-pi, pi) or moved by whole turns
  * into their limits; rows that are not solutions 0), which are solutions, which
  * are inside the limits, the Jacobian's smallest singular value (NaN on other
  * rows), the status (G6_OK ...), the flags (G6F_..., candidates tried above
- * G6_DIAG_CAND_SHIFT) and the primary's tail, margin and close pairs. */
+ * G6_DIAG_CAND_SHIFT), the primary's tail, margin and clusters split, and the
+ * smallest error a candidate's polish reached. */
 static PyObject *py_general6r_solve(PyObject *self, PyObject *args)
 {
     PyObject *o[10];
@@ -2410,7 +2612,7 @@ static PyObject *py_general6r_solve(PyObject *self, PyObject *args)
     static const int types[N_OUT] = {NPY_DOUBLE, NPY_BOOL, NPY_BOOL, NPY_DOUBLE, NPY_INT64,
                                      NPY_INT64, NPY_DOUBLE};
     static const int ndims[N_OUT] = {3, 2, 2, 2, 1, 1, 2};
-    static const npy_intp d1[N_OUT] = {16, 16, 16, 16, 0, 0, 3};
+    static const npy_intp d1[N_OUT] = {16, 16, 16, 16, 0, 0, 4};
     PyArrayObject *a[N_OUT];
     for (int k = 0; k < N_OUT; k++)
         if (!(a[k] = array_arg(o[3 + k], names[k], types[k], ndims[k], 1)) ||
@@ -2559,7 +2761,7 @@ static int general6r_constants(PyObject *m)
 {
     g6_init_tables();
     static const struct { const char *name; int value; } ints[] = {
-        {"G6_MAXSOL", G6_MAXSOL}, {"G6_MAXCAND", G6_MAXCAND}, {"GP_NVAR", GP_NVAR}, {"GP_TAIL_TOL", GP_TAIL_TOL},
+        {"G6_MAXSOL", G6_MAXSOL}, {"G6_MAXCAND", G6_MAXCAND}, {"G6_MAXVAR", G6_MAXVAR}, {"GP_NVAR", GP_NVAR}, {"GP_TAIL_TOL", GP_TAIL_TOL},
         {"GP_NULL_TOL", GP_NULL_TOL}, {"GP_IMAG_TOL", GP_IMAG_TOL}, {"GP_TOL", GP_TOL},
         {"GP_DEDUPE", GP_DEDUPE}, {"GP_MAX_ITER", GP_MAX_ITER},
         {"GP_PAIR_GAP", GP_PAIR_GAP}, {"GP_SCALE", GP_SCALE},
@@ -2572,6 +2774,7 @@ static int general6r_constants(PyObject *m)
         {"G6F_SEC_DEGENERATE", G6F_SEC_DEGENERATE}, {"G6F_SEC_CLUSTER", G6F_SEC_CLUSTER},
         {"G6F_PROJECTED", G6F_PROJECTED}, {"G6F_PROJ_DEGENERATE", G6F_PROJ_DEGENERATE},
         {"G6F_RESCUED", G6F_RESCUED}, {"G6F_NOISY", G6F_NOISY}, {"G6F_SEC_NOISY", G6F_SEC_NOISY},
+        {"G6F_EIGEN", G6F_EIGEN},
         {"G6_DIAG_CAND_SHIFT", G6_DIAG_CAND_SHIFT}};
     for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
         if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)

@@ -61,7 +61,7 @@ from robokin.kinematics.ik.analytic._common import fk_error, make_set
 from robokin.kinematics.ik.analytic._geometry import poe_from_chain
 from robokin.kinematics.jacobian import min_singular_value
 from robokin.kinematics.per_chain import cached
-from robokin.spatial import invert, wrap_angle
+from robokin.spatial import invert
 
 __all__ = ["NAME", "General6R", "Variant", "make_single", "raw_solve", "setup", "solve",
            "why_not"]
@@ -74,13 +74,14 @@ SETUP_SEED = 20_241_993
 FIT_SAMPLES = 64  # rows per least-squares fit (27 unknowns)
 FIT_TOL = 1e-9  # largest relative residual of a fit
 TAIL_TOL = 1e-6  # largest relative DFT tail above degree 8 of a usable determinant
-NEAR_TAIL = 1e-11  # a tail above: near a degenerate pose, the projection runs too
+NEAR_TAIL = 1e-12  # a tail above: near a degenerate pose, the next variant runs too
 NULL_TOL = 1e-7  # pivot of Sigma below this fraction of the largest: a null direction
 IMAG_TOL = 5e-2  # imaginary part of theta_a [rad] still tried as a real root
 SOLUTION_TOL = 9e-13  # rotation [rad] and position [m, per metre of scale] error
 DEDUPE_TOL = 1e-6  # [rad] solutions closer than this are one (more near-singular)
 NEWTON_ITERATIONS = 60  # most: singular solutions converge linearly
 PAIR_GAP = 1e-2  # [rad] roots closer than this form a cluster (a multiple root)
+FALLBACKS = 2  # variants after the secondary, each with another split and direction
 RANK_TOL = 1e-9  # Jacobian singular value [per metre of scale] below: rank deficient
 ISOLATED = 1e-4  # ... above: a set-up configuration whose solutions are compared
 SPECIAL_VALUES = np.array([0.0, np.pi / 2, -np.pi / 2, np.pi])
@@ -123,12 +124,13 @@ class General6R:
         params: The kernel's parameter vector (read-only), or None when the family
             does not apply.
         primary: The variant run for every pose.
-        secondary: The variant run where the primary is degenerate, or None.
+        secondary: The variant run where the primary is degenerate or noisy.
         reason: Why the family does not apply ("" when it does).
         measured: What the set-up measured (for ``Family.measured``).
         tail: The primary's largest relative DFT tail on the set-up poses.
         scale: The arm's length scale [m]: the largest distance of a joint axis point
             or the tool from the base at zero joint values (at least 1e-3).
+        variants: Every variant in the kernel's order (primary, secondary, ...).
     """
 
     params: np.ndarray | None
@@ -138,6 +140,7 @@ class General6R:
     measured: str = ""
     tail: float = float("nan")
     scale: float = 1.0
+    variants: tuple[Variant, ...] = ()
 
 
 def why_not(chain: Any) -> str:
@@ -237,8 +240,9 @@ def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
     T (N, 4, 4) C-contiguous float64 -> (q (N, 16, 6) [rad], valid (N, 16), inside
     (N, 16) the valid rows within the limits, sigma (N, 16) the Jacobian's smallest
     singular value, status (N,) int64 (kernel codes), diag (N,) int64 (kernel flags
-    ``G6F_*``; ``>> G6_DIAG_CAND_SHIFT`` the candidates polished), stats (N, 3): the
-    primary's relative DFT tail, null-space margin and clusters split).
+    ``G6F_*``; ``>> G6_DIAG_CAND_SHIFT`` the candidates polished), stats (N, 4): the
+    primary's relative DFT tail, null-space margin and clusters split, and the
+    smallest error [m, rad] a candidate's polish reached).
     Revolute values are in [-pi, pi), or moved by whole turns into their limits
     where that is possible; rows that are not solutions are NaN. No input checks.
     """
@@ -249,7 +253,7 @@ def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
     sigma = np.empty((N, MAX_SOLUTIONS))
     status = np.empty(N, np.int64)
     diag = np.empty(N, np.int64)
-    stats = np.empty((N, 3))
+    stats = np.empty((N, 4))
     par = N >= _PARALLEL_MIN if parallel is None else bool(parallel)
     K.general6r_solve(chain.arrays.packed, params, T, Q, valid, inside, sigma, status, diag,
                       stats, par)
@@ -267,8 +271,10 @@ def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _union(sets: list[np.ndarray]) -> np.ndarray:
-    """The distinct rows (modulo 2 pi) of the (k_i, 6) sets, each set's rows distinct
-    already (the kernel's): first occurrence kept."""
+    """The distinct rows (modulo 2 pi) of the (k_i, 6) sets, first occurrence kept.
+
+    Each set's rows are distinct already (the kernel's).
+    """
     out = sets[0]
     for q in sets[1:]:
         if len(q):
@@ -278,9 +284,12 @@ def _union(sets: list[np.ndarray]) -> np.ndarray:
 
 def _setup_configurations(chain: Any, rng: np.random.Generator, scale: float
                           ) -> np.ndarray:
-    """(<= 2 SETUP_POSES, 6) joint values: uniform ones, then about half of the joints at
-    0, +-pi/2, pi, the others uniform; non-singular ones only (Jacobian singular values
-    above ``ISOLATED * scale``: the solutions are isolated, a finite set to compare)."""
+    """Set-up configurations, (<= 2 SETUP_POSES, 6) joint values.
+
+    Uniform ones, then ones with about half of the joints at 0, +-pi/2, pi and the
+    others uniform; non-singular ones only (Jacobian singular values above
+    ``ISOLATED * scale``: the solutions are isolated, a finite set to compare).
+    """
     q = rng.uniform(-np.pi, np.pi, (8 * SETUP_POSES, 6))
     special = SPECIAL_VALUES[rng.integers(0, len(SPECIAL_VALUES), q.shape)]
     half = 4 * SETUP_POSES
@@ -310,8 +319,11 @@ class _Trial:
     missed: int
 
     def key(self) -> tuple[int, int, int, int, float]:
-        """How good a primary it is: misses, then degenerate and noisy poses (where
-        the kernel needs the secondary), clusters, tail."""
+        """How good a primary it is (smaller is better).
+
+        Misses, then degenerate and noisy poses (where the kernel needs the
+        secondary), clusters, tail.
+        """
         return (self.missed, int(self.degenerate.sum()), int(self.noisy.sum()),
                 self.clusters, self.tail)
 
@@ -423,17 +435,36 @@ def _setup(chain: Any) -> General6R:
         if missed == 0:
             break
     assert best is not None
-    missed, p, s, params = best
+    missed, p, s, _ = best
     if missed:
         return General6R(None, scale=scale, reason=(
             f"the general 6R elimination missed {missed} of {n_ref} solutions of its "
             f"{len(q)} test poses (best variants: {p}, then {s})"))
+    order = _fallbacks(trials, p, s)
+    params = _params([blocks[v] for v in order], scale)
     tp = trials[p]
-    measured = (f"Raghavan-Roth elimination, {p} (secondary {s}; primary degenerate at "
-                f"{int(tp.degenerate.sum())} of {len(q)} test poses, half at 0, +-pi/2, "
-                f"pi); all {n_ref} solutions of the test poses found; DFT tail "
-                f"{tp.tail:.1e}")
-    return General6R(params, p, s, measured=measured, tail=tp.tail, scale=scale)
+    measured = (f"Raghavan-Roth elimination, {p} (then {', '.join(map(str, order[1:]))} "
+                f"where it is degenerate or noisy: at {int((tp.degenerate | tp.noisy).sum())}"
+                f" of {len(q)} test poses, half at 0, +-pi/2, pi); all {n_ref} solutions "
+                f"of the test poses found; DFT tail {tp.tail:.1e}")
+    return General6R(params, p, s, measured=measured, tail=tp.tail, scale=scale,
+                     variants=tuple(order))
+
+
+def _fallbacks(trials: dict[Variant, _Trial], p: Variant, s: Variant) -> list[Variant]:
+    """The variants the kernel tries in turn.
+
+    p, s, then up to FALLBACKS more, each with another split and direction (its own
+    right side, which a pose can make rank deficient where the others' is not), best
+    key first.
+    """
+    order = [p, s]
+    for v in sorted(trials, key=lambda v: trials[v].key()):
+        if len(order) == 2 + FALLBACKS:
+            break
+        if all((v.split, v.reversed) != (u.split, u.reversed) for u in order):
+            order.append(v)
+    return order
 
 
 # -------------------------------------------------------------- the solver
@@ -532,7 +563,7 @@ def make_single(chain: Any) -> Any:
         Q = empty((1, MAX_SOLUTIONS, 6))
         valid, inside = empty((1, MAX_SOLUTIONS), b1), empty((1, MAX_SOLUTIONS), b1)
         sigma, status, diag = empty((1, MAX_SOLUTIONS)), empty(1, np.int64), empty(1, np.int64)
-        kern(packed, params, T1, Q, valid, inside, sigma, status, diag, empty((1, 3)), False)
+        kern(packed, params, T1, Q, valid, inside, sigma, status, diag, empty((1, 4)), False)
         runs = int(diag[0] & secondary != 0)
         return trusted(Q[0], valid[0], is_rev, limits,
                        {"within_limits": inside[0], "singular": sigma[0] < 1e-6}, {},
