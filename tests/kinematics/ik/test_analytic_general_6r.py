@@ -613,3 +613,24 @@ def test_panda_with_joint2_held_at_zero_is_degenerate_and_says_so():
     assert sols.method == "numeric (joint2 held)"
     reduced = robokin.Robot(panda.chain.with_fixed({1: 0.0}))
     assert "a degenerate arm" in robokin.ik.family(reduced).reason
+
+
+def test_nearly_degenerate_arm_is_refused_with_a_reason_not_a_traceback():
+    # a random sparse arm (found by the sparse sweep): axes 1, 2 parallel, axis 3
+    # 2.9e-4 rad from them and a spherical wrist, 2.9e-4 rad from rank 5 everywhere
+    # (Jacobian's smallest singular value 1e-8..9e-5): no set-up configuration has
+    # isolated solutions. The family is refused with that reason (it raised a bare
+    # ValueError from numpy before); robot.ik falls back to numeric and says so, and
+    # method="analytic" is an InputError naming the reason.
+    rows = [(-0.1498, -0.4836, 0.0), (-0.3551, 0.0, 0.000287), (-0.1308, 0.0, H),
+            (0.0, -0.3423, H), (0.0, 0.0, -H), (0.0, 0.0, -H)]
+    robot = robokin.Robot.from_dh([{"joint": "revolute", "a": a, "d": d, "alpha": al,
+                                    "theta": 0.0, "limits": [-math.pi, math.pi]}
+                                   for a, d, al in rows])
+    fam = robokin.ik.family(robot)
+    assert fam.solver is None
+    assert "general_6r: a nearly degenerate arm" in fam.reason
+    q = np.array([0.3, 0.2, -0.4, 0.5, 0.6, 0.7])
+    assert robot.ik(robot.fk(q)).method == "numeric"
+    with pytest.raises(InputError, match="nearly degenerate arm"):
+        robot.ik(robot.fk(q), method="analytic")

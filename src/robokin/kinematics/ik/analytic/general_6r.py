@@ -35,6 +35,8 @@ This module does the per-arm set-up, once per chain (cached with the chain):
 Arms with a prismatic joint or dependent joints are not offered this family (the
 elimination is written for revolute joints), nor degenerate arms (rank-deficient
 Jacobian everywhere: two coincident axes, infinitely many solutions for every pose),
+nor nearly degenerate ones (its smallest singular value below ``ISOLATED`` per metre
+of arm at every set-up configuration: no isolated solutions to check the set-up on),
 nor, should it happen, arms whose chosen variants miss a reference solution: their
 ``Family.reason`` says why and ``robot.ik`` falls back to the numeric solver, which
 its ``method`` says.
@@ -418,6 +420,13 @@ def _setup(chain: Any) -> General6R:
     if reason:
         return General6R(None, reason=reason, scale=scale)
     q = _setup_configurations(chain, rng, scale)
+    if len(q) == 0:
+        return General6R(None, scale=scale, reason=(
+            "a nearly degenerate arm: its Jacobian's smallest singular value is below "
+            f"{ISOLATED:g} per metre of arm at all of {8 * SETUP_POSES} test "
+            "configurations (e.g. axes within a fraction of a milliradian of a "
+            "rank-deficient geometry), so the set-up cannot check the elimination on "
+            "isolated solutions"))
     blocks = _fits(chain, rng)
     if isinstance(blocks, str):  # pragma: no cover
         return General6R(None, reason=blocks, scale=scale)
