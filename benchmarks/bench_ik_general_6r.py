@@ -40,7 +40,8 @@ Measured per group and set:
   (missing) and the reverse (extra), matched within 1e-6 rad.
 
 Every robokin solution is checked to reproduce its pose before anything is reported.
-Run: ``python benchmarks/bench_ik_general_6r.py [--poses 10000] [--ssik 200]``.
+Run: ``python benchmarks/bench_ik_general_6r.py [--poses 10000] [--ssik 200]
+[--groups irb140,random]`` (ssik's set-up is minutes of CPU per arm the first time).
 """
 
 from __future__ import annotations
@@ -75,6 +76,12 @@ def random_arm(rng: np.random.Generator, k: int) -> robokin.Robot:
              "alpha": rng.uniform(-np.pi, np.pi), "theta": rng.uniform(-np.pi, np.pi),
              "limits": [-np.pi, np.pi]} for _ in range(6)]
     return robokin.Robot.from_dh(rows, name=f"random{k}")
+
+
+def random_arms(count: int) -> list[robokin.Robot]:
+    """``count`` random general DH arms (seed 0)."""
+    rng = np.random.default_rng(0)
+    return [random_arm(rng, k) for k in range(count)]
 
 
 def sparse_arms(rng: np.random.Generator, count: int) -> list[robokin.Robot]:
@@ -114,13 +121,22 @@ def panda_held() -> list[robokin.Robot]:
                           name=f"panda ({j}={v:g} held)") for j, v in HELD.items()]
 
 
-def groups(n_random: int, n_sparse: int) -> list[tuple[str, list[robokin.Robot]]]:
-    rng = np.random.default_rng(0)
-    return [("random general 6R DH arms", [random_arm(rng, k) for k in range(n_random)]),
-            ("ABB IRB140 (rtb-data URDF)", [robokin.Robot.from_urdf(IRB140, geometry=False)]),
-            ("UR5, twisted forearm + offset wrist", [ur_twisted()]),
-            ("random sparse DH arms", sparse_arms(np.random.default_rng(1), n_sparse)),
-            ("Panda, joint 1 / 2 / 3 held", panda_held())]
+GROUPS = ("random", "irb140", "ur_twisted", "sparse", "panda_held")
+
+
+def groups(n_random: int, n_sparse: int, keys: tuple[str, ...] = GROUPS
+           ) -> list[tuple[str, list[robokin.Robot]]]:
+    """(title, arms) of the groups named in ``keys`` (see ``GROUPS``), in that order."""
+    make = {
+        "random": lambda: ("random general 6R DH arms", random_arms(n_random)),
+        "irb140": lambda: ("ABB IRB140 (rtb-data URDF)",
+                           [robokin.Robot.from_urdf(IRB140, geometry=False)]),
+        "ur_twisted": lambda: ("UR5, twisted forearm + offset wrist", [ur_twisted()]),
+        "sparse": lambda: ("random sparse DH arms",
+                           sparse_arms(np.random.default_rng(1), n_sparse)),
+        "panda_held": lambda: ("Panda, joint 1 / 2 / 3 held", panda_held()),
+    }
+    return [make[k]() for k in keys]
 
 
 def open_limits(robot: robokin.Robot) -> robokin.Robot:
@@ -337,7 +353,8 @@ def run_set(name: str, kind: str, robots: list, opt: Options, rng: np.random.Gen
                                                       strict=True)]
         if opt.ssik and r_i == 0:
             ssik_rows.append(ssik_run(robot, q[:opt.ssik], T[:opt.ssik], ours[:opt.ssik]))
-    print(f"\n{name}, {kind} poses: {per * len(robots)} poses ({len(robots)} arm(s))")
+    print(f"\n{name}, {kind} poses: {per * len(robots)} poses ({len(robots)} arm(s))",
+          flush=True)
     print(f"  robokin µs/pose: kernel 1 thread {speed['1 thread cpu']:.1f} CPU "
           f"({speed['1 thread']:.1f} wall), all threads {speed['all threads']:.1f}, "
           f"robot.ik {speed['robot.ik']:.1f}")
@@ -357,15 +374,16 @@ def run_set(name: str, kind: str, robots: list, opt: Options, rng: np.random.Gen
         print(f"  ssik (first arm, {opt.ssik} poses): set-up {s['setup']:.1f} s, "
               f"{s['ms']:.2f} ms/pose, generating {100 * s['generating']:.1f} % of "
               f"{s['isolated']}, wrong {s['wrong']}, robokin's not found {s['missing']}, "
-              f"not robokin's {s['extra']}")
+              f"not robokin's {s['extra']}", flush=True)
 
 
-def main(opt: Options, n_random: int = 5, n_sparse: int = 8) -> None:
+def main(opt: Options, n_random: int = 5, n_sparse: int = 8,
+         keys: tuple[str, ...] = GROUPS) -> None:
     """Run every comparison and print one block per arm group and pose set."""
     print(f"robokin {robokin.__version__}, kernels {_native.ISA}, "
-          f"{_native.num_threads()} pool threads")
+          f"{_native.num_threads()} pool threads", flush=True)
     rng = np.random.default_rng(2)
-    for name, robots in groups(n_random, n_sparse):
+    for name, robots in groups(n_random, n_sparse, keys):
         for robot in robots:
             fam = robokin.ik.family(robot)
             assert fam.name == "general_6r", (robot.name, fam)
@@ -383,5 +401,11 @@ if __name__ == "__main__":
                     help="ssik poses per set on each group's first arm (set-up: minutes)")
     ap.add_argument("--random", type=int, default=5, help="random general arms")
     ap.add_argument("--sparse", type=int, default=8, help="random sparse arms")
+    ap.add_argument("--groups", default=",".join(GROUPS),
+                    help=f"comma-separated arm groups, of {', '.join(GROUPS)}")
     a = ap.parse_args()
-    main(Options(a.poses, a.sub, a.ref_seeds, a.ik_geo, a.ssik), a.random, a.sparse)
+    keys = tuple(k.strip() for k in a.groups.split(",") if k.strip())
+    bad = [k for k in keys if k not in GROUPS]
+    if bad:
+        ap.error(f"--groups: unknown {', '.join(bad)}; choose from {', '.join(GROUPS)}")
+    main(Options(a.poses, a.sub, a.ref_seeds, a.ik_geo, a.ssik), a.random, a.sparse, keys)
