@@ -36,9 +36,9 @@ Measured per group and set:
   chain, ``solve(T, respect_limits=False)``): set-up time (``prepare()``: its per-arm
   symbolic derivation, cached on disk by ssik after the first run), milliseconds per
   pose (CPU time of the calling thread and wall, one Python call per pose), the
-  generating configuration recovered (a row within 1e-6 rad), rows with an FK error above 1e-9 m / rad, and on the
-  non-singular poses the solutions robokin has that ssik does not (missing) and the
-  reverse (extra), matched within 1e-6 rad.
+  generating configuration recovered (a row within 1e-6 rad), rows with an FK error
+  above 1e-9 m / rad, and on the non-singular poses the solutions robokin has that
+  ssik does not (missing) and the reverse (extra), matched within 1e-6 rad.
 
 Every robokin solution is checked to reproduce its pose before anything is reported.
 Run: ``python benchmarks/bench_ik_general_6r.py [--poses 10000] [--ssik 200]
