@@ -515,8 +515,11 @@ LOST = [
     ("irb140", [-0.08899906526957402, 2.447224238106835, 1.1345, -math.pi,
                 -1.5707962267948965, 1e-07]),
     ("irb140", [H, 2.0900648210551056, 0.0, -math.pi, -H, -math.pi]),
-    # the Panda with joint 1 held at 0 / 0.7 and joint 3 at 0: clusters, a degenerate
-    # primary, a pose 1e-7 from a degenerate one
+    # the Panda with joint 1 held at 0 / 0.7, joint 3 at 0 and joint 7 at 0.7:
+    # clusters, a degenerate primary, a pose 1e-7 from a degenerate one, a noisy
+    # cluster where every other variant is degenerate (the primary's sibling)
+    ("panda_joint7_0.7", [2.8973, 1.5707962267948965, H, -3.0718, 3.141592753589793,
+                          3.1415936535897933]),
     ("panda_joint1_0", [-1.5707963277948966, math.pi, -1.4694468369271578, -H, -H,
                         3.141592652589793]),
     ("panda_joint1_0", [-1.7628, math.pi, 1.5707963257948965, -1.5707964267948966,
@@ -568,7 +571,7 @@ def test_special_poses_against_a_dense_multistart():
     # the whole solution set, not only the generating configuration: a pose where four
     # solutions share joint 6 (IRB140), one where every variant is degenerate
     # (sparse_c: the projection), one near a degenerate pose (sparse_a)
-    for name, q in (LOST[0], LOST[12], LOST[8]):
+    for name, q in (LOST[0], LOST[13], LOST[9]):
         robot = six_r_arm(name)
         T = robot.fk(np.array(q))
         ours = robot.ik(T).solutions()
@@ -579,11 +582,11 @@ def test_special_poses_against_a_dense_multistart():
 
 
 def test_kernel_candidates_and_flags_on_a_degenerate_pose():
-    # sparse_c at LOST[12]: det Sigma vanishes for every theta in every variant, the
+    # sparse_c at LOST[13]: det Sigma vanishes for every theta in every variant, the
     # projection (c_d) gives candidates near the generating configuration
     robot = sparse_arm("sparse_c")
     g = general_6r.setup(robot.chain)
-    q = np.array(LOST[12][1])
+    q = np.array(LOST[13][1])
     out = np.empty((K.G6_MAXCAND, 6))
     n, flags = K.general6r_candidates(g.params, np.ascontiguousarray(robot.fk(q)), out)
     assert flags & K.G6F_DEGENERATE and flags & K.G6F_PROJECTED
@@ -595,9 +598,13 @@ def test_kernel_candidates_and_flags_on_a_degenerate_pose():
 
 def test_setup_ranks_fallback_variants_with_their_own_right_side():
     g = general_6r.setup(irb140().chain)
-    assert len(g.variants) == 2 + general_6r.FALLBACKS
+    p = g.primary
+    sibling = general_6r.Variant(p.reversed, p.split, 1 - p.multiplier)
     assert g.variants[:2] == (g.primary, g.secondary)
-    sides = {(v.split, v.reversed) for v in g.variants[2:]}
+    assert g.variants[-1] == sibling or (g.secondary == sibling
+                                         and len(g.variants) == 2 + general_6r.FALLBACKS)
+    fallbacks = g.variants[2:2 + general_6r.FALLBACKS]
+    sides = {(v.split, v.reversed) for v in fallbacks}
     assert len(sides) == general_6r.FALLBACKS
     assert not sides & {(v.split, v.reversed) for v in g.variants[:2]}
     assert int(g.params[K.GP_NVAR]) == len(g.variants)

@@ -465,7 +465,13 @@ def _fallbacks(trials: dict[Variant, _Trial], p: Variant, s: Variant) -> list[Va
 
     p, s, then up to FALLBACKS more, each with another split and direction (its own
     right side, which a pose can make rank deficient where the others' is not), best
-    key first.
+    key first; last the primary's other dialytic multiplier (its sibling), unless
+    already there. The sibling runs only where every variant before it was
+    degenerate or noisy: where the others are degenerate and the primary splits a
+    noisy cluster (the Panda with joint 7 held at 0.7, q2 = q3 = pi/2, q5 = q6 = pi:
+    four solutions share q5), the split is sensitive to rounding in the fit (a
+    6.7e-15 change lost the generating configuration) and the sibling's multiplier
+    gives an independent set of candidates.
     """
     order = [p, s]
     for v in sorted(trials, key=lambda v: trials[v].key()):
@@ -473,6 +479,9 @@ def _fallbacks(trials: dict[Variant, _Trial], p: Variant, s: Variant) -> list[Va
             break
         if all((v.split, v.reversed) != (u.split, u.reversed) for u in order):
             order.append(v)
+    sibling = Variant(p.reversed, p.split, 1 - p.multiplier)
+    if sibling not in order:
+        order.append(sibling)
     return order
 
 
