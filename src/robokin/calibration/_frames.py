@@ -32,7 +32,8 @@ from robokin.exceptions import ModelError
 from robokin.model.chain import Chain, ChainBuilder, joint_motion
 from robokin.spatial import invert, rotx, roty, rotz, trans
 
-__all__ = ["Row", "joint_frames", "reframe", "row_matrix", "rows_from_axes"]
+__all__ = ["Row", "frames_at_zero", "joint_frames", "reframe", "row_matrix",
+           "rows_from_axes", "zero_values"]
 
 RowForm = Literal["dh", "hayati"]
 _TINY = 1e-12
@@ -186,17 +187,45 @@ def _closest_frame(W: np.ndarray, target: np.ndarray) -> np.ndarray:
     return W @ rotz(phi) @ trans(0.0, 0.0, s)
 
 
+def zero_values(chain: Chain) -> np.ndarray:
+    """Each chain joint's motion value ``u_k`` at zero joint coordinates, (n_chain,)."""
+    c = np.asarray(chain.coupling.offset, dtype=float).reshape(-1)
+    return np.array([j.sign * ck + j.offset for j, ck in zip(chain.joints, c)])
+
+
+def frames_at_zero(chain: Chain) -> tuple[np.ndarray, np.ndarray]:
+    """Joint frames at zero joint coordinates (n_chain, 4, 4), and the flange (4, 4).
+
+    The frame right before ``J_k`` with every earlier joint at its ``q = 0``
+    value; the flange is the end of the chain (before the tool), base left out.
+    """
+    e = zero_values(chain)
+    out = np.empty((chain.n_chain, 4, 4))
+    W = np.array(chain.head)
+    for k, j in enumerate(chain.joints):
+        out[k] = W
+        W = W @ joint_motion(j.kind, e[k]) @ chain.frame_offsets[k] @ chain.link_offsets[k]
+    return out, W
+
+
 def reframe(chain: Chain, like: Chain) -> Chain:
-    """``chain`` re-expressed with its link frames as close as possible to ``like``'s.
+    r"""``chain`` re-expressed with its link frames as close as possible to ``like``'s.
 
     Both chains need the same joints (kinds). The result has exactly
-    ``chain``'s forward kinematics (each joint frame only slides along and turns
-    about its own axis, which commutes with the joint's motion), its joints,
-    coupling, base and tool; its joint frames are the ones on ``chain``'s axes
-    nearest ``like``'s, and its link frames sit where ``like``'s ``F_k`` put them.
-    A robot file or URDF written from it therefore has link origins near the
-    physical links, not metres away as a DH table of near-parallel axes puts
-    them (ros-industrial/universal_robot#357).
+    ``chain``'s forward kinematics, its joints (offsets included), coupling,
+    base and tool. Its joint frames at ``q = 0`` are the frames on ``chain``'s
+    axes nearest ``like``'s (each only slides along and turns about its own
+    axis, which commutes with the joint's motion), and its link frames sit
+    relative to them as ``like``'s do at equal joint coordinates. A robot file
+    or URDF written from it therefore has link origins near the physical links,
+    not metres away as a DH table of near-parallel axes puts them
+    (ros-industrial/universal_robot#357).
+
+    .. math:: T(q) = \prod_k V_k J_k(u_k - e_k) V_k^{-1} \cdot P
+
+    with ``V_k`` the new joint frames at ``q = 0``, ``e_k`` the joint values there
+    and ``P`` the flange at ``q = 0``; each factor is written as joint ``k``
+    followed by ``F'_k = J(e'_k - e_k) F'_{like}`` and ``G'_k``.
 
     Raises:
         ModelError: the chains differ in joint count or kinds.
@@ -204,22 +233,15 @@ def reframe(chain: Chain, like: Chain) -> Chain:
     if like.n_chain != chain.n_chain or any(
             a.kind != b.kind for a, b in zip(chain.joints, like.joints)):
         raise ModelError("reframe: the chains must have the same joints")
-    W = joint_frames(chain)
-    Wl = joint_frames(like)
-    V = np.empty_like(W)
-    for k, (j, jl) in enumerate(zip(chain.joints, like.joints)):
-        # at equal joint coordinates the link frames should match:
-        # V_k J(u_k) ~ W'_k J(u'_k)  =>  target V_k = W'_k J(u'_k - u_k)
-        target = Wl[k] @ joint_motion(j.kind, jl.offset - j.offset)
-        V[k] = _closest_frame(W[k], target)
+    W, tip = frames_at_zero(chain)
+    Wl, _ = frames_at_zero(like)
+    e, el = zero_values(chain), zero_values(like)
     n = chain.n_chain
-    tip = W[-1] @ chain.frame_offsets[-1] @ chain.link_offsets[-1]
+    V = [_closest_frame(W[k], Wl[k]) for k in range(n)] + [tip]
     builder = ChainBuilder().constant(V[0])
-    for k in range(n):
-        after = V[k + 1] if k + 1 < n else tip
-        C = invert(V[k]) @ after
-        F = like.frame_offsets[k]
-        builder.joint(chain.joints[k]).constant(F).frame().constant(invert(F) @ C)
-    out = builder.build(base=chain.base, tool=chain.tool,
-                        coordinates=chain.coordinates, coupling=chain.coupling)
-    return out
+    for k, j in enumerate(chain.joints):
+        F = joint_motion(j.kind, el[k] - e[k]) @ like.frame_offsets[k]
+        C = joint_motion(j.kind, -e[k]) @ invert(V[k]) @ V[k + 1]
+        builder.joint(j).constant(F).frame().constant(invert(F) @ C)
+    return builder.build(base=chain.base, tool=chain.tool,
+                         coordinates=chain.coordinates, coupling=chain.coupling)

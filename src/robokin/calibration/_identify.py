@@ -32,16 +32,15 @@ def structural_rules(model: Model, kind: str, parallel_tol: float) -> dict[str, 
     so the report lists them.
     """
     out: dict[str, str] = {}
-    j1 = model.chain.joints[0]
     out["j1.theta"] = ("a rotation about joint 1's axis: absorbed by the base "
                        "(measuring frame) pose")
     if "j1.d" in model.names:
         out["j1.d"] = "a shift along joint 1's axis: absorbed by the base pose"
     n = model.chain.n_chain
     last = f"j{n}"
+    offset = "theta" if model.chain.joints[-1].kind == "revolute" else "d"
     for p in ("theta", "d", "a", "alpha"):
-        what = ("its zero offset" if (p == "theta") == (model.chain.joints[-1].kind
-                                                         == "revolute") else f"{p}")
+        what = "zero offset" if p == offset else f"link parameter {p}"
         out[f"{last}.{p}"] = (f"the last joint's {what}: absorbed by the tool "
                               "(flange -> TCP) transform")
     if kind == "position":
@@ -55,7 +54,7 @@ def structural_rules(model: Model, kind: str, parallel_tol: float) -> dict[str, 
     if m > 1 and m < n and f"j{m}.d" in model.names:
         out[f"j{m}.d"] = (f"a shift along joints 1-{m}'s parallel axes: absorbed by "
                           "the base pose")
-    del j1, parallel_tol
+    del parallel_tol
     return out
 
 
