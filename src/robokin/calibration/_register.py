@@ -86,12 +86,19 @@ def register_points(
     return B, t
 
 
-def register_poses(flange: np.ndarray, measured: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def register_poses(flange: np.ndarray, measured: np.ndarray,
+                   tool0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Base pose and tool pose from measured poses ``M_i = B F_i X``.
+
+    When the flange rotations leave the split between ``B`` and ``X`` open (every
+    joint axis parallel: ``B Rz(phi)`` and ``Rz(-phi) X`` fit alike), the
+    solution nearest the nominal tool ``tool0`` is taken, and the translations
+    are the least-norm ones.
 
     Args:
         flange: Nominal flange poses (N, 4, 4) in the robot base frame.
         measured: Measured tool poses (N, 4, 4) in the measuring frame.
+        tool0: The nominal tool (4, 4), for that choice (default identity).
 
     Returns:
         ``B`` (4, 4) and ``X`` (4, 4).
@@ -105,8 +112,15 @@ def register_poses(flange: np.ndarray, measured: np.ndarray) -> tuple[np.ndarray
         rows[i, :, :9] = np.kron(I3, RM[i])
         rows[i, :, 9:] = -np.kron(RF[i].T, I3)
     Rf = rows.reshape(-1, 18)
-    _, _, Vt = np.linalg.svd(Rf.T @ Rf)  # the 18 x 18 Gram matrix: see register_points
-    v = Vt[-1]
+    _, e, Vt = np.linalg.svd(Rf.T @ Rf)  # the 18 x 18 Gram matrix: see register_points
+    null = Vt[e <= max(e[-1], 1e-10 * e[0]) * 1e3 + 1e-300]
+    if len(null) > 1:  # the split is open: the member nearest the nominal tool
+        Y0 = (np.eye(3) if tool0 is None else np.asarray(tool0)[:3, :3]).T
+        target = Y0.reshape(-1, order="F")
+        coef, *_ = np.linalg.lstsq(null[:, :9].T, target, rcond=None)
+        v = coef @ null
+    else:
+        v = Vt[-1]
     Y = v[:9].reshape(3, 3, order="F")
     RB = v[9:].reshape(3, 3, order="F")
     if np.linalg.det(RB) < 0:
@@ -119,7 +133,7 @@ def register_poses(flange: np.ndarray, measured: np.ndarray) -> tuple[np.ndarray
     A[:, :, 3:] = I3
     b = measured[:, :3, 3] - np.einsum("ij,nj->ni", RB, flange[:, :3, 3])
     Af = A.reshape(-1, 6)
-    sol = np.linalg.solve(Af.T @ Af, Af.T @ b.reshape(-1))
+    sol = np.linalg.pinv(Af.T @ Af, rcond=1e-10) @ (Af.T @ b.reshape(-1))
     B = np.eye(4)
     X = np.eye(4)
     B[:3, :3], B[:3, 3] = RB, sol[3:]

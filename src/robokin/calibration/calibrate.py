@@ -57,6 +57,9 @@ PARALLEL_TOL = math.radians(10.0)
 #: chi-square quantile at 1 - 1e-4 (scipy.stats.chi2.ppf(1 - 1e-4, dof)), for 3
 #: (points) or 6 (poses) components: 2 in 10,000 inliers are set aside.
 _CHI2_LIMIT = {3: 21.107513466160444, 6: 27.85634123601417}
+#: A parameter redundant at the nominal geometry comes back at the estimate only
+#: when its scaled singular value exceeds this share of the largest.
+PRACTICAL_TOL = 1e-3
 
 
 @dataclass(frozen=True)
@@ -216,7 +219,7 @@ def _register(model: Model, q: np.ndarray, measured: np.ndarray, pose: bool,
     x0 = np.zeros(model.size)
     flange = model.evaluate(q, x0, np.eye(4), np.eye(4)).T
     if pose:
-        return register_poses(flange, measured)
+        return register_poses(flange, measured, tool)
     B, t = register_points(flange, measured, tool[:3, 3])
     T0 = np.array(tool, dtype=float)
     T0[:3, 3] = t
@@ -257,23 +260,46 @@ def _rich_q(robot: Robot, count: int) -> np.ndarray:
     return rng.uniform(lim[:, 0], lim[:, 1], (count, robot.n))
 
 
-def _structural_drops(problem: Problem, robot: Robot, x: np.ndarray,
-                      active: list[int]) -> list[tuple[str, list[str]]]:
-    """Parameters that trade with others for every pose, at parameters ``x``."""
+def _rich_jacobian(problem: Problem, robot: Robot, x: np.ndarray,
+                   active: list[int]) -> np.ndarray:
+    """The identification Jacobian of a rich synthetic pose set (no compliance)."""
     rich = Problem(problem.model, _rich_q(robot, max(60, 2 * len(active))),
                    np.zeros((0, 3)), problem.pose, problem.base, problem.tool, None,
                    problem.rotation_weight)
     ev = rich.evaluate(x, np.array(active))
     assert ev.Jp is not None and ev.Jr is not None
     J = np.concatenate([ev.Jp, ev.Jr], axis=1) if problem.pose else ev.Jp
-    if problem.model.compliance[0] >= 0 or any(i >= 0 for i in problem.model.compliance):
-        # compliance columns need torques: judged on the data alone
-        keep = [c for c, i in enumerate(active)
-                if i not in problem.model.compliance]
-        names = [problem.model.names[active[c]] for c in keep]
-        return dependent_parameters(J.reshape(-1, len(active))[:, keep], names)
-    return dependent_parameters(J.reshape(-1, len(active)),
-                                [problem.model.names[i] for i in active])
+    return J.reshape(-1, len(active))
+
+
+def _structural_drops(problem: Problem, robot: Robot, x: np.ndarray,
+                      active: list[int], tol: float = RANK_TOL
+                      ) -> list[tuple[str, list[str]]]:
+    """Parameters that trade with others for every pose, at parameters ``x``.
+
+    Compliance columns need torques: they are judged on the data alone.
+    """
+    cols = [i for i in active if i not in problem.model.compliance]
+    J = _rich_jacobian(problem, robot, x, cols)
+    return dependent_parameters(J, [problem.model.names[i] for i in cols], tol)
+
+
+def _restored(problem: Problem, robot: Robot, x: np.ndarray, active: list[int],
+              dropped: list[int]) -> list[int]:
+    """Parameters dropped at nominal that the estimate identifies after all.
+
+    One is restored when, with it, the smallest scaled singular value of the
+    rich Jacobian stays above :data:`PRACTICAL_TOL` of the largest: an exact
+    redundancy at the nominal geometry (parallel axes) that the estimate breaks
+    only by its 0.05 deg tilts stays dropped (it would amplify noise ~1000x).
+    """
+    back: list[int] = []
+    for i in dropped:
+        cols = [c for c in active + back + [i] if c not in problem.model.compliance]
+        s, _, _ = scaled_svd(_rich_jacobian(problem, robot, x, cols))
+        if s[-1] > PRACTICAL_TOL * s[0]:
+            back.append(i)
+    return back
 
 
 def _robust_stages(problem: Problem, x: np.ndarray, active: list[int],
@@ -396,15 +422,22 @@ def calibrate(
     prob = Problem(mdl, qa, meas, pose, B0, T0, tq, rotation_weight or 0.1)
     x = np.zeros(mdl.size)
     unident = dict(absorbed)
+    at_nominal = []
     for name, partners in _structural_drops(prob, robot, x, active):
         unident[name] = "redundant with " + ", ".join(partners)
         active.remove(mdl.index(name))
+        at_nominal.append(mdl.index(name))
     x, inliers, _ = _robust_stages(prob, x, active, rotation_weight is not None)
     # judged again at the estimate: the set may change away from nominal
-    for name, partners in _structural_drops(prob, robot, x, active):
-        unident[name] = "redundant with " + ", ".join(partners)
+    for name, partners in _structural_drops(prob, robot, x, active, PRACTICAL_TOL):
+        unident[name] = ("redundant with " + ", ".join(partners) + " (nearly: any "
+                         "pose set amplifies noise > 1000x for it)")
         active.remove(mdl.index(name))
         x[mdl.index(name)] = 0.0
+    for i in _restored(prob, robot, x, active, at_nominal):
+        active.append(i)
+        del unident[mdl.names[i]]
+    active.sort()
     x = prob.solve(x, np.array(active), rows=inliers)
     cov, sigma, J = _covariance(prob, x, active, inliers)
     _refuse_unidentified(J, [mdl.names[i] for i in active], len(inliers), per_pose)
@@ -421,7 +454,7 @@ def _result(robot: Robot, prob: Problem, x: np.ndarray, active: list[int],
     params, pcov = _parameters(robot, prob, x, active, cov)
     ev = prob.evaluate(x, None, inliers)
     rp, rr = prob.split_residual(ev, inliers)
-    registered = _registered(robot, prob)
+    registered = _registered(robot, prob, inliers)
     unidentifiable = tuple((n, r) for n, r in unident.items()
                            if n not in {p.name for p in params})
     return CalibrationResult(
@@ -435,15 +468,18 @@ def _result(robot: Robot, prob: Problem, x: np.ndarray, active: list[int],
         rotation_weight=prob.rotation_weight if prob.pose else math.nan, sigma=sigma)
 
 
-def _registered(robot: Robot, prob: Problem) -> Robot:
-    """The nominal robot with only the measuring frame and the tool fitted."""
+def _registered(robot: Robot, prob: Problem, inliers: np.ndarray) -> Robot:
+    """The nominal robot with only the measuring frame and the tool fitted.
+
+    A least-squares fit of the inliers, as ``model="base_tool"`` makes.
+    """
     mdl = prob.model
     x = np.zeros(mdl.size)
     act = [i for i, n in enumerate(mdl.names) if n.startswith(("base.", "tool."))]
     if not prob.pose:
         act = [i for i in act if mdl.names[i] not in ("tool.roll", "tool.pitch",
                                                       "tool.yaw")]
-    x = prob.solve(x, np.array(act), loss="soft_l1", f_scale=1e-3)
+    x = prob.solve(x, np.array(act), rows=inliers)
     chain = robot.chain.replace(base=prob.base @ mdl.pose_correction(x, "base"),
                                 tool=prob.tool @ mdl.pose_correction(x, "tool"))
     return robot.replace(chain=chain, name=f"{robot.name}_registered", meta={})
