@@ -59,13 +59,14 @@ def observability_index(robot: Robot, q: npt.ArrayLike, kind: str = "position", 
                         parallel_tol: float = math.radians(10.0)) -> float:
     """O1 of the poses ``q`` (N, n) for ``robot``'s identifiable parameters (larger is better).
 
-    Columns are scaled by their norms over the poses given, so the index
-    compares pose sets of one robot, not robots.
+    The Jacobian is in SI units (m per m, m per rad): its scaling is the same
+    for every pose set, so the index ranks pose sets of one robot the way the
+    determinant criterion of :func:`select_poses` does (a fixed column scaling
+    multiplies every set's O1 by the same factor). It does not compare robots.
     """
     qa = _check(robot, q, kind)
     J = _jacobians(robot, qa, kind, parallel_tol)
     Jf = J.reshape(-1, J.shape[-1])
-    Jf = Jf / np.where(np.linalg.norm(Jf, axis=0) > 0, np.linalg.norm(Jf, axis=0), 1.0)
     e = np.linalg.svd(Jf.T @ Jf, compute_uv=False)
     s = np.sqrt(np.maximum(e, 1e-300))
     return float(math.exp(np.log(s).mean()) / math.sqrt(len(qa)))
