@@ -282,6 +282,7 @@ def _register_extra_commands() -> None:
         "robokin.cli_retime",
         "robokin.cli_schema",
         "robokin.cli_cell",
+        "robokin.cli_calibrate",
     ):
         try:
             importlib.import_module(mod)

@@ -9,6 +9,7 @@ so the Jacobian is exact, not a small-residual approximation.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -104,7 +105,8 @@ class Problem:
         J = np.concatenate([ev.Jp, w * Jr], axis=1).reshape(-1, len(active))
         return r, J
 
-    def solve(self, x0: np.ndarray, active: np.ndarray, *, loss: str = "linear",
+    def solve(self, x0: np.ndarray, active: np.ndarray, *,
+              loss: Literal["linear", "soft_l1"] = "linear",
               f_scale: float = 1.0, rows: np.ndarray | None = None,
               max_nfev: int = 60) -> np.ndarray:
         """Fit the active parameters from ``x0`` (full vector); returns the full vector."""
@@ -121,8 +123,13 @@ class Problem:
                 cache["last"] = hit
             return hit[1]
 
-        res = least_squares(lambda xa: both(xa)[0], x0[active],
-                            jac=lambda xa: both(xa)[1], method="trf", loss=loss,
+        def fun(xa: np.ndarray) -> np.ndarray:
+            return both(xa)[0]
+
+        def jac(xa: np.ndarray) -> np.ndarray:
+            return both(xa)[1]
+
+        res = least_squares(fun, x0[active], jac=jac, method="trf", loss=loss,
                             f_scale=f_scale, x_scale="jac", max_nfev=max_nfev,
                             xtol=1e-12, ftol=1e-12, gtol=1e-12, tr_solver="lsmr")
         return self.full(res.x, active, x0)

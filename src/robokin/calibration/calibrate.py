@@ -500,7 +500,7 @@ def _parameters(robot: Robot, prob: Problem, x: np.ndarray, active: list[int],
         g[pos[i]] = 1.0
         unit = {"length": "m", "angle": "rad", "scale": "1",
                 "compliance": "rad/(N m)"}[mdl.kinds[i]]
-        rows.append((n, float(mdl.nominal[i]), float(mdl.nominal[i] + x[i]), unit, g))
+        rows.append((n, float(mdl.nominal[i]) + 0.0, float(mdl.nominal[i] + x[i]), unit, g))
     for side, T_nom, T_fit in (("base", robot.base, prob.base),
                                ("tool", robot.tool, prob.tool)):
         idx = [mdl.index(f"{side}.{c}") for c in ("x", "y", "z", "yaw", "pitch", "roll")]
