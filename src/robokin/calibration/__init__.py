@@ -11,15 +11,15 @@ Robots factory calibration as a robot. See ``docs/calibration.md``.
 from __future__ import annotations
 
 from robokin.calibration import synthetic
-from robokin.calibration.calibrate import CalibrationResult, Parameter, calibrate
-from robokin.calibration.evaluate import (
+from robokin.calibration._calibrate import CalibrationResult, Parameter, calibrate
+from robokin.calibration._evaluate import (
     ErrorStats,
     HoldoutReport,
     evaluate,
     holdout_report,
     plot_errors,
 )
-from robokin.calibration.select import observability_index, select_poses
+from robokin.calibration._select import observability_index, select_poses
 from robokin.calibration.ur import load_ur_calibration
 
 __all__ = [

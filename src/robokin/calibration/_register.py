@@ -81,8 +81,12 @@ def register_points(
         pts = np.einsum("nij,j->ni", R, t) + p
         RB, tB = _kabsch(pts, measured)
         local = np.einsum("ji,nj->ni", RB, measured - tB) - p  # R_B^T (m - t_B) - p
-        t = np.einsum("nji,nj->i", R, local) / N  # mean R_i^T (...)
+        t_new = np.einsum("nji,nj->i", R, local) / N  # mean R_i^T (...)
         B[:3, :3], B[:3, 3] = RB, tB
+        done = np.abs(t_new - t).max() < 1e-12
+        t = t_new
+        if done:
+            break
     return B, t
 
 

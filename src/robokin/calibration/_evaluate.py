@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any, Literal, overload
 import numpy as np
 import numpy.typing as npt
 
-from robokin.calibration.calibrate import CalibrationResult, check_measurements
+from robokin.calibration._calibrate import CalibrationResult, check_measurements
 from robokin.exceptions import InputError
 
 if TYPE_CHECKING:

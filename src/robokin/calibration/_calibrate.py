@@ -8,8 +8,9 @@ The steps (see ``docs/calibration.md``):
    (:mod:`robokin.calibration._register`), so any tracker placement converges;
 3. the parameters absorbed by construction left out, with the reason
    (:func:`~robokin.calibration._identify.structural_rules`);
-4. a robust fit (``soft_l1``) that finds outlier poses, then a least-squares fit
-   of the inliers (``scipy.optimize.least_squares``, exact Jacobian);
+4. a least-squares fit (``scipy.optimize.least_squares``, exact Jacobian); when
+   poses lie beyond a chi-square limit of the robust noise estimate, a robust
+   (``soft_l1``) fit sets them aside, and the inliers are fitted again;
 5. identifiability judged by rank at the estimate, on a rich synthetic pose set
    (parameters that trade with others for every pose are dropped and named) and
    on the data (a set that cannot identify what was asked is refused, naming
@@ -302,26 +303,43 @@ def _restored(problem: Problem, robot: Robot, x: np.ndarray, active: list[int],
     return back
 
 
+def _inliers(problem: Problem, x: np.ndarray) -> tuple[np.ndarray, float]:
+    """Poses within the chi-square limit of a robust noise estimate (MAD), and it."""
+    rp, rr = problem.split_residual(problem.evaluate(x, None))
+    comp = rp if rr is None else np.concatenate([rp, problem.rotation_weight * rr], 1)
+    sigma = 1.4826 * float(np.median(np.abs(comp)))
+    limit = _CHI2_LIMIT[comp.shape[1]] * max(sigma, 1e-12) ** 2
+    return np.flatnonzero((comp**2).sum(1) <= limit), sigma
+
+
 def _robust_stages(problem: Problem, x: np.ndarray, active: list[int],
                    weight_given: bool) -> tuple[np.ndarray, np.ndarray, float]:
-    """Robust fit, noise and rotation weight, outliers; returns (x, inlier rows, sigma)."""
+    """Fit, noise and rotation weight, outliers; returns (x, inlier rows, sigma).
+
+    A least-squares fit of every pose first; for poses the rotation weight is
+    then the ratio of the robust position and rotation noise (MAD). Only when
+    some pose lies beyond the chi-square limit is the fit redone: without the
+    suspects, then with a robust loss (``soft_l1`` of each pose's residual,
+    scale 3 sigma, :meth:`~robokin.calibration._fit.Problem.solve_robust`) over
+    every pose, and the outliers found again.
+    """
     act = np.array(active)
-    scale = 1e-3
-    x = problem.solve(x, act, loss="soft_l1", f_scale=scale)
-    ev = problem.evaluate(x, None)
-    rp, rr = problem.split_residual(ev)
-    if rr is not None and not weight_given:
+    x = problem.solve(x, act)
+    if problem.pose and not weight_given:
+        rp, rr = problem.split_residual(problem.evaluate(x, None))
+        assert rr is not None
         sp = 1.4826 * np.median(np.abs(rp))
         sr = 1.4826 * np.median(np.abs(rr))
         if sp > 0 and sr > 0:
             problem.rotation_weight = float(sp / sr)
-            x = problem.solve(x, act, loss="soft_l1", f_scale=scale)
-            ev = problem.evaluate(x, None)
-            rp, rr = problem.split_residual(ev)
-    comp = rp if rr is None else np.concatenate([rp, problem.rotation_weight * rr], 1)
-    sigma = 1.4826 * float(np.median(np.abs(comp)))
-    limit = _CHI2_LIMIT[comp.shape[1]] * max(sigma, 1e-12) ** 2
-    inliers = np.flatnonzero((comp**2).sum(1) <= limit)
+            x = problem.solve(x, act)
+    inliers, sigma = _inliers(problem, x)
+    if len(inliers) < len(problem.q):
+        # the suspects left out first (a least-squares fit of the rest), then a
+        # robust fit of every pose from there, then the outliers found again
+        x = problem.solve(x, act, rows=inliers)
+        x = problem.solve_robust(x, act, 3 * max(sigma, 1e-12))
+        inliers, sigma = _inliers(problem, x)
     return x, inliers, sigma
 
 
