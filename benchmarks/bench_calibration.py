@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import sys
 import time
 import warnings
 from dataclasses import dataclass
@@ -39,10 +40,12 @@ from pathlib import Path
 
 import numpy as np
 
-import robokin
-from robokin import calibration
-from robokin.calibration import synthetic
-from robokin.spatial import invert, pose_from_xyz_rpy
+sys.path.insert(0, str(Path(__file__).parent))
+
+import robokin  # noqa: E402
+from robokin import calibration  # noqa: E402
+from robokin.calibration import synthetic  # noqa: E402
+from robokin.spatial import invert, pose_from_xyz_rpy  # noqa: E402
 
 TRACKER = pose_from_xyz_rpy([2.0, 0.5, 0.3], [0.3, -2.0, 1.0])
 TOOL = pose_from_xyz_rpy([0.010, 0.020, 0.150], [0.1, 0.2, 0.3])
@@ -118,9 +121,6 @@ def run_robotkinecal(d: Data, kind: str, runs: int):
         from spatialmath import SE3
     except ImportError as exc:
         return {"skip": f"not installed ({exc.name})"}
-    import sys
-
-    sys.path.insert(0, str(Path(__file__).parent))
     from peers import rtb_ets
 
     robot = rtb.Robot(rtb_ets(d.nominal))
@@ -174,6 +174,15 @@ def line(label, r, floor):
             f"  max {r['max'] * 1e3:6.3f} mm  {r['t'][0]:6.3f}-{r['t'][1]:6.3f} s{extra}")
 
 
+def _version(name):
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version(name)
+    except PackageNotFoundError:
+        return "(absent)"
+
+
 def robots():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
@@ -198,9 +207,10 @@ def main() -> None:
                 print(f"  {'nominal (base+tool fitted)':28s} RMS "
                       f"{np.sqrt((e**2).mean()) * 1e3:7.4f} mm")
                 print(line("robokin", run_robokin(d, kind, args.runs), d.floor))
-                print(line("robotkinecal 0.1", run_robotkinecal(d, kind, args.runs),
+                print(line(f"robotkinecal {_version('robotkinecal')}", run_robotkinecal(d, kind, args.runs),
                            d.floor))
-                print(line("figaroh", run_figaroh(d, kind, args.runs), d.floor))
+                print(line(f"figaroh {_version('figaroh')}",
+                           run_figaroh(d, kind, args.runs), d.floor))
             if args.quick:
                 continue
             variants(name, robot, args.runs)
