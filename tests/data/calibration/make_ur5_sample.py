@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from robokin.calibration import synthetic
-from robokin.calibration.ur import ur_nominal
 from robokin.calibration._frames import Row, joint_frames, row_matrix, rows_from_axes
+from robokin.calibration.ur import ur_nominal
 from robokin.spatial import invert
 
 
