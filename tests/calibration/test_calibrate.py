@@ -261,6 +261,21 @@ def test_nan_measurement_is_refused(ur5):
         calibration.calibrate(ur5, case.q, m)
 
 
+def test_an_explicit_redundant_parameter_is_refused():
+    # on the SCARA (all axes vertical) j3.theta trades with the base and tool
+    scara = robokin.load("scara")
+    case = make_case(scara, "pose", n=80, hold=0, seed=12)
+    auto = calibration.calibrate(scara, case.q, case.measured, kind="pose")
+    assert "redundant with" in dict(auto.unidentifiable)["j3.theta"]
+    asked = [p.name for p in auto.parameters] + ["j3.theta"]
+    with pytest.raises(InputError, match=r"cannot identify .*'j3.theta': redundant with"):
+        calibration.calibrate(scara, case.q, case.measured, kind="pose", model=asked)
+    # without its partners it is identifiable: asked alone with a few, it is fitted
+    few = calibration.calibrate(scara, case.q, case.measured, kind="pose",
+                                model=["base.x", "base.y", "j3.theta", "j2.a"])
+    assert "j3.theta" in {p.name for p in few.parameters}
+
+
 def test_a_prismatic_arm_reports_its_redundancies():
     # the SCARA: every axis vertical, a prismatic shaft; the fit must still
     # reach the floor with only identifiable parameters (no rank-deficient fit)

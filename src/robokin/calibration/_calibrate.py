@@ -430,7 +430,7 @@ def calibrate(
                          f"got {rotation_weight!r}")
     pose = kind == "pose"
     mdl = Model.from_chain(robot.chain, parallel_tol=parallel_tol, extras=ext)
-    absorbed = structural_rules(mdl, kind, parallel_tol)
+    absorbed = structural_rules(mdl, kind)
     active = _active_set(mdl, absorbed, model, fixed)
     per_pose = 6 if pose else 3
     if N * per_pose < len(active):
@@ -438,14 +438,36 @@ def calibrate(
                              [mdl.names[i] for i in active], N, per_pose)
     B0, T0 = _register(mdl, qa, meas, pose, robot.tool)
     prob = Problem(mdl, qa, meas, pose, B0, T0, tq, rotation_weight or 0.1)
-    x = np.zeros(mdl.size)
     unident = dict(absorbed)
+    x, inliers = _fit_identifiable(prob, robot, active, unident,
+                                   rotation_weight is not None)
+    if not isinstance(model, str):
+        lost = [n for n in model if n not in fixed and mdl.index(n) not in active]
+        if lost:
+            raise InputError("model", "cannot identify " + "; ".join(
+                f"{n!r}: {unident[n]}" for n in lost) + " (leave it out)")
+    x = prob.solve(x, np.array(active), rows=inliers)
+    cov, sigma, J = _covariance(prob, x, active, inliers)
+    _refuse_unidentified(J, [mdl.names[i] for i in active], len(inliers), per_pose)
+    return _result(robot, prob, x, active, cov, sigma, J, inliers, unident, kind)
+
+
+def _fit_identifiable(prob: Problem, robot: Robot, active: list[int],
+                      unident: dict[str, str], weight_given: bool
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """The fit with identifiability judged at nominal and again at the estimate.
+
+    Updates ``active`` (sorted) and ``unident`` (name -> reason) in place;
+    returns the parameters and the inlier rows.
+    """
+    mdl = prob.model
+    x = np.zeros(mdl.size)
     at_nominal = []
     for name, partners in _structural_drops(prob, robot, x, active):
         unident[name] = "redundant with " + ", ".join(partners)
         active.remove(mdl.index(name))
         at_nominal.append(mdl.index(name))
-    x, inliers, _ = _robust_stages(prob, x, active, rotation_weight is not None)
+    x, inliers, _ = _robust_stages(prob, x, active, weight_given)
     # judged again at the estimate: the set may change away from nominal
     for name, partners in _structural_drops(prob, robot, x, active, PRACTICAL_TOL):
         unident[name] = ("redundant with " + ", ".join(partners) + " (nearly: any "
@@ -456,10 +478,7 @@ def calibrate(
         active.append(i)
         del unident[mdl.names[i]]
     active.sort()
-    x = prob.solve(x, np.array(active), rows=inliers)
-    cov, sigma, J = _covariance(prob, x, active, inliers)
-    _refuse_unidentified(J, [mdl.names[i] for i in active], len(inliers), per_pose)
-    return _result(robot, prob, x, active, cov, sigma, J, inliers, unident, kind)
+    return x, inliers
 
 
 def _result(robot: Robot, prob: Problem, x: np.ndarray, active: list[int],

@@ -25,7 +25,7 @@ __all__ = ["dependent_parameters", "scaled_svd", "structural_rules"]
 RANK_TOL = 1e-6
 
 
-def structural_rules(model: Model, kind: str, parallel_tol: float) -> dict[str, str]:
+def structural_rules(model: Model, kind: str) -> dict[str, str]:
     """Parameters absorbed by construction, with the reason (name -> reason).
 
     Names of the last joint's row (which the model never carries) are included
@@ -54,7 +54,6 @@ def structural_rules(model: Model, kind: str, parallel_tol: float) -> dict[str, 
     if m > 1 and m < n and f"j{m}.d" in model.names:
         out[f"j{m}.d"] = (f"a shift along joints 1-{m}'s parallel axes: absorbed by "
                           "the base pose")
-    del parallel_tol
     return out
 
 

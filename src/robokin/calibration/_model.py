@@ -75,7 +75,9 @@ class Step:
     """One factor of the product.
 
     Attributes:
-        op: ``"const"``, ``"joint"`` or an elementary ``"tx" .. "rz"``.
+        op: ``"const"``, ``"joint"``, an elementary ``"tx" .. "rz"``, or the
+            placeholders ``"base"`` and ``"tool"`` (``B_0``, ``T_0``: given at
+            evaluation).
         value: The constant (4, 4), or the nominal value of an elementary step.
         param: Index into the full parameter vector, or -1 (fixed).
         joint: The chain joint index of a ``"joint"`` step.
@@ -147,7 +149,7 @@ class Model:
             nominal.append(value)
             return len(names) - 1
 
-        steps: list[Step] = [Step("const", np.eye(4))]  # B0: supplied at evaluation
+        steps: list[Step] = [Step("base")]  # B0: supplied at evaluation
         for nm, op in zip(_POSE_NAMES, _POSE_OPS):
             steps.append(Step(op, 0.0, add(f"base.{nm}", "length" if op[0] == "t"
                                            else "angle", 0.0)))
@@ -178,7 +180,7 @@ class Model:
                 steps.append(Step("ry", r.beta, add(f"j{j}.beta", "angle", r.beta)))
         flange = invert(D[-1]) @ W[-1] @ chain.frame_offsets[-1] @ chain.link_offsets[-1]
         steps.append(Step("const", flange))
-        steps.append(Step("const", np.eye(4)))  # T0: supplied at evaluation
+        steps.append(Step("tool"))  # T0: supplied at evaluation
         for nm, op in zip(_POSE_NAMES, _POSE_OPS):
             steps.append(Step(op, 0.0, add(f"tool.{nm}", "length" if op[0] == "t"
                                            else "angle", 0.0)))
@@ -230,14 +232,11 @@ class Model:
         col = {} if active is None else {int(i): c for c, i in enumerate(active)}
         screws: list[tuple[int, str, np.ndarray, float | np.ndarray]] = []
         F = np.array(base, dtype=float)[None]  # (1, 4, 4) until the first joint
-        consts = 0
         for st in self.steps:
-            if st.op == "const":
-                consts += 1
-                M = tool if consts == 4 else st.value
-                if consts == 1:
-                    continue  # the base, already in F
-                F = F @ M
+            if st.op == "base":
+                continue  # F starts at the base
+            if st.op in ("const", "tool"):
+                F = F @ (tool if st.op == "tool" else st.value)
                 continue
             if st.op == "joint":
                 k = st.joint

@@ -32,7 +32,7 @@ def _jacobians(robot: Robot, q: np.ndarray, kind: str,
                parallel_tol: float) -> np.ndarray:
     """Per-pose identification Jacobians (N, 3 or 6, p) at the nominal robot."""
     model = Model.from_chain(robot.chain, parallel_tol=parallel_tol)
-    absorbed = structural_rules(model, kind, parallel_tol)
+    absorbed = structural_rules(model, kind)
     active = np.array([i for i, n in enumerate(model.names) if n not in absorbed])
     ev = model.evaluate(q, np.zeros(model.size), robot.base, robot.tool, active)
     assert ev.Jp is not None and ev.Jr is not None

@@ -69,7 +69,7 @@ def perturb(
         parallel_tol: As :func:`~robokin.calibration.calibrate`.
     """
     model = Model.from_chain(robot.chain, parallel_tol=parallel_tol)
-    absorbed = structural_rules(model, "pose", parallel_tol)
+    absorbed = structural_rules(model, "pose")
     x = np.zeros(model.size)
     truth: dict[str, float] = {}
     for i, (name, kind) in enumerate(zip(model.names, model.kinds)):
