@@ -230,10 +230,8 @@ def variants(name, robot, runs) -> None:
     print(line("5 % outliers of 2 mm", run_robokin(d, "position", runs), d.floor))
     print(line("  robotkinecal, same", run_robotkinecal(d, "position", runs), d.floor))
     d = make_data(robot, "position", n=30, candidates=2000, seed=5)
-    for crit in ("D", "I"):
-        sel = calibration.select_poses(robot, d.q, 30, criterion=crit)
-        print(line(f"30 selected of 2000 ({crit})", run_robokin(d, "position", 1, sel),
-                   d.floor))
+    sel = calibration.select_poses(robot, d.q, 30)
+    print(line("30 selected of 2000", run_robokin(d, "position", 1, sel), d.floor))
     rng = np.random.default_rng(6)
     rand = [run_robokin(d, "position", 1, rng.choice(len(d.q), 30, replace=False))
             for _ in range(10)]

@@ -39,29 +39,6 @@ def test_selected_poses_beat_random_ones(ur5, case):
     assert sel < np.median(rand)
 
 
-def test_i_optimal_selection_lowers_the_mean_prediction_variance(ur5, case):
-    # oracle: trace(M A^-1) computed here from the Jacobians of every candidate
-    from robokin.calibration._select import _jacobians
-
-    J = _jacobians(ur5, case.q, "position", np.radians(10))
-    p = J.shape[-1]
-    # columns scaled (trace(M A^-1) does not change; inv() stays well conditioned)
-    J = J / np.linalg.norm(J.reshape(-1, p), axis=0)
-    M = np.einsum("cip,ciq->pq", J, J) / len(J)
-
-    def variance(idx):
-        A = np.einsum("cip,ciq->pq", J[idx], J[idx])
-        return np.trace(M @ np.linalg.inv(A))
-
-    sel = calibration.select_poses(ur5, case.q, 30, criterion="I")
-    rng = np.random.default_rng(9)
-    randoms = [variance(rng.choice(len(case.q), 30, replace=False)) for _ in range(10)]
-    assert variance(sel) < min(randoms)
-    assert p == 27
-    with pytest.raises(InputError, match="argument 'criterion'"):
-        calibration.select_poses(ur5, case.q, 30, criterion="A")
-
-
 def test_selection_is_deterministic_and_checks_k(ur5, case):
     a = calibration.select_poses(ur5, case.q[:200], 20, kind="pose")
     b = calibration.select_poses(ur5, case.q[:200], 20, kind="pose")

@@ -78,17 +78,10 @@ def select_poses(
     k: int,
     kind: str = "position",
     *,
-    criterion: str = "D",
     exchange_passes: int = 3,
     parallel_tol: float = math.radians(10.0),
 ) -> np.ndarray:
     """Indices of the ``k`` candidate poses that identify the parameters best.
-
-    ``criterion="D"`` maximises the determinant of the information matrix (the
-    observability index O1); ``criterion="I"`` minimises the average prediction
-    variance over all the candidates, ``trace(M A^-1)`` with ``M`` the candidates'
-    mean information: the expected hold-out error where the candidates stand for
-    the workspace to be used (I-optimality; greedy start by D, exchange by I).
 
     Args:
         robot: The nominal robot.
@@ -97,7 +90,6 @@ def select_poses(
         k: How many to select (at least the parameters' count / 3, or / 6 for
             poses).
         kind: ``"position"`` or ``"pose"``.
-        criterion: ``"D"`` or ``"I"`` (see above).
         exchange_passes: Exchange passes after the greedy start.
         parallel_tol: As :func:`~robokin.calibration.calibrate`.
 
@@ -105,10 +97,8 @@ def select_poses(
         Indices (k,) into ``candidate_q``, in the order they were chosen.
 
     Raises:
-        InputError: ``k`` out of range, an unknown criterion, bad candidates.
+        InputError: ``k`` out of range, bad candidates.
     """
-    if criterion not in ("D", "I"):
-        raise InputError("criterion", f"expected 'D' or 'I', got {criterion!r}")
     q = _check(robot, candidate_q, kind)
     C = len(q)
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 1 <= k <= C:
@@ -128,17 +118,16 @@ def select_poses(
         chosen.append(best)
         free[best] = False
         A += J[best].T @ J[best]
-    mean_info = np.einsum("cip,ciq->pq", J, J) / C if criterion == "I" else None
     for _ in range(exchange_passes):
         improved = False
         for slot in range(len(chosen)):
             i = chosen[slot]
             A_minus = A - J[i].T @ J[i]
             Ainv = np.linalg.inv(A_minus)
-            gain = _gains(J, Ainv, +1, mean_info)
+            gain = _gains(J, Ainv, +1)
             gain[~free] = -np.inf
             best = int(np.argmax(gain))
-            if gain[best] > _gains(J[i:i + 1], Ainv, +1, mean_info)[0] + 1e-12:
+            if gain[best] > _gains(J[i:i + 1], Ainv, +1)[0] + 1e-12:
                 chosen[slot] = best
                 free[i], free[best] = True, False
                 A = A_minus + J[best].T @ J[best]
@@ -148,20 +137,9 @@ def select_poses(
     return np.array(chosen, dtype=np.intp)
 
 
-def _gains(J: np.ndarray, Ainv: np.ndarray, sign: int,
-           mean_info: np.ndarray | None = None) -> np.ndarray:
-    """What adding each candidate to ``A`` gains, (C,).
-
-    D: ``log det(I + J_c A^-1 J_c^T)`` (the matrix determinant lemma). I (with
-    ``mean_info`` M): the drop of ``trace(M A^-1)``, ``trace((I + X_c)^-1 Y_c)``
-    with ``X_c = J_c A^-1 J_c^T`` and ``Y_c = J_c A^-1 M A^-1 J_c^T``
-    (Sherman-Morrison-Woodbury).
-    """
-    X = np.einsum("cip,pq,cjq->cij", J, Ainv, J)
-    S = sign * X + np.eye(J.shape[1])
-    if mean_info is None:
-        sgn, logdet = np.linalg.slogdet(S)
-        return np.where(sgn > 0, logdet, -np.inf)
-    B = Ainv @ mean_info @ Ainv
-    Y = np.einsum("cip,pq,cjq->cij", J, B, J)
-    return np.trace(np.linalg.solve(S, Y), axis1=1, axis2=2)
+def _gains(J: np.ndarray, Ainv: np.ndarray, sign: int) -> np.ndarray:
+    """``log det(I + sign J_c A^-1 J_c^T)`` per candidate (matrix determinant lemma)."""
+    M = np.einsum("cip,pq,cjq->cij", J, Ainv, J)
+    M = sign * M + np.eye(J.shape[1])
+    sgn, logdet = np.linalg.slogdet(M)
+    return np.where(sgn > 0, logdet, -np.inf)
