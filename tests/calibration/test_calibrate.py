@@ -245,6 +245,8 @@ def test_unidentifiable_names_asked_for_are_refused(ur5):
     ({"extras": ["compliance"]}, r"'torque'.*compliance"),
     ({"torque": np.zeros((60, 6))}, r"'torque'.*without extras"),
     ({"rotation_weight": -1.0}, r"'rotation_weight'"),
+    ({"parallel_tol": float("nan")}, r"'parallel_tol'"),
+    ({"parallel_tol": 2.0}, r"'parallel_tol'"),
 ])
 def test_bad_input_names_the_argument(ur5, kwargs, match):
     case = make_case(ur5, "position", n=60, hold=0)

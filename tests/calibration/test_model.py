@@ -104,6 +104,15 @@ def test_hayati_beta_exactly_on_parallel_axes(name, hayati):
         assert f"j{k}.beta" in model.names and f"j{k}.d" not in model.names
 
 
+def test_exactly_parallel_axes_never_take_dh(ur5):
+    # parallel_tol=0 asks for DH everywhere; exactly parallel axes have no
+    # common normal, so they still get the Hayati row (no division by zero)
+    model = Model.from_chain(ur5.chain, parallel_tol=0.0)
+    assert [r.form for r in model.rows] == ["dh", "hayati", "hayati", "dh", "dh"]
+    assert all(np.isfinite([r.theta, r.d, r.a, r.alpha, r.beta]).all()
+               for r in model.rows)
+
+
 def test_near_parallel_axes_take_beta_with_short_lengths():
     # axis 3 tilted 0.5 deg about y towards axis 2 (0.45 m away): standard DH
     # puts the common normal ~50 m away (d = a / tan 0.5 deg); the Hayati row

@@ -428,6 +428,9 @@ def calibrate(
                                             math.isfinite(rotation_weight)):
         raise InputError("rotation_weight", f"expected a positive number [m/rad], "
                          f"got {rotation_weight!r}")
+    if not 0.0 <= parallel_tol < math.pi / 2:
+        raise InputError("parallel_tol", f"expected an angle in [0, pi/2) [rad], got "
+                         f"{parallel_tol!r}")
     pose = kind == "pose"
     mdl = Model.from_chain(robot.chain, parallel_tol=parallel_tol, extras=ext)
     absorbed = structural_rules(mdl, kind)

@@ -158,7 +158,7 @@ def rows_from_axes(
     for k in range(n - 1):
         p, z = frames[k + 1][:3, 3], frames[k + 1][:3, 2]
         angle = math.acos(max(-1.0, min(1.0, abs(float(D[-1][:3, 2] @ z)))))
-        if angle < parallel_tol:
+        if angle < max(parallel_tol, 1e-9):  # exactly parallel: DH has no normal
             d = 0.0 if d_parallel is None else float(d_parallel[k])
             row = _hayati_row(D[-1], p, z, d)
         else:
