@@ -90,3 +90,104 @@ def test_the_public_functions_refuse_them_too(ur5):
     np.testing.assert_array_equal(check_joints(np.arange(3, dtype=np.int32), 3),
                                   [0.0, 1.0, 2.0])
     assert check_joints(np.zeros(3, np.float32), 3).dtype == np.float64
+
+
+# ------------------------------------------- issue 25: unaligned float64 arrays
+def unaligned(a) -> np.ndarray:
+    """``a`` as a read-only, C-contiguous float64 array one byte off alignment
+    (``np.frombuffer(b, offset=1)``, as a memory-mapped record file gives)."""
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    u = np.frombuffer(b"\0" + a.tobytes(), dtype=np.float64, offset=1).reshape(a.shape)
+    assert not u.flags.aligned and u.flags.c_contiguous and not u.flags.writeable
+    return u
+
+
+def _general_6r():
+    """A UR5 with a twisted upper arm: the general 6R solver, not a closed form."""
+    rows = [{"a": 0, "alpha": np.pi / 2, "d": 0.089}, {"a": -0.425, "alpha": 0.1, "d": 0},
+            {"a": -0.392, "alpha": 0, "d": 0.05}, {"a": 0, "alpha": np.pi / 2, "d": 0.109},
+            {"a": 0.01, "alpha": -np.pi / 2, "d": 0.095}, {"a": 0, "alpha": 0, "d": 0.082}]
+    return robokin.Robot.from_dh(rows)
+
+
+def _entries():
+    """Every public entry whose arrays reach robokin._native: (name, call(make))."""
+    from robokin.kinematics.forward import forward_kinematics
+    from robokin.spatial import pose_error
+
+    ur5, panda, g6 = robokin.load("ur5"), robokin.load("panda"), _general_6r()
+    q = np.array([[0.1, -1.2, 1.1, -0.4, 1.3, 0.2], [0.0, -np.pi / 2, np.pi / 2, 0.0,
+                                                     np.pi / 2, 0.0]])
+    T = ur5.fk(q)
+    q7 = np.array([0.1, -0.3, 0.2, -1.8, 0.1, 1.6, 0.3])
+    T7 = panda.fk(q7)
+    Tg = g6.fk(q[0])
+    return [
+        ("fk", lambda m: ur5.fk(m(q))),
+        ("fk_all", lambda m: ur5.fk_all(m(q))),
+        ("jacobian", lambda m: ur5.jacobian(m(q))),
+        ("forward_kinematics", lambda m: forward_kinematics(ur5.chain, m(q))),
+        ("ik closed form", lambda m: ur5.ik(m(T), q_near=m(q)).q),
+        ("ik general 6R", lambda m: g6.ik(m(Tg)).q),
+        # numeric IK draws random restarts from a process-wide generator unless
+        # given one: the same rng for both calls
+        ("ik numeric", lambda m: ur5.ik(m(T), q_near=m(q), method="numeric",
+                                        rng=np.random.default_rng(1)).q),
+        ("ik fixed joint", lambda m: panda.ik(m(T7), fixed={"joint7": 0.3}).q),
+        ("ik_near", lambda m: ur5.ik_near(m(T), m(q)).q),
+        ("ik_near numeric", lambda m: panda.ik_near(m(T7), m(q7)).q),
+        ("pose_error", lambda m: pose_error(m(T), m(T[::-1]))),
+        ("actuators", lambda m: robokin.load("scara").actuators_from_joints(
+            m([0.1, 0.2, 0.3, 0.05]))),
+    ]
+
+
+@pytest.mark.parametrize("entry", _entries(), ids=lambda e: e[0])
+def test_unaligned_arrays_are_copied_not_refused(entry):
+    """Issue 25: a bare ValueError from robokin._native ("must be a C-contiguous
+    native float64 array"). Oracle: the answer for the same values, aligned."""
+    _, call = entry
+    want = call(np.asarray)
+    got = call(unaligned)
+    np.testing.assert_array_equal(got, want)
+
+
+def test_unaligned_arrays_reach_collision_and_trajectories():
+    pytest.importorskip("coal")
+    from robokin import collision, trajectory
+
+    scene = collision.Scene.load(collision.scene_path("press"))
+    robot = robokin.load("aubo_i5")
+    q = np.linspace([0, -0.2, 1.0, 0, 1.2, 0], [0.5, 0.1, 1.2, 0.2, 1.0, 0.3], 20)
+    want = collision.check(robot, scene, q)
+    got = collision.check(robot, scene, unaligned(q))
+    np.testing.assert_array_equal(got.min_distance, want.min_distance)
+    T = robot.fk(q[-1])
+    a = trajectory.cartesian_line(robot, q[0], T, 1.0, dt=0.05)
+    b = trajectory.cartesian_line(robot, unaligned(q[0]), unaligned(T), 1.0, dt=0.05)
+    np.testing.assert_array_equal(a.q, b.q)
+    c = trajectory.quintic(unaligned(q[0]), unaligned(q[-1]), 1.0, dt=0.05)
+    np.testing.assert_array_equal(c.q, trajectory.quintic(q[0], q[-1], 1.0, dt=0.05).q)
+
+
+def test_unaligned_arrays_reach_the_cell_functions():
+    pytest.importorskip("dask")
+    pytest.importorskip("zarr")
+    from robokin import cell
+
+    robot = robokin.load("ur5")
+    q = np.array([[0.1, -1.2, 1.1, -0.4, 1.3, 0.2], [0.4, -1.0, 1.3, -0.6, 1.1, 0.1]])
+    task = robot.fk(q)
+    cands = cell.base_grid([0.0, 0.05], [0.0], [0.0], [0.0])
+    want = cell.place(robot, task, cands, max_step=np.inf, scheduler="synchronous")
+    got = cell.place(robot, unaligned(task), unaligned(cands), max_step=np.inf,
+                     scheduler="synchronous")
+    np.testing.assert_array_equal(got.feasible, want.feasible)
+    np.testing.assert_array_equal(got.score, want.score)
+    R = task[:, :3, :3]
+    box = [[0.2, -0.1, 0.2], [0.4, 0.1, 0.4]]
+    m1 = cell.reach_map(robot, region=box, voxel=0.1, orientations=R,
+                        scheduler="synchronous")
+    m2 = cell.reach_map(robot, region=unaligned(box), voxel=0.1,
+                        orientations=unaligned(R), scheduler="synchronous")
+    np.testing.assert_array_equal(m1.reachable, m2.reachable)

@@ -9,9 +9,14 @@ string), so its cost does not depend on the size of the value.
 
 from __future__ import annotations
 
+import re
 import reprlib
 
-__all__ = ["short_repr"]
+__all__ = ["control_character", "printable", "short_repr"]
+
+# C0 and C1 control characters and DEL, but not tab or newline: an escape sequence
+# from a file (``\x1b[2J``) must not reach the terminal as one.
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
 
 _REPR = reprlib.Repr()
 _REPR.maxlevel = 2
@@ -40,3 +45,27 @@ def short_repr(value: object, limit: int = 60) -> str:
     if len(text) > limit:
         text = text[: max(limit - 3, 0)] + "..."
     return text
+
+
+def printable(text: str) -> str:
+    r"""``text`` with control characters shown as ``\xNN`` (tab and newline kept).
+
+    For text from a file on its way to a terminal: an escape sequence in a robot
+    name (``"\e[2J"`` in YAML) is printed as the characters ``\x1b[2J``, not
+    obeyed.
+    """
+    return _CONTROL.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
+
+
+def control_character(text: str) -> str | None:
+    r"""What is wrong with a name holding a control character, or None.
+
+    Names (robot, joint, link, object) become XML attributes, file names and
+    lines on a terminal: a control character (``\x1b``, a NUL, a newline) has
+    no place in any of them.
+    """
+    m = _CONTROL.search(text) or re.search(r"[\t\n]", text)
+    if m is None:
+        return None
+    return (f"a name must be printable text, got the control character "
+            f"\\x{ord(m.group()):02x} at position {m.start()}")

@@ -2,7 +2,9 @@
 
 Arrays are converted to float64 only from real numbers: complex values (whose
 imaginary part a cast would drop), masked arrays (whose mask a cast would drop),
-booleans and text are refused, not silently cast. Poses are bounded: a
+booleans and text are refused, not silently cast. Arrays the compiled kernels
+cannot read as they are (another byte order, an unaligned buffer such as
+``np.frombuffer(b, offset=1)``, a strided view) are copied, never refused. Poses are bounded: a
 translation beyond :data:`MAX_TRANSLATION` metres is refused, since FK,
 Jacobians and IK in float64 lose every digit of a sub-millimetre result there.
 """
@@ -52,9 +54,11 @@ def _real_array(x: npt.ArrayLike, name: str, expected: str) -> np.ndarray:
         # None would become NaN, a bool 1.0, a complex number lose its imaginary part
         raise InputError(name, f"expected {expected}, got {short_repr(x)}")
     try:
-        return np.asarray(a, dtype=np.float64)
+        out = np.asarray(a, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise InputError(name, f"expected {expected}, got {short_repr(x)}") from exc
+    # an unaligned buffer (np.frombuffer(b, offset=1)): copied, as other layouts are
+    return out if out.flags.aligned else out.copy()
 
 
 def check_joints(q: npt.ArrayLike, n: int, name: str = "q") -> np.ndarray:
@@ -67,7 +71,7 @@ def check_joints(q: npt.ArrayLike, n: int, name: str = "q") -> np.ndarray:
         InputError: not real numbers (complex, masked, boolean or text values
             included), or a shape other than ``(..., n)``.
     """
-    if type(q) is not np.ndarray or q.dtype != np.float64:
+    if type(q) is not np.ndarray or q.dtype != np.float64 or not q.flags.aligned:
         q = _real_array(q, name, "numbers")
     if q.ndim == 0 or q.shape[-1] != n:
         raise InputError(
@@ -117,7 +121,7 @@ def check_transform(T: npt.ArrayLike, name: str = "T") -> np.ndarray:
         InputError: not real numbers, a wrong shape, or the first pose that fails
             the test: what is wrong and the pose's batch index.
     """
-    if type(T) is not np.ndarray or T.dtype != np.float64:
+    if type(T) is not np.ndarray or T.dtype != np.float64 or not T.flags.aligned:
         T = _real_array(T, name, "a 4x4 matrix")
     if T.ndim < 2 or T.shape[-2:] != (4, 4):
         raise InputError(name, f"expected shape (..., 4, 4), got {T.shape}")

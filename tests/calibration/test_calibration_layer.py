@@ -1,24 +1,29 @@
-"""calibration/ sits on top: nothing in the core imports it; importing robokin loads none of it."""
+"""calibration/ sits on top: nothing below imports it; importing robokin loads none of it.
+
+Oracle: the parsed source (tests/test_layers.py's import graph, every import of every
+module counted) and a fresh interpreter's ``sys.modules``.
+"""
 
 from __future__ import annotations
 
 import subprocess
 import sys
 
-from ..test_layers import SRC, imported_modules
+from test_layers import import_graph, layer_of
 
 
-def test_nothing_below_imports_calibration():
-    bad = []
-    for path in sorted(SRC.rglob("*.py")):
-        rel = path.relative_to(SRC).as_posix()
-        if rel.startswith("calibration/") or rel == "cli_calibrate.py":
-            continue
-        mods = imported_modules(path.read_text(encoding="utf-8"))
-        if any(m == "robokin.calibration" or m.startswith("robokin.calibration.")
-               for m in mods):
-            bad.append(rel)
+def test_only_the_face_imports_calibration():
+    # the package root and cli/ may; nothing in any other layer
+    bad = [f"{m}:{line} imports {t}" for m, targets in import_graph().items()
+           if layer_of(m) not in ("calibration", "face") for t, line in targets
+           if layer_of(t) == "calibration"]
     assert bad == []
+
+
+def test_the_command_is_the_one_face_module_that_imports_it():
+    users = {m for m, targets in import_graph().items() if layer_of(m) == "face"
+             and any(layer_of(t) == "calibration" for t, _ in targets)}
+    assert users == {"robokin.cli.calibrate"}
 
 
 def test_import_robokin_does_not_load_calibration():

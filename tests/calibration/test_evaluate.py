@@ -53,3 +53,6 @@ def test_holdout_report_and_plot(solved, tmp_path):
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     with pytest.raises(InputError, match="exists"):
         calibration.plot_errors(rep, path=path)
+    with pytest.raises(InputError, match=r"path.*\.png, \.svg or \.pdf"):
+        calibration.plot_errors(rep, path=tmp_path / "errors.jpg")
+    assert not (tmp_path / "errors.jpg").exists()

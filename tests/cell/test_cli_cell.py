@@ -46,8 +46,14 @@ def test_reach_streams_a_map_and_draws_its_sections(capsys, tmp_path):
     (["--voxel", "-5"], "'--voxel'"),
     (["--region", "0,0,0,100,100"], "'--region'"),
     (["--region", "0,0,0,100,0,100"], "'region'.*is empty"),
-    (["--orientations", "0"], "'orientations'"),
-    (["--scheduler", "nowhere"], "'scheduler'"),
+    (["--orientations", "0"], "'--orientations': expected an integer >= 1"),
+    (["--scheduler", "nowhere"], "'--scheduler'"),
+    # issue 25: a MemoryError (7.45 GiB) after exit 3; now refused before anything
+    (["--orientations", "1000000000"],
+     "'--orientations': 1,000,000,000 orientations = 1,000,000,000 per voxel, more than "
+     "the 100,000 robokin tries"),
+    (["--orientations", "1000", "--rolls", "101"],
+     "1,000 orientations x 101 rolls = 101,000 per voxel, more than the 100,000"),
 ])
 def test_reach_bad_input_is_one_line_exit_2(capsys, tmp_path, args, match):
     import re
@@ -88,3 +94,105 @@ def test_place_bad_input_is_one_line_exit_2(capsys, tmp_path, args, match):
 
     code, _, err = run(capsys, "place", "aubo_i5", "--out", str(tmp_path / "p"), *args)
     assert code == 2 and re.search(match, err) and len(err.strip().splitlines()) == 1
+
+
+# ------------------------------------------- issue 25: what a bad option really is
+@pytest.mark.parametrize(("option", "value", "message"), [
+    ("--x", "0:1e9:0.001", "'0:1e9:0.001' gives 1,000,000,000,001 values, more than the "
+                           "10,000 a range may hold"),
+    ("--x", "1:0:1", "'1:0:1' runs backwards: from 1 is above to 0 (write '0:1:1')"),
+    ("--x", "0:100:0", "'0:100:0': the step must be > 0, got 0"),
+    ("--y", "0:100:-5", "'0:100:-5': the step must be > 0, got -5"),
+    ("--yaw", "0:360:1e-9", "'0:360:1e-9' gives 360,000,000,001 values"),
+    ("--x", "-1e308:1e308:1", "'-1e308:1e308:1' gives too many values"),  # b - a = inf
+    ("--x", "0:1", "expected 'from:to:step' (three numbers), got '0:1'"),
+    ("--z", "nan:1:1", "expected finite numbers"),
+])
+def test_place_ranges_say_the_real_problem(capsys, tmp_path, option, value, message):
+    """Issue 25: each said "expected 'from:to:step'"; it is said before the robot
+    or the scene is loaded (no scene is given here), and nothing is written."""
+    out = tmp_path / "p"
+    code, _, err = run(capsys, "place", "ur5", f"{option}={value}", "--out", str(out))
+    assert code == 2 and f"argument '{option}': " + message in err
+    assert len(err.strip().splitlines()) == 1 and not out.exists()
+
+
+def test_place_refuses_a_grid_of_too_many_bases(capsys, tmp_path):
+    code, _, err = run(capsys, "place", "ur5", "--scene", "press", "--x=0:9999:1",
+                       "--y=0:9999:1", "--out", str(tmp_path / "p"))
+    assert code == 2 and ("10,000 x 10,000 x 1 x 1 = 100,000,000 candidate bases, more "
+                          "than the 1,000,000") in err
+
+
+class _Server:
+    """A local TCP server that accepts and then stays silent, or sends junk."""
+
+    def __init__(self, junk: bytes | None):
+        import socket
+        import threading
+
+        self.sock = socket.create_server(("127.0.0.1", 0))
+        self.port = self.sock.getsockname()[1]
+        self.junk, self.conns = junk, []
+        threading.Thread(target=self._serve, daemon=True).start()
+
+    def _serve(self):
+        while True:
+            try:
+                conn, _ = self.sock.accept()
+            except OSError:
+                return
+            self.conns.append(conn)
+            if self.junk is not None:
+                conn.sendall(self.junk)
+
+    def close(self):
+        for c in self.conns:
+            c.close()
+        self.sock.close()
+
+
+def _closed_port() -> int:
+    import socket
+
+    with socket.create_server(("127.0.0.1", 0)) as s:
+        return s.getsockname()[1]
+
+
+@pytest.mark.parametrize("kind", ["closed", "silent", "junk"])
+@pytest.mark.parametrize("command", ["reach", "place"])
+def test_a_scheduler_that_does_not_answer_is_exit_2_naming_it(capsys, tmp_path, kind,
+                                                               command):
+    """Issue 25: ``--scheduler tcp://10.255.255.1:8786`` ended in exit 3 with a raw
+    TimeoutError after 30 s. A closed port, a port that accepts and stays silent
+    (an unroutable address behind a proxy looks like this) and one that answers
+    junk each end within --connect-timeout (per step) with exit 2 naming the address,
+    before anything is computed or written."""
+    server = None if kind == "closed" else _Server(None if kind == "silent" else
+                                                   b"\xff" * 64 + b"HTTP/1.1 400\r\n")
+    port = _closed_port() if server is None else server.port
+    address = f"tcp://127.0.0.1:{port}"
+    out = tmp_path / "o"
+    try:
+        code, _, err = run(capsys, command, "ur5", "--scheduler", address,
+                           "--connect-timeout", "0.5", "--out", str(out))
+    finally:
+        if server is not None:
+            server.close()
+    assert code == 2, err
+    assert err.startswith(f"robokin: error: argument '--scheduler': cannot reach the Dask "
+                          f"scheduler at '{address}' within 0.5 s: ")
+    why = {"closed": "connection refused", "silent": "no answer",
+           "junk": "something answers there, but not as a Dask scheduler"}[kind]
+    assert why in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_the_probe_lets_a_real_scheduler_through():
+    from distributed import LocalCluster
+
+    from robokin.cell._scheduler import probe_scheduler
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster:
+        probe_scheduler(cluster.scheduler_address, 5.0)  # no error

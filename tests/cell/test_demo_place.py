@@ -13,7 +13,8 @@ pytest.importorskip("dask")
 def test_the_demo_maps_feasible_bases_and_its_own_is_one(tmp_path):
     from rich.console import Console
 
-    from robokin.demo import PLACE_SPAN, PLACE_STEP, run_demo
+    from robokin.cli.demo import run_demo
+    from robokin.cli.demo_job import PLACE_SPAN, PLACE_STEP
 
     console = Console(file=io.StringIO(), width=140)
     result = run_demo(out=tmp_path, console=console, html_animation=False, place=True)
@@ -31,6 +32,11 @@ def test_the_demo_maps_feasible_bases_and_its_own_is_one(tmp_path):
     assert "placement.png" in (tmp_path / "report.html").read_text()
     text = console.file.getvalue()
     assert "bases feasible; this cell's base feasible" in text
+    # issue 25: the placement search is in the timing line and the total
+    timings = summary["timings_s"]
+    assert timings["total"] >= timings["place"] + timings["plan"]
+    time_line = next(ln for ln in text.splitlines() if "│ time" in ln)
+    assert f"place {timings['place']:.2f}" in time_line
 
 
 def test_the_cli_takes_place(tmp_path, capsys):

@@ -98,6 +98,6 @@ def test_a_placement_on_the_cluster_equals_the_local_one(client):
 def test_an_unreachable_scheduler_is_an_input_error(ur5, monkeypatch):
     from robokin.cell import _scheduler
 
-    monkeypatch.setattr(_scheduler, "_CONNECT_TIMEOUT", 1.0)
+    monkeypatch.setattr(_scheduler, "CONNECT_TIMEOUT", 1.0)
     with pytest.raises(InputError, match="argument 'scheduler'.*cannot reach"):
         cell.reach_map(ur5, scheduler="tcp://127.0.0.1:9", **MAP)

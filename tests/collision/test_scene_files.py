@@ -198,3 +198,73 @@ def test_changing_the_scene_after_a_check_is_seen_by_the_next_check():
     pairs = {(p.body_a, p.body_b) for p in check(r, sc, q).pairs}
     assert ("base", "block") not in pairs and ("shoulder_pan", "block") not in pairs
     assert ("elbow", "block") in pairs
+
+
+# ------------------------------------------- issue 25: exclusions naming nothing
+SCENE = """\
+name: cell
+units: {length: mm, angle: deg}
+objects:
+  - {name: table, type: box, size: [600, 800, 20], xyz: [0, 500, 390]}
+  - {name: post, type: cylinder, radius: 50, length: 400, xyz: [700, 0, 200]}
+exclude: EXCLUDE
+"""
+
+
+@pytest.mark.parametrize(("exclude", "match"), [
+    ("[[base, nothere]]",
+     r"cell.yaml:6: exclude\[0\]: no object 'nothere' in this scene; a pair is "
+     r"\[robot link, object\], the objects are \['table', 'post'\]"),
+    ("[[base, table], [wrist_1, tabel]]", r"exclude\[1\]: no object 'tabel'"),
+    ("[[table, post]]", r"exclude\[0\]: 'table' and 'post' are both objects"),
+])
+def test_an_exclusion_naming_no_object_is_refused_at_load(tmp_path, exclude, match):
+    """Issue 25: ``exclude: [[base, nothere]]`` was ignored silently."""
+    f = tmp_path / "cell.yaml"
+    f.write_text(SCENE.replace("EXCLUDE", exclude))
+    with pytest.raises(ModelError, match=match):
+        Scene.load(f)
+
+
+def test_an_exclusion_naming_no_link_is_refused_when_it_meets_the_robot(tmp_path):
+    f = tmp_path / "cell.yaml"
+    f.write_text(SCENE.replace("EXCLUDE", "[[table, shoulder_pann]]"))  # [object, link]
+    scene = Scene.load(f)
+    ur5 = robokin.load("ur5")
+    with pytest.raises(ModelError, match=r"cell.yaml: exclude: exclude \['shoulder_pann', "
+                       r"'table'\]: 'shoulder_pann' is neither a link of the robot "
+                       r"\(links: \['base', 'shoulder_pan', 'shoulder_lift', 'elbow', "
+                       r"'wrist_1', 'wrist_2', 'wrist_3', 'tool'\]\) nor an object"):
+        check(ur5, scene, np.zeros((2, 6)))
+    # spelt right (in either order) the pair is kept and the robot attaches
+    f.write_text(SCENE.replace("EXCLUDE", "[[table, shoulder_pan]]"))
+    kept = Scene.load(f)
+    assert kept.exclude == {frozenset(("table", "shoulder_pan"))}
+    kept.attach(ur5)
+    with pytest.raises(InputError, match="'post' is an object"):
+        kept.exclude_pair("post", "table")
+
+
+def test_a_scene_names_a_robot_file_relative_to_itself(tmp_path, monkeypatch, capsys):
+    """Issue 25: `robokin check cell/scene.yaml plan.csv` looked for the scene's
+    `robot: arm.yaml` in the current folder. Oracle: the same robot file loaded by
+    its full path; a built-in name stays a name."""
+    from robokin.cli import main
+    from robokin.trajectory import io, quintic
+
+    folder = tmp_path / "cell"
+    folder.mkdir()
+    ur5 = robokin.load("ur5")
+    robokin.save(ur5.replace(name="my_arm"), folder / "arm.yaml")
+    (folder / "scene.yaml").write_text(
+        "robot: {name: arm.yaml}\n"
+        "objects: [{name: post, type: box, size: [0.1, 0.1, 0.1], xyz: [2, 0, 0]}]\n")
+    sc = Scene.load(folder / "scene.yaml")
+    assert sc.robot_name == str(folder / "arm.yaml")
+    assert robokin.load(sc.robot_name).name == "my_arm"
+    plan = quintic(np.zeros(6), np.full(6, 0.2), 0.5).replace(joint_names=ur5.joint_names)
+    csv = io.write_csv(plan, tmp_path / "plan.csv")
+    monkeypatch.chdir(tmp_path)  # not the scene's folder
+    assert main(["check", "cell/scene.yaml", str(csv)]) == 0, capsys.readouterr().err
+    (folder / "named.yaml").write_text("robot: {name: ur5}\n")
+    assert Scene.load(folder / "named.yaml").robot_name == "ur5"

@@ -9,7 +9,7 @@ import yaml
 
 import robokin
 from reference import random_q
-from robokin.io.robot_files import document_from_robot, load_robot, save_robot
+from robokin.io.robot_files import document_from_robot, load_parts, save_robot
 
 GOOD = """\
 name: two_link
@@ -30,7 +30,7 @@ def _write(tmp_path: Path, text: str) -> Path:
 
 
 def test_units_are_converted_once_at_the_edge(tmp_path):
-    robot = load_robot(_write(tmp_path, GOOD))
+    robot = robokin.load(_write(tmp_path, GOOD))
     np.testing.assert_allclose(robot.limits, [[-np.pi / 2, np.pi / 2], [0.0, 0.2]])
     T = robot.fk([0.0, 0.02])
     # j1: Rz(0) Tz(0.1) Tx(0.3); j2: Rz(90 deg) Tz(0.05 + 0.02); tool Tz(0.1) Rx(180 deg)
@@ -70,7 +70,7 @@ CASES = [
 @pytest.mark.parametrize(("text", "match"), CASES)
 def test_malformed_files_name_the_file_and_field(tmp_path, text, match):
     with pytest.raises(robokin.ModelError, match=match):
-        load_robot(_write(tmp_path, text))
+        load_parts(_write(tmp_path, text))
 
 
 def test_missing_file_is_a_model_error(tmp_path):
@@ -84,10 +84,10 @@ def test_unknown_builtin_lists_the_names():
 
 
 def test_save_round_trips_a_loaded_file(tmp_path):
-    robot = load_robot(_write(tmp_path, GOOD))
+    robot = robokin.load(_write(tmp_path, GOOD))
     out = save_robot(robot, tmp_path / "copy.yaml")
     assert yaml.safe_load(out.read_text()) == yaml.safe_load(GOOD)
-    again = load_robot(out)
+    again = robokin.load(out)
     np.testing.assert_array_equal(again.fk([0.3, 0.1]), robot.fk([0.3, 0.1]))
 
 
@@ -107,7 +107,7 @@ def test_code_built_robots_save_as_exact_elementary_files(tmp_path, name, rng):
 def test_failed_save_keeps_the_old_file(tmp_path, monkeypatch):
     target = tmp_path / "robot.yaml"
     target.write_text(GOOD)
-    robot = load_robot(target)
+    robot = robokin.load(target)
 
     def boom(*args, **kwargs):
         raise OSError("disk full")
@@ -129,7 +129,7 @@ joints:
   - {op: tx, value: 1000}
   - {op: rz, joint: revolute, name: b, depends: {a: -1}, depends_offset: 90}
 """
-    robot = load_robot(_write(tmp_path, text))
+    robot = robokin.load(_write(tmp_path, text))
     assert robot.n == 1
     T = robot.fk([0.25])
     np.testing.assert_allclose(T[:3, 3], [np.cos(0.25), np.sin(0.25), 0], atol=1e-12)
@@ -139,7 +139,7 @@ joints:
     with pytest.raises(
         robokin.ModelError, match=r"joints\[2\]\.depends.*unknown coordinate 'zz'"
     ):
-        load_robot(_write(tmp_path, bad))
+        load_parts(_write(tmp_path, bad))
 
 
 def test_code_built_robot_keeps_its_actuators_when_saved(tmp_path, rng):
@@ -212,14 +212,14 @@ def test_save_gives_normal_permissions_and_keeps_existing_ones(tmp_path):
 def test_numbers_must_be_numbers_and_errors_name_the_line(tmp_path, old, new, message):
     assert old in GOOD
     with pytest.raises(robokin.ModelError, match=message):
-        load_robot(_write(tmp_path, GOOD.replace(old, new, 1)))
+        load_parts(_write(tmp_path, GOOD.replace(old, new, 1)))
 
 
 def test_too_many_joint_rows_are_refused_before_validation(tmp_path):
     rows = "".join("  - {a: 0.1}\n" for _ in range(1001))
     with pytest.raises(robokin.ModelError, match=r"joints: 1,001 rows; a robot file "
                                                  r"holds at most 1,000"):
-        load_robot(_write(tmp_path, "name: long\njoints:\n" + rows))
+        load_parts(_write(tmp_path, "name: long\njoints:\n" + rows))
 
 
 def test_a_file_without_units_that_reads_as_an_89_m_arm_warns(tmp_path):
@@ -227,20 +227,62 @@ def test_a_file_without_units_that_reads_as_an_89_m_arm_warns(tmp_path):
              "  - {a: -425, alpha: 0, d: 0}\n"
     with pytest.warns(UserWarning, match=r"no 'units:'.*-425 m \(joints\[1\]\.a\) "
                                          r"suggests millimetres"):
-        robot = load_robot(_write(tmp_path, ur5_mm))
+        robot = robokin.load(_write(tmp_path, ur5_mm))
     assert robot.fk(np.zeros(2))[2, 3] == pytest.approx(89.159)  # read as asked
     deg = "name: d\njoints:\n  - {a: 0.4, alpha: 90}\n"
     with pytest.warns(UserWarning, match=r"90 rad \(joints\[0\]\.alpha\) suggests "
                                          "degrees"):
-        load_robot(_write(tmp_path, deg))
+        load_parts(_write(tmp_path, deg))
     import warnings
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        load_robot(_write(tmp_path, GOOD))  # units given: no warning
-        load_robot(_write(tmp_path, "name: m\njoints:\n  - {a: 0.425, alpha: 1.57}\n"))
+        load_parts(_write(tmp_path, GOOD))  # units given: no warning
+        load_parts(_write(tmp_path, "name: m\njoints:\n  - {a: 0.425, alpha: 1.57}\n"))
         for name in robokin.robots.names():
             robokin.load(name)
+
+
+@pytest.mark.parametrize(
+    ("units", "row", "match"),
+    [
+        ("{angle: rad}", "{a: 0.4, alpha: 90}",
+         r"declares units: \{length: m, angle: rad\}; an angle of 90 rad "
+         r"\(joints\[0\]\.alpha\) suggests degrees: declare 'angle: deg'"),
+        ("{length: mm, angle: rad}", "{a: 400, alpha: -180, theta: 0}",
+         r"angle: rad\}; an angle of -180 rad \(joints\[0\]\.alpha\) suggests degrees"),
+        ("{length: m}", "{a: 425, alpha: 0}",
+         r"a length of 425 m \(joints\[0\]\.a\) suggests millimetres: declare "
+         r"'length: mm'"),
+    ],
+)
+def test_declared_units_whose_numbers_suggest_others_warn(tmp_path, units, row, match):
+    """Issue 25: ``units: {angle: rad}`` with ``alpha: 90`` loaded without a note."""
+    with pytest.warns(UserWarning, match=match):
+        load_parts(_write(tmp_path, f"name: a\nunits: {units}\njoints:\n  - {row}\n"))
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the same numbers in the unit they suggest
+        load_parts(_write(tmp_path, "name: a\nunits: {length: mm, angle: deg}\n"
+                                    "joints:\n  - {a: 425, alpha: 90}\n"))
+
+
+@pytest.mark.parametrize("name", ["arm.urdf", "arm.urdf.xacro", "arm.xacro"])
+def test_load_of_a_urdf_points_to_urdf_import(tmp_path, monkeypatch, name):
+    """Issue 25: load('x.urdf') said "must be a mapping of fields"."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / name).write_text('<robot name="r"><link name="a"/></robot>\n')
+    for given in (name, tmp_path / name):
+        with pytest.raises(robokin.ModelError, match=r"a URDF or xacro, not a robokin "
+                           r"robot file: read it with robokin.Robot.from_urdf\(.*\) or "
+                           r"convert it once with 'robokin import "):
+            robokin.load(given)
+    # the same XML under a robot-file name: the content gives it away
+    f = _write(tmp_path, '<robot name="r"><link name="a"/></robot>\n')
+    with pytest.raises(robokin.ModelError, match=r"robot.yaml: a robot file must be a "
+                       r"mapping of fields, got str; this looks like XML \(a URDF\?\)"):
+        robokin.load(f)
 
 
 def test_sections_are_an_explicit_table():

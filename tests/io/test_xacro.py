@@ -14,8 +14,8 @@ from robokin.exceptions import InputError, ModelError
 pytest.importorskip("yourdfpy")
 pytest.importorskip("xacro")
 from reference import pin_fk  # noqa: E402
+from robokin import Robot  # noqa: E402
 from robokin.io.ros_packages import PackageFinder  # noqa: E402
-from robokin.io.urdf import robot_from_urdf  # noqa: E402
 from robokin.io.xacro import expand_xacro, is_xacro  # noqa: E402
 
 DEMO = Path(__file__).parent.parent / "data" / "xacro" / "demo_description"
@@ -96,15 +96,15 @@ def test_ament_prefix_path_and_package_xml_above_the_file(tmp_path, monkeypatch)
     monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
     monkeypatch.setenv("AMENT_PREFIX_PATH", str(tmp_path / "install"))
     # $(find demo_description): the package.xml above arm.urdf.xacro names it
-    robot = robot_from_urdf(ARM, missing_mesh="error")
+    robot = Robot.from_urdf(ARM, missing_mesh="error")
     files = {Path(s["filename"]) for s in robot.meta["urdf_shapes"] if s["type"] == "mesh"}
     assert files == {DEMO / "meshes" / "cube.stl", share / "meshes" / "link_3.stl"}
 
 
 def test_xacro_args_change_the_model_and_unknown_ones_are_refused(rng):
     with pytest.warns(UserWarning, match="package 'demo_meshes' not found"):
-        short = robot_from_urdf(ARM)
-    long = robot_from_urdf(ARM, xacro_args={"upper_length": "0.6", "prefix": "left_"},
+        short = Robot.from_urdf(ARM)
+    long = Robot.from_urdf(ARM, xacro_args={"upper_length": "0.6", "prefix": "left_"},
                            missing_mesh="ignore")
     assert long.joint_names == ("left_joint_1", "left_joint_2", "left_joint_3")
     assert "upper_length:=0.6" in long.source
@@ -115,16 +115,16 @@ def test_xacro_args_change_the_model_and_unknown_ones_are_refused(rng):
     assert_fk_matches_pinocchio(long, rng, m=10)
     with pytest.raises(InputError, match=r"declares no argument 'lenght'; it declares "
                                          r"\['prefix', 'upper_length'\]"):
-        robot_from_urdf(ARM, xacro_args={"lenght": "1"})
+        Robot.from_urdf(ARM, xacro_args={"lenght": "1"})
     with pytest.raises(InputError, match="not a xacro file"):
-        robot_from_urdf(DEMO.parent.parent / "urdf" / "ur5.urdf", xacro_args={"a": "1"})
+        Robot.from_urdf(DEMO.parent.parent / "urdf" / "ur5.urdf", xacro_args={"a": "1"})
 
 
 def test_missing_package_names_it_and_lists_the_search_path(tmp_path, monkeypatch):
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path))
     root = rtb_xacro() / "abb_irb140_description"
     with pytest.raises(ModelError) as err:
-        robot_from_urdf(root / "urdf" / "irb140.xacro", package_map={"other": tmp_path})
+        Robot.from_urdf(root / "urdf" / "irb140.xacro", package_map={"other": tmp_path})
     msg = str(err.value)
     assert msg.startswith(f"{root / 'urdf' / 'irb140.xacro'}: $(find abb_irb140): "
                           "package 'abb_irb140' not found; searched the package map "
@@ -132,7 +132,7 @@ def test_missing_package_names_it_and_lists_the_search_path(tmp_path, monkeypatc
     assert f"package.xml files in {root / 'urdf'} and the folders above it" in msg
     assert "--package abb_irb140=DIR" in msg
     with pytest.raises(InputError, match="package 'abb_irb140': no such folder"):
-        robot_from_urdf(root / "urdf" / "irb140.xacro",
+        Robot.from_urdf(root / "urdf" / "irb140.xacro",
                         package_map={"abb_irb140": tmp_path / "nowhere"})
 
 
@@ -181,7 +181,7 @@ def test_an_expanded_urdf_error_names_the_xacro(tmp_path):
               '</joint>\n</robot>\n')
     with pytest.raises(ModelError, match=r"bad.urdf.xacro: joint\[j\].limit: .*"
                                          r"\(line \d+ of the URDF expanded from it\)"):
-        robot_from_urdf(f)
+        Robot.from_urdf(f)
 
 
 def test_is_xacro_and_xacro_warnings(tmp_path):
@@ -210,7 +210,7 @@ def test_cli_import_xacro_notes_each_dropped_mesh(tmp_path, capsys, monkeypatch)
         "'package://demo_meshes/meshes/link_3.stl': package 'demo_meshes' not found")
     assert "r_base_link -> r_tool0" in text
     loaded = robokin.load(out)
-    direct = robot_from_urdf(ARM, xacro_args={"upper_length": "0.6", "prefix": "r_"},
+    direct = Robot.from_urdf(ARM, xacro_args={"upper_length": "0.6", "prefix": "r_"},
                              missing_mesh="ignore")
     q = np.random.default_rng(3).uniform(-2, 2, (10, 3))
     np.testing.assert_allclose(loaded.fk(q), direct.fk(q), atol=1e-12)
@@ -241,3 +241,121 @@ def test_cli_dh_reads_a_xacro(capsys, tmp_path):
     same, _ = capsys.readouterr()
     assert code == 0 and json.loads(out)["rows"] == json.loads(same)["rows"]
     assert len(json.loads(out)["rows"]) == 6
+
+
+# ------------------------------------------- issue 25: xacro is a program, bounded
+BOMBS = {
+    # 9**387420489: computed until killed (CPU)
+    "power": HEAD + '  <link name="${9**9**9}"/>\n</robot>\n',
+    # a 200 MB string from a 126-byte file (it took 625 MB)
+    "repeat": HEAD + "  <link name=\"${'a'*(2*10**8)}\"/>\n</robot>\n",
+    # 1.6 KB of properties, each twice the one before: 16 B x 2**28 = 4 GiB
+    "chain": HEAD + '  <xacro:property name="p0" value="aaaaaaaaaaaaaaaa"/>\n'
+    + "".join(f'  <xacro:property name="p{i}" value="${{p{i - 1}}}${{p{i - 1}}}"/>\n'
+              for i in range(1, 29)) + '  <link name="${p28}"/>\n</robot>\n',
+}
+
+BOMB_RUN = """
+import json, resource, sys, time
+from robokin.io.xacro import expand_xacro
+t = time.monotonic()
+try:
+    expand_xacro(sys.argv[1])
+    error = None
+except Exception as exc:
+    error = f"{type(exc).__name__}: {exc}"
+print(json.dumps({"seconds": time.monotonic() - t, "error": error,
+                  "child_peak_mb": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+                  / 1024}))
+"""
+
+
+@pytest.mark.parametrize("bomb", sorted(BOMBS))
+def test_xacro_bombs_end_in_seconds_and_megabytes_with_an_error(tmp_path, bomb):
+    """Issue 25: these ran until killed, took 625 MB, or 20 s and 3 GB. Each now ends
+    with one ModelError naming the file and the limit it hit, the expansion call in
+    under 5 s (its wall-clock limit is 3 s) and the expanding child's peak RSS under
+    300 MB (it may add 192 MiB to the ~35 MB it starts with). Measured in a fresh
+    interpreter: RUSAGE_CHILDREN is the expanding child alone."""
+    import json
+    import subprocess
+    import sys
+
+    f = write(tmp_path / f"{bomb}.urdf.xacro", BOMBS[bomb])
+    assert f.stat().st_size < 2000
+    res = subprocess.run([sys.executable, "-c", BOMB_RUN, str(f)], capture_output=True,
+                         text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    out = json.loads(res.stdout)
+    assert out["error"] is not None and out["error"].startswith(
+        f"ModelError: {f}: xacro: expanding this file ")
+    assert any(limit in out["error"] for limit in (
+        "of CPU time, its limit", "MiB of memory, its limit", "(wall clock), its limit"))
+    assert "robokin.io.xacro.LIMITS" in out["error"]
+    assert out["seconds"] < 5.0
+    assert 0 < out["child_peak_mb"] < 300
+
+
+def test_each_limit_is_named(tmp_path):
+    """CPU time (a limit of 1 s CPU, 60 s wall), memory (a 2 GB string) and the wall
+    clock (an include of a FIFO nothing writes: the child waits forever)."""
+    from robokin.io.xacro import XacroLimits
+
+    power = write(tmp_path / "power.xacro", BOMBS["power"])
+    with pytest.raises(ModelError, match=r"power.xacro: xacro: expanding this file used "
+                                         r"more than 1 s of CPU time, its limit"):
+        expand_xacro(power, limits=XacroLimits(cpu_seconds=1, wall_seconds=60))
+    big = write(tmp_path / "big.xacro",
+                HEAD + "  <link name=\"${'a'*(2*10**9)}\"/>\n</robot>\n")
+    with pytest.raises(ModelError, match=r"needed more than 64 MiB of memory, its limit"):
+        expand_xacro(big, limits=XacroLimits(memory_mb=64))
+    fifo = tmp_path / "part.xacro"
+    os.mkfifo(fifo)
+    waits = write(tmp_path / "waits.xacro",
+                  HEAD + '  <xacro:include filename="part.xacro"/>\n</robot>\n')
+    with pytest.raises(ModelError, match=r"waits.xacro: xacro: expanding this file took "
+                                         r"more than 0.5 s \(wall clock\), its limit"):
+        expand_xacro(waits, limits=XacroLimits(wall_seconds=0.5))
+
+
+def test_an_include_of_dev_zero_is_bounded(tmp_path):
+    """/dev/zero never ends: expat refuses its first byte (inside the limits)."""
+    (tmp_path / "zero.xacro").symlink_to("/dev/zero")
+    f = write(tmp_path / "z.xacro", HEAD + '  <xacro:include filename="zero.xacro"/>\n'
+              '</robot>\n')
+    with pytest.raises(ModelError, match=r"zero.xacro:1: not valid XML"):
+        expand_xacro(f)
+
+
+def test_limits_are_checked():
+    from robokin.io.xacro import XacroLimits
+
+    for bad in ({"cpu_seconds": 0}, {"cpu_seconds": 1.5}, {"wall_seconds": 0},
+                {"wall_seconds": float("nan")}, {"memory_mb": 1}):
+        with pytest.raises(InputError, match="argument 'limits'"):
+            XacroLimits(**bad)
+    with pytest.raises(InputError, match="expected an XacroLimits"):
+        expand_xacro(ARM, limits={"cpu_seconds": 1})
+
+
+def test_the_child_answers_as_the_expansion_in_this_process(rng):
+    """Oracle: the URDF expanded in this process by the same code (robokin's
+    _expand), character for character; the packages the child found are known to
+    the finder the caller keeps."""
+    from robokin.io.xacro import _expand
+
+    pmap = {"demo_description": DEMO}
+    child = expand_xacro(ARM, package_map=pmap, args={"prefix": "x_"})
+    here = _expand(ARM, {"prefix": "x_"}, PackageFinder(pmap, near=ARM))
+    assert child.urdf == here[0] and child.includes == here[1]
+    assert child.packages.lookups()["demo_description"] == str(DEMO)
+    assert {p.name for p in child.includes} == {"parts.xacro", "limits.xacro"}
+
+
+def test_a_relative_path_and_package_map_expand(monkeypatch):
+    """A relative package folder made $(find) return a relative path, which xacro
+    read against the including file's folder (the path twice)."""
+    monkeypatch.chdir(DEMO.parent)
+    out = expand_xacro(Path("demo_description/urdf/arm.urdf.xacro"),
+                       package_map={"demo_description": "demo_description"})
+    assert "joint_1" in out.urdf

@@ -138,3 +138,61 @@ def test_set_num_threads_clamps_and_reports():
         assert _native.set_num_threads(2) == 2 == _native.num_threads()
     finally:
         k.set_num_threads(threads)
+
+
+def _import_with(env: dict[str, str]) -> subprocess.CompletedProcess:
+    code = ("import robokin._native as n; "
+            "print(n.ISA, n.num_threads(), n.single.num_threads())")
+    return subprocess.run([sys.executable, "-W", "always", "-c", code],
+                          env=dict(os.environ, **env), capture_output=True, text=True,
+                          check=True)
+
+
+@pytest.mark.parametrize(("value", "threads", "message"), [
+    # atoi read 1e3 as one thread, and 0, -1, abc fell back without a word
+    ("1e3", "default", "ROBOKIN_NUM_THREADS='1e3' is not a whole number from 1 to 64; "
+                       "using {k} threads (the CPUs this process may use)"),
+    ("0", "default", "ROBOKIN_NUM_THREADS='0' is not a whole number"),
+    ("-1", "default", "ROBOKIN_NUM_THREADS='-1' is not a whole number"),
+    ("abc", "default", "ROBOKIN_NUM_THREADS='abc' is not a whole number"),
+    ("2.5", "default", "ROBOKIN_NUM_THREADS='2.5' is not a whole number"),
+    ("1000", 64, "ROBOKIN_NUM_THREADS='1000' is more than 64; using 64 threads"),
+    ("3", 3, None),
+    (" 1 ", 1, None),
+])
+def test_robokin_num_threads_bad_values_warn_naming_the_value_used(value, threads,
+                                                                   message):
+    """Issue 25: bad values fell back silently; each is a warning naming the
+    variable, its value and the count used (the oracle: num_threads() of every copy
+    in use)."""
+    default = min(len(os.sched_getaffinity(0)), 64)
+    k = default if threads == "default" else threads
+    res = _import_with({"ROBOKIN_NUM_THREADS": value})
+    isa, n_kernels, n_single = res.stdout.split()
+    assert int(n_kernels) == int(n_single) == k
+    if message is None:
+        assert "ROBOKIN_NUM_THREADS" not in res.stderr
+    else:
+        assert "RuntimeWarning: " + message.format(k=k) in res.stderr
+
+
+@pytest.mark.parametrize("value", ["bogus", "sse9", ""])
+def test_robokin_isa_unknown_values_warn_and_use_the_best_copy(value):
+    best = _import_with({}).stdout.split()[0]
+    res = _import_with({"ROBOKIN_ISA": value})
+    assert res.stdout.split()[0] == best
+    if value:
+        assert (f"RuntimeWarning: ROBOKIN_ISA='{value}' is not one of baseline, avx2, "
+                f"avx512; using {best} (the best copy this CPU runs)") in res.stderr
+    else:
+        assert "ROBOKIN_ISA" not in res.stderr
+
+
+def test_robokin_isa_beyond_this_cpu_warns():
+    best = _import_with({}).stdout.split()[0]
+    res = _import_with({"ROBOKIN_ISA": "avx512"})
+    assert res.stdout.split()[0] == best
+    if best == "avx512":
+        assert "ROBOKIN_ISA" not in res.stderr
+    else:  # pragma: no cover - depends on the CPU
+        assert f"has no avx512 copy; using {best}" in res.stderr

@@ -164,3 +164,43 @@ def test_mujoco_warnings_become_python_warnings_not_a_log_file(tmp_path, monkeyp
         mj.mj_step(model, data)
     assert any("MuJoCo:" in str(w.message) for w in caught)
     assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
+# ------------------------------------------ issue 25: mass properties no body has
+@pytest.mark.parametrize(("mass", "moments", "field", "match"), [
+    (1e300, (1.0, 1.0, 1.0), "mass", r"a mass of 1e\+300 kg, more than the 100000 kg"),
+    (3.0, (1e300, 1e300, 1e300), "inertia", r"a principal moment of 1e\+300 kg m\^2"),
+    # [1, 1, 5]: C = 2.5 (A + B), no rigid body (A + B >= C for every mass layout)
+    (3.0, (1.0, 1.0, 5.0), "inertia",
+     r"principal moments \[1.0, 1.0, 5.0\] kg m\^2 break the triangle inequality "
+     r"A \+ B >= C \(by 150%"),
+])
+def test_mjcf_export_refuses_mass_properties_no_body_has(tmp_path, mass, moments,
+                                                         field, match):
+    import yaml
+
+    doc = yaml.safe_load(robokin.robots.path("ur5").read_text())
+    doc["dynamics"]["links"]["elbow"] = {"mass": mass, "inertia": [*moments, 0, 0, 0]}
+    f = tmp_path / "ur5.yaml"
+    f.write_text(yaml.safe_dump(doc, sort_keys=False))
+    robot = robokin.load(f)  # kinematics still load: only physics needs them
+    with pytest.raises(robokin.ModelError, match=rf"ur5.yaml: dynamics.links.elbow."
+                                                 rf"{field}: {match}"):
+        sim.to_mjcf(robot)
+    from robokin.cli import main
+
+    assert main(["export", str(f), "-o", str(tmp_path / "ur5.xml")]) == 2
+    assert not (tmp_path / "ur5.xml").exists()
+
+
+def test_mjcf_export_balances_a_rounded_tensor_with_a_note():
+    """Within 25 % (the Puma 560's elbow: 0.086 > 0.0125 + 0.066 by 9.6 %), the two
+    smaller moments grow by half the shortfall each and the export says so."""
+    export = sim.build_mjcf(robokin.load("puma560"))
+    (note,) = [n for n in export.notes if n.startswith("link 'elbow'")]
+    assert "violate A + B >= C" in note
+    model = load_model(export.xml)
+    body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "elbow")
+    A, B, C = np.sort(model.body_inertia[body])
+    assert A + B >= C * (1 - 1e-9)
+    assert pytest.approx(0.086) == C

@@ -286,6 +286,52 @@ def test_bag_errors(tmp_path, plan_and_run):
         read_bag_log(bag, max_messages=5)
 
 
+def _sim_bag(path, names, t, q, heads_ns, recv_start=1_700_000_000 * 10**9):
+    """JointState messages with the given header stamps [ns], received on the wall
+    clock 2 ms after ``recv_start + t``."""
+    with Writer(path, version=9, storage_plugin=StoragePlugin.MCAP) as w:
+        js = w.add_connection("/joint_states", "sensor_msgs/msg/JointState", typestore=TS)
+        for tk, qk, hk in zip(t, q, heads_ns):
+            w.write(js, recv_start + int(round(tk * 1e9)) + 2_000_000,
+                    TS.serialize_cdr(state_msg(int(hk), names, qk),
+                                     "sensor_msgs/msg/JointState"))
+    return path
+
+
+def test_a_bag_whose_first_stamp_is_zero_is_read(tmp_path, plan_and_run):
+    """Issue 25: simulation time starts at 0.0; that stamp was read as "not stamped"
+    (the wall-clock receive time, 1.7e9 s), so the next stamp (0.008 s) went
+    "backwards" and the bag was refused. Oracle: the times written."""
+    ur5, _, t, q = plan_and_run
+    heads = np.round(t * 1e9).astype(np.int64)          # 0, 8 ms, 16 ms, ...
+    assert heads[0] == 0
+    bag = _sim_bag(tmp_path / "sim", ur5.joint_names, t, q, heads)
+    log = read_bag_log(bag)
+    np.testing.assert_allclose(log.t, t, atol=1e-12)
+    np.testing.assert_array_equal(log.q, q)
+    # real backwards time on that clock is still refused
+    back = heads.copy()
+    back[5] = back[3]
+    with pytest.raises(ModelError, match="time goes backwards at message 5"):
+        read_bag_log(_sim_bag(tmp_path / "back", ur5.joint_names, t, q, back))
+
+
+def test_a_zero_stamp_on_the_bag_clock_is_not_stamped(tmp_path, plan_and_run):
+    """Stamps on the wall clock with a few unstamped (zero) messages: those take
+    their receive times, as before; all zero: the receive times."""
+    ur5, _, t, q = plan_and_run
+    start = 1_700_000_000 * 10**9
+    heads = start + np.round(t * 1e9).astype(np.int64)
+    heads[[0, 7]] = 0
+    log = read_bag_log(_sim_bag(tmp_path / "wall", ur5.joint_names, t, q, heads))
+    expect = t.copy()
+    expect[[0, 7]] += 0.002                       # received 2 ms after the stamp
+    np.testing.assert_allclose(log.t, expect - expect[0], atol=1e-9)
+    none = read_bag_log(_sim_bag(tmp_path / "none", ur5.joint_names, t, q,
+                                 np.zeros(len(t), np.int64)))
+    np.testing.assert_allclose(none.t, t, atol=1e-9)
+
+
 def test_aubo_i5_ros2_program_is_a_valid_message_with_the_driver_names():
     from robokin.trajectory.controllers import controller_program
 

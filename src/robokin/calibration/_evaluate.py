@@ -168,9 +168,17 @@ def plot_errors(report: HoldoutReport, *, path: str | Path | None = None,
     Returns:
         The matplotlib Figure.
     """
-    from robokin.viz.plots import _figure, save_figure
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
-    fig = _figure(figsize=(10.0, 4.2))
+    from robokin.io.atomic import save_figure_atomic
+
+    # a Figure on the Agg canvas (no pyplot state, no window) and io's atomic save:
+    # calibration sits below viz (docs/conventions.md, "Layers"), as collision/plots.py
+    if path is not None and Path(path).suffix.lower() not in (".png", ".svg", ".pdf"):
+        raise InputError("path", f"expected a .png, .svg or .pdf file, got {Path(path).name}")
+    fig = Figure(figsize=(10.0, 4.2), layout="constrained")
+    FigureCanvasAgg(fig)
     ax, hx = fig.subplots(1, 2, gridspec_kw={"width_ratios": [3, 1]})
     i = np.arange(report.errors_after.size)
     for e, s, color, label in ((report.errors_before, report.before, "0.6", "before"),
@@ -192,5 +200,5 @@ def plot_errors(report: HoldoutReport, *, path: str | Path | None = None,
     hx.set_ylabel("poses")
     fig.suptitle(title or "calibration: hold-out position errors")
     if path is not None:
-        save_figure(fig, path, overwrite=overwrite)
+        save_figure_atomic(fig, path, overwrite=overwrite, dpi=120)
     return fig

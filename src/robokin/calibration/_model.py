@@ -203,7 +203,7 @@ class Model:
                      torque: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
         """Chain joint values ``u`` (N, n_chain) and the chain values ``v`` (N, n_chain)."""
         chain = self.chain
-        v = chain.chain_values(q)
+        v = chain.coupling.apply(q)
         sign = np.array([j.sign for j in chain.joints])
         off = np.array([j.offset for j in chain.joints])
         u = sign * v + off

@@ -72,7 +72,7 @@ def progress_callback(progress: Progress, total: int, text: str,
         TimeRemainingColumn,
     )
 
-    console = Console(stderr=True)
+    console = Console(stderr=True, emoji=False)  # an address is printed as typed
     console.print(f"{text}: {total:,} Dask tasks on {describe(scheduler)}", markup=False,
                   highlight=False)
     with Progress(

@@ -39,10 +39,12 @@ from typing import Any, TypeVar
 from robokin._text import short_repr
 from robokin.exceptions import InputError, MissingExtraError
 
-__all__ = ["LOCAL_SCHEDULERS", "describe", "require_scale", "run_chunks"]
+__all__ = ["CONNECT_TIMEOUT", "LOCAL_SCHEDULERS", "describe", "probe_scheduler",
+           "require_scale", "run_chunks"]
 
 LOCAL_SCHEDULERS = ("threads", "processes", "synchronous")
-_CONNECT_TIMEOUT = 15.0  # [s] to reach a scheduler given by address
+#: Seconds to reach a scheduler given by address and hear it answer as one.
+CONNECT_TIMEOUT = 10.0
 
 J = TypeVar("J")
 R = TypeVar("R")
@@ -243,6 +245,94 @@ def _run_distributed(
             client.cancel(live)
 
 
+def _unreachable(scheduler: Any, timeout: float, why: str, argument: str) -> InputError:
+    return InputError(
+        argument,
+        f"cannot reach the Dask scheduler at {short_repr(scheduler, 200)} within "
+        f"{timeout:g} s: {why}; start one with 'dask scheduler' and 'dask worker "
+        "ADDRESS' (docs/scale.md)")
+
+
+async def _identity(address: str, timeout: float) -> Any:
+    """The scheduler's answer to ``identity`` (each step bounded by ``timeout``)."""
+    import asyncio
+
+    from distributed.comm import connect
+
+    # distributed's connect retries until its timeout, then reads the handshake
+    # with no bound at all (a port that accepts and stays silent hangs there)
+    # (the outer bound a little later than connect's own: a refused connection
+    # is reported as refused, not as silence)
+    comm = await asyncio.wait_for(connect(address, timeout=timeout), 1.5 * timeout + 0.5)
+    try:
+        await asyncio.wait_for(comm.write({"op": "identity", "reply": True}), timeout)
+        return await asyncio.wait_for(comm.read(), timeout)
+    finally:
+        comm.abort()
+
+
+def _os_reason(exc: OSError) -> str:
+    """The innermost system error of a failed connect (``Connection refused``)."""
+    inner: BaseException = exc
+    while inner.__cause__ is not None:
+        inner = inner.__cause__
+    if isinstance(inner, OSError) and inner.strerror:
+        return inner.strerror.lower() + " (no Dask scheduler listens there)"
+    return " ".join(str(exc).split())[:200] or type(exc).__name__
+
+
+def probe_scheduler(scheduler: Any, timeout: float = CONNECT_TIMEOUT, *,
+                    argument: str = "scheduler") -> None:
+    """Raise unless a Dask scheduler answers at the address within ``timeout``.
+
+    A closed port, an address nothing answers from (a firewall, an unroutable
+    network) and a server that answers but is no Dask scheduler each end in at
+    most about ``timeout`` seconds (twice that for a server that is slow at every
+    step, plus up to half of it for the connection) with one
+    :class:`InputError` naming the address. ``None``, a local
+    scheduler name and a :class:`distributed.Client` are not probed.
+
+    Args:
+        scheduler: As :func:`run_chunks` takes it.
+        timeout: Seconds to connect, and again to hear the answer (> 0).
+        argument: The argument named in the error (``--scheduler`` on the CLI).
+
+    Raises:
+        InputError: the scheduler cannot be reached (naming ``argument``), or a
+            bad ``scheduler`` or ``timeout``.
+    """
+    import asyncio
+    import concurrent.futures
+
+    if not (isinstance(timeout, int | float) and math.isfinite(timeout) and timeout > 0):
+        raise InputError("timeout", f"expected seconds > 0, got {short_repr(timeout)}")
+    if scheduler is None or _is_client(scheduler) or scheduler in LOCAL_SCHEDULERS:
+        return
+    try:
+        check_scheduler(scheduler)
+    except InputError as exc:
+        raise InputError(argument, exc.reason) from None
+    address = scheduler if "://" in scheduler else f"tcp://{scheduler}"
+    # a thread of its own: the caller may be inside an event loop (a notebook)
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        job = pool.submit(asyncio.run, _identity(address, timeout))
+        try:
+            reply = job.result(timeout=3 * timeout + 1)
+        except (TimeoutError, asyncio.TimeoutError, concurrent.futures.TimeoutError):
+            raise _unreachable(scheduler, timeout, "no answer (a firewall, an "
+                               "unroutable network, or not a Dask scheduler)",
+                               argument) from None
+        except OSError as exc:
+            raise _unreachable(scheduler, timeout, _os_reason(exc), argument) from None
+        except Exception as exc:  # garbage on the wire: any decoding error
+            raise _unreachable(scheduler, timeout, "something answers there, but not "
+                               f"as a Dask scheduler ({type(exc).__name__})",
+                               argument) from None
+    if not (isinstance(reply, dict) and reply.get("type") == "Scheduler"):
+        raise _unreachable(scheduler, timeout, "something answers there, but not as a "
+                           "Dask scheduler", argument)
+
+
 @contextmanager
 def _client(scheduler: Any) -> Iterator[Any]:
     if _is_client(scheduler):
@@ -250,15 +340,12 @@ def _client(scheduler: Any) -> Iterator[Any]:
         return
     from distributed import Client
 
+    probe_scheduler(scheduler, CONNECT_TIMEOUT)
     try:
-        client = Client(scheduler, timeout=_CONNECT_TIMEOUT, set_as_default=False)
-    except (OSError, TimeoutError) as exc:
-        raise InputError(
-            "scheduler",
-            f"cannot reach the Dask scheduler at {short_repr(scheduler)} within "
-            f"{_CONNECT_TIMEOUT:.0f} s ({type(exc).__name__}: {exc}); start one with "
-            "'dask scheduler' and 'dask worker ADDRESS' (docs/scale.md)",
-        ) from None
+        client = Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
+    except Exception as exc:  # it answered the probe a moment ago
+        raise _unreachable(scheduler, CONNECT_TIMEOUT, f"{type(exc).__name__}: "
+                           f"{' '.join(str(exc).split())[:200]}", "scheduler") from None
     try:
         yield client
     finally:

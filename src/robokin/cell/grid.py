@@ -25,9 +25,12 @@ from robokin._text import short_repr
 from robokin.exceptions import InputError
 from robokin.spatial import rotz
 
-__all__ = ["VoxelGrid", "tool_orientations"]
+__all__ = ["MAX_ORIENTATIONS", "VoxelGrid", "check_orientation_count", "tool_orientations"]
 
 _MAX_VOXELS = 2**40  # a bound on V that keeps every index exact in int64 arithmetic
+#: Most tool orientations per voxel (approach directions x rolls): 100,000 is a
+#: direction every 0.7 degrees with 1 roll; a map's counts hold V x K bytes.
+MAX_ORIENTATIONS = 100_000
 _GOLDEN_ANGLE = math.pi * (3.0 - math.sqrt(5.0))  # [rad]
 
 
@@ -180,8 +183,7 @@ def tool_orientations(count: int, rolls: int = 1) -> np.ndarray:
     Raises:
         InputError: a count or roll number that is not an integer >= 1.
     """
-    count = _positive_int(count, "orientations")
-    rolls = _positive_int(rolls, "rolls")
+    count, rolls = check_orientation_count(count, rolls)
     i = np.arange(count, dtype=np.float64)
     z = 1.0 - (2.0 * i + 1.0) / count
     r = np.sqrt(np.maximum(0.0, 1.0 - z * z))
@@ -198,6 +200,33 @@ def tool_orientations(count: int, rolls: int = 1) -> np.ndarray:
     Rz = rotz(roll)[:, :3, :3]
     out = base[:, None] @ Rz[None]
     return np.ascontiguousarray(out.reshape(count * rolls, 3, 3))
+
+
+def check_orientation_count(count: object, rolls: object = 1, *,
+                            names: tuple[str, str] = ("orientations", "rolls")
+                            ) -> tuple[int, int]:
+    """``(count, rolls)`` as integers >= 1 whose product is at most :data:`MAX_ORIENTATIONS`.
+
+    Checked before anything is allocated (``orientations=10**9`` asked for 72 GB
+    of rotation matrices).
+
+    Args:
+        count: Approach directions.
+        rolls: Rolls about each.
+        names: The argument names for messages (the CLI's ``--orientations``).
+
+    Raises:
+        InputError: not integers >= 1, or too many orientations (how many, the
+            cap).
+    """
+    count = _positive_int(count, names[0])
+    rolls = _positive_int(rolls, names[1])
+    if count * rolls > MAX_ORIENTATIONS:
+        times = f" x {rolls:,} rolls" if rolls > 1 else ""
+        raise InputError(names[0], f"{count:,} orientations{times} = {count * rolls:,} "
+                         f"per voxel, more than the {MAX_ORIENTATIONS:,} robokin "
+                         "tries (robokin.cell.grid.MAX_ORIENTATIONS)")
+    return count, rolls
 
 
 def _positive_int(value: object, name: str) -> int:

@@ -32,6 +32,7 @@ from typing import IO, Any
 from robokin.exceptions import InputError
 
 __all__ = [
+    "check_distinct",
     "file_stem",
     "new_file_mode",
     "publish_folder",
@@ -199,13 +200,9 @@ def staged_outputs(
             targets are the same file.
     """
     checked = [(Path(p), arg, over) for p, arg, over in targets]
-    seen: dict[Path, str] = {}
+    check_distinct([(path, arg) for path, arg, _ in checked])
     for path, arg, over in checked:
         _check_target(path, over, arg, how)
-        key = path.parent.resolve() / path.name
-        if key in seen:
-            raise InputError(arg, f"{path} is also the output of {seen[key]}")
-        seen[key] = arg
     stages: dict[Path, Path] = {}
     staged: list[Path] = []
     try:
@@ -228,6 +225,71 @@ def staged_outputs(
     finally:
         for stage in stages.values():
             shutil.rmtree(stage, ignore_errors=True)
+
+
+def _output_key(path: Path) -> tuple[str, ...]:
+    """What identifies the file a write to ``path`` replaces.
+
+    The folder resolved (symlinks, ``..``) and the name; an existing file also
+    by device and inode (a hard link is the same file), and a symlink also by
+    its target (a write replaces the link, which the user made to name it).
+    """
+    keys = [os.path.join(os.path.realpath(path.parent if str(path.parent) else "."),
+                         path.name)]
+    with contextlib.suppress(OSError):
+        st = os.lstat(path)
+        keys.append(f"{st.st_dev}:{st.st_ino}")
+    if os.path.islink(path):
+        keys.append(os.path.realpath(path))
+    return tuple(keys)
+
+
+def _input_keys(path: Path) -> tuple[str, ...]:
+    """What identifies the file read from ``path``: the link and its target."""
+    keys = list(_output_key(path))
+    keys.append(os.path.realpath(path))
+    with contextlib.suppress(OSError):
+        st = os.stat(path)
+        keys.append(f"{st.st_dev}:{st.st_ino}")
+    return tuple(keys)
+
+
+def check_distinct(outputs: Sequence[tuple[str | Path, str]],
+                   inputs: Sequence[tuple[str | Path | None, str]] = ()) -> None:
+    """Refuse two outputs that are one file, and an output that is an input.
+
+    A command with several outputs (``robokin traj -o X.csv --ros2 X.csv``)
+    would write the second over the first, and an output named like an input
+    (``robokin sim ... out/simulated.csv --out out``) would replace what the user
+    wrote: both are refused before anything is computed or written.
+
+    Args:
+        outputs: ``(path, argument)`` per file to write (the option naming it).
+        inputs: ``(path, argument)`` per file read (None: not a file, skipped).
+
+    Raises:
+        InputError: naming the output's argument, the file and the other
+            argument.
+    """
+    read: dict[str, str] = {}
+    for path, arg in inputs:
+        if path is None:
+            continue
+        for key in _input_keys(Path(path)):
+            read.setdefault(key, arg)
+    written: dict[str, str] = {}
+    for path, arg in outputs:
+        keys = _output_key(Path(path))
+        other = next((read[k] for k in keys if k in read), None)
+        if other is not None:
+            raise InputError(arg, f"{path} is the input {other}; robokin never writes "
+                             "over a file it reads: choose another name")
+        other = next((written[k] for k in keys if k in written), None)
+        if other is not None:
+            raise InputError(arg, f"{path} is also the output of {other}; choose "
+                             "another name")
+        for k in keys:
+            written[k] = arg
 
 
 def _cannot_write(path: Path, argument: str, exc: OSError, folder: Path | None = None

@@ -72,14 +72,15 @@ class PackageFinder:
             if not isinstance(name, str) or not name or "/" in name:
                 raise InputError("package_map", f"a package name must be non-empty "
                                  f"text without '/', got {name!r}")
-            d = Path(directory).expanduser()
+            # absolute: xacro reads a relative include against the including file
+            d = Path(directory).expanduser().absolute()
             if not d.is_dir():
                 raise InputError("package_map", f"package '{name}': no such folder "
                                  f"{d}")
             self.package_map[name] = d
-        self.ros_package_path = [Path(p) for p in
+        self.ros_package_path = [Path(p).absolute() for p in
                                  env.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
-        self.ament_prefix_path = [Path(p) for p in
+        self.ament_prefix_path = [Path(p).absolute() for p in
                                   env.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
         self.near = None if near is None else Path(near).resolve().parent
         self._crawled: dict[str, Path] | None = None
@@ -133,6 +134,18 @@ class PackageFinder:
                 dirs[:] = sorted(x for x in dirs if not x.startswith("."))
         self._crawled = found
         return found
+
+    def lookups(self) -> dict[str, str | None]:
+        """Every package looked up so far: ``{name: folder or None}`` (JSON-ready)."""
+        return {k: None if v is None else str(v) for k, v in self._cache.items()}
+
+    def absorb(self, lookups: Mapping[str, str | None]) -> None:
+        """Take lookups made by a copy of this finder (in a child process).
+
+        Only names this finder has not looked up itself: its own answers stay.
+        """
+        for name, found in lookups.items():
+            self._cache.setdefault(str(name), None if found is None else Path(found))
 
     def search_path(self) -> list[str]:
         """The places searched, in order, for messages."""

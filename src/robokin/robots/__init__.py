@@ -5,8 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from robokin.exceptions import ModelError
+from robokin.io.robot_files import load_parts
+from robokin.robot import Robot
 
-__all__ = ["load", "names", "path"]
+__all__ = ["URDF_SUFFIXES", "load", "names", "path"]
 
 _HERE = Path(__file__).parent
 
@@ -28,11 +30,25 @@ def path(name: str) -> Path:
     return p
 
 
-def load(name_or_path):
-    """Load a built-in robot by name, or a robot file by path."""
-    from robokin.io.robot_files import load_robot
+#: Names of files that are URDF or xacro, not robot files.
+URDF_SUFFIXES = (".urdf", ".xacro", ".urdf.xml")
 
+
+def load(name_or_path: str | Path) -> Robot:
+    """Load a built-in robot by name, or a robot file by path.
+
+    Raises:
+        ModelError: an unknown name (listing the built-in ones), a bad robot
+            file, or a URDF or xacro (pointing to ``Robot.from_urdf`` and
+            ``robokin import``).
+    """
     s = str(name_or_path)
-    if isinstance(name_or_path, Path) or s.endswith((".yaml", ".yml")) or "/" in s:
-        return load_robot(Path(name_or_path))
-    return load_robot(path(s))
+    if s.lower().endswith(URDF_SUFFIXES):
+        raise ModelError(
+            "a URDF or xacro, not a robokin robot file: read it with "
+            f"robokin.Robot.from_urdf({s!r}) or convert it once with "
+            f"'robokin import {s} -o ROBOT.yaml'", file=s)
+    if isinstance(name_or_path, Path) or s.endswith((".yaml", ".yml")) or "/" in s \
+            or Path(s).is_file():
+        return Robot.from_parts(load_parts(Path(name_or_path)))
+    return Robot.from_parts(load_parts(path(s)))

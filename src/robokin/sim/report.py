@@ -20,7 +20,8 @@ if TYPE_CHECKING:
     from robokin.sim.inverse import InverseDynamics
     from robokin.sim.simulate import SimResult
 
-__all__ = ["plot_decoupling", "plot_torques", "run_summary", "write_run"]
+__all__ = ["RUN_FILES", "plot_decoupling", "plot_torques", "run_summary", "speed_text",
+           "write_run"]
 
 
 def _unit(revolute: bool) -> tuple[str, str]:
@@ -118,6 +119,26 @@ def plot_decoupling(check: Any, *, path: str | Path | None = None,
     return fig
 
 
+def speed_text(real_time_factor: float) -> str:
+    """How fast a run went against the clock, in words.
+
+    Args:
+        real_time_factor: Wall time per simulated second (below 1: faster).
+
+    Returns:
+        ``"80x faster than real time"``, ``"2.5x slower than real time"`` or
+        ``"at about real time"`` (within 5 %).
+    """
+    rtf = float(real_time_factor)
+    if not math.isfinite(rtf) or rtf <= 0:
+        return "at an unknown speed"
+    if abs(rtf - 1.0) <= 0.05:
+        return "at about real time"
+    ratio = 1.0 / rtf if rtf < 1.0 else rtf
+    shown = f"{ratio:.0f}" if ratio >= 10 else f"{ratio:.1f}"
+    return f"{shown}x {'faster' if rtf < 1.0 else 'slower'} than real time"
+
+
 def _display(revolute: bool) -> tuple[float, str]:
     return (180.0 / math.pi, "deg") if revolute else (1000.0, "mm")
 
@@ -179,6 +200,11 @@ def run_summary(result: SimResult, inverse: InverseDynamics | None = None
         "mass_properties": result.export.links.describe(),
         "notes": list(result.export.notes),
     }
+
+
+#: The files :func:`write_run` writes (each after its ``prefix``).
+RUN_FILES = ("model.xml", "simulated.csv", "tracking.png", "torques.png", "contacts.csv",
+             "summary.json")
 
 
 def write_run(result: SimResult, inverse: InverseDynamics | None, out: str | Path, *,

@@ -16,7 +16,7 @@ and ``rosidl_runtime_py.set_message_fields`` read), or, with
       effort: []
       time_from_start: {sec: 0, nanosec: 5000000}
 
-ROS messages are SI: a :class:`~robokin.trajectory.io.ControllerProfile`'s
+ROS messages are SI: a :class:`~robokin.trajectory.controller_profile.ControllerProfile`'s
 joint order, signs, zero offsets and names apply, its units do not. A zero
 header stamp tells the controller to start now. :func:`read_joint_trajectory`
 reads the file back (a message or a goal).
@@ -46,7 +46,7 @@ from robokin._text import short_repr
 from robokin.exceptions import InputError, MissingExtraError, ModelError
 from robokin.io.atomic import write_atomic
 from robokin.io.text_files import MAX_CSV_BYTES
-from robokin.trajectory.io import ControllerProfile
+from robokin.trajectory.controller_profile import ControllerProfile
 from robokin.trajectory.samples import Trajectory
 
 __all__ = [
@@ -334,8 +334,10 @@ def read_bag_log(
             first message, in its order.
         is_revolute: (n,) angle flags in the order of ``joint_names`` (default:
             all angles).
-        stamp: ``"header"``: the messages' header stamps (the receive time
-            where a stamp is zero); ``"receive"``: the bag's receive times.
+        stamp: ``"header"``: the messages' header stamps (a zero stamp is "not
+            stamped", read as the receive time, when the stamps are on the bag's
+            clock; on a clock of their own, such as simulation time starting at
+            0.0, it is a time); ``"receive"``: the bag's receive times.
         max_messages: The most messages read from the topic.
 
     Returns:
@@ -393,6 +395,27 @@ def _joint_states(reader: Any, conns: list[Any], max_messages: int, path: Path
     return rows
 
 
+#: Header stamps within this of their receive times [ns] are on the bag's clock.
+_SAME_CLOCK_NS = 60 * 10**9
+
+
+def _header_times(head: list[int], recv: list[int]) -> list[int]:
+    """The header stamps as times [ns], a zero stamp read as its clock says.
+
+    A zero stamp means "not stamped" (the receive time is used) when the other
+    stamps are on the bag's clock (the median within a minute of their receive
+    times), or when every stamp is zero; when they are on a clock of their own
+    (simulation time, which starts at 0.0), zero is a time like any other.
+    """
+    stamped = [(h, r) for h, r in zip(head, recv) if h > 0]
+    if not stamped:
+        return list(recv)
+    gaps = sorted(abs(h - r) for h, r in stamped)
+    if gaps[len(gaps) // 2] > _SAME_CLOCK_NS:
+        return list(head)
+    return [h if h > 0 else r for h, r in zip(head, recv)]
+
+
 def _log_from_states(rows: list[tuple[int, int, list[str], list[float]]], path: Path,
                      topic: str, joint_names: Sequence[str] | None,
                      is_revolute: npt.ArrayLike | None,
@@ -411,18 +434,20 @@ def _log_from_states(rows: list[tuple[int, int, list[str], list[float]]], path: 
     if extra:
         warnings.warn(f"{path}: {topic} also names {short_repr(extra, 200)}, joints "
                       "the robot does not have: ignored", UserWarning, stacklevel=3)
-    times, q = [], []
+    recv, head, q = [], [], []
     for t_recv, t_head, names, pos in rows:
         if len(pos) != len(names):
             continue  # a message without positions for its names (velocity only)
         where = {nm: k for k, nm in enumerate(names)}
         if not all(j in where for j in wanted):
             continue
-        times.append(t_head if stamp == "header" and t_head > 0 else t_recv)
+        recv.append(t_recv)
+        head.append(t_head)
         q.append([pos[where[j]] for j in wanted])
     if not q:
         raise ModelError(f"no message on {topic} holds positions of all of {wanted}",
                          file=path)
+    times = _header_times(head, recv) if stamp == "header" else recv
     ns = np.asarray(times, np.int64)
     step = np.diff(ns)
     if np.any(step < 0):

@@ -15,6 +15,7 @@ from robokin._validation import (
     check_poses_fast,
 )
 from robokin.exceptions import InputError
+from robokin.kinematics.ik.fixed import solve_fixed
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
 
@@ -42,9 +43,10 @@ def solve(
     """
     if method not in _METHODS:
         raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
+    if len(options) == 1 and "fixed" in options:
+        # held joints, no other option: no re-packing of the keyword arguments
+        return solve_fixed(robot, T, options["fixed"], q_near=q_near, method=method)
     if "fixed" in options:
-        from robokin.kinematics.ik.fixed import solve_fixed
-
         return solve_fixed(robot, T, options.pop("fixed"), q_near=q_near, method=method,
                            **options)
     qn: npt.NDArray[np.float64] | None = None
@@ -52,7 +54,7 @@ def solve(
         qn = (q_near if _plain_joints(q_near, robot.n)
               else check_finite(check_joints(q_near, robot.n, "q_near"), "q_near"))
     if (not options and type(T) is np.ndarray and T.shape == (4, 4)
-            and T.dtype == np.float64 and method != "numeric"):
+            and T.dtype == np.float64 and T.flags.aligned and method != "numeric"):
         # hot path: one pose, a 6R closed form, default options (one compiled call
         # validates the pose and solves it)
         single = _single_solver(robot)
@@ -110,4 +112,4 @@ def _plain_joints(q: object, n: int) -> TypeGuard[npt.NDArray[np.float64]]:
     full checks).
     """
     return (type(q) is np.ndarray and q.shape == (n,) and q.dtype == np.float64
-            and math.isfinite(sum(q.tolist())))
+            and q.flags.aligned and math.isfinite(sum(q.tolist())))

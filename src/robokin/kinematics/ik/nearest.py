@@ -109,14 +109,15 @@ def _nearest(robot: RobotLike, sols: SolutionSet, T: npt.ArrayLike, q_near: np.n
         ok = (sols.valid & sols.flags["within_limits"])[None]
         qn = q_near[None]
         Tf = np.asarray(T, dtype=np.float64)[None]
-        if not (Q.flags.c_contiguous and qn.flags.c_contiguous and Tf.flags.c_contiguous):
-            Q, qn, Tf = (np.ascontiguousarray(a) for a in (Q, qn, Tf))
+        if not all(a.flags.c_contiguous and a.flags.aligned for a in (Q, qn, Tf)):
+            Q, qn, Tf = (np.require(a, requirements=("C", "A")) for a in (Q, qn, Tf))
     else:
         N = int(np.prod(lead, dtype=np.int64))
         Q = np.ascontiguousarray(sols.q.reshape(N, k, n))
         ok = np.ascontiguousarray((sols.valid & sols.flags["within_limits"]).reshape(N, k))
         qn = np.ascontiguousarray(np.broadcast_to(q_near, lead + (n,)).reshape(N, n))
-        Tf = np.ascontiguousarray(np.asarray(T, dtype=np.float64).reshape(N, 4, 4))
+        Tf = np.require(np.asarray(T, dtype=np.float64).reshape(N, 4, 4),
+                        requirements=("C", "A"))  # an unaligned buffer: copied
     q = np.empty((N, n))
     err = np.empty((N, 2))
     found = np.empty(N, dtype=bool)
