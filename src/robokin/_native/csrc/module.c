@@ -19,6 +19,7 @@
 #include "six_r.c"
 #include "broadphase.c"
 #include "general6r.c"
+#include "process.c"
 
 /* ---------------------------------------------------------------- arguments */
 
@@ -572,6 +573,7 @@ static PyMethodDef methods[] = {
     SIX_R_METHODS
     BROADPHASE_METHODS
     GENERAL6R_METHODS
+    PROCESS_METHODS
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, MODULE_NAME,
@@ -604,7 +606,7 @@ PyMODINIT_FUNC MODULE_INIT(void)
     PyModule_AddObject(m, "LAYOUT_TAG", PyFloat_FromDouble(PACKED_TAG));
     PyModule_AddObject(m, "MAX_TRANSLATION", PyFloat_FromDouble(MAX_TRANSLATION));
     if (six_r_constants(m) < 0 || broadphase_constants(m) < 0 ||
-        general6r_constants(m) < 0) {
+        general6r_constants(m) < 0 || process_constants(m) < 0) {
         Py_DECREF(m);
         return NULL;
     }
