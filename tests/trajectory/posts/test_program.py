@@ -12,10 +12,18 @@ within the limits), those with the written flags are exactly the generating one
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from program_parsers import PARSERS
+from robokin.exceptions import InputError
 from robokin.spatial import invert
-from robokin.trajectory.posts import post_names, render_program, write_program
+from robokin.trajectory.posts import (
+    decimate,
+    post_names,
+    render_program,
+    write_program,
+)
 from robokin.trajectory.posts.arm_config import (
     abb_confdata,
     arm_configuration,
@@ -24,7 +32,7 @@ from robokin.trajectory.posts.arm_config import (
     staubli_config,
     yaskawa_rconf,
 )
-from vendor_arms import CREATED, PointSet
+from vendor_arms import CREATED, PROFILES, PathResult, PointSet
 
 DIALECTS = ["abb_rapid", "fanuc_tp", "kawasaki_as", "kuka_krl", "staubli_val3",
             "yaskawa_inform"]
@@ -207,3 +215,112 @@ def test_render_is_deterministic_and_write_matches_render(tmp_path, arm, sampled
                       created=CREATED, name="same")
     for path in w.files:
         assert path.read_bytes().decode("ascii") == a.texts[path.name]
+
+
+# ------------------------------------------------------------------ writing safely
+def test_files_are_never_replaced_without_force_and_all_or_none(tmp_path, arm, sampled):
+    prof = PROFILES["kuka"]
+    first = write_program(arm, sampled, "kuka_krl", tmp_path, name="p", profile=prof)
+    before = {p: p.read_bytes() for p in first.files}
+    with pytest.raises(InputError, match=r"p\.src exists; pass force=True \(--force\)"):
+        write_program(arm, sampled.q[:50], "kuka_krl", tmp_path, name="p", profile=prof)
+    assert {p: p.read_bytes() for p in first.files} == before
+    again = write_program(arm, sampled.q[:50], "kuka_krl", tmp_path, name="p", profile=prof,
+                          force=True)
+    assert again.files == first.files and before != {p: p.read_bytes() for p in again.files}
+    # one of the two files exists: neither is written
+    (tmp_path / "q.dat").write_text("mine")
+    with pytest.raises(InputError, match="q.dat exists"):
+        write_program(arm, sampled, "kuka_krl", tmp_path, name="q", profile=prof)
+    assert not (tmp_path / "q.src").exists() and (tmp_path / "q.dat").read_text() == "mine"
+
+
+def test_out_dir_is_made_inside_an_existing_folder(tmp_path, arm):
+    prog = write_program(arm, np.zeros((1, 6)), "abb_rapid", tmp_path / "new", name="m",
+                         profile=PROFILES["abb"])
+    assert prog.files == (tmp_path / "new" / "m.mod",)
+    with pytest.raises(InputError, match="does not exist"):
+        write_program(arm, np.zeros((1, 6)), "abb_rapid", tmp_path / "a" / "b", name="m")
+
+
+def test_refusals(arm, seam, sampled):
+    import robokin
+    result, _ = seam
+    with pytest.raises(InputError, match=r"not feasible \(waypoint 7: out of reach\)"):
+        render_program(arm, PathResult(result.q, feasible=False,
+                                       reason="waypoint 7: out of reach"), "kuka_krl")
+    q = np.zeros((2, 6))
+    q[1, 4] = np.radians(130)  # beyond A5's 120 deg
+    with pytest.raises(InputError, match=r"target 2 is outside robot's joint limits"):
+        render_program(arm, q, "kuka_krl")
+    panda = robokin.load("panda")
+    with pytest.raises(InputError, match="drive 6 revolute axes; panda has 7"):
+        render_program(panda, np.zeros((1, 7)), "abb_rapid")
+    bad = [({"joint_speed": 0}, "joint_speed"), ({"joint_speed": 1.5}, "joint_speed"),
+           ({"speed": -1}, "speed"), ({"zone": float("nan")}, "zone"),
+           ({"stride": 0}, "stride"), ({"stride": 2, "tolerance": 1e-3}, "stride")]
+    for kw, arg in bad:
+        with pytest.raises(InputError, match=arg):
+            render_program(arm, sampled, "kuka_krl", **kw)
+    with pytest.raises(InputError, match="tolerance.*use stride"):
+        render_program(arm, result, "kuka_krl", tolerance=1e-3)
+    with pytest.raises(InputError, match="expected a Trajectory"):
+        render_program(arm, "path.csv", "kuka_krl")
+    with pytest.raises(InputError, match="holds at most 5000"):
+        render_program(arm, np.zeros((5001, 6)), "kuka_krl")
+
+
+def test_robot_file_options_per_dialect(tmp_path):
+    import yaml
+
+    import robokin
+    from robokin.exceptions import ModelError
+
+    doc = {k: v for k, v in robokin.load("ur5").meta["document"].items()
+           if k != "controller"}
+    doc["controller"] = {"name": "cell 3", "posts": {"fanuc_tp": {"cnt": 100, "user_tool": 4}}}
+    f = tmp_path / "arm.yaml"
+    f.write_text(yaml.safe_dump(doc, sort_keys=False))
+    robot = robokin.load(f)
+    q = np.array([[0.1, -1.2, 1.3, -1.5, -1.5, 0.2]] * 3) + np.arange(3)[:, None] * 0.05
+    text = render_program(robot, q, "fanuc_tp", name="a").texts["A.ls"]
+    assert "CNT100" in text and "UTOOL_NUM=4 ;" in text
+    # the call's options win
+    text = render_program(robot, q, "fanuc_tp", name="a", options={"cnt": 10}).texts["A.ls"]
+    assert "CNT10 " in text and "UTOOL_NUM=4 ;" in text
+    doc["controller"]["posts"] = {"fanuc_tp": {"cnt": 300}}
+    f.write_text(yaml.safe_dump(doc, sort_keys=False))
+    with pytest.raises(ModelError, match=r"arm.yaml: controller.posts.fanuc_tp.cnt: expected an integer 0..100"):
+        render_program(robokin.load(f), q, "fanuc_tp")
+    doc["controller"]["posts"] = {"fanuk_tp": {}}
+    f.write_text(yaml.safe_dump(doc, sort_keys=False))
+    with pytest.raises(ModelError, match=r"controller.posts: unknown post processor"):
+        render_program(robokin.load(f), q, "fanuc_tp")
+    doc["controller"] = {"root": {"xyz_mm": [0, 0, 400], "rpy_deg": [0, 0, 180]}}
+    f.write_text(yaml.safe_dump(doc, sort_keys=False))
+    prof = robokin.trajectory.controllers.controller_profile(robokin.load(f))
+    np.testing.assert_allclose(prof.frame("root")[:3, 3], [0, 0, 0.4])
+    doc["controller"] = {"root": {"xyz": [0, 0, 400]}}
+    f.write_text(yaml.safe_dump(doc, sort_keys=False))
+    with pytest.raises(ModelError, match=r"controller.root: expected \{xyz_mm"):
+        robokin.trajectory.controllers.controller_profile(robokin.load(f))
+
+
+# ------------------------------------------------------------------ decimation
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31), tol=st.sampled_from([0.0, 1e-9, 1e-3, 0.05, 1.0]))
+def test_decimation_stays_within_tolerance(seed, tol):
+    """Oracle: the polyline through the kept samples, checked at every sample."""
+    rng = np.random.default_rng(seed)
+    q = np.cumsum(rng.normal(0, 0.02, (rng.integers(2, 300), 6)), axis=0)
+    keep = rng.integers(0, len(q), 3).tolist()
+    idx = decimate(q, tol, keep=keep)
+    assert idx[0] == 0 and idx[-1] == len(q) - 1 and set(keep) <= set(idx.tolist())
+    assert np.all(np.diff(idx) > 0)
+    for a, b in zip(idx[:-1], idx[1:]):
+        s = (np.arange(a, b + 1) - a) / (b - a)
+        chord = q[a] + s[:, None] * (q[b] - q[a])
+        assert np.abs(q[a:b + 1] - chord).max() <= tol + 1e-12
+    # a straight line needs only its ends
+    line = np.linspace(0, 1, 50)[:, None] * np.ones(6)
+    assert decimate(line, 1e-9).tolist() == [0, 49]

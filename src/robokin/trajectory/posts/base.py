@@ -269,11 +269,11 @@ class PostProcessor(ABC):
     def program_name(self, requested: str) -> tuple[str, str | None]:
         """A legal program name made from ``requested``, and a note when it changed.
 
-        Letters, digits and ``_`` are kept (anything else becomes ``_``), the name
+        Letters, digits and ``_`` are kept (runs of anything else become one ``_``), the name
         starts with a letter (``P`` is put in front otherwise), is cut to
         :attr:`name_limit` and capitalised where the dialect wants it.
         """
-        name = _NAME_REST.sub("_", requested).strip("_") or "robokin"
+        name = re.sub("_+", "_", _NAME_REST.sub("_", requested)).strip("_") or "robokin"
         if not name[0].isalpha():
             name = "P" + name
         name = name[: self.name_limit]

@@ -392,7 +392,7 @@ def _post_for(robot: Robot, dialect: str | PostProcessor, options: Mapping[str, 
             get_post(key, **merged)
         except InputError as exc:
             raise ModelError(exc.reason, file=robot.path,
-                             field=f"controller.posts.{key}") from None
+                             field=f"controller.posts.{key}.{exc.argument}") from None
     merged.update(options or {})
     return get_post(key, **merged)
 
