@@ -9,12 +9,13 @@ What becomes of each kind of motion:
 
 - a sampled joint trajectory (:class:`~robokin.trajectory.samples.Trajectory`):
   joint moves through a subset of its samples: every ``stride``-th (and the last),
-  or by default the fewest samples whose joint-space polyline stays within
-  ``tolerance`` [rad] of every sample (Douglas-Peucker in joint space, max-norm over
-  the joints; the via points are always kept). A controller's synchronous joint move
-  (PTP, MoveAbsJ, J, MOVJ, movej) is a straight line in joint space, so the path
-  stays within ``tolerance`` of the plan wherever the points are reached exactly;
-  with blending, corners are cut by the zone. Each move's speed is the fraction of
+  or by default the samples Douglas-Peucker keeps so that every sample lies within
+  ``tolerance`` [rad] (per joint) of the joint-space polyline through them
+  (:func:`decimate`; the via points are always kept). A controller's synchronous
+  joint move (PTP, MoveAbsJ, J, MOVJ, movej) is a straight line in joint space, so
+  its path passes within ``tolerance`` of every planned sample where the points are
+  reached exactly (its timing is the controller's); with blending, corners are cut
+  by the zone. Each move's speed is the fraction of
   the joints' rate limits the trajectory uses on that stretch (robots with rate
   limits), else ``joint_speed``;
 - a process path (the result of :func:`robokin.process.follow`: ``.q`` (N, n),
@@ -67,7 +68,8 @@ if TYPE_CHECKING:
     from robokin.robot import Robot
     from robokin.trajectory.io import ControllerProfile
 
-__all__ = ["Program", "decimate", "program_job", "render_program", "write_program"]
+__all__ = ["Program", "chord_deviation", "decimate", "program_job", "render_program",
+           "write_program"]
 
 _JOINT: MoveKind = "joint"
 _LINEAR: MoveKind = "linear"
@@ -106,12 +108,14 @@ class Program:
 
 # ------------------------------------------------------------------ decimation
 def decimate(q: npt.ArrayLike, tolerance: float, keep: Sequence[int] = ()) -> np.ndarray:
-    """Indices of the fewest samples whose polyline stays within ``tolerance``.
+    """Indices of samples whose polyline passes within ``tolerance`` of every sample.
 
     Douglas-Peucker on the joint-space polyline: a sample is kept when it is
-    farther than ``tolerance`` (max-norm over the joints, at the same fraction of
-    the chord) from the chord between the kept samples around it. The first and last
-    samples and ``keep`` are always kept.
+    farther than ``tolerance`` from the chord between the kept samples around it,
+    its distance measured to the nearest point of the chord (Euclidean projection)
+    and taken per joint (max-norm): every sample of the plan lies within
+    ``tolerance``, joint by joint, of a point of the controller's joint path. The
+    first and last samples and ``keep`` are always kept.
 
     Args:
         q: Samples (m, n) [rad, m].
@@ -137,15 +141,29 @@ def decimate(q: npt.ArrayLike, tolerance: float, keep: Sequence[int] = ()) -> np
         a, b = stack.pop()
         if b - a < 2:
             continue
-        s = (np.arange(a + 1, b) - a) / (b - a)
-        chord = q[a] + s[:, None] * (q[b] - q[a])
-        dev = np.abs(q[a + 1:b] - chord).max(axis=1)
+        dev = chord_deviation(q[a:b + 1])[1:-1]
         k = int(np.argmax(dev))
         if dev[k] > tolerance:
             mid = a + 1 + k
             chosen.add(mid)
             stack += [(a, mid), (mid, b)]
     return np.array(sorted(chosen))
+
+
+def chord_deviation(q: npt.ArrayLike) -> np.ndarray:
+    """Per sample, the max-norm distance to the nearest point of the first-last chord.
+
+    Args:
+        q: Samples (m, n); the chord runs from ``q[0]`` to ``q[-1]``.
+
+    Returns:
+        (m,) distances [rad, m] (0 at both ends).
+    """
+    q = np.asarray(q, dtype=np.float64)
+    d = q[-1] - q[0]
+    dd = float(d @ d)
+    s = np.zeros(len(q)) if dd == 0.0 else np.clip((q - q[0]) @ d / dd, 0.0, 1.0)
+    return np.abs(q - (q[0] + s[:, None] * d)).max(axis=1)
 
 
 def _stride_indices(m: int, stride: int) -> np.ndarray:
@@ -192,7 +210,7 @@ def _trajectory_plan(robot: Robot, traj: Trajectory, stride: int | None,
         raise InputError("stride", "give stride or tolerance, not both")
     if stride is not None:
         idx = _stride_indices(len(traj), stride)
-        how = f"every {stride}. sample"
+        how = f"one sample in {stride}"
     else:
         tol = 1e-3 if tolerance is None else float(tolerance)
         vias = np.searchsorted(traj.t, np.asarray(traj.via_times) - 1e-9)
