@@ -34,7 +34,6 @@ from robokin.trajectory.posts.base import (
     ProgramJob,
     Statement,
     comment_text,
-    quaternion_wxyz,
 )
 
 __all__ = ["AbbRapid"]
@@ -91,8 +90,7 @@ class AbbRapid(PostProcessor):
         return "[" + ",".join(self.length(v) for v in p) + "]"
 
     def _quat(self, R: np.ndarray) -> str:
-        digits = self.angle_decimals + 4
-        return "[" + ",".join(f"{v:.{digits}f}" for v in quaternion_wxyz(R)) + "]"
+        return "[" + ",".join(self.quaternion(R, self.angle_decimals + 4)) + "]"
 
     def speed_name(self, mm_s: float) -> str:
         """``vNNN`` when predefined, else the declared ``rkVNNN``."""

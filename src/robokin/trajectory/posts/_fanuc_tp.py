@@ -92,7 +92,7 @@ class FanucTp(PostProcessor):
     def _wpr(self, T: np.ndarray) -> list[str]:
         """``X, Y, Z, W, P, R`` as text."""
         r, p, w = euler_deg(T[:3, :3], "ZYX")
-        return [self.length(v) for v in T[:3, 3]] + [self.angle(v) for v in (w, p, r)]
+        return [self.length(v) for v in T[:3, 3]] + [self.euler(v) for v in (w, p, r)]
 
     def _frame_lines(self, job: ProgramJob) -> list[str]:
         tool, base = self._wpr(job.tool), self._wpr(job.base)

@@ -58,7 +58,7 @@ class KawasakiAs(PostProcessor):
     def _trans(self, T: np.ndarray) -> str:
         o, a, t = euler_deg(T[:3, :3], "ZYZ")
         return " ".join([self.length(v) for v in T[:3, 3]]
-                        + [self.angle(v) for v in (o, a, t)])
+                        + [self.euler(v) for v in (o, a, t)])
 
     def header(self, job: ProgramJob) -> list[str]:
         """Comments (``;``), tool and base."""

@@ -75,7 +75,7 @@ class KukaKrl(PostProcessor):
         a, b, c = euler_deg(T[:3, :3], "ZYX")
         x, y, z = T[:3, 3]
         return (f"{{X {self.length(x)},Y {self.length(y)},Z {self.length(z)},"
-                f"A {self.angle(a)},B {self.angle(b)},C {self.angle(c)}}}")
+                f"A {self.euler(a)},B {self.euler(b)},C {self.euler(c)}}}")
 
     def header(self, job: ProgramJob) -> list[str]:
         """``DEF``, comments, initialisation, frames and approximation parameters."""
@@ -105,7 +105,7 @@ class KukaKrl(PostProcessor):
         ext = ",".join(f"E{k} 0.0" for k in range(1, 7))
         return f"XP{t.number}", (
             f"DECL E6POS XP{t.number}={{X {self.length(x)},Y {self.length(y)},"
-            f"Z {self.length(z)},A {self.angle(a)},B {self.angle(b)},C {self.angle(c)},"
+            f"Z {self.length(z)},A {self.euler(a)},B {self.euler(b)},C {self.euler(c)},"
             f"S {int(s)},T {int(turn)},{ext}}}")
 
     def joint_move(self, job: ProgramJob, move: Move, previous: Move | None

@@ -85,8 +85,8 @@ class StaubliVal3(PostProcessor):
     def _pose_attrs(self, R: np.ndarray, p: np.ndarray) -> str:
         rx, ry, rz = euler_deg(R, "XYZ")
         return (f'x="{self.length(p[0])}" y="{self.length(p[1])}" '
-                f'z="{self.length(p[2])}" rx="{self.angle(rx)}" ry="{self.angle(ry)}" '
-                f'rz="{self.angle(rz)}"')
+                f'z="{self.length(p[2])}" rx="{self.euler(rx)}" ry="{self.euler(ry)}" '
+                f'rz="{self.euler(rz)}"')
 
     def header(self, job: ProgramJob) -> list[str]:
         """Comment lines (``//``)."""

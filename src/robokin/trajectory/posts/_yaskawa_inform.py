@@ -112,7 +112,7 @@ class YaskawaInform(PostProcessor):
             return f"{name}=" + ",".join(str(int(p)) for p in pulses)
         rz, ry, rx = euler_deg(t.rotation, "ZYX")
         return (f"{name}=" + ",".join(self.length(v) for v in t.position) + ","
-                + ",".join(self.angle(v) for v in (rx, ry, rz)))
+                + ",".join(self.euler(v) for v in (rx, ry, rz)))
 
     def _data(self, job: ProgramJob, move: Move, previous: Move | None) -> tuple[str, ...]:
         mode = self._mode(job, move)
@@ -180,4 +180,4 @@ class YaskawaInform(PostProcessor):
 
 def _values(post: PostProcessor, T: np.ndarray) -> str:
     rz, ry, rx = euler_deg(T[:3, :3], "ZYX")
-    return " ".join([post.length(v) for v in T[:3, 3]] + [post.angle(v) for v in (rx, ry, rz)])
+    return " ".join([post.length(v) for v in T[:3, 3]] + [post.euler(v) for v in (rx, ry, rz)])

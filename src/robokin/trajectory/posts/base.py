@@ -354,6 +354,29 @@ class PostProcessor(ABC):
         """An angle [deg] at :attr:`angle_decimals` (never ``-0``)."""
         return _fixed(value, self.angle_decimals, width)
 
+    def euler(self, value: float, width: int = 0) -> str:
+        """An Euler angle [deg]: as :meth:`angle`, -180 written as 180.
+
+        The same rotation; rounding noise would otherwise flip the sign from target
+        to target.
+        """
+        text = self.angle(value, width)
+        if float(text) == -180.0:
+            text = self.angle(180.0, width)
+        return text
+
+    def quaternion(self, rotation: npt.ArrayLike, digits: int) -> list[str]:
+        """``w x y z`` at ``digits`` decimals, one sign per rotation, never ``-0``.
+
+        The first component that is not zero after rounding is positive.
+        """
+        q = quaternion_wxyz(rotation)
+        rounded = np.round(q, digits)
+        first = next((v for v in rounded if v != 0.0), 1.0)
+        if first < 0.0:
+            q = -q
+        return [_fixed(v, digits) for v in q]
+
     def axis_value(self, value: float, revolute: bool = True, width: int = 0) -> str:
         """A joint value: an angle [deg] or a length [mm]."""
         return self.angle(value, width) if revolute else self.length(value, width)
