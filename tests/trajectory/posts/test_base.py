@@ -38,11 +38,24 @@ def test_euler_and_quaternion_text_have_one_sign_per_rotation():
     # half turns about z: w = 0 up to noise; the text is the same whatever the noise
     for noise in (1e-17, -1e-17, 0.0):
         R = Rotation.from_rotvec([0, 0, np.pi + noise]).as_matrix()
-        assert post.quaternion(R, 8) == ["0.00000000", "0.00000000", "0.00000000",
+        q = quaternion_wxyz(R)
+        assert post.quaternion(q, 8) == ["0.00000000", "0.00000000", "0.00000000",
                                          "1.00000000"]
+        assert post.quaternion(-q, 8) == post.quaternion(q, 8)
     q = quaternion_wxyz(Rotation.random(20, random_state=1).as_matrix())
     assert (q[:, 0] >= 0).all()
     np.testing.assert_allclose(np.linalg.norm(q, axis=1), 1.0)
+
+
+def test_target_orientations_given_or_computed_agree():
+    R = Rotation.from_euler("xyz", [10, -80, 170], degrees=True).as_matrix()
+    plain = Target(1, np.zeros(6), np.zeros(3), R)
+    given = Target(1, np.zeros(6), np.zeros(3), R, orientations={
+        s: euler_deg(R, s) for s in ("ZYX", "XYZ", "ZYZ")} | {"wxyz": quaternion_wxyz(R)})
+    for seq in ("ZYX", "XYZ", "ZYZ"):
+        np.testing.assert_allclose(plain.euler(seq), given.euler(seq), atol=1e-12)
+    np.testing.assert_allclose(plain.quaternion(), given.quaternion(), atol=1e-15)
+    assert not given.orientations["ZYX"].flags.writeable
 
 
 def test_records_refuse_bad_values():

@@ -34,6 +34,7 @@ from robokin.trajectory.posts.base import (
     ProgramJob,
     Statement,
     comment_text,
+    quaternion_wxyz,
 )
 
 __all__ = ["AbbRapid"]
@@ -84,13 +85,13 @@ class AbbRapid(PostProcessor):
     # ------------------------------------------------------------ data values
     def _pose(self, T: np.ndarray) -> str:
         """``[[x,y,z],[q1,q2,q3,q4]]`` (a pose)."""
-        return f"[{self._trans(T[:3, 3])},{self._quat(T[:3, :3])}]"
+        return f"[{self._trans(T[:3, 3])},{self._quat(quaternion_wxyz(T[:3, :3]))}]"
 
     def _trans(self, p: np.ndarray) -> str:
         return "[" + ",".join(self.length(v) for v in p) + "]"
 
-    def _quat(self, R: np.ndarray) -> str:
-        return "[" + ",".join(self.quaternion(R, self.angle_decimals + 4)) + "]"
+    def _quat(self, wxyz: np.ndarray) -> str:
+        return "[" + ",".join(self.quaternion(wxyz, self.angle_decimals + 4)) + "]"
 
     def speed_name(self, mm_s: float) -> str:
         """``vNNN`` when predefined, else the declared ``rkVNNN``."""
@@ -145,7 +146,7 @@ class AbbRapid(PostProcessor):
         t = move.target
         cf = abb_confdata(t.joints, t.behind_axis_1, t.behind_lower_arm)
         return (f"CONST robtarget p{t.number} := [{self._trans(t.position)},"
-                f"{self._quat(t.rotation)},[{','.join(str(int(c)) for c in cf)}],{_EXT}];")
+                f"{self._quat(t.quaternion())},[{','.join(str(int(c)) for c in cf)}],{_EXT}];")
 
     def joint_move(self, job: ProgramJob, move: Move, previous: Move | None
                    ) -> Statement:

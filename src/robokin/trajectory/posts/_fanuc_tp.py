@@ -135,9 +135,9 @@ class FanucTp(PostProcessor):
                            f"\tJ4={j[3]} deg,\tJ5={j[4]} deg,\tJ6={j[5]} deg", "};"]
         conf = fanuc_config(t.joints, t.behind_axis_1, t.behind_lower_arm,
                             self.turn_axes)[0]
-        T = np.eye(4)
-        T[:3, :3], T[:3, 3] = t.rotation, t.position
-        x, y, z, w, p, r = self._wpr(T)
+        r, p, w = t.euler("ZYX")
+        x, y, z = (self.length(v) for v in t.position)
+        w, p, r = (self.euler(v) for v in (w, p, r))
         return head + [f"{frames}\t\tCONFIG : '{conf}',",
                        f"\tX = {x:>9}  mm,\tY = {y:>9}  mm,\tZ = {z:>9}  mm,",
                        f"\tW = {w:>9} deg,\tP = {p:>9} deg,\tR = {r:>9} deg", "};"]

@@ -55,8 +55,8 @@ class KawasakiAs(PostProcessor):
         """``NAME.as``."""
         return (f"{name}.as",)
 
-    def _trans(self, T: np.ndarray) -> str:
-        o, a, t = euler_deg(T[:3, :3], "ZYZ")
+    def _trans(self, T: np.ndarray, angles: np.ndarray | None = None) -> str:
+        o, a, t = euler_deg(T[:3, :3], "ZYZ") if angles is None else angles
         return " ".join([self.length(v) for v in T[:3, 3]]
                         + [self.euler(v) for v in (o, a, t)])
 
@@ -98,7 +98,7 @@ class KawasakiAs(PostProcessor):
         T = np.eye(4)
         T[:3, :3], T[:3, 3] = t.rotation, t.position
         return Statement((*self._settings(move, previous), f"LMOVE rkp{t.number}"),
-                         (f"T\trkp{t.number} {self._trans(T)}",))
+                         (f"T\trkp{t.number} {self._trans(T, t.euler('ZYZ'))}",))
 
     def footer(self, job: ProgramJob) -> list[str]:
         """``BREAK``: wait until the last motion ends."""

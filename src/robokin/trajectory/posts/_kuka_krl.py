@@ -100,7 +100,7 @@ class KukaKrl(PostProcessor):
             ext = ",".join(f"E{k} 0.0" for k in range(1, 7))
             return f"XJ{t.number}", f"DECL E6AXIS XJ{t.number}={{{axes},{ext}}}"
         s, turn = kuka_status_turn(t.joints, t.behind_axis_1, t.behind_lower_arm)
-        a, b, c = euler_deg(t.rotation, "ZYX")
+        a, b, c = t.euler("ZYX")
         x, y, z = t.position
         ext = ",".join(f"E{k} 0.0" for k in range(1, 7))
         return f"XP{t.number}", (

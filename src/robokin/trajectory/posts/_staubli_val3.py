@@ -82,8 +82,9 @@ class StaubliVal3(PostProcessor):
         return (f"{name}/{name}.pjx", f"{name}/start.pgx", f"{name}/stop.pgx",
                 f"{name}/{name}.dtx")
 
-    def _pose_attrs(self, R: np.ndarray, p: np.ndarray) -> str:
-        rx, ry, rz = euler_deg(R, "XYZ")
+    def _pose_attrs(self, R: np.ndarray, p: np.ndarray, angles: np.ndarray | None = None
+                    ) -> str:
+        rx, ry, rz = euler_deg(R, "XYZ") if angles is None else angles
         return (f'x="{self.length(p[0])}" y="{self.length(p[1])}" '
                 f'z="{self.length(p[2])}" rx="{self.euler(rx)}" ry="{self.euler(ry)}" '
                 f'rz="{self.euler(rz)}"')
@@ -101,7 +102,7 @@ class StaubliVal3(PostProcessor):
         k = t.number - 1
         joints = " ".join(f'j{i + 1}="{self.angle(v)}"' for i, v in enumerate(t.joints))
         shoulder, elbow, wrist = staubli_config(t.joints, t.behind_axis_1)[0]
-        point = (f'<Value key="{k}" {self._pose_attrs(t.rotation, t.position)} '
+        point = (f'<Value key="{k}" {self._pose_attrs(t.rotation, t.position, t.euler("XYZ"))} '
                  f'shoulder="{shoulder}" elbow="{elbow}" wrist="{wrist}" '
                  'fatherId="fRk[0]" />')
         blend = "off" if move.zone == 0.0 else ("joint" if move.kind == "joint"

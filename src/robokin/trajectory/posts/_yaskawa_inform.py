@@ -110,7 +110,7 @@ class YaskawaInform(PostProcessor):
             ppd = np.asarray(self.pulses_per_degree)
             pulses = np.rint(t.joints * ppd).astype(np.int64)
             return f"{name}=" + ",".join(str(int(p)) for p in pulses)
-        rz, ry, rx = euler_deg(t.rotation, "ZYX")
+        rz, ry, rx = t.euler("ZYX")
         return (f"{name}=" + ",".join(self.length(v) for v in t.position) + ","
                 + ",".join(self.euler(v) for v in (rx, ry, rz)))
 

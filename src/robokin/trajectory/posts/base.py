@@ -31,8 +31,10 @@ import math
 import re
 import warnings
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from datetime import datetime
+from types import MappingProxyType
 from typing import Any, ClassVar, Literal
 
 import numpy as np
@@ -76,6 +78,11 @@ class Target:
         behind_axis_1: The wrist point is behind axis 1
             (:mod:`~robokin.trajectory.posts.arm_config`).
         behind_lower_arm: The elbow point is behind the line through axes 2 and 3.
+        orientations: The rotation's Euler angles [deg] by sequence (``"ZYX"``,
+            ``"XYZ"``, ``"ZYZ"``) and ``"wxyz"``, its quaternion, computed for a whole
+            program at once by :func:`~robokin.trajectory.posts.program_job`; those
+            missing are computed when asked for (:meth:`euler`,
+            :meth:`quaternion`).
     """
 
     number: int
@@ -84,6 +91,7 @@ class Target:
     rotation: npt.NDArray[np.float64]
     behind_axis_1: bool = False
     behind_lower_arm: bool = False
+    orientations: Mapping[str, npt.NDArray[np.float64]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         """Freeze the arrays."""
@@ -91,6 +99,18 @@ class Target:
         object.__setattr__(self, "joints", _frozen(joints, joints.shape, "joints"))
         object.__setattr__(self, "position", _frozen(self.position, (3,), "position"))
         object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3), "rotation"))
+        object.__setattr__(self, "orientations", MappingProxyType(
+            {k: _frozen(v, np.shape(v), k) for k, v in dict(self.orientations).items()}))
+
+    def euler(self, sequence: Literal["ZYX", "XYZ", "ZYZ"]) -> np.ndarray:
+        """The rotation's Euler angles (3,) [deg] (:func:`euler_deg`)."""
+        got = self.orientations.get(sequence)
+        return euler_deg(self.rotation, sequence) if got is None else got
+
+    def quaternion(self) -> np.ndarray:
+        """The rotation's unit quaternion ``(w, x, y, z)``, ``w >= 0``."""
+        got = self.orientations.get("wxyz")
+        return quaternion_wxyz(self.rotation) if got is None else got
 
 
 @dataclass(frozen=True)
@@ -365,12 +385,13 @@ class PostProcessor(ABC):
             text = self.angle(180.0, width)
         return text
 
-    def quaternion(self, rotation: npt.ArrayLike, digits: int) -> list[str]:
-        """``w x y z`` at ``digits`` decimals, one sign per rotation, never ``-0``.
+    def quaternion(self, wxyz: npt.ArrayLike, digits: int) -> list[str]:
+        """A unit quaternion ``w x y z`` at ``digits`` decimals, one sign, never ``-0``.
 
-        The first component that is not zero after rounding is positive.
+        The first component that is not zero after rounding is positive (the same
+        rotation is written the same way whatever the rounding noise).
         """
-        q = quaternion_wxyz(rotation)
+        q = np.asarray(wxyz, dtype=np.float64)
         rounded = np.round(q, digits)
         first = next((v for v in rounded if v != 0.0), 1.0)
         if first < 0.0:

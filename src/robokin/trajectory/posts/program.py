@@ -60,6 +60,8 @@ from robokin.trajectory.posts.base import (
     PostProcessor,
     ProgramJob,
     Target,
+    euler_deg,
+    quaternion_wxyz,
 )
 from robokin.trajectory.posts.registry import get_post, post_names
 from robokin.trajectory.samples import Trajectory
@@ -376,8 +378,12 @@ def program_job(
     root, tool, base = _frames(robot, prof, plan.q[0], wobj)
     poses = _mm(invert(wobj) @ robot.fk(plan.q))
     cfg = arm_configuration(robot, plan.q, prof, prof.frame("root"))
-    targets = [Target(k + 1, cfg.joints_deg[k], poses[k, :3, 3], poses[k, :3, :3],
-                      bool(cfg.behind_axis_1[k]), bool(cfg.behind_lower_arm[k]))
+    R = poses[:, :3, :3]
+    orient = {seq: euler_deg(R, seq) for seq in ("ZYX", "XYZ", "ZYZ")}
+    orient["wxyz"] = quaternion_wxyz(R)
+    targets = [Target(k + 1, cfg.joints_deg[k], poses[k, :3, 3], R[k],
+                      bool(cfg.behind_axis_1[k]), bool(cfg.behind_lower_arm[k]),
+                      {key: v[k] for key, v in orient.items()})
                for k in range(len(plan.q))]
     moves = tuple(Move(kind, t, float(v), float(z), cartesian=cartesian and kind == "joint"
                        and k > 0)
