@@ -321,6 +321,7 @@ def _register_extra_commands() -> None:
         "robokin.cli_retime",
         "robokin.cli_schema",
         "robokin.cli_cell",
+        "robokin.cli_follow",
     ):
         try:
             importlib.import_module(mod)
