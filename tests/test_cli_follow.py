@@ -72,11 +72,16 @@ def test_infeasible_path_writes_the_diagnostics_and_no_program(tmp_path, capsys)
                     "  - {xyz: [100, 500, 430], rpy: [180, 0, 180]}\n"
                     "  - {xyz: [100, 500, 2500], rpy: [180, 0, 180]}\n")
     code = main(["follow", "press", str(path), "--program", "kuka_krl",
-                 "--out", str(tmp_path)])
+                 "--out", str(tmp_path), "--html"])
     out, err = capsys.readouterr()
     assert code == 1 and "no feasible motion: waypoint 1" in err
     assert "NOT feasible" in out
     assert (tmp_path / "far.joints.csv").exists() and (tmp_path / "far.png").exists()
+    # the 3D page: the press cell and the two waypoints, the second one red
+    page = (tmp_path / "far.html").read_text()
+    assert '"name":"waypoint 0","kind":"sphere"' in page
+    assert '"name":"waypoint 1","kind":"sphere"' in page
+    assert page.index('"color":[215,40,40]') > page.index('"name":"waypoint 1"')
     assert not (tmp_path / "far.src").exists()
     rows = list(csv.reader((tmp_path / "far.joints.csv").open()))
     assert rows[2][-1] == "0" and rows[2][1] == ""

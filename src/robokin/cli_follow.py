@@ -4,15 +4,16 @@
 placement, tool and objects) and the tool path (:mod:`robokin.io.path_files`), asks
 :func:`robokin.process.follow` for the joint motion over every IK branch (and the
 tool's free rotation, with ``--free-axis z``), and writes into ``DIR``:
-``NAME.joints.csv`` (the configuration per waypoint), ``NAME.png`` (joint angles
-along the path, unreachable waypoints in red) and one program per ``--program``
+``NAME.joints.csv`` (the configuration per waypoint), ``NAME.png``
+(:func:`robokin.process.plot_follow`: the tool path with every waypoint green or
+red, the joints, the steps and margins), optionally ``NAME.html`` (``--html``: the
+3D animation with the waypoints as green / red markers) and one program per ``--program``
 (:func:`robokin.trajectory.posts.write_program`). An infeasible path writes the CSV
 and the plot (to see where and why) and no program, and exits with code 1.
 """
 
 from __future__ import annotations
 
-import importlib
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -73,32 +74,6 @@ def joints_csv_text(robot: Robot, q: np.ndarray, free_angle: np.ndarray,
     return "\n".join(lines) + "\n"
 
 
-def _plot(robot: Robot, res: Any, reachable: np.ndarray, title: str) -> Any:
-    """Joint angles along the path; red where no configuration reaches the waypoint."""
-    import numpy as np
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(10.0, 6.5), layout="constrained")
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(2, 1, sharex=True, height_ratios=[3, 1])
-    k = np.arange(res.q.shape[0])
-    scale = np.where(robot.is_revolute, 180.0 / math.pi, 1000.0)
-    for j, name in enumerate(robot.joint_names):
-        axes[0].plot(k, res.q[:, j] * scale[j], label=name, linewidth=1.2)
-    axes[0].set_ylabel("joint [deg | mm]")
-    axes[0].legend(loc="upper right", fontsize="small", ncol=3)
-    axes[1].plot(k, np.degrees(res.free_angle), color="k", linewidth=1.0)
-    axes[1].set_ylabel("tool turn [deg]")
-    axes[1].set_xlabel("waypoint")
-    for ax in axes:
-        for bad in np.flatnonzero(~reachable):
-            ax.axvspan(bad - 0.5, bad + 0.5, color=(0.85, 0.16, 0.16), alpha=0.35, lw=0)
-        ax.grid(True, alpha=0.3)
-    axes[0].set_title(title[:200])
-    return fig
-
-
 def _load_inputs(scene: Path, robot: str | None) -> tuple[Any, Robot, Robot]:
     """The scene, the bare robot and the robot as the scene places it."""
     import robokin
@@ -113,17 +88,6 @@ def _load_inputs(scene: Path, robot: str | None) -> tuple[Any, Robot, Robot]:
         raise InputError("--robot", "the scene names no robot; pass --robot")
     bare = robokin.load(name)
     return sc, bare, sc.attach(bare)
-
-
-def _process() -> Any:
-    """robokin.process, imported when the command runs."""
-    from robokin.exceptions import InputError
-
-    try:
-        return importlib.import_module("robokin.process")
-    except ImportError as exc:  # pragma: no cover - present once the process paths land
-        raise InputError("follow", f"robokin.process is not available in this build "
-                         f"({exc})") from None
 
 
 @app.command("follow", context_settings=_NUMERIC_ARGS)
@@ -162,6 +126,9 @@ def follow_command(
     force: Annotated[bool, typer.Option(
         "--force", help="Replace the files of an earlier run.")] = False,
     no_plot: Annotated[bool, typer.Option("--no-plot", help="Write no plot.")] = False,
+    html: Annotated[bool, typer.Option(
+        "--html", help="Also write NAME.html: the motion in 3D with the scene and the "
+        "waypoints as green (reachable) / red (not) markers.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
                        ] = False,
     output_format: FormatOption = None,
@@ -171,6 +138,7 @@ def follow_command(
     Exit code 1 when the path has no feasible motion (the CSV and the plot still
     show where and why); no program is written then.
     """
+    from robokin import process
     from robokin.exceptions import InputError
     from robokin.io.atomic import check_distinct
     from robokin.io.path_files import read_tool_path
@@ -192,18 +160,18 @@ def follow_command(
     sc, bare, placed = _load_inputs(scene, robot)
     folder = out if out is not None else (path.parent if str(path.parent) else Path("."))
     stem = name or path.stem
-    targets = _targets(folder, stem, no_plot, dialects)
+    targets = _targets(folder, stem, no_plot, html, dialects)
     check_distinct([(p, opt) for p, opt in targets],
                    [(path, "PATH"), (scene, "SCENE"), (bare.path, "--robot")])
     _refuse_existing(targets, force)
     poses = read_tool_path(path)
-    process = _process()
     res = process.follow(bare, poses, free_axis=free_axis, free_range=rng,
                          free_step=math.radians(free_step),
                          max_step=math.radians(max_step), scene=sc,
                          clearance=clearance * 1e-3)
     written = _write_outputs(placed, res, folder, stem, no_plot, force, dialects,
-                             speed * 1e-3, zone * 1e-3, f"{bare.name}: {path.name}")
+                             speed * 1e-3, zone * 1e-3, f"{bare.name}: {path.name}",
+                             sc if html else None)
     _report(res, poses.shape[0], written, fmt)
     if not res.feasible:
         raise DomainFailure(f"no feasible motion: {res.reason}")
@@ -224,7 +192,7 @@ def _check_dialects(given: list[str]) -> list[str]:
     return out
 
 
-def _targets(folder: Path, stem: str, no_plot: bool, dialects: list[str]
+def _targets(folder: Path, stem: str, no_plot: bool, html: bool, dialects: list[str]
              ) -> list[tuple[Path, str]]:
     """Every file the command writes, with its option."""
     from robokin.io.atomic import file_stem
@@ -234,6 +202,8 @@ def _targets(folder: Path, stem: str, no_plot: bool, dialects: list[str]
     out = [(folder / f"{base}.joints.csv", "--out")]
     if not no_plot:
         out.append((folder / f"{base}.png", "--out"))
+    if html:
+        out.append((folder / f"{base}.html", "--html"))
     for d in dialects:
         post = get_post(d)
         legal, _ = post.program_name(stem)
@@ -255,13 +225,16 @@ def _refuse_existing(targets: list[tuple[Path, str]], force: bool) -> None:
 
 def _write_outputs(robot: Robot, res: Any, folder: Path, stem: str, no_plot: bool,
                    force: bool, dialects: list[str], speed: float, zone: float,
-                   title: str) -> list[str]:
-    """The CSV and the plot (all or none), then the programs (feasible only)."""
-    import numpy as np
+                   title: str, html_scene: Any) -> list[str]:
+    """The CSV, the plot and the page (all or none), then the programs (feasible only).
 
+    ``html_scene``: the scene to draw in ``NAME.html``, or None for no page.
+    """
     from robokin.exceptions import InputError
     from robokin.io.atomic import file_stem, staged_outputs
+    from robokin.process import path_markers, plot_follow
     from robokin.trajectory.posts import write_program
+    from robokin.viz.html import animation_html
 
     if not folder.is_dir():
         try:
@@ -269,18 +242,23 @@ def _write_outputs(robot: Robot, res: Any, folder: Path, stem: str, no_plot: boo
         except OSError as exc:
             raise InputError("--out", f"{folder}: cannot create: "
                              f"{exc.strerror or exc}") from None
-    report = getattr(res, "waypoints", None)
-    reachable = (np.asarray(report.reachable, bool) if report is not None
-                 else np.isfinite(res.q).all(axis=1))
+    reachable = res.waypoints.reachable
     base = file_stem(stem)
     outputs = [(folder / f"{base}.joints.csv", "--out", force)]
     if not no_plot:
         outputs.append((folder / f"{base}.png", "--out", force))
+    if html_scene is not None:
+        outputs.append((folder / f"{base}.html", "--html", force))
     with staged_outputs(outputs, how="pass --force") as staged:
         staged[0].write_text(joints_csv_text(robot, res.q, res.free_angle, reachable))
         if not no_plot:
-            fig = _plot(robot, res, reachable, title)
+            state = "feasible" if res.feasible else res.reason
+            fig = plot_follow(res, robot=robot, title=f"{title}: {state}")
             fig.savefig(staged[1], dpi=110)
+        if html_scene is not None:
+            staged[-1].write_text(animation_html(
+                robot, _held(res.q), scene=path_markers(res, scene=html_scene),
+                title=title, dt=0.05), encoding="utf-8")
     lines = [f"wrote {p}" for p, _, _ in outputs]
     if not res.feasible:
         return lines
@@ -290,6 +268,21 @@ def _write_outputs(robot: Robot, res: Any, folder: Path, stem: str, no_plot: boo
         lines.append(f"wrote {', '.join(str(p) for p in prog.files)}: {prog.describe()}")
         lines += [f"note: {n}" for n in prog.notes]
     return lines
+
+
+def _held(q: np.ndarray) -> np.ndarray:
+    """The motion for the animation: a waypoint without a configuration holds the last.
+
+    Before the first configuration found, the first one found is held.
+    """
+    import numpy as np
+
+    ok = np.isfinite(q).all(axis=1)
+    if not ok.any():
+        return np.zeros((1, q.shape[1]))
+    idx = np.maximum.accumulate(np.where(ok, np.arange(q.shape[0]), -1))
+    idx[idx < 0] = int(np.argmax(ok))
+    return q[idx]
 
 
 def _report(res: Any, n: int, written: list[str], fmt: str) -> None:
