@@ -287,3 +287,50 @@ def test_too_many_sampled_poses_are_refused_before_any_work():
         process.follow(load("ur5"), np.broadcast_to(np.eye(4), (30_000, 4, 4)),
                        free_axis="z", free_step=math.radians(5))
     assert err.value.argument == "poses"
+
+
+# ------------------------------------------- the issue's paths (the benchmark's)
+
+
+def _bench():
+    """benchmarks/bench_process.py, whose four paths the issue measures."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).parents[2] / "benchmarks" / "bench_process.py"
+    spec = importlib.util.spec_from_file_location("bench_process", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+#: What the exact search must find on each path (fixed orientation, free axis):
+#: "ok", or the failure kind and the waypoint it names.
+EXPECTED = {
+    ("ur5", "seam"): ("ok", "ok"), ("ur5", "circle"): ("ok", "ok"),
+    ("ur5", "spline"): ("ok", "ok"), ("ur5", "holes"): ("ok", "ok"),
+    # the tool turns a whole turn round the tray: q6 cannot on the AUBO's +-175 deg
+    ("aubo_i5", "seam"): (("jump", 216), "ok"), ("aubo_i5", "circle"): ("ok", "ok"),
+    # q5 = 0 exactly at waypoint 100 with the tool as given; turning it avoids that
+    ("aubo_i5", "spline"): (("singular", 100), "ok"), ("aubo_i5", "holes"): ("ok", "ok"),
+}
+
+
+@pytest.mark.parametrize("name", ["ur5", "aubo_i5"])
+def test_the_issue_paths_get_a_valid_motion_or_the_reason(name):
+    bench = _bench()
+    for path, (robot, poses) in bench.paths(load(name)).items():
+        step = math.inf if path == "holes" else bench.MAX_STEP
+        for expect, kw in zip(EXPECTED[(name, path)], ({}, bench.FREE), strict=True):
+            res = process.follow(robot, poses, max_step=step, **kw)
+            if expect == "ok":
+                assert_valid_motion(robot, res, poses, step)
+                # naive tracking, when feasible, is one path of the same graph (the
+                # fixed orientation): its objective cannot beat the optimum
+                q = bench.naive(robot, poses)
+                if not kw and bench.measure(robot, poses, q, max_step=step)["feasible"]:
+                    mu_ref = arm_facts(robot).mu_ref
+                    assert ref.objective(robot, q, mu_ref=mu_ref) >= res.cost - 1e-9
+            else:
+                kind, index = expect
+                assert (res.failure.kind, res.failure.index) == (kind, index), res.reason
