@@ -14,7 +14,8 @@ turn, clear of the table, the part and the press, for the motion with the least
 joint travel. The result is written as a KUKA KRL program (``seam.src`` and
 ``seam.dat``) and an ABB RAPID module (``seam.mod``), the tool and the work object
 (the bracket's frame) declared, and read back: every Cartesian target is checked
-against the seam.
+against the seam. ``seam_diagnostics.png`` and ``seam.html`` show every seam pose
+green (reachable) or red (not) along the path and in 3D.
 
 Requirements: robokin[collision] (coal, for the scene).
 """
@@ -32,6 +33,7 @@ from robokin import collision, process
 from robokin.model import geometry
 from robokin.spatial import invert, pose_from_xyz_rpy, rotx
 from robokin.trajectory.posts import write_program
+from robokin.viz.html import write_html
 
 PART_SIZE = np.array([0.16, 0.12, 0.04])  # [m] the bracket
 PART_CENTRE = np.array([0.0, 0.69, 0.32])  # [m] on the table top (z = 0.30 m)
@@ -75,8 +77,12 @@ def read_krl_targets(src_dat: tuple[str, str]) -> np.ndarray:
         r"DECL E6POS XP\d+=\{X (\S+),Y (\S+),Z (\S+),", dat)])
 
 
-def main(out_dir: Path = Path("robokin-examples") / "weld_seam") -> None:
-    """Follow the seam, write KRL and RAPID into ``out_dir``, read them back."""
+def main(out_dir: Path = Path("robokin-examples") / "weld_seam") -> process.FollowResult:
+    """Follow the seam, write KRL and RAPID into ``out_dir``, read them back.
+
+    Returns:
+        The motion along the seam (``robokin.process.follow``'s result).
+    """
     scene = press_cell_with_part()
     robot = robokin.load(scene.robot_name or "aubo_i5")
     placed = scene.attach(robot)
@@ -86,12 +92,17 @@ def main(out_dir: Path = Path("robokin-examples") / "weld_seam") -> None:
     print(f"{len(poses)} seam poses: {'feasible' if res.feasible else res.reason}; "
           f"joint travel {math.degrees(res.travel):.1f} deg, largest step "
           f"{math.degrees(res.max_step):.2f} deg")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    # where the seam is reachable (green) or not (red), as a plot and in 3D
+    process.plot_follow(res, robot=placed, path=out_dir / "seam_diagnostics.png",
+                        overwrite=True)
+    write_html(out_dir / "seam.html", placed, np.nan_to_num(res.q),
+               scene=process.path_markers(res, scene=scene), dt=0.05)
     if not res.feasible:
         raise SystemExit(f"no motion along the seam: {res.reason}")
     turn = np.degrees(res.free_angle)
     print(f"torch turned between {turn.min():.0f} and {turn.max():.0f} deg about its axis")
 
-    out_dir.mkdir(parents=True, exist_ok=True)
     krl = write_program(placed, res, "kuka_krl", out_dir, name="seam", force=True,
                         speed=0.008, zone=0.0005, work_object=part_frame)
     rapid = write_program(placed, res, "abb_rapid", out_dir, name="seam", force=True,
@@ -107,6 +118,8 @@ def main(out_dir: Path = Path("robokin-examples") / "weld_seam") -> None:
     print(f"KRL LIN targets on the seam within {np.abs(got - want).max() * 1000:.2f} um")
     moves = re.findall(r"^\s*(MoveL|MoveAbsJ) ", rapid.texts["seam.mod"], re.M)
     print(f"RAPID: {moves.count('MoveAbsJ')} MoveAbsJ, {moves.count('MoveL')} MoveL")
+    print(f"wrote {out_dir / 'seam_diagnostics.png'} and {out_dir / 'seam.html'}")
+    return res
 
 
 if __name__ == "__main__":
