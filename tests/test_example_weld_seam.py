@@ -27,7 +27,7 @@ def test_weld_seam_programs_follow_the_seam(tmp_path, capsys):
     spec = importlib.util.spec_from_file_location("weld_seam_example", SCRIPT)
     example = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(example)
-    res = example.main(tmp_path)
+    res = example.run(tmp_path)  # what main() does, with the motion returned
     assert "feasible" in capsys.readouterr().out
     poses, part = example.seam_poses()
     # the motion: the seam reached with the torch turned about its axis, clear of

@@ -77,12 +77,13 @@ def read_krl_targets(src_dat: tuple[str, str]) -> np.ndarray:
         r"DECL E6POS XP\d+=\{X (\S+),Y (\S+),Z (\S+),", dat)])
 
 
-def main(out_dir: Path = Path("robokin-examples") / "weld_seam") -> process.FollowResult:
-    """Follow the seam, write KRL and RAPID into ``out_dir``, read them back.
+def main(out_dir: Path = Path("robokin-examples") / "weld_seam") -> None:
+    """Follow the seam, write KRL and RAPID into ``out_dir``, read them back."""
+    run(out_dir)
 
-    Returns:
-        The motion along the seam (``robokin.process.follow``'s result).
-    """
+
+def run(out_dir: Path) -> process.FollowResult:
+    """What :func:`main` does, returning the motion along the seam (for the tests)."""
     scene = press_cell_with_part()
     robot = robokin.load(scene.robot_name or "aubo_i5")
     placed = scene.attach(robot)
