@@ -20,7 +20,7 @@ from robokin import process
 from robokin._native import num_threads, set_num_threads
 from robokin.exceptions import InputError
 from robokin.process._graph import arm_facts
-from robokin.spatial import rotz
+from robokin.spatial import rotz, wrap_angle
 
 
 def assert_valid_motion(robot, res, poses, max_step):
@@ -334,3 +334,36 @@ def test_the_issue_paths_get_a_valid_motion_or_the_reason(name):
             else:
                 kind, index = expect
                 assert (res.failure.kind, res.failure.index) == (kind, index), res.reason
+
+
+@pytest.mark.parametrize("name", ["ur5", "aubo_i5", "puma560"])
+def test_the_tool_turn_by_shifting_the_last_joint_equals_ik_at_every_rotation(name):
+    # oracle: the same layers built with the shortcut off (IK of every rotated
+    # pose); the shortcut applies when the tool z is the last joint's axis and the
+    # IK returns every solution (not the Panda's numeric IK)
+    import dataclasses
+
+    from robokin.process._graph import build_layers
+    from robokin.process._inputs import tool_samples
+    from robokin.process.costs import Costs
+    from robokin.spatial import trans
+
+    robot = load(name).with_tool(trans(0.0, 0.0, 0.12))
+    facts = arm_facts(robot)
+    off = dataclasses.replace(facts, spin=0)
+    assert facts.spin != 0
+    assert arm_facts(load(name).with_tool(trans(0.01, 0.0, 0.12))).spin == 0
+    assert arm_facts(load("panda").with_tool(trans(0.0, 0.0, 0.12))).spin == 0
+    rng = np.random.default_rng(3)
+    q = rng.uniform(robot.limits[:, 0], robot.limits[:, 1], (6, robot.n))
+    poses = robot.fk(q)
+    samples = tool_samples("z", (-1.0, 1.0), 0.25)
+    a = build_layers(facts, poses, samples, Costs())
+    b = build_layers(off, poses, samples, Costs())
+    assert np.array_equal(np.isfinite(a.cost), np.isfinite(b.cost))
+    assert np.array_equal(a.code, b.code)
+    ok = np.isfinite(a.cost)
+    assert ok.sum() > 20
+    np.testing.assert_allclose(a.cost[ok], b.cost[ok], rtol=1e-9, atol=1e-12)
+    d = a.Q[ok] - b.Q[ok]
+    np.testing.assert_allclose(np.where(facts.wraps, wrap_angle(d), d), 0.0, atol=1e-9)

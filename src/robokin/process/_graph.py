@@ -46,6 +46,12 @@ class ArmFacts:
             afterwards, ``_turns.py``).
         mu_ref: The largest manipulability on a fixed sample of configurations: the
             reference the relative manipulability divides by.
+        spin: +1 or -1 when turning the tool about its own z axis by an angle is
+            turning the last joint by (+-) that angle (the tool's z axis is the last
+            joint's axis, which wraps: a flange tool, a torch or drill along the
+            flange axis); 0 otherwise. Then the IK of a waypoint at every sampled
+            tool rotation is the IK at the first one with the last joint shifted
+            (``build_layers``).
     """
 
     robot: Robot
@@ -54,6 +60,7 @@ class ArmFacts:
     wraps: np.ndarray
     circle: np.ndarray
     mu_ref: float
+    spin: int = 0
 
     @property
     def n(self) -> int:
@@ -88,7 +95,36 @@ def arm_facts(robot: Robot) -> ArmFacts:
     out = node_costs(facts, q, ok, ~ok, mode, weights)
     mu = out[2]
     mu_ref = float(np.nanmax(mu)) if np.isfinite(mu).any() else 0.0
-    return ArmFacts(robot, arrays.packed, limits, wraps, circle, mu_ref)
+    return ArmFacts(robot, arrays.packed, limits, wraps, circle, mu_ref,
+                    _spin(robot, wraps, q[:2]))
+
+
+def _spin(robot: Robot, wraps: np.ndarray, q: np.ndarray) -> int:
+    """+-1 when FK(q + d e_n) = FK(q) Rz(+-d) for the last coordinate n, else 0.
+
+    For a serial chain FK = A(q_1..q_{n-1}) R_n(q_n) C; the identity holds for all q
+    and d exactly when C^-1 R_n(d) C = Rz(+-d), a property of the constant C alone,
+    so checking it at two configurations and one angle (to 1e-12) decides it. Only
+    for arms whose IK returns every solution (closed form, general 6R): a numeric
+    IK's answers depend on the pose, so the shifted set would not be its set.
+    """
+    from robokin.spatial import rotz
+
+    chain = robot.chain
+    if (not chain.coupling.is_identity or not bool(wraps[-1])
+            or not bool(robot.is_revolute[-1])):
+        return 0
+    method = str(robot.ik(robot.fk(q[0])).method)
+    if not method.startswith(("analytic", "general_6r")):
+        return 0
+    d = 0.7
+    q2 = q.copy()
+    q2[:, -1] += d
+    T1, T2 = robot.fk(q), robot.fk(q2)
+    for sign in (1, -1):
+        if np.abs(T1 @ rotz(sign * d) - T2).max() <= 1e-12:
+            return sign
+    return 0
 
 
 def node_costs(
@@ -158,6 +194,28 @@ def _solve_chunk(robot: Robot, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
     return q, np.asarray(sols.valid, dtype=bool), np.asarray(sols.singular, dtype=bool)
 
 
+def _solve_rotated(facts: ArmFacts, poses: np.ndarray, samples: ToolSamples
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every IK solution of poses (c, 4, 4) at every sampled tool rotation.
+
+    Returns q (c K, k, n), valid and singular (c K, k), rotation-major per pose.
+    With ``facts.spin`` the IK runs once per pose (at the first rotation) and the
+    last joint is shifted by the other rotations' angles (the same solutions: the
+    wrist centre does not move, so reach, branches and singularity are the same;
+    the node kernel puts the shifted joint into its turn).
+    """
+    K = samples.count
+    if facts.spin == 0 or K == 1:
+        T = poses[:, None] @ samples.rotations  # (c, K, 4, 4)
+        return _solve_chunk(facts.robot, T.reshape(-1, 4, 4))
+    q0, valid, sing = _solve_chunk(facts.robot, poses @ samples.rotations[0])
+    c, k, n = q0.shape
+    q = np.repeat(q0[:, None], K, axis=1)  # (c, K, k, n)
+    q[..., n - 1] += facts.spin * (samples.angles - samples.angles[0])[None, :, None]
+    return (q.reshape(c * K, k, n), np.repeat(valid[:, None], K, axis=1).reshape(c * K, k),
+            np.repeat(sing[:, None], K, axis=1).reshape(c * K, k))
+
+
 def build_layers(
     facts: ArmFacts, poses: np.ndarray, samples: ToolSamples, costs: Costs
 ) -> Layers:
@@ -180,8 +238,7 @@ def build_layers(
     k = 0
     for a in range(0, L, per_chunk):
         b = min(L, a + per_chunk)
-        T = poses[a:b, None] @ samples.rotations  # (c, K, 4, 4)
-        q, valid, sing = _solve_chunk(facts.robot, T.reshape(-1, 4, 4))
+        q, valid, sing = _solve_rotated(facts, poses[a:b], samples)
         if not arrays or q.shape[1] > k:
             arrays = _grow(arrays, L, K, q.shape[1], n)
             k = q.shape[1]
