@@ -37,6 +37,7 @@ import numpy.typing as npt
 
 from robokin._text import short_repr
 from robokin.cell import _store
+from robokin.cell import plots as _plots
 from robokin.cell._evaluate import ReachChunk, ReachJob, evaluate_reach
 from robokin.cell._inputs import Progress, ik_method, placed_robot, progress_callback
 from robokin.cell._scheduler import Throttle, check_scheduler, run_chunks
@@ -140,7 +141,15 @@ class ReachMap:
         return self.grid.size
 
     def volume(self, threshold: float = 0.0) -> float:
-        """Volume [m^3] of the voxels whose index exceeds ``threshold``."""
+        """Volume [m^3] of the voxels whose index exceeds ``threshold``.
+
+        With ``threshold=0``: the voxels whose centre the tool reaches in at
+        least one of the K orientations, a midpoint cubature of the position
+        workspace whose volume
+        :func:`~robokin.kinematics.workspace.sample_workspace` estimates with
+        its uncertainty (low by the boundary voxels reachable only between the
+        K orientations; see ``docs/scale.md``).
+        """
         idx = np.asarray(self.index[...])
         return float(np.count_nonzero(idx > threshold)) * self.grid.voxel**3
 
@@ -233,9 +242,7 @@ class ReachMap:
     # ------------------------------------------------------------- plots
     def plot_sections(self, path: str | Path | None = None, **kwargs: Any) -> Figure:
         """Sections through the map as heatmaps (see :func:`robokin.cell.plots.plot_sections`)."""
-        from robokin.cell.plots import plot_sections
-
-        return plot_sections(self, path=path, **kwargs)
+        return _plots.plot_sections(self, path=path, **kwargs)
 
     # ------------------------------------------------------------- files
     def save(self, path: str | Path, *, overwrite: bool = False) -> Path:
@@ -384,9 +391,10 @@ def reach_map(
         method: ``"auto"`` (the closed form when the arm has one, every
             solution; else the numeric solver, one solution per target from its
             deterministic seed-table restarts), ``"analytic"`` or ``"numeric"``.
-        manipulability: Compute the best manipulability per voxel (about as
-            costly again as the IK: one Jacobian and determinant per solution;
-            a singular value decomposition for an arm without 6 joints).
+        manipulability: Compute the best manipulability per voxel (for a
+            6-joint arm ``|det J|`` per solution in compiled code, about a tenth
+            of the IK's cost; a Jacobian and its singular values per solution
+            for other arms).
         chunk: Voxels per Dask task (default: about 131,000 IK targets, and at
             most 50,000 tasks).
         progress: True for a progress bar on stderr, or ``progress(done, total)``

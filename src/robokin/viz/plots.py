@@ -127,7 +127,7 @@ def plot_cross_section(
         at: Position of the slab along the third axis [m]; default the middle
             of the bounds.
         thickness: Slab thickness [m]; default 5 % of the extent along the
-            third axis (at least one voxel).
+            third axis (at least 1 % of the largest extent).
         color_by: ``"manipulability"`` colours the subset with known
             manipulability; ``"density"`` draws a 2D histogram of all samples.
         ax: A matplotlib Axes to draw in; a new figure when None.
@@ -143,7 +143,7 @@ def plot_cross_section(
     lo, hi = ws.bounds[0, c], ws.bounds[1, c]
     at = 0.5 * (lo + hi) if at is None else float(at)
     if thickness is None:
-        thickness = max(0.05 * (hi - lo), ws.voxel_size)
+        thickness = max(0.05 * (hi - lo), 0.01 * float(np.max(ws.extent)))
     names = "xyz"
     if color_by == "manipulability" and ws.manipulability.size:
         pts = ws.points[ws.manipulability_index]

@@ -7,8 +7,8 @@ from typing import Annotated
 
 import typer
 
-from robokin.cli import app, json_text
-from robokin.cli_output import (
+from robokin.cli.common import json_text
+from robokin.cli.output import (
     Column,
     FormatOption,
     OutputTable,
@@ -17,7 +17,9 @@ from robokin.cli_output import (
     resolve_format,
 )
 
-__all__ = ["workspace"]
+__all__ = ["commands", "workspace"]
+
+commands = typer.Typer()
 
 
 def _refuse_earlier_run(targets: list[Path], out: Path) -> None:
@@ -32,7 +34,7 @@ def _refuse_earlier_run(targets: list[Path], out: Path) -> None:
                          "pass --force to replace them, or --out to write elsewhere")
 
 
-@app.command()
+@commands.command()
 def workspace(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     samples: Annotated[
@@ -41,9 +43,12 @@ def workspace(
     out: Annotated[
         Path, typer.Option("--out", help="Output folder for the plots.")
     ] = Path("robokin-workspace"),
-    voxel_mm: Annotated[
-        float, typer.Option("--voxel", help="Voxel edge [mm] (0: the longest extent / 100).")
-    ] = 0.0,
+    volume_points: Annotated[
+        int | None, typer.Option(
+            "--volume-points",
+            help="Monte-Carlo test points of the volume (default: min(samples, "
+                 "200,000); 0: no volume).")
+    ] = None,
     seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
     force: Annotated[bool, typer.Option(
         "--force", help="Replace the files of an earlier run in --out.")] = False,
@@ -52,10 +57,13 @@ def workspace(
     ] = False,
     output_format: FormatOption = None,
 ) -> None:
-    """Sample the reachable workspace: bounds, volume, XY/XZ sections, manipulability.
+    """Sample the reachable workspace: bounds, volume (± its standard error), XY/XZ sections.
 
-    The plots and the summary go into --out; the files of an earlier run there are
-    replaced only with --force.
+    The volume is that of the position workspace: the points the tool point
+    reaches inside the joint limits with any orientation (Monte Carlo, with a
+    position-only IK membership test; see ``docs/scale.md``). The plots and the
+    summary go into --out; the files of an earlier run there are replaced only
+    with --force.
     """
     import numpy as np
     from rich.console import Console
@@ -70,8 +78,8 @@ def workspace(
     as_json = fmt == "json"
     if samples < 1:
         raise typer.BadParameter(f"--samples must be >= 1, got {samples}")
-    if not (voxel_mm >= 0 and np.isfinite(voxel_mm)):
-        raise typer.BadParameter(f"--voxel must be >= 0 [mm] (0: auto), got {voxel_mm}")
+    if volume_points is not None and volume_points < 0:
+        raise typer.BadParameter(f"--volume-points must be >= 0, got {volume_points}")
     if out.exists() and not out.is_dir():
         raise typer.BadParameter(f"--out {out} is a file, expected a folder")
     if not out.parent.is_dir():
@@ -95,8 +103,8 @@ def workspace(
             robot,
             samples,
             rng=np.random.default_rng(seed),
-            voxel_size=voxel_mm / 1000.0 if voxel_mm > 0 else None,
-            progress=lambda done, total: bar.update(task, completed=done),
+            volume_points=volume_points,
+            progress=lambda done, total: bar.update(task, completed=done, total=total),
         )
     out.mkdir(exist_ok=True)
     paths = save_workspace_plots(ws, out)
@@ -117,8 +125,18 @@ def workspace(
         ("extent", ws.extent),
     ):
         table.add_row(label, *(float(v * 1000) for v in row))
-    table.notes.append(
-        f"volume ≈ {ws.volume:.4f} m³ ({ws.occupied_voxels:,} voxels of "
-        f"{ws.voxel_size * 1000:.1f} mm)")
+    e = ws.volume_estimate
+    if e is not None:
+        table.notes.append(
+            f"volume of the position workspace (points the tool point reaches inside "
+            f"the joint limits, any orientation): {e.value:.4f} ± {e.std_error:.4f} m³ "
+            f"(± 1 standard error; 95 %: {e.interval[0]:.4f}–{e.interval[1]:.4f} m³), "
+            f"by Monte Carlo: {e.hits:,} of {e.points:,} points in a {e.box_volume:.3f} "
+            "m³ box reached by position-only IK")
+        if e.rescued:
+            table.notes.append(
+                f"the fast membership test missed {e.rescued} of {e.rechecked} "
+                "rechecked points that a thorough solve reached; the volume and its "
+                "error include that share of the misses")
     table.notes += [f"wrote {p}" for p in [*paths, summary_path]]
     emit(table, fmt)

@@ -20,17 +20,17 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robokin.cli import DomainFailure, app, json_text
-from robokin.cli_output import FormatOption, resolve_format
+from robokin.cli.common import NUMERIC_ARGS, DomainFailure, json_text, load_robot
+from robokin.cli.output import FormatOption, resolve_format
 
 if TYPE_CHECKING:
     import numpy as np
 
     from robokin.robot import Robot
 
-__all__ = ["follow_command", "joints_csv_text", "parse_range"]
+__all__ = ["commands", "follow_command", "joints_csv_text", "parse_range"]
 
-_NUMERIC_ARGS = {"ignore_unknown_options": True}
+commands = typer.Typer()
 
 
 def parse_range(text: str, option: str) -> tuple[float, float]:
@@ -76,7 +76,6 @@ def joints_csv_text(robot: Robot, q: np.ndarray, free_angle: np.ndarray,
 
 def _load_inputs(scene: Path, robot: str | None) -> tuple[Any, Robot, Robot]:
     """The scene, the bare robot and the robot as the scene places it."""
-    import robokin
     from robokin import collision
     from robokin.exceptions import InputError
 
@@ -86,11 +85,11 @@ def _load_inputs(scene: Path, robot: str | None) -> tuple[Any, Robot, Robot]:
     name = robot or sc.robot_name
     if name is None:
         raise InputError("--robot", "the scene names no robot; pass --robot")
-    bare = robokin.load(name)
+    bare = load_robot(name)
     return sc, bare, sc.attach(bare)
 
 
-@app.command("follow", context_settings=_NUMERIC_ARGS)
+@commands.command("follow", context_settings=NUMERIC_ARGS)
 def follow_command(
     scene: Annotated[Path, typer.Argument(help="Scene file (YAML), or a bundled name.")],
     path: Annotated[Path, typer.Argument(
@@ -291,7 +290,7 @@ def _report(res: Any, n: int, written: list[str], fmt: str) -> None:
                          "travel_rad": float(res.travel), "max_step_rad": float(res.max_step),
                          "reason": res.reason, "files": written}))
         return
-    from robokin.cli_output import say
+    from robokin.cli.output import say
 
     state = "feasible" if res.feasible else "NOT feasible"
     say(f"{n} waypoints: {state}; joint travel {math.degrees(res.travel):.1f} deg, "

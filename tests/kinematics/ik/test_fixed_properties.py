@@ -1,0 +1,231 @@
+"""Held-joint IK of 7R arms, property tests (issue 23, items 5 and 6).
+
+Configurations are drawn with every joint biased to the values users hit: 0,
++-pi/2, pi, +-1e-9, +-1e-7, +-1e-6 (next to singular), either limit, or uniform
+inside the limits. The pose is ``robot.fk(q)`` and ``q[j]`` is held. Oracles:
+
+* every returned solution reproduces the pose to 1e-12 (m, rad) and holds the value;
+* non-singular configurations (the six remaining columns of the Jacobian have a
+  smallest singular value >= 1e-4: isolated solutions, the generating configuration
+  is one of them) give back the generating configuration (to 1e-6 rad, modulo 2 pi);
+* singular ones, when the generating configuration is inside the limits, give at
+  least one valid solution inside the limits (``within_limits``: 1e-9 slack).
+
+Arms: the built-in Panda with joint 4, 5, 6 or 7 held (joints 1-3 held leave no
+meeting axis triple: general 6R, not this closed form) and an exact SRS arm with
+the KUKA LBR iiwa 14 R820's link lengths and joint ranges, each joint held.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robokin
+from reference import pose_errors
+
+hyp = pytest.importorskip("hypothesis")
+st = pytest.importorskip("hypothesis.strategies")
+
+SPECIAL = (0.0, np.pi / 2, -np.pi / 2, np.pi, 1e-9, -1e-9, 1e-7, -1e-7, 1e-6, -1e-6)
+NON_SINGULAR = 1e-4  # smallest singular value of the 6 x 6 remaining Jacobian [m, rad]
+
+
+def iiwa14_srs() -> robokin.Robot:
+    """An exact SRS arm: the KUKA LBR iiwa 14 R820 (standard DH, flange frame).
+
+    Link lengths d_bs = 0.36, d_se = 0.42, d_ew = 0.40, d_wf = 0.126 m as in Faria,
+    Ferreira, Erlhagen, Monteiro and Bicho, "Position-based kinematics for 7-DoF
+    serial manipulators with global configuration control, joint limit and
+    singularity avoidance", Mechanism and Machine Theory 121 (2018), table 1;
+    joint ranges +-170, 120, 170, 120, 170, 120, 175 deg from KUKA's "LBR iiwa 7
+    R800, LBR iiwa 14 R820 specification". Every offset is zero: axes 1-3 meet in
+    the shoulder, 5-7 in the wrist.
+    """
+    deg = np.radians
+    table = [(-np.pi / 2, 0.36, 170), (np.pi / 2, 0.0, 120), (np.pi / 2, 0.42, 170),
+             (-np.pi / 2, 0.0, 120), (-np.pi / 2, 0.40, 170), (np.pi / 2, 0.0, 120),
+             (0.0, 0.126, 175)]
+    rows = [{"a": 0.0, "alpha": alpha, "d": d, "theta": 0.0,
+             "limits": [-deg(r), deg(r)], "name": f"a{i + 1}"}
+            for i, (alpha, d, r) in enumerate(table)]
+    return robokin.Robot.from_dh(rows, convention="standard", name="iiwa14_srs")
+
+
+PANDA = robokin.load("panda")
+SRS = iiwa14_srs()
+CASES = [("panda", j) for j in (3, 4, 5, 6)] + [("srs", j) for j in range(7)]
+ROBOTS = {"panda": PANDA, "srs": SRS}
+
+
+def configurations(robot):
+    """Joint values biased to 0, +-pi/2, pi, 1e-9..1e-6 from them, the limits."""
+    joints = [st.one_of(st.sampled_from(SPECIAL + (float(lo), float(hi))),
+                        st.floats(float(lo), float(hi)))
+              for lo, hi in robot.limits]
+    return st.tuples(*joints).map(np.array)
+
+
+def _angle_gap(Q, q):
+    return np.abs((Q - q + np.pi) % (2 * np.pi) - np.pi).max(axis=-1)
+
+
+def check_held(robot, j, q, *, singular=True):
+    """The oracles of the module docstring for configuration q with joint j held.
+
+    ``singular=False`` leaves out the third (in-limit solution at singular
+    configurations), which :func:`test_singular_configurations_get_an_in_limit_solution`
+    asserts on its own.
+    """
+    T = robot.fk(q)
+    sols = robot.ik(T, fixed={robot.joint_names[j]: float(q[j])})
+    Q = sols.q[sols.valid]
+    assert np.all(Q[:, j] == q[j])
+    if len(Q):
+        dp, dr = pose_errors(robot.fk(Q), T)
+        assert dp.max() <= 1e-12 and dr.max() <= 1e-12, (q.tolist(), dp.max(), dr.max())
+    J = np.delete(robot.jacobian(q), j, axis=1)
+    sigma = np.linalg.svd(J, compute_uv=False)[-1]
+    lim = robot.limits
+    inside = bool(np.all((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9)))
+    if sigma >= NON_SINGULAR:
+        assert len(Q) and _angle_gap(Q, q).min() <= 1e-6, (q.tolist(), sols.status)
+    elif inside and singular:
+        ok = sols.valid & sols.within_limits
+        assert ok.any(), (q.tolist(), sols.status)
+
+
+IDS = [f"{a}-joint{j + 1}" for a, j in CASES]
+
+# Configurations a run has failed on, asserted on every run (hypothesis's own
+# draws depend on the order tests run in: besides its seed it draws from the
+# numeric constants of the non-test modules already imported, so which robokin
+# modules other tests imported first changes the examples it makes).
+REGRESSIONS = {
+    # q2 at its limit: the kernel's row came back 1.6e-9 outside it (beyond the
+    # 1e-9 slack of within_limits); now clamped to the limit and re-polished
+    ("panda", 5): [[0.0, -1.7628, -np.pi / 2, -3.0718, -1e-7, 0.0, 0.0]],
+    # a family row 1e-3 rad outside with another joint one ulp past its limit: the
+    # slide gave up (that joint "outside" and not moved by the family)
+    ("panda", 3): [[1e-7, 1e-6, 2.8973, -3.0718, 1e-7, 3.7525, 2.8973]],
+    # formerly strict xfails (full stretch, axes 1, 3, 5, 7 in line; joint 2 or 6
+    # held next to 0), passing since the swivel band is searched as a family
+    ("srs", 0): [[0.0, 0.0, 1.0, 1e-9, 0.0, 0.0, 0.0]],
+    ("srs", 1): [[1e-6, np.pi / 2, 0.0, 0.0, 0.0, 1e-9, 0.0],
+                 [1.324997415506072, -0.8140006520993246, -1e-9, -2.0943951023931953,
+                  -1e-7, 1e-6, -3.0543261909900767]],
+    ("srs", 2): [[0.0, 0.0, 1.0, 1e-9, 0.0, 1.9375, 0.0]],
+    ("srs", 4): [[np.pi / 2, 0.0, np.pi / 2, 0.0, 0.0, 2.0, 0.0]],
+    ("srs", 5): [[0.0, 1e-9, 0.0, 0.0, 0.0, -np.pi / 2, 0.0]],
+    ("srs", 6): [[0.0, 0.0, np.pi / 2, 0.0, np.pi / 2, -1e-9, 0.0]],
+}
+
+# Known gap (docs/ik.md, "Known gap"): singular configurations inside the limits
+# with no in-limit solution returned, found in 3,000 special-value configurations
+# per held joint (3 of 1,597 singular ones for the SRS arm with joint 2 held, 1 of
+# 1,578 with joint 6 held; every other case 100 %): full stretch (q4 within 1e-9
+# of 0) or q6 at 1e-9, with three joints at their limits; the rows returned lie
+# 3e-8 to 3e-3 rad outside.
+KNOWN_GAPS = [
+    ("srs", 1, [-2.9670597283903604, -0.9787868389859129, -2.9670597283903604, 1e-9,
+                np.pi / 2, 2.0943951023931953, -np.pi / 2]),
+    ("srs", 5, [2.9670597283903604, -2.0943951023931953, -2.9670597283903604, 1e-7,
+                2.9670597283903604, 1e-9, -3.0543261909900767]),
+]
+
+
+@pytest.mark.parametrize(("arm", "j"), CASES, ids=IDS)
+def test_held_joint_special_configurations(arm, j):
+    # every row exact, the generating configuration back where it is isolated
+    robot = ROBOTS[arm]
+
+    @hyp.settings(max_examples=60, deadline=None, derandomize=True, database=None,
+                  suppress_health_check=list(hyp.HealthCheck))
+    @hyp.given(q=configurations(robot))
+    def run(q):
+        check_held(robot, j, q, singular=False)
+
+    run()
+
+
+@pytest.mark.parametrize(("arm", "j"), CASES, ids=IDS)
+def test_singular_configurations_get_an_in_limit_solution(arm, j):
+    robot = ROBOTS[arm]
+
+    def check(q):
+        check_held(robot, j, q)
+
+    run = hyp.given(q=configurations(robot))(check)
+    for q in REGRESSIONS.get((arm, j), []):
+        run = hyp.example(q=np.array(q))(run)
+    hyp.settings(max_examples=60, deadline=None, derandomize=True, database=None,
+                 suppress_health_check=list(hyp.HealthCheck))(run)()
+
+
+@pytest.mark.xfail(strict=True, reason="known gap: singular SRS, rows 3e-8-3e-3 rad outside")
+@pytest.mark.parametrize(("arm", "j", "q"), KNOWN_GAPS,
+                         ids=[f"{a}-joint{j + 1}-{i}" for i, (a, j, _) in enumerate(KNOWN_GAPS)])
+def test_known_gap_singular_configurations(arm, j, q):
+    # the in-limit oracle of check_held on configurations it fails on today
+    check_held(ROBOTS[arm], j, np.array(q))
+
+
+@pytest.mark.parametrize(("arm", "j"), CASES, ids=IDS)
+def test_held_joint_random_configurations_come_back(arm, j):
+    # uniform in-limit configurations are non-singular almost surely: all 300 come
+    # back. With the SRS arm's elbow held the six joints left move in a one-parameter
+    # family (the swivel) at every pose: there an in-limit solution must come back.
+    robot = ROBOTS[arm]
+    rng = np.random.default_rng(7 + j)
+    lim = robot.limits
+    q = rng.uniform(lim[:, 0], lim[:, 1], (300, 7))
+    T = robot.fk(q)
+    sols = robot.ik(T, fixed={robot.joint_names[j]: q[:, j]})
+    assert sols.shape == (300,)
+    if (arm, j) == ("srs", 3):
+        assert (sols.valid & sols.within_limits).any(axis=-1).all()
+        assert sols.singular[sols.valid].all()
+    else:
+        gap = np.where(sols.valid, _angle_gap(sols.q, q[:, None, :]), np.inf).min(axis=-1)
+        assert gap.max() <= 1e-6
+    Q = sols.q[sols.valid]
+    dp, dr = pose_errors(robot.fk(Q), np.broadcast_to(T[:, None], sols.q.shape[:2] + (4, 4))
+                         [sols.valid])
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+
+
+def special_batch(robot, n, rng):
+    """n configurations, each joint a third of the time uniform in its limits, a
+    special value (SPECIAL) or a limit: a fixed set for a given rng (unlike the
+    hypothesis draws above, independent of the order tests run in)."""
+    lim = robot.limits
+    q = rng.uniform(lim[:, 0], lim[:, 1], (n, 7))
+    pick = rng.integers(0, 3, (n, 7))
+    special = np.array(SPECIAL)[rng.integers(0, len(SPECIAL), (n, 7))]
+    limit = np.where(rng.integers(0, 2, (n, 7)) == 0, lim[:, 0], lim[:, 1])
+    return np.where(pick == 1, special, np.where(pick == 2, limit, q))
+
+
+@pytest.mark.parametrize(("arm", "j"), CASES, ids=IDS)
+def test_special_value_batch(arm, j):
+    # the oracles of check_held on 400 seeded special-value configurations in one
+    # batch call: exact rows, the generating configuration back where the remaining
+    # Jacobian is regular, an in-limit row at singular in-limit configurations
+    robot = ROBOTS[arm]
+    lim = robot.limits
+    q = special_batch(robot, 400, np.random.default_rng(1000 + 10 * j + (arm == "srs")))
+    T = robot.fk(q)
+    sols = robot.ik(T, fixed={robot.joint_names[j]: q[:, j]})
+    Q = sols.q[sols.valid]
+    assert np.all(Q[:, j] == np.broadcast_to(q[:, None, j], sols.valid.shape)[sols.valid])
+    dp, dr = pose_errors(robot.fk(Q), np.broadcast_to(T[:, None], sols.q.shape[:2] + (4, 4))
+                         [sols.valid])
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+    sigma = np.linalg.svd(np.delete(robot.jacobian(q), j, axis=-1), compute_uv=False)[:, -1]
+    regular = sigma >= NON_SINGULAR
+    gap = np.where(sols.valid, _angle_gap(sols.q, q[:, None, :]), np.inf).min(axis=-1)
+    assert np.all(gap[regular] <= 1e-6), q[regular & (gap > 1e-6)][:3].tolist()
+    inside = np.all((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9), axis=-1)
+    ok = (sols.valid & sols.within_limits).any(axis=-1)
+    miss = ~regular & inside & ~ok
+    assert not miss.any(), q[miss][:3].tolist()
