@@ -53,7 +53,7 @@ class Placed:
     clearance: float
 
 
-def place(robot: Any, scene: Any, clearance: Any) -> Placed:
+def place(robot: Robot, scene: Any, clearance: Any) -> Placed:
     """Check ``robot``, ``scene`` and ``clearance``; place the robot in the scene."""
     from robokin.robot import Robot as _Robot
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -44,6 +44,9 @@ from robokin.process.costs import Costs
 from robokin.process.report import Failure, FollowResult, WaypointReport
 from robokin.spatial import wrap_angle
 
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
 __all__ = ["MAX_ROUNDS", "follow"]
 
 #: Most search rounds with a scene (each removes colliding nodes or steps).
@@ -51,7 +54,7 @@ MAX_ROUNDS = 200
 
 
 def follow(
-    robot: Any,
+    robot: Robot,
     poses: npt.ArrayLike,
     *,
     free_axis: str | None = None,

@@ -16,7 +16,7 @@ import hashlib
 import math
 import time
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -37,6 +37,9 @@ from robokin.process._tsp import (
 from robokin.process.costs import Costs
 from robokin.process.report import OrderResult
 
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
 __all__ = ["order"]
 
 _STARTS = 8  # nearest-neighbour starts without q_start
@@ -45,7 +48,7 @@ _NEAR = 8  # neighbour-list length of the re-insertion move
 
 
 def order(
-    robot: Any,
+    robot: Robot,
     poses: npt.ArrayLike,
     *,
     free_axis: str | None = None,

@@ -14,12 +14,15 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robokin.exceptions import InputError
 from robokin.process.report import FollowResult
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["path_markers", "plot_follow"]
 
@@ -67,7 +70,7 @@ def path_markers(result: FollowResult, *, scene: Any = None,
     return out
 
 
-def plot_follow(result: FollowResult, *, robot: Any = None, path: str | Path | None = None,
+def plot_follow(result: FollowResult, *, robot: Robot | None = None, path: str | Path | None = None,
                 degrees: bool = True, title: str | None = None,
                 overwrite: bool = False) -> Any:
     """The diagnostics of a followed path: where it is reachable, the motion, its margins.
