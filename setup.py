@@ -29,10 +29,11 @@ from setuptools.command.build_ext import build_ext
 from setuptools.errors import CompileError, PlatformError
 
 CSRC = "src/robokin/_native/csrc"
-HEADERS = [f"{CSRC}/{h}" for h in ("lanes.h", "chain.h", "subproblems.h", "args.h", "kernels_args.gen.h", "kernels_entry.gen.h", "pool.h", "pool.c", "fk.c",
-                                     "lm.c", "nearest.c", "six_r.c", "broadphase.c", "general6r.c",
-                                     "manipulability.c", "pieper.c", "pieper_srs.c",
-                                     "module.c")]
+HEADERS = [f"{CSRC}/{h}" for h in (
+    "lanes.h", "chain.h", "vec3.h", "subproblems.h", "args.h", "kernels_args.gen.h",
+    "kernels_entry.gen.h", "pool.h", "pool.c", "fk.c", "lm.c", "nearest.c", "six_r.c",
+    "broadphase.c", "general6r.c", "process.c", "manipulability.c", "pieper.c",
+    "pieper_srs.c", "module.c")]
 UNIX = sys.platform != "win32"
 # -fno-math-errno: sqrt inlines (and vectorises); no other fast-math licence
 FLAGS = ["-O3", "-fno-math-errno", "-Wno-psabi"] if UNIX else ["/O2"]

@@ -37,7 +37,7 @@ class Arr:
     """An ndarray argument: dtype, shape, writeable (an output)."""
 
     name: str
-    dtype: str  # f64, i64, bool, i8
+    dtype: str  # f64, i64, i32, i8, u8, bool
     shape: tuple[int | str, ...]
     out: bool = False
     values: tuple[str, str] | None = None  # index arrays: every value in [lo, hi] (C exprs)
@@ -313,7 +313,7 @@ GENERAL6R = Group("general6r.c", kernels=(
         Arr("Q", "f64", ("N", 16, 6), out=True), Arr("valid", "bool", ("N", 16), out=True),
         Arr("inside", "bool", ("N", 16), out=True), Arr("sigma", "f64", ("N", 16), out=True),
         Arr("status", "i64", ("N",), out=True), Arr("diag", "i64", ("N",), out=True),
-        Arr("stats", "f64", ("N", 3), out=True), Flag("parallel")),
+        Arr("stats", "f64", ("N", 4), out=True), Flag("parallel")),
         "None", "Every solution of poses T (N, 4, 4): Q (N, 16, 6), masks (N, 16), ...",
         checks=(Check("g6_chain_ok(&a->packed)",
                       "the chain is not 6R revolute without dependent joints"),
@@ -323,6 +323,12 @@ GENERAL6R = Group("general6r.c", kernels=(
                                   Arr("angles", "f64", ("M", 3)), Arr("X", "f64", ("M", 27), out=True),
                                   Arr("Y", "f64", ("M", 14), out=True)),
            "None", "The left side's fitting rows at angles (M, 3): X (M, 27), Y (M, 14)."),
+    Kernel("general6r_candidates", (Arr("params", "f64", ("P",)), Arr("T", "f64", (4, 4)),
+                                    Arr("out", "f64", ("G6_MAXCAND", 6), out=True)),
+           "tuple[int, int]",
+           "One pose's candidates before the polish (chain values) into out; (n, flags).",
+           checks=(Check("g6_params_ok(a->params, (long)P)",
+                         "params is not a general 6R parameter vector"),)),
     Kernel("general6r_roots", (Arr("c", "f64", ("D",)), Arr("wr", "f64", ("D - 1",), out=True),
                                Arr("wi", "f64", ("D - 1",), out=True)),
            "bool", "Roots of the polynomial with coefficients c (low order first), into wr, wi.",
@@ -330,10 +336,11 @@ GENERAL6R = Group("general6r.c", kernels=(
                          "isfinite(a->c[D - 1])",
                          "need 1 <= degree <= 32 and a finite non-zero leading coefficient"),)),
 ), constants=_consts(
-    "G6_MAXSOL GP_NVAR GP_TAIL_TOL GP_NULL_TOL GP_IMAG_TOL GP_TOL GP_DEDUPE GP_MAX_ITER "
-    "GP_PAIR_GAP GP_HEAD VB_DIR VB_A VB_MULT VB_C VB_CI VB_P VB_SIZE G6_OK G6_NONE "
-    "G6_DEGENERATE G6_BAD_POSE G6F_DEGENERATE G6F_AMBIGUOUS G6F_SECONDARY "
-    "G6F_SEC_DEGENERATE G6F_SEC_AMBIGUOUS G6_DIAG_CAND_SHIFT"),
+    "G6_MAXSOL G6_MAXCAND G6_MAXVAR GP_NVAR GP_TAIL_TOL GP_NULL_TOL GP_IMAG_TOL GP_TOL "
+    "GP_DEDUPE GP_MAX_ITER GP_PAIR_GAP GP_SCALE GP_FALLBACK GP_NEAR_TAIL GP_HEAD VB_DIR VB_A "
+    "VB_MULT VB_C VB_CI VB_P VB_SIZE G6_OK G6_NONE G6_DEGENERATE G6_BAD_POSE G6F_DEGENERATE "
+    "G6F_CLUSTER G6F_SECONDARY G6F_SEC_DEGENERATE G6F_SEC_CLUSTER G6F_PROJECTED "
+    "G6F_PROJ_DEGENERATE G6F_RESCUED G6F_NOISY G6F_SEC_NOISY G6F_EIGEN G6_DIAG_CAND_SHIFT"),
     init="g6_init", comment="general6r_solve: solutions per pose, parameter layout, codes")
 
 _PAIRS = (Arr("pa", "i64", ("P",), values=("0", "S - 1")), Arr("pb", "i64", ("P",)), Arr("is_self", "bool", ("P",)))
@@ -366,5 +373,43 @@ BROADPHASE = Group("broadphase.c", kernels=(
            "None", "Segment-segment distances of pts (N, 4, 3) into out (N,)."),
 ), constants=(Const("BP_CHUNK_WORK"),))
 
-GROUPS: tuple[Group, ...] = (FK, LM, SIX_R, PIEPER, GENERAL6R, BROADPHASE)
+PROCESS = Group("process.c", kernels=(
+    Kernel("process_nodes", (
+        Packed(), Arr("Q", "f64", ("P", "n")), Arr("valid", "bool", ("P",)),
+        Arr("singular", "bool", ("P",)), Arr("mode", "u8", ("n",), ), Arr("weights", "f64", ("PW_N",)),
+        Arr("Qc", "f64", ("P", "n"), out=True), Arr("cost", "f64", ("P",), out=True),
+        Arr("mu", "f64", ("P",), out=True), Arr("code", "i8", ("P",), out=True)),
+        "None", "Per node of Q (P, n): canonical values Qc, cost, manipulability, status.",
+        checks=(Check("pr_modes_ok(&a->packed, a->mode)",
+                      "a turn mode on a coordinate that does not wrap"),)),
+    Kernel("process_dp", (
+        Arr("Q", "f64", ("L", "M", "n")), Arr("cost", "f64", ("L", "M")), Arr("circle", "u8", ("n",)),
+        Float("max_step", 5e-324, INF), Float("weight", 0.0, BIG), Arr("start", "f64", ("M",)),
+        Arr("forbidden", "i64", ("F", 3)), Arr("value", "f64", ("L", "M"), out=True),
+        Arr("pred", "i32", ("L", "M"), out=True), Arr("restart", "u8", ("L",), out=True),
+        Arr("choice", "i32", ("L",), out=True)),
+        "int", "The exact shortest path through layers Q (L, M, n); returns the segments.",
+        checks=(Check("L >= 1 && M >= 1 && M <= 0x3fffffff && n >= 1 && n <= MAXJ",
+                      "Q must have a layer, a node and 1 to 32 joints"),
+                Check("pr_forbidden_ok(a->forbidden, F, L, M)",
+                      "forbidden edges out of range or not sorted by (layer, v)"))),
+    Kernel("process_clusters", (Arr("Q", "f64", ("P", "M", "n")), Arr("cost", "f64", ("P", "M")),
+                                Arr("circle", "u8", ("n",)), Arr("out", "f64", ("P", "P"), out=True)),
+           "None", "The least largest-joint-change between every two layers into out (P, P).",
+           checks=(Check("n >= 1 && n <= MAXJ && M <= 0x3fffffff && P <= 0x3fffffff",
+                         "Q must have 1 to 32 joints"),)),
+    Kernel("process_pairs", (Arr("A", "f64", ("na", "n")), Arr("B", "f64", ("nb", "n")),
+                             Arr("circle", "u8", ("n",)), Arr("out", "f64", ("na", "nb"), out=True)),
+           "None", "The largest joint change between every row of A (a, n) and B (b, n).",
+           checks=(Check("n >= 1 && n <= MAXJ", "A must have 1 to 32 joints"),)),
+    Kernel("process_limit_cost", (Arr("values", "f64", ("P",)), Float("lo"), Float("hi"),
+                                  Float("margin"), Arr("out", "f64", ("P",), out=True)),
+           "None", "The limit cost of each value (P,) into out (P,)."),
+), constants=_consts(
+    "PN_OK PN_NONE PN_LIMITS PN_SINGULAR PM_PLAIN PM_TURN PM_CIRCLE PW_SING_W PW_SING_MARGIN "
+    "PW_SING_TOL PW_MU_REF PW_LIM_W PW_LIM_MARGIN PW_N PR_MAXB")
+    + (Const("PR_LIMIT_TOL", type="float"),),
+    comment="node status codes, coordinate modes, the weights layout, the bucket cap")
+
+GROUPS: tuple[Group, ...] = (FK, LM, SIX_R, PIEPER, GENERAL6R, BROADPHASE, PROCESS)
 OPTION_VECTORS: tuple[Opts, ...] = (LM_OPTS,)

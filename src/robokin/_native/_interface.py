@@ -141,6 +141,8 @@ class Kernels(Protocol):
     PIEPER_TAG_VALUE: float
     # general6r.c: general6r_solve: solutions per pose, parameter layout, codes
     G6_MAXSOL: int
+    G6_MAXCAND: int
+    G6_MAXVAR: int
     GP_NVAR: int
     GP_TAIL_TOL: int
     GP_NULL_TOL: int
@@ -149,6 +151,9 @@ class Kernels(Protocol):
     GP_DEDUPE: int
     GP_MAX_ITER: int
     GP_PAIR_GAP: int
+    GP_SCALE: int
+    GP_FALLBACK: int
+    GP_NEAR_TAIL: int
     GP_HEAD: int
     VB_DIR: int
     VB_A: int
@@ -162,13 +167,36 @@ class Kernels(Protocol):
     G6_DEGENERATE: int
     G6_BAD_POSE: int
     G6F_DEGENERATE: int
-    G6F_AMBIGUOUS: int
+    G6F_CLUSTER: int
     G6F_SECONDARY: int
     G6F_SEC_DEGENERATE: int
-    G6F_SEC_AMBIGUOUS: int
+    G6F_SEC_CLUSTER: int
+    G6F_PROJECTED: int
+    G6F_PROJ_DEGENERATE: int
+    G6F_RESCUED: int
+    G6F_NOISY: int
+    G6F_SEC_NOISY: int
+    G6F_EIGEN: int
     G6_DIAG_CAND_SHIFT: int
     # broadphase.c
     BP_CHUNK_WORK: int
+    # process.c: node status codes, coordinate modes, the weights layout, the bucket cap
+    PN_OK: int
+    PN_NONE: int
+    PN_LIMITS: int
+    PN_SINGULAR: int
+    PM_PLAIN: int
+    PM_TURN: int
+    PM_CIRCLE: int
+    PW_SING_W: int
+    PW_SING_MARGIN: int
+    PW_SING_TOL: int
+    PW_MU_REF: int
+    PW_LIM_W: int
+    PW_LIM_MARGIN: int
+    PW_N: int
+    PR_MAXB: int
+    PR_LIMIT_TOL: float
 
     def fk1(self, q: object, packed: object, /) -> F64 | None:
         """Pose (4, 4) of one configuration q (n,), or None for the general path."""
@@ -336,6 +364,9 @@ class Kernels(Protocol):
     def general6r_fit_rows(self, consts: F64, a: int, angles: F64, X: F64, Y: F64, /) -> None:
         """The left side's fitting rows at angles (M, 3): X (M, 27), Y (M, 14)."""
 
+    def general6r_candidates(self, params: F64, T: F64, out: F64, /) -> tuple[int, int]:
+        """One pose's candidates before the polish (chain values) into out; (n, flags)."""
+
     def general6r_roots(self, c: F64, wr: F64, wi: F64, /) -> bool:
         """Roots of the polynomial with coefficients c (low order first), into wr, wi."""
 
@@ -400,3 +431,60 @@ class Kernels(Protocol):
 
     def seg_seg(self, pts: F64, out: F64, /) -> None:
         """Segment-segment distances of pts (N, 4, 3) into out (N,)."""
+
+    def process_nodes(
+        self,
+        packed: F64,
+        Q: F64,
+        valid: Bools,
+        singular: Bools,
+        mode: npt.NDArray[np.uint8],
+        weights: F64,
+        Qc: F64,
+        cost: F64,
+        mu: F64,
+        code: npt.NDArray[np.int8],
+        /,
+    ) -> None:
+        """Per node of Q (P, n): canonical values Qc, cost, manipulability, status."""
+
+    def process_dp(
+        self,
+        Q: F64,
+        cost: F64,
+        circle: npt.NDArray[np.uint8],
+        max_step: float,
+        weight: float,
+        start: F64,
+        forbidden: I64,
+        value: F64,
+        pred: npt.NDArray[np.int32],
+        restart: npt.NDArray[np.uint8],
+        choice: npt.NDArray[np.int32],
+        /,
+    ) -> int:
+        """The exact shortest path through layers Q (L, M, n); returns the segments."""
+
+    def process_clusters(
+        self,
+        Q: F64,
+        cost: F64,
+        circle: npt.NDArray[np.uint8],
+        out: F64,
+        /,
+    ) -> None:
+        """The least largest-joint-change between every two layers into out (P, P)."""
+
+    def process_pairs(self, A: F64, B: F64, circle: npt.NDArray[np.uint8], out: F64, /) -> None:
+        """The largest joint change between every row of A (a, n) and B (b, n)."""
+
+    def process_limit_cost(
+        self,
+        values: F64,
+        lo: float,
+        hi: float,
+        margin: float,
+        out: F64,
+        /,
+    ) -> None:
+        """The limit cost of each value (P,) into out (P,)."""

@@ -31,7 +31,9 @@ static PyArrayObject *array_arg(PyObject *o, const char *kernel, const char *nam
         (writeable && !PyArray_ISWRITEABLE(a))) {
         const char *type = typenum == NPY_INT64 ? "int64"
                            : typenum == NPY_BOOL ? "bool"
-                           : typenum == NPY_INT8 ? "int8" : "float64";
+                           : typenum == NPY_INT8 ? "int8"
+                           : typenum == NPY_INT32 ? "int32"
+                           : typenum == NPY_UINT8 ? "uint8" : "float64";
         PyErr_Format(PyExc_ValueError,
                      "robokin._native.%s: %s must be a C-contiguous aligned native %s array "
                      "with %d dimension(s)%s", kernel, name, type, ndim,

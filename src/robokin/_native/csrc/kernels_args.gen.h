@@ -454,6 +454,19 @@ typedef struct {
 } general6r_fit_rows_args;
 static PyObject *general6r_fit_rows_body(const general6r_fit_rows_args *a);
 
+/* general6r_candidates: general6r.c */
+typedef struct {
+    const double *params;
+    PyArrayObject *params_array;
+    const double *T;
+    PyArrayObject *T_array;
+    double *out;
+    PyArrayObject *out_array;
+    npy_intp P;
+    char unused; /* a struct is never empty */
+} general6r_candidates_args;
+static PyObject *general6r_candidates_body(const general6r_candidates_args *a);
+
 /* general6r_roots: general6r.c */
 typedef struct {
     const double *c;
@@ -604,5 +617,111 @@ typedef struct {
     char unused; /* a struct is never empty */
 } seg_seg_args;
 static PyObject *seg_seg_body(const seg_seg_args *a);
+
+/* process_nodes: process.c */
+typedef struct {
+    Chain packed;
+    const double *Q;
+    PyArrayObject *Q_array;
+    const npy_bool *valid;
+    PyArrayObject *valid_array;
+    const npy_bool *singular;
+    PyArrayObject *singular_array;
+    const unsigned char *mode;
+    PyArrayObject *mode_array;
+    const double *weights;
+    PyArrayObject *weights_array;
+    double *Qc;
+    PyArrayObject *Qc_array;
+    double *cost;
+    PyArrayObject *cost_array;
+    double *mu;
+    PyArrayObject *mu_array;
+    signed char *code;
+    PyArrayObject *code_array;
+    npy_intp n;
+    npy_intp nc;
+    npy_intp P;
+    char unused; /* a struct is never empty */
+} process_nodes_args;
+static PyObject *process_nodes_body(const process_nodes_args *a);
+
+/* process_dp: process.c */
+typedef struct {
+    const double *Q;
+    PyArrayObject *Q_array;
+    const double *cost;
+    PyArrayObject *cost_array;
+    const unsigned char *circle;
+    PyArrayObject *circle_array;
+    double max_step;
+    double weight;
+    const double *start;
+    PyArrayObject *start_array;
+    const long long *forbidden;
+    PyArrayObject *forbidden_array;
+    double *value;
+    PyArrayObject *value_array;
+    int *pred;
+    PyArrayObject *pred_array;
+    unsigned char *restart;
+    PyArrayObject *restart_array;
+    int *choice;
+    PyArrayObject *choice_array;
+    npy_intp L;
+    npy_intp M;
+    npy_intp n;
+    npy_intp F;
+    char unused; /* a struct is never empty */
+} process_dp_args;
+static PyObject *process_dp_body(const process_dp_args *a);
+
+/* process_clusters: process.c */
+typedef struct {
+    const double *Q;
+    PyArrayObject *Q_array;
+    const double *cost;
+    PyArrayObject *cost_array;
+    const unsigned char *circle;
+    PyArrayObject *circle_array;
+    double *out;
+    PyArrayObject *out_array;
+    npy_intp P;
+    npy_intp M;
+    npy_intp n;
+    char unused; /* a struct is never empty */
+} process_clusters_args;
+static PyObject *process_clusters_body(const process_clusters_args *a);
+
+/* process_pairs: process.c */
+typedef struct {
+    const double *A;
+    PyArrayObject *A_array;
+    const double *B;
+    PyArrayObject *B_array;
+    const unsigned char *circle;
+    PyArrayObject *circle_array;
+    double *out;
+    PyArrayObject *out_array;
+    npy_intp na;
+    npy_intp n;
+    npy_intp nb;
+    char unused; /* a struct is never empty */
+} process_pairs_args;
+static PyObject *process_pairs_body(const process_pairs_args *a);
+
+/* process_limit_cost: process.c */
+typedef struct {
+    const double *values;
+    PyArrayObject *values_array;
+    double lo;
+    double hi;
+    double margin;
+    double *out;
+    PyArrayObject *out_array;
+    npy_intp P;
+    char unused; /* a struct is never empty */
+} process_limit_cost_args;
+static PyObject *process_limit_cost_body(const process_limit_cost_args *a);
 
 #endif

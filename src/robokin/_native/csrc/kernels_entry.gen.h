@@ -940,9 +940,9 @@ static PyObject *py_general6r_solve(PyObject *self, PyObject *const *args, Py_ss
     if (!(PyArray_DIMS(a.diag_array)[0] == (npy_intp)(N)))
         return kernel_fail("robokin._native.general6r_solve: diag must be (N)");
     if (!(PyArray_DIMS(a.stats_array)[0] == (npy_intp)(N)))
-        return kernel_fail("robokin._native.general6r_solve: stats must be (N, 3)");
-    if (!(PyArray_DIMS(a.stats_array)[1] == (npy_intp)(3)))
-        return kernel_fail("robokin._native.general6r_solve: stats must be (N, 3)");
+        return kernel_fail("robokin._native.general6r_solve: stats must be (N, 4)");
+    if (!(PyArray_DIMS(a.stats_array)[1] == (npy_intp)(4)))
+        return kernel_fail("robokin._native.general6r_solve: stats must be (N, 4)");
     return general6r_solve_body(&a);
 }
 
@@ -993,6 +993,43 @@ static PyObject *py_general6r_fit_rows(PyObject *self, PyObject *const *args, Py
     if (!(PyArray_DIMS(a.Y_array)[1] == (npy_intp)(14)))
         return kernel_fail("robokin._native.general6r_fit_rows: Y must be (M, 14)");
     return general6r_fit_rows_body(&a);
+}
+
+static PyObject *py_general6r_candidates(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    general6r_candidates_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 3) {
+        PyErr_SetString(PyExc_TypeError, "general6r_candidates(params, T, out) takes 3 arguments");
+        return NULL;
+    }
+    a.params_array = array_arg(args[0], "general6r_candidates", "params", NPY_DOUBLE, 1, 0);
+    if (a.params_array == NULL)
+        return NULL;
+    a.params = (const double *)PyArray_DATA(a.params_array);
+    a.P = PyArray_DIMS(a.params_array)[0];
+    a.T_array = array_arg(args[1], "general6r_candidates", "T", NPY_DOUBLE, 2, 0);
+    if (a.T_array == NULL)
+        return NULL;
+    a.T = (const double *)PyArray_DATA(a.T_array);
+    a.out_array = array_arg(args[2], "general6r_candidates", "out", NPY_DOUBLE, 2, 1);
+    if (a.out_array == NULL)
+        return NULL;
+    a.out = (double *)PyArray_DATA(a.out_array);
+    npy_intp P = a.P;
+    (void)P;
+    if (!(g6_params_ok(a.params, (long)P)))
+        return kernel_fail("robokin._native.general6r_candidates: params is not a general 6R parameter vector");
+    if (!(PyArray_DIMS(a.T_array)[0] == (npy_intp)(4)))
+        return kernel_fail("robokin._native.general6r_candidates: T must be (4, 4)");
+    if (!(PyArray_DIMS(a.T_array)[1] == (npy_intp)(4)))
+        return kernel_fail("robokin._native.general6r_candidates: T must be (4, 4)");
+    if (!(PyArray_DIMS(a.out_array)[0] == (npy_intp)(G6_MAXCAND)))
+        return kernel_fail("robokin._native.general6r_candidates: out must be (G6_MAXCAND, 6)");
+    if (!(PyArray_DIMS(a.out_array)[1] == (npy_intp)(6)))
+        return kernel_fail("robokin._native.general6r_candidates: out must be (G6_MAXCAND, 6)");
+    return general6r_candidates_body(&a);
 }
 
 static PyObject *py_general6r_roots(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
@@ -1423,6 +1460,286 @@ static PyObject *py_seg_seg(PyObject *self, PyObject *const *args, Py_ssize_t na
     return seg_seg_body(&a);
 }
 
+static PyObject *py_process_nodes(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    process_nodes_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 10) {
+        PyErr_SetString(PyExc_TypeError, "process_nodes(packed, Q, valid, singular, mode, weights, Qc, cost, mu, code) takes 10 arguments");
+        return NULL;
+    }
+    if (!chain_arg(args[0], &a.packed, "process_nodes"))
+        return NULL;
+    a.n = a.packed.n;
+    a.nc = a.packed.nc;
+    a.Q_array = array_arg(args[1], "process_nodes", "Q", NPY_DOUBLE, 2, 0);
+    if (a.Q_array == NULL)
+        return NULL;
+    a.Q = (const double *)PyArray_DATA(a.Q_array);
+    a.P = PyArray_DIMS(a.Q_array)[0];
+    a.valid_array = array_arg(args[2], "process_nodes", "valid", NPY_BOOL, 1, 0);
+    if (a.valid_array == NULL)
+        return NULL;
+    a.valid = (const npy_bool *)PyArray_DATA(a.valid_array);
+    a.singular_array = array_arg(args[3], "process_nodes", "singular", NPY_BOOL, 1, 0);
+    if (a.singular_array == NULL)
+        return NULL;
+    a.singular = (const npy_bool *)PyArray_DATA(a.singular_array);
+    a.mode_array = array_arg(args[4], "process_nodes", "mode", NPY_UINT8, 1, 0);
+    if (a.mode_array == NULL)
+        return NULL;
+    a.mode = (const unsigned char *)PyArray_DATA(a.mode_array);
+    a.weights_array = array_arg(args[5], "process_nodes", "weights", NPY_DOUBLE, 1, 0);
+    if (a.weights_array == NULL)
+        return NULL;
+    a.weights = (const double *)PyArray_DATA(a.weights_array);
+    a.Qc_array = array_arg(args[6], "process_nodes", "Qc", NPY_DOUBLE, 2, 1);
+    if (a.Qc_array == NULL)
+        return NULL;
+    a.Qc = (double *)PyArray_DATA(a.Qc_array);
+    a.cost_array = array_arg(args[7], "process_nodes", "cost", NPY_DOUBLE, 1, 1);
+    if (a.cost_array == NULL)
+        return NULL;
+    a.cost = (double *)PyArray_DATA(a.cost_array);
+    a.mu_array = array_arg(args[8], "process_nodes", "mu", NPY_DOUBLE, 1, 1);
+    if (a.mu_array == NULL)
+        return NULL;
+    a.mu = (double *)PyArray_DATA(a.mu_array);
+    a.code_array = array_arg(args[9], "process_nodes", "code", NPY_INT8, 1, 1);
+    if (a.code_array == NULL)
+        return NULL;
+    a.code = (signed char *)PyArray_DATA(a.code_array);
+    npy_intp n = a.n; npy_intp nc = a.nc; npy_intp P = a.P;
+    (void)n; (void)nc; (void)P;
+    if (!(pr_modes_ok(&a.packed, a.mode)))
+        return kernel_fail("robokin._native.process_nodes: a turn mode on a coordinate that does not wrap");
+    if (!(PyArray_DIMS(a.Q_array)[1] == (npy_intp)(n)))
+        return kernel_fail("robokin._native.process_nodes: Q must be (P, n)");
+    if (!(PyArray_DIMS(a.valid_array)[0] == (npy_intp)(P)))
+        return kernel_fail("robokin._native.process_nodes: valid must be (P)");
+    if (!(PyArray_DIMS(a.singular_array)[0] == (npy_intp)(P)))
+        return kernel_fail("robokin._native.process_nodes: singular must be (P)");
+    if (!(PyArray_DIMS(a.mode_array)[0] == (npy_intp)(n)))
+        return kernel_fail("robokin._native.process_nodes: mode must be (n)");
+    if (!(PyArray_DIMS(a.weights_array)[0] == (npy_intp)(PW_N)))
+        return kernel_fail("robokin._native.process_nodes: weights must be (PW_N)");
+    if (!(PyArray_DIMS(a.Qc_array)[0] == (npy_intp)(P)))
+        return kernel_fail("robokin._native.process_nodes: Qc must be (P, n)");
+    if (!(PyArray_DIMS(a.Qc_array)[1] == (npy_intp)(n)))
+        return kernel_fail("robokin._native.process_nodes: Qc must be (P, n)");
+    if (!(PyArray_DIMS(a.cost_array)[0] == (npy_intp)(P)))
+        return kernel_fail("robokin._native.process_nodes: cost must be (P)");
+    if (!(PyArray_DIMS(a.mu_array)[0] == (npy_intp)(P)))
+        return kernel_fail("robokin._native.process_nodes: mu must be (P)");
+    if (!(PyArray_DIMS(a.code_array)[0] == (npy_intp)(P)))
+        return kernel_fail("robokin._native.process_nodes: code must be (P)");
+    return process_nodes_body(&a);
+}
+
+static PyObject *py_process_dp(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    process_dp_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 11) {
+        PyErr_SetString(PyExc_TypeError, "process_dp(Q, cost, circle, max_step, weight, start, forbidden, value, pred, restart, choice) takes 11 arguments");
+        return NULL;
+    }
+    a.Q_array = array_arg(args[0], "process_dp", "Q", NPY_DOUBLE, 3, 0);
+    if (a.Q_array == NULL)
+        return NULL;
+    a.Q = (const double *)PyArray_DATA(a.Q_array);
+    a.L = PyArray_DIMS(a.Q_array)[0];
+    a.M = PyArray_DIMS(a.Q_array)[1];
+    a.n = PyArray_DIMS(a.Q_array)[2];
+    a.cost_array = array_arg(args[1], "process_dp", "cost", NPY_DOUBLE, 2, 0);
+    if (a.cost_array == NULL)
+        return NULL;
+    a.cost = (const double *)PyArray_DATA(a.cost_array);
+    a.circle_array = array_arg(args[2], "process_dp", "circle", NPY_UINT8, 1, 0);
+    if (a.circle_array == NULL)
+        return NULL;
+    a.circle = (const unsigned char *)PyArray_DATA(a.circle_array);
+    if (!double_arg(args[3], "process_dp", "max_step", 5e-324, INFINITY, &a.max_step))
+        return NULL;
+    if (!double_arg(args[4], "process_dp", "weight", 0.0, 1.7976931348623157e+308, &a.weight))
+        return NULL;
+    a.start_array = array_arg(args[5], "process_dp", "start", NPY_DOUBLE, 1, 0);
+    if (a.start_array == NULL)
+        return NULL;
+    a.start = (const double *)PyArray_DATA(a.start_array);
+    a.forbidden_array = array_arg(args[6], "process_dp", "forbidden", NPY_INT64, 2, 0);
+    if (a.forbidden_array == NULL)
+        return NULL;
+    a.forbidden = (const long long *)PyArray_DATA(a.forbidden_array);
+    a.F = PyArray_DIMS(a.forbidden_array)[0];
+    a.value_array = array_arg(args[7], "process_dp", "value", NPY_DOUBLE, 2, 1);
+    if (a.value_array == NULL)
+        return NULL;
+    a.value = (double *)PyArray_DATA(a.value_array);
+    a.pred_array = array_arg(args[8], "process_dp", "pred", NPY_INT32, 2, 1);
+    if (a.pred_array == NULL)
+        return NULL;
+    a.pred = (int *)PyArray_DATA(a.pred_array);
+    a.restart_array = array_arg(args[9], "process_dp", "restart", NPY_UINT8, 1, 1);
+    if (a.restart_array == NULL)
+        return NULL;
+    a.restart = (unsigned char *)PyArray_DATA(a.restart_array);
+    a.choice_array = array_arg(args[10], "process_dp", "choice", NPY_INT32, 1, 1);
+    if (a.choice_array == NULL)
+        return NULL;
+    a.choice = (int *)PyArray_DATA(a.choice_array);
+    npy_intp L = a.L; npy_intp M = a.M; npy_intp n = a.n; npy_intp F = a.F;
+    (void)L; (void)M; (void)n; (void)F;
+    if (!(L >= 1 && M >= 1 && M <= 0x3fffffff && n >= 1 && n <= MAXJ))
+        return kernel_fail("robokin._native.process_dp: Q must have a layer, a node and 1 to 32 joints");
+    if (!(pr_forbidden_ok(a.forbidden, F, L, M)))
+        return kernel_fail("robokin._native.process_dp: forbidden edges out of range or not sorted by (layer, v)");
+    if (!(PyArray_DIMS(a.cost_array)[0] == (npy_intp)(L)))
+        return kernel_fail("robokin._native.process_dp: cost must be (L, M)");
+    if (!(PyArray_DIMS(a.cost_array)[1] == (npy_intp)(M)))
+        return kernel_fail("robokin._native.process_dp: cost must be (L, M)");
+    if (!(PyArray_DIMS(a.circle_array)[0] == (npy_intp)(n)))
+        return kernel_fail("robokin._native.process_dp: circle must be (n)");
+    if (!(PyArray_DIMS(a.start_array)[0] == (npy_intp)(M)))
+        return kernel_fail("robokin._native.process_dp: start must be (M)");
+    if (!(PyArray_DIMS(a.forbidden_array)[1] == (npy_intp)(3)))
+        return kernel_fail("robokin._native.process_dp: forbidden must be (F, 3)");
+    if (!(PyArray_DIMS(a.value_array)[0] == (npy_intp)(L)))
+        return kernel_fail("robokin._native.process_dp: value must be (L, M)");
+    if (!(PyArray_DIMS(a.value_array)[1] == (npy_intp)(M)))
+        return kernel_fail("robokin._native.process_dp: value must be (L, M)");
+    if (!(PyArray_DIMS(a.pred_array)[0] == (npy_intp)(L)))
+        return kernel_fail("robokin._native.process_dp: pred must be (L, M)");
+    if (!(PyArray_DIMS(a.pred_array)[1] == (npy_intp)(M)))
+        return kernel_fail("robokin._native.process_dp: pred must be (L, M)");
+    if (!(PyArray_DIMS(a.restart_array)[0] == (npy_intp)(L)))
+        return kernel_fail("robokin._native.process_dp: restart must be (L)");
+    if (!(PyArray_DIMS(a.choice_array)[0] == (npy_intp)(L)))
+        return kernel_fail("robokin._native.process_dp: choice must be (L)");
+    return process_dp_body(&a);
+}
+
+static PyObject *py_process_clusters(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    process_clusters_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 4) {
+        PyErr_SetString(PyExc_TypeError, "process_clusters(Q, cost, circle, out) takes 4 arguments");
+        return NULL;
+    }
+    a.Q_array = array_arg(args[0], "process_clusters", "Q", NPY_DOUBLE, 3, 0);
+    if (a.Q_array == NULL)
+        return NULL;
+    a.Q = (const double *)PyArray_DATA(a.Q_array);
+    a.P = PyArray_DIMS(a.Q_array)[0];
+    a.M = PyArray_DIMS(a.Q_array)[1];
+    a.n = PyArray_DIMS(a.Q_array)[2];
+    a.cost_array = array_arg(args[1], "process_clusters", "cost", NPY_DOUBLE, 2, 0);
+    if (a.cost_array == NULL)
+        return NULL;
+    a.cost = (const double *)PyArray_DATA(a.cost_array);
+    a.circle_array = array_arg(args[2], "process_clusters", "circle", NPY_UINT8, 1, 0);
+    if (a.circle_array == NULL)
+        return NULL;
+    a.circle = (const unsigned char *)PyArray_DATA(a.circle_array);
+    a.out_array = array_arg(args[3], "process_clusters", "out", NPY_DOUBLE, 2, 1);
+    if (a.out_array == NULL)
+        return NULL;
+    a.out = (double *)PyArray_DATA(a.out_array);
+    npy_intp P = a.P; npy_intp M = a.M; npy_intp n = a.n;
+    (void)P; (void)M; (void)n;
+    if (!(n >= 1 && n <= MAXJ && M <= 0x3fffffff && P <= 0x3fffffff))
+        return kernel_fail("robokin._native.process_clusters: Q must have 1 to 32 joints");
+    if (!(PyArray_DIMS(a.cost_array)[0] == (npy_intp)(P)))
+        return kernel_fail("robokin._native.process_clusters: cost must be (P, M)");
+    if (!(PyArray_DIMS(a.cost_array)[1] == (npy_intp)(M)))
+        return kernel_fail("robokin._native.process_clusters: cost must be (P, M)");
+    if (!(PyArray_DIMS(a.circle_array)[0] == (npy_intp)(n)))
+        return kernel_fail("robokin._native.process_clusters: circle must be (n)");
+    if (!(PyArray_DIMS(a.out_array)[0] == (npy_intp)(P)))
+        return kernel_fail("robokin._native.process_clusters: out must be (P, P)");
+    if (!(PyArray_DIMS(a.out_array)[1] == (npy_intp)(P)))
+        return kernel_fail("robokin._native.process_clusters: out must be (P, P)");
+    return process_clusters_body(&a);
+}
+
+static PyObject *py_process_pairs(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    process_pairs_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 4) {
+        PyErr_SetString(PyExc_TypeError, "process_pairs(A, B, circle, out) takes 4 arguments");
+        return NULL;
+    }
+    a.A_array = array_arg(args[0], "process_pairs", "A", NPY_DOUBLE, 2, 0);
+    if (a.A_array == NULL)
+        return NULL;
+    a.A = (const double *)PyArray_DATA(a.A_array);
+    a.na = PyArray_DIMS(a.A_array)[0];
+    a.n = PyArray_DIMS(a.A_array)[1];
+    a.B_array = array_arg(args[1], "process_pairs", "B", NPY_DOUBLE, 2, 0);
+    if (a.B_array == NULL)
+        return NULL;
+    a.B = (const double *)PyArray_DATA(a.B_array);
+    a.nb = PyArray_DIMS(a.B_array)[0];
+    a.circle_array = array_arg(args[2], "process_pairs", "circle", NPY_UINT8, 1, 0);
+    if (a.circle_array == NULL)
+        return NULL;
+    a.circle = (const unsigned char *)PyArray_DATA(a.circle_array);
+    a.out_array = array_arg(args[3], "process_pairs", "out", NPY_DOUBLE, 2, 1);
+    if (a.out_array == NULL)
+        return NULL;
+    a.out = (double *)PyArray_DATA(a.out_array);
+    npy_intp na = a.na; npy_intp n = a.n; npy_intp nb = a.nb;
+    (void)na; (void)n; (void)nb;
+    if (!(n >= 1 && n <= MAXJ))
+        return kernel_fail("robokin._native.process_pairs: A must have 1 to 32 joints");
+    if (!(PyArray_DIMS(a.B_array)[1] == (npy_intp)(n)))
+        return kernel_fail("robokin._native.process_pairs: B must be (nb, n)");
+    if (!(PyArray_DIMS(a.circle_array)[0] == (npy_intp)(n)))
+        return kernel_fail("robokin._native.process_pairs: circle must be (n)");
+    if (!(PyArray_DIMS(a.out_array)[0] == (npy_intp)(na)))
+        return kernel_fail("robokin._native.process_pairs: out must be (na, nb)");
+    if (!(PyArray_DIMS(a.out_array)[1] == (npy_intp)(nb)))
+        return kernel_fail("robokin._native.process_pairs: out must be (na, nb)");
+    return process_pairs_body(&a);
+}
+
+static PyObject *py_process_limit_cost(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    process_limit_cost_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "process_limit_cost(values, lo, hi, margin, out) takes 5 arguments");
+        return NULL;
+    }
+    a.values_array = array_arg(args[0], "process_limit_cost", "values", NPY_DOUBLE, 1, 0);
+    if (a.values_array == NULL)
+        return NULL;
+    a.values = (const double *)PyArray_DATA(a.values_array);
+    a.P = PyArray_DIMS(a.values_array)[0];
+    if (!double_arg(args[1], "process_limit_cost", "lo", -INFINITY, INFINITY, &a.lo))
+        return NULL;
+    if (!double_arg(args[2], "process_limit_cost", "hi", -INFINITY, INFINITY, &a.hi))
+        return NULL;
+    if (!double_arg(args[3], "process_limit_cost", "margin", -INFINITY, INFINITY, &a.margin))
+        return NULL;
+    a.out_array = array_arg(args[4], "process_limit_cost", "out", NPY_DOUBLE, 1, 1);
+    if (a.out_array == NULL)
+        return NULL;
+    a.out = (double *)PyArray_DATA(a.out_array);
+    npy_intp P = a.P;
+    (void)P;
+    if (!(PyArray_DIMS(a.out_array)[0] == (npy_intp)(P)))
+        return kernel_fail("robokin._native.process_limit_cost: out must be (P)");
+    return process_limit_cost_body(&a);
+}
+
 static PyMethodDef kernel_methods[] = {
     {"fk1", (PyCFunction)(void (*)(void))py_fk1, METH_FASTCALL,
      "fk1(q, packed) -> F64 | None: Pose (4, 4) of one configuration q (n,), or None for the general path."},
@@ -1476,6 +1793,8 @@ static PyMethodDef kernel_methods[] = {
      "general6r_solve(packed, params, T, Q, valid, inside, sigma, status, diag, stats, parallel) -> None: Every solution of poses T (N, 4, 4): Q (N, 16, 6), masks (N, 16), ..."},
     {"general6r_fit_rows", (PyCFunction)(void (*)(void))py_general6r_fit_rows, METH_FASTCALL,
      "general6r_fit_rows(consts, a, angles, X, Y) -> None: The left side's fitting rows at angles (M, 3): X (M, 27), Y (M, 14)."},
+    {"general6r_candidates", (PyCFunction)(void (*)(void))py_general6r_candidates, METH_FASTCALL,
+     "general6r_candidates(params, T, out) -> tuple[int, int]: One pose's candidates before the polish (chain values) into out; (n, flags)."},
     {"general6r_roots", (PyCFunction)(void (*)(void))py_general6r_roots, METH_FASTCALL,
      "general6r_roots(c, wr, wi) -> bool: Roots of the polynomial with coefficients c (low order first), into wr, wi."},
     {"rounded_box_bounds", (PyCFunction)(void (*)(void))py_rounded_box_bounds, METH_FASTCALL,
@@ -1488,6 +1807,16 @@ static PyMethodDef kernel_methods[] = {
      "motion_bounds(packed, q, frames, link, sph_c, sph_r, sph_start, sph_count, reach, spins, pa, pb, is_self, out) -> None: Per interval and pair, the bound on the change of the distance, into out."},
     {"seg_seg", (PyCFunction)(void (*)(void))py_seg_seg, METH_FASTCALL,
      "seg_seg(pts, out) -> None: Segment-segment distances of pts (N, 4, 3) into out (N,)."},
+    {"process_nodes", (PyCFunction)(void (*)(void))py_process_nodes, METH_FASTCALL,
+     "process_nodes(packed, Q, valid, singular, mode, weights, Qc, cost, mu, code) -> None: Per node of Q (P, n): canonical values Qc, cost, manipulability, status."},
+    {"process_dp", (PyCFunction)(void (*)(void))py_process_dp, METH_FASTCALL,
+     "process_dp(Q, cost, circle, max_step, weight, start, forbidden, value, pred, restart, choice) -> int: The exact shortest path through layers Q (L, M, n); returns the segments."},
+    {"process_clusters", (PyCFunction)(void (*)(void))py_process_clusters, METH_FASTCALL,
+     "process_clusters(Q, cost, circle, out) -> None: The least largest-joint-change between every two layers into out (P, P)."},
+    {"process_pairs", (PyCFunction)(void (*)(void))py_process_pairs, METH_FASTCALL,
+     "process_pairs(A, B, circle, out) -> None: The largest joint change between every row of A (a, n) and B (b, n)."},
+    {"process_limit_cost", (PyCFunction)(void (*)(void))py_process_limit_cost, METH_FASTCALL,
+     "process_limit_cost(values, lo, hi, margin, out) -> None: The limit cost of each value (P,) into out (P,)."},
     {NULL, NULL, 0, NULL}};
 
 /* every declared constant onto the module, then the groups' init functions */
@@ -1600,6 +1929,8 @@ static int add_constants(PyObject *m)
         {"PIEPER_PARALLEL_MIN", (long)(PK_PARALLEL_MIN)},
         {"PIEPER_MAX_JOINTS", (long)(PK_MAXJ)},
         {"G6_MAXSOL", (long)(G6_MAXSOL)},
+        {"G6_MAXCAND", (long)(G6_MAXCAND)},
+        {"G6_MAXVAR", (long)(G6_MAXVAR)},
         {"GP_NVAR", (long)(GP_NVAR)},
         {"GP_TAIL_TOL", (long)(GP_TAIL_TOL)},
         {"GP_NULL_TOL", (long)(GP_NULL_TOL)},
@@ -1608,6 +1939,9 @@ static int add_constants(PyObject *m)
         {"GP_DEDUPE", (long)(GP_DEDUPE)},
         {"GP_MAX_ITER", (long)(GP_MAX_ITER)},
         {"GP_PAIR_GAP", (long)(GP_PAIR_GAP)},
+        {"GP_SCALE", (long)(GP_SCALE)},
+        {"GP_FALLBACK", (long)(GP_FALLBACK)},
+        {"GP_NEAR_TAIL", (long)(GP_NEAR_TAIL)},
         {"GP_HEAD", (long)(GP_HEAD)},
         {"VB_DIR", (long)(VB_DIR)},
         {"VB_A", (long)(VB_A)},
@@ -1621,12 +1955,33 @@ static int add_constants(PyObject *m)
         {"G6_DEGENERATE", (long)(G6_DEGENERATE)},
         {"G6_BAD_POSE", (long)(G6_BAD_POSE)},
         {"G6F_DEGENERATE", (long)(G6F_DEGENERATE)},
-        {"G6F_AMBIGUOUS", (long)(G6F_AMBIGUOUS)},
+        {"G6F_CLUSTER", (long)(G6F_CLUSTER)},
         {"G6F_SECONDARY", (long)(G6F_SECONDARY)},
         {"G6F_SEC_DEGENERATE", (long)(G6F_SEC_DEGENERATE)},
-        {"G6F_SEC_AMBIGUOUS", (long)(G6F_SEC_AMBIGUOUS)},
+        {"G6F_SEC_CLUSTER", (long)(G6F_SEC_CLUSTER)},
+        {"G6F_PROJECTED", (long)(G6F_PROJECTED)},
+        {"G6F_PROJ_DEGENERATE", (long)(G6F_PROJ_DEGENERATE)},
+        {"G6F_RESCUED", (long)(G6F_RESCUED)},
+        {"G6F_NOISY", (long)(G6F_NOISY)},
+        {"G6F_SEC_NOISY", (long)(G6F_SEC_NOISY)},
+        {"G6F_EIGEN", (long)(G6F_EIGEN)},
         {"G6_DIAG_CAND_SHIFT", (long)(G6_DIAG_CAND_SHIFT)},
         {"BP_CHUNK_WORK", (long)(BP_CHUNK_WORK)},
+        {"PN_OK", (long)(PN_OK)},
+        {"PN_NONE", (long)(PN_NONE)},
+        {"PN_LIMITS", (long)(PN_LIMITS)},
+        {"PN_SINGULAR", (long)(PN_SINGULAR)},
+        {"PM_PLAIN", (long)(PM_PLAIN)},
+        {"PM_TURN", (long)(PM_TURN)},
+        {"PM_CIRCLE", (long)(PM_CIRCLE)},
+        {"PW_SING_W", (long)(PW_SING_W)},
+        {"PW_SING_MARGIN", (long)(PW_SING_MARGIN)},
+        {"PW_SING_TOL", (long)(PW_SING_TOL)},
+        {"PW_MU_REF", (long)(PW_MU_REF)},
+        {"PW_LIM_W", (long)(PW_LIM_W)},
+        {"PW_LIM_MARGIN", (long)(PW_LIM_MARGIN)},
+        {"PW_N", (long)(PW_N)},
+        {"PR_MAXB", (long)(PR_MAXB)},
     };
     for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
         if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
@@ -1648,6 +2003,13 @@ static int add_constants(PyObject *m)
     {
         PyObject *v = PyFloat_FromDouble(PK_TAG_VALUE);
         if (v == NULL || PyModule_AddObject(m, "PIEPER_TAG_VALUE", v) < 0) {
+            Py_XDECREF(v);
+            return -1;
+        }
+    }
+    {
+        PyObject *v = PyFloat_FromDouble(PR_LIMIT_TOL);
+        if (v == NULL || PyModule_AddObject(m, "PR_LIMIT_TOL", v) < 0) {
             Py_XDECREF(v);
             return -1;
         }

@@ -31,6 +31,7 @@
 #include "general6r.c"
 #include "manipulability.c"
 #include "pieper.c"
+#include "process.c"
 
 #define F64(a) ((double *)PyArray_DATA(a))
 #define DIM(a, d) (PyArray_DIMS(a)[d])

@@ -102,7 +102,7 @@
  */
 #include "chain.h"
 #include "pool.h"
-#include "subproblems.h"
+#include "vec3.h"
 
 enum {
     SR_AXES = 0, SR_POINTS = 18, SR_WRIST = 30, SR_PERP2 = 33, SR_TOOL_T = 36,

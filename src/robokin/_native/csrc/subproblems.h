@@ -1,74 +1,18 @@
 /*
- * Scalar 3-vector helpers, angles and Paden's subproblems 1 and 4 in plain C: the
- * one copy the closed-form kernels share (six_r.c's set-up, pieper.c,
- * pieper_srs.c; six_r.c's lane versions are built on the same formulas).
- *
- * No fused multiply-adds here, in the AVX2 and AVX-512 copies either: the closed
- * forms take branches on rounding-level quantities (a discriminant at a boundary,
- * a wrist-singularity test), and one rounding of every product keeps the copies'
- * slots, flags and values identical.
+ * Scalar angles and Paden subproblems for the one-pose closed forms (pieper.c,
+ * pieper_srs.c): a fast atan2, (cos, sin) of an angle without trigonometry, the
+ * joint coordinate of a chain angle, and subproblems 1 and 4 (IK-Geo's
+ * formulation). six_r.c solves the same subproblems in lanes (L3, vd) for batches.
  */
 #ifndef ROBOKIN_SUBPROBLEMS_H
 #define ROBOKIN_SUBPROBLEMS_H
 
+#include <math.h>
+
 #include "chain.h"
+#include "vec3.h"
 
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT OFF
-#elif defined(__GNUC__)
-#pragma GCC push_options
-#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
-#endif
-
-/* ------------------------------------------------------------------- vectors */
-
-typedef struct { double x, y, z; } v3;
-typedef struct { v3 r0, r1, r2; } m3; /* a rotation by its rows */
-
-/* the 3-vector at P[i], P[i + 1], P[i + 2] */
-static inline v3 v3_at(const double *P, int i) { return (v3){P[i], P[i + 1], P[i + 2]}; }
-
-/* a . b */
-static inline double v3_dot(v3 a, v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-
-/* a x b */
-static inline v3 v3_cross(v3 a, v3 b)
-{
-    return (v3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
-/* a + b, a - b, s a */
-static inline v3 v3_add(v3 a, v3 b) { return (v3){a.x + b.x, a.y + b.y, a.z + b.z}; }
-static inline v3 v3_sub(v3 a, v3 b) { return (v3){a.x - b.x, a.y - b.y, a.z - b.z}; }
-static inline v3 v3_scale(v3 a, double s) { return (v3){a.x * s, a.y * s, a.z * s}; }
-
-/* rot(k, t) v for unit k given c = cos t, s = sin t, by Rodrigues' formula:
- * v cos t + (k x v) sin t + k (k . v)(1 - cos t) */
-static inline v3 v3_rot(v3 k, double c, double s, v3 v)
-{
-    double kv = v3_dot(k, v) * (1.0 - c);
-    v3 x = v3_cross(k, v);
-    return (v3){v.x * c + x.x * s + k.x * kv, v.y * c + x.y * s + k.y * kv,
-                v.z * c + x.z * s + k.z * kv};
-}
-
-/* R v */
-static inline v3 m3_mv(const m3 *R, v3 v)
-{
-    return (v3){v3_dot(R->r0, v), v3_dot(R->r1, v), v3_dot(R->r2, v)};
-}
-
-/* R^T v */
-static inline v3 m3_mtv(const m3 *R, v3 v)
-{
-    return (v3){R->r0.x * v.x + R->r1.x * v.y + R->r2.x * v.z,
-                R->r0.y * v.x + R->r1.y * v.y + R->r2.y * v.z,
-                R->r0.z * v.x + R->r1.z * v.y + R->r2.z * v.z};
-}
-
-/* ----------------------------------------------------------------- angles */
-
-#define G3_TAN_PI_8 0.41421356237309503
+#define SR_TAN_PI_8 0.41421356237309503
 
 /* atan(u) for |u| <= tan(pi/8): u + u^3 p(u^2), p a degree-10 least-squares fit on
  * Chebyshev nodes to (atan(u) - u) / u^3 (relative error < 3e-16), by Estrin's
@@ -95,7 +39,7 @@ static inline double fast_atan2(double y, double x)
         return atan2(y, x);
     int swap = ay > ax;
     double num = swap ? ax : ay, den = swap ? ay : ax;
-    int big = num > G3_TAN_PI_8 * den;
+    int big = num > SR_TAN_PI_8 * den;
     double u = (big ? num - den : num) / (big ? num + den : den);
     double r = atan_core1(u) + (big ? M_PI_4 : 0.0);
     r = swap ? M_PI_2 - r : r;
@@ -214,12 +158,5 @@ static inline Roots sp4_roots(double A, double B, double rhs, double disc, doubl
     r.boundary = r.n == 1;
     return r;
 }
-
-
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT DEFAULT
-#elif defined(__GNUC__)
-#pragma GCC pop_options
-#endif
 
 #endif /* ROBOKIN_SUBPROBLEMS_H */
