@@ -36,7 +36,9 @@ HEADERS = [f"{CSRC}/{h}" for h in (
     "pieper_srs.c", "module.c")]
 UNIX = sys.platform != "win32"
 # -fno-math-errno: sqrt inlines (and vectorises); no other fast-math licence
-FLAGS = ["-O3", "-fno-math-errno", "-Wno-psabi"] if UNIX else ["/O2"]
+# -Wall -Wextra -Wshadow: the unity build compiles without a warning (keep it so)
+FLAGS = (["-O3", "-fno-math-errno", "-Wno-psabi", "-Wall", "-Wextra", "-Wshadow"] if UNIX
+         else ["/O2"])
 LIBS = ["pthread"] if UNIX else []
 HOW = ("README.md, 'Installing', says what a source build needs; a wheel (built "
        "by .ci/wheel) installs without either")

@@ -129,3 +129,20 @@ def test_fk1_takes_the_general_path_for_a_misaligned_packed():
     np.testing.assert_array_equal(K.fk1(q, packed), robot.fk(q))  # same bits
     with pytest.raises(ValueError, match="fk: packed must be a C-contiguous aligned"):
         K.fk(shifted, q[None], np.empty((1, 4, 4)))
+
+
+def test_the_layout_the_kernels_parse_is_the_declared_one():
+    d = _generator().load_declarations()
+    for name in ("ur5", "panda"):
+        arrays = robokin.load(name).chain.arrays
+        parsed = K.layout(arrays.packed)
+        names = [s.name for s in d.PACKED_LAYOUT]
+        assert list(parsed)[3:] == names  # the C walk visits the declared sections in order
+        at = 4
+        for section in d.PACKED_LAYOUT:  # each where the declaration puts it
+            value = np.asarray(getattr(arrays, section.name)).ravel()
+            np.testing.assert_array_equal(arrays.packed[at:at + value.size], value)
+            np.testing.assert_array_equal(parsed[section.name].ravel(), value)
+            at += value.size
+        assert at == arrays.packed.size
+    assert K.LAYOUT_TAG == d.LAYOUT_TAG == arrays.packed[0]

@@ -4,10 +4,12 @@ This module is the one place (with the kernel's C body) a kernel is added.
 ``_generate.py`` reads it (``setup.py`` runs it before compiling; it imports
 nothing from robokin) and writes
 
+* ``csrc/chain_layout.gen.h``: the packed chain layout (``PACKED_LAYOUT`` below,
+  which ``model/chain_arrays.py`` packs by) as an X-macro ``chain.h`` parses by;
 * ``csrc/kernels_args.gen.h``: per kernel a ``<name>_args`` struct (the checked
   arguments and the bound shape symbols) and the body's prototype
   ``static PyObject *<name>_body(const <name>_args *a)``; the option-vector
-  indices (``enum``); the packed chain layout offsets (``CL_*``);
+  indices (``enum``);
 * ``csrc/kernels_entry.gen.h``: per kernel the METH_FASTCALL entry point that
   unpacks and checks every argument (array dtype, ndim, C-contiguity, alignment,
   byte order, writeability, every shape relation, index arrays in range, option
@@ -410,6 +412,39 @@ PROCESS = Group("process.c", kernels=(
     "PW_SING_TOL PW_MU_REF PW_LIM_W PW_LIM_MARGIN PW_N PR_MAXB")
     + (Const("PR_LIMIT_TOL", type="float"),),
     comment="node status codes, coordinate modes, the weights layout, the bucket cap")
+
+@dataclass(frozen=True)
+class Section:
+    """One section of a chain's packed vector: ``ChainArrays`` field, ``Chain`` field, shape.
+
+    Dimensions are ints or ``"nc"``, ``"n"``, ``"nc + 1"`` (C and Python read them alike).
+    """
+
+    name: str
+    c_field: str
+    shape: tuple[int | str, ...]
+
+
+#: packed[0]: the layout's version, checked by chain.h's chain_view.
+LAYOUT_TAG = 7391.0
+#: packed[0:4] = [LAYOUT_TAG, nc, n, identity], then these sections, in this order.
+PACKED_LAYOUT: tuple[Section, ...] = (
+    Section("consts", "consts", ("nc + 1", 4, 4)),  # C_0 .. C_nc
+    Section("xform", "xform", ("nc + 1", 6)),  # per constant: [1, cos a, sin a, t] or 0
+    Section("kind", "kind", ("nc",)),  # 1.0 prismatic, 0.0 revolute
+    Section("sign", "sign", ("nc",)),
+    Section("offset", "offset", ("nc",)),
+    Section("M", "M", ("nc", "n")),  # coupling, row-major
+    Section("c", "c", ("nc",)),
+    Section("base", "base", (4, 4)),
+    Section("frame", "frame", ("nc", 4, 4)),  # F_k
+    Section("link", "link", ("nc", 4, 4)),  # G_k (the last times the tool)
+    Section("lower", "lo", ("n",)),
+    Section("upper", "hi", ("n",)),
+    Section("seed_lower", "seed_lo", ("n",)),
+    Section("seed_upper", "seed_hi", ("n",)),
+    Section("wrap", "wrap", ("n",)),  # 1.0 where a coordinate may move by whole turns
+)
 
 GROUPS: tuple[Group, ...] = (FK, LM, SIX_R, PIEPER, GENERAL6R, BROADPHASE, PROCESS)
 OPTION_VECTORS: tuple[Opts, ...] = (LM_OPTS,)

@@ -223,7 +223,8 @@ def entry_header() -> str:
             e.build()
             names = ", ".join(_arg_name(a) for a in k.args)
             out += [f"static PyObject *py_{k.name}(PyObject *self, PyObject *const *args, "
-                    "Py_ssize_t nargs)", "{", "    (void)self;", f"    {k.name}_args a;",
+                    "Py_ssize_t nargs)", "{", "    (void)self;",
+                    *(["    (void)args;"] if not k.args else []), f"    {k.name}_args a;",
                     "    memset(&a, 0, sizeof(a));",
                     f"    if (nargs != {len(k.args)}) {{",
                     f"        PyErr_SetString(PyExc_TypeError, \"{k.name}({names}) takes "
@@ -328,12 +329,29 @@ def interface() -> str:
     return "\n".join(out)
 
 
+def chain_layout() -> str:
+    """``chain_layout.gen.h``: the packed layout as an X-macro for chain.h."""
+    rows = []
+    for sec in D.PACKED_LAYOUT:
+        dims = [f"({d})" for d in sec.shape] + ["1"] * (3 - len(sec.shape))
+        rows.append(f"    X({sec.c_field}, {len(sec.shape)}, {', '.join(dims)}, \"{sec.name}\")")
+    return "\n".join([
+        "/* chain_layout.gen.h: " + STAMP + " */",
+        "#ifndef ROBOKIN_CHAIN_LAYOUT_GEN_H", "#define ROBOKIN_CHAIN_LAYOUT_GEN_H", "",
+        f"#define PACKED_TAG {D.LAYOUT_TAG!r} /* packed[0]: the layout's version */",
+        "#define PACKED_HEAD 4 /* [PACKED_TAG, nc, n, identity] */", "",
+        "/* X(Chain field, ndim, d0, d1, d2, ChainArrays name) per section, in order;",
+        " * the dimensions are expressions in nc and n */",
+        "#define PACKED_SECTIONS(X) \\", " \\\n".join(rows), "", "#endif", ""])
+
+
 def outputs() -> dict[Path, str]:
     """Every generated file's path and text."""
     for g in D.GROUPS:
         for k in g.kernels:
             assert NAME.match(k.name) and not keyword.iskeyword(k.name), k.name
-    return {CSRC / "kernels_args.gen.h": args_header(),
+    return {CSRC / "chain_layout.gen.h": chain_layout(),
+            CSRC / "kernels_args.gen.h": args_header(),
             CSRC / "kernels_entry.gen.h": entry_header(),
             HERE / "_interface.py": interface()}
 

@@ -342,7 +342,6 @@ static void det12_lanes(const double (*S)[144], int k0, double *out, double *rat
                 A[12 * i + j] -= f * A[12 * k + j];
         }
     }
-    for (int l = 0; l < W; l++)
     for (int l = 0; l < W; l++) {
         out[k0 + l] = d[l];
         ratio[k0 + l] = pmax[l] > 0.0 ? pmin[l] / pmax[l] : 0.0;
@@ -773,6 +772,7 @@ static void deflate(double *c, int deg, double r)
  * already found. Returns 0 when hqr fails. */
 static int all_roots16(const double *c, int jbest, double *wr, double *wi)
 {
+    (void)jbest;
     double xs[G6_NSAMP], ps[G6_NSAMP], d, work[17];
     for (int m = 1; m < G6_NSAMP; m++) { /* sample jbest + m, x increasing with m */
         xs[m] = tan(0.5 * (G6_TWO_PI * m / G6_NSAMP - G6_PI));

@@ -598,6 +598,7 @@ static PyObject *py_sincos(PyObject *self, PyObject *const *args, Py_ssize_t nar
 static PyObject *py_num_threads(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
+    (void)args;
     num_threads_args a;
     memset(&a, 0, sizeof(a));
     if (nargs != 0) {
@@ -624,6 +625,7 @@ static PyObject *py_set_num_threads(PyObject *self, PyObject *const *args, Py_ss
 static PyObject *py_cpu_has_avx2_fma(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
+    (void)args;
     cpu_has_avx2_fma_args a;
     memset(&a, 0, sizeof(a));
     if (nargs != 0) {
@@ -636,6 +638,7 @@ static PyObject *py_cpu_has_avx2_fma(PyObject *self, PyObject *const *args, Py_s
 static PyObject *py_cpu_has_avx512(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)self;
+    (void)args;
     cpu_has_avx512_args a;
     memset(&a, 0, sizeof(a));
     if (nargs != 0) {

@@ -234,17 +234,23 @@ static PyObject *layout_body(const layout_args *a)
 {
     const Chain *ch = &a->packed;
     int nc = ch->nc, n = ch->n;
-    return Py_BuildValue(
-        "{s:i,s:i,s:O,s:N,s:N,s:N,s:N,s:N,s:N,s:N,s:N,s:N,s:N,s:N,s:N,s:N,s:N,s:N}",
-        "n_chain", nc, "n", n, "identity", ch->ident ? Py_True : Py_False,
-        "consts", section(ch->consts, 3, nc + 1, 4, 4), "xform", section(ch->xform, 2, nc + 1, 6, 0),
-        "kind", section(ch->kind, 1, nc, 0, 0), "sign", section(ch->sign, 1, nc, 0, 0),
-        "offset", section(ch->offset, 1, nc, 0, 0), "M", section(ch->M, 2, nc, n, 0),
-        "c", section(ch->c, 1, nc, 0, 0), "base", section(ch->base, 2, 4, 4, 0),
-        "frame", section(ch->frame, 3, nc, 4, 4), "link", section(ch->link, 3, nc, 4, 4),
-        "lower", section(ch->lo, 1, n, 0, 0), "upper", section(ch->hi, 1, n, 0, 0),
-        "seed_lower", section(ch->seed_lo, 1, n, 0, 0), "seed_upper", section(ch->seed_hi, 1, n, 0, 0),
-        "wrap", section(ch->wrap, 1, n, 0, 0));
+    PyObject *d = Py_BuildValue("{s:i,s:i,s:O}", "n_chain", nc, "n", n, "identity",
+                                ch->ident ? Py_True : Py_False);
+    if (d == NULL)
+        return NULL;
+#define LAYOUT_ITEM(f, nd, d0, d1, d2, key)                                              \
+    {                                                                                    \
+        PyObject *v = section(ch->f, nd, d0, d1, d2);                                    \
+        if (v == NULL || PyDict_SetItemString(d, key, v) < 0) {                          \
+            Py_XDECREF(v);                                                               \
+            Py_DECREF(d);                                                                \
+            return NULL;                                                                 \
+        }                                                                                \
+        Py_DECREF(v);                                                                    \
+    }
+    PACKED_SECTIONS(LAYOUT_ITEM)
+#undef LAYOUT_ITEM
+    return d;
 }
 
 /* ---------------------------------------------------------- pool and the CPU */

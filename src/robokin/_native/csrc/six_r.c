@@ -1445,10 +1445,10 @@ static void sw_block(const SR *K, const Chain *ch, const double *const *T,
         LRoots r3 = elbow_roots(K, rhs3);
         L3 g61 = l3_rot(K->h[0], c.c1, -c.s1, g6);
         for (int i3 = 0; i3 < 2; i3++) {
-            vl m3 = m1 & (i3 ? r3.two : r3.one);
-            if (!vany(m3))
+            vl mask3 = m1 & (i3 ? r3.two : r3.one);
+            if (!vany(mask3))
                 continue;
-            any_pos |= m3;
+            any_pos |= mask3;
             vd th3 = r3.t[i3], c3 = r3.c[i3], s3 = r3.s[i3], c2, s2;
             L3 u = l3_addc(l3_rotc(K->h[2], c3, s3, K->b), K->a);
             vd th2 = lsp1(K->h[1], u, d, &c2, &s2);
@@ -1467,7 +1467,7 @@ static void sw_block(const SR *K, const Chain *ch, const double *const *T,
             vl check = ~r1.two | ~r3.two | ~r5.two | (gap < SR_CHECK_BAND) |
                        BRL(K->check > 0.0 ? -1 : 0);
             for (int i5 = 0; i5 < 2; i5++) {
-                vl m5 = m3 & (i5 ? r5.two & ~free_ : r5.one);
+                vl m5 = mask3 & (i5 ? r5.two & ~free_ : r5.one);
                 if (!vany(m5))
                     continue;
                 c.c5 = r5.c[i5];
