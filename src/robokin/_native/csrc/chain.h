@@ -207,10 +207,13 @@ ALWAYS_INLINE vl joint_values(const Chain *ch, const vd *q, vd *v, vd *s, vd *c)
     return ok;
 }
 
-/* The tool pose (top 3x4 into t) of configurations q (n lanes-vectors). When o and
- * z are given, the origin and z axis of every joint frame (just after its joint)
- * go there, 3 x nc each (o[3 k + r]). Returns the lanes with finite joint values. */
-ALWAYS_INLINE vl chain_pose(const Chain *ch, const vd *q, vd *t, vd *o, vd *z)
+/* The one walk along the chain: the tool pose (top 3x4 into t) of configurations q
+ * (n lane-vectors). When o and z are given, the origin and z axis of every joint
+ * frame (just after its joint) go there, 3 x nc each (o[3 k + r]); when fr is
+ * given, the top 3x4 of every link frame (after F_k), 12 x nc each (fr[12 k + i]),
+ * taken off the walk without changing it (so the tool pose is fk's, bit for bit).
+ * Returns the lanes with finite joint values. */
+ALWAYS_INLINE vl chain_walk(const Chain *ch, const vd *q, vd *t, vd *o, vd *z, vd *fr)
 {
     vd v[MAXJ], s[MAXJ], c[MAXJ];
     vl ok = joint_values(ch, q, v, s, c);
@@ -222,9 +225,20 @@ ALWAYS_INLINE vl chain_pose(const Chain *ch, const vd *q, vd *t, vd *o, vd *z)
                 o[3 * k + r] = t[4 * r + 3];
                 z[3 * k + r] = t[4 * r + 2];
             }
+        if (fr != NULL) {
+            for (int i = 0; i < 12; i++)
+                fr[12 * k + i] = t[i];
+            const_right(fr + 12 * k, ch->frame + 16 * k, NULL);
+        }
         const_right(t, ch->consts + 16 * (k + 1), ch->xform + 6 * (k + 1));
     }
     return ok;
+}
+
+/* The tool pose (and joint origins and axes when o, z are given): chain_walk */
+ALWAYS_INLINE vl chain_pose(const Chain *ch, const vd *q, vd *t, vd *o, vd *z)
+{
+    return chain_walk(ch, q, t, o, z, NULL);
 }
 
 /* Pose (into t) and the geometric Jacobian with respect to the independent
