@@ -19,6 +19,7 @@ from robokin._validation import check_transform
 from robokin.exceptions import FrozenError, InputError
 from robokin.kinematics import forward
 from robokin.kinematics import jacobian as _jac
+from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.dispatch import solve as _ik_solve
 from robokin.kinematics.ik.nearest import solve_near as _solve_near
 from robokin.model.chain import Chain
@@ -89,11 +90,15 @@ class Robot:
         meta: Free-form extra fields from the robot file (a read-only mapping).
         rate_limits: Per-joint velocity / acceleration / jerk limits
             (:class:`~robokin.model.rate_limits.RateLimits`, SI), or None.
+        arm: The :class:`~robokin.kinematics.arm.Arm` the kinematics run on (the
+            chain and the state derived from it, built on first use, freed with
+            the Robot).
     """
 
-    __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain", "dynamics",
-                 "geometry", "meta", "name", "path", "rate_limits", "source",
+    __slots__ = ("actuator_limits", "actuator_names", "actuators", "arm", "chain",
+                 "dynamics", "geometry", "meta", "name", "path", "rate_limits", "source",
                  "__weakref__")
+    arm: Arm
     chain: Chain
     name: str
     source: str
@@ -170,6 +175,7 @@ class Robot:
                 "rate_limits",
                 f"expected RateLimits for {chain.n} joints, got {rate_limits!r}")
         init(self, "rate_limits", rate_limits)
+        init(self, "arm", Arm(chain, name, actuators, limits))
 
     # ------------------------------------------------------------------ building
     @classmethod
@@ -407,8 +413,9 @@ class Robot:
         if space == "actuator":
             if q_near is not None:
                 q_near = self.joints_from_actuators(q_near)
-            sols = _ik_solve(self, T, q_near=q_near, method=method, **options)
-            out = sols.to_actuator_space(self)
+            arm = self.arm
+            sols = _ik_solve(arm, T, q_near=q_near, method=method, **options)
+            out = sols.to_actuator_space(arm)
             if self.actuators is not None and out.is_revolute.any():
                 # Motor angles never wrap: a motor turn through a reduction is not a
                 # whole joint turn, so 2*pi-shifted motor values are other poses.
@@ -418,7 +425,7 @@ class Robot:
             return out
         if space != "joint":
             raise InputError("space", f"expected 'joint' or 'actuator', got {space!r}")
-        return _ik_solve(self, T, q_near=q_near, method=method, **options)
+        return _ik_solve(self.arm, T, q_near=q_near, method=method, **options)
 
     def ik_near(
         self,
@@ -444,7 +451,7 @@ class Robot:
             An :class:`~robokin.kinematics.ik.numeric.IKResult`: ``.q`` (..., n),
             ``.success`` (...), ``.reason``.
         """
-        return _solve_near(self, T, q_near, method=method, **options)
+        return _solve_near(self.arm, T, q_near, method=method, **options)
 
     # ---------------------------------------------------------------- actuators
     def actuators_from_joints(self, q: npt.ArrayLike) -> np.ndarray:

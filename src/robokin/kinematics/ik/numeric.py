@@ -61,12 +61,11 @@ from robokin._validation import (
     check_transform,
 )
 from robokin.exceptions import InputError
-from robokin.kinematics.per_chain import cached
+from robokin.kinematics.arm import ArmSource, arm_of
 from robokin.model.chain import Chain
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.solutions import SolutionSet
-    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["IKPathResult", "IKResult", "ik_path", "parse_mask", "solve", "solve_all"]
 
@@ -178,9 +177,12 @@ class SeedTable:
         return self.rows, self.cell_start, self.grid
 
 
-def seed_table(chain: Chain) -> SeedTable:
-    """The chain's :class:`SeedTable` (built on first use, then cached)."""
-    return cached(chain, "numeric_seed_table", lambda: _build_seed_table(chain))
+def seed_table(robot: ArmSource) -> SeedTable:
+    """The arm's :class:`SeedTable` (built on first use, kept in its ``Arm``)."""
+    arm = arm_of(robot)
+    if arm.seed_table is None:
+        arm.seed_table = _build_seed_table(arm.chain)
+    return arm.seed_table
 
 
 def _build_seed_table(chain: Chain) -> SeedTable:
@@ -417,7 +419,7 @@ def _bad_target(Tf: np.ndarray, lead: tuple[int, ...], i: int) -> InputError:
 
 # ------------------------------------------------------------------------- solve
 def solve(
-    robot: RobotLike,
+    robot: ArmSource,
     T: npt.ArrayLike,
     *,
     q0: npt.ArrayLike | None = None,
@@ -435,7 +437,7 @@ def solve(
     """One joint solution per target pose, by damped least squares with restarts.
 
     Args:
-        robot: The :class:`~robokin.robot.Robot`.
+        robot: The arm (a :class:`~robokin.robot.Robot` or its ``Arm``).
         T: Target tool poses in the world frame, shape (..., 4, 4) [m].
         q0: Initial guess (..., n) or (n,) [rad, m]; default the middle of the
             limits (angles clipped to [-pi, pi]).
@@ -466,7 +468,8 @@ def solve(
         InputError: a bad pose (wrong shape, non-finite, not a rigid transform), a
             bad ``q0`` or option.
     """
-    chain = robot.chain
+    arm = arm_of(robot)
+    chain = arm.chain
     packed = chain.arrays.packed
     n = chain.n
     Tf, lead = _targets(T)
@@ -497,7 +500,7 @@ def solve(
     opts[K.O_N_SEEDS] = R
     if R and opts[K.O_TABLE_ROT] >= 0.0:
         opts[K.O_N_TABLE] = _TABLE_SEEDS
-        tab = seed_table(chain).kernel_args()
+        tab = seed_table(arm).kernel_args()
     else:
         tab = _NO_TABLE
     # random numbers only when some restart of this round is not a table one (the
@@ -593,7 +596,7 @@ _SOLVE_ALL_OPTIONS = frozenset(
 
 
 def solve_all(
-    robot: RobotLike,
+    robot: ArmSource,
     T: npt.ArrayLike,
     *,
     q_near: npt.ArrayLike | None = None,
@@ -613,7 +616,7 @@ def solve_all(
     continuum: the set is a sample of it.
 
     Args:
-        robot: The :class:`~robokin.robot.Robot`.
+        robot: The arm (a :class:`~robokin.robot.Robot` or its ``Arm``).
         T: Target poses (..., 4, 4) [m].
         q_near: Current configuration (..., n) or (n,), the first seed.
         n_seeds: Descents per target.
@@ -638,7 +641,8 @@ def solve_all(
             "options", f"unknown option(s) {unknown} for the numeric IK solver; accepted: "
             f"n_seeds, q_near, {', '.join(sorted(_SOLVE_ALL_OPTIONS))}"
         )
-    chain = robot.chain
+    arm = arm_of(robot)
+    chain = arm.chain
     arr = chain.arrays
     n = chain.n
     wrap = arr.wrap == 1.0
@@ -680,7 +684,7 @@ def solve_all(
     none = np.flatnonzero(~ok.any(axis=1))
     best_err = err.min(axis=1)
     if none.size and max_restarts > 0:
-        res = solve(robot, Tf[none], q0=q[none, np.argmin(err[none], axis=1)], mask=None
+        res = solve(arm, Tf[none], q0=q[none, np.argmin(err[none], axis=1)], mask=None
                     if options.get("mask") is None else options["mask"],
                     weights=options.get("weights"), tol=options.get("tol", 1e-9),
                     tol_rotation=options.get("tol_rotation"),
@@ -735,7 +739,7 @@ def _mask_names(opts: np.ndarray) -> str:
 
 # -------------------------------------------------------------------------- ik_path
 def ik_path(
-    robot: RobotLike,
+    robot: ArmSource,
     T_path: npt.ArrayLike,
     q_start: npt.ArrayLike,
     *,
@@ -757,7 +761,7 @@ def ik_path(
     too coarsely near a singularity).
 
     Args:
-        robot: The :class:`~robokin.robot.Robot`.
+        robot: The arm (a :class:`~robokin.robot.Robot` or its ``Arm``).
         T_path: Poses (m, 4, 4) [m].
         q_start: Configuration (n,) the path starts from [rad, m].
         mask: Task rows, see :func:`parse_mask`.
@@ -774,7 +778,8 @@ def ik_path(
     Raises:
         InputError: bad poses (shape (m, 4, 4), rigid), ``q_start`` or options.
     """
-    chain = robot.chain
+    arm = arm_of(robot)
+    chain = arm.chain
     n = chain.n
     Tf, lead = _targets(T_path)
     if len(lead) != 1:

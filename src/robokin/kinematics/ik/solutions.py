@@ -19,17 +19,15 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from robokin._validation import check_broadcasts, check_finite, check_joints
 from robokin.exceptions import UnreachableError
+from robokin.kinematics.arm import ArmSource, arm_of
 from robokin.spatial import wrap_angle
-
-if TYPE_CHECKING:
-    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["SolutionSet", "wrap_angle"]
 
@@ -386,12 +384,18 @@ class SolutionSet:
             error=None if self.error is None else sel(rep(self.error)),
         )
 
-    def to_actuator_space(self, robot: RobotLike) -> SolutionSet:
-        """The same set in motor coordinates (limits checked in both spaces)."""
-        lim = robot.actuator_limits
-        if robot.actuators is None or lim is None:  # limits come with the map
+    def to_actuator_space(self, robot: ArmSource) -> SolutionSet:
+        """The same set in motor coordinates (limits checked in both spaces).
+
+        Args:
+            robot: The arm (a Robot or its :class:`~robokin.kinematics.arm.Arm`),
+                whose actuator map and motor limits apply.
+        """
+        arm = arm_of(robot)
+        lim, actuators = arm.actuator_limits, arm.actuators
+        if actuators is None or lim is None:  # limits come with the map
             return self
-        phi = robot.actuators.inverse(self.q, what=f"actuator map of '{robot.name}'")
+        phi = actuators.inverse(self.q, what=f"actuator map of '{arm.name}'")
         inside = self.flags["within_limits"] & (
             (phi >= lim[:, 0] - 1e-9) & (phi <= lim[:, 1] + 1e-9)
         ).all(axis=-1)

@@ -8,6 +8,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin._native import kernels as _K
+from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.solutions import SolutionSet
 
 __all__ = ["STATUS_TEXT", "fit_turns", "fk_error", "make_set", "q_near_rows"]
@@ -81,7 +82,7 @@ def fk_error(chain: Any, q: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.n
 
 
 def make_set(
-    robot: Any,
+    robot: Arm,
     q: np.ndarray,
     valid: np.ndarray,
     *,

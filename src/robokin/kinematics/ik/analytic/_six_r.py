@@ -14,6 +14,7 @@ from typing import Any, Literal
 import numpy as np
 
 from robokin._native import kernels as K
+from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.analytic._common import (
     STATUS_TEXT,
     branch_labels,
@@ -164,7 +165,7 @@ def make_single(chain: Any, params: np.ndarray, *, method: str,
 
 
 def solve_six_r(
-    robot: Any,
+    robot: Arm,
     T: np.ndarray,
     q_near: np.ndarray | None,
     *,

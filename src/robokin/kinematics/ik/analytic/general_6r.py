@@ -10,7 +10,7 @@ the solutions' ``theta_a`` as real roots (Manocha & Canny 1994). Every root is
 back-substituted, polished by Newton steps on the true chain and kept only when it
 reproduces the pose to ``1e-9`` (m and rad).
 
-This module does the per-arm set-up, once per chain (cached with the chain):
+This module does the per-arm set-up, once per chain (kept in its ``Arm``):
 
 * **fit**: the left side of each split is linear in 27 pose-independent monomials;
   their coefficients are fitted by least squares from rows the kernel computes
@@ -45,8 +45,8 @@ from typing import Any
 import numpy as np
 
 from robokin import _native
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.analytic._common import fk_error, make_set
-from robokin.kinematics.per_chain import cached
 from robokin.spatial import invert, wrap_angle
 
 __all__ = ["NAME", "General6R", "Variant", "make_single", "raw_solve", "setup", "solve",
@@ -132,9 +132,12 @@ def why_not(chain: Any) -> str:
     return ""
 
 
-def setup(chain: Any) -> General6R:
-    """The set-up of ``chain`` (fits and variant choice), computed once per chain."""
-    return cached(chain, ("general_6r", SETUP_POSES), lambda: _setup(chain))
+def setup(robot: ArmSource) -> General6R:
+    """The set-up of the arm's chain (fits and variant choice), kept in its Arm."""
+    arm = arm_of(robot)
+    if arm.general_6r is None:
+        arm.general_6r = _setup(arm.chain)
+    return arm.general_6r
 
 
 # ----------------------------------------------------------------- the fit
@@ -358,7 +361,7 @@ def _setup(chain: Any) -> General6R:
 # -------------------------------------------------------------- the solver
 
 
-def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
+def solve(robot: ArmSource, T: np.ndarray, q_near: np.ndarray | None = None, *,
           singular_tol: float = 1e-6, compute_error: bool = False,
           parallel: bool | None = None) -> Any:
     """Every solution of a general 6R arm for poses T (..., 4, 4).
@@ -393,10 +396,11 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
     )
     from robokin.exceptions import InputError
 
-    chain = robot.chain
-    g = setup(chain)
+    arm = arm_of(robot)
+    chain = arm.chain
+    g = setup(arm)
     if g.params is None:
-        raise InputError("robot", f"'{robot.name}' is not solved by {NAME}: {g.reason}")
+        raise InputError("robot", f"'{arm.name}' is not solved by {NAME}: {g.reason}")
     T = check_poses_fast(T, "T")
     lead = T.shape[:-2]
     if q_near is not None:
@@ -413,13 +417,13 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
         error = np.where(valid, np.hypot(dp, dr), np.inf)
     info = {"family": NAME, "variant": str(g.primary), "secondary": str(g.secondary),
             "secondary_runs": int(((diag & K.G6F_SECONDARY) != 0).sum())}
-    return make_set(robot, Q, valid, inside=inside.reshape(shape),
+    return make_set(arm, Q, valid, inside=inside.reshape(shape),
                     singular=(sigma < singular_tol).reshape(shape), branches={},
                     status_codes=_STATUS[status].reshape(lead), method=NAME, info=info,
                     error=error)
 
 
-def make_single(chain: Any) -> Any:
+def make_single(arm: Arm) -> Any:
     """The single-pose hot path: ``single(T, q6) -> SolutionSet | None``.
 
     For one pose ``T`` (4, 4) float64 with default options (``q6``, the closed forms' joint-6
@@ -430,7 +434,8 @@ def make_single(chain: Any) -> Any:
     from robokin.kinematics.ik.analytic._common import STATUS_TEXT
     from robokin.kinematics.ik.solutions import SolutionSet
 
-    g = setup(chain)
+    g = setup(arm)
+    chain = arm.chain
     packed, params = chain.arrays.packed, g.params
     if params is None:
         raise ValueError(f"general_6r is not offered for this chain: {g.reason}")

@@ -69,6 +69,7 @@ from typing import Any
 import numpy as np
 
 from robokin._native import kernels as K
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.analytic._common import STATUS_TEXT, fk_error
 from robokin.kinematics.ik.analytic._geometry import (
     Poe,
@@ -274,7 +275,7 @@ def _status(codes: np.ndarray) -> np.ndarray:
     return text
 
 
-def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None, *, params: np.ndarray,
+def solve(robot: Arm, T: np.ndarray, q_near: np.ndarray | None, *, params: np.ndarray,
           method: str, info: dict[str, Any], values: np.ndarray | None = None,
           compute_error: bool = False) -> SolutionSet:
     """Every solution for poses T (..., 4, 4), held values broadcast with them.
@@ -382,10 +383,10 @@ class FamilySolver:
     info: dict[str, Any]
     one: Any
 
-    def __call__(self, robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
+    def __call__(self, robot: ArmSource, T: np.ndarray, q_near: np.ndarray | None = None, *,
                  compute_error: bool = False) -> SolutionSet:
         """Every solution for poses T (..., 4, 4); see :func:`solve`."""
-        return solve(robot, T, q_near, params=self.params, method=self.method,
+        return solve(arm_of(robot), T, q_near, params=self.params, method=self.method,
                      info=self.info, compute_error=compute_error)
 
     def single(self, T: np.ndarray, q6: float) -> SolutionSet | None:

@@ -28,7 +28,7 @@ from robokin.kinematics.ik.analytic._geometry import (
 )
 
 if TYPE_CHECKING:
-    from robokin.kinematics.robot_like import RobotLike
+    from robokin.kinematics.arm import Arm
 
 __all__ = ["measure"]
 
@@ -110,7 +110,7 @@ def _align_angle(h, u, d):
                       np.einsum("...i,...i", d, u) - (u @ h) * (d @ h))
 
 
-def solve_geometry(robot: RobotLike, g: ScaraGeometry, T: np.ndarray, *,
+def solve_geometry(robot: Arm, g: ScaraGeometry, T: np.ndarray, *,
                    orientation_tol: float = 1e-9, compute_error: bool = False,
                    method: str = "analytic:scara", info: dict | None = None):
     """Every solution (up to 2) for poses T (..., 4, 4)."""
