@@ -159,7 +159,8 @@ class Workspace:
     @property
     def extent(self) -> np.ndarray:
         """Bounding-box edge lengths [m], shape (3,)."""
-        return self.bounds[1] - self.bounds[0]
+        extent: np.ndarray = self.bounds[1] - self.bounds[0]
+        return extent
 
     @property
     def volume(self) -> float:
@@ -232,7 +233,8 @@ def random_joints(
             "limits", f"expected finite limits of shape (n, 2), got {lim.shape}"
         )
     u = rng.random((int(count), lim.shape[0]))
-    return lim[:, 0] + u * (lim[:, 1] - lim[:, 0])
+    q: np.ndarray = lim[:, 0] + u * (lim[:, 1] - lim[:, 0])
+    return q
 
 
 def reach_ball(chain: Chain) -> tuple[np.ndarray, float]:

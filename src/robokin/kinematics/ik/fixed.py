@@ -31,6 +31,7 @@ from typing import Any, Protocol
 import numpy as np
 import numpy.typing as npt
 
+from robokin import _native
 from robokin._validation import (
     _real_array,
     check_broadcasts,
@@ -87,7 +88,7 @@ def solve_fixed(
         ((name, value),) = fixed.items()
         held = _held_solvers(robot).get(name)
         if held is not None and type(value) in _NUMBERS:
-            out = held.single(T, value, None)
+            out: SolutionSet | None = held.single(T, value, None)
             if out is not None:
                 return out
     names = list(robot.joint_names)
@@ -164,7 +165,7 @@ class HeldSolver:
               values: np.ndarray, *, compute_error: bool = False) -> SolutionSet:
         """Every solution for validated poses T (..., 4, 4) at held values (...)."""
         info = dict(self.info)
-        name = robot.joint_names[int(self.params[_pk.K.PIEPER_HELD])]
+        name = robot.joint_names[int(self.params[_native.kernels.PIEPER_HELD])]
         info["held"] = {name: values}
         return _pk.solve(robot, T, q_near, params=self.params, method=self.method,
                          info=info, values=values, compute_error=compute_error)
@@ -212,9 +213,13 @@ def _moved_targets(robot: Arm, end: str, T: np.ndarray, v: np.ndarray) -> np.nda
     if end == "last":
         j = robot.n - 1
         Cn = C[-1]
-        return T @ invert(Cn) @ joint_motion(robot.chain.joints[j].kind, -robot.chain.joints[j].sign * v) @ Cn
+        last: np.ndarray = (T @ invert(Cn) @ joint_motion(
+            robot.chain.joints[j].kind, -robot.chain.joints[j].sign * v) @ Cn)
+        return last
     C0 = C[0]
-    return C0 @ joint_motion(robot.chain.joints[0].kind, -robot.chain.joints[0].sign * v) @ invert(C0) @ T
+    first: np.ndarray = (C0 @ joint_motion(
+        robot.chain.joints[0].kind, -robot.chain.joints[0].sign * v) @ invert(C0) @ T)
+    return first
 
 
 #: Reduced arms kept per arm: a sweep of a middle joint builds one per value

@@ -217,7 +217,8 @@ def _build_seed_table(chain: Chain) -> SeedTable:
 
 def _grid_cells(p: np.ndarray, origin: np.ndarray, inv: np.ndarray, G: int) -> np.ndarray:
     c = np.clip(np.floor((p - origin) * inv).astype(np.int64), 0, G - 1)
-    return (c[:, 0] * G + c[:, 1]) * G + c[:, 2]
+    cells: np.ndarray = (c[:, 0] * G + c[:, 1]) * G + c[:, 2]
+    return cells
 
 
 # kernel arguments for "no seed table" (a 0-row table)
@@ -332,7 +333,8 @@ def _opts(mask: Any, weights: Any, tol: Any, tol_rotation: Any, max_iterations: 
         except TypeError:
             key = hit = None
         if hit is not None:
-            return hit.copy()
+            again: np.ndarray = hit.copy()
+            return again
     opts = _make_opts(mask, weights, tol, tol_rotation, max_iterations, max_step)
     if key is not None and len(_OPTS_CACHE) < 256:
         _OPTS_CACHE[key] = opts.copy()

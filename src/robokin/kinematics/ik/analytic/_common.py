@@ -10,6 +10,7 @@ import numpy.typing as npt
 from robokin._native import kernels as _K
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.solutions import SolutionSet
+from robokin.model.chain import Chain
 
 __all__ = ["STATUS_TEXT", "fit_turns", "fk_error", "make_set", "q_near_rows"]
 
@@ -58,7 +59,7 @@ def q_near_rows(q_near: Any, lead: tuple[int, ...], n: int) -> np.ndarray:
     return np.ascontiguousarray(np.broadcast_to(qn, lead + (n,)).reshape(-1, n))
 
 
-def fk_error(chain: Any, q: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def fk_error(chain: Chain, q: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Position [m] and rotation [rad] error of FK(q) against T.
 
     Args:
@@ -120,4 +121,4 @@ def branch_labels(lead: tuple[int, ...], table: dict[str, list[int]]) -> dict[st
     return dict(out)
 
 
-_LABEL_CACHE: dict = {}
+_LABEL_CACHE: dict[Any, dict[str, np.ndarray]] = {}

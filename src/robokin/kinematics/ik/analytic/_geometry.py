@@ -91,5 +91,6 @@ def closest_point(origins: np.ndarray, axes: np.ndarray) -> np.ndarray:
 def unit_perpendicular(h: np.ndarray) -> np.ndarray:
     """A unit vector perpendicular to ``h``."""
     e = np.eye(3)[int(np.argmin(np.abs(h)))]
-    v = e - np.dot(e, h) * h
-    return v / np.linalg.norm(v)
+    v: np.ndarray = e - np.dot(e, h) * h
+    unit: np.ndarray = v / np.linalg.norm(v)
+    return unit

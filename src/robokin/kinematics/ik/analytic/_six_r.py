@@ -29,6 +29,7 @@ from robokin.kinematics.ik.analytic._geometry import (
     unit_perpendicular,
 )
 from robokin.kinematics.ik.solutions import SolutionSet
+from robokin.model.chain import Chain
 
 __all__ = ["make_single", "pack", "raw_solve", "solve_six_r"]
 
@@ -44,7 +45,7 @@ _LABELS = {
 _PARALLEL_MIN = K.SIX_R_PARALLEL_MIN
 
 
-def pack(chain: Any, kind: Kind, *, singular_tol: float = 1e-9,
+def pack(chain: Chain, kind: Kind, *, singular_tol: float = 1e-9,
          disc_tol: float = 1e-12, mirror: bool = False,
          poe: Poe | None = None) -> np.ndarray:
     """The kernel parameter vector of a 6R chain (layout in ``csrc/six_r.c``)."""
@@ -128,7 +129,7 @@ _NO_Q_NEAR = np.zeros((1, 6))
 _NO_Q_NEAR.setflags(write=False)
 
 
-def make_single(chain: Any, params: np.ndarray, *, method: str,
+def make_single(chain: Chain, params: np.ndarray, *, method: str,
                 info: dict[str, Any]) -> Any:
     """The single-pose hot path of an exact (not near-family) 6R arm.
 

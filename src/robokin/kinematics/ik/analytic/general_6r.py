@@ -40,14 +40,18 @@ References:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robokin import _native
 from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.analytic._common import fk_error, make_set
+from robokin.model.chain import Chain
 from robokin.spatial import invert, wrap_angle
+
+if TYPE_CHECKING:
+    from robokin.kinematics.ik.solutions import SolutionSet
 
 __all__ = ["NAME", "General6R", "Variant", "make_single", "raw_solve", "setup", "solve",
            "why_not"]
@@ -119,7 +123,7 @@ class General6R:
     tail: float = float("nan")
 
 
-def why_not(chain: Any) -> str:
+def why_not(chain: Chain) -> str:
     """Why the general 6R solver does not take ``chain`` ("" when it does)."""
     if chain.n_chain != 6 or chain.n != 6:
         return (f"{chain.n} joint coordinates on {chain.n_chain} chain joints: the general "
@@ -143,7 +147,7 @@ def setup(robot: ArmSource) -> General6R:
 # ----------------------------------------------------------------- the fit
 
 
-def _direction_consts(chain: Any, reverse: bool) -> np.ndarray:
+def _direction_consts(chain: Chain, reverse: bool) -> np.ndarray:
     """C'_0 .. C'_6 of the chain (or of its reversal, C'_k = C_{6-k}^-1), (7, 4, 4)."""
     C = np.array(chain.arrays.consts, dtype=np.float64)
     return np.ascontiguousarray(invert(C[::-1]) if reverse else C)
@@ -197,7 +201,7 @@ def _params(blocks: list[np.ndarray]) -> np.ndarray:
 # -------------------------------------------------------------- the kernel
 
 
-def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
+def raw_solve(chain: Chain, params: np.ndarray, T: np.ndarray,
               parallel: bool | None = None) -> tuple[np.ndarray, ...]:
     """The bare kernel call.
 
@@ -228,13 +232,15 @@ def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
 def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(len(a), len(b)) bool: configurations equal modulo 2 pi within DEDUPE_TOL."""
     d = wrap_angle(a[:, None, :] - b[None, :, :])
-    return np.abs(d).max(axis=-1) < 10 * DEDUPE_TOL
+    close: np.ndarray = np.abs(d).max(axis=-1) < 10 * DEDUPE_TOL
+    return close
 
 
 def _distinct(q: np.ndarray) -> np.ndarray:
     """The rows of q (k, 6) without repeats (modulo 2 pi), in order."""
     same = _close(q, q) & np.tri(len(q), k=-1, dtype=bool)
-    return q[~same.any(axis=1)]
+    rows: np.ndarray = q[~same.any(axis=1)]
+    return rows
 
 
 @dataclass(frozen=True, eq=False)
@@ -271,7 +277,7 @@ class _Trial:
         return 8 * int(self.trouble.sum()) + self.pairs
 
 
-def _fits(chain: Any, rng: np.random.Generator) -> dict[Variant, np.ndarray] | str:
+def _fits(chain: Chain, rng: np.random.Generator) -> dict[Variant, np.ndarray] | str:
     """Every variant's kernel block, or why the fit failed."""
     blocks = {}
     for rev in (False, True):
@@ -286,7 +292,7 @@ def _fits(chain: Any, rng: np.random.Generator) -> dict[Variant, np.ndarray] | s
     return blocks
 
 
-def _trials(chain: Any, blocks: dict[Variant, np.ndarray], q: np.ndarray
+def _trials(chain: Chain, blocks: dict[Variant, np.ndarray], q: np.ndarray
             ) -> tuple[dict[Variant, _Trial], int]:
     """Each variant alone on the poses of q, against the reference.
 
@@ -335,7 +341,7 @@ def _choose(trials: dict[Variant, _Trial], poses: int) -> tuple[Variant, Variant
     return None if best is None else (best[1], best[2])
 
 
-def _setup(chain: Any) -> General6R:
+def _setup(chain: Chain) -> General6R:
     reason = why_not(chain)
     if reason:
         return General6R(None, reason=reason)
@@ -363,7 +369,7 @@ def _setup(chain: Any) -> General6R:
 
 def solve(robot: ArmSource, T: np.ndarray, q_near: np.ndarray | None = None, *,
           singular_tol: float = 1e-6, compute_error: bool = False,
-          parallel: bool | None = None) -> Any:
+          parallel: bool | None = None) -> SolutionSet:
     """Every solution of a general 6R arm for poses T (..., 4, 4).
 
     Args:

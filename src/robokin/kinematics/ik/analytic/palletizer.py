@@ -40,6 +40,7 @@ from robokin.kinematics.ik.analytic._geometry import (
 from robokin.kinematics.ik.analytic.scara import _align_angle, _elbow_angles, _rot
 
 if TYPE_CHECKING:
+    from robokin.kinematics.ik.solutions import SolutionSet
     from robokin.model.chain import Chain
 
 __all__ = ["measure", "pose_from_position_yaw"]
@@ -111,7 +112,8 @@ def geometry(chain: Chain, poe: Poe) -> PalletizerGeometry:
 
 def level_rotation(g: PalletizerGeometry) -> np.ndarray:
     """The tool rotation (3, 3) at yaw 0."""
-    return g.Rc @ g.M[:3, :3]
+    R: np.ndarray = g.Rc @ g.M[:3, :3]
+    return R
 
 
 def pose_from_position_yaw(robot: ArmSource, xyz: Any, yaw: Any) -> np.ndarray:
@@ -138,7 +140,8 @@ def pose_from_position_yaw(robot: ArmSource, xyz: Any, yaw: Any) -> np.ndarray:
 
 def solve_geometry(robot: Arm, g: PalletizerGeometry, T: np.ndarray, *,
                    level_tol: float = 1e-9, compute_error: bool = False,
-                   method: str = "analytic:palletizer", info: dict | None = None):
+                   method: str = "analytic:palletizer",
+                   info: dict[str, Any] | None = None) -> SolutionSet:
     """Every solution (up to 4) for poses T (..., 4, 4)."""
     chain = robot.chain
     T = np.asarray(T, dtype=np.float64)

@@ -78,6 +78,7 @@ from robokin.kinematics.ik.analytic._geometry import (
     poe_from_chain,
 )
 from robokin.kinematics.ik.solutions import SolutionSet
+from robokin.model.chain import Chain
 
 __all__ = ["NAME", "FamilySolver", "Setup", "family_solver", "make_single", "measure", "raw_solve", "setup",
            "solve"]
@@ -169,7 +170,7 @@ def measure(poe: Poe, held: int | None = None) -> tuple[float, str, str]:
     return found[0][0] / max(1.0, scale), "; ".join(texts), ""
 
 
-def setup(chain: Any, held: int | None = None, *, tol: float = 1e-9,
+def setup(chain: Chain, held: int | None = None, *, tol: float = 1e-9,
           singular_tol: float = 1e-9) -> Setup:
     """The kernel parameters of ``chain`` (a 6R chain, or 7R with joint ``held`` held).
 
@@ -324,7 +325,7 @@ def solve(robot: Arm, T: np.ndarray, q_near: np.ndarray | None, *, params: np.nd
         branches, _status(status).reshape(lead), method, error, dict(info))
 
 
-def make_single(chain: Any, params: np.ndarray, *, method: str,
+def make_single(chain: Chain, params: np.ndarray, *, method: str,
                 info: dict[str, Any], held: str | None = None) -> Any:
     """The single-pose hot path: ``single(T, x, qn) -> SolutionSet | None``.
 
@@ -398,7 +399,7 @@ class FamilySolver:
         return self.one(T, 0.0, None) if q6 == 0.0 else None
 
 
-def family_solver(chain: Any, setup: Setup) -> FamilySolver:
+def family_solver(chain: Chain, setup: Setup) -> FamilySolver:
     """The :class:`FamilySolver` of a chain set up by :func:`setup`."""
     params = setup.params
     if params is None:
