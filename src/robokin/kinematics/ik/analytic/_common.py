@@ -11,6 +11,7 @@ from robokin._native import kernels as _K
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.model.chain import Chain
+from robokin.spatial import wrap_angle
 
 __all__ = ["STATUS_TEXT", "fit_turns", "fk_error", "make_set", "q_near_rows"]
 
@@ -34,7 +35,7 @@ def fit_turns(q: np.ndarray, is_revolute: np.ndarray, limits: np.ndarray) -> np.
     Prismatic values are left alone; a value no turn brings inside stays wrapped.
     """
     tw = 2.0 * np.pi
-    w = (q + np.pi) % tw - np.pi
+    w = wrap_angle(q)
     lo, hi = limits[:, 0], limits[:, 1]
     with np.errstate(invalid="ignore"):
         up = w + tw * np.ceil((lo - 1e-9 - w) / tw)
