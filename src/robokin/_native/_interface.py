@@ -78,6 +78,7 @@ class Kernels(Protocol):
     AXES: int
     POINTS: int
     WRIST: int
+    PERP2: int
     TOOL_T: int
     TOOL_R: int
     PERP: int
@@ -105,6 +106,13 @@ class Kernels(Protocol):
     AA: int
     BB: int
     FAMILY: int
+    E5: int
+    PLANE: int
+    SPLIT_TOL: int
+    TOL_P: int
+    TOL_R: int
+    CHECK: int
+    SIZE: int
     N_PARAMS: int
     # family codes (params[FAMILY]) and per-pose status codes
     THREE_PARALLEL: int
@@ -209,6 +217,15 @@ class Kernels(Protocol):
         target or q0 (-1 if none).
         """
 
+    def seed_uniforms(
+        self, targets: F64, q0: F64, key: int, base: int, out: F64, /
+    ) -> None:
+        """Restart numbers of targets (N, 4, 4) from q0 (N, n) into out (N, R, n).
+
+        Uniform in [0, 1), a stream per target keyed by its pose, its q0 and
+        ``key``; row r of out is the stream's number ``base + r``.
+        """
+
     def lm_path(
         self, packed: F64, targets: F64, q_start: F64, opts: F64, out: F64, /
     ) -> int:
@@ -250,14 +267,14 @@ class Kernels(Protocol):
 
     # ------------------------------------------------------------------ 6R IK
     def six_r_ik1(
-        self, T: object, params: F64, q6: float, /
+        self, T: object, params: F64, q6: float, packed: F64, /
     ) -> (
         tuple[int, F64, Bools, Bools, Bools] | tuple[int, None, None, None, None]
     ):
         """``(code, Q (8, 6), valid, singular, within_limits (8,))`` of one pose."""
 
     def six_r_ik(
-        self, params: F64, T: F64, qn: F64, /
+        self, params: F64, T: F64, qn: F64, packed: F64, /
     ) -> tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]:
         """``(Q (N, 8, 6), valid, singular, within_limits (N, 8), status (N,))``."""
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from collections import OrderedDict
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Protocol, TypeAlias
+from typing import Protocol, TypeAlias
 
 import numpy as np
 import numpy.typing as npt
@@ -31,12 +31,6 @@ import numpy.typing as npt
 from robokin.exceptions import InputError
 from robokin.model.chain import Chain
 from robokin.model.coupling import AffineMap
-
-if TYPE_CHECKING:
-    from robokin.kinematics.ik.analytic.detect import Family
-    from robokin.kinematics.ik.analytic.general_6r import General6R
-    from robokin.kinematics.ik.fixed import HeldSolver
-    from robokin.kinematics.ik.numeric import SeedTable
 
 __all__ = ["Arm", "ArmSource", "FamilyKey", "HasArm", "ReducedKey", "arm_of"]
 
@@ -55,27 +49,34 @@ class Arm:
         name: The arm's name (in messages).
         actuators: ``q = A phi + b`` from motor to joint coordinates, or None.
         actuator_limits: Motor limits (m, 2), SI units, or None.
-        family: The closed-form family at ``detect``'s default settings, or None
-            until detected (the single-pose IK path reads it on every call).
-        families: The families detected at other settings.
-        general_6r: The general-6R set-up (fits and elimination variants), or None
-            until first needed.
-        seed_table: The numeric solver's restart seeds, or None until first needed.
-        held_solvers: Joint name -> the closed form with that joint held (7R arms),
+        family: The closed-form family at ``detect``'s default settings (a
+            ``detect.Family``), or None until detected (the single-pose IK path
+            reads it on every call).
+        families: The families (``detect.Family``) detected at other settings.
+        general_6r: The general-6R set-up (a ``general_6r.General6R``: fits and
+            elimination variants), or None until first needed.
+        seed_table: The numeric solver's restart seeds (a ``numeric.SeedTable``),
             or None until first needed.
+        held_solvers: Joint name -> the closed form with that joint held (a
+            ``fixed.HeldSolver``; 7R arms), or None until first needed.
         reduced: The arms of the remaining coordinates of the last held-joint
             reductions (most recently used last; ``fixed`` bounds it).
+
+    The derived fields are typed ``object`` here and narrowed by the module that
+    fills them (``isinstance`` on its own record type): this module imports
+    nothing else of ``kinematics``, so no import (type-only ones included) runs
+    from the Arm back to its users (``tests/test_layers.py``: the ``arm`` layer).
     """
 
     chain: Chain
     name: str = "robot"
     actuators: AffineMap | None = None
     actuator_limits: npt.NDArray[np.float64] | None = None
-    family: Family | None = None
-    families: dict[FamilyKey, Family] = field(default_factory=dict)
-    general_6r: General6R | None = None
-    seed_table: SeedTable | None = None
-    held_solvers: dict[str, HeldSolver] | None = None
+    family: object | None = None
+    families: dict[FamilyKey, object] = field(default_factory=dict)
+    general_6r: object | None = None
+    seed_table: object | None = None
+    held_solvers: dict[str, object] | None = None
     reduced: OrderedDict[ReducedKey, Arm] = field(default_factory=OrderedDict)
 
     @property

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -176,11 +176,11 @@ def _held_solvers(robot: Arm) -> dict[str, HeldSolver]:
 
     Set up once per arm, kept in it (microseconds per joint: no reduced chain is built).
     """
-    if robot.held_solvers is not None:
-        return robot.held_solvers
+    if robot.held_solvers is not None:  # only this function fills it
+        return cast(dict[str, HeldSolver], robot.held_solvers)
     chain = robot.chain
     out: dict[str, HeldSolver] = {}
-    robot.held_solvers = out
+    robot.held_solvers = cast(dict[str, object], out)
     if chain.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
         return out
     for j, name in enumerate(robot.joint_names):

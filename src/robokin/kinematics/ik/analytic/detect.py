@@ -46,6 +46,7 @@ from robokin.kinematics.ik.analytic import scara as _scara
 from robokin.kinematics.ik.analytic import spherical_wrist as _sw
 from robokin.kinematics.ik.analytic import three_parallel as _tp
 from robokin.kinematics.ik.analytic._geometry import Poe, poe_from_chain
+from robokin.kinematics.ik.analytic._six_r import SINGULAR_TOL
 from robokin.model.chain import Chain
 
 if TYPE_CHECKING:
@@ -128,7 +129,8 @@ class SixRSolver:
         deviation: The measured deviation from the family [rad or m].
         method: The sets' ``method`` text.
         info: The sets' ``info``.
-        params: The packed parameters at the default ``singular_tol`` (1e-9).
+        params: The packed parameters at the default ``singular_tol``
+            (``_six_r.SINGULAR_TOL``).
         tuned: Parameters packed for other ``singular_tol`` values.
     """
 
@@ -143,20 +145,20 @@ class SixRSolver:
 
     def __call__(self, robot: ArmSource, T: npt.NDArray[np.float64],
                  q_near: npt.NDArray[np.float64] | None = None, *,
-                 singular_tol: float = 1e-9, compute_error: bool = False,
+                 singular_tol: float = SINGULAR_TOL, compute_error: bool = False,
                  polish_iterations: int = 8, tol: float = 1e-9) -> SolutionSet:
         """Every solution for poses T (..., 4, 4); see ``_six_r.solve_six_r``."""
         from robokin.kinematics.ik.analytic._six_r import solve_six_r
 
         arm = arm_of(robot)
-        P = self.params if singular_tol == 1e-9 else self.tuned.get(singular_tol)
+        P = self.params if singular_tol == SINGULAR_TOL else self.tuned.get(singular_tol)
         if P is None:
             P = self.tuned[singular_tol] = self.pack(arm.chain, singular_tol)
         return solve_six_r(arm, T, q_near, params=P, method=self.method, info=self.info,
                            near=self.near, compute_error=compute_error,
                            polish_iterations=polish_iterations, tol=tol)
 
-    def pack(self, chain: Chain, singular_tol: float = 1e-9) -> npt.NDArray[np.float64]:
+    def pack(self, chain: Chain, singular_tol: float = SINGULAR_TOL) -> npt.NDArray[np.float64]:
         """The kernel parameters of ``chain`` (this family's) at ``singular_tol``."""
         from robokin.kinematics.ik.analytic._six_r import pack
 
@@ -237,12 +239,18 @@ def detect(robot: ArmSource, *, tol: float = EXACT_TOL, near_angle: float = NEAR
     arm = arm_of(robot)
     key: FamilyKey = (tol, near_angle, near_distance, general_6r)
     if key == _DEFAULT_KEY:
-        if arm.family is None:
-            arm.family = _detect(arm, *key)
-        return arm.family
+        return default_family(arm)
     fam = arm.families.get(key)
-    if fam is None:
+    if not isinstance(fam, Family):
         fam = arm.families[key] = _detect(arm, *key)
+    return fam
+
+
+def default_family(arm: Arm) -> Family:
+    """The arm's family at the default settings (detected on first use, kept)."""
+    fam = arm.family
+    if not isinstance(fam, Family):
+        fam = arm.family = _detect(arm, *_DEFAULT_KEY)
     return fam
 
 

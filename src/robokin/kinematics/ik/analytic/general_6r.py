@@ -139,9 +139,10 @@ def why_not(chain: Chain) -> str:
 def setup(robot: ArmSource) -> General6R:
     """The set-up of the arm's chain (fits and variant choice), kept in its Arm."""
     arm = arm_of(robot)
-    if arm.general_6r is None:
-        arm.general_6r = _setup(arm.chain)
-    return arm.general_6r
+    g = arm.general_6r
+    if not isinstance(g, General6R):
+        g = arm.general_6r = _setup(arm.chain)
+    return g
 
 
 # ----------------------------------------------------------------- the fit
