@@ -129,6 +129,8 @@ class Kernels(Protocol):
     # general6r_solve: solutions per pose, parameter-vector layout (GP_*: header
     # fields; VB_*: one variant block of VB_SIZE values), status and flag codes
     G6_MAXSOL: int
+    G6_MAXCAND: int
+    G6_MAXVAR: int
     GP_NVAR: int
     GP_TAIL_TOL: int
     GP_NULL_TOL: int
@@ -137,6 +139,9 @@ class Kernels(Protocol):
     GP_DEDUPE: int
     GP_MAX_ITER: int
     GP_PAIR_GAP: int
+    GP_SCALE: int
+    GP_FALLBACK: int
+    GP_NEAR_TAIL: int
     GP_HEAD: int
     VB_DIR: int
     VB_A: int
@@ -150,10 +155,16 @@ class Kernels(Protocol):
     G6_DEGENERATE: int
     G6_BAD_POSE: int
     G6F_DEGENERATE: int
-    G6F_AMBIGUOUS: int
+    G6F_CLUSTER: int
     G6F_SECONDARY: int
     G6F_SEC_DEGENERATE: int
-    G6F_SEC_AMBIGUOUS: int
+    G6F_SEC_CLUSTER: int
+    G6F_PROJECTED: int
+    G6F_PROJ_DEGENERATE: int
+    G6F_RESCUED: int
+    G6F_NOISY: int
+    G6F_SEC_NOISY: int
+    G6F_EIGEN: int
     G6_DIAG_CAND_SHIFT: int
     # ---------------------------------------------------------- pieper.c constants
     # Pieper parameter vector layout (PIEPER_N_PARAMS entries, pieper.setup), the
@@ -316,6 +327,9 @@ class Kernels(Protocol):
         self, consts: F64, a: int, angles: F64, X: F64, Y: F64, /
     ) -> None:
         """The left side's fitting rows at angles (M, 3): X (M, 27), Y (M, 14)."""
+
+    def general6r_candidates(self, params: F64, T: F64, out: F64, /) -> tuple[int, int]:
+        """One pose's candidates before the polish (chain values) into out; (n, flags)."""
 
     def general6r_roots(self, c: F64, wr: F64, wi: F64, /) -> bool:
         """Roots of the polynomial with coefficients c (low order first), into wr, wi."""
