@@ -21,6 +21,7 @@
 #include "general6r.c"
 #include "manipulability.c"
 #include "pieper.c"
+#include "process.c"
 
 /* ---------------------------------------------------------------- arguments */
 
@@ -605,6 +606,7 @@ static PyMethodDef methods[] = {
     GENERAL6R_METHODS
     MANIPULABILITY_METHODS
     PIEPER_METHODS
+    PROCESS_METHODS
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, MODULE_NAME,
@@ -637,7 +639,8 @@ PyMODINIT_FUNC MODULE_INIT(void)
     PyModule_AddObject(m, "LAYOUT_TAG", PyFloat_FromDouble(PACKED_TAG));
     PyModule_AddObject(m, "MAX_TRANSLATION", PyFloat_FromDouble(MAX_TRANSLATION));
     if (six_r_constants(m) < 0 || broadphase_constants(m) < 0 ||
-        general6r_constants(m) < 0 || pieper_constants(m) < 0) {
+        general6r_constants(m) < 0 || pieper_constants(m) < 0 ||
+        process_constants(m) < 0) {
         Py_DECREF(m);
         return NULL;
     }
