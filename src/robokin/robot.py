@@ -21,6 +21,8 @@ from robokin.kinematics import forward
 from robokin.kinematics import jacobian as _jac
 from robokin.kinematics.ik.dispatch import solve as _ik_solve
 from robokin.kinematics.ik.nearest import solve_near as _solve_near
+from robokin.kinematics.ik.self_motion import SelfMotion
+from robokin.kinematics.ik.self_motion import self_motion as _self_motion
 from robokin.model.chain import Chain
 from robokin.model.coupling import AffineMap
 from robokin.model.rate_limits import RateLimits
@@ -445,6 +447,23 @@ class Robot:
             ``.success`` (...), ``.reason``.
         """
         return _solve_near(self, T, q_near, method=method, **options)
+
+    def self_motion(self, T: npt.ArrayLike, parameter: str = "auto") -> SelfMotion:
+        """The self-motion manifold of one pose of a 7R arm: every branch, exact limits.
+
+        Args:
+            T: The tool pose (4, 4) [m] in the world frame.
+            parameter: ``"auto"`` (the swivel on SRS arms, else the last joint with
+                a held-joint closed form: q7 on the Panda / FR3), ``"swivel"`` or a
+                joint name.
+
+        Returns:
+            A :class:`~robokin.kinematics.ik.self_motion.SelfMotion`: ``.sample(t)``
+            (..., k, n), ``.intervals`` (m, 2) inside every limit with
+            ``.interval_branch``, ``.crossings``, ``.singular``, ``.best(criterion)``,
+            ``.nearest(q)``.
+        """
+        return _self_motion(self, T, parameter)
 
     # ---------------------------------------------------------------- actuators
     def actuators_from_joints(self, q: npt.ArrayLike) -> np.ndarray:

@@ -1,0 +1,607 @@
+r"""The self-motion manifold of a 7R arm at one pose: every branch, exact limits.
+
+A seven-joint arm reaches a pose in a one-parameter family of configurations.
+:func:`self_motion` (``Robot.self_motion``) describes that family for one pose as
+branches :math:`q_b(t)` over a parameter t:
+
+* ``"swivel"`` on SRS arms (axes 1-3 and 5-7 meet, the KUKA iiwa type): the arm
+  angle about the shoulder-wrist line, closed form (``swivel.py``), 8 branches;
+* a joint name: that joint held at t, the rest solved by the held-joint closed
+  form (``pieper``: the Panda / FR3 with joint 4-7, an SRS arm with joint 1-3 or
+  5-7), 8 branches whose slots stay the same branch for every t;
+* ``"auto"``: the swivel on SRS arms, else the last joint with a held-joint closed
+  form (q7 on the Panda / FR3: He and Liu's closed form).
+
+**Limits exactly.** A branch leaves a joint's range where that joint equals a
+limit: those points are the solutions of a finitely-solvable problem (the swivel's
+subproblem 4 per joint and limit on SRS arms; the pose solved with that joint held
+at its limit otherwise), each one mapped to its parameter value and branch. The
+intervals of t inside every limit lie between those points (and the branch ends),
+each decided at its midpoint. A grid of the parameter (``grid`` values) checks the
+result: a change of state on the grid that no exact point explains (a crossing the
+held-joint solver missed) is found by bisection to the last bit and counted in
+``info["bisected"]``.
+
+**Branch ends and singular points.** A branch of a joint parameter ends where the
+held-joint 6R chain is singular (the manifold folds over the parameter: two slots
+meet); those ends are found by bisection on the branch's existence (to the last
+bit) and flagged ``"fold"``. Points where two axes of a meeting triple line up
+(the Panda's q2 = 0, the iiwa's q2, q6 = 0) are found exactly like limits and
+flagged ``"aligned axes"``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+
+from robokin._validation import check_finite, check_joints, check_poses_fast
+from robokin.exceptions import InputError
+from robokin.kinematics.ik.swivel import SwivelArm, swivel_arm
+from robokin.kinematics.per_chain import cached
+
+if TYPE_CHECKING:
+    from robokin.kinematics.robot_like import RobotLike
+
+__all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SingularPoint", "self_motion"]
+
+#: Parameter values on the checking grid.
+GRID = 721
+#: Bisection steps (a 2 pi domain to 2**-52 of its width).
+_BISECT = 56
+#: Rows of a slot at the same point are the same configuration within this [rad].
+_SAME = 1e-6
+_TWO_PI = 2 * np.pi
+#: Zoom rounds of SelfMotion.best (each narrows to 2 / (samples - 1) of the span).
+_ZOOMS = 6
+
+
+@dataclass(frozen=True)
+class LimitCrossing:
+    """A branch meeting a joint limit: ``joint`` (0-based) at ``limit`` ("lower"/"upper")."""
+
+    t: float
+    branch: int
+    joint: int
+    limit: str
+
+
+@dataclass(frozen=True)
+class SingularPoint:
+    """A singular point of a branch: ``kind`` "fold" or "aligned axes"."""
+
+    t: float
+    branch: int
+    kind: str
+
+
+@dataclass(frozen=True)
+class ManifoldPoint:
+    """One configuration on the manifold: ``q`` (n,), at ``t`` on ``branch``, ``score``."""
+
+    q: np.ndarray
+    t: float
+    branch: int
+    score: float
+
+
+# ------------------------------------------------------------------ the families
+class _Family:
+    """Branches of one pose: ``rows(t)`` and the exact points where a joint is at a value."""
+
+    k = 8
+    periodic = False
+    domain: tuple[float, float]
+    name: str
+    joint: int | None
+
+    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Q (m, k, n) (NaN where a branch has no point), valid (m, k), singular (m, k)."""
+        raise NotImplementedError
+
+    def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
+        """Parameter values where joint j may equal ``value`` (with the configuration)."""
+        raise NotImplementedError
+
+    def points(self, queries: list[tuple[int, float]]) -> list[list[tuple[float, int]]]:
+        """Per query (joint j, value): every (t, branch) where joint j equals value.
+
+        The candidates of every query are evaluated in one batch; a branch takes a
+        candidate when its joint j is at the value there (and its configuration is
+        the candidate's, when the candidate has one).
+        """
+        cands = [self.candidates(j, v) for j, v in queries]
+        ts = np.array([t for c in cands for t, _ in c], dtype=np.float64)
+        out: list[list[tuple[float, int]]] = [[] for _ in queries]
+        if not ts.size:
+            return out
+        q, valid, _ = self.rows(ts)
+        i = 0
+        for (j, value), cand, res in zip(queries, cands, out, strict=True):
+            for t, row in cand:
+                ok = valid[i].copy()
+                d = np.full(len(ok), np.inf)
+                d[ok] = (np.abs(_wrap(q[i, ok, j] - value)) if row is None
+                         else np.abs(_wrap(q[i, ok] - row)).max(-1))
+                # a shoulder joint is shared by both wrist roots (and vice versa)
+                res += [(t, int(b)) for b in np.flatnonzero(d < _SAME)]
+                i += 1
+        return out
+
+
+class _SwivelFamily(_Family):
+    periodic = True
+    domain = (-np.pi, np.pi)
+    name = "swivel"
+    joint = None
+
+    def __init__(self, arm: SwivelArm, T: np.ndarray, robot: RobotLike) -> None:
+        self.arm = arm
+        self.fr = arm.frame(T)
+        self.T = T
+        self.robot = robot
+
+    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        q, real, sing = self.arm.configurations(self.fr, t)
+        return _polish(self.robot, q, real, self.T), real, sing
+
+    def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
+        if j == 3:
+            return []  # the elbow does not move with the swivel
+        return [(psi, None) for psi, _ in self.arm.limit_swivels(self.fr, j, value)]
+
+
+class _HeldFamily(_Family):
+    def __init__(self, robot: RobotLike, params: np.ndarray, j: int, T: np.ndarray) -> None:
+        self.robot = robot
+        self.params = params
+        self.joint = j
+        self.name = robot.joint_names[j]
+        lo, hi = (float(x) for x in robot.limits[j])
+        self.domain = (lo, hi)
+        self.T = T
+
+    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        from robokin.kinematics.ik.analytic import pieper as pk
+
+        t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
+        Tb = np.ascontiguousarray(np.broadcast_to(self.T, (len(t), 4, 4)))
+        Q, valid, sing, _, _ = pk.raw_solve(self.params, Tb, t)
+        Q = Q.copy()
+        Q[~valid] = np.nan
+        return _into_limits(self.robot, Q), valid, sing
+
+    def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
+        sols = self.robot.ik(self.T, fixed={self.robot.joint_names[j]: value})
+        if "swivel" in str(sols.info.get("measured", "")) and j == 3:
+            return []  # the SRS elbow held: a family, constant on the manifold
+        out: list[tuple[float, np.ndarray | None]] = []
+        for row in sols.q[sols.valid]:
+            t = _shift_into(float(row[self.joint]), self.domain)
+            if t is not None:
+                out.append((t, row))
+        return out
+
+
+def _wrap(a: np.ndarray) -> np.ndarray:
+    return np.remainder(np.asarray(a) + np.pi, _TWO_PI) - np.pi
+
+
+def _shift_into(t: float, domain: tuple[float, float]) -> float | None:
+    """T shifted by whole turns into the closed domain, or None."""
+    lo, hi = domain
+    for s in (0.0, _TWO_PI, -_TWO_PI):
+        if lo - 1e-12 <= t + s <= hi + 1e-12:
+            return min(max(t + s, lo), hi)
+    return None
+
+
+def _into_limits(robot: RobotLike, q: np.ndarray) -> np.ndarray:
+    """Revolute angles shifted by 2 pi into the limits where that fits."""
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    rev = np.asarray(robot.is_revolute, bool)
+    up = rev & (q < lo) & (q + _TWO_PI <= hi)
+    down = rev & (q > hi) & (q - _TWO_PI >= lo)
+    return q + _TWO_PI * up - _TWO_PI * down
+
+
+def _polish(robot: RobotLike, q: np.ndarray, real: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """Rows whose pose error exceeds 1e-13 get minimum-norm Gauss-Newton steps."""
+    from robokin.kinematics.forward import forward_kinematics
+    from robokin.kinematics.jacobian import jacobian_and_pose
+    from robokin.spatial import pose_error
+
+    rows = np.flatnonzero(real.reshape(-1))
+    if not rows.size:
+        return q
+    flat = q.reshape(-1, q.shape[-1])
+    e = pose_error(forward_kinematics(robot.chain, flat[rows]), T)
+    for _ in range(3):
+        bad = np.abs(e).max(-1) > 1e-13
+        if not bad.any():
+            break
+        rows, e = rows[bad], e[bad]
+        J, _ = jacobian_and_pose(robot.chain, flat[rows])
+        flat[rows] = flat[rows] + np.einsum("mij,mj->mi", np.linalg.pinv(J), e)
+        e = pose_error(forward_kinematics(robot.chain, flat[rows]), T)
+    return flat.reshape(q.shape)
+
+
+# ------------------------------------------------------------------ the result
+@dataclass(frozen=True, eq=False)
+class SelfMotion:
+    """The self-motion manifold of one pose of a 7R arm (:func:`self_motion`).
+
+    Attributes:
+        T: The pose (4, 4).
+        parameter: ``"swivel"`` or the joint name held as the parameter t.
+        joint: The parameter's joint index, or None for the swivel.
+        domain: (2,) the parameter's range [rad] (the joint's limits, or -pi..pi).
+        periodic: True when t wraps (the swivel).
+        n_branches: k, the number of branch slots.
+        intervals: (m, 2) parameter intervals [rad] where a branch is inside every
+            joint limit, sorted by branch then start.
+        interval_branch: (m,) the branch of each interval.
+        crossings: Every point where a branch meets a joint limit.
+        singular: Branch ends ("fold") and aligned-axes points.
+        method: How the branches are computed.
+        info: ``bisected`` (state changes found by bisection, not exactly),
+            ``grid`` (values checked).
+    """
+
+    T: np.ndarray
+    parameter: str
+    joint: int | None
+    domain: np.ndarray
+    periodic: bool
+    n_branches: int
+    intervals: np.ndarray
+    interval_branch: np.ndarray
+    crossings: tuple[LimitCrossing, ...]
+    singular: tuple[SingularPoint, ...]
+    method: str
+    info: dict[str, Any]
+    _family: _Family = field(repr=False)
+    _limits: np.ndarray = field(repr=False)
+
+    def sample(self, t: npt.ArrayLike, *, within_limits: bool = False) -> np.ndarray:
+        """Every branch at parameter values t: (..., k, n), NaN where a branch has none.
+
+        Args:
+            t: Parameter values (...) [rad].
+            within_limits: Also NaN the rows outside a joint limit.
+        """
+        ta = check_finite(np.asarray(t, dtype=np.float64), "t")
+        q, _, _ = self._family.rows(ta.reshape(-1))
+        if within_limits:
+            q = np.where(self._inside(q)[..., None], q, np.nan)
+        return q.reshape(ta.shape + q.shape[-2:])
+
+    def inside(self, t: npt.ArrayLike) -> np.ndarray:
+        """(..., k) bool: the branch exists at t and is inside every joint limit."""
+        ta = check_finite(np.asarray(t, dtype=np.float64), "t")
+        q, _, _ = self._family.rows(ta.reshape(-1))
+        return self._inside(q).reshape(ta.shape + (q.shape[-2],))
+
+    def _inside(self, q: np.ndarray) -> np.ndarray:
+        lo, hi = self._limits[:, 0], self._limits[:, 1]
+        with np.errstate(invalid="ignore"):
+            return np.all((q >= lo - 1e-12) & (q <= hi + 1e-12), axis=-1)
+
+    @property
+    def reachable(self) -> bool:
+        """True when some part of the manifold is inside every joint limit."""
+        return bool(len(self.intervals))
+
+    def best(self, criterion: str | Callable[[np.ndarray], np.ndarray] = "margin", *,
+             robot: RobotLike | None = None, samples: int = 64) -> ManifoldPoint | None:
+        """The in-limit configuration that maximises ``criterion``, or None.
+
+        Args:
+            criterion: ``"margin"`` (the smallest distance to a joint limit [rad]),
+                ``"manipulability"`` (Yoshikawa's, needs ``robot``) or a function
+                of configurations (m, n) -> scores (m,).
+            robot: The arm (for ``"manipulability"``).
+            samples: Values per feasible interval before the golden-section refinement.
+        """
+        score = _criterion(criterion, robot, self._limits)
+        return self._maximise(score, samples)
+
+    def nearest(self, q_near: npt.ArrayLike, *, samples: int = 64) -> ManifoldPoint | None:
+        """The in-limit configuration nearest ``q_near`` (n,) (2 pi wrapped distance)."""
+        qn = check_finite(check_joints(q_near, self._limits.shape[0], "q_near"), "q_near")
+
+        def score(q: np.ndarray) -> np.ndarray:
+            return -np.linalg.norm(_wrap(q - qn), axis=-1)
+
+        return self._maximise(score, samples)
+
+    def _maximise(self, score: Callable[[np.ndarray], np.ndarray],
+                  samples: int) -> ManifoldPoint | None:
+        """The best in-limit point: samples of every interval, then zooming in."""
+        if not len(self.intervals):
+            return None
+        m = max(int(samples), 3)
+        u = np.linspace(0.0, 1.0, m)
+        a, b = self.intervals[:, :1], self.intervals[:, 1:]
+        t, br = a + (b - a) * u, self.interval_branch
+        rows = np.arange(len(t))
+        for _ in range(_ZOOMS):
+            i = np.argmax(self._scores(score, t, br), axis=1)
+            step = (t[:, -1] - t[:, 0]) / (m - 1)
+            lo = np.maximum(t[rows, i] - step, a[:, 0])
+            hi = np.minimum(t[rows, i] + step, b[:, 0])
+            t = lo[:, None] + (hi - lo)[:, None] * u
+        s = self._scores(score, t, br)
+        r, c = np.unravel_index(int(np.argmax(s)), s.shape)
+        if not np.isfinite(s[r, c]):
+            return None
+        q = self._family.rows(np.array([t[r, c]]))[0][0, br[r]]
+        return ManifoldPoint(q, float(t[r, c]), int(br[r]), float(s[r, c]))
+
+    def _scores(self, score: Callable[[np.ndarray], np.ndarray], t: np.ndarray,
+                br: np.ndarray) -> np.ndarray:
+        """Scores (p, m) of branch br[i] at t[i, :]; -inf outside the limits."""
+        q = self._family.rows(t.reshape(-1))[0]
+        q = q.reshape(t.shape + q.shape[-2:])
+        qb = q[np.arange(len(t)), :, br]  # (p, m, n)
+        ok = np.isfinite(qb).all(-1) & self._inside(qb)
+        flat = qb.reshape(-1, qb.shape[-1])
+        out = np.full(flat.shape[0], -np.inf)
+        good = ok.reshape(-1)
+        if good.any():
+            out[good] = score(flat[good])
+        return out.reshape(t.shape)
+
+
+def _criterion(criterion: Any, robot: RobotLike | None, limits: np.ndarray
+               ) -> Callable[[np.ndarray], np.ndarray]:
+    if callable(criterion):
+        def user(q: np.ndarray) -> np.ndarray:
+            return np.asarray(criterion(q), dtype=np.float64).reshape(len(q))
+        return user
+    if criterion == "margin":
+        def margin(q: np.ndarray) -> np.ndarray:
+            return np.minimum(q - limits[:, 0], limits[:, 1] - q).min(-1)
+        return margin
+    if criterion == "manipulability":
+        if robot is None:
+            raise InputError("robot", "criterion 'manipulability' needs the robot: "
+                                      "sm.best('manipulability', robot=robot)")
+        from robokin.kinematics.jacobian import manipulability
+
+        chain = robot.chain
+        return lambda q: manipulability(chain, q)
+    raise InputError("criterion", f"expected 'margin', 'manipulability' or a function "
+                                  f"of configurations (m, n) -> (m,), got {criterion!r}")
+
+
+# ------------------------------------------------------------------ building it
+def _family(robot: RobotLike, T: np.ndarray, parameter: str) -> _Family:
+    names = list(robot.joint_names)
+    choices = ["auto", "swivel", *names]
+    if robot.n != 7 or robot.chain.n_chain != 7 or not robot.chain.coupling.is_identity:
+        raise InputError("robot", f"self_motion needs a 7-joint serial arm without "
+                                  f"coupled joints; {robot.name!r} has {robot.n} joints")
+    if parameter not in choices:
+        raise InputError("parameter", f"expected one of {', '.join(map(repr, choices))}, "
+                                      f"got {parameter!r}")
+    arm = cached(robot.chain, "swivel_arm", lambda: swivel_arm(robot.chain))
+    if parameter in ("auto", "swivel") and arm is not None:
+        return _SwivelFamily(arm, T, robot)
+    if parameter == "swivel":
+        raise InputError("parameter", f"{robot.name!r} is not an SRS arm (axes 1-3 and "
+                                      f"5-7 must meet): give a joint name or 'auto'")
+    from robokin.kinematics.ik.fixed import _held_solvers
+
+    held = {n: h for n, h in _held_solvers(robot).items()
+            if not (arm is not None and n == names[3])}  # the SRS elbow: a family
+    if parameter == "auto":
+        usable = [n for n in names if n in held]
+        if not usable:
+            raise InputError("parameter", f"no held-joint closed form on {robot.name!r}: "
+                                          "the general 7R self-motion is not built yet")
+        parameter = usable[-1]
+    if parameter not in held:
+        raise InputError("parameter", f"no closed form with {parameter!r} held on "
+                                      f"{robot.name!r}; joints with one: "
+                                      f"{', '.join(held) or 'none'}")
+    return _HeldFamily(robot, held[parameter].params, names.index(parameter), T)
+
+
+def self_motion(robot: RobotLike, T: npt.ArrayLike, parameter: str = "auto", *,
+                grid: int = GRID) -> SelfMotion:
+    """The self-motion manifold of one pose T (4, 4) of a 7R arm.
+
+    Args:
+        robot: A 7-joint arm.
+        T: The tool pose (4, 4) [m].
+        parameter: ``"auto"``, ``"swivel"`` (SRS arms) or a joint name.
+        grid: Parameter values of the checking grid (see the module docstring).
+
+    Returns:
+        A :class:`SelfMotion`.
+
+    Raises:
+        InputError: not a 7R arm, a bad pose, or a parameter without a closed form
+            (the message lists the choices).
+    """
+    Ta = check_poses_fast(T, "T")
+    if Ta.shape != (4, 4):
+        raise InputError("T", f"self_motion takes one pose (4, 4), got {Ta.shape}")
+    fam = _family(robot, Ta, parameter)
+    limits = np.asarray(robot.limits, dtype=np.float64)
+    marks = _exact_points(robot, fam, limits)
+    grid_t = np.linspace(fam.domain[0], fam.domain[1], int(grid))
+    q, valid, _ = fam.rows(grid_t)
+    ends, bisected = _state_changes(fam, grid_t, q, valid, limits, marks)
+    intervals, owner = _intervals(fam, limits, marks, ends)
+    crossings = tuple(LimitCrossing(t, b, j, s) for t, b, j, s in marks["limit"])
+    singular = tuple(SingularPoint(t, b, k) for t, b, k in marks["fold"] + marks["aligned"])
+    method = ("swivel closed form (SRS)" if fam.name == "swivel"
+              else f"analytic:pieper ({fam.name} held)")
+    return SelfMotion(Ta, fam.name, fam.joint, np.array(fam.domain), fam.periodic, fam.k,
+                      intervals, owner, crossings, singular, method,
+                      {"bisected": bisected, "grid": int(grid)}, fam, limits)
+
+
+def _exact_points(robot: RobotLike, fam: _Family, limits: np.ndarray) -> dict[str, list]:
+    """Every limit point and aligned-axes point of every branch, exactly."""
+    out: dict[str, list] = {"limit": [], "fold": [], "aligned": []}
+    rev = np.asarray(robot.is_revolute, bool)
+    queries: list[tuple[int, float]] = []
+    tags: list[tuple[str, Any]] = []
+    for j in range(robot.n):
+        lo, hi = limits[j]
+        if j == fam.joint or (rev[j] and hi - lo >= _TWO_PI):
+            continue  # the parameter, or every angle has an in-limit turn
+        queries += [(j, float(lo)), (j, float(hi))]
+        tags += [("limit", "lower"), ("limit", "upper")]
+    for j, value in _aligned_values(robot):
+        if j != fam.joint:
+            queries.append((j, value))
+            tags.append(("aligned", "aligned axes"))
+    for (j, _), (kind, text), found in zip(queries, tags, fam.points(queries), strict=True):
+        if kind == "limit":
+            out["limit"] += [(t, b, j, text) for t, b in found]
+        else:
+            out["aligned"] += [(t, b, text) for t, b in found]
+    return out
+
+
+def _aligned_values(robot: RobotLike) -> list[tuple[int, float]]:
+    """(joint, value): where axes j-1 and j+1 of a meeting triple line up."""
+    def build() -> list[tuple[int, float]]:
+        from robokin.kinematics.ik.analytic._geometry import poe_from_chain
+        from robokin.kinematics.ik.swivel import _sp4
+
+        poe = poe_from_chain(robot.chain)
+        sign, offset = robot.chain.arrays.sign, robot.chain.arrays.offset
+        found = []
+        for j in range(1, robot.chain.n_chain - 1):
+            a, h, b = poe.h[j - 1], poe.h[j], poe.h[j + 1]
+            for c in (1.0, -1.0):
+                tp, tm, real = _sp4(h, a, b, np.array(c))
+                if bool(real) and abs(float(tp) - float(tm)) < 1e-6:
+                    v = float((tp + tm) / 2)
+                    found.append((j, float(_wrap((v - offset[j]) * sign[j]))))
+        return found
+
+    return cached(robot.chain, "aligned_axes", build)
+
+
+def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray,
+                   limits: np.ndarray, marks: dict[str, list]
+                   ) -> tuple[list[tuple[float, int]], int]:
+    """Branch ends (bisected on existence) and unexplained in-limit changes on the grid.
+
+    Returns ``([(t, branch), ...] extra breakpoints, how many were bisected)``; the
+    fold ends are added to ``marks["fold"]``.
+    """
+    extra: list[tuple[float, int]] = []
+    lo, hi = limits[:, 0], limits[:, 1]
+    with np.errstate(invalid="ignore"):
+        inside = valid & np.all((q >= lo - 1e-12) & (q <= hi + 1e-12), axis=-1)
+    exact: dict[int, list[float]] = {}
+    for tt, b, *_ in marks["limit"] + marks["aligned"]:
+        exact.setdefault(b, []).append(tt)
+    bisected = 0
+    for b in range(fam.k):
+        for i in np.flatnonzero(valid[1:, b] != valid[:-1, b]):
+            te = _bisect(_exists(fam, b), t[i], t[i + 1], bool(valid[i, b]))
+            marks["fold"].append((te, b, "fold"))
+            extra.append((te, b))
+        for i in np.flatnonzero((inside[1:, b] != inside[:-1, b])
+                                & valid[1:, b] & valid[:-1, b]):
+            if any(t[i] <= x <= t[i + 1] for x in exact.get(b, [])):
+                continue
+            te = _bisect(_inside_at(fam, b, limits), t[i], t[i + 1], bool(inside[i, b]))
+            extra.append((te, b))
+            bisected += 1
+    return extra, bisected
+
+
+def _exists(fam: _Family, b: int) -> Callable[[float], bool]:
+    """T -> whether branch b has a point at t."""
+    return lambda x: bool(fam.rows(np.array([x]))[1][0, b])
+
+
+def _inside_at(fam: _Family, b: int, limits: np.ndarray) -> Callable[[float], bool]:
+    """T -> whether branch b is inside every limit at t."""
+    def inside(x: float) -> bool:
+        q = fam.rows(np.array([x]))[0][0, b]
+        return bool(np.all((q >= limits[:, 0] - 1e-12) & (q <= limits[:, 1] + 1e-12)))
+    return inside
+
+
+def _bisect(state: Callable[[float], bool], a: float, b: float, at_a: bool) -> float:
+    """The point in [a, b] where ``state`` changes from ``at_a`` (to the last bit)."""
+    for _ in range(_BISECT):
+        m = 0.5 * (a + b)
+        if m in (a, b):
+            break
+        if state(m) == at_a:
+            a = m
+        else:
+            b = m
+    return a if at_a else b
+
+
+def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list],
+               extra: list[tuple[float, int]]) -> tuple[np.ndarray, np.ndarray]:
+    """Per branch: the maximal parameter intervals inside every limit."""
+    lo_d, hi_d = fam.domain
+    cuts: dict[int, list[float]] = {b: [lo_d, hi_d] for b in range(fam.k)}
+    for t, b, *_ in marks["limit"] + marks["fold"]:
+        cuts[b].append(t)
+    for t, b in extra:
+        cuts[b].append(t)
+    pieces: list[tuple[int, float, float]] = []
+    mids, owners, spans = [], [], []
+    for b in range(fam.k):
+        c = np.unique(np.clip(cuts[b], lo_d, hi_d))
+        for a, e in zip(c[:-1], c[1:], strict=True):
+            if e > a:
+                mids.append(0.5 * (a + e))
+                owners.append(b)
+                spans.append((a, e))
+    if not mids:
+        return np.zeros((0, 2)), np.zeros(0, dtype=int)
+    q, valid, _ = fam.rows(np.array(mids))
+    idx = np.arange(len(mids))
+    qb = q[idx, owners]
+    with np.errstate(invalid="ignore"):
+        ok = valid[idx, owners] & np.all((qb >= limits[:, 0]) & (qb <= limits[:, 1]), -1)
+    for (a, e), b, good in zip(spans, owners, ok, strict=True):
+        if not good:
+            continue
+        if pieces and pieces[-1][0] == b and pieces[-1][2] == a:
+            pieces[-1] = (b, pieces[-1][1], e)
+        else:
+            pieces.append((b, a, e))
+    if fam.periodic:
+        pieces = _join_wrap(pieces, lo_d, hi_d)
+    arr = np.array([[a, e] for _, a, e in pieces]).reshape(-1, 2)
+    return arr, np.array([b for b, _, _ in pieces], dtype=int)
+
+
+def _join_wrap(pieces: list[tuple[int, float, float]], lo: float, hi: float
+               ) -> list[tuple[int, float, float]]:
+    """Periodic parameter: a branch's piece ending at hi and one starting at lo join.
+
+    The joined interval is given as (start, end + 2 pi) with end + 2 pi > hi.
+    """
+    out = list(pieces)
+    for b in {p[0] for p in pieces}:
+        own = [p for p in out if p[0] == b]
+        first = next((p for p in own if p[1] == lo), None)
+        last = next((p for p in own if p[2] == hi), None)
+        if first is not None and last is not None and first is not last:
+            out.remove(first)
+            out.remove(last)
+            out.append((b, last[1], first[2] + _TWO_PI))
+    return sorted(out)
