@@ -23,6 +23,7 @@ from robokin._validation import (
 )
 from robokin.exceptions import InputError
 from robokin.kinematics.ik.numeric import IKResult
+from robokin.kinematics.ik.self_motion import auto_parameter, nearest_on_manifold
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.solutions import SolutionSet
@@ -74,6 +75,8 @@ def solve_near(
     from robokin.kinematics.ik.analytic.detect import detect
 
     fam = detect(robot)
+    if fam.solver is None and auto_parameter(robot) is not None:
+        return _manifold_near(robot, T, q_near)
     if fam.solver is None:
         if method == "analytic":
             raise InputError("method", f"no closed form for robot '{robot.name}': "
@@ -81,6 +84,40 @@ def solve_near(
         return _numeric_near(robot, T, q_near)
     sols = robot.ik(T, q_near=q_near, method="analytic")
     return _nearest(robot, sols, T, q_near)
+
+
+def _manifold_near(robot: RobotLike, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
+    """A 7R arm with a self-motion closed form: the in-limit point nearest ``q_near``.
+
+    Per pose, every branch of the self-motion is sampled and the nearest in-limit
+    sample zoomed in on (``self_motion.nearest_on_manifold``).
+    """
+    from robokin.kinematics.ik.analytic._common import fk_error
+
+    T = check_transform(T, "T")
+    lead = T.shape[:-2]
+    check_broadcasts(q_near, lead + (robot.n,), "q_near")
+    Tf = T.reshape(-1, 4, 4)
+    qn = np.broadcast_to(q_near, lead + (robot.n,)).reshape(-1, robot.n)
+    q = np.full((len(Tf), robot.n), np.nan)
+    for i, (Ti, qi) in enumerate(zip(Tf, qn, strict=True)):
+        p = nearest_on_manifold(robot, Ti, qi)
+        if p is not None:
+            q[i] = p.q
+    found = np.isfinite(q).all(-1)
+    dp, dr = fk_error(robot.chain, q[:, None], Tf)
+    dp, dr = dp[:, 0], dr[:, 0]
+    reason = np.where(found, "converged",
+                      "no configuration of the self-motion inside the joint limits")
+    zeros = np.zeros(lead, dtype=np.int64)
+    if not lead:
+        return IKResult(q=q[0], success=np.bool_(found[0]), error=float(np.hypot(dp[0], dr[0])),
+                        iterations=0, restarts=0, reason=str(reason[0]),
+                        position_error=float(dp[0]), rotation_error=float(dr[0]))
+    return IKResult(q=q.reshape(lead + (robot.n,)), success=found.reshape(lead),
+                    error=np.hypot(dp, dr).reshape(lead), iterations=zeros, restarts=zeros,
+                    reason=reason.astype(object).reshape(lead),
+                    position_error=dp.reshape(lead), rotation_error=dr.reshape(lead))
 
 
 def _numeric_near(robot: RobotLike, T: npt.ArrayLike, q_near: np.ndarray,

@@ -47,7 +47,8 @@ from robokin.kinematics.per_chain import cached
 if TYPE_CHECKING:
     from robokin.kinematics.robot_like import RobotLike
 
-__all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SingularPoint", "self_motion"]
+__all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SingularPoint", "auto_parameter",
+           "nearest_on_manifold", "parameter_values", "self_motion"]
 
 #: Parameter values on the checking grid.
 GRID = 721
@@ -56,6 +57,9 @@ _BISECT = 56
 #: Rows of a slot at the same point are the same configuration within this [rad].
 _SAME = 1e-6
 _TWO_PI = 2 * np.pi
+#: At most this many grid changes without an exact point are bisected (a pose on a
+#: singular manifold, e.g. the SRS arm stretched with its wrist in line, has many).
+_MAX_BISECT = 64
 #: Zoom rounds of SelfMotion.best (each narrows to 2 / (samples - 1) of the span).
 _ZOOMS = 6
 
@@ -147,7 +151,8 @@ class _SwivelFamily(_Family):
 
     def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         q, real, sing = self.arm.configurations(self.fr, t)
-        return _polish(self.robot, q, real, self.T), real, sing
+        q, ok = _polish(self.robot, q, real, self.T)
+        return q, ok, sing
 
     def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
         if j == 3:
@@ -209,26 +214,44 @@ def _into_limits(robot: RobotLike, q: np.ndarray) -> np.ndarray:
     return q + _TWO_PI * up - _TWO_PI * down
 
 
-def _polish(robot: RobotLike, q: np.ndarray, real: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """Rows whose pose error exceeds 1e-13 get minimum-norm Gauss-Newton steps."""
+def _polish(robot: RobotLike, q: np.ndarray, real: np.ndarray, T: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """Rows whose pose error exceeds 1e-13 get minimum-norm Gauss-Newton steps.
+
+    The error is the larger of the position [m] and rotation [rad] norms. A step
+    is kept only where it lowers it; rows still above 5e-13 (next to a singular
+    point of the closed form) are dropped (NaN, not valid).
+    """
     from robokin.kinematics.forward import forward_kinematics
     from robokin.kinematics.jacobian import jacobian_and_pose
     from robokin.spatial import pose_error
 
-    rows = np.flatnonzero(real.reshape(-1))
+    ok = real.copy()
+    rows = np.flatnonzero(ok.reshape(-1))
     if not rows.size:
-        return q
+        return q, ok
     flat = q.reshape(-1, q.shape[-1])
     e = pose_error(forward_kinematics(robot.chain, flat[rows]), T)
     for _ in range(3):
-        bad = np.abs(e).max(-1) > 1e-13
+        bad = _size(e) > 1e-13
         if not bad.any():
             break
         rows, e = rows[bad], e[bad]
         J, _ = jacobian_and_pose(robot.chain, flat[rows])
-        flat[rows] = flat[rows] + np.einsum("mij,mj->mi", np.linalg.pinv(J), e)
-        e = pose_error(forward_kinematics(robot.chain, flat[rows]), T)
-    return flat.reshape(q.shape)
+        trial = flat[rows] + np.einsum("mij,mj->mi", np.linalg.pinv(J), e)
+        et = pose_error(forward_kinematics(robot.chain, trial), T)
+        better = _size(et) < _size(e)
+        flat[rows[better]] = trial[better]
+        e = np.where(better[:, None], et, e)
+    lost = rows[_size(e) > 5e-13]
+    flat[lost] = np.nan
+    ok.reshape(-1)[lost] = False
+    return flat.reshape(q.shape), ok
+
+
+def _size(e: np.ndarray) -> np.ndarray:
+    """The larger of the position and rotation norms of pose errors (..., 6)."""
+    return np.maximum(np.linalg.norm(e[..., :3], axis=-1), np.linalg.norm(e[..., 3:], axis=-1))
 
 
 # ------------------------------------------------------------------ the result
@@ -251,6 +274,7 @@ class SelfMotion:
         method: How the branches are computed.
         info: ``bisected`` (state changes found by bisection, not exactly),
             ``grid`` (values checked).
+        limits: The arm's joint limits (n, 2).
     """
 
     T: np.ndarray
@@ -266,7 +290,7 @@ class SelfMotion:
     method: str
     info: dict[str, Any]
     _family: _Family = field(repr=False)
-    _limits: np.ndarray = field(repr=False)
+    limits: np.ndarray = field(repr=False)
 
     def sample(self, t: npt.ArrayLike, *, within_limits: bool = False) -> np.ndarray:
         """Every branch at parameter values t: (..., k, n), NaN where a branch has none.
@@ -288,7 +312,7 @@ class SelfMotion:
         return self._inside(q).reshape(ta.shape + (q.shape[-2],))
 
     def _inside(self, q: np.ndarray) -> np.ndarray:
-        lo, hi = self._limits[:, 0], self._limits[:, 1]
+        lo, hi = self.limits[:, 0], self.limits[:, 1]
         with np.errstate(invalid="ignore"):
             return np.all((q >= lo - 1e-12) & (q <= hi + 1e-12), axis=-1)
 
@@ -308,12 +332,12 @@ class SelfMotion:
             robot: The arm (for ``"manipulability"``).
             samples: Values per feasible interval before the golden-section refinement.
         """
-        score = _criterion(criterion, robot, self._limits)
+        score = _criterion(criterion, robot, self.limits)
         return self._maximise(score, samples)
 
     def nearest(self, q_near: npt.ArrayLike, *, samples: int = 64) -> ManifoldPoint | None:
         """The in-limit configuration nearest ``q_near`` (n,) (2 pi wrapped distance)."""
-        qn = check_finite(check_joints(q_near, self._limits.shape[0], "q_near"), "q_near")
+        qn = check_finite(check_joints(q_near, self.limits.shape[0], "q_near"), "q_near")
 
         def score(q: np.ndarray) -> np.ndarray:
             return -np.linalg.norm(_wrap(q - qn), axis=-1)
@@ -322,40 +346,76 @@ class SelfMotion:
 
     def _maximise(self, score: Callable[[np.ndarray], np.ndarray],
                   samples: int) -> ManifoldPoint | None:
-        """The best in-limit point: samples of every interval, then zooming in."""
-        if not len(self.intervals):
-            return None
-        m = max(int(samples), 3)
-        u = np.linspace(0.0, 1.0, m)
-        a, b = self.intervals[:, :1], self.intervals[:, 1:]
-        t, br = a + (b - a) * u, self.interval_branch
-        rows = np.arange(len(t))
-        for _ in range(_ZOOMS):
-            i = np.argmax(self._scores(score, t, br), axis=1)
-            step = (t[:, -1] - t[:, 0]) / (m - 1)
-            lo = np.maximum(t[rows, i] - step, a[:, 0])
-            hi = np.minimum(t[rows, i] + step, b[:, 0])
-            t = lo[:, None] + (hi - lo)[:, None] * u
-        s = self._scores(score, t, br)
-        r, c = np.unravel_index(int(np.argmax(s)), s.shape)
-        if not np.isfinite(s[r, c]):
-            return None
-        q = self._family.rows(np.array([t[r, c]]))[0][0, br[r]]
-        return ManifoldPoint(q, float(t[r, c]), int(br[r]), float(s[r, c]))
+        return _maximise(self._family, self.limits, self.intervals, self.interval_branch,
+                         score, samples)
 
-    def _scores(self, score: Callable[[np.ndarray], np.ndarray], t: np.ndarray,
-                br: np.ndarray) -> np.ndarray:
-        """Scores (p, m) of branch br[i] at t[i, :]; -inf outside the limits."""
-        q = self._family.rows(t.reshape(-1))[0]
-        q = q.reshape(t.shape + q.shape[-2:])
-        qb = q[np.arange(len(t)), :, br]  # (p, m, n)
-        ok = np.isfinite(qb).all(-1) & self._inside(qb)
-        flat = qb.reshape(-1, qb.shape[-1])
-        out = np.full(flat.shape[0], -np.inf)
-        good = ok.reshape(-1)
-        if good.any():
-            out[good] = score(flat[good])
-        return out.reshape(t.shape)
+
+def _maximise(fam: _Family, limits: np.ndarray, intervals: np.ndarray, branches: np.ndarray,
+              score: Callable[[np.ndarray], np.ndarray], samples: int) -> ManifoldPoint | None:
+    """The best in-limit point: samples of every interval, then zooming in."""
+    if not len(intervals):
+        return None
+    m = max(int(samples), 3)
+    u = np.linspace(0.0, 1.0, m)
+    a, b = intervals[:, :1], intervals[:, 1:]
+    t, br = a + (b - a) * u, np.asarray(branches)
+    rows = np.arange(len(t))
+    for _ in range(_ZOOMS):
+        i = np.argmax(_scores(fam, limits, score, t, br), axis=1)
+        step = (t[:, -1] - t[:, 0]) / (m - 1)
+        lo = np.maximum(t[rows, i] - step, a[:, 0])
+        hi = np.minimum(t[rows, i] + step, b[:, 0])
+        t = lo[:, None] + (hi - lo)[:, None] * u
+    s = _scores(fam, limits, score, t, br)
+    r, c = np.unravel_index(int(np.argmax(s)), s.shape)
+    if not np.isfinite(s[r, c]):
+        return None
+    q = fam.rows(np.array([t[r, c]]))[0][0, br[r]]
+    return ManifoldPoint(q, float(t[r, c]), int(br[r]), float(s[r, c]))
+
+
+def _scores(fam: _Family, limits: np.ndarray, score: Callable[[np.ndarray], np.ndarray],
+            t: np.ndarray, br: np.ndarray) -> np.ndarray:
+    """Scores (p, m) of branch br[i] at t[i, :]; -inf outside the limits."""
+    q = fam.rows(t.reshape(-1))[0]
+    q = q.reshape(t.shape + q.shape[-2:])
+    qb = q[np.arange(len(t)), :, br]  # (p, m, n)
+    ok = np.isfinite(qb).all(-1) & _within(qb, limits)
+    flat = qb.reshape(-1, qb.shape[-1])
+    out = np.full(flat.shape[0], -np.inf)
+    good = ok.reshape(-1)
+    if good.any():
+        out[good] = score(flat[good])
+    return out.reshape(t.shape)
+
+
+def nearest_on_manifold(robot: RobotLike, T: np.ndarray, q_near: np.ndarray, *,
+                        samples: int = 181) -> ManifoldPoint | None:
+    """The in-limit configuration of pose T (4, 4) nearest ``q_near`` (n,), or None.
+
+    Without the exact intervals (``ik_near``'s fast path): every branch sampled at
+    ``samples`` parameter values, the nearest in-limit sample then zoomed in on.
+    """
+    fam = _family(robot, T, "auto")
+    k = fam.k
+    intervals = np.tile(np.array(fam.domain, dtype=np.float64), (k, 1))
+
+    def score(q: np.ndarray) -> np.ndarray:
+        return -np.linalg.norm(_wrap(q - q_near), axis=-1)
+
+    return _maximise(fam, np.asarray(robot.limits, dtype=np.float64), intervals,
+                     np.arange(k), score, samples)
+
+
+def auto_parameter(robot: RobotLike) -> str | None:
+    """The parameter ``self_motion(T)`` takes on this arm, or None (no closed form)."""
+    def build() -> str | None:
+        try:
+            return _family(robot, np.eye(4), "auto").name
+        except InputError:
+            return None
+
+    return cached(robot.chain, "self_motion_parameter", build)
 
 
 def _criterion(criterion: Any, robot: RobotLike | None, limits: np.ndarray
@@ -436,7 +496,7 @@ def self_motion(robot: RobotLike, T: npt.ArrayLike, parameter: str = "auto", *,
     fam = _family(robot, Ta, parameter)
     limits = np.asarray(robot.limits, dtype=np.float64)
     marks = _exact_points(robot, fam, limits)
-    grid_t = np.linspace(fam.domain[0], fam.domain[1], int(grid))
+    grid_t = _grid(fam, int(grid), marks)
     q, valid, _ = fam.rows(grid_t)
     ends, bisected = _state_changes(fam, grid_t, q, valid, limits, marks)
     intervals, owner = _intervals(fam, limits, marks, ends)
@@ -494,61 +554,66 @@ def _aligned_values(robot: RobotLike) -> list[tuple[int, float]]:
     return cached(robot.chain, "aligned_axes", build)
 
 
+def _grid(fam: _Family, m: int, marks: dict[str, list]) -> np.ndarray:
+    """The checking grid: m values over the range, refined next to aligned points.
+
+    Next to a point where a triple lines up a branch's outer angles swing by up to
+    pi over a tiny parameter range, where the held-joint solver can miss a limit
+    crossing: values at 10^-k (k = 1..12) either side catch those for bisection.
+    """
+    lo, hi = fam.domain
+    t = [np.linspace(lo, hi, m)]
+    near = np.array([10.0 ** -k for k in range(1, 13)])
+    for ts, *_ in marks["aligned"]:
+        t.append(np.clip(np.concatenate([ts - near, ts + near]), lo, hi))
+    return np.unique(np.concatenate(t))
+
+
 def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray,
                    limits: np.ndarray, marks: dict[str, list]
                    ) -> tuple[list[tuple[float, int]], int]:
     """Branch ends (bisected on existence) and unexplained in-limit changes on the grid.
 
     Returns ``([(t, branch), ...] extra breakpoints, how many were bisected)``; the
-    fold ends are added to ``marks["fold"]``.
+    fold ends are added to ``marks["fold"]``. All cells are bisected together (one
+    batch per step).
     """
-    extra: list[tuple[float, int]] = []
-    lo, hi = limits[:, 0], limits[:, 1]
-    with np.errstate(invalid="ignore"):
-        inside = valid & np.all((q >= lo - 1e-12) & (q <= hi + 1e-12), axis=-1)
+    inside = valid & _within(q, limits)
     exact: dict[int, list[float]] = {}
     for tt, b, *_ in marks["limit"] + marks["aligned"]:
         exact.setdefault(b, []).append(tt)
-    bisected = 0
+    folds, changes = [], []
     for b in range(fam.k):
-        for i in np.flatnonzero(valid[1:, b] != valid[:-1, b]):
-            te = _bisect(_exists(fam, b), t[i], t[i + 1], bool(valid[i, b]))
-            marks["fold"].append((te, b, "fold"))
-            extra.append((te, b))
+        folds += [(i, b) for i in np.flatnonzero(valid[1:, b] != valid[:-1, b])]
         for i in np.flatnonzero((inside[1:, b] != inside[:-1, b])
                                 & valid[1:, b] & valid[:-1, b]):
-            if any(t[i] <= x <= t[i + 1] for x in exact.get(b, [])):
-                continue
-            te = _bisect(_inside_at(fam, b, limits), t[i], t[i + 1], bool(inside[i, b]))
-            extra.append((te, b))
-            bisected += 1
-    return extra, bisected
-
-
-def _exists(fam: _Family, b: int) -> Callable[[float], bool]:
-    """T -> whether branch b has a point at t."""
-    return lambda x: bool(fam.rows(np.array([x]))[1][0, b])
-
-
-def _inside_at(fam: _Family, b: int, limits: np.ndarray) -> Callable[[float], bool]:
-    """T -> whether branch b is inside every limit at t."""
-    def inside(x: float) -> bool:
-        q = fam.rows(np.array([x]))[0][0, b]
-        return bool(np.all((q >= limits[:, 0] - 1e-12) & (q <= limits[:, 1] + 1e-12)))
-    return inside
-
-
-def _bisect(state: Callable[[float], bool], a: float, b: float, at_a: bool) -> float:
-    """The point in [a, b] where ``state`` changes from ``at_a`` (to the last bit)."""
+            if not any(t[i] <= x <= t[i + 1] for x in exact.get(b, [])):
+                changes.append((i, b))
+    changes = changes[:_MAX_BISECT]
+    cells = folds + changes
+    if not cells:
+        return [], 0
+    idx = np.array([i for i, _ in cells])
+    br = np.array([b for _, b in cells])
+    kind = np.array([c >= len(folds) for c in range(len(cells))])  # True: in-limit change
+    state0 = np.where(kind, inside[idx, br], valid[idx, br])
+    lo, hi = t[idx].astype(np.float64), t[idx + 1].astype(np.float64)
     for _ in range(_BISECT):
-        m = 0.5 * (a + b)
-        if m in (a, b):
-            break
-        if state(m) == at_a:
-            a = m
-        else:
-            b = m
-    return a if at_a else b
+        mid = 0.5 * (lo + hi)
+        qm, vm, _ = fam.rows(mid)
+        rows = np.arange(len(mid))
+        now = np.where(kind, vm[rows, br] & _within(qm[rows, br], limits), vm[rows, br])
+        same = now == state0
+        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+    ends = np.where(state0, lo, hi)  # the last point of the state that holds there
+    marks["fold"] += [(float(e), int(b), "fold") for e, b, k in zip(ends, br, kind) if not k]
+    return [(float(e), int(b)) for e, b in zip(ends, br)], len(changes)
+
+
+def _within(q: np.ndarray, limits: np.ndarray) -> np.ndarray:
+    """(...) bool: rows q (..., n) inside every limit (1e-12 slack); NaN rows False."""
+    with np.errstate(invalid="ignore"):
+        return np.all((q >= limits[:, 0] - 1e-12) & (q <= limits[:, 1] + 1e-12), axis=-1)
 
 
 def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list],
@@ -605,3 +670,22 @@ def _join_wrap(pieces: list[tuple[int, float, float]], lo: float, hi: float
             out.remove(last)
             out.append((b, last[1], first[2] + _TWO_PI))
     return sorted(out)
+
+
+def parameter_values(robot: RobotLike, T: np.ndarray, q: np.ndarray) -> tuple[str, np.ndarray]:
+    """The self-motion parameter of configurations q (..., k, n) of poses T (..., 4, 4).
+
+    Returns ``(name, values (..., k))``: the swivel angle on SRS arms, else the
+    ``auto`` parameter's joint (the last joint without a closed form); NaN rows give
+    NaN.
+    """
+    name = auto_parameter(robot) or robot.joint_names[-1]
+    if name != "swivel":
+        return name, q[..., robot.joint_names.index(name)]
+    arm = cached(robot.chain, "swivel_arm", lambda: swivel_arm(robot.chain))
+    assert arm is not None
+    lead = q.shape[:-2]
+    Tf = np.broadcast_to(T, lead + (4, 4)).reshape(-1, 4, 4)
+    qf = q.reshape((len(Tf),) + q.shape[-2:])
+    out = np.stack([arm.swivel_of(arm.frame(Ti), qi) for Ti, qi in zip(Tf, qf, strict=True)])
+    return name, out.reshape(q.shape[:-1])
