@@ -209,3 +209,28 @@ def test_ik_near_picks_the_nearest_point_of_the_manifold(arm):
         res = robot.ik_near(T, qn)
         assert res.success and res.error < 1e-12 and robot.within_limits(res.q)
         assert np.linalg.norm(res.q - qn) <= np.linalg.norm(q0 - qn) + 1e-9
+
+
+def test_general_7r_branches_are_continued():
+    # an iiwa14 with a 1 cm shoulder offset (a2): axes 1-3 no longer meet, so joint 7
+    # held has no closed form and goes to the general 6R solver, continued.
+    # Oracle: the generating configuration at its own q7, every sampled row exact.
+    rows = [{"a": 0.01 if i == 1 else 0.0, "alpha": alpha, "d": d, "theta": 0.0,
+             "limits": [-np.radians(r), np.radians(r)], "name": f"a{i + 1}"}
+            for i, (alpha, d, r) in enumerate(
+                [(-np.pi / 2, 0.36, 170), (np.pi / 2, 0.0, 120), (np.pi / 2, 0.42, 170),
+                 (-np.pi / 2, 0.0, 120), (-np.pi / 2, 0.40, 170), (np.pi / 2, 0.0, 120),
+                 (0.0, 0.126, 175)])]
+    robot = robokin.Robot.from_dh(rows, convention="standard", name="offset_iiwa")
+    q0 = np.array([0.3, 0.5, -0.4, 1.2, 0.5, -0.9, 0.2])
+    T = robot.fk(q0)
+    sm = robot.self_motion(T, parameter="a7")
+    assert sm.method.startswith("continued general 6R")
+    d = np.abs((sm.sample(q0[6]) - q0 + np.pi) % (2 * np.pi) - np.pi).max(-1)
+    assert np.nanmin(d) < 1e-9
+    Q = sm.sample(np.linspace(*sm.domain, 41))
+    ok = np.isfinite(Q).all(-1)
+    dp, dr = pose_errors(robot.fk(np.where(ok[..., None], Q, 0.0)), T)
+    assert ok.any() and dp[ok].max() <= 1e-12 and dr[ok].max() <= 1e-12
+    assert any(a <= q0[6] <= e for (a, e), b in zip(sm.intervals, sm.interval_branch)
+               if d[b] < 1e-9)

@@ -10,7 +10,10 @@ branches :math:`q_b(t)` over a parameter t:
   form (``pieper``: the Panda / FR3 with joint 4-7, an SRS arm with joint 1-3 or
   5-7), 8 branches whose slots stay the same branch for every t;
 * ``"auto"``: the swivel on SRS arms, else the last joint with a held-joint closed
-  form (q7 on the Panda / FR3: He and Liu's closed form).
+  form (q7 on the Panda / FR3: He and Liu's closed form), else the last joint;
+* a joint without a held-joint closed form: the general held-joint 6R solver at
+  181 values, its rows continued into branches by nearest pairing with step
+  halving (``_ContinuedFamily``): seconds per pose.
 
 **Limits exactly.** A branch leaves a joint's range where that joint equals a
 limit: those points are the solutions of a finitely-solvable problem (the swivel's
@@ -60,6 +63,12 @@ _TWO_PI = 2 * np.pi
 #: At most this many grid changes without an exact point are bisected (a pose on a
 #: singular manifold, e.g. the SRS arm stretched with its wrist in line, has many).
 _MAX_BISECT = 64
+#: Largest joint step [rad] between paired rows of a continued branch.
+_JUMP = 0.3
+#: Checking-grid values of a continued family.
+_CONTINUED_GRID = 181
+#: Step halvings of the continuation.
+_REFINE = 4
 #: Zoom rounds of SelfMotion.best (each narrows to 2 / (samples - 1) of the span).
 _ZOOMS = 6
 
@@ -190,6 +199,131 @@ class _HeldFamily(_Family):
             if t is not None:
                 out.append((t, row))
         return out
+
+
+class _ContinuedFamily(_Family):
+    """Any 7R arm, a joint held by the general held-joint 6R solver, branches continued.
+
+    The pose is solved at ``nodes`` held values (one batch); consecutive values'
+    rows are paired by nearest distance (2 pi wrapped), and where a pairing is
+    ambiguous (the second-nearest within twice the nearest) or a step jumps more
+    than ``_JUMP`` the step is halved (a midpoint solved) up to ``_REFINE`` times.
+    Paired rows form tracks (the branches); a row with no partner starts a track.
+    ``rows(t)`` solves at t and gives each track the row nearest its value there
+    (interpolated between its nodes).
+    """
+
+    def __init__(self, robot: RobotLike, j: int, T: np.ndarray, nodes: int = 181) -> None:
+        self.robot = robot
+        self.joint = j
+        self.name = robot.joint_names[j]
+        self.domain = (float(robot.limits[j, 0]), float(robot.limits[j, 1]))
+        self.T = T
+        t = np.linspace(*self.domain, nodes)
+        Q = self._solve(t)
+        for _ in range(_REFINE):
+            bad = [i for i in range(len(t) - 1) if not _clean_step(Q[i], Q[i + 1])]
+            if not bad:
+                break
+            mid = 0.5 * (t[bad] + t[np.array(bad) + 1])
+            t = np.concatenate([t, mid])
+            Q = np.concatenate([Q, self._solve(mid)])
+            order = np.argsort(t)
+            t, Q = t[order], Q[order]
+        self.t_nodes = t
+        self.tracks = _link(Q)  # (m, k, n)
+        self.k = self.tracks.shape[1]
+
+    def _solve(self, t: np.ndarray) -> np.ndarray:
+        sols = self.robot.ik(self.T, fixed={self.name: t})
+        Q = np.where(sols.valid[..., None], sols.q, np.nan)
+        return _into_limits(self.robot, Q)
+
+    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        t = np.atleast_1d(np.asarray(t, dtype=np.float64))
+        Q = self._solve(t)  # (m, K, n)
+        ref = self._interpolated(t)  # (m, k, n)
+        out = np.full(ref.shape, np.nan)
+        for i in range(len(t)):
+            d = _dist(ref[i][:, None], Q[i][None])  # (k, K)
+            d[~np.isfinite(d)] = np.inf
+            while np.isfinite(d).any():
+                b, r = np.unravel_index(int(np.argmin(d)), d.shape)
+                if d[b, r] > _JUMP:
+                    break
+                out[i, b] = Q[i, r]
+                d[b, :] = np.inf
+                d[:, r] = np.inf
+        valid = np.isfinite(out).all(-1)
+        return out, valid, np.zeros_like(valid)
+
+    def _interpolated(self, t: np.ndarray) -> np.ndarray:
+        """Each track's value at t (m, k, n): linear between its nodes (NaN off it)."""
+        tn, X = self.t_nodes, self.tracks
+        i = np.clip(np.searchsorted(tn, t) - 1, 0, len(tn) - 2)
+        w = ((t - tn[i]) / (tn[i + 1] - tn[i]))[:, None, None]
+        a, b = X[i], X[i + 1]
+        mid = a + w * _wrap(b - a)
+        near = np.where(w < 0.5, a, b)
+        return np.where(np.isfinite(mid), mid, near)
+
+    def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
+        sols = self.robot.ik(self.T, fixed={self.robot.joint_names[j]: value})
+        out: list[tuple[float, np.ndarray | None]] = []
+        for row in sols.q[sols.valid]:
+            t = _shift_into(float(row[self.joint]), self.domain)
+            if t is not None:
+                out.append((t, row))
+        return out
+
+
+def _dist(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Largest 2 pi wrapped joint difference of rows a and b (broadcast, NaN -> NaN)."""
+    return np.abs(_wrap(a - b)).max(-1)
+
+
+def _clean_step(A: np.ndarray, B: np.ndarray) -> bool:
+    """True when every row of A pairs with one of B unambiguously and within _JUMP."""
+    a, b = A[np.isfinite(A).all(-1)], B[np.isfinite(B).all(-1)]
+    if len(a) != len(b):
+        return False
+    if not len(a):
+        return True
+    d = np.sort(_dist(a[:, None], b[None]), axis=1)
+    if d[:, 0].max() > _JUMP:
+        return False
+    return bool(len(b) < 2 or np.all(d[:, 1] > 2 * d[:, 0]))
+
+
+def _link(Q: np.ndarray) -> np.ndarray:
+    """Tracks (m, k, n) from rows per node (m, K, n): nearest pairing node to node."""
+    m, K, n = Q.shape
+    tracks: list[np.ndarray] = []
+    last: list[int] = []  # per track: its row at the previous node, or -1
+    for i in range(m):
+        now = [-1] * len(tracks)
+        rows = [r for r in range(K) if np.isfinite(Q[i, r]).all()]
+        prev = [(tr, last[tr]) for tr in range(len(tracks)) if last[tr] >= 0]
+        if prev and rows:
+            d = np.array([[float(_dist(Q[i - 1, pr], Q[i, r])) for r in rows] for _, pr in prev])
+            while np.isfinite(d).any():
+                a, c = np.unravel_index(int(np.argmin(d)), d.shape)
+                if d[a, c] > _JUMP:
+                    break
+                now[prev[a][0]] = rows[c]
+                tracks[prev[a][0]][i] = Q[i, rows[c]]
+                d[a, :] = np.inf
+                d[:, c] = np.inf
+        for r in rows:
+            if r not in now:
+                tr = np.full((m, n), np.nan)
+                tr[i] = Q[i, r]
+                tracks.append(tr)
+                now.append(r)
+        last = now
+    if not tracks:
+        return np.full((m, 1, n), np.nan)
+    return np.stack(tracks, axis=1)
 
 
 def _wrap(a: np.ndarray) -> np.ndarray:
@@ -408,12 +542,21 @@ def nearest_on_manifold(robot: RobotLike, T: np.ndarray, q_near: np.ndarray, *,
 
 
 def auto_parameter(robot: RobotLike) -> str | None:
-    """The parameter ``self_motion(T)`` takes on this arm, or None (no closed form)."""
+    """The closed-form parameter ``self_motion(T)`` takes on this arm, or None.
+
+    None for arms that are not 7R, or whose self-motion is continued numerically
+    (no swivel, no held-joint closed form).
+    """
     def build() -> str | None:
-        try:
-            return _family(robot, np.eye(4), "auto").name
-        except InputError:
+        chain = robot.chain
+        if robot.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
             return None
+        if cached(chain, "swivel_arm", lambda: swivel_arm(chain)) is not None:
+            return "swivel"
+        from robokin.kinematics.ik.fixed import _held_solvers
+
+        usable = [n for n in robot.joint_names if n in _held_solvers(robot)]
+        return usable[-1] if usable else None
 
     return cached(robot.chain, "self_motion_parameter", build)
 
@@ -462,14 +605,9 @@ def _family(robot: RobotLike, T: np.ndarray, parameter: str) -> _Family:
             if not (arm is not None and n == names[3])}  # the SRS elbow: a family
     if parameter == "auto":
         usable = [n for n in names if n in held]
-        if not usable:
-            raise InputError("parameter", f"no held-joint closed form on {robot.name!r}: "
-                                          "the general 7R self-motion is not built yet")
-        parameter = usable[-1]
-    if parameter not in held:
-        raise InputError("parameter", f"no closed form with {parameter!r} held on "
-                                      f"{robot.name!r}; joints with one: "
-                                      f"{', '.join(held) or 'none'}")
+        parameter = usable[-1] if usable else names[-1]
+    if parameter not in held:  # the general held-joint 6R solver, continued
+        return _ContinuedFamily(robot, names.index(parameter), T)
     return _HeldFamily(robot, held[parameter].params, names.index(parameter), T)
 
 
@@ -496,6 +634,8 @@ def self_motion(robot: RobotLike, T: npt.ArrayLike, parameter: str = "auto", *,
     fam = _family(robot, Ta, parameter)
     limits = np.asarray(robot.limits, dtype=np.float64)
     marks = _exact_points(robot, fam, limits)
+    if isinstance(fam, _ContinuedFamily):
+        grid = min(int(grid), _CONTINUED_GRID)  # each value is a general-6R solve
     grid_t = _grid(fam, int(grid), marks)
     q, valid, _ = fam.rows(grid_t)
     ends, bisected = _state_changes(fam, grid_t, q, valid, limits, marks)
@@ -503,7 +643,8 @@ def self_motion(robot: RobotLike, T: npt.ArrayLike, parameter: str = "auto", *,
     crossings = tuple(LimitCrossing(t, b, j, s) for t, b, j, s in marks["limit"])
     singular = tuple(SingularPoint(t, b, k) for t, b, k in marks["fold"] + marks["aligned"])
     method = ("swivel closed form (SRS)" if fam.name == "swivel"
-              else f"analytic:pieper ({fam.name} held)")
+              else f"continued general 6R ({fam.name} held)"
+              if isinstance(fam, _ContinuedFamily) else f"analytic:pieper ({fam.name} held)")
     return SelfMotion(Ta, fam.name, fam.joint, np.array(fam.domain), fam.periodic, fam.k,
                       intervals, owner, crossings, singular, method,
                       {"bisected": bisected, "grid": int(grid)}, fam, limits)
