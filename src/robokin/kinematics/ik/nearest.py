@@ -75,7 +75,9 @@ def solve_near(
     from robokin.kinematics.ik.analytic.detect import detect
 
     fam = detect(robot)
-    if fam.solver is None and auto_parameter(robot) is not None:
+    if fam.solver is None and method == "auto" and auto_parameter(robot) is not None:
+        # a 7R arm with a closed-form self-motion ("analytic" still names the 6R
+        # families only, as before issue 29)
         return _manifold_near(robot, T, q_near)
     if fam.solver is None:
         if method == "analytic":

@@ -69,6 +69,8 @@ _JUMP = 0.3
 _CONTINUED_GRID = 181
 #: Step halvings of the continuation.
 _REFINE = 4
+#: Half-width [rad] of ik_near's window around q_near's own parameter value.
+_WINDOW = 0.05
 #: Zoom rounds of SelfMotion.best (each narrows to 2 / (samples - 1) of the span).
 _ZOOMS = 6
 
@@ -120,6 +122,11 @@ class _Family:
         """Parameter values where joint j may equal ``value`` (with the configuration)."""
         raise NotImplementedError
 
+    def param_of(self, q: np.ndarray) -> float:
+        """The parameter value of a configuration q (n,) (of this pose or near it)."""
+        assert self.joint is not None
+        return float(q[self.joint])
+
     def points(self, queries: list[tuple[int, float]]) -> list[list[tuple[float, int]]]:
         """Per query (joint j, value): every (t, branch) where joint j equals value.
 
@@ -162,6 +169,9 @@ class _SwivelFamily(_Family):
         q, real, sing = self.arm.configurations(self.fr, t)
         q, ok = _polish(self.robot, q, real, self.T)
         return q, ok, sing
+
+    def param_of(self, q: np.ndarray) -> float:
+        return float(self.arm.swivel_of(self.fr, q))
 
     def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
         if j == 3:
@@ -528,17 +538,28 @@ def nearest_on_manifold(robot: RobotLike, T: np.ndarray, q_near: np.ndarray, *,
     """The in-limit configuration of pose T (4, 4) nearest ``q_near`` (n,), or None.
 
     Without the exact intervals (``ik_near``'s fast path): every branch sampled at
-    ``samples`` parameter values, the nearest in-limit sample then zoomed in on.
+    ``samples`` parameter values over its range and over +-0.05 rad around
+    ``q_near``'s own parameter value, the nearest in-limit sample zoomed in on.
     """
     fam = _family(robot, T, "auto")
     k = fam.k
-    intervals = np.tile(np.array(fam.domain, dtype=np.float64), (k, 1))
+    lo, hi = fam.domain
+    # every branch over the whole range, and a window around q_near's own parameter
+    # value (an in-limit island narrower than the samples is found there)
+    tn = fam.param_of(q_near)
+    if fam.periodic:
+        window = (tn - _WINDOW, tn + _WINDOW)
+    else:
+        window = (max(lo, tn - _WINDOW), min(hi, tn + _WINDOW))
+        if window[0] >= window[1]:
+            window = (lo, hi)
+    intervals = np.vstack([np.tile([lo, hi], (k, 1)), np.tile(window, (k, 1))])
 
     def score(q: np.ndarray) -> np.ndarray:
         return -np.linalg.norm(_wrap(q - q_near), axis=-1)
 
     return _maximise(fam, np.asarray(robot.limits, dtype=np.float64), intervals,
-                     np.arange(k), score, samples)
+                     np.tile(np.arange(k), 2), score, samples)
 
 
 def auto_parameter(robot: RobotLike) -> str | None:
