@@ -71,8 +71,10 @@ _CONTINUED_GRID = 181
 _REFINE = 4
 #: Half-width [rad] of ik_near's window around q_near's own parameter value.
 _WINDOW = 0.05
-#: Zoom rounds of SelfMotion.best (each narrows to 2 / (samples - 1) of the span).
-_ZOOMS = 6
+#: Zoom rounds of SelfMotion.best / nearest (each narrows the span about 4 times).
+_ZOOMS = 8
+#: Intervals zoomed in on (the best by their samples).
+_KEEP = 3
 
 
 @dataclass(frozen=True)
@@ -474,7 +476,7 @@ class SelfMotion:
                 ``"manipulability"`` (Yoshikawa's, needs ``robot``) or a function
                 of configurations (m, n) -> scores (m,).
             robot: The arm (for ``"manipulability"``).
-            samples: Values per feasible interval before the golden-section refinement.
+            samples: Values per feasible interval before zooming in on the best.
         """
         score = _criterion(criterion, robot, self.limits)
         return self._maximise(score, samples)
@@ -496,24 +498,36 @@ class SelfMotion:
 
 def _maximise(fam: _Family, limits: np.ndarray, intervals: np.ndarray, branches: np.ndarray,
               score: Callable[[np.ndarray], np.ndarray], samples: int) -> ManifoldPoint | None:
-    """The best in-limit point: samples of every interval, then zooming in."""
+    """The best in-limit point: ``samples`` values per interval, then zooming in.
+
+    The best ``_KEEP`` intervals (by their best sample) are zoomed ``_ZOOMS`` times,
+    each time to +-1 step around their best value with 9 values.
+    """
     if not len(intervals):
         return None
     m = max(int(samples), 3)
-    u = np.linspace(0.0, 1.0, m)
     a, b = intervals[:, :1], intervals[:, 1:]
-    t, br = a + (b - a) * u, np.asarray(branches)
+    t, br = a + (b - a) * np.linspace(0.0, 1.0, m), np.asarray(branches)
+    s = _scores(fam, limits, score, t, br)
+    top = np.argsort(-s.max(axis=1))[:_KEEP]
+    top = top[np.isfinite(s[top].max(axis=1))]
+    if not len(top):
+        return None
+    t, s, br, a, b = t[top], s[top], br[top], a[top], b[top]
+    u = np.linspace(0.0, 1.0, 9)
     rows = np.arange(len(t))
     for _ in range(_ZOOMS):
-        i = np.argmax(_scores(fam, limits, score, t, br), axis=1)
-        step = (t[:, -1] - t[:, 0]) / (m - 1)
+        i = np.argmax(s, axis=1)
+        step = (t[:, -1] - t[:, 0]) / (t.shape[1] - 1)
         lo = np.maximum(t[rows, i] - step, a[:, 0])
         hi = np.minimum(t[rows, i] + step, b[:, 0])
+        keep_t, keep_s = t[rows, i], s[rows, i]
         t = lo[:, None] + (hi - lo)[:, None] * u
-    s = _scores(fam, limits, score, t, br)
+        s = _scores(fam, limits, score, t, br)
+        t, s = np.column_stack([t, keep_t]), np.column_stack([s, keep_s])  # never worse
+        order = np.argsort(t, axis=1)
+        t, s = np.take_along_axis(t, order, 1), np.take_along_axis(s, order, 1)
     r, c = np.unravel_index(int(np.argmax(s)), s.shape)
-    if not np.isfinite(s[r, c]):
-        return None
     q = fam.rows(np.array([t[r, c]]))[0][0, br[r]]
     return ManifoldPoint(q, float(t[r, c]), int(br[r]), float(s[r, c]))
 
@@ -534,7 +548,7 @@ def _scores(fam: _Family, limits: np.ndarray, score: Callable[[np.ndarray], np.n
 
 
 def nearest_on_manifold(robot: RobotLike, T: np.ndarray, q_near: np.ndarray, *,
-                        samples: int = 181) -> ManifoldPoint | None:
+                        samples: int = 61) -> ManifoldPoint | None:
     """The in-limit configuration of pose T (4, 4) nearest ``q_near`` (n,), or None.
 
     Without the exact intervals (``ik_near``'s fast path): every branch sampled at
