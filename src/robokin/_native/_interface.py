@@ -78,6 +78,7 @@ class Kernels(Protocol):
     AXES: int
     POINTS: int
     WRIST: int
+    PERP2: int
     TOOL_T: int
     TOOL_R: int
     PERP: int
@@ -105,6 +106,13 @@ class Kernels(Protocol):
     AA: int
     BB: int
     FAMILY: int
+    E5: int
+    PLANE: int
+    SPLIT_TOL: int
+    TOL_P: int
+    TOL_R: int
+    CHECK: int
+    SIZE: int
     N_PARAMS: int
     # family codes (params[FAMILY]) and per-pose status codes
     THREE_PARALLEL: int
@@ -121,6 +129,8 @@ class Kernels(Protocol):
     # general6r_solve: solutions per pose, parameter-vector layout (GP_*: header
     # fields; VB_*: one variant block of VB_SIZE values), status and flag codes
     G6_MAXSOL: int
+    G6_MAXCAND: int
+    G6_MAXVAR: int
     GP_NVAR: int
     GP_TAIL_TOL: int
     GP_NULL_TOL: int
@@ -129,6 +139,9 @@ class Kernels(Protocol):
     GP_DEDUPE: int
     GP_MAX_ITER: int
     GP_PAIR_GAP: int
+    GP_SCALE: int
+    GP_FALLBACK: int
+    GP_NEAR_TAIL: int
     GP_HEAD: int
     VB_DIR: int
     VB_A: int
@@ -142,10 +155,16 @@ class Kernels(Protocol):
     G6_DEGENERATE: int
     G6_BAD_POSE: int
     G6F_DEGENERATE: int
-    G6F_AMBIGUOUS: int
+    G6F_CLUSTER: int
     G6F_SECONDARY: int
     G6F_SEC_DEGENERATE: int
-    G6F_SEC_AMBIGUOUS: int
+    G6F_SEC_CLUSTER: int
+    G6F_PROJECTED: int
+    G6F_PROJ_DEGENERATE: int
+    G6F_RESCUED: int
+    G6F_NOISY: int
+    G6F_SEC_NOISY: int
+    G6F_EIGEN: int
     G6_DIAG_CAND_SHIFT: int
     # ---------------------------------------------------------- pieper.c constants
     # Pieper parameter vector layout (PIEPER_N_PARAMS entries, pieper.setup), the
@@ -175,6 +194,25 @@ class Kernels(Protocol):
     PIEPER_BAD_POSE: int
     PIEPER_PARALLEL_MIN: int
     PIEPER_TAG_VALUE: float
+    # --------------------------------------------------------- process.c constants
+    # process_nodes: node status codes (PN_*), coordinate modes (PM_*), the layout
+    # of its weights vector (PW_*: PW_N entries); process_dp's bucket cap
+    PN_OK: int
+    PN_NONE: int
+    PN_LIMITS: int
+    PN_SINGULAR: int
+    PM_PLAIN: int
+    PM_TURN: int
+    PM_CIRCLE: int
+    PW_SING_W: int
+    PW_SING_MARGIN: int
+    PW_SING_TOL: int
+    PW_MU_REF: int
+    PW_LIM_W: int
+    PW_LIM_MARGIN: int
+    PW_N: int
+    PR_MAXB: int
+    PR_LIMIT_TOL: float
     # ---------------------------------------------------------- FK and Jacobian
     def fk1(self, q: object, packed: object, /) -> F64 | None:
         """Pose (4, 4) of one configuration q (n,), or None for the general path."""
@@ -207,6 +245,15 @@ class Kernels(Protocol):
 
         Returns the number of targets not solved and the index of the first bad
         target or q0 (-1 if none).
+        """
+
+    def seed_uniforms(
+        self, targets: F64, q0: F64, key: int, base: int, out: F64, /
+    ) -> None:
+        """Restart numbers of targets (N, 4, 4) from q0 (N, n) into out (N, R, n).
+
+        Uniform in [0, 1), a stream per target keyed by its pose, its q0 and
+        ``key``; row r of out is the stream's number ``base + r``.
         """
 
     def lm_path(
@@ -250,14 +297,14 @@ class Kernels(Protocol):
 
     # ------------------------------------------------------------------ 6R IK
     def six_r_ik1(
-        self, T: object, params: F64, q6: float, /
+        self, T: object, params: F64, q6: float, packed: F64, /
     ) -> (
         tuple[int, F64, Bools, Bools, Bools] | tuple[int, None, None, None, None]
     ):
         """``(code, Q (8, 6), valid, singular, within_limits (8,))`` of one pose."""
 
     def six_r_ik(
-        self, params: F64, T: F64, qn: F64, /
+        self, params: F64, T: F64, qn: F64, packed: F64, /
     ) -> tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]:
         """``(Q (N, 8, 6), valid, singular, within_limits (N, 8), status (N,))``."""
 
@@ -299,6 +346,9 @@ class Kernels(Protocol):
         self, consts: F64, a: int, angles: F64, X: F64, Y: F64, /
     ) -> None:
         """The left side's fitting rows at angles (M, 3): X (M, 27), Y (M, 14)."""
+
+    def general6r_candidates(self, params: F64, T: F64, out: F64, /) -> tuple[int, int]:
+        """One pose's candidates before the polish (chain values) into out; (n, flags)."""
 
     def general6r_roots(self, c: F64, wr: F64, wi: F64, /) -> bool:
         """Roots of the polynomial with coefficients c (low order first), into wr, wi."""
@@ -362,6 +412,55 @@ class Kernels(Protocol):
         /,
     ) -> None:
         """Per interval and pair, the bound on the change of the distance, into out."""
+
+    # --------------------------------------------------------- process paths
+    def process_nodes(
+        self,
+        packed: F64,
+        Q: F64,
+        valid: Bools,
+        singular: Bools,
+        mode: npt.NDArray[np.uint8],
+        weights: F64,
+        Qc: F64,
+        cost: F64,
+        mu: F64,
+        code: npt.NDArray[np.int8],
+        /,
+    ) -> None:
+        """Per node of Q (P, n): canonical values Qc, cost, manipulability, status."""
+
+    def process_dp(
+        self,
+        Q: F64,
+        cost: F64,
+        circle: npt.NDArray[np.uint8],
+        max_step: float,
+        weight: float,
+        start: F64,
+        forbidden: I64,
+        value: F64,
+        pred: npt.NDArray[np.int32],
+        restart: npt.NDArray[np.uint8],
+        choice: npt.NDArray[np.int32],
+        /,
+    ) -> int:
+        """The exact shortest path through layers Q (L, M, n); returns the segments."""
+
+    def process_clusters(
+        self, Q: F64, cost: F64, circle: npt.NDArray[np.uint8], out: F64, /
+    ) -> None:
+        """The least largest-joint-change between every two layers into out (P, P)."""
+
+    def process_pairs(
+        self, A: F64, B: F64, circle: npt.NDArray[np.uint8], out: F64, /
+    ) -> None:
+        """The largest joint change between every row of A (a, n) and B (b, n)."""
+
+    def process_limit_cost(
+        self, values: F64, lo: float, hi: float, margin: float, out: F64, /
+    ) -> None:
+        """The limit cost of each value (P,) into out (P,)."""
 
     # ------------------------------------------------------- for tests and set-up
     def seg_seg(self, pts: F64, out: F64, /) -> None:

@@ -71,6 +71,8 @@ def describe_scene(scene: Scene) -> bytes:
         parts.append(np.asarray(scene.tool.tcp).tobytes())
         parts.extend(_describe_shape(s) for s in scene.tool.shapes)
     parts.extend(",".join(sorted(p)).encode() for p in sorted(scene.exclude, key=sorted))
+    parts.append(repr(getattr(scene, "allowed", None)).encode())
+    parts.append(repr(sorted(getattr(scene, "groups", {}).items())).encode())
     return b"|".join(parts)
 
 
@@ -81,4 +83,6 @@ def _describe_shape(shape: Shape) -> bytes:
         np.asarray(shape.placement, dtype=np.float64).tobytes(),
         str(shape.file or "").encode(),
         np.float64(shape.scale).tobytes(),
+        b"" if shape.vertices is None else np.asarray(shape.vertices).tobytes(),
+        b"" if shape.faces is None else np.asarray(shape.faces).tobytes(),
     ])

@@ -1,8 +1,9 @@
 """URDF in (URDF out is :mod:`robokin.io.urdf_export`).
 
-* :func:`robot_from_urdf` reads a URDF (file or XML string, parsed with
-  ``yourdfpy``, the ``robokin[urdf]`` extra) and compiles the serial chain from a
-  base link to a tip link to the canonical chain.
+* :func:`parts_from_urdf` reads a URDF (file or XML string, parsed with
+  ``yourdfpy``, the ``robokin[urdf]`` extra), compiles the serial chain from a
+  base link to a tip link to the canonical chain and returns the robot's parts
+  (:meth:`robokin.robot.Robot.from_urdf` makes them a Robot).
 * :func:`dh_from_urdf` derives standard and modified DH tables from a URDF arm
   (see :mod:`robokin.io.dh_extract`).
 
@@ -40,239 +41,53 @@ Import rules (documented in ``docs/urdf.md``):
 from __future__ import annotations
 
 import math
-import os
-import re
 import warnings
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from robokin._text import short_repr
-from robokin.exceptions import ModelError
+from robokin.exceptions import ModelError, user_stacklevel
 from robokin.io.ros_packages import PackageFinder
+from robokin.io.urdf_geometry import (
+    Drops,
+    MissingMesh,
+    geometry_of,
+    resolve_mesh,
+    with_shapes,
+)
+from robokin.io.urdf_tool import (
+    axis_frame,
+    freeze_tool_tree,
+    link_owners,
+    resolve_mimic,
+)
+from robokin.io.urdf_tree import Step, Tree, UrdfChain
 from robokin.io.urdf_xml import MAX_URDF_JOINTS, MOVABLE, parse_urdf
 from robokin.model.chain import Chain, ChainBuilder, Joint, JointKind
 from robokin.model.coupling import Dependency, coupling_from_dependencies, mimic
-from robokin.model.geometry import MESH_SUFFIXES, mesh_file_problem
+from robokin.model.parts import RobotParts
+from robokin.spatial import invert
 
 if TYPE_CHECKING:
     from robokin.io.dh_extract import DHExtraction
     from robokin.io.xacro import XacroExpansion
-    from robokin.robot import Robot
 
 __all__ = [
     "MAX_URDF_JOINTS",
     "UrdfChain",
-    "dh_from_robot",
+    "axis_frame",
     "dh_from_urdf",
     "parse_urdf",
-    "robot_from_urdf",
+    "parts_from_urdf",
+    "resolve_mesh",
 ]
-
-MissingMesh = Literal["warn", "error", "ignore"]
-_SCHEME = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]*)://")
-
-# Exact rotations that take the local z axis onto +x / +y (no cos(pi/2) residue).
-_Z_TO_X = np.array([[0.0, 0, 1, 0], [0, 1, 0, 0], [-1, 0, 0, 0], [0, 0, 0, 1]])
-_Z_TO_Y = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]])
-
-
-@dataclass(frozen=True)
-class _Step:
-    """One URDF joint on the path, walked forwards or (fixed joints only) backwards."""
-
-    joint: Any
-    reverse: bool
-
-
-class _Tree:
-    """The link/joint tree of a parsed URDF with checks and path queries."""
-
-    def __init__(self, robot: Any, file: Path | None) -> None:
-        self.file = file
-        self.links: dict[str, Any] = {}
-        for link in robot.links:
-            if link.name in self.links:
-                raise ModelError(f"link '{link.name}' is defined twice", file=file)
-            self.links[link.name] = link
-        self.joints: dict[str, Any] = {}
-        self.parent_joint: dict[str, Any] = {}
-        self.children: dict[str, list[Any]] = {name: [] for name in self.links}
-        for j in robot.joints:
-            where = f"joint[{j.name}]"
-            if j.name in self.joints:
-                raise ModelError("joint defined twice", file=file, field=where)
-            for role in ("parent", "child"):
-                link = getattr(j, role)
-                if link not in self.links:
-                    raise ModelError(
-                        f"{role} link '{link}' is not defined", file=file,
-                        field=f"{where}.{role}",
-                    )
-            if j.child in self.parent_joint:
-                raise ModelError(
-                    f"link '{j.child}' has two parent joints "
-                    f"('{self.parent_joint[j.child].name}' and '{j.name}'): "
-                    "a URDF must be a tree",
-                    file=file, field=where,
-                )
-            self.joints[j.name] = j
-            self.parent_joint[j.child] = j
-            self.children[j.parent].append(j)
-        roots = [n for n in self.links if n not in self.parent_joint]
-        if not roots:
-            raise ModelError("the joints form a loop: no root link", file=file)
-        if len(roots) > 1:
-            raise ModelError(
-                f"several root links {roots}: a URDF must be one connected tree",
-                file=file,
-            )
-        self.root = roots[0]
-        # Every link must be reachable from the root (no loop elsewhere).
-        seen = set(self._descendants(self.root))
-        if len(seen) != len(self.links):
-            loop = sorted(set(self.links) - seen)
-            raise ModelError(f"links {loop} form a loop", file=file)
-
-    def _descendants(self, link: str) -> list[str]:
-        out, stack = [], [link]
-        while stack:
-            cur = stack.pop()
-            out.append(cur)
-            stack.extend(j.child for j in self.children[cur])
-        return out
-
-    def ancestors(self, link: str) -> list[str]:
-        """The link, its parent link, ..., the root."""
-        out = [link]
-        while out[-1] in self.parent_joint:
-            out.append(self.parent_joint[out[-1]].parent)
-        return out
-
-    def check_link(self, name: str, role: str) -> None:
-        if name not in self.links:
-            names = sorted(self.links)
-            shown = ", ".join(names[:30]) + (" ..." if len(names) > 30 else "")
-            raise ModelError(
-                f"unknown {role} link '{name}'; links: {shown}", file=self.file,
-                field=f"{role}_link",
-            )
-
-    def path(self, base: str, tip: str) -> list[_Step]:
-        """The joints from ``base`` to ``tip``."""
-        up = self.ancestors(base)
-        down = self.ancestors(tip)
-        down_set = set(down)
-        common = next(a for a in up if a in down_set)  # one tree: the root at least
-        steps = []
-        for link in up[: up.index(common)]:
-            j = self.parent_joint[link]
-            if j.type != "fixed":
-                raise ModelError(
-                    f"the base link '{base}' hangs below the movable joint '{j.name}' "
-                    f"that is not between it and the tip '{tip}'; choose a base link "
-                    f"above it (e.g. '{self.root}')",
-                    file=self.file, field="base_link",
-                )
-            steps.append(_Step(j, True))
-        for link in reversed(down[: down.index(common)]):
-            steps.append(_Step(self.parent_joint[link], False))
-        return steps
-
-    def default_tip(self, base: str) -> str:
-        """The leaf below ``base`` whose path has the most movable joints."""
-        top = base  # a base hanging by fixed joints (ROS-I 'base') looks from above
-        while top in self.parent_joint and self.parent_joint[top].type == "fixed":
-            top = self.parent_joint[top].parent
-        leaves = [n for n in self._descendants(top) if not self.children[n]]
-        counts = {
-            leaf: sum(s.joint.type in MOVABLE for s in self.path(base, leaf))
-            for leaf in leaves
-        }
-        best = max(counts.values())
-        if best == 0:
-            raise ModelError(
-                f"no movable joint below the base link '{base}'", file=self.file,
-                field="tip_link",
-            )
-        cands = sorted(leaf for leaf, c in counts.items() if c == best)
-        if len(cands) == 1:
-            return cands[0]
-        if "tool0" in cands:
-            return "tool0"
-        raise ModelError(
-            f"ambiguous tip link: {len(cands)} leaves {cands} are each {best} movable "
-            f"joints from '{base}'; pass tip_link= (CLI: --tip) to choose one",
-            file=self.file, field="tip_link",
-        )
 
 
 def _origin(j: Any) -> np.ndarray:
     return np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=np.float64)
-
-
-def _invert(T: np.ndarray) -> np.ndarray:
-    out = np.eye(4)
-    out[:3, :3] = T[:3, :3].T
-    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
-    return out
-
-
-def axis_frame(axis: Sequence[float], *, where: str = "axis") -> tuple[np.ndarray, float]:
-    """A rotation ``A`` (4, 4) and sign with ``A @ Rz(sign q) @ A.T`` = rotation about ``axis``.
-
-    Axis-aligned axes give exact matrices; a negative axis (``-x``, ``-y``, ``-z``,
-    or any axis with a negative z component) gives ``sign = -1``.
-
-    Raises:
-        ModelError: a zero or non-finite axis.
-    """
-    u = np.asarray(axis, dtype=np.float64).reshape(-1)
-    norm = float(np.linalg.norm(u)) if u.shape == (3,) else 0.0
-    if u.shape != (3,) or not np.isfinite(u).all() or norm < 1e-12:
-        raise ModelError(f"the joint axis must be a non-zero 3-vector, got {u.tolist()}",
-                         field=where)
-    u = u / norm
-    nz = np.flatnonzero(np.abs(u) > 1e-15)
-    if len(nz) == 1:
-        i = int(nz[0])
-        sign = 1.0 if u[i] > 0 else -1.0
-        return ((_Z_TO_X, _Z_TO_Y, np.eye(4))[i]).copy(), sign
-    sign = 1.0
-    if u[2] < 0:
-        u, sign = -u, -1.0
-    # Minimal rotation taking z onto u (Rodrigues, 1 + cos >= 1 here).
-    v = np.array([-u[1], u[0], 0.0])
-    c = u[2]
-    K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    A = np.eye(4)
-    A[:3, :3] = np.eye(3) + K + K @ K / (1.0 + c)
-    return A, sign
-
-
-@dataclass(frozen=True)
-class UrdfChain:
-    """What :func:`robot_from_urdf` made of the URDF, besides the chain.
-
-    Attributes:
-        base_link: The chosen base link.
-        tip_link: The chosen tip link.
-        child_links: The URDF child link of every chain joint (n_chain).
-        link_frames: Every URDF link rigidly attached to the chain:
-            ``name -> (k, T)``, the link's pose ``T`` (4, 4) in the frame ``k`` of
-            ``fk_all`` (0: the base link; k: chain joint k's child link).
-        dropped_links: Links not rigidly attached to the chain (they move with
-            joints off the chain), sorted.
-    """
-
-    base_link: str
-    tip_link: str
-    child_links: tuple[str, ...]
-    link_frames: Mapping[str, tuple[int, np.ndarray]]
-    dropped_links: tuple[str, ...]
 
 
 def _limits(j: Any, file: Path | None) -> tuple[float, float]:
@@ -313,49 +128,14 @@ def _kind(j: Any) -> JointKind:
     return "prismatic" if j.type == "prismatic" else "revolute"
 
 
-def _resolve_mimic(tree: _Tree, j: Any) -> tuple[Any, float, float]:
-    """The independent master of a mimic joint, with the composed multiplier/offset."""
-    mult, off, seen = 1.0, 0.0, {j.name}
-    cur = j
-    while cur.mimic is not None:
-        name = cur.mimic.joint
-        master = tree.joints.get(name)
-        where = f"joint[{cur.name}].mimic"
-        if master is None:
-            raise ModelError(f"mimics unknown joint '{name}'", file=tree.file, field=where)
-        if master.type not in MOVABLE:
-            raise ModelError(
-                f"mimics the {master.type} joint '{name}'", file=tree.file, field=where
-            )
-        if name in seen:
-            raise ModelError("mimic joints form a loop", file=tree.file, field=where)
-        seen.add(name)
-        m = 1.0 if cur.mimic.multiplier is None else float(cur.mimic.multiplier)
-        o = 0.0 if cur.mimic.offset is None else float(cur.mimic.offset)
-        mult, off = mult * m, mult * o + off
-        cur = master
-    return cur, mult, off
+def _path_steps(tree: Tree, base_link: str | None, tip_link: str | None,
+                file: Path | None) -> tuple[str, str, list[Step], int]:
+    """The base, the tip, the joints between them and the index of the last movable one.
 
-
-def chain_from_urdf_model(
-    robot: Any,
-    *,
-    base_link: str | None = None,
-    tip_link: str | None = None,
-    file: Path | None = None,
-) -> tuple[Chain, UrdfChain]:
-    """Compile the chain ``base_link`` -> ``tip_link`` of a parsed URDF model.
-
-    Args:
-        robot: A ``yourdfpy.Robot`` (``yourdfpy.URDF(...).robot``).
-        base_link: Base link name (default: the root).
-        tip_link: Tip link name (default: see the module docstring).
-        file: The file, for error messages.
-
-    Returns:
-        The canonical chain and the :class:`UrdfChain` bookkeeping.
+    Raises:
+        ModelError: an unknown link, base = tip, a floating or planar joint on the
+            path, or no movable joint (naming the file and field).
     """
-    tree = _Tree(robot, file)
     base = tree.root if base_link is None else str(base_link)
     tree.check_link(base, "base")
     if tip_link is None:
@@ -378,7 +158,45 @@ def chain_from_urdf_model(
         raise ModelError(
             f"no movable joint between '{base}' and '{tip}'", file=file, field="tip_link"
         )
-    last = movable[-1]
+    return base, tip, steps, movable[-1]
+
+
+def _add_hanging_links(tree: Tree, frames: dict[str, tuple[int, np.ndarray]]) -> None:
+    """Add to ``frames`` the links hanging off the path by fixed joints (they move with it)."""
+    stack = list(frames)
+    while stack:
+        link = stack.pop()
+        kk, T = frames[link]
+        for j in tree.children[link]:
+            if j.child in frames or j.type != "fixed":
+                continue
+            frames[j.child] = (kk, T @ _origin(j))
+            stack.append(j.child)
+
+
+def chain_from_urdf_model(
+    urdf_robot: Any,
+    *,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    file: Path | None = None,
+    tool_joints: Mapping[str, float] | None = None,
+) -> tuple[Chain, UrdfChain]:
+    """Compile the chain ``base_link`` -> ``tip_link`` of a parsed URDF model.
+
+    Args:
+        urdf_robot: A ``yourdfpy.Robot`` (``yourdfpy.URDF(...).robot``).
+        base_link: Base link name (default: the root).
+        tip_link: Tip link name (default: see the module docstring).
+        file: The file, for error messages.
+        tool_joints: Positions of joints in the tool's tree (default: 0 clamped
+            into their limits); see :mod:`robokin.io.urdf_tool`.
+
+    Returns:
+        The canonical chain and the :class:`UrdfChain` bookkeeping.
+    """
+    tree = Tree(urdf_robot, file)
+    base, tip, steps, last = _path_steps(tree, base_link, tip_link, file)
     builder = ChainBuilder()
     tool = np.eye(4)
     coords: list[Joint] = []
@@ -399,7 +217,7 @@ def chain_from_urdf_model(
     for i, s in enumerate(steps):
         j = s.joint
         if s.reverse:  # fixed, walked from child to parent
-            C = _invert(_origin(j))
+            C = invert(_origin(j))
             builder.constant(C)
             T_rel = T_rel @ C
             frames[j.parent] = (k, T_rel.copy())
@@ -422,7 +240,7 @@ def chain_from_urdf_model(
             add_coordinate(j)
             joint = Joint(j.name, kind, _limits(j, file), sign)
         else:
-            master, mult, off = _resolve_mimic(tree, j)
+            master, mult, off = resolve_mimic(tree.joints, j, file)
             add_coordinate(master)
             deps[j.name] = mimic(master.name, mult, off)
             lim = (-math.inf, math.inf) if j.limit is None else _limits(j, file)
@@ -437,17 +255,13 @@ def chain_from_urdf_model(
         coupling = coupling_from_dependencies(names, [c.name for c in coords], deps)
         coordinates = tuple(coords)
     chain = builder.build(tool=tool, coordinates=coordinates, coupling=coupling)
-    # Links hanging off the path by fixed joints move with it.
-    on_path = set(frames)
-    stack = list(on_path)
-    while stack:
-        link = stack.pop()
-        kk, T = frames[link]
-        for j in tree.children[link]:
-            if j.child in frames or j.type != "fixed":
-                continue
-            frames[j.child] = (kk, T @ _origin(j))
-            stack.append(j.child)
+    _add_hanging_links(tree, frames)
+    # The tool's tree: subtrees below the last link's rigid body, joints frozen.
+    positions, left_out = freeze_tool_tree(
+        tree, frames, len(names), set(names) | coord_names, tool_joints, file)
+    for msg in left_out:
+        warnings.warn(f"{file or 'URDF'}: {msg} left out: they move with the arm",
+                      UserWarning, stacklevel=user_stacklevel())
     dropped = tuple(sorted(set(tree.links) - set(frames)))
     info = UrdfChain(
         base_link=base,
@@ -455,180 +269,14 @@ def chain_from_urdf_model(
         child_links=tuple(child_links),
         link_frames=frames,
         dropped_links=dropped,
+        owners=link_owners(frames, names, child_links[-1]),
+        tool_joints=positions,
     )
     return chain, info
 
 
-# ---------------------------------------------------------------------- geometry
-def _resolve_mesh(
-    filename: str, file: Path | None, packages: PackageFinder
-) -> tuple[Path | None, str]:
-    """Resolve a mesh reference to a path; ``(None, reason)`` when it cannot be."""
-    if filename.startswith("package://"):
-        rest = filename[len("package://"):]
-        pkg, _, sub = rest.partition("/")
-        root = packages.find(pkg)
-        if root is None:
-            return None, packages.not_found(pkg)
-        inside = os.path.normpath(sub)
-        if os.path.isabs(sub) or inside == ".." or inside.startswith(".." + os.sep):
-            return None, (f"the path leaves the package '{pkg}' (its folder {root}; "
-                          f"it resolves to {os.path.normpath(root / sub)}): not read")
-        return _mesh_file(root / sub)
-    if filename.startswith("file://"):
-        return _mesh_file(Path(filename[len("file://"):]))
-    scheme = _SCHEME.match(filename)
-    if scheme:
-        return None, f"a remote mesh ({scheme.group(1)}://) is not fetched"
-    p = Path(filename)
-    if not p.is_absolute():
-        if file is None:
-            return None, "a relative mesh path in a URDF string has no directory"
-        p = file.parent / p
-    return _mesh_file(p)
-
-
-def _mesh_file(p: Path) -> tuple[Path | None, str]:
-    """``p`` when it names an existing mesh file robokin reads, else the reason."""
-    if p.suffix.lower() not in MESH_SUFFIXES:
-        return None, (f"not a mesh file (suffix {short_repr(p.suffix)}; robokin "
-                      f"reads {', '.join(MESH_SUFFIXES)})")
-    problem = mesh_file_problem(p)
-    if problem is not None:
-        return None, problem
-    return p, ""
-
-
-class _Drops:
-    """Shapes left out of the import: raised, or recorded and reported per reason.
-
-    Shapes left out for the same reason (every mesh of one missing package) make
-    one note: :meth:`notes`, warned once each in ``"warn"`` mode by :meth:`report`.
-    """
-
-    def __init__(self, mode: MissingMesh, file: Path | None) -> None:
-        self.mode, self.file = mode, file
-        self.messages: list[str] = []
-        self._by_reason: dict[str, list[tuple[str, str, str]]] = {}
-
-    def drop(self, link: str, role: str, uri: str, why: str) -> None:
-        msg = f"link '{link}' {role} mesh {short_repr(uri, 200)}: {why}"
-        if self.mode == "error":
-            raise ModelError(msg, file=self.file, field=f"link[{link}].{role}")
-        self.messages.append(msg)
-        self._by_reason.setdefault(why, []).append((link, role, uri))
-
-    def notes(self) -> tuple[str, ...]:
-        """One line per reason: the shape (or how many, of which links) and why."""
-        out = []
-        for why, shapes in self._by_reason.items():
-            if len(shapes) == 1:
-                link, role, uri = shapes[0]
-                out.append(f"link '{link}' {role} mesh {short_repr(uri, 200)}: {why}")
-                continue
-            links = list(dict.fromkeys(link for link, _, _ in shapes))
-            shown = ", ".join(links[:8]) + (f" and {len(links) - 8} more"
-                                            if len(links) > 8 else "")
-            roles = " and ".join(sorted({role for _, role, _ in shapes},
-                                        reverse=True))
-            out.append(f"{len(shapes)} {roles} meshes of link"
-                       f"{'s' if len(links) > 1 else ''} {shown}: {why}")
-        return tuple(out)
-
-    def report(self, stacklevel: int) -> None:
-        """Warn once per reason (``"warn"`` mode)."""
-        if self.mode == "warn":
-            for note in self.notes():
-                warnings.warn(f"left out {note}; shapes skipped", UserWarning,
-                              stacklevel=stacklevel + 1)
-
-
-def _geometry_of(
-    urdf_robot: Any,
-    info: UrdfChain,
-    file: Path | None,
-    packages: PackageFinder,
-    drops: _Drops,
-) -> list[dict[str, Any]]:
-    """Every visual and collision shape of the chain's links, placed in fk_all frames.
-
-    Each entry: ``{"link": URDF link, "frame": k, "role": "visual"|"collision",
-    "pose": (4, 4) in frame k, "type": "box"|"cylinder"|"sphere"|"mesh",
-    "size"|"radius"|"length"|"filename"|"scale": ...}``.
-    """
-    out: list[dict[str, Any]] = []
-    for link in urdf_robot.links:
-        if link.name not in info.link_frames:
-            continue
-        k, T = info.link_frames[link.name]
-        for role, items in (("visual", link.visuals), ("collision", link.collisions)):
-            for item in items:
-                g = item.geometry
-                pose = T @ (np.eye(4) if item.origin is None else item.origin)
-                entry: dict[str, Any] = {
-                    "link": link.name, "frame": k, "role": role, "pose": pose,
-                    "name": item.name,
-                }
-                if g.box is not None:
-                    entry.update(type="box", size=tuple(float(v) for v in g.box.size))
-                elif g.cylinder is not None:
-                    entry.update(type="cylinder", radius=float(g.cylinder.radius),
-                                 length=float(g.cylinder.length))
-                elif g.sphere is not None:
-                    entry.update(type="sphere", radius=float(g.sphere.radius))
-                elif g.mesh is not None:
-                    path, why = _resolve_mesh(g.mesh.filename, file, packages)
-                    if path is None:
-                        drops.drop(link.name, role, g.mesh.filename, why)
-                        continue
-                    scale = g.mesh.scale
-                    scale = (1.0, 1.0, 1.0) if scale is None else tuple(
-                        float(v) for v in np.broadcast_to(scale, (3,))
-                    )
-                    entry.update(type="mesh", filename=str(path), scale=scale,
-                                 uri=g.mesh.filename)
-                else:  # pragma: no cover - _check_xml refuses empty geometry
-                    continue
-                out.append(entry)
-    return out
-
-
-def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]], drops: _Drops
-                     ) -> Robot:
-    """Put the collision shapes on the geometry layer.
-
-    Visual shapes stand in where a link has no collision shape.
-    """
-    from robokin.model import geometry as geo
-
-    names = geo.link_names(robot)
-    with_collision = {e["link"] for e in shapes if e["role"] == "collision"}
-    per_link: dict[str, list[Any]] = {}
-    for e in shapes:
-        if e["role"] == "visual" and e["link"] in with_collision:
-            continue
-        pose, label = e["pose"], e.get("name") or ""
-        t = e["type"]
-        if t == "box":
-            shape = geo.box(e["size"], pose, name=label)
-        elif t == "cylinder":
-            shape = geo.cylinder(e["radius"], e["length"], pose, name=label)
-        elif t == "sphere":
-            shape = geo.sphere(e["radius"], pose, name=label)
-        else:
-            sc = e["scale"]
-            if not (sc[0] == sc[1] == sc[2]):
-                drops.drop(e["link"], e["role"], e["uri"],
-                           f"non-uniform scale {list(sc)} is not supported")
-                continue
-            shape = geo.mesh(e["filename"], pose, scale=sc[0], name=label,
-                             owner=e["link"])
-        per_link.setdefault(names[e["frame"]], []).append(shape)
-    return robot.replace(geometry=geo.RobotGeometry.from_mapping(robot, per_link))
-
-
 # ------------------------------------------------------------------------ public
-def robot_from_urdf(
+def parts_from_urdf(
     path_or_string: str | Path | bytes,
     base_link: str | None = None,
     tip_link: str | None = None,
@@ -638,8 +286,18 @@ def robot_from_urdf(
     geometry: bool = True,
     missing_mesh: MissingMesh = "warn",
     name: str | None = None,
-) -> Robot:
-    """Load the serial chain of a URDF or xacro as a robot (needs ``robokin[urdf]``).
+    srdf: str | Path | bytes | None = None,
+    tool_joints: Mapping[str, float] | None = None,
+) -> RobotParts:
+    """The parts of the serial chain of a URDF or xacro (needs ``robokin[urdf]``).
+
+    :meth:`robokin.robot.Robot.from_urdf` takes the same arguments and returns
+    a Robot.
+
+    Links hung by fixed joints anywhere on the chain move with their link, and
+    the links below the tip (a gripper's tree, its fingers frozen at
+    ``tool_joints``) join the tool (:mod:`robokin.io.urdf_tool`); their shapes
+    become those links' geometry.
 
     Args:
         path_or_string: A URDF file path, or the XML itself (a string starting
@@ -664,15 +322,25 @@ def robot_from_urdf(
             same reason (every mesh of a package that is not found) give one
             warning.
         name: The robot's name (default: the URDF's ``<robot name>``).
+        srdf: The robot's SRDF (a path or the XML; :mod:`robokin.io.srdf`):
+            its ``<disable_collisions>`` pairs become self-collision exclusions
+            on robokin's links (:func:`robokin.io.srdf.excluded_link_pairs`)
+            and, as in MoveIt, every other pair is checked (adjacent links are
+            no longer skipped by default); without ``tip_link`` its end
+            effector's parent link (or its chain's tip) is the tip.
+        tool_joints: ``{joint: position}`` [rad, m] for joints of the tool's
+            tree (a gripper's fingers; default: 0 clamped into the limits).
 
     Returns:
-        A :class:`~robokin.robot.Robot` (its ``dynamics`` from the links'
+        :class:`~robokin.model.parts.RobotParts` (their ``dynamics`` from the links'
         ``<inertial>`` and the joints' ``effort``, see
         :mod:`robokin.io.urdf_inertial`) with ``robot.meta["urdf"]`` holding the
         :class:`UrdfChain`, ``robot.meta["urdf_shapes"]`` the shapes,
         ``robot.meta["urdf_dropped_shapes"]`` one message per shape left out,
         ``robot.meta["urdf_dropped_notes"]`` one per reason (what ``robokin
-        import`` prints) and, for a xacro, ``robot.meta["xacro"]`` the
+        import`` prints), ``robot.meta["srdf"]`` the
+        :class:`~robokin.io.srdf.Srdf` (when given) and, for a xacro,
+        ``robot.meta["xacro"]`` the
         :class:`~robokin.io.xacro.XacroExpansion` (its ``urdf`` is the
         expanded text).
 
@@ -681,10 +349,11 @@ def robot_from_urdf(
             xacro, an error in it or a package that is not found.
         InputError: a package map folder that does not exist; ``xacro_args``
             for a file that is not a xacro, or naming an argument the xacro
-            does not declare.
+            does not declare; a ``tool_joints`` entry that is not a joint of
+            the tool's tree or is outside its limits.
         MissingExtraError: yourdfpy (or, for a xacro, xacro) is not installed.
     """
-    from robokin.robot import Robot
+    from robokin.io.srdf import parse_srdf
 
     if missing_mesh not in ("warn", "error", "ignore"):
         raise ModelError(
@@ -694,13 +363,20 @@ def robot_from_urdf(
         )
     expansion, urdf_robot, file = _parse_source(path_or_string, package_map,
                                                 xacro_args)
+    semantic = None if srdf is None else parse_srdf(srdf)
+    if semantic is not None:
+        links = {link.name for link in urdf_robot.links}
+        semantic.check_links(links, urdf_robot.name)
+        if tip_link is None:
+            tip_link = semantic.default_tip(links)
     chain, info = chain_from_urdf_model(
-        urdf_robot, base_link=base_link, tip_link=tip_link, file=file
+        urdf_robot, base_link=base_link, tip_link=tip_link, file=file,
+        tool_joints=tool_joints,
     )
-    drops = _Drops(missing_mesh, file)
+    drops = Drops(missing_mesh, file)
     packages = expansion.packages if expansion is not None else \
         PackageFinder(package_map, near=file)
-    shapes = _geometry_of(urdf_robot, info, file, packages, drops) if geometry \
+    shapes = geometry_of(urdf_robot, info, file, packages, drops) if geometry \
         else []
     source = "URDF string" if file is None else \
         f"{'xacro' if expansion is not None else 'URDF'} {file}"
@@ -709,20 +385,19 @@ def robot_from_urdf(
         meta["xacro"] = expansion
         if expansion.args:
             source += " (" + ", ".join(f"{k}:={v}" for k, v in expansion.args.items()) + ")"
-    robot = Robot(
+    robot = RobotParts(
         chain,
         name=name or urdf_robot.name,
         source=f"{source}, chain {info.base_link} -> {info.tip_link}",
         meta=meta,
         rate_limits=_velocity_limits(urdf_robot, chain, source),
     )
-    if shapes:
-        robot = _attach_geometry(robot, shapes, drops)
+    robot = with_shapes(robot, shapes, drops, info, semantic)
     from robokin.io.urdf_inertial import dynamics_from_urdf
 
     robot = robot.replace(dynamics=dynamics_from_urdf(robot, urdf_robot,
                                                       info.link_frames, file))
-    drops.report(stacklevel=2)
+    drops.report()
     return robot.replace(meta={**robot.meta,
                                "urdf_dropped_shapes": tuple(drops.messages),
                                "urdf_dropped_notes": drops.notes()})
@@ -770,7 +445,7 @@ def dh_from_urdf(
     Args:
         path_or_string: URDF file, XML string or xacro file.
         base_link: Chain start (default: the root).
-        tip_link: Chain end (default as in :func:`robot_from_urdf`).
+        tip_link: Chain end (default as in :func:`parts_from_urdf`).
         convention: ``"standard"`` or ``"modified"``.
         reference_link: The link whose frame guides the choice of DH frame 0 (its
             x axis and origin). Default: the ROS-Industrial ``base`` link when the
@@ -778,15 +453,15 @@ def dh_from_urdf(
             base frame, which vendors' DH tables use), else the base link.
         virtual_frames: Fold the remaining base and tool transforms into fixed
             rows (virtual frames) so the table alone reproduces the robot.
-        package_map: As in :func:`robot_from_urdf` (a xacro's ``$(find)``).
-        xacro_args: As in :func:`robot_from_urdf`.
+        package_map: As in :func:`parts_from_urdf` (a xacro's ``$(find)``).
+        xacro_args: As in :func:`parts_from_urdf`.
 
     Returns:
         A :class:`~robokin.io.dh_extract.DHExtraction`.
     """
     from robokin.io.dh_extract import dh_from_robot as _dh
 
-    robot = robot_from_urdf(path_or_string, base_link, tip_link, package_map,
+    robot = parts_from_urdf(path_or_string, base_link, tip_link, package_map,
                             xacro_args=xacro_args, geometry=False)
     info: UrdfChain = robot.meta["urdf"]
     ref = reference_link
@@ -802,12 +477,3 @@ def dh_from_urdf(
         reference = info.link_frames[ref][1]
     return _dh(robot, convention=convention, reference=reference,
                virtual_frames=virtual_frames)
-
-
-def dh_from_robot(
-    robot: Robot, convention: Literal["standard", "modified"] = "standard", **kwargs: Any
-) -> DHExtraction:
-    """See :func:`robokin.io.dh_extract.dh_from_robot`."""
-    from robokin.io.dh_extract import dh_from_robot as _dh
-
-    return _dh(robot, convention=convention, **kwargs)

@@ -35,8 +35,6 @@ the meshes themselves.
 from __future__ import annotations
 
 import math
-import os
-import stat
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -46,15 +44,19 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin._text import short_repr
-from robokin.exceptions import InputError, MissingExtraError, ModelError
+from robokin.exceptions import InputError, MissingExtraError
+from robokin.model.mesh_files import load_mesh, mesh_file_problem
 
 if TYPE_CHECKING:
+    from trimesh import Trimesh
+
     from robokin.model.chain import Chain
 
 
 __all__ = [
     "LENGTH_UNITS",
     "MAX_MESH_BYTES",
+    "MAX_MESH_VERTICES",
     "MESH_SUFFIXES",
     "SHAPE_KINDS",
     "HasChain",
@@ -64,11 +66,13 @@ __all__ = [
     "box",
     "capsule",
     "capsule_between",
+    "cone",
     "cylinder",
     "cylinder_between",
     "link_names",
     "mesh",
     "mesh_file_problem",
+    "mesh_from_arrays",
     "segment_pose",
     "sphere",
 ]
@@ -79,6 +83,8 @@ MESH_SUFFIXES = (".stl", ".obj", ".dae", ".ply", ".off", ".glb", ".gltf")
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
 #: Largest mesh file loaded [bytes] (256 MiB).
 MAX_MESH_BYTES = 256 * 2**20
+#: Most vertices of a mesh given in memory (a MoveIt scene's mesh).
+MAX_MESH_VERTICES = 1_000_000
 
 
 class HasChain(Protocol):
@@ -118,9 +124,12 @@ class Shape:
             sphere ``(radius,)``; mesh ``()`` [m].
         placement: Pose of the shape in its parent frame, (4, 4) [m].
         name: Optional label.
-        file: The mesh file (meshes only).
+        file: The mesh file (meshes only; None for a mesh given in memory).
         scale: Factor from mesh-file units to metres (meshes only).
         owner: The link or object the shape belongs to (for error messages).
+        vertices: A mesh given in memory (a MoveIt scene's mesh, a cone):
+            vertices (V, 3) [m] in the shape's frame; None for a mesh file.
+        faces: Its triangles (F, 3), indices into ``vertices``.
     """
 
     kind: ShapeKind
@@ -130,6 +139,8 @@ class Shape:
     file: Path | None = None
     scale: float = 1.0
     owner: str = ""
+    vertices: np.ndarray | None = None
+    faces: np.ndarray | None = None
     # derived data (bounds, coal and trimesh objects), built on first use
     _cache: dict[str, Any] = field(init=False, repr=False, default_factory=dict)
 
@@ -160,15 +171,54 @@ class Shape:
         object.__setattr__(self, "size", size)
         object.__setattr__(self, "placement", _placement(self.placement))
         if self.kind == "mesh":
-            if self.file is None:
-                raise InputError("file", "a mesh shape needs a file")
-            object.__setattr__(self, "file", Path(self.file))
+            if (self.vertices is None) != (self.faces is None):
+                raise InputError("vertices", "a mesh in memory needs both vertices "
+                                 "and faces")
+            if self.vertices is not None:
+                self._check_memory_mesh()
+            elif self.file is None:
+                raise InputError("file", "a mesh shape needs a file (or vertices "
+                                 "and faces)")
+            else:
+                object.__setattr__(self, "file", Path(self.file))
             if not (math.isfinite(self.scale) and self.scale > 0):
                 raise InputError("scale", f"must be positive, got {self.scale}")
+        elif self.vertices is not None or self.faces is not None:
+            raise InputError("vertices", f"only a mesh has vertices, not a {self.kind}")
+
+    def _check_memory_mesh(self) -> None:
+        """Check and freeze a mesh given in memory (vertices in metres, scale 1)."""
+        if self.file is not None or self.scale != 1.0:
+            raise InputError("vertices", "a mesh in memory has no file and scale 1 "
+                             "(its vertices are in metres)")
+        v = np.array(self.vertices, dtype=np.float64)
+        try:
+            f = np.array(self.faces, dtype=np.int64)
+        except (TypeError, ValueError, OverflowError):
+            raise InputError("faces", "expected integer vertex indices") from None
+        if v.ndim != 2 or v.shape[1] != 3 or len(v) < 3:
+            raise InputError("vertices", f"expected (V >= 3, 3) points, got {v.shape}")
+        if f.ndim != 2 or f.shape[1] != 3 or len(f) < 1:
+            raise InputError("faces", f"expected (F >= 1, 3) triangles, got {f.shape}")
+        if len(v) > MAX_MESH_VERTICES or len(f) > 2 * MAX_MESH_VERTICES:
+            raise InputError("vertices", f"{len(v):,} vertices and {len(f):,} "
+                             f"triangles: robokin takes at most {MAX_MESH_VERTICES:,} "
+                             "vertices (robokin.model.geometry.MAX_MESH_VERTICES)")
+        if not np.isfinite(v).all():
+            raise InputError("vertices", "not finite (NaN or infinity)")
+        if f.min() < 0 or f.max() >= len(v):
+            raise InputError("faces", f"vertex indices must be in [0, {len(v) - 1}], "
+                             f"got {int(f.min())}..{int(f.max())}")
+        v.setflags(write=False)
+        f.setflags(write=False)
+        object.__setattr__(self, "vertices", v)
+        object.__setattr__(self, "faces", f)
 
     def __repr__(self) -> str:
         """A short summary: kind, size, and the file of a mesh."""
         extra = f", file={str(self.file)!r}" if self.file is not None else ""
+        if self.vertices is not None and self.faces is not None:
+            extra = f", vertices={len(self.vertices)}, faces={len(self.faces)}"
         return f"Shape({self.kind!r}, size={self.size}{extra})"
 
     def placed(self, T: npt.ArrayLike) -> Shape:
@@ -180,7 +230,7 @@ class Shape:
         return replace(self, owner=owner)
 
     # ------------------------------------------------------------------ meshes
-    def trimesh(self):
+    def trimesh(self) -> Trimesh:
         """The shape as a ``trimesh.Trimesh`` in its own frame (metres), cached.
 
         Raises:
@@ -190,12 +240,14 @@ class Shape:
         """
         cache = self._cache
         if "trimesh" in cache:
-            return cache["trimesh"]
+            cached: Trimesh = cache["trimesh"]
+            return cached
         try:
             import trimesh
         except ImportError:  # pragma: no cover - the extra is installed in CI
             raise MissingExtraError("trimesh", "collision") from None
         k = self.kind
+        m: Trimesh
         if k == "box":
             m = trimesh.creation.box(extents=self.size)
         elif k == "sphere":
@@ -204,8 +256,10 @@ class Shape:
             m = trimesh.creation.cylinder(radius=self.size[0], height=self.size[1])
         elif k == "capsule":
             m = trimesh.creation.capsule(height=self.size[1], radius=self.size[0])
+        elif self.vertices is not None:
+            m = trimesh.Trimesh(vertices=self.vertices, faces=self.faces, process=False)
         else:
-            m = _load_mesh(self.file, self.scale, self.owner)
+            m = load_mesh(self.file, self.scale, self.owner, MAX_MESH_BYTES)
         cache["trimesh"] = m
         return m
 
@@ -219,7 +273,8 @@ class Shape:
         """An oriented bounding box in the shape's own frame: centre (3,), half sizes (3,)."""
         cache = self._cache
         if "box" in cache:
-            return cache["box"]
+            box: tuple[np.ndarray, np.ndarray] = cache["box"]
+            return box
         k, s = self.kind, self.size
         c = np.zeros(3)
         if k == "box":
@@ -231,7 +286,7 @@ class Shape:
         elif k == "capsule":
             h = np.array([s[0], s[0], s[1] / 2 + s[0]])
         else:
-            v = np.asarray(self.trimesh().vertices, dtype=float)
+            v = np.asarray(self.trimesh().vertices, dtype=np.float64)
             lo, hi = v.min(axis=0), v.max(axis=0)
             c, h = (lo + hi) / 2, (hi - lo) / 2
         cache["box"] = (c, h)
@@ -245,7 +300,8 @@ class Shape:
         """
         cache = self._cache
         if "spheres" in cache:
-            return cache["spheres"]
+            spheres: tuple[np.ndarray, np.ndarray] = cache["spheres"]
+            return spheres
         if self.kind == "capsule":
             r, L = self.size
             # k + 1 centres on the axis, ends included: a point within r of the
@@ -275,8 +331,8 @@ class Shape:
         return out
 
     # ------------------------------------------------------------------- coal
-    def coal_geometry(self):
-        """The coal collision geometry (cached; meshes as an OBBRSS BVH)."""
+    def coal_geometry(self) -> Any:
+        """The coal collision geometry (cached; meshes as an OBBRSS BVH; coal is untyped)."""
         cache = self._cache
         if "coal" in cache:
             return cache["coal"]
@@ -300,7 +356,7 @@ class Shape:
         cache["coal"] = g
         return g
 
-    def coal_convex(self):
+    def coal_convex(self) -> Any:
         """A convex coal geometry containing the shape (its hull), or the primitive itself."""
         cache = self._cache
         if "convex" in cache:
@@ -321,82 +377,13 @@ class Shape:
         return g
 
 
-def _coal():
+def _coal() -> Any:
+    """The coal module (untyped), or MissingExtraError naming ``robokin[collision]``."""
     try:
         import coal
     except ImportError:  # pragma: no cover - the extra is installed in CI
         raise MissingExtraError("coal", "collision") from None
     return coal
-
-
-_FILE_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
-               (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
-               (stat.S_ISSOCK, "a socket"))
-
-
-def mesh_file_problem(path: str | Path) -> str | None:
-    """Why ``path`` cannot be read as a mesh file, or None when it can.
-
-    A mesh is read only from a regular file: a folder, a FIFO, a device
-    (``/dev/zero``) or a symlink to one is reported as not a regular file (never
-    opened: a FIFO would block, ``/dev/zero`` never ends); a path that does not
-    exist as "no such file".
-    """
-    try:
-        st = os.stat(path)  # follows a symlink: its target is what would be read
-    except FileNotFoundError:
-        return f"no such file {path}"
-    except OSError as exc:
-        return f"cannot read {path}: {exc.strerror or exc}"
-    if stat.S_ISREG(st.st_mode):
-        return None
-    kind = next((k for test, k in _FILE_KINDS if test(st.st_mode)), "not a file")
-    via = " (through a symlink)" if os.path.islink(path) else ""
-    return f"{path} is not a regular file: {kind}{via}"
-
-
-def _load_mesh(path: Path | None, scale: float, owner: str):
-    import trimesh
-
-    where = f" (link '{owner}')" if owner else ""
-    if path is None:
-        raise ModelError(f"mesh file not found{where}", file=path, field=owner or None)
-    problem = mesh_file_problem(path)
-    if problem is not None:
-        what = "not found" if problem.startswith("no such file") else f": {problem}"
-        raise ModelError(f"mesh file {what}{where}".replace(" :", ":"), file=path,
-                         field=owner or None)
-    size = Path(path).stat().st_size
-    if size > MAX_MESH_BYTES:
-        raise ModelError(f"mesh file of {size:,} bytes{where}, more than the "
-                         f"{MAX_MESH_BYTES:,} robokin loads (robokin.model.geometry."
-                         "MAX_MESH_BYTES)", file=path, field=owner or None)
-    try:
-        loaded = trimesh.load(str(path), force="mesh")
-    except Exception as exc:  # trimesh raises many kinds on a bad file
-        raise ModelError(
-            f"cannot read mesh{where}: {type(exc).__name__}: {exc}"[:300],
-            file=path,
-            field=owner or None,
-        ) from None
-    faces = getattr(loaded, "faces", None)
-    vertices = getattr(loaded, "vertices", None)
-    if faces is None or vertices is None or len(faces) == 0 or len(vertices) < 4:
-        raise ModelError(
-            f"mesh file holds no triangles{where}", file=path, field=owner or None
-        )
-    if not np.isfinite(np.asarray(vertices)).all():
-        raise ModelError(
-            f"mesh file holds non-finite vertices{where}",
-            file=path,
-            field=owner or None,
-        )
-    m = trimesh.Trimesh(
-        vertices=np.asarray(vertices, dtype=np.float64) * scale,
-        faces=np.asarray(faces),
-        process=False,
-    )
-    return m
 
 
 # ------------------------------------------------------------------ constructors
@@ -494,6 +481,60 @@ def mesh(
         scale=LENGTH_UNITS[units] * float(scale),
         owner=owner,
     )
+
+
+def mesh_from_arrays(
+    vertices: npt.ArrayLike,
+    faces: npt.ArrayLike,
+    placement: npt.ArrayLike | None = None,
+    *,
+    name: str = "",
+    owner: str = "",
+) -> Shape:
+    """A mesh given in memory: ``vertices`` (V, 3) [m] and triangles ``faces`` (F, 3).
+
+    Raises:
+        InputError: bad shapes, non-finite vertices, indices out of range, or more
+            than :data:`MAX_MESH_VERTICES` vertices.
+    """
+    return Shape("mesh", (), _placement(placement), name=name, owner=owner,
+                 vertices=np.asarray(vertices), faces=np.asarray(faces))
+
+
+def cone(
+    radius: float,
+    length: float,
+    placement: npt.ArrayLike | None = None,
+    *,
+    segments: int = 32,
+    name: str = "",
+) -> Shape:
+    """A cone along local z as a mesh that contains it (robokin has no cone primitive).
+
+    As MoveIt's (``geometric_shapes``) cone: the base circle of ``radius`` at
+    ``z = -length / 2``, the tip at ``z = +length / 2``. The base is a regular
+    polygon of ``segments`` sides *around* the circle (its corners at
+    ``radius / cos(pi / segments)``), so the mesh contains the cone and a check
+    against it is never optimistic (it is at most 0.5 % wider with 32 sides).
+
+    Raises:
+        InputError: a radius or length that is not positive and finite.
+    """
+    r, L = float(radius), float(length)
+    if not (math.isfinite(r) and r > 0 and math.isfinite(L) and L > 0):
+        raise InputError("size", f"a cone needs a positive radius and length, got "
+                         f"({radius}, {length})")
+    k = int(segments)
+    if k < 3:
+        raise InputError("segments", f"at least 3, got {segments}")
+    a = 2 * math.pi * np.arange(k) / k
+    R = r / math.cos(math.pi / k)
+    ring = np.stack([R * np.cos(a), R * np.sin(a), np.full(k, -L / 2)], axis=1)
+    vertices = np.vstack([ring, [[0.0, 0.0, L / 2], [0.0, 0.0, -L / 2]]])
+    i = np.arange(k)
+    side = np.stack([i, (i + 1) % k, np.full(k, k)], axis=1)
+    bottom = np.stack([(i + 1) % k, i, np.full(k, k + 1)], axis=1)
+    return mesh_from_arrays(vertices, np.vstack([side, bottom]), placement, name=name)
 
 
 # ---------------------------------------------------------------- robot geometry

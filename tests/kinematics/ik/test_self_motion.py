@@ -195,20 +195,42 @@ def test_ik_says_it_samples_the_manifold(arm):
 
 
 @pytest.mark.parametrize("arm", ["panda", "srs"])
-def test_ik_near_picks_the_nearest_point_of_the_manifold(arm):
+def test_ik_near_self_motion_picks_the_nearest_point_of_the_manifold(arm):
     # oracle: from q0 itself (in limits) the answer is q0; from a nudged q0 the
-    # answer is exact and no farther than q0 is
+    # answer is exact and no farther than q0 is; SelfMotion.nearest agrees
     robot = ARMS[arm]
     rng = np.random.default_rng(7)
     for _ in range(3):
         q0 = rng.uniform(robot.limits[:, 0] * 0.9, robot.limits[:, 1] * 0.9)
         T = robot.fk(q0)
-        res = robot.ik_near(T, q0)
+        res = robot.ik_near(T, q0, method="self_motion")
         assert res.success and np.abs(res.q - q0).max() < 1e-6
         qn = q0 + 0.05
-        res = robot.ik_near(T, qn)
+        res = robot.ik_near(T, qn, method="self_motion")
         assert res.success and res.error < 1e-12 and robot.within_limits(res.q)
         assert np.linalg.norm(res.q - qn) <= np.linalg.norm(q0 - qn) + 1e-9
+    p = robot.self_motion(T).nearest(qn)
+    assert p is not None and np.linalg.norm(p.q - qn) <= np.linalg.norm(q0 - qn) + 1e-9
+
+
+def test_ik_near_auto_on_7r_is_the_numeric_descent():
+    # oracle: method="auto" on a 7R arm is the numeric descent from q_near, so it
+    # returns exactly what method="numeric" returns (same inputs, same outputs)
+    q0 = np.array([0.1, 0.3, -0.2, -1.5, 0.2, 1.6, 0.4])
+    T, qn = PANDA.fk(q0), q0 + 0.02
+    auto, num = PANDA.ik_near(T, qn), PANDA.ik_near(T, qn, method="numeric")
+    assert auto.success and np.array_equal(auto.q, num.q)
+
+
+def test_ik_near_self_motion_errors_list_the_methods():
+    T = PANDA.fk(np.full(7, 0.1))
+    with pytest.raises(InputError, match="self_motion"):
+        PANDA.ik_near(T, np.full(7, 0.1), method="fast")
+    with pytest.raises(InputError, match="options"):
+        PANDA.ik_near(T, np.full(7, 0.1), method="self_motion", mask="xyz")
+    ur5 = robokin.load("ur5")
+    with pytest.raises(InputError, match="method='self_motion' needs a 7R arm"):
+        ur5.ik_near(ur5.fk(np.zeros(6)), np.zeros(6), method="self_motion")
 
 
 def test_general_7r_branches_are_continued():

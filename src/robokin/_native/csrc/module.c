@@ -21,6 +21,7 @@
 #include "general6r.c"
 #include "manipulability.c"
 #include "pieper.c"
+#include "process.c"
 
 /* ---------------------------------------------------------------- arguments */
 
@@ -265,6 +266,33 @@ static PyObject *py_lm_solve(PyObject *self, PyObject *args)
         }
     }
     return Py_BuildValue("(ll)", fails, first_bad);
+}
+
+/* seed_uniforms(targets (N, 4, 4), q0 (N, n), key, base, out (N, R, n)): the numeric
+ * IK's restart numbers, from the inputs (lm.c's seed_uniforms) */
+static PyObject *py_seed_uniforms(PyObject *self, PyObject *args)
+{
+    PyObject *to, *qo, *oo;
+    unsigned long long key;
+    long base;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOKlO", &to, &qo, &key, &base, &oo))
+        return NULL;
+    PyArrayObject *T, *q, *out;
+    if (!(T = array_arg(to, "targets", NPY_DOUBLE, 3, 0)) ||
+        !(q = array_arg(qo, "q0", NPY_DOUBLE, 2, 0)) ||
+        !(out = array_arg(oo, "out", NPY_DOUBLE, 3, 1)))
+        return NULL;
+    npy_intp N = DIM(T, 0), n = DIM(q, 1);
+    if (DIM(T, 1) != 4 || DIM(T, 2) != 4 || DIM(q, 0) != N || n < 1 || n > MAXJ ||
+        DIM(out, 0) != N || DIM(out, 2) != n || base < 0) {
+        PyErr_SetString(PyExc_ValueError, "robokin._native.seed_uniforms: inconsistent shapes");
+        return NULL;
+    }
+    Py_BEGIN_ALLOW_THREADS
+    seed_uniforms(F64(T), F64(q), (long)N, (int)n, (long)DIM(out, 1), key, base, F64(out));
+    Py_END_ALLOW_THREADS
+    Py_RETURN_NONE;
 }
 
 /* lm_path(packed, targets (N, 4, 4), q_start (n,), opts, out (N, n + N_RES))
@@ -552,6 +580,8 @@ static PyMethodDef methods[] = {
     {"lm_solve", py_lm_solve, METH_VARARGS,
      "lm_solve(packed, targets, q0, seeds, opts, out, tab, cstart, gdat, parallel) "
      "-> (fails, first_bad): numeric IK of a batch."},
+    {"seed_uniforms", py_seed_uniforms, METH_VARARGS,
+     "seed_uniforms(targets, q0, key, base, out): restart numbers from the inputs."},
     {"lm_path", py_lm_path, METH_VARARGS,
      "lm_path(packed, targets, q_start, opts, out) -> first failure or -1."},
     {"pose_error", py_pose_error, METH_VARARGS,
@@ -576,6 +606,7 @@ static PyMethodDef methods[] = {
     GENERAL6R_METHODS
     MANIPULABILITY_METHODS
     PIEPER_METHODS
+    PROCESS_METHODS
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, MODULE_NAME,
@@ -608,7 +639,8 @@ PyMODINIT_FUNC MODULE_INIT(void)
     PyModule_AddObject(m, "LAYOUT_TAG", PyFloat_FromDouble(PACKED_TAG));
     PyModule_AddObject(m, "MAX_TRANSLATION", PyFloat_FromDouble(MAX_TRANSLATION));
     if (six_r_constants(m) < 0 || broadphase_constants(m) < 0 ||
-        general6r_constants(m) < 0 || pieper_constants(m) < 0) {
+        general6r_constants(m) < 0 || pieper_constants(m) < 0 ||
+        process_constants(m) < 0) {
         Py_DECREF(m);
         return NULL;
     }

@@ -68,6 +68,7 @@
  */
 #include "chain.h"
 #include "pool.h"
+#include "subproblems.h"
 
 /* Same floating-point rules as six_r.c (whose helpers this file uses): no fused
  * multiply-adds, so every copy of the kernels takes the same branches. */
@@ -1157,6 +1158,13 @@ static double pk_coords(const double *P, const PkGeo *g, const double *th, int h
     return margin;
 }
 
+/* Whether held value x (none: held < 0) lies inside its limits (1e-9 slack, as
+ * pk_coords): when it does not, no row can, and the repairs are not tried. */
+static int pk_held_inside(const double *P, int held, double x)
+{
+    return held < 0 || (x - P[PK_LO + held] >= -1e-9 && P[PK_HI + held] - x >= -1e-9);
+}
+
 /* A row th (remaining chain, exact) just outside the limits, next to a singular
  * configuration: the exact configurations around it form a thin set along the
  * near-null directions, and the generating configuration may be one of them at
@@ -1298,72 +1306,118 @@ static double pk_outside(double q, double lo, double hi, double *lim)
     return gap;
 }
 
+/* Whether the 6 x 6 Jacobian J certainly has no singular value below
+ * PK_FAMILY_SIGMA of its largest: |det J| = prod sigma_i <= sigma_min sigma_max^5
+ * and sigma_max <= |J|_F, so |det J| > 2 PK_FAMILY_SIGMA |J|_F^6 (2: room for
+ * the rounding of the elimination) proves sigma_min > PK_FAMILY_SIGMA sigma_max.
+ * Gaussian elimination with partial pivoting, a few hundred flops: the Jacobi SVD
+ * of pk_slide (thousands) runs only where this cannot rule a family out. */
+static int pk_regular(const double J[6][6])
+{
+    double A[6][6], fro = 0.0, det = 1.0;
+    for (int r = 0; r < 6; r++)
+        for (int c = 0; c < 6; c++) {
+            A[r][c] = J[r][c];
+            fro += J[r][c] * J[r][c];
+        }
+    for (int c = 0; c < 6; c++) {
+        int piv = c;
+        for (int r = c + 1; r < 6; r++)
+            if (fabs(A[r][c]) > fabs(A[piv][c]))
+                piv = r;
+        if (!(fabs(A[piv][c]) > 0.0))
+            return 0;
+        if (piv != c)
+            for (int k = c; k < 6; k++) {
+                double t = A[c][k];
+                A[c][k] = A[piv][k];
+                A[piv][k] = t;
+            }
+        det *= A[c][c];
+        for (int r = c + 1; r < 6; r++) {
+            double m = A[r][c] / A[c][c];
+            for (int k = c + 1; k < 6; k++)
+                A[r][k] -= m * A[c][k];
+        }
+    }
+    return fabs(det) > 2.0 * PK_FAMILY_SIGMA * fro * fro * fro;
+}
+
 /* A row th on a one-parameter family of exact solutions (a singular configuration
  * whose remaining Jacobian has a null direction: smallest singular value below
- * PK_FAMILY_SIGMA, the next one well above it) but outside the limits: slide along
- * the family, steps of at most 0.05 rad along its null vector each followed by a
- * Newton polish with the joint being brought in held, until that joint reaches
- * its limit (then the next joint outside, if any). Kept when every joint ends
+ * PK_FAMILY_SIGMA of the largest) but outside the limits: slide along the family.
+ * Each step linearizes every joint along the null vector, q_j(a) = q_j + d_j a,
+ * intersects the intervals of a that keep each joint inside its limits (the
+ * feasible set of the family parameter, to first order), moves to the point of
+ * the intersection nearest a = 0 (its middle when rounding left it empty: two
+ * joints at their limits at one point), at most 0.05 rad, and Newton-polishes
+ * the pose with the joints brought to a limit held. Kept when every joint ends
  * inside and the pose holds to PK_ACCEPT: returns 1 when th changed. */
 static int pk_slide(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
 {
     double trial[6];
     for (int j = 0; j < 6; j++)
         trial[j] = th[j];
-    int done = 0;
-    for (int it = 0; it < 96 && !done; it++) {
+    for (int it = 0; it < 96; it++) {
         m3 R;
         v3 p;
-        double J[6][6], sig[6], V[6][6];
+        double J[6][6], sig[6], V[6][6], lo = -INFINITY, hi = INFINITY, worst = 0.0;
         pk_fk(g, trial, &R, &p, J);
+        if (it == 0 && pk_regular(J))
+            return 0; /* isolated: no family to slide along */
         pk_svd6(J, sig, V);
-#ifdef PK_DEBUG
-        fprintf(stderr, "   slide it %d sig %.3e %.3e %.3e v %.4f %.4f %.4f %.4f %.4f %.4f\n", it, sig[0], sig[1], sig[5], V[0][0], V[1][0], V[2][0], V[3][0], V[4][0], V[5][0]);
-#endif
         if (!(sig[0] <= PK_FAMILY_SIGMA * sig[5]))
             return 0; /* no one-parameter family here */
-        /* the joint farthest outside, and how the family moves it */
-        int worst = -1;
-        double wgap = 0.0, wlim = 0.0;
         for (int j = 0; j < 6; j++) {
             int f = g->full[j];
-            double lim, q = P[PK_SIGN + f] * (trial[j] - P[PK_OFFSET + f]);
-            double gap = pk_outside(wrap_pi(q), P[PK_LO + f], P[PK_HI + f], &lim);
-            if (gap > wgap) {
-                wgap = gap;
-                worst = j;
-                wlim = lim - wrap_pi(q) + q; /* the limit at q's turn */
+            double sg = P[PK_SIGN + f], d = sg * V[j][0];
+            double qw = wrap_pi(sg * (trial[j] - P[PK_OFFSET + f]));
+            double l = P[PK_LO + f], h = P[PK_HI + f], best = qw, bd = INFINITY;
+            for (int m = -1; m <= 1; m++) { /* the turn of q nearest [l, h] */
+                double qm = qw + 2.0 * M_PI * m, dd = qm < l ? l - qm : qm > h ? qm - h : 0.0;
+                if (dd < bd) {
+                    bd = dd;
+                    best = qm;
+                }
+            }
+            worst = fmax(worst, bd);
+            if (fabs(d) > 1e-12) {
+                double a1 = (l - best) / d, a2 = (h - best) / d;
+                lo = fmax(lo, fmin(a1, a2));
+                hi = fmin(hi, fmax(a1, a2));
+            } else if (bd > 1e-10) {
+                return 0; /* outside (beyond the 1e-10 of "inside" below), the family does not move it */
             }
         }
-        if (worst < 0) {
-            done = 1;
-            break;
-        }
-        int f = g->full[worst];
-        double dq = P[PK_SIGN + f] * V[worst][0]; /* d q_worst / d alpha */
-        if (!(fabs(dq) > 1e-12))
-            return 0; /* the family does not move this joint */
-        double q = P[PK_SIGN + f] * (trial[worst] - P[PK_OFFSET + f]);
-        double alpha = (wlim - q) / dq, big = 0.0;
+        if (!(worst > 1e-10))
+            break; /* inside */
+        double alpha = lo <= hi ? fmin(fmax(0.0, lo), hi) : 0.5 * (lo + hi);
+        if (!isfinite(alpha))
+            return 0;
+        double big = 0.0;
         for (int j = 0; j < 6; j++)
             big = fmax(big, fabs(V[j][0]));
         double cap = 0.05 / big;
-        int last = fabs(alpha) <= cap;
-        if (!last)
+        if (fabs(alpha) > cap)
             alpha = copysign(cap, alpha);
-        for (int j = 0; j < 6; j++)
+        else if (fabs(alpha) * big < 1e-15)
+            return 0; /* no progress */
+        unsigned frozen = 0u;
+        for (int j = 0; j < 6; j++) {
             trial[j] += alpha * V[j][0];
-        if (last)
-            trial[worst] = P[PK_SIGN + f] * wlim + P[PK_OFFSET + f];
-        double perr = pk_polish_held(g, RT, pT, trial, last ? 1u << worst : 0u);
+            int f = g->full[j];
+            double q = wrap_pi(P[PK_SIGN + f] * (trial[j] - P[PK_OFFSET + f])), lim;
+            if (pk_outside(q, P[PK_LO + f], P[PK_HI + f], &lim) == 0.0 &&
+                fmin(q - P[PK_LO + f], P[PK_HI + f] - q) < 1e-12 && fabs(V[j][0]) > 1e-6)
+                frozen |= 1u << j; /* brought to a limit: held there by the polish */
+        }
+        double perr = pk_polish_held(g, RT, pT, trial, frozen);
 #ifdef PK_DEBUG
-        fprintf(stderr, "   slide worst %d gap %.3e alpha %.3e err %.3e\n", worst, wgap, alpha, perr);
+        fprintf(stderr, "   slide it %d sig %.2e worst %.3e interval [%.3e, %.3e] alpha %.3e err %.3e\n", it, sig[0], worst, lo, hi, alpha, perr);
 #endif
         if (!(perr <= PK_ACCEPT))
             return 0;
     }
-    if (!done)
-        return 0;
     double q[PK_MAXJ];
     if (!(pk_coords(P, g, trial, -1, 0.0, q) >= -1e-9))
         return 0;
@@ -1421,6 +1475,9 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
     if (code != PK_OK)
         return code;
     int any = 0;
+    unsigned lmask = 0u; /* rows outside, not flagged singular: slid only when none is inside */
+    int held_in = pk_held_inside(P, held, x); /* else no row can come inside */
+    double late[8][6];
     int jx = g.full[it], jz = g.full[it + 2];
     PkTri tri;
     pk_tri_init(&tri, g.h[it], g.h[it + 1], g.h[it + 2]);
@@ -1474,21 +1531,36 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
             int slot = 2 * pos.slot[i] + k;
             double *qs = o.Q + o.n * slot;
             int all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
-            if (!all && pk_resplit(P, &g, it, &RT, pT, th))
+            int sing = pos.sing[i] || tr.sing[k], fix = !all && held_in;
+            if (fix && pk_resplit(P, &g, it, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
             /* joints on one line only at a singular configuration: try there only */
-            if (!all && (pos.sing[i] || tr.sing[k]) && pk_repair(P, &g, &RT, pT, th))
+            if (fix && !all && sing && pk_repair(P, &g, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
-            if (!all && pk_inside(P, &g, &RT, pT, th))
+            if (fix && !all && pk_inside(P, &g, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
-            if (!all && pk_slide(P, &g, &RT, pT, th))
-                all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            /* a family to slide along: at rows the subproblems flag singular here,
+             * at the others below only when no row came inside */
+            if (fix && !all && sing) {
+                if (pk_slide(P, &g, &RT, pT, th))
+                    all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            } else if (fix && !all) {
+                for (int j = 0; j < 6; j++)
+                    late[slot][j] = th[j];
+                lmask |= 1u << slot;
+            }
             o.valid[slot] = 1;
             o.inside[slot] = (unsigned char)all;
-            o.sing[slot] = (unsigned char)(pos.sing[i] || tr.sing[k]);
+            o.sing[slot] = (unsigned char)sing;
             any = 1;
         }
     }
+    int inside = 0;
+    for (int slot = 0; slot < 8; slot++)
+        inside |= o.valid[slot] && o.inside[slot];
+    for (int slot = 0; slot < 8 && !inside; slot++)
+        if ((lmask >> slot & 1u) && pk_slide(P, &g, &RT, pT, late[slot]))
+            o.inside[slot] = pk_coords(P, &g, late[slot], held, x, o.Q + o.n * slot) >= -1e-9;
     return any ? PK_OK : PK_NO_ORIENTATION;
 }
 

@@ -42,7 +42,7 @@
 #pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
 #endif
 
-#define PS_FLAT 1e-13 /* the held joint's swivel equation this flat: it does not move */
+#define PS_REACH 1e-13 /* a held angle this far [rad] past the end of its swivel range: at the end */
 
 static inline m3 ps_transpose(const m3 *A)
 {
@@ -210,7 +210,8 @@ static double ps_angle_newton(v3 hv, v3 u, v3 pv, double alpha, double t)
  * t = t0 +- D from products of sines of half-angles, so that angles next to 0 or
  * pi (two remaining axes next to coincident, the arm next to full stretch) keep
  * every digit (a cosine alone loses half of them); Newton-polished on the angle.
- * *dbl: a double root (alpha at an end of the range within 1e-15 rad); *flat:
+ * *dbl: a double root or two within 1e-7 rad (alpha at an end of the range, or
+ * past it by at most PS_REACH: rounding, a pose error that small); *flat:
  * the whole range within 1e-13 rad of alpha (the joint does not move with the
  * swivel: a family). */
 static void ps_roots(const PsArm *a, int j, double L, double *t, int *n, int *dbl, int *flat,
@@ -229,17 +230,16 @@ static void ps_roots(const PsArm *a, int j, double L, double *t, int *n, int *db
 #ifdef PK_DEBUG
     fprintf(stderr, " roots j %d alpha %.9e range %.9e %.9e gh %.3e gp %.3e\n", j, alpha, amin, amax, gh, gp);
 #endif
-    if (*flat || alpha < amin - 1e-15 || alpha > amax + 1e-15)
+    if (*flat || alpha < amin - PS_REACH || alpha > amax + PS_REACH)
         return;
     double k = sin(gh) * sin(gp);
     double hav = sin(0.5 * (alpha - gh + gp)) * sin(0.5 * (alpha + gh - gp)) / k;
-    hav = fmax(0.0, fmin(1.0, hav));
+    hav = alpha <= amin ? 0.0 : alpha >= amax ? 1.0 : fmax(0.0, fmin(1.0, hav));
     double D = 2.0 * atan2(sqrt(hav), sqrt(1.0 - hav));
     t[(*n)++] = ps_angle_newton(hv, u, pv, alpha, t0 + D);
-    if (fabs(alpha - amin) <= 1e-15 || fabs(alpha - amax) <= 1e-15 || D == 0.0 || D == M_PI) {
-        *dbl = 1;
+    *dbl = D < 1e-7 || M_PI - D < 1e-7;
+    if (D == 0.0 || D == M_PI)
         return;
-    }
     t[(*n)++] = ps_angle_newton(hv, u, pv, alpha, t0 - D);
 }
 
@@ -325,12 +325,12 @@ static int ps_finish(const double *P, const PkGeo *g, const m3 *RT, v3 pT, const
     if (!(err <= PK_ACCEPT))
         return 0;
     double *qs = o.Q + o.n * slot;
-    int all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
-    if (!all && sing && pk_repair(P, g, RT, pT, th))
+    int all = pk_coords(P, g, th, held, x, qs) >= -1e-9, fix = pk_held_inside(P, held, x);
+    if (fix && !all && sing && pk_repair(P, g, RT, pT, th))
         all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
-    if (!all && pk_inside(P, g, RT, pT, th))
+    if (fix && !all && pk_inside(P, g, RT, pT, th))
         all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
-    if (!all && pk_slide(P, g, RT, pT, th))
+    if (fix && !all && pk_slide(P, g, RT, pT, th))
         all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
     o.valid[slot] = 1;
     o.inside[slot] = (unsigned char)all;
@@ -488,43 +488,92 @@ static int ps_candidates(const double *P, const PsArm *a, int held, double *psi)
     return np;
 }
 
-/* The family at one elbow angle: each branch at its deepest candidate swivel
- * angle, stored from slot base (held elbow: 4 branches; else the other triple's
- * 2). Returns the number stored. */
-static int ps_family(const double *P, const PkGeo *g, const m3 *RT, v3 pT, const PsArm *a,
-                     const PkTri *ta, const PkTri *tb, double th4, int held, double tk,
-                     double x, const double *qn, int base, PkOut o)
+/* The best configuration offered for each slot: the largest limit margin */
+typedef struct {
+    double th[7], margin;
+    int have;
+    unsigned char sing;
+} PsBest;
+
+static void ps_offer(const double *P, const PkGeo *g, int held, double x, const double *th7,
+                     int slot, int sing, PsBest *best)
 {
-    double psi[64];
-    int np = ps_candidates(P, a, held, psi);
-    double best_m[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY}, best[4][7];
-    unsigned char best_s[4] = {0, 0, 0, 0};
-    int have[4] = {0, 0, 0, 0};
-    for (int i = 0; i < np; i++) {
-        double th[4][7], q[PK_MAXJ], th6[6];
-        int br[4];
-        unsigned char sg[4];
-        int m = ps_configs(P, a, ta, tb, psi[i], th4, held, tk, qn, th, br, sg);
-        for (int c = 0; c < m; c++) {
-            for (int j = 0, r = 0; j < 7; j++)
-                if (j != held)
-                    th6[r++] = th[c][j];
-            double mg = pk_coords(P, g, th6, held, x, q);
-            if (!have[br[c]] || mg > best_m[br[c]]) {
-                have[br[c]] = 1;
-                best_m[br[c]] = mg;
-                best_s[br[c]] = sg[c];
-                for (int j = 0; j < 7; j++)
-                    best[br[c]][j] = th[c][j];
-            }
-        }
+    double th6[6], q[PK_MAXJ];
+    for (int j = 0, r = 0; j < 7; j++)
+        if (j != held)
+            th6[r++] = th7[j];
+    double mg = pk_coords(P, g, th6, held, x, q);
+    PsBest *b = best + slot;
+    if (!b->have || mg > b->margin) {
+        b->have = 1;
+        b->margin = mg;
+        b->sing = (unsigned char)sing;
+        for (int j = 0; j < 7; j++)
+            b->th[j] = th7[j];
     }
-    int stored = 0;
-    for (int b = 0; b < 4; b++)
-        if (have[b])
-            stored += ps_finish(P, g, RT, pT, best[b], held, x, 1, base + b, o);
-    (void)best_s;
-    return stored;
+}
+
+/* Every configuration at elbow angle th4 (elbow slot i4; the arm a) offered to
+ * best: at the held joint's swivel roots (slot 4 i4 + 2 root + branch), or,
+ * where the held joint does not move with the swivel (always for the held
+ * elbow), at every candidate swivel angle of the family (slot 4 i4 + branch;
+ * held elbow: 2 shoulder + wrist branch), each then flagged singular. */
+static void ps_at_elbow(const double *P, const PkGeo *g, const PsArm *a, const PkTri *ta,
+                        const PkTri *tb, int held, double tk, double x, const double *qn,
+                        double th4, int i4, int sing, PsBest *best)
+{
+    double tr[2], sg, th[4][7], psi[64];
+    int nr = 0, dblr = 0, flat = held == 3, br[4];
+    unsigned char sgl[4];
+    if (!flat)
+        ps_roots(a, held, tk, tr, &nr, &dblr, &flat, &sg);
+    if (flat) {
+        int np = ps_candidates(P, a, held, psi);
+        for (int i = 0; i < np; i++) {
+            int m = ps_configs(P, a, ta, tb, psi[i], th4, held, tk, qn, th, br, sgl);
+            for (int c = 0; c < m; c++)
+                ps_offer(P, g, held, x, th[c], held == 3 ? br[c] : 4 * i4 + br[c], 1, best);
+        }
+        return;
+    }
+    for (int ip = 0; ip < nr; ip++) {
+        int m = ps_configs(P, a, ta, tb, sg * tr[ip], th4, held, tk, qn, th, br, sgl);
+        for (int c = 0; c < m; c++)
+            ps_offer(P, g, held, x, th[c], 4 * i4 + 2 * ip + br[c], sgl[c] || sing || dblr,
+                     best);
+    }
+}
+
+/* Next to full stretch every elbow angle in the distance's rounding band
+ * (PsElbow) reaches the wrist point, and the rest of the arm moves with it to
+ * first order: a one-parameter family. When no row so far lies inside the
+ * limits, each side of the band (slots 0-3: +, 4-7: -) is searched at its ends,
+ * its center and 14 points between, and a slot's best replaces a row outside the
+ * limits. */
+static void ps_band_family(const double *P, const PkGeo *g, const m3 *RT, v3 pT, v3 S,
+                           v3 Wp, v3 w, const m3 *G, const PsElbow *el, const PkTri *ta,
+                           const PkTri *tb, int held, double tk, double x, const double *qn,
+                           PkOut o)
+{
+    double scale = g->scale;
+    for (int i4 = 0; i4 < 2; i4++) {
+        double side = i4 ? -1.0 : 1.0;
+        PsBest best[8];
+        for (int k = 0; k < 8; k++)
+            best[k].have = 0;
+        for (int k = -1; k <= 15; k++) {
+            double f = k < 0 ? 0.0 : el->inner + (el->outer - el->inner) * k / 15.0;
+            if (k < 0 && el->inner > 0.0)
+                continue; /* the center is in the band only when the ends touch */
+            double th4 = el->center + side * f;
+            PsArm a;
+            if (ps_arm(P, S, Wp, w, G, th4, scale, &a))
+                ps_at_elbow(P, g, &a, ta, tb, held, tk, x, qn, th4, i4, 1, best);
+        }
+        for (int slot = 4 * i4; slot < 4 * i4 + 4; slot++)
+            if (best[slot].have && !(o.valid[slot] && o.inside[slot]))
+                ps_finish(P, g, RT, pT, best[slot].th, held, x, 1, slot, o);
+    }
 }
 
 /* Every solution of an SRS arm with joint `held` at x (the module comment). */
@@ -538,23 +587,17 @@ static int pk_srs(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double x
     m3 G = pk_mul_t(RT, &RM); /* the rotation of e1 ... e7 */
     v3 w = v3_add(pT, m3_mv(&G, v3_sub(Wp, tM)));
     double tk = P[PK_SIGN + held] * x + P[PK_OFFSET + held];
-    double rho = v3_norm(v3_sub(w, S)), t4[2] = {0.0, 0.0};
-    int n4, dbl4 = 0;
+    double rho = v3_norm(v3_sub(w, S));
     PsElbow el = {0, 0, {0.0, 0.0}, 0.0, 0.0, 0.0};
     if (held == 3) {
         v3 o4 = v3_at(P, PK_POINTS + 9), h4 = v3_at(P, PK_AXES + 9);
         v3 W4 = v3_add(o4, v3_rot(h4, cos(tk), sin(tk), v3_sub(Wp, o4)));
         if (fabs(v3_norm(v3_sub(W4, S)) - rho) > 1e-9 * fmax(1.0, scale))
             return PK_OUT_OF_REACH;
-        n4 = 1;
-        t4[0] = tk;
+        el.n = 1;
+        el.t[0] = tk;
     } else if (!ps_elbow(P, S, Wp, rho, scale, &el)) {
         return PK_OUT_OF_REACH;
-    } else {
-        n4 = el.n;
-        dbl4 = el.dbl;
-        t4[0] = el.t[0];
-        t4[1] = el.t[1];
     }
     PkTri ta, tb;
     v3 h[7];
@@ -562,58 +605,47 @@ static int pk_srs(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double x
         h[j] = v3_at(P, PK_AXES + 3 * j);
     pk_tri_init(&ta, h[0], h[1], h[2]);
     pk_tri_init(&tb, h[4], h[5], h[6]);
-    int any = 0, degenerate = 0;
-    /* elbow candidates: the roots; a double root next to full stretch stands for
-     * both sides of its band (slots 0-3 and 4-7) when a held middle joint needs the
-     * band (ps_band_elbow) */
-    int ne = n4;
-    double te[2] = {t4[0], t4[1]};
-    int side[2] = {1, -1};
-    if (n4 == 1 && held != 3) {
+    /* elbow candidates: the roots; a double root stands for both sides of its band
+     * (slots 0-3 and 4-7) when the held joint needs the band (ps_band_elbow) */
+    int ne = el.n, side[2] = {1, -1}, degenerate = 0;
+    double te[2] = {el.t[0], el.t[1]};
+    if (el.n == 1 && held != 3) {
         ne = 2;
-        te[1] = t4[0];
+        te[1] = el.t[0];
     }
+    PsBest best[8];
+    for (int k = 0; k < 8; k++)
+        best[k].have = 0;
     for (int i4 = 0; i4 < ne; i4++) {
-        double th4 = te[i4];
+        double th4 = te[i4], tr[2], sg, tb4;
         PsArm a;
         if (!ps_arm(P, S, Wp, w, &G, th4, scale, &a)) {
             degenerate = 1;
             continue;
         }
-        if (held == 3) {
-            any += ps_family(P, g, RT, pT, &a, &ta, &tb, th4, held, tk, x, qn, 0, o);
-            continue;
-        }
-        double tr[2], sg, tb4;
-        int nr = 0, dblr = 0, flat = 0;
-        ps_roots(&a, held, tk, tr, &nr, &dblr, &flat, &sg);
+        int nr = 0, dblr = 0, flat = held == 3;
+        if (!flat)
+            ps_roots(&a, held, tk, tr, &nr, &dblr, &flat, &sg);
         if (!nr && !flat && el.outer < 1e-3 &&
             ps_band_elbow(P, S, Wp, w, &G, held, tk, &el, side[i4], th4, scale, &tb4) &&
             ps_arm(P, S, Wp, w, &G, tb4, scale, &a)) {
             th4 = tb4;
-            ps_roots(&a, held, tk, tr, &nr, &dblr, &flat, &sg);
-        }
-        if (ne > n4 && i4 == 1 && (nr || flat) && th4 == te[0])
+        } else if (ne > el.n && i4 == 1) {
             continue; /* the double root itself served: no second side */
-#ifdef PK_DEBUG
-        fprintf(stderr, "srs i4 %d t4 %.17g dbl %d held roots %d flat %d dbl %d: %.17g %.17g\n", i4, th4, dbl4, nr, flat, dblr, tr[0], tr[1]);
-#endif
-        if (flat) { /* the held joint does not move with the swivel: a family */
-            any += ps_family(P, g, RT, pT, &a, &ta, &tb, th4, held, tk, x, qn, 4 * i4, o);
-            continue;
         }
-        for (int ip = 0; ip < nr; ip++) {
-            double th[4][7];
-            int br[4];
-            unsigned char sgl[4];
-            int m = ps_configs(P, &a, &ta, &tb, sg * tr[ip], th4, held, tk, qn, th, br, sgl);
-            for (int c = 0; c < m; c++)
-                any += ps_finish(P, g, RT, pT, th[c], held, x,
-                                 sgl[c] || dbl4 || dblr, 4 * i4 + 2 * ip + br[c], o);
-        }
+        ps_at_elbow(P, g, &a, &ta, &tb, held, tk, x, qn, th4, i4, el.dbl, best);
     }
-    if (any)
-        return PK_OK;
+    for (int slot = 0; slot < 8; slot++)
+        if (best[slot].have)
+            ps_finish(P, g, RT, pT, best[slot].th, held, x, best[slot].sing, slot, o);
+    int inside = 0;
+    for (int slot = 0; slot < 8; slot++)
+        inside |= o.valid[slot] && o.inside[slot];
+    if (!inside && held != 3 && el.outer < 1e-3)
+        ps_band_family(P, g, RT, pT, S, Wp, w, &G, &el, &ta, &tb, held, tk, x, qn, o);
+    for (int slot = 0; slot < 8; slot++)
+        if (o.valid[slot])
+            return PK_OK;
     return degenerate ? PK_DEGENERATE : PK_NO_ORIENTATION;
 }
 

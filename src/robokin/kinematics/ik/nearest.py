@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from robokin._native import kernels
 from robokin._validation import (
     check_broadcasts,
     check_finite,
@@ -22,20 +23,23 @@ from robokin._validation import (
     check_transform,
 )
 from robokin.exceptions import InputError
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
+from robokin.kinematics.ik import numeric
+from robokin.kinematics.ik.analytic.detect import detect
+from robokin.kinematics.ik.dispatch import solve
 from robokin.kinematics.ik.numeric import IKResult
 from robokin.kinematics.ik.self_motion import auto_parameter, nearest_on_manifold
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.solutions import SolutionSet
-    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["solve_near"]
 
-_METHODS = ("auto", "analytic", "numeric")
+_METHODS = ("auto", "analytic", "numeric", "self_motion")
 
 
 def solve_near(
-    robot: RobotLike,
+    robot: ArmSource,
     T: npt.ArrayLike,
     q_near: npt.ArrayLike,
     *,
@@ -45,12 +49,15 @@ def solve_near(
     """The solution nearest ``q_near`` for every target pose.
 
     Args:
-        robot: The :class:`~robokin.robot.Robot`.
+        robot: The arm (a :class:`~robokin.robot.Robot` or its ``Arm``).
         T: Target tool poses (..., 4, 4) [m] in the world frame.
         q_near: Current configuration [rad, m], (n,) or (..., n) broadcasting to
             the targets.
-        method: ``"auto"`` (the closed form where the arm has one, else numeric),
-            ``"analytic"`` or ``"numeric"``.
+        method: ``"auto"`` (the closed form where the arm has one, else numeric:
+            on 7R arms the numeric descent from ``q_near``), ``"analytic"``,
+            ``"numeric"`` or ``"self_motion"`` (7R arms whose self-motion has a
+            closed form: the in-limit point of the whole manifold nearest
+            ``q_near``, milliseconds per pose; see ``docs/ik.md``).
         **options: Options of the numeric solver
             (:func:`robokin.kinematics.ik.numeric.solve`, e.g. ``mask``, ``tol``,
             ``max_restarts``); giving any selects it.
@@ -64,31 +71,36 @@ def solve_near(
     Raises:
         InputError: a bad pose, ``q_near``, method or option.
     """
+    arm = arm_of(robot)
     if method not in _METHODS:
         raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
-    q_near = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
+    q_near = check_finite(check_joints(q_near, arm.n, "q_near"), "q_near")
+    if method == "self_motion":
+        if options:
+            raise InputError("options", f"{sorted(options)} are numeric-solver options; "
+                                        "method='self_motion' takes none")
+        if auto_parameter(arm) is None:
+            raise InputError("method", f"method='self_motion' needs a 7R arm whose "
+                                       f"self-motion has a closed form (SRS swivel or "
+                                       f"a held-joint closed form); robot '{arm.name}' "
+                                       f"has none: use method='numeric'")
+        return _manifold_near(arm, T, q_near)
     if method == "numeric" or options:
         if method == "analytic":
             raise InputError("options", f"{sorted(options)} are numeric-solver options; "
                                         "the closed form takes none")
-        return _numeric_near(robot, T, q_near, **options)
-    from robokin.kinematics.ik.analytic.detect import detect
-
-    fam = detect(robot)
-    if fam.solver is None and method == "auto" and auto_parameter(robot) is not None:
-        # a 7R arm with a closed-form self-motion ("analytic" still names the 6R
-        # families only, as before issue 29)
-        return _manifold_near(robot, T, q_near)
+        return _numeric_near(arm, T, q_near, **options)
+    fam = detect(arm)
     if fam.solver is None:
         if method == "analytic":
-            raise InputError("method", f"no closed form for robot '{robot.name}': "
+            raise InputError("method", f"no closed form for robot '{arm.name}': "
                                        f"{fam.reason}")
-        return _numeric_near(robot, T, q_near)
-    sols = robot.ik(T, q_near=q_near, method="analytic")
-    return _nearest(robot, sols, T, q_near)
+        return _numeric_near(arm, T, q_near)
+    sols = solve(arm, T, q_near=q_near, method="analytic")
+    return _nearest(arm, sols, T, q_near)
 
 
-def _manifold_near(robot: RobotLike, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
+def _manifold_near(arm: Arm, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
     """A 7R arm with a self-motion closed form: the in-limit point nearest ``q_near``.
 
     Per pose, every branch of the self-motion is sampled and the nearest in-limit
@@ -98,16 +110,16 @@ def _manifold_near(robot: RobotLike, T: npt.ArrayLike, q_near: np.ndarray) -> IK
 
     T = check_transform(T, "T")
     lead = T.shape[:-2]
-    check_broadcasts(q_near, lead + (robot.n,), "q_near")
+    check_broadcasts(q_near, lead + (arm.n,), "q_near")
     Tf = T.reshape(-1, 4, 4)
-    qn = np.broadcast_to(q_near, lead + (robot.n,)).reshape(-1, robot.n)
-    q = np.full((len(Tf), robot.n), np.nan)
+    qn = np.broadcast_to(q_near, lead + (arm.n,)).reshape(-1, arm.n)
+    q = np.full((len(Tf), arm.n), np.nan)
     for i, (Ti, qi) in enumerate(zip(Tf, qn, strict=True)):
-        p = nearest_on_manifold(robot, Ti, qi)
+        p = nearest_on_manifold(arm, Ti, qi, dispatch=solve)
         if p is not None:
             q[i] = p.q
     found = np.isfinite(q).all(-1)
-    dp, dr = fk_error(robot.chain, q[:, None], Tf)
+    dp, dr = fk_error(arm.chain, q[:, None], Tf)
     dp, dr = dp[:, 0], dr[:, 0]
     reason = np.where(found, "converged",
                       "no configuration of the self-motion inside the joint limits")
@@ -116,30 +128,26 @@ def _manifold_near(robot: RobotLike, T: npt.ArrayLike, q_near: np.ndarray) -> IK
         return IKResult(q=q[0], success=np.bool_(found[0]), error=float(np.hypot(dp[0], dr[0])),
                         iterations=0, restarts=0, reason=str(reason[0]),
                         position_error=float(dp[0]), rotation_error=float(dr[0]))
-    return IKResult(q=q.reshape(lead + (robot.n,)), success=found.reshape(lead),
+    return IKResult(q=q.reshape(lead + (arm.n,)), success=found.reshape(lead),
                     error=np.hypot(dp, dr).reshape(lead), iterations=zeros, restarts=zeros,
                     reason=reason.astype(object).reshape(lead),
                     position_error=dp.reshape(lead), rotation_error=dr.reshape(lead))
 
 
-def _numeric_near(robot: RobotLike, T: npt.ArrayLike, q_near: np.ndarray,
+def _numeric_near(robot: Arm, T: npt.ArrayLike, q_near: np.ndarray,
                   **options: Any) -> IKResult:
     """The numeric solver started at ``q_near``.
 
     ``q_near`` is checked against the poses first, so a mismatch is reported as
     ``q_near``, the argument the caller passed.
     """
-    from robokin.kinematics.ik import numeric
-
     T = check_transform(T, "T")
     check_broadcasts(q_near, T.shape[:-2] + (robot.n,), "q_near")
     return numeric.solve(robot, T, q0=q_near, **options)
 
 
-def _nearest(robot: RobotLike, sols: SolutionSet, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
+def _nearest(robot: Arm, sols: SolutionSet, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
     """The row of ``sols`` nearest ``q_near`` per pose, inside the limits, as a result."""
-    from robokin._native import kernels
-
     lead, n = sols.shape, robot.n
     k = sols.q.shape[-2]
     if not lead and q_near.shape == (n,):  # one pose: no reshaping copies

@@ -37,20 +37,20 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from robokin._validation import check_finite, check_joints, check_poses_fast
 from robokin.exceptions import InputError
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
+from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
 from robokin.kinematics.ik.swivel import SwivelArm, swivel_arm
-from robokin.kinematics.per_chain import cached
+from robokin.spatial import wrap_angle as _wrap
 
-if TYPE_CHECKING:
-    from robokin.kinematics.robot_like import RobotLike
-
-__all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SingularPoint", "auto_parameter",
+__all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SelfMotionSetup", "SingularPoint",
+           "auto_parameter",
            "nearest_on_manifold", "parameter_values", "self_motion"]
 
 #: Parameter values on the checking grid.
@@ -161,7 +161,7 @@ class _SwivelFamily(_Family):
     name = "swivel"
     joint = None
 
-    def __init__(self, arm: SwivelArm, T: np.ndarray, robot: RobotLike) -> None:
+    def __init__(self, arm: SwivelArm, T: np.ndarray, robot: Arm) -> None:
         self.arm = arm
         self.fr = arm.frame(T)
         self.T = T
@@ -182,8 +182,10 @@ class _SwivelFamily(_Family):
 
 
 class _HeldFamily(_Family):
-    def __init__(self, robot: RobotLike, params: np.ndarray, j: int, T: np.ndarray) -> None:
+    def __init__(self, robot: Arm, params: np.ndarray, j: int, T: np.ndarray,
+                 dispatch: Dispatch) -> None:
         self.robot = robot
+        self.dispatch = dispatch
         self.params = params
         self.joint = j
         self.name = robot.joint_names[j]
@@ -202,7 +204,8 @@ class _HeldFamily(_Family):
         return _into_limits(self.robot, Q), valid, sing
 
     def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
-        sols = self.robot.ik(self.T, fixed={self.robot.joint_names[j]: value})
+        sols = solve_fixed(self.robot, self.T, {self.robot.joint_names[j]: value},
+                           dispatch=self.dispatch)
         if "swivel" in str(sols.info.get("measured", "")) and j == 3:
             return []  # the SRS elbow held: a family, constant on the manifold
         out: list[tuple[float, np.ndarray | None]] = []
@@ -225,8 +228,10 @@ class _ContinuedFamily(_Family):
     (interpolated between its nodes).
     """
 
-    def __init__(self, robot: RobotLike, j: int, T: np.ndarray, nodes: int = 181) -> None:
+    def __init__(self, robot: Arm, j: int, T: np.ndarray, dispatch: Dispatch,
+                 nodes: int = 181) -> None:
         self.robot = robot
+        self.dispatch = dispatch
         self.joint = j
         self.name = robot.joint_names[j]
         self.domain = (float(robot.limits[j, 0]), float(robot.limits[j, 1]))
@@ -247,7 +252,7 @@ class _ContinuedFamily(_Family):
         self.k = self.tracks.shape[1]
 
     def _solve(self, t: np.ndarray) -> np.ndarray:
-        sols = self.robot.ik(self.T, fixed={self.name: t})
+        sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
         Q = np.where(sols.valid[..., None], sols.q, np.nan)
         return _into_limits(self.robot, Q)
 
@@ -280,7 +285,8 @@ class _ContinuedFamily(_Family):
         return np.where(np.isfinite(mid), mid, near)
 
     def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
-        sols = self.robot.ik(self.T, fixed={self.robot.joint_names[j]: value})
+        sols = solve_fixed(self.robot, self.T, {self.robot.joint_names[j]: value},
+                           dispatch=self.dispatch)
         out: list[tuple[float, np.ndarray | None]] = []
         for row in sols.q[sols.valid]:
             t = _shift_into(float(row[self.joint]), self.domain)
@@ -291,7 +297,8 @@ class _ContinuedFamily(_Family):
 
 def _dist(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Largest 2 pi wrapped joint difference of rows a and b (broadcast, NaN -> NaN)."""
-    return np.abs(_wrap(a - b)).max(-1)
+    out: np.ndarray = np.abs(_wrap(a - b)).max(-1)
+    return out
 
 
 def _clean_step(A: np.ndarray, B: np.ndarray) -> bool:
@@ -338,10 +345,6 @@ def _link(Q: np.ndarray) -> np.ndarray:
     return np.stack(tracks, axis=1)
 
 
-def _wrap(a: np.ndarray) -> np.ndarray:
-    return np.remainder(np.asarray(a) + np.pi, _TWO_PI) - np.pi
-
-
 def _shift_into(t: float, domain: tuple[float, float]) -> float | None:
     """T shifted by whole turns into the closed domain, or None."""
     lo, hi = domain
@@ -351,16 +354,17 @@ def _shift_into(t: float, domain: tuple[float, float]) -> float | None:
     return None
 
 
-def _into_limits(robot: RobotLike, q: np.ndarray) -> np.ndarray:
+def _into_limits(robot: Arm, q: np.ndarray) -> np.ndarray:
     """Revolute angles shifted by 2 pi into the limits where that fits."""
     lo, hi = robot.limits[:, 0], robot.limits[:, 1]
     rev = np.asarray(robot.is_revolute, bool)
     up = rev & (q < lo) & (q + _TWO_PI <= hi)
     down = rev & (q > hi) & (q - _TWO_PI >= lo)
-    return q + _TWO_PI * up - _TWO_PI * down
+    out: np.ndarray = q + _TWO_PI * up - _TWO_PI * down
+    return out
 
 
-def _polish(robot: RobotLike, q: np.ndarray, real: np.ndarray, T: np.ndarray
+def _polish(robot: Arm, q: np.ndarray, real: np.ndarray, T: np.ndarray
             ) -> tuple[np.ndarray, np.ndarray]:
     """Rows whose pose error exceeds 1e-13 get minimum-norm Gauss-Newton steps.
 
@@ -397,7 +401,8 @@ def _polish(robot: RobotLike, q: np.ndarray, real: np.ndarray, T: np.ndarray
 
 def _size(e: np.ndarray) -> np.ndarray:
     """The larger of the position and rotation norms of pose errors (..., 6)."""
-    return np.maximum(np.linalg.norm(e[..., :3], axis=-1), np.linalg.norm(e[..., 3:], axis=-1))
+    out: np.ndarray = np.maximum(np.linalg.norm(e[..., :3], axis=-1), np.linalg.norm(e[..., 3:], axis=-1))
+    return out
 
 
 # ------------------------------------------------------------------ the result
@@ -460,7 +465,8 @@ class SelfMotion:
     def _inside(self, q: np.ndarray) -> np.ndarray:
         lo, hi = self.limits[:, 0], self.limits[:, 1]
         with np.errstate(invalid="ignore"):
-            return np.all((q >= lo - 1e-12) & (q <= hi + 1e-12), axis=-1)
+            out: np.ndarray = np.all((q >= lo - 1e-12) & (q <= hi + 1e-12), axis=-1)
+            return out
 
     @property
     def reachable(self) -> bool:
@@ -468,7 +474,7 @@ class SelfMotion:
         return bool(len(self.intervals))
 
     def best(self, criterion: str | Callable[[np.ndarray], np.ndarray] = "margin", *,
-             robot: RobotLike | None = None, samples: int = 64) -> ManifoldPoint | None:
+             robot: ArmSource | None = None, samples: int = 64) -> ManifoldPoint | None:
         """The in-limit configuration that maximises ``criterion``, or None.
 
         Args:
@@ -486,7 +492,8 @@ class SelfMotion:
         qn = check_finite(check_joints(q_near, self.limits.shape[0], "q_near"), "q_near")
 
         def score(q: np.ndarray) -> np.ndarray:
-            return -np.linalg.norm(_wrap(q - qn), axis=-1)
+            out: np.ndarray = -np.linalg.norm(_wrap(q - qn), axis=-1)
+            return out
 
         return self._maximise(score, samples)
 
@@ -547,15 +554,20 @@ def _scores(fam: _Family, limits: np.ndarray, score: Callable[[np.ndarray], np.n
     return out.reshape(t.shape)
 
 
-def nearest_on_manifold(robot: RobotLike, T: np.ndarray, q_near: np.ndarray, *,
-                        samples: int = 61) -> ManifoldPoint | None:
+def nearest_on_manifold(robot: ArmSource, T: np.ndarray, q_near: np.ndarray, *,
+                        dispatch: Dispatch, samples: int = 61) -> ManifoldPoint | None:
     """The in-limit configuration of pose T (4, 4) nearest ``q_near`` (n,), or None.
+
+    ``dispatch`` is ``dispatch.solve`` (solves the arm with a joint held; passed in,
+    as :func:`~robokin.kinematics.ik.fixed.solve_fixed` takes it, so this module
+    does not import the dispatcher that imports it).
 
     Without the exact intervals (``ik_near``'s fast path): every branch sampled at
     ``samples`` parameter values over its range and over +-0.05 rad around
     ``q_near``'s own parameter value, the nearest in-limit sample zoomed in on.
     """
-    fam = _family(robot, T, "auto")
+    arm = arm_of(robot)
+    fam = _family(arm, T, "auto", dispatch)
     k = fam.k
     lo, hi = fam.domain
     # every branch over the whole range, and a window around q_near's own parameter
@@ -570,33 +582,62 @@ def nearest_on_manifold(robot: RobotLike, T: np.ndarray, q_near: np.ndarray, *,
     intervals = np.vstack([np.tile([lo, hi], (k, 1)), np.tile(window, (k, 1))])
 
     def score(q: np.ndarray) -> np.ndarray:
-        return -np.linalg.norm(_wrap(q - q_near), axis=-1)
+        out: np.ndarray = -np.linalg.norm(_wrap(q - q_near), axis=-1)
+        return out
 
-    return _maximise(fam, np.asarray(robot.limits, dtype=np.float64), intervals,
+    return _maximise(fam, np.asarray(arm.limits, dtype=np.float64), intervals,
                      np.tile(np.arange(k), 2), score, samples)
 
 
-def auto_parameter(robot: RobotLike) -> str | None:
+def auto_parameter(robot: ArmSource) -> str | None:
     """The closed-form parameter ``self_motion(T)`` takes on this arm, or None.
 
     None for arms that are not 7R, or whose self-motion is continued numerically
     (no swivel, no held-joint closed form).
     """
-    def build() -> str | None:
-        chain = robot.chain
-        if robot.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
-            return None
-        if cached(chain, "swivel_arm", lambda: swivel_arm(chain)) is not None:
-            return "swivel"
-        from robokin.kinematics.ik.fixed import _held_solvers
+    arm = arm_of(robot)
+    chain = arm.chain
+    if arm.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
+        return None
+    setup = _setup(arm)
+    if not setup.parameter_known:
+        if setup.swivel is not None:
+            setup.parameter = "swivel"
+        else:
+            from robokin.kinematics.ik.fixed import _held_solvers
 
-        usable = [n for n in robot.joint_names if n in _held_solvers(robot)]
-        return usable[-1] if usable else None
+            usable = [n for n in arm.joint_names if n in _held_solvers(arm)]
+            setup.parameter = usable[-1] if usable else None
+        setup.parameter_known = True
+    return setup.parameter
 
-    return cached(robot.chain, "self_motion_parameter", build)
+
+@dataclass(slots=True, eq=False)
+class SelfMotionSetup:
+    """What the self-motion of a 7R arm needs per chain (kept in ``Arm.self_motion``).
+
+    Attributes:
+        swivel: The SRS arm's swivel closed form, or None (not SRS).
+        parameter: ``auto_parameter``'s answer once ``parameter_known``.
+        parameter_known: True once ``parameter`` is set.
+        aligned: ``_aligned_values``' (joint, value) pairs, or None until needed.
+    """
+
+    swivel: SwivelArm | None
+    parameter: str | None = None
+    parameter_known: bool = False
+    aligned: list[tuple[int, float]] | None = None
 
 
-def _criterion(criterion: Any, robot: RobotLike | None, limits: np.ndarray
+def _setup(arm: Arm) -> SelfMotionSetup:
+    """The arm's :class:`SelfMotionSetup`, built on first use (a 7-joint chain)."""
+    setup = arm.self_motion
+    if not isinstance(setup, SelfMotionSetup):
+        setup = arm.self_motion = SelfMotionSetup(swivel_arm(arm.chain))
+    return setup
+
+
+def _criterion(criterion: Any, robot: ArmSource | None, limits: np.ndarray
                ) -> Callable[[np.ndarray], np.ndarray]:
     if callable(criterion):
         def user(q: np.ndarray) -> np.ndarray:
@@ -604,7 +645,8 @@ def _criterion(criterion: Any, robot: RobotLike | None, limits: np.ndarray
         return user
     if criterion == "margin":
         def margin(q: np.ndarray) -> np.ndarray:
-            return np.minimum(q - limits[:, 0], limits[:, 1] - q).min(-1)
+            out: np.ndarray = np.minimum(q - limits[:, 0], limits[:, 1] - q).min(-1)
+            return out
         return margin
     if criterion == "manipulability":
         if robot is None:
@@ -612,14 +654,14 @@ def _criterion(criterion: Any, robot: RobotLike | None, limits: np.ndarray
                                       "sm.best('manipulability', robot=robot)")
         from robokin.kinematics.jacobian import manipulability
 
-        chain = robot.chain
+        chain = arm_of(robot).chain
         return lambda q: manipulability(chain, q)
     raise InputError("criterion", f"expected 'margin', 'manipulability' or a function "
                                   f"of configurations (m, n) -> (m,), got {criterion!r}")
 
 
 # ------------------------------------------------------------------ building it
-def _family(robot: RobotLike, T: np.ndarray, parameter: str) -> _Family:
+def _family(robot: Arm, T: np.ndarray, parameter: str, dispatch: Dispatch) -> _Family:
     names = list(robot.joint_names)
     choices = ["auto", "swivel", *names]
     if robot.n != 7 or robot.chain.n_chain != 7 or not robot.chain.coupling.is_identity:
@@ -628,7 +670,7 @@ def _family(robot: RobotLike, T: np.ndarray, parameter: str) -> _Family:
     if parameter not in choices:
         raise InputError("parameter", f"expected one of {', '.join(map(repr, choices))}, "
                                       f"got {parameter!r}")
-    arm = cached(robot.chain, "swivel_arm", lambda: swivel_arm(robot.chain))
+    arm = _setup(robot).swivel
     if parameter in ("auto", "swivel") and arm is not None:
         return _SwivelFamily(arm, T, robot)
     if parameter == "swivel":
@@ -642,18 +684,20 @@ def _family(robot: RobotLike, T: np.ndarray, parameter: str) -> _Family:
         usable = [n for n in names if n in held]
         parameter = usable[-1] if usable else names[-1]
     if parameter not in held:  # the general held-joint 6R solver, continued
-        return _ContinuedFamily(robot, names.index(parameter), T)
-    return _HeldFamily(robot, held[parameter].params, names.index(parameter), T)
+        return _ContinuedFamily(robot, names.index(parameter), T, dispatch)
+    return _HeldFamily(robot, held[parameter].params, names.index(parameter), T, dispatch)
 
 
-def self_motion(robot: RobotLike, T: npt.ArrayLike, parameter: str = "auto", *,
-                grid: int = GRID) -> SelfMotion:
+def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
+                dispatch: Dispatch, grid: int = GRID) -> SelfMotion:
     """The self-motion manifold of one pose T (4, 4) of a 7R arm.
 
     Args:
-        robot: A 7-joint arm.
+        robot: A 7-joint arm (a Robot, its ``Arm`` or a chain).
         T: The tool pose (4, 4) [m].
         parameter: ``"auto"``, ``"swivel"`` (SRS arms) or a joint name.
+        dispatch: ``dispatch.solve`` (solves the arm with a joint held; the caller
+            passes it, as to :func:`~robokin.kinematics.ik.fixed.solve_fixed`).
         grid: Parameter values of the checking grid (see the module docstring).
 
     Returns:
@@ -663,10 +707,11 @@ def self_motion(robot: RobotLike, T: npt.ArrayLike, parameter: str = "auto", *,
         InputError: not a 7R arm, a bad pose, or a parameter without a closed form
             (the message lists the choices).
     """
+    robot = arm_of(robot)
     Ta = check_poses_fast(T, "T")
     if Ta.shape != (4, 4):
         raise InputError("T", f"self_motion takes one pose (4, 4), got {Ta.shape}")
-    fam = _family(robot, Ta, parameter)
+    fam = _family(robot, Ta, parameter, dispatch)
     limits = np.asarray(robot.limits, dtype=np.float64)
     marks = _exact_points(robot, fam, limits)
     if isinstance(fam, _ContinuedFamily):
@@ -685,9 +730,9 @@ def self_motion(robot: RobotLike, T: npt.ArrayLike, parameter: str = "auto", *,
                       {"bisected": bisected, "grid": int(grid)}, fam, limits)
 
 
-def _exact_points(robot: RobotLike, fam: _Family, limits: np.ndarray) -> dict[str, list]:
+def _exact_points(robot: Arm, fam: _Family, limits: np.ndarray) -> dict[str, list[Any]]:
     """Every limit point and aligned-axes point of every branch, exactly."""
-    out: dict[str, list] = {"limit": [], "fold": [], "aligned": []}
+    out: dict[str, list[Any]] = {"limit": [], "fold": [], "aligned": []}
     rev = np.asarray(robot.is_revolute, bool)
     queries: list[tuple[int, float]] = []
     tags: list[tuple[str, Any]] = []
@@ -709,28 +754,32 @@ def _exact_points(robot: RobotLike, fam: _Family, limits: np.ndarray) -> dict[st
     return out
 
 
-def _aligned_values(robot: RobotLike) -> list[tuple[int, float]]:
+def _aligned_values(robot: Arm) -> list[tuple[int, float]]:
     """(joint, value): where axes j-1 and j+1 of a meeting triple line up."""
-    def build() -> list[tuple[int, float]]:
-        from robokin.kinematics.ik.analytic._geometry import poe_from_chain
-        from robokin.kinematics.ik.swivel import _sp4
-
-        poe = poe_from_chain(robot.chain)
-        sign, offset = robot.chain.arrays.sign, robot.chain.arrays.offset
-        found = []
-        for j in range(1, robot.chain.n_chain - 1):
-            a, h, b = poe.h[j - 1], poe.h[j], poe.h[j + 1]
-            for c in (1.0, -1.0):
-                tp, tm, real = _sp4(h, a, b, np.array(c))
-                if bool(real) and abs(float(tp) - float(tm)) < 1e-6:
-                    v = float((tp + tm) / 2)
-                    found.append((j, float(_wrap((v - offset[j]) * sign[j]))))
-        return found
-
-    return cached(robot.chain, "aligned_axes", build)
+    setup = _setup(robot)
+    if setup.aligned is None:
+        setup.aligned = _find_aligned(robot)
+    return setup.aligned
 
 
-def _grid(fam: _Family, m: int, marks: dict[str, list]) -> np.ndarray:
+def _find_aligned(robot: Arm) -> list[tuple[int, float]]:
+    from robokin.kinematics.ik.analytic._geometry import poe_from_chain
+    from robokin.kinematics.ik.swivel import _sp4
+
+    poe = poe_from_chain(robot.chain)
+    sign, offset = robot.chain.arrays.sign, robot.chain.arrays.offset
+    found = []
+    for j in range(1, robot.chain.n_chain - 1):
+        a, h, b = poe.h[j - 1], poe.h[j], poe.h[j + 1]
+        for c in (1.0, -1.0):
+            tp, tm, real = _sp4(h, a, b, np.array(c))
+            if bool(real) and abs(float(tp) - float(tm)) < 1e-6:
+                v = float((tp + tm) / 2)
+                found.append((j, float(_wrap((v - offset[j]) * sign[j]))))
+    return found
+
+
+def _grid(fam: _Family, m: int, marks: dict[str, list[Any]]) -> np.ndarray:
     """The checking grid: m values over the range, refined next to aligned points.
 
     Next to a point where a triple lines up a branch's outer angles swing by up to
@@ -746,7 +795,7 @@ def _grid(fam: _Family, m: int, marks: dict[str, list]) -> np.ndarray:
 
 
 def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray,
-                   limits: np.ndarray, marks: dict[str, list]
+                   limits: np.ndarray, marks: dict[str, list[Any]]
                    ) -> tuple[list[tuple[float, int]], int]:
     """Branch ends (bisected on existence) and unexplained in-limit changes on the grid.
 
@@ -789,10 +838,11 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
 def _within(q: np.ndarray, limits: np.ndarray) -> np.ndarray:
     """(...) bool: rows q (..., n) inside every limit (1e-12 slack); NaN rows False."""
     with np.errstate(invalid="ignore"):
-        return np.all((q >= limits[:, 0] - 1e-12) & (q <= limits[:, 1] + 1e-12), axis=-1)
+        out: np.ndarray = np.all((q >= limits[:, 0] - 1e-12) & (q <= limits[:, 1] + 1e-12), axis=-1)
+        return out
 
 
-def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list],
+def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
                extra: list[tuple[float, int]]) -> tuple[np.ndarray, np.ndarray]:
     """Per branch: the maximal parameter intervals inside every limit."""
     lo_d, hi_d = fam.domain
@@ -848,17 +898,19 @@ def _join_wrap(pieces: list[tuple[int, float, float]], lo: float, hi: float
     return sorted(out)
 
 
-def parameter_values(robot: RobotLike, T: np.ndarray, q: np.ndarray) -> tuple[str, np.ndarray]:
+def parameter_values(robot: ArmSource, T: np.ndarray, q: np.ndarray
+                     ) -> tuple[str, np.ndarray]:
     """The self-motion parameter of configurations q (..., k, n) of poses T (..., 4, 4).
 
     Returns ``(name, values (..., k))``: the swivel angle on SRS arms, else the
     ``auto`` parameter's joint (the last joint without a closed form); NaN rows give
     NaN.
     """
-    name = auto_parameter(robot) or robot.joint_names[-1]
+    owner = arm_of(robot)
+    name = auto_parameter(owner) or owner.joint_names[-1]
     if name != "swivel":
-        return name, q[..., robot.joint_names.index(name)]
-    arm = cached(robot.chain, "swivel_arm", lambda: swivel_arm(robot.chain))
+        return name, q[..., owner.joint_names.index(name)]
+    arm = _setup(owner).swivel
     assert arm is not None
     lead = q.shape[:-2]
     Tf = np.broadcast_to(T, lead + (4, 4)).reshape(-1, 4, 4)

@@ -44,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from robokin.kinematics.ik.analytic._geometry import poe_from_chain
+from robokin.spatial import wrap_angle
 
 __all__ = ["SwivelArm", "swivel_arm"]
 
@@ -63,15 +64,18 @@ def _rot(u: np.ndarray, ang: np.ndarray) -> np.ndarray:
                   np.stack([-y, x, zero], -1)], -2)
     outer = u[..., :, None] * u[..., None, :]
     eye = np.broadcast_to(np.eye(3), K.shape)
-    return c * eye + s * K + (1 - c) * outer
+    out: np.ndarray = c * eye + s * K + (1 - c) * outer
+    return out
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.einsum("...i,...i->...", a, b)
+    out: np.ndarray = np.einsum("...i,...i->...", a, b)
+    return out
 
 
 def _mv(R: np.ndarray, v: np.ndarray) -> np.ndarray:
-    return np.einsum("...ij,...j->...i", R, v)
+    out: np.ndarray = np.einsum("...ij,...j->...i", R, v)
+    return out
 
 
 def _sp4(h: np.ndarray, x: np.ndarray, y: np.ndarray, c: np.ndarray
@@ -126,7 +130,8 @@ def _triple(ha: np.ndarray, hb: np.ndarray, hc: np.ndarray, R: np.ndarray,
 def _perp(h: np.ndarray) -> np.ndarray:
     e = np.eye(3)[int(np.argmin(np.abs(h)))]
     v = e - np.dot(e, h) * h
-    return v / np.linalg.norm(v)
+    out: np.ndarray = v / np.linalg.norm(v)
+    return out
 
 
 def _meet(h: np.ndarray, o: np.ndarray) -> tuple[float, np.ndarray]:
@@ -225,11 +230,12 @@ class SwivelArm:
 
     def wrap(self, q: np.ndarray) -> np.ndarray:
         """Angles into (-pi, pi], then by 2 pi into the limits where that fits."""
-        q = np.remainder(q + np.pi, 2 * np.pi) - np.pi
+        q = wrap_angle(q)
         lo, hi = self.limits[:, 0], self.limits[:, 1]
         up = (q < lo) & (q + 2 * np.pi <= hi)
         down = (q > hi) & (q - 2 * np.pi >= lo)
-        return q + 2 * np.pi * up - 2 * np.pi * down
+        out: np.ndarray = q + 2 * np.pi * up - 2 * np.pi * down
+        return out
 
     def swivel_of(self, fr: dict[str, Any], q: np.ndarray) -> np.ndarray:
         """The swivel angle [rad] of configurations q (..., 7) of the pose."""
@@ -276,14 +282,15 @@ class SwivelArm:
                 continue
             for phi in {float(tp), float(tm)}:
                 psi = sgn * phi + fr["psi0"][e]
-                out.append((float(np.remainder(psi + np.pi, 2 * np.pi) - np.pi), e))
+                out.append((float(wrap_angle(psi)), e))
         return out
 
 
 def _angle_of(u: np.ndarray, r: np.ndarray, h4: np.ndarray) -> np.ndarray:
     """Swivel angle: about u from r to u x h4 (normalised)."""
     d = np.cross(u, h4)
-    return np.arctan2(_dot(u, np.cross(r, d)), _dot(r, d))
+    out: np.ndarray = np.arctan2(_dot(u, np.cross(r, d)), _dot(r, d))
+    return out
 
 
 def _smallest_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
