@@ -152,6 +152,18 @@ def test_special_configurations(arm, values, at_limit):
     _check_manifold(robot, q0)
 
 
+@pytest.mark.xfail(strict=True, reason="known gap (found by the hypothesis test in the "
+                   "whole suite; fails on 3943a47, before the merge, too): SRS arm, q2 at "
+                   "its upper limit, q6 = 0.5: branch 0 is inside the limits at "
+                   "swivel 0.178 but the intervals miss it")
+def test_known_gap_srs_interval_missed_next_to_q2_limit():
+    # oracle: the 2,000-value brute-force scan of _check_ends against the intervals
+    robot = ARMS["srs"]
+    q0 = _special_config(robot, [0.0] * 5 + [0.5, 0.0])
+    q0[1] = robot.limits[1, 1]
+    _check_manifold(robot, q0)
+
+
 def test_parameter_choices_and_errors():
     assert SRS.self_motion(SRS.fk(np.full(7, 0.3))).parameter == "swivel"
     assert PANDA.self_motion(PANDA.fk(np.array([0, 0.3, 0, -1.5, 0, 1.5, 0.7]))).parameter == "joint7"
