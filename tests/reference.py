@@ -91,3 +91,23 @@ def pin_fk(xml: str, frame: str, values: dict[str, float]) -> np.ndarray:
             q[j.idx_q], q[j.idx_q + 1] = math.cos(v), math.sin(v)
     pin.framesForwardKinematics(model, data, q)
     return data.oMf[model.getFrameId(frame)].homogeneous
+
+
+def iiwa14_srs():
+    """An exact SRS arm with the KUKA LBR iiwa 14 R820's link lengths and ranges.
+
+    Standard DH, flange frame: d_bs = 0.36, d_se = 0.42, d_ew = 0.40, d_wf = 0.126 m
+    (Faria et al., Mechanism and Machine Theory 121, 2018, table 1); joint ranges
+    +-170, 120, 170, 120, 170, 120, 175 deg (KUKA's iiwa specification). Every
+    offset is zero: axes 1-3 meet in the shoulder, 5-7 in the wrist. (The same arm
+    as ``kinematics/ik/test_fixed_properties.py``'s.)
+    """
+    import robokin
+
+    table = [(-np.pi / 2, 0.36, 170), (np.pi / 2, 0.0, 120), (np.pi / 2, 0.42, 170),
+             (-np.pi / 2, 0.0, 120), (-np.pi / 2, 0.40, 170), (np.pi / 2, 0.0, 120),
+             (0.0, 0.126, 175)]
+    rows = [{"a": 0.0, "alpha": alpha, "d": d, "theta": 0.0,
+             "limits": [-np.radians(r), np.radians(r)], "name": f"a{i + 1}"}
+            for i, (alpha, d, r) in enumerate(table)]
+    return robokin.Robot.from_dh(rows, convention="standard", name="iiwa14_srs")

@@ -61,6 +61,9 @@ class Arm:
             ``fixed.HeldSolver``; 7R arms), or None until first needed.
         reduced: The arms of the remaining coordinates of the last held-joint
             reductions (most recently used last; ``fixed`` bounds it).
+        self_motion: The self-motion set-up of a 7R arm (a
+            ``self_motion.SelfMotionSetup``: swivel closed form, parameter,
+            aligned-axes values), or None until first needed.
 
     The derived fields are typed ``object`` here and narrowed by the module that
     fills them (``isinstance`` on its own record type): this module imports
@@ -78,6 +81,7 @@ class Arm:
     seed_table: object | None = None
     held_solvers: dict[str, object] | None = None
     reduced: OrderedDict[ReducedKey, Arm] = field(default_factory=OrderedDict)
+    self_motion: object | None = None
 
     @property
     def arm(self) -> Arm:

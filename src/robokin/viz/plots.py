@@ -18,6 +18,7 @@ from robokin.exceptions import InputError
 from robokin.io.atomic import file_stem, save_figure_atomic
 
 if TYPE_CHECKING:
+    from robokin.kinematics.ik.self_motion import SelfMotion
     from robokin.robot import Robot
     from robokin.trajectory.samples import Trajectory
 
@@ -25,6 +26,7 @@ __all__ = [
     "place_labels",
     "plot_comparison",
     "plot_joints",
+    "plot_self_motion",
     "plot_robot",
     "plot_tool_path",
     "plot_tool_position",
@@ -279,6 +281,62 @@ def plot_joints(traj: Trajectory, *, path: str | Path | None = None, degrees: bo
                          label="via points" if j == 0 else None)
     axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
     fig.suptitle(title or f"joint motion: {traj.duration:.3g} s, {len(traj)} samples")
+    return _finish(fig, path, overwrite)
+
+
+def plot_self_motion(sm: SelfMotion, *, path: str | Path | None = None,
+                     degrees: bool = True, samples: int = 721, title: str | None = None,
+                     overwrite: bool = False) -> Any:
+    """The branches of a self-motion manifold: one panel per joint, a line per branch.
+
+    Each branch's joint value over the parameter t is drawn thin where it leaves a
+    joint limit and thick over its intervals inside every limit
+    (``sm.intervals``); limits are dashed, limit crossings dots and singular
+    points crosses.
+
+    Args:
+        sm: A :class:`~robokin.kinematics.ik.self_motion.SelfMotion`
+            (``robot.self_motion(T)``).
+        path: Save to this PNG/SVG/PDF file too.
+        degrees: Angles in degrees, else rad.
+        samples: Parameter values drawn per branch.
+        title: Figure title.
+        overwrite: Replace an existing file.
+
+    Returns:
+        The matplotlib Figure.
+    """
+    s = 180.0 / np.pi if degrees else 1.0
+    unit = "deg" if degrees else "rad"
+    lo, hi = sm.domain
+    t = np.linspace(lo, hi, int(samples))
+    q = sm.sample(t)  # (m, k, n)
+    inside = sm.inside(t)
+    n = q.shape[-1]
+    fig = _figure((10.0, 1.6 * n + 1.0))
+    axes = fig.subplots(n, 1, sharex=True)
+    colors = [f"C{b % 10}" for b in range(sm.n_branches)]
+    for j, ax in enumerate(axes):
+        for b in range(sm.n_branches):
+            ax.plot(t * s, q[:, b, j] * s, color=colors[b], linewidth=0.6, alpha=0.5)
+            ax.plot(t * s, np.where(inside[:, b], q[:, b, j], np.nan) * s, color=colors[b],
+                    linewidth=2.0, label=f"branch {b}" if j == 0 else None)
+        for v in sm.limits[j]:
+            ax.axhline(v * s, color="0.3", linestyle="--", linewidth=0.8)
+        for c in sm.crossings:
+            if c.joint == j:
+                ax.plot(c.t * s, sm.limits[j, 0 if c.limit == "lower" else 1] * s, "o",
+                        color=colors[c.branch], markersize=3)
+        ax.set_ylabel(f"q{j + 1} [{unit}]")
+        ax.grid(True, alpha=0.3)
+    for p in sm.singular:
+        qp = sm.sample(p.t)[p.branch]
+        for j, ax in enumerate(axes):
+            ax.plot(p.t * s, qp[j] * s, "x", color="k", markersize=4)
+    axes[-1].set_xlabel(f"{sm.parameter} [{unit}]")
+    axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
+    fig.suptitle(title or f"self-motion over {sm.parameter}: {len(sm.intervals)} "
+                          "in-limit interval(s) (thick)")
     return _finish(fig, path, overwrite)
 
 

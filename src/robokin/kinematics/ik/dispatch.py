@@ -85,7 +85,32 @@ def solve(
             )
     from robokin.kinematics.ik.numeric import solve_all
 
-    return solve_all(arm, T, q_near=qn, **options)
+    sols = solve_all(arm, T, q_near=qn, **options)
+    chain = arm.chain
+    if arm.n == 7 and chain.n_chain == 7 and chain.coupling.is_identity:
+        sols = _say_sample(arm, T, sols)
+    return sols
+
+
+def _say_sample(arm: Arm, T: npt.NDArray[np.float64], sols: SolutionSet) -> SolutionSet:
+    """A 7R arm's numeric set says it is a sample of the self-motion, with parameters.
+
+    ``info["self_motion"]`` says what the rows are; ``info["parameter"]`` names the
+    self-motion parameter (the swivel on SRS arms, else a joint) and
+    ``info["parameter_values"]`` (..., k) gives each row's value (NaN rows: NaN).
+    """
+    from dataclasses import replace
+
+    from robokin.kinematics.ik.self_motion import parameter_values
+
+    name, values = parameter_values(arm, T, sols.q)
+    info = dict(sols.info)
+    info["self_motion"] = ("a sample of a one-parameter family (7 joints, 6 pose "
+                           "components): robot.self_motion(T) gives every branch "
+                           "with its exact in-limit intervals")
+    info["parameter"] = name
+    info["parameter_values"] = np.where(sols.valid, values, np.nan)
+    return replace(sols, info=info)
 
 
 def _check_options(fam: Family, options: dict[str, Any]) -> None:

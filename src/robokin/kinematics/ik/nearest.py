@@ -28,13 +28,14 @@ from robokin.kinematics.ik import numeric
 from robokin.kinematics.ik.analytic.detect import detect
 from robokin.kinematics.ik.dispatch import solve
 from robokin.kinematics.ik.numeric import IKResult
+from robokin.kinematics.ik.self_motion import auto_parameter, nearest_on_manifold
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.solutions import SolutionSet
 
 __all__ = ["solve_near"]
 
-_METHODS = ("auto", "analytic", "numeric")
+_METHODS = ("auto", "analytic", "numeric", "self_motion")
 
 
 def solve_near(
@@ -52,8 +53,11 @@ def solve_near(
         T: Target tool poses (..., 4, 4) [m] in the world frame.
         q_near: Current configuration [rad, m], (n,) or (..., n) broadcasting to
             the targets.
-        method: ``"auto"`` (the closed form where the arm has one, else numeric),
-            ``"analytic"`` or ``"numeric"``.
+        method: ``"auto"`` (the closed form where the arm has one, else numeric:
+            on 7R arms the numeric descent from ``q_near``), ``"analytic"``,
+            ``"numeric"`` or ``"self_motion"`` (7R arms whose self-motion has a
+            closed form: the in-limit point of the whole manifold nearest
+            ``q_near``, milliseconds per pose; see ``docs/ik.md``).
         **options: Options of the numeric solver
             (:func:`robokin.kinematics.ik.numeric.solve`, e.g. ``mask``, ``tol``,
             ``max_restarts``); giving any selects it.
@@ -71,6 +75,16 @@ def solve_near(
     if method not in _METHODS:
         raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
     q_near = check_finite(check_joints(q_near, arm.n, "q_near"), "q_near")
+    if method == "self_motion":
+        if options:
+            raise InputError("options", f"{sorted(options)} are numeric-solver options; "
+                                        "method='self_motion' takes none")
+        if auto_parameter(arm) is None:
+            raise InputError("method", f"method='self_motion' needs a 7R arm whose "
+                                       f"self-motion has a closed form (SRS swivel or "
+                                       f"a held-joint closed form); robot '{arm.name}' "
+                                       f"has none: use method='numeric'")
+        return _manifold_near(arm, T, q_near)
     if method == "numeric" or options:
         if method == "analytic":
             raise InputError("options", f"{sorted(options)} are numeric-solver options; "
@@ -84,6 +98,40 @@ def solve_near(
         return _numeric_near(arm, T, q_near)
     sols = solve(arm, T, q_near=q_near, method="analytic")
     return _nearest(arm, sols, T, q_near)
+
+
+def _manifold_near(arm: Arm, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
+    """A 7R arm with a self-motion closed form: the in-limit point nearest ``q_near``.
+
+    Per pose, every branch of the self-motion is sampled and the nearest in-limit
+    sample zoomed in on (``self_motion.nearest_on_manifold``).
+    """
+    from robokin.kinematics.ik.analytic._common import fk_error
+
+    T = check_transform(T, "T")
+    lead = T.shape[:-2]
+    check_broadcasts(q_near, lead + (arm.n,), "q_near")
+    Tf = T.reshape(-1, 4, 4)
+    qn = np.broadcast_to(q_near, lead + (arm.n,)).reshape(-1, arm.n)
+    q = np.full((len(Tf), arm.n), np.nan)
+    for i, (Ti, qi) in enumerate(zip(Tf, qn, strict=True)):
+        p = nearest_on_manifold(arm, Ti, qi, dispatch=solve)
+        if p is not None:
+            q[i] = p.q
+    found = np.isfinite(q).all(-1)
+    dp, dr = fk_error(arm.chain, q[:, None], Tf)
+    dp, dr = dp[:, 0], dr[:, 0]
+    reason = np.where(found, "converged",
+                      "no configuration of the self-motion inside the joint limits")
+    zeros = np.zeros(lead, dtype=np.int64)
+    if not lead:
+        return IKResult(q=q[0], success=np.bool_(found[0]), error=float(np.hypot(dp[0], dr[0])),
+                        iterations=0, restarts=0, reason=str(reason[0]),
+                        position_error=float(dp[0]), rotation_error=float(dr[0]))
+    return IKResult(q=q.reshape(lead + (arm.n,)), success=found.reshape(lead),
+                    error=np.hypot(dp, dr).reshape(lead), iterations=zeros, restarts=zeros,
+                    reason=reason.astype(object).reshape(lead),
+                    position_error=dp.reshape(lead), rotation_error=dr.reshape(lead))
 
 
 def _numeric_near(robot: Arm, T: npt.ArrayLike, q_near: np.ndarray,

@@ -1,0 +1,332 @@
+r"""The swivel (arm angle) closed form of an SRS arm: every configuration of a pose.
+
+An SRS arm (KUKA iiwa type) has axes 1-3 meeting in the shoulder point S and axes
+5-7 in the wrist point W. For a pose T the wrist point goes to
+:math:`W_T = T M^{-1} W`; the elbow angle fixes the distance :math:`|S - W_T|`
+(subproblem 3, two roots), and the shoulder rotation :math:`R_A = e_1 e_2 e_3` must
+take :math:`a = e_4 W - S` to :math:`w = W_T - S`. Every such rotation is
+:math:`R_A(\psi) = \mathrm{rot}(\hat w, \psi - \psi_0) R_0` with :math:`R_0` the
+smallest rotation taking a to w: the swivel :math:`\psi` turns the arm about the
+shoulder-wrist line (Shimizu et al. 2008; Singh and Kreutz 1989).
+
+**The swivel angle** :math:`\psi` is measured about :math:`\hat w` (shoulder to
+wrist) from the direction of axis 1 (its part perpendicular to :math:`\hat w`) to
+:math:`\hat w \times R_A h_4`, the arm plane's in-plane normal to the shoulder-wrist
+line (:math:`h_4`, the elbow axis, is normal to the arm plane on the iiwa): on the
+iiwa14 at :math:`q_3 = 0` it is 0 or :math:`\pi`. It is undefined where the
+shoulder-wrist line is along axis 1 (the base x axis' part is used there and the
+pose flagged).
+
+Each triple is split by subproblem 4 (its middle angle, two roots) and subproblem 1
+(the outer ones). Slots: ``slot = 4 * elbow + 2 * shoulder + wrist`` (each 0/1:
+the + / - root of that subproblem), the same for every swivel value.
+
+**Joint limits exactly.** A shoulder or wrist joint at a value L is one condition
+:math:`x \cdot \mathrm{rot}(\hat w, \pm\varphi)\, y = c` on the swivel (first joint
+of the triple: its axis turned by L applied to the middle axis, and so on): one
+subproblem 4, at most two swivel angles per joint and limit. The elbow is constant
+over the swivel.
+
+References:
+    Shimizu, Kakuya, Yoon, Kitagaki and Kosuge, "Analytical inverse kinematic
+    computation for 7-DOF redundant manipulators with joint limits and its
+    application to redundancy resolution", IEEE T-RO 24(5), 2008.
+    Singh and Kreutz, "Gravity compensation and an inverse kinematics-based
+    description of the self-motion of 7-DOF manipulators", 1989.
+    Elias and Wen, "IK-Geo", arXiv:2211.05737 (2022): subproblems 1, 3, 4.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from robokin.kinematics.ik.analytic._geometry import poe_from_chain
+from robokin.spatial import wrap_angle
+
+__all__ = ["SwivelArm", "swivel_arm"]
+
+#: Axes meeting within this distance [m, relative to the arm's length over 1 m].
+_MEET_TOL = 1e-9
+#: A subproblem-4 root whose |C| exceeds its amplitude by this (relative) is a double root.
+_DOUBLE = 1e-12
+
+
+def _rot(u: np.ndarray, ang: np.ndarray) -> np.ndarray:
+    """Rotation matrices (..., 3, 3) about unit axes u (..., 3) by ang (...) [rad]."""
+    u = np.asarray(u, dtype=np.float64)
+    c, s = np.cos(ang)[..., None, None], np.sin(ang)[..., None, None]
+    x, y, z = u[..., 0], u[..., 1], u[..., 2]
+    zero = np.zeros_like(x)
+    K = np.stack([np.stack([zero, -z, y], -1), np.stack([z, zero, -x], -1),
+                  np.stack([-y, x, zero], -1)], -2)
+    outer = u[..., :, None] * u[..., None, :]
+    eye = np.broadcast_to(np.eye(3), K.shape)
+    out: np.ndarray = c * eye + s * K + (1 - c) * outer
+    return out
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    out: np.ndarray = np.einsum("...i,...i->...", a, b)
+    return out
+
+
+def _mv(R: np.ndarray, v: np.ndarray) -> np.ndarray:
+    out: np.ndarray = np.einsum("...ij,...j->...i", R, v)
+    return out
+
+
+def _sp4(h: np.ndarray, x: np.ndarray, y: np.ndarray, c: np.ndarray
+         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r"""Subproblem 4: the angles t with :math:`x \cdot \mathrm{rot}(h, t)\, y = c`.
+
+    Returns ``(t_plus, t_minus, real)``: the two roots (...) [rad] and where they are
+    real (a |C| past the amplitude by rounding, relative 1e-12, is a double root).
+    """
+    ypar = _dot(h, y)[..., None] * h
+    yp = y - ypar
+    A = _dot(x, yp)
+    B = _dot(x, np.cross(h, yp))
+    C = c - _dot(x, ypar)
+    rho = np.hypot(A, B)
+    real = np.abs(C) <= rho * (1 + _DOUBLE) + 1e-300
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = np.arccos(np.clip(C / rho, -1.0, 1.0))
+    phi = np.arctan2(B, A)
+    return phi + d, phi - d, real & (rho > 0)
+
+
+def _sp1(h: np.ndarray, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Subproblem 1: the angle about h from x to y, and |x's part normal to h|."""
+    xp = x - _dot(h, x)[..., None] * h
+    yp = y - _dot(h, y)[..., None] * h
+    return np.arctan2(_dot(h, np.cross(xp, yp)), _dot(xp, yp)), np.linalg.norm(xp, axis=-1)
+
+
+def _triple(ha: np.ndarray, hb: np.ndarray, hc: np.ndarray, R: np.ndarray,
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r"""Every split of a rotation R (..., 3, 3) into :math:`e_a e_b e_c` (axes meet).
+
+    Returns ``(v (..., 2, 3) chain angles, real (..., 2), singular (..., 2))``; the
+    second axis is the middle angle's +/- root. Where the outer axes line up (a
+    singular triple) only their sum is fixed: the first angle is set to 0.
+    """
+    vb_p, vb_m, real = _sp4(hb, ha, hc, _dot(ha, _mv(R, hc)))
+    vb = np.stack([vb_p, vb_m], -1)  # (..., 2)
+    Rb = _rot(hb, vb)  # (..., 2, 3, 3)
+    Rx = R[..., None, :, :]
+    va, spread = _sp1(ha, _mv(Rb, hc), _mv(Rx, hc)[..., :] + 0 * vb[..., None])
+    singular = spread < 1e-9
+    va = np.where(singular, 0.0, va)
+    B = _rot(ha, va) @ Rb
+    e = _perp(hc)
+    vc, _ = _sp1(hc, e + 0 * vb[..., None], _mv(np.swapaxes(B, -1, -2) @ Rx, e))
+    v = np.stack([va, vb, vc], -1)
+    return v, np.broadcast_to(real[..., None], vb.shape), singular
+
+
+def _perp(h: np.ndarray) -> np.ndarray:
+    e = np.eye(3)[int(np.argmin(np.abs(h)))]
+    v = e - np.dot(e, h) * h
+    out: np.ndarray = v / np.linalg.norm(v)
+    return out
+
+
+def _meet(h: np.ndarray, o: np.ndarray) -> tuple[float, np.ndarray]:
+    from robokin.kinematics.ik.analytic.pieper import _meet as meet
+
+    return meet(h, o)
+
+
+@dataclass(frozen=True, eq=False)
+class SwivelArm:
+    """An SRS arm's constants for the swivel closed form (:func:`swivel_arm`).
+
+    Attributes:
+        h: Unit joint axes (7, 3) at zero chain values, base frame.
+        o4: A point on the elbow axis (3,) [m].
+        S: The shoulder point (3,) [m]; W: the wrist point at zero (3,) [m].
+        M: The tool pose at zero chain values (4, 4).
+        sign: Joint signs (7,); offset: joint offsets (7,) [rad].
+        limits: Joint limits (7, 2) [rad].
+        ref: The swivel's reference direction (axis 1) (3,).
+    """
+
+    h: np.ndarray
+    o4: np.ndarray
+    S: np.ndarray
+    W: np.ndarray
+    M: np.ndarray
+    sign: np.ndarray
+    offset: np.ndarray
+    limits: np.ndarray
+    ref: np.ndarray
+
+    # ------------------------------------------------------------- the frame
+    def frame(self, T: np.ndarray) -> dict[str, Any]:
+        r"""Per-pose constants: the elbow roots and :math:`R_0, \psi_0` per elbow.
+
+        Args:
+            T: One pose (4, 4).
+
+        Returns:
+            A dict: ``u`` (3,) shoulder-wrist unit vector, ``v4`` (2,) elbow chain
+            angles, ``elbow_real`` (2,), ``R0`` (2, 3, 3), ``psi0`` (2,), ``TR``
+            (3, 3) the wrist triple's target before the swivel, ``ref_ok`` bool.
+        """
+        Minv = np.linalg.inv(self.M)
+        Wt = (T @ Minv @ np.append(self.W, 1.0))[:3]
+        w = Wt - self.S
+        d = float(np.linalg.norm(w))
+        u = w / d if d > 0 else np.array([0.0, 0.0, 1.0])
+        h4 = self.h[3]
+        p, q = self.W - self.o4, self.S - self.o4
+        # |rot(h4, v) p - q| = d  <=>  q . rot(h4, v) p = (|p|^2 + |q|^2 - d^2) / 2
+        vp, vm, real = _sp4(h4, q, p, np.array((p @ p + q @ q - d * d) / 2))
+        v4 = np.array([vp, vm], dtype=np.float64)
+        a = (self.o4 + _mv(_rot(h4, v4), p)) - self.S  # (2, 3)
+        R0 = np.stack([_smallest_rotation(ai, w) for ai in a])
+        r = self.ref - (self.ref @ u) * u
+        ref_ok = bool(np.linalg.norm(r) > 1e-9)
+        if not ref_ok:
+            x = np.array([1.0, 0.0, 0.0])
+            r = x - (x @ u) * u
+        r = r / np.linalg.norm(r)
+        psi0 = np.array([_angle_of(u, r, _mv(R0[i], h4)) for i in range(2)])
+        TR = T[:3, :3] @ Minv[:3, :3]
+        return {"u": u, "r": r, "v4": v4, "elbow_real": np.broadcast_to(real, (2,)).copy(),
+                "R0": R0, "psi0": psi0, "TR": TR, "ref_ok": ref_ok}
+
+    def configurations(self, fr: dict[str, Any], psi: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Every configuration at swivel angles psi (m,): q (m, 8, 7), valid, singular.
+
+        Joint values are wrapped into (-pi, pi], then shifted by 2 pi into the limits
+        where that puts them inside.
+        """
+        psi = np.atleast_1d(np.asarray(psi, dtype=np.float64))
+        m = psi.shape[0]
+        h = self.h
+        v = np.full((m, 2, 2, 2, 7), np.nan)
+        real = np.zeros((m, 2, 2, 2), bool)
+        sing = np.zeros((m, 2, 2, 2), bool)
+        for e in range(2):
+            RA = _rot(fr["u"], psi - fr["psi0"][e]) @ fr["R0"][e]  # (m, 3, 3)
+            sA, rA, gA = _triple(h[0], h[1], h[2], RA)  # (m, 2, 3)
+            R4 = _rot(h[3], fr["v4"][e])
+            RB = np.swapaxes(RA @ R4, -1, -2) @ fr["TR"]
+            sB, rB, gB = _triple(h[4], h[5], h[6], RB)
+            v[:, e, :, :, 0:3] = sA[:, :, None, :]
+            v[:, e, :, :, 3] = fr["v4"][e]
+            v[:, e, :, :, 4:7] = sB[:, None, :, :]
+            real[:, e] = fr["elbow_real"][e] & rA[:, :, None] & rB[:, None, :]
+            sing[:, e] = gA[:, :, None] | gB[:, None, :]
+        q: np.ndarray = self.wrap((v.reshape(m, 8, 7) - self.offset) * self.sign)
+        ok = real.reshape(m, 8)
+        q[~ok] = np.nan
+        return q, ok, sing.reshape(m, 8)
+
+    def wrap(self, q: np.ndarray) -> np.ndarray:
+        """Angles into (-pi, pi], then by 2 pi into the limits where that fits."""
+        q = wrap_angle(q)
+        lo, hi = self.limits[:, 0], self.limits[:, 1]
+        up = (q < lo) & (q + 2 * np.pi <= hi)
+        down = (q > hi) & (q - 2 * np.pi >= lo)
+        out: np.ndarray = q + 2 * np.pi * up - 2 * np.pi * down
+        return out
+
+    def swivel_of(self, fr: dict[str, Any], q: np.ndarray) -> np.ndarray:
+        """The swivel angle [rad] of configurations q (..., 7) of the pose."""
+        v = self.sign * np.asarray(q) + self.offset
+        RA = _rot(self.h[0], v[..., 0]) @ _rot(self.h[1], v[..., 1]) @ _rot(self.h[2], v[..., 2])
+        return _angle_of(fr["u"], fr["r"], _mv(RA, self.h[3]))
+
+    def limit_swivels(self, fr: dict[str, Any], j: int, q_value: float
+                      ) -> list[tuple[float, int]]:
+        """Swivel angles where joint j (0-based, not the elbow) is at ``q_value``.
+
+        Returns ``[(psi, elbow), ...]``: at most two per elbow root (subproblem 4).
+        """
+        L = self.sign[j] * q_value + self.offset[j]
+        h = self.h
+        u = fr["u"]
+        out = []
+        for e in range(2):
+            if not fr["elbow_real"][e]:
+                continue
+            R0, TR = fr["R0"][e], fr["TR"]
+            R4 = _rot(h[3], fr["v4"][e])
+            if j < 3:
+                a, b, c = h[0], h[1], h[2]
+                if j == 0:
+                    x, y, k = _mv(_rot(a, L), b), R0 @ c, b @ c
+                elif j == 1:
+                    x, y, k = a, R0 @ c, a @ _mv(_rot(b, L), c)
+                else:
+                    x, y, k = a, R0 @ _mv(_rot(c, -L), b), a @ b
+                sgn = 1.0
+            else:
+                a, b, c = h[4], h[5], h[6]
+                base = R0 @ R4
+                if j == 4:
+                    x, y, k = base @ _mv(_rot(a, L), b), TR @ c, b @ c
+                elif j == 5:
+                    x, y, k = base @ a, TR @ c, a @ _mv(_rot(b, L), c)
+                else:
+                    x, y, k = base @ a, TR @ _mv(_rot(c, -L), b), a @ b
+                sgn = -1.0  # R_B holds rot(u, -phi)
+            tp, tm, real = _sp4(u, x, y, np.array(k))
+            if not bool(real):
+                continue
+            for phi in {float(tp), float(tm)}:
+                psi = sgn * phi + fr["psi0"][e]
+                out.append((float(wrap_angle(psi)), e))
+        return out
+
+
+def _angle_of(u: np.ndarray, r: np.ndarray, h4: np.ndarray) -> np.ndarray:
+    """Swivel angle: about u from r to u x h4 (normalised)."""
+    d = np.cross(u, h4)
+    out: np.ndarray = np.arctan2(_dot(u, np.cross(r, d)), _dot(r, d))
+    return out
+
+
+def _smallest_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The smallest rotation taking the direction of a to that of b (3, 3)."""
+    na, nb = np.linalg.norm(a), np.linalg.norm(b)
+    if na == 0 or nb == 0:
+        return np.eye(3)
+    a, b = a / na, b / nb
+    axis = np.cross(a, b)
+    s, c = np.linalg.norm(axis), float(a @ b)
+    if s < 1e-15:
+        if c > 0:
+            return np.eye(3)
+        return _rot(_perp(a), np.array(np.pi))
+    return _rot(axis / s, np.array(np.arctan2(s, c)))
+
+
+def swivel_arm(chain: Any) -> SwivelArm | None:
+    """The swivel constants of a 7R chain whose axes 1-3 and 5-7 meet, else None."""
+    if chain.n_chain != 7 or not chain.coupling.is_identity:
+        return None
+    poe = poe_from_chain(chain)
+    if poe.prismatic.any():
+        return None
+    pts = np.vstack([poe.o, poe.M[:3, 3]])
+    scale = float(np.linalg.norm(np.diff(pts, axis=0), axis=1).sum())
+    lim = _MEET_TOL * max(1.0, scale)
+    dS, S = _meet(poe.h[0:3], poe.o[0:3])
+    dW, W = _meet(poe.h[4:7], poe.o[4:7])
+    if dS > lim or dW > lim:
+        return None
+    # the elbow axis must be off the shoulder-wrist plane's degenerate cases
+    if np.linalg.norm(np.cross(poe.h[3], S - poe.o[3])) < lim:
+        return None
+    lims = np.asarray(chain.limits, dtype=np.float64)
+    return SwivelArm(poe.h.copy(), poe.o[3].copy(), S, W, poe.M.copy(),
+                     np.asarray(chain.arrays.sign, dtype=np.float64).copy(),
+                     np.asarray(chain.arrays.offset, dtype=np.float64).copy(),
+                     lims, poe.h[0].copy())

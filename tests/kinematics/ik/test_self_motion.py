@@ -1,0 +1,276 @@
+"""The self-motion manifold of one pose of a 7R arm (``Robot.self_motion``).
+
+Oracles (independent of the code under test):
+* the generating configuration q0 of T = FK(q0) lies on a branch at its own
+  parameter value (q0's joint 7 on the Panda; the swivel angle computed from q0's
+  shoulder rotation on the SRS arm), except where a triple's outer axes line up
+  (then only their sum is fixed);
+* forward kinematics of every sampled row reproduces T to 1e-12;
+* each interval end that is not the end of the parameter's range has a joint
+  exactly at its limit (1e-10) or is a branch end, and just inside it every joint is
+  within its limits;
+* a brute-force scan (2,000 values) agrees with the intervals away from their ends;
+* ``best("margin")`` scores at least q0's own margin when q0 is inside the limits,
+  and ``nearest(q0)`` returns q0.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import robokin
+from reference import iiwa14_srs, pose_errors
+from robokin.exceptions import InputError
+
+PANDA = robokin.load("panda")
+SRS = iiwa14_srs()
+ARMS = {"panda": PANDA, "srs": SRS}
+SPECIAL = (0.0, np.pi / 2, -np.pi / 2, np.pi, 1e-9, -1e-9, 1e-6, -1e-6)
+
+
+def _param_of(sm, q):
+    """q's parameter value: its held joint, or its swivel angle (the family's own map)."""
+    if sm.joint is not None:
+        return float(q[sm.joint])
+    fam = sm._family
+    return float(fam.arm.swivel_of(fam.fr, q))
+
+
+def _aligned(robot, q):
+    """True where a triple's outer axes line up (joint 2 or 6 at 0 or pi)."""
+    return bool(np.any(np.abs(np.sin(q[[1, 5]])) < 1e-6))
+
+
+def _special_config(robot, draw_values):
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    q = []
+    for j, v in enumerate(draw_values):
+        q.append(float(np.clip(v, lo[j], hi[j])))
+    return np.array(q)
+
+
+def _check_manifold(robot, q0):
+    T = robot.fk(q0)
+    sm = robot.self_motion(T)
+    # rows exact: a grid over the range plus every interval end
+    t = np.concatenate([np.linspace(*sm.domain, 97), sm.intervals.ravel()])
+    Q = sm.sample(t)
+    ok = np.isfinite(Q).all(-1)
+    dp, dr = pose_errors(robot.fk(np.where(ok[..., None], Q, 0.0)), T)
+    assert np.all(dp[ok] <= 1e-12) and np.all(dr[ok] <= 1e-12), (dp[ok].max(), dr[ok].max())
+    # the generating configuration on a branch at its parameter value
+    t0 = _param_of(sm, q0)
+    rows = sm.sample(t0)
+    d = np.abs((rows - q0 + np.pi) % (2 * np.pi) - np.pi).max(-1)
+    # the stretched elbow (q4 = 0) is a double root: its rounding band is the square
+    # root of the rounding (3e-8), every point of it exact (the pose check above)
+    tol = 1e-7 if abs(np.sin(q0[3])) < 1e-6 else 1e-9
+    if not _aligned(robot, q0):
+        assert np.nanmin(d) < tol, (q0.tolist(), np.nanmin(d))
+    inside0 = robot.within_limits(q0)
+    strictly = bool(np.all((q0 > robot.limits[:, 0] + 1e-9) & (q0 < robot.limits[:, 1] - 1e-9)))
+    if strictly and not _aligned(robot, q0):
+        # q0 strictly inside: its parameter value lies in an interval of its branch
+        # (of one of them where the stretched elbow's two roots meet)
+        mine = np.flatnonzero(d < tol)
+        own = sm.intervals[np.isin(sm.interval_branch, mine)]
+        assert any(a - 1e-9 <= x <= e + 1e-9 for a, e in own
+                   for x in (t0, t0 + 2 * np.pi)), (t0, own)
+    # the stretched SRS elbow (q4 = 0) is a multi-parameter family whose rows are split
+    # arbitrarily (known gap, docs/ik.md "Seven-axis arms"; pinned by
+    # test_known_gap_srs_interval_missed_next_to_q2_limit): its intervals are not
+    # checked against the scan
+    stretched = abs(np.sin(q0[3])) < 1e-6
+    if not _aligned(robot, q0) and not stretched:
+        # q0 itself on an aligned triple: a crossing there can be missed (known gap,
+        # docs/ik.md "Seven-axis arms"); elsewhere every end is exact
+        aligned = [p.t for p in sm.singular if p.kind == "aligned axes"]
+        if not aligned:
+            assert sm.info["bisected"] == 0  # every change of state at an exact point
+        _check_ends(robot, sm, aligned)
+    return sm, inside0
+
+
+def _check_ends(robot, sm, aligned):
+    lim = robot.limits
+    folds = {(round(p.t, 9), p.branch) for p in sm.singular if p.kind == "fold"}
+    lo_d, hi_d = sm.domain
+    for (a, e), b in zip(sm.intervals, sm.interval_branch):
+        for end, inward in ((a, 1.0), (e, -1.0)):
+            endw = (end + np.pi) % (2 * np.pi) - np.pi if sm.periodic else end
+            if not sm.periodic and (abs(end - lo_d) < 1e-15 or abs(end - hi_d) < 1e-15):
+                continue
+            if (round(endw, 9), b) in folds:
+                continue
+            q = sm.sample(end)[b]
+            gap = np.minimum(np.abs(q - lim[:, 0]), np.abs(q - lim[:, 1]))
+            if not any(abs(endw - x) < 1e-3 for x in aligned):
+                assert gap.min() <= 1e-10, (end, b, gap.min())  # a joint exactly at a limit
+            eps = 1e-7 * (e - a)
+            qin = sm.sample(end + inward * eps)[b]
+            assert robot.within_limits(qin), (end, b)
+    # brute force: dense scan against the intervals, away from their ends
+    t = np.linspace(lo_d, hi_d, 2000)
+    inside = sm.inside(t)
+    for b in range(sm.n_branches):
+        own = sm.intervals[sm.interval_branch == b]
+        for ti, flag in zip(t, inside[:, b]):
+            cand = (ti, ti + 2 * np.pi) if sm.periodic else (ti,)
+            inn = any(a + 1e-6 < x < e - 1e-6 for a, e in own for x in cand)
+            near = any(min(abs(x - a), abs(x - e)) <= 1e-6 for a, e in own for x in cand)
+            # next to an aligned point the outer angles swing by pi over ~1e-9:
+            # bisected there, not exact (module docstring), so not scanned
+            if not near and not any(abs(ti - x) < 1e-2 for x in aligned):
+                assert flag == inn, (b, ti, flag, own)
+
+
+@pytest.mark.parametrize("arm", ["panda", "srs"])
+def test_random_configurations(arm):
+    robot = ARMS[arm]
+    rng = np.random.default_rng(29)
+    for _ in range(6):
+        q0 = rng.uniform(robot.limits[:, 0], robot.limits[:, 1])
+        sm, inside = _check_manifold(robot, q0)
+        assert inside and sm.reachable
+        best = sm.best("margin")
+        margin0 = np.minimum(q0 - robot.limits[:, 0], robot.limits[:, 1] - q0).min()
+        assert best is not None and best.score >= margin0 - 1e-9
+        assert np.allclose(robot.fk(best.q), sm.T, atol=1e-12)
+        near = sm.nearest(q0)
+        assert near is not None and np.abs(near.q - q0).max() < 1e-6
+
+
+@settings(max_examples=6, deadline=None, derandomize=True, database=None,
+          suppress_health_check=[HealthCheck.too_slow])
+@given(arm=st.sampled_from(["panda", "srs"]),
+       values=st.lists(st.one_of(st.sampled_from(SPECIAL),
+                                 st.floats(-np.pi, np.pi)), min_size=7, max_size=7),
+       at_limit=st.integers(-1, 6))
+def test_special_configurations(arm, values, at_limit):
+    robot = ARMS[arm]
+    q0 = _special_config(robot, values)
+    if at_limit >= 0:
+        q0[at_limit] = robot.limits[at_limit, 1]
+    _check_manifold(robot, q0)
+
+
+@pytest.mark.xfail(strict=True, reason="known gap (found by the hypothesis test in the "
+                   "whole suite; fails on 3943a47, before the merge, too): SRS arm, q2 at "
+                   "its upper limit, q6 = 0.5: branch 0 is inside the limits at "
+                   "swivel 0.178 but the intervals miss it")
+def test_known_gap_srs_interval_missed_next_to_q2_limit():
+    # oracle: the 2,000-value brute-force scan of _check_ends against the intervals
+    robot = ARMS["srs"]
+    q0 = _special_config(robot, [0.0] * 5 + [0.5, 0.0])
+    q0[1] = robot.limits[1, 1]
+    sm = robot.self_motion(robot.fk(q0))
+    _check_ends(robot, sm, [p.t for p in sm.singular if p.kind == "aligned axes"])
+
+
+def test_parameter_choices_and_errors():
+    assert SRS.self_motion(SRS.fk(np.full(7, 0.3))).parameter == "swivel"
+    assert PANDA.self_motion(PANDA.fk(np.array([0, 0.3, 0, -1.5, 0, 1.5, 0.7]))).parameter == "joint7"
+    sm = SRS.self_motion(SRS.fk(np.full(7, 0.3)), parameter="a7")
+    assert sm.parameter == "a7" and sm.joint == 6
+    with pytest.raises(InputError, match="swivel.*joint1"):
+        PANDA.self_motion(np.eye(4), parameter="elbow")
+    with pytest.raises(InputError, match="not an SRS arm"):
+        PANDA.self_motion(np.eye(4), parameter="swivel")
+    with pytest.raises(InputError, match="7-joint"):
+        robokin.load("ur5").self_motion(np.eye(4))
+    with pytest.raises(InputError, match="one pose"):
+        PANDA.self_motion(np.stack([np.eye(4)] * 2))
+    with pytest.raises(InputError, match="criterion"):
+        SRS.self_motion(SRS.fk(np.full(7, 0.3))).best("comfort")
+
+
+def test_unreachable_pose_has_no_interval():
+    T = np.eye(4)
+    T[:3, 3] = [3.0, 0.0, 0.5]  # beyond the reach of either arm
+    for robot in ARMS.values():
+        sm = robot.self_motion(T)
+        assert not sm.reachable and sm.best() is None
+        assert np.isnan(sm.sample(0.1)).all()
+
+
+@pytest.mark.parametrize("arm", ["panda", "srs"])
+def test_ik_says_it_samples_the_manifold(arm):
+    # oracle: each row's stated parameter value reproduces the row on the manifold
+    robot = ARMS[arm]
+    q0 = np.clip(np.array([0.3, -0.5, 0.2, -2.0, 0.4, 1.5, 0.6]), robot.limits[:, 0],
+                 robot.limits[:, 1])
+    T = robot.fk(q0)
+    sols = robot.ik(T)
+    assert "a sample" in sols.info["self_motion"]
+    assert sols.info["parameter"] == ("joint7" if arm == "panda" else "swivel")
+    sm = robot.self_motion(T)
+    for row, t in zip(sols.q[sols.valid], sols.info["parameter_values"][sols.valid]):
+        d = np.abs((sm.sample(t) - row + np.pi) % (2 * np.pi) - np.pi).max(-1)
+        assert np.nanmin(d) < 1e-6
+
+
+@pytest.mark.parametrize("arm", ["panda", "srs"])
+def test_ik_near_self_motion_picks_the_nearest_point_of_the_manifold(arm):
+    # oracle: from q0 itself (in limits) the answer is q0; from a nudged q0 the
+    # answer is exact and no farther than q0 is; SelfMotion.nearest agrees
+    robot = ARMS[arm]
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        q0 = rng.uniform(robot.limits[:, 0] * 0.9, robot.limits[:, 1] * 0.9)
+        T = robot.fk(q0)
+        res = robot.ik_near(T, q0, method="self_motion")
+        assert res.success and np.abs(res.q - q0).max() < 1e-6
+        qn = q0 + 0.05
+        res = robot.ik_near(T, qn, method="self_motion")
+        assert res.success and res.error < 1e-12 and robot.within_limits(res.q)
+        assert np.linalg.norm(res.q - qn) <= np.linalg.norm(q0 - qn) + 1e-9
+    p = robot.self_motion(T).nearest(qn)
+    assert p is not None and np.linalg.norm(p.q - qn) <= np.linalg.norm(q0 - qn) + 1e-9
+
+
+def test_ik_near_auto_on_7r_is_the_numeric_descent():
+    # oracle: method="auto" on a 7R arm is the numeric descent from q_near, so it
+    # returns exactly what method="numeric" returns (same inputs, same outputs)
+    q0 = np.array([0.1, 0.3, -0.2, -1.5, 0.2, 1.6, 0.4])
+    T, qn = PANDA.fk(q0), q0 + 0.02
+    auto, num = PANDA.ik_near(T, qn), PANDA.ik_near(T, qn, method="numeric")
+    assert auto.success and np.array_equal(auto.q, num.q)
+
+
+def test_ik_near_self_motion_errors_list_the_methods():
+    T = PANDA.fk(np.full(7, 0.1))
+    with pytest.raises(InputError, match="self_motion"):
+        PANDA.ik_near(T, np.full(7, 0.1), method="fast")
+    with pytest.raises(InputError, match="options"):
+        PANDA.ik_near(T, np.full(7, 0.1), method="self_motion", mask="xyz")
+    ur5 = robokin.load("ur5")
+    with pytest.raises(InputError, match="method='self_motion' needs a 7R arm"):
+        ur5.ik_near(ur5.fk(np.zeros(6)), np.zeros(6), method="self_motion")
+
+
+def test_general_7r_branches_are_continued():
+    # an iiwa14 with a 1 cm shoulder offset (a2): axes 1-3 no longer meet, so joint 7
+    # held has no closed form and goes to the general 6R solver, continued.
+    # Oracle: the generating configuration at its own q7, every sampled row exact.
+    rows = [{"a": 0.01 if i == 1 else 0.0, "alpha": alpha, "d": d, "theta": 0.0,
+             "limits": [-np.radians(r), np.radians(r)], "name": f"a{i + 1}"}
+            for i, (alpha, d, r) in enumerate(
+                [(-np.pi / 2, 0.36, 170), (np.pi / 2, 0.0, 120), (np.pi / 2, 0.42, 170),
+                 (-np.pi / 2, 0.0, 120), (-np.pi / 2, 0.40, 170), (np.pi / 2, 0.0, 120),
+                 (0.0, 0.126, 175)])]
+    robot = robokin.Robot.from_dh(rows, convention="standard", name="offset_iiwa")
+    q0 = np.array([0.3, 0.5, -0.4, 1.2, 0.5, -0.9, 0.2])
+    T = robot.fk(q0)
+    sm = robot.self_motion(T, parameter="a7")
+    assert sm.method.startswith("continued general 6R")
+    d = np.abs((sm.sample(q0[6]) - q0 + np.pi) % (2 * np.pi) - np.pi).max(-1)
+    assert np.nanmin(d) < 1e-9
+    Q = sm.sample(np.linspace(*sm.domain, 41))
+    ok = np.isfinite(Q).all(-1)
+    dp, dr = pose_errors(robot.fk(np.where(ok[..., None], Q, 0.0)), T)
+    assert ok.any() and dp[ok].max() <= 1e-12 and dr[ok].max() <= 1e-12
+    assert any(a <= q0[6] <= e for (a, e), b in zip(sm.intervals, sm.interval_branch)
+               if d[b] < 1e-9)
