@@ -282,6 +282,10 @@ def demo(
     scheduler: Annotated[
         str | None, typer.Option(help="Dask scheduler address for --place (default: this machine).")
     ] = None,
+    plan: Annotated[
+        bool, typer.Option("--plan", help="Also plan the free moves with robokin's planner "
+                           "and compare the cycle time.")
+    ] = False,
 ) -> None:
     """The main job: the AUBO-i5 loads a press (plan, check, plots, HTML report).
 
@@ -291,7 +295,8 @@ def demo(
     from robokin.demo import run_demo
 
     result = run_demo(out=out, clearance_mm=clearance, view=view, force=force,
-                      console=_console(), sim=sim, place=place, scheduler=scheduler)
+                      console=_console(), sim=sim, place=place, scheduler=scheduler,
+                      plan=plan)
     if not result.ok:
         raise DomainFailure("the plan is not collision-free with the required clearance "
                             "(see the report)")
@@ -313,6 +318,7 @@ def _register_extra_commands() -> None:
         "robokin.cli_retime",
         "robokin.cli_schema",
         "robokin.cli_cell",
+        "robokin.cli_plan",
     ):
         try:
             importlib.import_module(mod)
@@ -329,7 +335,7 @@ def _split_debug(args: list[str]) -> tuple[list[str], bool]:
 
 
 #: Options that take as many values as the robot has joints (``--near q1 ... qn``).
-MULTI_VALUE_OPTIONS = ("--near",)
+MULTI_VALUE_OPTIONS = ("--near", "--start", "--goal", "--goal-pose")
 
 
 def _is_number(token: str) -> bool:

@@ -116,6 +116,39 @@ class Kernels(Protocol):
     SIX_R_PARALLEL_MIN: int
     # ------------------------------------------------------ broadphase.c constants
     BP_CHUNK_WORK: int
+    # ------------------------------------------------- plan_check.c, plan_geom.c
+    # check results (PC_*), core kinds of shapes (PK_*), pair distance methods
+    # (PD_*), the distance taken off every computed one [m]
+    PC_FREE: int
+    PC_HIT: int
+    PC_UNDECIDED: int
+    PK_POINT: int
+    PK_SEGMENT: int
+    PK_BOX: int
+    PK_CYLINDER: int
+    PK_HULL: int
+    PD_SEGSEG: int
+    PD_SEGBOX: int
+    PD_BOXSEG: int
+    PD_GJK: int
+    PD_HULL: int
+    PC_EPS: float
+    # ------------------------------------------------------------- plan_rrtc.c
+    # plan_rrtc options (RC_N_OPTS entries), plan_shortcut options (SC_N_OPTS),
+    # plan_rrtc result codes
+    RC_RANGE: int
+    RC_TIME: int
+    RC_MAX_NODES: int
+    RC_N_OPTS: int
+    SC_VERTEX_TRIES: int
+    SC_TRIES: int
+    SC_MAX_FAIL: int
+    SC_TIME: int
+    SC_N_OPTS: int
+    RC_SOLVED: int
+    RC_TIMEOUT: int
+    RC_NODES: int
+    RC_FAILED: int
 
     # ------------------------------------------------------- general6r.c constants
     # general6r_solve: solutions per pose, parameter-vector layout (GP_*: header
@@ -311,6 +344,45 @@ class Kernels(Protocol):
         /,
     ) -> None:
         """Per interval and pair, the bound on the change of the distance, into out."""
+
+    # ----------------------------------------------------------------- planning
+    def plan_model(
+        self, packed: F64, shape_i: I64, shape_f: F64, hull: F64, pair_i: I64,
+        reach: F64, S: int, /,
+    ) -> object:
+        """The compiled planning model of a robot in a scene (a capsule).
+
+        shape_i (N, 4): core kind, link (-1: object), hull start, hull count;
+        shape_f (N, 21): rb pose, half sizes, radius, cylinder radius; hull (H, 3);
+        pair_i (P, 7): shapes a, b, method, self, mover, j0, j1; reach (S, nc).
+        """
+
+    def plan_check_states(
+        self, model: object, q: F64, margin: F64, exact: object, status: I64,
+        pair: I64, /,
+    ) -> tuple[int, ...]:
+        """Validity of states q (m, n) into status (m,) and pair (m,); work counters."""
+
+    def plan_check_edges(
+        self, model: object, q0: F64, q1: F64, margin: F64, exact: object,
+        status: I64, pair: I64, where: F64, /,
+    ) -> tuple[int, ...]:
+        """Validity of the straight edges q0 -> q1 (m, n); work counters."""
+
+    def plan_distances(self, model: object, q: F64, out: F64, /) -> None:
+        """Certified lower bounds on every pair's distance at q (m, n) into out (m, P)."""
+
+    def plan_rrtc(
+        self, model: object, start: F64, goals: F64, lo: F64, hi: F64, margin: F64,
+        opts: F64, seed: int, exact: object, /,
+    ) -> tuple[int, F64 | None, int, tuple[int, ...], tuple[int, int, int, float]]:
+        """RRT-Connect: (code, path (K, n) or None, goal row, counters, search)."""
+
+    def plan_shortcut(
+        self, model: object, path: F64, margin: F64, opts: F64, seed: int,
+        exact: object, /,
+    ) -> tuple[F64, tuple[int, ...]]:
+        """Random shortcuts of path (K, n), every new edge checked; (path, counters)."""
 
     # ------------------------------------------------------- for tests and set-up
     def seg_seg(self, pts: F64, out: F64, /) -> None:

@@ -18,6 +18,9 @@
 #include "nearest.c"
 #include "six_r.c"
 #include "broadphase.c"
+#include "plan_geom.c"
+#include "plan_check.c"
+#include "plan_rrtc.c"
 #include "general6r.c"
 
 /* ---------------------------------------------------------------- arguments */
@@ -571,6 +574,8 @@ static PyMethodDef methods[] = {
      "cpu_has_avx512() -> bool: whether this CPU runs the AVX-512 copy."},
     SIX_R_METHODS
     BROADPHASE_METHODS
+    PLAN_CHECK_METHODS
+    PLAN_RRTC_METHODS
     GENERAL6R_METHODS
     {NULL, NULL, 0, NULL}};
 
@@ -604,7 +609,8 @@ PyMODINIT_FUNC MODULE_INIT(void)
     PyModule_AddObject(m, "LAYOUT_TAG", PyFloat_FromDouble(PACKED_TAG));
     PyModule_AddObject(m, "MAX_TRANSLATION", PyFloat_FromDouble(MAX_TRANSLATION));
     if (six_r_constants(m) < 0 || broadphase_constants(m) < 0 ||
-        general6r_constants(m) < 0) {
+        general6r_constants(m) < 0 || plan_check_constants(m) < 0 ||
+        plan_rrtc_constants(m) < 0) {
         Py_DECREF(m);
         return NULL;
     }

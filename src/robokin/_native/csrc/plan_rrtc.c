@@ -1,0 +1,542 @@
+/*
+ * The default planner of robokin.planning: RRT-Connect (Kuffner & LaValle,
+ * "RRT-Connect: an efficient approach to single-query path planning", ICRA 2000)
+ * in joint space, with every edge checked by plan_check.c's check_edge, and random
+ * shortcutting of the path it finds. OMPL's planners stay available from Python;
+ * this copy exists because OMPL's per-call cost into a Python motion validator
+ * dominated the planning time (docs/decisions.md has the measurement).
+ *
+ * Deterministic: every random number comes from a xoshiro256** generator seeded
+ * from the caller's seed (Blackman & Vigna, "Scrambled linear pseudorandom number
+ * generators", ACM TOMS 47(4), 2021; seeded through splitmix64), so the same inputs
+ * give the same path whenever the time limit is not what stopped the search.
+ * Nearest neighbours: a linear scan (trees of a few thousand nodes at most).
+ *
+ * PLAN_RRTC_METHODS lists this file's entries of module.c's method table.
+ */
+#include <time.h>
+
+/* plan_rrtc option vector (opts has RC_N_OPTS entries) */
+enum { RC_RANGE = 0, RC_TIME = 1, RC_MAX_NODES = 2, RC_N_OPTS = 3 };
+/* plan_shortcut option vector (opts has SC_N_OPTS entries) */
+enum { SC_VERTEX_TRIES = 0, SC_TRIES = 1, SC_MAX_FAIL = 2, SC_TIME = 3, SC_N_OPTS = 4 };
+/* results */
+enum { RC_SOLVED = 0, RC_TIMEOUT = 1, RC_NODES = 2, RC_FAILED = 3 };
+
+/* ---------------------------------------------------------------------- rng */
+
+typedef struct {
+    uint64_t s[4];
+} Rng;
+
+static uint64_t splitmix64(uint64_t *x)
+{
+    uint64_t z = (*x += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+static void rng_seed(Rng *r, uint64_t seed)
+{
+    for (int i = 0; i < 4; i++)
+        r->s[i] = splitmix64(&seed);
+}
+
+static inline uint64_t rotl(uint64_t x, int k)
+{
+    return (x << k) | (x >> (64 - k));
+}
+
+static uint64_t rng_next(Rng *r)
+{
+    uint64_t *s = r->s;
+    uint64_t out = rotl(s[1] * 5, 7) * 9, t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = rotl(s[3], 45);
+    return out;
+}
+
+/* uniform in [0, 1) with 53 random bits */
+static inline double rng_uniform(Rng *r)
+{
+    return (double)(rng_next(r) >> 11) * 0x1.0p-53;
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* --------------------------------------------------------------------- trees */
+
+typedef struct {
+    double *q;     /* (cap, n) */
+    long *parent;  /* (cap,): -1 - root index for a root */
+    long count, cap;
+    int n;
+} Tree;
+
+static long tree_add(Tree *T, const double *q, long parent)
+{
+    if (T->count == T->cap) {
+        long c = T->cap > 0 ? 2 * T->cap : 256;
+        double *nq = realloc(T->q, (size_t)c * T->n * sizeof(double));
+        if (nq == NULL)
+            return -1;
+        T->q = nq;
+        long *np = realloc(T->parent, (size_t)c * sizeof(long));
+        if (np == NULL)
+            return -1;
+        T->parent = np;
+        T->cap = c;
+    }
+    memcpy(T->q + (size_t)T->count * T->n, q, (size_t)T->n * sizeof(double));
+    T->parent[T->count] = parent;
+    return T->count++;
+}
+
+static void tree_free(Tree *T)
+{
+    free(T->q);
+    free(T->parent);
+}
+
+static inline double dist2(const double *a, const double *b, int n)
+{
+    double s = 0.0;
+    for (int j = 0; j < n; j++) {
+        double d = a[j] - b[j];
+        s += d * d;
+    }
+    return s;
+}
+
+/* The node of T nearest q (the first of equals: deterministic). */
+static long tree_nearest(const Tree *T, const double *q)
+{
+    long best = 0;
+    double bd = INFINITY;
+    for (long i = 0; i < T->count; i++) {
+        double d = dist2(T->q + (size_t)i * T->n, q, T->n);
+        if (d < bd) {
+            bd = d;
+            best = i;
+        }
+    }
+    return best;
+}
+
+/* q_new = the point at most `range` from a towards b; returns 1 when it is b. */
+static int steer(const double *a, const double *b, double range, int n, double *out)
+{
+    double d = sqrt(dist2(a, b, n));
+    if (d <= range) {
+        memcpy(out, b, (size_t)n * sizeof(double));
+        return 1;
+    }
+    double f = range / d;
+    for (int j = 0; j < n; j++)
+        out[j] = a[j] + f * (b[j] - a[j]);
+    return 0;
+}
+
+enum { GROW_TRAPPED = 0, GROW_ADVANCED = 1, GROW_REACHED = 2, GROW_ERROR = 3 };
+
+/* One step of T towards target: the new node in *added. */
+static int grow_tree(Checker *C, Tree *T, const double *target, double range, double *tmp,
+                     long *added)
+{
+    long near = tree_nearest(T, target);
+    const double *qn = T->q + (size_t)near * T->n;
+    int reach = steer(qn, target, range, T->n, tmp);
+    if (dist2(qn, tmp, T->n) == 0.0)
+        return GROW_TRAPPED;
+    int r = check_edge(C, qn, tmp);
+    if (r == PC_ERROR || r == PC_UNDECIDED)
+        return GROW_ERROR;
+    if (r != PC_FREE)
+        return GROW_TRAPPED;
+    *added = tree_add(T, tmp, near);
+    if (*added < 0)
+        return GROW_ERROR;
+    return reach ? GROW_REACHED : GROW_ADVANCED;
+}
+
+typedef struct {
+    double *q; /* (count, n) */
+    long count;
+    long goal; /* the goal reached (index into the goals) */
+} Path;
+
+/* The path root(a) .. a in A then b .. root(b) in B (a and b hold the same state:
+ * b is skipped); A is the start tree when a_is_start, else the order is reversed. */
+static int join_path(const Tree *A, long a, const Tree *B, long b, int a_is_start, Path *out)
+{
+    const Tree *S = a_is_start ? A : B, *G = a_is_start ? B : A;
+    long s = a_is_start ? a : b, g = a_is_start ? b : a;
+    long ns = 0, ng = 0;
+    for (long i = s; i >= 0; i = S->parent[i])
+        ns++;
+    for (long i = g; i >= 0; i = G->parent[i])
+        ng++;
+    const int n = A->n;
+    out->count = ns + ng - 1;
+    out->q = malloc((size_t)out->count * n * sizeof(double));
+    if (out->q == NULL)
+        return 0;
+    long k = ns - 1;
+    for (long i = s; i >= 0; i = S->parent[i], k--)
+        memcpy(out->q + (size_t)k * n, S->q + (size_t)i * n, (size_t)n * sizeof(double));
+    k = ns;
+    long last = g;
+    for (long i = G->parent[g]; i >= 0; i = G->parent[i], k++) {
+        memcpy(out->q + (size_t)k * n, G->q + (size_t)i * n, (size_t)n * sizeof(double));
+        last = i;
+    }
+    out->goal = last; /* the goal tree's roots are the goals, added first */
+    return 1;
+}
+
+typedef struct {
+    long iterations, nodes_start, nodes_goal;
+    double seconds;
+} RrtStats;
+
+/* RRT-Connect from start to any of the k goals (roots of the goal tree). The caller
+ * has checked start and goals. Returns RC_*; the path in *out when RC_SOLVED. */
+static int rrt_connect(Checker *C, const double *start, const double *goals, long k,
+                       const double *lo, const double *hi, const double *opts, Rng *rng,
+                       Path *out, RrtStats *rs)
+{
+    const int n = C->M->n;
+    const double range = opts[RC_RANGE], t0 = now_seconds();
+    const long max_nodes = (long)opts[RC_MAX_NODES];
+    Tree Ts = {NULL, NULL, 0, 0, n}, Tg = {NULL, NULL, 0, 0, n};
+    double qr[MAXJ], tmp[MAXJ];
+    int code = RC_FAILED;
+    if (tree_add(&Ts, start, -1) < 0)
+        goto done;
+    for (long i = 0; i < k; i++)
+        if (tree_add(&Tg, goals + (size_t)i * n, -1) < 0)
+            goto done;
+    /* the straight edge to the nearest goal first */
+    {
+        long g = tree_nearest(&Tg, start);
+        int r = check_edge(C, start, Tg.q + (size_t)g * n);
+        if (r == PC_ERROR || r == PC_UNDECIDED)
+            goto done;
+        if (r == PC_FREE) { /* the goal joins the start tree: [start, goal] */
+            long a = tree_add(&Ts, Tg.q + (size_t)g * n, 0);
+            if (a >= 0 && join_path(&Ts, a, &Tg, g, 1, out))
+                code = RC_SOLVED;
+            goto done;
+        }
+    }
+    Tree *A = &Ts, *B = &Tg;
+    for (long it = 0;; it++) {
+        rs->iterations = it;
+        if (now_seconds() - t0 > opts[RC_TIME]) {
+            code = RC_TIMEOUT;
+            break;
+        }
+        if (Ts.count + Tg.count >= max_nodes) {
+            code = RC_NODES;
+            break;
+        }
+        for (int j = 0; j < n; j++)
+            qr[j] = lo[j] + rng_uniform(rng) * (hi[j] - lo[j]);
+        long added = -1;
+        int r = grow_tree(C, A, qr, range, tmp, &added);
+        if (r == GROW_ERROR)
+            break;
+        if (r != GROW_TRAPPED) {
+            double target[MAXJ];
+            memcpy(target, A->q + (size_t)added * n, (size_t)n * sizeof(double));
+            long other = -1;
+            int g;
+            do {
+                g = grow_tree(C, B, target, range, tmp, &other);
+            } while (g == GROW_ADVANCED);
+            if (g == GROW_ERROR)
+                break;
+            if (g == GROW_REACHED) {
+                code = join_path(A, added, B, other, A == &Ts, out) ? RC_SOLVED : RC_FAILED;
+                break;
+            }
+        }
+        Tree *x = A;
+        A = B;
+        B = x;
+    }
+done:
+    rs->nodes_start = Ts.count;
+    rs->nodes_goal = Tg.count;
+    rs->seconds = now_seconds() - t0;
+    tree_free(&Ts);
+    tree_free(&Tg);
+    return code;
+}
+
+/* ---------------------------------------------------------------- shortcuts */
+
+static double path_length(const double *q, long K, int n)
+{
+    double s = 0.0;
+    for (long i = 0; i + 1 < K; i++)
+        s += sqrt(dist2(q + (size_t)i * n, q + (size_t)(i + 1) * n, n));
+    return s;
+}
+
+/* Random shortcutting of the path q (*K x n, capacity cap rows, in place): first
+ * vertex pairs (i, j >= i + 2) joined straight when the edge is free, then pairs of
+ * points on two segments. A shortcut is kept only when free and shorter; failures in
+ * a row end each phase (opts[SC_MAX_FAIL]). Returns PC_FREE or PC_ERROR. */
+/* Drop the waypoints of q (*K x n) that lie on the straight segment between their
+ * neighbours (to rounding: off it by at most 1e-12 of its length), as RRT-Connect's
+ * connect steps leave them: the segments on either side are that segment, already
+ * checked. */
+static void drop_collinear(double *q, long *K, int n)
+{
+    long m = 1;
+    for (long i = 1; i + 1 < *K; i++) {
+        const double *a = q + (size_t)(m - 1) * n, *b = q + (size_t)i * n, *c = b + n;
+        double ab = 0.0, bc = 0.0, ac = 0.0;
+        for (int d = 0; d < n; d++) {
+            ab += (b[d] - a[d]) * (b[d] - a[d]);
+            bc += (c[d] - b[d]) * (c[d] - b[d]);
+            ac += (c[d] - a[d]) * (c[d] - a[d]);
+        }
+        if (sqrt(ab) + sqrt(bc) <= sqrt(ac) * (1.0 + 1e-12))
+            continue; /* b lies on a -> c */
+        if (m != i)
+            memcpy(q + (size_t)m * n, b, (size_t)n * sizeof(double));
+        m++;
+    }
+    memcpy(q + (size_t)m * n, q + (size_t)(*K - 1) * n, (size_t)n * sizeof(double));
+    *K = m + 1;
+}
+
+static int shortcut(Checker *C, double *q, long *K, long cap, const double *opts, Rng *rng)
+{
+    const int n = C->M->n;
+    const double t0 = now_seconds();
+    long fails = 0;
+    if (*K > 2)
+        drop_collinear(q, K, n);
+    for (long it = 0; it < (long)opts[SC_VERTEX_TRIES] && *K > 2; it++) {
+        if (fails >= (long)opts[SC_MAX_FAIL] || now_seconds() - t0 > opts[SC_TIME])
+            break;
+        long i = (long)(rng_uniform(rng) * (double)*K), j = (long)(rng_uniform(rng) * (double)*K);
+        if (i > j) {
+            long x = i;
+            i = j;
+            j = x;
+        }
+        if (j - i < 2) {
+            fails++;
+            continue;
+        }
+        int r = check_edge(C, q + (size_t)i * n, q + (size_t)j * n);
+        if (r == PC_ERROR || r == PC_UNDECIDED)
+            return PC_ERROR;
+        if (r != PC_FREE) {
+            fails++;
+            continue;
+        }
+        memmove(q + (size_t)(i + 1) * n, q + (size_t)j * n, (size_t)(*K - j) * n * sizeof(double));
+        *K -= j - i - 1;
+        fails = 0;
+    }
+    fails = 0;
+    double a[MAXJ], b[MAXJ];
+    for (long it = 0; it < (long)opts[SC_TRIES] && *K > 2; it++) {
+        if (fails >= (long)opts[SC_MAX_FAIL] || now_seconds() - t0 > opts[SC_TIME])
+            break;
+        long S = *K - 1; /* segments */
+        long i = (long)(rng_uniform(rng) * (double)S), j = (long)(rng_uniform(rng) * (double)S);
+        double ti = rng_uniform(rng), tj = rng_uniform(rng);
+        if (i > j || (i == j && ti > tj)) {
+            long x = i;
+            i = j;
+            j = x;
+            double y = ti;
+            ti = tj;
+            tj = y;
+        }
+        if (i == j) {
+            fails++;
+            continue;
+        }
+        const double *qi = q + (size_t)i * n, *qj = q + (size_t)j * n;
+        for (int d = 0; d < n; d++) {
+            a[d] = qi[d] + ti * (qi[n + d] - qi[d]);
+            b[d] = qj[d] + tj * (qj[n + d] - qj[d]);
+        }
+        /* the stretch a -> q[i+1] .. q[j] -> b against the straight a -> b */
+        double old = sqrt(dist2(a, qi + n, n)) + path_length(qi + n, j - i, n) +
+                     sqrt(dist2(qj, b, n));
+        double shorter = sqrt(dist2(a, b, n));
+        if (!(shorter < old - 1e-9 * (1.0 + old))) {
+            fails++;
+            continue;
+        }
+        int r = check_edge(C, a, b);
+        if (r == PC_ERROR || r == PC_UNDECIDED)
+            return PC_ERROR;
+        if (r != PC_FREE) {
+            fails++;
+            continue;
+        }
+        /* new path: q[0..i], a, b, q[j+1..]: j - i vertices out, 2 in */
+        long newK = *K - (j - i) + 2;
+        if (newK > cap) {
+            fails++;
+            continue;
+        }
+        memmove(q + (size_t)(i + 3) * n, q + (size_t)(j + 1) * n,
+                (size_t)(*K - j - 1) * n * sizeof(double));
+        memcpy(q + (size_t)(i + 1) * n, a, (size_t)n * sizeof(double));
+        memcpy(q + (size_t)(i + 2) * n, b, (size_t)n * sizeof(double));
+        *K = newK;
+        fails = 0;
+    }
+    return PC_FREE;
+}
+
+/* --------------------------------------------------------------- entries */
+
+static PyObject *path_array(const double *q, long K, int n)
+{
+    npy_intp dims[2] = {K, n};
+    PyObject *a = PyArray_SimpleNew(2, dims, NPY_DOUBLE);
+    if (a != NULL && K > 0)
+        memcpy(PyArray_DATA((PyArrayObject *)a), q, (size_t)K * n * sizeof(double));
+    return a;
+}
+
+/* plan_rrtc(model, start (n,), goals (k, n), lo (n,), hi (n,), margin (P,), opts
+ * (RC_N_OPTS,), seed, exact) -> (code, path (K, n) or None, goal index, stats,
+ * (iterations, start nodes, goal nodes, seconds)) */
+static PyObject *py_plan_rrtc(PyObject *self, PyObject *args)
+{
+    PyObject *mo, *so, *go, *lo_o, *hi_o, *mg, *oo, *cb;
+    unsigned long long seed;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOOOOKO", &mo, &so, &go, &lo_o, &hi_o, &mg, &oo, &seed, &cb))
+        return NULL;
+    Checker C;
+    if (!checker_args(mo, mg, cb, &C))
+        return NULL;
+    const int n = C.M->n;
+    PyArrayObject *st = array_arg(so, "start", NPY_DOUBLE, 1, 0);
+    PyArrayObject *gl = st ? array_arg(go, "goals", NPY_DOUBLE, 2, 0) : NULL;
+    PyArrayObject *lo = gl ? array_arg(lo_o, "lo", NPY_DOUBLE, 1, 0) : NULL;
+    PyArrayObject *hi = lo ? array_arg(hi_o, "hi", NPY_DOUBLE, 1, 0) : NULL;
+    PyArrayObject *op = hi ? array_arg(oo, "opts", NPY_DOUBLE, 1, 0) : NULL;
+    if (op == NULL || bp_dim(st, 0) != n || bp_dim(gl, 1) != n || bp_dim(gl, 0) < 1 ||
+        bp_dim(lo, 0) != n || bp_dim(hi, 0) != n || bp_dim(op, 0) != RC_N_OPTS ||
+        !(bp_f64(op)[RC_RANGE] > 0.0)) {
+        work_free(&C.w);
+        return op == NULL ? NULL : bp_fail("plan_rrtc: inconsistent shapes or options");
+    }
+    Rng rng;
+    rng_seed(&rng, (uint64_t)seed);
+    Path path = {NULL, 0, -1};
+    RrtStats rs = {0, 0, 0, 0.0};
+    int code;
+    Py_BEGIN_ALLOW_THREADS
+    code = rrt_connect(&C, bp_f64(st), bp_f64(gl), (long)bp_dim(gl, 0), bp_f64(lo), bp_f64(hi),
+                       bp_f64(op), &rng, &path, &rs);
+    Py_END_ALLOW_THREADS
+    if (PyErr_Occurred()) {
+        free(path.q);
+        return check_failed(&C);
+    }
+    PyObject *pa;
+    if (code == RC_SOLVED) {
+        pa = path_array(path.q, path.count, n);
+    } else {
+        pa = Py_None;
+        Py_INCREF(pa);
+    }
+    free(path.q);
+    work_free(&C.w);
+    if (pa == NULL)
+        return NULL;
+    return Py_BuildValue("(iNlN(llld))", code, pa, path.goal, stats_tuple(&C.st), rs.iterations,
+                         rs.nodes_start, rs.nodes_goal, rs.seconds);
+}
+
+/* plan_shortcut(model, path (K, n), margin (P,), opts (SC_N_OPTS,), seed, exact) ->
+ * (path (K', n), stats): random shortcuts, every new edge checked. */
+static PyObject *py_plan_shortcut(PyObject *self, PyObject *args)
+{
+    PyObject *mo, *po, *mg, *oo, *cb;
+    unsigned long long seed;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOKO", &mo, &po, &mg, &oo, &seed, &cb))
+        return NULL;
+    Checker C;
+    if (!checker_args(mo, mg, cb, &C))
+        return NULL;
+    const int n = C.M->n;
+    PyArrayObject *pa = array_arg(po, "path", NPY_DOUBLE, 2, 0);
+    PyArrayObject *op = pa ? array_arg(oo, "opts", NPY_DOUBLE, 1, 0) : NULL;
+    if (op == NULL || bp_dim(pa, 1) != n || bp_dim(pa, 0) < 1 || bp_dim(op, 0) != SC_N_OPTS) {
+        work_free(&C.w);
+        return op == NULL ? NULL : bp_fail("plan_shortcut: inconsistent shapes or options");
+    }
+    long K = (long)bp_dim(pa, 0), cap = 2 * K + 16;
+    double *q = malloc((size_t)cap * n * sizeof(double));
+    if (q == NULL)
+        return check_failed(&C);
+    memcpy(q, bp_f64(pa), (size_t)K * n * sizeof(double));
+    Rng rng;
+    rng_seed(&rng, (uint64_t)seed);
+    int r;
+    Py_BEGIN_ALLOW_THREADS
+    r = shortcut(&C, q, &K, cap, bp_f64(op), &rng);
+    Py_END_ALLOW_THREADS
+    if (r == PC_ERROR) {
+        free(q);
+        if (!PyErr_Occurred())
+            PyErr_SetString(PyExc_ValueError,
+                            "robokin._native.plan_shortcut: a mesh pair needs exact");
+        return check_failed(&C);
+    }
+    PyObject *out = path_array(q, K, n);
+    free(q);
+    work_free(&C.w);
+    if (out == NULL)
+        return NULL;
+    return Py_BuildValue("(NN)", out, stats_tuple(&C.st));
+}
+
+#define PLAN_RRTC_METHODS                                                                \
+    {"plan_rrtc", py_plan_rrtc, METH_VARARGS,                                            \
+     "plan_rrtc(model, start, goals, lo, hi, margin, opts, seed, exact) -> (code, path, " \
+     "goal, stats, search): RRT-Connect with exact edge checks."},                       \
+    {"plan_shortcut", py_plan_shortcut, METH_VARARGS,                                    \
+     "plan_shortcut(model, path, margin, opts, seed, exact) -> (path, stats): random "   \
+     "shortcuts, every new edge checked."},
+
+static int plan_rrtc_constants(PyObject *m)
+{
+    static const struct { const char *name; int value; } ints[] = {
+        {"RC_RANGE", RC_RANGE}, {"RC_TIME", RC_TIME}, {"RC_MAX_NODES", RC_MAX_NODES},
+        {"RC_N_OPTS", RC_N_OPTS}, {"SC_VERTEX_TRIES", SC_VERTEX_TRIES}, {"SC_TRIES", SC_TRIES},
+        {"SC_MAX_FAIL", SC_MAX_FAIL}, {"SC_TIME", SC_TIME}, {"SC_N_OPTS", SC_N_OPTS},
+        {"RC_SOLVED", RC_SOLVED}, {"RC_TIMEOUT", RC_TIMEOUT}, {"RC_NODES", RC_NODES},
+        {"RC_FAILED", RC_FAILED}};
+    for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
+        if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
+            return -1;
+    return 0;
+}
