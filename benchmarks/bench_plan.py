@@ -120,9 +120,13 @@ def in_region(kind: str, p: np.ndarray) -> np.ndarray:
 
 
 # --------------------------------------------------------------------- problems
-def make_problems(pl: planning.Planner, kind: str, count: int, seed: int
-                  ) -> list[tuple[np.ndarray, np.ndarray]]:
-    """``count`` (start, goal) pairs: free, goal in the region, direct edge blocked."""
+def make_problems(pl: planning.Planner, kind: str, count: int, seed: int,
+                  check_s: float = 3.0) -> tuple[list[tuple[np.ndarray, np.ndarray]], int]:
+    """``count`` (start, goal) pairs: free, goal in the region, direct edge blocked,
+    and solvable: OMPL's RRTConnect (on robokin's checks) finds a path within
+    ``check_s`` seconds (a random goal can lie in a part of the free space no path
+    reaches). Returns the problems and how many candidates were dropped as unsolved.
+    """
     rng = np.random.default_rng(seed)
     lo, hi = pl.limits[:, 0], pl.limits[:, 1]
     lo, hi = np.maximum(lo, -math.pi), np.minimum(hi, math.pi)
@@ -144,12 +148,19 @@ def make_problems(pl: planning.Planner, kind: str, count: int, seed: int
     k = min(len(S), len(G), 8 * count)
     S, G = S[:k], G[:k]
     blocked = ~pl.edges_free(S, G)
+    dropped = 0
     for a, b, blk in zip(S, G, blocked):
-        if blk:
-            out.append((a, b))
+        if not blk:
+            continue
+        if check_s > 0 and not pl.plan(a, b, planner="ompl:RRTConnect",
+                                       time_limit=check_s, simplify=False,
+                                       smooth=False).success:
+            dropped += 1
+            continue
+        out.append((a, b))
         if len(out) == count:
             break
-    return out
+    return out, dropped
 
 
 # ------------------------------------------------------------ pinocchio + coal
@@ -271,14 +282,21 @@ class Family:
     robot: str
     scene: str
     times: list[float] = field(default_factory=list)
+    cpu: list[float] = field(default_factory=list)
     ok: list[bool] = field(default_factory=list)
     valid: list[bool] = field(default_factory=list)
     length: list[float] = field(default_factory=list)
     search: list[float] = field(default_factory=list)
     base_times: list[float] = field(default_factory=list)
+    base_cpu: list[float] = field(default_factory=list)
     base_ok: list[bool] = field(default_factory=list)
     ompl_times: list[float] = field(default_factory=list)
     ompl_ok: list[bool] = field(default_factory=list)
+    dropped: int = 0
+    ompl_search_s: float = 0.0
+    ompl_kernel_s: float = 0.0
+    ompl_calls: int = 0
+    own_search_s: float = 0.0
     state_us: float = 0.0
     state1_us: float = 0.0
     pin_state_us: float = 0.0
@@ -286,6 +304,44 @@ class Family:
 
 def _pct(x: list[float], q: float) -> float:
     return float(np.percentile(x, q)) if x else math.nan
+
+
+def ompl_overhead(pl: planning.Planner, problems: list, fam: Family) -> None:
+    """OMPL's RRTConnect on robokin's checks: time in the kernels vs the rest.
+
+    The model's state and edge checks are wrapped to sum the time spent inside the
+    compiled kernels; the rest of OMPL's search time is OMPL plus the Python calls
+    into and out of the callbacks. The compiled RRT-Connect's search on the same
+    problems is timed alongside.
+    """
+    model = pl.model
+    spent = {"kernel": 0.0, "calls": 0}
+    states, edges = model.check_states, model.check_edges
+
+    def timed(fn):
+        def call(*a, **k):
+            t = time.perf_counter()
+            out = fn(*a, **k)
+            spent["kernel"] += time.perf_counter() - t
+            spent["calls"] += 1
+            return out
+        return call
+
+    model.check_states, model.check_edges = timed(states), timed(edges)  # type: ignore
+    total = 0.0
+    try:
+        for i, (a, b) in enumerate(problems):
+            res = pl.plan(a, b, planner="ompl:RRTConnect", time_limit=2.0, seed=i,
+                          simplify=False, smooth=False)
+            total += res.stats.get("search_s", res.time)
+    finally:
+        model.check_states, model.check_edges = states, edges  # type: ignore
+    own = sum(pl.plan(a, b, seed=i, simplify=False, smooth=False).stats["search_s"]
+              for i, (a, b) in enumerate(problems))
+    fam.ompl_search_s = total
+    fam.ompl_kernel_s = spent["kernel"]
+    fam.ompl_calls = spent["calls"]
+    fam.own_search_s = own
 
 
 def state_costs(pl: planning.Planner, pc: PinCoal, fam: Family) -> None:
@@ -311,61 +367,91 @@ def run_family(robot_name: str, kind: str, args: argparse.Namespace) -> Family:
     pl = planning.Planner(robot, scene)
     pc = pin_coal(pl)
     fam = Family(robot_name, kind)
-    problems = make_problems(pl, kind, args.problems, seed=zlib.crc32(f"{robot_name}/{kind}".encode()))
+    problems, fam.dropped = make_problems(pl, kind, args.problems,
+                                          seed=zlib.crc32(f"{robot_name}/{kind}".encode()),
+                                          check_s=args.solvable_s)
     for i, (a, b) in enumerate(problems):
         res = pl.plan(a, b, time_limit=args.time_limit, seed=i)
         fam.ok.append(res.success)
         fam.times.append(res.time)
+        fam.cpu.append(res.stats.get("cpu_s", res.time))
         if res.success:
             fam.search.append(res.stats.get("search_s", math.nan))
             fam.length.append(res.length)
             fam.valid.append(dense_valid(pc, np.asarray(res.q)))
     lo, hi = pl.limits[:, 0], pl.limits[:, 1]
     for i, (a, b) in enumerate(problems[: args.baseline]):
+        c = time.process_time()
         ok, t, _ = ompl_baseline(pc, lo, hi, a, b, args.baseline_limit)
+        fam.base_cpu.append(time.process_time() - c)
         fam.base_ok.append(ok)
         fam.base_times.append(t)
         res = pl.plan(a, b, time_limit=args.time_limit, seed=i, planner="ompl:RRTConnect")
         fam.ompl_ok.append(res.success)
         fam.ompl_times.append(res.time)
+    ompl_overhead(pl, problems[: args.baseline], fam)
     state_costs(pl, pc, fam)
     return fam
 
 
 def report(fams: list[Family]) -> dict:
     rows = []
-    print("| robot | scene | solved | invalid | median [ms] | p95 [ms] | length [rad] | "
-          "baseline solved | baseline median [ms] | ratio | OMPL+robokin median [ms] | "
-          "state [us] batch / single / pin+coal |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| robot | scene | solved | invalid | median [ms] wall / CPU | p95 [ms] | "
+          "length [rad] | baseline solved | baseline median [ms] wall / CPU | ratio | "
+          "OMPL+robokin median [ms] | state [us] batch / single / pin+coal | dropped |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for f in fams:
         med, p95 = 1e3 * _pct(f.times, 50), 1e3 * _pct(f.times, 95)
-        bmed = 1e3 * _pct(f.base_times, 50)
+        cmed = 1e3 * _pct(f.cpu, 50)
+        bmed, bcpu = 1e3 * _pct(f.base_times, 50), 1e3 * _pct(f.base_cpu, 50)
         omed = 1e3 * _pct(f.ompl_times, 50)
         row = dict(robot=f.robot, scene=f.scene, problems=len(f.ok), solved=sum(f.ok),
                    invalid=len(f.valid) - sum(f.valid), median_ms=med, p95_ms=p95,
-                   length=_pct(f.length, 50), baseline_solved=sum(f.base_ok),
-                   baseline_n=len(f.base_ok), baseline_median_ms=bmed,
+                   cpu_median_ms=cmed, length=_pct(f.length, 50),
+                   baseline_solved=sum(f.base_ok), baseline_n=len(f.base_ok),
+                   baseline_median_ms=bmed, baseline_cpu_median_ms=bcpu,
                    ompl_robokin_median_ms=omed, state_us=f.state_us,
                    state1_us=f.state1_us, pin_state_us=f.pin_state_us,
-                   search_median_ms=1e3 * _pct(f.search, 50))
+                   search_median_ms=1e3 * _pct(f.search, 50), dropped=f.dropped)
         rows.append(row)
         print(f"| {f.robot} | {f.scene} | {sum(f.ok)}/{len(f.ok)} | {row['invalid']} | "
-              f"{med:.2f} | {p95:.2f} | {row['length']:.2f} | "
-              f"{sum(f.base_ok)}/{len(f.base_ok)} | {bmed:.0f} | {bmed / med:.0f}x | "
-              f"{omed:.2f} | {f.state_us:.2f} / {f.state1_us:.2f} / {f.pin_state_us:.0f} |")
+              f"{med:.2f} / {cmed:.2f} | {p95:.2f} | {row['length']:.2f} | "
+              f"{sum(f.base_ok)}/{len(f.base_ok)} | {bmed:.0f} / {bcpu:.0f} | "
+              f"{bmed / med:.0f}x | {omed:.2f} | {f.state_us:.2f} / {f.state1_us:.2f} / "
+              f"{f.pin_state_us:.0f} | {f.dropped} |")
     allt = [t for f in fams for t in f.times]
+    allc = [t for f in fams for t in f.cpu]
     allb = [t for f in fams for t in f.base_times]
+    allbc = [t for f in fams for t in f.base_cpu]
     solved = sum(sum(f.ok) for f in fams)
     total = sum(len(f.ok) for f in fams)
     invalid = sum(r["invalid"] for r in rows)
+    calls = sum(f.ompl_calls for f in fams)
+    o_total = sum(f.ompl_search_s for f in fams)
+    o_kernel = sum(f.ompl_kernel_s for f in fams)
+    own = sum(f.own_search_s for f in fams)
+    print(f"\nOMPL RRTConnect on robokin's checks (the baseline problems): search "
+          f"{o_total:.3f} s, of it {o_kernel:.3f} s in the kernels "
+          f"({100 * o_kernel / max(o_total, 1e-12):.0f} %), {calls} callbacks, "
+          f"{1e6 * (o_total - o_kernel) / max(calls, 1):.1f} us outside the kernels "
+          f"per callback; the compiled RRT-Connect's search on the same problems: "
+          f"{own:.3f} s")
     summary = dict(solved=solved, problems=total, invalid=invalid,
+                   ompl_search_s=o_total, ompl_kernel_s=o_kernel, ompl_calls=calls,
+                   own_search_s=own,
                    median_ms=1e3 * _pct(allt, 50), p95_ms=1e3 * _pct(allt, 95),
-                   baseline_median_ms=1e3 * _pct(allb, 50))
+                   cpu_median_ms=1e3 * _pct(allc, 50), cpu_p95_ms=1e3 * _pct(allc, 95),
+                   baseline_median_ms=1e3 * _pct(allb, 50),
+                   baseline_cpu_median_ms=1e3 * _pct(allbc, 50),
+                   dropped=sum(f.dropped for f in fams))
     print(f"\nall: solved {solved}/{total} ({100 * solved / max(total, 1):.1f} %), "
-          f"invalid {invalid}, median {summary['median_ms']:.2f} ms, p95 "
-          f"{summary['p95_ms']:.2f} ms; baseline median {summary['baseline_median_ms']:.0f} ms "
-          f"({summary['baseline_median_ms'] / summary['median_ms']:.0f}x)")
+          f"invalid {invalid}, median {summary['median_ms']:.2f} ms wall / "
+          f"{summary['cpu_median_ms']:.2f} ms CPU, p95 {summary['p95_ms']:.2f} ms wall; "
+          f"baseline median {summary['baseline_median_ms']:.0f} ms wall / "
+          f"{summary['baseline_cpu_median_ms']:.0f} ms CPU "
+          f"({summary['baseline_median_ms'] / summary['median_ms']:.0f}x wall, "
+          f"{summary['baseline_cpu_median_ms'] / summary['cpu_median_ms']:.0f}x CPU); "
+          f"{summary['dropped']} unsolvable candidates dropped")
     return dict(families=rows, summary=summary)
 
 
@@ -376,6 +462,9 @@ def main() -> None:
                     help="problems per family also run by the OMPL baselines")
     ap.add_argument("--time-limit", type=float, default=1.0)
     ap.add_argument("--baseline-limit", type=float, default=2.0)
+    ap.add_argument("--solvable-s", type=float, default=3.0,
+                    help="drop candidate problems OMPL's RRTConnect does not solve in "
+                    "this many seconds (0: keep all)")
     ap.add_argument("--robots", nargs="*", default=list(ROBOTS))
     ap.add_argument("--scenes", nargs="*", default=list(SCENES))
     ap.add_argument("--json", default=None, help="write the figures to this file")

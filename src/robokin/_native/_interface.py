@@ -134,21 +134,24 @@ class Kernels(Protocol):
     PD_HULL: int
     PC_EPS: float
     # ------------------------------------------------------------- plan_rrtc.c
-    # plan_rrtc options (RC_N_OPTS entries), plan_shortcut options (SC_N_OPTS),
-    # plan_rrtc result codes
+    # plan_rrtc options (RC_N_OPTS entries) and result codes
     RC_RANGE: int
     RC_TIME: int
     RC_MAX_NODES: int
     RC_N_OPTS: int
-    SC_VERTEX_TRIES: int
-    SC_TRIES: int
-    SC_MAX_FAIL: int
-    SC_TIME: int
-    SC_N_OPTS: int
     RC_SOLVED: int
     RC_TIMEOUT: int
     RC_NODES: int
     RC_FAILED: int
+    # ------------------------------------------------------------- plan_path.c
+    # plan_simplify options (SP_N_OPTS entries)
+    SP_VERTEX_TRIES: int
+    SP_TRIES: int
+    SP_MAX_FAIL: int
+    SP_TIME: int
+    SP_CUT_ROUNDS: int
+    SP_SHARP_TURN: int
+    SP_N_OPTS: int
 
     # ------------------------------------------------------- general6r.c constants
     # general6r_solve: solutions per pose, parameter-vector layout (GP_*: header
@@ -378,11 +381,11 @@ class Kernels(Protocol):
     ) -> tuple[int, F64 | None, int, tuple[int, ...], tuple[int, int, int, float]]:
         """RRT-Connect: (code, path (K, n) or None, goal row, counters, search)."""
 
-    def plan_shortcut(
+    def plan_simplify(
         self, model: object, path: F64, margin: F64, opts: F64, seed: int,
         exact: object, /,
     ) -> tuple[F64, tuple[int, ...]]:
-        """Random shortcuts of path (K, n), every new edge checked; (path, counters)."""
+        """Shortcuts, then sharp corners cut, of path (K, n); (path, counters)."""
 
     # ------------------------------------------------------- for tests and set-up
     def seg_seg(self, pts: F64, out: F64, /) -> None:

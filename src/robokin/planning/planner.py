@@ -25,7 +25,7 @@ from robokin.planning._model import CollisionModel
 from robokin.planning._ompl import OMPL_PLANNERS, ompl_plan
 from robokin.planning.goals import Goals, goal_configurations, outside_limits
 from robokin.planning.result import PlanResult
-from robokin.planning.smoothing import cut_corners, retime_checked
+from robokin.planning.smoothing import SHARP_TURN, retime_checked
 
 if TYPE_CHECKING:
     from robokin.collision.scene import Scene
@@ -38,13 +38,16 @@ __all__ = ["DEFAULT_PLANNER", "PLANNERS", "Planner", "plan"]
 DEFAULT_PLANNER = "rrtconnect"
 #: Every planner name :meth:`Planner.plan` accepts.
 PLANNERS = (DEFAULT_PLANNER, *(f"ompl:{name}" for name in OMPL_PLANNERS))
-#: Longest RRT-Connect edge as a fraction of the diagonal of the joint-limit box.
+#: Longest RRT-Connect edge [rad, m]: the smaller of RANGE and RANGE_FRACTION of the
+#: diagonal of the joint-limit box (docs/planning.md: 1.0 gave the lowest median
+#: over the benchmark's six families among 0.5-2.0).
+RANGE = 1.0
 RANGE_FRACTION = 0.1
 #: Most tree nodes of one RRT-Connect query (bounds memory and time).
 MAX_NODES = 200_000
 #: Shortcutting: vertex-pair tries, point-pair tries, failures in a row that end a
 #: phase.
-SHORTCUT = (10, 30, 8)
+SHORTCUT = (10, 20, 5)
 #: Rounds of corner cutting.
 SMOOTH_ROUNDS = 3
 
@@ -204,8 +207,9 @@ class Planner:
                 :data:`PLANNERS`.
             clearance: Distance the robot keeps from the scene [m].
             self_clearance: Distance the robot's links keep from each other [m].
-            planner_range: Longest tree edge [rad, m] (default: a tenth of the
-                diagonal of the joint-limit box; OMPL: its own default).
+            planner_range: Longest tree edge [rad, m] (default: 1.0, or a tenth of
+                the diagonal of the joint-limit box if that is shorter; OMPL: its own
+                default).
             simplify: Shortcut the path (every new edge checked).
             smooth: Cut its corners (Chaikin; every new edge checked).
             retime: Also retime it (:meth:`trajectory`) into ``result.trajectory``.
@@ -253,15 +257,8 @@ class Planner:
                               stats=stats)
         raw = path
         t1 = time.perf_counter()
-        if simplify and path.shape[0] > 2:
-            path = self._shortcut(path, margin, int(seed), stats)
-        waypoints = path
-        t2 = time.perf_counter()
-        if smooth and path.shape[0] > 2:
-            path = cut_corners(path, lambda a, b: self.model.check_edges(a, b, margin).free,
-                               rounds=SMOOTH_ROUNDS)
-        t3 = time.perf_counter()
-        stats.update(shortcut_s=t2 - t1, smooth_s=t3 - t2, cpu_s=time.process_time() - c0)
+        path = self._simplify(path, margin, int(seed), simplify, smooth, stats)
+        stats.update(simplify_s=time.perf_counter() - t1, cpu_s=time.process_time() - c0)
         index = int(goal_rows[goal_at])
         elapsed = time.perf_counter() - t0
         traj = None
@@ -270,7 +267,7 @@ class Planner:
                                    **(retime_options or {}))
         return PlanResult(True, path, "solved", elapsed, planner,
                           goal=free_goals[goal_at], goal_index=index, goals=goals.q,
-                          waypoints=waypoints, raw=raw, trajectory=traj, stats=stats)
+                          raw=raw, trajectory=traj, stats=stats)
 
     def _range(self, planner_range: float | None) -> float | None:
         if planner_range is None:
@@ -317,7 +314,7 @@ class Planner:
         lo, hi = self._bounds(q0, goals)
         if planner == DEFAULT_PLANNER:
             if step is None:
-                step = RANGE_FRACTION * float(np.linalg.norm(hi - lo))
+                step = min(RANGE, RANGE_FRACTION * float(np.linalg.norm(hi - lo)))
             opts = np.zeros(_k.RC_N_OPTS)
             opts[_k.RC_RANGE], opts[_k.RC_TIME] = step, limit
             opts[_k.RC_MAX_NODES] = MAX_NODES
@@ -346,16 +343,48 @@ class Planner:
         path[-1] = goals[goal_at]
         return path, goal_at, "solved"
 
-    def _shortcut(self, path: np.ndarray, margin: np.ndarray, seed: int,
-                  stats: dict[str, Any]) -> np.ndarray:
-        opts = np.zeros(_k.SC_N_OPTS)
-        opts[_k.SC_VERTEX_TRIES], opts[_k.SC_TRIES], opts[_k.SC_MAX_FAIL] = SHORTCUT
-        opts[_k.SC_TIME] = math.inf
-        out, work = _k.plan_shortcut(self.model.capsule, np.ascontiguousarray(path),
+    def _simplify(self, path: np.ndarray, margin: np.ndarray, seed: int,
+                  shortcut: bool, smooth: bool, stats: dict[str, Any]) -> np.ndarray:
+        """Shortcuts, then the sharp corners cut (csrc/plan_path.c), new edges checked."""
+        if path.shape[0] <= 2 or not (shortcut or smooth):
+            return path
+        opts = np.zeros(_k.SP_N_OPTS)
+        if shortcut:
+            tries = SHORTCUT
+            opts[_k.SP_VERTEX_TRIES], opts[_k.SP_TRIES], opts[_k.SP_MAX_FAIL] = tries
+        opts[_k.SP_TIME] = math.inf
+        opts[_k.SP_CUT_ROUNDS] = SMOOTH_ROUNDS if smooth else 0
+        opts[_k.SP_SHARP_TURN] = SHARP_TURN
+        out, work = _k.plan_simplify(self.model.capsule, np.ascontiguousarray(path),
                                      margin, opts, (seed * 0x9E3779B1 + 1) % 2**64,
                                      self.model.exact_callback)
-        stats["shortcut_edges"] = _work(work)["edges"]
+        stats["simplify_edges"] = _work(work)["edges"]
         return _drop_repeats(np.asarray(out))
+
+    def simplify(self, path: npt.ArrayLike, *, seed: int = 0, shortcut: bool = True,
+                 smooth: bool = True, clearance: float = 0.0,
+                 self_clearance: float = 0.0) -> np.ndarray:
+        """A shorter, smoother version of a collision-free path, same ends.
+
+        Random shortcuts (deterministic for ``seed``), then Chaikin corner cutting
+        of the corners sharp enough to stop the arm (:mod:`robokin.planning.smoothing`);
+        every new segment is proven free with the margins, the others lie on the
+        given segments.
+
+        Args:
+            path: Waypoints (K, n) [rad, m]; every segment free.
+            seed: Seed of the shortcut choices.
+            shortcut: Try shortcuts.
+            smooth: Cut the sharp corners.
+            clearance: Robot-scene margin [m].
+            self_clearance: Robot-robot margin [m].
+
+        Returns:
+            The new waypoints (K', n).
+        """
+        q = self._q(path, "path")
+        margin = self.margin(clearance, self_clearance)
+        return self._simplify(q, margin, int(seed), shortcut, smooth, {})
 
     # ------------------------------------------------------------ retiming
     def trajectory(self, path: PlanResult | npt.ArrayLike, *, clearance: float = 0.0,

@@ -31,8 +31,7 @@ class PlanResult:
         goal_index: Its row in the goal set given (for a pose goal: in
             ``goals``), or None.
         goals: The candidate goal configurations (k, n) the planner aimed at.
-        waypoints: The path after shortcutting, before smoothing (K', n).
-        raw: The planner's own path (before shortcutting).
+        raw: The planner's own path (before shortcutting and corner cutting).
         trajectory: The retimed trajectory when asked for (``retime=True``), else None.
         stats: Counters of the query: states and edges checked, tree nodes,
             seconds per stage.
@@ -46,14 +45,13 @@ class PlanResult:
     goal: np.ndarray | None = None
     goal_index: int | None = None
     goals: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-    waypoints: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     raw: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     trajectory: Trajectory | None = None
     stats: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         """Freeze the arrays."""
-        for name in ("q", "goals", "waypoints", "raw", "goal"):
+        for name in ("q", "goals", "raw", "goal"):
             a = getattr(self, name)
             if isinstance(a, np.ndarray):
                 a.setflags(write=False)

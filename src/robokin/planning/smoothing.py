@@ -5,15 +5,15 @@ runs a C2 spline through its waypoints and must stop where the path turns by mor
 than :data:`~robokin.trajectory._retime_path.CORNER_DEG` (60 deg). Two steps, each
 keeping the guarantee that what the robot runs is collision-free:
 
-1. :func:`cut_corners`: Chaikin's corner cutting (Chaikin, "An algorithm for high
-   speed curve generation", Computer Graphics and Image Processing 3(4), 1974) on
+1. Corner cutting (:meth:`robokin.planning.Planner.simplify`, compiled in
+   ``csrc/plan_path.c``): Chaikin's corner cutting (Chaikin, "An algorithm for high
+   speed curve generation", Computer Graphics and Image Processing 3(4), 1974) of
    the corners sharp enough to stop the arm (turning by more than
-   :data:`SHARP_TURN`): the corner w_i is replaced by the points a quarter of the
-   way to its neighbours when the new segment between them is proven free (all
-   corners of a round in one batch); otherwise it stays. The other new segments
-   lie on old ones. Each round halves those corners' turns. Gentler corners are
-   left to the spline: cutting them too added knots and made the retimed motion
-   longer (docs/planning.md has the numbers).
+   :data:`SHARP_TURN`): corner w_i is replaced by the points a quarter of the way
+   to its neighbours when the new segment between them is proven free; otherwise
+   it stays. The other new segments lie on old ones. Each round halves those
+   corners' turns. Gentler corners are left to the spline: cutting them too added
+   knots and made the retimed motion longer (docs/planning.md has the numbers).
 2. :func:`retime_checked`: the time-optimal C2 spline through the waypoints under
    the robot's limits, then every step between consecutive samples proven free as
    a straight edge (a controller interpolates between them). The spline leaves the
@@ -36,59 +36,13 @@ if TYPE_CHECKING:
     from robokin.robot import Robot
     from robokin.trajectory.samples import Trajectory
 
-__all__ = ["SHARP_TURN", "EdgeCheck", "cut_corners", "retime_checked"]
+__all__ = ["SHARP_TURN", "EdgeCheck", "retime_checked"]
 
 #: A batch edge check: (q0 (m, n), q1 (m, n)) -> (m,) bool, True when proven free.
 EdgeCheck = Callable[[np.ndarray, np.ndarray], np.ndarray]
 #: Corners turning by more than this [rad] are cut: 5 deg below the turn at which
 #: retiming stops the arm (robokin.trajectory._retime_path.CORNER_DEG).
 SHARP_TURN = math.radians(CORNER_DEG - 5.0)
-
-
-def _turns(q: np.ndarray) -> np.ndarray:
-    """Turning angle [rad] at every interior waypoint of q (K, n)."""
-    u = np.diff(q, axis=0)
-    norm = np.linalg.norm(u, axis=1)
-    u = u / np.where(norm > 0, norm, 1.0)[:, None]
-    cos = np.clip(np.einsum("ij,ij->i", u[:-1], u[1:]), -1.0, 1.0)
-    return np.arccos(cos)
-
-
-def cut_corners(q: np.ndarray, free: EdgeCheck, *, rounds: int = 3,
-                ratio: float = 0.25) -> np.ndarray:
-    """Chaikin corner cutting of the sharp corners of q (K, n), new segments checked.
-
-    Args:
-        q: Waypoints [rad, m], shape (K, n); every segment already free.
-        free: The batch edge check.
-        rounds: Rounds of cutting (each doubles the points at most).
-        ratio: Where each corner is cut, as a fraction of its segments (1/4:
-            Chaikin).
-
-    Returns:
-        The new waypoints (K', n), same ends; every segment free.
-    """
-    out = np.asarray(q, dtype=float)
-    for _ in range(rounds):
-        if out.shape[0] < 3:
-            break
-        turns = _turns(out)
-        cut = np.flatnonzero(turns > SHARP_TURN)
-        if cut.size == 0:
-            break
-        cur = out[1:-1]
-        a = cur + ratio * (out[:-2] - cur)
-        b = cur + ratio * (out[2:] - cur)
-        ok = np.zeros(cur.shape[0], dtype=bool)
-        ok[cut] = free(a[cut], b[cut])
-        if not ok.any():
-            break
-        rows = [out[:1]]
-        for i in range(cur.shape[0]):
-            rows.append(np.stack([a[i], b[i]]) if ok[i] else cur[i : i + 1])
-        rows.append(out[-1:])
-        out = np.concatenate(rows)
-    return out
 
 
 def retime_checked(

@@ -21,6 +21,7 @@
 #include "plan_geom.c"
 #include "plan_check.c"
 #include "plan_rrtc.c"
+#include "plan_path.c"
 #include "general6r.c"
 
 /* ---------------------------------------------------------------- arguments */
@@ -576,6 +577,7 @@ static PyMethodDef methods[] = {
     BROADPHASE_METHODS
     PLAN_CHECK_METHODS
     PLAN_RRTC_METHODS
+    PLAN_PATH_METHODS
     GENERAL6R_METHODS
     {NULL, NULL, 0, NULL}};
 
@@ -610,7 +612,7 @@ PyMODINIT_FUNC MODULE_INIT(void)
     PyModule_AddObject(m, "MAX_TRANSLATION", PyFloat_FromDouble(MAX_TRANSLATION));
     if (six_r_constants(m) < 0 || broadphase_constants(m) < 0 ||
         general6r_constants(m) < 0 || plan_check_constants(m) < 0 ||
-        plan_rrtc_constants(m) < 0) {
+        plan_rrtc_constants(m) < 0 || plan_path_constants(m) < 0) {
         Py_DECREF(m);
         return NULL;
     }

@@ -46,6 +46,17 @@
 #define PC_MAX_SAMPLES 200000  /* states per edge before it counts as hit */
 #define PC_CAPSULE "robokin.plan_model"
 
+/* min and max of two doubles that are never NaN here (libm's fmin/fmax are calls) */
+static inline double dmin(double a, double b)
+{
+    return a < b ? a : b;
+}
+
+static inline double dmax(double a, double b)
+{
+    return a > b ? a : b;
+}
+
 enum { PC_FREE = 0, PC_HIT = 1, PC_UNDECIDED = 2, PC_ERROR = 3 };
 
 /* The compiled model. Shapes 0 .. S-1 are the robot's (rb poses in their link
@@ -68,6 +79,12 @@ typedef struct {
     int *mover, *j0, *j1;         /* per pair: the shape whose motion bounds the pair's,
                                      over chain joints j0 <= j < j1 */
     int *by_link_start, *by_link; /* robot shapes grouped by link: (nc + 3), (S) */
+    /* the cheap bounds of every object pair at once (cheap_all), W objects per step */
+    int Opad;                     /* objects, padded to a whole number of W */
+    double *ob_soa;               /* (16, Opad): centre (3), R^T rows (9), half sizes
+                                     (3), radius; padding objects far away */
+    int *pair_of;                 /* (S, Opad): the pair of (robot shape, object), -1 */
+    int *self_list, n_self;       /* the self pairs */
 } PlanModel;
 
 /* One open (pair, interval) of an edge. */
@@ -95,6 +112,7 @@ typedef struct {
     unsigned char *cum_ok; /* (cap, S) whether cum holds them (for this level's h) */
     long q_cap;
     double *rate0; /* (P,) static motion rates of the current edge */
+    double *cheap; /* (4, P) cheap bounds g and ub at an edge's two ends */
 } Work;
 
 typedef struct {
@@ -125,6 +143,9 @@ static void model_free(PlanModel *M)
     free(M->pa);
     free(M->reach);
     free(M->by_link_start);
+    free(M->ob_soa);
+    free(M->pair_of);
+    free(M->self_list);
     free(M);
 }
 
@@ -227,6 +248,50 @@ static void pair_cheap(Checker *C, int p, const double *poses, double *g, double
     }
 }
 
+/* pair_cheap of every pair at one state, into g (P) and ub (P): the object pairs
+ * W objects at a time (the balls of each robot shape against the objects' boxes, in
+ * lanes; the same formulas as pair_cheap), the self pairs one by one. */
+static void cheap_all(Checker *C, const double *poses, double *g, double *ub)
+{
+    const PlanModel *M = C->M;
+    const int Op = M->Opad;
+    const double *so = M->ob_soa;
+    for (int s = 0; s < M->S; s++) {
+        const double *T = poses + 12 * s;
+        const vd cx = BR(T[3]), cy = BR(T[7]), cz = BR(T[11]);
+        const double rho = M->rho[s] + PC_EPS, rad = M->rad[s];
+        const int inside = M->centre_in[s];
+        const int *pairs = M->pair_of + (size_t)s * Op;
+        for (int j = 0; j < Op; j += W) {
+            vd f[16];
+            for (int k = 0; k < 16; k++)
+                memcpy(&f[k], so + (size_t)k * Op + j, sizeof(vd));
+            vd dx = cx - f[0], dy = cy - f[1], dz = cz - f[2], e2 = BR(0.0);
+            for (int a = 0; a < 3; a++) {
+                vd l = f[3 + 3 * a] * dx + f[4 + 3 * a] * dy + f[5 + 3 * a] * dz;
+                vd e = vabs(l) - f[12 + a];
+                e = vsel(e > BR(0.0), e, BR(0.0));
+                e2 += e * e;
+            }
+            vd d = vsqrt(e2);
+            vd gv = d - rho - f[15];
+            vd uv = d - rad - f[15];
+            for (int l = 0; l < W; l++) {
+                int p = pairs[j + l];
+                if (p < 0)
+                    continue;
+                g[p] = gv[l];
+                ub[p] = inside && M->core_ok[M->pb[p]] ? uv[l] : INFINITY;
+            }
+        }
+    }
+    for (int k = 0; k < M->n_self; k++) {
+        int p = M->self_list[k];
+        pair_cheap(C, p, poses, g + p, ub + p);
+    }
+    C->st.bounds += M->P - M->n_self;
+}
+
 /* Pair p's distance bound at one state given its cheap bounds (g, ub), refined only
  * as far as it can matter: returned as it is when g exceeds `all` (it closes every
  * interval it bounds), or when g clears the margin and even the true distance (at
@@ -264,14 +329,6 @@ static double pair_refine(Checker *C, int p, const double *poses, double g, doub
     *exact = method != PD_HULL;
     double d = core_distance(method, &A, &B) - M->rad[a] - M->rad[b] - PC_EPS;
     return d > g ? d : g;
-}
-
-/* Pair p's bound at one state for a plain decision against its margin. */
-static double pair_bound(Checker *C, int p, const double *poses, int *exact)
-{
-    double g, ub, mg = C->margin[p];
-    pair_cheap(C, p, poses, &g, &ub);
-    return pair_refine(C, p, poses, g, ub, mg, mg, exact);
 }
 
 /* The static motion rate of pair p over the current edge: sum_j R_j |dv_j|. */
@@ -445,6 +502,7 @@ static void work_free(Work *w)
     free(w->cum);
     free(w->cum_ok);
     free(w->rate0);
+    free(w->cheap);
     memset(w, 0, sizeof(*w));
 }
 
@@ -456,7 +514,8 @@ static int checker_init(Checker *C, const PlanModel *M, const double *margin, Py
     C->exact_cb = cb;
     C->hit_pair = -1;
     C->w.rate0 = malloc(((size_t)M->P + 1) * sizeof(double));
-    return C->w.rate0 != NULL && work_states(C, 2 * W);
+    C->w.cheap = malloc((4 * (size_t)M->P + 1) * sizeof(double));
+    return C->w.rate0 != NULL && C->w.cheap != NULL && work_states(C, 2 * W);
 }
 
 /* ------------------------------------------------------------------- checks */
@@ -476,9 +535,12 @@ static int check_states(Checker *C, const double *q, long count, long long *stat
             const double *poses = C->w.poses + (size_t)l * S * 12;
             const double *qi = q + (size_t)(i0 + l) * M->n;
             int code = PC_FREE, who = -1;
+            double *G = C->w.cheap, *U = G + M->P;
+            cheap_all(C, poses, G, U);
             for (int p = 0; p < M->P && code == PC_FREE; p++) {
                 int ex;
-                double lb = pair_bound(C, p, poses, &ex);
+                double mg = C->margin[p];
+                double lb = G[p] > mg ? G[p] : pair_refine(C, p, poses, G[p], U[p], mg, mg, &ex);
                 if (lb <= C->margin[p]) {
                     code = settle(C, p, ex, qi, 0.0, &lb);
                     if (code == PC_ERROR)
@@ -518,16 +580,33 @@ static int edge_ends(Checker *C, const double *q0, const double *q1, long *ni)
     const PlanModel *M = C->M;
     Work *w = &C->w;
     const double *P0 = w->poses, *P1 = w->poses + (size_t)M->S * 12;
+    const int P = M->P;
+    double *G0 = w->cheap, *U0 = G0 + P, *G1 = U0 + P, *U1 = G1 + P;
     memset(w->cum_ok, 0, 2 * (size_t)M->S);
-    *ni = 0;
-    for (int p = 0; p < M->P; p++) {
+    cheap_all(C, P0, G0, U0);
+    cheap_all(C, P1, G1, U1);
+    /* the far end first, on its own: a planner's new state is often in collision,
+     * and finding that before the work of proving the pairs between is cheaper */
+    for (int p = 0; p < P; p++) {
         const double mg = C->margin[p];
-        double g0, u0, g1, u1, rate = w->rate0[p];
-        pair_cheap(C, p, P0, &g0, &u0);
-        pair_cheap(C, p, P1, &g1, &u1);
+        if (G1[p] > mg)
+            continue;
+        int ex;
+        double l1 = pair_refine(C, p, P1, G1[p], U1[p], mg, mg, &ex);
+        if (l1 <= mg) {
+            int r = settle(C, p, ex, q1, 1.0, &l1);
+            if (r != PC_FREE)
+                return r;
+        }
+        G1[p] = l1; /* refined (or the exact distance coal gave): still a lower bound */
+    }
+    *ni = 0;
+    for (int p = 0; p < P; p++) {
+        const double mg = C->margin[p];
+        double g0 = G0[p], u0 = U0[p], g1 = G1[p], u1 = U1[p], rate = w->rate0[p];
         if (g0 > mg && g1 > mg && g0 + g1 > rate + 2 * mg)
             continue;
-        rate = fmin(rate, fmin(state_rate(C, p, 0, 1.0), state_rate(C, p, 1, 1.0)));
+        rate = dmin(rate, dmin(state_rate(C, p, 0, 1.0), state_rate(C, p, 1, 1.0)));
         if (g0 > mg && g1 > mg && g0 + g1 > rate + 2 * mg)
             continue;
         const double lim = rate + 2 * mg;
@@ -588,11 +667,11 @@ static int edge_level(Checker *C, const double *q0, const double *dq, int cur, l
             double lim = rate * half + 2 * mg;
             if (g > mg && g > lim - I0.la && g > lim - I0.lb)
                 continue; /* both halves proven */
-            rate = fmin(rate, state_rate(C, I0.p, s, half));
+            rate = dmin(rate, state_rate(C, I0.p, s, half));
             lim = rate * half + 2 * mg;
             int ex;
-            double lm = pair_refine(C, I0.p, poses, g, ub, fmin(lim - I0.la, lim - I0.lb),
-                                    fmax(lim - I0.la, lim - I0.lb), &ex);
+            double lm = pair_refine(C, I0.p, poses, g, ub, dmin(lim - I0.la, lim - I0.lb),
+                                    dmax(lim - I0.la, lim - I0.lb), &ex);
             if (lm <= mg) {
                 int r = settle(C, I0.p, ex, qm, tm, &lm);
                 if (r != PC_FREE)
@@ -692,6 +771,53 @@ static void *dup_data(PyArrayObject *a, size_t count, size_t size)
     return p;
 }
 
+/* The tables of cheap_all: the objects' boxes in lanes (padded with boxes far away,
+ * which no pair reads), the pair of each (robot shape, object), the self pairs. */
+static int model_lanes(PlanModel *M)
+{
+    const int O = M->O, S = M->S, Op = ((O + W - 1) / W) * W;
+    M->Opad = Op;
+    M->ob_soa = malloc((16 * (size_t)Op + 1) * sizeof(double));
+    M->pair_of = malloc(((size_t)S * Op + 1) * sizeof(int));
+    M->self_list = malloc(((size_t)M->P + 1) * sizeof(int));
+    if (!M->ob_soa || !M->pair_of || !M->self_list) {
+        PyErr_NoMemory();
+        return 0;
+    }
+    for (int j = 0; j < Op; j++) {
+        const double *T = j < O ? M->rb + 16 * (size_t)(S + j) : NULL;
+        double col[16];
+        for (int k = 0; k < 16; k++)
+            col[k] = 0.0;
+        if (T == NULL) {
+            col[0] = col[1] = col[2] = 1e30;
+            col[3] = col[7] = col[11] = 1.0;
+        } else {
+            col[0] = T[3];
+            col[1] = T[7];
+            col[2] = T[11];
+            for (int a = 0; a < 3; a++)
+                for (int r = 0; r < 3; r++)
+                    col[3 + 3 * a + r] = T[4 * r + a]; /* row a of R^T */
+            for (int a = 0; a < 3; a++)
+                col[12 + a] = M->h[3 * (size_t)(S + j) + a];
+            col[15] = M->rad[S + j];
+        }
+        for (int k = 0; k < 16; k++)
+            M->ob_soa[(size_t)k * Op + j] = col[k];
+    }
+    for (size_t i = 0; i < (size_t)S * Op; i++)
+        M->pair_of[i] = -1;
+    M->n_self = 0;
+    for (int p = 0; p < M->P; p++) {
+        if (M->self[p])
+            M->self_list[M->n_self++] = p;
+        else
+            M->pair_of[(size_t)M->pa[p] * Op + (M->pb[p] - S)] = p;
+    }
+    return 1;
+}
+
 /* Fill M's tables from the arguments of plan_model; 0 with ValueError if they are
  * inconsistent, -1 with MemoryError. */
 static int model_fill(PlanModel *M, PyArrayObject **a, long S)
@@ -751,7 +877,7 @@ static int model_fill(PlanModel *M, PyArrayObject **a, long S)
         if (kind == PK_HULL) {
             rho = 0.0;
             for (long k = hs; k < hs + hn; k++)
-                rho = fmax(rho, sqrt(dot3(M->hull + 3 * k, M->hull + 3 * k)));
+                rho = dmax(rho, sqrt(dot3(M->hull + 3 * k, M->hull + 3 * k)));
         }
         M->rho[x] = rho + M->rad[x];
     }
@@ -790,7 +916,7 @@ static int model_fill(PlanModel *M, PyArrayObject **a, long S)
         fill[k] = M->by_link_start[k];
     for (long x = 0; x < S; x++)
         M->by_link[fill[M->link[x]]++] = (int)x;
-    return 1;
+    return model_lanes(M) ? 1 : -1;
 }
 
 /* plan_model(packed, shape_i (N, 4) int64, shape_f (N, 21), hull (H, 3), pair_i (P, 7)

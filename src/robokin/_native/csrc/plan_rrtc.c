@@ -1,8 +1,8 @@
 /*
  * The default planner of robokin.planning: RRT-Connect (Kuffner & LaValle,
  * "RRT-Connect: an efficient approach to single-query path planning", ICRA 2000)
- * in joint space, with every edge checked by plan_check.c's check_edge, and random
- * shortcutting of the path it finds. OMPL's planners stay available from Python;
+ * in joint space, every edge checked by plan_check.c's check_edge (plan_path.c
+ * then shortens and smooths the path it finds). OMPL's planners stay available from Python;
  * this copy exists because OMPL's per-call cost into a Python motion validator
  * dominated the planning time (docs/decisions.md has the measurement).
  *
@@ -10,7 +10,8 @@
  * from the caller's seed (Blackman & Vigna, "Scrambled linear pseudorandom number
  * generators", ACM TOMS 47(4), 2021; seeded through splitmix64), so the same inputs
  * give the same path whenever the time limit is not what stopped the search.
- * Nearest neighbours: a linear scan (trees of a few thousand nodes at most).
+ * Nearest neighbours: a linear scan (trees of a few thousand nodes at most). The
+ * generator and the clock serve plan_path.c too (included after this file).
  *
  * PLAN_RRTC_METHODS lists this file's entries of module.c's method table.
  */
@@ -284,132 +285,6 @@ done:
     return code;
 }
 
-/* ---------------------------------------------------------------- shortcuts */
-
-static double path_length(const double *q, long K, int n)
-{
-    double s = 0.0;
-    for (long i = 0; i + 1 < K; i++)
-        s += sqrt(dist2(q + (size_t)i * n, q + (size_t)(i + 1) * n, n));
-    return s;
-}
-
-/* Random shortcutting of the path q (*K x n, capacity cap rows, in place): first
- * vertex pairs (i, j >= i + 2) joined straight when the edge is free, then pairs of
- * points on two segments. A shortcut is kept only when free and shorter; failures in
- * a row end each phase (opts[SC_MAX_FAIL]). Returns PC_FREE or PC_ERROR. */
-/* Drop the waypoints of q (*K x n) that lie on the straight segment between their
- * neighbours (to rounding: off it by at most 1e-12 of its length), as RRT-Connect's
- * connect steps leave them: the segments on either side are that segment, already
- * checked. */
-static void drop_collinear(double *q, long *K, int n)
-{
-    long m = 1;
-    for (long i = 1; i + 1 < *K; i++) {
-        const double *a = q + (size_t)(m - 1) * n, *b = q + (size_t)i * n, *c = b + n;
-        double ab = 0.0, bc = 0.0, ac = 0.0;
-        for (int d = 0; d < n; d++) {
-            ab += (b[d] - a[d]) * (b[d] - a[d]);
-            bc += (c[d] - b[d]) * (c[d] - b[d]);
-            ac += (c[d] - a[d]) * (c[d] - a[d]);
-        }
-        if (sqrt(ab) + sqrt(bc) <= sqrt(ac) * (1.0 + 1e-12))
-            continue; /* b lies on a -> c */
-        if (m != i)
-            memcpy(q + (size_t)m * n, b, (size_t)n * sizeof(double));
-        m++;
-    }
-    memcpy(q + (size_t)m * n, q + (size_t)(*K - 1) * n, (size_t)n * sizeof(double));
-    *K = m + 1;
-}
-
-static int shortcut(Checker *C, double *q, long *K, long cap, const double *opts, Rng *rng)
-{
-    const int n = C->M->n;
-    const double t0 = now_seconds();
-    long fails = 0;
-    if (*K > 2)
-        drop_collinear(q, K, n);
-    for (long it = 0; it < (long)opts[SC_VERTEX_TRIES] && *K > 2; it++) {
-        if (fails >= (long)opts[SC_MAX_FAIL] || now_seconds() - t0 > opts[SC_TIME])
-            break;
-        long i = (long)(rng_uniform(rng) * (double)*K), j = (long)(rng_uniform(rng) * (double)*K);
-        if (i > j) {
-            long x = i;
-            i = j;
-            j = x;
-        }
-        if (j - i < 2) {
-            fails++;
-            continue;
-        }
-        int r = check_edge(C, q + (size_t)i * n, q + (size_t)j * n);
-        if (r == PC_ERROR || r == PC_UNDECIDED)
-            return PC_ERROR;
-        if (r != PC_FREE) {
-            fails++;
-            continue;
-        }
-        memmove(q + (size_t)(i + 1) * n, q + (size_t)j * n, (size_t)(*K - j) * n * sizeof(double));
-        *K -= j - i - 1;
-        fails = 0;
-    }
-    fails = 0;
-    double a[MAXJ], b[MAXJ];
-    for (long it = 0; it < (long)opts[SC_TRIES] && *K > 2; it++) {
-        if (fails >= (long)opts[SC_MAX_FAIL] || now_seconds() - t0 > opts[SC_TIME])
-            break;
-        long S = *K - 1; /* segments */
-        long i = (long)(rng_uniform(rng) * (double)S), j = (long)(rng_uniform(rng) * (double)S);
-        double ti = rng_uniform(rng), tj = rng_uniform(rng);
-        if (i > j || (i == j && ti > tj)) {
-            long x = i;
-            i = j;
-            j = x;
-            double y = ti;
-            ti = tj;
-            tj = y;
-        }
-        if (i == j) {
-            fails++;
-            continue;
-        }
-        const double *qi = q + (size_t)i * n, *qj = q + (size_t)j * n;
-        for (int d = 0; d < n; d++) {
-            a[d] = qi[d] + ti * (qi[n + d] - qi[d]);
-            b[d] = qj[d] + tj * (qj[n + d] - qj[d]);
-        }
-        /* the stretch a -> q[i+1] .. q[j] -> b against the straight a -> b */
-        double old = sqrt(dist2(a, qi + n, n)) + path_length(qi + n, j - i, n) +
-                     sqrt(dist2(qj, b, n));
-        double shorter = sqrt(dist2(a, b, n));
-        if (!(shorter < old - 1e-9 * (1.0 + old))) {
-            fails++;
-            continue;
-        }
-        int r = check_edge(C, a, b);
-        if (r == PC_ERROR || r == PC_UNDECIDED)
-            return PC_ERROR;
-        if (r != PC_FREE) {
-            fails++;
-            continue;
-        }
-        /* new path: q[0..i], a, b, q[j+1..]: j - i vertices out, 2 in */
-        long newK = *K - (j - i) + 2;
-        if (newK > cap) {
-            fails++;
-            continue;
-        }
-        memmove(q + (size_t)(i + 3) * n, q + (size_t)(j + 1) * n,
-                (size_t)(*K - j - 1) * n * sizeof(double));
-        memcpy(q + (size_t)(i + 1) * n, a, (size_t)n * sizeof(double));
-        memcpy(q + (size_t)(i + 2) * n, b, (size_t)n * sizeof(double));
-        *K = newK;
-        fails = 0;
-    }
-    return PC_FREE;
-}
-
 /* --------------------------------------------------------------- entries */
 
 static PyObject *path_array(const double *q, long K, int n)
@@ -474,66 +349,16 @@ static PyObject *py_plan_rrtc(PyObject *self, PyObject *args)
                          rs.nodes_start, rs.nodes_goal, rs.seconds);
 }
 
-/* plan_shortcut(model, path (K, n), margin (P,), opts (SC_N_OPTS,), seed, exact) ->
- * (path (K', n), stats): random shortcuts, every new edge checked. */
-static PyObject *py_plan_shortcut(PyObject *self, PyObject *args)
-{
-    PyObject *mo, *po, *mg, *oo, *cb;
-    unsigned long long seed;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOKO", &mo, &po, &mg, &oo, &seed, &cb))
-        return NULL;
-    Checker C;
-    if (!checker_args(mo, mg, cb, &C))
-        return NULL;
-    const int n = C.M->n;
-    PyArrayObject *pa = array_arg(po, "path", NPY_DOUBLE, 2, 0);
-    PyArrayObject *op = pa ? array_arg(oo, "opts", NPY_DOUBLE, 1, 0) : NULL;
-    if (op == NULL || bp_dim(pa, 1) != n || bp_dim(pa, 0) < 1 || bp_dim(op, 0) != SC_N_OPTS) {
-        work_free(&C.w);
-        return op == NULL ? NULL : bp_fail("plan_shortcut: inconsistent shapes or options");
-    }
-    long K = (long)bp_dim(pa, 0), cap = 2 * K + 16;
-    double *q = malloc((size_t)cap * n * sizeof(double));
-    if (q == NULL)
-        return check_failed(&C);
-    memcpy(q, bp_f64(pa), (size_t)K * n * sizeof(double));
-    Rng rng;
-    rng_seed(&rng, (uint64_t)seed);
-    int r;
-    Py_BEGIN_ALLOW_THREADS
-    r = shortcut(&C, q, &K, cap, bp_f64(op), &rng);
-    Py_END_ALLOW_THREADS
-    if (r == PC_ERROR) {
-        free(q);
-        if (!PyErr_Occurred())
-            PyErr_SetString(PyExc_ValueError,
-                            "robokin._native.plan_shortcut: a mesh pair needs exact");
-        return check_failed(&C);
-    }
-    PyObject *out = path_array(q, K, n);
-    free(q);
-    work_free(&C.w);
-    if (out == NULL)
-        return NULL;
-    return Py_BuildValue("(NN)", out, stats_tuple(&C.st));
-}
-
 #define PLAN_RRTC_METHODS                                                                \
     {"plan_rrtc", py_plan_rrtc, METH_VARARGS,                                            \
      "plan_rrtc(model, start, goals, lo, hi, margin, opts, seed, exact) -> (code, path, " \
      "goal, stats, search): RRT-Connect with exact edge checks."},                       \
-    {"plan_shortcut", py_plan_shortcut, METH_VARARGS,                                    \
-     "plan_shortcut(model, path, margin, opts, seed, exact) -> (path, stats): random "   \
-     "shortcuts, every new edge checked."},
 
 static int plan_rrtc_constants(PyObject *m)
 {
     static const struct { const char *name; int value; } ints[] = {
         {"RC_RANGE", RC_RANGE}, {"RC_TIME", RC_TIME}, {"RC_MAX_NODES", RC_MAX_NODES},
-        {"RC_N_OPTS", RC_N_OPTS}, {"SC_VERTEX_TRIES", SC_VERTEX_TRIES}, {"SC_TRIES", SC_TRIES},
-        {"SC_MAX_FAIL", SC_MAX_FAIL}, {"SC_TIME", SC_TIME}, {"SC_N_OPTS", SC_N_OPTS},
-        {"RC_SOLVED", RC_SOLVED}, {"RC_TIMEOUT", RC_TIMEOUT}, {"RC_NODES", RC_NODES},
+        {"RC_N_OPTS", RC_N_OPTS}, {"RC_SOLVED", RC_SOLVED}, {"RC_TIMEOUT", RC_TIMEOUT}, {"RC_NODES", RC_NODES},
         {"RC_FAILED", RC_FAILED}};
     for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
         if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
