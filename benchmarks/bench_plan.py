@@ -120,6 +120,18 @@ def in_region(kind: str, p: np.ndarray) -> np.ndarray:
 
 
 # --------------------------------------------------------------------- problems
+def seed_ompl(seed: int = 1) -> None:
+    """Seed OMPL's process-wide generator (before its first use: the problem filter
+    and the OMPL runs then repeat from run to run)."""
+    from ompl import util as ou
+
+    ou.setLogLevel(ou.LOG_NONE)
+    ou.RNG.setSeed(seed)
+
+
+seed_ompl()
+
+
 def make_problems(pl: planning.Planner, kind: str, count: int, seed: int,
                   check_s: float = 3.0) -> tuple[list[tuple[np.ndarray, np.ndarray]], int]:
     """``count`` (start, goal) pairs: free, goal in the region, direct edge blocked,

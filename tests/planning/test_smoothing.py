@@ -10,9 +10,9 @@ segments.
 from __future__ import annotations
 
 import numpy as np
-from planning_oracle import Oracle, pose
 
 import robokin
+from planning_oracle import Oracle, pose
 from robokin import planning
 from robokin.collision import Scene
 from robokin.planning.smoothing import SHARP_TURN, retime_checked
@@ -28,6 +28,12 @@ def _turns(q):
     u = np.diff(q, axis=0)
     u /= np.linalg.norm(u, axis=1)[:, None]
     return np.arccos(np.clip(np.einsum("ij,ij->i", u[:-1], u[1:]), -1, 1))
+
+
+def _dist(p, a, b):
+    d = b - a
+    t = np.clip(np.dot(p - a, d) / np.dot(d, d), 0, 1)
+    return np.linalg.norm(a + t * d - p)
 
 
 def _on_segment(p, a, b):
@@ -83,18 +89,28 @@ def test_a_corner_whose_cut_would_collide_stays():
     assert Oracle(robot, scene).path_min(out) > 0.0
 
 
-def test_a_failed_check_of_the_retimed_steps_stops_at_every_waypoint():
+def test_a_step_not_proven_free_makes_its_segment_run_straight():
     robot = robokin.load("ur5")
+    gentle = np.array([[0.0] * 6, [1.0] + [0.0] * 5, [1.8, 0.4] + [0.0] * 4,
+                       [2.4, 1.0] + [0.0] * 4])  # turns of 27 and 18 deg
     calls = []
 
-    def free(a, b):
+    def free(a, b):  # the first check: every step beside segment 1 -> 2 fails
         calls.append(len(a))
-        return np.ones(len(a), bool) if len(calls) > 1 else np.zeros(len(a), bool)
+        if len(calls) > 1:
+            return np.ones(len(a), bool)
+        mid = 0.5 * (a + b)
+        return np.array([_dist(m, gentle[1], gentle[2]) > 0.05 for m in mid])
 
-    gentle = np.array([[0.0] * 6, [1.0] + [0.0] * 5, [1.8, 0.4] + [0.0] * 4])  # 27 deg
-    tr, smooth = retime_checked(robot, gentle, free)
-    assert not smooth
-    for q in tr.q:  # every sample on one of the two straight segments
-        assert _on_segment(q, gentle[0], gentle[1]) or _on_segment(q, gentle[1], gentle[2])
-    tr2, smooth2 = retime_checked(robot, gentle, lambda a, b: np.ones(len(a), bool))
-    assert smooth2 and tr2.duration < tr.duration  # not stopping is faster
+    tr, stops = retime_checked(robot, gentle, free)
+    assert stops == 2 and len(calls) == 2  # both ends of that segment, once
+    # stopping at waypoints 1 and 2 leaves three straight stretches: every sample
+    # lies on the polyline (before, the spline cut its corners)
+    for q in tr.q:
+        assert any(_on_segment(q, a, b) for a, b in zip(gentle[:-1], gentle[1:]))
+    smooth, none = retime_checked(robot, gentle, lambda a, b: np.ones(len(a), bool))
+    assert none == 0 and smooth.duration < tr.duration  # not stopping is faster
+    worst, every = retime_checked(robot, gentle, lambda a, b: np.zeros(len(a), bool))
+    assert every == 2  # never proven: it stops at every waypoint (and is returned)
+    for q in worst.q:
+        assert any(_on_segment(q, a, b) for a, b in zip(gentle[:-1], gentle[1:]))

@@ -81,7 +81,7 @@ def ompl_plan(
         edge_free: Whether the straight edge between two configurations is free.
         time_limit: Seconds OMPL may plan.
         planner_range: Longest tree edge (planners that have one), or None (OMPL's
-            default).
+            default: a fifth of the diagonal of the bounds).
 
     Returns:
         The outcome.

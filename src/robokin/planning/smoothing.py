@@ -17,9 +17,9 @@ keeping the guarantee that what the robot runs is collision-free:
 2. :func:`retime_checked`: the time-optimal C2 spline through the waypoints under
    the robot's limits, then every step between consecutive samples proven free as
    a straight edge (a controller interpolates between them). The spline leaves the
-   proven polyline a little between knots, hence the check; if a step is not
-   proven free, the path is retimed stopping at every waypoint instead, where the
-   motion follows each proven segment exactly.
+   proven polyline a little between knots, hence the check; where a step is not
+   proven free, the arm stops at both ends of the path segment beside it, so that
+   stretch follows the proven segment exactly, and the path is retimed again.
 """
 
 from __future__ import annotations
@@ -45,10 +45,24 @@ EdgeCheck = Callable[[np.ndarray, np.ndarray], np.ndarray]
 SHARP_TURN = math.radians(CORNER_DEG - 5.0)
 
 
+def _nearest_segment(q: np.ndarray, x: np.ndarray) -> int:
+    """The segment of the polyline q (K, n) nearest the configuration x (n,)."""
+    a, d = q[:-1], np.diff(q, axis=0)
+    dd = np.einsum("ij,ij->i", d, d)
+    t = np.clip(np.einsum("ij,ij->i", x - a, d) / np.where(dd > 0, dd, 1.0), 0.0, 1.0)
+    return int(np.argmin(np.linalg.norm(a + t[:, None] * d - x, axis=1)))
+
+
 def retime_checked(
     robot: Robot, q: np.ndarray, free: EdgeCheck, **retime_options: Any
-) -> tuple[Trajectory, bool]:
+) -> tuple[Trajectory, int]:
     """Retime the path q (K, n) time-optimally and prove every sampled step free.
+
+    The C2 spline through the waypoints first; where a sampled step is not proven
+    free, the segment of the path it runs beside is run on its own (the arm stops
+    at both its ends, a repeated sample being a dwell, so that stretch is a
+    two-knot spline: the straight, proven segment itself), and the whole is retimed
+    again, until every step is proven free (at worst stopping at every waypoint).
 
     Args:
         robot: The robot (its rate limits are the default limits).
@@ -58,16 +72,23 @@ def retime_checked(
             ``a_max``, ``j_max``, ``dt``, ...).
 
     Returns:
-        The trajectory, and whether it runs through the waypoints without
-        stopping (False: the fallback that stops at every waypoint).
+        The trajectory, and how many interior waypoints it stops at for the check
+        (0: it runs through them all).
     """
     from robokin.trajectory.retiming import retime
 
-    tr = retime(robot, q, **retime_options)
-    if bool(free(tr.q[:-1], tr.q[1:]).all()):
-        return tr, True
-    # stop at every waypoint: a repeated sample is a dwell, and each stretch between
-    # two waypoints a two-knot spline, the straight segment itself
-    stops = np.repeat(q, 2, axis=0)[1:-1]
-    tr = retime(robot, stops, **retime_options)
-    return tr, False
+    K = q.shape[0]
+    stop = np.zeros(K, dtype=bool)
+    stop[[0, -1]] = True
+    while True:
+        src = np.repeat(q, np.where(stop, 2, 1), axis=0)[1:-1]
+        tr = retime(robot, src, **retime_options)
+        bad = np.flatnonzero(~free(tr.q[:-1], tr.q[1:]))
+        if bad.size == 0 or stop.all():
+            return tr, int(stop[1:-1].sum())
+        before = stop.copy()
+        for i in bad:
+            k = _nearest_segment(q, 0.5 * (tr.q[i] + tr.q[i + 1]))
+            stop[k] = stop[k + 1] = True
+        if np.array_equal(stop, before):  # pragma: no cover - a stretch between stops
+            stop[:] = True  # is its own segment; rounding alone could bring us here

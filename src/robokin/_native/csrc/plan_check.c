@@ -112,7 +112,7 @@ typedef struct {
     unsigned char *cum_ok; /* (cap, S) whether cum holds them (for this level's h) */
     long q_cap;
     double *rate0; /* (P,) static motion rates of the current edge */
-    double *cheap; /* (4, P) cheap bounds g and ub at an edge's two ends */
+    double *cheap; /* (6, P) cheap bounds g and ub at an edge's two ends and middle */
 } Work;
 
 typedef struct {
@@ -514,7 +514,7 @@ static int checker_init(Checker *C, const PlanModel *M, const double *margin, Py
     C->exact_cb = cb;
     C->hit_pair = -1;
     C->w.rate0 = malloc(((size_t)M->P + 1) * sizeof(double));
-    C->w.cheap = malloc((4 * (size_t)M->P + 1) * sizeof(double));
+    C->w.cheap = malloc((6 * (size_t)M->P + 1) * sizeof(double));
     return C->w.rate0 != NULL && C->w.cheap != NULL && work_states(C, 2 * W);
 }
 
@@ -573,53 +573,74 @@ static void joint_deltas(Checker *C, const double *q0, const double *q1)
     }
 }
 
-/* Level 0 of check_edge: both ends of every pair; the pairs whose whole edge is not
- * proven go into items (*ni of them). Returns PC_FREE or what ended the edge. */
-static int edge_ends(Checker *C, const double *q0, const double *q1, long *ni)
+/* Decide the pairs whose cheap bound at work-space state `slot` (q) is at or below
+ * their margin; their refined bounds replace G. Returns PC_FREE or what ended it. */
+static int probe_state(Checker *C, long slot, const double *q, double t, double *G,
+                       const double *U)
 {
     const PlanModel *M = C->M;
-    Work *w = &C->w;
-    const double *P0 = w->poses, *P1 = w->poses + (size_t)M->S * 12;
-    const int P = M->P;
-    double *G0 = w->cheap, *U0 = G0 + P, *G1 = U0 + P, *U1 = G1 + P;
-    memset(w->cum_ok, 0, 2 * (size_t)M->S);
-    cheap_all(C, P0, G0, U0);
-    cheap_all(C, P1, G1, U1);
-    /* the far end first, on its own: a planner's new state is often in collision,
-     * and finding that before the work of proving the pairs between is cheaper */
-    for (int p = 0; p < P; p++) {
+    const double *poses = C->w.poses + (size_t)slot * M->S * 12;
+    for (int p = 0; p < M->P; p++) {
         const double mg = C->margin[p];
-        if (G1[p] > mg)
+        if (G[p] > mg)
             continue;
         int ex;
-        double l1 = pair_refine(C, p, P1, G1[p], U1[p], mg, mg, &ex);
-        if (l1 <= mg) {
-            int r = settle(C, p, ex, q1, 1.0, &l1);
+        double l = pair_refine(C, p, poses, G[p], U[p], mg, mg, &ex);
+        if (l <= mg) {
+            int r = settle(C, p, ex, q, t, &l);
             if (r != PC_FREE)
                 return r;
         }
-        G1[p] = l1; /* refined (or the exact distance coal gave): still a lower bound */
+        G[p] = l; /* refined (or the exact distance coal gave): still a lower bound */
     }
+    return PC_FREE;
+}
+
+/* Level 0 of check_edge, with the edge's states in the work space as [midpoint, q0,
+ * q1]: the far end and the midpoint are probed first (a planner's new state, or a
+ * shortcut, is often in collision, and finding that before the work of proving the
+ * pairs between is cheaper; the midpoint's bounds serve level 1), then both ends of
+ * every pair; the pairs whose whole edge is not proven go into items (*ni).
+ * Returns PC_FREE or what ended the edge. */
+static int edge_ends(Checker *C, const double *q0, const double *q1, const double *qm,
+                     long *ni)
+{
+    const PlanModel *M = C->M;
+    Work *w = &C->w;
+    const int P = M->P, S = M->S;
+    const double *P0 = w->poses + (size_t)S * 12, *P1 = P0 + (size_t)S * 12;
+    double *G0 = w->cheap, *U0 = G0 + P, *G1 = U0 + P, *U1 = G1 + P;
+    double *Gm = U1 + P, *Um = Gm + P;
+    memset(w->cum_ok, 0, 3 * (size_t)S);
+    cheap_all(C, P1, G1, U1);
+    int r = probe_state(C, 2, q1, 1.0, G1, U1);
+    if (r != PC_FREE)
+        return r;
+    cheap_all(C, w->poses, Gm, Um);
+    r = probe_state(C, 0, qm, 0.5, Gm, Um);
+    if (r != PC_FREE)
+        return r;
+    cheap_all(C, P0, G0, U0);
     *ni = 0;
     for (int p = 0; p < P; p++) {
         const double mg = C->margin[p];
         double g0 = G0[p], u0 = U0[p], g1 = G1[p], u1 = U1[p], rate = w->rate0[p];
         if (g0 > mg && g1 > mg && g0 + g1 > rate + 2 * mg)
             continue;
-        rate = dmin(rate, dmin(state_rate(C, p, 0, 1.0), state_rate(C, p, 1, 1.0)));
+        rate = dmin(rate, dmin(state_rate(C, p, 1, 1.0), state_rate(C, p, 2, 1.0)));
         if (g0 > mg && g1 > mg && g0 + g1 > rate + 2 * mg)
             continue;
         const double lim = rate + 2 * mg;
         int ex;
         double l0 = pair_refine(C, p, P0, g0, u0, lim - g1, lim - g1, &ex);
         if (l0 <= mg) {
-            int r = settle(C, p, ex, q0, 0.0, &l0);
+            r = settle(C, p, ex, q0, 0.0, &l0);
             if (r != PC_FREE)
                 return r;
         }
         double l1 = pair_refine(C, p, P1, g1, u1, lim - l0, lim - l0, &ex);
         if (l1 <= mg) {
-            int r = settle(C, p, ex, q1, 1.0, &l1);
+            r = settle(C, p, ex, q1, 1.0, &l1);
             if (r != PC_FREE)
                 return r;
         }
@@ -631,22 +652,26 @@ static int edge_ends(Checker *C, const double *q0, const double *q1, long *ni)
 
 /* One level of check_edge: every span of list `cur` (ns of them, ni items) halved at
  * its midpoint (computed together), each item refined there and its halves kept
- * where still open, into list 1 - cur. */
+ * where still open, into list 1 - cur. Level 1 (`first`) finds its one midpoint,
+ * the edge's, in work-space state 0 with its cheap bounds from edge_ends. */
 static int edge_level(Checker *C, const double *q0, const double *dq, int cur, long *ns,
-                      long *ni)
+                      long *ni, int first)
 {
     const PlanModel *M = C->M;
-    const int n = M->n, S = M->S;
+    const int n = M->n, S = M->S, P = M->P;
     Work *w = &C->w;
-    for (long s = 0; s < *ns; s++) {
-        double t = 0.5 * (w->span[cur][s].ta + w->span[cur][s].tb);
-        double *qm = w->q + (size_t)s * n;
-        for (int j = 0; j < n; j++)
-            qm[j] = q0[j] + t * dq[j];
+    const double *Gm = w->cheap + 4 * (size_t)P, *Um = Gm + P;
+    if (!first) {
+        for (long s = 0; s < *ns; s++) {
+            double t = 0.5 * (w->span[cur][s].ta + w->span[cur][s].tb);
+            double *qm = w->q + (size_t)s * n;
+            for (int j = 0; j < n; j++)
+                qm[j] = q0[j] + t * dq[j];
+        }
+        model_poses(M, w->q, *ns, w->poses, w->axes);
+        C->st.states += *ns;
     }
-    model_poses(M, w->q, *ns, w->poses, w->axes);
     memset(w->cum_ok, 0, (size_t)*ns * S);
-    C->st.states += *ns;
     const int nxt = 1 - cur;
     if (!grow((void **)&w->span[nxt], &w->span_cap[nxt], 2 * *ns, sizeof(Span)) ||
         !grow((void **)&w->item[nxt], &w->item_cap[nxt], 2 * *ni, sizeof(Item)))
@@ -663,7 +688,12 @@ static int edge_level(Checker *C, const double *q0, const double *dq, int cur, l
             const Item I0 = w->item[cur][it];
             const double mg = C->margin[I0.p];
             double g, ub, rate = I0.rate;
-            pair_cheap(C, I0.p, poses, &g, &ub);
+            if (first) {
+                g = Gm[I0.p];
+                ub = Um[I0.p];
+            } else {
+                pair_cheap(C, I0.p, poses, &g, &ub);
+            }
             double lim = rate * half + 2 * mg;
             if (g > mg && g > lim - I0.la && g > lim - I0.lb)
                 continue; /* both halves proven */
@@ -711,21 +741,23 @@ static int check_edge(Checker *C, const double *q0, const double *q1)
         dq[j] = q1[j] - q0[j];
     for (int p = 0; p < P; p++)
         w->rate0[p] = static_rate(C, p);
-    if (!work_states(C, 2) ||
+    if (!work_states(C, 3) ||
         !grow((void **)&w->span[0], &w->span_cap[0], 1, sizeof(Span)) ||
         !grow((void **)&w->item[0], &w->item_cap[0], P, sizeof(Item)))
         return PC_ERROR;
-    memcpy(w->q, q0, n * sizeof(double));
-    memcpy(w->q + n, q1, n * sizeof(double));
-    model_poses(M, w->q, 2, w->poses, w->axes);
-    C->st.states += 2;
+    for (int j = 0; j < n; j++) /* [midpoint, q0, q1]: one lane batch */
+        w->q[j] = q0[j] + 0.5 * dq[j];
+    memcpy(w->q + n, q0, n * sizeof(double));
+    memcpy(w->q + 2 * n, q1, n * sizeof(double));
+    model_poses(M, w->q, 3, w->poses, w->axes);
+    C->st.states += 3;
     long ni = 0;
-    int r = edge_ends(C, q0, q1, &ni);
+    int r = edge_ends(C, q0, q1, w->q, &ni);
     if (r != PC_FREE)
         return r;
     long ns = ni > 0;
     w->span[0][0] = (Span){0.0, 1.0, 0, ni};
-    long total = 2;
+    long total = 3;
     int cur = 0;
     for (int level = 1; ns > 0; level++) {
         if (level > PC_MAX_LEVEL || total + ns > PC_MAX_SAMPLES) {
@@ -736,8 +768,8 @@ static int check_edge(Checker *C, const double *q0, const double *q1)
         }
         if (!work_states(C, ns))
             return PC_ERROR;
-        total += ns;
-        r = edge_level(C, q0, dq, cur, &ns, &ni);
+        total += level > 1 ? ns : 0;
+        r = edge_level(C, q0, dq, cur, &ns, &ni, level == 1);
         if (r != PC_FREE)
             return r;
         cur = 1 - cur;

@@ -21,10 +21,6 @@ static double path_length(const double *q, long K, int n)
     return s;
 }
 
-/* Random shortcutting of the path q (*K x n, capacity cap rows, in place): first
- * vertex pairs (i, j >= i + 2) joined straight when the edge is free, then pairs of
- * points on two segments. A shortcut is kept only when free and shorter; failures in
- * a row end each phase (opts[SP_MAX_FAIL]). Returns PC_FREE or PC_ERROR. */
 /* Drop the waypoints of q (*K x n) that lie on the straight segment between their
  * neighbours (to rounding: off it by at most 1e-12 of its length), as RRT-Connect's
  * connect steps leave them: the segments on either side are that segment, already
@@ -50,23 +46,31 @@ static void drop_collinear(double *q, long *K, int n)
     *K = m + 1;
 }
 
+/* Random shortcutting of the path q (*K x n, capacity cap rows, in place): first
+ * vertex pairs (i, j >= i + 2) joined straight when the edge is free (a pair that
+ * failed is not tried again until a shortcut succeeds), then pairs of points on two
+ * segments. A shortcut is kept only when free and shorter; failures in
+ * a row end each phase (opts[SP_MAX_FAIL]). Returns PC_FREE or PC_ERROR. */
+#define SP_MEMO 64 /* vertex pairs remembered as failed (until a shortcut succeeds) */
+
 static int shortcut(Checker *C, double *q, long *K, long cap, const double *opts, Rng *rng)
 {
     const int n = C->M->n;
     const double t0 = now_seconds();
-    long fails = 0;
+    long fails = 0, memo[SP_MEMO][2], nmemo = 0;
     if (*K > 2)
         drop_collinear(q, K, n);
     for (long it = 0; it < (long)opts[SP_VERTEX_TRIES] && *K > 2; it++) {
         if (fails >= (long)opts[SP_MAX_FAIL] || now_seconds() - t0 > opts[SP_TIME])
             break;
-        long i = (long)(rng_uniform(rng) * (double)*K), j = (long)(rng_uniform(rng) * (double)*K);
-        if (i > j) {
-            long x = i;
-            i = j;
-            j = x;
-        }
-        if (j - i < 2) {
+        /* a pair i < j - 1, j uniform after i: a short path has few, so the pairs
+         * that failed since the last success are not checked again */
+        long i = (long)(rng_uniform(rng) * (double)(*K - 2));
+        long j = i + 2 + (long)(rng_uniform(rng) * (double)(*K - i - 2));
+        int seen = 0;
+        for (long k = 0; k < nmemo; k++)
+            seen |= memo[k][0] == i && memo[k][1] == j;
+        if (seen) {
             fails++;
             continue;
         }
@@ -75,11 +79,16 @@ static int shortcut(Checker *C, double *q, long *K, long cap, const double *opts
             return PC_ERROR;
         if (r != PC_FREE) {
             fails++;
+            if (nmemo < SP_MEMO) {
+                memo[nmemo][0] = i;
+                memo[nmemo++][1] = j;
+            }
             continue;
         }
         memmove(q + (size_t)(i + 1) * n, q + (size_t)j * n, (size_t)(*K - j) * n * sizeof(double));
         *K -= j - i - 1;
         fails = 0;
+        nmemo = 0;
     }
     fails = 0;
     double a[MAXJ], b[MAXJ];
