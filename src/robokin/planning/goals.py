@@ -62,6 +62,8 @@ class Goals:
 def outside_limits(q: np.ndarray, limits: np.ndarray) -> str:
     """Why configuration q (n,) is outside the joint limits (n, 2), or ''."""
     lo, hi = limits[:, 0] - LIMIT_TOL, limits[:, 1] + LIMIT_TOL
+    if bool(np.all((q >= lo) & (q <= hi))):
+        return ""
     for j in range(q.shape[0]):
         if q[j] < lo[j]:
             return f"joint {j + 1} at {q[j]:.6g} is below its lower limit {limits[j, 0]:.6g}"
@@ -126,11 +128,10 @@ def goal_configurations(robot: Robot, goal: npt.ArrayLike) -> Goals:
             f"pose (4, 4), got shape {g.shape} ({short_repr(goal)})")
     check_finite(q, "goal")
     limits = np.asarray(robot.limits, dtype=float)
-    reasons = [outside_limits(row, limits) for row in q]
-    keep = np.array([not r for r in reasons], dtype=bool)
+    keep = np.all((q >= limits[:, 0] - LIMIT_TOL) & (q <= limits[:, 1] + LIMIT_TOL), axis=1)
     if not keep.any():
         what = "the goal" if kind == "configuration" else "every goal"
         return Goals(kind, np.zeros((0, n)), np.zeros(0, dtype=np.int64), None,
-                     f"{what} is outside the joint limits: {reasons[0]}")
+                     f"{what} is outside the joint limits: {outside_limits(q[0], limits)}")
     out = np.clip(q[keep], limits[:, 0], limits[:, 1])
     return Goals(kind, np.ascontiguousarray(out), np.flatnonzero(keep))

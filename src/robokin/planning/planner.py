@@ -82,6 +82,7 @@ class Planner:
         self.scene = scene
         self.n = self.model.n
         self.limits = np.asarray(self.robot.limits, dtype=float)
+        self._finite = bool(np.isfinite(self.limits).all())
         self._margins: dict[tuple[float, float], np.ndarray] = {}
 
     def __repr__(self) -> str:
@@ -283,6 +284,8 @@ class Planner:
     def _bounds(self, q0: np.ndarray, goals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Finite sampling bounds: the joint limits (where infinite: around the ends)."""
         lo, hi = self.limits[:, 0].copy(), self.limits[:, 1].copy()
+        if self._finite:
+            return lo, hi
         ends = np.vstack([q0[None], goals])
         bad_lo, bad_hi = ~np.isfinite(lo), ~np.isfinite(hi)
         lo[bad_lo] = ends.min(axis=0)[bad_lo] - math.pi

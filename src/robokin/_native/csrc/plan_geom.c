@@ -337,16 +337,32 @@ static double gjk_lower(const Core *A, const Core *B, double *ub)
 /* ------------------------------------------------------------------ segment-box */
 
 /* The distance between the segment [p, q] and the box |x_a| <= h_a (both in the
- * box's frame), exactly: the squared distance from x(t) = p + t (q - p) to the box
- * is sum_a e_a(t)^2, e_a = max(|x_a| - h_a, 0), a convex quadratic on each piece of
- * [0, 1] between the (at most 6) parameters where some |x_a(t)| = h_a; its minimum
- * on each piece is in closed form, and the smallest of them is the answer. */
+ * box's frame), exactly. The squared distance from x(t) = p + t (q - p) to the box
+ * is f(t) = sum_a e_a(t)^2, e_a = max(|x_a| - h_a, 0): convex, continuously
+ * differentiable, and quadratic between the (at most 6) parameters where some
+ * |x_a(t)| = h_a, so its derivative f' is nondecreasing and linear between them.
+ * The minimum is at t = 0 when f'(0) >= 0, at t = 1 when f'(1) <= 0, else at the
+ * root of f', found on the first piece whose end has f' >= 0 by interpolating f'
+ * linearly there (exact on the piece). */
+static inline double seg_box_slope(const double *p, const double *d, const double *h,
+                                   double t)
+{
+    double g = 0.0;
+    for (int a = 0; a < 3; a++) {
+        double x = p[a] + t * d[a];
+        if (x > h[a])
+            g += (x - h[a]) * d[a];
+        else if (x < -h[a])
+            g += (x + h[a]) * d[a];
+    }
+    return g; /* f'(t) / 2 */
+}
+
 static double seg_box(const double *p, const double *q, const double *h)
 {
-    double d[3], br[8];
+    double d[3], br[7];
     int nb = 0;
     sub3(q, p, d);
-    br[nb++] = 0.0;
     for (int a = 0; a < 3; a++)
         if (d[a] != 0.0)
             for (int s = -1; s <= 1; s += 2) {
@@ -354,44 +370,36 @@ static double seg_box(const double *p, const double *q, const double *h)
                 if (t > 0.0 && t < 1.0)
                     br[nb++] = t;
             }
-    br[nb++] = 1.0;
-    for (int i = 1; i < nb; i++) /* insertion sort: at most 8 values */
+    for (int i = 1; i < nb; i++) /* insertion sort: at most 6 values */
         for (int j = i; j > 0 && br[j] < br[j - 1]; j--) {
             double x = br[j];
             br[j] = br[j - 1];
             br[j - 1] = x;
         }
-    double best = INFINITY;
-    for (int i = 0; i + 1 < nb; i++) {
-        double ta = br[i], tb = br[i + 1], tm = 0.5 * (ta + tb);
-        double A = 0.0, B = 0.0; /* f(t) = sum (alpha + beta t)^2 on this piece */
-        double al[3], be[3];
-        for (int a = 0; a < 3; a++) {
-            double xm = p[a] + tm * d[a];
-            if (xm > h[a]) {
-                al[a] = p[a] - h[a];
-                be[a] = d[a];
-            } else if (xm < -h[a]) {
-                al[a] = -p[a] - h[a];
-                be[a] = -d[a];
-            } else {
-                al[a] = be[a] = 0.0;
+    br[nb++] = 1.0;
+    double t = 1.0, prev = 0.0, g_prev = seg_box_slope(p, d, h, 0.0);
+    if (g_prev >= 0.0) {
+        t = 0.0;
+    } else {
+        for (int i = 0; i < nb; i++) {
+            double g = seg_box_slope(p, d, h, br[i]);
+            if (g >= 0.0) {
+                double span = g - g_prev;
+                t = span > 0.0 ? prev - g_prev * (br[i] - prev) / span : br[i];
+                t = t < prev ? prev : (t > br[i] ? br[i] : t);
+                break;
             }
-            A += be[a] * be[a];
-            B += al[a] * be[a];
+            prev = br[i];
+            g_prev = g;
         }
-        double t = A > 0.0 ? -B / A : ta;
-        t = t < ta ? ta : (t > tb ? tb : t);
-        double f = 0.0;
-        for (int a = 0; a < 3; a++) { /* evaluated from the definition, not the piece */
-            double x = fabs(p[a] + t * d[a]) - h[a];
-            if (x > 0.0)
-                f += x * x;
-        }
-        if (f < best)
-            best = f;
     }
-    return sqrt(best);
+    double f = 0.0;
+    for (int a = 0; a < 3; a++) { /* f at the minimiser, from its definition */
+        double x = fabs(p[a] + t * d[a]) - h[a];
+        if (x > 0.0)
+            f += x * x;
+    }
+    return sqrt(f);
 }
 
 /* The core of a point or segment as its two end points in the world. */
