@@ -103,6 +103,7 @@ class Planner:
         m = self._margins.get(key)
         if m is None:
             m = self._margins[key] = self.model.margins(*key)
+            m.setflags(write=False)  # cached: shared by every query with these margins
         return m
 
     def _q(self, q: npt.ArrayLike, name: str) -> np.ndarray:
