@@ -93,8 +93,10 @@ def test_no_path_is_exit_1_with_the_reason(tmp_path, capsys):
     (["--goal", "nowhere"], "--goal"),
     (["--goal-pose", "1", "2", "3"], "--goal-pose"),
     (["--goal", "pick", "--goal-pose", "pick"], "--goal"),
-    (["--goal", "pick", "--planner", "rrt*"], "planner"),
+    (["--goal", "pick", "--planner", "rrt*"], "--planner"),
     (["--goal", "pick", "--clearance", "-1"], "--clearance"),
+    (["--goal", "pick", "--time-limit", "0"], "--time-limit"),
+    (["--goal", "pick", "--dt", "-0.1"], "--dt"),
 ])
 def test_bad_input_is_exit_2_naming_the_option(args, option, tmp_path, capsys):
     if option is None:  # the well-formed call of this table, for contrast

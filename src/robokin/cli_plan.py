@@ -38,6 +38,9 @@ __all__ = ["plan_command"]
 
 #: The files ``robokin plan`` writes into ``--out``.
 OUTPUTS = ("plan.csv", "plan.png")
+#: The options behind the arguments of Planner.plan and Planner.trajectory.
+_OPTIONS = {"time_limit": "--time-limit", "seed": "--seed", "planner": "--planner",
+            "dt": "--dt", "goal": "--goal-pose", "start": "--start"}
 
 
 def _numbers(text: str) -> list[float] | None:
@@ -171,11 +174,17 @@ def plan_command(
     target = (_configuration(goal, "--goal", rob, sc, deg, mm) if goal is not None
               else _pose(str(goal_pose), sc, deg, mm))
     pl = planning.Planner(rob, sc)
-    res = pl.plan(q0, target, time_limit=time_limit, seed=seed, planner=planner,
-                  clearance=clearance * 1e-3)
-    if not res.success:
-        raise DomainFailure(f"no path: {res.reason}")
-    traj = pl.trajectory(res, clearance=clearance * 1e-3, dt=dt)
+    try:
+        res = pl.plan(q0, target, time_limit=time_limit, seed=seed, planner=planner,
+                      clearance=clearance * 1e-3)
+        if not res.success:
+            raise DomainFailure(f"no path: {res.reason}")
+        traj = pl.trajectory(res, clearance=clearance * 1e-3, dt=dt)
+    except InputError as exc:  # name the option, not the function argument
+        option = _OPTIONS.get(exc.argument)
+        if option is None:
+            raise
+        raise InputError(option, exc.reason) from None
     out.mkdir(parents=True, exist_ok=True)
     targets = [(out / n, "--out", force) for n in names]
     with staged_outputs(targets, how="pass --force (or choose another --out)") as staged:
