@@ -5,26 +5,40 @@ as separate extension modules: ``robokin._native._base`` for the compiler's
 baseline target and, on x86-64 with GCC or clang, ``_avx2`` (AVX2 + FMA) and
 ``_avx512`` (AVX-512 F/DQ/VL). At import ``robokin._native`` picks the copy the CPU
 runs. Nothing is compiled at run time.
+
+Building from source needs a C compiler and the Python headers (the wheels need
+neither). Before compiling, the build checks both with a two-line test file and
+stops with one line saying what is missing, instead of the compiler's or
+setuptools' own error.
 """
 
+import os
 import platform
+import shutil
 import sys
+import tempfile
 
 import numpy
 from setuptools import Extension, setup
+from setuptools.command.build_ext import build_ext
+from setuptools.errors import CompileError, PlatformError
 
 CSRC = "src/robokin/_native/csrc"
 HEADERS = [f"{CSRC}/{h}" for h in ("lanes.h", "chain.h", "pool.h", "pool.c", "fk.c",
-                                     "lm.c", "nearest.c", "six_r.c", "broadphase.c",
-                                     "plan_geom.c", "plan_check.c", "plan_rrtc.c",
-                                     "plan_path.c", "general6r.c", "module.c")]
+                                     "lm.c", "nearest.c", "six_r.c", "broadphase.c", "general6r.c",
+                                     "manipulability.c", "pieper.c", "plan_geom.c", "plan_check.c",
+                                     "plan_rrtc.c", "plan_path.c", "module.c")]
 UNIX = sys.platform != "win32"
 # -fno-math-errno: sqrt inlines (and vectorises); no other fast-math licence
 FLAGS = ["-O3", "-fno-math-errno", "-Wno-psabi"] if UNIX else ["/O2"]
 LIBS = ["pthread"] if UNIX else []
+HOW = ("README.md, 'Installing', says what a source build needs; a wheel (built "
+       "by .ci/wheel) installs without either")
+PROBE = "#include <Python.h>\nint robokin_probe(void) { return 0; }\n"
 
 
 def extension(name: str, source: str, extra: list[str]) -> Extension:
+    """One instruction-set copy of the kernels: ``robokin._native.<name>``."""
     return Extension(
         f"robokin._native.{name}",
         [f"{CSRC}/{source}"],
@@ -35,10 +49,44 @@ def extension(name: str, source: str, extra: list[str]) -> Extension:
     )
 
 
+class BuildExt(build_ext):
+    """``build_ext`` that first checks for a C compiler and the Python headers."""
+
+    def build_extensions(self) -> None:
+        """Check the toolchain (unix compilers), then compile every extension."""
+        if self.compiler.compiler_type == "unix":
+            self._check_toolchain()
+        super().build_extensions()
+
+    def _check_toolchain(self) -> None:
+        cc = self.compiler.compiler_so[0]
+        if shutil.which(cc) is None:
+            origin = "named by CC" if os.environ.get("CC") else "Python's default"
+            raise PlatformError(
+                f"robokin: no C compiler: {cc!r} ({origin}) was not found; install "
+                f"one (Debian/Ubuntu: apt-get install gcc python3-dev) or set CC; {HOW}")
+        dirs = list(self.include_dirs or [])
+        if not any(os.path.isfile(os.path.join(d, "Python.h")) for d in dirs):
+            raise PlatformError(
+                f"robokin: no Python headers (Python.h is not in "
+                f"{', '.join(dirs) or 'any include folder'}); install them (Debian/Ubuntu: apt-get install python3-dev, Fedora: "
+                f"dnf install python3-devel); {HOW}")
+        with tempfile.TemporaryDirectory() as tmp:
+            probe = os.path.join(tmp, "probe.c")
+            with open(probe, "w") as fh:
+                fh.write(PROBE)
+            try:
+                self.compiler.compile([probe], output_dir=tmp, include_dirs=dirs)
+            except CompileError as exc:
+                raise PlatformError(
+                    f"robokin: the C compiler {cc!r} cannot build a Python extension "
+                    f"here ({exc}); {HOW}") from None
+
+
 modules = [extension("_base", "build_base.c", [])]
 if UNIX and platform.machine().lower() in ("x86_64", "amd64"):
     modules.append(extension("_avx2", "build_avx2.c", ["-mavx2", "-mfma"]))
     modules.append(extension("_avx512", "build_avx512.c",
                              ["-mavx512f", "-mavx512dq", "-mavx512vl", "-mavx2", "-mfma"]))
 
-setup(ext_modules=modules)
+setup(ext_modules=modules, cmdclass={"build_ext": BuildExt})

@@ -1,7 +1,7 @@
 """Cell design at scale: reachability-map throughput on Dask against the bare batch IK.
 
 Run: ``python benchmarks/bench_cell.py [--voxel 0.05] [--orientations 32] [--rounds 3]
-[--rss-evals 1e8] [--sweep]``.
+[--rss-evals 1e8] [--sweep] [--core]``.
 
 Everything side by side in one run, on the UR5 over its default region (the
 workspace bounds), after checking correctness:
@@ -10,7 +10,9 @@ workspace bounds), after checking correctness:
    ``distributed.LocalCluster`` of two workers are compared array by array (bit
    for bit); random (voxel, orientation) pairs are re-solved by direct IK
    (``robot.ik`` one pose at a time) and must agree 100 %; the best
-   manipulability of random voxels is compared with ``robot.manipulability``.
+   manipulability of random voxels is compared with ``robot.manipulability``;
+   the cost of one manipulability, compiled (``|det J|``, ``manipulability.c``)
+   and the old way (a stored Jacobian and ``numpy.linalg.det``).
 2. **Throughput, in alternating rounds** (medians; the box is shared, so each
    round measures every variant back to back):
 
@@ -52,6 +54,8 @@ from robokin.cell.grid import VoxelGrid, tool_orientations
 from robokin.cell.reach_map import _REGION_MARGIN, _REGION_SAMPLES, _default_chunk
 
 FIELDS = ("counts", "index", "solutions", "manipulability")
+CORE = ("bare batch IK (robot.ik)", "map work, no Dask, w off", "map work, no Dask, w on",
+        "LocalCluster 2x1, w off", "LocalCluster 2x1, w on")
 
 
 def rate(n: int, seconds: float) -> float:
@@ -155,6 +159,33 @@ def check_correctness(robot, kw, client, samples: int, rng) -> None:
         raise SystemExit("the map disagrees with direct IK")
 
 
+def manipulability_cost(robot, rng, count: int = 500_000, rounds: int = 5) -> None:
+    """ns per configuration, one thread: the compiled |det J| (manipulability.c)
+    against a stored Jacobian and numpy.linalg.det (the map's path before issue 25)."""
+    from robokin.kinematics.jacobian import jacobian, manipulability
+
+    q = robot.limits[:, 0] + rng.random((count, robot.n)) * np.ptp(robot.limits, axis=1)
+    ok = rng.random(count) < 0.5  # an IK solution set's valid rows
+    before = num_threads()
+    set_num_threads(1)
+    try:
+        fused, stored = [], []
+        for _ in range(rounds):
+            t = time.perf_counter()
+            w = manipulability(robot.chain, q, method="det", where=ok)
+            fused.append((time.perf_counter() - t) / ok.sum() * 1e9)
+            t = time.perf_counter()
+            ref = np.abs(np.linalg.det(jacobian(robot.chain, q[ok])))
+            stored.append((time.perf_counter() - t) / ok.sum() * 1e9)
+    finally:
+        set_num_threads(before)
+    worst = float(np.max(np.abs(w[ok] - ref)) / ref.max())
+    print(f"manipulability per solution, one thread ({rounds} rounds, min-max): compiled "
+          f"|det J| {min(fused):.0f}-{max(fused):.0f} ns, stored Jacobian + numpy det "
+          f"{min(stored):.0f}-{max(stored):.0f} ns; largest difference / largest w "
+          f"{worst:.1e}")
+
+
 def projection(robot, per_core: dict[str, float]) -> None:
     region = default_region(robot, _REGION_SAMPLES, _REGION_MARGIN)
     g = VoxelGrid.from_region(region, 0.005)
@@ -215,6 +246,9 @@ def main() -> None:
     ap.add_argument("--rss-evals", type=float, default=1e8, help="0 to skip")
     ap.add_argument("--rss-orientations", type=int, default=200)
     ap.add_argument("--sweep", action="store_true", help="also time chunk sizes")
+    ap.add_argument("--core", action="store_true",
+                    help="only bare IK, the work without Dask and LocalCluster 2x1 (w off, "
+                         "w on): more rounds in a quiet window")
     args = ap.parse_args()
 
     from distributed import Client
@@ -242,6 +276,7 @@ def main() -> None:
             local_cluster(1) as lc1, Client(lc1) as c1, \
             tempfile.TemporaryDirectory() as tmp:
         check_correctness(robot, {**kw, "voxel": args.voxel * 2}, c2, args.samples, rng)
+        manipulability_cost(robot, rng)
         wall: dict[str, list[float]] = {}
         cpu: dict[str, list[float]] = {}
         here, pids2, pids1 = [os.getpid()], cluster_pids(c2), cluster_pids(c1)
@@ -273,6 +308,8 @@ def main() -> None:
             "LocalCluster 1x1, w on": (lambda: cell.reach_map(
                 robot, **kw, scheduler=c1), pids1),
         }
+        if args.core:
+            variants = {k: v for k, v in variants.items() if k in CORE}
         for r in range(args.rounds):
             for label, (fn, pids) in variants.items():
                 set_num_threads(all_threads)
@@ -296,7 +333,14 @@ def main() -> None:
                   f"{med[label]:7.3f} {100 * med[label] / med[ref]:5.1f}%   "
                   f"{medc[label]:6.3f} {100 * medc[label] / medc[ref]:5.1f}%   "
                   + ", ".join(f"{x:.3f}" for x in wall[label]))
+        for label in ("LocalCluster 2x1, w off", "LocalCluster 2x1, w on"):
+            ratio = [100 * a / b for a, b in zip(wall[label], wall[ref])]
+            print(f"  {label} / bare batch IK, round by round (back to back): "
+                  f"{min(ratio):.0f}-{max(ratio):.0f} %, median "
+                  f"{statistics.median(ratio):.0f} %")
         for kind, m in (("wall, best", best), ("wall, median", med), ("CPU, median", medc)):
+            if args.core:
+                break
             print(f"  {kind}: LocalCluster 2 vs 1 worker "
                   f"{m['LocalCluster 2x1, w off'] / m['LocalCluster 1x1, w off']:.2f}x (w off), "
                   f"{m['LocalCluster 2x1, w on'] / m['LocalCluster 1x1, w on']:.2f}x (w on); "
@@ -312,6 +356,8 @@ def main() -> None:
                 t = min(timed_map(robot, kw, scheduler=c2, chunk=b) for _ in range(2))
                 print(f"  {b * K:>8,} targets per task ({-(-V // b)} tasks): "
                       f"{rate(N, t):.3f} M/s")
+    if args.core:
+        return
     projection(robot, {"1 worker, w off, best": best["LocalCluster 1x1, w off"],
                        "1 worker, w on, best": best["LocalCluster 1x1, w on"],
                        "2 workers / 2, w off, best": best["LocalCluster 2x1, w off"] / 2,

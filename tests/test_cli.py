@@ -217,3 +217,64 @@ def test_fk_outside_the_limits_notes_the_joint_and_its_limits(capsys, args, note
     assert len(err.splitlines()) == 1
     code, _, err = run(capsys, "fk", "aubo_i5", "3.05", "0", "0", "0", "0", "0")
     assert code == 0 and err == ""  # inside: nothing to say
+
+
+# ------------------------------------------------------------ issue 25: first hour
+def test_fk_mm_prints_the_matrix_in_mm_too(capsys):
+    """The 4x4's translation is in the unit of the xyz line (oracle: robot.fk)."""
+    q = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6]
+    T = robokin.load("ur5").fk(np.array(q))
+    code, out, _ = run(capsys, "fk", "ur5", *map(str, q), "--mm")
+    assert code == 0
+    rows = [ln.strip(" []") for ln in out.splitlines() if ln.lstrip().startswith("[")]
+    matrix = np.array([[float(v) for v in r.split()] for r in rows])
+    np.testing.assert_allclose(matrix[:3, 3], T[:3, 3] * 1000, atol=1e-6)
+    np.testing.assert_allclose(matrix[:3, :3], T[:3, :3], atol=1e-6)
+    assert "translation in mm" in out
+    code, out, _ = run(capsys, "fk", "ur5", *map(str, q), "--mm", "--json")
+    doc = json.loads(out)
+    np.testing.assert_allclose(np.array(doc["pose"])[:3, 3], T[:3, 3] * 1000, atol=1e-9)
+    assert doc["units"] == {"length": "mm", "angle": "rad"}
+
+
+def test_ik_of_a_redundant_arm_says_it_is_a_sample_and_fixed_holds_a_joint(capsys):
+    """Oracle: the Panda configuration that made the pose comes back with --fixed
+    joint7 held at its value, and every listed row reaches the pose."""
+    panda = robokin.load("panda")
+    q = np.array([0.1, -0.3, 0.2, -2.0, 0.3, 1.8, 0.7])
+    T = panda.fk(q)
+    from robokin.spatial import rpy_from_matrix
+
+    pose = [*map(str, T[:3, 3]), *map(str, rpy_from_matrix(T))]
+    code, out, _ = run(capsys, "ik", "panda", *pose)
+    assert code == 0
+    assert "panda: a sample of" in out and "of a continuum" in out
+    assert "--fixed joint7=VALUE" in out
+    pose_deg = [*map(str, T[:3, 3]), *map(str, np.degrees(rpy_from_matrix(T)))]
+    code, out, _ = run(capsys, "ik", "panda", *pose_deg, "--fixed",
+                       "joint7=40.10704565915762", "--deg", "--json")
+    assert code == 0, out
+    doc = json.loads(out)
+    assert doc["fixed"] == {"joint7": pytest.approx(40.10704565915762)}
+    assert not doc["sample_of_continuum"]
+    sols = np.radians([s["q"] for s in doc["solutions"]])
+    np.testing.assert_allclose(sols[:, 6], 0.7, atol=1e-12)
+    np.testing.assert_allclose(panda.fk(sols), np.broadcast_to(T, (len(sols), 4, 4)),
+                               atol=1e-9)
+    assert np.abs(sols - q).max(axis=1).min() < 1e-9
+    # a six-joint arm: no note
+    code, out, _ = run(capsys, "ik", "ur5", "0.4", "0.1", "0.5", "3.1", "0", "0")
+    assert code == 0 and "continuum" not in out
+
+
+@pytest.mark.parametrize(("fixed", "match"), [
+    ("joint9=1", "unknown joint 'joint9'; joints: joint1"),
+    ("joint7", "expected NAME=VALUE"),
+    ("joint7=x", "expected a number for joint7"),
+    ("joint7=nan", "expected a finite number"),
+])
+def test_ik_fixed_errors_name_the_option(capsys, fixed, match):
+    code, _, err = run(capsys, "ik", "panda", "0.4", "0.1", "0.5", "3.1", "0", "0",
+                       "--fixed", fixed)
+    assert code == 2 and "argument '--fixed'" in err and match in err
+    _one_line(err)

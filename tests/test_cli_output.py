@@ -197,6 +197,48 @@ def test_traj_rerun_needs_force_and_replaces(tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.csv", "m.png", "m.yaml"]
 
 
+def test_traj_rerun_blames_no_option_the_user_did_not_give(tmp_path, capsys):
+    """Issue 25: re-running `traj m.yaml` said "argument '-o'" though no -o was given."""
+    f = tmp_path / "m.yaml"
+    f.write_text(MOTION)
+    assert run(capsys, "traj", str(f))[0] == 0
+    code, _, err = run(capsys, "traj", str(f))
+    assert code == 2 and err.count("\n") == 1
+    assert "'-o'" not in err and "'--plot'" not in err
+    assert (f"{tmp_path / 'm.csv'} and {tmp_path / 'm.png'} exist (written next to "
+            "m.yaml by an earlier run); pass --force to replace them") in err
+    code, _, err = run(capsys, "traj", str(f), "--no-plot")
+    assert code == 2 and f"{tmp_path / 'm.csv'} exists" in err and "or -o to" in err
+    # an explicit -o is replaced, as its help says
+    code, _, err = run(capsys, "traj", str(f), "-o", str(tmp_path / "m.csv"),
+                       "--no-plot")
+    assert code == 0, err
+
+
+def test_workspace_refuses_to_overwrite_an_earlier_run_without_force(tmp_path, capsys):
+    """Issue 25: `workspace` replaced its folder's files while `traj` refused."""
+    out = tmp_path / "ws"
+    args = ["workspace", "scara", "--samples", "2000", "--out", str(out)]
+    assert run(capsys, *args)[0] == 0
+    written = {p.name: p.read_bytes() for p in out.iterdir()}
+    assert sorted(written) == ["scara_workspace.json", "scara_workspace_xy.png",
+                               "scara_workspace_xz.png"]
+    code, _, err = run(capsys, *args[:-4], "--samples", "3000", "--out", str(out))
+    assert code == 2 and "argument '--out'" in err and "pass --force" in err
+    assert "scara_workspace.json" in err
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == written
+    code, _, err = run(capsys, *args[:-4], "--samples", "3000", "--out", str(out),
+                       "--force")
+    assert code == 0, err
+    assert (out / "scara_workspace.json").read_bytes() != written["scara_workspace.json"]
+    # a folder with other files is not an earlier run: nothing of it is replaced
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "notes.txt").write_text("mine")
+    assert run(capsys, *args[:-1], str(other))[0] == 0
+    assert (other / "notes.txt").read_text() == "mine"
+
+
 def test_traj_writes_all_outputs_or_none(tmp_path, capsys):
     f = tmp_path / "m.yaml"
     f.write_text(MOTION)

@@ -128,3 +128,32 @@ def test_import_reports_every_shape_it_leaves_out(tmp_path, capsys):
     assert "gone.stl" in notes[0] and "remote" in notes[1] and "notes.txt" in notes[2]
     text = out.read_text()
     assert "notes.txt" not in text and ".stl" not in text and "geometry" not in text
+
+
+def test_import_notes_a_missing_package_once(capsys, tmp_path, monkeypatch):
+    """Issue 25: irb140.urdf's 14 meshes of one missing package made 14 notes of ~400
+    characters. Oracle: the URDF itself, whose 14 meshes all name that package."""
+    import warnings
+
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    monkeypatch.delenv("AMENT_PREFIX_PATH", raising=False)
+    urdf = DATA / "irb140.urdf"
+    n_meshes = urdf.read_text().count('filename="package://abb_irb140_support/')
+    assert n_meshes == 14
+    code, _, err = run(capsys, "import", str(urdf), "-o", str(tmp_path / "irb.yaml"))
+    assert code == 0
+    notes = [ln for ln in err.splitlines() if ln.startswith("robokin: note:")]
+    assert len(notes) == 1, err
+    assert notes[0].startswith("robokin: note: left out 14 visual and collision meshes "
+                               "of links base_link, link_1, link_2, link_3, link_4, "
+                               "link_5, link_6: package 'abb_irb140_support' not found")
+    assert "--package abb_irb140_support=DIR" in notes[0]
+    # the API: every shape still listed, one warning for the one reason
+    from robokin.io.urdf import robot_from_urdf
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        robot = robot_from_urdf(urdf)
+    assert len(robot.meta["urdf_dropped_shapes"]) == 14
+    assert [str(w.message)[:20] for w in caught] == ["left out 14 visual a"]
+    assert caught[0].filename == __file__  # points at the caller

@@ -56,6 +56,15 @@ def test_there_are_examples():
     assert {"00_modelling", "01_kinematics", "02_motion", "03_collision"} <= folders
 
 
+def test_example_folders_are_numbered_uniquely():
+    """Issue 25: two folders were numbered 05_."""
+    folders = sorted(p.name for p in EXAMPLES.iterdir() if p.is_dir()
+                     and not p.name.startswith((".", "__")))
+    numbers = [name.split("_", 1)[0] for name in folders]
+    assert all(n.isdigit() and len(n) == 2 for n in numbers), folders
+    assert len(set(numbers)) == len(numbers), folders
+
+
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: f"{p.parent.name}/{p.name}")
 def test_example_shape(script):
     source = script.read_text()

@@ -5,7 +5,8 @@
 """Workspace of the SCARA and a standalone HTML animation of the UR5.
 
 Samples 300,000 SCARA configurations inside the joint limits (batch FK), prints
-the reachable bounds and a voxel volume estimate, saves the XY / XZ sections
+the reachable bounds and the volume of its position workspace (Monte Carlo, with
+its standard error), saves the XY / XZ sections
 coloured by manipulability, then writes a self-contained HTML file that plays
 a UR5 motion in any browser with no server and no network.
 
@@ -36,7 +37,8 @@ def main(out_dir: Path = Path("robokin-examples") / "visualisation") -> None:
     lo, hi = ws.bounds * 1000  # [mm]
     print(
         f"SCARA workspace: x {lo[0]:.0f}..{hi[0]:.0f}, y {lo[1]:.0f}..{hi[1]:.0f}, "
-        f"z {lo[2]:.0f}..{hi[2]:.0f} mm; volume about {ws.volume:.3f} m^3"
+        f"z {lo[2]:.0f}..{hi[2]:.0f} mm; volume {ws.volume:.4f} "
+        f"+- {ws.volume_std_error:.4f} m^3"
     )
     out_dir.mkdir(parents=True, exist_ok=True)
     for path in save_workspace_plots(ws, out_dir):

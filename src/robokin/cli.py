@@ -201,7 +201,11 @@ def fk(
         bool, typer.Option("--json", help="Machine-readable output.")
     ] = False,
 ) -> None:
-    """Forward kinematics: the tool pose as a matrix, position and RPY."""
+    """Forward kinematics: the tool pose as a matrix, position and RPY.
+
+    With --mm every length is in millimetres (the matrix's translation too), with
+    --deg every angle in degrees; --json says which under "units".
+    """
     import numpy as np
 
     from robokin.spatial import rpy_from_matrix
@@ -221,20 +225,24 @@ def fk(
     rpy = rpy_from_matrix(T)
     L = 1000.0 if mm else 1.0
     A = 180 / math.pi if deg else 1.0
+    shown = T.copy()
+    shown[:3, 3] *= L  # the matrix in the same length unit as xyz
+    lu, au = ("mm" if mm else "m"), ("deg" if deg else "rad")
     if as_json:
         print(
             json_text(
                 {
-                    "pose": T.tolist(),
+                    "pose": shown.tolist(),
                     "xyz": (T[:3, 3] * L).tolist(),
                     "rpy": (rpy * A).tolist(),
+                    "units": {"length": lu, "angle": au},
                 }
             )
         )
         return
     con = _console()
-    con.print(np.array2string(T, precision=6, suppress_small=True))
-    lu, au = ("mm" if mm else "m"), ("deg" if deg else "rad")
+    con.print(f"tool pose (4x4, translation in {lu}):", markup=False)
+    con.print(np.array2string(shown, precision=6, suppress_small=True), markup=False)
     con.print(
         f"xyz [{lu}]: " + "  ".join(f"{v:.6f}" for v in T[:3, 3] * L), markup=False
     )

@@ -205,7 +205,8 @@ def reach_command(
     table.add_row("orientations", f"{summary['orientations']} per voxel "
                   f"({summary['ik_evaluations']:,} IK targets)")
     table.add_row("reachable", f"{summary['reachable_voxels']:,} voxels, "
-                  f"{summary['reachable_volume_m3']:.4f} m³")
+                  f"{summary['reachable_volume_m3']:.4f} m³ (voxel centres reached in "
+                  "any orientation tried)")
     table.add_row("every orientation", f"{summary['dexterous_voxels']:,} voxels")
     if summary["manipulability_max"] is not None:
         table.add_row("best manipulability", f"{summary['manipulability_max']:.4g}")

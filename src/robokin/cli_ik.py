@@ -3,14 +3,57 @@
 from __future__ import annotations
 
 import math
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
 from robokin.cli import DomainFailure, _load, app, json_text
 from robokin.cli_output import Column, FormatOption, OutputTable, emit, resolve_format
+from robokin.exceptions import InputError
 
 __all__ = ["ik"]
+
+
+def _held_joints(robot: Any, items: list[str], A: float, L: float) -> dict[str, float]:
+    """``--fixed NAME=VALUE`` options as ``{joint: value [rad, m]}``."""
+    held: dict[str, float] = {}
+    for item in items:
+        name, sep, text = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise InputError("--fixed", f"expected NAME=VALUE, got {item!r}")
+        if name not in robot.joint_names:
+            raise InputError("--fixed", f"unknown joint {name!r}; joints: "
+                             + ", ".join(robot.joint_names))
+        try:
+            value = float(text)
+        except ValueError:
+            raise InputError("--fixed", f"expected a number for {name}, got "
+                             f"{text!r}") from None
+        if not math.isfinite(value):
+            raise InputError("--fixed", f"expected a finite number for {name}, got "
+                             f"{text!r}")
+        revolute = robot.is_revolute[robot.joint_names.index(name)]
+        held[name] = value / (A if revolute else L)
+    return held
+
+
+def _continuum_note(robot: Any, sols: Any, held: dict[str, float]) -> str | None:
+    """The note for a redundant arm: the solutions listed are a sample of a continuum.
+
+    None when the pose (and the held joints) leave finitely many solutions.
+    """
+    mask = str(sols.info.get("mask", "x y z rx ry rz")) if isinstance(
+        sols.info, dict) else "x y z rx ry rz"
+    constrained = len(mask.split())
+    free = robot.n - len(held)
+    if free <= constrained:
+        return None
+    example = next(n for n in reversed(robot.joint_names) if n not in held)
+    return (f"{robot.name} has {free} free joints for {constrained} pose components: "
+            f"its solutions form a continuum ({free - constrained}-dimensional "
+            f"self-motion) and these are a sample of it; --fixed {example}=VALUE "
+            "holds a joint and lists every solution of the others")
 
 
 @app.command(context_settings={"ignore_unknown_options": True})
@@ -30,11 +73,21 @@ def ik(
     method: Annotated[str, typer.Option(help="auto | analytic | numeric")] = "auto",
     limits: Annotated[bool, typer.Option("--limits", help="Only solutions inside the "
                                                             "joint limits.")] = False,
+    fixed: Annotated[list[str] | None, typer.Option(
+        "--fixed", help="NAME=VALUE: hold this joint at VALUE (rad/m, or deg/mm with "
+        "--deg/--mm) and solve the others; repeatable. For arms with more joints than "
+        "the pose constrains (the Panda's 7), every solution with that joint held.")
+    ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
                        ] = False,
     output_format: FormatOption = None,
 ) -> None:
-    """Inverse kinematics: every solution for the pose x y z roll pitch yaw."""
+    """Inverse kinematics: every solution for the pose x y z roll pitch yaw.
+
+    For an arm with more joints than the pose constrains (the Panda) the solutions
+    form a continuum: the table is a sample of it, and --fixed NAME=VALUE holds
+    joints to list every solution of the others.
+    """
     import numpy as np
 
     from robokin.kinematics.ik.analytic._common import fk_error
@@ -59,7 +112,15 @@ def ik(
         if len(vals) != r.n:
             raise typer.BadParameter(f"--near needs {r.n} values, got {len(vals)}")
         q_near = np.where(rev, np.array(vals) / A, np.array(vals) / L)
-    sols = r.ik(T, q_near=q_near, method=method)
+    held = _held_joints(r, fixed or [], A, L)
+    options = {} if not held else {"fixed": held}
+    try:
+        sols = r.ik(T, q_near=q_near, method=method, **options)
+    except InputError as exc:
+        if exc.argument != "fixed":
+            raise
+        raise InputError("--fixed", exc.reason) from None
+    continuum = _continuum_note(r, sols, held)
     if limits:
         sols = sols.keep_within_limits()
     q = sols.q[sols.valid]
@@ -74,6 +135,9 @@ def ik(
     if fmt == "json":
         print(json_text({
             "method": sols.method, "status": status,
+            "fixed": {k: float(v * (A if r.is_revolute[r.joint_names.index(k)] else L))
+                      for k, v in held.items()},
+            "sample_of_continuum": continuum is not None,
             "solutions": [
                 {"q": disp[i].tolist(),
                  "flags": {k: bool(v[i]) for k, v in flags.items()},
@@ -85,7 +149,9 @@ def ik(
         au, lu = ("deg" if deg else "rad"), ("mm" if mm else "m")
         units = [au if rv else lu for rv in rev]
         table = OutputTable(
-            f"{r.name}: {len(q)} solution(s) [{sols.method}]; angles {au}, lengths {lu}",
+            f"{r.name}: {'a sample of ' if continuum else ''}{len(q)} solution(s)"
+            f"{' of a continuum' if continuum else ''} [{sols.method}]; angles {au}, "
+            f"lengths {lu}",
             [Column("#", right=True),
              *[Column(f"q{j + 1} [{u}]", fmt=lambda v: f"{v:.6f}", right=True)
                for j, u in enumerate(units)],
@@ -102,6 +168,8 @@ def ik(
         table.notes.append(
             "FK err: max of position [m] and rotation [rad] error"
             + ("; sorted by distance from --near" if q_near is not None else ""))
+        if continuum is not None:
+            table.notes.append(continuum)
         emit(table, fmt)
     if not len(q):
         raise DomainFailure(f"no IK solution: {status}")

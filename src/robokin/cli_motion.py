@@ -16,6 +16,7 @@ from robokin.cli_output import FormatOption, resolve_format
 from robokin.io.motion_files import (
     MAX_MOTION_SAMPLES,
     load_motion_file,
+    motion_limits,
     plan_from_document,
 )
 
@@ -107,20 +108,17 @@ def traj(
                    + [(p, arg) for p, arg in ((ros2, "--ros2"), (program, "--program"))
                       if p is not None],
                    [(path, "FILE"), (robot.path, "(the motion file's robot)")])
-    with staged_outputs(outputs, how="pass --force (or give -o / --plot)") as staged:
+    if not force:
+        _refuse_earlier_run([(p, opt) for (p, opt, _), given in
+                             zip(outputs, (output, plot)) if given is None], path)
+    with staged_outputs(outputs, how="pass --force") as staged:
         write_csv(tr, staged[0], robot.joint_names, rates=rates)
         if png is not None:
             from robokin.viz.plots import plot_joints
 
             plot_joints(tr, path=staged[1], title=f"{robot.name}: {path.name}"[:200])
     extra = _controller_outputs(robot, tr, ros2, ros2_goal, ros2_stride, program)
-    L = 1e-3 if spec.units.length == "mm" else 1.0
-    A = math.pi / 180.0 if spec.units.angle == "deg" else 1.0
-    jscale = np.where(robot.is_revolute, A, L)
-    vel = None if spec.limits.velocity is None else np.broadcast_to(
-        np.asarray(spec.limits.velocity, float), (robot.n,)) * jscale
-    acc = None if spec.limits.acceleration is None else np.broadcast_to(
-        np.asarray(spec.limits.acceleration, float), (robot.n,)) * jscale
+    vel, acc = motion_limits(spec, robot, path)
     report = tr.check_limits(robot, velocity=vel, acceleration=acc)
     peaks = tr.peaks()
     su = np.where(robot.is_revolute, 180 / math.pi, 1000.0)
@@ -159,6 +157,27 @@ def traj(
                 say(f"limit violated: {v}", fmt)
     if not report.ok:
         raise DomainFailure(f"{len(report)} limit violation(s); first: {report.first()}")
+
+
+def _refuse_earlier_run(defaults: list[tuple[Path, str]], motion: Path) -> None:
+    """Outputs named after the motion file (no -o / --plot) need --force to be replaced.
+
+    The error names the files and the motion file, not an option the user did not
+    give.
+    """
+    import os
+
+    from robokin.exceptions import InputError
+
+    there = [(p, opt) for p, opt in defaults if os.path.lexists(p)]
+    if not there:
+        return
+    many = len(there) > 1
+    names = " and ".join(str(p) for p, _ in there)
+    options = " / ".join(opt for _, opt in there)
+    raise InputError("FILE", f"{names} {'exist' if many else 'exists'} (written next "
+                     f"to {motion.name} by an earlier run); pass --force to replace "
+                     f"{'them' if many else 'it'}, or {options} to write elsewhere")
 
 
 def _controller_outputs(robot: Robot, tr: Trajectory, ros2: Path | None, goal: bool,

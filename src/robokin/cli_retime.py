@@ -2,8 +2,10 @@
 
 Reads a motion file (YAML, planned as ``robokin traj`` plans it) or a trajectory
 CSV (with ``--robot``), retimes the same path to its minimum cycle time within the
-robot file's joint speed and acceleration limits (or those given), and writes into
-``--out``:
+joint speed and acceleration limits, and writes into ``--out``. The limits are, for
+each kind, those of the option (``--v-max``, ``--a-max``, ``--j-max``), else the
+motion file's ``limits:``, else the robot file's ``rate_limits:``; the command says
+which it used (``cycle_time.json`` too, under ``limits.sources``). Files:
 
 * ``retimed.csv`` -- the time-optimal motion (time, joints, velocities,
   accelerations; SI units);
@@ -54,14 +56,22 @@ def _per_joint(text: str | None, option: str, scale: Any) -> Any:
     return vals * scale
 
 
-def _load(file: Path, robot: str | None) -> tuple[Any, Any]:
-    """The robot and the trajectory of a motion file or a trajectory CSV."""
+def _load(file: Path, robot: str | None) -> tuple[Any, Any, dict[str, Any]]:
+    """The robot, the trajectory and the file's own limits (SI; motion files only).
+
+    The limits are ``{"v_max": (n,) or None, "a_max": (n,) or None}`` from a motion
+    file's ``limits:``; a trajectory CSV has none.
+    """
     import robokin
     from robokin.exceptions import InputError
 
     suffix = file.suffix.lower()
     if suffix in (".yaml", ".yml"):
-        from robokin.io.motion_files import load_motion_file, plan_from_document
+        from robokin.io.motion_files import (
+            load_motion_file,
+            motion_limits,
+            plan_from_document,
+        )
         from robokin.trajectory import PathError
 
         if robot is not None:
@@ -69,9 +79,11 @@ def _load(file: Path, robot: str | None) -> tuple[Any, Any]:
                              "for trajectory CSVs")
         spec, path = load_motion_file(file)
         try:
-            return plan_from_document(spec, path)
+            rob, traj = plan_from_document(spec, path)
         except PathError as exc:
             raise DomainFailure(str(exc)) from None
+        v_max, a_max = motion_limits(spec, rob, path)
+        return rob, traj, {"v_max": v_max, "a_max": a_max}
     if suffix == ".csv":
         from robokin.trajectory.io import read_csv
 
@@ -80,9 +92,43 @@ def _load(file: Path, robot: str | None) -> tuple[Any, Any]:
                              "name or a robot file)")
         rob = robokin.load(robot)
         return rob, read_csv(file, joint_names=rob.joint_names,
-                             is_revolute=rob.is_revolute)
+                             is_revolute=rob.is_revolute), {}
     raise InputError("TRAJ", f"expected a motion file (.yaml) or a trajectory CSV "
                      f"(.csv), got {file.name!r}")
+
+
+def _choose_limits(options: dict[str, Any], own: dict[str, Any], file: Path,
+                   robot: Any) -> dict[str, str]:
+    """Fill ``options`` with the motion file's limits where no option gives one.
+
+    Returns where each limit comes from, for the user: the option, the motion
+    file's ``limits:`` or the robot file's ``rate_limits:``.
+    """
+    robot_file = f"{robot.name}'s robot file (rate_limits:)"
+    sources = {}
+    for key, kind in (("v_max", "velocity"), ("a_max", "acceleration"),
+                      ("j_max", "jerk")):
+        if isinstance(options[key], str):  # --j-max robot
+            sources[kind] = robot_file
+        elif options[key] is not None:
+            sources[kind] = _ARGS[key]
+        elif own.get(key) is not None:
+            options[key] = own[key]
+            sources[kind] = f"{file.name} (limits:)"
+        elif key != "j_max":
+            sources[kind] = robot_file
+    if options["tool_speed"] is not None:
+        sources["tool speed"] = "--tool-speed"
+    return sources
+
+
+def _sources_line(sources: dict[str, str]) -> str:
+    """``limits: velocity and acceleration from m.yaml (limits:)`` (one clause per source)."""
+    by: dict[str, list[str]] = {}
+    for kind, src in sources.items():
+        by.setdefault(src, []).append(kind)
+    return "limits: " + "; ".join(f"{' and '.join(kinds)} from {src}"
+                                  for src, kinds in by.items())
 
 
 def _check_out(out: Path, force: bool) -> None:
@@ -96,7 +142,7 @@ def _check_out(out: Path, force: bool) -> None:
     out.mkdir(parents=True, exist_ok=True)
 
 
-def _print(rep: Any, robot: Any, files: list[Path]) -> None:
+def _print(rep: Any, robot: Any, files: list[Path], sources: dict[str, str]) -> None:
     from rich.table import Table
 
     from robokin.cli_output import console
@@ -107,6 +153,8 @@ def _print(rep: Any, robot: Any, files: list[Path]) -> None:
     if planned is not None:
         head += f" (planned {planned:.3f} s, {planned / rep.minimum_cycle_time:.2f}x)"
     con.print(head)
+    con.print(cell(_sources_line(sources), 400, markup=False), markup=False,
+              soft_wrap=True)
     table = Table(title="per section")
     cols = ["section", "planned \\[s]", "minimum \\[s]"]
     cols += [] if rep.slower is None else [f"at {rep.cycle_time:g} s \\[s]"]
@@ -169,7 +217,7 @@ def retime_command(
     from robokin.trajectory.cycle_time import cycle_time_report
     from robokin.trajectory.io import write_csv
 
-    rob, traj = _load(file, robot)
+    rob, traj, own_limits = _load(file, robot)
     lin = 1e-3 if mm else 1.0
     scale = np.where(rob.is_revolute, math.pi / 180.0 if deg else 1.0, lin)
     options = {"v_max": _per_joint(v_max, "--v-max", scale),
@@ -184,6 +232,7 @@ def retime_command(
     names += [] if no_plot else ["bottlenecks.png"]
     check_distinct([(out / n, "--out") for n in names],
                    [(file, "TRAJ"), (rob.path, "--robot")])
+    sources = _choose_limits(options, own_limits, file, rob)
     _check_out(out, force)
     try:
         rep = cycle_time_report(rob, traj, **options)
@@ -211,12 +260,13 @@ def retime_command(
 
     doc = {"robot": rob.name, "source": str(file), **rep.to_dict(),
            "files": [str(f) for f in files]}
+    doc["limits"]["sources"] = sources
     files.append(write_atomic(out / MARKER, json_text(doc, indent=2) + "\n",
                               overwrite=True))
     if as_json:
         print(json_text(doc))
     else:
-        _print(rep, rob, files)
+        _print(rep, rob, files, sources)
     if too_short:
         raise DomainFailure(f"a cycle time of {cycle_time:g} s is shorter than the "
                             f"minimum {rep.minimum_cycle_time:.6g} s of this path "

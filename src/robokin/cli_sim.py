@@ -109,6 +109,7 @@ def _print_summary(robot: Any, summary: dict[str, Any], out: Path) -> None:
     from rich.table import Table
 
     from robokin.cli_output import console
+    from robokin.sim.report import speed_text
 
     con = console()
     table = Table(title=f"{cell(robot.name)} in MuJoCo: simulated run vs plan")
@@ -127,8 +128,8 @@ def _print_summary(robot: Any, summary: dict[str, Any], out: Path) -> None:
     con.print(table)
     timing = summary["timing"]
     con.print(f"{timing['simulated_s']:.2f} s simulated at {timing['physics_rate_hz']:.0f} Hz"
-              f" in {timing['wall_s']:.2f} s: {timing['real_time_factor']:.4f} x real "
-              f"time; {len(summary['contacts'])} contact(s)", markup=False)
+              f" in {timing['wall_s']:.2f} s: {speed_text(timing['real_time_factor'])}; "
+              f"{len(summary['contacts'])} contact(s)", markup=False)
     con.print(f"mass properties: {summary['mass_properties']}", markup=False)
     verdict = "PASS" if summary["ok"] else "FAIL: " + "; ".join(summary["reasons"])
     con.print(("[bold green]" if summary["ok"] else "[bold red]") + cell(verdict, 400)

@@ -60,7 +60,7 @@ def import_urdf(
     A xacro is expanded first (robokin[ros]; no ROS install). Every visual or
     collision shape left out (a mesh whose package or file is not found, a
     remote or unsupported mesh, a non-uniform scale) is reported on stderr,
-    one line each.
+    one line per reason (every mesh of a missing package on one line).
     """
     import yaml
 
@@ -73,8 +73,8 @@ def import_urdf(
     robot = robot_from_urdf(file, base_link=base, tip_link=tip, package_map=pmap,
                             xacro_args=_pairs(arg, "--arg"), missing_mesh="ignore")
     info = robot.meta["urdf"]
-    for msg in robot.meta.get("urdf_dropped_shapes", ()):
-        typer.echo(f"robokin: note: left out {msg}", err=True)
+    for note in robot.meta.get("urdf_dropped_notes", ()):
+        typer.echo(f"robokin: note: left out {note}", err=True)
     if out is None:
         print(yaml.safe_dump(document_from_robot(robot), sort_keys=False,
                              default_flow_style=None), end="")

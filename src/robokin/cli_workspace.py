@@ -20,6 +20,18 @@ from robokin.cli_output import (
 __all__ = ["workspace"]
 
 
+def _refuse_earlier_run(targets: list[Path], out: Path) -> None:
+    """Files an earlier run left in ``out`` are replaced only with --force."""
+    import os
+
+    from robokin.exceptions import InputError
+
+    there = [p.name for p in targets if os.path.lexists(p)]
+    if there:
+        raise InputError("--out", f"{out} holds an earlier run's {', '.join(there)}; "
+                         "pass --force to replace them, or --out to write elsewhere")
+
+
 @app.command()
 def workspace(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
@@ -29,16 +41,28 @@ def workspace(
     out: Annotated[
         Path, typer.Option("--out", help="Output folder for the plots.")
     ] = Path("robokin-workspace"),
-    voxel_mm: Annotated[
-        float, typer.Option("--voxel", help="Voxel edge [mm] (0: the longest extent / 100).")
-    ] = 0.0,
+    volume_points: Annotated[
+        int | None, typer.Option(
+            "--volume-points",
+            help="Monte-Carlo test points of the volume (default: min(samples, "
+                 "200,000); 0: no volume).")
+    ] = None,
     seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    force: Annotated[bool, typer.Option(
+        "--force", help="Replace the files of an earlier run in --out.")] = False,
     as_json: Annotated[
         bool, typer.Option("--json", help="Same as --format json.")
     ] = False,
     output_format: FormatOption = None,
 ) -> None:
-    """Sample the reachable workspace: bounds, volume, XY/XZ sections, manipulability."""
+    """Sample the reachable workspace: bounds, volume (± its standard error), XY/XZ sections.
+
+    The volume is that of the position workspace: the points the tool point
+    reaches inside the joint limits with any orientation (Monte Carlo, with a
+    position-only IK membership test; see ``docs/scale.md``). The plots and the
+    summary go into --out; the files of an earlier run there are replaced only
+    with --force.
+    """
     import numpy as np
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
@@ -46,14 +70,14 @@ def workspace(
     import robokin
     from robokin.io.atomic import check_distinct, file_stem, write_atomic
     from robokin.kinematics.workspace import sample_workspace
-    from robokin.viz.plots import save_workspace_plots
+    from robokin.viz.plots import save_workspace_plots, workspace_plot_paths
 
     fmt = resolve_format(output_format, as_json)
     as_json = fmt == "json"
     if samples < 1:
         raise typer.BadParameter(f"--samples must be >= 1, got {samples}")
-    if not (voxel_mm >= 0 and np.isfinite(voxel_mm)):
-        raise typer.BadParameter(f"--voxel must be >= 0 [mm] (0: auto), got {voxel_mm}")
+    if volume_points is not None and volume_points < 0:
+        raise typer.BadParameter(f"--volume-points must be >= 0, got {volume_points}")
     if out.exists() and not out.is_dir():
         raise typer.BadParameter(f"--out {out} is a file, expected a folder")
     if not out.parent.is_dir():
@@ -61,6 +85,9 @@ def workspace(
     robot = robokin.load(name)
     check_distinct([(out / f"{file_stem(robot.name)}_workspace{end}", "--out")
                     for end in ("_xy.png", "_xz.png", ".json")], [(robot.path, "NAME")])
+    summary_path = Path(out) / f"{file_stem(robot.name)}_workspace.json"
+    if not force:
+        _refuse_earlier_run([*workspace_plot_paths(robot.name, out), summary_path], out)
     con = Console(stderr=fmt != "table")
     with Progress(
         TextColumn("[bold]sampling[/bold] {task.completed:,.0f}/{task.total:,.0f}"),
@@ -74,14 +101,13 @@ def workspace(
             robot,
             samples,
             rng=np.random.default_rng(seed),
-            voxel_size=voxel_mm / 1000.0 if voxel_mm > 0 else None,
-            progress=lambda done, total: bar.update(task, completed=done),
+            volume_points=volume_points,
+            progress=lambda done, total: bar.update(task, completed=done, total=total),
         )
     out.mkdir(exist_ok=True)
     paths = save_workspace_plots(ws, out)
     summary = ws.summary()
     summary["plots"] = [str(p) for p in paths]
-    summary_path = Path(out) / f"{file_stem(robot.name)}_workspace.json"
     write_atomic(summary_path, json_text(summary) + "\n", argument="--out")
     if as_json:
         print(json_text(summary))
@@ -97,8 +123,18 @@ def workspace(
         ("extent", ws.extent),
     ):
         table.add_row(label, *(float(v * 1000) for v in row))
-    table.notes.append(
-        f"volume ≈ {ws.volume:.4f} m³ ({ws.occupied_voxels:,} voxels of "
-        f"{ws.voxel_size * 1000:.1f} mm)")
+    e = ws.volume_estimate
+    if e is not None:
+        table.notes.append(
+            f"volume of the position workspace (points the tool point reaches inside "
+            f"the joint limits, any orientation): {e.value:.4f} ± {e.std_error:.4f} m³ "
+            f"(± 1 standard error; 95 %: {e.interval[0]:.4f}–{e.interval[1]:.4f} m³), "
+            f"by Monte Carlo: {e.hits:,} of {e.points:,} points in a {e.box_volume:.3f} "
+            "m³ box reached by position-only IK")
+        if e.rescued:
+            table.notes.append(
+                f"the fast membership test missed {e.rescued} of {e.rechecked} "
+                "rechecked points that a thorough solve reached; the volume and its "
+                "error include that share of the misses")
     table.notes += [f"wrote {p}" for p in [*paths, summary_path]]
     emit(table, fmt)

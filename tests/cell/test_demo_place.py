@@ -31,6 +31,11 @@ def test_the_demo_maps_feasible_bases_and_its_own_is_one(tmp_path):
     assert "placement.png" in (tmp_path / "report.html").read_text()
     text = console.file.getvalue()
     assert "bases feasible; this cell's base feasible" in text
+    # issue 25: the placement search is in the timing line and the total
+    timings = summary["timings_s"]
+    assert timings["total"] >= timings["place"] + timings["plan"]
+    time_line = next(ln for ln in text.splitlines() if "│ time" in ln)
+    assert f"place {timings['place']:.2f}" in time_line
 
 
 def test_the_cli_takes_place(tmp_path, capsys):

@@ -31,15 +31,21 @@ def test_the_determinant_equals_the_svd_product_on_a_6r_arm(name, rng):
     np.testing.assert_array_equal(manipulability(robot.chain, q), svd)  # the default
 
 
-def test_the_cell_chunks_change_no_bit(monkeypatch, rng):
+@pytest.mark.parametrize("name", ["ur5", "panda"])
+def test_the_cell_chunks_change_no_bit(monkeypatch, rng, name):
     import robokin.cell._evaluate as ev
 
-    ur5 = robokin.load("ur5")
-    q = random_q(ur5, rng, 100)
-    whole = cell_manipulability(ur5.chain, q)
-    monkeypatch.setattr(ev, "_MANIPULABILITY_BATCH", 7)
-    np.testing.assert_array_equal(cell_manipulability(ur5.chain, q), whole)
-    assert cell_manipulability(ur5.chain, q[:0]).shape == (0,)
+    robot = robokin.load(name)
+    q = random_q(robot, rng, (25, 4))
+    ok = rng.random((25, 4)) < 0.7
+    whole = cell_manipulability(robot.chain, q, ok)
+    monkeypatch.setattr(ev, "_MANIPULABILITY_BATCH", 7)  # the SVD path's batches
+    np.testing.assert_array_equal(cell_manipulability(robot.chain, q, ok), whole)
+    # masked rows are 0, the others the value each row gets alone
+    assert (whole[~ok] == 0).all()
+    for i, j in zip(*np.nonzero(ok)):
+        assert cell_manipulability(robot.chain, q[i, j][None])[0] == whole[i, j]
+    assert cell_manipulability(robot.chain, q[:0, 0]).shape == (0,)
 
 
 def test_an_unknown_method_is_named():

@@ -188,3 +188,93 @@ def test_a_plan_in_actuator_space_places_like_the_plan():
     np.testing.assert_array_equal(b.branch, a.branch)
     np.testing.assert_allclose(b.score, a.score, rtol=1e-9)
     np.testing.assert_allclose(b.best_q, a.best_q, atol=1e-9)
+
+
+# ---------------------------------------------------------- a set of poses (issue 25)
+def _best_per_pose(robot, task):
+    """Oracle: per pose, the largest manipulability (SVD) over its closed-form
+    solutions inside the limits (robot.ik one pose at a time)."""
+    best = []
+    for T in task:
+        sols = robot.ik(T)
+        q = sols.q[sols.within_limits]
+        best.append(robot.manipulability(q).max() if len(q) else -1.0)
+    return np.array(best)
+
+
+def test_a_set_of_poses_accepts_the_base_it_was_made_at():
+    # The reported case: 40 FK poses of in-limit UR5 configurations (the whole
+    # +-360 deg travel) as a set. Following a branch across them carried unwrapped
+    # angles out of the limits ("no continuous branch ... task pose 16 of 40");
+    # each pose only needs an in-limit solution of its own.
+    ur5 = robokin.load("ur5")
+    rng = np.random.default_rng(25)
+    q = rng.uniform(ur5.limits[:, 0], ur5.limits[:, 1], (40, 6))
+    task = ur5.fk(q)
+    pl = cell.place(ur5, task, np.eye(4), max_step=math.inf)
+    assert pl.feasible[0] and pl.reason[0] == "ok" and pl.best_index == 0
+    # one in-limit solution per pose, reaching it
+    assert pl.best_q.shape == (40, 6) and ur5.within_limits(pl.best_q).all()
+    np.testing.assert_allclose(ur5.fk(pl.best_q), task, atol=1e-9)
+    # the score: the smallest over the poses of each pose's best manipulability,
+    # at least that of the configurations the poses were made from
+    best = _best_per_pose(ur5, task)
+    assert pl.score[0] == pytest.approx(best.min(), rel=1e-9)
+    assert pl.score[0] >= ur5.manipulability(q).min() - 1e-12
+    np.testing.assert_allclose(ur5.manipulability(pl.best_q), best, rtol=1e-9)
+    # a set has no order: shuffled, the same verdict, score and solutions
+    perm = rng.permutation(40)
+    shuffled = cell.place(ur5, task[perm], np.eye(4), max_step=math.inf)
+    assert shuffled.feasible[0] and shuffled.score[0] == pl.score[0]
+    np.testing.assert_array_equal(shuffled.best_q, pl.best_q[perm])
+    # as a motion (the default max_step) the same poses are not one branch
+    motion = cell.place(ur5, task, np.eye(4))
+    assert not motion.feasible[0] and motion.reason[0].startswith("no continuous branch")
+    # manipulability asked for: the pose that limits it is named
+    strict = cell.place(ur5, task, np.eye(4), max_step=math.inf,
+                        min_manipulability=best.min() * 1.01)
+    assert strict.reason[0] == (
+        f"manipulability: {best.min():.3g} < {best.min() * 1.01:.3g} required at task "
+        f"pose {int(np.argmin(best))} (its best solution inside the limits)")
+
+
+def test_a_set_of_poses_in_a_scene_takes_per_pose_the_best_clear_solution(press):
+    bare, scene, task = press
+    base = cell.base_grid([0.0], [0.1])
+    pl = cell.place(bare, task, base, scene=scene, clearance=0.004, max_step=math.inf)
+    assert pl.feasible[0] and pl.clearance[0] >= 0.004
+    tooled = scene.with_base(np.eye(4)).attach(bare)
+    local = np.linalg.inv(base[0]) @ task
+    np.testing.assert_allclose(tooled.fk(pl.best_q), local, atol=1e-9)
+    # Oracle, brute force: every in-limit solution of every pose checked on its
+    # own; the chosen one must be clear, and none with a larger manipulability.
+    from robokin.collision import check
+
+    sols = tooled.ik(local)
+    ok = sols.within_limits
+    rows = sols.q[ok]
+    rep = check(bare, scene.with_base(base[0]), rows, clearance=0.004, subdivide=False)
+    dist = np.full(ok.shape, np.nan)
+    dist[ok] = rep.closest_at(np.arange(len(rows)))[0]
+    w = np.where(ok, 0.0, np.nan)
+    w[ok] = tooled.manipulability(rows)
+    chosen = np.array([np.flatnonzero(ok[i] & (np.abs(sols.q[i] - pl.best_q[i]).max(
+        axis=-1) < 1e-9))[0] for i in range(len(task))])
+    idx = np.arange(len(task))
+    assert (dist[idx, chosen] > 0.004).all()
+    better = ok & (w > w[idx, chosen][:, None] * (1 + 1e-12))
+    assert not (better & (dist > 0.004)).any()
+    top = np.nanargmax(w, axis=-1)
+    assert (chosen != top).sum() >= 10  # the scene really changes the choice
+    assert pl.score[0] == pytest.approx(w[idx, chosen].min(), rel=1e-9)
+
+
+def test_a_set_of_poses_on_an_arm_without_a_closed_form():
+    panda = robokin.load("panda")
+    rng = np.random.default_rng(7)
+    q = rng.uniform(panda.limits[:, 0], panda.limits[:, 1], (6, 7))
+    task = panda.fk(q)
+    pl = cell.place(panda, task, np.eye(4), max_step=math.inf)
+    assert pl.feasible[0] and panda.within_limits(pl.best_q).all()
+    np.testing.assert_allclose(panda.fk(pl.best_q), task, atol=1e-8)
+    assert pl.score[0] == pytest.approx(panda.manipulability(pl.best_q).min(), rel=1e-9)

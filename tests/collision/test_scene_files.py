@@ -243,3 +243,28 @@ def test_an_exclusion_naming_no_link_is_refused_when_it_meets_the_robot(tmp_path
     kept.attach(ur5)
     with pytest.raises(InputError, match="'post' is an object"):
         kept.exclude_pair("post", "table")
+
+
+def test_a_scene_names_a_robot_file_relative_to_itself(tmp_path, monkeypatch, capsys):
+    """Issue 25: `robokin check cell/scene.yaml plan.csv` looked for the scene's
+    `robot: arm.yaml` in the current folder. Oracle: the same robot file loaded by
+    its full path; a built-in name stays a name."""
+    from robokin.cli import main
+    from robokin.trajectory import io, quintic
+
+    folder = tmp_path / "cell"
+    folder.mkdir()
+    ur5 = robokin.load("ur5")
+    robokin.save(ur5.replace(name="my_arm"), folder / "arm.yaml")
+    (folder / "scene.yaml").write_text(
+        "robot: {name: arm.yaml}\n"
+        "objects: [{name: post, type: box, size: [0.1, 0.1, 0.1], xyz: [2, 0, 0]}]\n")
+    sc = Scene.load(folder / "scene.yaml")
+    assert sc.robot_name == str(folder / "arm.yaml")
+    assert robokin.load(sc.robot_name).name == "my_arm"
+    plan = quintic(np.zeros(6), np.full(6, 0.2), 0.5).replace(joint_names=ur5.joint_names)
+    csv = io.write_csv(plan, tmp_path / "plan.csv")
+    monkeypatch.chdir(tmp_path)  # not the scene's folder
+    assert main(["check", "cell/scene.yaml", str(csv)]) == 0, capsys.readouterr().err
+    (folder / "named.yaml").write_text("robot: {name: ur5}\n")
+    assert Scene.load(folder / "named.yaml").robot_name == "ur5"

@@ -80,3 +80,24 @@ def test_sim_command_drives_motors(tmp_path, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert summary["servo"]["actuators"] == "motor" and summary["ok"]
     assert main(["sim", "ur5", str(path), "--motors", "--out", str(tmp_path / "u")]) == 2
+
+
+@pytest.mark.parametrize(("factor", "text"), [
+    (0.0126, "79x faster than real time"),   # 1 / 0.0126 = 79.4
+    (0.25, "4.0x faster than real time"),
+    (1.02, "at about real time"),
+    (2.5, "2.5x slower than real time"),
+    (40.0, "40x slower than real time"),
+])
+def test_speed_text(factor, text):
+    from robokin.sim.report import speed_text
+
+    assert speed_text(factor) == text
+
+
+def test_sim_says_how_much_faster_than_real_time(tmp_path, plan_csv, capsys):
+    """Issue 25: "0.0126 x real time" read as 80 times slower."""
+    assert main(["sim", "ur5", str(plan_csv), "--out", str(tmp_path / "run")]) == 0
+    out = capsys.readouterr().out
+    line = next(ln for ln in out.splitlines() if "simulated at" in ln)
+    assert "x faster than real time" in line and "x real time" not in line

@@ -35,4 +35,12 @@ def test_demo_sim_reports_a_simulated_run(tmp_path):
     assert "Simulated run (MuJoCo)" in html and "corr(|error|, |acc|)" in html
     for name in ("sim_model.xml", "sim_tracking.png", "sim_torques.png"):
         assert (tmp_path / name).stat().st_size > 400
-    assert "simulated run" in console.file.getvalue()
+    text = console.file.getvalue()
+    assert "simulated run" in text
+    # issue 25: the speed in words, and the simulation in the timing line
+    assert "faster than real time" in text and "x real time" not in text
+    timings = json.loads((tmp_path / "summary.json").read_text())["timings_s"]
+    assert set(timings) >= {"plan", "check", "retime", "write", "sim", "total"}
+    assert timings["total"] >= timings["sim"] + timings["plan"]
+    time_line = next(ln for ln in text.splitlines() if "│ time" in ln)
+    assert f"sim {timings['sim']:.2f}" in time_line

@@ -89,7 +89,7 @@ def test_limits_in_degrees_and_from_the_command_line(motion, tmp_path, capsys):
     lim = json.loads(text)["limits"]
     np.testing.assert_allclose(lim["velocity"], [math.pi / 2] * 6)
     np.testing.assert_allclose(lim["acceleration"], np.radians([90] * 3 + [180] * 3))
-    assert lim["sources"]["velocity"] == "argument"
+    assert lim["sources"]["velocity"] == "--v-max"  # the option that gave it (issue 25)
 
 
 @pytest.mark.parametrize("args, match", [
@@ -131,3 +131,53 @@ def test_an_output_folder_with_other_files_is_refused(motion, tmp_path, capsys):
     code, _, _ = run(capsys, "retime", str(motion), "--out", str(out), "--no-plot",
                      "--force")
     assert code == 0 and (out / "mine.txt").read_text() == "keep me"
+
+
+def test_a_motion_files_limits_are_used_and_named(motion, tmp_path, capsys):
+    """Issue 25: `retime motion.yaml` kept the robot file's limits and said nothing.
+
+    Oracle: the library's report under the motion file's limits (90 deg/s,
+    180 deg/s^2) and under the robot file's (AUBO-i5: 150-180 deg/s, 25-30 rad/s^2)
+    differ; the command's minimum is the former. A kind the file leaves out comes
+    from the robot file, an option beats both.
+    """
+    from robokin.io.motion_files import load_motion_file, plan_from_document
+    from robokin.trajectory.cycle_time import cycle_time_report
+
+    robot, traj = plan_from_document(*load_motion_file(motion))
+    want = cycle_time_report(robot, traj, v_max=math.radians(90),
+                             a_max=math.radians(180)).minimum_cycle_time
+    assert abs(want - cycle_time_report(robot, traj).minimum_cycle_time) > 0.5
+    code, text, _ = run(capsys, "retime", str(motion), "--out", str(tmp_path / "a"))
+    assert code == 0
+    assert "limits: velocity and acceleration from press.yaml (limits:)" in text
+    doc = json.loads((tmp_path / "a" / "cycle_time.json").read_text())
+    assert doc["minimum_cycle_time_s"] == pytest.approx(want, rel=1e-9)
+    np.testing.assert_allclose(doc["limits"]["velocity"], [math.radians(90)] * 6)
+    # velocity only in the file: the acceleration is the robot file's
+    motion.write_text(MOTION.replace("limits: {velocity: 90, acceleration: 180}",
+                                     "limits: {velocity: 90}"))
+    code, text, _ = run(capsys, "retime", str(motion), "--out", str(tmp_path / "b"))
+    assert code == 0
+    assert ("limits: velocity from press.yaml (limits:); acceleration from aubo_i5's "
+            "robot file (rate_limits:)") in text
+    robot, traj = plan_from_document(*load_motion_file(motion))
+    np.testing.assert_allclose(
+        json.loads((tmp_path / "b" / "cycle_time.json").read_text())["limits"][
+            "acceleration"], robot.rate_limits.acceleration)
+    # an option beats the file
+    code, text, _ = run(capsys, "retime", str(motion), "--out", str(tmp_path / "c"),
+                        "--v-max", "60", "--deg")
+    assert code == 0 and "velocity from --v-max" in text
+
+
+def test_a_csv_needs_robot_and_the_readme_says_so(tmp_path, capsys):
+    from pathlib import Path
+
+    csv = tmp_path / "t.csv"
+    csv.write_text("t [s],a [rad]\n0,0\n1,1\n")
+    code, _, err = run(capsys, "retime", str(csv), "--out", str(tmp_path / "o"))
+    assert code == 2 and "--robot" in err
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    row = next(ln for ln in readme.splitlines() if ln.startswith("| `robokin retime"))
+    assert "TRAJ.csv --robot NAME" in row

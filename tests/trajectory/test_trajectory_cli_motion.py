@@ -43,7 +43,7 @@ def test_traj_writes_csv_plot_and_summary(tmp_path, capsys):
     assert (tmp_path / "press.png").stat().st_size > 20_000
     # never replaces what exists unless -o names it
     code, _, err = run(capsys, "traj", str(f))
-    assert code == 2 and "exists" in err
+    assert code == 2 and "exist" in err  # "exist": two files (issue 25 names both)
     code, out, _ = run(capsys, "traj", str(f), "-o", str(tmp_path / "press.csv"),
                        "--no-plot", "--json")
     doc = json.loads(out)

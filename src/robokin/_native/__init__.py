@@ -34,10 +34,12 @@ try:
     import robokin._native._base as _base
 except ImportError as exc:  # pragma: no cover - a broken install
     raise ImportError(
-        "robokin's compiled kernels (robokin._native._base) are missing: robokin was "
-        "installed without building its C extension. Reinstall it where a C compiler "
-        "is available (pip install --force-reinstall --no-binary robokin robokin), "
-        f"or use a wheel. ({exc})"
+        f"robokin's compiled kernels (robokin._native._base) are missing from "
+        f"{os.path.dirname(__file__)}: this copy of robokin was not built. In the "
+        "source tree run `pip install -e .` (or `python setup.py build_ext "
+        "--inplace`), which needs a C compiler and the Python headers (README.md, "
+        "'Installing'); or install a wheel built by .ci/wheel, which needs neither. "
+        f"({exc})"
     ) from exc
 
 

@@ -117,16 +117,16 @@ class Kernels(Protocol):
     # ------------------------------------------------------ broadphase.c constants
     BP_CHUNK_WORK: int
     # ------------------------------------------------- plan_check.c, plan_geom.c
-    # check results (PC_*), core kinds of shapes (PK_*), pair distance methods
+    # check results (PC_*), core kinds of shapes (PG_*), pair distance methods
     # (PD_*), the distance taken off every computed one [m]
     PC_FREE: int
     PC_HIT: int
     PC_UNDECIDED: int
-    PK_POINT: int
-    PK_SEGMENT: int
-    PK_BOX: int
-    PK_CYLINDER: int
-    PK_HULL: int
+    PG_POINT: int
+    PG_SEGMENT: int
+    PG_BOX: int
+    PG_CYLINDER: int
+    PG_HULL: int
     PD_SEGSEG: int
     PD_SEGBOX: int
     PD_BOXSEG: int
@@ -183,6 +183,34 @@ class Kernels(Protocol):
     G6F_SEC_DEGENERATE: int
     G6F_SEC_AMBIGUOUS: int
     G6_DIAG_CAND_SHIFT: int
+    # ---------------------------------------------------------- pieper.c constants
+    # Pieper parameter vector layout (PIEPER_N_PARAMS entries, pieper.setup), the
+    # triple cases, status codes and the batch size that goes to the pool
+    PIEPER_N: int
+    PIEPER_HELD: int
+    PIEPER_CASE: int
+    PIEPER_SING_TOL: int
+    PIEPER_SCALE: int
+    PIEPER_POINT: int
+    PIEPER_AXES: int
+    PIEPER_POINTS: int
+    PIEPER_TOOL_R: int
+    PIEPER_TOOL_T: int
+    PIEPER_SIGN: int
+    PIEPER_OFFSET: int
+    PIEPER_LO: int
+    PIEPER_HI: int
+    PIEPER_TAG: int
+    PIEPER_N_PARAMS: int
+    PIEPER_MAX_JOINTS: int
+    PIEPER_START: int
+    PIEPER_END: int
+    PIEPER_BOTH: int
+    PIEPER_POINT2: int
+    PIEPER_DEGENERATE: int
+    PIEPER_BAD_POSE: int
+    PIEPER_PARALLEL_MIN: int
+    PIEPER_TAG_VALUE: float
     # ---------------------------------------------------------- FK and Jacobian
     def fk1(self, q: object, packed: object, /) -> F64 | None:
         """Pose (4, 4) of one configuration q (n,), or None for the general path."""
@@ -245,6 +273,13 @@ class Kernels(Protocol):
     ) -> None:
         """Per pose, the solution row of Q (N, k, n) nearest qn (N, n), into q."""
 
+    def abs_det_jacobian(self, packed: F64, q: F64, mask: Bools, out: F64, /) -> bool:
+        """``|det J|`` of q (N, 6) where mask (N,), 0 elsewhere, into out (N,).
+
+        For a 6-coordinate chain (``manipulability.c``); whether every masked row was
+        finite (unmasked rows are never read).
+        """
+
     # -------------------------------------------------------------- validation
     def check_poses(self, T: F64, tol: float, /) -> tuple[int, int]:
         """``(code, index)`` of the first non-rigid pose of T (N, 4, 4), or (0, -1)."""
@@ -261,6 +296,22 @@ class Kernels(Protocol):
         self, params: F64, T: F64, qn: F64, /
     ) -> tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]:
         """``(Q (N, 8, 6), valid, singular, within_limits (N, 8), status (N,))``."""
+
+    # ------------------------------------------------- Pieper (intersecting triple)
+    def pieper_ik1(
+        self, T: object, params: F64, x: float, qn: F64 | None, /
+    ) -> (
+        tuple[int, F64, Bools, Bools, Bools] | tuple[int, None, None, None, None]
+    ):
+        """``(code, Q (8, n), valid, singular, within_limits (8,))`` of one pose."""
+
+    def pieper_ik(
+        self, params: F64, T: F64, x: F64, qn: F64, /
+    ) -> tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]:
+        """``(Q (N, 8, n), valid, singular, within_limits (N, 8), status (N,))``."""
+
+    def pieper_roots(self, coeffs: F64, re: F64, im: F64, /) -> None:
+        """The four roots of a quartic (coefficients lowest order first)."""
 
     # ------------------------------------------------------------ general 6R IK
     def general6r_solve(

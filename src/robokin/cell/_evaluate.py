@@ -10,8 +10,8 @@ a map is the same bit for bit whatever the chunking and wherever it runs:
   it gets alone (``tests/native``; the numeric solver is given no random
   restarts: only its deterministic seed-table restarts);
 * the manipulability is computed per solution (a determinant, or a product
-  of singular values) and the per-voxel results are maxima and integer sums,
-  which do not depend on order.
+  of singular values), each on its own, and the per-voxel results are maxima
+  and integer sums, which do not depend on order.
 """
 
 from __future__ import annotations
@@ -90,21 +90,29 @@ class ReachChunk:
     reachable_voxels: int
 
 
-def manipulability(chain: Chain, q: np.ndarray) -> np.ndarray:
-    """Yoshikawa's manipulability of configurations q (P, n) [rad, m], shape (P,).
+def manipulability(chain: Chain, q: np.ndarray, ok: np.ndarray | None = None) -> np.ndarray:
+    """Yoshikawa's manipulability of configurations q (..., n) [rad, m], shape (...).
 
     :func:`robokin.kinematics.jacobian.manipulability` with ``method="det"``
-    (``|det J|`` for a 6-joint arm, the product of singular values otherwise),
-    :data:`_MANIPULABILITY_BATCH` configurations at a time so the temporaries
-    stay bounded. Each row is computed on its own, so chunking changes no bit.
+    (``|det J|`` for a 6-joint arm, computed in compiled code with the
+    Jacobian, in one call: it stores nothing but the result; the product of
+    singular values otherwise, :data:`_MANIPULABILITY_BATCH` configurations at
+    a time so the temporaries stay bounded), where ``ok`` (...) (default
+    everywhere; 0 elsewhere, where q is not read: NaN rows of a solution set
+    are fine). Each row is computed on its own, so chunking changes no bit.
     """
     from robokin.kinematics.jacobian import manipulability as yoshikawa
 
-    out = np.empty(q.shape[0])
-    for a in range(0, q.shape[0], _MANIPULABILITY_BATCH):  # bounded temporaries
-        b = min(a + _MANIPULABILITY_BATCH, q.shape[0])
-        out[a:b] = yoshikawa(chain, q[a:b], method="det")
-    return out
+    lead = q.shape[:-1]
+    flat = q.reshape(-1, q.shape[-1])
+    mask = np.ones(flat.shape[0], dtype=bool) if ok is None else ok.reshape(-1)
+    if chain.n == 6:  # compiled, no temporaries: one call
+        return yoshikawa(chain, flat, method="det", where=mask).reshape(lead)
+    out = np.empty(flat.shape[0])
+    for a in range(0, flat.shape[0], _MANIPULABILITY_BATCH):  # bounded temporaries
+        b = min(a + _MANIPULABILITY_BATCH, flat.shape[0])
+        out[a:b] = yoshikawa(chain, flat[a:b], method="det", where=mask[a:b])
+    return out.reshape(lead)
 
 
 def solve_poses(robot: Robot, T: np.ndarray, numeric: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -178,8 +186,7 @@ def evaluate_reach(job: ReachJob, start: int, stop: int) -> ReachChunk:
     index = (counts > 0).sum(axis=-1) / K
     best = None
     if job.with_manipulability:
-        w = np.zeros(ok.shape)
-        w[ok] = manipulability(job.robot.chain, q[ok])
+        w = manipulability(job.robot.chain, q, ok)
         best = w.reshape(B, -1).max(axis=-1)
     reachable = int(np.count_nonzero(index))
     if job.store is None:

@@ -30,7 +30,7 @@ def default_region(robot: Robot, samples: int, margin: float) -> np.ndarray:
     from robokin.kinematics.workspace import sample_workspace
 
     ws = sample_workspace(robot, samples, rng=np.random.default_rng(0),
-                          manipulability_samples=0)
+                          volume_points=0, manipulability_samples=0)
     lo, hi = ws.bounds
     pad = margin * np.maximum(hi - lo, 1e-3)
     return np.stack([lo - pad, hi + pad])
@@ -39,16 +39,14 @@ def default_region(robot: Robot, samples: int, margin: float) -> np.ndarray:
 def reach_bound(robot: Robot) -> float:
     """An upper bound [m] on the distance of the tool point from the first joint.
 
-    The sum of the lengths of the constant transforms after the first joint,
-    plus the strokes of prismatic joints: no configuration reaches farther.
+    The radius of :func:`robokin.kinematics.workspace.reach_ball`: the sum of
+    the lengths of the constant transforms after the first joint, plus the
+    strokes of prismatic joints; no configuration reaches farther.
     """
-    chain = robot.chain
-    consts = np.asarray(chain.arrays.consts).reshape(-1, 4, 4)
-    total = float(np.linalg.norm(consts[1:, :3, 3], axis=-1).sum())
-    lim = np.asarray(robot.limits)
-    rev = np.asarray(robot.is_revolute, dtype=bool)
-    stroke = np.abs(lim[~rev]).max(axis=-1) if (~rev).any() else np.zeros(0)
-    return total + float(np.nan_to_num(stroke, posinf=1e3).sum())
+    from robokin.kinematics.workspace import reach_ball
+
+    radius = reach_ball(robot.chain)[1]
+    return radius if np.isfinite(radius) else 1e3
 
 
 def describe_robot(robot: Robot) -> bytes:
@@ -73,6 +71,8 @@ def describe_scene(scene: Scene) -> bytes:
         parts.append(np.asarray(scene.tool.tcp).tobytes())
         parts.extend(_describe_shape(s) for s in scene.tool.shapes)
     parts.extend(",".join(sorted(p)).encode() for p in sorted(scene.exclude, key=sorted))
+    parts.append(repr(getattr(scene, "allowed", None)).encode())
+    parts.append(repr(sorted(getattr(scene, "groups", {}).items())).encode())
     return b"|".join(parts)
 
 
@@ -83,4 +83,6 @@ def _describe_shape(shape: Shape) -> bytes:
         np.asarray(shape.placement, dtype=np.float64).tobytes(),
         str(shape.file or "").encode(),
         np.float64(shape.scale).tobytes(),
+        b"" if shape.vertices is None else np.asarray(shape.vertices).tobytes(),
+        b"" if shape.faces is None else np.asarray(shape.faces).tobytes(),
     ])

@@ -6,7 +6,9 @@ al., "Robot placement based on reachability inversion", ICRA 2013):
 
 1. **Reach on one branch.** Is every task pose reachable inside the joint
    limits, on one continuous IK branch, so the motion runs without a flip? (See
-   :mod:`robokin.cell._tracking`.)
+   :mod:`robokin.cell._tracking`.) For a set of poses in no order
+   (``max_step=math.inf``) each pose only needs a solution inside the limits
+   of its own (:mod:`robokin.cell._pose_set`).
 2. **Clearance.** Along that branch, does the arm (and its tool) keep at least
    ``clearance`` from the scene and from itself
    (:func:`robokin.collision.check` on the task's samples)?
@@ -38,6 +40,7 @@ import numpy.typing as npt
 from robokin._text import short_repr
 from robokin.cell._evaluate import manipulability as _manipulability
 from robokin.cell._inputs import ik_method, placed_robot, progress_callback
+from robokin.cell._pose_set import PoseSet, rank_solutions
 from robokin.cell._scheduler import check_scheduler, run_chunks
 from robokin.cell._tracking import track
 from robokin.exceptions import InputError, UnreachableError
@@ -117,12 +120,14 @@ class Placement:
         manipulability: (C,) smallest manipulability along the chosen branch
             (NaN where not reachable).
         branch: (C,) which solution of the first task pose the chosen branch
-            starts from (-1 where none).
+            starts from (for a set of poses: the solution chosen for the first
+            pose; -1 where none).
         reason: (C,) ``"ok"`` or why the candidate fails.
         task: The task tool poses (N, 4, 4) [m] in the world.
         required_clearance: The clearance asked for [m].
         best_index: Index of the best feasible candidate, or None.
-        best_q: The best candidate's joint path along the task (N, n), or None.
+        best_q: The best candidate's joint path along the task (N, n) (for a
+            set of poses: the solution chosen for each pose), or None.
         best_report: Its full collision check (with subdivision), or None (no
             scene, or nothing feasible).
     """
@@ -382,8 +387,12 @@ def place(
         clearance: Smallest distance [m] the arm must keep from the scene.
         scheduler: Where the chunks run (as for :func:`reach_map`).
         max_step: Largest joint change [rad, m] between consecutive task poses
-            on one branch; ``math.inf`` for a set of poses in no particular
-            order (each must be reachable, on the branch nearest the previous).
+            on one branch. ``math.inf`` makes the task a set of poses in no
+            order, with no motion between them: each pose then needs only a
+            solution of its own inside the joint limits (no branch is followed
+            and no joint value carried over), the one with the best
+            manipulability among those with the clearance asked for; the score
+            is the smallest manipulability over the poses so chosen.
         min_manipulability: Smallest manipulability acceptable along the task.
         method: ``"auto"``, ``"analytic"`` or ``"numeric"`` (see
             :func:`reach_map`).
@@ -540,6 +549,8 @@ def evaluate_place(job: PlaceJob, start: int, stop: int, *,
     Bs = job.candidates[start:stop]
     C, N = Bs.shape[0], job.task.shape[0]
     local = invert(Bs)[:, None] @ job.task[None]
+    if math.isinf(job.max_step):
+        return _evaluate_set(job, start, stop, local, keep_path=keep_path)
     tr = track(job.robot, local, job.max_step, job.numeric)
     k = tr.alive.shape[1]
     w_min = np.full((C, k), np.nan)
@@ -563,6 +574,80 @@ def evaluate_place(job: PlaceJob, start: int, stop: int, *,
             path = tr.q[c, j].copy()
     return PlaceChunk(start, stop, reachable, clearance, manip, branch, reason,
                       tr.unreached, path)
+
+
+def _evaluate_set(job: PlaceJob, start: int, stop: int, local: np.ndarray, *,
+                  keep_path: bool) -> PlaceChunk:
+    """:func:`evaluate_place` for a set of poses (``max_step`` infinite).
+
+    ``local`` holds the task poses in each candidate's base frame (C, N, 4, 4).
+    """
+    ps = rank_solutions(job.robot, local, job.numeric)
+    C, N = ps.ok.shape[:2]
+    reachable = ps.unreached < 0
+    clearance = np.full(C, np.nan)
+    manip = np.full(C, np.nan)
+    branch = np.full(C, -1, dtype=np.int64)
+    reason = np.empty(C, dtype=object)
+    path = None
+    poses = np.arange(N)
+    for c in range(C):
+        if not reachable[c]:
+            reason[c] = _reach_reason(int(ps.unreached[c]), 0, N)
+            continue
+        slots, dist, why = _choose_solutions(job, job.candidates[start + c], ps, c)
+        w = ps.w[c, poses, slots]
+        branch[c], clearance[c], manip[c], reason[c] = slots[0], dist, w.min(), why
+        if keep_path:
+            path = ps.q[c, poses, slots].copy()
+    return PlaceChunk(start, stop, reachable, clearance, manip, branch, reason,
+                      ps.unreached, path)
+
+
+def _choose_solutions(job: PlaceJob, base: np.ndarray, ps: PoseSet,
+                      c: int) -> tuple[np.ndarray, float, str]:
+    """One solution per task pose of candidate c: (slots (N,), clearance [m], reason).
+
+    Per pose, the solution with the best manipulability among those that meet
+    the manipulability and clearance asked for (so the smallest manipulability
+    over the set is as large as it can be); a pose with none keeps its best one,
+    and the reason names what fails. Each pose's solutions are checked against
+    the scene in rounds: the best of every pose still open, then the next...
+    """
+    N = ps.ok.shape[1]
+    order, ok, w = ps.order[c], ps.ok[c], ps.w[c]
+    poses = np.arange(N)
+    slots = order[:, 0].copy()
+    w_best = w[poses, slots]
+    worst = int(np.argmin(w_best))
+    if w_best[worst] < job.min_manipulability:
+        return (slots, math.inf if job.scene is None else math.nan,
+                f"manipulability: {w_best[worst]:.3g} < {job.min_manipulability:.3g} "
+                f"required at task pose {worst} (its best solution inside the limits)")
+    if job.scene is None or job.bare is None:
+        return slots, math.inf, OK
+    from robokin.collision import check
+
+    scene = job.scene.with_base(base)
+    todo = poses
+    for r in range(order.shape[1]):
+        cand = order[todo, r]
+        usable = ok[todo, cand] & (w[todo, cand] >= job.min_manipulability)
+        todo, cand = todo[usable], cand[usable]  # (ranked: nothing usable after)
+        if todo.size == 0:
+            break
+        report = check(job.bare, scene, ps.q[c, todo, cand], clearance=job.clearance,
+                       subdivide=False)
+        bad = np.zeros(todo.size, dtype=bool)
+        for col in report.collisions:
+            bad[col.first_index : col.last_index + 1] = True
+        for iv in report.violations:
+            bad[iv.first_index : iv.last_index + 1] = True
+        slots[todo[~bad]] = cand[~bad]
+        todo = todo[bad]
+    report = check(job.bare, scene, ps.q[c, poses, slots], clearance=job.clearance,
+                   subdivide=False)
+    return slots, float(report.min_distance), _collision_reason(report, job.clearance)
 
 
 def _reach_reason(unreached: int, died_at: int, N: int) -> str:

@@ -159,7 +159,8 @@ def plot_floor(
 
     Each (x, y) cell shows the best candidate standing there (over heights and
     yaws): feasible ones coloured by score, infeasible ones in grey tones by
-    reason. The best placement is starred.
+    reason. The best placement is starred. The legend sits below the map, so it
+    hides no cell.
 
     Args:
         pl: The placement search result.
@@ -220,7 +221,9 @@ def plot_floor(
     sm = mpl.cm.ScalarMappable(norm=norm, cmap=cmap)
     fig.colorbar(sm, ax=ax, label="score: smallest manipulability along the task",
                  shrink=0.85)
-    ax.legend(handles=handles, fontsize=7, loc="upper left", framealpha=0.85)
+    # below the map, never over it: the best cells are often in a corner
+    fig.legend(handles=handles, fontsize=7, loc="outside lower center",
+               ncol=min(len(handles), 4), frameon=False)
     n_ok = int(pl.feasible.sum())
     ax.set_title(f"robot bases: {n_ok} of {len(pl.feasible)} feasible")
     if path is not None:

@@ -140,7 +140,15 @@ class ReachMap:
         return self.grid.size
 
     def volume(self, threshold: float = 0.0) -> float:
-        """Volume [m^3] of the voxels whose index exceeds ``threshold``."""
+        """Volume [m^3] of the voxels whose index exceeds ``threshold``.
+
+        With ``threshold=0``: the voxels whose centre the tool reaches in at
+        least one of the K orientations, a midpoint cubature of the position
+        workspace whose volume
+        :func:`~robokin.kinematics.workspace.sample_workspace` estimates with
+        its uncertainty (low by the boundary voxels reachable only between the
+        K orientations; see ``docs/scale.md``).
+        """
         idx = np.asarray(self.index[...])
         return float(np.count_nonzero(idx > threshold)) * self.grid.voxel**3
 
@@ -384,9 +392,10 @@ def reach_map(
         method: ``"auto"`` (the closed form when the arm has one, every
             solution; else the numeric solver, one solution per target from its
             deterministic seed-table restarts), ``"analytic"`` or ``"numeric"``.
-        manipulability: Compute the best manipulability per voxel (about as
-            costly again as the IK: one Jacobian and determinant per solution;
-            a singular value decomposition for an arm without 6 joints).
+        manipulability: Compute the best manipulability per voxel (for a
+            6-joint arm ``|det J|`` per solution in compiled code, about a tenth
+            of the IK's cost; a Jacobian and its singular values per solution
+            for other arms).
         chunk: Voxels per Dask task (default: about 131,000 IK targets, and at
             most 50,000 tasks).
         progress: True for a progress bar on stderr, or ``progress(done, total)``

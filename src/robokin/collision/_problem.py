@@ -114,10 +114,11 @@ class _Problem:
             )
         # Pairs at shape level: (robot shape, object) then (robot shape, robot shape).
         names = geo.names
+        excluded = scene.excluded_pairs(placed)
         pa, pb, is_self = [], [], []
         for i in range(S):
             for j, ob in enumerate(objects):
-                if frozenset((names[link[i]], ob.name)) in scene.exclude:
+                if frozenset((names[link[i]], ob.name)) in excluded:
                     continue
                 pa.append(i)
                 pb.append(j)

@@ -24,6 +24,14 @@ Object shapes use the keys of robot-file geometry (``type``, ``size``,
 ``radius``, ``length``, ``from``/``to``, ``file``, ``units``, ``xyz``, ``rpy``);
 their ``xyz``/``rpy`` place them in the world. ``q`` in a pose is an optional
 joint configuration (file angle units) that reaches it, a seed for IK.
+
+:meth:`Scene.load` also reads a MoveIt planning scene: a ``.scene`` file
+(:mod:`robokin.io.moveit_scene`) or a ``moveit_msgs/PlanningScene`` YAML
+(:mod:`robokin.io.moveit_scene_yaml`). A MoveIt object of several shapes becomes
+one robokin object per shape (``id/0``, ``id/1``, ...; ``Scene.groups`` maps
+the id to them); its allowed-collision matrix (``Scene.allowed``) and exclusions
+naming URDF links are mapped onto robokin's links when the scene meets a robot
+from a URDF (:meth:`Scene.excluded_pairs`).
 """
 
 from __future__ import annotations
@@ -41,6 +49,7 @@ from robokin._text import control_character, short_repr
 from robokin._validation import check_transform
 from robokin.exceptions import InputError, ModelError
 from robokin.io.geometry_sections import number_field, shape_from_spec
+from robokin.io.moveit_scene import AllowedCollisions, MoveItScene
 from robokin.model import geometry as _geo
 from robokin.model.geometry import Shape
 
@@ -82,6 +91,26 @@ def _check_pair(scene: Scene, pair: Sequence[str], file: Any, field: str) -> Non
         raise ModelError(f"{short_repr(link)} and {short_repr(obj)} are both objects; "
                          "objects are never checked against each other, a pair is "
                          "[robot link, object]", file=file, field=field)
+
+
+def _robot_file(name: str, file: Any) -> str:
+    """A scene's robot: a robot file next to the scene file (as a path), or ``name``.
+
+    A relative ``.yaml`` / ``.yml`` name is read relative to the scene file, as a
+    motion file's ``robot:`` is; anything else (a built-in name, an absolute path)
+    is kept as written.
+    """
+    candidate = Path(name)
+    if (file is None or candidate.is_absolute()
+            or candidate.suffix.lower() not in (".yaml", ".yml")):
+        return name
+    beside = Path(file).parent / candidate
+    return str(beside) if beside.is_file() else name
+def _parts(robot: Robot) -> dict[str, tuple[str, ...]]:
+    """The URDF links with shapes each robokin link holds (a robot from a URDF)."""
+    info = robot.meta.get("urdf")
+    parts = getattr(info, "parts", None)
+    return parts() if callable(parts) else {}
 
 
 def _fresh(shape: Shape) -> Shape:
@@ -145,8 +174,14 @@ class Scene:
         exclude: (robot link, object) name pairs never checked.
         poses: Named TCP poses in the world, ``{name: (4, 4)}``.
         pose_joints: Joint configurations reaching ``poses`` (when given), ``{name: (n,)}``.
-        robot_name: The robot the scene was built for (built-in name or file), or None.
+        robot_name: The robot the scene was built for (built-in name or file; a
+            relative robot file is given relative to the scene file), or None.
         path: The scene file, or None.
+        groups: A MoveIt object's id -> the robokin objects of its shapes.
+        allowed: A MoveIt scene's allowed-collision matrix, or None.
+        joint_state: A MoveIt scene's robot state ``{joint: position}``.
+        frame: The planning frame a MoveIt scene's poses are in (when it names
+            one); robokin takes it as the world frame.
     """
 
     def __init__(self, name: str = "scene") -> None:
@@ -160,6 +195,10 @@ class Scene:
         self.pose_joints: dict[str, np.ndarray] = {}
         self.robot_name: str | None = None
         self.path: Path | None = None
+        self.groups: dict[str, tuple[str, ...]] = {}
+        self.allowed: AllowedCollisions | None = None
+        self.joint_state: dict[str, float] = {}
+        self.frame: str | None = None
         self._version = 0
 
     def __repr__(self) -> str:
@@ -201,6 +240,8 @@ class Scene:
         out.exclude = set(self.exclude)
         out.poses = dict(self.poses)
         out.pose_joints = dict(self.pose_joints)
+        out.groups = dict(self.groups)
+        out.joint_state = dict(self.joint_state)
         out.base = _pose(pose, "pose")
         return out
 
@@ -336,21 +377,25 @@ class Scene:
         self.exclude.add(frozenset((link, obj)))
         self._version += 1
 
-    def check_exclusions(self, links: Sequence[str]) -> None:
+    def check_exclusions(self, links: Sequence[str], urdf_links: Iterable[str] = ()
+                         ) -> None:
         """Raise unless every excluded pair names one of ``links`` and an object.
 
         Args:
             links: The robot's link names (``RobotGeometry.names``: ``base``, the
                 joints, ``tool``).
+            urdf_links: The URDF links of a robot imported from a URDF (a pair
+                may name one; :meth:`excluded_pairs` maps it onto ``links``).
 
         Raises:
             ModelError: a pair whose link is not one of ``links`` (naming the
                 scene file, the pair and listing the links).
         """
-        objects = set(self.names)
+        objects = set(self.names) | set(self.groups)
+        known = set(links) | set(urdf_links)
         for pair in sorted(sorted(p) for p in self.exclude):
             others = [x for x in pair if x not in objects] or pair[:1]
-            bad = [x for x in others if x not in links]
+            bad = [x for x in others if x not in known]
             if bad:
                 raise ModelError(
                     f"exclude {pair}: {short_repr(bad[0])} is neither a link of the "
@@ -373,7 +418,11 @@ class Scene:
         geo = robot.geometry if isinstance(robot.geometry, RobotGeometry) else None
         if geo is None:
             geo = RobotGeometry.empty(robot)
-        self.check_exclusions(geo.names)
+        info = robot.meta.get("urdf")
+        self.check_exclusions(geo.names, getattr(info, "owners", {}))
+        if self.allowed is not None:
+            pairs = self._allowed_self_pairs(geo.names, _parts(robot))
+            geo = geo.with_exclusions(tuple(p) for p in pairs)
         out = robot
         if not np.array_equal(self.base, np.eye(4)):
             out = out.with_base(self.base @ robot.base)
@@ -384,6 +433,55 @@ class Scene:
         return out.replace(meta={**out.meta,
                                  _PLACED: (self, out.chain, out.geometry, bare)})
 
+    def _allowed_self_pairs(self, links: Sequence[str],
+                            parts: Mapping[str, tuple[str, ...]]) -> set[frozenset[str]]:
+        """The robokin link pairs the allowed-collision matrix never checks.
+
+        The rule of :func:`robokin.io.srdf.excluded_link_pairs` (every URDF pair
+        between two robokin links allowed), or the robokin names themselves.
+        """
+        from robokin.io.srdf import excluded_link_pairs
+
+        acm = self.allowed
+        if acm is None:
+            return set()
+        out = excluded_link_pairs(parts, acm.allows)
+        for i, a in enumerate(links):
+            out |= {frozenset((a, b)) for b in links[i + 1:] if acm.allows(a, b)}
+        return out
+
+    def excluded_pairs(self, robot: Robot) -> frozenset[frozenset[str]]:
+        """The (robot link, object) pairs never checked, on robokin's names.
+
+        A pair is excluded when ``exclude`` (or the allowed-collision matrix)
+        names the robokin link, or names **every** URDF link with shapes that
+        the robokin link holds (a robot from a URDF), against the object or the
+        MoveIt object it is a shape of. Names the robot or scene does not have
+        never match (a MoveIt matrix lists every link of its robot).
+
+        Args:
+            robot: The robot (placed by :meth:`attach` or not).
+        """
+        from robokin.model.geometry import RobotGeometry, link_names
+
+        geo = robot.geometry
+        links = geo.names if isinstance(geo, RobotGeometry) else link_names(robot)
+        parts = _parts(robot)
+        group_of = {name: gid for gid, names in self.groups.items() for name in names}
+        acm = self.allowed
+
+        def allowed(a: str, b: str) -> bool:
+            return frozenset((a, b)) in self.exclude or (acm is not None and acm.allows(a, b))
+
+        out = set()
+        for obj in self.names:
+            targets = (obj, group_of[obj]) if obj in group_of else (obj,)
+            for link in links:
+                if any(allowed(link, o) for o in targets) or (parts.get(link) and all(
+                        any(allowed(a, o) for o in targets) for a in parts[link])):
+                    out.add(frozenset((link, obj)))
+        return frozenset(out)
+
     def _fingerprint(self) -> tuple:
         """What the compiled check depends on (attributes may be assigned directly)."""
         base = np.asarray(self.base, dtype=float)
@@ -392,6 +490,8 @@ class Scene:
             base.tobytes(),
             id(self.tool),
             frozenset(self.exclude),
+            id(self.allowed),
+            tuple(self.groups.items()),
             tuple(id(o) for o in self._objects.values()),
         )
 
@@ -407,20 +507,67 @@ class Scene:
     # ------------------------------------------------------------------ files
     @classmethod
     def load(cls, path: str | Path) -> Scene:
-        """Load a scene file (YAML).
+        """Load a scene file: robokin's YAML, or a MoveIt planning scene.
+
+        A file ending ``.scene`` is MoveIt's text format; a YAML file holding
+        ``moveit_msgs/PlanningScene`` fields (``world``, ``robot_state``,
+        ``allowed_collision_matrix``, ...) is a PlanningScene message; any other
+        YAML is a robokin scene file.
 
         Raises:
-            ModelError: missing file, bad YAML, a bad field (names the file, the
-                field path and the reason) or a bad mesh.
+            ModelError: missing file, bad YAML or text, a bad field (names the
+                file, the field path or line and the reason), an unsupported
+                MoveIt entry, or a bad mesh.
         """
+        from robokin.io.moveit_scene import is_scene_text_file, read_scene_text
+        from robokin.io.moveit_scene_yaml import (
+            is_planning_scene_document,
+            planning_scene_from_document,
+        )
+        from robokin.io.text_files import read_text_file
         from robokin.io.yaml_reader import read_yaml_document
 
         path = Path(path)
+        if is_scene_text_file(path):
+            return cls.from_moveit(read_scene_text(read_text_file(path), path))
         ydoc = read_yaml_document(path)
         try:
+            if is_planning_scene_document(ydoc.data):
+                return cls.from_moveit(planning_scene_from_document(ydoc.data, path))
             return cls.from_document(ydoc.data, file=path)
         except ModelError as exc:
             raise ydoc.locate(exc) from None
+
+    @classmethod
+    def from_moveit(cls, moveit: MoveItScene) -> Scene:
+        """A scene from a MoveIt planning scene read by :mod:`robokin.io.moveit_scene`.
+
+        An object of one shape keeps its id; an object of several shapes becomes
+        ``id/0``, ``id/1``, ... (``scene.groups[id]`` lists them). Its
+        allowed-collision matrix, joint state and planning frame are kept
+        (``allowed``, ``joint_state``, ``frame``).
+
+        Raises:
+            ModelError: a name robokin cannot use, or two objects whose shapes'
+                names clash (naming the file and line).
+        """
+        file = moveit.file
+        scene = cls(_text(moveit.name, file, "name"))
+        scene.path = file
+        for obj in moveit.objects:
+            names = [obj.id] if len(obj.shapes) == 1 else \
+                [f"{obj.id}/{i}" for i in range(len(obj.shapes))]
+            for name, shape in zip(names, obj.shapes):
+                if name in scene._objects:
+                    raise ModelError(f"object name '{name}' is given twice (an object's "
+                                     "shapes are named id/0, id/1, ...)", file=file,
+                                     line=obj.line)
+                scene.add(_text(name, file, "id"), shape)
+            scene.groups[obj.id] = tuple(names)
+        scene.allowed = moveit.allowed
+        scene.joint_state = dict(moveit.joint_state)
+        scene.frame = moveit.frame
+        return scene
 
     @classmethod
     def from_document(cls, doc: Any, file: str | Path | None = None) -> Scene:
@@ -479,7 +626,8 @@ class Scene:
                 raise ModelError("expected {name: ..., base: {xyz, rpy}}; "
                                  + unknown_key(keys), file=file, field="robot")
             scene.robot_name = (None if rob.get("name") is None
-                                else _text(rob["name"], file, "robot.name"))
+                                else _robot_file(_text(rob["name"], file, "robot.name"),
+                                                 file))
             scene.base = placement(rob.get("base"), "robot.base")
         tool = doc.get("tool")
         if tool is not None:

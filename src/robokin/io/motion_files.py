@@ -46,6 +46,7 @@ __all__ = [
     "MAX_MOTION_SAMPLES",
     "MAX_SEGMENTS",
     "load_motion_file",
+    "motion_limits",
     "plan_from_document",
 ]
 
@@ -231,19 +232,10 @@ def _plan(spec: Any, file: Path, progress: Any, max_samples: int) -> tuple[Any, 
                              "values", file=file, field=field)
         return np.asarray(values, float) * jscale
 
-    def per_joint(v, field):
-        if v is None:
-            return None
-        arr = np.broadcast_to(np.asarray(v, float), (robot.n,)) if np.ndim(v) == 0 \
-            else np.asarray(v, float)
-        if arr.shape != (robot.n,):
-            raise ModelError(f"expected one value or {robot.n}", file=file, field=field)
-        return arr * jscale
-
+    v_max, a_max = motion_limits(spec, robot, file)
     with fields(None):
         pb = PathBuilder(robot, joints(spec.start, "start"), dt=spec.dt,
-                         v_max=per_joint(spec.limits.velocity, "limits.velocity"),
-                         a_max=per_joint(spec.limits.acceleration, "limits.acceleration"),
+                         v_max=v_max, a_max=a_max,
                          tool_speed=None if spec.tool_speed is None else spec.tool_speed * L,
                          tool_acceleration=None if spec.tool_acceleration is None
                          else spec.tool_acceleration * L,
@@ -269,6 +261,43 @@ def _plan(spec: Any, file: Path, progress: Any, max_samples: int) -> tuple[Any, 
     if progress is not None:
         progress(total + 1, total + 1)
     return robot, traj
+
+
+def motion_limits(spec: Any, robot: Robot, file: Path | None = None
+                  ) -> tuple[Any, Any]:
+    """A motion file's ``limits:`` in SI units, one value per joint.
+
+    Args:
+        spec: The validated document (:func:`load_motion_file`).
+        robot: Its robot (for the joint count and kinds).
+        file: The motion file, for error messages.
+
+    Returns:
+        ``(velocity, acceleration)``: each (n,) [rad/s or m/s; rad/s^2 or m/s^2],
+        or None where the file gives none.
+
+    Raises:
+        ModelError: a list that is not one value per joint (file and field named).
+    """
+    import numpy as np
+
+    L = 1e-3 if spec.units.length == "mm" else 1.0
+    A = math.pi / 180.0 if spec.units.angle == "deg" else 1.0
+    scale = np.where(robot.is_revolute, A, L)
+    out: list[Any] = []
+    for kind in ("velocity", "acceleration"):
+        value = getattr(spec.limits, kind)
+        if value is None:
+            out.append(None)
+            continue
+        arr = np.asarray(value, float)
+        if arr.ndim == 0:
+            arr = np.broadcast_to(arr, (robot.n,))
+        if arr.shape != (robot.n,):
+            raise ModelError(f"expected one value or {robot.n}", file=file,
+                             field=f"limits.{kind}")
+        out.append(arr * scale)
+    return out[0], out[1]
 
 
 def _robot(spec: Any, file: Path) -> Any:

@@ -40,11 +40,9 @@ Import rules (documented in ``docs/urdf.md``):
 from __future__ import annotations
 
 import math
-import os
-import re
 import warnings
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -53,10 +51,22 @@ import numpy as np
 from robokin._text import short_repr
 from robokin.exceptions import ModelError
 from robokin.io.ros_packages import PackageFinder
+from robokin.io.urdf_geometry import (
+    Drops,
+    MissingMesh,
+    geometry_of,
+    resolve_mesh,
+    with_shapes,
+)
+from robokin.io.urdf_tool import (
+    axis_frame,
+    freeze_tool_tree,
+    link_owners,
+    resolve_mimic,
+)
 from robokin.io.urdf_xml import MAX_URDF_JOINTS, MOVABLE, parse_urdf
 from robokin.model.chain import Chain, ChainBuilder, Joint, JointKind
 from robokin.model.coupling import Dependency, coupling_from_dependencies, mimic
-from robokin.model.geometry import MESH_SUFFIXES, mesh_file_problem
 
 if TYPE_CHECKING:
     from robokin.io.dh_extract import DHExtraction
@@ -66,18 +76,15 @@ if TYPE_CHECKING:
 __all__ = [
     "MAX_URDF_JOINTS",
     "UrdfChain",
+    "axis_frame",
     "dh_from_robot",
     "dh_from_urdf",
     "parse_urdf",
+    "resolve_mesh",
     "robot_from_urdf",
 ]
 
-MissingMesh = Literal["warn", "error", "ignore"]
-_SCHEME = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]*)://")
 
-# Exact rotations that take the local z axis onto +x / +y (no cos(pi/2) residue).
-_Z_TO_X = np.array([[0.0, 0, 1, 0], [0, 1, 0, 0], [-1, 0, 0, 0], [0, 0, 0, 1]])
-_Z_TO_Y = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]])
 
 
 @dataclass(frozen=True)
@@ -221,38 +228,6 @@ def _invert(T: np.ndarray) -> np.ndarray:
     return out
 
 
-def axis_frame(axis: Sequence[float], *, where: str = "axis") -> tuple[np.ndarray, float]:
-    """A rotation ``A`` (4, 4) and sign with ``A @ Rz(sign q) @ A.T`` = rotation about ``axis``.
-
-    Axis-aligned axes give exact matrices; a negative axis (``-x``, ``-y``, ``-z``,
-    or any axis with a negative z component) gives ``sign = -1``.
-
-    Raises:
-        ModelError: a zero or non-finite axis.
-    """
-    u = np.asarray(axis, dtype=np.float64).reshape(-1)
-    norm = float(np.linalg.norm(u)) if u.shape == (3,) else 0.0
-    if u.shape != (3,) or not np.isfinite(u).all() or norm < 1e-12:
-        raise ModelError(f"the joint axis must be a non-zero 3-vector, got {u.tolist()}",
-                         field=where)
-    u = u / norm
-    nz = np.flatnonzero(np.abs(u) > 1e-15)
-    if len(nz) == 1:
-        i = int(nz[0])
-        sign = 1.0 if u[i] > 0 else -1.0
-        return ((_Z_TO_X, _Z_TO_Y, np.eye(4))[i]).copy(), sign
-    sign = 1.0
-    if u[2] < 0:
-        u, sign = -u, -1.0
-    # Minimal rotation taking z onto u (Rodrigues, 1 + cos >= 1 here).
-    v = np.array([-u[1], u[0], 0.0])
-    c = u[2]
-    K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    A = np.eye(4)
-    A[:3, :3] = np.eye(3) + K + K @ K / (1.0 + c)
-    return A, sign
-
-
 @dataclass(frozen=True)
 class UrdfChain:
     """What :func:`robot_from_urdf` made of the URDF, besides the chain.
@@ -263,9 +238,15 @@ class UrdfChain:
         child_links: The URDF child link of every chain joint (n_chain).
         link_frames: Every URDF link rigidly attached to the chain:
             ``name -> (k, T)``, the link's pose ``T`` (4, 4) in the frame ``k`` of
-            ``fk_all`` (0: the base link; k: chain joint k's child link).
+            ``fk_all`` (0: the base link; k: chain joint k's child link); the
+            tool's tree (fingers at ``tool_joints``) in frame ``n_chain``.
         dropped_links: Links not rigidly attached to the chain (they move with
-            joints off the chain), sorted.
+            joints off the chain, other than the tool's), sorted.
+        owners: The robokin link each placed URDF link belongs to: ``base``, a
+            chain joint's name, or ``tool`` (see :mod:`robokin.io.urdf_tool`).
+        tool_joints: The position [rad, m] each joint of the tool's tree is
+            frozen at (mimic joints included).
+        shaped_links: The URDF links whose shapes robokin's geometry holds.
     """
 
     base_link: str
@@ -273,6 +254,18 @@ class UrdfChain:
     child_links: tuple[str, ...]
     link_frames: Mapping[str, tuple[int, np.ndarray]]
     dropped_links: tuple[str, ...]
+    owners: Mapping[str, str] = field(default_factory=dict)
+    tool_joints: Mapping[str, float] = field(default_factory=dict)
+    shaped_links: frozenset[str] = frozenset()
+
+    def parts(self) -> dict[str, tuple[str, ...]]:
+        """The URDF links with shapes each robokin link holds: ``{link: (URDF links)}``."""
+        out: dict[str, list[str]] = {}
+        for link in sorted(self.shaped_links):
+            owner = self.owners.get(link)
+            if owner is not None:
+                out.setdefault(owner, []).append(link)
+        return {k: tuple(v) for k, v in out.items()}
 
 
 def _limits(j: Any, file: Path | None) -> tuple[float, float]:
@@ -313,36 +306,13 @@ def _kind(j: Any) -> JointKind:
     return "prismatic" if j.type == "prismatic" else "revolute"
 
 
-def _resolve_mimic(tree: _Tree, j: Any) -> tuple[Any, float, float]:
-    """The independent master of a mimic joint, with the composed multiplier/offset."""
-    mult, off, seen = 1.0, 0.0, {j.name}
-    cur = j
-    while cur.mimic is not None:
-        name = cur.mimic.joint
-        master = tree.joints.get(name)
-        where = f"joint[{cur.name}].mimic"
-        if master is None:
-            raise ModelError(f"mimics unknown joint '{name}'", file=tree.file, field=where)
-        if master.type not in MOVABLE:
-            raise ModelError(
-                f"mimics the {master.type} joint '{name}'", file=tree.file, field=where
-            )
-        if name in seen:
-            raise ModelError("mimic joints form a loop", file=tree.file, field=where)
-        seen.add(name)
-        m = 1.0 if cur.mimic.multiplier is None else float(cur.mimic.multiplier)
-        o = 0.0 if cur.mimic.offset is None else float(cur.mimic.offset)
-        mult, off = mult * m, mult * o + off
-        cur = master
-    return cur, mult, off
-
-
 def chain_from_urdf_model(
     robot: Any,
     *,
     base_link: str | None = None,
     tip_link: str | None = None,
     file: Path | None = None,
+    tool_joints: Mapping[str, float] | None = None,
 ) -> tuple[Chain, UrdfChain]:
     """Compile the chain ``base_link`` -> ``tip_link`` of a parsed URDF model.
 
@@ -351,6 +321,8 @@ def chain_from_urdf_model(
         base_link: Base link name (default: the root).
         tip_link: Tip link name (default: see the module docstring).
         file: The file, for error messages.
+        tool_joints: Positions of joints in the tool's tree (default: 0 clamped
+            into their limits); see :mod:`robokin.io.urdf_tool`.
 
     Returns:
         The canonical chain and the :class:`UrdfChain` bookkeeping.
@@ -422,7 +394,7 @@ def chain_from_urdf_model(
             add_coordinate(j)
             joint = Joint(j.name, kind, _limits(j, file), sign)
         else:
-            master, mult, off = _resolve_mimic(tree, j)
+            master, mult, off = resolve_mimic(tree.joints, j, file)
             add_coordinate(master)
             deps[j.name] = mimic(master.name, mult, off)
             lim = (-math.inf, math.inf) if j.limit is None else _limits(j, file)
@@ -448,6 +420,12 @@ def chain_from_urdf_model(
                 continue
             frames[j.child] = (kk, T @ _origin(j))
             stack.append(j.child)
+    # The tool's tree: subtrees below the last link's rigid body, joints frozen.
+    positions, left_out = freeze_tool_tree(
+        tree, frames, len(names), set(names) | coord_names, tool_joints, file)
+    for msg in left_out:
+        warnings.warn(f"{file or 'URDF'}: {msg} left out: they move with the arm",
+                      UserWarning, stacklevel=3)
     dropped = tuple(sorted(set(tree.links) - set(frames)))
     info = UrdfChain(
         base_link=base,
@@ -455,148 +433,10 @@ def chain_from_urdf_model(
         child_links=tuple(child_links),
         link_frames=frames,
         dropped_links=dropped,
+        owners=link_owners(frames, names, child_links[-1]),
+        tool_joints=positions,
     )
     return chain, info
-
-
-# ---------------------------------------------------------------------- geometry
-def _resolve_mesh(
-    filename: str, file: Path | None, packages: PackageFinder
-) -> tuple[Path | None, str]:
-    """Resolve a mesh reference to a path; ``(None, reason)`` when it cannot be."""
-    if filename.startswith("package://"):
-        rest = filename[len("package://"):]
-        pkg, _, sub = rest.partition("/")
-        root = packages.find(pkg)
-        if root is None:
-            return None, packages.not_found(pkg)
-        inside = os.path.normpath(sub)
-        if os.path.isabs(sub) or inside == ".." or inside.startswith(".." + os.sep):
-            return None, (f"the path leaves the package '{pkg}' (its folder {root}; "
-                          f"it resolves to {os.path.normpath(root / sub)}): not read")
-        return _mesh_file(root / sub)
-    if filename.startswith("file://"):
-        return _mesh_file(Path(filename[len("file://"):]))
-    scheme = _SCHEME.match(filename)
-    if scheme:
-        return None, f"a remote mesh ({scheme.group(1)}://) is not fetched"
-    p = Path(filename)
-    if not p.is_absolute():
-        if file is None:
-            return None, "a relative mesh path in a URDF string has no directory"
-        p = file.parent / p
-    return _mesh_file(p)
-
-
-def _mesh_file(p: Path) -> tuple[Path | None, str]:
-    """``p`` when it names an existing mesh file robokin reads, else the reason."""
-    if p.suffix.lower() not in MESH_SUFFIXES:
-        return None, (f"not a mesh file (suffix {short_repr(p.suffix)}; robokin "
-                      f"reads {', '.join(MESH_SUFFIXES)})")
-    problem = mesh_file_problem(p)
-    if problem is not None:
-        return None, problem
-    return p, ""
-
-
-class _Drops:
-    """Shapes left out of the import: raised, warned or only recorded."""
-
-    def __init__(self, mode: MissingMesh, file: Path | None) -> None:
-        self.mode, self.file = mode, file
-        self.messages: list[str] = []
-
-    def drop(self, link: str, role: str, uri: str, why: str) -> None:
-        msg = f"link '{link}' {role} mesh {short_repr(uri, 200)}: {why}"
-        if self.mode == "error":
-            raise ModelError(msg, file=self.file, field=f"link[{link}].{role}")
-        if self.mode == "warn":
-            warnings.warn(f"{msg}; shape skipped", UserWarning, stacklevel=4)
-        self.messages.append(msg)
-
-
-def _geometry_of(
-    urdf_robot: Any,
-    info: UrdfChain,
-    file: Path | None,
-    packages: PackageFinder,
-    drops: _Drops,
-) -> list[dict[str, Any]]:
-    """Every visual and collision shape of the chain's links, placed in fk_all frames.
-
-    Each entry: ``{"link": URDF link, "frame": k, "role": "visual"|"collision",
-    "pose": (4, 4) in frame k, "type": "box"|"cylinder"|"sphere"|"mesh",
-    "size"|"radius"|"length"|"filename"|"scale": ...}``.
-    """
-    out: list[dict[str, Any]] = []
-    for link in urdf_robot.links:
-        if link.name not in info.link_frames:
-            continue
-        k, T = info.link_frames[link.name]
-        for role, items in (("visual", link.visuals), ("collision", link.collisions)):
-            for item in items:
-                g = item.geometry
-                pose = T @ (np.eye(4) if item.origin is None else item.origin)
-                entry: dict[str, Any] = {
-                    "link": link.name, "frame": k, "role": role, "pose": pose,
-                    "name": item.name,
-                }
-                if g.box is not None:
-                    entry.update(type="box", size=tuple(float(v) for v in g.box.size))
-                elif g.cylinder is not None:
-                    entry.update(type="cylinder", radius=float(g.cylinder.radius),
-                                 length=float(g.cylinder.length))
-                elif g.sphere is not None:
-                    entry.update(type="sphere", radius=float(g.sphere.radius))
-                elif g.mesh is not None:
-                    path, why = _resolve_mesh(g.mesh.filename, file, packages)
-                    if path is None:
-                        drops.drop(link.name, role, g.mesh.filename, why)
-                        continue
-                    scale = g.mesh.scale
-                    scale = (1.0, 1.0, 1.0) if scale is None else tuple(
-                        float(v) for v in np.broadcast_to(scale, (3,))
-                    )
-                    entry.update(type="mesh", filename=str(path), scale=scale,
-                                 uri=g.mesh.filename)
-                else:  # pragma: no cover - _check_xml refuses empty geometry
-                    continue
-                out.append(entry)
-    return out
-
-
-def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]], drops: _Drops
-                     ) -> Robot:
-    """Put the collision shapes on the geometry layer.
-
-    Visual shapes stand in where a link has no collision shape.
-    """
-    from robokin.model import geometry as geo
-
-    names = geo.link_names(robot)
-    with_collision = {e["link"] for e in shapes if e["role"] == "collision"}
-    per_link: dict[str, list[Any]] = {}
-    for e in shapes:
-        if e["role"] == "visual" and e["link"] in with_collision:
-            continue
-        pose, label = e["pose"], e.get("name") or ""
-        t = e["type"]
-        if t == "box":
-            shape = geo.box(e["size"], pose, name=label)
-        elif t == "cylinder":
-            shape = geo.cylinder(e["radius"], e["length"], pose, name=label)
-        elif t == "sphere":
-            shape = geo.sphere(e["radius"], pose, name=label)
-        else:
-            sc = e["scale"]
-            if not (sc[0] == sc[1] == sc[2]):
-                drops.drop(e["link"], e["role"], e["uri"],
-                           f"non-uniform scale {list(sc)} is not supported")
-                continue
-            shape = geo.mesh(e["filename"], pose, scale=sc[0], name=label,
-                             owner=e["link"])
-        per_link.setdefault(names[e["frame"]], []).append(shape)
-    return robot.replace(geometry=geo.RobotGeometry.from_mapping(robot, per_link))
 
 
 # ------------------------------------------------------------------------ public
@@ -610,8 +450,15 @@ def robot_from_urdf(
     geometry: bool = True,
     missing_mesh: MissingMesh = "warn",
     name: str | None = None,
+    srdf: str | Path | bytes | None = None,
+    tool_joints: Mapping[str, float] | None = None,
 ) -> Robot:
     """Load the serial chain of a URDF or xacro as a robot (needs ``robokin[urdf]``).
+
+    Links hung by fixed joints anywhere on the chain move with their link, and
+    the links below the tip (a gripper's tree, its fingers frozen at
+    ``tool_joints``) join the tool (:mod:`robokin.io.urdf_tool`); their shapes
+    become those links' geometry.
 
     Args:
         path_or_string: A URDF file path, or the XML itself (a string starting
@@ -632,16 +479,29 @@ def robot_from_urdf(
             file that is not a mesh, a non-uniform scale): ``"warn"`` (default:
             a UserWarning naming the link and file, the shape is skipped),
             ``"error"`` (ModelError) or ``"ignore"`` (skipped silently; still
-            listed in ``meta["urdf_dropped_shapes"]``).
+            listed in ``meta["urdf_dropped_shapes"]``). Shapes left out for the
+            same reason (every mesh of a package that is not found) give one
+            warning.
         name: The robot's name (default: the URDF's ``<robot name>``).
+        srdf: The robot's SRDF (a path or the XML; :mod:`robokin.io.srdf`):
+            its ``<disable_collisions>`` pairs become self-collision exclusions
+            on robokin's links (:func:`robokin.io.srdf.excluded_link_pairs`)
+            and, as in MoveIt, every other pair is checked (adjacent links are
+            no longer skipped by default); without ``tip_link`` its end
+            effector's parent link (or its chain's tip) is the tip.
+        tool_joints: ``{joint: position}`` [rad, m] for joints of the tool's
+            tree (a gripper's fingers; default: 0 clamped into the limits).
 
     Returns:
         A :class:`~robokin.robot.Robot` (its ``dynamics`` from the links'
         ``<inertial>`` and the joints' ``effort``, see
         :mod:`robokin.io.urdf_inertial`) with ``robot.meta["urdf"]`` holding the
         :class:`UrdfChain`, ``robot.meta["urdf_shapes"]`` the shapes,
-        ``robot.meta["urdf_dropped_shapes"]`` one message per shape left out
-        and, for a xacro, ``robot.meta["xacro"]`` the
+        ``robot.meta["urdf_dropped_shapes"]`` one message per shape left out,
+        ``robot.meta["urdf_dropped_notes"]`` one per reason (what ``robokin
+        import`` prints), ``robot.meta["srdf"]`` the
+        :class:`~robokin.io.srdf.Srdf` (when given) and, for a xacro,
+        ``robot.meta["xacro"]`` the
         :class:`~robokin.io.xacro.XacroExpansion` (its ``urdf`` is the
         expanded text).
 
@@ -650,9 +510,11 @@ def robot_from_urdf(
             xacro, an error in it or a package that is not found.
         InputError: a package map folder that does not exist; ``xacro_args``
             for a file that is not a xacro, or naming an argument the xacro
-            does not declare.
+            does not declare; a ``tool_joints`` entry that is not a joint of
+            the tool's tree or is outside its limits.
         MissingExtraError: yourdfpy (or, for a xacro, xacro) is not installed.
     """
+    from robokin.io.srdf import parse_srdf
     from robokin.robot import Robot
 
     if missing_mesh not in ("warn", "error", "ignore"):
@@ -663,13 +525,20 @@ def robot_from_urdf(
         )
     expansion, urdf_robot, file = _parse_source(path_or_string, package_map,
                                                 xacro_args)
+    semantic = None if srdf is None else parse_srdf(srdf)
+    if semantic is not None:
+        links = {link.name for link in urdf_robot.links}
+        semantic.check_links(links, urdf_robot.name)
+        if tip_link is None:
+            tip_link = semantic.default_tip(links)
     chain, info = chain_from_urdf_model(
-        urdf_robot, base_link=base_link, tip_link=tip_link, file=file
+        urdf_robot, base_link=base_link, tip_link=tip_link, file=file,
+        tool_joints=tool_joints,
     )
-    drops = _Drops(missing_mesh, file)
+    drops = Drops(missing_mesh, file)
     packages = expansion.packages if expansion is not None else \
         PackageFinder(package_map, near=file)
-    shapes = _geometry_of(urdf_robot, info, file, packages, drops) if geometry \
+    shapes = geometry_of(urdf_robot, info, file, packages, drops) if geometry \
         else []
     source = "URDF string" if file is None else \
         f"{'xacro' if expansion is not None else 'URDF'} {file}"
@@ -685,14 +554,15 @@ def robot_from_urdf(
         meta=meta,
         rate_limits=_velocity_limits(urdf_robot, chain, source),
     )
-    if shapes:
-        robot = _attach_geometry(robot, shapes, drops)
+    robot = with_shapes(robot, shapes, drops, info, semantic)
     from robokin.io.urdf_inertial import dynamics_from_urdf
 
     robot = robot.replace(dynamics=dynamics_from_urdf(robot, urdf_robot,
                                                       info.link_frames, file))
+    drops.report(stacklevel=2)
     return robot.replace(meta={**robot.meta,
-                               "urdf_dropped_shapes": tuple(drops.messages)})
+                               "urdf_dropped_shapes": tuple(drops.messages),
+                               "urdf_dropped_notes": drops.notes()})
 
 
 def _parse_source(

@@ -20,7 +20,8 @@ from robokin._validation import MAX_TRANSLATION
 from robokin.exceptions import MissingExtraError, ModelError
 from robokin.io.text_files import read_file_bytes
 
-__all__ = ["JOINT_TYPES", "MAX_URDF_JOINTS", "MOVABLE", "parse_urdf"]
+__all__ = ["JOINT_TYPES", "MAX_URDF_JOINTS", "MOVABLE", "parse_urdf",
+           "parse_xml_strictly", "read_source"]
 
 #: Joint types that move.
 MOVABLE = ("revolute", "continuous", "prismatic")
@@ -38,7 +39,7 @@ def _yourdfpy():
     return yourdfpy
 
 
-def _read_source(source: str | Path | bytes) -> tuple[bytes, Path | None]:
+def read_source(source: str | Path | bytes) -> tuple[bytes, Path | None]:
     """The XML bytes and the file they came from (None for a string)."""
     if isinstance(source, bytes):
         return source, None
@@ -61,8 +62,20 @@ def _xml_parser() -> Any:
                            huge_tree=False)
 
 
-def _check_xml(data: bytes, file: Path | None) -> None:
-    """Strict XML parse (yourdfpy silently 'recovers' broken XML) and structure."""
+def parse_xml_strictly(data: bytes, file: Path | None, what: str = "URDF") -> Any:
+    """The root element of an XML document, parsed strictly and safely.
+
+    lxml with entities, DTDs, the network and huge trees off
+    (:func:`_xml_parser`); a ``<!DOCTYPE>`` is refused. Used for URDF and SRDF.
+
+    Args:
+        data: The document's bytes.
+        file: Its file, for messages (None for a string).
+        what: The kind of document, for messages (``"URDF"``, ``"SRDF"``).
+
+    Raises:
+        ModelError: malformed XML or a ``<!DOCTYPE>`` (naming the file and line).
+    """
     from lxml import etree
 
     try:
@@ -72,8 +85,14 @@ def _check_xml(data: bytes, file: Path | None) -> None:
                          line=getattr(exc, "lineno", None)) from None
     if tree.docinfo.doctype or tree.docinfo.internalDTD is not None:
         raise ModelError("a <!DOCTYPE> (a DTD, entity declarations) is not allowed "
-                         "in a URDF", file=file, line=1)
-    root = tree.getroot()
+                         f"in a{'n' if what[0] in 'AEFHILMNORSX' else ''} {what}",
+                         file=file, line=1)
+    return tree.getroot()
+
+
+def _check_xml(data: bytes, file: Path | None) -> None:
+    """Strict XML parse (yourdfpy silently 'recovers' broken XML) and structure."""
+    root = parse_xml_strictly(data, file)
     if root.tag != "robot":
         raise ModelError(f"the root element must be <robot>, got "
                          f"<{short_repr(root.tag, 40)}>", file=file,
@@ -233,7 +252,7 @@ def parse_urdf(source: str | Path | bytes) -> tuple[Any, Path | None]:
             file, the element and the line).
         MissingExtraError: yourdfpy is not installed.
     """
-    data, file = _read_source(source)
+    data, file = read_source(source)
     _check_xml(data, file)
     yourdfpy = _yourdfpy()
     try:

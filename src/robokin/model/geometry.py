@@ -55,6 +55,7 @@ if TYPE_CHECKING:
 __all__ = [
     "LENGTH_UNITS",
     "MAX_MESH_BYTES",
+    "MAX_MESH_VERTICES",
     "MESH_SUFFIXES",
     "SHAPE_KINDS",
     "HasChain",
@@ -64,11 +65,13 @@ __all__ = [
     "box",
     "capsule",
     "capsule_between",
+    "cone",
     "cylinder",
     "cylinder_between",
     "link_names",
     "mesh",
     "mesh_file_problem",
+    "mesh_from_arrays",
     "segment_pose",
     "sphere",
 ]
@@ -79,6 +82,8 @@ MESH_SUFFIXES = (".stl", ".obj", ".dae", ".ply", ".off", ".glb", ".gltf")
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
 #: Largest mesh file loaded [bytes] (256 MiB).
 MAX_MESH_BYTES = 256 * 2**20
+#: Most vertices of a mesh given in memory (a MoveIt scene's mesh).
+MAX_MESH_VERTICES = 1_000_000
 
 
 class HasChain(Protocol):
@@ -118,9 +123,12 @@ class Shape:
             sphere ``(radius,)``; mesh ``()`` [m].
         placement: Pose of the shape in its parent frame, (4, 4) [m].
         name: Optional label.
-        file: The mesh file (meshes only).
+        file: The mesh file (meshes only; None for a mesh given in memory).
         scale: Factor from mesh-file units to metres (meshes only).
         owner: The link or object the shape belongs to (for error messages).
+        vertices: A mesh given in memory (a MoveIt scene's mesh, a cone):
+            vertices (V, 3) [m] in the shape's frame; None for a mesh file.
+        faces: Its triangles (F, 3), indices into ``vertices``.
     """
 
     kind: ShapeKind
@@ -130,6 +138,8 @@ class Shape:
     file: Path | None = None
     scale: float = 1.0
     owner: str = ""
+    vertices: np.ndarray | None = None
+    faces: np.ndarray | None = None
     # derived data (bounds, coal and trimesh objects), built on first use
     _cache: dict[str, Any] = field(init=False, repr=False, default_factory=dict)
 
@@ -160,15 +170,54 @@ class Shape:
         object.__setattr__(self, "size", size)
         object.__setattr__(self, "placement", _placement(self.placement))
         if self.kind == "mesh":
-            if self.file is None:
-                raise InputError("file", "a mesh shape needs a file")
-            object.__setattr__(self, "file", Path(self.file))
+            if (self.vertices is None) != (self.faces is None):
+                raise InputError("vertices", "a mesh in memory needs both vertices "
+                                 "and faces")
+            if self.vertices is not None:
+                self._check_memory_mesh()
+            elif self.file is None:
+                raise InputError("file", "a mesh shape needs a file (or vertices "
+                                 "and faces)")
+            else:
+                object.__setattr__(self, "file", Path(self.file))
             if not (math.isfinite(self.scale) and self.scale > 0):
                 raise InputError("scale", f"must be positive, got {self.scale}")
+        elif self.vertices is not None or self.faces is not None:
+            raise InputError("vertices", f"only a mesh has vertices, not a {self.kind}")
+
+    def _check_memory_mesh(self) -> None:
+        """Check and freeze a mesh given in memory (vertices in metres, scale 1)."""
+        if self.file is not None or self.scale != 1.0:
+            raise InputError("vertices", "a mesh in memory has no file and scale 1 "
+                             "(its vertices are in metres)")
+        v = np.array(self.vertices, dtype=np.float64)
+        try:
+            f = np.array(self.faces, dtype=np.int64)
+        except (TypeError, ValueError, OverflowError):
+            raise InputError("faces", "expected integer vertex indices") from None
+        if v.ndim != 2 or v.shape[1] != 3 or len(v) < 3:
+            raise InputError("vertices", f"expected (V >= 3, 3) points, got {v.shape}")
+        if f.ndim != 2 or f.shape[1] != 3 or len(f) < 1:
+            raise InputError("faces", f"expected (F >= 1, 3) triangles, got {f.shape}")
+        if len(v) > MAX_MESH_VERTICES or len(f) > 2 * MAX_MESH_VERTICES:
+            raise InputError("vertices", f"{len(v):,} vertices and {len(f):,} "
+                             f"triangles: robokin takes at most {MAX_MESH_VERTICES:,} "
+                             "vertices (robokin.model.geometry.MAX_MESH_VERTICES)")
+        if not np.isfinite(v).all():
+            raise InputError("vertices", "not finite (NaN or infinity)")
+        if f.min() < 0 or f.max() >= len(v):
+            raise InputError("faces", f"vertex indices must be in [0, {len(v) - 1}], "
+                             f"got {int(f.min())}..{int(f.max())}")
+        v.setflags(write=False)
+        f.setflags(write=False)
+        object.__setattr__(self, "vertices", v)
+        object.__setattr__(self, "faces", f)
 
     def __repr__(self) -> str:
         """A short summary: kind, size, and the file of a mesh."""
         extra = f", file={str(self.file)!r}" if self.file is not None else ""
+        if self.vertices is not None and self.faces is not None:
+            extra = f", vertices={len(self.vertices)}, faces={len(self.faces)}"
         return f"Shape({self.kind!r}, size={self.size}{extra})"
 
     def placed(self, T: npt.ArrayLike) -> Shape:
@@ -204,6 +253,8 @@ class Shape:
             m = trimesh.creation.cylinder(radius=self.size[0], height=self.size[1])
         elif k == "capsule":
             m = trimesh.creation.capsule(height=self.size[1], radius=self.size[0])
+        elif self.vertices is not None:
+            m = trimesh.Trimesh(vertices=self.vertices, faces=self.faces, process=False)
         else:
             m = _load_mesh(self.file, self.scale, self.owner)
         cache["trimesh"] = m
@@ -494,6 +545,60 @@ def mesh(
         scale=LENGTH_UNITS[units] * float(scale),
         owner=owner,
     )
+
+
+def mesh_from_arrays(
+    vertices: npt.ArrayLike,
+    faces: npt.ArrayLike,
+    placement: npt.ArrayLike | None = None,
+    *,
+    name: str = "",
+    owner: str = "",
+) -> Shape:
+    """A mesh given in memory: ``vertices`` (V, 3) [m] and triangles ``faces`` (F, 3).
+
+    Raises:
+        InputError: bad shapes, non-finite vertices, indices out of range, or more
+            than :data:`MAX_MESH_VERTICES` vertices.
+    """
+    return Shape("mesh", (), _placement(placement), name=name, owner=owner,
+                 vertices=np.asarray(vertices), faces=np.asarray(faces))
+
+
+def cone(
+    radius: float,
+    length: float,
+    placement: npt.ArrayLike | None = None,
+    *,
+    segments: int = 32,
+    name: str = "",
+) -> Shape:
+    """A cone along local z as a mesh that contains it (robokin has no cone primitive).
+
+    As MoveIt's (``geometric_shapes``) cone: the base circle of ``radius`` at
+    ``z = -length / 2``, the tip at ``z = +length / 2``. The base is a regular
+    polygon of ``segments`` sides *around* the circle (its corners at
+    ``radius / cos(pi / segments)``), so the mesh contains the cone and a check
+    against it is never optimistic (it is at most 0.5 % wider with 32 sides).
+
+    Raises:
+        InputError: a radius or length that is not positive and finite.
+    """
+    r, L = float(radius), float(length)
+    if not (math.isfinite(r) and r > 0 and math.isfinite(L) and L > 0):
+        raise InputError("size", f"a cone needs a positive radius and length, got "
+                         f"({radius}, {length})")
+    k = int(segments)
+    if k < 3:
+        raise InputError("segments", f"at least 3, got {segments}")
+    a = 2 * math.pi * np.arange(k) / k
+    R = r / math.cos(math.pi / k)
+    ring = np.stack([R * np.cos(a), R * np.sin(a), np.full(k, -L / 2)], axis=1)
+    vertices = np.vstack([ring, [[0.0, 0.0, L / 2], [0.0, 0.0, -L / 2]]])
+    i = np.arange(k)
+    side = np.stack([i, (i + 1) % k, np.full(k, k)], axis=1)
+    bottom = np.stack([(i + 1) % k, i, np.full(k, k + 1)], axis=1)
+    return mesh_from_arrays(vertices, np.vstack([side, bottom]), placement, name=name)
 
 
 # ---------------------------------------------------------------- robot geometry

@@ -28,15 +28,15 @@ if TYPE_CHECKING:
 
 __all__ = ["CollisionModel", "EdgeReport", "StateReport"]
 
-#: Core kind of each shape kind (plan_geom.c's PK_*).
+#: Core kind of each shape kind (plan_geom.c's PG_*).
 _CORE = {
-    "sphere": _k.PK_POINT,
-    "capsule": _k.PK_SEGMENT,
-    "box": _k.PK_BOX,
-    "cylinder": _k.PK_CYLINDER,
-    "mesh": _k.PK_HULL,
+    "sphere": _k.PG_POINT,
+    "capsule": _k.PG_SEGMENT,
+    "box": _k.PG_BOX,
+    "cylinder": _k.PG_CYLINDER,
+    "mesh": _k.PG_HULL,
 }
-_ROUND = (_k.PK_POINT, _k.PK_SEGMENT)
+_ROUND = (_k.PG_POINT, _k.PG_SEGMENT)
 
 
 @dataclass(frozen=True)
@@ -178,13 +178,13 @@ class CollisionModel:
             a = int(pr.pa[p])
             b = int(pr.pb[p]) + (0 if pr.is_self[p] else S)
             ka, kb = int(kinds[a]), int(kinds[b])
-            if ka == _k.PK_HULL or kb == _k.PK_HULL:
+            if ka == _k.PG_HULL or kb == _k.PG_HULL:
                 method = _k.PD_HULL
             elif ka in _ROUND and kb in _ROUND:
                 method = _k.PD_SEGSEG
-            elif ka in _ROUND and kb == _k.PK_BOX:
+            elif ka in _ROUND and kb == _k.PG_BOX:
                 method = _k.PD_SEGBOX
-            elif ka == _k.PK_BOX and kb in _ROUND:
+            elif ka == _k.PG_BOX and kb in _ROUND:
                 method = _k.PD_BOXSEG
             else:
                 method = _k.PD_GJK

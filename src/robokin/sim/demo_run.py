@@ -57,6 +57,8 @@ def _img(path: Path, alt: str) -> str:
 
 
 def _section_html(s: dict[str, Any], files: dict[str, Path]) -> str:
+    from robokin.sim.report import speed_text
+
     e = html.escape
     rows = []
     for r in s["joints"]:
@@ -83,7 +85,7 @@ properties: {e(s['mass_properties'])}.</p>
 <p><b>{e(verdict)}</b> (tolerance {tol['angle_deg']:.2g} deg, {tol['length_mm']:.2g} mm;
 torques against the published limits where known; contacts: {e(contacts)}).
 {t['simulated_s']:.1f} s simulated in {t['wall_s']:.2f} s:
-{t['real_time_factor']:.4f} x real time. Minimum clearance of the simulated motion
+{e(speed_text(t['real_time_factor']))}. Minimum clearance of the simulated motion
 {s['simulated_min_clearance_mm']:.2f} mm (plan {s['plan_min_clearance_mm']:.2f} mm).</p>
 <table><tr><th>joint</th><th>max |error| [deg]</th><th>at [s]</th><th>RMS [deg]</th>
 <th>corr(|error|, |acc|)</th><th>peak torque [N m]</th><th>required (inverse

@@ -548,7 +548,7 @@ class _Writer:
                     ET.SubElement(contact, "exclude", {"body1": names[a],
                                                        "body2": names[b]})
         if self.scene is not None:
-            for pair in sorted(sorted(p) for p in self.scene.exclude):
+            for pair in sorted(sorted(p) for p in self.scene.excluded_pairs(self.robot)):
                 link = [x for x in pair if x in names]
                 obj = [x for x in pair if x in self.scene.names]
                 if link and obj:

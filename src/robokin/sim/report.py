@@ -20,7 +20,8 @@ if TYPE_CHECKING:
     from robokin.sim.inverse import InverseDynamics
     from robokin.sim.simulate import SimResult
 
-__all__ = ["RUN_FILES", "plot_decoupling", "plot_torques", "run_summary", "write_run"]
+__all__ = ["RUN_FILES", "plot_decoupling", "plot_torques", "run_summary", "speed_text",
+           "write_run"]
 
 
 def _unit(revolute: bool) -> tuple[str, str]:
@@ -116,6 +117,26 @@ def plot_decoupling(check: Any, *, path: str | Path | None = None,
     if path is not None:
         save_figure(fig, path, overwrite=overwrite)
     return fig
+
+
+def speed_text(real_time_factor: float) -> str:
+    """How fast a run went against the clock, in words.
+
+    Args:
+        real_time_factor: Wall time per simulated second (below 1: faster).
+
+    Returns:
+        ``"80x faster than real time"``, ``"2.5x slower than real time"`` or
+        ``"at about real time"`` (within 5 %).
+    """
+    rtf = float(real_time_factor)
+    if not math.isfinite(rtf) or rtf <= 0:
+        return "at an unknown speed"
+    if abs(rtf - 1.0) <= 0.05:
+        return "at about real time"
+    ratio = 1.0 / rtf if rtf < 1.0 else rtf
+    shown = f"{ratio:.0f}" if ratio >= 10 else f"{ratio:.1f}"
+    return f"{shown}x {'faster' if rtf < 1.0 else 'slower'} than real time"
 
 
 def _display(revolute: bool) -> tuple[float, str]:

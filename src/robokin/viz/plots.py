@@ -127,7 +127,7 @@ def plot_cross_section(
         at: Position of the slab along the third axis [m]; default the middle
             of the bounds.
         thickness: Slab thickness [m]; default 5 % of the extent along the
-            third axis (at least one voxel).
+            third axis (at least 1 % of the largest extent).
         color_by: ``"manipulability"`` colours the subset with known
             manipulability; ``"density"`` draws a 2D histogram of all samples.
         ax: A matplotlib Axes to draw in; a new figure when None.
@@ -143,7 +143,7 @@ def plot_cross_section(
     lo, hi = ws.bounds[0, c], ws.bounds[1, c]
     at = 0.5 * (lo + hi) if at is None else float(at)
     if thickness is None:
-        thickness = max(0.05 * (hi - lo), ws.voxel_size)
+        thickness = max(0.05 * (hi - lo), 0.01 * float(np.max(ws.extent)))
     names = "xyz"
     if color_by == "manipulability" and ws.manipulability.size:
         pts = ws.points[ws.manipulability_index]
@@ -202,14 +202,20 @@ def save_workspace_plots(ws: Any, out_dir: str | Path) -> list[Path]:
     if not out.is_dir():
         raise InputError("out_dir", f"{out} is not a folder")
     written = []
+    paths = dict(zip(("xy", "xz"), workspace_plot_paths(ws.robot_name, out)))
     for plane in ("xy", "xz"):
         fig = _figure(figsize=(12.0, 5.5))
         axes = fig.subplots(1, 2)
         plot_cross_section(ws, plane, color_by="manipulability", ax=axes[0])
         plot_cross_section(ws, plane, color_by="density", ax=axes[1])
-        name = f"{file_stem(ws.robot_name)}_workspace_{plane}.png"
-        written.append(save_figure(fig, out / name, overwrite=True, dpi=110))
+        written.append(save_figure(fig, paths[plane], overwrite=True, dpi=110))
     return written
+
+
+def workspace_plot_paths(robot_name: str, out_dir: str | Path) -> list[Path]:
+    """The files :func:`save_workspace_plots` writes for ``robot_name``: XY, then XZ."""
+    return [Path(out_dir) / f"{file_stem(robot_name)}_workspace_{plane}.png"
+            for plane in ("xy", "xz")]
 
 
 def _finish(fig, path, overwrite):

@@ -139,7 +139,7 @@ def test_panda_with_joint7_held_is_complete_against_a_numeric_reference():
         q = rng.uniform(lim[:, 0], lim[:, 1])
         T = robot.fk(q)
         sols = robot.ik(T, fixed={"joint7": q[6]})
-        assert sols.method == "general_6r (joint7 held)"
+        assert sols.method == "analytic:pieper (joint7 held)"
         assert any(np.allclose(x, q, atol=1e-6) for x in sols)
         moved = fixed_ik._moved_targets(robot, "last", T[None], np.array([q[6]]))[0]
         ref = numeric.solve_all(reduced, moved, n_seeds=1500,
@@ -148,3 +148,54 @@ def test_panda_with_joint7_held_is_complete_against_a_numeric_reference():
         for r in ref.q[ref.valid]:
             assert np.abs(ours - r).max(axis=1).min() < 1e-6
         assert len(ours) == len(ref.q[ref.valid])
+
+
+def test_readme_example_gives_back_the_configuration():
+    # issue 23: the README's example returned 4 rows, none of them qp, all outside
+    # the limits; the closed form must return qp and held.nearest(qp) must be qp
+    panda = robokin.load("panda")
+    qp = np.array([0.0, -0.3, 0.0, -2.0, 0.0, 1.8, 0.7])
+    held = panda.ik(panda.fk(qp), fixed={"joint7": 0.7})
+    assert held.method == "analytic:pieper (joint7 held)"
+    assert held.info["held"] == {"joint7": 0.7}
+    near = held.nearest(qp)
+    np.testing.assert_allclose(near, qp, atol=1e-12)
+    inside = held.q[held.valid & held.within_limits]
+    assert np.abs(inside - qp).max(axis=1).min() <= 1e-12
+
+
+def test_the_single_pose_path_equals_the_batch_and_a_sweep_equals_single_values():
+    # the hot path (one pose, a number held) and the batch kernel give the same
+    # rows, flags and slots; a sweep of a middle joint (joint 5, a new remaining
+    # chain per value) equals one call per value
+    panda = robokin.load("panda")
+    rng = np.random.default_rng(11)
+    lim = panda.limits
+    q = rng.uniform(lim[:, 0], lim[:, 1], (40, 7))
+    T = panda.fk(q)
+    for j in (3, 4, 6):
+        name = panda.joint_names[j]
+        batch = panda.ik(T, fixed={name: q[:, j]})
+        for i in range(0, 40, 7):
+            one = panda.ik(T[i], fixed={name: float(q[i, j])})
+            np.testing.assert_array_equal(one.valid, batch[i].valid)
+            np.testing.assert_array_equal(one.q, batch[i].q)
+            np.testing.assert_array_equal(one.singular, batch[i].singular)
+    values = q[0, 4] + np.linspace(-0.2, 0.2, 9)
+    sweep = panda.ik(T[0], fixed={"joint5": values})
+    assert sweep.shape == (9,)
+    for i, v in enumerate(values):
+        one = panda.ik(T[0], fixed={"joint5": float(v)})
+        np.testing.assert_array_equal(one.q, sweep[i].q)
+
+
+def test_held_closed_form_passes_q_near_and_compute_error():
+    panda = robokin.load("panda")
+    T = panda.fk(Q0)
+    sols = panda.ik(T, fixed={"joint7": Q0[6]}, q_near=Q0, compute_error=True)
+    assert sols.method == "analytic:pieper (joint7 held)"
+    assert np.all(sols.error[sols.valid] <= 1e-12)
+    np.testing.assert_allclose(sols.nearest(Q0), Q0, atol=1e-12)
+    # the numeric method still goes the reduced-chain way
+    num = panda.ik(T, fixed={"joint7": Q0[6]}, method="numeric")
+    assert "held" in num.method and "pieper" not in num.method

@@ -23,6 +23,8 @@
 #include "plan_rrtc.c"
 #include "plan_path.c"
 #include "general6r.c"
+#include "manipulability.c"
+#include "pieper.c"
 
 /* ---------------------------------------------------------------- arguments */
 
@@ -579,6 +581,8 @@ static PyMethodDef methods[] = {
     PLAN_RRTC_METHODS
     PLAN_PATH_METHODS
     GENERAL6R_METHODS
+    MANIPULABILITY_METHODS
+    PIEPER_METHODS
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, MODULE_NAME,
@@ -611,8 +615,9 @@ PyMODINIT_FUNC MODULE_INIT(void)
     PyModule_AddObject(m, "LAYOUT_TAG", PyFloat_FromDouble(PACKED_TAG));
     PyModule_AddObject(m, "MAX_TRANSLATION", PyFloat_FromDouble(MAX_TRANSLATION));
     if (six_r_constants(m) < 0 || broadphase_constants(m) < 0 ||
-        general6r_constants(m) < 0 || plan_check_constants(m) < 0 ||
-        plan_rrtc_constants(m) < 0 || plan_path_constants(m) < 0) {
+        general6r_constants(m) < 0 || pieper_constants(m) < 0 ||
+        plan_check_constants(m) < 0 || plan_rrtc_constants(m) < 0 ||
+        plan_path_constants(m) < 0) {
         Py_DECREF(m);
         return NULL;
     }

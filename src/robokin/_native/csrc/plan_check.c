@@ -891,22 +891,22 @@ static int model_fill(PlanModel *M, PyArrayObject **a, long S)
     const double *sf = bp_f64(a[SF]);
     for (long x = 0; x < N; x++) {
         long long kind = si[4 * x], link = si[4 * x + 1], hs = si[4 * x + 2], hn = si[4 * x + 3];
-        if (kind < PK_POINT || kind > PK_HULL || (x < S ? (link < 0 || link > nc + 1) : link != -1) ||
-            hs < 0 || hn < 0 || hs + hn > H || (kind == PK_HULL && hn < 1))
+        if (kind < PG_POINT || kind > PG_HULL || (x < S ? (link < 0 || link > nc + 1) : link != -1) ||
+            hs < 0 || hn < 0 || hs + hn > H || (kind == PG_HULL && hn < 1))
             return 0;
         M->kind[x] = (int)kind;
         M->link[x] = (int)link;
         M->hs[x] = (int)hs;
         M->hn[x] = (int)hn;
-        M->centre_in[x] = kind != PK_HULL;
-        M->core_ok[x] = kind == PK_POINT || kind == PK_SEGMENT || kind == PK_BOX;
+        M->centre_in[x] = kind != PG_HULL;
+        M->core_ok[x] = kind == PG_POINT || kind == PG_SEGMENT || kind == PG_BOX;
         memcpy(M->rb + 16 * x, sf + 21 * x, 16 * sizeof(double));
         memcpy(M->h + 3 * x, sf + 21 * x + 16, 3 * sizeof(double));
         M->rad[x] = sf[21 * x + 19];
         M->cr[x] = sf[21 * x + 20];
         const double *h = M->h + 3 * x;
         double rho = sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
-        if (kind == PK_HULL) {
+        if (kind == PG_HULL) {
             rho = 0.0;
             for (long k = hs; k < hs + hn; k++)
                 rho = dmax(rho, sqrt(dot3(M->hull + 3 * k, M->hull + 3 * k)));
@@ -1172,8 +1172,8 @@ static int plan_check_constants(PyObject *m)
 {
     static const struct { const char *name; int value; } ints[] = {
         {"PC_FREE", PC_FREE}, {"PC_HIT", PC_HIT}, {"PC_UNDECIDED", PC_UNDECIDED},
-        {"PK_POINT", PK_POINT}, {"PK_SEGMENT", PK_SEGMENT}, {"PK_BOX", PK_BOX},
-        {"PK_CYLINDER", PK_CYLINDER}, {"PK_HULL", PK_HULL}, {"PD_SEGSEG", PD_SEGSEG},
+        {"PG_POINT", PG_POINT}, {"PG_SEGMENT", PG_SEGMENT}, {"PG_BOX", PG_BOX},
+        {"PG_CYLINDER", PG_CYLINDER}, {"PG_HULL", PG_HULL}, {"PD_SEGSEG", PD_SEGSEG},
         {"PD_SEGBOX", PD_SEGBOX}, {"PD_BOXSEG", PD_BOXSEG}, {"PD_GJK", PD_GJK},
         {"PD_HULL", PD_HULL}};
     for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)

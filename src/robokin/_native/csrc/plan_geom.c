@@ -18,7 +18,7 @@
  */
 #include "chain.h"
 
-enum { PK_POINT = 0, PK_SEGMENT = 1, PK_BOX = 2, PK_CYLINDER = 3, PK_HULL = 4 };
+enum { PG_POINT = 0, PG_SEGMENT = 1, PG_BOX = 2, PG_CYLINDER = 3, PG_HULL = 4 };
 
 #define GJK_MAX_ITER 64  /* iterations of gjk_lower (polytopes finish in a few) */
 #define GJK_REL 1e-12    /* stop when |v|^2 - v.w <= GJK_REL |v|^2: lb >= (1 - 1e-12) ub */
@@ -53,14 +53,14 @@ static void core_support(const Core *c, const double *d, double *out)
     for (int a = 0; a < 3; a++) /* d in the core's frame: R^T d */
         l[a] = T[a] * d[0] + T[4 + a] * d[1] + T[8 + a] * d[2];
     switch (c->kind) {
-    case PK_SEGMENT:
+    case PG_SEGMENT:
         x[2] = l[2] >= 0.0 ? c->h[2] : -c->h[2];
         break;
-    case PK_BOX:
+    case PG_BOX:
         for (int a = 0; a < 3; a++)
             x[a] = l[a] >= 0.0 ? c->h[a] : -c->h[a];
         break;
-    case PK_CYLINDER: {
+    case PG_CYLINDER: {
         double rr = sqrt(l[0] * l[0] + l[1] * l[1]);
         if (rr > 0.0) {
             x[0] = c->cr * l[0] / rr;
@@ -69,7 +69,7 @@ static void core_support(const Core *c, const double *d, double *out)
         x[2] = l[2] >= 0.0 ? c->h[2] : -c->h[2];
         break;
     }
-    case PK_HULL: {
+    case PG_HULL: {
         double best = -INFINITY;
         int k = 0;
         for (int i = 0; i < c->nv; i++) {
@@ -86,7 +86,7 @@ static void core_support(const Core *c, const double *d, double *out)
         }
         break;
     }
-    default: /* PK_POINT */
+    default: /* PG_POINT */
         break;
     }
     for (int a = 0; a < 3; a++)
@@ -406,7 +406,7 @@ static double seg_box(const double *p, const double *q, const double *h)
 static inline void core_ends(const Core *c, double *p, double *q)
 {
     const double *T = c->T;
-    double hz = c->kind == PK_SEGMENT ? c->h[2] : 0.0;
+    double hz = c->kind == PG_SEGMENT ? c->h[2] : 0.0;
     for (int a = 0; a < 3; a++) {
         p[a] = T[4 * a + 3] - hz * T[4 * a + 2];
         q[a] = T[4 * a + 3] + hz * T[4 * a + 2];

@@ -15,6 +15,7 @@ from robokin._validation import (
     check_poses_fast,
 )
 from robokin.exceptions import InputError
+from robokin.kinematics.ik.fixed import solve_fixed
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
 
@@ -42,9 +43,10 @@ def solve(
     """
     if method not in _METHODS:
         raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
+    if len(options) == 1 and "fixed" in options:
+        # held joints, no other option: no re-packing of the keyword arguments
+        return solve_fixed(robot, T, options["fixed"], q_near=q_near, method=method)
     if "fixed" in options:
-        from robokin.kinematics.ik.fixed import solve_fixed
-
         return solve_fixed(robot, T, options.pop("fixed"), q_near=q_near, method=method,
                            **options)
     qn: npt.NDArray[np.float64] | None = None

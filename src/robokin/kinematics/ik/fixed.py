@@ -1,10 +1,19 @@
 """IK with some joints given: every solution of the remaining chain.
 
 A 7R arm such as the Panda has infinitely many solutions for a pose; with one joint
-held at a chosen value the remaining 6R chain has finitely many, and the general 6R
-solver finds them all. ``robot.ik(T, fixed={"joint7": 0.3})`` does that; an array
-of values (broadcasting with the poses) sweeps the redundancy parameter, e.g. the
-self-motion manifold of one pose as a batch.
+held at a chosen value the remaining 6R chain has finitely many.
+``robot.ik(T, fixed={"joint7": 0.3})`` finds them all; an array of values
+(broadcasting with the poses) sweeps the redundancy parameter, e.g. the self-motion
+manifold of one pose as a batch.
+
+When three consecutive axes of the six joints left meet in a point (the Panda with
+joint 4, 5, 6 or 7 held, an SRS arm with any joint held: with the elbow held
+both triples meet and the six joints move in a swivel family) the
+``pieper`` closed form solves them (``analytic/pieper.py``): its compiled kernel
+takes the held value with each pose and builds the remaining chain itself, so one
+set-up per (chain, held joint) serves every value, and a single pose with a number
+held takes a hot path (one compiled call). Otherwise the remaining chain is built
+and solved by ``Robot.ik`` (the general 6R solver for a 6R chain):
 
 When the held joint is the first or the last of a chain without dependent joints,
 the remaining chain does not depend on its value: one reduced chain (value 0)
@@ -17,6 +26,7 @@ from __future__ import annotations
 
 from collections import OrderedDict
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -30,6 +40,7 @@ from robokin._validation import (
     check_poses_fast,
 )
 from robokin.exceptions import InputError
+from robokin.kinematics.ik.analytic import pieper as _pk
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.per_chain import cached
 from robokin.model.chain import joint_motion
@@ -70,6 +81,16 @@ def solve_fixed(
         InputError: an unknown joint name (the message lists them), a non-finite
             value, values that do not broadcast with the poses, or every joint held.
     """
+    if (q_near is None and not options and type(fixed) is dict and len(fixed) == 1
+            and type(T) is np.ndarray and method != "numeric"):
+        # hot path: one pose, one joint held at a number, a closed form (the compiled
+        # call checks T's type, shape and rigidity, and that the value is finite)
+        ((name, value),) = fixed.items()
+        held = _held_solvers(robot).get(name)
+        if held is not None and type(value) in _NUMBERS:
+            out = held.single(T, value, None)
+            if out is not None:
+                return out
     names = list(robot.joint_names)
     if not isinstance(fixed, Mapping) or not fixed:
         raise InputError("fixed", f"expected a mapping of joint names to values, e.g. "
@@ -97,6 +118,11 @@ def solve_fixed(
         qc = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
         check_broadcasts(qc, lead + (robot.n,), "q_near", "the poses' and values'")
         qn = np.broadcast_to(qc, lead + (robot.n,)).reshape(-1, robot.n)[:, keep]
+    held = _held_solvers(robot).get(next(iter(fixed))) if len(idx) == 1 else None
+    if held is not None and method != "numeric" and set(options) <= {"compute_error"}:
+        qf = None if q_near is None else np.broadcast_to(qc, lead + (robot.n,))
+        return held.solve(robot, Tb.reshape(lead + (4, 4)), qf, V[:, 0].reshape(lead),
+                          **options)
     end = _end_joint(robot, idx)
     if end is not None:
         reduced = _reduced(robot, idx, (0.0,))
@@ -113,6 +139,60 @@ def solve_fixed(
                               method=method, **options)
             parts.append((rows, sols))
     return _assemble(robot, lead, idx, keep, V, parts, dict(zip(fixed, values)))
+
+
+_NUMBERS = (float, int, np.float64)
+
+
+@dataclass(frozen=True, eq=False)
+class HeldSolver:
+    """The ``pieper`` closed form of a chain with one joint held (any value).
+
+    Attributes:
+        params: ``pieper.setup(chain, held)``'s parameters.
+        method: The sets' ``method`` text, e.g. "analytic:pieper (joint7 held)".
+        info: The sets' ``info`` (without the held values).
+        single: ``single(T, x, qn)``: one pose (4, 4) with the joint at x
+            (``pieper.make_single``).
+    """
+
+    params: np.ndarray
+    method: str
+    info: dict[str, Any]
+    single: Any
+
+    def solve(self, robot: RobotLike, T: np.ndarray, q_near: np.ndarray | None,
+              values: np.ndarray, *, compute_error: bool = False) -> SolutionSet:
+        """Every solution for validated poses T (..., 4, 4) at held values (...)."""
+        info = dict(self.info)
+        name = robot.joint_names[int(self.params[_pk.K.PIEPER_HELD])]
+        info["held"] = {name: values}
+        return _pk.solve(robot, T, q_near, params=self.params, method=self.method,
+                         info=info, values=values, compute_error=compute_error)
+
+
+def _held_solvers(robot: RobotLike) -> dict[str, HeldSolver]:
+    """Joint name -> the closed form with that joint held, where one applies.
+
+    Set up once per chain (microseconds per joint: no reduced chain is built).
+    """
+    def build() -> dict[str, HeldSolver]:
+        chain = robot.chain
+        out: dict[str, HeldSolver] = {}
+        if chain.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
+            return out
+        for j, name in enumerate(robot.joint_names):
+            setup = _pk.setup(chain, j)
+            if setup.params is None:
+                continue
+            method = f"analytic:{_pk.NAME} ({name} held)"
+            info = {"family": _pk.NAME, "measured": setup.measured, "near_family": False}
+            one = _pk.make_single(chain, setup.params, method=method, info=info,
+                                  held=name)
+            out[name] = HeldSolver(setup.params, method, info, one)
+        return out
+
+    return cached(robot.chain, "fixed_closed_form", build)
 
 
 def _end_joint(robot: RobotLike, idx: list[int]) -> str | None:

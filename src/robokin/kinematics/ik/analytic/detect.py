@@ -12,6 +12,9 @@ Families, tried in this order:
 
 * ``three_parallel``: 6R, axes 2-4 parallel, axes 5/6 meet (UR, AUBO, Doosan);
 * ``spherical_wrist``: 6R, axes 2/3 parallel, axes 4-6 meet (Puma, KUKA, ABB...);
+* ``pieper``: 6R, axes 1-3 or axes 4-6 meet in a point (a spherical shoulder or a
+  spherical wrist without axes 2, 3 parallel; the Panda or an SRS arm with one
+  joint held, ``fixed.py``), exact arms only;
 * ``scara``: 3 revolute + 1 prismatic, all axes parallel;
 * ``palletizer``: 4 coordinates on 5 revolute chain joints, a parallelogram keeping
   the tool level (QFMD010);
@@ -35,6 +38,7 @@ import numpy as np
 
 from robokin.kinematics.ik.analytic import general_6r as _g6
 from robokin.kinematics.ik.analytic import palletizer as _pal
+from robokin.kinematics.ik.analytic import pieper as _pk
 from robokin.kinematics.ik.analytic import scara as _scara
 from robokin.kinematics.ik.analytic import spherical_wrist as _sw
 from robokin.kinematics.ik.analytic import three_parallel as _tp
@@ -148,6 +152,10 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float,
         if found and not found[0][0]:  # an exact closed form
             _, dev, mod, text = found[0]
             return _six_r_family(chain, poe, mod.NAME, text, False, dev, details)
+        pieper = _pieper_family(chain, details, tol)
+        if pieper.solver is not None:
+            return pieper
+        details = pieper.details
         if general_6r:
             general = _general_6r_family(chain, details)
             if general.solver is not None:
@@ -195,6 +203,21 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float,
         "(three parallel axes, spherical wrist), 4-axis SCARA (R-R-R-P) and the "
         "4-axis level-tool palletizer"
     )
+
+
+def _pieper_family(chain: Any, details: dict[str, str], tol: float) -> Family:
+    """The ``pieper`` closed form when an axis triple of ``chain`` meets exactly.
+
+    Else a "none" family whose details say why.
+    """
+    setup = _pk.setup(chain, tol=tol)
+    details = dict(details)
+    if setup.params is None:
+        details[_pk.NAME] = setup.reason
+        return _none(setup.reason, details)
+    details[_pk.NAME] = setup.measured
+    solver = _pk.family_solver(chain, setup)
+    return Family(_pk.NAME, solver, measured=setup.measured, details=details)
 
 
 def _general_6r_family(chain: Any, details: dict[str, str]) -> Family:

@@ -1,0 +1,1640 @@
+/*
+ * Closed-form IK of 6R chains with three consecutive intersecting axes (Pieper's
+ * case), also as the remaining chain of a 7R arm with one joint held at a value:
+ *
+ *   start triple: axes 1, 2, 3 meet in S (the Panda's and SRS arms' shoulder);
+ *   end triple:   axes 4, 5, 6 meet in W (a spherical wrist without axes 2, 3
+ *                 parallel; SRS arms with joint 1, 2 or 3 held).
+ *
+ * The algorithm is described for users in robokin/kinematics/ik/analytic/pieper.py.
+ * In short, on the product-of-exponentials geometry T = e1 e2 ... e6 M:
+ *
+ *   1. the triple rotates about its point, so the point's image fixes the other
+ *      three joints a, b, c: e_a e_b e_c p = d (start: p = M T^-1 S, d = S, axes
+ *      4-6; end: p = W, d = T M^-1 W, axes 1-3). With y = e_a^-1 d and z = e_c p,
+ *      e_b z = y holds when the heights along h_b and the distances to a point o_b
+ *      of axis b agree: two equations P u_a - Q u_c = r, linear in u_a = (cos,
+ *      sin) theta_a and u_c = (cos, sin) theta_c (Pieper; Raghavan and Roth);
+ *   2. when axes b, c (or a, b) are coplanar (meet or are parallel: the mutual
+ *      moment vanishes), Q (or P) is singular and a combination of the rows holds
+ *      one angle alone: two subproblem-4 equations in turn (He and Liu's closed
+ *      form of the Panda with q7 given is this case: axes 5, 6 meet); otherwise
+ *      u_c (or u_a) is eliminated, |u| = 1 leaves a trigonometric polynomial of
+ *      degree 2 in the other angle, solved as a quartic in the tangent of its
+ *      half-angle from a shifted origin (so its leading coefficient, f at the
+ *      shift + pi, is never small), every real root Newton-polished;
+ *   3. theta_b by subproblem 1; the triple from the orientation: its middle angle
+ *      by subproblem 4 (two branches), the outer ones by subproblem 1. When its
+ *      outer axes line up (singular) only their sum is fixed: the split is chosen
+ *      inside the joint limits, nearest q_near (or 0), and flagged.
+ *
+ * Each pose yields 8 slots, slot = 2 * position + triple: position 0-3 numbers the
+ * solutions of step 1-2 (in the coplanar case 2 * first root + second root, '+'
+ * root 0; in the quartic case in increasing angle from the shift), triple 0 / 1
+ * the '+' / '-' root of the middle angle. A slot without a solution is NaN,
+ * invalid, not singular and not within limits. Status: 0 ok, 1 out of reach, 2
+ * orientation not achievable, 5 degenerate (the position equations hold no
+ * angle at this held value); PK_BAD_POSE + pose_problem's code when the one-pose
+ * entry found T not a rigid transform.
+ *
+ * The parameter vector (pieper.pack writes it; Python reads the PK_ indices from
+ * the module constants, named PIEPER_*):
+ *
+ *   PK_N         chain joints n (6, or 7 with one held)
+ *   PK_HELD      the held joint's index, or -1
+ *   PK_CASE      PK_START or PK_END: which triple of the 6 remaining joints meets;
+ *                PK_BOTH: both (the swivel case, pk_swivel)
+ *   PK_SING_TOL  singular triple: |sin| of the outer axes' angle below it
+ *   PK_SCALE     the arm's length scale [m] (row scaling and tolerances)
+ *   PK_POINT     the triple's point at zero chain values, full chain (3)
+ *   PK_POINT2    PK_BOTH: the end triple's point (PK_POINT is the start's)
+ *   PK_AXES, PK_POINTS  unit axes h_k and points o_k at zero chain values (n x 3)
+ *   PK_TOOL_R, PK_TOOL_T  M: rotation rows (9), translation (3)
+ *   PK_SIGN, PK_OFFSET, PK_LO, PK_HI   per joint (n each): chain value
+ *                v = sign q + offset, joint limits
+ *   PK_TAG       PK_TAG_VALUE (identifies the vector)
+ *
+ * A held joint k at value x turns every later axis, point and M about axis k by
+ * sign_k x + offset_k: the remaining chain is built per call (a few dozen flops),
+ * so a sweep of held values is one batch with no per-value set-up.
+ *
+ * References:
+ *   Pieper, "The kinematics of manipulators under computer control", PhD thesis,
+ *   Stanford, 1968; Raghavan and Roth, "Inverse kinematics of the general 6R
+ *   manipulator and related linkages", J. Mech. Des. 115 (1993);
+ *   He and Liu, "Analytical inverse kinematics for Franka Emika Panda - a
+ *   geometrical solver for 7-DOF manipulators with unconventional design",
+ *   ICCRE 2021; Elias and Wen, "IK-Geo", arXiv:2211.05737 (subproblems 1-4).
+ */
+#include "chain.h"
+#include "pool.h"
+
+/* Same floating-point rules as six_r.c (whose helpers this file uses): no fused
+ * multiply-adds, so every copy of the kernels takes the same branches. */
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#elif defined(__GNUC__)
+#pragma GCC push_options
+#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
+#endif
+
+#define PK_MAXJ 7
+enum {
+    PK_N = 0, PK_HELD = 1, PK_CASE = 2, PK_SING_TOL = 3, PK_SCALE = 4, PK_POINT = 5,
+    PK_AXES = 8, PK_POINTS = 8 + 3 * PK_MAXJ, PK_TOOL_R = 8 + 6 * PK_MAXJ,
+    PK_TOOL_T = PK_TOOL_R + 9, PK_SIGN = PK_TOOL_T + 3, PK_OFFSET = PK_SIGN + PK_MAXJ,
+    PK_LO = PK_OFFSET + PK_MAXJ, PK_HI = PK_LO + PK_MAXJ, PK_POINT2 = PK_HI + PK_MAXJ,
+    PK_TAG = PK_POINT2 + 3,
+    PK_N_PARAMS = PK_TAG + 1
+};
+enum { PK_START = 0, PK_END = 1, PK_BOTH = 2 };
+enum { PK_OK = 0, PK_OUT_OF_REACH = 1, PK_NO_ORIENTATION = 2, PK_DEGENERATE = 5,
+       PK_BAD_POSE = 16 };
+#define PK_TAG_VALUE 1968.0625 /* Pieper's year, and a sixteenth */
+#define PK_PARALLEL_MIN 512    /* below this many poses, one thread */
+#define PK_GRAIN 32            /* poses per pool chunk */
+#define PK_COPLANAR 1e-13      /* |mutual moment| / scale below it: coplanar axes (rounding) */
+#define PK_EXACT 1e-13         /* pose errors below it need no Newton polish */
+#define PK_ACCEPT 4e-13        /* pose errors above it after the polish: not a solution */
+
+/* ------------------------------------------------------------ geometry */
+
+/* rot(k, t) as rows, from c = cos t, s = sin t (Rodrigues) */
+static inline m3 pk_rotm(v3 k, double c, double s)
+{
+    double v = 1.0 - c;
+    return (m3){{c + k.x * k.x * v, k.x * k.y * v - k.z * s, k.x * k.z * v + k.y * s},
+                {k.y * k.x * v + k.z * s, c + k.y * k.y * v, k.y * k.z * v - k.x * s},
+                {k.z * k.x * v - k.y * s, k.z * k.y * v + k.x * s, c + k.z * k.z * v}};
+}
+
+/* A B (rows) */
+static inline m3 pk_mul(const m3 *A, const m3 *B)
+{
+    return (m3){v3_add(v3_add(v3_scale(B->r0, A->r0.x), v3_scale(B->r1, A->r0.y)),
+                       v3_scale(B->r2, A->r0.z)),
+                v3_add(v3_add(v3_scale(B->r0, A->r1.x), v3_scale(B->r1, A->r1.y)),
+                       v3_scale(B->r2, A->r1.z)),
+                v3_add(v3_add(v3_scale(B->r0, A->r2.x), v3_scale(B->r1, A->r2.y)),
+                       v3_scale(B->r2, A->r2.z))};
+}
+
+/* A B^T (rows) */
+static inline m3 pk_mul_t(const m3 *A, const m3 *B)
+{
+    return (m3){{v3_dot(A->r0, B->r0), v3_dot(A->r0, B->r1), v3_dot(A->r0, B->r2)},
+                {v3_dot(A->r1, B->r0), v3_dot(A->r1, B->r1), v3_dot(A->r1, B->r2)},
+                {v3_dot(A->r2, B->r0), v3_dot(A->r2, B->r1), v3_dot(A->r2, B->r2)}};
+}
+
+static inline double v3_norm(v3 a) { return sqrt(v3_dot(a, a)); }
+
+/* The remaining 6R chain at zero values (PoE): axes, points, M, the triple's point,
+ * and which full-chain joint each of the six is. */
+typedef struct {
+    v3 h[6], o[6], pt, pt2, tM;
+    m3 RM;
+    int full[6];
+    int kase;
+    double scale;
+} PkGeo;
+
+/* The remaining chain with the held joint (if any) at joint value x. */
+static void pk_geometry(const double *P, double x, PkGeo *g)
+{
+    int n = (int)P[PK_N], k = (int)P[PK_HELD], r = 0;
+    double c = 1.0, s = 0.0;
+    v3 hk = {0.0, 0.0, 1.0}, ok = {0.0, 0.0, 0.0};
+    if (k >= 0) {
+        double v = P[PK_SIGN + k] * x + P[PK_OFFSET + k];
+        c = cos(v);
+        s = sin(v);
+        hk = v3_at(P, PK_AXES + 3 * k);
+        ok = v3_at(P, PK_POINTS + 3 * k);
+    }
+    g->kase = (int)P[PK_CASE];
+    g->scale = P[PK_SCALE];
+    for (int j = 0; j < n; j++) {
+        if (j == k)
+            continue;
+        v3 h = v3_at(P, PK_AXES + 3 * j), o = v3_at(P, PK_POINTS + 3 * j);
+        if (k >= 0 && j > k) {
+            h = v3_rot(hk, c, s, h);
+            o = v3_add(ok, v3_rot(hk, c, s, v3_sub(o, ok)));
+        }
+        g->h[r] = h;
+        g->o[r] = o;
+        g->full[r++] = j;
+    }
+    g->RM = (m3){v3_at(P, PK_TOOL_R), v3_at(P, PK_TOOL_R + 3), v3_at(P, PK_TOOL_R + 6)};
+    g->tM = v3_at(P, PK_TOOL_T);
+    g->pt = v3_at(P, PK_POINT);
+    g->pt2 = v3_at(P, PK_POINT2);
+    if (k >= 0) {
+        m3 Rk = pk_rotm(hk, c, s);
+        g->RM = pk_mul(&Rk, &g->RM);
+        g->tM = v3_add(ok, v3_rot(hk, c, s, v3_sub(g->tM, ok)));
+        int first = g->full[g->kase == PK_END ? 3 : 0];
+        if (k < first) /* the triple comes after the held joint: its point moves */
+            g->pt = v3_add(ok, v3_rot(hk, c, s, v3_sub(g->pt, ok)));
+        if (k < g->full[3])
+            g->pt2 = v3_add(ok, v3_rot(hk, c, s, v3_sub(g->pt2, ok)));
+    }
+}
+
+/* ------------------------------------------------------------ quartic */
+
+/* The largest real root of m^3 + a m^2 + b m + c (Cardano / trigonometric),
+ * Newton-refined. */
+static double pk_cubic_max(double a, double b, double c)
+{
+    double q = (a * a - 3.0 * b) / 9.0;
+    double r = (2.0 * a * a * a - 9.0 * a * b + 27.0 * c) / 54.0;
+    double q3 = q * q * q, m;
+    if (r * r < q3) {
+        double th = acos(fmax(-1.0, fmin(1.0, r / sqrt(q3))));
+        /* the roots are -2 sqrt(q) cos((th + 2 pi j) / 3) - a / 3, th in [0, pi];
+         * the largest is j = 1: (th + 2 pi) / 3 in [2 pi / 3, pi], cos <= -1 / 2 */
+        m = -2.0 * sqrt(q) * cos((th + 2.0 * M_PI) / 3.0) - a / 3.0;
+    } else {
+        double A = -copysign(cbrt(fabs(r) + sqrt(r * r - q3)), r);
+        double B = A != 0.0 ? q / A : 0.0;
+        m = A + B - a / 3.0;
+    }
+    for (int it = 0; it < 2; it++) {
+        double f = ((m + a) * m + b) * m + c, d = (3.0 * m + 2.0 * a) * m + b;
+        if (d == 0.0)
+            break;
+        double mn = m - f / d;
+        if (!isfinite(mn))
+            break;
+        m = mn;
+    }
+    return m;
+}
+
+/* Roots of y^2 + b y + c into re, im (im >= 0 for the first of a complex pair) */
+static void pk_quadratic(double b, double c, double *re, double *im)
+{
+    double disc = 0.25 * b * b - c;
+    if (disc >= 0.0) {
+        double s = sqrt(disc);
+        double y1 = -0.5 * b - copysign(s, b); /* no cancellation */
+        re[0] = y1;
+        re[1] = y1 != 0.0 ? c / y1 : 0.0;
+        im[0] = im[1] = 0.0;
+    } else {
+        re[0] = re[1] = -0.5 * b;
+        im[0] = sqrt(-disc);
+        im[1] = -im[0];
+    }
+}
+
+/* The four roots (re, im) of c4 t^4 + c3 t^3 + c2 t^2 + c1 t + c0, c4 != 0
+ * (Ferrari: the depressed quartic factored into two quadratics by the largest
+ * root of its resolvent cubic). */
+static void pk_quartic(const double *cf, double *re, double *im)
+{
+    double b = cf[3] / cf[4], c = cf[2] / cf[4], d = cf[1] / cf[4], e = cf[0] / cf[4];
+    double bb = b * b;
+    double p = c - 0.375 * bb;
+    double q = d - 0.5 * b * c + 0.125 * bb * b;
+    double r = e - 0.25 * b * d + 0.0625 * bb * c - 3.0 / 256.0 * bb * bb;
+    double shift = -0.25 * b;
+    double sc = fmax(fmax(fabs(p), sqrt(fabs(r))), cbrt(fabs(q)) * cbrt(fabs(q)));
+    if (fabs(q) <= 1e-14 * (sc * sqrt(sc) + 1e-300)) { /* biquadratic */
+        double zr[2], zi[2];
+        pk_quadratic(p, r, zr, zi);
+        for (int i = 0; i < 2; i++) {
+            /* sqrt of the complex zr + i zi */
+            double mod = hypot(zr[i], zi[i]);
+            double sr = sqrt(fmax(0.0, 0.5 * (mod + zr[i])));
+            double si = copysign(sqrt(fmax(0.0, 0.5 * (mod - zr[i]))), zi[i]);
+            re[2 * i] = shift + sr;
+            im[2 * i] = si;
+            re[2 * i + 1] = shift - sr;
+            im[2 * i + 1] = -si;
+        }
+        return;
+    }
+    /* 8 m^3 + 8 p m^2 + (2 p^2 - 8 r) m - q^2 = 0 */
+    double m = pk_cubic_max(p, 0.25 * p * p - r, -0.125 * q * q);
+    if (!(m > 0.0))
+        m = 1e-300;
+    double s2 = sqrt(2.0 * m), k = q / (2.0 * s2);
+    pk_quadratic(-s2, 0.5 * p + m + k, re, im);
+    pk_quadratic(s2, 0.5 * p + m - k, re + 2, im + 2);
+    for (int i = 0; i < 4; i++)
+        re[i] += shift;
+}
+
+/* Subproblem 1 with the components perpendicular to k taken first: t with
+ * rot(k, t) p = q (least squares), its cosine and sine. Unlike sp1's
+ * q . p - (k . p)(k . q) this keeps its accuracy when p and q lie close to the
+ * axis (a triple next to its singularity). */
+static inline double pk_sp1(v3 k, v3 p, v3 q, double *c, double *s)
+{
+    v3 pp = v3_sub(p, v3_scale(k, v3_dot(k, p))), qp = v3_sub(q, v3_scale(k, v3_dot(k, q)));
+    double y = v3_dot(k, v3_cross(pp, qp)), x = v3_dot(pp, qp);
+    unit2(y, x, c, s);
+    return fast_atan2(y, x);
+}
+
+/* ------------------------------------------------- the position problem */
+
+/* A trigonometric polynomial of degree 2: a0 + a1 cos x + b1 sin x + a2 cos 2x +
+ * b2 sin 2x, its value and derivative */
+typedef struct { double a0, a1, b1, a2, b2; } Trig2;
+
+static inline double trig2(const Trig2 *f, double x, double *df)
+{
+    double c = cos(x), s = sin(x), c2 = c * c - s * s, s2 = 2.0 * s * c;
+    if (df)
+        *df = -f->a1 * s + f->b1 * c - 2.0 * f->a2 * s2 + 2.0 * f->b2 * c2;
+    return f->a0 + f->a1 * c + f->b1 * s + f->a2 * c2 + f->b2 * s2;
+}
+
+/* f'' at x */
+static inline double trig2_dd(const Trig2 *f, double x)
+{
+    double c = cos(x), s = sin(x), c2 = c * c - s * s, s2 = 2.0 * s * c;
+    return -f->a1 * c - f->b1 * s - 4.0 * f->a2 * c2 - 4.0 * f->b2 * s2;
+}
+
+/* Newton on f from x (at most `iters` steps, never a step past pi / 4) */
+static double trig2_newton(const Trig2 *f, double x, int iters)
+{
+    for (int i = 0; i < iters; i++) {
+        double d, v = trig2(f, x, &d);
+        if (v == 0.0 || d == 0.0)
+            break;
+        double dx = v / d;
+        if (fabs(dx) > 0.25 * M_PI)
+            dx = copysign(0.25 * M_PI, dx);
+        x -= dx;
+        if (fabs(dx) < 1e-16)
+            break;
+    }
+    return x;
+}
+
+/* Real roots of f (at most 4) into x, sorted; returns their count. Roots that
+ * come out of the quartic as a complex pair with a small imaginary part (a
+ * double root split by rounding) are kept as candidates: the extremum between
+ * them is found and the pair restored from f's local quadratic (or the double
+ * root itself), and the caller verifies every candidate. */
+static int trig2_roots(const Trig2 *f, double *x, int *nearly_double)
+{
+    /* the shift: f(shift + pi) largest of 8 samples */
+    double best = -1.0, delta = 0.0;
+    for (int j = 0; j < 8; j++) {
+        double d = 0.25 * M_PI * j, v = fabs(trig2(f, d + M_PI, NULL));
+        if (v > best) {
+            best = v;
+            delta = d;
+        }
+    }
+    double size = fabs(f->a0) + fabs(f->a1) + fabs(f->b1) + fabs(f->a2) + fabs(f->b2);
+    if (!(best > 1e-14 * size)) /* f vanishes identically */
+        return -1;
+    double cd = cos(delta), sd = sin(delta), c2d = cos(2.0 * delta), s2d = sin(2.0 * delta);
+    double A1 = f->a1 * cd + f->b1 * sd, B1 = -f->a1 * sd + f->b1 * cd;
+    double A2 = f->a2 * c2d + f->b2 * s2d, B2 = -f->a2 * s2d + f->b2 * c2d;
+    double cf[5] = {f->a0 + A1 + A2, 2.0 * B1 + 4.0 * B2, 2.0 * f->a0 - 6.0 * A2,
+                    2.0 * B1 - 4.0 * B2, f->a0 - A1 + A2};
+    double re[4], im[4];
+    pk_quartic(cf, re, im);
+    int n = 0;
+    *nearly_double = 0;
+    for (int i = 0; i < 4; i++) {
+        double t = re[i];
+        if (!isfinite(t))
+            continue;
+        double ang = delta + 2.0 * atan(t);
+        if (im[i] == 0.0) {
+            x[n++] = trig2_newton(f, ang, 3);
+            continue;
+        }
+        if (im[i] < 0.0 || fabs(im[i]) > 1e-4 * (1.0 + t * t))
+            continue; /* the second of a pair, or truly complex */
+        /* a pair with a small imaginary part: the extremum between them */
+        double xm = ang;
+        for (int it = 0; it < 6; it++) {
+            double d0, dd = trig2_dd(f, xm);
+            trig2(f, xm, &d0);
+            if (dd == 0.0)
+                break;
+            double step = d0 / dd;
+            if (fabs(step) > 0.1)
+                step = copysign(0.1, step);
+            xm -= step;
+            if (fabs(step) < 1e-15)
+                break;
+        }
+        double v = trig2(f, xm, NULL), dd = trig2_dd(f, xm);
+        *nearly_double = 1;
+        if (dd != 0.0 && v * dd < 0.0) {
+            double w = sqrt(-2.0 * v / dd);
+            x[n++] = trig2_newton(f, xm - w, 3);
+            x[n++] = trig2_newton(f, xm + w, 3);
+        } else {
+            x[n++] = xm; /* a double root, or none: verified by the caller */
+        }
+    }
+    /* sort by angle from the shift (insertion sort of <= 4) */
+    for (int i = 0; i < n; i++)
+        x[i] = delta + wrap_pi(x[i] - delta - M_PI) + M_PI;
+    for (int i = 1; i < n; i++)
+        for (int j = i; j > 0 && x[j] < x[j - 1]; j--) {
+            double t = x[j];
+            x[j] = x[j - 1];
+            x[j - 1] = t;
+        }
+    return n;
+}
+
+/* Solutions of the position problem: up to 4 (theta_a, theta_b, theta_c), each
+ * with its slot (0-3), singular flag and residual */
+typedef struct {
+    int n;
+    double t[4][3], c[4][3], s[4][3], res[4];
+    unsigned char slot[4], sing[4];
+} PkPos;
+
+/* The two equations P u_a - Q u_c = r of the position problem (module comment):
+ * row 1 the heights along h_b, row 2 the squared distances to o_b divided by
+ * 2 scale. */
+typedef struct {
+    double P[2][2], Q[2][2], r[2];
+    v3 ha, hb, hc, oa, ob, oc, d, p;
+    double mab, mbc; /* mutual moments / scale of axes (a, b), (b, c) */
+    double scale;
+} PkEq;
+
+static void pk_equations(const PkGeo *g, int ia, v3 p, v3 d, PkEq *e)
+{
+    v3 ha = g->h[ia], hb = g->h[ia + 1], hc = g->h[ia + 2];
+    v3 oa = g->o[ia], oc = g->o[ia + 2];
+    v3 mid = v3_scale(v3_add(oa, oc), 0.5);
+    v3 ob = v3_add(g->o[ia + 1], v3_scale(hb, v3_dot(hb, v3_sub(mid, g->o[ia + 1]))));
+    double L = g->scale, inv2L = 0.5 / L;
+    v3 a = v3_sub(d, oa), apar = v3_scale(ha, v3_dot(ha, a)), aperp = v3_sub(a, apar);
+    v3 axa = v3_cross(ha, a);
+    v3 b = v3_sub(p, oc), bpar = v3_scale(hc, v3_dot(hc, b)), bperp = v3_sub(b, bpar);
+    v3 hxb = v3_cross(hc, b);
+    v3 dab = v3_sub(oa, ob), dcb = v3_sub(oc, ob);
+    v3 wa = v3_scale(dab, 1.0 / L), wc = v3_scale(dcb, 1.0 / L);
+    e->P[0][0] = v3_dot(hb, aperp);
+    e->P[0][1] = -v3_dot(hb, axa);
+    e->P[1][0] = v3_dot(wa, aperp);
+    e->P[1][1] = -v3_dot(wa, axa);
+    e->Q[0][0] = v3_dot(hb, bperp);
+    e->Q[0][1] = v3_dot(hb, hxb);
+    e->Q[1][0] = v3_dot(wc, bperp);
+    e->Q[1][1] = v3_dot(wc, hxb);
+    double l1 = v3_dot(hb, v3_add(apar, dab));
+    double l2 = (v3_dot(a, a) + v3_dot(dab, dab)) * inv2L + v3_dot(wa, apar);
+    double r1 = v3_dot(hb, v3_add(bpar, dcb));
+    double r2 = (v3_dot(b, b) + v3_dot(dcb, dcb)) * inv2L + v3_dot(wc, bpar);
+    e->r[0] = r1 - l1;
+    e->r[1] = r2 - l2;
+    e->ha = ha;
+    e->hb = hb;
+    e->hc = hc;
+    e->oa = oa;
+    e->ob = ob;
+    e->oc = oc;
+    e->d = d;
+    e->p = p;
+    e->scale = L;
+    e->mab = v3_dot(dab, v3_cross(ha, hb)) / L;
+    e->mbc = v3_dot(dcb, v3_cross(hb, hc)) / L;
+}
+
+/* The unit left null vector of the 2 x 2 matrix whose rows are the dot products
+ * of v1, v2 (perpendicular to h, parallel to each other) with a basis of the
+ * plane perpendicular to h: n1 v1 + n2 v2 = 0. */
+static void pk_null(v3 h, v3 v1, v3 v2, double *n)
+{
+    v1 = v3_sub(v1, v3_scale(h, v3_dot(h, v1)));
+    v2 = v3_sub(v2, v3_scale(h, v3_dot(h, v2)));
+    v3 e = v3_dot(v1, v1) >= v3_dot(v2, v2) ? v1 : v2;
+    double ne = v3_norm(e);
+    if (ne > 0.0)
+        e = v3_scale(e, 1.0 / ne);
+    n[0] = v3_dot(v2, e);
+    n[1] = -v3_dot(v1, e);
+    double nn = hypot(n[0], n[1]);
+    if (nn > 0.0) {
+        n[0] /= nn;
+        n[1] /= nn;
+    } else {
+        n[0] = 1.0;
+        n[1] = 0.0;
+    }
+}
+
+/* theta_b from theta_a, theta_c (given by cosine and sine): rot(h_b, theta_b)
+ * (z - o_b) = y - o_b (least squares); its cosine, sine into cb, sb and the
+ * residual of that rotation [m] into res */
+static double pk_theta_b(const PkEq *e, double ca, double sa, double cc, double sc,
+                         double *cb, double *sb, double *res)
+{
+    v3 y = v3_add(e->oa, v3_rot(e->ha, ca, -sa, v3_sub(e->d, e->oa)));
+    v3 z = v3_add(e->oc, v3_rot(e->hc, cc, sc, v3_sub(e->p, e->oc)));
+    v3 zy = v3_sub(z, e->ob), yy = v3_sub(y, e->ob);
+    double tb = pk_sp1(e->hb, zy, yy, cb, sb);
+    *res = v3_norm(v3_sub(v3_rot(e->hb, *cb, *sb, zy), yy));
+    return tb;
+}
+
+/* A c + B s = C: up to two roots (Roots of six_r.c). A discriminant down to
+ * -1e-13 (A^2 + B^2) is a double root (rounding); any positive one gives two roots,
+ * however close: next to a double root a root's error is second order in the
+ * pose, so two accurate close roots beat one merged root (which would be off by
+ * the square root of their distance). */
+static Roots pk_sp4(double A, double B, double C)
+{
+    double phi = fast_atan2(B, A), cphi, sphi;
+    unit2(B, A, &cphi, &sphi);
+    return sp4_roots(A, B, C, A * A + B * B - C * C, 1e-13, 0, phi, cphi, sphi);
+}
+
+/* A solution (theta_a, theta_c given by angle, cosine and sine; theta_b solved) */
+static void pk_pos_add(PkPos *out, const PkEq *e, int slot, double ta, double ca, double sa,
+                       double tc, double cc, double sc, int sing)
+{
+    int i = out->n++;
+    double cb, sb, res;
+    double tb = pk_theta_b(e, ca, sa, cc, sc, &cb, &sb, &res);
+    out->t[i][0] = ta;
+    out->t[i][1] = tb;
+    out->t[i][2] = tc;
+    out->c[i][0] = ca;
+    out->s[i][0] = sa;
+    out->c[i][1] = cb;
+    out->s[i][1] = sb;
+    out->c[i][2] = cc;
+    out->s[i][2] = sc;
+    out->res[i] = res;
+    out->slot[i] = (unsigned char)slot;
+    out->sing[i] = (unsigned char)sing;
+}
+
+/* Coplanar axes b, c (Q singular; swap: a, b and P): the null combination n of the
+ * rows holds theta_x alone (x = a, or c when swapped); the other combination m then
+ * gives theta_y. pref_a, pref_c: the chain angles to take when one is free. */
+static int pk_coplanar(const PkEq *e, int swap, double pref_a, double pref_c, PkPos *out)
+{
+    double n[2], L = e->scale;
+    v3 h = swap ? e->ha : e->hc, o = swap ? e->oa : e->oc;
+    /* the rows' vectors: h_b and (o - o_b) / scale (the second row's scaling) */
+    pk_null(h, e->hb, v3_scale(v3_sub(o, e->ob), 1.0 / L), n);
+    const double(*X)[2] = swap ? e->Q : e->P; /* x's matrix */
+    const double(*Y)[2] = swap ? e->P : e->Q;
+    double sx = swap ? -1.0 : 1.0; /* P u_a - Q u_c = r: the sign of x's term */
+    double A = sx * (n[0] * X[0][0] + n[1] * X[1][0]);
+    double B = sx * (n[0] * X[0][1] + n[1] * X[1][1]);
+    double C = n[0] * e->r[0] + n[1] * e->r[1];
+    Roots rx;
+    int xfree = hypot(A, B) <= 1e-12 * L;
+    if (xfree) { /* the point on axis x: theta_x free (or no solution) */
+        if (fabs(C) > 1e-9 * L)
+            return PK_OUT_OF_REACH;
+        double tx = swap ? pref_c : pref_a;
+        rx.n = 1;
+        rx.boundary = 1;
+        rx.t[0] = tx;
+        rx.c[0] = cos(tx);
+        rx.s[0] = sin(tx);
+    } else {
+        rx = pk_sp4(A, B, C);
+    }
+    double m0 = -n[1], m1 = n[0];
+    double Ay = -sx * (m0 * Y[0][0] + m1 * Y[1][0]);
+    double By = -sx * (m0 * Y[0][1] + m1 * Y[1][1]);
+    int yfree = hypot(Ay, By) <= 1e-12 * L;
+    for (int i = 0; i < rx.n; i++) {
+        double cx = rx.c[i], sxn = rx.s[i];
+        /* m . (X u_x sx - r) = -sx m . Y u_y ... written out: */
+        double Xu0 = X[0][0] * cx + X[0][1] * sxn, Xu1 = X[1][0] * cx + X[1][1] * sxn;
+        double Cy = m0 * (e->r[0] - sx * Xu0) + m1 * (e->r[1] - sx * Xu1);
+        Roots ry;
+        if (yfree) {
+            double ty = swap ? pref_a : pref_c;
+            ry.n = 1;
+            ry.boundary = 1;
+            ry.t[0] = ty;
+            ry.c[0] = cos(ty);
+            ry.s[0] = sin(ty);
+        } else {
+            ry = pk_sp4(Ay, By, Cy);
+        }
+        for (int j = 0; j < ry.n; j++) {
+            int sing = xfree || rx.boundary || ry.boundary;
+            if (swap)
+                pk_pos_add(out, e, 2 * i + j, ry.t[j], ry.c[j], ry.s[j], rx.t[i], rx.c[i],
+                           rx.s[i], sing);
+            else
+                pk_pos_add(out, e, 2 * i + j, rx.t[i], rx.c[i], rx.s[i], ry.t[j], ry.c[j],
+                           ry.s[j], sing);
+        }
+    }
+    return out->n ? PK_OK : PK_OUT_OF_REACH;
+}
+
+/* General axes: u_y eliminated through the better-conditioned of P, Q; f(theta_x)
+ * = |K u_x - k|^2 - D^2 = 0 with u_y = (K u_x - k) / D. */
+static int pk_general(const PkEq *e, PkPos *out)
+{
+    double dP = e->P[0][0] * e->P[1][1] - e->P[0][1] * e->P[1][0];
+    double dQ = e->Q[0][0] * e->Q[1][1] - e->Q[0][1] * e->Q[1][0];
+    double nP = e->P[0][0] * e->P[0][0] + e->P[0][1] * e->P[0][1] +
+                e->P[1][0] * e->P[1][0] + e->P[1][1] * e->P[1][1];
+    double nQ = e->Q[0][0] * e->Q[0][0] + e->Q[0][1] * e->Q[0][1] +
+                e->Q[1][0] * e->Q[1][0] + e->Q[1][1] * e->Q[1][1];
+    /* eliminate u_c (x = a) when Q is the better conditioned */
+    int xa = fabs(dQ) * (nP + 1e-300) >= fabs(dP) * (nQ + 1e-300);
+    double K[2][2], k[2], D;
+    if (xa) { /* Q u_c = P u_a - r: u_c = adj(Q) (P u_a - r) / dQ */
+        double aq[2][2] = {{e->Q[1][1], -e->Q[0][1]}, {-e->Q[1][0], e->Q[0][0]}};
+        for (int i = 0; i < 2; i++) {
+            for (int j = 0; j < 2; j++)
+                K[i][j] = aq[i][0] * e->P[0][j] + aq[i][1] * e->P[1][j];
+            k[i] = aq[i][0] * e->r[0] + aq[i][1] * e->r[1];
+        }
+        D = dQ;
+    } else { /* P u_a = Q u_c + r: u_a = adj(P) (Q u_c + r) / dP */
+        double ap[2][2] = {{e->P[1][1], -e->P[0][1]}, {-e->P[1][0], e->P[0][0]}};
+        for (int i = 0; i < 2; i++) {
+            for (int j = 0; j < 2; j++)
+                K[i][j] = ap[i][0] * e->Q[0][j] + ap[i][1] * e->Q[1][j];
+            k[i] = -(ap[i][0] * e->r[0] + ap[i][1] * e->r[1]);
+        }
+        D = dP;
+    }
+    if (D == 0.0)
+        return PK_DEGENERATE;
+    double al = K[0][0] * K[0][0] + K[1][0] * K[1][0];
+    double ga = K[0][1] * K[0][1] + K[1][1] * K[1][1];
+    double be = K[0][0] * K[0][1] + K[1][0] * K[1][1];
+    double g1 = K[0][0] * k[0] + K[1][0] * k[1], g2 = K[0][1] * k[0] + K[1][1] * k[1];
+    Trig2 f = {0.5 * (al + ga) + k[0] * k[0] + k[1] * k[1] - D * D, -2.0 * g1, -2.0 * g2,
+               0.5 * (al - ga), be};
+    double xs[8];
+    int nd;
+    int nx = trig2_roots(&f, xs, &nd);
+    if (nx < 0)
+        return PK_DEGENERATE;
+    for (int i = 0; i < nx && out->n < 4; i++) {
+        double x = xs[i], cx = cos(x), sx = sin(x);
+        double uy0 = (K[0][0] * cx + K[0][1] * sx - k[0]) / D;
+        double uy1 = (K[1][0] * cx + K[1][1] * sx - k[1]) / D;
+        double ny = hypot(uy0, uy1);
+        if (!(fabs(ny - 1.0) < 1e-6))
+            continue; /* not a root */
+        double y = fast_atan2(uy1, uy0), cy, sy;
+        unit2(uy1, uy0, &cy, &sy);
+        double ta = xa ? x : y, tc = xa ? y : x;
+        /* the same solution twice (a double root found from both sides) */
+        int dup = 0;
+        for (int j = 0; j < out->n; j++)
+            if (fabs(wrap_pi(out->t[j][0] - ta)) < 1e-9 &&
+                fabs(wrap_pi(out->t[j][2] - tc)) < 1e-9)
+                dup = 1;
+        if (dup)
+            continue;
+        if (xa)
+            pk_pos_add(out, e, out->n, x, cx, sx, y, cy, sy, nd);
+        else
+            pk_pos_add(out, e, out->n, y, cy, sy, x, cx, sx, nd);
+        if (!(out->res[out->n - 1] < 1e-6 * e->scale))
+            out->n--; /* not a root after all */
+    }
+    return out->n ? PK_OK : PK_OUT_OF_REACH;
+}
+
+/* ------------------------------------------------------------- the triple */
+
+/* Joint x's coordinate interval for a split theta_x + sigma theta_z = phi: the
+ * joint z value (coordinate) nearest pref such that both joints are within their
+ * limits (by whole turns), or pref clamped into z's limits when none is. */
+static double pk_split(const double *P, int jx, int jz, double phi, double sigma,
+                       double pref)
+{
+    double sx = P[PK_SIGN + jx], ox = P[PK_OFFSET + jx], sz = P[PK_SIGN + jz];
+    double oz = P[PK_OFFSET + jz];
+    double lox = P[PK_LO + jx], hix = P[PK_HI + jx], loz = P[PK_LO + jz], hiz = P[PK_HI + jz];
+    /* q_x = c0 + kappa q_z (mod 2 pi) */
+    double c0 = wrap_pi(sx * (phi - sigma * oz - ox)), kappa = -sx * sigma * sz;
+    double best = NAN, bestd = INFINITY;
+    for (int m = -2; m <= 2; m++) {
+        double lo, hi;
+        if (kappa > 0.0) {
+            lo = lox - c0 + 2.0 * M_PI * m;
+            hi = hix - c0 + 2.0 * M_PI * m;
+        } else {
+            lo = c0 + 2.0 * M_PI * m - hix;
+            hi = c0 + 2.0 * M_PI * m - lox;
+        }
+        lo = fmax(lo, loz);
+        hi = fmin(hi, hiz);
+        if (lo > hi)
+            continue;
+        double q = fmin(fmax(pref, lo), hi), d = fabs(q - pref);
+        if (d < bestd) {
+            bestd = d;
+            best = q;
+        }
+    }
+    if (isnan(best))
+        best = fmin(fmax(pref, loz), hiz);
+    return sz * best + oz; /* theta_z */
+}
+
+/* A triple's pose-independent constants: the half-angle sines and cosines of
+ * (bx - bz) / 2 and (bx + bz) / 2, bx, bz the angles of hx, hz from hy, and the
+ * azimuth t0 about hy where rot(hy, t) hz comes nearest hx (with its cosine, sine). */
+typedef struct {
+    v3 hx, hy, hz;
+    double cd, sd, cs, ss, t0, c0, s0;
+} PkTri;
+
+static void pk_tri_init(PkTri *k, v3 hx, v3 hy, v3 hz)
+{
+    double bx = atan2(v3_norm(v3_cross(hy, hx)), v3_dot(hy, hx));
+    double bz = atan2(v3_norm(v3_cross(hy, hz)), v3_dot(hy, hz));
+    v3 xp = v3_sub(hx, v3_scale(hy, v3_dot(hx, hy)));
+    v3 zp = v3_sub(hz, v3_scale(hy, v3_dot(hz, hy)));
+    k->hx = hx;
+    k->hy = hy;
+    k->hz = hz;
+    k->cd = cos(0.5 * (bx - bz));
+    k->sd = sin(0.5 * (bx - bz));
+    k->cs = cos(0.5 * (bx + bz));
+    k->ss = sin(0.5 * (bx + bz));
+    k->t0 = atan2(v3_dot(hy, v3_cross(zp, xp)), v3_dot(zp, xp));
+    unit2(v3_dot(hy, v3_cross(zp, xp)), v3_dot(zp, xp), &k->c0, &k->s0);
+}
+
+/* The middle angle of a triple: ty with rot(hy, ty) hz at the angle psi from hx
+ * that w = R hz makes. Subproblem 4 for unit vectors by the spherical law of
+ * cosines in half-angle form, so that roots next to a double root keep their
+ * accuracy: with D the turn from t0,
+ *   sin^2(D / 2) ~ sin((psi + bx - bz) / 2) sin((psi - bx + bz) / 2),
+ *   cos^2(D / 2) ~ sin((bx + bz + psi) / 2) sin((bx + bz - psi) / 2),
+ * sin, cos(psi / 2) = |hx -+ w| / 2 (no trigonometry). Roots t0 + D, t0 - D. */
+static Roots pk_middle(const PkTri *k, v3 w)
+{
+    Roots r;
+    double sp = 0.5 * v3_norm(v3_sub(k->hx, w)), cp = 0.5 * v3_norm(v3_add(k->hx, w));
+    double a1 = sp * k->cd + cp * k->sd, a2 = sp * k->cd - cp * k->sd;
+    double b1 = k->ss * cp + k->cs * sp, b2 = k->ss * cp - k->cs * sp;
+    double S = a1 * a2, C = b1 * b2;
+    r.boundary = 0;
+    if (S < -1e-13 || C < -1e-13) {
+        r.n = 0;
+        return r;
+    }
+    S = fmax(S, 0.0);
+    C = fmax(C, 0.0);
+    double hs = sqrt(S), hc = sqrt(C);
+    double D = 2.0 * fast_atan2(hs, hc), n2 = S + C;
+    double cD = (C - S) / n2, sD = 2.0 * hs * hc / n2;
+    r.t[0] = k->t0 + D;
+    r.t[1] = k->t0 - D;
+    r.c[0] = k->c0 * cD - k->s0 * sD;
+    r.s[0] = k->s0 * cD + k->c0 * sD;
+    r.c[1] = k->c0 * cD + k->s0 * sD;
+    r.s[1] = k->s0 * cD - k->c0 * sD;
+    r.n = S > 0.0 ? 2 : 1;
+    r.boundary = r.n == 1;
+    return r;
+}
+
+/* A triple's solutions: angles, singular flags, and whether the solution still
+ * needs checking against the pose (near the singularity the two vector residuals
+ * do not pin the rotation) */
+typedef struct {
+    int n;
+    double t[2][3];
+    unsigned char sing[2], check[2];
+} PkTrip;
+
+/* rot(hx, tx) rot(hy, ty) rot(hz, tz) = R: up to two solutions; jx, jz: the outer
+ * joints' full-chain indices, pref_z z's preferred coordinate at the singularity. */
+static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int jz,
+                      double pref_z, double stol, PkTrip *out)
+{
+    v3 hx = k->hx, hy = k->hy, hz = k->hz;
+    v3 w = m3_mv(R, hz), rtx = m3_mtv(R, hx);
+    Roots ry = pk_middle(k, w);
+    out->n = 0;
+    for (int i = 0; i < ry.n; i++) {
+        double ty = ry.t[i], cy = ry.c[i], sy = ry.s[i];
+        v3 v = v3_rot(hy, cy, sy, hz);
+        double sv = v3_norm(v3_cross(v, hx));
+        if (sv < stol) {
+            /* at the singularity: hold the exact singular angle where it reproduces
+             * R, and split the outer angles inside the limits */
+            double sigma = v3_dot(v, hx) >= 0.0 ? 1.0 : -1.0, cs, ss;
+            double tys = sp1(hy, hz, v3_scale(hx, sigma), &cs, &ss);
+            v3 vs = v3_rot(hy, cs, ss, hz);
+            if (v3_norm(v3_sub(vs, v3_scale(hx, sigma))) < 1e-13) {
+                m3 Ry = pk_rotm(hy, cs, ss);
+                m3 X = pk_mul_t(R, &Ry); /* R rot(hy, -tys) = rot(hx, phi) */
+                if (v3_norm(v3_sub(m3_mv(&X, hx), hx)) < PK_EXACT) {
+                    v3 e = v3_cross(hx, hy);
+                    double ne = v3_norm(e);
+                    e = ne > 1e-6 ? v3_scale(e, 1.0 / ne) : v3_cross(hx, hz);
+                    double cp, sp;
+                    double phi = sp1(hx, e, m3_mv(&X, e), &cp, &sp);
+                    double tz = pk_split(P, jx, jz, phi, sigma, pref_z);
+                    out->t[0][0] = phi - sigma * tz;
+                    out->t[0][1] = tys;
+                    out->t[0][2] = tz;
+                    out->sing[0] = 1;
+                    out->check[0] = 1;
+                    out->n = 1;
+                    return;
+                }
+            }
+        }
+        double cx, sx, cz, sz;
+        double tx = pk_sp1(hx, v, w, &cx, &sx);
+        v3 u = v3_rot(hy, cy, -sy, hx);
+        double tz = -pk_sp1(hz, u, rtx, &cz, &sz);
+        if (sv < 1e-6) {
+            /* near the singularity the split of tx + sigma tz costs only sv per
+             * radian of pose: move it inside the limits when that stays exact */
+            double sigma = v3_dot(v, hx) >= 0.0 ? 1.0 : -1.0;
+            double qz = P[PK_SIGN + jz] * (tz - P[PK_OFFSET + jz]);
+            double tz2 = pk_split(P, jx, jz, tx + sigma * tz, sigma, qz);
+            double eps = wrap_pi(tz2 - tz);
+#ifdef PK_DEBUG
+            fprintf(stderr, "   resplit sv %.3e tz %.17g tz2 %.17g eps %.3e\n", sv, tz, tz2, eps);
+#endif
+            if (fabs(eps) * sv <= 0.01 * PK_EXACT) {
+                tx -= sigma * eps;
+                tz += eps;
+            }
+        }
+        int j = out->n++;
+        out->t[j][0] = tx;
+        out->t[j][1] = ty;
+        out->t[j][2] = tz;
+        out->sing[j] = (unsigned char)(sv < 1e-7);
+        /* R' hz = R hz and R'^T hx = R^T hx pin R' = R, to within the residuals
+         * divided by sv (the sine of the angle between hz and R'^T hx) */
+        double res = v3_norm(v3_sub(v3_rot(hx, cx, sx, v), w)) +
+                     v3_norm(v3_sub(v3_rot(hz, cz, sz, u), rtx));
+        out->check[j] = (unsigned char)(sv < 1e-4 || !(res < 1e-2 * PK_EXACT * sv));
+    }
+}
+
+/* ---------------------------------------------------------------- polish */
+
+/* Pose of the remaining chain at angles th, and the Jacobian (6 x 6, rows
+ * [v / scale; w], spatial at the tool point) when J is not NULL. */
+static void pk_fk(const PkGeo *g, const double *th, m3 *R, v3 *p, double J[6][6])
+{
+    m3 A = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+    v3 t = {0.0, 0.0, 0.0}, hc[6], oc[6];
+    for (int j = 0; j < 6; j++) {
+        hc[j] = m3_mv(&A, g->h[j]);
+        oc[j] = v3_add(m3_mv(&A, g->o[j]), t);
+        m3 Rj = pk_rotm(g->h[j], cos(th[j]), sin(th[j]));
+        t = v3_add(t, m3_mv(&A, v3_sub(g->o[j], m3_mv(&Rj, g->o[j]))));
+        A = pk_mul(&A, &Rj);
+    }
+    *R = pk_mul(&A, &g->RM);
+    *p = v3_add(m3_mv(&A, g->tM), t);
+    if (J == NULL)
+        return;
+    for (int j = 0; j < 6; j++) {
+        v3 v = v3_scale(v3_cross(hc[j], v3_sub(*p, oc[j])), 1.0 / g->scale);
+        J[0][j] = v.x;
+        J[1][j] = v.y;
+        J[2][j] = v.z;
+        J[3][j] = hc[j].x;
+        J[4][j] = hc[j].y;
+        J[5][j] = hc[j].z;
+    }
+}
+
+/* The pose error e = [(p_T - p) / scale; rotation vector of R_T R^T] (small angles);
+ * returns the larger of |p_T - p| / max(1, scale) and the rotation angle */
+static double pk_error(const m3 *RT, v3 pT, const m3 *R, v3 p, double scale, double *e)
+{
+    v3 dp = v3_scale(v3_sub(pT, p), 1.0 / scale);
+    double pn = v3_norm(v3_sub(pT, p)) / fmax(1.0, scale);
+    m3 E = pk_mul_t(RT, R);
+    e[0] = dp.x;
+    e[1] = dp.y;
+    e[2] = dp.z;
+    e[3] = 0.5 * (E.r2.y - E.r1.z);
+    e[4] = 0.5 * (E.r0.z - E.r2.x);
+    e[5] = 0.5 * (E.r1.x - E.r0.y);
+    /* |rotation vector| for small angles; 3 - trace = 2 (1 - cos) is large past pi / 2 */
+    double rn = sqrt(e[3] * e[3] + e[4] * e[4] + e[5] * e[5]);
+    return fmax(fmax(pn, rn), 3.0 - (E.r0.x + E.r1.y + E.r2.z));
+}
+
+/* The least-squares step J dx = e of a 6 x 6 Jacobian (rows J[r][.]): Householder
+ * QR with column pivoting, columns whose pivot falls below 1e-10 of the first
+ * left out (a singular configuration: no step along its near-null directions). */
+static void pk_lstsq(double J[6][6], const double *e, double *dx)
+{
+    double A[6][6], b[6], norms[6];
+    int perm[6], rank = 0;
+    for (int r = 0; r < 6; r++) {
+        b[r] = e[r];
+        for (int c = 0; c < 6; c++)
+            A[r][c] = J[r][c];
+    }
+    for (int c = 0; c < 6; c++) {
+        perm[c] = c;
+        double s = 0.0;
+        for (int r = 0; r < 6; r++)
+            s += A[r][c] * A[r][c];
+        norms[c] = s;
+    }
+    double first = 0.0;
+    for (int k = 0; k < 6; k++) {
+        int best = k; /* pivot: the remaining column of largest norm */
+        for (int c = k + 1; c < 6; c++)
+            if (norms[c] > norms[best])
+                best = c;
+        if (best != k) {
+            for (int r = 0; r < 6; r++) {
+                double t = A[r][k];
+                A[r][k] = A[r][best];
+                A[r][best] = t;
+            }
+            double t = norms[k];
+            norms[k] = norms[best];
+            norms[best] = t;
+            int ti = perm[k];
+            perm[k] = perm[best];
+            perm[best] = ti;
+        }
+        double nx = 0.0;
+        for (int r = k; r < 6; r++)
+            nx += A[r][k] * A[r][k];
+        nx = sqrt(nx);
+        if (k == 0)
+            first = nx;
+        if (!(nx > 1e-10 * first))
+            break;
+        double alpha = A[k][k] > 0.0 ? -nx : nx, v[6];
+        for (int r = 0; r < 6; r++)
+            v[r] = r < k ? 0.0 : A[r][k];
+        v[k] -= alpha;
+        double vv = 0.0;
+        for (int r = k; r < 6; r++)
+            vv += v[r] * v[r];
+        if (vv > 0.0) {
+            for (int c = k; c < 6; c++) {
+                double d = 0.0;
+                for (int r = k; r < 6; r++)
+                    d += v[r] * A[r][c];
+                d *= 2.0 / vv;
+                for (int r = k; r < 6; r++)
+                    A[r][c] -= d * v[r];
+            }
+            double d = 0.0;
+            for (int r = k; r < 6; r++)
+                d += v[r] * b[r];
+            d *= 2.0 / vv;
+            for (int r = k; r < 6; r++)
+                b[r] -= d * v[r];
+        }
+        for (int c = k + 1; c < 6; c++)
+            norms[c] -= A[k][c] * A[k][c];
+        rank = k + 1;
+    }
+    double y[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    for (int r = rank - 1; r >= 0; r--) {
+        double s = b[r];
+        for (int c = r + 1; c < rank; c++)
+            s -= A[r][c] * y[c];
+        y[r] = s / A[r][r];
+    }
+    for (int c = 0; c < 6; c++)
+        dx[perm[c]] = y[c];
+}
+
+/* Newton steps on the remaining chain's angles (least squares, pk_lstsq; kept only
+ * while they reduce the error); returns the final error (pk_error) */
+static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
+{
+    m3 R;
+    v3 p;
+    double J[6][6], e[6];
+    pk_fk(g, th, &R, &p, J);
+    double err = pk_error(RT, pT, &R, p, g->scale, e);
+    for (int it = 0; it < 6 && err > 1e-16; it++) {
+        double dx[6], trial[6], big = 0.0;
+        pk_lstsq(J, e, dx);
+        for (int j = 0; j < 6; j++) {
+            trial[j] = wrap_pi(th[j] + dx[j]);
+            big = fmax(big, fabs(dx[j]));
+        }
+        if (!(big < 0.1))
+            break; /* not a small correction: a near-null direction */
+        m3 R2;
+        v3 p2;
+        double J2[6][6], e2[6];
+        pk_fk(g, trial, &R2, &p2, J2);
+        double err2 = pk_error(RT, pT, &R2, p2, g->scale, e2);
+        if (!(err2 < err))
+            break;
+        err = err2;
+        for (int j = 0; j < 6; j++) {
+            th[j] = trial[j];
+            e[j] = e2[j];
+            for (int r = 0; r < 6; r++)
+                J[r][j] = J2[r][j];
+        }
+    }
+    return err;
+}
+
+/* ------------------------------------------------------------- one pose */
+
+/* One pose's outputs: Q (8 x n), valid, singular, within limits (8 each). */
+typedef struct {
+    double *Q;
+    unsigned char *valid, *sing, *inside;
+    int n;
+} PkOut;
+
+static void pk_clear(PkOut o)
+{
+    for (int k = 0; k < 8; k++) {
+        o.valid[k] = o.sing[k] = o.inside[k] = 0;
+        for (int j = 0; j < o.n; j++)
+            o.Q[o.n * k + j] = NAN;
+    }
+}
+
+/* Near a singular triple (its outer axes almost in line) only tx + sigma tz is
+ * well determined: when th (remaining chain, triple at it) lies outside the
+ * limits, move that split inside them where the pose error stays within
+ * PK_ACCEPT (checked by forward kinematics). Returns 1 when th changed. */
+static int pk_resplit(const double *P, const PkGeo *g, int it, const m3 *RT, v3 pT,
+                      double *th)
+{
+    v3 hx = g->h[it], hy = g->h[it + 1], hz = g->h[it + 2];
+    v3 v = v3_rot(hy, cos(th[it + 1]), sin(th[it + 1]), hz);
+    double sv = v3_norm(v3_cross(v, hx));
+    if (!(sv < 1e-6))
+        return 0;
+    int jx = g->full[it], jz = g->full[it + 2];
+    double sigma = v3_dot(v, hx) >= 0.0 ? 1.0 : -1.0;
+    double tx = th[it], tz = th[it + 2];
+    double qz = P[PK_SIGN + jz] * (tz - P[PK_OFFSET + jz]);
+    double eps = wrap_pi(pk_split(P, jx, jz, tx + sigma * tz, sigma, qz) - tz);
+    if (eps == 0.0 || !(fabs(eps) * sv <= 0.1 * PK_ACCEPT))
+        return 0;
+    double trial[6];
+    for (int j = 0; j < 6; j++)
+        trial[j] = th[j];
+    trial[it] = tx - sigma * eps;
+    trial[it + 2] = tz + eps;
+    m3 R;
+    v3 p;
+    double e[6];
+    pk_fk(g, trial, &R, &p, NULL);
+    if (!(pk_error(RT, pT, &R, p, g->scale, e) <= PK_ACCEPT))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        th[j] = trial[j];
+    return 1;
+}
+
+/* Joints on one line (a singular configuration: equal Jacobian columns up to the
+ * sign sigma) only fix th_i + sigma th_j: when th lies outside the limits, trade
+ * each such pair's split inside them (pk_split), two passes over the pairs, kept
+ * when the pose still holds to PK_ACCEPT. Returns 1 when th changed. */
+static int pk_repair(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
+{
+    double trial[6];
+    int moved = 0;
+    for (int j = 0; j < 6; j++)
+        trial[j] = th[j];
+    for (int pass = 0; pass < 2; pass++) {
+        m3 R;
+        v3 p;
+        double J[6][6];
+        pk_fk(g, trial, &R, &p, J);
+        for (int i = 0; i < 6; i++)
+            for (int j = i + 1; j < 6; j++) {
+                double dot = J[3][i] * J[3][j] + J[4][i] * J[4][j] + J[5][i] * J[5][j];
+                double sigma = dot >= 0.0 ? 1.0 : -1.0, diff = 0.0;
+                for (int r = 0; r < 6; r++)
+                    diff = fmax(diff, fabs(J[r][i] - sigma * J[r][j]));
+                if (!(diff < 1e-9))
+                    continue;
+                int fi = g->full[i], fj = g->full[j], ini, inj;
+                joint_value(trial[i], P[PK_SIGN + fi], P[PK_OFFSET + fi], P[PK_LO + fi],
+                            P[PK_HI + fi], &ini);
+                double qj = joint_value(trial[j], P[PK_SIGN + fj], P[PK_OFFSET + fj],
+                                        P[PK_LO + fj], P[PK_HI + fj], &inj);
+                if (ini && inj)
+                    continue;
+                double phi = trial[i] + sigma * trial[j];
+                double tj = pk_split(P, fi, fj, phi, sigma, qj);
+                trial[j] = tj;
+                trial[i] = phi - sigma * tj;
+                moved = 1;
+#ifdef PK_DEBUG
+                fprintf(stderr, "   repair pair %d %d sigma %g diff %.3e -> %.6f %.6f\n", i, j,
+                        sigma, diff, trial[i], trial[j]);
+#endif
+            }
+    }
+    if (!moved)
+        return 0;
+    m3 R;
+    v3 p;
+    double e[6];
+    pk_fk(g, trial, &R, &p, NULL);
+    double err = pk_error(RT, pT, &R, p, g->scale, e);
+#ifdef PK_DEBUG
+    fprintf(stderr, "   repair err %.3e\n", err);
+#endif
+    if (!(err <= PK_ACCEPT))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        th[j] = wrap_pi(trial[j]);
+    return 1;
+}
+
+/* The joint coordinates of chain angles th (6, remaining chain) into q (full
+ * chain, held joint at x) and their smallest margin to the limits [rad]
+ * (negative: outside) */
+static double pk_coords(const double *P, const PkGeo *g, const double *th, int held,
+                        double x, double *q)
+{
+    double margin = INFINITY;
+    for (int j = 0; j < 6; j++) {
+        int f = g->full[j], in;
+        double lo = P[PK_LO + f], hi = P[PK_HI + f];
+        q[f] = joint_value(th[j], P[PK_SIGN + f], P[PK_OFFSET + f], lo, hi, &in);
+        margin = fmin(margin, fmin(q[f] - lo, hi - q[f]));
+    }
+    if (held >= 0) {
+        q[held] = x;
+        margin = fmin(margin, fmin(x - P[PK_LO + held], P[PK_HI + held] - x));
+    }
+    return margin;
+}
+
+/* Roots psi of h . rot(u, sg psi) p = rhs (sg = +-1) appended to psi[*n] */
+static void pk_psi_roots(v3 h, v3 u, v3 p, double rhs, double sg, double *psi, int *n)
+{
+    double A, B, C;
+    sp4_coeffs(h, u, p, &A, &B, &C);
+    if (hypot(A, B) < 1e-12)
+        return;
+    Roots r = pk_sp4(A, B, rhs - C);
+    for (int i = 0; i < r.n; i++)
+        psi[(*n)++] = wrap_pi(sg * r.t[i]);
+}
+
+/* Both triples meet (an SRS arm with its elbow held): the shoulder-wrist distance
+ * is fixed, so a reachable pose has a one-parameter family of solutions, the
+ * swivel psi of the arm about the line S-W: R_A(psi) = rot(u, psi) R_A0, R_B =
+ * R_A^T G, each triple two branches. Each branch (slot 2 iA + iB) is returned at
+ * the psi where its configuration lies deepest inside the limits, among psi = 0,
+ * every psi where a joint reaches a limit (a subproblem 4 in psi per joint and
+ * limit) and the midpoints between them: a feasible stretch of the family is
+ * bounded by such psi, so a branch with any in-limit configuration gets one.
+ * Every row is flagged singular (the family is a self-motion). */
+static int pk_swivel(const double *P, const PkGeo *g, const m3 *RT, v3 pT, const m3 *G,
+                     double x, const double *qn, PkOut o)
+{
+    int held = (int)P[PK_HELD];
+    v3 S = g->pt, Wp = g->pt2;
+    v3 w = v3_add(pT, m3_mv(G, v3_sub(Wp, g->tM)));
+    v3 a = v3_sub(Wp, S), b = v3_sub(w, S);
+    double la = v3_norm(a), lb = v3_norm(b);
+    if (fabs(la - lb) > 1e-9 * fmax(1.0, g->scale))
+        return PK_OUT_OF_REACH;
+    if (la < 1e-12 * g->scale)
+        return PK_DEGENERATE;
+    a = v3_scale(a, 1.0 / la);
+    b = v3_scale(b, 1.0 / lb);
+    v3 ax = v3_cross(a, b);
+    double sn = v3_norm(ax), cs = v3_dot(a, b);
+    m3 R0;
+    if (sn > 1e-12) {
+        R0 = pk_rotm(v3_scale(ax, 1.0 / sn), cs, sn);
+    } else if (cs > 0.0) {
+        R0 = (m3){{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+    } else {
+        v3 e = fabs(a.x) < 0.9 ? (v3){1.0, 0.0, 0.0} : (v3){0.0, 1.0, 0.0};
+        e = v3_sub(e, v3_scale(a, v3_dot(e, a)));
+        R0 = pk_rotm(v3_scale(e, 1.0 / v3_norm(e)), -1.0, 0.0);
+    }
+    v3 u = b;
+    /* candidate swivel angles: 0 and where each joint reaches a limit */
+    double psi[128];
+    int np = 0;
+    psi[np++] = 0.0;
+    for (int t = 0; t < 2; t++) {
+        int o3 = 3 * t;
+        v3 hx = g->h[o3], hy = g->h[o3 + 1], hz = g->h[o3 + 2];
+        for (int jj = 0; jj < 3; jj++) {
+            int f = g->full[o3 + jj];
+            for (int side = 0; side < 2; side++) {
+                double L = P[PK_SIGN + f] * P[(side ? PK_HI : PK_LO) + f] + P[PK_OFFSET + f];
+                double cL = cos(L), sL = sin(L);
+                if (t == 0) { /* R_A = rot(u, psi) R0 */
+                    if (jj == 1)
+                        pk_psi_roots(hx, u, m3_mv(&R0, hz), v3_dot(hx, v3_rot(hy, cL, sL, hz)),
+                                     1.0, psi, &np);
+                    else if (jj == 0)
+                        pk_psi_roots(v3_rot(hx, cL, sL, hy), u, m3_mv(&R0, hz), v3_dot(hy, hz),
+                                     1.0, psi, &np);
+                    else
+                        pk_psi_roots(hx, u, m3_mv(&R0, v3_rot(hz, cL, -sL, hy)),
+                                     v3_dot(hx, hy), 1.0, psi, &np);
+                } else { /* R_B = R0^T rot(u, -psi) G */
+                    v3 gz = m3_mv(G, hz);
+                    if (jj == 1)
+                        pk_psi_roots(m3_mv(&R0, hx), u, gz, v3_dot(hx, v3_rot(hy, cL, sL, hz)),
+                                     -1.0, psi, &np);
+                    else if (jj == 0)
+                        pk_psi_roots(m3_mv(&R0, v3_rot(hx, cL, sL, hy)), u, gz, v3_dot(hy, hz),
+                                     -1.0, psi, &np);
+                    else
+                        pk_psi_roots(m3_mv(&R0, hx), u, m3_mv(G, v3_rot(hz, cL, -sL, hy)),
+                                     v3_dot(hx, hy), -1.0, psi, &np);
+                }
+            }
+        }
+    }
+    /* midpoints between consecutive candidates (around the circle) */
+    for (int i = 1; i < np; i++)
+        for (int j = i; j > 0 && psi[j] < psi[j - 1]; j--) {
+            double t = psi[j];
+            psi[j] = psi[j - 1];
+            psi[j - 1] = t;
+        }
+    int nb = np;
+    for (int i = 0; i < nb; i++) {
+        double nxt = i + 1 < nb ? psi[i + 1] : psi[0] + 2.0 * M_PI;
+        psi[np++] = 0.5 * (psi[i] + nxt);
+    }
+    PkTri ta, tb;
+    pk_tri_init(&ta, g->h[0], g->h[1], g->h[2]);
+    pk_tri_init(&tb, g->h[3], g->h[4], g->h[5]);
+    double best_m[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY}, best_th[4][6];
+    int have[4] = {0, 0, 0, 0};
+    for (int i = 0; i < np; i++) {
+        m3 Ru = pk_rotm(u, cos(psi[i]), sin(psi[i]));
+        m3 RA = pk_mul(&Ru, &R0);
+        m3 RAt = {{RA.r0.x, RA.r1.x, RA.r2.x}, {RA.r0.y, RA.r1.y, RA.r2.y},
+                  {RA.r0.z, RA.r1.z, RA.r2.z}};
+        m3 RB = pk_mul(&RAt, G);
+        PkTrip A, B;
+        pk_triple(P, &ta, &RA, g->full[0], g->full[2], qn[g->full[2]], P[PK_SING_TOL], &A);
+        pk_triple(P, &tb, &RB, g->full[3], g->full[5], qn[g->full[5]], P[PK_SING_TOL], &B);
+        for (int ka = 0; ka < A.n; ka++)
+            for (int kb = 0; kb < B.n; kb++) {
+                double th[6], q[PK_MAXJ];
+                for (int j = 0; j < 3; j++) {
+                    th[j] = A.t[ka][j];
+                    th[3 + j] = B.t[kb][j];
+                }
+                double m = pk_coords(P, g, th, held, x, q);
+                int slot = 2 * ka + kb;
+                if (!have[slot] || m > best_m[slot]) {
+                    have[slot] = 1;
+                    best_m[slot] = m;
+                    for (int j = 0; j < 6; j++)
+                        best_th[slot][j] = th[j];
+                }
+            }
+    }
+    int any = 0;
+    for (int slot = 0; slot < 4; slot++) {
+        if (!have[slot])
+            continue;
+        double *th = best_th[slot];
+        m3 R;
+        v3 pp;
+        double ev[6];
+        pk_fk(g, th, &R, &pp, NULL);
+        double err = pk_error(RT, pT, &R, pp, g->scale, ev);
+        if (err > PK_EXACT)
+            err = pk_polish(g, RT, pT, th);
+        if (!(err <= PK_ACCEPT))
+            continue;
+        double q[PK_MAXJ];
+        double m = pk_coords(P, g, th, held, x, q);
+        for (int j = 0; j < o.n; j++)
+            o.Q[o.n * slot + j] = q[j];
+        o.valid[slot] = 1;
+        o.inside[slot] = (unsigned char)(m >= -1e-9);
+        o.sing[slot] = 1;
+        any = 1;
+    }
+    return any ? PK_OK : PK_NO_ORIENTATION;
+}
+
+/* Every solution of pose T (4 x 4 row-major) with the held joint (if any) at x;
+ * qn: the preferred coordinates (n) at singularities. Returns the status. */
+static int pk_one(const double *P, const double *T, double x, const double *qn, PkOut o)
+{
+    PkGeo g;
+    pk_geometry(P, x, &g);
+    pk_clear(o);
+    int held = (int)P[PK_HELD];
+    double stol = P[PK_SING_TOL];
+    m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
+    v3 pT = {T[3], T[7], T[11]};
+    m3 G = pk_mul_t(&RT, &g.RM); /* the rotation of e1 ... e6 */
+    if (g.kase == PK_BOTH)
+        return pk_swivel(P, &g, &RT, pT, &G, x, qn, o);
+    int start = g.kase == PK_START, ia = start ? 3 : 0, it = start ? 0 : 3;
+    v3 p, d;
+    if (start) {
+        p = v3_add(m3_mv(&g.RM, m3_mtv(&RT, v3_sub(g.pt, pT))), g.tM);
+        d = g.pt;
+    } else {
+        p = g.pt;
+        d = v3_add(m3_mv(&G, v3_sub(g.pt, g.tM)), pT);
+    }
+    PkEq e;
+    pk_equations(&g, ia, p, d, &e);
+    PkPos pos;
+    pos.n = 0;
+    int code;
+    /* preferred chain angles of the position joints (when one is free) */
+    double pref_a = P[PK_SIGN + g.full[ia]] * qn[g.full[ia]] + P[PK_OFFSET + g.full[ia]];
+    double pref_c = P[PK_SIGN + g.full[ia + 2]] * qn[g.full[ia + 2]] +
+                    P[PK_OFFSET + g.full[ia + 2]];
+    if (fabs(e.mbc) <= PK_COPLANAR)
+        code = pk_coplanar(&e, 0, pref_a, pref_c, &pos);
+    else if (fabs(e.mab) <= PK_COPLANAR)
+        code = pk_coplanar(&e, 1, pref_a, pref_c, &pos);
+    else
+        code = pk_general(&e, &pos);
+#ifdef PK_DEBUG
+    fprintf(stderr, "code %d mab %.3e mbc %.3e npos %d\n", code, e.mab, e.mbc, pos.n);
+    for (int i = 0; i < pos.n; i++)
+        fprintf(stderr, "  pos %d: %.12f %.12f %.12f res %.3e sing %d\n", pos.slot[i], pos.t[i][0],
+                pos.t[i][1], pos.t[i][2], pos.res[i], pos.sing[i]);
+#endif
+    if (code != PK_OK)
+        return code;
+    int any = 0;
+    int jx = g.full[it], jz = g.full[it + 2];
+    PkTri tri;
+    pk_tri_init(&tri, g.h[it], g.h[it + 1], g.h[it + 2]);
+    double exact_p = PK_EXACT * fmax(1.0, g.scale);
+    for (int i = 0; i < pos.n; i++) {
+        if (!(pos.res[i] < 1e-6 * g.scale))
+            continue;
+        double th[6];
+        /* the other three's rotation */
+        m3 Rp = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+        for (int j = 0; j < 3; j++) {
+            th[ia + j] = pos.t[i][j];
+            m3 Rj = pk_rotm(g.h[ia + j], pos.c[i][j], pos.s[i][j]);
+            Rp = pk_mul(&Rp, &Rj);
+        }
+        m3 Rt;
+        if (start) {
+            Rt = pk_mul_t(&G, &Rp); /* R_A = G R_B^T */
+        } else {
+            m3 Rpt = {{Rp.r0.x, Rp.r1.x, Rp.r2.x},
+                      {Rp.r0.y, Rp.r1.y, Rp.r2.y},
+                      {Rp.r0.z, Rp.r1.z, Rp.r2.z}};
+            Rt = pk_mul(&Rpt, &G); /* R_B = R_A^T G */
+        }
+        PkTrip tr;
+        pk_triple(P, &tri, &Rt, jx, jz, qn[jz], stol, &tr);
+#ifdef PK_DEBUG
+        fprintf(stderr, "  triple n %d\n", tr.n);
+#endif
+        for (int k = 0; k < tr.n; k++) {
+            /* this solution's angles (the polish and the repairs change all six) */
+            for (int j = 0; j < 3; j++) {
+                th[ia + j] = pos.t[i][j];
+                th[it + j] = tr.t[k][j];
+            }
+            if (tr.check[k] || !(pos.res[i] < exact_p)) {
+                /* check against the pose; Newton-polish when not exact */
+                m3 R;
+                v3 pp;
+                double ev[6];
+                pk_fk(&g, th, &R, &pp, NULL);
+                double err = pk_error(&RT, pT, &R, pp, g.scale, ev);
+                if (err > PK_EXACT)
+                    err = pk_polish(&g, &RT, pT, th);
+#ifdef PK_DEBUG
+                fprintf(stderr, "    check slot %d err %.3e th %.17g %.17g %.17g\n", 2 * pos.slot[i] + k, err, th[0], th[1], th[2]);
+#endif
+                if (!(err <= PK_ACCEPT))
+                    continue; /* not a solution to 1e-12: never returned */
+            }
+            int slot = 2 * pos.slot[i] + k;
+            double *qs = o.Q + o.n * slot;
+            int all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            if (!all && pk_resplit(P, &g, it, &RT, pT, th))
+                all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            /* joints on one line only at a singular configuration: try there only */
+            if (!all && (pos.sing[i] || tr.sing[k]) && pk_repair(P, &g, &RT, pT, th))
+                all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            o.valid[slot] = 1;
+            o.inside[slot] = (unsigned char)all;
+            o.sing[slot] = (unsigned char)(pos.sing[i] || tr.sing[k]);
+            any = 1;
+        }
+    }
+    return any ? PK_OK : PK_NO_ORIENTATION;
+}
+
+/* --------------------------------------------------------------- entries */
+
+#define PK_F64(a) ((double *)PyArray_DATA((PyArrayObject *)(a)))
+#define PK_U8(a) ((unsigned char *)PyArray_DATA((PyArrayObject *)(a)))
+#define PK_DIM(a, d) (PyArray_DIMS((PyArrayObject *)(a))[d])
+
+/* A batch: poses T (N x 16), held values x (m, row i % m), preferred
+ * coordinates qn (mq x n, row i % mq), outputs per pose. */
+typedef struct {
+    const double *P, *T, *x, *qn;
+    long mx, mq;
+    int n;
+    double *Q;
+    unsigned char *valid, *sing, *inside;
+    signed char *status;
+} PkJob;
+
+/* Poses [b, e) of a batch (a pool task). */
+static void pk_range(void *ctx, long b, long e)
+{
+    const PkJob *jb = ctx;
+    int n = jb->n;
+    for (long i = b; i < e; i++) {
+        PkOut o = {jb->Q + 8 * n * i, jb->valid + 8 * i, jb->sing + 8 * i,
+                   jb->inside + 8 * i, n};
+        jb->status[i] = (signed char)pk_one(jb->P, jb->T + 16 * i, jb->x[i % jb->mx],
+                                            jb->qn + n * (i % jb->mq), o);
+    }
+}
+
+/* params as a Pieper parameter vector, or NULL with ValueError */
+static const double *pk_params(PyObject *o)
+{
+    PyArrayObject *a = array_arg(o, "params", NPY_DOUBLE, 1, 0);
+    if (a == NULL)
+        return NULL;
+    const double *P = PK_F64(a);
+    if (PK_DIM(a, 0) != PK_N_PARAMS || P[PK_TAG] != PK_TAG_VALUE ||
+        !(P[PK_N] == 6.0 || P[PK_N] == 7.0) ||
+        !(P[PK_HELD] >= -1.0 && P[PK_HELD] < P[PK_N]) ||
+        (P[PK_N] == 7.0) != (P[PK_HELD] >= 0.0)) {
+        PyErr_SetString(PyExc_ValueError,
+                        "robokin._native: params is not a Pieper parameter vector "
+                        "(pieper.pack)");
+        return NULL;
+    }
+    return P;
+}
+
+/* (Q, valid, singular, within_limits): lead + (8, n) and lead + (8,) with lead = ()
+ * (nlead 0) or (N,) (nlead 1), into out[4]; 0 on a memory error. */
+static int pk_outputs(int nlead, npy_intp N, int n, PyObject **out)
+{
+    npy_intp dq[3] = {N, 8, n}, df[2] = {N, 8};
+    out[0] = PyArray_SimpleNew(nlead + 2, dq + 1 - nlead, NPY_DOUBLE);
+    for (int i = 1; i < 4; i++)
+        out[i] = out[0] == NULL ? NULL : PyArray_SimpleNew(nlead + 1, df + 1 - nlead, NPY_BOOL);
+    if (out[0] == NULL || out[1] == NULL || out[2] == NULL || out[3] == NULL) {
+        for (int i = 0; i < 4; i++)
+            Py_XDECREF(out[i]);
+        return 0;
+    }
+    return 1;
+}
+
+/* pieper_ik1(T, params, x, qn) -> (code, Q (8, n), valid (8,), singular (8,),
+ * within_limits (8,)): one pose with the held joint at x (ignored without one),
+ * validated in the same call (pose_problem's tests); qn None or a float64 (n,)
+ * array of preferred coordinates at singularities. code >= BAD_POSE: nothing was
+ * solved and the arrays are None. The fast path for one pose: METH_FASTCALL, no
+ * pool, T read through its strides. */
+static PyObject *py_pieper_ik1(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 4) {
+        PyErr_SetString(PyExc_TypeError, "pieper_ik1(T, params, x, qn) takes 4 arguments");
+        return NULL;
+    }
+    const double *P = pk_params(args[1]);
+    if (P == NULL)
+        return NULL;
+    double x = PyFloat_AsDouble(args[2]);
+    if (x == -1.0 && PyErr_Occurred())
+        return NULL;
+    int n = (int)P[PK_N];
+    double qn[PK_MAXJ] = {0.0};
+    if (args[3] != Py_None) {
+        PyArrayObject *qa = array_arg(args[3], "qn", NPY_DOUBLE, 1, 0);
+        if (qa == NULL)
+            return NULL;
+        if (PK_DIM(qa, 0) != n) {
+            PyErr_SetString(PyExc_ValueError, "robokin._native.pieper_ik1: qn must be (n,)");
+            return NULL;
+        }
+        for (int j = 0; j < n; j++)
+            qn[j] = PK_F64(qa)[j];
+    }
+    int code = PK_BAD_POSE;
+    double T[16];
+    PyObject *to = args[0];
+    if (PyArray_Check(to)) {
+        PyArrayObject *ta = (PyArrayObject *)to;
+        if (PyArray_TYPE(ta) == NPY_DOUBLE && PyArray_NDIM(ta) == 2 && PK_DIM(ta, 0) == 4 &&
+            PK_DIM(ta, 1) == 4 && PyArray_ISNOTSWAPPED(ta) && PyArray_ISALIGNED(ta)) {
+            const char *d = PyArray_BYTES(ta);
+            npy_intp rs = PyArray_STRIDE(ta, 0), cs = PyArray_STRIDE(ta, 1);
+            for (int r = 0; r < 4; r++)
+                for (int c = 0; c < 4; c++)
+                    T[4 * r + c] = *(const double *)(d + r * rs + c * cs);
+            code = pose_problem(T, POSE_ROW_TOL, POSE_ORTH_TOL);
+            code = code ? PK_BAD_POSE + code : 0;
+        }
+    }
+    if (code == 0 && !isfinite(x))
+        code = PK_BAD_POSE;
+    if (code)
+        return Py_BuildValue("(iOOOO)", code, Py_None, Py_None, Py_None, Py_None);
+    PyObject *out[4];
+    if (!pk_outputs(0, 0, n, out))
+        return NULL;
+    PkOut o = {PK_F64(out[0]), PK_U8(out[1]), PK_U8(out[2]), PK_U8(out[3]), n};
+    code = pk_one(P, T, x, qn, o);
+    PyObject *res = PyTuple_New(5);
+    if (res == NULL) {
+        for (int i = 0; i < 4; i++)
+            Py_DECREF(out[i]);
+        return NULL;
+    }
+    PyTuple_SET_ITEM(res, 0, PyLong_FromLong(code));
+    for (int i = 0; i < 4; i++)
+        PyTuple_SET_ITEM(res, i + 1, out[i]);
+    return res;
+}
+
+/* pieper_ik(params, T (N, 4, 4), x (m,), qn (mq, n)) -> (Q (N, 8, n), valid,
+ * singular, within_limits (N, 8), status (N,) int8): a batch, not validated (the
+ * caller checked poses and values); pose i's held value is x[i % m] and its
+ * preferred coordinates qn[i % mq] (a sweep of held values is one batch).
+ * Batches of PARALLEL_MIN poses or more run on the pool. */
+static PyObject *py_pieper_ik(PyObject *self, PyObject *args)
+{
+    PyObject *po, *to, *xo, *qo;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOO", &po, &to, &xo, &qo))
+        return NULL;
+    const double *P = pk_params(po);
+    PyArrayObject *T, *x, *qn;
+    if (P == NULL || !(T = array_arg(to, "T", NPY_DOUBLE, 3, 0)) ||
+        !(x = array_arg(xo, "x", NPY_DOUBLE, 1, 0)) ||
+        !(qn = array_arg(qo, "qn", NPY_DOUBLE, 2, 0)))
+        return NULL;
+    int n = (int)P[PK_N];
+    if (PK_DIM(T, 1) != 4 || PK_DIM(T, 2) != 4 || PK_DIM(x, 0) < 1 || PK_DIM(qn, 0) < 1 ||
+        PK_DIM(qn, 1) != n) {
+        PyErr_SetString(PyExc_ValueError,
+                        "robokin._native.pieper_ik: T must be (N, 4, 4), x (m >= 1,) and "
+                        "qn (mq >= 1, n)");
+        return NULL;
+    }
+    npy_intp N = PK_DIM(T, 0);
+    PyObject *out[4];
+    if (!pk_outputs(1, N, n, out))
+        return NULL;
+    npy_intp dims[1] = {N};
+    PyObject *status = PyArray_SimpleNew(1, dims, NPY_INT8);
+    if (status == NULL) {
+        for (int i = 0; i < 4; i++)
+            Py_DECREF(out[i]);
+        return NULL;
+    }
+    PkJob jb = {P, PK_F64(T), PK_F64(x), PK_F64(qn), (long)PK_DIM(x, 0),
+                (long)PK_DIM(qn, 0), n, PK_F64(out[0]), PK_U8(out[1]), PK_U8(out[2]),
+                PK_U8(out[3]), (signed char *)PyArray_DATA((PyArrayObject *)status)};
+    Py_BEGIN_ALLOW_THREADS
+    if (N >= PK_PARALLEL_MIN)
+        pool_for((long)N, PK_GRAIN, pk_range, &jb);
+    else
+        pk_range(&jb, 0, (long)N);
+    Py_END_ALLOW_THREADS
+    return Py_BuildValue("(NNNNN)", out[0], out[1], out[2], out[3], status);
+}
+
+/* pieper_roots(coeffs (5,), re (4,), im (4,)): the quartic solver (for tests) */
+static PyObject *py_pieper_roots(PyObject *self, PyObject *args)
+{
+    PyObject *co, *ro, *io;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOO", &co, &ro, &io))
+        return NULL;
+    PyArrayObject *c, *re, *im;
+    if (!(c = array_arg(co, "coeffs", NPY_DOUBLE, 1, 0)) ||
+        !(re = array_arg(ro, "re", NPY_DOUBLE, 1, 1)) ||
+        !(im = array_arg(io, "im", NPY_DOUBLE, 1, 1)))
+        return NULL;
+    if (PK_DIM(c, 0) != 5 || PK_DIM(re, 0) != 4 || PK_DIM(im, 0) != 4 || PK_F64(c)[4] == 0.0) {
+        PyErr_SetString(PyExc_ValueError,
+                        "robokin._native.pieper_roots: coeffs (5,) with a non-zero last, "
+                        "re and im (4,)");
+        return NULL;
+    }
+    pk_quartic(PK_F64(c), PK_F64(re), PK_F64(im));
+    Py_RETURN_NONE;
+}
+
+#define PIEPER_METHODS                                                                   \
+    {"pieper_ik1", (PyCFunction)(void (*)(void))py_pieper_ik1, METH_FASTCALL,            \
+     "pieper_ik1(T, params, x, qn) -> (code, Q, valid, singular, within_limits): one "   \
+     "pose of the Pieper closed form, validated."},                                       \
+    {"pieper_ik", py_pieper_ik, METH_VARARGS,                                            \
+     "pieper_ik(params, T, x, qn) -> (Q, valid, singular, within_limits, status): a "    \
+     "batch of the Pieper closed form, held values x."},                                  \
+    {"pieper_roots", py_pieper_roots, METH_VARARGS,                                      \
+     "pieper_roots(coeffs, re, im): the roots of a quartic, lowest order first."},
+
+static int pieper_constants(PyObject *m)
+{
+    static const struct { const char *name; int value; } ints[] = {
+        {"PIEPER_N", PK_N}, {"PIEPER_HELD", PK_HELD}, {"PIEPER_CASE", PK_CASE},
+        {"PIEPER_SING_TOL", PK_SING_TOL}, {"PIEPER_SCALE", PK_SCALE},
+        {"PIEPER_POINT", PK_POINT}, {"PIEPER_AXES", PK_AXES}, {"PIEPER_POINTS", PK_POINTS},
+        {"PIEPER_TOOL_R", PK_TOOL_R}, {"PIEPER_TOOL_T", PK_TOOL_T},
+        {"PIEPER_SIGN", PK_SIGN}, {"PIEPER_OFFSET", PK_OFFSET}, {"PIEPER_LO", PK_LO},
+        {"PIEPER_HI", PK_HI}, {"PIEPER_TAG", PK_TAG}, {"PIEPER_N_PARAMS", PK_N_PARAMS},
+        {"PIEPER_MAX_JOINTS", PK_MAXJ}, {"PIEPER_START", PK_START}, {"PIEPER_END", PK_END},
+        {"PIEPER_BOTH", PK_BOTH}, {"PIEPER_POINT2", PK_POINT2},
+        {"PIEPER_DEGENERATE", PK_DEGENERATE}, {"PIEPER_BAD_POSE", PK_BAD_POSE}, {"PIEPER_PARALLEL_MIN", PK_PARALLEL_MIN}};
+    for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
+        if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
+            return -1;
+    if (PyModule_AddObject(m, "PIEPER_TAG_VALUE", PyFloat_FromDouble(PK_TAG_VALUE)) < 0)
+        return -1;
+    return 0;
+}
+
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT DEFAULT
+#elif defined(__GNUC__)
+#pragma GCC pop_options
+#endif

@@ -1,0 +1,170 @@
+"""Held-joint IK of 7R arms, property tests (issue 23, items 5 and 6).
+
+Configurations are drawn with every joint biased to the values users hit: 0,
++-pi/2, pi, +-1e-9, +-1e-7, +-1e-6 (next to singular), either limit, or uniform
+inside the limits. The pose is ``robot.fk(q)`` and ``q[j]`` is held. Oracles:
+
+* every returned solution reproduces the pose to 1e-12 (m, rad) and holds the value;
+* non-singular configurations (the six remaining columns of the Jacobian have a
+  smallest singular value >= 1e-4: isolated solutions, the generating configuration
+  is one of them) give back the generating configuration (to 1e-6 rad, modulo 2 pi);
+* singular ones, when the generating configuration is inside the limits, give at
+  least one valid solution inside the limits (``within_limits``: 1e-9 slack).
+
+Arms: the built-in Panda with joint 4, 5, 6 or 7 held (joints 1-3 held leave no
+meeting axis triple: general 6R, not this closed form) and an exact SRS arm with
+the KUKA LBR iiwa 14 R820's link lengths and joint ranges, each joint held.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robokin
+from reference import pose_errors
+
+hyp = pytest.importorskip("hypothesis")
+st = pytest.importorskip("hypothesis.strategies")
+
+SPECIAL = (0.0, np.pi / 2, -np.pi / 2, np.pi, 1e-9, -1e-9, 1e-7, -1e-7, 1e-6, -1e-6)
+NON_SINGULAR = 1e-4  # smallest singular value of the 6 x 6 remaining Jacobian [m, rad]
+
+
+def iiwa14_srs() -> robokin.Robot:
+    """An exact SRS arm: the KUKA LBR iiwa 14 R820 (standard DH, flange frame).
+
+    Link lengths d_bs = 0.36, d_se = 0.42, d_ew = 0.40, d_wf = 0.126 m as in Faria,
+    Ferreira, Erlhagen, Monteiro and Bicho, "Position-based kinematics for 7-DoF
+    serial manipulators with global configuration control, joint limit and
+    singularity avoidance", Mechanism and Machine Theory 121 (2018), table 1;
+    joint ranges +-170, 120, 170, 120, 170, 120, 175 deg from KUKA's "LBR iiwa 7
+    R800, LBR iiwa 14 R820 specification". Every offset is zero: axes 1-3 meet in
+    the shoulder, 5-7 in the wrist.
+    """
+    deg = np.radians
+    table = [(-np.pi / 2, 0.36, 170), (np.pi / 2, 0.0, 120), (np.pi / 2, 0.42, 170),
+             (-np.pi / 2, 0.0, 120), (-np.pi / 2, 0.40, 170), (np.pi / 2, 0.0, 120),
+             (0.0, 0.126, 175)]
+    rows = [{"a": 0.0, "alpha": alpha, "d": d, "theta": 0.0,
+             "limits": [-deg(r), deg(r)], "name": f"a{i + 1}"}
+            for i, (alpha, d, r) in enumerate(table)]
+    return robokin.Robot.from_dh(rows, convention="standard", name="iiwa14_srs")
+
+
+PANDA = robokin.load("panda")
+SRS = iiwa14_srs()
+CASES = [("panda", j) for j in (3, 4, 5, 6)] + [("srs", j) for j in range(7)]
+ROBOTS = {"panda": PANDA, "srs": SRS}
+
+
+def configurations(robot):
+    """Joint values biased to 0, +-pi/2, pi, 1e-9..1e-6 from them, the limits."""
+    joints = [st.one_of(st.sampled_from(SPECIAL + (float(lo), float(hi))),
+                        st.floats(float(lo), float(hi)))
+              for lo, hi in robot.limits]
+    return st.tuples(*joints).map(np.array)
+
+
+def _angle_gap(Q, q):
+    return np.abs((Q - q + np.pi) % (2 * np.pi) - np.pi).max(axis=-1)
+
+
+def check_held(robot, j, q, *, singular=True):
+    """The oracles of the module docstring for configuration q with joint j held.
+
+    ``singular=False`` leaves out the third (in-limit solution at singular
+    configurations), which :func:`test_singular_configurations_get_an_in_limit_solution`
+    asserts on its own.
+    """
+    T = robot.fk(q)
+    sols = robot.ik(T, fixed={robot.joint_names[j]: float(q[j])})
+    Q = sols.q[sols.valid]
+    assert np.all(Q[:, j] == q[j])
+    if len(Q):
+        dp, dr = pose_errors(robot.fk(Q), T)
+        assert dp.max() <= 1e-12 and dr.max() <= 1e-12, (q.tolist(), dp.max(), dr.max())
+    J = np.delete(robot.jacobian(q), j, axis=1)
+    sigma = np.linalg.svd(J, compute_uv=False)[-1]
+    lim = robot.limits
+    inside = bool(np.all((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9)))
+    if sigma >= NON_SINGULAR:
+        assert len(Q) and _angle_gap(Q, q).min() <= 1e-6, (q.tolist(), sols.status)
+    elif inside and singular:
+        ok = sols.valid & sols.within_limits
+        assert ok.any(), (q.tolist(), sols.status)
+
+
+IDS = [f"{a}-joint{j + 1}" for a, j in CASES]
+
+# Known gap (docs/ik.md, "Known gap"): the SRS arm at full stretch (q4 = 0) with
+# q2 or q6 at (or within 1e-6 rad of) 0, where axes 1, 3, 5, 7 line up, and with
+# joint 2 or 6 held within 1e-6 rad of 0 (two of the six axes left nearly
+# coincide): 2-12 % of the singular in-limit configurations get no in-limit
+# solution (rows dropped when the polish cannot bring them to 1e-12, or splits of
+# three or more joints on one line not traded inside the limits).
+KNOWN_GAPS = {  # each with a configuration it fails on (run first)
+    ("srs", 0): [0.0, 0.0, 1.0, 1e-9, 0.0, 0.0, 0.0],
+    ("srs", 1): [1e-6, np.pi / 2, 0.0, 0.0, 0.0, 1e-9, 0.0],
+    ("srs", 2): [0.0, 0.0, 1.0, 1e-9, 0.0, 1.9375, 0.0],
+    ("srs", 4): [np.pi / 2, 0.0, np.pi / 2, 0.0, 0.0, 2.0, 0.0],
+    ("srs", 5): [0.0, 1e-9, 0.0, 0.0, 0.0, -np.pi / 2, 0.0],
+    ("srs", 6): [0.0, 0.0, np.pi / 2, 0.0, np.pi / 2, -1e-9, 0.0],
+}
+SINGULAR_CASES = [
+    pytest.param(a, j, id=i, marks=pytest.mark.xfail(
+        strict=True, reason="known gap: SRS at full stretch / near-coincident axes"))
+    if (a, j) in KNOWN_GAPS else pytest.param(a, j, id=i)
+    for (a, j), i in zip(CASES, IDS, strict=True)]
+
+
+@pytest.mark.parametrize(("arm", "j"), CASES, ids=IDS)
+def test_held_joint_special_configurations(arm, j):
+    # every row exact, the generating configuration back where it is isolated
+    robot = ROBOTS[arm]
+
+    @hyp.settings(max_examples=60, deadline=None, derandomize=True, database=None,
+                  suppress_health_check=list(hyp.HealthCheck))
+    @hyp.given(q=configurations(robot))
+    def run(q):
+        check_held(robot, j, q, singular=False)
+
+    run()
+
+
+@pytest.mark.parametrize(("arm", "j"), SINGULAR_CASES)
+def test_singular_configurations_get_an_in_limit_solution(arm, j):
+    robot = ROBOTS[arm]
+
+    def check(q):
+        check_held(robot, j, q)
+
+    run = hyp.given(q=configurations(robot))(check)
+    if (arm, j) in KNOWN_GAPS:
+        run = hyp.example(q=np.array(KNOWN_GAPS[arm, j]))(run)
+    hyp.settings(max_examples=60, deadline=None, derandomize=True, database=None,
+                 suppress_health_check=list(hyp.HealthCheck))(run)()
+
+
+@pytest.mark.parametrize(("arm", "j"), CASES, ids=IDS)
+def test_held_joint_random_configurations_come_back(arm, j):
+    # uniform in-limit configurations are non-singular almost surely: all 300 come
+    # back. With the SRS arm's elbow held the six joints left move in a one-parameter
+    # family (the swivel) at every pose: there an in-limit solution must come back.
+    robot = ROBOTS[arm]
+    rng = np.random.default_rng(7 + j)
+    lim = robot.limits
+    q = rng.uniform(lim[:, 0], lim[:, 1], (300, 7))
+    T = robot.fk(q)
+    sols = robot.ik(T, fixed={robot.joint_names[j]: q[:, j]})
+    assert sols.shape == (300,)
+    if (arm, j) == ("srs", 3):
+        assert (sols.valid & sols.within_limits).any(axis=-1).all()
+        assert sols.singular[sols.valid].all()
+    else:
+        gap = np.where(sols.valid, _angle_gap(sols.q, q[:, None, :]), np.inf).min(axis=-1)
+        assert gap.max() <= 1e-6
+    Q = sols.q[sols.valid]
+    dp, dr = pose_errors(robot.fk(Q), np.broadcast_to(T[:, None], sols.q.shape[:2] + (4, 4))
+                         [sols.valid])
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12
