@@ -5,8 +5,11 @@ collision checker's problem: the robot as the scene places it
 (``scene.attach``), each shape's coal geometry placed by the robot's link frames
 (``link_frames``, tested against pinocchio and the DH tables elsewhere), the
 scene's objects, and the checked pairs re-derived from the robot geometry's
-``self_pairs`` and the scene's exclusions. Distances are coal's (``coal.distance``
-with its own default request), one call per pair.
+``self_pairs`` and the scene's exclusions. Distances are coal's (``coal.distance``),
+one call per pair, each with a fresh request and result whose GJK starts from
+coal's default guess: no cached guess carried from one call to the next (a cached
+guess made pinocchio's collision checks miss 88 of 2100 colliding Panda states;
+``benchmarks/plan_baseline.py``).
 """
 
 from __future__ import annotations
@@ -18,6 +21,13 @@ from robokin.collision import Scene
 from robokin.kinematics.forward import link_frames
 from robokin.model import geometry as geo
 from robokin.spatial import pose_from_xyz_rpy
+
+
+def _request():
+    """A distance request that starts GJK from coal's default guess, never a cached one."""
+    req = coal.DistanceRequest()
+    req.gjk_initial_guess = coal.GJKInitialGuess.DefaultGuess
+    return req
 
 
 def _tf(T):
@@ -57,10 +67,10 @@ class Oracle:
             res = coal.DistanceResult()
             if other is None:
                 out[p] = coal.distance(self.geom[i], tf[i], self.ob_geom[j], self.ob_tf[j],
-                                       coal.DistanceRequest(), res)
+                                       _request(), res)
             else:
                 out[p] = coal.distance(self.geom[i], tf[i], self.geom[other], tf[other],
-                                       coal.DistanceRequest(), res)
+                                       _request(), res)
         return out
 
     def min_distance(self, q):
