@@ -176,6 +176,26 @@ def test_an_enclosed_goal_ends_at_the_time_limit():
     assert 0.2 <= res.time < 1.0
 
 
+def test_the_time_limit_counts_the_goals_ik_and_checks(ur5_shelf):
+    # a pose goal a small step from HOME (the straight edge to its own branch is
+    # free, so a search would solve it at once): with a 1e-7 s limit the IK and the
+    # checks of every goal alone take longer, and the query says so instead of
+    # searching on a fresh clock; with 1 s it is solved
+    pl, oracle = ur5_shelf
+    near = HOME + np.array([0.05, 0.05, -0.05, 0.05, 0.05, 0.05])
+    assert pl.edges_free(HOME[None], near[None])[0]
+    T = pl.robot.fk(near)
+    res = pl.plan(HOME, T, time_limit=1e-7)
+    assert not res.success
+    assert res.reason == ("no path found before the time limit (1e-07 s): the goals "
+                          "and their checks took it")
+    assert res.goals.shape[0] > 8  # every branch was still computed
+    res = pl.plan(HOME, T, time_limit=1.0)
+    assert res.success, res.reason
+    np.testing.assert_allclose(pl.robot.fk(res.q[-1]), T, atol=1e-9)
+    assert oracle.path_min(res.q) > 0.0
+
+
 def test_the_clearance_is_kept_along_the_whole_path(ur5_shelf):
     pl, oracle = ur5_shelf
     front = pose((0.4, 0.0, 0.57), (0.0, np.pi / 2, 0.0))  # in front of the cell

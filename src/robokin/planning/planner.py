@@ -203,7 +203,9 @@ class Planner:
             goal: A configuration (n,), a goal set (k, n), or a TCP pose (4, 4) in
                 the world (every in-limit IK solution is a goal; see
                 :mod:`robokin.planning.goals`).
-            time_limit: Seconds the search may take [s].
+            time_limit: Seconds from the call until a path is found [s]: the
+                goals' IK and the checks of the ends count, the search gets what
+                is left (shortening and smoothing after it are not cut short).
             seed: Seed of every random choice: the same inputs and seed give the
                 same path (the compiled planner; when the time limit does not cut
                 the search).
@@ -254,7 +256,13 @@ class Planner:
                               time.perf_counter() - t0, planner, goals=goals.q)
         free_goals, goal_rows = fail
         stats: dict[str, Any] = {"goals": int(free_goals.shape[0])}
-        path, goal_at, why = self._search(planner, q0, free_goals, margin, limit,
+        left = limit - (time.perf_counter() - t0)  # the goals' IK and checks count
+        if left <= 0:
+            return PlanResult(False, np.zeros((0, self.n)),
+                              f"no path found before the time limit ({limit:g} s): the "
+                              "goals and their checks took it", time.perf_counter() - t0,
+                              planner, goals=goals.q, stats=stats)
+        path, goal_at, why = self._search(planner, q0, free_goals, margin, (limit, left),
                                           int(seed), step, stats)
         if path is None:
             return PlanResult(False, np.zeros((0, self.n)), why,
@@ -315,15 +323,20 @@ class Planner:
         return goals.q[grep.free], goals.index[grep.free]
 
     def _search(self, planner: str, q0: np.ndarray, goals: np.ndarray,
-                margin: np.ndarray, limit: float, seed: int, step: float | None,
-                stats: dict[str, Any]) -> tuple[np.ndarray | None, int, str]:
-        """Run the planner: (path, goal row, reason)."""
+                margin: np.ndarray, limits: tuple[float, float], seed: int,
+                step: float | None, stats: dict[str, Any]
+                ) -> tuple[np.ndarray | None, int, str]:
+        """Run the planner: (path, goal row, reason).
+
+        ``limits``: the query's time limit (named in the reason) and the search's.
+        """
+        limit, left = limits
         lo, hi = self._bounds(q0, goals)
         if step is None:
             step = min(RANGE, RANGE_FRACTION * float(np.linalg.norm(hi - lo)))
         if planner == DEFAULT_PLANNER:
             opts = np.zeros(_k.RC_N_OPTS)
-            opts[_k.RC_RANGE], opts[_k.RC_TIME] = step, limit
+            opts[_k.RC_RANGE], opts[_k.RC_TIME] = step, left
             opts[_k.RC_MAX_NODES] = MAX_NODES
             code, path, goal_at, work, search = _k.plan_rrtc(
                 self.model.capsule, q0, np.ascontiguousarray(goals), lo, hi, margin,
@@ -340,11 +353,11 @@ class Planner:
         out = ompl_plan(planner.split(":", 1)[1], self.n, lo, hi, q0, goals,
                         lambda q: bool(self.model.check_states(q, margin).free[0]),
                         lambda a, b: bool(self.model.check_edges(a, b, margin).free[0]),
-                        limit, step)
+                        left, step)
         stats.update(states=out.states, edges=out.edges, search_s=time.perf_counter() - t)
         if out.path is None:
-            return None, -1, (f"no path found before the time limit ({limit:g} s): "
-                              f"OMPL says {out.status!r}")
+            return None, -1, (f"no path found before the time limit ({limit:g} "
+                              f"s): OMPL says {out.status!r}")
         path = out.path
         goal_at = int(np.argmin(np.linalg.norm(goals - path[-1], axis=1)))
         path[-1] = goals[goal_at]
@@ -462,7 +475,8 @@ def plan(robot: Robot, scene: Scene, start: npt.ArrayLike, goal: npt.ArrayLike, 
         start: The start configuration (n,) [rad, m].
         goal: A configuration (n,), a goal set (k, n) or a TCP pose (4, 4) in the
             world.
-        time_limit: Seconds the search may take [s].
+        time_limit: Seconds from the call until a path is found [s] (see
+            :meth:`Planner.plan`).
         seed: Seed of every random choice (same inputs, same path).
         **options: The other keywords of :meth:`Planner.plan`.
 
