@@ -26,8 +26,9 @@ from setuptools.errors import CompileError, PlatformError
 CSRC = "src/robokin/_native/csrc"
 HEADERS = [f"{CSRC}/{h}" for h in ("lanes.h", "chain.h", "pool.h", "pool.c", "fk.c",
                                      "lm.c", "nearest.c", "six_r.c", "broadphase.c", "general6r.c",
-                                     "manipulability.c", "pieper.c", "plan_geom.c", "plan_check.c",
-                                     "plan_rrtc.c", "plan_path.c", "module.c")]
+                                     "manipulability.c", "pieper.c", "pieper_srs.c",
+                                     "plan_geom.c", "plan_check.c", "plan_rrtc.c",
+                                     "plan_path.c", "module.c")]
 UNIX = sys.platform != "win32"
 # -fno-math-errno: sqrt inlines (and vectorises); no other fast-math licence
 FLAGS = ["-O3", "-fno-math-errno", "-Wno-psabi"] if UNIX else ["/O2"]

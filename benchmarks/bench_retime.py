@@ -146,7 +146,7 @@ def row(name, ours, ref, fine, extra=""):
 
 def main() -> None:
     from robokin import collision
-    from robokin.demo import A_MAX, V_MAX, plan_press_loading
+    from robokin.cli.demo import A_MAX, V_MAX, plan_press_loading
 
     print("| path | robokin | toppra, its grid | toppra, 4,000 intervals | robokin vs "
           "toppra / vs fine | robokin worst excess | toppra worst excess |")

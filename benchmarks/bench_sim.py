@@ -21,7 +21,7 @@ import numpy as np
 
 import robokin
 from robokin import collision, sim, trajectory
-from robokin.demo import plan_press_loading
+from robokin.cli.demo import plan_press_loading
 from robokin.model.dynamics import LinkInertia, RobotDynamics
 from robokin.model.geometry import link_names
 from robokin.sim._mujoco import load_model, mujoco

@@ -18,9 +18,9 @@ PRELUDE = """
 import re, resource, sys
 import numpy, pydantic, yaml
 import robokin, robokin.cli, robokin.io.robot_files, robokin.io.motion_files
+import robokin.trajectory.motion_plan
 from robokin import collision
 robokin.load("ur5")
-robokin.cli._register_extra_commands()
 _vm = int(re.search(r"VmSize:\\s+(\\d+)", open("/proc/self/status").read()).group(1))
 _cap = (_vm + {extra_mb} * 1024) * 1024
 resource.setrlimit(resource.RLIMIT_AS, (_cap, _cap))

@@ -189,7 +189,7 @@ def test_json_output_is_strict_json_with_nulls_explained(capsys, tmp_path):
 def test_show_never_hands_rich_an_unbounded_word(capsys):
     r = robokin.load("ur5")
     long = r.replace(source="x" * 1_000_000, name="[bold red]ur5[/]")
-    from robokin.cli import cell
+    from robokin.cli.common import cell
 
     assert len(cell(long.source, 300)) <= 300
     assert cell(long.name) == "\\[bold red]ur5\\[/]"

@@ -84,7 +84,7 @@ def test_a_narrow_terminal_folds_cells_instead_of_cutting(capsys, monkeypatch):
 
 
 def test_a_folded_cell_keeps_every_character(capsys, monkeypatch):
-    from robokin.cli_output import Column, OutputTable, emit
+    from robokin.cli.output import Column, OutputTable, emit
 
     monkeypatch.setenv("COLUMNS", "12")
     monkeypatch.setenv("TTY_COMPATIBLE", "1")
@@ -100,15 +100,100 @@ def test_a_folded_cell_keeps_every_character(capsys, monkeypatch):
 URDF = os.path.join(os.path.dirname(__file__), "data", "urdf", "ur5.urdf")
 
 
-@pytest.mark.parametrize("cmd", [["robots"], ["show", "panda"],
-                                 ["motors", "scara", "0", "0", "0", "0.1"],
-                                 ["dh", URDF, "--mm"]])
-def test_every_table_command_has_csv_and_text(capsys, cmd):
+def _robots_table():
+    """The built-in arms: one YAML file each in robokin/robots, joints from the model."""
+    folder = os.path.join(os.path.dirname(robokin.__file__), "robots")
+    names = sorted(f[:-5] for f in os.listdir(folder) if f.endswith(".yaml"))
+    return [[n, str(robokin.load(n).n)] for n in names]
+
+
+# The expected tables, from the published parameters (not from robokin's output).
+D = np.degrees
+#: Franka's published modified DH (mm, deg) and joint limits (rad, here in deg).
+PANDA = [["joint1", "revolute", 0, 0, 0, 333, -D(2.8973), D(2.8973)],
+         ["joint2", "revolute", -90, 0, 0, 0, -D(1.7628), D(1.7628)],
+         ["joint3", "revolute", 90, 0, 0, 316, -D(2.8973), D(2.8973)],
+         ["joint4", "revolute", 90, 82.5, 0, 0, -D(3.0718), -D(0.0698)],
+         ["joint5", "revolute", -90, -82.5, 0, 384, -D(2.8973), D(2.8973)],
+         ["joint6", "revolute", 90, 0, 0, 0, -D(0.0175), D(3.7525)],
+         ["joint7", "revolute", 90, 88, 0, 0, -D(2.8973), D(2.8973)],
+         ["flange", "fixed", 0, 0, 0, 107]]
+#: The SCARA paper's motor map at q = (0, 0, 0, l4 = 0.1 m): phi3 = i (q3 - 2 pi l4 /
+#: lead) = -10 pi, phi4 = j q3 = 0 (i = 1, lead 20 mm, j = 15).
+MOTORS = [["motor1", 0.0, "rad", "yes"], ["motor2", 0.0, "rad", "yes"],
+          ["motor3", -10 * np.pi, "rad", "yes"], ["motor4", 0.0, "rad", "yes"]]
+#: Universal Robots' published standard DH of the UR5 (theta, d, a, alpha; mm, deg).
+UR5_DH = [["shoulder_pan_joint", "revolute", 0, 89.159, 0, 90],
+          ["shoulder_lift_joint", "revolute", 0, 0, -425, 0],
+          ["elbow_joint", "revolute", 0, 0, -392.25, 0],
+          ["wrist_1_joint", "revolute", 0, 109.15, 0, 90],
+          ["wrist_2_joint", "revolute", 0, 94.65, 0, -90],
+          ["wrist_3_joint", "revolute", 0, 82.3, 0, 0]]
+
+
+def _cells(row: list[str]) -> list:
+    """A table row as strings and numbers (a ``[lo, hi]`` cell becomes two numbers)."""
+    out: list = []
+    for cell in row:
+        cell = cell.strip()
+        if re.fullmatch(r"\[\S+, \S+\]", cell):
+            out += [float(x) for x in cell[1:-1].split(",")]
+            continue
+        try:
+            out.append(float(cell))
+        except ValueError:
+            out.append(cell)
+    while out and out[-1] == "":  # an empty last cell (the flange has no limits)
+        out.pop()
+    return out
+
+
+def _same_rows(got: list[list], want: list[list], tol: float) -> None:
+    assert len(got) == len(want), (got, want)
+    for g, w in zip(got, want):
+        assert len(g) == len(w), (g, w)
+        for a, b in zip(g, w):
+            if isinstance(b, str):
+                assert a == b, (g, w)
+            else:
+                assert a == pytest.approx(b, rel=tol, abs=1e-12), (g, w)
+
+
+def _text_rows(out: str, first: str, columns: int) -> list[list]:
+    """The rows of the first text table from the line starting with ``first`` on."""
+    lines = out.splitlines()
+    start = next(i for i, ln in enumerate(lines) if ln.startswith(first + " "))
+    rows = []
+    for ln in lines[start:]:
+        parts = re.split(r"\s{2,}", ln.strip())
+        if not ln.strip() or ":" in parts[0]:  # a blank line or the notes after it
+            break
+        rows.append(_cells(parts)[:columns])
+    return rows
+
+
+@pytest.mark.parametrize(("cmd", "want", "tol"), [
+    (["robots"], "robots", 0.0),
+    (["show", "panda"], PANDA, 1e-8),     # limits printed to 9 significant digits
+    (["motors", "scara", "0", "0", "0", "0.1"], MOTORS, 1e-11),
+    (["dh", URDF, "--mm"], UR5_DH, 1e-12),
+])
+def test_every_table_command_has_csv_and_text_with_the_values(capsys, cmd, want, tol):
+    if want == "robots":
+        want = _robots_table()
     code, out, _ = run(capsys, *cmd, "--format", "csv")
     assert code == 0 and "…" not in out
-    assert list(csv.reader(io.StringIO(out)))[0]
+    table = list(csv.reader(io.StringIO(out.split("\n\n")[0])))
+    got = [_cells(r) for r in table[1:]]
+    if cmd == ["robots"]:  # the source column: checked whole below
+        got = [[r[0], str(int(r[1]))] for r in got]
+    _same_rows(got, want, tol)
     code, out, _ = run(capsys, *cmd)  # captured stdout: not a terminal
     assert code == 0 and "…" not in out and "━" not in out
+    rows = _text_rows(out, table[1][0], 2 if cmd == ["robots"] else len(want[0]))
+    if cmd == ["robots"]:
+        rows = [[r[0], str(int(r[1]))] for r in rows]
+    _same_rows(rows, want, max(tol, 1e-11))  # text: 12 significant digits
 
 
 def test_robots_never_cut_a_source(capsys):
@@ -122,9 +207,8 @@ def test_help_keeps_units_in_brackets():
     """rich ate '[mm]': help texts are shown as written, for every command."""
     from typer.testing import CliRunner
 
-    from robokin.cli import _register_extra_commands, app
+    from robokin.cli import app
 
-    _register_extra_commands()
     runner = CliRunner()
     res = runner.invoke(app, ["demo", "--help"], env={"COLUMNS": "200"})
     assert "Required clearance [mm]." in res.output
@@ -265,17 +349,18 @@ def test_staged_outputs_refuse_one_file_twice(tmp_path):
 def test_press_views_labels_do_not_overlap(monkeypatch, tmp_path):
     """column_left and column_right share x and z: the side view labels both apart."""
     pytest.importorskip("coal")
-    import robokin.viz.plots as plots
     from robokin import collision
-    from robokin.demo import _plot_press_views, plan_press_loading
+    from robokin.cli import demo_report
+    from robokin.cli.demo import plan_press_loading
+    from robokin.cli.demo_report import plot_press_views
 
     scene = collision.Scene.load(collision.scene_path("press"))
     robot = scene.attach(robokin.load("aubo_i5"))
     traj, _ = plan_press_loading(robot, scene, dt=0.05)
     figures = []
-    monkeypatch.setattr(plots, "save_figure",
+    monkeypatch.setattr(demo_report, "save_figure",
                         lambda fig, path, **kw: figures.append(fig) or path)
-    _plot_press_views(traj, scene, None, tmp_path / "v.png")
+    plot_press_views(traj, scene, None, tmp_path / "v.png")
     fig = figures[0]
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
@@ -342,7 +427,7 @@ def test_a_name_with_a_control_character_is_refused(tmp_path):
 
 
 def test_the_one_console_replaces_no_emoji():
-    from robokin.cli_output import console
+    from robokin.cli.output import console
 
     con = console()
     with con.capture() as cap:

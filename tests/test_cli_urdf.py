@@ -149,11 +149,10 @@ def test_import_notes_a_missing_package_once(capsys, tmp_path, monkeypatch):
                                "link_5, link_6: package 'abb_irb140_support' not found")
     assert "--package abb_irb140_support=DIR" in notes[0]
     # the API: every shape still listed, one warning for the one reason
-    from robokin.io.urdf import robot_from_urdf
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        robot = robot_from_urdf(urdf)
+        robot = robokin.Robot.from_urdf(urdf)
     assert len(robot.meta["urdf_dropped_shapes"]) == 14
     assert [str(w.message)[:20] for w in caught] == ["left out 14 visual a"]
     assert caught[0].filename == __file__  # points at the caller

@@ -16,7 +16,7 @@ pytest.importorskip("coal")
 def demo(tmp_path_factory):
     from rich.console import Console
 
-    from robokin.demo import run_demo
+    from robokin.cli.demo import run_demo
 
     out = tmp_path_factory.mktemp("demo")
     console = Console(file=io.StringIO(), width=120)

@@ -16,7 +16,7 @@ pytest.importorskip("toppra")
 @pytest.fixture(scope="module")
 def planned():
     from robokin import collision
-    from robokin.demo import plan_press_loading
+    from robokin.cli.demo import plan_press_loading
 
     scene = collision.Scene.load(collision.scene_path("press"))
     bare = robokin.load("aubo_i5")
@@ -26,10 +26,10 @@ def planned():
 
 
 def test_minimum_cycle_time_beside_the_planned_one(planned):
-    from robokin.demo import _cycle_times
+    from robokin.cli.demo_job import cycle_times
 
     robot, bare, scene, traj = planned
-    c = _cycle_times(robot, bare, scene, traj, clearance=0.004)
+    c = cycle_times(robot, bare, scene, traj, clearance=0.004)
     assert c["planned_s"] == pytest.approx(24.0)
     assert 2.0 < c["minimum_s"] < c["minimum_demo_caps_s"] < c["planned_s"]
     assert not c["retimed_collides"] and c["retimed_min_clearance_mm"] >= 4.0
@@ -60,7 +60,7 @@ def test_the_retimed_demo_path_keeps_its_lines_and_limits(planned):
 def test_report_and_summary_show_it(tmp_path):
     from rich.console import Console
 
-    from robokin.demo import run_demo
+    from robokin.cli.demo import run_demo
 
     console = Console(file=io.StringIO(), width=160)
     result = run_demo(out=tmp_path, console=console, html_animation=False)

@@ -1,4 +1,4 @@
-"""``robokin demo --plan`` (robokin.demo_plan): the press cycle with planned free moves.
+"""``robokin demo --plan`` (robokin.cli.demo_plan): the press cycle with planned free moves.
 
 Oracles: the cycle passes through the hand-made plan's via configurations at the
 ends of its steps, keeps the process lines on their straight Cartesian paths, and
@@ -20,8 +20,8 @@ pytest.importorskip("coal")
 
 
 def test_the_planned_cycle_passes_the_via_points_and_clears_the_press():
-    from robokin.demo import DT, PLAN, plan_press_loading
-    from robokin.demo_plan import planned_cycle
+    from robokin.cli.demo_job import DT, PLAN, plan_press_loading
+    from robokin.cli.demo_plan import planned_cycle
 
     scene = Scene.load(scene_path("press"))
     bare = robokin.load("aubo_i5")
@@ -44,7 +44,7 @@ def test_the_planned_cycle_passes_the_via_points_and_clears_the_press():
 def test_demo_plan_reports_the_cycle_next_to_the_hand_made_one(tmp_path):
     from rich.console import Console
 
-    from robokin.demo import run_demo
+    from robokin.cli.demo import run_demo
     from robokin.trajectory.io import read_csv
 
     console = Console(file=io.StringIO(), width=140)

@@ -121,8 +121,9 @@ def _check(cell, line, text):
 
 def _retime(cell, line, text):
     """The motion file's limits: are the ones used (library, same limits)."""
-    from robokin.io.motion_files import load_motion_file, plan_from_document
+    from robokin.io.motion_files import load_motion_file
     from robokin.trajectory.cycle_time import cycle_time_report
+    from robokin.trajectory.motion_plan import plan_from_document
 
     folder = cell / shlex.split(line, comments=True)[-1]
     doc = json.loads((folder / "cycle_time.json").read_text())

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import sys
+
 __all__ = [
     "FrozenError",
     "InputError",
@@ -102,3 +105,19 @@ class MissingExtraError(RobokinError, ImportError):
             f"this feature needs the '{package}' package: "
             f"pip install 'robokin[{extra}]'"
         )
+
+
+def user_stacklevel() -> int:
+    """The ``stacklevel`` that makes ``warnings.warn`` name the first caller outside robokin.
+
+    Called where the warning is raised: however many robokin functions lie
+    between the user's call and the warning (``Robot.from_urdf`` ->
+    ``parts_from_urdf`` -> ...), the warning points at the user's line.
+    """
+    package = os.path.dirname(os.path.abspath(__file__)) + os.sep
+    frame = sys._getframe(1)  # the function that will call warnings.warn
+    level = 1
+    while frame.f_back is not None and frame.f_code.co_filename.startswith(package):
+        frame = frame.f_back
+        level += 1
+    return level

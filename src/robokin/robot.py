@@ -1,4 +1,9 @@
-"""The Robot: a canonical chain plus its name, source, actuators, geometry, limits.
+"""The Robot: the parts of an arm (:mod:`robokin.model.parts`) and what it computes.
+
+A Robot is assembled from parts (a canonical chain plus its name, source,
+actuators, geometry, dynamics and limits) and delegates the computing to
+:mod:`robokin.kinematics`. The files it is read from and written to are
+:mod:`robokin.io`'s, which read and write parts and know nothing of Robots.
 
 A Robot is immutable: assigning or deleting an attribute raises
 :class:`~robokin.exceptions.FrozenError`, its arrays are read-only and ``meta`` is
@@ -7,169 +12,60 @@ a read-only mapping; ``with_tool`` / ``with_base`` / ``replace`` return new ones
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace as _replace
 from pathlib import Path
-from types import MappingProxyType
-from typing import TYPE_CHECKING, Any, Literal, TypeGuard
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
 
-from robokin._validation import check_transform
-from robokin.exceptions import FrozenError, InputError
+from robokin import _html
+from robokin._validation import check_finite, check_joints, check_transform
+from robokin.exceptions import InputError
+from robokin.io.robot_files import document_from_robot
+from robokin.io.robot_tables import MM_PER_M, joint_rows_mm_deg
+from robokin.io.urdf import parts_from_urdf
+from robokin.io.urdf_export import urdf_from_robot
 from robokin.kinematics import forward
 from robokin.kinematics import jacobian as _jac
 from robokin.kinematics.ik.dispatch import solve as _ik_solve
 from robokin.kinematics.ik.nearest import solve_near as _solve_near
-from robokin.model.chain import Chain
-from robokin.model.coupling import AffineMap
-from robokin.model.rate_limits import RateLimits
+from robokin.model.dh import chain_from_dh, chain_from_elementary
+from robokin.model.parts import RobotParts
 
 if TYPE_CHECKING:
+    from robokin.io.urdf_geometry import MissingMesh
     from robokin.kinematics.ik.numeric import IKResult
     from robokin.kinematics.ik.solutions import SolutionSet
-    from robokin.model.dynamics import RobotDynamics
-    from robokin.model.geometry import RobotGeometry
 
 __all__ = ["Robot"]
 
 Space = Literal["joint", "actuator"]
 _FK_SINGLE = forward.fk_single  # one configuration, or None for the general path
-_HOW_TO_CHANGE = ("make a changed copy with robot.replace(...), robot.with_tool(T) or "
-                  "robot.with_base(T)")
+#: Methods a Robot no longer has, and what to call instead (issue 24).
+_MOVED = {"plot": "the facade does not draw; use robokin.viz.plot_robot(robot, q)"}
 
 
-def _is_frozen_limits(lim: object, m: int) -> TypeGuard[npt.NDArray[np.float64]]:
-    """True for limits a Robot already checked and froze (kept, not copied)."""
-    return (type(lim) is np.ndarray and lim.dtype == np.float64 and not lim.flags.writeable
-            and lim.shape == (m, 2) and not np.isnan(lim).any())
+class Robot(RobotParts):
+    """A serial manipulator: its parts and what it computes (FK, Jacobians, IK).
 
-
-def _actuator_fields(
-    actuators: AffineMap | None,
-    names: Sequence[str] | None,
-    limits: npt.ArrayLike | None,
-) -> tuple[tuple[str, ...] | None, npt.NDArray[np.float64] | None]:
-    """The motor names and frozen motor limits (m, 2) of an actuator map, or Nones."""
-    if actuators is None:
-        if limits is not None:
-            raise InputError("actuator_limits", "given without an actuator map")
-        return None, None
-    m = actuators.n_in
-    names = tuple(names or (f"motor{i + 1}" for i in range(m)))
-    if limits is None:
-        lim = np.tile([-np.inf, np.inf], (m, 1))
-    elif _is_frozen_limits(limits, m):
-        return names, limits
-    else:
-        lim = np.array(limits, dtype=float)
-        if lim.shape != (m, 2) or np.isnan(lim).any():
-            raise InputError(
-                "actuator_limits",
-                f"expected shape ({m}, 2) without NaN for {m} motors, got {lim.shape}",
-            )
-    lim.setflags(write=False)
-    return names, lim
-
-
-class Robot:
-    """A serial manipulator.
-
-    Attributes:
-        chain: The canonical chain (:class:`robokin.model.chain.Chain`).
-        name: The robot's name.
-        source: Where its parameters come from (citation), may be empty.
-        actuators: ``q = A phi + b`` from motor to joint coordinates, or None.
-        actuator_names: Names of the motor coordinates (m), or None.
-        actuator_limits: Motor limits (m, 2), SI units, or None.
-        geometry: Link and tool shapes (see ``robokin.model.geometry``), or None.
-        dynamics: Link masses, centres of mass, inertias and joint torque limits
-            (:class:`~robokin.model.dynamics.RobotDynamics`), or None.
-        path: The robot file it was loaded from, or None.
-        meta: Free-form extra fields from the robot file (a read-only mapping).
-        rate_limits: Per-joint velocity / acceleration / jerk limits
-            (:class:`~robokin.model.rate_limits.RateLimits`, SI), or None.
+    The parts (:class:`~robokin.model.parts.RobotParts`) are the attributes
+    (``chain``, ``name``, ``source``, ``actuators``, ``actuator_names``,
+    ``actuator_limits``, ``geometry``, ``dynamics``, ``path``, ``meta``,
+    ``rate_limits``), checked and frozen when the Robot is made; a Robot is accepted
+    wherever parts are, and :meth:`from_parts` makes one from parts read by
+    :mod:`robokin.io`.
     """
 
-    __slots__ = ("actuator_limits", "actuator_names", "actuators", "chain", "dynamics",
-                 "geometry", "meta", "name", "path", "rate_limits", "source",
-                 "__weakref__")
-    chain: Chain
-    name: str
-    source: str
-    actuators: AffineMap | None
-    actuator_names: tuple[str, ...] | None
-    actuator_limits: npt.NDArray[np.float64] | None
-    geometry: RobotGeometry | None
-    dynamics: RobotDynamics | None
-    path: Path | None
-    meta: Mapping[str, Any]
-    rate_limits: RateLimits | None
+    __slots__ = ()
 
-    def __setattr__(self, name: str, value: Any) -> None:
-        """Refuse: a Robot is immutable (raises FrozenError)."""
-        raise FrozenError("Robot", name, _HOW_TO_CHANGE)
-
-    def __delattr__(self, name: str) -> None:
-        """Refuse: a Robot is immutable (raises FrozenError)."""
-        raise FrozenError("Robot", name, _HOW_TO_CHANGE)
-
-    def __reduce__(self) -> tuple:
-        # pickle and copy rebuild through __init__ (slots cannot be set directly)
-        """Pickle and copy rebuild through __init__ (slots cannot be set directly)."""
-        return (_rebuild, (self.chain, self._fields()))
-
-    def _fields(self) -> dict[str, Any]:
-        return {"name": self.name, "source": self.source, "actuators": self.actuators,
-                "actuator_names": self.actuator_names,
-                "actuator_limits": self.actuator_limits, "geometry": self.geometry,
-                "dynamics": self.dynamics, "path": self.path, "meta": dict(self.meta),
-                "rate_limits": self.rate_limits}
-
-    def __init__(
-        self,
-        chain: Chain,
-        *,
-        name: str = "robot",
-        source: str = "",
-        actuators: AffineMap | None = None,
-        actuator_names: Sequence[str] | None = None,
-        actuator_limits: npt.ArrayLike | None = None,
-        geometry: RobotGeometry | None = None,
-        dynamics: RobotDynamics | None = None,
-        path: str | Path | None = None,
-        meta: Mapping[str, Any] | None = None,
-        rate_limits: RateLimits | None = None,
-    ) -> None:
-        """Check and freeze the parts (see the class docstring for each)."""
-        init = object.__setattr__
-        init(self, "chain", chain)
-        init(self, "name", name)
-        init(self, "source", source)
-        if actuators is not None and actuators.n_out != chain.n:
-            raise InputError(
-                "actuators",
-                f"maps {actuators.n_in} motors to {actuators.n_out} joints, "
-                f"but the robot has {chain.n} joints",
-            )
-        init(self, "actuators", actuators)
-        names, limits = _actuator_fields(actuators, actuator_names, actuator_limits)
-        init(self, "actuator_names", names)
-        init(self, "actuator_limits", limits)
-        init(self, "geometry", geometry)
-        if dynamics is not None and len(getattr(dynamics, "names", ())) != chain.n_chain + 2:
-            raise InputError("dynamics", f"expected data for {chain.n_chain + 2} links "
-                             "(base, the chain joints, tool); see "
-                             "robokin.model.dynamics.RobotDynamics.from_mapping")
-        init(self, "dynamics", dynamics)
-        init(self, "path", None if path is None else Path(path))
-        init(self, "meta", MappingProxyType(dict(meta or {})))
-        if rate_limits is not None and (not isinstance(rate_limits, RateLimits)
-                                        or rate_limits.n != chain.n):
-            raise InputError(
-                "rate_limits",
-                f"expected RateLimits for {chain.n} joints, got {rate_limits!r}")
-        init(self, "rate_limits", rate_limits)
+    def __getattr__(self, name: str) -> Any:
+        """Name the replacement of a removed method (``Robot.plot``) in the error."""
+        if name in _MOVED:
+            raise AttributeError(f"'Robot' object has no attribute {name!r}: "
+                                 f"{_MOVED[name]}")
+        raise AttributeError(f"'Robot' object has no attribute {name!r}")
 
     # ------------------------------------------------------------------ building
     @classmethod
@@ -194,8 +90,6 @@ class Robot:
             ModelError: a row that is not a mapping, an unknown key, a value that
                 is not a finite number, reversed limits (naming ``rows[i].key``).
         """
-        from robokin.model.dh import chain_from_dh
-
         base = None if base is None else check_transform(base, "base")
         tool = None if tool is None else check_transform(tool, "tool")
         chain = chain_from_dh(rows, convention, base=base, tool=tool, coordinates=coordinates)
@@ -212,103 +106,66 @@ class Robot:
         coordinates: Sequence[Mapping[str, Any]] | None = None,
     ) -> Robot:
         """Build from elementary Rot/Trans operators (see :mod:`robokin.model.dh`)."""
-        from robokin.model.dh import chain_from_elementary
-
         base = None if base is None else check_transform(base, "base")
         tool = None if tool is None else check_transform(tool, "tool")
         chain = chain_from_elementary(ops, base=base, tool=tool, coordinates=coordinates)
         return cls(chain, name=name)
 
     @classmethod
+    def from_parts(cls, parts: RobotParts) -> Robot:
+        """The Robot of parts read by :mod:`robokin.io` (the same objects, not copies)."""
+        if isinstance(parts, cls):
+            return parts
+        return cls(parts.chain, **parts._fields())
+
+    @classmethod
     def from_urdf(
-        cls, path: str | Path, base_link: str | None = None, tip_link: str | None = None,
-        **kwargs: Any,
+        cls,
+        path: str | Path | bytes,
+        base_link: str | None = None,
+        tip_link: str | None = None,
+        package_map: Mapping[str, str | Path] | None = None,
+        *,
+        xacro_args: Mapping[str, str] | None = None,
+        geometry: bool = True,
+        missing_mesh: MissingMesh = "warn",
+        name: str | None = None,
+        srdf: str | Path | bytes | None = None,
+        tool_joints: Mapping[str, float] | None = None,
     ) -> Robot:
         """Load the serial chain of a URDF or xacro file (needs ``robokin[urdf]``).
 
         A ``.xacro`` / ``.urdf.xacro`` file is expanded first (needs
         ``robokin[ros]``): ``Robot.from_urdf("arm.urdf.xacro",
         package_map={"pkg": "dir"}, xacro_args={"name": "value"}, tip_link=...)``.
-        Keywords as :func:`robokin.io.urdf.robot_from_urdf`.
+        The arguments are those of :func:`robokin.io.urdf.parts_from_urdf`, which
+        reads the parts.
         """
-        from robokin.io.urdf import robot_from_urdf
+        return cls.from_parts(parts_from_urdf(
+            path, base_link, tip_link, package_map, xacro_args=xacro_args,
+            geometry=geometry, missing_mesh=missing_mesh, name=name, srdf=srdf,
+            tool_joints=tool_joints))
 
-        return robot_from_urdf(path, base_link=base_link, tip_link=tip_link, **kwargs)
+    def to_urdf(
+        self,
+        *,
+        name: str | None = None,
+        velocity: float = 1.0,
+        effort: float = 100.0,
+        mesh_uri: Callable[[Path], str] | None = None,
+    ) -> str:
+        """A URDF string with the same FK, limits and geometry.
 
-    def to_urdf(self, **kwargs: Any) -> str:
-        """A URDF string with the same FK, limits and geometry."""
-        from robokin.io.urdf_export import urdf_from_robot
-
-        return urdf_from_robot(self, **kwargs)
-
-    def replace(self, **changes: Any) -> Robot:
-        """A copy with some attributes replaced (``chain``, ``name``, ``geometry``, ...)."""
-        kw = {"chain": self.chain, **self._fields()}
-        unknown = sorted(set(changes) - set(kw))
-        if unknown:
-            raise InputError(unknown[0], f"not a Robot attribute; replace() takes "
-                             f"{sorted(kw)}")
-        kw.update(changes)
-        chain = kw.pop("chain")
-        return Robot(chain, **kw)
-
-    def with_tool(self, tool: npt.ArrayLike) -> Robot:
-        """A copy with the tool transform (4, 4) [m] replaced."""
-        return self.replace(chain=self.chain.replace(tool=check_transform(tool, "tool")))
-
-    def with_base(self, base: npt.ArrayLike) -> Robot:
-        """A copy with the base transform (4, 4) [m] replaced."""
-        return self.replace(chain=self.chain.replace(base=check_transform(base, "base")))
-
-    # ---------------------------------------------------------------- properties
-    @property
-    def n(self) -> int:
-        """Number of independent joint coordinates."""
-        return self.chain.n
-
-    @property
-    def n_chain(self) -> int:
-        """Number of chain joints, dependent ones included."""
-        return self.chain.n_chain
-
-    @property
-    def limits(self) -> np.ndarray:
-        """Joint limits (n, 2) in SI units."""
-        return self.chain.limits
-
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """Names of the independent joint coordinates."""
-        return tuple(c.name for c in self.chain.coordinates)
-
-    @property
-    def is_revolute(self) -> np.ndarray:
-        """(n,) bool: which coordinates are angles (wrap) rather than lengths."""
-        return self.chain.is_revolute
-
-    @property
-    def base(self) -> np.ndarray:
-        """Base transform (4, 4)."""
-        return self.chain.base
-
-    @property
-    def tool(self) -> np.ndarray:
-        """Tool transform (4, 4)."""
-        return self.chain.tool
-
-    def __repr__(self) -> str:
-        """A short summary: the name and the number of joints."""
-        return f"Robot(name={self.name!r}, n={self.n})"
+        The arguments are those of :func:`robokin.io.urdf_export.urdf_from_robot`.
+        """
+        return urdf_from_robot(self, name=name, velocity=velocity, effort=effort,
+                               mesh_uri=mesh_uri)
 
     def _repr_html_(self) -> str:
         """Jupyter: the joint rows (mm, degrees), the limits and the tool pose at zero.
 
         Bounded: at most :data:`robokin._html.MAX_ROWS` rows per table.
         """
-        from robokin import _html
-        from robokin.io.robot_files import document_from_robot
-        from robokin.io.robot_tables import MM_PER_M, joint_rows_mm_deg
-
         doc = document_from_robot(self)
         keys, rows = joint_rows_mm_deg(doc)
         scale = np.where(self.is_revolute, 180.0 / np.pi, MM_PER_M)
@@ -412,8 +269,6 @@ class Robot:
             if self.actuators is not None and out.is_revolute.any():
                 # Motor angles never wrap: a motor turn through a reduction is not a
                 # whole joint turn, so 2*pi-shifted motor values are other poses.
-                from dataclasses import replace as _replace
-
                 out = _replace(out, is_revolute=np.zeros(out.n, bool))
             return out
         if space != "joint":
@@ -459,11 +314,10 @@ class Robot:
                 than joints) is not reachable through the actuator map.
             ModelError: the actuator matrix cannot be inverted.
         """
-        from robokin._validation import check_finite, check_joints
-
         q = check_finite(check_joints(q, self.n, "q"), "q")
         if self.actuators is None:
-            return q.copy()
+            result: np.ndarray = q.copy()
+            return result
         what = f"actuator map of '{self.name}'"
         phi = self.actuators.inverse(q, what=what)
         if self.actuators.n_in < self.actuators.n_out:
@@ -483,20 +337,17 @@ class Robot:
 
     def joints_from_actuators(self, phi: npt.ArrayLike) -> np.ndarray:
         """Joint coordinates ``q = A phi + b``: (..., m) -> (..., n)."""
-        from robokin._validation import check_finite, check_joints
-
         m = self.n if self.actuators is None else self.actuators.n_in
         phi = check_finite(check_joints(phi, m, "phi"), "phi")
         if self.actuators is None:
-            return phi.copy()
+            result: np.ndarray = phi.copy()
+            return result
         return self.actuators.apply(phi)
 
     def within_actuator_limits(
         self, phi: npt.ArrayLike, tol: float = 1e-9
     ) -> npt.NDArray[np.bool_] | np.bool_:
         """(...) bool: every motor coordinate (..., m) inside its limits (tolerance ``tol``)."""
-        from robokin._validation import check_joints
-
         m = self.n if self.actuators is None else self.actuators.n_in
         phi = check_joints(phi, m, "phi")
         lim = self.limits if self.actuator_limits is None else self.actuator_limits
@@ -507,19 +358,6 @@ class Robot:
         self, q: npt.ArrayLike, tol: float = 1e-9
     ) -> npt.NDArray[np.bool_] | np.bool_:
         """(...) bool: every coordinate inside its limits (with tolerance ``tol``)."""
-        from robokin._validation import check_joints
-
         q = check_joints(q, self.n, "q")
         lim = self.limits
         return ((q >= lim[:, 0] - tol) & (q <= lim[:, 1] + tol)).all(axis=-1)
-
-    def plot(self, q: npt.ArrayLike, **kwargs: Any):
-        """Draw the arm at ``q`` as a 3D stick-and-frame figure (matplotlib)."""
-        from robokin.viz.plots import plot_robot
-
-        return plot_robot(self, q, **kwargs)
-
-
-def _rebuild(chain: Chain, fields: dict[str, Any]) -> Robot:
-    """Unpickle a Robot (see ``Robot.__reduce__``)."""
-    return Robot(chain, **fields)

@@ -10,10 +10,18 @@ quaternions are ``(w, x, y, z)``.
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
+
+from robokin._native import kernels
+from robokin._validation import _real_array
+from robokin.exceptions import InputError
+
+if TYPE_CHECKING:
+    from scipy.spatial.transform import Rotation
 
 __all__ = [
     "axis_angle_from_matrix",
@@ -109,7 +117,8 @@ def invert(T: npt.ArrayLike) -> np.ndarray:
     return out
 
 
-def _rotation():
+def _rotation() -> type[Rotation]:
+    """The Rotation class of scipy (scipy is imported on first use)."""
     from scipy.spatial.transform import Rotation
 
     return Rotation
@@ -124,9 +133,6 @@ def _from_R(R: np.ndarray) -> np.ndarray:
 
 def _shaped(x: npt.ArrayLike, name: str, tail: tuple[int, ...]) -> np.ndarray:
     """``x`` as float64 of shape ``(...) + tail``, or an InputError naming ``name``."""
-    from robokin._validation import _real_array
-    from robokin.exceptions import InputError
-
     a = _real_array(x, name, "numbers")
     if a.shape[a.ndim - len(tail):] != tail or a.ndim < len(tail):
         want = ", ".join(map(str, tail))
@@ -134,11 +140,12 @@ def _shaped(x: npt.ArrayLike, name: str, tail: tuple[int, ...]) -> np.ndarray:
     return a
 
 
-def _apply(fn, x: npt.ArrayLike, width: int, name: str) -> np.ndarray:
+def _apply(fn: Callable[[np.ndarray], Rotation], x: npt.ArrayLike, width: int,
+           name: str) -> np.ndarray:
     """Run a scipy Rotation constructor on a batch of any leading shape."""
     x = _shaped(x, name, (width,))
     lead = x.shape[:-1]
-    R = fn(x.reshape(-1, width)).as_matrix().reshape(lead + (3, 3))
+    R: np.ndarray = fn(x.reshape(-1, width)).as_matrix().reshape(lead + (3, 3))
     return _from_R(R)
 
 
@@ -146,7 +153,7 @@ def _as(fn_name: str, T: npt.ArrayLike, **kw: Any) -> np.ndarray:
     T = _shaped(T, "T", (4, 4))
     lead = T.shape[:-2]
     rot = _rotation().from_matrix(T[..., :3, :3].reshape(-1, 3, 3))
-    out = getattr(rot, fn_name)(**kw)
+    out: np.ndarray = getattr(rot, fn_name)(**kw)
     return out.reshape(lead + out.shape[1:])
 
 
@@ -166,15 +173,11 @@ def rpy_from_matrix(T: npt.ArrayLike) -> np.ndarray:
 
 def pose_from_xyz_rpy(xyz: npt.ArrayLike, rpy: npt.ArrayLike) -> np.ndarray:
     """Pose from a position [m] (..., 3) and roll-pitch-yaw [rad] (..., 3)."""
-    T = matrix_from_rpy(rpy)
-    xyz = np.asarray(xyz, dtype=np.float64)
-    T, xyz = (
-        np.broadcast_to(
-            T, np.broadcast_shapes(T.shape, xyz.shape[:-1] + (4, 4))
-        ).copy(),
-        xyz,
-    )
-    T[..., :3, 3] = xyz
+    R = matrix_from_rpy(rpy)
+    p = np.asarray(xyz, dtype=np.float64)
+    T: np.ndarray = np.broadcast_to(
+        R, np.broadcast_shapes(R.shape, p.shape[:-1] + (4, 4))).copy()
+    T[..., :3, 3] = p
     return T
 
 
@@ -192,7 +195,8 @@ def matrix_from_quaternion(wxyz: npt.ArrayLike) -> np.ndarray:
 def quaternion_from_matrix(T: npt.ArrayLike) -> np.ndarray:
     """Unit quaternion ``(w, x, y, z)`` with w >= 0; (..., 4, 4) -> (..., 4)."""
     xyzw = _as("as_quat", T, canonical=True)
-    return xyzw[..., [3, 0, 1, 2]]
+    out: np.ndarray = xyzw[..., [3, 0, 1, 2]]
+    return out
 
 
 def matrix_from_axis_angle(rotvec: npt.ArrayLike) -> np.ndarray:
@@ -209,7 +213,8 @@ def rotvec_from_rotation(R: npt.ArrayLike) -> np.ndarray:
     lead = R.shape[:-2]
     if R.size == 0:
         return np.zeros(lead + (3,))
-    return _rotation().from_matrix(R.reshape(-1, 3, 3)).as_rotvec().reshape(lead + (3,))
+    out: np.ndarray = _rotation().from_matrix(R.reshape(-1, 3, 3)).as_rotvec()
+    return out.reshape(lead + (3,))
 
 
 def rotation_from_rotvec(w: npt.ArrayLike) -> np.ndarray:
@@ -218,7 +223,8 @@ def rotation_from_rotvec(w: npt.ArrayLike) -> np.ndarray:
     lead = w.shape[:-1]
     if w.size == 0:
         return np.zeros(lead + (3, 3))
-    return _rotation().from_rotvec(w.reshape(-1, 3)).as_matrix().reshape(lead + (3, 3))
+    out: np.ndarray = _rotation().from_rotvec(w.reshape(-1, 3)).as_matrix()
+    return out.reshape(lead + (3, 3))
 
 
 def axis_angle_from_matrix(T: npt.ArrayLike) -> np.ndarray:
@@ -229,7 +235,8 @@ def axis_angle_from_matrix(T: npt.ArrayLike) -> np.ndarray:
 def wrap_angle(a: npt.ArrayLike) -> np.ndarray:
     """Angles [rad] wrapped into [-pi, pi), same shape."""
     a = np.asarray(a, dtype=np.float64)
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
+    out: np.ndarray = (a + np.pi) % (2.0 * np.pi) - np.pi
+    return out
 
 
 def pose_error(current: npt.ArrayLike, target: npt.ArrayLike) -> np.ndarray:
@@ -245,15 +252,11 @@ def pose_error(current: npt.ArrayLike, target: npt.ArrayLike) -> np.ndarray:
         residual the numeric IK descends on (one compiled formula, ``chain.h``
         ``pose_residual``).
     """
-    from robokin._native import kernels
-
     current = _shaped(current, "current", (4, 4))
     target = _shaped(target, "target", (4, 4))
     try:
         lead = np.broadcast_shapes(current.shape[:-2], target.shape[:-2])
     except ValueError as exc:
-        from robokin.exceptions import InputError
-
         raise InputError("target", f"shape {target.shape} does not broadcast with "
                                    f"current's {current.shape}") from exc
     a = np.ascontiguousarray(np.broadcast_to(current, lead + (4, 4))).reshape(-1, 4, 4)

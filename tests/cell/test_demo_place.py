@@ -13,7 +13,8 @@ pytest.importorskip("dask")
 def test_the_demo_maps_feasible_bases_and_its_own_is_one(tmp_path):
     from rich.console import Console
 
-    from robokin.demo import PLACE_SPAN, PLACE_STEP, run_demo
+    from robokin.cli.demo import run_demo
+    from robokin.cli.demo_job import PLACE_SPAN, PLACE_STEP
 
     console = Console(file=io.StringIO(), width=140)
     result = run_demo(out=tmp_path, console=console, html_animation=False, place=True)

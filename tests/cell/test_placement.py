@@ -22,7 +22,7 @@ def assert_same(x, y, what):
 @pytest.fixture(scope="module")
 def press():
     from robokin import collision
-    from robokin.demo import placement_task, plan_press_loading
+    from robokin.cli.demo_job import placement_task, plan_press_loading
 
     scene = collision.Scene.load(collision.scene_path("press"))
     bare = robokin.load("aubo_i5")

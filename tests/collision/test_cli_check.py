@@ -104,7 +104,7 @@ def test_plot_distance_draws_the_pairs_and_the_clearance(press_motion, tmp_path)
 
 
 def test_trajectory_csv_reader_converts_units(tmp_path):
-    from robokin.cli_collision import read_trajectory_csv
+    from robokin.cli.collision import read_trajectory_csv
 
     path = tmp_path / "t.csv"
     path.write_text("t [ms],a [deg],b [mm]\n0,90,1000\n500,180,-20\n")

@@ -10,7 +10,7 @@ import pytest
 import robokin
 from robokin.collision import Scene, check
 from robokin.exceptions import InputError
-from robokin.io.robot_files import robot_from_document
+from robokin.io.robot_files import parts_from_document
 from robokin.model import geometry as geo
 from robokin.model.geometry import RobotGeometry
 
@@ -141,7 +141,7 @@ def _planar_3r(exclude=None):
     }
     if exclude is not None:
         doc["collision"] = {"exclude": exclude}
-    return robot_from_document(doc)
+    return robokin.Robot.from_parts(parts_from_document(doc))
 
 
 def test_self_collision_of_non_adjacent_links_and_exclusions():

@@ -14,7 +14,7 @@ from robokin import collision
 from robokin.exceptions import ModelError
 
 pytest.importorskip("yourdfpy")
-from robokin.io.urdf import robot_from_urdf  # noqa: E402
+from robokin import Robot  # noqa: E402
 
 DATA = Path(__file__).parent.parent / "data"
 URDF = DATA / "urdf" / "gripper_arm.urdf"
@@ -22,7 +22,7 @@ URDF = DATA / "urdf" / "gripper_arm.urdf"
 
 @pytest.fixture(scope="module")
 def robot():
-    return robot_from_urdf(URDF, tip_link="tcp")
+    return Robot.from_urdf(URDF, tip_link="tcp")
 
 
 def test_load_scene_text_names_shapes_and_groups():

@@ -43,7 +43,7 @@ def test_ur5_urdf_gives_urs_published_table():
 
 def test_modified_table_of_the_ur5_urdf_is_the_shifted_standard_one(rng):
     pytest.importorskip("yourdfpy")
-    from robokin.io.urdf import dh_from_urdf, robot_from_urdf
+    from robokin.io.urdf import dh_from_urdf
 
     std = dh_from_urdf(DATA / "ur5.urdf")
     mod = dh_from_urdf(DATA / "ur5.urdf", convention="modified")
@@ -51,9 +51,9 @@ def test_modified_table_of_the_ur5_urdf_is_the_shifted_standard_one(rng):
         prev = std.rows[i - 1] if i else {"a": 0.0, "alpha": 0.0}
         assert (row["a"], row["alpha"]) == (prev["a"], prev["alpha"])
         assert (row["d"], row["theta"]) == (std.rows[i]["d"], std.rows[i]["theta"])
-    urdf = robot_from_urdf(DATA / "ur5.urdf", geometry=False)
+    urdf = robokin.Robot.from_urdf(DATA / "ur5.urdf", geometry=False)
     q = random_q(urdf, rng)
-    np.testing.assert_allclose(mod.robot().fk(q), urdf.fk(q), atol=1e-12)
+    np.testing.assert_allclose(robokin.Robot(mod.chain()).fk(q), urdf.fk(q), atol=1e-12)
 
 
 def test_panda_urdf_gives_frankas_modified_table():
@@ -81,7 +81,7 @@ def test_every_builtin_arm_has_a_table_with_the_same_fk(name, convention, rng):
     for virtual in (False, True):
         ext = dh_from_robot(robot, convention, virtual_frames=virtual)
         q = random_q(robot, rng)
-        np.testing.assert_allclose(ext.robot().fk(q), robot.fk(q), atol=1e-12)
+        np.testing.assert_allclose(robokin.Robot(ext.chain()).fk(q), robot.fk(q), atol=1e-12)
         if virtual:
             np.testing.assert_array_equal(ext.base, np.eye(4))
             np.testing.assert_array_equal(ext.tool, np.eye(4))
@@ -108,7 +108,7 @@ def test_dependent_joints_keep_their_coupling(rng):
     assert forearm["depends"] == {"theta2": -1.0, "theta3": 1.0}
     assert [c["name"] for c in ext.coordinates] == ["theta1", "theta2", "theta3", "theta4"]
     q = random_q(robot, rng)
-    np.testing.assert_allclose(ext.robot().fk(q), robot.fk(q), atol=1e-12)
+    np.testing.assert_allclose(robokin.Robot(ext.chain()).fk(q), robot.fk(q), atol=1e-12)
 
 
 @pytest.mark.parametrize("convention", ["standard", "modified"])

@@ -18,8 +18,8 @@ from hypothesis import strategies as st
 
 import robokin
 from robokin.exceptions import RobokinError
-from robokin.io.motion_files import load_motion_file, plan_from_document
-from robokin.io.robot_files import load_robot
+from robokin.io.motion_files import load_motion_file
+from robokin.trajectory.motion_plan import plan_from_document
 
 KEYS = ["name", "source", "units", "length", "angle", "convention", "joints", "a",
         "alpha", "d", "theta", "joint", "limits", "sign", "depends", "depends_offset",
@@ -109,7 +109,7 @@ def test_robot_file_loader_raises_only_robokin_errors(tmp_path_factory, doc):
     path = _write(tmp_path_factory, doc, "robot.yaml")
 
     def load():
-        robot = load_robot(path)
+        robot = robokin.load(path)
         robot.fk([0.0] * robot.n)
 
     _only_robokin_errors(load)
@@ -130,7 +130,7 @@ def test_motion_file_loader_raises_only_robokin_errors(tmp_path_factory, doc):
 def test_the_bases_are_valid_files(tmp_path):
     # the fuzz grafts onto files that load and plan: its examples reach the
     # validation of every field, not only the top level
-    robot = load_robot(_write_plain(tmp_path, ROBOT, "robot.yaml"))
+    robot = robokin.load(_write_plain(tmp_path, ROBOT, "robot.yaml"))
     assert robot.n == 6
     spec, p = load_motion_file(_write_plain(tmp_path, MOTION, "motion.yaml"))
     _, traj = plan_from_document(spec, p, max_samples=3000)

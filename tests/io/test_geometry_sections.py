@@ -6,7 +6,7 @@ import pytest
 
 import robokin
 from robokin import ModelError
-from robokin.io.robot_files import robot_from_document
+from robokin.io.robot_files import parts_from_document
 from robokin.model import geometry as geo
 
 ROW = {"name": "j1", "joint": "revolute", "a": 400, "alpha": 0, "d": 0, "theta": 0}
@@ -26,7 +26,7 @@ def _doc(geometry=None, collision=None, length="mm"):
 
 
 def test_geometry_section_scales_mm_and_degrees():
-    r = robot_from_document(
+    r = parts_from_document(
         _doc(
             {
                 "j1": [
@@ -65,25 +65,25 @@ def test_geometry_section_scales_mm_and_degrees():
 
 def test_geometry_section_errors_name_the_field():
     with pytest.raises(ModelError, match=r"geometry\.elbow: unknown link 'elbow'"):
-        robot_from_document(_doc({"elbow": [{"type": "sphere", "radius": 1}]}))
+        parts_from_document(_doc({"elbow": [{"type": "sphere", "radius": 1}]}))
     with pytest.raises(
         ModelError, match=r"geometry\.j1\[0\]\.radius: missing required"
     ):
-        robot_from_document(_doc({"j1": [{"type": "capsule", "length": 3}]}))
+        parts_from_document(_doc({"j1": [{"type": "capsule", "length": 3}]}))
     with pytest.raises(
         ModelError, match=r"geometry\.j1\[0\]\.type: 'type' must be one of"
     ):
-        robot_from_document(_doc({"j1": [{"type": "cone"}]}))
+        parts_from_document(_doc({"j1": [{"type": "cone"}]}))
     with pytest.raises(ModelError, match=r"geometry\.j1\[0\]\.colour: unknown key; accepted: name, xyz, rpy, type"):
-        robot_from_document(
+        parts_from_document(
             _doc({"j1": [{"type": "sphere", "radius": 1, "colour": "red"}]})
         )
     with pytest.raises(ModelError, match=r"geometry\.j1\[0\]\.size: expected 3 numbers"):
-        robot_from_document(_doc({"j1": [{"type": "box", "size": [1, 2]}]}))
+        parts_from_document(_doc({"j1": [{"type": "box", "size": [1, 2]}]}))
 
 
 def test_collision_section_exclusions_and_adjacency():
-    r = robot_from_document(
+    r = parts_from_document(
         _doc(
             {
                 "base": [{"type": "sphere", "radius": 10}],
@@ -100,7 +100,7 @@ def test_collision_section_exclusions_and_adjacency():
         "j1", "tool"
     )  # not adjacent... tool carries nothing though
     assert g.self_pairs() == []
-    r2 = robot_from_document(
+    r2 = parts_from_document(
         _doc(
             {
                 "base": [{"type": "sphere", "radius": 10}],
@@ -112,7 +112,7 @@ def test_collision_section_exclusions_and_adjacency():
     with pytest.raises(
         ModelError, match=r"collision\.exclude\[0\]: unknown link 'hand'"
     ):
-        robot_from_document(_doc(None, {"exclude": [["base", "hand"]]}))
+        parts_from_document(_doc(None, {"exclude": [["base", "hand"]]}))
 
 
 def _write_box_stl(path, size_mm):
@@ -211,7 +211,7 @@ def test_corrupt_mesh_names_the_file_and_the_link(tmp_path):
 def test_unsupported_mesh_format_is_refused(tmp_path):
     (tmp_path / "part.step").write_text("ISO-10303-21;")
     with pytest.raises(ModelError, match="unsupported mesh format"):
-        robot_from_document(
+        parts_from_document(
             _doc({"j1": [{"type": "mesh", "file": "part.step"}]}),
             file=tmp_path / "a.yaml",
         )

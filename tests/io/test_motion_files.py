@@ -12,11 +12,8 @@ import pytest
 from bounded import run_bounded
 from robokin.cli import main
 from robokin.exceptions import ModelError
-from robokin.io.motion_files import (
-    MAX_MOTION_SAMPLES,
-    load_motion_file,
-    plan_from_document,
-)
+from robokin.io.motion_files import MAX_MOTION_SAMPLES, load_motion_file
+from robokin.trajectory.motion_plan import plan_from_document
 
 MOTION = """\
 robot: ur5
@@ -43,7 +40,8 @@ def _file(tmp_path, dt=0.005, duration=1.0, dwell=0.5):
 def test_absurd_sample_counts_are_refused_before_allocating(tmp_path, kw, field):
     path = _file(tmp_path, **kw)
     proc = run_bounded(f"""
-        from robokin.io.motion_files import load_motion_file, plan_from_document
+        from robokin.io.motion_files import load_motion_file
+        from robokin.trajectory.motion_plan import plan_from_document
         spec, p = load_motion_file({str(path)!r})
         try:
             plan_from_document(spec, p)

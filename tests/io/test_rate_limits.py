@@ -10,7 +10,7 @@ import yaml
 
 import robokin
 from robokin.exceptions import InputError, ModelError
-from robokin.io.robot_files import document_from_robot, load_robot, save_robot
+from robokin.io.robot_files import document_from_robot, load_parts, save_robot
 from robokin.model.rate_limits import RateLimits
 
 ARM = """\
@@ -35,7 +35,7 @@ def _write(tmp_path: Path, text: str) -> Path:
 
 
 def test_values_are_in_the_file_units_per_second(tmp_path):
-    lim = load_robot(_write(tmp_path, ARM)).rate_limits
+    lim = load_parts(_write(tmp_path, ARM)).rate_limits
     np.testing.assert_allclose(lim.velocity, [math.radians(90), 0.25])
     np.testing.assert_allclose(lim.acceleration, [math.radians(180), 1.0])
     assert math.isnan(lim.jerk[0]) and lim.jerk[1] == pytest.approx(5.0)
@@ -47,7 +47,7 @@ def test_one_number_applies_to_every_joint(tmp_path):
     text = ARM.replace("velocity: [90, 250]", "velocity: 90")
     # one number in the file's units: 90 deg/s for the revolute joint, 90 mm/s for
     # the prismatic one
-    lim = load_robot(_write(tmp_path, text)).rate_limits
+    lim = load_parts(_write(tmp_path, text)).rate_limits
     np.testing.assert_allclose(lim.velocity, [math.radians(90), 0.09])
 
 
@@ -63,19 +63,19 @@ def test_one_number_applies_to_every_joint(tmp_path):
 ])
 def test_bad_values_name_the_field_and_line(tmp_path, replace, match):
     with pytest.raises(ModelError, match=match) as info:
-        load_robot(_write(tmp_path, ARM.replace(*replace)))
+        load_parts(_write(tmp_path, ARM.replace(*replace)))
     assert info.value.line is not None  # the editor can jump there
 
 
 def test_a_section_with_no_limit_is_refused(tmp_path):
     text = ARM.split("rate_limits:")[0] + "rate_limits: {source: nothing}\n"
     with pytest.raises(ModelError, match="at least one of velocity"):
-        load_robot(_write(tmp_path, text))
+        load_parts(_write(tmp_path, text))
 
 
 def test_loaded_file_round_trips_unchanged(tmp_path):
-    robot = load_robot(_write(tmp_path, ARM))
-    back = load_robot(save_robot(robot, tmp_path / "copy.yaml"))
+    robot = load_parts(_write(tmp_path, ARM))
+    back = load_parts(save_robot(robot, tmp_path / "copy.yaml"))
     assert back.rate_limits == robot.rate_limits
     # the file's own units are kept
     assert yaml.safe_load((tmp_path / "copy.yaml").read_text())["rate_limits"][
@@ -90,7 +90,7 @@ def test_robot_built_in_memory_writes_si_limits(tmp_path):
     doc = document_from_robot(robot)
     assert doc["units"] == {"length": "m", "angle": "rad"}
     assert doc["rate_limits"]["jerk"][:5] == [None] * 5
-    back = load_robot(save_robot(robot, tmp_path / "mem.yaml"))
+    back = load_parts(save_robot(robot, tmp_path / "mem.yaml"))
     assert back.rate_limits == lim
 
 
@@ -132,7 +132,7 @@ def test_builtin_limits_with_their_sources():
 
 # ------------------------------------------------------------------------- URDF
 pytest.importorskip("yourdfpy")
-from robokin.io.urdf import robot_from_urdf  # noqa: E402
+from robokin import Robot  # noqa: E402
 
 URDF = """<robot name="two">
   <link name="a"/><link name="b"/><link name="c"/>
@@ -145,20 +145,20 @@ URDF = """<robot name="two">
 
 
 def test_urdf_velocity_is_imported_and_zero_means_unknown():
-    lim = robot_from_urdf(URDF).rate_limits
+    lim = Robot.from_urdf(URDF).rate_limits
     assert lim.velocity[0] == 2.5 and math.isnan(lim.velocity[1])
     assert lim.acceleration is None and "<limit velocity>" in lim.source
 
 
 def test_urdf_without_velocities_gives_no_limits():
-    assert robot_from_urdf(URDF.replace('velocity="2.5"', 'velocity="0"')
+    assert Robot.from_urdf(URDF.replace('velocity="2.5"', 'velocity="0"')
                            ).rate_limits is None
 
 
 @pytest.mark.parametrize("name", ["aubo_i5", "ur5", "panda"])
 def test_urdf_round_trip_keeps_the_speed_limits(name):
     robot = robokin.load(name)
-    back = robot_from_urdf(robot.to_urdf())
+    back = Robot.from_urdf(robot.to_urdf())
     np.testing.assert_allclose(back.rate_limits.velocity, robot.rate_limits.velocity,
                                rtol=1e-15)
 
@@ -167,7 +167,7 @@ def test_mimic_joints_are_written_with_their_scaled_speed():
     robot = robokin.load("qfmd010").replace(
         rate_limits=RateLimits(velocity=[1.0, 2.0, 3.0, 4.0]))
     text = robot.to_urdf()
-    back = robot_from_urdf(text)
+    back = Robot.from_urdf(text)
     np.testing.assert_allclose(back.rate_limits.velocity, [1, 2, 3, 4])
     # the forearm joint is theta3 - theta2: both drive it, each at its own speed
     assert 'velocity="2.0"' in text and 'velocity="3.0"' in text
@@ -176,4 +176,4 @@ def test_mimic_joints_are_written_with_their_scaled_speed():
 def test_unknown_speeds_get_the_placeholder():
     text = robokin.load("puma560").to_urdf(velocity=0.0)
     assert "<limit velocity> and an effort without a torque limit are placeholders" in text
-    assert robot_from_urdf(text).rate_limits is None  # 0 reads back as unknown
+    assert Robot.from_urdf(text).rate_limits is None  # 0 reads back as unknown

@@ -9,7 +9,7 @@ import yaml
 
 import robokin
 from reference import random_q
-from robokin.io.robot_files import document_from_robot, load_robot, save_robot
+from robokin.io.robot_files import document_from_robot, load_parts, save_robot
 
 GOOD = """\
 name: two_link
@@ -30,7 +30,7 @@ def _write(tmp_path: Path, text: str) -> Path:
 
 
 def test_units_are_converted_once_at_the_edge(tmp_path):
-    robot = load_robot(_write(tmp_path, GOOD))
+    robot = robokin.load(_write(tmp_path, GOOD))
     np.testing.assert_allclose(robot.limits, [[-np.pi / 2, np.pi / 2], [0.0, 0.2]])
     T = robot.fk([0.0, 0.02])
     # j1: Rz(0) Tz(0.1) Tx(0.3); j2: Rz(90 deg) Tz(0.05 + 0.02); tool Tz(0.1) Rx(180 deg)
@@ -70,7 +70,7 @@ CASES = [
 @pytest.mark.parametrize(("text", "match"), CASES)
 def test_malformed_files_name_the_file_and_field(tmp_path, text, match):
     with pytest.raises(robokin.ModelError, match=match):
-        load_robot(_write(tmp_path, text))
+        load_parts(_write(tmp_path, text))
 
 
 def test_missing_file_is_a_model_error(tmp_path):
@@ -84,10 +84,10 @@ def test_unknown_builtin_lists_the_names():
 
 
 def test_save_round_trips_a_loaded_file(tmp_path):
-    robot = load_robot(_write(tmp_path, GOOD))
+    robot = robokin.load(_write(tmp_path, GOOD))
     out = save_robot(robot, tmp_path / "copy.yaml")
     assert yaml.safe_load(out.read_text()) == yaml.safe_load(GOOD)
-    again = load_robot(out)
+    again = robokin.load(out)
     np.testing.assert_array_equal(again.fk([0.3, 0.1]), robot.fk([0.3, 0.1]))
 
 
@@ -107,7 +107,7 @@ def test_code_built_robots_save_as_exact_elementary_files(tmp_path, name, rng):
 def test_failed_save_keeps_the_old_file(tmp_path, monkeypatch):
     target = tmp_path / "robot.yaml"
     target.write_text(GOOD)
-    robot = load_robot(target)
+    robot = robokin.load(target)
 
     def boom(*args, **kwargs):
         raise OSError("disk full")
@@ -129,7 +129,7 @@ joints:
   - {op: tx, value: 1000}
   - {op: rz, joint: revolute, name: b, depends: {a: -1}, depends_offset: 90}
 """
-    robot = load_robot(_write(tmp_path, text))
+    robot = robokin.load(_write(tmp_path, text))
     assert robot.n == 1
     T = robot.fk([0.25])
     np.testing.assert_allclose(T[:3, 3], [np.cos(0.25), np.sin(0.25), 0], atol=1e-12)
@@ -139,7 +139,7 @@ joints:
     with pytest.raises(
         robokin.ModelError, match=r"joints\[2\]\.depends.*unknown coordinate 'zz'"
     ):
-        load_robot(_write(tmp_path, bad))
+        load_parts(_write(tmp_path, bad))
 
 
 def test_code_built_robot_keeps_its_actuators_when_saved(tmp_path, rng):
@@ -212,14 +212,14 @@ def test_save_gives_normal_permissions_and_keeps_existing_ones(tmp_path):
 def test_numbers_must_be_numbers_and_errors_name_the_line(tmp_path, old, new, message):
     assert old in GOOD
     with pytest.raises(robokin.ModelError, match=message):
-        load_robot(_write(tmp_path, GOOD.replace(old, new, 1)))
+        load_parts(_write(tmp_path, GOOD.replace(old, new, 1)))
 
 
 def test_too_many_joint_rows_are_refused_before_validation(tmp_path):
     rows = "".join("  - {a: 0.1}\n" for _ in range(1001))
     with pytest.raises(robokin.ModelError, match=r"joints: 1,001 rows; a robot file "
                                                  r"holds at most 1,000"):
-        load_robot(_write(tmp_path, "name: long\njoints:\n" + rows))
+        load_parts(_write(tmp_path, "name: long\njoints:\n" + rows))
 
 
 def test_a_file_without_units_that_reads_as_an_89_m_arm_warns(tmp_path):
@@ -227,18 +227,18 @@ def test_a_file_without_units_that_reads_as_an_89_m_arm_warns(tmp_path):
              "  - {a: -425, alpha: 0, d: 0}\n"
     with pytest.warns(UserWarning, match=r"no 'units:'.*-425 m \(joints\[1\]\.a\) "
                                          r"suggests millimetres"):
-        robot = load_robot(_write(tmp_path, ur5_mm))
+        robot = robokin.load(_write(tmp_path, ur5_mm))
     assert robot.fk(np.zeros(2))[2, 3] == pytest.approx(89.159)  # read as asked
     deg = "name: d\njoints:\n  - {a: 0.4, alpha: 90}\n"
     with pytest.warns(UserWarning, match=r"90 rad \(joints\[0\]\.alpha\) suggests "
                                          "degrees"):
-        load_robot(_write(tmp_path, deg))
+        load_parts(_write(tmp_path, deg))
     import warnings
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        load_robot(_write(tmp_path, GOOD))  # units given: no warning
-        load_robot(_write(tmp_path, "name: m\njoints:\n  - {a: 0.425, alpha: 1.57}\n"))
+        load_parts(_write(tmp_path, GOOD))  # units given: no warning
+        load_parts(_write(tmp_path, "name: m\njoints:\n  - {a: 0.425, alpha: 1.57}\n"))
         for name in robokin.robots.names():
             robokin.load(name)
 
@@ -259,12 +259,12 @@ def test_a_file_without_units_that_reads_as_an_89_m_arm_warns(tmp_path):
 def test_declared_units_whose_numbers_suggest_others_warn(tmp_path, units, row, match):
     """Issue 25: ``units: {angle: rad}`` with ``alpha: 90`` loaded without a note."""
     with pytest.warns(UserWarning, match=match):
-        load_robot(_write(tmp_path, f"name: a\nunits: {units}\njoints:\n  - {row}\n"))
+        load_parts(_write(tmp_path, f"name: a\nunits: {units}\njoints:\n  - {row}\n"))
     import warnings
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the same numbers in the unit they suggest
-        load_robot(_write(tmp_path, "name: a\nunits: {length: mm, angle: deg}\n"
+        load_parts(_write(tmp_path, "name: a\nunits: {length: mm, angle: deg}\n"
                                     "joints:\n  - {a: 425, alpha: 90}\n"))
 
 

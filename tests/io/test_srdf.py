@@ -15,7 +15,7 @@ from robokin.io import srdf as srdf_mod
 from robokin.io.srdf import excluded_link_pairs, parse_srdf
 
 pytest.importorskip("yourdfpy")
-from robokin.io.urdf import robot_from_urdf  # noqa: E402
+from robokin import Robot  # noqa: E402
 
 DATA = Path(__file__).parent.parent / "data" / "urdf"
 URDF = DATA / "gripper_arm.urdf"
@@ -83,7 +83,7 @@ def test_merged_links_rule():
 
 
 def test_robot_from_urdf_with_srdf_maps_the_pairs():
-    robot = robot_from_urdf(URDF, srdf=SRDF)
+    robot = Robot.from_urdf(URDF, srdf=SRDF)
     assert robot.meta["urdf"].tip_link == "flange"  # the end effector's parent link
     assert robot.meta["srdf"].name == "gripper_arm"
     geo = robot.geometry
@@ -111,7 +111,7 @@ def _colliding_pair_q(robot, pair):
                         ("base_link", "finger_right"), ("base_link", "wrist_cam")]),
 ])
 def test_a_disabled_pair_is_not_reported_and_is_otherwise(pair, urdf_pairs):
-    plain = robot_from_urdf(URDF, tip_link="tcp")
+    plain = Robot.from_urdf(URDF, tip_link="tcp")
     q = _colliding_pair_q(plain, pair)
     adjacent = [("base_link", "link_1"), ("link_1", "link_2"), ("link_2", "link_3"),
                 ("link_2", "camera_mount"), ("link_2", "camera"), ("link_3", "hand"),
@@ -119,7 +119,7 @@ def test_a_disabled_pair_is_not_reported_and_is_otherwise(pair, urdf_pairs):
                 ("link_3", "wrist_cam")]
 
     def reported(pairs):
-        robot = robot_from_urdf(URDF, tip_link="tcp", srdf=srdf_text(*adjacent, *pairs))
+        robot = Robot.from_urdf(URDF, tip_link="tcp", srdf=srdf_text(*adjacent, *pairs))
         rep = collision.check(robot, collision.Scene(), q[None], subdivide=False)
         return any({c[2], c[3]} == set(pair) for c in rep.collisions)
 
@@ -170,7 +170,7 @@ def test_a_huge_file_is_refused_before_parsing(tmp_path):
 def test_unknown_links_and_elements_are_warned_about_and_skipped():
     text = srdf_text(("base_link", "nope"), extra='<my_extension value="1"/>\n')
     with pytest.warns(UserWarning) as record:
-        robot = robot_from_urdf(URDF, tip_link="tcp", srdf=text)
+        robot = Robot.from_urdf(URDF, tip_link="tcp", srdf=text)
     messages = [str(w.message) for w in record]
     assert any("unknown SRDF element <my_extension>" in m for m in messages)
     assert any(":3: <disable_collisions> names link 'nope', which the URDF does not "
@@ -181,7 +181,7 @@ def test_unknown_links_and_elements_are_warned_about_and_skipped():
 def test_a_srdf_for_another_robot_is_warned_about():
     text = srdf_text().replace('name="gripper_arm"', 'name="other"')
     with pytest.warns(UserWarning, match="the SRDF is for robot 'other'"):
-        robot_from_urdf(URDF, tip_link="tcp", srdf=text)
+        Robot.from_urdf(URDF, tip_link="tcp", srdf=text)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        robot_from_urdf(URDF, tip_link="tcp", srdf=srdf_text())
+        Robot.from_urdf(URDF, tip_link="tcp", srdf=srdf_text())

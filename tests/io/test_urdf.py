@@ -15,7 +15,8 @@ from robokin.spatial import rotz
 
 pytest.importorskip("yourdfpy")
 from reference import pin_fk  # noqa: E402
-from robokin.io.urdf import axis_frame, robot_from_urdf  # noqa: E402
+from robokin import Robot  # noqa: E402
+from robokin.io.urdf import axis_frame  # noqa: E402
 
 DATA = Path(__file__).parent.parent / "data" / "urdf"
 
@@ -27,7 +28,7 @@ def random_q(robot, rng, m=20):
 
 def test_industrial_arm_matches_pinocchio(rng):
     xml = (DATA / "industrial6.urdf").read_text()
-    robot = robot_from_urdf(DATA / "industrial6.urdf")
+    robot = Robot.from_urdf(DATA / "industrial6.urdf")
     assert robot.meta["urdf"].tip_link == "tool0"  # not the fixed 'base' leaf
     assert robot.joint_names == tuple(f"joint_{i}" for i in range(1, 7))
     # negative axes become reversed joints; continuous joints are unlimited
@@ -43,7 +44,7 @@ def test_industrial_arm_matches_pinocchio(rng):
 
 def test_link_frames_are_the_urdf_child_link_frames(rng):
     xml = (DATA / "industrial6.urdf").read_text()
-    robot = robot_from_urdf(xml)  # the XML string works as well as the path
+    robot = Robot.from_urdf(xml)  # the XML string works as well as the path
     q = random_q(robot, rng, 5)
     frames = robot.fk_all(q)
     for qi, Fi in zip(q, frames):
@@ -59,7 +60,7 @@ def test_link_frames_are_the_urdf_child_link_frames(rng):
 
 def test_tilted_axes_prismatic_and_mimic_match_pinocchio(rng):
     text = (DATA / "tilted_prismatic.urdf").read_text()
-    robot = robot_from_urdf(DATA / "tilted_prismatic.urdf")
+    robot = Robot.from_urdf(DATA / "tilted_prismatic.urdf")
     assert robot.n == 4 and robot.n_chain == 5
     assert robot.joint_names == ("joint_a", "joint_b", "joint_d", "joint_e")
     assert robot.chain.joints[1].kind == "prismatic"
@@ -89,31 +90,31 @@ def test_axis_frame_rotates_about_the_axis(axis):
 
 
 def test_ur5_urdf_is_the_dh_model_turned_by_pi(rng):
-    urdf = robot_from_urdf(DATA / "ur5.urdf", missing_mesh="ignore")
+    urdf = Robot.from_urdf(DATA / "ur5.urdf", missing_mesh="ignore")
     dh = robokin.load("ur5")
     q = random_q(dh, rng)
     # ROS-Industrial base_link is REP-103: the controller's 'base' turned by pi
     np.testing.assert_allclose(urdf.fk(q), rotz(math.pi) @ dh.fk(q), atol=1e-12)
     # from the 'base' frame (a fixed leaf walked backwards) the two are identical
-    from_base = robot_from_urdf(DATA / "ur5.urdf", base_link="base", geometry=False)
+    from_base = Robot.from_urdf(DATA / "ur5.urdf", base_link="base", geometry=False)
     np.testing.assert_allclose(from_base.fk(q), dh.fk(q), atol=1e-12)
     np.testing.assert_allclose(urdf.limits[2], [-math.pi, math.pi])
 
 
 def test_panda_urdf_is_the_modified_dh_model(rng):
-    arm = robot_from_urdf(DATA / "panda.urdf", tip_link="panda_link8")
+    arm = Robot.from_urdf(DATA / "panda.urdf", tip_link="panda_link8")
     dh = robokin.load("panda")
     q = random_q(dh, rng)
     np.testing.assert_allclose(arm.fk(q), dh.fk(q), atol=1e-12)
     np.testing.assert_allclose(arm.limits, dh.limits)
     # with the hand: the known -45 deg turn and the finger offset
-    hand = robot_from_urdf(DATA / "panda.urdf", tip_link="panda_hand")
+    hand = Robot.from_urdf(DATA / "panda.urdf", tip_link="panda_hand")
     np.testing.assert_allclose(hand.fk(q), dh.fk(q) @ rotz(-math.pi / 4), atol=1e-12)
 
 
 def test_mimic_master_off_the_chain_becomes_a_coordinate(rng):
-    right = robot_from_urdf(DATA / "panda.urdf", tip_link="panda_rightfinger")
-    left = robot_from_urdf(DATA / "panda.urdf", tip_link="panda_leftfinger")
+    right = Robot.from_urdf(DATA / "panda.urdf", tip_link="panda_rightfinger")
+    left = Robot.from_urdf(DATA / "panda.urdf", tip_link="panda_leftfinger")
     assert right.n == 8 and right.joint_names[-1] == "panda_finger_joint1"
     assert [j.name for j in right.chain.joints][-1] == "panda_finger_joint2"
     np.testing.assert_allclose(right.limits[-1], [0.0, 0.04])
@@ -125,10 +126,10 @@ def test_mimic_master_off_the_chain_becomes_a_coordinate(rng):
 
 def test_ambiguous_tip_lists_candidates_and_explicit_tip_works(rng):
     with pytest.raises(ModelError, match=r"ambiguous tip.*left_tool.*right_tool"):
-        robot_from_urdf(DATA / "branched.urdf")
+        Robot.from_urdf(DATA / "branched.urdf")
     with pytest.raises(ModelError, match=r"ambiguous tip.*panda_leftfinger"):
-        robot_from_urdf(DATA / "panda.urdf")
-    left = robot_from_urdf(DATA / "branched.urdf", tip_link="left_tool")
+        Robot.from_urdf(DATA / "panda.urdf")
+    left = Robot.from_urdf(DATA / "branched.urdf", tip_link="left_tool")
     assert left.joint_names == ("waist", "left_shoulder", "left_elbow")
     q = np.array([0.3, 0.4, -0.5])
     # planar check: shoulder at (0, 0.2, 0.8) in the chest, two links of 0.3/0.25
@@ -139,15 +140,15 @@ def test_ambiguous_tip_lists_candidates_and_explicit_tip_works(rng):
     np.testing.assert_allclose(left.fk(q)[:3, 3], p, atol=1e-12)
     # a base below a movable joint that is not on the way to the tip
     with pytest.raises(ModelError, match="hangs below the movable joint 'left_shoulder'"):
-        robot_from_urdf(DATA / "branched.urdf", base_link="left_1", tip_link="right_tool")
+        Robot.from_urdf(DATA / "branched.urdf", base_link="left_1", tip_link="right_tool")
     with pytest.raises(ModelError, match="unknown tip link 'nose'; links: chest"):
-        robot_from_urdf(DATA / "branched.urdf", tip_link="nose")
+        Robot.from_urdf(DATA / "branched.urdf", tip_link="nose")
 
 
 def test_geometry_meshes_package_map_and_missing_mesh():
     pytest.importorskip("trimesh")
     with pytest.warns(UserWarning, match=r"link 'arm' collision mesh 'meshes/not_there.stl'"):
-        robot = robot_from_urdf(DATA / "meshes_arm.urdf",
+        robot = Robot.from_urdf(DATA / "meshes_arm.urdf",
                                 package_map={"meshy_description": str(DATA)})
     geo = robot.geometry
     assert geo.names == ("base", "j1", "tool")
@@ -159,20 +160,20 @@ def test_geometry_meshes_package_map_and_missing_mesh():
     assert arm_box.kind == "box" and arm_box.size == (0.2, 0.05, 0.05)
     np.testing.assert_allclose(base_mesh.trimesh().extents, [0.05] * 3, atol=1e-12)
     with pytest.raises(ModelError, match=r"not_there.stl.*no such file"):
-        robot_from_urdf(DATA / "meshes_arm.urdf", missing_mesh="error",
+        Robot.from_urdf(DATA / "meshes_arm.urdf", missing_mesh="error",
                         package_map={"meshy_description": DATA})
     # the package map resolves package:// (here: the visual mesh)
-    shapes = robot_from_urdf(
+    shapes = Robot.from_urdf(
         DATA / "meshes_arm.urdf", missing_mesh="ignore",
         package_map={"meshy_description": DATA},
     ).meta["urdf_shapes"]
     visual = [s for s in shapes if s["role"] == "visual"]
     assert visual[0]["filename"] == str(DATA / "meshes" / "cube.stl")
     with pytest.raises(ModelError, match="package .meshy_description. not found; searched the package map"):
-        robot_from_urdf(DATA / "meshes_arm.urdf", missing_mesh="error",
+        Robot.from_urdf(DATA / "meshes_arm.urdf", missing_mesh="error",
                         package_map={})
     # kinematics only: no geometry read, no warning
-    assert robot_from_urdf(DATA / "meshes_arm.urdf", geometry=False).geometry is None
+    assert Robot.from_urdf(DATA / "meshes_arm.urdf", geometry=False).geometry is None
 
 
 @pytest.mark.parametrize(
@@ -209,14 +210,14 @@ def test_geometry_meshes_package_map_and_missing_mesh():
 )
 def test_bad_urdf_raises_model_error(xml, match):
     with pytest.raises(ModelError, match=match):
-        robot_from_urdf(xml)
+        Robot.from_urdf(xml)
 
 
 def test_malformed_file_and_missing_file_name_the_file():
     with pytest.raises(ModelError, match=r"malformed.urdf:\d+: not valid XML"):
-        robot_from_urdf(DATA / "malformed.urdf")
+        Robot.from_urdf(DATA / "malformed.urdf")
     with pytest.raises(ModelError, match="nope.urdf: no such file"):
-        robot_from_urdf(DATA / "nope.urdf")
+        Robot.from_urdf(DATA / "nope.urdf")
 
 
 def test_missing_yourdfpy_names_the_extra(monkeypatch):
@@ -231,7 +232,7 @@ def test_missing_yourdfpy_names_the_extra(monkeypatch):
 
     monkeypatch.setattr(builtins, "__import__", fake)
     with pytest.raises(ImportError, match=r"robokin\[urdf\]"):
-        robot_from_urdf(DATA / "ur5.urdf")
+        Robot.from_urdf(DATA / "ur5.urdf")
 
 
 @pytest.mark.parametrize(
@@ -287,7 +288,7 @@ def test_dtds_and_entities_are_refused(tmp_path, dtd):
                     + ARM.format(link="", joint='<origin xyz="0 0 0"/>')
                     .replace('name="r"', 'name="&c;"' if "&b;" in dtd else 'name="r"'))
     with pytest.raises(ModelError, match=r"evil\.urdf:1: a <!DOCTYPE>"):
-        robot_from_urdf(path)
+        Robot.from_urdf(path)
 
 
 @pytest.mark.parametrize(("link", "joint", "message"), [
@@ -307,7 +308,7 @@ def test_non_finite_origins_and_bad_shapes_name_file_element_and_line(
     path = tmp_path / "arm.urdf"
     path.write_text(ARM.format(link=link, joint=joint))
     with pytest.raises(ModelError, match=message):
-        robot_from_urdf(path)
+        Robot.from_urdf(path)
 
 
 def test_lines_are_those_of_the_element(tmp_path):
@@ -315,7 +316,7 @@ def test_lines_are_those_of_the_element(tmp_path):
     path.write_text(ARM.format(link="", joint='\n\n<origin xyz="1 2 x"/>')
                     .replace("><", ">\n<"))
     with pytest.raises(ModelError) as exc:
-        robot_from_urdf(path)
+        Robot.from_urdf(path)
     line = exc.value.line
     assert 'xyz="1 2 x"' in path.read_text().splitlines()[line - 1]
 
@@ -330,7 +331,7 @@ def test_every_left_out_shape_is_listed_and_no_non_mesh_path_is_kept(tmp_path):
     path = tmp_path / "arm.urdf"
     path.write_text(ARM.format(link=shapes + '<collision><geometry><box size="1 1 1"/>'
                                              '</geometry></collision>', joint=""))
-    robot = robot_from_urdf(path, missing_mesh="ignore")
+    robot = Robot.from_urdf(path, missing_mesh="ignore")
     dropped = robot.meta["urdf_dropped_shapes"]
     assert len(dropped) == 5
     for word in ("no such file", "remote mesh (http://)", "not a mesh file",
@@ -339,10 +340,10 @@ def test_every_left_out_shape_is_listed_and_no_non_mesh_path_is_kept(tmp_path):
     kinds = [s.kind for ss in robot.geometry.shapes for s in ss]
     assert kinds == ["box"]
     with pytest.warns(UserWarning) as record:
-        robot_from_urdf(path)
+        Robot.from_urdf(path)
     assert len(record) == 5
     with pytest.raises(ModelError, match="gone.stl"):
-        robot_from_urdf(path, missing_mesh="error")
+        Robot.from_urdf(path, missing_mesh="error")
 
 
 def _chain_urdf(n: int) -> str:
@@ -361,12 +362,12 @@ def test_a_urdf_of_thousands_of_joints_is_refused_before_it_is_built(tmp_path):
     path.write_text(_chain_urdf(MAX_URDF_JOINTS + 1))
     with pytest.raises(ModelError, match=r"long\.urdf:1: 1,001 <joint> elements; "
                                          r"robokin reads at most 1,000"):
-        robot_from_urdf(path)
+        Robot.from_urdf(path)
     path.write_text(_chain_urdf(MAX_URDF_JOINTS))  # at the cap: read, but a serial
     with pytest.raises(ModelError, match="1000 joints.*at most 32"):  # chain that long
-        robot_from_urdf(path, geometry=False)  # is more than the kernels take
+        Robot.from_urdf(path, geometry=False)  # is more than the kernels take
     path.write_text(_chain_urdf(MAX_JOINTS))
-    robot = robot_from_urdf(path, geometry=False)
+    robot = Robot.from_urdf(path, geometry=False)
     assert robot.n == MAX_JOINTS
     assert robot.fk(np.zeros(robot.n))[2, 3] == pytest.approx(10.0 * MAX_JOINTS / 1000)
 
@@ -388,7 +389,7 @@ def test_absurd_lengths_are_refused_at_import_naming_the_field(tmp_path, link, j
     path = tmp_path / "arm.urdf"
     path.write_text(ARM.format(link=link, joint=joint))
     with pytest.raises(ModelError, match=message):
-        robot_from_urdf(path)
+        Robot.from_urdf(path)
 
 
 def test_a_prismatic_limit_is_a_length_a_revolute_one_an_angle(tmp_path):
@@ -397,9 +398,9 @@ def test_a_prismatic_limit_is_a_length_a_revolute_one_an_angle(tmp_path):
                                                  'lower="-1e7" upper="1"')
     path.write_text(text.replace('type="revolute"', 'type="prismatic"'))
     with pytest.raises(ModelError, match=r"joint\[j\]\.limit\.lower: .*a length beyond"):
-        robot_from_urdf(path)
+        Robot.from_urdf(path)
     path.write_text(text)
-    assert robot_from_urdf(path).limits[0, 0] == -1e7  # radians: not a length
+    assert Robot.from_urdf(path).limits[0, 0] == -1e7  # radians: not a length
 
 
 def test_cli_import_of_a_1e308_origin_writes_nothing(tmp_path, capsys):
@@ -450,16 +451,16 @@ def test_package_uris_that_leave_the_package_are_not_read(tmp_path, uri):
     (pkg / "meshes").mkdir(parents=True)
     (tmp_path / "secret.stl").write_bytes((DATA / "meshes" / "cube.stl").read_bytes())
     path = _mesh_urdf(tmp_path, uri)
-    robot = robot_from_urdf(path, package_map={"pkg": pkg}, missing_mesh="ignore")
+    robot = Robot.from_urdf(path, package_map={"pkg": pkg}, missing_mesh="ignore")
     (dropped,) = robot.meta["urdf_dropped_shapes"]
     assert f"the path leaves the package 'pkg' (its folder {pkg}" in dropped
     assert "not read" in dropped
     assert [s.kind for ss in robot.geometry.shapes for s in ss] == ["box"]
     with pytest.raises(ModelError, match="leaves the package"):
-        robot_from_urdf(path, package_map={"pkg": pkg}, missing_mesh="error")
+        Robot.from_urdf(path, package_map={"pkg": pkg}, missing_mesh="error")
     # inside the package, '..' that stays inside is fine
     (pkg / "meshes" / "ok.stl").write_bytes((DATA / "meshes" / "cube.stl").read_bytes())
-    fine = robot_from_urdf(_mesh_urdf(tmp_path, "package://pkg/meshes/../meshes/ok.stl"),
+    fine = Robot.from_urdf(_mesh_urdf(tmp_path, "package://pkg/meshes/../meshes/ok.stl"),
                            package_map={"pkg": pkg}, missing_mesh="error")
     assert fine.meta["urdf_dropped_shapes"] == ()
 
@@ -486,4 +487,4 @@ def test_a_mesh_that_is_not_a_regular_file_is_never_read(tmp_path, kind):
         what = "a folder"
     path = _mesh_urdf(tmp_path, uri)
     with pytest.raises(ModelError, match=r"is not a regular file: " + re.escape(what)):
-        robot_from_urdf(path, missing_mesh="error")
+        Robot.from_urdf(path, missing_mesh="error")

@@ -13,7 +13,7 @@ from robokin.io.urdf_export import urdf_from_robot
 from robokin.spatial import rotx, trans
 
 pytest.importorskip("yourdfpy")
-from robokin.io.urdf import robot_from_urdf  # noqa: E402
+from robokin import Robot  # noqa: E402
 
 DATA = Path(__file__).parent.parent / "data" / "urdf"
 
@@ -26,7 +26,7 @@ def random_q(robot, rng, m=50):
 @pytest.mark.parametrize("name", robokin.robots.names())
 def test_every_builtin_arm_round_trips(name, rng):
     robot = robokin.load(name)
-    back = robot_from_urdf(urdf_from_robot(robot))
+    back = Robot.from_urdf(urdf_from_robot(robot))
     assert back.joint_names == robot.joint_names
     np.testing.assert_array_equal(back.limits, robot.limits)
     np.testing.assert_array_equal(back.is_revolute, robot.is_revolute)
@@ -41,7 +41,7 @@ def test_base_and_tool_transforms_survive(rng):
     root = ET.fromstring(text)
     assert root.find("joint[@name='world_to_base']/parent").get("link") == "world"
     assert root.find("link[@name='tool0']") is not None
-    back = robot_from_urdf(text)
+    back = Robot.from_urdf(text)
     q = random_q(robot, rng)
     np.testing.assert_allclose(back.fk(q), robot.fk(q), atol=1e-12)
 
@@ -81,7 +81,7 @@ def test_reversed_joint_and_offsets_are_written_as_urdf_expects(rng):
     assert axis == [0.0, 0.0, -1.0]
     assert root.find("joint[@name='c']").get("type") == "continuous"
     assert root.find("joint[@name='b']").get("type") == "prismatic"
-    back = robot_from_urdf(text)
+    back = Robot.from_urdf(text)
     q = random_q(robot, rng)
     np.testing.assert_allclose(back.fk(q), robot.fk(q), atol=1e-12)
     # modified DH: the URDF child link frames are the DH link frames
@@ -108,13 +108,13 @@ def test_dependent_joints_become_mimic_joints(rng):
 
 def test_imported_robot_exports_its_link_frames_and_geometry(rng):
     pytest.importorskip("trimesh")
-    robot = robot_from_urdf(DATA / "industrial6.urdf")
-    again = robot_from_urdf(urdf_from_robot(robot))
+    robot = Robot.from_urdf(DATA / "industrial6.urdf")
+    again = Robot.from_urdf(urdf_from_robot(robot))
     assert again.meta["urdf"].child_links == robot.meta["urdf"].child_links
     q = random_q(robot, rng, 10)
     np.testing.assert_allclose(again.fk_all(q), robot.fk_all(q), atol=1e-12)
-    ur5 = robot_from_urdf(DATA / "ur5.urdf", missing_mesh="ignore")
-    back = robot_from_urdf(urdf_from_robot(ur5))
+    ur5 = Robot.from_urdf(DATA / "ur5.urdf", missing_mesh="ignore")
+    back = Robot.from_urdf(urdf_from_robot(ur5))
     for a, b in zip(ur5.geometry.shapes, back.geometry.shapes):
         assert [s.kind for s in a] == [s.kind for s in b]
         for s1, s2 in zip(a, b):

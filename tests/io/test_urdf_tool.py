@@ -14,7 +14,7 @@ from robokin.exceptions import InputError
 from robokin.kinematics.forward import link_frames
 
 pytest.importorskip("yourdfpy")
-from robokin.io.urdf import robot_from_urdf  # noqa: E402
+from robokin import Robot  # noqa: E402
 
 DATA = Path(__file__).parent.parent / "data" / "urdf"
 URDF = DATA / "gripper_arm.urdf"
@@ -69,7 +69,7 @@ def assert_same_poses(ours, ref):
 
 
 def test_gripper_tree_joins_the_tool_with_fingers_at_their_defaults(rng):
-    robot = robot_from_urdf(URDF, tip_link="tcp")
+    robot = Robot.from_urdf(URDF, tip_link="tcp")
     info = robot.meta["urdf"]
     # the tool: everything rigid with the last link but the last link itself
     tool = {"flange", "hand", "tcp", "finger_left", "finger_right", "wrist_cam"}
@@ -97,7 +97,7 @@ def test_gripper_tree_joins_the_tool_with_fingers_at_their_defaults(rng):
 
 
 def test_a_camera_on_a_middle_link_stays_on_that_link(rng):
-    robot = robot_from_urdf(URDF, tip_link="tcp")
+    robot = Robot.from_urdf(URDF, tip_link="tcp")
     assert robot.meta["urdf"].owners["camera"] == "joint_2"
     assert len(robot.geometry.link("joint_2")) == 3  # link_2, the mount, the camera
     for q in rng.uniform(-2, 2, (5, 3)):
@@ -106,7 +106,7 @@ def test_a_camera_on_a_middle_link_stays_on_that_link(rng):
 
 
 def test_tool_joints_choose_the_fingers_positions(rng):
-    robot = robot_from_urdf(URDF, tip_link="tcp",
+    robot = Robot.from_urdf(URDF, tip_link="tcp",
                             tool_joints={"finger_left_joint": 0.04, "wrist_cam_joint": -1})
     info = robot.meta["urdf"]
     assert info.tool_joints == {"finger_left_joint": 0.04, "finger_right_joint": 0.045,
@@ -125,7 +125,7 @@ def test_tool_joints_choose_the_fingers_positions(rng):
 ])
 def test_bad_tool_joints_are_refused_by_name(values, match):
     with pytest.raises(InputError, match=match) as err:
-        robot_from_urdf(URDF, tip_link="tcp", tool_joints=values)
+        Robot.from_urdf(URDF, tip_link="tcp", tool_joints=values)
     assert err.value.argument == "tool_joints"
 
 
@@ -136,7 +136,7 @@ def test_a_tool_joint_that_mimics_the_arm_is_left_out_with_a_warning():
         '    <mimic joint="joint_1"/>\n  </joint>')
     assert "<mimic joint=\"joint_1\"/>" in xml
     with pytest.warns(UserWarning, match="wrist_cam_joint.*mimics the arm's joint 'joint_1'"):
-        robot = robot_from_urdf(xml, tip_link="tcp")
+        robot = Robot.from_urdf(xml, tip_link="tcp")
     assert "wrist_cam" in robot.meta["urdf"].dropped_links
     assert "wrist_cam" not in robot.meta["urdf"].owners
 
@@ -145,5 +145,5 @@ def test_without_a_gripper_tree_nothing_changes():
     """The tip's own fixed links still move with it; no joint is frozen."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        robot = robot_from_urdf(DATA / "industrial6.urdf")
+        robot = Robot.from_urdf(DATA / "industrial6.urdf")
     assert robot.meta["urdf"].tool_joints == {}

@@ -14,8 +14,8 @@ from robokin.exceptions import InputError, ModelError
 pytest.importorskip("yourdfpy")
 pytest.importorskip("xacro")
 from reference import pin_fk  # noqa: E402
+from robokin import Robot  # noqa: E402
 from robokin.io.ros_packages import PackageFinder  # noqa: E402
-from robokin.io.urdf import robot_from_urdf  # noqa: E402
 from robokin.io.xacro import expand_xacro, is_xacro  # noqa: E402
 
 DEMO = Path(__file__).parent.parent / "data" / "xacro" / "demo_description"
@@ -96,15 +96,15 @@ def test_ament_prefix_path_and_package_xml_above_the_file(tmp_path, monkeypatch)
     monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
     monkeypatch.setenv("AMENT_PREFIX_PATH", str(tmp_path / "install"))
     # $(find demo_description): the package.xml above arm.urdf.xacro names it
-    robot = robot_from_urdf(ARM, missing_mesh="error")
+    robot = Robot.from_urdf(ARM, missing_mesh="error")
     files = {Path(s["filename"]) for s in robot.meta["urdf_shapes"] if s["type"] == "mesh"}
     assert files == {DEMO / "meshes" / "cube.stl", share / "meshes" / "link_3.stl"}
 
 
 def test_xacro_args_change_the_model_and_unknown_ones_are_refused(rng):
     with pytest.warns(UserWarning, match="package 'demo_meshes' not found"):
-        short = robot_from_urdf(ARM)
-    long = robot_from_urdf(ARM, xacro_args={"upper_length": "0.6", "prefix": "left_"},
+        short = Robot.from_urdf(ARM)
+    long = Robot.from_urdf(ARM, xacro_args={"upper_length": "0.6", "prefix": "left_"},
                            missing_mesh="ignore")
     assert long.joint_names == ("left_joint_1", "left_joint_2", "left_joint_3")
     assert "upper_length:=0.6" in long.source
@@ -115,16 +115,16 @@ def test_xacro_args_change_the_model_and_unknown_ones_are_refused(rng):
     assert_fk_matches_pinocchio(long, rng, m=10)
     with pytest.raises(InputError, match=r"declares no argument 'lenght'; it declares "
                                          r"\['prefix', 'upper_length'\]"):
-        robot_from_urdf(ARM, xacro_args={"lenght": "1"})
+        Robot.from_urdf(ARM, xacro_args={"lenght": "1"})
     with pytest.raises(InputError, match="not a xacro file"):
-        robot_from_urdf(DEMO.parent.parent / "urdf" / "ur5.urdf", xacro_args={"a": "1"})
+        Robot.from_urdf(DEMO.parent.parent / "urdf" / "ur5.urdf", xacro_args={"a": "1"})
 
 
 def test_missing_package_names_it_and_lists_the_search_path(tmp_path, monkeypatch):
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path))
     root = rtb_xacro() / "abb_irb140_description"
     with pytest.raises(ModelError) as err:
-        robot_from_urdf(root / "urdf" / "irb140.xacro", package_map={"other": tmp_path})
+        Robot.from_urdf(root / "urdf" / "irb140.xacro", package_map={"other": tmp_path})
     msg = str(err.value)
     assert msg.startswith(f"{root / 'urdf' / 'irb140.xacro'}: $(find abb_irb140): "
                           "package 'abb_irb140' not found; searched the package map "
@@ -132,7 +132,7 @@ def test_missing_package_names_it_and_lists_the_search_path(tmp_path, monkeypatc
     assert f"package.xml files in {root / 'urdf'} and the folders above it" in msg
     assert "--package abb_irb140=DIR" in msg
     with pytest.raises(InputError, match="package 'abb_irb140': no such folder"):
-        robot_from_urdf(root / "urdf" / "irb140.xacro",
+        Robot.from_urdf(root / "urdf" / "irb140.xacro",
                         package_map={"abb_irb140": tmp_path / "nowhere"})
 
 
@@ -181,7 +181,7 @@ def test_an_expanded_urdf_error_names_the_xacro(tmp_path):
               '</joint>\n</robot>\n')
     with pytest.raises(ModelError, match=r"bad.urdf.xacro: joint\[j\].limit: .*"
                                          r"\(line \d+ of the URDF expanded from it\)"):
-        robot_from_urdf(f)
+        Robot.from_urdf(f)
 
 
 def test_is_xacro_and_xacro_warnings(tmp_path):
@@ -210,7 +210,7 @@ def test_cli_import_xacro_notes_each_dropped_mesh(tmp_path, capsys, monkeypatch)
         "'package://demo_meshes/meshes/link_3.stl': package 'demo_meshes' not found")
     assert "r_base_link -> r_tool0" in text
     loaded = robokin.load(out)
-    direct = robot_from_urdf(ARM, xacro_args={"upper_length": "0.6", "prefix": "r_"},
+    direct = Robot.from_urdf(ARM, xacro_args={"upper_length": "0.6", "prefix": "r_"},
                              missing_mesh="ignore")
     q = np.random.default_rng(3).uniform(-2, 2, (10, 3))
     np.testing.assert_allclose(loaded.fk(q), direct.fk(q), atol=1e-12)

@@ -106,7 +106,7 @@ def test_a_bomb_built_in_memory_gets_a_short_message_not_its_repr():
     # the second defence: a document that never went through the YAML budget
     # (built in code) still gets a message cut before it is formatted
     proc = run_bounded("""
-        from robokin.io.robot_files import robot_from_document
+        from robokin.io.robot_files import parts_from_document
         bomb = ["lol"] * 9
         for _ in range(8):
             bomb = [bomb] * 9
@@ -115,7 +115,7 @@ def test_a_bomb_built_in_memory_gets_a_short_message_not_its_repr():
                     {"name": "x", "joints": [{}], "geometry": {"joint1": [
                         {"type": "box", "size": bomb}]}}):
             try:
-                robot_from_document(doc, file="mem.yaml")
+                parts_from_document(doc, file="mem.yaml")
             except robokin.ModelError as exc:
                 assert len(str(exc)) < 300, len(str(exc))
                 print("REFUSED", exc)

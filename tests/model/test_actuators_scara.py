@@ -1,14 +1,13 @@
 """The built-in SCARA in actuator (motor) space: the paper's motor angles, round trips,
 FK / Jacobian / IK with ``space="actuator"`` (issue 5)."""
 
-import importlib.util
-
 import numpy as np
 import pytest
 
 import robokin
 from robokin.exceptions import InputError
 from robokin.spatial import axis_angle_from_matrix
+from robokin.trajectory.samples import Trajectory
 
 T_PAPER = np.arange(0.0, 5.0 + 1e-9, 0.5)
 # Paper parameters: c1 = 400, c2 = 325, c3 = 275, c4 = -150 mm; lead 20 mm, i = 1, j = 15.
@@ -180,14 +179,6 @@ def test_passive_joint_driven_through_the_matrix(scara):
     assert r.actuator_names == ("motor1", "motor2", "motor3")
 
 
-def _has(module):
-    try:
-        return importlib.util.find_spec(module) is not None
-    except ModuleNotFoundError:
-        return False
-
-
-@pytest.mark.skipif(not _has("robokin.kinematics.ik.numeric"), reason="numeric IK not built yet")
 def test_numeric_ik_in_actuator_space_nearest_does_not_wrap_motor_angles(scara):
     phi = scara.actuators_from_joints(np.array([[0.3, 0.8, 0.5, 0.05]]))
     T = scara.fk(phi, space="actuator")
@@ -203,9 +194,6 @@ def test_numeric_ik_in_actuator_space_nearest_does_not_wrap_motor_angles(scara):
     assert not sols.is_revolute.any()
 
 
-@pytest.mark.skipif(not _has("robokin.kinematics.ik.analytic.detect")
-                    or not _has("robokin.kinematics.ik.numeric"),
-                    reason="IK solvers not built yet")
 def test_ik_in_actuator_space(scara, rng):
     q = rng.uniform(scara.limits[:, 0] * 0.8, scara.limits[:, 1] * 0.8, (6, 4))
     q[:, 1] = np.where(np.abs(q[:, 1]) < 0.2, 0.5, q[:, 1])  # away from the elbow singularity
@@ -235,16 +223,13 @@ def test_paper_motion_as_a_trajectory_in_motor_space(scara):
     """Motor positions, velocities and accelerations of the paper's first test motion
     (theta3 = 36 t deg, l4 = t^2 mm): phi3 = 36t - 18t^2, phi3' = 36 - 36t, phi3'' = -36,
     phi4 = 540 t, phi4' = 540, phi4'' = 0 (deg, s)."""
-    samples = pytest.importorskip("robokin.trajectory.samples")
-    if not hasattr(samples.Trajectory, "to_actuator_space"):
-        pytest.skip("trajectory actuator space not built yet")
     t = T_PAPER
     z = np.zeros_like(t)
     d = np.radians
     q = np.stack([z, z, d(36 * t), t**2 / 1000], axis=-1)
     qd = np.stack([z, z, d(36 + z), 2 * t / 1000], axis=-1)
     qdd = np.stack([z, z, z, 2 / 1000 + z], axis=-1)
-    tr = samples.Trajectory(t, q, qd, qdd).to_actuator_space(scara)
+    tr = Trajectory(t, q, qd, qdd).to_actuator_space(scara)
     assert tr.space == "actuator"
     np.testing.assert_allclose(np.degrees(tr.q[:, 2]), 36 * t - 18 * t**2, atol=1e-9)
     np.testing.assert_allclose(np.degrees(tr.qd[:, 2]), 36 - 36 * t, atol=1e-9)

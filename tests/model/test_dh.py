@@ -130,14 +130,14 @@ def test_virtual_frames_equal_the_patent_composition(rng):
 
 
 def test_dropping_the_virtual_frames_gives_a_wrong_pose(rng):
-    from robokin.io.robot_files import robot_from_document
+    from robokin.io.robot_files import parts_from_document
 
     robot = robokin.load("improved_dh_arm")
     doc = robot.meta["document"]
     without = dict(
         doc, joints=[r for r in doc["joints"] if not r["name"].startswith("frame_")]
     )
-    wrong = robot_from_document(without)
+    wrong = robokin.Robot.from_parts(parts_from_document(without))
     q = random_q(robot, rng, 20)
     err = np.abs(wrong.fk(q)[..., :3, 3] - robot.fk(q)[..., :3, 3]).max(axis=-1)
     assert (err > 0.05).all()  # d2 = 300 mm and d5 = -120 mm are lost

@@ -16,7 +16,7 @@ pytest.importorskip("coal")
 def test_demo_sim_reports_a_simulated_run(tmp_path):
     from rich.console import Console
 
-    from robokin.demo import run_demo
+    from robokin.cli.demo import run_demo
 
     console = Console(file=io.StringIO(), width=120)
     result = run_demo(out=tmp_path, console=console, html_animation=False, sim=True)

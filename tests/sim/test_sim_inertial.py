@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 import robokin
-from robokin.io.robot_files import document_from_robot, load_robot, robot_from_document
+from robokin.io.robot_files import document_from_robot, load_parts, parts_from_document
 from robokin.model.dynamics import (
     LinkInertia,
     RobotDynamics,
@@ -55,7 +55,7 @@ def test_inertial_data_round_trips_through_robot_files(tmp_path):
     robot = robokin.load("ur5")
     changed = robot.replace(dynamics=_random_dynamics(robot, 3), name="ur5_copy")
     path = robokin.save(changed, tmp_path / "copy.yaml")
-    back = load_robot(path)
+    back = load_parts(path)
     for a, b in zip(changed.dynamics.links, back.dynamics.links):
         if a is None:
             assert b is None
@@ -75,7 +75,7 @@ def test_dynamics_section_declared_units_and_rpy():
     doc["dynamics"] = {"units": {"length": "mm", "mass": "g"}, "links": {
         "elbow": {"mass": 2000, "com": [-100, 0, 0], "inertia": [1e4, 2e4, 3e4, 0, 0, 0],
                   "rpy": [0, 0, 90]}}}
-    lk = robot_from_document(doc).dynamics.link("elbow")
+    lk = parts_from_document(doc).dynamics.link("elbow")
     assert lk.mass == 2.0
     np.testing.assert_allclose(lk.com, [-0.1, 0, 0])
     # 1e4 g mm^2 = 1e-5 kg m^2; the tensor's axes turned 90 deg about z
@@ -94,7 +94,7 @@ def test_dynamics_section_errors_name_the_field(bad, field):
     doc = yaml.safe_load(robokin.robots.path("scara").read_text())
     doc["dynamics"] = bad
     with pytest.raises(robokin.ModelError) as exc:
-        robot_from_document(doc, file="scara.yaml")
+        parts_from_document(doc, file="scara.yaml")
     assert exc.value.field == field
 
 

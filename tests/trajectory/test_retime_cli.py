@@ -141,8 +141,9 @@ def test_a_motion_files_limits_are_used_and_named(motion, tmp_path, capsys):
     differ; the command's minimum is the former. A kind the file leaves out comes
     from the robot file, an option beats both.
     """
-    from robokin.io.motion_files import load_motion_file, plan_from_document
+    from robokin.io.motion_files import load_motion_file
     from robokin.trajectory.cycle_time import cycle_time_report
+    from robokin.trajectory.motion_plan import plan_from_document
 
     robot, traj = plan_from_document(*load_motion_file(motion))
     want = cycle_time_report(robot, traj, v_max=math.radians(90),

@@ -17,6 +17,7 @@ from browser_shots import (
     require_chromium,
     run_chromium,
 )
+from robokin.collision.scene import Scene
 from robokin.exceptions import InputError
 from robokin.viz.html import animation_html, write_html
 
@@ -37,8 +38,7 @@ def _ur5_motion(m: int = 300) -> np.ndarray:
 
 
 def _scene():
-    scene_mod = pytest.importorskip("robokin.collision.scene")
-    scene = scene_mod.Scene("cell")
+    scene = Scene("cell")
     pose = np.eye(4)
     pose[:3, 3] = [0.5, 0.2, -0.1]
     scene.add_box("table", size=(0.6, 0.8, 0.05), pose=pose)

@@ -84,7 +84,7 @@ def test_comparison_and_robot_figures(path_traj, robot, tmp_path):
     T = robot.fk(np.radians([0, 10, 80, 0, 90, 0]))
     np.testing.assert_allclose([xs[-1], ys[-1], zs[-1]], T[:3, 3], atol=1e-12)
     assert (tmp_path / "arm.png").stat().st_size > 20_000
-    fig = robot.plot(np.zeros(6), frames=False)  # Robot.plot goes through here
+    fig = robokin.viz.plot_robot(robot, np.zeros(6), frames=False)
     assert len(fig.axes[0].get_lines()) == 1
 
 

@@ -38,6 +38,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin._text import short_repr
+from robokin.cell import plots as _plots
 from robokin.cell._evaluate import manipulability as _manipulability
 from robokin.cell._inputs import ik_method, placed_robot, progress_callback
 from robokin.cell._pose_set import PoseSet, rank_solutions
@@ -222,9 +223,7 @@ class Placement:
 
     def plot_floor(self, path: str | Path | None = None, **kwargs: Any) -> Figure:
         """The floor heatmap (see :func:`robokin.cell.plots.plot_floor`)."""
-        from robokin.cell.plots import plot_floor
-
-        return plot_floor(self, path=path, **kwargs)
+        return _plots.plot_floor(self, path=path, **kwargs)
 
 
 # ------------------------------------------------------------------ inputs

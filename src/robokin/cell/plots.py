@@ -5,25 +5,104 @@ a plane of voxels coloured by reachability index from blue (few orientations)
 to red (every orientation), unreachable voxels left blank. The floor map shows
 each candidate base position coloured by its placement score, infeasible ones
 in grey by reason. Lengths are drawn in millimetres.
+
+The figures read a map or a placement through the protocols below (what
+:class:`~robokin.cell.reach_map.ReachMap` and
+:class:`~robokin.cell.placement.Placement` hold), so this module imports neither:
+their ``plot_sections`` / ``plot_floor`` methods call in here, one way.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, Protocol
 
 import numpy as np
+import numpy.typing as npt
 
+from robokin._text import short_repr
+from robokin._validation import check_finite_number
+from robokin.cell.grid import VoxelGrid
 from robokin.exceptions import InputError
+from robokin.viz.plots import _figure as figure
+from robokin.viz.plots import save_figure
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from robokin.cell.placement import Placement
-    from robokin.cell.reach_map import ReachMap
+__all__ = ["FloorSource", "SectionSource", "plot_floor", "plot_sections"]
 
-__all__ = ["plot_floor", "plot_sections"]
+Axis = Literal["x", "y", "z"]
+_AXES: dict[object, Axis] = {"x": "x", "y": "y", "z": "z"}
+Quantity = Literal["index", "manipulability", "solutions"]
+
+
+class SectionSource(Protocol):
+    """What :func:`plot_sections` reads of a reachability map (a ``ReachMap``)."""
+
+    @property
+    def robot_name(self) -> str:
+        """The robot's name."""
+        ...
+
+    @property
+    def grid(self) -> VoxelGrid:
+        """The voxel grid."""
+        ...
+
+    @property
+    def orientations(self) -> np.ndarray:
+        """Tool orientations (K, 3, 3)."""
+        ...
+
+    @property
+    def index(self) -> Any:
+        """Reachability index per voxel (V,), a NumPy or Zarr array."""
+        ...
+
+    @property
+    def base(self) -> np.ndarray | None:
+        """The robot's base pose (4, 4) [m], or None."""
+        ...
+
+    def as_grid(self, values: npt.ArrayLike) -> np.ndarray:
+        """Per-voxel values arranged on the grid."""
+        ...
+
+    def section(self, axis: Axis, at: float, quantity: Quantity = "index"
+                ) -> tuple[np.ndarray, np.ndarray]:
+        """A plane of voxels normal to ``axis`` through ``at`` [m], and its extent."""
+        ...
+
+
+class FloorSource(Protocol):
+    """What :func:`plot_floor` reads of a placement search (a ``Placement``)."""
+
+    @property
+    def candidates(self) -> np.ndarray:
+        """Base poses (C, 4, 4) [m]."""
+        ...
+
+    @property
+    def feasible(self) -> np.ndarray:
+        """(C,) bool."""
+        ...
+
+    @property
+    def score(self) -> np.ndarray:
+        """(C,) placement scores."""
+        ...
+
+    @property
+    def reason(self) -> np.ndarray:
+        """(C,) why each candidate fails, or ``"ok"``."""
+        ...
+
+    @property
+    def best_index(self) -> int | None:
+        """Index of the best feasible candidate, or None."""
+        ...
 
 _LABELS = {
     "index": "reachability index",
@@ -33,49 +112,48 @@ _LABELS = {
 
 
 def _figure(size: tuple[float, float]) -> Figure:
-    from robokin.viz.plots import _figure as figure
-
     fig: Figure = figure(size)
     return fig
 
 
-def _densest_layer(m: ReachMap, k: int) -> float:
+def _densest_layer(m: SectionSource, k: int) -> float:
     """Coordinate [m] of the layer normal to axis k with the largest summed index."""
     cube = m.as_grid(np.asarray(m.index[...]))
     other = tuple(i for i in range(3) if i != k)
     return float(m.grid.axis(k)[int(np.argmax(cube.sum(axis=other)))])
 
 
-def _check_sections(sections: Sequence[tuple[str, float]]) -> list[tuple[str, float]]:
+def _check_sections(sections: Sequence[tuple[str, float]]) -> list[tuple[Axis, float]]:
     """The ``(axis, at [m])`` pairs, ``at`` a finite float, or :class:`InputError`."""
-    from robokin._text import short_repr
-    from robokin._validation import check_finite_number
-
-    out = []
+    out: list[tuple[Axis, float]] = []
     for pair in sections:
         try:
             axis, at = pair
         except (TypeError, ValueError):
             raise InputError("sections", f"expected (axis, at [m]) pairs, got "
                              f"{short_repr(pair)}") from None
-        out.append((axis, check_finite_number(at, "sections")))
+        name = _AXES.get(axis)
+        if name is None:
+            raise InputError("sections", f"axis must be 'x', 'y' or 'z', got "
+                             f"{short_repr(axis)}")
+        out.append((name, check_finite_number(at, "sections")))
     if not out:
         raise InputError("sections", "expected at least one (axis, at) pair")
     return out
 
 
 def plot_sections(
-    m: ReachMap,
+    m: SectionSource,
     *,
     path: str | Path | None = None,
-    quantity: Literal["index", "manipulability", "solutions"] = "index",
+    quantity: Quantity = "index",
     sections: Sequence[tuple[str, float]] | None = None,
     overwrite: bool = True,
 ) -> Figure:
     """Sections through a reachability map as heatmaps.
 
     Args:
-        m: The map.
+        m: The map (a :class:`~robokin.cell.reach_map.ReachMap`).
         path: Save the figure here (``.png``, ``.svg``, ``.pdf``), atomically.
         quantity: ``"index"``, ``"manipulability"`` or ``"solutions"``.
         sections: ``[(axis, at [m]), ...]`` planes normal to ``axis``; default
@@ -94,15 +172,15 @@ def plot_sections(
     if sections is None:
         y = float(m.base[1, 3]) if m.base is not None else _densest_layer(m, 1)
         sections = [("y", y), ("z", _densest_layer(m, 2))]
-    sections = _check_sections(sections)
-    fig = _figure((5.2 * len(sections) + 1.0, 5.0))
+    checked = _check_sections(sections)
+    fig = _figure((5.2 * len(checked) + 1.0, 5.0))
     label = _LABELS.get(quantity, quantity)
     vmax = 1.0 if quantity == "index" else None
     image = None
-    for i, (axis, at) in enumerate(sections):
-        values, ext = m.section(axis, at, quantity)  # type: ignore[arg-type]
+    for i, (axis, at) in enumerate(checked):
+        values, ext = m.section(axis, at, quantity)
         shown = np.ma.masked_less_equal(values.T.astype(float), 0.0)
-        ax = fig.add_subplot(1, len(sections), i + 1)
+        ax = fig.add_subplot(1, len(checked), i + 1)
         u, v = [c for c in "xyz" if c != axis]
         image = ax.imshow(
             shown,
@@ -125,8 +203,6 @@ def plot_sections(
         f"{m.orientations.shape[0]} orientations"
     )
     if path is not None:
-        from robokin.viz.plots import save_figure
-
         save_figure(fig, path, overwrite=overwrite)
     return fig
 
@@ -148,7 +224,7 @@ def _category(reason: str) -> str:
 
 
 def plot_floor(
-    pl: Placement,
+    pl: FloorSource,
     *,
     path: str | Path | None = None,
     scene: Any = None,
@@ -163,7 +239,7 @@ def plot_floor(
     hides no cell.
 
     Args:
-        pl: The placement search result.
+        pl: The placement search result (a :class:`~robokin.cell.placement.Placement`).
         path: Save the figure here (``.png``, ``.svg``, ``.pdf``), atomically.
         scene: Draw the footprints of this scene's boxes.
         mark: An extra base pose (4, 4) to mark with a ring (e.g. the cell's
@@ -227,8 +303,6 @@ def plot_floor(
     n_ok = int(pl.feasible.sum())
     ax.set_title(f"robot bases: {n_ok} of {len(pl.feasible)} feasible")
     if path is not None:
-        from robokin.viz.plots import save_figure
-
         save_figure(fig, path, overwrite=overwrite)
     return fig
 

@@ -37,6 +37,7 @@ import numpy.typing as npt
 
 from robokin._text import short_repr
 from robokin.cell import _store
+from robokin.cell import plots as _plots
 from robokin.cell._evaluate import ReachChunk, ReachJob, evaluate_reach
 from robokin.cell._inputs import Progress, ik_method, placed_robot, progress_callback
 from robokin.cell._scheduler import Throttle, check_scheduler, run_chunks
@@ -241,9 +242,7 @@ class ReachMap:
     # ------------------------------------------------------------- plots
     def plot_sections(self, path: str | Path | None = None, **kwargs: Any) -> Figure:
         """Sections through the map as heatmaps (see :func:`robokin.cell.plots.plot_sections`)."""
-        from robokin.cell.plots import plot_sections
-
-        return plot_sections(self, path=path, **kwargs)
+        return _plots.plot_sections(self, path=path, **kwargs)
 
     # ------------------------------------------------------------- files
     def save(self, path: str | Path, *, overwrite: bool = False) -> Path:

@@ -8,11 +8,18 @@ scene) and reused; :meth:`_Problem.run` does one trajectory (see the algorithm i
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robokin._native import kernels as _k
+from robokin.collision._shapes import (
+    collision_intervals,
+    rounded_box,
+    segment_of,
+    spins_about_last_joint,
+)
 from robokin.collision.report import (
     TIE,
     Closest,
@@ -22,9 +29,10 @@ from robokin.collision.report import (
     PairMinimum,
 )
 from robokin.exceptions import InputError
+from robokin.model.geometry import RobotGeometry
 
 if TYPE_CHECKING:
-    from robokin.collision.scene import Scene
+    from robokin.collision.scene import Scene, SceneObject
     from robokin.robot import Robot
 
 
@@ -39,19 +47,28 @@ class _Problem:
     """The compiled check: shapes, bounding spheres, pairs, coal functors."""
 
     def __init__(self, robot: Robot, scene: Scene, self_collision: bool) -> None:
-        from robokin.model.geometry import RobotGeometry
-
-        coal = _coal()
-        self.coal = coal
+        self.coal = _coal()
         placed = scene.attach(robot)
         self.robot = placed
         geo = placed.geometry
         if geo is None:  # pragma: no cover - Scene.attach always sets a geometry
             geo = RobotGeometry.empty(placed)
-        chain = placed.chain
-        self.chain = chain
-        nc = chain.n_chain
-        self.nc = nc
+        self.chain = placed.chain
+        self.nc = self.chain.n_chain
+        self._robot_shapes(geo, robot.name)
+        self._scene_objects(list(scene.objects))
+        self._pairs(geo, scene.excluded_pairs(placed), self_collision)
+        self._distance_functors()
+        self._closed_forms()
+        self.req = self.coal.DistanceRequest()
+        self.req.gjk_tolerance = 1e-9  # [m] (coal: 1e-6) distances exact to ~1e-9
+        self.res = self.coal.DistanceResult()
+        # Constants for the motion bounds.
+        self.reach = self._static_reach()
+
+    # ------------------------------------------------------------ the set-up
+    def _robot_shapes(self, geo: RobotGeometry, name: str) -> None:
+        """The robot's shapes, their links, bounding spheres and reach."""
         # Robot shapes, frame index = link index (0 base .. nc + 1 tool).
         shapes, link = [], []
         for k, ss in enumerate(geo.shapes):
@@ -63,7 +80,7 @@ class _Problem:
         if not shapes:
             raise InputError(
                 "robot",
-                f"{robot.name} has no collision geometry (no shapes on its links "
+                f"{name} has no collision geometry (no shapes on its links "
                 "or tool), so nothing can be checked: give it a geometry: section "
                 "or the scene a tool with shapes",
             )
@@ -91,10 +108,13 @@ class _Problem:
                 np.linalg.norm(self.sph_c, axis=1) + self.sph_r,
             )
         self.spins = np.array(
-            [self._spins(s, k, placed.chain) for s, k in zip(shapes, link)], dtype=bool
+            [spins_about_last_joint(s, k, self.chain) for s, k in zip(shapes, link)], dtype=bool
         )
+
+    def _scene_objects(self, objects: list[SceneObject]) -> None:
+        """The scene's objects: oriented boxes for the broad phase, coal transforms."""
+        coal = self.coal
         # Scene objects: oriented boxes for the broad phase, fixed coal transforms.
-        objects = list(scene.objects)
         self.objects = objects
         O = len(objects)
         self.ob_R = np.zeros((O, 3, 3))
@@ -112,9 +132,13 @@ class _Problem:
                     np.ascontiguousarray(pose[:3, :3]), np.ascontiguousarray(pose[:3, 3])
                 )
             )
+
+    def _pairs(self, geo: RobotGeometry, excluded: frozenset[frozenset[str]],
+               self_collision: bool) -> None:
+        """The shape pairs to check and the sphere combinations of the self pairs."""
+        link, objects, S = self.link, self.objects, len(self.shapes)
         # Pairs at shape level: (robot shape, object) then (robot shape, robot shape).
         names = geo.names
-        excluded = scene.excluded_pairs(placed)
         pa, pb, is_self = [], [], []
         for i in range(S):
             for j, ob in enumerate(objects):
@@ -159,6 +183,11 @@ class _Problem:
             c2.append(B_.ravel())
         self.self_c1 = np.concatenate(c1) if c1 else np.zeros(0, int)
         self.self_c2 = np.concatenate(c2) if c2 else np.zeros(0, int)
+
+    def _distance_functors(self) -> None:
+        """Exact geometry: coal distance functors (meshes: exact BVH and convex hull)."""
+        coal, shapes, objects = self.coal, self.shapes, self.objects
+        pa, pb, is_self, P = self.pa, self.pb, self.is_self, self.P
         # Exact geometry: distance functors (meshes: exact BVH and convex hull).
         self.has_mesh = np.zeros(P, dtype=bool)
         self.fn_exact: list[Any] = []
@@ -186,51 +215,31 @@ class _Problem:
                 functor(sa.coal_convex(), sb.coal_convex()) if mesh else None
             )
 
+    def _closed_forms(self) -> None:
+        """Capsule/sphere segments and rounded boxes of every shape and object."""
+        shapes, objects = self.shapes, self.objects
+        S, O = len(shapes), len(objects)
+        pa, pb, is_self, P = self.pa, self.pb, self.is_self, self.P
         # Capsule/sphere pairs have a closed-form distance: computed for all samples
         # at once (segment-segment distance minus the radii).
-        def segment(sh):
-            if sh.kind == "sphere":
-                c = sh.placement[:3, 3]
-                return np.stack([c, c]), sh.size[0]
-            if sh.kind == "capsule":
-                h = sh.size[1] / 2 * sh.placement[:3, 2]
-                c = sh.placement[:3, 3]
-                return np.stack([c - h, c + h]), sh.size[0]
-            return None, 0.0
-
         self.seg_local = np.zeros((S, 2, 3))
         self.seg_r = np.zeros(S)
         seg_ok = np.zeros(S, dtype=bool)
         for i, sh in enumerate(shapes):
-            seg, rad = segment(sh)
+            seg, rad = segment_of(sh)
             if seg is not None:
                 self.seg_local[i], self.seg_r[i], seg_ok[i] = seg, rad, True
-        ob_seg = [segment(ob.shape) for ob in objects]
+        ob_seg = [segment_of(ob.shape) for ob in objects]
         self.analytic = np.zeros(P, dtype=bool)
         for p in range(P):
-            if not seg_ok[pa[p]]:
-                continue
-            self.analytic[p] = (
-                seg_ok[pb[p]] if is_self[p] else ob_seg[pb[p]][0] is not None
-            )
-        self.ob_seg = np.array(
-            [sg if sg is not None else np.zeros((2, 3)) for sg, _ in ob_seg]
-        )
-        self.ob_seg = self.ob_seg.reshape(O, 2, 3)
+            if seg_ok[pa[p]]:
+                self.analytic[p] = (seg_ok[pb[p]] if is_self[p]
+                                    else ob_seg[pb[p]][0] is not None)
+        self.ob_seg = np.array([sg if sg is not None else np.zeros((2, 3))
+                                for sg, _ in ob_seg]).reshape(O, 2, 3)
         self.ob_seg_r = np.array([rad for _, rad in ob_seg]) if O else np.zeros(0)
 
         # Rounded bounding boxes (pose in the parent frame, half sizes, radius).
-        def rounded_box(sh):
-            k, sz = sh.kind, sh.size
-            T = np.array(sh.placement)
-            if k == "capsule":
-                return T, np.array([0.0, 0.0, sz[1] / 2]), sz[0]
-            if k == "sphere":
-                return T, np.zeros(3), sz[0]
-            c, h = sh.local_box()
-            T[:3, 3] = T[:3, :3] @ c + T[:3, 3]
-            return T, np.array(h, dtype=float), 0.0
-
         rbs = [rounded_box(sh) for sh in shapes]
         self.rb_local = np.array([x[0] for x in rbs]).reshape(S, 4, 4)
         self.rb_h = np.array([x[1] for x in rbs]).reshape(S, 3)
@@ -239,39 +248,8 @@ class _Problem:
         self.ob_rb_pose = np.array([x[0] for x in obs]).reshape(O, 4, 4)
         self.ob_rb_h = np.array([x[1] for x in obs]).reshape(O, 3)
         self.ob_rb_r = np.array([x[2] for x in obs]).reshape(O)
-        self.req = coal.DistanceRequest()
-        self.req.gjk_tolerance = 1e-9  # [m] (coal: 1e-6) distances exact to ~1e-9
-        self.res = coal.DistanceResult()
-        # Constants for the motion bounds.
-        self.reach = self._static_reach()
 
     # ------------------------------------------------------------ motion bounds
-    @staticmethod
-    def _spins(shape, k: int, chain) -> bool:
-        """True when the last joint moving link k turns ``shape`` onto itself.
-
-        A sphere centred on that revolute joint's axis, or a cylinder or capsule
-        along it, does not move when the joint turns.
-        """
-        nc = chain.n_chain
-        kk = min(k, nc)
-        if kk == 0 or chain.joints[kk - 1].kind != "revolute":
-            return False
-        if shape.kind not in ("sphere", "cylinder", "capsule"):
-            return False
-        T = chain.frame_offsets[kk - 1]
-        if k == nc + 1:
-            T = T @ chain.link_offsets[nc - 1] @ chain.tool
-        inv = np.linalg.inv(T)  # the joint's axis in the link frame
-        p0, axis = inv[:3, 3], inv[:3, 2]
-        c = shape.placement[:3, 3]
-        off = (c - p0) - np.dot(c - p0, axis) * axis
-        if np.linalg.norm(off) > 1e-9:
-            return False
-        if shape.kind == "sphere":
-            return True
-        return bool(np.linalg.norm(np.cross(shape.placement[:3, 2], axis)) < 1e-9)
-
     def _static_reach(self) -> np.ndarray:
         """(nc, S): bound on the distance from joint j's origin to shape s.
 
@@ -373,15 +351,18 @@ class _Problem:
         W = frame @ self.place[s]
         return self.coal.Transform3s(np.ascontiguousarray(W[:3, :3]), W[:3, 3].copy())
 
-    def exact(self, p: int, frames_i: np.ndarray, hull: bool = False) -> float:
-        """Exact (or convex-hull lower-bound) distance of pair p at one configuration."""
+    def _pair_transforms(self, p: int, frames_i: np.ndarray):
+        """The coal transforms of pair p's two shapes at one configuration."""
         a = self.pa[p]
         Ta = self._T3(frames_i[self.link[a]], a)
         if self.is_self[p]:
             b = self.pb[p]
-            Tb = self._T3(frames_i[self.link[b]], b)
-        else:
-            Tb = self.ob_T3[self.pb[p]]
+            return Ta, self._T3(frames_i[self.link[b]], b)
+        return Ta, self.ob_T3[self.pb[p]]
+
+    def exact(self, p: int, frames_i: np.ndarray, hull: bool = False) -> float:
+        """Exact (or convex-hull lower-bound) distance of pair p at one configuration."""
+        Ta, Tb = self._pair_transforms(p, frames_i)
         fn = self.fn_hull[p] if hull else self.fn_exact[p]
         res = self.res
         res.clear()  # coal keeps the minimum over calls otherwise
@@ -391,13 +372,7 @@ class _Problem:
         self, p: int, frames_i: np.ndarray
     ) -> tuple[float, np.ndarray, np.ndarray]:
         """Distance and nearest points (world) of pair p at one configuration."""
-        a = self.pa[p]
-        Ta = self._T3(frames_i[self.link[a]], a)
-        if self.is_self[p]:
-            b = self.pb[p]
-            Tb = self._T3(frames_i[self.link[b]], b)
-        else:
-            Tb = self.ob_T3[self.pb[p]]
+        Ta, Tb = self._pair_transforms(p, frames_i)
         res = self.coal.DistanceResult()
         ga, gb = self.geoms[p]
         d = self.coal.distance(ga, Ta, gb, Tb, self.req, res)
@@ -421,19 +396,8 @@ class _Problem:
         P = self.P
         frames = self.frames(q)
         if P == 0:
-            return CollisionReport(
-                math.inf,
-                False,
-                [],
-                [],
-                [],
-                None,
-                [],
-                clearance,
-                times,
-                _problem=self,
-                _q=q,
-            )
+            return CollisionReport(math.inf, False, [], [], [], None, [], clearance, times,
+                                   _problem=self, _q=q)
         LB = self.lower_bounds(frames)
         Ms = self.motion(q, frames)  # (P, m-1)
         C = np.zeros((P, m))
@@ -494,13 +458,27 @@ class _Problem:
                     LB, done | hulled, C, np.ascontiguousarray(rows, dtype=np.int64)
                 )
 
-        # 1. Exact queries where they decide something: a sample whose bound does
-        #    not clear the threshold (to classify it), or lies below its pair's best
-        #    so far (to find the pair's minimum). Each round queries a strided
-        #    subset plus each pair's lowest bound, then spreads the new values to
-        #    the neighbours through the motion bounds; the stride halves per round.
-        #    Pair minima are settled to ``pair_tolerance``; a last pass settles
-        #    the global minimum exactly.
+        # 1. Exact queries where they decide something (see _settle).
+        self._settle(D, LB, done, evaluate, propagate, clearance, pair_tol, pair_rtol)
+        # 2. Subdivision: intervals whose ends do not clear the motion between.
+        self.subdivisions = 0
+        between = (self._subdivide(q, D, LB, Ms, done, evaluate, clearance, tol)
+                   if subdivide and m >= 2 else {})
+        return self._report(q, times, frames, D, between, clearance)
+
+    def _settle(self, D: np.ndarray, LB: np.ndarray, done: np.ndarray,
+                evaluate: Callable[..., None], propagate: Callable[[np.ndarray], None],
+                clearance: float, pair_tol: float, pair_rtol: float) -> None:
+        """Exact queries where they decide something, filling ``D`` and ``done``.
+
+        A sample whose bound does not clear the threshold is queried (to classify
+        it), or one whose bound lies below its pair's best so far (to find the
+        pair's minimum). Each round queries a strided subset plus each pair's
+        lowest bound, then spreads the new values to the neighbours through the
+        motion bounds; the stride halves per round. Pair minima are settled to
+        ``pair_tol``; a last pass settles the global minimum exactly.
+        """
+        P, m = D.shape
         cols = np.arange(m)
         stride = 0  # first round: only each pair's lowest bound
         final = False
@@ -539,34 +517,32 @@ class _Problem:
             propagate(rows)
             best[rows] = np.where(done[rows], D[rows], np.inf).min(axis=1)
             stride = max(m // 32, 1) if stride == 0 else max(stride // 4, 1)
-        # 2. Subdivision: intervals whose ends do not clear the motion between.
+
+    def _subdivide(self, q: np.ndarray, D: np.ndarray, LB: np.ndarray, Ms: np.ndarray,
+                   done: np.ndarray, evaluate: Callable[..., None], clearance: float,
+                   tol: float) -> dict[tuple[int, int], tuple[float, float]]:
+        """Hits between samples: (pair, interval) -> (fraction, distance).
+
+        The intervals whose end distances do not clear the motion bound between
+        them get exact ends, then a bisection (:meth:`_bisect`).
+        """
         between: dict[tuple[int, int], tuple[float, float]] = {}
-        self.subdivisions = 0
-        if subdivide and m >= 2:
-            bad = (LB[:, :-1] + LB[:, 1:] <= Ms + 2 * clearance) & (Ms > tol)
-            viol = (D[:, :-1] <= clearance) | (D[:, 1:] <= clearance)
-            bad &= ~viol
-            if bad.any():
-                ps, idx = np.nonzero(bad)
-                for off in (0, 1):
-                    sel = ~done[ps, idx + off]
-                    evaluate(ps[sel], idx[sel] + off, force_exact=True)
-                still = D[ps, idx] + D[ps, idx + 1] <= Ms[ps, idx] + 2 * clearance
-                still &= (D[ps, idx] > clearance) & (D[ps, idx + 1] > clearance)
-                for p, i in zip(ps[still].tolist(), idx[still].tolist()):
-                    found = self._bisect(
-                        p,
-                        q[i],
-                        q[i + 1],
-                        D[p, i],
-                        D[p, i + 1],
-                        Ms[p, i],
-                        clearance,
-                        tol,
-                    )
-                    if found is not None:
-                        between[(p, i)] = found
-        return self._report(q, times, frames, D, between, clearance)
+        bad = (LB[:, :-1] + LB[:, 1:] <= Ms + 2 * clearance) & (Ms > tol)
+        bad &= ~((D[:, :-1] <= clearance) | (D[:, 1:] <= clearance))
+        if not bad.any():
+            return between
+        ps, idx = np.nonzero(bad)
+        for off in (0, 1):
+            sel = ~done[ps, idx + off]
+            evaluate(ps[sel], idx[sel] + off, force_exact=True)
+        still = D[ps, idx] + D[ps, idx + 1] <= Ms[ps, idx] + 2 * clearance
+        still &= (D[ps, idx] > clearance) & (D[ps, idx + 1] > clearance)
+        for p, i in zip(ps[still].tolist(), idx[still].tolist()):
+            found = self._bisect(p, q[i], q[i + 1], D[p, i], D[p, i + 1], Ms[p, i],
+                                 clearance, tol)
+            if found is not None:
+                between[(p, i)] = found
+        return between
 
     def _bisect(self, p, q0, q1, d0, d1, M, thr, tol):
         """Search an interval for a configuration at or below ``thr``; (fraction, d) or None."""
@@ -643,35 +619,15 @@ class _Problem:
                     if dv <= thr:
                         bmask[i0] = True
                         bfrac[i0] = (frac, dv)
-                out.extend(_runs(mask, bmask, bfrac, per_sample, ba, bb, t_at))
+                out.extend(collision_intervals(mask, bmask, bfrac, per_sample, ba, bb, t_at))
         pairs.sort(key=lambda r: r.distance)
-        closest = None
-        min_distance = math.inf
-        if best_overall is not None:
-            dmin, p, i, frac, btw_flag = best_overall
-            fr = (
-                frames[i]
-                if not btw_flag
-                else self.frames(q[i] + frac * (q[i + 1] - q[i]))
-            )
-            d, pa_, pb_ = self.nearest(p, fr)
-            min_distance = float(dmin)
-            closest = Closest(
-                float(dmin),
-                int(i),
-                t_at(i, frac),
-                self.body_a[p],
-                self.body_b[p],
-                pa_,
-                pb_,
-                btw_flag,
-            )
+        closest = (None if best_overall is None
+                   else self._closest(q, frames, best_overall, t_at))
+        min_distance = math.inf if closest is None else closest.distance
         intervals.sort(key=lambda r: (r.first_index, r.body_a, r.body_b))
         violations.sort(key=lambda r: (r.first_index, r.body_a, r.body_b))
-        collisions = [
-            Collision(r.first_index, r.last_index, r.body_a, r.body_b)
-            for r in intervals
-        ]
+        collisions = [Collision(r.first_index, r.last_index, r.body_a, r.body_b)
+                      for r in intervals]
         return CollisionReport(
             min_distance=min_distance,
             collides=bool(intervals),
@@ -687,6 +643,16 @@ class _Problem:
             _problem=self,
             _q=q,
         )
+
+    def _closest(self, q: np.ndarray, frames: np.ndarray,
+                 best: tuple[float, int, int, float, bool],
+                 t_at: Callable[..., float]) -> Closest:
+        """The nearest points at ``best``, the minimum (d, pair, sample, fraction, between)."""
+        dmin, p, i, frac, between = best
+        fr = self.frames(q[i] + frac * (q[i + 1] - q[i])) if between else frames[i]
+        _, point_a, point_b = self.nearest(p, fr)
+        return Closest(float(dmin), int(i), t_at(i, frac), self.body_a[p], self.body_b[p],
+                       point_a, point_b, between)
 
     def closest_at(
         self, q: np.ndarray, idx: np.ndarray
@@ -731,30 +697,3 @@ class _Problem:
             for p in plist:
                 out[i] = min(out[i], self.exact(p, frames[i]))
         return out
-
-
-def _runs(mask, bmask, bfrac, per_sample, ba, bb, t_at) -> list[Interval]:
-    """Group colliding samples and between-sample hits into intervals.
-
-    Positions 2i are samples, 2i + 1 the motion from sample i to i + 1.
-    """
-    m = len(mask)
-    seq = np.zeros(2 * m - 1, dtype=bool)
-    seq[0::2] = mask
-    if m > 1:
-        seq[1::2] = bmask | (mask[:-1] & mask[1:])
-    out: list[Interval] = []
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], seq.astype(np.int8), [0]])))
-    for s, e in zip(edges[0::2], edges[1::2] - 1):
-        s, e = int(s), int(e)
-        dvals = [float(per_sample[k // 2]) for k in range(s, e + 1) if k % 2 == 0]
-        dvals += [
-            bfrac[k // 2][1] for k in range(s, e + 1) if k % 2 and (k // 2) in bfrac
-        ]
-        t0 = t_at(s // 2) if s % 2 == 0 else t_at(s // 2, bfrac[s // 2][0])
-        t1 = t_at(e // 2) if e % 2 == 0 else t_at(e // 2, bfrac[e // 2][0])
-        only_between = s == e and s % 2 == 1
-        out.append(
-            Interval(s // 2, (e + 1) // 2, ba, bb, t0, t1, min(dvals), only_between)
-        )
-    return out

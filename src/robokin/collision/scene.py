@@ -36,7 +36,6 @@ from a URDF (:meth:`Scene.excluded_pairs`).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -45,10 +44,10 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-from robokin._text import control_character, short_repr
+from robokin._text import short_repr
 from robokin._validation import check_transform
+from robokin.collision._scene_document import SceneDocument, _text
 from robokin.exceptions import InputError, ModelError
-from robokin.io.geometry_sections import number_field, shape_from_spec
 from robokin.io.moveit_scene import AllowedCollisions, MoveItScene
 from robokin.model import geometry as _geo
 from robokin.model.geometry import Shape
@@ -58,54 +57,9 @@ if TYPE_CHECKING:
 
 __all__ = ["Scene", "SceneObject", "Tool"]
 
-_LENGTH = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
-_ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 _PLACED = "_robokin_scene_placement"  # meta key: (scene, chain, geometry, unplaced robot)
 
 
-def _text(value: Any, file: Any, field: str) -> str:
-    """A name from a scene file: text of at most 200 characters."""
-    if not isinstance(value, str) or len(value) > 200:
-        raise ModelError(f"expected a name (text, at most 200 characters), got "
-                         f"{short_repr(value)}", file=file, field=field)
-    problem = control_character(value)
-    if problem is not None:
-        raise ModelError(f"{problem} ({short_repr(value)})", file=file, field=field)
-    return value
-
-
-def _check_pair(scene: Scene, pair: Sequence[str], file: Any, field: str) -> None:
-    """An exclusion is [robot link, object]: the object must be one of the scene's.
-
-    The link is checked when the scene meets a robot (:meth:`Scene.attach`).
-    """
-    link, obj = pair
-    objects = scene.names
-    if obj not in objects and link in objects:
-        link, obj = obj, link  # [object, link]: the order does not matter
-    if obj not in objects:
-        raise ModelError(f"no object {short_repr(obj)} in this scene; a pair is "
-                         f"[robot link, object], the objects are {list(objects)}",
-                         file=file, field=field)
-    if link in objects:
-        raise ModelError(f"{short_repr(link)} and {short_repr(obj)} are both objects; "
-                         "objects are never checked against each other, a pair is "
-                         "[robot link, object]", file=file, field=field)
-
-
-def _robot_file(name: str, file: Any) -> str:
-    """A scene's robot: a robot file next to the scene file (as a path), or ``name``.
-
-    A relative ``.yaml`` / ``.yml`` name is read relative to the scene file, as a
-    motion file's ``robot:`` is; anything else (a built-in name, an absolute path)
-    is kept as written.
-    """
-    candidate = Path(name)
-    if (file is None or candidate.is_absolute()
-            or candidate.suffix.lower() not in (".yaml", ".yml")):
-        return name
-    beside = Path(file).parent / candidate
-    return str(beside) if beside.is_file() else name
 def _parts(robot: Robot) -> dict[str, tuple[str, ...]]:
     """The URDF links with shapes each robokin link holds (a robot from a URDF)."""
     info = robot.meta.get("urdf")
@@ -572,146 +526,19 @@ class Scene:
     @classmethod
     def from_document(cls, doc: Any, file: str | Path | None = None) -> Scene:
         """Build a scene from a parsed scene document (see the module docstring)."""
-        from robokin.io.scene_files import scene_section_keys
-        from robokin.io.validate import unknown_key
-        from robokin.spatial import pose_from_xyz_rpy
-
-        if not isinstance(doc, Mapping):
-            raise ModelError("a scene file must be a mapping of fields", file=file)
-        allowed = scene_section_keys()
-        for key in doc:
-            if key not in allowed:
-                raise ModelError(unknown_key(allowed), file=file, field=str(key))
-        units = doc.get("units") or {}
-        if not isinstance(units, Mapping):
-            raise ModelError(
-                "expected {length: m|mm, angle: rad|deg}", file=file, field="units"
-            )
-        lu, au = units.get("length", "m"), units.get("angle", "rad")
-        if not isinstance(lu, str) or lu not in _LENGTH:
-            raise ModelError(
-                f"expected one of {list(_LENGTH)}, got {short_repr(lu)}",
-                file=file,
-                field="units.length",
-            )
-        if not isinstance(au, str) or au not in _ANGLE:
-            raise ModelError(
-                f"expected one of {list(_ANGLE)}, got {short_repr(au)}",
-                file=file,
-                field="units.angle",
-            )
-        L, A = _LENGTH[lu], _ANGLE[au]
-        base_dir = Path(file).parent if file is not None else None
+        fields = SceneDocument(doc, file)
         scene = cls(_text(doc.get("name", Path(file).stem if file else "scene"),
                           file, "name"))
         scene.path = None if file is None else Path(file)
-
-        def placement(p: Any, where: str) -> np.ndarray:
-            if p is None:
-                return np.eye(4)
-            keys = scene_section_keys("placement")
-            if not isinstance(p, Mapping) or set(p) - set(keys):
-                raise ModelError(
-                    "expected {xyz: [x, y, z], rpy: [r, p, y]}; "
-                    + unknown_key(keys), file=file, field=where
-                )
-            xyz = number_field(p, "xyz", where, file, 3) if "xyz" in p else np.zeros(3)
-            rpy = number_field(p, "rpy", where, file, 3) if "rpy" in p else np.zeros(3)
-            return pose_from_xyz_rpy(xyz * L, rpy * A)
-
-        rob = doc.get("robot")
-        if rob is not None:
-            keys = scene_section_keys("robot")
-            if not isinstance(rob, Mapping) or set(rob) - set(keys):
-                raise ModelError("expected {name: ..., base: {xyz, rpy}}; "
-                                 + unknown_key(keys), file=file, field="robot")
-            scene.robot_name = (None if rob.get("name") is None
-                                else _robot_file(_text(rob["name"], file, "robot.name"),
-                                                 file))
-            scene.base = placement(rob.get("base"), "robot.base")
-        tool = doc.get("tool")
+        robot = fields.robot()
+        if robot is not None:
+            scene.robot_name, scene.base = robot
+        tool = fields.tool()
         if tool is not None:
-            keys = scene_section_keys("tool")
-            if not isinstance(tool, Mapping) or set(tool) - set(keys):
-                raise ModelError("expected {name, tcp: {xyz, rpy}, shapes: [...]}; "
-                                 + unknown_key(keys), file=file, field="tool")
-            shapes = tool.get("shapes") or []
-            if not isinstance(shapes, list):
-                raise ModelError(
-                    "expected a list of shapes", file=file, field="tool.shapes"
-                )
-            scene.set_tool(
-                [
-                    shape_from_spec(
-                        s,
-                        length=L,
-                        angle=A,
-                        base_dir=base_dir,
-                        file=file,
-                        where=f"tool.shapes[{i}]",
-                        owner="tool",
-                    )
-                    for i, s in enumerate(shapes)
-                ],
-                placement(tool.get("tcp"), "tool.tcp"),
-                name=_text(tool.get("name", "tool"), file, "tool.name"),
-            )
-        objects = doc.get("objects") or []
-        if not isinstance(objects, list):
-            raise ModelError("expected a list of objects", file=file, field="objects")
-        for i, spec in enumerate(objects):
-            where = f"objects[{i}]"
-            if not isinstance(spec, Mapping) or "name" not in spec:
-                raise ModelError("an object needs a 'name'", file=file, field=where)
-            name = _text(spec["name"], file, f"{where}.name")
-            if name in scene._objects:
-                raise ModelError(
-                    f"duplicate object name {short_repr(name)}", file=file, field=f"{where}.name"
-                )
-            shape = shape_from_spec(
-                {k: v for k, v in spec.items() if k != "name"},
-                length=L,
-                angle=A,
-                base_dir=base_dir,
-                file=file,
-                where=where,
-                owner=name,
-            )
-            if shape.kind == "mesh":
-                try:
-                    shape.check_file()
-                except ModelError as exc:
-                    raise ModelError(
-                        exc.reason, file=file, field=f"{where}.file"
-                    ) from None
+            shapes, tcp, name = tool
+            scene.set_tool(shapes, tcp, name=name)
+        for name, shape in fields.objects():
             scene.add(name, shape)
-        excl = doc.get("exclude") or []
-        if not isinstance(excl, list):
-            raise ModelError(
-                "expected a list of [link, object] pairs", file=file, field="exclude"
-            )
-        for i, p in enumerate(excl):
-            if not (isinstance(p, list | tuple) and len(p) == 2):
-                raise ModelError(
-                    "expected a pair [link, object]", file=file, field=f"exclude[{i}]"
-                )
-            pair = [_text(x, file, f"exclude[{i}]") for x in p]
-            _check_pair(scene, pair, file, f"exclude[{i}]")
-            scene.exclude.add(frozenset(pair))
-        poses = doc.get("poses") or {}
-        if not isinstance(poses, Mapping):
-            raise ModelError("expected {name: {xyz, rpy, q}}", file=file, field="poses")
-        for pname, spec in poses.items():
-            pname = _text(pname, file, "poses")
-            where = f"poses.{pname}"
-            if not isinstance(spec, Mapping):
-                raise ModelError("expected {xyz, rpy, q}", file=file, field=where)
-            scene.poses[pname] = placement(
-                {k: v for k, v in spec.items() if k != "q"}, where
-            )
-            if "q" in spec:
-                q = spec["q"]
-                count = len(q) if isinstance(q, list) and q else 1
-                scene.pose_joints[pname] = number_field(spec, "q", where, file,
-                                                        count) * A
+        scene.exclude.update(fields.exclusions(scene.names))
+        scene.poses, scene.pose_joints = fields.poses()
         return scene

@@ -48,7 +48,7 @@ from robokin.model.coupling import (
 )
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.model.parts import RobotParts
 
 __all__ = [
     "actuators_from_section",
@@ -267,7 +267,7 @@ def actuators_from_section(
     return amap, names, limits, tuple(kinds)
 
 
-def apply_actuators_section(robot: Robot, value: Any, file: Any, units: Any) -> Robot:
+def apply_actuators_section(robot: RobotParts, value: Any, file: Any, units: Any) -> RobotParts:
     """The section reader: a copy of ``robot`` with its actuators (file units)."""
     chain = robot.chain
     amap, names, limits, kinds = actuators_from_section(
@@ -276,7 +276,7 @@ def apply_actuators_section(robot: Robot, value: Any, file: Any, units: Any) -> 
                          meta={**robot.meta, "actuator_kinds": kinds})
 
 
-def section_from_robot(robot: Robot) -> dict[str, Any] | None:
+def section_from_robot(robot: RobotParts) -> dict[str, Any] | None:
     """The ``actuators:`` section (matrix form, SI units) of a robot, or None.
 
     For writing robots built in memory; files loaded from disk keep their own

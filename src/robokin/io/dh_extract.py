@@ -40,10 +40,14 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from robokin._validation import check_transform
 from robokin.exceptions import InputError, ModelError
+from robokin.model.chain import Chain
+from robokin.model.dh import chain_from_dh
+from robokin.spatial import invert, rpy_from_matrix
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.model.parts import RobotParts
 
 __all__ = ["DHExtraction", "dh_from_robot", "dh_rows_for_transform"]
 
@@ -62,13 +66,6 @@ def _frame(x: np.ndarray, z: np.ndarray, o: np.ndarray) -> np.ndarray:
     T[:3, 2] = z
     T[:3, 3] = o
     return T
-
-
-def _inv(T: np.ndarray) -> np.ndarray:
-    out = np.eye(4)
-    out[:3, :3] = T[:3, :3].T
-    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
-    return out
 
 
 def _std(theta: float, d: float, a: float, alpha: float) -> np.ndarray:
@@ -141,7 +138,7 @@ def dh_rows_for_transform(
     T = np.asarray(T, dtype=np.float64)
     if convention == "modified":
         # inv(Rz Tz Tx Rx) = Rx(-alpha) Tx(-a) Rz(-theta) Tz(-d)
-        rows = dh_rows_for_transform(_inv(T), "standard")
+        rows = dh_rows_for_transform(invert(T), "standard")
         return [(_clean(-t), _clean(-d), _clean(-a), _clean(-al))
                 for t, d, a, al in reversed(rows)]
     if np.allclose(T, np.eye(4), atol=1e-15, rtol=0):
@@ -151,7 +148,7 @@ def dh_rows_for_transform(
         return [p]
     mid, _ = _next_frame(np.eye(4), T[:3, 3], T[:3, 2])
     p1, r1 = _std_params(mid)
-    p2, r2 = _std_params(_inv(mid) @ T)
+    p2, r2 = _std_params(invert(mid) @ T)
     if max(r1, r2) > 1e-9:  # pragma: no cover - by construction
         raise ModelError(f"internal: virtual-frame fit residual {max(r1, r2):.3g}")
     return [p1, p2]
@@ -163,7 +160,7 @@ class DHExtraction:
 
     Attributes:
         convention: ``"standard"`` or ``"modified"``.
-        rows: DH rows as :meth:`Robot.from_dh` takes them (SI units).
+        rows: DH rows as :meth:`robokin.Robot.from_dh` takes them (SI units).
         base: The remaining base transform (4, 4) in the robot's world frame.
         tool: The remaining tool transform (4, 4).
         coordinates: Explicit coordinates for rows with ``depends``, or None.
@@ -182,17 +179,16 @@ class DHExtraction:
     needs_virtual_frames: bool = False
     notes: tuple[str, ...] = field(default_factory=tuple)
 
-    def robot(self, name: str = "robot") -> Robot:
-        """The robot this table describes (same FK as the source robot)."""
-        from robokin.robot import Robot
+    def chain(self) -> Chain:
+        """The chain this table describes (same FK as the source robot's).
 
-        return Robot.from_dh(
-            self.rows, self.convention, base=self.base, tool=self.tool, name=name,
-            coordinates=self.coordinates,
-        )
+        ``robokin.Robot(extraction.chain(), name=...)`` is a robot of it.
+        """
+        return chain_from_dh(self.rows, self.convention, base=self.base,
+                             tool=self.tool, coordinates=self.coordinates)
 
 
-def _identity_rows(chain) -> dict[int, int]:
+def _identity_rows(chain: Chain) -> dict[int, int]:
     """Chain joint index -> coordinate index for joints that are their coordinate."""
     M, c = chain.coupling.matrix, chain.coupling.offset
     names = [x.name for x in chain.coordinates]
@@ -208,7 +204,7 @@ def _identity_rows(chain) -> dict[int, int]:
 
 
 def dh_from_robot(
-    robot: Robot,
+    robot: RobotParts,
     convention: Literal["standard", "modified"] = "standard",
     *,
     reference: npt.ArrayLike | None = None,
@@ -217,7 +213,7 @@ def dh_from_robot(
     """Derive a DH table from a robot's joint axes (see the module docstring).
 
     Args:
-        robot: Any robot.
+        robot: Any robot (or robot parts).
         convention: ``"standard"`` or ``"modified"``.
         reference: A frame (4, 4) in the robot's world frame whose origin and x
             axis guide DH frame 0 (default: ``robot.base``).
@@ -225,14 +221,12 @@ def dh_from_robot(
             rows named ``base_frame*`` / ``tool_frame*``.
 
     Returns:
-        A :class:`DHExtraction`; ``extraction.robot()`` has the same FK as
+        A :class:`DHExtraction`; ``extraction.chain()`` has the same FK as
         ``robot`` (checked here at random configurations).
 
     Raises:
         InputError: an unknown convention or a bad reference frame.
     """
-    from robokin._validation import check_transform
-
     if convention not in ("standard", "modified"):
         raise InputError(
             "convention", f"expected 'standard' or 'modified', got {convention!r}"
@@ -240,19 +234,10 @@ def dh_from_robot(
     chain = robot.chain
     ref = chain.base if reference is None else check_transform(reference, "reference")
     # Axes at zero chain values (each joint at its zero offset).
-    T = chain.base @ chain.head
-    points, axes = [], []
-    for k, j in enumerate(chain.joints):
-        points.append(T[:3, 3].copy())
-        axes.append(j.sign * T[:3, 2])
-        Jz = np.eye(4)
-        if j.kind == "revolute":
-            c, s = math.cos(j.offset), math.sin(j.offset)
-            Jz[:2, :2] = [[c, -s], [s, c]]
-        else:
-            Jz[2, 3] = j.offset
-        T = T @ Jz @ chain.frame_offsets[k] @ chain.link_offsets[k]
-    tip = T @ chain.tool
+    at_zero = chain.frames_at(np.zeros(chain.n_chain))
+    points = [F[:3, 3] for F in at_zero[:-1]]
+    axes = [j.sign * F[:3, 2] for j, F in zip(chain.joints, at_zero)]
+    tip = at_zero[-1]
     n = len(axes)
     notes: list[str] = []
     # Frame 0.
@@ -284,12 +269,12 @@ def dh_from_robot(
     # Standard rows from successive frames.
     std = []
     for i in range(1, n + 1):
-        p, res = _std_params(_inv(frames[i - 1]) @ frames[i])
+        p, res = _std_params(invert(frames[i - 1]) @ frames[i])
         if res > 1e-9:  # pragma: no cover - by construction
             raise ModelError(f"internal: DH fit residual {res:.3g} at row {i}")
         std.append(p)
     base_rem = frames[0]
-    tool_rem = _inv(frames[-1]) @ tip
+    tool_rem = invert(frames[-1]) @ tip
     # Rows with names, kinds, limits and dependencies.
     ident = _identity_rows(chain)
     M, cvec = chain.coupling.matrix, chain.coupling.offset
@@ -353,22 +338,23 @@ def dh_from_robot(
     return out
 
 
-def _verify(robot: Robot, ext: DHExtraction) -> None:
-    """Guard: the table must reproduce the robot's FK."""
+def _verify(robot: RobotParts, ext: DHExtraction) -> None:
+    """Guard: the table must reproduce the robot's FK (the tool pose)."""
     rng = np.random.default_rng(0)
     lim = np.clip(robot.limits, -math.pi, math.pi)
-    q = rng.uniform(lim[:, 0], lim[:, 1], (8, robot.n))
-    err = np.abs(ext.robot().fk(q) - robot.fk(q)).max()
-    if not err < 1e-9:  # pragma: no cover - a bug, not a user error
-        raise ModelError(f"internal: derived DH table misses the FK by {err:.3g}")
+    ours, theirs = ext.chain(), robot.chain
+    for q in rng.uniform(lim[:, 0], lim[:, 1], (8, robot.n)):
+        err = np.abs(ours.frames_at(ours.coupling.apply(q))[-1]
+                     - theirs.frames_at(theirs.coupling.apply(q))[-1]).max()
+        if not err < 1e-9:  # pragma: no cover - a bug, not a user error
+            raise ModelError(f"internal: derived DH table misses the FK by {err:.3g}")
 
 
 def describe(ext: DHExtraction, *, deg: bool = True) -> dict[str, Any]:
     """A plain, JSON-ready summary (angles in degrees when ``deg``), a new dict."""
     A = 180.0 / math.pi if deg else 1.0
-    from robokin.spatial import rpy_from_matrix
 
-    def place(T):
+    def place(T: np.ndarray) -> dict[str, list[float]]:
         return {"xyz": [float(v) for v in T[:3, 3]],
                 "rpy": [float(v) * A for v in rpy_from_matrix(T)]}
 

@@ -35,7 +35,7 @@ from robokin.io.validate import validate_document
 from robokin.model.dynamics import LinkInertia, RobotDynamics
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.model.parts import RobotParts
 
 __all__ = ["apply_dynamics_section", "dynamics_section"]
 
@@ -76,7 +76,7 @@ def _schema() -> Any:
     return Section
 
 
-def apply_dynamics_section(robot: Robot, value: Any, file: Any, units: Any) -> Robot:
+def apply_dynamics_section(robot: RobotParts, value: Any, file: Any, units: Any) -> RobotParts:
     """The section reader: a copy of ``robot`` with its dynamics (file units).
 
     Args:
@@ -132,7 +132,7 @@ def apply_dynamics_section(robot: Robot, value: Any, file: Any, units: Any) -> R
     return robot.replace(dynamics=dyn)
 
 
-def dynamics_section(robot: Robot) -> dict[str, Any] | None:
+def dynamics_section(robot: RobotParts) -> dict[str, Any] | None:
     """The ``dynamics:`` section (SI units) of a robot, or None when it has none.
 
     For writing robots built in memory (e.g. imported from URDF); files loaded

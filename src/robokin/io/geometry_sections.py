@@ -37,7 +37,7 @@ from robokin.model.geometry import (
 )
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.model.parts import RobotParts
 
 __all__ = [
     "apply_collision_section",
@@ -320,7 +320,7 @@ def _link_index(geo: RobotGeometry, name: Any, file: Any, field: str) -> int:
                          f"{list(geo.names)}", file=file, field=field) from None
 
 
-def apply_geometry_section(robot: Robot, value: Any, file: Any, units: Any) -> Robot:
+def apply_geometry_section(robot: RobotParts, value: Any, file: Any, units: Any) -> RobotParts:
     """The ``geometry:`` section reader: a copy of ``robot`` with its link shapes.
 
     Args:
@@ -360,7 +360,7 @@ def apply_geometry_section(robot: Robot, value: Any, file: Any, units: Any) -> R
     return robot.replace(geometry=geo)
 
 
-def apply_collision_section(robot: Robot, value: Any, file: Any, units: Any) -> Robot:
+def apply_collision_section(robot: RobotParts, value: Any, file: Any, units: Any) -> RobotParts:
     """The ``collision:`` section reader: link pairs excluded from self-collision.
 
     Args:
@@ -435,14 +435,14 @@ def geometry_model() -> Any:
     return dict.__class_getitem__((StrictStr, union_of(list_of(one), one)))
 
 
-def geometry_section(robot: Robot) -> dict[str, Any] | None:
+def geometry_section(robot: RobotParts) -> dict[str, Any] | None:
     """The ``geometry:`` section (SI units) of a robot, or None when it has none."""
     if not isinstance(robot.geometry, RobotGeometry):
         return None
     return sections_from_geometry(robot.geometry).get("geometry")
 
 
-def collision_section(robot: Robot) -> dict[str, Any] | None:
+def collision_section(robot: RobotParts) -> dict[str, Any] | None:
     """The ``collision:`` section of a robot, or None when it has nothing to say."""
     if not isinstance(robot.geometry, RobotGeometry):
         return None

@@ -1,4 +1,9 @@
-"""Motion files (YAML): a robot, its via points and segments -> a sampled trajectory.
+"""Motion files (YAML): a robot, its via points and segments, read and checked.
+
+This module reads and validates the file (:func:`load_motion_file`) and gives its
+limits in SI units (:func:`motion_limits`);
+:func:`robokin.trajectory.motion_plan.plan_from_document` builds the trajectory
+it describes.
 
 A motion file names a robot and its via points::
 
@@ -30,24 +35,23 @@ and at most :data:`MAX_SEGMENTS` segments.
 from __future__ import annotations
 
 import math
-from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from robokin.exceptions import InputError, ModelError
+from robokin.exceptions import ModelError
 from robokin.io.text_files import MAX_TEXT_BYTES
 from robokin.io.validate import validate_document
 from robokin.io.yaml_reader import read_yaml_document
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.model.parts import RobotParts
 
 __all__ = [
     "MAX_MOTION_SAMPLES",
     "MAX_SEGMENTS",
+    "check_budget",
     "load_motion_file",
     "motion_limits",
-    "plan_from_document",
 ]
 
 #: Default cap on the samples of a motion file's whole trajectory.
@@ -131,6 +135,9 @@ def load_motion_file(path: str | Path, *, max_bytes: int = MAX_TEXT_BYTES
     Raises:
         ModelError: missing, too large or binary file, bad YAML, or a bad field
             (file, line and field path named).
+
+    :func:`robokin.trajectory.motion_plan.plan_from_document` builds its
+    trajectory.
     """
     path = Path(path)
     ydoc = read_yaml_document(path, max_bytes=max_bytes)
@@ -146,7 +153,7 @@ def load_motion_file(path: str | Path, *, max_bytes: int = MAX_TEXT_BYTES
     return spec, path
 
 
-def _check_budget(spec: Any, file: Path, max_samples: int) -> None:
+def check_budget(spec: Any, file: Path, max_samples: int) -> None:
     """Refuse explicit durations that ask for more than ``max_samples`` samples.
 
     The field named is the unusual one: ``dt`` when it is below the default 5 ms
@@ -174,96 +181,7 @@ def _check_budget(spec: Any, file: Path, max_samples: int) -> None:
             "--max-samples or max_samples=)", file=file, field=field)
 
 
-def plan_from_document(
-    spec: Any, file: Path, progress: Any = None, *,
-    max_samples: int = MAX_MOTION_SAMPLES,
-) -> tuple[Any, Any]:
-    """Build the trajectory a validated motion file describes: ``(robot, traj)``.
-
-    Args:
-        spec: The validated document (:func:`load_motion_file`).
-        file: The motion file (robot files resolve relative to its folder).
-        progress: Optional ``progress(done, total)`` per segment.
-        max_samples: Most samples the trajectory may hold; checked before any
-            sampling.
-
-    Raises:
-        ModelError: a field that does not fit the robot, or a motion of more than
-            ``max_samples`` samples (file and field named).
-        PathError: a line that cannot be followed.
-        UnreachableError: a pose with no IK solution.
-    """
-    source = getattr(spec, "_source", None)
-    try:
-        return _plan(spec, file, progress, max_samples)
-    except ModelError as exc:
-        raise (exc if source is None else source.locate(exc)) from None
-
-
-def _plan(spec: Any, file: Path, progress: Any, max_samples: int) -> tuple[Any, Any]:
-    import numpy as np
-
-    from robokin.trajectory import PathBuilder
-
-    _check_budget(spec, file, max_samples)
-    # the builder's argument names -> the motion file's fields
-    top = {"v_max": "limits.velocity", "a_max": "limits.acceleration",
-           "tool_speed": "tool_speed", "tool_acceleration": "tool_acceleration",
-           "dt": "dt", "ik": "ik", "q_start": "start", "max_samples": "dt"}
-
-    @contextmanager
-    def fields(where: str | None):
-        """Re-raise a builder's InputError as a ModelError naming the file's field."""
-        try:
-            yield
-        except InputError as exc:
-            field = top.get(exc.argument) or (
-                f"{where}.{exc.argument}" if where else exc.argument)
-            raise ModelError(exc.reason, file=file, field=field) from None
-
-    robot = _robot(spec, file)
-    L = 1e-3 if spec.units.length == "mm" else 1.0
-    A = math.pi / 180.0 if spec.units.angle == "deg" else 1.0
-    jscale = np.where(robot.is_revolute, A, L)
-
-    def joints(values, field):
-        if len(values) != robot.n:
-            raise ModelError(f"{robot.name} has {robot.n} joints, got {len(values)} "
-                             "values", file=file, field=field)
-        return np.asarray(values, float) * jscale
-
-    v_max, a_max = motion_limits(spec, robot, file)
-    with fields(None):
-        pb = PathBuilder(robot, joints(spec.start, "start"), dt=spec.dt,
-                         v_max=v_max, a_max=a_max,
-                         tool_speed=None if spec.tool_speed is None else spec.tool_speed * L,
-                         tool_acceleration=None if spec.tool_acceleration is None
-                         else spec.tool_acceleration * L,
-                         smooth=spec.smooth, ik=spec.ik, max_samples=max_samples)
-
-    def pose(target, field):
-        return _target_pose(robot, pb.q_end, target, L, A, file, field)
-
-    total = len(spec.segments)
-    for i, st in enumerate(spec.segments):
-        field = f"segments[{i}]"
-        kinds = [k for k in ("joint", "pose", "line", "dwell") if getattr(st, k) is not None]
-        if len(kinds) != 1:
-            raise ModelError("needs exactly one of joint, pose, line, dwell", file=file,
-                             field=field)
-        common = {"label": st.label or f"{kinds[0]} {i + 1}"}
-        with fields(field):
-            _add_step(pb, st, joints, pose, field, L, common)
-        if progress is not None:
-            progress(i + 1, total + 1)
-    with fields("segments"):
-        traj = pb.build()
-    if progress is not None:
-        progress(total + 1, total + 1)
-    return robot, traj
-
-
-def motion_limits(spec: Any, robot: Robot, file: Path | None = None
+def motion_limits(spec: Any, robot: RobotParts, file: Path | None = None
                   ) -> tuple[Any, Any]:
     """A motion file's ``limits:`` in SI units, one value per joint.
 
@@ -298,53 +216,3 @@ def motion_limits(spec: Any, robot: Robot, file: Path | None = None
                              field=f"limits.{kind}")
         out.append(arr * scale)
     return out[0], out[1]
-
-
-def _robot(spec: Any, file: Path) -> Any:
-    """The motion file's robot: a robot file next to it, or a built-in name."""
-    import robokin
-
-    name = spec.robot
-    candidate = file.parent / name
-    try:
-        return robokin.load(candidate if candidate.suffix in (".yaml", ".yml")
-                            and candidate.exists() else name)
-    except ModelError as exc:
-        if exc.file is not None:
-            raise
-        raise ModelError(exc.reason, file=file, field="robot") from None
-
-
-def _target_pose(robot: Robot, q_end: Any, target: Any, L: float, A: float,
-                 file: Path, field: str) -> Any:
-    """The pose a ``pose:`` / ``line:`` target names (rpy kept when omitted)."""
-    import numpy as np
-
-    from robokin.spatial import matrix_from_rpy
-
-    T = robot.fk(q_end).copy()
-    if target.xyz is not None and target.dxyz is not None:
-        raise ModelError("give xyz or dxyz, not both", file=file, field=field)
-    if target.rpy is not None:
-        T[:3, :3] = matrix_from_rpy(np.asarray(target.rpy) * A)[:3, :3]
-    if target.xyz is not None:
-        T[:3, 3] = np.asarray(target.xyz) * L
-    elif target.dxyz is not None:
-        T[:3, 3] += np.asarray(target.dxyz) * L
-    return T
-
-
-def _add_step(pb: Any, st: Any, joints: Any, pose: Any, field: str, L: float,
-              common: dict[str, Any]) -> None:
-    """Add one validated motion-file step to the path builder."""
-    if st.joint is not None:
-        pb.joint(joints(st.joint, f"{field}.joint"), st.duration,
-                 profile=st.profile, stop=st.stop, **common)
-    elif st.pose is not None:
-        pb.pose(pose(st.pose, f"{field}.pose"), st.duration, profile=st.profile,
-                stop=st.stop, **common)
-    elif st.line is not None:
-        pb.line(pose(st.line, f"{field}.line"), st.duration, profile=st.profile,
-                speed_in=st.speed_in * L, speed_out=st.speed_out * L, **common)
-    else:
-        pb.dwell(st.dwell, **common)

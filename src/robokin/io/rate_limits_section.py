@@ -31,7 +31,7 @@ from robokin.io.validate import validate_document
 from robokin.model.rate_limits import RATE_KINDS, RateLimits
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.model.parts import RobotParts
 
 __all__ = ["apply_rate_limits_section", "rate_limits_from_section",
            "section_from_robot"]
@@ -117,14 +117,14 @@ def rate_limits_from_section(value: Any, is_revolute: np.ndarray, file: Any = No
                       source=spec.source)
 
 
-def apply_rate_limits_section(robot: Robot, value: Any, file: Any, units: Any
-                              ) -> Robot:
+def apply_rate_limits_section(robot: RobotParts, value: Any, file: Any, units: Any
+                              ) -> RobotParts:
     """The section reader: a copy of ``robot`` with its rate limits (file units)."""
     limits = rate_limits_from_section(value, robot.is_revolute, file, units)
     return robot.replace(rate_limits=limits)
 
 
-def section_from_robot(robot: Robot) -> dict[str, Any] | None:
+def section_from_robot(robot: RobotParts) -> dict[str, Any] | None:
     """The ``rate_limits:`` section (SI units) of a robot, or None.
 
     For writing robots built in memory; files loaded from disk keep their own

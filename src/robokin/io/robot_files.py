@@ -34,7 +34,7 @@ import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -51,9 +51,9 @@ from robokin.io.atomic import write_atomic
 from robokin.io.text_files import MAX_TEXT_BYTES
 from robokin.io.validate import list_of, union_of, validate_document
 from robokin.io.yaml_reader import read_yaml_document
-
-if TYPE_CHECKING:
-    from robokin.robot import Robot
+from robokin.model.dh import chain_from_dh, chain_from_elementary
+from robokin.model.parts import RobotParts
+from robokin.spatial import pose_from_xyz_rpy, rpy_from_matrix
 
 __all__ = [
     "MAX_JOINTS",
@@ -63,8 +63,8 @@ __all__ = [
     "SectionIO",
     "document_from_robot",
     "file_model",
-    "load_robot",
-    "robot_from_document",
+    "load_parts",
+    "parts_from_document",
     "save_robot",
 ]
 
@@ -86,11 +86,11 @@ class SectionIO:
     """How one optional robot-file section is read and written.
 
     Attributes:
-        read: ``read(robot, value, file, units) -> Robot``: a copy of the robot
-            with the section applied (``units`` the file's); raises ModelError
+        read: ``read(parts, value, file, units) -> RobotParts``: a copy of the
+            parts with the section applied (``units`` the file's); raises ModelError
             naming the field path.
-        write: ``write(robot) -> value or None``: the section (SI units) of a
-            robot built in memory, None when it has nothing to write.
+        write: ``write(parts) -> value or None``: the section (SI units) of
+            parts (a robot) built in memory, None when it has nothing to write.
         model: ``model() -> type``: the section's pydantic model (or type), for
             the robot file's JSON Schema (:func:`file_model`); None: any value.
     """
@@ -248,8 +248,6 @@ def file_model() -> Any:
 def _placement(p, L: float, A: float) -> np.ndarray | None:
     if p is None:
         return None
-    from robokin.spatial import pose_from_xyz_rpy
-
     return pose_from_xyz_rpy(np.array(p.xyz) * L, np.array(p.rpy) * A)
 
 
@@ -399,15 +397,14 @@ def _warn_units(doc: Mapping, lengths: list[tuple[str, float]],
         warnings.warn(f"{name} {said}; {'; '.join(hints)}", UserWarning, stacklevel=4)
 
 
-def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
-    """Build a Robot from a parsed robot-file document (a dict in file units).
+def parts_from_document(doc: Any, file: str | Path | None = None) -> RobotParts:
+    """The robot parts of a parsed robot-file document (a dict in file units).
+
+    :meth:`robokin.robot.Robot.from_parts` makes them a Robot.
 
     Raises:
         ModelError: naming ``file``, the field path and the reason.
     """
-    from robokin.model.dh import chain_from_dh, chain_from_elementary
-    from robokin.robot import Robot
-
     spec, rows = _validated(doc, file)
     L = _LENGTH[spec.units.length]
     A = _ANGLE[spec.units.angle]
@@ -442,24 +439,24 @@ def robot_from_document(doc: Any, file: str | Path | None = None) -> Robot:
     if spec.controller is not None:
         # Validated where it is used: robokin.trajectory.io.ControllerProfile.
         meta["controller"] = copy.deepcopy(spec.controller)
-    robot = Robot(chain, name=spec.name, source=spec.source, path=file, meta=meta)
+    parts = RobotParts(chain, name=spec.name, source=spec.source, path=file, meta=meta)
     for key, section in SECTIONS.items():
         value = getattr(spec, key)
         if value is not None:
-            robot = section.read(robot, value, file, spec.units)
+            parts = section.read(parts, value, file, spec.units)
     # The file's document describes exactly this state; a changed copy (with_tool,
     # replace(...)) no longer matches it and is written from its model instead.
-    return robot.replace(meta={**robot.meta, "document_state": _state(robot)})
+    return parts.replace(meta={**parts.meta, "document_state": _state(parts)})
 
 
-def _state(robot: Robot) -> tuple:
+def _state(robot: RobotParts) -> tuple[object, ...]:
     """What a stored document must still describe: the same objects, by identity."""
     return (robot.chain, robot.geometry, robot.actuators, robot.name, robot.source,
             robot.actuator_names, robot.actuator_limits, robot.dynamics,
             robot.rate_limits)
 
 
-def _document_matches(robot: Robot) -> bool:
+def _document_matches(robot: RobotParts) -> bool:
     state = robot.meta.get("document_state")
     if state is None:
         return False
@@ -467,9 +464,11 @@ def _document_matches(robot: Robot) -> bool:
     return all(a is b or (isinstance(a, str) and a == b) for a, b in zip(state, now))
 
 
-def load_robot(path: str | Path, *, max_bytes: int = MAX_TEXT_BYTES,
-               max_nodes: int | None = None) -> Robot:
-    """Load and validate a robot file.
+def load_parts(path: str | Path, *, max_bytes: int = MAX_TEXT_BYTES,
+               max_nodes: int | None = None) -> RobotParts:
+    """Load and validate a robot file: the robot's parts.
+
+    ``robokin.load(path)`` makes them a Robot.
 
     Args:
         path: The robot file (YAML).
@@ -485,13 +484,13 @@ def load_robot(path: str | Path, *, max_bytes: int = MAX_TEXT_BYTES,
     path = Path(path)
     ydoc = read_yaml_document(path, max_bytes=max_bytes, max_nodes=max_nodes)
     try:
-        return robot_from_document(ydoc.data, file=path)
+        return parts_from_document(ydoc.data, file=path)
     except ModelError as exc:
         raise ydoc.locate(exc) from None
 
 
-def document_from_robot(robot: Robot) -> dict[str, Any]:
-    """The robot-file document of a robot.
+def document_from_robot(robot: RobotParts) -> dict[str, Any]:
+    """The robot-file document of a robot (or of robot parts).
 
     Robots loaded from a file, and not changed since, return that file's document
     unchanged (units kept). Others (built in code, or changed with ``with_tool``,
@@ -505,10 +504,8 @@ def document_from_robot(robot: Robot) -> dict[str, Any]:
     return _elementary_document(robot)
 
 
-def _elementary_document(robot: Robot) -> dict[str, Any]:
+def _elementary_document(robot: RobotParts) -> dict[str, Any]:
     """Write any chain as elementary ops (translation xyz then rpy for each constant)."""
-    from robokin.spatial import rpy_from_matrix
-
     chain = robot.chain
 
     def const_ops(T: np.ndarray) -> list[dict[str, Any]]:
@@ -586,13 +583,13 @@ def _elementary_document(robot: Robot) -> dict[str, Any]:
     return doc
 
 
-def save_robot(robot: Robot, path: str | Path) -> Path:
+def save_robot(robot: RobotParts, path: str | Path) -> Path:
     """Write the robot file atomically (see :func:`robokin.io.atomic.write_atomic`).
 
     A failure never leaves a half-written file, and an existing file is replaced
     only once the new content is complete on disk.
 
-    The document is read back (in memory, as :func:`load_robot` would read the
+    The document is read back (in memory, as :func:`load_parts` would read the
     file) before anything is written: a robot whose file robokin would refuse
     to load (a length beyond :data:`~robokin._validation.MAX_TRANSLATION`, a
     name it cannot hold) is refused here, naming the field, and no file is
@@ -611,7 +608,7 @@ def save_robot(robot: Robot, path: str | Path) -> Path:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the loader's unit hints: not a refusal
-            robot_from_document(yaml.safe_load(text), file=path)
+            parts_from_document(yaml.safe_load(text), file=path)
     except ModelError as exc:
         raise ModelError(f"{exc.reason}; robokin would refuse this robot file, so it "
                          "is not written", file=path, field=exc.field) from None

@@ -1,8 +1,9 @@
 """URDF in (URDF out is :mod:`robokin.io.urdf_export`).
 
-* :func:`robot_from_urdf` reads a URDF (file or XML string, parsed with
-  ``yourdfpy``, the ``robokin[urdf]`` extra) and compiles the serial chain from a
-  base link to a tip link to the canonical chain.
+* :func:`parts_from_urdf` reads a URDF (file or XML string, parsed with
+  ``yourdfpy``, the ``robokin[urdf]`` extra), compiles the serial chain from a
+  base link to a tip link to the canonical chain and returns the robot's parts
+  (:meth:`robokin.robot.Robot.from_urdf` makes them a Robot).
 * :func:`dh_from_urdf` derives standard and modified DH tables from a URDF arm
   (see :mod:`robokin.io.dh_extract`).
 
@@ -42,14 +43,13 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from robokin._text import short_repr
-from robokin.exceptions import ModelError
+from robokin.exceptions import ModelError, user_stacklevel
 from robokin.io.ros_packages import PackageFinder
 from robokin.io.urdf_geometry import (
     Drops,
@@ -64,208 +64,30 @@ from robokin.io.urdf_tool import (
     link_owners,
     resolve_mimic,
 )
+from robokin.io.urdf_tree import Step, Tree, UrdfChain
 from robokin.io.urdf_xml import MAX_URDF_JOINTS, MOVABLE, parse_urdf
 from robokin.model.chain import Chain, ChainBuilder, Joint, JointKind
 from robokin.model.coupling import Dependency, coupling_from_dependencies, mimic
+from robokin.model.parts import RobotParts
+from robokin.spatial import invert
 
 if TYPE_CHECKING:
     from robokin.io.dh_extract import DHExtraction
     from robokin.io.xacro import XacroExpansion
-    from robokin.robot import Robot
 
 __all__ = [
     "MAX_URDF_JOINTS",
     "UrdfChain",
     "axis_frame",
-    "dh_from_robot",
     "dh_from_urdf",
     "parse_urdf",
+    "parts_from_urdf",
     "resolve_mesh",
-    "robot_from_urdf",
 ]
-
-
-
-
-@dataclass(frozen=True)
-class _Step:
-    """One URDF joint on the path, walked forwards or (fixed joints only) backwards."""
-
-    joint: Any
-    reverse: bool
-
-
-class _Tree:
-    """The link/joint tree of a parsed URDF with checks and path queries."""
-
-    def __init__(self, robot: Any, file: Path | None) -> None:
-        self.file = file
-        self.links: dict[str, Any] = {}
-        for link in robot.links:
-            if link.name in self.links:
-                raise ModelError(f"link '{link.name}' is defined twice", file=file)
-            self.links[link.name] = link
-        self.joints: dict[str, Any] = {}
-        self.parent_joint: dict[str, Any] = {}
-        self.children: dict[str, list[Any]] = {name: [] for name in self.links}
-        for j in robot.joints:
-            where = f"joint[{j.name}]"
-            if j.name in self.joints:
-                raise ModelError("joint defined twice", file=file, field=where)
-            for role in ("parent", "child"):
-                link = getattr(j, role)
-                if link not in self.links:
-                    raise ModelError(
-                        f"{role} link '{link}' is not defined", file=file,
-                        field=f"{where}.{role}",
-                    )
-            if j.child in self.parent_joint:
-                raise ModelError(
-                    f"link '{j.child}' has two parent joints "
-                    f"('{self.parent_joint[j.child].name}' and '{j.name}'): "
-                    "a URDF must be a tree",
-                    file=file, field=where,
-                )
-            self.joints[j.name] = j
-            self.parent_joint[j.child] = j
-            self.children[j.parent].append(j)
-        roots = [n for n in self.links if n not in self.parent_joint]
-        if not roots:
-            raise ModelError("the joints form a loop: no root link", file=file)
-        if len(roots) > 1:
-            raise ModelError(
-                f"several root links {roots}: a URDF must be one connected tree",
-                file=file,
-            )
-        self.root = roots[0]
-        # Every link must be reachable from the root (no loop elsewhere).
-        seen = set(self._descendants(self.root))
-        if len(seen) != len(self.links):
-            loop = sorted(set(self.links) - seen)
-            raise ModelError(f"links {loop} form a loop", file=file)
-
-    def _descendants(self, link: str) -> list[str]:
-        out, stack = [], [link]
-        while stack:
-            cur = stack.pop()
-            out.append(cur)
-            stack.extend(j.child for j in self.children[cur])
-        return out
-
-    def ancestors(self, link: str) -> list[str]:
-        """The link, its parent link, ..., the root."""
-        out = [link]
-        while out[-1] in self.parent_joint:
-            out.append(self.parent_joint[out[-1]].parent)
-        return out
-
-    def check_link(self, name: str, role: str) -> None:
-        if name not in self.links:
-            names = sorted(self.links)
-            shown = ", ".join(names[:30]) + (" ..." if len(names) > 30 else "")
-            raise ModelError(
-                f"unknown {role} link '{name}'; links: {shown}", file=self.file,
-                field=f"{role}_link",
-            )
-
-    def path(self, base: str, tip: str) -> list[_Step]:
-        """The joints from ``base`` to ``tip``."""
-        up = self.ancestors(base)
-        down = self.ancestors(tip)
-        down_set = set(down)
-        common = next(a for a in up if a in down_set)  # one tree: the root at least
-        steps = []
-        for link in up[: up.index(common)]:
-            j = self.parent_joint[link]
-            if j.type != "fixed":
-                raise ModelError(
-                    f"the base link '{base}' hangs below the movable joint '{j.name}' "
-                    f"that is not between it and the tip '{tip}'; choose a base link "
-                    f"above it (e.g. '{self.root}')",
-                    file=self.file, field="base_link",
-                )
-            steps.append(_Step(j, True))
-        for link in reversed(down[: down.index(common)]):
-            steps.append(_Step(self.parent_joint[link], False))
-        return steps
-
-    def default_tip(self, base: str) -> str:
-        """The leaf below ``base`` whose path has the most movable joints."""
-        top = base  # a base hanging by fixed joints (ROS-I 'base') looks from above
-        while top in self.parent_joint and self.parent_joint[top].type == "fixed":
-            top = self.parent_joint[top].parent
-        leaves = [n for n in self._descendants(top) if not self.children[n]]
-        counts = {
-            leaf: sum(s.joint.type in MOVABLE for s in self.path(base, leaf))
-            for leaf in leaves
-        }
-        best = max(counts.values())
-        if best == 0:
-            raise ModelError(
-                f"no movable joint below the base link '{base}'", file=self.file,
-                field="tip_link",
-            )
-        cands = sorted(leaf for leaf, c in counts.items() if c == best)
-        if len(cands) == 1:
-            return cands[0]
-        if "tool0" in cands:
-            return "tool0"
-        raise ModelError(
-            f"ambiguous tip link: {len(cands)} leaves {cands} are each {best} movable "
-            f"joints from '{base}'; pass tip_link= (CLI: --tip) to choose one",
-            file=self.file, field="tip_link",
-        )
 
 
 def _origin(j: Any) -> np.ndarray:
     return np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=np.float64)
-
-
-def _invert(T: np.ndarray) -> np.ndarray:
-    out = np.eye(4)
-    out[:3, :3] = T[:3, :3].T
-    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
-    return out
-
-
-@dataclass(frozen=True)
-class UrdfChain:
-    """What :func:`robot_from_urdf` made of the URDF, besides the chain.
-
-    Attributes:
-        base_link: The chosen base link.
-        tip_link: The chosen tip link.
-        child_links: The URDF child link of every chain joint (n_chain).
-        link_frames: Every URDF link rigidly attached to the chain:
-            ``name -> (k, T)``, the link's pose ``T`` (4, 4) in the frame ``k`` of
-            ``fk_all`` (0: the base link; k: chain joint k's child link); the
-            tool's tree (fingers at ``tool_joints``) in frame ``n_chain``.
-        dropped_links: Links not rigidly attached to the chain (they move with
-            joints off the chain, other than the tool's), sorted.
-        owners: The robokin link each placed URDF link belongs to: ``base``, a
-            chain joint's name, or ``tool`` (see :mod:`robokin.io.urdf_tool`).
-        tool_joints: The position [rad, m] each joint of the tool's tree is
-            frozen at (mimic joints included).
-        shaped_links: The URDF links whose shapes robokin's geometry holds.
-    """
-
-    base_link: str
-    tip_link: str
-    child_links: tuple[str, ...]
-    link_frames: Mapping[str, tuple[int, np.ndarray]]
-    dropped_links: tuple[str, ...]
-    owners: Mapping[str, str] = field(default_factory=dict)
-    tool_joints: Mapping[str, float] = field(default_factory=dict)
-    shaped_links: frozenset[str] = frozenset()
-
-    def parts(self) -> dict[str, tuple[str, ...]]:
-        """The URDF links with shapes each robokin link holds: ``{link: (URDF links)}``."""
-        out: dict[str, list[str]] = {}
-        for link in sorted(self.shaped_links):
-            owner = self.owners.get(link)
-            if owner is not None:
-                out.setdefault(owner, []).append(link)
-        return {k: tuple(v) for k, v in out.items()}
 
 
 def _limits(j: Any, file: Path | None) -> tuple[float, float]:
@@ -306,28 +128,14 @@ def _kind(j: Any) -> JointKind:
     return "prismatic" if j.type == "prismatic" else "revolute"
 
 
-def chain_from_urdf_model(
-    robot: Any,
-    *,
-    base_link: str | None = None,
-    tip_link: str | None = None,
-    file: Path | None = None,
-    tool_joints: Mapping[str, float] | None = None,
-) -> tuple[Chain, UrdfChain]:
-    """Compile the chain ``base_link`` -> ``tip_link`` of a parsed URDF model.
+def _path_steps(tree: Tree, base_link: str | None, tip_link: str | None,
+                file: Path | None) -> tuple[str, str, list[Step], int]:
+    """The base, the tip, the joints between them and the index of the last movable one.
 
-    Args:
-        robot: A ``yourdfpy.Robot`` (``yourdfpy.URDF(...).robot``).
-        base_link: Base link name (default: the root).
-        tip_link: Tip link name (default: see the module docstring).
-        file: The file, for error messages.
-        tool_joints: Positions of joints in the tool's tree (default: 0 clamped
-            into their limits); see :mod:`robokin.io.urdf_tool`.
-
-    Returns:
-        The canonical chain and the :class:`UrdfChain` bookkeeping.
+    Raises:
+        ModelError: an unknown link, base = tip, a floating or planar joint on the
+            path, or no movable joint (naming the file and field).
     """
-    tree = _Tree(robot, file)
     base = tree.root if base_link is None else str(base_link)
     tree.check_link(base, "base")
     if tip_link is None:
@@ -350,7 +158,45 @@ def chain_from_urdf_model(
         raise ModelError(
             f"no movable joint between '{base}' and '{tip}'", file=file, field="tip_link"
         )
-    last = movable[-1]
+    return base, tip, steps, movable[-1]
+
+
+def _add_hanging_links(tree: Tree, frames: dict[str, tuple[int, np.ndarray]]) -> None:
+    """Add to ``frames`` the links hanging off the path by fixed joints (they move with it)."""
+    stack = list(frames)
+    while stack:
+        link = stack.pop()
+        kk, T = frames[link]
+        for j in tree.children[link]:
+            if j.child in frames or j.type != "fixed":
+                continue
+            frames[j.child] = (kk, T @ _origin(j))
+            stack.append(j.child)
+
+
+def chain_from_urdf_model(
+    urdf_robot: Any,
+    *,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    file: Path | None = None,
+    tool_joints: Mapping[str, float] | None = None,
+) -> tuple[Chain, UrdfChain]:
+    """Compile the chain ``base_link`` -> ``tip_link`` of a parsed URDF model.
+
+    Args:
+        urdf_robot: A ``yourdfpy.Robot`` (``yourdfpy.URDF(...).robot``).
+        base_link: Base link name (default: the root).
+        tip_link: Tip link name (default: see the module docstring).
+        file: The file, for error messages.
+        tool_joints: Positions of joints in the tool's tree (default: 0 clamped
+            into their limits); see :mod:`robokin.io.urdf_tool`.
+
+    Returns:
+        The canonical chain and the :class:`UrdfChain` bookkeeping.
+    """
+    tree = Tree(urdf_robot, file)
+    base, tip, steps, last = _path_steps(tree, base_link, tip_link, file)
     builder = ChainBuilder()
     tool = np.eye(4)
     coords: list[Joint] = []
@@ -371,7 +217,7 @@ def chain_from_urdf_model(
     for i, s in enumerate(steps):
         j = s.joint
         if s.reverse:  # fixed, walked from child to parent
-            C = _invert(_origin(j))
+            C = invert(_origin(j))
             builder.constant(C)
             T_rel = T_rel @ C
             frames[j.parent] = (k, T_rel.copy())
@@ -409,23 +255,13 @@ def chain_from_urdf_model(
         coupling = coupling_from_dependencies(names, [c.name for c in coords], deps)
         coordinates = tuple(coords)
     chain = builder.build(tool=tool, coordinates=coordinates, coupling=coupling)
-    # Links hanging off the path by fixed joints move with it.
-    on_path = set(frames)
-    stack = list(on_path)
-    while stack:
-        link = stack.pop()
-        kk, T = frames[link]
-        for j in tree.children[link]:
-            if j.child in frames or j.type != "fixed":
-                continue
-            frames[j.child] = (kk, T @ _origin(j))
-            stack.append(j.child)
+    _add_hanging_links(tree, frames)
     # The tool's tree: subtrees below the last link's rigid body, joints frozen.
     positions, left_out = freeze_tool_tree(
         tree, frames, len(names), set(names) | coord_names, tool_joints, file)
     for msg in left_out:
         warnings.warn(f"{file or 'URDF'}: {msg} left out: they move with the arm",
-                      UserWarning, stacklevel=3)
+                      UserWarning, stacklevel=user_stacklevel())
     dropped = tuple(sorted(set(tree.links) - set(frames)))
     info = UrdfChain(
         base_link=base,
@@ -440,7 +276,7 @@ def chain_from_urdf_model(
 
 
 # ------------------------------------------------------------------------ public
-def robot_from_urdf(
+def parts_from_urdf(
     path_or_string: str | Path | bytes,
     base_link: str | None = None,
     tip_link: str | None = None,
@@ -452,8 +288,11 @@ def robot_from_urdf(
     name: str | None = None,
     srdf: str | Path | bytes | None = None,
     tool_joints: Mapping[str, float] | None = None,
-) -> Robot:
-    """Load the serial chain of a URDF or xacro as a robot (needs ``robokin[urdf]``).
+) -> RobotParts:
+    """The parts of the serial chain of a URDF or xacro (needs ``robokin[urdf]``).
+
+    :meth:`robokin.robot.Robot.from_urdf` takes the same arguments and returns
+    a Robot.
 
     Links hung by fixed joints anywhere on the chain move with their link, and
     the links below the tip (a gripper's tree, its fingers frozen at
@@ -493,7 +332,7 @@ def robot_from_urdf(
             tree (a gripper's fingers; default: 0 clamped into the limits).
 
     Returns:
-        A :class:`~robokin.robot.Robot` (its ``dynamics`` from the links'
+        :class:`~robokin.model.parts.RobotParts` (their ``dynamics`` from the links'
         ``<inertial>`` and the joints' ``effort``, see
         :mod:`robokin.io.urdf_inertial`) with ``robot.meta["urdf"]`` holding the
         :class:`UrdfChain`, ``robot.meta["urdf_shapes"]`` the shapes,
@@ -515,7 +354,6 @@ def robot_from_urdf(
         MissingExtraError: yourdfpy (or, for a xacro, xacro) is not installed.
     """
     from robokin.io.srdf import parse_srdf
-    from robokin.robot import Robot
 
     if missing_mesh not in ("warn", "error", "ignore"):
         raise ModelError(
@@ -547,7 +385,7 @@ def robot_from_urdf(
         meta["xacro"] = expansion
         if expansion.args:
             source += " (" + ", ".join(f"{k}:={v}" for k, v in expansion.args.items()) + ")"
-    robot = Robot(
+    robot = RobotParts(
         chain,
         name=name or urdf_robot.name,
         source=f"{source}, chain {info.base_link} -> {info.tip_link}",
@@ -559,7 +397,7 @@ def robot_from_urdf(
 
     robot = robot.replace(dynamics=dynamics_from_urdf(robot, urdf_robot,
                                                       info.link_frames, file))
-    drops.report(stacklevel=2)
+    drops.report()
     return robot.replace(meta={**robot.meta,
                                "urdf_dropped_shapes": tuple(drops.messages),
                                "urdf_dropped_notes": drops.notes()})
@@ -607,7 +445,7 @@ def dh_from_urdf(
     Args:
         path_or_string: URDF file, XML string or xacro file.
         base_link: Chain start (default: the root).
-        tip_link: Chain end (default as in :func:`robot_from_urdf`).
+        tip_link: Chain end (default as in :func:`parts_from_urdf`).
         convention: ``"standard"`` or ``"modified"``.
         reference_link: The link whose frame guides the choice of DH frame 0 (its
             x axis and origin). Default: the ROS-Industrial ``base`` link when the
@@ -615,15 +453,15 @@ def dh_from_urdf(
             base frame, which vendors' DH tables use), else the base link.
         virtual_frames: Fold the remaining base and tool transforms into fixed
             rows (virtual frames) so the table alone reproduces the robot.
-        package_map: As in :func:`robot_from_urdf` (a xacro's ``$(find)``).
-        xacro_args: As in :func:`robot_from_urdf`.
+        package_map: As in :func:`parts_from_urdf` (a xacro's ``$(find)``).
+        xacro_args: As in :func:`parts_from_urdf`.
 
     Returns:
         A :class:`~robokin.io.dh_extract.DHExtraction`.
     """
     from robokin.io.dh_extract import dh_from_robot as _dh
 
-    robot = robot_from_urdf(path_or_string, base_link, tip_link, package_map,
+    robot = parts_from_urdf(path_or_string, base_link, tip_link, package_map,
                             xacro_args=xacro_args, geometry=False)
     info: UrdfChain = robot.meta["urdf"]
     ref = reference_link
@@ -639,12 +477,3 @@ def dh_from_urdf(
         reference = info.link_frames[ref][1]
     return _dh(robot, convention=convention, reference=reference,
                virtual_frames=virtual_frames)
-
-
-def dh_from_robot(
-    robot: Robot, convention: Literal["standard", "modified"] = "standard", **kwargs: Any
-) -> DHExtraction:
-    """See :func:`robokin.io.dh_extract.dh_from_robot`."""
-    from robokin.io.dh_extract import dh_from_robot as _dh
-
-    return _dh(robot, convention=convention, **kwargs)

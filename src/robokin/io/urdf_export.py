@@ -28,11 +28,11 @@ import numpy as np
 
 from robokin._text import printable
 from robokin.io.atomic import write_atomic
-from robokin.io.urdf import UrdfChain
+from robokin.io.urdf_tree import UrdfChain
 from robokin.model.chain import joint_motion
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.model.parts import RobotParts
 
 __all__ = ["rpy_of", "urdf_from_robot", "write_urdf"]
 
@@ -117,7 +117,7 @@ def _origin_el(parent: ET.Element, T: np.ndarray) -> None:
 
 
 def urdf_from_robot(
-    robot: Robot,
+    robot: RobotParts,
     *,
     name: str | None = None,
     velocity: float = 1.0,
@@ -323,7 +323,7 @@ def urdf_from_robot(
     return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
-def _known_velocities(robot: Robot) -> np.ndarray | None:
+def _known_velocities(robot: RobotParts) -> np.ndarray | None:
     """The robot's speed limits (n,) [rad/s or m/s], NaN where unknown.
 
     None when the robot knows none.
@@ -333,7 +333,7 @@ def _known_velocities(robot: Robot) -> np.ndarray | None:
     return None if v is None or np.isnan(v).all() else v
 
 
-def write_urdf(robot: Robot, path: str | Path, **kwargs: Any) -> Path:
+def write_urdf(robot: RobotParts, path: str | Path, **kwargs: Any) -> Path:
     """Write :func:`urdf_from_robot` to ``path`` atomically; returns the path.
 
     An existing file is replaced (keeping its permissions) only once the new

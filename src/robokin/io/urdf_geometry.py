@@ -21,26 +21,20 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from robokin._text import short_repr
-from robokin.exceptions import ModelError
+from robokin.exceptions import ModelError, user_stacklevel
 from robokin.io.ros_packages import PackageFinder
 from robokin.model.geometry import MESH_SUFFIXES, mesh_file_problem
+from robokin.spatial import invert
 
 if TYPE_CHECKING:
     from robokin.io.srdf import Srdf
-    from robokin.io.urdf import UrdfChain
-    from robokin.robot import Robot
+    from robokin.io.urdf_tree import UrdfChain
+    from robokin.model.parts import RobotParts
 
 __all__ = ["Drops", "MissingMesh", "geometry_of", "resolve_mesh", "with_shapes"]
 
 MissingMesh = Literal["warn", "error", "ignore"]
 _SCHEME = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]*)://")
-
-
-def _invert(T: np.ndarray) -> np.ndarray:
-    out = np.eye(4)
-    out[:3, :3] = T[:3, :3].T
-    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
-    return out
 
 
 def resolve_mesh(
@@ -125,12 +119,12 @@ class Drops:
                        f"{'s' if len(links) > 1 else ''} {shown}: {why}")
         return tuple(out)
 
-    def report(self, stacklevel: int) -> None:
-        """Warn once per reason (``"warn"`` mode)."""
+    def report(self) -> None:
+        """Warn once per reason (``"warn"`` mode), naming the caller outside robokin."""
         if self.mode == "warn":
             for note in self.notes():
                 warnings.warn(f"left out {note}; shapes skipped", UserWarning,
-                              stacklevel=stacklevel + 1)
+                              stacklevel=user_stacklevel())
 
 
 def geometry_of(
@@ -183,8 +177,8 @@ def geometry_of(
     return out
 
 
-def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]], drops: Drops,
-                     owners: Mapping[str, str]) -> tuple[Robot, frozenset[str]]:
+def _attach_geometry(robot: RobotParts, shapes: list[dict[str, Any]], drops: Drops,
+                     owners: Mapping[str, str]) -> tuple[RobotParts, frozenset[str]]:
     """Put the collision shapes on the geometry layer; the URDF links that gave some.
 
     Visual shapes stand in where a link has no collision shape. A shape goes to
@@ -193,7 +187,7 @@ def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]], drops: Drops,
     """
     from robokin.model import geometry as geo
 
-    tool_from_last = _invert(np.asarray(robot.chain.tool, dtype=float))
+    tool_from_last = invert(robot.chain.tool)
     with_collision = {e["link"] for e in shapes if e["role"] == "collision"}
     per_link: dict[str, list[Any]] = {}
     shaped: set[str] = set()
@@ -226,8 +220,8 @@ def _attach_geometry(robot: Robot, shapes: list[dict[str, Any]], drops: Drops,
 
 
 
-def with_shapes(robot: Robot, shapes: list[dict[str, Any]], drops: Drops,
-                 info: UrdfChain, semantic: Srdf | None) -> Robot:
+def with_shapes(robot: RobotParts, shapes: list[dict[str, Any]], drops: Drops,
+                 info: UrdfChain, semantic: Srdf | None) -> RobotParts:
     """The robot with its geometry, the SRDF's exclusions and the final bookkeeping."""
     from robokin.io.srdf import excluded_link_pairs
 

@@ -21,12 +21,12 @@ from robokin.exceptions import InputError, ModelError
 from robokin.model.dynamics import LinkInertia, RobotDynamics
 
 if TYPE_CHECKING:
-    from robokin.robot import Robot
+    from robokin.model.parts import RobotParts
 
 __all__ = ["dynamics_from_urdf", "write_inertials"]
 
 
-def dynamics_from_urdf(robot: Robot, urdf_robot: Any, link_frames: Mapping[str, Any],
+def dynamics_from_urdf(robot: RobotParts, urdf_robot: Any, link_frames: Mapping[str, Any],
                        file: Any = None) -> RobotDynamics | None:
     """The robot's dynamics from a parsed URDF (None when it has no inertial data).
 
@@ -69,7 +69,7 @@ def dynamics_from_urdf(robot: Robot, urdf_robot: Any, link_frames: Mapping[str, 
         torque_limits=efforts, source=source)
 
 
-def _efforts(robot: Robot, urdf_robot: Any) -> np.ndarray | None:
+def _efforts(robot: RobotParts, urdf_robot: Any) -> np.ndarray | None:
     """Per coordinate, the effort of the URDF joint of that name (> 0), else inf."""
     by_name = {j.name: j for j in urdf_robot.joints}
     out = []
@@ -82,7 +82,7 @@ def _efforts(robot: Robot, urdf_robot: Any) -> np.ndarray | None:
     return None if np.isinf(arr).all() else arr
 
 
-def write_inertials(root: ET.Element, robot: Robot,
+def write_inertials(root: ET.Element, robot: RobotParts,
                     targets: Sequence[tuple[str, np.ndarray]],
                     fmt: Any) -> None:
     """Add an ``<inertial>`` to each URDF link that carries robokin links with data.

@@ -5,7 +5,7 @@
 ``args``; ``$(find NAME)`` and ``${find('NAME')}`` resolve through a
 :class:`~robokin.io.ros_packages.PackageFinder` (the package map,
 ``ROS_PACKAGE_PATH``, ``AMENT_PREFIX_PATH``, the folders above the file). The
-expanded URDF is read by :func:`robokin.io.urdf.robot_from_urdf`, which resolves
+expanded URDF is read by :func:`robokin.io.urdf.parts_from_urdf`, which resolves
 ``package://`` meshes through the same finder.
 
 Why ros/xacro directly and not xacrodoc (the library first chosen): xacrodoc 2.0

@@ -22,7 +22,8 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-from robokin.exceptions import ModelError
+from robokin._validation import check_finite, check_joints
+from robokin.exceptions import InputError, ModelError
 from robokin.model.chain_arrays import MAX_JOINTS, ChainArrays, chain_arrays
 from robokin.model.coupling import AffineMap
 
@@ -227,9 +228,38 @@ class Chain:
         """Boolean (n,): which independent coordinates are angles."""
         return np.array([c.kind == "revolute" for c in self.coordinates])
 
-    def chain_values(self, q: np.ndarray) -> np.ndarray:
-        """Chain joint values ``M q + c``: (..., n) -> (..., n_chain)."""
-        return self.coupling.apply(q)
+    def frames_at(self, q_chain: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Where each chain joint acts, and the tool pose, for one set of joint values.
+
+        The model's one walk along the chain, for questions about its geometry
+        (joint axes, DH tables, file export); forward kinematics, link frames and
+        Jacobians of configurations are the compiled kernels' (``chain.h``).
+
+        Args:
+            q_chain: Chain joint coordinates ``q_chain = M q + c`` (the coupling
+                applied, before each joint's sign and offset) [rad, m], shape
+                (n_chain,). Zeros put every joint at its zero offset.
+
+        Returns:
+            (n_chain + 1, 4, 4): entry k < n_chain is the frame joint k turns
+            about (revolute) or slides along (prismatic), its z axis, in the
+            world frame, ``C_0 J_1 C_1 ... J_k C_k`` (0-based: the base and head
+            for k = 0); the last entry is the tool pose ``T``.
+
+        Raises:
+            InputError: ``q_chain`` does not hold n_chain finite values.
+        """
+        qc = check_finite(check_joints(q_chain, self.n_chain, "q_chain"), "q_chain")
+        if qc.shape != (self.n_chain,):
+            raise InputError("q_chain", f"expected one configuration ({self.n_chain},), "
+                             f"got shape {qc.shape}")
+        consts = self.arrays.consts
+        out = np.empty((self.n_chain + 1, 4, 4))
+        out[0] = consts[0]
+        for k, joint in enumerate(self.joints):
+            move = joint_motion(joint.kind, joint.sign * qc[k] + joint.offset)
+            out[k + 1] = out[k] @ move @ consts[k + 1]
+        return out
 
     def with_fixed(self, values: Mapping[int, float]) -> Chain:
         """The chain with some independent coordinates held at given values.

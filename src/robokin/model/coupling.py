@@ -107,12 +107,12 @@ class AffineMap:
     @property
     def n_in(self) -> int:
         """Number of input coordinates."""
-        return self.matrix.shape[1]
+        return int(self.matrix.shape[1])
 
     @property
     def n_out(self) -> int:
         """Number of output coordinates."""
-        return self.matrix.shape[0]
+        return int(self.matrix.shape[0])
 
     @property
     def is_invertible(self) -> bool:
@@ -123,13 +123,15 @@ class AffineMap:
         """Map inputs ``(..., n_in)`` to outputs ``(..., n_out)``."""
         if self.is_identity:
             return x
-        return x @ self.matrix.T + self.offset
+        result: np.ndarray = x @ self.matrix.T + self.offset
+        return result
 
     def apply_rate(self, xd: np.ndarray) -> np.ndarray:
         """Map velocities or accelerations (the offset drops out)."""
         if self.is_identity:
             return xd
-        return xd @ self.matrix.T
+        result: np.ndarray = xd @ self.matrix.T
+        return result
 
     def inverse(self, y: np.ndarray, *, what: str = "map") -> np.ndarray:
         """Solve ``matrix @ x + offset = y`` for x, ``(..., n_out) -> (..., n_in)``.
@@ -142,7 +144,8 @@ class AffineMap:
         """
         if self.is_identity:
             return y
-        return (y - self.offset) @ self.pseudo_inverse(what=what).T
+        result: np.ndarray = (y - self.offset) @ self.pseudo_inverse(what=what).T
+        return result
 
     def inverse_rate(self, yd: np.ndarray, *, what: str = "map") -> np.ndarray:
         """Inverse map of velocities or accelerations, ``(..., n_out) -> (..., n_in)``.
@@ -152,7 +155,8 @@ class AffineMap:
         """
         if self.is_identity:
             return yd
-        return yd @ self.pseudo_inverse(what=what).T
+        result: np.ndarray = yd @ self.pseudo_inverse(what=what).T
+        return result
 
     def residual(self, y: np.ndarray, *, what: str = "map") -> np.ndarray:
         """``(...)`` largest entry of ``|matrix @ inverse(y) + offset - y|``.
@@ -163,13 +167,15 @@ class AffineMap:
         if self.is_identity:
             return np.zeros(y.shape[:-1])
         back = self.apply(self.inverse(y, what=what))
-        return np.abs(back - y).max(axis=-1, initial=0.0)
+        result: np.ndarray = np.abs(back - y).max(axis=-1, initial=0.0)
+        return result
 
     def pseudo_inverse(self, *, what: str = "map") -> np.ndarray:
         """The left inverse ``(n_in, n_out)``; raises ModelError when rank-deficient."""
         cached = self.__dict__.get("_pinv")
         if cached is not None:
-            return cached
+            result: np.ndarray = cached
+            return result
         A = self.matrix
         rank = np.linalg.matrix_rank(A)
         if rank < A.shape[1]:

@@ -58,7 +58,7 @@ _ELEM_KEYS = {
 _OPS = {"rx", "ry", "rz", "tx", "ty", "tz", "frame"}
 
 
-def _num(row: Mapping, key: str, where: str, default: float | None = 0.0) -> float:
+def _num(row: Mapping[str, Any], key: str, where: str, default: float | None = 0.0) -> float:
     if key not in row or row[key] is None:
         if default is None:
             raise ModelError(f"missing required field '{key}'", field=where)
@@ -72,7 +72,7 @@ def _num(row: Mapping, key: str, where: str, default: float | None = 0.0) -> flo
     return v
 
 
-def _limits(row: Mapping, where: str) -> tuple[float, float]:
+def _limits(row: Mapping[str, Any], where: str) -> tuple[float, float]:
     lim = row.get("limits")
     if lim is None:
         return (-math.inf, math.inf)
@@ -99,22 +99,26 @@ def _kind(
     row: Mapping[str, Any], where: str, default: str = "revolute"
 ) -> JointKind | Literal["fixed"]:
     kind = row.get("joint", default)
-    if kind == "revolute" or kind == "prismatic" or kind == "fixed":
-        return kind
+    if kind == "revolute":
+        return "revolute"
+    if kind == "prismatic":
+        return "prismatic"
+    if kind == "fixed":
+        return "fixed"
     raise ModelError(
         f"joint must be 'revolute', 'prismatic' or 'fixed', got {short_repr(kind)}",
         field=f"{where}.joint",
     )
 
 
-def _sign(row: Mapping, where: str) -> float:
+def _sign(row: Mapping[str, Any], where: str) -> float:
     s = row.get("sign", 1)
     if s not in (1, -1, 1.0, -1.0) or isinstance(s, bool):
         raise ModelError(f"sign must be +1 or -1, got {short_repr(s)}", field=f"{where}.sign")
     return float(s)
 
 
-def _check_row(row: Any, where: str, keys: set[str]) -> Mapping:
+def _check_row(row: Any, where: str, keys: set[str]) -> Mapping[str, Any]:
     if not isinstance(row, Mapping):
         raise ModelError(
             f"a row must be a mapping of fields, got {type(row).__name__}", field=where
@@ -130,10 +134,10 @@ def _check_row(row: Any, where: str, keys: set[str]) -> Mapping:
 class _Assembler:
     """Collects joints and their dependencies while a builder lays out the chain."""
 
-    def __init__(self, coordinates: Sequence[Mapping] | None, prefix: str) -> None:
+    def __init__(self, coordinates: Sequence[Mapping[str, Any]] | None, prefix: str) -> None:
         self.builder = ChainBuilder()
         self.prefix = prefix
-        self.rows: list[tuple[Joint, Mapping | None, float, str]] = []
+        self.rows: list[tuple[Joint, Mapping[str, Any] | None, float, str]] = []
         self.explicit = None
         if coordinates is not None:
             self.explicit = []
@@ -165,7 +169,7 @@ class _Assembler:
         self.rows.append((joint, depends, dep_offset, where))
         self.builder.joint(joint)
 
-    def build(self, base, tool) -> Chain:
+    def build(self, base: np.ndarray | None, tool: np.ndarray | None) -> Chain:
         joints = [r[0] for r in self.rows]
         if self.explicit is None:
             coords = [j for j, dep, _, _ in self.rows if dep is None]

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -236,19 +236,6 @@ class RobotDynamics:
             raise InputError("link", f"unknown link {name!r}; the links are "
                              f"{list(self.names)}")
         return self.links[self.names.index(name)]
-
-    def with_links(self, links: Mapping[str, LinkInertia | None]) -> RobotDynamics:
-        """A copy with some links' data replaced."""
-        for key in links:
-            self.link(key)
-        return replace(self, links=tuple(links.get(nm, old) if nm in links else old
-                                         for nm, old in zip(self.names, self.links)))
-
-    @property
-    def total_mass(self) -> float:
-        """Sum of the known link masses [kg], the base's excluded."""
-        return float(sum(lk.mass for nm, lk in zip(self.names, self.links)
-                         if lk is not None and nm != "base"))
 
 
 def estimate_link(shapes: Iterable[Shape], density: float) -> LinkInertia | None:

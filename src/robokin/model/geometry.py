@@ -35,8 +35,6 @@ the meshes themselves.
 from __future__ import annotations
 
 import math
-import os
-import stat
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -46,9 +44,12 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin._text import short_repr
-from robokin.exceptions import InputError, MissingExtraError, ModelError
+from robokin.exceptions import InputError, MissingExtraError
+from robokin.model.mesh_files import load_mesh, mesh_file_problem
 
 if TYPE_CHECKING:
+    from trimesh import Trimesh
+
     from robokin.model.chain import Chain
 
 
@@ -229,7 +230,7 @@ class Shape:
         return replace(self, owner=owner)
 
     # ------------------------------------------------------------------ meshes
-    def trimesh(self):
+    def trimesh(self) -> Trimesh:
         """The shape as a ``trimesh.Trimesh`` in its own frame (metres), cached.
 
         Raises:
@@ -239,12 +240,14 @@ class Shape:
         """
         cache = self._cache
         if "trimesh" in cache:
-            return cache["trimesh"]
+            cached: Trimesh = cache["trimesh"]
+            return cached
         try:
             import trimesh
         except ImportError:  # pragma: no cover - the extra is installed in CI
             raise MissingExtraError("trimesh", "collision") from None
         k = self.kind
+        m: Trimesh
         if k == "box":
             m = trimesh.creation.box(extents=self.size)
         elif k == "sphere":
@@ -256,7 +259,7 @@ class Shape:
         elif self.vertices is not None:
             m = trimesh.Trimesh(vertices=self.vertices, faces=self.faces, process=False)
         else:
-            m = _load_mesh(self.file, self.scale, self.owner)
+            m = load_mesh(self.file, self.scale, self.owner, MAX_MESH_BYTES)
         cache["trimesh"] = m
         return m
 
@@ -270,7 +273,8 @@ class Shape:
         """An oriented bounding box in the shape's own frame: centre (3,), half sizes (3,)."""
         cache = self._cache
         if "box" in cache:
-            return cache["box"]
+            box: tuple[np.ndarray, np.ndarray] = cache["box"]
+            return box
         k, s = self.kind, self.size
         c = np.zeros(3)
         if k == "box":
@@ -282,7 +286,7 @@ class Shape:
         elif k == "capsule":
             h = np.array([s[0], s[0], s[1] / 2 + s[0]])
         else:
-            v = np.asarray(self.trimesh().vertices, dtype=float)
+            v = np.asarray(self.trimesh().vertices, dtype=np.float64)
             lo, hi = v.min(axis=0), v.max(axis=0)
             c, h = (lo + hi) / 2, (hi - lo) / 2
         cache["box"] = (c, h)
@@ -296,7 +300,8 @@ class Shape:
         """
         cache = self._cache
         if "spheres" in cache:
-            return cache["spheres"]
+            spheres: tuple[np.ndarray, np.ndarray] = cache["spheres"]
+            return spheres
         if self.kind == "capsule":
             r, L = self.size
             # k + 1 centres on the axis, ends included: a point within r of the
@@ -326,8 +331,8 @@ class Shape:
         return out
 
     # ------------------------------------------------------------------- coal
-    def coal_geometry(self):
-        """The coal collision geometry (cached; meshes as an OBBRSS BVH)."""
+    def coal_geometry(self) -> Any:
+        """The coal collision geometry (cached; meshes as an OBBRSS BVH; coal is untyped)."""
         cache = self._cache
         if "coal" in cache:
             return cache["coal"]
@@ -351,7 +356,7 @@ class Shape:
         cache["coal"] = g
         return g
 
-    def coal_convex(self):
+    def coal_convex(self) -> Any:
         """A convex coal geometry containing the shape (its hull), or the primitive itself."""
         cache = self._cache
         if "convex" in cache:
@@ -372,82 +377,13 @@ class Shape:
         return g
 
 
-def _coal():
+def _coal() -> Any:
+    """The coal module (untyped), or MissingExtraError naming ``robokin[collision]``."""
     try:
         import coal
     except ImportError:  # pragma: no cover - the extra is installed in CI
         raise MissingExtraError("coal", "collision") from None
     return coal
-
-
-_FILE_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
-               (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
-               (stat.S_ISSOCK, "a socket"))
-
-
-def mesh_file_problem(path: str | Path) -> str | None:
-    """Why ``path`` cannot be read as a mesh file, or None when it can.
-
-    A mesh is read only from a regular file: a folder, a FIFO, a device
-    (``/dev/zero``) or a symlink to one is reported as not a regular file (never
-    opened: a FIFO would block, ``/dev/zero`` never ends); a path that does not
-    exist as "no such file".
-    """
-    try:
-        st = os.stat(path)  # follows a symlink: its target is what would be read
-    except FileNotFoundError:
-        return f"no such file {path}"
-    except OSError as exc:
-        return f"cannot read {path}: {exc.strerror or exc}"
-    if stat.S_ISREG(st.st_mode):
-        return None
-    kind = next((k for test, k in _FILE_KINDS if test(st.st_mode)), "not a file")
-    via = " (through a symlink)" if os.path.islink(path) else ""
-    return f"{path} is not a regular file: {kind}{via}"
-
-
-def _load_mesh(path: Path | None, scale: float, owner: str):
-    import trimesh
-
-    where = f" (link '{owner}')" if owner else ""
-    if path is None:
-        raise ModelError(f"mesh file not found{where}", file=path, field=owner or None)
-    problem = mesh_file_problem(path)
-    if problem is not None:
-        what = "not found" if problem.startswith("no such file") else f": {problem}"
-        raise ModelError(f"mesh file {what}{where}".replace(" :", ":"), file=path,
-                         field=owner or None)
-    size = Path(path).stat().st_size
-    if size > MAX_MESH_BYTES:
-        raise ModelError(f"mesh file of {size:,} bytes{where}, more than the "
-                         f"{MAX_MESH_BYTES:,} robokin loads (robokin.model.geometry."
-                         "MAX_MESH_BYTES)", file=path, field=owner or None)
-    try:
-        loaded = trimesh.load(str(path), force="mesh")
-    except Exception as exc:  # trimesh raises many kinds on a bad file
-        raise ModelError(
-            f"cannot read mesh{where}: {type(exc).__name__}: {exc}"[:300],
-            file=path,
-            field=owner or None,
-        ) from None
-    faces = getattr(loaded, "faces", None)
-    vertices = getattr(loaded, "vertices", None)
-    if faces is None or vertices is None or len(faces) == 0 or len(vertices) < 4:
-        raise ModelError(
-            f"mesh file holds no triangles{where}", file=path, field=owner or None
-        )
-    if not np.isfinite(np.asarray(vertices)).all():
-        raise ModelError(
-            f"mesh file holds non-finite vertices{where}",
-            file=path,
-            field=owner or None,
-        )
-    m = trimesh.Trimesh(
-        vertices=np.asarray(vertices, dtype=np.float64) * scale,
-        faces=np.asarray(faces),
-        process=False,
-    )
-    return m
 
 
 # ------------------------------------------------------------------ constructors

@@ -24,6 +24,7 @@ from robokin._native import kernels as _k
 
 if TYPE_CHECKING:
     from robokin.collision.scene import Scene
+    from robokin.model.chain import Chain
     from robokin.robot import Robot
 
 __all__ = ["CollisionModel", "EdgeReport", "StateReport"]
@@ -73,7 +74,7 @@ class EdgeReport:
 _STATS = ("states", "bounds", "exact", "coal_calls", "edges", "unproven")
 
 
-def _prismatic_travel(chain: Any, limits: np.ndarray) -> np.ndarray:
+def _prismatic_travel(chain: Chain, limits: np.ndarray) -> np.ndarray:
     """Largest |v_k| of each chain joint over the joint limits (0 for revolute ones).
 
     v = sign (M q + c) + offset is affine in q, so its extremes over the limit box

@@ -5,6 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from robokin.exceptions import ModelError
+from robokin.io.robot_files import load_parts
+from robokin.robot import Robot
 
 __all__ = ["URDF_SUFFIXES", "load", "names", "path"]
 
@@ -32,7 +34,7 @@ def path(name: str) -> Path:
 URDF_SUFFIXES = (".urdf", ".xacro", ".urdf.xml")
 
 
-def load(name_or_path):
+def load(name_or_path: str | Path) -> Robot:
     """Load a built-in robot by name, or a robot file by path.
 
     Raises:
@@ -40,8 +42,6 @@ def load(name_or_path):
             file, or a URDF or xacro (pointing to ``Robot.from_urdf`` and
             ``robokin import``).
     """
-    from robokin.io.robot_files import load_robot
-
     s = str(name_or_path)
     if s.lower().endswith(URDF_SUFFIXES):
         raise ModelError(
@@ -50,5 +50,5 @@ def load(name_or_path):
             f"'robokin import {s} -o ROBOT.yaml'", file=s)
     if isinstance(name_or_path, Path) or s.endswith((".yaml", ".yml")) or "/" in s \
             or Path(s).is_file():
-        return load_robot(Path(name_or_path))
-    return load_robot(path(s))
+        return Robot.from_parts(load_parts(Path(name_or_path)))
+    return Robot.from_parts(load_parts(path(s)))

@@ -40,7 +40,6 @@ write it, and it stays readable and diffable; MuJoCo compiles it when simulating
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal
 from xml.etree import ElementTree as ET
@@ -52,11 +51,18 @@ from robokin._text import short_repr
 from robokin.exceptions import InputError, ModelError
 from robokin.model.chain import joint_motion
 from robokin.model.dynamics import LinkInertia, ResolvedLinks, resolve_links
+from robokin.sim._mjcf_elements import _fmt, _geom, _parts, _pose_attrs, _vec
+from robokin.sim._mjcf_tuning import (
+    JointMap,
+    _check_q_ref,
+    _effective_inertia,
+    _stable_step,
+)
 from robokin.sim.servo import servo_gains
+from robokin.spatial import invert
 
 if TYPE_CHECKING:
     from robokin.collision.scene import Scene
-    from robokin.model.geometry import Shape
     from robokin.robot import Robot
 
 __all__ = ["MAX_LINK_INERTIA", "MAX_LINK_MASS", "MJCF_TIMESTEP", "TRIANGLE_SLACK",
@@ -85,76 +91,6 @@ MAX_LINK_INERTIA = 1e6
 TRIANGLE_SLACK = 0.25
 _ROBOT_RGBA = "0.95 0.55 0.15 1"
 _SCENE_RGBA = "0.6 0.6 0.65 0.6"
-
-
-def _fmt(v: float) -> str:
-    v = float(v)
-    return "0" if v == 0.0 else repr(v)
-
-
-def _vec(values: Any) -> str:
-    return " ".join(_fmt(v) for v in np.asarray(values, dtype=float).reshape(-1))
-
-
-def _pose_attrs(T: np.ndarray) -> dict[str, str]:
-    """``pos`` and ``quat`` (w x y z) attributes of a pose, identity parts left out."""
-    from robokin.spatial import quaternion_from_matrix
-
-    out = {}
-    if np.any(T[:3, 3] != 0.0):
-        out["pos"] = _vec(T[:3, 3])
-    if not np.array_equal(T[:3, :3], np.eye(3)):
-        out["quat"] = _vec(quaternion_from_matrix(T))
-    return out
-
-
-@dataclass(frozen=True)
-class JointMap:
-    """How the robot's joint coordinates set the MuJoCo joints.
-
-    Every MuJoCo joint robokin writes has the value ``matrix[j] @ q`` (the
-    constant parts of the chain sit in the body poses).
-
-    Attributes:
-        names: The MuJoCo joints, in tree order (J).
-        matrix: (J, n): each joint's value per unit of each coordinate.
-        masters: Per coordinate (n), the joint whose value it is (named as the
-            coordinate).
-    """
-
-    names: tuple[str, ...]
-    matrix: F64
-    masters: tuple[str, ...]
-
-    def selection(self, model: Any) -> tuple[np.ndarray, np.ndarray, F64]:
-        """Addresses in a compiled model and the map ``x = S q``.
-
-        Returns:
-            ``(qpos_adr (J,), dof_adr (J,), S (nv, n))``: where each joint sits in
-            ``qpos`` and ``qvel``, and the matrix taking coordinates (and their
-            rates) to every degree of freedom.
-        """
-        mj = _mj()
-        ids = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_JOINT, nm) for nm in self.names]
-        qadr = np.array([model.jnt_qposadr[i] for i in ids], dtype=np.int64)
-        dadr = np.array([model.jnt_dofadr[i] for i in ids], dtype=np.int64)
-        S = np.zeros((model.nv, len(self.masters)))
-        S[dadr] = self.matrix
-        return qadr, dadr, S
-
-    def qpos(self, model: Any, q: npt.ArrayLike) -> F64:
-        """A full ``qpos`` (nq,) for joint coordinates ``q`` (n,)."""
-        qadr, _, _ = self.selection(model)
-        out = np.array(model.qpos0, dtype=np.float64)
-        out[qadr] = self.matrix @ np.asarray(q, dtype=np.float64)
-        return out
-
-    def master_qpos(self, model: Any) -> np.ndarray:
-        """``qpos`` addresses of the coordinates' joints, (n,)."""
-        mj = _mj()
-        return np.array([model.jnt_qposadr[mj.mj_name2id(model, mj.mjtObj.mjOBJ_JOINT,
-                                                         nm)] for nm in self.masters],
-                        dtype=np.int64)
 
 
 @dataclass(frozen=True, eq=False)
@@ -198,102 +134,6 @@ class MjcfExport:
     notes: tuple[str, ...]
     timestep: float
     moments: F64
-
-
-def _mj() -> Any:
-    from robokin.sim._mujoco import mujoco
-
-    return mujoco()
-
-
-# ----------------------------------------------------------------------- layout
-@dataclass
-class _Part:
-    """The MuJoCo joint of one chain joint."""
-
-    name: str
-    row: F64  # its value per unit of each coordinate (n,)
-    axis_sign: float  # the joint turns the body by axis_sign * value about F^-1 z
-    master: int | None  # the coordinate whose joint it is, or None (dependent)
-
-
-def _masters(M: np.ndarray) -> dict[int, tuple[int, float]]:
-    """Per coordinate, the chain joint that is its joint (one +-1 entry), and the sign."""
-    out: dict[int, tuple[int, float]] = {}
-    taken: set[int] = set()
-    for k in range(M.shape[0]):
-        nz = np.flatnonzero(M[k])
-        if len(nz) == 1 and abs(M[k, nz[0]]) == 1.0 and int(nz[0]) not in out \
-                and k not in taken:
-            out[int(nz[0])] = (k, float(M[k, nz[0]]))
-            taken.add(k)
-    return out
-
-
-def _parts(robot: Robot) -> tuple[list[_Part | None], list[int]]:
-    """Per chain joint its MuJoCo joint, and the coordinates that need a leaf body.
-
-    A constant chain joint (driven by no coordinate) has no joint (None).
-    """
-    chain = robot.chain
-    M = chain.arrays.M
-    cnames = list(robot.joint_names)
-    masters = _masters(M)
-    master_of = {k: (i, m) for i, (k, m) in masters.items()}
-    used = set(cnames)
-    out: list[_Part | None] = []
-    for k, joint in enumerate(chain.joints):
-        if not M[k].any():
-            out.append(None)
-            continue
-        if k in master_of:
-            i, m = master_of[k]
-            row = np.zeros(len(cnames))
-            row[i] = 1.0
-            out.append(_Part(cnames[i], row, joint.sign * m, i))
-            continue
-        name, j = joint.name, 2
-        while name in used:
-            name, j = f"{joint.name}_{j}", j + 1
-        used.add(name)
-        out.append(_Part(name, np.array(M[k], dtype=np.float64), joint.sign, None))
-    leaves = [i for i in range(len(cnames)) if i not in masters]
-    return out, leaves
-
-
-# ------------------------------------------------------------------------ geoms
-def _mesh_asset(asset: ET.Element, shape: Shape, name: str) -> None:
-    """The convex hull of a mesh shape, inline (MuJoCo collides convex hulls)."""
-    hull = shape.trimesh().convex_hull
-    ET.SubElement(asset, "mesh", {
-        "name": name,
-        "vertex": _vec(np.asarray(hull.vertices)),
-        "face": " ".join(str(int(v)) for v in np.asarray(hull.faces).reshape(-1)),
-    })
-
-
-def _geom(parent: ET.Element, asset: ET.Element, shape: Shape, name: str,
-          rgba: str, pose: np.ndarray | None = None) -> None:
-    P = np.asarray(shape.placement if pose is None else pose, dtype=float)
-    attrs: dict[str, str] = {"name": name, "rgba": rgba}
-    k, s = shape.kind, shape.size
-    if k == "box":
-        attrs.update(type="box", size=_vec(np.array(s) / 2))
-    elif k == "sphere":
-        attrs.update(type="sphere", size=_vec(s[:1]))
-    elif k == "cylinder":
-        attrs.update(type="cylinder", size=_vec([s[0], s[1] / 2]))
-    elif k == "capsule":
-        if s[1] > 0:
-            attrs.update(type="capsule", size=_vec([s[0], s[1] / 2]))
-        else:
-            attrs.update(type="sphere", size=_vec(s[:1]))
-    else:
-        mesh_name = f"mesh_{name}"
-        _mesh_asset(asset, shape, mesh_name)
-        attrs.update(type="mesh", mesh=mesh_name)
-    attrs.update(_pose_attrs(P))
-    ET.SubElement(parent, "geom", attrs)
 
 
 # ------------------------------------------------------------------------ mass
@@ -434,6 +274,19 @@ class _Writer:
         self.joint_rows: list[F64] = []
         self.dependent: list[tuple[str, F64]] = []  # (joint, its row)
 
+    @classmethod
+    def bodies(cls, robot: Robot, scene: Scene | None, links: ResolvedLinks,
+               timestep: float, gravity_compensation: bool, torque_limits: F64,
+               contact_forces: bool) -> _Writer:
+        """A writer with the robot's and the scene's bodies, contacts and equalities."""
+        writer = cls(robot, scene, links, timestep, gravity_compensation, torque_limits,
+                     contact_forces)
+        writer.robot_tree()
+        writer.scene_bodies()
+        writer.contact_filter()
+        writer.equality(timestep)
+        return writer
+
     # -- bodies
     def _body(self, parent: ET.Element, name: str, T: np.ndarray, k: int,
               moving: bool, has_joint: bool) -> ET.Element:
@@ -452,12 +305,12 @@ class _Writer:
     def _joint(self, body: ET.Element, name: str, kind: str, F: np.ndarray,
                axis_sign: float, row: F64, master: int | None,
                armature: float = 0.0) -> None:
-        R, t = F[:3, :3], F[:3, 3]
+        inv = invert(F)  # the joint's axis and origin in its body: F^-1 z, F^-1 origin
         attrs = {"name": name, "type": "hinge" if kind == "revolute" else "slide",
-                 "axis": _vec(axis_sign * R.T[:, 2])}
+                 "axis": _vec(axis_sign * inv[:3, 2])}
         if armature:
             attrs["armature"] = _fmt(armature)
-        pos = -R.T @ t
+        pos = inv[:3, 3]
         if kind == "revolute" and np.any(pos != 0.0):
             attrs["pos"] = _vec(pos)
         if master is not None:
@@ -627,48 +480,6 @@ class _Writer:
         return ET.tostring(self.root, encoding="unicode") + "\n"
 
 
-def _effective_inertia(xml: str, joints: JointMap, q_ref: np.ndarray,
-                       A: np.ndarray | None) -> tuple[F64, F64, F64]:
-    """Effective inertias for the servos, and how to spread a coordinate's force.
-
-    Returns:
-        ``(inertia, weights, matrices)``: the diagonal of the mass matrix in joint
-        (or motor) coordinates ``M = S^T M_x S`` (``A^T S^T M_x S A``): the inertia
-        each actuator moves with the other joints held, averaged over the rows of
-        ``q_ref`` (k, n); per coordinate the tendon weights over the
-        MuJoCo joints (n, J), ``W = (X^T D X)^-1 X^T D`` (``x = X q`` the joint
-        map, ``D`` the joints' own inertias): ``W X = I`` makes each tendon's
-        length its coordinate, and its force pushes each joint in proportion to
-        that joint's inertia, so a coupled joint's equality constraint barely has
-        to act (forcing one light joint and letting a soft constraint drag the
-        rest along is unstable); and the mass matrices in those coordinates at
-        each row of ``q_ref``, (k, n, n).
-    """
-    from robokin.sim._mujoco import full_mass_matrix, load_model
-
-    mj = _mj()
-    model = load_model(xml)
-    data = mj.MjData(model)
-    _, dadr, S = joints.selection(model)
-    out, diag, mats = [], [], []
-    for q in np.atleast_2d(q_ref):
-        data.qpos[:] = joints.qpos(model, q)
-        mj.mj_forward(model, data)
-        Mfull = full_mass_matrix(model, data)
-        Mq = S.T @ Mfull @ S
-        if A is not None:
-            Mq = A.T @ Mq @ A
-        out.append(np.diag(Mq).copy())
-        mats.append(Mq)
-        diag.append(np.diag(Mfull)[dadr])
-    D = np.diag(np.mean(diag, axis=0))
-    X = joints.matrix  # (J, n)
-    weights = np.linalg.solve(X.T @ D @ X, X.T @ D)  # W X = I: tendon length = q
-    exact = np.abs(weights - np.round(weights)) < 1e-12
-    weights[exact] = np.round(weights[exact])
-    return np.mean(out, axis=0), weights, np.array(mats)
-
-
 def default_reference(robot: Robot) -> F64:
     """The configuration default gains are tuned at: zero, clipped into the limits."""
     lo, hi = robot.limits[:, 0], robot.limits[:, 1]
@@ -704,7 +515,7 @@ def build_mjcf(
         density: Density for estimated links [kg/m^3] (default: the robot's, else
             :data:`~robokin.model.dynamics.DEFAULT_DENSITY`).
         timestep: Physics step [s], > 0; divided (at most
-            :data:`MAX_SUBSTEPS` times) when stiff servos need it (the export's
+            :data:`~robokin.sim._mjcf_tuning.MAX_SUBSTEPS` times) when stiff servos need it (the export's
             ``timestep`` and notes say so).
         contact_forces: False: contacts exert no force (MuJoCo's contact
             detection is off in the model; :func:`robokin.sim.simulate` then
@@ -733,12 +544,8 @@ def build_mjcf(
     placed = scene.attach(robot) if scene is not None else robot
     limits = _torque_limits(placed, torque_limits)
     links = resolve_links(placed, strict=strict, density=density)
-    writer = _Writer(placed, scene, links, float(timestep), servo.gravity_compensation,
-                     limits, contact_forces)
-    writer.robot_tree()
-    writer.scene_bodies()
-    writer.contact_filter()
-    writer.equality(float(timestep))
+    writer = _Writer.bodies(placed, scene, links, float(timestep),
+                            servo.gravity_compensation, limits, contact_forces)
     joints = JointMap(tuple(writer.joint_names), np.array(writer.joint_rows),
                       tuple(placed.joint_names))
     A = placed.actuators.matrix if space == "motor" and placed.actuators else None
@@ -753,12 +560,8 @@ def build_mjcf(
         ctrl_offset = P @ placed.actuators.offset
     # the text is rebuilt with actuators (ElementTree elements are not reusable
     # after text(): a fresh writer keeps the two passes independent)
-    writer = _Writer(placed, scene, links, step, servo.gravity_compensation,
-                     limits, contact_forces)
-    writer.robot_tree()
-    writer.scene_bodies()
-    writer.contact_filter()
-    writer.equality(step)
+    writer = _Writer.bodies(placed, scene, links, step, servo.gravity_compensation,
+                            limits, contact_forces)
     moments = writer.actuators(space, kp, kv, weights)
     xml = writer.text()
     notes = [f"mass properties: {links.describe()}"] + writer.notes + ([note] if note
@@ -772,63 +575,6 @@ def names_for(robot: Robot, space: ActuatorSpace) -> tuple[str, ...]:
     """The actuators' names: the joint names, or the motor names."""
     return tuple(robot.actuator_names or ()) if space == "motor" \
         else tuple(robot.joint_names)
-
-
-#: At most this many physics steps per requested step when the servos are stiff.
-MAX_SUBSTEPS = 16
-
-
-def _stable_step(kp: F64, mats: F64, dt: float, names: Sequence[str]
-                 ) -> tuple[float, str]:
-    """The physics step: ``dt``, or a fraction of it the servos' stiffness needs.
-
-    The servos' damping is integrated implicitly; their stiffness is not, so the
-    fastest mode of ``M^-1 K`` (``M`` the mass matrix in the actuators'
-    coordinates at each reference configuration, ``K = diag(kp)``) must be well
-    resolved: ``omega_max step <= 0.5``. Gains tuned joint by joint on the
-    diagonal of ``M`` can make a coupled mode much faster than any joint's loop
-    (a heavy tip on light links); the step is then divided by the smallest
-    integer that resolves it (the default 10 Hz servos on the AUBO-i5 at 1 kHz:
-    0.25, no division).
-
-    Returns:
-        ``(step [s], note)``: the note says why the step was refined ("" if not).
-
-    Raises:
-        InputError: more than :data:`MAX_SUBSTEPS` divisions would be needed
-            (naming ``gains``).
-    """
-    worst, where = 0.0, 0
-    for M in mats:
-        lam, vec = np.linalg.eig(np.linalg.solve(M, np.diag(kp)))
-        k = int(np.argmax(lam.real))
-        if lam.real[k] > worst:
-            worst, where = float(lam.real[k]), int(np.argmax(np.abs(vec[:, k])))
-    w_dt = math.sqrt(max(worst, 0.0)) * dt
-    split = max(1, math.ceil(w_dt / 0.5 - 1e-12))
-    if split > MAX_SUBSTEPS:
-        raise InputError("gains", f"too stiff for a {dt:g} s step: the fastest servo "
-                         f"mode (mostly {names[where]!r}) has omega dt = {w_dt:.3g}, "
-                         f"more than {MAX_SUBSTEPS} substeps could resolve (lower the "
-                         "gains or the step)")
-    if split == 1:
-        return dt, ""
-    return dt / split, (f"physics step refined to {dt / split * 1e3:.4g} ms: the "
-                        f"servos' fastest mode (mostly {names[where]!r}) is at "
-                        f"{math.sqrt(worst) / (2 * math.pi):.3g} Hz")
-
-
-def _check_q_ref(q_ref: npt.ArrayLike, n: int) -> F64:
-    try:
-        q = np.array(q_ref, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InputError("q_ref", f"expected joint values, got {short_repr(q_ref)}"
-                         ) from None
-    q = np.atleast_2d(q)
-    if q.ndim != 2 or q.shape[1] != n or not np.isfinite(q).all():
-        raise InputError("q_ref", f"expected finite (n,) or (k, n) values with n = {n}, "
-                         f"got shape {q.shape}")
-    return q
 
 
 def to_mjcf(robot: Robot, scene: Scene | None = None, **options: Any) -> str:

@@ -34,12 +34,15 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from robokin.exceptions import MissingExtraError, RobokinError
+from robokin.exceptions import InputError, MissingExtraError, RobokinError
 from robokin.trajectory._retime_path import SplinePath
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["ConstAccelLaw", "RuckigLaw", "StretchedLaw", "TimeLaw", "jerk_limited_law",
            "topp_ra_law"]
@@ -192,7 +195,14 @@ def _toppra() -> Any:
     return toppra
 
 
-def _tool_rates(robot: Any, path: SplinePath, s: np.ndarray) -> np.ndarray:
+def _needs_robot(robot: Robot | None) -> Robot:
+    """The robot a tool speed limit is computed with (its Jacobian)."""
+    if robot is None:
+        raise InputError("robot", "a tool speed limit needs the robot (its Jacobian)")
+    return robot
+
+
+def _tool_rates(robot: Robot, path: SplinePath, s: np.ndarray) -> np.ndarray:
     """``|dp/ds|``: tool-point travel per unit of path parameter at ``s`` (k,)."""
     J = robot.jacobian(path(s))[..., :3, :]
     return np.asarray(np.linalg.norm(np.einsum("kij,kj->ki", J, path(s, 1)), axis=1))
@@ -229,7 +239,7 @@ def _joint_speed_bound(v_max: np.ndarray) -> Any:
     return x_max
 
 
-def _tool_speed_bound(robot: Any, v_tool: float) -> Any:
+def _tool_speed_bound(robot: Robot, v_tool: float) -> Any:
     """``x_max(s) = (v_tool / |dp/ds|)^2``: the tool point within ``v_tool``."""
     def x_max(path: Any, grid: np.ndarray) -> np.ndarray:
         rate = _tool_rates(robot, path, grid)
@@ -386,7 +396,7 @@ def _u_bound(A: np.ndarray, B: np.ndarray, C: np.ndarray, i: int, x: float,
 
 
 def topp_ra_law(path: SplinePath, v_max: np.ndarray, a_max: np.ndarray, *,
-                robot: Any = None, tool_speed: float | None = None,
+                robot: Robot | None = None, tool_speed: float | None = None,
                 grid_points: int | None = None) -> ConstAccelLaw:
     """The time-optimal law along ``path`` within joint speed and acceleration limits.
 
@@ -425,7 +435,7 @@ def topp_ra_law(path: SplinePath, v_max: np.ndarray, a_max: np.ndarray, *,
                 a_max, discretization_scheme=tc.DiscretizationType.Interpolation)]
     if tool_speed is not None:
         cons.append(_speed_constraint(toppra, path.dof,
-                                      _tool_speed_bound(robot, tool_speed)))
+                                      _tool_speed_bound(_needs_robot(robot), tool_speed)))
     algo = toppra.algorithm.TOPPRA(cons, path, gridpoints=grid, solver_wrapper="seidel")
     K = algo.compute_controllable_sets(0.0, 0.0)
     if np.isnan(K).any() or K[0, 0] > 1e-9 * max(1.0, float(K[:, 1].max())):
@@ -434,7 +444,7 @@ def topp_ra_law(path: SplinePath, v_max: np.ndarray, a_max: np.ndarray, *,
     A, B, C, x_cap = _stage_rows(cons, path, grid)
     x, why = _forward_pass(A, B, C, x_cap, K, grid)
     speed_bounds = [_joint_speed_bound(v_max)] + (
-        [] if tool_speed is None else [_tool_speed_bound(robot, tool_speed)])
+        [] if tool_speed is None else [_tool_speed_bound(_needs_robot(robot), tool_speed)])
 
     def feasible(s: np.ndarray, x: np.ndarray, u: np.ndarray) -> np.ndarray:
         """Every limit at path points ``s`` with ``sd^2 = x`` and ``sdd = u``."""
@@ -485,7 +495,7 @@ def path_space_limits(path: SplinePath, v: np.ndarray, a: np.ndarray, j: np.ndar
 
 
 def jerk_limited_law(path: SplinePath, v_max: np.ndarray, a_max: np.ndarray,
-                     j_max: np.ndarray, *, robot: Any = None,
+                     j_max: np.ndarray, *, robot: Robot | None = None,
                      tool_speed: float | None = None) -> RuckigLaw:
     """A jerk-limited rest-to-rest law along ``path`` (ruckig on the path parameter).
 
@@ -517,7 +527,7 @@ def jerk_limited_law(path: SplinePath, v_max: np.ndarray, a_max: np.ndarray,
     if tool_speed is not None:
         k = path.knots
         s = np.sort(np.concatenate([k, (k[:-1] + k[1:]) / 2]))
-        rate = float(_tool_rates(robot, path, s).max())
+        rate = float(_tool_rates(_needs_robot(robot), path, s).max())
     V, A, J = path_space_limits(path, v_max, a_max, j_max, rate, tool_speed)
     inp = ruckig.InputParameter(1)
     inp.current_position = [0.0]

@@ -1,7 +1,7 @@
 """Controller programs: what a real controller runs, chosen by the robot's profile.
 
 A robot file's ``controller:`` section is a
-:class:`~robokin.trajectory.io.ControllerProfile` (joint order, signs, zero
+:class:`~robokin.trajectory.controller_profile.ControllerProfile` (joint order, signs, zero
 offsets, units, the controller's joint names) plus ``programs``, the outputs
 that controller runs, its default first. Three programs exist, each checked
 against its format by the tests (nothing more is claimed):
@@ -43,13 +43,8 @@ import numpy as np
 from robokin._text import short_repr
 from robokin.exceptions import InputError, ModelError
 from robokin.io.atomic import write_atomic
-from robokin.trajectory.io import (
-    PROGRAMS,
-    ControllerProfile,
-    csv_text,
-    read_csv,
-    ur_script,
-)
+from robokin.trajectory.controller_profile import PROGRAMS, ControllerProfile
+from robokin.trajectory.io import csv_text, read_csv, ur_script
 from robokin.trajectory.samples import Trajectory
 
 if TYPE_CHECKING:

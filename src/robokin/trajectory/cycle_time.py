@@ -28,12 +28,15 @@ every jerk ``1 - 1/c^3`` to its limit at the bottleneck (and more elsewhere);
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robokin.exceptions import InputError
 from robokin.trajectory.retiming import RetimeResult, retime_detailed
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["Bottleneck", "CycleTimeReport", "SectionSummary", "cycle_time_report",
            "limit_ratios"]
@@ -281,7 +284,7 @@ class CycleTimeReport:
 
 
 def cycle_time_report(
-    robot: Any,
+    robot: Robot,
     traj: Any,
     *,
     cycle_time: float | None = None,

@@ -225,15 +225,6 @@ class PathBuilder:
                                      label or "dwell"))
         return self
 
-    def duration_so_far(self) -> float | None:
-        """Sum of the known durations, or None while some are still to derive."""
-        total = 0.0
-        for s in self.segments:
-            if s.duration is None:
-                return None
-            total += s.duration
-        return total
-
     # --------------------------------------------------------------- building
     def _rest_duration(self, seg: Segment, q_from: np.ndarray) -> float:
         if self.v_max is None and self.a_max is None:

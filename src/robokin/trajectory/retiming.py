@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -53,6 +53,9 @@ from robokin.trajectory._retime_laws import (
 from robokin.trajectory._retime_path import Piece, source_of, split_path
 from robokin.trajectory.joint import check_max_samples
 from robokin.trajectory.samples import Trajectory
+
+if TYPE_CHECKING:
+    from robokin.robot import Robot
 
 __all__ = ["RetimeLimits", "RetimeResult", "SectionTiming", "retime",
            "retime_detailed"]
@@ -86,7 +89,7 @@ class RetimeLimits:
     sources: dict[str, str] = field(default_factory=dict)
 
 
-def _per_joint(value: Any, kind: str, arg: str, robot: Any, n: int,
+def _per_joint(value: Any, kind: str, arg: str, robot: Robot, n: int,
                names: tuple[str, ...]) -> np.ndarray:
     """One positive finite limit per joint, from the argument or the robot file."""
     if value is None:
@@ -114,7 +117,7 @@ def _per_joint(value: Any, kind: str, arg: str, robot: Any, n: int,
     return out
 
 
-def resolve_limits(robot: Any, n: int, names: tuple[str, ...], v_max: LimitArg,
+def resolve_limits(robot: Robot, n: int, names: tuple[str, ...], v_max: LimitArg,
                    a_max: LimitArg, j_max: LimitArg | Literal["robot"],
                    tool_speed: float | None) -> RetimeLimits:
     """The limits of one call: arguments first, then the robot file.
@@ -189,7 +192,7 @@ class SectionTiming:
 class _Plan:
     """What a retiming computed, kept to re-sample it (slower, rounded)."""
 
-    robot: Any
+    robot: Robot
     pieces: list[Piece]
     laws: list[TimeLaw | None]
     dwell: list[float]
@@ -479,7 +482,7 @@ def _timings(plan: _Plan, laws: list[TimeLaw | None], off: np.ndarray
 
 # ----------------------------------------------------------------- public entry
 def retime_detailed(
-    robot: Any,
+    robot: Robot,
     traj: Any,
     *,
     v_max: LimitArg = None,
@@ -551,7 +554,7 @@ def retime_detailed(
 
 
 def retime(
-    robot: Any,
+    robot: Robot,
     traj: Any,
     *,
     v_max: LimitArg = None,

@@ -16,7 +16,7 @@ and ``rosidl_runtime_py.set_message_fields`` read), or, with
       effort: []
       time_from_start: {sec: 0, nanosec: 5000000}
 
-ROS messages are SI: a :class:`~robokin.trajectory.io.ControllerProfile`'s
+ROS messages are SI: a :class:`~robokin.trajectory.controller_profile.ControllerProfile`'s
 joint order, signs, zero offsets and names apply, its units do not. A zero
 header stamp tells the controller to start now. :func:`read_joint_trajectory`
 reads the file back (a message or a goal).
@@ -46,7 +46,7 @@ from robokin._text import short_repr
 from robokin.exceptions import InputError, MissingExtraError, ModelError
 from robokin.io.atomic import write_atomic
 from robokin.io.text_files import MAX_CSV_BYTES
-from robokin.trajectory.io import ControllerProfile
+from robokin.trajectory.controller_profile import ControllerProfile
 from robokin.trajectory.samples import Trajectory
 
 __all__ = [

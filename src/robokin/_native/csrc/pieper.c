@@ -96,6 +96,9 @@ enum { PK_OK = 0, PK_OUT_OF_REACH = 1, PK_NO_ORIENTATION = 2, PK_DEGENERATE = 5,
 #define PK_COPLANAR 1e-13      /* |mutual moment| / scale below it: coplanar axes (rounding) */
 #define PK_EXACT 1e-13         /* pose errors below it need no Newton polish */
 #define PK_ACCEPT 4e-13        /* pose errors above it after the polish: not a solution */
+#define PK_NUDGE 1e-4         /* rows this far [rad] outside the limits: pk_inside tries */
+#define PK_FAMILY_SIGMA 1e-9  /* Jacobian's smallest / largest singular value below it: a family */
+#define PK_SP4_SLACK 1e-13     /* |C| - hypot(A, B) / scale below it: a double root (rounding) */
 
 /* ------------------------------------------------------------ geometry */
 
@@ -488,16 +491,21 @@ static double pk_theta_b(const PkEq *e, double ca, double sa, double cc, double 
     return tb;
 }
 
-/* A c + B s = C: up to two roots (Roots of six_r.c). A discriminant down to
- * -1e-13 (A^2 + B^2) is a double root (rounding); any positive one gives two roots,
+/* A c + B s = C: up to two roots (Roots of six_r.c). |C| above hypot(A, B) by
+ * at most `slack` (absolute, in the units of A, B, C: what rounding of the
+ * coefficients can make of a double root), or a discriminant down to -1e-13
+ * (A^2 + B^2), is a double root; any positive discriminant gives two roots,
  * however close: next to a double root a root's error is second order in the
  * pose, so two accurate close roots beat one merged root (which would be off by
  * the square root of their distance). */
-static Roots pk_sp4(double A, double B, double C)
+static Roots pk_sp4(double A, double B, double C, double slack)
 {
     double phi = fast_atan2(B, A), cphi, sphi;
     unit2(B, A, &cphi, &sphi);
-    return sp4_roots(A, B, C, A * A + B * B - C * C, 1e-13, 0, phi, cphi, sphi);
+    double disc = A * A + B * B - C * C;
+    if (disc < 0.0 && fabs(C) - hypot(A, B) <= slack)
+        disc = 0.0;
+    return sp4_roots(A, B, C, disc, 1e-13, 0, phi, cphi, sphi);
 }
 
 /* A solution (theta_a, theta_c given by angle, cosine and sine; theta_b solved) */
@@ -538,6 +546,9 @@ static int pk_coplanar(const PkEq *e, int swap, double pref_a, double pref_c, Pk
     double C = n[0] * e->r[0] + n[1] * e->r[1];
     Roots rx;
     int xfree = hypot(A, B) <= 1e-12 * L;
+#ifdef PK_DEBUG
+    fprintf(stderr, " coplanar swap %d n %.3e %.3e A %.6e B %.6e C %.6e disc %.3e xfree %d\n", swap, n[0], n[1], A, B, C, A*A+B*B-C*C, xfree);
+#endif
     if (xfree) { /* the point on axis x: theta_x free (or no solution) */
         if (fabs(C) > 1e-9 * L)
             return PK_OUT_OF_REACH;
@@ -548,7 +559,7 @@ static int pk_coplanar(const PkEq *e, int swap, double pref_a, double pref_c, Pk
         rx.c[0] = cos(tx);
         rx.s[0] = sin(tx);
     } else {
-        rx = pk_sp4(A, B, C);
+        rx = pk_sp4(A, B, C, PK_SP4_SLACK * L);
     }
     double m0 = -n[1], m1 = n[0];
     double Ay = -sx * (m0 * Y[0][0] + m1 * Y[1][0]);
@@ -568,8 +579,11 @@ static int pk_coplanar(const PkEq *e, int swap, double pref_a, double pref_c, Pk
             ry.c[0] = cos(ty);
             ry.s[0] = sin(ty);
         } else {
-            ry = pk_sp4(Ay, By, Cy);
+            ry = pk_sp4(Ay, By, Cy, PK_SP4_SLACK * L);
         }
+#ifdef PK_DEBUG
+        fprintf(stderr, "  y: Ay %.6e By %.6e Cy %.6e disc %.3e n %d\n", Ay, By, Cy, Ay*Ay+By*By-Cy*Cy, ry.n);
+#endif
         for (int j = 0; j < ry.n; j++) {
             int sing = xfree || rx.boundary || ry.boundary;
             if (swap)
@@ -965,8 +979,9 @@ static void pk_lstsq(double J[6][6], const double *e, double *dx)
 }
 
 /* Newton steps on the remaining chain's angles (least squares, pk_lstsq; kept only
- * while they reduce the error); returns the final error (pk_error) */
-static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
+ * while they reduce the error), the joints in `frozen` (bit j: angle j) held;
+ * returns the final error (pk_error) */
+static double pk_polish_held(const PkGeo *g, const m3 *RT, v3 pT, double *th, unsigned frozen)
 {
     m3 R;
     v3 p;
@@ -975,8 +990,14 @@ static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
     double err = pk_error(RT, pT, &R, p, g->scale, e);
     for (int it = 0; it < 6 && err > 1e-16; it++) {
         double dx[6], trial[6], big = 0.0;
+        for (int j = 0; j < 6; j++)
+            if (frozen >> j & 1u)
+                for (int r = 0; r < 6; r++)
+                    J[r][j] = 0.0;
         pk_lstsq(J, e, dx);
         for (int j = 0; j < 6; j++) {
+            if (frozen >> j & 1u)
+                dx[j] = 0.0;
             trial[j] = wrap_pi(th[j] + dx[j]);
             big = fmax(big, fabs(dx[j]));
         }
@@ -998,6 +1019,11 @@ static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
         }
     }
     return err;
+}
+
+static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
+{
+    return pk_polish_held(g, RT, pT, th, 0u);
 }
 
 /* ------------------------------------------------------------- one pose */
@@ -1131,159 +1157,275 @@ static double pk_coords(const double *P, const PkGeo *g, const double *th, int h
     return margin;
 }
 
-/* Roots psi of h . rot(u, sg psi) p = rhs (sg = +-1) appended to psi[*n] */
-static void pk_psi_roots(v3 h, v3 u, v3 p, double rhs, double sg, double *psi, int *n)
+/* Whether held value x (none: held < 0) lies inside its limits (1e-9 slack, as
+ * pk_coords): when it does not, no row can, and the repairs are not tried. */
+static int pk_held_inside(const double *P, int held, double x)
 {
-    double A, B, C;
-    sp4_coeffs(h, u, p, &A, &B, &C);
-    if (hypot(A, B) < 1e-12)
-        return;
-    Roots r = pk_sp4(A, B, rhs - C);
-    for (int i = 0; i < r.n; i++)
-        psi[(*n)++] = wrap_pi(sg * r.t[i]);
+    return held < 0 || (x - P[PK_LO + held] >= -1e-9 && P[PK_HI + held] - x >= -1e-9);
 }
 
-/* Both triples meet (an SRS arm with its elbow held): the shoulder-wrist distance
- * is fixed, so a reachable pose has a one-parameter family of solutions, the
- * swivel psi of the arm about the line S-W: R_A(psi) = rot(u, psi) R_A0, R_B =
- * R_A^T G, each triple two branches. Each branch (slot 2 iA + iB) is returned at
- * the psi where its configuration lies deepest inside the limits, among psi = 0,
- * every psi where a joint reaches a limit (a subproblem 4 in psi per joint and
- * limit) and the midpoints between them: a feasible stretch of the family is
- * bounded by such psi, so a branch with any in-limit configuration gets one.
- * Every row is flagged singular (the family is a self-motion). */
-static int pk_swivel(const double *P, const PkGeo *g, const m3 *RT, v3 pT, const m3 *G,
-                     double x, const double *qn, PkOut o)
+/* A row th (remaining chain, exact) just outside the limits, next to a singular
+ * configuration: the exact configurations around it form a thin set along the
+ * near-null directions, and the generating configuration may be one of them at
+ * a limit (a joint exactly at its limit reached only to rounding). Clamp the
+ * joints outside to the limit they passed, hold them there and Newton-polish the
+ * others (their least-squares step slides along the singular direction back to
+ * the pose); up to three rounds, as a polish may push another joint out. Kept
+ * when the pose holds to PK_ACCEPT and every joint is inside (1e-9 slack, as
+ * pk_coords): returns 1 when th changed. */
+static int pk_inside(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
 {
-    int held = (int)P[PK_HELD];
-    v3 S = g->pt, Wp = g->pt2;
-    v3 w = v3_add(pT, m3_mv(G, v3_sub(Wp, g->tM)));
-    v3 a = v3_sub(Wp, S), b = v3_sub(w, S);
-    double la = v3_norm(a), lb = v3_norm(b);
-    if (fabs(la - lb) > 1e-9 * fmax(1.0, g->scale))
-        return PK_OUT_OF_REACH;
-    if (la < 1e-12 * g->scale)
-        return PK_DEGENERATE;
-    a = v3_scale(a, 1.0 / la);
-    b = v3_scale(b, 1.0 / lb);
-    v3 ax = v3_cross(a, b);
-    double sn = v3_norm(ax), cs = v3_dot(a, b);
-    m3 R0;
-    if (sn > 1e-12) {
-        R0 = pk_rotm(v3_scale(ax, 1.0 / sn), cs, sn);
-    } else if (cs > 0.0) {
-        R0 = (m3){{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
-    } else {
-        v3 e = fabs(a.x) < 0.9 ? (v3){1.0, 0.0, 0.0} : (v3){0.0, 1.0, 0.0};
-        e = v3_sub(e, v3_scale(a, v3_dot(e, a)));
-        R0 = pk_rotm(v3_scale(e, 1.0 / v3_norm(e)), -1.0, 0.0);
-    }
-    v3 u = b;
-    /* candidate swivel angles: 0 and where each joint reaches a limit */
-    double psi[128];
-    int np = 0;
-    psi[np++] = 0.0;
-    for (int t = 0; t < 2; t++) {
-        int o3 = 3 * t;
-        v3 hx = g->h[o3], hy = g->h[o3 + 1], hz = g->h[o3 + 2];
-        for (int jj = 0; jj < 3; jj++) {
-            int f = g->full[o3 + jj];
-            for (int side = 0; side < 2; side++) {
-                double L = P[PK_SIGN + f] * P[(side ? PK_HI : PK_LO) + f] + P[PK_OFFSET + f];
-                double cL = cos(L), sL = sin(L);
-                if (t == 0) { /* R_A = rot(u, psi) R0 */
-                    if (jj == 1)
-                        pk_psi_roots(hx, u, m3_mv(&R0, hz), v3_dot(hx, v3_rot(hy, cL, sL, hz)),
-                                     1.0, psi, &np);
-                    else if (jj == 0)
-                        pk_psi_roots(v3_rot(hx, cL, sL, hy), u, m3_mv(&R0, hz), v3_dot(hy, hz),
-                                     1.0, psi, &np);
-                    else
-                        pk_psi_roots(hx, u, m3_mv(&R0, v3_rot(hz, cL, -sL, hy)),
-                                     v3_dot(hx, hy), 1.0, psi, &np);
-                } else { /* R_B = R0^T rot(u, -psi) G */
-                    v3 gz = m3_mv(G, hz);
-                    if (jj == 1)
-                        pk_psi_roots(m3_mv(&R0, hx), u, gz, v3_dot(hx, v3_rot(hy, cL, sL, hz)),
-                                     -1.0, psi, &np);
-                    else if (jj == 0)
-                        pk_psi_roots(m3_mv(&R0, v3_rot(hx, cL, sL, hy)), u, gz, v3_dot(hy, hz),
-                                     -1.0, psi, &np);
-                    else
-                        pk_psi_roots(m3_mv(&R0, hx), u, m3_mv(G, v3_rot(hz, cL, -sL, hy)),
-                                     v3_dot(hx, hy), -1.0, psi, &np);
+    double trial[6];
+    unsigned frozen = 0u;
+    for (int j = 0; j < 6; j++)
+        trial[j] = th[j];
+    for (int round = 0; round < 3; round++) {
+        int moved = 0;
+        for (int j = 0; j < 6; j++) {
+            int f = g->full[j];
+            double sg = P[PK_SIGN + f], off = P[PK_OFFSET + f];
+            double lo = P[PK_LO + f], hi = P[PK_HI + f];
+            double q = wrap_pi(sg * (trial[j] - off)), best = q, gap = INFINITY;
+            for (int m = -1; m <= 1; m++) { /* the turn of q nearest [lo, hi] */
+                double qm = q + 2.0 * M_PI * m;
+                double d = qm < lo ? lo - qm : qm > hi ? qm - hi : 0.0;
+                if (d < gap) {
+                    gap = d;
+                    best = qm;
                 }
             }
+            if (gap <= 0.0 || (frozen >> j & 1u))
+                continue;
+            if (gap > PK_NUDGE)
+                return 0; /* not a thin set's width away */
+            trial[j] = sg * (best < lo ? lo : hi) + off;
+            frozen |= 1u << j;
+            moved = 1;
         }
+        if (!moved)
+            break;
+        double perr = pk_polish_held(g, RT, pT, trial, frozen);
+#ifdef PK_DEBUG
+        fprintf(stderr, "   inside round %d frozen %x err %.3e th %.12f %.12f %.12f %.12f %.12f %.12f\n", round, frozen, perr, trial[0], trial[1], trial[2], trial[3], trial[4], trial[5]);
+#endif
+        if (!(perr <= PK_ACCEPT))
+            return 0;
     }
-    /* midpoints between consecutive candidates (around the circle) */
-    for (int i = 1; i < np; i++)
-        for (int j = i; j > 0 && psi[j] < psi[j - 1]; j--) {
-            double t = psi[j];
-            psi[j] = psi[j - 1];
-            psi[j - 1] = t;
-        }
-    int nb = np;
-    for (int i = 0; i < nb; i++) {
-        double nxt = i + 1 < nb ? psi[i + 1] : psi[0] + 2.0 * M_PI;
-        psi[np++] = 0.5 * (psi[i] + nxt);
-    }
-    PkTri ta, tb;
-    pk_tri_init(&ta, g->h[0], g->h[1], g->h[2]);
-    pk_tri_init(&tb, g->h[3], g->h[4], g->h[5]);
-    double best_m[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY}, best_th[4][6];
-    int have[4] = {0, 0, 0, 0};
-    for (int i = 0; i < np; i++) {
-        m3 Ru = pk_rotm(u, cos(psi[i]), sin(psi[i]));
-        m3 RA = pk_mul(&Ru, &R0);
-        m3 RAt = {{RA.r0.x, RA.r1.x, RA.r2.x}, {RA.r0.y, RA.r1.y, RA.r2.y},
-                  {RA.r0.z, RA.r1.z, RA.r2.z}};
-        m3 RB = pk_mul(&RAt, G);
-        PkTrip A, B;
-        pk_triple(P, &ta, &RA, g->full[0], g->full[2], qn[g->full[2]], P[PK_SING_TOL], &A);
-        pk_triple(P, &tb, &RB, g->full[3], g->full[5], qn[g->full[5]], P[PK_SING_TOL], &B);
-        for (int ka = 0; ka < A.n; ka++)
-            for (int kb = 0; kb < B.n; kb++) {
-                double th[6], q[PK_MAXJ];
-                for (int j = 0; j < 3; j++) {
-                    th[j] = A.t[ka][j];
-                    th[3 + j] = B.t[kb][j];
-                }
-                double m = pk_coords(P, g, th, held, x, q);
-                int slot = 2 * ka + kb;
-                if (!have[slot] || m > best_m[slot]) {
-                    have[slot] = 1;
-                    best_m[slot] = m;
-                    for (int j = 0; j < 6; j++)
-                        best_th[slot][j] = th[j];
-                }
-            }
-    }
-    int any = 0;
-    for (int slot = 0; slot < 4; slot++) {
-        if (!have[slot])
-            continue;
-        double *th = best_th[slot];
-        m3 R;
-        v3 pp;
-        double ev[6];
-        pk_fk(g, th, &R, &pp, NULL);
-        double err = pk_error(RT, pT, &R, pp, g->scale, ev);
-        if (err > PK_EXACT)
-            err = pk_polish(g, RT, pT, th);
-        if (!(err <= PK_ACCEPT))
-            continue;
-        double q[PK_MAXJ];
-        double m = pk_coords(P, g, th, held, x, q);
-        for (int j = 0; j < o.n; j++)
-            o.Q[o.n * slot + j] = q[j];
-        o.valid[slot] = 1;
-        o.inside[slot] = (unsigned char)(m >= -1e-9);
-        o.sing[slot] = 1;
-        any = 1;
-    }
-    return any ? PK_OK : PK_NO_ORIENTATION;
+    double q[PK_MAXJ];
+    if (!(pk_coords(P, g, trial, -1, 0.0, q) >= -1e-9))
+        return 0;
+    m3 R;
+    v3 p;
+    double e[6];
+    pk_fk(g, trial, &R, &p, NULL);
+    if (!(pk_error(RT, pT, &R, p, g->scale, e) <= PK_ACCEPT))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        th[j] = trial[j];
+    return 1;
 }
+
+/* The singular values (ascending) and right singular vectors (columns of V) of a
+ * 6 x 6 matrix A (destroyed): one-sided Jacobi (Hestenes), which keeps small
+ * singular values accurate relative to the columns (A^T A would square them into
+ * rounding). */
+static void pk_svd6(double A[6][6], double *sig, double V[6][6])
+{
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++)
+            V[i][j] = i == j ? 1.0 : 0.0;
+    for (int sweep = 0; sweep < 30; sweep++) {
+        int rotated = 0;
+        for (int p = 0; p < 5; p++)
+            for (int q = p + 1; q < 6; q++) {
+                double a = 0.0, b = 0.0, c = 0.0;
+                for (int r = 0; r < 6; r++) {
+                    a += A[r][p] * A[r][p];
+                    b += A[r][q] * A[r][q];
+                    c += A[r][p] * A[r][q];
+                }
+                if (!(fabs(c) > 1e-15 * sqrt(a * b)))
+                    continue;
+                rotated = 1;
+                double z = 0.5 * (b - a) / c;
+                double t = copysign(1.0, z) / (fabs(z) + sqrt(z * z + 1.0));
+                double cs = 1.0 / sqrt(t * t + 1.0), sn = t * cs;
+                for (int r = 0; r < 6; r++) {
+                    double x = A[r][p], y = A[r][q];
+                    A[r][p] = cs * x - sn * y;
+                    A[r][q] = sn * x + cs * y;
+                    x = V[r][p];
+                    y = V[r][q];
+                    V[r][p] = cs * x - sn * y;
+                    V[r][q] = sn * x + cs * y;
+                }
+            }
+        if (!rotated)
+            break;
+    }
+    double nrm[6];
+    int idx[6] = {0, 1, 2, 3, 4, 5};
+    for (int c = 0; c < 6; c++) {
+        double sum = 0.0;
+        for (int r = 0; r < 6; r++)
+            sum += A[r][c] * A[r][c];
+        nrm[c] = sqrt(sum);
+    }
+    for (int i = 1; i < 6; i++)
+        for (int j = i; j > 0 && nrm[idx[j]] < nrm[idx[j - 1]]; j--) {
+            int t = idx[j];
+            idx[j] = idx[j - 1];
+            idx[j - 1] = t;
+        }
+    double Vs[6][6];
+    for (int c = 0; c < 6; c++) {
+        sig[c] = nrm[idx[c]];
+        for (int r = 0; r < 6; r++)
+            Vs[r][c] = V[r][idx[c]];
+    }
+    for (int r = 0; r < 6; r++)
+        for (int c = 0; c < 6; c++)
+            V[r][c] = Vs[r][c];
+}
+
+/* How far joint coordinate q lies outside [lo, hi] at its nearest turn (0 inside),
+ * and that limit into *lim. */
+static double pk_outside(double q, double lo, double hi, double *lim)
+{
+    double gap = INFINITY;
+    *lim = lo;
+    for (int m = -1; m <= 1; m++) {
+        double qm = q + 2.0 * M_PI * m;
+        double d = qm < lo ? lo - qm : qm > hi ? qm - hi : 0.0;
+        if (d < gap) {
+            gap = d;
+            *lim = qm < lo ? lo - 2.0 * M_PI * m : hi - 2.0 * M_PI * m;
+        }
+    }
+    return gap;
+}
+
+/* Whether the 6 x 6 Jacobian J certainly has no singular value below
+ * PK_FAMILY_SIGMA of its largest: |det J| = prod sigma_i <= sigma_min sigma_max^5
+ * and sigma_max <= |J|_F, so |det J| > 2 PK_FAMILY_SIGMA |J|_F^6 (2: room for
+ * the rounding of the elimination) proves sigma_min > PK_FAMILY_SIGMA sigma_max.
+ * Gaussian elimination with partial pivoting, a few hundred flops: the Jacobi SVD
+ * of pk_slide (thousands) runs only where this cannot rule a family out. */
+static int pk_regular(const double J[6][6])
+{
+    double A[6][6], fro = 0.0, det = 1.0;
+    for (int r = 0; r < 6; r++)
+        for (int c = 0; c < 6; c++) {
+            A[r][c] = J[r][c];
+            fro += J[r][c] * J[r][c];
+        }
+    for (int c = 0; c < 6; c++) {
+        int piv = c;
+        for (int r = c + 1; r < 6; r++)
+            if (fabs(A[r][c]) > fabs(A[piv][c]))
+                piv = r;
+        if (!(fabs(A[piv][c]) > 0.0))
+            return 0;
+        if (piv != c)
+            for (int k = c; k < 6; k++) {
+                double t = A[c][k];
+                A[c][k] = A[piv][k];
+                A[piv][k] = t;
+            }
+        det *= A[c][c];
+        for (int r = c + 1; r < 6; r++) {
+            double m = A[r][c] / A[c][c];
+            for (int k = c + 1; k < 6; k++)
+                A[r][k] -= m * A[c][k];
+        }
+    }
+    return fabs(det) > 2.0 * PK_FAMILY_SIGMA * fro * fro * fro;
+}
+
+/* A row th on a one-parameter family of exact solutions (a singular configuration
+ * whose remaining Jacobian has a null direction: smallest singular value below
+ * PK_FAMILY_SIGMA of the largest) but outside the limits: slide along the family.
+ * Each step linearizes every joint along the null vector, q_j(a) = q_j + d_j a,
+ * intersects the intervals of a that keep each joint inside its limits (the
+ * feasible set of the family parameter, to first order), moves to the point of
+ * the intersection nearest a = 0 (its middle when rounding left it empty: two
+ * joints at their limits at one point), at most 0.05 rad, and Newton-polishes
+ * the pose with the joints brought to a limit held. Kept when every joint ends
+ * inside and the pose holds to PK_ACCEPT: returns 1 when th changed. */
+static int pk_slide(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
+{
+    double trial[6];
+    for (int j = 0; j < 6; j++)
+        trial[j] = th[j];
+    for (int it = 0; it < 96; it++) {
+        m3 R;
+        v3 p;
+        double J[6][6], sig[6], V[6][6], lo = -INFINITY, hi = INFINITY, worst = 0.0;
+        pk_fk(g, trial, &R, &p, J);
+        if (it == 0 && pk_regular(J))
+            return 0; /* isolated: no family to slide along */
+        pk_svd6(J, sig, V);
+        if (!(sig[0] <= PK_FAMILY_SIGMA * sig[5]))
+            return 0; /* no one-parameter family here */
+        for (int j = 0; j < 6; j++) {
+            int f = g->full[j];
+            double sg = P[PK_SIGN + f], d = sg * V[j][0];
+            double qw = wrap_pi(sg * (trial[j] - P[PK_OFFSET + f]));
+            double l = P[PK_LO + f], h = P[PK_HI + f], best = qw, bd = INFINITY;
+            for (int m = -1; m <= 1; m++) { /* the turn of q nearest [l, h] */
+                double qm = qw + 2.0 * M_PI * m, dd = qm < l ? l - qm : qm > h ? qm - h : 0.0;
+                if (dd < bd) {
+                    bd = dd;
+                    best = qm;
+                }
+            }
+            worst = fmax(worst, bd);
+            if (fabs(d) > 1e-12) {
+                double a1 = (l - best) / d, a2 = (h - best) / d;
+                lo = fmax(lo, fmin(a1, a2));
+                hi = fmin(hi, fmax(a1, a2));
+            } else if (bd > 1e-10) {
+                return 0; /* outside (beyond the 1e-10 of "inside" below), the family does not move it */
+            }
+        }
+        if (!(worst > 1e-10))
+            break; /* inside */
+        double alpha = lo <= hi ? fmin(fmax(0.0, lo), hi) : 0.5 * (lo + hi);
+        if (!isfinite(alpha))
+            return 0;
+        double big = 0.0;
+        for (int j = 0; j < 6; j++)
+            big = fmax(big, fabs(V[j][0]));
+        double cap = 0.05 / big;
+        if (fabs(alpha) > cap)
+            alpha = copysign(cap, alpha);
+        else if (fabs(alpha) * big < 1e-15)
+            return 0; /* no progress */
+        unsigned frozen = 0u;
+        for (int j = 0; j < 6; j++) {
+            trial[j] += alpha * V[j][0];
+            int f = g->full[j];
+            double q = wrap_pi(P[PK_SIGN + f] * (trial[j] - P[PK_OFFSET + f])), lim;
+            if (pk_outside(q, P[PK_LO + f], P[PK_HI + f], &lim) == 0.0 &&
+                fmin(q - P[PK_LO + f], P[PK_HI + f] - q) < 1e-12 && fabs(V[j][0]) > 1e-6)
+                frozen |= 1u << j; /* brought to a limit: held there by the polish */
+        }
+        double perr = pk_polish_held(g, RT, pT, trial, frozen);
+#ifdef PK_DEBUG
+        fprintf(stderr, "   slide it %d sig %.2e worst %.3e interval [%.3e, %.3e] alpha %.3e err %.3e\n", it, sig[0], worst, lo, hi, alpha, perr);
+#endif
+        if (!(perr <= PK_ACCEPT))
+            return 0;
+    }
+    double q[PK_MAXJ];
+    if (!(pk_coords(P, g, trial, -1, 0.0, q) >= -1e-9))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        th[j] = wrap_pi(trial[j]);
+    return 1;
+}
+
+#include "pieper_srs.c"
 
 /* Every solution of pose T (4 x 4 row-major) with the held joint (if any) at x;
  * qn: the preferred coordinates (n) at singularities. Returns the status. */
@@ -1298,7 +1440,7 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
     v3 pT = {T[3], T[7], T[11]};
     m3 G = pk_mul_t(&RT, &g.RM); /* the rotation of e1 ... e6 */
     if (g.kase == PK_BOTH)
-        return pk_swivel(P, &g, &RT, pT, &G, x, qn, o);
+        return pk_srs(P, &g, &RT, pT, x, qn, o);
     int start = g.kase == PK_START, ia = start ? 3 : 0, it = start ? 0 : 3;
     v3 p, d;
     if (start) {
@@ -1332,6 +1474,9 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
     if (code != PK_OK)
         return code;
     int any = 0;
+    unsigned lmask = 0u; /* rows outside, not flagged singular: slid only when none is inside */
+    int held_in = pk_held_inside(P, held, x); /* else no row can come inside */
+    double late[8][6];
     int jx = g.full[it], jz = g.full[it + 2];
     PkTri tri;
     pk_tri_init(&tri, g.h[it], g.h[it + 1], g.h[it + 2]);
@@ -1385,17 +1530,36 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
             int slot = 2 * pos.slot[i] + k;
             double *qs = o.Q + o.n * slot;
             int all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
-            if (!all && pk_resplit(P, &g, it, &RT, pT, th))
+            int sing = pos.sing[i] || tr.sing[k], fix = !all && held_in;
+            if (fix && pk_resplit(P, &g, it, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
             /* joints on one line only at a singular configuration: try there only */
-            if (!all && (pos.sing[i] || tr.sing[k]) && pk_repair(P, &g, &RT, pT, th))
+            if (fix && !all && sing && pk_repair(P, &g, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            if (fix && !all && pk_inside(P, &g, &RT, pT, th))
+                all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            /* a family to slide along: at rows the subproblems flag singular here,
+             * at the others below only when no row came inside */
+            if (fix && !all && sing) {
+                if (pk_slide(P, &g, &RT, pT, th))
+                    all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            } else if (fix && !all) {
+                for (int j = 0; j < 6; j++)
+                    late[slot][j] = th[j];
+                lmask |= 1u << slot;
+            }
             o.valid[slot] = 1;
             o.inside[slot] = (unsigned char)all;
-            o.sing[slot] = (unsigned char)(pos.sing[i] || tr.sing[k]);
+            o.sing[slot] = (unsigned char)sing;
             any = 1;
         }
     }
+    int inside = 0;
+    for (int slot = 0; slot < 8; slot++)
+        inside |= o.valid[slot] && o.inside[slot];
+    for (int slot = 0; slot < 8 && !inside; slot++)
+        if ((lmask >> slot & 1u) && pk_slide(P, &g, &RT, pT, late[slot]))
+            o.inside[slot] = pk_coords(P, &g, late[slot], held, x, o.Q + o.n * slot) >= -1e-9;
     return any ? PK_OK : PK_NO_ORIENTATION;
 }
 

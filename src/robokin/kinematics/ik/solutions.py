@@ -29,7 +29,7 @@ from robokin.exceptions import UnreachableError
 from robokin.spatial import wrap_angle
 
 if TYPE_CHECKING:
-    from robokin.kinematics.robot_like import RobotLike
+    from robokin.model.parts import RobotParts
 
 __all__ = ["SolutionSet", "wrap_angle"]
 
@@ -386,7 +386,7 @@ class SolutionSet:
             error=None if self.error is None else sel(rep(self.error)),
         )
 
-    def to_actuator_space(self, robot: RobotLike) -> SolutionSet:
+    def to_actuator_space(self, robot: RobotParts) -> SolutionSet:
         """The same set in motor coordinates (limits checked in both spaces)."""
         lim = robot.actuator_limits
         if robot.actuators is None or lim is None:  # limits come with the map

@@ -203,6 +203,12 @@ def setup(chain: Any, held: int | None = None, *, tol: float = 1e-9,
         dist, point = _meet(poe.h[idx], poe.o[idx])
         if dist <= lim:
             meets[case] = (dist, point, idx)
+    if held is not None:  # an SRS arm: the whole chain's shoulder 1-3 and wrist 5-7 meet
+        whole = {case: (dist, point, idx) for case, idx in
+                 ((K.PIEPER_START, [0, 1, 2]), (K.PIEPER_END, [4, 5, 6]))
+                 for dist, point in [_meet(poe.h[idx], poe.o[idx])] if dist <= lim}
+        if len(whole) == 2:
+            meets = whole
     if not meets:
         return Setup(None, "no three consecutive axes meet: " + measure(poe, held)[1])
     both = len(meets) == 2
@@ -235,8 +241,8 @@ def setup(chain: Any, held: int | None = None, *, tol: float = 1e-9,
     which = "1-3" if case == K.PIEPER_START else "4-6"
     text = f"axes {which} meet within {dist:.1e} m"
     if both:
-        text = (f"axes 1-3 and 4-6 meet within {max(d for d, _, _ in meets.values()):.1e}"
-                " m (a one-parameter family at every reachable pose: the swivel)")
+        text = (f"axes 1-3 and 5-7 meet within {max(d for d, _, _ in meets.values()):.1e}"
+                " m (an SRS arm: solved on its swivel)")
     return Setup(P, measured=text, held=held)
 
 

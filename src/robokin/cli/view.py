@@ -7,9 +7,9 @@ from typing import Annotated
 
 import typer
 
-from robokin.cli import app
+__all__ = ["commands", "view"]
 
-__all__ = ["view"]
+commands = typer.Typer()
 
 
 def _load_scene(spec: str):
@@ -22,7 +22,7 @@ def _load_scene(spec: str):
     return collision.Scene.load(path)
 
 
-@app.command()
+@commands.command()
 def view(
     name: Annotated[str, typer.Argument(help="Built-in robot name or robot file.")],
     traj: Annotated[

@@ -11,22 +11,19 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from robokin.cli import DomainFailure, app, json_text
-from robokin.cli_output import FormatOption, resolve_format
-from robokin.io.motion_files import (
-    MAX_MOTION_SAMPLES,
-    load_motion_file,
-    motion_limits,
-    plan_from_document,
-)
+from robokin.cli.common import NUMERIC_ARGS, DomainFailure, json_text
+from robokin.cli.output import FormatOption, resolve_format
+from robokin.io.motion_files import MAX_MOTION_SAMPLES, load_motion_file, motion_limits
+from robokin.trajectory.motion_plan import plan_from_document
 
 if TYPE_CHECKING:
     from robokin.robot import Robot
     from robokin.trajectory.samples import Trajectory
 
-__all__ = ["compare", "traj"]
+__all__ = ["commands", "compare", "traj"]
 
-_NUMERIC_ARGS = {"ignore_unknown_options": True}
+commands = typer.Typer()
+
 
 
 def _default_out(path: Path | None, fallback: Path, explicit: bool) -> tuple[Path, bool]:
@@ -36,7 +33,7 @@ def _default_out(path: Path | None, fallback: Path, explicit: bool) -> tuple[Pat
     return fallback, False
 
 
-@app.command(context_settings=_NUMERIC_ARGS)
+@commands.command(context_settings=NUMERIC_ARGS)
 def traj(
     file: Annotated[Path, typer.Argument(help="Motion file (YAML).")],
     output: Annotated[Path | None, typer.Option(
@@ -133,7 +130,7 @@ def traj(
             "violations": [v.__dict__ for v in report],
         }))
     else:
-        from robokin.cli_output import Column, OutputTable, emit, fixed, say
+        from robokin.cli.output import Column, OutputTable, emit, fixed, say
 
         say(f"{robot.name}: {len(tr.labels)} segments, {tr.duration:.3f} s, "
             f"{len(tr)} samples at {spec.dt * 1000:g} ms", fmt)
@@ -231,7 +228,7 @@ def _read_run(log: Path, plan: Trajectory, topic: str | None, stamp: str
                         stamp="header" if stamp == "header" else "receive")
 
 
-@app.command(context_settings=_NUMERIC_ARGS)
+@commands.command(context_settings=NUMERIC_ARGS)
 def compare(
     plan: Annotated[Path, typer.Argument(help="Planned trajectory CSV.")],
     log: Annotated[Path, typer.Argument(
@@ -281,7 +278,7 @@ def compare(
     if fmt == "json":
         print(json_text({"joints": rows, "plot": None if png is None else str(png)}))
         return
-    from robokin.cli_output import Column, OutputTable, emit, fixed, say
+    from robokin.cli.output import Column, OutputTable, emit, fixed, say
 
     table = OutputTable(f"{log.name} vs {plan.name}: {len(cmp.t)} samples compared", [
         Column("joint"), Column("unit"), Column("max |error|", fixed(4), True),

@@ -13,13 +13,15 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robokin.cli import DomainFailure, app, json_text
-from robokin.cli_output import FormatOption, resolve_format
+from robokin.cli.common import DomainFailure, json_text
+from robokin.cli.output import FormatOption, resolve_format
 
 if TYPE_CHECKING:
     from robokin.robot import Robot
 
-__all__ = ["read_trajectory_csv"]
+__all__ = ["commands", "read_trajectory_csv"]
+
+commands = typer.Typer()
 
 
 def read_trajectory_csv(path: str | Path, robot: Robot | None = None) -> tuple[Any, Any]:
@@ -42,7 +44,7 @@ def read_trajectory_csv(path: str | Path, robot: Robot | None = None) -> tuple[A
     return tr.t, tr.q
 
 
-@app.command("check", context_settings={"ignore_unknown_options": True})
+@commands.command("check", context_settings={"ignore_unknown_options": True})
 def check_command(
     scene: Annotated[
         Path, typer.Argument(help="Scene file (YAML), or a bundled name.")
@@ -141,7 +143,7 @@ def check_command(
 def _print_report(
     rep, clearance_mm: float, violated: bool, m: int, plot, top: int, fmt: str
 ) -> None:
-    from robokin.cli_output import Column, OutputTable, emit, fixed, say
+    from robokin.cli.output import Column, OutputTable, emit, fixed, say
 
     limit = max(clearance_mm * 1e-3, 0.0)
     pairs = OutputTable(f"closest pairs ({m} samples)", [

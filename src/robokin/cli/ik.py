@@ -3,18 +3,23 @@
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robokin.cli import DomainFailure, _load, app, json_text
-from robokin.cli_output import Column, FormatOption, OutputTable, emit, resolve_format
+from robokin.cli.common import DomainFailure, json_text, load_robot
+from robokin.cli.output import Column, FormatOption, OutputTable, emit, resolve_format
 from robokin.exceptions import InputError
 
-__all__ = ["ik"]
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
+__all__ = ["commands", "ik"]
+
+commands = typer.Typer()
 
 
-def _held_joints(robot: Any, items: list[str], A: float, L: float) -> dict[str, float]:
+def _held_joints(robot: Robot, items: list[str], A: float, L: float) -> dict[str, float]:
     """``--fixed NAME=VALUE`` options as ``{joint: value [rad, m]}``."""
     held: dict[str, float] = {}
     for item in items:
@@ -38,7 +43,7 @@ def _held_joints(robot: Any, items: list[str], A: float, L: float) -> dict[str, 
     return held
 
 
-def _continuum_note(robot: Any, sols: Any, held: dict[str, float]) -> str | None:
+def _continuum_note(robot: Robot, sols: Any, held: dict[str, float]) -> str | None:
     """The note for a redundant arm: the solutions listed are a sample of a continuum.
 
     None when the pose (and the held joints) leave finitely many solutions.
@@ -56,7 +61,7 @@ def _continuum_note(robot: Any, sols: Any, held: dict[str, float]) -> str | None
             "holds a joint and lists every solution of the others")
 
 
-@app.command(context_settings={"ignore_unknown_options": True})
+@commands.command(context_settings={"ignore_unknown_options": True})
 def ik(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     x: Annotated[float, typer.Argument(help="Tool position x.")],
@@ -94,7 +99,7 @@ def ik(
     from robokin.spatial import pose_from_xyz_rpy
 
     fmt = resolve_format(output_format, as_json)
-    r = _load(name)
+    r = load_robot(name)
     L = 1000.0 if mm else 1.0
     A = 180.0 / math.pi if deg else 1.0
     for label, v in zip(("x", "y", "z", "roll", "pitch", "yaw"), (x, y, z, roll, pitch, yaw)):
@@ -113,9 +118,11 @@ def ik(
             raise typer.BadParameter(f"--near needs {r.n} values, got {len(vals)}")
         q_near = np.where(rev, np.array(vals) / A, np.array(vals) / L)
     held = _held_joints(r, fixed or [], A, L)
-    options = {} if not held else {"fixed": held}
+    options: dict[str, Any] = {"method": method}  # checked by Robot.ik, naming it
+    if held:
+        options["fixed"] = held
     try:
-        sols = r.ik(T, q_near=q_near, method=method, **options)
+        sols = r.ik(T, q_near=q_near, **options)
     except InputError as exc:
         if exc.argument != "fixed":
             raise

@@ -11,10 +11,12 @@ from typing import Annotated
 
 import typer
 
-from robokin.cli import _console, _load, app, cell, json_text
-from robokin.cli_output import FormatOption
+from robokin.cli.common import cell, console, json_text, load_robot
+from robokin.cli.output import FormatOption
 
-__all__ = ["dh", "export_urdf", "import_urdf"]
+__all__ = ["commands", "dh", "export_urdf", "import_urdf"]
+
+commands = typer.Typer()
 
 
 def _not_the_input(out: Path, source: str | Path) -> None:
@@ -37,7 +39,7 @@ def _pairs(items: list[str] | None, option: str) -> dict[str, str]:
     return out
 
 
-@app.command("import")
+@commands.command("import")
 def import_urdf(
     file: Annotated[Path, typer.Argument(help="The URDF or xacro (.xacro, .urdf.xacro) file.")],
     base: Annotated[str | None, typer.Option("--base", help="Base link.")] = None,
@@ -65,12 +67,12 @@ def import_urdf(
     import yaml
 
     from robokin.io.robot_files import document_from_robot, save_robot
-    from robokin.io.urdf import robot_from_urdf
+    from robokin.io.urdf import parts_from_urdf
 
     pmap = _pairs(package, "--package")
     if out is not None:
         _not_the_input(out, file)
-    robot = robot_from_urdf(file, base_link=base, tip_link=tip, package_map=pmap,
+    robot = parts_from_urdf(file, base_link=base, tip_link=tip, package_map=pmap,
                             xacro_args=_pairs(arg, "--arg"), missing_mesh="ignore")
     info = robot.meta["urdf"]
     for note in robot.meta.get("urdf_dropped_notes", ()):
@@ -80,7 +82,7 @@ def import_urdf(
                              default_flow_style=None), end="")
         return
     save_robot(robot, out)
-    _console().print(
+    console().print(
         f"{cell(robot.name, markup=False)}: {robot.n} joints, "
         f"{cell(info.base_link, markup=False)} -> {cell(info.tip_link, markup=False)}; "
         f"wrote {out}", markup=False,
@@ -107,7 +109,7 @@ def _export_format(out: Path | None, fmt: str | None) -> str:
     return "urdf"  # .urdf, and any other name as before MJCF export existed
 
 
-@app.command("export")
+@commands.command("export")
 def export_urdf(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     out: Annotated[
@@ -132,9 +134,9 @@ def export_urdf(
     kind = _export_format(out, fmt)
     if scene is not None and kind != "mjcf":
         raise InputError("--scene", "a scene goes into an MJCF model only (-o NAME.xml)")
-    robot = _load(name)
+    robot = load_robot(name)
     if kind == "mjcf":
-        from robokin.cli_sim import load_scene
+        from robokin.cli.sim import load_scene
         from robokin.sim import to_mjcf
 
         text = to_mjcf(robot, None if scene is None else load_scene(scene))
@@ -148,11 +150,11 @@ def export_urdf(
     from robokin.io.atomic import write_atomic
 
     write_atomic(out, text)
-    _console().print(f"{cell(robot.name, markup=False)}: wrote {out} ({kind.upper()})",
+    console().print(f"{cell(robot.name, markup=False)}: wrote {out} ({kind.upper()})",
                      markup=False)
 
 
-@app.command("dh")
+@commands.command("dh")
 def dh(
     file: Annotated[Path, typer.Argument(help="The URDF or xacro file.")],
     base: Annotated[str | None, typer.Option("--base", help="Base link.")] = None,
@@ -178,7 +180,7 @@ def dh(
         "--arg", help="NAME=VALUE for a xacro's <xacro:arg> (repeatable).")] = None,
 ) -> None:
     """Derive the DH table of a URDF or xacro arm (degrees; metres unless --mm)."""
-    from robokin.cli_output import Column, OutputTable, emit, general, resolve_format
+    from robokin.cli.output import Column, OutputTable, emit, general, resolve_format
     from robokin.io.dh_extract import describe
     from robokin.io.urdf import dh_from_urdf
 

@@ -7,8 +7,8 @@ from typing import Annotated
 
 import typer
 
-from robokin.cli import app, json_text
-from robokin.cli_output import (
+from robokin.cli.common import json_text
+from robokin.cli.output import (
     Column,
     FormatOption,
     OutputTable,
@@ -17,7 +17,9 @@ from robokin.cli_output import (
     resolve_format,
 )
 
-__all__ = ["workspace"]
+__all__ = ["commands", "workspace"]
+
+commands = typer.Typer()
 
 
 def _refuse_earlier_run(targets: list[Path], out: Path) -> None:
@@ -32,7 +34,7 @@ def _refuse_earlier_run(targets: list[Path], out: Path) -> None:
                          "pass --force to replace them, or --out to write elsewhere")
 
 
-@app.command()
+@commands.command()
 def workspace(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     samples: Annotated[

@@ -1,6 +1,6 @@
 """``robokin demo --plan``: the press loading with its free moves planned by robokin.
 
-The hand-made demo (:mod:`robokin.demo`) moves between the scene's poses along
+The hand-made demo (:mod:`robokin.cli.demo`) moves between the scene's poses along
 via points a person chose. Here the two free moves (home to the pick approach,
 the pick approach to the press approach) are found by the collision-free planner
 (:class:`robokin.planning.Planner`: RRT-Connect, shortcutting, corner cutting,
@@ -15,6 +15,7 @@ does, and the whole cycle is checked against the press again, independently
 
 from __future__ import annotations
 
+import html
 import time
 from typing import TYPE_CHECKING, Any
 
@@ -25,7 +26,7 @@ if TYPE_CHECKING:
     from robokin.robot import Robot
     from robokin.trajectory.samples import Trajectory
 
-__all__ = ["planned_cycle"]
+__all__ = ["planned_cycle", "planned_html", "planned_text"]
 
 
 def _dwell(q: np.ndarray, duration: float, dt: float, label: str) -> Trajectory:
@@ -45,7 +46,8 @@ def planned_cycle(robot: Robot, scene: Scene, hand: Trajectory, plan: tuple, *,
         robot: The AUBO-i5 (unplaced; the scene places it).
         scene: The press scene.
         hand: The hand-made trajectory (its via points give each move's ends).
-        plan: The demo's steps ``(label, kind, pose, duration)`` (``demo.PLAN``).
+        plan: The demo's steps ``(label, kind, pose, duration)``
+            (:data:`robokin.cli.demo_job.PLAN`).
         clearance: Distance kept from the press [m].
         dt: Sampling period [s].
         seed: Planner seed.
@@ -99,3 +101,25 @@ def planned_cycle(robot: Robot, scene: Scene, hand: Trajectory, plan: tuple, *,
         "check_s": round(time.perf_counter() - t, 3),
     }
     return cycle, summary
+
+
+def planned_text(p: dict[str, Any]) -> str:
+    """The "planned by robokin" line of the terminal table and the report."""
+    hand = p.get("hand_made_minimum_s")
+    versus = "" if hand is None else f" against {hand:.2f} s for the hand-made path"
+    return (f"{p['duration_s']:.2f} s cycle under the AUBO-i5's joint limits{versus} "
+            f"(the same limits, process lines and dwells); free moves planned in "
+            f"{p['planning_ms']:.0f} ms; "
+            f"{'collides' if p['collides'] else 'collision-free'}, "
+            f"{p['min_clearance_mm']:.1f} mm clearance")
+
+
+def planned_html(p: dict[str, Any]) -> str:
+    """The report's "Planned by robokin" section: the line and one row per free move."""
+    rows = "\n".join(
+        f"<tr><td>{html.escape(m['label'])}</td><td>{m['waypoints']}</td>"
+        f"<td>{m['length_rad']:.3f}</td><td>{m['planning_ms']:.1f}</td>"
+        f"<td>{m['duration_s']:.3f}</td></tr>" for m in p["moves"])
+    return (f"<h2>Planned by robokin</h2><p>{html.escape(planned_text(p))}</p>"
+            "<table><tr><th>free move</th><th>waypoints</th><th>length [rad]</th>"
+            f"<th>planning [ms]</th><th>duration [s]</th></tr>{rows}</table>")

@@ -12,13 +12,18 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robokin.cli import DomainFailure, app, cell, json_text
+from robokin.cli.common import DomainFailure, cell, json_text
 
-__all__ = ["load_scene", "sim_command"]
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
+__all__ = ["commands", "load_scene", "sim_command"]
+
+commands = typer.Typer()
 
 
 def load_scene(name_or_path: str | Path) -> Any:
@@ -31,7 +36,7 @@ def load_scene(name_or_path: str | Path) -> Any:
     return collision.Scene.load(path)
 
 
-def _read_plan(path: Path, robot: Any, motors: bool) -> Any:
+def _read_plan(path: Path, robot: Robot, motors: bool) -> Any:
     from robokin.exceptions import InputError
     from robokin.trajectory.io import read_csv
 
@@ -46,7 +51,7 @@ def _read_plan(path: Path, robot: Any, motors: bool) -> Any:
     return tr.replace(space="actuator")
 
 
-@app.command("sim", context_settings={"ignore_unknown_options": True})
+@commands.command("sim", context_settings={"ignore_unknown_options": True})
 def sim_command(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     trajectory: Annotated[Path, typer.Argument(
@@ -105,10 +110,10 @@ def sim_command(
                             + "; ".join(res.reasons))
 
 
-def _print_summary(robot: Any, summary: dict[str, Any], out: Path) -> None:
+def _print_summary(robot: Robot, summary: dict[str, Any], out: Path) -> None:
     from rich.table import Table
 
-    from robokin.cli_output import console
+    from robokin.cli.output import console
     from robokin.sim.report import speed_text
 
     con = console()

@@ -8,12 +8,12 @@ from typing import Annotated
 
 import typer
 
-from robokin.cli import app
+__all__ = ["commands", "schema"]
 
-__all__ = ["schema"]
+commands = typer.Typer()
 
 
-@app.command()
+@commands.command()
 def schema(
     kind: Annotated[str, typer.Argument(help="robot | scene | motion")],
     out: Annotated[Path | None, typer.Option(

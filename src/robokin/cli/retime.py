@@ -23,13 +23,18 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robokin.cli import DomainFailure, app, cell, json_text
+from robokin.cli.common import DomainFailure, cell, json_text
 
-__all__ = ["retime_command"]
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
+__all__ = ["commands", "retime_command"]
+
+commands = typer.Typer()
 
 MARKER = "cycle_time.json"  # a folder holding this was written by robokin retime
 _ARGS = {"v_max": "--v-max", "a_max": "--a-max", "j_max": "--j-max",
@@ -67,12 +72,9 @@ def _load(file: Path, robot: str | None) -> tuple[Any, Any, dict[str, Any]]:
 
     suffix = file.suffix.lower()
     if suffix in (".yaml", ".yml"):
-        from robokin.io.motion_files import (
-            load_motion_file,
-            motion_limits,
-            plan_from_document,
-        )
+        from robokin.io.motion_files import load_motion_file, motion_limits
         from robokin.trajectory import PathError
+        from robokin.trajectory.motion_plan import plan_from_document
 
         if robot is not None:
             raise InputError("--robot", "a motion file names its own robot; --robot is "
@@ -98,7 +100,7 @@ def _load(file: Path, robot: str | None) -> tuple[Any, Any, dict[str, Any]]:
 
 
 def _choose_limits(options: dict[str, Any], own: dict[str, Any], file: Path,
-                   robot: Any) -> dict[str, str]:
+                   robot: Robot) -> dict[str, str]:
     """Fill ``options`` with the motion file's limits where no option gives one.
 
     Returns where each limit comes from, for the user: the option, the motion
@@ -142,10 +144,10 @@ def _check_out(out: Path, force: bool) -> None:
     out.mkdir(parents=True, exist_ok=True)
 
 
-def _print(rep: Any, robot: Any, files: list[Path], sources: dict[str, str]) -> None:
+def _print(rep: Any, robot: Robot, files: list[Path], sources: dict[str, str]) -> None:
     from rich.table import Table
 
-    from robokin.cli_output import console
+    from robokin.cli.output import console
 
     con = console()
     planned = rep.source_duration
@@ -173,7 +175,7 @@ def _print(rep: Any, robot: Any, files: list[Path], sources: dict[str, str]) -> 
     con.print("wrote " + ", ".join(str(f) for f in files), markup=False)
 
 
-@app.command("retime", context_settings={"ignore_unknown_options": True})
+@commands.command("retime", context_settings={"ignore_unknown_options": True})
 def retime_command(
     file: Annotated[Path, typer.Argument(
         help="Motion file (YAML) or trajectory CSV.", metavar="TRAJ")],

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robokin.cli import DomainFailure, app, json_text
-from robokin.cli_output import (
+from robokin.cli.common import DomainFailure, json_text
+from robokin.cli.output import (
     Column,
     FormatOption,
     OutputTable,
@@ -27,7 +27,12 @@ from robokin.cli_output import (
 from robokin.exceptions import InputError
 from robokin.io.atomic import check_distinct
 
-__all__ = ["MAX_AXIS_VALUES", "MAX_CANDIDATES", "parse_axis", "place_command", "reach_command"]
+if TYPE_CHECKING:
+    from robokin.robot import Robot
+
+__all__ = ["commands", "MAX_AXIS_VALUES", "MAX_CANDIDATES", "parse_axis", "place_command", "reach_command"]
+
+commands = typer.Typer()
 
 #: ``--connect-timeout``: seconds to reach a ``--scheduler`` address.
 ConnectTimeout = Annotated[float | None, typer.Option(
@@ -127,7 +132,7 @@ def _out_dir(out: Path) -> Path:
     return out
 
 
-@app.command("reach")
+@commands.command("reach")
 def reach_command(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     voxel: Annotated[float, typer.Option("--voxel", help="Voxel edge [mm].")] = 50.0,
@@ -214,7 +219,7 @@ def reach_command(
     emit(table, fmt)
 
 
-@app.command("place")
+@commands.command("place")
 def place_command(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     scene: Annotated[
@@ -306,7 +311,7 @@ def place_command(
                             f"{pl.reasons_text()}")
 
 
-def _task_poses(task: str, robot: Any, scene: Any, every: int) -> tuple[Any, bool]:
+def _task_poses(task: str, robot: Robot, scene: Any, every: int) -> tuple[Any, bool]:
     """Task poses (N, 4, 4) and whether they are a set (no order) rather than a motion."""
     import numpy as np
 
@@ -317,11 +322,11 @@ def _task_poses(task: str, robot: Any, scene: Any, every: int) -> tuple[Any, boo
     if task == "demo":
         if scene is None:
             raise InputError("--task", "'demo' needs --scene press")
-        from robokin.demo import placement_task, plan_press_loading
+        from robokin.cli.demo_job import placement_task, plan_press_loading
 
         traj, _ = plan_press_loading(scene.attach(robot), scene)
         return placement_task(traj, every), False
-    from robokin.cli_collision import read_trajectory_csv
+    from robokin.cli.collision import read_trajectory_csv
 
     _, q = read_trajectory_csv(Path(task), robot)
     placed = robot if scene is None else scene.attach(robot)

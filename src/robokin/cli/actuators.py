@@ -12,8 +12,8 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from robokin.cli import _NUMERIC_ARGS, _load, app, json_text
-from robokin.cli_output import (
+from robokin.cli.common import NUMERIC_ARGS, json_text, load_robot
+from robokin.cli.output import (
     Column,
     FormatOption,
     OutputTable,
@@ -23,7 +23,9 @@ from robokin.cli_output import (
     say,
 )
 
-__all__ = ["joints", "motors"]
+__all__ = ["commands", "joints", "motors"]
+
+commands = typer.Typer()
 
 _DEG = math.pi / 180.0
 
@@ -70,7 +72,7 @@ def _inside(values: np.ndarray, limits: np.ndarray | None) -> np.ndarray:
     return (values >= limits[:, 0] - 1e-9) & (values <= limits[:, 1] + 1e-9)
 
 
-@app.command(context_settings=_NUMERIC_ARGS)
+@commands.command(context_settings=NUMERIC_ARGS)
 def motors(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     q: Annotated[list[float], typer.Argument(help="Joint values (rad, m).")],
@@ -82,7 +84,7 @@ def motors(
 ) -> None:
     """Motor coordinates from joint coordinates: phi = A^+ (q - b)."""
     fmt = resolve_format(output_format, as_json)
-    r = _load(name)
+    r = load_robot(name)
     if len(q) != r.n:
         raise typer.BadParameter(f"{r.name} has {r.n} joints, got {len(q)} values")
     rev = r.is_revolute
@@ -97,7 +99,7 @@ def motors(
         say("no actuator map: motors drive the joints one to one", fmt)
 
 
-@app.command(context_settings=_NUMERIC_ARGS)
+@commands.command(context_settings=NUMERIC_ARGS)
 def joints(
     name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
     phi: Annotated[list[float], typer.Argument(help="Motor values (rad, m).")],
@@ -109,7 +111,7 @@ def joints(
 ) -> None:
     """Joint coordinates from motor coordinates: q = A phi + b."""
     fmt = resolve_format(output_format, as_json)
-    r = _load(name)
+    r = load_robot(name)
     angular = np.array([k == "rotary" for k in _motor_kinds(r)])
     if len(phi) != angular.size:
         raise typer.BadParameter(

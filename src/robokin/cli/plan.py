@@ -23,18 +23,24 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from robokin.cli import DomainFailure, app, json_text
-from robokin.cli_output import FormatOption, resolve_format
+from robokin.cli.common import NUMERIC_ARGS, DomainFailure, json_text
+from robokin.cli.output import FormatOption, resolve_format
 
 if TYPE_CHECKING:
-    from robokin.collision.scene import Scene
-    from robokin.robot import Robot
+    import numpy as np
 
-__all__ = ["plan_command"]
+    from robokin.collision.scene import Scene
+    from robokin.planning import Planner, PlanResult
+    from robokin.robot import Robot
+    from robokin.trajectory.samples import Trajectory
+
+__all__ = ["commands", "plan_command"]
+
+commands = typer.Typer()
 
 #: The files ``robokin plan`` writes into ``--out``.
 OUTPUTS = ("plan.csv", "plan.png")
@@ -51,7 +57,7 @@ def _numbers(text: str) -> list[float] | None:
 
 
 def _configuration(text: str, option: str, robot: Robot, scene: Scene, deg: bool,
-                   mm: bool) -> Any:
+                   mm: bool) -> np.ndarray:
     """N joint values (in the CLI units) or the name of a scene pose with ``q``."""
     import numpy as np
 
@@ -72,7 +78,7 @@ def _configuration(text: str, option: str, robot: Robot, scene: Scene, deg: bool
     return np.where(robot.is_revolute, np.array(vals) * a, np.array(vals) * length)
 
 
-def _pose(text: str, scene: Scene, deg: bool, mm: bool) -> Any:
+def _pose(text: str, scene: Scene, deg: bool, mm: bool) -> np.ndarray:
     """``x y z roll pitch yaw`` (CLI units) or a scene pose's name -> (4, 4)."""
     import numpy as np
 
@@ -120,7 +126,7 @@ def _check_out(out: Path, names: list[str], force: bool) -> None:
                          "(or choose another --out)")
 
 
-@app.command("plan", context_settings={"ignore_unknown_options": True})
+@commands.command("plan", context_settings=NUMERIC_ARGS)
 def plan_command(
     scene: Annotated[Path, typer.Argument(help="Scene file (YAML), or a bundled name.")],
     start: Annotated[str, typer.Option(
@@ -198,7 +204,9 @@ def plan_command(
     _report(res, traj, pl, files, fmt)
 
 
-def _report(res: Any, traj: Any, pl: Any, files: list[str], fmt: str) -> None:
+def _report(res: PlanResult, traj: Trajectory, pl: Planner, files: list[str],
+            fmt: str) -> None:
+    """Print what was planned and written (text or ``--json``)."""
     import numpy as np
 
     rev = pl.robot.is_revolute
@@ -212,11 +220,13 @@ def _report(res: Any, traj: Any, pl: Any, files: list[str], fmt: str) -> None:
     if fmt == "json":
         print(json_text(doc))
         return
-    from robokin.cli_output import say
+    from robokin.cli.output import say
 
+    which = "" if res.goal_index is None else \
+        f"; goal {res.goal_index + 1} of {res.goals.shape[0]}"
     say(f"{pl.robot.name} in {pl.scene.name}: path found by {res.planner} in "
         f"{res.time * 1e3:.1f} ms ({res.q.shape[0]} waypoints, joint-space length "
-        f"{res.length:.3f}; goal {res.goal_index + 1} of {res.goals.shape[0]})", fmt)
+        f"{res.length:.3f}{which})", fmt)
     say(f"time-optimal trajectory: {traj.duration:.3f} s, {len(traj)} samples, every "
         "step proven collision-free", fmt)
     say("goal [deg, mm]: " + " ".join(f"{v:g}" for v in goal), fmt)
