@@ -67,9 +67,10 @@ def bench_robokin(robot, T_single, T_batch, loop_n: int) -> None:
     P = fam.solver.params()
     T1 = np.ascontiguousarray(T_single[None])
     robot.ik(T_single)
-    raw_solve(P, T1)
+    raw_solve(P, T1, packed=robot.chain.arrays.packed)
     s_api = _best(lambda: robot.ik(T_single), number=2000)
-    s_raw = _best(lambda: raw_solve(P, T1), number=2000)
+    packed = robot.chain.arrays.packed
+    s_raw = _best(lambda: raw_solve(P, T1, packed=packed), number=2000)
     robot.ik(T_batch[:1000])
     tb = _best(lambda: robot.ik(T_batch), repeat=3)
     sols = robot.ik(T_batch)
@@ -77,8 +78,38 @@ def bench_robokin(robot, T_single, T_batch, loop_n: int) -> None:
     err = float(np.max(np.where(sols.valid, np.maximum(dp, dr), 0.0)))
     n = sols.count[:loop_n].mean()  # the same poses as the peers' counts
     _row(f"robokin {robot.name} robot.ik", s_api * 1e6, len(T_batch) / tb, n, err)
-    tr = _best(lambda: raw_solve(P, np.ascontiguousarray(T_batch)), repeat=3)
+    tr = _best(lambda: raw_solve(P, np.ascontiguousarray(T_batch), packed=packed), repeat=3)
     _row(f"robokin {robot.name} kernel only", s_raw * 1e6, len(T_batch) / tr, n, err)
+
+
+def cpu_rate(robot, T_batch) -> None:
+    """Batch throughput by wall clock and by the process's CPU time, 1 and 2 threads.
+
+    On a shared machine the wall-clock rate measures the load as much as the code;
+    poses per CPU-second (best of 5) is what one core delivers while it runs, and
+    twice that is what two free cores would. The load average is printed with it.
+    """
+    import os
+
+    import robokin._native as native
+
+    before = native.num_threads()
+    try:
+        for k in (1, 2):
+            native.set_num_threads(k)
+            robot.ik(T_batch[:1000])
+            wall = cpu = np.inf
+            for _ in range(5):
+                w0, c0 = time.perf_counter(), time.process_time()
+                robot.ik(T_batch)
+                wall = min(wall, time.perf_counter() - w0)
+                cpu = min(cpu, time.process_time() - c0)
+            n = len(T_batch)
+            print(f"  {robot.name} robot.ik, {k} thread(s): {n / wall / 1e6:.3f} M poses/s "
+                  f"wall, {n / cpu / 1e6:.3f} M poses per CPU-second "
+                  f"(load average {os.getloadavg()[0]:.1f})")
+    finally:
+        native.set_num_threads(before)
 
 
 def bench_eaik(robot, T_single, T_batch, loop_n: int) -> float:
@@ -206,6 +237,7 @@ def main(batch: int = 100_000, loop_n: int = 10_000) -> None:
         q = rng.uniform(-np.pi, np.pi, (batch, 6))
         T = robot.fk(q)
         bench_robokin(robot, T[0], T, loop_n)
+        cpu_rate(robot, T)
         eaik_rate = bench_eaik(robot, T[0], T, loop_n)
         if name == "ur5":
             bench_ur_analytic(robot, T[0], T[:loop_n])

@@ -78,6 +78,7 @@ class Kernels(Protocol):
     AXES: int
     POINTS: int
     WRIST: int
+    PERP2: int
     TOOL_T: int
     TOOL_R: int
     PERP: int
@@ -105,6 +106,13 @@ class Kernels(Protocol):
     AA: int
     BB: int
     FAMILY: int
+    E5: int
+    PLANE: int
+    SPLIT_TOL: int
+    TOL_P: int
+    TOL_R: int
+    CHECK: int
+    SIZE: int
     N_PARAMS: int
     # family codes (params[FAMILY]) and per-pose status codes
     THREE_PARALLEL: int
@@ -157,6 +165,8 @@ class Kernels(Protocol):
     # general6r_solve: solutions per pose, parameter-vector layout (GP_*: header
     # fields; VB_*: one variant block of VB_SIZE values), status and flag codes
     G6_MAXSOL: int
+    G6_MAXCAND: int
+    G6_MAXVAR: int
     GP_NVAR: int
     GP_TAIL_TOL: int
     GP_NULL_TOL: int
@@ -165,6 +175,9 @@ class Kernels(Protocol):
     GP_DEDUPE: int
     GP_MAX_ITER: int
     GP_PAIR_GAP: int
+    GP_SCALE: int
+    GP_FALLBACK: int
+    GP_NEAR_TAIL: int
     GP_HEAD: int
     VB_DIR: int
     VB_A: int
@@ -178,10 +191,16 @@ class Kernels(Protocol):
     G6_DEGENERATE: int
     G6_BAD_POSE: int
     G6F_DEGENERATE: int
-    G6F_AMBIGUOUS: int
+    G6F_CLUSTER: int
     G6F_SECONDARY: int
     G6F_SEC_DEGENERATE: int
-    G6F_SEC_AMBIGUOUS: int
+    G6F_SEC_CLUSTER: int
+    G6F_PROJECTED: int
+    G6F_PROJ_DEGENERATE: int
+    G6F_RESCUED: int
+    G6F_NOISY: int
+    G6F_SEC_NOISY: int
+    G6F_EIGEN: int
     G6_DIAG_CAND_SHIFT: int
     # ---------------------------------------------------------- pieper.c constants
     # Pieper parameter vector layout (PIEPER_N_PARAMS entries, pieper.setup), the
@@ -245,6 +264,15 @@ class Kernels(Protocol):
         target or q0 (-1 if none).
         """
 
+    def seed_uniforms(
+        self, targets: F64, q0: F64, key: int, base: int, out: F64, /
+    ) -> None:
+        """Restart numbers of targets (N, 4, 4) from q0 (N, n) into out (N, R, n).
+
+        Uniform in [0, 1), a stream per target keyed by its pose, its q0 and
+        ``key``; row r of out is the stream's number ``base + r``.
+        """
+
     def lm_path(
         self, packed: F64, targets: F64, q_start: F64, opts: F64, out: F64, /
     ) -> int:
@@ -286,14 +314,14 @@ class Kernels(Protocol):
 
     # ------------------------------------------------------------------ 6R IK
     def six_r_ik1(
-        self, T: object, params: F64, q6: float, /
+        self, T: object, params: F64, q6: float, packed: F64, /
     ) -> (
         tuple[int, F64, Bools, Bools, Bools] | tuple[int, None, None, None, None]
     ):
         """``(code, Q (8, 6), valid, singular, within_limits (8,))`` of one pose."""
 
     def six_r_ik(
-        self, params: F64, T: F64, qn: F64, /
+        self, params: F64, T: F64, qn: F64, packed: F64, /
     ) -> tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]:
         """``(Q (N, 8, 6), valid, singular, within_limits (N, 8), status (N,))``."""
 
@@ -335,6 +363,9 @@ class Kernels(Protocol):
         self, consts: F64, a: int, angles: F64, X: F64, Y: F64, /
     ) -> None:
         """The left side's fitting rows at angles (M, 3): X (M, 27), Y (M, 14)."""
+
+    def general6r_candidates(self, params: F64, T: F64, out: F64, /) -> tuple[int, int]:
+        """One pose's candidates before the polish (chain values) into out; (n, flags)."""
 
     def general6r_roots(self, c: F64, wr: F64, wi: F64, /) -> bool:
         """Roots of the polynomial with coefficients c (low order first), into wr, wi."""

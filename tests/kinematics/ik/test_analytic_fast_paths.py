@@ -159,19 +159,19 @@ def test_kernel_constants_index_what_pack_writes(name, family):
     poe = poe_from_chain(chain)
     assert P.shape == (K.N_PARAMS,)
     # the sections tile the vector without overlap
-    sizes = {"AXES": 18, "POINTS": 12, "WRIST": 3, "TOOL_T": 3, "TOOL_R": 9, "PERP": 3,
-             "SIGN": 6, "OFFSET": 6, "LO": 6, "HI": 6}
+    sizes = {"AXES": 18, "POINTS": 12, "WRIST": 3, "PERP2": 3, "TOOL_T": 3, "TOOL_R": 9,
+             "PERP": 3, "SIGN": 6, "OFFSET": 6, "LO": 6, "HI": 6, "PLANE": 7}
     scalars = ["S3", "S4", "SING_TOL", "DISC_TOL", "MIRROR", "A3", "B3", "C3", "PHI3",
                "CPHI3", "SPHI3", "A5", "B5", "C5", "PHI5", "CPHI5", "SPHI5", "AA", "BB",
-               "FAMILY"]
+               "FAMILY", "E5", "SPLIT_TOL", "TOL_P", "TOL_R", "CHECK", "SIZE"]
     used = np.zeros(K.N_PARAMS, int)
     for key, size in list(sizes.items()) + [(k, 1) for k in scalars]:
         used[getattr(K, key):getattr(K, key) + size] += 1
-    assert used.max() == 1 and used[3 * 11:3 * 12].sum() == 0  # 33-35 unused
-    assert used.sum() == K.N_PARAMS - 3
+    assert used.max() == 1 and used.sum() == K.N_PARAMS  # the sections tile it
     # what sits at each index
     assert P[K.FAMILY] == getattr(K, family)
     assert (P[K.SING_TOL], P[K.DISC_TOL], P[K.MIRROR]) == (3e-9, 7e-12, 1.0)
+    assert P[K.CHECK] == -1.0  # mirrored (near-family) seeds: Python polishes them
     np.testing.assert_array_equal(P[K.SIGN:K.SIGN + 6], chain.arrays.sign)
     np.testing.assert_array_equal(P[K.OFFSET:K.OFFSET + 6], chain.arrays.offset)
     np.testing.assert_array_equal(P[K.LO:K.LO + 6], chain.limits[:, 0])
@@ -182,7 +182,15 @@ def test_kernel_constants_index_what_pack_writes(name, family):
     h = P[K.AXES:K.AXES + 18].reshape(6, 3)
     np.testing.assert_allclose(np.linalg.norm(h, axis=1), 1.0, atol=1e-15)
     np.testing.assert_allclose(np.abs(np.einsum("ij,ij->i", h, poe.h)), 1.0, atol=1e-12)
-    assert abs(P[K.PERP:K.PERP + 3] @ h[1 if family == "THREE_PARALLEL" else 3]) < 1e-15
+    hw = h[1 if family == "THREE_PARALLEL" else 3]
+    e = P[K.PERP:K.PERP + 3]
+    assert abs(e @ hw) < 1e-15
+    np.testing.assert_array_equal(P[K.PERP2:K.PERP2 + 3], np.cross(hw, e))
+    # theta5's discriminant constant: -(hw.h5)^2 - (h5.h6)^2, zero for these wrists
+    assert P[K.E5] == -((hw @ h[4]) ** 2 + (h[4] @ h[5]) ** 2) and abs(P[K.E5]) < 1e-30
+    assert P[K.TOL_R] == 0.5e-12  # half the guarantee
+    assert P[K.TOL_P] == 0.5e-12 * max(1.0, P[K.SIZE])  # [m], arms larger than 1 m
+    assert P[K.SPLIT_TOL] == 0.4e-12
     assert P[K.S3] == np.sign(h[1] @ h[2]) and abs(P[K.S4]) == 1.0
     o = P[K.POINTS:K.POINTS + 12].reshape(4, 3)
     a = o[2] - o[1]
@@ -196,7 +204,7 @@ def test_kernel_constants_index_what_pack_writes(name, family):
     bad = P.copy()
     bad[K.FAMILY] = 2.0
     with pytest.raises(ValueError, match="6R parameter vector"):
-        kernels.six_r_ik(bad, np.eye(4)[None], np.zeros((1, 6)))
+        kernels.six_r_ik(bad, np.eye(4)[None], np.zeros((1, 6)), chain.arrays.packed)
     assert max(K.STATUS_OK, K.STATUS_OUT_OF_REACH, K.STATUS_NO_ORIENTATION) < K.BAD_POSE
 
 

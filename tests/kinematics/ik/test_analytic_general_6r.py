@@ -1,5 +1,6 @@
-"""The general 6R solver (issue 20): completeness against an independent multi-start
-reference, FK round trips, batches, threads, the root finder, and bad input."""
+"""The general 6R solver (issues 20, 23): completeness against an independent
+multi-start reference, the generating configuration at special joint values
+(hypothesis), FK round trips to 1e-12, batches, threads, the root finder, bad input."""
 
 import dataclasses
 import math
@@ -13,7 +14,9 @@ from robokin import _native
 from robokin.exceptions import InputError
 from robokin.kinematics.ik import numeric
 from robokin.kinematics.ik.analytic import general_6r
+from robokin.kinematics.ik.analytic._common import fk_error
 from robokin.kinematics.ik.analytic.detect import detect
+from robokin.kinematics.jacobian import min_singular_value
 
 K = _native.kernels
 IRB140 = Path(__file__).parents[2] / "data" / "urdf" / "irb140.urdf"
@@ -319,9 +322,10 @@ def test_prismatic_and_dependent_joints_are_not_offered():
     assert "six joints" in general_6r.why_not(panda.chain)
 
 
-def test_arm_no_variant_solves_is_not_offered_and_says_why():
-    # several consecutive axes meet and axes 3, 4 are parallel: every elimination
-    # has a rank-deficient right side or det Sigma = 0 (docs/ik.md, limits)
+def test_degenerate_arm_is_not_offered_and_says_why():
+    # axes 3 and 4 on one line (a = 0, alpha = 0, the offset along the axis): the
+    # Jacobian has rank 5 everywhere, every pose has infinitely many solutions. The
+    # family is refused with that reason, and robot.ik says it fell back to numeric.
     h = math.pi / 2
     rows = [{"a": 0.0, "d": -0.285, "alpha": -h, "theta": 2.35},
             {"a": -0.368, "d": 0.445, "alpha": 0.4381, "theta": -2.228},
@@ -330,12 +334,17 @@ def test_arm_no_variant_solves_is_not_offered_and_says_why():
             {"a": 0.0, "d": -0.032, "alpha": -h, "theta": 1.579},
             {"a": 0.0, "d": 0.0, "alpha": 0.0, "theta": -2.369}]
     robot = robokin.Robot.from_dh(rows)
+    assert robot.is_singular(np.random.default_rng(0).uniform(-3, 3, (50, 6)), tol=1e-9).all()
     fam = robokin.ik.family(robot)
     assert fam.name == "none" and fam.solver is None
-    assert "general_6r: no elimination variant finds every solution" in fam.reason
+    assert "general_6r: a degenerate arm: its Jacobian has rank below 6" in fam.reason
     assert general_6r.setup(robot.chain).params is None
-    sols = robot.ik(robot.fk(np.full(6, 0.3)))  # the numeric fallback
+    with pytest.raises(InputError, match="degenerate arm"):
+        general_6r.solve(robot, robot.fk(np.full(6, 0.3)))
+    sols = robot.ik(robot.fk(np.full(6, 0.3)))  # the numeric fallback, and it says so
     assert sols.method == "numeric" and sols.count >= 1
+    with pytest.raises(InputError, match="degenerate arm"):
+        robot.ik(robot.fk(np.full(6, 0.3)), method="analytic")
 
 
 def test_bad_pose_and_option_raise_input_errors():
@@ -366,3 +375,272 @@ def test_kernel_rejects_inconsistent_arguments():
         general_6r.raw_solve(robokin.load("panda").chain, g.params, T)
     with pytest.raises(ValueError, match="degree"):
         K.general6r_roots(np.array([1.0, 0.0]), np.empty(2), np.empty(2))
+
+
+# ------------------------------------------ special configurations (issue 23)
+# The oracle: a configuration whose Jacobian's smallest singular value is above
+# ISOLATED (rows in m and rad per rad) has isolated solutions, so the configuration
+# that made the pose must come back (modulo 2 pi, within GENERATING_TOL rad); at a
+# singular one (a continuum, or two solutions merging) at least one solution must.
+# Every returned solution reproduces its pose to FK_TOL: position error [m] per metre
+# of the arm's scale (1 for arms of about a metre) and rotation error [rad].
+ISOLATED = 1e-3
+GENERATING_TOL = 1e-6
+FK_TOL = 1e-12
+SPECIAL = (0.0, math.pi / 2, -math.pi / 2, math.pi)
+TINY = (0.0, 1e-9, -1e-9, 1e-7, -1e-7, 1e-6, -1e-6)
+H = math.pi / 2
+# random sparse DH arms outside every closed form, (a [m], d [m], alpha [rad]) per
+# joint, theta offsets 0; each exposed a failure mode (docs/ik.md, General 6R arms)
+SPARSE_ROWS = {
+    "sparse_a": [(0.0, 0.1395, H), (-0.3161, 0.427, -3.031215), (0.0, 0.0, -H),
+                 (-0.2219, 0.0, 0.0), (0.0, 0.0, H), (0.0, 0.0, -0.437946)],
+    "sparse_b": [(0.0, 0.33, H), (0.0, -0.4014, 2.462557), (0.4209, 0.0, 0.0),
+                 (0.0153, -0.1615, H), (-0.0485, 0.0, 0.0), (0.0, 0.0, 0.0)],
+    "sparse_c": [(0.0, 0.0, H), (0.0, -0.1897, -H), (0.0, 0.2472, 0.604968),
+                 (0.0, -0.2141, H), (-0.2824, -0.1452, 0.0), (0.0, -0.1591, -0.346073)],
+    "sparse_d": [(0.0, 0.127, -H), (-0.2229, -0.1015, -1.272109), (-0.3101, 0.0, 0.0),
+                 (-0.0494, 0.0, 0.0), (0.0, 0.116, -H), (0.4634, 0.4652, 0.975554)],
+    "sparse_e": [(0.471, -0.2789, 0.0), (0.2585, 0.4837, -0.330254), (-0.0058, 0.2051, 0.0),
+                 (0.0142, 0.0, -H), (0.0233, 0.0, 0.0), (-0.1993, 0.0, -2.029053)],
+    "sparse_f": [(0.2869, 0.0, 0.0), (0.0, -0.1508, H), (0.0, -0.1198, 3.072959),
+                 (0.4445, 0.0, -H), (-0.0895, -0.0399, 0.0), (0.0, -0.2543, -2.289809)],
+    "sparse_h": [(-0.3898, 0.0421, 0.0), (-0.019, 0.0, 0.0), (0.472, 0.0, H),
+                 (0.0, 0.0, -1.218876), (-0.1349, 0.2073, -H), (0.0, 0.0, -H)],
+}
+
+
+def sparse_arm(name):
+    rows = [{"joint": "revolute", "a": a, "d": d, "alpha": al, "theta": 0.0,
+             "limits": [-math.pi, math.pi]} for a, d, al in SPARSE_ROWS[name]]
+    return robokin.Robot.from_dh(rows, name=name)
+
+
+def general_arm(seed):
+    return random_dh_arm(np.random.default_rng(seed), name=f"general_{seed}")
+
+
+def six_r_arm(name):
+    if name == "irb140":
+        return irb140()
+    if name.startswith("general_"):
+        return general_arm(int(name.split("_")[1]))
+    return sparse_arm(name)
+
+
+# Panda joints held (the reduced chains are general 6R on this branch; another solver
+# may take some, hence the method is only required not to be the numeric fallback)
+HELD = {"joint1": 0.4, "joint2": -0.6, "joint3": 0.9, "joint4": -1.2, "joint5": 0.7,
+        "joint6": 1.2, "joint7": 0.7}
+
+
+def check_special(robot, q, sols, T, scale, smin):
+    """The oracle above for configurations q (m, n), their poses T, the SolutionSet,
+    the arm's scale [m] and the Jacobian's smallest singular values smin (m,)."""
+    dp, dr = fk_error(robot.chain, sols.q, T)
+    err = np.where(sols.valid, np.maximum(dp / max(1.0, scale), dr), 0.0)
+    assert err.max() <= FK_TOL, err.max()
+    gap = np.where(sols.valid, np.abs(wrapped(sols.q - q[:, None, :])).max(axis=-1),
+                   np.inf).min(axis=-1)
+    isolated = smin > ISOLATED
+    lost = isolated & (gap >= GENERATING_TOL)
+    assert not lost.any(), q[lost].tolist()
+    assert (sols.count[~isolated] >= 1).all(), q[~isolated & (sols.count == 0)].tolist()
+
+
+def check_6r(robot, q):
+    """check_special on a 6R arm solved by robot.ik."""
+    T = robot.fk(q)
+    sols = robot.ik(T)
+    assert sols.method == "general_6r"
+    check_special(robot, q, sols, T, general_6r.setup(robot.chain).scale,
+                  min_singular_value(robot.chain, q))
+
+
+def special_configurations(limits, size=12):
+    """Hypothesis strategy: (size, n) joint values, each joint at 0, +-pi/2 or pi plus
+    0, +-1e-9, +-1e-7 or +-1e-6, at a limit, or uniform."""
+    st = pytest.importorskip("hypothesis.strategies")
+    special = st.builds(lambda b, t: b + t, st.sampled_from(SPECIAL), st.sampled_from(TINY))
+
+    def joint(lo, hi):
+        ends = st.sampled_from([max(lo, -math.pi), min(hi, math.pi)])
+        return st.one_of(special, special, ends, st.floats(-math.pi, math.pi))
+
+    row = st.tuples(*(joint(lo, hi) for lo, hi in limits))
+    return st.lists(row, min_size=size, max_size=size).map(np.array)
+
+
+@pytest.mark.parametrize("name", ["irb140", "general_31", "general_32", "general_33",
+                                  *SPARSE_ROWS])
+def test_generating_configuration_at_special_joint_values(name):
+    hyp = pytest.importorskip("hypothesis")
+    robot = six_r_arm(name)
+    assert robokin.ik.family(robot).name == "general_6r"
+
+    @hyp.settings(max_examples=25, deadline=None, derandomize=True, database=None)
+    @hyp.given(special_configurations(robot.limits))
+    def check(q):
+        check_6r(robot, q)
+
+    check()
+
+
+@pytest.mark.parametrize("joint", list(HELD))
+def test_panda_with_a_joint_held_at_special_joint_values(joint):
+    # the reduced chain (any one joint held) is solved without the numeric fallback;
+    # the oracle on the Panda's own configuration, through the public held-joint call
+    hyp = pytest.importorskip("hypothesis")
+    panda = robokin.load("panda")
+    k = int(joint[-1]) - 1
+    keep = [j for j in range(7) if j != k]
+    scale = general_6r.setup(panda.chain.with_fixed({k: HELD[joint]})).scale
+    free = np.delete(panda.limits, k, axis=0)
+
+    @hyp.settings(max_examples=25, deadline=None, derandomize=True, database=None)
+    @hyp.given(special_configurations(free))
+    def check(q6):
+        q = np.insert(q6, k, HELD[joint], axis=1)
+        T = panda.fk(q)
+        sols = panda.ik(T, fixed={joint: HELD[joint]})
+        assert not sols.method.startswith("numeric"), sols.method
+        smin = np.linalg.svd(panda.jacobian(q)[..., keep], compute_uv=False)[..., -1]
+        check_special(panda, q, sols, T, scale, smin)
+
+    check()
+
+
+# configurations the elimination lost before issue 23 (on the arms above; found by
+# the special-value sweeps): each must now come back
+LOST = [
+    # four solutions share joint 6: a 4-dimensional null space (split by the shifts)
+    ("irb140", [math.pi, 1.441969420022903, 0.27410390540137985, -math.pi, -2.0944, -math.pi]),
+    ("irb140", [-0.08899906526957402, 2.447224238106835, 1.1345, -math.pi,
+                -1.5707962267948965, 1e-07]),
+    ("irb140", [H, 2.0900648210551056, 0.0, -math.pi, -H, -math.pi]),
+    # the Panda with joint 1 held at 0 / 0.7, joint 3 at 0 and joint 7 at 0.7:
+    # clusters, a degenerate primary, a pose 1e-7 from a degenerate one, a noisy
+    # cluster where every other variant is degenerate (the primary's sibling)
+    ("panda_joint7_0.7", [2.8973, 1.5707962267948965, H, -3.0718, 3.141592753589793,
+                          3.1415936535897933]),
+    ("panda_joint1_0", [-1.5707963277948966, math.pi, -1.4694468369271578, -H, -H,
+                        3.141592652589793]),
+    ("panda_joint1_0", [-1.7628, math.pi, 1.5707963257948965, -1.5707964267948966,
+                        1.5707973267948965, -2.8973]),
+    ("panda_joint1_0.7", [1.7628, math.pi, -1.0567443151570002, H, -1.5707963257948965,
+                          math.pi]),
+    ("panda_joint3_0", [-2.8973, 1.7628, -1.5707963257948965, 0.0, -1.5707963277948966,
+                        1.8200234741852706]),
+    ("panda_joint3_0", [-1.4216889866622433, 1.5707953267948966, -3.0718, 0.0,
+                        -1.6216714595150272, H]),
+    # sparse arms: solutions sharing angles, a nearly rank-deficient right side,
+    # every variant degenerate (the projection), a wide multiple root
+    ("sparse_a", [0.7249860371262926, H, -math.pi, 1.5707963277948966, -1e-09,
+                  0.9453635139748178]),
+    ("sparse_a", [2.8207963021201756, -0.2510437936434946, math.pi, -0.016193681844320018,
+                  -1.5707953267948966, math.pi]),
+    ("sparse_b", [2.788486605067879, H, H, -math.pi, 1.5707963257948965, -0.44124258698566]),
+    ("sparse_b", [-H, H, H, math.pi, -math.pi, -math.pi]),
+    ("sparse_c", [math.pi, H, 0.0, -H, 1.998813010710128, -1.5707953267948966]),
+    ("sparse_c", [0.0, H, 0.0, -H, 0.4425330513975929, math.pi]),
+    ("sparse_d", [-1e-07, H, math.pi, H, math.pi, 0.31291939267913005]),
+    ("sparse_e", [-1.2396648034037674, math.pi, -1.5707962267948965, -1.4435457642274057,
+                  -1e-09, -1.5707964267948966]),
+    # singular targets (a continuum): one valid solution
+    ("sparse_a", [H, -1.5707963277948966, -1e-09, math.pi, -H, 0.21721860372141277]),
+    ("sparse_c", [-H, math.pi, 0.0, -math.pi, H, 1.5707973267948965]),
+    ("sparse_e", [0.28006822694827394, -1.5707962267948965, H, -H, -H, math.pi]),
+    ("sparse_f", [3.141592652589793, 2.447224238106835, 1.5707973267948965, -H, math.pi,
+                  3.141592654589793]),
+    ("sparse_h", [-H, -1e-07, -math.pi, -1.5707963277948966, -1.5707953267948966, -1e-06]),
+]
+
+
+def lost_arm(name):
+    if name.startswith("panda_joint"):
+        joint, value = name[len("panda_"):].split("_")
+        panda = robokin.load("panda")
+        k = int(joint[-1]) - 1
+        return robokin.Robot(panda.chain.with_fixed({k: float(value)}), name=name)
+    return six_r_arm(name)
+
+
+def test_configurations_lost_before_now_come_back():
+    for name, q in LOST:
+        check_6r(lost_arm(name), np.array([q]))
+
+
+def test_special_poses_against_a_dense_multistart():
+    # the whole solution set, not only the generating configuration: a pose where four
+    # solutions share joint 6 (IRB140), one where every variant is degenerate
+    # (sparse_c: the projection), one near a degenerate pose (sparse_a)
+    for name, q in (LOST[0], LOST[13], LOST[9]):
+        robot = six_r_arm(name)
+        T = robot.fk(np.array(q))
+        ours = robot.ik(T).solutions()
+        ref = multistart_reference(robot, T, seed=7, n_seeds=1500)
+        assert len(ref) >= 1
+        assert len(not_in(ref, ours)) == 0, (name, "missing solutions")
+        assert len(not_in(ours, ref)) == 0, (name, "solutions the reference does not have")
+
+
+def test_kernel_candidates_and_flags_on_a_degenerate_pose():
+    # sparse_c at LOST[13]: det Sigma vanishes for every theta in every variant, the
+    # projection (c_d) gives candidates near the generating configuration
+    robot = sparse_arm("sparse_c")
+    g = general_6r.setup(robot.chain)
+    q = np.array(LOST[13][1])
+    out = np.empty((K.G6_MAXCAND, 6))
+    n, flags = K.general6r_candidates(g.params, np.ascontiguousarray(robot.fk(q)), out)
+    assert flags & K.G6F_DEGENERATE and flags & K.G6F_PROJECTED
+    assert not flags & K.G6F_PROJ_DEGENERATE
+    assert np.abs(wrapped(out[:n] - q)).max(axis=1).min() < 1e-4
+    with pytest.raises(ValueError, match="candidates"):
+        K.general6r_candidates(g.params, np.eye(3), out)
+
+
+def test_setup_ranks_fallback_variants_with_their_own_right_side():
+    g = general_6r.setup(irb140().chain)
+    p = g.primary
+    sibling = general_6r.Variant(p.reversed, p.split, 1 - p.multiplier)
+    assert g.variants[:2] == (g.primary, g.secondary)
+    assert g.variants[-1] == sibling or (g.secondary == sibling
+                                         and len(g.variants) == 2 + general_6r.FALLBACKS)
+    fallbacks = g.variants[2:2 + general_6r.FALLBACKS]
+    sides = {(v.split, v.reversed) for v in fallbacks}
+    assert len(sides) == general_6r.FALLBACKS
+    assert not sides & {(v.split, v.reversed) for v in g.variants[:2]}
+    assert int(g.params[K.GP_NVAR]) == len(g.variants)
+    assert 2.5 < g.scale < 3.5  # the rtb-data IRB140 file is a 2.8 m model
+
+
+def test_panda_with_joint2_held_at_zero_is_degenerate_and_says_so():
+    # joint 2 at 0 puts axes 1 and 3 on one line: every pose has a continuum of
+    # solutions; the held-joint call falls back to the numeric solver and says so
+    panda = robokin.load("panda")
+    q = np.array([0.3, 0.0, 0.2, -2.0, 0.4, 1.6, 0.7])
+    sols = panda.ik(panda.fk(q), fixed={"joint2": 0.0})
+    assert sols.method == "numeric (joint2 held)"
+    reduced = robokin.Robot(panda.chain.with_fixed({1: 0.0}))
+    assert "a degenerate arm" in robokin.ik.family(reduced).reason
+
+
+def test_nearly_degenerate_arm_is_refused_with_a_reason_not_a_traceback():
+    # a random sparse arm (found by the sparse sweep): axes 1, 2 parallel, axis 3
+    # 2.9e-4 rad from them and a spherical wrist, 2.9e-4 rad from rank 5 everywhere
+    # (Jacobian's smallest singular value 1e-8..9e-5): no set-up configuration has
+    # isolated solutions. The family is refused with that reason (it raised a bare
+    # ValueError from numpy before); robot.ik falls back to numeric and says so, and
+    # method="analytic" is an InputError naming the reason.
+    rows = [(-0.1498, -0.4836, 0.0), (-0.3551, 0.0, 0.000287), (-0.1308, 0.0, H),
+            (0.0, -0.3423, H), (0.0, 0.0, -H), (0.0, 0.0, -H)]
+    robot = robokin.Robot.from_dh([{"joint": "revolute", "a": a, "d": d, "alpha": al,
+                                    "theta": 0.0, "limits": [-math.pi, math.pi]}
+                                   for a, d, al in rows])
+    fam = robokin.ik.family(robot)
+    assert fam.solver is None
+    assert "general_6r: a nearly degenerate arm" in fam.reason
+    q = np.array([0.3, 0.2, -0.4, 0.5, 0.6, 0.7])
+    assert robot.ik(robot.fk(q)).method == "numeric"
+    with pytest.raises(InputError, match="nearly degenerate arm"):
+        robot.ik(robot.fk(q), method="analytic")

@@ -429,4 +429,75 @@ static int pose_problem(const double *T, double row_tol, double orth_tol)
     return det < 0.0 ? 4 : 0;
 }
 
+/* ------------------------------------------------------- singular values */
+
+/* Smallest singular value of 6 x 6 Jacobians J[r * js + j] (lane-wise): inverse
+ * iteration on J^T J (Cholesky), from the unit vector of the smallest Cholesky
+ * pivot, then the Rayleigh quotient; an upper bound that is sharp when J is nearly
+ * singular, 0 where J^T J is not positive definite (to rounding). The closed forms'
+ * singular flag (six_r.c); robot.is_singular computes the same with an SVD. */
+ALWAYS_INLINE vd jac_sigma_min6(const vd *J, int js)
+{
+    vd B[36], L[36];
+    for (int i = 0; i < 6; i++)
+        for (int j = i; j < 6; j++) {
+            vd s = BR(0.0);
+            for (int r = 0; r < 6; r++)
+                s += J[r * js + i] * J[r * js + j];
+            B[6 * i + j] = B[6 * j + i] = s;
+        }
+    vl bad = BRL(0);
+    for (int j = 0; j < 6; j++) {
+        vd s = B[6 * j + j];
+        for (int k = 0; k < j; k++)
+            s -= L[6 * j + k] * L[6 * j + k];
+        bad |= ~(s > BR(0.0));
+        L[6 * j + j] = vsqrt(vsel(bad, BR(1.0), s));
+        vd inv = BR(1.0) / L[6 * j + j];
+        for (int i = j + 1; i < 6; i++) {
+            vd t = B[6 * i + j];
+            for (int k = 0; k < j; k++)
+                t -= L[6 * i + k] * L[6 * j + k];
+            L[6 * i + j] = t * inv;
+        }
+    }
+    vd x[6], small = L[0];
+    vl at = BRL(0);
+    for (int k = 1; k < 6; k++) {
+        vl m = L[6 * k + k] < small;
+        small = vsel(m, L[6 * k + k], small);
+        at = (at & ~m) | (BRL(k) & m);
+    }
+    for (int k = 0; k < 6; k++)
+        x[k] = vsel(at == BRL(k), BR(1.0), BR(0.0));
+    for (int it = 0; it < 4; it++) {
+        vd z[6], nrm = BR(0.0);
+        for (int i = 0; i < 6; i++) { /* L z = x */
+            vd s = x[i];
+            for (int k = 0; k < i; k++)
+                s -= L[6 * i + k] * z[k];
+            z[i] = s / L[6 * i + i];
+        }
+        for (int i = 5; i >= 0; i--) { /* L^T x = z */
+            vd s = z[i];
+            for (int k = i + 1; k < 6; k++)
+                s -= L[6 * k + i] * x[k];
+            x[i] = s / L[6 * i + i];
+            nrm += x[i] * x[i];
+        }
+        vd inv = BR(1.0) / vsqrt(vsel(nrm > BR(0.0), nrm, BR(1.0)));
+        for (int i = 0; i < 6; i++)
+            x[i] *= inv;
+    }
+    vd lam = BR(0.0); /* Rayleigh quotient x^T B x */
+    for (int i = 0; i < 6; i++) {
+        vd bx = BR(0.0);
+        for (int j = 0; j < 6; j++)
+            bx += B[6 * i + j] * x[j];
+        lam += x[i] * bx;
+    }
+    vd sig = vsqrt(vsel(lam > BR(0.0), lam, BR(0.0)));
+    return vsel(bad | ~vfinite(sig), BR(0.0), sig);
+}
+
 #endif

@@ -28,29 +28,66 @@
  * x = tan((theta_a - phi) / 2) (phi + pi the sample of largest |D|): the roots the
  * samples bracket by safeguarded Newton steps, deflated, then the eigenvalues of
  * the deflated polynomial's balanced companion matrix (Francis double-shift QR as
- * in EISPACK hqr). Roots with a small imaginary part are tried too. Each root: the
- * null vector of Sigma (pivoted QR) gives x_b, x_c; least squares on Q's block
- * gives u, w; joint a+3 follows from the orientation. Where two roots are close or
- * complex (two solutions nearly sharing theta_a) both solutions also come from the
- * span of Sigma's two smallest singular vectors (a 2 x 2 pencil). Newton steps on
- * the true chain polish every candidate; a candidate whose error stops falling is
- * spurious and dropped, and so is one that does not reproduce the pose to 1e-9.
+ * in EISPACK hqr). Roots with a small imaginary part are tried too.
+ *
+ * Back-substitution. Each root: the null vector of Sigma (pivoted QR) is the
+ * monomial vector of (x_b, x_c), read as two half angles (principal axes, finite at
+ * x = inf); least squares on Q's block gives u, w; joint a+3 follows from the
+ * orientation. Where k solutions share theta_a (special configurations: the four
+ * arm solutions of an IRB140 sharing the wrist angle, k = 4), Sigma's null space
+ * has dimension k and any null vector is a mix of their monomial vectors. Roots
+ * closer than GP_PAIR_GAP or complex (how a k-fold root comes out of rounding:
+ * spread by eps^(1/k)) form a cluster; at its centroid the k trailing columns of a
+ * rank-revealing QR span the null space, and the monomial structure splits it
+ * (g6_split, Moller-Stetter): y[up] = x_b y[dn] for every genuine monomial vector,
+ * so inside the null space the solutions are the common eigenvectors of the k x k
+ * shift operators along b and along c (one eigenproblem of a generic combination).
+ *
+ * Degenerate poses. At some poses of some arms det Sigma vanishes for every theta
+ * (in every variant): the eliminated system has a spurious solution curve besides
+ * the isolated solutions. Then the pose is moved along a fixed direction xi,
+ * T(s) = T Exp(s xi): the isolated solutions move with it, so along theta(s)
+ * det Sigma(theta(s); T(s)) = 0, and the lowest coefficient c_d(theta) of
+ * det(Sigma_0(theta) + s Sigma_1(theta)) (Sigma_1 = d Sigma / ds at s = 0, computed
+ * exactly) vanishes at every isolated solution's theta_a (the generalized
+ * characteristic polynomial of Canny 1990, with the pose as the perturbation, which
+ * keeps the system consistent). c_d is again a trigonometric polynomial of degree
+ * 8: sampled from a complete-pivoting LU of Sigma_0 (c_d = det U_11 det(Schur
+ * complement of Sigma_1 on the d-dimensional null spaces)); at its roots the
+ * solutions' monomial vectors lie in Sigma_0's right null space V and are null
+ * vectors of Y^T Sigma_1 V (Y the left null space).
+ *
+ * Newton steps on the true chain (Levenberg-Marquardt with damping |e|^2,
+ * Yamashita & Fukushima 2001: quadratic near regular solutions, and convergent onto
+ * a manifold of solutions) polish every candidate; a candidate whose error stops
+ * falling far from zero is spurious and dropped; a solution is kept when it
+ * reproduces the pose to GP_TOL (position [m] and rotation [rad]), once.
+ * Where nothing at all is found and the elimination reported trouble (a singular
+ * target: a continuum of solutions), the null spaces of Sigma at the 24 sample
+ * angles are split into candidates instead (flagged G6F_RESCUED): where the
+ * continuum moves theta_a, those in its range are on it.
  *
  * An arm is solved by a variant: the split a, the chain or its reversal (the IK
  * of T^-1 on C_6^-1 Rz(-v_6) ... Rz(-v_1) C_0^-1) and the multiplier. The Python
- * set-up picks a primary and a secondary one; the secondary runs for a pose when
- * the primary's determinant is degenerate or one of its roots has a null space of
- * dimension two (two solutions sharing theta_a, e.g. a wrist flip), and the
- * solutions of both are merged.
+ * set-up ranks a few (primary, secondary, then others with another split or
+ * direction); for a pose the next one runs while the previous is degenerate or
+ * noisy there.
  *
  * References:
  *   Raghavan, M. and Roth, B. "Inverse kinematics of the general 6R manipulator
  *   and related linkages", J. Mech. Design 115(3), 1993.
  *   Manocha, D. and Canny, J. "Efficient inverse kinematics for general 6R
  *   manipulators", IEEE Trans. Robotics and Automation 10(5), 1994.
+ *   Canny, J. "Generalised characteristic polynomials", J. Symbolic Computation
+ *   9(3), 1990.
+ *   Moller, H. M. and Stetter, H. J. "Multivariate polynomial equations with
+ *   multiple zeros solved by matrix eigenproblems", Numer. Math. 70, 1995.
+ *   Yamashita, N. and Fukushima, M. "On the rate of convergence of the
+ *   Levenberg-Marquardt method", Computing Suppl. 15, 2001.
  *   Smith, B. T. et al. "Matrix Eigensystem Routines - EISPACK Guide", 1976
  *   (balanc, hqr). Golub, G. and Van Loan, C. "Matrix Computations", 4th ed.,
- *   5.2 (Householder QR), 5.4.2 (column pivoting).
+ *   5.2 (Householder QR), 5.4.2 (column pivoting), 3.4.8 (complete pivoting),
+ *   7.4 (Hessenberg reduction), 7.6.1 (inverse iteration).
  *
  * GENERAL6R_METHODS lists this file's entries of module.c's method table;
  * general6r_constants(m) adds its constants to the module.
@@ -66,19 +103,30 @@
 #define G6_NSAMP 24    /* samples of det Sigma */
 #define G6_DEG 8       /* its trigonometric degree */
 #define G6_MAXDEG 32   /* polynomials general6r_roots takes */
+#define G6_MAXSPLIT 8  /* largest null space split into solutions */
+#define G6_VARCAND (3 * G6_MAXROOT + 2 * G6_MAXSPLIT) /* candidates of one variant */
+#define G6_MAXCAND (8 * G6_VARCAND) /* of one pose (the room g6_candidates fills) */
+#define G6_MAXVAR 12   /* variants a parameter vector holds */
+#define G6_MULTI_TOL 1e-4 /* a root near others whose Sigma has a second pivot below this
+                           * fraction of the largest: a spread multiple root */
 #define G6_GRAIN 8     /* poses per pool chunk */
 #define G6_PARALLEL_MIN 32
 
 /* params: a header, then G6_NVAR variant blocks (robokin's general_6r packs it) */
-enum { GP_NVAR = 0 /* variants: 1 (primary) or 2 (+ secondary) */,
+enum { GP_NVAR = 0 /* variants, in the order tried: 1 (primary) .. G6_MAXVAR */,
        GP_TAIL_TOL = 1 /* largest relative DFT tail above degree 8 */,
-       GP_NULL_TOL = 2 /* second-smallest / largest pivot of Sigma: 2-D null space */,
+       GP_NULL_TOL = 2 /* pivot of Sigma below this fraction of the largest: null */,
        GP_IMAG_TOL = 3 /* imaginary part of theta_a accepted as real */,
        GP_TOL = 4 /* position [m] and rotation [rad] error of a solution */,
        GP_DEDUPE = 5 /* solutions closer than this [rad] are one */,
        GP_MAX_ITER = 6 /* Newton iterations */,
-       GP_PAIR_GAP = 7 /* [rad] roots closer than this: both solutions from a 2-D null space */,
-       GP_HEAD = 8 };
+       GP_PAIR_GAP = 7 /* [rad] roots closer than this form a cluster */,
+       GP_SCALE = 8 /* [m] the arm's length scale: position part of the pose motions */,
+       GP_FALLBACK = 9 /* 1: the projection and the rescue run where needed (0: the
+                        * variants alone, for the set-up's trials) */,
+       GP_NEAR_TAIL = 10 /* a tail above this (and within GP_TAIL_TOL): a noisy
+                          * determinant near a degenerate pose, the projection too */,
+       GP_HEAD = 11 };
 /* variant block: direction (0 the chain, 1 its reversal), split a, multiplier
  * (0 x_b, 1 x_c), the direction's constants C'_0..C'_6 and their inverses (4x4
  * row-major), the fitted P_s, P_c, P_1 (14 x 9 row-major each) */
@@ -88,12 +136,22 @@ enum { VB_DIR = 0, VB_A = 1, VB_MULT = 2, VB_C = 4, VB_CI = VB_C + 7 * 16,
 enum { G6_OK = 0, G6_NONE = 1 /* no real solution */,
        G6_DEGENERATE = 2 /* no solution and the elimination was degenerate */,
        G6_BAD_POSE = 3 /* a non-finite pose */ };
-/* per pose diagnostics (bit flags) */
-enum { G6F_DEGENERATE = 1, G6F_AMBIGUOUS = 2, G6F_SECONDARY = 4, G6F_SEC_DEGENERATE = 8,
-       G6F_SEC_AMBIGUOUS = 16 };
-#define G6_DIAG_CAND_SHIFT 8 /* diag >> 8: the roots back-substituted (polish candidates) */
+/* per pose diagnostics (bit flags): the primary degenerate (its right side rank
+ * deficient or det Sigma identically 0) / it split a cluster; the secondary ran /
+ * was degenerate / split a cluster; the projection (c_d) ran / was degenerate too;
+ * the rescue (a singular target) ran; the primary / secondary noisy (near a
+ * degenerate pose: a tail above GP_NEAR_TAIL, Sigma nearly singular at every
+ * sample, or a simple root with a 2-D null space) */
+enum { G6F_DEGENERATE = 1, G6F_CLUSTER = 2, G6F_SECONDARY = 4, G6F_SEC_DEGENERATE = 8,
+       G6F_SEC_CLUSTER = 16, G6F_PROJECTED = 32, G6F_PROJ_DEGENERATE = 64,
+       G6F_RESCUED = 128, G6F_NOISY = 256, G6F_SEC_NOISY = 512, G6F_EIGEN = 1024,
+       G6F_MULTI = 2048 /* internal: a root with a second small pivot */ };
+#define G6_DIAG_CAND_SHIFT 16 /* diag >> 16: the candidates polished */
 
-/* tables filled once at module init (general6r_constants) */
+/* the fixed direction xi (rotation, translation per GP_SCALE) poses are moved along:
+ * no structure an arm could share (components from the golden ratio's powers) */
+static const double G6_XI[6] = {0.3090169943749474, -0.4999999999999999, 0.6180339887498949,
+                                0.4045084971874737, -0.2360679774997897, 0.1458980337503155};
 static double g6_xgi[9][9];          /* inverse of the u, w grid's monomial matrix */
 static double g6_er[17][17], g6_ei[17][17]; /* (1 + ix)^m (1 - ix)^(16-m): x^j coefficients */
 static double g6_cs[G6_NSAMP], g6_sn[G6_NSAMP]; /* cos, sin of 2 pi k / 24 */
@@ -238,9 +296,12 @@ static void house_apply_t(const double *V, const double *beta, int m, int n, dou
 
 /* det Sigma(theta_k) = det(s_k S[0] + c_k S[1] + S[2]) (12 x 12 row-major) for the W
  * sample angles k0 .. k0 + W - 1, one per lane: LU with partial pivoting (each lane
- * its own pivots) */
-static void det12_lanes(const double (*S)[144], int k0, double *out)
+ * its own pivots); ratio: the smallest |pivot| over the largest (small at every
+ * sample: Sigma is nearly rank deficient for every theta, a pose near a degenerate
+ * one) */
+static void det12_lanes(const double (*S)[144], int k0, double *out, double *ratio)
 {
+    vd pmin = BR(INFINITY), pmax = BR(0.0);
     vd sv, cv, A[144];
     for (int l = 0; l < W; l++) {
         sv[l] = g6_sn[k0 + l];
@@ -270,6 +331,8 @@ static void det12_lanes(const double (*S)[144], int k0, double *out)
             d = vsel(m, -d, d);
         }
         vd p = A[12 * k + k];
+        pmin = vsel(vabs(p) < pmin, vabs(p), pmin);
+        pmax = vsel(vabs(p) > pmax, vabs(p), pmax);
         vl zero = p == BR(0.0);
         d = vsel(zero, BR(0.0), d * p);
         vd inv = BR(1.0) / vsel(zero, BR(1.0), p);
@@ -280,15 +343,18 @@ static void det12_lanes(const double (*S)[144], int k0, double *out)
         }
     }
     for (int l = 0; l < W; l++)
+    for (int l = 0; l < W; l++) {
         out[k0 + l] = d[l];
+        ratio[k0 + l] = pmax[l] > 0.0 ? pmin[l] / pmax[l] : 0.0;
+    }
 }
 
 /* Null vectors of Sigma(theta_l) = s_l S[0] + c_l S[1] + S[2] (12 x 12 row-major),
  * one angle per lane, by Householder QR with column pivoting of Sigma^T:
- * Sigma^T P = U R, the null vector y = U e_12 (|Sigma y| = |r_12|) and y2 = U e_11,
- * the next (with y, the null space where two singular values are small); r:
- * |diagonal of R|, non-increasing (Golub & Van Loan 5.4.2, downdated column norms). */
-static void null_vector12_lanes(const double (*S)[144], vd sv, vd cv, vd *y, vd *y2, vd *r)
+ * Sigma^T P = U R, the null vector y = U e_12 (|Sigma y| = |r_12|); r: |diagonal of
+ * R|, non-increasing, how many are small is the null space's dimension (Golub & Van
+ * Loan 5.4.2, downdated column norms). */
+static void null_vector12_lanes(const double (*S)[144], vd sv, vd cv, vd *y, vd *r)
 {
     vd A[144], V[11][12], beta[11], n2[12], n2ref[12];
     /* column j of A = Sigma^T is row j of Sigma: A[12 j + i] */
@@ -361,29 +427,23 @@ static void null_vector12_lanes(const double (*S)[144], vd sv, vd cv, vd *y, vd 
             }
         }
     }
-    for (int i = 0; i < 12; i++) {
+    for (int i = 0; i < 12; i++)
         y[i] = BR(i == 11 ? 1.0 : 0.0);
-        y2[i] = BR(i == 10 ? 1.0 : 0.0);
-    }
     for (int k = 10; k >= 0; k--) {
-        vd t = BR(0.0), t2 = BR(0.0);
-        for (int i = k; i < 12; i++) {
+        vd t = BR(0.0);
+        for (int i = k; i < 12; i++)
             t += V[k][i] * y[i];
-            t2 += V[k][i] * y2[i];
-        }
         t *= beta[k];
-        t2 *= beta[k];
-        for (int i = k; i < 12; i++) {
+        for (int i = k; i < 12; i++)
             y[i] -= t * V[k][i];
-            y2[i] -= t2 * V[k][i];
-        }
     }
 }
-
 /* Solve the n x n row-major A x = b (both destroyed; x in b) by LU with partial
- * pivoting; 0 when a pivot is exactly zero. */
-static int solve_dense(double *A, double *b, int n)
+ * pivoting; 0 when a pivot is exactly zero. *pmin, *pmax: the smallest and largest
+ * |pivot| (NULL: not wanted). */
+static int solve_dense_pivots(double *A, double *b, int n, double *pmin, double *pmax)
 {
+    double lo = INFINITY, hi = 0.0;
     for (int k = 0; k < n; k++) {
         int p = k;
         double best = fabs(A[n * k + k]);
@@ -394,6 +454,8 @@ static int solve_dense(double *A, double *b, int n)
             }
         if (best == 0.0)
             return 0;
+        lo = best < lo ? best : lo;
+        hi = best > hi ? best : hi;
         if (p != k) {
             for (int j = 0; j < n; j++) {
                 double t = A[n * k + j];
@@ -418,7 +480,16 @@ static int solve_dense(double *A, double *b, int n)
             s -= A[n * k + j] * b[j];
         b[k] = s / A[n * k + k];
     }
+    if (pmin != NULL) {
+        *pmin = lo;
+        *pmax = hi;
+    }
     return 1;
+}
+
+static int solve_dense(double *A, double *b, int n)
+{
+    return solve_dense_pivots(A, b, n, NULL, NULL);
 }
 
 /* ------------------------------------------------------- polynomial roots */
@@ -726,6 +797,304 @@ static int all_roots16(const double *c, int jbest, double *wr, double *wi)
     return poly_roots(work, deg, wr + nf, wi + nf);
 }
 
+/* ------------------------------------------------- small dense linear algebra */
+
+/* The k trailing columns of U in the Householder QR with column pivoting
+ * A^T P = U R of the n x n row-major A (n <= 12, k <= n): an orthonormal basis of
+ * the space of A's k smallest singular values (its null space where they vanish);
+ * Y (k x n row-major), Y[0] = U e_n the null vector; r: |diagonal of R|,
+ * non-increasing. Column norms are recomputed at every step (small n). */
+static void null_basis(const double *A, int n, int k, double *Y, double *r)
+{
+    double M[144], V[12][12], beta[12];
+    /* column j of M (column-major, M[n j + i]) is row j of A: M = A^T */
+    memcpy(M, A, sizeof(double) * n * n);
+    for (int c = 0; c < n; c++) {
+        int p = c;
+        double best = -1.0;
+        for (int j = c; j < n; j++) {
+            double t = 0.0;
+            for (int i = c; i < n; i++)
+                t += M[n * j + i] * M[n * j + i];
+            if (t > best) {
+                best = t;
+                p = j;
+            }
+        }
+        if (p != c)
+            for (int i = 0; i < n; i++) {
+                double t = M[n * c + i];
+                M[n * c + i] = M[n * p + i];
+                M[n * p + i] = t;
+            }
+        double nrm = sqrt(best), *a = M + n * c, *v = V[c];
+        r[c] = nrm;
+        double alpha = a[c] > 0.0 ? -nrm : nrm;
+        for (int i = 0; i < n; i++)
+            v[i] = i < c ? 0.0 : a[i];
+        v[c] = a[c] - alpha;
+        double vv = 0.0;
+        for (int i = c; i < n; i++)
+            vv += v[i] * v[i];
+        beta[c] = vv > 0.0 ? 2.0 / vv : 0.0;
+        for (int j = c + 1; j < n; j++) {
+            double *col = M + n * j, t = 0.0;
+            for (int i = c; i < n; i++)
+                t += v[i] * col[i];
+            t *= beta[c];
+            for (int i = c; i < n; i++)
+                col[i] -= t * v[i];
+        }
+    }
+    for (int j = 0; j < k; j++) {
+        double *y = Y + n * j;
+        for (int i = 0; i < n; i++)
+            y[i] = i == n - 1 - j ? 1.0 : 0.0;
+        for (int c = n - 1; c >= 0; c--) {
+            double t = 0.0;
+            for (int i = c; i < n; i++)
+                t += V[c][i] * y[i];
+            t *= beta[c];
+            for (int i = c; i < n; i++)
+                y[i] -= t * V[c][i];
+        }
+    }
+}
+
+/* Reduce the n x n row-major A (n <= 24) to upper Hessenberg form by Householder
+ * similarity transformations (Golub & Van Loan 7.4.3; eigenvalues only, the
+ * transformations are not kept); the entries below the subdiagonal become 0. */
+static void hessenberg(double *A, int n)
+{
+    for (int k = 0; k + 2 < n; k++) {
+        double v[24], nrm = 0.0;
+        for (int i = k + 1; i < n; i++)
+            nrm += A[n * i + k] * A[n * i + k];
+        nrm = sqrt(nrm);
+        if (nrm == 0.0)
+            continue;
+        double alpha = A[n * (k + 1) + k] > 0.0 ? -nrm : nrm, vv = 0.0;
+        for (int i = 0; i < n; i++)
+            v[i] = i <= k ? 0.0 : A[n * i + k];
+        v[k + 1] -= alpha;
+        for (int i = k + 1; i < n; i++)
+            vv += v[i] * v[i];
+        if (vv == 0.0)
+            continue;
+        double beta = 2.0 / vv;
+        for (int j = 0; j < n; j++) { /* A <- H A */
+            double t = 0.0;
+            for (int i = k + 1; i < n; i++)
+                t += v[i] * A[n * i + j];
+            t *= beta;
+            for (int i = k + 1; i < n; i++)
+                A[n * i + j] -= t * v[i];
+        }
+        for (int i = 0; i < n; i++) { /* A <- A H */
+            double t = 0.0;
+            for (int j = k + 1; j < n; j++)
+                t += A[n * i + j] * v[j];
+            t *= beta;
+            for (int j = k + 1; j < n; j++)
+                A[n * i + j] -= t * v[j];
+        }
+        for (int i = k + 2; i < n; i++)
+            A[n * i + k] = 0.0;
+    }
+}
+
+/* x (n) the unit eigenvector of the n x n row-major M (n <= G6_MAXSPLIT) for its
+ * eigenvalue nearest lam: inverse iteration (Golub & Van Loan 7.6.1) with the shift
+ * a hair off lam (moved further if it hits an eigenvalue exactly), from a start with
+ * no structure an eigenvector could be orthogonal to. */
+static void inverse_iteration(const double *M, int n, double lam, double *x)
+{
+    double scale = fabs(lam);
+    for (int i = 0; i < n * n; i++)
+        scale = fabs(M[i]) > scale ? fabs(M[i]) : scale;
+    double mu = lam + 1e-10 * scale;
+    for (int i = 0; i < n; i++)
+        x[i] = 1.0 + 0.3183098861837907 * i;
+    for (int it = 0; it < 3; it++) {
+        double A[G6_MAXSPLIT * G6_MAXSPLIT], b[G6_MAXSPLIT], nrm = 0.0;
+        for (int i = 0; i < n * n; i++)
+            A[i] = M[i];
+        for (int i = 0; i < n; i++) {
+            A[n * i + i] -= mu;
+            b[i] = x[i];
+        }
+        if (!solve_dense(A, b, n)) {
+            mu += 1e-8 * scale;
+            continue;
+        }
+        for (int i = 0; i < n; i++)
+            nrm += b[i] * b[i];
+        nrm = sqrt(nrm);
+        if (!(nrm > 0.0) || !isfinite(nrm))
+            break;
+        for (int i = 0; i < n; i++)
+            x[i] = b[i] / nrm;
+    }
+}
+
+/* det of the n x n row-major A (destroyed), LU with partial pivoting */
+static double det_small(double *A, int n)
+{
+    double d = 1.0;
+    for (int k = 0; k < n; k++) {
+        int p = k;
+        for (int i = k + 1; i < n; i++)
+            if (fabs(A[n * i + k]) > fabs(A[n * p + k]))
+                p = i;
+        if (A[n * p + k] == 0.0)
+            return 0.0;
+        if (p != k) {
+            for (int j = 0; j < n; j++) {
+                double t = A[n * k + j];
+                A[n * k + j] = A[n * p + j];
+                A[n * p + j] = t;
+            }
+            d = -d;
+        }
+        d *= A[n * k + k];
+        for (int i = k + 1; i < n; i++) {
+            double f = A[n * i + k] / A[n * k + k];
+            for (int j = k + 1; j < n; j++)
+                A[n * i + j] -= f * A[n * k + j];
+        }
+    }
+    return d;
+}
+
+/* The LU factorization with complete pivoting Pr A Pc = L U of a 12 x 12 row-major
+ * A (Golub & Van Loan 3.4.8): the multipliers L (unit lower, row-major, zero above
+ * the diagonal), U (upper), the row and column orders pr, pc (row i of Pr A is row
+ * pr[i] of A), sign = sign(Pr) sign(Pc), piv = |U_kk|. An exactly zero pivot is
+ * replaced by DBL_EPSILON times the first (a rank below 12: counted as null). */
+typedef struct {
+    double L[144], U[144], piv[12];
+    int pr[12], pc[12], sign;
+} G6Lu;
+
+static void lu_complete(const double *A0, G6Lu *F)
+{
+    double *A = F->U, *L = F->L;
+    memcpy(A, A0, sizeof(F->U));
+    memset(L, 0, sizeof(F->L));
+    F->sign = 1;
+    for (int i = 0; i < 12; i++)
+        F->pr[i] = F->pc[i] = i;
+    for (int k = 0; k < 12; k++) {
+        int bi = k, bj = k;
+        double best = -1.0;
+        for (int i = k; i < 12; i++)
+            for (int j = k; j < 12; j++)
+                if (fabs(A[12 * i + j]) > best) {
+                    best = fabs(A[12 * i + j]);
+                    bi = i;
+                    bj = j;
+                }
+        if (bi != k) {
+            for (int j = 0; j < 12; j++) {
+                double t = A[12 * k + j];
+                A[12 * k + j] = A[12 * bi + j];
+                A[12 * bi + j] = t;
+                t = L[12 * k + j];
+                L[12 * k + j] = L[12 * bi + j];
+                L[12 * bi + j] = t;
+            }
+            int t = F->pr[k];
+            F->pr[k] = F->pr[bi];
+            F->pr[bi] = t;
+            F->sign = -F->sign;
+        }
+        if (bj != k) {
+            for (int i = 0; i < 12; i++) {
+                double t = A[12 * i + k];
+                A[12 * i + k] = A[12 * i + bj];
+                A[12 * i + bj] = t;
+            }
+            int t = F->pc[k];
+            F->pc[k] = F->pc[bj];
+            F->pc[bj] = t;
+            F->sign = -F->sign;
+        }
+        double p = A[12 * k + k];
+        if (p == 0.0)
+            p = A[12 * k + k] = DBL_EPSILON * (k > 0 ? F->piv[0] : 1.0);
+        F->piv[k] = fabs(p);
+        for (int i = k + 1; i < 12; i++) {
+            double f = A[12 * i + k] / p;
+            L[12 * i + k] = f;
+            A[12 * i + k] = 0.0;
+            for (int j = k + 1; j < 12; j++)
+                A[12 * i + j] -= f * A[12 * k + j];
+        }
+    }
+}
+
+/* The pencil A + s B (12 x 12 row-major, A of rank 12 - d, factored in F) near
+ * s = 0. With m = 12 - d, the first m steps of F are a factorization Pr A Pc =
+ * L' [U_11 U_12; 0 S] with L' = F's multipliers of those steps (identity below) and
+ * S, zero to rounding, ignored (the later steps only reorder its rows and columns):
+ *   V (d x 12): a basis of A's right null space, Pc [-U_11^-1 U_12; I];
+ *   Y (d x 12): of its left null space, Pr^T L'^-T [0; I];
+ *   G (d x d) = Y^T B V, the Schur complement of L'^-1 Pr B Pc on the null spaces;
+ *   returns det(A + s B) / s^d at s = 0: sign(Pr) sign(Pc) det U_11 det G
+ *   (Canny's generalized characteristic polynomial, lowest coefficient).
+ * V, Y or G may be NULL. */
+static double pencil_lowest(const G6Lu *F, const double *B, int d, double *V, double *Y,
+                            double *G)
+{
+    const double *U = F->U, *L = F->L;
+    const int m = 12 - d;
+    double du = F->sign;
+    for (int k = 0; k < m; k++)
+        du *= U[12 * k + k];
+    double X[12 * 12], Vl[12 * 12], Yl[12 * 12], BV[12 * 12], Gl[144];
+    for (int c = 0; c < d; c++) /* X = -U_11^-1 U_12 (m x d) */
+        for (int i = m - 1; i >= 0; i--) {
+            double acc = -U[12 * i + m + c];
+            for (int j = i + 1; j < m; j++)
+                acc -= U[12 * i + j] * X[d * j + c];
+            X[d * i + c] = acc / U[12 * i + i];
+        }
+    for (int c = 0; c < d; c++) {
+        double *v = Vl + 12 * c, *y = Yl + 12 * c, w[12];
+        for (int i = 0; i < 12; i++)
+            v[F->pc[i]] = i < m ? X[d * i + c] : (i - m == c ? 1.0 : 0.0);
+        for (int i = 11; i >= 0; i--) { /* L'^T w = e_{m + c} */
+            double acc = i == m + c ? 1.0 : 0.0;
+            if (i < m)
+                for (int j = i + 1; j < 12; j++)
+                    acc -= L[12 * j + i] * w[j];
+            w[i] = acc;
+        }
+        for (int i = 0; i < 12; i++)
+            y[F->pr[i]] = w[i];
+        for (int i = 0; i < 12; i++) { /* B v */
+            double acc = 0.0;
+            for (int j = 0; j < 12; j++)
+                acc += B[12 * i + j] * v[j];
+            BV[12 * c + i] = acc;
+        }
+    }
+    for (int r = 0; r < d; r++)
+        for (int c = 0; c < d; c++) {
+            double acc = 0.0;
+            for (int i = 0; i < 12; i++)
+                acc += Yl[12 * r + i] * BV[12 * c + i];
+            Gl[d * r + c] = acc;
+        }
+    if (V != NULL)
+        memcpy(V, Vl, sizeof(double) * 12 * d);
+    if (Y != NULL)
+        memcpy(Y, Yl, sizeof(double) * 12 * d);
+    if (G != NULL)
+        memcpy(G, Gl, sizeof(double) * d * d);
+    return du * det_small(Gl, d);
+}
+
 /* -------------------------------------------------------- the elimination */
 
 typedef struct {
@@ -834,83 +1203,121 @@ static void g6_rot_span(const double *vb, const double *v, int first_const, int 
     }
 }
 
-/* Two solutions (t_b, t_c) in the span of y, y2 (Sigma's two smallest singular
- * vectors at a root two solutions (nearly) share): the combinations c with the
- * monomial structure, shift(c) = tan(t/2) c along b or c, from the 2 x 2 pencil
- * the shifted rows make (the eigenvector structure of a multiple root, Manocha &
- * Canny 1994, section 5.2), along the direction where the two differ more.
- * Returns how many (1 or 2) went to tb, tc. */
-static int g6_two_solutions(const double *y, const double *y2, int mult, double *tb,
-                            double *tc)
+/* Rows (dn, up) of the monomial shift along b (along_b) or c: y[up] = x y[dn] for
+ * the monomial vector of (x_b, x_c), x its tangent of half the angle. Returns how
+ * many (8 or 9). */
+static int g6_shift_rows(int mult, int along_b, int *dn, int *up)
 {
-    int ni = mult == 0 ? 4 : 3, nj = mult == 0 ? 3 : 4;
-    double best_sep = -1.0, psi_best[2] = {0.0, 0.0}, A0b[4] = {0}, A1b[4] = {0};
-    for (int along_b = 1; along_b >= 0; along_b--) {
-        /* A0 = P^T B_dn, A1 = P^T B_up with P = B_dn + B_up (2 x 2, row-major) */
-        double A0[4] = {0}, A1[4] = {0};
-        for (int i = 0; i < ni; i++)
-            for (int j = 0; j < nj; j++) {
-                int i2 = i + along_b, j2 = j + !along_b;
-                if (i2 >= ni || j2 >= nj)
-                    continue;
-                double dn[2] = {y[nj * i + j], y2[nj * i + j]};
-                double up[2] = {y[nj * i2 + j2], y2[nj * i2 + j2]};
-                for (int r = 0; r < 2; r++)
-                    for (int c = 0; c < 2; c++) {
-                        A0[2 * r + c] += (dn[r] + up[r]) * dn[c];
-                        A1[2 * r + c] += (dn[r] + up[r]) * up[c];
-                    }
-            }
-        /* det(cos(psi) A1 - sin(psi) A0) = ca cos^2 + cb cos sin + cc sin^2 = 0 */
-        double ca = A1[0] * A1[3] - A1[1] * A1[2], cc = A0[0] * A0[3] - A0[1] * A0[2];
-        double cb = -(A1[0] * A0[3] + A0[0] * A1[3] - A1[1] * A0[2] - A0[1] * A1[2]);
-        /* the two angles: a quadratic in tan (or cot) psi, the discriminant clamped */
-        double disc = cb * cb - 4.0 * ca * cc, sq = sqrt(disc > 0.0 ? disc : 0.0), psi[2];
-        if (fabs(cc) >= fabs(ca)) { /* cc tan^2 + cb tan + ca = 0 */
-            double qq = -0.5 * (cb + (cb >= 0.0 ? sq : -sq));
-            psi[0] = atan2(qq, cc);
-            psi[1] = qq != 0.0 ? atan2(ca, qq) : psi[0];
-        } else { /* ca cot^2 + cb cot + cc = 0 */
-            double qq = -0.5 * (cb + (cb >= 0.0 ? sq : -sq));
-            psi[0] = atan2(ca, qq);
-            psi[1] = qq != 0.0 ? atan2(qq, cc) : psi[0];
+    int ni = mult == 0 ? 4 : 3, nj = mult == 0 ? 3 : 4, m = 0;
+    for (int i = 0; i < ni; i++)
+        for (int j = 0; j < nj; j++) {
+            int i2 = i + along_b, j2 = j + !along_b;
+            if (i2 >= ni || j2 >= nj)
+                continue;
+            dn[m] = nj * i + j;
+            up[m] = nj * i2 + j2;
+            m++;
         }
-        double sep = fabs(sin(psi[0] - psi[1]));
-        if (sep > best_sep) {
-            best_sep = sep;
-            psi_best[0] = psi[0];
-            psi_best[1] = psi[1];
-            memcpy(A0b, A0, sizeof(A0));
-            memcpy(A1b, A1, sizeof(A1));
+    return m;
+}
+
+/* The shift operator on the span of Y (k x 12 row-major, k <= 8): X (k x k
+ * row-major) with F X = E in the least squares sense, E = (cos g U - sin g D) Y^T,
+ * F = (sin g U + cos g D) Y^T (U, D the up and down rows). For a monomial vector
+ * Y^T c whose half angle is g + delta, (cos delta E - sin delta F) c = 0, so c is an
+ * eigenvector of X for tan(delta) (whatever else the span holds). The chart offset
+ * g among 0, pi/4, pi/2, 3 pi/4 with the best conditioned F (its R's diagonal); 0
+ * when F is rank deficient for every one. */
+static int g6_shift_operator(const double *Y, int k, int mult, int along_b, double *X)
+{
+    int dn[9], up[9];
+    const int m = g6_shift_rows(mult, along_b, dn, up);
+    double best = 0.0, Fb[9 * G6_MAXSPLIT], Vb[9 * G6_MAXSPLIT], Eb[9 * G6_MAXSPLIT];
+    double betab[G6_MAXSPLIT];
+    for (int gi = 0; gi < 4; gi++) {
+        const double cg = cos(0.25 * G6_PI * gi), sg = sin(0.25 * G6_PI * gi);
+        double F[9 * G6_MAXSPLIT], E[9 * G6_MAXSPLIT], V[9 * G6_MAXSPLIT], beta[G6_MAXSPLIT];
+        for (int j = 0; j < k; j++) /* column-major, column j */
+            for (int i = 0; i < m; i++) {
+                double u = Y[12 * j + up[i]], d = Y[12 * j + dn[i]];
+                F[m * j + i] = sg * u + cg * d;
+                E[m * j + i] = cg * u - sg * d;
+            }
+        house_qr(F, m, k, V, beta);
+        double rmin = INFINITY, rmax = 0.0;
+        for (int j = 0; j < k; j++) {
+            double r = fabs(F[m * j + j]);
+            rmin = r < rmin ? r : rmin;
+            rmax = r > rmax ? r : rmax;
+        }
+        double cond = rmax > 0.0 ? rmin / rmax : 0.0;
+        if (cond > best) {
+            best = cond;
+            memcpy(Fb, F, sizeof(F));
+            memcpy(Vb, V, sizeof(V));
+            memcpy(Eb, E, sizeof(E));
+            memcpy(betab, beta, sizeof(beta));
         }
     }
-    int n = best_sep > 1e-12 ? 2 : 1;
-    for (int k = 0; k < n; k++) {
-        double cs = cos(psi_best[k]), sn = sin(psi_best[k]), Mx[4];
-        for (int i = 0; i < 4; i++)
-            Mx[i] = cs * A1b[i] - sn * A0b[i];
-        /* c: the null vector of the 2 x 2 Mx, from its larger row */
-        double c0, c1;
-        if (Mx[0] * Mx[0] + Mx[1] * Mx[1] >= Mx[2] * Mx[2] + Mx[3] * Mx[3]) {
-            c0 = -Mx[1];
-            c1 = Mx[0];
-        } else {
-            c0 = -Mx[3];
-            c1 = Mx[2];
+    if (!(best > 1e-12))
+        return 0;
+    for (int j = 0; j < k; j++) { /* column j of X: R x = (Q^T E)_j */
+        double *e = Eb + m * j;
+        house_apply_t(Vb, betab, m, k, e);
+        for (int i = k - 1; i >= 0; i--) {
+            double acc = e[i];
+            for (int c = i + 1; c < k; c++)
+                acc -= Fb[m * c + i] * X[k * c + j];
+            X[k * i + j] = acc / Fb[m * i + i];
         }
-        double z[12];
-        for (int i = 0; i < 12; i++)
-            z[i] = c0 * y[i] + c1 * y2[i];
-        tb[k] = g6_half_angle(z, mult, 1);
-        tc[k] = g6_half_angle(z, mult, 0);
+    }
+    return 1;
+}
+
+/* The solutions (t_b, t_c) in the span of Y (k x 12 row-major, 2 <= k <= 8), the
+ * null space where k solutions share theta_a (Moller & Stetter 1995; Manocha &
+ * Canny 1994, 5.2): each is a common eigenvector c of the shift operators along b
+ * and c, so an eigenvector of X_b + rho X_c (rho generic), read as half angles of
+ * Y^T c. Every eigenvalue gives a candidate (complex ones their real part: two
+ * solutions nearly sharing both angles); the spurious ones fail the Newton polish.
+ * Returns how many went to tb, tc. */
+static int g6_split(const double *Y, int k, int mult, double *tb, double *tc)
+{
+    const double rho = 0.6180339887498949;
+    double Xb[G6_MAXSPLIT * G6_MAXSPLIT], Xc[G6_MAXSPLIT * G6_MAXSPLIT];
+    double M[G6_MAXSPLIT * G6_MAXSPLIT], H[G6_MAXSPLIT * G6_MAXSPLIT];
+    double wr[G6_MAXSPLIT], wi[G6_MAXSPLIT];
+    int ob = g6_shift_operator(Y, k, mult, 1, Xb), oc = g6_shift_operator(Y, k, mult, 0, Xc);
+    if (!ob && !oc)
+        return 0;
+    for (int i = 0; i < k * k; i++)
+        M[i] = (ob ? Xb[i] : 0.0) + (oc ? rho * Xc[i] : 0.0);
+    memcpy(H, M, sizeof(double) * k * k);
+    hessenberg(H, k);
+    if (!hqr(H, k, wr, wi))
+        return 0;
+    int n = 0;
+    for (int e = 0; e < k; e++) {
+        if (wi[e] < 0.0)
+            continue; /* the conjugate's twin */
+        double x[G6_MAXSPLIT], z[12];
+        inverse_iteration(M, k, wr[e], x);
+        for (int i = 0; i < 12; i++) {
+            double acc = 0.0;
+            for (int j = 0; j < k; j++)
+                acc += x[j] * Y[12 * j + i];
+            z[i] = acc;
+        }
+        tb[n] = g6_half_angle(z, mult, 1);
+        tc[n] = g6_half_angle(z, mult, 0);
+        n++;
     }
     return n;
 }
-
 /* What the back-substitution of one variant and pose needs. */
 typedef struct {
     const double *vb, *Tp, *Q, *V8, *beta8, *A8;
-    int a, dir;
+    int a, dir, mult;
 } G6Back;
 
 /* The candidate of root theta (sin s, cos c) with joints a+1, a+2 at tb, tc: u, w
@@ -975,108 +1382,279 @@ static int g6_candidate(const G6Back *G, double th, double s, double c, double t
     return ok;
 }
 
-/* Candidate chain values of one variant for the pose T (4x4 row-major): appended
- * to cand (at most 3 G6_MAXROOT); flags get G6F_DEGENERATE / G6F_AMBIGUOUS; stats[0]
- * the relative DFT tail, stats[1] the margin (the smallest ratio of Sigma's
- * second-smallest to largest pivot over the roots tried), stats[2] how many roots
- * were close to another (two solutions nearly sharing theta_a: both taken from a
- * 2-D null space). Returns the number of candidates. */
-static int g6_variant(const double *P, const double *vb, const double *T, G6Cand *cand,
-                      int *flags, double *stats)
-{
-    const int dir = (int)vb[VB_DIR], a = (int)vb[VB_A], mult = (int)vb[VB_MULT];
-    const double tail_tol = P[GP_TAIL_TOL], null_tol = P[GP_NULL_TOL];
-    const double imag_tol = P[GP_IMAG_TOL];
-    double Tp[16], k6inv[16], tmp[16];
-    double *tail = stats;
-    stats[0] = stats[1] = INFINITY;
-    stats[2] = 0.0;
-    if (dir)
-        rigid_inv(T, Tp);
-    else
-        memcpy(Tp, T, sizeof(Tp));
-    mul4(vb + VB_CI, Tp, tmp);             /* C'_0^-1 T' */
-    mul4(tmp, vb + VB_CI + 16 * 6, k6inv); /* ... C'_6^-1 = K_6^-1 */
+/* ------------------------------------------------ one variant at one pose */
 
-    /* right side, its 14 x 8 block's QR and left null space */
+/* A variant at a pose: the right side, its 14 x 8 block's QR and left null space,
+ * the dialytic matrices Sigma(theta) = s S[0] + c S[1] + S[2]. */
+typedef struct {
+    const double *vb;
+    int dir, a, mult;
+    double Tp[16], k6inv[16];
     double Q[14 * 9], A8[8 * 14], V8[8 * 14], beta8[8];
-    g6_right(vb, a, k6inv, Q);
-    for (int j = 0; j < 8; j++)
-        for (int i = 0; i < 14; i++)
-            A8[14 * j + i] = Q[9 * i + j];
-    house_qr(A8, 14, 8, V8, beta8);
-    double rmax = 0.0, rmin = INFINITY;
-    for (int k = 0; k < 8; k++) {
-        double d = fabs(A8[14 * k + k]);
-        rmax = d > rmax ? d : rmax;
-        rmin = d < rmin ? d : rmin;
-    }
-    if (!(rmin > 1e-12 * rmax)) {
-        *flags |= G6F_DEGENERATE;
-        return 0;
-    }
-    /* the left null space N (6 x 14): rows 8..13 of Q^T, i.e. H_0 .. H_7 e_r */
     double Nn[6][14];
-    for (int r = 0; r < 6; r++) {
-        double *x = Nn[r];
-        for (int i = 0; i < 14; i++)
-            x[i] = i == 8 + r ? 1.0 : 0.0;
-        for (int k = 7; k >= 0; k--) {
-            const double *v = V8 + 14 * k;
-            double s = 0.0;
-            for (int i = k; i < 14; i++)
-                s += v[i] * x[i];
-            s *= beta8[k];
-            for (int i = k; i < 14; i++)
-                x[i] -= s * v[i];
-        }
-    }
-    /* M = N P' (6 x 27): N [P_s | P_c | P_1 - Q_9 (x) h], h = (1+x_b^2)(1+x_c^2) */
+    double rowscale[6]; /* the 6 equations' equilibration */
+    double rcond;       /* the right side's block: smallest / largest |R_kk| */
+    double S[3][144];
+} G6Var;
+
+/* The projection's data (degenerate poses): Sigma's derivative along the pose motion
+ * and the dimension d of Sigma's generic null space. */
+typedef struct {
+    int d;
+    double Sd[3][144];
+} G6Proj;
+
+/* The 6 eliminated equations (6 x 27) in {s, c, 1} (x) the 9 monomials of (x_b, x_c):
+ * Na [P_s | P_c | P_1 - q (x) h] with q = Na qa + Nb qb (Nb may be NULL) and
+ * h = (1 + x_b^2)(1 + x_c^2): N P' for Sigma, and its derivative dN P' + N dP'. */
+static void g6_rows(const double *Pm, const double (*Na)[14], const double (*Nb)[14],
+                    const double *qa, const double *qb, double (*Mx)[27])
+{
     static const double h9[9] = {1, 0, 1, 0, 0, 0, 1, 0, 1};
-    const double *Pm = vb + VB_P;
-    double Mx[6][27];
     for (int r = 0; r < 6; r++) {
         double nq = 0.0;
         for (int e = 0; e < 14; e++)
-            nq += Nn[r][e] * Q[9 * e + 8];
-        for (int m = 0; m < 9; m++)
-            Mx[r][18 + m] = -nq * h9[m];
+            nq += Na[r][e] * qa[e] + (Nb != NULL ? Nb[r][e] * qb[e] : 0.0);
         for (int m = 0; m < 18; m++)
             Mx[r][m] = 0.0;
+        for (int m = 0; m < 9; m++)
+            Mx[r][18 + m] = -nq * h9[m];
         for (int blk = 0; blk < 3; blk++)
             for (int e = 0; e < 14; e++) {
-                double f = Nn[r][e];
+                double f = Na[r][e];
                 for (int m = 0; m < 9; m++)
                     Mx[r][9 * blk + m] += f * Pm[126 * blk + 9 * e + m];
             }
     }
-    for (int r = 0; r < 6; r++) { /* equilibrate the 6 equations */
-        double mx = 0.0;
-        for (int col = 0; col < 27; col++)
-            mx = fabs(Mx[r][col]) > mx ? fabs(Mx[r][col]) : mx;
-        if (mx == 0.0) {
-            *flags |= G6F_DEGENERATE;
-            return 0;
-        }
-        for (int col = 0; col < 27; col++)
-            Mx[r][col] /= mx;
-    }
-    /* the dialytic matrices: Sigma(theta) = s S[0] + c S[1] + S[2] */
-    double S[3][144];
-    memset(S, 0, sizeof(S));
+}
+
+/* Sigma's three 12 x 12 blocks from the equations Mx (rows divided by scale): the
+ * 6 equations, then the same multiplied by x_b (mult 0) or x_c (mult 1). */
+static void g6_layout(const double (*Mx)[27], const double *scale, int mult, double (*S)[144])
+{
+    memset(S, 0, 3 * 144 * sizeof(double));
     for (int blk = 0; blk < 3; blk++)
         for (int r = 0; r < 6; r++)
             for (int i = 0; i < 3; i++)
                 for (int j = 0; j < 3; j++) {
-                    double x = Mx[r][9 * blk + 3 * i + j];
+                    double x = Mx[r][9 * blk + 3 * i + j] / scale[r];
                     S[blk][12 * r + g6_col(mult, 0, i, j)] = x;
                     S[blk][12 * (6 + r) + g6_col(mult, 1, i, j)] = x;
                 }
-    /* det Sigma at 24 angles, its DFT */
-    double D[G6_NSAMP];
+}
+
+/* Sigma(theta) (12 x 12 row-major) of the blocks S */
+static void g6_sigma_at(const double (*S)[144], double th, double *A)
+{
+    double s = sin(th), c = cos(th);
+    for (int i = 0; i < 144; i++)
+        A[i] = s * S[0][i] + c * S[1][i] + S[2][i];
+}
+
+/* The reciprocal condition number of the 8 x 8 upper triangular R (column-major in
+ * a 14 x 8 array, R_ij = A[14 j + i]): its smallest singular value by three steps of
+ * inverse iteration on R^T R, over its largest column norm (the diagonal of an
+ * unpivoted QR does not reveal a near rank deficiency). */
+static double g6_rcond8(const double *A)
+{
+    double x[8], y[8], big = 0.0;
+    for (int j = 0; j < 8; j++) {
+        double c = 0.0;
+        for (int i = 0; i <= j; i++)
+            c += A[14 * j + i] * A[14 * j + i];
+        big = c > big ? c : big;
+        x[j] = 1.0 + 0.3183098861837907 * j;
+    }
+    double nrm = 0.0;
+    for (int it = 0; it < 3; it++) {
+        for (int i = 0; i < 8; i++) { /* R^T y = x */
+            double acc = x[i];
+            for (int k = 0; k < i; k++)
+                acc -= A[14 * i + k] * y[k];
+            y[i] = acc / A[14 * i + i];
+        }
+        for (int i = 7; i >= 0; i--) { /* R x = y */
+            double acc = y[i];
+            for (int k = i + 1; k < 8; k++)
+                acc -= A[14 * k + i] * x[k];
+            x[i] = acc / A[14 * i + i];
+        }
+        nrm = 0.0;
+        for (int i = 0; i < 8; i++)
+            nrm += x[i] * x[i];
+        nrm = sqrt(nrm);
+        if (!(nrm > 0.0) || !isfinite(nrm))
+            return 0.0;
+        for (int i = 0; i < 8; i++)
+            x[i] /= nrm;
+    }
+    return sqrt(1.0 / nrm) / sqrt(big); /* |(R^T R)^-1 x| -> 1 / sigma_min^2 */
+}
+
+/* Variant vb at pose T (4x4 row-major) into V; 0 when its right side's 14 x 8 block
+ * is rank deficient or an equation vanishes (the elimination does not apply). */
+static int g6_prepare(const double *vb, const double *T, G6Var *V)
+{
+    double tmp[16];
+    V->vb = vb;
+    V->dir = (int)vb[VB_DIR];
+    V->a = (int)vb[VB_A];
+    V->mult = (int)vb[VB_MULT];
+    if (V->dir)
+        rigid_inv(T, V->Tp);
+    else
+        memcpy(V->Tp, T, sizeof(V->Tp));
+    mul4(vb + VB_CI, V->Tp, tmp);                /* C'_0^-1 T' */
+    mul4(tmp, vb + VB_CI + 16 * 6, V->k6inv);    /* ... C'_6^-1 = K_6^-1 */
+    g6_right(vb, V->a, V->k6inv, V->Q);
+    for (int j = 0; j < 8; j++)
+        for (int i = 0; i < 14; i++)
+            V->A8[14 * j + i] = V->Q[9 * i + j];
+    house_qr(V->A8, 14, 8, V->V8, V->beta8);
+    double rmax = 0.0, rmin = INFINITY;
+    for (int k = 0; k < 8; k++) {
+        double d = fabs(V->A8[14 * k + k]);
+        rmax = d > rmax ? d : rmax;
+        rmin = d < rmin ? d : rmin;
+    }
+    if (!(rmin > 1e-12 * rmax))
+        return 0;
+    V->rcond = g6_rcond8(V->A8);
+    /* the left null space N (6 x 14): rows 8..13 of Q^T, i.e. H_0 .. H_7 e_r */
+    for (int r = 0; r < 6; r++) {
+        double *x = V->Nn[r];
+        for (int i = 0; i < 14; i++)
+            x[i] = i == 8 + r ? 1.0 : 0.0;
+        for (int k = 7; k >= 0; k--) {
+            const double *v = V->V8 + 14 * k;
+            double s = 0.0;
+            for (int i = k; i < 14; i++)
+                s += v[i] * x[i];
+            s *= V->beta8[k];
+            for (int i = k; i < 14; i++)
+                x[i] -= s * v[i];
+        }
+    }
+    double q9[14], Mx[6][27];
+    for (int e = 0; e < 14; e++)
+        q9[e] = V->Q[9 * e + 8];
+    g6_rows(vb + VB_P, (const double (*)[14])V->Nn, NULL, q9, NULL, Mx);
+    for (int r = 0; r < 6; r++) { /* equilibrate the 6 equations */
+        double mx = 0.0;
+        for (int col = 0; col < 27; col++)
+            mx = fabs(Mx[r][col]) > mx ? fabs(Mx[r][col]) : mx;
+        if (!(mx > 0.0))
+            return 0;
+        V->rowscale[r] = mx;
+    }
+    g6_layout((const double (*)[27])Mx, V->rowscale, V->mult, V->S);
+    return 1;
+}
+
+/* C = A B for 4x4 row-major matrices (general: the last rows may be anything) */
+static void mul4g(const double *A, const double *B, double *C)
+{
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++) {
+            double acc = 0.0;
+            for (int k = 0; k < 4; k++)
+                acc += A[4 * r + k] * B[4 * k + c];
+            C[4 * r + c] = acc;
+        }
+}
+
+/* The twist matrix [w]x, v of xi = (w, v) (4x4 row-major, last row 0) */
+static void g6_twist(const double *w, const double *v, double *X)
+{
+    double Xm[16] = {0.0, -w[2], w[1], v[0], w[2], 0.0, -w[0], v[1],
+                     -w[1], w[0], 0.0, v[2], 0.0, 0.0, 0.0, 0.0};
+    memcpy(X, Xm, sizeof(Xm));
+}
+
+/* pj->Sd = d Sigma / ds at s = 0 for the pose T Exp(s xi) (G6_XI, its translation
+ * times scale), exactly: the right side Q is a polynomial of degree 3 in the entries
+ * of K_6^-1, so the five-point central difference of Q is exact up to rounding; the
+ * left null space moves by dN = -N dQ_8 Q_8^+ (first order; any smooth choice of
+ * basis changes det Sigma by a factor that does not vanish); the equations' scales
+ * stay those of Sigma. */
+static void g6_derivative(const G6Var *V, double scale, G6Proj *pj)
+{
+    double X[16], dTp[16], tmp[16], dk6[16];
+    double v[3] = {G6_XI[3] * scale, G6_XI[4] * scale, G6_XI[5] * scale};
+    g6_twist(G6_XI, v, X);
+    if (V->dir) { /* T' = (T Exp(s xi))^-1 = Exp(-s xi) T^-1 */
+        mul4g(X, V->Tp, dTp);
+        for (int i = 0; i < 16; i++)
+            dTp[i] = -dTp[i];
+    } else {
+        mul4g(V->Tp, X, dTp);
+    }
+    mul4g(V->vb + VB_CI, dTp, tmp);
+    mul4g(tmp, V->vb + VB_CI + 16 * 6, dk6);
+    double big = 0.0, dbig = 0.0;
+    for (int i = 0; i < 12; i++) {
+        big = fabs(V->k6inv[i]) > big ? fabs(V->k6inv[i]) : big;
+        dbig = fabs(dk6[i]) > dbig ? fabs(dk6[i]) : dbig;
+    }
+    const double h = dbig > 0.0 ? 0.25 * big / dbig : 1.0;
+    double Qs[4][14 * 9], dQ[14 * 9];
+    static const double steps[4] = {1.0, -1.0, 2.0, -2.0};
+    for (int k = 0; k < 4; k++) {
+        double K[16];
+        for (int i = 0; i < 16; i++)
+            K[i] = V->k6inv[i] + steps[k] * h * dk6[i];
+        g6_right(V->vb, V->a, K, Qs[k]);
+    }
+    for (int i = 0; i < 14 * 9; i++)
+        dQ[i] = (8.0 * (Qs[0][i] - Qs[1][i]) - (Qs[2][i] - Qs[3][i])) / (12.0 * h);
+    /* dN_r = -(H [z; 0])^T with z R = N_r dQ_8 (R the 8 x 8 factor of Q_8 = H R) */
+    double dN[6][14];
+    for (int r = 0; r < 6; r++) {
+        double w[8], x[14];
+        for (int c = 0; c < 8; c++) {
+            double acc = 0.0;
+            for (int e = 0; e < 14; e++)
+                acc += V->Nn[r][e] * dQ[9 * e + c];
+            w[c] = acc;
+        }
+        for (int j = 0; j < 8; j++) {
+            double acc = w[j];
+            for (int i = 0; i < j; i++)
+                acc -= x[i] * V->A8[14 * j + i];
+            x[j] = acc / V->A8[14 * j + j];
+        }
+        for (int i = 8; i < 14; i++)
+            x[i] = 0.0;
+        for (int k = 7; k >= 0; k--) {
+            const double *hv = V->V8 + 14 * k;
+            double s = 0.0;
+            for (int i = k; i < 14; i++)
+                s += hv[i] * x[i];
+            s *= V->beta8[k];
+            for (int i = k; i < 14; i++)
+                x[i] -= s * hv[i];
+        }
+        for (int i = 0; i < 14; i++)
+            dN[r][i] = -x[i];
+    }
+    double q9[14], dq9[14], M1[6][27];
+    for (int e = 0; e < 14; e++) {
+        q9[e] = V->Q[9 * e + 8];
+        dq9[e] = dQ[9 * e + 8];
+    }
+    g6_rows(V->vb + VB_P, (const double (*)[14])dN, (const double (*)[14])V->Nn, q9, dq9,
+            M1);
+    g6_layout((const double (*)[27])M1, V->rowscale, V->mult, pj->Sd);
+}
+
+/* From 24 samples D_k = f(2 pi k / 24) of a trigonometric polynomial f of degree 8:
+ * its DFT, the relative tail above degree 8 (*tail, which must vanish) and the
+ * degree-16 polynomial cpoly in x = tan((theta - phi) / 2) whose roots are f's,
+ * phi + pi the sample of largest |f| (cpoly's leading coefficient is f there).
+ * Returns the index of that sample, or -1 when f vanishes or is not finite. */
+static int g6_trig_poly(const double *D, double *cpoly, double *phi, double *tail)
+{
     int jbest = 0;
-    for (int k = 0; k < G6_NSAMP; k += W)
-        det12_lanes((const double (*)[144])S, k, D);
     for (int k = 1; k < G6_NSAMP; k++)
         if (fabs(D[k]) > fabs(D[jbest]))
             jbest = k;
@@ -1096,100 +1674,485 @@ static int g6_variant(const double *P, const double *vb, const double *T, G6Cand
         else
             tl = mag > tl ? mag : tl;
     }
-    if (!(head > 0.0) || !isfinite(head)) {
-        *flags |= G6F_DEGENERATE;
-        return 0;
-    }
+    *tail = INFINITY;
+    if (!(head > 0.0) || !isfinite(head))
+        return -1;
     *tail = tl / head;
-    if (!(*tail <= tail_tol)) {
-        *flags |= G6F_DEGENERATE;
-        return 0;
+    const double ph = G6_TWO_PI * jbest / G6_NSAMP - G6_PI;
+    double zr[G6_DEG + 1], zi[G6_DEG + 1];
+    for (int f = 1; f <= G6_DEG; f++) { /* the DFT rotated by phi */
+        double cf = cos(f * ph), sf = sin(f * ph);
+        zr[f] = dr[f] * cf - di[f] * sf;
+        zi[f] = dr[f] * sf + di[f] * cf;
     }
-    /* the degree-16 polynomial in x = tan((theta - phi) / 2), phi + pi the sample
-     * of largest |D| (its leading coefficient is D there) */
-    double phi = G6_TWO_PI * jbest / G6_NSAMP - G6_PI;
-    double cpoly[17];
     for (int j = 0; j <= 16; j++) {
         double acc = dr[0] * g6_er[8][j];
-        for (int f = 1; f <= G6_DEG; f++) {
-            double cf = cos(f * phi), sf = sin(f * phi);
-            double zr = dr[f] * cf - di[f] * sf, zi = dr[f] * sf + di[f] * cf;
-            acc += 2.0 * (zr * g6_er[8 + f][j] - zi * g6_ei[8 + f][j]);
-        }
+        for (int f = 1; f <= G6_DEG; f++)
+            acc += 2.0 * (zr[f] * g6_er[8 + f][j] - zi[f] * g6_ei[8 + f][j]);
         cpoly[j] = acc;
     }
-    double wr[16], wi[16];
-    if (!all_roots16(cpoly, jbest, wr, wi)) {
-        *flags |= G6F_DEGENERATE;
-        return 0;
+    *phi = ph;
+    return jbest;
+}
+
+/* The roots theta of cpoly that are real or within imag_tol of it, in [-pi, pi),
+ * sorted, each with a weight (2 for a complex pair: a possible pair of close real
+ * roots, how a double root comes out of rounding; else 1) and near[i]: the root may
+ * be part of a multiple root spread by rounding (by eps^(1/k) for a k-fold one): it
+ * is complex, or another root lies within gap, or a complex root close to the axis
+ * (imaginary part of theta below 0.25) lies within 0.15 rad. Returns how many, or -1
+ * when the eigenvalue iteration fails. */
+static int g6_real_roots(const double *cpoly, int jbest, double phi, double imag_tol,
+                         double gap, double *ths, int *wts, int *near)
+{
+    double wr[16], wi[16], re[16];
+    if (!all_roots16(cpoly, jbest, wr, wi))
+        return -1;
+    int nn = 0, nr = 0;
+    for (int k = 0; k < 16; k++) { /* complex roots close to the axis */
+        double z2 = wr[k] * wr[k] + wi[k] * wi[k], ia = 2.0 * fabs(wi[k]) / (1.0 + z2);
+        if (wi[k] > 0.0 && ia < 0.25)
+            re[nn++] = phi + 2.0 * atan(wr[k]);
     }
-    /* the accepted roots (a complex pair counts once, as a possible pair of close
-     * real roots; so do roots within the pair gap of another) */
-    const double pair_gap = P[GP_PAIR_GAP];
-    double ths[16];
-    int nr = 0, pair[16];
     for (int k = 0; k < 16; k++) {
         if (wi[k] < 0.0)
             continue; /* the conjugate's twin */
         double z2 = wr[k] * wr[k] + wi[k] * wi[k];
-        if (2.0 * fabs(wi[k]) / (1.0 + z2) <= imag_tol) {
-            pair[nr] = wi[k] != 0.0;
-            ths[nr++] = phi + 2.0 * atan(wr[k]);
+        if (!(2.0 * fabs(wi[k]) / (1.0 + z2) <= imag_tol))
+            continue;
+        double th = wrap_pi(phi + 2.0 * atan(wr[k]));
+        int w = wi[k] != 0.0 ? 2 : 1, i = nr++, nb = w > 1;
+        for (int j = 0; j < nn && !nb; j++) /* a complex one near, not itself */
+            nb = fabs(wrap_pi(re[j] - th)) < 0.15 && !(w > 1 && fabs(wrap_pi(re[j] - th)) < 1e-12);
+        for (; i > 0 && ths[i - 1] > th; i--) {
+            ths[i] = ths[i - 1];
+            wts[i] = wts[i - 1];
+            near[i] = near[i - 1];
+        }
+        ths[i] = th;
+        wts[i] = w;
+        near[i] = nb;
+    }
+    for (int i = 0; i < nr; i++) /* neighbours within the gap (around the circle too) */
+        for (int j = 0; j < nr; j++)
+            if (i != j && fabs(wrap_pi(ths[i] - ths[j])) < gap)
+                near[i] = 1;
+    return nr;
+}
+
+/* The same roots as eigenvalues (Manocha & Canny 1994, section 5): with t = theta -
+ * phi, x = tan(t / 2), (1 + x^2) Sigma = x^2 M2 + x M1 + M0 (M2 = Sigma(phi + pi),
+ * the best conditioned sample, invertible), and its roots are the eigenvalues of the
+ * companion matrix [[0, I], [-M2^-1 M0, -M2^-1 M1]] (24 x 24; 8 of them at x = +-i,
+ * dropped by the imaginary-part rule). Where k solutions share theta_a with a
+ * k-dimensional null space the eigenvalue is semi-simple and comes out to rounding,
+ * where the determinant's k-fold root spreads by eps^(1/k): run where the
+ * determinant's roots cluster. Sorted and weighted as g6_real_roots; -1 when M2 is
+ * singular or hqr fails. */
+static int g6_eig_roots(const double (*S)[144], double phi, double imag_tol, double *ths,
+                        int *wts)
+{
+    const double cp = cos(phi), sp = sin(phi);
+    double M2[144], R[12 * 24], E[24 * 24], wr[24], wi[24];
+    for (int i = 0; i < 144; i++) {
+        double a = cp * S[0][i] - sp * S[1][i], b = sp * S[0][i] + cp * S[1][i];
+        M2[i] = S[2][i] - b;
+        R[24 * (i / 12) + (i % 12)] = b + S[2][i]; /* M0 | M1, 12 x 24 row-major */
+        R[24 * (i / 12) + 12 + (i % 12)] = 2.0 * a;
+    }
+    /* R <- M2^-1 [M0 M1]: LU with partial pivoting, 24 right-hand sides */
+    for (int k = 0; k < 12; k++) {
+        int p = k;
+        for (int i = k + 1; i < 12; i++)
+            if (fabs(M2[12 * i + k]) > fabs(M2[12 * p + k]))
+                p = i;
+        if (M2[12 * p + k] == 0.0)
+            return -1;
+        if (p != k) {
+            for (int j = 0; j < 12; j++) {
+                double t = M2[12 * k + j];
+                M2[12 * k + j] = M2[12 * p + j];
+                M2[12 * p + j] = t;
+            }
+            for (int j = 0; j < 24; j++) {
+                double t = R[24 * k + j];
+                R[24 * k + j] = R[24 * p + j];
+                R[24 * p + j] = t;
+            }
+        }
+        for (int i = k + 1; i < 12; i++) {
+            double f = M2[12 * i + k] / M2[12 * k + k];
+            for (int j = k + 1; j < 12; j++)
+                M2[12 * i + j] -= f * M2[12 * k + j];
+            for (int j = 0; j < 24; j++)
+                R[24 * i + j] -= f * R[24 * k + j];
         }
     }
-    for (int i = 0; i < nr; i++)
-        for (int j = i + 1; j < nr; j++)
-            if (fabs(wrap_pi(ths[i] - ths[j])) < pair_gap)
-                pair[i] = pair[j] = 1;
-    G6Back G = {vb, Tp, Q, V8, beta8, A8, a, dir};
-    /* back-substitution, W roots at a time for the null vectors */
-    int nc = 0;
-    for (int k0 = 0; k0 < nr; k0 += W) {
-        vd sv, cv, yv[12], yv2[12], rv[12];
-        for (int l = 0; l < W; l++) {
-            double th = ths[k0 + l < nr ? k0 + l : k0];
-            sv[l] = sin(th);
-            cv[l] = cos(th);
+    for (int k = 11; k >= 0; k--)
+        for (int j = 0; j < 24; j++) {
+            double acc = R[24 * k + j];
+            for (int c = k + 1; c < 12; c++)
+                acc -= M2[12 * k + c] * R[24 * c + j];
+            R[24 * k + j] = acc / M2[12 * k + k];
         }
-        null_vector12_lanes((const double (*)[144])S, sv, cv, yv, yv2, rv);
-        for (int l = 0; l < W && k0 + l < nr; l++) {
-            double th = ths[k0 + l], s = sv[l], c = cv[l];
-            double y[12];
+    memset(E, 0, sizeof(E));
+    for (int i = 0; i < 12; i++) {
+        E[24 * i + 12 + i] = 1.0;
+        for (int j = 0; j < 24; j++)
+            E[24 * (12 + i) + j] = -R[24 * i + j];
+    }
+    balance(E, 24);
+    hessenberg(E, 24);
+    if (!hqr(E, 24, wr, wi))
+        return -1;
+    int nr = 0;
+    for (int k = 0; k < 24 && nr < G6_MAXROOT; k++) {
+        if (wi[k] < 0.0)
+            continue;
+        double z2 = wr[k] * wr[k] + wi[k] * wi[k];
+        if (!(2.0 * fabs(wi[k]) / (1.0 + z2) <= imag_tol))
+            continue;
+        double th = wrap_pi(phi + 2.0 * atan(wr[k]));
+        int w = wi[k] != 0.0 ? 2 : 1, i = nr++;
+        for (; i > 0 && ths[i - 1] > th; i--) {
+            ths[i] = ths[i - 1];
+            wts[i] = wts[i - 1];
+        }
+        ths[i] = th;
+        wts[i] = w;
+    }
+    return nr;
+}
+
+/* Orthonormalize the k rows of Z (k x 12) in place (modified Gram-Schmidt), dropping
+ * rows that are (nearly) in the span of the previous ones; returns how many remain. */
+static int g6_orthonormal(double *Z, int k)
+{
+    int n = 0;
+    for (int j = 0; j < k; j++) {
+        double *z = Z + 12 * j, n0 = 0.0, nrm = 0.0;
+        for (int i = 0; i < 12; i++)
+            n0 += z[i] * z[i];
+        for (int p = 0; p < n; p++) {
+            const double *y = Z + 12 * p;
+            double t = 0.0;
             for (int i = 0; i < 12; i++)
-                y[i] = yv[i][l];
-            double margin = rv[10][l] / rv[0][l];
-            stats[1] = margin < stats[1] ? margin : stats[1];
-            if (!(margin > null_tol))
-                *flags |= G6F_AMBIGUOUS;
-            /* the smallest singular vector's solution; where two solutions may share
-             * theta (a close or complex pair, a 2-D null space) also the two in the
-             * span of the two smallest (at a singular solution the pair is one
-             * solution twice and only the first is right) */
-            double tb[3], tc[3];
-            int np = 1;
-            tb[0] = g6_half_angle(y, mult, 1);
-            tc[0] = g6_half_angle(y, mult, 0);
-            if (pair[k0 + l] || !(margin > null_tol)) {
-                stats[2] += 1.0;
-                double y2[12];
-                for (int i = 0; i < 12; i++)
-                    y2[i] = yv2[i][l];
-                np += g6_two_solutions(y, y2, mult, tb + 1, tc + 1);
-            }
-            for (int k = 0; k < np; k++) {
-                cand[nc].slow = np > 1;
-                nc += g6_candidate(&G, th, s, c, tb[k], tc[k], cand + nc);
-            }
+                t += y[i] * z[i];
+            for (int i = 0; i < 12; i++)
+                z[i] -= t * y[i];
         }
+        for (int i = 0; i < 12; i++)
+            nrm += z[i] * z[i];
+        if (!(nrm > 1e-20 * n0) || !(nrm > 0.0))
+            continue;
+        nrm = 1.0 / sqrt(nrm);
+        double *o = Z + 12 * n;
+        for (int i = 0; i < 12; i++)
+            o[i] = z[i] * nrm;
+        n++;
+    }
+    return n;
+}
+
+/* The dimension of a null space from the |diagonal| r[0..n-1] (non-increasing) of a
+ * rank-revealing factorization: the most trailing directions (at most kmax) that
+ * lie below a gap (a ratio above 1e3) and below tiny r[0]; 0 when there is no such
+ * gap (a larger space is safe: the split keeps every solution it holds). Near a multiple root or a degenerate pose the null directions are small
+ * but not at rounding level, so a fixed threshold would cut them. */
+static int g6_nullity(const double *r, int n, int kmax, double tiny)
+{
+    int k = 0;
+    for (int j = 1; j <= kmax && j < n; j++) {
+        const int i = n - j;
+        if (r[i] < tiny * r[0] && r[i - 1] > 1e3 * r[i])
+            k = j;
+    }
+    return k;
+}
+
+/* Projected mode: an orthonormal basis Z (k' x 12, k' <= k) of the monomial vectors
+ * the projection allows at theta: in the right null space of Sigma_0(theta) (its
+ * dimension dl >= d: more where the rank drops further, counted from the pivots
+ * below null_tol of the largest) and there in the null space of the Schur
+ * complement G = Y^T Sigma_1 V (its k smallest directions). Returns k'. */
+static int g6_proj_basis(const G6Var *V, const G6Proj *pj, double th, int k, double null_tol,
+                         double *Z)
+{
+    double A[144], B[144], Vn[12 * 12], G[144], C[144], r[12];
+    G6Lu F;
+    g6_sigma_at((const double (*)[144])V->S, th, A);
+    g6_sigma_at((const double (*)[144])pj->Sd, th, B);
+    lu_complete(A, &F);
+    int dl = pj->d;
+    for (int i = 1; i < 12 - pj->d; i++)
+        if (F.piv[i] < null_tol * F.piv[0] && dl < G6_MAXSPLIT)
+            dl++;
+    pencil_lowest(&F, B, dl, Vn, NULL, G);
+    int kk = k < dl ? k : dl;
+    null_basis(G, dl, kk, C, r);
+    for (int j = 0; j < kk; j++)
+        for (int i = 0; i < 12; i++) {
+            double acc = 0.0;
+            for (int c = 0; c < dl; c++)
+                acc += C[dl * j + c] * Vn[12 * c + i];
+            Z[12 * j + i] = acc;
+        }
+    return g6_orthonormal(Z, kk);
+}
+
+/* Candidates from one theta and a basis Z (k x 12) of the monomial vectors there:
+ * the vector itself (k = 1) or the split of the span; appended to cand (at most
+ * room), slow marks those from a multiple root. Returns how many. */
+static int g6_from_basis(const G6Back *G, double th, const double *Z, int k, int slow,
+                         G6Cand *cand, int room)
+{
+    double tb[G6_MAXSPLIT], tc[G6_MAXSPLIT];
+    int n = 0, nc = 0;
+    if (k == 1) {
+        tb[0] = g6_half_angle(Z, G->mult, 1);
+        tc[0] = g6_half_angle(Z, G->mult, 0);
+        n = 1;
+    } else if (k > 1) {
+        n = g6_split(Z, k, G->mult, tb, tc);
+    }
+    const double s = sin(th), c = cos(th);
+    for (int i = 0; i < n && nc < room; i++) {
+        cand[nc].slow = slow;
+        nc += g6_candidate(G, th, s, c, tb[i], tc[i], cand + nc);
     }
     return nc;
 }
 
-/* ------------------------------------------------------------ Newton polish */
+/* Back-substitution of the roots ths (sorted, weights wts) of one variant: every
+ * root alone (Sigma's null vector; projected: the projection's; where its null space
+ * has dimension k >= 2, also its split), then every cluster of roots closer than
+ * GP_PAIR_GAP (complex ones count twice) or with a null space of dimension k >= 2,
+ * split at its centroid. Flags get G6F_CLUSTER; stats[1] the
+ * smallest ratio of Sigma's second-smallest to largest pivot over the roots, stats[2]
+ * the clusters split. Returns the candidates appended to cand. */
+static int g6_back(const G6Var *V, const G6Proj *pj, const double *P, const double *ths,
+                   const int *wts, const int *near, int nr, G6Cand *cand, int *flags,
+                   double *stats)
+{
+    const double null_tol = P[GP_NULL_TOL], gap = P[GP_PAIR_GAP];
+    G6Back G = {V->vb, V->Tp, V->Q, V->V8, V->beta8, V->A8, V->a, V->dir, V->mult};
+    double Z[12 * 12], r[12];
+    int nc = 0, nul[G6_MAXROOT], lab[G6_MAXROOT];
+    if (pj == NULL) {
+        for (int k0 = 0; k0 < nr; k0 += W) { /* W roots at a time for the null vectors */
+            vd sv, cv, yv[12], rv[12];
+            for (int l = 0; l < W; l++) {
+                double th = ths[k0 + l < nr ? k0 + l : k0];
+                sv[l] = sin(th);
+                cv[l] = cos(th);
+            }
+            null_vector12_lanes((const double (*)[144])V->S, sv, cv, yv, rv);
+            for (int l = 0; l < W && k0 + l < nr; l++) {
+                double y[12], margin = rv[10][l] / rv[0][l];
+                if (near[k0 + l] && margin < G6_MULTI_TOL)
+                    *flags |= G6F_MULTI; /* near others, a second small pivot */
+                for (int i = 0; i < 12; i++)
+                    y[i] = yv[i][l];
+                stats[1] = margin < stats[1] ? margin : stats[1];
+                double rl[12];
+                for (int i = 0; i < 12; i++)
+                    rl[i] = rv[i][l];
+                nul[k0 + l] = g6_nullity(rl, 12, G6_MAXSPLIT, null_tol);
+                nul[k0 + l] = nul[k0 + l] < 1 ? 1 : nul[k0 + l];
+                nc += g6_from_basis(&G, ths[k0 + l], y, 1, 0, cand + nc, G6_VARCAND - nc);
+                if (nul[k0 + l] > 1) { /* solutions sharing this theta: split here too
+                                        * (a cluster's centroid may be off it) */
+                    double A[144];
+                    g6_sigma_at((const double (*)[144])V->S, ths[k0 + l], A);
+                    null_basis(A, 12, nul[k0 + l], Z, r);
+                    nc += g6_from_basis(&G, ths[k0 + l], Z, nul[k0 + l], 1, cand + nc,
+                                        G6_VARCAND - nc);
+                }
+            }
+        }
+    } else {
+        for (int i = 0; i < nr; i++) {
+            int k = g6_proj_basis(V, pj, ths[i], 1, null_tol, Z);
+            nul[i] = 1;
+            nc += g6_from_basis(&G, ths[i], Z, k, 0, cand + nc, G6_VARCAND - nc);
+        }
+    }
+    /* clusters: chains of neighbours closer than the gap (around the circle too) */
+    int ncl = 0;
+    for (int i = 0; i < nr; i++)
+        lab[i] = i > 0 && ths[i] - ths[i - 1] < gap ? lab[i - 1] : ncl++;
+    if (ncl > 1 && ths[0] + G6_TWO_PI - ths[nr - 1] < gap)
+        for (int i = 0; i < nr; i++)
+            lab[i] = lab[i] == ncl - 1 ? 0 : lab[i];
+    for (int c = 0; c < ncl; c++) {
+        int weight = 0, k = 0;
+        double sx = 0.0, sy = 0.0;
+        for (int i = 0; i < nr; i++)
+            if (lab[i] == c) {
+                weight += wts[i];
+                k = nul[i] > k ? nul[i] : k;
+                sx += wts[i] * cos(ths[i]);
+                sy += wts[i] * sin(ths[i]);
+            }
+        if (pj == NULL && weight == 1 && k > 1)
+            *flags |= G6F_NOISY; /* a simple root with a 2-D null space */
+        k = weight > k ? weight : k;
+        if (k < 2)
+            continue;
+        const double th = atan2(sy, sx);
+        k = k < G6_MAXSPLIT ? k : G6_MAXSPLIT;
+        *flags |= G6F_CLUSTER;
+        stats[2] += 1.0;
+        if (pj == NULL) {
+            double A[144];
+            g6_sigma_at((const double (*)[144])V->S, th, A);
+            null_basis(A, 12, G6_MAXSPLIT, Z, r);
+            /* the null space's dimension at the centroid (off the multiple root by
+             * about the roots' spread: looser) */
+            int n0 = g6_nullity(r, 12, G6_MAXSPLIT, 1e-4);
+            k = n0 > k ? n0 : k;
+        } else {
+            k = g6_proj_basis(V, pj, th, k, null_tol, Z);
+        }
+        nc += g6_from_basis(&G, th, Z, k, 1, cand + nc, G6_VARCAND - nc);
+    }
+    return nc;
+}
 
-#define NEWTON_RATIO 0.7 /* a step must cut the error by this factor (after 3) */
-#define SLOW_RATIO 0.9   /* ... from a close pair of roots (after SLOW_START) */
-#define SLOW_START 8
+/* Candidate chain values of one variant for the pose T (4x4 row-major), appended to
+ * cand (at most G6_VARCAND); project: through the projection (a degenerate pose).
+ * flags get G6F_DEGENERATE (the right side is rank deficient, the determinant or
+ * the projection vanishes, or the root finder fails) and G6F_CLUSTER; stats[0] the
+ * relative DFT tail, stats[1], stats[2] as g6_back. Returns the candidates. */
+static int g6_variant(const double *P, const double *vb, const double *T, int project,
+                      G6Cand *cand, int *flags, double *stats)
+{
+    const double tail_tol = P[GP_TAIL_TOL];
+    G6Var V;
+    G6Proj pj;
+    double D[G6_NSAMP], cpoly[17], phi = 0.0, tail = INFINITY;
+    int jbest = -1;
+    stats[0] = stats[1] = INFINITY;
+    stats[2] = 0.0;
+    if (!g6_prepare(vb, T, &V)) {
+        *flags |= G6F_DEGENERATE;
+        return 0;
+    }
+    if (!project) {
+        double ratio[G6_NSAMP], rmax = 0.0;
+        for (int k = 0; k < G6_NSAMP; k += W)
+            det12_lanes((const double (*)[144])V.S, k, D, ratio);
+        for (int k = 0; k < G6_NSAMP; k++)
+            rmax = ratio[k] > rmax ? ratio[k] : rmax;
+        jbest = g6_trig_poly(D, cpoly, &phi, &tail);
+        /* noisy: near a degenerate pose (a noisy determinant, Sigma nearly singular
+         * at every sample) or a right side nearly rank deficient (u, w badly
+         * determined by the back-substitution) */
+        if (tail > P[GP_NEAR_TAIL] || rmax < 1e-5 || V.rcond < 1e-6)
+            *flags |= G6F_NOISY;
+    } else {
+        /* c_d at the samples, d the smallest null space seen (pivots below 1e-5 of
+         * the largest: near a degenerate pose they are ~ its distance, and the
+         * coefficients below d are that small, with their roots spread by rounding),
+         * else the first of d - 1, d + 1, d + 2 whose polynomial has no tail */
+        double A[144], B[G6_NSAMP][144];
+        G6Lu F[G6_NSAMP];
+        int d0 = 12;
+        g6_derivative(&V, P[GP_SCALE], &pj);
+        for (int k = 0; k < G6_NSAMP; k++) {
+            double th = G6_TWO_PI * k / G6_NSAMP;
+            int dk = 0;
+            g6_sigma_at((const double (*)[144])V.S, th, A);
+            g6_sigma_at((const double (*)[144])pj.Sd, th, B[k]);
+            lu_complete(A, &F[k]);
+            for (int i = 11; i > 0 && F[k].piv[i] < 1e-5 * F[k].piv[0]; i--)
+                dk++;
+            d0 = dk < d0 ? dk : d0;
+        }
+        d0 = d0 < 1 ? 1 : d0;
+        const int tries[4] = {d0, d0 - 1, d0 + 1, d0 + 2};
+        for (int t = 0; t < 4; t++) {
+            const int d = tries[t];
+            if (d < 1 || d > G6_MAXSPLIT)
+                continue;
+            for (int k = 0; k < G6_NSAMP; k++)
+                D[k] = pencil_lowest(&F[k], B[k], d, NULL, NULL, NULL);
+            jbest = g6_trig_poly(D, cpoly, &phi, &tail);
+            pj.d = d;
+            if (jbest >= 0 && tail <= tail_tol)
+                break;
+        }
+    }
+    stats[0] = tail;
+    if (jbest < 0 || !(tail <= tail_tol)) {
+        *flags |= G6F_DEGENERATE;
+        return 0;
+    }
+    double ths[G6_MAXROOT];
+    int wts[G6_MAXROOT];
+    int near[G6_MAXROOT];
+    int nr = g6_real_roots(cpoly, jbest, phi, P[GP_IMAG_TOL], P[GP_PAIR_GAP], ths, wts, near);
+    if (nr < 0) {
+        *flags |= G6F_DEGENERATE;
+        return 0;
+    }
+    int f = 0;
+    int nc = g6_back(&V, project ? &pj : NULL, P, ths, wts, near, nr, cand, &f, stats);
+    if ((f & G6F_MULTI) && !project) {
+        /* a multiple root (roots close together where Sigma has a second small
+         * pivot, not a pair of solutions turning complex): its eigenvalue is
+         * accurate where the determinant's roots spread; the back-substitution again
+         * from the eigenvalues */
+        int nr2 = g6_eig_roots((const double (*)[144])V.S, phi, P[GP_IMAG_TOL], ths, wts);
+        if (nr2 >= 0) {
+            f = G6F_EIGEN;
+            stats[1] = INFINITY;
+            stats[2] = 0.0;
+            memset(near, 0, sizeof(near));
+            nc = g6_back(&V, NULL, P, ths, wts, near, nr2, cand, &f, stats);
+        }
+    }
+    *flags |= f & ~G6F_MULTI;
+    return nc;
+}
+
+/* The candidates of pose T: the primary variant; where its determinant is
+ * degenerate or noisy (a tail above GP_NEAR_TAIL: near a degenerate pose, where the
+ * roots of close solutions spread) the secondary too; where that is as well, the
+ * projection of each in turn (until one is not degenerate). flags as g6_pose's diag,
+ * stats the primary's. Returns how many went to cand (room for G6_MAXCAND). */
+static int g6_candidates(const double *P, const double *T, G6Cand *cand, int *flags,
+                         double *stats)
+{
+    const int nv = (int)P[GP_NVAR];
+    int nc = 0;
+    double st[3];
+    for (int v = 0; v < nv && nc + 2 * G6_VARCAND <= G6_MAXCAND; v++) {
+        int f = 0;
+        nc += g6_variant(P, P + GP_HEAD + v * VB_SIZE, T, 0, cand + nc, &f, v ? st : stats);
+        if (v == 0)
+            *flags |= f;
+        else
+            *flags |= G6F_SECONDARY | (f & G6F_DEGENERATE ? G6F_SEC_DEGENERATE : 0) |
+                      (f & G6F_CLUSTER ? G6F_SEC_CLUSTER : 0) |
+                      (f & G6F_NOISY ? G6F_SEC_NOISY : 0);
+        if (!(f & (G6F_DEGENERATE | G6F_NOISY)))
+            return nc;
+    }
+    if (P[GP_FALLBACK] == 0.0)
+        return nc;
+    *flags |= G6F_PROJECTED;
+    for (int v = 0; v < nv && nc + G6_VARCAND <= G6_MAXCAND; v++) {
+        int f = 0;
+        nc += g6_variant(P, P + GP_HEAD + v * VB_SIZE, T, 1, cand + nc, &f, st);
+        if (!(f & G6F_DEGENERATE))
+            return nc;
+    }
+    *flags |= G6F_PROJ_DEGENERATE;
+    return nc;
+}
+
+/* ------------------------------------------------------------ Newton polish */
 
 /* Smallest singular value of the 6 x 6 row-major J (lane-wise): inverse iteration
  * on J^T J (Cholesky), started at the unit vector of the smallest Cholesky pivot;
@@ -1260,18 +2223,91 @@ static vd g6_sigma_min(const vd *J)
     return vsel(bad | ~vfinite(sig), BR(0.0), sig);
 }
 
-/* Newton steps on the true chain from the candidates (chain values), W at a time;
- * the distinct ones that reproduce T within tol go to q (wrapped into [-pi, pi))
- * and sig (Jacobian's smallest singular value). Returns how many. */
-static int g6_polish(const Chain *ch, const double *P, const double *T, const G6Cand *cand,
-                     int ncand, double *q, double *sig)
+#define NEWTON_RATIO 0.7 /* a step must cut the error by this factor (after 3) ... */
+#define SLOW_RATIO 0.9   /* ... from a multiple root (after SLOW_START) ... */
+#define SLOW_START 8
+#define G6_FAR 1e-6      /* ... while the error [m, rad] is above this: else spurious */
+
+/* One Levenberg-Marquardt step dq of lane l: the least-squares solution of
+ * [J; sqrt(lam) I] dq = [e; 0] with lam = |e|^2 (Yamashita & Fukushima 2001:
+ * quadratic convergence to a regular solution and onto a manifold of solutions,
+ * where J is singular), by Householder QR of the 12 x 6 matrix (not the normal
+ * equations, whose squared condition number stalls the error near a solution with
+ * sigma ~ 1e-9); a step above 0.5 rad is shortened to it. Returns 0 when the step
+ * is not finite. */
+static int g6_lm_step(const vd *J, const vd *e, int l, double *dq)
 {
-    const double tol = P[GP_TOL], dedupe = P[GP_DEDUPE];
-    const int max_iter = (int)P[GP_MAX_ITER];
-    int nsol = 0;
+    double A[6 * 12], V[6 * 12], beta[6], b[12], e2 = 0.0;
+    for (int r = 0; r < 6; r++)
+        e2 += e[r][l] * e[r][l];
+    const double mu = sqrt(e2) + 1e-300;
+    for (int j = 0; j < 6; j++) /* column-major, column j: J's, then mu e_j */
+        for (int r = 0; r < 12; r++)
+            A[12 * j + r] = r < 6 ? J[6 * r + j][l] : (r - 6 == j ? mu : 0.0);
+    for (int r = 0; r < 12; r++)
+        b[r] = r < 6 ? e[r][l] : 0.0;
+    house_qr(A, 12, 6, V, beta);
+    house_apply_t(V, beta, 12, 6, b);
+    double big = 0.0;
+    for (int i = 5; i >= 0; i--) {
+        double acc = b[i];
+        for (int k = i + 1; k < 6; k++)
+            acc -= A[12 * k + i] * dq[k];
+        dq[i] = acc / A[12 * i + i];
+        big = fabs(dq[i]) > big ? fabs(dq[i]) : big;
+    }
+    if (!isfinite(big))
+        return 0;
+    if (big > 0.5)
+        for (int i = 0; i < 6; i++)
+            dq[i] *= 0.5 / big;
+    return 1;
+}
+
+/* One step dq of lane l: Newton's (LU with partial pivoting of J) where J is well
+ * conditioned (its pivots within 1e-6 of each other), else g6_lm_step's. */
+static int g6_step(const vd *J, const vd *e, int l, double *dq)
+{
+    double A[36];
+    for (int r = 0; r < 6; r++) {
+        dq[r] = e[r][l];
+        for (int j = 0; j < 6; j++)
+            A[6 * r + j] = J[6 * r + j][l];
+    }
+    double pmin, pmax;
+    if (solve_dense_pivots(A, dq, 6, &pmin, &pmax) && pmin > 1e-6 * pmax) {
+        double big = 0.0;
+        for (int i = 0; i < 6; i++)
+            big = fabs(dq[i]) > big ? fabs(dq[i]) : big;
+        if (isfinite(big)) {
+            if (big > 0.5)
+                for (int i = 0; i < 6; i++)
+                    dq[i] *= 0.5 / big;
+            return 1;
+        }
+    }
+    return g6_lm_step(J, e, l, dq);
+}
+
+/* Polish the candidates (chain values) towards T, W at a time, by the steps above
+ * until the error stops falling: the distinct ones that reproduce T (position error
+ * within GP_TOL times max(1, GP_SCALE) [m], rotation within GP_TOL [rad]) are
+ * appended to q (joint coordinates wrapped into [-pi, pi)), after the nsol there, and
+ * sig (the Jacobian's smallest singular value). Two solutions are one when they
+ * differ by less than GP_DEDUPE, or than 1e-10 / sigma (capped at 1e-3) for a
+ * near-singular one (Newton leaves it 1e-15 / sigma off). *best: the smallest final
+ * error of any candidate. Returns the solutions in q. */
+static int g6_polish(const Chain *ch, const double *P, const double *T, const G6Cand *cand,
+                     int ncand, double *q, double *sig, int nsol, double *best, int patient)
+{
+    const double tol_r = P[GP_TOL], dedupe = P[GP_DEDUPE], scale = fmax(1.0, P[GP_SCALE]);
+    const double tol_p = tol_r * scale, floor_err = 1e-14 * scale;
+    const int max_iter = (int)P[GP_MAX_ITER] * (patient ? 2 : 1);
     vd tt[12];
     for (int i = 0; i < 12; i++)
         tt[i] = BR(T[i]);
+    if (best != NULL)
+        *best = INFINITY;
     for (int c0 = 0; c0 < ncand; c0 += W) {
         vd qv[MAXJ], t[12], J[36], e[6];
         for (int j = 0; j < 6; j++)
@@ -1280,72 +2316,94 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
                 qv[j][l] = ch->sign[j] * (cand[c].v[j] - ch->offset[j]);
             }
         vl done = BRL(0);
-        for (int l = 0; l < W; l++)
+        double prev[W], qbest[6][W] = {{0.0}}, mlast[W];
+        int slow[W], since[W];
+        for (int l = 0; l < W; l++) {
             if (c0 + l >= ncand)
                 done[l] = -1;
-        double prev[W];
-        int slow[W];
-        for (int l = 0; l < W; l++)
             slow[l] = c0 + l < ncand && cand[c0 + l].slow;
+            prev[l] = mlast[l] = INFINITY;
+            since[l] = 0;
+        }
         for (int it = 0;; it++) {
             chain_pose_jac(ch, qv, t, J, 6);
             pose_residual(t, tt, e, BRL(-1));
             int all = 1;
             for (int l = 0; l < W; l++) {
+                if (done[l])
+                    continue;
                 double m = 0.0;
                 for (int r = 0; r < 6; r++)
                     m = fabs(e[r][l]) > m ? fabs(e[r][l]) : m;
-                /* converged, or a spurious root: from a true one Newton converges
-                 * quadratically, so a lane whose error stops falling gives up; near
-                 * a singular solution (a close pair of roots) it may be linear with
-                 * ratio 1/2 after an erratic start */
-                int stalled = slow[l] ? it >= SLOW_START && m > SLOW_RATIO * prev[l]
-                                      : it >= 3 && m > NEWTON_RATIO * prev[l];
-                if (!(m > 1e-14) || !isfinite(m) || stalled)
+                /* converged (to rounding), or spurious: from a true root Newton
+                 * converges quadratically, so far from zero a lane whose error stops
+                 * falling gives up; from a multiple root it may be linear with ratio
+                 * 1/2 after an erratic start; close to zero (a near-singular
+                 * solution) it goes on until 3 steps bring no new best */
+                since[l] = m < prev[l] ? 0 : since[l] + 1;
+                int stalled = m > G6_FAR ? (slow[l] ? it >= SLOW_START && m > SLOW_RATIO * prev[l]
+                                                     : it >= 3 && m > NEWTON_RATIO * prev[l])
+                                         : since[l] >= 3;
+                /* patient (nothing found otherwise: a near-singular target, whose
+                 * steps may fall slowly and erratically from far): only 15 steps
+                 * without a new best stop a lane */
+                if (patient)
+                    stalled = since[l] >= 15;
+                if (m < prev[l]) {
+                    prev[l] = m;
+                    for (int j = 0; j < 6; j++)
+                        qbest[j][l] = qv[j][l];
+                }
+                mlast[l] = m;
+                if (!(m > floor_err) || !isfinite(m) || stalled)
                     done[l] = -1;
-                prev[l] = m;
                 all &= done[l] != 0;
             }
             if (all || it == max_iter)
                 break;
             for (int l = 0; l < W; l++) {
+                double dq[6];
                 if (done[l])
                     continue;
-                double A[36], b[6];
-                for (int r = 0; r < 6; r++) {
-                    b[r] = e[r][l];
-                    for (int j = 0; j < 6; j++)
-                        A[6 * r + j] = J[6 * r + j][l];
-                }
-                if (!solve_dense(A, b, 6)) {
+                if (!g6_step(J, e, l, dq)) {
                     done[l] = -1;
                     continue;
                 }
-                double big = 0.0;
                 for (int j = 0; j < 6; j++)
-                    big = fabs(b[j]) > big ? fabs(b[j]) : big;
-                double f = big > 0.5 ? 0.5 / big : 1.0; /* a far seed: damp */
-                for (int j = 0; j < 6; j++)
-                    qv[j][l] += f * b[j];
+                    qv[j][l] += dq[j];
             }
+        }
+        int worse = 0; /* a lane that ended above its best: back to the best */
+        for (int l = 0; l < W && c0 + l < ncand; l++)
+            if (mlast[l] > prev[l] && isfinite(prev[l])) {
+                worse = 1;
+                for (int j = 0; j < 6; j++)
+                    qv[j][l] = qbest[j][l];
+            }
+        if (worse) {
+            chain_pose_jac(ch, qv, t, J, 6);
+            pose_residual(t, tt, e, BRL(-1));
         }
         vd sg = g6_sigma_min(J);
         for (int l = 0; l < W && c0 + l < ncand; l++) {
             double ep = sqrt(e[0][l] * e[0][l] + e[1][l] * e[1][l] + e[2][l] * e[2][l]);
             double er = sqrt(e[3][l] * e[3][l] + e[4][l] * e[4][l] + e[5][l] * e[5][l]);
-            if (!(ep <= tol && er <= tol))
+            if (best != NULL && fmax(ep, er) < *best)
+                *best = fmax(ep, er);
+            if (!(ep <= tol_p && er <= tol_r))
                 continue;
             double qs[6];
             for (int j = 0; j < 6; j++)
                 qs[j] = wrap_pi(qv[j][l]);
             int dup = 0;
             for (int s = 0; s < nsol && !dup; s++) {
-                double m = 0.0;
+                double m = 0.0, smin = fmin(sg[l], sig[s]);
+                double tol = smin > 0.0 ? fmax(dedupe, fmin(1e-3, 1e-10 / smin)) : 1e-3;
                 for (int j = 0; j < 6; j++) {
                     double d = fabs(wrap_pi(qs[j] - q[6 * s + j]));
                     m = d > m ? d : m;
                 }
-                dup = m < dedupe;
+                dup = m < tol;
             }
             if (dup || nsol == G6_MAXSOL)
                 continue;
@@ -1359,32 +2417,69 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
 
 /* --------------------------------------------------------------- per pose */
 
+/* A singular target (nothing found and the elimination in trouble: a continuum of
+ * solutions, where det Sigma vanishes identically or is noisy, or a candidate came
+ * within G6_FAR: a near-singular solution). A cluster alone does not call it: it is
+ * how an unreachable pose near the workspace's boundary looks (pairs of solutions
+ * turned complex). First the nc0 candidates again, patiently (from far a
+ * near-singular solution's Newton steps may fall slowly). Then, where a continuum
+ * moves theta_a, every theta_a in its range has a solution, whose monomial vector
+ * lies in Sigma(theta_a)'s null space: at each of the 24 sample angles of each
+ * variant the null space (pivots below 1e-8 of the largest, at least one vector) is
+ * split into candidates, polished onto T. Returns the solutions in q. */
+static int g6_rescue(const Chain *ch, const double *P, const double *T, G6Cand *cand,
+                     int nc0, double *q, double *sig)
+{
+    const int nv = (int)P[GP_NVAR];
+    int ns = g6_polish(ch, P, T, cand, nc0, q, sig, 0, NULL, 1); /* the candidates, patiently */
+    if (ns > 0)
+        return ns;
+    for (int v = 0; v < nv; v++) {
+        G6Var V;
+        if (!g6_prepare(P + GP_HEAD + v * VB_SIZE, T, &V))
+            continue;
+        G6Back G = {V.vb, V.Tp, V.Q, V.V8, V.beta8, V.A8, V.a, V.dir, V.mult};
+        int nc = 0;
+        for (int k = 0; k < G6_NSAMP; k++) {
+            double A[144], Z[12 * 12], r[12], th = G6_TWO_PI * k / G6_NSAMP;
+            int n0 = 1;
+            g6_sigma_at((const double (*)[144])V.S, th, A);
+            null_basis(A, 12, G6_MAXSPLIT, Z, r);
+            while (n0 < G6_MAXSPLIT && r[11 - n0] < 1e-8 * r[0])
+                n0++;
+            nc += g6_from_basis(&G, th, Z, n0, 1, cand + nc, G6_MAXCAND - nc);
+        }
+        ns = g6_polish(ch, P, T, cand, nc, q, sig, 0, NULL, 1);
+        if (ns > 0)
+            return ns;
+    }
+    return 0;
+}
+
 static int g6_pose(const Chain *ch, const double *P, const double *T, double *q, double *sig,
                    long long *diag, double *stats)
 {
     for (int i = 0; i < 16; i++)
         if (!isfinite(T[i])) {
             *diag = 0;
-            stats[0] = stats[1] = INFINITY;
+            stats[0] = stats[1] = stats[3] = INFINITY;
             stats[2] = 0.0;
             return -1;
         }
-    G6Cand cand[6 * G6_MAXROOT]; /* two variants, up to three per root */
-    int flags = 0, f2 = 0;
-    double st2[3];
-    int nc = g6_variant(P, P + GP_HEAD, T, cand, &flags, stats);
-    if ((int)P[GP_NVAR] > 1 && (flags & (G6F_DEGENERATE | G6F_AMBIGUOUS))) {
-        nc += g6_variant(P, P + GP_HEAD + VB_SIZE, T, cand + nc, &f2, st2);
-        flags |= G6F_SECONDARY;
-        if (f2 & G6F_DEGENERATE)
-            flags |= G6F_SEC_DEGENERATE;
-        if (f2 & G6F_AMBIGUOUS)
-            flags |= G6F_SEC_AMBIGUOUS;
+    G6Cand cand[G6_MAXCAND];
+    int flags = 0;
+    double best;
+    int nc = g6_candidates(P, T, cand, &flags, stats);
+    int ns = g6_polish(ch, P, T, cand, nc, q, sig, 0, &best, 0);
+    stats[3] = best;
+    if (ns == 0 && P[GP_FALLBACK] != 0.0 &&
+        ((flags & (G6F_DEGENERATE | G6F_NOISY)) || best < G6_FAR * fmax(1.0, P[GP_SCALE]))) {
+        ns = g6_rescue(ch, P, T, cand, nc, q, sig);
+        flags |= G6F_RESCUED;
     }
-    *diag = flags | (nc << G6_DIAG_CAND_SHIFT);
-    int ns = g6_polish(ch, P, T, cand, nc, q, sig);
+    *diag = flags | ((long long)nc << G6_DIAG_CAND_SHIFT);
     if (ns == 0 && (flags & G6F_DEGENERATE) &&
-        (!(flags & G6F_SECONDARY) || (flags & G6F_SEC_DEGENERATE)))
+        (P[GP_FALLBACK] == 0.0 || (flags & G6F_PROJ_DEGENERATE)))
         return -2;
     return ns;
 }
@@ -1403,7 +2498,7 @@ static void g6_range(void *ctx, long b, long e)
     for (long i = b; i < e; i++) {
         double q[6 * G6_MAXSOL], sig[G6_MAXSOL];
         int ns = g6_pose(job->ch, job->P, job->T + 16 * i, q, sig, job->diag + i,
-                         job->stats + 3 * i);
+                         job->stats + 4 * i);
         job->status[i] = ns == -1 ? G6_BAD_POSE : ns == -2 ? G6_DEGENERATE
                          : ns == 0 ? G6_NONE : G6_OK;
         ns = ns < 0 ? 0 : ns;
@@ -1447,9 +2542,12 @@ static int g6_params_ok(const double *P, long len)
     if (len < GP_HEAD)
         return 0;
     int nv = (int)P[GP_NVAR];
-    if (!(P[GP_NVAR] == 1.0 || P[GP_NVAR] == 2.0) || len != GP_HEAD + nv * VB_SIZE)
+    if (!(P[GP_NVAR] >= 1.0 && P[GP_NVAR] <= G6_MAXVAR && P[GP_NVAR] == nv) ||
+        len != GP_HEAD + nv * VB_SIZE)
         return 0;
-    if (!(P[GP_MAX_ITER] >= 0.0 && P[GP_MAX_ITER] <= 100.0))
+    if (!(P[GP_MAX_ITER] >= 0.0 && P[GP_MAX_ITER] <= 100.0) ||
+        !(P[GP_SCALE] > 0.0 && P[GP_SCALE] < 1e6) ||
+        !(P[GP_FALLBACK] == 0.0 || P[GP_FALLBACK] == 1.0))
         return 0;
     for (int k = 0; k < nv; k++) {
         const double *vb = P + GP_HEAD + k * VB_SIZE;
@@ -1463,12 +2561,13 @@ static int g6_params_ok(const double *P, long len)
 
 /* general6r_solve(packed, params, T (N, 4, 4), Q (N, 16, 6), valid (N, 16) bool,
  *                 inside (N, 16) bool, sigma (N, 16), status (N,) int64,
- *                 diag (N,) int64, stats (N, 3), parallel): per pose up to 16
+ *                 diag (N,) int64, stats (N, 4), parallel): per pose up to 16
  * solutions (joint coordinates, revolute ones in [-pi, pi) or moved by whole turns
  * into their limits; rows that are not solutions 0), which are solutions, which
  * are inside the limits, the Jacobian's smallest singular value (NaN on other
  * rows), the status (G6_OK ...), the flags (G6F_..., candidates tried above
- * G6_DIAG_CAND_SHIFT) and the primary's tail, margin and close pairs. */
+ * G6_DIAG_CAND_SHIFT), the primary's tail, margin and clusters split, and the
+ * smallest error a candidate's polish reached. */
 static PyObject *py_general6r_solve(PyObject *self, PyObject *args)
 {
     PyObject *o[10];
@@ -1513,7 +2612,7 @@ static PyObject *py_general6r_solve(PyObject *self, PyObject *args)
     static const int types[N_OUT] = {NPY_DOUBLE, NPY_BOOL, NPY_BOOL, NPY_DOUBLE, NPY_INT64,
                                      NPY_INT64, NPY_DOUBLE};
     static const int ndims[N_OUT] = {3, 2, 2, 2, 1, 1, 2};
-    static const npy_intp d1[N_OUT] = {16, 16, 16, 16, 0, 0, 3};
+    static const npy_intp d1[N_OUT] = {16, 16, 16, 16, 0, 0, 4};
     PyArrayObject *a[N_OUT];
     for (int k = 0; k < N_OUT; k++)
         if (!(a[k] = array_arg(o[3 + k], names[k], types[k], ndims[k], 1)) ||
@@ -1588,6 +2687,36 @@ static PyObject *py_general6r_fit_rows(PyObject *self, PyObject *args)
     Py_RETURN_NONE;
 }
 
+/* general6r_candidates(params, T (4, 4), out (G6_MAXCAND, 6)) -> (n, flags): the
+ * candidates one pose gives before the polish (chain values, original joint order),
+ * for tests and diagnostics */
+static PyObject *py_general6r_candidates(PyObject *self, PyObject *args)
+{
+    PyObject *po, *to, *oo;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOO", &po, &to, &oo))
+        return NULL;
+    PyArrayObject *P, *T, *O;
+    if (!(P = array_arg(po, "params", NPY_DOUBLE, 1, 0)) ||
+        !(T = array_arg(to, "T", NPY_DOUBLE, 2, 0)) ||
+        !(O = array_arg(oo, "out", NPY_DOUBLE, 2, 1)))
+        return NULL;
+    if (!g6_params_ok((const double *)PyArray_DATA(P), (long)PyArray_DIMS(P)[0]) ||
+        !g6_shape(T, "T", 4, 4, 0) || !g6_shape(O, "out", G6_MAXCAND, 6, 0)) {
+        PyErr_SetString(PyExc_ValueError, "robokin._native.general6r_candidates: bad "
+                                          "params, T (4, 4) or out (G6_MAXCAND, 6)");
+        return NULL;
+    }
+    G6Cand cand[G6_MAXCAND];
+    int flags = 0, n;
+    double stats[3], *out = (double *)PyArray_DATA(O);
+    n = g6_candidates((const double *)PyArray_DATA(P), (const double *)PyArray_DATA(T), cand,
+                      &flags, stats);
+    for (int i = 0; i < n; i++)
+        memcpy(out + 6 * i, cand[i].v, sizeof(cand[i].v));
+    return Py_BuildValue("ii", n, flags);
+}
+
 /* general6r_roots(c (deg + 1,) lowest power first, wr (deg,), wi (deg,)) -> bool:
  * the kernel's polynomial root finder (balanced companion matrix + hqr), for tests */
 static PyObject *py_general6r_roots(PyObject *self, PyObject *args)
@@ -1623,6 +2752,8 @@ static PyObject *py_general6r_roots(PyObject *self, PyObject *args)
      "parallel): every IK solution of a general 6R chain."},                              \
     {"general6r_fit_rows", py_general6r_fit_rows, METH_VARARGS,                            \
      "general6r_fit_rows(consts, a, angles, X, Y): the left side's fitting rows."},        \
+    {"general6r_candidates", py_general6r_candidates, METH_VARARGS,                        \
+     "general6r_candidates(params, T, out) -> (n, flags): one pose's candidates."},       \
     {"general6r_roots", py_general6r_roots, METH_VARARGS,                                  \
      "general6r_roots(c, wr, wi) -> ok: polynomial roots (companion matrix + hqr)."},
 
@@ -1630,16 +2761,20 @@ static int general6r_constants(PyObject *m)
 {
     g6_init_tables();
     static const struct { const char *name; int value; } ints[] = {
-        {"G6_MAXSOL", G6_MAXSOL}, {"GP_NVAR", GP_NVAR}, {"GP_TAIL_TOL", GP_TAIL_TOL},
+        {"G6_MAXSOL", G6_MAXSOL}, {"G6_MAXCAND", G6_MAXCAND}, {"G6_MAXVAR", G6_MAXVAR}, {"GP_NVAR", GP_NVAR}, {"GP_TAIL_TOL", GP_TAIL_TOL},
         {"GP_NULL_TOL", GP_NULL_TOL}, {"GP_IMAG_TOL", GP_IMAG_TOL}, {"GP_TOL", GP_TOL},
         {"GP_DEDUPE", GP_DEDUPE}, {"GP_MAX_ITER", GP_MAX_ITER},
-        {"GP_PAIR_GAP", GP_PAIR_GAP}, {"GP_HEAD", GP_HEAD},
+        {"GP_PAIR_GAP", GP_PAIR_GAP}, {"GP_SCALE", GP_SCALE},
+        {"GP_FALLBACK", GP_FALLBACK}, {"GP_NEAR_TAIL", GP_NEAR_TAIL}, {"GP_HEAD", GP_HEAD},
         {"VB_DIR", VB_DIR}, {"VB_A", VB_A}, {"VB_MULT", VB_MULT}, {"VB_C", VB_C},
         {"VB_CI", VB_CI}, {"VB_P", VB_P}, {"VB_SIZE", VB_SIZE}, {"G6_OK", G6_OK},
         {"G6_NONE", G6_NONE}, {"G6_DEGENERATE", G6_DEGENERATE},
         {"G6_BAD_POSE", G6_BAD_POSE}, {"G6F_DEGENERATE", G6F_DEGENERATE},
-        {"G6F_AMBIGUOUS", G6F_AMBIGUOUS}, {"G6F_SECONDARY", G6F_SECONDARY},
-        {"G6F_SEC_DEGENERATE", G6F_SEC_DEGENERATE}, {"G6F_SEC_AMBIGUOUS", G6F_SEC_AMBIGUOUS},
+        {"G6F_CLUSTER", G6F_CLUSTER}, {"G6F_SECONDARY", G6F_SECONDARY},
+        {"G6F_SEC_DEGENERATE", G6F_SEC_DEGENERATE}, {"G6F_SEC_CLUSTER", G6F_SEC_CLUSTER},
+        {"G6F_PROJECTED", G6F_PROJECTED}, {"G6F_PROJ_DEGENERATE", G6F_PROJ_DEGENERATE},
+        {"G6F_RESCUED", G6F_RESCUED}, {"G6F_NOISY", G6F_NOISY}, {"G6F_SEC_NOISY", G6F_SEC_NOISY},
+        {"G6F_EIGEN", G6F_EIGEN},
         {"G6_DIAG_CAND_SHIFT", G6_DIAG_CAND_SHIFT}};
     for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
         if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)

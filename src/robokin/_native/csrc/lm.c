@@ -596,6 +596,58 @@ static void lm_worker(Ctx *cx)
     }
 }
 
+/* --------------------------------------------------------- restart seeds */
+
+/* The restarts' random numbers come from the inputs, not from a generator's
+ * state: target i's numbers are a counter-based stream keyed by a hash of its
+ * pose's bits, its start configuration's bits and a caller's key (0 by default,
+ * or drawn once from an explicit rng). So a target's answer does not depend on
+ * its place in a batch, on the other targets, on the number of threads or on
+ * earlier calls (robokin.kinematics.ik.numeric). */
+
+/* splitmix64's finaliser (Steele, Lea and Flood, "Fast splittable pseudorandom
+ * number generators", OOPSLA 2014): a bijective avalanche of 64 bits */
+static inline unsigned long long seed_mix(unsigned long long z)
+{
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+/* The stream key of one target: its pose T (16 values) and start q0 (n values),
+ * bit for bit, and the caller's key */
+static unsigned long long seed_key(const double *T, const double *q0, int n,
+                                   unsigned long long key)
+{
+    unsigned long long h = seed_mix(key ^ 0x6a09e667f3bcc909ULL);
+    for (int i = 0; i < 16 + n; i++) {
+        unsigned long long w;
+        memcpy(&w, i < 16 ? T + i : q0 + (i - 16), sizeof(w));
+        h = seed_mix(h ^ w) + 0x9e3779b97f4a7c15ULL;
+    }
+    return h;
+}
+
+/* Number (r, j) of a stream: uniform in [0, 1) on the 2^53 grid */
+static inline double seed_uniform(unsigned long long h, long r, int j)
+{
+    unsigned long long c = (unsigned long long)r * NMAX + (unsigned long long)j + 1ULL;
+    return (double)(seed_mix(h + c * 0x9e3779b97f4a7c15ULL) >> 11) * 0x1.0p-53;
+}
+
+/* out[i, r, j] = seed_uniform(stream of target i, base + r, j) for targets (N x 16),
+ * q0 (N x n), out (N x R x n) */
+static void seed_uniforms(const double *targets, const double *q0, long N, int n, long R,
+                          unsigned long long key, long base, double *out)
+{
+    for (long i = 0; i < N; i++) {
+        unsigned long long h = seed_key(targets + 16 * i, q0 + (size_t)i * n, n, key);
+        for (long r = 0; r < R; r++)
+            for (int j = 0; j < n; j++)
+                out[((size_t)i * R + r) * n + j] = seed_uniform(h, base + r, j);
+    }
+}
+
 /* ------------------------------------------------------------------ drivers */
 
 static void lm_task(void *ctx, long b, long e)

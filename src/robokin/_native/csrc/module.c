@@ -271,6 +271,33 @@ static PyObject *py_lm_solve(PyObject *self, PyObject *args)
     return Py_BuildValue("(ll)", fails, first_bad);
 }
 
+/* seed_uniforms(targets (N, 4, 4), q0 (N, n), key, base, out (N, R, n)): the numeric
+ * IK's restart numbers, from the inputs (lm.c's seed_uniforms) */
+static PyObject *py_seed_uniforms(PyObject *self, PyObject *args)
+{
+    PyObject *to, *qo, *oo;
+    unsigned long long key;
+    long base;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOKlO", &to, &qo, &key, &base, &oo))
+        return NULL;
+    PyArrayObject *T, *q, *out;
+    if (!(T = array_arg(to, "targets", NPY_DOUBLE, 3, 0)) ||
+        !(q = array_arg(qo, "q0", NPY_DOUBLE, 2, 0)) ||
+        !(out = array_arg(oo, "out", NPY_DOUBLE, 3, 1)))
+        return NULL;
+    npy_intp N = DIM(T, 0), n = DIM(q, 1);
+    if (DIM(T, 1) != 4 || DIM(T, 2) != 4 || DIM(q, 0) != N || n < 1 || n > MAXJ ||
+        DIM(out, 0) != N || DIM(out, 2) != n || base < 0) {
+        PyErr_SetString(PyExc_ValueError, "robokin._native.seed_uniforms: inconsistent shapes");
+        return NULL;
+    }
+    Py_BEGIN_ALLOW_THREADS
+    seed_uniforms(F64(T), F64(q), (long)N, (int)n, (long)DIM(out, 1), key, base, F64(out));
+    Py_END_ALLOW_THREADS
+    Py_RETURN_NONE;
+}
+
 /* lm_path(packed, targets (N, 4, 4), q_start (n,), opts, out (N, n + N_RES))
  * -> index of the first failure, or -1 */
 static PyObject *py_lm_path(PyObject *self, PyObject *args)
@@ -556,6 +583,8 @@ static PyMethodDef methods[] = {
     {"lm_solve", py_lm_solve, METH_VARARGS,
      "lm_solve(packed, targets, q0, seeds, opts, out, tab, cstart, gdat, parallel) "
      "-> (fails, first_bad): numeric IK of a batch."},
+    {"seed_uniforms", py_seed_uniforms, METH_VARARGS,
+     "seed_uniforms(targets, q0, key, base, out): restart numbers from the inputs."},
     {"lm_path", py_lm_path, METH_VARARGS,
      "lm_path(packed, targets, q_start, opts, out) -> first failure or -1."},
     {"pose_error", py_pose_error, METH_VARARGS,

@@ -59,7 +59,7 @@ def solve(
         # validates the pose and solves it)
         single = _single_solver(robot)
         if single is not None and (qn is None or qn.shape == (6,)):
-            out = single(T, 0.0 if qn is None else float(qn[5]))
+            out = single(T, math.nan if qn is None else float(qn[5]))
             if out is not None:
                 return out
     T = check_poses_fast(T, "T")

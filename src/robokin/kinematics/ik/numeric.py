@@ -23,7 +23,11 @@ samples of the central 80 % of the joint ranges with their tool poses) whose pos
 are nearest the target, then from random seeds inside the limits (alternately from
 the central 80 % of each joint range, where descents meet limits less often, and
 from the whole range) until the target is reached or
-the budget (restarts, wall time) is spent. Results are always inside the limits;
+the budget (restarts, wall time) is spent. The random seeds come from the inputs,
+not from a generator's state: each target's from a counter-based stream keyed by a
+hash of its pose and start configuration (``_seed_key``; an explicit ``rng`` changes
+the key), so the same call gives the same bits whatever the batch around a target
+and the thread count (see ``docs/conventions.md``, Repeatability). Results are always inside the limits;
 a target that is not reached comes back with ``success=False``, the best
 configuration found and the error it leaves, never an exception.
 
@@ -231,17 +235,30 @@ def _middle(chain: Chain) -> np.ndarray:
     return 0.5 * (arr.seed_lower + arr.seed_upper)
 
 
-_DEFAULT_RNG: list[np.random.Generator] = []
+def _seed_key(rng: np.random.Generator | None) -> int:
+    """The key of the restart streams: 0, or one number drawn from ``rng``.
+
+    Restart seeds are not drawn from a generator's state: each target's come from
+    a counter-based stream keyed by a hash of its pose, its start configuration
+    and this key (``csrc/lm.c``, ``seed_uniforms``), so a target's answer does not
+    depend on its place in a batch, the other targets, the thread count or earlier
+    calls. An explicit ``rng`` changes the key (one draw per call).
+    """
+    if rng is None:
+        return 0
+    if not isinstance(rng, np.random.Generator):
+        raise InputError("rng", f"expected a numpy.random.Generator, got {rng!r:.60}")
+    return int(rng.integers(0, 2**63, dtype=np.uint64))
 
 
-def _rng(rng: np.random.Generator | None) -> np.random.Generator:
-    if rng is not None:
-        if not isinstance(rng, np.random.Generator):
-            raise InputError("rng", f"expected a numpy.random.Generator, got {rng!r:.60}")
-        return rng
-    if not _DEFAULT_RNG:
-        _DEFAULT_RNG.append(np.random.default_rng())
-    return _DEFAULT_RNG[0]
+def _uniforms(Tf: np.ndarray, Q0: np.ndarray, key: int, base: int, R: int) -> np.ndarray:
+    """Restart numbers (N, R, n) in [0, 1) of targets Tf (N, 4, 4) started at Q0 (N, n).
+
+    Numbers ``base .. base + R - 1`` of each target's stream (``_seed_key``).
+    """
+    out = np.empty((Tf.shape[0], R, Q0.shape[1]))
+    K.seed_uniforms(np.ascontiguousarray(Tf), np.ascontiguousarray(Q0), key, base, out)
+    return out
 
 
 # --------------------------------------------------------------------- the options
@@ -455,8 +472,12 @@ def solve(
             None for no limit. Checked between rounds of restarts.
         max_step: Largest joint change per iteration [rad or m].
         parallel: Use all threads (default: for 8 targets or more, and for rounds
-            of restarts of 2 targets or more).
-        rng: Random generator for the restart seeds (default a module-level one).
+            of restarts of 2 targets or more). Results do not depend on it.
+        rng: Random generator keying the restart seeds (one number drawn per call).
+            Default None: each target's restarts come from its own pose and start
+            configuration only, so the same inputs give the same bits, whatever
+            the batch around a target and the thread count (``max_time`` aside: a
+            search stopped by the clock depends on the machine's speed).
 
     Returns:
         An :class:`IKResult` with leading shape (...). Failure is reported, never
@@ -466,6 +487,29 @@ def solve(
         InputError: a bad pose (wrong shape, non-finite, not a rigid transform), a
             bad ``q0`` or option.
     """
+    return _solve(robot, T, q0=q0, mask=mask, weights=weights, tol=tol,
+                  tol_rotation=tol_rotation, max_iterations=max_iterations,
+                  max_restarts=max_restarts, max_time=max_time, max_step=max_step,
+                  parallel=parallel, key=_seed_key(rng))
+
+
+def _solve(
+    robot: RobotLike,
+    T: npt.ArrayLike,
+    *,
+    q0: npt.ArrayLike | None,
+    mask: Any,
+    weights: npt.ArrayLike | None,
+    tol: float,
+    tol_rotation: float | None,
+    max_iterations: int,
+    max_restarts: int,
+    max_time: float | None,
+    max_step: float,
+    parallel: bool | None,
+    key: int,
+) -> IKResult:
+    """:func:`solve` with the restart streams' key (``_seed_key``)."""
     chain = robot.chain
     packed = chain.arrays.packed
     n = chain.n
@@ -475,7 +519,6 @@ def solve(
     max_restarts = _count(max_restarts, "max_restarts")
     if max_time is not None:
         max_time = _positive(max_time, "max_time")
-    gen = _rng(rng)
     t_start = _clock()
     if q0 is None:
         Q0 = np.broadcast_to(_middle(chain), (N, n))
@@ -502,7 +545,8 @@ def solve(
         tab = _NO_TABLE
     # random numbers only when some restart of this round is not a table one (the
     # table always has more rows than _TABLE_SEEDS)
-    seeds = gen.random((N, R, n)) if opts[K.O_N_TABLE] < R else np.zeros((N, max(R, 1), n))
+    seeds = (_uniforms(Tf, Q0, key, 0, R) if opts[K.O_N_TABLE] < R
+             else np.zeros((N, max(R, 1), n)))
     fails, bad = K.lm_solve(packed, Tf, Q0, seeds, opts, out, *tab, use_par)
     if bad >= 0:
         raise _bad_input(out, n, Tf, Q0, lead, bad)
@@ -527,8 +571,13 @@ def solve(
             sub = np.empty((todo.size, n + K.N_RES))
             par = bool((parallel is None and todo.size >= _PARALLEL_MIN_RESTARTS)
                        or parallel)
-            K.lm_solve(packed, Tf[todo], Q0[todo], gen.random((todo.size, R, n)), opts,
-                       sub, *_NO_TABLE, par)
+            # each target continues its own stream: numbers used[i] on (a target
+            # left here has spent every restart it was given, the same count)
+            seeds = np.empty((todo.size, R, n))
+            for base in np.unique(used[todo]):
+                rows = used[todo] == base
+                seeds[rows] = _uniforms(Tf[todo[rows]], Q0[todo[rows]], key, int(base), R)
+            K.lm_solve(packed, Tf[todo], Q0[todo], seeds, opts, sub, *_NO_TABLE, par)
             attempts = sub[:, n + K.R_RESTARTS] + 1
             used[todo] += attempts
             out[todo, n + K.R_ITERS] += sub[:, n + K.R_ITERS]
@@ -647,7 +696,7 @@ def solve_all(
     max_restarts = _count(options.get("max_restarts", 200), "max_restarts")
     Tf, lead = _targets(T)
     N = Tf.shape[0]
-    gen = _rng(options.get("rng"))
+    key = _seed_key(options.get("rng"))
     opts = _opts(options.get("mask"), options.get("weights"), options.get("tol", 1e-9),
                  options.get("tol_rotation"), options.get("max_iterations", 100),
                  options.get("max_step", 1.0))
@@ -656,11 +705,16 @@ def solve_all(
     if N == 0:
         return SolutionSet.empty(lead, n, is_rev, lim, "no solution", method="numeric")
     S = n_seeds
-    seeds = arr.seed_lower + gen.random((N, S, n)) * (arr.seed_upper - arr.seed_lower)
+    # each target's seeds from its own stream, keyed by its pose and q_near
+    start = np.broadcast_to(_middle(chain), (N, n))
     if q_near is not None:
         qn = check_finite(check_joints(q_near, n, "q_near"), "q_near")
         check_broadcasts(qn, lead + (n,), "q_near")
-        seeds[:, 0] = np.broadcast_to(qn, lead + (n,)).reshape(N, n)
+        start = np.broadcast_to(qn, lead + (n,)).reshape(N, n)
+    seeds = arr.seed_lower + _uniforms(Tf, start, key, 0, S) * (arr.seed_upper
+                                                                - arr.seed_lower)
+    if q_near is not None:
+        seeds[:, 0] = start
     flatT = np.ascontiguousarray(np.repeat(Tf, S, axis=0))
     flatQ = np.ascontiguousarray(seeds.reshape(N * S, n))
     opts[K.O_USE_Q0] = 1.0
@@ -680,13 +734,12 @@ def solve_all(
     none = np.flatnonzero(~ok.any(axis=1))
     best_err = err.min(axis=1)
     if none.size and max_restarts > 0:
-        res = solve(robot, Tf[none], q0=q[none, np.argmin(err[none], axis=1)], mask=None
-                    if options.get("mask") is None else options["mask"],
-                    weights=options.get("weights"), tol=options.get("tol", 1e-9),
-                    tol_rotation=options.get("tol_rotation"),
-                    max_iterations=options.get("max_iterations", 100),
-                    max_restarts=max_restarts, max_time=options.get("max_time"),
-                    max_step=options.get("max_step", 1.0), parallel=par, rng=gen)
+        res = _solve(robot, Tf[none], q0=q[none, np.argmin(err[none], axis=1)],
+                     mask=options.get("mask"), weights=options.get("weights"),
+                     tol=options.get("tol", 1e-9), tol_rotation=options.get("tol_rotation"),
+                     max_iterations=options.get("max_iterations", 100),
+                     max_restarts=max_restarts, max_time=options.get("max_time"),
+                     max_step=options.get("max_step", 1.0), parallel=par, key=key)
         q[none, 0] = res.q
         ok[none, 0] = res.success
         err[none, 0] = res.error
@@ -706,10 +759,10 @@ def solve_all(
     if q_near is not None:
         d = q - seeds[:, :1]
         d = np.where(wrap, wrap_angle(d), d)
-        key = np.where(keep, np.linalg.norm(d, axis=-1), np.inf)
+        rank = np.where(keep, np.linalg.norm(d, axis=-1), np.inf)
     else:
-        key = np.where(keep, np.arange(S, dtype=np.float64), np.inf)
-    order = np.argsort(key, axis=1, kind="stable")
+        rank = np.where(keep, np.arange(S, dtype=np.float64), np.inf)
+    order = np.argsort(rank, axis=1, kind="stable")
     k = max(int(keep.sum(axis=1).max()), 1)
     order = order[:, :k]
     q = np.take_along_axis(q, order[..., None], axis=1)

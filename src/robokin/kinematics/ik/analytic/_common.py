@@ -48,9 +48,13 @@ def inside_limits(q: np.ndarray, limits: np.ndarray) -> npt.NDArray[np.bool_]:
 
 
 def q_near_rows(q_near: Any, lead: tuple[int, ...], n: int) -> np.ndarray:
-    """``q_near`` broadcast to the pose batch and flattened to (N, n), or (1, n) zeros."""
+    """``q_near`` broadcast to the pose batch and flattened to (N, n).
+
+    Without ``q_near``, one row of NaN: no preference (the 6R kernels then keep
+    q6 = 0 at a wrist singularity).
+    """
     if q_near is None:
-        return np.zeros((1, n))
+        return np.full((1, n), np.nan)
     qn = np.asarray(q_near, dtype=np.float64)
     if qn.ndim == 1:
         return np.ascontiguousarray(qn.reshape(1, n))

@@ -14,6 +14,7 @@ from typing import Any, Literal
 import numpy as np
 
 from robokin._native import kernels as K
+from robokin._native import single as single_copy
 from robokin.kinematics.ik.analytic._common import (
     STATUS_TEXT,
     branch_labels,
@@ -29,7 +30,7 @@ from robokin.kinematics.ik.analytic._geometry import (
 )
 from robokin.kinematics.ik.solutions import SolutionSet
 
-__all__ = ["make_single", "pack", "raw_solve", "solve_six_r"]
+__all__ = ["POSE_TOL", "SINGULAR_TOL", "make_single", "pack", "raw_solve", "solve_six_r"]
 
 Kind = Literal["three_parallel", "spherical_wrist"]
 
@@ -41,12 +42,34 @@ _LABELS = {
 }
 # Below this many poses the kernel runs on one thread (the pool's launch costs more).
 _PARALLEL_MIN = K.SIX_R_PARALLEL_MIN
+# A solution is flagged singular within this (a sine) of a singularity, as
+# robot.is_singular's default on the smallest singular value.
+SINGULAR_TOL = 1e-6
+# The pose error [m] (times the arm's size when above 1 m) and [rad] every solution
+# meets (checked and polished in the kernel where the closed form may not).
+POSE_TOL = 1e-12
+# The wrist split's orientation budget [rad] (csrc/six_r.c, 'the wrist split'):
+# below the kernel's polish target (half of POSE_TOL), so a split is not undone.
+SPLIT_TOL = 0.4 * POSE_TOL
 
 
-def pack(chain: Any, kind: Kind, *, singular_tol: float = 1e-9,
-         disc_tol: float = 1e-12, mirror: bool = False,
+def pack(chain: Any, kind: Kind, *, singular_tol: float = SINGULAR_TOL,
+         disc_tol: float = 1e-10, mirror: bool = False, check_all: bool = False,
          poe: Poe | None = None) -> np.ndarray:
-    """The kernel parameter vector of a 6R chain (layout in ``csrc/six_r.c``)."""
+    """The kernel parameter vector of a 6R chain (layout in ``csrc/six_r.c``).
+
+    Args:
+        chain: The canonical 6R chain.
+        kind: The family.
+        singular_tol: A solution is flagged ``singular`` within this (a sine) of a
+            singularity (wrist, elbow or shoulder; ``csrc/six_r.c``).
+        disc_tol: Subproblem 4 discriminant tolerance (relative).
+        mirror: Near-family seeds: mirrored past a boundary, no check against the
+            chain (``near.polish`` does it on the true chain).
+        check_all: Check (and polish) every solution against the chain, not only
+            those near a boundary or singularity (for tests and measurements).
+        poe: The chain's product-of-exponentials description, if at hand.
+    """
     poe = poe_from_chain(chain) if poe is None else poe
     h = poe.h.copy()
     o = poe.o.copy()
@@ -77,6 +100,8 @@ def pack(chain: Any, kind: Kind, *, singular_tol: float = 1e-9,
     put(K.TOOL_T, poe.M[:3, 3])
     put(K.TOOL_R, poe.M[:3, :3])
     put(K.PERP, e)
+    hw = h[1] if three else h[3]
+    put(K.PERP2, np.cross(hw, e))
     put(K.SIGN, chain.arrays.sign)
     put(K.OFFSET, chain.arrays.offset)
     lim = chain.limits
@@ -105,12 +130,29 @@ def pack(chain: Any, kind: Kind, *, singular_tol: float = 1e-9,
         P[iphi + 1], P[iphi + 2] = (A / r, B / r) if r > 0 else (1.0, 0.0)
     P[K.AA] = a @ a
     P[K.BB] = b @ b
+    # theta5's discriminant for unit vectors: |x_perp|^2 + E5 + 2 d C5 (exact)
+    P[K.E5] = -((hw @ h[4]) ** 2 + (h[4] @ h[5]) ** 2)
+    if three:  # the planar part in the basis (e, e2) of the plane normal to h2
+        e2 = np.cross(h[1], e)
+        w4 = ow - o[3]
+        put(K.PLANE, [a @ e, a @ e2, b @ e, b @ e2, w4 @ e, w4 @ e2, w4 @ h[1]])
+    P[K.SPLIT_TOL] = SPLIT_TOL
+    # the pose error every solution meets: POSE_TOL times the arm's size L (at
+    # least 1 m) and POSE_TOL [rad]; the kernel aims at half of it, so the
+    # guarantee holds under any other rounding of the same measure (robot.fk and
+    # spatial.pose_error)
+    size = float(np.linalg.norm(o[1] - o[0]) + np.linalg.norm(o[2] - o[1])
+                 + np.linalg.norm(ow - o[2]) + np.linalg.norm(poe.M[:3, 3] - ow))
+    P[K.SIZE] = size
+    P[K.TOL_P] = 0.5 * POSE_TOL * max(1.0, size)
+    P[K.TOL_R] = 0.5 * POSE_TOL
+    P[K.CHECK] = -1.0 if mirror else (1.0 if check_all else 0.0)
     P.setflags(write=False)
     return P
 
 
-def raw_solve(params: np.ndarray, T: np.ndarray,
-              qn: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+def raw_solve(params: np.ndarray, T: np.ndarray, qn: np.ndarray | None = None,
+              *, packed: np.ndarray) -> tuple[np.ndarray, ...]:
     """The bare kernel call, without input checks.
 
     T (N, 4, 4) contiguous float64 -> (Q (N, 8, 6), valid, singular, within_limits
@@ -118,12 +160,13 @@ def raw_solve(params: np.ndarray, T: np.ndarray,
 
     ``singular`` and ``within_limits`` are False on rows that are not valid.
     Batches of ``_PARALLEL_MIN`` poses or more run on the kernels' thread pool.
-    The family is recorded in ``params`` (``pack``).
+    The family is recorded in ``params`` (``pack``); ``packed`` is the chain's
+    ``ChainArrays.packed`` (solutions are checked and polished on it).
     """
-    return K.six_r_ik(params, T, _NO_Q_NEAR if qn is None else qn)
+    return K.six_r_ik(params, T, _NO_Q_NEAR if qn is None else qn, packed)
 
 
-_NO_Q_NEAR = np.zeros((1, 6))
+_NO_Q_NEAR = np.full((1, 6), np.nan)  # no preference at the wrist singularity
 _NO_Q_NEAR.setflags(write=False)
 
 
@@ -132,13 +175,17 @@ def make_single(chain: Any, params: np.ndarray, *, method: str,
     """The single-pose hot path of an exact (not near-family) 6R arm.
 
     Returns ``single(T, q6) -> SolutionSet | None`` for one pose ``T`` (4, 4)
-    float64 and the joint-6 value ``q6`` kept at the wrist singularity. The pose is
+    float64 and the preferred joint-6 value ``q6`` at the wrist singularity (NaN: none,
+    q6 = 0 there). The pose is
     validated inside the same compiled call (``six_r_ik1``); ``None`` means it is
     not a rigid transform (the caller re-checks it to raise the detailed error).
     Every call returns freshly allocated arrays; only the read-only joint kinds,
     limits and branch labels are shared between results.
     """
-    solve1 = K.six_r_ik1
+    # the copy for one pose (AVX2 on an AVX-512 CPU: 4 lanes cost less than 8 for
+    # a lone pose; both copies give the same bits, tested)
+    solve1 = single_copy.six_r_ik1
+    packed = chain.arrays.packed
     is_rev = np.array(chain.is_revolute, dtype=bool)
     is_rev.setflags(write=False)
     limits = np.asarray(chain.limits, dtype=np.float64)
@@ -153,7 +200,7 @@ def make_single(chain: Any, params: np.ndarray, *, method: str,
     trusted = SolutionSet._trusted
 
     def single(T: np.ndarray, q6: float) -> SolutionSet | None:
-        code, Q, valid, sing, inside = solve1(T, params, q6)
+        code, Q, valid, sing, inside = solve1(T, params, q6, packed)
         if code >= bad or Q is None or valid is None or sing is None or inside is None:
             return None
         return trusted(Q, valid, is_rev, limits,
@@ -181,7 +228,8 @@ def solve_six_r(
     lead = T.shape[:-2]
     Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
     qn = q_near_rows(q_near, lead, 6)
-    Q, valid, sing, inside, status = raw_solve(params, Tf, qn)
+    Q, valid, sing, inside, status = raw_solve(params, Tf, qn,
+                                               packed=robot.chain.arrays.packed)
     Q = Q.reshape(lead + (8, 6))
     valid = valid.reshape(lead + (8,))
     sing = sing.reshape(lead + (8,))

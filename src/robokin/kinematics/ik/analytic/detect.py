@@ -241,13 +241,18 @@ def _general_6r_family(chain: Any, details: dict[str, str]) -> Family:
 
 def _six_r_family(chain: Any, poe: Any, name: Kind, text: str, near: bool, dev: float,
                   details: dict[str, str]) -> Family:
-    from robokin.kinematics.ik.analytic._six_r import make_single, pack, solve_six_r
+    from robokin.kinematics.ik.analytic._six_r import (
+        SINGULAR_TOL,
+        make_single,
+        pack,
+        solve_six_r,
+    )
 
     params_cache: dict[tuple[float, float], np.ndarray] = {}
     method = f"analytic:{name}" + ("+newton" if near else "")
     info = {"family": name, "measured": text, "near_family": near}
 
-    def solver(robot, T, q_near=None, *, singular_tol: float = 1e-9,
+    def solver(robot, T, q_near=None, *, singular_tol: float = SINGULAR_TOL,
                compute_error: bool = False, **options):
         key = (singular_tol, 1e-12)
         P = params_cache.get(key)

@@ -1,14 +1,19 @@
 """General 6R arms: every IK solution by Raghavan-Roth elimination.
 
-Any arm of six revolute joints without dependent joints is solved completely, up
-to 16 solutions, by the compiled kernel in ``robokin/_native/csrc/general6r.c``
-(its header gives the elimination step by step): the loop-closure equations of a
-split of the chain into three joints and the inverse of the other three give 14
-equations (Raghavan & Roth 1993); eliminating two angles leaves a 12 x 12 matrix
-``Sigma(theta_a)`` whose determinant, a trigonometric polynomial of degree 8, has
-the solutions' ``theta_a`` as real roots (Manocha & Canny 1994). Every root is
-back-substituted, polished by Newton steps on the true chain and kept only when it
-reproduces the pose to ``1e-9`` (m and rad).
+Any arm of six revolute joints without dependent joints whose solutions are finite
+(its Jacobian has full rank somewhere) is solved completely, up to 16 solutions, by
+the compiled kernel in ``robokin/_native/csrc/general6r.c`` (its header gives the
+elimination step by step): the loop-closure equations of a split of the chain into
+three joints and the inverse of the other three give 14 equations (Raghavan & Roth
+1993); eliminating two angles leaves a 12 x 12 matrix ``Sigma(theta_a)`` whose
+determinant, a trigonometric polynomial of degree 8, has the solutions' ``theta_a``
+as real roots (Manocha & Canny 1994). Where several solutions share ``theta_a``
+(special configurations) the null space of ``Sigma`` is split by its monomial
+structure; where the determinant vanishes identically at a pose (every variant), the
+lowest coefficient of its expansion along a pose motion takes its place (Canny's
+generalized characteristic polynomial). Every candidate is polished by Newton steps
+on the true chain and kept only when it reproduces the pose to ``SOLUTION_TOL``
+(rotation [rad]; position [m] per metre of arm, ``scale``).
 
 This module does the per-arm set-up, once per chain (cached with the chain):
 
@@ -18,23 +23,31 @@ This module does the per-arm set-up, once per chain (cached with the chain):
 * **variant choice**: a variant is a split ``a`` in {1, 2, 3}, the chain or its
   reversal (the IK of ``T^-1`` on the reversed chain) and the dialytic multiplier
   (``x_b`` or ``x_c``), 12 in all. Arms with special geometry make some variants
-  degenerate (a UR arm: only the split with the three parallel axes on the left
-  works) or miss solutions that share ``theta_a`` (a wrist flip: a 2-D null space).
-  Every variant runs on ``SETUP_POSES`` deterministic poses (from random joint
-  values); the union of their validated solutions plus the generating
-  configurations is the reference; the chosen pair (primary, secondary) finds all
-  of it, the primary alone where it reports no trouble, with the smallest DFT tail.
-  Per pose, the kernel runs the secondary when the primary's determinant is
-  degenerate or one of its roots has a 2-D null space, and merges.
+  degenerate at some or all poses (a UR arm: only the split with the three parallel
+  axes on the left works). Every variant runs alone on ``SETUP_POSES`` deterministic
+  poses from uniform joint values and as many from joint values at 0, +-pi/2, pi;
+  the union of their solutions plus the generating configurations is the
+  reference. The primary is the variant that finds all of it and is degenerate at
+  the fewest poses (there the kernel needs the secondary, or the projection, both
+  slower), then splits the fewest multiple roots, then has the smallest DFT tail;
+  the secondary is the one that does best on the primary's degenerate poses.
 
 Arms with a prismatic joint or dependent joints are not offered this family (the
-elimination is written for revolute joints), nor arms no variant pair solves.
+elimination is written for revolute joints), nor degenerate arms (rank-deficient
+Jacobian everywhere: two coincident axes, infinitely many solutions for every pose),
+nor nearly degenerate ones (its smallest singular value below ``ISOLATED`` per metre
+of arm at every set-up configuration: no isolated solutions to check the set-up on),
+nor, should it happen, arms whose chosen variants miss a reference solution: their
+``Family.reason`` says why and ``robot.ik`` falls back to the numeric solver, which
+its ``method`` says.
 
 References:
     Raghavan, M. and Roth, B. "Inverse kinematics of the general 6R manipulator and
     related linkages", J. Mech. Design 115(3):502-508, 1993.
     Manocha, D. and Canny, J. "Efficient inverse kinematics for general 6R
     manipulators", IEEE Trans. Robotics and Automation 10(5):648-657, 1994.
+    Canny, J. "Generalised characteristic polynomials", J. Symbolic Computation
+    9(3):241-250, 1990.
 """
 
 from __future__ import annotations
@@ -45,9 +58,12 @@ from typing import Any
 import numpy as np
 
 from robokin import _native
+from robokin.kinematics.forward import forward_kinematics
 from robokin.kinematics.ik.analytic._common import fk_error, make_set
+from robokin.kinematics.ik.analytic._geometry import poe_from_chain
+from robokin.kinematics.jacobian import min_singular_value
 from robokin.kinematics.per_chain import cached
-from robokin.spatial import invert, wrap_angle
+from robokin.spatial import invert
 
 __all__ = ["NAME", "General6R", "Variant", "make_single", "raw_solve", "setup", "solve",
            "why_not"]
@@ -55,17 +71,22 @@ __all__ = ["NAME", "General6R", "Variant", "make_single", "raw_solve", "setup", 
 NAME = "general_6r"
 K = _native.kernels
 MAX_SOLUTIONS = 16
-SETUP_POSES = 20  # deterministic poses the variant choice is measured on
+SETUP_POSES = 20  # deterministic poses per kind (uniform, special) the choice is made on
 SETUP_SEED = 20_241_993
 FIT_SAMPLES = 64  # rows per least-squares fit (27 unknowns)
 FIT_TOL = 1e-9  # largest relative residual of a fit
 TAIL_TOL = 1e-6  # largest relative DFT tail above degree 8 of a usable determinant
-NULL_TOL = 1e-7  # Sigma's second-smallest / largest pivot below: 2-D null space
+NEAR_TAIL = 1e-12  # a tail above: near a degenerate pose, the next variant runs too
+NULL_TOL = 1e-7  # pivot of Sigma below this fraction of the largest: a null direction
 IMAG_TOL = 5e-2  # imaginary part of theta_a [rad] still tried as a real root
-SOLUTION_TOL = 1e-9  # position [m] and rotation [rad] error of a solution
-DEDUPE_TOL = 1e-6  # [rad] solutions closer than this are one
-NEWTON_ITERATIONS = 40  # most: singular solutions converge linearly
-PAIR_GAP = 1e-2  # [rad] roots closer: both solutions from a 2-D null space
+SOLUTION_TOL = 9e-13  # rotation [rad] and position [m, per metre of scale] error
+DEDUPE_TOL = 1e-6  # [rad] solutions closer than this are one (more near-singular)
+NEWTON_ITERATIONS = 60  # most: singular solutions converge linearly
+PAIR_GAP = 1e-2  # [rad] roots closer than this form a cluster (a multiple root)
+FALLBACKS = 2  # variants after the secondary, each with another split and direction
+RANK_TOL = 1e-9  # Jacobian singular value [per metre of scale] below: rank deficient
+ISOLATED = 1e-4  # ... above: a set-up configuration whose solutions are compared
+SPECIAL_VALUES = np.array([0.0, np.pi / 2, -np.pi / 2, np.pi])
 _PARALLEL_MIN = 32  # below this many poses one thread (the kernel's own threshold)
 # kernel status (ok, none, degenerate, bad pose) -> _common.STATUS_TEXT code
 _STATUS = np.array([0, 1, 5, 1], dtype=np.int8)
@@ -105,10 +126,13 @@ class General6R:
         params: The kernel's parameter vector (read-only), or None when the family
             does not apply.
         primary: The variant run for every pose.
-        secondary: The variant run where the primary reports trouble, or None.
+        secondary: The variant run where the primary is degenerate or noisy.
         reason: Why the family does not apply ("" when it does).
         measured: What the set-up measured (for ``Family.measured``).
         tail: The primary's largest relative DFT tail on the set-up poses.
+        scale: The arm's length scale [m]: the largest distance of a joint axis point
+            or the tool from the base at zero joint values (at least 1e-3).
+        variants: Every variant in the kernel's order (primary, secondary, ...).
     """
 
     params: np.ndarray | None
@@ -117,10 +141,16 @@ class General6R:
     reason: str = ""
     measured: str = ""
     tail: float = float("nan")
+    scale: float = 1.0
+    variants: tuple[Variant, ...] = ()
 
 
 def why_not(chain: Any) -> str:
-    """Why the general 6R solver does not take ``chain`` ("" when it does)."""
+    """Why the general 6R solver does not take ``chain`` ("" when it does).
+
+    The structural reasons only (joint kinds and count, dependent joints); the
+    set-up adds its own (a degenerate arm), see :func:`setup`.
+    """
     if chain.n_chain != 6 or chain.n != 6:
         return (f"{chain.n} joint coordinates on {chain.n_chain} chain joints: the general "
                 "6R solver takes six joints")
@@ -135,6 +165,14 @@ def why_not(chain: Any) -> str:
 def setup(chain: Any) -> General6R:
     """The set-up of ``chain`` (fits and variant choice), computed once per chain."""
     return cached(chain, ("general_6r", SETUP_POSES), lambda: _setup(chain))
+
+
+def _scale(chain: Any) -> float:
+    """The arm's length scale [m] (see :class:`General6R`)."""
+    poe = poe_from_chain(chain)
+    far = max(float(np.linalg.norm(poe.o, axis=1).max()),
+              float(np.linalg.norm(poe.M[:3, 3])))
+    return max(far, 1e-3)
 
 
 # ----------------------------------------------------------------- the fit
@@ -161,7 +199,7 @@ def _fit(consts: np.ndarray, a: int, rng: np.random.Generator) -> tuple[np.ndarr
     return P, float(resid)
 
 
-def _header(n_variants: int) -> np.ndarray:
+def _header(n_variants: int, scale: float = 1.0, fallback: bool = True) -> np.ndarray:
     h = np.zeros(K.GP_HEAD)
     h[K.GP_NVAR] = n_variants
     h[K.GP_TAIL_TOL] = TAIL_TOL
@@ -171,6 +209,9 @@ def _header(n_variants: int) -> np.ndarray:
     h[K.GP_DEDUPE] = DEDUPE_TOL
     h[K.GP_MAX_ITER] = NEWTON_ITERATIONS
     h[K.GP_PAIR_GAP] = PAIR_GAP
+    h[K.GP_SCALE] = scale
+    h[K.GP_FALLBACK] = float(fallback)
+    h[K.GP_NEAR_TAIL] = NEAR_TAIL
     return h
 
 
@@ -185,8 +226,8 @@ def _block(v: Variant, consts: np.ndarray, P: np.ndarray) -> np.ndarray:
     return b
 
 
-def _params(blocks: list[np.ndarray]) -> np.ndarray:
-    P = np.concatenate([_header(len(blocks))] + blocks)
+def _params(blocks: list[np.ndarray], scale: float, fallback: bool = True) -> np.ndarray:
+    P = np.concatenate([_header(len(blocks), scale, fallback)] + blocks)
     P.setflags(write=False)
     return P
 
@@ -198,12 +239,14 @@ def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
               parallel: bool | None = None) -> tuple[np.ndarray, ...]:
     """The bare kernel call.
 
-    T (N, 4, 4) C-contiguous float64 -> (q (N, 16, 6) [rad], valid (N, 16), inside (N, 16) the valid rows within the limits, sigma (N, 16) the
-    Jacobian's smallest singular value, status (N,) int64 (kernel codes), diag (N,)
-    int64 (kernel flags; >> G6_DIAG_CAND_SHIFT the roots tried), stats (N, 3): the
-    primary's relative DFT tail, null-space margin and roots taken as close pairs).
+    T (N, 4, 4) C-contiguous float64 -> (q (N, 16, 6) [rad], valid (N, 16), inside
+    (N, 16) the valid rows within the limits, sigma (N, 16) the Jacobian's smallest
+    singular value, status (N,) int64 (kernel codes), diag (N,) int64 (kernel flags
+    ``G6F_*``; ``>> G6_DIAG_CAND_SHIFT`` the candidates polished), stats (N, 4): the
+    primary's relative DFT tail, null-space margin and clusters split, and the
+    smallest error [m, rad] a candidate's polish reached).
     Revolute values are in [-pi, pi), or moved by whole turns into their limits
-    where that is possible; rows that are not solutions are 0. No input checks.
+    where that is possible; rows that are not solutions are NaN. No input checks.
     """
     N = T.shape[0]
     Q = np.empty((N, MAX_SOLUTIONS, 6))
@@ -212,7 +255,7 @@ def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
     sigma = np.empty((N, MAX_SOLUTIONS))
     status = np.empty(N, np.int64)
     diag = np.empty(N, np.int64)
-    stats = np.empty((N, 3))
+    stats = np.empty((N, 4))
     par = N >= _PARALLEL_MIN if parallel is None else bool(parallel)
     K.general6r_solve(chain.arrays.packed, params, T, Q, valid, inside, sigma, status, diag,
                       stats, par)
@@ -224,14 +267,38 @@ def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
 
 def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(len(a), len(b)) bool: configurations equal modulo 2 pi within DEDUPE_TOL."""
-    d = wrap_angle(a[:, None, :] - b[None, :, :])
+    d = a[:, None, :] - b[None, :, :]
+    d -= (2.0 * np.pi) * np.rint(d / (2.0 * np.pi))
     return np.abs(d).max(axis=-1) < 10 * DEDUPE_TOL
 
 
-def _distinct(q: np.ndarray) -> np.ndarray:
-    """The rows of q (k, 6) without repeats (modulo 2 pi), in order."""
-    same = _close(q, q) & np.tri(len(q), k=-1, dtype=bool)
-    return q[~same.any(axis=1)]
+def _union(sets: list[np.ndarray]) -> np.ndarray:
+    """The distinct rows (modulo 2 pi) of the (k_i, 6) sets, first occurrence kept.
+
+    Each set's rows are distinct already (the kernel's).
+    """
+    out = sets[0]
+    for q in sets[1:]:
+        if len(q):
+            out = np.concatenate([out, q[~_close(q, out).any(axis=1)]])
+    return out
+
+
+def _setup_configurations(chain: Any, rng: np.random.Generator, scale: float
+                          ) -> np.ndarray:
+    """Set-up configurations, (<= 2 SETUP_POSES, 6) joint values.
+
+    Uniform ones, then ones with about half of the joints at 0, +-pi/2, pi and the
+    others uniform; non-singular ones only (Jacobian singular values above
+    ``ISOLATED * scale``: the solutions are isolated, a finite set to compare).
+    """
+    q = rng.uniform(-np.pi, np.pi, (8 * SETUP_POSES, 6))
+    special = SPECIAL_VALUES[rng.integers(0, len(SPECIAL_VALUES), q.shape)]
+    half = 4 * SETUP_POSES
+    q[half:] = np.where(rng.random((half, 6)) < 0.5, special[half:], q[half:])
+    ok = min_singular_value(chain, q) > ISOLATED * scale
+    uniform, special_q = q[:half][ok[:half]], q[half:][ok[half:]]
+    return np.concatenate([uniform[:SETUP_POSES], special_q[:SETUP_POSES]])
 
 
 @dataclass(frozen=True, eq=False)
@@ -240,32 +307,27 @@ class _Trial:
 
     Attributes:
         covered: Per pose, which reference solutions it found, (k_i,) bool each.
-        trouble: (poses,) bool, where it would hand the pose to the secondary
-            (degenerate determinant or a 2-D null space).
-        degenerate: Poses with a degenerate determinant.
+        degenerate: (poses,) bool: where it is degenerate (the kernel then runs the
+            secondary, or the projection).
+        clusters: Multiple roots it split.
         tail: Its largest relative DFT tail.
-        pairs: Roots it took as close pairs (from a 2-D null space).
     """
 
     covered: list[np.ndarray]
-    trouble: np.ndarray
-    degenerate: int
+    degenerate: np.ndarray
+    noisy: np.ndarray
+    clusters: int
     tail: float
-    pairs: int
+    missed: int
 
-    @property
-    def missed(self) -> int:
-        """Reference solutions it does not find alone."""
-        return sum(int((~c).sum()) for c in self.covered)
+    def key(self) -> tuple[int, int, int, int, float]:
+        """How good a primary it is (smaller is better).
 
-    @property
-    def cost(self) -> int:
-        """Expected work and fragility of a variant as the primary.
-
-        A pose sent to the secondary costs about one variant (8 roots), each root
-        taken from a 2-D null space one.
+        Misses, then degenerate and noisy poses (where the kernel needs the
+        secondary), clusters, tail.
         """
-        return 8 * int(self.trouble.sum()) + self.pairs
+        return (self.missed, int(self.degenerate.sum()), int(self.noisy.sum()),
+                self.clusters, self.tail)
 
 
 def _fits(chain: Any, rng: np.random.Generator) -> dict[Variant, np.ndarray] | str:
@@ -283,53 +345,69 @@ def _fits(chain: Any, rng: np.random.Generator) -> dict[Variant, np.ndarray] | s
     return blocks
 
 
-def _trials(chain: Any, blocks: dict[Variant, np.ndarray], q: np.ndarray
-            ) -> tuple[dict[Variant, _Trial], int]:
+def _solutions(run: tuple[np.ndarray, ...]) -> list[np.ndarray]:
+    """Per pose, the valid rows of a raw_solve result."""
+    return [run[0][i][run[1][i]] for i in range(len(run[0]))]
+
+
+def _trials(chain: Any, blocks: dict[Variant, np.ndarray], q: np.ndarray, scale: float
+            ) -> tuple[dict[Variant, _Trial], list[np.ndarray]]:
     """Each variant alone on the poses of q, against the reference.
 
     The reference is the union of every variant's validated solutions and the
     generating configurations.
     """
-    from robokin.kinematics.forward import forward_kinematics
-
     T = np.ascontiguousarray(forward_kinematics(chain, q))
-    runs = {v: raw_solve(chain, _params([b]), T, parallel=False) for v, b in blocks.items()}
-    found = {v: [r[0][i][r[1][i]] for i in range(len(q))] for v, r in runs.items()}
-    ref = [_distinct(np.concatenate([q[i:i + 1]] + [f[i] for f in found.values()]))
-           for i in range(len(q))]
+    runs = {v: raw_solve(chain, _params([b], scale, fallback=False), T, parallel=False)
+            for v, b in blocks.items()}
+    found = {v: _solutions(r) for v, r in runs.items()}
+    ref = [_union([q[i:i + 1]] + [f[i] for f in found.values()]) for i in range(len(q))]
+    # compare isolated solutions only (a singular one is a point of a continuum, or two
+    # merging, where variants may return different points)
+    ref = [r[min_singular_value(chain, r) > ISOLATED * scale] if len(r) else r for r in ref]
     trials = {}
     for v, (_, _, _, _, _, diag, stats) in runs.items():
         tail = stats[:, 0]
+        covered = [np.asarray(_close(ref[i], found[v][i]).any(axis=1)) for i in range(len(q))]
         trials[v] = _Trial(
-            covered=[np.asarray(_close(ref[i], found[v][i]).any(axis=1))
-                     for i in range(len(q))],
-            trouble=(diag & (K.G6F_DEGENERATE | K.G6F_AMBIGUOUS)) != 0,
-            degenerate=int(((diag & K.G6F_DEGENERATE) != 0).sum()),
+            covered=covered, degenerate=(diag & K.G6F_DEGENERATE) != 0,
+            noisy=(diag & K.G6F_NOISY) != 0,
+            clusters=int(stats[:, 2].sum()),
             tail=float(np.max(np.where(np.isfinite(tail), tail, 1.0))),
-            pairs=int(stats[:, 2].sum()))
-    return trials, sum(len(r) for r in ref)
+            missed=sum(int((~c).sum()) for c in covered))
+    return trials, ref
 
 
-def _choose(trials: dict[Variant, _Trial], poses: int) -> tuple[Variant, Variant] | None:
-    """The (primary, secondary) pair that finds every reference solution.
+def _ranked_pairs(trials: dict[Variant, _Trial]) -> list[tuple[Variant, Variant]]:
+    """(primary, secondary) pairs, best first.
 
-    The secondary runs where the primary reports trouble; among the pairs that
-    work, the least primary cost wins, then the smaller tail. None when no pair does.
+    Primaries by :meth:`_Trial.key`; for each, the secondaries by what they miss and
+    how often they are degenerate where the primary is degenerate (a secondary with
+    the primary's hidden joint meets the same multiple roots: last), then their key.
     """
-    best = None
-    for p, tp in trials.items():
-        if 2 * tp.degenerate > poses:  # it would merely hand poses on
-            continue
-        for s, ts in trials.items():
-            if s == p or not all((cp | (tp.trouble[i] & cs)).all() for i, (cp, cs)
-                                 in enumerate(zip(tp.covered, ts.covered, strict=True))):
-                continue
-            # a secondary with the primary's hidden joint meets the same double roots
-            key = (tp.cost, tp.tail, p.hidden_joint == s.hidden_joint, ts.missed, ts.cost,
-                   ts.tail)
-            if best is None or key < best[0]:
-                best = (key, p, s)
-    return None if best is None else (best[1], best[2])
+    pairs = []
+    for p in sorted(trials, key=lambda v: trials[v].key()):
+        deg = trials[p].degenerate | trials[p].noisy
+
+        def rank(s: Variant, p: Variant = p, deg: np.ndarray = deg) -> tuple[Any, ...]:
+            t = trials[s]
+            missed = sum(int((~c).sum()) for c, d in zip(t.covered, deg, strict=True) if d)
+            return (missed, int(((t.degenerate | t.noisy) & deg).sum()),
+                    p.hidden_joint == s.hidden_joint, t.key())
+
+        pairs += [(p, s) for s in sorted((s for s in trials if s != p), key=rank)[:2]]
+    return pairs
+
+
+def _degenerate_arm(chain: Any, q: np.ndarray, scale: float) -> str:
+    """Why the arm has no finite solution sets ("" when its Jacobian has full rank)."""
+    smin = min_singular_value(chain, q)
+    if (smin > RANK_TOL * scale).any():
+        return ""
+    return (f"a degenerate arm: its Jacobian has rank below 6 at every one of {len(q)} "
+            f"test configurations (smallest singular value at most {smin.max():.1e}; "
+            "e.g. two joint axes on one line), so every pose it reaches has infinitely "
+            "many solutions and there is no finite set to find")
 
 
 def _setup(chain: Any) -> General6R:
@@ -337,22 +415,74 @@ def _setup(chain: Any) -> General6R:
     if reason:
         return General6R(None, reason=reason)
     rng = np.random.default_rng(SETUP_SEED)
+    scale = _scale(chain)
+    reason = _degenerate_arm(chain, rng.uniform(-np.pi, np.pi, (2 * SETUP_POSES, 6)), scale)
+    if reason:
+        return General6R(None, reason=reason, scale=scale)
+    q = _setup_configurations(chain, rng, scale)
+    if len(q) == 0:
+        return General6R(None, scale=scale, reason=(
+            "a nearly degenerate arm: its Jacobian's smallest singular value is below "
+            f"{ISOLATED:g} per metre of arm at all of {8 * SETUP_POSES} test "
+            "configurations (e.g. axes within a fraction of a milliradian of a "
+            "rank-deficient geometry), so the set-up cannot check the elimination on "
+            "isolated solutions"))
     blocks = _fits(chain, rng)
     if isinstance(blocks, str):  # pragma: no cover
-        return General6R(None, reason=blocks)
-    trials, n_ref = _trials(chain, blocks, rng.uniform(-np.pi, np.pi, (SETUP_POSES, 6)))
-    pair = _choose(trials, SETUP_POSES)
-    if pair is None:
-        alone = min(trials, key=lambda v: trials[v].missed)
-        return General6R(None, reason=(
-            f"no elimination variant finds every solution on {SETUP_POSES} test poses "
-            f"(best: {alone}, {n_ref - trials[alone].missed} of {n_ref})"))
-    p, s = pair
-    tail = trials[p].tail
-    measured = (f"Raghavan-Roth elimination, {p} (secondary {s} on "
-                f"{int(trials[p].trouble.sum())} of {SETUP_POSES} test poses); all "
-                f"{n_ref} solutions of the test poses found; DFT tail {tail:.1e}")
-    return General6R(_params([blocks[p], blocks[s]]), p, s, measured=measured, tail=tail)
+        return General6R(None, reason=blocks, scale=scale)
+    trials, ref = _trials(chain, blocks, q, scale)
+    n_ref = sum(len(r) for r in ref)
+    T = np.ascontiguousarray(forward_kinematics(chain, q))
+    best = None
+    for p, s in _ranked_pairs(trials)[:6]:
+        params = _params([blocks[p], blocks[s]], scale)
+        got = _solutions(raw_solve(chain, params, T, parallel=False))
+        missed = sum(int((~_close(r, g).any(axis=1)).sum()) for r, g in zip(ref, got,
+                                                                          strict=True))
+        if best is None or missed < best[0]:
+            best = (missed, p, s, params)
+        if missed == 0:
+            break
+    assert best is not None
+    missed, p, s, _ = best
+    if missed:
+        return General6R(None, scale=scale, reason=(
+            f"the general 6R elimination missed {missed} of {n_ref} solutions of its "
+            f"{len(q)} test poses (best variants: {p}, then {s})"))
+    order = _fallbacks(trials, p, s)
+    params = _params([blocks[v] for v in order], scale)
+    tp = trials[p]
+    measured = (f"Raghavan-Roth elimination, {p} (then {', '.join(map(str, order[1:]))} "
+                f"where it is degenerate or noisy: at {int((tp.degenerate | tp.noisy).sum())}"
+                f" of {len(q)} test poses, half at 0, +-pi/2, pi); all {n_ref} solutions "
+                f"of the test poses found; DFT tail {tp.tail:.1e}")
+    return General6R(params, p, s, measured=measured, tail=tp.tail, scale=scale,
+                     variants=tuple(order))
+
+
+def _fallbacks(trials: dict[Variant, _Trial], p: Variant, s: Variant) -> list[Variant]:
+    """The variants the kernel tries in turn.
+
+    p, s, then up to FALLBACKS more, each with another split and direction (its own
+    right side, which a pose can make rank deficient where the others' is not), best
+    key first; last the primary's other dialytic multiplier (its sibling), unless
+    already there. The sibling runs only where every variant before it was
+    degenerate or noisy: where the others are degenerate and the primary splits a
+    noisy cluster (the Panda with joint 7 held at 0.7, q2 = q3 = pi/2, q5 = q6 = pi:
+    four solutions share q5), the split is sensitive to rounding in the fit (a
+    6.7e-15 change lost the generating configuration) and the sibling's multiplier
+    gives an independent set of candidates.
+    """
+    order = [p, s]
+    for v in sorted(trials, key=lambda v: trials[v].key()):
+        if len(order) == 2 + FALLBACKS:
+            break
+        if all((v.split, v.reversed) != (u.split, u.reversed) for u in order):
+            order.append(v)
+    sibling = Variant(p.reversed, p.split, 1 - p.multiplier)
+    if sibling not in order:
+        order.append(sibling)
+    return order
 
 
 # -------------------------------------------------------------- the solver
@@ -451,7 +581,7 @@ def make_single(chain: Any) -> Any:
         Q = empty((1, MAX_SOLUTIONS, 6))
         valid, inside = empty((1, MAX_SOLUTIONS), b1), empty((1, MAX_SOLUTIONS), b1)
         sigma, status, diag = empty((1, MAX_SOLUTIONS)), empty(1, np.int64), empty(1, np.int64)
-        kern(packed, params, T1, Q, valid, inside, sigma, status, diag, empty((1, 3)), False)
+        kern(packed, params, T1, Q, valid, inside, sigma, status, diag, empty((1, 4)), False)
         runs = int(diag[0] & secondary != 0)
         return trusted(Q[0], valid[0], is_rev, limits,
                        {"within_limits": inside[0], "singular": sigma[0] < 1e-6}, {},
