@@ -26,6 +26,7 @@ from setuptools.errors import CompileError, PlatformError
 CSRC = "src/robokin/_native/csrc"
 HEADERS = [f"{CSRC}/{h}" for h in ("lanes.h", "chain.h", "pool.h", "pool.c", "fk.c",
                                      "lm.c", "nearest.c", "six_r.c", "broadphase.c", "general6r.c",
+                                     "process.c",
                                      "manipulability.c", "pieper.c", "pieper_srs.c",
                                      "plan_geom.c", "plan_check.c", "plan_rrtc.c",
                                      "plan_path.c", "module.c")]

@@ -58,7 +58,7 @@ ALLOWED: dict[str, frozenset[str]] = {
     "trajectory": frozenset(_CORE),
     "collision": frozenset(_CORE),
     "planning": frozenset({*_CORE, "trajectory", "collision"}),
-    "process": frozenset({*_CORE, "trajectory", "collision"}),
+    "process": frozenset({*_CORE, "trajectory", "collision", "viz"}),
     "calibration": frozenset({*_CORE, "trajectory"}),
     "viz": frozenset({*_CORE, "trajectory", "collision"}),
     "cell": frozenset({*_CORE, "trajectory", "collision", "viz"}),

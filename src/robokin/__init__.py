@@ -61,12 +61,14 @@ def save(robot: Robot, path: str | Path) -> Path:
 
 def __getattr__(name: str) -> Any:
     # Lazy subpackages: ``robokin.ik``, ``robokin.trajectory``, ``robokin.collision``,
+    # ``robokin.calibration``,
     # ``robokin.sim`` (MuJoCo, robokin[sim]), ``robokin.cell`` (Dask, robokin[scale]).
     import importlib
 
     if name == "ik":
         return importlib.import_module("robokin.kinematics.ik")
     if name in (
+        "calibration",
         "cell",
         "trajectory",
         "collision",

@@ -230,6 +230,25 @@ class Kernels(Protocol):
     PIEPER_BAD_POSE: int
     PIEPER_PARALLEL_MIN: int
     PIEPER_TAG_VALUE: float
+    # --------------------------------------------------------- process.c constants
+    # process_nodes: node status codes (PN_*), coordinate modes (PM_*), the layout
+    # of its weights vector (PW_*: PW_N entries); process_dp's bucket cap
+    PN_OK: int
+    PN_NONE: int
+    PN_LIMITS: int
+    PN_SINGULAR: int
+    PM_PLAIN: int
+    PM_TURN: int
+    PM_CIRCLE: int
+    PW_SING_W: int
+    PW_SING_MARGIN: int
+    PW_SING_TOL: int
+    PW_MU_REF: int
+    PW_LIM_W: int
+    PW_LIM_MARGIN: int
+    PW_N: int
+    PR_MAXB: int
+    PR_LIMIT_TOL: float
     # ---------------------------------------------------------- FK and Jacobian
     def fk1(self, q: object, packed: object, /) -> F64 | None:
         """Pose (4, 4) of one configuration q (n,), or None for the general path."""
@@ -468,6 +487,55 @@ class Kernels(Protocol):
         exact: object, /,
     ) -> tuple[F64, tuple[int, ...]]:
         """Shortcuts, then sharp corners cut, of path (K, n); (path, counters)."""
+
+    # --------------------------------------------------------- process paths
+    def process_nodes(
+        self,
+        packed: F64,
+        Q: F64,
+        valid: Bools,
+        singular: Bools,
+        mode: npt.NDArray[np.uint8],
+        weights: F64,
+        Qc: F64,
+        cost: F64,
+        mu: F64,
+        code: npt.NDArray[np.int8],
+        /,
+    ) -> None:
+        """Per node of Q (P, n): canonical values Qc, cost, manipulability, status."""
+
+    def process_dp(
+        self,
+        Q: F64,
+        cost: F64,
+        circle: npt.NDArray[np.uint8],
+        max_step: float,
+        weight: float,
+        start: F64,
+        forbidden: I64,
+        value: F64,
+        pred: npt.NDArray[np.int32],
+        restart: npt.NDArray[np.uint8],
+        choice: npt.NDArray[np.int32],
+        /,
+    ) -> int:
+        """The exact shortest path through layers Q (L, M, n); returns the segments."""
+
+    def process_clusters(
+        self, Q: F64, cost: F64, circle: npt.NDArray[np.uint8], out: F64, /
+    ) -> None:
+        """The least largest-joint-change between every two layers into out (P, P)."""
+
+    def process_pairs(
+        self, A: F64, B: F64, circle: npt.NDArray[np.uint8], out: F64, /
+    ) -> None:
+        """The largest joint change between every row of A (a, n) and B (b, n)."""
+
+    def process_limit_cost(
+        self, values: F64, lo: float, hi: float, margin: float, out: F64, /
+    ) -> None:
+        """The limit cost of each value (P,) into out (P,)."""
 
     # ------------------------------------------------------- for tests and set-up
     def seg_seg(self, pts: F64, out: F64, /) -> None:

@@ -259,6 +259,10 @@ async def _identity(address: str, timeout: float) -> Any:
 
     from distributed.comm import connect
 
+    # a plain TCP connect first: distributed's connect retries a refused port until
+    # its timeout and, on a loaded machine, may end on a timed-out attempt instead
+    # of the refusal (a closed port then read as silence)
+    await _tcp_open(address, timeout)
     # distributed's connect retries until its timeout, then reads the handshake
     # with no bound at all (a port that accepts and stays silent hangs there)
     # (the outer bound a little later than connect's own: a refused connection
@@ -271,13 +275,31 @@ async def _identity(address: str, timeout: float) -> Any:
         comm.abort()
 
 
+async def _tcp_open(address: str, timeout: float) -> None:
+    """Open and close a TCP connection to a ``tcp://host:port`` address.
+
+    Other schemes are left to distributed; a refused connection raises at once.
+    """
+    import asyncio
+
+    scheme, _, rest = address.partition("://")
+    host, sep, port = rest.rpartition(":")
+    if scheme != "tcp" or not sep or not port.isdigit():
+        return
+    _, writer = await asyncio.wait_for(
+        asyncio.open_connection(host.strip("[]"), int(port)), timeout)
+    writer.close()
+
+
 def _os_reason(exc: OSError) -> str:
     """The innermost system error of a failed connect (``Connection refused``)."""
     inner: BaseException = exc
     while inner.__cause__ is not None:
         inner = inner.__cause__
-    if isinstance(inner, OSError) and inner.strerror:
-        return inner.strerror.lower() + " (no Dask scheduler listens there)"
+    if isinstance(inner, OSError) and (inner.errno or inner.strerror):
+        # the system's words for the errno (asyncio's strerror is "Connect call failed")
+        text = os.strerror(inner.errno) if inner.errno else str(inner.strerror)
+        return text.lower() + " (no Dask scheduler listens there)"
     return " ".join(str(exc).split())[:200] or type(exc).__name__
 
 

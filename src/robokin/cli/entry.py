@@ -26,9 +26,11 @@ import typer.core
 
 from robokin.cli import (
     actuators,
+    calibrate,
     cell,
     collision,
     demo,
+    follow,
     ik,
     motion,
     plan,
@@ -79,7 +81,7 @@ app = typer.Typer(
 #: defines its commands on its own ``commands = typer.Typer()``; adding a module
 #: here is how a command joins ``robokin`` (docs/conventions.md, "Where things go").
 COMMAND_MODULES = (robots, demo, ik, motion, urdf, collision, plan, view, actuators,
-                   workspace, sim, retime, schema, cell)
+                   workspace, sim, retime, schema, cell, follow, calibrate)
 for _module in COMMAND_MODULES:
     app.registered_commands.extend(_module.commands.registered_commands)
 

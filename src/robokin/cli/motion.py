@@ -57,8 +57,21 @@ def traj(
     ros2_stride: Annotated[int, typer.Option(
         "--ros2-stride", help="Keep every N-th sample (and the last) in --ros2.")] = 1,
     program: Annotated[Path | None, typer.Option(
-        "--program", help="Also write the program the robot's controller profile "
-        "names (URScript, ROS 2 or waypoint file; replaced if it exists).")] = None,
+        "--program", help="Also write a controller program. A dialect name (kuka_krl, "
+        "abb_rapid, fanuc_tp, yaskawa_inform, staubli_val3, kawasaki_as, or a "
+        "registered one): its files, named after the motion file, in --program-dir "
+        "(an existing one is replaced only with --force). A file path: the program "
+        "the robot's controller profile names (URScript, ROS 2 or waypoint file; "
+        "replaced if it exists).")] = None,
+    program_dir: Annotated[Path | None, typer.Option(
+        "--program-dir", help="Folder of a --program DIALECT's files (default: the "
+        "motion file's folder).")] = None,
+    program_tolerance: Annotated[float | None, typer.Option(
+        "--program-tolerance", help="--program DIALECT: keep the samples within this "
+        "joint-space deviation [deg] (default 0.057 deg = 1 mrad).")] = None,
+    program_stride: Annotated[int | None, typer.Option(
+        "--program-stride", help="--program DIALECT: keep every N-th sample (and the "
+        "last) instead.")] = None,
     force: Annotated[bool, typer.Option(
         "--force", help="Replace FILE.csv / FILE.png left by an earlier run.")] = False,
     output_format: FormatOption = None,
@@ -69,8 +82,10 @@ def traj(
     is replaced only with --force); the plot likewise as FILE.png. The CSV and the
     plot are written all or none: nothing is written when either cannot be.
     --ros2 and --program use the robot file's controller: section (joint names,
-    order, signs, offsets; docs/controllers.md, docs/ros2.md). Exit code 1 when the
-    motion violates a joint limit (the files are still written).
+    order, signs, offsets; docs/controllers.md, docs/ros2.md). --program DIALECT
+    writes joint moves through the samples (decimated: --program-tolerance,
+    --program-stride) in that controller's language. Exit code 1 when the motion
+    violates a joint limit (the files are still written).
     """
     import numpy as np
     from rich.progress import Progress
@@ -101,20 +116,29 @@ def traj(
     if not no_plot:
         png, png_over = _default_out(plot, path.with_suffix(".png"), True)
         outputs.append((png, "--plot", png_over or force))
+    dialect = _program_dialect(program, program_dir, program_tolerance, program_stride)
+    program_files = [] if dialect is None else _dialect_files(
+        robot, dialect, program_dir or path.parent, path.stem)
     check_distinct([(p, arg) for p, arg, _ in outputs]
-                   + [(p, arg) for p, arg in ((ros2, "--ros2"), (program, "--program"))
-                      if p is not None],
+                   + [(p, arg) for p, arg in ((ros2, "--ros2"),
+                                              (None if dialect else program, "--program"))
+                      if p is not None] + [(p, "--program") for p in program_files],
                    [(path, "FILE"), (robot.path, "(the motion file's robot)")])
     if not force:
         _refuse_earlier_run([(p, opt) for (p, opt, _), given in
-                             zip(outputs, (output, plot)) if given is None], path)
+                             zip(outputs, (output, plot)) if given is None]
+                            + [(p, "--program-dir") for p in program_files], path)
     with staged_outputs(outputs, how="pass --force") as staged:
         write_csv(tr, staged[0], robot.joint_names, rates=rates)
         if png is not None:
             from robokin.viz.plots import plot_joints
 
             plot_joints(tr, path=staged[1], title=f"{robot.name}: {path.name}"[:200])
-    extra = _controller_outputs(robot, tr, ros2, ros2_goal, ros2_stride, program)
+    extra = _controller_outputs(robot, tr, ros2, ros2_goal, ros2_stride,
+                                None if dialect else program)
+    if dialect is not None:
+        extra += _dialect_program(robot, tr, dialect, program_dir or path.parent,
+                                  path.stem, force, program_tolerance, program_stride)
     vel, acc = motion_limits(spec, robot, path)
     report = tr.check_limits(robot, velocity=vel, acceleration=acc)
     peaks = tr.peaks()
@@ -171,7 +195,7 @@ def _refuse_earlier_run(defaults: list[tuple[Path, str]], motion: Path) -> None:
         return
     many = len(there) > 1
     names = " and ".join(str(p) for p, _ in there)
-    options = " / ".join(opt for _, opt in there)
+    options = " / ".join(dict.fromkeys(opt for _, opt in there))
     raise InputError("FILE", f"{names} {'exist' if many else 'exists'} (written next "
                      f"to {motion.name} by an earlier run); pass --force to replace "
                      f"{'them' if many else 'it'}, or {options} to write elsewhere")
@@ -201,6 +225,49 @@ def _controller_outputs(robot: Robot, tr: Trajectory, ros2: Path | None, goal: b
         prog = write_controller_program(robot, tr, program, overwrite=True)
         lines.append(f"wrote {program}: {prog.describe()}")
     return lines
+
+
+def _program_dialect(program: Path | None, program_dir: Path | None,
+                     tolerance: float | None, stride: int | None) -> str | None:
+    """The dialect named by --program (None: a file path, or no --program)."""
+    from robokin.exceptions import InputError
+    from robokin.trajectory.posts import post_names
+
+    text = "" if program is None else str(program)
+    bare = bool(text) and "/" not in text and "\\" not in text and "." not in text
+    dialect = text if bare and text.lower().replace("-", "_") in post_names() else None
+    if bare and dialect is None:
+        raise InputError("--program", f"{text!r} is neither a dialect ({post_names()}) "
+                         "nor a file name with a suffix (move.script, move.ros2.yaml, "
+                         "move.waypoints.csv)")
+    for value, opt in ((program_dir, "--program-dir"), (tolerance, "--program-tolerance"),
+                       (stride, "--program-stride")):
+        if value is not None and dialect is None:
+            raise InputError(opt, "applies to --program DIALECT (one of "
+                             f"{post_names()})")
+    return dialect
+
+
+def _dialect_files(robot: Robot, dialect: str, folder: Path, stem: str) -> list[Path]:
+    """The files --program DIALECT will write (for the distinct-output check)."""
+    from robokin.trajectory.posts import get_post
+
+    post = get_post(dialect)
+    name, _ = post.program_name(stem)
+    return [folder / rel for rel in post.file_names(name)]
+
+
+def _dialect_program(robot: Robot, tr: Trajectory, dialect: str, folder: Path, stem: str,
+                     force: bool, tolerance_deg: float | None, stride: int | None
+                     ) -> list[str]:
+    """Write --program DIALECT; lines saying what was written (and its notes)."""
+    from robokin.trajectory.posts import write_program
+
+    tol = None if tolerance_deg is None else math.radians(tolerance_deg)
+    prog = write_program(robot, tr, dialect, folder, name=stem, force=force,
+                         tolerance=tol, stride=stride)
+    files = ", ".join(str(p) for p in prog.files)
+    return [f"wrote {files}: {prog.describe()}"] + [f"note: {n}" for n in prog.notes]
 
 
 def _is_bag(path: Path) -> bool:

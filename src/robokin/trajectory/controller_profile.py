@@ -7,16 +7,19 @@ writing and undoes it when reading. :func:`load_profile` reads one from YAML/JSO
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any, Literal, TypeVar
 
 import numpy as np
 
 from robokin._text import short_repr
 from robokin.exceptions import InputError, ModelError
+from robokin.spatial import pose_from_xyz_rpy
 
 __all__ = ["PROGRAMS", "ControllerProfile", "load_profile"]
 
@@ -48,6 +51,16 @@ class ControllerProfile:
         programs: What the controller runs, its default first: ``"urscript"``,
             ``"ros2"``, ``"waypoints"`` (:mod:`robokin.trajectory.controllers`);
             None: any but URScript, a waypoint file by default.
+        root: The controller's robot root frame (KUKA ``$ROBROOT``, ABB's base
+            frame: z up along axis 1, x where the arm reaches at axis 1's zero) in
+            the model's base frame: ``(x, y, z, roll, pitch, yaw)`` [m, rad]
+            (None: the model's base frame). Used by the post processors
+            (:mod:`robokin.trajectory.posts`) for frames and configuration flags.
+        flange: The controller's flange frame in the model's last link frame, the
+            same six numbers (None: the model's last link frame); tool data are
+            written relative to it.
+        posts: Options per post processor dialect, ``{dialect: {option: value}}``
+            (checked by :func:`robokin.trajectory.posts.write_program`).
     """
 
     name: str = "default"
@@ -58,6 +71,9 @@ class ControllerProfile:
     length_unit: Literal["m", "mm"] = "m"
     names: tuple[str, ...] | None = None
     programs: tuple[str, ...] | None = None
+    root: tuple[float, ...] | None = None
+    flange: tuple[float, ...] | None = None
+    posts: Mapping[str, Mapping[str, Any]] | None = None
 
     def __post_init__(self) -> None:
         """Check the units and the per-column lists; store them as tuples."""
@@ -74,10 +90,33 @@ class ControllerProfile:
         if bad or (self.programs is not None and not self.programs):
             raise ModelError(f"programs must be a non-empty list of {list(PROGRAMS)}, "
                              f"got {short_repr(self.programs)}", field="programs")
-        for f in ("order", "signs", "offsets", "names", "programs"):
+        for f in ("order", "signs", "offsets", "names", "programs", "root", "flange"):
             v = getattr(self, f)
             if v is not None:
                 object.__setattr__(self, f, tuple(v))
+        for f in ("root", "flange"):
+            v = getattr(self, f)
+            if v is not None and (len(v) != 6 or not all(
+                    isinstance(x, (int, float)) and not isinstance(x, bool)
+                    and math.isfinite(x) for x in v)):
+                raise ModelError(f"expected six finite numbers (x, y, z, roll, pitch, "
+                                 f"yaw), got {short_repr(v)}", field=f)
+        if self.posts is not None:
+            if not isinstance(self.posts, Mapping) or not all(
+                    isinstance(k, str) and isinstance(v, Mapping)
+                    for k, v in self.posts.items()):
+                raise ModelError("expected a mapping {dialect: {option: value}}, got "
+                                 f"{short_repr(self.posts)}", field="posts")
+            object.__setattr__(self, "posts", MappingProxyType(
+                {k: MappingProxyType(copy.deepcopy(dict(v)))
+                 for k, v in self.posts.items()}))
+
+    def frame(self, which: Literal["root", "flange"]) -> np.ndarray:
+        """``root`` or ``flange`` as a (4, 4) transform [m] (identity when not set)."""
+        v = getattr(self, which)
+        if v is None:
+            return np.eye(4)
+        return pose_from_xyz_rpy(v[:3], v[3:])
 
     @classmethod
     def from_dict(cls, doc: Mapping[str, Any], *, file: Any = None) -> ControllerProfile:
@@ -89,7 +128,7 @@ class ControllerProfile:
         """
         doc = dict(doc)
         known = {"name", "order", "signs", "offsets", "offset_unit", "angle_unit",
-                 "length_unit", "names", "joints", "programs"}
+                 "length_unit", "names", "joints", "programs", "root", "flange", "posts"}
         extra = sorted(set(doc) - known)
         if extra:
             raise ModelError(f"unknown key(s) {extra}; known: {sorted(known)}",
@@ -116,16 +155,25 @@ class ControllerProfile:
                                  field="order") from None
         if offsets is not None and doc.get("offset_unit", doc.get("angle_unit")) == "deg":
             offsets = [math.radians(o) for o in offsets]
+        root = _frame_field(doc, "root", file)
+        flange = _frame_field(doc, "flange", file)
         try:
             return cls(name=doc.get("name", "default"), order=_tuple(order),
                        signs=_tuple(signs), offsets=_tuple(offsets),
                        angle_unit=doc.get("angle_unit", "rad"),
                        length_unit=doc.get("length_unit", "m"), names=_tuple(names),
-                       programs=_tuple(programs))
+                       programs=_tuple(programs), root=root, flange=flange,
+                       posts=doc.get("posts"))
         except ModelError as exc:
             raise ModelError(exc.reason, file=file, field=exc.field) from None
 
-    def _parts(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def parts(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The model joint per controller column, the signs and the offsets (n,) each.
+
+        Raises:
+            InputError: the order is not a permutation of ``n`` joints, or the
+                signs / offsets do not have ``n`` entries.
+        """
         order = np.arange(n) if self.order is None else np.asarray(self.order, int)
         if sorted(order.tolist()) != list(range(n)):
             raise InputError("profile", f"order {order.tolist()} is not a permutation "
@@ -138,13 +186,13 @@ class ControllerProfile:
 
     def export(self, q: np.ndarray, *, rates: bool = False) -> np.ndarray:
         """Model values (m, n) SI -> controller columns (m, n) SI (units not applied)."""
-        order, signs, offs = self._parts(q.shape[-1])
+        order, signs, offs = self.parts(q.shape[-1])
         c = q[..., order] * signs
         return c if rates else c + offs
 
     def undo(self, c: np.ndarray, *, rates: bool = False) -> np.ndarray:
         """Controller columns (m, n) SI -> model values (m, n) SI."""
-        order, signs, offs = self._parts(c.shape[-1])
+        order, signs, offs = self.parts(c.shape[-1])
         v = (c if rates else c - offs) * signs
         out = np.empty_like(v)
         out[..., order] = v
@@ -154,12 +202,12 @@ class ControllerProfile:
         """Controller column names (the model's, reordered, unless ``names``)."""
         if self.names is not None:
             return list(self.names)
-        order, _, _ = self._parts(len(model_names))
+        order, _, _ = self.parts(len(model_names))
         return [model_names[k] for k in order]
 
     def column_revolute(self, is_revolute: np.ndarray) -> np.ndarray:
         """Revolute flags in controller order."""
-        order, _, _ = self._parts(len(is_revolute))
+        order, _, _ = self.parts(len(is_revolute))
         return np.asarray(is_revolute, bool)[order]
 
 
@@ -183,6 +231,23 @@ def _list_field(doc: Mapping[str, Any], key: str, kinds: tuple[type, ...],
         raise ModelError(f"expected a list of {what}, got {short_repr(value)}",
                          file=file, field=key)
     return list(value)
+
+
+def _frame_field(doc: Mapping[str, Any], key: str, file: Any
+                 ) -> tuple[float, ...] | None:
+    """``doc[key]`` = ``{xyz_mm: [x, y, z], rpy_deg: [r, p, y]}`` as six SI numbers."""
+    value = doc.get(key)
+    if value is None:
+        return None
+    if not isinstance(value, Mapping) or set(value) - {"xyz_mm", "rpy_deg"}:
+        raise ModelError("expected {xyz_mm: [x, y, z], rpy_deg: [roll, pitch, yaw]}, "
+                         f"got {short_repr(value)}", file=file, field=key)
+    xyz = _list_field(value, "xyz_mm", (int, float), file) or [0.0, 0.0, 0.0]
+    rpy = _list_field(value, "rpy_deg", (int, float), file) or [0.0, 0.0, 0.0]
+    if len(xyz) != 3 or len(rpy) != 3:
+        raise ModelError("xyz_mm and rpy_deg need three numbers each", file=file,
+                         field=key)
+    return tuple([v / 1000.0 for v in xyz] + [math.radians(v) for v in rpy])
 
 
 def load_profile(path: str | Path) -> ControllerProfile:

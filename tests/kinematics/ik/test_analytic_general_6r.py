@@ -449,10 +449,12 @@ def check_special(robot, q, sols, T, scale, smin):
 
 
 def check_6r(robot, q):
-    """check_special on a 6R arm solved by robot.ik."""
+    """check_special on a 6R arm solved by robot.ik: the general 6R solver, or the
+    pieper closed form that ``method="auto"`` prefers where it applies (the Panda
+    with joint 7 held); never the numeric sample."""
     T = robot.fk(q)
     sols = robot.ik(T)
-    assert sols.method == "general_6r"
+    assert sols.method in ("general_6r", "analytic:pieper"), sols.method
     check_special(robot, q, sols, T, general_6r.setup(robot.chain).scale,
                   min_singular_value(robot.chain, q))
 
@@ -629,18 +631,23 @@ def test_nearly_degenerate_arm_is_refused_with_a_reason_not_a_traceback():
     # a random sparse arm (found by the sparse sweep): axes 1, 2 parallel, axis 3
     # 2.9e-4 rad from them and a spherical wrist, 2.9e-4 rad from rank 5 everywhere
     # (Jacobian's smallest singular value 1e-8..9e-5): no set-up configuration has
-    # isolated solutions. The family is refused with that reason (it raised a bare
-    # ValueError from numpy before); robot.ik falls back to numeric and says so, and
-    # method="analytic" is an InputError naming the reason.
+    # isolated solutions. The general 6R set-up refuses it with that reason (it raised
+    # a bare ValueError from numpy before); the spherical wrist makes it a pieper arm,
+    # which robot.ik takes: every generating configuration back, rows to 1e-12.
     rows = [(-0.1498, -0.4836, 0.0), (-0.3551, 0.0, 0.000287), (-0.1308, 0.0, H),
             (0.0, -0.3423, H), (0.0, 0.0, -H), (0.0, 0.0, -H)]
     robot = robokin.Robot.from_dh([{"joint": "revolute", "a": a, "d": d, "alpha": al,
                                     "theta": 0.0, "limits": [-math.pi, math.pi]}
                                    for a, d, al in rows])
     fam = robokin.ik.family(robot)
-    assert fam.solver is None
-    assert "general_6r: a nearly degenerate arm" in fam.reason
-    q = np.array([0.3, 0.2, -0.4, 0.5, 0.6, 0.7])
-    assert robot.ik(robot.fk(q)).method == "numeric"
-    with pytest.raises(InputError, match="nearly degenerate arm"):
-        robot.ik(robot.fk(q), method="analytic")
+    assert fam.name == "pieper"
+    assert "a nearly degenerate arm" in general_6r.setup(robot.chain).reason
+    q = np.random.default_rng(3).uniform(-math.pi, math.pi, (50, 6))
+    T = robot.fk(q)
+    sols = robot.ik(T)
+    assert sols.method == "analytic:pieper"
+    dp, dr = fk_error(robot.chain, sols.q, T)
+    assert np.where(sols.valid, np.maximum(dp, dr), 0.0).max() <= FK_TOL
+    gap = np.where(sols.valid, np.abs(wrapped(sols.q - q[:, None, :])).max(axis=-1),
+                   np.inf).min(axis=-1)
+    assert (gap < GENERATING_TOL).all()

@@ -25,6 +25,7 @@
 #include "general6r.c"
 #include "manipulability.c"
 #include "pieper.c"
+#include "process.c"
 
 /* ---------------------------------------------------------------- arguments */
 
@@ -612,6 +613,7 @@ static PyMethodDef methods[] = {
     GENERAL6R_METHODS
     MANIPULABILITY_METHODS
     PIEPER_METHODS
+    PROCESS_METHODS
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, MODULE_NAME,
@@ -646,7 +648,7 @@ PyMODINIT_FUNC MODULE_INIT(void)
     if (six_r_constants(m) < 0 || broadphase_constants(m) < 0 ||
         general6r_constants(m) < 0 || pieper_constants(m) < 0 ||
         plan_check_constants(m) < 0 || plan_rrtc_constants(m) < 0 ||
-        plan_path_constants(m) < 0) {
+        plan_path_constants(m) < 0 || process_constants(m) < 0) {
         Py_DECREF(m);
         return NULL;
     }

@@ -68,6 +68,7 @@
  */
 #include "chain.h"
 #include "pool.h"
+#include "subproblems.h"
 
 /* Same floating-point rules as six_r.c (whose helpers this file uses): no fused
  * multiply-adds, so every copy of the kernels takes the same branches. */

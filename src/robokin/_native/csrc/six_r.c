@@ -102,6 +102,7 @@
  */
 #include "chain.h"
 #include "pool.h"
+#include "vec3.h"
 
 enum {
     SR_AXES = 0, SR_POINTS = 18, SR_WRIST = 30, SR_PERP2 = 33, SR_TOOL_T = 36,
@@ -143,20 +144,6 @@ enum { SR_OK = 0, SR_OUT_OF_REACH = 1, SR_NO_ORIENTATION = 2, SR_BAD_POSE = 16 }
 #define SR_RESCUE_ITERS 40
 
 /* ------------------------------------------------------------------- vectors */
-
-typedef struct { double x, y, z; } v3;
-
-/* the 3-vector at P[i], P[i + 1], P[i + 2] */
-static inline v3 v3_at(const double *P, int i) { return (v3){P[i], P[i + 1], P[i + 2]}; }
-
-static inline double v3_dot(v3 a, v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-
-static inline v3 v3_cross(v3 a, v3 b)
-{
-    return (v3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
-static inline v3 v3_sub(v3 a, v3 b) { return (v3){a.x - b.x, a.y - b.y, a.z - b.z}; }
 
 /* Lane vectors: one 3-vector per lane, and a rotation by its rows. */
 typedef struct { vd x, y, z; } L3;
