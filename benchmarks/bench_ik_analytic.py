@@ -64,7 +64,7 @@ def bench_robokin(robot, T_single, T_batch, loop_n: int) -> None:
     from robokin.kinematics.ik.analytic._six_r import raw_solve
 
     fam = robokin.ik.family(robot)
-    P = fam.solver.params()
+    P = fam.solver.params
     T1 = np.ascontiguousarray(T_single[None])
     robot.ik(T_single)
     raw_solve(P, T1, packed=robot.chain.arrays.packed)

@@ -116,7 +116,7 @@ def median_time(fn, args, repeat):
 
 
 def run_robokin(panda, q, T, repeat):
-    held = fixed_ik._held_solvers(panda)["joint7"]
+    held = fixed_ik._held_solvers(panda.arm)["joint7"]
     v = [float(x) for x in q[:, 6]]
     Ts = list(T)
     rows = []

@@ -31,6 +31,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "spatial": ("robokin.spatial", "robokin._validation", "robokin._text",
                 "robokin.exceptions", "robokin._html"),
     "model": ("robokin.model",),
+    "arm": ("robokin.kinematics.arm",),
     "kinematics": ("robokin.kinematics",),
     "io": ("robokin.io",),
     "robot": ("robokin.robot", "robokin.robots"),
@@ -45,16 +46,19 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "face": ("robokin.cli", "robokin.__main__", "robokin"),
 }
 
-_CORE = ("native", "spatial", "model", "kinematics", "io", "robot")
+_CORE = ("native", "spatial", "model", "arm", "kinematics", "io", "robot")
 #: Layer -> the other layers it may import. The core (native, spatial, model,
 #: kinematics, io, robot) imports nothing above it; io never imports robot.py.
+#: The per-arm state (``kinematics.arm``) sits under the rest of kinematics: the
+#: modules that fill it import it, it imports none of them (not even for types).
 ALLOWED: dict[str, frozenset[str]] = {
     "native": frozenset(),
     "spatial": frozenset({"native"}),
     "model": frozenset({"spatial", "native"}),
-    "kinematics": frozenset({"model", "spatial", "native"}),
+    "arm": frozenset({"model", "spatial", "native"}),
+    "kinematics": frozenset({"arm", "model", "spatial", "native"}),
     "io": frozenset({"model", "spatial", "native"}),
-    "robot": frozenset({"io", "kinematics", "model", "spatial", "native"}),
+    "robot": frozenset({"io", "arm", "kinematics", "model", "spatial", "native"}),
     "trajectory": frozenset(_CORE),
     "collision": frozenset(_CORE),
     "planning": frozenset({*_CORE, "trajectory", "collision"}),

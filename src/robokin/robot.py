@@ -29,6 +29,7 @@ from robokin.io.urdf import parts_from_urdf
 from robokin.io.urdf_export import urdf_from_robot
 from robokin.kinematics import forward
 from robokin.kinematics import jacobian as _jac
+from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.dispatch import solve as _ik_solve
 from robokin.kinematics.ik.nearest import solve_near as _solve_near
 from robokin.model.dh import chain_from_dh, chain_from_elementary
@@ -56,9 +57,25 @@ class Robot(RobotParts):
     ``rate_limits``), checked and frozen when the Robot is made; a Robot is accepted
     wherever parts are, and :meth:`from_parts` makes one from parts read by
     :mod:`robokin.io`.
+
+    Attributes:
+        arm: The :class:`~robokin.kinematics.arm.Arm` the kinematics run on (the
+            chain and the state derived from it, made on first use and freed with
+            the Robot; a changed copy gets a new one).
     """
 
-    __slots__ = ()
+    __slots__ = ("_arm",)
+    _arm: Arm
+
+    @property
+    def arm(self) -> Arm:
+        """The Robot's :class:`~robokin.kinematics.arm.Arm` (made on first use)."""
+        try:
+            return self._arm
+        except AttributeError:  # first use: the parts were checked by __init__
+            arm = Arm(self.chain, self.name, self.actuators, self.actuator_limits)
+            object.__setattr__(self, "_arm", arm)
+            return arm
 
     def __getattr__(self, name: str) -> Any:
         """Name the replacement of a removed method (``Robot.plot``) in the error."""
@@ -264,8 +281,9 @@ class Robot(RobotParts):
         if space == "actuator":
             if q_near is not None:
                 q_near = self.joints_from_actuators(q_near)
-            sols = _ik_solve(self, T, q_near=q_near, method=method, **options)
-            out = sols.to_actuator_space(self)
+            arm = self.arm
+            sols = _ik_solve(arm, T, q_near=q_near, method=method, **options)
+            out = sols.to_actuator_space(arm)
             if self.actuators is not None and out.is_revolute.any():
                 # Motor angles never wrap: a motor turn through a reduction is not a
                 # whole joint turn, so 2*pi-shifted motor values are other poses.
@@ -273,7 +291,7 @@ class Robot(RobotParts):
             return out
         if space != "joint":
             raise InputError("space", f"expected 'joint' or 'actuator', got {space!r}")
-        return _ik_solve(self, T, q_near=q_near, method=method, **options)
+        return _ik_solve(self.arm, T, q_near=q_near, method=method, **options)
 
     def ik_near(
         self,
@@ -299,7 +317,7 @@ class Robot(RobotParts):
             An :class:`~robokin.kinematics.ik.numeric.IKResult`: ``.q`` (..., n),
             ``.success`` (...), ``.reason``.
         """
-        return _solve_near(self, T, q_near, method=method, **options)
+        return _solve_near(self.arm, T, q_near, method=method, **options)
 
     # ---------------------------------------------------------------- actuators
     def actuators_from_joints(self, q: npt.ArrayLike) -> np.ndarray:

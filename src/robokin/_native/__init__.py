@@ -63,14 +63,14 @@ def _best() -> Kernels:
         except ImportError:  # pragma: no cover - built without the AVX-512 copy
             pass
         else:
-            return _avx512
+            return cast(Kernels, _avx512)
     if _base.cpu_has_avx2_fma():
         try:
             import robokin._native._avx2 as _avx2
         except ImportError:  # pragma: no cover - built without the AVX2 copy
-            return _base
-        return _avx2
-    return _base
+            return cast(Kernels, _base)
+        return cast(Kernels, _avx2)
+    return cast(Kernels, _base)
 
 
 def _pick() -> Kernels:
@@ -87,7 +87,7 @@ def _pick() -> Kernels:
             f"{best.ISA} (the best copy this CPU runs)")
         return best
     if isa == "baseline":
-        return _base
+        return cast(Kernels, _base)
     order = ["baseline", "avx2+fma", "avx512"]
     if order.index(isa) > order.index(best.ISA):
         _environment_warning(

@@ -136,7 +136,8 @@ def manipulability(
             raise InputError("q", f"holds a non-finite value at index {at}")
         return out.reshape(lead)
     if mask is None:
-        return np.prod(np.linalg.svd(jacobian(chain, q), compute_uv=False), axis=-1)
+        w: np.ndarray = np.prod(np.linalg.svd(jacobian(chain, q), compute_uv=False), axis=-1)
+        return w
     out = np.zeros(lead)
     if mask.any():
         J = jacobian(chain, q[mask])

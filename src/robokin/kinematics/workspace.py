@@ -46,10 +46,10 @@ import numpy.typing as npt
 
 from robokin.exceptions import InputError
 from robokin.kinematics import forward
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.jacobian import manipulability as _manipulability
 
 if TYPE_CHECKING:
-    from robokin.kinematics.robot_like import RobotLike
     from robokin.model.chain import Chain
 
 __all__ = [
@@ -159,7 +159,8 @@ class Workspace:
     @property
     def extent(self) -> np.ndarray:
         """Bounding-box edge lengths [m], shape (3,)."""
-        return self.bounds[1] - self.bounds[0]
+        extent: np.ndarray = self.bounds[1] - self.bounds[0]
+        return extent
 
     @property
     def volume(self) -> float:
@@ -189,7 +190,7 @@ class Workspace:
         return out
 
 
-def _sampling_limits(robot: RobotLike) -> np.ndarray:
+def _sampling_limits(robot: Arm) -> np.ndarray:
     lim = np.array(robot.limits, dtype=float)
     rev = np.asarray(robot.is_revolute, dtype=bool)
     for i in range(lim.shape[0]):
@@ -232,7 +233,8 @@ def random_joints(
             "limits", f"expected finite limits of shape (n, 2), got {lim.shape}"
         )
     u = rng.random((int(count), lim.shape[0]))
-    return lim[:, 0] + u * (lim[:, 1] - lim[:, 0])
+    q: np.ndarray = lim[:, 0] + u * (lim[:, 1] - lim[:, 0])
+    return q
 
 
 def reach_ball(chain: Chain) -> tuple[np.ndarray, float]:
@@ -266,7 +268,7 @@ def reach_ball(chain: Chain) -> tuple[np.ndarray, float]:
 
 
 def position_reachable(
-    robot: RobotLike,
+    robot: ArmSource,
     points: npt.ArrayLike,
     *,
     seeds: npt.ArrayLike | None = None,
@@ -300,6 +302,7 @@ def position_reachable(
     Raises:
         InputError: points not (..., 3) finite numbers, bad seeds.
     """
+    robot = arm_of(robot)
     from robokin._validation import check_finite
     from robokin.kinematics.ik.numeric import solve
 
@@ -336,7 +339,7 @@ def _wilson(hits: float, m: int, z: float = 1.959963984540054) -> tuple[float, f
     return max(0.0, c - h), min(1.0, c + h)
 
 
-def _volume_box(robot: RobotLike, bounds: np.ndarray, margin: float) -> np.ndarray:
+def _volume_box(robot: Arm, bounds: np.ndarray, margin: float) -> np.ndarray:
     """The cloud's bounds grown by ``margin`` of the extent, cut to the reach ball."""
     extent = bounds[1] - bounds[0]
     pad = margin * np.maximum(extent, 1e-3 * max(float(extent.max()), 1e-3))
@@ -348,7 +351,7 @@ def _volume_box(robot: RobotLike, bounds: np.ndarray, margin: float) -> np.ndarr
     return box
 
 
-def _membership(robot: RobotLike, X: np.ndarray, tree: Any, sample_q: np.ndarray,
+def _membership(robot: Arm, X: np.ndarray, tree: Any, sample_q: np.ndarray,
                 progress: Callable[[int], None] | None) -> tuple[np.ndarray, np.ndarray]:
     """position_reachable of X (M, 3), seeded by the nearest samples, in chunks.
 
@@ -370,7 +373,7 @@ def _membership(robot: RobotLike, X: np.ndarray, tree: Any, sample_q: np.ndarray
     return hit, seed
 
 
-def _sample_box(robot: RobotLike, bounds: np.ndarray, M: int, rng: np.random.Generator,
+def _sample_box(robot: Arm, bounds: np.ndarray, M: int, rng: np.random.Generator,
                 tree: Any, sample_q: np.ndarray, progress: Callable[[int], None] | None,
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``(box, X, hit, seed)``: M test points in a box that holds the set.
@@ -393,7 +396,7 @@ def _sample_box(robot: RobotLike, bounds: np.ndarray, M: int, rng: np.random.Gen
     return box, X, hit, seed
 
 
-def _estimate_volume(robot: RobotLike, points: np.ndarray, sample_q: np.ndarray,
+def _estimate_volume(robot: Arm, points: np.ndarray, sample_q: np.ndarray,
                      bounds: np.ndarray, M: int, rng: np.random.Generator,
                      progress: Callable[[int], None] | None) -> VolumeEstimate:
     """The hit-or-miss estimate (see the module docstring) with M test points."""
@@ -429,7 +432,7 @@ def _count(value: Any, name: str, minimum: int) -> int:
 
 
 def sample_workspace(
-    robot: RobotLike,
+    robot: ArmSource,
     n_samples: int = 1_000_000,
     *,
     rng: np.random.Generator | None = None,
@@ -470,6 +473,7 @@ def sample_workspace(
         InputError: a count that is not a positive integer (``volume_points``:
             not >= 0), or a prismatic joint without finite limits.
     """
+    robot = arm_of(robot)
     n_samples = _count(n_samples, "n_samples", 1)
     chunk = _count(chunk, "chunk", 1)
     M = min(n_samples, DEFAULT_VOLUME_POINTS) if volume_points is None else _count(

@@ -48,14 +48,14 @@ def test_the_end_joint_shortcut_equals_a_reduced_chain_per_value():
     robot = robokin.load("panda")
     T = robot.fk(Q0)
     v = 0.9
-    moved = fixed_ik._moved_targets(robot, "last", T[None], np.array([v]))[0]
-    reduced0 = fixed_ik._reduced(robot, [6], (0.0,))
-    reduced_v = fixed_ik._reduced(robot, [6], (v,))
+    moved = fixed_ik._moved_targets(robot.arm, "last", T[None], np.array([v]))[0]
+    reduced0 = robokin.Robot(fixed_ik._reduced(robot.arm, [6], (0.0,)).chain)
+    reduced_v = robokin.Robot(fixed_ik._reduced(robot.arm, [6], (v,)).chain)
     q6 = np.array([0.1, 0.2, -0.3, -1.5, 0.5, 1.2])
     # the chain held at v reaches T_v(q6); the chain held at 0 reaches the moved target
     T_v = reduced_v.fk(q6)
     np.testing.assert_allclose(
-        fixed_ik._moved_targets(robot, "last", T_v[None], np.array([v]))[0],
+        fixed_ik._moved_targets(robot.arm, "last", T_v[None], np.array([v]))[0],
         reduced0.fk(q6), atol=1e-12)
     # every solution of the chain held at v for T reaches the moved target at 0
     sols = reduced_v.ik(T)
@@ -118,10 +118,8 @@ def test_a_sweep_keeps_only_the_last_reduced_chains():
     sols = robot.ik(np.broadcast_to(T, (len(values), 4, 4)), fixed={"joint3": values})
     np.testing.assert_array_equal(sols.q[..., 2][sols.valid],
                                   np.broadcast_to(values[:, None], sols.valid.shape)[sols.valid])
-    # a sweep of a middle joint builds one reduced robot per value; a bounded few stay
-    from robokin.kinematics.per_chain import cached
-
-    kept = cached(robot.chain, "fixed", dict)
+    # a sweep of a middle joint builds one reduced arm per value; a bounded few stay
+    kept = robot.arm.reduced
     assert len(kept) == fixed_ik._REDUCED_KEPT
     assert list(kept)[-1] == ((2,), (float(values[-1]),))
 
@@ -134,14 +132,14 @@ def test_panda_with_joint7_held_is_complete_against_a_numeric_reference():
     robot = robokin.load("panda")
     rng = np.random.default_rng(3)
     lim = robot.limits
-    reduced = fixed_ik._reduced(robot, [6], (0.0,))
+    reduced = fixed_ik._reduced(robot.arm, [6], (0.0,))
     for _ in range(3):
         q = rng.uniform(lim[:, 0], lim[:, 1])
         T = robot.fk(q)
         sols = robot.ik(T, fixed={"joint7": q[6]})
         assert sols.method == "analytic:pieper (joint7 held)"
         assert any(np.allclose(x, q, atol=1e-6) for x in sols)
-        moved = fixed_ik._moved_targets(robot, "last", T[None], np.array([q[6]]))[0]
+        moved = fixed_ik._moved_targets(robot.arm, "last", T[None], np.array([q[6]]))[0]
         ref = numeric.solve_all(reduced, moved, n_seeds=1500,
                                 rng=np.random.default_rng(0))
         ours = sols.q[sols.valid & sols.within_limits][:, :6]

@@ -16,7 +16,7 @@ ARMS = ("ur5", "aubo_i5", "puma560", "panda", "scara", "qfmd010", "improved_dh_a
 @pytest.mark.parametrize("name", ARMS)
 def test_table_rows_are_fk_of_in_limit_configurations_bucketed_by_cell(name):
     robot = robokin.load(name)
-    tab, cstart, gdat = numeric.seed_table(robot.chain).kernel_args()
+    tab, cstart, gdat = numeric.seed_table(robot.arm).kernel_args()
     n = robot.n
     assert tab.shape == (numeric._TABLE_SIZE, 12 + n)
     q = tab[:, 12:]
@@ -43,7 +43,7 @@ def test_grid_search_finds_the_nearest_rows_of_the_cells_it_scans(rot_w):
     from robokin._native import kernels as K
 
     robot = robokin.load("panda")
-    tab, cstart, gdat = numeric.seed_table(robot.chain).kernel_args()
+    tab, cstart, gdat = numeric.seed_table(robot.arm).kernel_args()
     G = int(gdat[6])
     cells = np.clip(np.floor((tab[:, :3] - gdat[:3]) * gdat[3:6]).astype(int), 0, G - 1)
     rng = np.random.default_rng(3)

@@ -24,14 +24,14 @@ the first). Otherwise each distinct value gets its own reduced chain (cached).
 
 from __future__ import annotations
 
-from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol, cast
 
 import numpy as np
 import numpy.typing as npt
 
+from robokin import _native
 from robokin._validation import (
     _real_array,
     check_broadcasts,
@@ -40,23 +40,21 @@ from robokin._validation import (
     check_poses_fast,
 )
 from robokin.exceptions import InputError
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.analytic import pieper as _pk
 from robokin.kinematics.ik.solutions import SolutionSet
-from robokin.kinematics.per_chain import cached
 from robokin.model.chain import joint_motion
 from robokin.spatial import invert
-
-if TYPE_CHECKING:
-    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["solve_fixed"]
 
 
 def solve_fixed(
-    robot: RobotLike,
+    robot: ArmSource,
     T: npt.ArrayLike,
     fixed: Mapping[str, npt.ArrayLike],
     *,
+    dispatch: Dispatch,
     q_near: npt.ArrayLike | None = None,
     method: str = "auto",
     **options: Any,
@@ -64,10 +62,11 @@ def solve_fixed(
     """Every solution for poses ``T`` with the joints named in ``fixed`` held.
 
     Args:
-        robot: The :class:`~robokin.robot.Robot`.
+        robot: The arm (an :class:`~robokin.kinematics.arm.Arm` or a Robot).
         T: Target poses (..., 4, 4) [m].
         fixed: Joint name -> value [rad or m]: a number, or an array broadcasting
             with the poses' leading shape (a sweep).
+        dispatch: ``dispatch.solve``: solves the remaining chain.
         q_near: Current configuration (..., n) of the whole arm, optional.
         method: As in ``Robot.ik``, for the remaining chain.
         **options: Passed to the solver of the remaining chain.
@@ -81,6 +80,7 @@ def solve_fixed(
         InputError: an unknown joint name (the message lists them), a non-finite
             value, values that do not broadcast with the poses, or every joint held.
     """
+    robot = arm_of(robot)
     if (q_near is None and not options and type(fixed) is dict and len(fixed) == 1
             and type(T) is np.ndarray and method != "numeric"):
         # hot path: one pose, one joint held at a number, a closed form (the compiled
@@ -88,7 +88,7 @@ def solve_fixed(
         ((name, value),) = fixed.items()
         held = _held_solvers(robot).get(name)
         if held is not None and type(value) in _NUMBERS:
-            out = held.single(T, value, None)
+            out: SolutionSet | None = held.single(T, value, None)
             if out is not None:
                 return out
     names = list(robot.joint_names)
@@ -127,7 +127,7 @@ def solve_fixed(
     if end is not None:
         reduced = _reduced(robot, idx, (0.0,))
         Tm = _moved_targets(robot, end, Tb, V[:, 0])
-        sols = reduced.ik(Tm, q_near=qn, method=method, **options)
+        sols = dispatch(reduced, Tm, q_near=qn, method=method, **options)
         parts = [(np.arange(len(Tb)), sols)]
     else:
         parts = []
@@ -135,8 +135,8 @@ def solve_fixed(
         for g, vals in enumerate(uniq):
             rows = np.flatnonzero(inverse.ravel() == g)
             reduced = _reduced(robot, idx, tuple(float(x) for x in vals))
-            sols = reduced.ik(Tb[rows], q_near=None if qn is None else qn[rows],
-                              method=method, **options)
+            sols = dispatch(reduced, Tb[rows], q_near=None if qn is None else qn[rows],
+                          method=method, **options)
             parts.append((rows, sols))
     return _assemble(robot, lead, idx, keep, V, parts, dict(zip(fixed, values)))
 
@@ -161,41 +161,41 @@ class HeldSolver:
     info: dict[str, Any]
     single: Any
 
-    def solve(self, robot: RobotLike, T: np.ndarray, q_near: np.ndarray | None,
+    def solve(self, robot: Arm, T: np.ndarray, q_near: np.ndarray | None,
               values: np.ndarray, *, compute_error: bool = False) -> SolutionSet:
         """Every solution for validated poses T (..., 4, 4) at held values (...)."""
         info = dict(self.info)
-        name = robot.joint_names[int(self.params[_pk.K.PIEPER_HELD])]
+        name = robot.joint_names[int(self.params[_native.kernels.PIEPER_HELD])]
         info["held"] = {name: values}
         return _pk.solve(robot, T, q_near, params=self.params, method=self.method,
                          info=info, values=values, compute_error=compute_error)
 
 
-def _held_solvers(robot: RobotLike) -> dict[str, HeldSolver]:
+def _held_solvers(robot: Arm) -> dict[str, HeldSolver]:
     """Joint name -> the closed form with that joint held, where one applies.
 
-    Set up once per chain (microseconds per joint: no reduced chain is built).
+    Set up once per arm, kept in it (microseconds per joint: no reduced chain is built).
     """
-    def build() -> dict[str, HeldSolver]:
-        chain = robot.chain
-        out: dict[str, HeldSolver] = {}
-        if chain.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
-            return out
-        for j, name in enumerate(robot.joint_names):
-            setup = _pk.setup(chain, j)
-            if setup.params is None:
-                continue
-            method = f"analytic:{_pk.NAME} ({name} held)"
-            info = {"family": _pk.NAME, "measured": setup.measured, "near_family": False}
-            one = _pk.make_single(chain, setup.params, method=method, info=info,
-                                  held=name)
-            out[name] = HeldSolver(setup.params, method, info, one)
+    if robot.held_solvers is not None:  # only this function fills it
+        return cast(dict[str, HeldSolver], robot.held_solvers)
+    chain = robot.chain
+    out: dict[str, HeldSolver] = {}
+    robot.held_solvers = cast(dict[str, object], out)
+    if chain.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
         return out
+    for j, name in enumerate(robot.joint_names):
+        setup = _pk.setup(chain, j)
+        if setup.params is None:
+            continue
+        method = f"analytic:{_pk.NAME} ({name} held)"
+        info = {"family": _pk.NAME, "measured": setup.measured, "near_family": False}
+        one = _pk.make_single(chain, setup.params, method=method, info=info,
+                              held=name)
+        out[name] = HeldSolver(setup.params, method, info, one)
+    return out
 
-    return cached(robot.chain, "fixed_closed_form", build)
 
-
-def _end_joint(robot: RobotLike, idx: list[int]) -> str | None:
+def _end_joint(robot: Arm, idx: list[int]) -> str | None:
     """"first" / "last" when one held coordinate is the chain's first / last joint."""
     chain = robot.chain
     if len(idx) != 1 or not chain.coupling.is_identity:
@@ -207,46 +207,56 @@ def _end_joint(robot: RobotLike, idx: list[int]) -> str | None:
     return None
 
 
-def _moved_targets(robot: RobotLike, end: str, T: np.ndarray, v: np.ndarray) -> np.ndarray:
+def _moved_targets(robot: Arm, end: str, T: np.ndarray, v: np.ndarray) -> np.ndarray:
     """The targets of the reduced chain (held value 0) that equal T at value v."""
     C = robot.chain.arrays.consts
     if end == "last":
         j = robot.n - 1
         Cn = C[-1]
-        return T @ invert(Cn) @ joint_motion(robot.chain.joints[j].kind, -robot.chain.joints[j].sign * v) @ Cn
+        last: np.ndarray = (T @ invert(Cn) @ joint_motion(
+            robot.chain.joints[j].kind, -robot.chain.joints[j].sign * v) @ Cn)
+        return last
     C0 = C[0]
-    return C0 @ joint_motion(robot.chain.joints[0].kind, -robot.chain.joints[0].sign * v) @ invert(C0) @ T
+    first: np.ndarray = (C0 @ joint_motion(
+        robot.chain.joints[0].kind, -robot.chain.joints[0].sign * v) @ invert(C0) @ T)
+    return first
 
 
-#: Reduced robots kept per chain: a sweep of a middle joint builds one per value
+#: Reduced arms kept per arm: a sweep of a middle joint builds one per value
 #: (a general-6R set-up each); the most recently used ones are kept, not all.
 _REDUCED_KEPT = 16
 
 
-def _reduced(robot: RobotLike, idx: list[int], values: tuple[float, ...]) -> Any:
-    """The robot of the remaining coordinates (the last few kept per chain)."""
+def _reduced(robot: Arm, idx: list[int], values: tuple[float, ...]) -> Arm:
+    """The arm of the remaining coordinates (the last few kept in ``robot.reduced``)."""
     key = (tuple(idx), values)
-    kept: OrderedDict[Any, Any] = cached(robot.chain, "fixed", OrderedDict)
+    kept = robot.reduced
     if key in kept:
         kept.move_to_end(key)
         return kept[key]
-
-    def build() -> Any:
-        held = ", ".join(f"{robot.joint_names[j]}={v:g}" for j, v in zip(idx, values,
-                                                                          strict=True))
-        chain = robot.chain.with_fixed(dict(zip(idx, values, strict=True)))
-        # a bare robot of the same class: the chain and a name, nothing per link or
-        # per joint of the whole arm (geometry, actuators, dynamics, rate limits)
-        make: Any = type(robot)
-        return make(chain, name=f"{robot.name} ({held} held)")
-
-    value = kept[key] = build()
+    held = ", ".join(f"{robot.joint_names[j]}={v:g}" for j, v in zip(idx, values,
+                                                                      strict=True))
+    # the chain and a name, nothing per motor of the whole arm (actuators)
+    value = kept[key] = Arm(robot.chain.with_fixed(dict(zip(idx, values, strict=True))),
+                            name=f"{robot.name} ({held} held)")
     while len(kept) > _REDUCED_KEPT:
         kept.popitem(last=False)
     return value
 
 
-def _assemble(robot: RobotLike, lead: tuple[int, ...], idx: list[int], keep: list[int],
+class Dispatch(Protocol):
+    """``dispatch.solve``'s signature: solves the reduced arm.
+
+    The dispatcher passes itself in (it imports this module).
+    """
+
+    def __call__(self, robot: ArmSource, T: npt.ArrayLike, *,
+                 q_near: npt.ArrayLike | None = None, method: str = "auto",
+                 **options: Any) -> SolutionSet:
+        """Every solution for poses T (..., 4, 4)."""
+
+
+def _assemble(robot: Arm, lead: tuple[int, ...], idx: list[int], keep: list[int],
               V: np.ndarray, parts: list[tuple[np.ndarray, SolutionSet]],
               fixed: dict[str, np.ndarray]) -> SolutionSet:
     N = V.shape[0]

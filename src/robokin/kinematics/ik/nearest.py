@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from robokin._native import kernels
 from robokin._validation import (
     check_broadcasts,
     check_finite,
@@ -22,11 +23,14 @@ from robokin._validation import (
     check_transform,
 )
 from robokin.exceptions import InputError
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
+from robokin.kinematics.ik import numeric
+from robokin.kinematics.ik.analytic.detect import detect
+from robokin.kinematics.ik.dispatch import solve
 from robokin.kinematics.ik.numeric import IKResult
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.solutions import SolutionSet
-    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["solve_near"]
 
@@ -34,7 +38,7 @@ _METHODS = ("auto", "analytic", "numeric")
 
 
 def solve_near(
-    robot: RobotLike,
+    robot: ArmSource,
     T: npt.ArrayLike,
     q_near: npt.ArrayLike,
     *,
@@ -44,7 +48,7 @@ def solve_near(
     """The solution nearest ``q_near`` for every target pose.
 
     Args:
-        robot: The :class:`~robokin.robot.Robot`.
+        robot: The arm (a :class:`~robokin.robot.Robot` or its ``Arm``).
         T: Target tool poses (..., 4, 4) [m] in the world frame.
         q_near: Current configuration [rad, m], (n,) or (..., n) broadcasting to
             the targets.
@@ -63,44 +67,39 @@ def solve_near(
     Raises:
         InputError: a bad pose, ``q_near``, method or option.
     """
+    arm = arm_of(robot)
     if method not in _METHODS:
         raise InputError("method", f"expected one of {_METHODS}, got {method!r}")
-    q_near = check_finite(check_joints(q_near, robot.n, "q_near"), "q_near")
+    q_near = check_finite(check_joints(q_near, arm.n, "q_near"), "q_near")
     if method == "numeric" or options:
         if method == "analytic":
             raise InputError("options", f"{sorted(options)} are numeric-solver options; "
                                         "the closed form takes none")
-        return _numeric_near(robot, T, q_near, **options)
-    from robokin.kinematics.ik.analytic.detect import detect
-
-    fam = detect(robot)
+        return _numeric_near(arm, T, q_near, **options)
+    fam = detect(arm)
     if fam.solver is None:
         if method == "analytic":
-            raise InputError("method", f"no closed form for robot '{robot.name}': "
+            raise InputError("method", f"no closed form for robot '{arm.name}': "
                                        f"{fam.reason}")
-        return _numeric_near(robot, T, q_near)
-    sols = robot.ik(T, q_near=q_near, method="analytic")
-    return _nearest(robot, sols, T, q_near)
+        return _numeric_near(arm, T, q_near)
+    sols = solve(arm, T, q_near=q_near, method="analytic")
+    return _nearest(arm, sols, T, q_near)
 
 
-def _numeric_near(robot: RobotLike, T: npt.ArrayLike, q_near: np.ndarray,
+def _numeric_near(robot: Arm, T: npt.ArrayLike, q_near: np.ndarray,
                   **options: Any) -> IKResult:
     """The numeric solver started at ``q_near``.
 
     ``q_near`` is checked against the poses first, so a mismatch is reported as
     ``q_near``, the argument the caller passed.
     """
-    from robokin.kinematics.ik import numeric
-
     T = check_transform(T, "T")
     check_broadcasts(q_near, T.shape[:-2] + (robot.n,), "q_near")
     return numeric.solve(robot, T, q0=q_near, **options)
 
 
-def _nearest(robot: RobotLike, sols: SolutionSet, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
+def _nearest(robot: Arm, sols: SolutionSet, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
     """The row of ``sols`` nearest ``q_near`` per pose, inside the limits, as a result."""
-    from robokin._native import kernels
-
     lead, n = sols.shape, robot.n
     k = sols.q.shape[-2]
     if not lead and q_near.shape == (n,):  # one pose: no reshaping copies

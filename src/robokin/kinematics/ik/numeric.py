@@ -65,12 +65,11 @@ from robokin._validation import (
     check_transform,
 )
 from robokin.exceptions import InputError
-from robokin.kinematics.per_chain import cached
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.model.chain import Chain
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.solutions import SolutionSet
-    from robokin.kinematics.robot_like import RobotLike
 
 __all__ = ["IKPathResult", "IKResult", "ik_path", "parse_mask", "solve", "solve_all"]
 
@@ -182,9 +181,13 @@ class SeedTable:
         return self.rows, self.cell_start, self.grid
 
 
-def seed_table(chain: Chain) -> SeedTable:
-    """The chain's :class:`SeedTable` (built on first use, then cached)."""
-    return cached(chain, "numeric_seed_table", lambda: _build_seed_table(chain))
+def seed_table(robot: ArmSource) -> SeedTable:
+    """The arm's :class:`SeedTable` (built on first use, kept in its ``Arm``)."""
+    arm = arm_of(robot)
+    tab = arm.seed_table
+    if not isinstance(tab, SeedTable):
+        tab = arm.seed_table = _build_seed_table(arm.chain)
+    return tab
 
 
 def _build_seed_table(chain: Chain) -> SeedTable:
@@ -219,7 +222,8 @@ def _build_seed_table(chain: Chain) -> SeedTable:
 
 def _grid_cells(p: np.ndarray, origin: np.ndarray, inv: np.ndarray, G: int) -> np.ndarray:
     c = np.clip(np.floor((p - origin) * inv).astype(np.int64), 0, G - 1)
-    return (c[:, 0] * G + c[:, 1]) * G + c[:, 2]
+    cells: np.ndarray = (c[:, 0] * G + c[:, 1]) * G + c[:, 2]
+    return cells
 
 
 # kernel arguments for "no seed table" (a 0-row table)
@@ -347,7 +351,8 @@ def _opts(mask: Any, weights: Any, tol: Any, tol_rotation: Any, max_iterations: 
         except TypeError:
             key = hit = None
         if hit is not None:
-            return hit.copy()
+            again: np.ndarray = hit.copy()
+            return again
     opts = _make_opts(mask, weights, tol, tol_rotation, max_iterations, max_step)
     if key is not None and len(_OPTS_CACHE) < 256:
         _OPTS_CACHE[key] = opts.copy()
@@ -434,7 +439,7 @@ def _bad_target(Tf: np.ndarray, lead: tuple[int, ...], i: int) -> InputError:
 
 # ------------------------------------------------------------------------- solve
 def solve(
-    robot: RobotLike,
+    robot: ArmSource,
     T: npt.ArrayLike,
     *,
     q0: npt.ArrayLike | None = None,
@@ -452,7 +457,7 @@ def solve(
     """One joint solution per target pose, by damped least squares with restarts.
 
     Args:
-        robot: The :class:`~robokin.robot.Robot`.
+        robot: The arm (a :class:`~robokin.robot.Robot` or its ``Arm``).
         T: Target tool poses in the world frame, shape (..., 4, 4) [m].
         q0: Initial guess (..., n) or (n,) [rad, m]; default the middle of the
             limits (angles clipped to [-pi, pi]).
@@ -487,14 +492,14 @@ def solve(
         InputError: a bad pose (wrong shape, non-finite, not a rigid transform), a
             bad ``q0`` or option.
     """
-    return _solve(robot, T, q0=q0, mask=mask, weights=weights, tol=tol,
+    return _solve(arm_of(robot), T, q0=q0, mask=mask, weights=weights, tol=tol,
                   tol_rotation=tol_rotation, max_iterations=max_iterations,
                   max_restarts=max_restarts, max_time=max_time, max_step=max_step,
                   parallel=parallel, key=_seed_key(rng))
 
 
 def _solve(
-    robot: RobotLike,
+    arm: Arm,
     T: npt.ArrayLike,
     *,
     q0: npt.ArrayLike | None,
@@ -510,7 +515,7 @@ def _solve(
     key: int,
 ) -> IKResult:
     """:func:`solve` with the restart streams' key (``_seed_key``)."""
-    chain = robot.chain
+    chain = arm.chain
     packed = chain.arrays.packed
     n = chain.n
     Tf, lead = _targets(T)
@@ -540,7 +545,7 @@ def _solve(
     opts[K.O_N_SEEDS] = R
     if R and opts[K.O_TABLE_ROT] >= 0.0:
         opts[K.O_N_TABLE] = _TABLE_SEEDS
-        tab = seed_table(chain).kernel_args()
+        tab = seed_table(arm).kernel_args()
     else:
         tab = _NO_TABLE
     # random numbers only when some restart of this round is not a table one (the
@@ -642,7 +647,7 @@ _SOLVE_ALL_OPTIONS = frozenset(
 
 
 def solve_all(
-    robot: RobotLike,
+    robot: ArmSource,
     T: npt.ArrayLike,
     *,
     q_near: npt.ArrayLike | None = None,
@@ -662,7 +667,7 @@ def solve_all(
     continuum: the set is a sample of it.
 
     Args:
-        robot: The :class:`~robokin.robot.Robot`.
+        robot: The arm (a :class:`~robokin.robot.Robot` or its ``Arm``).
         T: Target poses (..., 4, 4) [m].
         q_near: Current configuration (..., n) or (n,), the first seed.
         n_seeds: Descents per target.
@@ -687,7 +692,8 @@ def solve_all(
             "options", f"unknown option(s) {unknown} for the numeric IK solver; accepted: "
             f"n_seeds, q_near, {', '.join(sorted(_SOLVE_ALL_OPTIONS))}"
         )
-    chain = robot.chain
+    arm = arm_of(robot)
+    chain = arm.chain
     arr = chain.arrays
     n = chain.n
     wrap = arr.wrap == 1.0
@@ -734,7 +740,7 @@ def solve_all(
     none = np.flatnonzero(~ok.any(axis=1))
     best_err = err.min(axis=1)
     if none.size and max_restarts > 0:
-        res = _solve(robot, Tf[none], q0=q[none, np.argmin(err[none], axis=1)],
+        res = _solve(arm, Tf[none], q0=q[none, np.argmin(err[none], axis=1)],
                      mask=options.get("mask"), weights=options.get("weights"),
                      tol=options.get("tol", 1e-9), tol_rotation=options.get("tol_rotation"),
                      max_iterations=options.get("max_iterations", 100),
@@ -788,7 +794,7 @@ def _mask_names(opts: np.ndarray) -> str:
 
 # -------------------------------------------------------------------------- ik_path
 def ik_path(
-    robot: RobotLike,
+    robot: ArmSource,
     T_path: npt.ArrayLike,
     q_start: npt.ArrayLike,
     *,
@@ -810,7 +816,7 @@ def ik_path(
     too coarsely near a singularity).
 
     Args:
-        robot: The :class:`~robokin.robot.Robot`.
+        robot: The arm (a :class:`~robokin.robot.Robot` or its ``Arm``).
         T_path: Poses (m, 4, 4) [m].
         q_start: Configuration (n,) the path starts from [rad, m].
         mask: Task rows, see :func:`parse_mask`.
@@ -827,7 +833,8 @@ def ik_path(
     Raises:
         InputError: bad poses (shape (m, 4, 4), rigid), ``q_start`` or options.
     """
-    chain = robot.chain
+    arm = arm_of(robot)
+    chain = arm.chain
     n = chain.n
     Tf, lead = _targets(T_path)
     if len(lead) != 1:

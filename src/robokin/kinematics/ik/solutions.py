@@ -19,17 +19,15 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from robokin._validation import check_broadcasts, check_finite, check_joints
 from robokin.exceptions import UnreachableError
+from robokin.kinematics.arm import ArmSource, arm_of
 from robokin.spatial import wrap_angle
-
-if TYPE_CHECKING:
-    from robokin.model.parts import RobotParts
 
 __all__ = ["SolutionSet", "wrap_angle"]
 
@@ -149,8 +147,8 @@ class SolutionSet:
 
     # ------------------------------------------------------------------ basics
     @classmethod
-    def empty(cls, lead: tuple[int, ...], n: int, is_revolute, limits, status: str,
-              method: str = "") -> SolutionSet:
+    def empty(cls, lead: tuple[int, ...], n: int, is_revolute: npt.ArrayLike,
+              limits: npt.ArrayLike, status: str, method: str = "") -> SolutionSet:
         """A set with no solution for any of the poses, all with ``status``."""
         st = np.empty(lead, dtype=object)
         st[...] = status
@@ -165,12 +163,13 @@ class SolutionSet:
     @property
     def n(self) -> int:
         """Number of joint coordinates."""
-        return self.q.shape[-1]
+        return int(self.q.shape[-1])
 
     @property
     def count(self) -> np.ndarray:
         """(...) number of valid solutions per pose."""
-        return self.valid.sum(axis=-1)
+        count: np.ndarray = self.valid.sum(axis=-1)
+        return count
 
     @property
     def singular(self) -> np.ndarray:
@@ -369,14 +368,20 @@ class SolutionSet:
         valid = self.valid[..., :, None] & inside
         lead = self.shape
         k, s = q.shape[-3], q.shape[-2]
-        flat = lambda a: a.reshape(lead + (k * s,) + a.shape[len(lead) + 2:])  # noqa: E731
-        rep = lambda a: flat(np.broadcast_to(a[..., :, None], lead + (k, s)))  # noqa: E731
+        def flat(a: np.ndarray) -> np.ndarray:
+            return a.reshape(lead + (k * s,) + a.shape[len(lead) + 2:])
+
+        def rep(a: np.ndarray) -> np.ndarray:
+            return flat(np.broadcast_to(a[..., :, None], lead + (k, s)))
+
         flags = {key: rep(v) for key, v in self.flags.items()}
         flags["within_limits"] = flat(inside)
         # Keep only columns that are valid somewhere, to bound the size.
         V = flat(valid)
         keep = V.reshape(-1, k * s).any(axis=0)
-        sel = lambda a: a[..., keep] if a.ndim == len(lead) + 1 else a[..., keep, :]  # noqa: E731
+        def sel(a: np.ndarray) -> np.ndarray:
+            return a[..., keep] if a.ndim == len(lead) + 1 else a[..., keep, :]
+
         return replace(
             self,
             q=sel(flat(q)),
@@ -386,12 +391,18 @@ class SolutionSet:
             error=None if self.error is None else sel(rep(self.error)),
         )
 
-    def to_actuator_space(self, robot: RobotParts) -> SolutionSet:
-        """The same set in motor coordinates (limits checked in both spaces)."""
-        lim = robot.actuator_limits
-        if robot.actuators is None or lim is None:  # limits come with the map
+    def to_actuator_space(self, robot: ArmSource) -> SolutionSet:
+        """The same set in motor coordinates (limits checked in both spaces).
+
+        Args:
+            robot: The arm (a Robot or its :class:`~robokin.kinematics.arm.Arm`),
+                whose actuator map and motor limits apply.
+        """
+        arm = arm_of(robot)
+        lim, actuators = arm.actuator_limits, arm.actuators
+        if actuators is None or lim is None:  # limits come with the map
             return self
-        phi = robot.actuators.inverse(self.q, what=f"actuator map of '{robot.name}'")
+        phi = actuators.inverse(self.q, what=f"actuator map of '{arm.name}'")
         inside = self.flags["within_limits"] & (
             (phi >= lim[:, 0] - 1e-9) & (phi <= lim[:, 1] + 1e-9)
         ).all(axis=-1)

@@ -243,7 +243,7 @@ def test_avx2_and_avx512_copies_agree_to_the_bit():
         robot = robokin.load(name)
         q = draw_configurations(robot, np.random.default_rng(1), 4000)
         T = np.ascontiguousarray(robot.fk(q))
-        P, packed = robokin.ik.family(robot).solver.params(), robot.chain.arrays.packed
+        P, packed = robokin.ik.family(robot).solver.params, robot.chain.arrays.packed
         a = _avx2.six_r_ik(P, T, np.ascontiguousarray(q), packed)
         b = _avx512.six_r_ik(P, T, np.ascontiguousarray(q), packed)
         for x, y in zip(a, b, strict=True):

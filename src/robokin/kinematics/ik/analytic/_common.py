@@ -8,7 +8,10 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin._native import kernels as _K
+from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.solutions import SolutionSet
+from robokin.model.chain import Chain
+from robokin.spatial import wrap_angle
 
 __all__ = ["STATUS_TEXT", "fit_turns", "fk_error", "make_set", "q_near_rows"]
 
@@ -32,7 +35,7 @@ def fit_turns(q: np.ndarray, is_revolute: np.ndarray, limits: np.ndarray) -> np.
     Prismatic values are left alone; a value no turn brings inside stays wrapped.
     """
     tw = 2.0 * np.pi
-    w = (q + np.pi) % tw - np.pi
+    w = wrap_angle(q)
     lo, hi = limits[:, 0], limits[:, 1]
     with np.errstate(invalid="ignore"):
         up = w + tw * np.ceil((lo - 1e-9 - w) / tw)
@@ -61,7 +64,7 @@ def q_near_rows(q_near: Any, lead: tuple[int, ...], n: int) -> np.ndarray:
     return np.ascontiguousarray(np.broadcast_to(qn, lead + (n,)).reshape(-1, n))
 
 
-def fk_error(chain: Any, q: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def fk_error(chain: Chain, q: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Position [m] and rotation [rad] error of FK(q) against T.
 
     Args:
@@ -85,7 +88,7 @@ def fk_error(chain: Any, q: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.n
 
 
 def make_set(
-    robot: Any,
+    robot: Arm,
     q: np.ndarray,
     valid: np.ndarray,
     *,
@@ -109,9 +112,14 @@ def make_set(
     )
 
 
-def branch_labels(lead: tuple[int, ...], table: dict[str, list[int]]) -> dict[str, np.ndarray]:
-    """Per-slot constant labels broadcast over the pose batch (read-only views)."""
-    key = (lead, id(table))
+def branch_labels(lead: tuple[int, ...],
+                  table: dict[str, tuple[int, ...]]) -> dict[str, np.ndarray]:
+    """Per-slot constant labels broadcast over the pose batch (read-only views).
+
+    The views are kept per batch shape and table (keyed by the table's values,
+    at most 65 kept).
+    """
+    key = (lead, tuple(table.items()))
     out = _LABEL_CACHE.get(key)
     if out is None:
         k = len(next(iter(table.values())))
@@ -123,4 +131,4 @@ def branch_labels(lead: tuple[int, ...], table: dict[str, list[int]]) -> dict[st
     return dict(out)
 
 
-_LABEL_CACHE: dict = {}
+_LABEL_CACHE: dict[Any, dict[str, np.ndarray]] = {}

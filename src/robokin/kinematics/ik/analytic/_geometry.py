@@ -1,7 +1,7 @@
 r"""The chain as a product of exponentials: joint axes and points at zero joint value.
 
 With every chain joint value ``v_k = 0`` (``J_k`` the identity) the frame just before
-joint ``k`` is ``P_k = C_0 C_1 ... C_{k-1}``; its z axis is the joint's unit axis
+joint ``k`` is ``P_k = C_0 C_1 ... C_{k-1}`` (``Chain.frames_at``, the model's walk); its z axis is the joint's unit axis
 ``h_k`` and its origin a point ``o_k`` on it (base frame). Then
 
 .. math::
@@ -47,17 +47,21 @@ class Poe:
 
 
 def poe_from_chain(chain: Chain) -> Poe:
-    """The chain's axes and points at ``v = 0`` (see the module docstring)."""
-    consts = chain.arrays.consts
+    """The chain's axes and points at ``v = 0`` (see the module docstring).
+
+    The frames come from the model's one walk along the chain
+    (:meth:`~robokin.model.chain.Chain.frames_at`), at the chain values that put
+    every joint at ``v = 0`` (``q_chain = -sign * offset``, exact: signs are +-1),
+    which exist for coupled chains too (no coordinates ``q`` need give them).
+    """
+    arr = chain.arrays
+    frames = chain.frames_at(-arr.sign * arr.offset)
     nc = chain.n_chain
-    P = consts[0].copy()
     h = np.empty((nc, 3))
-    o = np.empty((nc, 3))
     for k in range(nc):
-        h[k] = P[:3, 2] / np.linalg.norm(P[:3, 2])
-        o[k] = P[:3, 3]
-        P = P @ consts[k + 1]
-    return Poe(h, o, np.asarray(chain.arrays.kind, dtype=bool).copy(), P)
+        h[k] = frames[k, :3, 2] / np.linalg.norm(frames[k, :3, 2])
+    o = frames[:nc, :3, 3].copy()
+    return Poe(h, o, np.asarray(arr.kind, dtype=bool).copy(), frames[nc].copy())
 
 
 def angle_between_axes(a: np.ndarray, b: np.ndarray) -> float:
@@ -91,5 +95,6 @@ def closest_point(origins: np.ndarray, axes: np.ndarray) -> np.ndarray:
 def unit_perpendicular(h: np.ndarray) -> np.ndarray:
     """A unit vector perpendicular to ``h``."""
     e = np.eye(3)[int(np.argmin(np.abs(h)))]
-    v = e - np.dot(e, h) * h
-    return v / np.linalg.norm(v)
+    v: np.ndarray = e - np.dot(e, h) * h
+    unit: np.ndarray = v / np.linalg.norm(v)
+    return unit

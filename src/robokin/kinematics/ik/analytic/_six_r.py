@@ -15,6 +15,7 @@ import numpy as np
 
 from robokin._native import kernels as K
 from robokin._native import single as single_copy
+from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.analytic._common import (
     STATUS_TEXT,
     branch_labels,
@@ -29,16 +30,17 @@ from robokin.kinematics.ik.analytic._geometry import (
     unit_perpendicular,
 )
 from robokin.kinematics.ik.solutions import SolutionSet
+from robokin.model.chain import Chain
 
 __all__ = ["POSE_TOL", "SINGULAR_TOL", "make_single", "pack", "raw_solve", "solve_six_r"]
 
 Kind = Literal["three_parallel", "spherical_wrist"]
 
 # slot = 4 * shoulder + 2 * elbow + wrist; 0 -> +1 ('+' root), 1 -> -1
-_LABELS = {
-    "shoulder": [1, 1, 1, 1, -1, -1, -1, -1],
-    "elbow": [1, 1, -1, -1, 1, 1, -1, -1],
-    "wrist": [1, -1, 1, -1, 1, -1, 1, -1],
+_LABELS: dict[str, tuple[int, ...]] = {
+    "shoulder": (1, 1, 1, 1, -1, -1, -1, -1),
+    "elbow": (1, 1, -1, -1, 1, 1, -1, -1),
+    "wrist": (1, -1, 1, -1, 1, -1, 1, -1),
 }
 # Below this many poses the kernel runs on one thread (the pool's launch costs more).
 _PARALLEL_MIN = K.SIX_R_PARALLEL_MIN
@@ -53,7 +55,7 @@ POSE_TOL = 1e-12
 SPLIT_TOL = 0.4 * POSE_TOL
 
 
-def pack(chain: Any, kind: Kind, *, singular_tol: float = SINGULAR_TOL,
+def pack(chain: Chain, kind: Kind, *, singular_tol: float = SINGULAR_TOL,
          disc_tol: float = 1e-10, mirror: bool = False, check_all: bool = False,
          poe: Poe | None = None) -> np.ndarray:
     """The kernel parameter vector of a 6R chain (layout in ``csrc/six_r.c``).
@@ -170,7 +172,7 @@ _NO_Q_NEAR = np.full((1, 6), np.nan)  # no preference at the wrist singularity
 _NO_Q_NEAR.setflags(write=False)
 
 
-def make_single(chain: Any, params: np.ndarray, *, method: str,
+def make_single(chain: Chain, params: np.ndarray, *, method: str,
                 info: dict[str, Any]) -> Any:
     """The single-pose hot path of an exact (not near-family) 6R arm.
 
@@ -211,7 +213,7 @@ def make_single(chain: Any, params: np.ndarray, *, method: str,
 
 
 def solve_six_r(
-    robot: Any,
+    robot: Arm,
     T: np.ndarray,
     q_near: np.ndarray | None,
     *,

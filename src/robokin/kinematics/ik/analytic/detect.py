@@ -25,34 +25,51 @@ Families, tried in this order:
   Newton polish because that misses solutions the calibration error moves away
   from the nominal ones (measured in ``docs/ik.md``).
 
-Detection is cached per chain (chains are immutable).
+Detection is kept in the arm's :class:`~robokin.kinematics.arm.Arm` (chains are
+immutable); each family's solver is a declared record taking the arm as an argument,
+with the option names it accepts (the dispatcher checks them before calling).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol, TypeAlias
 
 import numpy as np
+import numpy.typing as npt
 
+from robokin.kinematics.arm import Arm, ArmSource, FamilyKey, arm_of
 from robokin.kinematics.ik.analytic import general_6r as _g6
 from robokin.kinematics.ik.analytic import palletizer as _pal
 from robokin.kinematics.ik.analytic import pieper as _pk
 from robokin.kinematics.ik.analytic import scara as _scara
 from robokin.kinematics.ik.analytic import spherical_wrist as _sw
 from robokin.kinematics.ik.analytic import three_parallel as _tp
-from robokin.kinematics.ik.analytic._geometry import poe_from_chain
-from robokin.kinematics.per_chain import cached
+from robokin.kinematics.ik.analytic._geometry import Poe, poe_from_chain
+from robokin.kinematics.ik.analytic._six_r import SINGULAR_TOL
+from robokin.model.chain import Chain
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.analytic._six_r import Kind
+    from robokin.kinematics.ik.solutions import SolutionSet
 
-__all__ = ["Family", "detect"]
+__all__ = ["Family", "FamilySolver", "SingleSolver", "detect"]
 
 EXACT_TOL = 1e-9
 NEAR_ANGLE = 5e-3
 NEAR_DISTANCE = 5e-3
+
+
+class SingleSolver(Protocol):
+    """The single-pose hot path: ``single(T, q6) -> SolutionSet | None``.
+
+    One pose ``T`` (4, 4) float64, default options; ``q6`` is the joint-6 value kept
+    at a wrist singularity. None when T is not a rigid transform (the caller
+    re-checks it and raises the detailed error).
+    """
+
+    def __call__(self, T: npt.NDArray[np.float64], q6: float, /) -> SolutionSet | None:
+        """The solutions of one pose, or None."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -60,10 +77,9 @@ class Family:
     """The closed-form family of an arm.
 
     Attributes:
-        name: ``"three_parallel"``, ``"spherical_wrist"``, ``"scara"``,
+        name: ``"three_parallel"``, ``"spherical_wrist"``, ``"pieper"``, ``"scara"``,
             ``"palletizer"``, ``"general_6r"``, or ``"none"``.
-        solver: ``solver(robot, T, q_near=None, **options) -> SolutionSet``, or
-            None when no closed form applies.
+        solver: A :class:`FamilySolver`, or None when no closed form applies.
         reason: Why no closed form applies ("" when one does).
         measured: What the detector measured, e.g. "axes 2-4 parallel within
             3.0e-04 rad; axes 5, 6 meet within 2.1e-05 m".
@@ -71,15 +87,19 @@ class Family:
             is polished by Newton steps on the true chain).
         deviation: The largest measured angle [rad] / distance [m] from the family.
         details: Every family's measurement (name -> text).
+        options: The option names ``solver`` accepts (checked before calling it).
+        single: The single-pose hot path (:class:`SingleSolver`), or None.
     """
 
     name: str
-    solver: Callable[..., Any] | None
+    solver: FamilySolver | None
     reason: str = ""
     measured: str = ""
     near: bool = False
     deviation: float = 0.0
     details: dict[str, str] = field(default_factory=dict)
+    options: frozenset[str] = frozenset()
+    single: SingleSolver | None = None
 
     def __str__(self) -> str:
         """One line: the family and what was measured, or why there is none."""
@@ -89,11 +109,120 @@ class Family:
         return f"{self.name}{tag}: {self.measured}"
 
 
+#: The options of each family's solver (the keyword-only parameters of the
+#: function it calls; ``tests/kinematics/ik/test_analytic_detect.py`` ties them).
+SIX_R_OPTIONS = frozenset({"singular_tol", "compute_error", "polish_iterations", "tol"})
+SCARA_OPTIONS = frozenset({"orientation_tol", "compute_error"})
+PALLETIZER_OPTIONS = frozenset({"level_tol", "compute_error"})
+PIEPER_OPTIONS = frozenset({"compute_error"})
+GENERAL_6R_OPTIONS = frozenset({"singular_tol", "compute_error", "parallel"})
 
 
-def detect(robot: Any, *, tol: float = EXACT_TOL, near_angle: float = NEAR_ANGLE,
+@dataclass(frozen=True, eq=False)
+class SixRSolver:
+    """The closed form of a three-parallel or spherical-wrist arm.
+
+    Attributes:
+        kind: The family name (``_six_r.Kind``).
+        poe: The chain's product-of-exponentials description.
+        near: A near-family arm (seeds mirrored, Newton polish).
+        deviation: The measured deviation from the family [rad or m].
+        method: The sets' ``method`` text.
+        info: The sets' ``info``.
+        params: The packed parameters at the default ``singular_tol``
+            (``_six_r.SINGULAR_TOL``).
+        tuned: Parameters packed for other ``singular_tol`` values.
+    """
+
+    kind: Kind
+    poe: Poe
+    near: bool
+    deviation: float
+    method: str
+    info: dict[str, Any]
+    params: npt.NDArray[np.float64]
+    tuned: dict[float, npt.NDArray[np.float64]] = field(default_factory=dict)
+
+    def __call__(self, robot: ArmSource, T: npt.NDArray[np.float64],
+                 q_near: npt.NDArray[np.float64] | None = None, *,
+                 singular_tol: float = SINGULAR_TOL, compute_error: bool = False,
+                 polish_iterations: int = 8, tol: float = 1e-9) -> SolutionSet:
+        """Every solution for poses T (..., 4, 4); see ``_six_r.solve_six_r``."""
+        from robokin.kinematics.ik.analytic._six_r import solve_six_r
+
+        arm = arm_of(robot)
+        P = self.params if singular_tol == SINGULAR_TOL else self.tuned.get(singular_tol)
+        if P is None:
+            P = self.tuned[singular_tol] = self.pack(arm.chain, singular_tol)
+        return solve_six_r(arm, T, q_near, params=P, method=self.method, info=self.info,
+                           near=self.near, compute_error=compute_error,
+                           polish_iterations=polish_iterations, tol=tol)
+
+    def pack(self, chain: Chain, singular_tol: float = SINGULAR_TOL) -> npt.NDArray[np.float64]:
+        """The kernel parameters of ``chain`` (this family's) at ``singular_tol``."""
+        from robokin.kinematics.ik.analytic._six_r import pack
+
+        if self.near:  # seeds past a boundary the nominal geometry moved: mirror them
+            return pack(chain, self.kind, singular_tol=singular_tol, poe=self.poe,
+                        disc_tol=min(0.5, 100.0 * self.deviation), mirror=True)
+        return pack(chain, self.kind, singular_tol=singular_tol, poe=self.poe)
+
+
+@dataclass(frozen=True, eq=False)
+class ScaraSolver:
+    """The SCARA closed form (``scara.solve_geometry``) of one geometry."""
+
+    geometry: _scara.ScaraGeometry
+
+    def __call__(self, robot: ArmSource, T: npt.NDArray[np.float64],
+                 q_near: npt.NDArray[np.float64] | None = None, *,
+                 orientation_tol: float = 1e-9, compute_error: bool = False) -> SolutionSet:
+        """Every solution (up to 2) for poses T (..., 4, 4)."""
+        return _scara.solve_geometry(arm_of(robot), self.geometry, T,
+                                     orientation_tol=orientation_tol,
+                                     compute_error=compute_error)
+
+
+@dataclass(frozen=True, eq=False)
+class PalletizerSolver:
+    """The level-tool palletizer closed form (``palletizer.solve_geometry``)."""
+
+    geometry: _pal.PalletizerGeometry
+
+    def __call__(self, robot: ArmSource, T: npt.NDArray[np.float64],
+                 q_near: npt.NDArray[np.float64] | None = None, *,
+                 level_tol: float = 1e-9, compute_error: bool = False) -> SolutionSet:
+        """Every solution (up to 4) for poses T (..., 4, 4)."""
+        return _pal.solve_geometry(arm_of(robot), self.geometry, T, level_tol=level_tol,
+                                   compute_error=compute_error)
+
+
+@dataclass(frozen=True, eq=False)
+class General6RSolver:
+    """The general 6R elimination (``general_6r.solve``); its set-up is the arm's."""
+
+    def __call__(self, robot: ArmSource, T: npt.NDArray[np.float64],
+                 q_near: npt.NDArray[np.float64] | None = None, *,
+                 singular_tol: float = 1e-6, compute_error: bool = False,
+                 parallel: bool | None = None) -> SolutionSet:
+        """Every solution for poses T (..., 4, 4)."""
+        return _g6.solve(arm_of(robot), T, q_near, singular_tol=singular_tol,
+                         compute_error=compute_error, parallel=parallel)
+
+
+#: A family's solver: ``solver(robot, T, q_near=None, **options) -> SolutionSet``
+#: (``robot`` an :class:`~robokin.kinematics.arm.Arm` or a Robot, ``T`` validated
+#: poses (..., 4, 4) [m]), one of these declared records; its options are the
+#: keyword-only parameters of its ``__call__`` (``Family.options``).
+FamilySolver: TypeAlias = (
+    "SixRSolver | ScaraSolver | PalletizerSolver | _pk.FamilySolver | General6RSolver")
+
+
+def detect(robot: ArmSource, *, tol: float = EXACT_TOL, near_angle: float = NEAR_ANGLE,
            near_distance: float = NEAR_DISTANCE, general_6r: bool = True) -> Family:
-    """The closed-form family of ``robot`` (a Robot or a Chain).
+    """The closed-form family of ``robot`` (a Robot, an Arm or a Chain).
+
+    Kept in the arm (a bare Chain is detected afresh on every call).
 
     Args:
         robot: The arm.
@@ -107,9 +236,25 @@ def detect(robot: Any, *, tol: float = EXACT_TOL, near_angle: float = NEAR_ANGLE
     Returns:
         A :class:`Family`.
     """
-    chain = getattr(robot, "chain", robot)
-    return cached(chain, ("ik_family", tol, near_angle, near_distance, general_6r),
-                  lambda: _detect(chain, tol, near_angle, near_distance, general_6r))
+    arm = arm_of(robot)
+    key: FamilyKey = (tol, near_angle, near_distance, general_6r)
+    if key == _DEFAULT_KEY:
+        return default_family(arm)
+    fam = arm.families.get(key)
+    if not isinstance(fam, Family):
+        fam = arm.families[key] = _detect(arm, *key)
+    return fam
+
+
+def default_family(arm: Arm) -> Family:
+    """The arm's family at the default settings (detected on first use, kept)."""
+    fam = arm.family
+    if not isinstance(fam, Family):
+        fam = arm.family = _detect(arm, *_DEFAULT_KEY)
+    return fam
+
+
+_DEFAULT_KEY: FamilyKey = (EXACT_TOL, NEAR_ANGLE, NEAR_DISTANCE, True)
 
 
 def _none(reason: str, details: dict[str, str] | None = None) -> Family:
@@ -125,8 +270,9 @@ def _grade(ang: float, dist: float, tol: float, near_angle: float,
     return None
 
 
-def _detect(chain: Any, tol: float, near_angle: float, near_distance: float,
+def _detect(arm: Arm, tol: float, near_angle: float, near_distance: float,
             general_6r: bool = True) -> Family:
+    chain = arm.chain
     nc, n = chain.n_chain, chain.n
     poe = poe_from_chain(chain)
     n_pri = int(poe.prismatic.sum())
@@ -137,38 +283,7 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float,
         if not chain.coupling.is_identity:
             return _none("a 6R arm with dependent joints: no closed form here, and "
                          + _g6.why_not(chain))
-        found = []
-        details = {}
-        for mod in (_tp, _sw):
-            ang, dist, text, why = mod.measure(poe)
-            details[mod.NAME] = text
-            if why:
-                details[mod.NAME] += f" ({why})"
-                continue
-            grade = _grade(ang, dist, tol, near_angle, near_distance)
-            if grade is not None:
-                found.append((grade != "exact", max(ang, dist), mod, text))
-        found.sort(key=lambda f: (f[0], f[1]))
-        if found and not found[0][0]:  # an exact closed form
-            _, dev, mod, text = found[0]
-            return _six_r_family(chain, poe, mod.NAME, text, False, dev, details)
-        pieper = _pieper_family(chain, details, tol)
-        if pieper.solver is not None:
-            return pieper
-        details = pieper.details
-        if general_6r:
-            general = _general_6r_family(chain, details)
-            if general.solver is not None:
-                return general
-            details = general.details
-        if found:  # near family: the nominal closed form + Newton polish
-            _, dev, mod, text = found[0]
-            return _six_r_family(chain, poe, mod.NAME, text, True, dev, details)
-        return _none(
-            "6R arm without three parallel axes (2-4) with meeting axes 5, 6, without "
-            "a spherical wrist with parallel axes 2, 3, and not solved by the general "
-            "6R elimination: " + "; ".join(f"{k}: {v}" for k, v in details.items()),
-            details)
+        return _detect_6r(arm, poe, tol, near_angle, near_distance, general_6r)
     if nc == 4 and n == 4:
         if n_pri != 1 or not chain.coupling.is_identity:
             return _none(f"a 4-joint arm with {n_pri} prismatic joint(s): the SCARA "
@@ -177,13 +292,8 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float,
         if why or ang > tol:
             return _none(f"not a SCARA: {text}" + (f" ({why})" if why else ""),
                          {"scara": text})
-        g = _scara.geometry(poe)
-
-        def scara_solver(robot, T, q_near=None, **options):
-            return _scara.solve_geometry(robot, g, T, **options)
-
-        return Family("scara", scara_solver, measured=text, deviation=ang,
-                      details={"scara": text})
+        return Family("scara", ScaraSolver(_scara.geometry(poe)), measured=text,
+                      deviation=ang, details={"scara": text}, options=SCARA_OPTIONS)
     if n == 4 and nc == 5:
         if n_pri:
             return _none("a 4-axis arm on 5 chain joints with a prismatic joint")
@@ -191,13 +301,9 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float,
         if why or ang > tol:
             return _none(f"not a level-tool palletizer: {text}"
                          + (f" ({why})" if why else ""), {"palletizer": text})
-        pal = _pal.geometry(chain, poe)
-
-        def pal_solver(robot, T, q_near=None, **options):
-            return _pal.solve_geometry(robot, pal, T, **options)
-
-        return Family("palletizer", pal_solver, measured=text, deviation=ang,
-                      details={"palletizer": text})
+        return Family("palletizer", PalletizerSolver(_pal.geometry(chain, poe)),
+                      measured=text, deviation=ang, details={"palletizer": text},
+                      options=PALLETIZER_OPTIONS)
     return _none(
         f"{n} joint coordinates on {nc} chain joints: the closed forms cover 6R arms "
         "(three parallel axes, spherical wrist), 4-axis SCARA (R-R-R-P) and the "
@@ -205,7 +311,45 @@ def _detect(chain: Any, tol: float, near_angle: float, near_distance: float,
     )
 
 
-def _pieper_family(chain: Any, details: dict[str, str], tol: float) -> Family:
+def _detect_6r(arm: Arm, poe: Poe, tol: float, near_angle: float, near_distance: float,
+               general_6r: bool) -> Family:
+    """The family of a 6R arm without dependent joints, in the module's order."""
+    chain = arm.chain
+    found = []
+    details = {}
+    for mod in (_tp, _sw):
+        ang, dist, text, why = mod.measure(poe)
+        details[mod.NAME] = text
+        if why:
+            details[mod.NAME] += f" ({why})"
+            continue
+        grade = _grade(ang, dist, tol, near_angle, near_distance)
+        if grade is not None:
+            found.append((grade != "exact", max(ang, dist), mod.NAME, text))
+    found.sort(key=lambda f: (f[0], f[1]))
+    if found and not found[0][0]:  # an exact closed form
+        _, dev, name, text = found[0]
+        return _six_r_family(chain, poe, name, text, False, dev, details)
+    pieper = _pieper_family(chain, details, tol)
+    if pieper.solver is not None:
+        return pieper
+    details = pieper.details
+    if general_6r:
+        general = _general_6r_family(arm, details)
+        if general.solver is not None:
+            return general
+        details = general.details
+    if found:  # near family: the nominal closed form + Newton polish
+        _, dev, name, text = found[0]
+        return _six_r_family(chain, poe, name, text, True, dev, details)
+    return _none(
+        "6R arm without three parallel axes (2-4) with meeting axes 5, 6, without "
+        "a spherical wrist with parallel axes 2, 3, and not solved by the general "
+        "6R elimination: " + "; ".join(f"{k}: {v}" for k, v in details.items()),
+        details)
+
+
+def _pieper_family(chain: Chain, details: dict[str, str], tol: float) -> Family:
     """The ``pieper`` closed form when an axis triple of ``chain`` meets exactly.
 
     Else a "none" family whose details say why.
@@ -217,57 +361,37 @@ def _pieper_family(chain: Any, details: dict[str, str], tol: float) -> Family:
         return _none(setup.reason, details)
     details[_pk.NAME] = setup.measured
     solver = _pk.family_solver(chain, setup)
-    return Family(_pk.NAME, solver, measured=setup.measured, details=details)
+    return Family(_pk.NAME, solver, measured=setup.measured, details=details,
+                  options=PIEPER_OPTIONS, single=solver.single)
 
 
-def _general_6r_family(chain: Any, details: dict[str, str]) -> Family:
-    """The general 6R solver when its set-up works for ``chain``.
+def _general_6r_family(arm: Arm, details: dict[str, str]) -> Family:
+    """The general 6R solver when its set-up works for the arm.
 
     Else a "none" family whose details say why.
     """
-    setup = _g6.setup(chain)
+    setup = _g6.setup(arm)
     details = dict(details)
     if setup.params is None:
         details[_g6.NAME] = setup.reason
         return _none(setup.reason, details)
     details[_g6.NAME] = setup.measured
-
-    def general_solver(robot, T, q_near=None, **options):
-        return _g6.solve(robot, T, q_near, **options)
-
-    general_solver.single = _g6.make_single(chain)  # type: ignore[attr-defined]
-    return Family(_g6.NAME, general_solver, measured=setup.measured, details=details)
+    return Family(_g6.NAME, General6RSolver(), measured=setup.measured, details=details,
+                  options=GENERAL_6R_OPTIONS, single=_g6.make_single(arm))
 
 
-def _six_r_family(chain: Any, poe: Any, name: Kind, text: str, near: bool, dev: float,
+def _six_r_family(chain: Chain, poe: Poe, name: Kind, text: str, near: bool, dev: float,
                   details: dict[str, str]) -> Family:
-    from robokin.kinematics.ik.analytic._six_r import (
-        SINGULAR_TOL,
-        make_single,
-        pack,
-        solve_six_r,
-    )
+    """A three-parallel or spherical-wrist family (near: + Newton polish)."""
+    from robokin.kinematics.ik.analytic._six_r import make_single, pack
 
-    params_cache: dict[tuple[float, float], np.ndarray] = {}
     method = f"analytic:{name}" + ("+newton" if near else "")
-    info = {"family": name, "measured": text, "near_family": near}
-
-    def solver(robot, T, q_near=None, *, singular_tol: float = SINGULAR_TOL,
-               compute_error: bool = False, **options):
-        key = (singular_tol, 1e-12)
-        P = params_cache.get(key)
-        if P is None:
-            if near:  # seeds past a boundary the nominal geometry moved: mirror them
-                P = pack(chain, name, singular_tol=singular_tol, poe=poe,
-                         disc_tol=min(0.5, 100.0 * dev), mirror=True)
-            else:
-                P = pack(chain, name, singular_tol=singular_tol, poe=poe)
-            params_cache[key] = P
-        return solve_six_r(robot, T, q_near, params=P, method=method,
-                           info=info, near=near, compute_error=compute_error, **options)
-
-    solver.params = lambda: pack(chain, name, poe=poe)  # type: ignore[attr-defined]
+    info: dict[str, Any] = {"family": name, "measured": text, "near_family": near}
+    nominal = pack(chain, name, poe=poe)
+    solver = SixRSolver(name, poe, near, dev, method, info, nominal)
+    if near:
+        solver = SixRSolver(name, poe, near, dev, method, info, solver.pack(chain))
     # the single-pose hot path (default options, exact family only)
-    solver.single = None if near else make_single(  # type: ignore[attr-defined]
-        chain, pack(chain, name, poe=poe), method=method, info=info)
-    return Family(name, solver, measured=text, near=near, deviation=dev, details=details)
+    single = None if near else make_single(chain, nominal, method=method, info=info)
+    return Family(name, solver, measured=text, near=near, deviation=dev, details=details,
+                  options=SIX_R_OPTIONS, single=single)

@@ -15,7 +15,7 @@ generalized characteristic polynomial). Every candidate is polished by Newton st
 on the true chain and kept only when it reproduces the pose to ``SOLUTION_TOL``
 (rotation [rad]; position [m] per metre of arm, ``scale``).
 
-This module does the per-arm set-up, once per chain (cached with the chain):
+This module does the per-arm set-up, once per chain (kept in its ``Arm``):
 
 * **fit**: the left side of each split is linear in 27 pose-independent monomials;
   their coefficients are fitted by least squares from rows the kernel computes
@@ -53,17 +53,21 @@ References:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robokin import _native
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.forward import forward_kinematics
 from robokin.kinematics.ik.analytic._common import fk_error, make_set
 from robokin.kinematics.ik.analytic._geometry import poe_from_chain
 from robokin.kinematics.jacobian import min_singular_value
-from robokin.kinematics.per_chain import cached
-from robokin.spatial import invert
+from robokin.model.chain import Chain
+from robokin.spatial import invert, wrap_angle
+
+if TYPE_CHECKING:
+    from robokin.kinematics.ik.solutions import SolutionSet
 
 __all__ = ["NAME", "General6R", "Variant", "make_single", "raw_solve", "setup", "solve",
            "why_not"]
@@ -145,7 +149,7 @@ class General6R:
     variants: tuple[Variant, ...] = ()
 
 
-def why_not(chain: Any) -> str:
+def why_not(chain: Chain) -> str:
     """Why the general 6R solver does not take ``chain`` ("" when it does).
 
     The structural reasons only (joint kinds and count, dependent joints); the
@@ -162,12 +166,16 @@ def why_not(chain: Any) -> str:
     return ""
 
 
-def setup(chain: Any) -> General6R:
-    """The set-up of ``chain`` (fits and variant choice), computed once per chain."""
-    return cached(chain, ("general_6r", SETUP_POSES), lambda: _setup(chain))
+def setup(robot: ArmSource) -> General6R:
+    """The set-up of the arm's chain (fits and variant choice), kept in its Arm."""
+    arm = arm_of(robot)
+    g = arm.general_6r
+    if not isinstance(g, General6R):
+        g = arm.general_6r = _setup(arm.chain)
+    return g
 
 
-def _scale(chain: Any) -> float:
+def _scale(chain: Chain) -> float:
     """The arm's length scale [m] (see :class:`General6R`)."""
     poe = poe_from_chain(chain)
     far = max(float(np.linalg.norm(poe.o, axis=1).max()),
@@ -178,7 +186,7 @@ def _scale(chain: Any) -> float:
 # ----------------------------------------------------------------- the fit
 
 
-def _direction_consts(chain: Any, reverse: bool) -> np.ndarray:
+def _direction_consts(chain: Chain, reverse: bool) -> np.ndarray:
     """C'_0 .. C'_6 of the chain (or of its reversal, C'_k = C_{6-k}^-1), (7, 4, 4)."""
     C = np.array(chain.arrays.consts, dtype=np.float64)
     return np.ascontiguousarray(invert(C[::-1]) if reverse else C)
@@ -235,7 +243,7 @@ def _params(blocks: list[np.ndarray], scale: float, fallback: bool = True) -> np
 # -------------------------------------------------------------- the kernel
 
 
-def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
+def raw_solve(chain: Chain, params: np.ndarray, T: np.ndarray,
               parallel: bool | None = None) -> tuple[np.ndarray, ...]:
     """The bare kernel call.
 
@@ -267,9 +275,9 @@ def raw_solve(chain: Any, params: np.ndarray, T: np.ndarray,
 
 def _close(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(len(a), len(b)) bool: configurations equal modulo 2 pi within DEDUPE_TOL."""
-    d = a[:, None, :] - b[None, :, :]
-    d -= (2.0 * np.pi) * np.rint(d / (2.0 * np.pi))
-    return np.abs(d).max(axis=-1) < 10 * DEDUPE_TOL
+    d = wrap_angle(a[:, None, :] - b[None, :, :])
+    close: np.ndarray = np.abs(d).max(axis=-1) < 10 * DEDUPE_TOL
+    return close
 
 
 def _union(sets: list[np.ndarray]) -> np.ndarray:
@@ -284,7 +292,7 @@ def _union(sets: list[np.ndarray]) -> np.ndarray:
     return out
 
 
-def _setup_configurations(chain: Any, rng: np.random.Generator, scale: float
+def _setup_configurations(chain: Chain, rng: np.random.Generator, scale: float
                           ) -> np.ndarray:
     """Set-up configurations, (<= 2 SETUP_POSES, 6) joint values.
 
@@ -330,7 +338,7 @@ class _Trial:
                 self.clusters, self.tail)
 
 
-def _fits(chain: Any, rng: np.random.Generator) -> dict[Variant, np.ndarray] | str:
+def _fits(chain: Chain, rng: np.random.Generator) -> dict[Variant, np.ndarray] | str:
     """Every variant's kernel block, or why the fit failed."""
     blocks = {}
     for rev in (False, True):
@@ -350,7 +358,7 @@ def _solutions(run: tuple[np.ndarray, ...]) -> list[np.ndarray]:
     return [run[0][i][run[1][i]] for i in range(len(run[0]))]
 
 
-def _trials(chain: Any, blocks: dict[Variant, np.ndarray], q: np.ndarray, scale: float
+def _trials(chain: Chain, blocks: dict[Variant, np.ndarray], q: np.ndarray, scale: float
             ) -> tuple[dict[Variant, _Trial], list[np.ndarray]]:
     """Each variant alone on the poses of q, against the reference.
 
@@ -399,7 +407,7 @@ def _ranked_pairs(trials: dict[Variant, _Trial]) -> list[tuple[Variant, Variant]
     return pairs
 
 
-def _degenerate_arm(chain: Any, q: np.ndarray, scale: float) -> str:
+def _degenerate_arm(chain: Chain, q: np.ndarray, scale: float) -> str:
     """Why the arm has no finite solution sets ("" when its Jacobian has full rank)."""
     smin = min_singular_value(chain, q)
     if (smin > RANK_TOL * scale).any():
@@ -410,7 +418,7 @@ def _degenerate_arm(chain: Any, q: np.ndarray, scale: float) -> str:
             "many solutions and there is no finite set to find")
 
 
-def _setup(chain: Any) -> General6R:
+def _setup(chain: Chain) -> General6R:
     reason = why_not(chain)
     if reason:
         return General6R(None, reason=reason)
@@ -488,9 +496,9 @@ def _fallbacks(trials: dict[Variant, _Trial], p: Variant, s: Variant) -> list[Va
 # -------------------------------------------------------------- the solver
 
 
-def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
+def solve(robot: ArmSource, T: np.ndarray, q_near: np.ndarray | None = None, *,
           singular_tol: float = 1e-6, compute_error: bool = False,
-          parallel: bool | None = None) -> Any:
+          parallel: bool | None = None) -> SolutionSet:
     """Every solution of a general 6R arm for poses T (..., 4, 4).
 
     Args:
@@ -523,10 +531,11 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
     )
     from robokin.exceptions import InputError
 
-    chain = robot.chain
-    g = setup(chain)
+    arm = arm_of(robot)
+    chain = arm.chain
+    g = setup(arm)
     if g.params is None:
-        raise InputError("robot", f"'{robot.name}' is not solved by {NAME}: {g.reason}")
+        raise InputError("robot", f"'{arm.name}' is not solved by {NAME}: {g.reason}")
     T = check_poses_fast(T, "T")
     lead = T.shape[:-2]
     if q_near is not None:
@@ -543,13 +552,13 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
         error = np.where(valid, np.hypot(dp, dr), np.inf)
     info = {"family": NAME, "variant": str(g.primary), "secondary": str(g.secondary),
             "secondary_runs": int(((diag & K.G6F_SECONDARY) != 0).sum())}
-    return make_set(robot, Q, valid, inside=inside.reshape(shape),
+    return make_set(arm, Q, valid, inside=inside.reshape(shape),
                     singular=(sigma < singular_tol).reshape(shape), branches={},
                     status_codes=_STATUS[status].reshape(lead), method=NAME, info=info,
                     error=error)
 
 
-def make_single(chain: Any) -> Any:
+def make_single(arm: Arm) -> Any:
     """The single-pose hot path: ``single(T, q6) -> SolutionSet | None``.
 
     For one pose ``T`` (4, 4) float64 with default options (``q6``, the closed forms' joint-6
@@ -560,7 +569,8 @@ def make_single(chain: Any) -> Any:
     from robokin.kinematics.ik.analytic._common import STATUS_TEXT
     from robokin.kinematics.ik.solutions import SolutionSet
 
-    g = setup(chain)
+    g = setup(arm)
+    chain = arm.chain
     packed, params = chain.arrays.packed, g.params
     if params is None:
         raise ValueError(f"general_6r is not offered for this chain: {g.reason}")

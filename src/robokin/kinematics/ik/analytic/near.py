@@ -19,13 +19,13 @@ from robokin.kinematics.ik.analytic._common import fit_turns, fk_error, inside_l
 from robokin.spatial import pose_error, wrap_angle
 
 if TYPE_CHECKING:
-    from robokin.kinematics.robot_like import RobotLike
+    from robokin.kinematics.arm import Arm
 
 __all__ = ["polish"]
 
 
 def polish(
-    robot: RobotLike,
+    robot: Arm,
     T: np.ndarray,
     Q: np.ndarray,
     valid: np.ndarray,

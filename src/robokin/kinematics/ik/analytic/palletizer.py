@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.analytic._common import fit_turns, fk_error, make_set
 from robokin.kinematics.ik.analytic._geometry import (
     Poe,
@@ -39,7 +40,7 @@ from robokin.kinematics.ik.analytic._geometry import (
 from robokin.kinematics.ik.analytic.scara import _align_angle, _elbow_angles, _rot
 
 if TYPE_CHECKING:
-    from robokin.kinematics.robot_like import RobotLike
+    from robokin.kinematics.ik.solutions import SolutionSet
     from robokin.model.chain import Chain
 
 __all__ = ["measure", "pose_from_position_yaw"]
@@ -111,10 +112,11 @@ def geometry(chain: Chain, poe: Poe) -> PalletizerGeometry:
 
 def level_rotation(g: PalletizerGeometry) -> np.ndarray:
     """The tool rotation (3, 3) at yaw 0."""
-    return g.Rc @ g.M[:3, :3]
+    R: np.ndarray = g.Rc @ g.M[:3, :3]
+    return R
 
 
-def pose_from_position_yaw(robot: RobotLike, xyz: Any, yaw: Any) -> np.ndarray:
+def pose_from_position_yaw(robot: ArmSource, xyz: Any, yaw: Any) -> np.ndarray:
     """The level target pose(s) (..., 4, 4) at a position with a yaw.
 
     The tool sits at ``xyz`` (..., 3) [m], turned by ``yaw`` (...) [rad] about
@@ -122,7 +124,8 @@ def pose_from_position_yaw(robot: RobotLike, xyz: Any, yaw: Any) -> np.ndarray:
     """
     from robokin.kinematics.ik.analytic._geometry import poe_from_chain
 
-    g = geometry(robot.chain, poe_from_chain(robot.chain))
+    chain = arm_of(robot).chain
+    g = geometry(chain, poe_from_chain(chain))
     xyz = np.asarray(xyz, dtype=np.float64)
     yaw = np.asarray(yaw, dtype=np.float64)
     lead = np.broadcast_shapes(xyz.shape[:-1], yaw.shape)
@@ -135,9 +138,10 @@ def pose_from_position_yaw(robot: RobotLike, xyz: Any, yaw: Any) -> np.ndarray:
     return T
 
 
-def solve_geometry(robot: RobotLike, g: PalletizerGeometry, T: np.ndarray, *,
+def solve_geometry(robot: Arm, g: PalletizerGeometry, T: np.ndarray, *,
                    level_tol: float = 1e-9, compute_error: bool = False,
-                   method: str = "analytic:palletizer", info: dict | None = None):
+                   method: str = "analytic:palletizer",
+                   info: dict[str, Any] | None = None) -> SolutionSet:
     """Every solution (up to 4) for poses T (..., 4, 4)."""
     chain = robot.chain
     T = np.asarray(T, dtype=np.float64)

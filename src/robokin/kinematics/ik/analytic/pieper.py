@@ -69,6 +69,7 @@ from typing import Any
 import numpy as np
 
 from robokin._native import kernels as K
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.analytic._common import STATUS_TEXT, fk_error
 from robokin.kinematics.ik.analytic._geometry import (
     Poe,
@@ -77,6 +78,7 @@ from robokin.kinematics.ik.analytic._geometry import (
     poe_from_chain,
 )
 from robokin.kinematics.ik.solutions import SolutionSet
+from robokin.model.chain import Chain
 
 __all__ = ["NAME", "FamilySolver", "Setup", "family_solver", "make_single", "measure", "raw_solve", "setup",
            "solve"]
@@ -168,7 +170,7 @@ def measure(poe: Poe, held: int | None = None) -> tuple[float, str, str]:
     return found[0][0] / max(1.0, scale), "; ".join(texts), ""
 
 
-def setup(chain: Any, held: int | None = None, *, tol: float = 1e-9,
+def setup(chain: Chain, held: int | None = None, *, tol: float = 1e-9,
           singular_tol: float = 1e-9) -> Setup:
     """The kernel parameters of ``chain`` (a 6R chain, or 7R with joint ``held`` held).
 
@@ -280,7 +282,7 @@ def _status(codes: np.ndarray) -> np.ndarray:
     return text
 
 
-def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None, *, params: np.ndarray,
+def solve(robot: Arm, T: np.ndarray, q_near: np.ndarray | None, *, params: np.ndarray,
           method: str, info: dict[str, Any], values: np.ndarray | None = None,
           compute_error: bool = False) -> SolutionSet:
     """Every solution for poses T (..., 4, 4), held values broadcast with them.
@@ -329,7 +331,7 @@ def solve(robot: Any, T: np.ndarray, q_near: np.ndarray | None, *, params: np.nd
         branches, _status(status).reshape(lead), method, error, dict(info))
 
 
-def make_single(chain: Any, params: np.ndarray, *, method: str,
+def make_single(chain: Chain, params: np.ndarray, *, method: str,
                 info: dict[str, Any], held: str | None = None) -> Any:
     """The single-pose hot path: ``single(T, x, qn) -> SolutionSet | None``.
 
@@ -388,10 +390,10 @@ class FamilySolver:
     info: dict[str, Any]
     one: Any
 
-    def __call__(self, robot: Any, T: np.ndarray, q_near: np.ndarray | None = None, *,
+    def __call__(self, robot: ArmSource, T: np.ndarray, q_near: np.ndarray | None = None, *,
                  compute_error: bool = False) -> SolutionSet:
         """Every solution for poses T (..., 4, 4); see :func:`solve`."""
-        return solve(robot, T, q_near, params=self.params, method=self.method,
+        return solve(arm_of(robot), T, q_near, params=self.params, method=self.method,
                      info=self.info, compute_error=compute_error)
 
     def single(self, T: np.ndarray, q6: float) -> SolutionSet | None:
@@ -403,7 +405,7 @@ class FamilySolver:
         return self.one(T, 0.0, None) if q6 == 0.0 else None
 
 
-def family_solver(chain: Any, setup: Setup) -> FamilySolver:
+def family_solver(chain: Chain, setup: Setup) -> FamilySolver:
     """The :class:`FamilySolver` of a chain set up by :func:`setup`."""
     params = setup.params
     if params is None:

@@ -16,7 +16,7 @@ from the upper arm (a right-handed arm seen along ``-h``), -1 otherwise.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -28,7 +28,8 @@ from robokin.kinematics.ik.analytic._geometry import (
 )
 
 if TYPE_CHECKING:
-    from robokin.kinematics.robot_like import RobotLike
+    from robokin.kinematics.arm import Arm
+    from robokin.kinematics.ik.solutions import SolutionSet
 
 __all__ = ["measure"]
 
@@ -72,10 +73,12 @@ def _rot(h: np.ndarray, ang: np.ndarray, v: np.ndarray) -> np.ndarray:
     """rot(h, ang) v for a fixed unit h; ang (...), v (..., 3) or (3,)."""
     c = np.cos(ang)[..., None]
     s = np.sin(ang)[..., None]
-    return v * c + np.cross(h, v) * s + h * (v @ h)[..., None] * (1.0 - c)
+    out: np.ndarray = v * c + np.cross(h, v) * s + h * (v @ h)[..., None] * (1.0 - c)
+    return out
 
 
-def _elbow_angles(h, a, b, d):
+def _elbow_angles(h: np.ndarray, a: np.ndarray, b: np.ndarray,
+                  d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Paden-Kahan subproblem 3: angles v with |a + rot(h, v) b| = |d|.
 
     Args:
@@ -100,19 +103,21 @@ def _elbow_angles(h, a, b, d):
     return np.stack([phi + gam, phi - gam], axis=-1), disc, r2
 
 
-def _align_angle(h, u, d):
+def _align_angle(h: np.ndarray, u: np.ndarray, d: np.ndarray) -> np.ndarray:
     """Paden-Kahan subproblem 1: the angle about ``h`` taking ``u`` towards ``d``.
 
     Onto ``d``'s direction, components along ``h`` ignored; broadcasts over
     leading axes.
     """
-    return np.arctan2(np.einsum("...i,...i", d, np.cross(h, u)),
-                      np.einsum("...i,...i", d, u) - (u @ h) * (d @ h))
+    ang: np.ndarray = np.arctan2(np.einsum("...i,...i", d, np.cross(h, u)),
+                                 np.einsum("...i,...i", d, u) - (u @ h) * (d @ h))
+    return ang
 
 
-def solve_geometry(robot: RobotLike, g: ScaraGeometry, T: np.ndarray, *,
+def solve_geometry(robot: Arm, g: ScaraGeometry, T: np.ndarray, *,
                    orientation_tol: float = 1e-9, compute_error: bool = False,
-                   method: str = "analytic:scara", info: dict | None = None):
+                   method: str = "analytic:scara",
+                   info: dict[str, Any] | None = None) -> SolutionSet:
     """Every solution (up to 2) for poses T (..., 4, 4)."""
     chain = robot.chain
     T = np.asarray(T, dtype=np.float64)
