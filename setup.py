@@ -6,12 +6,17 @@ baseline target and, on x86-64 with GCC or clang, ``_avx2`` (AVX2 + FMA) and
 ``_avx512`` (AVX-512 F/DQ/VL). At import ``robokin._native`` picks the copy the CPU
 runs. Nothing is compiled at run time.
 
+Before compiling, ``src/robokin/_native/_generate.py`` writes the kernels' entry
+points (``csrc/kernels_*.gen.h``) and their typed Protocol (``_interface.py``) from
+the declarations in ``_declare.py`` (files that did not change are left alone).
+
 Building from source needs a C compiler and the Python headers (the wheels need
 neither). Before compiling, the build checks both with a two-line test file and
 stops with one line saying what is missing, instead of the compiler's or
 setuptools' own error.
 """
 
+import importlib.util
 import os
 import platform
 import shutil
@@ -24,15 +29,16 @@ from setuptools.command.build_ext import build_ext
 from setuptools.errors import CompileError, PlatformError
 
 CSRC = "src/robokin/_native/csrc"
-HEADERS = [f"{CSRC}/{h}" for h in ("lanes.h", "chain.h", "pool.h", "pool.c", "fk.c",
-                                     "lm.c", "nearest.c", "six_r.c", "broadphase.c", "general6r.c",
-                                     "process.c",
-                                     "manipulability.c", "pieper.c", "pieper_srs.c",
-                                     "plan_geom.c", "plan_check.c", "plan_rrtc.c",
-                                     "plan_path.c", "module.c")]
+HEADERS = [f"{CSRC}/{h}" for h in (
+    "lanes.h", "chain.h", "vec3.h", "subproblems.h", "args.h", "kernels_args.gen.h",
+    "kernels_entry.gen.h", "pool.h", "pool.c", "fk.c", "lm.c", "nearest.c", "six_r.c",
+    "broadphase.c", "general6r.c", "process.c", "manipulability.c", "pieper.c",
+    "pieper_srs.c", "plan_geom.c", "plan_check.c", "plan_rrtc.c", "plan_path.c", "module.c")]
 UNIX = sys.platform != "win32"
 # -fno-math-errno: sqrt inlines (and vectorises); no other fast-math licence
-FLAGS = ["-O3", "-fno-math-errno", "-Wno-psabi"] if UNIX else ["/O2"]
+# -Wall -Wextra -Wshadow: the unity build compiles without a warning (keep it so)
+FLAGS = (["-O3", "-fno-math-errno", "-Wno-psabi", "-Wall", "-Wextra", "-Wshadow"] if UNIX
+         else ["/O2"])
 LIBS = ["pthread"] if UNIX else []
 HOW = ("README.md, 'Installing', says what a source build needs; a wheel (built "
        "by .ci/wheel) installs without either")
@@ -85,6 +91,18 @@ class BuildExt(build_ext):
                     f"here ({exc}); {HOW}") from None
 
 
+def generate() -> None:
+    """Write the entry points and the Protocol from _declare.py (_generate.py)."""
+    spec = importlib.util.spec_from_file_location(
+        "robokin_native_generate", "src/robokin/_native/_generate.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    module.write()
+
+
+generate()
 modules = [extension("_base", "build_base.c", [])]
 if UNIX and platform.machine().lower() in ("x86_64", "amd64"):
     modules.append(extension("_avx2", "build_avx2.c", ["-mavx2", "-mfma"]))

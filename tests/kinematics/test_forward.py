@@ -21,12 +21,23 @@ def test_batch_shapes_and_batch_equals_loop(name, shape, rng):
     flat_q = q.reshape(-1, robot.n)
     loop = np.array([robot.fk(x) for x in flat_q]).reshape(T.shape)
     np.testing.assert_array_equal(T, loop)
-    np.testing.assert_allclose(
-        link_frames(robot.chain, q)[..., -1, :, :], T, atol=1e-15
-    )
+    # frames and fk are one walk along the chain (chain.h's chain_walk): same bits
+    np.testing.assert_array_equal(link_frames(robot.chain, q)[..., -1, :, :], T)
     np.testing.assert_allclose(
         F[..., 0, :, :], np.broadcast_to(robot.base, shape + (4, 4))
     )
+
+
+@pytest.mark.parametrize("name", ["panda", "ur5", "puma560", "qfmd010"])
+def test_link_frames_end_at_fk_bit_for_bit(name):
+    """Oracle: fk's own tool pose. frames walked the chain a second time (F_k then
+    G_k) and differed from fk by 4.4e-16 on 40 % of Panda samples; now exact."""
+    robot = robokin.load(name)
+    q = random_q(robot, np.random.default_rng(7), 2000)
+    q[:5] = 0.0
+    q[5:10] = np.pi / 2
+    frames = link_frames(robot.chain, q)
+    np.testing.assert_array_equal(frames[:, -1], robot.fk(q))
 
 
 def test_parallel_kernel_equals_serial(rng):

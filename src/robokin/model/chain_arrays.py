@@ -2,9 +2,11 @@
 
 A :class:`ChainArrays` is built by :class:`~robokin.model.chain.Chain` when the chain
 is made (it is the chain's ``arrays`` field) and is the only thing the kernels
-receive: they read its :attr:`ChainArrays.packed` vector, whose layout is below and
-in ``robokin/_native/csrc/chain.h`` (``chain_view``; a test parses it back). All
-arrays are float64 and read-only; SI units.
+receive: they read its :attr:`ChainArrays.packed` vector. Its layout is declared
+once, in ``robokin/_native/_declare.py`` (``PACKED_LAYOUT``): :func:`chain_arrays`
+packs the sections in that order and ``chain.h``'s ``chain_view`` parses them by the
+header generated from it (a test parses a packed chain back). All arrays are
+float64 and read-only; SI units.
 
 ``packed`` layout (``nc`` chain joints, ``n`` independent coordinates)::
 
@@ -22,14 +24,16 @@ arrays are float64 and read-only; SI units.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
+from robokin._native._declare import LAYOUT_TAG, PACKED_LAYOUT
+
 __all__ = ["LAYOUT_TAG", "MAX_JOINTS", "ChainArrays", "chain_arrays"]
 
-LAYOUT_TAG = 7391.0  # packed[0]; chain.h PACKED_TAG
 MAX_JOINTS = 32  # chain joints and coordinates the kernels take; chain.h MAXJ
 
 F64 = npt.NDArray[np.float64]
@@ -207,11 +211,24 @@ def chain_arrays(
         "lower": lim[:, 0], "upper": lim[:, 1], "seed_lower": seed_lo,
         "seed_upper": seed_hi, "wrap": _wrap_flags(M, kind, is_revolute),
     }
-    packed = np.concatenate(
-        [[LAYOUT_TAG, nc, n, float(identity)]] + [np.ravel(v) for v in parts.values()]
-    )
+    packed = _pack(parts, nc, n, identity)
     return ChainArrays(
         n_chain=nc, n=n, identity=identity, packed=_ro(packed), limits=_ro(lim),
         is_revolute=_ro_bool(is_revolute),
         **{k: _ro(v) for k, v in parts.items()},
     )
+
+
+def _pack(parts: Mapping[str, npt.ArrayLike], nc: int, n: int, identity: bool) -> F64:
+    """The sections in ``PACKED_LAYOUT``'s order after the head, each of its shape."""
+    dims = {"nc": nc, "n": n, "nc + 1": nc + 1}
+    chunks = [np.array([LAYOUT_TAG, nc, n, float(identity)])]
+    if set(parts) != {s.name for s in PACKED_LAYOUT}:  # pragma: no cover - a coding error
+        raise RuntimeError(f"chain_arrays: sections {sorted(parts)} differ from PACKED_LAYOUT")
+    for section in PACKED_LAYOUT:
+        value = np.asarray(parts[section.name], dtype=np.float64)
+        shape = tuple(d if isinstance(d, int) else dims[d] for d in section.shape)
+        if value.shape != shape:  # pragma: no cover - a coding error
+            raise RuntimeError(f"chain_arrays: {section.name} is {value.shape}, not {shape}")
+        chunks.append(value.ravel())
+    return np.concatenate(chunks)

@@ -340,7 +340,7 @@ class Planner:
             opts[_k.RC_MAX_NODES] = MAX_NODES
             code, path, goal_at, work, search = _k.plan_rrtc(
                 self.model.capsule, q0, np.ascontiguousarray(goals), lo, hi, margin,
-                opts, seed, self.model.exact_callback)
+                opts, seed % 2**64, self.model.exact_callback)
             stats.update(_work(work), iterations=search[0], nodes=search[1] + search[2],
                          search_s=search[3])
             if code == _k.RC_SOLVED:

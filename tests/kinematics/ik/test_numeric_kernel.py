@@ -141,7 +141,8 @@ def test_inconsistent_arrays_are_refused_not_read_out_of_bounds():
                    (4, opts[:10].copy()), (3, np.zeros((8, 1, 5)))]:
         wrong = list(args)
         wrong[k] = bad
-        with pytest.raises(ValueError, match="shapes"):
+        name = ["packed", "targets", "q0", "seeds", "opts", "out"][k]
+        with pytest.raises(ValueError, match=rf"lm_solve: {name} must be \("):
             K.lm_solve(*wrong)
     for k, bad in [(2, q0.astype(np.float32)), (0, packed[:-3].copy()),
                    (5, np.empty((8, 6 + K.N_RES))[:, ::-1])]:

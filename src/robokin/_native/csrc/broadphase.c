@@ -17,8 +17,8 @@
  * top 3x4 block of a row-major 4x4 transform, p[4 r + c]: a box's axes are its
  * columns, its centre the last column.
  *
- * BROADPHASE_METHODS lists this file's entries of module.c's method table;
- * broadphase_constants(m) adds its constants to the module.
+ * Its entries and constants are declared in ../_declare.py (BROADPHASE); the
+ * generated entry points check shapes and index ranges before the bodies run.
  */
 #include "chain.h"
 #include "pool.h"
@@ -479,70 +479,30 @@ static void motion_range(void *ctx, long b, long e)
 
 /* ---------------------------------------------------------------- arguments */
 
-/* module.c's helpers (defined after this file in the unity build) */
-static PyArrayObject *array_arg(PyObject *o, const char *name, int typenum, int ndim,
-                                int writeable);
-static int chain_arg(PyObject *o, Chain *ch);
-
-/* array_arg, and bool arrays too (shape masks and pair flags) */
-static PyArrayObject *bp_arg(PyObject *o, const char *name, int typenum, int ndim,
-                             int writeable)
-{
-    if (typenum != NPY_BOOL)
-        return array_arg(o, name, typenum, ndim, writeable);
-    PyArrayObject *a = (PyArrayObject *)o;
-    if (!PyArray_Check(o) || PyArray_TYPE(a) != NPY_BOOL || PyArray_NDIM(a) != ndim ||
-        !PyArray_IS_C_CONTIGUOUS(a) || (writeable && !PyArray_ISWRITEABLE(a))) {
-        PyErr_Format(PyExc_ValueError,
-                     "robokin._native: %s must be a C-contiguous bool array with %d "
-                     "dimension(s)", name, ndim);
-        return NULL;
-    }
-    return a;
-}
-
-/* Parse `count` arrays (names, numpy types, dimensions, writeable flags) into a. */
-typedef struct {
-    const char *name;
-    int type, ndim, writeable;
-} ArgSpec;
-
-static int bp_args(PyObject *const *objs, const ArgSpec *spec, int count, PyArrayObject **a)
-{
-    for (int i = 0; i < count; i++) {
-        a[i] = bp_arg(objs[i], spec[i].name, spec[i].type, spec[i].ndim, spec[i].writeable);
-        if (a[i] == NULL)
-            return 0;
-    }
-    return 1;
-}
-
 static inline npy_intp bp_dim(PyArrayObject *a, int d)
 {
     return PyArray_DIMS(a)[d];
 }
 
-static inline const double *bp_f64(PyArrayObject *a)
+/* the pair indices pb: a robot shape where is_self, an object (below `objects`)
+ * elsewhere (the generated entry checked pa and the shapes) */
+static int samples_args(PyArrayObject *frames, const long long *link, const long long *pa,
+                        const long long *pb, const npy_bool *self, npy_intp S, npy_intp P,
+                        npy_intp objects, Samples *sm)
 {
-    return (const double *)PyArray_DATA(a);
-}
-
-static inline const long long *bp_i64(PyArrayObject *a)
-{
-    return (const long long *)PyArray_DATA(a);
-}
-
-static inline const npy_bool *bp_mask(PyArrayObject *a)
-{
-    return (const npy_bool *)PyArray_DATA(a);
-}
-
-/* every index in [0, hi) */
-static int bp_in_range(const long long *x, npy_intp n, npy_intp hi)
-{
-    for (npy_intp i = 0; i < n; i++)
-        if (x[i] < 0 || x[i] >= hi)
+    for (npy_intp p = 0; p < P; p++)
+        if (pb[p] < 0 || pb[p] >= (self[p] ? S : objects))
             return 0;
+    sm->frames = (const double *)PyArray_DATA(frames);
+    sm->m = (long)bp_dim(frames, 0);
+    sm->nl = (long)bp_dim(frames, 1);
+    sm->S = (long)S;
+    sm->P = (long)P;
+    sm->link = link;
+    sm->pa = pa;
+    sm->pb = pb;
+    sm->is_self = self;
+    sm->nomem = 0;
     return 1;
 }
 
@@ -552,76 +512,28 @@ static PyObject *bp_fail(const char *what)
     return NULL;
 }
 
-/* The frames (m, nl, 4, 4), the robot shapes' links (S,) and the pairs (P,) of the
- * kernels; `objects` is how many objects the object pairs may index. */
-static int samples_args(PyArrayObject *frames, PyArrayObject *link, PyArrayObject *pa,
-                        PyArrayObject *pb, PyArrayObject *is_self, npy_intp objects,
-                        Samples *sm)
-{
-    npy_intp S = bp_dim(link, 0), P = bp_dim(pa, 0);
-    if (bp_dim(frames, 2) != 4 || bp_dim(frames, 3) != 4 || bp_dim(pb, 0) != P ||
-        bp_dim(is_self, 0) != P || !bp_in_range(bp_i64(link), S, bp_dim(frames, 1)) ||
-        !bp_in_range(bp_i64(pa), P, S))
-        return 0;
-    const npy_bool *self = bp_mask(is_self);
-    const long long *b = bp_i64(pb);
-    for (npy_intp p = 0; p < P; p++)
-        if (b[p] < 0 || b[p] >= (self[p] ? S : objects))
-            return 0;
-    sm->frames = bp_f64(frames);
-    sm->m = (long)bp_dim(frames, 0);
-    sm->nl = (long)bp_dim(frames, 1);
-    sm->S = (long)S;
-    sm->P = (long)P;
-    sm->link = bp_i64(link);
-    sm->pa = bp_i64(pa);
-    sm->pb = b;
-    sm->is_self = self;
-    sm->nomem = 0;
-    return 1;
-}
+#define SAMPLES(a, objects, sm) \
+    samples_args((a)->frames_array, (a)->link, (a)->pa, (a)->pb, (a)->is_self, (a)->S, \
+                 (a)->P, (objects), (sm))
 
 /* rounded_box_bounds(frames (m, L, 4, 4), link (S,), local (S, 4, 4), h (S, 3),
  * r (S,), ob_pose (O, 4, 4), ob_h (O, 3), ob_r (O,), pa (P,), pb (P,),
  * is_self (P,) bool, skip (P,) bool, out (P, m)): sat_gap of every pair not
  * skipped at every sample into out (skipped rows are left as they are). */
-static PyObject *py_rounded_box_bounds(PyObject *self, PyObject *args)
+static PyObject *rounded_box_bounds_body(const rounded_box_bounds_args *a)
 {
-    PyObject *o[13];
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
-                          &o[6], &o[7], &o[8], &o[9], &o[10], &o[11], &o[12]))
-        return NULL;
-    static const ArgSpec spec[13] = {
-        {"frames", NPY_DOUBLE, 4, 0}, {"link", NPY_INT64, 1, 0},
-        {"local", NPY_DOUBLE, 3, 0},  {"h", NPY_DOUBLE, 2, 0},
-        {"r", NPY_DOUBLE, 1, 0},      {"ob_pose", NPY_DOUBLE, 3, 0},
-        {"ob_h", NPY_DOUBLE, 2, 0},   {"ob_r", NPY_DOUBLE, 1, 0},
-        {"pa", NPY_INT64, 1, 0},      {"pb", NPY_INT64, 1, 0},
-        {"is_self", NPY_BOOL, 1, 0},  {"skip", NPY_BOOL, 1, 0},
-        {"out", NPY_DOUBLE, 2, 1}};
-    PyArrayObject *a[13];
-    if (!bp_args(o, spec, 13, a))
-        return NULL;
-    enum { FR, LINK, LOC, H, R, OBP, OBH, OBR, PA, PB, SELF, SKIP, OUT };
     BoxJob job;
-    npy_intp S = bp_dim(a[LINK], 0), O = bp_dim(a[OBP], 0), P = bp_dim(a[PA], 0);
-    npy_intp m = bp_dim(a[FR], 0);
-    if (!samples_args(a[FR], a[LINK], a[PA], a[PB], a[SELF], O, &job.sm) ||
-        bp_dim(a[LOC], 0) != S || bp_dim(a[LOC], 1) != 4 || bp_dim(a[LOC], 2) != 4 ||
-        bp_dim(a[H], 0) != S || bp_dim(a[H], 1) != 3 || bp_dim(a[R], 0) != S ||
-        bp_dim(a[OBP], 1) != 4 || bp_dim(a[OBP], 2) != 4 || bp_dim(a[OBH], 0) != O ||
-        bp_dim(a[OBH], 1) != 3 || bp_dim(a[OBR], 0) != O || bp_dim(a[SKIP], 0) != P ||
-        bp_dim(a[OUT], 0) != P || bp_dim(a[OUT], 1) != m)
-        return bp_fail("rounded_box_bounds: inconsistent shapes or indices");
-    job.local = bp_f64(a[LOC]);
-    job.h = bp_f64(a[H]);
-    job.r = bp_f64(a[R]);
-    job.ob_pose = bp_f64(a[OBP]);
-    job.ob_h = bp_f64(a[OBH]);
-    job.ob_r = bp_f64(a[OBR]);
-    job.skip = bp_mask(a[SKIP]);
-    job.out = (double *)PyArray_DATA(a[OUT]);
+    npy_intp S = a->S, P = a->P, m = a->m;
+    if (!SAMPLES(a, a->O, &job.sm))
+        return bp_fail("rounded_box_bounds: a pair index out of range");
+    job.local = a->local;
+    job.h = a->h;
+    job.r = a->r;
+    job.ob_pose = a->ob_pose;
+    job.ob_h = a->ob_h;
+    job.ob_r = a->ob_r;
+    job.skip = a->skip;
+    job.out = a->out;
     Py_BEGIN_ALLOW_THREADS
     pool_for((long)m, bp_grain((long)(P + S)), box_bounds_range, &job);
     Py_END_ALLOW_THREADS
@@ -633,40 +545,19 @@ static PyObject *py_rounded_box_bounds(PyObject *self, PyObject *args)
 /* capsule_distances(frames (m, L, 4, 4), link (S,), seg (S, 2, 3), seg_r (S,),
  * ob_seg (O, 2, 3), ob_r (O,), pa, pb, is_self (P,), pairs (k,), out (k, m)): the
  * exact distance of every listed capsule/sphere pair at every sample. */
-static PyObject *py_capsule_distances(PyObject *self, PyObject *args)
+static PyObject *capsule_distances_body(const capsule_distances_args *a)
 {
-    PyObject *o[11];
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOOO", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
-                          &o[6], &o[7], &o[8], &o[9], &o[10]))
-        return NULL;
-    static const ArgSpec spec[11] = {
-        {"frames", NPY_DOUBLE, 4, 0}, {"link", NPY_INT64, 1, 0},
-        {"seg", NPY_DOUBLE, 3, 0},    {"seg_r", NPY_DOUBLE, 1, 0},
-        {"ob_seg", NPY_DOUBLE, 3, 0}, {"ob_r", NPY_DOUBLE, 1, 0},
-        {"pa", NPY_INT64, 1, 0},      {"pb", NPY_INT64, 1, 0},
-        {"is_self", NPY_BOOL, 1, 0},  {"pairs", NPY_INT64, 1, 0},
-        {"out", NPY_DOUBLE, 2, 1}};
-    PyArrayObject *a[11];
-    if (!bp_args(o, spec, 11, a))
-        return NULL;
-    enum { FR, LINK, SEG, SEGR, OBS, OBR, PA, PB, SELF, PAIRS, OUT };
     CapsuleJob job;
-    npy_intp S = bp_dim(a[LINK], 0), O = bp_dim(a[OBS], 0), P = bp_dim(a[PA], 0);
-    npy_intp m = bp_dim(a[FR], 0), k = bp_dim(a[PAIRS], 0);
-    if (!samples_args(a[FR], a[LINK], a[PA], a[PB], a[SELF], O, &job.sm) ||
-        bp_dim(a[SEG], 0) != S || bp_dim(a[SEG], 1) != 2 || bp_dim(a[SEG], 2) != 3 ||
-        bp_dim(a[SEGR], 0) != S || bp_dim(a[OBS], 1) != 2 || bp_dim(a[OBS], 2) != 3 ||
-        bp_dim(a[OBR], 0) != O || !bp_in_range(bp_i64(a[PAIRS]), k, P) ||
-        bp_dim(a[OUT], 0) != k || bp_dim(a[OUT], 1) != m)
-        return bp_fail("capsule_distances: inconsistent shapes or indices");
-    job.seg = bp_f64(a[SEG]);
-    job.seg_r = bp_f64(a[SEGR]);
-    job.ob_seg = bp_f64(a[OBS]);
-    job.ob_r = bp_f64(a[OBR]);
-    job.pairs = bp_i64(a[PAIRS]);
+    npy_intp S = a->S, m = a->m, k = a->k;
+    if (!SAMPLES(a, a->O, &job.sm))
+        return bp_fail("capsule_distances: a pair index out of range");
+    job.seg = a->seg;
+    job.seg_r = a->seg_r;
+    job.ob_seg = a->ob_seg;
+    job.ob_r = a->ob_r;
+    job.pairs = a->pairs;
     job.k = (long)k;
-    job.out = (double *)PyArray_DATA(a[OUT]);
+    job.out = a->out;
     Py_BEGIN_ALLOW_THREADS
     pool_for((long)m, bp_grain((long)(k + S)), capsule_range, &job);
     Py_END_ALLOW_THREADS
@@ -677,28 +568,12 @@ static PyObject *py_capsule_distances(PyObject *self, PyObject *args)
 
 /* propagate_bounds(LB (P, m), known (P, m) bool, C (P, m), rows (k,)):
  * propagate_rows, in place (one thread: each row is one pass over m values). */
-static PyObject *py_propagate_bounds(PyObject *self, PyObject *args)
+static PyObject *propagate_bounds_body(const propagate_bounds_args *a)
 {
-    PyObject *o[4];
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOO", &o[0], &o[1], &o[2], &o[3]))
-        return NULL;
-    static const ArgSpec spec[4] = {{"LB", NPY_DOUBLE, 2, 1},
-                                    {"known", NPY_BOOL, 2, 0},
-                                    {"C", NPY_DOUBLE, 2, 0},
-                                    {"rows", NPY_INT64, 1, 0}};
-    PyArrayObject *a[4];
-    if (!bp_args(o, spec, 4, a))
-        return NULL;
-    npy_intp P = bp_dim(a[0], 0), m = bp_dim(a[0], 1), k = bp_dim(a[3], 0);
-    for (int i = 1; i < 3; i++)
-        if (bp_dim(a[i], 0) != P || bp_dim(a[i], 1) != m)
-            return bp_fail("propagate_bounds: LB, known and C differ in shape");
-    if (!bp_in_range(bp_i64(a[3]), k, P))
-        return bp_fail("propagate_bounds: a row out of range");
-    double *LB = (double *)PyArray_DATA(a[0]);
+    double *LB = a->LB;
+    npy_intp m = a->m, k = a->k;
     Py_BEGIN_ALLOW_THREADS
-    propagate_rows(LB, bp_mask(a[1]), bp_f64(a[2]), (long)m, bp_i64(a[3]), (long)k);
+    propagate_rows(LB, a->known, a->C, (long)m, a->rows, (long)k);
     Py_END_ALLOW_THREADS
     Py_RETURN_NONE;
 }
@@ -709,53 +584,25 @@ static PyObject *py_propagate_bounds(PyObject *self, PyObject *args)
  * the pair's distance (motion_range). q holds finite values and frames are its link
  * frames (robokin.kinematics.forward.link_frames, which checks q); reach[j, s] bounds
  * the distance from joint j's origin to shape s with prismatic joints at zero travel. */
-static PyObject *py_motion_bounds(PyObject *self, PyObject *args)
+static PyObject *motion_bounds_body(const motion_bounds_args *a)
 {
-    PyObject *po, *o[13];
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOOO", &po, &o[0], &o[1], &o[2], &o[3], &o[4],
-                          &o[5], &o[6], &o[7], &o[8], &o[9], &o[10], &o[11], &o[12]))
-        return NULL;
-    Chain ch;
-    if (!chain_arg(po, &ch))
-        return NULL;
-    static const ArgSpec spec[13] = {
-        {"q", NPY_DOUBLE, 2, 0},         {"frames", NPY_DOUBLE, 4, 0},
-        {"link", NPY_INT64, 1, 0},       {"sph_c", NPY_DOUBLE, 2, 0},
-        {"sph_r", NPY_DOUBLE, 1, 0},     {"sph_start", NPY_INT64, 1, 0},
-        {"sph_count", NPY_INT64, 1, 0},  {"reach", NPY_DOUBLE, 2, 0},
-        {"spins", NPY_BOOL, 1, 0},       {"pa", NPY_INT64, 1, 0},
-        {"pb", NPY_INT64, 1, 0},         {"is_self", NPY_BOOL, 1, 0},
-        {"out", NPY_DOUBLE, 2, 1}};
-    PyArrayObject *a[13];
-    if (!bp_args(o, spec, 13, a))
-        return NULL;
-    enum { Q, FR, LINK, SC, SR, SST, SCN, REACH, SPINS, PA, PB, SELF, OUT };
     MotionJob job;
-    const int nc = ch.nc;
-    npy_intp m = bp_dim(a[Q], 0), S = bp_dim(a[LINK], 0), P = bp_dim(a[PA], 0);
-    npy_intp nq = bp_dim(a[SR], 0);
+    const int nc = a->packed.nc;
+    npy_intp m = a->m, S = a->S, P = a->P, nq = a->nq;
     /* pb of an object pair is not read here: any index passes */
-    int ok = samples_args(a[FR], a[LINK], a[PA], a[PB], a[SELF], NPY_MAX_INTP, &job.sm) &&
-             bp_dim(a[Q], 1) == ch.n && bp_dim(a[FR], 0) == m &&
-             bp_dim(a[FR], 1) == nc + 2 && bp_dim(a[SC], 0) == nq && bp_dim(a[SC], 1) == 3 &&
-             bp_dim(a[SST], 0) == S && bp_dim(a[SCN], 0) == S && bp_dim(a[REACH], 0) == nc &&
-             bp_dim(a[REACH], 1) == S && bp_dim(a[SPINS], 0) == S && m >= 1 &&
-             bp_dim(a[OUT], 0) == P && bp_dim(a[OUT], 1) == m - 1;
-    for (npy_intp s = 0; ok && s < S; s++) {
-        long long st = bp_i64(a[SST])[s], cn = bp_i64(a[SCN])[s];
-        ok = st >= 0 && cn >= 0 && st + cn <= nq;
-    }
+    int ok = SAMPLES(a, NPY_MAX_INTP, &job.sm);
+    for (npy_intp s = 0; ok && s < S; s++)
+        ok = a->sph_start[s] + a->sph_count[s] <= nq;
     if (!ok)
-        return bp_fail("motion_bounds: inconsistent shapes or indices");
-    job.ch = &ch;
-    job.q = bp_f64(a[Q]);
-    job.sph_c = bp_f64(a[SC]);
-    job.sph_r = bp_f64(a[SR]);
-    job.sph_start = bp_i64(a[SST]);
-    job.sph_count = bp_i64(a[SCN]);
-    job.spins = bp_mask(a[SPINS]);
-    job.out = (double *)PyArray_DATA(a[OUT]);
+        return bp_fail("motion_bounds: a pair or sphere index out of range");
+    job.ch = &a->packed;
+    job.q = a->q;
+    job.sph_c = a->sph_c;
+    job.sph_r = a->sph_r;
+    job.sph_start = a->sph_start;
+    job.sph_count = a->sph_count;
+    job.spins = a->spins;
+    job.out = a->out;
     job.reach = malloc(((size_t)nc * S + 1) * sizeof(double));
     job.v = malloc(((size_t)m * nc + 1) * sizeof(double));
     job.axis = malloc(((size_t)m * nc * 6 + 1) * sizeof(double));
@@ -765,7 +612,7 @@ static PyObject *py_motion_bounds(PyObject *self, PyObject *args)
         free(job.axis);
         return PyErr_NoMemory();
     }
-    memcpy(job.reach, bp_f64(a[REACH]), (size_t)nc * S * sizeof(double));
+    memcpy(job.reach, a->reach, (size_t)nc * S * sizeof(double));
     Py_BEGIN_ALLOW_THREADS
     pool_for((long)m, 64, motion_axes_range, &job);
     motion_reach(&job);
@@ -781,21 +628,11 @@ static PyObject *py_motion_bounds(PyObject *self, PyObject *args)
 
 /* seg_seg(pts (N, 4, 3), out (N,)): the distance between segments [p1, q1] and
  * [p2, q2] given as the rows p1, q1, p2, q2 of each pts[i] (for tests). */
-static PyObject *py_seg_seg(PyObject *self, PyObject *args)
+static PyObject *seg_seg_body(const seg_seg_args *a)
 {
-    PyObject *o[2];
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OO", &o[0], &o[1]))
-        return NULL;
-    static const ArgSpec spec[2] = {{"pts", NPY_DOUBLE, 3, 0}, {"out", NPY_DOUBLE, 1, 1}};
-    PyArrayObject *a[2];
-    if (!bp_args(o, spec, 2, a))
-        return NULL;
-    npy_intp N = bp_dim(a[0], 0);
-    if (bp_dim(a[0], 1) != 4 || bp_dim(a[0], 2) != 3 || bp_dim(a[1], 0) != N)
-        return bp_fail("seg_seg: pts must be (N, 4, 3) and out (N,)");
-    const double *p = bp_f64(a[0]);
-    double *out = (double *)PyArray_DATA(a[1]);
+    npy_intp N = a->N;
+    const double *p = a->pts;
+    double *out = a->out;
     Py_BEGIN_ALLOW_THREADS
     for (npy_intp i = 0; i < N; i++)
         out[i] = seg_seg(p + 12 * i, p + 12 * i + 3, p + 12 * i + 6, p + 12 * i + 9);
@@ -803,24 +640,3 @@ static PyObject *py_seg_seg(PyObject *self, PyObject *args)
     Py_RETURN_NONE;
 }
 
-#define BROADPHASE_METHODS                                                               \
-    {"rounded_box_bounds", py_rounded_box_bounds, METH_VARARGS,                          \
-     "rounded_box_bounds(frames, link, local, h, r, ob_pose, ob_h, ob_r, pa, pb, "       \
-     "is_self, skip, out): separating-axis lower bounds of every pair at every sample."}, \
-    {"capsule_distances", py_capsule_distances, METH_VARARGS,                            \
-     "capsule_distances(frames, link, seg, seg_r, ob_seg, ob_r, pa, pb, is_self, pairs, " \
-     "out): exact distances of capsule/sphere pairs at every sample."},                  \
-    {"propagate_bounds", py_propagate_bounds, METH_VARARGS,                              \
-     "propagate_bounds(LB, known, C, rows): spread known distances through the motion "  \
-     "bounds, in place."},                                                               \
-    {"motion_bounds", py_motion_bounds, METH_VARARGS,                                    \
-     "motion_bounds(packed, q, frames, link, sph_c, sph_r, sph_start, sph_count, reach, " \
-     "spins, pa, pb, is_self, out): per interval and pair, the bound on the change of "  \
-     "the distance."},                                                     \
-    {"seg_seg", py_seg_seg, METH_VARARGS,                                                \
-     "seg_seg(pts (N, 4, 3), out (N,)): segment-segment distances (for tests)."},
-
-static int broadphase_constants(PyObject *m)
-{
-    return PyModule_AddIntConstant(m, "BP_CHUNK_WORK", BP_CHUNK_WORK);
-}

@@ -10,8 +10,9 @@
  *
  * C_0 = B L_0 (base and head), C_k = F_k G_k (C_n also carries the tool); J_k is a
  * rotation about (revolute) or a translation along (prismatic) the local z axis.
- * The arrays come from robokin.model.chain_arrays.ChainArrays.packed (its layout
- * is documented there; chain_view parses and checks it). A transform under
+ * The arrays come from robokin.model.chain_arrays.ChainArrays.packed; its layout is
+ * declared once, in robokin/_native/_declare.py (PACKED_LAYOUT), which chain_arrays
+ * packs by and chain_layout.gen.h carries here (chain_view parses and checks it). A transform under
  * construction is its top 3x4 block, row-major, t[4 r + c].
  */
 #ifndef ROBOKIN_CHAIN_H
@@ -21,7 +22,7 @@
 #include "lanes.h"
 
 #define MAXJ 32        /* chain joints and coordinates the kernels take */
-#define PACKED_TAG 7391.0 /* packed[0]: layout version (chain_arrays.LAYOUT_TAG) */
+#include "chain_layout.gen.h" /* PACKED_TAG, PACKED_SECTIONS: from _declare.py */
 
 typedef struct {
     int nc;    /* chain joints */
@@ -53,7 +54,10 @@ static int chain_view(const double *p, long len, Chain *ch)
         fn != (int)fn)
         return 0;
     int nc = (int)fnc, n = (int)fn;
-    long need = 4 + (nc + 1) * 22L + 3L * nc + (long)nc * n + nc + 16 + 32L * nc + 5L * n;
+    long need = PACKED_HEAD;
+#define CHAIN_SIZE(f, nd, d0, d1, d2, key) need += (long)(d0) * (d1) * (d2);
+    PACKED_SECTIONS(CHAIN_SIZE)
+#undef CHAIN_SIZE
     if (len != need)
         return 0;
     ch->nc = nc;
@@ -61,22 +65,10 @@ static int chain_view(const double *p, long len, Chain *ch)
     ch->ident = p[3] == 1.0;
     if (ch->ident && nc != n)
         return 0;
-    const double *o = p + 4;
-    ch->consts = o;  o += (nc + 1) * 16;
-    ch->xform = o;   o += (nc + 1) * 6;
-    ch->kind = o;    o += nc;
-    ch->sign = o;    o += nc;
-    ch->offset = o;  o += nc;
-    ch->M = o;       o += (long)nc * n;
-    ch->c = o;       o += nc;
-    ch->base = o;    o += 16;
-    ch->frame = o;   o += 16L * nc;
-    ch->link = o;    o += 16L * nc;
-    ch->lo = o;      o += n;
-    ch->hi = o;      o += n;
-    ch->seed_lo = o; o += n;
-    ch->seed_hi = o; o += n;
-    ch->wrap = o;
+    const double *o = p + PACKED_HEAD;
+#define CHAIN_TAKE(f, nd, d0, d1, d2, key) ch->f = o; o += (long)(d0) * (d1) * (d2);
+    PACKED_SECTIONS(CHAIN_TAKE)
+#undef CHAIN_TAKE
     return 1;
 }
 
@@ -215,10 +207,13 @@ ALWAYS_INLINE vl joint_values(const Chain *ch, const vd *q, vd *v, vd *s, vd *c)
     return ok;
 }
 
-/* The tool pose (top 3x4 into t) of configurations q (n lanes-vectors). When o and
- * z are given, the origin and z axis of every joint frame (just after its joint)
- * go there, 3 x nc each (o[3 k + r]). Returns the lanes with finite joint values. */
-ALWAYS_INLINE vl chain_pose(const Chain *ch, const vd *q, vd *t, vd *o, vd *z)
+/* The one walk along the chain: the tool pose (top 3x4 into t) of configurations q
+ * (n lane-vectors). When o and z are given, the origin and z axis of every joint
+ * frame (just after its joint) go there, 3 x nc each (o[3 k + r]); when fr is
+ * given, the top 3x4 of every link frame (after F_k), 12 x nc each (fr[12 k + i]),
+ * taken off the walk without changing it (so the tool pose is fk's, bit for bit).
+ * Returns the lanes with finite joint values. */
+ALWAYS_INLINE vl chain_walk(const Chain *ch, const vd *q, vd *t, vd *o, vd *z, vd *fr)
 {
     vd v[MAXJ], s[MAXJ], c[MAXJ];
     vl ok = joint_values(ch, q, v, s, c);
@@ -230,9 +225,20 @@ ALWAYS_INLINE vl chain_pose(const Chain *ch, const vd *q, vd *t, vd *o, vd *z)
                 o[3 * k + r] = t[4 * r + 3];
                 z[3 * k + r] = t[4 * r + 2];
             }
+        if (fr != NULL) {
+            for (int i = 0; i < 12; i++)
+                fr[12 * k + i] = t[i];
+            const_right(fr + 12 * k, ch->frame + 16 * k, NULL);
+        }
         const_right(t, ch->consts + 16 * (k + 1), ch->xform + 6 * (k + 1));
     }
     return ok;
+}
+
+/* The tool pose (and joint origins and axes when o, z are given): chain_walk */
+ALWAYS_INLINE vl chain_pose(const Chain *ch, const vd *q, vd *t, vd *o, vd *z)
+{
+    return chain_walk(ch, q, t, o, z, NULL);
 }
 
 /* Pose (into t) and the geometric Jacobian with respect to the independent

@@ -82,7 +82,8 @@ static void jacobian_range(void *ctx, long b, long e)
     }
 }
 
-/* base, the frame of every chain joint (after F_k), then the tool pose */
+/* base, the frame of every chain joint (after F_k), then the tool pose: chain.h's
+ * one walk (chain_walk), so the tool pose is fk's bit for bit */
 static void frames_range(void *ctx, long b, long e)
 {
     FkJob *job = (FkJob *)ctx;
@@ -90,23 +91,18 @@ static void frames_range(void *ctx, long b, long e)
     const int n = ch->n, nc = ch->nc;
     for (long i = b; i < e; i += W) {
         int count = e - i < W ? (int)(e - i) : W;
-        vd q[MAXJ], t[12], v[MAXJ], s[MAXJ], c[MAXJ];
+        vd q[MAXJ], t[12], fr[12 * MAXJ];
         gather(job->q, n, i, count, q);
-        vl ok = joint_values(ch, q, v, s, c);
+        vl ok = chain_walk(ch, q, t, NULL, NULL, fr);
         double *out = job->frames + i * (nc + 2) * 16;
-        for (int l = 0; l < count; l++)
+        for (int l = 0; l < count; l++) {
+            double *o = out + l * (nc + 2) * 16;
             for (int a = 0; a < 16; a++)
-                out[l * (nc + 2) * 16 + a] = ch->base[a];
-        load_top(t, ch->consts);
-        for (int k = 0; k < nc; k++) {
-            joint_right(t, ch->kind[k] != 0.0, v[k], s[k], c[k]);
-            const_right(t, ch->frame + 16 * k, NULL);
-            for (int l = 0; l < count; l++)
-                store_pose(t, l, out + (l * (nc + 2) + k + 1) * 16);
-            const_right(t, ch->link + 16 * k, NULL);
+                o[a] = ch->base[a];
+            for (int k = 0; k < nc; k++)
+                store_pose(fr + 12 * k, l, o + (k + 1) * 16);
+            store_pose(t, l, o + (nc + 1) * 16);
         }
-        for (int l = 0; l < count; l++)
-            store_pose(t, l, out + (l * (nc + 2) + nc + 1) * 16);
         flag_bad(job, ok, count);
     }
 }

@@ -89,8 +89,8 @@
  *   5.2 (Householder QR), 5.4.2 (column pivoting), 3.4.8 (complete pivoting),
  *   7.4 (Hessenberg reduction), 7.6.1 (inverse iteration).
  *
- * GENERAL6R_METHODS lists this file's entries of module.c's method table;
- * general6r_constants(m) adds its constants to the module.
+ * Its entries and constants are declared in ../_declare.py (GENERAL6R); g6_init
+ * fills the tables at module init.
  */
 #include <float.h>
 #include <string.h>
@@ -342,7 +342,6 @@ static void det12_lanes(const double (*S)[144], int k0, double *out, double *rat
                 A[12 * i + j] -= f * A[12 * k + j];
         }
     }
-    for (int l = 0; l < W; l++)
     for (int l = 0; l < W; l++) {
         out[k0 + l] = d[l];
         ratio[k0 + l] = pmax[l] > 0.0 ? pmin[l] / pmax[l] : 0.0;
@@ -773,6 +772,7 @@ static void deflate(double *c, int deg, double r)
  * already found. Returns 0 when hqr fails. */
 static int all_roots16(const double *c, int jbest, double *wr, double *wi)
 {
+    (void)jbest;
     double xs[G6_NSAMP], ps[G6_NSAMP], d, work[17];
     for (int m = 1; m < G6_NSAMP; m++) { /* sample jbest + m, x increasing with m */
         xs[m] = tan(0.5 * (G6_TWO_PI * m / G6_NSAMP - G6_PI));
@@ -2521,19 +2521,14 @@ static void g6_range(void *ctx, long b, long e)
 
 /* ---------------------------------------------------------- Python entries */
 
-static PyArrayObject *array_arg(PyObject *o, const char *name, int typenum, int ndim,
-                                int writeable);
-static int chain_arg(PyObject *o, Chain *ch);
-
-static int g6_shape(PyArrayObject *a, const char *name, npy_intp d0, npy_intp d1, npy_intp d2)
+/* a 6R chain of revolute joints without dependent ones */
+static int g6_chain_ok(const Chain *ch)
 {
-    npy_intp want[3] = {d0, d1, d2};
-    for (int k = 0; k < PyArray_NDIM(a); k++)
-        if (PyArray_DIMS(a)[k] != want[k]) {
-            PyErr_Format(PyExc_ValueError, "robokin._native.general6r: %s has a bad shape",
-                         name);
+    if (ch->nc != 6 || ch->n != 6 || !ch->ident)
+        return 0;
+    for (int k = 0; k < 6; k++)
+        if (ch->kind[k] != 0.0)
             return 0;
-        }
     return 1;
 }
 
@@ -2568,62 +2563,12 @@ static int g6_params_ok(const double *P, long len)
  * rows), the status (G6_OK ...), the flags (G6F_..., candidates tried above
  * G6_DIAG_CAND_SHIFT), the primary's tail, margin and clusters split, and the
  * smallest error a candidate's polish reached. */
-static PyObject *py_general6r_solve(PyObject *self, PyObject *args)
+static PyObject *general6r_solve_body(const general6r_solve_args *a)
 {
-    PyObject *o[10];
-    int parallel;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOOp", &o[0], &o[1], &o[2], &o[3], &o[4], &o[5],
-                          &o[6], &o[7], &o[8], &o[9], &parallel))
-        return NULL;
-    Chain ch;
-    if (!chain_arg(o[0], &ch))
-        return NULL;
-    if (ch.nc != 6 || ch.n != 6 || !ch.ident) {
-        PyErr_SetString(PyExc_ValueError,
-                        "robokin._native.general6r_solve: the chain is not 6R without "
-                        "dependent joints");
-        return NULL;
-    }
-    for (int k = 0; k < 6; k++)
-        if (ch.kind[k] != 0.0) {
-            PyErr_SetString(PyExc_ValueError,
-                            "robokin._native.general6r_solve: a prismatic joint");
-            return NULL;
-        }
-    PyArrayObject *P = array_arg(o[1], "params", NPY_DOUBLE, 1, 0);
-    if (P == NULL)
-        return NULL;
-    if (!g6_params_ok((const double *)PyArray_DATA(P), (long)PyArray_DIMS(P)[0])) {
-        PyErr_SetString(PyExc_ValueError,
-                        "robokin._native.general6r_solve: params is not a general 6R "
-                        "parameter vector");
-        return NULL;
-    }
-    PyArrayObject *T = array_arg(o[2], "T", NPY_DOUBLE, 3, 0);
-    if (T == NULL)
-        return NULL;
-    npy_intp N = PyArray_DIMS(T)[0];
-    if (!g6_shape(T, "T", N, 4, 4))
-        return NULL;
-    enum { A_Q, A_VALID, A_INSIDE, A_SIG, A_STATUS, A_DIAG, A_STATS, N_OUT };
-    static const char *names[N_OUT] = {"Q", "valid", "inside", "sigma", "status", "diag",
-                                       "stats"};
-    static const int types[N_OUT] = {NPY_DOUBLE, NPY_BOOL, NPY_BOOL, NPY_DOUBLE, NPY_INT64,
-                                     NPY_INT64, NPY_DOUBLE};
-    static const int ndims[N_OUT] = {3, 2, 2, 2, 1, 1, 2};
-    static const npy_intp d1[N_OUT] = {16, 16, 16, 16, 0, 0, 4};
-    PyArrayObject *a[N_OUT];
-    for (int k = 0; k < N_OUT; k++)
-        if (!(a[k] = array_arg(o[3 + k], names[k], types[k], ndims[k], 1)) ||
-            !g6_shape(a[k], names[k], N, d1[k], 6))
-            return NULL;
-    G6Job job = {&ch, (const double *)PyArray_DATA(P), (const double *)PyArray_DATA(T),
-                 (double *)PyArray_DATA(a[A_Q]), (double *)PyArray_DATA(a[A_SIG]),
-                 (double *)PyArray_DATA(a[A_STATS]), (npy_bool *)PyArray_DATA(a[A_VALID]),
-                 (npy_bool *)PyArray_DATA(a[A_INSIDE]),
-                 (long long *)PyArray_DATA(a[A_STATUS]),
-                 (long long *)PyArray_DATA(a[A_DIAG])};
+    npy_intp N = a->N;
+    int parallel = a->parallel;
+    G6Job job = {&a->packed, a->params, a->T, a->Q, a->sigma, a->stats, a->valid, a->inside,
+                 a->status, a->diag};
     Py_BEGIN_ALLOW_THREADS
     if (parallel && N >= G6_PARALLEL_MIN)
         pool_for((long)N, G6_GRAIN, g6_range, &job);
@@ -2637,29 +2582,12 @@ static PyObject *py_general6r_solve(PyObject *self, PyObject *args)
  * the left side J_a K_a J_{a+1} K_{a+1} J_{a+2} K_{a+2} at the angles: Y its 14
  * equations times (1 + x_b^2)(1 + x_c^2), X the 27 monomials
  * {s_a, c_a, 1} (x) {x_b^i x_c^j} (index 9 block + 3 i + j) they are linear in */
-static PyObject *py_general6r_fit_rows(PyObject *self, PyObject *args)
+static PyObject *general6r_fit_rows_body(const general6r_fit_rows_args *args)
 {
-    PyObject *co, *ao, *xo, *yo;
-    int a;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OiOOO", &co, &a, &ao, &xo, &yo))
-        return NULL;
-    PyArrayObject *C, *ang, *X, *Y;
-    if (!(C = array_arg(co, "consts", NPY_DOUBLE, 3, 0)) ||
-        !(ang = array_arg(ao, "angles", NPY_DOUBLE, 2, 0)) ||
-        !(X = array_arg(xo, "X", NPY_DOUBLE, 2, 1)) ||
-        !(Y = array_arg(yo, "Y", NPY_DOUBLE, 2, 1)))
-        return NULL;
-    npy_intp M = PyArray_DIMS(ang)[0];
-    if (a < 1 || a > 3) {
-        PyErr_SetString(PyExc_ValueError, "robokin._native.general6r_fit_rows: a must be 1, 2 or 3");
-        return NULL;
-    }
-    if (!g6_shape(C, "consts", 7, 4, 4) || !g6_shape(ang, "angles", M, 3, 0) ||
-        !g6_shape(X, "X", M, 27, 0) || !g6_shape(Y, "Y", M, 14, 0))
-        return NULL;
-    const double *K = (const double *)PyArray_DATA(C), *t = (const double *)PyArray_DATA(ang);
-    double *x = (double *)PyArray_DATA(X), *y = (double *)PyArray_DATA(Y);
+    npy_intp M = args->M;
+    int a = (int)args->a;
+    const double *K = args->consts, *t = args->angles;
+    double *x = args->X, *y = args->Y;
     for (npy_intp r = 0; r < M; r++) {
         double L[16], Rz[16] = {0}, tmp[16];
         memset(L, 0, sizeof(L));
@@ -2690,28 +2618,12 @@ static PyObject *py_general6r_fit_rows(PyObject *self, PyObject *args)
 /* general6r_candidates(params, T (4, 4), out (G6_MAXCAND, 6)) -> (n, flags): the
  * candidates one pose gives before the polish (chain values, original joint order),
  * for tests and diagnostics */
-static PyObject *py_general6r_candidates(PyObject *self, PyObject *args)
+static PyObject *general6r_candidates_body(const general6r_candidates_args *a)
 {
-    PyObject *po, *to, *oo;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOO", &po, &to, &oo))
-        return NULL;
-    PyArrayObject *P, *T, *O;
-    if (!(P = array_arg(po, "params", NPY_DOUBLE, 1, 0)) ||
-        !(T = array_arg(to, "T", NPY_DOUBLE, 2, 0)) ||
-        !(O = array_arg(oo, "out", NPY_DOUBLE, 2, 1)))
-        return NULL;
-    if (!g6_params_ok((const double *)PyArray_DATA(P), (long)PyArray_DIMS(P)[0]) ||
-        !g6_shape(T, "T", 4, 4, 0) || !g6_shape(O, "out", G6_MAXCAND, 6, 0)) {
-        PyErr_SetString(PyExc_ValueError, "robokin._native.general6r_candidates: bad "
-                                          "params, T (4, 4) or out (G6_MAXCAND, 6)");
-        return NULL;
-    }
     G6Cand cand[G6_MAXCAND];
     int flags = 0, n;
-    double stats[3], *out = (double *)PyArray_DATA(O);
-    n = g6_candidates((const double *)PyArray_DATA(P), (const double *)PyArray_DATA(T), cand,
-                      &flags, stats);
+    double stats[3], *out = a->out;
+    n = g6_candidates(a->params, a->T, cand, &flags, stats);
     for (int i = 0; i < n; i++)
         memcpy(out + 6 * i, cand[i].v, sizeof(cand[i].v));
     return Py_BuildValue("ii", n, flags);
@@ -2719,65 +2631,20 @@ static PyObject *py_general6r_candidates(PyObject *self, PyObject *args)
 
 /* general6r_roots(c (deg + 1,) lowest power first, wr (deg,), wi (deg,)) -> bool:
  * the kernel's polynomial root finder (balanced companion matrix + hqr), for tests */
-static PyObject *py_general6r_roots(PyObject *self, PyObject *args)
+static PyObject *general6r_roots_body(const general6r_roots_args *a)
 {
-    PyObject *co, *ro, *io;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOO", &co, &ro, &io))
-        return NULL;
-    PyArrayObject *c, *wr, *wi;
-    if (!(c = array_arg(co, "c", NPY_DOUBLE, 1, 0)) ||
-        !(wr = array_arg(ro, "wr", NPY_DOUBLE, 1, 1)) ||
-        !(wi = array_arg(io, "wi", NPY_DOUBLE, 1, 1)))
-        return NULL;
-    npy_intp deg = PyArray_DIMS(c)[0] - 1;
-    const double *cd = (const double *)PyArray_DATA(c);
-    if (deg < 1 || deg > G6_MAXDEG || PyArray_DIMS(wr)[0] != deg ||
-        PyArray_DIMS(wi)[0] != deg || cd[deg] == 0.0 || !isfinite(cd[deg])) {
-        PyErr_SetString(PyExc_ValueError,
-                        "robokin._native.general6r_roots: need 1 <= degree <= 32, a "
-                        "non-zero leading coefficient and outputs of the degree's length");
-        return NULL;
-    }
+    npy_intp deg = a->D - 1;
+    const double *cd = a->c;
     int ok;
     Py_BEGIN_ALLOW_THREADS
-    ok = poly_roots(cd, (int)deg, (double *)PyArray_DATA(wr), (double *)PyArray_DATA(wi));
+    ok = poly_roots(cd, (int)deg, a->wr, a->wi);
     Py_END_ALLOW_THREADS
     return PyBool_FromLong(ok);
 }
 
-#define GENERAL6R_METHODS                                                                  \
-    {"general6r_solve", py_general6r_solve, METH_VARARGS,                                  \
-     "general6r_solve(packed, params, T, Q, valid, inside, sigma, status, diag, stats, " \
-     "parallel): every IK solution of a general 6R chain."},                              \
-    {"general6r_fit_rows", py_general6r_fit_rows, METH_VARARGS,                            \
-     "general6r_fit_rows(consts, a, angles, X, Y): the left side's fitting rows."},        \
-    {"general6r_candidates", py_general6r_candidates, METH_VARARGS,                        \
-     "general6r_candidates(params, T, out) -> (n, flags): one pose's candidates."},       \
-    {"general6r_roots", py_general6r_roots, METH_VARARGS,                                  \
-     "general6r_roots(c, wr, wi) -> ok: polynomial roots (companion matrix + hqr)."},
-
-static int general6r_constants(PyObject *m)
+/* module init: the tables (run once per process per copy) */
+static int g6_init(void)
 {
     g6_init_tables();
-    static const struct { const char *name; int value; } ints[] = {
-        {"G6_MAXSOL", G6_MAXSOL}, {"G6_MAXCAND", G6_MAXCAND}, {"G6_MAXVAR", G6_MAXVAR}, {"GP_NVAR", GP_NVAR}, {"GP_TAIL_TOL", GP_TAIL_TOL},
-        {"GP_NULL_TOL", GP_NULL_TOL}, {"GP_IMAG_TOL", GP_IMAG_TOL}, {"GP_TOL", GP_TOL},
-        {"GP_DEDUPE", GP_DEDUPE}, {"GP_MAX_ITER", GP_MAX_ITER},
-        {"GP_PAIR_GAP", GP_PAIR_GAP}, {"GP_SCALE", GP_SCALE},
-        {"GP_FALLBACK", GP_FALLBACK}, {"GP_NEAR_TAIL", GP_NEAR_TAIL}, {"GP_HEAD", GP_HEAD},
-        {"VB_DIR", VB_DIR}, {"VB_A", VB_A}, {"VB_MULT", VB_MULT}, {"VB_C", VB_C},
-        {"VB_CI", VB_CI}, {"VB_P", VB_P}, {"VB_SIZE", VB_SIZE}, {"G6_OK", G6_OK},
-        {"G6_NONE", G6_NONE}, {"G6_DEGENERATE", G6_DEGENERATE},
-        {"G6_BAD_POSE", G6_BAD_POSE}, {"G6F_DEGENERATE", G6F_DEGENERATE},
-        {"G6F_CLUSTER", G6F_CLUSTER}, {"G6F_SECONDARY", G6F_SECONDARY},
-        {"G6F_SEC_DEGENERATE", G6F_SEC_DEGENERATE}, {"G6F_SEC_CLUSTER", G6F_SEC_CLUSTER},
-        {"G6F_PROJECTED", G6F_PROJECTED}, {"G6F_PROJ_DEGENERATE", G6F_PROJ_DEGENERATE},
-        {"G6F_RESCUED", G6F_RESCUED}, {"G6F_NOISY", G6F_NOISY}, {"G6F_SEC_NOISY", G6F_SEC_NOISY},
-        {"G6F_EIGEN", G6F_EIGEN},
-        {"G6_DIAG_CAND_SHIFT", G6_DIAG_CAND_SHIFT}};
-    for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
-        if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
-            return -1;
     return 0;
 }

@@ -33,18 +33,9 @@
 #define NMAX MAXJ
 #define TAB_K_MAX 8 /* most seed-table restarts per target */
 
-/* opts[]: the option vector robokin.kinematics.ik.numeric fills (it reads these
- * indices from the module) */
-enum { O_W = 0 /* 6 task weights, 0 = masked out */, O_TOL_P = 6, O_TOL_R = 7,
-       O_MAX_ITER = 8 /* iterations per attempt */, O_USE_Q0 = 9 /* 1: first attempt from q0 */,
-       O_MAX_STEP = 10 /* largest joint step per iteration */, O_MU0 = 11,
-       O_N_SEEDS = 12 /* restarts available (<= seeds per target) */,
-       O_PATH_MAX_JUMP = 13 /* path: largest joint change per sample */,
-       O_STALL_EVERY = 14, O_STALL_RATIO = 15, O_MU_DOWN = 16, O_MU_UP = 17,
-       O_SEED_SHRINK = 18 /* odd restarts seed in [lo + f span, hi - f span] */,
-       O_N_TABLE = 19 /* the first restarts start from this many table rows */,
-       O_TABLE_ROT = 20 /* [m^2] per unit squared rotation distance; 0 position only */,
-       N_OPTS = 21 };
+/* opts[]: the option vector robokin.kinematics.ik.numeric fills; its indices
+ * (O_*, N_OPTS) and every entry's range are declared in ../_declare.py (LM_OPTS) and
+ * generated into kernels_args.gen.h, whose entry points check them. */
 /* out rows: q (n), then these columns */
 enum { R_ERR = 0 /* combined residual norm [m, rad] */, R_EP = 1, R_ER = 2, R_ITERS = 3,
        R_RESTARTS = 4, R_CODE = 5, N_RES = 6 };
@@ -52,6 +43,24 @@ enum { CODE_OK = 0, CODE_ITER = 1 /* iterations of the last attempt ran out */,
        CODE_STALL = 2 /* a local minimum or pinned at limits */, CODE_BAD_TARGET = 3,
        CODE_JUMP = 4 /* path: joint jump larger than allowed */,
        CODE_NOT_RUN = 5 /* path: after an earlier failure */, CODE_BAD_Q0 = 6 };
+/* the task rows opts selects (weights above 0) */
+static int lm_mask_rows(const double *opts)
+{
+    int m = 0;
+    for (int i = 0; i < 6; i++)
+        m += opts[O_W + i] > 0.0;
+    return m;
+}
+
+/* whether a seed-table grid description gdat (7,) has G = gdat[6] cells a side
+ * (1 to 1024) and cstart the G^3 + 1 entries of its cells */
+static int grid_fits(const double *gdat, npy_intp cstart_len)
+{
+    double G = gdat[6];
+    return G >= 1.0 && G <= 1024.0 && G == floor(G) &&
+           cstart_len == (npy_intp)(G * G * G) + 1;
+}
+
 #define MU_MAX 1e9
 #define MU_MIN 1e-9
 

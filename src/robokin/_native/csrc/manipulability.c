@@ -18,10 +18,6 @@
 
 #define DET_GRAIN 256 /* rows per pool chunk */
 
-/* module.c's argument helpers */
-static PyArrayObject *array_arg(PyObject *o, const char *name, int typenum, int ndim,
-                                int writeable);
-static int batch_args(PyObject *po, PyObject *qo, Chain *ch, PyArrayObject **q);
 
 typedef struct {
     const Chain *ch;
@@ -101,26 +97,10 @@ static void det_range(void *ctx, long b, long e)
 
 /* abs_det_jacobian(packed, q (N, 6), mask (N,) bool, out (N,)) -> all masked rows
  * finite */
-static PyObject *py_abs_det_jacobian(PyObject *self, PyObject *args)
+static PyObject *abs_det_jacobian_body(const abs_det_jacobian_args *a)
 {
-    PyObject *po, *qo, *mo, *oo;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOO", &po, &qo, &mo, &oo))
-        return NULL;
-    Chain ch;
-    PyArrayObject *q, *mask, *out;
-    if (!batch_args(po, qo, &ch, &q) || !(mask = array_arg(mo, "mask", NPY_BOOL, 1, 0)) ||
-        !(out = array_arg(oo, "out", NPY_DOUBLE, 1, 1)))
-        return NULL;
-    long N = (long)PyArray_DIM(q, 0);
-    if (ch.n != 6 || PyArray_DIM(mask, 0) != N || PyArray_DIM(out, 0) != N) {
-        PyErr_SetString(PyExc_ValueError,
-                        "robokin._native.abs_det_jacobian: needs a 6-coordinate chain, "
-                        "q (N, 6), mask (N,) and out (N,)");
-        return NULL;
-    }
-    DetJob job = {&ch, (const double *)PyArray_DATA(q),
-                  (const unsigned char *)PyArray_DATA(mask), (double *)PyArray_DATA(out), 1};
+    long N = (long)a->N;
+    DetJob job = {&a->packed, a->q, a->mask, a->out, 1};
     Py_BEGIN_ALLOW_THREADS
     if (N >= FK_PARALLEL_MIN)
         pool_for(N, DET_GRAIN, det_range, &job);
@@ -130,7 +110,3 @@ static PyObject *py_abs_det_jacobian(PyObject *self, PyObject *args)
     return PyBool_FromLong(job.ok);
 }
 
-#define MANIPULABILITY_METHODS                                                          \
-    {"abs_det_jacobian", py_abs_det_jacobian, METH_VARARGS,                             \
-     "abs_det_jacobian(packed, q, mask, out) -> all masked rows finite: |det J| of "    \
-     "a 6-coordinate arm where mask, 0 elsewhere."},

@@ -1594,24 +1594,16 @@ static void pk_range(void *ctx, long b, long e)
     }
 }
 
-/* params as a Pieper parameter vector, or NULL with ValueError */
-static const double *pk_params(PyObject *o)
+/* whether params (PK_N_PARAMS values) is a Pieper parameter vector (pieper.pack) */
+static int pk_params_ok(const double *P)
 {
-    PyArrayObject *a = array_arg(o, "params", NPY_DOUBLE, 1, 0);
-    if (a == NULL)
-        return NULL;
-    const double *P = PK_F64(a);
-    if (PK_DIM(a, 0) != PK_N_PARAMS || P[PK_TAG] != PK_TAG_VALUE ||
-        !(P[PK_N] == 6.0 || P[PK_N] == 7.0) ||
-        !(P[PK_HELD] >= -1.0 && P[PK_HELD] < P[PK_N]) ||
-        (P[PK_N] == 7.0) != (P[PK_HELD] >= 0.0)) {
-        PyErr_SetString(PyExc_ValueError,
-                        "robokin._native: params is not a Pieper parameter vector "
-                        "(pieper.pack)");
-        return NULL;
-    }
-    return P;
+    return P[PK_TAG] == PK_TAG_VALUE && (P[PK_N] == 6.0 || P[PK_N] == 7.0) &&
+           P[PK_HELD] >= -1.0 && P[PK_HELD] < P[PK_N] &&
+           (P[PK_N] == 7.0) == (P[PK_HELD] >= 0.0);
 }
+
+/* the joints of a parameter vector (for the generated shape check of qn) */
+#define PK_N_OF(P) ((P)[PK_N])
 
 /* (Q, valid, singular, within_limits): lead + (8, n) and lead + (8,) with lead = ()
  * (nlead 0) or (N,) (nlead 1), into out[4]; 0 on a memory error. */
@@ -1635,23 +1627,14 @@ static int pk_outputs(int nlead, npy_intp N, int n, PyObject **out)
  * array of preferred coordinates at singularities. code >= BAD_POSE: nothing was
  * solved and the arrays are None. The fast path for one pose: METH_FASTCALL, no
  * pool, T read through its strides. */
-static PyObject *py_pieper_ik1(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+static PyObject *pieper_ik1_body(const pieper_ik1_args *a)
 {
-    (void)self;
-    if (nargs != 4) {
-        PyErr_SetString(PyExc_TypeError, "pieper_ik1(T, params, x, qn) takes 4 arguments");
-        return NULL;
-    }
-    const double *P = pk_params(args[1]);
-    if (P == NULL)
-        return NULL;
-    double x = PyFloat_AsDouble(args[2]);
-    if (x == -1.0 && PyErr_Occurred())
-        return NULL;
+    const double *P = a->params;
+    double x = a->x;
     int n = (int)P[PK_N];
     double qn[PK_MAXJ] = {0.0};
-    if (args[3] != Py_None) {
-        PyArrayObject *qa = array_arg(args[3], "qn", NPY_DOUBLE, 1, 0);
+    if (a->qn != Py_None) {
+        PyArrayObject *qa = array_arg(a->qn, "pieper_ik1", "qn", NPY_DOUBLE, 1, 0);
         if (qa == NULL)
             return NULL;
         if (PK_DIM(qa, 0) != n) {
@@ -1663,7 +1646,7 @@ static PyObject *py_pieper_ik1(PyObject *self, PyObject *const *args, Py_ssize_t
     }
     int code = PK_BAD_POSE;
     double T[16];
-    PyObject *to = args[0];
+    PyObject *to = a->T;
     if (PyArray_Check(to)) {
         PyArrayObject *ta = (PyArrayObject *)to;
         if (PyArray_TYPE(ta) == NPY_DOUBLE && PyArray_NDIM(ta) == 2 && PK_DIM(ta, 0) == 4 &&
@@ -1703,27 +1686,11 @@ static PyObject *py_pieper_ik1(PyObject *self, PyObject *const *args, Py_ssize_t
  * caller checked poses and values); pose i's held value is x[i % m] and its
  * preferred coordinates qn[i % mq] (a sweep of held values is one batch).
  * Batches of PARALLEL_MIN poses or more run on the pool. */
-static PyObject *py_pieper_ik(PyObject *self, PyObject *args)
+static PyObject *pieper_ik_body(const pieper_ik_args *a)
 {
-    PyObject *po, *to, *xo, *qo;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOO", &po, &to, &xo, &qo))
-        return NULL;
-    const double *P = pk_params(po);
-    PyArrayObject *T, *x, *qn;
-    if (P == NULL || !(T = array_arg(to, "T", NPY_DOUBLE, 3, 0)) ||
-        !(x = array_arg(xo, "x", NPY_DOUBLE, 1, 0)) ||
-        !(qn = array_arg(qo, "qn", NPY_DOUBLE, 2, 0)))
-        return NULL;
+    const double *P = a->params;
     int n = (int)P[PK_N];
-    if (PK_DIM(T, 1) != 4 || PK_DIM(T, 2) != 4 || PK_DIM(x, 0) < 1 || PK_DIM(qn, 0) < 1 ||
-        PK_DIM(qn, 1) != n) {
-        PyErr_SetString(PyExc_ValueError,
-                        "robokin._native.pieper_ik: T must be (N, 4, 4), x (m >= 1,) and "
-                        "qn (mq >= 1, n)");
-        return NULL;
-    }
-    npy_intp N = PK_DIM(T, 0);
+    npy_intp N = a->N;
     PyObject *out[4];
     if (!pk_outputs(1, N, n, out))
         return NULL;
@@ -1734,8 +1701,7 @@ static PyObject *py_pieper_ik(PyObject *self, PyObject *args)
             Py_DECREF(out[i]);
         return NULL;
     }
-    PkJob jb = {P, PK_F64(T), PK_F64(x), PK_F64(qn), (long)PK_DIM(x, 0),
-                (long)PK_DIM(qn, 0), n, PK_F64(out[0]), PK_U8(out[1]), PK_U8(out[2]),
+    PkJob jb = {P, a->T, a->x, a->qn, (long)a->m, (long)a->mq, n, PK_F64(out[0]), PK_U8(out[1]), PK_U8(out[2]),
                 PK_U8(out[3]), (signed char *)PyArray_DATA((PyArrayObject *)status)};
     Py_BEGIN_ALLOW_THREADS
     if (N >= PK_PARALLEL_MIN)
@@ -1747,56 +1713,12 @@ static PyObject *py_pieper_ik(PyObject *self, PyObject *args)
 }
 
 /* pieper_roots(coeffs (5,), re (4,), im (4,)): the quartic solver (for tests) */
-static PyObject *py_pieper_roots(PyObject *self, PyObject *args)
+static PyObject *pieper_roots_body(const pieper_roots_args *a)
 {
-    PyObject *co, *ro, *io;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOO", &co, &ro, &io))
-        return NULL;
-    PyArrayObject *c, *re, *im;
-    if (!(c = array_arg(co, "coeffs", NPY_DOUBLE, 1, 0)) ||
-        !(re = array_arg(ro, "re", NPY_DOUBLE, 1, 1)) ||
-        !(im = array_arg(io, "im", NPY_DOUBLE, 1, 1)))
-        return NULL;
-    if (PK_DIM(c, 0) != 5 || PK_DIM(re, 0) != 4 || PK_DIM(im, 0) != 4 || PK_F64(c)[4] == 0.0) {
-        PyErr_SetString(PyExc_ValueError,
-                        "robokin._native.pieper_roots: coeffs (5,) with a non-zero last, "
-                        "re and im (4,)");
-        return NULL;
-    }
-    pk_quartic(PK_F64(c), PK_F64(re), PK_F64(im));
+    pk_quartic(a->coeffs, a->re, a->im);
     Py_RETURN_NONE;
 }
 
-#define PIEPER_METHODS                                                                   \
-    {"pieper_ik1", (PyCFunction)(void (*)(void))py_pieper_ik1, METH_FASTCALL,            \
-     "pieper_ik1(T, params, x, qn) -> (code, Q, valid, singular, within_limits): one "   \
-     "pose of the Pieper closed form, validated."},                                       \
-    {"pieper_ik", py_pieper_ik, METH_VARARGS,                                            \
-     "pieper_ik(params, T, x, qn) -> (Q, valid, singular, within_limits, status): a "    \
-     "batch of the Pieper closed form, held values x."},                                  \
-    {"pieper_roots", py_pieper_roots, METH_VARARGS,                                      \
-     "pieper_roots(coeffs, re, im): the roots of a quartic, lowest order first."},
-
-static int pieper_constants(PyObject *m)
-{
-    static const struct { const char *name; int value; } ints[] = {
-        {"PIEPER_N", PK_N}, {"PIEPER_HELD", PK_HELD}, {"PIEPER_CASE", PK_CASE},
-        {"PIEPER_SING_TOL", PK_SING_TOL}, {"PIEPER_SCALE", PK_SCALE},
-        {"PIEPER_POINT", PK_POINT}, {"PIEPER_AXES", PK_AXES}, {"PIEPER_POINTS", PK_POINTS},
-        {"PIEPER_TOOL_R", PK_TOOL_R}, {"PIEPER_TOOL_T", PK_TOOL_T},
-        {"PIEPER_SIGN", PK_SIGN}, {"PIEPER_OFFSET", PK_OFFSET}, {"PIEPER_LO", PK_LO},
-        {"PIEPER_HI", PK_HI}, {"PIEPER_TAG", PK_TAG}, {"PIEPER_N_PARAMS", PK_N_PARAMS},
-        {"PIEPER_MAX_JOINTS", PK_MAXJ}, {"PIEPER_START", PK_START}, {"PIEPER_END", PK_END},
-        {"PIEPER_BOTH", PK_BOTH}, {"PIEPER_POINT2", PK_POINT2},
-        {"PIEPER_DEGENERATE", PK_DEGENERATE}, {"PIEPER_BAD_POSE", PK_BAD_POSE}, {"PIEPER_PARALLEL_MIN", PK_PARALLEL_MIN}};
-    for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
-        if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
-            return -1;
-    if (PyModule_AddObject(m, "PIEPER_TAG_VALUE", PyFloat_FromDouble(PK_TAG_VALUE)) < 0)
-        return -1;
-    return 0;
-}
 
 #if defined(__clang__)
 #pragma STDC FP_CONTRACT DEFAULT

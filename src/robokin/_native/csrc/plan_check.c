@@ -35,7 +35,9 @@
  * interval still open after PC_MAX_LEVEL halvings, or an edge needing more than
  * PC_MAX_SAMPLES states, counts as a collision: never "free" without a proof.
  *
- * PLAN_CHECK_METHODS lists this file's entries of module.c's method table.
+ * The entries (plan_model, plan_check_states, plan_check_edges, plan_distances) are
+ * declared in _native/_declare.py; their generated entry points check every argument
+ * but the model capsule and its sizes, which checker_args checks here.
  */
 #include <stdint.h>
 
@@ -795,11 +797,11 @@ static const PlanModel *model_arg(PyObject *o)
 }
 
 /* Copy a C-contiguous array's data into a new buffer of `count` items. */
-static void *dup_data(PyArrayObject *a, size_t count, size_t size)
+static void *dup_data(const void *data, size_t count, size_t size)
 {
     void *p = malloc(count * size + 1);
     if (p != NULL && count > 0)
-        memcpy(p, PyArray_DATA(a), count * size);
+        memcpy(p, data, count * size);
     return p;
 }
 
@@ -852,14 +854,12 @@ static int model_lanes(PlanModel *M)
 
 /* Fill M's tables from the arguments of plan_model; 0 with ValueError if they are
  * inconsistent, -1 with MemoryError. */
-static int model_fill(PlanModel *M, PyArrayObject **a, long S)
+static int model_fill(PlanModel *M, const plan_model_args *a)
 {
-    enum { SI, SF, HULL, PI, REACH };
-    const long N = (long)bp_dim(a[SI], 0), H = (long)bp_dim(a[HULL], 0);
-    const long P = (long)bp_dim(a[PI], 0), nc = M->ch.nc;
-    if (bp_dim(a[SI], 1) != 4 || bp_dim(a[SF], 0) != N || bp_dim(a[SF], 1) != 21 ||
-        bp_dim(a[HULL], 1) != 3 || bp_dim(a[PI], 1) != 7 || bp_dim(a[REACH], 0) != S ||
-        bp_dim(a[REACH], 1) != nc || S < 0 || S > N || N > 1000000 || P > 10000000)
+    /* the entry checked the shapes, S <= N <= 1e6 and P <= 1e7; reach's columns are
+     * checked against the chain here */
+    const long N = (long)a->N, H = (long)a->H, P = (long)a->P, S = a->S, nc = M->ch.nc;
+    if ((long)a->nc != nc)
         return 0;
     M->S = (int)S;
     M->O = (int)(N - S);
@@ -870,9 +870,9 @@ static int model_fill(PlanModel *M, PyArrayObject **a, long S)
     M->nc = (int)nc;
     M->kind = malloc((size_t)N * 6 * sizeof(int) + 1);
     M->rb = malloc((size_t)N * 22 * sizeof(double) + 1);
-    M->hull = dup_data(a[HULL], (size_t)H * 3, sizeof(double));
+    M->hull = dup_data(a->hull, (size_t)H * 3, sizeof(double));
     M->pa = malloc((size_t)P * 7 * sizeof(int) + 1);
-    M->reach = dup_data(a[REACH], (size_t)S * nc, sizeof(double));
+    M->reach = dup_data(a->reach, (size_t)S * nc, sizeof(double));
     M->by_link_start = malloc(((size_t)nc + 3 + S) * sizeof(int) + 1);
     if (!M->kind || !M->rb || !M->hull || !M->pa || !M->reach || !M->by_link_start) {
         PyErr_NoMemory();
@@ -887,8 +887,8 @@ static int model_fill(PlanModel *M, PyArrayObject **a, long S)
     M->rad = M->h + (size_t)N * 3;
     M->cr = M->rad + N;
     M->rho = M->cr + N;
-    const long long *si = bp_i64(a[SI]);
-    const double *sf = bp_f64(a[SF]);
+    const long long *si = a->shape_i;
+    const double *sf = a->shape_f;
     for (long x = 0; x < N; x++) {
         long long kind = si[4 * x], link = si[4 * x + 1], hs = si[4 * x + 2], hn = si[4 * x + 3];
         if (kind < PG_POINT || kind > PG_HULL || (x < S ? (link < 0 || link > nc + 1) : link != -1) ||
@@ -919,7 +919,7 @@ static int model_fill(PlanModel *M, PyArrayObject **a, long S)
     M->mover = M->self + P;
     M->j0 = M->mover + P;
     M->j1 = M->j0 + P;
-    const long long *pi = bp_i64(a[PI]);
+    const long long *pi = a->pair_i;
     for (long p = 0; p < P; p++) {
         const long long *r = pi + 7 * p;
         long long pa = r[0], pb = r[1], me = r[2], se = r[3], mv = r[4], j0 = r[5], j1 = r[6];
@@ -956,27 +956,13 @@ static int model_fill(PlanModel *M, PyArrayObject **a, long S)
  * core kind, link (-1 for objects), hull start, hull count; shape_f: rb pose (16),
  * half sizes (3), rounding radius, cylinder radius; pair_i: shape a, shape b (objects
  * after the S robot shapes), method PD_*, self, mover, j0, j1. */
-static PyObject *py_plan_model(PyObject *self, PyObject *args)
+static PyObject *plan_model_body(const plan_model_args *a)
 {
-    PyObject *po, *o[5];
-    long S;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOOl", &po, &o[0], &o[1], &o[2], &o[3], &o[4], &S))
-        return NULL;
-    static const ArgSpec spec[5] = {{"shape_i", NPY_INT64, 2, 0}, {"shape_f", NPY_DOUBLE, 2, 0},
-                                    {"hull", NPY_DOUBLE, 2, 0},   {"pair_i", NPY_INT64, 2, 0},
-                                    {"reach", NPY_DOUBLE, 2, 0}};
-    PyArrayObject *a[5];
-    if (!bp_args(o, spec, 5, a))
-        return NULL;
-    PyArrayObject *pk = array_arg(po, "packed", NPY_DOUBLE, 1, 0);
-    if (pk == NULL)
-        return NULL;
     PlanModel *M = calloc(1, sizeof(PlanModel));
     if (M == NULL)
         return PyErr_NoMemory();
-    long len = (long)bp_dim(pk, 0);
-    M->packed = dup_data(pk, (size_t)len, sizeof(double));
+    long len = (long)a->len;
+    M->packed = dup_data(a->packed, (size_t)len, sizeof(double));
     if (M->packed == NULL) {
         model_free(M);
         return PyErr_NoMemory();
@@ -985,7 +971,7 @@ static PyObject *py_plan_model(PyObject *self, PyObject *args)
         model_free(M);
         return bp_fail("plan_model: packed is not a ChainArrays layout");
     }
-    int ok = model_fill(M, a, S);
+    int ok = model_fill(M, a);
     if (ok <= 0) {
         model_free(M);
         return ok < 0 ? NULL : bp_fail("plan_model: inconsistent shapes, pairs or indices");
@@ -997,15 +983,20 @@ static PyObject *py_plan_model(PyObject *self, PyObject *args)
 }
 
 /* The (model, margin (P,), exact) arguments every check takes. */
-static int checker_args(PyObject *mo, PyObject *mg, PyObject *cb, Checker *C)
+/* The (model, q's columns n, margin (P,), exact) arguments every check takes: the
+ * generated entry checked the arrays; here the capsule, that n and P are the model's
+ * and that exact is None or callable. */
+static int checker_args(PyObject *mo, npy_intp n, const double *margin, npy_intp P,
+                        PyObject *cb, Checker *C)
 {
     const PlanModel *M = model_arg(mo);
     if (M == NULL)
         return 0;
-    PyArrayObject *m = array_arg(mg, "margin", NPY_DOUBLE, 1, 0);
-    if (m == NULL)
+    if (n != M->n) {
+        bp_fail("plan: q must have one column per joint of the model");
         return 0;
-    if (bp_dim(m, 0) != M->P) {
+    }
+    if (P != M->P) {
         bp_fail("plan: margin must hold one value per pair");
         return 0;
     }
@@ -1013,7 +1004,7 @@ static int checker_args(PyObject *mo, PyObject *mg, PyObject *cb, Checker *C)
         bp_fail("plan: exact must be None or a callable (p, q) -> distance");
         return 0;
     }
-    if (!checker_init(C, M, bp_f64(m), cb == Py_None ? NULL : cb)) {
+    if (!checker_init(C, M, margin, cb == Py_None ? NULL : cb)) {
         work_free(&C->w);
         PyErr_NoMemory();
         return 0;
@@ -1038,29 +1029,16 @@ static PyObject *check_failed(Checker *C)
 
 /* plan_check_states(model, q (m, n), margin (P,), exact, status (m,) int64,
  * pair (m,) int64) -> stats: PC_* per state and the pair that decided it (-1). */
-static PyObject *py_plan_check_states(PyObject *self, PyObject *args)
+static PyObject *plan_check_states_body(const plan_check_states_args *a)
 {
-    PyObject *mo, *qo, *mg, *cb, *so, *wo;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOO", &mo, &qo, &mg, &cb, &so, &wo))
-        return NULL;
     Checker C;
-    if (!checker_args(mo, mg, cb, &C))
+    if (!checker_args(a->model, a->n, a->margin, a->P, a->exact, &C))
         return NULL;
-    PyArrayObject *q = array_arg(qo, "q", NPY_DOUBLE, 2, 0);
-    PyArrayObject *st = q ? array_arg(so, "status", NPY_INT64, 1, 1) : NULL;
-    PyArrayObject *pr = st ? array_arg(wo, "pair", NPY_INT64, 1, 1) : NULL;
-    npy_intp m = q ? bp_dim(q, 0) : 0;
-    if (pr == NULL || bp_dim(q, 1) != C.M->n || bp_dim(st, 0) != m || bp_dim(pr, 0) != m) {
-        work_free(&C.w);
-        return pr == NULL ? NULL : bp_fail("plan_check_states: inconsistent shapes");
-    }
     if (!work_states(&C, W))
         return check_failed(&C);
     int r;
     Py_BEGIN_ALLOW_THREADS
-    r = check_states(&C, bp_f64(q), (long)m, (long long *)PyArray_DATA(st),
-                     (long long *)PyArray_DATA(pr));
+    r = check_states(&C, a->q, (long)a->m, a->status, a->pair);
     Py_END_ALLOW_THREADS
     if (r == PC_ERROR)
         return check_failed(&C);
@@ -1071,35 +1049,21 @@ static PyObject *py_plan_check_states(PyObject *self, PyObject *args)
 /* plan_check_edges(model, q0 (m, n), q1 (m, n), margin (P,), exact, status (m,) int64,
  * pair (m,) int64, where (m,) float64) -> stats: per edge PC_*, the pair that decided
  * it (-1 when free) and where along it (t in [0, 1]). */
-static PyObject *py_plan_check_edges(PyObject *self, PyObject *args)
+static PyObject *plan_check_edges_body(const plan_check_edges_args *a)
 {
-    PyObject *mo, *ao, *bo, *mg, *cb, *so, *wo, *to;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOOOO", &mo, &ao, &bo, &mg, &cb, &so, &wo, &to))
-        return NULL;
     Checker C;
-    if (!checker_args(mo, mg, cb, &C))
+    if (!checker_args(a->model, a->n, a->margin, a->P, a->exact, &C))
         return NULL;
-    PyArrayObject *q0 = array_arg(ao, "q0", NPY_DOUBLE, 2, 0);
-    PyArrayObject *q1 = q0 ? array_arg(bo, "q1", NPY_DOUBLE, 2, 0) : NULL;
-    PyArrayObject *st = q1 ? array_arg(so, "status", NPY_INT64, 1, 1) : NULL;
-    PyArrayObject *pr = st ? array_arg(wo, "pair", NPY_INT64, 1, 1) : NULL;
-    PyArrayObject *wh = pr ? array_arg(to, "where", NPY_DOUBLE, 1, 1) : NULL;
-    npy_intp m = q0 ? bp_dim(q0, 0) : 0;
+    const npy_intp m = a->m;
     const int n = C.M->n;
-    if (wh == NULL || bp_dim(q0, 1) != n || bp_dim(q1, 0) != m || bp_dim(q1, 1) != n ||
-        bp_dim(st, 0) != m || bp_dim(pr, 0) != m || bp_dim(wh, 0) != m) {
-        work_free(&C.w);
-        return wh == NULL ? NULL : bp_fail("plan_check_edges: inconsistent shapes");
-    }
-    long long *status = (long long *)PyArray_DATA(st), *pair = (long long *)PyArray_DATA(pr);
-    double *where = (double *)PyArray_DATA(wh);
+    long long *status = a->status, *pair = a->pair;
+    double *where = a->where;
     int r = PC_FREE;
     Py_BEGIN_ALLOW_THREADS
     for (npy_intp i = 0; i < m && r != PC_ERROR; i++) {
         C.hit_pair = -1;
         C.hit_t = NAN;
-        r = check_edge(&C, bp_f64(q0) + (size_t)i * n, bp_f64(q1) + (size_t)i * n);
+        r = check_edge(&C, a->q0 + (size_t)i * n, a->q1 + (size_t)i * n);
         status[i] = r;
         pair[i] = r == PC_FREE ? -1 : C.hit_pair;
         where[i] = r == PC_FREE ? NAN : C.hit_t;
@@ -1113,20 +1077,14 @@ static PyObject *py_plan_check_edges(PyObject *self, PyObject *args)
 
 /* plan_distances(model, q (m, n), out (m, P)): per state and pair the certified lower
  * bound on the distance (exact for primitives; a mesh's convex hull). */
-static PyObject *py_plan_distances(PyObject *self, PyObject *args)
+static PyObject *plan_distances_body(const plan_distances_args *a)
 {
-    PyObject *mo, *qo, *oo;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOO", &mo, &qo, &oo))
+    const PlanModel *M = model_arg(a->model);
+    if (M == NULL)
         return NULL;
-    const PlanModel *M = model_arg(mo);
-    PyArrayObject *q = M ? array_arg(qo, "q", NPY_DOUBLE, 2, 0) : NULL;
-    PyArrayObject *out = q ? array_arg(oo, "out", NPY_DOUBLE, 2, 1) : NULL;
-    if (out == NULL)
-        return NULL;
-    npy_intp m = bp_dim(q, 0);
-    if (bp_dim(q, 1) != M->n || bp_dim(out, 0) != m || bp_dim(out, 1) != M->P)
-        return bp_fail("plan_distances: inconsistent shapes");
+    const npy_intp m = a->m;
+    if (a->n != M->n || a->P != M->P)
+        return bp_fail("plan_distances: q must be (m, n) and out (m, P) of the model");
     Checker C;
     memset(&C, 0, sizeof(C));
     C.M = M;
@@ -1138,10 +1096,10 @@ static PyObject *py_plan_distances(PyObject *self, PyObject *args)
     for (int p = 0; p < M->P; p++)
         none[p] = -INFINITY; /* no margin: always the exact (or hull) distance */
     C.margin = none;
-    double *o = (double *)PyArray_DATA(out);
+    double *o = a->out;
     Py_BEGIN_ALLOW_THREADS
     for (npy_intp i = 0; i < m; i++) {
-        model_poses(M, bp_f64(q) + (size_t)i * M->n, 1, poses, axes);
+        model_poses(M, a->q + (size_t)i * M->n, 1, poses, axes);
         for (int p = 0; p < M->P; p++) {
             int ex;
             double g, ub;
@@ -1153,31 +1111,4 @@ static PyObject *py_plan_distances(PyObject *self, PyObject *args)
     Py_END_ALLOW_THREADS
     free(poses);
     Py_RETURN_NONE;
-}
-
-#define PLAN_CHECK_METHODS                                                               \
-    {"plan_model", py_plan_model, METH_VARARGS,                                          \
-     "plan_model(packed, shape_i, shape_f, hull, pair_i, reach, S) -> the compiled "     \
-     "planning model of a robot in a scene (a capsule)."},                               \
-    {"plan_check_states", py_plan_check_states, METH_VARARGS,                            \
-     "plan_check_states(model, q, margin, exact, status, pair) -> stats: the validity "  \
-     "of states."},                                                                      \
-    {"plan_check_edges", py_plan_check_edges, METH_VARARGS,                              \
-     "plan_check_edges(model, q0, q1, margin, exact, status, pair, where) -> stats: "    \
-     "the validity of straight joint-space edges (conservative advancement)."},          \
-    {"plan_distances", py_plan_distances, METH_VARARGS,                                  \
-     "plan_distances(model, q, out): certified lower bounds on every pair's distance."},
-
-static int plan_check_constants(PyObject *m)
-{
-    static const struct { const char *name; int value; } ints[] = {
-        {"PC_FREE", PC_FREE}, {"PC_HIT", PC_HIT}, {"PC_UNDECIDED", PC_UNDECIDED},
-        {"PG_POINT", PG_POINT}, {"PG_SEGMENT", PG_SEGMENT}, {"PG_BOX", PG_BOX},
-        {"PG_CYLINDER", PG_CYLINDER}, {"PG_HULL", PG_HULL}, {"PD_SEGSEG", PD_SEGSEG},
-        {"PD_SEGBOX", PD_SEGBOX}, {"PD_BOXSEG", PD_BOXSEG}, {"PD_GJK", PD_GJK},
-        {"PD_HULL", PD_HULL}};
-    for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
-        if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
-            return -1;
-    return PyModule_AddObject(m, "PC_EPS", PyFloat_FromDouble(PC_EPS));
 }

@@ -4,12 +4,11 @@
  * check_edge; the random numbers and the clock are plan_rrtc.c's (deterministic for
  * a seed).
  *
- * PLAN_PATH_METHODS lists this file's entries of module.c's method table.
+ * plan_simplify is declared in _native/_declare.py (its option vector SP_* too).
  */
 
-/* plan_simplify option vector (opts has SP_N_OPTS entries) */
-enum { SP_VERTEX_TRIES = 0, SP_TRIES = 1, SP_MAX_FAIL = 2, SP_TIME = 3, SP_CUT_ROUNDS = 4,
-       SP_SHARP_TURN = 5, SP_N_OPTS = 6 };
+/* the option vector (SP_*, SP_N_OPTS entries) is generated from _declare.py's SP_OPTS
+ * into kernels_args.gen.h */
 
 /* ---------------------------------------------------------------- shortcuts */
 
@@ -214,31 +213,20 @@ static int cut_corners(Checker *C, double **q, long *K, int rounds, double sharp
 /* plan_simplify(model, path (K, n), margin (P,), opts (SP_N_OPTS,), seed, exact) ->
  * (path (K', n), stats): random shortcuts, then the sharp corners cut; every new edge
  * checked. */
-static PyObject *py_plan_simplify(PyObject *self, PyObject *args)
+static PyObject *plan_simplify_body(const plan_simplify_args *a)
 {
-    PyObject *mo, *po, *mg, *oo, *cb;
-    unsigned long long seed;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOKO", &mo, &po, &mg, &oo, &seed, &cb))
-        return NULL;
     Checker C;
-    if (!checker_args(mo, mg, cb, &C))
+    if (!checker_args(a->model, a->n, a->margin, a->P, a->exact, &C))
         return NULL;
     const int n = C.M->n;
-    PyArrayObject *pa = array_arg(po, "path", NPY_DOUBLE, 2, 0);
-    PyArrayObject *op = pa ? array_arg(oo, "opts", NPY_DOUBLE, 1, 0) : NULL;
-    if (op == NULL || bp_dim(pa, 1) != n || bp_dim(pa, 0) < 1 || bp_dim(op, 0) != SP_N_OPTS) {
-        work_free(&C.w);
-        return op == NULL ? NULL : bp_fail("plan_simplify: inconsistent shapes or options");
-    }
-    const double *opts = bp_f64(op);
-    long K = (long)bp_dim(pa, 0), cap = 2 * K + 16;
+    const double *opts = a->opts;
+    long K = (long)a->K, cap = 2 * K + 16;
     double *q = malloc((size_t)cap * n * sizeof(double));
     if (q == NULL)
         return check_failed(&C);
-    memcpy(q, bp_f64(pa), (size_t)K * n * sizeof(double));
+    memcpy(q, a->path, (size_t)K * n * sizeof(double));
     Rng rng;
-    rng_seed(&rng, (uint64_t)seed);
+    rng_seed(&rng, (uint64_t)a->seed);
     int r;
     Py_BEGIN_ALLOW_THREADS
     r = shortcut(&C, q, &K, cap, opts, &rng);
@@ -255,21 +243,4 @@ static PyObject *py_plan_simplify(PyObject *self, PyObject *args)
     if (out == NULL)
         return NULL;
     return Py_BuildValue("(NN)", out, stats_tuple(&C.st));
-}
-
-#define PLAN_PATH_METHODS                                                                \
-    {"plan_simplify", py_plan_simplify, METH_VARARGS,                                    \
-     "plan_simplify(model, path, margin, opts, seed, exact) -> (path, stats): random "   \
-     "shortcuts, then the sharp corners cut; every new edge checked."},
-
-static int plan_path_constants(PyObject *m)
-{
-    static const struct { const char *name; int value; } ints[] = {
-        {"SP_VERTEX_TRIES", SP_VERTEX_TRIES}, {"SP_TRIES", SP_TRIES},
-        {"SP_MAX_FAIL", SP_MAX_FAIL}, {"SP_TIME", SP_TIME}, {"SP_CUT_ROUNDS", SP_CUT_ROUNDS},
-        {"SP_SHARP_TURN", SP_SHARP_TURN}, {"SP_N_OPTS", SP_N_OPTS}};
-    for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
-        if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
-            return -1;
-    return 0;
 }

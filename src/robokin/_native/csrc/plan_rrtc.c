@@ -13,14 +13,12 @@
  * Nearest neighbours: a linear scan (trees of a few thousand nodes at most). The
  * generator and the clock serve plan_path.c too (included after this file).
  *
- * PLAN_RRTC_METHODS lists this file's entries of module.c's method table.
+ * plan_rrtc is declared in _native/_declare.py (its option vector RC_* too).
  */
 #include <time.h>
 
-/* plan_rrtc option vector (opts has RC_N_OPTS entries) */
-enum { RC_RANGE = 0, RC_TIME = 1, RC_MAX_NODES = 2, RC_N_OPTS = 3 };
-/* plan_shortcut option vector (opts has SC_N_OPTS entries) */
-enum { SC_VERTEX_TRIES = 0, SC_TRIES = 1, SC_MAX_FAIL = 2, SC_TIME = 3, SC_N_OPTS = 4 };
+/* the option vector (RC_RANGE, RC_TIME, RC_MAX_NODES; RC_N_OPTS entries) is generated
+ * from _declare.py's RC_OPTS into kernels_args.gen.h */
 /* results */
 enum { RC_SOLVED = 0, RC_TIMEOUT = 1, RC_NODES = 2, RC_FAILED = 3 };
 
@@ -299,36 +297,20 @@ static PyObject *path_array(const double *q, long K, int n)
 /* plan_rrtc(model, start (n,), goals (k, n), lo (n,), hi (n,), margin (P,), opts
  * (RC_N_OPTS,), seed, exact) -> (code, path (K, n) or None, goal index, stats,
  * (iterations, start nodes, goal nodes, seconds)) */
-static PyObject *py_plan_rrtc(PyObject *self, PyObject *args)
+static PyObject *plan_rrtc_body(const plan_rrtc_args *a)
 {
-    PyObject *mo, *so, *go, *lo_o, *hi_o, *mg, *oo, *cb;
-    unsigned long long seed;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOOOKO", &mo, &so, &go, &lo_o, &hi_o, &mg, &oo, &seed, &cb))
-        return NULL;
     Checker C;
-    if (!checker_args(mo, mg, cb, &C))
+    if (!checker_args(a->model, a->n, a->margin, a->P, a->exact, &C))
         return NULL;
     const int n = C.M->n;
-    PyArrayObject *st = array_arg(so, "start", NPY_DOUBLE, 1, 0);
-    PyArrayObject *gl = st ? array_arg(go, "goals", NPY_DOUBLE, 2, 0) : NULL;
-    PyArrayObject *lo = gl ? array_arg(lo_o, "lo", NPY_DOUBLE, 1, 0) : NULL;
-    PyArrayObject *hi = lo ? array_arg(hi_o, "hi", NPY_DOUBLE, 1, 0) : NULL;
-    PyArrayObject *op = hi ? array_arg(oo, "opts", NPY_DOUBLE, 1, 0) : NULL;
-    if (op == NULL || bp_dim(st, 0) != n || bp_dim(gl, 1) != n || bp_dim(gl, 0) < 1 ||
-        bp_dim(lo, 0) != n || bp_dim(hi, 0) != n || bp_dim(op, 0) != RC_N_OPTS ||
-        !(bp_f64(op)[RC_RANGE] > 0.0)) {
-        work_free(&C.w);
-        return op == NULL ? NULL : bp_fail("plan_rrtc: inconsistent shapes or options");
-    }
     Rng rng;
-    rng_seed(&rng, (uint64_t)seed);
+    rng_seed(&rng, (uint64_t)a->seed);
     Path path = {NULL, 0, -1};
     RrtStats rs = {0, 0, 0, 0.0};
     int code;
     Py_BEGIN_ALLOW_THREADS
-    code = rrt_connect(&C, bp_f64(st), bp_f64(gl), (long)bp_dim(gl, 0), bp_f64(lo), bp_f64(hi),
-                       bp_f64(op), &rng, &path, &rs);
+    code = rrt_connect(&C, a->start, a->goals, (long)a->k, a->lo, a->hi, a->opts, &rng, &path,
+                       &rs);
     Py_END_ALLOW_THREADS
     if (PyErr_Occurred()) {
         free(path.q);
@@ -347,21 +329,4 @@ static PyObject *py_plan_rrtc(PyObject *self, PyObject *args)
         return NULL;
     return Py_BuildValue("(iNlN(llld))", code, pa, path.goal, stats_tuple(&C.st), rs.iterations,
                          rs.nodes_start, rs.nodes_goal, rs.seconds);
-}
-
-#define PLAN_RRTC_METHODS                                                                \
-    {"plan_rrtc", py_plan_rrtc, METH_VARARGS,                                            \
-     "plan_rrtc(model, start, goals, lo, hi, margin, opts, seed, exact) -> (code, path, " \
-     "goal, stats, search): RRT-Connect with exact edge checks."},                       \
-
-static int plan_rrtc_constants(PyObject *m)
-{
-    static const struct { const char *name; int value; } ints[] = {
-        {"RC_RANGE", RC_RANGE}, {"RC_TIME", RC_TIME}, {"RC_MAX_NODES", RC_MAX_NODES},
-        {"RC_N_OPTS", RC_N_OPTS}, {"RC_SOLVED", RC_SOLVED}, {"RC_TIMEOUT", RC_TIMEOUT}, {"RC_NODES", RC_NODES},
-        {"RC_FAILED", RC_FAILED}};
-    for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
-        if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
-            return -1;
-    return 0;
 }

@@ -22,11 +22,11 @@ void pool_for(long n, long grain, pool_task fn, void *ctx)
 #include <sched.h>
 #include <unistd.h>
 
-static pthread_mutex_t job_lock = PTHREAD_MUTEX_INITIALIZER; /* one job at a time */
-static pthread_mutex_t mu = PTHREAD_MUTEX_INITIALIZER;
+static pthread_mutex_t job_lock = PTHREAD_MUTEX_INITIALIZER; /* one pool_job at a time */
+static pthread_mutex_t pool_mu = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t cv_start = PTHREAD_COND_INITIALIZER;
 static pthread_cond_t cv_done = PTHREAD_COND_INITIALIZER;
-static int threads = 0;  /* configured count (0: not yet read) */
+static int pool_n = 0;  /* configured count (0: not yet read) */
 static int started = 0;  /* workers running */
 static long generation = 0;
 static struct {
@@ -36,7 +36,7 @@ static struct {
     long next;  /* atomic: first item of the next chunk */
     int wanted; /* workers taking part */
     int done;   /* workers finished */
-} job;
+} pool_job;
 
 static int default_threads(void)
 {
@@ -58,26 +58,36 @@ static int default_threads(void)
     return k < 1 ? 1 : (k < POOL_MAX ? (int)k : POOL_MAX);
 }
 
+/* pool_n is read by pool_for with the GIL released and written by
+ * set_num_threads with it held (another thread may be in pool_for): atomic. */
 int pool_threads(void)
 {
-    if (threads == 0)
-        threads = default_threads();
-    return threads;
+    int k = __atomic_load_n(&pool_n, __ATOMIC_RELAXED);
+    if (k == 0) {
+        int zero = 0, d = default_threads();
+        /* first use: the default, unless another thread set a count meanwhile */
+        if (__atomic_compare_exchange_n(&pool_n, &zero, d, 0, __ATOMIC_RELAXED,
+                                        __ATOMIC_RELAXED))
+            k = d;
+        else
+            k = zero;
+    }
+    return k;
 }
 
 void pool_set_threads(int n)
 {
-    threads = n < 1 ? 1 : (n > POOL_MAX ? POOL_MAX : n);
+    __atomic_store_n(&pool_n, n < 1 ? 1 : (n > POOL_MAX ? POOL_MAX : n), __ATOMIC_RELAXED);
 }
 
 static void run_chunks(void)
 {
     for (;;) {
-        long b = __atomic_fetch_add(&job.next, job.grain, __ATOMIC_RELAXED);
-        if (b >= job.n)
+        long b = __atomic_fetch_add(&pool_job.next, pool_job.grain, __ATOMIC_RELAXED);
+        if (b >= pool_job.n)
             return;
-        long e = b + job.grain < job.n ? b + job.grain : job.n;
-        job.fn(job.ctx, b, e);
+        long e = b + pool_job.grain < pool_job.n ? b + pool_job.grain : pool_job.n;
+        pool_job.fn(pool_job.ctx, b, e);
     }
 }
 
@@ -85,33 +95,44 @@ static void *worker_main(void *arg)
 {
     int id = (int)(long)arg; /* 1, 2, ... */
     long seen = 0;
-    pthread_mutex_lock(&mu);
+    pthread_mutex_lock(&pool_mu);
     for (;;) {
         while (generation == seen)
-            pthread_cond_wait(&cv_start, &mu);
+            pthread_cond_wait(&cv_start, &pool_mu);
         seen = generation;
-        if (id > job.wanted)
+        if (id > pool_job.wanted)
             continue;
-        pthread_mutex_unlock(&mu);
+        pthread_mutex_unlock(&pool_mu);
         run_chunks();
-        pthread_mutex_lock(&mu);
-        if (++job.done == job.wanted)
+        pthread_mutex_lock(&pool_mu);
+        if (++pool_job.done == pool_job.wanted)
             pthread_cond_signal(&cv_done);
     }
     return NULL;
 }
 
-static void atfork_prepare(void) { pthread_mutex_lock(&job_lock); }
-static void atfork_parent(void) { pthread_mutex_unlock(&job_lock); }
+/* fork: the parent holds both locks across fork() (no job runs, no worker is
+ * between two states), so the child gets them unlocked by their owner (the
+ * forking thread, its only thread) and fresh condition variables; its workers did
+ * not come along, so it starts its own on first use. */
+static void atfork_prepare(void)
+{
+    pthread_mutex_lock(&job_lock);
+    pthread_mutex_lock(&pool_mu);
+}
+
+static void atfork_parent(void)
+{
+    pthread_mutex_unlock(&pool_mu);
+    pthread_mutex_unlock(&job_lock);
+}
+
 static void atfork_child(void)
 {
-    /* the workers did not come along: start afresh */
-    pthread_mutex_t m0 = PTHREAD_MUTEX_INITIALIZER;
-    pthread_cond_t c0 = PTHREAD_COND_INITIALIZER;
-    job_lock = m0;
-    mu = m0;
-    cv_start = c0;
-    cv_done = c0;
+    pthread_mutex_unlock(&pool_mu);
+    pthread_mutex_unlock(&job_lock);
+    pthread_cond_init(&cv_start, NULL);
+    pthread_cond_init(&cv_done, NULL);
     started = 0;
     generation = 0;
 }
@@ -128,14 +149,14 @@ void pool_for(long n, long grain, pool_task fn, void *ctx)
     if (want > chunks - 1)
         want = (int)(chunks - 1);
     if (want <= 0 || pthread_mutex_trylock(&job_lock) != 0) {
-        fn(ctx, 0, n); /* one chunk, one thread, or another job is running */
+        fn(ctx, 0, n); /* one chunk, one thread, or another pool_job is running */
         return;
     }
     if (!registered) {
         pthread_atfork(atfork_prepare, atfork_parent, atfork_child);
         registered = 1;
     }
-    pthread_mutex_lock(&mu);
+    pthread_mutex_lock(&pool_mu);
     while (started < want) {
         pthread_t th;
         pthread_attr_t attr;
@@ -149,21 +170,21 @@ void pool_for(long n, long grain, pool_task fn, void *ctx)
     }
     if (want > started)
         want = started;
-    job.fn = fn;
-    job.ctx = ctx;
-    job.n = n;
-    job.grain = grain;
-    job.next = 0;
-    job.wanted = want;
-    job.done = 0;
+    pool_job.fn = fn;
+    pool_job.ctx = ctx;
+    pool_job.n = n;
+    pool_job.grain = grain;
+    pool_job.next = 0;
+    pool_job.wanted = want;
+    pool_job.done = 0;
     generation++;
     pthread_cond_broadcast(&cv_start);
-    pthread_mutex_unlock(&mu);
+    pthread_mutex_unlock(&pool_mu);
     run_chunks();
-    pthread_mutex_lock(&mu);
-    while (job.done < job.wanted)
-        pthread_cond_wait(&cv_done, &mu);
-    pthread_mutex_unlock(&mu);
+    pthread_mutex_lock(&pool_mu);
+    while (pool_job.done < pool_job.wanted)
+        pthread_cond_wait(&cv_done, &pool_mu);
+    pthread_mutex_unlock(&pool_mu);
     pthread_mutex_unlock(&job_lock);
 }
 #endif

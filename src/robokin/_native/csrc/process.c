@@ -33,8 +33,8 @@
  *   Where no node of a layer can be reached the search restarts there (a new
  *   segment), so every layer gets a configuration where one exists.
  *
- * PROCESS_METHODS lists this file's entries of module.c's method table;
- * process_constants(m) adds its constants.
+ * Its entries and constants are declared in ../_declare.py (PROCESS); the
+ * generated entry points check the arguments before the bodies run.
  */
 #include "chain.h"
 #include "pool.h"
@@ -741,250 +741,83 @@ static void pairs_range(void *ctx, long r0, long r1)
 
 /* ------------------------------------------------------------ Python bindings */
 
-static PyArrayObject *pr_arg(PyObject *o, const char *name, int type, int ndim,
-                             int writeable)
+/* every coordinate's mode known, and turn modes only where the coordinate wraps */
+static int pr_modes_ok(const Chain *ch, const unsigned char *mode)
 {
-    if (!PyArray_Check(o)) {
-        PyErr_Format(PyExc_ValueError, "robokin._native: %s is not an ndarray", name);
-        return NULL;
-    }
-    PyArrayObject *a = (PyArrayObject *)o;
-    if (PyArray_TYPE(a) != type || PyArray_NDIM(a) != ndim || !PyArray_IS_C_CONTIGUOUS(a) ||
-        !PyArray_ISNOTSWAPPED(a) || !PyArray_ISALIGNED(a) ||
-        (writeable && !PyArray_ISWRITEABLE(a))) {
-        PyErr_Format(PyExc_ValueError,
-                     "robokin._native: %s must be a C-contiguous native array of type %d "
-                     "with %d dimension(s)%s", name, type, ndim,
-                     writeable ? ", writeable" : "");
-        return NULL;
-    }
-    return a;
+    for (int j = 0; j < ch->n; j++)
+        if (mode[j] > PM_CIRCLE || (mode[j] != PM_PLAIN && ch->wrap[j] != 1.0))
+            return 0;
+    return 1;
 }
 
-#define PR_DIM(a, d) (PyArray_DIMS(a)[d])
-#define PR_DATA(T, a) ((T *)PyArray_DATA(a))
-
-static PyObject *pr_fail(const char *what)
+/* forbidden edges (F, 3) = (layer, u, v): inside (L - 1, M, M), sorted by (layer, v) */
+static int pr_forbidden_ok(const long long *e, npy_intp F, npy_intp L, npy_intp M)
 {
-    PyErr_Format(PyExc_ValueError, "robokin._native.%s", what);
-    return NULL;
-}
-
-static int pr_chain(PyObject *o, Chain *ch)
-{
-    PyArrayObject *p = pr_arg(o, "packed", NPY_DOUBLE, 1, 0);
-    if (p == NULL)
-        return 0;
-    if (!chain_view(PR_DATA(double, p), (long)PR_DIM(p, 0), ch)) {
-        pr_fail("process: packed is not a ChainArrays layout");
-        return 0;
+    for (npy_intp p = 0; p < F; p++) {
+        if (e[3 * p] < 0 || e[3 * p] >= L - 1 || e[3 * p + 1] < 0 || e[3 * p + 1] >= M ||
+            e[3 * p + 2] < 0 || e[3 * p + 2] >= M)
+            return 0;
+        if (p > 0 && (e[3 * p] < e[3 * p - 3] ||
+                      (e[3 * p] == e[3 * p - 3] && e[3 * p + 2] < e[3 * p - 1])))
+            return 0;
     }
     return 1;
 }
 
-/* process_nodes(packed, Q (P, n), valid (P,) bool, singular (P,) bool, mode (n,) uint8,
- *               weights (PW_N,), Qc (P, n), cost (P,), mu (P,), code (P,) int8) */
-static PyObject *py_process_nodes(PyObject *self, PyObject *args)
+/* canonical values, status, relative manipulability and cost of every node */
+static PyObject *process_nodes_body(const process_nodes_args *a)
 {
-    PyObject *po, *o[9];
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOO", &po, &o[0], &o[1], &o[2], &o[3], &o[4],
-                          &o[5], &o[6], &o[7], &o[8]))
-        return NULL;
-    Chain ch;
-    if (!pr_chain(po, &ch))
-        return NULL;
-    static const char *names[9] = {"Q", "valid", "singular", "mode", "weights",
-                                   "Qc", "cost", "mu", "code"};
-    static const int types[9] = {NPY_DOUBLE, NPY_BOOL, NPY_BOOL, NPY_UINT8, NPY_DOUBLE,
-                                 NPY_DOUBLE, NPY_DOUBLE, NPY_DOUBLE, NPY_INT8};
-    static const int ndims[9] = {2, 1, 1, 1, 1, 2, 1, 1, 1};
-    PyArrayObject *a[9];
-    for (int i = 0; i < 9; i++)
-        if ((a[i] = pr_arg(o[i], names[i], types[i], ndims[i], i >= 5)) == NULL)
-            return NULL;
-    npy_intp P = PR_DIM(a[0], 0);
-    int n = ch.n;
-    if (PR_DIM(a[0], 1) != n || PR_DIM(a[1], 0) != P || PR_DIM(a[2], 0) != P ||
-        PR_DIM(a[3], 0) != n || PR_DIM(a[4], 0) != PW_N || PR_DIM(a[5], 0) != P ||
-        PR_DIM(a[5], 1) != n || PR_DIM(a[6], 0) != P || PR_DIM(a[7], 0) != P ||
-        PR_DIM(a[8], 0) != P)
-        return pr_fail("process_nodes: inconsistent shapes");
-    const unsigned char *mode = PR_DATA(unsigned char, a[3]);
-    for (int j = 0; j < n; j++)
-        if (mode[j] > PM_CIRCLE || (mode[j] != PM_PLAIN && ch.wrap[j] != 1.0))
-            return pr_fail("process_nodes: a turn mode on a coordinate that does not wrap");
-    NodeJob job = {&ch, PR_DATA(double, a[0]), PR_DATA(npy_bool, a[1]),
-                   PR_DATA(npy_bool, a[2]), mode, PR_DATA(double, a[4]),
-                   PR_DATA(double, a[5]), PR_DATA(double, a[6]), PR_DATA(double, a[7]),
-                   PR_DATA(signed char, a[8])};
+    NodeJob job = {&a->packed, a->Q, a->valid, a->singular, a->mode, a->weights, a->Qc,
+                   a->cost, a->mu, a->code};
     Py_BEGIN_ALLOW_THREADS
-    pool_for((long)P, PR_GRAIN, nodes_range, &job);
+    pool_for((long)a->P, PR_GRAIN, nodes_range, &job);
     Py_END_ALLOW_THREADS
     Py_RETURN_NONE;
 }
 
-/* process_dp(Q (L, M, n), cost (L, M), circle (n,) uint8, max_step, weight,
- *            start (M,), forbidden (F, 3) int64, value (L, M), pred (L, M) int32,
- *            restart (L,) uint8, choice (L,) int32) -> segments */
-static PyObject *py_process_dp(PyObject *self, PyObject *args)
+/* the exact layered shortest path -> segments */
+static PyObject *process_dp_body(const process_dp_args *a)
 {
-    PyObject *o[9];
-    double max_step, weight;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOddOOOOOO", &o[0], &o[1], &o[2], &max_step, &weight,
-                          &o[3], &o[4], &o[5], &o[6], &o[7], &o[8]))
-        return NULL;
-    static const char *names[9] = {"Q", "cost", "circle", "start", "forbidden",
-                                   "value", "pred", "restart", "choice"};
-    static const int types[9] = {NPY_DOUBLE, NPY_DOUBLE, NPY_UINT8, NPY_DOUBLE, NPY_INT64,
-                                 NPY_DOUBLE, NPY_INT32, NPY_UINT8, NPY_INT32};
-    static const int ndims[9] = {3, 2, 1, 1, 2, 2, 2, 1, 1};
-    PyArrayObject *a[9];
-    for (int i = 0; i < 9; i++)
-        if ((a[i] = pr_arg(o[i], names[i], types[i], ndims[i], i >= 5)) == NULL)
-            return NULL;
-    npy_intp L = PR_DIM(a[0], 0), M = PR_DIM(a[0], 1), n = PR_DIM(a[0], 2);
-    npy_intp F = PR_DIM(a[4], 0);
-    if (L < 1 || M < 1 || n < 1 || n > MAXJ || M > 0x3fffffff || PR_DIM(a[1], 0) != L ||
-        PR_DIM(a[1], 1) != M || PR_DIM(a[2], 0) != n || PR_DIM(a[3], 0) != M ||
-        PR_DIM(a[4], 1) != 3 || PR_DIM(a[5], 0) != L || PR_DIM(a[5], 1) != M ||
-        PR_DIM(a[6], 0) != L || PR_DIM(a[6], 1) != M || PR_DIM(a[7], 0) != L ||
-        PR_DIM(a[8], 0) != L)
-        return pr_fail("process_dp: inconsistent shapes");
-    if (!(max_step > 0.0) || !(weight >= 0.0) || !isfinite(weight))
-        return pr_fail("process_dp: max_step must be > 0 and weight finite and >= 0");
-    const long long *e = PR_DATA(long long, a[4]);
-    for (npy_intp p = 0; p < F; p++) {
-        if (e[3 * p] < 0 || e[3 * p] >= L - 1 || e[3 * p + 1] < 0 || e[3 * p + 1] >= M ||
-            e[3 * p + 2] < 0 || e[3 * p + 2] >= M)
-            return pr_fail("process_dp: a forbidden edge out of range");
-        if (p > 0 && (e[3 * p] < e[3 * p - 3] ||
-                      (e[3 * p] == e[3 * p - 3] && e[3 * p + 2] < e[3 * p - 1])))
-            return pr_fail("process_dp: forbidden edges not sorted by (layer, v)");
-    }
-    Graph g = {PR_DATA(double, a[0]), PR_DATA(double, a[1]), PR_DATA(unsigned char, a[2]),
-               (int)M, (int)n, max_step, weight};
-    Forbidden fb = {e, (long)F, 0};
-    unsigned char *restart = PR_DATA(unsigned char, a[7]);
+    Graph g = {a->Q, a->cost, a->circle, (int)a->M, (int)a->n, a->max_step, a->weight};
+    Forbidden fb = {a->forbidden, (long)a->F, 0};
     int rc;
     Py_BEGIN_ALLOW_THREADS
-    rc = layered_search(&g, (long)L, PR_DATA(double, a[3]), &fb, PR_DATA(double, a[5]),
-                        PR_DATA(int, a[6]), restart, PR_DATA(int, a[8]));
+    rc = layered_search(&g, (long)a->L, a->start, &fb, a->value, a->pred, a->restart,
+                        a->choice);
     Py_END_ALLOW_THREADS
     if (rc < 0)
         return PyErr_NoMemory();
     long segments = 0;
-    for (npy_intp s = 0; s < L; s++)
-        segments += restart[s];
+    for (npy_intp s = 0; s < a->L; s++)
+        segments += a->restart[s];
     return PyLong_FromLong(segments);
 }
 
-/* process_clusters(Q (P, M, n), cost (P, M), circle (n,) uint8, out (P, P)): the
- * least largest-joint-change between the usable nodes of every two layers */
-static PyObject *py_process_clusters(PyObject *self, PyObject *args)
+/* the least largest-joint-change between the usable nodes of every two layers */
+static PyObject *process_clusters_body(const process_clusters_args *a)
 {
-    PyObject *o[4];
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOO", &o[0], &o[1], &o[2], &o[3]))
-        return NULL;
-    static const char *names[4] = {"Q", "cost", "circle", "out"};
-    static const int types[4] = {NPY_DOUBLE, NPY_DOUBLE, NPY_UINT8, NPY_DOUBLE};
-    static const int ndims[4] = {3, 2, 1, 2};
-    PyArrayObject *a[4];
-    for (int i = 0; i < 4; i++)
-        if ((a[i] = pr_arg(o[i], names[i], types[i], ndims[i], i == 3)) == NULL)
-            return NULL;
-    npy_intp P = PR_DIM(a[0], 0), M = PR_DIM(a[0], 1), n = PR_DIM(a[0], 2);
-    if (n < 1 || n > MAXJ || PR_DIM(a[1], 0) != P || PR_DIM(a[1], 1) != M ||
-        PR_DIM(a[2], 0) != n || PR_DIM(a[3], 0) != P || PR_DIM(a[3], 1) != P ||
-        M > 0x3fffffff || P > 0x3fffffff)
-        return pr_fail("process_clusters: inconsistent shapes");
-    ClusterJob job = {PR_DATA(double, a[0]), PR_DATA(double, a[1]),
-                      PR_DATA(unsigned char, a[2]), (int)P, (int)M, (int)n,
-                      PR_DATA(double, a[3])};
+    ClusterJob job = {a->Q, a->cost, a->circle, (int)a->P, (int)a->M, (int)a->n, a->out};
     Py_BEGIN_ALLOW_THREADS
-    pool_for((long)P, 1, clusters_range, &job);
+    pool_for((long)a->P, 1, clusters_range, &job);
     Py_END_ALLOW_THREADS
     Py_RETURN_NONE;
 }
 
-/* process_pairs(A (a, n), B (b, n), circle (n,) uint8, out (a, b)): the largest
- * joint change between every row of A and every row of B (canonical values) */
-static PyObject *py_process_pairs(PyObject *self, PyObject *args)
+/* the largest joint change between every row of A and every row of B */
+static PyObject *process_pairs_body(const process_pairs_args *a)
 {
-    PyObject *o[4];
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOO", &o[0], &o[1], &o[2], &o[3]))
-        return NULL;
-    static const char *names[4] = {"A", "B", "circle", "out"};
-    static const int types[4] = {NPY_DOUBLE, NPY_DOUBLE, NPY_UINT8, NPY_DOUBLE};
-    static const int ndims[4] = {2, 2, 1, 2};
-    PyArrayObject *a[4];
-    for (int i = 0; i < 4; i++)
-        if ((a[i] = pr_arg(o[i], names[i], types[i], ndims[i], i == 3)) == NULL)
-            return NULL;
-    npy_intp na = PR_DIM(a[0], 0), nb = PR_DIM(a[1], 0), n = PR_DIM(a[0], 1);
-    if (n < 1 || n > MAXJ || PR_DIM(a[1], 1) != n || PR_DIM(a[2], 0) != n ||
-        PR_DIM(a[3], 0) != na || PR_DIM(a[3], 1) != nb)
-        return pr_fail("process_pairs: inconsistent shapes");
-    PairJob job = {PR_DATA(double, a[0]), PR_DATA(double, a[1]),
-                   PR_DATA(unsigned char, a[2]), (long)nb, (int)n, PR_DATA(double, a[3])};
-    long grain = nb > 0 ? 1 + 4096 / (long)nb : 1;
+    PairJob job = {a->A, a->B, a->circle, (long)a->nb, (int)a->n, a->out};
+    long grain = a->nb > 0 ? 1 + 4096 / (long)a->nb : 1;
     Py_BEGIN_ALLOW_THREADS
-    pool_for((long)na, grain, pairs_range, &job);
+    pool_for((long)a->na, grain, pairs_range, &job);
     Py_END_ALLOW_THREADS
     Py_RETURN_NONE;
 }
 
-/* process_limit_cost(values (P,), lo, hi, margin, out (P,)): limit_ramp per value
- * (the limit cost process_nodes adds up, for the turn choice in Python) */
-static PyObject *py_process_limit_cost(PyObject *self, PyObject *args)
+/* limit_ramp per value (the limit cost process_nodes adds up) */
+static PyObject *process_limit_cost_body(const process_limit_cost_args *a)
 {
-    PyObject *vo, *oo;
-    double lo, hi, margin;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OdddO", &vo, &lo, &hi, &margin, &oo))
-        return NULL;
-    PyArrayObject *v = pr_arg(vo, "values", NPY_DOUBLE, 1, 0);
-    PyArrayObject *out = v == NULL ? NULL : pr_arg(oo, "out", NPY_DOUBLE, 1, 1);
-    if (out == NULL)
-        return NULL;
-    npy_intp P = PR_DIM(v, 0);
-    if (PR_DIM(out, 0) != P)
-        return pr_fail("process_limit_cost: values and out differ in size");
-    const double *x = PR_DATA(double, v);
-    double *y = PR_DATA(double, out);
-    for (npy_intp i = 0; i < P; i++)
-        y[i] = limit_ramp(x[i], lo, hi, margin);
+    for (npy_intp i = 0; i < a->P; i++)
+        a->out[i] = limit_ramp(a->values[i], a->lo, a->hi, a->margin);
     Py_RETURN_NONE;
-}
-
-#define PROCESS_METHODS                                                                  \
-    {"process_nodes", py_process_nodes, METH_VARARGS,                                    \
-     "process_nodes(packed, Q, valid, singular, mode, weights, Qc, cost, mu, code): "    \
-     "canonical values, status, relative manipulability and cost of every node."},       \
-    {"process_dp", py_process_dp, METH_VARARGS,                                          \
-     "process_dp(Q, cost, circle, max_step, weight, start, forbidden, value, pred, "     \
-     "restart, choice) -> segments: the exact layered shortest path."},                   \
-    {"process_clusters", py_process_clusters, METH_VARARGS,                              \
-     "process_clusters(Q, cost, circle, out): the least step between every two layers."}, \
-    {"process_pairs", py_process_pairs, METH_VARARGS,                                    \
-     "process_pairs(A, B, circle, out): the largest joint change between all rows."},    \
-    {"process_limit_cost", py_process_limit_cost, METH_VARARGS,                          \
-     "process_limit_cost(values, lo, hi, margin, out): the limit cost of each value."},
-
-static int process_constants(PyObject *m)
-{
-    static const struct { const char *name; int value; } ints[] = {
-        {"PN_OK", PN_OK}, {"PN_NONE", PN_NONE}, {"PN_LIMITS", PN_LIMITS},
-        {"PN_SINGULAR", PN_SINGULAR}, {"PM_PLAIN", PM_PLAIN}, {"PM_TURN", PM_TURN},
-        {"PM_CIRCLE", PM_CIRCLE}, {"PW_SING_W", PW_SING_W},
-        {"PW_SING_MARGIN", PW_SING_MARGIN}, {"PW_SING_TOL", PW_SING_TOL},
-        {"PW_MU_REF", PW_MU_REF}, {"PW_LIM_W", PW_LIM_W}, {"PW_LIM_MARGIN", PW_LIM_MARGIN},
-        {"PW_N", PW_N}, {"PR_MAXB", PR_MAXB}};
-    for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
-        if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
-            return -1;
-    return PyModule_AddObject(m, "PR_LIMIT_TOL", PyFloat_FromDouble(PR_LIMIT_TOL));
 }

@@ -54,7 +54,7 @@
  * wrist) is below SR_CHECK_BAND; the others are not singular.
  *
  * Both families read one flat parameter vector that _six_r.pack writes (Python
- * reads these indices from the module constants six_r_constants adds, named
+ * reads these indices from the module constants _declare.py declares, named
  * without the SR_):
  *
  *   SR_AXES      unit joint axes h1..h6 (base frame, zero chain values), 6 x 3
@@ -1445,10 +1445,10 @@ static void sw_block(const SR *K, const Chain *ch, const double *const *T,
         LRoots r3 = elbow_roots(K, rhs3);
         L3 g61 = l3_rot(K->h[0], c.c1, -c.s1, g6);
         for (int i3 = 0; i3 < 2; i3++) {
-            vl m3 = m1 & (i3 ? r3.two : r3.one);
-            if (!vany(m3))
+            vl mask3 = m1 & (i3 ? r3.two : r3.one);
+            if (!vany(mask3))
                 continue;
-            any_pos |= m3;
+            any_pos |= mask3;
             vd th3 = r3.t[i3], c3 = r3.c[i3], s3 = r3.s[i3], c2, s2;
             L3 u = l3_addc(l3_rotc(K->h[2], c3, s3, K->b), K->a);
             vd th2 = lsp1(K->h[1], u, d, &c2, &s2);
@@ -1467,7 +1467,7 @@ static void sw_block(const SR *K, const Chain *ch, const double *const *T,
             vl check = ~r1.two | ~r3.two | ~r5.two | (gap < SR_CHECK_BAND) |
                        BRL(K->check > 0.0 ? -1 : 0);
             for (int i5 = 0; i5 < 2; i5++) {
-                vl m5 = m3 & (i5 ? r5.two & ~free_ : r5.one);
+                vl m5 = mask3 & (i5 ? r5.two & ~free_ : r5.one);
                 if (!vany(m5))
                     continue;
                 c.c5 = r5.c[i5];
@@ -1556,10 +1556,6 @@ static void six_r_block(const SR *K, const Chain *ch, const double *const *T,
 
 /* --------------------------------------------------------------- entries */
 
-/* module.c's argument helpers (defined there, after this file) */
-static PyArrayObject *array_arg(PyObject *o, const char *name, int typenum, int ndim,
-                                int writeable);
-static int chain_arg(PyObject *o, Chain *ch);
 #define SR_F64(a) ((double *)PyArray_DATA((PyArrayObject *)(a)))
 #define SR_U8(a) ((unsigned char *)PyArray_DATA((PyArrayObject *)(a)))
 #define SR_DIM(a, d) (PyArray_DIMS(a)[d])
@@ -1596,32 +1592,10 @@ static void six_r_range(void *ctx, long b, long e)
     }
 }
 
-/* params as a parameter vector of a known family, or NULL with ValueError */
-static const double *six_r_params(PyObject *o)
+/* whether params (SR_N_PARAMS values) is a parameter vector of a known family */
+static int six_r_params_ok(const double *P)
 {
-    PyArrayObject *a = array_arg(o, "params", NPY_DOUBLE, 1, 0);
-    if (a == NULL)
-        return NULL;
-    const double *P = SR_F64(a);
-    if (SR_DIM(a, 0) != SR_N_PARAMS ||
-        (P[SR_FAMILY] != SR_THREE_PARALLEL && P[SR_FAMILY] != SR_SPHERICAL_WRIST)) {
-        PyErr_SetString(PyExc_ValueError,
-                        "robokin._native: params is not a 6R parameter vector (_six_r.pack)");
-        return NULL;
-    }
-    return P;
-}
-
-/* The chain of a 6R closed form (6 joints, 6 coordinates), or NULL with ValueError */
-static int six_r_chain(PyObject *o, Chain *ch)
-{
-    if (!chain_arg(o, ch))
-        return 0;
-    if (ch->nc != 6 || ch->n != 6) {
-        PyErr_SetString(PyExc_ValueError, "robokin._native: packed is not a 6R chain");
-        return 0;
-    }
-    return 1;
+    return P[SR_FAMILY] == SR_THREE_PARALLEL || P[SR_FAMILY] == SR_SPHERICAL_WRIST;
 }
 
 /* (Q, valid, singular, within_limits) arrays, shapes lead + (8, 6) and lead + (8,)
@@ -1646,25 +1620,14 @@ static int six_r_outputs(int nlead, npy_intp N, PyObject **out)
  * (BAD_POSE + pose_problem's code, or BAD_POSE itself when T is not a float64
  * (4, 4) array); the caller takes its general, validating path. The fast path for
  * one pose: METH_FASTCALL, no pool, T read through its strides, lane 0 of a block. */
-static PyObject *py_six_r_ik1(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+static PyObject *six_r_ik1_body(const six_r_ik1_args *a)
 {
-    (void)self;
-    if (nargs != 4) {
-        PyErr_SetString(PyExc_TypeError, "six_r_ik1(T, params, q6, packed) takes 4 arguments");
-        return NULL;
-    }
-    const double *P = six_r_params(args[1]);
-    if (P == NULL)
-        return NULL;
-    double q6 = PyFloat_AsDouble(args[2]);
-    if (q6 == -1.0 && PyErr_Occurred())
-        return NULL;
-    Chain ch;
-    if (!six_r_chain(args[3], &ch))
-        return NULL;
+    const double *P = a->params;
+    double q6 = a->q6;
+    const Chain ch = a->packed;
     int code = SR_BAD_POSE;
     double T[16];
-    PyObject *to = args[0];
+    PyObject *to = a->T;
     if (PyArray_Check(to)) {
         PyArrayObject *ta = (PyArrayObject *)to;
         if (PyArray_TYPE(ta) == NPY_DOUBLE && PyArray_NDIM(ta) == 2 && SR_DIM(ta, 0) == 4 &&
@@ -1711,24 +1674,10 @@ static PyObject *py_six_r_ik1(PyObject *self, PyObject *const *args, Py_ssize_t 
  * singular, within_limits (N, 8), status (N,) int8): a batch, not validated (the
  * caller checked the poses); joint 6 at the wrist singularity is qn[i % m, 5].
  * Batches of PARALLEL_MIN poses or more run on the pool. */
-static PyObject *py_six_r_ik(PyObject *self, PyObject *args)
+static PyObject *six_r_ik_body(const six_r_ik_args *a)
 {
-    PyObject *po, *to, *qo, *co;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOOO", &po, &to, &qo, &co))
-        return NULL;
-    const double *P = six_r_params(po);
-    PyArrayObject *T, *qn;
-    Chain ch;
-    if (P == NULL || !(T = array_arg(to, "T", NPY_DOUBLE, 3, 0)) ||
-        !(qn = array_arg(qo, "qn", NPY_DOUBLE, 2, 0)) || !six_r_chain(co, &ch))
-        return NULL;
-    if (SR_DIM(T, 1) != 4 || SR_DIM(T, 2) != 4 || SR_DIM(qn, 0) < 1 || SR_DIM(qn, 1) != 6) {
-        PyErr_SetString(PyExc_ValueError,
-                        "robokin._native.six_r_ik: T must be (N, 4, 4) and qn (m >= 1, 6)");
-        return NULL;
-    }
-    npy_intp N = SR_DIM(T, 0);
+    const double *P = a->params;
+    npy_intp N = a->N;
     PyObject *out[4];
     if (!six_r_outputs(1, N, out))
         return NULL;
@@ -1741,7 +1690,7 @@ static PyObject *py_six_r_ik(PyObject *self, PyObject *args)
     }
     SR K;
     sr_read(P, &K);
-    SixRJob jb = {&K, &ch, SR_F64(T), SR_F64(qn), (long)SR_DIM(qn, 0), SR_F64(out[0]),
+    SixRJob jb = {&K, &a->packed, a->T, a->qn, (long)a->m, SR_F64(out[0]),
                   SR_U8(out[1]), SR_U8(out[2]), SR_U8(out[3]),
                   (signed char *)PyArray_DATA((PyArrayObject *)status)};
     Py_BEGIN_ALLOW_THREADS
@@ -1754,66 +1703,19 @@ static PyObject *py_six_r_ik(PyObject *self, PyObject *args)
 }
 
 /* atan2(y (N,), x (N,), out (N,)): the kernels' atan2 (for tests) */
-static PyObject *py_six_r_atan2(PyObject *self, PyObject *args)
+static PyObject *atan2_body(const atan2_args *a)
 {
-    PyObject *yo, *xo, *oo;
-    (void)self;
-    if (!PyArg_ParseTuple(args, "OOO", &yo, &xo, &oo))
-        return NULL;
-    PyArrayObject *y, *x, *out;
-    if (!(y = array_arg(yo, "y", NPY_DOUBLE, 1, 0)) ||
-        !(x = array_arg(xo, "x", NPY_DOUBLE, 1, 0)) ||
-        !(out = array_arg(oo, "out", NPY_DOUBLE, 1, 1)))
-        return NULL;
-    npy_intp N = SR_DIM(y, 0);
-    if (SR_DIM(x, 0) != N || SR_DIM(out, 0) != N) {
-        PyErr_SetString(PyExc_ValueError, "robokin._native.atan2: sizes differ");
-        return NULL;
-    }
+    npy_intp N = a->N;
     for (npy_intp i = 0; i < N; i += W) {
         vd yv, xv;
         for (int l = 0; l < W; l++) {
-            yv[l] = SR_F64(y)[i + l < N ? i + l : i];
-            xv[l] = SR_F64(x)[i + l < N ? i + l : i];
+            yv[l] = a->y[i + l < N ? i + l : i];
+            xv[l] = a->x[i + l < N ? i + l : i];
         }
         vd r = vatan2(yv, xv);
         for (int l = 0; l < W && i + l < N; l++)
-            SR_F64(out)[i + l] = r[l];
+            a->out[i + l] = r[l];
     }
     Py_RETURN_NONE;
 }
 
-#define SIX_R_METHODS                                                                    \
-    {"six_r_ik1", (PyCFunction)(void (*)(void))py_six_r_ik1, METH_FASTCALL,              \
-     "six_r_ik1(T, params, q6, packed) -> (code, Q, valid, singular, within_limits): "    \
-     "one pose of a 6R closed form, validated."},                                         \
-    {"six_r_ik", py_six_r_ik, METH_VARARGS,                                              \
-     "six_r_ik(params, T, qn, packed) -> (Q, valid, singular, within_limits, status): "   \
-     "a batch of a 6R closed form."},                                                     \
-    {"atan2", py_six_r_atan2, METH_VARARGS, "atan2(y, x, out): the kernels' atan2."},
-
-static int six_r_constants(PyObject *m)
-{
-    static const struct { const char *name; int value; } ints[] = {
-        {"AXES", SR_AXES}, {"POINTS", SR_POINTS}, {"WRIST", SR_WRIST}, {"PERP2", SR_PERP2},
-        {"TOOL_T", SR_TOOL_T}, {"TOOL_R", SR_TOOL_R}, {"PERP", SR_PERP},
-        {"SIGN", SR_SIGN}, {"OFFSET", SR_OFFSET}, {"LO", SR_LO}, {"HI", SR_HI},
-        {"S3", SR_S3}, {"S4", SR_S4}, {"SING_TOL", SR_SING_TOL},
-        {"DISC_TOL", SR_DISC_TOL}, {"MIRROR", SR_MIRROR},
-        {"A3", SR_A3}, {"B3", SR_B3}, {"C3", SR_C3}, {"PHI3", SR_PHI3},
-        {"CPHI3", SR_CPHI3}, {"SPHI3", SR_SPHI3},
-        {"A5", SR_A5}, {"B5", SR_B5}, {"C5", SR_C5}, {"PHI5", SR_PHI5},
-        {"CPHI5", SR_CPHI5}, {"SPHI5", SR_SPHI5},
-        {"AA", SR_AA}, {"BB", SR_BB}, {"FAMILY", SR_FAMILY}, {"E5", SR_E5},
-        {"PLANE", SR_PLANE}, {"SPLIT_TOL", SR_SPLIT_TOL}, {"TOL_P", SR_TOL_P},
-        {"TOL_R", SR_TOL_R}, {"CHECK", SR_CHECK}, {"SIZE", SR_SIZE},
-        {"N_PARAMS", SR_N_PARAMS},
-        {"THREE_PARALLEL", SR_THREE_PARALLEL}, {"SPHERICAL_WRIST", SR_SPHERICAL_WRIST},
-        {"STATUS_OK", SR_OK}, {"STATUS_OUT_OF_REACH", SR_OUT_OF_REACH},
-        {"STATUS_NO_ORIENTATION", SR_NO_ORIENTATION}, {"BAD_POSE", SR_BAD_POSE},
-        {"SIX_R_PARALLEL_MIN", SR_PARALLEL_MIN}};
-    for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
-        if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
-            return -1;
-    return 0;
-}
