@@ -86,3 +86,25 @@ def test_a_scene_survives_moveit_text(problems, tmp_path):
         assert a.kind == b.kind
         np.testing.assert_allclose(a.size, b.size, rtol=1e-8)
         np.testing.assert_allclose(a.placement, b.placement, atol=1e-8)
+
+
+@pytest.mark.parametrize("angle, scale, valid", [
+    (0.0, 0.0, True), (5e-7, 0.0, True), (2e-6, 0.0, False), (np.pi / 2, 0.0, False),
+    (np.pi, 0.0, False), (0.0, 1e-12, True), (5e-7, 1e-12, True), (2e-6, 1e-12, False)])
+def test_the_pose_recheck_reads_small_rotations_exactly(problems, angle, scale, valid):
+    # oracle: a rotation of the goal pose by a known angle about x (scipy), its matrix
+    # shrunk by ``scale`` as round-off in forward kinematics leaves it; the re-check
+    # allows 1e-6 rad. acos of the trace reads a 1e-12 shrink as 1.7e-6 rad (it
+    # refused planned Panda paths whose end was 4.6e-13 off); atan2 of the sine and
+    # cosine parts does not
+    from dataclasses import replace
+
+    from scipy.spatial.transform import Rotation
+
+    p = next(x for x in problems if x.robot == "panda" and x.family == "bookshelf_thin")
+    G = np.array(p.goal_pose)
+    G[:3, :3] = G[:3, :3] @ Rotation.from_rotvec([angle, 0.0, 0.0]).as_matrix()
+    G[:3, :3] *= 1.0 - scale
+    at_goal = replace(p, start=p.goal, goal_pose=G)
+    rc = plan_baseline.recheck_path(at_goal, p.goal[None], goal="pose")
+    assert rc.valid is valid, rc.reason

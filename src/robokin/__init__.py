@@ -78,6 +78,7 @@ def __getattr__(name: str) -> Any:
         "kinematics",
         "model",
         "sim",
+        "planning",
     ):
         return importlib.import_module(f"robokin.{name}")
     raise AttributeError(f"module 'robokin' has no attribute {name!r}")

@@ -297,3 +297,19 @@ def test_retime_returns_the_trajectory(ur5):
     assert isinstance(out, trajectory.Trajectory)
     assert out.joint_names == ur5.joint_names
     assert out.duration == pytest.approx(trapezoid_time(1.0, 1.0, 2.0), abs=1e-6)
+
+
+@pytest.mark.parametrize("seed", [0, 4, 7, 12, 22])
+def test_a_dense_corner_cut_polyline_settles_within_the_limits(ur5, seed):
+    # Regression (issue 26): a polyline smoothed by corner cutting (many close
+    # knots) once ended in "the limit check did not settle": each stretch of the
+    # law met a new peak between the samples, a tenth of the last excess.
+    q = np.cumsum(np.random.default_rng(seed).normal(size=(6, 6)), axis=0)
+    for _ in range(2):  # Chaikin: every corner replaced by its quarter points
+        a = q[1:-1] + 0.25 * (q[:-2] - q[1:-1])
+        b = q[1:-1] + 0.25 * (q[2:] - q[1:-1])
+        q = np.vstack([q[:1], np.stack([a, b], axis=1).reshape(-1, 6), q[-1:]])
+    res = trajectory.retime_detailed(ur5, q, v_max=2.0, a_max=6.0)
+    assert (np.abs(res.trajectory.qd) / 2.0).max() <= 1 + 1e-9
+    assert (np.abs(res.trajectory.qdd) / 6.0).max() <= 1 + 1e-9
+    np.testing.assert_allclose(res.trajectory.q[[0, -1]], q[[0, -1]], atol=1e-9)

@@ -413,6 +413,73 @@ PROCESS = Group("process.c", kernels=(
     + (Const("PR_LIMIT_TOL", type="float"),),
     comment="node status codes, coordinate modes, the weights layout, the bucket cap")
 
+RC_OPTS = Opts("opts", "RC_", "RC_N_OPTS", (
+    Opt("RANGE", 5e-324, BIG, doc="[joint units] longest step of an extension"),
+    Opt("TIME", -INF, INF, doc="[s] time limit of the search"),
+    Opt("MAX_NODES", 1, 1e9, whole=True, doc="most nodes of both trees"),
+))
+SP_OPTS = Opts("opts", "SP_", "SP_N_OPTS", (
+    Opt("VERTEX_TRIES", 0, 1e12, whole=True, doc="vertex-pair shortcut attempts"),
+    Opt("TRIES", 0, 1e12, whole=True, doc="point-pair shortcut attempts"),
+    Opt("MAX_FAIL", 0, 1e12, whole=True, doc="failures in a row that end a phase"),
+    Opt("TIME", -INF, INF, doc="[s] time limit of each phase"),
+    Opt("CUT_ROUNDS", 0, 1000, whole=True, doc="rounds of corner cutting"),
+    Opt("SHARP_TURN", -BIG, BIG, doc="[rad] corners turning more than this are cut"),
+))
+
+_MODEL = Obj("model", "object")  # plan_model's capsule; the body checks it and its sizes
+_EXACT = Obj("exact", "object")  # None or a callable (p, q) -> distance (coal)
+_SEED = Int("seed", 0, 2**64 - 1, unsigned64=True)
+_STATS = "tuple[int, int, int, int, int, int]"
+PLAN_CHECK = Group("plan_check.c", kernels=(
+    Kernel("plan_model", (Arr("packed", "f64", ("len",)), Arr("shape_i", "i64", ("N", 4)),
+                          Arr("shape_f", "f64", ("N", 21)), Arr("hull", "f64", ("H", 3)),
+                          Arr("pair_i", "i64", ("P", 7)), Arr("reach", "f64", ("S_r", "nc")),
+                          Int("S", 0, 1000000)),
+           "object", "The compiled planning model of a robot in a scene (a capsule).\n\n"
+           "shape_i (N, 4): core kind, link (-1: object), hull start, hull count;\n"
+           "shape_f (N, 21): rb pose, half sizes, radius, cylinder radius; hull (H, 3);\n"
+           "pair_i (P, 7): shapes a, b, method, self, mover, j0, j1; reach (S, nc).",
+           checks=(Check("S_r == a->S && a->S <= N && N <= 1000000 && P <= 10000000",
+                         "reach must be (S, nc) with S <= N <= 1000000 shapes, P <= 10000000 "
+                         "pairs"),)),
+    Kernel("plan_check_states", (_MODEL, Arr("q", "f64", ("m", "n")), Arr("margin", "f64", ("P",)),
+                                 _EXACT, Arr("status", "i64", ("m",), out=True),
+                                 Arr("pair", "i64", ("m",), out=True)),
+           _STATS, "Validity of states q (m, n) into status (m,) and pair (m,); work counters."),
+    Kernel("plan_check_edges", (_MODEL, Arr("q0", "f64", ("m", "n")), Arr("q1", "f64", ("m", "n")),
+                                Arr("margin", "f64", ("P",)), _EXACT,
+                                Arr("status", "i64", ("m",), out=True),
+                                Arr("pair", "i64", ("m",), out=True),
+                                Arr("where", "f64", ("m",), out=True)),
+           _STATS, "Validity of the straight edges q0 -> q1 (m, n); work counters."),
+    Kernel("plan_distances", (_MODEL, Arr("q", "f64", ("m", "n")),
+                              Arr("out", "f64", ("m", "P"), out=True)),
+           "None", "Certified lower bounds on every pair's distance at q (m, n) into out (m, P)."),
+), constants=_consts(
+    "PC_FREE PC_HIT PC_UNDECIDED PG_POINT PG_SEGMENT PG_BOX PG_CYLINDER PG_HULL PD_SEGSEG "
+    "PD_SEGBOX PD_BOXSEG PD_GJK PD_HULL") + (Const("PC_EPS", type="float"),),
+    comment="check results (PC_*), core kinds of shapes (PG_*), pair distance methods (PD_*), "
+    "the distance taken off every computed one [m]")
+
+PLAN_RRTC = Group("plan_rrtc.c", kernels=(
+    Kernel("plan_rrtc", (_MODEL, Arr("start", "f64", ("n",)), Arr("goals", "f64", ("k", "n")),
+                         Arr("lo", "f64", ("n",)), Arr("hi", "f64", ("n",)),
+                         Arr("margin", "f64", ("P",)), RC_OPTS, _SEED, _EXACT),
+           "tuple[int, F64 | None, int, " + _STATS + ", tuple[int, int, int, float]]",
+           "RRT-Connect: (code, path (K, n) or None, goal row, counters, search).",
+           checks=(Check("k >= 1", "goals needs a row"),)),
+), constants=_consts("RC_SOLVED RC_TIMEOUT RC_NODES RC_FAILED"),
+    comment="plan_rrtc result codes")
+
+PLAN_PATH = Group("plan_path.c", kernels=(
+    Kernel("plan_simplify", (_MODEL, Arr("path", "f64", ("K", "n")), Arr("margin", "f64", ("P",)),
+                             SP_OPTS, _SEED, _EXACT),
+           "tuple[F64, " + _STATS + "]",
+           "Shortcuts, then sharp corners cut, of path (K, n); (path, counters).",
+           checks=(Check("K >= 1", "path needs a row"),)),
+))
+
 @dataclass(frozen=True)
 class Section:
     """One section of a chain's packed vector: ``ChainArrays`` field, ``Chain`` field, shape.
@@ -446,5 +513,6 @@ PACKED_LAYOUT: tuple[Section, ...] = (
     Section("wrap", "wrap", ("n",)),  # 1.0 where a coordinate may move by whole turns
 )
 
-GROUPS: tuple[Group, ...] = (FK, LM, SIX_R, PIEPER, GENERAL6R, BROADPHASE, PROCESS)
-OPTION_VECTORS: tuple[Opts, ...] = (LM_OPTS,)
+GROUPS: tuple[Group, ...] = (FK, LM, SIX_R, PIEPER, GENERAL6R, BROADPHASE, PROCESS,
+                             PLAN_CHECK, PLAN_RRTC, PLAN_PATH)
+OPTION_VECTORS: tuple[Opts, ...] = (LM_OPTS, RC_OPTS, SP_OPTS)

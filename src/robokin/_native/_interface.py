@@ -44,6 +44,19 @@ class Kernels(Protocol):
     O_N_TABLE: int
     O_TABLE_ROT: int
     N_OPTS: int
+    # opts: option vector indices (RC_N_OPTS entries)
+    RC_RANGE: int
+    RC_TIME: int
+    RC_MAX_NODES: int
+    RC_N_OPTS: int
+    # opts: option vector indices (SP_N_OPTS entries)
+    SP_VERTEX_TRIES: int
+    SP_TRIES: int
+    SP_MAX_FAIL: int
+    SP_TIME: int
+    SP_CUT_ROUNDS: int
+    SP_SHARP_TURN: int
+    SP_N_OPTS: int
     # fk.c / module.c
     LANES: int
     MAX_JOINTS: int
@@ -197,6 +210,26 @@ class Kernels(Protocol):
     PW_N: int
     PR_MAXB: int
     PR_LIMIT_TOL: float
+    # plan_check.c: check results (PC_*), core kinds of shapes (PG_*), pair distance methods (PD_*), the distance taken off every computed one [m]
+    PC_FREE: int
+    PC_HIT: int
+    PC_UNDECIDED: int
+    PG_POINT: int
+    PG_SEGMENT: int
+    PG_BOX: int
+    PG_CYLINDER: int
+    PG_HULL: int
+    PD_SEGSEG: int
+    PD_SEGBOX: int
+    PD_BOXSEG: int
+    PD_GJK: int
+    PD_HULL: int
+    PC_EPS: float
+    # plan_rrtc.c: plan_rrtc result codes
+    RC_SOLVED: int
+    RC_TIMEOUT: int
+    RC_NODES: int
+    RC_FAILED: int
 
     def fk1(self, q: object, packed: object, /) -> F64 | None:
         """Pose (4, 4) of one configuration q (n,), or None for the general path."""
@@ -488,3 +521,77 @@ class Kernels(Protocol):
         /,
     ) -> None:
         """The limit cost of each value (P,) into out (P,)."""
+
+    def plan_model(
+        self,
+        packed: F64,
+        shape_i: I64,
+        shape_f: F64,
+        hull: F64,
+        pair_i: I64,
+        reach: F64,
+        S: int,
+        /,
+    ) -> object:
+        """The compiled planning model of a robot in a scene (a capsule).
+
+        shape_i (N, 4): core kind, link (-1: object), hull start, hull count;
+        shape_f (N, 21): rb pose, half sizes, radius, cylinder radius; hull (H, 3);
+        pair_i (P, 7): shapes a, b, method, self, mover, j0, j1; reach (S, nc).
+        """
+
+    def plan_check_states(
+        self,
+        model: object,
+        q: F64,
+        margin: F64,
+        exact: object,
+        status: I64,
+        pair: I64,
+        /,
+    ) -> tuple[int, int, int, int, int, int]:
+        """Validity of states q (m, n) into status (m,) and pair (m,); work counters."""
+
+    def plan_check_edges(
+        self,
+        model: object,
+        q0: F64,
+        q1: F64,
+        margin: F64,
+        exact: object,
+        status: I64,
+        pair: I64,
+        where: F64,
+        /,
+    ) -> tuple[int, int, int, int, int, int]:
+        """Validity of the straight edges q0 -> q1 (m, n); work counters."""
+
+    def plan_distances(self, model: object, q: F64, out: F64, /) -> None:
+        """Certified lower bounds on every pair's distance at q (m, n) into out (m, P)."""
+
+    def plan_rrtc(
+        self,
+        model: object,
+        start: F64,
+        goals: F64,
+        lo: F64,
+        hi: F64,
+        margin: F64,
+        opts: F64,
+        seed: int,
+        exact: object,
+        /,
+    ) -> tuple[int, F64 | None, int, tuple[int, int, int, int, int, int], tuple[int, int, int, float]]:
+        """RRT-Connect: (code, path (K, n) or None, goal row, counters, search)."""
+
+    def plan_simplify(
+        self,
+        model: object,
+        path: F64,
+        margin: F64,
+        opts: F64,
+        seed: int,
+        exact: object,
+        /,
+    ) -> tuple[F64, tuple[int, int, int, int, int, int]]:
+        """Shortcuts, then sharp corners cut, of path (K, n); (path, counters)."""

@@ -38,6 +38,12 @@ could stand: robot bases on a 100 mm floor grid within 400 mm of the cell's base
 scored for the same motion (:func:`robokin.cell.place`: one continuous IK branch,
 joint limits, clearance, manipulability) and ``placement.png`` maps the feasible
 ones (``placement.csv`` lists them all); the cell's own base comes out feasible.
+
+With ``plan=True`` (``robokin demo --plan``) robokin also plans the free moves
+itself (:mod:`robokin.cli.demo_plan`: the collision-free planner between the same
+configurations, process lines and dwells kept, every move time-optimal under the
+robot file's limits) and reports that cycle time next to the hand-made path's
+(``planned_trajectory.csv``, a "planned by robokin" row and report section).
 """
 
 from __future__ import annotations
@@ -178,6 +184,32 @@ def _place(run: _Run, bare: Robot, scene: Scene, traj: Trajectory, clearance: fl
     return placement
 
 
+def _plan_free_moves(run: _Run, bare: Robot, scene: Scene, traj: Trajectory,
+                     clearance: float) -> tuple[Trajectory, dict[str, Any]]:
+    """The cycle with its free moves planned by robokin (``--plan``), and its summary."""
+    from robokin.cli.demo_plan import planned_cycle
+
+    t = time.perf_counter()
+    task = run.bar.add_task("planning the free moves", total=None)
+    planned = planned_cycle(bare, scene, traj, PLAN, clearance=clearance, dt=DT)
+    run.bar.update(task, completed=1, total=1)
+    run.timings["robokin_plan"] = time.perf_counter() - t
+    return planned
+
+
+def _add_planned(run: _Run, summary: dict[str, Any], cycle: dict[str, Any],
+                 clearance: float, planned: Trajectory, planned_summary: dict[str, Any]
+                 ) -> None:
+    """Write ``planned_trajectory.csv``; its summary entry; ``ok`` only if it clears."""
+    run.files["planned_trajectory.csv"] = io.write_csv(
+        planned, run.out / "planned_trajectory.csv", precision=9, overwrite=True)
+    summary["planned_by_robokin"] = {
+        **planned_summary, "hand_made_planned_s": cycle.get("planned_s"),
+        "hand_made_minimum_s": cycle.get("minimum_s")}
+    summary["ok"] = bool(summary["ok"] and not planned_summary["collides"]
+                         and planned_summary["min_clearance_mm"] >= clearance * 1000.0)
+
+
 def _waypoints(traj: Trajectory) -> Trajectory:
     """The samples at the via points (for ``waypoints.csv``)."""
     idx = np.unique(
@@ -275,6 +307,10 @@ def _terminal_table(summary: dict[str, Any], timings: dict[str, float],
         + " deg/s²",
     )
     table.add_row("shortest cycle", cycle_text(summary["cycle_time"]))
+    if "planned_by_robokin" in summary:
+        from robokin.cli.demo_plan import planned_text
+
+        table.add_row("planned by robokin", planned_text(summary["planned_by_robokin"]))
     table.add_row("joint limit violations", str(len(summary["limit_violations"])))
     table.add_row(
         "minimum clearance",
@@ -318,6 +354,7 @@ def run_demo(
     sim: bool = False,
     place: bool = False,
     scheduler: Any = None,
+    plan: bool = False,
 ) -> DemoResult:
     """Run the press-loading demo end to end and write its outputs.
 
@@ -336,6 +373,8 @@ def run_demo(
             ``placement.csv``; needs ``robokin[scale]``).
         scheduler: Where the placement search runs (None: this machine; a Dask
             scheduler address or client).
+        plan: Also plan the free moves with robokin's planner and report that
+            cycle time next to the hand-made one (:mod:`robokin.cli.demo_plan`).
 
     Returns:
         A :class:`DemoResult`; ``ok`` is True only when the plan is collision-free
@@ -359,6 +398,7 @@ def run_demo(
         t = time.perf_counter()
         cycle = cycle_times(robot, bare, scene, traj, clearance)
         run.timings["retime"] = time.perf_counter() - t
+        planned = _plan_free_moves(run, bare, scene, traj, clearance) if plan else None
         placement = _place(run, bare, scene, traj, clearance, scheduler) if place else None
         program, done = _write_outputs(run, robot, bare, scene, traj, report, clearance,
                                        html_animation)
@@ -368,6 +408,8 @@ def run_demo(
         if placement is not None:
             summary["placement"] = placement_summary(placement, scene)
         summary["cycle_time"] = cycle
+        if planned is not None:
+            _add_planned(run, summary, cycle, clearance, *planned)
         program_name = "program" + program.suffix
         summary["controller"] = {"program": program.program, "file": program_name,
                                  "profile": program.profile.name,
@@ -376,6 +418,10 @@ def run_demo(
                  "placement.png")
         images = {k: run.files[k] for k in shown if k in run.files}
         sim_html = _simulate(run, summary, bare, scene, traj, report) if sim else ""
+        if "planned_by_robokin" in summary:
+            from robokin.cli.demo_plan import planned_html
+
+            sim_html = planned_html(summary["planned_by_robokin"]) + sim_html
         timings["total"] = time.perf_counter() - run.started
         summary["timings_s"] = {k: round(v, 3) for k, v in timings.items()}
         report_path = out / "report.html"
@@ -413,6 +459,10 @@ def demo(
     scheduler: Annotated[
         str | None, typer.Option(help="Dask scheduler address for --place (default: this machine).")
     ] = None,
+    plan: Annotated[
+        bool, typer.Option("--plan", help="Also plan the free moves with robokin's planner "
+                           "and compare the cycle time.")
+    ] = False,
 ) -> None:
     """The main job: the AUBO-i5 loads a press (plan, check, plots, HTML report).
 
@@ -420,7 +470,8 @@ def demo(
     clearance and inside the joint limits.
     """
     result = run_demo(out=out, clearance_mm=clearance, view=view, force=force,
-                      console=console(), sim=sim, place=place, scheduler=scheduler)
+                      console=console(), sim=sim, place=place, scheduler=scheduler,
+                      plan=plan)
     if not result.ok:
         raise DomainFailure("the plan is not collision-free with the required clearance "
                             "(see the report)")

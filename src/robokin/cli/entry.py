@@ -33,6 +33,7 @@ from robokin.cli import (
     follow,
     ik,
     motion,
+    plan,
     retime,
     robots,
     schema,
@@ -79,8 +80,8 @@ app = typer.Typer(
 #: The command modules, in the order ``robokin --help`` lists their commands. Each
 #: defines its commands on its own ``commands = typer.Typer()``; adding a module
 #: here is how a command joins ``robokin`` (docs/conventions.md, "Where things go").
-COMMAND_MODULES = (robots, demo, ik, motion, urdf, collision, view, actuators, workspace,
-                   sim, retime, schema, cell, follow, calibrate)
+COMMAND_MODULES = (robots, demo, ik, motion, urdf, collision, plan, view, actuators,
+                   workspace, sim, retime, schema, cell, follow, calibrate)
 for _module in COMMAND_MODULES:
     app.registered_commands.extend(_module.commands.registered_commands)
 
@@ -102,7 +103,7 @@ def _split_debug(args: list[str]) -> tuple[list[str], bool]:
 
 
 #: Options that take as many values as the robot has joints (``--near q1 ... qn``).
-MULTI_VALUE_OPTIONS = ("--near",)
+MULTI_VALUE_OPTIONS = ("--near", "--start", "--goal", "--goal-pose")
 
 
 def _is_number(token: str) -> bool:

@@ -23,6 +23,25 @@ enum {
     N_OPTS = 21
 };
 
+/* opts: option vector entries (Opts in _declare.py) */
+enum {
+    RC_RANGE = 0, /* [joint units] longest step of an extension */
+    RC_TIME = 1, /* [s] time limit of the search */
+    RC_MAX_NODES = 2, /* most nodes of both trees */
+    RC_N_OPTS = 3
+};
+
+/* opts: option vector entries (Opts in _declare.py) */
+enum {
+    SP_VERTEX_TRIES = 0, /* vertex-pair shortcut attempts */
+    SP_TRIES = 1, /* point-pair shortcut attempts */
+    SP_MAX_FAIL = 2, /* failures in a row that end a phase */
+    SP_TIME = 3, /* [s] time limit of each phase */
+    SP_CUT_ROUNDS = 4, /* rounds of corner cutting */
+    SP_SHARP_TURN = 5, /* [rad] corners turning more than this are cut */
+    SP_N_OPTS = 6
+};
+
 /* every entry of opts inside its declared range (NaN fails) */
 static int opts_o_ok(const double *v)
 {
@@ -73,6 +92,45 @@ static int opts_o_ok(const double *v)
             return 0;
     for (int i = O_TABLE_ROT; i < O_TABLE_ROT + 1; i++)
         if (!(v[i] >= -1.0 && v[i] <= 1.7976931348623157e+308))
+            return 0;
+    return 1;
+}
+
+/* every entry of opts inside its declared range (NaN fails) */
+static int opts_rc_ok(const double *v)
+{
+    for (int i = RC_RANGE; i < RC_RANGE + 1; i++)
+        if (!(v[i] >= 5e-324 && v[i] <= 1.7976931348623157e+308))
+            return 0;
+    for (int i = RC_TIME; i < RC_TIME + 1; i++)
+        if (!(v[i] >= -INFINITY && v[i] <= INFINITY))
+            return 0;
+    for (int i = RC_MAX_NODES; i < RC_MAX_NODES + 1; i++)
+        if (!(v[i] >= 1.0 && v[i] <= 1000000000.0) || v[i] != floor(v[i]))
+            return 0;
+    return 1;
+}
+
+/* every entry of opts inside its declared range (NaN fails) */
+static int opts_sp_ok(const double *v)
+{
+    for (int i = SP_VERTEX_TRIES; i < SP_VERTEX_TRIES + 1; i++)
+        if (!(v[i] >= 0.0 && v[i] <= 1000000000000.0) || v[i] != floor(v[i]))
+            return 0;
+    for (int i = SP_TRIES; i < SP_TRIES + 1; i++)
+        if (!(v[i] >= 0.0 && v[i] <= 1000000000000.0) || v[i] != floor(v[i]))
+            return 0;
+    for (int i = SP_MAX_FAIL; i < SP_MAX_FAIL + 1; i++)
+        if (!(v[i] >= 0.0 && v[i] <= 1000000000000.0) || v[i] != floor(v[i]))
+            return 0;
+    for (int i = SP_TIME; i < SP_TIME + 1; i++)
+        if (!(v[i] >= -INFINITY && v[i] <= INFINITY))
+            return 0;
+    for (int i = SP_CUT_ROUNDS; i < SP_CUT_ROUNDS + 1; i++)
+        if (!(v[i] >= 0.0 && v[i] <= 1000.0) || v[i] != floor(v[i]))
+            return 0;
+    for (int i = SP_SHARP_TURN; i < SP_SHARP_TURN + 1; i++)
+        if (!(v[i] >= -1.7976931348623157e+308 && v[i] <= 1.7976931348623157e+308))
             return 0;
     return 1;
 }
@@ -723,5 +781,126 @@ typedef struct {
     char unused; /* a struct is never empty */
 } process_limit_cost_args;
 static PyObject *process_limit_cost_body(const process_limit_cost_args *a);
+
+/* plan_model: plan_check.c */
+typedef struct {
+    const double *packed;
+    PyArrayObject *packed_array;
+    const long long *shape_i;
+    PyArrayObject *shape_i_array;
+    const double *shape_f;
+    PyArrayObject *shape_f_array;
+    const double *hull;
+    PyArrayObject *hull_array;
+    const long long *pair_i;
+    PyArrayObject *pair_i_array;
+    const double *reach;
+    PyArrayObject *reach_array;
+    long S;
+    npy_intp len;
+    npy_intp N;
+    npy_intp H;
+    npy_intp P;
+    npy_intp S_r;
+    npy_intp nc;
+    char unused; /* a struct is never empty */
+} plan_model_args;
+static PyObject *plan_model_body(const plan_model_args *a);
+
+/* plan_check_states: plan_check.c */
+typedef struct {
+    PyObject *model;
+    const double *q;
+    PyArrayObject *q_array;
+    const double *margin;
+    PyArrayObject *margin_array;
+    PyObject *exact;
+    long long *status;
+    PyArrayObject *status_array;
+    long long *pair;
+    PyArrayObject *pair_array;
+    npy_intp m;
+    npy_intp n;
+    npy_intp P;
+    char unused; /* a struct is never empty */
+} plan_check_states_args;
+static PyObject *plan_check_states_body(const plan_check_states_args *a);
+
+/* plan_check_edges: plan_check.c */
+typedef struct {
+    PyObject *model;
+    const double *q0;
+    PyArrayObject *q0_array;
+    const double *q1;
+    PyArrayObject *q1_array;
+    const double *margin;
+    PyArrayObject *margin_array;
+    PyObject *exact;
+    long long *status;
+    PyArrayObject *status_array;
+    long long *pair;
+    PyArrayObject *pair_array;
+    double *where;
+    PyArrayObject *where_array;
+    npy_intp m;
+    npy_intp n;
+    npy_intp P;
+    char unused; /* a struct is never empty */
+} plan_check_edges_args;
+static PyObject *plan_check_edges_body(const plan_check_edges_args *a);
+
+/* plan_distances: plan_check.c */
+typedef struct {
+    PyObject *model;
+    const double *q;
+    PyArrayObject *q_array;
+    double *out;
+    PyArrayObject *out_array;
+    npy_intp m;
+    npy_intp n;
+    npy_intp P;
+    char unused; /* a struct is never empty */
+} plan_distances_args;
+static PyObject *plan_distances_body(const plan_distances_args *a);
+
+/* plan_rrtc: plan_rrtc.c */
+typedef struct {
+    PyObject *model;
+    const double *start;
+    PyArrayObject *start_array;
+    const double *goals;
+    PyArrayObject *goals_array;
+    const double *lo;
+    PyArrayObject *lo_array;
+    const double *hi;
+    PyArrayObject *hi_array;
+    const double *margin;
+    PyArrayObject *margin_array;
+    const double *opts;
+    unsigned long long seed;
+    PyObject *exact;
+    npy_intp n;
+    npy_intp k;
+    npy_intp P;
+    char unused; /* a struct is never empty */
+} plan_rrtc_args;
+static PyObject *plan_rrtc_body(const plan_rrtc_args *a);
+
+/* plan_simplify: plan_path.c */
+typedef struct {
+    PyObject *model;
+    const double *path;
+    PyArrayObject *path_array;
+    const double *margin;
+    PyArrayObject *margin_array;
+    const double *opts;
+    unsigned long long seed;
+    PyObject *exact;
+    npy_intp K;
+    npy_intp n;
+    npy_intp P;
+    char unused; /* a struct is never empty */
+} plan_simplify_args;
+static PyObject *plan_simplify_body(const plan_simplify_args *a);
 
 #endif

@@ -1743,6 +1743,280 @@ static PyObject *py_process_limit_cost(PyObject *self, PyObject *const *args, Py
     return process_limit_cost_body(&a);
 }
 
+static PyObject *py_plan_model(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    plan_model_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 7) {
+        PyErr_SetString(PyExc_TypeError, "plan_model(packed, shape_i, shape_f, hull, pair_i, reach, S) takes 7 arguments");
+        return NULL;
+    }
+    a.packed_array = array_arg(args[0], "plan_model", "packed", NPY_DOUBLE, 1, 0);
+    if (a.packed_array == NULL)
+        return NULL;
+    a.packed = (const double *)PyArray_DATA(a.packed_array);
+    a.len = PyArray_DIMS(a.packed_array)[0];
+    a.shape_i_array = array_arg(args[1], "plan_model", "shape_i", NPY_INT64, 2, 0);
+    if (a.shape_i_array == NULL)
+        return NULL;
+    a.shape_i = (const long long *)PyArray_DATA(a.shape_i_array);
+    a.N = PyArray_DIMS(a.shape_i_array)[0];
+    a.shape_f_array = array_arg(args[2], "plan_model", "shape_f", NPY_DOUBLE, 2, 0);
+    if (a.shape_f_array == NULL)
+        return NULL;
+    a.shape_f = (const double *)PyArray_DATA(a.shape_f_array);
+    a.hull_array = array_arg(args[3], "plan_model", "hull", NPY_DOUBLE, 2, 0);
+    if (a.hull_array == NULL)
+        return NULL;
+    a.hull = (const double *)PyArray_DATA(a.hull_array);
+    a.H = PyArray_DIMS(a.hull_array)[0];
+    a.pair_i_array = array_arg(args[4], "plan_model", "pair_i", NPY_INT64, 2, 0);
+    if (a.pair_i_array == NULL)
+        return NULL;
+    a.pair_i = (const long long *)PyArray_DATA(a.pair_i_array);
+    a.P = PyArray_DIMS(a.pair_i_array)[0];
+    a.reach_array = array_arg(args[5], "plan_model", "reach", NPY_DOUBLE, 2, 0);
+    if (a.reach_array == NULL)
+        return NULL;
+    a.reach = (const double *)PyArray_DATA(a.reach_array);
+    a.S_r = PyArray_DIMS(a.reach_array)[0];
+    a.nc = PyArray_DIMS(a.reach_array)[1];
+    if (!long_arg(args[6], "plan_model", "S", 0LL, 1000000LL, &a.S))
+        return NULL;
+    npy_intp len = a.len; npy_intp N = a.N; npy_intp H = a.H; npy_intp P = a.P; npy_intp S_r = a.S_r; npy_intp nc = a.nc;
+    (void)len; (void)N; (void)H; (void)P; (void)S_r; (void)nc;
+    if (!(S_r == a.S && a.S <= N && N <= 1000000 && P <= 10000000))
+        return kernel_fail("robokin._native.plan_model: reach must be (S, nc) with S <= N <= 1000000 shapes, P <= 10000000 pairs");
+    if (!(PyArray_DIMS(a.shape_i_array)[1] == (npy_intp)(4)))
+        return kernel_fail("robokin._native.plan_model: shape_i must be (N, 4)");
+    if (!(PyArray_DIMS(a.shape_f_array)[0] == (npy_intp)(N)))
+        return kernel_fail("robokin._native.plan_model: shape_f must be (N, 21)");
+    if (!(PyArray_DIMS(a.shape_f_array)[1] == (npy_intp)(21)))
+        return kernel_fail("robokin._native.plan_model: shape_f must be (N, 21)");
+    if (!(PyArray_DIMS(a.hull_array)[1] == (npy_intp)(3)))
+        return kernel_fail("robokin._native.plan_model: hull must be (H, 3)");
+    if (!(PyArray_DIMS(a.pair_i_array)[1] == (npy_intp)(7)))
+        return kernel_fail("robokin._native.plan_model: pair_i must be (P, 7)");
+    return plan_model_body(&a);
+}
+
+static PyObject *py_plan_check_states(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    plan_check_states_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 6) {
+        PyErr_SetString(PyExc_TypeError, "plan_check_states(model, q, margin, exact, status, pair) takes 6 arguments");
+        return NULL;
+    }
+    a.model = args[0];
+    a.q_array = array_arg(args[1], "plan_check_states", "q", NPY_DOUBLE, 2, 0);
+    if (a.q_array == NULL)
+        return NULL;
+    a.q = (const double *)PyArray_DATA(a.q_array);
+    a.m = PyArray_DIMS(a.q_array)[0];
+    a.n = PyArray_DIMS(a.q_array)[1];
+    a.margin_array = array_arg(args[2], "plan_check_states", "margin", NPY_DOUBLE, 1, 0);
+    if (a.margin_array == NULL)
+        return NULL;
+    a.margin = (const double *)PyArray_DATA(a.margin_array);
+    a.P = PyArray_DIMS(a.margin_array)[0];
+    a.exact = args[3];
+    a.status_array = array_arg(args[4], "plan_check_states", "status", NPY_INT64, 1, 1);
+    if (a.status_array == NULL)
+        return NULL;
+    a.status = (long long *)PyArray_DATA(a.status_array);
+    a.pair_array = array_arg(args[5], "plan_check_states", "pair", NPY_INT64, 1, 1);
+    if (a.pair_array == NULL)
+        return NULL;
+    a.pair = (long long *)PyArray_DATA(a.pair_array);
+    npy_intp m = a.m; npy_intp n = a.n; npy_intp P = a.P;
+    (void)m; (void)n; (void)P;
+    if (!(PyArray_DIMS(a.status_array)[0] == (npy_intp)(m)))
+        return kernel_fail("robokin._native.plan_check_states: status must be (m)");
+    if (!(PyArray_DIMS(a.pair_array)[0] == (npy_intp)(m)))
+        return kernel_fail("robokin._native.plan_check_states: pair must be (m)");
+    return plan_check_states_body(&a);
+}
+
+static PyObject *py_plan_check_edges(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    plan_check_edges_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 8) {
+        PyErr_SetString(PyExc_TypeError, "plan_check_edges(model, q0, q1, margin, exact, status, pair, where) takes 8 arguments");
+        return NULL;
+    }
+    a.model = args[0];
+    a.q0_array = array_arg(args[1], "plan_check_edges", "q0", NPY_DOUBLE, 2, 0);
+    if (a.q0_array == NULL)
+        return NULL;
+    a.q0 = (const double *)PyArray_DATA(a.q0_array);
+    a.m = PyArray_DIMS(a.q0_array)[0];
+    a.n = PyArray_DIMS(a.q0_array)[1];
+    a.q1_array = array_arg(args[2], "plan_check_edges", "q1", NPY_DOUBLE, 2, 0);
+    if (a.q1_array == NULL)
+        return NULL;
+    a.q1 = (const double *)PyArray_DATA(a.q1_array);
+    a.margin_array = array_arg(args[3], "plan_check_edges", "margin", NPY_DOUBLE, 1, 0);
+    if (a.margin_array == NULL)
+        return NULL;
+    a.margin = (const double *)PyArray_DATA(a.margin_array);
+    a.P = PyArray_DIMS(a.margin_array)[0];
+    a.exact = args[4];
+    a.status_array = array_arg(args[5], "plan_check_edges", "status", NPY_INT64, 1, 1);
+    if (a.status_array == NULL)
+        return NULL;
+    a.status = (long long *)PyArray_DATA(a.status_array);
+    a.pair_array = array_arg(args[6], "plan_check_edges", "pair", NPY_INT64, 1, 1);
+    if (a.pair_array == NULL)
+        return NULL;
+    a.pair = (long long *)PyArray_DATA(a.pair_array);
+    a.where_array = array_arg(args[7], "plan_check_edges", "where", NPY_DOUBLE, 1, 1);
+    if (a.where_array == NULL)
+        return NULL;
+    a.where = (double *)PyArray_DATA(a.where_array);
+    npy_intp m = a.m; npy_intp n = a.n; npy_intp P = a.P;
+    (void)m; (void)n; (void)P;
+    if (!(PyArray_DIMS(a.q1_array)[0] == (npy_intp)(m)))
+        return kernel_fail("robokin._native.plan_check_edges: q1 must be (m, n)");
+    if (!(PyArray_DIMS(a.q1_array)[1] == (npy_intp)(n)))
+        return kernel_fail("robokin._native.plan_check_edges: q1 must be (m, n)");
+    if (!(PyArray_DIMS(a.status_array)[0] == (npy_intp)(m)))
+        return kernel_fail("robokin._native.plan_check_edges: status must be (m)");
+    if (!(PyArray_DIMS(a.pair_array)[0] == (npy_intp)(m)))
+        return kernel_fail("robokin._native.plan_check_edges: pair must be (m)");
+    if (!(PyArray_DIMS(a.where_array)[0] == (npy_intp)(m)))
+        return kernel_fail("robokin._native.plan_check_edges: where must be (m)");
+    return plan_check_edges_body(&a);
+}
+
+static PyObject *py_plan_distances(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    plan_distances_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 3) {
+        PyErr_SetString(PyExc_TypeError, "plan_distances(model, q, out) takes 3 arguments");
+        return NULL;
+    }
+    a.model = args[0];
+    a.q_array = array_arg(args[1], "plan_distances", "q", NPY_DOUBLE, 2, 0);
+    if (a.q_array == NULL)
+        return NULL;
+    a.q = (const double *)PyArray_DATA(a.q_array);
+    a.m = PyArray_DIMS(a.q_array)[0];
+    a.n = PyArray_DIMS(a.q_array)[1];
+    a.out_array = array_arg(args[2], "plan_distances", "out", NPY_DOUBLE, 2, 1);
+    if (a.out_array == NULL)
+        return NULL;
+    a.out = (double *)PyArray_DATA(a.out_array);
+    a.P = PyArray_DIMS(a.out_array)[1];
+    npy_intp m = a.m; npy_intp n = a.n; npy_intp P = a.P;
+    (void)m; (void)n; (void)P;
+    if (!(PyArray_DIMS(a.out_array)[0] == (npy_intp)(m)))
+        return kernel_fail("robokin._native.plan_distances: out must be (m, P)");
+    return plan_distances_body(&a);
+}
+
+static PyObject *py_plan_rrtc(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    plan_rrtc_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 9) {
+        PyErr_SetString(PyExc_TypeError, "plan_rrtc(model, start, goals, lo, hi, margin, opts, seed, exact) takes 9 arguments");
+        return NULL;
+    }
+    a.model = args[0];
+    a.start_array = array_arg(args[1], "plan_rrtc", "start", NPY_DOUBLE, 1, 0);
+    if (a.start_array == NULL)
+        return NULL;
+    a.start = (const double *)PyArray_DATA(a.start_array);
+    a.n = PyArray_DIMS(a.start_array)[0];
+    a.goals_array = array_arg(args[2], "plan_rrtc", "goals", NPY_DOUBLE, 2, 0);
+    if (a.goals_array == NULL)
+        return NULL;
+    a.goals = (const double *)PyArray_DATA(a.goals_array);
+    a.k = PyArray_DIMS(a.goals_array)[0];
+    a.lo_array = array_arg(args[3], "plan_rrtc", "lo", NPY_DOUBLE, 1, 0);
+    if (a.lo_array == NULL)
+        return NULL;
+    a.lo = (const double *)PyArray_DATA(a.lo_array);
+    a.hi_array = array_arg(args[4], "plan_rrtc", "hi", NPY_DOUBLE, 1, 0);
+    if (a.hi_array == NULL)
+        return NULL;
+    a.hi = (const double *)PyArray_DATA(a.hi_array);
+    a.margin_array = array_arg(args[5], "plan_rrtc", "margin", NPY_DOUBLE, 1, 0);
+    if (a.margin_array == NULL)
+        return NULL;
+    a.margin = (const double *)PyArray_DATA(a.margin_array);
+    a.P = PyArray_DIMS(a.margin_array)[0];
+    PyArrayObject *opts_array = array_arg(args[6], "plan_rrtc", "opts", NPY_DOUBLE, 1, 0);
+    if (opts_array == NULL)
+        return NULL;
+    if (PyArray_DIMS(opts_array)[0] != RC_N_OPTS)
+        return kernel_fail("robokin._native.plan_rrtc: opts must be (RC_N_OPTS,)");
+    a.opts = (const double *)PyArray_DATA(opts_array);
+    if (!opts_rc_ok(a.opts))
+        return kernel_fail("robokin._native.plan_rrtc: opts: a value outside its range (_declare.py)");
+    if (!uint64_arg(args[7], "plan_rrtc", "seed", 0LL, 18446744073709551615ULL, &a.seed))
+        return NULL;
+    a.exact = args[8];
+    npy_intp n = a.n; npy_intp k = a.k; npy_intp P = a.P;
+    (void)n; (void)k; (void)P;
+    if (!(k >= 1))
+        return kernel_fail("robokin._native.plan_rrtc: goals needs a row");
+    if (!(PyArray_DIMS(a.goals_array)[1] == (npy_intp)(n)))
+        return kernel_fail("robokin._native.plan_rrtc: goals must be (k, n)");
+    if (!(PyArray_DIMS(a.lo_array)[0] == (npy_intp)(n)))
+        return kernel_fail("robokin._native.plan_rrtc: lo must be (n)");
+    if (!(PyArray_DIMS(a.hi_array)[0] == (npy_intp)(n)))
+        return kernel_fail("robokin._native.plan_rrtc: hi must be (n)");
+    return plan_rrtc_body(&a);
+}
+
+static PyObject *py_plan_simplify(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    plan_simplify_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 6) {
+        PyErr_SetString(PyExc_TypeError, "plan_simplify(model, path, margin, opts, seed, exact) takes 6 arguments");
+        return NULL;
+    }
+    a.model = args[0];
+    a.path_array = array_arg(args[1], "plan_simplify", "path", NPY_DOUBLE, 2, 0);
+    if (a.path_array == NULL)
+        return NULL;
+    a.path = (const double *)PyArray_DATA(a.path_array);
+    a.K = PyArray_DIMS(a.path_array)[0];
+    a.n = PyArray_DIMS(a.path_array)[1];
+    a.margin_array = array_arg(args[2], "plan_simplify", "margin", NPY_DOUBLE, 1, 0);
+    if (a.margin_array == NULL)
+        return NULL;
+    a.margin = (const double *)PyArray_DATA(a.margin_array);
+    a.P = PyArray_DIMS(a.margin_array)[0];
+    PyArrayObject *opts_array = array_arg(args[3], "plan_simplify", "opts", NPY_DOUBLE, 1, 0);
+    if (opts_array == NULL)
+        return NULL;
+    if (PyArray_DIMS(opts_array)[0] != SP_N_OPTS)
+        return kernel_fail("robokin._native.plan_simplify: opts must be (SP_N_OPTS,)");
+    a.opts = (const double *)PyArray_DATA(opts_array);
+    if (!opts_sp_ok(a.opts))
+        return kernel_fail("robokin._native.plan_simplify: opts: a value outside its range (_declare.py)");
+    if (!uint64_arg(args[4], "plan_simplify", "seed", 0LL, 18446744073709551615ULL, &a.seed))
+        return NULL;
+    a.exact = args[5];
+    npy_intp K = a.K; npy_intp n = a.n; npy_intp P = a.P;
+    (void)K; (void)n; (void)P;
+    if (!(K >= 1))
+        return kernel_fail("robokin._native.plan_simplify: path needs a row");
+    return plan_simplify_body(&a);
+}
+
 static PyMethodDef kernel_methods[] = {
     {"fk1", (PyCFunction)(void (*)(void))py_fk1, METH_FASTCALL,
      "fk1(q, packed) -> F64 | None: Pose (4, 4) of one configuration q (n,), or None for the general path."},
@@ -1820,6 +2094,18 @@ static PyMethodDef kernel_methods[] = {
      "process_pairs(A, B, circle, out) -> None: The largest joint change between every row of A (a, n) and B (b, n)."},
     {"process_limit_cost", (PyCFunction)(void (*)(void))py_process_limit_cost, METH_FASTCALL,
      "process_limit_cost(values, lo, hi, margin, out) -> None: The limit cost of each value (P,) into out (P,)."},
+    {"plan_model", (PyCFunction)(void (*)(void))py_plan_model, METH_FASTCALL,
+     "plan_model(packed, shape_i, shape_f, hull, pair_i, reach, S) -> object: The compiled planning model of a robot in a scene (a capsule)."},
+    {"plan_check_states", (PyCFunction)(void (*)(void))py_plan_check_states, METH_FASTCALL,
+     "plan_check_states(model, q, margin, exact, status, pair) -> tuple[int, int, int, int, int, int]: Validity of states q (m, n) into status (m,) and pair (m,); work counters."},
+    {"plan_check_edges", (PyCFunction)(void (*)(void))py_plan_check_edges, METH_FASTCALL,
+     "plan_check_edges(model, q0, q1, margin, exact, status, pair, where) -> tuple[int, int, int, int, int, int]: Validity of the straight edges q0 -> q1 (m, n); work counters."},
+    {"plan_distances", (PyCFunction)(void (*)(void))py_plan_distances, METH_FASTCALL,
+     "plan_distances(model, q, out) -> None: Certified lower bounds on every pair's distance at q (m, n) into out (m, P)."},
+    {"plan_rrtc", (PyCFunction)(void (*)(void))py_plan_rrtc, METH_FASTCALL,
+     "plan_rrtc(model, start, goals, lo, hi, margin, opts, seed, exact) -> tuple[int, F64 | None, int, tuple[int, int, int, int, int, int], tuple[int, int, int, float]]: RRT-Connect: (code, path (K, n) or None, goal row, counters, search)."},
+    {"plan_simplify", (PyCFunction)(void (*)(void))py_plan_simplify, METH_FASTCALL,
+     "plan_simplify(model, path, margin, opts, seed, exact) -> tuple[F64, tuple[int, int, int, int, int, int]]: Shortcuts, then sharp corners cut, of path (K, n); (path, counters)."},
     {NULL, NULL, 0, NULL}};
 
 /* every declared constant onto the module, then the groups' init functions */
@@ -1843,6 +2129,17 @@ static int add_constants(PyObject *m)
         {"O_N_TABLE", (long)(O_N_TABLE)},
         {"O_TABLE_ROT", (long)(O_TABLE_ROT)},
         {"N_OPTS", (long)(N_OPTS)},
+        {"RC_RANGE", (long)(RC_RANGE)},
+        {"RC_TIME", (long)(RC_TIME)},
+        {"RC_MAX_NODES", (long)(RC_MAX_NODES)},
+        {"RC_N_OPTS", (long)(RC_N_OPTS)},
+        {"SP_VERTEX_TRIES", (long)(SP_VERTEX_TRIES)},
+        {"SP_TRIES", (long)(SP_TRIES)},
+        {"SP_MAX_FAIL", (long)(SP_MAX_FAIL)},
+        {"SP_TIME", (long)(SP_TIME)},
+        {"SP_CUT_ROUNDS", (long)(SP_CUT_ROUNDS)},
+        {"SP_SHARP_TURN", (long)(SP_SHARP_TURN)},
+        {"SP_N_OPTS", (long)(SP_N_OPTS)},
         {"LANES", (long)(W)},
         {"MAX_JOINTS", (long)(MAXJ)},
         {"FK_PARALLEL_MIN", (long)(FK_PARALLEL_MIN)},
@@ -1985,6 +2282,23 @@ static int add_constants(PyObject *m)
         {"PW_LIM_MARGIN", (long)(PW_LIM_MARGIN)},
         {"PW_N", (long)(PW_N)},
         {"PR_MAXB", (long)(PR_MAXB)},
+        {"PC_FREE", (long)(PC_FREE)},
+        {"PC_HIT", (long)(PC_HIT)},
+        {"PC_UNDECIDED", (long)(PC_UNDECIDED)},
+        {"PG_POINT", (long)(PG_POINT)},
+        {"PG_SEGMENT", (long)(PG_SEGMENT)},
+        {"PG_BOX", (long)(PG_BOX)},
+        {"PG_CYLINDER", (long)(PG_CYLINDER)},
+        {"PG_HULL", (long)(PG_HULL)},
+        {"PD_SEGSEG", (long)(PD_SEGSEG)},
+        {"PD_SEGBOX", (long)(PD_SEGBOX)},
+        {"PD_BOXSEG", (long)(PD_BOXSEG)},
+        {"PD_GJK", (long)(PD_GJK)},
+        {"PD_HULL", (long)(PD_HULL)},
+        {"RC_SOLVED", (long)(RC_SOLVED)},
+        {"RC_TIMEOUT", (long)(RC_TIMEOUT)},
+        {"RC_NODES", (long)(RC_NODES)},
+        {"RC_FAILED", (long)(RC_FAILED)},
     };
     for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
         if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
@@ -2013,6 +2327,13 @@ static int add_constants(PyObject *m)
     {
         PyObject *v = PyFloat_FromDouble(PR_LIMIT_TOL);
         if (v == NULL || PyModule_AddObject(m, "PR_LIMIT_TOL", v) < 0) {
+            Py_XDECREF(v);
+            return -1;
+        }
+    }
+    {
+        PyObject *v = PyFloat_FromDouble(PC_EPS);
+        if (v == NULL || PyModule_AddObject(m, "PC_EPS", v) < 0) {
             Py_XDECREF(v);
             return -1;
         }

@@ -1,0 +1,70 @@
+"""Goal arguments (robokin.planning.goals): configurations, sets and poses.
+
+Oracles: a pose's candidates are exactly the in-limit IK solutions, each 2*pi
+turn of a joint whose range exceeds 2*pi included (FK of every candidate is the
+pose, and the generating configuration is among them); rows outside the joint
+limits are dropped with the reason naming the joint.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robokin
+from robokin.exceptions import InputError
+from robokin.planning import goal_configurations
+
+
+def test_a_configuration_and_a_set_keep_their_rows():
+    robot = robokin.load("panda")
+    q = np.array([0.1, -0.5, 0.2, -2.0, 0.1, 1.5, 0.3])
+    g = goal_configurations(robot, q)
+    assert g.kind == "configuration" and np.array_equal(g.q, q[None])
+    bad = q.copy()
+    bad[3] = 0.5  # joint 4's upper limit is -0.0698
+    g = goal_configurations(robot, np.stack([bad, q, q + 0.01]))
+    assert g.kind == "set" and np.array_equal(g.index, [1, 2])
+    assert np.array_equal(g.q[0], q)
+    g = goal_configurations(robot, bad)
+    assert g.q.shape == (0, 7) and "joint 4" in g.reason and "upper limit" in g.reason
+
+
+def test_a_pose_gives_every_in_limit_solution_with_its_whole_turns():
+    robot = robokin.load("ur5")  # +-360 deg joints: each angle twice
+    q = np.array([0.3, -1.2, 1.0, -0.5, 1.2, 0.4])
+    T = robot.fk(q)
+    g = goal_configurations(robot, T)
+    assert g.kind == "pose" and np.array_equal(g.pose, T)
+    np.testing.assert_allclose(robot.fk(g.q), np.broadcast_to(T, (len(g.q), 4, 4)),
+                               atol=1e-9)
+    assert np.min(np.abs(g.q - q).max(axis=1)) < 1e-9  # the generating one is there
+    assert np.min(np.abs(g.q - (q - [2 * np.pi, 0, 0, 0, 0, 0])).max(axis=1)) < 1e-9
+    per_branch = len(robot.ik(T).keep_within_limits())
+    assert len(g.q) == len(robot.ik(T).keep_within_limits().expand_turns())
+    assert len(g.q) > per_branch
+    assert np.all(g.q >= robot.limits[:, 0]) and np.all(g.q <= robot.limits[:, 1])
+
+
+def test_an_unreachable_pose_says_so():
+    robot = robokin.load("aubo_i5")
+    T = np.eye(4)
+    T[:3, 3] = (5.0, 0.0, 0.0)
+    g = goal_configurations(robot, T)
+    assert g.q.shape == (0, 6) and g.reason.startswith("the goal pose is unreachable")
+
+
+def test_a_four_joint_arm_reads_a_rigid_transform_as_a_pose():
+    robot = robokin.load("scara")
+    q = np.array([0.3, 0.5, 0.1, 0.2])
+    T = robot.fk(q)
+    assert goal_configurations(robot, T).kind == "pose"
+    four = np.array([q, q + 0.01, q + 0.02, q + 0.03])  # not a rigid transform
+    assert goal_configurations(robot, four).kind == "set"
+
+
+@pytest.mark.parametrize("bad", [np.zeros(5), np.zeros((2, 5)), np.zeros((0, 6)),
+                                 np.full(6, np.nan), "home", np.zeros((3, 4, 4))])
+def test_bad_goals_are_named(bad):
+    with pytest.raises(InputError, match="'goal'"):
+        goal_configurations(robokin.load("ur5"), bad)
