@@ -2154,74 +2154,9 @@ static int g6_candidates(const double *P, const double *T, G6Cand *cand, int *fl
 
 /* ------------------------------------------------------------ Newton polish */
 
-/* Smallest singular value of the 6 x 6 row-major J (lane-wise): inverse iteration
- * on J^T J (Cholesky), started at the unit vector of the smallest Cholesky pivot;
- * an upper bound that is sharp when J is nearly singular, 0 where J^T J is not
- * positive definite. */
-static vd g6_sigma_min(const vd *J)
-{
-    vd B[36], L[36];
-    for (int i = 0; i < 6; i++)
-        for (int j = i; j < 6; j++) {
-            vd s = BR(0.0);
-            for (int r = 0; r < 6; r++)
-                s += J[6 * r + i] * J[6 * r + j];
-            B[6 * i + j] = B[6 * j + i] = s;
-        }
-    vl bad = BRL(0);
-    for (int j = 0; j < 6; j++) {
-        vd s = B[6 * j + j];
-        for (int k = 0; k < j; k++)
-            s -= L[6 * j + k] * L[6 * j + k];
-        bad |= ~(s > BR(0.0));
-        L[6 * j + j] = vsqrt(vsel(bad, BR(1.0), s));
-        vd inv = BR(1.0) / L[6 * j + j];
-        for (int i = j + 1; i < 6; i++) {
-            vd t = B[6 * i + j];
-            for (int k = 0; k < j; k++)
-                t -= L[6 * i + k] * L[6 * j + k];
-            L[6 * i + j] = t * inv;
-        }
-    }
-    vd x[6], small = L[0];
-    vl at = BRL(0);
-    for (int k = 1; k < 6; k++) {
-        vl m = L[6 * k + k] < small;
-        small = vsel(m, L[6 * k + k], small);
-        at = (at & ~m) | (BRL(k) & m);
-    }
-    for (int k = 0; k < 6; k++)
-        x[k] = vsel(at == BRL(k), BR(1.0), BR(0.0));
-    for (int it = 0; it < 4; it++) {
-        vd z[6];
-        for (int i = 0; i < 6; i++) { /* L z = x */
-            vd s = x[i];
-            for (int k = 0; k < i; k++)
-                s -= L[6 * i + k] * z[k];
-            z[i] = s / L[6 * i + i];
-        }
-        vd nrm = BR(0.0);
-        for (int i = 5; i >= 0; i--) { /* L^T x = z */
-            vd s = z[i];
-            for (int k = i + 1; k < 6; k++)
-                s -= L[6 * k + i] * x[k];
-            x[i] = s / L[6 * i + i];
-            nrm += x[i] * x[i];
-        }
-        vd inv = BR(1.0) / vsqrt(nrm);
-        for (int i = 0; i < 6; i++)
-            x[i] *= inv;
-    }
-    vd lam = BR(0.0); /* Rayleigh quotient x^T B x */
-    for (int i = 0; i < 6; i++) {
-        vd bx = BR(0.0);
-        for (int j = 0; j < 6; j++)
-            bx += B[6 * i + j] * x[j];
-        lam += x[i] * bx;
-    }
-    vd sig = vsqrt(vsel(lam > BR(0.0), lam, BR(0.0)));
-    return vsel(bad | ~vfinite(sig), BR(0.0), sig);
-}
+/* Smallest singular value of the 6 x 6 row-major J (lane-wise): chain.h's
+ * jac_sigma_min6, the one copy of the inverse iteration on J^T J. */
+static vd g6_sigma_min(const vd *J) { return jac_sigma_min6(J, 6); }
 
 #define NEWTON_RATIO 0.7 /* a step must cut the error by this factor (after 3) ... */
 #define SLOW_RATIO 0.9   /* ... from a multiple root (after SLOW_START) ... */
