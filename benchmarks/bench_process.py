@@ -58,8 +58,10 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import robokin  # noqa: E402
+from process.paths import panel_holes  # noqa: E402  (the tests' panel of holes)
 from robokin import process  # noqa: E402
 from robokin.spatial import rotx, roty, rotz, trans  # noqa: E402
 
@@ -146,18 +148,9 @@ def spline(robot, n=201):
 
 
 def holes(robot, count=60, seed=7):
-    """``count`` hole poses on a curved panel in front of the arm (drill z into it)."""
-    rng = np.random.default_rng(seed)
-    a = rng.uniform(-0.7, 0.7, count)
-    z = rng.uniform(0.05, 0.45, count)
-    T = np.zeros((count, 4, 4))
-    T[:, 3, 3] = 1.0
-    for i in range(count):
-        zax = np.array([np.cos(a[i]), np.sin(a[i]), 0.0])
-        xax = np.array([0.0, 0.0, -1.0])
-        T[i, :3, :3] = np.stack([xax, np.cross(zax, xax), zax], axis=1)
-        T[i, :3, 3] = [0.55 * np.cos(a[i]), 0.55 * np.sin(a[i]), z[i]]
-    return T
+    """``count`` hole poses on a curved panel in front of the arm (drill z into it):
+    the panel of the process tests (``tests/process/paths.py``)."""
+    return panel_holes(robot.name, count, seed)
 
 
 def paths(robot):

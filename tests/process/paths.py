@@ -41,11 +41,10 @@ def panel_holes(robot_name, count, seed):
     z = rng.uniform(0.05, 0.45, count)
     T = np.zeros((count, 4, 4))
     T[:, 3, 3] = 1.0
-    for i in range(count):
-        zax = np.array([np.cos(a[i]), np.sin(a[i]), 0.0])
-        xax = np.array([0.0, 0.0, -1.0])
-        T[i, :3, :3] = np.stack([xax, np.cross(zax, xax), zax], axis=1)
-        T[i, :3, 3] = [0.55 * np.cos(a[i]), 0.55 * np.sin(a[i]), z[i]]
+    zax = np.stack([np.cos(a), np.sin(a), np.zeros(count)], axis=-1)
+    xax = np.broadcast_to([0.0, 0.0, -1.0], zax.shape)
+    T[:, :3, :3] = np.stack([xax, np.cross(zax, xax), zax], axis=-1)
+    T[:, :3, 3] = np.stack([0.55 * np.cos(a), 0.55 * np.sin(a), z], axis=-1)
     return T
 
 
