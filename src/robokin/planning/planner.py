@@ -39,9 +39,10 @@ DEFAULT_PLANNER = "rrtconnect"
 #: Every planner name :meth:`Planner.plan` accepts.
 PLANNERS = (DEFAULT_PLANNER, *(f"ompl:{name}" for name in OMPL_PLANNERS))
 #: Longest RRT-Connect edge [rad, m]: the smaller of RANGE and RANGE_FRACTION of the
-#: diagonal of the joint-limit box (docs/planning.md: 1.0 gave the lowest median
-#: over the benchmark's six families among 0.5-2.0).
-RANGE = 1.0
+#: diagonal of the joint-limit box (docs/planning.md: on the issue-26 problem set 0.5
+#: halved the median CPU time of the thin shelf and the cage against 1.0, and was
+#: no worse on the other families; 1.0 had been best on the earlier simple scenes).
+RANGE = 0.5
 RANGE_FRACTION = 0.1
 #: Most tree nodes of one RRT-Connect query (bounds memory and time).
 MAX_NODES = 200_000
@@ -218,7 +219,7 @@ class Planner:
                 :data:`PLANNERS`.
             clearance: Distance the robot keeps from the scene [m].
             self_clearance: Distance the robot's links keep from each other [m].
-            planner_range: Longest tree edge [rad, m] (default: 1.0, or a tenth of
+            planner_range: Longest tree edge [rad, m] (default: 0.5, or a tenth of
                 the diagonal of the joint-limit box if that is shorter; for OMPL's
                 planners that have a range too).
             simplify: Shortcut the path (every new edge checked): True (20 attempts),
