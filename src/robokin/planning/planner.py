@@ -82,11 +82,11 @@ class Planner:
         self.robot = self.model.robot
         self.scene = scene
         self.n = self.model.n
-        #: the robot before the scene placed it: pose goals are solved on it (its
-        #: IK set-up kept across Planners), moved from the placed robot's frames
-        self.solver = scene.unplaced(robot)
-        if self.solver.n != self.n:  # not the same joints: solve on the placed one
-            self.solver = self.robot
+        # the robot before the scene placed it: pose goals are solved on it (its
+        # IK set-up kept across Planners), moved from the placed robot's frames
+        self._solver = scene.unplaced(robot)
+        if self._solver.n != self.n:  # not the same joints: solve on the placed one
+            self._solver = self.robot
         self.limits = np.asarray(self.robot.limits, dtype=float)
         self._finite = bool(np.isfinite(self.limits).all())
         self._margins: dict[tuple[float, float], np.ndarray] = {}
@@ -255,7 +255,7 @@ class Planner:
                              f"{np.shape(start)}")
         q0 = q0[0]
         margin = self.margin(clearance, self_clearance)
-        goals = goal_configurations(self.robot, goal, solver=self.solver)
+        goals = goal_configurations(self.robot, goal, solver=self._solver)
         ends = self._check_ends(q0, goals, margin, t0 + limit)
         if isinstance(ends, str):
             return PlanResult(False, np.zeros((0, self.n)), ends,
