@@ -68,3 +68,63 @@ def test_a_four_joint_arm_reads_a_rigid_transform_as_a_pose():
 def test_bad_goals_are_named(bad):
     with pytest.raises(InputError, match="'goal'"):
         goal_configurations(robokin.load("ur5"), bad)
+
+
+def test_a_seven_joint_pose_samples_every_in_limit_interval_of_its_self_motion():
+    # oracle: FK of every candidate is the pose (to 1e-9); every in-limit interval of
+    # robot.self_motion(T) holds at least one first-round candidate; later rounds
+    # halve the cells, so no candidate repeats and round r holds 2**r times round 0
+    robot = robokin.load("panda")
+    q = np.array([0.0, 0.3, 0.0, -1.8, 0.0, 2.1, 0.8])
+    T = robot.fk(q)
+    g = goal_configurations(robot, T)
+    sm = robot.self_motion(T)
+    assert g.kind == "pose" and g.manifold is not None and g.rounds == 1
+    assert len(sm.intervals) >= 3
+    t = g.q[:, 6]  # the parameter is q7 on the Panda
+    for (a, b), br in zip(sm.intervals, sm.interval_branch, strict=True):
+        inside = (t >= a) & (t <= b)
+        assert inside.any()
+        branch = sm.sample(t[inside])[np.arange(inside.sum()), br]
+        assert np.any(np.abs(branch - g.q[inside]).max(axis=1) < 1e-12)
+    first = len(g.q)
+    for r in range(1, 3):
+        g, rows = g.grown()
+        assert len(rows) == first * 2**r and g.rounds == r + 1
+    np.testing.assert_allclose(robot.fk(g.q), np.broadcast_to(T, (len(g.q), 4, 4)),
+                               atol=1e-9)
+    assert np.all(g.q >= robot.limits[:, 0]) and np.all(g.q <= robot.limits[:, 1])
+    assert len(np.unique(np.round(g.q, 12), axis=0)) == len(g.q)
+
+
+def test_a_pose_written_to_twelve_digits_keeps_its_self_motion():
+    # a rotation orthonormal only to ~1e-12 (a pose read back from a file) made the
+    # held-q7 closed form reject every branch (it accepts a solution within 1e-12):
+    # the goal is projected onto SE(3) first. Oracle: FK of the candidates is the
+    # written pose to 1e-9 and the generating q7's branch is reached.
+    robot = robokin.load("panda")
+    q = np.array([-1.005, 1.7246, 0.98118, -2.46426, 2.5477, 1.62304, -0.55742])
+    T = robot.fk(q)
+    T[:3, :3] *= 1.0 - 1e-12  # as a pose rounded to 12 digits may be
+    # (robokin's self_motion(T) of this T had no in-limit interval on 2026-12-02)
+    g = goal_configurations(robot, T)
+    assert g.manifold is not None and len(g.q) > 0
+    np.testing.assert_allclose(robot.fk(g.q), np.broadcast_to(T, (len(g.q), 4, 4)),
+                               atol=1e-9)
+
+
+def test_a_placed_robot_solves_its_pose_on_the_unplaced_one():
+    # oracle: the placed robot's own FK of every candidate is the world pose; the
+    # candidates equal those of the placed robot solved directly
+    robot = robokin.load("panda")
+    placed = robot.with_base(robot.base @ np.array(
+        [[0, -1, 0, 0.3], [1, 0, 0, -0.2], [0, 0, 1, 0.1], [0, 0, 0, 1.0]]))
+    placed = placed.with_tool(placed.tool @ np.array(
+        [[1, 0, 0, 0], [0, 0, -1, 0.01], [0, 1, 0, 0.1], [0, 0, 0, 1.0]]))
+    T = placed.fk(np.array([0.2, 0.4, -0.3, -1.9, 0.2, 2.0, 0.5]))
+    g = goal_configurations(placed, T, solver=robot)
+    direct = goal_configurations(placed, T)
+    np.testing.assert_allclose(placed.fk(g.q), np.broadcast_to(T, (len(g.q), 4, 4)),
+                               atol=1e-9)
+    assert g.q.shape == direct.q.shape
+    np.testing.assert_allclose(g.q, direct.q, atol=1e-8)

@@ -289,3 +289,55 @@ def test_result_arrays_are_read_only_and_the_summary_reads(ur5_shelf):
     assert res.stats["edges"] >= 1 and res.stats["states"] >= 2
     fail = pl.plan(HOME, BAD)
     assert not fail and "success=False" in repr(fail) and fail.length == 0.0
+
+
+def _elbow_ring(robot, T):
+    """Balls along the elbow's circle of the pose's self-motion but for one free arc.
+
+    The held-q7 IK at five q7 values and ``robot.ik``'s own solutions all put the
+    elbow (frame 4's origin) on a ball; the manifold sample farthest from all of
+    theirs keeps its elbow 0.16 m from every ball. Returns the scene, those
+    configurations and the free one.
+    """
+    from robokin.kinematics.forward import link_frames
+
+    sm = robot.self_motion(T)
+    q = sm.sample(np.linspace(*sm.domain, 2001), within_limits=True).reshape(-1, robot.n)
+    q = q[np.isfinite(q).all(axis=1)]
+    elbow = link_frames(robot.chain, q)[:, 4, :3, 3]
+    sampled = [robot.ik(T, fixed={"joint7": v}).keep_within_limits().solutions()
+               for v in np.linspace(0.15, 1.45, 5)]
+    sampled.append(robot.ik(T).keep_within_limits().solutions())
+    blocked = np.vstack([np.asarray(s).reshape(-1, robot.n) for s in sampled])
+    near = link_frames(robot.chain, blocked)[:, 4, :3, 3]
+    w = int(np.argmax(np.linalg.norm(elbow[:, None] - near[None], axis=-1).min(axis=1)))
+    scene = Scene("elbow ring")
+    balls: list[np.ndarray] = []
+    for e in elbow[np.linalg.norm(elbow - elbow[w], axis=1) > 0.16]:
+        if not balls or np.linalg.norm(np.array(balls) - e, axis=1).min() > 0.02:
+            balls.append(e)
+            scene.add_sphere(f"ball_{len(balls)}", 0.02, pose(e))
+    return scene, blocked, q[w]
+
+
+def test_a_seven_joint_pose_goal_reaches_the_free_part_of_its_self_motion():
+    # the Panda's pose T: the elbow's circle of its self-motion is lined with balls
+    # but for one arc; every configuration of the held-q7 IK at five q7 values and
+    # every solution robot.ik returns collides (so the old goals, robot.ik's, were
+    # all in collision and the query failed). Oracle: coal (tests/planning_oracle.py)
+    # says those collide and the free arc's sample is free; the path ends at a
+    # configuration whose FK is T (to 1e-9) and is free sampled every 0.01 rad.
+    robot = robokin.load("panda")
+    T = robot.fk(np.array([0.0, 0.3, 0.0, -1.8, 0.0, 2.1, 0.8]))
+    scene, blocked, free = _elbow_ring(robot, T)
+    oracle = Oracle(robot, scene)
+    assert len(blocked) >= 5 and all(oracle.min_distance(b) < 0.0 for b in blocked)
+    assert oracle.min_distance(free) > 0.05
+    start = np.array([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
+    pl = planning.Planner(robot, scene)
+    res = pl.plan(start, T, time_limit=5.0)
+    assert res.success, res.reason
+    np.testing.assert_allclose(robot.fk(res.q[-1]), T, atol=1e-9)
+    assert np.array_equal(res.q[-1], res.goals[res.goal_index])
+    assert np.abs(blocked - res.q[-1]).max(axis=1).min() > 1e-3  # none of the old goals
+    assert oracle.path_min(res.q) > 0.0

@@ -7,9 +7,12 @@
 * a goal set (k, n): each row;
 * a TCP pose (4, 4) in the world: every solution ``robot.ik(T)`` returns inside the
   joint limits, with the whole-turn equivalents of joints whose range exceeds
-  2 pi (a UR joint at +-360 deg reaches each angle twice); for a redundant arm
-  (more than six joints), the solutions ``robot.ik`` returns for the pose (its own
-  handling of the redundancy), not the whole self-motion manifold.
+  2 pi (a UR joint at +-360 deg reaches each angle twice); for a 7R arm, samples
+  of the pose's whole self-motion manifold (``robot.self_motion(T)``: every branch,
+  every interval inside the joint limits), spread over the intervals by their
+  length, at least one each (:class:`ManifoldGoals`). The planner asks for denser
+  samples (:meth:`Goals.grown`) while every goal so far is in collision or the
+  search cannot reach them.
 
 For a four-joint arm a (4, 4) array is ambiguous; it is read as a pose when it is
 a rigid transform (last row 0 0 0 1, orthonormal rotation), else as four
@@ -29,13 +32,57 @@ from robokin._validation import _real_array, check_finite
 from robokin.exceptions import InputError
 
 if TYPE_CHECKING:
+    from robokin.kinematics.ik.self_motion import SelfMotion
     from robokin.robot import Robot
 
-__all__ = ["GoalKind", "Goals", "goal_configurations", "outside_limits"]
+__all__ = ["GoalKind", "Goals", "ManifoldGoals", "goal_configurations", "outside_limits"]
 
 GoalKind = Literal["configuration", "set", "pose"]
 #: Tolerance [rad, m] of the joint-limit test of starts and goals.
 LIMIT_TOL = 1e-9
+#: Self-motion samples of a 7R pose goal's first round (spread over the in-limit
+#: intervals by length, at least one each); each later round doubles the density.
+MANIFOLD_FIRST = 32
+#: Rounds of manifold samples at most: the last has 2**7 = 128 times the first
+#: round's density (32 samples over 2.9 rad: a spacing of 0.7 mrad), 8160 in all.
+MANIFOLD_ROUNDS = 8
+
+
+@dataclass(frozen=True, eq=False)
+class ManifoldGoals:
+    """The self-motion manifold of a 7R pose goal, sampled round by round.
+
+    Round r places ``counts[i] * 2**r`` samples at the centres of equal cells of
+    in-limit interval i, so no sample repeats an earlier round's (a round's centres
+    are the earlier rounds' cell boundaries) and every round is spread over every
+    branch and interval.
+
+    Attributes:
+        motion: ``robot.self_motion(T)``.
+        counts: (m,) first-round samples of each interval (>= 1).
+    """
+
+    motion: SelfMotion
+    counts: np.ndarray
+
+    @classmethod
+    def of(cls, motion: SelfMotion, first: int = MANIFOLD_FIRST) -> ManifoldGoals:
+        """The sampler of ``motion`` with about ``first`` samples in round 0."""
+        length = np.diff(motion.intervals, axis=1)[:, 0]
+        total = float(length.sum())
+        share = length / total * first if total > 0 else np.zeros_like(length)
+        return cls(motion, np.maximum(1, np.rint(share)).astype(np.int64))
+
+    def round(self, r: int) -> np.ndarray:
+        """The configurations (k, n) of round r inside the joint limits [rad]."""
+        sm, per = self.motion, self.counts * 2**r
+        a, b = sm.intervals[:, 0], sm.intervals[:, 1]
+        cell = np.repeat(np.arange(len(per)), per)
+        j = np.arange(int(per.sum())) - np.repeat(np.cumsum(per) - per, per)
+        t = a[cell] + (b[cell] - a[cell]) * (j + 0.5) / per[cell]
+        q = sm.sample(t, within_limits=True)[np.arange(len(t)), sm.interval_branch[cell]]
+        q = q[np.isfinite(q).all(axis=1)]
+        return np.ascontiguousarray(np.clip(q, sm.limits[:, 0], sm.limits[:, 1]))
 
 
 @dataclass(frozen=True, eq=False)
@@ -50,6 +97,9 @@ class Goals:
             (a configuration: 0; a pose: the candidate's own number).
         pose: The TCP pose (4, 4) in the world for a pose goal, else None.
         reason: Why there is no candidate (empty when k > 0).
+        manifold: A 7R pose goal's self-motion sampler (``q`` holds its rounds
+            0 .. ``rounds - 1``), else None.
+        rounds: The manifold rounds in ``q``.
     """
 
     kind: GoalKind
@@ -57,6 +107,23 @@ class Goals:
     index: np.ndarray
     pose: np.ndarray | None = None
     reason: str = ""
+    manifold: ManifoldGoals | None = None
+    rounds: int = 1
+
+    @property
+    def can_grow(self) -> bool:
+        """Whether :meth:`grown` has denser manifold samples to add."""
+        return self.manifold is not None and self.rounds < MANIFOLD_ROUNDS
+
+    def grown(self) -> tuple[Goals, np.ndarray]:
+        """These goals with the next manifold round appended, and its new rows."""
+        if self.manifold is None or not self.can_grow:
+            raise ValueError("no denser samples: not a manifold goal, or the last round")
+        new = self.manifold.round(self.rounds)
+        rows = np.arange(len(self.q), len(self.q) + len(new))
+        q = np.ascontiguousarray(np.vstack([self.q, new]))
+        return (Goals(self.kind, q, np.arange(len(q)), self.pose, self.reason,
+                      self.manifold, self.rounds + 1), rows)
 
 
 def outside_limits(q: np.ndarray, limits: np.ndarray) -> str:
@@ -81,12 +148,57 @@ def _is_rigid(T: np.ndarray) -> bool:
     )
 
 
-def _pose_goals(robot: Robot, T: np.ndarray) -> Goals:
+def _rigid(T: np.ndarray) -> np.ndarray:
+    """T with its rotation projected onto SO(3) (the nearest rotation, by SVD)."""
+    U, _, Vt = np.linalg.svd(T[:3, :3])
+    out = T.copy()
+    out[:3, :3] = U @ Vt
+    return out
+
+
+def _in_frame(robot: Robot, solver: Robot, T: np.ndarray) -> np.ndarray:
+    """The pose of ``solver``'s tool when ``robot``'s is at T (the same joint values).
+
+    ``robot.fk(q) = pre @ solver.fk(q) @ post`` with ``pre = robot.base @
+    solver.base^-1`` and ``post = solver.tool^-1 @ robot.tool``.
+    """
+    from robokin.spatial import invert
+
+    if np.array_equal(robot.base, solver.base) and np.array_equal(robot.tool, solver.tool):
+        return T
+    pre = np.asarray(robot.base) @ invert(solver.base)
+    post = invert(solver.tool) @ np.asarray(robot.tool)
+    out: np.ndarray = invert(pre) @ T @ invert(post)
+    return out
+
+
+def _manifold_goals(robot: Robot, T: np.ndarray) -> Goals | None:
+    """A 7R arm's pose goal on its self-motion manifold; None when it has none."""
+    from robokin.kinematics.ik.self_motion import auto_parameter
+
+    if auto_parameter(robot) is None:
+        return None
+    # the held-joint closed form accepts a solution only within 1e-12 of the pose: a
+    # rotation orthonormal to 1e-12 only (a pose written to 12 digits) would lose
+    # every branch, so it is projected onto SO(3) first (a change below 1e-11)
+    sm = robot.self_motion(_rigid(T))
+    if not sm.reachable:
+        return None  # robot.ik says why (or finds what the manifold missed)
+    sampler = ManifoldGoals.of(sm)
+    q = sampler.round(0)
+    return Goals("pose", q, np.arange(len(q)), T, "", sampler, 1)
+
+
+def _pose_goals(robot: Robot, T: np.ndarray, solver: Robot) -> Goals:
     """Every in-limit IK solution of the pose T, whole turns included."""
     from robokin._validation import check_transform
 
     T = check_transform(T, "goal")
-    sols = robot.ik(T)
+    Ts = _in_frame(robot, solver, T)
+    manifold = _manifold_goals(solver, Ts)
+    if manifold is not None:
+        return Goals("pose", manifold.q, manifold.index, T, "", manifold.manifold, 1)
+    sols = solver.ik(Ts)
     inside = sols.keep_within_limits()
     q = np.asarray(inside.expand_turns().solutions(), dtype=float).reshape(-1, robot.n)
     if q.shape[0] == 0:
@@ -98,12 +210,17 @@ def _pose_goals(robot: Robot, T: np.ndarray) -> Goals:
     return Goals("pose", np.ascontiguousarray(q), np.arange(q.shape[0]), T)
 
 
-def goal_configurations(robot: Robot, goal: npt.ArrayLike) -> Goals:
+def goal_configurations(robot: Robot, goal: npt.ArrayLike, *,
+                        solver: Robot | None = None) -> Goals:
     """The candidate goal configurations of ``goal`` (see the module docstring).
 
     Args:
         robot: The robot as placed in the scene (poses are in the world).
         goal: A configuration (n,), a goal set (k, n) [rad, m], or a TCP pose (4, 4).
+        solver: The same arm with other base and tool transforms (the robot before
+            the scene placed it) to solve a pose goal with, the pose moved into its
+            frames: its IK set-up, built on first use (0.2 s for the Panda's
+            self-motion), then serves every Planner of that robot. Default: robot.
 
     Returns:
         The candidates inside the joint limits; none (with a reason) when every
@@ -115,7 +232,7 @@ def goal_configurations(robot: Robot, goal: npt.ArrayLike) -> Goals:
     n = robot.n
     g = _real_array(goal, "goal", "a configuration, a goal set or a pose")
     if g.shape == (4, 4) and (n != 4 or _is_rigid(g)):
-        return _pose_goals(robot, g)
+        return _pose_goals(robot, g, robot if solver is None else solver)
     if g.ndim == 1 and g.shape[0] == n:
         kind: GoalKind = "configuration"
         q = g[None, :]

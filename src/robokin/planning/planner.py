@@ -39,9 +39,10 @@ DEFAULT_PLANNER = "rrtconnect"
 #: Every planner name :meth:`Planner.plan` accepts.
 PLANNERS = (DEFAULT_PLANNER, *(f"ompl:{name}" for name in OMPL_PLANNERS))
 #: Longest RRT-Connect edge [rad, m]: the smaller of RANGE and RANGE_FRACTION of the
-#: diagonal of the joint-limit box (docs/planning.md: 1.0 gave the lowest median
-#: over the benchmark's six families among 0.5-2.0).
-RANGE = 1.0
+#: diagonal of the joint-limit box (docs/planning.md: on the issue-26 problem set 0.5
+#: halved the median CPU time of the thin shelf and the cage against 1.0, and was
+#: no worse on the other families; 1.0 had been best on the earlier simple scenes).
+RANGE = 0.5
 RANGE_FRACTION = 0.1
 #: Most tree nodes of one RRT-Connect query (bounds memory and time).
 MAX_NODES = 200_000
@@ -81,6 +82,11 @@ class Planner:
         self.robot = self.model.robot
         self.scene = scene
         self.n = self.model.n
+        # the robot before the scene placed it: pose goals are solved on it (its
+        # IK set-up kept across Planners), moved from the placed robot's frames
+        self._solver = scene.unplaced(robot)
+        if self._solver.n != self.n:  # not the same joints: solve on the placed one
+            self._solver = self.robot
         self.limits = np.asarray(self.robot.limits, dtype=float)
         self._finite = bool(np.isfinite(self.limits).all())
         self._margins: dict[tuple[float, float], np.ndarray] = {}
@@ -213,7 +219,7 @@ class Planner:
                 :data:`PLANNERS`.
             clearance: Distance the robot keeps from the scene [m].
             self_clearance: Distance the robot's links keep from each other [m].
-            planner_range: Longest tree edge [rad, m] (default: 1.0, or a tenth of
+            planner_range: Longest tree edge [rad, m] (default: 0.5, or a tenth of
                 the diagonal of the joint-limit box if that is shorter; for OMPL's
                 planners that have a range too).
             simplify: Shortcut the path (every new edge checked): True (20 attempts),
@@ -249,21 +255,29 @@ class Planner:
                              f"{np.shape(start)}")
         q0 = q0[0]
         margin = self.margin(clearance, self_clearance)
-        goals = goal_configurations(self.robot, goal)
-        fail = self._check_ends(q0, goals, margin, clearance, self_clearance)
-        if isinstance(fail, str):
-            return PlanResult(False, np.zeros((0, self.n)), fail,
+        goals = goal_configurations(self.robot, goal, solver=self._solver)
+        ends = self._check_ends(q0, goals, margin, t0 + limit)
+        if isinstance(ends, str):
+            return PlanResult(False, np.zeros((0, self.n)), ends,
                               time.perf_counter() - t0, planner, goals=goals.q)
-        free_goals, goal_rows = fail
-        stats: dict[str, Any] = {"goals": int(free_goals.shape[0])}
-        left = limit - (time.perf_counter() - t0)  # the goals' IK and checks count
-        if left <= 0:
-            return PlanResult(False, np.zeros((0, self.n)),
-                              f"no path found before the time limit ({limit:g} s): the "
-                              "goals and their checks took it", time.perf_counter() - t0,
-                              planner, goals=goals.q, stats=stats)
-        path, goal_at, why = self._search(planner, q0, free_goals, margin, (limit, left),
-                                          int(seed), step, stats)
+        goals, free = ends
+        stats: dict[str, Any] = {}
+        while True:
+            stats.update(goals=int(free.sum()), goal_rounds=goals.rounds)
+            left = limit - (time.perf_counter() - t0)  # the goals' IK and checks count
+            if left <= 0:
+                return PlanResult(False, np.zeros((0, self.n)),
+                                  f"no path found before the time limit ({limit:g} s): the "
+                                  "goals and their checks took it", time.perf_counter() - t0,
+                                  planner, goals=goals.q, stats=stats)
+            # a manifold goal set may grow: its first goals get half the time left
+            more = goals.can_grow
+            path, goal_at, why, timed_out = self._search(
+                planner, q0, goals.q[free], margin, (limit, left / 2 if more else left),
+                int(seed), step, stats)
+            if path is not None or not (timed_out and more):
+                break
+            goals, free = self._grow(goals, free, margin, t0 + limit)
         if path is None:
             return PlanResult(False, np.zeros((0, self.n)), why,
                               time.perf_counter() - t0, planner, goals=goals.q,
@@ -272,14 +286,14 @@ class Planner:
         t1 = time.perf_counter()
         path = self._simplify(path, margin, int(seed), _tries(simplify), smooth, stats)
         stats.update(simplify_s=time.perf_counter() - t1, cpu_s=time.process_time() - c0)
-        index = int(goal_rows[goal_at])
+        index = int(goals.index[np.flatnonzero(free)[goal_at]])
         elapsed = time.perf_counter() - t0
         traj = None
         if retime:
             traj = self.trajectory(path, clearance=clearance, self_clearance=self_clearance,
                                    **(retime_options or {}))
         return PlanResult(True, path, "solved", elapsed, planner,
-                          goal=free_goals[goal_at], goal_index=index, goals=goals.q,
+                          goal=goals.q[free][goal_at], goal_index=index, goals=goals.q,
                           raw=raw, trajectory=traj, stats=stats)
 
     def _range(self, planner_range: float | None) -> float | None:
@@ -302,9 +316,11 @@ class Planner:
         return lo, hi
 
     def _check_ends(self, q0: np.ndarray, goals: Goals, margin: np.ndarray,
-                    clearance: float, self_clearance: float
-                    ) -> str | tuple[np.ndarray, np.ndarray]:
-        """The free goals and their rows, or why the query cannot start."""
+                    deadline: float) -> str | tuple[Goals, np.ndarray]:
+        """The goals (grown while all collide) and which are free, or why not to start.
+
+        ``deadline``: the :func:`time.perf_counter` time the query must end by.
+        """
         why = outside_limits(q0, self.limits)
         if why:
             return f"the start is outside the joint limits: {why}"
@@ -314,19 +330,34 @@ class Planner:
                                                                     margin)
         if goals.q.shape[0] == 0:
             return goals.reason
-        grep = self.model.check_states(goals.q, margin)
-        if not grep.free.any():
+        free = self.model.check_states(goals.q, margin).free
+        if not free.any() and goals.can_grow:
+            goals, free = self._grow(goals, free, margin, deadline)
+        if not free.any():
+            grep = self.model.check_states(goals.q[:1], margin)
             what = "the goal is" if goals.q.shape[0] == 1 else (
                 f"every goal ({goals.q.shape[0]}) is")
             return (f"{what} in collision: " + self._pair_text(goals.q[0],
                                                                int(grep.pair[0]), margin))
-        return goals.q[grep.free], goals.index[grep.free]
+        return goals, free
+
+    def _grow(self, goals: Goals, free: np.ndarray, margin: np.ndarray,
+              deadline: float) -> tuple[Goals, np.ndarray]:
+        """Denser manifold rounds until one adds a free goal (or none is left, or time)."""
+        while goals.can_grow and time.perf_counter() < deadline:
+            goals, rows = goals.grown()
+            new = (self.model.check_states(goals.q[rows], margin).free if len(rows)
+                   else np.zeros(0, dtype=bool))
+            free = np.concatenate([free, new])
+            if new.any():
+                break
+        return goals, free
 
     def _search(self, planner: str, q0: np.ndarray, goals: np.ndarray,
                 margin: np.ndarray, limits: tuple[float, float], seed: int,
                 step: float | None, stats: dict[str, Any]
-                ) -> tuple[np.ndarray | None, int, str]:
-        """Run the planner: (path, goal row, reason).
+                ) -> tuple[np.ndarray | None, int, str, bool]:
+        """Run the planner: (path, goal row, reason, whether the search timed out).
 
         ``limits``: the query's time limit (named in the reason) and the search's.
         """
@@ -344,11 +375,11 @@ class Planner:
             stats.update(_work(work), iterations=search[0], nodes=search[1] + search[2],
                          search_s=search[3])
             if code == _k.RC_SOLVED:
-                return np.asarray(path), int(goal_at), "solved"
+                return np.asarray(path), int(goal_at), "solved", False
             what = {_k.RC_TIMEOUT: f"the time limit ({limit:g} s)",
                     _k.RC_NODES: f"the node limit ({MAX_NODES})"}.get(code, "an error")
             return None, -1, (f"no path found before {what}: {search[0]} iterations, "
-                              f"{search[1] + search[2]} tree nodes")
+                              f"{search[1] + search[2]} tree nodes"), code == _k.RC_TIMEOUT
         t = time.perf_counter()
         out = ompl_plan(planner.split(":", 1)[1], self.n, lo, hi, q0, goals,
                         lambda q: bool(self.model.check_states(q, margin).free[0]),
@@ -357,11 +388,11 @@ class Planner:
         stats.update(states=out.states, edges=out.edges, search_s=time.perf_counter() - t)
         if out.path is None:
             return None, -1, (f"no path found before the time limit ({limit:g} "
-                              f"s): OMPL says {out.status!r}")
+                              f"s): OMPL says {out.status!r}"), True
         path = out.path
         goal_at = int(np.argmin(np.linalg.norm(goals - path[-1], axis=1)))
         path[-1] = goals[goal_at]
-        return path, goal_at, "solved"
+        return path, goal_at, "solved", False
 
     def _simplify(self, path: np.ndarray, margin: np.ndarray, seed: int,
                   tries: int, smooth: bool, stats: dict[str, Any]) -> np.ndarray:
