@@ -72,16 +72,16 @@ def test_robots_built_in_a_loop_are_freed_and_memory_stays_flat():
 def test_the_derived_state_is_the_arms_and_goes_with_it():
     # the family, its single-pose path and the seed table are fields of robot.arm;
     # a robot of another tool has its own; dropping the robot frees them
-    from robokin.kinematics.ik import numeric
+    from robokin.kinematics.ik.restart_seeds import seed_table
 
     robot = robokin.load("ur5").with_tool(np.eye(4))
     T = robot.fk(np.zeros(6))
     assert robot.arm.family is None and robot.arm.seed_table is None
     robot.ik(T)
-    tab = numeric.seed_table(robot)
+    tab = seed_table(robot)
     fam = robot.arm.family
     assert fam is not None and fam.single is not None and robot.arm.seed_table is tab
-    assert numeric.seed_table(robot) is tab and robokin.ik.family(robot) is fam
+    assert seed_table(robot) is tab and robokin.ik.family(robot) is fam
     other = robot.with_tool(np.eye(4))
     other.ik(T)
     assert other.arm.family is not fam
