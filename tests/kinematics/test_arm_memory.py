@@ -70,21 +70,41 @@ def test_robots_built_in_a_loop_are_freed_and_memory_stays_flat():
 
 
 def test_the_derived_state_is_the_arms_and_goes_with_it():
-    # the family, its single-pose path and the seed table are fields of robot.arm;
+    # the family, its single-pose path and the seed table are kept in robot.arm;
     # a robot of another tool has its own; dropping the robot frees them
-    from robokin.kinematics.ik.restart_seeds import seed_table
+    from robokin.kinematics.ik.analytic.detect import FAMILY
+    from robokin.kinematics.ik.restart_seeds import SEED_TABLE, seed_table
 
     robot = robokin.load("ur5").with_tool(np.eye(4))
     T = robot.fk(np.zeros(6))
-    assert robot.arm.family is None and robot.arm.seed_table is None
+    assert FAMILY not in robot.arm.state and SEED_TABLE not in robot.arm.state
     robot.ik(T)
     tab = seed_table(robot)
-    fam = robot.arm.family
-    assert fam is not None and fam.single is not None and robot.arm.seed_table is tab
+    fam = robot.arm.state[FAMILY]
+    assert fam.single is not None and robot.arm.state[SEED_TABLE] is tab
     assert seed_table(robot) is tab and robokin.ik.family(robot) is fam
     other = robot.with_tool(np.eye(4))
     other.ik(T)
-    assert other.arm.family is not fam
+    assert other.arm.derived(FAMILY) is not fam
     ref = weakref.ref(fam)
     del robot, fam, tab
     assert ref() is None
+
+
+def test_a_kind_of_derived_state_is_built_once_per_arm():
+    # oracle: a counting build function; the value is kept per Arm, not shared
+    from robokin.kinematics.arm import Arm, Derived
+
+    calls = []
+
+    def build(arm):
+        calls.append(arm)
+        return [arm.n]
+
+    kind = Derived("test state", build)
+    chain = robokin.load("ur5").chain
+    a, b = Arm(chain), Arm(chain)
+    first = a.derived(kind)
+    assert a.derived(kind) is first and calls == [a]
+    assert b.derived(kind) is not first and calls == [a, b]
+    assert a.state == {kind: [6]} and repr(kind) == "Derived('test state')"

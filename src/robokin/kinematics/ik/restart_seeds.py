@@ -18,12 +18,12 @@ import numpy as np
 
 from robokin import _native
 from robokin.exceptions import InputError
-from robokin.kinematics.arm import ArmSource, arm_of
+from robokin.kinematics.arm import ArmSource, Derived, arm_of
 from robokin.kinematics.forward import forward_kinematics
 from robokin.model.chain import Chain
 
 __all__ = [
-    "NO_TABLE", "SEED_SHRINK", "TABLE_ROT", "TABLE_SEEDS", "TABLE_SIZE", "SeedTable",
+    "NO_TABLE", "SEED_SHRINK", "SEED_TABLE", "TABLE_ROT", "TABLE_SEEDS", "TABLE_SIZE", "SeedTable",
     "build_seed_table", "grid_cells", "middle", "seed_key", "seed_table", "uniforms",
 ]
 
@@ -63,11 +63,7 @@ class SeedTable:
 
 def seed_table(robot: ArmSource) -> SeedTable:
     """The arm's :class:`SeedTable` (built on first use, kept in its ``Arm``)."""
-    arm = arm_of(robot)
-    tab = arm.seed_table
-    if not isinstance(tab, SeedTable):
-        tab = arm.seed_table = build_seed_table(arm.chain)
-    return tab
+    return arm_of(robot).derived(SEED_TABLE)
 
 
 def build_seed_table(chain: Chain) -> SeedTable:
@@ -109,6 +105,10 @@ def grid_cells(p: np.ndarray, origin: np.ndarray, inv: np.ndarray, G: int) -> np
     cells: np.ndarray = (c[:, 0] * G + c[:, 1]) * G + c[:, 2]
     return cells
 
+
+#: The arm's seed table, kept in its ``Arm`` (``arm.derived(SEED_TABLE)``).
+SEED_TABLE: Derived[SeedTable] = Derived(
+    "numeric IK seed table", lambda arm: build_seed_table(arm.chain))
 
 #: The kernel arguments for "no seed table" (a 0-row table).
 NO_TABLE = (np.empty((0, 12)), np.zeros(1, dtype=np.int64), np.zeros(7))
