@@ -33,6 +33,7 @@ from peers import _constants, pinocchio_model, rtb_ets  # noqa: E402
 
 import robokin  # noqa: E402
 from robokin.kinematics.ik import numeric  # noqa: E402
+from robokin.kinematics.ik.restart_seeds import middle  # noqa: E402
 
 ROBOTS = ("ur5", "panda", "improved_dh_arm")
 BUDGET = 1_000_000  # restarts: the 10 ms wall-time budget is what stops robokin
@@ -260,7 +261,7 @@ def main() -> None:
         box = np.clip(lim, -np.pi, np.pi)
         Q = rng.uniform(box[:, 0], box[:, 1], (args.n, robot.n))
         targets = robot.fk(Q)
-        fixed = np.tile(numeric._middle(robot.chain), (args.n, 1))
+        fixed = np.tile(middle(robot.chain), (args.n, 1))
         rand = rng.uniform(box[:, 0], box[:, 1], (args.n, robot.n))
         check_models(robot, rng)
         fns = solvers(robot, args.tol)

@@ -16,7 +16,8 @@ import pytest
 
 import robokin
 from robokin._native import kernels as K
-from robokin.kinematics.ik import numeric
+from robokin.kinematics.ik.lm_options import option_vector
+from robokin.kinematics.ik.restart_seeds import NO_TABLE
 
 NATIVE = Path(robokin.__file__).parent / "_native"
 
@@ -53,9 +54,9 @@ def _lm_args():
     robot = robokin.load("ur5")
     q = np.zeros((2, 6)) + 0.3
     T = robot.fk(q)
-    opts = numeric._opts(None, None, 1e-9, None, 100, 1.0)
+    opts = option_vector(None, None, 1e-9, None, 100, 1.0)
     opts[K.O_USE_Q0] = 1.0
-    tab, cstart, gdat = numeric._NO_TABLE
+    tab, cstart, gdat = NO_TABLE
     return [robot.chain.arrays.packed, T, q + 1e-3, np.zeros((2, 1, 6)), opts,
             np.empty((2, 6 + K.N_RES)), tab, cstart, gdat, False]
 

@@ -5,9 +5,10 @@ needs). Here the :class:`~robokin.model.chain.Chain` (with its ``ChainArrays``) 
 what the arm is, and the :class:`Arm` holds it together with everything derived from
 it: the closed-form family of every detection setting, the general-6R set-up, the
 numeric solver's seed table, the closed forms with one joint held and the reduced
-arms of a held-joint sweep. Each field is filled on first use by the module that
-computes it (``detect``, ``general_6r``, ``numeric``, ``fixed``) and goes with the
-Arm.
+arms of a held-joint sweep. Each kind of derived state is declared, with its type,
+by the module that computes it, as a :class:`Derived` (``detect.FAMILY``,
+``general_6r.SETUP``, ``restart_seeds.SEED_TABLE``, ``fixed.HELD_SOLVERS``), built
+on first use by :meth:`Arm.derived` and kept in the Arm, so it goes with the Arm.
 
 A :class:`~robokin.robot.Robot` owns one Arm (``robot.arm``) and delegates its
 kinematics to it; the Arm holds the chain, the chain holds nothing back, so a Robot,
@@ -22,8 +23,9 @@ kept only for that call).
 from __future__ import annotations
 
 from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Protocol, TypeAlias
+from typing import Any, Generic, Protocol, TypeAlias, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -32,12 +34,38 @@ from robokin.exceptions import InputError
 from robokin.model.chain import Chain
 from robokin.model.coupling import AffineMap
 
-__all__ = ["Arm", "ArmSource", "FamilyKey", "HasArm", "ReducedKey", "arm_of"]
+__all__ = ["Arm", "ArmSource", "Derived", "HasArm", "ReducedKey", "arm_of"]
 
-#: ``detect``'s settings: (tol, near_angle, near_distance, general_6r).
-FamilyKey: TypeAlias = tuple[float, float, float, bool]
 #: A held-joint reduction: (held coordinate indices, held values).
 ReducedKey: TypeAlias = tuple[tuple[int, ...], tuple[float, ...]]
+
+V = TypeVar("V")
+
+
+@dataclass(frozen=True, eq=False)
+class Derived(Generic[V]):
+    """One kind of derived per-arm state: its type, its name and how it is built.
+
+    The module that computes the state declares it once, typed by what it holds,
+    e.g. ``SEED_TABLE: Derived[SeedTable] = Derived("seed table", build)``;
+    :meth:`Arm.derived` then returns a ``SeedTable`` (a typed key, as
+    ``contextvars.ContextVar[T]``). This module names none of those types, so
+    nothing, type-only imports included, runs from the Arm back to its users
+    (``tests/test_layers.py``: the ``arm`` layer), and a new kind of state is a
+    change to the module that computes it only.
+
+    Attributes:
+        name: What the state is (in messages and reprs).
+        build: ``build(arm)``: the state of ``arm``, never None; called once per Arm,
+            on first use.
+    """
+
+    name: str
+    build: Callable[[Arm], V]
+
+    def __repr__(self) -> str:
+        """The name only."""
+        return f"Derived({self.name!r})"
 
 
 @dataclass(slots=True, eq=False, repr=False)
@@ -49,39 +77,38 @@ class Arm:
         name: The arm's name (in messages).
         actuators: ``q = A phi + b`` from motor to joint coordinates, or None.
         actuator_limits: Motor limits (m, 2), SI units, or None.
-        family: The closed-form family at ``detect``'s default settings (a
-            ``detect.Family``), or None until detected (the single-pose IK path
-            reads it on every call).
-        families: The families (``detect.Family``) detected at other settings.
-        general_6r: The general-6R set-up (a ``general_6r.General6R``: fits and
-            elimination variants), or None until first needed.
-        seed_table: The numeric solver's restart seeds (a ``numeric.SeedTable``),
-            or None until first needed.
-        held_solvers: Joint name -> the closed form with that joint held (a
-            ``fixed.HeldSolver``; 7R arms), or None until first needed.
+        state: The derived state built so far, by kind (:class:`Derived` -> its
+            value); read it with :meth:`derived`, which types the value.
         reduced: The arms of the remaining coordinates of the last held-joint
             reductions (most recently used last; ``fixed`` bounds it).
         self_motion: The self-motion set-up of a 7R arm (a
             ``self_motion.SelfMotionSetup``: swivel closed form, parameter,
-            aligned-axes values), or None until first needed.
-
-    The derived fields are typed ``object`` here and narrowed by the module that
-    fills them (``isinstance`` on its own record type): this module imports
-    nothing else of ``kinematics``, so no import (type-only ones included) runs
-    from the Arm back to its users (``tests/test_layers.py``: the ``arm`` layer).
+            aligned-axes values), or None until first needed; typed ``object`` and
+            narrowed by ``self_motion`` until that module declares a
+            :class:`Derived` for it like the others.
     """
 
     chain: Chain
     name: str = "robot"
     actuators: AffineMap | None = None
     actuator_limits: npt.NDArray[np.float64] | None = None
-    family: object | None = None
-    families: dict[FamilyKey, object] = field(default_factory=dict)
-    general_6r: object | None = None
-    seed_table: object | None = None
-    held_solvers: dict[str, object] | None = None
+    state: dict[Derived[Any], Any] = field(default_factory=dict, init=False)
     reduced: OrderedDict[ReducedKey, Arm] = field(default_factory=OrderedDict)
     self_motion: object | None = None
+
+    def derived(self, kind: Derived[V]) -> V:
+        """The arm's state of ``kind``, built by ``kind.build(self)`` on first use and kept.
+
+        Args:
+            kind: The kind of state (declared by the module that computes it).
+
+        Returns:
+            The state, typed as ``kind`` declares it.
+        """
+        value: V | None = self.state.get(kind)
+        if value is None:
+            value = self.state[kind] = kind.build(self)
+        return value
 
     @property
     def arm(self) -> Arm:

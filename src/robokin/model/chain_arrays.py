@@ -134,16 +134,17 @@ def _seed_range(lower: np.ndarray, upper: np.ndarray,
 
 
 def _wrap_flags(M: np.ndarray, kind: np.ndarray, is_revolute: np.ndarray) -> np.ndarray:
-    """Coordinates whose whole turns are whole turns of every chain joint they drive."""
-    wrap = np.zeros(M.shape[1])
-    for j in range(M.shape[1]):
-        col = M[:, j]
-        used = col != 0.0
-        wrap[j] = float(
-            is_revolute[j]
-            and np.all(kind[used] == 0.0)
-            and np.allclose(col[used], np.round(col[used]))
-        )
+    """Coordinates whose whole turns are whole turns of every chain joint they drive.
+
+    Coordinate j wraps when it is revolute and every chain joint it drives
+    (``M[:, j] != 0``) is revolute with a whole coefficient (``np.allclose``'s test,
+    |m - round(m)| <= 1e-8 + 1e-5 |round(m)|, on all of them at once).
+    """
+    whole = np.round(M)
+    near_whole = np.abs(M - whole) <= 1e-8 + 1e-5 * np.abs(whole)
+    bad = (M != 0.0) & ((kind != 0.0)[:, None] | ~near_whole)
+    wrap: np.ndarray = (np.asarray(is_revolute, dtype=bool) & ~bad.any(axis=0)).astype(
+        np.float64)
     return wrap
 
 

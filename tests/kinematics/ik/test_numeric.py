@@ -464,7 +464,7 @@ def test_every_solver_accepts_and_refuses_the_same_poses():
 
 # ---------------------------------------------------------------- repeatability
 # Oracle: the first call's bits. Restart seeds come from each target's pose and
-# start configuration (numeric._seed_key), so nothing else may change them: not
+# start configuration (restart_seeds.seed_key), so nothing else may change them: not
 # earlier calls, not the batch around a target, not the thread count (issue 23:
 # twenty calls used to give 19 different answers, up to 4.55 rad apart).
 

@@ -14,6 +14,8 @@ from reference import pose_errors, random_q
 from robokin._native import _base, kernels
 from robokin.exceptions import InputError
 from robokin.kinematics.ik import numeric
+from robokin.kinematics.ik.lm_options import option_vector
+from robokin.kinematics.ik.restart_seeds import NO_TABLE
 
 K = kernels
 ARMS = ["ur5", "panda", "improved_dh_arm", "aubo_i5", "puma560"]
@@ -131,9 +133,9 @@ def test_inconsistent_arrays_are_refused_not_read_out_of_bounds():
     packed = robot.chain.arrays.packed
     q = random_q(robot, np.random.default_rng(14), 8)
     T, q0 = robot.fk(q), q + 1e-3  # one descent from nearby each
-    opts = numeric._opts(None, None, 1e-9, None, 100, 1.0)
+    opts = option_vector(None, None, 1e-9, None, 100, 1.0)
     opts[K.O_USE_Q0] = 1.0
-    tab, cstart, gdat = numeric._NO_TABLE
+    tab, cstart, gdat = NO_TABLE
     args = [packed, T, q0, np.zeros((8, 1, 6)), opts, np.empty((8, 6 + K.N_RES)), tab,
             cstart, gdat, False]
     assert K.lm_solve(*args) == (0, -1)  # consistent: all eight solved

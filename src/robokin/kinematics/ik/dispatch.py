@@ -16,7 +16,7 @@ from robokin._validation import (
 )
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, ArmSource, arm_of
-from robokin.kinematics.ik.analytic.detect import Family, default_family, detect
+from robokin.kinematics.ik.analytic.detect import FAMILY, Family, detect
 from robokin.kinematics.ik.fixed import solve_fixed
 from robokin.kinematics.ik.solutions import SolutionSet
 
@@ -66,7 +66,7 @@ def solve(
             and T.dtype == np.float64 and T.flags.aligned and method != "numeric"):
         # hot path: one pose, a 6R closed form, default options (one compiled call
         # validates the pose and solves it)
-        single = default_family(arm).single
+        single = arm.derived(FAMILY).single
         if single is not None and (qn is None or qn.shape == (6,)):
             out = single(T, math.nan if qn is None else float(qn[5]))
             if out is not None:

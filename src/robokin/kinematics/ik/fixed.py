@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Protocol, cast
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -40,7 +40,7 @@ from robokin._validation import (
     check_poses_fast,
 )
 from robokin.exceptions import InputError
-from robokin.kinematics.arm import Arm, ArmSource, arm_of
+from robokin.kinematics.arm import Arm, ArmSource, Derived, arm_of
 from robokin.kinematics.ik.analytic import pieper as _pk
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.model.chain import joint_motion
@@ -176,11 +176,13 @@ def _held_solvers(robot: Arm) -> dict[str, HeldSolver]:
 
     Set up once per arm, kept in it (microseconds per joint: no reduced chain is built).
     """
-    if robot.held_solvers is not None:  # only this function fills it
-        return cast(dict[str, HeldSolver], robot.held_solvers)
+    return robot.derived(HELD_SOLVERS)
+
+
+def _build_held_solvers(robot: Arm) -> dict[str, HeldSolver]:
+    """:func:`_held_solvers`' table, built (empty unless a 7R arm without dependent joints)."""
     chain = robot.chain
     out: dict[str, HeldSolver] = {}
-    robot.held_solvers = cast(dict[str, object], out)
     if chain.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
         return out
     for j, name in enumerate(robot.joint_names):
@@ -193,6 +195,11 @@ def _held_solvers(robot: Arm) -> dict[str, HeldSolver]:
                               held=name)
         out[name] = HeldSolver(setup.params, method, info, one)
     return out
+
+
+#: The arm's held-joint closed forms, kept in its ``Arm``.
+HELD_SOLVERS: Derived[dict[str, HeldSolver]] = Derived(
+    "held-joint closed forms", _build_held_solvers)
 
 
 def _end_joint(robot: Arm, idx: list[int]) -> str | None:

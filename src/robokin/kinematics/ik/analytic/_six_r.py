@@ -26,6 +26,7 @@ from robokin.kinematics.ik.analytic._common import (
 from robokin.kinematics.ik.analytic._geometry import (
     Poe,
     closest_point,
+    cross3,
     poe_from_chain,
     unit_perpendicular,
 )
@@ -103,7 +104,7 @@ def pack(chain: Chain, kind: Kind, *, singular_tol: float = SINGULAR_TOL,
     put(K.TOOL_R, poe.M[:3, :3])
     put(K.PERP, e)
     hw = h[1] if three else h[3]
-    put(K.PERP2, np.cross(hw, e))
+    put(K.PERP2, cross3(hw, e))
     put(K.SIGN, chain.arrays.sign)
     put(K.OFFSET, chain.arrays.offset)
     lim = chain.limits
@@ -125,7 +126,7 @@ def pack(chain: Chain, kind: Kind, *, singular_tol: float = SINGULAR_TOL,
     ):
         kp = kk @ pp
         hk = hh @ kk
-        A, B, C = hh @ pp - hk * kp, hh @ np.cross(kk, pp), hk * kp
+        A, B, C = hh @ pp - hk * kp, hh @ cross3(kk, pp), hk * kp
         r = np.hypot(A, B)
         P[ia], P[ib], P[ic] = A, B, C
         P[iphi] = np.arctan2(B, A)
@@ -135,7 +136,7 @@ def pack(chain: Chain, kind: Kind, *, singular_tol: float = SINGULAR_TOL,
     # theta5's discriminant for unit vectors: |x_perp|^2 + E5 + 2 d C5 (exact)
     P[K.E5] = -((hw @ h[4]) ** 2 + (h[4] @ h[5]) ** 2)
     if three:  # the planar part in the basis (e, e2) of the plane normal to h2
-        e2 = np.cross(h[1], e)
+        e2 = cross3(h[1], e)
         w4 = ow - o[3]
         put(K.PLANE, [a @ e, a @ e2, b @ e, b @ e2, w4 @ e, w4 @ e2, w4 @ h[1]])
     P[K.SPLIT_TOL] = SPLIT_TOL

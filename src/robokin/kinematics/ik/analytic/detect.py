@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any, Protocol, TypeAlias
 import numpy as np
 import numpy.typing as npt
 
-from robokin.kinematics.arm import Arm, ArmSource, FamilyKey, arm_of
+from robokin.kinematics.arm import Arm, ArmSource, Derived, arm_of
 from robokin.kinematics.ik.analytic import general_6r as _g6
 from robokin.kinematics.ik.analytic import palletizer as _pal
 from robokin.kinematics.ik.analytic import pieper as _pk
@@ -53,7 +53,10 @@ if TYPE_CHECKING:
     from robokin.kinematics.ik.analytic._six_r import Kind
     from robokin.kinematics.ik.solutions import SolutionSet
 
-__all__ = ["Family", "FamilySolver", "SingleSolver", "detect"]
+__all__ = ["FAMILIES", "FAMILY", "Family", "FamilyKey", "FamilySolver", "SingleSolver", "detect"]
+
+#: ``detect``'s settings: (tol, near_angle, near_distance, general_6r).
+FamilyKey: TypeAlias = tuple[float, float, float, bool]
 
 EXACT_TOL = 1e-9
 NEAR_ANGLE = 5e-3
@@ -239,22 +242,30 @@ def detect(robot: ArmSource, *, tol: float = EXACT_TOL, near_angle: float = NEAR
     arm = arm_of(robot)
     key: FamilyKey = (tol, near_angle, near_distance, general_6r)
     if key == _DEFAULT_KEY:
-        return default_family(arm)
-    fam = arm.families.get(key)
-    if not isinstance(fam, Family):
-        fam = arm.families[key] = _detect(arm, *key)
-    return fam
-
-
-def default_family(arm: Arm) -> Family:
-    """The arm's family at the default settings (detected on first use, kept)."""
-    fam = arm.family
-    if not isinstance(fam, Family):
-        fam = arm.family = _detect(arm, *_DEFAULT_KEY)
+        return arm.derived(FAMILY)
+    kept = arm.derived(FAMILIES)
+    fam = kept.get(key)
+    if fam is None:
+        fam = kept[key] = _detect(arm, *key)
     return fam
 
 
 _DEFAULT_KEY: FamilyKey = (EXACT_TOL, NEAR_ANGLE, NEAR_DISTANCE, True)
+
+#: The arm's family at the default settings, kept in its ``Arm`` (the single-pose
+#: IK path reads it on every call).
+FAMILY: Derived[Family] = Derived(
+    "closed-form family", lambda arm: _detect(arm, *_DEFAULT_KEY))
+
+
+def _no_families(arm: Arm) -> dict[FamilyKey, Family]:
+    """A new, empty table of families by settings."""
+    return {}
+
+
+#: The arm's families detected at other settings, by settings.
+FAMILIES: Derived[dict[FamilyKey, Family]] = Derived(
+    "closed-form families at other settings", _no_families)
 
 
 def _none(reason: str, details: dict[str, str] | None = None) -> Family:

@@ -58,7 +58,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from robokin import _native
-from robokin.kinematics.arm import Arm, ArmSource, arm_of
+from robokin.kinematics.arm import Arm, ArmSource, Derived, arm_of
 from robokin.kinematics.forward import forward_kinematics
 from robokin.kinematics.ik.analytic._common import fk_error, make_set
 from robokin.kinematics.ik.analytic._geometry import poe_from_chain
@@ -69,8 +69,8 @@ from robokin.spatial import invert, wrap_angle
 if TYPE_CHECKING:
     from robokin.kinematics.ik.solutions import SolutionSet
 
-__all__ = ["NAME", "General6R", "Variant", "make_single", "raw_solve", "setup", "solve",
-           "why_not"]
+__all__ = ["NAME", "SETUP", "General6R", "Variant", "make_single", "raw_solve", "setup",
+           "solve", "why_not"]
 
 NAME = "general_6r"
 K = _native.kernels
@@ -168,11 +168,11 @@ def why_not(chain: Chain) -> str:
 
 def setup(robot: ArmSource) -> General6R:
     """The set-up of the arm's chain (fits and variant choice), kept in its Arm."""
-    arm = arm_of(robot)
-    g = arm.general_6r
-    if not isinstance(g, General6R):
-        g = arm.general_6r = _setup(arm.chain)
-    return g
+    return arm_of(robot).derived(SETUP)
+
+
+#: The arm's general-6R set-up, kept in its ``Arm`` (``arm.derived(SETUP)``).
+SETUP: Derived[General6R] = Derived("general 6R set-up", lambda arm: _setup(arm.chain))
 
 
 def _scale(chain: Chain) -> float:

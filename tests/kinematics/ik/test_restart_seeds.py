@@ -8,7 +8,8 @@ import pytest
 
 import robokin
 from reference import pose_errors, random_q
-from robokin.kinematics.ik import numeric
+from robokin.kinematics.ik import numeric, restart_seeds
+from robokin.kinematics.ik.lm_options import option_vector
 
 ARMS = ("ur5", "aubo_i5", "puma560", "panda", "scara", "qfmd010", "improved_dh_arm")
 
@@ -16,9 +17,9 @@ ARMS = ("ur5", "aubo_i5", "puma560", "panda", "scara", "qfmd010", "improved_dh_a
 @pytest.mark.parametrize("name", ARMS)
 def test_table_rows_are_fk_of_in_limit_configurations_bucketed_by_cell(name):
     robot = robokin.load(name)
-    tab, cstart, gdat = numeric.seed_table(robot.arm).kernel_args()
+    tab, cstart, gdat = restart_seeds.seed_table(robot.arm).kernel_args()
     n = robot.n
-    assert tab.shape == (numeric._TABLE_SIZE, 12 + n)
+    assert tab.shape == (restart_seeds.TABLE_SIZE, 12 + n)
     q = tab[:, 12:]
     assert robot.within_limits(q, tol=0.0).all()
     T = robot.fk(q)
@@ -28,22 +29,22 @@ def test_table_rows_are_fk_of_in_limit_configurations_bucketed_by_cell(name):
     G = int(gdat[6])
     assert cstart.shape == (G**3 + 1,) and cstart[0] == 0 and cstart[-1] == len(tab)
     assert np.all(np.diff(cstart) >= 0)
-    cells = numeric._grid_cells(tab[:, :3], gdat[:3], gdat[3:6], G)
+    cells = restart_seeds.grid_cells(tab[:, :3], gdat[:3], gdat[3:6], G)
     for c in np.flatnonzero(np.diff(cstart)):
         assert (cells[cstart[c]:cstart[c + 1]] == c).all()
     # the same table every time (a fixed sampling seed), read-only
-    again = numeric._build_seed_table(robot.chain).kernel_args()
+    again = restart_seeds.build_seed_table(robot.chain).kernel_args()
     for a, b in zip((tab, cstart, gdat), again, strict=True):
         np.testing.assert_array_equal(a, b)
         assert not a.flags.writeable
 
 
-@pytest.mark.parametrize("rot_w", [0.0, numeric._TABLE_ROT])
+@pytest.mark.parametrize("rot_w", [0.0, restart_seeds.TABLE_ROT])
 def test_grid_search_finds_the_nearest_rows_of_the_cells_it_scans(rot_w):
     from robokin._native import kernels as K
 
     robot = robokin.load("panda")
-    tab, cstart, gdat = numeric.seed_table(robot.arm).kernel_args()
+    tab, cstart, gdat = restart_seeds.seed_table(robot.arm).kernel_args()
     G = int(gdat[6])
     cells = np.clip(np.floor((tab[:, :3] - gdat[:3]) * gdat[3:6]).astype(int), 0, G - 1)
     rng = np.random.default_rng(3)
@@ -81,7 +82,7 @@ def test_table_restarts_round_trip_to_1e9_inside_limits_independent_of_rng(name)
     robot = robokin.load(name)
     rng = np.random.default_rng(11)
     T = robot.fk(random_q(robot, rng, 200))
-    mid = numeric._middle(robot.chain)
+    mid = restart_seeds.middle(robot.chain)
     # max_restarts=4: q0 (the middle of the limits), then only table seeds
     a = numeric.solve(robot, T, q0=mid, max_restarts=4, rng=np.random.default_rng(1))
     b = numeric.solve(robot, T, q0=mid, max_restarts=4, rng=np.random.default_rng(2))
@@ -105,12 +106,12 @@ def test_table_restarts_round_trip_to_1e9_inside_limits_independent_of_rng(name)
 def test_results_deterministic_for_a_seeded_rng_with_table_and_random_restarts():
     robot = robokin.load("improved_dh_arm")
     T = robot.fk(random_q(robot, np.random.default_rng(5), 300))
-    r1 = numeric.solve(robot, T, q0=numeric._middle(robot.chain),
+    r1 = numeric.solve(robot, T, q0=restart_seeds.middle(robot.chain),
                        rng=np.random.default_rng(9))
-    r2 = numeric.solve(robot, T, q0=numeric._middle(robot.chain),
+    r2 = numeric.solve(robot, T, q0=restart_seeds.middle(robot.chain),
                        rng=np.random.default_rng(9))
     assert r1.success.all()
-    assert (r1.restarts > numeric._TABLE_SEEDS).any()  # random seeds were used too
+    assert (r1.restarts > restart_seeds.TABLE_SEEDS).any()  # random seeds were used too
     np.testing.assert_array_equal(r1.q, r2.q)
     np.testing.assert_array_equal(r1.restarts, r2.restarts)
     assert robot.within_limits(r1.q, tol=0.0).all()
@@ -118,12 +119,12 @@ def test_results_deterministic_for_a_seeded_rng_with_table_and_random_restarts()
 
 def test_masks_choose_the_table_metric():
     K = numeric.K
-    full = numeric._opts(None, None, 1e-9, None, 100, 1.0)
-    assert full[K.O_TABLE_ROT] == numeric._TABLE_ROT
-    assert numeric._opts("xyz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] == 0.0
-    assert numeric._opts("xyz rz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] == 0.0
-    assert numeric._opts("rx ry rz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] < 0.0
-    assert numeric._opts("x y rz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] < 0.0
+    full = option_vector(None, None, 1e-9, None, 100, 1.0)
+    assert full[K.O_TABLE_ROT] == restart_seeds.TABLE_ROT
+    assert option_vector("xyz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] == 0.0
+    assert option_vector("xyz rz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] == 0.0
+    assert option_vector("rx ry rz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] < 0.0
+    assert option_vector("x y rz", None, 1e-9, None, 100, 1.0)[K.O_TABLE_ROT] < 0.0
 
 
 @pytest.mark.parametrize("mask", ["xyz", "rx ry rz"])
@@ -132,7 +133,7 @@ def test_masked_solves_with_restarts_converge_inside_limits(mask):
     rng = np.random.default_rng(4)
     Q = random_q(robot, rng, 60)
     T = robot.fk(Q)
-    res = numeric.solve(robot, T, mask=mask, q0=numeric._middle(robot.chain), rng=rng)
+    res = numeric.solve(robot, T, mask=mask, q0=restart_seeds.middle(robot.chain), rng=rng)
     assert res.success.all()
     assert robot.within_limits(res.q, tol=0.0).all()
     dp, dr = pose_errors(robot.fk(res.q), T)
