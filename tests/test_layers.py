@@ -29,7 +29,7 @@ SRC = Path(robokin.__file__).parent
 LAYERS: dict[str, tuple[str, ...]] = {
     "native": ("robokin._native",),
     "spatial": ("robokin.spatial", "robokin._validation", "robokin._text",
-                "robokin.exceptions", "robokin._html"),
+                "robokin.exceptions", "robokin._html", "robokin._units"),
     "model": ("robokin.model",),
     "arm": ("robokin.kinematics.arm",),
     "kinematics": ("robokin.kinematics",),

@@ -61,3 +61,34 @@ def test_calibrated_robot_keeps_names_geometry_and_limits(ur5):
     np.testing.assert_allclose(r.base[:3, 3], TRACKER[:3, 3], atol=1e-4)
     np.testing.assert_allclose(r.tool[:3, 3], TOOL[:3, 3], atol=1e-4)
     assert math.isfinite(res.residual_rms)
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560_modified", "panda", "scara",
+                                  "irb140"])
+def test_joint_frames_are_the_compiled_chain_at_rest(name):
+    """Oracle: the compiled kernels (robot.fk and robot.jacobian, chain.h), with a base
+    and a tool on the robot: ``B @ tip @ T_tool`` is the tool pose at q = 0 and each
+    frame's z axis (times the joint's sign) is the Jacobian's angular column there
+    (linear, for a prismatic joint);
+    joint_frames is the same walk with every joint motion the identity (issue 24:
+    one chain walk, the model's Chain.frames_at)."""
+    from robokin.calibration._frames import joint_frames
+
+    robot = irb140() if name == "irb140" else robokin.load(name)
+    base = robokin.spatial.pose_from_xyz_rpy([0.1, -0.2, 0.3], [0.2, -0.1, 0.4])
+    robot = robot.with_base(base).with_tool(TOOL)
+    chain = robot.chain
+    if not chain.coupling.is_identity:
+        pytest.skip("the Jacobian columns are per coordinate, not per chain joint")
+    signs = np.array([j.sign for j in chain.joints])
+    for q, frames in (
+            (np.zeros(robot.n), frames_at_zero(chain)),
+            (-np.array([j.offset for j in chain.joints]) * signs,
+             (joint_frames(chain), None))):
+        W, tip = frames
+        if tip is not None:
+            np.testing.assert_allclose(base @ tip @ chain.tool, robot.fk(q), atol=1e-12)
+        axes = np.einsum("ij,kj->ki", base[:3, :3], W[:, :3, 2]) * signs[:, None]
+        J = robot.jacobian(q)
+        columns = np.where(robot.is_revolute[:, None], J[3:].T, J[:3].T)  # prismatic: v
+        np.testing.assert_allclose(axes, columns, atol=1e-12)

@@ -73,12 +73,17 @@ def joint_frames(chain: Chain) -> np.ndarray:
         (n_chain, 4, 4): ``W_1 = L_0``, ``W_{k+1} = W_k C_k``; the base
         transform ``B`` is left out.
     """
-    out = np.empty((chain.n_chain, 4, 4))
-    W = np.array(chain.head)
-    for k in range(chain.n_chain):
-        out[k] = W
-        W = W @ chain.frame_offsets[k] @ chain.link_offsets[k]
-    return out
+    at_rest = np.array([-j.offset * j.sign for j in chain.joints])  # every J_k = I
+    frames: np.ndarray = _without_base_and_tool(chain).frames_at(at_rest)[:-1]
+    return frames
+
+
+def _without_base_and_tool(chain: Chain) -> Chain:
+    """The chain with identity base and tool (base frame in, flange out).
+
+    So the model's one walk (:meth:`Chain.frames_at`) serves the frames here.
+    """
+    return chain.replace(base=np.eye(4), tool=np.eye(4))
 
 
 def _sense(x: np.ndarray, x_prev: np.ndarray, z_prev: np.ndarray) -> np.ndarray:
@@ -199,13 +204,9 @@ def frames_at_zero(chain: Chain) -> tuple[np.ndarray, np.ndarray]:
     The frame right before ``J_k`` with every earlier joint at its ``q = 0``
     value; the flange is the end of the chain (before the tool), base left out.
     """
-    e = zero_values(chain)
-    out = np.empty((chain.n_chain, 4, 4))
-    W = np.array(chain.head)
-    for k, j in enumerate(chain.joints):
-        out[k] = W
-        W = W @ joint_motion(j.kind, e[k]) @ chain.frame_offsets[k] @ chain.link_offsets[k]
-    return out, W
+    c = np.asarray(chain.coupling.offset, dtype=float).reshape(-1)  # q = 0: q_chain = c
+    frames = _without_base_and_tool(chain).frames_at(c)
+    return frames[:-1], frames[-1]
 
 
 def reframe(chain: Chain, like: Chain) -> Chain:

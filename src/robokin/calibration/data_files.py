@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from robokin._units import ANGLE_UNITS, LENGTH_UNITS
 from robokin.exceptions import InputError, ModelError
 
 if TYPE_CHECKING:
@@ -37,8 +38,9 @@ __all__ = ["MAX_BYTES", "read_measurements", "write_measurements"]
 #: Largest measurement file read [bytes].
 MAX_BYTES = 64 << 20
 _HEADER = re.compile(r"^\s*(?P<name>[^\[]*?)\s*(?:\[(?P<unit>[^\]]*)\])?\s*$")
-_LENGTH = {None: 1.0, "m": 1.0, "mm": 1e-3}
-_ANGLE = {None: 1.0, "rad": 1.0, "deg": math.pi / 180.0}
+#: Unit name (None: not given, SI) -> factor to SI.
+_LENGTH: dict[str | None, float] = {None: 1.0, **dict(LENGTH_UNITS.items())}
+_ANGLE: dict[str | None, float] = {None: 1.0, **dict(ANGLE_UNITS.items())}
 _ROTATIONS = (("qw", "qx", "qy", "qz"), ("roll", "pitch", "yaw"), ("rx", "ry", "rz"))
 
 

@@ -13,6 +13,7 @@ import numpy as np
 import typer
 
 from robokin.cli.common import NUMERIC_ARGS, json_text, load_robot
+from robokin.cli.options import DegFlag, JsonFlag, MmFlag, RobotName
 from robokin.cli.output import (
     Column,
     FormatOption,
@@ -74,12 +75,11 @@ def _inside(values: np.ndarray, limits: np.ndarray | None) -> np.ndarray:
 
 @commands.command(context_settings=NUMERIC_ARGS)
 def motors(
-    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    name: RobotName,
     q: Annotated[list[float], typer.Argument(help="Joint values (rad, m).")],
-    deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
-    mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
-                       ] = False,
+    deg: DegFlag = False,
+    mm: MmFlag = False,
+    as_json: JsonFlag = False,
     output_format: FormatOption = None,
 ) -> None:
     """Motor coordinates from joint coordinates: phi = A^+ (q - b)."""
@@ -101,12 +101,11 @@ def motors(
 
 @commands.command(context_settings=NUMERIC_ARGS)
 def joints(
-    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    name: RobotName,
     phi: Annotated[list[float], typer.Argument(help="Motor values (rad, m).")],
-    deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
-    mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
-                       ] = False,
+    deg: DegFlag = False,
+    mm: MmFlag = False,
+    as_json: JsonFlag = False,
     output_format: FormatOption = None,
 ) -> None:
     """Joint coordinates from motor coordinates: q = A phi + b."""

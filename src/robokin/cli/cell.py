@@ -15,7 +15,8 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robokin.cli.common import DomainFailure, json_text
+from robokin.cli.common import DomainFailure, json_text, load_scene
+from robokin.cli.options import JsonFlag, RobotName
 from robokin.cli.output import (
     Column,
     FormatOption,
@@ -113,14 +114,7 @@ def _probe(scheduler: str | None, timeout: float | None) -> None:
 
 
 def _scene(name: str | None) -> Any:
-    if name is None:
-        return None
-    from robokin import collision
-
-    path = Path(name)
-    if not path.exists() and path.suffix == "":
-        path = collision.scene_path(name)
-    return collision.Scene.load(path)
+    return None if name is None else load_scene(name)
 
 
 def _out_dir(out: Path) -> Path:
@@ -134,7 +128,7 @@ def _out_dir(out: Path) -> Path:
 
 @commands.command("reach")
 def reach_command(
-    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    name: RobotName,
     voxel: Annotated[float, typer.Option("--voxel", help="Voxel edge [mm].")] = 50.0,
     out: Annotated[
         Path, typer.Option("--out", help="Output folder (map.zarr, sections.png, reach.json).")
@@ -163,7 +157,7 @@ def reach_command(
     force: Annotated[
         bool, typer.Option("--force", help="Replace a map.zarr holding another map.")
     ] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")] = False,
+    as_json: JsonFlag = False,
     output_format: FormatOption = None,
 ) -> None:
     """Reachability map: which positions the tool reaches, in how many orientations.
@@ -221,7 +215,7 @@ def reach_command(
 
 @commands.command("place")
 def place_command(
-    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    name: RobotName,
     scene: Annotated[
         str | None, typer.Option(help="Scene (file or bundled name); its base is "
                                       "replaced by each candidate.")
@@ -249,7 +243,7 @@ def place_command(
         str | None, typer.Option(help="Dask scheduler address (default: this machine).")
     ] = None,
     connect_timeout: ConnectTimeout = None,
-    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")] = False,
+    as_json: JsonFlag = False,
     output_format: FormatOption = None,
 ) -> None:
     """Score candidate robot bases for a task: reach on one branch, clearance, manipulability.

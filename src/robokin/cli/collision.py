@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robokin.cli.common import DomainFailure, json_text
+from robokin.cli.common import DomainFailure, json_text, load_scene, scene_robot
+from robokin.cli.options import JsonFlag
 from robokin.cli.output import FormatOption, resolve_format
 
 if TYPE_CHECKING:
@@ -64,9 +65,7 @@ def check_command(
         typer.Option("--plot", help="Write a distance-over-time plot here."),
     ] = None,
     top: Annotated[int, typer.Option(help="How many closest pairs to list.")] = 8,
-    as_json: Annotated[
-        bool, typer.Option("--json", help="Same as --format json.")
-    ] = False,
+    as_json: JsonFlag = False,
     output_format: FormatOption = None,
 ) -> None:
     """Check a joint trajectory against a scene: minimum distances and collisions."""
@@ -79,13 +78,8 @@ def check_command(
         raise InputError("--top", f"expected a count >= 0, got {top}")
     if not math.isfinite(clearance) or clearance < 0:
         raise InputError("--clearance", f"expected a number >= 0 [mm], got {clearance}")
-    if not scene.exists() and scene.suffix == "":
-        scene = collision.scene_path(str(scene))
-    sc = collision.Scene.load(scene)
-    name = robot or sc.robot_name
-    if name is None:
-        raise InputError("--robot", "the scene names no robot; pass --robot")
-    rob = robokin.load(name)
+    sc = load_scene(scene)
+    rob = robokin.load(scene_robot(sc, robot))
     if plot is not None:
         from robokin.io.atomic import check_distinct
 

@@ -9,6 +9,7 @@ A command module (``robokin/cli/<topic>.py``) defines its commands on its own
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -18,11 +19,12 @@ from robokin.cli.output import console as _output_console
 from robokin.io.strict_json import strict_json as json_text
 
 if TYPE_CHECKING:
+    from robokin.collision import Scene
     from robokin.model.parts import RobotParts
     from robokin.robot import Robot
 
 __all__ = ["NUMERIC_ARGS", "DomainFailure", "cell", "console", "json_text", "load_robot",
-           "outside_limits_notes"]
+           "load_scene", "outside_limits_notes", "scene_file", "scene_robot"]
 
 #: ``context_settings`` of commands whose positional arguments are numbers that
 #: may be negative (``fk ur5 0 -1.5 ...``).
@@ -62,6 +64,40 @@ def load_robot(name: str) -> Robot:
     from robokin.robots import load
 
     return load(name)
+
+
+def scene_file(spec: str | Path) -> Path:
+    """The scene file a SCENE argument names: a file, or a bundled scene (``press``).
+
+    A path that does not exist and has no suffix is a bundled scene's name.
+    """
+    from robokin import collision
+
+    path = Path(spec)
+    if not path.exists() and path.suffix == "":
+        path = collision.scene_path(str(spec))
+    return path
+
+
+def load_scene(spec: str | Path) -> Scene:
+    """The scene a SCENE argument names (:func:`scene_file`)."""
+    from robokin import collision
+
+    return collision.Scene.load(scene_file(spec))
+
+
+def scene_robot(scene: Scene, robot: str | None) -> str:
+    """The robot to use with ``scene``: ``--robot`` if given, else the scene's.
+
+    Raises:
+        InputError: neither names a robot (naming ``--robot``).
+    """
+    from robokin.exceptions import InputError
+
+    name = robot or scene.robot_name
+    if name is None:
+        raise InputError("--robot", "the scene names no robot; pass --robot")
+    return name
 
 
 def outside_limits_notes(robot: RobotParts, q: npt.ArrayLike, *, deg: bool = False,

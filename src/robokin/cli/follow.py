@@ -20,7 +20,15 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robokin.cli.common import NUMERIC_ARGS, DomainFailure, json_text, load_robot
+from robokin.cli.common import (
+    NUMERIC_ARGS,
+    DomainFailure,
+    json_text,
+    load_robot,
+    load_scene,
+    scene_robot,
+)
+from robokin.cli.options import JsonFlag, NoPlotFlag
 from robokin.cli.output import FormatOption, resolve_format
 
 if TYPE_CHECKING:
@@ -76,16 +84,8 @@ def joints_csv_text(robot: Robot, q: np.ndarray, free_angle: np.ndarray,
 
 def _load_inputs(scene: Path, robot: str | None) -> tuple[Any, Robot, Robot]:
     """The scene, the bare robot and the robot as the scene places it."""
-    from robokin import collision
-    from robokin.exceptions import InputError
-
-    if not scene.exists() and scene.suffix == "":
-        scene = collision.scene_path(str(scene))
-    sc = collision.Scene.load(scene)
-    name = robot or sc.robot_name
-    if name is None:
-        raise InputError("--robot", "the scene names no robot; pass --robot")
-    bare = load_robot(name)
+    sc = load_scene(scene)
+    bare = load_robot(scene_robot(sc, robot))
     return sc, bare, sc.attach(bare)
 
 
@@ -124,12 +124,11 @@ def follow_command(
         "--name", help="Program and file name (default: the tool path's name).")] = None,
     force: Annotated[bool, typer.Option(
         "--force", help="Replace the files of an earlier run.")] = False,
-    no_plot: Annotated[bool, typer.Option("--no-plot", help="Write no plot.")] = False,
+    no_plot: NoPlotFlag = False,
     html: Annotated[bool, typer.Option(
         "--html", help="Also write NAME.html: the motion in 3D with the scene and the "
         "waypoints as green (reachable) / red (not) markers.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
-                       ] = False,
+    as_json: JsonFlag = False,
     output_format: FormatOption = None,
 ) -> None:
     """Follow a tool path over every IK branch; write the joints, a plot and programs.

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from robokin.cli.common import DomainFailure, json_text, load_robot
+from robokin.cli.options import DegFlag, JsonFlag, MmFlag, RobotName
 from robokin.cli.output import Column, FormatOption, OutputTable, emit, resolve_format
 from robokin.exceptions import InputError
 
@@ -63,15 +64,15 @@ def _continuum_note(robot: Robot, sols: Any, held: dict[str, float]) -> str | No
 
 @commands.command(context_settings={"ignore_unknown_options": True})
 def ik(
-    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    name: RobotName,
     x: Annotated[float, typer.Argument(help="Tool position x.")],
     y: Annotated[float, typer.Argument(help="Tool position y.")],
     z: Annotated[float, typer.Argument(help="Tool position z.")],
     roll: Annotated[float, typer.Argument(help="Roll (about x).")],
     pitch: Annotated[float, typer.Argument(help="Pitch (about y).")],
     yaw: Annotated[float, typer.Argument(help="Yaw (about z).")],
-    deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
-    mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
+    deg: DegFlag = False,
+    mm: MmFlag = False,
     near: Annotated[str | None, typer.Option(
         "--near", help="Current joint values q1 ... qn, as many as the robot has "
                        "joints (rad/m, or deg/mm with --deg/--mm).")] = None,
@@ -83,8 +84,7 @@ def ik(
         "--deg/--mm) and solve the others; repeatable. For arms with more joints than "
         "the pose constrains (the Panda's 7), every solution with that joint held.")
     ] = None,
-    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
-                       ] = False,
+    as_json: JsonFlag = False,
     output_format: FormatOption = None,
 ) -> None:
     """Inverse kinematics: every solution for the pose x y z roll pitch yaw.

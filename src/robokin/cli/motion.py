@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from robokin.cli.common import NUMERIC_ARGS, DomainFailure, json_text
+from robokin.cli.options import JsonFlag, NoPlotFlag
 from robokin.cli.output import FormatOption, resolve_format
 from robokin.io.motion_files import MAX_MOTION_SAMPLES, load_motion_file, motion_limits
 from robokin.trajectory.motion_plan import plan_from_document
@@ -40,11 +41,10 @@ def traj(
         "-o", "--output", help="CSV to write (replaced if it exists).")] = None,
     plot: Annotated[Path | None, typer.Option(
         "--plot", help="Joint plot to write (PNG/SVG/PDF; replaced if it exists).")] = None,
-    no_plot: Annotated[bool, typer.Option("--no-plot", help="Write no plot.")] = False,
+    no_plot: NoPlotFlag = False,
     rates: Annotated[bool, typer.Option(
         "--rates", help="Also write velocity and acceleration columns.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
-                       ] = False,
+    as_json: JsonFlag = False,
     max_samples: Annotated[int, typer.Option(
         "--max-samples", help="Most samples the motion may hold (refused above).")
     ] = MAX_MOTION_SAMPLES,
@@ -302,13 +302,12 @@ def compare(
         help="Logged run: CSV (time + joints), or a ROS 2 bag (folder, .mcap or .db3).")],
     plot: Annotated[Path | None, typer.Option(
         "--plot", help="Error plot to write (replaced if it exists).")] = None,
-    no_plot: Annotated[bool, typer.Option("--no-plot", help="Write no plot.")] = False,
+    no_plot: NoPlotFlag = False,
     time_shift: Annotated[float, typer.Option(
         "--time-shift", help="Added to the log's times [s].")] = 0.0,
     radians: Annotated[bool, typer.Option(
         "--rad", help="Report radians and metres (default degrees and mm).")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
-                       ] = False,
+    as_json: JsonFlag = False,
     topic: Annotated[str | None, typer.Option(
         "--topic", help="JointState topic of a ROS 2 bag log (default /joint_states).")
     ] = None,

@@ -27,7 +27,14 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from robokin.cli.common import NUMERIC_ARGS, DomainFailure, json_text
+from robokin.cli.common import (
+    NUMERIC_ARGS,
+    DomainFailure,
+    json_text,
+    scene_file,
+    scene_robot,
+)
+from robokin.cli.options import DegFlag, JsonFlag, MmFlag, NoPlotFlag
 from robokin.cli.output import FormatOption, resolve_format
 
 if TYPE_CHECKING:
@@ -102,16 +109,10 @@ def _pose(text: str, scene: Scene, deg: bool, mm: bool) -> np.ndarray:
 def _scene_and_robot(scene_arg: Path, robot_arg: str | None) -> tuple[Scene, Robot, Path]:
     import robokin
     from robokin import collision
-    from robokin.exceptions import InputError
 
-    path = scene_arg
-    if not path.exists() and path.suffix == "":
-        path = collision.scene_path(str(path))
+    path = scene_file(scene_arg)
     sc = collision.Scene.load(path)
-    name = robot_arg or sc.robot_name
-    if name is None:
-        raise InputError("--robot", "the scene names no robot; pass --robot")
-    return sc, robokin.load(name), path
+    return sc, robokin.load(scene_robot(sc, robot_arg)), path
 
 
 def _check_out(out: Path, names: list[str], force: bool) -> None:
@@ -138,8 +139,8 @@ def plan_command(
         "scene pose name (every IK branch is a goal).")] = None,
     robot: Annotated[str | None, typer.Option(
         "--robot", help="Built-in name or robot file (default: the scene's).")] = None,
-    deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
-    mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
+    deg: DegFlag = False,
+    mm: MmFlag = False,
     clearance: Annotated[float, typer.Option(
         help="Distance kept from the scene \\[mm].")] = 0.0,
     time_limit: Annotated[float, typer.Option(
@@ -150,11 +151,10 @@ def plan_command(
     dt: Annotated[float, typer.Option("--dt", help="Sampling period \\[s].")] = 0.005,
     out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path(
         "robokin-plan"),
-    no_plot: Annotated[bool, typer.Option("--no-plot", help="Write no plot.")] = False,
+    no_plot: NoPlotFlag = False,
     force: Annotated[bool, typer.Option(
         "--force", help="Replace plan.csv / plan.png left by an earlier run.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
-                       ] = False,
+    as_json: JsonFlag = False,
     output_format: FormatOption = None,
 ) -> None:
     """Plan a collision-free motion from --start to --goal (or --goal-pose); retime it.

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from robokin.cli.common import DomainFailure, cell, json_text
+from robokin.cli.options import NoPlotFlag
 
 if TYPE_CHECKING:
     from robokin.robot import Robot
@@ -202,7 +203,7 @@ def retime_command(
     dt: Annotated[float, typer.Option("--dt", help="Sampling period \\[s].")] = 0.005,
     no_dwells: Annotated[bool, typer.Option(
         "--no-dwells", help="Drop the dwells (they take no time).")] = False,
-    no_plot: Annotated[bool, typer.Option("--no-plot", help="Write no plot.")] = False,
+    no_plot: NoPlotFlag = False,
     force: Annotated[bool, typer.Option(
         "--force", help="Write into a folder that holds other files.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Machine-readable summary.")

@@ -16,6 +16,7 @@ from robokin.cli.common import (
     load_robot,
     outside_limits_notes,
 )
+from robokin.cli.options import DegFlag, MmFlag, RobotName
 from robokin.cli.output import (
     Column,
     FormatOption,
@@ -53,7 +54,7 @@ def robots(output_format: FormatOption = None) -> None:
 
 @commands.command()
 def show(
-    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    name: RobotName,
     output_format: FormatOption = None,
 ) -> None:
     """Show a robot: its joints, limits and the tool pose at zero, in mm and degrees.
@@ -101,10 +102,10 @@ def show(
 
 @commands.command(context_settings=NUMERIC_ARGS)
 def fk(
-    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    name: RobotName,
     q: Annotated[list[float], typer.Argument(help="Joint values (rad, m).")],
-    deg: Annotated[bool, typer.Option("--deg", help="Angles in degrees.")] = False,
-    mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
+    deg: DegFlag = False,
+    mm: MmFlag = False,
     as_json: Annotated[
         bool, typer.Option("--json", help="Machine-readable output.")
     ] = False,

@@ -16,24 +16,15 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robokin.cli.common import DomainFailure, cell, json_text
+from robokin.cli.common import DomainFailure, cell, json_text, load_scene
+from robokin.cli.options import RobotName
 
 if TYPE_CHECKING:
     from robokin.robot import Robot
 
-__all__ = ["commands", "load_scene", "sim_command"]
+__all__ = ["commands", "sim_command"]
 
 commands = typer.Typer()
-
-
-def load_scene(name_or_path: str | Path) -> Any:
-    """A scene file, or a bundled scene by name (``press``)."""
-    from robokin import collision
-
-    path = Path(name_or_path)
-    if not path.exists() and path.suffix == "":
-        path = collision.scene_path(str(name_or_path))
-    return collision.Scene.load(path)
 
 
 def _read_plan(path: Path, robot: Robot, motors: bool) -> Any:
@@ -53,7 +44,7 @@ def _read_plan(path: Path, robot: Robot, motors: bool) -> Any:
 
 @commands.command("sim", context_settings={"ignore_unknown_options": True})
 def sim_command(
-    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    name: RobotName,
     trajectory: Annotated[Path, typer.Argument(
         help="Planned trajectory CSV: t \\[s],<joint> \\[rad|m]... (robokin's format).")],
     out: Annotated[Path, typer.Option("--out", help="Output folder (created).")],

@@ -12,6 +12,7 @@ from typing import Annotated
 import typer
 
 from robokin.cli.common import cell, console, json_text, load_robot
+from robokin.cli.options import JsonFlag, MmFlag, RobotName
 from robokin.cli.output import FormatOption
 
 __all__ = ["commands", "dh", "export_urdf", "import_urdf"]
@@ -111,7 +112,7 @@ def _export_format(out: Path | None, fmt: str | None) -> str:
 
 @commands.command("export")
 def export_urdf(
-    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    name: RobotName,
     out: Annotated[
         Path | None, typer.Option(
             "-o", "--out", help="File to write (replaced if it exists): .xml or .mjcf "
@@ -136,7 +137,7 @@ def export_urdf(
         raise InputError("--scene", "a scene goes into an MJCF model only (-o NAME.xml)")
     robot = load_robot(name)
     if kind == "mjcf":
-        from robokin.cli.sim import load_scene
+        from robokin.cli.common import load_scene
         from robokin.sim import to_mjcf
 
         text = to_mjcf(robot, None if scene is None else load_scene(scene))
@@ -170,9 +171,8 @@ def dh(
         bool,
         typer.Option("--virtual-frames", help="Fold base/tool into fixed rows."),
     ] = False,
-    mm: Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Same as --format json.")
-                       ] = False,
+    mm: MmFlag = False,
+    as_json: JsonFlag = False,
     output_format: FormatOption = None,
     package: Annotated[list[str] | None, typer.Option(
         "--package", help="NAME=DIR for a xacro's $(find NAME) (repeatable).")] = None,

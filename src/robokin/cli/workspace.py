@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from robokin.cli.common import json_text
+from robokin.cli.options import JsonFlag, RobotName
 from robokin.cli.output import (
     Column,
     FormatOption,
@@ -36,7 +37,7 @@ def _refuse_earlier_run(targets: list[Path], out: Path) -> None:
 
 @commands.command()
 def workspace(
-    name: Annotated[str, typer.Argument(help="Built-in name or robot file.")],
+    name: RobotName,
     samples: Annotated[
         int, typer.Option("--samples", "-n", help="Joint samples.")
     ] = 1_000_000,
@@ -52,9 +53,7 @@ def workspace(
     seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
     force: Annotated[bool, typer.Option(
         "--force", help="Replace the files of an earlier run in --out.")] = False,
-    as_json: Annotated[
-        bool, typer.Option("--json", help="Same as --format json.")
-    ] = False,
+    as_json: JsonFlag = False,
     output_format: FormatOption = None,
 ) -> None:
     """Sample the reachable workspace: bounds, volume (± its standard error), XY/XZ sections.

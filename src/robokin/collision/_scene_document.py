@@ -8,7 +8,6 @@ the scene from them. Every error names the file and the field.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -16,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from robokin._text import control_character, short_repr
+from robokin._units import ANGLE_UNITS, LENGTH_UNITS
 from robokin.exceptions import ModelError
 from robokin.io.geometry_sections import number_field, shape_from_spec
 from robokin.io.scene_files import scene_section_keys
@@ -23,8 +23,7 @@ from robokin.io.validate import unknown_key
 from robokin.model.geometry import Shape
 from robokin.spatial import pose_from_xyz_rpy
 
-_LENGTH = {"m": 1.0, "mm": 1e-3, "cm": 1e-2}
-_ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
+_LENGTH = {**LENGTH_UNITS, "cm": 1e-2}  # scenes also take centimetres
 
 def _text(value: Any, file: Any, field: str) -> str:
     """A name from a scene file: text of at most 200 characters."""
@@ -104,10 +103,10 @@ class SceneDocument:
         if not isinstance(lu, str) or lu not in _LENGTH:
             raise ModelError(f"expected one of {list(_LENGTH)}, got {short_repr(lu)}",
                              file=file, field="units.length")
-        if not isinstance(au, str) or au not in _ANGLE:
-            raise ModelError(f"expected one of {list(_ANGLE)}, got {short_repr(au)}",
+        if not isinstance(au, str) or au not in ANGLE_UNITS:
+            raise ModelError(f"expected one of {list(ANGLE_UNITS)}, got {short_repr(au)}",
                              file=file, field="units.angle")
-        return _LENGTH[lu], _ANGLE[au]
+        return _LENGTH[lu], ANGLE_UNITS[au]
 
     def placement(self, p: Any, where: str) -> np.ndarray:
         """A ``{xyz, rpy}`` placement in SI (identity when absent)."""

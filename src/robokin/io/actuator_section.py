@@ -31,11 +31,11 @@ be numbers (``ratio: "100"`` is refused).
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from robokin._units import ANGLE_UNITS, LENGTH_UNITS
 from robokin.exceptions import ModelError
 from robokin.io.validate import validate_document
 from robokin.model.coupling import (
@@ -57,8 +57,6 @@ __all__ = [
     "section_model",
 ]
 
-_LENGTH = {"m": 1.0, "mm": 1e-3}
-_ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 
 
 def _schema():
@@ -149,8 +147,8 @@ def actuators_from_section(
             matrix that cannot be inverted (rank below the number of motors).
     """
     spec = _validate(value, file)
-    L = _LENGTH[getattr(units, "length", "m")]
-    A = _ANGLE[getattr(units, "angle", "rad")]
+    L = LENGTH_UNITS[getattr(units, "length", "m")]
+    A = ANGLE_UNITS[getattr(units, "angle", "rad")]
     n = len(joint_names)
     q_scale = np.array([A if k == "revolute" else L for k in joint_kinds])
 

@@ -49,7 +49,7 @@ from robokin.spatial import invert, rpy_from_matrix
 if TYPE_CHECKING:
     from robokin.model.parts import RobotParts
 
-__all__ = ["DHExtraction", "dh_from_robot", "dh_rows_for_transform"]
+__all__ = ["DHExtraction", "dh_from_robot", "dh_rows_for_transform", "identity_rows"]
 
 _TOL = 1e-9
 
@@ -188,8 +188,12 @@ class DHExtraction:
                              tool=self.tool, coordinates=self.coordinates)
 
 
-def _identity_rows(chain: Chain) -> dict[int, int]:
-    """Chain joint index -> coordinate index for joints that are their coordinate."""
+def identity_rows(chain: Chain) -> dict[int, int]:
+    """Chain joint index -> coordinate index for joints that are their coordinate.
+
+    A joint is its coordinate when the coordinate has the joint's name and the
+    coupling's row of the joint is that coordinate alone (factor 1, offset 0).
+    """
     M, c = chain.coupling.matrix, chain.coupling.offset
     names = [x.name for x in chain.coordinates]
     out = {}
@@ -276,7 +280,7 @@ def dh_from_robot(
     base_rem = frames[0]
     tool_rem = invert(frames[-1]) @ tip
     # Rows with names, kinds, limits and dependencies.
-    ident = _identity_rows(chain)
+    ident = identity_rows(chain)
     M, cvec = chain.coupling.matrix, chain.coupling.offset
     cnames = [x.name for x in chain.coordinates]
     explicit = len(ident) != n or len(cnames) != n

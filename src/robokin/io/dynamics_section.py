@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from robokin._units import ANGLE_UNITS
 from robokin.exceptions import InputError, ModelError
 from robokin.io.validate import validate_document
 from robokin.model.dynamics import LinkInertia, RobotDynamics
@@ -39,9 +40,8 @@ if TYPE_CHECKING:
 
 __all__ = ["apply_dynamics_section", "dynamics_section"]
 
-_LENGTH = {"m": 1.0, "cm": 1e-2, "mm": 1e-3}
+_LENGTH = {"m": 1.0, "cm": 1e-2, "mm": 1e-3}  # dynamics also take centimetres
 _MASS = {"kg": 1.0, "g": 1e-3}
-_ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 
 
 def _schema() -> Any:
@@ -99,7 +99,7 @@ def apply_dynamics_section(robot: RobotParts, value: Any, file: Any, units: Any)
     spec = validate_document(_schema(), value, file=file, prefix=("dynamics",))
     L = _LENGTH[spec.units.length or getattr(units, "length", "m")]
     M = _MASS[spec.units.mass]
-    A = _ANGLE[getattr(units, "angle", "rad")]
+    A = ANGLE_UNITS[getattr(units, "angle", "rad")]
     names = link_names(robot)
     links: dict[str, LinkInertia] = {}
     for name, lk in spec.links.items():

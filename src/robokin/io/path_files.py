@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from robokin._text import short_repr
+from robokin._units import ANGLE_UNITS, LENGTH_UNITS
 from robokin.exceptions import ModelError
 from robokin.io.text_files import MAX_CSV_BYTES, read_text_file
 from robokin.io.yaml_reader import read_yaml_document
@@ -49,8 +50,6 @@ __all__ = ["MAX_PATH_BYTES", "MAX_PATH_POSES", "read_tool_path"]
 MAX_PATH_BYTES = MAX_CSV_BYTES
 #: The most poses a tool-path file may hold.
 MAX_PATH_POSES = 1_000_000
-_LENGTH = {"m": 1.0, "mm": 1e-3}
-_ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 _RPY = ("roll", "pitch", "yaw")
 _QUAT = ("qw", "qx", "qy", "qz")
 
@@ -92,9 +91,9 @@ def _scales(header: list[str], path: Path) -> tuple[dict[str, int], dict[str, fl
         if name in cols:
             raise ModelError(f"column {name!r} given twice", file=path, line=1)
         if name in ("x", "y", "z"):
-            table, what = _LENGTH, "a length: m or mm"
+            table, what = LENGTH_UNITS, "a length: m or mm"
         elif name in _RPY:
-            table, what = _ANGLE, "an angle: rad or deg"
+            table, what = ANGLE_UNITS, "an angle: rad or deg"
         elif name in _QUAT:
             table, what = {"": 1.0}, "a quaternion component: no unit"
             unit = unit or ""
@@ -189,7 +188,7 @@ def _poses_from_document(doc: Any, path: Path) -> np.ndarray:
         raise ModelError("expected {length: m|mm, angle: rad|deg}", file=path,
                          field="units")
     length, angle = units.get("length", "m"), units.get("angle", "rad")
-    if length not in _LENGTH or angle not in _ANGLE:
+    if length not in LENGTH_UNITS or angle not in ANGLE_UNITS:
         raise ModelError(f"expected length m or mm and angle rad or deg, got "
                          f"{short_repr(dict(units))}", file=path, field="units")
     poses = doc.get("poses")
@@ -208,4 +207,4 @@ def _poses_from_document(doc: Any, path: Path) -> np.ndarray:
                              f"{short_repr(item)}", file=path, field=where)
         xyz[k] = _vector(item["xyz"], 3, f"{where}.xyz", path)
         rpy[k] = _vector(item["rpy"], 3, f"{where}.rpy", path)
-    return pose_from_xyz_rpy(xyz * _LENGTH[length], rpy * _ANGLE[angle])
+    return pose_from_xyz_rpy(xyz * LENGTH_UNITS[length], rpy * ANGLE_UNITS[angle])

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from robokin._text import short_repr
+from robokin._units import ANGLE_UNITS, LENGTH_UNITS
 from robokin.exceptions import ModelError
 from robokin.io.validate import validate_document
 from robokin.model.rate_limits import RATE_KINDS, RateLimits
@@ -36,8 +37,6 @@ if TYPE_CHECKING:
 __all__ = ["apply_rate_limits_section", "rate_limits_from_section",
            "section_from_robot"]
 
-_LENGTH = {"m": 1.0, "mm": 1e-3}
-_ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 
 
 def _schema() -> Any:
@@ -100,8 +99,8 @@ def rate_limits_from_section(value: Any, is_revolute: np.ndarray, file: Any = No
     spec = validate_document(_schema(), value, file=file, prefix=("rate_limits",))
     rev = np.asarray(is_revolute, dtype=bool).reshape(-1)
     n = rev.size
-    unit = np.where(rev, _ANGLE[getattr(units, "angle", "rad")],
-                    _LENGTH[getattr(units, "length", "m")])
+    unit = np.where(rev, ANGLE_UNITS[getattr(units, "angle", "rad")],
+                    LENGTH_UNITS[getattr(units, "length", "m")])
     out: dict[str, np.ndarray | None] = {}
     for kind in RATE_KINDS:
         v = getattr(spec, kind)

@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from robokin._text import control_character
+from robokin._units import ANGLE_UNITS, LENGTH_UNITS
 from robokin._validation import MAX_TRANSLATION
 from robokin.exceptions import ModelError
 from robokin.io import (
@@ -68,8 +69,6 @@ __all__ = [
     "save_robot",
 ]
 
-_LENGTH = {"m": 1.0, "mm": 1e-3}
-_ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
 #: Most joint rows (or elementary operations) a robot file may hold.
 MAX_JOINTS = 1000
 #: Longest name (robot, joint, coordinate) [characters].
@@ -406,8 +405,8 @@ def parts_from_document(doc: Any, file: str | Path | None = None) -> RobotParts:
         ModelError: naming ``file``, the field path and the reason.
     """
     spec, rows = _validated(doc, file)
-    L = _LENGTH[spec.units.length]
-    A = _ANGLE[spec.units.angle]
+    L = LENGTH_UNITS[spec.units.length]
+    A = ANGLE_UNITS[spec.units.angle]
     si_rows = _si_rows(spec, rows, L, A)
     lengths = _lengths(spec, si_rows, L)
     _check_lengths(lengths, file)

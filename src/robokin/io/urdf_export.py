@@ -28,6 +28,7 @@ import numpy as np
 
 from robokin._text import printable
 from robokin.io.atomic import write_atomic
+from robokin.io.dh_extract import identity_rows
 from robokin.io.urdf_tree import UrdfChain
 from robokin.model.chain import joint_motion
 
@@ -226,14 +227,7 @@ def urdf_from_robot(
     vmax = _known_velocities(robot)
     speeds = np.full(len(cnames), np.nan) if vmax is None else vmax
     # Coordinates that are a chain joint of the same name with an identity row.
-    is_self = {}
-    for kk, j in enumerate(chain.joints):
-        if j.name in cnames:
-            i = cnames.index(j.name)
-            e = np.zeros(len(cnames))
-            e[i] = 1.0
-            if np.array_equal(M[kk], e) and c[kk] == 0.0:
-                is_self[j.name] = kk
+    is_self = {chain.joints[kk].name: kk for kk in identity_rows(chain)}
     master_of: dict[int, str] = {}
     for i, cn in enumerate(cnames):
         if cn in is_self:

@@ -33,28 +33,10 @@ __all__ = ["chain_from_dh", "chain_from_elementary", "Convention"]
 
 Convention = Literal["standard", "modified"]
 
-_DH_KEYS = {
-    "a",
-    "alpha",
-    "d",
-    "theta",
-    "joint",
-    "limits",
-    "sign",
-    "name",
-    "depends",
-    "depends_offset",
-}
-_ELEM_KEYS = {
-    "op",
-    "value",
-    "joint",
-    "limits",
-    "sign",
-    "name",
-    "depends",
-    "depends_offset",
-}
+#: The joint fields a DH row and an elementary operation share.
+_JOINT_KEYS = {"joint", "limits", "sign", "name", "depends", "depends_offset"}
+_DH_KEYS = {"a", "alpha", "d", "theta"} | _JOINT_KEYS
+_ELEM_KEYS = {"op", "value"} | _JOINT_KEYS
 _OPS = {"rx", "ry", "rz", "tx", "ty", "tz", "frame"}
 
 

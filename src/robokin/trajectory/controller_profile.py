@@ -18,6 +18,7 @@ from typing import Any, Literal, TypeVar
 import numpy as np
 
 from robokin._text import short_repr
+from robokin._units import ANGLE_UNITS, LENGTH_UNITS
 from robokin.exceptions import InputError, ModelError
 from robokin.spatial import pose_from_xyz_rpy
 
@@ -25,8 +26,6 @@ __all__ = ["PROGRAMS", "ControllerProfile", "load_profile"]
 
 _T = TypeVar("_T")
 
-_ANGLE = {"rad": 1.0, "deg": math.pi / 180.0}
-_LENGTH = {"m": 1.0, "mm": 1e-3}
 #: Programs a controller profile may name (robokin.trajectory.controllers).
 PROGRAMS = ("urscript", "ros2", "waypoints")
 
@@ -77,10 +76,10 @@ class ControllerProfile:
 
     def __post_init__(self) -> None:
         """Check the units and the per-column lists; store them as tuples."""
-        if self.angle_unit not in _ANGLE:
+        if self.angle_unit not in ANGLE_UNITS:
             raise ModelError(f"angle_unit must be 'rad' or 'deg', got {short_repr(self.angle_unit)}",
                              field="angle_unit")
-        if self.length_unit not in _LENGTH:
+        if self.length_unit not in LENGTH_UNITS:
             raise ModelError(f"length_unit must be 'm' or 'mm', got {short_repr(self.length_unit)}",
                              field="length_unit")
         if self.signs is not None and any(s not in (1, -1) for s in self.signs):

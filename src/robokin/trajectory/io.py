@@ -43,12 +43,11 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin._text import short_repr
+from robokin._units import ANGLE_UNITS, LENGTH_UNITS
 from robokin.exceptions import InputError, ModelError
 from robokin.io.atomic import write_atomic
 from robokin.io.text_files import MAX_CSV_BYTES, read_text_file
 from robokin.trajectory.controller_profile import (
-    _ANGLE,
-    _LENGTH,
     PROGRAMS,
     ControllerProfile,
     load_profile,
@@ -123,7 +122,7 @@ def csv_text(traj: Trajectory, joint_names: Sequence[str] | None = None, *,
     rev = traj.revolute()
     cols_names = profile.column_names(names)
     crev = profile.column_revolute(rev)
-    unit = np.array([_ANGLE[profile.angle_unit] if r else _LENGTH[profile.length_unit]
+    unit = np.array([ANGLE_UNITS[profile.angle_unit] if r else LENGTH_UNITS[profile.length_unit]
                      for r in crev])
     ulab = [profile.angle_unit if r else profile.length_unit for r in crev]
     blocks = [traj.t[:, None], profile.export(traj.q) / unit]
@@ -287,10 +286,10 @@ def _trajectory_from_table(header: list[str] | None, data: np.ndarray, path: Pat
             if base is None:
                 rev[i] = True if rev_given is None else rev_given[i]
                 scale = 1.0
-            elif base in _ANGLE:
-                scale = _ANGLE[base]
-            elif base in _LENGTH:
-                rev[i], scale = False, _LENGTH[base]
+            elif base in ANGLE_UNITS:
+                scale = ANGLE_UNITS[base]
+            elif base in LENGTH_UNITS:
+                rev[i], scale = False, LENGTH_UNITS[base]
             else:
                 raise ModelError(f"unknown unit [{short_repr(unit, 20)}] in column "
                                  f"{short_repr(cells[k][0])}; use rad, deg, m or mm",

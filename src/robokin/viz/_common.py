@@ -30,6 +30,9 @@ if TYPE_CHECKING:
     from robokin.robot import Robot
 
 __all__ = [
+    "COLORS",
+    "Colors",
+    "Drawing",
     "Motion",
     "ReportArrays",
     "SceneShape",
@@ -39,15 +42,33 @@ __all__ = [
     "robot_shapes",
     "has_link_shapes",
     "scene_shapes",
+    "drawing",
     "shape_from",
     "skeleton",
 ]
 
-LINK_COLOR = (232, 142, 48)
-JOINT_COLOR = (58, 62, 74)
+
+
+@dataclass(frozen=True)
+class Colors:
+    """The drawing colours (RGB, 0-255) both views use.
+
+    Attributes:
+        link: Robot links.
+        joint: Joint axes, base and flange.
+        collision: Bodies in collision.
+        distance: The closest-points segment.
+    """
+
+    link: tuple[int, int, int] = (232, 142, 48)
+    joint: tuple[int, int, int] = (58, 62, 74)
+    collision: tuple[int, int, int] = (225, 30, 30)
+    distance: tuple[int, int, int] = (20, 160, 230)
+
+
+#: The colours of the HTML page and the live viewer.
+COLORS = Colors()
 SCENE_COLOR = (150, 170, 195)
-COLLISION_COLOR = (225, 30, 30)
-DISTANCE_COLOR = (20, 160, 230)
 
 
 @dataclass(frozen=True)
@@ -299,7 +320,7 @@ def robot_shapes(robot: Robot) -> list[tuple[int, SceneShape]]:
     for i, shapes in enumerate(per_link):
         if i > nc + 1:
             break
-        color = JOINT_COLOR if i in (0, nc + 1) else LINK_COLOR
+        color = COLORS.joint if i in (0, nc + 1) else COLORS.link
         for j, shape in enumerate(shapes):
             s = shape_from(f"{geo.names[i]}_{j}", shape, color=color)
             if s is not None:
@@ -420,3 +441,29 @@ def _pair_tracker(
         return np.asarray(d, dtype=float), np.stack([pa, pb], axis=-2)
 
     return public
+
+
+@dataclass(frozen=True)
+class Drawing:
+    """What both views draw of a robot's motion, read once from the arguments.
+
+    Attributes:
+        motion: The joint samples (:func:`motion_from`).
+        report: The collision report's arrays over the samples (:func:`report_arrays`).
+        shapes: The robot's own shapes (:func:`robot_shapes`).
+        skeleton_only: No shape on a moving link: draw the skeleton instead.
+    """
+
+    motion: Motion
+    report: ReportArrays
+    shapes: list[tuple[int, SceneShape]]
+    skeleton_only: bool
+
+
+def drawing(robot: Robot, trajectory: Any = None, report: Any = None, *,
+            dt: float = 0.005) -> Drawing:
+    """The :class:`Drawing` of ``robot`` following ``trajectory`` with ``report``."""
+    motion = motion_from(robot, trajectory, dt=dt)
+    shapes = robot_shapes(robot)
+    return Drawing(motion, report_arrays(report, motion.q.shape[0]), shapes,
+                   not has_link_shapes(shapes, robot))

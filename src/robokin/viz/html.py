@@ -13,24 +13,14 @@ from __future__ import annotations
 import base64
 import html as _html
 import json
+from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robokin.io.atomic import write_atomic
-from robokin.viz._common import (
-    COLLISION_COLOR,
-    DISTANCE_COLOR,
-    JOINT_COLOR,
-    LINK_COLOR,
-    has_link_shapes,
-    motion_from,
-    report_arrays,
-    robot_shapes,
-    scene_shapes,
-    skeleton,
-)
+from robokin.viz._common import COLORS, drawing, scene_shapes, skeleton
 
 if TYPE_CHECKING:
     from robokin.robot import Robot
@@ -94,9 +84,9 @@ def animation_html(
     autoplay: bool = True,
 ) -> str:
     """The animation page as a string (see :func:`write_html`)."""
-    motion = motion_from(robot, trajectory, dt=dt)
+    view = drawing(robot, trajectory, report, dt=dt)
+    motion, rep, shapes = view.motion, view.report, view.shapes
     m = motion.q.shape[0]
-    rep = report_arrays(report, m)
     keep = []
     if rep.distance is not None:
         keep.append(int(np.argmin(rep.distance)))
@@ -113,7 +103,6 @@ def animation_html(
         track = (rep.distance[idx], None)
     F = idx.size
     nc = robot.chain.n_chain
-    shapes = robot_shapes(robot)
     data: dict[str, Any] = {
         "title": title or robot.name,
         "robot": robot.name,
@@ -137,12 +126,7 @@ def animation_html(
         ),
         "scale": sk.scale,
         "scene": [_shape_json(s) for s in scene_shapes(scene)],
-        "colors": {
-            "link": LINK_COLOR,
-            "joint": JOINT_COLOR,
-            "collision": COLLISION_COLOR,
-            "distance": DISTANCE_COLOR,
-        },
+        "colors": asdict(COLORS),
         "colliding": rep.colliding[idx].astype(int).tolist(),
         "collisions": [[int(a), int(b), x, y] for a, b, x, y in rep.bodies],
         "redBodies": _red_bodies(idx, rep.bodies),
@@ -150,7 +134,7 @@ def animation_html(
         "closest": None if track is None or track[1] is None else _b64(track[1]),
         "minDistance": rep.min_distance,
     }
-    data["skeleton"] = not has_link_shapes(shapes, robot)
+    data["skeleton"] = view.skeleton_only
     if shapes:
         from robokin.kinematics.forward import link_frames
 

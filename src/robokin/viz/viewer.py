@@ -32,18 +32,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from robokin.exceptions import MissingExtraError
-from robokin.viz._common import (
-    COLLISION_COLOR,
-    DISTANCE_COLOR,
-    JOINT_COLOR,
-    LINK_COLOR,
-    has_link_shapes,
-    motion_from,
-    report_arrays,
-    robot_shapes,
-    scene_shapes,
-    skeleton,
-)
+from robokin.viz._common import COLORS, drawing, scene_shapes, skeleton
 
 if TYPE_CHECKING:
     from robokin.robot import Robot
@@ -140,10 +129,10 @@ class RobotViewer:
         traj = trajectory
         if traj is not None and not hasattr(traj, "q") and np.ndim(traj) == 1:
             traj = np.asarray(traj, dtype=float)[None, :]
-        self.motion = motion_from(robot, traj, dt=dt)
+        view = drawing(robot, traj, report, dt=dt)
+        self.motion, self.report = view.motion, view.report
         self.free = trajectory is None or self.motion.q.shape[0] == 1
         m = self.motion.q.shape[0]
-        self.report = report_arrays(report, m)
         if port == 0:
             port = _free_port(host)
         from robokin.viz._origin_guard import guarded_start
@@ -157,8 +146,8 @@ class RobotViewer:
         self._stop = threading.Event()
         self.frame = 0
         self.q = self.motion.q[0].copy()
-        self._shapes = robot_shapes(robot)
-        self._skeleton = not has_link_shapes(self._shapes, robot)
+        self._shapes = view.shapes
+        self._skeleton = view.skeleton_only
         self._red = False
         sk = skeleton(robot, self.motion.q[: min(m, 1)])
         self._radius = sk.radius
@@ -264,21 +253,21 @@ class RobotViewer:
         if self._skeleton:
             for k, _ in enumerate(sk.links):
                 h = sc.add_cylinder(
-                    f"/robot/link{k}", radius=r, height=1.0, color=LINK_COLOR
+                    f"/robot/link{k}", radius=r, height=1.0, color=COLORS.link
                 )
                 self._segments.append(h)
-                self._link_nodes.append((h, LINK_COLOR))
+                self._link_nodes.append((h, COLORS.link))
             used = sorted({int(v) for v in sk.links.reshape(-1)})
             self._ball_index = used
             for k in used:
-                h = sc.add_icosphere(f"/robot/ball{k}", radius=r, color=LINK_COLOR)
+                h = sc.add_icosphere(f"/robot/ball{k}", radius=r, color=COLORS.link)
                 self._balls.append(h)
-                self._link_nodes.append((h, LINK_COLOR))
+                self._link_nodes.append((h, COLORS.link))
             for k, kind in enumerate(sk.joint_kinds):
                 if kind == "prismatic":
                     h = sc.add_box(
                         f"/robot/joint{k}",
-                        color=JOINT_COLOR,
+                        color=COLORS.joint,
                         dimensions=(1.6 * r, 1.6 * r, 3.2 * r),
                     )
                 else:
@@ -286,14 +275,14 @@ class RobotViewer:
                         f"/robot/joint{k}",
                         radius=1.3 * r,
                         height=2.5 * r,
-                        color=JOINT_COLOR,
+                        color=COLORS.joint,
                     )
                 self._joints.append(h)
             sc.add_cylinder(
                 "/robot/pedestal",
                 radius=2.2 * r,
                 height=r,
-                color=JOINT_COLOR,
+                color=COLORS.joint,
                 position=sk.base[0, :3, 3] - sk.base[0, :3, 2] * 0.5 * r,
                 wxyz=_wxyz(sk.base[0, :3, :3]),
             )
@@ -305,7 +294,7 @@ class RobotViewer:
             self._closest = sc.add_line_segments(
                 "/closest",
                 points=np.zeros((1, 2, 3)),
-                colors=DISTANCE_COLOR,
+                colors=COLORS.distance,
                 thickness=0.25 * r,
             )
 
@@ -445,9 +434,9 @@ class RobotViewer:
             return
         self._red = red
         for h, color in self._link_nodes:
-            h.color = COLLISION_COLOR if red else color
+            h.color = COLORS.collision if red else color
         for name, (h, color) in self._scene_nodes.items():
-            h.color = COLLISION_COLOR if name in bodies else color
+            h.color = COLORS.collision if name in bodies else color
 
     def show_frame(self, i: int) -> None:
         """Show trajectory sample ``i``: robot, closest segment, collision colour."""
@@ -466,7 +455,7 @@ class RobotViewer:
             if found is not None:
                 dist = float(found[0][0])
                 self._closest.points = found[1][:1]
-                color = COLLISION_COLOR if red else DISTANCE_COLOR
+                color = COLORS.collision if red else COLORS.distance
                 self._closest.colors = np.tile(
                     np.array(color, dtype=np.uint8), (1, 2, 1)
                 )

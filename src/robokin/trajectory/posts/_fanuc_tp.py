@@ -22,10 +22,10 @@ ends with ``CNT`` ``cnt`` (FANUC's CNT is a 0-100 rounding, not a distance), els
 from __future__ import annotations
 
 import textwrap
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import ClassVar
-
-import numpy as np
 
 from robokin.exceptions import InputError
 from robokin.trajectory.posts.arm_config import fanuc_config
@@ -35,7 +35,6 @@ from robokin.trajectory.posts.base import (
     ProgramJob,
     Statement,
     comment_text,
-    euler_deg,
 )
 
 __all__ = ["FanucTp"]
@@ -70,16 +69,13 @@ class FanucTp(PostProcessor):
     name_limit: ClassVar[int] = 36
     upper_names: ClassVar[bool] = True
     max_moves: ClassVar[int] = 9999
+    int_options: ClassVar[Mapping[str, tuple[int, int]]] = MappingProxyType(
+        {"cnt": (0, 100), "user_frame": (0, 9), "user_tool": (1, 10),
+         "frame_register": (1, 100)})
 
     def __post_init__(self) -> None:
         """Check the options."""
         super().__post_init__()
-        checks = {"cnt": (0, 100), "user_frame": (0, 9), "user_tool": (1, 10),
-                  "frame_register": (1, 100)}
-        for f, (lo, hi) in checks.items():
-            v = getattr(self, f)
-            if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
-                raise InputError(f, f"expected an integer {lo}..{hi}, got {v!r}")
         axes = tuple(self.turn_axes)
         if len(axes) != 3 or any(a not in range(1, 7) for a in axes):
             raise InputError("turn_axes", f"expected three axes 1..6, got {axes!r}")
@@ -89,13 +85,8 @@ class FanucTp(PostProcessor):
         """``NAME.ls``."""
         return (f"{name}.ls",)
 
-    def _wpr(self, T: np.ndarray) -> list[str]:
-        """``X, Y, Z, W, P, R`` as text."""
-        r, p, w = euler_deg(T[:3, :3], "ZYX")
-        return [self.length(v) for v in T[:3, 3]] + [self.euler(v) for v in (w, p, r)]
-
     def _frame_lines(self, job: ProgramJob) -> list[str]:
-        tool, base = self._wpr(job.tool), self._wpr(job.base)
+        tool, base = self.xyz_wpr(job.tool), self.xyz_wpr(job.base)
         if not self.set_frames:
             return [f"! UTOOL[{self.user_tool}] X Y Z W P R:",
                     "!  " + " ".join(tool[:3]), "!  " + " ".join(tool[3:]),

@@ -24,7 +24,9 @@ characters.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import ClassVar
 
 import numpy as np
@@ -37,7 +39,6 @@ from robokin.trajectory.posts.base import (
     ProgramJob,
     Statement,
     comment_text,
-    euler_deg,
 )
 
 __all__ = ["YaskawaInform"]
@@ -66,14 +67,12 @@ class YaskawaInform(PostProcessor):
     name_limit: ClassVar[int] = 32
     upper_names: ClassVar[bool] = True
     max_moves: ClassVar[int] = 9999
+    int_options: ClassVar[Mapping[str, tuple[int, int]]] = MappingProxyType(
+        {"pl": (1, 8), "tool": (0, 63), "user_frame": (1, 63)})
 
     def __post_init__(self) -> None:
         """Check the options."""
         super().__post_init__()
-        for f, (lo, hi) in {"pl": (1, 8), "tool": (0, 63), "user_frame": (1, 63)}.items():
-            v = getattr(self, f)
-            if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
-                raise InputError(f, f"expected an integer {lo}..{hi}, got {v!r}")
         if self.pulses_per_degree is not None:
             ppd = tuple(self.pulses_per_degree)
             if len(ppd) != 6 or not all(
@@ -133,13 +132,13 @@ class YaskawaInform(PostProcessor):
 
     def header(self, job: ProgramJob) -> list[str]:
         """Comment lines (``'``) and ``NOP``."""
-        tool = _values(self, job.tool)
+        tool, base = (" ".join(self.xyz_wpr(T)) for T in (job.tool, job.base))
         lines = [f"'{comment_text(job.description, 60)}",
                  f"'robokin: {comment_text(job.robot, 40)}, profile "
                  f"{comment_text(job.profile, 40)}",
                  f"'TOOL {self.tool}: {tool}"]
         if self._frame(job) != "ROBOT":
-            lines.append(f"'USER {self.user_frame}: {_values(self, job.base)}")
+            lines.append(f"'USER {self.user_frame}: {base}")
         lines += [f"'note: {comment_text(n, 60)}" for n in job.notes]
         return ["NOP", *lines]
 
@@ -177,7 +176,3 @@ class YaskawaInform(PostProcessor):
                  *data, *inst, *code]
         return {self.file_names(job.name)[0]: "\r\n".join(lines) + "\r\n"}
 
-
-def _values(post: PostProcessor, T: np.ndarray) -> str:
-    rz, ry, rx = euler_deg(T[:3, :3], "ZYX")
-    return " ".join([post.length(v) for v in T[:3, 3]] + [post.euler(v) for v in (rx, ry, rz)])

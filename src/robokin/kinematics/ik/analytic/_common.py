@@ -13,7 +13,8 @@ from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.model.chain import Chain
 from robokin.spatial import wrap_angle
 
-__all__ = ["STATUS_TEXT", "fit_turns", "fk_error", "make_set", "q_near_rows"]
+__all__ = ["STATUS_TEXT", "fit_turns", "fk_error", "make_set", "q_near_rows",
+           "read_only_joint_data"]
 
 # Status code -> text. Codes 0-2 are those the 6R kernels return (csrc/six_r.c);
 # the SCARA and palletizer closed forms use them too. 3: palletizer, 4: near.polish,
@@ -110,6 +111,21 @@ def make_set(
         branches=branches, status=status, method=method, error=error,
         info=dict(info or {}),
     )
+
+
+def read_only_joint_data(chain: Chain) -> tuple[np.ndarray, np.ndarray]:
+    """The chain's ``is_revolute`` (n,) and ``limits`` (n, 2), read-only.
+
+    What a solver's closure hands to every :class:`SolutionSet` it builds (the
+    limits are copied only when the chain's are writeable).
+    """
+    is_rev = np.array(chain.is_revolute, dtype=bool)
+    is_rev.setflags(write=False)
+    limits = np.asarray(chain.limits, dtype=np.float64)
+    if limits.flags.writeable:
+        limits = limits.copy()
+        limits.setflags(write=False)
+    return is_rev, limits
 
 
 def branch_labels(lead: tuple[int, ...],

@@ -26,8 +26,18 @@ import numpy as np
 
 from robokin.model.chain import Chain
 
-__all__ = ["Poe", "angle_between_axes", "closest_point", "cross3", "line_distance",
-           "poe_from_chain"]
+__all__ = [
+    "Poe",
+    "angle_between_axes",
+    "closest_point",
+    "cross3",
+    "line_distance",
+    "poe_from_chain",
+    "rotate_about",
+    "subproblem_1",
+    "subproblem_3",
+    "subproblem_4",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,3 +121,71 @@ def unit_perpendicular(h: np.ndarray) -> np.ndarray:
     v: np.ndarray = e - np.dot(e, h) * h
     unit: np.ndarray = v / np.linalg.norm(v)
     return unit
+
+
+def rotate_about(h: np.ndarray, ang: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """rot(h, ang) v for a fixed unit h; ang (...), v (..., 3) or (3,)."""
+    c = np.cos(ang)[..., None]
+    s = np.sin(ang)[..., None]
+    out: np.ndarray = v * c + np.cross(h, v) * s + h * (v @ h)[..., None] * (1.0 - c)
+    return out
+
+
+def subproblem_1(h: np.ndarray, u: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """Paden-Kahan subproblem 1: the angle about ``h`` taking ``u`` towards ``d``.
+
+    Onto ``d``'s direction, components along ``h`` ignored; broadcasts over
+    leading axes.
+    """
+    ang: np.ndarray = np.arctan2(np.einsum("...i,...i", d, np.cross(h, u)),
+                                 np.einsum("...i,...i", d, u) - (u @ h) * (d @ h))
+    return ang
+
+
+def subproblem_3(h: np.ndarray, a: np.ndarray, b: np.ndarray,
+                 d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Paden-Kahan subproblem 3: angles v with |a + rot(h, v) b| = |d|.
+
+    Squared, it is subproblem 4: ``a . rot(h, v) b = (|d|^2 - |a|^2 - |b|^2) / 2``.
+
+    Args:
+        h: Unit axis, shape (3,).
+        a: First link vector [m], shape (3,).
+        b: Second link vector [m], shape (3,).
+        d: Targets [m], shape (..., 3).
+
+    Returns:
+        ``(v (..., 2), disc (...), r2)`` as :func:`subproblem_4`.
+    """
+    return subproblem_4(h, a, b, 0.5 * (np.einsum("...i,...i", d, d) - a @ a - b @ b))
+
+
+def subproblem_4(h: np.ndarray, p: np.ndarray, q: np.ndarray,
+                 d: np.ndarray | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Paden-Kahan subproblem 4: angles v with ``p . rot(h, v) q = d``.
+
+    With ``A = p.q - (p.h)(h.q)``, ``B = p.(h x q)``, ``C = (p.h)(h.q)`` the
+    equation is ``A cos v + B sin v = d - C``: ``v = atan2(B, A) +- atan2(sqrt(disc),
+    d - C)`` with ``disc = A^2 + B^2 - (d - C)^2`` (the C twin: ``six_r.c``).
+
+    Args:
+        h: Unit axis, shape (3,).
+        p: Vectors [m], shape (..., 3).
+        q: Vector [m], shape (3,).
+        d: Right-hand sides, shape (...).
+
+    Returns:
+        ``(v (..., 2), disc (...), r2)``: both roots (equal when ``disc`` = 0), the
+        discriminant (< 0: no solution; the roots are then the nearest angles) and
+        its scale ``r2 = A^2 + B^2``.
+    """
+    kq = h @ q
+    A = p @ q - (p @ h) * kq
+    B = p @ np.cross(h, q)
+    C = (p @ h) * kq
+    rhs = d - C
+    r2 = A * A + B * B
+    disc = r2 - rhs * rhs
+    gam = np.arctan2(np.sqrt(np.maximum(disc, 0.0)), rhs)
+    phi = np.arctan2(B, A)
+    return np.stack([phi + gam, phi - gam], axis=-1), disc, r2

@@ -22,6 +22,7 @@ from robokin.kinematics.ik.analytic._common import (
     fk_error,
     make_set,
     q_near_rows,
+    read_only_joint_data,
 )
 from robokin.kinematics.ik.analytic._geometry import (
     Poe,
@@ -189,12 +190,7 @@ def make_single(chain: Chain, params: np.ndarray, *, method: str,
     # a lone pose; both copies give the same bits, tested)
     solve1 = single_copy.six_r_ik1
     packed = chain.arrays.packed
-    is_rev = np.array(chain.is_revolute, dtype=bool)
-    is_rev.setflags(write=False)
-    limits = np.asarray(chain.limits, dtype=np.float64)
-    if limits.flags.writeable:
-        limits = limits.copy()
-        limits.setflags(write=False)
+    is_rev, limits = read_only_joint_data(chain)
     labels = branch_labels((), _LABELS)
     bad = K.BAD_POSE
     texts = tuple(STATUS_TEXT)

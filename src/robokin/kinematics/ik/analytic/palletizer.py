@@ -35,9 +35,12 @@ from robokin.kinematics.ik.analytic._common import fit_turns, fk_error, make_set
 from robokin.kinematics.ik.analytic._geometry import (
     Poe,
     angle_between_axes,
+    rotate_about,
+    subproblem_1,
+    subproblem_3,
+    subproblem_4,
     unit_perpendicular,
 )
-from robokin.kinematics.ik.analytic.scara import _align_angle, _elbow_angles, _rot
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.solutions import SolutionSet
@@ -76,7 +79,7 @@ def _analyse(chain: Chain, poe: Poe) -> tuple[PalletizerGeometry, float, str, st
     theta_c = float(sv @ (sign * c + off))
     h2 = h[1] + s3 * h[2] + s4 * h[3]
     h2 /= np.linalg.norm(h2)
-    Rc = _rot(h2, np.array(theta_c), np.eye(3)).T  # columns rot(h2, theta_c) e_i
+    Rc = rotate_about(h2, np.array(theta_c), np.eye(3)).T  # columns rot(h2, theta_c) e_i
     h5c = Rc @ h[4]
     ang = max(angle_between_axes(h[1], h[2]), angle_between_axes(h[1], h[3]),
               angle_between_axes(h[0], h5c))
@@ -130,7 +133,7 @@ def pose_from_position_yaw(robot: ArmSource, xyz: Any, yaw: Any) -> np.ndarray:
     yaw = np.asarray(yaw, dtype=np.float64)
     lead = np.broadcast_shapes(xyz.shape[:-1], yaw.shape)
     R0 = level_rotation(g)
-    Rz = np.moveaxis(_rot(g.h[0], yaw[..., None], np.eye(3)), -1, -2)
+    Rz = np.moveaxis(rotate_about(g.h[0], yaw[..., None], np.eye(3)), -1, -2)
     T = np.zeros(lead + (4, 4))
     T[..., :3, :3] = Rz @ R0
     T[..., :3, 3] = xyz
@@ -157,26 +160,17 @@ def solve_geometry(robot: Arm, g: PalletizerGeometry, T: np.ndarray, *,
     RTM = T[..., :3, :3] @ g.M[:3, :3].T
     pp = p - o[0] - RTM @ (g.M[:3, 3] - o[4])
     # waist: pp . rot(h1, v1) h2 = h2 . (o5 - o1)
-    k2 = h1 @ h2
-    A = pp @ h2 - (pp @ h1) * k2
-    B = pp @ np.cross(h1, h2)
-    C = (pp @ h1) * k2
-    rhs = h2 @ (o[4] - o[0]) - C
-    r2 = A * A + B * B
-    disc = r2 - rhs * rhs
+    v1, disc, r2 = subproblem_4(h1, pp, h2, h2 @ (o[4] - o[0]))  # (..., 2)
     reach1 = disc >= -1e-12 * r2
-    gam = np.arctan2(np.sqrt(np.maximum(disc, 0.0)), rhs)
-    phi = np.arctan2(B, A)
-    v1 = np.stack([phi + gam, phi - gam], axis=-1)  # (..., 2)
-    d = (_rot(h1, -v1, pp[..., None, :]) - (o[1] - o[0])
+    d = (rotate_about(h1, -v1, pp[..., None, :]) - (o[1] - o[0])
          - g.Rc @ (o[4] - o[3]))  # (..., 2, 3)
     a = o[2] - o[1]
     b = o[3] - o[2]
     h3 = h[2]
-    v3, disc3, r3 = _elbow_angles(h3, a, b, d)  # (..., 2, 2): [waist, elbow]
+    v3, disc3, r3 = subproblem_3(h3, a, b, d)  # (..., 2, 2): [waist, elbow]
     reach3 = disc3 >= -1e-12 * r3
-    u = a + _rot(h3, v3, b)  # (..., 2, 2, 3)
-    v2 = _align_angle(h2, u, d[..., :, None, :])
+    u = a + rotate_about(h3, v3, b)  # (..., 2, 2, 3)
+    v2 = subproblem_1(h2, u, d[..., :, None, :])
     v1b = np.broadcast_to(v1[..., :, None], v2.shape)
     v4 = g.s4 * (g.theta_c - v2 - g.s3 * v3)
     v5 = g.s5 * (psi[..., None, None] - v1b)

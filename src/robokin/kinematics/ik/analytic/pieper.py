@@ -70,7 +70,11 @@ import numpy as np
 
 from robokin._native import kernels as K
 from robokin.kinematics.arm import Arm, ArmSource, arm_of
-from robokin.kinematics.ik.analytic._common import STATUS_TEXT, fk_error
+from robokin.kinematics.ik.analytic._common import (
+    STATUS_TEXT,
+    fk_error,
+    read_only_joint_data,
+)
 from robokin.kinematics.ik.analytic._geometry import (
     Poe,
     angle_between_axes,
@@ -342,12 +346,7 @@ def make_single(chain: Chain, params: np.ndarray, *, method: str,
     name) each set's ``info["held"]`` is ``{held: x}``.
     """
     solve1 = K.pieper_ik1
-    is_rev = np.array(chain.is_revolute, dtype=bool)
-    is_rev.setflags(write=False)
-    limits = np.asarray(chain.limits, dtype=np.float64)
-    if limits.flags.writeable:
-        limits = limits.copy()
-        limits.setflags(write=False)
+    is_rev, limits = read_only_joint_data(chain)
     labels = {k: np.asarray(v, dtype=np.int8) for k, v in LABELS.items()}
     for v in labels.values():
         v.setflags(write=False)

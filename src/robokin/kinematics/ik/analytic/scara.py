@@ -24,6 +24,9 @@ from robokin.kinematics.ik.analytic._common import fit_turns, fk_error, make_set
 from robokin.kinematics.ik.analytic._geometry import (
     Poe,
     angle_between_axes,
+    rotate_about,
+    subproblem_1,
+    subproblem_3,
     unit_perpendicular,
 )
 
@@ -69,51 +72,6 @@ def geometry(poe: Poe) -> ScaraGeometry:
     return ScaraGeometry(h, unit_perpendicular(h), rev, pri, s, poe.o, poe.M)
 
 
-def _rot(h: np.ndarray, ang: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """rot(h, ang) v for a fixed unit h; ang (...), v (..., 3) or (3,)."""
-    c = np.cos(ang)[..., None]
-    s = np.sin(ang)[..., None]
-    out: np.ndarray = v * c + np.cross(h, v) * s + h * (v @ h)[..., None] * (1.0 - c)
-    return out
-
-
-def _elbow_angles(h: np.ndarray, a: np.ndarray, b: np.ndarray,
-                  d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Paden-Kahan subproblem 3: angles v with |a + rot(h, v) b| = |d|.
-
-    Args:
-        h: Unit axis, shape (3,).
-        a: First link vector [m], shape (3,).
-        b: Second link vector [m], shape (3,).
-        d: Targets [m], shape (..., 3).
-
-    Returns:
-        ``(v (..., 2), disc (...), r2)``: both roots (equal when ``disc`` = 0),
-        the discriminant (< 0: out of reach) and its scale ``r2``.
-    """
-    kb = h @ b
-    A = a @ b - (a @ h) * kb
-    B = a @ np.cross(h, b)
-    C = (a @ h) * kb
-    rhs = 0.5 * (np.einsum("...i,...i", d, d) - a @ a - b @ b) - C
-    r2 = A * A + B * B
-    disc = r2 - rhs * rhs
-    gam = np.arctan2(np.sqrt(np.maximum(disc, 0.0)), rhs)
-    phi = np.arctan2(B, A)
-    return np.stack([phi + gam, phi - gam], axis=-1), disc, r2
-
-
-def _align_angle(h: np.ndarray, u: np.ndarray, d: np.ndarray) -> np.ndarray:
-    """Paden-Kahan subproblem 1: the angle about ``h`` taking ``u`` towards ``d``.
-
-    Onto ``d``'s direction, components along ``h`` ignored; broadcasts over
-    leading axes.
-    """
-    ang: np.ndarray = np.arctan2(np.einsum("...i,...i", d, np.cross(h, u)),
-                                 np.einsum("...i,...i", d, u) - (u @ h) * (d @ h))
-    return ang
-
-
 def solve_geometry(robot: Arm, g: ScaraGeometry, T: np.ndarray, *,
                    orientation_tol: float = 1e-9, compute_error: bool = False,
                    method: str = "analytic:scara",
@@ -132,17 +90,17 @@ def solve_geometry(robot: Arm, g: ScaraGeometry, T: np.ndarray, *,
     o, s = g.o, g.s
     t = g.M[:3, 3]
     p = T[..., :3, 3]
-    w = p - o[a_] - _rot(h, psi, t - o[c_])
+    w = p - o[a_] - rotate_about(h, psi, t - o[c_])
     hp = s[g.pri] * h
     vp = (w @ h - h @ (o[c_] - o[a_])) / (h @ hp)
     d = w - vp[..., None] * hp
     a = o[b_] - o[a_]
     b = o[c_] - o[b_]
     # subproblem 3 -> 4: a . rot(h, vb) b = (|d|^2 - |a|^2 - |b|^2) / 2
-    vb, disc, r2 = _elbow_angles(h, a, b, d)  # (..., 2)
+    vb, disc, r2 = subproblem_3(h, a, b, d)  # (..., 2)
     reach = disc >= -1e-12 * r2
-    u = a + _rot(h, vb, b)  # (..., 2, 3)
-    va = _align_angle(h, u, d[..., None, :])
+    u = a + rotate_about(h, vb, b)  # (..., 2, 3)
+    va = subproblem_1(h, u, d[..., None, :])
     vc = s[c_] * (psi[..., None] - s[a_] * va - s[b_] * vb)
     v = np.empty(lead + (2, 4))
     v[..., a_] = va
@@ -155,7 +113,7 @@ def solve_geometry(robot: Arm, g: ScaraGeometry, T: np.ndarray, *,
     valid = (reach & ok_orient)[..., None] & np.array([True, True])
     valid[..., 1] &= disc > 1e-12 * r2  # a double root at full stretch counts once
     sing = (np.abs(disc) <= 1e-12 * r2)[..., None] & valid
-    elbow = np.where(np.einsum("...i,...i", np.cross(a, _rot(h, vb, b)), h) >= 0, 1, -1)
+    elbow = np.where(np.einsum("...i,...i", np.cross(a, rotate_about(h, vb, b)), h) >= 0, 1, -1)
     status = np.where(valid.any(axis=-1), 0, np.where(ok_orient, 1, 2)).astype(np.int8)
     error = None
     if compute_error:
