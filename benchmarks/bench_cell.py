@@ -25,7 +25,10 @@ workspace bounds), after checking correctness:
      with glibc's malloc told to keep freed memory (``MALLOC_TUNED``: Dask's
      workers otherwise get fresh pages for every array of every task);
    * the same on 1 worker (1 core): the per-core rate;
-   * ``reach_map`` with ``scheduler=None`` (local threads).
+   * ``reach_map`` with ``scheduler=None`` (local threads);
+   * "before": the local-threads and two-worker maps as before issue 25's fix,
+     in the same rounds (one IK call per task, glibc's thresholds left as Dask
+     pinned them: :func:`as_before`).
 3. **Projection**: the 5 mm, 200-orientation UR5 map on a 100-core cluster,
    from the measured 1-worker (per-core) rate.
 4. **Memory**: a map of at least ``--rss-evals`` IK evaluations streamed into a
@@ -55,7 +58,39 @@ from robokin.cell.reach_map import _REGION_MARGIN, _REGION_SAMPLES, _default_chu
 
 FIELDS = ("counts", "index", "solutions", "manipulability")
 CORE = ("bare batch IK (robot.ik)", "map work, no Dask, w off", "map work, no Dask, w on",
-        "LocalCluster 2x1, w off", "LocalCluster 2x1, w on")
+        "local threads, w on", "local threads, w on, before",
+        "LocalCluster 2x1, w off", "LocalCluster 2x1, w on", "LocalCluster 2x1, w on, before")
+
+
+def as_before(on: bool) -> None:
+    """Run tasks as before issue 25's fix (``on``): one IK call per task (no
+    SOLVE_BATCH) and glibc's thresholds left as Dask pinned them (no
+    ``reuse_freed_memory``); else as now. Called here and on every worker, so
+    the same run times both."""
+    import contextlib
+
+    from robokin.cell import _evaluate, _malloc
+
+    saved = _malloc.__dict__.setdefault(  # kept in the module: this runs on workers too
+        "_bench_saved", (_evaluate.SOLVE_BATCH, _malloc.reuse_freed_memory))
+    batch, reuse = saved
+    _evaluate.SOLVE_BATCH = 2**62 if on else batch
+    _malloc.reuse_freed_memory = contextlib.nullcontext if on else reuse
+
+
+def before(fn, clients):
+    """``fn`` run as before the fix (see :func:`as_before`), then back to now."""
+    def run():
+        for c in clients:
+            c.run(as_before, True)
+        as_before(True)
+        try:
+            fn()
+        finally:
+            as_before(False)
+            for c in clients:
+                c.run(as_before, False)
+    return run
 
 
 def rate(n: int, seconds: float) -> float:
@@ -293,10 +328,14 @@ def main() -> None:
             "local threads, w off": (lambda: cell.reach_map(
                 robot, **kw, manipulability=False), here),
             "local threads, w on": (lambda: cell.reach_map(robot, **kw), here),
+            "local threads, w on, before": (before(lambda: cell.reach_map(robot, **kw), []),
+                                            here),
             "LocalCluster 2x1, w off": (lambda: cell.reach_map(
                 robot, **kw, scheduler=c2, manipulability=False), pids2),
             "LocalCluster 2x1, w on": (lambda: cell.reach_map(
                 robot, **kw, scheduler=c2), pids2),
+            "LocalCluster 2x1, w on, before": (before(lambda: cell.reach_map(
+                robot, **kw, scheduler=c2), [c2]), pids2),
             "LocalCluster 2x1, w on, Zarr": (lambda: cell.reach_map(
                 robot, **kw, scheduler=c2, store=fresh_store()), pids2),
             "LocalCluster 2x1 tuned, w off": (lambda: cell.reach_map(
@@ -333,7 +372,9 @@ def main() -> None:
                   f"{med[label]:7.3f} {100 * med[label] / med[ref]:5.1f}%   "
                   f"{medc[label]:6.3f} {100 * medc[label] / medc[ref]:5.1f}%   "
                   + ", ".join(f"{x:.3f}" for x in wall[label]))
-        for label in ("LocalCluster 2x1, w off", "LocalCluster 2x1, w on"):
+        for label in ("LocalCluster 2x1, w off", "LocalCluster 2x1, w on",
+                      "LocalCluster 2x1, w on, before", "local threads, w on",
+                      "local threads, w on, before"):
             ratio = [100 * a / b for a, b in zip(wall[label], wall[ref])]
             print(f"  {label} / bare batch IK, round by round (back to back): "
                   f"{min(ratio):.0f}-{max(ratio):.0f} %, median "

@@ -78,9 +78,11 @@ def test_processes_scheduler_changes_no_bit(ur5, small_map):
 
 
 def test_a_numeric_arm_maps_with_one_solution_per_target(rng):
+    # method="numeric": the numeric sample alone (the default on a 7-axis arm also
+    # searches the self-motion manifold: tests/cell/test_manifold.py)
     panda = robokin.load("panda")
     m = cell.reach_map(panda, region=[[0.2, -0.3, 0.2], [0.7, 0.3, 0.6]], voxel=0.2,
-                       orientations=6, chunk=5)
+                       orientations=6, chunk=5, method="numeric")
     assert m.method == "numeric" and m.counts.max() <= 1
     assert m.index.sum() > 0
     from robokin.kinematics.ik.numeric import solve
@@ -94,7 +96,7 @@ def test_a_numeric_arm_maps_with_one_solution_per_target(rng):
     ok = res.success & panda.within_limits(res.q)
     np.testing.assert_array_equal(m.reachable[v], ok)
     again = cell.reach_map(panda, region=[[0.2, -0.3, 0.2], [0.7, 0.3, 0.6]], voxel=0.2,
-                           orientations=6, chunk=2)
+                           orientations=6, chunk=2, method="numeric")
     assert_maps_equal(m, again)
 
 
@@ -298,3 +300,14 @@ def test_the_map_agrees_with_the_workspace_volume(ur5):
     # and its volume (count x voxel^3: midpoint cubature at 100 mm) agrees with the
     # Monte-Carlo estimate to 1 %: 3.582 vs 3.593 +- 0.012 m^3
     assert abs(m.volume() - ws.volume) <= 0.01 * ws.volume
+
+
+def test_solving_a_task_in_batches_changes_no_bit(ur5, small_map, monkeypatch):
+    # a task solves SOLVE_BATCH targets at a time (issue 25: bounded temporaries);
+    # batches of 7 targets (rounded to whole voxels) give the same map bit for bit
+    import robokin.cell._evaluate as ev
+
+    monkeypatch.setattr(ev, "SOLVE_BATCH", 7)
+    again = cell.reach_map(ur5, region=REGION, voxel=0.15, orientations=12, rolls=2,
+                           scheduler="synchronous")
+    assert_maps_equal(small_map, again)

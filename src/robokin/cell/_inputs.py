@@ -14,7 +14,7 @@ if TYPE_CHECKING:
     from robokin.collision.scene import Scene
     from robokin.robot import Robot
 
-__all__ = ["Progress", "ik_method", "placed_robot", "progress_callback"]
+__all__ = ["Progress", "ik_method", "manifold_sweep", "placed_robot", "progress_callback"]
 
 Progress = bool | Callable[[int, int], None] | None
 
@@ -50,6 +50,20 @@ def ik_method(robot: Robot, method: str) -> tuple[bool, str]:
     if fam.solver is None:
         raise InputError("method", f"no closed form for robot '{robot.name}': {fam.reason}")
     return False, f"analytic:{fam.name}"
+
+
+def manifold_sweep(robot: Robot, method: str) -> str | None:
+    """The joint whose values sweep a 7R arm's self-motion manifold, or None.
+
+    With ``method="auto"`` a 7-joint arm with a held-joint closed form counts a
+    pose reachable when any part of its manifold is inside the joint limits
+    (:mod:`robokin.cell._manifold`); ``"numeric"`` keeps the one numeric sample.
+    """
+    if method != "auto" or robot.n != 7:
+        return None
+    from robokin.cell._manifold import sweep_joint
+
+    return sweep_joint(robot)
 
 
 @contextmanager

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robokin.cell._evaluate import manipulability, solve_poses
+from robokin.cell._evaluate import manipulability, solve_task
 
 if TYPE_CHECKING:
     from robokin.robot import Robot
@@ -50,7 +50,8 @@ class PoseSet:
     unreached: np.ndarray
 
 
-def rank_solutions(robot: Robot, T: np.ndarray, numeric: bool) -> PoseSet:
+def rank_solutions(robot: Robot, T: np.ndarray, numeric: bool, sweep: str | None = None
+                   ) -> PoseSet:
     """Every in-limit solution of poses T (C, N, 4, 4), ranked by manipulability.
 
     Args:
@@ -58,17 +59,13 @@ def rank_solutions(robot: Robot, T: np.ndarray, numeric: bool) -> PoseSet:
         T: Task poses per candidate (C, N, 4, 4) [m].
         numeric: One numeric solution per pose (seed-table restarts) instead of
             every closed-form solution.
+        sweep: With ``numeric`` on a 7R arm, the joint sweeping the self-motion
+            manifold where the numeric sample missed (or None).
 
     Returns:
         The :class:`PoseSet`.
     """
-    C, N = T.shape[:2]
-    q, ok = solve_poses(robot, np.ascontiguousarray(T.reshape(C * N, 4, 4)), numeric)
-    k, n = q.shape[-2:]
-    q = q.reshape(C, N, k, n)
-    ok = np.asarray(ok).reshape(C, N, k)
+    q, ok, unreached = solve_task(robot, T, numeric, sweep)
     w = manipulability(robot.chain, q, ok)
     order = np.argsort(np.where(ok, -w, np.inf), axis=-1, kind="stable")
-    reached = ok.any(axis=-1)
-    unreached = np.where(reached.all(axis=-1), -1, np.argmax(~reached, axis=-1))
     return PoseSet(q, ok, w, order, unreached)

@@ -122,9 +122,17 @@ def _one_kernel_thread() -> None:
 
 
 def _task(fn: Callable[[J, int, int], R], job: J, start: int, stop: int) -> R:
-    """One chunk, on whatever worker runs it: kernels on one thread, then ``fn``."""
+    """One chunk, on whatever worker runs it.
+
+    The kernels on one thread, then ``fn`` with freed memory reused
+    (:mod:`robokin.cell._malloc`: on a Dask worker glibc otherwise maps fresh
+    pages for every array).
+    """
+    from robokin.cell._malloc import reuse_freed_memory
+
     _one_kernel_thread()
-    return fn(job, start, stop)
+    with reuse_freed_memory():
+        return fn(job, start, stop)
 
 
 def run_chunks(

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robokin.cell._evaluate import NUMERIC_RESTARTS, solve_poses
+from robokin.cell._evaluate import solve_poses, solve_task
 from robokin.spatial import wrap_angle
 
 if TYPE_CHECKING:
@@ -50,7 +50,8 @@ class Tracks:
     unreached: np.ndarray
 
 
-def track(robot: Robot, T: np.ndarray, max_step: float, numeric: bool) -> Tracks:
+def track(robot: Robot, T: np.ndarray, max_step: float, numeric: bool,
+          sweep: str | None = None) -> Tracks:
     """Follow every branch of poses T (C, N, 4, 4) in the robot's world frame.
 
     Args:
@@ -58,18 +59,17 @@ def track(robot: Robot, T: np.ndarray, max_step: float, numeric: bool) -> Tracks
         T: Task poses per candidate (C, N, 4, 4) [m].
         max_step: Largest joint change between consecutive poses [rad, m].
         numeric: Follow one numeric track instead of the closed form's branches.
+        sweep: With ``numeric`` on a 7R arm, the joint sweeping the first pose's
+            self-motion manifold where its numeric sample missed (or None).
 
     Returns:
         The :class:`Tracks`.
     """
     if numeric:
-        return _track_numeric(robot, T, max_step)
+        return _track_numeric(robot, T, max_step, sweep)
     C, N = T.shape[:2]
-    q, ok = solve_poses(robot, np.ascontiguousarray(T.reshape(C * N, 4, 4)), False)
+    q, ok, unreached = solve_task(robot, T, False)
     k, n = q.shape[-2:]
-    q = q.reshape(C, N, k, n)
-    ok = ok.reshape(C, N, k)
-    unreached = _first_false(np.asarray(ok.any(axis=-1)))
     rev = np.asarray(robot.is_revolute, dtype=bool)
     lim = np.asarray(robot.limits)
     paths = np.full((C, k, N, n), np.nan)
@@ -95,16 +95,16 @@ def track(robot: Robot, T: np.ndarray, max_step: float, numeric: bool) -> Tracks
     return Tracks(paths, alive, died, unreached)
 
 
-def _track_numeric(robot: Robot, T: np.ndarray, max_step: float) -> Tracks:
+def _track_numeric(robot: Robot, T: np.ndarray, max_step: float, sweep: str | None
+                   ) -> Tracks:
     from robokin.kinematics.ik.numeric import solve
 
     C, N = T.shape[:2]
     n = robot.n
     paths = np.full((C, 1, N, n), np.nan)
-    first = solve(robot, np.ascontiguousarray(T[:, 0]), max_restarts=NUMERIC_RESTARTS)
-    cur = np.asarray(first.q, dtype=np.float64).reshape(C, n)
-    alive = np.asarray(first.success, dtype=bool).reshape(C) & np.asarray(
-        robot.within_limits(cur))
+    first, found = solve_poses(robot, np.ascontiguousarray(T[:, 0]), True, sweep)
+    cur = first.reshape(C, n)
+    alive = found.reshape(C)
     died = np.where(alive, N, 0)
     unreached = np.where(alive, -1, 0)
     paths[:, 0, 0] = np.where(alive[:, None], cur, np.nan)
@@ -121,9 +121,3 @@ def _track_numeric(robot: Robot, T: np.ndarray, max_step: float) -> Tracks:
         cur = np.where(alive[:, None], q, cur)
         paths[:, 0, i] = np.where(alive[:, None], cur, np.nan)
     return Tracks(paths, alive[:, None], died[:, None], unreached)
-
-
-def _first_false(mask: np.ndarray) -> np.ndarray:
-    """(C,) index of the first False along the last axis of (C, N), -1 if none."""
-    bad = ~mask
-    return np.where(bad.any(axis=-1), np.argmax(bad, axis=-1), -1)

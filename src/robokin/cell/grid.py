@@ -22,6 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin._text import short_repr
+from robokin._validation import check_finite_number
 from robokin.exceptions import InputError
 from robokin.spatial import rotz
 
@@ -130,10 +131,12 @@ class VoxelGrid:
 
 def check_voxel(voxel: object) -> float:
     """The voxel edge [m] as a float, or :class:`InputError` naming ``voxel``."""
-    if isinstance(voxel, bool) or not isinstance(voxel, int | float | np.number):
-        raise InputError("voxel", f"expected an edge length > 0 [m], got {short_repr(voxel)}")
-    v = float(voxel)
-    if not (math.isfinite(v) and v > 0.0):
+    try:
+        v = check_finite_number(voxel, "voxel")
+    except InputError:
+        raise InputError("voxel", f"expected an edge length > 0 [m], got "
+                                  f"{short_repr(voxel)}") from None
+    if not v > 0.0:
         raise InputError("voxel", f"expected an edge length > 0 [m], got {v:g}")
     return v
 

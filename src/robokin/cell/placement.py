@@ -40,7 +40,12 @@ import numpy.typing as npt
 from robokin._text import short_repr
 from robokin.cell import plots as _plots
 from robokin.cell._evaluate import manipulability as _manipulability
-from robokin.cell._inputs import ik_method, placed_robot, progress_callback
+from robokin.cell._inputs import (
+    ik_method,
+    manifold_sweep,
+    placed_robot,
+    progress_callback,
+)
 from robokin.cell._pose_set import PoseSet, rank_solutions
 from robokin.cell._scheduler import check_scheduler, run_chunks
 from robokin.cell._tracking import track
@@ -76,6 +81,8 @@ class PlaceJob:
         max_step: Largest joint change between task poses on a branch [rad, m].
         min_manipulability: Smallest acceptable manipulability along the task.
         numeric: Follow numeric tracks (no closed form).
+        sweep: With ``numeric`` on a 7R arm, the joint sweeping a pose's
+            self-motion manifold where the numeric sample missed (or None).
     """
 
     robot: Robot
@@ -87,6 +94,7 @@ class PlaceJob:
     max_step: float
     min_manipulability: float
     numeric: bool
+    sweep: str | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -424,8 +432,9 @@ def place(
     C_poses = _candidates(candidates)
     _check_span(T, tooled)
     numeric, _ = ik_method(tooled, method)
+    sweep = manifold_sweep(tooled, method) if numeric else None
     job = PlaceJob(tooled, bare, scene, T, C_poses, clearance, max_step,
-                   min_manipulability, numeric)
+                   min_manipulability, numeric, sweep)
     C, N = C_poses.shape[0], T.shape[0]
     B = _chunk(chunk, C, N)
     ranges = [(a, min(a + B, C)) for a in range(0, C, B)]
@@ -550,7 +559,7 @@ def evaluate_place(job: PlaceJob, start: int, stop: int, *,
     local = invert(Bs)[:, None] @ job.task[None]
     if math.isinf(job.max_step):
         return _evaluate_set(job, start, stop, local, keep_path=keep_path)
-    tr = track(job.robot, local, job.max_step, job.numeric)
+    tr = track(job.robot, local, job.max_step, job.numeric, job.sweep)
     k = tr.alive.shape[1]
     w_min = np.full((C, k), np.nan)
     if tr.alive.any():
@@ -581,7 +590,7 @@ def _evaluate_set(job: PlaceJob, start: int, stop: int, local: np.ndarray, *,
 
     ``local`` holds the task poses in each candidate's base frame (C, N, 4, 4).
     """
-    ps = rank_solutions(job.robot, local, job.numeric)
+    ps = rank_solutions(job.robot, local, job.numeric, job.sweep)
     C, N = ps.ok.shape[:2]
     reachable = ps.unreached < 0
     clearance = np.full(C, np.nan)

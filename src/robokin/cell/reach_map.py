@@ -39,7 +39,13 @@ from robokin._text import short_repr
 from robokin.cell import _store
 from robokin.cell import plots as _plots
 from robokin.cell._evaluate import ReachChunk, ReachJob, evaluate_reach
-from robokin.cell._inputs import Progress, ik_method, placed_robot, progress_callback
+from robokin.cell._inputs import (
+    Progress,
+    ik_method,
+    manifold_sweep,
+    placed_robot,
+    progress_callback,
+)
 from robokin.cell._scheduler import Throttle, check_scheduler, run_chunks
 from robokin.cell.grid import VoxelGrid, tool_orientations
 from robokin.exceptions import InputError
@@ -95,7 +101,9 @@ class ReachMap:
         counts: IK solutions per voxel and orientation, inside the joint limits
             (and collision-free with a scene), (V, K) uint8. Closed-form arms
             count their distinct solutions (not the 2 pi copies of a joint with
-            more than one turn of travel); numerically solved arms 0 or 1.
+            more than one turn of travel); numerically solved arms 0 or 1 (a
+            7-axis arm: 1 when any part of the pose's self-motion manifold is
+            inside the limits).
         index: Reachability index per voxel, the fraction of orientations with a
             solution, (V,) float64 in [0, 1].
         solutions: Solutions per voxel summed over its orientations, (V,) int32.
@@ -390,7 +398,10 @@ def reach_map(
             ``orientations``).
         method: ``"auto"`` (the closed form when the arm has one, every
             solution; else the numeric solver, one solution per target from its
-            deterministic seed-table restarts), ``"analytic"`` or ``"numeric"``.
+            deterministic seed-table restarts; a 7-axis arm with a held-joint
+            closed form then searches the self-motion manifold of every target
+            the numeric sample missed: ``docs/scale.md``), ``"analytic"`` or
+            ``"numeric"`` (the numeric sample alone).
         manipulability: Compute the best manipulability per voxel (for a
             6-joint arm ``|det J|`` per solution in compiled code, about a tenth
             of the IK's cost; a Jacobian and its singular values per solution
@@ -426,12 +437,15 @@ def reach_map(
     else:
         grid = VoxelGrid.from_region(region, voxel)
     numeric, method_name = ik_method(world, method)
+    sweep = manifold_sweep(world, method) if numeric else None
+    if sweep is not None:
+        method_name = f"numeric + self-motion ({sweep} swept)"
     V, K = grid.size, R.shape[0]
     if store is None:
         _check_in_memory(V, K, bool(manipulability))
     B = _chunk(chunk, V, K)
     ranges = [(a, min(a + B, V)) for a in range(0, V, B)]
-    job = ReachJob(world, bare, scene, grid, R, numeric, bool(manipulability))
+    job = ReachJob(world, bare, scene, grid, R, numeric, bool(manipulability), sweep=sweep)
     shell = ReachMap(world.name, grid, R, np.zeros((0, K), np.uint8), np.zeros(0),
                      np.zeros(0, np.int32), None, method_name,
                      None if scene is None else scene.name, np.array(world.base))
@@ -622,6 +636,7 @@ def _fingerprint(job: ReachJob, chunk: int) -> str:
         np.array(job.grid.shape, np.int64).tobytes(),
         job.orientations.tobytes(),
         b"numeric" if job.numeric else b"analytic",
+        (job.sweep or "").encode(),
         b"w" if job.with_manipulability else b"-",
         np.int64(chunk).tobytes(),
     ):
