@@ -81,7 +81,7 @@ def _check_manifold(robot, q0):
                    for x in (t0, t0 + 2 * np.pi)), (t0, own)
     # the stretched SRS elbow (q4 = 0) is a multi-parameter family whose rows are split
     # arbitrarily (known gap, docs/ik.md "Seven-axis arms"; pinned by
-    # test_known_gap_srs_interval_missed_next_to_q2_limit): its intervals are not
+    # test_srs_interval_next_to_q2_limit_is_found, one such pose): its intervals are not
     # checked against the scan
     stretched = abs(np.sin(q0[3])) < 1e-6
     if not _aligned(robot, q0) and not stretched:
@@ -157,12 +157,11 @@ def test_special_configurations(arm, values, at_limit):
     _check_manifold(robot, q0)
 
 
-@pytest.mark.xfail(strict=True, reason="known gap (found by the hypothesis test in the "
-                   "whole suite; fails on 3943a47, before the merge, too): SRS arm, q2 at "
-                   "its upper limit, q6 = 0.5: branch 0 is inside the limits at "
-                   "swivel 0.178 but the intervals miss it")
-def test_known_gap_srs_interval_missed_next_to_q2_limit():
-    # oracle: the 2,000-value brute-force scan of _check_ends against the intervals
+def test_srs_interval_next_to_q2_limit_is_found():
+    # SRS arm, q2 at its upper limit, q6 = 0.5: branch 0 is inside the limits at swivel
+    # 0.178; the grid-and-bisection path (before the compiled cells) missed it (a
+    # strict xfail until then). Oracle: the 2,000-value brute-force scan of
+    # _check_ends against the intervals
     robot = ARMS["srs"]
     q0 = _special_config(robot, [0.0] * 5 + [0.5, 0.0])
     q0[1] = robot.limits[1, 1]

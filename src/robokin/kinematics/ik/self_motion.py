@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from robokin._native import kernels as K
 from robokin._validation import check_finite, check_joints, check_poses_fast
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, ArmSource, arm_of
@@ -161,16 +162,47 @@ class _SwivelFamily(_Family):
     name = "swivel"
     joint = None
 
-    def __init__(self, arm: SwivelArm, T: np.ndarray, robot: Arm) -> None:
+    def __init__(self, arm: SwivelArm, T: np.ndarray, robot: Arm, reference: bool = False
+                 ) -> None:
         self.arm = arm
-        self.fr = arm.frame(T)
-        self.T = T
+        self.T = np.ascontiguousarray(T, dtype=np.float64)
         self.robot = robot
+        self.reference = reference
+        self._fr: dict[str, Any] | None = None
+
+    @property
+    def fr(self) -> dict[str, Any]:
+        """The numpy twin's per-pose constants (built when first needed)."""
+        if self._fr is None:
+            self._fr = self.arm.frame(self.T)
+        return self._fr
 
     def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        q, real, sing = self.arm.configurations(self.fr, t)
-        q, ok = _polish(self.robot, q, real, self.T)
-        return q, ok, sing
+        if self.reference:  # the numpy twin (the tests' reference)
+            q, real, sing = self.arm.configurations(self.fr, t)
+            q, ok = _polish(self.robot, q, real, self.T)
+            return q, ok, sing
+        t = np.atleast_1d(np.asarray(t, dtype=np.float64))
+        Q, valid, sing = self.arm.rows(self.T[None], t[None])
+        return Q[0], valid[0], sing[0]
+
+    def exact(self) -> tuple[np.ndarray, np.ndarray, tuple[LimitCrossing, ...],
+                             tuple[SingularPoint, ...]]:
+        """The compiled intervals, owners, limit crossings and singular points."""
+        iv, niv, pts, npts = self.arm.manifold(self.T[None])
+        intervals = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
+        owner = np.repeat(np.arange(8), niv[0])
+        p = pts[0, :npts[0]]
+        kinds = {int(K.SM_KIND_LOWER): "lower", int(K.SM_KIND_UPPER): "upper",
+                 int(K.SM_KIND_ALIGNED): "aligned axes", int(K.SM_KIND_FOLD): "fold"}
+        cross, sing = [], []
+        for t, b, j, k in p:
+            kind = kinds[int(k)]
+            if kind in ("lower", "upper"):
+                cross.append(LimitCrossing(float(t), int(b), int(j), kind))
+            else:
+                sing.append(SingularPoint(float(t), int(b), kind))
+        return intervals, owner, tuple(cross), tuple(sing)
 
     def param_of(self, q: np.ndarray) -> float:
         return float(self.arm.swivel_of(self.fr, q))
@@ -661,7 +693,8 @@ def _criterion(criterion: Any, robot: ArmSource | None, limits: np.ndarray
 
 
 # ------------------------------------------------------------------ building it
-def _family(robot: Arm, T: np.ndarray, parameter: str, dispatch: Dispatch) -> _Family:
+def _family(robot: Arm, T: np.ndarray, parameter: str, dispatch: Dispatch,
+            reference: bool = False) -> _Family:
     names = list(robot.joint_names)
     choices = ["auto", "swivel", *names]
     if robot.n != 7 or robot.chain.n_chain != 7 or not robot.chain.coupling.is_identity:
@@ -672,7 +705,7 @@ def _family(robot: Arm, T: np.ndarray, parameter: str, dispatch: Dispatch) -> _F
                                       f"got {parameter!r}")
     arm = _setup(robot).swivel
     if parameter in ("auto", "swivel") and arm is not None:
-        return _SwivelFamily(arm, T, robot)
+        return _SwivelFamily(arm, T, robot, reference)
     if parameter == "swivel":
         raise InputError("parameter", f"{robot.name!r} is not an SRS arm (axes 1-3 and "
                                       f"5-7 must meet): give a joint name or 'auto'")
@@ -689,7 +722,7 @@ def _family(robot: Arm, T: np.ndarray, parameter: str, dispatch: Dispatch) -> _F
 
 
 def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
-                dispatch: Dispatch, grid: int = GRID) -> SelfMotion:
+                dispatch: Dispatch, grid: int = GRID, reference: bool = False) -> SelfMotion:
     """The self-motion manifold of one pose T (4, 4) of a 7R arm.
 
     Args:
@@ -699,6 +732,8 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
         dispatch: ``dispatch.solve`` (solves the arm with a joint held; the caller
             passes it, as to :func:`~robokin.kinematics.ik.fixed.solve_fixed`).
         grid: Parameter values of the checking grid (see the module docstring).
+        reference: The swivel computed by its numpy twin (rows, limit points, grid
+            and bisection), not the compiled kernel: the tests' reference.
 
     Returns:
         A :class:`SelfMotion`.
@@ -711,8 +746,13 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
     Ta = check_poses_fast(T, "T")
     if Ta.shape != (4, 4):
         raise InputError("T", f"self_motion takes one pose (4, 4), got {Ta.shape}")
-    fam = _family(robot, Ta, parameter, dispatch)
+    fam = _family(robot, Ta, parameter, dispatch, reference)
     limits = np.asarray(robot.limits, dtype=np.float64)
+    if isinstance(fam, _SwivelFamily) and not reference:
+        intervals, owner, crossings, singular = fam.exact()
+        return SelfMotion(Ta, fam.name, None, np.array(fam.domain), True, 8, intervals, owner,
+                          crossings, singular, "swivel closed form (SRS), compiled",
+                          {"bisected": 0, "grid": 0}, fam, limits)
     marks = _exact_points(robot, fam, limits)
     if isinstance(fam, _ContinuedFamily):
         grid = min(int(grid), _CONTINUED_GRID)  # each value is a general-6R solve
