@@ -2,7 +2,7 @@
 
 Oracles (independent of the kernel under test):
 * the numpy twin ``SwivelArm.configurations`` + ``_polish`` (swivel.py,
-  self_motion.py): the kernel's rows are its rows (same slots, same validity);
+  self_motion_families.py): the kernel's rows are its rows (same slots, same validity);
 * forward kinematics of every kernel row reproduces the pose to 1e-12;
 * the generating configuration q0 of T = FK(q0) is a row at q0's own swivel angle;
 * every interval end has a joint of its branch exactly at a limit (1e-12), and
@@ -20,7 +20,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from reference import iiwa14_srs, pose_errors
-from robokin.kinematics.ik.self_motion import _polish, _setup
+from robokin.kinematics.ik.self_motion_families import _polish, _setup
 
 SRS = iiwa14_srs()
 ARM = _setup(SRS.arm).swivel
