@@ -290,7 +290,11 @@ def auto_parameter(robot: ArmSource) -> str | None:
         else:
             from robokin.kinematics.ik.fixed import _held_solvers
 
-            usable = [n for n in arm.joint_names if n in _held_solvers(arm)]
+            # not the elbow: on a near-SRS arm (the rtb-data iiwa14, a Gen3) it moves
+            # over a tiny range on the manifold (the shoulder-wrist distance nearly
+            # fixes it), a parameter the grid and the users cannot sample
+            usable = [n for n in arm.joint_names[:3] + arm.joint_names[4:]
+                      if n in _held_solvers(arm)]
             setup.parameter = usable[-1] if usable else None
         setup.parameter_known = True
     return setup.parameter

@@ -134,16 +134,12 @@ class _SwivelFamily(_Family):
         intervals = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
         owner = np.repeat(np.arange(8), niv[0])
         p = pts[0, :npts[0]]
-        kinds = {int(K.SM_KIND_LOWER): "lower", int(K.SM_KIND_UPPER): "upper",
-                 int(K.SM_KIND_ALIGNED): "aligned axes", int(K.SM_KIND_FOLD): "fold"}
-        cross, sing = [], []
-        for t, b, j, k in p:
-            kind = kinds[int(k)]
-            if kind in ("lower", "upper"):
-                cross.append(LimitCrossing(float(t), int(b), int(j), kind))
-            else:
-                sing.append(SingularPoint(float(t), int(b), kind))
-        return intervals, owner, tuple(cross), tuple(sing)
+        limit = p[:, 3] <= K.SM_KIND_UPPER
+        names = ("lower", "upper", "aligned axes", "fold")  # SM_KIND_* 0-3
+        cross = tuple(LimitCrossing(t, int(b), int(j), names[int(k)])
+                      for t, b, j, k in p[limit].tolist())
+        sing = tuple(SingularPoint(t, int(b), names[int(k)]) for t, b, _, k in p[~limit].tolist())
+        return intervals, owner, cross, sing
 
     def param_of(self, q: np.ndarray) -> float:
         return float(self.arm.swivel_of(self.fr, q))
@@ -425,7 +421,8 @@ def _family(robot: Arm, T: np.ndarray, parameter: str, dispatch: Dispatch,
     held = {n: h for n, h in _held_solvers(robot).items()
             if not (arm is not None and n == names[3])}  # the SRS elbow: a family
     if parameter == "auto":
-        usable = [n for n in names if n in held]
+        usable = [n for n in names if n in held and n != names[3]]  # not the elbow
+        # (auto_parameter says why)
         parameter = usable[-1] if usable else names[-1]
     if parameter not in held:  # the general held-joint 6R solver, continued
         return _ContinuedFamily(robot, names.index(parameter), T, dispatch)
