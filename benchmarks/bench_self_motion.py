@@ -16,22 +16,63 @@ own q7 / swivel (within 1e-6 rad), rows with a pose error above 1e-9 (wrong) and
 the largest error. Configurations uniform in the limits. Times: best of
 ``--repeat`` runs, peers in the same run.
 
-Run: ``python benchmarks/bench_self_motion.py [--poses 200]``.
+Arms: the Panda; the exact iiwa14-type SRS arm (the compiled swivel,
+``csrc/self_motion.c``: also timed as bare kernel batches); the rtb-data
+``lbr_iiwa_14_r820.urdf`` (shoulder offset 0.44 mm: not exactly SRS, so the held
+joint path: ``auto`` picks joint_a4 with the Pieper closed form, continuation-free)
+and a Gen3-like arm (Kinova Gen3 7-DoF, the classic DH table of the Kinova Gen3 user
+guide: d = -0.2848, -0.0118, -0.4208, -0.0128, -0.3143, 0, -0.1674 m, alpha = pi/2
+(pi for joint 7), theta offsets 0, pi, ..., pi; limits +-128.9, 147.8, 120.3 deg on
+joints 2, 4, 6, the continuous joints 1, 3, 5, 7 taken as +-180 deg; its 11.8 and
+12.8 mm offsets leave no held-joint closed form: the general held-joint 6R solver,
+continued). The last two take ``--slow-poses`` poses (seconds per pose). Every time
+is given as wall time and as process CPU time (the machine is shared).
+
+Run: ``python benchmarks/bench_self_motion.py [--poses 200] [--slow-poses 5]``.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
-from bench_ik_held import best_time, run_geofik, run_ssik, score
+from bench_ik_held import run_geofik, run_ssik, score
 
 import robokin
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from reference import iiwa14_srs  # noqa: E402
+
+IIWA_URDF = "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf"
+
+
+def gen3_like() -> robokin.Robot:
+    """Kinova Gen3 7-DoF from the classic DH table of its user guide (module docstring)."""
+    d = [-0.2848, -0.0118, -0.4208, -0.0128, -0.3143, 0.0, -0.1674]
+    lim = [180, 128.9, 180, 147.8, 180, 120.3, 180]
+    rows = [{"a": 0.0, "alpha": np.pi if i == 6 else np.pi / 2, "d": d[i],
+             "theta": 0.0 if i == 0 else np.pi, "limits": [-np.radians(lim[i]),
+                                                         np.radians(lim[i])],
+             "name": f"joint_{i + 1}"} for i in range(7)]
+    return robokin.Robot.from_dh(rows, convention="standard", name="gen3_like")
+
+
+def arms(slow: int) -> list[tuple[str, robokin.Robot, int | None]]:
+    """(name, robot, poses or None for --poses) of the arms that can be built here."""
+    out: list[tuple[str, robokin.Robot, int | None]] = [
+        ("panda", robokin.load("panda"), None), ("iiwa14 SRS", iiwa14_srs(), None)]
+    try:
+        import rtbdata
+
+        urdf = Path(rtbdata.__file__).parent / IIWA_URDF
+        out.append(("iiwa14 URDF", robokin.Robot.from_urdf(str(urdf), geometry=False), slow))
+    except ImportError:
+        print("iiwa14 URDF: rtb-data not installed")
+    out.append(("gen3-like", gen3_like(), slow))
+    return out
 
 
 def parameter_of(sm, q):
@@ -40,31 +81,63 @@ def parameter_of(sm, q):
     return float(sm._family.arm.swivel_of(sm._family.fr, q))
 
 
+def cpu_and_wall(fn, repeat):
+    """(best wall [s], best process CPU [s]) over repeat calls."""
+    wall = cpu = np.inf
+    for _ in range(repeat):
+        t0, c0 = time.perf_counter(), time.process_time()
+        fn()
+        wall, cpu = min(wall, time.perf_counter() - t0), min(cpu, time.process_time() - c0)
+    return wall, cpu
+
+
 def run_robokin(robot, q, T, repeat):
     sms = [robot.self_motion(t) for t in T]
     rows = [sm.sample(parameter_of(sm, qi)) for sm, qi in zip(sms, q, strict=True)]
     # every sampled row of every pose (64 values) for the wrong-row count
     grid = [sm.sample(np.linspace(*sm.domain, 64)).reshape(-1, 7) for sm in sms]
-    whole = best_time(lambda: [robot.self_motion(t) for t in T], repeat) / len(T)
-    t64 = np.linspace(-1.0, 1.0, 64)
-    per_value = best_time(lambda: [sm.sample(t64) for sm in sms], repeat) / (64 * len(T))
-    return rows, grid, {"manifold": whole, "per value": per_value}
+    whole = cpu_and_wall(lambda: [robot.self_motion(t) for t in T], repeat)
+    t64 = [np.linspace(*sm.domain, 64) for sm in sms]
+    per_value = cpu_and_wall(lambda: [sm.sample(t) for sm, t in zip(sms, t64, strict=True)],
+                             repeat)
+    return rows, grid, {"manifold": [x / len(T) for x in whole],
+                        "per value": [x / (64 * len(T)) for x in per_value],
+                        "method": sms[0].method}
 
 
-def main(n: int = 200, repeat: int = 3, seed: int = 0) -> None:
+def run_kernels(robot, T, repeat):
+    """The SRS swivel kernels on the whole batch: rows at 64 angles, the manifolds."""
+    arm = robot.arm.self_motion.swivel
+    psi = np.tile(np.linspace(-np.pi, np.pi, 64), (len(T), 1))
+    rows = cpu_and_wall(lambda: arm.rows(T, psi), repeat)
+    man = cpu_and_wall(lambda: arm.manifold(T), repeat)
+    return [x / psi.size for x in rows], [x / len(T) for x in man]
+
+
+def us(pair):
+    return f"{pair[0] * 1e6:.1f} (CPU {pair[1] * 1e6:.1f})"
+
+
+def main(n: int = 200, repeat: int = 3, seed: int = 0, slow: int = 5) -> None:
     rng = np.random.default_rng(seed)
-    print(f"robokin {robokin.__version__}; poses per arm: {n}; best of {repeat}")
-    for name, robot in (("panda", robokin.load("panda")), ("iiwa14 SRS", iiwa14_srs())):
-        q = rng.uniform(robot.limits[:, 0], robot.limits[:, 1], (n, 7))
+    print(f"robokin {robokin.__version__}; poses per arm: {n} ({slow} on the held-joint "
+          f"arms); best of {repeat}; times in us, wall (process CPU)")
+    for name, robot, m in arms(slow):
+        count = n if m is None else m
+        q = rng.uniform(robot.limits[:, 0], robot.limits[:, 1], (count, 7))
         T = robot.fk(q)
         robot.self_motion(T[0])  # set-up (held-joint solvers, reduced chains)
-        rows, grid, times = run_robokin(robot, q, T, repeat)
+        rows, grid, times = run_robokin(robot, q, T, repeat if m is None else 1)
         rec, _, _, _ = score(robot, q, T, rows)
         _, wrong, worst, total = score(robot, q, T, grid)
-        print(f"{name:11s} robokin self_motion: recovered {rec}/{n}, wrong {wrong} of {total}"
-              f" sampled rows (max error {worst:.1e}); whole manifold "
-              f"{times['manifold'] * 1e3:.1f} ms/pose, sample {times['per value'] * 1e6:.1f}"
-              " us per (pose, value)")
+        print(f"{name:11s} robokin self_motion [{times['method']}]: recovered {rec}/{count}, "
+              f"wrong {wrong} of {total} sampled rows (max error {worst:.1e}); whole "
+              f"manifold {us(times['manifold'])} per pose, sample {us(times['per value'])}"
+              " per (pose, value)")
+        if name == "iiwa14 SRS":
+            krows, kman = run_kernels(robot, T, repeat)
+            print(f"{name:11s} kernels, one batch: swivel_rows {us(krows)} per (pose, value),"
+                  f" swivel_manifold {us(kman)} per pose")
         if name != "panda":
             continue
         for peer, fn in (("ssik charts", run_ssik), ("geofikpy q7", run_geofik)):
@@ -82,7 +155,8 @@ def main(n: int = 200, repeat: int = 3, seed: int = 0) -> None:
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--poses", type=int, default=200)
+    ap.add_argument("--slow-poses", type=int, default=5)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--seed", type=int, default=0)
     a = ap.parse_args()
-    main(a.poses, a.repeat, a.seed)
+    main(a.poses, a.repeat, a.seed, a.slow_poses)

@@ -480,6 +480,28 @@ PLAN_PATH = Group("plan_path.c", kernels=(
            checks=(Check("K >= 1", "path needs a row"),)),
 ))
 
+SELF_MOTION = Group("self_motion.c", kernels=(
+    Kernel("swivel_rows", (Arr("params", "f64", ("SM_N_PARAMS",)), Arr("T", "f64", POSE),
+                           Arr("psi", "f64", ("N", "m")), Arr("Q", "f64", ("N", "m", 8, 7), out=True),
+                           Arr("valid", "bool", ("N", "m", 8), out=True),
+                           Arr("sing", "bool", ("N", "m", 8), out=True)),
+           "None", "Every SRS configuration of poses T (N, 4, 4) at swivel angles psi (N, m): "
+                   "Q (N, m, 8, 7), valid, singular (N, m, 8).",
+           checks=(Check("sm_params_ok(a->params)", "params is not a swivel parameter vector"),)),
+    Kernel("swivel_manifold", (Arr("params", "f64", ("SM_N_PARAMS",)), Arr("T", "f64", POSE),
+                               Arr("iv", "f64", ("N", 8, "SM_MAXI", 2), out=True),
+                               Arr("niv", "i64", ("N", 8), out=True),
+                               Arr("pts", "f64", ("N", "SM_MAXP", 4), out=True),
+                               Arr("npts", "i64", ("N",), out=True)),
+           "None", "Per pose: the swivel intervals inside every limit per branch (N, 8, "
+                   "SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] "
+                   "(N, SM_MAXP, 4) with counts (N,).",
+           checks=(Check("sm_params_ok(a->params)", "params is not a swivel parameter vector"),)),
+), constants=_consts(
+    "H O S W MR MT SIGN OFFSET LO HI REF TAG N_PARAMS MAXI MAXP KIND_LOWER KIND_UPPER "
+    "KIND_ALIGNED KIND_FOLD", "SM_", "SM_") + (Const("SM_TAG_VALUE", "SM_TAG_VALUE", "float"),),
+    comment="swivel parameter vector layout (swivel.SwivelArm.packed), point kinds")
+
 @dataclass(frozen=True)
 class Section:
     """One section of a chain's packed vector: ``ChainArrays`` field, ``Chain`` field, shape.
@@ -514,5 +536,5 @@ PACKED_LAYOUT: tuple[Section, ...] = (
 )
 
 GROUPS: tuple[Group, ...] = (FK, LM, SIX_R, PIEPER, GENERAL6R, BROADPHASE, PROCESS,
-                             PLAN_CHECK, PLAN_RRTC, PLAN_PATH)
+                             PLAN_CHECK, PLAN_RRTC, PLAN_PATH, SELF_MOTION)
 OPTION_VECTORS: tuple[Opts, ...] = (LM_OPTS, RC_OPTS, SP_OPTS)

@@ -230,6 +230,27 @@ class Kernels(Protocol):
     RC_TIMEOUT: int
     RC_NODES: int
     RC_FAILED: int
+    # self_motion.c: swivel parameter vector layout (swivel.SwivelArm.packed), point kinds
+    SM_H: int
+    SM_O: int
+    SM_S: int
+    SM_W: int
+    SM_MR: int
+    SM_MT: int
+    SM_SIGN: int
+    SM_OFFSET: int
+    SM_LO: int
+    SM_HI: int
+    SM_REF: int
+    SM_TAG: int
+    SM_N_PARAMS: int
+    SM_MAXI: int
+    SM_MAXP: int
+    SM_KIND_LOWER: int
+    SM_KIND_UPPER: int
+    SM_KIND_ALIGNED: int
+    SM_KIND_FOLD: int
+    SM_TAG_VALUE: float
 
     def fk1(self, q: object, packed: object, /) -> F64 | None:
         """Pose (4, 4) of one configuration q (n,), or None for the general path."""
@@ -595,3 +616,27 @@ class Kernels(Protocol):
         /,
     ) -> tuple[F64, tuple[int, int, int, int, int, int]]:
         """Shortcuts, then sharp corners cut, of path (K, n); (path, counters)."""
+
+    def swivel_rows(
+        self,
+        params: F64,
+        T: F64,
+        psi: F64,
+        Q: F64,
+        valid: Bools,
+        sing: Bools,
+        /,
+    ) -> None:
+        """Every SRS configuration of poses T (N, 4, 4) at swivel angles psi (N, m): Q (N, m, 8, 7), valid, singular (N, m, 8)."""
+
+    def swivel_manifold(
+        self,
+        params: F64,
+        T: F64,
+        iv: F64,
+        niv: I64,
+        pts: F64,
+        npts: I64,
+        /,
+    ) -> None:
+        """Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,)."""

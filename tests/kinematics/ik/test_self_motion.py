@@ -81,7 +81,7 @@ def _check_manifold(robot, q0):
                    for x in (t0, t0 + 2 * np.pi)), (t0, own)
     # the stretched SRS elbow (q4 = 0) is a multi-parameter family whose rows are split
     # arbitrarily (known gap, docs/ik.md "Seven-axis arms"; pinned by
-    # test_known_gap_srs_interval_missed_next_to_q2_limit): its intervals are not
+    # test_srs_interval_next_to_q2_limit_is_found, one such pose): its intervals are not
     # checked against the scan
     stretched = abs(np.sin(q0[3])) < 1e-6
     if not _aligned(robot, q0) and not stretched:
@@ -157,12 +157,11 @@ def test_special_configurations(arm, values, at_limit):
     _check_manifold(robot, q0)
 
 
-@pytest.mark.xfail(strict=True, reason="known gap (found by the hypothesis test in the "
-                   "whole suite; fails on 3943a47, before the merge, too): SRS arm, q2 at "
-                   "its upper limit, q6 = 0.5: branch 0 is inside the limits at "
-                   "swivel 0.178 but the intervals miss it")
-def test_known_gap_srs_interval_missed_next_to_q2_limit():
-    # oracle: the 2,000-value brute-force scan of _check_ends against the intervals
+def test_srs_interval_next_to_q2_limit_is_found():
+    # SRS arm, q2 at its upper limit, q6 = 0.5: branch 0 is inside the limits at swivel
+    # 0.178; the grid-and-bisection path (before the compiled cells) missed it (a
+    # strict xfail until then). Oracle: the 2,000-value brute-force scan of
+    # _check_ends against the intervals
     robot = ARMS["srs"]
     q0 = _special_config(robot, [0.0] * 5 + [0.5, 0.0])
     q0[1] = robot.limits[1, 1]
@@ -274,3 +273,24 @@ def test_general_7r_branches_are_continued():
     assert ok.any() and dp[ok].max() <= 1e-12 and dr[ok].max() <= 1e-12
     assert any(a <= q0[6] <= e for (a, e), b in zip(sm.intervals, sm.interval_branch)
                if d[b] < 1e-9)
+
+
+def test_auto_parameter_is_not_the_elbow_of_a_near_srs_arm():
+    # the rtb-data iiwa14 (shoulder offset 0.44 mm): the elbow has a held-joint closed
+    # form but moves over a tiny range on the manifold (the shoulder-wrist distance
+    # nearly fixes it), so 'auto' chose a parameter almost no value of which has a
+    # row. Oracle: the generating configuration at its own parameter value, and rows
+    # at more than a tenth of 64 values across the parameter's range.
+    rtbdata = pytest.importorskip("rtbdata")
+    from pathlib import Path
+
+    urdf = (Path(rtbdata.__file__).parent
+            / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf")
+    robot = robokin.Robot.from_urdf(str(urdf), geometry=False)
+    q0 = np.array([0.3, 0.5, -0.4, 1.2, 0.5, -0.9, 0.2])
+    sm = robot.self_motion(robot.fk(q0))
+    assert sm.joint is not None and sm.joint != 3
+    d = np.abs((sm.sample(q0[sm.joint]) - q0 + np.pi) % (2 * np.pi) - np.pi).max(-1)
+    assert np.nanmin(d) < 1e-9
+    rows = np.isfinite(sm.sample(np.linspace(*sm.domain, 64))).all(-1).any(-1)
+    assert rows.mean() > 0.1, rows.mean()

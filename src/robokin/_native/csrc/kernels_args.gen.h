@@ -903,4 +903,43 @@ typedef struct {
 } plan_simplify_args;
 static PyObject *plan_simplify_body(const plan_simplify_args *a);
 
+/* swivel_rows: self_motion.c */
+typedef struct {
+    const double *params;
+    PyArrayObject *params_array;
+    const double *T;
+    PyArrayObject *T_array;
+    const double *psi;
+    PyArrayObject *psi_array;
+    double *Q;
+    PyArrayObject *Q_array;
+    npy_bool *valid;
+    PyArrayObject *valid_array;
+    npy_bool *sing;
+    PyArrayObject *sing_array;
+    npy_intp N;
+    npy_intp m;
+    char unused; /* a struct is never empty */
+} swivel_rows_args;
+static PyObject *swivel_rows_body(const swivel_rows_args *a);
+
+/* swivel_manifold: self_motion.c */
+typedef struct {
+    const double *params;
+    PyArrayObject *params_array;
+    const double *T;
+    PyArrayObject *T_array;
+    double *iv;
+    PyArrayObject *iv_array;
+    long long *niv;
+    PyArrayObject *niv_array;
+    double *pts;
+    PyArrayObject *pts_array;
+    long long *npts;
+    PyArrayObject *npts_array;
+    npy_intp N;
+    char unused; /* a struct is never empty */
+} swivel_manifold_args;
+static PyObject *swivel_manifold_body(const swivel_manifold_args *a);
+
 #endif

@@ -2017,6 +2017,143 @@ static PyObject *py_plan_simplify(PyObject *self, PyObject *const *args, Py_ssiz
     return plan_simplify_body(&a);
 }
 
+static PyObject *py_swivel_rows(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    swivel_rows_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 6) {
+        PyErr_SetString(PyExc_TypeError, "swivel_rows(params, T, psi, Q, valid, sing) takes 6 arguments");
+        return NULL;
+    }
+    a.params_array = array_arg(args[0], "swivel_rows", "params", NPY_DOUBLE, 1, 0);
+    if (a.params_array == NULL)
+        return NULL;
+    a.params = (const double *)PyArray_DATA(a.params_array);
+    a.T_array = array_arg(args[1], "swivel_rows", "T", NPY_DOUBLE, 3, 0);
+    if (a.T_array == NULL)
+        return NULL;
+    a.T = (const double *)PyArray_DATA(a.T_array);
+    a.N = PyArray_DIMS(a.T_array)[0];
+    a.psi_array = array_arg(args[2], "swivel_rows", "psi", NPY_DOUBLE, 2, 0);
+    if (a.psi_array == NULL)
+        return NULL;
+    a.psi = (const double *)PyArray_DATA(a.psi_array);
+    a.m = PyArray_DIMS(a.psi_array)[1];
+    a.Q_array = array_arg(args[3], "swivel_rows", "Q", NPY_DOUBLE, 4, 1);
+    if (a.Q_array == NULL)
+        return NULL;
+    a.Q = (double *)PyArray_DATA(a.Q_array);
+    a.valid_array = array_arg(args[4], "swivel_rows", "valid", NPY_BOOL, 3, 1);
+    if (a.valid_array == NULL)
+        return NULL;
+    a.valid = (npy_bool *)PyArray_DATA(a.valid_array);
+    a.sing_array = array_arg(args[5], "swivel_rows", "sing", NPY_BOOL, 3, 1);
+    if (a.sing_array == NULL)
+        return NULL;
+    a.sing = (npy_bool *)PyArray_DATA(a.sing_array);
+    npy_intp N = a.N; npy_intp m = a.m;
+    (void)N; (void)m;
+    if (!(sm_params_ok(a.params)))
+        return kernel_fail("robokin._native.swivel_rows: params is not a swivel parameter vector");
+    if (!(PyArray_DIMS(a.params_array)[0] == (npy_intp)(SM_N_PARAMS)))
+        return kernel_fail("robokin._native.swivel_rows: params must be (SM_N_PARAMS)");
+    if (!(PyArray_DIMS(a.T_array)[1] == (npy_intp)(4)))
+        return kernel_fail("robokin._native.swivel_rows: T must be (N, 4, 4)");
+    if (!(PyArray_DIMS(a.T_array)[2] == (npy_intp)(4)))
+        return kernel_fail("robokin._native.swivel_rows: T must be (N, 4, 4)");
+    if (!(PyArray_DIMS(a.psi_array)[0] == (npy_intp)(N)))
+        return kernel_fail("robokin._native.swivel_rows: psi must be (N, m)");
+    if (!(PyArray_DIMS(a.Q_array)[0] == (npy_intp)(N)))
+        return kernel_fail("robokin._native.swivel_rows: Q must be (N, m, 8, 7)");
+    if (!(PyArray_DIMS(a.Q_array)[1] == (npy_intp)(m)))
+        return kernel_fail("robokin._native.swivel_rows: Q must be (N, m, 8, 7)");
+    if (!(PyArray_DIMS(a.Q_array)[2] == (npy_intp)(8)))
+        return kernel_fail("robokin._native.swivel_rows: Q must be (N, m, 8, 7)");
+    if (!(PyArray_DIMS(a.Q_array)[3] == (npy_intp)(7)))
+        return kernel_fail("robokin._native.swivel_rows: Q must be (N, m, 8, 7)");
+    if (!(PyArray_DIMS(a.valid_array)[0] == (npy_intp)(N)))
+        return kernel_fail("robokin._native.swivel_rows: valid must be (N, m, 8)");
+    if (!(PyArray_DIMS(a.valid_array)[1] == (npy_intp)(m)))
+        return kernel_fail("robokin._native.swivel_rows: valid must be (N, m, 8)");
+    if (!(PyArray_DIMS(a.valid_array)[2] == (npy_intp)(8)))
+        return kernel_fail("robokin._native.swivel_rows: valid must be (N, m, 8)");
+    if (!(PyArray_DIMS(a.sing_array)[0] == (npy_intp)(N)))
+        return kernel_fail("robokin._native.swivel_rows: sing must be (N, m, 8)");
+    if (!(PyArray_DIMS(a.sing_array)[1] == (npy_intp)(m)))
+        return kernel_fail("robokin._native.swivel_rows: sing must be (N, m, 8)");
+    if (!(PyArray_DIMS(a.sing_array)[2] == (npy_intp)(8)))
+        return kernel_fail("robokin._native.swivel_rows: sing must be (N, m, 8)");
+    return swivel_rows_body(&a);
+}
+
+static PyObject *py_swivel_manifold(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    swivel_manifold_args a;
+    memset(&a, 0, sizeof(a));
+    if (nargs != 6) {
+        PyErr_SetString(PyExc_TypeError, "swivel_manifold(params, T, iv, niv, pts, npts) takes 6 arguments");
+        return NULL;
+    }
+    a.params_array = array_arg(args[0], "swivel_manifold", "params", NPY_DOUBLE, 1, 0);
+    if (a.params_array == NULL)
+        return NULL;
+    a.params = (const double *)PyArray_DATA(a.params_array);
+    a.T_array = array_arg(args[1], "swivel_manifold", "T", NPY_DOUBLE, 3, 0);
+    if (a.T_array == NULL)
+        return NULL;
+    a.T = (const double *)PyArray_DATA(a.T_array);
+    a.N = PyArray_DIMS(a.T_array)[0];
+    a.iv_array = array_arg(args[2], "swivel_manifold", "iv", NPY_DOUBLE, 4, 1);
+    if (a.iv_array == NULL)
+        return NULL;
+    a.iv = (double *)PyArray_DATA(a.iv_array);
+    a.niv_array = array_arg(args[3], "swivel_manifold", "niv", NPY_INT64, 2, 1);
+    if (a.niv_array == NULL)
+        return NULL;
+    a.niv = (long long *)PyArray_DATA(a.niv_array);
+    a.pts_array = array_arg(args[4], "swivel_manifold", "pts", NPY_DOUBLE, 3, 1);
+    if (a.pts_array == NULL)
+        return NULL;
+    a.pts = (double *)PyArray_DATA(a.pts_array);
+    a.npts_array = array_arg(args[5], "swivel_manifold", "npts", NPY_INT64, 1, 1);
+    if (a.npts_array == NULL)
+        return NULL;
+    a.npts = (long long *)PyArray_DATA(a.npts_array);
+    npy_intp N = a.N;
+    (void)N;
+    if (!(sm_params_ok(a.params)))
+        return kernel_fail("robokin._native.swivel_manifold: params is not a swivel parameter vector");
+    if (!(PyArray_DIMS(a.params_array)[0] == (npy_intp)(SM_N_PARAMS)))
+        return kernel_fail("robokin._native.swivel_manifold: params must be (SM_N_PARAMS)");
+    if (!(PyArray_DIMS(a.T_array)[1] == (npy_intp)(4)))
+        return kernel_fail("robokin._native.swivel_manifold: T must be (N, 4, 4)");
+    if (!(PyArray_DIMS(a.T_array)[2] == (npy_intp)(4)))
+        return kernel_fail("robokin._native.swivel_manifold: T must be (N, 4, 4)");
+    if (!(PyArray_DIMS(a.iv_array)[0] == (npy_intp)(N)))
+        return kernel_fail("robokin._native.swivel_manifold: iv must be (N, 8, SM_MAXI, 2)");
+    if (!(PyArray_DIMS(a.iv_array)[1] == (npy_intp)(8)))
+        return kernel_fail("robokin._native.swivel_manifold: iv must be (N, 8, SM_MAXI, 2)");
+    if (!(PyArray_DIMS(a.iv_array)[2] == (npy_intp)(SM_MAXI)))
+        return kernel_fail("robokin._native.swivel_manifold: iv must be (N, 8, SM_MAXI, 2)");
+    if (!(PyArray_DIMS(a.iv_array)[3] == (npy_intp)(2)))
+        return kernel_fail("robokin._native.swivel_manifold: iv must be (N, 8, SM_MAXI, 2)");
+    if (!(PyArray_DIMS(a.niv_array)[0] == (npy_intp)(N)))
+        return kernel_fail("robokin._native.swivel_manifold: niv must be (N, 8)");
+    if (!(PyArray_DIMS(a.niv_array)[1] == (npy_intp)(8)))
+        return kernel_fail("robokin._native.swivel_manifold: niv must be (N, 8)");
+    if (!(PyArray_DIMS(a.pts_array)[0] == (npy_intp)(N)))
+        return kernel_fail("robokin._native.swivel_manifold: pts must be (N, SM_MAXP, 4)");
+    if (!(PyArray_DIMS(a.pts_array)[1] == (npy_intp)(SM_MAXP)))
+        return kernel_fail("robokin._native.swivel_manifold: pts must be (N, SM_MAXP, 4)");
+    if (!(PyArray_DIMS(a.pts_array)[2] == (npy_intp)(4)))
+        return kernel_fail("robokin._native.swivel_manifold: pts must be (N, SM_MAXP, 4)");
+    if (!(PyArray_DIMS(a.npts_array)[0] == (npy_intp)(N)))
+        return kernel_fail("robokin._native.swivel_manifold: npts must be (N)");
+    return swivel_manifold_body(&a);
+}
+
 static PyMethodDef kernel_methods[] = {
     {"fk1", (PyCFunction)(void (*)(void))py_fk1, METH_FASTCALL,
      "fk1(q, packed) -> F64 | None: Pose (4, 4) of one configuration q (n,), or None for the general path."},
@@ -2106,6 +2243,10 @@ static PyMethodDef kernel_methods[] = {
      "plan_rrtc(model, start, goals, lo, hi, margin, opts, seed, exact) -> tuple[int, F64 | None, int, tuple[int, int, int, int, int, int], tuple[int, int, int, float]]: RRT-Connect: (code, path (K, n) or None, goal row, counters, search)."},
     {"plan_simplify", (PyCFunction)(void (*)(void))py_plan_simplify, METH_FASTCALL,
      "plan_simplify(model, path, margin, opts, seed, exact) -> tuple[F64, tuple[int, int, int, int, int, int]]: Shortcuts, then sharp corners cut, of path (K, n); (path, counters)."},
+    {"swivel_rows", (PyCFunction)(void (*)(void))py_swivel_rows, METH_FASTCALL,
+     "swivel_rows(params, T, psi, Q, valid, sing) -> None: Every SRS configuration of poses T (N, 4, 4) at swivel angles psi (N, m): Q (N, m, 8, 7), valid, singular (N, m, 8)."},
+    {"swivel_manifold", (PyCFunction)(void (*)(void))py_swivel_manifold, METH_FASTCALL,
+     "swivel_manifold(params, T, iv, niv, pts, npts) -> None: Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,)."},
     {NULL, NULL, 0, NULL}};
 
 /* every declared constant onto the module, then the groups' init functions */
@@ -2299,6 +2440,25 @@ static int add_constants(PyObject *m)
         {"RC_TIMEOUT", (long)(RC_TIMEOUT)},
         {"RC_NODES", (long)(RC_NODES)},
         {"RC_FAILED", (long)(RC_FAILED)},
+        {"SM_H", (long)(SM_H)},
+        {"SM_O", (long)(SM_O)},
+        {"SM_S", (long)(SM_S)},
+        {"SM_W", (long)(SM_W)},
+        {"SM_MR", (long)(SM_MR)},
+        {"SM_MT", (long)(SM_MT)},
+        {"SM_SIGN", (long)(SM_SIGN)},
+        {"SM_OFFSET", (long)(SM_OFFSET)},
+        {"SM_LO", (long)(SM_LO)},
+        {"SM_HI", (long)(SM_HI)},
+        {"SM_REF", (long)(SM_REF)},
+        {"SM_TAG", (long)(SM_TAG)},
+        {"SM_N_PARAMS", (long)(SM_N_PARAMS)},
+        {"SM_MAXI", (long)(SM_MAXI)},
+        {"SM_MAXP", (long)(SM_MAXP)},
+        {"SM_KIND_LOWER", (long)(SM_KIND_LOWER)},
+        {"SM_KIND_UPPER", (long)(SM_KIND_UPPER)},
+        {"SM_KIND_ALIGNED", (long)(SM_KIND_ALIGNED)},
+        {"SM_KIND_FOLD", (long)(SM_KIND_FOLD)},
     };
     for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
         if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)
@@ -2334,6 +2494,13 @@ static int add_constants(PyObject *m)
     {
         PyObject *v = PyFloat_FromDouble(PC_EPS);
         if (v == NULL || PyModule_AddObject(m, "PC_EPS", v) < 0) {
+            Py_XDECREF(v);
+            return -1;
+        }
+    }
+    {
+        PyObject *v = PyFloat_FromDouble(SM_TAG_VALUE);
+        if (v == NULL || PyModule_AddObject(m, "SM_TAG_VALUE", v) < 0) {
             Py_XDECREF(v);
             return -1;
         }

@@ -36,6 +36,7 @@
 #include "manipulability.c"
 #include "pieper.c"
 #include "process.c"
+#include "self_motion.c"
 
 #define F64(a) ((double *)PyArray_DATA(a))
 #define DIM(a, d) (PyArray_DIMS(a)[d])

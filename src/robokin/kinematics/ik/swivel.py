@@ -43,6 +43,7 @@ from typing import Any
 
 import numpy as np
 
+from robokin._native import kernels as K
 from robokin.kinematics.ik.analytic._geometry import poe_from_chain
 from robokin.spatial import wrap_angle
 
@@ -152,6 +153,7 @@ class SwivelArm:
         sign: Joint signs (7,); offset: joint offsets (7,) [rad].
         limits: Joint limits (7, 2) [rad].
         ref: The swivel's reference direction (axis 1) (3,).
+        params: The compiled twin's parameter vector (``csrc/self_motion.c``).
     """
 
     h: np.ndarray
@@ -163,6 +165,7 @@ class SwivelArm:
     offset: np.ndarray
     limits: np.ndarray
     ref: np.ndarray
+    params: np.ndarray
 
     # ------------------------------------------------------------- the frame
     def frame(self, T: np.ndarray) -> dict[str, Any]:
@@ -227,6 +230,48 @@ class SwivelArm:
         ok = real.reshape(m, 8)
         q[~ok] = np.nan
         return q, ok, sing.reshape(m, 8)
+
+    def rows(self, T: np.ndarray, psi: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The compiled twin of :meth:`configurations` with the polish, batched.
+
+        Args:
+            T: Poses (N, 4, 4).
+            psi: Swivel angles (N, m) [rad].
+
+        Returns:
+            ``(Q (N, m, 8, 7), valid (N, m, 8), singular (N, m, 8))``: every slot at
+            every angle, rows whose pose error exceeds 1e-13 Newton-polished (up to 3
+            minimum-norm steps, each kept where it lowers the error), rows still above
+            5e-13 dropped (NaN, not valid).
+        """
+        T = np.ascontiguousarray(T, dtype=np.float64)
+        psi = np.ascontiguousarray(psi, dtype=np.float64)
+        N, m = psi.shape
+        Q = np.empty((N, m, 8, 7))
+        valid = np.empty((N, m, 8), bool)
+        sing = np.empty((N, m, 8), bool)
+        K.swivel_rows(self.params, T, psi, Q, valid, sing)
+        return Q, valid, sing
+
+    def manifold(self, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The exact in-limit swivel intervals of poses T (N, 4, 4), compiled.
+
+        Returns:
+            ``(iv (N, 8, SM_MAXI, 2), counts (N, 8), points (N, SM_MAXP, 4), npoints
+            (N,))``: per branch its intervals (an interval across pi ends past pi);
+            points as ``[psi, branch, joint, kind]`` with kind ``SM_KIND_LOWER``,
+            ``_UPPER`` (a joint at that limit), ``_ALIGNED`` (a triple's outer axes
+            in line) or ``_FOLD`` (a triple's middle angle at an end of its range).
+        """
+        T = np.ascontiguousarray(T, dtype=np.float64)
+        N = len(T)
+        iv = np.empty((N, 8, K.SM_MAXI, 2))
+        niv = np.empty((N, 8), np.int64)
+        pts = np.empty((N, K.SM_MAXP, 4))
+        npts = np.empty(N, np.int64)
+        K.swivel_manifold(self.params, T, iv, niv, pts, npts)
+        return iv, niv, pts, npts
 
     def wrap(self, q: np.ndarray) -> np.ndarray:
         """Angles into (-pi, pi], then by 2 pi into the limits where that fits."""
@@ -326,7 +371,26 @@ def swivel_arm(chain: Any) -> SwivelArm | None:
     if np.linalg.norm(np.cross(poe.h[3], S - poe.o[3])) < lim:
         return None
     lims = np.asarray(chain.limits, dtype=np.float64)
-    return SwivelArm(poe.h.copy(), poe.o[3].copy(), S, W, poe.M.copy(),
-                     np.asarray(chain.arrays.sign, dtype=np.float64).copy(),
-                     np.asarray(chain.arrays.offset, dtype=np.float64).copy(),
-                     lims, poe.h[0].copy())
+    sign = np.asarray(chain.arrays.sign, dtype=np.float64).copy()
+    offset = np.asarray(chain.arrays.offset, dtype=np.float64).copy()
+    return SwivelArm(poe.h.copy(), poe.o[3].copy(), S, W, poe.M.copy(), sign, offset,
+                     lims, poe.h[0].copy(), _pack(poe.h, poe.o, S, W, poe.M, sign, offset,
+                                                  lims))
+
+
+def _pack(h: np.ndarray, o: np.ndarray, S: np.ndarray, W: np.ndarray, M: np.ndarray,
+          sign: np.ndarray, offset: np.ndarray, limits: np.ndarray) -> np.ndarray:
+    """The parameter vector of ``csrc/self_motion.c`` (its SM_ layout)."""
+    P = np.zeros(K.SM_N_PARAMS)
+    P[K.SM_H:K.SM_H + 21] = h.ravel()
+    P[K.SM_O:K.SM_O + 21] = o.ravel()
+    P[K.SM_S:K.SM_S + 3] = S
+    P[K.SM_W:K.SM_W + 3] = W
+    P[K.SM_MR:K.SM_MR + 9] = M[:3, :3].ravel()
+    P[K.SM_MT:K.SM_MT + 3] = M[:3, 3]
+    for at, v in ((K.SM_SIGN, sign), (K.SM_OFFSET, offset), (K.SM_LO, limits[:, 0]),
+                  (K.SM_HI, limits[:, 1])):
+        P[at:at + 7] = v
+    P[K.SM_REF:K.SM_REF + 3] = h[0]
+    P[K.SM_TAG] = K.SM_TAG_VALUE
+    return P

@@ -1,0 +1,734 @@
+/*
+ * The self-motion of an SRS arm (axes 1-3 meet in the shoulder S, 5-7 in the
+ * wrist W: the KUKA iiwa type) over its swivel angle psi, compiled: the twin of
+ * robokin/kinematics/ik/swivel.py (its numpy version is the tests' reference;
+ * the formulas, slots and conventions are the same, line for line).
+ *
+ *   swivel_rows:     every configuration (8 slots, slot = 4 elbow + 2 shoulder +
+ *                    wrist, each 0 / 1 the + / - root of its subproblem 4) of
+ *                    poses T at swivel angles psi, Newton-polished where the
+ *                    pose error exceeds 1e-13 (dropped above 5e-13), singular
+ *                    flags (a triple's outer axes in line);
+ *   swivel_manifold: the exact intervals of psi inside every joint limit, per
+ *                    branch, and the points where a branch meets a limit or has
+ *                    a triple's outer axes in line.
+ *
+ * Limits exactly (Shimizu et al. 2008): joint j of a triple at chain angle L is
+ * one condition x . rot(u, phi) y = k on the swivel (u the shoulder-wrist
+ * direction, phi = psi - psi0 at the shoulder, psi0 - psi at the wrist): a
+ * subproblem 4, A cos phi + B sin phi = C, i.e. a quadratic in tan(phi / 2): at
+ * most two swivel angles per joint, limit and elbow root. Every change of a
+ * branch's state (inside the limits or not, existing or not) happens at one of
+ * those angles (existence changes where a triple's middle angle reaches an end
+ * of its range, the same condition with L that end), so the state is constant
+ * between consecutive ones and decided at the midpoint: the intervals are
+ * exact, with no grid.
+ *
+ * The parameter vector (swivel.py's SwivelArm.pack writes it; Python reads the
+ * SM_ indices from the module constants):
+ *
+ *   SM_H, SM_O    unit joint axes h_k and points o_k at zero chain values (7 x 3)
+ *   SM_S, SM_W    the shoulder and wrist points (3 each)
+ *   SM_MR, SM_MT  the tool pose at zero: rotation rows (9), translation (3)
+ *   SM_SIGN, SM_OFFSET, SM_LO, SM_HI   per joint (7 each): v = sign q + offset, limits
+ *   SM_REF        the swivel's reference direction (axis 1) (3)
+ *   SM_TAG        SM_TAG_VALUE
+ *
+ * References: Shimizu, Kakuya, Yoon, Kitagaki and Kosuge, "Analytical inverse
+ * kinematic computation for 7-DOF redundant manipulators with joint limits and
+ * its application to redundancy resolution", IEEE T-RO 24(5), 2008; Elias and
+ * Wen, "IK-Geo", arXiv:2211.05737 (subproblems 1 and 4).
+ */
+#include "chain.h"
+#include "pool.h"
+#include "vec3.h"
+
+enum {
+    SM_H = 0, SM_O = 21, SM_S = 42, SM_W = 45, SM_MR = 48, SM_MT = 57, SM_SIGN = 60,
+    SM_OFFSET = 67, SM_LO = 74, SM_HI = 81, SM_REF = 88, SM_TAG = 91, SM_N_PARAMS = 92
+};
+#define SM_TAG_VALUE 2008.0625 /* Shimizu et al.'s year, and a sixteenth */
+#define SM_MAXI 40             /* intervals per branch (at most 33 cells per elbow) */
+#define SM_MAXP 256            /* points per pose: 32 swivel angles per elbow, 4 branches */
+#define SM_KIND_LOWER 0
+#define SM_KIND_UPPER 1
+#define SM_KIND_ALIGNED 2
+#define SM_KIND_FOLD 3
+#define SM_DOUBLE 1e-12  /* a subproblem-4 |C| past its amplitude by this (relative): a double root */
+#define SM_EXACT 1e-13   /* pose errors below it need no polish */
+#define SM_ACCEPT 5e-13  /* pose errors above it after the polish: dropped */
+#define SM_SAME 1e-6     /* a branch's joint this near a value [rad]: at it */
+#define SM_GRAIN 16      /* poses per pool chunk */
+#define SM_PARALLEL_MIN 64
+
+static int sm_params_ok(const double *P) { return P[SM_TAG] == SM_TAG_VALUE; }
+
+/* ------------------------------------------------------------ geometry */
+
+typedef struct {
+    v3 h[7], o[7], S, Wp, MT, ref;
+    m3 MR;
+    const double *sign, *offset, *lo, *hi;
+} SmArm;
+
+typedef struct {
+    v3 u, r;
+    double v4[2], psi0[2];
+    int elbow_real, ref_ok;
+    m3 R0[2], TR;
+} SmFrame;
+
+static inline m3 sm_rotm(v3 k, double t)
+{
+    double c = cos(t), s = sin(t), v = 1.0 - c;
+    return (m3){{c + k.x * k.x * v, k.x * k.y * v - k.z * s, k.x * k.z * v + k.y * s},
+                {k.y * k.x * v + k.z * s, c + k.y * k.y * v, k.y * k.z * v - k.x * s},
+                {k.z * k.x * v - k.y * s, k.z * k.y * v + k.x * s, c + k.z * k.z * v}};
+}
+
+static inline m3 sm_mul(const m3 *A, const m3 *B) /* A B */
+{
+    m3 out;
+    v3 *o = &out.r0;
+    const v3 *a = &A->r0;
+    for (int i = 0; i < 3; i++)
+        o[i] = v3_add(v3_add(v3_scale(B->r0, a[i].x), v3_scale(B->r1, a[i].y)),
+                      v3_scale(B->r2, a[i].z));
+    return out;
+}
+
+static inline m3 sm_tr(const m3 *A)
+{
+    return (m3){{A->r0.x, A->r1.x, A->r2.x}, {A->r0.y, A->r1.y, A->r2.y},
+                {A->r0.z, A->r1.z, A->r2.z}};
+}
+
+static inline double sm_norm(v3 a) { return sqrt(v3_dot(a, a)); }
+
+static void sm_arm(const double *P, SmArm *a)
+{
+    for (int k = 0; k < 7; k++) {
+        a->h[k] = v3_at(P, SM_H + 3 * k);
+        a->o[k] = v3_at(P, SM_O + 3 * k);
+    }
+    a->S = v3_at(P, SM_S);
+    a->Wp = v3_at(P, SM_W);
+    a->MT = v3_at(P, SM_MT);
+    a->ref = v3_at(P, SM_REF);
+    a->MR = (m3){v3_at(P, SM_MR), v3_at(P, SM_MR + 3), v3_at(P, SM_MR + 6)};
+    a->sign = P + SM_SIGN;
+    a->offset = P + SM_OFFSET;
+    a->lo = P + SM_LO;
+    a->hi = P + SM_HI;
+}
+
+/* Subproblem 4 (swivel.py _sp4): the angles t with x . rot(h, t) y = c, as
+ * A cos t + B sin t = C; returns whether they are real. */
+static int sm_sp4(v3 h, v3 x, v3 y, double c, double *tp, double *tm, double *A, double *B,
+                  double *C)
+{
+    v3 ypar = v3_scale(h, v3_dot(h, y)), yp = v3_sub(y, ypar);
+    *A = v3_dot(x, yp);
+    *B = v3_dot(x, v3_cross(h, yp));
+    *C = c - v3_dot(x, ypar);
+    double rho = hypot(*A, *B);
+    int real = fabs(*C) <= rho * (1.0 + SM_DOUBLE) + 1e-300 && rho > 0.0;
+    double d = rho > 0.0 ? acos(fmax(-1.0, fmin(1.0, *C / rho))) : NAN;
+    double phi = atan2(*B, *A);
+    *tp = phi + d;
+    *tm = phi - d;
+    return real;
+}
+
+/* Subproblem 1 (swivel.py _sp1): the angle about h from x to y; *spread = |x's
+ * part normal to h| */
+static double sm_sp1(v3 h, v3 x, v3 y, double *spread)
+{
+    v3 xp = v3_sub(x, v3_scale(h, v3_dot(h, x))), yp = v3_sub(y, v3_scale(h, v3_dot(h, y)));
+    *spread = sm_norm(xp);
+    return atan2(v3_dot(h, v3_cross(xp, yp)), v3_dot(xp, yp));
+}
+
+/* A unit vector normal to h: the base axis h has least of, less its h part */
+static v3 sm_perp(v3 h)
+{
+    double ax = fabs(h.x), ay = fabs(h.y), az = fabs(h.z);
+    v3 e = (ax <= ay && ax <= az) ? (v3){1.0, 0.0, 0.0}
+         : (ay <= az) ? (v3){0.0, 1.0, 0.0} : (v3){0.0, 0.0, 1.0};
+    e = v3_sub(e, v3_scale(h, v3_dot(e, h)));
+    return v3_scale(e, 1.0 / sm_norm(e));
+}
+
+/* Every split of R into rot(ha, va) rot(hb, vb) rot(hc, vc) (swivel.py _triple):
+ * v[i] for the middle angle's + / - root; returns whether they are real. */
+static int sm_triple(v3 ha, v3 hb, v3 hc, const m3 *R, double v[2][3], int sing[2])
+{
+    double tp, tm, A, B, C;
+    v3 Rhc = m3_mv(R, hc);
+    int real = sm_sp4(hb, ha, hc, v3_dot(ha, Rhc), &tp, &tm, &A, &B, &C);
+    double vb[2] = {tp, tm};
+    v3 e = sm_perp(hc), Re = m3_mv(R, e);
+    for (int i = 0; i < 2; i++) {
+        m3 Rb = sm_rotm(hb, vb[i]);
+        double spread, dummy;
+        double va = sm_sp1(ha, m3_mv(&Rb, hc), Rhc, &spread);
+        sing[i] = spread < 1e-9;
+        if (sing[i])
+            va = 0.0;
+        m3 Ra = sm_rotm(ha, va), Bm = sm_mul(&Ra, &Rb);
+        v[i][0] = va;
+        v[i][1] = vb[i];
+        v[i][2] = sm_sp1(hc, e, m3_mtv(&Bm, Re), &dummy);
+    }
+    return real;
+}
+
+/* The smallest rotation taking the direction of a to that of b */
+static m3 sm_smallest(v3 a, v3 b)
+{
+    double na = sm_norm(a), nb = sm_norm(b);
+    if (na == 0.0 || nb == 0.0)
+        return (m3){{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+    a = v3_scale(a, 1.0 / na);
+    b = v3_scale(b, 1.0 / nb);
+    v3 ax = v3_cross(a, b);
+    double s = sm_norm(ax), c = v3_dot(a, b);
+    if (s < 1e-15) {
+        if (c > 0.0)
+            return (m3){{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+        return sm_rotm(sm_perp(a), M_PI);
+    }
+    return sm_rotm(v3_scale(ax, 1.0 / s), atan2(s, c));
+}
+
+/* The swivel angle: about u from r to u x h4 */
+static double sm_angle_of(v3 u, v3 r, v3 h4)
+{
+    v3 d = v3_cross(u, h4);
+    return atan2(v3_dot(u, v3_cross(r, d)), v3_dot(r, d));
+}
+
+/* The pose's constants (swivel.py SwivelArm.frame); T row-major 4 x 4 */
+static void sm_frame(const SmArm *a, const double *T, SmFrame *f)
+{
+    m3 TRm = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
+    v3 Tt = {T[3], T[7], T[11]};
+    m3 MRt = sm_tr(&a->MR);
+    v3 Wt = v3_add(m3_mv(&TRm, m3_mv(&MRt, v3_sub(a->Wp, a->MT))), Tt);
+    v3 w = v3_sub(Wt, a->S);
+    double d = sm_norm(w);
+    f->u = d > 0.0 ? v3_scale(w, 1.0 / d) : (v3){0.0, 0.0, 1.0};
+    v3 h4 = a->h[3], p = v3_sub(a->Wp, a->o[3]), q = v3_sub(a->S, a->o[3]);
+    double A, B, C;
+    f->elbow_real = sm_sp4(h4, q, p, 0.5 * (v3_dot(p, p) + v3_dot(q, q) - d * d), &f->v4[0],
+                           &f->v4[1], &A, &B, &C);
+    v3 r = v3_sub(a->ref, v3_scale(f->u, v3_dot(a->ref, f->u)));
+    f->ref_ok = sm_norm(r) > 1e-9;
+    if (!f->ref_ok) {
+        v3 x = {1.0, 0.0, 0.0};
+        r = v3_sub(x, v3_scale(f->u, v3_dot(x, f->u)));
+    }
+    f->r = v3_scale(r, 1.0 / sm_norm(r));
+    for (int e = 0; e < 2; e++) {
+        m3 R4 = sm_rotm(h4, f->v4[e]);
+        v3 ae = v3_sub(v3_add(a->o[3], m3_mv(&R4, p)), a->S);
+        f->R0[e] = sm_smallest(ae, w);
+        f->psi0[e] = sm_angle_of(f->u, f->r, m3_mv(&f->R0[e], h4));
+    }
+    f->TR = sm_mul(&TRm, &MRt);
+}
+
+/* A chain angle as the joint coordinate: wrapped, then by 2 pi into the limits
+ * where that fits (swivel.py SwivelArm.wrap) */
+static inline double sm_joint(const SmArm *a, int j, double v)
+{
+    double q = wrap_pi((v - a->offset[j]) * a->sign[j]);
+    double lo = a->lo[j], hi = a->hi[j];
+    if (q < lo && q + 2.0 * M_PI <= hi)
+        q += 2.0 * M_PI;
+    else if (q > hi && q - 2.0 * M_PI >= lo)
+        q -= 2.0 * M_PI;
+    return q;
+}
+
+static void sm_configs_part(const SmArm *a, const SmFrame *f, int e, double psi, int part,
+                            double q[4][7], int ok[4], int sing[4]);
+
+/* The 4 configurations of elbow root e at swivel angle psi (slots 4 e + 2 s + w,
+ * here 2 s + w): joint coordinates q, whether real, singular. */
+static void sm_configs(const SmArm *a, const SmFrame *f, int e, double psi, double q[4][7],
+                       int ok[4], int sing[4])
+{
+    sm_configs_part(a, f, e, psi, 3, q, ok, sing);
+}
+
+/* sm_configs of the triples in `part` (1 shoulder, 2 wrist, 3 both); the other
+ * triple's joints are left NaN and count as real, not singular */
+static void sm_configs_part(const SmArm *a, const SmFrame *f, int e, double psi, int part,
+                            double q[4][7], int ok[4], int sing[4])
+{
+    m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
+    m3 RA = sm_mul(&Ru, &f->R0[e]);
+    double sA[2][3] = {{NAN, NAN, NAN}, {NAN, NAN, NAN}}, sB[2][3] = {{NAN, NAN, NAN}, {NAN, NAN, NAN}};
+    int gA[2] = {0, 0}, gB[2] = {0, 0}, rA = 1, rB = 1;
+    if (part & 1)
+        rA = sm_triple(a->h[0], a->h[1], a->h[2], &RA, sA, gA);
+    if (part & 2) {
+        m3 R4 = sm_rotm(a->h[3], f->v4[e]), RAR4 = sm_mul(&RA, &R4), X = sm_tr(&RAR4);
+        m3 RB = sm_mul(&X, &f->TR);
+        rB = sm_triple(a->h[4], a->h[5], a->h[6], &RB, sB, gB);
+    }
+    int real = f->elbow_real && rA && rB;
+    for (int s = 0; s < 2; s++)
+        for (int w = 0; w < 2; w++) {
+            int k = 2 * s + w;
+            ok[k] = real;
+            sing[k] = gA[s] || gB[w];
+            for (int j = 0; j < 3; j++) {
+                q[k][j] = real ? sm_joint(a, j, sA[s][j]) : NAN;
+                q[k][4 + j] = real ? sm_joint(a, 4 + j, sB[w][j]) : NAN;
+            }
+            q[k][3] = real ? sm_joint(a, 3, f->v4[e]) : NAN;
+        }
+}
+
+/* ------------------------------------------------------------ the polish */
+
+/* Forward kinematics (product of exponentials) of chain angles v: R, p, and the
+ * axes h' and points o' of every joint in the base frame */
+static void sm_fk(const SmArm *a, const double *v, m3 *R, v3 *p, v3 *hw, v3 *ow)
+{
+    m3 G = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+    v3 g = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 7; k++) {
+        hw[k] = m3_mv(&G, a->h[k]);
+        ow[k] = v3_add(m3_mv(&G, a->o[k]), g);
+        m3 Rk = sm_rotm(a->h[k], v[k]);
+        g = v3_add(m3_mv(&G, v3_sub(a->o[k], m3_mv(&Rk, a->o[k]))), g);
+        G = sm_mul(&G, &Rk);
+    }
+    *R = sm_mul(&G, &a->MR);
+    *p = v3_add(m3_mv(&G, a->MT), g);
+}
+
+/* The error [p_T - p; log(R_T R^T)] (chain.h pose_residual's) and its size:
+ * the larger of the position and rotation norms */
+static double sm_error(const m3 *RT, v3 pT, const m3 *R, v3 p, double *e)
+{
+    v3 dp = v3_sub(pT, p);
+    m3 Rt = sm_tr(R), E = sm_mul(RT, &Rt);
+    double vx = 0.5 * (E.r2.y - E.r1.z), vy = 0.5 * (E.r0.z - E.r2.x),
+           vz = 0.5 * (E.r1.x - E.r0.y);
+    double s = sqrt(vx * vx + vy * vy + vz * vz), c = 0.5 * (E.r0.x + E.r1.y + E.r2.z - 1.0);
+    double fct = s > 0.0 ? atan2(s, c) / s : 1.0;
+    e[0] = dp.x;
+    e[1] = dp.y;
+    e[2] = dp.z;
+    e[3] = fct * vx;
+    e[4] = fct * vy;
+    e[5] = fct * vz;
+    return fmax(sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]),
+                sqrt(e[3] * e[3] + e[4] * e[4] + e[5] * e[5]));
+}
+
+/* The minimum-norm step dq (7) = pinv(J) e for J (6 x 7), as numpy's pinv:
+ * one-sided Jacobi on the columns of A = J^T (7 x 6) gives A V = B with orthogonal
+ * columns b_i (sigma_i = |b_i|), so pinv(J) e = sum_i b_i (v_i . e) / sigma_i^2
+ * over sigma_i > 1e-15 sigma_max */
+static void sm_pinv_step(double J[6][7], const double *e, double *dq)
+{
+    double B[6][7], V[6][6];
+    for (int i = 0; i < 6; i++) {
+        for (int k = 0; k < 7; k++)
+            B[i][k] = J[i][k];
+        for (int l = 0; l < 6; l++)
+            V[i][l] = i == l;
+    }
+    for (int sweep = 0; sweep < 30; sweep++) {
+        double off = 0.0;
+        for (int i = 0; i < 5; i++)
+            for (int l = i + 1; l < 6; l++) {
+                double al = 0.0, be = 0.0, ga = 0.0;
+                for (int k = 0; k < 7; k++) {
+                    al += B[i][k] * B[i][k];
+                    be += B[l][k] * B[l][k];
+                    ga += B[i][k] * B[l][k];
+                }
+                if (!(fabs(ga) > 1e-300) || fabs(ga) <= 1e-17 * sqrt(al * be))
+                    continue;
+                off = fmax(off, fabs(ga) / sqrt(al * be));
+                double zeta = (be - al) / (2.0 * ga);
+                double t = copysign(1.0, zeta) / (fabs(zeta) + sqrt(1.0 + zeta * zeta));
+                double c = 1.0 / sqrt(1.0 + t * t), s = c * t;
+                for (int k = 0; k < 7; k++) {
+                    double x = B[i][k], y = B[l][k];
+                    B[i][k] = c * x - s * y;
+                    B[l][k] = s * x + c * y;
+                }
+                for (int k = 0; k < 6; k++) {
+                    double x = V[i][k], y = V[l][k];
+                    V[i][k] = c * x - s * y;
+                    V[l][k] = s * x + c * y;
+                }
+            }
+        if (off <= 1e-17)
+            break;
+    }
+    double sig2[6], smax = 0.0;
+    for (int i = 0; i < 6; i++) {
+        sig2[i] = 0.0;
+        for (int k = 0; k < 7; k++)
+            sig2[i] += B[i][k] * B[i][k];
+        smax = fmax(smax, sig2[i]);
+    }
+    for (int k = 0; k < 7; k++)
+        dq[k] = 0.0;
+    for (int i = 0; i < 6; i++) {
+        if (!(sig2[i] > 1e-30 * smax))
+            continue;
+        double ve = 0.0;
+        for (int l = 0; l < 6; l++)
+            ve += V[i][l] * e[l];
+        for (int k = 0; k < 7; k++)
+            dq[k] += B[i][k] * ve / sig2[i];
+    }
+}
+
+/* A row q (7) of pose (RT, pT): up to 3 minimum-norm Gauss-Newton steps where its
+ * error exceeds SM_EXACT, each kept where it lowers the error (swivel.py's
+ * _polish); returns 0 (row dropped) when it stays above SM_ACCEPT. */
+static int sm_polish(const SmArm *a, const m3 *RT, v3 pT, double *q)
+{
+    double v[7], e[6];
+    m3 R;
+    v3 p, hw[7], ow[7];
+    for (int k = 0; k < 7; k++)
+        v[k] = a->sign[k] * q[k] + a->offset[k];
+    sm_fk(a, v, &R, &p, hw, ow);
+    double err = sm_error(RT, pT, &R, p, e);
+    for (int it = 0; it < 3 && err > SM_EXACT; it++) {
+        double J[6][7], dq[7], vt[7], et[6], qt[7];
+        for (int k = 0; k < 7; k++) {
+            v3 lin = v3_cross(hw[k], v3_sub(p, ow[k]));
+            double s = a->sign[k];
+            J[0][k] = s * lin.x;
+            J[1][k] = s * lin.y;
+            J[2][k] = s * lin.z;
+            J[3][k] = s * hw[k].x;
+            J[4][k] = s * hw[k].y;
+            J[5][k] = s * hw[k].z;
+        }
+        sm_pinv_step(J, e, dq);
+        for (int k = 0; k < 7; k++) {
+            qt[k] = q[k] + dq[k];
+            vt[k] = a->sign[k] * qt[k] + a->offset[k];
+        }
+        m3 Rt;
+        v3 pt, hwt[7], owt[7];
+        sm_fk(a, vt, &Rt, &pt, hwt, owt);
+        double et_size = sm_error(RT, pT, &Rt, pt, et);
+        if (!(et_size < err))
+            break;
+        err = et_size;
+        for (int k = 0; k < 7; k++) {
+            q[k] = qt[k];
+            hw[k] = hwt[k];
+            ow[k] = owt[k];
+        }
+        for (int i = 0; i < 6; i++)
+            e[i] = et[i];
+        p = pt;
+    }
+    return err <= SM_ACCEPT;
+}
+
+/* ------------------------------------------------------------ rows */
+
+typedef struct {
+    const double *P, *T, *psi;
+    long m;
+    double *Q;
+    npy_bool *valid, *sing;
+} SmRowsJob;
+
+static void sm_rows_range(void *arg, long i0, long i1)
+{
+    const SmRowsJob *jb = (const SmRowsJob *)arg;
+    SmArm a;
+    sm_arm(jb->P, &a);
+    for (long i = i0; i < i1; i++) {
+        const double *T = jb->T + 16 * i;
+        SmFrame f;
+        sm_frame(&a, T, &f);
+        m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
+        v3 pT = {T[3], T[7], T[11]};
+        for (long k = 0; k < jb->m; k++) {
+            long row = i * jb->m + k;
+            double *Q = jb->Q + 56 * row;
+            npy_bool *ok = jb->valid + 8 * row, *sg = jb->sing + 8 * row;
+            for (int e = 0; e < 2; e++) {
+                double q[4][7];
+                int okk[4], sing[4];
+                sm_configs(&a, &f, e, jb->psi[row], q, okk, sing);
+                for (int b = 0; b < 4; b++) {
+                    int slot = 4 * e + b;
+                    int good = okk[b] && sm_polish(&a, &RT, pT, q[b]);
+                    for (int j = 0; j < 7; j++)
+                        Q[7 * slot + j] = good ? q[b][j] : NAN;
+                    ok[slot] = (npy_bool)good;
+                    sg[slot] = (npy_bool)sing[b];
+                }
+            }
+        }
+    }
+}
+
+static PyObject *swivel_rows_body(const swivel_rows_args *a)
+{
+    SmRowsJob jb = {a->params, a->T, a->psi, (long)a->m, a->Q, a->valid, a->sing};
+    Py_BEGIN_ALLOW_THREADS
+    if (a->N * a->m >= SM_PARALLEL_MIN * 16 && a->N > 1)
+        pool_for((long)a->N, SM_GRAIN, sm_rows_range, &jb);
+    else
+        sm_rows_range(&jb, 0, (long)a->N);
+    Py_END_ALLOW_THREADS
+    Py_RETURN_NONE;
+}
+
+/* ------------------------------------------------------------ the manifold */
+
+typedef struct {
+    double psi;
+    int joint, kind;
+    double value; /* the joint coordinate (limits) or chain angle (aligned / fold) */
+} SmCand;
+
+/* Swivel angles (up to 2) where joint j (0-2, 4-6) is at chain angle L on elbow
+ * root e (swivel.py limit_swivels), each Newton-polished on its subproblem 4 */
+static int sm_limit_psi(const SmArm *a, const SmFrame *f, int e, int j, double L, double *psi)
+{
+    const v3 *h = a->h;
+    v3 x, y;
+    double k, sgn;
+    if (j < 3) {
+        v3 ha = h[0], hb = h[1], hc = h[2];
+        const m3 *R0 = &f->R0[e];
+        if (j == 0) {
+            m3 Ra = sm_rotm(ha, L);
+            x = m3_mv(&Ra, hb);
+            y = m3_mv(R0, hc);
+            k = v3_dot(hb, hc);
+        } else if (j == 1) {
+            m3 Rb = sm_rotm(hb, L);
+            x = ha;
+            y = m3_mv(R0, hc);
+            k = v3_dot(ha, m3_mv(&Rb, hc));
+        } else {
+            m3 Rc = sm_rotm(hc, -L);
+            x = ha;
+            y = m3_mv(R0, m3_mv(&Rc, hb));
+            k = v3_dot(ha, hb);
+        }
+        sgn = 1.0;
+    } else {
+        v3 ha = h[4], hb = h[5], hc = h[6];
+        m3 R4 = sm_rotm(h[3], f->v4[e]), base = sm_mul(&f->R0[e], &R4);
+        if (j == 4) {
+            m3 Ra = sm_rotm(ha, L);
+            x = m3_mv(&base, m3_mv(&Ra, hb));
+            y = m3_mv(&f->TR, hc);
+            k = v3_dot(hb, hc);
+        } else if (j == 5) {
+            m3 Rb = sm_rotm(hb, L);
+            x = m3_mv(&base, ha);
+            y = m3_mv(&f->TR, hc);
+            k = v3_dot(ha, m3_mv(&Rb, hc));
+        } else {
+            m3 Rc = sm_rotm(hc, -L);
+            x = m3_mv(&base, ha);
+            y = m3_mv(&f->TR, m3_mv(&Rc, hb));
+            k = v3_dot(ha, hb);
+        }
+        sgn = -1.0;
+    }
+    double t[2], A, B, C;
+    if (!sm_sp4(f->u, x, y, k, &t[0], &t[1], &A, &B, &C))
+        return 0;
+    int n = 0;
+    for (int i = 0; i < 2; i++) {
+        double phi = t[i], g = A * cos(phi) + B * sin(phi) - C;
+        for (int it = 0; it < 3; it++) { /* Newton on A cos + B sin = C */
+            double d = -A * sin(phi) + B * cos(phi);
+            if (!(fabs(d) > 1e-8 * hypot(A, B)) || g == 0.0)
+                break;
+            double p2 = phi - g / d, g2 = A * cos(p2) + B * sin(p2) - C;
+            if (!(fabs(g2) < fabs(g)))
+                break;
+            phi = p2;
+            g = g2;
+        }
+        if (i == 1 && t[0] == t[1])
+            break; /* a double root once */
+        psi[n++] = wrap_pi(sgn * phi + f->psi0[e]);
+    }
+    return n;
+}
+
+/* The candidates of elbow root e: every joint at each finite limit, and each
+ * triple's middle angle at an end of its range (outer axes in line, or a fold) */
+static int sm_candidates(const SmArm *a, const SmFrame *f, int e, SmCand *c)
+{
+    int n = 0;
+    double psi[2];
+    for (int j = 0; j < 7; j++) {
+        if (j == 3 || a->hi[j] - a->lo[j] >= 2.0 * M_PI)
+            continue;
+        for (int s = 0; s < 2; s++) {
+            double lim = s ? a->hi[j] : a->lo[j];
+            int m = sm_limit_psi(a, f, e, j, a->sign[j] * lim + a->offset[j], psi);
+            for (int i = 0; i < m; i++)
+                c[n++] = (SmCand){psi[i], j, s ? SM_KIND_UPPER : SM_KIND_LOWER, lim};
+        }
+    }
+    for (int t = 0; t < 2; t++) {
+        int o = 4 * t;
+        v3 ha = a->h[o], hb = a->h[o + 1], hc = a->h[o + 2];
+        v3 hp = v3_sub(hc, v3_scale(hb, v3_dot(hb, hc)));
+        double A = v3_dot(ha, hp), B = v3_dot(ha, v3_cross(hb, hp));
+        double base = atan2(B, A); /* ha . rot(hb, v) hc is extremal at base, base + pi */
+        for (int s = 0; s < 2; s++) {
+            double L = base + s * M_PI;
+            m3 Rb = sm_rotm(hb, L);
+            double al = fabs(v3_dot(ha, m3_mv(&Rb, hc)));
+            int kind = al > 1.0 - 1e-12 ? SM_KIND_ALIGNED : SM_KIND_FOLD;
+            int m = sm_limit_psi(a, f, e, o + 1, L, psi);
+            for (int i = 0; i < m; i++)
+                c[n++] = (SmCand){psi[i], o + 1, kind, L};
+        }
+    }
+    return n;
+}
+
+static int sm_cmp(const void *x, const void *y)
+{
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+static int sm_inside(const SmArm *a, const double *q)
+{
+    for (int j = 0; j < 7; j++)
+        if (!(q[j] >= a->lo[j] && q[j] <= a->hi[j]))
+            return 0;
+    return 1;
+}
+
+typedef struct {
+    const double *P, *T;
+    double *iv, *pts;
+    long long *niv, *npts;
+} SmManJob;
+
+/* One pose: intervals (8, SM_MAXI, 2) with counts (8), points (SM_MAXP, 4) */
+static void sm_manifold1(const SmArm *a, const double *T, double *iv, long long *niv,
+                         double *pts, long long *npts)
+{
+    SmFrame f;
+    sm_frame(a, T, &f);
+    *npts = 0;
+    for (int b = 0; b < 8; b++)
+        niv[b] = 0;
+    if (!f.elbow_real)
+        return;
+    for (int e = 0; e < 2; e++) {
+        SmCand c[64];
+        int nc = sm_candidates(a, &f, e, c);
+        double cut[66];
+        int m = 0;
+        cut[m++] = -M_PI;
+        cut[m++] = M_PI;
+        for (int i = 0; i < nc; i++)
+            cut[m++] = c[i].psi;
+        qsort(cut, (size_t)m, sizeof(double), sm_cmp);
+        /* the points: which branches are at the value there */
+        for (int i = 0; i < nc; i++) {
+            double q[4][7];
+            int ok[4], sg[4];
+            sm_configs_part(a, &f, e, c[i].psi, c[i].joint < 3 ? 1 : 2, q, ok, sg);
+            for (int b = 0; b < 4; b++) {
+                if (!ok[b] || *npts >= SM_MAXP)
+                    continue;
+                double d = c[i].kind <= SM_KIND_UPPER
+                    ? q[b][c[i].joint] - c[i].value
+                    : a->sign[c[i].joint] * q[b][c[i].joint] + a->offset[c[i].joint] - c[i].value;
+                if (fabs(wrap_pi(d)) < SM_SAME) {
+                    double *r = pts + 4 * (*npts)++;
+                    r[0] = c[i].psi;
+                    r[1] = 4 * e + b;
+                    r[2] = c[i].joint;
+                    r[3] = c[i].kind;
+                }
+            }
+        }
+        /* the cells: each branch's state at the midpoint, runs merged */
+        int open[4] = {0, 0, 0, 0};
+        for (int i = 0; i + 1 < m; i++) {
+            double lo = cut[i], hi = cut[i + 1];
+            if (!(hi > lo))
+                continue;
+            double q[4][7];
+            int ok[4], sg[4];
+            sm_configs(a, &f, e, 0.5 * (lo + hi), q, ok, sg);
+            for (int b = 0; b < 4; b++) {
+                int slot = 4 * e + b, in = ok[b] && sm_inside(a, q[b]);
+                double *r = iv + 2 * (SM_MAXI * slot + niv[slot]);
+                if (in && open[b]) {
+                    r[-1] = hi; /* extends the open interval */
+                } else if (in && niv[slot] < SM_MAXI) {
+                    r[0] = lo;
+                    r[1] = hi;
+                    niv[slot]++;
+                }
+                open[b] = in;
+            }
+        }
+        /* periodic: a run ending at pi and one starting at -pi join */
+        for (int b = 0; b < 4; b++) {
+            int slot = 4 * e + b;
+            long long k = niv[slot];
+            double *r = iv + 2 * SM_MAXI * slot;
+            if (k >= 2 && r[0] == -M_PI && r[2 * k - 1] == M_PI) {
+                double end = r[1] + 2.0 * M_PI, start = r[2 * k - 2];
+                for (long long i = 0; i + 1 < k; i++) {
+                    r[2 * i] = r[2 * i + 2];
+                    r[2 * i + 1] = r[2 * i + 3];
+                }
+                r[2 * k - 4] = start;
+                r[2 * k - 3] = end;
+                niv[slot] = k - 1;
+            }
+        }
+    }
+}
+
+static void sm_manifold_range(void *arg, long i0, long i1)
+{
+    const SmManJob *jb = (const SmManJob *)arg;
+    SmArm a;
+    sm_arm(jb->P, &a);
+    for (long i = i0; i < i1; i++)
+        sm_manifold1(&a, jb->T + 16 * i, jb->iv + 16 * SM_MAXI * i, jb->niv + 8 * i,
+                     jb->pts + 4 * SM_MAXP * i, jb->npts + i);
+}
+
+static PyObject *swivel_manifold_body(const swivel_manifold_args *a)
+{
+    SmManJob jb = {a->params, a->T, a->iv, a->pts, a->niv, a->npts};
+    Py_BEGIN_ALLOW_THREADS
+    if (a->N >= SM_PARALLEL_MIN)
+        pool_for((long)a->N, SM_GRAIN, sm_manifold_range, &jb);
+    else
+        sm_manifold_range(&jb, 0, (long)a->N);
+    Py_END_ALLOW_THREADS
+    Py_RETURN_NONE;
+}

@@ -1,0 +1,429 @@
+"""The branches of one pose's self-motion: the swivel, held-joint and continued families.
+
+Each family gives ``rows(t)`` (every branch at parameter values t) and the exact
+parameter values where a joint equals a value (``points``), for
+:mod:`~robokin.kinematics.ik.self_motion` (the module docstring there says how they
+are used). The SRS swivel's rows and intervals are compiled (``csrc/self_motion.c``;
+``reference=True`` keeps its numpy twin).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from robokin._native import kernels as K
+from robokin.exceptions import InputError
+from robokin.kinematics.arm import Arm
+from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
+from robokin.kinematics.ik.swivel import SwivelArm, swivel_arm
+from robokin.spatial import wrap_angle as _wrap
+
+#: Rows of a slot at the same point are the same configuration within this [rad].
+_SAME = 1e-6
+_TWO_PI = 2 * np.pi
+#: Largest joint step [rad] between paired rows of a continued branch.
+_JUMP = 0.3
+#: Step halvings of the continuation.
+_REFINE = 4
+
+
+@dataclass(frozen=True)
+class LimitCrossing:
+    """A branch meeting a joint limit: ``joint`` (0-based) at ``limit`` ("lower"/"upper")."""
+
+    t: float
+    branch: int
+    joint: int
+    limit: str
+
+
+@dataclass(frozen=True)
+class SingularPoint:
+    """A singular point of a branch: ``kind`` "fold" or "aligned axes"."""
+
+    t: float
+    branch: int
+    kind: str
+
+
+class _Family:
+    """Branches of one pose: ``rows(t)`` and the exact points where a joint is at a value."""
+
+    k = 8
+    periodic = False
+    domain: tuple[float, float]
+    name: str
+    joint: int | None
+
+    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Q (m, k, n) (NaN where a branch has no point), valid (m, k), singular (m, k)."""
+        raise NotImplementedError
+
+    def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
+        """Parameter values where joint j may equal ``value`` (with the configuration)."""
+        raise NotImplementedError
+
+    def param_of(self, q: np.ndarray) -> float:
+        """The parameter value of a configuration q (n,) (of this pose or near it)."""
+        assert self.joint is not None
+        return float(q[self.joint])
+
+    def points(self, queries: list[tuple[int, float]]) -> list[list[tuple[float, int]]]:
+        """Per query (joint j, value): every (t, branch) where joint j equals value.
+
+        The candidates of every query are evaluated in one batch; a branch takes a
+        candidate when its joint j is at the value there (and its configuration is
+        the candidate's, when the candidate has one).
+        """
+        cands = [self.candidates(j, v) for j, v in queries]
+        ts = np.array([t for c in cands for t, _ in c], dtype=np.float64)
+        out: list[list[tuple[float, int]]] = [[] for _ in queries]
+        if not ts.size:
+            return out
+        q, valid, _ = self.rows(ts)
+        i = 0
+        for (j, value), cand, res in zip(queries, cands, out, strict=True):
+            for t, row in cand:
+                ok = valid[i].copy()
+                d = np.full(len(ok), np.inf)
+                d[ok] = (np.abs(_wrap(q[i, ok, j] - value)) if row is None
+                         else np.abs(_wrap(q[i, ok] - row)).max(-1))
+                # a shoulder joint is shared by both wrist roots (and vice versa)
+                res += [(t, int(b)) for b in np.flatnonzero(d < _SAME)]
+                i += 1
+        return out
+
+
+class _SwivelFamily(_Family):
+    periodic = True
+    domain = (-np.pi, np.pi)
+    name = "swivel"
+    joint = None
+
+    def __init__(self, arm: SwivelArm, T: np.ndarray, robot: Arm, reference: bool = False
+                 ) -> None:
+        self.arm = arm
+        self.T = np.ascontiguousarray(T, dtype=np.float64)
+        self.robot = robot
+        self.reference = reference
+        self._fr: dict[str, Any] | None = None
+
+    @property
+    def fr(self) -> dict[str, Any]:
+        """The numpy twin's per-pose constants (built when first needed)."""
+        if self._fr is None:
+            self._fr = self.arm.frame(self.T)
+        return self._fr
+
+    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        if self.reference:  # the numpy twin (the tests' reference)
+            q, real, sing = self.arm.configurations(self.fr, t)
+            q, ok = _polish(self.robot, q, real, self.T)
+            return q, ok, sing
+        t = np.atleast_1d(np.asarray(t, dtype=np.float64))
+        Q, valid, sing = self.arm.rows(self.T[None], t[None])
+        return Q[0], valid[0], sing[0]
+
+    def exact(self) -> tuple[np.ndarray, np.ndarray, tuple[LimitCrossing, ...],
+                             tuple[SingularPoint, ...]]:
+        """The compiled intervals, owners, limit crossings and singular points."""
+        iv, niv, pts, npts = self.arm.manifold(self.T[None])
+        intervals = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
+        owner = np.repeat(np.arange(8), niv[0])
+        p = pts[0, :npts[0]]
+        limit = p[:, 3] <= K.SM_KIND_UPPER
+        names = ("lower", "upper", "aligned axes", "fold")  # SM_KIND_* 0-3
+        cross = tuple(LimitCrossing(t, int(b), int(j), names[int(k)])
+                      for t, b, j, k in p[limit].tolist())
+        sing = tuple(SingularPoint(t, int(b), names[int(k)]) for t, b, _, k in p[~limit].tolist())
+        return intervals, owner, cross, sing
+
+    def param_of(self, q: np.ndarray) -> float:
+        return float(self.arm.swivel_of(self.fr, q))
+
+    def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
+        if j == 3:
+            return []  # the elbow does not move with the swivel
+        return [(psi, None) for psi, _ in self.arm.limit_swivels(self.fr, j, value)]
+
+
+class _JointFamily(_Family):
+    """A family over a held joint: its candidates are the pose solved with j held."""
+
+    robot: Arm
+    dispatch: Dispatch
+    T: np.ndarray
+    joint: int
+
+    def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
+        sols = solve_fixed(self.robot, self.T, {self.robot.joint_names[j]: value},
+                           dispatch=self.dispatch)
+        if "swivel" in str(sols.info.get("measured", "")) and j == 3:
+            return []  # the SRS elbow held: a family, constant on the manifold
+        out: list[tuple[float, np.ndarray | None]] = []
+        for row in sols.q[sols.valid]:
+            t = _shift_into(float(row[self.joint]), self.domain)
+            if t is not None:
+                out.append((t, row))
+        return out
+
+
+class _HeldFamily(_JointFamily):
+    def __init__(self, robot: Arm, params: np.ndarray, j: int, T: np.ndarray,
+                 dispatch: Dispatch) -> None:
+        self.robot = robot
+        self.dispatch = dispatch
+        self.params = params
+        self.joint = j
+        self.name = robot.joint_names[j]
+        lo, hi = (float(x) for x in robot.limits[j])
+        self.domain = (lo, hi)
+        self.T = T
+
+    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        from robokin.kinematics.ik.analytic import pieper as pk
+
+        t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
+        Tb = np.ascontiguousarray(np.broadcast_to(self.T, (len(t), 4, 4)))
+        Q, valid, sing, _, _ = pk.raw_solve(self.params, Tb, t)
+        Q = Q.copy()
+        Q[~valid] = np.nan
+        return _into_limits(self.robot, Q), valid, sing
+
+
+
+class _ContinuedFamily(_JointFamily):
+    """Any 7R arm, a joint held by the general held-joint 6R solver, branches continued.
+
+    The pose is solved at ``nodes`` held values (one batch); consecutive values'
+    rows are paired by nearest distance (2 pi wrapped), and where a pairing is
+    ambiguous (the second-nearest within twice the nearest) or a step jumps more
+    than ``_JUMP`` the step is halved (a midpoint solved) up to ``_REFINE`` times.
+    Paired rows form tracks (the branches); a row with no partner starts a track.
+    ``rows(t)`` solves at t and gives each track the row nearest its value there
+    (interpolated between its nodes).
+    """
+
+    def __init__(self, robot: Arm, j: int, T: np.ndarray, dispatch: Dispatch,
+                 nodes: int = 181) -> None:
+        self.robot = robot
+        self.dispatch = dispatch
+        self.joint = j
+        self.name = robot.joint_names[j]
+        self.domain = (float(robot.limits[j, 0]), float(robot.limits[j, 1]))
+        self.T = T
+        t = np.linspace(*self.domain, nodes)
+        Q = self._solve(t)
+        for _ in range(_REFINE):
+            bad = [i for i in range(len(t) - 1) if not _clean_step(Q[i], Q[i + 1])]
+            if not bad:
+                break
+            mid = 0.5 * (t[bad] + t[np.array(bad) + 1])
+            t = np.concatenate([t, mid])
+            Q = np.concatenate([Q, self._solve(mid)])
+            order = np.argsort(t)
+            t, Q = t[order], Q[order]
+        self.t_nodes = t
+        self.tracks = _link(Q)  # (m, k, n)
+        self.k = self.tracks.shape[1]
+
+    def _solve(self, t: np.ndarray) -> np.ndarray:
+        sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
+        Q = np.where(sols.valid[..., None], sols.q, np.nan)
+        return _into_limits(self.robot, Q)
+
+    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        t = np.atleast_1d(np.asarray(t, dtype=np.float64))
+        Q = self._solve(t)  # (m, K, n)
+        ref = self._interpolated(t)  # (m, k, n)
+        out = np.full(ref.shape, np.nan)
+        for i in range(len(t)):
+            d = _dist(ref[i][:, None], Q[i][None])  # (k, K)
+            d[~np.isfinite(d)] = np.inf
+            while np.isfinite(d).any():
+                b, r = np.unravel_index(int(np.argmin(d)), d.shape)
+                if d[b, r] > _JUMP:
+                    break
+                out[i, b] = Q[i, r]
+                d[b, :] = np.inf
+                d[:, r] = np.inf
+        valid = np.isfinite(out).all(-1)
+        return out, valid, np.zeros_like(valid)
+
+    def _interpolated(self, t: np.ndarray) -> np.ndarray:
+        """Each track's value at t (m, k, n): linear between its nodes (NaN off it)."""
+        tn, X = self.t_nodes, self.tracks
+        i = np.clip(np.searchsorted(tn, t) - 1, 0, len(tn) - 2)
+        w = ((t - tn[i]) / (tn[i + 1] - tn[i]))[:, None, None]
+        a, b = X[i], X[i + 1]
+        mid = a + w * _wrap(b - a)
+        near = np.where(w < 0.5, a, b)
+        return np.where(np.isfinite(mid), mid, near)
+
+
+def _dist(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Largest 2 pi wrapped joint difference of rows a and b (broadcast, NaN -> NaN)."""
+    out: np.ndarray = np.abs(_wrap(a - b)).max(-1)
+    return out
+
+
+def _clean_step(A: np.ndarray, B: np.ndarray) -> bool:
+    """True when every row of A pairs with one of B unambiguously and within _JUMP."""
+    a, b = A[np.isfinite(A).all(-1)], B[np.isfinite(B).all(-1)]
+    if len(a) != len(b):
+        return False
+    if not len(a):
+        return True
+    d = np.sort(_dist(a[:, None], b[None]), axis=1)
+    if d[:, 0].max() > _JUMP:
+        return False
+    return bool(len(b) < 2 or np.all(d[:, 1] > 2 * d[:, 0]))
+
+
+def _link(Q: np.ndarray) -> np.ndarray:
+    """Tracks (m, k, n) from rows per node (m, K, n): nearest pairing node to node."""
+    m, K, n = Q.shape
+    tracks: list[np.ndarray] = []
+    last: list[int] = []  # per track: its row at the previous node, or -1
+    for i in range(m):
+        now = [-1] * len(tracks)
+        rows = [r for r in range(K) if np.isfinite(Q[i, r]).all()]
+        prev = [(tr, last[tr]) for tr in range(len(tracks)) if last[tr] >= 0]
+        if prev and rows:
+            d = np.array([[float(_dist(Q[i - 1, pr], Q[i, r])) for r in rows] for _, pr in prev])
+            while np.isfinite(d).any():
+                a, c = np.unravel_index(int(np.argmin(d)), d.shape)
+                if d[a, c] > _JUMP:
+                    break
+                now[prev[a][0]] = rows[c]
+                tracks[prev[a][0]][i] = Q[i, rows[c]]
+                d[a, :] = np.inf
+                d[:, c] = np.inf
+        for r in rows:
+            if r not in now:
+                tr = np.full((m, n), np.nan)
+                tr[i] = Q[i, r]
+                tracks.append(tr)
+                now.append(r)
+        last = now
+    if not tracks:
+        return np.full((m, 1, n), np.nan)
+    return np.stack(tracks, axis=1)
+
+
+def _shift_into(t: float, domain: tuple[float, float]) -> float | None:
+    """T shifted by whole turns into the closed domain, or None."""
+    lo, hi = domain
+    for s in (0.0, _TWO_PI, -_TWO_PI):
+        if lo - 1e-12 <= t + s <= hi + 1e-12:
+            return min(max(t + s, lo), hi)
+    return None
+
+
+def _into_limits(robot: Arm, q: np.ndarray) -> np.ndarray:
+    """Revolute angles shifted by 2 pi into the limits where that fits."""
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    rev = np.asarray(robot.is_revolute, bool)
+    up = rev & (q < lo) & (q + _TWO_PI <= hi)
+    down = rev & (q > hi) & (q - _TWO_PI >= lo)
+    out: np.ndarray = q + _TWO_PI * up - _TWO_PI * down
+    return out
+
+
+def _polish(robot: Arm, q: np.ndarray, real: np.ndarray, T: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """Rows whose pose error exceeds 1e-13 get minimum-norm Gauss-Newton steps.
+
+    The error is the larger of the position [m] and rotation [rad] norms. A step
+    is kept only where it lowers it; rows still above 5e-13 (next to a singular
+    point of the closed form) are dropped (NaN, not valid).
+    """
+    from robokin.kinematics.forward import forward_kinematics
+    from robokin.kinematics.jacobian import jacobian_and_pose
+    from robokin.spatial import pose_error
+
+    ok = real.copy()
+    rows = np.flatnonzero(ok.reshape(-1))
+    if not rows.size:
+        return q, ok
+    flat = q.reshape(-1, q.shape[-1])
+    e = pose_error(forward_kinematics(robot.chain, flat[rows]), T)
+    for _ in range(3):
+        bad = _size(e) > 1e-13
+        if not bad.any():
+            break
+        rows, e = rows[bad], e[bad]
+        J, _ = jacobian_and_pose(robot.chain, flat[rows])
+        trial = flat[rows] + np.einsum("mij,mj->mi", np.linalg.pinv(J), e)
+        et = pose_error(forward_kinematics(robot.chain, trial), T)
+        better = _size(et) < _size(e)
+        flat[rows[better]] = trial[better]
+        e = np.where(better[:, None], et, e)
+    lost = rows[_size(e) > 5e-13]
+    flat[lost] = np.nan
+    ok.reshape(-1)[lost] = False
+    return flat.reshape(q.shape), ok
+
+
+def _size(e: np.ndarray) -> np.ndarray:
+    """The larger of the position and rotation norms of pose errors (..., 6)."""
+    out: np.ndarray = np.maximum(np.linalg.norm(e[..., :3], axis=-1), np.linalg.norm(e[..., 3:], axis=-1))
+    return out
+
+
+@dataclass(slots=True, eq=False)
+class SelfMotionSetup:
+    """What the self-motion of a 7R arm needs per chain (kept in ``Arm.self_motion``).
+
+    Attributes:
+        swivel: The SRS arm's swivel closed form, or None (not SRS).
+        parameter: ``auto_parameter``'s answer once ``parameter_known``.
+        parameter_known: True once ``parameter`` is set.
+        aligned: ``_aligned_values``' (joint, value) pairs, or None until needed.
+    """
+
+    swivel: SwivelArm | None
+    parameter: str | None = None
+    parameter_known: bool = False
+    aligned: list[tuple[int, float]] | None = None
+
+
+def _setup(arm: Arm) -> SelfMotionSetup:
+    """The arm's :class:`SelfMotionSetup`, built on first use (a 7-joint chain)."""
+    setup = arm.self_motion
+    if not isinstance(setup, SelfMotionSetup):
+        setup = arm.self_motion = SelfMotionSetup(swivel_arm(arm.chain))
+    return setup
+
+
+# ------------------------------------------------------------------ choosing one
+def _family(robot: Arm, T: np.ndarray, parameter: str, dispatch: Dispatch,
+            reference: bool = False) -> _Family:
+    names = list(robot.joint_names)
+    choices = ["auto", "swivel", *names]
+    if robot.n != 7 or robot.chain.n_chain != 7 or not robot.chain.coupling.is_identity:
+        raise InputError("robot", f"self_motion needs a 7-joint serial arm without "
+                                  f"coupled joints; {robot.name!r} has {robot.n} joints")
+    if parameter not in choices:
+        raise InputError("parameter", f"expected one of {', '.join(map(repr, choices))}, "
+                                      f"got {parameter!r}")
+    arm = _setup(robot).swivel
+    if parameter in ("auto", "swivel") and arm is not None:
+        return _SwivelFamily(arm, T, robot, reference)
+    if parameter == "swivel":
+        raise InputError("parameter", f"{robot.name!r} is not an SRS arm (axes 1-3 and "
+                                      f"5-7 must meet): give a joint name or 'auto'")
+    from robokin.kinematics.ik.fixed import _held_solvers
+
+    held = {n: h for n, h in _held_solvers(robot).items()
+            if not (arm is not None and n == names[3])}  # the SRS elbow: a family
+    if parameter == "auto":
+        usable = [n for n in names if n in held and n != names[3]]  # not the elbow
+        # (auto_parameter says why)
+        parameter = usable[-1] if usable else names[-1]
+    if parameter not in held:  # the general held-joint 6R solver, continued
+        return _ContinuedFamily(robot, names.index(parameter), T, dispatch)
+    return _HeldFamily(robot, held[parameter].params, names.index(parameter), T, dispatch)

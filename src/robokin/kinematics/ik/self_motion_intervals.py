@@ -1,0 +1,195 @@
+"""The in-limit intervals of a self-motion family: exact points, grid check, bisection.
+
+The limits of each joint are exact points of the family (``_Family.points``); the
+intervals lie between them and are decided at their midpoints; a checking grid and
+bisection catch what the exact points miss (the module docstring of
+:mod:`~robokin.kinematics.ik.self_motion`). The compiled SRS swivel needs none of
+this (``_SwivelFamily.exact``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from robokin.kinematics.arm import Arm
+from robokin.kinematics.ik.self_motion_families import _Family, _setup
+from robokin.spatial import wrap_angle as _wrap
+
+#: Parameter values on the checking grid.
+GRID = 721
+#: Bisection steps (a 2 pi domain to 2**-52 of its width).
+_BISECT = 56
+_TWO_PI = 2 * np.pi
+#: At most this many grid changes without an exact point are bisected (a pose on a
+#: singular manifold, e.g. the SRS arm stretched with its wrist in line, has many).
+_MAX_BISECT = 64
+
+
+def _exact_points(robot: Arm, fam: _Family, limits: np.ndarray) -> dict[str, list[Any]]:
+    """Every limit point and aligned-axes point of every branch, exactly."""
+    out: dict[str, list[Any]] = {"limit": [], "fold": [], "aligned": []}
+    rev = np.asarray(robot.is_revolute, bool)
+    queries: list[tuple[int, float]] = []
+    tags: list[tuple[str, Any]] = []
+    for j in range(robot.n):
+        lo, hi = limits[j]
+        if j == fam.joint or (rev[j] and hi - lo >= _TWO_PI):
+            continue  # the parameter, or every angle has an in-limit turn
+        queries += [(j, float(lo)), (j, float(hi))]
+        tags += [("limit", "lower"), ("limit", "upper")]
+    for j, value in _aligned_values(robot):
+        if j != fam.joint:
+            queries.append((j, value))
+            tags.append(("aligned", "aligned axes"))
+    for (j, _), (kind, text), found in zip(queries, tags, fam.points(queries), strict=True):
+        if kind == "limit":
+            out["limit"] += [(t, b, j, text) for t, b in found]
+        else:
+            out["aligned"] += [(t, b, text) for t, b in found]
+    return out
+
+
+def _aligned_values(robot: Arm) -> list[tuple[int, float]]:
+    """(joint, value): where axes j-1 and j+1 of a meeting triple line up."""
+    setup = _setup(robot)
+    if setup.aligned is None:
+        setup.aligned = _find_aligned(robot)
+    return setup.aligned
+
+
+def _find_aligned(robot: Arm) -> list[tuple[int, float]]:
+    from robokin.kinematics.ik.analytic._geometry import poe_from_chain
+    from robokin.kinematics.ik.swivel import _sp4
+
+    poe = poe_from_chain(robot.chain)
+    sign, offset = robot.chain.arrays.sign, robot.chain.arrays.offset
+    found = []
+    for j in range(1, robot.chain.n_chain - 1):
+        a, h, b = poe.h[j - 1], poe.h[j], poe.h[j + 1]
+        for c in (1.0, -1.0):
+            tp, tm, real = _sp4(h, a, b, np.array(c))
+            if bool(real) and abs(float(tp) - float(tm)) < 1e-6:
+                v = float((tp + tm) / 2)
+                found.append((j, float(_wrap((v - offset[j]) * sign[j]))))
+    return found
+
+
+def _grid(fam: _Family, m: int, marks: dict[str, list[Any]]) -> np.ndarray:
+    """The checking grid: m values over the range, refined next to aligned points.
+
+    Next to a point where a triple lines up a branch's outer angles swing by up to
+    pi over a tiny parameter range, where the held-joint solver can miss a limit
+    crossing: values at 10^-k (k = 1..12) either side catch those for bisection.
+    """
+    lo, hi = fam.domain
+    t = [np.linspace(lo, hi, m)]
+    near = np.array([10.0 ** -k for k in range(1, 13)])
+    for ts, *_ in marks["aligned"]:
+        t.append(np.clip(np.concatenate([ts - near, ts + near]), lo, hi))
+    return np.unique(np.concatenate(t))
+
+
+def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray,
+                   limits: np.ndarray, marks: dict[str, list[Any]]
+                   ) -> tuple[list[tuple[float, int]], int]:
+    """Branch ends (bisected on existence) and unexplained in-limit changes on the grid.
+
+    Returns ``([(t, branch), ...] extra breakpoints, how many were bisected)``; the
+    fold ends are added to ``marks["fold"]``. All cells are bisected together (one
+    batch per step).
+    """
+    inside = valid & _within(q, limits)
+    exact: dict[int, list[float]] = {}
+    for tt, b, *_ in marks["limit"] + marks["aligned"]:
+        exact.setdefault(b, []).append(tt)
+    folds, changes = [], []
+    for b in range(fam.k):
+        folds += [(i, b) for i in np.flatnonzero(valid[1:, b] != valid[:-1, b])]
+        for i in np.flatnonzero((inside[1:, b] != inside[:-1, b])
+                                & valid[1:, b] & valid[:-1, b]):
+            if not any(t[i] <= x <= t[i + 1] for x in exact.get(b, [])):
+                changes.append((i, b))
+    changes = changes[:_MAX_BISECT]
+    cells = folds + changes
+    if not cells:
+        return [], 0
+    idx = np.array([i for i, _ in cells])
+    br = np.array([b for _, b in cells])
+    kind = np.array([c >= len(folds) for c in range(len(cells))])  # True: in-limit change
+    state0 = np.where(kind, inside[idx, br], valid[idx, br])
+    lo, hi = t[idx].astype(np.float64), t[idx + 1].astype(np.float64)
+    for _ in range(_BISECT):
+        mid = 0.5 * (lo + hi)
+        qm, vm, _ = fam.rows(mid)
+        rows = np.arange(len(mid))
+        now = np.where(kind, vm[rows, br] & _within(qm[rows, br], limits), vm[rows, br])
+        same = now == state0
+        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+    ends = np.where(state0, lo, hi)  # the last point of the state that holds there
+    marks["fold"] += [(float(e), int(b), "fold") for e, b, k in zip(ends, br, kind) if not k]
+    return [(float(e), int(b)) for e, b in zip(ends, br)], len(changes)
+
+
+def _within(q: np.ndarray, limits: np.ndarray) -> np.ndarray:
+    """(...) bool: rows q (..., n) inside every limit (1e-12 slack); NaN rows False."""
+    with np.errstate(invalid="ignore"):
+        out: np.ndarray = np.all((q >= limits[:, 0] - 1e-12) & (q <= limits[:, 1] + 1e-12), axis=-1)
+        return out
+
+
+def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
+               extra: list[tuple[float, int]]) -> tuple[np.ndarray, np.ndarray]:
+    """Per branch: the maximal parameter intervals inside every limit."""
+    lo_d, hi_d = fam.domain
+    cuts: dict[int, list[float]] = {b: [lo_d, hi_d] for b in range(fam.k)}
+    for t, b, *_ in marks["limit"] + marks["fold"]:
+        cuts[b].append(t)
+    for t, b in extra:
+        cuts[b].append(t)
+    pieces: list[tuple[int, float, float]] = []
+    mids, owners, spans = [], [], []
+    for b in range(fam.k):
+        c = np.unique(np.clip(cuts[b], lo_d, hi_d))
+        for a, e in zip(c[:-1], c[1:], strict=True):
+            if e > a:
+                mids.append(0.5 * (a + e))
+                owners.append(b)
+                spans.append((a, e))
+    if not mids:
+        return np.zeros((0, 2)), np.zeros(0, dtype=int)
+    q, valid, _ = fam.rows(np.array(mids))
+    idx = np.arange(len(mids))
+    qb = q[idx, owners]
+    with np.errstate(invalid="ignore"):
+        ok = valid[idx, owners] & np.all((qb >= limits[:, 0]) & (qb <= limits[:, 1]), -1)
+    for (a, e), b, good in zip(spans, owners, ok, strict=True):
+        if not good:
+            continue
+        if pieces and pieces[-1][0] == b and pieces[-1][2] == a:
+            pieces[-1] = (b, pieces[-1][1], e)
+        else:
+            pieces.append((b, a, e))
+    if fam.periodic:
+        pieces = _join_wrap(pieces, lo_d, hi_d)
+    arr = np.array([[a, e] for _, a, e in pieces]).reshape(-1, 2)
+    return arr, np.array([b for b, _, _ in pieces], dtype=int)
+
+
+def _join_wrap(pieces: list[tuple[int, float, float]], lo: float, hi: float
+               ) -> list[tuple[int, float, float]]:
+    """Periodic parameter: a branch's piece ending at hi and one starting at lo join.
+
+    The joined interval is given as (start, end + 2 pi) with end + 2 pi > hi.
+    """
+    out = list(pieces)
+    for b in {p[0] for p in pieces}:
+        own = [p for p in out if p[0] == b]
+        first = next((p for p in own if p[1] == lo), None)
+        last = next((p for p in own if p[2] == hi), None)
+        if first is not None and last is not None and first is not last:
+            out.remove(first)
+            out.remove(last)
+            out.append((b, last[1], first[2] + _TWO_PI))
+    return sorted(out)
