@@ -281,6 +281,11 @@ SIX_R = Group("six_r.c", kernels=(
     Kernel("atan2", (Arr("y", "f64", ("N",)), Arr("x", "f64", ("N",)),
                      Arr("out", "f64", ("N",), out=True)),
            "None", "The kernels' atan2 of y, x (N,) into out."),
+    Kernel("sp4_pair", (Arr("x", "f64", ("N", 7)), Float("tol", 0.0, BIG), Flag("mirror"),
+                        Arr("lane", "f64", ("N", 8), out=True), Arr("one", "f64", ("N", 8), out=True)),
+           "None", "Subproblem 4 of rows x (N, 7) in lanes and one at a time (for tests).\n\n"
+           "x rows: A, B, rhs, disc, phi, cos phi, sin phi; out rows: t0, t1, c0, c1, s0,\n"
+           "s1, has a root, has two."),
 ), constants=_consts(
     "AXES POINTS WRIST PERP2 TOOL_T TOOL_R PERP SIGN OFFSET LO HI S3 S4 SING_TOL DISC_TOL "
     "MIRROR A3 B3 C3 PHI3 CPHI3 SPHI3 A5 B5 C5 PHI5 CPHI5 SPHI5 AA BB FAMILY E5 PLANE "

@@ -68,6 +68,7 @@ static const KOpt opts_sp_ranges[] = {{SP_VERTEX_TRIES, 1, 1, 0.0, 1000000000000
     X(six_r_ik1, "six_r_ik1(T, params, q6, packed) -> tuple[int, F64, Bools, Bools, Bools] | tuple[int, None, None, None, None]: ``(code, Q (8, 6), valid, singular, within_limits (8,))`` of one pose.") \
     X(six_r_ik, "six_r_ik(params, T, qn, packed) -> tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]: ``(Q (N, 8, 6), valid, singular, within_limits (N, 8), status (N,))``.") \
     X(atan2, "atan2(y, x, out) -> None: The kernels' atan2 of y, x (N,) into out.") \
+    X(sp4_pair, "sp4_pair(x, tol, mirror, lane, one) -> None: Subproblem 4 of rows x (N, 7) in lanes and one at a time (for tests).") \
     X(pieper_ik1, "pieper_ik1(T, params, x, qn) -> tuple[int, F64, Bools, Bools, Bools] | tuple[int, None, None, None, None]: ``(code, Q (8, n), valid, singular, within_limits (8,))`` of one pose.") \
     X(pieper_ik, "pieper_ik(params, T, x, qn) -> tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]: ``(Q (N, 8, n), valid, singular, within_limits (N, 8), status (N,))``.") \
     X(pieper_roots, "pieper_roots(coeffs, re, im) -> None: The four roots of a quartic (coefficients lowest order first).") \
@@ -114,6 +115,7 @@ typedef struct { char unused; /* a struct is never empty */ } cpu_has_avx512_arg
 typedef struct { PyObject *T; const double *params; double q6; Chain packed; union { struct { npy_intp n, nc; }; npy_intp sym[2]; }; } six_r_ik1_args; /* six_r.c */
 typedef struct { const double *params; const double *T; const double *qn; Chain packed; union { struct { npy_intp N, m, n, nc; }; npy_intp sym[4]; }; } six_r_ik_args; /* six_r.c */
 typedef struct { const double *y; const double *x; double *out; union { struct { npy_intp N; }; npy_intp sym[1]; }; } atan2_args; /* six_r.c */
+typedef struct { const double *x; double tol; int mirror; double *lane; double *one; union { struct { npy_intp N; }; npy_intp sym[1]; }; } sp4_pair_args; /* six_r.c */
 typedef struct { PyObject *T; const double *params; double x; PyObject *qn; } pieper_ik1_args; /* pieper.c */
 typedef struct { const double *params; const double *T; const double *x; const double *qn; union { struct { npy_intp N, m, mq, nq; }; npy_intp sym[4]; }; } pieper_ik_args; /* pieper.c */
 typedef struct { const double *coeffs; double *re; double *im; } pieper_roots_args; /* pieper.c */
