@@ -147,3 +147,36 @@ def test_the_layout_the_kernels_parse_is_the_declared_one():
             at += value.size
         assert at == arrays.packed.size
     assert K.LAYOUT_TAG == d.LAYOUT_TAG == arrays.packed[0]
+
+
+def test_a_shape_the_descriptor_cannot_hold_is_refused_naming_the_kernel():
+    # Oracle: the descriptor holds `sym`, `sym +- c`, `c` or `c + sym` only; any
+    # other relation must be a Check, and the generator says which kernel.
+    gen = _generator()
+    d = gen.D  # the generator's own declaration classes
+    for shape in (("N", "PK_N_OF(a->params)"), ("N", "2 * N"), ("N", "M + 1")):
+        kernel = d.Kernel("probe", (d.Arr("x", "f64", shape),), "None", "probe")
+        with pytest.raises(ValueError, match="probe: shape entry"):
+            gen._Entry(kernel)
+
+
+def test_every_checked_dimension_is_checked_by_the_descriptor_parser():
+    # Oracle: the shapes declared in _declare.py; a good call runs, and changing
+    # any one dimension that does not bind is refused naming the argument.
+    pose = np.eye(4)[None].repeat(3, axis=0)
+    args = [pose, pose.copy(), np.empty((3, 6))]
+    K.pose_error(*args)
+    for i, bad in ((1, np.eye(4)[None].repeat(2, axis=0)), (1, np.zeros((3, 4, 3))),
+                   (2, np.empty((2, 6))), (2, np.empty((3, 5)))):
+        call = list(args)
+        call[i] = bad
+        name = ("current", "target", "out")[i]
+        with pytest.raises(ValueError, match=rf"pose_error: {name} must be \(N, "):
+            K.pose_error(*call)
+    ur5 = robokin.load("ur5")
+    packed = ur5.chain.arrays.packed
+    K.frames(packed, np.zeros((2, 6)), np.empty((2, 8, 4, 4)))
+    with pytest.raises(ValueError, match=r"frames: out must be \(N, nc \+ 2, 4, 4\)"):
+        K.frames(packed, np.zeros((2, 6)), np.empty((2, 7, 4, 4)))
+    with pytest.raises(ValueError, match=r"frames: q must be \(N, n\)"):
+        K.frames(packed, np.zeros((2, 5)), np.empty((2, 8, 4, 4)))

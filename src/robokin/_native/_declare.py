@@ -6,24 +6,26 @@ nothing from robokin) and writes
 
 * ``csrc/chain_layout.gen.h``: the packed chain layout (``PACKED_LAYOUT`` below,
   which ``model/chain_arrays.py`` packs by) as an X-macro ``chain.h`` parses by;
-* ``csrc/kernels_args.gen.h``: per kernel a ``<name>_args`` struct (the checked
-  arguments and the bound shape symbols) and the body's prototype
-  ``static PyObject *<name>_body(const <name>_args *a)``; the option-vector
-  indices (``enum``);
-* ``csrc/kernels_entry.gen.h``: per kernel the METH_FASTCALL entry point that
-  unpacks and checks every argument (array dtype, ndim, C-contiguity, alignment,
+* ``csrc/kernels_args.gen.h``: the kernel list ``KERNELS(X)``, per kernel a
+  ``<name>_args`` struct (the checked arguments and the bound shape symbols) and
+  the body's prototype ``static PyObject *<name>_body(const <name>_args *a)``; the
+  option-vector indices (``enum``) and ranges;
+* ``csrc/kernels_entry.gen.h``: per kernel a descriptor table (``KSpec``, one
+  ``KArg`` row per argument) that ``csrc/args.h``'s ``kernel_args`` reads to
+  unpack and check every argument (array dtype, ndim, C-contiguity, alignment,
   byte order, writeability, every shape relation, index arrays in range, option
   values in their declared ranges and whole where declared) before the body runs;
-  the method table; ``add_constants`` (every constant below);
+  the entry points and method table (macros over ``KERNELS``); ``add_constants``
+  (every constant below);
 * ``_interface.py``: the typed Protocol the type checker sees.
 
 ``tests/native/test_generated.py`` fails when a generated file differs from what
 this module produces. ``docs/conventions.md`` ("Adding a kernel") says how to use it.
 
 Shapes: a tuple of ints and strings. A bare name not seen before binds that
-dimension (``N``); a name seen before, or any expression (``n + N_RES``), is
-checked. ``packed`` binds ``n`` (joints) and ``nc`` (chain coordinates). Bound
-names are ``npy_intp`` fields of the args struct, so the body reads ``a->N``.
+dimension (``N``); a name seen before, a C constant (``SR_N_PARAMS``) or
+``sym +- c`` (``n + N_RES``) is checked; any other relation is a ``Check``.
+``packed`` binds ``n`` (joints) and ``nc`` (chain coordinates). Bound names are ``npy_intp`` fields of the args struct, so the body reads ``a->N``.
 """
 
 from __future__ import annotations
@@ -279,6 +281,11 @@ SIX_R = Group("six_r.c", kernels=(
     Kernel("atan2", (Arr("y", "f64", ("N",)), Arr("x", "f64", ("N",)),
                      Arr("out", "f64", ("N",), out=True)),
            "None", "The kernels' atan2 of y, x (N,) into out."),
+    Kernel("sp4_pair", (Arr("x", "f64", ("N", 7)), Float("tol", 0.0, BIG), Flag("mirror"),
+                        Arr("lane", "f64", ("N", 8), out=True), Arr("one", "f64", ("N", 8), out=True)),
+           "None", "Subproblem 4 of rows x (N, 7) in lanes and one at a time (for tests).\n\n"
+           "x rows: A, B, rhs, disc, phi, cos phi, sin phi; out rows: t0, t1, c0, c1, s0,\n"
+           "s1, has a root, has two."),
 ), constants=_consts(
     "AXES POINTS WRIST PERP2 TOOL_T TOOL_R PERP SIGN OFFSET LO HI S3 S4 SING_TOL DISC_TOL "
     "MIRROR A3 B3 C3 PHI3 CPHI3 SPHI3 A5 B5 C5 PHI5 CPHI5 SPHI5 AA BB FAMILY E5 PLANE "
@@ -294,11 +301,12 @@ PIEPER = Group("pieper.c", kernels=(
            "``(code, Q (8, n), valid, singular, within_limits (8,))`` of one pose.",
            checks=(Check("pk_params_ok(a->params)", "params is not a Pieper parameter vector"),)),
     Kernel("pieper_ik", (Arr("params", "f64", ("PK_N_PARAMS",)), Arr("T", "f64", POSE),
-                         Arr("x", "f64", ("m",)), Arr("qn", "f64", ("mq", "PK_N_OF(a->params)"))),
+                         Arr("x", "f64", ("m",)), Arr("qn", "f64", ("mq", "nq"))),
            "tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]",
            "``(Q (N, 8, n), valid, singular, within_limits (N, 8), status (N,))``.",
            checks=(Check("pk_params_ok(a->params)", "params is not a Pieper parameter vector"),
-                   Check("m >= 1 && mq >= 1", "x and qn need a row"))),
+                   Check("m >= 1 && mq >= 1", "x and qn need a row"),
+                   Check("nq == PK_N_OF(a->params)", "qn must be (mq, PK_N_OF(a->params))"))),
     Kernel("pieper_roots", (Arr("coeffs", "f64", (5,)), Arr("re", "f64", (4,), out=True),
                             Arr("im", "f64", (4,), out=True)),
            "None", "The four roots of a quartic (coefficients lowest order first).",

@@ -41,19 +41,15 @@ def load_declarations() -> ModuleType:
 
 if TYPE_CHECKING:
     from robokin._native import _declare as D
-    from robokin._native._declare import Arg, Kernel
+    from robokin._native._declare import Arg, Group, Kernel, Opts
 else:
     D = load_declarations()
 
 
-def _binds(dim: int | str, bound: list[str]) -> bool:
-    """Whether a shape entry binds a new symbol.
-
-    A bare name not bound yet and not a C constant (capitals with an underscore,
-    as ``SR_N_PARAMS``) binds.
-    """
-    return (isinstance(dim, str) and bool(NAME.match(dim)) and dim not in bound
-            and not (dim.isupper() and "_" in dim))
+MAX_ARGS = 16  # KA_MAXARGS in csrc/args.h
+KIND = {"Packed": "KA_PACKED", "Arr": "KA_ARR", "Opts": "KA_OPTS", "Float": "KA_FLOAT",
+        "Flag": "KA_FLAG", "Obj": "KA_OBJ"}
+TERM = re.compile(r"^(\w+)(?:\s*([+-])\s*(\w+))?$")
 
 
 def _c_double(x: float) -> str:
@@ -62,180 +58,185 @@ def _c_double(x: float) -> str:
     return repr(float(x))
 
 
+def _is_const(name: str) -> bool:
+    """A C constant (a number, or capitals with an underscore, as ``SR_N_PARAMS``)."""
+    return name.isdigit() or (name.isupper() and "_" in name)
+
+
 class _Entry:
-    """The C text of one kernel's args struct and entry point."""
+    """One kernel's args struct, descriptor table and checks, as C text.
+
+    Shapes are ``sym``, ``sym +- c``, ``c`` or ``c + sym`` (``c`` a number or a C
+    constant): a :class:`KDim` ``{sym, add}``; a symbol not bound yet binds.
+    """
 
     def __init__(self, k: Kernel) -> None:
         self.k = k
         self.bound: list[str] = []  # shape symbols, in binding order
-        self.lines: list[str] = []  # entry body after parsing
-        self.known_consts: set[str] = set()
+        if len(k.args) > MAX_ARGS:
+            raise ValueError(f"{k.name}: more than {MAX_ARGS} arguments (KA_MAXARGS)")
+        self.late = 0  # bit i: argument i has a dimension that does not bind
+        self.rows = [self._row(i, a) for i, a in enumerate(k.args)]
+        self.indexed = sum(1 << i for i, a in enumerate(k.args)
+                           if isinstance(a, D.Arr) and a.values is not None)
 
-    def fields(self) -> list[str]:
+    def _dim(self, dim: int | str, bind: bool = False) -> tuple[str, bool]:
+        """``({sym, add}, binds)`` of one shape entry or index bound."""
+        m = TERM.match(str(dim).strip())
+        if m is None:
+            raise ValueError(f"{self.k.name}: shape entry {dim!r} is not sym, sym +- c or c "
+                             "(use a Check)")
+        head, op, tail = m.groups()
+        if op is None and not _is_const(head):
+            if head not in self.bound:
+                if not bind:
+                    raise ValueError(f"{self.k.name}: {head!r} is not bound yet")
+                self.bound.append(head)
+                return f"{{{len(self.bound) - 1}, 0}}", True
+            return f"{{{self.bound.index(head)}, 0}}", False
+        if op is None:
+            return f"{{-1, {head}}}", False
+        if _is_const(head) and op == "+":
+            head, tail = tail, head
+        if head not in self.bound or not _is_const(tail):
+            raise ValueError(f"{self.k.name}: shape entry {dim!r} needs a bound symbol first")
+        return f"{{{self.bound.index(head)}, {op}({tail})}}", False
+
+    def _dims(self, i: int, shape: tuple[int | str, ...]) -> tuple[str, int]:
+        """Argument i's shape as KDims, and which entries bind (bit mask)."""
+        parts, binds = [], 0
+        for j, d in enumerate(shape):
+            text, b = self._dim(d, bind=True)
+            parts.append(text)
+            binds |= b << j
+        if binds != (1 << len(shape)) - 1:
+            self.late |= 1 << i
+        return ", ".join(parts), binds
+
+    def _row(self, i: int, a: Arg) -> str:
+        """Argument i's descriptor row."""
+        at = f"{self.k.name}, {a.name}"
+        if isinstance(a, D.Packed):
+            dims, binds = self._dims(i, ("n", "nc"))
+            return f"KA_ROW({at}, KA_PACKED, .binds = {binds:#x}, .dim = {{{dims}}})"
+        if isinstance(a, D.Arr):
+            dims, binds = self._dims(i, a.shape)
+            text = '"(' + ", ".join(str(d) for d in a.shape) + ')"'
+            if a.values is None:
+                return f"KA_ARRAY({at}, {int(a.out)}, {binds:#x}, {NPY[a.dtype]}, {text}, {dims})"
+            if a.dtype != "i64":
+                raise ValueError(f"{self.k.name}: {a.name}: values are for i64 index arrays")
+            lo, hi = (self._dim(v)[0].strip("{}") for v in a.values)
+            said = f"[{a.values[0]}, {a.values[1]}]" + (" or decreasing" if a.monotone else "")
+            return (f'KA_INDEX({at}, {int(a.out)}, {binds:#x}, "{said}", {int(a.monotone)}, '
+                    f"{lo}, {hi}, {text}, {dims})")
+        if isinstance(a, D.Opts):
+            return (f'KA_ROW({at}, KA_OPTS, .ndim = 1, .typenum = NPY_DOUBLE, .shape = "({a.size},)", '
+                    f".dim = {{{{-1, {a.size}}}}}, .opts = {_opts_table(a)}, .nopts = {len(a.fields)})")
+        if isinstance(a, D.Int):
+            kind = "KA_UINT64" if a.unsigned64 else "KA_INT"
+            return f"KA_ROW({at}, {kind}, .lo = {a.lo}LL, .hi = {a.hi}ULL)"
+        if isinstance(a, D.Float):
+            return f"KA_ROW({at}, KA_FLOAT, .flo = {_c_double(a.lo)}, .fhi = {_c_double(a.hi)})"
+        return f"KA_PLAIN({at}, {KIND[type(a).__name__]})"
+
+    def fields(self) -> str:
+        """The args struct's members, on one line."""
         out: list[str] = []
         for a in self.k.args:
             if isinstance(a, D.Arr):
-                qual = "" if a.out else "const "
-                out.append(f"    {qual}{CTYPE[a.dtype]} *{a.name};")
-                out.append(f"    PyArrayObject *{a.name}_array;")
+                out.append(f"{'' if a.out else 'const '}{CTYPE[a.dtype]} *{a.name};")
             elif isinstance(a, D.Opts):
-                out.append(f"    const double *{a.name};")
+                out.append(f"const double *{a.name};")
             elif isinstance(a, D.Packed):
-                out.append(f"    Chain {a.name};")
+                out.append(f"Chain {a.name};")
             elif isinstance(a, D.Int):
-                out.append(f"    {'unsigned long long' if a.unsigned64 else 'long'} {a.name};")
-            elif isinstance(a, D.Float):
-                out.append(f"    double {a.name};")
-            elif isinstance(a, D.Flag):
-                out.append(f"    int {a.name};")
-            elif isinstance(a, D.Obj):
-                out.append(f"    PyObject *{a.name};")
-        out += [f"    npy_intp {s};" for s in self.bound]
-        return out
-
-    def _fail(self, message: str) -> str:
-        text = f"robokin._native.{self.k.name}: {message}".replace('"', '\\"')
-        return f'return kernel_fail("{text}");'
-
-    def build(self) -> None:
-        k, L = self.k, self.lines
-        deferred: list[tuple[str, str]] = []  # (C condition, message)
-        value_checks: list[str] = []
-        for i, a in enumerate(k.args):
-            src = f"args[{i}]"
-            if isinstance(a, D.Packed):
-                L.append(f"    if (!chain_arg({src}, &a.{a.name}, \"{k.name}\"))")
-                L.append("        return NULL;")
-                for sym, expr in (("n", f"a.{a.name}.n"), ("nc", f"a.{a.name}.nc")):
-                    if sym not in self.bound:
-                        self.bound.append(sym)
-                        L.append(f"    a.{sym} = {expr};")
-                    else:
-                        deferred.append((f"a.{sym} == {expr}", f"{sym} does not fit the chain"))
-            elif isinstance(a, D.Arr):
-                L.append(f"    a.{a.name}_array = array_arg({src}, \"{k.name}\", \"{a.name}\", "
-                         f"{NPY[a.dtype]}, {len(a.shape)}, {int(a.out)});")
-                L.append(f"    if (a.{a.name}_array == NULL)")
-                L.append("        return NULL;")
-                cast = "" if a.out else "const "
-                L.append(f"    a.{a.name} = ({cast}{CTYPE[a.dtype]} *)PyArray_DATA(a.{a.name}_array);")
-                shape = ", ".join(str(s) for s in a.shape)
-                for j, dim in enumerate(a.shape):
-                    got = f"PyArray_DIMS(a.{a.name}_array)[{j}]"
-                    if isinstance(dim, str) and _binds(dim, self.bound):
-                        self.bound.append(dim)
-                        L.append(f"    a.{dim} = {got};")
-                    else:
-                        deferred.append((f"{got} == (npy_intp)({self._expr(dim)})",
-                                         f"{a.name} must be ({shape})"))
-                if a.values is not None:
-                    lo, hi = (self._expr(v) for v in a.values)
-                    value_checks.append(
-                        f"    if (!index_values(a.{a.name}, PyArray_SIZE(a.{a.name}_array), "
-                        f"(long long)({lo}), (long long)({hi}), {int(a.monotone)}))\n"
-                        f"        {self._fail(f'{a.name}: an index outside [{a.values[0]}, {a.values[1]}]' + (' or decreasing' if a.monotone else ''))}")
-            elif isinstance(a, D.Opts):
-                L.append(f"    PyArrayObject *{a.name}_array = array_arg({src}, \"{k.name}\", "
-                         f"\"{a.name}\", NPY_DOUBLE, 1, 0);")
-                L.append(f"    if ({a.name}_array == NULL)")
-                L.append("        return NULL;")
-                L.append(f"    if (PyArray_DIMS({a.name}_array)[0] != {a.size})")
-                L.append(f"        {self._fail(f'{a.name} must be ({a.size},)')}")
-                L.append(f"    a.{a.name} = (const double *)PyArray_DATA({a.name}_array);")
-                L.append(f"    if (!{a.name.lower()}_{a.prefix.lower().rstrip('_')}_ok(a.{a.name}))")
-                L.append(f"        {self._fail(f'{a.name}: a value outside its range (_declare.py)')}")
-            elif isinstance(a, D.Int):
-                kind = "uint64_arg" if a.unsigned64 else "long_arg"
-                L.append(f"    if (!{kind}({src}, \"{k.name}\", \"{a.name}\", {a.lo}LL, "
-                         f"{a.hi}{'ULL' if a.unsigned64 else 'LL'}, &a.{a.name}))")
-                L.append("        return NULL;")
-            elif isinstance(a, D.Float):
-                L.append(f"    if (!double_arg({src}, \"{k.name}\", \"{a.name}\", "
-                         f"{_c_double(a.lo)}, {_c_double(a.hi)}, &a.{a.name}))")
-                L.append("        return NULL;")
-            elif isinstance(a, D.Flag):
-                L.append(f"    if ((a.{a.name} = PyObject_IsTrue({src})) < 0)")
-                L.append("        return NULL;")
-            elif isinstance(a, D.Obj):
-                L.append(f"    a.{a.name} = {src};")
+                out.append(f"{'unsigned long long' if a.unsigned64 else 'long'} {a.name};")
+            else:
+                ctype = {"Float": "double ", "Flag": "int ", "Obj": "PyObject *"}
+                out.append(f"{ctype[type(a).__name__]}{a.name};")
         if self.bound:
-            L.append("    " + " ".join(f"npy_intp {s} = a.{s};" for s in self.bound))
-            L.append("    " + " ".join(f"(void){s};" for s in self.bound))
-        for c in k.checks:
-            L.append(f"    if (!({c.cond.replace('a->', 'a.')}))")
-            L.append(f"        {self._fail(c.message)}")
-        for cond, msg in deferred:
-            L.append(f"    if (!({cond}))")
-            L.append(f"        {self._fail(msg)}")
-        L.extend(value_checks)
+            out.append(f"union {{ struct {{ npy_intp {', '.join(self.bound)}; }}; "
+                       f"npy_intp sym[{len(self.bound)}]; }};")
+        return " ".join(out) or "char unused; /* a struct is never empty */"
 
-    def _expr(self, dim: int | str) -> str:
-        return str(dim).replace("a->", "a.")
+    def check(self) -> str:
+        """``KERNEL_CHECK(name, expr)``, or "" for a kernel without checks."""
+        if not self.k.checks:
+            return ""
+        sym = re.compile(r"(?<![\w.>])(" + "|".join(self.bound or ["$^"]) + r")\b")
+        parts = []
+        for c in self.k.checks:
+            cond = sym.sub(r"a->\1", c.cond)
+            parts.append(f'!({cond}) ? "{c.message}"')
+        return f"KERNEL_CHECK({self.k.name}, {' : '.join(parts)} : NULL)"
+
+    def spec(self) -> str:
+        """The KSpec with its descriptor table, on one line."""
+        k = self.k
+        names = ", ".join(a.name for a in k.args)
+        argv = f"(const KArg[]){{{', '.join(self.rows)}}}" if k.args else "NULL"
+        sym_at = f"offsetof({k.name}_args, sym)" if self.bound else "0"
+        check = f"{k.name}_check" if k.checks else "NULL"
+        return (f'static const KSpec {k.name}_spec = {{"{k.name}", "{k.name}({names})", '
+                f"{len(k.args)}, {argv}, {sym_at}, {self.late:#x}, {self.indexed:#x}, {check}}};")
 
 
-def _opts_c() -> tuple[list[str], list[str]]:
-    """The option-vector enums (for kernels_args.gen.h) and range checkers."""
-    enums, checkers = [], []
+def _opts_table(o: Opts) -> str:
+    return f"{o.name.lower()}_{o.prefix.lower().rstrip('_')}_ranges"
+
+
+def _opts_c() -> list[str]:
+    """The option-vector enums and range tables (for kernels_args.gen.h)."""
+    out: list[str] = []
     for o in D.OPTION_VECTORS:
-        items, at = [], 0
+        items, ranges, at = [], [], 0
         for f in o.fields:
             doc = f" /* {f.doc} */" if f.doc else ""
             items.append(f"    {o.prefix}{f.name} = {at},{doc}")
+            ranges.append(f"{{{o.prefix}{f.name}, {f.count}, {int(f.whole)}, {_c_double(f.lo)}, "
+                          f"{_c_double(f.hi)}}}")
             at += f.count
         items.append(f"    {o.size} = {at}")
-        enums += [f"/* {o.name}: option vector entries (Opts in _declare.py) */", "enum {",
-                  *items, "};", ""]
-        fn = f"{o.name.lower()}_{o.prefix.lower().rstrip('_')}_ok"
-        checkers += [f"/* every entry of {o.name} inside its declared range (NaN fails) */",
-                     f"static int {fn}(const double *v)", "{"]
-        for f in o.fields:
-            whole = " || v[i] != floor(v[i])" if f.whole else ""
-            checkers += [f"    for (int i = {o.prefix}{f.name}; i < {o.prefix}{f.name} + {f.count}; i++)",
-                         f"        if (!(v[i] >= {_c_double(f.lo)} && v[i] <= {_c_double(f.hi)}){whole})",
-                         "            return 0;"]
-        checkers += ["    return 1;", "}", ""]
-    return enums, checkers
+        out += [f"/* {o.name}: option vector entries (Opts in _declare.py) and their ranges */",
+                "enum {", *items, "};",
+                f"static const KOpt {_opts_table(o)}[] = {{{', '.join(ranges)}}};", ""]
+    return out
+
+
+def _kernels() -> list[tuple[Group, Kernel, _Entry]]:
+    return [(g, k, _Entry(k)) for g in D.GROUPS for k in g.kernels]
+
+
+def _doc(k: Kernel) -> str:
+    names = ", ".join(a.name for a in k.args)
+    doc = f"{k.name}({names}) -> {k.returns}: {k.doc.splitlines()[0]}"
+    return doc.replace("\\", "\\\\").replace('"', '\\"')
 
 
 def args_header() -> str:
-    """``kernels_args.gen.h``: option enums, args structs and body prototypes."""
-    enums, checkers = _opts_c()
+    """``kernels_args.gen.h``: option enums and ranges, the kernel list, args structs."""
+    kernels = _kernels()
     out = ["/* kernels_args.gen.h: " + STAMP + " */", "#ifndef ROBOKIN_KERNELS_ARGS_GEN_H",
-           "#define ROBOKIN_KERNELS_ARGS_GEN_H", "", *enums, *checkers]
-    for g in D.GROUPS:
-        for k in g.kernels:
-            e = _Entry(k)
-            e.build()
-            out += [f"/* {k.name}: {g.file} */", "typedef struct {", *e.fields(),
-                    "    char unused; /* a struct is never empty */",
-                    f"}} {k.name}_args;", f"static PyObject *{k.name}_body(const {k.name}_args *a);", ""]
-    out += ["#endif", ""]
+           "#define ROBOKIN_KERNELS_ARGS_GEN_H", "", *_opts_c(),
+           "/* every kernel: X(name, doc) */", "#define KERNELS(X) \\",
+           " \\\n".join(f'    X({k.name}, "{_doc(k)}")' for _, k, _ in kernels), "",
+           "/* per kernel, the checked arguments and the bound shape symbols (a->N) */"]
+    out += [f"typedef struct {{ {e.fields()} }} {k.name}_args; /* {g.file} */"
+            for g, k, e in kernels]
+    out += ["", "KERNELS(KERNEL_BODY)", "", "#endif", ""]
     return "\n".join(out)
 
 
 def entry_header() -> str:
-    """``kernels_entry.gen.h``: entry points, method table, constants."""
+    """``kernels_entry.gen.h``: checks, descriptor tables, entry points, method table, constants."""
     out = ["/* kernels_entry.gen.h: " + STAMP + " */", ""]
-    table = []
-    for g in D.GROUPS:
-        for k in g.kernels:
-            e = _Entry(k)
-            e.build()
-            names = ", ".join(_arg_name(a) for a in k.args)
-            out += [f"static PyObject *py_{k.name}(PyObject *self, PyObject *const *args, "
-                    "Py_ssize_t nargs)", "{", "    (void)self;",
-                    *(["    (void)args;"] if not k.args else []), f"    {k.name}_args a;",
-                    "    memset(&a, 0, sizeof(a));",
-                    f"    if (nargs != {len(k.args)}) {{",
-                    f"        PyErr_SetString(PyExc_TypeError, \"{k.name}({names}) takes "
-                    f"{len(k.args)} argument{'s' if len(k.args) != 1 else ''}\");",
-                    "        return NULL;", "    }", *e.lines,
-                    f"    return {k.name}_body(&a);", "}", ""]
-            doc = f"{k.name}({names}) -> {k.returns}: {k.doc.splitlines()[0]}"
-            doc = doc.replace("\\", "\\\\").replace('"', '\\"')
-            table.append(f"    {{\"{k.name}\", (PyCFunction)(void (*)(void))py_{k.name}, "
-                         f"METH_FASTCALL,\n     \"{doc}\"}},")
-    out += ["static PyMethodDef kernel_methods[] = {", *table, "    {NULL, NULL, 0, NULL}};", ""]
+    out += ["/* per kernel: its checks, then its KSpec with one KArg row per argument */"]
+    for _, _, e in _kernels():
+        out += [line for line in (e.check(), e.spec()) if line]
+    out += ["", "KERNELS(KERNEL_ENTRY)", "",
+            "static PyMethodDef kernel_methods[] = {KERNELS(KERNEL_METHOD){NULL, NULL, 0, NULL}};",
+            ""]
     out += ["/* every declared constant onto the module, then the groups' init functions */",
             "static int add_constants(PyObject *m)", "{"]
     ints: list[tuple[str, str]] = []
@@ -248,13 +249,15 @@ def entry_header() -> str:
             (floats if c.type == "float" else ints).append((c.name, c.c))
     out += ["    static const struct { const char *name; long value; } ints[] = {"]
     out += [f"        {{\"{name}\", (long)({expr})}}," for name, expr in ints]
+    out += ["    };", "    const struct { const char *name; double value; } floats[] = {"]
+    out += [f"        {{\"{name}\", (double)({expr})}}," for name, expr in floats]
     out += ["    };", "    for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)",
             "        if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)",
-            "            return -1;"]
-    for name, expr in floats:
-        out += ["    {", f"        PyObject *v = PyFloat_FromDouble({expr});",
-                f"        if (v == NULL || PyModule_AddObject(m, \"{name}\", v) < 0) {{",
-                "            Py_XDECREF(v);", "            return -1;", "        }", "    }"]
+            "            return -1;",
+            "    for (size_t i = 0; i < sizeof(floats) / sizeof(floats[0]); i++) {",
+            "        PyObject *v = PyFloat_FromDouble(floats[i].value);",
+            "        if (v == NULL || PyModule_AddObject(m, floats[i].name, v) < 0) {",
+            "            Py_XDECREF(v);", "            return -1;", "        }", "    }"]
     for g in D.GROUPS:
         if g.init:
             out += [f"    if ({g.init}() < 0)", "        return -1;"]

@@ -375,6 +375,13 @@ class Kernels(Protocol):
     def atan2(self, y: F64, x: F64, out: F64, /) -> None:
         """The kernels' atan2 of y, x (N,) into out."""
 
+    def sp4_pair(self, x: F64, tol: float, mirror: bool, lane: F64, one: F64, /) -> None:
+        """Subproblem 4 of rows x (N, 7) in lanes and one at a time (for tests).
+
+        x rows: A, B, rhs, disc, phi, cos phi, sin phi; out rows: t0, t1, c0, c1, s0,
+        s1, has a root, has two.
+        """
+
     def pieper_ik1(
         self,
         T: object,

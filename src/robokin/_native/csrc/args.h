@@ -1,7 +1,10 @@
 /*
- * The argument checks the generated entry points (kernels_entry.gen.h) call: one
- * copy, used by every kernel. Each returns 0 with a ValueError (TypeError for a
- * Python value of the wrong type) naming the kernel and the argument.
+ * The argument checks of every kernel entry point: one copy, driven by the
+ * per-kernel descriptor tables kernels_entry.gen.h declares (from ../_declare.py).
+ * kernel_args() unpacks and checks a METH_FASTCALL argument vector into a
+ * kernel's args struct; each failure is a ValueError (TypeError for a Python
+ * value of the wrong type or a wrong argument count) naming the kernel and the
+ * argument.
  */
 #ifndef ROBOKIN_ARGS_H
 #define ROBOKIN_ARGS_H
@@ -9,11 +12,7 @@
 #include <stdio.h>
 #include "chain.h"
 
-static PyObject *kernel_fail(const char *message)
-{
-    PyErr_SetString(PyExc_ValueError, message);
-    return NULL;
-}
+#define KA_MAXARGS 16 /* the most arguments of a kernel (_generate.py checks) */
 
 /* o as a C-contiguous, aligned, native array of typenum with ndim dimensions
  * (writeable when asked); NULL with ValueError otherwise. */
@@ -123,6 +122,219 @@ static int index_values(const long long *x, npy_intp count, long long lo, long l
     for (npy_intp i = 0; i < count; i++)
         if (x[i] < lo || x[i] > hi || (monotone && i > 0 && x[i] < x[i - 1]))
             return 0;
+    return 1;
+}
+
+/* ---- the descriptor tables and their one parser ---- */
+
+enum { KA_PACKED, KA_ARR, KA_OPTS, KA_INT, KA_UINT64, KA_FLOAT, KA_FLAG, KA_OBJ };
+
+/* a dimension or an index bound: add + (sym >= 0 ? the kernel's symbol sym : 0) */
+typedef struct {
+    signed char sym;
+    long long add;
+} KDim;
+
+/* one entry (or count entries) of an option vector and its range */
+typedef struct {
+    int at, count, whole;
+    double lo, hi;
+} KOpt;
+
+/* one argument: kind, where it goes in the args struct, and what it must be */
+typedef struct {
+    const char *name;
+    size_t at;               /* offsetof the field in the kernel's args struct */
+    unsigned char kind;      /* KA_* */
+    unsigned char out;       /* arrays: writeable */
+    unsigned char ndim;      /* arrays: dimensions */
+    unsigned char binds;     /* arrays, packed: bit j when dimension j binds its symbol */
+    int typenum;             /* arrays: NPY_* */
+    const char *shape;       /* arrays, opts: the shape as declared, for messages */
+    KDim dim[4];             /* arrays: the shape; packed: the symbols n, nc; opts: size */
+    long long lo;            /* ints: range */
+    unsigned long long hi;
+    double flo, fhi;         /* floats: range */
+    const char *values;      /* index arrays: "[lo, hi]" as declared (NULL: no check) */
+    KDim vlo, vhi;           /* index arrays: every value in [vlo, vhi] */
+    int monotone;            /* index arrays: non-decreasing */
+    const KOpt *opts;        /* opts: the ranges of the entries */
+    int nopts;
+} KArg;
+
+/* one kernel: its name, call signature, arguments and extra checks */
+typedef struct {
+    const char *name;
+    const char *signature;             /* "fk(packed, q, out)" */
+    int nargs;
+    const KArg *argv;
+    size_t sym_at;                     /* offsetof its npy_intp symbol array */
+    unsigned late;                     /* bit i: argument i has dimensions to check */
+    unsigned indexed;                  /* bit i: argument i is an index array */
+    const char *(*check)(const void *a); /* NULL, or the message of the first failed check */
+} KSpec;
+
+#define KA_IN_FLAGS (NPY_ARRAY_C_CONTIGUOUS | NPY_ARRAY_ALIGNED)
+#define KA_OUT_FLAGS (KA_IN_FLAGS | NPY_ARRAY_WRITEABLE)
+
+static inline npy_intp kdim(KDim d, const npy_intp *sym)
+{
+    return (npy_intp)(d.add + (d.sym >= 0 ? (long long)sym[d.sym] : 0));
+}
+
+static int kopts_ok(const double *v, const KOpt *r, int count)
+{
+    for (int k = 0; k < count; k++)
+        for (int i = r[k].at; i < r[k].at + r[k].count; i++)
+            if (!(v[i] >= r[k].lo && v[i] <= r[k].hi) || (r[k].whole && v[i] != floor(v[i])))
+                return 0;
+    return 1;
+}
+
+static int kfail(const KSpec *k, const char *name, const char *what, const char *detail)
+{
+    PyErr_Format(PyExc_ValueError, "robokin._native.%s: %s%s%s", k->name, name, what, detail);
+    return 0;
+}
+
+/* pass 1: one argument converted and stored, its binding dimensions bound (option
+ * vectors checked whole) */
+static inline int karg_parse(const KSpec *k, const KArg *g, PyObject *o, char *a, npy_intp *sym,
+                      PyArrayObject **arr)
+{
+    void *at = a + g->at;
+    *arr = NULL;
+    switch (g->kind) {
+    case KA_PACKED: {
+        Chain *ch = (Chain *)at;
+        if (!chain_arg(o, ch, k->name))
+            return 0;
+        const npy_intp got[2] = {ch->n, ch->nc};
+        for (int j = 0; j < 2; j++)
+            if (g->binds >> j & 1)
+                sym[g->dim[j].sym] = got[j];
+        return 1;
+    }
+    case KA_ARR:
+    case KA_OPTS:
+        *arr = (PyArrayObject *)o;
+        if (!(PyArray_Check(o) && PyArray_TYPE(*arr) == g->typenum &&
+              PyArray_NDIM(*arr) == g->ndim && PyArray_ISNOTSWAPPED(*arr) &&
+              PyArray_CHKFLAGS(*arr, g->out ? KA_OUT_FLAGS : KA_IN_FLAGS)) &&
+            (*arr = array_arg(o, k->name, g->name, g->typenum, g->ndim, g->out)) == NULL)
+            return 0; /* the fast test failed, array_arg said why */
+        *(void **)at = PyArray_DATA(*arr);
+        for (int j = 0; j < g->ndim; j++)
+            if (g->binds >> j & 1)
+                sym[g->dim[j].sym] = PyArray_DIMS(*arr)[j];
+        if (g->kind == KA_OPTS) { /* checked at once: the kernel's checks may read it */
+            if (PyArray_DIMS(*arr)[0] != g->dim[0].add)
+                return kfail(k, g->name, " must be ", g->shape);
+            if (!kopts_ok((const double *)PyArray_DATA(*arr), g->opts, g->nopts))
+                return kfail(k, g->name, ": a value outside its range (_declare.py)", "");
+        }
+        return 1;
+    case KA_INT:
+        return long_arg(o, k->name, g->name, g->lo, (long long)g->hi, (long *)at);
+    case KA_UINT64:
+        return uint64_arg(o, k->name, g->name, g->lo, g->hi, (unsigned long long *)at);
+    case KA_FLOAT:
+        return double_arg(o, k->name, g->name, g->flo, g->fhi, (double *)at);
+    case KA_FLAG:
+        return (*(int *)at = PyObject_IsTrue(o)) >= 0;
+    default: /* KA_OBJ */
+        *(PyObject **)at = o;
+        return 1;
+    }
+}
+
+/* pass 2: the dimensions that do not bind */
+static inline int karg_shape(const KSpec *k, const KArg *g, const char *a, const npy_intp *sym,
+                      PyArrayObject *arr)
+{
+    if (g->kind == KA_PACKED) {
+        const Chain *ch = (const Chain *)(a + g->at);
+        const npy_intp got[2] = {ch->n, ch->nc};
+        static const char *const names[2] = {"n", "nc"};
+        for (int j = 0; j < 2; j++)
+            if (!(g->binds >> j & 1) && got[j] != kdim(g->dim[j], sym))
+                return kfail(k, names[j], " does not fit the chain", "");
+        return 1;
+    }
+    if (g->kind != KA_ARR)
+        return 1;
+    for (int j = 0; j < g->ndim; j++)
+        if (!(g->binds >> j & 1) && PyArray_DIMS(arr)[j] != kdim(g->dim[j], sym))
+            return kfail(k, g->name, " must be ", g->shape);
+    return 1;
+}
+
+/* a kernel's check function: the message of its first failed check, or NULL */
+#define KERNEL_CHECK(k, expr) \
+    static const char *k##_check(const void *p) \
+    { \
+        const k##_args *a = (const k##_args *)p; \
+        return (expr); \
+    }
+
+/* a kernel's METH_FASTCALL entry point: arguments checked (k##_spec), then its body */
+#define KERNEL_ENTRY(k, doc) \
+    static PyObject *py_##k(PyObject *self, PyObject *const *args, Py_ssize_t nargs) \
+    { \
+        (void)self; \
+        k##_args a; \
+        memset(&a, 0, sizeof(a)); \
+        return kernel_args(&k##_spec, args, nargs, &a) ? k##_body(&a) : NULL; \
+    }
+
+/* a kernel's row of the method table */
+#define KERNEL_METHOD(k, doc) {#k, (PyCFunction)(void (*)(void))py_##k, METH_FASTCALL, doc},
+
+/* a kernel's body prototype */
+#define KERNEL_BODY(k, doc) static PyObject *k##_body(const k##_args *a);
+
+/* descriptor rows (kernels_entry.gen.h): argument f of kernel k */
+#define KA_ROW(k, f, kind_, ...) {.name = #f, .at = offsetof(k##_args, f), .kind = kind_, __VA_ARGS__}
+#define KA_PLAIN(k, f, kind_) {.name = #f, .at = offsetof(k##_args, f), .kind = kind_}
+/* an array: writeable, binds (bit mask), typenum, the shape's text, then its dimensions */
+#define KA_ARRAY(k, f, out_, binds_, typenum_, shape_, ...) \
+    KA_ROW(k, f, KA_ARR, .out = out_, .binds = binds_, .typenum = typenum_, .shape = shape_, \
+           .ndim = sizeof((KDim[]){__VA_ARGS__}) / sizeof(KDim), .dim = {__VA_ARGS__})
+/* an int64 index array: as KA_ARRAY, after the values' text, monotony and bounds
+ * (every value in [{lo_sym, lo_add}, {hi_sym, hi_add}]) */
+#define KA_INDEX(k, f, out_, binds_, said, mono, lo_sym, lo_add, hi_sym, hi_add, shape_, ...) \
+    KA_ROW(k, f, KA_ARR, .out = out_, .binds = binds_, .typenum = NPY_INT64, .shape = shape_, \
+           .ndim = sizeof((KDim[]){__VA_ARGS__}) / sizeof(KDim), .dim = {__VA_ARGS__}, \
+           .values = said, .vlo = {lo_sym, lo_add}, .vhi = {hi_sym, hi_add}, .monotone = mono)
+
+/* args (nargs of them) checked and unpacked into a (k's args struct, zeroed); 0 with an
+ * error set */
+static int kernel_args(const KSpec *k, PyObject *const *args, Py_ssize_t nargs, void *a)
+{
+    PyArrayObject *arr[KA_MAXARGS];
+    char *base = (char *)a;
+    npy_intp *sym = (npy_intp *)(base + k->sym_at);
+    if (nargs != k->nargs) {
+        PyErr_Format(PyExc_TypeError, "%s takes %d argument%s", k->signature, k->nargs,
+                     k->nargs == 1 ? "" : "s");
+        return 0;
+    }
+    for (int i = 0; i < k->nargs; i++)
+        if (!karg_parse(k, &k->argv[i], args[i], base, sym, &arr[i]))
+            return 0;
+    const char *failed = k->check != NULL ? k->check(a) : NULL;
+    if (failed != NULL)
+        return kfail(k, failed, "", "");
+    for (int i = 0; k->late >> i; i++)
+        if ((k->late >> i & 1) && !karg_shape(k, &k->argv[i], base, sym, arr[i]))
+            return 0;
+    for (int i = 0; k->indexed >> i; i++) {
+        const KArg *g = &k->argv[i];
+        if ((k->indexed >> i & 1) &&
+            !index_values((const long long *)PyArray_DATA(arr[i]), PyArray_SIZE(arr[i]),
+                          kdim(g->vlo, sym), kdim(g->vhi, sym), g->monotone))
+            return kfail(k, g->name, ": an index outside ", g->values);
+    }
     return 1;
 }
 

@@ -479,23 +479,18 @@ static void motion_range(void *ctx, long b, long e)
 
 /* ---------------------------------------------------------------- arguments */
 
-static inline npy_intp bp_dim(PyArrayObject *a, int d)
-{
-    return PyArray_DIMS(a)[d];
-}
-
 /* the pair indices pb: a robot shape where is_self, an object (below `objects`)
  * elsewhere (the generated entry checked pa and the shapes) */
-static int samples_args(PyArrayObject *frames, const long long *link, const long long *pa,
-                        const long long *pb, const npy_bool *self, npy_intp S, npy_intp P,
-                        npy_intp objects, Samples *sm)
+static int samples_args(const double *frames, npy_intp m, npy_intp nl, const long long *link,
+                        const long long *pa, const long long *pb, const npy_bool *self,
+                        npy_intp S, npy_intp P, npy_intp objects, Samples *sm)
 {
     for (npy_intp p = 0; p < P; p++)
         if (pb[p] < 0 || pb[p] >= (self[p] ? S : objects))
             return 0;
-    sm->frames = (const double *)PyArray_DATA(frames);
-    sm->m = (long)bp_dim(frames, 0);
-    sm->nl = (long)bp_dim(frames, 1);
+    sm->frames = frames;
+    sm->m = (long)m;
+    sm->nl = (long)nl;
     sm->S = (long)S;
     sm->P = (long)P;
     sm->link = link;
@@ -512,8 +507,8 @@ static PyObject *bp_fail(const char *what)
     return NULL;
 }
 
-#define SAMPLES(a, objects, sm) \
-    samples_args((a)->frames_array, (a)->link, (a)->pa, (a)->pb, (a)->is_self, (a)->S, \
+#define SAMPLES(a, nl, objects, sm) \
+    samples_args((a)->frames, (a)->m, (nl), (a)->link, (a)->pa, (a)->pb, (a)->is_self, (a)->S, \
                  (a)->P, (objects), (sm))
 
 /* rounded_box_bounds(frames (m, L, 4, 4), link (S,), local (S, 4, 4), h (S, 3),
@@ -524,7 +519,7 @@ static PyObject *rounded_box_bounds_body(const rounded_box_bounds_args *a)
 {
     BoxJob job;
     npy_intp S = a->S, P = a->P, m = a->m;
-    if (!SAMPLES(a, a->O, &job.sm))
+    if (!SAMPLES(a, a->L, a->O, &job.sm))
         return bp_fail("rounded_box_bounds: a pair index out of range");
     job.local = a->local;
     job.h = a->h;
@@ -549,7 +544,7 @@ static PyObject *capsule_distances_body(const capsule_distances_args *a)
 {
     CapsuleJob job;
     npy_intp S = a->S, m = a->m, k = a->k;
-    if (!SAMPLES(a, a->O, &job.sm))
+    if (!SAMPLES(a, a->L, a->O, &job.sm))
         return bp_fail("capsule_distances: a pair index out of range");
     job.seg = a->seg;
     job.seg_r = a->seg_r;
@@ -590,7 +585,7 @@ static PyObject *motion_bounds_body(const motion_bounds_args *a)
     const int nc = a->packed.nc;
     npy_intp m = a->m, S = a->S, P = a->P, nq = a->nq;
     /* pb of an object pair is not read here: any index passes */
-    int ok = SAMPLES(a, NPY_MAX_INTP, &job.sm);
+    int ok = SAMPLES(a, a->nc + 2, NPY_MAX_INTP, &job.sm);
     for (npy_intp s = 0; ok && s < S; s++)
         ok = a->sph_start[s] + a->sph_count[s] <= nq;
     if (!ok)

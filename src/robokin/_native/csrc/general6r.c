@@ -769,7 +769,11 @@ static void deflate(double *c, int deg, double r)
  * sample points bracket (a sign change of p between neighbouring samples) by
  * safeguarded Newton steps, deflated; the rest as the eigenvalues of the deflated
  * polynomial's balanced companion matrix (hqr), a smaller matrix for every root
- * already found. Returns 0 when hqr fails. */
+ * already found. Returns 0 when hqr fails.
+ * jbest is not needed (not a bug): c's variable is measured from phi, so sample
+ * jbest + m sits at x = tan(pi m / 24 - pi / 2) whatever jbest is (the sample jbest
+ * itself at x = infinity, where c's leading coefficient is f); the choice of
+ * jbest (the elimination phase) is already in c. */
 static int all_roots16(const double *c, int jbest, double *wr, double *wi)
 {
     (void)jbest;

@@ -2,7 +2,7 @@
 #ifndef ROBOKIN_KERNELS_ARGS_GEN_H
 #define ROBOKIN_KERNELS_ARGS_GEN_H
 
-/* opts: option vector entries (Opts in _declare.py) */
+/* opts: option vector entries (Opts in _declare.py) and their ranges */
 enum {
     O_W = 0, /* 6 task weights, 0 = masked out */
     O_TOL_P = 6,
@@ -22,16 +22,18 @@ enum {
     O_TABLE_ROT = 20, /* [m^2] per unit squared rotation distance; 0 position only, < 0 no table */
     N_OPTS = 21
 };
+static const KOpt opts_o_ranges[] = {{O_W, 6, 0, 0.0, 1.7976931348623157e+308}, {O_TOL_P, 1, 0, 0.0, 1.7976931348623157e+308}, {O_TOL_R, 1, 0, 0.0, 1.7976931348623157e+308}, {O_MAX_ITER, 1, 1, 1.0, 1000000000.0}, {O_USE_Q0, 1, 1, 0.0, 1.0}, {O_MAX_STEP, 1, 0, 0.0, INFINITY}, {O_MU0, 1, 0, 0.0, 1.7976931348623157e+308}, {O_N_SEEDS, 1, 1, 0.0, 1000000000.0}, {O_PATH_MAX_JUMP, 1, 0, 0.0, INFINITY}, {O_STALL_EVERY, 1, 1, 1.0, 1000000000.0}, {O_STALL_RATIO, 1, 0, 0.0, 1.7976931348623157e+308}, {O_MU_DOWN, 1, 0, 0.0, 1.7976931348623157e+308}, {O_MU_UP, 1, 0, 0.0, 1.7976931348623157e+308}, {O_SEED_SHRINK, 1, 0, 0.0, 0.5}, {O_N_TABLE, 1, 1, 0.0, 8.0}, {O_TABLE_ROT, 1, 0, -1.0, 1.7976931348623157e+308}};
 
-/* opts: option vector entries (Opts in _declare.py) */
+/* opts: option vector entries (Opts in _declare.py) and their ranges */
 enum {
     RC_RANGE = 0, /* [joint units] longest step of an extension */
     RC_TIME = 1, /* [s] time limit of the search */
     RC_MAX_NODES = 2, /* most nodes of both trees */
     RC_N_OPTS = 3
 };
+static const KOpt opts_rc_ranges[] = {{RC_RANGE, 1, 0, 5e-324, 1.7976931348623157e+308}, {RC_TIME, 1, 0, -INFINITY, INFINITY}, {RC_MAX_NODES, 1, 1, 1.0, 1000000000.0}};
 
-/* opts: option vector entries (Opts in _declare.py) */
+/* opts: option vector entries (Opts in _declare.py) and their ranges */
 enum {
     SP_VERTEX_TRIES = 0, /* vertex-pair shortcut attempts */
     SP_TRIES = 1, /* point-pair shortcut attempts */
@@ -41,905 +43,107 @@ enum {
     SP_SHARP_TURN = 5, /* [rad] corners turning more than this are cut */
     SP_N_OPTS = 6
 };
+static const KOpt opts_sp_ranges[] = {{SP_VERTEX_TRIES, 1, 1, 0.0, 1000000000000.0}, {SP_TRIES, 1, 1, 0.0, 1000000000000.0}, {SP_MAX_FAIL, 1, 1, 0.0, 1000000000000.0}, {SP_TIME, 1, 0, -INFINITY, INFINITY}, {SP_CUT_ROUNDS, 1, 1, 0.0, 1000.0}, {SP_SHARP_TURN, 1, 0, -1.7976931348623157e+308, 1.7976931348623157e+308}};
 
-/* every entry of opts inside its declared range (NaN fails) */
-static int opts_o_ok(const double *v)
-{
-    for (int i = O_W; i < O_W + 6; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1.7976931348623157e+308))
-            return 0;
-    for (int i = O_TOL_P; i < O_TOL_P + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1.7976931348623157e+308))
-            return 0;
-    for (int i = O_TOL_R; i < O_TOL_R + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1.7976931348623157e+308))
-            return 0;
-    for (int i = O_MAX_ITER; i < O_MAX_ITER + 1; i++)
-        if (!(v[i] >= 1.0 && v[i] <= 1000000000.0) || v[i] != floor(v[i]))
-            return 0;
-    for (int i = O_USE_Q0; i < O_USE_Q0 + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1.0) || v[i] != floor(v[i]))
-            return 0;
-    for (int i = O_MAX_STEP; i < O_MAX_STEP + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= INFINITY))
-            return 0;
-    for (int i = O_MU0; i < O_MU0 + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1.7976931348623157e+308))
-            return 0;
-    for (int i = O_N_SEEDS; i < O_N_SEEDS + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1000000000.0) || v[i] != floor(v[i]))
-            return 0;
-    for (int i = O_PATH_MAX_JUMP; i < O_PATH_MAX_JUMP + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= INFINITY))
-            return 0;
-    for (int i = O_STALL_EVERY; i < O_STALL_EVERY + 1; i++)
-        if (!(v[i] >= 1.0 && v[i] <= 1000000000.0) || v[i] != floor(v[i]))
-            return 0;
-    for (int i = O_STALL_RATIO; i < O_STALL_RATIO + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1.7976931348623157e+308))
-            return 0;
-    for (int i = O_MU_DOWN; i < O_MU_DOWN + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1.7976931348623157e+308))
-            return 0;
-    for (int i = O_MU_UP; i < O_MU_UP + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1.7976931348623157e+308))
-            return 0;
-    for (int i = O_SEED_SHRINK; i < O_SEED_SHRINK + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 0.5))
-            return 0;
-    for (int i = O_N_TABLE; i < O_N_TABLE + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 8.0) || v[i] != floor(v[i]))
-            return 0;
-    for (int i = O_TABLE_ROT; i < O_TABLE_ROT + 1; i++)
-        if (!(v[i] >= -1.0 && v[i] <= 1.7976931348623157e+308))
-            return 0;
-    return 1;
-}
+/* every kernel: X(name, doc) */
+#define KERNELS(X) \
+    X(fk1, "fk1(q, packed) -> F64 | None: Pose (4, 4) of one configuration q (n,), or None for the general path.") \
+    X(fk, "fk(packed, q, out) -> bool: Batch FK of q (N, n) into out (N, 4, 4); whether every q was finite.") \
+    X(jacobian, "jacobian(packed, q, J, T) -> bool: Jacobians J (N, 6, n) and poses T (N, 4, 4) of q (N, n); all finite.") \
+    X(frames, "frames(packed, q, out) -> bool: Base, link frames and tool pose, out (N, n_chain + 2, 4, 4); all finite.") \
+    X(layout, "layout(packed) -> dict[str, Any]: The sections the kernels parse out of packed (for tests).") \
+    X(abs_det_jacobian, "abs_det_jacobian(packed, q, mask, out) -> bool: ``|det J|`` of q (N, 6) where mask (N,), 0 elsewhere, into out (N,).") \
+    X(lm_solve, "lm_solve(packed, targets, q0, seeds, opts, out, tab, cstart, gdat, parallel) -> tuple[int, int]: Numeric IK of targets (N, 4, 4) into out (N, n + N_RES).") \
+    X(seed_uniforms, "seed_uniforms(targets, q0, key, base, out) -> None: Restart numbers of targets (N, 4, 4) from q0 (N, n) into out (N, R, n).") \
+    X(lm_path, "lm_path(packed, targets, q_start, opts, out) -> int: Numeric IK along targets (N, 4, 4) from q_start (n,); first failure or -1.") \
+    X(pose_error, "pose_error(current, target, out) -> None: Residual ``[p_t - p; log(R_t R^T)]`` of (N, 4, 4) poses into out (N, 6).") \
+    X(table_nearest, "table_nearest(rows, cstart, grid, T, k, rot_w) -> I64: Indices of the seed-table rows nearest the pose T (4, 4), nearest first.") \
+    X(nearest, "nearest(packed, Q, ok, qn, is_rev, T, q, err, found) -> None: Per pose, the solution row of Q (N, k, n) nearest qn (N, n), into q.") \
+    X(check_poses, "check_poses(T, tol) -> tuple[int, int]: ``(code, index)`` of the first non-rigid pose of T (N, 4, 4), or (0, -1).") \
+    X(sincos, "sincos(x, s, c) -> None: The kernels' sine and cosine of x (N,) into s and c.") \
+    X(num_threads, "num_threads() -> int: Threads of the pool the batch kernels use.") \
+    X(set_num_threads, "set_num_threads(k) -> int: Set the threads of the pool (1 to 64); returns the number in use.") \
+    X(cpu_has_avx2_fma, "cpu_has_avx2_fma() -> bool: Whether this CPU runs the AVX2 + FMA copy.") \
+    X(cpu_has_avx512, "cpu_has_avx512() -> bool: Whether this CPU runs the AVX-512 copy.") \
+    X(six_r_ik1, "six_r_ik1(T, params, q6, packed) -> tuple[int, F64, Bools, Bools, Bools] | tuple[int, None, None, None, None]: ``(code, Q (8, 6), valid, singular, within_limits (8,))`` of one pose.") \
+    X(six_r_ik, "six_r_ik(params, T, qn, packed) -> tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]: ``(Q (N, 8, 6), valid, singular, within_limits (N, 8), status (N,))``.") \
+    X(atan2, "atan2(y, x, out) -> None: The kernels' atan2 of y, x (N,) into out.") \
+    X(sp4_pair, "sp4_pair(x, tol, mirror, lane, one) -> None: Subproblem 4 of rows x (N, 7) in lanes and one at a time (for tests).") \
+    X(pieper_ik1, "pieper_ik1(T, params, x, qn) -> tuple[int, F64, Bools, Bools, Bools] | tuple[int, None, None, None, None]: ``(code, Q (8, n), valid, singular, within_limits (8,))`` of one pose.") \
+    X(pieper_ik, "pieper_ik(params, T, x, qn) -> tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]: ``(Q (N, 8, n), valid, singular, within_limits (N, 8), status (N,))``.") \
+    X(pieper_roots, "pieper_roots(coeffs, re, im) -> None: The four roots of a quartic (coefficients lowest order first).") \
+    X(general6r_solve, "general6r_solve(packed, params, T, Q, valid, inside, sigma, status, diag, stats, parallel) -> None: Every solution of poses T (N, 4, 4): Q (N, 16, 6), masks (N, 16), ...") \
+    X(general6r_fit_rows, "general6r_fit_rows(consts, a, angles, X, Y) -> None: The left side's fitting rows at angles (M, 3): X (M, 27), Y (M, 14).") \
+    X(general6r_candidates, "general6r_candidates(params, T, out) -> tuple[int, int]: One pose's candidates before the polish (chain values) into out; (n, flags).") \
+    X(general6r_roots, "general6r_roots(c, wr, wi) -> bool: Roots of the polynomial with coefficients c (low order first), into wr, wi.") \
+    X(rounded_box_bounds, "rounded_box_bounds(frames, link, local, h, r, ob_pose, ob_h, ob_r, pa, pb, is_self, skip, out) -> None: Separating-axis lower bounds of every pair at every sample, into out.") \
+    X(capsule_distances, "capsule_distances(frames, link, seg, seg_r, ob_seg, ob_r, pa, pb, is_self, pairs, out) -> None: Exact distances of the listed capsule/sphere pairs at every sample.") \
+    X(propagate_bounds, "propagate_bounds(LB, known, C, rows) -> None: Spread known distances through the motion bounds, in place in LB.") \
+    X(motion_bounds, "motion_bounds(packed, q, frames, link, sph_c, sph_r, sph_start, sph_count, reach, spins, pa, pb, is_self, out) -> None: Per interval and pair, the bound on the change of the distance, into out.") \
+    X(seg_seg, "seg_seg(pts, out) -> None: Segment-segment distances of pts (N, 4, 3) into out (N,).") \
+    X(process_nodes, "process_nodes(packed, Q, valid, singular, mode, weights, Qc, cost, mu, code) -> None: Per node of Q (P, n): canonical values Qc, cost, manipulability, status.") \
+    X(process_dp, "process_dp(Q, cost, circle, max_step, weight, start, forbidden, value, pred, restart, choice) -> int: The exact shortest path through layers Q (L, M, n); returns the segments.") \
+    X(process_clusters, "process_clusters(Q, cost, circle, out) -> None: The least largest-joint-change between every two layers into out (P, P).") \
+    X(process_pairs, "process_pairs(A, B, circle, out) -> None: The largest joint change between every row of A (a, n) and B (b, n).") \
+    X(process_limit_cost, "process_limit_cost(values, lo, hi, margin, out) -> None: The limit cost of each value (P,) into out (P,).") \
+    X(plan_model, "plan_model(packed, shape_i, shape_f, hull, pair_i, reach, S) -> object: The compiled planning model of a robot in a scene (a capsule).") \
+    X(plan_check_states, "plan_check_states(model, q, margin, exact, status, pair) -> tuple[int, int, int, int, int, int]: Validity of states q (m, n) into status (m,) and pair (m,); work counters.") \
+    X(plan_check_edges, "plan_check_edges(model, q0, q1, margin, exact, status, pair, where) -> tuple[int, int, int, int, int, int]: Validity of the straight edges q0 -> q1 (m, n); work counters.") \
+    X(plan_distances, "plan_distances(model, q, out) -> None: Certified lower bounds on every pair's distance at q (m, n) into out (m, P).") \
+    X(plan_rrtc, "plan_rrtc(model, start, goals, lo, hi, margin, opts, seed, exact) -> tuple[int, F64 | None, int, tuple[int, int, int, int, int, int], tuple[int, int, int, float]]: RRT-Connect: (code, path (K, n) or None, goal row, counters, search).") \
+    X(plan_simplify, "plan_simplify(model, path, margin, opts, seed, exact) -> tuple[F64, tuple[int, int, int, int, int, int]]: Shortcuts, then sharp corners cut, of path (K, n); (path, counters).") \
+    X(swivel_rows, "swivel_rows(params, T, psi, Q, valid, sing) -> None: Every SRS configuration of poses T (N, 4, 4) at swivel angles psi (N, m): Q (N, m, 8, 7), valid, singular (N, m, 8).") \
+    X(swivel_manifold, "swivel_manifold(params, T, iv, niv, pts, npts) -> None: Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,).")
 
-/* every entry of opts inside its declared range (NaN fails) */
-static int opts_rc_ok(const double *v)
-{
-    for (int i = RC_RANGE; i < RC_RANGE + 1; i++)
-        if (!(v[i] >= 5e-324 && v[i] <= 1.7976931348623157e+308))
-            return 0;
-    for (int i = RC_TIME; i < RC_TIME + 1; i++)
-        if (!(v[i] >= -INFINITY && v[i] <= INFINITY))
-            return 0;
-    for (int i = RC_MAX_NODES; i < RC_MAX_NODES + 1; i++)
-        if (!(v[i] >= 1.0 && v[i] <= 1000000000.0) || v[i] != floor(v[i]))
-            return 0;
-    return 1;
-}
+/* per kernel, the checked arguments and the bound shape symbols (a->N) */
+typedef struct { PyObject *q; PyObject *packed; } fk1_args; /* fk.c / module.c */
+typedef struct { Chain packed; const double *q; double *out; union { struct { npy_intp n, nc, N; }; npy_intp sym[3]; }; } fk_args; /* fk.c / module.c */
+typedef struct { Chain packed; const double *q; double *J; double *T; union { struct { npy_intp n, nc, N; }; npy_intp sym[3]; }; } jacobian_args; /* fk.c / module.c */
+typedef struct { Chain packed; const double *q; double *out; union { struct { npy_intp n, nc, N; }; npy_intp sym[3]; }; } frames_args; /* fk.c / module.c */
+typedef struct { Chain packed; union { struct { npy_intp n, nc; }; npy_intp sym[2]; }; } layout_args; /* fk.c / module.c */
+typedef struct { Chain packed; const double *q; const npy_bool *mask; double *out; union { struct { npy_intp n, nc, N; }; npy_intp sym[3]; }; } abs_det_jacobian_args; /* fk.c / module.c */
+typedef struct { Chain packed; const double *targets; const double *q0; const double *seeds; const double *opts; double *out; const double *tab; const long long *cstart; const double *gdat; int parallel; union { struct { npy_intp n, nc, N, R, M, tab_cols, C; }; npy_intp sym[7]; }; } lm_solve_args; /* lm.c */
+typedef struct { const double *targets; const double *q0; unsigned long long key; long base; double *out; union { struct { npy_intp N, n, R; }; npy_intp sym[3]; }; } seed_uniforms_args; /* lm.c */
+typedef struct { Chain packed; const double *targets; const double *q_start; const double *opts; double *out; union { struct { npy_intp n, nc, N; }; npy_intp sym[3]; }; } lm_path_args; /* lm.c */
+typedef struct { const double *current; const double *target; double *out; union { struct { npy_intp N; }; npy_intp sym[1]; }; } pose_error_args; /* lm.c */
+typedef struct { const double *rows; const long long *cstart; const double *grid; const double *T; long k; double rot_w; union { struct { npy_intp M, cols, C; }; npy_intp sym[3]; }; } table_nearest_args; /* lm.c */
+typedef struct { Chain packed; const double *Q; const npy_bool *ok; const double *qn; const npy_bool *is_rev; const double *T; double *q; double *err; npy_bool *found; union { struct { npy_intp n, nc, N, k; }; npy_intp sym[4]; }; } nearest_args; /* lm.c */
+typedef struct { const double *T; double tol; union { struct { npy_intp N; }; npy_intp sym[1]; }; } check_poses_args; /* lm.c */
+typedef struct { const double *x; double *s; double *c; union { struct { npy_intp N; }; npy_intp sym[1]; }; } sincos_args; /* lm.c */
+typedef struct { char unused; /* a struct is never empty */ } num_threads_args; /* lm.c */
+typedef struct { long k; } set_num_threads_args; /* lm.c */
+typedef struct { char unused; /* a struct is never empty */ } cpu_has_avx2_fma_args; /* lm.c */
+typedef struct { char unused; /* a struct is never empty */ } cpu_has_avx512_args; /* lm.c */
+typedef struct { PyObject *T; const double *params; double q6; Chain packed; union { struct { npy_intp n, nc; }; npy_intp sym[2]; }; } six_r_ik1_args; /* six_r.c */
+typedef struct { const double *params; const double *T; const double *qn; Chain packed; union { struct { npy_intp N, m, n, nc; }; npy_intp sym[4]; }; } six_r_ik_args; /* six_r.c */
+typedef struct { const double *y; const double *x; double *out; union { struct { npy_intp N; }; npy_intp sym[1]; }; } atan2_args; /* six_r.c */
+typedef struct { const double *x; double tol; int mirror; double *lane; double *one; union { struct { npy_intp N; }; npy_intp sym[1]; }; } sp4_pair_args; /* six_r.c */
+typedef struct { PyObject *T; const double *params; double x; PyObject *qn; } pieper_ik1_args; /* pieper.c */
+typedef struct { const double *params; const double *T; const double *x; const double *qn; union { struct { npy_intp N, m, mq, nq; }; npy_intp sym[4]; }; } pieper_ik_args; /* pieper.c */
+typedef struct { const double *coeffs; double *re; double *im; } pieper_roots_args; /* pieper.c */
+typedef struct { Chain packed; const double *params; const double *T; double *Q; npy_bool *valid; npy_bool *inside; double *sigma; long long *status; long long *diag; double *stats; int parallel; union { struct { npy_intp n, nc, P, N; }; npy_intp sym[4]; }; } general6r_solve_args; /* general6r.c */
+typedef struct { const double *consts; long a; const double *angles; double *X; double *Y; union { struct { npy_intp M; }; npy_intp sym[1]; }; } general6r_fit_rows_args; /* general6r.c */
+typedef struct { const double *params; const double *T; double *out; union { struct { npy_intp P; }; npy_intp sym[1]; }; } general6r_candidates_args; /* general6r.c */
+typedef struct { const double *c; double *wr; double *wi; union { struct { npy_intp D; }; npy_intp sym[1]; }; } general6r_roots_args; /* general6r.c */
+typedef struct { const double *frames; const long long *link; const double *local; const double *h; const double *r; const double *ob_pose; const double *ob_h; const double *ob_r; const long long *pa; const long long *pb; const npy_bool *is_self; const npy_bool *skip; double *out; union { struct { npy_intp m, L, S, O, P; }; npy_intp sym[5]; }; } rounded_box_bounds_args; /* broadphase.c */
+typedef struct { const double *frames; const long long *link; const double *seg; const double *seg_r; const double *ob_seg; const double *ob_r; const long long *pa; const long long *pb; const npy_bool *is_self; const long long *pairs; double *out; union { struct { npy_intp m, L, S, O, P, k; }; npy_intp sym[6]; }; } capsule_distances_args; /* broadphase.c */
+typedef struct { double *LB; const npy_bool *known; const double *C; const long long *rows; union { struct { npy_intp P, m, k; }; npy_intp sym[3]; }; } propagate_bounds_args; /* broadphase.c */
+typedef struct { Chain packed; const double *q; const double *frames; const long long *link; const double *sph_c; const double *sph_r; const long long *sph_start; const long long *sph_count; const double *reach; const npy_bool *spins; const long long *pa; const long long *pb; const npy_bool *is_self; double *out; union { struct { npy_intp n, nc, m, S, nq, P; }; npy_intp sym[6]; }; } motion_bounds_args; /* broadphase.c */
+typedef struct { const double *pts; double *out; union { struct { npy_intp N; }; npy_intp sym[1]; }; } seg_seg_args; /* broadphase.c */
+typedef struct { Chain packed; const double *Q; const npy_bool *valid; const npy_bool *singular; const unsigned char *mode; const double *weights; double *Qc; double *cost; double *mu; signed char *code; union { struct { npy_intp n, nc, P; }; npy_intp sym[3]; }; } process_nodes_args; /* process.c */
+typedef struct { const double *Q; const double *cost; const unsigned char *circle; double max_step; double weight; const double *start; const long long *forbidden; double *value; int *pred; unsigned char *restart; int *choice; union { struct { npy_intp L, M, n, F; }; npy_intp sym[4]; }; } process_dp_args; /* process.c */
+typedef struct { const double *Q; const double *cost; const unsigned char *circle; double *out; union { struct { npy_intp P, M, n; }; npy_intp sym[3]; }; } process_clusters_args; /* process.c */
+typedef struct { const double *A; const double *B; const unsigned char *circle; double *out; union { struct { npy_intp na, n, nb; }; npy_intp sym[3]; }; } process_pairs_args; /* process.c */
+typedef struct { const double *values; double lo; double hi; double margin; double *out; union { struct { npy_intp P; }; npy_intp sym[1]; }; } process_limit_cost_args; /* process.c */
+typedef struct { const double *packed; const long long *shape_i; const double *shape_f; const double *hull; const long long *pair_i; const double *reach; long S; union { struct { npy_intp len, N, H, P, S_r, nc; }; npy_intp sym[6]; }; } plan_model_args; /* plan_check.c */
+typedef struct { PyObject *model; const double *q; const double *margin; PyObject *exact; long long *status; long long *pair; union { struct { npy_intp m, n, P; }; npy_intp sym[3]; }; } plan_check_states_args; /* plan_check.c */
+typedef struct { PyObject *model; const double *q0; const double *q1; const double *margin; PyObject *exact; long long *status; long long *pair; double *where; union { struct { npy_intp m, n, P; }; npy_intp sym[3]; }; } plan_check_edges_args; /* plan_check.c */
+typedef struct { PyObject *model; const double *q; double *out; union { struct { npy_intp m, n, P; }; npy_intp sym[3]; }; } plan_distances_args; /* plan_check.c */
+typedef struct { PyObject *model; const double *start; const double *goals; const double *lo; const double *hi; const double *margin; const double *opts; unsigned long long seed; PyObject *exact; union { struct { npy_intp n, k, P; }; npy_intp sym[3]; }; } plan_rrtc_args; /* plan_rrtc.c */
+typedef struct { PyObject *model; const double *path; const double *margin; const double *opts; unsigned long long seed; PyObject *exact; union { struct { npy_intp K, n, P; }; npy_intp sym[3]; }; } plan_simplify_args; /* plan_path.c */
+typedef struct { const double *params; const double *T; const double *psi; double *Q; npy_bool *valid; npy_bool *sing; union { struct { npy_intp N, m; }; npy_intp sym[2]; }; } swivel_rows_args; /* self_motion.c */
+typedef struct { const double *params; const double *T; double *iv; long long *niv; double *pts; long long *npts; union { struct { npy_intp N; }; npy_intp sym[1]; }; } swivel_manifold_args; /* self_motion.c */
 
-/* every entry of opts inside its declared range (NaN fails) */
-static int opts_sp_ok(const double *v)
-{
-    for (int i = SP_VERTEX_TRIES; i < SP_VERTEX_TRIES + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1000000000000.0) || v[i] != floor(v[i]))
-            return 0;
-    for (int i = SP_TRIES; i < SP_TRIES + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1000000000000.0) || v[i] != floor(v[i]))
-            return 0;
-    for (int i = SP_MAX_FAIL; i < SP_MAX_FAIL + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1000000000000.0) || v[i] != floor(v[i]))
-            return 0;
-    for (int i = SP_TIME; i < SP_TIME + 1; i++)
-        if (!(v[i] >= -INFINITY && v[i] <= INFINITY))
-            return 0;
-    for (int i = SP_CUT_ROUNDS; i < SP_CUT_ROUNDS + 1; i++)
-        if (!(v[i] >= 0.0 && v[i] <= 1000.0) || v[i] != floor(v[i]))
-            return 0;
-    for (int i = SP_SHARP_TURN; i < SP_SHARP_TURN + 1; i++)
-        if (!(v[i] >= -1.7976931348623157e+308 && v[i] <= 1.7976931348623157e+308))
-            return 0;
-    return 1;
-}
-
-/* fk1: fk.c / module.c */
-typedef struct {
-    PyObject *q;
-    PyObject *packed;
-    char unused; /* a struct is never empty */
-} fk1_args;
-static PyObject *fk1_body(const fk1_args *a);
-
-/* fk: fk.c / module.c */
-typedef struct {
-    Chain packed;
-    const double *q;
-    PyArrayObject *q_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp n;
-    npy_intp nc;
-    npy_intp N;
-    char unused; /* a struct is never empty */
-} fk_args;
-static PyObject *fk_body(const fk_args *a);
-
-/* jacobian: fk.c / module.c */
-typedef struct {
-    Chain packed;
-    const double *q;
-    PyArrayObject *q_array;
-    double *J;
-    PyArrayObject *J_array;
-    double *T;
-    PyArrayObject *T_array;
-    npy_intp n;
-    npy_intp nc;
-    npy_intp N;
-    char unused; /* a struct is never empty */
-} jacobian_args;
-static PyObject *jacobian_body(const jacobian_args *a);
-
-/* frames: fk.c / module.c */
-typedef struct {
-    Chain packed;
-    const double *q;
-    PyArrayObject *q_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp n;
-    npy_intp nc;
-    npy_intp N;
-    char unused; /* a struct is never empty */
-} frames_args;
-static PyObject *frames_body(const frames_args *a);
-
-/* layout: fk.c / module.c */
-typedef struct {
-    Chain packed;
-    npy_intp n;
-    npy_intp nc;
-    char unused; /* a struct is never empty */
-} layout_args;
-static PyObject *layout_body(const layout_args *a);
-
-/* abs_det_jacobian: fk.c / module.c */
-typedef struct {
-    Chain packed;
-    const double *q;
-    PyArrayObject *q_array;
-    const npy_bool *mask;
-    PyArrayObject *mask_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp n;
-    npy_intp nc;
-    npy_intp N;
-    char unused; /* a struct is never empty */
-} abs_det_jacobian_args;
-static PyObject *abs_det_jacobian_body(const abs_det_jacobian_args *a);
-
-/* lm_solve: lm.c */
-typedef struct {
-    Chain packed;
-    const double *targets;
-    PyArrayObject *targets_array;
-    const double *q0;
-    PyArrayObject *q0_array;
-    const double *seeds;
-    PyArrayObject *seeds_array;
-    const double *opts;
-    double *out;
-    PyArrayObject *out_array;
-    const double *tab;
-    PyArrayObject *tab_array;
-    const long long *cstart;
-    PyArrayObject *cstart_array;
-    const double *gdat;
-    PyArrayObject *gdat_array;
-    int parallel;
-    npy_intp n;
-    npy_intp nc;
-    npy_intp N;
-    npy_intp R;
-    npy_intp M;
-    npy_intp tab_cols;
-    npy_intp C;
-    char unused; /* a struct is never empty */
-} lm_solve_args;
-static PyObject *lm_solve_body(const lm_solve_args *a);
-
-/* seed_uniforms: lm.c */
-typedef struct {
-    const double *targets;
-    PyArrayObject *targets_array;
-    const double *q0;
-    PyArrayObject *q0_array;
-    unsigned long long key;
-    long base;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp N;
-    npy_intp n;
-    npy_intp R;
-    char unused; /* a struct is never empty */
-} seed_uniforms_args;
-static PyObject *seed_uniforms_body(const seed_uniforms_args *a);
-
-/* lm_path: lm.c */
-typedef struct {
-    Chain packed;
-    const double *targets;
-    PyArrayObject *targets_array;
-    const double *q_start;
-    PyArrayObject *q_start_array;
-    const double *opts;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp n;
-    npy_intp nc;
-    npy_intp N;
-    char unused; /* a struct is never empty */
-} lm_path_args;
-static PyObject *lm_path_body(const lm_path_args *a);
-
-/* pose_error: lm.c */
-typedef struct {
-    const double *current;
-    PyArrayObject *current_array;
-    const double *target;
-    PyArrayObject *target_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp N;
-    char unused; /* a struct is never empty */
-} pose_error_args;
-static PyObject *pose_error_body(const pose_error_args *a);
-
-/* table_nearest: lm.c */
-typedef struct {
-    const double *rows;
-    PyArrayObject *rows_array;
-    const long long *cstart;
-    PyArrayObject *cstart_array;
-    const double *grid;
-    PyArrayObject *grid_array;
-    const double *T;
-    PyArrayObject *T_array;
-    long k;
-    double rot_w;
-    npy_intp M;
-    npy_intp cols;
-    npy_intp C;
-    char unused; /* a struct is never empty */
-} table_nearest_args;
-static PyObject *table_nearest_body(const table_nearest_args *a);
-
-/* nearest: lm.c */
-typedef struct {
-    Chain packed;
-    const double *Q;
-    PyArrayObject *Q_array;
-    const npy_bool *ok;
-    PyArrayObject *ok_array;
-    const double *qn;
-    PyArrayObject *qn_array;
-    const npy_bool *is_rev;
-    PyArrayObject *is_rev_array;
-    const double *T;
-    PyArrayObject *T_array;
-    double *q;
-    PyArrayObject *q_array;
-    double *err;
-    PyArrayObject *err_array;
-    npy_bool *found;
-    PyArrayObject *found_array;
-    npy_intp n;
-    npy_intp nc;
-    npy_intp N;
-    npy_intp k;
-    char unused; /* a struct is never empty */
-} nearest_args;
-static PyObject *nearest_body(const nearest_args *a);
-
-/* check_poses: lm.c */
-typedef struct {
-    const double *T;
-    PyArrayObject *T_array;
-    double tol;
-    npy_intp N;
-    char unused; /* a struct is never empty */
-} check_poses_args;
-static PyObject *check_poses_body(const check_poses_args *a);
-
-/* sincos: lm.c */
-typedef struct {
-    const double *x;
-    PyArrayObject *x_array;
-    double *s;
-    PyArrayObject *s_array;
-    double *c;
-    PyArrayObject *c_array;
-    npy_intp N;
-    char unused; /* a struct is never empty */
-} sincos_args;
-static PyObject *sincos_body(const sincos_args *a);
-
-/* num_threads: lm.c */
-typedef struct {
-    char unused; /* a struct is never empty */
-} num_threads_args;
-static PyObject *num_threads_body(const num_threads_args *a);
-
-/* set_num_threads: lm.c */
-typedef struct {
-    long k;
-    char unused; /* a struct is never empty */
-} set_num_threads_args;
-static PyObject *set_num_threads_body(const set_num_threads_args *a);
-
-/* cpu_has_avx2_fma: lm.c */
-typedef struct {
-    char unused; /* a struct is never empty */
-} cpu_has_avx2_fma_args;
-static PyObject *cpu_has_avx2_fma_body(const cpu_has_avx2_fma_args *a);
-
-/* cpu_has_avx512: lm.c */
-typedef struct {
-    char unused; /* a struct is never empty */
-} cpu_has_avx512_args;
-static PyObject *cpu_has_avx512_body(const cpu_has_avx512_args *a);
-
-/* six_r_ik1: six_r.c */
-typedef struct {
-    PyObject *T;
-    const double *params;
-    PyArrayObject *params_array;
-    double q6;
-    Chain packed;
-    npy_intp n;
-    npy_intp nc;
-    char unused; /* a struct is never empty */
-} six_r_ik1_args;
-static PyObject *six_r_ik1_body(const six_r_ik1_args *a);
-
-/* six_r_ik: six_r.c */
-typedef struct {
-    const double *params;
-    PyArrayObject *params_array;
-    const double *T;
-    PyArrayObject *T_array;
-    const double *qn;
-    PyArrayObject *qn_array;
-    Chain packed;
-    npy_intp N;
-    npy_intp m;
-    npy_intp n;
-    npy_intp nc;
-    char unused; /* a struct is never empty */
-} six_r_ik_args;
-static PyObject *six_r_ik_body(const six_r_ik_args *a);
-
-/* atan2: six_r.c */
-typedef struct {
-    const double *y;
-    PyArrayObject *y_array;
-    const double *x;
-    PyArrayObject *x_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp N;
-    char unused; /* a struct is never empty */
-} atan2_args;
-static PyObject *atan2_body(const atan2_args *a);
-
-/* pieper_ik1: pieper.c */
-typedef struct {
-    PyObject *T;
-    const double *params;
-    PyArrayObject *params_array;
-    double x;
-    PyObject *qn;
-    char unused; /* a struct is never empty */
-} pieper_ik1_args;
-static PyObject *pieper_ik1_body(const pieper_ik1_args *a);
-
-/* pieper_ik: pieper.c */
-typedef struct {
-    const double *params;
-    PyArrayObject *params_array;
-    const double *T;
-    PyArrayObject *T_array;
-    const double *x;
-    PyArrayObject *x_array;
-    const double *qn;
-    PyArrayObject *qn_array;
-    npy_intp N;
-    npy_intp m;
-    npy_intp mq;
-    char unused; /* a struct is never empty */
-} pieper_ik_args;
-static PyObject *pieper_ik_body(const pieper_ik_args *a);
-
-/* pieper_roots: pieper.c */
-typedef struct {
-    const double *coeffs;
-    PyArrayObject *coeffs_array;
-    double *re;
-    PyArrayObject *re_array;
-    double *im;
-    PyArrayObject *im_array;
-    char unused; /* a struct is never empty */
-} pieper_roots_args;
-static PyObject *pieper_roots_body(const pieper_roots_args *a);
-
-/* general6r_solve: general6r.c */
-typedef struct {
-    Chain packed;
-    const double *params;
-    PyArrayObject *params_array;
-    const double *T;
-    PyArrayObject *T_array;
-    double *Q;
-    PyArrayObject *Q_array;
-    npy_bool *valid;
-    PyArrayObject *valid_array;
-    npy_bool *inside;
-    PyArrayObject *inside_array;
-    double *sigma;
-    PyArrayObject *sigma_array;
-    long long *status;
-    PyArrayObject *status_array;
-    long long *diag;
-    PyArrayObject *diag_array;
-    double *stats;
-    PyArrayObject *stats_array;
-    int parallel;
-    npy_intp n;
-    npy_intp nc;
-    npy_intp P;
-    npy_intp N;
-    char unused; /* a struct is never empty */
-} general6r_solve_args;
-static PyObject *general6r_solve_body(const general6r_solve_args *a);
-
-/* general6r_fit_rows: general6r.c */
-typedef struct {
-    const double *consts;
-    PyArrayObject *consts_array;
-    long a;
-    const double *angles;
-    PyArrayObject *angles_array;
-    double *X;
-    PyArrayObject *X_array;
-    double *Y;
-    PyArrayObject *Y_array;
-    npy_intp M;
-    char unused; /* a struct is never empty */
-} general6r_fit_rows_args;
-static PyObject *general6r_fit_rows_body(const general6r_fit_rows_args *a);
-
-/* general6r_candidates: general6r.c */
-typedef struct {
-    const double *params;
-    PyArrayObject *params_array;
-    const double *T;
-    PyArrayObject *T_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp P;
-    char unused; /* a struct is never empty */
-} general6r_candidates_args;
-static PyObject *general6r_candidates_body(const general6r_candidates_args *a);
-
-/* general6r_roots: general6r.c */
-typedef struct {
-    const double *c;
-    PyArrayObject *c_array;
-    double *wr;
-    PyArrayObject *wr_array;
-    double *wi;
-    PyArrayObject *wi_array;
-    npy_intp D;
-    char unused; /* a struct is never empty */
-} general6r_roots_args;
-static PyObject *general6r_roots_body(const general6r_roots_args *a);
-
-/* rounded_box_bounds: broadphase.c */
-typedef struct {
-    const double *frames;
-    PyArrayObject *frames_array;
-    const long long *link;
-    PyArrayObject *link_array;
-    const double *local;
-    PyArrayObject *local_array;
-    const double *h;
-    PyArrayObject *h_array;
-    const double *r;
-    PyArrayObject *r_array;
-    const double *ob_pose;
-    PyArrayObject *ob_pose_array;
-    const double *ob_h;
-    PyArrayObject *ob_h_array;
-    const double *ob_r;
-    PyArrayObject *ob_r_array;
-    const long long *pa;
-    PyArrayObject *pa_array;
-    const long long *pb;
-    PyArrayObject *pb_array;
-    const npy_bool *is_self;
-    PyArrayObject *is_self_array;
-    const npy_bool *skip;
-    PyArrayObject *skip_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp m;
-    npy_intp L;
-    npy_intp S;
-    npy_intp O;
-    npy_intp P;
-    char unused; /* a struct is never empty */
-} rounded_box_bounds_args;
-static PyObject *rounded_box_bounds_body(const rounded_box_bounds_args *a);
-
-/* capsule_distances: broadphase.c */
-typedef struct {
-    const double *frames;
-    PyArrayObject *frames_array;
-    const long long *link;
-    PyArrayObject *link_array;
-    const double *seg;
-    PyArrayObject *seg_array;
-    const double *seg_r;
-    PyArrayObject *seg_r_array;
-    const double *ob_seg;
-    PyArrayObject *ob_seg_array;
-    const double *ob_r;
-    PyArrayObject *ob_r_array;
-    const long long *pa;
-    PyArrayObject *pa_array;
-    const long long *pb;
-    PyArrayObject *pb_array;
-    const npy_bool *is_self;
-    PyArrayObject *is_self_array;
-    const long long *pairs;
-    PyArrayObject *pairs_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp m;
-    npy_intp L;
-    npy_intp S;
-    npy_intp O;
-    npy_intp P;
-    npy_intp k;
-    char unused; /* a struct is never empty */
-} capsule_distances_args;
-static PyObject *capsule_distances_body(const capsule_distances_args *a);
-
-/* propagate_bounds: broadphase.c */
-typedef struct {
-    double *LB;
-    PyArrayObject *LB_array;
-    const npy_bool *known;
-    PyArrayObject *known_array;
-    const double *C;
-    PyArrayObject *C_array;
-    const long long *rows;
-    PyArrayObject *rows_array;
-    npy_intp P;
-    npy_intp m;
-    npy_intp k;
-    char unused; /* a struct is never empty */
-} propagate_bounds_args;
-static PyObject *propagate_bounds_body(const propagate_bounds_args *a);
-
-/* motion_bounds: broadphase.c */
-typedef struct {
-    Chain packed;
-    const double *q;
-    PyArrayObject *q_array;
-    const double *frames;
-    PyArrayObject *frames_array;
-    const long long *link;
-    PyArrayObject *link_array;
-    const double *sph_c;
-    PyArrayObject *sph_c_array;
-    const double *sph_r;
-    PyArrayObject *sph_r_array;
-    const long long *sph_start;
-    PyArrayObject *sph_start_array;
-    const long long *sph_count;
-    PyArrayObject *sph_count_array;
-    const double *reach;
-    PyArrayObject *reach_array;
-    const npy_bool *spins;
-    PyArrayObject *spins_array;
-    const long long *pa;
-    PyArrayObject *pa_array;
-    const long long *pb;
-    PyArrayObject *pb_array;
-    const npy_bool *is_self;
-    PyArrayObject *is_self_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp n;
-    npy_intp nc;
-    npy_intp m;
-    npy_intp S;
-    npy_intp nq;
-    npy_intp P;
-    char unused; /* a struct is never empty */
-} motion_bounds_args;
-static PyObject *motion_bounds_body(const motion_bounds_args *a);
-
-/* seg_seg: broadphase.c */
-typedef struct {
-    const double *pts;
-    PyArrayObject *pts_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp N;
-    char unused; /* a struct is never empty */
-} seg_seg_args;
-static PyObject *seg_seg_body(const seg_seg_args *a);
-
-/* process_nodes: process.c */
-typedef struct {
-    Chain packed;
-    const double *Q;
-    PyArrayObject *Q_array;
-    const npy_bool *valid;
-    PyArrayObject *valid_array;
-    const npy_bool *singular;
-    PyArrayObject *singular_array;
-    const unsigned char *mode;
-    PyArrayObject *mode_array;
-    const double *weights;
-    PyArrayObject *weights_array;
-    double *Qc;
-    PyArrayObject *Qc_array;
-    double *cost;
-    PyArrayObject *cost_array;
-    double *mu;
-    PyArrayObject *mu_array;
-    signed char *code;
-    PyArrayObject *code_array;
-    npy_intp n;
-    npy_intp nc;
-    npy_intp P;
-    char unused; /* a struct is never empty */
-} process_nodes_args;
-static PyObject *process_nodes_body(const process_nodes_args *a);
-
-/* process_dp: process.c */
-typedef struct {
-    const double *Q;
-    PyArrayObject *Q_array;
-    const double *cost;
-    PyArrayObject *cost_array;
-    const unsigned char *circle;
-    PyArrayObject *circle_array;
-    double max_step;
-    double weight;
-    const double *start;
-    PyArrayObject *start_array;
-    const long long *forbidden;
-    PyArrayObject *forbidden_array;
-    double *value;
-    PyArrayObject *value_array;
-    int *pred;
-    PyArrayObject *pred_array;
-    unsigned char *restart;
-    PyArrayObject *restart_array;
-    int *choice;
-    PyArrayObject *choice_array;
-    npy_intp L;
-    npy_intp M;
-    npy_intp n;
-    npy_intp F;
-    char unused; /* a struct is never empty */
-} process_dp_args;
-static PyObject *process_dp_body(const process_dp_args *a);
-
-/* process_clusters: process.c */
-typedef struct {
-    const double *Q;
-    PyArrayObject *Q_array;
-    const double *cost;
-    PyArrayObject *cost_array;
-    const unsigned char *circle;
-    PyArrayObject *circle_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp P;
-    npy_intp M;
-    npy_intp n;
-    char unused; /* a struct is never empty */
-} process_clusters_args;
-static PyObject *process_clusters_body(const process_clusters_args *a);
-
-/* process_pairs: process.c */
-typedef struct {
-    const double *A;
-    PyArrayObject *A_array;
-    const double *B;
-    PyArrayObject *B_array;
-    const unsigned char *circle;
-    PyArrayObject *circle_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp na;
-    npy_intp n;
-    npy_intp nb;
-    char unused; /* a struct is never empty */
-} process_pairs_args;
-static PyObject *process_pairs_body(const process_pairs_args *a);
-
-/* process_limit_cost: process.c */
-typedef struct {
-    const double *values;
-    PyArrayObject *values_array;
-    double lo;
-    double hi;
-    double margin;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp P;
-    char unused; /* a struct is never empty */
-} process_limit_cost_args;
-static PyObject *process_limit_cost_body(const process_limit_cost_args *a);
-
-/* plan_model: plan_check.c */
-typedef struct {
-    const double *packed;
-    PyArrayObject *packed_array;
-    const long long *shape_i;
-    PyArrayObject *shape_i_array;
-    const double *shape_f;
-    PyArrayObject *shape_f_array;
-    const double *hull;
-    PyArrayObject *hull_array;
-    const long long *pair_i;
-    PyArrayObject *pair_i_array;
-    const double *reach;
-    PyArrayObject *reach_array;
-    long S;
-    npy_intp len;
-    npy_intp N;
-    npy_intp H;
-    npy_intp P;
-    npy_intp S_r;
-    npy_intp nc;
-    char unused; /* a struct is never empty */
-} plan_model_args;
-static PyObject *plan_model_body(const plan_model_args *a);
-
-/* plan_check_states: plan_check.c */
-typedef struct {
-    PyObject *model;
-    const double *q;
-    PyArrayObject *q_array;
-    const double *margin;
-    PyArrayObject *margin_array;
-    PyObject *exact;
-    long long *status;
-    PyArrayObject *status_array;
-    long long *pair;
-    PyArrayObject *pair_array;
-    npy_intp m;
-    npy_intp n;
-    npy_intp P;
-    char unused; /* a struct is never empty */
-} plan_check_states_args;
-static PyObject *plan_check_states_body(const plan_check_states_args *a);
-
-/* plan_check_edges: plan_check.c */
-typedef struct {
-    PyObject *model;
-    const double *q0;
-    PyArrayObject *q0_array;
-    const double *q1;
-    PyArrayObject *q1_array;
-    const double *margin;
-    PyArrayObject *margin_array;
-    PyObject *exact;
-    long long *status;
-    PyArrayObject *status_array;
-    long long *pair;
-    PyArrayObject *pair_array;
-    double *where;
-    PyArrayObject *where_array;
-    npy_intp m;
-    npy_intp n;
-    npy_intp P;
-    char unused; /* a struct is never empty */
-} plan_check_edges_args;
-static PyObject *plan_check_edges_body(const plan_check_edges_args *a);
-
-/* plan_distances: plan_check.c */
-typedef struct {
-    PyObject *model;
-    const double *q;
-    PyArrayObject *q_array;
-    double *out;
-    PyArrayObject *out_array;
-    npy_intp m;
-    npy_intp n;
-    npy_intp P;
-    char unused; /* a struct is never empty */
-} plan_distances_args;
-static PyObject *plan_distances_body(const plan_distances_args *a);
-
-/* plan_rrtc: plan_rrtc.c */
-typedef struct {
-    PyObject *model;
-    const double *start;
-    PyArrayObject *start_array;
-    const double *goals;
-    PyArrayObject *goals_array;
-    const double *lo;
-    PyArrayObject *lo_array;
-    const double *hi;
-    PyArrayObject *hi_array;
-    const double *margin;
-    PyArrayObject *margin_array;
-    const double *opts;
-    unsigned long long seed;
-    PyObject *exact;
-    npy_intp n;
-    npy_intp k;
-    npy_intp P;
-    char unused; /* a struct is never empty */
-} plan_rrtc_args;
-static PyObject *plan_rrtc_body(const plan_rrtc_args *a);
-
-/* plan_simplify: plan_path.c */
-typedef struct {
-    PyObject *model;
-    const double *path;
-    PyArrayObject *path_array;
-    const double *margin;
-    PyArrayObject *margin_array;
-    const double *opts;
-    unsigned long long seed;
-    PyObject *exact;
-    npy_intp K;
-    npy_intp n;
-    npy_intp P;
-    char unused; /* a struct is never empty */
-} plan_simplify_args;
-static PyObject *plan_simplify_body(const plan_simplify_args *a);
-
-/* swivel_rows: self_motion.c */
-typedef struct {
-    const double *params;
-    PyArrayObject *params_array;
-    const double *T;
-    PyArrayObject *T_array;
-    const double *psi;
-    PyArrayObject *psi_array;
-    double *Q;
-    PyArrayObject *Q_array;
-    npy_bool *valid;
-    PyArrayObject *valid_array;
-    npy_bool *sing;
-    PyArrayObject *sing_array;
-    npy_intp N;
-    npy_intp m;
-    char unused; /* a struct is never empty */
-} swivel_rows_args;
-static PyObject *swivel_rows_body(const swivel_rows_args *a);
-
-/* swivel_manifold: self_motion.c */
-typedef struct {
-    const double *params;
-    PyArrayObject *params_array;
-    const double *T;
-    PyArrayObject *T_array;
-    double *iv;
-    PyArrayObject *iv_array;
-    long long *niv;
-    PyArrayObject *niv_array;
-    double *pts;
-    PyArrayObject *pts_array;
-    long long *npts;
-    PyArrayObject *npts_array;
-    npy_intp N;
-    char unused; /* a struct is never empty */
-} swivel_manifold_args;
-static PyObject *swivel_manifold_body(const swivel_manifold_args *a);
+KERNELS(KERNEL_BODY)
 
 #endif

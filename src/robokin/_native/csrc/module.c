@@ -7,7 +7,8 @@
  * works.
  *
  * Every entry point is generated (kernels_entry.gen.h, from ../_declare.py): it
- * checks every argument (dtype, shape, alignment, index and option ranges) and
+ * checks every argument (dtype, shape, alignment, index and option ranges; one
+ * parser, args.h's kernel_args, reading the kernel's descriptor table) and
  * fills a <name>_args struct, then calls <name>_body, written by hand in the
  * kernel's file (this file holds the bodies of FK, the numeric IK's helpers and the
  * pool's). Argument errors are internal ones (the Python layer validates what

@@ -414,6 +414,16 @@ static inline int consider(const Graph *g, const double *x, const double *y, int
     return 1;
 }
 
+/* The views of layers i (source s) and i + 1 (target t) both relax_* steps read:
+ * nodes Qs, Qt (M x n), target costs ct, values Vs, Vt and target predecessors Pt. */
+#define LAYER_PAIR(g, i, value, pred) \
+    const int M = (g)->M, n = (g)->n; \
+    const double *Qs = (g)->Q + (size_t)(i) * M * n, *Qt = Qs + (size_t)M * n; \
+    const double *ct = (g)->cost + (size_t)((i) + 1) * M; \
+    const double *Vs = (value) + (size_t)(i) * M; \
+    double *Vt = (value) + (size_t)((i) + 1) * M; \
+    int *Pt = (pred) + (size_t)((i) + 1) * M
+
 /* Pull every node of layer i + 1 from layer i: through the buckets of `axes`, or,
  * without a step limit (dense), through the usable nodes of layer i sorted by
  * value (`byval`, count `nval`), which stops at the first that cannot win.
@@ -421,12 +431,7 @@ static inline int consider(const Graph *g, const double *x, const double *y, int
 static long relax_layer(const Graph *g, long i, const Axis *axes, const int *byval,
                         int nval, double *value, int *pred, Forbidden *fb)
 {
-    const int M = g->M, n = g->n;
-    const double *Qs = g->Q + (size_t)i * M * n, *Qt = Qs + (size_t)M * n;
-    const double *ct = g->cost + (size_t)(i + 1) * M;
-    const double *Vs = value + (size_t)i * M;
-    double *Vt = value + (size_t)(i + 1) * M;
-    int *Pt = pred + (size_t)(i + 1) * M;
+    LAYER_PAIR(g, i, value, pred);
     long reached = 0;
     for (int v = 0; v < M; v++) {
         Vt[v] = INFINITY;
@@ -485,12 +490,7 @@ static long relax_layer(const Graph *g, long i, const Axis *axes, const int *byv
  * may touch this layer (the caller checks). Returns the nodes reached. */
 static long relax_dense(const Graph *g, long i, double *value, int *pred, double *yT)
 {
-    const int M = g->M, n = g->n;
-    const double *Qs = g->Q + (size_t)i * M * n, *Qt = Qs + (size_t)M * n;
-    const double *ct = g->cost + (size_t)(i + 1) * M;
-    const double *Vs = value + (size_t)i * M;
-    double *Vt = value + (size_t)(i + 1) * M;
-    int *Pt = pred + (size_t)(i + 1) * M;
+    LAYER_PAIR(g, i, value, pred);
     const double tp = 2.0 * M_PI;
     for (int v = 0; v < M; v++)
         for (int j = 0; j < n; j++)

@@ -102,6 +102,7 @@
  */
 #include "chain.h"
 #include "pool.h"
+#include "subproblems.h"
 #include "vec3.h"
 
 enum {
@@ -209,7 +210,6 @@ ALWAYS_INLINE L3 lm3_mtv(const LM3 *R, L3 v)
 
 /* ----------------------------------------------------------------- angles */
 
-#define SR_TAN_PI_8 0.41421356237309503
 #define SIGN_BIT BRL(0x8000000000000000ULL)
 
 ALWAYS_INLINE vd vmin(vd a, vd b) { return vsel(a < b, a, b); }
@@ -230,19 +230,10 @@ ALWAYS_INLINE vd vwrap_pi(vd x)
     return x - 2.0 * M_PI * vfloor((x + M_PI) * (0.5 / M_PI));
 }
 
-/* atan(u) for |u| <= tan(pi/8): u + u^3 p(u^2), p a degree-10 least-squares fit on
- * Chebyshev nodes to (atan(u) - u) / u^3 (relative error < 3e-16), by Estrin's
- * scheme (short dependency chains). */
+/* atan(u) for |u| <= tan(pi/8), lane-wise (subproblems.h's polynomial) */
 ALWAYS_INLINE vd atan_core(vd u)
 {
-    vd s = u * u, s2 = s * s, s4 = s2 * s2;
-    vd q0 = -0.33333333333333326 + 0.19999999999994086 * s;
-    vd q1 = -0.14285714284481754 + 0.11111111005585772 * s;
-    vd q2 = -0.0909090431754569 + 0.07692179168372903 * s;
-    vd q3 = -0.06664474627546399 + 0.05857954331450998 * s;
-    vd q4 = -0.05084928654128961 + 0.03922789786600753 * s - 0.019183482806421463 * s2;
-    vd p = (q0 + s2 * q1) + s4 * ((q2 + s2 * q3) + s4 * q4);
-    return u + u * s * p;
+    ATAN_CORE_BODY(vd, u)
 }
 
 /* atan2(y, x) to within a few ulp (< 1e-15 rad): octant reduction to
@@ -385,12 +376,7 @@ ALWAYS_INLINE LRoots lsp4(vd A, vd B, vd rhs, vd disc, double tol, int mirror, v
     vd sq = vsqrt(vmax(disc, BR(0.0)));
     vd g = vatan2(sq, rhs), cg, sg;
     vunit(rhs, sq, &cg, &sg);
-    r.t[0] = phi + g;
-    r.c[0] = cphi * cg - sphi * sg;
-    r.s[0] = sphi * cg + cphi * sg;
-    r.t[1] = phi - g;
-    r.c[1] = cphi * cg + sphi * sg;
-    r.s[1] = sphi * cg - cphi * sg;
+    SP4_PAIR(r, phi, cphi, sphi, g, cg, sg);
     r.one = ~(disc < -tol * r2);
     r.two = r.one & (disc > tol * r2 * 1e-3);
     r.gap = vsel(r2 > 0.0, sq / vsqrt(vsel(r2 > 0.0, r2, BR(1.0))), BR(0.0));
@@ -400,13 +386,12 @@ ALWAYS_INLINE LRoots lsp4(vd A, vd B, vd rhs, vd disc, double tol, int mirror, v
             for (int l = 0; l < W; l++) {
                 if (!mir[l])
                     continue;
-                double base = phi[l] + atan2(0.0, rhs[l]);
-                double gm = atan2(sqrt(-disc[l]), fabs(rhs[l]));
-                r.t[0][l] = base + gm;
-                r.t[1][l] = base - gm;
+                double t[2], c[2], s[2];
+                sp4_mirror(phi[l], rhs[l], disc[l], t, c, s);
                 for (int i = 0; i < 2; i++) {
-                    r.c[i][l] = cos(r.t[i][l]);
-                    r.s[i][l] = sin(r.t[i][l]);
+                    r.t[i][l] = t[i];
+                    r.c[i][l] = c[i];
+                    r.s[i][l] = s[i];
                 }
                 r.two[l] = -1;
             }
@@ -1719,3 +1704,33 @@ static PyObject *atan2_body(const atan2_args *a)
     Py_RETURN_NONE;
 }
 
+
+/* Subproblem 4 of every row of x (N, 7) = [A, B, rhs, disc, phi, cos phi, sin phi],
+ * in lanes (lsp4) into lane and one row at a time (subproblems.h's sp4_roots) into
+ * one, each row [t0, t1, c0, c1, s0, s1, roots, two]; for the test tying them. */
+static PyObject *sp4_pair_body(const sp4_pair_args *a)
+{
+    npy_intp N = a->N;
+    for (npy_intp i = 0; i < N; i += W) {
+        double buf[7][W];
+        vd in[7];
+        for (int j = 0; j < 7; j++) {
+            for (int l = 0; l < W; l++)
+                buf[j][l] = a->x[7 * (i + l < N ? i + l : i) + j];
+            memcpy(&in[j], buf[j], sizeof(vd));
+        }
+        LRoots r = lsp4(in[0], in[1], in[2], in[3], a->tol, a->mirror, in[4], in[5], in[6]);
+        for (int l = 0; l < W && i + l < N; l++) {
+            const double *x = a->x + 7 * (i + l);
+            Roots q = sp4_roots(x[0], x[1], x[2], x[3], a->tol, a->mirror, x[4], x[5], x[6]);
+            double *o = a->lane + 8 * (i + l), *p = a->one + 8 * (i + l);
+            const double lv[8] = {r.t[0][l], r.t[1][l], r.c[0][l], r.c[1][l], r.s[0][l],
+                                  r.s[1][l], r.one[l] ? 1.0 : 0.0, r.two[l] ? 1.0 : 0.0};
+            const double sv[8] = {q.t[0], q.t[1], q.c[0], q.c[1], q.s[0], q.s[1],
+                                  q.n >= 1 ? 1.0 : 0.0, q.n == 2 ? 1.0 : 0.0};
+            memcpy(o, lv, sizeof(lv));
+            memcpy(p, sv, sizeof(sv));
+        }
+    }
+    Py_RETURN_NONE;
+}

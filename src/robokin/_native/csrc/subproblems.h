@@ -12,21 +12,27 @@
 #include "chain.h"
 #include "vec3.h"
 
+#ifndef SR_TAN_PI_8
 #define SR_TAN_PI_8 0.41421356237309503
+#endif
 
 /* atan(u) for |u| <= tan(pi/8): u + u^3 p(u^2), p a degree-10 least-squares fit on
  * Chebyshev nodes to (atan(u) - u) / u^3 (relative error < 3e-16), by Estrin's
- * scheme (short dependency chains). */
+ * scheme (short dependency chains). One copy for a double and for lanes (six_r.c's
+ * atan_core): T is the type. */
+#define ATAN_CORE_BODY(T, u) \
+    T s = (u) * (u), s2 = s * s, s4 = s2 * s2; \
+    T q0 = -0.33333333333333326 + 0.19999999999994086 * s; \
+    T q1 = -0.14285714284481754 + 0.11111111005585772 * s; \
+    T q2 = -0.0909090431754569 + 0.07692179168372903 * s; \
+    T q3 = -0.06664474627546399 + 0.05857954331450998 * s; \
+    T q4 = -0.05084928654128961 + 0.03922789786600753 * s - 0.019183482806421463 * s2; \
+    T p = (q0 + s2 * q1) + s4 * ((q2 + s2 * q3) + s4 * q4); \
+    return (u) + (u) * s * p;
+
 static inline double atan_core1(double u)
 {
-    double s = u * u, s2 = s * s, s4 = s2 * s2;
-    double q0 = -0.33333333333333326 + 0.19999999999994086 * s;
-    double q1 = -0.14285714284481754 + 0.11111111005585772 * s;
-    double q2 = -0.0909090431754569 + 0.07692179168372903 * s;
-    double q3 = -0.06664474627546399 + 0.05857954331450998 * s;
-    double q4 = -0.05084928654128961 + 0.03922789786600753 * s - 0.019183482806421463 * s2;
-    double p = (q0 + s2 * q1) + s4 * ((q2 + s2 * q3) + s4 * q4);
-    return u + u * s * p;
+    ATAN_CORE_BODY(double, u)
 }
 
 /* atan2(y, x) to within a few ulp (< 1e-15 rad) without the libm call and with few
@@ -107,6 +113,34 @@ typedef struct {
     double t[2], c[2], s[2];
 } Roots;
 
+/* The two roots phi + g and phi - g of a subproblem 4 into r.t, with their cosines
+ * and sines from those of phi and g. One copy for a double and for lanes (six_r.c's
+ * lsp4). */
+#define SP4_PAIR(r, phi, cphi, sphi, g, cg, sg) \
+    do { \
+        (r).t[0] = (phi) + (g); \
+        (r).c[0] = (cphi) * (cg) - (sphi) * (sg); \
+        (r).s[0] = (sphi) * (cg) + (cphi) * (sg); \
+        (r).t[1] = (phi) - (g); \
+        (r).c[1] = (cphi) * (cg) + (sphi) * (sg); \
+        (r).s[1] = (sphi) * (cg) - (cphi) * (sg); \
+    } while (0)
+
+/* A negative disc's two seeds mirrored about the double root phi (+ pi when
+ * rhs < 0), with their cosines and sines (near-family seeds; scalar and lanes). */
+static inline void sp4_mirror(double phi, double rhs, double disc, double t[2], double c[2],
+                              double s[2])
+{
+    double base = phi + atan2(0.0, rhs); /* the double root: phi or phi + pi */
+    double g = atan2(sqrt(-disc), fabs(rhs));
+    t[0] = base + g;
+    t[1] = base - g;
+    for (int i = 0; i < 2; i++) {
+        c[i] = cos(t[i]);
+        s[i] = sin(t[i]);
+    }
+}
+
 /* Roots of A cos t + B sin t = rhs given disc = A^2 + B^2 - rhs^2 and the phase
  * phi = atan2(B, A) with its cosine and sine (Paden subproblem 4; IK-Geo sec. III).
  * A negative disc within tol (A^2 + B^2) is a double root (boundary); with mirror
@@ -117,43 +151,24 @@ static inline Roots sp4_roots(double A, double B, double rhs, double disc, doubl
 {
     Roots r;
     double r2 = A * A + B * B;
-    if (disc < 0.0) {
-        if (disc < -tol * r2) {
-            r.n = 0;
-            r.boundary = 0;
-            r.t[0] = r.t[1] = 0.0;
-            r.c[0] = r.c[1] = 1.0;
-            r.s[0] = r.s[1] = 0.0;
-            return r;
-        }
-        double base = phi + atan2(0.0, rhs); /* the double root: phi or phi + pi */
-        r.boundary = 1;
-        if (mirror) {
-            double g = atan2(sqrt(-disc), fabs(rhs));
-            r.n = 2;
-            r.t[0] = base + g;
-            r.t[1] = base - g;
-            for (int i = 0; i < 2; i++) {
-                r.c[i] = cos(r.t[i]);
-                r.s[i] = sin(r.t[i]);
-            }
-            return r;
-        }
-        r.n = 1;
-        r.t[0] = r.t[1] = base;
-        r.c[0] = r.c[1] = cos(base);
-        r.s[0] = r.s[1] = sin(base);
+    if (disc < -tol * r2) {
+        r.n = 0;
+        r.boundary = 0;
+        r.t[0] = r.t[1] = 0.0;
+        r.c[0] = r.c[1] = 1.0;
+        r.s[0] = r.s[1] = 0.0;
         return r;
     }
-    double sq = sqrt(disc), cg, sg;
+    if (disc < 0.0 && mirror) {
+        r.n = 2;
+        r.boundary = 1;
+        sp4_mirror(phi, rhs, disc, r.t, r.c, r.s);
+        return r;
+    }
+    double sq = sqrt(fmax(disc, 0.0)), cg, sg;
     double g = fast_atan2(sq, rhs);
     unit2(sq, rhs, &cg, &sg);
-    r.t[0] = phi + g;
-    r.c[0] = cphi * cg - sphi * sg;
-    r.s[0] = sphi * cg + cphi * sg;
-    r.t[1] = phi - g;
-    r.c[1] = cphi * cg + sphi * sg;
-    r.s[1] = sphi * cg - cphi * sg;
+    SP4_PAIR(r, phi, cphi, sphi, g, cg, sg);
     r.n = disc <= tol * r2 * 1e-3 ? 1 : 2;
     r.boundary = r.n == 1;
     return r;
