@@ -98,6 +98,8 @@ enum { PK_OK = 0, PK_OUT_OF_REACH = 1, PK_NO_ORIENTATION = 2, PK_DEGENERATE = 5,
 #define PK_EXACT 1e-13         /* pose errors below it need no Newton polish */
 #define PK_ACCEPT 4e-13        /* pose errors above it after the polish: not a solution */
 #define PK_NUDGE 1e-4         /* rows this far [rad] outside the limits: pk_inside tries */
+#define PK_NUDGE_SING 5e-2    /* the same for rows flagged singular (a thin set's width there) */
+#define PK_CLAMP_SLACK 1e-10 /* pk_inside: joints out by at most this [rad] are not clamped */
 #define PK_FAMILY_SIGMA 1e-9  /* Jacobian's smallest / largest singular value below it: a family */
 #define PK_SP4_SLACK 1e-13     /* |C| - hypot(A, B) / scale below it: a double root (rounding) */
 
@@ -1009,6 +1011,9 @@ static double pk_polish_held(const PkGeo *g, const m3 *RT, v3 pT, double *th, un
         double J2[6][6], e2[6];
         pk_fk(g, trial, &R2, &p2, J2);
         double err2 = pk_error(RT, pT, &R2, p2, g->scale, e2);
+#ifdef PK_DEBUG
+        fprintf(stderr, "    polish it %d frozen %x err %.3e -> %.3e big %.3e\n", it, frozen, err, err2, big);
+#endif
         if (!(err2 < err))
             break;
         err = err2;
@@ -1171,10 +1176,16 @@ static int pk_held_inside(const double *P, int held, double x)
  * a limit (a joint exactly at its limit reached only to rounding). Clamp the
  * joints outside to the limit they passed, hold them there and Newton-polish the
  * others (their least-squares step slides along the singular direction back to
- * the pose); up to three rounds, as a polish may push another joint out. Kept
- * when the pose holds to PK_ACCEPT and every joint is inside (1e-9 slack, as
- * pk_coords): returns 1 when th changed. */
-static int pk_inside(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
+ * the pose); up to three rounds, as a polish may push another joint out. Joints
+ * out by at most PK_CLAMP_SLACK stay free (held at a limit they were only
+ * rounding past, the polish cannot return to the pose along a thin set). Tried
+ * for rows at most `reach` [rad] outside (PK_NUDGE; PK_NUDGE_SING at rows flagged
+ * singular, where the exact set next to a row is wider: the SRS arm stretched with
+ * q6 at 1e-9 has its in-limit member 3e-3 rad away). Kept when the pose holds to
+ * PK_ACCEPT and every joint is inside (1e-9 slack, as pk_coords): returns 1 when
+ * th changed. */
+static int pk_inside(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th,
+                     double reach)
 {
     double trial[6];
     unsigned frozen = 0u;
@@ -1195,9 +1206,9 @@ static int pk_inside(const double *P, const PkGeo *g, const m3 *RT, v3 pT, doubl
                     best = qm;
                 }
             }
-            if (gap <= 0.0 || (frozen >> j & 1u))
-                continue;
-            if (gap > PK_NUDGE)
+            if (gap <= PK_CLAMP_SLACK || (frozen >> j & 1u))
+                continue; /* inside, or out by less than rounding: not held */
+            if (gap > reach)
                 return 0; /* not a thin set's width away */
             trial[j] = sg * (best < lo ? lo : hi) + off;
             frozen |= 1u << j;
@@ -1537,7 +1548,7 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
             /* joints on one line only at a singular configuration: try there only */
             if (fix && !all && sing && pk_repair(P, &g, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
-            if (fix && !all && pk_inside(P, &g, &RT, pT, th))
+            if (fix && !all && pk_inside(P, &g, &RT, pT, th, sing ? PK_NUDGE_SING : PK_NUDGE))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
             /* a family to slide along: at rows the subproblems flag singular here,
              * at the others below only when no row came inside */
