@@ -35,12 +35,7 @@
  * Wen, "IK-Geo", arXiv:2211.05737 (subproblems).
  */
 
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT OFF
-#elif defined(__GNUC__)
-#pragma GCC push_options
-#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
-#endif
+/* Included by pieper.c, inside its floating-point rules (no fused multiply-adds). */
 
 #define PS_REACH 1e-13 /* a held angle this far [rad] past the end of its swivel range: at the end */
 
@@ -312,11 +307,7 @@ static int ps_finish(const double *P, const PkGeo *g, const m3 *RT, v3 pT, const
     for (int j = 0, r = 0; j < 7; j++)
         if (j != held)
             th[r++] = th7[j];
-    m3 R;
-    v3 p;
-    double ev[6];
-    pk_fk(g, th, &R, &p, NULL);
-    double err = pk_error(RT, pT, &R, p, g->scale, ev);
+    double err = pk_error_of(g, RT, pT, th);
     if (err > PK_EXACT)
         err = pk_polish(g, RT, pT, th);
 #ifdef PK_DEBUG
@@ -685,9 +676,3 @@ static int pk_srs(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double x
             return PK_OK;
     return degenerate ? PK_DEGENERATE : PK_NO_ORIENTATION;
 }
-
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT DEFAULT
-#elif defined(__GNUC__)
-#pragma GCC pop_options
-#endif
