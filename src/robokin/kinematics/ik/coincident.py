@@ -7,7 +7,11 @@ axes pointing the same way, -1 for opposite ones), the chain left is degenerate
 for the general 6R elimination, and the solutions form one-parameter families
 (the split of that sum), one per branch of the rest.
 
-Every family is found exactly by holding one of the pair as well, at a value c:
+Every family is found exactly by holding one of the pair as well, at a value c
+(and again at c + pi/2, the union kept, one row per family: where the helper
+chain is singular at a family's member, as the Panda's with q6 = 0 and q5 = pi/2,
+the general 6R elimination can miss that double root, and at the other value the
+member is regular):
 with q_{j-1} = c the arm is an ordinary held-joint problem (``solve_fixed`` on the
 other joint, here a general 6R chain), whose isolated solutions include every
 family's member at q_{j-1} = c; the rows with q_j within 1e-4 rad of v are kept
@@ -48,6 +52,19 @@ COINCIDENT = 1e-12
 NEAR_VALUE = 1e-4
 #: Pose error (m, rad) a returned row must reach
 EXACT = 1e-12
+#: The second helper value is c + this [rad]: where the helper chain is singular at
+#: a family's member (a double root the general 6R elimination can miss: the Panda
+#: with q6 = 0, q5 = pi/2), its member at the other value is regular (axis 2 turned)
+HELPER_TURN = np.pi / 2
+#: A second-helper row this close [rad] to a first-helper row after the split is
+#: that family again (next to a second singular set, q4 = 1e-9, the two copies
+#: differ by up to 2e-5 along the thin set); the first helper's rows are all kept
+SAME_FAMILY = 1e-4
+
+
+def _turn_gap(Q: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Largest angle difference (modulo 2 pi) of rows Q (k, n) from q (n,)."""
+    return np.asarray(np.abs((Q - q + np.pi) % (2.0 * np.pi) - np.pi).max(axis=-1))
 
 
 @dataclass(frozen=True)
@@ -160,11 +177,18 @@ def solve_coincident(robot: Arm, T: np.ndarray, pair: CoincidentPair, v: float,
         at v, the pair's split inside the limits where one is.
     """
     N, n = len(T), robot.n
-    helper = held_solve(pair.a, pair.c, T)
-    Q, valid = helper.q.reshape(N, -1, n), helper.valid.reshape(N, -1)
-    keep = valid & (np.abs(np.angle(np.exp(1j * (Q[..., pair.held] - v)))) <= NEAR_VALUE)
-    pose, row = np.nonzero(keep)
-    q = Q[pose, row].copy()
+    helpers = [held_solve(pair.a, c, T) for c in (pair.c, pair.c + HELPER_TURN)]
+    poses, rows, second = [], [], []
+    for h, helper in enumerate(helpers):
+        Q, valid = helper.q.reshape(N, -1, n), helper.valid.reshape(N, -1)
+        keep = valid & (np.abs(np.angle(np.exp(1j * (Q[..., pair.held] - v)))) <= NEAR_VALUE)
+        pk, rk = np.nonzero(keep)
+        poses.append(pk)
+        rows.append(Q[pk, rk])
+        second.append(np.full(len(pk), h == 1))
+    pose = np.concatenate(poses)
+    later = np.concatenate(second)
+    q = np.concatenate(rows).copy()
     q[:, pair.held] = v
     free = np.array([i for i in range(n) if i not in (pair.held, pair.a)])
     if len(q):
@@ -172,13 +196,13 @@ def solve_coincident(robot: Arm, T: np.ndarray, pair: CoincidentPair, v: float,
     lim = robot.limits
     q = fit_turns(q, robot.is_revolute, lim)  # each angle at its in-limit turn
     q[:, pair.held] = v
-    for r in range(len(q)):
-        total = q[r, pair.a] + pair.sign * q[r, pair.b]
-        pref = (q_near[pose[r], pair.a] if q_near is not None
+    for i in range(len(q)):
+        total = q[i, pair.a] + pair.sign * q[i, pair.b]
+        pref = (q_near[pose[i], pair.a] if q_near is not None
                 else 0.5 * (lim[pair.a, 0] + lim[pair.a, 1]))
         qa = _split(total, pair.sign, lim[pair.a], lim[pair.b], float(pref))
-        q[r, pair.a] = qa
-        q[r, pair.b] = pair.sign * (total - qa)
+        q[i, pair.a] = qa
+        q[i, pair.b] = pair.sign * (total - qa)
     if len(q):
         e = np.abs(_pose_error(forward_kinematics(robot.chain, q), T[pose]))
         exact = e.max(axis=-1) <= EXACT
@@ -188,16 +212,18 @@ def solve_coincident(robot: Arm, T: np.ndarray, pair: CoincidentPair, v: float,
     out = np.full((N, k, n), np.nan)
     ok = np.zeros((N, k), bool)
     slot = np.zeros(N, int)
-    for i in np.flatnonzero(exact):
-        p = pose[i]
-        out[p, slot[p]] = q[i]
-        ok[p, slot[p]] = True
-        slot[p] += 1
-    why = helper.status.reshape(N)
+    for i in np.flatnonzero(exact).tolist():
+        at = int(pose[i])
+        if later[i] and ok[at].any() and (_turn_gap(out[at, ok[at]], q[i]) <= SAME_FAMILY).any():
+            continue  # a family the first helper value found already
+        out[at, slot[at]] = q[i]
+        ok[at, slot[at]] = True
+        slot[at] += 1
+    why = helpers[0].status.reshape(N)
     status = np.where(ok.any(axis=-1), "ok",
                       np.where(why == "ok", "no solution with the held value", why))
     return SolutionSet(out, ok, robot.is_revolute, lim, flags={"singular": ok.copy()},
                        status=status.astype(object),
-                       method=f"{helper.method} + coincident axes split",
+                       method=f"{helpers[0].method} + coincident axes split",
                        info={"coincident": (robot.joint_names[pair.a],
                                             robot.joint_names[pair.b])})
