@@ -110,6 +110,8 @@ def test_joint2_held_at_zero_random():
 # a run's failure, kept (hypothesis's draws depend on the tests run before): the
 # helper chain at q1 = 0 is singular at the family's member (q6 = 0, q5 = pi/2)
 @hyp.example(q=np.array([np.pi / 2, 0.0, 1e-6, -1.5, np.pi / 2, 0.0, 0.0]))
+# q1 + q3 = -pi/2 - 1e-6 came back as the split (0, 3 pi / 2): q3 at the wrong turn
+@hyp.example(q=np.array([-np.pi / 2, 0.0, -1e-6, -1.5, np.pi / 2, 0.0, 0.0]))
 def test_joint2_held_at_zero_one_pose(q):
     # q2 forced to 0; one pose alone gives the rows of the same pose in a batch
     q = q.copy()

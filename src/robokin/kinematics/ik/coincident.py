@@ -203,6 +203,8 @@ def solve_coincident(robot: Arm, T: np.ndarray, pair: CoincidentPair, v: float,
         qa = _split(total, pair.sign, lim[pair.a], lim[pair.b], float(pref))
         q[i, pair.a] = qa
         q[i, pair.b] = pair.sign * (total - qa)
+    q = fit_turns(q, robot.is_revolute, lim)  # q_b at the in-limit turn of its split
+    q[:, pair.held] = v
     if len(q):
         e = np.abs(_pose_error(forward_kinematics(robot.chain, q), T[pose]))
         exact = e.max(axis=-1) <= EXACT
