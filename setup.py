@@ -30,7 +30,7 @@ from setuptools.errors import CompileError, PlatformError
 
 CSRC = "src/robokin/_native/csrc"
 HEADERS = [f"{CSRC}/{h}" for h in (
-    "lanes.h", "chain.h", "vec3.h", "subproblems.h", "args.h", "kernels_args.gen.h",
+    "lanes.h", "chain.h", "vec3.h", "subproblems.h", "ik_outputs.h", "args.h", "kernels_args.gen.h",
     "kernels_entry.gen.h", "pool.h", "pool.c", "fk.c", "lm.c", "nearest.c", "six_r.c",
     "broadphase.c", "general6r.c", "process.c", "manipulability.c", "pieper.c",
     "pieper_srs.c", "plan_geom.c", "plan_check.c", "plan_rrtc.c", "plan_path.c", "self_motion.c", "module.c")]

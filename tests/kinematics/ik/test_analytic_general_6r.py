@@ -618,11 +618,15 @@ def test_setup_ranks_fallback_variants_with_their_own_right_side():
 
 def test_panda_with_joint2_held_at_zero_is_degenerate_and_says_so():
     # joint 2 at 0 puts axes 1 and 3 on one line: every pose has a continuum of
-    # solutions; the held-joint call falls back to the numeric solver and says so
+    # solutions; the reduced chain is refused by the general 6R set-up, and the
+    # held-joint call solves the families instead (kinematics/ik/coincident.py,
+    # tests/kinematics/ik/test_coincident.py) and says so
     panda = robokin.load("panda")
     q = np.array([0.3, 0.0, 0.2, -2.0, 0.4, 1.6, 0.7])
     sols = panda.ik(panda.fk(q), fixed={"joint2": 0.0})
-    assert sols.method == "numeric (joint2 held)"
+    assert sols.method == ("general_6r (joint1 held) + coincident axes split "
+                           "(joint2 held)")
+    assert sols.singular[sols.valid].all()
     reduced = robokin.Robot(panda.chain.with_fixed({1: 0.0}))
     assert "a degenerate arm" in robokin.ik.family(reduced).reason
 

@@ -98,6 +98,8 @@ enum { PK_OK = 0, PK_OUT_OF_REACH = 1, PK_NO_ORIENTATION = 2, PK_DEGENERATE = 5,
 #define PK_EXACT 1e-13         /* pose errors below it need no Newton polish */
 #define PK_ACCEPT 4e-13        /* pose errors above it after the polish: not a solution */
 #define PK_NUDGE 1e-4         /* rows this far [rad] outside the limits: pk_inside tries */
+#define PK_NUDGE_SING 5e-2    /* the same for rows flagged singular (a thin set's width there) */
+#define PK_CLAMP_SLACK 1e-10 /* pk_inside: joints out by at most this [rad] are not clamped */
 #define PK_FAMILY_SIGMA 1e-9  /* Jacobian's smallest / largest singular value below it: a family */
 #define PK_SP4_SLACK 1e-13     /* |C| - hypot(A, B) / scale below it: a double root (rounding) */
 
@@ -895,6 +897,27 @@ static double pk_error(const m3 *RT, v3 pT, const m3 *R, v3 p, double scale, dou
     return fmax(fmax(pn, rn), 3.0 - (E.r0.x + E.r1.y + E.r2.z));
 }
 
+/* The pose error (pk_error) of chain angles th */
+static double pk_error_of(const PkGeo *g, const m3 *RT, v3 pT, const double *th)
+{
+    m3 R;
+    v3 p;
+    double e[6];
+    pk_fk(g, th, &R, &p, NULL);
+    return pk_error(RT, pT, &R, p, g->scale, e);
+}
+
+/* A repair's trial angles: copied into th when they reach the pose to PK_ACCEPT.
+ * Returns 1 when th changed. */
+static int pk_accept(const PkGeo *g, const m3 *RT, v3 pT, const double *trial, double *th)
+{
+    if (!(pk_error_of(g, RT, pT, trial) <= PK_ACCEPT))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        th[j] = trial[j];
+    return 1;
+}
+
 /* The least-squares step J dx = e of a 6 x 6 Jacobian (rows J[r][.]): Householder
  * QR with column pivoting, columns whose pivot falls below 1e-10 of the first
  * left out (a singular configuration: no step along its near-null directions). */
@@ -1009,6 +1032,9 @@ static double pk_polish_held(const PkGeo *g, const m3 *RT, v3 pT, double *th, un
         double J2[6][6], e2[6];
         pk_fk(g, trial, &R2, &p2, J2);
         double err2 = pk_error(RT, pT, &R2, p2, g->scale, e2);
+#ifdef PK_DEBUG
+        fprintf(stderr, "    polish it %d frozen %x err %.3e -> %.3e big %.3e\n", it, frozen, err, err2, big);
+#endif
         if (!(err2 < err))
             break;
         err = err2;
@@ -1069,15 +1095,7 @@ static int pk_resplit(const double *P, const PkGeo *g, int it, const m3 *RT, v3 
         trial[j] = th[j];
     trial[it] = tx - sigma * eps;
     trial[it + 2] = tz + eps;
-    m3 R;
-    v3 p;
-    double e[6];
-    pk_fk(g, trial, &R, &p, NULL);
-    if (!(pk_error(RT, pT, &R, p, g->scale, e) <= PK_ACCEPT))
-        return 0;
-    for (int j = 0; j < 6; j++)
-        th[j] = trial[j];
-    return 1;
+    return pk_accept(g, RT, pT, trial, th);
 }
 
 /* Joints on one line (a singular configuration: equal Jacobian columns up to the
@@ -1123,19 +1141,9 @@ static int pk_repair(const double *P, const PkGeo *g, const m3 *RT, v3 pT, doubl
     }
     if (!moved)
         return 0;
-    m3 R;
-    v3 p;
-    double e[6];
-    pk_fk(g, trial, &R, &p, NULL);
-    double err = pk_error(RT, pT, &R, p, g->scale, e);
-#ifdef PK_DEBUG
-    fprintf(stderr, "   repair err %.3e\n", err);
-#endif
-    if (!(err <= PK_ACCEPT))
-        return 0;
     for (int j = 0; j < 6; j++)
-        th[j] = wrap_pi(trial[j]);
-    return 1;
+        trial[j] = wrap_pi(trial[j]);
+    return pk_accept(g, RT, pT, trial, th);
 }
 
 /* The joint coordinates of chain angles th (6, remaining chain) into q (full
@@ -1171,10 +1179,16 @@ static int pk_held_inside(const double *P, int held, double x)
  * a limit (a joint exactly at its limit reached only to rounding). Clamp the
  * joints outside to the limit they passed, hold them there and Newton-polish the
  * others (their least-squares step slides along the singular direction back to
- * the pose); up to three rounds, as a polish may push another joint out. Kept
- * when the pose holds to PK_ACCEPT and every joint is inside (1e-9 slack, as
- * pk_coords): returns 1 when th changed. */
-static int pk_inside(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
+ * the pose); up to three rounds, as a polish may push another joint out. Joints
+ * out by at most PK_CLAMP_SLACK stay free (held at a limit they were only
+ * rounding past, the polish cannot return to the pose along a thin set). Tried
+ * for rows at most `reach` [rad] outside (PK_NUDGE; PK_NUDGE_SING at rows flagged
+ * singular, where the exact set next to a row is wider: the SRS arm stretched with
+ * q6 at 1e-9 has its in-limit member 3e-3 rad away). Kept when the pose holds to
+ * PK_ACCEPT and every joint is inside (1e-9 slack, as pk_coords): returns 1 when
+ * th changed. */
+static int pk_inside(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th,
+                     double reach)
 {
     double trial[6];
     unsigned frozen = 0u;
@@ -1195,9 +1209,9 @@ static int pk_inside(const double *P, const PkGeo *g, const m3 *RT, v3 pT, doubl
                     best = qm;
                 }
             }
-            if (gap <= 0.0 || (frozen >> j & 1u))
-                continue;
-            if (gap > PK_NUDGE)
+            if (gap <= PK_CLAMP_SLACK || (frozen >> j & 1u))
+                continue; /* inside, or out by less than rounding: not held */
+            if (gap > reach)
                 return 0; /* not a thin set's width away */
             trial[j] = sg * (best < lo ? lo : hi) + off;
             frozen |= 1u << j;
@@ -1215,15 +1229,7 @@ static int pk_inside(const double *P, const PkGeo *g, const m3 *RT, v3 pT, doubl
     double q[PK_MAXJ];
     if (!(pk_coords(P, g, trial, -1, 0.0, q) >= -1e-9))
         return 0;
-    m3 R;
-    v3 p;
-    double e[6];
-    pk_fk(g, trial, &R, &p, NULL);
-    if (!(pk_error(RT, pT, &R, p, g->scale, e) <= PK_ACCEPT))
-        return 0;
-    for (int j = 0; j < 6; j++)
-        th[j] = trial[j];
-    return 1;
+    return pk_accept(g, RT, pT, trial, th);
 }
 
 /* The singular values (ascending) and right singular vectors (columns of V) of a
@@ -1515,11 +1521,7 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
             }
             if (tr.check[k] || !(pos.res[i] < exact_p)) {
                 /* check against the pose; Newton-polish when not exact */
-                m3 R;
-                v3 pp;
-                double ev[6];
-                pk_fk(&g, th, &R, &pp, NULL);
-                double err = pk_error(&RT, pT, &R, pp, g.scale, ev);
+                double err = pk_error_of(&g, &RT, pT, th);
                 if (err > PK_EXACT)
                     err = pk_polish(&g, &RT, pT, th);
 #ifdef PK_DEBUG
@@ -1537,7 +1539,7 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
             /* joints on one line only at a singular configuration: try there only */
             if (fix && !all && sing && pk_repair(P, &g, &RT, pT, th))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
-            if (fix && !all && pk_inside(P, &g, &RT, pT, th))
+            if (fix && !all && pk_inside(P, &g, &RT, pT, th, sing ? PK_NUDGE_SING : PK_NUDGE))
                 all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
             /* a family to slide along: at rows the subproblems flag singular here,
              * at the others below only when no row came inside */
@@ -1605,21 +1607,7 @@ static int pk_params_ok(const double *P)
 /* the joints of a parameter vector (for the generated shape check of qn) */
 #define PK_N_OF(P) ((P)[PK_N])
 
-/* (Q, valid, singular, within_limits): lead + (8, n) and lead + (8,) with lead = ()
- * (nlead 0) or (N,) (nlead 1), into out[4]; 0 on a memory error. */
-static int pk_outputs(int nlead, npy_intp N, int n, PyObject **out)
-{
-    npy_intp dq[3] = {N, 8, n}, df[2] = {N, 8};
-    out[0] = PyArray_SimpleNew(nlead + 2, dq + 1 - nlead, NPY_DOUBLE);
-    for (int i = 1; i < 4; i++)
-        out[i] = out[0] == NULL ? NULL : PyArray_SimpleNew(nlead + 1, df + 1 - nlead, NPY_BOOL);
-    if (out[0] == NULL || out[1] == NULL || out[2] == NULL || out[3] == NULL) {
-        for (int i = 0; i < 4; i++)
-            Py_XDECREF(out[i]);
-        return 0;
-    }
-    return 1;
-}
+#include "ik_outputs.h"
 
 /* pieper_ik1(T, params, x, qn) -> (code, Q (8, n), valid (8,), singular (8,),
  * within_limits (8,)): one pose with the held joint at x (ignored without one),
@@ -1644,41 +1632,18 @@ static PyObject *pieper_ik1_body(const pieper_ik1_args *a)
         for (int j = 0; j < n; j++)
             qn[j] = PK_F64(qa)[j];
     }
-    int code = PK_BAD_POSE;
     double T[16];
-    PyObject *to = a->T;
-    if (PyArray_Check(to)) {
-        PyArrayObject *ta = (PyArrayObject *)to;
-        if (PyArray_TYPE(ta) == NPY_DOUBLE && PyArray_NDIM(ta) == 2 && PK_DIM(ta, 0) == 4 &&
-            PK_DIM(ta, 1) == 4 && PyArray_ISNOTSWAPPED(ta) && PyArray_ISALIGNED(ta)) {
-            const char *d = PyArray_BYTES(ta);
-            npy_intp rs = PyArray_STRIDE(ta, 0), cs = PyArray_STRIDE(ta, 1);
-            for (int r = 0; r < 4; r++)
-                for (int c = 0; c < 4; c++)
-                    T[4 * r + c] = *(const double *)(d + r * rs + c * cs);
-            code = pose_problem(T, POSE_ROW_TOL, POSE_ORTH_TOL);
-            code = code ? PK_BAD_POSE + code : 0;
-        }
-    }
+    int code = ik_read_pose(a->T, T, PK_BAD_POSE);
     if (code == 0 && !isfinite(x))
         code = PK_BAD_POSE;
     if (code)
         return Py_BuildValue("(iOOOO)", code, Py_None, Py_None, Py_None, Py_None);
     PyObject *out[4];
-    if (!pk_outputs(0, 0, n, out))
+    if (!ik_outputs(0, 0, n, out))
         return NULL;
     PkOut o = {PK_F64(out[0]), PK_U8(out[1]), PK_U8(out[2]), PK_U8(out[3]), n};
     code = pk_one(P, T, x, qn, o);
-    PyObject *res = PyTuple_New(5);
-    if (res == NULL) {
-        for (int i = 0; i < 4; i++)
-            Py_DECREF(out[i]);
-        return NULL;
-    }
-    PyTuple_SET_ITEM(res, 0, PyLong_FromLong(code));
-    for (int i = 0; i < 4; i++)
-        PyTuple_SET_ITEM(res, i + 1, out[i]);
-    return res;
+    return ik_result(code, out);
 }
 
 /* pieper_ik(params, T (N, 4, 4), x (m,), qn (mq, n)) -> (Q (N, 8, n), valid,
@@ -1691,25 +1656,12 @@ static PyObject *pieper_ik_body(const pieper_ik_args *a)
     const double *P = a->params;
     int n = (int)P[PK_N];
     npy_intp N = a->N;
-    PyObject *out[4];
-    if (!pk_outputs(1, N, n, out))
+    PyObject *out[4], *status;
+    if (!ik_outputs(1, N, n, out) || !ik_status(N, out, &status))
         return NULL;
-    npy_intp dims[1] = {N};
-    PyObject *status = PyArray_SimpleNew(1, dims, NPY_INT8);
-    if (status == NULL) {
-        for (int i = 0; i < 4; i++)
-            Py_DECREF(out[i]);
-        return NULL;
-    }
     PkJob jb = {P, a->T, a->x, a->qn, (long)a->m, (long)a->mq, n, PK_F64(out[0]), PK_U8(out[1]), PK_U8(out[2]),
                 PK_U8(out[3]), (signed char *)PyArray_DATA((PyArrayObject *)status)};
-    Py_BEGIN_ALLOW_THREADS
-    if (N >= PK_PARALLEL_MIN)
-        pool_for((long)N, PK_GRAIN, pk_range, &jb);
-    else
-        pk_range(&jb, 0, (long)N);
-    Py_END_ALLOW_THREADS
-    return Py_BuildValue("(NNNNN)", out[0], out[1], out[2], out[3], status);
+    return ik_run_batch(N, PK_PARALLEL_MIN, PK_GRAIN, pk_range, &jb, out, status);
 }
 
 /* pieper_roots(coeffs (5,), re (4,), im (4,)): the quartic solver (for tests) */

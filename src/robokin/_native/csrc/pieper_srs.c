@@ -35,12 +35,7 @@
  * Wen, "IK-Geo", arXiv:2211.05737 (subproblems).
  */
 
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT OFF
-#elif defined(__GNUC__)
-#pragma GCC push_options
-#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
-#endif
+/* Included by pieper.c, inside its floating-point rules (no fused multiply-adds). */
 
 #define PS_REACH 1e-13 /* a held angle this far [rad] past the end of its swivel range: at the end */
 
@@ -312,11 +307,7 @@ static int ps_finish(const double *P, const PkGeo *g, const m3 *RT, v3 pT, const
     for (int j = 0, r = 0; j < 7; j++)
         if (j != held)
             th[r++] = th7[j];
-    m3 R;
-    v3 p;
-    double ev[6];
-    pk_fk(g, th, &R, &p, NULL);
-    double err = pk_error(RT, pT, &R, p, g->scale, ev);
+    double err = pk_error_of(g, RT, pT, th);
     if (err > PK_EXACT)
         err = pk_polish(g, RT, pT, th);
 #ifdef PK_DEBUG
@@ -328,7 +319,7 @@ static int ps_finish(const double *P, const PkGeo *g, const m3 *RT, v3 pT, const
     int all = pk_coords(P, g, th, held, x, qs) >= -1e-9, fix = pk_held_inside(P, held, x);
     if (fix && !all && sing && pk_repair(P, g, RT, pT, th))
         all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
-    if (fix && !all && pk_inside(P, g, RT, pT, th))
+    if (fix && !all && pk_inside(P, g, RT, pT, th, sing ? PK_NUDGE_SING : PK_NUDGE))
         all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
     if (fix && !all && pk_slide(P, g, RT, pT, th))
         all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
@@ -461,6 +452,35 @@ static int ps_band_elbow(const double *P, v3 S, v3 Wp, v3 w, const m3 *G, int he
     return 1;
 }
 
+/* The smallest elbow deviation f in [0, outer] from the band's center (side +1 /
+ * -1) at which the held joint's angle range over the swivel reaches its value
+ * (at f = 0, full stretch, the range shrinks to a point): bisection on whether
+ * the range holds it. Returns 0 when it holds it at f = 0 or never. */
+static int ps_touch(const double *P, v3 S, v3 Wp, v3 w, const m3 *G, int held, double L,
+                    const PsElbow *e, int side, double scale, double *out)
+{
+    double a = 0.0, b = e->outer;
+    for (int it = 0; it < 64; it++) {
+        double f = it == 0 ? a : it == 1 ? b : 0.5 * (a + b), gm, gd, alpha;
+        if (!ps_cones(P, S, Wp, w, G, held, L, e->center + side * f, scale, &gm, &gd, &alpha))
+            return 0;
+        double lo = fabs(alpha - gd), hi = fmin(alpha + gd, 2.0 * M_PI - alpha - gd);
+        int ok = gm >= lo && gm <= hi;
+        if (it == 0 && ok)
+            return 0;
+        if (it == 1 && !ok)
+            return 0;
+        if (it >= 2) {
+            if (ok)
+                b = f;
+            else
+                a = f;
+        }
+    }
+    *out = b;
+    return 1;
+}
+
 /* Swivel candidates of a one-parameter family: 0, where each free joint reaches a
  * limit, and the midpoints between them around the circle. Returns the count. */
 static int ps_candidates(const double *P, const PsArm *a, int held, double *psi)
@@ -561,8 +581,16 @@ static void ps_band_family(const double *P, const PkGeo *g, const m3 *RT, v3 pT,
         PsBest best[8];
         for (int k = 0; k < 8; k++)
             best[k].have = 0;
-        for (int k = -1; k <= 15; k++) {
-            double f = k < 0 ? 0.0 : el->inner + (el->outer - el->inner) * k / 15.0;
+        double ft = 0.0;
+        int touch = ps_touch(P, S, Wp, w, G, held, tk, el, (int)side, scale, &ft) &&
+                    ft > 0.0 && ft < el->outer;
+#ifdef PK_DEBUG
+        fprintf(stderr, " band side %g center %.3e inner %.3e outer %.3e touch %d ft %.3e\n", side, el->center, el->inner, el->outer, touch, ft);
+#endif
+        for (int k = -1; k <= 15 + 17 * touch; k++) {
+            double f = k < 0    ? 0.0
+                       : k < 16 ? el->inner + (el->outer - el->inner) * k / 15.0
+                                : ft * pow(el->outer / ft, (k - 16) / 16.0);
             if (k < 0 && el->inner > 0.0)
                 continue; /* the center is in the band only when the ends touch */
             double th4 = el->center + side * f;
@@ -648,9 +676,3 @@ static int pk_srs(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double x
             return PK_OK;
     return degenerate ? PK_DEGENERATE : PK_NO_ORIENTATION;
 }
-
-#if defined(__clang__)
-#pragma STDC FP_CONTRACT DEFAULT
-#elif defined(__GNUC__)
-#pragma GCC pop_options
-#endif

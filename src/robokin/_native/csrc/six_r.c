@@ -1583,21 +1583,7 @@ static int six_r_params_ok(const double *P)
     return P[SR_FAMILY] == SR_THREE_PARALLEL || P[SR_FAMILY] == SR_SPHERICAL_WRIST;
 }
 
-/* (Q, valid, singular, within_limits) arrays, shapes lead + (8, 6) and lead + (8,)
- * with lead = () (nlead 0) or (N,) (nlead 1), into out[4]; 0 on a memory error. */
-static int six_r_outputs(int nlead, npy_intp N, PyObject **out)
-{
-    npy_intp dq[3] = {N, 8, 6}, df[2] = {N, 8};
-    out[0] = PyArray_SimpleNew(nlead + 2, dq + 1 - nlead, NPY_DOUBLE);
-    for (int i = 1; i < 4; i++)
-        out[i] = out[0] == NULL ? NULL : PyArray_SimpleNew(nlead + 1, df + 1 - nlead, NPY_BOOL);
-    if (out[0] == NULL || out[1] == NULL || out[2] == NULL || out[3] == NULL) {
-        for (int i = 0; i < 4; i++)
-            Py_XDECREF(out[i]);
-        return 0;
-    }
-    return 1;
-}
+#include "ik_outputs.h"
 
 /* six_r_ik1(T, params, q6, packed) -> (code, Q (8, 6), valid (8,), singular (8,),
  * within_limits (8,)): one pose, validated in the same call (pose_problem's tests,
@@ -1612,24 +1598,11 @@ static PyObject *six_r_ik1_body(const six_r_ik1_args *a)
     const Chain ch = a->packed;
     int code = SR_BAD_POSE;
     double T[16];
-    PyObject *to = a->T;
-    if (PyArray_Check(to)) {
-        PyArrayObject *ta = (PyArrayObject *)to;
-        if (PyArray_TYPE(ta) == NPY_DOUBLE && PyArray_NDIM(ta) == 2 && SR_DIM(ta, 0) == 4 &&
-            SR_DIM(ta, 1) == 4 && PyArray_ISNOTSWAPPED(ta) && PyArray_ISALIGNED(ta)) {
-            const char *d = PyArray_BYTES(ta);
-            npy_intp rs = PyArray_STRIDE(ta, 0), cs = PyArray_STRIDE(ta, 1);
-            for (int r = 0; r < 4; r++)
-                for (int c = 0; c < 4; c++)
-                    T[4 * r + c] = *(const double *)(d + r * rs + c * cs);
-            code = pose_problem(T, POSE_ROW_TOL, POSE_ORTH_TOL);
-            code = code ? SR_BAD_POSE + code : 0;
-        }
-    }
+    code = ik_read_pose(a->T, T, SR_BAD_POSE);
     if (code)
         return Py_BuildValue("(iOOOO)", code, Py_None, Py_None, Py_None, Py_None);
     PyObject *out[4];
-    if (!six_r_outputs(0, 0, out))
+    if (!ik_outputs(0, 0, 6, out))
         return NULL;
     SR K;
     sr_read(P, &K);
@@ -1643,16 +1616,7 @@ static PyObject *six_r_ik1_body(const six_r_ik1_args *a)
     }
     signed char st;
     six_r_block(&K, &ch, Tl, q6l, o, &st, 1);
-    PyObject *res = PyTuple_New(5);
-    if (res == NULL) {
-        for (int i = 0; i < 4; i++)
-            Py_DECREF(out[i]);
-        return NULL;
-    }
-    PyTuple_SET_ITEM(res, 0, PyLong_FromLong(st));
-    for (int i = 0; i < 4; i++)
-        PyTuple_SET_ITEM(res, i + 1, out[i]);
-    return res;
+    return ik_result(st, out);
 }
 
 /* six_r_ik(params, T (N, 4, 4), qn (m, 6), packed) -> (Q (N, 8, 6), valid,
@@ -1663,28 +1627,15 @@ static PyObject *six_r_ik_body(const six_r_ik_args *a)
 {
     const double *P = a->params;
     npy_intp N = a->N;
-    PyObject *out[4];
-    if (!six_r_outputs(1, N, out))
+    PyObject *out[4], *status;
+    if (!ik_outputs(1, N, 6, out) || !ik_status(N, out, &status))
         return NULL;
-    npy_intp dims[1] = {N};
-    PyObject *status = PyArray_SimpleNew(1, dims, NPY_INT8);
-    if (status == NULL) {
-        for (int i = 0; i < 4; i++)
-            Py_DECREF(out[i]);
-        return NULL;
-    }
     SR K;
     sr_read(P, &K);
     SixRJob jb = {&K, &a->packed, a->T, a->qn, (long)a->m, SR_F64(out[0]),
                   SR_U8(out[1]), SR_U8(out[2]), SR_U8(out[3]),
                   (signed char *)PyArray_DATA((PyArrayObject *)status)};
-    Py_BEGIN_ALLOW_THREADS
-    if (N >= SR_PARALLEL_MIN)
-        pool_for((long)N, SR_GRAIN, six_r_range, &jb);
-    else
-        six_r_range(&jb, 0, (long)N);
-    Py_END_ALLOW_THREADS
-    return Py_BuildValue("(NNNNN)", out[0], out[1], out[2], out[3], status);
+    return ik_run_batch(N, SR_PARALLEL_MIN, SR_GRAIN, six_r_range, &jb, out, status);
 }
 
 /* atan2(y (N,), x (N,), out (N,)): the kernels' atan2 (for tests) */

@@ -41,6 +41,7 @@ from robokin._validation import (
 )
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, ArmSource, Derived, arm_of
+from robokin.kinematics.ik import coincident as _co
 from robokin.kinematics.ik.analytic import pieper as _pk
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.model.chain import joint_motion
@@ -123,22 +124,57 @@ def solve_fixed(
         qf = None if q_near is None else np.broadcast_to(qc, lead + (robot.n,))
         return held.solve(robot, Tb.reshape(lead + (4, 4)), qf, V[:, 0].reshape(lead),
                           **options)
+    parts: list[tuple[np.ndarray, SolutionSet]] = []
+    rest = np.arange(len(Tb))
+    if len(idx) == 1 and method != "numeric" and not options:
+        qf = None if q_near is None else np.broadcast_to(qc, lead + (robot.n,)).reshape(
+            -1, robot.n)
+        rest = _coincident_parts(robot, idx[0], Tb, V[:, 0], qf, keep, dispatch, parts)
     end = _end_joint(robot, idx)
-    if end is not None:
+    if end is not None and len(rest):
         reduced = _reduced(robot, idx, (0.0,))
-        Tm = _moved_targets(robot, end, Tb, V[:, 0])
-        sols = dispatch(reduced, Tm, q_near=qn, method=method, **options)
-        parts = [(np.arange(len(Tb)), sols)]
-    else:
-        parts = []
-        uniq, inverse = np.unique(V, axis=0, return_inverse=True)
+        Tm = _moved_targets(robot, end, Tb[rest], V[rest, 0])
+        sols = dispatch(reduced, Tm, q_near=None if qn is None else qn[rest],
+                        method=method, **options)
+        parts.append((rest, sols))
+    elif len(rest):
+        uniq, inverse = np.unique(V[rest], axis=0, return_inverse=True)
         for g, vals in enumerate(uniq):
-            rows = np.flatnonzero(inverse.ravel() == g)
+            rows = rest[np.flatnonzero(inverse.ravel() == g)]
             reduced = _reduced(robot, idx, tuple(float(x) for x in vals))
             sols = dispatch(reduced, Tb[rows], q_near=None if qn is None else qn[rows],
-                          method=method, **options)
+                            method=method, **options)
             parts.append((rows, sols))
     return _assemble(robot, lead, idx, keep, V, parts, dict(zip(fixed, values)))
+
+
+def _coincident_parts(robot: Arm, j: int, T: np.ndarray, v: np.ndarray,
+                      q_near: np.ndarray | None, keep: list[int], dispatch: Dispatch,
+                      parts: list[tuple[np.ndarray, SolutionSet]]) -> np.ndarray:
+    """Solve the poses whose held value puts two axes on one line (``coincident``).
+
+    Appends (rows, set of the remaining coordinates) to ``parts`` per such value;
+    returns the rows left for the other paths.
+    """
+    uniq, inverse = np.unique(v, return_inverse=True)
+    rest = np.ones(len(T), bool)
+    name = robot.joint_names
+    for g, x in enumerate(uniq):
+        pair = _co.coincident_pair(robot, j, float(x))
+        if pair is None:
+            continue
+        rows = np.flatnonzero(inverse.ravel() == g)
+
+        def helper(a: int, c: float, Ts: np.ndarray) -> SolutionSet:
+            return solve_fixed(robot, Ts, {name[a]: c}, dispatch=dispatch)
+
+        sols = _co.solve_coincident(robot, T[rows], pair, float(x),
+                                    None if q_near is None else q_near[rows], helper)
+        parts.append((rows, SolutionSet(
+            sols.q[..., keep], sols.valid, robot.is_revolute[keep], robot.limits[keep],
+            flags={"singular": sols.singular}, status=sols.status, method=sols.method)))
+        rest[rows] = False
+    return np.flatnonzero(rest)
 
 
 _NUMBERS = (float, int, np.float64)
