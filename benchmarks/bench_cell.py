@@ -26,9 +26,9 @@ workspace bounds), after checking correctness:
      workers otherwise get fresh pages for every array of every task);
    * the same on 1 worker (1 core): the per-core rate;
    * ``reach_map`` with ``scheduler=None`` (local threads);
-   * "before": the local-threads and two-worker maps as before issue 25's fix,
-     in the same rounds (one IK call per task, glibc's thresholds left as Dask
-     pinned them: :func:`as_before`).
+   * "before": the local-threads and two-worker maps as before the fused
+     kernel (the solution sets, then a second manipulability pass:
+     :func:`as_before`).
 3. **Projection**: the 5 mm, 200-orientation UR5 map on a 100-core cluster,
    from the measured 1-worker (per-core) rate.
 4. **Memory**: a map of at least ``--rss-evals`` IK evaluations streamed into a
@@ -63,19 +63,17 @@ CORE = ("bare batch IK (robot.ik)", "map work, no Dask, w off", "map work, no Da
 
 
 def as_before(on: bool) -> None:
-    """Run tasks as before issue 25's fix (``on``): one IK call per task (no
-    SOLVE_BATCH) and glibc's thresholds left as Dask pinned them (no
-    ``reuse_freed_memory``); else as now. Called here and on every worker, so
-    the same run times both."""
-    import contextlib
+    """Run tasks as before the fused kernel (``on``): the closed form's solution
+    sets from ``robot.ik``, then the manipulability kernel in a second pass and
+    the per-voxel reduction in numpy (``fused_params`` returns None); else as
+    now (``_native/csrc/reach.c``). Called here and on every worker, so the same
+    run times both. (Round 1's "before", one IK call per task and glibc's
+    thresholds as Dask pinned them, is in docs/scale.md.)"""
+    from robokin.cell import _evaluate
 
-    from robokin.cell import _evaluate, _malloc
-
-    saved = _malloc.__dict__.setdefault(  # kept in the module: this runs on workers too
-        "_bench_saved", (_evaluate.SOLVE_BATCH, _malloc.reuse_freed_memory))
-    batch, reuse = saved
-    _evaluate.SOLVE_BATCH = 2**62 if on else batch
-    _malloc.reuse_freed_memory = contextlib.nullcontext if on else reuse
+    saved = _evaluate.__dict__.setdefault(  # kept in the module: this runs on workers too
+        "_bench_saved", _evaluate.fused_params)
+    _evaluate.fused_params = (lambda job: None) if on else saved
 
 
 def before(fn, clients):

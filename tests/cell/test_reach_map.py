@@ -311,3 +311,19 @@ def test_solving_a_task_in_batches_changes_no_bit(ur5, small_map, monkeypatch):
     again = cell.reach_map(ur5, region=REGION, voxel=0.15, orientations=12, rolls=2,
                            scheduler="synchronous")
     assert_maps_equal(small_map, again)
+
+
+def test_the_fused_kernel_gives_the_map_of_the_solution_sets(ur5, small_map, monkeypatch):
+    # issue 25: the closed form's counts and best manipulability come from one
+    # compiled pass (reach.c); the oracle is the unfused path (robot.ik's solution
+    # sets, then the manipulability kernel, reduced in numpy): the same map, bit
+    # for bit
+    import robokin.cell._evaluate as ev
+
+    job = ev.ReachJob(ur5, None, None, small_map.grid, small_map.orientations, False, True)
+    assert ev.fused_params(job) is not None
+    monkeypatch.setattr(ev, "fused_params", lambda job: None)
+    unfused = cell.reach_map(ur5, region=REGION, voxel=0.15, orientations=12, rolls=2,
+                             scheduler="synchronous")
+    assert_maps_equal(small_map, unfused)
+    assert np.asarray(small_map.manipulability).max() > 0

@@ -510,6 +510,18 @@ SELF_MOTION = Group("self_motion.c", kernels=(
     "KIND_ALIGNED KIND_FOLD", "SM_", "SM_") + (Const("SM_TAG_VALUE", "SM_TAG_VALUE", "float"),),
     comment="swivel parameter vector layout (swivel.SwivelArm.packed), point kinds")
 
+REACH = Group("reach.c", kernels=(
+    Kernel("six_r_reach", (Arr("params", "f64", ("SR_N_PARAMS",)), Arr("T", "f64", ("G", "K", 4, 4)),
+                           Packed(), Flag("with_w"), Arr("counts", "u8", ("G", "K"), out=True),
+                           Arr("best", "f64", ("G",), out=True)),
+           "None", "A reach map's 6R closed form in one pass, T (G voxels, K targets each).\n\n"
+                   "Per target the solutions inside the limits into counts (G, K); with ``with_w`` the\n"
+                   "best ``|det J|`` over a voxel's solutions into best (G,) (0: none).",
+           checks=(Check("six_r_params_ok(a->params)", "params is not a 6R parameter vector"),
+                   Check("n == 6 && nc == 6", "packed is not a 6R chain"),
+                   Check("K >= 1", "T needs a target per voxel"))),
+))
+
 @dataclass(frozen=True)
 class Section:
     """One section of a chain's packed vector: ``ChainArrays`` field, ``Chain`` field, shape.
@@ -544,5 +556,5 @@ PACKED_LAYOUT: tuple[Section, ...] = (
 )
 
 GROUPS: tuple[Group, ...] = (FK, LM, SIX_R, PIEPER, GENERAL6R, BROADPHASE, PROCESS,
-                             PLAN_CHECK, PLAN_RRTC, PLAN_PATH, SELF_MOTION)
+                             PLAN_CHECK, PLAN_RRTC, PLAN_PATH, SELF_MOTION, REACH)
 OPTION_VECTORS: tuple[Opts, ...] = (LM_OPTS, RC_OPTS, SP_OPTS)

@@ -647,3 +647,19 @@ class Kernels(Protocol):
         /,
     ) -> None:
         """Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,)."""
+
+    def six_r_reach(
+        self,
+        params: F64,
+        T: F64,
+        packed: F64,
+        with_w: bool,
+        counts: npt.NDArray[np.uint8],
+        best: F64,
+        /,
+    ) -> None:
+        """A reach map's 6R closed form in one pass, T (G voxels, K targets each).
+
+        Per target the solutions inside the limits into counts (G, K); with ``with_w`` the
+        best ``|det J|`` over a voxel's solutions into best (G,) (0: none).
+        """

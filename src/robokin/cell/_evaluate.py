@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     from robokin.robot import Robot
 
 __all__ = ["SOLVE_BATCH", "ReachChunk", "ReachJob", "evaluate_reach", "first_false",
-           "manipulability", "solve_poses", "solve_task"]
+           "fused_params", "manipulability", "solve_poses", "solve_task"]
 
 NUMERIC_RESTARTS = 4  # the numeric solver's seed-table restarts (no random ones)
 _MANIPULABILITY_BATCH = 16384  # Jacobians at a time (16384 x 6 x 6 x 8 B = 4.7 MB)
@@ -225,10 +225,11 @@ def evaluate_reach(job: ReachJob, start: int, stop: int) -> ReachChunk:
     counts = np.empty((B, K), dtype=np.uint8)
     best = np.empty(B) if job.with_manipulability else None
     step = max(1, SOLVE_BATCH // K)
+    params = fused_params(job)
     for a in range(start, stop, step):
         b = min(a + step, stop)
         _evaluate_batch(job, a, b, counts[a - start : b - start],
-                        None if best is None else best[a - start : b - start])
+                        None if best is None else best[a - start : b - start], params)
     solutions = counts.sum(axis=-1, dtype=np.int32)
     index = (counts > 0).sum(axis=-1) / K
     reachable = int(np.count_nonzero(index))
@@ -242,14 +243,44 @@ def evaluate_reach(job: ReachJob, start: int, stop: int) -> ReachChunk:
     return ReachChunk(start, stop, None, None, None, None, reachable)
 
 
+def fused_params(job: ReachJob) -> np.ndarray | None:
+    """The 6R closed form's parameters when a job can take the fused kernel, else None.
+
+    The fused kernel (``_native/csrc/reach.c``, ``six_r_reach``) solves and
+    reduces in one compiled pass: it serves the closed form of a three-parallel
+    or spherical-wrist arm (not a near-family one, which is polished in Python)
+    without a scene (the collision check needs every solution).
+    """
+    if job.numeric or job.scene is not None:
+        return None
+    from robokin.kinematics.ik.analytic.detect import SixRSolver, detect
+
+    solver = detect(job.robot.arm).solver
+    if isinstance(solver, SixRSolver) and not solver.near:
+        return solver.params
+    return None
+
+
 def _evaluate_batch(job: ReachJob, start: int, stop: int, counts: np.ndarray,
-                    best: np.ndarray | None) -> None:
+                    best: np.ndarray | None, params: np.ndarray | None = None) -> None:
     """Evaluate voxels ``start .. stop - 1`` into ``counts`` and ``best``.
 
     ``counts`` (B, K) gets the solutions per target; ``best`` (B,), unless None,
-    the best manipulability per voxel.
+    the best manipulability per voxel. With ``params`` (:func:`fused_params`)
+    one compiled call does both: the solutions are counted and their
+    manipulability reduced per voxel while they are in cache, nothing of size
+    (B, K, 8, 6) is returned (the same numbers, bit for bit, as the solution set
+    and :func:`manipulability`: ``tests/cell/test_evaluate.py``).
     """
     B, K = counts.shape
+    if params is not None:
+        from robokin._native import kernels
+
+        T = poses(job, start, stop).reshape(B, K, 4, 4)
+        out = np.empty(B) if best is None else best
+        kernels.six_r_reach(params, T, job.robot.chain.arrays.packed, best is not None,
+                            counts, out)
+        return
     q, ok = solve_poses(job.robot, poses(job, start, stop), job.numeric, job.sweep)
     if job.scene is not None and job.bare is not None and ok.any():
         ok[ok] = collision_free(job.bare, job.scene, q[ok])
