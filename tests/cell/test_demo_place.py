@@ -36,7 +36,10 @@ def test_the_demo_maps_feasible_bases_and_its_own_is_one(tmp_path):
     timings = summary["timings_s"]
     assert timings["total"] >= timings["place"] + timings["plan"]
     time_line = next(ln for ln in text.splitlines() if "│ time" in ln)
-    assert f"place {timings['place']:.2f}" in time_line
+    # the line prints the unrounded time to 2 decimals, the summary keeps 3: they agree
+    # to half a hundredth (9.595 in the summary may print as 9.59 or 9.60)
+    printed = float(time_line.split("place ", 1)[1].split()[0].rstrip(",)"))
+    assert abs(printed - timings["place"]) <= 0.0051
 
 
 def test_the_cli_takes_place(tmp_path, capsys):
