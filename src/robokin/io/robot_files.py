@@ -130,12 +130,12 @@ def _schema():
     from pydantic import (
         AfterValidator,
         BaseModel,
+        BeforeValidator,
         ConfigDict,
         Field,
         StrictFloat,
         StrictInt,
         StrictStr,
-        field_validator,
     )
 
     Name = Annotated[StrictStr, Field(max_length=MAX_NAME), AfterValidator(_printable)]
@@ -162,40 +162,38 @@ def _schema():
             raise ValueError("sign must be 1 or -1, got a boolean")
         return v
 
+    # the field types every joint entry shares, each with its check
+    Limits = Annotated[tuple[StrictFloat, StrictFloat] | None, AfterValidator(_check_limits)]
+    JointSign = Annotated[Sign, StrictInt, BeforeValidator(_check_sign)]
+    Depends = dict[Name, StrictFloat] | None
+    JointKind = Literal["revolute", "prismatic", "fixed"]
+
     class Row(Strict):
         name: Name | None = None
-        joint: Literal["revolute", "prismatic", "fixed"] = "revolute"
+        joint: JointKind = "revolute"
         a: StrictFloat = 0.0
         alpha: StrictFloat = 0.0
         d: StrictFloat = 0.0
         theta: StrictFloat = 0.0
-        limits: tuple[StrictFloat, StrictFloat] | None = None
-        sign: Annotated[Sign, StrictInt] = 1
-        depends: dict[Name, StrictFloat] | None = None
+        limits: Limits = None
+        sign: JointSign = 1
+        depends: Depends = None
         depends_offset: StrictFloat = 0.0
-
-        _lim = field_validator("limits")(_check_limits)
-        _sgn = field_validator("sign", mode="before")(_check_sign)
 
     class Op(Strict):
         op: Literal["rx", "ry", "rz", "tx", "ty", "tz", "frame"]
         value: StrictFloat = 0.0
         name: Name | None = None
-        joint: Literal["revolute", "prismatic", "fixed"] = "fixed"
-        limits: tuple[StrictFloat, StrictFloat] | None = None
-        sign: Annotated[Sign, StrictInt] = 1
-        depends: dict[Name, StrictFloat] | None = None
+        joint: JointKind = "fixed"
+        limits: Limits = None
+        sign: JointSign = 1
+        depends: Depends = None
         depends_offset: StrictFloat = 0.0
-
-        _lim = field_validator("limits")(_check_limits)
-        _sgn = field_validator("sign", mode="before")(_check_sign)
 
     class Coordinate(Strict):
         name: Name
         joint: Literal["revolute", "prismatic"] = "revolute"
-        limits: tuple[StrictFloat, StrictFloat] | None = None
-
-        _lim = field_validator("limits")(_check_limits)
+        limits: Limits = None
 
     class RobotFile(Strict):
         name: Name
