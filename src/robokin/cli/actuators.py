@@ -12,9 +12,9 @@ from typing import Annotated
 import numpy as np
 import typer
 
+from robokin.cli import output
 from robokin.cli.common import NUMERIC_ARGS, json_text, load_robot
 from robokin.cli.options import DegFlag, JsonFlag, MmFlag, RobotName
-from robokin.cli import output
 
 __all__ = ["commands", "joints", "motors"]
 

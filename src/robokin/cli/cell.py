@@ -15,9 +15,9 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
+from robokin.cli import output
 from robokin.cli.common import DomainFailure, json_text, load_scene
 from robokin.cli.options import JsonFlag, RobotName
-from robokin.cli import output
 from robokin.exceptions import InputError
 from robokin.io.atomic import check_distinct
 
