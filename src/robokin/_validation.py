@@ -11,6 +11,8 @@ Jacobians and IK in float64 lose every digit of a sub-millimetre result there.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import numpy.typing as npt
 
@@ -23,8 +25,10 @@ __all__ = [
     "check_broadcasts",
     "check_finite",
     "check_joints",
+    "check_nonnegative",
     "check_transform",
     "check_vector",
+    "frozen_floats",
 ]
 
 #: Largest translation accepted in a pose, and largest length in a robot file [m]
@@ -192,3 +196,42 @@ def check_finite_number(x: object, name: str) -> float:
     if not np.isfinite(v):
         raise InputError(name, f"expected a finite number, got {v}")
     return v
+
+
+def check_nonnegative(x: object, name: str, expected: str) -> float:
+    """Return ``x`` as a float: a finite Python number >= 0; raise InputError if not.
+
+    Args:
+        x: The value (an ``int`` or ``float``; NumPy scalars of those kinds too).
+        name: The argument named in the error.
+        expected: What the message says was expected, e.g. ``"a distance >= 0 [mm]"``.
+
+    Raises:
+        InputError: ``"expected {expected}, got {x}"``, naming ``name``.
+    """
+    if not (isinstance(x, int | float) and math.isfinite(x) and x >= 0):
+        raise InputError(name, f"expected {expected}, got {short_repr(x)}")
+    return float(x)
+
+
+def frozen_floats(a: npt.ArrayLike, name: str, *, ndim: int | None = None,
+                  shape: tuple[int, ...] | None = None) -> npt.NDArray[np.float64]:
+    """A read-only float64 copy of ``a``, of ``ndim`` dimensions or of ``shape``.
+
+    Args:
+        a: The values.
+        name: The argument (or field) named in the error.
+        ndim: The number of dimensions required, or None.
+        shape: The shape required, or None; with a shape the values must be finite.
+
+    Raises:
+        InputError: the wrong dimensions or shape, or non-finite values with
+            ``shape``, naming ``name``.
+    """
+    arr = np.array(a, dtype=np.float64)
+    if ndim is not None and arr.ndim != ndim:
+        raise InputError(name, f"expected {ndim} dimensions, got shape {arr.shape}")
+    if shape is not None and (arr.shape != shape or not np.isfinite(arr).all()):
+        raise InputError(name, f"expected finite values of shape {shape}, got {arr.shape}")
+    arr.setflags(write=False)
+    return arr

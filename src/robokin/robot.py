@@ -19,13 +19,14 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
+from typing_extensions import Unpack
 
 from robokin import _html
 from robokin._validation import check_finite, check_joints, check_transform
 from robokin.exceptions import InputError
 from robokin.io.robot_files import document_from_robot
 from robokin.io.robot_tables import MM_PER_M, joint_rows_mm_deg
-from robokin.io.urdf import parts_from_urdf
+from robokin.io.urdf import UrdfKeywords, parts_from_urdf
 from robokin.io.urdf_export import urdf_from_robot
 from robokin.kinematics import forward
 from robokin.kinematics import jacobian as _jac
@@ -38,7 +39,6 @@ from robokin.model.dh import chain_from_dh, chain_from_elementary
 from robokin.model.parts import RobotParts
 
 if TYPE_CHECKING:
-    from robokin.io.urdf_geometry import MissingMesh
     from robokin.kinematics.ik.numeric import IKResult
     from robokin.kinematics.ik.solutions import SolutionSet
 
@@ -144,13 +144,7 @@ class Robot(RobotParts):
         base_link: str | None = None,
         tip_link: str | None = None,
         package_map: Mapping[str, str | Path] | None = None,
-        *,
-        xacro_args: Mapping[str, str] | None = None,
-        geometry: bool = True,
-        missing_mesh: MissingMesh = "warn",
-        name: str | None = None,
-        srdf: str | Path | bytes | None = None,
-        tool_joints: Mapping[str, float] | None = None,
+        **options: Unpack[UrdfKeywords],
     ) -> Robot:
         """Load the serial chain of a URDF or xacro file (needs ``robokin[urdf]``).
 
@@ -160,10 +154,8 @@ class Robot(RobotParts):
         The arguments are those of :func:`robokin.io.urdf.parts_from_urdf`, which
         reads the parts.
         """
-        return cls.from_parts(parts_from_urdf(
-            path, base_link, tip_link, package_map, xacro_args=xacro_args,
-            geometry=geometry, missing_mesh=missing_mesh, name=name, srdf=srdf,
-            tool_joints=tool_joints))
+        return cls.from_parts(parts_from_urdf(path, base_link, tip_link, package_map,
+                                              **options))
 
     def to_urdf(
         self,

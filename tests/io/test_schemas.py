@@ -228,3 +228,27 @@ def test_the_schema_follows_the_model():
     assert set(RobotFile.model_fields) == set(props)
     row = json_schema("robot")["$defs"]["Row"]["properties"]
     assert set(Row.model_fields) == set(row)
+
+
+def test_joint_entries_keep_their_field_order_and_checks():
+    """Oracle: the field order ``robokin schema robot`` printed before the joint
+    fields were shared (docs/robot-files.md lists them in this order), and the
+    reader's refusals of reversed limits and a boolean sign on every entry kind."""
+    from pydantic import ValidationError
+
+    from robokin.io.robot_files import _schema
+
+    defs = json_schema("robot")["$defs"]
+    assert list(defs["Row"]["properties"]) == [
+        "name", "joint", "a", "alpha", "d", "theta", "limits", "sign", "depends",
+        "depends_offset"]
+    assert list(defs["Op"]["properties"]) == [
+        "op", "value", "name", "joint", "limits", "sign", "depends", "depends_offset"]
+    assert list(defs["Coordinate"]["properties"]) == ["name", "joint", "limits"]
+    _, Row, Op = _schema()
+    for model, base in ((Row, {}), (Op, {"op": "rz"})):
+        assert model(**base, limits=(-1.0, 1.0), sign=-1).sign == -1
+        with pytest.raises(ValidationError, match="limits reversed"):
+            model(**base, limits=(1.0, -1.0))
+        with pytest.raises(ValidationError, match="got a boolean"):
+            model(**base, sign=True)

@@ -232,3 +232,20 @@ def test_other_viser_servers_in_the_process_are_left_alone(ur5):
                 assert len(ws.recv(timeout=10)) > 0
     finally:
         server.stop()
+
+
+def test_view_passes_every_viewer_keyword(ur5):
+    """``view`` takes RobotViewer's keywords (declared once, issue 24); before,
+    ``dt``, ``verbose`` and ``allowed_hosts`` were refused. Oracle: the viewer's
+    timing follows ``dt`` (50 samples without times span 49 * dt) and the
+    served page is the viewer's."""
+    from robokin.viz import viewer as viewer_mod
+
+    q = _motion()
+    with viewer_mod.view(ur5, q, block=False, play=False, port=0, dt=0.02,
+                         verbose=False, allowed_hosts=("robot-cell",)) as v:
+        assert v.motion.t[-1] == pytest.approx(49 * 0.02)
+        assert not v.free
+        assert b"<html" in urllib.request.urlopen(v.url, timeout=10).read().lower()
+    with pytest.raises(TypeError, match="frame_rate"):
+        viewer_mod.view(ur5, q, block=False, frame_rate=30)  # type: ignore[call-arg]

@@ -40,8 +40,8 @@ class Tracks:
         alive: (C, k) bool: the track reaches the last pose.
         died_at: (C, k) int: the pose index where the track died (N if alive,
             0 if it never started).
-        unreached: (C,) int: the first pose without any solution inside the
-            limits (-1 when every pose has one).
+        unreached: (C,) int: as ``PoseSet.unreached`` (``robokin.cell._pose_set``),
+            from the same ``solve_task`` call.
     """
 
     q: np.ndarray

@@ -22,7 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin._text import short_repr
-from robokin._validation import check_finite_number
+from robokin._validation import _real_array, check_finite_number
 from robokin.exceptions import InputError
 from robokin.spatial import rotz
 
@@ -143,12 +143,7 @@ def check_voxel(voxel: object) -> float:
 
 def check_region(region: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper corners (3,) [m] of a region, or :class:`InputError`."""
-    try:
-        r = np.asarray(region, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InputError(
-            "region", f"expected [[x0, y0, z0], [x1, y1, z1]] [m], got {short_repr(region)}"
-        ) from None
+    r = _real_array(region, "region", "[[x0, y0, z0], [x1, y1, z1]] [m]")
     if r.shape != (2, 3):
         raise InputError(
             "region", f"expected [[x0, y0, z0], [x1, y1, z1]] [m], shape (2, 3), got {r.shape}"

@@ -54,7 +54,7 @@ from robokin.exceptions import InputError, UnreachableError
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from robokin.collision.check import CollisionReport
+    from robokin.collision.report import CollisionReport
     from robokin.collision.scene import Scene
     from robokin.robot import Robot
 

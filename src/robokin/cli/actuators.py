@@ -12,17 +12,9 @@ from typing import Annotated
 import numpy as np
 import typer
 
+from robokin.cli import output
 from robokin.cli.common import NUMERIC_ARGS, json_text, load_robot
 from robokin.cli.options import DegFlag, JsonFlag, MmFlag, RobotName
-from robokin.cli.output import (
-    Column,
-    FormatOption,
-    OutputTable,
-    emit,
-    general,
-    resolve_format,
-    say,
-)
 
 __all__ = ["commands", "joints", "motors"]
 
@@ -59,12 +51,13 @@ def _report(title: str, names: list[str], values: np.ndarray, units: list[str],
         print(json_text({key: values.tolist(), "names": names, "units": units,
                           "within_limits": inside.tolist()}))
         return
-    table = OutputTable(title, [Column("name"), Column("value", general(12), True),
-                                Column("unit"), Column("within limits")])
+    table = output.OutputTable(title, [
+        output.Column("name"), output.Column("value", output.general(12), True),
+        output.Column("unit"), output.Column("within limits")])
     for nm, v, u, ok in zip(names, values, units, inside):
         table.add_row(nm, float(v), u, "yes" if ok else "no",
                       style=None if ok else "red")
-    emit(table, fmt)
+    output.emit(table, fmt)
 
 
 def _inside(values: np.ndarray, limits: np.ndarray | None) -> np.ndarray:
@@ -80,10 +73,10 @@ def motors(
     deg: DegFlag = False,
     mm: MmFlag = False,
     as_json: JsonFlag = False,
-    output_format: FormatOption = None,
+    output_format: output.FormatOption = None,
 ) -> None:
     """Motor coordinates from joint coordinates: phi = A^+ (q - b)."""
-    fmt = resolve_format(output_format, as_json)
+    fmt = output.resolve_format(output_format, as_json)
     r = load_robot(name)
     if len(q) != r.n:
         raise typer.BadParameter(f"{r.name} has {r.n} joints, got {len(q)} values")
@@ -96,7 +89,7 @@ def motors(
             phi * _scales(angular, deg, mm), _units(angular, deg, mm),
             _inside(phi, lim), fmt, "phi")
     if fmt != "json" and r.actuators is None:
-        say("no actuator map: motors drive the joints one to one", fmt)
+        output.say("no actuator map: motors drive the joints one to one", fmt)
 
 
 @commands.command(context_settings=NUMERIC_ARGS)
@@ -106,10 +99,10 @@ def joints(
     deg: DegFlag = False,
     mm: MmFlag = False,
     as_json: JsonFlag = False,
-    output_format: FormatOption = None,
+    output_format: output.FormatOption = None,
 ) -> None:
     """Joint coordinates from motor coordinates: q = A phi + b."""
-    fmt = resolve_format(output_format, as_json)
+    fmt = output.resolve_format(output_format, as_json)
     r = load_robot(name)
     angular = np.array([k == "rotary" for k in _motor_kinds(r)])
     if len(phi) != angular.size:

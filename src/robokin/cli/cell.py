@@ -15,16 +15,9 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
+from robokin.cli import output
 from robokin.cli.common import DomainFailure, json_text, load_scene
 from robokin.cli.options import JsonFlag, RobotName
-from robokin.cli.output import (
-    Column,
-    FormatOption,
-    OutputTable,
-    emit,
-    general,
-    resolve_format,
-)
 from robokin.exceptions import InputError
 from robokin.io.atomic import check_distinct
 
@@ -158,7 +151,7 @@ def reach_command(
         bool, typer.Option("--force", help="Replace a map.zarr holding another map.")
     ] = False,
     as_json: JsonFlag = False,
-    output_format: FormatOption = None,
+    output_format: output.FormatOption = None,
 ) -> None:
     """Reachability map: which positions the tool reaches, in how many orientations.
 
@@ -170,7 +163,7 @@ def reach_command(
     from robokin.cell.grid import check_orientation_count
     from robokin.io.atomic import write_atomic
 
-    fmt = resolve_format(output_format, as_json)
+    fmt = output.resolve_format(output_format, as_json)
     if not (math.isfinite(voxel) and voxel > 0):
         raise InputError("--voxel", f"expected an edge length > 0 [mm], got {voxel:g}")
     check_orientation_count(orientations, rolls, names=("--orientations", "--rolls"))
@@ -198,8 +191,8 @@ def reach_command(
         print(json_text(summary))
         return
     nx, ny, nz = m.grid.shape
-    table = OutputTable(f"{robot.name}: reachability map ({m.method})",
-                        [Column(""), Column("value")])
+    table = output.OutputTable(f"{robot.name}: reachability map ({m.method})",
+                               [output.Column(""), output.Column("value")])
     table.add_row("voxels", f"{m.size:,} ({nx} x {ny} x {nz} of {voxel:g} mm)")
     table.add_row("orientations", f"{summary['orientations']} per voxel "
                   f"({summary['ik_evaluations']:,} IK targets)")
@@ -210,7 +203,7 @@ def reach_command(
     if summary["manipulability_max"] is not None:
         table.add_row("best manipulability", f"{summary['manipulability_max']:.4g}")
     table.notes += [f"wrote {p}" for p in (folder / "map.zarr", png, folder / "reach.json")]
-    emit(table, fmt)
+    output.emit(table, fmt)
 
 
 @commands.command("place")
@@ -244,7 +237,7 @@ def place_command(
     ] = None,
     connect_timeout: ConnectTimeout = None,
     as_json: JsonFlag = False,
-    output_format: FormatOption = None,
+    output_format: output.FormatOption = None,
 ) -> None:
     """Score candidate robot bases for a task: reach on one branch, clearance, manipulability.
 
@@ -257,7 +250,7 @@ def place_command(
     from robokin.cell.placement import DEFAULT_MAX_STEP
     from robokin.io.atomic import write_atomic
 
-    fmt = resolve_format(output_format, as_json)
+    fmt = output.resolve_format(output_format, as_json)
     if not (math.isfinite(clearance) and clearance >= 0):
         raise InputError("--clearance", f"expected a distance >= 0 [mm], got {clearance:g}")
     if every < 1:
@@ -299,7 +292,7 @@ def place_command(
     if fmt == "json":
         print(json_text(summary))
     else:
-        emit(_ranking_table(pl, robot.name, folder), fmt)
+        output.emit(_ranking_table(pl, robot.name, folder), fmt)
     if pl.best_index is None:
         raise DomainFailure(f"no feasible placement among {len(pl.feasible)} candidates: "
                             f"{pl.reasons_text()}")
@@ -327,14 +320,15 @@ def _task_poses(task: str, robot: Robot, scene: Any, every: int) -> tuple[Any, b
     return placed.fk(q[::every]), False
 
 
-def _ranking_table(pl: Any, robot_name: str, folder: Path, top: int = 10) -> OutputTable:
+def _ranking_table(pl: Any, robot_name: str, folder: Path,
+                   top: int = 10) -> output.OutputTable:
     """The best ``top`` feasible candidates, then why the others fail and the files."""
-    table = OutputTable(
+    numbers = [output.Column(head, output.general(digits), True) for head, digits in (
+        ("x [mm]", 6), ("y [mm]", 6), ("z [mm]", 6), ("yaw [deg]", 6), ("score", 4),
+        ("clearance [mm]", 4))]
+    table = output.OutputTable(
         f"{robot_name}: {int(pl.feasible.sum())} of {len(pl.feasible)} bases feasible",
-        [Column("rank", right=True), Column("x [mm]", general(6), True),
-         Column("y [mm]", general(6), True), Column("z [mm]", general(6), True),
-         Column("yaw [deg]", general(6), True), Column("score", general(4), True),
-         Column("clearance [mm]", general(4), True)])
+        [output.Column("rank", right=True), *numbers])
     for r, c in enumerate(pl.ranking[:top], start=1):
         T = pl.candidates[c]
         table.add_row(r, float(T[0, 3] * 1e3), float(T[1, 3] * 1e3), float(T[2, 3] * 1e3),

@@ -48,7 +48,6 @@ robot file's limits) and reports that cycle time next to the hand-made path's
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -59,6 +58,7 @@ import numpy as np
 import typer
 
 from robokin import collision
+from robokin._validation import check_nonnegative
 from robokin.cli.common import DomainFailure, console
 from robokin.cli.demo_job import (
     A_MAX,
@@ -81,7 +81,6 @@ from robokin.cli.demo_report import (
     timing_text,
     write_distance_csv,
 )
-from robokin.exceptions import InputError
 from robokin.io.atomic import write_atomic
 from robokin.io.strict_json import strict_json
 from robokin.robots import load as load_robot
@@ -118,15 +117,7 @@ class DemoResult:
 
 def _clearance(clearance_mm: float) -> float:
     """The required clearance [m] of the ``--clearance`` value [mm], checked."""
-    if not (
-        isinstance(clearance_mm, int | float)
-        and math.isfinite(clearance_mm)
-        and clearance_mm >= 0
-    ):
-        raise InputError(
-            "clearance", f"expected a distance >= 0 [mm], got {clearance_mm!r}"
-        )
-    return clearance_mm / 1000.0
+    return check_nonnegative(clearance_mm, "clearance", "a distance >= 0 [mm]") / 1000.0
 
 
 @dataclass

@@ -31,35 +31,20 @@ How it stays fast (coal queries are the expensive part):
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
 
-from robokin._text import short_repr
-from robokin.collision.report import (
-    TIE,
-    Closest,
-    Collision,
-    CollisionReport,
-    Interval,
-    PairMinimum,
-)
+from robokin._validation import _real_array, check_nonnegative
+from robokin.collision.report import TIE, CollisionReport
 from robokin.exceptions import InputError
 
 if TYPE_CHECKING:
     from robokin.collision.scene import Scene
     from robokin.robot import Robot
 
-__all__ = [
-    "Closest",
-    "Collision",
-    "CollisionReport",
-    "Interval",
-    "PairMinimum",
-    "check",
-]
+__all__ = ["check"]
 
 
 
@@ -73,12 +58,7 @@ def _as_samples(
             t = tt
     else:
         q = q_samples
-    try:
-        q = np.array(q, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InputError(
-            "q_samples", f"expected numbers, got {short_repr(q_samples)}"
-        ) from None
+    q = _real_array(q, "q_samples", "numbers").copy()
     if q.ndim == 1:
         q = q[None, :]
     if q.ndim != 2 or q.shape[1] != n or q.shape[0] == 0:
@@ -141,14 +121,7 @@ def check(
             shapes (neither its own geometry nor the scene's tool).
         MissingExtraError: coal (or trimesh for meshes) is not installed.
     """
-    if not (
-        isinstance(clearance, int | float)
-        and math.isfinite(clearance)
-        and clearance >= 0
-    ):
-        raise InputError(
-            "clearance", f"expected a finite number >= 0 [m], got {short_repr(clearance)}"
-        )
+    check_nonnegative(clearance, "clearance", "a finite number >= 0 [m]")
     q, tt = _as_samples(q_samples, robot.n, t)
     problem = _problem_for(robot, scene, self_collision)
     return problem.run(

@@ -130,12 +130,12 @@ def _schema():
     from pydantic import (
         AfterValidator,
         BaseModel,
+        BeforeValidator,
         ConfigDict,
         Field,
         StrictFloat,
         StrictInt,
         StrictStr,
-        field_validator,
     )
 
     Name = Annotated[StrictStr, Field(max_length=MAX_NAME), AfterValidator(_printable)]
@@ -162,40 +162,37 @@ def _schema():
             raise ValueError("sign must be 1 or -1, got a boolean")
         return v
 
+    # the field types every joint entry shares, each with its check
+    Limits = Annotated[tuple[StrictFloat, StrictFloat], AfterValidator(_check_limits)]
+    JointSign = Annotated[Sign, StrictInt, BeforeValidator(_check_sign)]
+    JointKind = Literal["revolute", "prismatic", "fixed"]
+
     class Row(Strict):
         name: Name | None = None
-        joint: Literal["revolute", "prismatic", "fixed"] = "revolute"
+        joint: JointKind = "revolute"
         a: StrictFloat = 0.0
         alpha: StrictFloat = 0.0
         d: StrictFloat = 0.0
         theta: StrictFloat = 0.0
-        limits: tuple[StrictFloat, StrictFloat] | None = None
-        sign: Annotated[Sign, StrictInt] = 1
+        limits: Limits | None = None
+        sign: JointSign = 1
         depends: dict[Name, StrictFloat] | None = None
         depends_offset: StrictFloat = 0.0
-
-        _lim = field_validator("limits")(_check_limits)
-        _sgn = field_validator("sign", mode="before")(_check_sign)
 
     class Op(Strict):
         op: Literal["rx", "ry", "rz", "tx", "ty", "tz", "frame"]
         value: StrictFloat = 0.0
         name: Name | None = None
-        joint: Literal["revolute", "prismatic", "fixed"] = "fixed"
-        limits: tuple[StrictFloat, StrictFloat] | None = None
-        sign: Annotated[Sign, StrictInt] = 1
+        joint: JointKind = "fixed"
+        limits: Limits | None = None
+        sign: JointSign = 1
         depends: dict[Name, StrictFloat] | None = None
         depends_offset: StrictFloat = 0.0
-
-        _lim = field_validator("limits")(_check_limits)
-        _sgn = field_validator("sign", mode="before")(_check_sign)
 
     class Coordinate(Strict):
         name: Name
         joint: Literal["revolute", "prismatic"] = "revolute"
-        limits: tuple[StrictFloat, StrictFloat] | None = None
-
-        _lim = field_validator("limits")(_check_limits)
+        limits: Limits | None = None
 
     class RobotFile(Strict):
         name: Name
@@ -325,19 +322,31 @@ def _si_rows(spec: Any, rows: list[Any], L: float, A: float) -> list[dict[str, A
     return out
 
 
-def _lengths(spec: Any, si_rows: list[dict[str, Any]], L: float
-             ) -> list[tuple[str, float]]:
-    """Every length of the file (field path, value in metres)."""
+def _row_values(si_rows: list[dict[str, Any]], op: str, fields: tuple[str, str],
+                with_limits: bool) -> list[tuple[str, float]]:
+    """The chain rows' values of one quantity (field path, SI value), row by row.
+
+    ``op`` is the first letter of the elementary ops holding it (``"t"``
+    lengths, ``"r"`` angles), ``fields`` the DH fields holding it; with
+    ``with_limits`` a prismatic joint's limits follow its row's values.
+    """
     out: list[tuple[str, float]] = []
     for i, d in enumerate(si_rows):
         where = f"joints[{i}]"
         if "op" in d:
-            if d["op"][0] == "t":
+            if d["op"][0] == op:
                 out.append((f"{where}.value", d["value"]))
         else:
-            out += [(f"{where}.a", d["a"]), (f"{where}.d", d["d"])]
-        if d.get("joint") == "prismatic" and "limits" in d:
+            out += [(f"{where}.{f}", d[f]) for f in fields]
+        if with_limits and d.get("joint") == "prismatic" and "limits" in d:
             out += [(f"{where}.limits", v) for v in d["limits"]]
+    return out
+
+
+def _lengths(spec: Any, si_rows: list[dict[str, Any]], L: float
+             ) -> list[tuple[str, float]]:
+    """Every length of the file (field path, value in metres)."""
+    out = _row_values(si_rows, "t", ("a", "d"), with_limits=True)
     for key in ("base", "tool"):
         p = getattr(spec, key)
         if p is not None:
@@ -347,15 +356,7 @@ def _lengths(spec: Any, si_rows: list[dict[str, Any]], L: float
 
 def _angles(spec: Any, si_rows: list[dict[str, Any]]) -> list[tuple[str, float]]:
     """Every angle of the chain rows (field path, value in radians)."""
-    out: list[tuple[str, float]] = []
-    for i, d in enumerate(si_rows):
-        where = f"joints[{i}]"
-        if "op" in d:
-            if d["op"][0] == "r":
-                out.append((f"{where}.value", d["value"]))
-        else:
-            out += [(f"{where}.alpha", d["alpha"]), (f"{where}.theta", d["theta"])]
-    return out
+    return _row_values(si_rows, "r", ("alpha", "theta"), with_limits=False)
 
 
 def _check_lengths(lengths: list[tuple[str, float]], file: Any) -> None:
@@ -376,18 +377,18 @@ def _warn_units(doc: Mapping, lengths: list[tuple[str, float]],
     """
     units = doc.get("units") if isinstance(doc.get("units"), Mapping) else None
     hints = []
-    if lengths and (units is None or units.get("length", "m") == "m"):
-        where, v = max(lengths, key=lambda wv: abs(wv[1]))
-        if abs(v) > _PLAUSIBLE_LENGTH:
-            hints.append(f"a length of {v:g} m ({where}) suggests millimetres: "
-                         + ("add 'units: {length: mm}'" if units is None else
-                            "declare 'length: mm' in units:"))
-    if angles and (units is None or units.get("angle", "rad") == "rad"):
-        where, v = max(angles, key=lambda wv: abs(wv[1]))
-        if abs(v) > _PLAUSIBLE_ANGLE:
-            hints.append(f"an angle of {v:g} rad ({where}) suggests degrees: "
-                         + ("add 'units: {angle: deg}'" if units is None else
-                            "declare 'angle: deg' in units:"))
+    # (values, units: key, SI unit, the other unit, its word; the plausible bound)
+    for values, key, si, other, word, bound in (
+            (lengths, "length", "m", "mm", "millimetres", _PLAUSIBLE_LENGTH),
+            (angles, "angle", "rad", "deg", "degrees", _PLAUSIBLE_ANGLE)):
+        if not values or (units is not None and units.get(key, si) != si):
+            continue
+        where, v = max(values, key=lambda wv: abs(wv[1]))
+        if abs(v) > bound:
+            article = "an" if key[0] in "aeiou" else "a"
+            hints.append(f"{article} {key} of {v:g} {si} ({where}) suggests {word}: "
+                         + (f"add 'units: {{{key}: {other}}}'" if units is None else
+                            f"declare '{key}: {other}' in units:"))
     if hints:
         name = "the robot file" if file is None else str(file)
         said = ("has no 'units:', so it is read in metres and radians" if units is None

@@ -44,7 +44,7 @@ import math
 import warnings
 from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, TypedDict
 
 import numpy as np
 
@@ -276,6 +276,17 @@ def chain_from_urdf_model(
 
 
 # ------------------------------------------------------------------------ public
+class UrdfKeywords(TypedDict, total=False):
+    """The keyword-only arguments of :func:`parts_from_urdf` (and ``Robot.from_urdf``)."""
+
+    xacro_args: Mapping[str, str] | None
+    geometry: bool
+    missing_mesh: MissingMesh
+    name: str | None
+    srdf: str | Path | bytes | None
+    tool_joints: Mapping[str, float] | None
+
+
 def parts_from_urdf(
     path_or_string: str | Path | bytes,
     base_link: str | None = None,

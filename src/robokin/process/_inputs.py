@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -17,6 +17,7 @@ from robokin._validation import (
     check_transform,
 )
 from robokin.exceptions import InputError
+from robokin.process.costs import Costs
 from robokin.spatial import rotz
 
 if TYPE_CHECKING:
@@ -24,7 +25,8 @@ if TYPE_CHECKING:
     from robokin.robot import Robot
 
 __all__ = ["MAX_ANGLES", "MAX_SAMPLES", "Placed", "ToolSamples", "check_max_step",
-           "check_poses", "check_q_start", "place", "tool_samples"]
+           "SearchInputs", "SearchKeywords", "check_poses", "check_q_start", "place",
+           "search_inputs", "tool_samples"]
 
 #: Most tool rotations sampled per waypoint (a tenth of a degree over a full turn).
 MAX_ANGLES = 3600
@@ -32,6 +34,7 @@ MAX_ANGLES = 3600
 #: IK solution (about 0.5 kB on a 6R arm), so this bounds the memory near 0.5 GB.
 MAX_SAMPLES = 1_000_000
 FREE_AXES = (None, "z")
+_FREE_STEP = math.radians(5.0)  # default tool-rotation sampling [rad]
 
 
 @dataclass(frozen=True, eq=False)
@@ -179,3 +182,55 @@ def check_q_start(q_start: npt.ArrayLike | None, robot: Robot) -> np.ndarray | N
         raise InputError("q_start", f"joint {j + 1} at {q[j]:.6g} is outside its limits "
                          f"[{lim[j, 0]:.6g}, {lim[j, 1]:.6g}]")
     return q.astype(np.float64, copy=True)
+
+
+class SearchKeywords(TypedDict, total=False):
+    """The keywords :func:`~robokin.process.follow` and :func:`~robokin.process.order` share."""
+
+    free_axis: str | None
+    free_range: tuple[float, float] | None
+    free_step: float
+    q_start: npt.ArrayLike | None
+    scene: Any
+    clearance: float
+    travel_weight: float
+    singularity_weight: float
+    singularity_margin: float
+    singular_tol: float
+    limit_weight: float
+    limit_margin: float
+
+
+@dataclass(frozen=True, eq=False)
+class SearchInputs:
+    """The checked inputs of a tool-path search.
+
+    Attributes:
+        placed: The robot and scene as placed (:func:`place`).
+        T: The tool poses (N, 4, 4) [m].
+        samples: The tool rotations tried per pose.
+        q_start: The start configuration (n,), or None.
+        costs: The objective's weights and margins.
+    """
+
+    placed: Placed
+    T: np.ndarray
+    samples: ToolSamples
+    q_start: np.ndarray | None
+    costs: Costs
+
+
+def search_inputs(robot: Robot, poses: Any, *, free_axis: Any = None,
+                  free_range: Any = None, free_step: Any = _FREE_STEP,
+                  q_start: npt.ArrayLike | None = None, scene: Any = None,
+                  clearance: Any = 0.0, **weights: float) -> SearchInputs:
+    """The :class:`SearchInputs` of ``poses`` and the keywords (``SearchKeywords``).
+
+    Raises:
+        InputError: a bad argument (named).
+    """
+    placed = place(robot, scene, clearance)
+    T = check_poses(poses)
+    samples = tool_samples(free_axis, free_range, free_step)
+    qs = check_q_start(q_start, placed.robot)
+    return SearchInputs(placed, T, samples, qs, Costs(**weights))

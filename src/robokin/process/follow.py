@@ -21,26 +21,23 @@ whether it has usable configurations (green) or not (red), for plots
 
 from __future__ import annotations
 
-import math
 import time
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
+from typing_extensions import Unpack
 
 from robokin import _native
 from robokin.process._collide import Collider
 from robokin.process._graph import ArmFacts, Layers, arm_facts, build_layers, check_size
 from robokin.process._inputs import (
     Placed,
+    SearchKeywords,
     check_max_step,
-    check_poses,
-    check_q_start,
-    place,
-    tool_samples,
+    search_inputs,
 )
 from robokin.process._search import Search, Solution
-from robokin.process.costs import Costs
 from robokin.process.report import Failure, FollowResult, WaypointReport
 from robokin.spatial import wrap_angle
 
@@ -57,19 +54,8 @@ def follow(
     robot: Robot,
     poses: npt.ArrayLike,
     *,
-    free_axis: str | None = None,
-    free_range: tuple[float, float] | None = None,
-    free_step: float = math.radians(5.0),
     max_step: float = 0.1,
-    q_start: npt.ArrayLike | None = None,
-    scene: Any = None,
-    clearance: float = 0.0,
-    travel_weight: float = 1.0,
-    singularity_weight: float = 0.1,
-    singularity_margin: float = 0.05,
-    singular_tol: float = 1e-3,
-    limit_weight: float = 0.1,
-    limit_margin: float = math.radians(5.0),
+    **options: Unpack[SearchKeywords],
 ) -> FollowResult:
     """The joint motion along a tool path with the least cost, over every IK branch.
 
@@ -110,13 +96,10 @@ def follow(
         MissingExtraError: a scene without ``robokin[collision]``.
     """
     t0 = time.perf_counter()
-    placed = place(robot, scene, clearance)
-    T = check_poses(poses)
-    samples = tool_samples(free_axis, free_range, free_step)
+    inputs = search_inputs(robot, poses, **options)
+    placed, T, samples, qs, costs = (inputs.placed, inputs.T, inputs.samples,
+                                     inputs.q_start, inputs.costs)
     step = check_max_step(max_step)
-    qs = check_q_start(q_start, placed.robot)
-    costs = Costs(travel_weight, singularity_weight, singularity_margin, singular_tol,
-                  limit_weight, limit_margin)
     check_size(T.shape[0], samples.count)
     facts = arm_facts(placed.robot)
     layers = build_layers(facts, T, samples, costs)

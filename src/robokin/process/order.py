@@ -20,11 +20,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
+from typing_extensions import Unpack
 
 from robokin import _native
 from robokin.process._collide import Collider
 from robokin.process._graph import ArmFacts, Layers, arm_facts, build_layers, check_size
-from robokin.process._inputs import check_poses, check_q_start, place, tool_samples
+from robokin.process._inputs import SearchKeywords, search_inputs
 from robokin.process._search import Search
 from robokin.process._tsp import (
     Tour,
@@ -50,19 +51,7 @@ _NEAR = 8  # neighbour-list length of the re-insertion move
 def order(
     robot: Robot,
     poses: npt.ArrayLike,
-    *,
-    free_axis: str | None = None,
-    free_range: tuple[float, float] | None = None,
-    free_step: float = math.radians(5.0),
-    q_start: npt.ArrayLike | None = None,
-    scene: Any = None,
-    clearance: float = 0.0,
-    travel_weight: float = 1.0,
-    singularity_weight: float = 0.1,
-    singularity_margin: float = 0.05,
-    singular_tol: float = 1e-3,
-    limit_weight: float = 0.1,
-    limit_margin: float = math.radians(5.0),
+    **options: Unpack[SearchKeywords],
 ) -> OrderResult:
     """Visit every pose once, in the order and with the IK branches that cost least.
 
@@ -94,12 +83,9 @@ def order(
         InputError: a bad argument (named).
     """
     t0 = time.perf_counter()
-    placed = place(robot, scene, clearance)
-    T = check_poses(poses)
-    samples = tool_samples(free_axis, free_range, free_step)
-    qs = check_q_start(q_start, placed.robot)
-    costs = Costs(travel_weight, singularity_weight, singularity_margin, singular_tol,
-                  limit_weight, limit_margin)
+    inputs = search_inputs(robot, poses, **options)
+    placed, T, samples, qs, costs = (inputs.placed, inputs.T, inputs.samples,
+                                     inputs.q_start, inputs.costs)
     check_size(T.shape[0], samples.count)
     facts = arm_facts(placed.robot)
     layers = build_layers(facts, T, samples, costs)

@@ -37,10 +37,11 @@ import re
 import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, TypedDict
 
 import numpy as np
 import numpy.typing as npt
+from typing_extensions import Unpack
 
 from robokin._text import short_repr
 from robokin._units import ANGLE_UNITS, LENGTH_UNITS
@@ -340,14 +341,28 @@ def _check_times(t: np.ndarray, path: Path, first_line: int, *,
     return np.concatenate([[True], step > 0])
 
 
-def read_csv(
-    path: str | Path,
-    *,
-    profile: ControllerProfile | None = None,
-    is_revolute: npt.ArrayLike | None = None,
-    joint_names: Sequence[str] | None = None,
-    max_bytes: int = MAX_CSV_BYTES,
-) -> Trajectory:
+class _TableKeywords(TypedDict, total=False):
+    """The keywords of :func:`read_csv` and :func:`read_log`."""
+
+    profile: ControllerProfile | None
+    is_revolute: npt.ArrayLike | None
+    joint_names: Sequence[str] | None
+    max_bytes: int
+
+
+def _read_table(path: Path, *, allow_repeats: bool,
+                profile: ControllerProfile | None = None,
+                is_revolute: npt.ArrayLike | None = None,
+                joint_names: Sequence[str] | None = None,
+                max_bytes: int = MAX_CSV_BYTES) -> Trajectory:
+    """A trajectory table read and checked (see :func:`read_csv`)."""
+    header, data, first = _load_table(path, max_bytes)
+    keep = _check_times(data[:, 0], path, first, allow_repeats=allow_repeats)
+    return _trajectory_from_table(header, data[keep], path, profile, is_revolute,
+                                  joint_names)
+
+
+def read_csv(path: str | Path, **options: Unpack[_TableKeywords]) -> Trajectory:
     """Read a trajectory CSV (the :func:`write_csv` format, or a logged run).
 
     The first column is time; the others are joints, optionally followed by
@@ -375,21 +390,10 @@ def read_csv(
             ``joint_names``, times that do not increase (naming the file and
             line).
     """
-    path = Path(path)
-    header, data, first = _load_table(path, max_bytes)
-    _check_times(data[:, 0], path, first, allow_repeats=False)
-    return _trajectory_from_table(header, data, path, profile, is_revolute,
-                                  joint_names)
+    return _read_table(Path(path), allow_repeats=False, **options)
 
 
-def read_log(
-    path: str | Path,
-    *,
-    profile: ControllerProfile | None = None,
-    is_revolute: npt.ArrayLike | None = None,
-    joint_names: Sequence[str] | None = None,
-    max_bytes: int = MAX_CSV_BYTES,
-) -> Trajectory:
+def read_log(path: str | Path, **options: Unpack[_TableKeywords]) -> Trajectory:
     """Read a logged real run (CSV of time + joint angles) as a Trajectory.
 
     Like :func:`read_csv`, but tolerant of what loggers write: repeated time
@@ -399,11 +403,7 @@ def read_log(
     Raises:
         ModelError: as :func:`read_csv`.
     """
-    path = Path(path)
-    header, data, first = _load_table(path, max_bytes)
-    keep = _check_times(data[:, 0], path, first, allow_repeats=True)
-    return _trajectory_from_table(header, data[keep], path, profile, is_revolute,
-                                  joint_names)
+    return _read_table(Path(path), allow_repeats=True, **options)
 
 
 # ------------------------------------------------------------------------ JSON

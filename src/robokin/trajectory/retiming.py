@@ -37,10 +37,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, TypedDict
 
 import numpy as np
 import numpy.typing as npt
+from typing_extensions import Unpack
 
 from robokin.exceptions import InputError
 from robokin.trajectory._retime_laws import (
@@ -481,6 +482,20 @@ def _timings(plan: _Plan, laws: list[TimeLaw | None], off: np.ndarray
 
 
 # ----------------------------------------------------------------- public entry
+class _RetimeKeywords(TypedDict, total=False):
+    """The keywords of :func:`retime_detailed`, which :func:`retime` passes on."""
+
+    v_max: LimitArg
+    a_max: LimitArg
+    j_max: LimitArg | Literal["robot"]
+    dt: float
+    tool_speed: float | None
+    keep_dwells: bool
+    round_to_dt: bool
+    grid_points: int | None
+    max_samples: int | None
+
+
 def retime_detailed(
     robot: Robot,
     traj: Any,
@@ -553,20 +568,7 @@ def retime_detailed(
     return _stretch_all(result, (T_round - result.dwell_time) / result.motion_time)
 
 
-def retime(
-    robot: Robot,
-    traj: Any,
-    *,
-    v_max: LimitArg = None,
-    a_max: LimitArg = None,
-    j_max: LimitArg | Literal["robot"] = None,
-    dt: float = 0.005,
-    tool_speed: float | None = None,
-    keep_dwells: bool = True,
-    round_to_dt: bool = False,
-    grid_points: int | None = None,
-    max_samples: int | None = None,
-) -> Trajectory:
+def retime(robot: Robot, traj: Any, **options: Unpack[_RetimeKeywords]) -> Trajectory:
     """The same path, time-optimal within per-joint velocity and acceleration limits.
 
     Args:
@@ -615,7 +617,4 @@ def retime(
         Berscheid, L., Kroeger, T., "Jerk-limited Real-time Trajectory
         Generation with Arbitrary Target States", RSS 2021.
     """
-    return retime_detailed(robot, traj, v_max=v_max, a_max=a_max, j_max=j_max, dt=dt,
-                           tool_speed=tool_speed, keep_dwells=keep_dwells,
-                           round_to_dt=round_to_dt, grid_points=grid_points,
-                           max_samples=max_samples).trajectory
+    return retime_detailed(robot, traj, **options).trajectory

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from robokin._validation import frozen_floats
 from robokin.exceptions import InputError
 
 if TYPE_CHECKING:
@@ -22,14 +23,6 @@ if TYPE_CHECKING:
 __all__ = ["LimitReport", "LimitViolation", "Trajectory"]
 
 Space = Literal["joint", "actuator"]
-
-
-def _ro(a: npt.ArrayLike, ndim: int, name: str) -> npt.NDArray[np.float64]:
-    arr = np.array(a, dtype=np.float64)
-    if arr.ndim != ndim:
-        raise InputError(name, f"expected {ndim} dimensions, got shape {arr.shape}")
-    arr.setflags(write=False)
-    return arr
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,19 +58,19 @@ class Trajectory:
 
     def __post_init__(self) -> None:
         """Check the shapes and times; freeze the arrays."""
-        t = _ro(self.t, 1, "t")
-        q = _ro(self.q, 2, "q")
+        t = frozen_floats(self.t, "t", ndim=1)
+        q = frozen_floats(self.q, "q", ndim=2)
         m, n = q.shape
         if t.shape[0] != m:
             raise InputError("t", f"expected {m} times for {m} samples, got {t.shape[0]}")
         if m > 1 and not (np.diff(t) > 0).all():
             raise InputError("t", "times must be strictly increasing")
-        qd = _ro(self.qd, 2, "qd")
-        qdd = _ro(self.qdd, 2, "qdd")
+        qd = frozen_floats(self.qd, "qd", ndim=2)
+        qdd = frozen_floats(self.qdd, "qdd", ndim=2)
         for name, arr in (("qd", qd), ("qdd", qdd)):
             if arr.shape != (m, n):
                 raise InputError(name, f"expected shape {(m, n)}, got {arr.shape}")
-        pose = None if self.pose is None else _ro(self.pose, 3, "pose")
+        pose = None if self.pose is None else frozen_floats(self.pose, "pose", ndim=3)
         if pose is not None and pose.shape != (m, 4, 4):
             raise InputError("pose", f"expected shape {(m, 4, 4)}, got {pose.shape}")
         names = self.joint_names
@@ -91,7 +84,7 @@ class Trajectory:
             if rev.shape != (n,):
                 raise InputError("is_revolute", f"expected {n} flags, got {rev.shape}")
             rev.setflags(write=False)
-        via = _ro(self.via_times, 1, "via_times")
+        via = frozen_floats(self.via_times, "via_times", ndim=1)
         for k, v in (("t", t), ("q", q), ("qd", qd), ("qdd", qdd), ("pose", pose),
                      ("joint_names", names), ("is_revolute", rev), ("via_times", via),
                      ("labels", tuple(self.labels))):

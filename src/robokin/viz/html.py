@@ -15,9 +15,10 @@ import html as _html
 import json
 from dataclasses import asdict
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
+from typing_extensions import Unpack
 
 from robokin.io.atomic import write_atomic
 from robokin.viz._common import COLORS, drawing, scene_shapes, skeleton
@@ -70,6 +71,17 @@ def _shape_json(s: Any, frame: int | None = None) -> dict[str, Any]:
         )
         d["faces"] = faces.reshape(-1).tolist()
     return d
+
+
+class _PageKeywords(TypedDict, total=False):
+    """The keywords of :func:`animation_html`, which :func:`write_html` passes on."""
+
+    scene: Any
+    report: Any
+    title: str | None
+    dt: float
+    max_frames: int
+    autoplay: bool
 
 
 def animation_html(
@@ -218,13 +230,7 @@ def write_html(
     path: str | Path,
     robot: Robot,
     trajectory: Any = None,
-    *,
-    scene: Any = None,
-    report: Any = None,
-    title: str | None = None,
-    dt: float = 0.005,
-    max_frames: int = 2500,
-    autoplay: bool = True,
+    **options: Unpack[_PageKeywords],
 ) -> Path:
     """Write the animation of ``robot`` as one self-contained HTML file.
 
@@ -251,17 +257,7 @@ def write_html(
         InputError: the folder is missing or read-only, or ``path`` is a folder.
     """
     path = Path(path)
-    text = animation_html(
-        robot,
-        trajectory,
-        scene=scene,
-        report=report,
-        title=title,
-        dt=dt,
-        max_frames=max_frames,
-        autoplay=autoplay,
-    )
-    return write_atomic(path, text)
+    return write_atomic(path, animation_html(robot, trajectory, **options))
 
 
 _TEMPLATE = """<!DOCTYPE html>

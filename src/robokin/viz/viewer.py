@@ -27,9 +27,10 @@ from __future__ import annotations
 import math
 import threading
 import time
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
+from typing_extensions import Unpack
 
 from robokin.exceptions import MissingExtraError
 from robokin.viz._common import COLORS, drawing, scene_shapes, skeleton
@@ -531,21 +532,37 @@ def _free_port(host: str) -> int:
         return int(s.getsockname()[1])
 
 
+class _ViewerKeywords(TypedDict, total=False):
+    """The keywords of :class:`RobotViewer` that :func:`view` passes on."""
+
+    scene: Any
+    report: Any
+    host: str
+    port: int
+    dt: float
+    verbose: bool
+    allowed_hosts: tuple[str, ...]
+
+
 def view(
     robot: Robot,
     trajectory: Any = None,
     *,
-    scene: Any = None,
-    report: Any = None,
-    host: str = "127.0.0.1",
-    port: int = 8080,
     block: bool = True,
     play: bool = True,
+    **options: Unpack[_ViewerKeywords],
 ) -> RobotViewer:
-    """Open the viewer (see :class:`RobotViewer`); with ``block`` serve until Ctrl-C."""
-    viewer = RobotViewer(
-        robot, trajectory, scene=scene, report=report, host=host, port=port
-    )
+    """Open the viewer (see :class:`RobotViewer`); with ``block`` serve until Ctrl-C.
+
+    Args:
+        robot: The robot.
+        trajectory: As :class:`RobotViewer`'s.
+        block: Serve until Ctrl-C before returning.
+        play: Start playing the trajectory.
+        **options: :class:`RobotViewer`'s keywords (``scene``, ``report``,
+            ``host``, ``port``, ``dt``, ``verbose``, ``allowed_hosts``).
+    """
+    viewer = RobotViewer(robot, trajectory, **options)
     if play:
         viewer.set_playing(True)
     if block:

@@ -40,6 +40,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 import numpy.typing as npt
 
+from robokin._validation import frozen_floats
 from robokin.exceptions import InputError
 from robokin.spatial import quaternion_from_matrix, rpy_from_matrix
 
@@ -55,14 +56,6 @@ __all__ = [
 ]
 
 MoveKind = Literal["joint", "linear"]
-
-
-def _frozen(a: npt.ArrayLike, shape: tuple[int, ...], name: str) -> np.ndarray:
-    arr = np.array(a, dtype=np.float64)
-    if arr.shape != shape or not np.isfinite(arr).all():
-        raise InputError(name, f"expected finite values of shape {shape}, got {arr.shape}")
-    arr.setflags(write=False)
-    return arr
 
 
 @dataclass(frozen=True, eq=False)
@@ -96,11 +89,13 @@ class Target:
     def __post_init__(self) -> None:
         """Freeze the arrays."""
         joints = np.array(self.joints, dtype=np.float64).reshape(-1)
-        object.__setattr__(self, "joints", _frozen(joints, joints.shape, "joints"))
-        object.__setattr__(self, "position", _frozen(self.position, (3,), "position"))
-        object.__setattr__(self, "rotation", _frozen(self.rotation, (3, 3), "rotation"))
+        for key, value, shape in (("joints", joints, joints.shape),
+                                  ("position", self.position, (3,)),
+                                  ("rotation", self.rotation, (3, 3))):
+            object.__setattr__(self, key, frozen_floats(value, key, shape=shape))
         object.__setattr__(self, "orientations", MappingProxyType(
-            {k: _frozen(v, np.shape(v), k) for k, v in dict(self.orientations).items()}))
+            {k: frozen_floats(v, k, shape=np.shape(v))
+             for k, v in dict(self.orientations).items()}))
 
     def euler(self, sequence: Literal["ZYX", "XYZ", "ZYZ"]) -> np.ndarray:
         """The rotation's Euler angles (3,) [deg] (:func:`euler_deg`)."""
@@ -185,8 +180,8 @@ class ProgramJob:
         object.__setattr__(self, "notes", tuple(self.notes))
         if not self.moves:
             raise InputError("moves", "a program needs at least one move")
-        object.__setattr__(self, "tool", _frozen(self.tool, (4, 4), "tool"))
-        object.__setattr__(self, "base", _frozen(self.base, (4, 4), "base"))
+        object.__setattr__(self, "tool", frozen_floats(self.tool, "tool", shape=(4, 4)))
+        object.__setattr__(self, "base", frozen_floats(self.base, "base", shape=(4, 4)))
 
     @property
     def targets(self) -> tuple[Target, ...]:

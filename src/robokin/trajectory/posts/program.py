@@ -43,10 +43,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 import numpy.typing as npt
+from typing_extensions import Unpack
 
 from robokin._text import short_repr
 from robokin.exceptions import InputError, ModelError
@@ -337,6 +338,20 @@ def _config_notes(cfg: Any, cartesian: np.ndarray) -> list[str]:
     return notes
 
 
+class _JobKeywords(TypedDict, total=False):
+    """The keywords of :func:`program_job` that :func:`write_program` passes on."""
+
+    name: str
+    stride: int | None
+    tolerance: float | None
+    joint_speed: float
+    speed: float
+    zone: float
+    cartesian: bool
+    work_object: npt.ArrayLike | None
+    created: datetime | None
+
+
 def program_job(
     robot: Robot,
     motion: Any,
@@ -428,7 +443,7 @@ def render_program(
     *,
     options: Mapping[str, Any] | None = None,
     profile: ControllerProfile | None = None,
-    **job: Any,
+    **job: Unpack[_JobKeywords],
 ) -> Program:
     """The program's texts, not written (arguments as :func:`write_program`)."""
     post = _post_for(robot, dialect, options, profile)
@@ -444,18 +459,10 @@ def write_program(
     dialect: str | PostProcessor,
     out_dir: str | Path,
     *,
-    name: str = "robokin",
     force: bool = False,
-    stride: int | None = None,
-    tolerance: float | None = None,
-    joint_speed: float = 0.2,
-    speed: float = 0.1,
-    zone: float = 0.001,
-    cartesian: bool = False,
-    work_object: npt.ArrayLike | None = None,
     options: Mapping[str, Any] | None = None,
     profile: ControllerProfile | None = None,
-    created: datetime | None = None,
+    **job: Unpack[_JobKeywords],
 ) -> Program:
     """Write the program of ``motion`` for a controller, in its language.
 
@@ -497,10 +504,7 @@ def write_program(
             cannot be written.
         ModelError: a bad ``controller:`` section.
     """
-    prog = render_program(robot, motion, dialect, options=options, profile=profile,
-                          name=name, stride=stride, tolerance=tolerance,
-                          joint_speed=joint_speed, speed=speed, zone=zone,
-                          cartesian=cartesian, work_object=work_object, created=created)
+    prog = render_program(robot, motion, dialect, options=options, profile=profile, **job)
     folder = Path(out_dir)
     if not folder.is_dir():
         if not folder.parent.is_dir() and str(folder.parent):

@@ -43,10 +43,9 @@ from robokin.kinematics.ik.analytic import general_6r as _g6
 from robokin.kinematics.ik.analytic import palletizer as _pal
 from robokin.kinematics.ik.analytic import pieper as _pk
 from robokin.kinematics.ik.analytic import scara as _scara
-from robokin.kinematics.ik.analytic import spherical_wrist as _sw
-from robokin.kinematics.ik.analytic import three_parallel as _tp
 from robokin.kinematics.ik.analytic._geometry import Poe, poe_from_chain
 from robokin.kinematics.ik.analytic._six_r import SINGULAR_TOL
+from robokin.kinematics.ik.analytic.six_r_families import SHAPES, measure
 from robokin.model.chain import Chain
 
 if TYPE_CHECKING:
@@ -327,16 +326,16 @@ def _detect_6r(arm: Arm, poe: Poe, tol: float, near_angle: float, near_distance:
     """The family of a 6R arm without dependent joints, in the module's order."""
     chain = arm.chain
     found = []
-    details = {}
-    for mod in (_tp, _sw):
-        ang, dist, text, why = mod.measure(poe)
-        details[mod.NAME] = text
+    details: dict[str, str] = {}
+    for shape in SHAPES:
+        ang, dist, text, why = measure(poe, shape)
+        details[shape.name] = text
         if why:
-            details[mod.NAME] += f" ({why})"
+            details[shape.name] += f" ({why})"
             continue
         grade = _grade(ang, dist, tol, near_angle, near_distance)
         if grade is not None:
-            found.append((grade != "exact", max(ang, dist), mod.NAME, text))
+            found.append((grade != "exact", max(ang, dist), shape.name, text))
     found.sort(key=lambda f: (f[0], f[1]))
     if found and not found[0][0]:  # an exact closed form
         _, dev, name, text = found[0]
