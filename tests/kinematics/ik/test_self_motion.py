@@ -337,3 +337,23 @@ def test_a_rotation_far_from_so3_is_refused_naming_T(eps):
     T[:3, :3] *= 1 - eps
     with pytest.raises(InputError, match="T.*orthonormal"):
         PANDA.self_motion(T)
+
+
+def test_the_self_motion_setup_is_typed_derived_state_of_the_arm():
+    """Oracle: the Arm's SELF_MOTION state is the set-up self_motion used (built once,
+    kept by that Arm); a new Arm of the same chain builds its own; the
+    swivel closed form exists for the SRS arm only. (Before: an untyped
+    ``Arm.self_motion`` field narrowed by isinstance.)"""
+    from robokin.kinematics.arm import Arm
+    from robokin.kinematics.ik.self_motion_families import SELF_MOTION, SelfMotionSetup
+
+    assert not hasattr(Arm(PANDA.chain), "self_motion")
+    for robot, srs in ((PANDA.with_tool(np.eye(4)), False), (SRS.with_tool(np.eye(4)), True)):
+        assert SELF_MOTION not in robot.arm.state
+        sm = robot.self_motion(robot.fk(np.full(7, 0.4)))
+        setup = robot.arm.state[SELF_MOTION]
+        assert isinstance(setup, SelfMotionSetup) and robot.arm.derived(SELF_MOTION) is setup
+        assert (setup.swivel is not None) == srs == (sm.parameter == "swivel")
+        assert setup.parameter_known is False or setup.parameter == sm.parameter
+        other = Arm(robot.chain)
+        assert other.derived(SELF_MOTION) is not setup
