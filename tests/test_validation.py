@@ -9,6 +9,7 @@ import robokin
 from robokin._validation import (
     MAX_TRANSLATION,
     check_joints,
+    check_rigid,
     check_transform,
     check_vector,
 )
@@ -191,3 +192,26 @@ def test_unaligned_arrays_reach_the_cell_functions():
     m2 = cell.reach_map(robot, region=unaligned(box), voxel=0.1,
                         orientations=unaligned(R), scheduler="synchronous")
     np.testing.assert_array_equal(m1.reachable, m2.reachable)
+
+
+def test_check_rigid_projects_rotations_near_so3_and_leaves_exact_ones_alone(ur5):
+    """Oracle: the nearest rotation to s R (R a rotation, s > 0) is R itself; an
+    exact pose comes back as the same array; a batch projects only its bad rows."""
+    T = ur5.fk(np.array([0.3, -1.1, 0.9, 0.2, 1.0, -0.4]))
+    assert check_rigid(T) is T
+    bad = np.stack([T, T])
+    bad[1, :3, :3] *= 1 - 1e-9
+    kept = bad.copy()
+    out = check_rigid(bad, "goal")
+    assert np.array_equal(bad, kept)  # the input is not modified
+    assert np.array_equal(out[0], T)
+    np.testing.assert_allclose(out[1], T, rtol=0, atol=4e-16)
+    R = out[1, :3, :3]
+    assert np.abs(R.T @ R - np.eye(3)).max() < 1e-15 and np.linalg.det(R) > 0
+
+
+def test_check_rigid_refuses_what_check_transform_refuses():
+    T = np.eye(4)
+    T[:3, :3] *= 1 - 1e-4
+    with pytest.raises(InputError, match="goal.*orthonormal"):
+        check_rigid(T, "goal")

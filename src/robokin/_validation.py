@@ -26,6 +26,7 @@ __all__ = [
     "check_finite",
     "check_joints",
     "check_nonnegative",
+    "check_rigid",
     "check_transform",
     "check_vector",
     "frozen_floats",
@@ -138,6 +139,49 @@ def check_transform(T: npt.ArrayLike, name: str = "T") -> np.ndarray:
 
 #: The fast name IK code uses; the same check.
 check_poses_fast = check_transform
+
+
+#: A rotation block farther than this from orthonormal (largest entry of
+#: ``R^T R - I``) is projected onto SO(3) by :func:`check_rigid`; below it the pose
+#: is used as given (forward kinematics' own rotations are within ~1e-15).
+ROTATION_EXACT = 1e-14
+
+
+def check_rigid(T: npt.ArrayLike, name: str = "T") -> np.ndarray:
+    """``T`` (..., 4, 4) checked as :func:`check_transform`, rotations projected onto SO(3).
+
+    The closed forms that accept a solution only when its pose matches the target
+    to ~1e-12 (the held-joint Pieper solver, the self-motion manifold) would find
+    nothing for a rotation that is orthonormal to 1e-12 only (a pose written to 12
+    digits). Every rotation within the accepted tolerance of one (1e-6, as
+    :func:`check_transform`) but more than :data:`ROTATION_EXACT` from orthonormal
+    is replaced by the nearest rotation (Frobenius norm: ``U V^T`` of its SVD), so
+    those solvers solve the rigid pose nearest the input. Other poses are
+    returned unchanged (the same array when nothing needed projecting); the
+    input is never modified.
+
+    Args:
+        T: Poses (..., 4, 4).
+        name: The argument's name in errors.
+
+    Returns:
+        float64 (..., 4, 4).
+
+    Raises:
+        InputError: as :func:`check_transform` (beyond 1e-6 from a rotation, a
+            reflection, ...).
+    """
+    T = check_transform(T, name)
+    R = T.reshape(-1, 4, 4)[:, :3, :3]
+    err = np.abs(np.einsum("mji,mjk->mik", R, R) - np.eye(3)).max(axis=(-2, -1))
+    off = err > ROTATION_EXACT
+    if not off.any():
+        return T
+    out = np.array(T, dtype=np.float64, copy=True)
+    flat = out.reshape(-1, 4, 4)
+    U, _, Vt = np.linalg.svd(flat[off, :3, :3])
+    flat[off, :3, :3] = U @ Vt  # det +1: check_transform refused reflections
+    return out
 
 
 def _pose_problem(T: np.ndarray, pose: np.ndarray, name: str, code: int,

@@ -7,7 +7,8 @@ it: the closed-form family of every detection setting, the general-6R set-up, th
 numeric solver's seed table, the closed forms with one joint held and the reduced
 arms of a held-joint sweep. Each kind of derived state is declared, with its type,
 by the module that computes it, as a :class:`Derived` (``detect.FAMILY``,
-``general_6r.SETUP``, ``restart_seeds.SEED_TABLE``, ``fixed.HELD_SOLVERS``), built
+``general_6r.SETUP``, ``restart_seeds.SEED_TABLE``, ``fixed.HELD_SOLVERS``,
+``self_motion_families.SELF_MOTION``), built
 on first use by :meth:`Arm.derived` and kept in the Arm, so it goes with the Arm.
 
 A :class:`~robokin.robot.Robot` owns one Arm (``robot.arm``) and delegates its
@@ -81,11 +82,6 @@ class Arm:
             value); read it with :meth:`derived`, which types the value.
         reduced: The arms of the remaining coordinates of the last held-joint
             reductions (most recently used last; ``fixed`` bounds it).
-        self_motion: The self-motion set-up of a 7R arm (a
-            ``self_motion.SelfMotionSetup``: swivel closed form, parameter,
-            aligned-axes values), or None until first needed; typed ``object`` and
-            narrowed by ``self_motion`` until that module declares a
-            :class:`Derived` for it like the others.
     """
 
     chain: Chain
@@ -94,7 +90,6 @@ class Arm:
     actuator_limits: npt.NDArray[np.float64] | None = None
     state: dict[Derived[Any], Any] = field(default_factory=dict, init=False)
     reduced: OrderedDict[ReducedKey, Arm] = field(default_factory=OrderedDict)
-    self_motion: object | None = None
 
     def derived(self, kind: Derived[V]) -> V:
         """The arm's state of ``kind``, built by ``kind.build(self)`` on first use and kept.

@@ -197,3 +197,22 @@ def test_held_closed_form_passes_q_near_and_compute_error():
     # the numeric method still goes the reduced-chain way
     num = panda.ik(T, fixed={"joint7": Q0[6]}, method="numeric")
     assert "held" in num.method and "pieper" not in num.method
+
+
+@pytest.mark.parametrize("eps", [1e-12, 1e-9])
+def test_held_closed_form_solves_a_pose_rounded_off_so3(eps):
+    """A rotation orthonormal to ~eps only (a pose read to 12 digits) is solved.
+
+    Oracle: Q0 (whose FK the pose is, before the rounding) among the solutions,
+    every solution's FK within ~eps of the pose. The held closed form accepts 4e-13
+    pose error only, so before check_rigid it returned no solution.
+    """
+    robot = robokin.load("panda")
+    T = robot.fk(Q0)
+    T[:3, :3] *= 1 - eps
+    sols = robot.ik(T, fixed={"joint7": Q0[6]})
+    assert "joint7 held" in sols.method and len(sols) >= 1
+    for q in sols:
+        dp, dr = pose_errors(robot.fk(q), T)
+        assert dp < 1e-11 and dr < 2 * eps + 1e-11
+    assert any(np.allclose(q, Q0, atol=1e-8) for q in sols)

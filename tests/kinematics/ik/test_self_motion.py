@@ -294,3 +294,66 @@ def test_auto_parameter_is_not_the_elbow_of_a_near_srs_arm():
     assert np.nanmin(d) < 1e-9
     rows = np.isfinite(sm.sample(np.linspace(*sm.domain, 64))).all(-1).any(-1)
     assert rows.mean() > 0.1, rows.mean()
+
+
+@pytest.mark.parametrize("arm", ["panda", "srs"])
+@pytest.mark.parametrize("eps", [1e-12, -1e-12, 1e-9, 1e-7])
+def test_a_rotation_off_so3_by_rounding_keeps_the_whole_manifold(arm, eps):
+    """A pose written to 12 digits (rotation orthonormal to ~1e-12) is the same pose.
+
+    Oracle: the manifold of the exact pose FK(q0) (same intervals, same branches,
+    ends within 10 eps) and FK of every sampled row within ~eps of the given pose;
+    the generating configuration on its branch. Before check_rigid the Panda's held
+    closed form (accepting 4e-13 pose error only) gave no interval at all.
+    """
+    robot = ARMS[arm]
+    q0 = np.array([0.3, -0.4, 0.5, -1.6, 0.2, 1.7, 0.6])
+    T = robot.fk(q0)
+    exact = robot.self_motion(T)
+    Tn = T.copy()
+    Tn[:3, :3] *= 1 - eps
+    before = Tn.copy()
+    sm = robot.self_motion(Tn)
+    assert np.array_equal(Tn, before)  # the input is not modified
+    assert len(exact.intervals) > 0
+    assert len(sm.intervals) == len(exact.intervals)
+    assert np.array_equal(sm.interval_branch, exact.interval_branch)
+    np.testing.assert_allclose(sm.intervals, exact.intervals, atol=max(10 * abs(eps), 1e-9))
+    t = np.linspace(*sm.domain, 41)
+    Q = sm.sample(t)
+    ok = np.isfinite(Q).all(-1)
+    assert ok.sum() > 0
+    dp, dr = pose_errors(robot.fk(np.where(ok[..., None], Q, 0.0)), T)
+    assert dp[ok].max() <= 1e-11 and dr[ok].max() <= 2 * abs(eps) + 1e-11
+    rows = sm.sample(_param_of(sm, q0))
+    d = np.abs((rows - q0 + np.pi) % (2 * np.pi) - np.pi).max(-1)
+    assert np.nanmin(d) < 10 * abs(eps) + 1e-9
+
+
+@pytest.mark.parametrize("eps", [1e-5, 1e-3])
+def test_a_rotation_far_from_so3_is_refused_naming_T(eps):
+    """Beyond robokin's pose tolerance (1e-6, as robot.ik) the pose is refused."""
+    T = PANDA.fk(np.zeros(7))
+    T[:3, :3] *= 1 - eps
+    with pytest.raises(InputError, match="T.*orthonormal"):
+        PANDA.self_motion(T)
+
+
+def test_the_self_motion_setup_is_typed_derived_state_of_the_arm():
+    """Oracle: the Arm's SELF_MOTION state is the set-up self_motion used (built once,
+    kept by that Arm); a new Arm of the same chain builds its own; the
+    swivel closed form exists for the SRS arm only. (Before: an untyped
+    ``Arm.self_motion`` field narrowed by isinstance.)"""
+    from robokin.kinematics.arm import Arm
+    from robokin.kinematics.ik.self_motion_families import SELF_MOTION, SelfMotionSetup
+
+    assert not hasattr(Arm(PANDA.chain), "self_motion")
+    for robot, srs in ((PANDA.with_tool(np.eye(4)), False), (SRS.with_tool(np.eye(4)), True)):
+        assert SELF_MOTION not in robot.arm.state
+        sm = robot.self_motion(robot.fk(np.full(7, 0.4)))
+        setup = robot.arm.state[SELF_MOTION]
+        assert isinstance(setup, SelfMotionSetup) and robot.arm.derived(SELF_MOTION) is setup
+        assert (setup.swivel is not None) == srs == (sm.parameter == "swivel")
+        assert setup.parameter_known is False or setup.parameter == sm.parameter
+        other = Arm(robot.chain)
+        assert other.derived(SELF_MOTION) is not setup

@@ -37,7 +37,7 @@ from robokin._validation import (
     check_broadcasts,
     check_finite,
     check_joints,
-    check_poses_fast,
+    check_rigid,
 )
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, ArmSource, Derived, arm_of
@@ -90,8 +90,8 @@ def solve_fixed(
         held = _held_solvers(robot).get(name)
         if held is not None and type(value) in _NUMBERS:
             out: SolutionSet | None = held.single(T, value, None)
-            if out is not None:
-                return out
+            if out is not None and (len(out) or check_rigid(T, "T") is T):
+                return out  # (no solution of a rotation off SO(3) by rounding: project)
     names = list(robot.joint_names)
     if not isinstance(fixed, Mapping) or not fixed:
         raise InputError("fixed", f"expected a mapping of joint names to values, e.g. "
@@ -103,7 +103,7 @@ def solve_fixed(
         idx.append(names.index(name))
     if len(idx) == robot.n:
         raise InputError("fixed", "every joint is held: nothing left to solve for")
-    T = check_poses_fast(T, "T")
+    T = check_rigid(T, "T")  # the held closed form needs a rigid pose
     values = [check_finite(_real_array(v, f"fixed[{name!r}]", "a number or numbers"),
                            f"fixed[{name!r}]") for name, v in fixed.items()]
     try:

@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from robokin._validation import check_finite, check_joints, check_poses_fast
+from robokin._validation import check_finite, check_joints, check_rigid
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import ArmSource, arm_of
 from robokin.kinematics.ik.fixed import Dispatch
@@ -95,7 +95,8 @@ class SelfMotion:
     """The self-motion manifold of one pose of a 7R arm (:func:`self_motion`).
 
     Attributes:
-        T: The pose (4, 4).
+        T: The pose solved (4, 4): the input, its rotation projected onto SO(3)
+            when it was off by more than rounding (``_validation.check_rigid``).
         parameter: ``"swivel"`` or the joint name held as the parameter t.
         joint: The parameter's joint index, or None for the swivel.
         domain: (2,) the parameter's range [rad] (the joint's limits, or -pi..pi).
@@ -345,7 +346,7 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
             (the message lists the choices).
     """
     robot = arm_of(robot)
-    Ta = check_poses_fast(T, "T")
+    Ta = check_rigid(T, "T")
     if Ta.shape != (4, 4):
         raise InputError("T", f"self_motion takes one pose (4, 4), got {Ta.shape}")
     fam = _family(robot, Ta, parameter, dispatch, reference)

@@ -16,7 +16,7 @@ import numpy as np
 
 from robokin._native import kernels as K
 from robokin.exceptions import InputError
-from robokin.kinematics.arm import Arm
+from robokin.kinematics.arm import Arm, Derived
 from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
 from robokin.kinematics.ik.swivel import SwivelArm, swivel_arm
 from robokin.spatial import wrap_angle as _wrap
@@ -376,7 +376,7 @@ def _size(e: np.ndarray) -> np.ndarray:
 
 @dataclass(slots=True, eq=False)
 class SelfMotionSetup:
-    """What the self-motion of a 7R arm needs per chain (kept in ``Arm.self_motion``).
+    """What the self-motion of a 7R arm needs per chain (the Arm's :data:`SELF_MOTION` state).
 
     Attributes:
         swivel: The SRS arm's swivel closed form, or None (not SRS).
@@ -391,12 +391,17 @@ class SelfMotionSetup:
     aligned: list[tuple[int, float]] | None = None
 
 
+def _build_setup(arm: Arm) -> SelfMotionSetup:
+    return SelfMotionSetup(swivel_arm(arm.chain))
+
+
+#: The self-motion set-up of a 7R arm, per Arm (docs/conventions.md "Per-arm state").
+SELF_MOTION: Derived[SelfMotionSetup] = Derived("self-motion set-up", _build_setup)
+
+
 def _setup(arm: Arm) -> SelfMotionSetup:
     """The arm's :class:`SelfMotionSetup`, built on first use (a 7-joint chain)."""
-    setup = arm.self_motion
-    if not isinstance(setup, SelfMotionSetup):
-        setup = arm.self_motion = SelfMotionSetup(swivel_arm(arm.chain))
-    return setup
+    return arm.derived(SELF_MOTION)
 
 
 # ------------------------------------------------------------------ choosing one

@@ -122,6 +122,8 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
     lo, hi = t[idx].astype(np.float64), t[idx + 1].astype(np.float64)
     for _ in range(_BISECT):
         mid = 0.5 * (lo + hi)
+        if np.all((mid == lo) | (mid == hi)):
+            break  # every cell two adjacent floats: the rest would change nothing
         qm, vm, _ = fam.rows(mid)
         rows = np.arange(len(mid))
         now = np.where(kind, vm[rows, br] & _within(qm[rows, br], limits), vm[rows, br])
