@@ -615,10 +615,15 @@ static int sm_cmp(const void *x, const void *y)
     return (a > b) - (a < b);
 }
 
+/* Inside every limit with the slack of SelfMotion.inside (self_motion.py _inside:
+ * 1e-12), so that a cell whose row rides a limit to rounding (a branch tangent to it,
+ * q = limit + 4e-16) is decided as .inside decides it. */
+#define SM_INSIDE_SLACK 1e-12
+
 static int sm_inside(const SmArm *a, const double *q)
 {
     for (int j = 0; j < 7; j++)
-        if (!(q[j] >= a->lo[j] && q[j] <= a->hi[j]))
+        if (!(q[j] >= a->lo[j] - SM_INSIDE_SLACK && q[j] <= a->hi[j] + SM_INSIDE_SLACK))
             return 0;
     return 1;
 }
