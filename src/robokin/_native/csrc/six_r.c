@@ -132,7 +132,7 @@ enum { SR_OK = 0, SR_OUT_OF_REACH = 1, SR_NO_ORIENTATION = 2, SR_BAD_POSE = 16 }
  * above -SR_SPLIT_DISC: rounding (1.4e-15 seen at a tangency), not the kernel's
  * 1e-12 tolerance (whose boundary root leaves up to 3e-12 m at a folded elbow). */
 #define SR_SPLIT_DISC 1e-14
-#define SR_LIMIT_SLACK 1e-9
+#define SR_LIMIT_SLACK LIMIT_SLACK /* chain.h: the wrap_into rule's */
 #define SR_LIMIT_AIM 1e-12
 #define SR_POLISH_ITERS 6
 /* A valid solution outside its limits by at most this much [rad, m] gets a descent
