@@ -255,6 +255,11 @@ LM = Group("lm.c", kernels=(
     Kernel("sincos", (Arr("x", "f64", ("N",)), Arr("s", "f64", ("N",), out=True),
                       Arr("c", "f64", ("N",), out=True)),
            "None", "The kernels' sine and cosine of x (N,) into s and c."),
+    Kernel("wrap_into", (Arr("v", "f64", ("N",)), Arr("lo", "f64", ("N",)),
+                         Arr("hi", "f64", ("N",)), Arr("out", "f64", ("N",), out=True)),
+           "None", "The wrap-into-limits rule (chain.h ``wrap_into``) of v (N,) into "
+           "[lo, hi] (N,) into out: within the limits up to ``LIMIT_SLACK`` stays, "
+           "else the fewest whole turns that fit, else unchanged."),
     Kernel("num_threads", (), "int", "Threads of the pool the batch kernels use."),
     Kernel("set_num_threads", (Int("k", -2**31, 2**31 - 1),), "int",
            "Set the threads of the pool (1 to 64); returns the number in use."),

@@ -340,6 +340,9 @@ class Kernels(Protocol):
     def sincos(self, x: F64, s: F64, c: F64, /) -> None:
         """The kernels' sine and cosine of x (N,) into s and c."""
 
+    def wrap_into(self, v: F64, lo: F64, hi: F64, out: F64, /) -> None:
+        """The wrap-into-limits rule (chain.h ``wrap_into``) of v (N,) into [lo, hi] (N,) into out: within the limits up to ``LIMIT_SLACK`` stays, else the fewest whole turns that fit, else unchanged."""
+
     def num_threads(self) -> int:
         """Threads of the pool the batch kernels use."""
 

@@ -378,19 +378,31 @@ ALWAYS_INLINE void pose_residual(const vd *t, const vd *tt, vd *e, vl active)
     }
 }
 
-/* A 2*pi-periodic coordinate shifted by whole turns into [lo, hi] where possible
- * (project clamps after it). */
-static double wrap_into(double v, double lo, double hi)
+/* How far outside its limits a joint value still counts as inside them [rad, m]. */
+#define LIMIT_SLACK 1e-9
+
+/* Whether v lies within [lo, hi] up to LIMIT_SLACK (NaN: no). */
+static inline int within_limits(double v, double lo, double hi)
 {
-    const double tp = 2.0 * M_PI;
-    if (v > hi) {
-        double k = ceil((v - hi) / tp);
-        if (v - k * tp >= lo)
-            v -= k * tp;
-    } else if (v < lo) {
-        double k = ceil((lo - v) / tp);
-        if (v + k * tp <= hi)
-            v += k * tp;
+    return v >= lo - LIMIT_SLACK && v <= hi + LIMIT_SLACK;
+}
+
+/* The one wrap-into-limits rule (docs/conventions.md "Joint values and limits"): a
+ * 2*pi-periodic coordinate v within [lo, hi] up to LIMIT_SLACK stays as it is;
+ * otherwise it moves by the fewest whole turns that bring it within them (the same
+ * slack), where some do; else (or NaN) it stays. Python's fit_turns calls it
+ * (kernel wrap_into); six_r.c's ljoint is its lane-wise twin (tested against it). */
+static inline double wrap_into(double v, double lo, double hi)
+{
+    const double tp = 2.0 * M_PI, lo_e = lo - LIMIT_SLACK, hi_e = hi + LIMIT_SLACK;
+    if (v > hi_e) {
+        double u = v - ceil((v - hi_e) / tp) * tp;
+        if (u >= lo_e)
+            v = u;
+    } else if (v < lo_e) {
+        double u = v + ceil((lo_e - v) / tp) * tp;
+        if (u <= hi_e)
+            v = u;
     }
     return v;
 }

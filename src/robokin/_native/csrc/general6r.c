@@ -2448,7 +2448,7 @@ static void g6_range(void *ctx, long b, long e)
             for (int j = 0; j < 6; j++) {
                 /* whole turns into the limits where possible (chain.h's wrap_into) */
                 double v = ok ? wrap_into(q[6 * s + j], ch->lo[j], ch->hi[j]) : NAN;
-                in &= v >= ch->lo[j] - 1e-9 && v <= ch->hi[j] + 1e-9;
+                in &= within_limits(v, ch->lo[j], ch->hi[j]);
                 Qo[6 * s + j] = v;
             }
             job->valid[i * G6_MAXSOL + s] = (npy_bool)ok;

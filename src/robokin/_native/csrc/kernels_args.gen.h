@@ -61,6 +61,7 @@ static const KOpt opts_sp_ranges[] = {{SP_VERTEX_TRIES, 1, 1, 0.0, 1000000000000
     X(nearest, "nearest(packed, Q, ok, qn, is_rev, T, q, err, found) -> None: Per pose, the solution row of Q (N, k, n) nearest qn (N, n), into q.") \
     X(check_poses, "check_poses(T, tol) -> tuple[int, int]: ``(code, index)`` of the first non-rigid pose of T (N, 4, 4), or (0, -1).") \
     X(sincos, "sincos(x, s, c) -> None: The kernels' sine and cosine of x (N,) into s and c.") \
+    X(wrap_into, "wrap_into(v, lo, hi, out) -> None: The wrap-into-limits rule (chain.h ``wrap_into``) of v (N,) into [lo, hi] (N,) into out: within the limits up to ``LIMIT_SLACK`` stays, else the fewest whole turns that fit, else unchanged.") \
     X(num_threads, "num_threads() -> int: Threads of the pool the batch kernels use.") \
     X(set_num_threads, "set_num_threads(k) -> int: Set the threads of the pool (1 to 64); returns the number in use.") \
     X(cpu_has_avx2_fma, "cpu_has_avx2_fma() -> bool: Whether this CPU runs the AVX2 + FMA copy.") \
@@ -111,6 +112,7 @@ typedef struct { const double *rows; const long long *cstart; const double *grid
 typedef struct { Chain packed; const double *Q; const npy_bool *ok; const double *qn; const npy_bool *is_rev; const double *T; double *q; double *err; npy_bool *found; union { struct { npy_intp n, nc, N, k; }; npy_intp sym[4]; }; } nearest_args; /* lm.c */
 typedef struct { const double *T; double tol; union { struct { npy_intp N; }; npy_intp sym[1]; }; } check_poses_args; /* lm.c */
 typedef struct { const double *x; double *s; double *c; union { struct { npy_intp N; }; npy_intp sym[1]; }; } sincos_args; /* lm.c */
+typedef struct { const double *v; const double *lo; const double *hi; double *out; union { struct { npy_intp N; }; npy_intp sym[1]; }; } wrap_into_args; /* lm.c */
 typedef struct { char unused; /* a struct is never empty */ } num_threads_args; /* lm.c */
 typedef struct { long k; } set_num_threads_args; /* lm.c */
 typedef struct { char unused; /* a struct is never empty */ } cpu_has_avx2_fma_args; /* lm.c */

@@ -384,24 +384,33 @@ ALWAYS_INLINE vl ldl_solve(vd (*A)[NMAX], vd *b, int k)
     return ok;
 }
 
+/* The lower triangle of the damped Gram matrix A = V V^T + lam I (k x k) of k vectors
+ * of length len, vector r's entry t at x[r * step + t * stride] (the rows of Jw:
+ * step NMAX, stride 1; its columns: step 1, stride NMAX). */
+ALWAYS_INLINE void damped_gram(const vd *x, int k, int step, int len, int stride, vd lam,
+                               vd (*A)[NMAX])
+{
+    for (int r = 0; r < k; r++) {
+        for (int c = 0; c <= r; c++) {
+            vd s = ZERO;
+            for (int t = 0; t < len; t++)
+                s += x[r * step + t * stride] * x[c * step + t * stride];
+            A[r][c] = s;
+        }
+        A[r][r] += lam;
+    }
+}
+
 /* The task-space step dq = Jw^T (Jw Jw^T + lam I)^-1 ye for m task rows, per lane.
  * Frozen joints have zero columns, so this is also the joint-space step when
  * fewer joints than task rows are free (the same step in exact arithmetic). */
-ALWAYS_INLINE vl task_space_step(vd (*Jw)[NMAX],
-                                                                  const vd *ye, vd lam,
-                                                                  int n, int m, vd *dq)
+ALWAYS_INLINE vl task_space_step(vd (*Jw)[NMAX], const vd *ye, vd lam, int n, int m,
+                                 vd *dq)
 {
     vd A[NMAX][NMAX], y[6];
-    for (int a = 0; a < m; a++) {
-        for (int b = 0; b <= a; b++) {
-            vd s = ZERO;
-            for (int j = 0; j < n; j++)
-                s += Jw[a][j] * Jw[b][j];
-            A[a][b] = s;
-        }
-        A[a][a] += lam;
+    damped_gram(&Jw[0][0], m, NMAX, n, 1, lam, A); /* Jw Jw^T + lam I */
+    for (int a = 0; a < m; a++)
         y[a] = ye[a];
-    }
     vl ok = ldl_solve(A, y, m);
     for (int j = 0; j < n; j++) {
         vd s = ZERO;
@@ -493,14 +502,8 @@ static void lm_worker(Ctx *cx)
         } else {
             /* joint space (more task rows than joints): (Jw^T Jw + lam I) dq = Jw^T ye */
             vd A[NMAX][NMAX];
+            damped_gram(&Jw[0][0], n, 1, m, NMAX, lam, A); /* Jw^T Jw + lam I */
             for (int i = 0; i < n; i++) {
-                for (int k = 0; k <= i; k++) {
-                    vd s = ZERO;
-                    for (int a = 0; a < m; a++)
-                        s += Jw[a][i] * Jw[a][k];
-                    A[i][k] = s;
-                }
-                A[i][i] += lam;
                 vd g = ZERO;
                 for (int a = 0; a < m; a++)
                     g += Jw[a][i] * ye[a];

@@ -209,6 +209,14 @@ static PyObject *check_poses_body(const check_poses_args *a)
     return Py_BuildValue("(in)", 0, (Py_ssize_t)-1);
 }
 
+/* chain.h's wrap_into of v[i] into [lo[i], hi[i]] (the one wrap-into-limits rule). */
+static PyObject *wrap_into_body(const wrap_into_args *a)
+{
+    for (npy_intp i = 0; i < a->N; i++)
+        a->out[i] = wrap_into(a->v[i], a->lo[i], a->hi[i]);
+    Py_RETURN_NONE;
+}
+
 static PyObject *sincos_body(const sincos_args *a)
 {
     npy_intp N = a->N;

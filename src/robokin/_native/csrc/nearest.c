@@ -7,7 +7,8 @@
 
 /* For each pose i: among rows r of Q[i] (k x n) with ok[i, r], the one nearest
  * qn[i] (revolute differences wrapped into [-pi, pi)), moved by whole turns to the
- * equivalent nearest qn[i] when that stays inside [lo, hi]; into q[i]. err[i] gets
+ * equivalent nearest qn[i] when that stays within [lo, hi] (chain.h's
+ * within_limits, the slack of the wrap_into rule); into q[i]. err[i] gets
  * its position and rotation error against T[i] (chain_pose, pose_residual).
  * Returns found[i]; rows of poses without a candidate are NaN. */
 static void nearest_rows(const Chain *ch, const double *Q, const unsigned char *ok,
@@ -46,7 +47,7 @@ static void nearest_rows(const Chain *ch, const double *Q, const unsigned char *
             double v = Qi[best * n + j];
             if (is_rev[j]) {
                 double s = qni[j] + wrap_pi(v - qni[j]);
-                if (s >= ch->lo[j] - 1e-12 && s <= ch->hi[j] + 1e-12)
+                if (within_limits(s, ch->lo[j], ch->hi[j]))
                     v = s;
             }
             qi[j] = v;

@@ -132,7 +132,7 @@ enum { SR_OK = 0, SR_OUT_OF_REACH = 1, SR_NO_ORIENTATION = 2, SR_BAD_POSE = 16 }
  * above -SR_SPLIT_DISC: rounding (1.4e-15 seen at a tangency), not the kernel's
  * 1e-12 tolerance (whose boundary root leaves up to 3e-12 m at a folded elbow). */
 #define SR_SPLIT_DISC 1e-14
-#define SR_LIMIT_SLACK 1e-9
+#define SR_LIMIT_SLACK LIMIT_SLACK /* chain.h: the wrap_into rule's */
 #define SR_LIMIT_AIM 1e-12
 #define SR_POLISH_ITERS 6
 /* A valid solution outside its limits by at most this much [rad, m] gets a descent
@@ -998,6 +998,52 @@ ALWAYS_INLINE LRoots lanes_shoulder(const SR *K, const LM3 *R, L3 p, L3 *pw)
     return lsp4(A, B, rhs, A * A + B * B - rhs * rhs, K->dtol, K->mirror, phi, cphi, sphi);
 }
 
+/* What family_block starts from (lanes): R06 and the poses' entries, the
+ * shoulder's roots (theta1) and pw, R06 h6, joint 6's preferred chain angle at the
+ * wrist singularity (from q6n), and one destination per lane (o[l]). */
+typedef struct {
+    LM3 R;
+    L3 pw, g6;
+    LRoots r1;
+    vd tt[12], pref;
+    Dest dst[W];
+} BlockStart;
+
+ALWAYS_INLINE void block_start(const SR *K, const double *const *T, const double *q6n,
+                               Slots *o, BlockStart *b)
+{
+    L3 p;
+    lanes_target(K, T, &b->R, &p);
+    lanes_pose(T, b->tt);
+    b->r1 = lanes_shoulder(K, &b->R, p, &b->pw);
+    b->g6 = lm3_mvc(&b->R, K->h[5]);
+    b->pref = BR(0.0);
+    for (int l = 0; l < W; l++) {
+        b->pref[l] = K->sign[5] * q6n[l] + K->off[5];
+        b->dst[l].o = o[l];
+    }
+}
+
+/* Shoulder branch i1 of a block: R06 and theta1's cosine and sine into the first
+ * fields of the family's context. */
+ALWAYS_INLINE void block_branch(const BlockStart *b, int i1, LM3 *R, vd *c1, vd *s1)
+{
+    *R = b->R;
+    *c1 = b->r1.c[i1];
+    *s1 = b->r1.s[i1];
+}
+
+/* Lane l of those fields, broadcast to every lane (the split searches' contexts). */
+ALWAYS_INLINE void lane_shoulder(const LM3 *R, vd c1, vd s1, int l, LM3 *Rl, vd *c1l,
+                                 vd *s1l)
+{
+    Rl->r0 = (L3){BR(R->r0.x[l]), BR(R->r0.y[l]), BR(R->r0.z[l])};
+    Rl->r1 = (L3){BR(R->r1.x[l]), BR(R->r1.y[l]), BR(R->r1.z[l])};
+    Rl->r2 = (L3){BR(R->r2.x[l]), BR(R->r2.y[l]), BR(R->r2.z[l])};
+    *c1l = BR(c1[l]);
+    *s1l = BR(s1[l]);
+}
+
 /* ------------------------------------------------ three parallel axes (UR) */
 
 /* A three-parallel pose with theta1 and theta5 chosen (lanes): what theta2-theta4
@@ -1111,11 +1157,7 @@ static void tp_split(const SR *K, const TPCtx *c, int l, vd th1v, vd th5v, doubl
     s.wh = half;
     s.th1 = BR(th1v[l]);
     s.th5 = BR(th5v[l]);
-    s.c.R.r0 = (L3){BR(c->R.r0.x[l]), BR(c->R.r0.y[l]), BR(c->R.r0.z[l])};
-    s.c.R.r1 = (L3){BR(c->R.r1.x[l]), BR(c->R.r1.y[l]), BR(c->R.r1.z[l])};
-    s.c.R.r2 = (L3){BR(c->R.r2.x[l]), BR(c->R.r2.y[l]), BR(c->R.r2.z[l])};
-    s.c.c1 = BR(c->c1[l]);
-    s.c.s1 = BR(c->s1[l]);
+    lane_shoulder(&c->R, c->c1, c->s1, l, &s.c.R, &s.c.c1, &s.c.s1);
     s.c.c5 = BR(c->c5[l]);
     s.c.s5 = BR(c->s5[l]);
     s.c.pl1 = BR(c->pl1[l]);
@@ -1192,126 +1234,100 @@ static void tp_split(const SR *K, const TPCtx *c, int l, vd th1v, vd th5v, doubl
             need[4 * i1 + 2 * i3 + i5] = 1;
 }
 
-/* Every solution of W poses of a three-parallel arm (axes 2, 3, 4 parallel, axes 5,
- * 6 meeting; IK-Geo 'three parallel, two intersecting'): theta1 (subproblem 4),
- * theta5 (subproblem 4 on h2 . R5 h6 = h2 . R1^T R06 h6), theta6 (subproblem 1;
- * the split at the wrist singularity, see the header), then tp_arm. Lane l's
- * outputs go to o[l] and need[l] (slots to check against the chain). Returns the
- * lanes' status via status[l]. */
-static void tp_block(const SR *K, const Chain *ch, const double *const *T,
-                     const double *q6n, Slots *o, int *status, unsigned char (*need)[8],
-                     int nl)
+/* Shoulder branch i1 (lanes m1) of W poses of a three-parallel arm (axes 2, 3, 4
+ * parallel, axes 5, 6 meeting; IK-Geo 'three parallel, two intersecting'): theta5
+ * (subproblem 4 on h2 . R5 h6 = h2 . R1^T R06 h6), theta6 (subproblem 1; the split at
+ * the wrist singularity, see the header), then tp_arm. *any_mid gets the lanes whose
+ * wrist solves, *any_ok those with a solution. */
+static void tp_branch(const SR *K, const Chain *ch, BlockStart *b, int i1, vl m1,
+                      unsigned char (*need)[8], int nl, vl *any_mid, vl *any_ok)
 {
-    LM3 R;
-    L3 p, pw;
-    vd tt[12];
-    lanes_target(K, T, &R, &p);
-    lanes_pose(T, tt);
-    LRoots r1 = lanes_shoulder(K, &R, p, &pw);
-    L3 g6 = lm3_mvc(&R, K->h[5]);
-    vd pref = BR(0.0);
-    for (int l = 0; l < W; l++)
-        pref[l] = K->sign[5] * q6n[l] + K->off[5];
-    vl any_wrist = BRL(0), any_ok = BRL(0);
-    Dest dst[W];
-    for (int l = 0; l < W; l++)
-        dst[l].o = o[l];
-    for (int i1 = 0; i1 < 2; i1++) {
-        vl m1 = i1 ? r1.two : r1.one;
-        if (!vany(m1))
+    TPCtx c;
+    block_branch(b, i1, &c.R, &c.c1, &c.s1);
+    vd th1 = b->r1.t[i1];
+    L3 x = l3_rot(K->h[0], c.c1, -c.s1, b->g6); /* R1^T R06 h6 */
+    LRoots r5 = wrist_roots(K, K->h[1], x);
+    vl mw = m1 & r5.one;
+    *any_mid |= mw;
+    if (!vany(mw))
+        return;
+    L3 y = lm3_mtv(&b->R, l3_rotc(K->h[0], c.c1, c.s1, K->h[1])); /* R06^T R1 h2 */
+    L3 yp = l3_perp(K->h[5], y);
+    vd sw = vsqrt(l3_dot(yp, yp));
+    vl free_ = sw < K->free_tol, nearby = sw < SR_SPLIT_BAND;
+    L3 pl = l3_subc(l3_rot(K->h[0], c.c1, -c.s1, b->pw), K->o21); /* R1^T pw - o21 */
+    c.pl1 = l3_dotc(pl, K->e);
+    c.pl2 = l3_dotc(pl, K->e2);
+    c.dh = l3_dotc(pl, K->h[1]) - K->w4h;
+    vd gap1 = vmin(b->r1.gap, sw);
+    vl check1 = ~b->r1.two | ~r5.two | (gap1 < SR_CHECK_BAND) | BRL(K->check > 0.0 ? -1 : 0);
+    for (int i5 = 0; i5 < 2; i5++) {
+        vl m5 = m1 & (i5 ? r5.two & ~free_ : r5.one);
+        if (!vany(m5))
             continue;
-        TPCtx c;
-        c.R = R;
-        c.c1 = r1.c[i1];
-        c.s1 = r1.s[i1];
-        vd th1 = r1.t[i1];
-        L3 x = l3_rot(K->h[0], c.c1, -c.s1, g6); /* R1^T R06 h6 */
-        LRoots r5 = wrist_roots(K, K->h[1], x);
-        vl mw = m1 & r5.one;
-        any_wrist |= mw;
-        if (!vany(mw))
-            continue;
-        L3 y = lm3_mtv(&R, l3_rotc(K->h[0], c.c1, c.s1, K->h[1])); /* R06^T R1 h2 */
-        L3 yp = l3_perp(K->h[5], y);
-        vd sw = vsqrt(l3_dot(yp, yp));
-        vl free_ = sw < K->free_tol, nearby = sw < SR_SPLIT_BAND;
-        L3 pl = l3_subc(l3_rot(K->h[0], c.c1, -c.s1, pw), K->o21); /* R1^T pw - o21 */
-        c.pl1 = l3_dotc(pl, K->e);
-        c.pl2 = l3_dotc(pl, K->e2);
-        c.dh = l3_dotc(pl, K->h[1]) - K->w4h;
-        vd gap1 = vmin(r1.gap, sw);
-        vl check1 = ~r1.two | ~r5.two | (gap1 < SR_CHECK_BAND) | BRL(K->check > 0.0 ? -1 : 0);
-        for (int i5 = 0; i5 < 2; i5++) {
-            vl m5 = m1 & (i5 ? r5.two & ~free_ : r5.one);
-            if (!vany(m5))
-                continue;
-            c.c5 = r5.c[i5];
-            c.s5 = r5.s[i5];
-            vd th5 = r5.t[i5], c6, s6;
-            vd th6 = lsp1(K->h[5], y, l3_rotc(K->h[4], c.c5, -c.s5, K->h[1]), &c6, &s6);
-            vd exact = th6, half = wrist_split(K, sw, pref, &th6, &c6, &s6);
-            TPArm a, ap;
-            tp_arm(K, &c, c6, s6, &a);
-            /* the preferred theta6 with theta5 at its singular value (the double
-             * root: rounding near another singularity can leave it 1e-12 off) */
-            vl tryp = m5 & pref_untried(sw, pref, th6) & BRL(i5 == 0 ? -1 : 0);
-            vd th5s = BR(0.0);
-            if (vany(tryp)) {
-                TPCtx cs = c;
-                vd cp, sp;
-                th5s = wrist_double_root(K, x, K->h[1], &cs.c5, &cs.s5);
-                vsincos(pref, &sp, &cp);
-                tp_arm(K, &cs, cp, sp, &ap);
-            } else {
-                ap = a;
-            }
-            /* not acceptable: the elbow unsolvable, or solvable only within the
-             * kernel's tolerance (its boundary root leaves up to 3e-12 m at a folded
-             * elbow), or a joint outside its limits */
-            vl bad = BRL(0);
-            for (int i3 = 0; i3 < 2; i3++) {
-                int slot = 4 * i1 + 2 * i3 + i5;
-                vd v[6] = {th1, a.th[i3][0], a.th[i3][1], a.th[i3][2], th5, th6};
-                vl ok = m5 & (i3 ? a.r3.two : a.r3.one);
-                vd gap = vmin(gap1, a.r3.gap);
-                vl shaky = ~a.r3.one | (a.disc < -SR_SPLIT_DISC * K->er2);
-                vl usep = tryp & (i3 ? ap.r3.two : ap.r3.one);
-                if (vany(usep)) { /* the preferred theta6 as it is, where the chain agrees */
-                    vd vp[6] = {th1, ap.th[i3][0], ap.th[i3][1], ap.th[i3][2], th5s, pref};
-                    usep = within_split(K, ch, vp, tt, usep);
-                    for (int j = 0; j < 6; j++)
-                        v[j] = vsel(usep, vp[j], v[j]);
-                    ok |= usep;
-                    shaky &= ~usep;
-                    gap = vsel(usep, vmin(gap1, ap.r3.gap), gap);
-                }
-                vl sing = gap < K->stol;
-                for (int l = 0; l < W; l++)
-                    dst[l].slot = slot;
-                vl in = lanes_write(K, dst, v, ok, sing);
-                bad |= (i3 ? BRL(0) : shaky) | (ok & ~in);
-                vl chk = ok & (check1 | ~a.r3.two | (a.r3.gap < SR_CHECK_BAND) | usep);
-                for (int l = 0; l < W; l++)
-                    if (chk[l])
-                        need[l][slot] = 1;
-                any_ok |= ok;
-            }
-            vl split = m5 & (free_ | nearby) & bad;
-            if (vany(split))
-                for (int l = 0; l < nl; l++) {
-                    if (!split[l])
-                        continue;
-                    tp_split(K, &c, l, th1, th5, th6[l], free_[l] ? th6[l] : exact[l],
-                             half[l], sw[l], gap1[l], o[l], i1, i5, need[l]);
-                    for (int i3 = 0; i3 < 2; i3++)
-                        if (o[l].valid[4 * i1 + 2 * i3 + i5])
-                            any_ok[l] = -1;
-                }
+        c.c5 = r5.c[i5];
+        c.s5 = r5.s[i5];
+        vd th5 = r5.t[i5], c6, s6;
+        vd th6 = lsp1(K->h[5], y, l3_rotc(K->h[4], c.c5, -c.s5, K->h[1]), &c6, &s6);
+        vd exact = th6, half = wrist_split(K, sw, b->pref, &th6, &c6, &s6);
+        TPArm a, ap;
+        tp_arm(K, &c, c6, s6, &a);
+        /* the preferred theta6 with theta5 at its singular value (the double
+         * root: rounding near another singularity can leave it 1e-12 off) */
+        vl tryp = m5 & pref_untried(sw, b->pref, th6) & BRL(i5 == 0 ? -1 : 0);
+        vd th5s = BR(0.0);
+        if (vany(tryp)) {
+            TPCtx cs = c;
+            vd cp, sp;
+            th5s = wrist_double_root(K, x, K->h[1], &cs.c5, &cs.s5);
+            vsincos(b->pref, &sp, &cp);
+            tp_arm(K, &cs, cp, sp, &ap);
+        } else {
+            ap = a;
         }
+        /* not acceptable: the elbow unsolvable, or solvable only within the
+         * kernel's tolerance (its boundary root leaves up to 3e-12 m at a folded
+         * elbow), or a joint outside its limits */
+        vl bad = BRL(0);
+        for (int i3 = 0; i3 < 2; i3++) {
+            int slot = 4 * i1 + 2 * i3 + i5;
+            vd v[6] = {th1, a.th[i3][0], a.th[i3][1], a.th[i3][2], th5, th6};
+            vl ok = m5 & (i3 ? a.r3.two : a.r3.one);
+            vd gap = vmin(gap1, a.r3.gap);
+            vl shaky = ~a.r3.one | (a.disc < -SR_SPLIT_DISC * K->er2);
+            vl usep = tryp & (i3 ? ap.r3.two : ap.r3.one);
+            if (vany(usep)) { /* the preferred theta6 as it is, where the chain agrees */
+                vd vp[6] = {th1, ap.th[i3][0], ap.th[i3][1], ap.th[i3][2], th5s, b->pref};
+                usep = within_split(K, ch, vp, b->tt, usep);
+                for (int j = 0; j < 6; j++)
+                    v[j] = vsel(usep, vp[j], v[j]);
+                ok |= usep;
+                shaky &= ~usep;
+                gap = vsel(usep, vmin(gap1, ap.r3.gap), gap);
+            }
+            vl sing = gap < K->stol;
+            for (int l = 0; l < W; l++)
+                b->dst[l].slot = slot;
+            vl in = lanes_write(K, b->dst, v, ok, sing);
+            bad |= (i3 ? BRL(0) : shaky) | (ok & ~in);
+            vl chk = ok & (check1 | ~a.r3.two | (a.r3.gap < SR_CHECK_BAND) | usep);
+            for (int l = 0; l < W; l++)
+                if (chk[l])
+                    need[l][slot] = 1;
+            *any_ok |= ok;
+        }
+        vl split = m5 & (free_ | nearby) & bad;
+        if (vany(split))
+            for (int l = 0; l < nl; l++) {
+                if (!split[l])
+                    continue;
+                tp_split(K, &c, l, th1, th5, th6[l], free_[l] ? th6[l] : exact[l],
+                         half[l], sw[l], gap1[l], b->dst[l].o, i1, i5, need[l]);
+                for (int i3 = 0; i3 < 2; i3++)
+                    if (b->dst[l].o.valid[4 * i1 + 2 * i3 + i5])
+                        (*any_ok)[l] = -1;
+            }
     }
-    for (int l = 0; l < W; l++)
-        status[l] = any_ok[l] ? SR_OK : (r1.one[l] && any_wrist[l]) || !r1.one[l]
-                                              ? SR_OUT_OF_REACH : SR_NO_ORIENTATION;
 }
 
 /* ----------------------------------------------------- spherical wrist (Puma) */
@@ -1358,11 +1374,7 @@ static void sw_split(const SR *K, const SWCtx *c, int l, const vd *v0, double wc
     s.K = K;
     s.wc = wc;
     s.wh = half;
-    s.c.R.r0 = (L3){BR(c->R.r0.x[l]), BR(c->R.r0.y[l]), BR(c->R.r0.z[l])};
-    s.c.R.r1 = (L3){BR(c->R.r1.x[l]), BR(c->R.r1.y[l]), BR(c->R.r1.z[l])};
-    s.c.R.r2 = (L3){BR(c->R.r2.x[l]), BR(c->R.r2.y[l]), BR(c->R.r2.z[l])};
-    s.c.c1 = BR(c->c1[l]);
-    s.c.s1 = BR(c->s1[l]);
+    lane_shoulder(&c->R, c->c1, c->s1, l, &s.c.R, &s.c.c1, &s.c.s1);
     s.c.c23 = BR(c->c23[l]);
     s.c.s23 = BR(c->s23[l]);
     s.c.c5 = BR(c->c5[l]);
@@ -1393,106 +1405,111 @@ static void sw_split(const SR *K, const SWCtx *c, int l, const vd *v0, double wc
     need[slot] = 1;
 }
 
-/* Every solution of W poses of a spherical-wrist arm (axes 2, 3 parallel, axes 4,
- * 5, 6 meeting; IK-Geo 'spherical wrist, two parallel'): the wrist centre fixes
- * theta1 (subproblem 4), theta3 (subproblem 3) and theta2 (subproblem 1); then
- * theta5 (subproblem 4), theta6 (subproblem 1; the split at the wrist singularity)
- * and theta4 (subproblem 1). As tp_block. */
-static void sw_block(const SR *K, const Chain *ch, const double *const *T,
-                     const double *q6n, Slots *o, int *status, unsigned char (*need)[8],
-                     int nl)
+/* Shoulder branch i1 (lanes m1) of W poses of a spherical-wrist arm (axes 2, 3
+ * parallel, axes 4, 5, 6 meeting; IK-Geo 'spherical wrist, two parallel'): the wrist
+ * centre fixes theta3 (subproblem 3) and theta2 (subproblem 1); then theta5
+ * (subproblem 4), theta6 (subproblem 1; the split at the wrist singularity) and
+ * theta4 (subproblem 1). *any_mid gets the lanes whose position solves, *any_ok those
+ * with a solution. */
+static void sw_branch(const SR *K, const Chain *ch, BlockStart *b, int i1, vl m1,
+                      unsigned char (*need)[8], int nl, vl *any_mid, vl *any_ok)
 {
-    LM3 R;
-    L3 p, pw;
-    vd tt[12];
-    lanes_target(K, T, &R, &p);
-    lanes_pose(T, tt);
-    LRoots r1 = lanes_shoulder(K, &R, p, &pw);
-    L3 g6 = lm3_mvc(&R, K->h[5]);
-    vd pref = BR(0.0);
-    for (int l = 0; l < W; l++)
-        pref[l] = K->sign[5] * q6n[l] + K->off[5];
-    vl any_pos = BRL(0), any_ok = BRL(0);
-    Dest dst[W];
-    for (int l = 0; l < W; l++)
-        dst[l].o = o[l];
-    for (int i1 = 0; i1 < 2; i1++) {
-        vl m1 = i1 ? r1.two : r1.one;
-        if (!vany(m1))
+    SWCtx c;
+    block_branch(b, i1, &c.R, &c.c1, &c.s1);
+    vd th1 = b->r1.t[i1];
+    L3 d = l3_subc(l3_rot(K->h[0], c.c1, -c.s1, b->pw), K->o21);
+    vd rhs3 = 0.5 * (l3_dot(d, d) - K->aa - K->bb) - K->ec;
+    LRoots r3 = elbow_roots(K, rhs3);
+    L3 g61 = l3_rot(K->h[0], c.c1, -c.s1, b->g6);
+    for (int i3 = 0; i3 < 2; i3++) {
+        vl mask3 = m1 & (i3 ? r3.two : r3.one);
+        if (!vany(mask3))
             continue;
-        SWCtx c;
-        c.R = R;
-        c.c1 = r1.c[i1];
-        c.s1 = r1.s[i1];
-        vd th1 = r1.t[i1];
-        L3 d = l3_subc(l3_rot(K->h[0], c.c1, -c.s1, pw), K->o21);
-        vd rhs3 = 0.5 * (l3_dot(d, d) - K->aa - K->bb) - K->ec;
-        LRoots r3 = elbow_roots(K, rhs3);
-        L3 g61 = l3_rot(K->h[0], c.c1, -c.s1, g6);
-        for (int i3 = 0; i3 < 2; i3++) {
-            vl mask3 = m1 & (i3 ? r3.two : r3.one);
-            if (!vany(mask3))
+        *any_mid |= mask3;
+        vd th3 = r3.t[i3], c3 = r3.c[i3], s3 = r3.s[i3], c2, s2;
+        L3 u = l3_addc(l3_rotc(K->h[2], c3, s3, K->b), K->a);
+        vd th2 = lsp1(K->h[1], u, d, &c2, &s2);
+        /* h3 = s3 h2 (snapped): rot(h2, th2) rot(h3, th3) = rot(h2, th2 + s3 th3) */
+        vd sg = K->s3 * s3;
+        c.c23 = c2 * c3 - s2 * sg;
+        c.s23 = s2 * c3 + c2 * sg;
+        L3 x = l3_rot(K->h[1], c.c23, -c.s23, g61); /* Rw h6 */
+        LRoots r5 = wrist_roots(K, K->h[3], x);
+        L3 y = lm3_mtv(&b->R, l3_rot(K->h[0], c.c1, c.s1,
+                                  l3_rotc(K->h[1], c.c23, c.s23, K->h[3])));
+        L3 yp = l3_perp(K->h[5], y);
+        vd sw = vsqrt(l3_dot(yp, yp));
+        vl free_ = sw < K->free_tol, nearby = sw < SR_SPLIT_BAND;
+        vd gap = vmin(vmin(b->r1.gap, r3.gap), sw);
+        vl check = ~b->r1.two | ~r3.two | ~r5.two | (gap < SR_CHECK_BAND) |
+                   BRL(K->check > 0.0 ? -1 : 0);
+        for (int i5 = 0; i5 < 2; i5++) {
+            vl m5 = mask3 & (i5 ? r5.two & ~free_ : r5.one);
+            if (!vany(m5))
                 continue;
-            any_pos |= mask3;
-            vd th3 = r3.t[i3], c3 = r3.c[i3], s3 = r3.s[i3], c2, s2;
-            L3 u = l3_addc(l3_rotc(K->h[2], c3, s3, K->b), K->a);
-            vd th2 = lsp1(K->h[1], u, d, &c2, &s2);
-            /* h3 = s3 h2 (snapped): rot(h2, th2) rot(h3, th3) = rot(h2, th2 + s3 th3) */
-            vd sg = K->s3 * s3;
-            c.c23 = c2 * c3 - s2 * sg;
-            c.s23 = s2 * c3 + c2 * sg;
-            L3 x = l3_rot(K->h[1], c.c23, -c.s23, g61); /* Rw h6 */
-            LRoots r5 = wrist_roots(K, K->h[3], x);
-            L3 y = lm3_mtv(&R, l3_rot(K->h[0], c.c1, c.s1,
-                                      l3_rotc(K->h[1], c.c23, c.s23, K->h[3])));
-            L3 yp = l3_perp(K->h[5], y);
-            vd sw = vsqrt(l3_dot(yp, yp));
-            vl free_ = sw < K->free_tol, nearby = sw < SR_SPLIT_BAND;
-            vd gap = vmin(vmin(r1.gap, r3.gap), sw);
-            vl check = ~r1.two | ~r3.two | ~r5.two | (gap < SR_CHECK_BAND) |
-                       BRL(K->check > 0.0 ? -1 : 0);
-            for (int i5 = 0; i5 < 2; i5++) {
-                vl m5 = mask3 & (i5 ? r5.two & ~free_ : r5.one);
-                if (!vany(m5))
-                    continue;
-                c.c5 = r5.c[i5];
-                c.s5 = r5.s[i5];
-                vd th5 = r5.t[i5], c6, s6;
-                vd th6 = lsp1(K->h[5], y, l3_rotc(K->h[4], c.c5, -c.s5, K->h[3]), &c6, &s6);
-                vd exact = th6, half = wrist_split(K, sw, pref, &th6, &c6, &s6);
-                vd th4 = sw_theta4(K, &c, c6, s6);
-                int slot = 4 * i1 + 2 * i3 + i5;
-                vd v[6] = {th1, th2, th3, th4, th5, th6};
-                vl usep = m5 & pref_untried(sw, pref, th6) & BRL(i5 == 0 ? -1 : 0);
-                if (vany(usep)) { /* the preferred theta6 as it is, theta5 at the double
-                                   * root, where the chain agrees */
-                    SWCtx cs = c;
-                    vd cp, sp, th5s = wrist_double_root(K, x, K->h[3], &cs.c5, &cs.s5);
-                    vsincos(pref, &sp, &cp);
-                    vd vp[6] = {th1, th2, th3, sw_theta4(K, &cs, cp, sp), th5s, pref};
-                    usep = within_split(K, ch, vp, tt, usep);
-                    for (int j = 0; j < 6; j++)
-                        v[j] = vsel(usep, vp[j], v[j]);
-                }
-                for (int l = 0; l < W; l++)
-                    dst[l].slot = slot;
-                vl sing = gap < K->stol;
-                vl in = lanes_write(K, dst, v, m5, sing);
-                any_ok |= m5;
-                for (int l = 0; l < W; l++)
-                    if ((m5 & (check | usep))[l])
-                        need[l][slot] = 1;
-                vl split = m5 & ~in & (free_ | nearby);
-                if (vany(split))
-                    for (int l = 0; l < nl; l++)
-                        if (split[l])
-                            sw_split(K, &c, l, v, free_[l] ? th6[l] : exact[l], half[l],
-                                     sing[l] != 0, o[l], slot, need[l]);
+            c.c5 = r5.c[i5];
+            c.s5 = r5.s[i5];
+            vd th5 = r5.t[i5], c6, s6;
+            vd th6 = lsp1(K->h[5], y, l3_rotc(K->h[4], c.c5, -c.s5, K->h[3]), &c6, &s6);
+            vd exact = th6, half = wrist_split(K, sw, b->pref, &th6, &c6, &s6);
+            vd th4 = sw_theta4(K, &c, c6, s6);
+            int slot = 4 * i1 + 2 * i3 + i5;
+            vd v[6] = {th1, th2, th3, th4, th5, th6};
+            vl usep = m5 & pref_untried(sw, b->pref, th6) & BRL(i5 == 0 ? -1 : 0);
+            if (vany(usep)) { /* the preferred theta6 as it is, theta5 at the double
+                               * root, where the chain agrees */
+                SWCtx cs = c;
+                vd cp, sp, th5s = wrist_double_root(K, x, K->h[3], &cs.c5, &cs.s5);
+                vsincos(b->pref, &sp, &cp);
+                vd vp[6] = {th1, th2, th3, sw_theta4(K, &cs, cp, sp), th5s, b->pref};
+                usep = within_split(K, ch, vp, b->tt, usep);
+                for (int j = 0; j < 6; j++)
+                    v[j] = vsel(usep, vp[j], v[j]);
             }
+            for (int l = 0; l < W; l++)
+                b->dst[l].slot = slot;
+            vl sing = gap < K->stol;
+            vl in = lanes_write(K, b->dst, v, m5, sing);
+            *any_ok |= m5;
+            for (int l = 0; l < W; l++)
+                if ((m5 & (check | usep))[l])
+                    need[l][slot] = 1;
+            vl split = m5 & ~in & (free_ | nearby);
+            if (vany(split))
+                for (int l = 0; l < nl; l++)
+                    if (split[l])
+                        sw_split(K, &c, l, v, free_[l] ? th6[l] : exact[l], half[l],
+                                 sing[l] != 0, b->dst[l].o, slot, need[l]);
         }
     }
+}
+
+/* Every solution of W poses T[l] of the family K->family: theta1 (subproblem 4, the
+ * shared block_start), then each shoulder branch by tp_branch or sw_branch. Lane l's
+ * outputs go to o[l] and need[l] (slots to check against the chain), its status to
+ * status[l]: no orientation when the position solves (three parallel: the shoulder
+ * solves and no wrist does), else out of reach. */
+static void family_block(const SR *K, const Chain *ch, const double *const *T,
+                         const double *q6n, Slots *o, int *status,
+                         unsigned char (*need)[8], int nl)
+{
+    BlockStart b;
+    block_start(K, T, q6n, o, &b);
+    const int wrist = K->family == SR_SPHERICAL_WRIST;
+    vl any_mid = BRL(0), any_ok = BRL(0);
+    for (int i1 = 0; i1 < 2; i1++) {
+        vl m1 = i1 ? b.r1.two : b.r1.one;
+        if (!vany(m1))
+            continue;
+        if (wrist)
+            sw_branch(K, ch, &b, i1, m1, need, nl, &any_mid, &any_ok);
+        else
+            tp_branch(K, ch, &b, i1, m1, need, nl, &any_mid, &any_ok);
+    }
+    vl no_orientation = wrist ? any_mid : b.r1.one & ~any_mid;
     for (int l = 0; l < W; l++)
-        status[l] = any_ok[l] ? SR_OK : any_pos[l] ? SR_NO_ORIENTATION : SR_OUT_OF_REACH;
+        status[l] = any_ok[l] ? SR_OK : no_orientation[l] ? SR_NO_ORIENTATION
+                                                          : SR_OUT_OF_REACH;
 }
 
 /* ------------------------------------------------------------------ blocks */
@@ -1518,10 +1535,7 @@ static void six_r_block(const SR *K, const Chain *ch, const double *const *T,
     unsigned char need[W][8];
     memset(need, 0, sizeof(need));
     int st[W];
-    if (K->family == SR_SPHERICAL_WRIST)
-        sw_block(K, ch, T, q6n, own, st, need, nl);
-    else
-        tp_block(K, ch, T, q6n, own, st, need, nl);
+    family_block(K, ch, T, q6n, own, st, need, nl);
     for (int l = 0; l < nl; l++) {
         status[l] = (signed char)st[l];
         if (ch == NULL || K->check < 0.0)

@@ -68,16 +68,13 @@ static inline void unit2(double y, double x, double *c, double *s)
 }
 
 /* The joint coordinate of chain angle v: sign (v - offset) wrapped to [-pi, pi],
- * then moved by whole turns into [lo, hi] (1e-9 slack) where it fits (wrap_into,
- * lm.c); *inside says whether it lies there. */
+ * then by chain.h's wrap_into rule into [lo, hi] (LIMIT_SLACK); *inside says whether
+ * it lies there. */
 static inline double joint_value(double v, double sign, double offset, double lo,
                                  double hi, int *inside)
 {
-    double q = wrap_pi(sign * (v - offset));
-    double lo_e = lo - 1e-9, hi_e = hi + 1e-9;
-    if (q < lo_e || q > hi_e) /* rare: spares the common case wrap_into's division */
-        q = wrap_into(q, lo_e, hi_e);
-    *inside = (q >= lo_e) & (q <= hi_e);
+    double q = wrap_into(wrap_pi(sign * (v - offset)), lo, hi);
+    *inside = within_limits(q, lo, hi);
     return q;
 }
 

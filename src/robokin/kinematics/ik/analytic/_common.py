@@ -31,19 +31,27 @@ STATUS_TEXT = np.array([_STATUS[k] for k in range(len(_STATUS))], dtype=object)
 
 
 def fit_turns(q: np.ndarray, is_revolute: np.ndarray, limits: np.ndarray) -> np.ndarray:
-    """Revolute values wrapped into [-pi, pi), then by whole turns into their limits.
+    """Revolute values wrapped into [-pi, pi), then by the wrap-into-limits rule.
 
-    Prismatic values are left alone; a value no turn brings inside stays wrapped.
+    The rule is the compiled one (kernel ``wrap_into``, docs/conventions.md "Joint
+    values and limits"): a value within its limits up to 1e-9 stays, else it moves
+    by the fewest whole turns that bring it within them, else it stays wrapped.
+    Prismatic values are left alone.
+
+    Args:
+        q: Joint coordinates [rad, m], shape (..., n).
+        is_revolute: Which joints are revolute, shape (n,).
+        limits: Joint limits [rad, m], shape (n, 2).
+
+    Returns:
+        The coordinates, shape (..., n).
     """
-    tw = 2.0 * np.pi
-    w = wrap_angle(q)
-    lo, hi = limits[:, 0], limits[:, 1]
-    with np.errstate(invalid="ignore"):
-        up = w + tw * np.ceil((lo - 1e-9 - w) / tw)
-        down = w - tw * np.ceil((w - hi - 1e-9) / tw)
-    w = np.where((w < lo - 1e-9) & (up <= hi + 1e-9), up, w)
-    w = np.where((w > hi + 1e-9) & (down >= lo - 1e-9), down, w)
-    return np.where(is_revolute, w, q)
+    w = np.ascontiguousarray(wrap_angle(np.asarray(q, dtype=np.float64)))
+    lo = np.ascontiguousarray(np.broadcast_to(limits[:, 0], w.shape), dtype=np.float64)
+    hi = np.ascontiguousarray(np.broadcast_to(limits[:, 1], w.shape), dtype=np.float64)
+    out = np.empty(w.shape)
+    _K.wrap_into(w.reshape(-1), lo.reshape(-1), hi.reshape(-1), out.reshape(-1))
+    return np.where(is_revolute, out, q)
 
 
 def inside_limits(q: np.ndarray, limits: np.ndarray) -> npt.NDArray[np.bool_]:
