@@ -254,3 +254,29 @@ def test_special_value_batch(arm, j):
     ok = (sols.valid & sols.within_limits).any(axis=-1)
     miss = ~regular & inside & ~ok
     assert not miss.any(), q[miss][:3].tolist()
+
+
+def test_slide_finds_the_coaxial_family_inside_the_limits():
+    # Panda, q7 held, q2 = 1e-9: axes 1 and 3 in line, so q1 + q3 is all the pose
+    # fixes (a one-parameter family; the remaining 6 x 6 Jacobian's smallest
+    # singular value is 8e-17). The mirrored elbow branch's closed-form row has
+    # q1, q3 outside their +-2.8973 limits; pk_slide moves it along the family to
+    # the limit. Oracle: every in-limit row reaches the pose (pose_errors), the
+    # generating configuration is among them, and a second in-limit row lies on
+    # the family (q1 + q3 and q2, q4..q7 equal to the generating one's), at a
+    # limit. Without the slide only 2 in-limit rows come back (measured).
+    lim = PANDA.limits
+    q = np.array([1e-6, 1e-9, -1e-6, -0.0698, np.pi / 2, np.pi / 2, -np.pi / 2])
+    T = PANDA.fk(q)
+    sols = PANDA.ik(T, fixed={"joint7": float(q[6])})
+    Q = sols.q[sols.valid & sols.within_limits]
+    dp, dr = pose_errors(PANDA.fk(Q), T)
+    assert dp.max() < 1e-9 and dr.max() < 1e-9
+    assert np.all((lim[:, 0] - 1e-9 <= Q) & (lim[:, 1] + 1e-9 >= Q))
+    assert _angle_gap(Q, q).min() <= 1e-6
+    on_family = [r for r in Q if _angle_gap(r[None], q)[0] > 1e-3
+                 and abs(r[0] + r[2] - q[0] - q[2]) < 1e-6
+                 and np.abs(np.delete(r, [0, 2]) - np.delete(q, [0, 2])).max() < 1e-6]
+    assert len(on_family) == 1
+    r = on_family[0]
+    assert min(abs(r[0] - lim[0]).min(), abs(r[2] - lim[2]).min()) < 1e-9

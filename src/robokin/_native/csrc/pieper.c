@@ -1349,6 +1349,46 @@ static int pk_regular(const double J[6][6])
     return fabs(det) > 2.0 * PK_FAMILY_SIGMA * fro * fro * fro;
 }
 
+/* Whether the row th is certainly isolated (pk_regular's bound, |det J| >
+ * 2 PK_FAMILY_SIGMA |J|_F^6, proven with room to spare) without forming J: the
+ * cheap first test of pk_slide, which most rows outside the limits pass.
+ * About the triple's point w the triple's columns have no linear part, so
+ * det J = det[h_x, h_y, h_z] det[h_j x (w - o_j)] / scale^3 over the three
+ * position joints j; the first depends on the triple's middle angle only, the
+ * second on two of the position joints' angles (each factor taken in a frame
+ * where the other angles drop out; det is unchanged by a rigid motion). |J|_F
+ * is bounded by its value with every |h_j x (p - o_j)| at its largest, the
+ * chain's length from o_j to the tool point (the 4 instead of pk_regular's 2
+ * covers that this bound and the two determinants round differently). */
+static int pk_isolated(const PkGeo *g, const double *th)
+{
+    if (g->kase == PK_BOTH)
+        return 0; /* SRS: a held joint may split the triples; pk_regular decides */
+    int t0 = g->kase == PK_END ? 3 : 0, p0 = 3 - t0;
+    double s = g->scale, reach = v3_norm(v3_sub(g->tM, g->o[5])), f2 = 6.0;
+    for (int j = 5; j >= 0; j--) {
+        f2 += reach * reach / (s * s);
+        if (j > 0)
+            reach += v3_norm(v3_sub(g->o[j], g->o[j - 1]));
+    }
+    v3 hz = v3_rot(g->h[t0 + 1], cos(th[t0 + 1]), sin(th[t0 + 1]), g->h[t0 + 2]);
+    double dt = v3_dot(g->h[t0], v3_cross(g->h[t0 + 1], hz));
+    v3 ha = g->h[p0 + 1], oa = g->o[p0 + 1], w = g->pt;
+    double ca = cos(th[p0 + 1]), sa = sin(th[p0 + 1]);
+    v3 hb = v3_rot(ha, ca, sa, g->h[p0 + 2]);
+    v3 ob = v3_add(oa, v3_rot(ha, ca, sa, v3_sub(g->o[p0 + 2], oa)));
+    if (p0 == 0) { /* w after joints 1 and 2 (joint 0 undone) */
+        w = v3_add(g->o[2], v3_rot(g->h[2], cos(th[2]), sin(th[2]), v3_sub(w, g->o[2])));
+        w = v3_add(oa, v3_rot(ha, ca, sa, v3_sub(w, oa)));
+    } else { /* w before joint 3 (the triple and joint 3 undone) */
+        w = v3_add(g->o[3], v3_rot(g->h[3], cos(th[3]), -sin(th[3]), v3_sub(w, g->o[3])));
+    }
+    v3 c0 = v3_cross(g->h[p0], v3_sub(w, g->o[p0]));
+    v3 c1 = v3_cross(ha, v3_sub(w, oa)), c2 = v3_cross(hb, v3_sub(w, ob));
+    double det = fabs(dt * v3_dot(c0, v3_cross(c1, c2))) / (s * s * s);
+    return det > 4.0 * PK_FAMILY_SIGMA * f2 * f2 * f2;
+}
+
 /* A row th on a one-parameter family of exact solutions (a singular configuration
  * whose remaining Jacobian has a null direction: smallest singular value below
  * PK_FAMILY_SIGMA of the largest) but outside the limits: slide along the family.
@@ -1362,6 +1402,8 @@ static int pk_regular(const double J[6][6])
 static int pk_slide(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
 {
     double trial[6];
+    if (pk_isolated(g, th))
+        return 0; /* isolated: no family to slide along */
     for (int j = 0; j < 6; j++)
         trial[j] = th[j];
     for (int it = 0; it < 96; it++) {
