@@ -115,6 +115,13 @@ typedef struct {
     long q_cap;
     double *rate0; /* (P,) static motion rates of the current edge */
     double *cheap; /* (6, P) cheap bounds g and ub at an edge's two ends and middle */
+    /* the far end of the last edge whose ends were proven free, with every pair's
+     * best lower bound there, its upper bound and whether the lower one is the exact
+     * distance: a chain of edges (RRT-Connect's connect steps) starts the next edge
+     * from them instead of bounding that state again */
+    double *last_q, *last_l, *last_u; /* (n), (P), (P) */
+    unsigned char *last_ex;           /* (P) */
+    int last_ok;
 } Work;
 
 typedef struct {
@@ -505,6 +512,10 @@ static void work_free(Work *w)
     free(w->cum_ok);
     free(w->rate0);
     free(w->cheap);
+    free(w->last_q);
+    free(w->last_l);
+    free(w->last_u);
+    free(w->last_ex);
     memset(w, 0, sizeof(*w));
 }
 
@@ -517,7 +528,13 @@ static int checker_init(Checker *C, const PlanModel *M, const double *margin, Py
     C->hit_pair = -1;
     C->w.rate0 = malloc(((size_t)M->P + 1) * sizeof(double));
     C->w.cheap = malloc((6 * (size_t)M->P + 1) * sizeof(double));
-    return C->w.rate0 != NULL && C->w.cheap != NULL && work_states(C, 2 * W);
+    C->w.last_q = malloc(((size_t)M->n + 1) * sizeof(double));
+    C->w.last_l = malloc(((size_t)M->P + 1) * sizeof(double));
+    C->w.last_u = malloc(((size_t)M->P + 1) * sizeof(double));
+    C->w.last_ex = malloc((size_t)M->P + 1);
+    return C->w.rate0 != NULL && C->w.cheap != NULL && C->w.last_q != NULL &&
+           C->w.last_l != NULL && C->w.last_u != NULL && C->w.last_ex != NULL &&
+           work_states(C, 2 * W);
 }
 
 /* ------------------------------------------------------------------- checks */
@@ -602,8 +619,11 @@ static int probe_state(Checker *C, long slot, const double *q, double t, double 
  * q1]: the far end and the midpoint are probed first (a planner's new state, or a
  * shortcut, is often in collision, and finding that before the work of proving the
  * pairs between is cheaper; the midpoint's bounds serve level 1), then both ends of
- * every pair; the pairs whose whole edge is not proven go into items (*ni).
- * Returns PC_FREE or what ended the edge. */
+ * every pair; the pairs whose whole edge is not proven go into items (*ni). When q0
+ * is the far end of the last edge whose ends were proven, its bounds are that
+ * edge's (lower bounds at the same state: reusing them only saves work). On
+ * success q1's bounds are kept for the next edge. Returns PC_FREE or what ended the
+ * edge. */
 static int edge_ends(Checker *C, const double *q0, const double *q1, const double *qm,
                      long *ni)
 {
@@ -613,6 +633,8 @@ static int edge_ends(Checker *C, const double *q0, const double *q1, const doubl
     const double *P0 = w->poses + (size_t)S * 12, *P1 = P0 + (size_t)S * 12;
     double *G0 = w->cheap, *U0 = G0 + P, *G1 = U0 + P, *U1 = G1 + P;
     double *Gm = U1 + P, *Um = Gm + P;
+    const int n = M->n, reuse = w->last_ok && memcmp(q0, w->last_q, n * sizeof(double)) == 0;
+    w->last_ok = 0; /* last_* are rewritten below */
     memset(w->cum_ok, 0, 3 * (size_t)S);
     cheap_all(C, P1, G1, U1);
     int r = probe_state(C, 2, q1, 1.0, G1, U1);
@@ -622,11 +644,20 @@ static int edge_ends(Checker *C, const double *q0, const double *q1, const doubl
     r = probe_state(C, 0, qm, 0.5, Gm, Um);
     if (r != PC_FREE)
         return r;
-    cheap_all(C, P0, G0, U0);
+    if (reuse) {
+        memcpy(G0, w->last_l, (size_t)P * sizeof(double));
+        memcpy(U0, w->last_u, (size_t)P * sizeof(double));
+    } else {
+        cheap_all(C, P0, G0, U0);
+    }
     *ni = 0;
     for (int p = 0; p < P; p++) {
         const double mg = C->margin[p];
         double g0 = G0[p], u0 = U0[p], g1 = G1[p], u1 = U1[p], rate = w->rate0[p];
+        const int ex0 = reuse && w->last_ex[p];
+        w->last_l[p] = g1; /* q1's bounds for the next edge (q0's were read above) */
+        w->last_u[p] = u1;
+        w->last_ex[p] = 0;
         if (g0 > mg && g1 > mg && g0 + g1 > rate + 2 * mg)
             continue;
         rate = dmin(rate, dmin(state_rate(C, p, 1, 1.0), state_rate(C, p, 2, 1.0)));
@@ -634,7 +665,7 @@ static int edge_ends(Checker *C, const double *q0, const double *q1, const doubl
             continue;
         const double lim = rate + 2 * mg;
         int ex;
-        double l0 = pair_refine(C, p, P0, g0, u0, lim - g1, lim - g1, &ex);
+        double l0 = ex0 ? g0 : pair_refine(C, p, P0, g0, u0, lim - g1, lim - g1, &ex);
         if (l0 <= mg) {
             r = settle(C, p, ex, q0, 0.0, &l0);
             if (r != PC_FREE)
@@ -645,10 +676,15 @@ static int edge_ends(Checker *C, const double *q0, const double *q1, const doubl
             r = settle(C, p, ex, q1, 1.0, &l1);
             if (r != PC_FREE)
                 return r;
+            ex = 0;
         }
+        w->last_l[p] = l1;
+        w->last_ex[p] = (unsigned char)ex;
         if (l0 + l1 <= lim)
             w->item[0][(*ni)++] = (Item){p, l0, l1, rate};
     }
+    memcpy(w->last_q, q1, n * sizeof(double));
+    w->last_ok = 1;
     return PC_FREE;
 }
 
