@@ -148,14 +148,6 @@ def _is_rigid(T: np.ndarray) -> bool:
     )
 
 
-def _rigid(T: np.ndarray) -> np.ndarray:
-    """T with its rotation projected onto SO(3) (the nearest rotation, by SVD)."""
-    U, _, Vt = np.linalg.svd(T[:3, :3])
-    out = T.copy()
-    out[:3, :3] = U @ Vt
-    return out
-
-
 def _in_frame(robot: Robot, solver: Robot, T: np.ndarray) -> np.ndarray:
     """The pose of ``solver``'s tool when ``robot``'s is at T (the same joint values).
 
@@ -178,10 +170,9 @@ def _manifold_goals(robot: Robot, T: np.ndarray) -> Goals | None:
 
     if auto_parameter(robot) is None:
         return None
-    # the held-joint closed form accepts a solution only within 1e-12 of the pose: a
-    # rotation orthonormal to 1e-12 only (a pose written to 12 digits) would lose
-    # every branch, so it is projected onto SO(3) first (a change below 1e-11)
-    sm = robot.self_motion(_rigid(T))
+    # a rotation orthonormal to 1e-12 only (a pose written to 12 digits) is projected
+    # onto SO(3) by self_motion itself (_validation.check_rigid)
+    sm = robot.self_motion(T)
     if not sm.reachable:
         return None  # robot.ik says why (or finds what the manifold missed)
     sampler = ManifoldGoals.of(sm)
