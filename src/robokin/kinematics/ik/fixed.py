@@ -90,8 +90,11 @@ def solve_fixed(
         held = _held_solvers(robot).get(name)
         if held is not None and type(value) in _NUMBERS:
             out: SolutionSet | None = held.single(T, value, None)
-            if out is not None and (len(out) or check_rigid(T, "T") is T):
-                return out  # (no solution of a rotation off SO(3) by rounding: project)
+            # "ok" has rows (read first: counting them costs a numpy reduction); no
+            # row for a rotation off SO(3) by rounding: project it and solve below
+            if out is not None and (out.status.item() == "ok" or len(out)
+                                    or check_rigid(T, "T") is T):
+                return out
     names = list(robot.joint_names)
     if not isinstance(fixed, Mapping) or not fixed:
         raise InputError("fixed", f"expected a mapping of joint names to values, e.g. "
