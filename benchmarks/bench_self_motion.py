@@ -42,6 +42,7 @@ import numpy as np
 from bench_ik_held import run_geofik, run_ssik, score
 
 import robokin
+from robokin.kinematics.ik.self_motion_families import SELF_MOTION
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from reference import iiwa14_srs  # noqa: E402
@@ -107,7 +108,7 @@ def run_robokin(robot, q, T, repeat):
 
 def run_kernels(robot, T, repeat):
     """The SRS swivel kernels on the whole batch: rows at 64 angles, the manifolds."""
-    arm = robot.arm.self_motion.swivel
+    arm = robot.arm.derived(SELF_MOTION).swivel
     psi = np.tile(np.linspace(-np.pi, np.pi, 64), (len(T), 1))
     rows = cpu_and_wall(lambda: arm.rows(T, psi), repeat)
     man = cpu_and_wall(lambda: arm.manifold(T), repeat)
