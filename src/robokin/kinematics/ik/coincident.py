@@ -43,6 +43,7 @@ from robokin.kinematics.forward import forward_kinematics
 from robokin.kinematics.ik.analytic._common import fit_turns
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.kinematics.jacobian import jacobian_and_pose
+from robokin.spatial import pose_error, wrap_angle
 
 __all__ = ["CoincidentPair", "coincident_pair", "solve_coincident"]
 
@@ -64,7 +65,7 @@ SAME_FAMILY = 1e-4
 
 def _turn_gap(Q: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Largest angle difference (modulo 2 pi) of rows Q (k, n) from q (n,)."""
-    return np.asarray(np.abs((Q - q + np.pi) % (2.0 * np.pi) - np.pi).max(axis=-1))
+    return np.asarray(np.abs(wrap_angle(Q - q)).max(axis=-1))
 
 
 @dataclass(frozen=True)
@@ -116,25 +117,17 @@ def coincident_pair(robot: Arm, j: int, v: float) -> CoincidentPair | None:
     return CoincidentPair(j, a, b, sign, float(c))
 
 
-def _pose_error(T: np.ndarray, Tt: np.ndarray) -> np.ndarray:
-    """(..., 6) error [position; rotation vector, small angles] from T to Tt."""
-    dp = Tt[..., :3, 3] - T[..., :3, 3]
-    E = Tt[..., :3, :3] @ np.swapaxes(T[..., :3, :3], -1, -2)
-    dr = 0.5 * np.stack([E[..., 2, 1] - E[..., 1, 2], E[..., 0, 2] - E[..., 2, 0],
-                         E[..., 1, 0] - E[..., 0, 1]], axis=-1)
-    return np.concatenate([dp, dr], axis=-1)
-
-
 def _polish(robot: Arm, q: np.ndarray, T: np.ndarray, free: np.ndarray) -> np.ndarray:
     """Newton (least squares) on the joints ``free`` of rows q (m, n) to poses T (m, 4, 4)."""
     q = q.copy()
     for _ in range(8):
         J, Tq = jacobian_and_pose(robot.chain, q)
-        e = _pose_error(Tq, T)
+        e = pose_error(Tq, T)
         if float(np.abs(e).max(initial=0.0)) <= 1e-16:
             break
-        for r in range(len(q)):
-            q[r, free] += np.linalg.lstsq(J[r][:, free], e[r], rcond=1e-10)[0]
+        # least squares on every row at once (pinv's rcond as lstsq's: relative cut)
+        step = np.linalg.pinv(J[:, :, free], rcond=1e-10) @ e[:, :, None]
+        q[:, free] += step[:, :, 0]
     return q
 
 
@@ -181,7 +174,7 @@ def solve_coincident(robot: Arm, T: np.ndarray, pair: CoincidentPair, v: float,
     poses, rows, second = [], [], []
     for h, helper in enumerate(helpers):
         Q, valid = helper.q.reshape(N, -1, n), helper.valid.reshape(N, -1)
-        keep = valid & (np.abs(np.angle(np.exp(1j * (Q[..., pair.held] - v)))) <= NEAR_VALUE)
+        keep = valid & (np.abs(wrap_angle(Q[..., pair.held] - v)) <= NEAR_VALUE)
         pk, rk = np.nonzero(keep)
         poses.append(pk)
         rows.append(Q[pk, rk])
@@ -206,7 +199,7 @@ def solve_coincident(robot: Arm, T: np.ndarray, pair: CoincidentPair, v: float,
     q = fit_turns(q, robot.is_revolute, lim)  # q_b at the in-limit turn of its split
     q[:, pair.held] = v
     if len(q):
-        e = np.abs(_pose_error(forward_kinematics(robot.chain, q), T[pose]))
+        e = np.abs(pose_error(forward_kinematics(robot.chain, q), T[pose]))
         exact = e.max(axis=-1) <= EXACT
     else:
         exact = np.zeros(0, bool)
