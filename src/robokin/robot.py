@@ -57,6 +57,14 @@ def _ik_solve() -> Dispatch:
 
 
 @cache
+def _held_single() -> Callable[[Arm, object, object], SolutionSet | None]:
+    """:func:`robokin.kinematics.ik.fixed.solve_held_single`, imported on first use."""
+    from robokin.kinematics.ik.fixed import solve_held_single
+
+    return solve_held_single
+
+
+@cache
 def _solve_near() -> Callable[..., IKResult]:
     """:func:`robokin.kinematics.ik.nearest.solve_near`, imported on first use."""
     from robokin.kinematics.ik.nearest import solve_near
@@ -294,6 +302,7 @@ class Robot(RobotParts):
         q_near: npt.ArrayLike | None = None,
         method: Literal["auto", "analytic", "numeric"] = "auto",
         *,
+        fixed: Mapping[str, npt.ArrayLike] | None = None,
         space: Space = "joint",
         **options: Any,
     ) -> SolutionSet:
@@ -305,6 +314,11 @@ class Robot(RobotParts):
                 singularity and by ``.nearest``; optional.
             method: ``"auto"`` (closed form when the arm has one, else numeric),
                 ``"analytic"`` or ``"numeric"``.
+            fixed: Joints held at given values, ``{name: value}`` [rad, m]: a
+                number, or an array broadcasting with the poses (a 7R arm with one
+                joint held: the remaining 6R chain solved completely; see
+                :func:`robokin.kinematics.ik.fixed.solve_fixed`). None: no joint
+                held.
             space: ``"actuator"`` returns motor coordinates (and takes ``q_near``
                 in motor coordinates).
             **options: Passed to the solver.
@@ -312,20 +326,30 @@ class Robot(RobotParts):
         Returns:
             A :class:`~robokin.kinematics.ik.solutions.SolutionSet`.
         """
-        if space == "actuator":
-            if q_near is not None:
-                q_near = self.joints_from_actuators(q_near)
-            arm = self.arm
-            sols = _ik_solve()(arm, T, q_near=q_near, method=method, **options)
-            out = sols.to_actuator_space(arm)
-            if self.actuators is not None and out.is_revolute.any():
-                # Motor angles never wrap: a motor turn through a reduction is not a
-                # whole joint turn, so 2*pi-shifted motor values are other poses.
-                out = _replace(out, is_revolute=np.zeros(out.n, bool))
-            return out
-        if space != "joint":
+        if fixed is not None:
+            if (q_near is None and not options and space == "joint"
+                    and (method == "auto" or method == "analytic")):
+                # hot path: one pose, one joint at a number, a closed form for it
+                # (None where that is not so: the general path below checks and
+                # raises)
+                out = _held_single()(self.arm, T, fixed)
+                if out is not None:
+                    return out
+            options["fixed"] = fixed
+        if space == "joint":
+            return _ik_solve()(self.arm, T, q_near=q_near, method=method, **options)
+        if space != "actuator":
             raise InputError("space", f"expected 'joint' or 'actuator', got {space!r}")
-        return _ik_solve()(self.arm, T, q_near=q_near, method=method, **options)
+        if q_near is not None:
+            q_near = self.joints_from_actuators(q_near)
+        arm = self.arm
+        sols = _ik_solve()(arm, T, q_near=q_near, method=method, **options)
+        out = sols.to_actuator_space(arm)
+        if self.actuators is not None and out.is_revolute.any():
+            # Motor angles never wrap: a motor turn through a reduction is not a
+            # whole joint turn, so 2*pi-shifted motor values are other poses.
+            out = _replace(out, is_revolute=np.zeros(out.n, bool))
+        return out
 
     def ik_near(
         self,
