@@ -98,14 +98,16 @@ def test_public_names_resolve_after_a_bare_import():
     probe = ("import numpy as np, robokin\n"
              "from robokin import (InputError, MissingExtraError, ModelError, RobokinError,\n"
              "                     Robot, UnreachableError, load, save, __version__)\n"
+             "for m in ('trajectory', 'collision', 'robots', 'spatial', 'kinematics',\n"
+             "          'model', 'io'):\n"
+             "    assert getattr(robokin, m).__name__ == 'robokin.' + m\n"
+             "SolutionSet = robokin.kinematics.ik.solutions.SolutionSet\n"
              "r = robokin.load('ur5')\n"
              "q = np.array([0.1, -0.4, 0.5, -0.2, 0.3, 0.6])\n"
              "s = r.ik(r.fk(q))\n"
+             "assert type(s) is SolutionSet\n"
              "assert np.abs(s.nearest(q) - q).max() < 1e-9\n"
              "assert robokin.ik.family(r).name\n"
-             "for m in ('trajectory', 'collision', 'robots', 'spatial', 'kinematics',\n"
-             "          'model'):\n"
-             "    assert getattr(robokin, m).__name__ == 'robokin.' + m\n"
              "print('ok')\n")
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                          timeout=120)
