@@ -54,3 +54,61 @@ def test_actuator_limits_must_match_the_motors():
     ur5 = robokin.load("ur5")
     with pytest.raises(robokin.InputError, match="without an actuator map"):
         ur5.replace(actuator_limits=np.zeros((6, 2)))
+
+
+_IMPORT_PROBE = """
+import json, sys
+import robokin
+print(json.dumps(sorted(sys.modules)))
+"""
+#: What ``import robokin`` must leave unloaded: the file readers (and PyYAML under
+#: them), the IK solvers, the kernels' declarations, and every heavy dependency.
+_NOT_ON_IMPORT = ("yaml", "scipy", "pydantic", "matplotlib", "typer", "rich",
+                  "typing_extensions", "robokin.io", "robokin.kinematics.ik",
+                  "robokin.robots", "robokin._native._declare", "robokin.model.dh",
+                  "robokin.trajectory", "robokin.collision", "robokin.viz")
+
+
+def test_import_robokin_loads_only_the_core():
+    """``import robokin`` stays light (issue 24 re-measure: 0.22-0.26 s, was 0.10-0.12).
+
+    Oracle: the module table of a fresh interpreter after ``import robokin`` holds
+    none of :data:`_NOT_ON_IMPORT` (nor their submodules); before the fix it held
+    PyYAML, the io readers and the IK solvers (71 robokin modules; now 20). The public
+    names still resolve afterwards.
+    """
+    import json
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", _IMPORT_PROBE], capture_output=True,
+                         text=True, check=True, timeout=120)
+    loaded = json.loads(out.stdout)
+    heavy = [m for m in loaded
+             if any(m == p or m.startswith(p + ".") for p in _NOT_ON_IMPORT)]
+    assert heavy == []
+    assert "robokin.robot" in loaded and "robokin.kinematics.forward" in loaded
+
+
+def test_public_names_resolve_after_a_bare_import():
+    """Every ``__all__`` name and lazy subpackage works from a fresh interpreter."""
+    import subprocess
+    import sys
+
+    probe = ("import numpy as np, robokin\n"
+             "from robokin import (InputError, MissingExtraError, ModelError, RobokinError,\n"
+             "                     Robot, UnreachableError, load, save, __version__)\n"
+             "for m in ('trajectory', 'collision', 'robots', 'spatial', 'kinematics',\n"
+             "          'model', 'io'):\n"
+             "    assert getattr(robokin, m).__name__ == 'robokin.' + m\n"
+             "SolutionSet = robokin.kinematics.ik.solutions.SolutionSet\n"
+             "r = robokin.load('ur5')\n"
+             "q = np.array([0.1, -0.4, 0.5, -0.2, 0.3, 0.6])\n"
+             "s = r.ik(r.fk(q))\n"
+             "assert type(s) is SolutionSet\n"
+             "assert np.abs(s.nearest(q) - q).max() < 1e-9\n"
+             "assert robokin.ik.family(r).name\n"
+             "print('ok')\n")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                         timeout=120)
+    assert out.stdout.strip() == "ok", out.stderr

@@ -61,7 +61,7 @@ def save(robot: Robot, path: str | Path) -> Path:
 
 def __getattr__(name: str) -> Any:
     # Lazy subpackages: ``robokin.ik``, ``robokin.trajectory``, ``robokin.collision``,
-    # ``robokin.calibration``,
+    # ``robokin.calibration``, ``robokin.io`` (the file readers: PyYAML, pydantic),
     # ``robokin.sim`` (MuJoCo, robokin[sim]), ``robokin.cell`` (Dask, robokin[scale]).
     import importlib
 
@@ -77,6 +77,7 @@ def __getattr__(name: str) -> Any:
         "viz",
         "kinematics",
         "model",
+        "io",
         "sim",
         "planning",
     ):

@@ -14,40 +14,81 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace as _replace
+from functools import cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
-from typing_extensions import Unpack
 
-from robokin import _html
 from robokin._validation import check_finite, check_joints, check_transform
 from robokin.exceptions import InputError
-from robokin.io.robot_files import document_from_robot
-from robokin.io.robot_tables import MM_PER_M, joint_rows_mm_deg
-from robokin.io.urdf import UrdfKeywords, parts_from_urdf
-from robokin.io.urdf_export import urdf_from_robot
 from robokin.kinematics import forward
 from robokin.kinematics import jacobian as _jac
 from robokin.kinematics.arm import Arm
-from robokin.kinematics.ik.dispatch import solve as _ik_solve
-from robokin.kinematics.ik.nearest import solve_near as _solve_near
-from robokin.kinematics.ik.self_motion import SelfMotion
-from robokin.kinematics.ik.self_motion import self_motion as _self_motion
-from robokin.model.dh import chain_from_dh, chain_from_elementary
 from robokin.model.parts import RobotParts
 
 if TYPE_CHECKING:
+    from typing_extensions import Unpack
+
+    from robokin.io.urdf import UrdfKeywords
+    from robokin.kinematics.ik.fixed import Dispatch
     from robokin.kinematics.ik.numeric import IKResult
+    from robokin.kinematics.ik.self_motion import SelfMotion
     from robokin.kinematics.ik.solutions import SolutionSet
 
 __all__ = ["Robot"]
 
 Space = Literal["joint", "actuator"]
 _FK_SINGLE = forward.fk_single  # one configuration, or None for the general path
-#: Methods a Robot no longer has, and what to call instead (issue 24).
-_MOVED = {"plot": "the facade does not draw; use robokin.viz.plot_robot(robot, q)"}
+
+
+# The IK entry points and the file readers are imported on first use, not by
+# ``import robokin``: they pull in every closed-form family, the numeric solver, the
+# self-motion code and PyYAML (``import robokin`` took 0.22-0.26 s with them, 0.10-0.12
+# s before they were added). A cached loader costs ~20 ns a call where a
+# function-level ``from ... import`` costs 0.3-0.6 us.
+@cache
+def _ik_solve() -> Dispatch:
+    """:func:`robokin.kinematics.ik.dispatch.solve`, imported on the first solve."""
+    from robokin.kinematics.ik.dispatch import solve
+
+    return solve
+
+
+@cache
+def _held_single() -> Callable[[Arm, object, object], SolutionSet | None]:
+    """:func:`robokin.kinematics.ik.fixed.solve_held_single`, imported on first use."""
+    from robokin.kinematics.ik.fixed import solve_held_single
+
+    return solve_held_single
+
+
+@cache
+def _solve_near() -> Callable[..., IKResult]:
+    """:func:`robokin.kinematics.ik.nearest.solve_near`, imported on first use."""
+    from robokin.kinematics.ik.nearest import solve_near
+
+    return solve_near
+
+
+class _Moved:
+    """A method a Robot no longer has: reading it raises AttributeError naming the replacement.
+
+    A descriptor rather than ``Robot.__getattr__``: a class with ``__getattr__`` takes
+    CPython's slow attribute path for *every* attribute (no specialised lookups), which
+    cost ``robot.fk(q)`` about 0.07 us a call (0.30 against 0.23 us).
+    """
+
+    def __init__(self, instead: str) -> None:
+        self.instead = instead
+        self.name = ""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, obj: object, owner: type | None = None) -> Any:
+        raise AttributeError(f"'Robot' object has no attribute {self.name!r}: {self.instead}")
 
 
 class Robot(RobotParts):
@@ -68,6 +109,8 @@ class Robot(RobotParts):
 
     __slots__ = ("_arm",)
     _arm: Arm
+    #: Removed in issue 24 (the facade does not draw).
+    plot = _Moved("the facade does not draw; use robokin.viz.plot_robot(robot, q)")
 
     @property
     def arm(self) -> Arm:
@@ -78,13 +121,6 @@ class Robot(RobotParts):
             arm = Arm(self.chain, self.name, self.actuators, self.actuator_limits)
             object.__setattr__(self, "_arm", arm)
             return arm
-
-    def __getattr__(self, name: str) -> Any:
-        """Name the replacement of a removed method (``Robot.plot``) in the error."""
-        if name in _MOVED:
-            raise AttributeError(f"'Robot' object has no attribute {name!r}: "
-                                 f"{_MOVED[name]}")
-        raise AttributeError(f"'Robot' object has no attribute {name!r}")
 
     # ------------------------------------------------------------------ building
     @classmethod
@@ -109,6 +145,8 @@ class Robot(RobotParts):
             ModelError: a row that is not a mapping, an unknown key, a value that
                 is not a finite number, reversed limits (naming ``rows[i].key``).
         """
+        from robokin.model.dh import chain_from_dh
+
         base = None if base is None else check_transform(base, "base")
         tool = None if tool is None else check_transform(tool, "tool")
         chain = chain_from_dh(rows, convention, base=base, tool=tool, coordinates=coordinates)
@@ -125,6 +163,8 @@ class Robot(RobotParts):
         coordinates: Sequence[Mapping[str, Any]] | None = None,
     ) -> Robot:
         """Build from elementary Rot/Trans operators (see :mod:`robokin.model.dh`)."""
+        from robokin.model.dh import chain_from_elementary
+
         base = None if base is None else check_transform(base, "base")
         tool = None if tool is None else check_transform(tool, "tool")
         chain = chain_from_elementary(ops, base=base, tool=tool, coordinates=coordinates)
@@ -154,6 +194,8 @@ class Robot(RobotParts):
         The arguments are those of :func:`robokin.io.urdf.parts_from_urdf`, which
         reads the parts.
         """
+        from robokin.io.urdf import parts_from_urdf
+
         return cls.from_parts(parts_from_urdf(path, base_link, tip_link, package_map,
                                               **options))
 
@@ -169,6 +211,8 @@ class Robot(RobotParts):
 
         The arguments are those of :func:`robokin.io.urdf_export.urdf_from_robot`.
         """
+        from robokin.io.urdf_export import urdf_from_robot
+
         return urdf_from_robot(self, name=name, velocity=velocity, effort=effort,
                                mesh_uri=mesh_uri)
 
@@ -177,6 +221,10 @@ class Robot(RobotParts):
 
         Bounded: at most :data:`robokin._html.MAX_ROWS` rows per table.
         """
+        from robokin import _html
+        from robokin.io.robot_files import document_from_robot
+        from robokin.io.robot_tables import MM_PER_M, joint_rows_mm_deg
+
         doc = document_from_robot(self)
         keys, rows = joint_rows_mm_deg(doc)
         scale = np.where(self.is_revolute, 180.0 / np.pi, MM_PER_M)
@@ -254,6 +302,7 @@ class Robot(RobotParts):
         q_near: npt.ArrayLike | None = None,
         method: Literal["auto", "analytic", "numeric"] = "auto",
         *,
+        fixed: Mapping[str, npt.ArrayLike] | None = None,
         space: Space = "joint",
         **options: Any,
     ) -> SolutionSet:
@@ -265,6 +314,11 @@ class Robot(RobotParts):
                 singularity and by ``.nearest``; optional.
             method: ``"auto"`` (closed form when the arm has one, else numeric),
                 ``"analytic"`` or ``"numeric"``.
+            fixed: Joints held at given values, ``{name: value}`` [rad, m]: a
+                number, or an array broadcasting with the poses (a 7R arm with one
+                joint held: the remaining 6R chain solved completely; see
+                :func:`robokin.kinematics.ik.fixed.solve_fixed`). None: no joint
+                held.
             space: ``"actuator"`` returns motor coordinates (and takes ``q_near``
                 in motor coordinates).
             **options: Passed to the solver.
@@ -272,20 +326,30 @@ class Robot(RobotParts):
         Returns:
             A :class:`~robokin.kinematics.ik.solutions.SolutionSet`.
         """
-        if space == "actuator":
-            if q_near is not None:
-                q_near = self.joints_from_actuators(q_near)
-            arm = self.arm
-            sols = _ik_solve(arm, T, q_near=q_near, method=method, **options)
-            out = sols.to_actuator_space(arm)
-            if self.actuators is not None and out.is_revolute.any():
-                # Motor angles never wrap: a motor turn through a reduction is not a
-                # whole joint turn, so 2*pi-shifted motor values are other poses.
-                out = _replace(out, is_revolute=np.zeros(out.n, bool))
-            return out
-        if space != "joint":
+        if fixed is not None:
+            if (q_near is None and not options and space == "joint"
+                    and (method == "auto" or method == "analytic")):
+                # hot path: one pose, one joint at a number, a closed form for it
+                # (None where that is not so: the general path below checks and
+                # raises)
+                out = _held_single()(self.arm, T, fixed)
+                if out is not None:
+                    return out
+            options["fixed"] = fixed
+        if space == "joint":
+            return _ik_solve()(self.arm, T, q_near=q_near, method=method, **options)
+        if space != "actuator":
             raise InputError("space", f"expected 'joint' or 'actuator', got {space!r}")
-        return _ik_solve(self.arm, T, q_near=q_near, method=method, **options)
+        if q_near is not None:
+            q_near = self.joints_from_actuators(q_near)
+        arm = self.arm
+        sols = _ik_solve()(arm, T, q_near=q_near, method=method, **options)
+        out = sols.to_actuator_space(arm)
+        if self.actuators is not None and out.is_revolute.any():
+            # Motor angles never wrap: a motor turn through a reduction is not a
+            # whole joint turn, so 2*pi-shifted motor values are other poses.
+            out = _replace(out, is_revolute=np.zeros(out.n, bool))
+        return out
 
     def ik_near(
         self,
@@ -314,7 +378,7 @@ class Robot(RobotParts):
             An :class:`~robokin.kinematics.ik.numeric.IKResult`: ``.q`` (..., n),
             ``.success`` (...), ``.reason``.
         """
-        return _solve_near(self.arm, T, q_near, method=method, **options)
+        return _solve_near()(self.arm, T, q_near, method=method, **options)
 
     def self_motion(self, T: npt.ArrayLike, parameter: str = "auto") -> SelfMotion:
         """The self-motion manifold of one pose of a 7R arm: every branch, exact limits.
@@ -331,7 +395,9 @@ class Robot(RobotParts):
             ``.interval_branch``, ``.crossings``, ``.singular``, ``.best(criterion)``,
             ``.nearest(q)``.
         """
-        return _self_motion(self.arm, T, parameter, dispatch=_ik_solve)
+        from robokin.kinematics.ik.self_motion import self_motion
+
+        return self_motion(self.arm, T, parameter, dispatch=_ik_solve())
 
     # ---------------------------------------------------------------- actuators
     def actuators_from_joints(self, q: npt.ArrayLike) -> np.ndarray:

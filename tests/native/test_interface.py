@@ -15,6 +15,7 @@ import re
 
 import pytest
 
+import robokin
 from robokin import _native
 from robokin._native._interface import Kernels
 
@@ -83,8 +84,10 @@ def test_each_function_takes_the_parameters_its_c_docstring_names(name):
 def test_the_packed_layout_constants_match_every_compiled_copy():
     # model/ does not import the kernels (layers point one way): the constants it
     # writes into ChainArrays.packed must equal chain.h's in every built copy
+    from robokin._native import _declare
     from robokin.model import chain_arrays
 
+    packed_tag = robokin.load("ur5").chain.arrays.packed[0]
     for copy in _copies().values():
-        assert copy.LAYOUT_TAG == chain_arrays.LAYOUT_TAG
+        assert copy.LAYOUT_TAG == _declare.LAYOUT_TAG == packed_tag
         assert copy.MAX_JOINTS == chain_arrays.MAX_JOINTS

@@ -30,9 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from robokin._native._declare import LAYOUT_TAG, PACKED_LAYOUT
-
-__all__ = ["LAYOUT_TAG", "MAX_JOINTS", "ChainArrays", "chain_arrays"]
+__all__ = ["MAX_JOINTS", "ChainArrays", "chain_arrays"]
 
 MAX_JOINTS = 32  # chain joints and coordinates the kernels take; chain.h MAXJ
 
@@ -222,6 +220,9 @@ def chain_arrays(
 
 def _pack(parts: Mapping[str, npt.ArrayLike], nc: int, n: int, identity: bool) -> F64:
     """The sections in ``PACKED_LAYOUT``'s order after the head, each of its shape."""
+    # imported here, not by ``import robokin``: _declare declares every kernel (~13 ms)
+    from robokin._native._declare import LAYOUT_TAG, PACKED_LAYOUT
+
     dims = {"nc": nc, "n": n, "nc + 1": nc + 1}
     chunks = [np.array([LAYOUT_TAG, nc, n, float(identity)])]
     if set(parts) != {s.name for s in PACKED_LAYOUT}:  # pragma: no cover - a coding error

@@ -216,3 +216,66 @@ def test_held_closed_form_solves_a_pose_rounded_off_so3(eps):
         dp, dr = pose_errors(robot.fk(q), T)
         assert dp < 1e-11 and dr < 2 * eps + 1e-11
     assert any(np.allclose(q, Q0, atol=1e-8) for q in sols)
+
+
+def test_the_one_pose_hot_path_equals_the_general_path_at_special_values():
+    """``robot.ik(T, fixed={name: x})`` (the hot path) == the checked batch path.
+
+    Oracle: the same pose solved as a batch of one with the value as an array (the
+    general path: ``check_rigid``, the batch kernel) gives the same rows, flags,
+    slots, status and method, bit for bit, on configurations drawn from the special
+    values (0, +-pi/2, pi, 1e-9..1e-6, the limits) and uniform ones; and the
+    generating configuration is among the rows wherever the 6 x 6 Jacobian is
+    non-singular.
+    """
+    from special_values import draw_configurations
+
+    panda = robokin.load("panda")
+    q = draw_configurations(panda, np.random.default_rng(23), 60)
+    T = panda.fk(q)
+    for j in (3, 5, 6):
+        name = panda.joint_names[j]
+        for i in range(len(q)):
+            one = panda.ik(T[i], fixed={name: float(q[i, j])})
+            ref = panda.ik(T[i][None], fixed={name: q[i:i + 1, j]})[0]
+            for a, b in [(one.q, ref.q), (one.valid, ref.valid),
+                         (one.within_limits, ref.within_limits),
+                         (one.singular, ref.singular), *((one.branches[k], ref.branches[k])
+                                                         for k in ref.branches)]:
+                np.testing.assert_array_equal(a, b)
+            assert one.status == ref.status and one.method == ref.method
+            assert one.info["held"] == {name: float(q[i, j])}
+            J = np.delete(panda.jacobian(q[i]), j, axis=1)
+            if np.linalg.svd(J, compute_uv=False)[-1] > 1e-4:
+                gap = np.abs((one.q[one.valid] - q[i] + np.pi) % (2 * np.pi) - np.pi)
+                assert gap.max(axis=1).min() < 1e-8, (name, q[i])
+
+
+def test_the_one_pose_hot_path_takes_no_detour():
+    """One pose, one joint held at a number: six Python frames, no re-dispatch.
+
+    Oracle: the Python functions entered during the call (``sys.setprofile``). The
+    path went robot.ik -> dispatch.solve -> solve_fixed -> arm_of -> ... (10 frames,
+    2.5 us of the 5.3-5.6 us call on the developers' machine); now robot.ik goes to
+    ``solve_held_single`` directly. A bad argument still takes the checked path
+    (``test_bad_held_joints_are_named``).
+    """
+    import sys
+
+    panda = robokin.load("panda")
+    T = panda.fk(Q0)
+    panda.ik(T, fixed={"joint7": Q0[6]})  # set-up on first use
+    entered: list[str] = []
+
+    def profile(frame, event, arg):
+        if event == "call":
+            entered.append(frame.f_code.co_name)
+
+    sys.setprofile(profile)
+    try:
+        sols = panda.ik(T, fixed={"joint7": Q0[6]})
+    finally:
+        sys.setprofile(None)
+    assert sols.method == "analytic:pieper (joint7 held)" and len(sols) >= 1
+    assert "solve" not in entered and "solve_fixed" not in entered, entered
+    assert len(entered) <= 6, entered

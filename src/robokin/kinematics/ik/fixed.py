@@ -82,19 +82,10 @@ def solve_fixed(
             value, values that do not broadcast with the poses, or every joint held.
     """
     robot = arm_of(robot)
-    if (q_near is None and not options and type(fixed) is dict and len(fixed) == 1
-            and type(T) is np.ndarray and method != "numeric"):
-        # hot path: one pose, one joint held at a number, a closed form (the compiled
-        # call checks T's type, shape and rigidity, and that the value is finite)
-        ((name, value),) = fixed.items()
-        held = _held_solvers(robot).get(name)
-        if held is not None and type(value) in _NUMBERS:
-            out: SolutionSet | None = held.single(T, value, None)
-            # "ok" has rows (read first: counting them costs a numpy reduction); no
-            # row for a rotation off SO(3) by rounding: project it and solve below
-            if out is not None and (out.status.item() == "ok" or len(out)
-                                    or check_rigid(T, "T") is T):
-                return out
+    if q_near is None and not options and method != "numeric":
+        out = solve_held_single(robot, T, fixed)
+        if out is not None:
+            return out
     names = list(robot.joint_names)
     if not isinstance(fixed, Mapping) or not fixed:
         raise InputError("fixed", f"expected a mapping of joint names to values, e.g. "
@@ -149,6 +140,42 @@ def solve_fixed(
                             method=method, **options)
             parts.append((rows, sols))
     return _assemble(robot, lead, idx, keep, V, parts, dict(zip(fixed, values)))
+
+
+def solve_held_single(robot: Arm, T: object, fixed: object) -> SolutionSet | None:
+    """The hot path of ``robot.ik(T, fixed={name: x})``: one pose, one joint at a number.
+
+    One compiled call (it checks T's type, shape and rigidity, and that the value is
+    finite) where the arm has a closed form with that joint held; no copy of the
+    arguments, no ``q_near``, default options (the caller checks those).
+
+    Args:
+        robot: The arm.
+        T: The pose (4, 4) [m], if it is one.
+        fixed: ``{joint name: value}`` [rad], if it is one.
+
+    Returns:
+        The set, or None where this path does not apply (anything else: not a
+        float64 (4, 4) rigid pose, a value that is not a finite number, a joint
+        without a held closed form; or no solution for a rotation off SO(3) by
+        rounding, which :func:`solve_fixed` projects and solves): the caller then
+        takes :func:`solve_fixed`, which raises the detailed error.
+    """
+    if type(fixed) is not dict or len(fixed) != 1 or type(T) is not np.ndarray:
+        return None
+    ((name, value),) = fixed.items()
+    if type(value) not in _NUMBERS:
+        return None
+    held = robot.derived(HELD_SOLVERS).get(name)
+    if held is None:
+        return None
+    out: SolutionSet | None = held.single(T, value, None)
+    # "ok" has rows (read first: counting them costs a numpy reduction); no row for a
+    # rotation off SO(3) by rounding: None, and solve_fixed projects it and solves
+    if out is not None and (out.status.item() == "ok" or len(out)
+                            or check_rigid(T, "T") is T):
+        return out
+    return None
 
 
 def _coincident_parts(robot: Arm, j: int, T: np.ndarray, v: np.ndarray,

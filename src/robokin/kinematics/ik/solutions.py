@@ -140,9 +140,18 @@ class SolutionSet:
         not valid already NaN (the compiled closed forms write them so).
         """
         self = object.__new__(cls)
-        self.__dict__.update(q=q, valid=valid, is_revolute=is_revolute, limits=limits,
-                             flags=flags, branches=branches, status=status,
-                             method=method, error=error, info=info)
+        # item by item: ~75 ns less than one update(**fields) (no keyword dict)
+        d = self.__dict__
+        d["q"] = q
+        d["valid"] = valid
+        d["is_revolute"] = is_revolute
+        d["limits"] = limits
+        d["flags"] = flags
+        d["branches"] = branches
+        d["status"] = status
+        d["method"] = method
+        d["error"] = error
+        d["info"] = info
         return self
 
     # ------------------------------------------------------------------ basics

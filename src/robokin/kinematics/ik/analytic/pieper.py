@@ -362,11 +362,11 @@ def make_single(chain: Chain, params: np.ndarray, *, method: str,
         code, Q, valid, sing, inside = solve1(T, params, x, qn)
         if code >= too_far or Q is None or valid is None or sing is None or inside is None:
             return None
-        out = dict(info)
+        out = info.copy()  # each set its own dicts (a caller may change them)
         if held is not None:
             out["held"] = {held: x}
         return trusted(Q, valid, is_rev, limits,
-                       {"within_limits": inside, "singular": sing}, dict(labels),
+                       {"within_limits": inside, "singular": sing}, labels.copy(),
                        texts[code], method, None, out)
 
     return single
