@@ -65,11 +65,12 @@ from robokin.kinematics.ik.self_motion_intervals import (
     _state_changes,
     _within,
 )
+from robokin.kinematics.ik.swivel import SwivelArm
 from robokin.spatial import wrap_angle as _wrap
 
 __all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SelfMotionSetup", "SingularPoint",
            "auto_parameter",
-           "nearest_on_manifold", "parameter_values", "self_motion"]
+           "nearest_on_manifold", "parameter_values", "self_motion", "swivel_nearest"]
 
 #: Checking-grid values of a continued family.
 _CONTINUED_GRID = 181
@@ -199,6 +200,9 @@ class SelfMotion:
     def nearest(self, q_near: npt.ArrayLike, *, samples: int = 64) -> ManifoldPoint | None:
         """The in-limit configuration nearest ``q_near`` (n,) (2 pi wrapped distance)."""
         qn = check_finite(check_joints(q_near, self.limits.shape[0], "q_near"), "q_near")
+        fam = self._family
+        if isinstance(fam, _SwivelFamily) and not fam.reference:
+            return _swivel_nearest(fam.arm, self.T, qn)
 
         def score(q: np.ndarray) -> np.ndarray:
             out: np.ndarray = -np.linalg.norm(_wrap(q - qn), axis=-1)
@@ -277,6 +281,8 @@ def nearest_on_manifold(robot: ArmSource, T: np.ndarray, q_near: np.ndarray, *,
     """
     arm = arm_of(robot)
     fam = _family(arm, T, "auto", dispatch)
+    if isinstance(fam, _SwivelFamily):
+        return _swivel_nearest(fam.arm, fam.T, q_near)
     k = fam.k
     lo, hi = fam.domain
     # every branch over the whole range, and a window around q_near's own parameter
@@ -296,6 +302,29 @@ def nearest_on_manifold(robot: ArmSource, T: np.ndarray, q_near: np.ndarray, *,
 
     return _maximise(fam, np.asarray(arm.limits, dtype=np.float64), intervals,
                      np.tile(np.arange(k), 2), score, samples)
+
+
+def _swivel_nearest(arm: SwivelArm, T: np.ndarray, q_near: np.ndarray) -> ManifoldPoint | None:
+    """The compiled nearest point of one pose (``SwivelArm.nearest``), or None."""
+    q, psi, slot, dist, found = arm.nearest(T[None], q_near[None])
+    if not found[0]:
+        return None
+    return ManifoldPoint(q[0], float(psi[0]), int(slot[0]), -float(dist[0]))
+
+
+def swivel_nearest(robot: ArmSource, T: np.ndarray, q_near: np.ndarray) -> np.ndarray | None:
+    """The in-limit configurations (m, 7) of poses T (m, 4, 4) nearest ``q_near`` (m, 7).
+
+    The compiled search on the exact swivel intervals (``SwivelArm.nearest``; NaN
+    rows where no part of a manifold is inside the limits); None when the arm is
+    not SRS (then :func:`nearest_on_manifold` per pose).
+    """
+    arm = _setup(arm_of(robot)).swivel
+    if arm is None:
+        return None
+    q, _, _, _, found = arm.nearest(T, q_near)
+    q[~found] = np.nan
+    return q
 
 
 def auto_parameter(robot: ArmSource) -> str | None:
