@@ -863,7 +863,8 @@ static PyObject *swivel_manifold_body(const swivel_manifold_args *a)
 
 #define SM_NEAR_GRID 32 /* swivel values of the coarse grid per elbow root */
 #define SM_NEAR_KEEP 3  /* local minima of the samples refined (the best by value) */
-#define SM_NEAR_XTOL 1e-8 /* Brent's tolerance on psi [rad] */
+#define SM_NEAR_XTOL 1e-8
+#define SM_NEAR_TRY 8   /* answers tried, nearest first, until one polishes inside the limits */ /* Brent's tolerance on psi [rad] */
 
 /* The squared 2 pi wrapped distance of row q (7) to qn */
 static double sm_dist2(const double *q, const double *qn)
@@ -952,14 +953,14 @@ typedef struct {
     int e, b;
 } SmMin;
 
-/* Keeps the SM_NEAR_KEEP smallest local minima in best (sorted, *n of them) */
-static void sm_keep(SmMin *best, int *n, SmMin m)
+/* Keeps the cap smallest of the points offered in best (sorted, *n of them) */
+static void sm_keep(SmMin *best, int *n, int cap, SmMin m)
 {
     int i;
-    if (*n < SM_NEAR_KEEP) {
+    if (*n < cap) {
         i = (*n)++;
     } else {
-        i = SM_NEAR_KEEP - 1;
+        i = cap - 1;
         if (!(m.g < best[i].g))
             return;
     }
@@ -987,8 +988,8 @@ static int sm_near1(const SmArm *a, const double *T, const double *qn, double *q
     const double h = 2.0 * M_PI / SM_NEAR_GRID;
     SmMin best[SM_NEAR_KEEP];
     int nbest = 0;
-    double end_g = INFINITY, end_psi = 0.0;
-    int end_e = -1, end_b = -1;
+    SmMin tries[SM_NEAR_TRY]; /* the nearest interval ends and refined minima */
+    int ntries = 0;
     for (int e = 0; e < 2; e++) {
         SmCand c[64];
         int nc = sm_candidates(a, &f, e, c);
@@ -1025,54 +1026,44 @@ static int sm_near1(const SmArm *a, const double *T, const double *qn, double *q
                 t[n] = hi;
                 g[n++] = sm_branch_dist(a, &f, e, b, hi, qn);
                 for (int k = 0; k < n; k += n - 1)
-                    if (g[k] < end_g) {
-                        end_g = g[k];
-                        end_psi = t[k];
-                        end_e = e;
-                        end_b = b;
-                    }
+                    if (g[k] < INFINITY)
+                        sm_keep(tries, &ntries, SM_NEAR_TRY, (SmMin){g[k], t[k], t[k], t[k], e, b});
                 for (int k = 0; k < n; k++) {
                     double gl = k > 0 ? g[k - 1] : INFINITY, gr = k + 1 < n ? g[k + 1] : INFINITY;
                     if (g[k] < INFINITY && g[k] <= gl && g[k] <= gr)
-                        sm_keep(best, &nbest, (SmMin){g[k], t[k], t[k > 0 ? k - 1 : 0],
+                        sm_keep(best, &nbest, SM_NEAR_KEEP, (SmMin){g[k], t[k], t[k > 0 ? k - 1 : 0],
                                                       t[k + 1 < n ? k + 1 : n - 1], e, b});
                 }
             }
     }
-    double bg = end_g, bpsi = end_psi;
-    int be = end_e, bb = end_b;
     for (int i = 0; i < nbest; i++) {
-        double fx = best[i].g;
-        double x = sm_brent(a, &f, best[i].e, best[i].b, qn, best[i].lo, best[i].hi, best[i].psi,
-                            &fx);
-        if (fx < bg) {
-            bg = fx;
-            bpsi = x;
-            be = best[i].e;
-            bb = best[i].b;
-        }
+        SmMin m = best[i];
+        m.psi = sm_brent(a, &f, m.e, m.b, qn, m.lo, m.hi, m.psi, &m.g);
+        sm_keep(tries, &ntries, SM_NEAR_TRY, m);
     }
-    if (be < 0)
-        return 0;
-    double q[4][7];
-    int ok[4], sg[4];
-    sm_configs(a, &f, be, bpsi, q, ok, sg);
+    /* nearest first, the first whose row polishes to the pose inside the limits (next
+     * to an aligned point the polish may move a row out of them) */
     m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
     v3 pT = {T[3], T[7], T[11]};
-    if (!ok[bb] || !sm_polish(a, &RT, pT, q[bb]))
-        return 0;
-    for (int j = 0; j < 7; j++) {
-        double v = q[bb][j];
-        if (!sm_inside_joint(a, j, v))
-            return 0;
-        qout[j] = fmin(fmax(v, a->lo[j]), a->hi[j]);
+    for (int i = 0; i < ntries; i++) {
+        double q[7];
+        if (!sm_branch_row(a, &f, tries[i].e, tries[i].b, tries[i].psi, q) ||
+            !sm_polish(a, &RT, pT, q))
+            continue;
+        int in = 1;
+        for (int j = 0; j < 7 && in; j++)
+            in = sm_inside_joint(a, j, q[j]);
+        if (!in)
+            continue;
+        for (int j = 0; j < 7; j++)
+            qout[j] = fmin(fmax(q[j], a->lo[j]), a->hi[j]);
+        *psi_out = wrap_pi(tries[i].psi);
+        *slot_out = 4 * tries[i].e + tries[i].b;
+        *d_out = sqrt(sm_dist2(qout, qn));
+        return 1;
     }
-    *psi_out = wrap_pi(bpsi);
-    *slot_out = 4 * be + bb;
-    *d_out = sqrt(sm_dist2(qout, qn));
-    return 1;
+    return 0;
 }
-
 typedef struct {
     const double *P, *T, *qn;
     double *q, *psi, *dist;
