@@ -116,10 +116,10 @@ def run_ssik_peer(name, robot, q, T, repeat):
         arm.self_motion(TS[0])
         charts = "charts available"
     except NotImplementedError as exc:
-        charts = f"no charts ({str(exc).split('.')[0]})"
+        charts = f"no charts ({str(exc).split('. ')[0]})"
 
     def solve_all():
-        return [np.array([np.asarray(s, dtype=float) for s in arm.solve(t)]).reshape(-1, 7)
+        return [np.array([np.asarray(s.q, dtype=float) for s in arm.solve(t)]).reshape(-1, 7)
                 for t in TS]
 
     rows = [r - off for r in solve_all()]
