@@ -402,13 +402,17 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
     Ta = check_rigid(T, "T")
     if Ta.shape != (4, 4):
         raise InputError("T", f"self_motion takes one pose (4, 4), got {Ta.shape}")
-    fam = _family(robot, Ta, parameter, dispatch, reference)
     limits = np.asarray(robot.limits, dtype=np.float64)
-    if isinstance(fam, _SwivelFamily) and not reference:
-        intervals, owner, points = fam.exact()
+    # the compiled swivel (an SRS arm's "auto"): no family choice, no per-call lists
+    swivel = (_setup(robot).swivel if robot.n == 7 and parameter in ("auto", "swivel")
+              and not reference else None)
+    if swivel is not None:
+        sw = _SwivelFamily(swivel, Ta, robot)
+        intervals, owner, points = sw.exact()
         return SelfMotion(Ta, "swivel", None, _SWIVEL_DOMAIN.copy(), True, 8, intervals, owner,
                           "swivel closed form (SRS), compiled", {"bisected": 0, "grid": 0},
-                          fam, limits, points)
+                          sw, limits, points)
+    fam = _family(robot, Ta, parameter, dispatch, reference)
     marks = _exact_points(robot, fam, limits)
     if isinstance(fam, _ContinuedFamily):
         grid = min(int(grid), _CONTINUED_GRID)  # each value is a general-6R solve
