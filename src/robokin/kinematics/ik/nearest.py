@@ -61,7 +61,8 @@ def solve_near(
             on 7R arms the numeric descent from ``q_near``), ``"analytic"``,
             ``"numeric"`` or ``"self_motion"`` (7R arms whose self-motion has a
             closed form: the in-limit point of the whole manifold nearest
-            ``q_near``, milliseconds per pose; see ``docs/ik.md``).
+            ``q_near``: compiled on SRS arms, ~0.1 ms per pose; sampled on
+            the others, milliseconds; see ``docs/ik.md``).
         **options: Options of the numeric solver
             (:func:`robokin.kinematics.ik.numeric.solve`, e.g. ``mask``, ``tol``,
             ``max_restarts``); giving any selects it.
