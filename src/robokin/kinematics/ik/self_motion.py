@@ -198,7 +198,12 @@ class SelfMotion:
         return self._maximise(score, samples)
 
     def nearest(self, q_near: npt.ArrayLike, *, samples: int = 64) -> ManifoldPoint | None:
-        """The in-limit configuration nearest ``q_near`` (n,) (2 pi wrapped distance)."""
+        """The in-limit configuration nearest ``q_near`` (n,) (2 pi wrapped distance).
+
+        On the compiled swivel (SRS arms) the kernel's search on the exact
+        intervals (``SwivelArm.nearest``; ``samples`` is not used); elsewhere
+        ``samples`` values per interval, then zooming in (as :meth:`best`).
+        """
         qn = check_finite(check_joints(q_near, self.limits.shape[0], "q_near"), "q_near")
         fam = self._family
         if isinstance(fam, _SwivelFamily) and not fam.reference:
