@@ -28,6 +28,12 @@ joints 2, 4, 6, the continuous joints 1, 3, 5, 7 taken as +-180 deg; its 11.8 an
 continued). The last two take ``--slow-poses`` poses (seconds per pose). Every time
 is given as wall time and as process CPU time (the machine is shared).
 
+Peers on the last two arms: ssik 8.2 built from the same URDF (``from_urdf``) and
+from the same DH table (``from_dh``; its joint angles are ours plus the theta
+offsets); both dispatch to ``seven_r.srs_polished`` (an approximate class: no
+charts), so its ``solve(T)`` sample is scored (set-up time printed: ssik caches its
+per-arm preparation under ``~/.cache/ssik`` itself). geofikpy is Panda-only.
+
 Run: ``python benchmarks/bench_self_motion.py [--poses 200] [--slow-poses 5]``.
 """
 
@@ -74,6 +80,52 @@ def arms(slow: int) -> list[tuple[str, robokin.Robot, int | None]]:
         print("iiwa14 URDF: rtb-data not installed")
     out.append(("gen3-like", gen3_like(), slow))
     return out
+
+
+#: The Gen3-like arm's DH theta offsets (ssik's from_dh has none: its q = ours + these).
+GEN3_THETA = np.array([0.0] + [np.pi] * 6)
+
+
+def ssik_arm(name: str, robot: robokin.Robot):
+    """(ssik Manipulator, q offset ours -> ssik, base/tool correction X, build seconds)."""
+    import ssik
+
+    t0 = time.perf_counter()
+    if name == "iiwa14 URDF":
+        import rtbdata
+
+        arm = ssik.Manipulator.from_urdf(str(Path(rtbdata.__file__).parent / IIWA_URDF))
+        off = np.zeros(7)
+    else:
+        d = [-0.2848, -0.0118, -0.4208, -0.0128, -0.3143, 0.0, -0.1674]
+        arm = ssik.Manipulator.from_dh([np.pi / 2] * 6 + [np.pi], [0.0] * 7, d,
+                                       limits=robot.limits + GEN3_THETA[:, None])
+        off = GEN3_THETA
+    arm.prepare()  # the per-arm set-up (cached by ssik on disk where it has one)
+    built = time.perf_counter() - t0
+    q0 = np.array([0.1, -0.3, 0.2, -1.0, 0.3, 0.8, 0.7])
+    X = np.linalg.inv(robot.fk(q0)) @ np.asarray(arm.fk(q0 + off))
+    return arm, off, X, built
+
+
+def run_ssik_peer(name, robot, q, T, repeat):
+    """ssik on a non-Panda arm: its charts where it has them, else its solve(T) sample."""
+    arm, off, X, built = ssik_arm(name, robot)
+    TS = T @ X
+    try:
+        arm.self_motion(TS[0])
+        charts = "charts available"
+    except NotImplementedError as exc:
+        charts = f"no charts ({str(exc).split('. ')[0]})"
+
+    def solve_all():
+        return [np.array([np.asarray(s.q, dtype=float) for s in arm.solve(t)]).reshape(-1, 7)
+                for t in TS]
+
+    rows = [r - off for r in solve_all()]
+    wall, cpu = cpu_and_wall(solve_all, repeat)
+    return rows, {"solver": arm.solver_name, "charts": charts, "setup": built,
+                  "solve": (wall / len(T), cpu / len(T))}
 
 
 def parameter_of(sm, q):
@@ -139,6 +191,24 @@ def main(n: int = 200, repeat: int = 3, seed: int = 0, slow: int = 5) -> None:
             krows, kman = run_kernels(robot, T, repeat)
             print(f"{name:11s} kernels, one batch: swivel_rows {us(krows)} per (pose, value),"
                   f" swivel_manifold {us(kman)} per pose")
+            qn = np.clip(q + 0.3, robot.limits[:, 0], robot.limits[:, 1])
+            near = cpu_and_wall(lambda: robot.ik_near(T, qn, method="self_motion"), repeat)
+            one = cpu_and_wall(lambda: [robot.ik_near(t, v, method="self_motion")
+                                        for t, v in zip(T, qn, strict=True)], repeat)
+            print(f"{name:11s} ik_near(method='self_motion'), q_near = q0 + 0.3: one batch "
+                  f"{us([x / len(T) for x in near])}, one pose per call "
+                  f"{us([x / len(T) for x in one])} per pose")
+        if name in ("iiwa14 URDF", "gen3-like"):
+            try:
+                prow, info = run_ssik_peer(name, robot, q, T, 1)
+            except ImportError as exc:
+                print(f"{name:11s} ssik: not installed ({exc})")
+            else:
+                rec, wrong, worst, total = score(robot, q, T, prow)
+                print(f"{name:11s} ssik [{info['solver']}, {info['charts']}; set-up "
+                      f"{info['setup']:.1f} s]: solve(T) recovered {rec}/{count}, wrong {wrong} "
+                      f"of {total} rows (max error {worst:.1e}); {us(info['solve'])} per pose")
+            print(f"{name:11s} geofikpy: not applicable (its closed forms are the Panda's only)")
         if name != "panda":
             continue
         for peer, fn in (("ssik charts", run_ssik), ("geofikpy q7", run_geofik)):

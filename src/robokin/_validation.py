@@ -145,6 +145,7 @@ check_poses_fast = check_transform
 #: ``R^T R - I``) is projected onto SO(3) by :func:`check_rigid`; below it the pose
 #: is used as given (forward kinematics' own rotations are within ~1e-15).
 ROTATION_EXACT = 1e-14
+_EYE3 = np.eye(3)
 
 
 def check_rigid(T: npt.ArrayLike, name: str = "T") -> np.ndarray:
@@ -173,7 +174,7 @@ def check_rigid(T: npt.ArrayLike, name: str = "T") -> np.ndarray:
     """
     T = check_transform(T, name)
     R = T.reshape(-1, 4, 4)[:, :3, :3]
-    err = np.abs(np.einsum("mji,mjk->mik", R, R) - np.eye(3)).max(axis=(-2, -1))
+    err = np.abs(np.swapaxes(R, -1, -2) @ R - _EYE3).max(axis=(-2, -1))  # R^T R - I
     off = err > ROTATION_EXACT
     if not off.any():
         return T

@@ -510,6 +510,16 @@ SELF_MOTION = Group("self_motion.c", kernels=(
                    "SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] "
                    "(N, SM_MAXP, 4) with counts (N,).",
            checks=(Check("sm_params_ok(a->params)", "params is not a swivel parameter vector"),)),
+    Kernel("swivel_near", (Arr("params", "f64", ("SM_N_PARAMS",)), Arr("T", "f64", POSE),
+                           Arr("q_near", "f64", ("N", 7)), Arr("q", "f64", ("N", 7), out=True),
+                           Arr("psi", "f64", ("N",), out=True),
+                           Arr("slot", "i64", ("N",), out=True),
+                           Arr("dist", "f64", ("N",), out=True),
+                           Arr("found", "bool", ("N",), out=True)),
+           "None", "Per pose: the in-limit configuration nearest q_near (N, 7) (2 pi wrapped "
+                   "distance) on the exact swivel intervals: q (N, 7), its psi, slot and "
+                   "distance (N,); found (N,) false (q NaN) where no part is inside.",
+           checks=(Check("sm_params_ok(a->params)", "params is not a swivel parameter vector"),)),
 ), constants=_consts(
     "H O S W MR MT SIGN OFFSET LO HI REF TAG N_PARAMS MAXI MAXP KIND_LOWER KIND_UPPER "
     "KIND_ALIGNED KIND_FOLD", "SM_", "SM_") + (Const("SM_TAG_VALUE", "SM_TAG_VALUE", "float"),),

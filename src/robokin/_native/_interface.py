@@ -651,6 +651,20 @@ class Kernels(Protocol):
     ) -> None:
         """Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,)."""
 
+    def swivel_near(
+        self,
+        params: F64,
+        T: F64,
+        q_near: F64,
+        q: F64,
+        psi: F64,
+        slot: I64,
+        dist: F64,
+        found: Bools,
+        /,
+    ) -> None:
+        """Per pose: the in-limit configuration nearest q_near (N, 7) (2 pi wrapped distance) on the exact swivel intervals: q (N, 7), its psi, slot and distance (N,); found (N,) false (q NaN) where no part is inside."""
+
     def six_r_reach(
         self,
         params: F64,

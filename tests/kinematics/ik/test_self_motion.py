@@ -357,3 +357,28 @@ def test_the_self_motion_setup_is_typed_derived_state_of_the_arm():
         assert setup.parameter_known is False or setup.parameter == sm.parameter
         other = Arm(robot.chain)
         assert other.derived(SELF_MOTION) is not setup
+
+
+def test_swivel_records_are_the_kernels_points_built_when_first_read():
+    """Oracle: the compiled kernel's own point rows ``[psi, branch, joint, kind]``
+    (``SwivelArm.manifold``): every limit row is one LimitCrossing, every other row one
+    SingularPoint, in order; the records are made on first access and kept (the same
+    tuple after). (Before: the records were built in every call; no ``_records``.)"""
+    from robokin.kinematics.ik.self_motion_families import _setup
+
+    arm = _setup(SRS.arm).swivel
+    kinds = ("lower", "upper", "aligned axes", "fold")
+    rng = np.random.default_rng(3)
+    for q0 in rng.uniform(SRS.limits[:, 0], SRS.limits[:, 1], (5, 7)):
+        T = SRS.fk(q0)
+        sm = SRS.self_motion(T)
+        assert sm._records is None
+        _, _, pts, npts = arm.manifold(T[None])
+        rows = pts[0, :npts[0]]
+        limit = rows[:, 3] <= 1
+        got = [(c.t, c.branch, c.joint, c.limit) for c in sm.crossings]
+        assert got == [(t, int(b), int(j), kinds[int(k)]) for t, b, j, k in rows[limit]]
+        got = [(p.t, p.branch, p.kind) for p in sm.singular]
+        assert got == [(t, int(b), kinds[int(k)]) for t, b, _, k in rows[~limit]]
+        assert len(got) + len(sm.crossings) == npts[0] > 0
+        assert sm.crossings is sm.crossings and sm._records is not None

@@ -95,6 +95,7 @@ static const KOpt opts_sp_ranges[] = {{SP_VERTEX_TRIES, 1, 1, 0.0, 1000000000000
     X(plan_simplify, "plan_simplify(model, path, margin, opts, seed, exact) -> tuple[F64, tuple[int, int, int, int, int, int]]: Shortcuts, then sharp corners cut, of path (K, n); (path, counters).") \
     X(swivel_rows, "swivel_rows(params, T, psi, Q, valid, sing) -> None: Every SRS configuration of poses T (N, 4, 4) at swivel angles psi (N, m): Q (N, m, 8, 7), valid, singular (N, m, 8).") \
     X(swivel_manifold, "swivel_manifold(params, T, iv, niv, pts, npts) -> None: Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,).") \
+    X(swivel_near, "swivel_near(params, T, q_near, q, psi, slot, dist, found) -> None: Per pose: the in-limit configuration nearest q_near (N, 7) (2 pi wrapped distance) on the exact swivel intervals: q (N, 7), its psi, slot and distance (N,); found (N,) false (q NaN) where no part is inside.") \
     X(six_r_reach, "six_r_reach(params, T, packed, with_w, counts, best) -> None: A reach map's 6R closed form in one pass, T (G voxels, K targets each).")
 
 /* per kernel, the checked arguments and the bound shape symbols (a->N) */
@@ -146,6 +147,7 @@ typedef struct { PyObject *model; const double *start; const double *goals; cons
 typedef struct { PyObject *model; const double *path; const double *margin; const double *opts; unsigned long long seed; PyObject *exact; union { struct { npy_intp K, n, P; }; npy_intp sym[3]; }; } plan_simplify_args; /* plan_path.c */
 typedef struct { const double *params; const double *T; const double *psi; double *Q; npy_bool *valid; npy_bool *sing; union { struct { npy_intp N, m; }; npy_intp sym[2]; }; } swivel_rows_args; /* self_motion.c */
 typedef struct { const double *params; const double *T; double *iv; long long *niv; double *pts; long long *npts; union { struct { npy_intp N; }; npy_intp sym[1]; }; } swivel_manifold_args; /* self_motion.c */
+typedef struct { const double *params; const double *T; const double *q_near; double *q; double *psi; long long *slot; double *dist; npy_bool *found; union { struct { npy_intp N; }; npy_intp sym[1]; }; } swivel_near_args; /* self_motion.c */
 typedef struct { const double *params; const double *T; Chain packed; int with_w; unsigned char *counts; double *best; union { struct { npy_intp G, K, n, nc; }; npy_intp sym[4]; }; } six_r_reach_args; /* reach.c */
 
 KERNELS(KERNEL_BODY)

@@ -78,13 +78,16 @@ typedef struct {
     m3 R0[2], TR;
 } SmFrame;
 
-static inline m3 sm_rotm(v3 k, double t)
+/* The rotation about unit axis k with cosine c and sine s */
+static inline m3 sm_rotm_cs(v3 k, double c, double s)
 {
-    double c = cos(t), s = sin(t), v = 1.0 - c;
+    double v = 1.0 - c;
     return (m3){{c + k.x * k.x * v, k.x * k.y * v - k.z * s, k.x * k.z * v + k.y * s},
                 {k.y * k.x * v + k.z * s, c + k.y * k.y * v, k.y * k.z * v - k.x * s},
                 {k.z * k.x * v - k.y * s, k.z * k.y * v + k.x * s, c + k.z * k.z * v}};
 }
+
+static inline m3 sm_rotm(v3 k, double t) { return sm_rotm_cs(k, cos(t), sin(t)); }
 
 static inline m3 sm_mul(const m3 *A, const m3 *B) /* A B */
 {
@@ -160,27 +163,72 @@ static v3 sm_perp(v3 h)
 }
 
 /* Every split of R into rot(ha, va) rot(hb, vb) rot(hc, vc) (swivel.py _triple):
- * v[i] for the middle angle's + / - root; returns whether they are real. */
-static int sm_triple(v3 ha, v3 hb, v3 hc, const m3 *R, double v[2][3], int sing[2])
+ * v[i] for the middle angle's + / - root; returns whether they are real. The
+ * rotations by vb and va are built from the cosines and sines the subproblems
+ * give (vb = phi +- d with cos phi = A / rho, cos d = C / rho; va = atan2(y, x)),
+ * not from the angles: no sine or cosine is evaluated. */
+typedef struct {
+    v3 ha, hb, hc, Rhc, ya, e, Re;
+    double vb[2], cb[2], sb[2];
+    int real;
+} SmSplit;
+
+/* The middle angle's roots of the split of R (with their cosines and sines) */
+static void sm_split(v3 ha, v3 hb, v3 hc, const m3 *R, SmSplit *t)
 {
     double tp, tm, A, B, C;
-    v3 Rhc = m3_mv(R, hc);
-    int real = sm_sp4(hb, ha, hc, v3_dot(ha, Rhc), &tp, &tm, &A, &B, &C);
-    double vb[2] = {tp, tm};
-    v3 e = sm_perp(hc), Re = m3_mv(R, e);
-    for (int i = 0; i < 2; i++) {
-        m3 Rb = sm_rotm(hb, vb[i]);
-        double spread, dummy;
-        double va = sm_sp1(ha, m3_mv(&Rb, hc), Rhc, &spread);
-        sing[i] = spread < 1e-9;
-        if (sing[i])
-            va = 0.0;
-        m3 Ra = sm_rotm(ha, va), Bm = sm_mul(&Ra, &Rb);
-        v[i][0] = va;
-        v[i][1] = vb[i];
-        v[i][2] = sm_sp1(hc, e, m3_mtv(&Bm, Re), &dummy);
+    t->ha = ha;
+    t->hb = hb;
+    t->hc = hc;
+    t->Rhc = m3_mv(R, hc);
+    t->real = sm_sp4(hb, ha, hc, v3_dot(ha, t->Rhc), &tp, &tm, &A, &B, &C);
+    double rho = hypot(A, B), x = rho > 0.0 ? fmax(-1.0, fmin(1.0, C / rho)) : NAN;
+    double cp = A / rho, sp = B / rho, cd = x, sd = sqrt(1.0 - x * x);
+    t->vb[0] = tp;
+    t->vb[1] = tm;
+    t->cb[0] = cp * cd - sp * sd;
+    t->cb[1] = cp * cd + sp * sd;
+    t->sb[0] = sp * cd + cp * sd;
+    t->sb[1] = sp * cd - cp * sd;
+    t->e = sm_perp(hc);
+    t->Re = m3_mv(R, t->e);
+    t->ya = v3_sub(t->Rhc, v3_scale(ha, v3_dot(ha, t->Rhc)));
+}
+
+/* The outer angles of root i of a split: v (3) chain angles; *sing where the outer
+ * axes line up (the first angle set to 0) */
+static void sm_split_root(const SmSplit *t, int i, double v[3], int *sing)
+{
+    m3 Rb = sm_rotm_cs(t->hb, t->cb[i], t->sb[i]);
+    v3 xa = m3_mv(&Rb, t->hc);
+    xa = v3_sub(xa, v3_scale(t->ha, v3_dot(t->ha, xa)));
+    double py = v3_dot(t->ha, v3_cross(xa, t->ya)), px = v3_dot(xa, t->ya), r = hypot(px, py);
+    double va = atan2(py, px), ca = r > 0.0 ? px / r : 1.0, sa = r > 0.0 ? py / r : 0.0;
+    *sing = sm_norm(xa) < 1e-9;
+    if (*sing) {
+        va = 0.0;
+        ca = 1.0;
+        sa = 0.0;
     }
-    return real;
+    m3 Ra = sm_rotm_cs(t->ha, ca, sa), Bm = sm_mul(&Ra, &Rb);
+    double dummy;
+    v[0] = va;
+    v[1] = t->vb[i];
+    v[2] = sm_sp1(t->hc, t->e, m3_mtv(&Bm, t->Re), &dummy);
+}
+
+/* Every split of R into rot(ha, va) rot(hb, vb) rot(hc, vc) (swivel.py _triple):
+ * v[i] for the middle angle's + / - root; returns whether they are real. The
+ * rotations by vb and va are built from the cosines and sines the subproblems
+ * give (vb = phi +- d with cos phi = A / rho, cos d = C / rho; va = atan2(y, x)),
+ * not from the angles: no sine or cosine is evaluated. */
+static int sm_triple(v3 ha, v3 hb, v3 hc, const m3 *R, double v[2][3], int sing[2])
+{
+    SmSplit t;
+    sm_split(ha, hb, hc, R, &t);
+    for (int i = 0; i < 2; i++)
+        sm_split_root(&t, i, v[i], &sing[i]);
+    return t.real;
 }
 
 /* The smallest rotation taking the direction of a to that of b */
@@ -290,6 +338,31 @@ static void sm_configs_part(const SmArm *a, const SmFrame *f, int e, double psi,
             }
             q[k][3] = real ? sm_joint(a, 3, f->v4[e]) : NAN;
         }
+}
+
+/* One branch: slot 4 e + b's joint coordinates q (7) at psi, as sm_configs gives
+ * them (the same operations on that root only); returns whether it is real. */
+static int sm_branch_row(const SmArm *a, const SmFrame *f, int e, int b, double psi, double *q)
+{
+    m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
+    m3 RA = sm_mul(&Ru, &f->R0[e]);
+    SmSplit tA, tB;
+    sm_split(a->h[0], a->h[1], a->h[2], &RA, &tA);
+    m3 R4 = sm_rotm(a->h[3], f->v4[e]), RAR4 = sm_mul(&RA, &R4), X = sm_tr(&RAR4);
+    m3 RB = sm_mul(&X, &f->TR);
+    sm_split(a->h[4], a->h[5], a->h[6], &RB, &tB);
+    if (!(f->elbow_real && tA.real && tB.real))
+        return 0;
+    double sA[3], sB[3];
+    int g;
+    sm_split_root(&tA, b / 2, sA, &g);
+    sm_split_root(&tB, b % 2, sB, &g);
+    for (int j = 0; j < 3; j++) {
+        q[j] = sm_joint(a, j, sA[j]);
+        q[4 + j] = sm_joint(a, 4 + j, sB[j]);
+    }
+    q[3] = sm_joint(a, 3, f->v4[e]);
+    return 1;
 }
 
 /* ------------------------------------------------------------ the polish */
@@ -620,12 +693,9 @@ static int sm_cmp(const void *x, const void *y)
  * q = limit + 4e-16) is decided as .inside decides it. */
 #define SM_INSIDE_SLACK 1e-12
 
-static int sm_inside(const SmArm *a, const double *q)
+static int sm_inside_joint(const SmArm *a, int j, double q)
 {
-    for (int j = 0; j < 7; j++)
-        if (!(q[j] >= a->lo[j] - SM_INSIDE_SLACK && q[j] <= a->hi[j] + SM_INSIDE_SLACK))
-            return 0;
-    return 1;
+    return q >= a->lo[j] - SM_INSIDE_SLACK && q <= a->hi[j] + SM_INSIDE_SLACK;
 }
 
 typedef struct {
@@ -633,6 +703,101 @@ typedef struct {
     double *iv, *pts;
     long long *niv, *npts;
 } SmManJob;
+
+/* The runs of swivel angles where one triple (part 1 the shoulder, 2 the wrist) of
+ * elbow root e exists with its three joints inside their limits, per root r of its
+ * middle angle: the cuts are the candidates of that triple's joints only (the other
+ * triple's do not change its state), each cell decided at its midpoint, adjacent
+ * in-cells merged. A branch (shoulder s, wrist w) is inside every limit where the
+ * runs of s and of w overlap (the elbow is constant over the swivel). */
+static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmCand *c, int nc,
+                    double run[2][SM_MAXI][2], int nrun[2])
+{
+    double cut[66];
+    int m = 0, j0 = part == 1 ? 0 : 4;
+    cut[m++] = -M_PI;
+    cut[m++] = M_PI;
+    for (int i = 0; i < nc; i++)
+        if ((c[i].joint < 3) == (part == 1))
+            cut[m++] = c[i].psi;
+    qsort(cut, (size_t)m, sizeof(double), sm_cmp);
+    int open[2] = {0, 0};
+    nrun[0] = nrun[1] = 0;
+    for (int i = 0; i + 1 < m; i++) {
+        double lo = cut[i], hi = cut[i + 1];
+        if (!(hi > lo))
+            continue;
+        double q[4][7];
+        int ok[4], sg[4];
+        sm_configs_part(a, f, e, 0.5 * (lo + hi), part, q, ok, sg);
+        for (int r = 0; r < 2; r++) {
+            int b = part == 1 ? 2 * r : r; /* the other triple's root 0: NaN there */
+            int in = ok[b];
+            for (int j = j0; j < j0 + 3 && in; j++)
+                in = sm_inside_joint(a, j, q[b][j]);
+            if (in && open[r]) {
+                run[r][nrun[r] - 1][1] = hi; /* extends the open run */
+            } else if (in && nrun[r] < SM_MAXI) {
+                run[r][nrun[r]][0] = lo;
+                run[r][nrun[r]][1] = hi;
+                nrun[r]++;
+            }
+            open[r] = in;
+        }
+    }
+}
+
+/* The overlaps of two sorted lists of disjoint runs into out (at most SM_MAXI) */
+static long long sm_overlap(double x[][2], int nx, double y[][2], int ny, double *out)
+{
+    long long n = 0;
+    int i = 0, k = 0;
+    while (i < nx && k < ny) {
+        double lo = fmax(x[i][0], y[k][0]), hi = fmin(x[i][1], y[k][1]);
+        if (hi > lo && n < SM_MAXI) {
+            out[2 * n] = lo;
+            out[2 * n + 1] = hi;
+            n++;
+        }
+        if (x[i][1] < y[k][1])
+            i++;
+        else
+            k++;
+    }
+    return n;
+}
+
+/* The intervals (4, SM_MAXI, 2) with counts (4) of the branches of elbow root e
+ * (slots 4 e + b) inside every limit, from its candidates c: the overlaps of each
+ * shoulder root's and wrist root's runs, a run through pi joined */
+static void sm_elbow_intervals(const SmArm *a, const SmFrame *f, int e, const SmCand *c, int nc,
+                               double *iv, long long *niv)
+{
+    for (int b = 0; b < 4; b++)
+        niv[b] = 0;
+    if (!f->elbow_real || !sm_inside_joint(a, 3, sm_joint(a, 3, f->v4[e])))
+        return; /* the elbow outside its limits: no branch of this root inside */
+    double rs[2][SM_MAXI][2], rw[2][SM_MAXI][2];
+    int ns[2], nw[2];
+    sm_runs(a, f, e, 1, c, nc, rs, ns);
+    sm_runs(a, f, e, 2, c, nc, rw, nw);
+    for (int b = 0; b < 4; b++) {
+        double *r = iv + 2 * SM_MAXI * b;
+        long long k = sm_overlap(rs[b / 2], ns[b / 2], rw[b % 2], nw[b % 2], r);
+        /* periodic: a run ending at pi and one starting at -pi join */
+        if (k >= 2 && r[0] == -M_PI && r[2 * k - 1] == M_PI) {
+            double end = r[1] + 2.0 * M_PI, start = r[2 * k - 2];
+            for (long long i = 0; i + 1 < k; i++) {
+                r[2 * i] = r[2 * i + 2];
+                r[2 * i + 1] = r[2 * i + 3];
+            }
+            r[2 * k - 4] = start;
+            r[2 * k - 3] = end;
+            k--;
+        }
+        niv[b] = k;
+    }
+}
 
 /* One pose: intervals (8, SM_MAXI, 2) with counts (8), points (SM_MAXP, 4) */
 static void sm_manifold1(const SmArm *a, const double *T, double *iv, long long *niv,
@@ -648,13 +813,6 @@ static void sm_manifold1(const SmArm *a, const double *T, double *iv, long long 
     for (int e = 0; e < 2; e++) {
         SmCand c[64];
         int nc = sm_candidates(a, &f, e, c);
-        double cut[66];
-        int m = 0;
-        cut[m++] = -M_PI;
-        cut[m++] = M_PI;
-        for (int i = 0; i < nc; i++)
-            cut[m++] = c[i].psi;
-        qsort(cut, (size_t)m, sizeof(double), sm_cmp);
         /* the points: which branches are at the value there */
         for (int i = 0; i < nc; i++) {
             double q[4][7];
@@ -675,44 +833,7 @@ static void sm_manifold1(const SmArm *a, const double *T, double *iv, long long 
                 }
             }
         }
-        /* the cells: each branch's state at the midpoint, runs merged */
-        int open[4] = {0, 0, 0, 0};
-        for (int i = 0; i + 1 < m; i++) {
-            double lo = cut[i], hi = cut[i + 1];
-            if (!(hi > lo))
-                continue;
-            double q[4][7];
-            int ok[4], sg[4];
-            sm_configs(a, &f, e, 0.5 * (lo + hi), q, ok, sg);
-            for (int b = 0; b < 4; b++) {
-                int slot = 4 * e + b, in = ok[b] && sm_inside(a, q[b]);
-                double *r = iv + 2 * (SM_MAXI * slot + niv[slot]);
-                if (in && open[b]) {
-                    r[-1] = hi; /* extends the open interval */
-                } else if (in && niv[slot] < SM_MAXI) {
-                    r[0] = lo;
-                    r[1] = hi;
-                    niv[slot]++;
-                }
-                open[b] = in;
-            }
-        }
-        /* periodic: a run ending at pi and one starting at -pi join */
-        for (int b = 0; b < 4; b++) {
-            int slot = 4 * e + b;
-            long long k = niv[slot];
-            double *r = iv + 2 * SM_MAXI * slot;
-            if (k >= 2 && r[0] == -M_PI && r[2 * k - 1] == M_PI) {
-                double end = r[1] + 2.0 * M_PI, start = r[2 * k - 2];
-                for (long long i = 0; i + 1 < k; i++) {
-                    r[2 * i] = r[2 * i + 2];
-                    r[2 * i + 1] = r[2 * i + 3];
-                }
-                r[2 * k - 4] = start;
-                r[2 * k - 3] = end;
-                niv[slot] = k - 1;
-            }
-        }
+        sm_elbow_intervals(a, &f, e, c, nc, iv + 2 * SM_MAXI * 4 * e, niv + 4 * e);
     }
 }
 
@@ -734,6 +855,249 @@ static PyObject *swivel_manifold_body(const swivel_manifold_args *a)
         pool_for((long)a->N, SM_GRAIN, sm_manifold_range, &jb);
     else
         sm_manifold_range(&jb, 0, (long)a->N);
+    Py_END_ALLOW_THREADS
+    Py_RETURN_NONE;
+}
+
+/* ------------------------------------------------------------ the nearest point */
+
+#define SM_NEAR_GRID 32 /* swivel values of the coarse grid per elbow root */
+#define SM_NEAR_KEEP 3  /* local minima of the samples refined (the best by value) */
+#define SM_NEAR_XTOL 1e-8
+#define SM_NEAR_TRY 8   /* answers tried, nearest first, until one polishes inside the limits */ /* Brent's tolerance on psi [rad] */
+
+/* The squared 2 pi wrapped distance of row q (7) to qn */
+static double sm_dist2(const double *q, const double *qn)
+{
+    double s = 0.0;
+    for (int j = 0; j < 7; j++) {
+        double d = wrap_pi(q[j] - qn[j]);
+        s += d * d;
+    }
+    return s;
+}
+
+/* sm_dist2 of branch b (0-3) of elbow root e at psi: INFINITY where it has no row */
+static double sm_branch_dist(const SmArm *a, const SmFrame *f, int e, int b, double psi,
+                             const double *qn)
+{
+    double q[7];
+    return sm_branch_row(a, f, e, b, psi, q) ? sm_dist2(q, qn) : INFINITY;
+}
+
+/* Brent's minimisation (golden section with parabolic steps; Brent 1973, ch. 5) of
+ * the distance of branch b over [lo, hi] from x (value fx); returns the best psi */
+static double sm_brent(const SmArm *a, const SmFrame *f, int e, int b, const double *qn,
+                       double lo, double hi, double x, double *fx)
+{
+    const double g = 0.3819660112501051;
+    double w = x, v = x, fw = *fx, fv = *fx, d = 0.0, step = 0.0;
+    for (int it = 0; it < 60; it++) {
+        double m = 0.5 * (lo + hi), tol = SM_NEAR_XTOL + 1e-12 * fabs(x), t2 = 2.0 * tol;
+        if (fabs(x - m) <= t2 - 0.5 * (hi - lo))
+            break;
+        int golden = 1;
+        if (fabs(step) > tol) { /* a parabola through x, w, v */
+            double r = (x - w) * (*fx - fv), q = (x - v) * (*fx - fw), p = (x - v) * q - (x - w) * r;
+            q = 2.0 * (q - r);
+            if (q > 0.0)
+                p = -p;
+            q = fabs(q);
+            if (fabs(p) < fabs(0.5 * q * step) && p > q * (lo - x) && p < q * (hi - x)) {
+                step = d;
+                d = p / q;
+                double u = x + d;
+                if (u - lo < t2 || hi - u < t2)
+                    d = x < m ? tol : -tol;
+                golden = 0;
+            }
+        }
+        if (golden) {
+            step = (x < m ? hi : lo) - x;
+            d = g * step;
+        }
+        double u = fabs(d) >= tol ? x + d : x + (d > 0.0 ? tol : -tol);
+        double fu = sm_branch_dist(a, f, e, b, u, qn);
+        if (fu <= *fx) {
+            if (u < x)
+                hi = x;
+            else
+                lo = x;
+            v = w;
+            fv = fw;
+            w = x;
+            fw = *fx;
+            x = u;
+            *fx = fu;
+        } else {
+            if (u < x)
+                lo = u;
+            else
+                hi = u;
+            if (fu <= fw || w == x) {
+                v = w;
+                fv = fw;
+                w = u;
+                fw = fu;
+            } else if (fu <= fv || v == x || v == w) {
+                v = u;
+                fv = fu;
+            }
+        }
+    }
+    return x;
+}
+
+typedef struct {
+    double g, psi, lo, hi; /* sampled value at psi, its bracket */
+    int e, b;
+} SmMin;
+
+/* Keeps the cap smallest of the points offered in best (sorted, *n of them) */
+static void sm_keep(SmMin *best, int *n, int cap, SmMin m)
+{
+    int i;
+    if (*n < cap) {
+        i = (*n)++;
+    } else {
+        i = cap - 1;
+        if (!(m.g < best[i].g))
+            return;
+    }
+    while (i > 0 && m.g < best[i - 1].g) {
+        best[i] = best[i - 1];
+        i--;
+    }
+    best[i] = m;
+}
+
+/* The in-limit configuration of pose T nearest qn (7): q (7), its psi and slot; 0
+ * when no part of the manifold is inside the limits (or its row fails the polish).
+ * Per elbow root: the exact intervals (sm_elbow_intervals), a grid of SM_NEAR_GRID
+ * swivel values; per branch and interval the samples (its ends and the grid values
+ * inside) give the local minima of the distance, the SM_NEAR_KEEP smallest are
+ * refined by Brent's method between their neighbouring samples; the best point
+ * (refined or an interval end) is Newton-polished and clamped into the limits. */
+static int sm_near1(const SmArm *a, const double *T, const double *qn, double *qout,
+                    double *psi_out, long long *slot_out, double *d_out)
+{
+    SmFrame f;
+    sm_frame(a, T, &f);
+    if (!f.elbow_real)
+        return 0;
+    const double h = 2.0 * M_PI / SM_NEAR_GRID;
+    SmMin best[SM_NEAR_KEEP];
+    int nbest = 0;
+    SmMin tries[SM_NEAR_TRY]; /* the nearest interval ends and refined minima */
+    int ntries = 0;
+    for (int e = 0; e < 2; e++) {
+        SmCand c[64];
+        int nc = sm_candidates(a, &f, e, c);
+        double iv[4][SM_MAXI][2];
+        long long niv[4];
+        sm_elbow_intervals(a, &f, e, c, nc, &iv[0][0][0], niv);
+        if (!(niv[0] | niv[1] | niv[2] | niv[3]))
+            continue;
+        double grid[SM_NEAR_GRID][4];
+        int done[SM_NEAR_GRID] = {0}; /* grid values evaluated when an interval needs them */
+        for (int b = 0; b < 4; b++)
+            for (long long i = 0; i < niv[b]; i++) {
+                double lo = iv[b][i][0], hi = iv[b][i][1];
+                double t[SM_NEAR_GRID + 3], g[SM_NEAR_GRID + 3];
+                int n = 0;
+                t[n] = lo;
+                g[n++] = sm_branch_dist(a, &f, e, b, lo, qn);
+                for (long k = (long)ceil((lo + M_PI) / h); -M_PI + k * h < hi; k++) {
+                    double tk = -M_PI + k * h;
+                    if (tk > lo && n < SM_NEAR_GRID + 2) {
+                        int kk = (int)(((k % SM_NEAR_GRID) + SM_NEAR_GRID) % SM_NEAR_GRID);
+                        if (!done[kk]) {
+                            double q[4][7];
+                            int ok[4], sg[4];
+                            sm_configs(a, &f, e, -M_PI + kk * h, q, ok, sg);
+                            for (int bb = 0; bb < 4; bb++)
+                                grid[kk][bb] = ok[bb] ? sm_dist2(q[bb], qn) : INFINITY;
+                            done[kk] = 1;
+                        }
+                        t[n] = tk;
+                        g[n++] = grid[kk][b];
+                    }
+                }
+                t[n] = hi;
+                g[n++] = sm_branch_dist(a, &f, e, b, hi, qn);
+                for (int k = 0; k < n; k += n - 1)
+                    if (g[k] < INFINITY)
+                        sm_keep(tries, &ntries, SM_NEAR_TRY, (SmMin){g[k], t[k], t[k], t[k], e, b});
+                for (int k = 0; k < n; k++) {
+                    double gl = k > 0 ? g[k - 1] : INFINITY, gr = k + 1 < n ? g[k + 1] : INFINITY;
+                    if (g[k] < INFINITY && g[k] <= gl && g[k] <= gr)
+                        sm_keep(best, &nbest, SM_NEAR_KEEP, (SmMin){g[k], t[k], t[k > 0 ? k - 1 : 0],
+                                                      t[k + 1 < n ? k + 1 : n - 1], e, b});
+                }
+            }
+    }
+    for (int i = 0; i < nbest; i++) {
+        SmMin m = best[i];
+        m.psi = sm_brent(a, &f, m.e, m.b, qn, m.lo, m.hi, m.psi, &m.g);
+        sm_keep(tries, &ntries, SM_NEAR_TRY, m);
+    }
+    /* nearest first, the first whose row polishes to the pose inside the limits (next
+     * to an aligned point the polish may move a row out of them) */
+    m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
+    v3 pT = {T[3], T[7], T[11]};
+    for (int i = 0; i < ntries; i++) {
+        double q[7];
+        if (!sm_branch_row(a, &f, tries[i].e, tries[i].b, tries[i].psi, q) ||
+            !sm_polish(a, &RT, pT, q))
+            continue;
+        int in = 1;
+        for (int j = 0; j < 7 && in; j++)
+            in = sm_inside_joint(a, j, q[j]);
+        if (!in)
+            continue;
+        for (int j = 0; j < 7; j++)
+            qout[j] = fmin(fmax(q[j], a->lo[j]), a->hi[j]);
+        *psi_out = wrap_pi(tries[i].psi);
+        *slot_out = 4 * tries[i].e + tries[i].b;
+        *d_out = sqrt(sm_dist2(qout, qn));
+        return 1;
+    }
+    return 0;
+}
+typedef struct {
+    const double *P, *T, *qn;
+    double *q, *psi, *dist;
+    long long *slot;
+    npy_bool *found;
+} SmNearJob;
+
+static void sm_near_range(void *arg, long i0, long i1)
+{
+    const SmNearJob *jb = (const SmNearJob *)arg;
+    SmArm a;
+    sm_arm(jb->P, &a);
+    for (long i = i0; i < i1; i++) {
+        int ok = sm_near1(&a, jb->T + 16 * i, jb->qn + 7 * i, jb->q + 7 * i, jb->psi + i,
+                          jb->slot + i, jb->dist + i);
+        jb->found[i] = (npy_bool)ok;
+        if (!ok) {
+            for (int j = 0; j < 7; j++)
+                jb->q[7 * i + j] = NAN;
+            jb->psi[i] = NAN;
+            jb->slot[i] = -1;
+            jb->dist[i] = INFINITY;
+        }
+    }
+}
+
+static PyObject *swivel_near_body(const swivel_near_args *a)
+{
+    SmNearJob jb = {a->params, a->T, a->q_near, a->q, a->psi, a->dist, a->slot, a->found};
+    Py_BEGIN_ALLOW_THREADS
+    if (a->N >= SM_PARALLEL_MIN)
+        pool_for((long)a->N, SM_GRAIN, sm_near_range, &jb);
+    else
+        sm_near_range(&jb, 0, (long)a->N);
     Py_END_ALLOW_THREADS
     Py_RETURN_NONE;
 }

@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from robokin._native import kernels as K
 from robokin._validation import check_finite, check_joints, check_rigid
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import ArmSource, arm_of
@@ -64,11 +65,12 @@ from robokin.kinematics.ik.self_motion_intervals import (
     _state_changes,
     _within,
 )
+from robokin.kinematics.ik.swivel import SwivelArm
 from robokin.spatial import wrap_angle as _wrap
 
 __all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SelfMotionSetup", "SingularPoint",
            "auto_parameter",
-           "nearest_on_manifold", "parameter_values", "self_motion"]
+           "nearest_on_manifold", "parameter_values", "self_motion", "swivel_nearest"]
 
 #: Checking-grid values of a continued family.
 _CONTINUED_GRID = 181
@@ -105,12 +107,16 @@ class SelfMotion:
         intervals: (m, 2) parameter intervals [rad] where a branch is inside every
             joint limit, sorted by branch then start.
         interval_branch: (m,) the branch of each interval.
-        crossings: Every point where a branch meets a joint limit.
-        singular: Branch ends ("fold") and aligned-axes points.
+        crossings: Every point where a branch meets a joint limit (a property:
+            built from ``_points`` on first access, then kept in ``_records``).
+        singular: Branch ends ("fold") and aligned-axes points (the same).
         method: How the branches are computed.
         info: ``bisected`` (state changes found by bisection, not exactly),
             ``grid`` (values checked).
         limits: The arm's joint limits (n, 2).
+        _points: The compiled swivel's points (p, 4) ``[t, branch, joint, kind]``
+            (``SM_KIND_*``), or None when ``_records`` was given.
+        _records: ``(crossings, singular)``, built from ``_points`` when first read.
     """
 
     T: np.ndarray
@@ -121,12 +127,31 @@ class SelfMotion:
     n_branches: int
     intervals: np.ndarray
     interval_branch: np.ndarray
-    crossings: tuple[LimitCrossing, ...]
-    singular: tuple[SingularPoint, ...]
     method: str
     info: dict[str, Any]
     _family: _Family = field(repr=False)
     limits: np.ndarray = field(repr=False)
+    _points: np.ndarray | None = field(default=None, repr=False)
+    _records: tuple[tuple[LimitCrossing, ...], tuple[SingularPoint, ...]] | None = field(
+        default=None, repr=False)
+
+    @property
+    def crossings(self) -> tuple[LimitCrossing, ...]:
+        """Every point where a branch meets a joint limit (:class:`LimitCrossing`)."""
+        return self._built()[0]
+
+    @property
+    def singular(self) -> tuple[SingularPoint, ...]:
+        """Branch ends ("fold") and aligned-axes points (:class:`SingularPoint`)."""
+        return self._built()[1]
+
+    def _built(self) -> tuple[tuple[LimitCrossing, ...], tuple[SingularPoint, ...]]:
+        """The records, made from the kernel's points on first access and kept."""
+        if self._records is None:
+            assert self._points is not None
+            object.__setattr__(self, "_records", _records_of(self._points))
+        assert self._records is not None
+        return self._records
 
     def sample(self, t: npt.ArrayLike, *, within_limits: bool = False) -> np.ndarray:
         """Every branch at parameter values t: (..., k, n), NaN where a branch has none.
@@ -173,8 +198,16 @@ class SelfMotion:
         return self._maximise(score, samples)
 
     def nearest(self, q_near: npt.ArrayLike, *, samples: int = 64) -> ManifoldPoint | None:
-        """The in-limit configuration nearest ``q_near`` (n,) (2 pi wrapped distance)."""
+        """The in-limit configuration nearest ``q_near`` (n,) (2 pi wrapped distance).
+
+        On the compiled swivel (SRS arms) the kernel's search on the exact
+        intervals (``SwivelArm.nearest``; ``samples`` is not used); elsewhere
+        ``samples`` values per interval, then zooming in (as :meth:`best`).
+        """
         qn = check_finite(check_joints(q_near, self.limits.shape[0], "q_near"), "q_near")
+        fam = self._family
+        if isinstance(fam, _SwivelFamily) and not fam.reference:
+            return _swivel_nearest(fam.arm, self.T, qn)
 
         def score(q: np.ndarray) -> np.ndarray:
             out: np.ndarray = -np.linalg.norm(_wrap(q - qn), axis=-1)
@@ -253,6 +286,8 @@ def nearest_on_manifold(robot: ArmSource, T: np.ndarray, q_near: np.ndarray, *,
     """
     arm = arm_of(robot)
     fam = _family(arm, T, "auto", dispatch)
+    if isinstance(fam, _SwivelFamily):
+        return _swivel_nearest(fam.arm, fam.T, q_near)
     k = fam.k
     lo, hi = fam.domain
     # every branch over the whole range, and a window around q_near's own parameter
@@ -272,6 +307,29 @@ def nearest_on_manifold(robot: ArmSource, T: np.ndarray, q_near: np.ndarray, *,
 
     return _maximise(fam, np.asarray(arm.limits, dtype=np.float64), intervals,
                      np.tile(np.arange(k), 2), score, samples)
+
+
+def _swivel_nearest(arm: SwivelArm, T: np.ndarray, q_near: np.ndarray) -> ManifoldPoint | None:
+    """The compiled nearest point of one pose (``SwivelArm.nearest``), or None."""
+    q, psi, slot, dist, found = arm.nearest(T[None], q_near[None])
+    if not found[0]:
+        return None
+    return ManifoldPoint(q[0], float(psi[0]), int(slot[0]), -float(dist[0]))
+
+
+def swivel_nearest(robot: ArmSource, T: np.ndarray, q_near: np.ndarray) -> np.ndarray | None:
+    """The in-limit configurations (m, 7) of poses T (m, 4, 4) nearest ``q_near`` (m, 7).
+
+    The compiled search on the exact swivel intervals (``SwivelArm.nearest``; NaN
+    rows where no part of a manifold is inside the limits); None when the arm is
+    not SRS (then :func:`nearest_on_manifold` per pose).
+    """
+    arm = _setup(arm_of(robot)).swivel
+    if arm is None:
+        return None
+    q, _, _, _, found = arm.nearest(T, q_near)
+    q[~found] = np.nan
+    return q
 
 
 def auto_parameter(robot: ArmSource) -> str | None:
@@ -349,13 +407,17 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
     Ta = check_rigid(T, "T")
     if Ta.shape != (4, 4):
         raise InputError("T", f"self_motion takes one pose (4, 4), got {Ta.shape}")
-    fam = _family(robot, Ta, parameter, dispatch, reference)
     limits = np.asarray(robot.limits, dtype=np.float64)
-    if isinstance(fam, _SwivelFamily) and not reference:
-        intervals, owner, crossings, singular = fam.exact()
-        return SelfMotion(Ta, fam.name, None, np.array(fam.domain), True, 8, intervals, owner,
-                          crossings, singular, "swivel closed form (SRS), compiled",
-                          {"bisected": 0, "grid": 0}, fam, limits)
+    # the compiled swivel (an SRS arm's "auto"): no family choice, no per-call lists
+    swivel = (_setup(robot).swivel if robot.n == 7 and parameter in ("auto", "swivel")
+              and not reference else None)
+    if swivel is not None:
+        sw = _SwivelFamily(swivel, Ta, robot)
+        intervals, owner, points = sw.exact()
+        return SelfMotion(Ta, "swivel", None, _SWIVEL_DOMAIN.copy(), True, 8, intervals, owner,
+                          "swivel closed form (SRS), compiled", {"bisected": 0, "grid": 0},
+                          sw, limits, points)
+    fam = _family(robot, Ta, parameter, dispatch, reference)
     marks = _exact_points(robot, fam, limits)
     if isinstance(fam, _ContinuedFamily):
         grid = min(int(grid), _CONTINUED_GRID)  # each value is a general-6R solve
@@ -369,8 +431,27 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
               else f"continued general 6R ({fam.name} held)"
               if isinstance(fam, _ContinuedFamily) else f"analytic:pieper ({fam.name} held)")
     return SelfMotion(Ta, fam.name, fam.joint, np.array(fam.domain), fam.periodic, fam.k,
-                      intervals, owner, crossings, singular, method,
-                      {"bisected": bisected, "grid": int(grid)}, fam, limits)
+                      intervals, owner, method, {"bisected": bisected, "grid": int(grid)}, fam,
+                      limits, _records=(crossings, singular))
+
+
+#: The swivel's parameter range (copied into each SelfMotion).
+_SWIVEL_DOMAIN = np.array([-np.pi, np.pi])
+#: The compiled swivel's point kinds (``SM_KIND_*`` 0-3), as the records name them.
+_KINDS = ("lower", "upper", "aligned axes", "fold")
+
+
+def _records_of(points: np.ndarray) -> tuple[tuple[LimitCrossing, ...],
+                                             tuple[SingularPoint, ...]]:
+    """The records of the compiled swivel's points (p, 4) ``[psi, branch, joint, kind]``."""
+    cross: list[LimitCrossing] = []
+    sing: list[SingularPoint] = []
+    for t, b, j, k in points.tolist():
+        if k <= K.SM_KIND_UPPER:
+            cross.append(LimitCrossing(t, int(b), int(j), _KINDS[int(k)]))
+        else:
+            sing.append(SingularPoint(t, int(b), _KINDS[int(k)]))
+    return tuple(cross), tuple(sing)
 
 
 def parameter_values(robot: ArmSource, T: np.ndarray, q: np.ndarray

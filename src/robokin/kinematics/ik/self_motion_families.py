@@ -127,19 +127,16 @@ class _SwivelFamily(_Family):
         Q, valid, sing = self.arm.rows(self.T[None], t[None])
         return Q[0], valid[0], sing[0]
 
-    def exact(self) -> tuple[np.ndarray, np.ndarray, tuple[LimitCrossing, ...],
-                             tuple[SingularPoint, ...]]:
-        """The compiled intervals, owners, limit crossings and singular points."""
+    def exact(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The compiled intervals (m, 2), their branches (m,) and points (p, 4).
+
+        The points are the kernel's rows ``[psi, branch, joint, kind]`` (kind
+        ``SM_KIND_*``); ``self_motion._records_of`` makes them records when read.
+        """
         iv, niv, pts, npts = self.arm.manifold(self.T[None])
-        intervals = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
-        owner = np.repeat(np.arange(8), niv[0])
-        p = pts[0, :npts[0]]
-        limit = p[:, 3] <= K.SM_KIND_UPPER
-        names = ("lower", "upper", "aligned axes", "fold")  # SM_KIND_* 0-3
-        cross = tuple(LimitCrossing(t, int(b), int(j), names[int(k)])
-                      for t, b, j, k in p[limit].tolist())
-        sing = tuple(SingularPoint(t, int(b), names[int(k)]) for t, b, _, k in p[~limit].tolist())
-        return intervals, owner, cross, sing
+        counts = niv[0]
+        intervals = iv[0][counts[:, None] > _SLOTS]
+        return intervals, _BRANCHES.repeat(counts), pts[0, :npts[0]]
 
     def param_of(self, q: np.ndarray) -> float:
         return float(self.arm.swivel_of(self.fr, q))
@@ -148,6 +145,11 @@ class _SwivelFamily(_Family):
         if j == 3:
             return []  # the elbow does not move with the swivel
         return [(psi, None) for psi, _ in self.arm.limit_swivels(self.fr, j, value)]
+
+
+#: Interval slots of a branch and the 8 swivel branches (``_SwivelFamily.exact``).
+_SLOTS = np.arange(K.SM_MAXI)
+_BRANCHES = np.arange(8)
 
 
 class _JointFamily(_Family):

@@ -273,6 +273,34 @@ class SwivelArm:
         K.swivel_manifold(self.params, T, iv, niv, pts, npts)
         return iv, niv, pts, npts
 
+    def nearest(self, T: np.ndarray, q_near: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The in-limit configuration of each pose nearest ``q_near``, compiled.
+
+        On the exact intervals (:meth:`manifold`): per branch and interval the
+        distance sampled at its ends and a 48-value swivel grid, the four smallest
+        local minima refined by Brent's method, the best point Newton-polished and
+        clamped into the limits (it is within 1e-12 of them).
+
+        Args:
+            T: Poses (N, 4, 4).
+            q_near: Configurations (N, 7) [rad]; the distance is 2 pi wrapped.
+
+        Returns:
+            ``(q (N, 7), psi (N,), slot (N,), distance (N,), found (N,))``: NaN, -1,
+            inf and False where no part of a pose's manifold is inside the limits.
+        """
+        T = np.ascontiguousarray(T, dtype=np.float64)
+        qn = np.ascontiguousarray(q_near, dtype=np.float64)
+        N = len(T)
+        q = np.empty((N, 7))
+        psi = np.empty(N)
+        slot = np.empty(N, np.int64)
+        dist = np.empty(N)
+        found = np.empty(N, bool)
+        K.swivel_near(self.params, T, qn, q, psi, slot, dist, found)
+        return q, psi, slot, dist, found
+
     def wrap(self, q: np.ndarray) -> np.ndarray:
         """Angles into (-pi, pi], then by 2 pi into the limits where that fits."""
         q = wrap_angle(q)
