@@ -16,8 +16,8 @@ import pytest
 
 import robokin
 from robokin._native import kernels as K
-from robokin.kinematics.ik.lm_options import option_vector
 from robokin.kinematics.ik import restart_seeds
+from robokin.kinematics.ik.lm_options import option_vector
 from robokin.kinematics.ik.restart_seeds import NO_TABLE
 
 NATIVE = Path(robokin.__file__).parent / "_native"
