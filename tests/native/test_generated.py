@@ -16,6 +16,7 @@ import pytest
 
 import robokin
 from robokin._native import kernels as K
+from robokin.kinematics.ik import restart_seeds
 from robokin.kinematics.ik.lm_options import option_vector
 from robokin.kinematics.ik.restart_seeds import NO_TABLE
 
@@ -75,11 +76,15 @@ def test_option_values_outside_their_ranges_are_refused(index, value):
 
 
 def test_table_rows_indices_are_checked():
+    """lm_solve checks the cell starts where it reads them (every visited cell's rows
+    within [0, M]); here the one cell is read at once (no descent from q0)."""
     args = _lm_args()
     args[6] = np.zeros((3, 18))  # M = 3 rows
     args[8] = np.array([0, 0, 0, 1, 1, 1, 1.0])  # G = 1: cstart has 2 entries
     args[4] = args[4].copy()
     args[4][K.O_N_TABLE] = 1
+    args[4][K.O_N_SEEDS] = 1
+    args[4][K.O_USE_Q0] = 0.0  # the first attempt is the table's
     for good in ([0, 3], [0, 0], [3, 3]):
         args[7] = np.array(good, dtype=np.int64)
         K.lm_solve(*args)
@@ -90,6 +95,39 @@ def test_table_rows_indices_are_checked():
     args[7] = np.array([0, 1, 3], dtype=np.int64)  # G = 1 needs 2 entries
     with pytest.raises(ValueError, match="cstart does not match gdat"):
         K.lm_solve(*args)
+
+
+def test_only_the_table_cells_lm_solve_reads_are_checked():
+    """A corrupt cell start the search never reaches does not change a bit of the
+    answer (oracle: the same call with the clean table), and one it reaches is
+    refused. Fails on a kernel that scans every cell start at its entry (refused)."""
+    robot = robokin.load("ur5")
+    tab, cstart, gdat = restart_seeds.seed_table(robot.arm).kernel_args()
+    G = int(gdat[6])
+    q = np.array([[0.3, -1.2, 1.1, -0.4, 1.0, 0.2]])
+    T = robot.fk(q)
+    opts = option_vector(None, None, 1e-9, None, 100, 1.0)
+    opts[K.O_USE_Q0] = 0.0
+    opts[K.O_N_SEEDS] = 4
+    opts[K.O_N_TABLE] = 4
+    seeds = np.full((1, 4, 6), 0.5)
+    target_cell = restart_seeds.grid_cells(T[:, :3, 3], gdat[:3], gdat[3:6], G)[0]
+    far = (G**3 - 1) if target_cell < G**3 // 2 else 0  # a corner cell, not searched
+    assert abs(far // (G * G) - target_cell // (G * G)) > 1
+
+    def run(cs):
+        out = np.empty((1, 6 + K.N_RES))
+        K.lm_solve(robot.chain.arrays.packed, T, q, seeds, opts, out, tab, cs, gdat, False)
+        return out
+
+    clean = run(cstart)
+    corrupt = cstart.copy()
+    corrupt[far + 1] = len(tab) + 100  # rows past the table
+    assert run(corrupt).tobytes() == clean.tobytes()
+    corrupt = cstart.copy()
+    corrupt[target_cell] = -5
+    with pytest.raises(ValueError, match="lm_solve: cstart: an index outside"):
+        run(corrupt)
 
 
 def test_python_ints_are_range_checked_before_the_cast():

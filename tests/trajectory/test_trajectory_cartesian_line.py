@@ -132,3 +132,35 @@ def test_a_line_to_an_unreachable_goal_says_so():
     goal[0, 3] = 5.0  # 5 m away: far beyond the UR5's 0.95 m reach
     with pytest.raises(trajectory.PathError, match="goal itself is unreachable: out of reach"):
         trajectory.cartesian_line(robot, q0, goal, 2.0)
+
+
+def test_the_followers_residual_is_spatial_pose_error_bit_for_bit(aubo):
+    """The follower's residual (trajectory.cartesian._err, the compiled kernel called
+    directly) is robokin.spatial.pose_error's (the oracle: the public, checked
+    function) bit for bit, rotations near pi and the identity included, on a
+    non-contiguous path too (follow_poses makes its own contiguous copy)."""
+    from robokin.spatial import pose_error
+    from robokin.trajectory.cartesian import _err, follow_poses, line_poses
+
+    rng = np.random.default_rng(3)
+    q = rng.uniform(-2.0, 2.0, (40, 6))
+    T = aubo.fk(q)
+    Tt = T[rng.permutation(40)]
+    Tt[0] = T[0]  # identical poses: zero residual
+    Tt[1] = T[1] @ matrix_from_axis_angle(np.array([np.pi - 1e-9, 0.0, 0.0]))
+    e = np.empty(6)
+    for a, b in zip(T, Tt, strict=True):
+        size = _err(a, b, e)
+        ref = pose_error(a, b)
+        assert e.tobytes() == ref.tobytes() and size == np.abs(ref).max()
+    # a strided (non-contiguous) path follows like its contiguous copy
+    T0, T1 = _goal(aubo, Q0, [0.02, 0.01, -0.03])
+    path = line_poses(T0, T1, np.linspace(0.0, 1.0, 21))
+    wide = np.zeros((21, 4, 8))
+    wide[:, :, ::2] = path
+    strided = wide[:, :, ::2]
+    assert not strided.flags.c_contiguous
+    a = follow_poses(aubo, strided, Q0)
+    b = follow_poses(aubo, path, Q0)
+    assert a.first_failure is None and a.error.max() < 1e-9
+    assert a.q.tobytes() == b.q.tobytes()

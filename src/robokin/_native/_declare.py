@@ -215,7 +215,10 @@ LM = Group("lm.c", kernels=(
                         Arr("seeds", "f64", ("N", "R", "n")), LM_OPTS,
                         Arr("out", "f64", ("N", "n + N_RES"), out=True),
                         Arr("tab", "f64", ("M", "tab_cols")),
-                        Arr("cstart", "i64", ("C",), values=("0", "M"), monotone=True),
+                        # cstart's values are checked where lm.c reads them (each cell's
+                        # [start, end) within [0, M]; a bad one: ValueError after the
+                        # run), not all G^3 + 1 of them on every call
+                        Arr("cstart", "i64", ("C",)),
                         Arr("gdat", "f64", (7,)), Flag("parallel")),
            "tuple[int, int]",
            "Numeric IK of targets (N, 4, 4) into out (N, n + N_RES).\n\n"

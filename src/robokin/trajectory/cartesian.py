@@ -23,10 +23,10 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 import numpy.typing as npt
 
+from robokin._native import kernels as _k
 from robokin._validation import check_finite, check_joints, check_transform
 from robokin.exceptions import InputError, RobokinError
 from robokin.spatial import (
-    pose_error,
     rotation_from_rotvec,
     rotvec_from_rotation,
     wrap_angle,
@@ -126,10 +126,12 @@ def line_poses(T_start: npt.ArrayLike, T_goal: npt.ArrayLike, s: npt.ArrayLike
 def _err(T: np.ndarray, Tt: np.ndarray, e: np.ndarray) -> float:
     """Fill ``e`` (6,) with the base-frame pose error; return its largest component.
 
-    The error runs from the current pose to the target
-    (:func:`robokin.spatial.pose_error`).
+    The error runs from the current pose to the target: the compiled residual of
+    :func:`robokin.spatial.pose_error`, called directly because ``T`` and ``Tt``
+    are the follower's own C-contiguous float64 (4, 4) poses (the argument checks
+    ``pose_error`` makes on a user's input were ~40 % of a 1,000-sample line).
     """
-    e[:] = pose_error(T, Tt)
+    _k.pose_error(T.reshape(1, 4, 4), Tt.reshape(1, 4, 4), e.reshape(1, 6))
     return float(np.abs(e).max())
 
 
@@ -177,7 +179,7 @@ def follow_poses(
     """
     from robokin.kinematics.jacobian import jacobian_and_pose
 
-    Tp = check_transform(T_path, "T_path")
+    Tp = np.ascontiguousarray(check_transform(T_path, "T_path"))
     if Tp.ndim != 3:
         raise InputError("T_path", f"expected shape (m, 4, 4), got {Tp.shape}")
     n = robot.n

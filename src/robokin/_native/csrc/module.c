@@ -116,6 +116,9 @@ static PyObject *lm_solve_body(const lm_solve_args *a)
     Py_BEGIN_ALLOW_THREADS
     lm_run(&cx, a->parallel);
     Py_END_ALLOW_THREADS
+    if (__atomic_load_n(&cx.bad_table, __ATOMIC_RELAXED)) /* checked where read (lm.c) */
+        return PyErr_Format(PyExc_ValueError, "robokin._native.lm_solve: cstart: an index "
+                            "outside [0, M] or decreasing");
     long fails = 0, first_bad = -1;
     for (npy_intp i = 0; i < a->N; i++) {
         double c = cx.out[(size_t)i * (n + N_RES) + n + R_CODE];
@@ -180,8 +183,11 @@ static PyObject *pose_error_body(const pose_error_args *a)
 static PyObject *table_nearest_body(const table_nearest_args *a)
 {
     int idx[TAB_K_MAX];
-    int found = table_nearest(a->rows, (long)a->cols, a->cstart, a->grid, (int)a->k,
-                              a->rot_w, a->T, idx);
+    int found = table_nearest(a->rows, (long)a->cols, (long)a->M, a->cstart, a->grid,
+                              (int)a->k, a->rot_w, a->T, idx);
+    if (found < 0) /* not reached: the entry checked every cell start */
+        return PyErr_Format(PyExc_ValueError, "robokin._native.table_nearest: cstart: an "
+                            "index outside [0, M] or decreasing");
     npy_intp dims[1] = {found};
     PyObject *out = PyArray_SimpleNew(1, dims, NPY_INT64);
     if (out != NULL)

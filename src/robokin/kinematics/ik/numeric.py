@@ -243,14 +243,17 @@ def _restart_rounds(chain: Chain, Tf: np.ndarray, Q0: np.ndarray, opts: np.ndarr
         sub = np.empty((todo.size, n + K.N_RES))
         par = bool((parallel is None and todo.size >= _PARALLEL_MIN_RESTARTS)
                    or parallel)
-        # (a target left here has spent every restart it was given, the same count)
-        seeds = np.empty((todo.size, R, n))
-        for base in np.unique(used[todo]):
-            rows = used[todo] == base
-            seeds[rows] = restart_seeds.uniforms(Tf[todo[rows]], Q0[todo[rows]], key,
-                                                 int(base), R)
-        K.lm_solve(packed, Tf[todo], Q0[todo], seeds, opts, sub, *restart_seeds.NO_TABLE,
-                   par)
+        # (a target left here has spent every restart it was given, the same count:
+        # one call for all, without np.unique's cost per round of a single solve)
+        Tt, Qt, base = Tf[todo], Q0[todo], used[todo]
+        if todo.size == 1 or (base == base[0]).all():
+            seeds = restart_seeds.uniforms(Tt, Qt, key, int(base[0]), R)
+        else:
+            seeds = np.empty((todo.size, R, n))
+            for b in np.unique(base):
+                rows = base == b
+                seeds[rows] = restart_seeds.uniforms(Tt[rows], Qt[rows], key, int(b), R)
+        K.lm_solve(packed, Tt, Qt, seeds, opts, sub, *restart_seeds.NO_TABLE, par)
         used[todo] += sub[:, n + K.R_RESTARTS] + 1
         out[todo, n + K.R_ITERS] += sub[:, n + K.R_ITERS]
         better = (sub[:, n + K.R_CODE] == K.CODE_OK) | (

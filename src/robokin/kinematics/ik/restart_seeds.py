@@ -136,7 +136,9 @@ def seed_key(rng: np.random.Generator | None) -> int:
         return 0
     if not isinstance(rng, np.random.Generator):
         raise InputError("rng", f"expected a numpy.random.Generator, got {rng!r:.60}")
-    return int(rng.integers(0, 2**63, dtype=np.uint64))
+    # one raw 64-bit draw of its bit generator (0.4 us; rng.integers took 2.7 us,
+    # ~15 % of a single solve)
+    return int(rng.bit_generator.random_raw())
 
 
 def uniforms(Tf: np.ndarray, Q0: np.ndarray, key: int, base: int, R: int) -> np.ndarray:
