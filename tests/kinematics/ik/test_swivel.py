@@ -120,7 +120,8 @@ def _check_intervals(sm):
         x = t[:, None]
         inn = np.zeros(len(t), bool)
         near = np.zeros(len(t), bool)
-        for sh in (0.0, _TWO_PI):
+        # t = pi is the point t = -pi: an interval starting at -pi ends there too
+        for sh in (-_TWO_PI, 0.0, _TWO_PI):
             inn |= ((x + sh > mine[:, 0]) & (x + sh < mine[:, 1])).any(1)
             near |= (np.minimum(np.abs(x + sh - mine[:, 0]),
                                 np.abs(x + sh - mine[:, 1])) < 1e-9).any(1)
