@@ -1587,6 +1587,9 @@ static int pk_walk(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double 
     pk_fk(g, th, &R, &p, J);
     if (pk_regular(J))
         return 0;
+#ifdef PK_DEBUG
+    fprintf(stderr, "   walk start\n");
+#endif
     double best[6], best_x = INFINITY;
     for (int dir = 0; dir < 2; dir++) {
         double cur[6], oa[6], v[6], prev[6];
@@ -1599,6 +1602,10 @@ static int pk_walk(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double 
             int stuck = 0;
             for (int j = 0; j < 6; j++)
                 stuck |= oa[j] > PK_WALK_STUCK * fabs(v[j]) * PK_WALK_LEN;
+#ifdef PK_DEBUG
+            if (stuck || k == 0)
+                fprintf(stderr, "   walk dir %d step %d stuck %d o %.2e %.2e %.2e %.2e %.2e %.2e v %.2e %.2e %.2e %.2e %.2e %.2e\n", dir, k, stuck, oa[0], oa[1], oa[2], oa[3], oa[4], oa[5], v[0], v[1], v[2], v[3], v[4], v[5]);
+#endif
             if (stuck)
                 break; /* a joint outside that the family hardly moves */
             double nxt[6], ob[6];
@@ -1652,8 +1659,107 @@ static int pk_walk(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double 
     return pk_accept(g, RT, pT, best, th);
 }
 
-/* The walk (pk_walk) for every valid row flagged singular and outside the limits
- * of a pose none of whose rows came inside: th from the row's coordinates. */
+/* Gauss-Newton steps on the pose with the joints in `frozen` held: the least-squares
+ * step of least norm over every singular direction down to 1e-15 of the largest
+ * (pk_lstsq leaves out those below 1e-10, and pk_polish_held steps of 0.1 rad or
+ * more: near several singular joints the pose is reached again only radians away
+ * along directions of singular value 1e-10), halved until it reduces the error (at
+ * most 14 times), up to 24 steps; returns the final error (pk_error). */
+static double pk_gauss_newton(const PkGeo *g, const m3 *RT, v3 pT, double *th, unsigned frozen)
+{
+    m3 R;
+    v3 p;
+    double J[6][6], e[6];
+    pk_fk(g, th, &R, &p, J);
+    double err = pk_error(RT, pT, &R, p, g->scale, e);
+    for (int it = 0; it < 24 && err > 1e-16; it++) {
+        double A[6][6], sig[6], V[6][6], dx[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+        for (int r = 0; r < 6; r++)
+            for (int c = 0; c < 6; c++)
+                A[r][c] = (frozen >> c & 1u) ? 0.0 : J[r][c];
+        pk_svd6(A, sig, V);
+        for (int i = 0; i < 6; i++) {
+            if (!(sig[i] > 1e-15 * sig[5]))
+                continue;
+            double ue = 0.0; /* (J v_i) . e = sigma_i u_i . e */
+            for (int r = 0; r < 6; r++) {
+                double a = 0.0;
+                for (int c = 0; c < 6; c++)
+                    a += ((frozen >> c & 1u) ? 0.0 : J[r][c]) * V[c][i];
+                ue += a * e[r];
+            }
+            for (int c = 0; c < 6; c++)
+                dx[c] += V[c][i] * ue / (sig[i] * sig[i]);
+        }
+        double t = 1.0, trial[6], e2[6], err2 = INFINITY;
+        for (int half = 0; half < 15; half++, t *= 0.5) {
+            for (int c = 0; c < 6; c++)
+                trial[c] = th[c] + t * dx[c];
+            m3 R2;
+            v3 p2;
+            pk_fk(g, trial, &R2, &p2, NULL);
+            err2 = pk_error(RT, pT, &R2, p2, g->scale, e2);
+            if (err2 < err)
+                break;
+        }
+        if (!(err2 < err))
+            break;
+        for (int c = 0; c < 6; c++)
+            th[c] = trial[c];
+        pk_fk(g, th, &R, &p, J);
+        err = pk_error(RT, pT, &R, p, g->scale, e);
+    }
+    return err;
+}
+
+/* The other last resort (after pk_walk): a row th just outside the limits whose
+ * joints outside the family does not move, or that lies on no exact family but on
+ * a thin set of near-solutions (singular values of 1e-10 to 1e-8): clamp the joints
+ * outside to the limit they passed, hold them, and Gauss-Newton the others back to
+ * the pose (pk_gauss_newton: it may move them radians); up to three rounds, as a
+ * joint may leave its limits on the way. Tried for rows at most PK_NUDGE outside;
+ * kept when every joint ends inside and the pose holds to PK_ACCEPT: returns 1
+ * when th changed. */
+static int pk_pin(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
+{
+    double trial[6], o[6];
+    unsigned frozen = 0u;
+    for (int j = 0; j < 6; j++)
+        trial[j] = th[j];
+    if (!(pk_excess(P, g, trial, o) <= PK_NUDGE))
+        return 0;
+    for (int round = 0; round < 3; round++) {
+        int moved = 0;
+        pk_excess(P, g, trial, o);
+        for (int j = 0; j < 6; j++) {
+            if (!(o[j] > 0.0) || (frozen >> j & 1u))
+                continue;
+            int f = g->full[j];
+            double sg = P[PK_SIGN + f], off = P[PK_OFFSET + f], lim;
+            pk_outside(wrap_pi(sg * (trial[j] - off)), P[PK_LO + f], P[PK_HI + f], &lim);
+            trial[j] = sg * lim + off;
+            frozen |= 1u << j;
+            moved = 1;
+        }
+        if (!moved)
+            break;
+        double err = pk_gauss_newton(g, RT, pT, trial, frozen);
+#ifdef PK_DEBUG
+        fprintf(stderr, "   pin round %d frozen %x err %.3e excess %.3e\n", round, frozen, err, pk_excess(P, g, trial, o));
+#endif
+        if (!(err <= PK_ACCEPT))
+            return 0;
+    }
+    if (!(pk_excess(P, g, trial, o) <= 0.5 * LIMIT_SLACK))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        trial[j] = wrap_pi(trial[j]);
+    return pk_accept(g, RT, pT, trial, th);
+}
+
+/* The last resorts (pk_walk, then pk_pin) for every valid row flagged singular and
+ * outside the limits of a pose none of whose rows came inside: th from the row's
+ * coordinates. */
 static void pk_walk_rows(const double *P, const PkGeo *g, const m3 *RT, v3 pT, int held,
                          double x, PkOut o)
 {
@@ -1670,7 +1776,7 @@ static void pk_walk_rows(const double *P, const PkGeo *g, const m3 *RT, v3 pT, i
             int f = g->full[j];
             th[j] = P[PK_SIGN + f] * qs[f] + P[PK_OFFSET + f];
         }
-        if (pk_walk(P, g, RT, pT, th))
+        if (pk_walk(P, g, RT, pT, th) || pk_pin(P, g, RT, pT, th))
             o.inside[slot] = pk_coords(P, g, th, held, x, qs) >= -1e-9;
     }
 }
