@@ -1572,13 +1572,19 @@ static int pk_family_dir(const PkGeo *g, const double *th, const double *prev, d
  * does (the row is isolated), loses the pose, or leaves a joint outside by more
  * than PK_WALK_STUCK times the most the rest of the walk could move it at its
  * present rate (a wrist flipped to q7 = pi: outside by 0.09 rad, moved 1e-9 per
- * radian). Kept when the pose holds to PK_ACCEPT:
+ * radian). Rows more than PK_WALK_REACH outside are not walked (a q1 0.165 rad
+ * past its limit on an SRS arm's coaxial family came inside; the bound keeps the
+ * cost down where no row can come inside). Kept when the pose holds to PK_ACCEPT:
  * returns 1 when th changed. */
 #define PK_WALK_STEP 0.05
 #define PK_WALK_LEN (2.0 * M_PI)
 #define PK_WALK_STUCK 1e3 /* outside by more than this times the most the family moves it: hopeless */
+#define PK_WALK_REACH 0.2  /* rows outside by more than this [rad] are not walked */
 static int pk_walk(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
 {
+    double v0[6], o0[6];
+    if (!(pk_excess(P, g, th, o0) <= PK_WALK_REACH))
+        return 0; /* farther out: the walk's cost where no row can come inside */
     if (pk_isolated(g, th))
         return 0;
     m3 R;
@@ -1587,17 +1593,24 @@ static int pk_walk(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double 
     pk_fk(g, th, &R, &p, J);
     if (pk_regular(J))
         return 0;
+    if (!pk_family_dir(g, th, NULL, 1.0, v0))
+        return 0; /* no family */
+    for (int j = 0; j < 6; j++)
+        if (o0[j] > PK_WALK_STUCK * fabs(v0[j]) * PK_WALK_LEN)
+            return 0; /* a joint outside that the family hardly moves (both ways) */
 #ifdef PK_DEBUG
     fprintf(stderr, "   walk start\n");
 #endif
     double best[6], best_x = INFINITY;
     for (int dir = 0; dir < 2; dir++) {
         double cur[6], oa[6], v[6], prev[6];
-        for (int j = 0; j < 6; j++)
+        for (int j = 0; j < 6; j++) {
             cur[j] = th[j];
-        pk_excess(P, g, cur, oa);
+            oa[j] = o0[j];
+            v[j] = dir ? -v0[j] : v0[j];
+        }
         for (int k = 0; k * PK_WALK_STEP < PK_WALK_LEN; k++) {
-            if (!pk_family_dir(g, cur, k ? prev : NULL, dir ? -1.0 : 1.0, v))
+            if (k && !pk_family_dir(g, cur, prev, 1.0, v))
                 break; /* the family ends (an isolated row) */
             int stuck = 0;
             for (int j = 0; j < 6; j++)
