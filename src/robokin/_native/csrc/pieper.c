@@ -1474,6 +1474,326 @@ static int pk_slide(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double
     return 1;
 }
 
+/* ------------------------------------------------- walk along a family */
+
+/* How far each joint of chain angles th (remaining chain) lies outside its limits
+ * (o[j], at the turn nearest them; negative: the margin inside) and the largest:
+ * a continuous function of th on the circle, so linear between nearby rows. */
+static double pk_excess(const double *P, const PkGeo *g, const double *th, double *o)
+{
+    double worst = -INFINITY;
+    for (int j = 0; j < 6; j++) {
+        int f = g->full[j];
+        double q = wrap_pi(P[PK_SIGN + f] * (th[j] - P[PK_OFFSET + f]));
+        double lo = P[PK_LO + f], hi = P[PK_HI + f], best = INFINITY;
+        for (int m = -1; m <= 1; m++) {
+            double qm = q + 2.0 * M_PI * m;
+            double d = qm < lo ? lo - qm : qm > hi ? qm - hi : -fmin(qm - lo, hi - qm);
+            best = fmin(best, d);
+        }
+        o[j] = best;
+        worst = fmax(worst, best);
+    }
+    return worst;
+}
+
+/* The t in [0, 1] where max_j (a_j + t (b_j - a_j)) is least (a convex piecewise
+ * linear function: its least value lies at an end or where two lines cross); the
+ * value into *val. */
+static double pk_minmax(const double *a, const double *b, double *val)
+{
+    double cand[2 + 15], best_t = 0.0, best = INFINITY;
+    int nc = 0;
+    cand[nc++] = 0.0;
+    cand[nc++] = 1.0;
+    for (int i = 0; i < 6; i++)
+        for (int k = i + 1; k < 6; k++) {
+            double den = (b[i] - a[i]) - (b[k] - a[k]);
+            if (den != 0.0) {
+                double t = (a[k] - a[i]) / den;
+                if (t > 0.0 && t < 1.0)
+                    cand[nc++] = t;
+            }
+        }
+    for (int c = 0; c < nc; c++) {
+        double t = cand[c], m = -INFINITY;
+        for (int j = 0; j < 6; j++)
+            m = fmax(m, a[j] + t * (b[j] - a[j]));
+        if (m < best) {
+            best = m;
+            best_t = t;
+        }
+    }
+    *val = best;
+    return best_t;
+}
+
+/* The unit null vector of the remaining Jacobian at th into v (oriented along
+ * `prev` when given, else by `sign` on its largest entry), if th lies on a
+ * one-parameter family (smallest singular value at most PK_FAMILY_SIGMA of the
+ * largest); returns 0 when it does not. */
+static int pk_family_dir(const PkGeo *g, const double *th, const double *prev, double sign,
+                         double *v)
+{
+    m3 R;
+    v3 p;
+    double J[6][6], sig[6], V[6][6];
+    pk_fk(g, th, &R, &p, J);
+    pk_svd6(J, sig, V);
+    if (!(sig[0] <= PK_FAMILY_SIGMA * sig[5]))
+        return 0;
+    double d = 0.0, big = 0.0;
+    for (int j = 0; j < 6; j++) {
+        v[j] = V[j][0];
+        if (prev != NULL)
+            d += v[j] * prev[j];
+        else if (fabs(v[j]) > fabs(big))
+            big = v[j];
+    }
+    double s = prev != NULL ? (d < 0.0 ? -1.0 : 1.0) : (big * sign < 0.0 ? -1.0 : 1.0);
+    for (int j = 0; j < 6; j++)
+        v[j] *= s;
+    return 1;
+}
+
+/* The last resort for a row th (remaining chain, exact) outside the limits on a
+ * one-parameter family of exact solutions, when no row of the pose came inside:
+ * next to several singular joints at once (the SRS arm stretched with the shoulder
+ * and its held joint 2 at 1e-9; the Panda with q2, q3 at 1e-9 and q5 at 1e-6) the
+ * joints outside move along the family at only ~1e-9 rad per radian, so the
+ * in-limit members can lie radians away, past stretches where other joints are
+ * outside (pk_inside's clamp and pk_slide's first-order step stall there). Walk
+ * the family (predictor: PK_WALK_STEP along the Jacobian's null vector; corrector:
+ * pk_polish) in both directions, up to PK_WALK_LEN each, and stop at the first
+ * row with every joint inside its limits; between two rows, where the linear
+ * interpolation of the joints' excess (pk_excess) says a window narrower than a
+ * step lies, that point is tried too. Failing that, the row with the smallest
+ * excess when it is within the 1e-9 slack. A walk ends early where the family
+ * does (the row is isolated), loses the pose, or leaves a joint outside by more
+ * than PK_WALK_STUCK times the most the rest of the walk could move it at its
+ * present rate (a wrist flipped to q7 = pi: outside by 0.09 rad, moved 1e-9 per
+ * radian). Rows more than PK_WALK_REACH outside are not walked (a q1 0.165 rad
+ * past its limit on an SRS arm's coaxial family came inside; the bound keeps the
+ * cost down where no row can come inside). Kept when the pose holds to PK_ACCEPT:
+ * returns 1 when th changed. */
+#define PK_WALK_STEP 0.05
+#define PK_WALK_LEN (2.0 * M_PI)
+#define PK_WALK_STUCK 1e3 /* outside by more than this times the most the family moves it: hopeless */
+#define PK_WALK_REACH 0.2  /* rows outside by more than this [rad] are not walked */
+static int pk_walk(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
+{
+    double v0[6], o0[6];
+    if (!(pk_excess(P, g, th, o0) <= PK_WALK_REACH))
+        return 0; /* farther out: the walk's cost where no row can come inside */
+    if (pk_isolated(g, th))
+        return 0;
+    m3 R;
+    v3 p;
+    double J[6][6];
+    pk_fk(g, th, &R, &p, J);
+    if (pk_regular(J))
+        return 0;
+    if (!pk_family_dir(g, th, NULL, 1.0, v0))
+        return 0; /* no family */
+    for (int j = 0; j < 6; j++)
+        if (o0[j] > PK_WALK_STUCK * fabs(v0[j]) * PK_WALK_LEN)
+            return 0; /* a joint outside that the family hardly moves (both ways) */
+#ifdef PK_DEBUG
+    fprintf(stderr, "   walk start\n");
+#endif
+    double best[6], best_x = INFINITY;
+    for (int dir = 0; dir < 2; dir++) {
+        double cur[6], oa[6], v[6], prev[6];
+        for (int j = 0; j < 6; j++) {
+            cur[j] = th[j];
+            oa[j] = o0[j];
+            v[j] = dir ? -v0[j] : v0[j];
+        }
+        for (int k = 0; k * PK_WALK_STEP < PK_WALK_LEN; k++) {
+            if (k && !pk_family_dir(g, cur, prev, 1.0, v))
+                break; /* the family ends (an isolated row) */
+            int stuck = 0;
+            for (int j = 0; j < 6; j++)
+                stuck |= oa[j] > PK_WALK_STUCK * fabs(v[j]) * PK_WALK_LEN;
+#ifdef PK_DEBUG
+            if (stuck || k == 0)
+                fprintf(stderr, "   walk dir %d step %d stuck %d o %.2e %.2e %.2e %.2e %.2e %.2e v %.2e %.2e %.2e %.2e %.2e %.2e\n", dir, k, stuck, oa[0], oa[1], oa[2], oa[3], oa[4], oa[5], v[0], v[1], v[2], v[3], v[4], v[5]);
+#endif
+            if (stuck)
+                break; /* a joint outside that the family hardly moves */
+            double nxt[6], ob[6];
+            for (int j = 0; j < 6; j++)
+                nxt[j] = cur[j] + PK_WALK_STEP * v[j];
+            if (!(pk_polish(g, RT, pT, nxt) <= PK_ACCEPT))
+                break; /* lost the family */
+            double xb = pk_excess(P, g, nxt, ob), xm, tm = pk_minmax(oa, ob, &xm);
+            if (xb > 0.0 && xm < fmin(0.0, best_x) && tm > 0.0 && tm < 1.0) {
+                double mid[6], om[6];
+                for (int j = 0; j < 6; j++)
+                    mid[j] = cur[j] + tm * PK_WALK_STEP * v[j];
+                if (pk_polish(g, RT, pT, mid) <= PK_ACCEPT) {
+                    double x = pk_excess(P, g, mid, om);
+#ifdef PK_DEBUG
+                    fprintf(stderr, "   walk dir %d step %d window t %.3f predicted %.3e got %.3e\n", dir, k, tm, xm, x);
+#endif
+                    if (x < best_x) {
+                        best_x = x;
+                        for (int j = 0; j < 6; j++)
+                            best[j] = mid[j];
+                    }
+                    if (x <= 0.0)
+                        break;
+                }
+            }
+#ifdef PK_DEBUG
+            if (k % 8 == 0)
+                fprintf(stderr, "   walk dir %d step %d excess %.3e\n", dir, k, xb);
+#endif
+            if (xb < best_x) {
+                best_x = xb;
+                for (int j = 0; j < 6; j++)
+                    best[j] = nxt[j];
+            }
+            if (best_x <= 0.0)
+                break;
+            for (int j = 0; j < 6; j++) {
+                cur[j] = nxt[j];
+                oa[j] = ob[j];
+                prev[j] = v[j];
+            }
+        }
+        if (best_x <= 0.0)
+            break;
+    }
+    if (!(best_x <= 0.5 * LIMIT_SLACK))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        best[j] = wrap_pi(best[j]);
+    return pk_accept(g, RT, pT, best, th);
+}
+
+/* Gauss-Newton steps on the pose with the joints in `frozen` held: the least-squares
+ * step of least norm over every singular direction down to 1e-15 of the largest
+ * (pk_lstsq leaves out those below 1e-10, and pk_polish_held steps of 0.1 rad or
+ * more: near several singular joints the pose is reached again only radians away
+ * along directions of singular value 1e-10), halved until it reduces the error (at
+ * most 14 times), up to 24 steps; returns the final error (pk_error). */
+static double pk_gauss_newton(const PkGeo *g, const m3 *RT, v3 pT, double *th, unsigned frozen)
+{
+    m3 R;
+    v3 p;
+    double J[6][6], e[6];
+    pk_fk(g, th, &R, &p, J);
+    double err = pk_error(RT, pT, &R, p, g->scale, e);
+    for (int it = 0; it < 24 && err > 1e-16; it++) {
+        double A[6][6], sig[6], V[6][6], dx[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+        for (int r = 0; r < 6; r++)
+            for (int c = 0; c < 6; c++)
+                A[r][c] = (frozen >> c & 1u) ? 0.0 : J[r][c];
+        pk_svd6(A, sig, V);
+        for (int i = 0; i < 6; i++) {
+            if (!(sig[i] > 1e-15 * sig[5]))
+                continue;
+            double ue = 0.0; /* (J v_i) . e = sigma_i u_i . e */
+            for (int r = 0; r < 6; r++) {
+                double a = 0.0;
+                for (int c = 0; c < 6; c++)
+                    a += ((frozen >> c & 1u) ? 0.0 : J[r][c]) * V[c][i];
+                ue += a * e[r];
+            }
+            for (int c = 0; c < 6; c++)
+                dx[c] += V[c][i] * ue / (sig[i] * sig[i]);
+        }
+        double t = 1.0, trial[6], e2[6], err2 = INFINITY;
+        for (int half = 0; half < 15; half++, t *= 0.5) {
+            for (int c = 0; c < 6; c++)
+                trial[c] = th[c] + t * dx[c];
+            m3 R2;
+            v3 p2;
+            pk_fk(g, trial, &R2, &p2, NULL);
+            err2 = pk_error(RT, pT, &R2, p2, g->scale, e2);
+            if (err2 < err)
+                break;
+        }
+        if (!(err2 < err))
+            break;
+        for (int c = 0; c < 6; c++)
+            th[c] = trial[c];
+        pk_fk(g, th, &R, &p, J);
+        err = pk_error(RT, pT, &R, p, g->scale, e);
+    }
+    return err;
+}
+
+/* The other last resort (after pk_walk): a row th just outside the limits whose
+ * joints outside the family does not move, or that lies on no exact family but on
+ * a thin set of near-solutions (singular values of 1e-10 to 1e-8): clamp the joints
+ * outside to the limit they passed, hold them, and Gauss-Newton the others back to
+ * the pose (pk_gauss_newton: it may move them radians); up to three rounds, as a
+ * joint may leave its limits on the way. Tried for rows at most PK_NUDGE outside;
+ * kept when every joint ends inside and the pose holds to PK_ACCEPT: returns 1
+ * when th changed. */
+static int pk_pin(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
+{
+    double trial[6], o[6];
+    unsigned frozen = 0u;
+    for (int j = 0; j < 6; j++)
+        trial[j] = th[j];
+    if (!(pk_excess(P, g, trial, o) <= PK_NUDGE))
+        return 0;
+    for (int round = 0; round < 3; round++) {
+        int moved = 0;
+        pk_excess(P, g, trial, o);
+        for (int j = 0; j < 6; j++) {
+            if (!(o[j] > 0.0) || (frozen >> j & 1u))
+                continue;
+            int f = g->full[j];
+            double sg = P[PK_SIGN + f], off = P[PK_OFFSET + f], lim;
+            pk_outside(wrap_pi(sg * (trial[j] - off)), P[PK_LO + f], P[PK_HI + f], &lim);
+            trial[j] = sg * lim + off;
+            frozen |= 1u << j;
+            moved = 1;
+        }
+        if (!moved)
+            break;
+        double err = pk_gauss_newton(g, RT, pT, trial, frozen);
+#ifdef PK_DEBUG
+        fprintf(stderr, "   pin round %d frozen %x err %.3e excess %.3e\n", round, frozen, err, pk_excess(P, g, trial, o));
+#endif
+        if (!(err <= PK_ACCEPT))
+            return 0;
+    }
+    if (!(pk_excess(P, g, trial, o) <= 0.5 * LIMIT_SLACK))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        trial[j] = wrap_pi(trial[j]);
+    return pk_accept(g, RT, pT, trial, th);
+}
+
+/* The last resorts (pk_walk, then pk_pin) for every valid row flagged singular and
+ * outside the limits of a pose none of whose rows came inside: th from the row's
+ * coordinates. */
+static void pk_walk_rows(const double *P, const PkGeo *g, const m3 *RT, v3 pT, int held,
+                         double x, PkOut o)
+{
+    for (int slot = 0; slot < 8; slot++)
+        if (o.valid[slot] && o.inside[slot])
+            return;
+    if (!pk_held_inside(P, held, x))
+        return; /* no row can come inside */
+    for (int slot = 0; slot < 8; slot++) {
+        if (!o.valid[slot] || !o.sing[slot])
+            continue;
+        double th[6], *qs = o.Q + o.n * slot;
+        for (int j = 0; j < 6; j++) {
+            int f = g->full[j];
+            th[j] = P[PK_SIGN + f] * qs[f] + P[PK_OFFSET + f];
+        }
+        if (pk_walk(P, g, RT, pT, th) || pk_pin(P, g, RT, pT, th))
+            o.inside[slot] = pk_coords(P, g, th, held, x, qs) >= -1e-9;
+    }
+}
+
 #include "pieper_srs.c"
 
 /* Every solution of pose T (4 x 4 row-major) with the held joint (if any) at x;
@@ -1605,6 +1925,8 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
     for (int slot = 0; slot < 8 && !inside; slot++)
         if ((lmask >> slot & 1u) && pk_slide(P, &g, &RT, pT, late[slot]))
             o.inside[slot] = pk_coords(P, &g, late[slot], held, x, o.Q + o.n * slot) >= -1e-9;
+    if (any)
+        pk_walk_rows(P, &g, &RT, pT, held, x, o);
     return any ? PK_OK : PK_NO_ORIENTATION;
 }
 
