@@ -53,11 +53,13 @@ from robokin.kinematics.ik.self_motion_families import (
     _ContinuedFamily,
     _Family,
     _family,
+    _HeldFamily,
     _setup,
     _SwivelFamily,
 )
 from robokin.kinematics.ik.self_motion_intervals import (
     GRID,
+    _compiled,
     _exact_points,
     _grid,
     _intervals,
@@ -356,6 +358,14 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
         return SelfMotion(Ta, fam.name, None, np.array(fam.domain), True, 8, intervals, owner,
                           crossings, singular, "swivel closed form (SRS), compiled",
                           {"bisected": 0, "grid": 0}, fam, limits)
+    fallback: dict[str, Any] = {}
+    if isinstance(fam, _HeldFamily) and not reference:
+        intervals, owner, crossings, singular, info = _compiled(robot, fam)
+        if not info["flags"]:
+            return SelfMotion(Ta, fam.name, fam.joint, np.array(fam.domain), False, fam.k,
+                              intervals, owner, crossings, singular,
+                              f"analytic:pieper ({fam.name} held), compiled", info, fam, limits)
+        fallback = {"compiled": False, "flags": info["flags"]}  # not certified: solved points
     marks = _exact_points(robot, fam, limits)
     if isinstance(fam, _ContinuedFamily):
         grid = min(int(grid), _CONTINUED_GRID)  # each value is a general-6R solve
@@ -370,7 +380,7 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
               if isinstance(fam, _ContinuedFamily) else f"analytic:pieper ({fam.name} held)")
     return SelfMotion(Ta, fam.name, fam.joint, np.array(fam.domain), fam.periodic, fam.k,
                       intervals, owner, crossings, singular, method,
-                      {"bisected": bisected, "grid": int(grid)}, fam, limits)
+                      {"bisected": bisected, "grid": int(grid), **fallback}, fam, limits)
 
 
 def parameter_values(robot: ArmSource, T: np.ndarray, q: np.ndarray
