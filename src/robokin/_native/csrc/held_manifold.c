@@ -35,15 +35,20 @@
 #define HM_MAXQ 24      /* (joint, value) queries */
 #define HM_MAXCUT 256   /* cuts per branch */
 #define HM_JUMP 0.5     /* a joint moving more than this [rad] in a cell: split */
-#define HM_DEPTH 8      /* splits of a grid cell */
+#define HM_DEPTH 14     /* splits of a grid cell */
 #define HM_TOL 1e-12    /* a crossing's joint at its value to this [rad] */
+#define HM_TOL_STEEP 1e-9 /* the same where t's last bit moves the joint more */
 #define HM_GRAIN 4
-#define HM_FOLD_STEPS 8 /* rows between a branch end and its grid row */
+#define HM_NEAR 1e-6 /* a node with 1 / |dq/dt|^2 below this times its cell: at a branch end */
+#define HM_MAXF 32 /* branch ends per slot remembered for its partner */
+#define HM_FOLD_TOL 1e-11 /* a branch end to this (relative) */
+#define HM_FOLD_STEPS 6 /* rows between a branch end and its grid row */
 #define HM_PARALLEL_MIN 8
 
 enum { HM_KIND_LOWER = 0, HM_KIND_UPPER = 1, HM_KIND_ALIGNED = 2, HM_KIND_FOLD = 3 };
 enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FLAG_FULL = 8,
        HM_FLAG_VANISH = 16, HM_FLAG_MEMORY = 32, HM_FLAG_BAD = 64 };
+
 
 /* Every slot at one t: coordinates (into the limits where a turn fits), slopes dq/dt
  * (NaN where the six other joints' Jacobian is singular), row exists, singular. */
@@ -65,8 +70,9 @@ typedef struct {
     long npts;
     double cut[8][HM_MAXCUT];
     int ncut[8];
-    long fold_cell[8];
-    double fold_t[8];
+    long fold_cell[8][HM_MAXF];
+    double fold_t[8][HM_MAXF];
+    int nfold[8];
 } HmCtx;
 
 /* The slopes dq/dt (n) of configuration q (n) along the manifold (held joint k at
@@ -216,7 +222,7 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
             best_f = fabs(f);
             best_t = t;
         }
-        if (f == 0.0 || best_f <= 1e-15)
+        if (f == 0.0 || best_f <= 1e-14)
             break;
         if ((f < 0) == (fa < 0)) {
             a = t;
@@ -240,8 +246,12 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
             tn = 0.5 * (a + e);
         t = tn;
     }
-    if (!(best_f <= HM_TOL))
+    /* a crossing as steep as an aligned triple makes it (q1, q3 swinging) may end
+     * with its bracket two adjacent floats: the value nearest the joint's there */
+    int collapsed = !(e - a > 2.0 * DBL_EPSILON * fmax(fabs(a), fabs(e)));
+    if (!(best_f <= HM_TOL) && !(collapsed && best_f <= HM_TOL_STEEP)) {
         c->flags |= HM_FLAG_CONVERGE;
+    }
     int kind = c->qkind[qi];
     hm_point(c, best_t, b, j, kind);
 }
@@ -311,12 +321,25 @@ static int hm_hermite_dips(double f0, double f1, double d0, double d1)
     return 0;
 }
 
+/* 1 / |dq/dt|^2 of slot b's row (0 where a slope is not finite) */
+static double hm_gap(const HmCtx *c, int b, const HmRow *r)
+{
+    double s = 0.0;
+    for (int j = 0; j < c->n; j++)
+        s += r->dq[b][j] * r->dq[b][j];
+    return isfinite(s) ? 1.0 / s : 0.0;
+}
+
 /* Whether a cell [r0, r1] of slot b must be split: a joint moving more than
  * HM_JUMP, a slope missing, or a query's sign change that its end slopes do not
  * explain as one monotone crossing, or whose Hermite model dips across. */
 static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1)
 {
-    double h = r1->t - r0->t;
+    double h = r1->t - r0->t, big = 0.0;
+    for (int j = 0; j < c->n; j++)
+        big = fmax(big, fabs(wrap_pi(r1->q[b][j] - r0->q[b][j])));
+    if (h < 1e-9 && big < 1e-6)
+        return 0; /* at a branch end (its rows within rounding of the double root) */
     for (int j = 0; j < c->n; j++) {
         if (fabs(wrap_pi(r1->q[b][j] - r0->q[b][j])) > HM_JUMP)
             return 1;
@@ -443,28 +466,72 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
  * root) takes the same end when its existence agreed at every bisection row. */
 static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1)
 {
-    double lo = r0->t, hi = r1->t, end;
+    double lo = r0->t, hi = r1->t, end = lo;
     int state0 = r0->valid[b], p = b ^ 1;
-    if (c->fold_cell[b] == cell) {
-        end = c->fold_t[b]; /* found with the partner */
-    } else {
+    HmRow chk;
+    int known = 0;
+    for (int f = 0; f < c->nfold[b] && !known; f++) {
+        if (c->fold_cell[b][f] != cell)
+            continue; /* the partner's end in this cell: checked on both sides */
+        double e = c->fold_t[b][f];
+        double out = e + copysign(HM_FOLD_TOL * fmax(1.0, fabs(e)), state0 ? 1.0 : -1.0);
+        hm_eval(c, e, 0u, &chk);
+        int ok = chk.valid[b];
+        hm_eval(c, out, 0u, &chk);
+        known = ok && !chk.valid[b];
+        end = e;
+    }
+    if (!known) {
         int agree = r0->valid[p] == state0 && r1->valid[p] == r1->valid[b];
+        /* v: the valid side, u: the other; g = 1 / |dq/dt|^2 falls linearly to 0
+         * at the fold (q moves as the square root of the distance): extrapolated
+         * from the last two valid rows, safeguarded by bisection */
+        double v = state0 ? lo : hi, u = state0 ? hi : lo, tv[2] = {v, NAN}, gv[2] = {0.0, 0.0};
         HmRow m;
+        int last_out = 0, last_est = 0;
+        gv[0] = hm_gap(c, b, state0 ? r0 : r1);
         for (int it = 0; it < 80; it++) {
-            double mid = 0.5 * (lo + hi);
-            if (mid == lo || mid == hi)
+            int est_used = 0;
+            double probe = 0.5 * (v + u), tiny = 0.25 * HM_FOLD_TOL * fmax(1.0, fabs(v));
+            if (probe == v || probe == u)
                 break;
-            hm_eval(c, mid, 0u, &m);
-            agree = agree && m.valid[p] == m.valid[b];
-            if (m.valid[b] == state0)
-                lo = mid;
-            else
-                hi = mid;
+            if (gv[0] == 0.0) {
+                probe = v + copysign(tiny, u - v); /* a slope infinite: at the fold */
+            } else if (last_out && last_est) {
+                probe = u - 0.05 * (u - v); /* the estimate overshot: just short of it */
+            } else if (isfinite(tv[1]) && gv[0] != gv[1]) {
+                double est = tv[0] - gv[0] * (tv[0] - tv[1]) / (gv[0] - gv[1]);
+                if ((est - v) * (u - v) > 0.0 && fabs(est - v) < fabs(u - v))
+                    probe = est;
+                est_used = probe == est;
+                if (fabs(probe - v) < tiny)
+                    probe = v + copysign(tiny, u - v);
+            }
+            if ((probe - u) * (u - v) >= 0.0)
+                probe = 0.5 * (v + u);
+            hm_eval(c, probe, 1u << b, &m);
+            last_out = !m.valid[b];
+            last_est = est_used;
+            if (m.valid[b]) {
+                tv[1] = tv[0];
+                gv[1] = gv[0];
+                tv[0] = v = probe;
+                gv[0] = hm_gap(c, b, &m);
+            } else {
+                u = probe;
+            }
+            if (fabs(u - v) <= HM_FOLD_TOL * fmax(1.0, fabs(v)))
+                break;
         }
+        if (!(fabs(u - v) <= 2.0 * HM_FOLD_TOL * fmax(1.0, fabs(v)))) {
+            c->flags |= HM_FLAG_CONVERGE;
+        }
+        lo = state0 ? v : u;
+        hi = state0 ? u : v;
         end = state0 ? lo : hi;
-        if (agree) {
-            c->fold_cell[p] = cell;
-            c->fold_t[p] = end;
+        if (agree && c->nfold[p] < HM_MAXF) {
+            c->fold_cell[p][c->nfold[p]] = cell;
+            c->fold_t[p][c->nfold[p]++] = end;
         }
     }
     hm_point(c, end, b, -1, HM_KIND_FOLD);
@@ -484,11 +551,40 @@ static int hm_cmp(const void *x, const void *y)
     return a < b ? -1 : a > b;
 }
 
-/* Slot b's pieces between its cuts, each decided at its midpoint, joined. */
+/* Whether slot b's row exists and is inside every limit (slack: allowed excess) */
+static int hm_inside(const HmCtx *c, const HmRow *r, int b, double slack)
+{
+    int good = r->valid[b];
+    for (int j = 0; j < c->n && good; j++)
+        good = r->q[b][j] >= c->P[PK_LO + j] - slack && r->q[b][j] <= c->P[PK_HI + j] + slack;
+    return good;
+}
+
+static int hm_emit(HmCtx *c, double *iv, long *k, double a, double e)
+{
+    if (*k > 0 && iv[2 * (*k - 1) + 1] == a && iv[2 * (*k - 1)] < a) {
+        iv[2 * (*k - 1) + 1] = e; /* continues the last one */
+        return 1;
+    }
+    if (*k >= HM_MAXI) {
+        c->flags |= HM_FLAG_FULL;
+        return 0;
+    }
+    iv[2 * *k] = a;
+    iv[2 * *k + 1] = e;
+    (*k)++;
+    return 1;
+}
+
+/* Slot b's pieces between its cuts (sorted, distinct), each decided at its
+ * midpoint, joined; a cut whose pieces on both sides are outside is an interval
+ * of its own ([t, t]) when its row is inside to 1e-12 (a branch touching the
+ * limits, e.g. the generating configuration at a limit at the range's end). */
 static void hm_intervals(HmCtx *c, int b, double lo, double hi, double *iv, long long *niv)
 {
     double *cut = c->cut[b];
-    int m = c->ncut[b];
+    int m = c->ncut[b], u = 0;
+    unsigned char good[HM_MAXCUT];
     if (m + 2 > HM_MAXCUT) {
         c->flags |= HM_FLAG_FULL;
         return;
@@ -498,35 +594,197 @@ static void hm_intervals(HmCtx *c, int b, double lo, double hi, double *iv, long
     for (int i = 0; i < m; i++)
         cut[i] = fmin(fmax(cut[i], lo), hi);
     qsort(cut, (size_t)m, sizeof(double), hm_cmp);
-    long k = 0;
-    int open = 0;
+    for (int i = 0; i < m; i++)
+        if (u == 0 || cut[i] > cut[u - 1])
+            cut[u++] = cut[i];
     HmRow r;
-    for (int i = 0; i + 1 < m; i++) {
-        double a = cut[i], e = cut[i + 1];
-        if (!(e > a))
-            continue;
-        hm_eval(c, 0.5 * (a + e), 0u, &r);
-        int good = r.valid[b];
-        for (int j = 0; j < c->n && good; j++)
-            good = r.q[b][j] >= c->P[PK_LO + j] && r.q[b][j] <= c->P[PK_HI + j];
-        if (!good) {
-            open = 0;
-            continue;
+    for (int i = 0; i + 1 < u; i++) {
+        hm_eval(c, 0.5 * (cut[i] + cut[i + 1]), 0u, &r);
+        good[i] = (unsigned char)hm_inside(c, &r, b, 0.0);
+    }
+    long k = 0;
+    for (int i = 0; i < u; i++) {
+        int left = i > 0 && good[i - 1], right = i + 1 < u && good[i];
+        if (!left && !right) {
+            hm_eval(c, cut[i], 0u, &r);
+            if (hm_inside(c, &r, b, 1e-12) && !hm_emit(c, iv, &k, cut[i], cut[i]))
+                break;
         }
-        if (open && iv[2 * (k - 1) + 1] == a) {
-            iv[2 * (k - 1) + 1] = e;
-            continue;
-        }
-        if (k >= HM_MAXI) {
-            c->flags |= HM_FLAG_FULL;
+        if (right && !hm_emit(c, iv, &k, cut[i], cut[i + 1]))
             break;
-        }
-        iv[2 * k] = a;
-        iv[2 * k + 1] = e;
-        k++;
-        open = 1;
     }
     *niv = k;
+}
+
+/* The existence margins of the position roots at held value x (pk_one's front end
+ * and pk_coplanar's two subproblems 4 written out): m[0] = (hypot(A, B) - |C|) /
+ * scale of the first angle (its two roots exist where m[0] >= 0), m[1 + i] the same
+ * of the second angle given first root i (NaN without it). A branch is born or
+ * dies where one crosses 0. Returns 0 when the position equations are not of the
+ * coplanar kind (He and Liu's case; the kernel then flags the pose). */
+static int hm_margins(const double *P, const double *T, double x, double *m)
+{
+    PkGeo g;
+    pk_geometry(P, x, &g);
+    m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
+    v3 pT = {T[3], T[7], T[11]};
+    m3 G = pk_mul_t(&RT, &g.RM);
+    int start = g.kase == PK_START, ia = start ? 3 : 0;
+    v3 p, d;
+    if (start) {
+        p = v3_add(m3_mv(&g.RM, m3_mtv(&RT, v3_sub(g.pt, pT))), g.tM);
+        d = g.pt;
+    } else {
+        p = g.pt;
+        d = v3_add(m3_mv(&G, v3_sub(g.pt, g.tM)), pT);
+    }
+    PkEq e;
+    pk_equations(&g, ia, p, d, &e);
+    int swap;
+    if (fabs(e.mbc) <= PK_COPLANAR)
+        swap = 0;
+    else if (fabs(e.mab) <= PK_COPLANAR)
+        swap = 1;
+    else
+        return 0;
+    double n[2], L = e.scale;
+    v3 h = swap ? e.ha : e.hc, o = swap ? e.oa : e.oc;
+    pk_null(h, e.hb, v3_scale(v3_sub(o, e.ob), 1.0 / L), n);
+    const double(*X)[2] = swap ? e.Q : e.P;
+    const double(*Y)[2] = swap ? e.P : e.Q;
+    double sx = swap ? -1.0 : 1.0;
+    double A = sx * (n[0] * X[0][0] + n[1] * X[1][0]);
+    double B = sx * (n[0] * X[0][1] + n[1] * X[1][1]);
+    double C = n[0] * e.r[0] + n[1] * e.r[1];
+    m[0] = (hypot(A, B) - fabs(C)) / L;
+    m[1] = m[2] = NAN;
+    if (hypot(A, B) <= 1e-12 * L)
+        return 0; /* the first angle free: not this kind */
+    Roots rx = pk_sp4(A, B, C, PK_SP4_SLACK * L);
+    double m0 = -n[1], m1 = n[0];
+    double Ay = -sx * (m0 * Y[0][0] + m1 * Y[1][0]);
+    double By = -sx * (m0 * Y[0][1] + m1 * Y[1][1]);
+    for (int i = 0; i < rx.n && i < 2; i++) {
+        double Xu0 = X[0][0] * rx.c[i] + X[0][1] * rx.s[i];
+        double Xu1 = X[1][0] * rx.c[i] + X[1][1] * rx.s[i];
+        double Cy = m0 * (e.r[0] - sx * Xu0) + m1 * (e.r[1] - sx * Xu1);
+        m[1 + i] = (hypot(Ay, By) - fabs(Cy)) / L;
+    }
+    if (rx.n == 1)
+        m[2] = m[1];
+    return 1;
+}
+
+/* The extremum of margin k in (a, e) (golden section; a maximum when want_max):
+ * its t. */
+static double hm_margin_extremum(const double *P, const double *T, int k, double a, double e,
+                                 int want_max)
+{
+    const double r = 0.6180339887498949;
+    double x1 = e - r * (e - a), x2 = a + r * (e - a), m[3], f1, f2;
+    hm_margins(P, T, x1, m);
+    f1 = want_max ? m[k] : -m[k];
+    hm_margins(P, T, x2, m);
+    f2 = want_max ? m[k] : -m[k];
+    for (int it = 0; it < 60 && e - a > 1e-13 * fmax(1.0, fabs(a)); it++) {
+        if (!(f1 <= f2)) { /* NaN counts as low */
+            e = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = e - r * (e - a);
+            hm_margins(P, T, x1, m);
+            f1 = want_max ? m[k] : -m[k];
+        } else {
+            a = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = a + r * (e - a);
+            hm_margins(P, T, x2, m);
+            f2 = want_max ? m[k] : -m[k];
+        }
+    }
+    return 0.5 * (a + e);
+}
+
+/* The first grid: G values over [lo, hi], and in every cell where a margin keeps
+ * its sign at both nodes but the parabola through it and a neighbour node turns
+ * back toward 0 inside the cell, its extremum (a branch born and dying between
+ * two nodes: an island; or a short gap). Returns the count (<= cap) into t,
+ * sorted; 0 and a flag when the margins are not available. */
+static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
+{
+    double (*m)[3] = malloc((size_t)G * sizeof(*m));
+    long nt = 0;
+    if (m == NULL) {
+        c->flags |= HM_FLAG_MEMORY;
+        return 0;
+    }
+    for (long i = 0; i < G; i++) {
+        t[i] = i == G - 1 ? hi : lo + (hi - lo) * (double)i / (double)(G - 1);
+        if (!hm_margins(c->P, c->T, t[i], m[i]))
+            c->flags |= HM_FLAG_BAD;
+    }
+    nt = G;
+    for (long i = 0; i + 1 < G; i++) {
+        if (isfinite(m[i][0]) && isfinite(m[i + 1][0]) && (m[i][0] < 0) != (m[i + 1][0] < 0)) {
+            /* the first angle's roots end here: the second's margins may change sign
+             * between the node and that end; a node just inside the end sees it */
+            double a = t[i], e = t[i + 1], me[3];
+            int in_a = m[i][0] >= 0;
+            for (int it = 0; it < 60 && e - a > 1e-12 * fmax(1.0, fabs(a)); it++) {
+                double mid = 0.5 * (a + e);
+                hm_margins(c->P, c->T, mid, me);
+                if ((me[0] >= 0) == in_a)
+                    a = mid;
+                else
+                    e = mid;
+            }
+            double w = 1e-9 * (t[i + 1] - t[i]) * (in_a ? -1.0 : 1.0), tin = in_a ? a : e;
+            if (nt < cap && (in_a ? tin + w > t[i] : tin + w < t[i + 1]))
+                t[nt++] = tin + w;
+        }
+        for (int k = 0; k < 3; k++) {
+            double a = m[i][k], e = m[i + 1][k];
+            if (!isfinite(a) || !isfinite(e) || (a < 0) != (e < 0))
+                continue;
+            /* the parabolas through (i - 1, i, i + 1) and (i, i + 1, i + 2) */
+            int turns = 0;
+            for (int side = 0; side < 2 && !turns; side++) {
+                long j = side ? i + 2 : i - 1;
+                if (j < 0 || j >= G || !isfinite(m[j][k]))
+                    continue;
+                double u[3] = {t[i], t[i + 1], t[j]}, f[3] = {a, e, m[j][k]};
+                /* divided differences */
+                double d1 = (f[1] - f[0]) / (u[1] - u[0]), d2 = (f[2] - f[1]) / (u[2] - u[1]);
+                double q2 = (d2 - d1) / (u[2] - u[0]);
+                if (q2 == 0.0)
+                    continue;
+                /* f = f0 + d1 (s - u0) + q2 (s - u0)(s - u1): f' = 0 at */
+                double s0 = 0.5 * (u[0] + u[1]) - d1 / (2.0 * q2);
+                if (!(s0 > u[0] && s0 < u[1]))
+                    continue;
+                double fs = f[0] + d1 * (s0 - u[0]) + q2 * (s0 - u[0]) * (s0 - u[1]);
+                /* toward 0: a maximum of a negative margin, a minimum of a positive one */
+                if ((a < 0 && q2 < 0 && fs > 2.0 * a) || (a >= 0 && q2 > 0 && fs < 0.5 * a))
+                    turns = 1;
+            }
+            if (!turns)
+                continue;
+            double te = hm_margin_extremum(c->P, c->T, k, t[i], t[i + 1], a < 0);
+            double me[3];
+            hm_margins(c->P, c->T, te, me);
+            if (!isfinite(me[k]) || (me[k] < 0) == (a < 0))
+                continue; /* no island, no gap */
+            if (nt >= cap) {
+                c->flags |= HM_FLAG_FULL;
+                break;
+            }
+            t[nt++] = te;
+        }
+    }
+    free(m);
+    qsort(t, (size_t)nt, sizeof(double), hm_cmp);
+    return nt;
 }
 
 /* One pose: grid rows, cells, folds, intervals. */
@@ -534,18 +792,23 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
 {
     const double *P = c->P;
     double lo = P[PK_LO + c->k], hi = P[PK_HI + c->k];
-    HmRow *rows = malloc((size_t)G * sizeof(HmRow));
+    long cap = 2 * G;
+    HmRow *rows = malloc((size_t)cap * sizeof(HmRow));
+    double *tg = malloc((size_t)cap * sizeof(double));
     for (int b = 0; b < 8; b++)
         niv[b] = 0;
-    if (rows == NULL) {
+    if (rows == NULL || tg == NULL) {
+        free(rows);
+        free(tg);
         c->flags |= HM_FLAG_MEMORY;
         return;
     }
+    G = hm_grid(c, G, lo, hi, tg, cap);
     for (long i = 0; i < G; i++)
-        hm_eval(c, i == G - 1 ? hi : lo + (hi - lo) * (double)i / (double)(G - 1), 0xffu,
-                &rows[i]);
+        hm_eval(c, tg[i], 0xffu, &rows[i]);
+    free(tg);
     for (int b = 0; b < 8; b++)
-        c->fold_cell[b] = -1;
+        c->nfold[b] = 0;
     for (int b = 0; b < 8; b++) {
         c->ncut[b] = 0;
         for (long i = 0; i < G; i++) {
@@ -554,7 +817,12 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
             if (i + 1 == G)
                 break;
             int v0 = rows[i].valid[b], v1 = rows[i + 1].valid[b];
-            if (v0 && v1)
+            double near = HM_NEAR * (rows[i + 1].t - rows[i].t);
+            if (v0 && v1 && hm_gap(c, b, &rows[i]) < near)
+                hm_fold_piece(c, b, &rows[i], &rows[i + 1]); /* a node at a branch end */
+            else if (v0 && v1 && hm_gap(c, b, &rows[i + 1]) < near)
+                hm_fold_piece(c, b, &rows[i + 1], &rows[i]);
+            else if (v0 && v1)
                 hm_cell(c, b, &rows[i], &rows[i + 1], 0);
             else if (v0 != v1)
                 hm_fold(c, b, i, &rows[i], &rows[i + 1]);
