@@ -402,7 +402,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
         }
         if ((d0 < 0) == (d1 < 0) || (f0 > 0) != (d0 < 0))
             continue; /* monotone, or moving away from the value first */
-        if (fabs(f0) > 0.5 * fabs(d0) * h + 0.5 * fabs(d1) * h && fabs(f1) > fabs(d1) * h)
+        if (fmin(fabs(f0), fabs(f1)) > fmax(fabs(d0), fabs(d1)) * h)
             continue; /* cannot reach it with the slopes seen (splits bound them) */
         HmRow m;
         hm_extremum(c, b, j, r0->t, d0, r1->t, d1, &m);
