@@ -211,6 +211,7 @@ def main(n: int = 200, repeat: int = 3, seed: int = 0, slow: int = 5) -> None:
             print(f"{name:11s} geofikpy: not applicable (its closed forms are the Panda's only)")
         if name != "panda":
             continue
+        held_kernel_rows(robot, T, repeat)
         for peer, fn in (("ssik charts", run_ssik), ("geofikpy q7", run_geofik)):
             try:
                 prow, ptimes = fn(robot, q, T, repeat)
@@ -221,6 +222,35 @@ def main(n: int = 200, repeat: int = 3, seed: int = 0, slow: int = 5) -> None:
             what = "per pose (charts)" if peer.startswith("ssik") else "per (pose, value)"
             print(f"{name:11s} {peer}: recovered {rec}/{n}, wrong {wrong} of {total} rows "
                   f"(max error {worst:.1e}); {ptimes['call'] * 1e6:.1f} us {what}")
+
+
+def held_kernel_rows(robot, T, repeat):
+    """The Panda's compiled held-joint manifold (issue 29): bare kernel and solved points.
+
+    Prints ``held_manifold`` on the whole batch (per pose, both cores for 8+ poses),
+    and ``self_motion(..., reference=True)`` (the solved-points path, what
+    ``robot.self_motion`` did before the kernel) on the same poses.
+    """
+    from robokin._native import kernels as K
+    from robokin.kinematics.ik.dispatch import solve
+    from robokin.kinematics.ik.self_motion import self_motion
+    from robokin.kinematics.ik.self_motion_families import _family
+    from robokin.kinematics.ik.self_motion_intervals import KERNEL_GRID, _aligned_values
+
+    T = np.ascontiguousarray(T)
+    N = len(T)
+    params = _family(robot.arm, T[0], "auto", solve).params
+    al = np.array(_aligned_values(robot.arm), dtype=np.float64).reshape(-1, 2)
+    out = (np.empty((N, 8, K.HM_MAXI, 2)), np.zeros((N, 8), np.int64),
+           np.empty((N, K.HM_MAXP, 4)), np.zeros(N, np.int64), np.zeros(N, np.int64),
+           np.zeros(N, np.int64))
+    kern = cpu_and_wall(lambda: K.held_manifold(params, T, al, KERNEL_GRID, *out), repeat)
+    flagged, solves = int((out[4] != 0).sum()), float(out[5].mean())
+    ref = cpu_and_wall(lambda: [self_motion(robot.arm, t, dispatch=solve, reference=True)
+                                for t in T], 1)
+    print(f"{'panda':11s} held_manifold kernel, one batch: {us([x / N for x in kern])} per pose "
+          f"({solves:.0f} closed-form solves per pose, {flagged} of {N} flagged to the "
+          f"solved-points path); solved points (reference=True) {us([x / N for x in ref])}")
 
 
 if __name__ == "__main__":

@@ -573,6 +573,28 @@ PACKED_LAYOUT: tuple[Section, ...] = (
     Section("wrap", "wrap", ("n",)),  # 1.0 where a coordinate may move by whole turns
 )
 
+HELD_MANIFOLD = Group("held_manifold.c", kernels=(
+    Kernel("held_manifold", (Arr("params", "f64", ("PK_N_PARAMS",)), Arr("T", "f64", POSE),
+                             Arr("aligned", "f64", ("A", 2)), Int("grid", 3, 100000),
+                             Arr("iv", "f64", ("N", 8, "HM_MAXI", 2), out=True),
+                             Arr("niv", "i64", ("N", 8), out=True),
+                             Arr("pts", "f64", ("N", "HM_MAXP", 4), out=True),
+                             Arr("npts", "i64", ("N",), out=True),
+                             Arr("flags", "i64", ("N",), out=True),
+                             Arr("evals", "i64", ("N",), out=True)),
+           "None", "Per pose of a held-joint Pieper family (the Panda's q7): the intervals "
+                   "inside every limit per slot (N, 8, HM_MAXI, 2) with counts (N, 8); points "
+                   "[t, branch, joint, kind] (N, HM_MAXP, 4) with counts (N,); flags (N,) "
+                   "(0: certain, else the solved-points path is needed) and pk_one calls (N,).\n\n"
+                   "aligned (A, 2): [joint, value] rows where a triple's outer axes line up; grid: "
+                   "values of t on the first grid.",
+           checks=(Check("pk_params_ok(a->params)", "params is not a Pieper parameter vector"),)),
+), constants=_consts("MAXI MAXP KIND_LOWER KIND_UPPER KIND_ALIGNED KIND_FOLD FLAG_SINGULAR "
+                     "FLAG_UNRESOLVED FLAG_CONVERGE FLAG_FULL FLAG_VANISH FLAG_MEMORY FLAG_BAD",
+                     "HM_", "HM_"),
+    comment="held-joint manifold output sizes, point kinds and flags")
+
 GROUPS: tuple[Group, ...] = (FK, LM, SIX_R, PIEPER, GENERAL6R, BROADPHASE, PROCESS,
-                             PLAN_CHECK, PLAN_RRTC, PLAN_PATH, SELF_MOTION, REACH)
+                             PLAN_CHECK, PLAN_RRTC, PLAN_PATH, SELF_MOTION, REACH,
+                             HELD_MANIFOLD)
 OPTION_VECTORS: tuple[Opts, ...] = (LM_OPTS, RC_OPTS, SP_OPTS)

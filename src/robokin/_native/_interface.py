@@ -251,6 +251,20 @@ class Kernels(Protocol):
     SM_KIND_ALIGNED: int
     SM_KIND_FOLD: int
     SM_TAG_VALUE: float
+    # held_manifold.c: held-joint manifold output sizes, point kinds and flags
+    HM_MAXI: int
+    HM_MAXP: int
+    HM_KIND_LOWER: int
+    HM_KIND_UPPER: int
+    HM_KIND_ALIGNED: int
+    HM_KIND_FOLD: int
+    HM_FLAG_SINGULAR: int
+    HM_FLAG_UNRESOLVED: int
+    HM_FLAG_CONVERGE: int
+    HM_FLAG_FULL: int
+    HM_FLAG_VANISH: int
+    HM_FLAG_MEMORY: int
+    HM_FLAG_BAD: int
 
     def fk1(self, q: object, packed: object, /) -> F64 | None:
         """Pose (4, 4) of one configuration q (n,), or None for the general path."""
@@ -679,4 +693,23 @@ class Kernels(Protocol):
 
         Per target the solutions inside the limits into counts (G, K); with ``with_w`` the
         best ``|det J|`` over a voxel's solutions into best (G,) (0: none).
+        """
+
+    def held_manifold(
+        self,
+        params: F64,
+        T: F64,
+        aligned: F64,
+        grid: int,
+        iv: F64,
+        niv: I64,
+        pts: F64,
+        npts: I64,
+        flags: I64,
+        evals: I64,
+        /,
+    ) -> None:
+        """Per pose of a held-joint Pieper family (the Panda's q7): the intervals inside every limit per slot (N, 8, HM_MAXI, 2) with counts (N, 8); points [t, branch, joint, kind] (N, HM_MAXP, 4) with counts (N,); flags (N,) (0: certain, else the solved-points path is needed) and pk_one calls (N,).
+
+        aligned (A, 2): [joint, value] rows where a triple's outer axes line up; grid: values of t on the first grid.
         """

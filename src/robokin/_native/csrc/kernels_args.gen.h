@@ -96,7 +96,8 @@ static const KOpt opts_sp_ranges[] = {{SP_VERTEX_TRIES, 1, 1, 0.0, 1000000000000
     X(swivel_rows, "swivel_rows(params, T, psi, Q, valid, sing) -> None: Every SRS configuration of poses T (N, 4, 4) at swivel angles psi (N, m): Q (N, m, 8, 7), valid, singular (N, m, 8).") \
     X(swivel_manifold, "swivel_manifold(params, T, iv, niv, pts, npts) -> None: Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,).") \
     X(swivel_near, "swivel_near(params, T, q_near, q, psi, slot, dist, found) -> None: Per pose: the in-limit configuration nearest q_near (N, 7) (2 pi wrapped distance) on the exact swivel intervals: q (N, 7), its psi, slot and distance (N,); found (N,) false (q NaN) where no part is inside.") \
-    X(six_r_reach, "six_r_reach(params, T, packed, with_w, counts, best) -> None: A reach map's 6R closed form in one pass, T (G voxels, K targets each).")
+    X(six_r_reach, "six_r_reach(params, T, packed, with_w, counts, best) -> None: A reach map's 6R closed form in one pass, T (G voxels, K targets each).") \
+    X(held_manifold, "held_manifold(params, T, aligned, grid, iv, niv, pts, npts, flags, evals) -> None: Per pose of a held-joint Pieper family (the Panda's q7): the intervals inside every limit per slot (N, 8, HM_MAXI, 2) with counts (N, 8); points [t, branch, joint, kind] (N, HM_MAXP, 4) with counts (N,); flags (N,) (0: certain, else the solved-points path is needed) and pk_one calls (N,).")
 
 /* per kernel, the checked arguments and the bound shape symbols (a->N) */
 typedef struct { PyObject *q; PyObject *packed; } fk1_args; /* fk.c / module.c */
@@ -149,6 +150,7 @@ typedef struct { const double *params; const double *T; const double *psi; doubl
 typedef struct { const double *params; const double *T; double *iv; long long *niv; double *pts; long long *npts; union { struct { npy_intp N; }; npy_intp sym[1]; }; } swivel_manifold_args; /* self_motion.c */
 typedef struct { const double *params; const double *T; const double *q_near; double *q; double *psi; long long *slot; double *dist; npy_bool *found; union { struct { npy_intp N; }; npy_intp sym[1]; }; } swivel_near_args; /* self_motion.c */
 typedef struct { const double *params; const double *T; Chain packed; int with_w; unsigned char *counts; double *best; union { struct { npy_intp G, K, n, nc; }; npy_intp sym[4]; }; } six_r_reach_args; /* reach.c */
+typedef struct { const double *params; const double *T; const double *aligned; long grid; double *iv; long long *niv; double *pts; long long *npts; long long *flags; long long *evals; union { struct { npy_intp N, A; }; npy_intp sym[2]; }; } held_manifold_args; /* held_manifold.c */
 
 KERNELS(KERNEL_BODY)
 

@@ -75,6 +75,8 @@ KERNEL_CHECK(swivel_near, !(sm_params_ok(a->params)) ? "params is not a swivel p
 static const KSpec swivel_near_spec = {"swivel_near", "swivel_near(params, T, q_near, q, psi, slot, dist, found)", 8, (const KArg[]){KA_ARRAY(swivel_near, params, 0, 0x0, NPY_DOUBLE, "(SM_N_PARAMS)", {-1, SM_N_PARAMS}), KA_ARRAY(swivel_near, T, 0, 0x1, NPY_DOUBLE, "(N, 4, 4)", {0, 0}, {-1, 4}, {-1, 4}), KA_ARRAY(swivel_near, q_near, 0, 0x0, NPY_DOUBLE, "(N, 7)", {0, 0}, {-1, 7}), KA_ARRAY(swivel_near, q, 1, 0x0, NPY_DOUBLE, "(N, 7)", {0, 0}, {-1, 7}), KA_ARRAY(swivel_near, psi, 1, 0x0, NPY_DOUBLE, "(N)", {0, 0}), KA_ARRAY(swivel_near, slot, 1, 0x0, NPY_INT64, "(N)", {0, 0}), KA_ARRAY(swivel_near, dist, 1, 0x0, NPY_DOUBLE, "(N)", {0, 0}), KA_ARRAY(swivel_near, found, 1, 0x0, NPY_BOOL, "(N)", {0, 0})}, offsetof(swivel_near_args, sym), 0xff, 0x0, swivel_near_check};
 KERNEL_CHECK(six_r_reach, !(six_r_params_ok(a->params)) ? "params is not a 6R parameter vector" : !(a->n == 6 && a->nc == 6) ? "packed is not a 6R chain" : !(a->K >= 1) ? "T needs a target per voxel" : NULL)
 static const KSpec six_r_reach_spec = {"six_r_reach", "six_r_reach(params, T, packed, with_w, counts, best)", 6, (const KArg[]){KA_ARRAY(six_r_reach, params, 0, 0x0, NPY_DOUBLE, "(SR_N_PARAMS)", {-1, SR_N_PARAMS}), KA_ARRAY(six_r_reach, T, 0, 0x3, NPY_DOUBLE, "(G, K, 4, 4)", {0, 0}, {1, 0}, {-1, 4}, {-1, 4}), KA_ROW(six_r_reach, packed, KA_PACKED, .binds = 0x3, .dim = {{2, 0}, {3, 0}}), KA_PLAIN(six_r_reach, with_w, KA_FLAG), KA_ARRAY(six_r_reach, counts, 1, 0x0, NPY_UINT8, "(G, K)", {0, 0}, {1, 0}), KA_ARRAY(six_r_reach, best, 1, 0x0, NPY_DOUBLE, "(G)", {0, 0})}, offsetof(six_r_reach_args, sym), 0x33, 0x0, six_r_reach_check};
+KERNEL_CHECK(held_manifold, !(pk_params_ok(a->params)) ? "params is not a Pieper parameter vector" : NULL)
+static const KSpec held_manifold_spec = {"held_manifold", "held_manifold(params, T, aligned, grid, iv, niv, pts, npts, flags, evals)", 10, (const KArg[]){KA_ARRAY(held_manifold, params, 0, 0x0, NPY_DOUBLE, "(PK_N_PARAMS)", {-1, PK_N_PARAMS}), KA_ARRAY(held_manifold, T, 0, 0x1, NPY_DOUBLE, "(N, 4, 4)", {0, 0}, {-1, 4}, {-1, 4}), KA_ARRAY(held_manifold, aligned, 0, 0x1, NPY_DOUBLE, "(A, 2)", {1, 0}, {-1, 2}), KA_ROW(held_manifold, grid, KA_INT, .lo = 3LL, .hi = 100000ULL), KA_ARRAY(held_manifold, iv, 1, 0x0, NPY_DOUBLE, "(N, 8, HM_MAXI, 2)", {0, 0}, {-1, 8}, {-1, HM_MAXI}, {-1, 2}), KA_ARRAY(held_manifold, niv, 1, 0x0, NPY_INT64, "(N, 8)", {0, 0}, {-1, 8}), KA_ARRAY(held_manifold, pts, 1, 0x0, NPY_DOUBLE, "(N, HM_MAXP, 4)", {0, 0}, {-1, HM_MAXP}, {-1, 4}), KA_ARRAY(held_manifold, npts, 1, 0x0, NPY_INT64, "(N)", {0, 0}), KA_ARRAY(held_manifold, flags, 1, 0x0, NPY_INT64, "(N)", {0, 0}), KA_ARRAY(held_manifold, evals, 1, 0x0, NPY_INT64, "(N)", {0, 0})}, offsetof(held_manifold_args, sym), 0x3f7, 0x0, held_manifold_check};
 
 KERNELS(KERNEL_ENTRY)
 
@@ -290,6 +292,19 @@ static int add_constants(PyObject *m)
         {"SM_KIND_UPPER", (long)(SM_KIND_UPPER)},
         {"SM_KIND_ALIGNED", (long)(SM_KIND_ALIGNED)},
         {"SM_KIND_FOLD", (long)(SM_KIND_FOLD)},
+        {"HM_MAXI", (long)(HM_MAXI)},
+        {"HM_MAXP", (long)(HM_MAXP)},
+        {"HM_KIND_LOWER", (long)(HM_KIND_LOWER)},
+        {"HM_KIND_UPPER", (long)(HM_KIND_UPPER)},
+        {"HM_KIND_ALIGNED", (long)(HM_KIND_ALIGNED)},
+        {"HM_KIND_FOLD", (long)(HM_KIND_FOLD)},
+        {"HM_FLAG_SINGULAR", (long)(HM_FLAG_SINGULAR)},
+        {"HM_FLAG_UNRESOLVED", (long)(HM_FLAG_UNRESOLVED)},
+        {"HM_FLAG_CONVERGE", (long)(HM_FLAG_CONVERGE)},
+        {"HM_FLAG_FULL", (long)(HM_FLAG_FULL)},
+        {"HM_FLAG_VANISH", (long)(HM_FLAG_VANISH)},
+        {"HM_FLAG_MEMORY", (long)(HM_FLAG_MEMORY)},
+        {"HM_FLAG_BAD", (long)(HM_FLAG_BAD)},
     };
     const struct { const char *name; double value; } floats[] = {
         {"MAX_TRANSLATION", (double)(MAX_TRANSLATION)},

@@ -38,6 +38,7 @@
 #include "pieper.c"
 #include "process.c"
 #include "self_motion.c"
+#include "held_manifold.c"
 #include "reach.c"
 
 #define F64(a) ((double *)PyArray_DATA(a))

@@ -54,11 +54,13 @@ from robokin.kinematics.ik.self_motion_families import (
     _ContinuedFamily,
     _Family,
     _family,
+    _HeldFamily,
     _setup,
     _SwivelFamily,
 )
 from robokin.kinematics.ik.self_motion_intervals import (
     GRID,
+    _compiled,
     _exact_points,
     _grid,
     _intervals,
@@ -418,6 +420,15 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
                           "swivel closed form (SRS), compiled", {"bisected": 0, "grid": 0},
                           sw, limits, points)
     fam = _family(robot, Ta, parameter, dispatch, reference)
+    fallback: dict[str, Any] = {}
+    if isinstance(fam, _HeldFamily) and not reference:
+        intervals, owner, crossings, singular, info = _compiled(robot, fam)
+        if not info["flags"]:
+            return SelfMotion(Ta, fam.name, fam.joint, np.array(fam.domain), False, fam.k,
+                              intervals, owner,
+                              f"analytic:pieper ({fam.name} held), compiled", info, fam, limits,
+                              _records=(crossings, singular))
+        fallback = {"compiled": False, "flags": info["flags"]}  # not certified: solved points
     marks = _exact_points(robot, fam, limits)
     if isinstance(fam, _ContinuedFamily):
         grid = min(int(grid), _CONTINUED_GRID)  # each value is a general-6R solve
@@ -431,8 +442,9 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
               else f"continued general 6R ({fam.name} held)"
               if isinstance(fam, _ContinuedFamily) else f"analytic:pieper ({fam.name} held)")
     return SelfMotion(Ta, fam.name, fam.joint, np.array(fam.domain), fam.periodic, fam.k,
-                      intervals, owner, method, {"bisected": bisected, "grid": int(grid)}, fam,
-                      limits, _records=(crossings, singular))
+                      intervals, owner, method,
+                      {"bisected": bisected, "grid": int(grid), **fallback}, fam, limits,
+                      _records=(crossings, singular))
 
 
 #: The swivel's parameter range (copied into each SelfMotion).

@@ -13,8 +13,15 @@ from typing import Any
 
 import numpy as np
 
+from robokin._native import kernels as K
 from robokin.kinematics.arm import Arm
-from robokin.kinematics.ik.self_motion_families import _Family, _setup
+from robokin.kinematics.ik.self_motion_families import (
+    LimitCrossing,
+    SingularPoint,
+    _Family,
+    _HeldFamily,
+    _setup,
+)
 from robokin.spatial import wrap_angle as _wrap
 
 #: Parameter values on the checking grid.
@@ -22,6 +29,8 @@ GRID = 721
 #: Bisection steps (a 2 pi domain to 2**-52 of its width).
 _BISECT = 56
 _TWO_PI = 2 * np.pi
+#: Parameter values on the compiled held-joint kernel's first grid (``held_manifold``).
+KERNEL_GRID = 181
 #: At most this many grid changes without an exact point are bisected (a pose on a
 #: singular manifold, e.g. the SRS arm stretched with its wrist in line, has many).
 _MAX_BISECT = 64
@@ -195,3 +204,41 @@ def _join_wrap(pieces: list[tuple[int, float, float]], lo: float, hi: float
             out.remove(last)
             out.append((b, last[1], first[2] + _TWO_PI))
     return sorted(out)
+
+
+_KINDS = ("lower", "upper", "aligned axes", "fold")  # HM_KIND_* 0-3
+
+
+def _compiled(robot: Arm, fam: _HeldFamily, grid: int = KERNEL_GRID
+              ) -> tuple[np.ndarray, np.ndarray, tuple[LimitCrossing, ...],
+                         tuple[SingularPoint, ...], dict[str, Any]]:
+    """A held-joint (Pieper) family's intervals and points by the compiled kernel.
+
+    ``csrc/held_manifold.c``: a grid of the parameter with the rows' slopes dq/dt,
+    crossings bracketed and refined by safeguarded Newton on q_j(t) - limit, folds
+    bisected, pieces decided at their midpoints. Returns ``(intervals, owner,
+    crossings, singular, info)``; ``info["flags"]`` is nonzero when the kernel
+    could not certify the pose (then the caller takes the solved-points path).
+    """
+    aligned = np.array([[j, v] for j, v in _aligned_values(robot)],
+                       dtype=np.float64).reshape(-1, 2)
+    T = np.ascontiguousarray(fam.T, dtype=np.float64)[None]
+    iv = np.empty((1, 8, K.HM_MAXI, 2))
+    niv = np.zeros((1, 8), dtype=np.int64)
+    pts = np.empty((1, K.HM_MAXP, 4))
+    npts, flags, evals = (np.zeros(1, dtype=np.int64) for _ in range(3))
+    K.held_manifold(np.ascontiguousarray(fam.params, dtype=np.float64), T, aligned, int(grid),
+                    iv, niv, pts, npts, flags, evals)
+    intervals = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
+    owner = np.repeat(np.arange(8), niv[0])
+    p = pts[0, :npts[0]]
+    p = p[np.lexsort((p[:, 0], p[:, 1]))]
+    limit = p[:, 3] <= K.HM_KIND_UPPER
+    cross = tuple(LimitCrossing(t, int(b), int(j), _KINDS[int(k)])
+                  for t, b, j, k in p[limit].tolist())
+    fold = p[:, 3] == K.HM_KIND_FOLD
+    sing = tuple(SingularPoint(t, int(b), _KINDS[int(k)])
+                 for t, b, _, k in np.concatenate([p[fold], p[~fold & ~limit]]).tolist())
+    info = {"bisected": 0, "grid": int(grid), "compiled": True, "flags": int(flags[0]),
+            "solves": int(evals[0])}
+    return intervals, owner, cross, sing, info

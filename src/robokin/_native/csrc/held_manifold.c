@@ -1,0 +1,912 @@
+/*
+ * The whole self-motion of one pose of a 7R arm with a held-joint Pieper closed
+ * form (the Panda / FR3 with q7 as the parameter t; issue 29), in one pass per
+ * pose, on top of pieper.c's pk_one (its rows, unchanged):
+ *
+ *   1. a grid of t values over the held joint's range, every slot's row there
+ *      (pk_one) and its derivative dq/dt (the six other joints' Jacobian columns
+ *      solve -J_held: the pose stays fixed along the manifold);
+ *   2. per slot and cell between grid nodes with a row at both ends: the cell is
+ *      split (a midpoint solved, up to HM_DEPTH times) while a joint moves more
+ *      than HM_JUMP in it or a joint's distance to a value (a limit or an
+ *      aligned-axes value) changes sign inconsistently with its end slopes, or
+ *      its cubic Hermite model (values and slopes at the ends) dips across the
+ *      value; then per (joint, value) a sign change of q_j - value brackets one
+ *      crossing, and opposite end slopes an extremum (located by regula falsi on
+ *      dq_j/dt) whose value decides two crossings or none; every crossing is
+ *      refined by safeguarded Newton (the analytic slope) / Illinois regula falsi
+ *      on q_j(t) - value until the joint is at the value to 1e-14 (the row is
+ *      pk_one's: pose error <= 4e-13);
+ *   3. cells where a slot's row appears or disappears (a fold: two slots meet)
+ *      are bisected on the row's existence to adjacent floats (pk_one's own
+ *      test, as the numpy path did);
+ *   4. per slot, the pieces between domain ends, limit crossings and folds are
+ *      decided at their midpoints (a row inside every limit) and joined.
+ *
+ * A pose is flagged (flags != 0: the caller takes the solved-points path) when a
+ * row next to an aligned triple is met (pk_one flags it singular: q1, q3 swing
+ * there), a cell cannot be resolved within HM_DEPTH splits, a crossing does not
+ * converge to HM_TOL, a branch vanishes inside a cell with rows at both ends, or
+ * an output fills up.
+ */
+
+#define HM_MAXI 40      /* intervals per branch */
+#define HM_MAXP 512     /* points per pose */
+#define HM_MAXQ 24      /* (joint, value) queries */
+#define HM_MAXCUT 256   /* cuts per branch */
+#define HM_JUMP 0.5     /* a joint moving more than this [rad] in a cell: split */
+#define HM_DEPTH 14     /* splits of a grid cell */
+#define HM_TOL 1e-12    /* a crossing's joint at its value to this [rad] */
+#define HM_TOL_STEEP 1e-9 /* the same where t's last bit moves the joint more */
+#define HM_GRAIN 4
+#define HM_NEAR 1e-6 /* a node with 1 / |dq/dt|^2 below this times its cell: at a branch end */
+#define HM_MAXF 32 /* branch ends per slot remembered for its partner */
+#define HM_FOLD_TOL 1e-11 /* a branch end to this (relative) */
+#define HM_FOLD_STEPS 6 /* rows between a branch end and its grid row */
+#define HM_PARALLEL_MIN 8
+
+enum { HM_KIND_LOWER = 0, HM_KIND_UPPER = 1, HM_KIND_ALIGNED = 2, HM_KIND_FOLD = 3 };
+enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FLAG_FULL = 8,
+       HM_FLAG_VANISH = 16, HM_FLAG_MEMORY = 32, HM_FLAG_BAD = 64 };
+
+
+/* Every slot at one t: coordinates (into the limits where a turn fits), slopes dq/dt
+ * (NaN where the six other joints' Jacobian is singular), row exists, singular. */
+typedef struct {
+    double t;
+    double q[8][PK_MAXJ], dq[8][PK_MAXJ];
+    unsigned char valid[8], sing[8];
+} HmRow;
+
+typedef struct {
+    const double *P, *T;
+    int n, k;
+    double qn[PK_MAXJ];
+    int nq, qj[HM_MAXQ], qkind[HM_MAXQ];
+    double qv[HM_MAXQ];
+    int flags;
+    long evals;
+    double *pts;
+    long npts;
+    double cut[8][HM_MAXCUT];
+    int ncut[8];
+    long fold_cell[8][HM_MAXF];
+    double fold_t[8][HM_MAXF];
+    int nfold[8];
+} HmCtx;
+
+/* The slopes dq/dt (n) of configuration q (n) along the manifold (held joint k at
+ * slope 1): the full chain's spatial Jacobian columns [h x (p - o) / scale; h],
+ * the six other columns solving -J_k (Gaussian elimination, partial pivoting).
+ * NaN when that 6 x 6 is singular to rounding. */
+static void hm_slopes(const double *P, int n, int k, const double *q, double *dq)
+{
+    double scale = P[PK_SCALE], C[PK_MAXJ][6];
+    m3 A = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+    v3 t = {0.0, 0.0, 0.0}, hc[PK_MAXJ], oc[PK_MAXJ];
+    for (int j = 0; j < n; j++) {
+        v3 h = v3_at(P, PK_AXES + 3 * j), o = v3_at(P, PK_POINTS + 3 * j);
+        double th = P[PK_SIGN + j] * q[j] + P[PK_OFFSET + j];
+        hc[j] = m3_mv(&A, h);
+        oc[j] = v3_add(m3_mv(&A, o), t);
+        m3 Rj = pk_rotm(h, cos(th), sin(th));
+        t = v3_add(t, m3_mv(&A, v3_sub(o, m3_mv(&Rj, o))));
+        A = pk_mul(&A, &Rj);
+    }
+    v3 p = v3_add(m3_mv(&A, v3_at(P, PK_TOOL_T)), t);
+    for (int j = 0; j < n; j++) {
+        v3 v = v3_scale(v3_cross(hc[j], v3_sub(p, oc[j])), P[PK_SIGN + j] / scale);
+        v3 w = v3_scale(hc[j], P[PK_SIGN + j]);
+        C[j][0] = v.x;
+        C[j][1] = v.y;
+        C[j][2] = v.z;
+        C[j][3] = w.x;
+        C[j][4] = w.y;
+        C[j][5] = w.z;
+    }
+    double M[6][7];
+    int col[6], c = 0;
+    for (int j = 0; j < n && c < 6; j++)
+        if (j != k)
+            col[c++] = j;
+    for (int r = 0; r < 6; r++) {
+        for (int i = 0; i < 6; i++)
+            M[r][i] = C[col[i]][r];
+        M[r][6] = -C[k][r];
+    }
+    for (int i = 0; i < 6; i++) {
+        int piv = i;
+        for (int r = i + 1; r < 6; r++)
+            if (fabs(M[r][i]) > fabs(M[piv][i]))
+                piv = r;
+        if (!(fabs(M[piv][i]) > 1e-14)) {
+            for (int j = 0; j < n; j++)
+                dq[j] = NAN;
+            return;
+        }
+        if (piv != i)
+            for (int m = i; m < 7; m++) {
+                double s = M[i][m];
+                M[i][m] = M[piv][m];
+                M[piv][m] = s;
+            }
+        for (int r = i + 1; r < 6; r++) {
+            double f = M[r][i] / M[i][i];
+            for (int m = i; m < 7; m++)
+                M[r][m] -= f * M[i][m];
+        }
+    }
+    double x[6];
+    for (int i = 5; i >= 0; i--) {
+        double s = M[i][6];
+        for (int m = i + 1; m < 6; m++)
+            s -= M[i][m] * x[m];
+        x[i] = s / M[i][i];
+    }
+    for (int i = 0; i < 6; i++)
+        dq[col[i]] = x[i];
+    dq[k] = 1.0;
+}
+
+/* Every slot at t (pk_one), shifted into the limits by whole turns where that fits
+ * (as the numpy path's _into_limits); slopes for the slots in `mask`. */
+static void hm_eval(HmCtx *c, double t, unsigned mask, HmRow *r)
+{
+    const double *P = c->P;
+    unsigned char inside[8];
+    PkOut o = {&r->q[0][0], r->valid, r->sing, inside, PK_MAXJ};
+    r->t = t;
+    c->evals++;
+    pk_one(P, c->T, t, c->qn, o);
+    for (int b = 0; b < 8; b++) {
+        if (!r->valid[b])
+            continue;
+        for (int j = 0; j < c->n; j++) {
+            double q = r->q[b][j], lo = P[PK_LO + j], hi = P[PK_HI + j];
+            if (q < lo && q + 2.0 * M_PI <= hi)
+                q += 2.0 * M_PI;
+            else if (q > hi && q - 2.0 * M_PI >= lo)
+                q -= 2.0 * M_PI;
+            r->q[b][j] = q;
+        }
+        if (mask >> b & 1u)
+            hm_slopes(P, c->n, c->k, r->q[b], r->dq[b]);
+    }
+}
+
+static void hm_point(HmCtx *c, double t, int b, int j, int kind)
+{
+    if (c->npts >= HM_MAXP) {
+        c->flags |= HM_FLAG_FULL;
+        return;
+    }
+    double *p = c->pts + 4 * c->npts++;
+    p[0] = t;
+    p[1] = b;
+    p[2] = j;
+    p[3] = kind;
+    if (kind == HM_KIND_ALIGNED)
+        return;
+    if (c->ncut[b] >= HM_MAXCUT) {
+        c->flags |= HM_FLAG_FULL;
+        return;
+    }
+    c->cut[b][c->ncut[b]++] = t;
+}
+
+/* q_j - value of slot b's row, at the turn of value nearest q_j */
+static inline double hm_f(const HmCtx *c, const HmRow *r, int b, int qi)
+{
+    return wrap_pi(r->q[b][c->qj[qi]] - c->qv[qi]);
+}
+
+/* The root of q_j(t) - value (query qi, slot b) in (a, e), fa, fe of opposite
+ * signs (fa at a, continuous over the cell): Newton from the better end with
+ * the slope, Illinois regula falsi where Newton leaves the bracket. */
+static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, double fe)
+{
+    int j = c->qj[qi];
+    double best_t = fabs(fa) < fabs(fe) ? a : e, best_f = fmin(fabs(fa), fabs(fe));
+    double t = a - fa * (e - a) / (fe - fa);
+    int side = 0;
+    HmRow r;
+    for (int it = 0; it < 80; it++) {
+        hm_eval(c, t, 1u << b, &r);
+        if (!r.valid[b]) {
+            c->flags |= HM_FLAG_VANISH;
+            return;
+        }
+        /* f continuous from a: the turn of q_j nearest fa's */
+        double f = fa + wrap_pi(hm_f(c, &r, b, qi) - fa), d = r.dq[b][j];
+        if (fabs(f) < best_f) {
+            best_f = fabs(f);
+            best_t = t;
+        }
+        if (f == 0.0 || best_f <= 1e-14)
+            break;
+        if ((f < 0) == (fa < 0)) {
+            a = t;
+            fa = f;
+            if (side == -1)
+                fe *= 0.5;
+            side = -1;
+        } else {
+            e = t;
+            fe = f;
+            if (side == 1)
+                fa *= 0.5;
+            side = 1;
+        }
+        if (!(e - a > 2.0 * DBL_EPSILON * fmax(fabs(a), fabs(e))))
+            break;
+        double tn = t - f / d;
+        if (!(tn > a && tn < e) || !isfinite(tn))
+            tn = a - fa * (e - a) / (fe - fa);
+        if (!(tn > a && tn < e))
+            tn = 0.5 * (a + e);
+        t = tn;
+    }
+    /* a crossing as steep as an aligned triple makes it (q1, q3 swinging) may end
+     * with its bracket two adjacent floats: the value nearest the joint's there */
+    int collapsed = !(e - a > 2.0 * DBL_EPSILON * fmax(fabs(a), fabs(e)));
+    if (!(best_f <= HM_TOL) && !(collapsed && best_f <= HM_TOL_STEEP)) {
+        c->flags |= HM_FLAG_CONVERGE;
+    }
+    int kind = c->qkind[qi];
+    hm_point(c, best_t, b, j, kind);
+}
+
+/* The extremum of q_j (slot b) in (a, e) where the slopes da, de have opposite
+ * signs: Illinois regula falsi on the slope; its row into *out. */
+static void hm_extremum(HmCtx *c, int b, int j, double a, double da, double e, double de,
+                        HmRow *out)
+{
+    int side = 0;
+    double t = 0.5 * (a + e);
+    for (int it = 0; it < 60; it++) {
+        t = a - da * (e - a) / (de - da);
+        if (!(t > a && t < e))
+            t = 0.5 * (a + e);
+        hm_eval(c, t, 1u << b, out);
+        if (!out->valid[b]) {
+            c->flags |= HM_FLAG_VANISH;
+            return;
+        }
+        double d = out->dq[b][j];
+        if (!isfinite(d) || d == 0.0)
+            return;
+        if ((d < 0) == (da < 0)) {
+            a = t;
+            da = d;
+            if (side == -1)
+                de *= 0.5;
+            side = -1;
+        } else {
+            e = t;
+            de = d;
+            if (side == 1)
+                da *= 0.5;
+            side = 1;
+        }
+        if (!(e - a > 1e-13 * fmax(1.0, fabs(t))))
+            return;
+    }
+}
+
+/* Whether the cubic Hermite model of f on [0, 1] (values f0, f1, slopes d0, d1 per
+ * unit of the cell) takes the other sign of f0 inside (at an extremum). */
+static int hm_hermite_dips(double f0, double f1, double d0, double d1)
+{
+    /* f(s) = f0 + d0 s + a s^2 + b s^3 */
+    double a = 3.0 * (f1 - f0) - 2.0 * d0 - d1, b = 2.0 * (f0 - f1) + d0 + d1;
+    double A = 3.0 * b, B = 2.0 * a, C = d0, s[2];
+    int ns = 0;
+    if (fabs(A) < 1e-300) {
+        if (fabs(B) > 0.0)
+            s[ns++] = -C / B;
+    } else {
+        double disc = B * B - 4.0 * A * C;
+        if (disc >= 0.0) {
+            double sq = sqrt(disc);
+            s[ns++] = (-B + sq) / (2.0 * A);
+            s[ns++] = (-B - sq) / (2.0 * A);
+        }
+    }
+    for (int i = 0; i < ns; i++)
+        if (s[i] > 0.0 && s[i] < 1.0) {
+            double x = s[i], v = f0 + x * (d0 + x * (a + x * b));
+            if ((v < 0) != (f0 < 0) || fabs(v) <= HM_TOL)
+                return 1;
+        }
+    return 0;
+}
+
+/* 1 / |dq/dt|^2 of slot b's row (0 where a slope is not finite) */
+static double hm_gap(const HmCtx *c, int b, const HmRow *r)
+{
+    double s = 0.0;
+    for (int j = 0; j < c->n; j++)
+        s += r->dq[b][j] * r->dq[b][j];
+    return isfinite(s) ? 1.0 / s : 0.0;
+}
+
+/* Whether a cell [r0, r1] of slot b must be split: a joint moving more than
+ * HM_JUMP, a slope missing, or a query's sign change that its end slopes do not
+ * explain as one monotone crossing, or whose Hermite model dips across. */
+static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1)
+{
+    double h = r1->t - r0->t, big = 0.0;
+    for (int j = 0; j < c->n; j++)
+        big = fmax(big, fabs(wrap_pi(r1->q[b][j] - r0->q[b][j])));
+    if (h < 1e-9 && big < 1e-6)
+        return 0; /* at a branch end (its rows within rounding of the double root) */
+    for (int j = 0; j < c->n; j++) {
+        if (fabs(wrap_pi(r1->q[b][j] - r0->q[b][j])) > HM_JUMP)
+            return 1;
+        if (!isfinite(r0->dq[b][j]) || !isfinite(r1->dq[b][j]))
+            return 1;
+    }
+    for (int qi = 0; qi < c->nq; qi++) {
+        int j = c->qj[qi];
+        double f0 = hm_f(c, r0, b, qi), f1 = f0 + wrap_pi(r1->q[b][j] - r0->q[b][j]);
+        double d0 = r0->dq[b][j] * h, d1 = r1->dq[b][j] * h;
+        if (fabs(f0) > 3.0 || fabs(f1) > 3.0)
+            continue; /* the value's far turn: nothing near */
+        if ((f0 < 0) != (f1 < 0)) {
+            if ((d0 < 0) != (d1 < 0) || (d0 < 0) != (f1 < f0))
+                return 1; /* more than one crossing may lie inside */
+        } else if ((d0 < 0) == (d1 < 0) && hm_hermite_dips(f0, f1, d0, d1)) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth);
+
+/* The zeros of queries exactly at a node (a generating configuration at a limit) */
+static void hm_node(HmCtx *c, int b, const HmRow *r)
+{
+    for (int qi = 0; qi < c->nq; qi++)
+        if (fabs(hm_f(c, r, b, qi)) <= HM_TOL)
+            hm_point(c, r->t, b, c->qj[qi], c->qkind[qi]);
+}
+
+static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
+{
+    if (hm_needs_split(c, b, r0, r1)) {
+        if (depth < HM_DEPTH) {
+            HmRow m;
+            hm_eval(c, 0.5 * (r0->t + r1->t), 1u << b, &m);
+            if (!m.valid[b]) {
+                c->flags |= HM_FLAG_VANISH;
+                return;
+            }
+            hm_node(c, b, &m);
+            hm_cell(c, b, r0, &m, depth + 1);
+            hm_cell(c, b, &m, r1, depth + 1);
+            return;
+        }
+        c->flags |= HM_FLAG_UNRESOLVED;
+    }
+    double h = r1->t - r0->t;
+    for (int qi = 0; qi < c->nq; qi++) {
+        int j = c->qj[qi];
+        double f0 = hm_f(c, r0, b, qi), f1 = f0 + wrap_pi(r1->q[b][j] - r0->q[b][j]);
+        double d0 = r0->dq[b][j], d1 = r1->dq[b][j];
+        if (fabs(f0) <= HM_TOL || fabs(f1) <= HM_TOL || fabs(f0) > 3.0)
+            continue; /* a node's zero (hm_node), or the far turn */
+        if ((f0 < 0) != (f1 < 0)) {
+            hm_root(c, b, qi, r0->t, f0, r1->t, f1);
+            continue;
+        }
+        if ((d0 < 0) == (d1 < 0) || (f0 > 0) != (d0 < 0))
+            continue; /* monotone, or moving away from the value first */
+        if (fmin(fabs(f0), fabs(f1)) > fmax(fabs(d0), fabs(d1)) * h)
+            continue; /* cannot reach it with the slopes seen (splits bound them) */
+        HmRow m;
+        hm_extremum(c, b, j, r0->t, d0, r1->t, d1, &m);
+        if (!m.valid[b])
+            continue;
+        double fm = f0 + wrap_pi(m.q[b][j] - r0->q[b][j]);
+        if (fabs(fm) <= HM_TOL) {
+            hm_point(c, m.t, b, j, c->qkind[qi]); /* touches the value */
+        } else if ((fm < 0) != (f0 < 0)) {
+            hm_root(c, b, qi, r0->t, f0, m.t, fm);
+            hm_root(c, b, qi, m.t, fm, r1->t, f1);
+        }
+    }
+}
+
+/* The piece between a branch end (row re, slope infinite there: q - q_end grows
+ * as the square root of the distance) and the grid row rn: rows at distances
+ * 4^-k (k = 1..HM_FOLD_STEPS) of the piece from the end, so that the steps are
+ * even in that square root; the cells between them as any other, the last one
+ * (at the end) by its sign changes alone (regula falsi needs no slope). */
+static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
+{
+    HmRow r[HM_FOLD_STEPS + 1];
+    int m = 0;
+    double w = rn->t - re->t;
+    for (int k = HM_FOLD_STEPS; k >= 1; k--) {
+        hm_eval(c, re->t + w * ldexp(1.0, -2 * k), 1u << b, &r[m]);
+        if (!r[m].valid[b]) {
+            c->flags |= HM_FLAG_VANISH;
+            return;
+        }
+        hm_node(c, b, &r[m]);
+        m++;
+    }
+    /* ordered from the end: re, r[0], ..., r[m - 1], rn (w may be negative) */
+    const HmRow *first = &r[0];
+    for (int qi = 0; qi < c->nq; qi++) {
+        int j = c->qj[qi];
+        double f0 = hm_f(c, re, b, qi), f1 = f0 + wrap_pi(first->q[b][j] - re->q[b][j]);
+        if (fabs(f0) <= HM_TOL || fabs(f1) <= HM_TOL || fabs(f0) > 3.0)
+            continue;
+        if ((f0 < 0) != (f1 < 0)) {
+            if (w > 0)
+                hm_root(c, b, qi, re->t, f0, first->t, f1);
+            else
+                hm_root(c, b, qi, first->t, f1, re->t, f0);
+        }
+    }
+    for (int i = 0; i + 1 <= m; i++) {
+        const HmRow *x = &r[i], *y = i + 1 < m ? &r[i + 1] : rn;
+        if (w > 0)
+            hm_cell(c, b, x, y, 0);
+        else
+            hm_cell(c, b, y, x, 0);
+    }
+}
+
+/* A fold in (r0, r1): slot b's row exists at one end only. Bisected on its
+ * existence until the ends are adjacent floats; the last t with a row is the
+ * branch end (a cut and a point). The partner slot (b ^ 1: the same position
+ * root) takes the same end when its existence agreed at every bisection row. */
+static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1)
+{
+    double lo = r0->t, hi = r1->t, end = lo;
+    int state0 = r0->valid[b], p = b ^ 1;
+    HmRow chk;
+    int known = 0;
+    for (int f = 0; f < c->nfold[b] && !known; f++) {
+        if (c->fold_cell[b][f] != cell)
+            continue; /* the partner's end in this cell: checked on both sides */
+        double e = c->fold_t[b][f];
+        double out = e + copysign(HM_FOLD_TOL * fmax(1.0, fabs(e)), state0 ? 1.0 : -1.0);
+        hm_eval(c, e, 0u, &chk);
+        int ok = chk.valid[b];
+        hm_eval(c, out, 0u, &chk);
+        known = ok && !chk.valid[b];
+        end = e;
+    }
+    if (!known) {
+        int agree = r0->valid[p] == state0 && r1->valid[p] == r1->valid[b];
+        /* v: the valid side, u: the other; g = 1 / |dq/dt|^2 falls linearly to 0
+         * at the fold (q moves as the square root of the distance): extrapolated
+         * from the last two valid rows, safeguarded by bisection */
+        double v = state0 ? lo : hi, u = state0 ? hi : lo, tv[2] = {v, NAN}, gv[2] = {0.0, 0.0};
+        HmRow m;
+        int last_out = 0, last_est = 0;
+        gv[0] = hm_gap(c, b, state0 ? r0 : r1);
+        for (int it = 0; it < 80; it++) {
+            int est_used = 0;
+            double probe = 0.5 * (v + u), tiny = 0.25 * HM_FOLD_TOL * fmax(1.0, fabs(v));
+            if (probe == v || probe == u)
+                break;
+            if (gv[0] == 0.0) {
+                probe = v + copysign(tiny, u - v); /* a slope infinite: at the fold */
+            } else if (last_out && last_est) {
+                probe = u - 0.05 * (u - v); /* the estimate overshot: just short of it */
+            } else if (isfinite(tv[1]) && gv[0] != gv[1]) {
+                double est = tv[0] - gv[0] * (tv[0] - tv[1]) / (gv[0] - gv[1]);
+                if ((est - v) * (u - v) > 0.0 && fabs(est - v) < fabs(u - v))
+                    probe = est;
+                est_used = probe == est;
+                if (fabs(probe - v) < tiny)
+                    probe = v + copysign(tiny, u - v);
+            }
+            if ((probe - u) * (u - v) >= 0.0)
+                probe = 0.5 * (v + u);
+            hm_eval(c, probe, 1u << b, &m);
+            last_out = !m.valid[b];
+            last_est = est_used;
+            if (m.valid[b]) {
+                tv[1] = tv[0];
+                gv[1] = gv[0];
+                tv[0] = v = probe;
+                gv[0] = hm_gap(c, b, &m);
+            } else {
+                u = probe;
+            }
+            if (fabs(u - v) <= HM_FOLD_TOL * fmax(1.0, fabs(v)))
+                break;
+        }
+        if (!(fabs(u - v) <= 2.0 * HM_FOLD_TOL * fmax(1.0, fabs(v)))) {
+            c->flags |= HM_FLAG_CONVERGE;
+        }
+        lo = state0 ? v : u;
+        hi = state0 ? u : v;
+        end = state0 ? lo : hi;
+        if (agree && c->nfold[p] < HM_MAXF) {
+            c->fold_cell[p][c->nfold[p]] = cell;
+            c->fold_t[p][c->nfold[p]++] = end;
+        }
+    }
+    hm_point(c, end, b, -1, HM_KIND_FOLD);
+    HmRow re;
+    hm_eval(c, end, 1u << b, &re);
+    if (!re.valid[b]) {
+        c->flags |= HM_FLAG_VANISH;
+        return;
+    }
+    hm_node(c, b, &re);
+    hm_fold_piece(c, b, &re, state0 ? r0 : r1);
+}
+
+static int hm_cmp(const void *x, const void *y)
+{
+    double a = *(const double *)x, b = *(const double *)y;
+    return a < b ? -1 : a > b;
+}
+
+/* Whether slot b's row exists and is inside every limit (slack: allowed excess) */
+static int hm_inside(const HmCtx *c, const HmRow *r, int b, double slack)
+{
+    int good = r->valid[b];
+    for (int j = 0; j < c->n && good; j++)
+        good = r->q[b][j] >= c->P[PK_LO + j] - slack && r->q[b][j] <= c->P[PK_HI + j] + slack;
+    return good;
+}
+
+static int hm_emit(HmCtx *c, double *iv, long *k, double a, double e)
+{
+    if (*k > 0 && iv[2 * (*k - 1) + 1] == a && iv[2 * (*k - 1)] < a) {
+        iv[2 * (*k - 1) + 1] = e; /* continues the last one */
+        return 1;
+    }
+    if (*k >= HM_MAXI) {
+        c->flags |= HM_FLAG_FULL;
+        return 0;
+    }
+    iv[2 * *k] = a;
+    iv[2 * *k + 1] = e;
+    (*k)++;
+    return 1;
+}
+
+/* Slot b's pieces between its cuts (sorted, distinct), each decided at its
+ * midpoint, joined; a cut whose pieces on both sides are outside is an interval
+ * of its own ([t, t]) when its row is inside to 1e-12 (a branch touching the
+ * limits, e.g. the generating configuration at a limit at the range's end). */
+static void hm_intervals(HmCtx *c, int b, double lo, double hi, double *iv, long long *niv)
+{
+    double *cut = c->cut[b];
+    int m = c->ncut[b], u = 0;
+    unsigned char good[HM_MAXCUT];
+    if (m + 2 > HM_MAXCUT) {
+        c->flags |= HM_FLAG_FULL;
+        return;
+    }
+    cut[m++] = lo;
+    cut[m++] = hi;
+    for (int i = 0; i < m; i++)
+        cut[i] = fmin(fmax(cut[i], lo), hi);
+    qsort(cut, (size_t)m, sizeof(double), hm_cmp);
+    for (int i = 0; i < m; i++)
+        if (u == 0 || cut[i] > cut[u - 1])
+            cut[u++] = cut[i];
+    HmRow r;
+    for (int i = 0; i + 1 < u; i++) {
+        hm_eval(c, 0.5 * (cut[i] + cut[i + 1]), 0u, &r);
+        good[i] = (unsigned char)hm_inside(c, &r, b, 0.0);
+    }
+    long k = 0;
+    for (int i = 0; i < u; i++) {
+        int left = i > 0 && good[i - 1], right = i + 1 < u && good[i];
+        if (!left && !right) {
+            hm_eval(c, cut[i], 0u, &r);
+            if (hm_inside(c, &r, b, 1e-12) && !hm_emit(c, iv, &k, cut[i], cut[i]))
+                break;
+        }
+        if (right && !hm_emit(c, iv, &k, cut[i], cut[i + 1]))
+            break;
+    }
+    *niv = k;
+}
+
+/* The existence margins of the position roots at held value x (pk_one's front end
+ * and pk_coplanar's two subproblems 4 written out): m[0] = (hypot(A, B) - |C|) /
+ * scale of the first angle (its two roots exist where m[0] >= 0), m[1 + i] the same
+ * of the second angle given first root i (NaN without it). A branch is born or
+ * dies where one crosses 0. Returns 0 when the position equations are not of the
+ * coplanar kind (He and Liu's case; the kernel then flags the pose). */
+static int hm_margins(const double *P, const double *T, double x, double *m)
+{
+    PkGeo g;
+    pk_geometry(P, x, &g);
+    m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
+    v3 pT = {T[3], T[7], T[11]};
+    m3 G = pk_mul_t(&RT, &g.RM);
+    int start = g.kase == PK_START, ia = start ? 3 : 0;
+    v3 p, d;
+    if (start) {
+        p = v3_add(m3_mv(&g.RM, m3_mtv(&RT, v3_sub(g.pt, pT))), g.tM);
+        d = g.pt;
+    } else {
+        p = g.pt;
+        d = v3_add(m3_mv(&G, v3_sub(g.pt, g.tM)), pT);
+    }
+    PkEq e;
+    pk_equations(&g, ia, p, d, &e);
+    int swap;
+    if (fabs(e.mbc) <= PK_COPLANAR)
+        swap = 0;
+    else if (fabs(e.mab) <= PK_COPLANAR)
+        swap = 1;
+    else
+        return 0;
+    double n[2], L = e.scale;
+    v3 h = swap ? e.ha : e.hc, o = swap ? e.oa : e.oc;
+    pk_null(h, e.hb, v3_scale(v3_sub(o, e.ob), 1.0 / L), n);
+    const double(*X)[2] = swap ? e.Q : e.P;
+    const double(*Y)[2] = swap ? e.P : e.Q;
+    double sx = swap ? -1.0 : 1.0;
+    double A = sx * (n[0] * X[0][0] + n[1] * X[1][0]);
+    double B = sx * (n[0] * X[0][1] + n[1] * X[1][1]);
+    double C = n[0] * e.r[0] + n[1] * e.r[1];
+    m[0] = (hypot(A, B) - fabs(C)) / L;
+    m[1] = m[2] = NAN;
+    if (hypot(A, B) <= 1e-12 * L)
+        return 0; /* the first angle free: not this kind */
+    Roots rx = pk_sp4(A, B, C, PK_SP4_SLACK * L);
+    double m0 = -n[1], m1 = n[0];
+    double Ay = -sx * (m0 * Y[0][0] + m1 * Y[1][0]);
+    double By = -sx * (m0 * Y[0][1] + m1 * Y[1][1]);
+    for (int i = 0; i < rx.n && i < 2; i++) {
+        double Xu0 = X[0][0] * rx.c[i] + X[0][1] * rx.s[i];
+        double Xu1 = X[1][0] * rx.c[i] + X[1][1] * rx.s[i];
+        double Cy = m0 * (e.r[0] - sx * Xu0) + m1 * (e.r[1] - sx * Xu1);
+        m[1 + i] = (hypot(Ay, By) - fabs(Cy)) / L;
+    }
+    if (rx.n == 1)
+        m[2] = m[1];
+    return 1;
+}
+
+/* The extremum of margin k in (a, e) (golden section; a maximum when want_max):
+ * its t. */
+static double hm_margin_extremum(const double *P, const double *T, int k, double a, double e,
+                                 int want_max)
+{
+    const double r = 0.6180339887498949;
+    double x1 = e - r * (e - a), x2 = a + r * (e - a), m[3], f1, f2;
+    hm_margins(P, T, x1, m);
+    f1 = want_max ? m[k] : -m[k];
+    hm_margins(P, T, x2, m);
+    f2 = want_max ? m[k] : -m[k];
+    for (int it = 0; it < 60 && e - a > 1e-13 * fmax(1.0, fabs(a)); it++) {
+        if (!(f1 <= f2)) { /* NaN counts as low */
+            e = x2;
+            x2 = x1;
+            f2 = f1;
+            x1 = e - r * (e - a);
+            hm_margins(P, T, x1, m);
+            f1 = want_max ? m[k] : -m[k];
+        } else {
+            a = x1;
+            x1 = x2;
+            f1 = f2;
+            x2 = a + r * (e - a);
+            hm_margins(P, T, x2, m);
+            f2 = want_max ? m[k] : -m[k];
+        }
+    }
+    return 0.5 * (a + e);
+}
+
+/* The first grid: G values over [lo, hi], and in every cell where a margin keeps
+ * its sign at both nodes but the parabola through it and a neighbour node turns
+ * back toward 0 inside the cell, its extremum (a branch born and dying between
+ * two nodes: an island; or a short gap). Returns the count (<= cap) into t,
+ * sorted; 0 and a flag when the margins are not available. */
+static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
+{
+    double (*m)[3] = malloc((size_t)G * sizeof(*m));
+    long nt = 0;
+    if (m == NULL) {
+        c->flags |= HM_FLAG_MEMORY;
+        return 0;
+    }
+    for (long i = 0; i < G; i++) {
+        t[i] = i == G - 1 ? hi : lo + (hi - lo) * (double)i / (double)(G - 1);
+        if (!hm_margins(c->P, c->T, t[i], m[i]))
+            c->flags |= HM_FLAG_BAD;
+    }
+    nt = G;
+    for (long i = 0; i + 1 < G; i++) {
+        if (isfinite(m[i][0]) && isfinite(m[i + 1][0]) && (m[i][0] < 0) != (m[i + 1][0] < 0)) {
+            /* the first angle's roots end here: the second's margins may change sign
+             * between the node and that end; a node just inside the end sees it */
+            double a = t[i], e = t[i + 1], me[3];
+            int in_a = m[i][0] >= 0;
+            for (int it = 0; it < 60 && e - a > 1e-12 * fmax(1.0, fabs(a)); it++) {
+                double mid = 0.5 * (a + e);
+                hm_margins(c->P, c->T, mid, me);
+                if ((me[0] >= 0) == in_a)
+                    a = mid;
+                else
+                    e = mid;
+            }
+            double w = 1e-9 * (t[i + 1] - t[i]) * (in_a ? -1.0 : 1.0), tin = in_a ? a : e;
+            if (nt < cap && (in_a ? tin + w > t[i] : tin + w < t[i + 1]))
+                t[nt++] = tin + w;
+        }
+        for (int k = 0; k < 3; k++) {
+            double a = m[i][k], e = m[i + 1][k];
+            if (!isfinite(a) || !isfinite(e) || (a < 0) != (e < 0))
+                continue;
+            /* the parabolas through (i - 1, i, i + 1) and (i, i + 1, i + 2) */
+            int turns = 0;
+            for (int side = 0; side < 2 && !turns; side++) {
+                long j = side ? i + 2 : i - 1;
+                if (j < 0 || j >= G || !isfinite(m[j][k]))
+                    continue;
+                double u[3] = {t[i], t[i + 1], t[j]}, f[3] = {a, e, m[j][k]};
+                /* divided differences */
+                double d1 = (f[1] - f[0]) / (u[1] - u[0]), d2 = (f[2] - f[1]) / (u[2] - u[1]);
+                double q2 = (d2 - d1) / (u[2] - u[0]);
+                if (q2 == 0.0)
+                    continue;
+                /* f = f0 + d1 (s - u0) + q2 (s - u0)(s - u1): f' = 0 at */
+                double s0 = 0.5 * (u[0] + u[1]) - d1 / (2.0 * q2);
+                if (!(s0 > u[0] && s0 < u[1]))
+                    continue;
+                double fs = f[0] + d1 * (s0 - u[0]) + q2 * (s0 - u[0]) * (s0 - u[1]);
+                /* toward 0: a maximum of a negative margin, a minimum of a positive one */
+                if ((a < 0 && q2 < 0 && fs > 2.0 * a) || (a >= 0 && q2 > 0 && fs < 0.5 * a))
+                    turns = 1;
+            }
+            if (!turns)
+                continue;
+            double te = hm_margin_extremum(c->P, c->T, k, t[i], t[i + 1], a < 0);
+            double me[3];
+            hm_margins(c->P, c->T, te, me);
+            if (!isfinite(me[k]) || (me[k] < 0) == (a < 0))
+                continue; /* no island, no gap */
+            if (nt >= cap) {
+                c->flags |= HM_FLAG_FULL;
+                break;
+            }
+            t[nt++] = te;
+        }
+    }
+    free(m);
+    qsort(t, (size_t)nt, sizeof(double), hm_cmp);
+    return nt;
+}
+
+/* One pose: grid rows, cells, folds, intervals. */
+static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
+{
+    const double *P = c->P;
+    double lo = P[PK_LO + c->k], hi = P[PK_HI + c->k];
+    long cap = 2 * G;
+    HmRow *rows = malloc((size_t)cap * sizeof(HmRow));
+    double *tg = malloc((size_t)cap * sizeof(double));
+    for (int b = 0; b < 8; b++)
+        niv[b] = 0;
+    if (rows == NULL || tg == NULL) {
+        free(rows);
+        free(tg);
+        c->flags |= HM_FLAG_MEMORY;
+        return;
+    }
+    G = hm_grid(c, G, lo, hi, tg, cap);
+    for (long i = 0; i < G; i++)
+        hm_eval(c, tg[i], 0xffu, &rows[i]);
+    free(tg);
+    for (int b = 0; b < 8; b++)
+        c->nfold[b] = 0;
+    for (int b = 0; b < 8; b++) {
+        c->ncut[b] = 0;
+        for (long i = 0; i < G; i++) {
+            if (rows[i].valid[b])
+                hm_node(c, b, &rows[i]);
+            if (i + 1 == G)
+                break;
+            int v0 = rows[i].valid[b], v1 = rows[i + 1].valid[b];
+            double near = HM_NEAR * (rows[i + 1].t - rows[i].t);
+            if (v0 && v1 && hm_gap(c, b, &rows[i]) < near)
+                hm_fold_piece(c, b, &rows[i], &rows[i + 1]); /* a node at a branch end */
+            else if (v0 && v1 && hm_gap(c, b, &rows[i + 1]) < near)
+                hm_fold_piece(c, b, &rows[i + 1], &rows[i]);
+            else if (v0 && v1)
+                hm_cell(c, b, &rows[i], &rows[i + 1], 0);
+            else if (v0 != v1)
+                hm_fold(c, b, i, &rows[i], &rows[i + 1]);
+        }
+        hm_intervals(c, b, lo, hi, iv + 2 * HM_MAXI * b, niv + b);
+    }
+    free(rows);
+}
+
+typedef struct {
+    const double *P, *T, *al;
+    long nal, G;
+    double *iv, *pts;
+    long long *niv, *npts, *flags, *evals;
+} HmJob;
+
+static void hm_range(void *ctx, long b0, long e0)
+{
+    const HmJob *jb = ctx;
+    const double *P = jb->P;
+    for (long i = b0; i < e0; i++) {
+        HmCtx *c = malloc(sizeof(HmCtx));
+        if (c == NULL) {
+            jb->flags[i] = HM_FLAG_MEMORY;
+            jb->npts[i] = 0;
+            continue;
+        }
+        c->P = P;
+        c->T = jb->T + 16 * i;
+        c->n = (int)P[PK_N];
+        c->k = (int)P[PK_HELD];
+        c->flags = 0;
+        c->evals = 0;
+        c->pts = jb->pts + 4 * HM_MAXP * i;
+        c->npts = 0;
+        for (int j = 0; j < PK_MAXJ; j++)
+            c->qn[j] = 0.0;
+        c->nq = 0;
+        for (int j = 0; j < c->n; j++) {
+            double l = P[PK_LO + j], h = P[PK_HI + j];
+            if (j == c->k || h - l >= 2.0 * M_PI)
+                continue; /* the parameter, or every angle has an in-limit turn */
+            c->qj[c->nq] = j;
+            c->qv[c->nq] = l;
+            c->qkind[c->nq++] = HM_KIND_LOWER;
+            c->qj[c->nq] = j;
+            c->qv[c->nq] = h;
+            c->qkind[c->nq++] = HM_KIND_UPPER;
+        }
+        for (long a = 0; a < jb->nal; a++) {
+            int j = (int)jb->al[2 * a];
+            if (j == c->k || j < 0 || j >= c->n)
+                continue;
+            if (c->nq >= HM_MAXQ) {
+                c->flags |= HM_FLAG_FULL;
+                break;
+            }
+            c->qj[c->nq] = j;
+            c->qv[c->nq] = jb->al[2 * a + 1];
+            c->qkind[c->nq++] = HM_KIND_ALIGNED;
+        }
+        if (P[PK_CASE] == PK_BOTH || c->k < 0 || c->n != 7)
+            c->flags |= HM_FLAG_BAD; /* not a Panda-type held family */
+        else
+            hm_pose(c, jb->G, jb->iv + 2 * HM_MAXI * 8 * i, jb->niv + 8 * i);
+        jb->npts[i] = c->npts;
+        jb->flags[i] = c->flags;
+        jb->evals[i] = c->evals;
+        free(c);
+    }
+}
+
+/* held_manifold(params, T (N, 4, 4), aligned (A, 2), grid, iv, niv, pts, npts,
+ * flags, evals): per pose the intervals of every slot inside every limit, the
+ * points [t, branch, joint, kind], the flags (0: certain) and pk_one calls. */
+static PyObject *held_manifold_body(const held_manifold_args *a)
+{
+    HmJob jb = {a->params, a->T, a->aligned, (long)a->A, (long)a->grid, a->iv, a->pts,
+                a->niv, a->npts, a->flags, a->evals};
+    Py_BEGIN_ALLOW_THREADS
+    if (a->N >= HM_PARALLEL_MIN)
+        pool_for((long)a->N, HM_GRAIN, hm_range, &jb);
+    else
+        hm_range(&jb, 0, (long)a->N);
+    Py_END_ALLOW_THREADS
+    Py_RETURN_NONE;
+}
