@@ -64,3 +64,36 @@ def test_a_pose_goal_path_ends_at_the_pose_by_pinocchio(robots, family):
     # every in-limit IK branch of the 6-axis arm (whole turns included) was a goal
     sols = robots[p.robot].ik(np.asarray(p.goal_pose)).keep_within_limits().expand_turns()
     assert res.goals.shape[0] == np.asarray(sols.solutions()).reshape(-1, 6).shape[0] > 8
+
+
+# An edge a UR5 cage search step took (problem ur5_gripper/cage/065), as hex floats.
+CAGE_EDGE = np.array([[float.fromhex(x) for x in row] for row in (
+    ("0x1.ea7fff9b977dep-1", "-0x1.e166ef02e624fp-1", "0x1.9273023317344p-3",
+     "0x1.e6d56f8998d8ap-1", "0x1.5a85bb166038fp+1", "-0x1.64a0b08094eb7p+1"),
+    ("0x1.53c86186aa082p+0", "-0x1.a9ed31872c7fp-1", "-0x1.de0d36256520ep-8",
+     "0x1.13f239f75f899p+0", "0x1.58fdc7803d3bep+1", "-0x1.7f8018894c526p+1"))])
+
+
+def test_cylinder_distances_never_read_an_overlap_of_cores_apart(robots):
+    """GJK on two cylinders (upper arm, gripper) along a free edge of the cage.
+
+    Oracle: coal's distance of every pair at every state (``plan_baseline``'s
+    pinocchio + coal checker on the URDF: the edge is free, 1.3 mm at its closest)
+    and of the cylinder pair itself. Before 2026-12-02 GJK's simplex read its rounding
+    on ever thinner tetrahedra as the origin inside at 12 of these 2001 states and
+    returned 0 for cores 7.8 mm apart (a free state called in collision).
+    """
+    p = next(q for q in plan_problems.load_problems() if q.id == "ur5_gripper/cage/065")
+    pl = planning.Planner(robots[p.robot], p.scene())
+    q0, q1 = CAGE_EDGE
+    t = np.linspace(0.0, 1.0, 2001)
+    qs = q0 + t[:, None] * (q1 - q0)
+    d = pl.model.distances(qs)
+    checker = plan_baseline.checker_for(p)
+    assert all(checker.free(q) for q in qs[::20])  # coal: free (every 0.005 of t)
+    assert d.min() > 1e-3  # robokin's certified bounds: every state free
+    pair = pl.model.names.index(("elbow_joint", "tool"))
+    from robokin.kinematics.forward import link_frames
+    for i in range(0, 2001, 100):
+        ref = pl.model.problem.exact(pair, link_frames(pl.model.chain, qs[i:i + 1])[0])
+        assert abs(d[i, pair] - ref) < 2e-6, (i, d[i, pair], ref)

@@ -59,6 +59,31 @@ def test_sharp_corners_are_cut_in_free_space_and_the_gentle_ones_kept():
     assert np.array_equal(short[0], PATH[0]) and np.array_equal(short[-1], PATH[-1])
 
 
+def test_a_zigzag_in_free_space_shortcuts_to_its_straight_segment():
+    """The vertex pass joins the start to the farthest vertex it sees: here the goal.
+
+    Oracle: the straight segment between the ends is free (coal, every 0.01 rad) and
+    the shortest joint-space path, so a shortcutter that finds it returns exactly the
+    two ends; the greedy pass tries that edge first, so it is the only edge checked
+    (before 2026-12-02 random vertex pairs came first: 5 edges here).
+    """
+    robot = robokin.load("ur5")
+    scene = Scene("far")
+    scene.add_box("far", (0.1, 0.1, 0.1), pose((3.0, 0.0, 0.0)))
+    pl = planning.Planner(robot, scene)
+    k = np.arange(9)
+    zigzag = np.tile(PATH[0], (9, 1))
+    zigzag[:, 0] += 0.15 * k
+    zigzag[:, 2] += 0.3 * (k % 2)  # every other waypoint 0.3 rad off the line
+    assert pl.path_free(zigzag)
+    assert Oracle(robot, scene).segment_min(zigzag[0], zigzag[-1]) > 0.0
+    for seed in range(3):
+        stats: dict[str, int] = {}
+        out = pl._simplify(zigzag, pl.margin(), seed, 20, False, stats)
+        np.testing.assert_array_equal(out, zigzag[[0, -1]])
+        assert stats["simplify_edges"] == 1
+
+
 def test_a_corner_whose_cut_would_collide_stays():
     # a ball where the cut of the first corner passes, clear of the corner itself:
     # at the flange point of the cut configuration farthest from the corner path

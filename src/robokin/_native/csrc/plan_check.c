@@ -46,6 +46,9 @@
 #define PC_EPS 1e-9            /* [m] taken off every computed distance (rounding) */
 #define PC_MAX_LEVEL 48        /* halvings of an edge before an open pair counts as hit */
 #define PC_MAX_SAMPLES 200000  /* states per edge before it counts as hit */
+#define PC_PROBE_STEP 0.3      /* [m] probe an edge's levels until its shapes move at
+                                  most this far between probed states (probe_depth) */
+#define PC_PROBE_LEVELS 5      /* at most: 2^5 + 1 states */
 #define PC_CAPSULE "robokin.plan_model"
 
 /* min and max of two doubles that are never NaN here (libm's fmin/fmax are calls) */
@@ -114,7 +117,9 @@ typedef struct {
     unsigned char *cum_ok; /* (cap, S) whether cum holds them (for this level's h) */
     long q_cap;
     double *rate0; /* (P,) static motion rates of the current edge */
-    double *cheap; /* (6, P) cheap bounds g and ub at an edge's two ends and middle */
+    double *cheap; /* (slots, 2, P): per work-space state of an edge's first levels
+                      (edge_ends), its cheap bounds g and ub */
+    long cheap_cap; /* slots cheap has room for */
     /* the far end of the last edge whose ends were proven free, with every pair's
      * best lower bound there, its upper bound and whether the lower one is the exact
      * distance: a chain of edges (RRT-Connect's connect steps) starts the next edge
@@ -528,6 +533,7 @@ static int checker_init(Checker *C, const PlanModel *M, const double *margin, Py
     C->hit_pair = -1;
     C->w.rate0 = malloc(((size_t)M->P + 1) * sizeof(double));
     C->w.cheap = malloc((6 * (size_t)M->P + 1) * sizeof(double));
+    C->w.cheap_cap = 3;
     C->w.last_q = malloc(((size_t)M->n + 1) * sizeof(double));
     C->w.last_l = malloc(((size_t)M->P + 1) * sizeof(double));
     C->w.last_u = malloc(((size_t)M->P + 1) * sizeof(double));
@@ -615,35 +621,58 @@ static int probe_state(Checker *C, long slot, const double *q, double t, double 
     return PC_FREE;
 }
 
-/* Level 0 of check_edge, with the edge's states in the work space as [midpoint, q0,
- * q1]: the far end and the midpoint are probed first (a planner's new state, or a
- * shortcut, is often in collision, and finding that before the work of proving the
- * pairs between is cheaper; the midpoint's bounds serve level 1), then both ends of
- * every pair; the pairs whose whole edge is not proven go into items (*ni). When q0
- * is the far end of the last edge whose ends were proven, its bounds are that
- * edge's (lower bounds at the same state: reusing them only saves work). On
- * success q1's bounds are kept for the next edge. Returns PC_FREE or what ended the
- * edge. */
-static int edge_ends(Checker *C, const double *q0, const double *q1, const double *qm,
-                     long *ni)
+/* The work-space slot of the state at t = (2k + 1) / 2^level of an edge whose first
+ * levels were probed (edge_ends): level 1's midpoint is slot 0, q0 and q1 are 1 and
+ * 2, level L >= 2 holds slots 1 + 2^(L-1) .. 2^L. */
+static inline long probe_slot(int level, long k)
+{
+    return level == 1 ? 0 : (1L << (level - 1)) + 1 + k;
+}
+
+/* Level 0 of check_edge, with the edge's states in the work space by probe_slot: the
+ * midpoint, q0, q1, then the midpoints of levels 2 .. `depth` (2^depth + 1 states;
+ * check_edge computed the first five, deeper levels are computed as they are probed,
+ * each level's states together). The far end, the midpoint and then the deeper midpoints,
+ * coarse to fine, are probed first (a planner's new state, or a shortcut, is often in
+ * collision, and finding that before the work of proving the pairs between is
+ * cheaper; the probed bounds serve levels 1 .. depth), then both ends of every pair;
+ * the pairs whose whole edge is not proven go into items (*ni). When q0 is the far
+ * end of the last edge whose ends were proven, its bounds are that edge's (lower
+ * bounds at the same state: reusing them only saves work). On success q1's bounds are
+ * kept for the next edge. Returns PC_FREE or what ended the edge. */
+static int edge_ends(Checker *C, const double *q0, const double *q1, int depth, long *ni)
 {
     const PlanModel *M = C->M;
     Work *w = &C->w;
     const int P = M->P, S = M->S;
     const double *P0 = w->poses + (size_t)S * 12, *P1 = P0 + (size_t)S * 12;
-    double *G0 = w->cheap, *U0 = G0 + P, *G1 = U0 + P, *U1 = G1 + P;
-    double *Gm = U1 + P, *Um = Gm + P;
+    double *Gm = w->cheap, *Um = Gm + P, *G0 = Um + P, *U0 = G0 + P, *G1 = U0 + P;
+    double *U1 = G1 + P;
     const int n = M->n, reuse = w->last_ok && memcmp(q0, w->last_q, n * sizeof(double)) == 0;
     w->last_ok = 0; /* last_* are rewritten below */
-    memset(w->cum_ok, 0, 3 * (size_t)S);
+    memset(w->cum_ok, 0, ((1UL << depth) + 1) * (size_t)S);
     cheap_all(C, P1, G1, U1);
     int r = probe_state(C, 2, q1, 1.0, G1, U1);
     if (r != PC_FREE)
         return r;
-    cheap_all(C, w->poses, Gm, Um);
-    r = probe_state(C, 0, qm, 0.5, Gm, Um);
-    if (r != PC_FREE)
-        return r;
+    for (int level = 1; level <= depth; level++) {
+        const long m = 1L << (level - 1);
+        if (level >= 3) { /* this level's states (check_edge computed levels 1-2) */
+            const long s0 = probe_slot(level, 0);
+            model_poses(M, w->q + (size_t)s0 * n, m, w->poses + (size_t)s0 * S * 12,
+                        w->axes + (size_t)s0 * M->nc * 6);
+            C->st.states += m;
+        }
+        for (long k = 0; k < m; k++) {
+            const long slot = probe_slot(level, k);
+            double *G = w->cheap + 2 * (size_t)P * slot;
+            cheap_all(C, w->poses + (size_t)slot * S * 12, G, G + P);
+            r = probe_state(C, slot, w->q + (size_t)slot * n, (double)(2 * k + 1) / (double)(2 * m),
+                            G, G + P);
+            if (r != PC_FREE)
+                return r;
+        }
+    }
     if (reuse) {
         memcpy(G0, w->last_l, (size_t)P * sizeof(double));
         memcpy(U0, w->last_u, (size_t)P * sizeof(double));
@@ -689,17 +718,19 @@ static int edge_ends(Checker *C, const double *q0, const double *q1, const doubl
 }
 
 /* One level of check_edge: every span of list `cur` (ns of them, ni items) halved at
- * its midpoint (computed together), each item refined there and its halves kept
- * where still open, into list 1 - cur. Level 1 (`first`) finds its one midpoint,
- * the edge's, in work-space state 0 with its cheap bounds from edge_ends. */
+ * its midpoint, each item refined there and its halves kept where still open, into
+ * list 1 - cur. The midpoints of levels 1 .. `depth` are edge_ends' probed states
+ * (their poses and cheap bounds in the slots of probe_slot); deeper ones are computed
+ * together, span s in slot s. */
 static int edge_level(Checker *C, const double *q0, const double *dq, int cur, long *ns,
-                      long *ni, int first)
+                      long *ni, int level, int depth)
 {
     const PlanModel *M = C->M;
     const int n = M->n, S = M->S, P = M->P;
     Work *w = &C->w;
-    const double *Gm = w->cheap + 4 * (size_t)P, *Um = Gm + P;
-    if (!first) {
+    const int probed = level <= depth;
+    const double scale = (double)(1L << (level - 1));
+    if (!probed) {
         for (long s = 0; s < *ns; s++) {
             double t = 0.5 * (w->span[cur][s].ta + w->span[cur][s].tb);
             double *qm = w->q + (size_t)s * n;
@@ -708,8 +739,8 @@ static int edge_level(Checker *C, const double *q0, const double *dq, int cur, l
         }
         model_poses(M, w->q, *ns, w->poses, w->axes);
         C->st.states += *ns;
+        memset(w->cum_ok, 0, (size_t)*ns * S);
     }
-    memset(w->cum_ok, 0, (size_t)*ns * S);
     const int nxt = 1 - cur;
     if (!grow((void **)&w->span[nxt], &w->span_cap[nxt], 2 * *ns, sizeof(Span)) ||
         !grow((void **)&w->item[nxt], &w->item_cap[nxt], 2 * *ni, sizeof(Item)))
@@ -718,24 +749,26 @@ static int edge_level(Checker *C, const double *q0, const double *dq, int cur, l
     for (long s = 0; s < *ns; s++) {
         const Span sp = w->span[cur][s];
         const double tm = 0.5 * (sp.ta + sp.tb), half = 0.5 * (sp.tb - sp.ta);
-        const double *poses = w->poses + (size_t)s * S * 12;
-        const double *qm = w->q + (size_t)s * n;
+        const long slot = probed ? probe_slot(level, (long)(sp.ta * scale + 0.5)) : s;
+        const double *poses = w->poses + (size_t)slot * S * 12;
+        const double *qm = w->q + (size_t)slot * n;
+        const double *Gs = w->cheap + 2 * (size_t)P * slot, *Us = Gs + P;
         Item *left = w->item[nxt] + ni2, *right = left + sp.count;
         long nl = 0, nr = 0;
         for (long it = sp.first; it < sp.first + sp.count; it++) {
             const Item I0 = w->item[cur][it];
             const double mg = C->margin[I0.p];
             double g, ub, rate = I0.rate;
-            if (first) {
-                g = Gm[I0.p];
-                ub = Um[I0.p];
+            if (probed) {
+                g = Gs[I0.p];
+                ub = Us[I0.p];
             } else {
                 pair_cheap(C, I0.p, poses, &g, &ub);
             }
             double lim = rate * half + 2 * mg;
             if (g > mg && g > lim - I0.la && g > lim - I0.lb)
                 continue; /* both halves proven */
-            rate = dmin(rate, state_rate(C, I0.p, s, half));
+            rate = dmin(rate, state_rate(C, I0.p, slot, half));
             lim = rate * half + 2 * mg;
             int ex;
             double lm = pair_refine(C, I0.p, poses, g, ub, dmin(lim - I0.la, lim - I0.lb),
@@ -764,6 +797,23 @@ static int edge_level(Checker *C, const double *q0, const double *dq, int cur, l
     return PC_FREE;
 }
 
+/* How many levels of the current edge edge_ends probes before proving it (1: the
+ * midpoint only): the fewest that leave at most PC_PROBE_STEP of the largest motion
+ * bound of a pair (rate0, [m] over the edge) between probed states, up to
+ * PC_PROBE_LEVELS. On the issue-26 problem set (docs/planning.md) 0.3 m gave a 0.5 rad
+ * search step 2 levels and a long shortcut 4-5: the median query 6.3 -> 4.9 ms CPU
+ * (0.2 m: 5.2, 0.45 m: 5.2, a fixed 2 levels: 5.5). */
+static int probe_depth(const Checker *C)
+{
+    double motion = 0.0;
+    for (int p = 0; p < C->M->P; p++)
+        motion = dmax(motion, C->w.rate0[p]);
+    int d = 1;
+    while (d < PC_PROBE_LEVELS && motion > PC_PROBE_STEP * (double)(1L << d))
+        d++;
+    return d;
+}
+
 /* Whether the edge q0 -> q1 is free (PC_FREE), hits (PC_HIT, or not proven free),
  * needs a callable it was not given (PC_UNDECIDED), or the callable failed
  * (PC_ERROR). See the top of this file. */
@@ -779,23 +829,34 @@ static int check_edge(Checker *C, const double *q0, const double *q1)
         dq[j] = q1[j] - q0[j];
     for (int p = 0; p < P; p++)
         w->rate0[p] = static_rate(C, p);
-    if (!work_states(C, 3) ||
+    const int depth = probe_depth(C);
+    const long first = (1L << depth) + 1; /* the states edge_ends computes */
+    if (!work_states(C, first) ||
+        !grow((void **)&w->cheap, &w->cheap_cap, first, 2 * (size_t)P * sizeof(double)) ||
         !grow((void **)&w->span[0], &w->span_cap[0], 1, sizeof(Span)) ||
         !grow((void **)&w->item[0], &w->item_cap[0], P, sizeof(Item)))
         return PC_ERROR;
-    for (int j = 0; j < n; j++) /* [midpoint, q0, q1]: one lane batch */
-        w->q[j] = q0[j] + 0.5 * dq[j];
     memcpy(w->q + n, q0, n * sizeof(double));
     memcpy(w->q + 2 * n, q1, n * sizeof(double));
-    model_poses(M, w->q, 3, w->poses, w->axes);
-    C->st.states += 3;
+    for (int level = 1; level <= depth; level++) {
+        const long m = 1L << (level - 1);
+        for (long k = 0; k < m; k++) {
+            const double t = (double)(2 * k + 1) / (double)(2 * m);
+            double *q = w->q + (size_t)probe_slot(level, k) * n;
+            for (int j = 0; j < n; j++)
+                q[j] = q0[j] + t * dq[j];
+        }
+    }
+    const long now = first < 5 ? first : 5; /* levels 1-2 now, deeper ones when probed */
+    model_poses(M, w->q, now, w->poses, w->axes);
+    C->st.states += now;
     long ni = 0;
-    int r = edge_ends(C, q0, q1, w->q, &ni);
+    int r = edge_ends(C, q0, q1, depth, &ni);
     if (r != PC_FREE)
         return r;
     long ns = ni > 0;
     w->span[0][0] = (Span){0.0, 1.0, 0, ni};
-    long total = 3;
+    long total = first;
     int cur = 0;
     for (int level = 1; ns > 0; level++) {
         if (level > PC_MAX_LEVEL || total + ns > PC_MAX_SAMPLES) {
@@ -806,8 +867,8 @@ static int check_edge(Checker *C, const double *q0, const double *q1)
         }
         if (!work_states(C, ns))
             return PC_ERROR;
-        total += level > 1 ? ns : 0;
-        r = edge_level(C, q0, dq, cur, &ns, &ni, level == 1);
+        total += level > depth ? ns : 0;
+        r = edge_level(C, q0, dq, cur, &ns, &ni, level, depth);
         if (r != PC_FREE)
             return r;
         cur = 1 - cur;

@@ -275,7 +275,10 @@ static int closest_simplex(double X[4][3], int nw, double *v)
  * support point of A - B in direction -v, every x of A - B has |x| >= v.x / |v| >=
  * v.w / |v| (Cauchy-Schwarz, then w minimises v.x): the bound holds at every
  * iteration, however GJK's simplex arithmetic rounds, so stopping early (iteration
- * cap, no progress) only loosens it. */
+ * cap, no progress) only loosens it. A positive bound also overrules the simplex
+ * when it reports the origin inside: on a cylinder GJK creeps towards the answer
+ * with ever thinner tetrahedra, whose inside test (with FMA contraction) could
+ * flip and report an overlap of cores 8 mm apart (docs/planning.md). */
 static double gjk_lower(const Core *A, const Core *B, double *ub)
 {
     double X[4][3], v[3], d[3], sa[3], sb[3], w[3];
@@ -317,7 +320,9 @@ static double gjk_lower(const Core *A, const Core *B, double *ub)
         double vn[3];
         nw = closest_simplex(X, nw, vn);
         double vvn = dot3(vn, vn);
-        if (nw == 4) { /* the origin is inside: the cores overlap */
+        if (nw == 4) { /* the origin is inside: the cores overlap ... */
+            if (lb > 0.0) /* ... unless a certified bound says they are apart: then the */
+                break;    /* simplex (a sliver, on a curved core) misread its rounding */
             *ub = 0.0;
             return 0.0;
         }

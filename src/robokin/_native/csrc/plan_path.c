@@ -45,51 +45,49 @@ static void drop_collinear(double *q, long *K, int n)
     *K = m + 1;
 }
 
-/* Random shortcutting of the path q (*K x n, capacity cap rows, in place): first
- * vertex pairs (i, j >= i + 2) joined straight when the edge is free (a pair that
- * failed is not tried again until a shortcut succeeds), then pairs of points on two
- * segments. A shortcut is kept only when free and shorter; failures in
- * a row end each phase (opts[SP_MAX_FAIL]). Returns PC_FREE or PC_ERROR. */
-#define SP_MEMO 64 /* vertex pairs remembered as failed (until a shortcut succeeds) */
+/* Greedy vertex shortcuts of the path q (*K x n, in place): from vertex i = 0 on, the
+ * farthest later vertex j >= i + 2 it sees (the edge i -> j proven free, tried from
+ * the last vertex down) replaces the vertices between; at most `tries` edges
+ * checked. The colliding tries are cheap (plan_check.c probes an edge coarse to fine
+ * before proving it), and one success can drop most of a planner's zigzag at once.
+ * Returns PC_FREE or PC_ERROR. */
+static int shortcut_vertices(Checker *C, double *q, long *K, long tries, double t0,
+                             double time_limit)
+{
+    const int n = C->M->n;
+    for (long i = 0; i + 2 < *K && tries > 0; i++) {
+        for (long j = *K - 1; j >= i + 2 && tries > 0; j--) {
+            if (now_seconds() - t0 > time_limit)
+                return PC_FREE;
+            tries--;
+            int r = check_edge(C, q + (size_t)i * n, q + (size_t)j * n);
+            if (r == PC_ERROR || r == PC_UNDECIDED)
+                return PC_ERROR;
+            if (r == PC_FREE) {
+                memmove(q + (size_t)(i + 1) * n, q + (size_t)j * n,
+                        (size_t)(*K - j) * n * sizeof(double));
+                *K -= j - i - 1;
+                break;
+            }
+        }
+    }
+    return PC_FREE;
+}
 
+/* Shortcutting of the path q (*K x n, capacity cap rows, in place): first greedy
+ * vertex shortcuts (shortcut_vertices, opts[SP_VERTEX_TRIES] edges), then random
+ * pairs of points on two segments joined straight, each kept only when free and
+ * shorter; opts[SP_MAX_FAIL] failures in a row end the second phase. Returns PC_FREE
+ * or PC_ERROR. */
 static int shortcut(Checker *C, double *q, long *K, long cap, const double *opts, Rng *rng)
 {
     const int n = C->M->n;
     const double t0 = now_seconds();
-    long fails = 0, memo[SP_MEMO][2], nmemo = 0;
     if (*K > 2)
         drop_collinear(q, K, n);
-    for (long it = 0; it < (long)opts[SP_VERTEX_TRIES] && *K > 2; it++) {
-        if (fails >= (long)opts[SP_MAX_FAIL] || now_seconds() - t0 > opts[SP_TIME])
-            break;
-        /* a pair i < j - 1, j uniform after i: a short path has few, so the pairs
-         * that failed since the last success are not checked again */
-        long i = (long)(rng_uniform(rng) * (double)(*K - 2));
-        long j = i + 2 + (long)(rng_uniform(rng) * (double)(*K - i - 2));
-        int seen = 0;
-        for (long k = 0; k < nmemo; k++)
-            seen |= memo[k][0] == i && memo[k][1] == j;
-        if (seen) {
-            fails++;
-            continue;
-        }
-        int r = check_edge(C, q + (size_t)i * n, q + (size_t)j * n);
-        if (r == PC_ERROR || r == PC_UNDECIDED)
-            return PC_ERROR;
-        if (r != PC_FREE) {
-            fails++;
-            if (nmemo < SP_MEMO) {
-                memo[nmemo][0] = i;
-                memo[nmemo++][1] = j;
-            }
-            continue;
-        }
-        memmove(q + (size_t)(i + 1) * n, q + (size_t)j * n, (size_t)(*K - j) * n * sizeof(double));
-        *K -= j - i - 1;
-        fails = 0;
-        nmemo = 0;
-    }
-    fails = 0;
+    if (shortcut_vertices(C, q, K, (long)opts[SP_VERTEX_TRIES], t0, opts[SP_TIME]) == PC_ERROR)
+        return PC_ERROR;
+    long fails = 0;
     double a[MAXJ], b[MAXJ];
     for (long it = 0; it < (long)opts[SP_TRIES] && *K > 2; it++) {
         if (fails >= (long)opts[SP_MAX_FAIL] || now_seconds() - t0 > opts[SP_TIME])
