@@ -14,8 +14,8 @@ time, CPU time of the run's processes (user + system of the waited children, fro
 the record. A step that fails is recorded (exit code) and the next one runs; the
 driver exits 1 when any failed.
 
-The quick set takes about 10 minutes on a quiet 2-core machine (measured under load
-and scaled, see ``docs/benchmarks.md``). ``--long`` adds the figures that take
+The quick set used 250 s of CPU time in its trial (24.8 min wall at load 5-17):
+about 5-8 minutes on a quiet 2-core machine (``docs/benchmarks.md``, the end). ``--long`` adds the figures that take
 minutes each: ssik's side-by-side table of ``bench_ik_general_6r.py`` (ssik's
 per-arm set-up must be cached in ``~/.cache/ssik``, or it takes up to 15 minutes an
 arm), ``bench_ik_held.py`` at full size with its ssik rows, and the 10^8-evaluation
