@@ -67,6 +67,9 @@ MAX_STEP = 0.5
 STEPS = 15
 FINAL = 3
 FINAL_RCOND = 1e-10
+#: Newton iterations of a row moved into the limits (its split or joints held: the
+#: rest well conditioned, converged in 2-3 where it can be)
+PIN_STEPS = 6
 #: Two rows this close [rad] (every joint) are one solution (next to a second
 #: aligned set, q5 = 1e-9 on the Panda, Newton leaves copies 1e-6 apart)
 SAME = 1e-4
@@ -99,7 +102,8 @@ def near_coincident_pair(robot: Arm, j: int, v: float) -> tuple[CoincidentPair, 
     return None
 
 
-def _newton(robot: Arm, q: np.ndarray, T: np.ndarray, free: np.ndarray) -> np.ndarray:
+def _newton(robot: Arm, q: np.ndarray, T: np.ndarray, free: np.ndarray,
+            steps: int = STEPS, final: int = FINAL) -> np.ndarray:
     """Newton on the joints ``free`` of rows q (m, n) to poses T (m, 4, 4), SVD steps.
 
     Each row's best iterate is kept (at a doubly singular configuration, the
@@ -109,8 +113,8 @@ def _newton(robot: Arm, q: np.ndarray, T: np.ndarray, free: np.ndarray) -> np.nd
     q = q.copy()
     best, low = q.copy(), np.full(len(q), np.inf)
     act = np.arange(len(q))  # rows not yet at 1e-16
-    for k in range(STEPS + FINAL):
-        if k == STEPS:
+    for k in range(steps + final):
+        if k == steps:
             act = np.flatnonzero(low > 1e-16)
             q[act] = best[act]  # the coarser steps from each row's best
         if not len(act):
@@ -125,7 +129,7 @@ def _newton(robot: Arm, q: np.ndarray, T: np.ndarray, free: np.ndarray) -> np.nd
         if not len(act):
             continue
         U, s, Vt = np.linalg.svd(J[:, :, free], full_matrices=False)
-        cut = RCOND if k < STEPS else FINAL_RCOND
+        cut = RCOND if k < steps else FINAL_RCOND
         inv = np.where(s > cut * s[:, :1], 1.0 / np.where(s > 0, s, 1.0), 0.0)
         step = np.einsum("mji,mj,mkj,mk->mi", Vt, inv, U, e)
         # at most MAX_STEP rad per joint (a step along a near-null direction can be
@@ -191,7 +195,7 @@ def _pinned(robot: Arm, q: np.ndarray, T: np.ndarray, pair: CoincidentPair,
     for g, mask in enumerate(masks):
         at = rows[group.ravel() == g]
         rest = np.array([i for i in free if not mask[i]])
-        moved[at] = _newton(robot, moved[at], T[at], rest)
+        moved[at] = _newton(robot, moved[at], T[at], rest, PIN_STEPS, 0)
     moved = fit_turns(moved, robot.is_revolute, lim)  # Newton wraps to +-pi
     moved[:, pair.held] = q[:, pair.held]
     return moved
