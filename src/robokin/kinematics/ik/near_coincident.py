@@ -76,6 +76,8 @@ SAME = 1e-4
 #: Pose error (m, rad; norms) a returned row must reach: a margin below the promised
 #: ``EXACT`` (1e-12; a converged row reaches 1e-16, one stuck near 1e-12 is suspect)
 ACCEPT = EXACT / 10
+#: Two Newton seeds of one pose this close [rad] (every joint) are one
+SAME_SEED = 1e-3
 #: Largest move [rad] of the split that brings a row into the pair's limits
 SHIFT = 1e-2
 #: Rows flagged singular: free-joint Jacobian's smallest / largest singular value below
@@ -201,6 +203,20 @@ def _pinned(robot: Arm, q: np.ndarray, T: np.ndarray, pair: CoincidentPair,
     return moved
 
 
+def _distinct(pose: list[int], seeds: list[np.ndarray]) -> tuple[list[int], list[np.ndarray]]:
+    """The seeds with a different pose or more than ``SAME_SEED`` apart (first kept)."""
+    kept: dict[int, list[np.ndarray]] = {}
+    out_pose, out = [], []
+    for p, q in zip(pose, seeds):
+        mine = kept.setdefault(p, [])
+        if any(float(np.abs(wrap_angle(q - r)).max()) <= SAME_SEED for r in mine):
+            continue
+        mine.append(q)
+        out_pose.append(p)
+        out.append(q)
+    return out_pose, out
+
+
 def _past(robot: Arm, q: np.ndarray) -> np.ndarray:
     """(m,) how far [rad] rows q (m, n) are outside the limits at most (0 inside)."""
     lim = robot.limits
@@ -285,6 +301,7 @@ def solve_near_coincident(robot: Arm, T: np.ndarray, pair: CoincidentPair, v0: f
                 seeds.append(q)
                 pose.append(p)
     free = np.array([i for i in range(n) if i != pair.held])
+    pose, seeds = _distinct(pose, seeds)  # both helper values find each family
     pose_a = np.array(pose, int)
     q = np.zeros((0, n))
     exact = np.zeros(0, bool)
