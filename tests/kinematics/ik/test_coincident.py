@@ -134,3 +134,48 @@ def test_split_follows_q_near():
     row = Q[np.argmin(_gap(Q[:, 3:], q[3:]).max(axis=-1))]
     assert row[0] == pytest.approx(-1.2, abs=1e-12)
     assert _gap(row[0] + row[2], q[0] + q[2]) <= 1e-9
+
+
+# --- joint 2 held next to 0 (near_coincident.py): axes 1 and 3 nearly on one line ---
+
+
+def near_batch(n, rng, v):
+    """Special-value configurations inside the limits, q2 = +-v (random sign)."""
+    lim = PANDA.limits
+    q = np.clip(special_batch(n, rng), lim[:, 0], lim[:, 1])
+    q[:, 1] = v * np.where(rng.integers(0, 2, n) == 0, 1.0, -1.0)
+    return q
+
+
+@pytest.mark.parametrize("v", [1e-9, 1e-7, 1e-4])
+def test_joint2_held_next_to_zero(v):
+    # Oracles, per configuration q (q2 = +-v, one call per pose):
+    # * FK of every valid row within 1e-12 of the pose (m: the Panda's reach is ~1 m;
+    #   rad), q2 held exactly; before: the numeric fallback, rows 1e-10..1e-9 off;
+    # * the generating configuration among the rows where the 6 x 6 Jacobian of the
+    #   free joints has a smallest singular value above 1e-5 of its largest (at
+    #   |q2| <= 1e-7 none is: axes 1 and 3 within 1e-7 of one line);
+    # * its family (q4..q7 and q1 + q3 within 1e-6) where the 6 x 5 Jacobian of
+    #   q1 (= q3), q4..q7 is regular (smallest singular value >= 1e-4): near-solutions
+    #   of the whole family reach the pose to ~|q2|, the exact ones are on it;
+    # * an in-limit valid row for every (in-limit) configuration.
+    q = near_batch(60, np.random.default_rng(int(-np.log10(v))), v)
+    T = PANDA.fk(q)
+    sets = [PANDA.ik(T[i], fixed={"joint2": q[i, 1]}) for i in range(len(q))]
+    J = np.delete(PANDA.jacobian(q), 1, axis=-1)
+    sv = np.linalg.svd(J, compute_uv=False)
+    regular = sv[:, -1] > 1e-5 * sv[:, 0]
+    fam_sv = np.linalg.svd(PANDA.jacobian(q)[..., [0, 3, 4, 5, 6]], compute_uv=False)[:, -1]
+    for i, s in enumerate(sets):
+        Q = s.q[s.valid]
+        assert len(Q) and np.all(Q[:, 1] == q[i, 1])
+        dp, dr = pose_errors(PANDA.fk(Q), np.broadcast_to(T[i], (len(Q), 4, 4)))
+        assert dp.max() <= 1e-12 and dr.max() <= 1e-12, (q[i].tolist(), dp.max(), dr.max())
+        if regular[i]:
+            assert _gap(Q, q[i]).max(axis=-1).min() <= 1e-6, q[i].tolist()
+        if fam_sv[i] >= 1e-4:
+            same = np.maximum(_gap(Q[:, 3:], q[i, 3:]).max(axis=-1),
+                              _gap(Q[:, 0] + Q[:, 2], q[i, 0] + q[i, 2]))
+            assert same.min() <= 1e-6, q[i].tolist()
+        assert (s.valid & s.within_limits).any(), q[i].tolist()
+    assert all("near-coincident" in s.method for s in sets)

@@ -42,6 +42,7 @@ from robokin._validation import (
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, ArmSource, Derived, arm_of
 from robokin.kinematics.ik import coincident as _co
+from robokin.kinematics.ik import near_coincident as _nco
 from robokin.kinematics.ik.analytic import pieper as _pk
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.model.chain import joint_motion
@@ -191,15 +192,21 @@ def _coincident_parts(robot: Arm, j: int, T: np.ndarray, v: np.ndarray,
     name = robot.joint_names
     for g, x in enumerate(uniq):
         pair = _co.coincident_pair(robot, j, float(x))
-        if pair is None:
+        near = None if pair is not None else _nco.near_coincident_pair(robot, j, float(x))
+        if pair is None and near is None:
             continue
         rows = np.flatnonzero(inverse.ravel() == g)
 
         def helper(a: int, c: float, Ts: np.ndarray) -> SolutionSet:
             return solve_fixed(robot, Ts, {name[a]: c}, dispatch=dispatch)
 
-        sols = _co.solve_coincident(robot, T[rows], pair, float(x),
-                                    None if q_near is None else q_near[rows], helper)
+        if near is not None:  # next to aligned: exact rows from the aligned families
+            sols = _nco.solve_near_coincident(robot, T[rows], near[0], near[1], float(x),
+                                              helper)
+        else:
+            assert pair is not None
+            sols = _co.solve_coincident(robot, T[rows], pair, float(x),
+                                        None if q_near is None else q_near[rows], helper)
         parts.append((rows, SolutionSet(
             sols.q[..., keep], sols.valid, robot.is_revolute[keep], robot.limits[keep],
             flags={"singular": sols.singular}, status=sols.status, method=sols.method)))
