@@ -42,7 +42,6 @@
 #define HM_NEAR 1e-6 /* a node with 1 / |dq/dt|^2 below this times its cell: at a branch end */
 #define HM_MAXF 32 /* branch ends per slot remembered for its partner */
 #define HM_FOLD_TOL 1e-11 /* a branch end to this (relative) */
-#define HM_FOLD_MARGIN_TOL 1e-12 /* a branch end from its margin, confirmed to this */
 #define HM_FOLD_STEPS 6 /* rows between a branch end and its grid row */
 #define HM_PARALLEL_MIN 8
 #define HM_DECIDE 1e-9 /* a grid row this far inside / outside decides its piece [rad] */
@@ -66,7 +65,7 @@ typedef struct {
     double qn[PK_MAXJ];
     int nq, qj[HM_MAXQ], qkind[HM_MAXQ];
     double qv[HM_MAXQ];
-    int flags, use_margin; /* use_margin: branch ends from the margins first */
+    int flags;
     long evals;
     double *pts;
     long npts;
@@ -365,7 +364,6 @@ static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r
 }
 
 static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth);
-static int hm_margins(const double *P, const double *T, double x, double *m);
 
 /* The zeros of queries exactly at a node (a generating configuration at a limit) */
 static void hm_node(HmCtx *c, int b, const HmRow *r)
@@ -463,52 +461,6 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
     }
 }
 
-/* The existence margin of slot b's position root at t: the smaller of the first
- * angle's and (given its root b >> 2) the second angle's, plus pk_sp4's slack
- * (a row exists where it is >= 0, up to rounding); -inf without the second. */
-static double hm_exist(const HmCtx *c, int b, double t)
-{
-    double m[3];
-    if (!hm_margins(c->P, c->T, t, m))
-        return NAN;
-    double e = fmin(m[0], m[1 + (b >> 2)]);
-    return isfinite(e) ? e + 1e-13 : -HUGE_VAL;
-}
-
-/* A branch end in (lo, hi) straight from slot b's existence margin (bisected on
- * the margin alone, no rows), confirmed by two rows: slot b's row at the end and
- * none HM_FOLD_TOL beyond it. Returns 1 with *end, 0 when the margin does not
- * explain the end (the caller bisects on rows). */
-static int hm_fold_margin(HmCtx *c, int b, double lo, double hi, int state0, double *end)
-{
-    double a = lo, e = hi, fa = hm_exist(c, b, lo), fe = hm_exist(c, b, hi);
-    if (isnan(fa) || isnan(fe) || (fa >= 0) != state0 || (fe >= 0) == state0)
-        return 0;
-    while (1) {
-        double mid = 0.5 * (a + e);
-        if (mid <= a || mid >= e)
-            break;
-        double fm = hm_exist(c, b, mid);
-        if (isnan(fm))
-            return 0;
-        if ((fm >= 0) == (fa >= 0))
-            a = mid;
-        else
-            e = mid;
-    }
-    double dir = state0 ? 1.0 : -1.0, tol = HM_FOLD_MARGIN_TOL * fmax(1.0, fabs(a));
-    double t = (state0 ? a : e) - dir * 0.25 * tol; /* just inside */
-    HmRow chk;
-    hm_eval(c, t, 0u, &chk);
-    if (!chk.valid[b])
-        return 0;
-    hm_eval(c, t + dir * tol, 0u, &chk);
-    if (chk.valid[b])
-        return 0;
-    *end = t;
-    return 1;
-}
-
 /* A fold in (r0, r1): slot b's row exists at one end only. Bisected on its
  * existence until the ends are adjacent floats; the last t with a row is the
  * branch end (a cut and a point). The partner slot (b ^ 1: the same position
@@ -530,8 +482,6 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
         known = ok && !chk.valid[b];
         end = e;
     }
-    if (!known && c->use_margin && hm_fold_margin(c, b, lo, hi, state0, &end))
-        known = 1; /* the partner confirms its own from the margin */
     if (!known) {
         int agree = r0->valid[p] == state0 && r1->valid[p] == r1->valid[b];
         /* v: the valid side, u: the other; g = 1 / |dq/dt|^2 falls linearly to 0
@@ -969,16 +919,8 @@ static void hm_range(void *ctx, long b0, long e0)
         }
         if (P[PK_CASE] == PK_BOTH || c->k < 0 || c->n != 7)
             c->flags |= HM_FLAG_BAD; /* not a Panda-type held family */
-        else {
-            c->use_margin = 1;
+        else
             hm_pose(c, jb->G, jb->iv + 2 * HM_MAXI * 8 * i, jb->niv + 8 * i);
-            if (c->flags) { /* again with every branch end bisected on rows */
-                c->flags = 0;
-                c->npts = 0;
-                c->use_margin = 0;
-                hm_pose(c, jb->G, jb->iv + 2 * HM_MAXI * 8 * i, jb->niv + 8 * i);
-            }
-        }
         jb->npts[i] = c->npts;
         jb->flags[i] = c->flags;
         jb->evals[i] = c->evals;
