@@ -44,6 +44,7 @@
 #define HM_FOLD_TOL 1e-11 /* a branch end to this (relative) */
 #define HM_FOLD_STEPS 6 /* rows between a branch end and its grid row */
 #define HM_PARALLEL_MIN 8
+#define HM_DECIDE 1e-9 /* a grid row this far inside / outside decides its piece [rad] */
 
 enum { HM_KIND_LOWER = 0, HM_KIND_UPPER = 1, HM_KIND_ALIGNED = 2, HM_KIND_FOLD = 3 };
 enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FLAG_FULL = 8,
@@ -580,7 +581,26 @@ static int hm_emit(HmCtx *c, double *iv, long *k, double a, double e)
  * midpoint, joined; a cut whose pieces on both sides are outside is an interval
  * of its own ([t, t]) when its row is inside to 1e-12 (a branch touching the
  * limits, e.g. the generating configuration at a limit at the range's end). */
-static void hm_intervals(HmCtx *c, int b, double lo, double hi, double *iv, long long *niv)
+/* Whether slot b's grid row r decides a piece: it exists and every joint is inside
+ * its limits, or one outside, by more than HM_DECIDE (far from the piece's cuts,
+ * which hold the joints at their limits to HM_TOL_STEEP); into *good. */
+static int hm_decides(const HmCtx *c, const HmRow *r, int b, unsigned char *good)
+{
+    if (!r->valid[b])
+        return 0;
+    double worst = HUGE_VAL;
+    for (int j = 0; j < c->n; j++) {
+        double m = fmin(r->q[b][j] - c->P[PK_LO + j], c->P[PK_HI + j] - r->q[b][j]);
+        worst = fmin(worst, m);
+    }
+    if (!(fabs(worst) > HM_DECIDE))
+        return 0;
+    *good = worst > 0.0;
+    return 1;
+}
+
+static void hm_intervals(HmCtx *c, int b, double lo, double hi, const HmRow *rows, long G,
+                         double *iv, long long *niv)
 {
     double *cut = c->cut[b];
     int m = c->ncut[b], u = 0;
@@ -598,8 +618,21 @@ static void hm_intervals(HmCtx *c, int b, double lo, double hi, double *iv, long
         if (u == 0 || cut[i] > cut[u - 1])
             cut[u++] = cut[i];
     HmRow r;
+    long g = 0; /* the first grid row past cut[i] */
     for (int i = 0; i + 1 < u; i++) {
-        hm_eval(c, 0.5 * (cut[i] + cut[i + 1]), 0u, &r);
+        /* a grid row strictly inside the piece, nearest its midpoint, decides it
+         * (the piece has one verdict: every crossing and fold is a cut); else
+         * the midpoint's row */
+        double mid = 0.5 * (cut[i] + cut[i + 1]);
+        long best = -1;
+        while (g < G && rows[g].t <= cut[i])
+            g++;
+        for (long h = g; h < G && rows[h].t < cut[i + 1]; h++)
+            if (best < 0 || fabs(rows[h].t - mid) < fabs(rows[best].t - mid))
+                best = h;
+        if (best >= 0 && hm_decides(c, &rows[best], b, &good[i]))
+            continue;
+        hm_eval(c, mid, 0u, &r);
         good[i] = (unsigned char)hm_inside(c, &r, b, 0.0);
     }
     long k = 0;
@@ -827,7 +860,7 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
             else if (v0 != v1)
                 hm_fold(c, b, i, &rows[i], &rows[i + 1]);
         }
-        hm_intervals(c, b, lo, hi, iv + 2 * HM_MAXI * b, niv + b);
+        hm_intervals(c, b, lo, hi, rows, G, iv + 2 * HM_MAXI * b, niv + b);
     }
     free(rows);
 }
