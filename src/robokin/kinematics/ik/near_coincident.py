@@ -113,7 +113,8 @@ def _newton(robot: Arm, q: np.ndarray, T: np.ndarray, free: np.ndarray,
     ``FINAL`` steps cut at ``FINAL_RCOND`` (such directions left out).
     """
     q = q.copy()
-    best, low = q.copy(), np.full(len(q), np.inf)
+    best: np.ndarray = q.copy()
+    low = np.full(len(q), np.inf)
     act = np.arange(len(q))  # rows not yet at 1e-16
     for k in range(steps + final):
         if k == steps:
@@ -164,7 +165,7 @@ def _into_limits(robot: Arm, q: np.ndarray, pair: CoincidentPair) -> np.ndarray:
     # Newton misses by ~1e-7): the middle; the polish after it recomputes q_b
     d = np.where(lo <= hi, np.clip(0.0, lo, hi), 0.5 * (lo + hi))
     d = np.where((lo <= hi + SHIFT) & (np.abs(d) <= SHIFT), d, 0.0)
-    out = q.copy()
+    out: np.ndarray = q.copy()
     out[:, pair.a] += d
     out[:, pair.b] -= pair.sign * d
     return out
