@@ -136,9 +136,11 @@ def _newton(robot: Arm, q: np.ndarray, T: np.ndarray, free: np.ndarray,
         J, e = _jacobian_residual(robot, packed, n, q[act], T[act])
         err = np.abs(e).max(axis=-1, initial=0.0)
         better = err < low[act]
-        best[act[better]], low[act[better]] = q[act[better]], err[better]
+        if better.any():
+            best[act[better]], low[act[better]] = q[act[better]], err[better]
         go = err > 1e-16
-        act, J, e = act[go], J[go], e[go]
+        if not go.all():
+            act, J, e = act[go], J[go], e[go]
         if len(act):
             act = _step(q, act, J, e, free, rev, RCOND if k < steps else FINAL_RCOND)
         k += 1
@@ -161,7 +163,7 @@ def _step(q: np.ndarray, act: np.ndarray, J: np.ndarray, e: np.ndarray, free: np
     # at most MAX_STEP rad per joint (a step along a near-null direction can be
     # thousands of radians), the angles kept in [-pi, pi] (their rounding small)
     step *= np.minimum(1.0, MAX_STEP / np.maximum(np.abs(step).max(axis=-1), 1e-300))[:, None]
-    old = q[act][:, free]
+    old = q[act[:, None], free]
     x = old + step
     new = np.where(rev, wrap_angle(x), x)
     q[act[:, None], free] = new
@@ -357,6 +359,8 @@ def solve_near_coincident(robot: Arm, T: np.ndarray, pair: CoincidentPair, v0: f
         exact = _exact(robot, q, T[pose_a])
         for hold in (False, True):  # rows outside the limits: moved in where exact
             out = np.flatnonzero(_past(robot, q) > 0.0)
+            if not len(out):
+                break
             moved = _pinned(robot, q[out], T[pose_a[out]], pair, free, hold)
             keep = (_exact(robot, moved, T[pose_a[out]])
                     & (_past(robot, moved) < _past(robot, q[out])))
