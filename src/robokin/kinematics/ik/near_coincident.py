@@ -34,6 +34,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from robokin._native import kernels
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.forward import forward_kinematics
 from robokin.kinematics.ik.analytic._common import fit_turns
@@ -110,37 +111,82 @@ def _newton(robot: Arm, q: np.ndarray, T: np.ndarray, free: np.ndarray,
 
     Each row's best iterate is kept (at a doubly singular configuration, the
     smallest singular value ~1e-14, the steps can wander once converged); the last
-    ``FINAL`` steps cut at ``FINAL_RCOND`` (such directions left out).
+    ``FINAL`` steps cut at ``FINAL_RCOND`` (such directions left out). One batch
+    for all rows, a row leaving it once at 1e-16; the compiled Jacobian and
+    residual (``chain.h``) are called directly on the batch (the public wrappers'
+    checks cost more than the step itself on a few rows).
     """
-    q = q.copy()
+    q = np.array(q, dtype=np.float64, order="C")
+    T = np.ascontiguousarray(T, dtype=np.float64)
+    n = robot.n
+    rev = robot.is_revolute[free]
+    packed = robot.chain.arrays.packed
     best: np.ndarray = q.copy()
     low = np.full(len(q), np.inf)
     act = np.arange(len(q))  # rows not yet at 1e-16
-    for k in range(steps + final):
+    k = 0
+    while k < steps + final:
         if k == steps:
             act = np.flatnonzero(low > 1e-16)
             q[act] = best[act]  # the coarser steps from each row's best
         if not len(act):
-            break
-        J, Tq = jacobian_and_pose(robot.chain, q[act])
-        e = pose_error(Tq, T[act])
+            if k >= steps:
+                break
+            k = steps  # every row at 1e-16 or at a fixed point: the coarser steps
+            continue
+        J, e = _jacobian_residual(robot, packed, n, q[act], T[act])
         err = np.abs(e).max(axis=-1, initial=0.0)
         better = err < low[act]
-        best[act[better]], low[act[better]] = q[act[better]], err[better]
+        if better.any():
+            best[act[better]], low[act[better]] = q[act[better]], err[better]
         go = err > 1e-16
-        act, J, e = act[go], J[go], e[go]
-        if not len(act):
-            continue
-        U, s, Vt = np.linalg.svd(J[:, :, free], full_matrices=False)
-        cut = RCOND if k < steps else FINAL_RCOND
-        inv = np.where(s > cut * s[:, :1], 1.0 / np.where(s > 0, s, 1.0), 0.0)
-        step = np.einsum("mji,mj,mkj,mk->mi", Vt, inv, U, e)
-        # at most MAX_STEP rad per joint (a step along a near-null direction can be
-        # thousands of radians), the angles kept in [-pi, pi] (their rounding small)
-        step *= np.minimum(1.0, MAX_STEP / np.maximum(np.abs(step).max(axis=-1), 1e-300))[:, None]
-        x = q[act][:, free] + step
-        q[act[:, None], free] = np.where(robot.is_revolute[free], wrap_angle(x), x)
+        if not go.all():
+            act, J, e = act[go], J[go], e[go]
+        if len(act):
+            act = _step(q, act, J, e, free, rev, RCOND if k < steps else FINAL_RCOND)
+        k += 1
     return best
+
+
+def _step(q: np.ndarray, act: np.ndarray, J: np.ndarray, e: np.ndarray, free: np.ndarray,
+          rev: np.ndarray, cut: float) -> np.ndarray:
+    """One SVD step of rows ``act`` of q (m, n) in place; the rows it moved.
+
+    J (k, 6, n) and e (k, 6) are those rows' Jacobians and residuals; the step is a
+    least-squares solve on the columns ``free`` with singular values below ``cut``
+    of the largest left out. A row the step leaves bitwise where it was is at a
+    fixed point of the iteration (the next steps would repeat this one): it leaves
+    the batch, which changes no result.
+    """
+    U, s, Vt = np.linalg.svd(J[:, :, free], full_matrices=False)
+    inv = np.where(s > cut * s[:, :1], 1.0 / np.where(s > 0, s, 1.0), 0.0)
+    step = np.einsum("mji,mj,mkj,mk->mi", Vt, inv, U, e)
+    # at most MAX_STEP rad per joint (a step along a near-null direction can be
+    # thousands of radians), the angles kept in [-pi, pi] (their rounding small)
+    step *= np.minimum(1.0, MAX_STEP / np.maximum(np.abs(step).max(axis=-1), 1e-300))[:, None]
+    old = q[act[:, None], free]
+    x = old + step
+    new = np.where(rev, wrap_angle(x), x)
+    q[act[:, None], free] = new
+    return act[np.any(new != old, axis=-1)]
+
+
+def _jacobian_residual(robot: Arm, packed: np.ndarray, n: int, q: np.ndarray,
+                       T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Jacobians (m, 6, n) at rows q (m, n) and residuals (m, 6) to poses T (m, 4, 4).
+
+    The same compiled formulas as :func:`jacobian_and_pose` and :func:`pose_error`
+    on C-contiguous float64 batches (made here); a non-finite row goes through
+    :func:`jacobian_and_pose` for its error.
+    """
+    m = len(q)
+    J = np.empty((m, 6, n))
+    Tq = np.empty((m, 4, 4))
+    if not kernels.jacobian(packed, q, J, Tq):
+        jacobian_and_pose(robot.chain, q)  # raises the InputError naming the row
+    e = np.empty((m, 6))
+    kernels.pose_error(Tq, T, e)
+    return J, e
 
 
 def _exact(robot: Arm, q: np.ndarray, T: np.ndarray, tol: float = ACCEPT) -> np.ndarray:
@@ -314,6 +360,8 @@ def solve_near_coincident(robot: Arm, T: np.ndarray, pair: CoincidentPair, v0: f
         exact = _exact(robot, q, T[pose_a])
         for hold in (False, True):  # rows outside the limits: moved in where exact
             out = np.flatnonzero(_past(robot, q) > 0.0)
+            if not len(out):
+                break
             moved = _pinned(robot, q[out], T[pose_a[out]], pair, free, hold)
             keep = (_exact(robot, moved, T[pose_a[out]])
                     & (_past(robot, moved) < _past(robot, q[out])))
