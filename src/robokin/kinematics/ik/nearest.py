@@ -61,8 +61,8 @@ def solve_near(
             on 7R arms the numeric descent from ``q_near``), ``"analytic"``,
             ``"numeric"`` or ``"self_motion"`` (7R arms whose self-motion has a
             closed form: the in-limit point of the whole manifold nearest
-            ``q_near``: compiled on SRS arms, ~0.1 ms per pose; sampled on
-            the others, milliseconds; see ``docs/ik.md``).
+            ``q_near``: compiled on SRS arms, ~0.1 ms per pose; on the others
+            the exact intervals searched in Python, ~5 ms; see ``docs/ik.md``).
         **options: Options of the numeric solver
             (:func:`robokin.kinematics.ik.numeric.solve`, e.g. ``mask``, ``tol``,
             ``max_restarts``); giving any selects it.
@@ -109,9 +109,8 @@ def _manifold_near(arm: Arm, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
     """A 7R arm with a self-motion closed form: the in-limit point nearest ``q_near``.
 
     SRS arms: the compiled search on the exact swivel intervals, all poses in one
-    batch (``self_motion.swivel_nearest``); other arms: per pose, every branch of the
-    self-motion sampled and the nearest in-limit sample zoomed in on
-    (``self_motion.nearest_on_manifold``).
+    batch (``self_motion.swivel_nearest``); other arms: per pose, the exact in-limit
+    intervals searched (``self_motion.nearest_on_manifold``).
     """
     from robokin.kinematics.ik.analytic._common import fk_error
 

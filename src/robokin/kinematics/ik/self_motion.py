@@ -67,8 +67,8 @@ from robokin.kinematics.ik.self_motion_intervals import (
     _state_changes,
     _within,
 )
+from robokin.kinematics.ik.self_motion_nearest import interval_nearest
 from robokin.kinematics.ik.swivel import SwivelArm
-from robokin.spatial import wrap_angle as _wrap
 
 __all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SelfMotionSetup", "SingularPoint",
            "auto_parameter",
@@ -76,8 +76,6 @@ __all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SelfMotionSetup", "S
 
 #: Checking-grid values of a continued family.
 _CONTINUED_GRID = 181
-#: Half-width [rad] of ik_near's window around q_near's own parameter value.
-_WINDOW = 0.05
 #: Zoom rounds of SelfMotion.best / nearest (each narrows the span about 4 times).
 _ZOOMS = 8
 #: Intervals zoomed in on (the best by their samples).
@@ -203,19 +201,21 @@ class SelfMotion:
         """The in-limit configuration nearest ``q_near`` (n,) (2 pi wrapped distance).
 
         On the compiled swivel (SRS arms) the kernel's search on the exact
-        intervals (``SwivelArm.nearest``; ``samples`` is not used); elsewhere
-        ``samples`` values per interval, then zooming in (as :meth:`best`).
+        intervals (``SwivelArm.nearest``); elsewhere the exact intervals searched
+        by ``self_motion_nearest.interval_nearest`` (end values, a 32-value grid,
+        golden-section refinement of the best local minima). ``samples`` is not
+        used (kept for callers that pass it).
         """
         qn = check_finite(check_joints(q_near, self.limits.shape[0], "q_near"), "q_near")
         fam = self._family
         if isinstance(fam, _SwivelFamily) and not fam.reference:
             return _swivel_nearest(fam.arm, self.T, qn)
 
-        def score(q: np.ndarray) -> np.ndarray:
-            out: np.ndarray = -np.linalg.norm(_wrap(q - qn), axis=-1)
-            return out
-
-        return self._maximise(score, samples)
+        found = interval_nearest(fam, self.limits, self.intervals, self.interval_branch, qn)
+        if found is None:
+            return None
+        q, t, branch, dist = found
+        return ManifoldPoint(q, t, branch, -dist)
 
     def _maximise(self, score: Callable[[np.ndarray], np.ndarray],
                   samples: int) -> ManifoldPoint | None:
@@ -275,40 +275,22 @@ def _scores(fam: _Family, limits: np.ndarray, score: Callable[[np.ndarray], np.n
 
 
 def nearest_on_manifold(robot: ArmSource, T: np.ndarray, q_near: np.ndarray, *,
-                        dispatch: Dispatch, samples: int = 61) -> ManifoldPoint | None:
+                        dispatch: Dispatch) -> ManifoldPoint | None:
     """The in-limit configuration of pose T (4, 4) nearest ``q_near`` (n,), or None.
 
     ``dispatch`` is ``dispatch.solve`` (solves the arm with a joint held; passed in,
     as :func:`~robokin.kinematics.ik.fixed.solve_fixed` takes it, so this module
     does not import the dispatcher that imports it).
 
-    Without the exact intervals (``ik_near``'s fast path): every branch sampled at
-    ``samples`` parameter values over its range and over +-0.05 rad around
-    ``q_near``'s own parameter value, the nearest in-limit sample zoomed in on.
+    SRS arms: the compiled swivel search; other arms: the exact in-limit intervals
+    of :func:`self_motion` (compiled ``held_manifold`` on the Panda) searched by
+    :func:`~robokin.kinematics.ik.self_motion_nearest.interval_nearest`.
     """
     arm = arm_of(robot)
-    fam = _family(arm, T, "auto", dispatch)
-    if isinstance(fam, _SwivelFamily):
-        return _swivel_nearest(fam.arm, fam.T, q_near)
-    k = fam.k
-    lo, hi = fam.domain
-    # every branch over the whole range, and a window around q_near's own parameter
-    # value (an in-limit island narrower than the samples is found there)
-    tn = fam.param_of(q_near)
-    if fam.periodic:
-        window = (tn - _WINDOW, tn + _WINDOW)
-    else:
-        window = (max(lo, tn - _WINDOW), min(hi, tn + _WINDOW))
-        if window[0] >= window[1]:
-            window = (lo, hi)
-    intervals = np.vstack([np.tile([lo, hi], (k, 1)), np.tile(window, (k, 1))])
-
-    def score(q: np.ndarray) -> np.ndarray:
-        out: np.ndarray = -np.linalg.norm(_wrap(q - q_near), axis=-1)
-        return out
-
-    return _maximise(fam, np.asarray(arm.limits, dtype=np.float64), intervals,
-                     np.tile(np.arange(k), 2), score, samples)
+    swivel = _setup(arm).swivel
+    if swivel is not None:
+        return _swivel_nearest(swivel, np.asarray(T, dtype=np.float64), q_near)
+    return self_motion(arm, T, dispatch=dispatch).nearest(q_near)
 
 
 def _swivel_nearest(arm: SwivelArm, T: np.ndarray, q_near: np.ndarray) -> ManifoldPoint | None:

@@ -1,0 +1,174 @@
+"""The in-limit point of a self-motion nearest a configuration, on the exact intervals.
+
+Used by ``SelfMotion.nearest`` and ``ik_near(..., method="self_motion")`` on the
+held-joint families (the Panda with q7 held), whose in-limit intervals come from
+the compiled ``held_manifold`` pass. Per branch and interval: the 2 pi wrapped
+distance to ``q_near`` at the interval's ends and at a grid inside it; the
+``_KEEP`` smallest local minima of those samples are refined by safeguarded
+Newton steps between their neighbouring samples (to ``_TOL`` rad in t; the best value seen kept); the candidates
+(refined minima and every interval end, where a constrained minimum lies) are
+tried nearest first, and the first whose row is inside every limit (1e-12) is
+returned, clamped into the limits.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robokin.kinematics.ik.self_motion_families import _Family
+from robokin.spatial import wrap_angle as _wrap
+
+__all__ = ["interval_nearest"]
+
+#: Parameter values per interval (ends included).
+GRID = 32
+#: Local minima refined.
+_KEEP = 3
+#: Step or bracket width [rad] at which the Newton search stops.
+_TOL = 1e-10
+#: Newton iterations at most.
+_MAX_ITER = 40
+#: Central-difference step [rad] of the Newton derivatives.
+_H = 1e-5
+#: Tolerance [rad] of the limit check of a returned row (then clamped).
+_LIMIT_TOL = 1e-12
+
+
+def interval_nearest(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
+                     branches: np.ndarray, q_near: np.ndarray, *, grid: int = GRID
+                     ) -> tuple[np.ndarray, float, int, float] | None:
+    """The in-limit configuration on the intervals nearest ``q_near``, or None.
+
+    Args:
+        fam: The self-motion family (its ``rows(t)`` gives every branch at t).
+        limits: Joint limits (n, 2) [rad].
+        intervals: (m, 2) in-limit parameter intervals [rad].
+        branches: (m,) the branch of each interval.
+        q_near: The configuration (n,) [rad].
+        grid: Values per interval (ends included), at least 3.
+
+    Returns:
+        ``(q (n,), t, branch, distance)``, or None when no row is inside the limits.
+    """
+    if not len(intervals):
+        return None
+    g = max(int(grid), 3)
+    a, b = intervals[:, :1], intervals[:, 1:]
+    t = a + (b - a) * np.linspace(0.0, 1.0, g)  # (m, g)
+    br = np.asarray(branches, dtype=np.int64)
+    d = _distances(fam, limits, t, br, q_near)
+    mt, mb, md = _refined_minima(fam, limits, t, d, br, q_near)
+    # interval ends are candidates exactly (a constrained minimum lies there)
+    cand_t = np.concatenate([mt, t[:, 0], t[:, -1]])
+    cand_b = np.concatenate([mb, br, br])
+    cand_d = np.concatenate([md, d[:, 0], d[:, -1]])
+    return _first_inside(fam, limits, cand_t, cand_b, cand_d, t, d, br)
+
+
+def _rows(fam: _Family, t: np.ndarray, br: np.ndarray) -> np.ndarray:
+    """Rows (p, g, n) of branch br[i] at t[i, :] (NaN where the branch has none)."""
+    q = fam.rows(t.reshape(-1))[0]
+    q = q.reshape(t.shape + q.shape[-2:])
+    return np.asarray(q[np.arange(len(t)), :, br])
+
+
+def _distances(fam: _Family, limits: np.ndarray, t: np.ndarray, br: np.ndarray,
+               q_near: np.ndarray) -> np.ndarray:
+    """Wrapped distances (p, g) of branch br[i] at t[i, :] to q_near; inf off the limits."""
+    if not t.size:
+        return np.zeros(t.shape)
+    q = _rows(fam, t, br)
+    lo, hi = limits[:, 0], limits[:, 1]
+    with np.errstate(invalid="ignore"):
+        ok = np.isfinite(q).all(-1) & np.all((q >= lo - 1e-9) & (q <= hi + 1e-9), axis=-1)
+        d = np.linalg.norm(_wrap(q - q_near), axis=-1)
+    return np.where(ok, d, np.inf)
+
+
+def _refined_minima(fam: _Family, limits: np.ndarray, t: np.ndarray, d: np.ndarray,
+                    br: np.ndarray, q_near: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The ``_KEEP`` smallest local minima of the samples, refined (``_newton``)."""
+    left = np.concatenate([np.full((len(d), 1), np.inf), d[:, :-1]], axis=1)
+    right = np.concatenate([d[:, 1:], np.full((len(d), 1), np.inf)], axis=1)
+    r, c = np.nonzero(np.isfinite(d) & (d <= left) & (d <= right))
+    if not len(r):
+        return np.zeros(0), np.zeros(0, dtype=np.int64), np.zeros(0)
+    order = np.argsort(d[r, c], kind="stable")[:_KEEP]
+    r, c = r[order], c[order]
+    g = t.shape[1]
+    # a minimum sample at an interval's end whose distance rises inward is the
+    # constrained minimum (the end is a candidate itself): not refined
+    end = (c == 0) | (c == g - 1)
+    if end.any():
+        inward = t[r, c] + np.where(c == 0, _H, -_H)
+        rises = _distances(fam, limits, inward[:, None], br[r], q_near)[:, 0] >= d[r, c]
+        keep = ~(end & rises)
+        r, c = r[keep], c[keep]
+        if not len(r):
+            return np.zeros(0), np.zeros(0, dtype=np.int64), np.zeros(0)
+    lo = t[r, np.maximum(c - 1, 0)]
+    hi = t[r, np.minimum(c + 1, g - 1)]
+    x, f = _newton(fam, limits, lo, hi, t[r, c], br[r], q_near)
+    return x, br[r], np.sqrt(f)
+
+
+def _newton(fam: _Family, limits: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+            t0: np.ndarray, br: np.ndarray, q_near: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """Minima (p,) of the squared distance on brackets [lo, hi], all at once.
+
+    Returns the parameter values and their squared distances (p,).
+
+    Safeguarded Newton steps on the squared distance (its derivatives by central
+    differences, step ``_H``), the bracket shrunk on the side the slope points
+    away from, a bisection where the step leaves the bracket or the curvature is
+    not positive; the best value seen is
+    kept, so the result is never farther than the sample it started from.
+    """
+    lo, hi, x = lo.copy(), hi.copy(), t0.copy()
+    best_x = t0.copy()
+    best_f = np.full(len(x), np.inf)
+    for _ in range(_MAX_ITER):
+        f = _distances(fam, limits, np.column_stack([x - _H, x, x + _H]), br, q_near) ** 2
+        fm, f0, fp = f[:, 0], f[:, 1], f[:, 2]
+        better = f0 < best_f
+        best_x, best_f = np.where(better, x, best_x), np.where(better, f0, best_f)
+        with np.errstate(invalid="ignore"):
+            g = (fp - fm) / (2 * _H)
+            c = (fp - 2 * f0 + fm) / _H**2
+        ok = np.isfinite(g) & np.isfinite(c)
+        hi = np.where(ok & (g > 0), x, hi)
+        lo = np.where(ok & (g < 0), x, lo)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            step = np.where(ok & (c > 0), -g / c, np.nan)
+        new = x + step
+        bad = ~np.isfinite(new) | (new <= lo) | (new >= hi)
+        new = np.where(bad, 0.5 * (lo + hi), new)
+        done = (np.abs(new - x) < _TOL) | (hi - lo < _TOL)
+        x = new
+        if np.all(done):
+            break
+    return best_x, best_f
+
+
+def _first_inside(fam: _Family, limits: np.ndarray, cand_t: np.ndarray, cand_b: np.ndarray,
+                  cand_d: np.ndarray, t: np.ndarray, d: np.ndarray, br: np.ndarray
+                  ) -> tuple[np.ndarray, float, int, float] | None:
+    """The nearest candidate whose row is inside the limits (1e-12), clamped; else None.
+
+    The grid samples are the last candidates (a row at an interval end can be
+    outside its limit by more than 1e-12 where the end was bisected).
+    """
+    all_t = np.concatenate([cand_t, t.ravel()])
+    all_b = np.concatenate([cand_b, np.repeat(br, t.shape[1])])
+    all_d = np.concatenate([cand_d, d.ravel()])
+    lo, hi = limits[:, 0], limits[:, 1]
+    for i in np.argsort(all_d, kind="stable"):
+        if not np.isfinite(all_d[i]):
+            break
+        q = fam.rows(all_t[i:i + 1])[0][0, all_b[i]]
+        if np.isfinite(q).all() and np.all((q >= lo - _LIMIT_TOL) & (q <= hi + _LIMIT_TOL)):
+            q = np.clip(q, lo, hi)
+            return q, float(all_t[i]), int(all_b[i]), float(all_d[i])
+    return None
