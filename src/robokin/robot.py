@@ -371,9 +371,9 @@ class Robot(RobotParts):
             method: ``"auto"``, ``"analytic"``, ``"numeric"`` or ``"self_motion"``
                 (7R arms with a closed-form self-motion: the in-limit point of the
                 whole manifold nearest ``q_near``: compiled on SRS arms, about
-                0.1-0.2 ms per pose; sampled on held-joint arms such as the Panda,
-                a few ms; see ``docs/ik.md``; ``"auto"`` on a 7R arm is the
-                numeric descent, ~0.03 ms).
+                0.1-0.2 ms per pose; on held-joint arms such as the Panda a search
+                of the exact in-limit intervals, 4-5 ms; see ``docs/ik.md``;
+                ``"auto"`` on a 7R arm is the numeric descent, ~0.03 ms).
             **options: Numeric-solver options (``mask``, ``tol``, ...).
 
         Returns:
