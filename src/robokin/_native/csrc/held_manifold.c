@@ -662,17 +662,8 @@ static int hm_margins(const double *P, const double *T, double x, double *m)
     m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
     v3 pT = {T[3], T[7], T[11]};
     m3 G = pk_mul_t(&RT, &g.RM);
-    int start = g.kase == PK_START, ia = start ? 3 : 0;
-    v3 p, d;
-    if (start) {
-        p = v3_add(m3_mv(&g.RM, m3_mtv(&RT, v3_sub(g.pt, pT))), g.tM);
-        d = g.pt;
-    } else {
-        p = g.pt;
-        d = v3_add(m3_mv(&G, v3_sub(g.pt, g.tM)), pT);
-    }
     PkEq e;
-    pk_equations(&g, ia, p, d, &e);
+    pk_pose_equations(&g, &RT, pT, &G, &e);
     int swap;
     if (fabs(e.mbc) <= PK_COPLANAR)
         swap = 0;

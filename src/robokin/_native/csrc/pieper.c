@@ -1796,6 +1796,25 @@ static void pk_walk_rows(const double *P, const PkGeo *g, const m3 *RT, v3 pT, i
 
 #include "pieper_srs.c"
 
+/* The position equations of pose (RT, pT) for geometry g (not PK_BOTH), G (pk_one's G)
+ * the rotation of e1 ... e6: the wrist point p and direction d of the held split,
+ * then pk_equations on the position joints (the first three, or the last three
+ * when the chain starts with its wrist). One copy for pk_one and the compiled
+ * manifold's existence margins (held_manifold.c). */
+static void pk_pose_equations(const PkGeo *g, const m3 *RT, v3 pT, const m3 *G, PkEq *e)
+{
+    int start = g->kase == PK_START, ia = start ? 3 : 0;
+    v3 p, d;
+    if (start) {
+        p = v3_add(m3_mv(&g->RM, m3_mtv(RT, v3_sub(g->pt, pT))), g->tM);
+        d = g->pt;
+    } else {
+        p = g->pt;
+        d = v3_add(m3_mv(G, v3_sub(g->pt, g->tM)), pT);
+    }
+    pk_equations(g, ia, p, d, e);
+}
+
 /* Every solution of pose T (4 x 4 row-major) with the held joint (if any) at x;
  * qn: the preferred coordinates (n) at singularities. Returns the status. */
 static int pk_one(const double *P, const double *T, double x, const double *qn, PkOut o)
@@ -1811,16 +1830,8 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
     if (g.kase == PK_BOTH)
         return pk_srs(P, &g, &RT, pT, x, qn, o);
     int start = g.kase == PK_START, ia = start ? 3 : 0, it = start ? 0 : 3;
-    v3 p, d;
-    if (start) {
-        p = v3_add(m3_mv(&g.RM, m3_mtv(&RT, v3_sub(g.pt, pT))), g.tM);
-        d = g.pt;
-    } else {
-        p = g.pt;
-        d = v3_add(m3_mv(&G, v3_sub(g.pt, g.tM)), pT);
-    }
     PkEq e;
-    pk_equations(&g, ia, p, d, &e);
+    pk_pose_equations(&g, &RT, pT, &G, &e);
     PkPos pos;
     pos.n = 0;
     int code;
