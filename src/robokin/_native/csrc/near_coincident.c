@@ -32,7 +32,7 @@
  * seed alone (no batch), so the order of poses and rows changes nothing.
  */
 #include "chain.h"
-#include "svd6.h"
+#include "linalg6.h"
 
 #if defined(__clang__)
 #pragma STDC FP_CONTRACT OFF
@@ -56,6 +56,7 @@
 #define NC_SPREAD 8          /* splits spread over the turn where the equation fails */
 #define NC_SEEDS NC_SPREAD   /* seeds per helper row at most (the Q rows needed) */
 #define NC_N 7               /* the arm's joints (7R) */
+#define NC_QR_SAFE 100.0     /* QR pivot ratio above this times the cut: no SVD needed */
 
 /* a target for the evaluations whose residual is not used */
 static const double NC_EYE[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
@@ -100,33 +101,44 @@ static double nc_maxabs(const double *e)
     return m;
 }
 
-/* One least-squares step on the joints `cols` of q, in place: the SVD of J's k
- * columns, singular values at most `cut` of the largest (or zero) left out, the
- * step scaled to at most NC_MAX_STEP rad, angles wrapped. 1 when q changed. */
+/* One least-squares step on the joints `cols` of q, in place: J's k columns'
+ * least-squares solution with singular values at most `cut` of the largest (or
+ * zero) left out, the step scaled to at most NC_MAX_STEP rad, angles wrapped.
+ * 1 when q changed.
+ *
+ * Where the pivoted QR (lstsq6) shows every singular value above NC_QR_SAFE
+ * times the cut (its pivot ratio bounds sigma_min / sigma_max from below by
+ * ratio / 53, linalg6.h), no value would be cut and the step is the unique
+ * least-squares solution, which the QR gives (a tenth of the SVD's cost); else
+ * the SVD (pk_svd6) takes the step with the cut. */
 static int nc_step(const Chain *ch, double J[6][6], const double *e, double cut, double *q,
                    const int *cols, int k)
 {
-    double A[6][6], sig[6], V[6][6], g[6], dx[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-    for (int r = 0; r < 6; r++)
-        for (int c = 0; c < 6; c++)
-            A[r][c] = J[r][c];
-    pk_svd6(A, sig, V); /* ascending */
-    for (int c = 0; c < 6; c++) { /* J^T e */
-        double s = 0.0;
-        for (int r = 0; r < 6; r++)
-            s += J[r][c] * e[r];
-        g[c] = s;
-    }
-    /* V diag(1 / s) U^T e = sum_c V_c (V_c . J^T e) / s_c^2 over the kept s_c */
-    for (int c = 0; c < 6; c++) {
-        if (!(sig[c] > cut * sig[5]) || !(sig[c] > 0.0))
-            continue;
-        double d = 0.0;
-        for (int i = 0; i < 6; i++)
-            d += V[i][c] * g[i];
-        d /= sig[c] * sig[c];
-        for (int i = 0; i < 6; i++)
-            dx[i] += V[i][c] * d;
+    double A[6][6], dx[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}, ratio;
+    memcpy(A, J, sizeof(A));
+    int rank = lstsq6(A, e, dx, 0.0, &ratio, k);
+    if (!(rank == k && ratio > NC_QR_SAFE * cut)) {
+        double sig[6], V[6][6], g[6];
+        memcpy(A, J, sizeof(A));
+        pk_svd6(A, sig, V); /* ascending */
+        for (int c = 0; c < 6; c++) { /* J^T e */
+            double s = 0.0;
+            for (int r = 0; r < 6; r++)
+                s += J[r][c] * e[r];
+            g[c] = s;
+            dx[c] = 0.0;
+        }
+        /* V diag(1 / s) U^T e = sum_c V_c (V_c . J^T e) / s_c^2 over the kept s_c */
+        for (int c = 0; c < 6; c++) {
+            if (!(sig[c] > cut * sig[5]) || !(sig[c] > 0.0))
+                continue;
+            double d = 0.0;
+            for (int i = 0; i < 6; i++)
+                d += V[i][c] * g[i];
+            d /= sig[c] * sig[c];
+            for (int i = 0; i < 6; i++)
+                dx[i] += V[i][c] * d;
+        }
     }
     double big = 1e-300;
     for (int i = 0; i < k; i++)
@@ -307,6 +319,57 @@ static int nc_solve3(double M[3][3], double *h, double *x)
     return 1;
 }
 
+/* The unit vector n orthogonal to F's first five columns (F's sixth is zero),
+ * when their smallest singular value is at least NC_FAMILY_RANK of the largest
+ * (else 0: the family is singular itself). The SVD of F (pk_svd6: the zero
+ * column never rotates) gives their left singular vectors U_c = F V_c / s_c; n is
+ * the unit vector e_i least inside their span with that span projected out
+ * (twice, for orthogonality to rounding). */
+static int nc_left_null(double F[6][6], double *nv)
+{
+    double A[6][6], sig[6], V[6][6], U[5][6];
+    memcpy(A, F, sizeof(A));
+    pk_svd6(A, sig, V); /* ascending: sig[0] the zero column's */
+    if (!(sig[1] >= NC_FAMILY_RANK * sig[5]))
+        return 0;
+    for (int c = 0; c < 5; c++)
+        for (int r = 0; r < 6; r++) {
+            double s = 0.0;
+            for (int j = 0; j < 6; j++)
+                s += F[r][j] * V[j][c + 1];
+            U[c][r] = s / sig[c + 1];
+        }
+    int best = 0;
+    double most = -1.0;
+    for (int i = 0; i < 6; i++) { /* |e_i - P e_i|^2 = 1 - sum_c U_c[i]^2 */
+        double s = 1.0;
+        for (int c = 0; c < 5; c++)
+            s -= U[c][i] * U[c][i];
+        if (s > most) {
+            most = s;
+            best = i;
+        }
+    }
+    for (int r = 0; r < 6; r++)
+        nv[r] = r == best;
+    for (int pass = 0; pass < 2; pass++) {
+        for (int c = 0; c < 5; c++) {
+            double d = 0.0;
+            for (int r = 0; r < 6; r++)
+                d += U[c][r] * nv[r];
+            for (int r = 0; r < 6; r++)
+                nv[r] -= d * U[c][r];
+        }
+        double len = 0.0;
+        for (int r = 0; r < 6; r++)
+            len += nv[r] * nv[r];
+        len = sqrt(len);
+        for (int r = 0; r < 6; r++)
+            nv[r] /= len;
+    }
+    return 1;
+}
+
 /* The splits t = q_a where the self-motion through `row` (an exact solution with
  * the held joint at w next to v0, q_a at c) crosses the held value v: to first
  * order (v - v0) h(t) = (w - v0) h(c), h(t) = n . c(t) = alpha + beta cos t +
@@ -320,7 +383,7 @@ static int nc_splits(const NcProblem *p, const double *row, double *ts)
     const double c = row[p->a];
     const double w = wrap_pi(row[p->held] - p->v0);
     const double total = row[p->a] + p->sign * row[p->b];
-    double t3[3] = {c, c + 2.0 * M_PI / 3.0, c + 4.0 * M_PI / 3.0}, col[3][6], M5[6][6];
+    double t3[3] = {c, c + 2.0 * M_PI / 3.0, c + 4.0 * M_PI / 3.0}, col[3][6], F[6][6];
     int cols[MAXJ], k = 0;
     cols[k++] = p->a;
     for (int j = 0; j < n; j++)
@@ -333,25 +396,20 @@ static int nc_splits(const NcProblem *p, const double *row, double *ts)
         q[p->held] = p->v0;
         q[p->a] = t3[i];
         q[p->b] = p->sign * (total - t3[i]);
-        if (i == 0) {
-            nc_eval(ch, q, NC_EYE, cols, k, J, e); /* the family's columns */
-            for (int r = 0; r < 6; r++) /* their transpose, padded: its null vector is n */
-                for (int cc = 0; cc < 6; cc++)
-                    M5[r][cc] = r < k ? J[cc][r] : 0.0;
-        }
+        if (i == 0)
+            nc_eval(ch, q, NC_EYE, cols, k, F, e); /* the family's columns, padded */
         nc_eval(ch, q, NC_EYE, held, 1, J, e);
         for (int r = 0; r < 6; r++)
             col[i][r] = J[r][0];
     }
     int m = 0;
-    double sig[6], V[6][6];
-    pk_svd6(M5, sig, V); /* sig[0]: the padding's zero; sig[1..5]: the family's */
-    if (k == 5 && sig[1] >= NC_FAMILY_RANK * sig[5]) {
+    double nv[6];
+    if (k == 5 && nc_left_null(F, nv)) {
         double h[3], hmax = 0.0, M[3][3], x[3];
         for (int i = 0; i < 3; i++) {
             h[i] = 0.0;
             for (int r = 0; r < 6; r++)
-                h[i] += V[r][0] * col[i][r];
+                h[i] += nv[r] * col[i][r];
             hmax = fmax(hmax, fabs(h[i]));
             M[i][0] = 1.0;
             M[i][1] = cos(t3[i]);
@@ -414,6 +472,23 @@ static long nc_seeds(const NcProblem *p, const double *H, const long long *pose,
     return S;
 }
 
+/* Whether the free joints' smallest singular value at q is below NC_FLAG of the
+ * largest. The pivoted QR's ratio r bounds sigma_min / sigma_max within [r / 53,
+ * r] (linalg6.h): the SVD only where that interval straddles NC_FLAG. */
+static int nc_flag(const Chain *ch, const double *q, const double *T, const int *cols, int k)
+{
+    double J[6][6], A[6][6], e[6], dx[6], ratio, sig[6], V[6][6];
+    nc_eval(ch, q, T, cols, k, J, e);
+    memcpy(A, J, sizeof(A));
+    int rank = lstsq6(A, e, dx, 0.0, &ratio, k);
+    if (rank < k || ratio < NC_FLAG)
+        return 1;
+    if (ratio > NC_QR_SAFE * NC_FLAG)
+        return 0;
+    pk_svd6(J, sig, V);
+    return sig[0] < NC_FLAG * sig[5];
+}
+
 /* Steps 3-6 on one seed q (in place) of pose T: exact (1/0) and singular flags */
 static void nc_row(const NcProblem *p, double *q, const double *T, npy_bool *exact,
                    npy_bool *singular)
@@ -434,11 +509,8 @@ static void nc_row(const NcProblem *p, double *q, const double *T, npy_bool *exa
             ok = 1;
         }
     }
-    double J[6][6], e[6], sig[6], V[6][6];
-    nc_eval(ch, q, T, cols, k, J, e);
-    pk_svd6(J, sig, V);
     *exact = (npy_bool)ok;
-    *singular = (npy_bool)(sig[0] < NC_FLAG * sig[5]);
+    *singular = (npy_bool)nc_flag(ch, q, T, cols, k);
 }
 
 /* The last step, on one pose's rows [b, e): the slot of each exact row, least

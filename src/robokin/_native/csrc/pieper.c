@@ -918,89 +918,7 @@ static int pk_accept(const PkGeo *g, const m3 *RT, v3 pT, const double *trial, d
     return 1;
 }
 
-/* The least-squares step J dx = e of a 6 x 6 Jacobian (rows J[r][.]): Householder
- * QR with column pivoting, columns whose pivot falls below 1e-10 of the first
- * left out (a singular configuration: no step along its near-null directions). */
-static void pk_lstsq(double J[6][6], const double *e, double *dx)
-{
-    double A[6][6], b[6], norms[6];
-    int perm[6], rank = 0;
-    for (int r = 0; r < 6; r++) {
-        b[r] = e[r];
-        for (int c = 0; c < 6; c++)
-            A[r][c] = J[r][c];
-    }
-    for (int c = 0; c < 6; c++) {
-        perm[c] = c;
-        double s = 0.0;
-        for (int r = 0; r < 6; r++)
-            s += A[r][c] * A[r][c];
-        norms[c] = s;
-    }
-    double first = 0.0;
-    for (int k = 0; k < 6; k++) {
-        int best = k; /* pivot: the remaining column of largest norm */
-        for (int c = k + 1; c < 6; c++)
-            if (norms[c] > norms[best])
-                best = c;
-        if (best != k) {
-            for (int r = 0; r < 6; r++) {
-                double t = A[r][k];
-                A[r][k] = A[r][best];
-                A[r][best] = t;
-            }
-            double t = norms[k];
-            norms[k] = norms[best];
-            norms[best] = t;
-            int ti = perm[k];
-            perm[k] = perm[best];
-            perm[best] = ti;
-        }
-        double nx = 0.0;
-        for (int r = k; r < 6; r++)
-            nx += A[r][k] * A[r][k];
-        nx = sqrt(nx);
-        if (k == 0)
-            first = nx;
-        if (!(nx > 1e-10 * first))
-            break;
-        double alpha = A[k][k] > 0.0 ? -nx : nx, v[6];
-        for (int r = 0; r < 6; r++)
-            v[r] = r < k ? 0.0 : A[r][k];
-        v[k] -= alpha;
-        double vv = 0.0;
-        for (int r = k; r < 6; r++)
-            vv += v[r] * v[r];
-        if (vv > 0.0) {
-            for (int c = k; c < 6; c++) {
-                double d = 0.0;
-                for (int r = k; r < 6; r++)
-                    d += v[r] * A[r][c];
-                d *= 2.0 / vv;
-                for (int r = k; r < 6; r++)
-                    A[r][c] -= d * v[r];
-            }
-            double d = 0.0;
-            for (int r = k; r < 6; r++)
-                d += v[r] * b[r];
-            d *= 2.0 / vv;
-            for (int r = k; r < 6; r++)
-                b[r] -= d * v[r];
-        }
-        for (int c = k + 1; c < 6; c++)
-            norms[c] -= A[k][c] * A[k][c];
-        rank = k + 1;
-    }
-    double y[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-    for (int r = rank - 1; r >= 0; r--) {
-        double s = b[r];
-        for (int c = r + 1; c < rank; c++)
-            s -= A[r][c] * y[c];
-        y[r] = s / A[r][r];
-    }
-    for (int c = 0; c < 6; c++)
-        dx[perm[c]] = y[c];
-}
+#include "linalg6.h" /* pk_lstsq, pk_svd6 */
 
 /* Newton steps on the remaining chain's angles (least squares, pk_lstsq; kept only
  * while they reduce the error), the joints in `frozen` (bit j: angle j) held;
@@ -1231,8 +1149,6 @@ static int pk_inside(const double *P, const PkGeo *g, const m3 *RT, v3 pT, doubl
         return 0;
     return pk_accept(g, RT, pT, trial, th);
 }
-
-#include "svd6.h" /* pk_svd6 */
 
 /* How far joint coordinate q lies outside [lo, hi] at its nearest turn (0 inside),
  * and that limit into *lim. */

@@ -43,7 +43,10 @@ from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, ArmSource, Derived, arm_of
 from robokin.kinematics.ik import coincident as _co
 from robokin.kinematics.ik import near_coincident as _nco
+from robokin.kinematics.ik.analytic import general_6r as _g6
 from robokin.kinematics.ik.analytic import pieper as _pk
+from robokin.kinematics.ik.analytic._common import STATUS_TEXT
+from robokin.kinematics.ik.analytic.detect import FAMILY
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.model.chain import joint_motion
 from robokin.spatial import invert
@@ -198,7 +201,9 @@ def _coincident_parts(robot: Arm, j: int, T: np.ndarray, v: np.ndarray,
         rows = np.flatnonzero(inverse.ravel() == g)
 
         def helper(a: int, c: float, Ts: np.ndarray) -> SolutionSet:
-            return solve_fixed(robot, Ts, {name[a]: c}, dispatch=dispatch)
+            fast = _end_general_6r(robot, a, c, Ts)
+            return fast if fast is not None else solve_fixed(robot, Ts, {name[a]: c},
+                                                             dispatch=dispatch)
 
         if near is not None:  # next to aligned: exact rows from the aligned families
             sols = _nco.solve_near_coincident(robot, T[rows], near[0], near[1], float(x),
@@ -212,6 +217,41 @@ def _coincident_parts(robot: Arm, j: int, T: np.ndarray, v: np.ndarray,
             flags={"singular": sols.singular}, status=sols.status, method=sols.method)))
         rest[rows] = False
     return np.flatnonzero(rest)
+
+
+def _end_general_6r(robot: Arm, a: int, c: float, T: np.ndarray) -> SolutionSet | None:
+    """``solve_fixed(robot, T, {joint a: c})`` by the compiled general 6R solver directly.
+
+    Where joint ``a`` is an end joint without a held closed form and the reduced
+    chain's family is general 6R, the path :func:`solve_fixed` takes (moved
+    targets, one reduced chain), the same rows, without its checks and two set
+    assemblies: the coincident paths' helper problems (two per call, ~0.3 ms of
+    overhead each through ``solve_fixed``). None where that path does not apply.
+
+    Args:
+        robot: The arm.
+        a: The held joint's index.
+        c: Its value [rad].
+        T: Validated poses (N, 4, 4) [m].
+    """
+    end = _end_joint(robot, [a])
+    name = robot.joint_names[a]
+    if end is None or _held_solvers(robot).get(name) is not None:
+        return None
+    reduced = _reduced(robot, [a], (0.0,))
+    if reduced.derived(FAMILY).name != _g6.NAME:
+        return None
+    Tm = np.ascontiguousarray(_moved_targets(robot, end, T, np.full(len(T), c)))
+    Q, valid, _, sigma, status, _, _ = _g6.raw_solve(reduced.chain, _g6.setup(reduced).params,
+                                                     Tm)
+    q = np.empty(Q.shape[:-1] + (robot.n,))
+    q[..., [j for j in range(robot.n) if j != a]] = Q
+    q[..., a] = c
+    return SolutionSet._trusted(
+        q, valid, robot.is_revolute, robot.limits,
+        {"singular": (sigma < 1e-6) & valid}, {},
+        np.asarray(STATUS_TEXT[_g6._STATUS[status]], dtype=object),
+        f"{_g6.NAME} ({name} held)", None, {"held": {name: np.full(len(T), c)}})
 
 
 _NUMBERS = (float, int, np.float64)
