@@ -45,8 +45,11 @@ from robokin.kinematics.ik.coincident import (
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.spatial import wrap_angle
 
-__all__ = ["near_coincident_pair", "solve_near_coincident"]
+__all__ = ["near_coincident_pair", "near_rows", "placed", "solve_near_coincident",
+           "status_text"]
 
+#: What the sets' ``method`` adds to the helper problem's
+METHOD = "near-coincident axes, Newton"
 #: Held values this close [rad] to an aligned value v0 take this path (the general
 #: 6R solver declines the chain up to ~1e-4 rad on the Panda; it solves 1e-3 exactly)
 NEAR = 1e-3
@@ -132,25 +135,48 @@ def solve_near_coincident(robot: Arm, T: np.ndarray, pair: CoincidentPair, v0: f
         rows.append(Qh[p, r])
     pose = np.concatenate(poses)
     by_pose = np.argsort(pose, kind="stable")  # each pose's rows in one block, in order
-    H = np.ascontiguousarray(np.concatenate(rows)[by_pose], dtype=np.float64)
-    pose = np.ascontiguousarray(pose[by_pose], dtype=np.int64)
+    rows_out = near_rows(robot, T, np.concatenate(rows)[by_pose], pose[by_pose], pair, v0, v)
+    return _assemble(robot, N, rows_out, helpers[0], pair)
+
+
+def near_rows(robot: Arm, T: np.ndarray, H: np.ndarray, pose: np.ndarray,
+              pair: CoincidentPair, v0: float, v: float) -> tuple[np.ndarray, ...]:
+    """The compiled pass (``kernels.near_coincident``) on helper rows H (M, n).
+
+    Args:
+        robot: The arm.
+        T: Validated poses (N, 4, 4) [m].
+        H: Exact helper rows (joint ``pair.a`` held, joint ``pair.held`` within
+            ``KEEP`` of v0), (M, n), each pose's rows in order.
+        pose: Their poses (M,), non-decreasing.
+        pair: The aligned pair.
+        v0: The aligned value [rad].
+        v: The held value [rad].
+
+    Returns:
+        ``(q (S, n), pose (S,), exact (S,), singular (S,), slot (S,))`` per seed row:
+        slot is the row's place among its pose's solutions, -1 when dropped.
+    """
+    n = robot.n
     S = kernels.NC_SEEDS * len(H)
     q = np.empty((S, n))
     at = np.empty(S, np.int64)
     exact = np.empty(S, bool)
     flag = np.empty(S, bool)
     slot = np.empty(S, np.int64)
-    m = kernels.near_coincident(robot.chain.arrays.packed, np.ascontiguousarray(T), H, pose,
-                                pair.held, pair.a, pair.b, pair.sign, v0, v, ACCEPT, q, at,
-                                exact, flag, slot)
-    return _assemble(robot, N, q[:m], at[:m], exact[:m], flag[:m], slot[:m], helpers[0], pair)
+    m = kernels.near_coincident(robot.chain.arrays.packed, np.ascontiguousarray(T),
+                                np.ascontiguousarray(H, dtype=np.float64),
+                                np.ascontiguousarray(pose, dtype=np.int64), pair.held, pair.a,
+                                pair.b, pair.sign, v0, v, ACCEPT, q, at, exact, flag, slot)
+    return q[:m], at[:m], exact[:m], flag[:m], slot[:m]
 
 
-def _assemble(robot: Arm, N: int, q: np.ndarray, pose: np.ndarray, exact: np.ndarray,
-              flag: np.ndarray, slot: np.ndarray, fam: SolutionSet,
-              pair: CoincidentPair) -> SolutionSet:
-    """The set (N, k, n) of the rows placed in their pose's slots (one per solution)."""
-    n = robot.n
+def placed(N: int, n: int, rows: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
+    """:func:`near_rows`' rows in their slots: ``(q (N, k, n), valid, singular (N, k))``.
+
+    k is the most exact rows of a pose (at least 1); slots no row took are NaN.
+    """
+    q, pose, exact, flag, slot = rows
     k = max(1, int(np.bincount(pose[exact], minlength=N).max(initial=0)))
     out = np.full((N, k, n), np.nan)
     ok = np.zeros((N, k), bool)
@@ -159,11 +185,26 @@ def _assemble(robot: Arm, N: int, q: np.ndarray, pose: np.ndarray, exact: np.nda
     out[pose[put], slot[put]] = q[put]
     ok[pose[put], slot[put]] = True
     sing[pose[put], slot[put]] = flag[put]
-    why = fam.status.reshape(N)
-    status = np.where(ok.any(axis=-1), "ok",
-                      np.where(why == "ok", "no solution with the held value", why))
+    return out, ok, sing
+
+
+def status_text(ok: np.ndarray, why: np.ndarray) -> np.ndarray:
+    """Per pose (N,) status, object dtype: "ok" where ``ok`` (N, k) has a row.
+
+    Elsewhere the helper's status ``why`` (N,), or "no solution with the held value"
+    where the helper found rows.
+    """
+    return np.where(ok.any(axis=-1), "ok",
+                    np.where(why == "ok", "no solution with the held value", why)
+                    ).astype(object)
+
+
+def _assemble(robot: Arm, N: int, rows: tuple[np.ndarray, ...], fam: SolutionSet,
+              pair: CoincidentPair) -> SolutionSet:
+    """The set (N, k, n) of the rows placed in their pose's slots (one per solution)."""
+    out, ok, sing = placed(N, robot.n, rows)
     return SolutionSet(out, ok, robot.is_revolute, robot.limits, flags={"singular": sing},
-                       status=status.astype(object),
-                       method=f"{fam.method} + near-coincident axes, Newton",
+                       status=status_text(ok, fam.status.reshape(N)),
+                       method=f"{fam.method} + {METHOD}",
                        info={"near_coincident": (robot.joint_names[pair.a],
                                                  robot.joint_names[pair.b])})
