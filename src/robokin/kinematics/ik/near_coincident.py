@@ -26,6 +26,12 @@ instead.
 
 Rows are flagged ``singular`` where the 6 x 6 Jacobian of the free joints has a
 smallest singular value below ``FLAG`` of its largest (next to a continuum).
+
+Everything after the helper solves runs compiled (``csrc/near_coincident.c``,
+kernel ``near_coincident``, :func:`near_rows`), one seed at a time; a step is the
+pivoted QR's solution where its pivots show no singular value near the cut (then
+it is the SVD step exactly), the SVD's otherwise (docs/ik.md, "Joint 2 held next
+to 0").
 """
 
 from __future__ import annotations
