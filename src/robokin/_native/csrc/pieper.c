@@ -102,6 +102,8 @@ enum { PK_OK = 0, PK_OUT_OF_REACH = 1, PK_NO_ORIENTATION = 2, PK_DEGENERATE = 5,
 #define PK_CLAMP_SLACK 1e-10 /* pk_inside: joints out by at most this [rad] are not clamped */
 #define PK_FAMILY_SIGMA 1e-9  /* Jacobian's smallest / largest singular value below it: a family */
 #define PK_SP4_SLACK 1e-13     /* |C| - hypot(A, B) / scale below it: a double root (rounding) */
+#define PK_SLOW 1e-6           /* polished candidates this far off the pose: pk_polish_slow */
+#define PK_SLOW_ITERS 40       /* its most Newton steps */
 
 /* ------------------------------------------------------------ geometry */
 
@@ -1002,17 +1004,17 @@ static void pk_lstsq(double J[6][6], const double *e, double *dx)
         dx[perm[c]] = y[c];
 }
 
-/* Newton steps on the remaining chain's angles (least squares, pk_lstsq; kept only
- * while they reduce the error), the joints in `frozen` (bit j: angle j) held;
- * returns the final error (pk_error) */
-static double pk_polish_held(const PkGeo *g, const m3 *RT, v3 pT, double *th, unsigned frozen)
+/* Newton steps (pk_polish_held) up to `iters`; with `twice`, each step the better
+ * of Newton's and twice it (pk_polish_slow) */
+static double pk_newton(const PkGeo *g, const m3 *RT, v3 pT, double *th, unsigned frozen,
+                        int iters, int twice)
 {
     m3 R;
     v3 p;
     double J[6][6], e[6];
     pk_fk(g, th, &R, &p, J);
     double err = pk_error(RT, pT, &R, p, g->scale, e);
-    for (int it = 0; it < 6 && err > 1e-16; it++) {
+    for (int it = 0; it < iters && err > 1e-16; it++) {
         double dx[6], trial[6], big = 0.0;
         for (int j = 0; j < 6; j++)
             if (frozen >> j & 1u)
@@ -1032,6 +1034,25 @@ static double pk_polish_held(const PkGeo *g, const m3 *RT, v3 pT, double *th, un
         double J2[6][6], e2[6];
         pk_fk(g, trial, &R2, &p2, J2);
         double err2 = pk_error(RT, pT, &R2, p2, g->scale, e2);
+        if (twice && 2.0 * big < 0.1) {
+            /* the doubled step: at a double root (a singular solution, where the
+             * error is quadratic along the null direction) Newton only halves the
+             * distance; twice its step lands on the root to first order */
+            double trial2[6], J3[6][6], e3[6];
+            for (int j = 0; j < 6; j++)
+                trial2[j] = wrap_pi(th[j] + 2.0 * dx[j]);
+            pk_fk(g, trial2, &R2, &p2, J3);
+            double err3 = pk_error(RT, pT, &R2, p2, g->scale, e3);
+            if (err3 < err2) {
+                err2 = err3;
+                for (int j = 0; j < 6; j++) {
+                    trial[j] = trial2[j];
+                    e2[j] = e3[j];
+                    for (int r = 0; r < 6; r++)
+                        J2[r][j] = J3[r][j];
+                }
+            }
+        }
 #ifdef PK_DEBUG
         fprintf(stderr, "    polish it %d frozen %x err %.3e -> %.3e big %.3e\n", it, frozen, err, err2, big);
 #endif
@@ -1048,9 +1069,31 @@ static double pk_polish_held(const PkGeo *g, const m3 *RT, v3 pT, double *th, un
     return err;
 }
 
+/* Newton steps on the remaining chain's angles (least squares, pk_lstsq; kept only
+ * while they reduce the error), the joints in `frozen` (bit j: angle j) held;
+ * returns the final error (pk_error) */
+static double pk_polish_held(const PkGeo *g, const m3 *RT, v3 pT, double *th, unsigned frozen)
+{
+    return pk_newton(g, RT, pT, th, frozen, 6, 0);
+}
+
 static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
 {
     return pk_polish_held(g, RT, pT, th, 0u);
+}
+
+/* A candidate the polish left above PK_ACCEPT but within PK_SLOW of the pose
+ * (next to a doubly singular configuration, e.g. both triples of the Panda with q6
+ * held next to aligned: the position step's double root rounded to one angle and
+ * the triple's outer angles taken at sv ~ 1e-11 start the polish 1e-5 off, where
+ * Newton converges only linearly, by 4x a step): up to PK_SLOW_ITERS more steps,
+ * each the better of Newton's step and twice it. Returns the final error; the
+ * caller still keeps the row only at PK_ACCEPT. */
+static double pk_polish_slow(const PkGeo *g, const m3 *RT, v3 pT, double *th, double err)
+{
+    if (!(err > PK_ACCEPT && err <= PK_SLOW))
+        return err;
+    return pk_newton(g, RT, pT, th, 0u, PK_SLOW_ITERS, 1);
 }
 
 /* ------------------------------------------------------------- one pose */
@@ -1896,7 +1939,7 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
                 /* check against the pose; Newton-polish when not exact */
                 double err = pk_error_of(&g, &RT, pT, th);
                 if (err > PK_EXACT)
-                    err = pk_polish(&g, &RT, pT, th);
+                    err = pk_polish_slow(&g, &RT, pT, th, pk_polish(&g, &RT, pT, th));
 #ifdef PK_DEBUG
                 fprintf(stderr, "    check slot %d err %.3e th %.17g %.17g %.17g\n", 2 * pos.slot[i] + k, err, th[0], th[1], th[2]);
 #endif
