@@ -297,6 +297,32 @@ def test_doubly_singular_configurations_get_an_in_limit_row_on_every_copy(arm, j
     check_each_copy(ROBOTS[arm], j, np.array(q))
 
 
+# Formerly rows 1.9e-9 past q2's limit (docs/ik.md's known gap, kind 2; found by
+# held_special_rates.py --n 20000, seeds 1 and 2): the SRS arm with q6 held at
+# +-1e-9 and q2 at its limit, joints 3, 5 and 7 next to in line (q4, q6 next to 0).
+# The rows hold the pose to 1e-16 on splits of q3 + q5 + q7 that only the wrist's
+# 1e-9 tilt makes inexact, its error taken up by q2 (1.9e-9) and q4; no family
+# moves q2 back. pk_pin now also starts from rows with a joint a split's width out
+# (q5 at pi) when that joint is in line with a free one: the split is moved inside
+# both limits (pk_pin_split), q2 pinned at its limit, and Gauss-Newton finds the
+# exact configuration (1e-16) inside the limits.
+PINNED_SPLIT = [
+    ("srs", 5, [1.0548523406808448, -2.0943951023931953, -1e-09, -1e-09, 0.0, 1e-09,
+                -3.0543261909900767]),
+    ("srs", 5, [1.5707963267948966, 2.0943951023931953, -1e-07, 1e-07, 0.013671631020979902,
+                -1e-09, 0.695144514886326]),
+]
+
+
+@pytest.mark.parametrize(("arm", "j", "q"), PINNED_SPLIT,
+                         ids=[f"{a}-joint{j + 1}-{i}"
+                              for i, (a, j, _) in enumerate(PINNED_SPLIT)])
+def test_rows_past_a_limit_in_line_with_a_split_get_an_in_limit_row(arm, j, q):
+    # oracles: check_held through robot.ik, then check_each_copy on every kernel copy
+    check_held(ROBOTS[arm], j, np.array(q))
+    check_each_copy(ROBOTS[arm], j, np.array(q))
+
+
 @pytest.mark.parametrize(("arm", "j"), CASES, ids=IDS)
 def test_held_joint_random_configurations_come_back(arm, j):
     # uniform in-limit configurations are non-singular almost surely: all 300 come

@@ -104,6 +104,7 @@ enum { PK_OK = 0, PK_OUT_OF_REACH = 1, PK_NO_ORIENTATION = 2, PK_DEGENERATE = 5,
 #define PK_SP4_SLACK 1e-13     /* |C| - hypot(A, B) / scale below it: a double root (rounding) */
 #define PK_SLOW 1e-6           /* polished candidates this far off the pose: pk_polish_slow */
 #define PK_SLOW_ITERS 40       /* its most Newton steps */
+#define PK_PIN_LINE 1e-6       /* pk_pin_split: Jacobian columns equal to this, joints in line */
 
 /* ------------------------------------------------------------ geometry */
 
@@ -1776,20 +1777,64 @@ static double pk_gauss_newton(const PkGeo *g, const m3 *RT, v3 pT, double *th, u
  * joint may leave its limits on the way. Tried for rows at most PK_NUDGE outside;
  * kept when every joint ends inside and the pose holds to PK_ACCEPT: returns 1
  * when th changed. */
+/* pk_pin's move for joint j of trial when a round's Gauss-Newton left it outside
+ * by more than PK_NUDGE: where its axis lies in line with a free joint i's (their
+ * remaining Jacobian columns equal up to the sign sigma, to PK_PIN_LINE, so that
+ * only th_i + sigma th_j is fixed to first order: the SRS arm's joints 3, 5, 7 with
+ * q4 and q6 next to 0), the split of that sum put inside both limits (pk_split,
+ * nearest j's present value) instead of clamping j; the next round's Gauss-Newton
+ * brings the pose back. Returns 1 when trial changed. */
+static int pk_pin_split(const double *P, const PkGeo *g, double *trial, int j,
+                        unsigned frozen)
+{
+    m3 R;
+    v3 p;
+    double J[6][6];
+    pk_fk(g, trial, &R, &p, J);
+    for (int i = 0; i < 6; i++) {
+        if (i == j || (frozen >> i & 1u))
+            continue;
+        double dot = J[3][i] * J[3][j] + J[4][i] * J[4][j] + J[5][i] * J[5][j];
+        double sigma = dot >= 0.0 ? 1.0 : -1.0, diff = 0.0;
+        for (int r = 0; r < 6; r++)
+            diff = fmax(diff, fabs(J[r][i] - sigma * J[r][j]));
+        if (!(diff < PK_PIN_LINE))
+            continue;
+        int fi = g->full[i], fj = g->full[j];
+        double phi = trial[i] + sigma * trial[j], t2[6], o[6];
+        double qj = wrap_pi(P[PK_SIGN + fj] * (trial[j] - P[PK_OFFSET + fj]));
+        for (int m = 0; m < 6; m++)
+            t2[m] = trial[m];
+        t2[j] = pk_split(P, fi, fj, phi, sigma, qj);
+        t2[i] = wrap_pi(phi - sigma * t2[j]);
+        pk_excess(P, g, t2, o);
+        if (o[i] > 0.0 || o[j] > 0.0)
+            continue; /* no split of this pair inside both limits */
+        for (int m = 0; m < 6; m++)
+            trial[m] = t2[m];
+        return 1;
+    }
+    return 0;
+}
+
 static int pk_pin(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
 {
     double trial[6], o[6];
     unsigned frozen = 0u;
     for (int j = 0; j < 6; j++)
         trial[j] = th[j];
-    if (!(pk_excess(P, g, trial, o) <= PK_NUDGE))
-        return 0;
     for (int round = 0; round < 3; round++) {
         int moved = 0;
         pk_excess(P, g, trial, o);
         for (int j = 0; j < 6; j++) {
             if (!(o[j] > 0.0) || (frozen >> j & 1u))
                 continue;
+            if (o[j] > PK_NUDGE && pk_pin_split(P, g, trial, j, frozen)) {
+                moved = 1;
+                continue;
+            }
+            if (round == 0 && o[j] > PK_NUDGE)
+                return 0; /* the row itself: only joints a thin set's width out are clamped */
             int f = g->full[j];
             double sg = P[PK_SIGN + f], off = P[PK_OFFSET + f], lim;
             pk_outside(wrap_pi(sg * (trial[j] - off)), P[PK_LO + f], P[PK_HI + f], &lim);
@@ -1800,8 +1845,10 @@ static int pk_pin(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *
         if (!moved)
             break;
         double err = pk_gauss_newton(g, RT, pT, trial, frozen);
+        if (err > PK_ACCEPT && err <= PK_SLOW)
+            err = pk_newton(g, RT, pT, trial, frozen, PK_SLOW_ITERS, 1);
 #ifdef PK_DEBUG
-        fprintf(stderr, "   pin round %d frozen %x err %.3e excess %.3e\n", round, frozen, err, pk_excess(P, g, trial, o));
+        fprintf(stderr, "   pin round %d frozen %x err %.3e excess %.3e th %.17g %.17g %.17g %.17g %.17g %.17g\n", round, frozen, err, pk_excess(P, g, trial, o), trial[0], trial[1], trial[2], trial[3], trial[4], trial[5]);
 #endif
         if (!(err <= PK_ACCEPT))
             return 0;
