@@ -1769,21 +1769,13 @@ static double pk_gauss_newton(const PkGeo *g, const m3 *RT, v3 pT, double *th, u
     return err;
 }
 
-/* The other last resort (after pk_walk): a row th just outside the limits whose
- * joints outside the family does not move, or that lies on no exact family but on
- * a thin set of near-solutions (singular values of 1e-10 to 1e-8): clamp the joints
- * outside to the limit they passed, hold them, and Gauss-Newton the others back to
- * the pose (pk_gauss_newton: it may move them radians); up to three rounds, as a
- * joint may leave its limits on the way. Tried for rows at most PK_NUDGE outside;
- * kept when every joint ends inside and the pose holds to PK_ACCEPT: returns 1
- * when th changed. */
-/* pk_pin's move for joint j of trial when a round's Gauss-Newton left it outside
- * by more than PK_NUDGE: where its axis lies in line with a free joint i's (their
- * remaining Jacobian columns equal up to the sign sigma, to PK_PIN_LINE, so that
- * only th_i + sigma th_j is fixed to first order: the SRS arm's joints 3, 5, 7 with
- * q4 and q6 next to 0), the split of that sum put inside both limits (pk_split,
- * nearest j's present value) instead of clamping j; the next round's Gauss-Newton
- * brings the pose back. Returns 1 when trial changed. */
+/* pk_pin's move for joint j of trial outside by more than PK_NUDGE (the row's own
+ * flip, or where a round's Gauss-Newton took it): where its axis lies in line with
+ * a free joint i's (their remaining Jacobian columns equal up to the sign sigma, to
+ * PK_PIN_LINE, so that only th_i + sigma th_j is fixed to first order: the SRS
+ * arm's joints 3, 5, 7 with q4 and q6 next to 0), the split of that sum put inside
+ * both limits (pk_split, nearest j's present value) instead of clamping j; the
+ * next round's Gauss-Newton brings the pose back. Returns 1 when trial changed. */
 static int pk_pin_split(const double *P, const PkGeo *g, double *trial, int j,
                         unsigned frozen)
 {
@@ -1817,6 +1809,18 @@ static int pk_pin_split(const double *P, const PkGeo *g, double *trial, int j,
     return 0;
 }
 
+/* The other last resort (after pk_walk): a row th just outside the limits whose
+ * joints outside the family does not move, or that lies on no exact family but on
+ * a thin set of near-solutions (singular values of 1e-10 to 1e-8): clamp the joints
+ * outside to the limit they passed, hold them, and Gauss-Newton the others back to
+ * the pose (pk_gauss_newton: it may move them radians); up to three rounds, as a
+ * joint may leave its limits on the way. A joint outside by more than PK_NUDGE
+ * (a whole flip, q + pi, or where a round's Gauss-Newton took it) is moved by its
+ * split with a joint in line (pk_pin_split) when it has one; otherwise the row is
+ * not tried (round 0) or the joint clamped (later rounds). A round ending between
+ * PK_ACCEPT and PK_SLOW gets pk_polish_slow's steps (the clamped joints held).
+ * Kept when every joint ends inside and the pose holds to PK_ACCEPT: returns 1
+ * when th changed. */
 static int pk_pin(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
 {
     double trial[6], o[6];
@@ -1848,7 +1852,7 @@ static int pk_pin(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *
         if (err > PK_ACCEPT && err <= PK_SLOW)
             err = pk_newton(g, RT, pT, trial, frozen, PK_SLOW_ITERS, 1);
 #ifdef PK_DEBUG
-        fprintf(stderr, "   pin round %d frozen %x err %.3e excess %.3e th %.17g %.17g %.17g %.17g %.17g %.17g\n", round, frozen, err, pk_excess(P, g, trial, o), trial[0], trial[1], trial[2], trial[3], trial[4], trial[5]);
+        fprintf(stderr, "   pin round %d frozen %x err %.3e excess %.3e\n", round, frozen, err, pk_excess(P, g, trial, o));
 #endif
         if (!(err <= PK_ACCEPT))
             return 0;

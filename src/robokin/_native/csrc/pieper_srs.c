@@ -688,6 +688,9 @@ static int pk_srs_reach(const double *P, const PkGeo *g, const m3 *RT, v3 pT, do
     return degenerate ? PK_DEGENERATE : PK_NO_ORIENTATION;
 }
 
+/* Every solution of an SRS arm with joint `held` at x: pk_srs_reach at PS_REACH,
+ * and again at PS_REACH_WIDE when that gave no row (not for the held elbow, whose
+ * swivel is a family: no held joint's roots to widen). */
 static int pk_srs(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double x,
                   const double *qn, PkOut o)
 {
