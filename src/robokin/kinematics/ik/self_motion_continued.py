@@ -135,9 +135,27 @@ class _ContinuedFamily(_JointFamily):
         t = np.atleast_1d(np.asarray(t, dtype=np.float64))
         R = self._solve(t)  # (M, K, n)
         P = self.predict(t)  # (M, k, n)
-        out = _assign(P, R)
+        out = self._polish(_assign(P, R), t)
         valid = np.isfinite(out).all(-1)
         return out, valid, np.zeros_like(valid)
+
+    def _polish(self, Q: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Rows Q (M, k, n) at t (M,) polished by Newton steps on the six free joints.
+
+        The general-6R rows reproduce the pose to ~1e-13; a step where they are above
+        1e-14 brings them to rounding (kept only where it reaches ``_EXACT``), so
+        rows at a limit crossing's t have the joint at its limit to ~1e-14.
+        """
+        M, k, n = Q.shape
+        ok = np.isfinite(Q).all(-1)
+        if not ok.any():
+            return Q
+        mi, bi = np.nonzero(ok)
+        q, good = _newton_held(self.robot, self.T, Q[mi, bi], np.full(len(mi), self.joint),
+                               t[mi], self.joint)
+        out = Q.copy()
+        out[mi[good], bi[good]] = q[good]
+        return out
 
     def predict(self, t: np.ndarray) -> np.ndarray:
         """Each track's cubic Hermite value at t (M, k, n) (NaN where it has none).
