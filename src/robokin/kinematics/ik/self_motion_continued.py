@@ -66,6 +66,10 @@ _EXACT = 1e-13
 #: Largest distance [rad] of a refined crossing from its track's prediction.
 _ON_TRACK = 1e-2
 _TWO_PI = 2 * np.pi
+#: Most nodes after the halvings (a degenerate pose would double them every round).
+_MAX_NODES = 3 * NODES
+#: Most tracks kept (the longest; a degenerate pose's rows do not pair).
+_MAX_TRACKS = 64
 #: Bisection steps of a fold (a cell to two adjacent doubles).
 _BISECT = 60
 
@@ -94,8 +98,8 @@ class _ContinuedFamily(_JointFamily):
         D = _slopes(robot, Q, j)
         for _ in range(_REFINE):
             bad = np.flatnonzero(~_clean_cells(t, Q, D))
-            if not bad.size:
-                break
+            if not bad.size or len(t) + bad.size > _MAX_NODES:
+                break  # clean, or a pose whose rows do not pair anywhere (degenerate)
             mid = 0.5 * (t[bad] + t[bad + 1])
             Qm = self._solve(mid)
             Dm = _slopes(robot, Qm, j)
@@ -330,9 +334,13 @@ def _fold_newton(robot: Arm, T: np.ndarray, q0: np.ndarray, s0: np.ndarray, dt: 
     tangent = np.where(good[:, None], s0 / np.where(good, sm_m, 1.0)[:, None], 0.0)
 
     def g_of(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        J, _ = jacobian_and_pose(robot.chain, q)
-        nv = np.linalg.svd(J)[2][:, -1, :]  # (p, n)
-        return nv[:, k] / nv[rows, m], nv / nv[rows, m][:, None]
+        nv = np.full((p, n), np.nan)
+        fin = np.flatnonzero(np.isfinite(q).all(-1) & (np.abs(q) < 1e3).all(-1))
+        if fin.size:
+            J, _ = jacobian_and_pose(robot.chain, q[fin])
+            nv[fin] = np.linalg.svd(J)[2][:, -1, :]  # the null vectors (p, n)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return nv[:, k] / nv[rows, m], nv / nv[rows, m][:, None]
 
     v0 = q0[rows, m]
     g0 = np.where(good, 1.0 / np.where(good, sm_m, 1.0), np.nan)
@@ -439,28 +447,28 @@ def _link(t: np.ndarray, Q: np.ndarray, D: np.ndarray) -> tuple[np.ndarray, np.n
     c, a = np.nonzero(link >= 0)
     has_prev[c + 1, link[c, a]] = True
     exists = np.isfinite(Q).all(-1)
-    tracks: list[np.ndarray] = []
-    slopes: list[np.ndarray] = []
     link_l = link.tolist()
+    chains: list[list[tuple[int, int]]] = []
     for i, r in zip(*np.nonzero(exists & ~has_prev), strict=True):
-        X = np.full((m, n), np.nan)
-        S = np.full((m, n), np.nan)
         i, r = int(i), int(r)
-        while True:
-            X[i], S[i] = Q[i, r], D[i, r]
-            if i == m - 1 or link_l[i][r] < 0:
-                break
+        chain = [(i, r)]
+        while i < m - 1 and link_l[i][r] >= 0:
             i, r = i + 1, link_l[i][r]
-        tracks.append(X)
-        slopes.append(S)
+            chain.append((i, r))
+        chains.append(chain)
     del cell, rows
-    if not tracks:
+    # the longest _MAX_TRACKS (all but on a degenerate pose), ordered by their start
+    chains = sorted(sorted(chains, key=len, reverse=True)[:_MAX_TRACKS], key=lambda c: c[0])
+    if not chains:
         empty = np.full((m, 1, n), np.nan)
         return empty, empty.copy()
-    order = sorted(range(len(tracks)), key=lambda s: int(np.argmax(
-        np.isfinite(tracks[s]).all(-1))))
-    return (np.stack([tracks[s] for s in order], axis=1),
-            np.stack([slopes[s] for s in order], axis=1))
+    X = np.full((m, len(chains), n), np.nan)
+    S = np.full((m, len(chains), n), np.nan)
+    for b, chain in enumerate(chains):
+        ii = np.array([i for i, _ in chain])
+        rr = np.array([r for _, r in chain])
+        X[ii, b], S[ii, b] = Q[ii, rr], D[ii, rr]
+    return X, S
 
 
 def _assign(P: np.ndarray, R: np.ndarray) -> np.ndarray:
@@ -498,19 +506,27 @@ def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray,
     free = np.ones((M, n), bool)
     free[np.arange(M), joints] = False
     idx = np.nonzero(free)[1].reshape(M, n - 1)
+    err = np.full(M, np.inf)
+    live = np.isfinite(q).all(-1)
     for it in range(_NEWTON + 1):
-        J, Tq = jacobian_and_pose(robot.chain, q)
+        live &= np.isfinite(q).all(-1) & (np.abs(q) < 1e3).all(-1)
+        rows = np.flatnonzero(live)
+        err[~live] = np.inf
+        if not rows.size:
+            break
+        J, Tq = jacobian_and_pose(robot.chain, q[rows])
         e = pose_error(Tq, T)
-        err = np.maximum(np.linalg.norm(e[:, :3], axis=1), np.linalg.norm(e[:, 3:], axis=1))
-        act = err > 0.1 * _EXACT
+        err[rows] = np.maximum(np.linalg.norm(e[:, :3], axis=1),
+                               np.linalg.norm(e[:, 3:], axis=1))
+        act = err[rows] > 0.1 * _EXACT
         if it == _NEWTON or not act.any():
             break
-        A = np.take_along_axis(J, idx[:, None, :], axis=2)[act]
+        A = np.take_along_axis(J, idx[rows][:, None, :], axis=2)[act]
         good = np.abs(np.linalg.det(A)) > 1e-14
         step = np.zeros((int(act.sum()), n - 1))
         if good.any():
             step[good] = np.linalg.solve(A[good], e[act][good][..., None])[..., 0]
-        rows = np.flatnonzero(act)
-        q[rows[:, None], idx[rows]] += step
+        moved = rows[act]
+        q[moved[:, None], idx[moved]] += step
     ok = err <= _EXACT
     return q, ok
