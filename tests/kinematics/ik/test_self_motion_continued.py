@@ -143,3 +143,49 @@ def test_limit_crossings_are_exact(arm):
             round(s.t, 9) for s in sm.singular}
         assert all(round(x, 9) in cuts for x in sm.intervals.ravel())
     assert checked > 0
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_manifold_solves_a_bounded_number_of_values(arm):
+    # the work of one manifold: general-6R values solved, counted by a dispatch that
+    # wraps the real one (deterministic, not a timing). Before the continuation by
+    # slopes: 181 nodes + halvings + a 181-value grid + 56 bisection steps per branch
+    # end + the limit points (2,000-4,000 values); now the nodes, the halvings next to
+    # folds and the pieces' midpoints.
+    from robokin.kinematics.ik.dispatch import solve
+    from robokin.kinematics.ik.self_motion import self_motion
+
+    robot = ARMS[arm]
+    solved = []
+
+    def counting(reduced, T, **kw):
+        solved.append(int(np.prod(np.shape(T)[:-2])))
+        return solve(reduced, T, **kw)
+
+    q0 = _configs(robot, 3, False)[0]
+    sm = self_motion(robot.arm, robot.fk(q0), robot.joint_names[-1], dispatch=counting)
+    assert len(sm.intervals) and sum(solved) <= 4 * 181, sum(solved)
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_single_value_hot_path_equals_the_batched_solve(arm):
+    # robot.ik(T, fixed={joint7: x}) with a number takes the single-pose path
+    # (fixed._end_single); oracle: the batched path (an array of one value), row for
+    # row, with the same validity, limit flags, status and method
+    from robokin.kinematics.ik.dispatch import solve
+    from robokin.kinematics.ik.fixed import solve_fixed
+
+    robot = ARMS[arm]
+    name = robot.joint_names[-1]
+    q0 = _configs(robot, 5, False)[0]
+    T = robot.fk(q0)
+    for x in (float(q0[6]), 0.0, -1.0, 2.5, float(robot.limits[6, 1])):
+        a = robot.ik(T, fixed={name: x})
+        b = solve_fixed(robot.arm, T, {name: np.array([x])}, dispatch=solve)
+        assert a.method == b.method
+        np.testing.assert_array_equal(a.q, b.q[0])
+        np.testing.assert_array_equal(a.valid, b.valid[0])
+        np.testing.assert_array_equal(a.within_limits, b.within_limits[0])
+        assert a.status.item() == b.status[0]
+    rows = robot.ik(T, fixed={name: float(q0[6])})
+    assert (_wrapped(rows.q[rows.valid] - q0).max(-1) < 1e-9).any()

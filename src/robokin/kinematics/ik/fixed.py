@@ -168,15 +168,58 @@ def solve_held_single(robot: Arm, T: object, fixed: object) -> SolutionSet | Non
     if type(value) not in _NUMBERS:
         return None
     held = robot.derived(HELD_SOLVERS).get(name)
-    if held is None:
-        return None
-    out: SolutionSet | None = held.single(T, value, None)
+    out: SolutionSet | None = (held.single(T, value, None) if held is not None
+                               else _end_single(robot, T, name, float(value)))
     # "ok" has rows (read first: counting them costs a numpy reduction); no row for a
     # rotation off SO(3) by rounding: None, and solve_fixed projects it and solves
     if out is not None and (out.status.item() == "ok" or len(out)
                             or check_rigid(T, "T") is T):
         return out
     return None
+
+
+def _end_single(robot: Arm, T: np.ndarray, name: str, value: float) -> SolutionSet | None:
+    """The first or last joint at a number, no held closed form: one compiled call.
+
+    The reduced chain (the joint at 0, kept in ``robot.reduced``) is solved at the
+    moved target by its own single-pose hot path (``FAMILY.single``: the general
+    6R solver on a general 7R arm; issue 29) and the held column is put in: the
+    set ``solve_fixed`` assembles, without its per-call validation and batching
+    (~190 -> ~60 us per call). None where this does not apply (a middle joint, a
+    value putting two axes on one line, a pose that is not float64 (4, 4), a
+    non-finite value, a reduced chain without a single-pose path).
+    """
+    from robokin.kinematics.ik.analytic.detect import FAMILY
+
+    names = robot.joint_names
+    if name not in names or T.shape != (4, 4) or T.dtype != np.float64 or not (
+            np.isfinite(value)):
+        return None
+    j = names.index(name)
+    end = _end_joint(robot, [j])
+    if end is None or _co.coincident_pair(robot, j, value) is not None or (
+            _nco.near_coincident_pair(robot, j, value) is not None):
+        return None
+    reduced = _reduced(robot, [j], (0.0,))
+    single = reduced.derived(FAMILY).single
+    if single is None:
+        return None
+    Tm = np.ascontiguousarray(_moved_targets(robot, end, T[None], np.array([value]))[0])
+    sub = single(Tm, np.nan)
+    if sub is None:
+        return None
+    k = sub.q.shape[0]
+    q = np.empty((k, robot.n))
+    keep = [c for c in range(robot.n) if c != j]
+    q[:, keep] = sub.q
+    q[:, j] = value
+    q[~sub.valid] = np.nan  # as SolutionSet does with rows that are not valid
+    lo, hi = robot.limits[j]
+    inside = sub.flags["within_limits"] & (lo - 1e-9 <= value <= hi + 1e-9)
+    return SolutionSet._trusted(
+        q, sub.valid, robot.is_revolute, robot.limits,
+        {"singular": sub.flags["singular"], "within_limits": inside}, {}, sub.status,
+        f"{sub.method} ({name} held)", None, {"held": {name: np.array(value)}})
 
 
 def _coincident_parts(robot: Arm, j: int, T: np.ndarray, v: np.ndarray,
