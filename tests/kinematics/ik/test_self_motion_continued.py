@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+
 from reference import offset_iiwa14, pose_errors, random_7r
 
 ARMS = {"offset_iiwa": offset_iiwa14(), "random7r": random_7r(29)}
@@ -112,7 +113,7 @@ def test_sample_matches_independent_held_solves(arm):
         assert d.min(axis=1).max() < 1e-9 and d.min(axis=0).max() < 1e-9, ti
         if np.min(np.abs(ends - ti)) < 1e-6:
             continue
-        for r in R[np.all((R >= robot.limits[:, 0]) & (R <= robot.limits[:, 1]), -1)]:
+        for r in R[np.all((robot.limits[:, 0] <= R) & (robot.limits[:, 1] >= R), -1)]:
             b = int(np.nanargmin(_wrapped(Q[i] - r).max(-1)))
             assert any(a <= ti <= e for (a, e), bb in zip(sm.intervals, sm.interval_branch,
                                                            strict=True) if bb == b), (ti, b)

@@ -229,27 +229,30 @@ class _ContinuedFamily(_JointFamily):
         """(t, track, query index) where a track's joint equals a query's value."""
         if not queries:
             return []
-        tn, X = self.t_nodes, self.tracks
-        u = np.linspace(0.0, 1.0, _SUB + 1)
-        cells = np.arange(len(tn) - 1)
-        ts = (tn[cells, None] + (tn[cells + 1] - tn[cells])[:, None] * u).ravel()
-        both = (np.isfinite(X[:-1]).all(-1) & np.isfinite(X[1:]).all(-1))  # (m-1, k)
-        P = self.predict(ts).reshape(len(cells), _SUB + 1, self.k, -1)
-        tt = ts.reshape(len(cells), _SUB + 1)
+        tn, X, S = self.t_nodes, self.tracks, self.slopes
+        both = np.isfinite(X[:-1]).all(-1) & np.isfinite(X[1:]).all(-1)  # (m-1, k)
+        cc, bb = np.nonzero(both)  # the (cell, track) pieces with both ends
+        u = np.linspace(0.0, 1.0, _SUB + 1)[None, :, None]
+        h = (tn[cc + 1] - tn[cc])[:, None, None]
+        qa, sa = X[cc, bb][:, None], S[cc, bb][:, None]
+        qb = qa + _wrap(X[cc + 1, bb][:, None] - qa)
+        sb = S[cc + 1, bb][:, None]
+        u2, u3 = u * u, u * u * u
+        P = ((2 * u3 - 3 * u2 + 1) * qa + (u3 - 2 * u2 + u) * h * sa
+             + (-2 * u3 + 3 * u2) * qb + (u3 - u2) * h * sb)  # (pieces, SUB + 1, n)
+        tt = tn[cc][:, None] + h[:, :, 0] * u[0, :, 0][None]  # (pieces, SUB + 1)
         starts, tracks, qidx, joints, values = [], [], [], [], []
         for qi, (j, v, _) in enumerate(queries):
-            g = _wrap(P[..., j] - v)  # (cells, SUB + 1, k)
-            with np.errstate(invalid="ignore"):
-                change = (np.sign(g[:, :-1]) != np.sign(g[:, 1:])) & (
-                    np.abs(g[:, :-1] - g[:, 1:]) < np.pi)
-            change &= both[:, None, :]
-            c, s, b = np.nonzero(change)
+            g = _wrap(P[..., j] - v)  # (pieces, SUB + 1)
+            change = (np.sign(g[:, :-1]) != np.sign(g[:, 1:])) & (
+                np.abs(g[:, :-1] - g[:, 1:]) < np.pi)
+            c, sidx = np.nonzero(change)
             if not c.size:
                 continue
-            g0, g1 = g[c, s, b], g[c, s + 1, b]
-            w = np.where(g0 != g1, g0 / (g0 - g1), 0.0)
-            starts.append(tt[c, s] + w * (tt[c, s + 1] - tt[c, s]))
-            tracks.append(b)
+            g0, g1 = g[c, sidx], g[c, sidx + 1]
+            w = np.where(g0 != g1, g0 / np.where(g0 != g1, g0 - g1, 1.0), 0.0)
+            starts.append(tt[c, sidx] + w * (tt[c, sidx + 1] - tt[c, sidx]))
+            tracks.append(bb[c])
             qidx.append(np.full(c.size, qi))
             joints.append(np.full(c.size, j))
             values.append(np.full(c.size, v))
