@@ -96,8 +96,9 @@ class _ContinuedFamily(_JointFamily):
         t = np.linspace(*self.domain, int(nodes))
         Q = self._solve(t)
         D = _slopes(robot, Q, j)
+        clean = _clean_cells(t, Q, D)
         for _ in range(_REFINE):
-            bad = np.flatnonzero(~_clean_cells(t, Q, D))
+            bad = np.flatnonzero(~clean)
             if not bad.size or len(t) + bad.size > _MAX_NODES:
                 break  # clean, or a pose whose rows do not pair anywhere (degenerate)
             mid = 0.5 * (t[bad] + t[bad + 1])
@@ -106,10 +107,15 @@ class _ContinuedFamily(_JointFamily):
             Q, Qm = _widen(Q, Qm)
             D, Dm = _widen(D, Dm)
             t = np.concatenate([t, mid])
+            new = np.concatenate([np.zeros(len(t) - len(mid), bool), np.ones(len(mid), bool)])
             order = np.argsort(t, kind="stable")
-            t = t[order]
+            t, new = t[order], new[order]
             Q = np.concatenate([Q, Qm])[order]
             D = np.concatenate([D, Dm])[order]
+            # only the cells next to a new node can have changed (the others were clean)
+            clean = np.ones(len(t) - 1, bool)
+            cells = np.flatnonzero(new[:-1] | new[1:])
+            clean[cells] = _clean_cells(t, Q, D, cells)
         self.t_nodes = t
         self.tracks, self.slopes = _link(t, Q, D)
         self.k = self.tracks.shape[1]
@@ -403,28 +409,36 @@ def _widen(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return pad(A), pad(B)
 
 
-def _residuals(t: np.ndarray, Q: np.ndarray, D: np.ndarray) -> np.ndarray:
-    """Trapezoid residuals (m-1, K, K) of node i's rows a against node i+1's rows b.
+def _residuals(t: np.ndarray, Q: np.ndarray, D: np.ndarray,
+               cells: np.ndarray | None = None) -> np.ndarray:
+    """Trapezoid residuals (c, K, K) of node i's rows a against node i+1's rows b.
 
-    Inf where either row is missing or its slope is not finite (NaN replaced first:
-    arithmetic on NaN is slow).
+    Per cell i in ``cells`` (default: every cell, m - 1). Inf where either row is
+    missing or its slope is not finite (NaN replaced first: arithmetic on NaN is
+    slow).
     """
+    c = np.arange(len(t) - 1) if cells is None else cells
     ok = np.isfinite(Q).all(-1) & np.isfinite(D).all(-1)
     Qz, Dz = np.where(ok[..., None], Q, 0.0), np.where(ok[..., None], D, 0.0)
-    h = (t[1:] - t[:-1])[:, None, None, None]
-    a, b = Qz[:-1, :, None], Qz[1:, None, :]
-    da, db = Dz[:-1, :, None], Dz[1:, None, :]
+    h = (t[c + 1] - t[c])[:, None, None, None]
+    a, b = Qz[c][:, :, None], Qz[c + 1][:, None, :]
+    da, db = Dz[c][:, :, None], Dz[c + 1][:, None, :]
     r = np.abs(_wrap(b - a) - 0.5 * h * (da + db)).max(-1)
-    r[~(ok[:-1, :, None] & ok[1:, None, :])] = np.inf
+    r[~(ok[c][:, :, None] & ok[c + 1][:, None, :])] = np.inf
     out: np.ndarray = r
     return out
 
 
-def _clean_cells(t: np.ndarray, Q: np.ndarray, D: np.ndarray) -> np.ndarray:
-    """(m-1,) bool: every row of both nodes pairs unambiguously across the cell."""
-    E = _residuals(t, Q, D)
-    fa = np.isfinite(Q[:-1]).all(-1)  # (m-1, K)
-    fb = np.isfinite(Q[1:]).all(-1)
+def _clean_cells(t: np.ndarray, Q: np.ndarray, D: np.ndarray,
+                 cells: np.ndarray | None = None) -> np.ndarray:
+    """(c,) bool: every row of both nodes pairs unambiguously across the cell.
+
+    Per cell in ``cells`` (default: every cell).
+    """
+    c = np.arange(len(t) - 1) if cells is None else cells
+    E = _residuals(t, Q, D, c)
+    fa = np.isfinite(Q[c]).all(-1)  # (c, K)
+    fb = np.isfinite(Q[c + 1]).all(-1)
     out = np.ones(len(E), bool)
     for axis, rows in ((2, fa), (1, fb)):
         s = np.sort(E, axis=axis)
