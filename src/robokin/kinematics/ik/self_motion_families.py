@@ -1,4 +1,7 @@
-"""The branches of one pose's self-motion: the swivel, held-joint and continued families.
+"""The branches of one pose's self-motion: the swivel and held-joint families.
+
+(The continued family of arms without a held-joint closed form is in
+:mod:`~robokin.kinematics.ik.self_motion_continued`.)
 
 Each family gives ``rows(t)`` (every branch at parameter values t) and the exact
 parameter values where a joint equals a value (``points``), for
