@@ -119,6 +119,8 @@ class _ContinuedFamily(_JointFamily):
         self.t_nodes = t
         self.tracks, self.slopes = _link(t, Q, D)
         self.k = self.tracks.shape[1]
+        self._exists = np.isfinite(self.tracks).all(-1)  # (m, k)
+        self._slopes0 = np.where(np.isfinite(self.slopes), self.slopes, 0.0)
         m, k, n = self.tracks.shape
         # per (cell, track): the fold inside the cell, its t and row (NaN: none)
         self.fold_t = np.full((m - 1, k), np.nan)
@@ -174,29 +176,37 @@ class _ContinuedFamily(_JointFamily):
         slopes; where it exists at one of them only (a fold in the cell): the
         tangent line from that one.
         """
-        tn, X, S = self.t_nodes, self.tracks, self.slopes
+        tn, X, S, E = self.t_nodes, self.tracks, self._slopes0, self._exists
+        M, (_, k, n) = len(t), X.shape
+        out = np.full((M, k, n), np.nan)
         i = np.clip(np.searchsorted(tn, t, side="right") - 1, 0, len(tn) - 2)
-        h = (tn[i + 1] - tn[i])[:, None, None]
-        u = ((t - tn[i]) / (tn[i + 1] - tn[i]))[:, None, None]
-        a, b, sa, sb = X[i], X[i + 1], S[i], S[i + 1]
+        fa, fb = E[i], E[i + 1]  # (M, k)
+        mi, bi = np.nonzero(fa | fb)  # only the tracks present in the cell
+        if not mi.size:
+            return out
+        c = i[mi]
+        fa, fb = fa[mi, bi][:, None], fb[mi, bi][:, None]
+        h = (tn[c + 1] - tn[c])[:, None]
+        u = ((t[mi] - tn[c]) / (tn[c + 1] - tn[c]))[:, None]
+        a = np.where(fa, X[c, bi], 0.0)
+        b = np.where(fb, X[c + 1, bi], 0.0)
+        sa, sb = S[c, bi], S[c + 1, bi]
         b = a + _wrap(b - a)
         u2, u3 = u * u, u * u * u
         herm = ((2 * u3 - 3 * u2 + 1) * a + (u3 - 2 * u2 + u) * h * sa
                 + (-2 * u3 + 3 * u2) * b + (u3 - u2) * h * sb)
-        fa, fb = np.isfinite(a).all(-1), np.isfinite(b).all(-1)
-        line_a = X[i] + u * h * sa
-        line_b = X[i + 1] + (u - 1) * h * sb
-        one: np.ndarray = np.where(fa[..., None], line_a, line_b)
+        one = np.where(fa, a + u * h * sa, X[c + 1, bi] + (u - 1) * h * sb)
         # a fold in the cell: q = q_f + (q_node - q_f) sqrt((t - t_f) / (t_node - t_f))
-        tf, qf = self.fold_t[i], self.fold_q[i]  # (M, k), (M, k, n)
-        tnode = np.where(fa, tn[i][:, None], tn[i + 1][:, None])
-        qnode = np.where(fa[..., None], X[i], X[i + 1])
-        with np.errstate(invalid="ignore", divide="ignore"):
-            r = (t[:, None] - tf) / (tnode - tf)
-            root = qf + _wrap(qnode - qf) * np.sqrt(r)[..., None]
-        fold = np.isfinite(tf) & np.isfinite(qf).all(-1)
-        one = np.where(fold[..., None], np.where((r >= 0)[..., None], root, np.nan), one)
-        out: np.ndarray = np.where((fa & fb)[..., None], herm, one)
+        tf, qf = self.fold_t[c, bi], self.fold_q[c, bi]
+        fold = np.isfinite(tf)
+        if fold.any():
+            tnode = np.where(fa[:, 0], tn[c], tn[c + 1])
+            qnode = np.where(fa, X[c, bi], X[c + 1, bi])
+            with np.errstate(invalid="ignore", divide="ignore"):
+                r = np.where(fold, (t[mi] - tf) / (tnode - tf), 0.0)
+                root = qf + _wrap(qnode - qf) * np.sqrt(np.maximum(r, 0.0))[:, None]
+            one = np.where(fold[:, None], np.where((r >= 0)[:, None], root, np.nan), one)
+        out[mi, bi] = np.where(fa & fb, herm, one)
         return out
 
     def param_of(self, q: np.ndarray) -> float:
@@ -497,8 +507,11 @@ def _assign(P: np.ndarray, R: np.ndarray) -> np.ndarray:
     out = np.full((M, k, n), np.nan)
     if R.shape[1] == 0:
         return out
-    d = np.abs(_wrap(P[:, :, None] - R[:, None])).max(-1)  # (M, k, K)
-    d[~np.isfinite(d)] = np.inf
+    fp, fr = np.isfinite(P).all(-1), np.isfinite(R).all(-1)  # (M, k), (M, K)
+    P0 = np.where(fp[..., None], P, 0.0)
+    R0 = np.where(fr[..., None], R, 0.0)  # (NaN arithmetic is slow)
+    d = np.abs(_wrap(P0[:, :, None] - R0[:, None])).max(-1)  # (M, k, K)
+    d[~(fp[:, :, None] & fr[:, None, :])] = np.inf
     best_row = np.argmin(d, axis=2)  # (M, k)
     best_track = np.argmin(d, axis=1)  # (M, K)
     mi = np.arange(M)[:, None]
