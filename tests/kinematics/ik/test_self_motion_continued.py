@@ -190,3 +190,19 @@ def test_single_value_hot_path_equals_the_batched_solve(arm):
         assert a.status.item() == b.status[0]
     rows = robot.ik(T, fixed={name: float(q0[6])})
     assert (_wrapped(rows.q[rows.valid] - q0).max(-1) < 1e-9).any()
+
+
+def test_a_pose_at_the_reach_boundary_is_bounded_and_flagged():
+    # the offset iiwa stretched (q4 = 0) with q2 = pi/2, q6 = 0: the wrist point is
+    # at the shoulder's full reach for every q7, so every row is singular and no
+    # cell pairs. Oracle: the rows still reproduce the pose (general-6R solutions),
+    # the work is bounded (it doubled its nodes to 5,270 and ran out of memory,
+    # then took seconds bisecting folds) and info says the pose is degenerate.
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array([0.78, 1.571, 2.029, 0.0, -2.798, 0.0, 2.711])
+    T, sm = _manifold(robot, q0)
+    assert sm.info["degenerate"] and sm.info["solves"] <= 4 * 181
+    Q = sm.sample(np.linspace(*sm.domain, 25))
+    ok = np.isfinite(Q).all(-1)
+    dp, dr = pose_errors(robot.fk(Q[ok]), T)
+    assert ok.any() and dp.max() <= 1e-12 and dr.max() <= 1e-12

@@ -434,8 +434,10 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
 
 
 def _solves(fam: _Family) -> dict[str, int]:
-    """``{"solves": general-6R values solved}`` of a continued family, else {}."""
-    return {"solves": fam.solves} if isinstance(fam, _ContinuedFamily) else {}
+    """A continued family's ``solves`` (general-6R values solved) and ``degenerate``."""
+    if not isinstance(fam, _ContinuedFamily):
+        return {}
+    return {"solves": fam.solves, "degenerate": fam.degenerate}
 
 
 #: The swivel's parameter range (copied into each SelfMotion).

@@ -68,6 +68,8 @@ _ON_TRACK = 1e-2
 _TWO_PI = 2 * np.pi
 #: Most nodes after the halvings (a degenerate pose would double them every round).
 _MAX_NODES = 3 * NODES
+#: Below this fraction of cells paired at the first nodes a pose is degenerate.
+_DEGENERATE = 0.5
 #: Most tracks kept (the longest; a degenerate pose's rows do not pair).
 _MAX_TRACKS = 64
 #: Bisection steps of a fold (a cell to two adjacent doubles).
@@ -82,6 +84,8 @@ class _ContinuedFamily(_JointFamily):
         tracks: (m, k, n) each branch's row at the nodes (NaN where it has none).
         slopes: (m, k, n) their slopes dq/dt.
         solves: Parameter values solved by the general 6R solver so far.
+        degenerate: Most cells of the first nodes did not pair (every row
+            singular): no halving, folds at the tracks' last nodes.
     """
 
     def __init__(self, robot: Arm, j: int, T: np.ndarray, dispatch: Dispatch,
@@ -97,7 +101,10 @@ class _ContinuedFamily(_JointFamily):
         Q = self._solve(t)
         D = _slopes(robot, Q, j)
         clean = _clean_cells(t, Q, D)
-        for _ in range(_REFINE):
+        # most cells unpaired: every row singular (the pose at the reach boundary,
+        # e.g. the elbow stretched for every value): no halving, no fold search
+        self.degenerate = bool(clean.mean() < _DEGENERATE) if clean.size else False
+        for _ in range(0 if self.degenerate else _REFINE):
             bad = np.flatnonzero(~clean)
             if not bad.size or len(t) + bad.size > _MAX_NODES:
                 break  # clean, or a pose whose rows do not pair anywhere (degenerate)
@@ -305,6 +312,8 @@ class _ContinuedFamily(_JointFamily):
         state = exist[c, b]  # True: the track exists at the cell's start
         near = np.where(state, c, c + 1)
         far = np.where(state, c + 1, c)
+        if self.degenerate:  # the track's last node (its rows are all singular)
+            return [(float(e), int(bb)) for e, bb in zip(tn[near], b, strict=True)]
         q_f, ok = _fold_newton(self.robot, self.T, self.tracks[near, b], self.slopes[near, b],
                                tn[far] - tn[near], self.joint)
         t_f = q_f[:, self.joint]
