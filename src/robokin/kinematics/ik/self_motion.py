@@ -112,7 +112,9 @@ class SelfMotion:
         singular: Branch ends ("fold") and aligned-axes points (the same).
         method: How the branches are computed.
         info: ``bisected`` (state changes found by bisection, not exactly),
-            ``grid`` (values checked).
+            ``grid`` (values checked; the continued family: its nodes), and on
+            the continued family ``solves`` (general-6R values solved) and
+            ``degenerate`` (its rows did not pair: every row singular).
         limits: The arm's joint limits (n, 2).
         _points: The compiled swivel's points (p, 4) ``[t, branch, joint, kind]``
             (``SM_KIND_*``), or None when ``_records`` was given.
