@@ -24,6 +24,7 @@ the first). Otherwise each distinct value gets its own reduced chain (cached).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
@@ -181,45 +182,88 @@ def solve_held_single(robot: Arm, T: object, fixed: object) -> SolutionSet | Non
 def _end_single(robot: Arm, T: np.ndarray, name: str, value: float) -> SolutionSet | None:
     """The first or last joint at a number, no held closed form: one compiled call.
 
-    The reduced chain (the joint at 0, kept in ``robot.reduced``) is solved at the
-    moved target by its own single-pose hot path (``FAMILY.single``: the general
-    6R solver on a general 7R arm; issue 29) and the held column is put in: the
-    set ``solve_fixed`` assembles, without its per-call validation and batching
-    (~190 -> ~60 us per call). None where this does not apply (a middle joint, a
-    value putting two axes on one line, a pose that is not float64 (4, 4), a
-    non-finite value, a reduced chain without a single-pose path).
+    The reduced chain (the joint at 0) solved at the moved target by its own
+    single-pose hot path (``FAMILY.single``: the general 6R solver on a general 7R
+    arm; issue 29) and the held column put in: the set ``solve_fixed`` assembles,
+    without its per-call validation and batching (~210 -> ~80 us per call, the
+    kernel ~40-45 of it). None where this does not apply (a middle joint, a value
+    putting two axes on one line, a pose that is not float64 (4, 4), a non-finite
+    value, a reduced chain without a single-pose path).
     """
-    from robokin.kinematics.ik.analytic.detect import FAMILY
-
-    names = robot.joint_names
-    if name not in names or T.shape != (4, 4) or T.dtype != np.float64 or not (
-            np.isfinite(value)):
+    if T.shape != (4, 4) or T.dtype != np.float64 or not math.isfinite(value):
         return None
-    j = names.index(name)
-    end = _end_joint(robot, [j])
-    if end is None or _co.coincident_pair(robot, j, value) is not None or (
-            _nco.near_coincident_pair(robot, j, value) is not None):
+    table = robot.derived(END_HELD)
+    if name not in table:
+        table[name] = _end_held(robot, name)
+    e = table[name]
+    if e is None or _co.coincident_pair(robot, e.j, value) is not None or (
+            _nco.near_coincident_pair(robot, e.j, value) is not None):
         return None
-    reduced = _reduced(robot, [j], (0.0,))
-    single = reduced.derived(FAMILY).single
-    if single is None:
-        return None
-    Tm = np.ascontiguousarray(_moved_targets(robot, end, T[None], np.array([value]))[0])
-    sub = single(Tm, np.nan)
+    J = joint_motion(e.kind, -e.sign * value)
+    Tm = T @ e.C_inv @ J @ e.C if e.last else e.C @ J @ e.C_inv @ T
+    sub = e.single(Tm, np.nan)
     if sub is None:
         return None
-    k = sub.q.shape[0]
+    k, j = sub.q.shape[0], e.j
     q = np.empty((k, robot.n))
-    keep = [c for c in range(robot.n) if c != j]
-    q[:, keep] = sub.q
-    q[:, j] = value
+    q[:, :j], q[:, j], q[:, j + 1:] = sub.q[:, :j], value, sub.q[:, j:]
     q[~sub.valid] = np.nan  # as SolutionSet does with rows that are not valid
-    lo, hi = robot.limits[j]
-    inside = sub.flags["within_limits"] & (lo - 1e-9 <= value <= hi + 1e-9)
+    inside = sub.flags["within_limits"] & (e.lo - 1e-9 <= value <= e.hi + 1e-9)
     return SolutionSet._trusted(
         q, sub.valid, robot.is_revolute, robot.limits,
         {"singular": sub.flags["singular"], "within_limits": inside}, {}, sub.status,
         f"{sub.method} ({name} held)", None, {"held": {name: np.array(value)}})
+
+
+@dataclass(frozen=True, eq=False)
+class EndHeld:
+    """The first or last joint held, solved by the reduced chain's single-pose path.
+
+    Attributes:
+        j: The joint's index.
+        last: True for the last joint (the target moves on the right), else the first.
+        single: The reduced chain's ``FAMILY.single`` (the joint at 0).
+        C, C_inv: The chain's constant next to the joint (``consts[-1]`` / ``[0]``)
+            and its inverse (4, 4).
+        kind: The joint's kind; sign: its chain sign.
+        lo, hi: Its limits.
+    """
+
+    j: int
+    last: bool
+    single: Any
+    C: np.ndarray
+    C_inv: np.ndarray
+    kind: Any
+    sign: float
+    lo: float
+    hi: float
+
+
+def _end_held(robot: Arm, name: str) -> EndHeld | None:
+    """:class:`EndHeld` of joint ``name``, or None (not an end joint, no single path)."""
+    from robokin.kinematics.ik.analytic.detect import FAMILY
+
+    names = robot.joint_names
+    if name not in names:
+        return None
+    j = names.index(name)
+    end = _end_joint(robot, [j])
+    if end is None:
+        return None
+    single = _reduced(robot, [j], (0.0,)).derived(FAMILY).single
+    if single is None:
+        return None
+    C = robot.chain.arrays.consts[-1 if end == "last" else 0]
+    joint = robot.chain.joints[j]
+    lo, hi = (float(x) for x in robot.limits[j])
+    return EndHeld(j, end == "last", single, np.array(C), invert(C), joint.kind,
+                   float(joint.sign), lo, hi)
+
+
+#: Per arm: joint name -> :class:`EndHeld` (or None), filled on first use of each.
+END_HELD: Derived[dict[str, EndHeld | None]] = Derived("end-joint held solvers",
+                                                       lambda arm: {})
 
 
 def _coincident_parts(robot: Arm, j: int, T: np.ndarray, v: np.ndarray,
