@@ -43,7 +43,7 @@ import numpy as np
 
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
-from robokin.kinematics.ik.self_motion_families import _into_limits, _JointFamily
+from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.jacobian import jacobian_and_pose
 from robokin.spatial import pose_error
 
@@ -76,7 +76,7 @@ _MAX_TRACKS = 64
 _BISECT = 60
 
 
-class _ContinuedFamily(_JointFamily):
+class _ContinuedFamily(_Family):
     """Any 7R arm, joint ``j`` held by the general held-joint 6R solver, continued.
 
     Attributes:
@@ -87,6 +87,11 @@ class _ContinuedFamily(_JointFamily):
         degenerate: Most cells of the first nodes did not pair (every row
             singular): no halving, folds at the tracks' last nodes.
     """
+
+    robot: Arm
+    dispatch: Dispatch
+    T: np.ndarray
+    joint: int
 
     def __init__(self, robot: Arm, j: int, T: np.ndarray, dispatch: Dispatch,
                  nodes: int = NODES) -> None:
@@ -171,7 +176,7 @@ class _ContinuedFamily(_JointFamily):
             return Q
         mi, bi = np.nonzero(ok)
         q, good = _newton_held(self.robot, self.T, Q[mi, bi], np.full(len(mi), self.joint),
-                               t[mi], self.joint)
+                               t[mi])
         out = Q.copy()
         out[mi[good], bi[good]] = q[good]
         return out
@@ -284,7 +289,7 @@ class _ContinuedFamily(_JointFamily):
         t0, b = np.concatenate(starts), np.concatenate(tracks)
         q0 = self.predict(t0)[np.arange(len(t0)), b]
         q, ok = _newton_held(self.robot, self.T, q0, np.concatenate(joints),
-                             np.concatenate(values), self.joint)
+                             np.concatenate(values))
         t1 = q[:, self.joint]
         lo, hi = self.domain
         ok &= (t1 >= lo) & (t1 <= hi)
@@ -378,7 +383,7 @@ def _fold_newton(robot: Arm, T: np.ndarray, q0: np.ndarray, s0: np.ndarray, dt: 
     q = q0
     for _ in range(30):
         guess = q_prev + (v - v_prev)[:, None] * tan_prev
-        q, reached = _newton_held(robot, T, guess, m, v, k)
+        q, reached = _newton_held(robot, T, guess, m, v)
         g, tan = g_of(q)
         ok &= reached & np.isfinite(g)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -532,7 +537,7 @@ def _assign(P: np.ndarray, R: np.ndarray) -> np.ndarray:
 
 
 def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray,
-                 values: np.ndarray, param: int) -> tuple[np.ndarray, np.ndarray]:
+                 values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Configurations (M, n) of pose T with joint ``joints[i]`` at ``values[i]``.
 
     Newton steps from q0 (M, n) on the six other joints (the parameter among them:
@@ -541,7 +546,6 @@ def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray,
     M, n = q0.shape
     q = q0.copy()
     q[np.arange(M), joints] = values
-    del param
     free = np.ones((M, n), bool)
     free[np.arange(M), joints] = False
     idx = np.nonzero(free)[1].reshape(M, n - 1)

@@ -21,11 +21,9 @@ from robokin._native import kernels as K
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, Derived
 from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
+from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.ik.swivel import SwivelArm, swivel_arm
-from robokin.spatial import wrap_angle as _wrap
 
-#: Rows of a slot at the same point are the same configuration within this [rad].
-_SAME = 1e-6
 _TWO_PI = 2 * np.pi
 
 
@@ -46,54 +44,6 @@ class SingularPoint:
     t: float
     branch: int
     kind: str
-
-
-class _Family:
-    """Branches of one pose: ``rows(t)`` and the exact points where a joint is at a value."""
-
-    k = 8
-    periodic = False
-    domain: tuple[float, float]
-    name: str
-    joint: int | None
-
-    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Q (m, k, n) (NaN where a branch has no point), valid (m, k), singular (m, k)."""
-        raise NotImplementedError
-
-    def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
-        """Parameter values where joint j may equal ``value`` (with the configuration)."""
-        raise NotImplementedError
-
-    def param_of(self, q: np.ndarray) -> float:
-        """The parameter value of a configuration q (n,) (of this pose or near it)."""
-        assert self.joint is not None
-        return float(q[self.joint])
-
-    def points(self, queries: list[tuple[int, float]]) -> list[list[tuple[float, int]]]:
-        """Per query (joint j, value): every (t, branch) where joint j equals value.
-
-        The candidates of every query are evaluated in one batch; a branch takes a
-        candidate when its joint j is at the value there (and its configuration is
-        the candidate's, when the candidate has one).
-        """
-        cands = [self.candidates(j, v) for j, v in queries]
-        ts = np.array([t for c in cands for t, _ in c], dtype=np.float64)
-        out: list[list[tuple[float, int]]] = [[] for _ in queries]
-        if not ts.size:
-            return out
-        q, valid, _ = self.rows(ts)
-        i = 0
-        for (j, value), cand, res in zip(queries, cands, out, strict=True):
-            for t, row in cand:
-                ok = valid[i].copy()
-                d = np.full(len(ok), np.inf)
-                d[ok] = (np.abs(_wrap(q[i, ok, j] - value)) if row is None
-                         else np.abs(_wrap(q[i, ok] - row)).max(-1))
-                # a shoulder joint is shared by both wrist roots (and vice versa)
-                res += [(t, int(b)) for b in np.flatnonzero(d < _SAME)]
-                i += 1
-        return out
 
 
 class _SwivelFamily(_Family):
@@ -203,16 +153,6 @@ def _shift_into(t: float, domain: tuple[float, float]) -> float | None:
         if lo - 1e-12 <= t + s <= hi + 1e-12:
             return min(max(t + s, lo), hi)
     return None
-
-
-def _into_limits(robot: Arm, q: np.ndarray) -> np.ndarray:
-    """Revolute angles shifted by 2 pi into the limits where that fits."""
-    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
-    rev = np.asarray(robot.is_revolute, bool)
-    up = rev & (q < lo) & (q + _TWO_PI <= hi)
-    down = rev & (q > hi) & (q - _TWO_PI >= lo)
-    out: np.ndarray = q + _TWO_PI * up - _TWO_PI * down
-    return out
 
 
 def _polish(robot: Arm, q: np.ndarray, real: np.ndarray, T: np.ndarray
