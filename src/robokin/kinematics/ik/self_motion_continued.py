@@ -21,15 +21,23 @@ module continues them into branches (issue 29):
    branch slots, each the same branch at every t.
 3. **Rows at any t.** ``rows(t)`` solves the pose at t (one batch) and gives each
    track the solved row nearest its cubic Hermite prediction from the
-   neighbouring nodes (mutual nearest, within ``_ASSIGN``): every returned row is
-   a general-6R solution (pose to 1e-12), its slot the continued branch.
+   neighbouring nodes (mutual nearest, within ``_ASSIGN``; next to a fold a
+   square-root model): every returned row is a general-6R solution (Newton-polished
+   to rounding where it was above 1e-14), its slot the continued branch.
 4. **Limits on the branch.** Per track, cell and joint, the cubic Hermite model
    sampled at ``_SUB`` sub-values brackets each crossing of a limit (and of an
    aligned-axes value); each is refined by Newton steps on the six other joints
    with t free and the joint held at the limit (the pose exact to 1e-13, the joint
    exactly at its limit), kept when it stays on its track.
-5. **Folds.** A track that starts or ends inside the range ends at a fold; its
-   end is bisected on the track's existence (to two adjacent doubles).
+5. **Folds.** A track that starts or ends inside the range ends at a fold, where
+   the branch turns back in t; in its fastest joint m it is smooth, so the fold
+   is the zero of dt/dq_m (from the null vector of the 6 x 7 Jacobian), found by
+   secant steps on the curve held at q_m (:func:`_fold_newton`); a fold those
+   steps do not certify is bisected on the track's existence.
+6. **Bounded work.** At most ``_MAX_NODES`` nodes and the ``_MAX_TRACKS`` longest
+   tracks; a pose where fewer than half of the first cells pair (every row
+   singular: the arm at its reach boundary for every t) is ``degenerate``: no
+   halving, folds at the tracks' last nodes.
 
 The intervals are then cut at the crossings and folds and decided at the pieces'
 midpoints (``self_motion_intervals._intervals``).
