@@ -69,6 +69,7 @@ STEPS = (
     Step("ik_general_6r", bench("bench_ik_general_6r.py", "--poses", "300", "--sub", "0")),
     Step("ik_held", bench("bench_ik_held.py", "--ssik-poses", "20"), runs=2),
     Step("self_motion", bench("bench_self_motion.py", "--poses", "30")),
+    Step("self_motion_general", bench("bench_self_motion_general.py", "--poses", "10")),
     Step("ik_numeric", bench("bench_ik_numeric.py", "--n", "300", "--ikpy-n", "20"), runs=4),
     Step("trajectory", bench("bench_trajectory.py"), runs=5),
     Step("collision", bench("bench_collision.py"), runs=5),

@@ -111,3 +111,37 @@ def iiwa14_srs():
              "limits": [-np.radians(r), np.radians(r)], "name": f"a{i + 1}"}
             for i, (alpha, d, r) in enumerate(table)]
     return robokin.Robot.from_dh(rows, convention="standard", name="iiwa14_srs")
+
+
+def offset_iiwa14(a2: float = 0.01):
+    """:func:`iiwa14_srs` with a shoulder offset ``a2`` [m] (1 cm by default).
+
+    Axes 1-3 no longer meet, so no joint held leaves a Pieper triple: joint 7 held
+    goes to the general held-joint 6R solver (issue 29's general 7R case).
+    """
+    import robokin
+
+    table = [(-np.pi / 2, 0.36, 170), (np.pi / 2, 0.0, 120), (np.pi / 2, 0.42, 170),
+             (-np.pi / 2, 0.0, 120), (-np.pi / 2, 0.40, 170), (np.pi / 2, 0.0, 120),
+             (0.0, 0.126, 175)]
+    rows = [{"a": a2 if i == 1 else 0.0, "alpha": alpha, "d": d, "theta": 0.0,
+             "limits": [-np.radians(r), np.radians(r)], "name": f"a{i + 1}"}
+            for i, (alpha, d, r) in enumerate(table)]
+    return robokin.Robot.from_dh(rows, convention="standard", name="offset_iiwa")
+
+
+def random_7r(seed: int = 29):
+    """A general 7R arm: a standard DH table drawn from ``seed``.
+
+    a in [0.05, 0.3] m, d in [-0.3, 0.3] m, alpha uniform in (-pi, pi), every joint
+    +-170 deg: no two axes meet or are parallel (generically), so no held joint has
+    a closed form.
+    """
+    import robokin
+
+    rng = np.random.default_rng(seed)
+    rows = [{"a": float(rng.uniform(0.05, 0.3)), "alpha": float(rng.uniform(-np.pi, np.pi)),
+             "d": float(rng.uniform(-0.3, 0.3)), "theta": 0.0,
+             "limits": [-np.radians(170), np.radians(170)], "name": f"r{i + 1}"}
+            for i in range(7)]
+    return robokin.Robot.from_dh(rows, convention="standard", name=f"random7r_{seed}")

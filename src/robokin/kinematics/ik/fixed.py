@@ -24,6 +24,7 @@ the first). Otherwise each distinct value gets its own reduced chain (cached).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
@@ -171,15 +172,106 @@ def solve_held_single(robot: Arm, T: object, fixed: object) -> SolutionSet | Non
     if type(value) not in _NUMBERS:
         return None
     held = robot.derived(HELD_SOLVERS).get(name)
-    if held is None:
-        return _near_single(robot, T, name, float(value))
-    out: SolutionSet | None = held.single(T, value, None)
+    out: SolutionSet | None
+    if held is not None:
+        out = held.single(T, value, None)
+    else:  # next to aligned axes, else a held end joint without a closed form
+        out = _near_single(robot, T, name, float(value))
+        if out is None:
+            out = _end_single(robot, T, name, float(value))
     # "ok" has rows (read first: counting them costs a numpy reduction); no row for a
     # rotation off SO(3) by rounding: None, and solve_fixed projects it and solves
     if out is not None and (out.status.item() == "ok" or len(out)
                             or check_rigid(T, "T") is T):
         return out
     return None
+
+
+def _end_single(robot: Arm, T: np.ndarray, name: str, value: float) -> SolutionSet | None:
+    """The first or last joint at a number, no held closed form: one compiled call.
+
+    The reduced chain (the joint at 0) solved at the moved target by its own
+    single-pose hot path (``FAMILY.single``: the general 6R solver on a general 7R
+    arm; issue 29) and the held column put in: the set ``solve_fixed`` assembles,
+    without its per-call validation and batching (~210 -> ~80 us per call, the
+    kernel ~40-45 of it). None where this does not apply (a middle joint, a value
+    putting two axes on one line, a pose that is not float64 (4, 4), a non-finite
+    value, a reduced chain without a single-pose path).
+    """
+    if T.shape != (4, 4) or T.dtype != np.float64 or not math.isfinite(value):
+        return None
+    table = robot.derived(END_HELD)
+    if name not in table:
+        table[name] = _end_held(robot, name)
+    e = table[name]
+    if e is None or _co.coincident_pair(robot, e.j, value) is not None or (
+            _nco.near_coincident_pair(robot, e.j, value) is not None):
+        return None
+    J = joint_motion(e.kind, -e.sign * value)
+    Tm = T @ e.C_inv @ J @ e.C if e.last else e.C @ J @ e.C_inv @ T
+    sub = e.single(Tm, np.nan)
+    if sub is None:
+        return None
+    k, j = sub.q.shape[0], e.j
+    q = np.empty((k, robot.n))
+    q[:, :j], q[:, j], q[:, j + 1:] = sub.q[:, :j], value, sub.q[:, j:]
+    q[~sub.valid] = np.nan  # as SolutionSet does with rows that are not valid
+    inside = sub.flags["within_limits"] & (e.lo - 1e-9 <= value <= e.hi + 1e-9)
+    return SolutionSet._trusted(
+        q, sub.valid, robot.is_revolute, robot.limits,
+        {"singular": sub.flags["singular"], "within_limits": inside}, {}, sub.status,
+        f"{sub.method} ({name} held)", None, {"held": {name: np.array(value)}})
+
+
+@dataclass(frozen=True, eq=False)
+class EndHeld:
+    """The first or last joint held, solved by the reduced chain's single-pose path.
+
+    Attributes:
+        j: The joint's index.
+        last: True for the last joint (the target moves on the right), else the first.
+        single: The reduced chain's ``FAMILY.single`` (the joint at 0).
+        C, C_inv: The chain's constant next to the joint (``consts[-1]`` / ``[0]``)
+            and its inverse (4, 4).
+        kind: The joint's kind; sign: its chain sign.
+        lo, hi: Its limits.
+    """
+
+    j: int
+    last: bool
+    single: Any
+    C: np.ndarray
+    C_inv: np.ndarray
+    kind: Any
+    sign: float
+    lo: float
+    hi: float
+
+
+def _end_held(robot: Arm, name: str) -> EndHeld | None:
+    """:class:`EndHeld` of joint ``name``, or None (not an end joint, no single path)."""
+    from robokin.kinematics.ik.analytic.detect import FAMILY
+
+    names = robot.joint_names
+    if name not in names:
+        return None
+    j = names.index(name)
+    end = _end_joint(robot, [j])
+    if end is None:
+        return None
+    single = _reduced(robot, [j], (0.0,)).derived(FAMILY).single
+    if single is None:
+        return None
+    C = robot.chain.arrays.consts[-1 if end == "last" else 0]
+    joint = robot.chain.joints[j]
+    lo, hi = (float(x) for x in robot.limits[j])
+    return EndHeld(j, end == "last", single, np.array(C), invert(C), joint.kind,
+                   float(joint.sign), lo, hi)
+
+
+#: Per arm: joint name -> :class:`EndHeld` (or None), filled on first use of each.
+END_HELD: Derived[dict[str, EndHeld | None]] = Derived("end-joint held solvers",
+                                                       lambda arm: {})
 
 
 def _coincident_parts(robot: Arm, j: int, T: np.ndarray, v: np.ndarray,

@@ -12,8 +12,9 @@ branches :math:`q_b(t)` over a parameter t:
 * ``"auto"``: the swivel on SRS arms, else the last joint with a held-joint closed
   form (q7 on the Panda / FR3: He and Liu's closed form), else the last joint;
 * a joint without a held-joint closed form: the general held-joint 6R solver at
-  181 values, its rows continued into branches by nearest pairing with step
-  halving (``_ContinuedFamily``): seconds per pose.
+  181 values (one batch), its rows continued into branches by their slopes
+  (``self_motion_continued``): limit crossings refined by Newton steps on the
+  branch, folds bisected.
 
 **Limits exactly.** A branch leaves a joint's range where that joint equals a
 limit: those points are the solutions of a finitely-solvable problem (the swivel's
@@ -47,11 +48,11 @@ from robokin._validation import check_finite, check_joints, check_rigid
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import ArmSource, arm_of
 from robokin.kinematics.ik.fixed import Dispatch
+from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
 from robokin.kinematics.ik.self_motion_families import (
     LimitCrossing,
     SelfMotionSetup,
     SingularPoint,
-    _ContinuedFamily,
     _Family,
     _family,
     _HeldFamily,
@@ -60,6 +61,7 @@ from robokin.kinematics.ik.self_motion_families import (
 )
 from robokin.kinematics.ik.self_motion_intervals import (
     GRID,
+    _aligned_values,
     _compiled,
     _exact_points,
     _grid,
@@ -74,8 +76,6 @@ __all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SelfMotionSetup", "S
            "auto_parameter",
            "nearest_on_manifold", "parameter_values", "self_motion", "swivel_nearest"]
 
-#: Checking-grid values of a continued family.
-_CONTINUED_GRID = 181
 #: Zoom rounds of SelfMotion.best / nearest (each narrows the span about 4 times).
 _ZOOMS = 8
 #: Intervals zoomed in on (the best by their samples).
@@ -112,7 +112,9 @@ class SelfMotion:
         singular: Branch ends ("fold") and aligned-axes points (the same).
         method: How the branches are computed.
         info: ``bisected`` (state changes found by bisection, not exactly),
-            ``grid`` (values checked).
+            ``grid`` (values checked; the continued family: its nodes), and on
+            the continued family ``solves`` (general-6R values solved) and
+            ``degenerate`` (its rows did not pair: every row singular).
         limits: The arm's joint limits (n, 2).
         _points: The compiled swivel's points (p, 4) ``[t, branch, joint, kind]``
             (``SM_KIND_*``), or None when ``_records`` was given.
@@ -411,12 +413,15 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
                               f"analytic:pieper ({fam.name} held), compiled", info, fam, limits,
                               _records=(crossings, singular))
         fallback = {"compiled": False, "flags": info["flags"]}  # not certified: solved points
-    marks = _exact_points(robot, fam, limits)
     if isinstance(fam, _ContinuedFamily):
-        grid = min(int(grid), _CONTINUED_GRID)  # each value is a general-6R solve
-    grid_t = _grid(fam, int(grid), marks)
-    q, valid, _ = fam.rows(grid_t)
-    ends, bisected = _state_changes(fam, grid_t, q, valid, limits, marks)
+        marks = fam.marks(limits, _aligned_values(robot))
+        ends: list[tuple[float, int]] = []
+        bisected, grid = 0, len(fam.t_nodes)
+    else:
+        marks = _exact_points(robot, fam, limits)
+        grid_t = _grid(fam, int(grid), marks)
+        q, valid, _ = fam.rows(grid_t)
+        ends, bisected = _state_changes(fam, grid_t, q, valid, limits, marks)
     intervals, owner = _intervals(fam, limits, marks, ends)
     crossings = tuple(LimitCrossing(t, b, j, s) for t, b, j, s in marks["limit"])
     singular = tuple(SingularPoint(t, b, k) for t, b, k in marks["fold"] + marks["aligned"])
@@ -425,8 +430,16 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
               if isinstance(fam, _ContinuedFamily) else f"analytic:pieper ({fam.name} held)")
     return SelfMotion(Ta, fam.name, fam.joint, np.array(fam.domain), fam.periodic, fam.k,
                       intervals, owner, method,
-                      {"bisected": bisected, "grid": int(grid), **fallback}, fam, limits,
+                      {"bisected": bisected, "grid": int(grid), **fallback,
+                       **_solves(fam)}, fam, limits,
                       _records=(crossings, singular))
+
+
+def _solves(fam: _Family) -> dict[str, int]:
+    """A continued family's ``solves`` (general-6R values solved) and ``degenerate``."""
+    if not isinstance(fam, _ContinuedFamily):
+        return {}
+    return {"solves": fam.solves, "degenerate": fam.degenerate}
 
 
 #: The swivel's parameter range (copied into each SelfMotion).

@@ -1,4 +1,7 @@
-"""The branches of one pose's self-motion: the swivel, held-joint and continued families.
+"""The branches of one pose's self-motion: the swivel and held-joint families.
+
+(The continued family of arms without a held-joint closed form is in
+:mod:`~robokin.kinematics.ik.self_motion_continued`.)
 
 Each family gives ``rows(t)`` (every branch at parameter values t) and the exact
 parameter values where a joint equals a value (``points``), for
@@ -18,16 +21,10 @@ from robokin._native import kernels as K
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, Derived
 from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
+from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.ik.swivel import SwivelArm, swivel_arm
-from robokin.spatial import wrap_angle as _wrap
 
-#: Rows of a slot at the same point are the same configuration within this [rad].
-_SAME = 1e-6
 _TWO_PI = 2 * np.pi
-#: Largest joint step [rad] between paired rows of a continued branch.
-_JUMP = 0.3
-#: Step halvings of the continuation.
-_REFINE = 4
 
 
 @dataclass(frozen=True)
@@ -47,54 +44,6 @@ class SingularPoint:
     t: float
     branch: int
     kind: str
-
-
-class _Family:
-    """Branches of one pose: ``rows(t)`` and the exact points where a joint is at a value."""
-
-    k = 8
-    periodic = False
-    domain: tuple[float, float]
-    name: str
-    joint: int | None
-
-    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Q (m, k, n) (NaN where a branch has no point), valid (m, k), singular (m, k)."""
-        raise NotImplementedError
-
-    def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
-        """Parameter values where joint j may equal ``value`` (with the configuration)."""
-        raise NotImplementedError
-
-    def param_of(self, q: np.ndarray) -> float:
-        """The parameter value of a configuration q (n,) (of this pose or near it)."""
-        assert self.joint is not None
-        return float(q[self.joint])
-
-    def points(self, queries: list[tuple[int, float]]) -> list[list[tuple[float, int]]]:
-        """Per query (joint j, value): every (t, branch) where joint j equals value.
-
-        The candidates of every query are evaluated in one batch; a branch takes a
-        candidate when its joint j is at the value there (and its configuration is
-        the candidate's, when the candidate has one).
-        """
-        cands = [self.candidates(j, v) for j, v in queries]
-        ts = np.array([t for c in cands for t, _ in c], dtype=np.float64)
-        out: list[list[tuple[float, int]]] = [[] for _ in queries]
-        if not ts.size:
-            return out
-        q, valid, _ = self.rows(ts)
-        i = 0
-        for (j, value), cand, res in zip(queries, cands, out, strict=True):
-            for t, row in cand:
-                ok = valid[i].copy()
-                d = np.full(len(ok), np.inf)
-                d[ok] = (np.abs(_wrap(q[i, ok, j] - value)) if row is None
-                         else np.abs(_wrap(q[i, ok] - row)).max(-1))
-                # a shoulder joint is shared by both wrist roots (and vice versa)
-                res += [(t, int(b)) for b in np.flatnonzero(d < _SAME)]
-                i += 1
-        return out
 
 
 class _SwivelFamily(_Family):
@@ -197,125 +146,6 @@ class _HeldFamily(_JointFamily):
 
 
 
-class _ContinuedFamily(_JointFamily):
-    """Any 7R arm, a joint held by the general held-joint 6R solver, branches continued.
-
-    The pose is solved at ``nodes`` held values (one batch); consecutive values'
-    rows are paired by nearest distance (2 pi wrapped), and where a pairing is
-    ambiguous (the second-nearest within twice the nearest) or a step jumps more
-    than ``_JUMP`` the step is halved (a midpoint solved) up to ``_REFINE`` times.
-    Paired rows form tracks (the branches); a row with no partner starts a track.
-    ``rows(t)`` solves at t and gives each track the row nearest its value there
-    (interpolated between its nodes).
-    """
-
-    def __init__(self, robot: Arm, j: int, T: np.ndarray, dispatch: Dispatch,
-                 nodes: int = 181) -> None:
-        self.robot = robot
-        self.dispatch = dispatch
-        self.joint = j
-        self.name = robot.joint_names[j]
-        self.domain = (float(robot.limits[j, 0]), float(robot.limits[j, 1]))
-        self.T = T
-        t = np.linspace(*self.domain, nodes)
-        Q = self._solve(t)
-        for _ in range(_REFINE):
-            bad = [i for i in range(len(t) - 1) if not _clean_step(Q[i], Q[i + 1])]
-            if not bad:
-                break
-            mid = 0.5 * (t[bad] + t[np.array(bad) + 1])
-            t = np.concatenate([t, mid])
-            Q = np.concatenate([Q, self._solve(mid)])
-            order = np.argsort(t)
-            t, Q = t[order], Q[order]
-        self.t_nodes = t
-        self.tracks = _link(Q)  # (m, k, n)
-        self.k = self.tracks.shape[1]
-
-    def _solve(self, t: np.ndarray) -> np.ndarray:
-        sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
-        Q = np.where(sols.valid[..., None], sols.q, np.nan)
-        return _into_limits(self.robot, Q)
-
-    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        t = np.atleast_1d(np.asarray(t, dtype=np.float64))
-        Q = self._solve(t)  # (m, K, n)
-        ref = self._interpolated(t)  # (m, k, n)
-        out = np.full(ref.shape, np.nan)
-        for i in range(len(t)):
-            d = _dist(ref[i][:, None], Q[i][None])  # (k, K)
-            d[~np.isfinite(d)] = np.inf
-            while np.isfinite(d).any():
-                b, r = np.unravel_index(int(np.argmin(d)), d.shape)
-                if d[b, r] > _JUMP:
-                    break
-                out[i, b] = Q[i, r]
-                d[b, :] = np.inf
-                d[:, r] = np.inf
-        valid = np.isfinite(out).all(-1)
-        return out, valid, np.zeros_like(valid)
-
-    def _interpolated(self, t: np.ndarray) -> np.ndarray:
-        """Each track's value at t (m, k, n): linear between its nodes (NaN off it)."""
-        tn, X = self.t_nodes, self.tracks
-        i = np.clip(np.searchsorted(tn, t) - 1, 0, len(tn) - 2)
-        w = ((t - tn[i]) / (tn[i + 1] - tn[i]))[:, None, None]
-        a, b = X[i], X[i + 1]
-        mid = a + w * _wrap(b - a)
-        near = np.where(w < 0.5, a, b)
-        return np.where(np.isfinite(mid), mid, near)
-
-
-def _dist(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Largest 2 pi wrapped joint difference of rows a and b (broadcast, NaN -> NaN)."""
-    out: np.ndarray = np.abs(_wrap(a - b)).max(-1)
-    return out
-
-
-def _clean_step(A: np.ndarray, B: np.ndarray) -> bool:
-    """True when every row of A pairs with one of B unambiguously and within _JUMP."""
-    a, b = A[np.isfinite(A).all(-1)], B[np.isfinite(B).all(-1)]
-    if len(a) != len(b):
-        return False
-    if not len(a):
-        return True
-    d = np.sort(_dist(a[:, None], b[None]), axis=1)
-    if d[:, 0].max() > _JUMP:
-        return False
-    return bool(len(b) < 2 or np.all(d[:, 1] > 2 * d[:, 0]))
-
-
-def _link(Q: np.ndarray) -> np.ndarray:
-    """Tracks (m, k, n) from rows per node (m, K, n): nearest pairing node to node."""
-    m, K, n = Q.shape
-    tracks: list[np.ndarray] = []
-    last: list[int] = []  # per track: its row at the previous node, or -1
-    for i in range(m):
-        now = [-1] * len(tracks)
-        rows = [r for r in range(K) if np.isfinite(Q[i, r]).all()]
-        prev = [(tr, last[tr]) for tr in range(len(tracks)) if last[tr] >= 0]
-        if prev and rows:
-            d = np.array([[float(_dist(Q[i - 1, pr], Q[i, r])) for r in rows] for _, pr in prev])
-            while np.isfinite(d).any():
-                a, c = np.unravel_index(int(np.argmin(d)), d.shape)
-                if d[a, c] > _JUMP:
-                    break
-                now[prev[a][0]] = rows[c]
-                tracks[prev[a][0]][i] = Q[i, rows[c]]
-                d[a, :] = np.inf
-                d[:, c] = np.inf
-        for r in rows:
-            if r not in now:
-                tr = np.full((m, n), np.nan)
-                tr[i] = Q[i, r]
-                tracks.append(tr)
-                now.append(r)
-        last = now
-    if not tracks:
-        return np.full((m, 1, n), np.nan)
-    return np.stack(tracks, axis=1)
-
-
 def _shift_into(t: float, domain: tuple[float, float]) -> float | None:
     """T shifted by whole turns into the closed domain, or None."""
     lo, hi = domain
@@ -323,16 +153,6 @@ def _shift_into(t: float, domain: tuple[float, float]) -> float | None:
         if lo - 1e-12 <= t + s <= hi + 1e-12:
             return min(max(t + s, lo), hi)
     return None
-
-
-def _into_limits(robot: Arm, q: np.ndarray) -> np.ndarray:
-    """Revolute angles shifted by 2 pi into the limits where that fits."""
-    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
-    rev = np.asarray(robot.is_revolute, bool)
-    up = rev & (q < lo) & (q + _TWO_PI <= hi)
-    down = rev & (q > hi) & (q - _TWO_PI >= lo)
-    out: np.ndarray = q + _TWO_PI * up - _TWO_PI * down
-    return out
 
 
 def _polish(robot: Arm, q: np.ndarray, real: np.ndarray, T: np.ndarray
@@ -432,5 +252,7 @@ def _family(robot: Arm, T: np.ndarray, parameter: str, dispatch: Dispatch,
         # (auto_parameter says why)
         parameter = usable[-1] if usable else names[-1]
     if parameter not in held:  # the general held-joint 6R solver, continued
+        from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
+
         return _ContinuedFamily(robot, names.index(parameter), T, dispatch)
     return _HeldFamily(robot, held[parameter].params, names.index(parameter), T, dispatch)

@@ -1,0 +1,75 @@
+"""The base of the self-motion families: ``rows(t)`` and the points where a joint is at a value.
+
+Shared by :mod:`~robokin.kinematics.ik.self_motion_families` (the swivel and
+held-joint families) and :mod:`~robokin.kinematics.ik.self_motion_continued` (the
+continued family of general 7R arms), which import it and not each other.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robokin.kinematics.arm import Arm
+from robokin.spatial import wrap_angle as _wrap
+
+#: Rows of a slot at the same point are the same configuration within this [rad].
+_SAME = 1e-6
+_TWO_PI = 2 * np.pi
+
+
+class _Family:
+    """Branches of one pose: ``rows(t)`` and the exact points where a joint is at a value."""
+
+    k = 8
+    periodic = False
+    domain: tuple[float, float]
+    name: str
+    joint: int | None
+
+    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Q (m, k, n) (NaN where a branch has no point), valid (m, k), singular (m, k)."""
+        raise NotImplementedError
+
+    def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
+        """Parameter values where joint j may equal ``value`` (with the configuration)."""
+        raise NotImplementedError
+
+    def param_of(self, q: np.ndarray) -> float:
+        """The parameter value of a configuration q (n,) (of this pose or near it)."""
+        assert self.joint is not None
+        return float(q[self.joint])
+
+    def points(self, queries: list[tuple[int, float]]) -> list[list[tuple[float, int]]]:
+        """Per query (joint j, value): every (t, branch) where joint j equals value.
+
+        The candidates of every query are evaluated in one batch; a branch takes a
+        candidate when its joint j is at the value there (and its configuration is
+        the candidate's, when the candidate has one).
+        """
+        cands = [self.candidates(j, v) for j, v in queries]
+        ts = np.array([t for c in cands for t, _ in c], dtype=np.float64)
+        out: list[list[tuple[float, int]]] = [[] for _ in queries]
+        if not ts.size:
+            return out
+        q, valid, _ = self.rows(ts)
+        i = 0
+        for (j, value), cand, res in zip(queries, cands, out, strict=True):
+            for t, row in cand:
+                ok = valid[i].copy()
+                d = np.full(len(ok), np.inf)
+                d[ok] = (np.abs(_wrap(q[i, ok, j] - value)) if row is None
+                         else np.abs(_wrap(q[i, ok] - row)).max(-1))
+                # a shoulder joint is shared by both wrist roots (and vice versa)
+                res += [(t, int(b)) for b in np.flatnonzero(d < _SAME)]
+                i += 1
+        return out
+
+
+def _into_limits(robot: Arm, q: np.ndarray) -> np.ndarray:
+    """Revolute angles shifted by 2 pi into the limits where that fits."""
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    rev = np.asarray(robot.is_revolute, bool)
+    up = rev & (q < lo) & (q + _TWO_PI <= hi)
+    down = rev & (q > hi) & (q - _TWO_PI >= lo)
+    out: np.ndarray = q + _TWO_PI * up - _TWO_PI * down
+    return out

@@ -1,0 +1,583 @@
+r"""The continued self-motion family: any 7R arm, a joint held by the general 6R solver.
+
+An arm without a held-joint closed form (no meeting triple left with the parameter
+joint held: an iiwa with a shoulder offset, a general 7R DH arm) is solved at a
+held value by the general held-joint 6R solver (``solve_fixed``; for the first or
+last joint one reduced chain serves every value, so a sweep is one batched
+compiled call). Its rows at different values are not in any fixed order; this
+module continues them into branches (issue 29):
+
+1. **Nodes.** The pose is solved at ``nodes`` values of the parameter t = q_k (one
+   batch), and every row gets its slope dq/dt: the other six joints' Jacobian
+   columns solve -J_k (the pose stays fixed along the manifold), as
+   ``held_manifold.c``'s ``hm_slopes`` does for the closed form.
+2. **Pairing by the predictor.** Rows a at t_i and b at t_{i+1} of one branch
+   satisfy the trapezoid rule ``q_b - q_a = h (dq_a + dq_b) / 2`` to O(h^3); rows of
+   different branches do not. A cell where some row has no unambiguous partner
+   (residual above ``_PAIR``, or a second candidate within 4 times the best) is
+   halved (its midpoint solved, one batch per round) up to ``_REFINE`` times:
+   only cells next to a fold (where two branches meet and the slopes blow up).
+   Mutual best partners (residual below ``_LINK``) are linked into tracks: the
+   branch slots, each the same branch at every t.
+3. **Rows at any t.** ``rows(t)`` solves the pose at t (one batch) and gives each
+   track the solved row nearest its cubic Hermite prediction from the
+   neighbouring nodes (mutual nearest, within ``_ASSIGN``; next to a fold a
+   square-root model): every returned row is a general-6R solution (Newton-polished
+   to rounding where it was above 1e-14), its slot the continued branch.
+4. **Limits on the branch.** Per track, cell and joint, the cubic Hermite model
+   sampled at ``_SUB`` sub-values brackets each crossing of a limit (and of an
+   aligned-axes value); each is refined by Newton steps on the six other joints
+   with t free and the joint held at the limit (the pose exact to 1e-13, the joint
+   exactly at its limit), kept when it stays on its track.
+5. **Folds.** A track that starts or ends inside the range ends at a fold, where
+   the branch turns back in t; in its fastest joint m it is smooth, so the fold
+   is the zero of dt/dq_m (from the null vector of the 6 x 7 Jacobian), found by
+   secant steps on the curve held at q_m (:func:`_fold_newton`); a fold those
+   steps do not certify is bisected on the track's existence.
+6. **Bounded work.** At most ``_MAX_NODES`` nodes and the ``_MAX_TRACKS`` longest
+   tracks; a pose where fewer than half of the first cells pair (every row
+   singular: the arm at its reach boundary for every t) is ``degenerate``: no
+   halving, folds at the tracks' last nodes.
+
+The intervals are then cut at the crossings and folds and decided at the pieces'
+midpoints (``self_motion_intervals._intervals``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from robokin.kinematics.arm import Arm
+from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
+from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
+from robokin.kinematics.jacobian import jacobian_and_pose
+from robokin.spatial import pose_error
+
+#: Parameter values solved first (over the joint's range).
+NODES = 181
+#: Halvings of a cell whose rows do not pair unambiguously.
+_REFINE = 6
+#: Trapezoid residual [rad] of an unambiguous pair.
+_PAIR = 1e-2
+#: Trapezoid residual [rad] of a pair linked after the halvings.
+_LINK = 0.2
+#: Largest distance [rad] of a solved row from a track's prediction in ``rows``.
+_ASSIGN = 0.3
+#: Sub-values per cell at which the Hermite model is checked for limit crossings.
+_SUB = 8
+#: Newton steps of a crossing (quadratic: 4-6 are used).
+_NEWTON = 12
+#: Pose error (position [m], rotation [rad]) a crossing's configuration reaches.
+_EXACT = 1e-13
+#: Largest distance [rad] of a refined crossing from its track's prediction.
+_ON_TRACK = 1e-2
+_TWO_PI = 2 * np.pi
+#: Most nodes after the halvings (a degenerate pose would double them every round).
+_MAX_NODES = 3 * NODES
+#: Below this fraction of cells paired at the first nodes a pose is degenerate.
+_DEGENERATE = 0.5
+#: Most tracks kept (the longest; a degenerate pose's rows do not pair).
+_MAX_TRACKS = 64
+#: Bisection steps of a fold (a cell to two adjacent doubles).
+_BISECT = 60
+
+
+class _ContinuedFamily(_Family):
+    """Any 7R arm, joint ``j`` held by the general held-joint 6R solver, continued.
+
+    Attributes:
+        t_nodes: (m,) the solved parameter values, sorted.
+        tracks: (m, k, n) each branch's row at the nodes (NaN where it has none).
+        slopes: (m, k, n) their slopes dq/dt.
+        solves: Parameter values solved by the general 6R solver so far.
+        degenerate: Most cells of the first nodes did not pair (every row
+            singular): no halving, folds at the tracks' last nodes.
+    """
+
+    robot: Arm
+    dispatch: Dispatch
+    T: np.ndarray
+    joint: int
+
+    def __init__(self, robot: Arm, j: int, T: np.ndarray, dispatch: Dispatch,
+                 nodes: int = NODES) -> None:
+        self.robot = robot
+        self.dispatch = dispatch
+        self.joint = j
+        self.name = robot.joint_names[j]
+        self.domain = (float(robot.limits[j, 0]), float(robot.limits[j, 1]))
+        self.T = np.ascontiguousarray(T, dtype=np.float64)
+        self.solves = 0
+        t = np.linspace(*self.domain, int(nodes))
+        Q = self._solve(t)
+        D = _slopes(robot, Q, j)
+        clean = _clean_cells(t, Q, D)
+        # most cells unpaired: every row singular (the pose at the reach boundary,
+        # e.g. the elbow stretched for every value): no halving, no fold search
+        self.degenerate = bool(clean.mean() < _DEGENERATE) if clean.size else False
+        for _ in range(0 if self.degenerate else _REFINE):
+            bad = np.flatnonzero(~clean)
+            if not bad.size or len(t) + bad.size > _MAX_NODES:
+                break  # clean, or a pose whose rows do not pair anywhere (degenerate)
+            mid = 0.5 * (t[bad] + t[bad + 1])
+            Qm = self._solve(mid)
+            Dm = _slopes(robot, Qm, j)
+            Q, Qm = _widen(Q, Qm)
+            D, Dm = _widen(D, Dm)
+            t = np.concatenate([t, mid])
+            new = np.concatenate([np.zeros(len(t) - len(mid), bool), np.ones(len(mid), bool)])
+            order = np.argsort(t, kind="stable")
+            t, new = t[order], new[order]
+            Q = np.concatenate([Q, Qm])[order]
+            D = np.concatenate([D, Dm])[order]
+            # only the cells next to a new node can have changed (the others were clean)
+            clean = np.ones(len(t) - 1, bool)
+            cells = np.flatnonzero(new[:-1] | new[1:])
+            clean[cells] = _clean_cells(t, Q, D, cells)
+        self.t_nodes = t
+        self.tracks, self.slopes = _link(t, Q, D)
+        self.k = self.tracks.shape[1]
+        self._exists = np.isfinite(self.tracks).all(-1)  # (m, k)
+        self._slopes0 = np.where(np.isfinite(self.slopes), self.slopes, 0.0)
+        m, k, n = self.tracks.shape
+        # per (cell, track): the fold inside the cell, its t and row (NaN: none)
+        self.fold_t = np.full((m - 1, k), np.nan)
+        self.fold_q = np.full((m - 1, k, n), np.nan)
+        self.folds = self._folds()
+
+    # ------------------------------------------------------------ rows
+    def _solve(self, t: np.ndarray) -> np.ndarray:
+        """Every general-6R row at held values t (m,): (m, K, n), NaN where none.
+
+        The valid rows come first in each value's K slots; K is the most any value has.
+        """
+        self.solves += len(t)
+        sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
+        valid = sols.valid.reshape(len(t), -1)
+        order = np.argsort(~valid, axis=1, kind="stable")
+        width = max(int(valid.sum(axis=1).max(initial=0)), 1)
+        order = order[:, :width]
+        q = np.take_along_axis(sols.q.reshape(len(t), -1, self.robot.n), order[..., None], 1)
+        ok = np.take_along_axis(valid, order, 1)
+        return _into_limits(self.robot, np.where(ok[..., None], q, np.nan))
+
+    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        t = np.atleast_1d(np.asarray(t, dtype=np.float64))
+        R = self._solve(t)  # (M, K, n)
+        P = self.predict(t)  # (M, k, n)
+        out = self._polish(_assign(P, R), t)
+        valid = np.isfinite(out).all(-1)
+        return out, valid, np.zeros_like(valid)
+
+    def _polish(self, Q: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Rows Q (M, k, n) at t (M,) polished by Newton steps on the six free joints.
+
+        The general-6R rows reproduce the pose to ~1e-13; a step where they are above
+        1e-14 brings them to rounding (kept only where it reaches ``_EXACT``), so
+        rows at a limit crossing's t have the joint at its limit to ~1e-14.
+        """
+        M, k, n = Q.shape
+        ok = np.isfinite(Q).all(-1)
+        if not ok.any():
+            return Q
+        mi, bi = np.nonzero(ok)
+        q, good = _newton_held(self.robot, self.T, Q[mi, bi], np.full(len(mi), self.joint),
+                               t[mi])
+        out = Q.copy()
+        out[mi[good], bi[good]] = q[good]
+        return out
+
+    def predict(self, t: np.ndarray) -> np.ndarray:
+        """Each track's cubic Hermite value at t (M, k, n) (NaN where it has none).
+
+        Between two nodes where the track exists: the cubic Hermite of its rows and
+        slopes; where it exists at one of them only (a fold in the cell): the
+        tangent line from that one.
+        """
+        tn, X, S, E = self.t_nodes, self.tracks, self._slopes0, self._exists
+        M, (_, k, n) = len(t), X.shape
+        out = np.full((M, k, n), np.nan)
+        i = np.clip(np.searchsorted(tn, t, side="right") - 1, 0, len(tn) - 2)
+        fa, fb = E[i], E[i + 1]  # (M, k)
+        mi, bi = np.nonzero(fa | fb)  # only the tracks present in the cell
+        if not mi.size:
+            return out
+        c = i[mi]
+        fa, fb = fa[mi, bi][:, None], fb[mi, bi][:, None]
+        h = (tn[c + 1] - tn[c])[:, None]
+        u = ((t[mi] - tn[c]) / (tn[c + 1] - tn[c]))[:, None]
+        a = np.where(fa, X[c, bi], 0.0)
+        b = np.where(fb, X[c + 1, bi], 0.0)
+        sa, sb = S[c, bi], S[c + 1, bi]
+        b = a + _wrap(b - a)
+        u2, u3 = u * u, u * u * u
+        herm = ((2 * u3 - 3 * u2 + 1) * a + (u3 - 2 * u2 + u) * h * sa
+                + (-2 * u3 + 3 * u2) * b + (u3 - u2) * h * sb)
+        one = np.where(fa, a + u * h * sa, X[c + 1, bi] + (u - 1) * h * sb)
+        # a fold in the cell: q = q_f + (q_node - q_f) sqrt((t - t_f) / (t_node - t_f))
+        tf, qf = self.fold_t[c, bi], self.fold_q[c, bi]
+        fold = np.isfinite(tf)
+        if fold.any():
+            tnode = np.where(fa[:, 0], tn[c], tn[c + 1])
+            qnode = np.where(fa, X[c, bi], X[c + 1, bi])
+            with np.errstate(invalid="ignore", divide="ignore"):
+                r = np.where(fold, (t[mi] - tf) / (tnode - tf), 0.0)
+                root = qf + _wrap(qnode - qf) * np.sqrt(np.maximum(r, 0.0))[:, None]
+            one = np.where(fold[:, None], np.where((r >= 0)[:, None], root, np.nan), one)
+        out[mi, bi] = np.where(fa & fb, herm, one)
+        return out
+
+    def param_of(self, q: np.ndarray) -> float:
+        return float(q[self.joint])
+
+    # ------------------------------------------------------------ exact points
+    def marks(self, limits: np.ndarray, aligned: list[tuple[int, float]]
+              ) -> dict[str, list[Any]]:
+        """Limit crossings, aligned-axes points and folds of every track.
+
+        Returns the dict ``self_motion_intervals._intervals`` takes: ``"limit"``
+        ``[(t, branch, joint, "lower"/"upper")]``, ``"aligned"`` ``[(t, branch,
+        "aligned axes")]``, ``"fold"`` ``[(t, branch, "fold")]``.
+        """
+        rev = np.asarray(self.robot.is_revolute, bool)
+        queries: list[tuple[int, float, str]] = []
+        for j in range(self.robot.n):
+            lo, hi = (float(x) for x in limits[j])
+            if j == self.joint or (rev[j] and hi - lo >= 2 * np.pi):
+                continue
+            queries += [(j, lo, "lower"), (j, hi, "upper")]
+        queries += [(j, v, "aligned axes") for j, v in aligned if j != self.joint]
+        found = self._crossings(queries)
+        out: dict[str, list[Any]] = {"limit": [], "fold": [], "aligned": []}
+        for t, b, qi in found:
+            j, _, kind = queries[qi]
+            if kind == "aligned axes":
+                out["aligned"].append((t, b, kind))
+            else:
+                out["limit"].append((t, b, j, kind))
+        out["fold"] = [(t, b, "fold") for t, b in self.folds]
+        return out
+
+    def _crossings(self, queries: list[tuple[int, float, str]]
+                   ) -> list[tuple[float, int, int]]:
+        """(t, track, query index) where a track's joint equals a query's value."""
+        if not queries:
+            return []
+        tn, X, S = self.t_nodes, self.tracks, self.slopes
+        both = np.isfinite(X[:-1]).all(-1) & np.isfinite(X[1:]).all(-1)  # (m-1, k)
+        cc, bb = np.nonzero(both)  # the (cell, track) pieces with both ends
+        u = np.linspace(0.0, 1.0, _SUB + 1)[None, :, None]
+        h = (tn[cc + 1] - tn[cc])[:, None, None]
+        qa, sa = X[cc, bb][:, None], S[cc, bb][:, None]
+        qb = qa + _wrap(X[cc + 1, bb][:, None] - qa)
+        sb = S[cc + 1, bb][:, None]
+        u2, u3 = u * u, u * u * u
+        P = ((2 * u3 - 3 * u2 + 1) * qa + (u3 - 2 * u2 + u) * h * sa
+             + (-2 * u3 + 3 * u2) * qb + (u3 - u2) * h * sb)  # (pieces, SUB + 1, n)
+        tt = tn[cc][:, None] + h[:, :, 0] * u[0, :, 0][None]  # (pieces, SUB + 1)
+        starts, tracks, qidx, joints, values = [], [], [], [], []
+        for qi, (j, v, _) in enumerate(queries):
+            g = _wrap(P[..., j] - v)  # (pieces, SUB + 1)
+            change = (np.sign(g[:, :-1]) != np.sign(g[:, 1:])) & (
+                np.abs(g[:, :-1] - g[:, 1:]) < np.pi)
+            c, sidx = np.nonzero(change)
+            if not c.size:
+                continue
+            g0, g1 = g[c, sidx], g[c, sidx + 1]
+            w = np.where(g0 != g1, g0 / np.where(g0 != g1, g0 - g1, 1.0), 0.0)
+            starts.append(tt[c, sidx] + w * (tt[c, sidx + 1] - tt[c, sidx]))
+            tracks.append(bb[c])
+            qidx.append(np.full(c.size, qi))
+            joints.append(np.full(c.size, j))
+            values.append(np.full(c.size, v))
+        if not starts:
+            return []
+        t0, b = np.concatenate(starts), np.concatenate(tracks)
+        q0 = self.predict(t0)[np.arange(len(t0)), b]
+        q, ok = _newton_held(self.robot, self.T, q0, np.concatenate(joints),
+                             np.concatenate(values))
+        t1 = q[:, self.joint]
+        lo, hi = self.domain
+        ok &= (t1 >= lo) & (t1 <= hi)
+        pred = self.predict(np.where(ok, t1, t0))[np.arange(len(t0)), b]
+        ok &= np.abs(_wrap(pred - q)).max(-1) < _ON_TRACK
+        out: list[tuple[float, int, int]] = []
+        for t, bb, qi in zip(t1[ok].tolist(), b[ok].tolist(),
+                             np.concatenate(qidx)[ok].tolist(), strict=True):
+            if not any(bb == b2 and qi == q2 and abs(t - t2) < 1e-9 for t2, b2, q2 in out):
+                out.append((t, bb, qi))
+        return out
+
+    def _folds(self) -> list[tuple[float, int]]:
+        """(t, track): where a track starts or ends inside the range (a fold).
+
+        Found on the curve by :func:`_fold_newton` (exact to ~1e-15 in t); a fold
+        it does not certify is bisected on the track's existence instead (the last
+        value, to two adjacent doubles, where the track's row still exists).
+        """
+        exist = np.isfinite(self.tracks).all(-1)  # (m, k)
+        c, b = np.nonzero(exist[1:] != exist[:-1])
+        if not c.size:
+            return []
+        tn = self.t_nodes
+        state = exist[c, b]  # True: the track exists at the cell's start
+        near = np.where(state, c, c + 1)
+        far = np.where(state, c + 1, c)
+        if self.degenerate:  # the track's last node (its rows are all singular)
+            return [(float(e), int(bb)) for e, bb in zip(tn[near], b, strict=True)]
+        q_f, ok = _fold_newton(self.robot, self.T, self.tracks[near, b], self.slopes[near, b],
+                               tn[far] - tn[near], self.joint)
+        t_f = q_f[:, self.joint]
+        lo, hi = np.minimum(tn[near], tn[far]), np.maximum(tn[near], tn[far])
+        ok &= (t_f >= lo) & (t_f <= hi)
+        ends = np.where(ok, t_f, np.nan)
+        self.fold_t[c[ok], b[ok]] = t_f[ok]
+        self.fold_q[c[ok], b[ok]] = q_f[ok]
+        if not ok.all():
+            ends[~ok] = self._bisect(c[~ok], b[~ok], state[~ok])
+        return [(float(e), int(bb)) for e, bb in zip(ends, b, strict=True)]
+
+    def _bisect(self, c: np.ndarray, b: np.ndarray, state: np.ndarray) -> np.ndarray:
+        """Fold ends (p,) in cells c by bisection on track b's existence."""
+        tn = self.t_nodes
+        lo, hi = tn[c].copy(), tn[c + 1].copy()
+        rows = np.arange(len(c))
+        for _ in range(_BISECT):
+            mid = 0.5 * (lo + hi)
+            if np.all((mid == lo) | (mid == hi)):
+                break
+            _, valid, _ = self.rows(mid)
+            same = valid[rows, b] == state
+            lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+        out: np.ndarray = np.where(state, lo, hi)
+        return out
+
+
+def _fold_newton(robot: Arm, T: np.ndarray, q0: np.ndarray, s0: np.ndarray, dt: np.ndarray,
+                 k: int) -> tuple[np.ndarray, np.ndarray]:
+    """The folds (p, n) next to rows q0 (p, n) with slopes s0 = dq/dt, toward t + dt.
+
+    Past a fold the branch turns back in t, but it is smooth in its fastest joint
+    m: held at v, the pose solved by Newton steps on the six others (t among them)
+    gives t(v), and the fold is the zero of g(v) = dt/dq_m = n_k / n_m (n the null
+    vector of the 6 x 7 Jacobian): secant steps from v0 = q0[m] and the point half
+    a cell along the tangent. True where |g| fell below 1e-12 with the pose exact.
+    """
+    p, n = q0.shape
+    rows = np.arange(p)
+    sm = s0.copy()
+    sm[:, k] = 0.0
+    m = np.argmax(np.abs(np.where(np.isfinite(sm), sm, np.inf)), axis=1)
+    sm_m = s0[rows, m]
+    good = np.isfinite(s0).all(-1) & (np.abs(sm_m) > 0)
+    tangent = np.where(good[:, None], s0 / np.where(good, sm_m, 1.0)[:, None], 0.0)
+
+    def g_of(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        nv = np.full((p, n), np.nan)
+        fin = np.flatnonzero(np.isfinite(q).all(-1) & (np.abs(q) < 1e3).all(-1))
+        if fin.size:
+            J, _ = jacobian_and_pose(robot.chain, q[fin])
+            nv[fin] = np.linalg.svd(J)[2][:, -1, :]  # the null vectors (p, n)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return nv[:, k] / nv[rows, m], nv / nv[rows, m][:, None]
+
+    v0 = q0[rows, m]
+    g0 = np.where(good, 1.0 / np.where(good, sm_m, 1.0), np.nan)
+    q_prev, v_prev, tan_prev = q0, v0, tangent
+    v = v0 + sm_m * dt * 0.5
+    ok = good.copy()
+    q = q0
+    for _ in range(30):
+        guess = q_prev + (v - v_prev)[:, None] * tan_prev
+        q, reached = _newton_held(robot, T, guess, m, v)
+        g, tan = g_of(q)
+        ok &= reached & np.isfinite(g)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            v_next = v - g * (v - v_prev) / (g - g0)
+        done = ~ok | (np.abs(g) < 1e-12) | ~np.isfinite(v_next) | (v_next == v)
+        if done.all():
+            break
+        v_next = np.where(done, v, v_next)
+        q_prev, v_prev, g0, tan_prev = q, v, g, tan
+        v = v_next
+    ok &= np.abs(g) < 1e-10
+    return q, ok
+
+
+def _wrap(x: np.ndarray) -> np.ndarray:
+    """Angles wrapped into [-pi, pi] (by rounding: ``%`` is ~20x slower with NaN)."""
+    out: np.ndarray = x - _TWO_PI * np.round(x / _TWO_PI)
+    return out
+
+
+def _slopes(robot: Arm, Q: np.ndarray, k: int) -> np.ndarray:
+    """dq/dq_k of rows Q (..., n) on the manifold of their pose (NaN rows, singular: NaN)."""
+    flat = Q.reshape(-1, Q.shape[-1])
+    out = np.full(flat.shape, np.nan)
+    ok = np.flatnonzero(np.isfinite(flat).all(-1))
+    if not ok.size:
+        return out.reshape(Q.shape)
+    J, _ = jacobian_and_pose(robot.chain, flat[ok])
+    free = [c for c in range(flat.shape[-1]) if c != k]
+    A, rhs = J[:, :, free], -J[:, :, k]
+    good = np.abs(np.linalg.det(A)) > 1e-12 * np.abs(A).max(axis=(1, 2)) ** 6
+    x = np.linalg.solve(A[good], rhs[good][..., None])[..., 0]
+    rows = ok[good]
+    out[np.ix_(rows, free)] = x
+    out[rows, k] = 1.0
+    return out.reshape(Q.shape)
+
+
+def _widen(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A (m, K1, n) and B (p, K2, n) padded with NaN rows to the same K."""
+    K = max(A.shape[1], B.shape[1])
+
+    def pad(X: np.ndarray) -> np.ndarray:
+        extra = np.full((X.shape[0], K - X.shape[1], X.shape[2]), np.nan)
+        return np.concatenate([X, extra], axis=1)
+
+    return pad(A), pad(B)
+
+
+def _residuals(t: np.ndarray, Q: np.ndarray, D: np.ndarray,
+               cells: np.ndarray | None = None) -> np.ndarray:
+    """Trapezoid residuals (c, K, K) of node i's rows a against node i+1's rows b.
+
+    Per cell i in ``cells`` (default: every cell, m - 1). Inf where either row is
+    missing or its slope is not finite (NaN replaced first: arithmetic on NaN is
+    slow).
+    """
+    c = np.arange(len(t) - 1) if cells is None else cells
+    ok = np.isfinite(Q).all(-1) & np.isfinite(D).all(-1)
+    Qz, Dz = np.where(ok[..., None], Q, 0.0), np.where(ok[..., None], D, 0.0)
+    h = (t[c + 1] - t[c])[:, None, None, None]
+    a, b = Qz[c][:, :, None], Qz[c + 1][:, None, :]
+    da, db = Dz[c][:, :, None], Dz[c + 1][:, None, :]
+    r = np.abs(_wrap(b - a) - 0.5 * h * (da + db)).max(-1)
+    r[~(ok[c][:, :, None] & ok[c + 1][:, None, :])] = np.inf
+    out: np.ndarray = r
+    return out
+
+
+def _clean_cells(t: np.ndarray, Q: np.ndarray, D: np.ndarray,
+                 cells: np.ndarray | None = None) -> np.ndarray:
+    """(c,) bool: every row of both nodes pairs unambiguously across the cell.
+
+    Per cell in ``cells`` (default: every cell).
+    """
+    c = np.arange(len(t) - 1) if cells is None else cells
+    E = _residuals(t, Q, D, c)
+    fa = np.isfinite(Q[c]).all(-1)  # (c, K)
+    fb = np.isfinite(Q[c + 1]).all(-1)
+    out = np.ones(len(E), bool)
+    for axis, rows in ((2, fa), (1, fb)):
+        s = np.sort(E, axis=axis)
+        best = np.take(s, 0, axis=axis)
+        second = np.take(s, 1, axis=axis) if s.shape[axis] > 1 else np.full_like(best, np.inf)
+        good = (best < _PAIR) & (second > 4 * best)
+        out &= np.all(good | ~rows, axis=1)
+    return out
+
+
+def _link(t: np.ndarray, Q: np.ndarray, D: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Tracks and their slopes (m, k, n) from rows per node (m, K, n): mutual best pairs."""
+    m, K, n = Q.shape
+    E = _residuals(t, Q, D)
+    nxt = np.argmin(E, axis=2)  # (m-1, K): row a's best partner at the next node
+    prv = np.argmin(E, axis=1)  # (m-1, K): row b's best partner at the previous node
+    cell = np.arange(m - 1)[:, None]
+    rows = np.arange(K)[None]
+    mutual = (np.take_along_axis(prv, nxt, axis=1) == rows) & (
+        np.take_along_axis(E, nxt[..., None], axis=2)[..., 0] < _LINK)
+    link = np.where(mutual, nxt, -1)  # (m-1, K)
+    has_prev = np.zeros((m, K), bool)
+    c, a = np.nonzero(link >= 0)
+    has_prev[c + 1, link[c, a]] = True
+    exists = np.isfinite(Q).all(-1)
+    link_l = link.tolist()
+    chains: list[list[tuple[int, int]]] = []
+    for i, r in zip(*np.nonzero(exists & ~has_prev), strict=True):
+        i, r = int(i), int(r)
+        chain = [(i, r)]
+        while i < m - 1 and link_l[i][r] >= 0:
+            i, r = i + 1, link_l[i][r]
+            chain.append((i, r))
+        chains.append(chain)
+    del cell, rows
+    # the longest _MAX_TRACKS (all but on a degenerate pose), ordered by their start
+    chains = sorted(sorted(chains, key=len, reverse=True)[:_MAX_TRACKS], key=lambda c: c[0])
+    if not chains:
+        empty = np.full((m, 1, n), np.nan)
+        return empty, empty.copy()
+    X = np.full((m, len(chains), n), np.nan)
+    S = np.full((m, len(chains), n), np.nan)
+    for b, chain in enumerate(chains):
+        ii = np.array([i for i, _ in chain])
+        rr = np.array([r for _, r in chain])
+        X[ii, b], S[ii, b] = Q[ii, rr], D[ii, rr]
+    return X, S
+
+
+def _assign(P: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """Each track's row (M, k, n): the solved row (M, K, n) nearest its prediction P.
+
+    Mutual nearest (2 pi wrapped, largest joint difference) within ``_ASSIGN``.
+    """
+    M, k, n = P.shape
+    out = np.full((M, k, n), np.nan)
+    if R.shape[1] == 0:
+        return out
+    fp, fr = np.isfinite(P).all(-1), np.isfinite(R).all(-1)  # (M, k), (M, K)
+    P0 = np.where(fp[..., None], P, 0.0)
+    R0 = np.where(fr[..., None], R, 0.0)  # (NaN arithmetic is slow)
+    d = np.abs(_wrap(P0[:, :, None] - R0[:, None])).max(-1)  # (M, k, K)
+    d[~(fp[:, :, None] & fr[:, None, :])] = np.inf
+    best_row = np.argmin(d, axis=2)  # (M, k)
+    best_track = np.argmin(d, axis=1)  # (M, K)
+    mi = np.arange(M)[:, None]
+    ok = (best_track[mi, best_row] == np.arange(k)[None]) & (
+        d[mi, np.arange(k)[None], best_row] < _ASSIGN)
+    m_i, b_i = np.nonzero(ok)
+    out[m_i, b_i] = R[m_i, best_row[m_i, b_i]]
+    return out
+
+
+def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray,
+                 values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Configurations (M, n) of pose T with joint ``joints[i]`` at ``values[i]``.
+
+    Newton steps from q0 (M, n) on the six other joints (the parameter among them:
+    t free); True where the pose is reached to ``_EXACT``.
+    """
+    M, n = q0.shape
+    q = q0.copy()
+    q[np.arange(M), joints] = values
+    free = np.ones((M, n), bool)
+    free[np.arange(M), joints] = False
+    idx = np.nonzero(free)[1].reshape(M, n - 1)
+    err = np.full(M, np.inf)
+    live = np.isfinite(q).all(-1)
+    for it in range(_NEWTON + 1):
+        live &= np.isfinite(q).all(-1) & (np.abs(q) < 1e3).all(-1)
+        rows = np.flatnonzero(live)
+        err[~live] = np.inf
+        if not rows.size:
+            break
+        J, Tq = jacobian_and_pose(robot.chain, q[rows])
+        e = pose_error(Tq, T)
+        err[rows] = np.maximum(np.linalg.norm(e[:, :3], axis=1),
+                               np.linalg.norm(e[:, 3:], axis=1))
+        act = err[rows] > 0.1 * _EXACT
+        if it == _NEWTON or not act.any():
+            break
+        A = np.take_along_axis(J, idx[rows][:, None, :], axis=2)[act]
+        good = np.abs(np.linalg.det(A)) > 1e-14
+        step = np.zeros((int(act.sum()), n - 1))
+        if good.any():
+            step[good] = np.linalg.solve(A[good], e[act][good][..., None])[..., 0]
+        moved = rows[act]
+        q[moved[:, None], idx[moved]] += step
+    ok = err <= _EXACT
+    return q, ok

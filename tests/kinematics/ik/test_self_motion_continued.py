@@ -1,0 +1,208 @@
+"""The continued self-motion family of general 7R arms (``self_motion_continued``).
+
+Arms: the iiwa14-type SRS arm with a 1 cm shoulder offset and a random general 7R
+DH arm (``reference.offset_iiwa14``, ``reference.random_7r``); joint 7 is the
+parameter (no held-joint closed form: the general held-joint 6R solver, continued).
+
+Oracles (independent of the continuation):
+* independent dense sampling: ``robot.ik(T, fixed={joint7: t})`` at 241 values gives
+  exactly the rows of ``sm.sample(t)`` (as sets, to 1e-9), and every independent
+  row inside the limits lies in an interval of the branch that holds it;
+* continuity: along 1,501 values each branch's rows move by at most 0.3 rad (2 pi
+  wrapped) between neighbours (a re-paired branch jumps by the distance between
+  two branches);
+* the generating configuration q0 of T = FK(q0) is on a branch at its own q7,
+  inside an interval of it when q0 is inside the limits (random and special
+  configurations);
+* at every limit crossing the branch's row has the joint at its limit to 1e-12 (or,
+  where the joint moves faster than t, t within 1e-12 of the crossing) and
+  reproduces the pose to 1e-12; every sampled row reproduces the pose to 1e-12.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from reference import offset_iiwa14, pose_errors, random_7r
+
+ARMS = {"offset_iiwa": offset_iiwa14(), "random7r": random_7r(29)}
+SPECIAL = (0.0, np.pi / 2, -np.pi / 2, np.pi, 1e-9, -1e-9)
+
+
+def _wrapped(a):
+    return np.abs((a + np.pi) % (2 * np.pi) - np.pi)
+
+
+def _configs(robot, seed, special):
+    rng = np.random.default_rng(seed)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    q = rng.uniform(0.9 * lo, 0.9 * hi, (3, 7))
+    if special:
+        pick = rng.random(q.shape) < 0.3
+        q = np.where(pick, np.clip(rng.choice(SPECIAL, q.shape), lo, hi), q)
+    return q
+
+
+def _manifold(robot, q0):
+    T = robot.fk(q0)
+    sm = robot.self_motion(T, parameter=robot.joint_names[-1])
+    assert sm.method.startswith("continued general 6R")
+    return T, sm
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+@pytest.mark.parametrize("special", [False, True])
+def test_generating_configuration_is_on_a_branch_inside_an_interval(arm, special):
+    # the continuation holds what the held-joint solver returns: q0 is checked where
+    # robot.ik(T, fixed={joint7: q0[6]}) returns it (the solver's own misses, at the
+    # elbow stretched, are counted by benchmarks/bench_self_motion_general.py)
+    robot = ARMS[arm]
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    checked = 0
+    for q0 in _configs(robot, 7, special):
+        T, sm = _manifold(robot, q0)
+        ref = robot.ik(T, fixed={robot.joint_names[-1]: float(q0[6])})
+        if not (_wrapped(ref.q[ref.valid] - q0).max(-1) < 1e-9).any():
+            continue
+        checked += 1
+        rows = sm.sample(q0[6])
+        d = _wrapped(rows - q0).max(-1)
+        assert np.nanmin(d) < 1e-9, (arm, q0)
+        if not np.all((q0 > lo + 1e-9) & (q0 < hi - 1e-9)):
+            continue  # at a limit: the interval may be the point itself
+        b = int(np.nanargmin(d))
+        inside = [(a, e) for (a, e), bb in zip(sm.intervals, sm.interval_branch, strict=True)
+                  if bb == b and a - 1e-12 <= q0[6] <= e + 1e-12]
+        assert inside, (arm, q0, sm.intervals)
+    assert checked >= 2
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_branches_are_continuous_and_rows_exact(arm):
+    robot = ARMS[arm]
+    q0 = _configs(robot, 3, False)[0]
+    T, sm = _manifold(robot, q0)
+    t = np.linspace(*sm.domain, 1501)
+    Q = sm.sample(t)  # (1501, k, 7)
+    step = _wrapped(np.diff(Q, axis=0)).max(-1)  # (1500, k)
+    assert np.nanmax(step) <= 0.3, np.nanmax(step)
+    ok = np.isfinite(Q).all(-1)
+    assert ok.any()
+    dp, dr = pose_errors(robot.fk(Q[ok]), T)
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_sample_matches_independent_held_solves(arm):
+    robot = ARMS[arm]
+    name = robot.joint_names[-1]
+    q0 = _configs(robot, 5, False)[1]
+    T, sm = _manifold(robot, q0)
+    t = np.linspace(*sm.domain, 241)
+    Q = sm.sample(t)
+    ends = sm.intervals.ravel()
+    for i, ti in enumerate(t):
+        ref = robot.ik(T, fixed={name: float(ti)})
+        R = ref.q[ref.valid]
+        S = Q[i][np.isfinite(Q[i]).all(-1)]
+        assert len(R) == len(S), (ti, len(R), len(S))
+        if not len(R):
+            continue
+        d = _wrapped(R[:, None] - S[None]).max(-1)  # (independent, sampled)
+        assert d.min(axis=1).max() < 1e-9 and d.min(axis=0).max() < 1e-9, ti
+        if np.min(np.abs(ends - ti)) < 1e-6:
+            continue
+        for r in R[np.all((robot.limits[:, 0] <= R) & (robot.limits[:, 1] >= R), -1)]:
+            b = int(np.nanargmin(_wrapped(Q[i] - r).max(-1)))
+            assert any(a <= ti <= e for (a, e), bb in zip(sm.intervals, sm.interval_branch,
+                                                           strict=True) if bb == b), (ti, b)
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_limit_crossings_are_exact(arm):
+    robot = ARMS[arm]
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    checked = 0
+    for q0 in _configs(robot, 11, False):
+        T, sm = _manifold(robot, q0)
+        for c in sm.crossings:
+            row = sm.sample(c.t)[c.branch]
+            assert np.isfinite(row).all(), c
+            limit = lo[c.joint] if c.limit == "lower" else hi[c.joint]
+            # the joint at its limit to 1e-12, or (next to a fold, where the row at a
+            # fixed t is ill-conditioned) t within 1e-12 of where it is: the joint's
+            # slope dq_j/dt by central differences along the branch
+            slope = np.diff(sm.sample(c.t + np.array([-1e-6, 1e-6]))[:, c.branch, c.joint])
+            scale = max(1.0, abs(float(slope[0])) / 2e-6) if np.isfinite(slope).all() else 1.0
+            assert abs(row[c.joint] - limit) <= 1e-12 * scale, (c, row[c.joint] - limit, scale)
+            dp, dr = pose_errors(robot.fk(row), T)
+            assert dp <= 1e-12 and dr <= 1e-12
+            checked += 1
+        # every interval end is a range end, a crossing or a fold
+        cuts = {round(x, 9) for x in sm.domain} | {round(c.t, 9) for c in sm.crossings} | {
+            round(s.t, 9) for s in sm.singular}
+        assert all(round(x, 9) in cuts for x in sm.intervals.ravel())
+    assert checked > 0
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_manifold_solves_a_bounded_number_of_values(arm):
+    # the work of one manifold: general-6R values solved, counted by a dispatch that
+    # wraps the real one (deterministic, not a timing). Before the continuation by
+    # slopes: 181 nodes + halvings + a 181-value grid + 56 bisection steps per branch
+    # end + the limit points (2,000-4,000 values); now the nodes, the halvings next to
+    # folds and the pieces' midpoints.
+    from robokin.kinematics.ik.dispatch import solve
+    from robokin.kinematics.ik.self_motion import self_motion
+
+    robot = ARMS[arm]
+    solved = []
+
+    def counting(reduced, T, **kw):
+        solved.append(int(np.prod(np.shape(T)[:-2])))
+        return solve(reduced, T, **kw)
+
+    q0 = _configs(robot, 3, False)[0]
+    sm = self_motion(robot.arm, robot.fk(q0), robot.joint_names[-1], dispatch=counting)
+    assert len(sm.intervals) and sum(solved) <= 4 * 181, sum(solved)
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_single_value_hot_path_equals_the_batched_solve(arm):
+    # robot.ik(T, fixed={joint7: x}) with a number takes the single-pose path
+    # (fixed._end_single); oracle: the batched path (an array of one value), row for
+    # row, with the same validity, limit flags, status and method
+    from robokin.kinematics.ik.dispatch import solve
+    from robokin.kinematics.ik.fixed import solve_fixed
+
+    robot = ARMS[arm]
+    name = robot.joint_names[-1]
+    q0 = _configs(robot, 5, False)[0]
+    T = robot.fk(q0)
+    for x in (float(q0[6]), 0.0, -1.0, 2.5, float(robot.limits[6, 1])):
+        a = robot.ik(T, fixed={name: x})
+        b = solve_fixed(robot.arm, T, {name: np.array([x])}, dispatch=solve)
+        assert a.method == b.method
+        np.testing.assert_array_equal(a.q, b.q[0])
+        np.testing.assert_array_equal(a.valid, b.valid[0])
+        np.testing.assert_array_equal(a.within_limits, b.within_limits[0])
+        assert a.status.item() == b.status[0]
+    rows = robot.ik(T, fixed={name: float(q0[6])})
+    assert (_wrapped(rows.q[rows.valid] - q0).max(-1) < 1e-9).any()
+
+
+def test_a_pose_at_the_reach_boundary_is_bounded_and_flagged():
+    # the offset iiwa stretched (q4 = 0) with q2 = pi/2, q6 = 0: the wrist point is
+    # at the shoulder's full reach for every q7, so every row is singular and no
+    # cell pairs. Oracle: the rows still reproduce the pose (general-6R solutions),
+    # the work is bounded (it doubled its nodes to 5,270 and ran out of memory,
+    # then took seconds bisecting folds) and info says the pose is degenerate.
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array([0.78, 1.571, 2.029, 0.0, -2.798, 0.0, 2.711])
+    T, sm = _manifold(robot, q0)
+    assert sm.info["degenerate"] and sm.info["solves"] <= 4 * 181
+    Q = sm.sample(np.linspace(*sm.domain, 25))
+    ok = np.isfinite(Q).all(-1)
+    dp, dr = pose_errors(robot.fk(Q[ok]), T)
+    assert ok.any() and dp.max() <= 1e-12 and dr.max() <= 1e-12
