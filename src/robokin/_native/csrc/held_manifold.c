@@ -264,8 +264,12 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
                 v3 p;
                 double J[6][6];
                 pk_fk(&g, th, &R, &p, J);
-                if (!pk_regular(J))
-                    return 0; /* pk_slide may move it */
+                if (!pk_regular(J)) { /* pk_slide's own test: a family to slide along */
+                    double sig[6], V[6][6];
+                    pk_svd6(J, sig, V);
+                    if (sig[0] <= PK_FAMILY_SIGMA * sig[5])
+                        return 0; /* pk_slide may move it */
+                }
             }
             r->valid[slot] = 1;
         }
