@@ -594,7 +594,34 @@ HELD_MANIFOLD = Group("held_manifold.c", kernels=(
                      "HM_", "HM_"),
     comment="held-joint manifold output sizes, point kinds and flags")
 
+NEAR_COINCIDENT = Group("near_coincident.c", kernels=(
+    Kernel("near_coincident", (
+        Packed(), Arr("T", "f64", POSE), Arr("H", "f64", ("M", "n")),
+        Arr("pose", "i64", ("M",), values=("0", "N - 1"), monotone=True),
+        Int("held", 0, 6), Int("a", 0, 6), Int("b", 0, 6), Float("sign", -1.0, 1.0),
+        Float("v0", -10.0, 10.0), Float("v", -10.0, 10.0), Float("accept", 0.0, 1.0),
+        Arr("Q", "f64", ("S", "n"), out=True), Arr("at", "i64", ("S",), out=True),
+        Arr("exact", "bool", ("S",), out=True), Arr("singular", "bool", ("S",), out=True),
+        Arr("slot", "i64", ("S",), out=True)),
+        "int", "The rows of a 7R arm with joint ``held`` at v next to v0 (axes a and b "
+               "nearly on one line), from the helper rows H (M, n) of poses ``pose`` (M,), "
+               "non-decreasing: seeds, Newton, moved into the limits, checked to ``accept`` "
+               "(m, rad), into Q (S, n) with their poses ``at``, ``exact``, ``singular`` "
+               "and ``slot`` (the row's place among its pose's solutions, -1: dropped); "
+               "returns the rows written (S >= NC_SEEDS * M).",
+        checks=(Check("a->packed.ident && n == NC_N",
+                      "the chain is not 7 independent joints"),
+                Check("a->held != a->a && a->held != a->b && a->a != a->b",
+                      "held, a and b must be three different joints"),
+                Check("a->sign == 1.0 || a->sign == -1.0", "sign must be 1.0 or -1.0"),
+                Check("S >= NC_SEEDS * M", "Q needs NC_SEEDS rows per helper row"))),
+), constants=tuple(Const(name, name, "float") for name in (
+    "NC_RCOND", "NC_FINAL_RCOND", "NC_MAX_STEP", "NC_CONVERGED", "NC_SAME", "NC_SAME_SEED",
+    "NC_SHIFT", "NC_FLAG", "NC_FAMILY_RANK")) + _consts(
+    "NC_STEPS NC_FINAL NC_PIN_STEPS NC_SPREAD NC_SEEDS NC_N"),
+    comment="near-coincident held joint: Newton and acceptance constants, seeds per row")
+
 GROUPS: tuple[Group, ...] = (FK, LM, SIX_R, PIEPER, GENERAL6R, BROADPHASE, PROCESS,
                              PLAN_CHECK, PLAN_RRTC, PLAN_PATH, SELF_MOTION, REACH,
-                             HELD_MANIFOLD)
+                             HELD_MANIFOLD, NEAR_COINCIDENT)
 OPTION_VECTORS: tuple[Opts, ...] = (LM_OPTS, RC_OPTS, SP_OPTS)

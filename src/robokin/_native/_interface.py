@@ -265,6 +265,22 @@ class Kernels(Protocol):
     HM_FLAG_VANISH: int
     HM_FLAG_MEMORY: int
     HM_FLAG_BAD: int
+    # near_coincident.c: near-coincident held joint: Newton and acceptance constants, seeds per row
+    NC_RCOND: float
+    NC_FINAL_RCOND: float
+    NC_MAX_STEP: float
+    NC_CONVERGED: float
+    NC_SAME: float
+    NC_SAME_SEED: float
+    NC_SHIFT: float
+    NC_FLAG: float
+    NC_FAMILY_RANK: float
+    NC_STEPS: int
+    NC_FINAL: int
+    NC_PIN_STEPS: int
+    NC_SPREAD: int
+    NC_SEEDS: int
+    NC_N: int
 
     def fk1(self, q: object, packed: object, /) -> F64 | None:
         """Pose (4, 4) of one configuration q (n,), or None for the general path."""
@@ -713,3 +729,25 @@ class Kernels(Protocol):
 
         aligned (A, 2): [joint, value] rows where a triple's outer axes line up; grid: values of t on the first grid.
         """
+
+    def near_coincident(
+        self,
+        packed: F64,
+        T: F64,
+        H: F64,
+        pose: I64,
+        held: int,
+        a: int,
+        b: int,
+        sign: float,
+        v0: float,
+        v: float,
+        accept: float,
+        Q: F64,
+        at: I64,
+        exact: Bools,
+        singular: Bools,
+        slot: I64,
+        /,
+    ) -> int:
+        """The rows of a 7R arm with joint ``held`` at v next to v0 (axes a and b nearly on one line), from the helper rows H (M, n) of poses ``pose`` (M,), non-decreasing: seeds, Newton, moved into the limits, checked to ``accept`` (m, rad), into Q (S, n) with their poses ``at``, ``exact``, ``singular`` and ``slot`` (the row's place among its pose's solutions, -1: dropped); returns the rows written (S >= NC_SEEDS * M)."""

@@ -179,3 +179,23 @@ def test_joint2_held_next_to_zero(v):
             assert same.min() <= 1e-6, q[i].tolist()
         assert (s.valid & s.within_limits).any(), q[i].tolist()
     assert all("near-coincident" in s.method for s in sets)
+
+
+@pytest.mark.parametrize("v", [1e-9, -1e-7, 1e-6, 1e-4, -1e-3])
+def test_joint2_next_to_zero_one_pose_path_is_the_batch_path(v):
+    # Oracle: robot.ik of one pose with a number held (fixed._near_single: both
+    # helper values in one compiled call, one set built) returns what the batch
+    # path (solve_fixed, _coincident_parts; poses (1, 4, 4)) returns for it, bit for
+    # bit: rows, masks, flags, status, method, the held value.
+    q = near_batch(12, np.random.default_rng(99), abs(v))
+    q[:, 1] = v
+    T = PANDA.fk(q)
+    for i in range(len(q)):
+        one = PANDA.ik(T[i], fixed={"joint2": v})
+        batch = PANDA.ik(T[i:i + 1], fixed={"joint2": v})
+        assert np.array_equal(one.q, batch.q[0], equal_nan=True)
+        for name in ("valid", "singular", "within_limits"):
+            assert np.array_equal(getattr(one, name), getattr(batch, name)[0]), name
+        assert one.status.shape == () and one.status.item() == batch.status[0]
+        assert one.method == batch.method and "near-coincident" in one.method
+        assert one.info["held"]["joint2"] == v

@@ -202,3 +202,82 @@ def test_an_island_narrower_than_a_grid_step_is_found(q, branch, island):
     assert any(mid < f < island[1] + 1e-5 for f in folds), folds
     own = sm.intervals[sm.interval_branch == branch]
     assert any(a < mid < e for a, e in own) == bool(sm.inside(mid)[branch])
+
+
+# Issue 29's slivers: the generating configuration with q6 exactly at its lower limit
+# and q5 at 0 or 1e-9 (axes 5 and 7 nearly in line). q6(t) has a maximum there within
+# rounding of the limit (6.5e-15 above it on the kernel's chain model, 1.0e-15 on the
+# URDF's: the model's own rounding, amplified). The kernel took it for a touch ([t, t],
+# dropped as zero width); now the branch is inside where q6 is within the 1e-12 slack
+# of every membership test (``SelfMotion.inside``) of its limit: 2 sqrt((excess +
+# 1e-12) / curvature) ~ 4.6e-6 of t, set by the slack rather than by rounding.
+GRAZES = [
+    [1.7217316091781831, -1.3075112735381205, 1.5463420696349144, -0.42217259885444136,
+     0.0, -0.0175, 0.8040005531116772],
+    [-2.097425653853579, -1.150327788043209, -1.2555078385110725, -0.18474875681191394,
+     1e-09, -0.0175, -1.9409137899448736],
+]
+
+
+def _exact_crossing(sm, q0: np.ndarray, joint: int, value: float) -> float:
+    """The t where the manifold's ``joint`` is exactly at ``value``, near q0 (40 digits).
+
+    Oracle: the kernel's own chain (its parameter vector: axes, points, tool; the
+    product of exponentials) and pose, solved by mpmath's Newton for the six other
+    coordinates with ``joint`` held; independent of the kernel's arithmetic.
+    """
+    mp = pytest.importorskip("mpmath")
+    mp.mp.dps = 40
+    P, T = np.asarray(sm._family.params), np.asarray(sm._family.T)  # the kernel's inputs
+    axes = [mp.matrix(P[8 + 3 * i:11 + 3 * i].tolist()) for i in range(7)]
+    points = [mp.matrix(P[29 + 3 * i:32 + 3 * i].tolist()) for i in range(7)]
+    RM, tM = mp.matrix(P[50:59].reshape(3, 3).tolist()), mp.matrix(P[59:62].tolist())
+    sign, offset = P[62:69], P[69:76]
+    TR, Tp = mp.matrix(T[:3, :3].tolist()), mp.matrix(T[:3, 3].tolist())
+
+    def residual(*x):
+        z = list(x)
+        z.insert(joint, mp.mpf(value))
+        A, t = mp.eye(3), mp.matrix([0, 0, 0])
+        for i in range(7):
+            h, th = axes[i], sign[i] * z[i] + offset[i]
+            K = mp.matrix([[0, -h[2], h[1]], [h[2], 0, -h[0]], [-h[1], h[0], 0]])
+            R = mp.cos(th) * mp.eye(3) + mp.sin(th) * K + (1 - mp.cos(th)) * (h * h.T)
+            t, A = t + A * (points[i] - R * points[i]), A * R
+        p, E = A * tM + t, TR * (A * RM).T
+        return [p[0] - Tp[0], p[1] - Tp[1], p[2] - Tp[2],
+                E[2, 1] - E[1, 2], E[0, 2] - E[2, 0], E[1, 0] - E[0, 1]]
+
+    start = [mp.mpf(v) for i, v in enumerate(q0) if i != joint]
+    x = mp.findroot(residual, start, tol=mp.mpf(10) ** -60, maxsteps=60)
+    return float(x[5])  # q7, the parameter
+
+
+@pytest.mark.parametrize("q", GRAZES, ids=["q5=0", "q5=1e-9"])
+def test_a_branch_grazing_a_limit_keeps_its_in_limit_stretch(q):
+    q = np.array(q)
+    band = LIMITS[5, 0] - 1e-12  # q6's limit with the membership tests' slack
+    T = PANDA.fk(q)
+    sm = PANDA.self_motion(T)
+    assert sm.info.get("compiled")
+    # the crossings' starts: the held-q6 closed form there (its own rounding is
+    # ~1e-8 in t this close to the fold), then 40 digits on the kernel's model
+    held = np.asarray(PANDA.ik(T, fixed={"joint6": band}).q).reshape(-1, 7)
+    near = held[np.abs(held[:, 6] - q[6]) < 1e-4]
+    near = near[np.argsort(near[:, 6])][[0, -1]]
+    ends = sorted(_exact_crossing(sm, s, 5, band) for s in near)
+    assert 1e-6 < ends[1] - ends[0] < 1e-4 and ends[0] < q[6] < ends[1], ends
+    rows = sm.sample(q[6])
+    on = [b for b in range(sm.n_branches) if np.allclose(rows[b], q, atol=1e-6)]
+    assert on  # the generating configuration's branches (two slots meet at q5 = 0)
+    t = np.linspace(ends[0] - 2e-6, ends[1] + 2e-6, 2001)
+    truth = sm.inside(t)  # the held-q7 rows with the 1e-12 slack: the dense oracle
+    for b in on:
+        own = [(a, e) for a, e in sm.intervals[sm.interval_branch == b] if a <= q[6] <= e]
+        assert len(own) == 1, (b, own)
+        # the kernel's ends: the exact crossings (the old kernel gave [t0, t0])
+        assert abs(own[0][0] - ends[0]) <= 1e-9 and abs(own[0][1] - ends[1]) <= 1e-9, (
+            b, own, ends)
+        inside = (t >= own[0][0]) & (t <= own[0][1])
+        clear = (np.abs(t - own[0][0]) > 1e-7) & (np.abs(t - own[0][1]) > 1e-7)
+        assert np.array_equal(inside[clear], truth[clear, b]), b

@@ -51,6 +51,7 @@
 #define HM_FOLD_STEPS 6 /* rows between a branch end and its grid row */
 #define HM_PARALLEL_MIN 8
 #define HM_DECIDE 1e-9 /* a grid row this far inside / outside decides its piece [rad] */
+#define HM_MAXG 8 /* grazes (a branch inside a limit by under HM_TOL) per slot */
 
 enum { HM_KIND_LOWER = 0, HM_KIND_UPPER = 1, HM_KIND_ALIGNED = 2, HM_KIND_FOLD = 3 };
 enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FLAG_FULL = 8,
@@ -80,7 +81,41 @@ typedef struct {
     long fold_cell[8][HM_MAXF];
     double fold_t[8][HM_MAXF];
     int nfold[8];
+    double graze_t[8][HM_MAXG][2]; /* a graze's in-limit stretch */
+    int graze_j[8][HM_MAXG], ngraze[8];
 } HmCtx;
+
+/* Gaussian elimination with partial pivoting of M (6 x 6 | right-hand side) into x;
+ * 0 when a pivot is below 1e-14 (singular to rounding). */
+static int hm_solve6(double M[6][7], double x[6])
+{
+    for (int i = 0; i < 6; i++) {
+        int piv = i;
+        for (int r = i + 1; r < 6; r++)
+            if (fabs(M[r][i]) > fabs(M[piv][i]))
+                piv = r;
+        if (!(fabs(M[piv][i]) > 1e-14))
+            return 0;
+        if (piv != i)
+            for (int m = i; m < 7; m++) {
+                double s = M[i][m];
+                M[i][m] = M[piv][m];
+                M[piv][m] = s;
+            }
+        for (int r = i + 1; r < 6; r++) {
+            double f = M[r][i] / M[i][i];
+            for (int m = i; m < 7; m++)
+                M[r][m] -= f * M[i][m];
+        }
+    }
+    for (int i = 5; i >= 0; i--) {
+        double s = M[i][6];
+        for (int m = i + 1; m < 6; m++)
+            s -= M[i][m] * x[m];
+        x[i] = s / M[i][i];
+    }
+    return 1;
+}
 
 /* The slopes dq/dt (n) of configuration q (n) along the manifold (held joint k at
  * slope 1): the full chain's spatial Jacobian columns [h x (p - o) / scale; h],
@@ -121,34 +156,11 @@ static void hm_slopes(const double *P, int n, int k, const double *q, double *dq
             M[r][i] = C[col[i]][r];
         M[r][6] = -C[k][r];
     }
-    for (int i = 0; i < 6; i++) {
-        int piv = i;
-        for (int r = i + 1; r < 6; r++)
-            if (fabs(M[r][i]) > fabs(M[piv][i]))
-                piv = r;
-        if (!(fabs(M[piv][i]) > 1e-14)) {
-            for (int j = 0; j < n; j++)
-                dq[j] = NAN;
-            return;
-        }
-        if (piv != i)
-            for (int m = i; m < 7; m++) {
-                double s = M[i][m];
-                M[i][m] = M[piv][m];
-                M[piv][m] = s;
-            }
-        for (int r = i + 1; r < 6; r++) {
-            double f = M[r][i] / M[i][i];
-            for (int m = i; m < 7; m++)
-                M[r][m] -= f * M[i][m];
-        }
-    }
     double x[6];
-    for (int i = 5; i >= 0; i--) {
-        double s = M[i][6];
-        for (int m = i + 1; m < 6; m++)
-            s -= M[i][m] * x[m];
-        x[i] = s / M[i][i];
+    if (!hm_solve6(M, x)) {
+        for (int j = 0; j < n; j++)
+            dq[j] = NAN;
+        return;
     }
     for (int i = 0; i < 6; i++)
         dq[col[i]] = x[i];
@@ -527,6 +539,147 @@ static void hm_node(HmCtx *c, int b, const HmRow *r)
             hm_point(c, r->t, b, c->qj[qi], c->qkind[qi]);
 }
 
+/* Joint j of configuration q (n) polished against the pose T: one Newton step whose
+ * pose residual is computed in long double (the six other joints' Jacobian in
+ * double). pk_one's rows are exact to ~1e-14 only, too coarse where a branch grazes
+ * a limit: its in-limit stretch is 2 sqrt(excess / curvature) wide, and 7e-15 of
+ * rounding in the excess moved its ends by 1.4e-7 (issue 29's slivers). */
+static double hm_polished(const HmCtx *c, const double *q, int j)
+{
+    const double *P = c->P, *T = c->T;
+    long double A[3][3] = {{1.0L, 0.0L, 0.0L}, {0.0L, 1.0L, 0.0L}, {0.0L, 0.0L, 1.0L}};
+    long double t[3] = {0.0L, 0.0L, 0.0L}, hc[PK_MAXJ][3], oc[PK_MAXJ][3];
+    for (int i = 0; i < c->n; i++) {
+        const double *h = P + PK_AXES + 3 * i, *o = P + PK_POINTS + 3 * i;
+        long double th = (long double)P[PK_SIGN + i] * q[i] + P[PK_OFFSET + i];
+        long double cs = cosl(th), sn = sinl(th), v = 1.0L - cs, R[3][3], Ro[3], An[3][3];
+        for (int r = 0; r < 3; r++)
+            for (int m = 0; m < 3; m++)
+                R[r][m] = (long double)h[r] * h[m] * v + (r == m ? cs : 0.0L);
+        R[0][1] -= h[2] * sn, R[0][2] += h[1] * sn, R[1][0] += h[2] * sn;
+        R[1][2] -= h[0] * sn, R[2][0] -= h[1] * sn, R[2][1] += h[0] * sn;
+        for (int r = 0; r < 3; r++) {
+            Ro[r] = o[r] - (R[r][0] * o[0] + R[r][1] * o[1] + R[r][2] * o[2]);
+            hc[i][r] = A[r][0] * h[0] + A[r][1] * h[1] + A[r][2] * h[2];
+            oc[i][r] = A[r][0] * o[0] + A[r][1] * o[1] + A[r][2] * o[2] + t[r];
+        }
+        for (int r = 0; r < 3; r++) {
+            t[r] += A[r][0] * Ro[0] + A[r][1] * Ro[1] + A[r][2] * Ro[2];
+            for (int m = 0; m < 3; m++)
+                An[r][m] = A[r][0] * R[0][m] + A[r][1] * R[1][m] + A[r][2] * R[2][m];
+        }
+        memcpy(A, An, sizeof(A));
+    }
+    /* the pose A M + t against T: position error and the small rotation w with
+     * R_T = exp([w]) R (the skew part of R_T R^T) */
+    long double R[3][3], p[3], E[3][3];
+    const double *RM = P + PK_TOOL_R, *tM = P + PK_TOOL_T;
+    for (int r = 0; r < 3; r++) {
+        p[r] = A[r][0] * tM[0] + A[r][1] * tM[1] + A[r][2] * tM[2] + t[r];
+        for (int m = 0; m < 3; m++)
+            R[r][m] = A[r][0] * RM[m] + A[r][1] * RM[3 + m] + A[r][2] * RM[6 + m];
+    }
+    for (int r = 0; r < 3; r++)
+        for (int m = 0; m < 3; m++)
+            E[r][m] = T[4 * r] * R[m][0] + T[4 * r + 1] * R[m][1] + T[4 * r + 2] * R[m][2];
+    double scale = P[PK_SCALE], rhs[6] = {
+        (double)((T[3] - p[0]) / scale), (double)((T[7] - p[1]) / scale),
+        (double)((T[11] - p[2]) / scale), (double)(0.5L * (E[2][1] - E[1][2])),
+        (double)(0.5L * (E[0][2] - E[2][0])), (double)(0.5L * (E[1][0] - E[0][1]))};
+    double M[6][7], x[6];
+    int col[6], m = 0;
+    for (int i = 0; i < c->n && m < 6; i++)
+        if (i != c->k)
+            col[m++] = i;
+    for (int i = 0; i < 6; i++) {
+        int a = col[i];
+        long double d[3] = {p[0] - oc[a][0], p[1] - oc[a][1], p[2] - oc[a][2]};
+        double sg = P[PK_SIGN + a];
+        M[0][i] = (double)((hc[a][1] * d[2] - hc[a][2] * d[1]) * sg / scale);
+        M[1][i] = (double)((hc[a][2] * d[0] - hc[a][0] * d[2]) * sg / scale);
+        M[2][i] = (double)((hc[a][0] * d[1] - hc[a][1] * d[0]) * sg / scale);
+        for (int r = 0; r < 3; r++)
+            M[3 + r][i] = (double)(hc[a][r] * sg);
+    }
+    for (int r = 0; r < 6; r++)
+        M[r][6] = rhs[r];
+    if (j == c->k || !hm_solve6(M, x))
+        return q[j];
+    for (int i = 0; i < 6; i++)
+        if (col[i] == j)
+            return q[j] + x[i];
+    return q[j];
+}
+
+/* The t between an extremum tm and a cell end te where joint j of slot b is at v
+ * (q_j - v is fm at tm, of the other sign at te, where its slope is de): Newton on
+ * the polished joint from the parabola's estimate (curvature |de| / 2|te - tm|),
+ * safeguarded by bisection of the bracket. */
+static double hm_graze_root(HmCtx *c, int b, int j, double v, double tm, double fm, double te,
+                            double de)
+{
+    double a = tm, e = te, kappa = fabs(de) / (2.0 * fabs(te - tm));
+    double t = tm + copysign(sqrt(fabs(fm) / kappa), te - tm), best = t, best_f = HUGE_VAL;
+    HmRow r;
+    for (int it = 0; it < 60; it++) {
+        if (!((t - a) * (t - e) < 0.0) || !isfinite(t))
+            t = 0.5 * (a + e);
+        hm_eval(c, t, 1u << b, &r);
+        if (!r.valid[b]) {
+            c->flags |= HM_FLAG_VANISH;
+            return best;
+        }
+        double f = wrap_pi(hm_polished(c, r.q[b], j) - v), step = f / r.dq[b][j];
+        if (fabs(f) < best_f) {
+            best_f = fabs(f);
+            best = t;
+        }
+        if (f == 0.0)
+            break;
+        if ((f < 0) == (fm < 0))
+            a = t;
+        else
+            e = t;
+        if (!(fabs(a - e) > 2.0 * DBL_EPSILON * fabs(t)) || fabs(step) <= DBL_EPSILON * fabs(t))
+            break;
+        t -= step;
+    }
+    if (!(best_f <= HM_TOL))
+        c->flags |= HM_FLAG_CONVERGE;
+    return best;
+}
+
+/* An extremum m of joint j (query qi, slot b) within HM_TOL of a limit, reached
+ * from outside: a branch grazing the limit. Inside is taken with the slack every
+ * membership test has (HM_TOL, as hm_inside's [t, t] and SelfMotion.inside): the
+ * branch is inside where the polished joint (hm_polished: the double row is only
+ * exact to ~1e-14) is within HM_TOL of its limit, a stretch of 2 sqrt((excess +
+ * HM_TOL) / curvature) in t, whose two ends are crossings (points, cuts) and which
+ * hm_intervals decides with the same slack. The stretch's width is then set by
+ * the slack, not by rounding (at the limit itself it would be 2 sqrt(excess /
+ * curvature): 3.7e-7 from an excess of 6.5e-15 that the model's own rounding
+ * moves). A dip from inside by less than HM_TOL is not a gap, as before; an
+ * aligned-axes value touched is one point. */
+static void hm_graze(HmCtx *c, int b, int qi, const HmRow *r0, const HmRow *m, const HmRow *r1)
+{
+    int j = c->qj[qi], g = c->ngraze[b], kind = c->qkind[qi];
+    double in = kind == HM_KIND_LOWER ? 1.0 : -1.0; /* the inside's sign of q_j - limit */
+    double v = c->qv[qi] - in * HM_TOL, f0 = hm_f(c, r0, b, qi);
+    double fm = wrap_pi(hm_polished(c, m->q[b], j) - v);
+    if (kind == HM_KIND_ALIGNED || f0 * in > 0.0 || !(fm * in > 0.0) || g >= HM_MAXG) {
+        hm_point(c, m->t, b, j, kind);
+        return;
+    }
+    double lo = hm_graze_root(c, b, j, v, m->t, fm, r0->t, r0->dq[b][j]);
+    double hi = hm_graze_root(c, b, j, v, m->t, fm, r1->t, r1->dq[b][j]);
+    hm_point(c, lo, b, j, kind);
+    hm_point(c, hi, b, j, kind);
+    c->graze_t[b][g][0] = lo;
+    c->graze_t[b][g][1] = hi;
+    c->graze_j[b][g] = j;
+    c->ngraze[b]++;
+}
+
 static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
 {
     if (hm_needs_split(c, b, r0, r1)) {
@@ -565,7 +718,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
             continue;
         double fm = f0 + wrap_pi(m.q[b][j] - r0->q[b][j]);
         if (fabs(fm) <= HM_TOL) {
-            hm_point(c, m.t, b, j, c->qkind[qi]); /* touches the value */
+            hm_graze(c, b, qi, r0, &m, r1); /* touches the value, or grazes a limit */
         } else if ((fm < 0) != (f0 < 0)) {
             hm_root(c, b, qi, r0->t, f0, m.t, fm);
             hm_root(c, b, qi, m.t, fm, r1->t, f1);
@@ -753,6 +906,24 @@ static int hm_decides(const HmCtx *c, const HmRow *r, int b, unsigned char *good
     return 1;
 }
 
+/* Whether the piece (a, e) of slot b lies in a graze's stretch (hm_graze): then
+ * decided by the row at its middle with the grazing joint polished, inside to
+ * HM_TOL, into *good. */
+static int hm_grazed(HmCtx *c, int b, double a, double e, unsigned char *good)
+{
+    for (int g = 0; g < c->ngraze[b]; g++) {
+        if (!(a >= c->graze_t[b][g][0] && e <= c->graze_t[b][g][1]))
+            continue;
+        HmRow r;
+        hm_eval(c, 0.5 * (a + e), 0u, &r);
+        if (r.valid[b])
+            r.q[b][c->graze_j[b][g]] = hm_polished(c, r.q[b], c->graze_j[b][g]);
+        *good = (unsigned char)hm_inside(c, &r, b, HM_TOL);
+        return 1;
+    }
+    return 0;
+}
+
 static void hm_intervals(HmCtx *c, int b, double lo, double hi, const HmRow *rows, long G,
                          double *iv, long long *niv)
 {
@@ -781,6 +952,8 @@ static void hm_intervals(HmCtx *c, int b, double lo, double hi, const HmRow *row
         long best = -1;
         while (g < G && rows[g].t <= cut[i])
             g++;
+        if (hm_grazed(c, b, cut[i], cut[i + 1], &good[i]))
+            continue;
         for (long h = g; h < G && rows[h].t < cut[i + 1]; h++)
             if (best < 0 || fabs(rows[h].t - mid) < fabs(rows[best].t - mid))
                 best = h;
@@ -989,6 +1162,7 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
         c->nfold[b] = 0;
     for (int b = 0; b < 8; b++) {
         c->ncut[b] = 0;
+        c->ngraze[b] = 0;
         for (long i = 0; i < G; i++) {
             if (rows[i].valid[b])
                 hm_node(c, b, &rows[i]);

@@ -97,7 +97,8 @@ static const KOpt opts_sp_ranges[] = {{SP_VERTEX_TRIES, 1, 1, 0.0, 1000000000000
     X(swivel_manifold, "swivel_manifold(params, T, iv, niv, pts, npts) -> None: Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,).") \
     X(swivel_near, "swivel_near(params, T, q_near, q, psi, slot, dist, found) -> None: Per pose: the in-limit configuration nearest q_near (N, 7) (2 pi wrapped distance) on the exact swivel intervals: q (N, 7), its psi, slot and distance (N,); found (N,) false (q NaN) where no part is inside.") \
     X(six_r_reach, "six_r_reach(params, T, packed, with_w, counts, best) -> None: A reach map's 6R closed form in one pass, T (G voxels, K targets each).") \
-    X(held_manifold, "held_manifold(params, T, aligned, grid, iv, niv, pts, npts, flags, evals) -> None: Per pose of a held-joint Pieper family (the Panda's q7): the intervals inside every limit per slot (N, 8, HM_MAXI, 2) with counts (N, 8); points [t, branch, joint, kind] (N, HM_MAXP, 4) with counts (N,); flags (N,) (0: certain, else the solved-points path is needed) and pk_one calls (N,).")
+    X(held_manifold, "held_manifold(params, T, aligned, grid, iv, niv, pts, npts, flags, evals) -> None: Per pose of a held-joint Pieper family (the Panda's q7): the intervals inside every limit per slot (N, 8, HM_MAXI, 2) with counts (N, 8); points [t, branch, joint, kind] (N, HM_MAXP, 4) with counts (N,); flags (N,) (0: certain, else the solved-points path is needed) and pk_one calls (N,).") \
+    X(near_coincident, "near_coincident(packed, T, H, pose, held, a, b, sign, v0, v, accept, Q, at, exact, singular, slot) -> int: The rows of a 7R arm with joint ``held`` at v next to v0 (axes a and b nearly on one line), from the helper rows H (M, n) of poses ``pose`` (M,), non-decreasing: seeds, Newton, moved into the limits, checked to ``accept`` (m, rad), into Q (S, n) with their poses ``at``, ``exact``, ``singular`` and ``slot`` (the row's place among its pose's solutions, -1: dropped); returns the rows written (S >= NC_SEEDS * M).")
 
 /* per kernel, the checked arguments and the bound shape symbols (a->N) */
 typedef struct { PyObject *q; PyObject *packed; } fk1_args; /* fk.c / module.c */
@@ -151,6 +152,7 @@ typedef struct { const double *params; const double *T; double *iv; long long *n
 typedef struct { const double *params; const double *T; const double *q_near; double *q; double *psi; long long *slot; double *dist; npy_bool *found; union { struct { npy_intp N; }; npy_intp sym[1]; }; } swivel_near_args; /* self_motion.c */
 typedef struct { const double *params; const double *T; Chain packed; int with_w; unsigned char *counts; double *best; union { struct { npy_intp G, K, n, nc; }; npy_intp sym[4]; }; } six_r_reach_args; /* reach.c */
 typedef struct { const double *params; const double *T; const double *aligned; long grid; double *iv; long long *niv; double *pts; long long *npts; long long *flags; long long *evals; union { struct { npy_intp N, A; }; npy_intp sym[2]; }; } held_manifold_args; /* held_manifold.c */
+typedef struct { Chain packed; const double *T; const double *H; const long long *pose; long held; long a; long b; double sign; double v0; double v; double accept; double *Q; long long *at; npy_bool *exact; npy_bool *singular; long long *slot; union { struct { npy_intp n, nc, N, M, S; }; npy_intp sym[5]; }; } near_coincident_args; /* near_coincident.c */
 
 KERNELS(KERNEL_BODY)
 

@@ -77,6 +77,8 @@ KERNEL_CHECK(six_r_reach, !(six_r_params_ok(a->params)) ? "params is not a 6R pa
 static const KSpec six_r_reach_spec = {"six_r_reach", "six_r_reach(params, T, packed, with_w, counts, best)", 6, (const KArg[]){KA_ARRAY(six_r_reach, params, 0, 0x0, NPY_DOUBLE, "(SR_N_PARAMS)", {-1, SR_N_PARAMS}), KA_ARRAY(six_r_reach, T, 0, 0x3, NPY_DOUBLE, "(G, K, 4, 4)", {0, 0}, {1, 0}, {-1, 4}, {-1, 4}), KA_ROW(six_r_reach, packed, KA_PACKED, .binds = 0x3, .dim = {{2, 0}, {3, 0}}), KA_PLAIN(six_r_reach, with_w, KA_FLAG), KA_ARRAY(six_r_reach, counts, 1, 0x0, NPY_UINT8, "(G, K)", {0, 0}, {1, 0}), KA_ARRAY(six_r_reach, best, 1, 0x0, NPY_DOUBLE, "(G)", {0, 0})}, offsetof(six_r_reach_args, sym), 0x33, 0x0, six_r_reach_check};
 KERNEL_CHECK(held_manifold, !(pk_params_ok(a->params)) ? "params is not a Pieper parameter vector" : NULL)
 static const KSpec held_manifold_spec = {"held_manifold", "held_manifold(params, T, aligned, grid, iv, niv, pts, npts, flags, evals)", 10, (const KArg[]){KA_ARRAY(held_manifold, params, 0, 0x0, NPY_DOUBLE, "(PK_N_PARAMS)", {-1, PK_N_PARAMS}), KA_ARRAY(held_manifold, T, 0, 0x1, NPY_DOUBLE, "(N, 4, 4)", {0, 0}, {-1, 4}, {-1, 4}), KA_ARRAY(held_manifold, aligned, 0, 0x1, NPY_DOUBLE, "(A, 2)", {1, 0}, {-1, 2}), KA_ROW(held_manifold, grid, KA_INT, .lo = 3LL, .hi = 100000ULL), KA_ARRAY(held_manifold, iv, 1, 0x0, NPY_DOUBLE, "(N, 8, HM_MAXI, 2)", {0, 0}, {-1, 8}, {-1, HM_MAXI}, {-1, 2}), KA_ARRAY(held_manifold, niv, 1, 0x0, NPY_INT64, "(N, 8)", {0, 0}, {-1, 8}), KA_ARRAY(held_manifold, pts, 1, 0x0, NPY_DOUBLE, "(N, HM_MAXP, 4)", {0, 0}, {-1, HM_MAXP}, {-1, 4}), KA_ARRAY(held_manifold, npts, 1, 0x0, NPY_INT64, "(N)", {0, 0}), KA_ARRAY(held_manifold, flags, 1, 0x0, NPY_INT64, "(N)", {0, 0}), KA_ARRAY(held_manifold, evals, 1, 0x0, NPY_INT64, "(N)", {0, 0})}, offsetof(held_manifold_args, sym), 0x3f7, 0x0, held_manifold_check};
+KERNEL_CHECK(near_coincident, !(a->packed.ident && a->n == NC_N) ? "the chain is not 7 independent joints" : !(a->held != a->a && a->held != a->b && a->a != a->b) ? "held, a and b must be three different joints" : !(a->sign == 1.0 || a->sign == -1.0) ? "sign must be 1.0 or -1.0" : !(a->S >= NC_SEEDS * a->M) ? "Q needs NC_SEEDS rows per helper row" : NULL)
+static const KSpec near_coincident_spec = {"near_coincident", "near_coincident(packed, T, H, pose, held, a, b, sign, v0, v, accept, Q, at, exact, singular, slot)", 16, (const KArg[]){KA_ROW(near_coincident, packed, KA_PACKED, .binds = 0x3, .dim = {{0, 0}, {1, 0}}), KA_ARRAY(near_coincident, T, 0, 0x1, NPY_DOUBLE, "(N, 4, 4)", {2, 0}, {-1, 4}, {-1, 4}), KA_ARRAY(near_coincident, H, 0, 0x1, NPY_DOUBLE, "(M, n)", {3, 0}, {0, 0}), KA_INDEX(near_coincident, pose, 0, 0x0, "[0, N - 1] or decreasing", 1, -1, 0, 2, -(1), "(M)", {3, 0}), KA_ROW(near_coincident, held, KA_INT, .lo = 0LL, .hi = 6ULL), KA_ROW(near_coincident, a, KA_INT, .lo = 0LL, .hi = 6ULL), KA_ROW(near_coincident, b, KA_INT, .lo = 0LL, .hi = 6ULL), KA_ROW(near_coincident, sign, KA_FLOAT, .flo = -1.0, .fhi = 1.0), KA_ROW(near_coincident, v0, KA_FLOAT, .flo = -10.0, .fhi = 10.0), KA_ROW(near_coincident, v, KA_FLOAT, .flo = -10.0, .fhi = 10.0), KA_ROW(near_coincident, accept, KA_FLOAT, .flo = 0.0, .fhi = 1.0), KA_ARRAY(near_coincident, Q, 1, 0x1, NPY_DOUBLE, "(S, n)", {4, 0}, {0, 0}), KA_ARRAY(near_coincident, at, 1, 0x0, NPY_INT64, "(S)", {4, 0}), KA_ARRAY(near_coincident, exact, 1, 0x0, NPY_BOOL, "(S)", {4, 0}), KA_ARRAY(near_coincident, singular, 1, 0x0, NPY_BOOL, "(S)", {4, 0}), KA_ARRAY(near_coincident, slot, 1, 0x0, NPY_INT64, "(S)", {4, 0})}, offsetof(near_coincident_args, sym), 0xf80e, 0x8, near_coincident_check};
 
 KERNELS(KERNEL_ENTRY)
 
@@ -305,6 +307,12 @@ static int add_constants(PyObject *m)
         {"HM_FLAG_VANISH", (long)(HM_FLAG_VANISH)},
         {"HM_FLAG_MEMORY", (long)(HM_FLAG_MEMORY)},
         {"HM_FLAG_BAD", (long)(HM_FLAG_BAD)},
+        {"NC_STEPS", (long)(NC_STEPS)},
+        {"NC_FINAL", (long)(NC_FINAL)},
+        {"NC_PIN_STEPS", (long)(NC_PIN_STEPS)},
+        {"NC_SPREAD", (long)(NC_SPREAD)},
+        {"NC_SEEDS", (long)(NC_SEEDS)},
+        {"NC_N", (long)(NC_N)},
     };
     const struct { const char *name; double value; } floats[] = {
         {"MAX_TRANSLATION", (double)(MAX_TRANSLATION)},
@@ -313,6 +321,15 @@ static int add_constants(PyObject *m)
         {"PR_LIMIT_TOL", (double)(PR_LIMIT_TOL)},
         {"PC_EPS", (double)(PC_EPS)},
         {"SM_TAG_VALUE", (double)(SM_TAG_VALUE)},
+        {"NC_RCOND", (double)(NC_RCOND)},
+        {"NC_FINAL_RCOND", (double)(NC_FINAL_RCOND)},
+        {"NC_MAX_STEP", (double)(NC_MAX_STEP)},
+        {"NC_CONVERGED", (double)(NC_CONVERGED)},
+        {"NC_SAME", (double)(NC_SAME)},
+        {"NC_SAME_SEED", (double)(NC_SAME_SEED)},
+        {"NC_SHIFT", (double)(NC_SHIFT)},
+        {"NC_FLAG", (double)(NC_FLAG)},
+        {"NC_FAMILY_RANK", (double)(NC_FAMILY_RANK)},
     };
     for (size_t i = 0; i < sizeof(ints) / sizeof(ints[0]); i++)
         if (PyModule_AddIntConstant(m, ints[i].name, ints[i].value) < 0)

@@ -39,6 +39,7 @@
 #include "process.c"
 #include "self_motion.c"
 #include "held_manifold.c"
+#include "near_coincident.c" /* after pieper.c: linalg6.h */
 #include "reach.c"
 
 #define F64(a) ((double *)PyArray_DATA(a))

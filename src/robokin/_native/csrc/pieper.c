@@ -102,6 +102,9 @@ enum { PK_OK = 0, PK_OUT_OF_REACH = 1, PK_NO_ORIENTATION = 2, PK_DEGENERATE = 5,
 #define PK_CLAMP_SLACK 1e-10 /* pk_inside: joints out by at most this [rad] are not clamped */
 #define PK_FAMILY_SIGMA 1e-9  /* Jacobian's smallest / largest singular value below it: a family */
 #define PK_SP4_SLACK 1e-13     /* |C| - hypot(A, B) / scale below it: a double root (rounding) */
+#define PK_SLOW 1e-6           /* polished candidates this far off the pose: pk_polish_slow */
+#define PK_SLOW_ITERS 40       /* its most Newton steps */
+#define PK_PIN_LINE 1e-6       /* pk_pin_split: Jacobian columns equal to this, joints in line */
 
 /* ------------------------------------------------------------ geometry */
 
@@ -918,101 +921,19 @@ static int pk_accept(const PkGeo *g, const m3 *RT, v3 pT, const double *trial, d
     return 1;
 }
 
-/* The least-squares step J dx = e of a 6 x 6 Jacobian (rows J[r][.]): Householder
- * QR with column pivoting, columns whose pivot falls below 1e-10 of the first
- * left out (a singular configuration: no step along its near-null directions). */
-static void pk_lstsq(double J[6][6], const double *e, double *dx)
-{
-    double A[6][6], b[6], norms[6];
-    int perm[6], rank = 0;
-    for (int r = 0; r < 6; r++) {
-        b[r] = e[r];
-        for (int c = 0; c < 6; c++)
-            A[r][c] = J[r][c];
-    }
-    for (int c = 0; c < 6; c++) {
-        perm[c] = c;
-        double s = 0.0;
-        for (int r = 0; r < 6; r++)
-            s += A[r][c] * A[r][c];
-        norms[c] = s;
-    }
-    double first = 0.0;
-    for (int k = 0; k < 6; k++) {
-        int best = k; /* pivot: the remaining column of largest norm */
-        for (int c = k + 1; c < 6; c++)
-            if (norms[c] > norms[best])
-                best = c;
-        if (best != k) {
-            for (int r = 0; r < 6; r++) {
-                double t = A[r][k];
-                A[r][k] = A[r][best];
-                A[r][best] = t;
-            }
-            double t = norms[k];
-            norms[k] = norms[best];
-            norms[best] = t;
-            int ti = perm[k];
-            perm[k] = perm[best];
-            perm[best] = ti;
-        }
-        double nx = 0.0;
-        for (int r = k; r < 6; r++)
-            nx += A[r][k] * A[r][k];
-        nx = sqrt(nx);
-        if (k == 0)
-            first = nx;
-        if (!(nx > 1e-10 * first))
-            break;
-        double alpha = A[k][k] > 0.0 ? -nx : nx, v[6];
-        for (int r = 0; r < 6; r++)
-            v[r] = r < k ? 0.0 : A[r][k];
-        v[k] -= alpha;
-        double vv = 0.0;
-        for (int r = k; r < 6; r++)
-            vv += v[r] * v[r];
-        if (vv > 0.0) {
-            for (int c = k; c < 6; c++) {
-                double d = 0.0;
-                for (int r = k; r < 6; r++)
-                    d += v[r] * A[r][c];
-                d *= 2.0 / vv;
-                for (int r = k; r < 6; r++)
-                    A[r][c] -= d * v[r];
-            }
-            double d = 0.0;
-            for (int r = k; r < 6; r++)
-                d += v[r] * b[r];
-            d *= 2.0 / vv;
-            for (int r = k; r < 6; r++)
-                b[r] -= d * v[r];
-        }
-        for (int c = k + 1; c < 6; c++)
-            norms[c] -= A[k][c] * A[k][c];
-        rank = k + 1;
-    }
-    double y[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-    for (int r = rank - 1; r >= 0; r--) {
-        double s = b[r];
-        for (int c = r + 1; c < rank; c++)
-            s -= A[r][c] * y[c];
-        y[r] = s / A[r][r];
-    }
-    for (int c = 0; c < 6; c++)
-        dx[perm[c]] = y[c];
-}
+#include "linalg6.h" /* pk_lstsq, pk_svd6 */
 
-/* Newton steps on the remaining chain's angles (least squares, pk_lstsq; kept only
- * while they reduce the error), the joints in `frozen` (bit j: angle j) held;
- * returns the final error (pk_error) */
-static double pk_polish_held(const PkGeo *g, const m3 *RT, v3 pT, double *th, unsigned frozen)
+/* Newton steps (pk_polish_held) up to `iters`; with `twice`, each step the better
+ * of Newton's and twice it (pk_polish_slow) */
+static double pk_newton(const PkGeo *g, const m3 *RT, v3 pT, double *th, unsigned frozen,
+                        int iters, int twice)
 {
     m3 R;
     v3 p;
     double J[6][6], e[6];
     pk_fk(g, th, &R, &p, J);
     double err = pk_error(RT, pT, &R, p, g->scale, e);
-    for (int it = 0; it < 6 && err > 1e-16; it++) {
+    for (int it = 0; it < iters && err > 1e-16; it++) {
         double dx[6], trial[6], big = 0.0;
         for (int j = 0; j < 6; j++)
             if (frozen >> j & 1u)
@@ -1032,6 +953,25 @@ static double pk_polish_held(const PkGeo *g, const m3 *RT, v3 pT, double *th, un
         double J2[6][6], e2[6];
         pk_fk(g, trial, &R2, &p2, J2);
         double err2 = pk_error(RT, pT, &R2, p2, g->scale, e2);
+        if (twice && 2.0 * big < 0.1) {
+            /* the doubled step: at a double root (a singular solution, where the
+             * error is quadratic along the null direction) Newton only halves the
+             * distance; twice its step lands on the root to first order */
+            double trial2[6], J3[6][6], e3[6];
+            for (int j = 0; j < 6; j++)
+                trial2[j] = wrap_pi(th[j] + 2.0 * dx[j]);
+            pk_fk(g, trial2, &R2, &p2, J3);
+            double err3 = pk_error(RT, pT, &R2, p2, g->scale, e3);
+            if (err3 < err2) {
+                err2 = err3;
+                for (int j = 0; j < 6; j++) {
+                    trial[j] = trial2[j];
+                    e2[j] = e3[j];
+                    for (int r = 0; r < 6; r++)
+                        J2[r][j] = J3[r][j];
+                }
+            }
+        }
 #ifdef PK_DEBUG
         fprintf(stderr, "    polish it %d frozen %x err %.3e -> %.3e big %.3e\n", it, frozen, err, err2, big);
 #endif
@@ -1048,9 +988,31 @@ static double pk_polish_held(const PkGeo *g, const m3 *RT, v3 pT, double *th, un
     return err;
 }
 
+/* Newton steps on the remaining chain's angles (least squares, pk_lstsq; kept only
+ * while they reduce the error), the joints in `frozen` (bit j: angle j) held;
+ * returns the final error (pk_error) */
+static double pk_polish_held(const PkGeo *g, const m3 *RT, v3 pT, double *th, unsigned frozen)
+{
+    return pk_newton(g, RT, pT, th, frozen, 6, 0);
+}
+
 static double pk_polish(const PkGeo *g, const m3 *RT, v3 pT, double *th)
 {
     return pk_polish_held(g, RT, pT, th, 0u);
+}
+
+/* A candidate the polish left above PK_ACCEPT but within PK_SLOW of the pose
+ * (next to a doubly singular configuration, e.g. both triples of the Panda with q6
+ * held next to aligned: the position step's double root rounded to one angle and
+ * the triple's outer angles taken at sv ~ 1e-11 start the polish 1e-5 off, where
+ * Newton converges only linearly, by 4x a step): up to PK_SLOW_ITERS more steps,
+ * each the better of Newton's step and twice it. Returns the final error; the
+ * caller still keeps the row only at PK_ACCEPT. */
+static double pk_polish_slow(const PkGeo *g, const m3 *RT, v3 pT, double *th, double err)
+{
+    if (!(err > PK_ACCEPT && err <= PK_SLOW))
+        return err;
+    return pk_newton(g, RT, pT, th, 0u, PK_SLOW_ITERS, 1);
 }
 
 /* ------------------------------------------------------------- one pose */
@@ -1230,69 +1192,6 @@ static int pk_inside(const double *P, const PkGeo *g, const m3 *RT, v3 pT, doubl
     if (!(pk_coords(P, g, trial, -1, 0.0, q) >= -1e-9))
         return 0;
     return pk_accept(g, RT, pT, trial, th);
-}
-
-/* The singular values (ascending) and right singular vectors (columns of V) of a
- * 6 x 6 matrix A (destroyed): one-sided Jacobi (Hestenes), which keeps small
- * singular values accurate relative to the columns (A^T A would square them into
- * rounding). */
-static void pk_svd6(double A[6][6], double *sig, double V[6][6])
-{
-    for (int i = 0; i < 6; i++)
-        for (int j = 0; j < 6; j++)
-            V[i][j] = i == j ? 1.0 : 0.0;
-    for (int sweep = 0; sweep < 30; sweep++) {
-        int rotated = 0;
-        for (int p = 0; p < 5; p++)
-            for (int q = p + 1; q < 6; q++) {
-                double a = 0.0, b = 0.0, c = 0.0;
-                for (int r = 0; r < 6; r++) {
-                    a += A[r][p] * A[r][p];
-                    b += A[r][q] * A[r][q];
-                    c += A[r][p] * A[r][q];
-                }
-                if (!(fabs(c) > 1e-15 * sqrt(a * b)))
-                    continue;
-                rotated = 1;
-                double z = 0.5 * (b - a) / c;
-                double t = copysign(1.0, z) / (fabs(z) + sqrt(z * z + 1.0));
-                double cs = 1.0 / sqrt(t * t + 1.0), sn = t * cs;
-                for (int r = 0; r < 6; r++) {
-                    double x = A[r][p], y = A[r][q];
-                    A[r][p] = cs * x - sn * y;
-                    A[r][q] = sn * x + cs * y;
-                    x = V[r][p];
-                    y = V[r][q];
-                    V[r][p] = cs * x - sn * y;
-                    V[r][q] = sn * x + cs * y;
-                }
-            }
-        if (!rotated)
-            break;
-    }
-    double nrm[6];
-    int idx[6] = {0, 1, 2, 3, 4, 5};
-    for (int c = 0; c < 6; c++) {
-        double sum = 0.0;
-        for (int r = 0; r < 6; r++)
-            sum += A[r][c] * A[r][c];
-        nrm[c] = sqrt(sum);
-    }
-    for (int i = 1; i < 6; i++)
-        for (int j = i; j > 0 && nrm[idx[j]] < nrm[idx[j - 1]]; j--) {
-            int t = idx[j];
-            idx[j] = idx[j - 1];
-            idx[j - 1] = t;
-        }
-    double Vs[6][6];
-    for (int c = 0; c < 6; c++) {
-        sig[c] = nrm[idx[c]];
-        for (int r = 0; r < 6; r++)
-            Vs[r][c] = V[r][idx[c]];
-    }
-    for (int r = 0; r < 6; r++)
-        for (int c = 0; c < 6; c++)
-            V[r][c] = Vs[r][c];
 }
 
 /* How far joint coordinate q lies outside [lo, hi] at its nearest turn (0 inside),
@@ -1725,13 +1624,57 @@ static double pk_gauss_newton(const PkGeo *g, const m3 *RT, v3 pT, double *th, u
     return err;
 }
 
+/* pk_pin's move for joint j of trial outside by more than PK_NUDGE (the row's own
+ * flip, or where a round's Gauss-Newton took it): where its axis lies in line with
+ * a free joint i's (their remaining Jacobian columns equal up to the sign sigma, to
+ * PK_PIN_LINE, so that only th_i + sigma th_j is fixed to first order: the SRS
+ * arm's joints 3, 5, 7 with q4 and q6 next to 0), the split of that sum put inside
+ * both limits (pk_split, nearest j's present value) instead of clamping j; the
+ * next round's Gauss-Newton brings the pose back. Returns 1 when trial changed. */
+static int pk_pin_split(const double *P, const PkGeo *g, double *trial, int j,
+                        unsigned frozen)
+{
+    m3 R;
+    v3 p;
+    double J[6][6];
+    pk_fk(g, trial, &R, &p, J);
+    for (int i = 0; i < 6; i++) {
+        if (i == j || (frozen >> i & 1u))
+            continue;
+        double dot = J[3][i] * J[3][j] + J[4][i] * J[4][j] + J[5][i] * J[5][j];
+        double sigma = dot >= 0.0 ? 1.0 : -1.0, diff = 0.0;
+        for (int r = 0; r < 6; r++)
+            diff = fmax(diff, fabs(J[r][i] - sigma * J[r][j]));
+        if (!(diff < PK_PIN_LINE))
+            continue;
+        int fi = g->full[i], fj = g->full[j];
+        double phi = trial[i] + sigma * trial[j], t2[6], o[6];
+        double qj = wrap_pi(P[PK_SIGN + fj] * (trial[j] - P[PK_OFFSET + fj]));
+        for (int m = 0; m < 6; m++)
+            t2[m] = trial[m];
+        t2[j] = pk_split(P, fi, fj, phi, sigma, qj);
+        t2[i] = wrap_pi(phi - sigma * t2[j]);
+        pk_excess(P, g, t2, o);
+        if (o[i] > 0.0 || o[j] > 0.0)
+            continue; /* no split of this pair inside both limits */
+        for (int m = 0; m < 6; m++)
+            trial[m] = t2[m];
+        return 1;
+    }
+    return 0;
+}
+
 /* The other last resort (after pk_walk): a row th just outside the limits whose
  * joints outside the family does not move, or that lies on no exact family but on
  * a thin set of near-solutions (singular values of 1e-10 to 1e-8): clamp the joints
  * outside to the limit they passed, hold them, and Gauss-Newton the others back to
  * the pose (pk_gauss_newton: it may move them radians); up to three rounds, as a
- * joint may leave its limits on the way. Tried for rows at most PK_NUDGE outside;
- * kept when every joint ends inside and the pose holds to PK_ACCEPT: returns 1
+ * joint may leave its limits on the way. A joint outside by more than PK_NUDGE
+ * (a whole flip, q + pi, or where a round's Gauss-Newton took it) is moved by its
+ * split with a joint in line (pk_pin_split) when it has one; otherwise the row is
+ * not tried (round 0) or the joint clamped (later rounds). A round ending between
+ * PK_ACCEPT and PK_SLOW gets pk_polish_slow's steps (the clamped joints held).
+ * Kept when every joint ends inside and the pose holds to PK_ACCEPT: returns 1
  * when th changed. */
 static int pk_pin(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
 {
@@ -1739,14 +1682,18 @@ static int pk_pin(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *
     unsigned frozen = 0u;
     for (int j = 0; j < 6; j++)
         trial[j] = th[j];
-    if (!(pk_excess(P, g, trial, o) <= PK_NUDGE))
-        return 0;
     for (int round = 0; round < 3; round++) {
         int moved = 0;
         pk_excess(P, g, trial, o);
         for (int j = 0; j < 6; j++) {
             if (!(o[j] > 0.0) || (frozen >> j & 1u))
                 continue;
+            if (o[j] > PK_NUDGE && pk_pin_split(P, g, trial, j, frozen)) {
+                moved = 1;
+                continue;
+            }
+            if (round == 0 && o[j] > PK_NUDGE)
+                return 0; /* the row itself: only joints a thin set's width out are clamped */
             int f = g->full[j];
             double sg = P[PK_SIGN + f], off = P[PK_OFFSET + f], lim;
             pk_outside(wrap_pi(sg * (trial[j] - off)), P[PK_LO + f], P[PK_HI + f], &lim);
@@ -1757,6 +1704,8 @@ static int pk_pin(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *
         if (!moved)
             break;
         double err = pk_gauss_newton(g, RT, pT, trial, frozen);
+        if (err > PK_ACCEPT && err <= PK_SLOW)
+            err = pk_newton(g, RT, pT, trial, frozen, PK_SLOW_ITERS, 1);
 #ifdef PK_DEBUG
         fprintf(stderr, "   pin round %d frozen %x err %.3e excess %.3e\n", round, frozen, err, pk_excess(P, g, trial, o));
 #endif
@@ -1896,7 +1845,7 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
                 /* check against the pose; Newton-polish when not exact */
                 double err = pk_error_of(&g, &RT, pT, th);
                 if (err > PK_EXACT)
-                    err = pk_polish(&g, &RT, pT, th);
+                    err = pk_polish_slow(&g, &RT, pT, th, pk_polish(&g, &RT, pT, th));
 #ifdef PK_DEBUG
                 fprintf(stderr, "    check slot %d err %.3e th %.17g %.17g %.17g\n", 2 * pos.slot[i] + k, err, th[0], th[1], th[2]);
 #endif

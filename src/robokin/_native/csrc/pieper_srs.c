@@ -38,6 +38,7 @@
 /* Included by pieper.c, inside its floating-point rules (no fused multiply-adds). */
 
 #define PS_REACH 1e-13 /* a held angle this far [rad] past the end of its swivel range: at the end */
+#define PS_REACH_WIDE 1e-8 /* the same when no row came out at PS_REACH (pk_srs) */
 
 static inline m3 ps_transpose(const m3 *A)
 {
@@ -126,6 +127,7 @@ static void pk_known(const double *P, const PkTri *k, const m3 *R, int which, do
 typedef struct {
     v3 h[7], u;
     m3 R0, R0R4, G, R4T;
+    double reach; /* ps_roots' slack past the range ends: PS_REACH (PS_REACH_WIDE in pk_srs's retry) */
 } PsArm;
 
 /* Joint j (0-2 shoulder, 4-6 wrist) at chain angle L as one condition on the
@@ -206,7 +208,7 @@ static double ps_angle_newton(v3 hv, v3 u, v3 pv, double alpha, double t)
  * pi (two remaining axes next to coincident, the arm next to full stretch) keep
  * every digit (a cosine alone loses half of them); Newton-polished on the angle.
  * *dbl: a double root or two within 1e-7 rad (alpha at an end of the range, or
- * past it by at most PS_REACH: rounding, a pose error that small); *flat:
+ * past it by at most a->reach: rounding, a pose error that small); *flat:
  * the whole range within 1e-13 rad of alpha (the joint does not move with the
  * swivel: a family). */
 static void ps_roots(const PsArm *a, int j, double L, double *t, int *n, int *dbl, int *flat,
@@ -225,7 +227,7 @@ static void ps_roots(const PsArm *a, int j, double L, double *t, int *n, int *db
 #ifdef PK_DEBUG
     fprintf(stderr, " roots j %d alpha %.9e range %.9e %.9e gh %.3e gp %.3e\n", j, alpha, amin, amax, gh, gp);
 #endif
-    if (*flat || alpha < amin - PS_REACH || alpha > amax + PS_REACH)
+    if (*flat || alpha < amin - a->reach || alpha > amax + a->reach)
         return;
     double k = sin(gh) * sin(gp);
     double hav = sin(0.5 * (alpha - gh + gp)) * sin(0.5 * (alpha + gh - gp)) / k;
@@ -309,7 +311,7 @@ static int ps_finish(const double *P, const PkGeo *g, const m3 *RT, v3 pT, const
             th[r++] = th7[j];
     double err = pk_error_of(g, RT, pT, th);
     if (err > PK_EXACT)
-        err = pk_polish(g, RT, pT, th);
+        err = pk_polish_slow(g, RT, pT, th, pk_polish(g, RT, pT, th));
 #ifdef PK_DEBUG
     fprintf(stderr, "  finish slot %d err %.3e th %.12g %.12g %.12g %.12g %.12g %.12g\n", slot, err, th[0], th[1], th[2], th[3], th[4], th[5]);
 #endif
@@ -389,6 +391,7 @@ static int ps_arm(const double *P, v3 S, v3 Wp, v3 w, const m3 *G, double th4, d
     a->R0R4 = pk_mul(&a->R0, &R4);
     a->R4T = ps_transpose(&R4);
     a->G = *G;
+    a->reach = PS_REACH;
     return 1;
 }
 
@@ -604,9 +607,15 @@ static void ps_band_family(const double *P, const PkGeo *g, const m3 *RT, v3 pT,
     }
 }
 
-/* Every solution of an SRS arm with joint `held` at x (the module comment). */
-static int pk_srs(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double x,
-                  const double *qn, PkOut o)
+/* Every solution of an SRS arm with joint `held` at x (the module comment), the
+ * held joint's swivel roots taken up to `reach` past the ends of its range.
+ * Where none came out at PS_REACH, again at PS_REACH_WIDE: the held value at an
+ * end of its range (a double root, e.g. the shoulder's middle joint held at 0:
+ * axes 1 and 3 in line) is missed by rounding when the elbow, next to stretched,
+ * carries errors ~ 1e-16 / sin(elbow) into the cone angles (1.9e-13 rad past the
+ * end at q4 = -2.9e-3); the rows found are polished and checked as any other. */
+static int pk_srs_reach(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double x,
+                        const double *qn, double reach, PkOut o)
 {
     int held = (int)P[PK_HELD];
     double scale = g->scale;
@@ -651,6 +660,7 @@ static int pk_srs(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double x
             degenerate = 1;
             continue;
         }
+        a.reach = reach;
         int nr = 0, dblr = 0, flat = held == 3;
         if (!flat)
             ps_roots(&a, held, tk, tr, &nr, &dblr, &flat, &sg);
@@ -676,4 +686,18 @@ static int pk_srs(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double x
         if (o.valid[slot])
             return PK_OK;
     return degenerate ? PK_DEGENERATE : PK_NO_ORIENTATION;
+}
+
+/* Every solution of an SRS arm with joint `held` at x: pk_srs_reach at PS_REACH,
+ * and again at PS_REACH_WIDE when that gave no row (not for the held elbow, whose
+ * swivel is a family: no held joint's roots to widen). */
+static int pk_srs(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double x,
+                  const double *qn, PkOut o)
+{
+    int code = pk_srs_reach(P, g, RT, pT, x, qn, PS_REACH, o);
+    if (code == PK_NO_ORIENTATION && (int)P[PK_HELD] != 3) {
+        pk_clear(o);
+        code = pk_srs_reach(P, g, RT, pT, x, qn, PS_REACH_WIDE, o);
+    }
+    return code;
 }
