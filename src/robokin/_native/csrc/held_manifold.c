@@ -624,7 +624,7 @@ static double hm_graze_root(HmCtx *c, int b, int j, double v, double tm, double 
     for (int it = 0; it < 60; it++) {
         if (!((t - a) * (t - e) < 0.0) || !isfinite(t))
             t = 0.5 * (a + e);
-        hm_eval(c, t, 1u << b, &r);
+        hm_eval(c, t, 1u << b, 1u << b, &r);
         if (!r.valid[b]) {
             c->flags |= HM_FLAG_VANISH;
             return best;
@@ -915,7 +915,7 @@ static int hm_grazed(HmCtx *c, int b, double a, double e, unsigned char *good)
         if (!(a >= c->graze_t[b][g][0] && e <= c->graze_t[b][g][1]))
             continue;
         HmRow r;
-        hm_eval(c, 0.5 * (a + e), 0u, &r);
+        hm_eval(c, 0.5 * (a + e), 0u, 1u << b, &r);
         if (r.valid[b])
             r.q[b][c->graze_j[b][g]] = hm_polished(c, r.q[b], c->graze_j[b][g]);
         *good = (unsigned char)hm_inside(c, &r, b, HM_TOL);
