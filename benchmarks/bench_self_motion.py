@@ -249,7 +249,7 @@ def held_kernel_rows(robot, T, repeat):
     ref = cpu_and_wall(lambda: [self_motion(robot.arm, t, dispatch=solve, reference=True)
                                 for t in T], 1)
     print(f"{'panda':11s} held_manifold kernel, one batch: {us([x / N for x in kern])} per pose "
-          f"({solves:.0f} closed-form solves per pose, {flagged} of {N} flagged to the "
+          f"({solves:.0f} full pk_one solves per pose, {flagged} of {N} flagged to the "
           f"solved-points path); solved points (reference=True) {us([x / N for x in ref])}")
 
 

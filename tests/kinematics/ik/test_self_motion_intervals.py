@@ -164,6 +164,20 @@ def test_compiled_manifold_agrees_with_rows_and_solved_points(special):
     assert compiled >= POSES * 3 // 4
 
 
+def test_compiled_manifold_calls_the_full_solver_only_where_it_may_differ():
+    # hm_closed: the closed form alone wherever pk_one would return it unchanged, so
+    # pk_one ("solves") runs at a few t values per pose (~70 on 1,150 poses; the
+    # whole search made ~750 before); the oracle for the answer is the held-q7 rows
+    # at 20,000 values (_check_dense) and the ends at their limits (_check_ends)
+    for q in _configurations(4, False, 2029):
+        T = PANDA.fk(q)
+        sm = PANDA.self_motion(T)
+        assert sm.info.get("compiled") and sm.info["flags"] == 0
+        assert 0 <= sm.info["solves"] < 300, sm.info["solves"]
+        _check_dense(sm)
+        _check_ends(PANDA, T, sm)
+
+
 # Found by the comparison (1,000 random poses): islands of a branch (born and dying
 # between two folds) narrower than the solved-points path's 721-value grid step.
 ISLANDS = [

@@ -23,6 +23,12 @@
  *   4. per slot, the pieces between domain ends, limit crossings and folds are
  *      decided at their midpoints (a row inside every limit) and joined.
  *
+ * Every row is pk_one's: hm_closed evaluates its closed form alone (the slots
+ * asked for, no polish, repairs or walks) and hands over to pk_one at the t
+ * values where pk_one would do more (a row singular, not exact, or outside the
+ * limits where a repair may move it): 67-71 full solves per pose instead of
+ * ~750, the same rows bit for bit (HM_VERIFY: 0 differences on 1,150 poses).
+ *
  * A pose is flagged (flags != 0: the caller takes the solved-points path) when a
  * row next to an aligned triple is met (pk_one flags it singular: q1, q3 swing
  * there), a cell cannot be resolved within HM_DEPTH splits, a crossing does not
@@ -67,7 +73,7 @@ typedef struct {
     int nq, qj[HM_MAXQ], qkind[HM_MAXQ];
     double qv[HM_MAXQ];
     int flags;
-    long evals;
+    long evals, cheap;
     double *pts;
     long npts;
     double cut[8][HM_MAXCUT];
@@ -161,16 +167,163 @@ static void hm_slopes(const double *P, int n, int k, const double *q, double *dq
     dq[k] = 1.0;
 }
 
-/* Every slot at t (pk_one), shifted into the limits by whole turns where that fits
- * (as the numpy path's _into_limits); slopes for the slots in `mask`. */
-static void hm_eval(HmCtx *c, double t, unsigned mask, HmRow *r)
+/* The slots in `need` at held value x by pk_one's closed form alone (its position
+ * roots, theta_b, the triple, the coordinates: the same calls in the same order,
+ * without its polish, repairs and walks), into r (the other slots invalid).
+ * Returns 1 when these are pk_one's rows for those slots, 0 when pk_one must
+ * decide: the position is not of the coplanar kind, or a needed row is flagged
+ * singular, needs its pose check or polish (pk_triple's check, theta_b's residual
+ * not exact), or lies outside the limits where pk_one's repairs may move it
+ * (within PK_NUDGE of them: pk_inside; not isolated: pk_slide). A regular row
+ * inside the limits, or outside by more than PK_NUDGE and isolated, is returned
+ * by pk_one unchanged whatever the other slots are. */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC push_options
+#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
+#endif
+/* How far chain angles th (remaining chain) lie outside the limits, each joint at
+ * its turn nearest them (as pk_inside measures it) [rad]: the largest. */
+static double hm_outside(const double *P, const PkGeo *g, const double *th)
+{
+    double worst = 0.0;
+    for (int j = 0; j < 6; j++) {
+        int f = g->full[j];
+        double lo = P[PK_LO + f], hi = P[PK_HI + f];
+        double q = wrap_pi(P[PK_SIGN + f] * (th[j] - P[PK_OFFSET + f])), gap = INFINITY;
+        for (int m = -1; m <= 1; m++) {
+            double qm = q + 2.0 * M_PI * m;
+            gap = fmin(gap, qm < lo ? lo - qm : qm > hi ? qm - hi : 0.0);
+        }
+        worst = fmax(worst, gap);
+    }
+    return worst;
+}
+
+static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
+{
+    const double *P = c->P, *T = c->T;
+    PkGeo g;
+    pk_geometry(P, x, &g);
+    for (int b = 0; b < 8; b++) {
+        r->valid[b] = r->sing[b] = 0;
+        for (int j = 0; j < PK_MAXJ; j++)
+            r->q[b][j] = NAN;
+    }
+    if (g.kase != PK_START)
+        return 0;
+    int held = (int)P[PK_HELD];
+    double stol = P[PK_SING_TOL];
+    m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
+    v3 pT = {T[3], T[7], T[11]};
+    m3 G = pk_mul_t(&RT, &g.RM);
+    const int ia = 3, it = 0;
+    PkEq e;
+    pk_pose_equations(&g, &RT, pT, &G, &e);
+    PkPos pos;
+    pos.n = 0;
+    int code;
+    double pref_a = P[PK_SIGN + g.full[ia]] * c->qn[g.full[ia]] + P[PK_OFFSET + g.full[ia]];
+    double pref_c = P[PK_SIGN + g.full[ia + 2]] * c->qn[g.full[ia + 2]] +
+                    P[PK_OFFSET + g.full[ia + 2]];
+    if (fabs(e.mbc) <= PK_COPLANAR)
+        code = pk_coplanar(&e, 0, pref_a, pref_c, &pos);
+    else if (fabs(e.mab) <= PK_COPLANAR)
+        code = pk_coplanar(&e, 1, pref_a, pref_c, &pos);
+    else
+        return 0; /* He and Liu's general case: not this kernel's */
+    if (code != PK_OK)
+        return 1; /* pk_one: cleared, no row */
+    int held_in = pk_held_inside(P, held, x);
+    int jx = g.full[it], jz = g.full[it + 2];
+    PkTri tri;
+    pk_tri_init(&tri, g.h[it], g.h[it + 1], g.h[it + 2]);
+    double exact_p = PK_EXACT * fmax(1.0, g.scale);
+    for (int i = 0; i < pos.n; i++) {
+        unsigned slots = 3u << (2 * pos.slot[i]);
+        if (!(need & slots) || !(pos.res[i] < 1e-6 * g.scale))
+            continue;
+        if (pos.sing[i])
+            return 0;
+        double th[6];
+        m3 Rp = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+        for (int j = 0; j < 3; j++) {
+            th[ia + j] = pos.t[i][j];
+            m3 Rj = pk_rotm(g.h[ia + j], pos.c[i][j], pos.s[i][j]);
+            Rp = pk_mul(&Rp, &Rj);
+        }
+        m3 Rt = pk_mul_t(&G, &Rp);
+        PkTrip tr;
+        pk_triple(P, &tri, &Rt, jx, jz, c->qn[jz], stol, &tr);
+        for (int k = 0; k < tr.n; k++) {
+            int slot = 2 * pos.slot[i] + k;
+            if (!(need >> slot & 1u))
+                continue;
+            if (tr.sing[k])
+                return 0;
+            for (int j = 0; j < 3; j++) {
+                th[ia + j] = pos.t[i][j];
+                th[it + j] = tr.t[k][j];
+            }
+            /* pk_one's check: kept unchanged when exact, else polished */
+            if ((tr.check[k] || !(pos.res[i] < exact_p)) &&
+                !(pk_error_of(&g, &RT, pT, th) <= PK_EXACT))
+                return 0;
+            double m = pk_coords(P, &g, th, held, x, r->q[slot]);
+            if (!(m >= -1e-9) && held_in && !(hm_outside(P, &g, th) > 2.0 * PK_NUDGE))
+                return 0; /* pk_inside (or, next to an aligned triple, pk_resplit) may move it */
+            if (!(m >= -1e-9) && held_in && !pk_isolated(&g, th)) {
+                m3 R;
+                v3 p;
+                double J[6][6];
+                pk_fk(&g, th, &R, &p, J);
+                if (!pk_regular(J)) { /* pk_slide's own test: a family to slide along */
+                    double sig[6], V[6][6];
+                    pk_svd6(J, sig, V);
+                    if (sig[0] <= PK_FAMILY_SIGMA * sig[5])
+                        return 0; /* pk_slide may move it */
+                }
+            }
+            r->valid[slot] = 1;
+        }
+    }
+    return 1;
+}
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC pop_options
+#endif
+
+/* The slots in `need` at t (hm_closed, else pk_one's every slot), shifted into the
+ * limits by whole turns where that fits (as the numpy path's _into_limits); slopes
+ * for the slots in `mask`. */
+static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
 {
     const double *P = c->P;
-    unsigned char inside[8];
-    PkOut o = {&r->q[0][0], r->valid, r->sing, inside, PK_MAXJ};
     r->t = t;
-    c->evals++;
-    pk_one(P, c->T, t, c->qn, o);
+    c->cheap++;
+    if (!hm_closed(c, t, need, r)) {
+        unsigned char inside[8];
+        PkOut o = {&r->q[0][0], r->valid, r->sing, inside, PK_MAXJ};
+        c->evals++;
+        pk_one(P, c->T, t, c->qn, o);
+    }
+#ifdef HM_VERIFY
+    else { /* a checking build (-DHM_VERIFY): every closed-form row against pk_one's */
+        double Q[8][PK_MAXJ];
+        unsigned char v[8], sg[8], in[8];
+        PkOut o = {&Q[0][0], v, sg, in, PK_MAXJ};
+        pk_one(P, c->T, t, c->qn, o);
+        for (int b = 0; b < 8; b++) {
+            if (!(need >> b & 1u))
+                continue;
+            int bad = v[b] != r->valid[b];
+            for (int j = 0; j < c->n && v[b] && !bad; j++)
+                bad = Q[b][j] != r->q[b][j];
+            if (bad)
+                fprintf(stderr, "mismatch t %.17g slot %d valid %d/%d q0 %.17g/%.17g\n", t, b,
+                        v[b], r->valid[b], Q[b][0], r->q[b][0]);
+        }
+    }
+#endif
     for (int b = 0; b < 8; b++) {
         if (!r->valid[b])
             continue;
@@ -186,6 +339,7 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, HmRow *r)
             hm_slopes(P, c->n, c->k, r->q[b], r->dq[b]);
     }
 }
+
 
 static void hm_point(HmCtx *c, double t, int b, int j, int kind)
 {
@@ -224,7 +378,7 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
     int side = 0;
     HmRow r;
     for (int it = 0; it < 80; it++) {
-        hm_eval(c, t, 1u << b, &r);
+        hm_eval(c, t, 1u << b, 1u << b, &r);
         if (!r.valid[b]) {
             c->flags |= HM_FLAG_VANISH;
             return;
@@ -280,7 +434,7 @@ static void hm_extremum(HmCtx *c, int b, int j, double a, double da, double e, d
         t = a - da * (e - a) / (de - da);
         if (!(t > a && t < e))
             t = 0.5 * (a + e);
-        hm_eval(c, t, 1u << b, out);
+        hm_eval(c, t, 1u << b, 1u << b, out);
         if (!out->valid[b]) {
             c->flags |= HM_FLAG_VANISH;
             return;
@@ -470,7 +624,7 @@ static double hm_graze_root(HmCtx *c, int b, int j, double v, double tm, double 
     for (int it = 0; it < 60; it++) {
         if (!((t - a) * (t - e) < 0.0) || !isfinite(t))
             t = 0.5 * (a + e);
-        hm_eval(c, t, 1u << b, &r);
+        hm_eval(c, t, 1u << b, 1u << b, &r);
         if (!r.valid[b]) {
             c->flags |= HM_FLAG_VANISH;
             return best;
@@ -531,7 +685,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
     if (hm_needs_split(c, b, r0, r1)) {
         if (depth < HM_DEPTH) {
             HmRow m;
-            hm_eval(c, 0.5 * (r0->t + r1->t), 1u << b, &m);
+            hm_eval(c, 0.5 * (r0->t + r1->t), 1u << b, 1u << b, &m);
             if (!m.valid[b]) {
                 c->flags |= HM_FLAG_VANISH;
                 return;
@@ -583,7 +737,7 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
     int m = 0;
     double w = rn->t - re->t;
     for (int k = HM_FOLD_STEPS; k >= 1; k--) {
-        hm_eval(c, re->t + w * ldexp(1.0, -2 * k), 1u << b, &r[m]);
+        hm_eval(c, re->t + w * ldexp(1.0, -2 * k), 1u << b, 1u << b, &r[m]);
         if (!r[m].valid[b]) {
             c->flags |= HM_FLAG_VANISH;
             return;
@@ -629,9 +783,9 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
             continue; /* the partner's end in this cell: checked on both sides */
         double e = c->fold_t[b][f];
         double out = e + copysign(HM_FOLD_TOL * fmax(1.0, fabs(e)), state0 ? 1.0 : -1.0);
-        hm_eval(c, e, 0u, &chk);
+        hm_eval(c, e, 0u, 1u << b, &chk);
         int ok = chk.valid[b];
-        hm_eval(c, out, 0u, &chk);
+        hm_eval(c, out, 0u, 1u << b, &chk);
         known = ok && !chk.valid[b];
         end = e;
     }
@@ -663,7 +817,7 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
             }
             if ((probe - u) * (u - v) >= 0.0)
                 probe = 0.5 * (v + u);
-            hm_eval(c, probe, 1u << b, &m);
+            hm_eval(c, probe, 1u << b, 1u << b, &m);
             last_out = !m.valid[b];
             last_est = est_used;
             if (m.valid[b]) {
@@ -690,7 +844,7 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
     }
     hm_point(c, end, b, -1, HM_KIND_FOLD);
     HmRow re;
-    hm_eval(c, end, 1u << b, &re);
+    hm_eval(c, end, 1u << b, 1u << b, &re);
     if (!re.valid[b]) {
         c->flags |= HM_FLAG_VANISH;
         return;
@@ -761,7 +915,7 @@ static int hm_grazed(HmCtx *c, int b, double a, double e, unsigned char *good)
         if (!(a >= c->graze_t[b][g][0] && e <= c->graze_t[b][g][1]))
             continue;
         HmRow r;
-        hm_eval(c, 0.5 * (a + e), 0u, &r);
+        hm_eval(c, 0.5 * (a + e), 0u, 1u << b, &r);
         if (r.valid[b])
             r.q[b][c->graze_j[b][g]] = hm_polished(c, r.q[b], c->graze_j[b][g]);
         *good = (unsigned char)hm_inside(c, &r, b, HM_TOL);
@@ -805,14 +959,14 @@ static void hm_intervals(HmCtx *c, int b, double lo, double hi, const HmRow *row
                 best = h;
         if (best >= 0 && hm_decides(c, &rows[best], b, &good[i]))
             continue;
-        hm_eval(c, mid, 0u, &r);
+        hm_eval(c, mid, 0u, 1u << b, &r);
         good[i] = (unsigned char)hm_inside(c, &r, b, 0.0);
     }
     long k = 0;
     for (int i = 0; i < u; i++) {
         int left = i > 0 && good[i - 1], right = i + 1 < u && good[i];
         if (!left && !right) {
-            hm_eval(c, cut[i], 0u, &r);
+            hm_eval(c, cut[i], 0u, 1u << b, &r);
             if (hm_inside(c, &r, b, 1e-12) && !hm_emit(c, iv, &k, cut[i], cut[i]))
                 break;
         }
@@ -1002,7 +1156,7 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
     }
     G = hm_grid(c, G, lo, hi, tg, cap);
     for (long i = 0; i < G; i++)
-        hm_eval(c, tg[i], 0xffu, &rows[i]);
+        hm_eval(c, tg[i], 0xffu, 0xffu, &rows[i]);
     free(tg);
     for (int b = 0; b < 8; b++)
         c->nfold[b] = 0;
@@ -1039,6 +1193,7 @@ typedef struct {
 
 static void hm_range(void *ctx, long b0, long e0)
 {
+
     const HmJob *jb = ctx;
     const double *P = jb->P;
     for (long i = b0; i < e0; i++) {
@@ -1054,6 +1209,7 @@ static void hm_range(void *ctx, long b0, long e0)
         c->k = (int)P[PK_HELD];
         c->flags = 0;
         c->evals = 0;
+        c->cheap = 0;
         c->pts = jb->pts + 4 * HM_MAXP * i;
         c->npts = 0;
         for (int j = 0; j < PK_MAXJ; j++)
@@ -1088,7 +1244,11 @@ static void hm_range(void *ctx, long b0, long e0)
             hm_pose(c, jb->G, jb->iv + 2 * HM_MAXI * 8 * i, jb->niv + 8 * i);
         jb->npts[i] = c->npts;
         jb->flags[i] = c->flags;
+#ifdef HM_COUNT_CHEAP
+        jb->evals[i] = c->cheap; /* a measuring build: every evaluation */
+#else
         jb->evals[i] = c->evals;
+#endif
         free(c);
     }
 }
