@@ -201,81 +201,56 @@ static double hm_outside(const double *P, const PkGeo *g, const double *th)
 
 static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
 {
-    const double *P = c->P, *T = c->T;
-    PkGeo g;
-    pk_geometry(P, x, &g);
+    const double *P = c->P;
     for (int b = 0; b < 8; b++) {
         r->valid[b] = r->sing[b] = 0;
         for (int j = 0; j < PK_MAXJ; j++)
             r->q[b][j] = NAN;
     }
-    if (g.kase != PK_START)
-        return 0;
-    int held = (int)P[PK_HELD];
-    double stol = P[PK_SING_TOL];
-    m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
-    v3 pT = {T[3], T[7], T[11]};
-    m3 G = pk_mul_t(&RT, &g.RM);
-    const int ia = 3, it = 0;
-    PkEq e;
-    pk_pose_equations(&g, &RT, pT, &G, &e);
-    PkPos pos;
-    pos.n = 0;
-    int code;
-    double pref_a = P[PK_SIGN + g.full[ia]] * c->qn[g.full[ia]] + P[PK_OFFSET + g.full[ia]];
-    double pref_c = P[PK_SIGN + g.full[ia + 2]] * c->qn[g.full[ia + 2]] +
-                    P[PK_OFFSET + g.full[ia + 2]];
-    if (fabs(e.mbc) <= PK_COPLANAR)
-        code = pk_coplanar(&e, 0, pref_a, pref_c, &pos);
-    else if (fabs(e.mab) <= PK_COPLANAR)
-        code = pk_coplanar(&e, 1, pref_a, pref_c, &pos);
-    else
+    PkFront f;
+    int code = pk_front(P, c->T, x, c->qn, 0, &f);
+    if (code == PK_FRONT_SWIVEL || code == PK_FRONT_GENERAL || f.g.kase != PK_START)
         return 0; /* He and Liu's general case: not this kernel's */
     if (code != PK_OK)
         return 1; /* pk_one: cleared, no row */
+    const PkGeo *g = &f.g;
+    const PkPos *pos = &f.pos;
+    int held = (int)P[PK_HELD];
+    double stol = P[PK_SING_TOL];
     int held_in = pk_held_inside(P, held, x);
-    int jx = g.full[it], jz = g.full[it + 2];
-    PkTri tri;
-    pk_tri_init(&tri, g.h[it], g.h[it + 1], g.h[it + 2]);
-    double exact_p = PK_EXACT * fmax(1.0, g.scale);
-    for (int i = 0; i < pos.n; i++) {
-        unsigned slots = 3u << (2 * pos.slot[i]);
-        if (!(need & slots) || !(pos.res[i] < 1e-6 * g.scale))
+    int ia = f.ia, it = f.it;
+    for (int i = 0; i < pos->n; i++) {
+        unsigned slots = 3u << (2 * pos->slot[i]);
+        if (!(need & slots) || !(pos->res[i] < 1e-6 * g->scale))
             continue;
-        if (pos.sing[i])
+        if (pos->sing[i])
             return 0;
         double th[6];
-        m3 Rp = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
-        for (int j = 0; j < 3; j++) {
-            th[ia + j] = pos.t[i][j];
-            m3 Rj = pk_rotm(g.h[ia + j], pos.c[i][j], pos.s[i][j]);
-            Rp = pk_mul(&Rp, &Rj);
-        }
-        m3 Rt = pk_mul_t(&G, &Rp);
+        m3 Rt = pk_front_rotation(&f, i, th);
         PkTrip tr;
-        pk_triple(P, &tri, &Rt, jx, jz, c->qn[jz], stol, &tr);
+        pk_triple(P, &f.tri, &Rt, f.jx, f.jz, c->qn[f.jz], stol, &tr);
         for (int k = 0; k < tr.n; k++) {
-            int slot = 2 * pos.slot[i] + k;
+            int slot = 2 * pos->slot[i] + k;
             if (!(need >> slot & 1u))
                 continue;
             if (tr.sing[k])
                 return 0;
             for (int j = 0; j < 3; j++) {
-                th[ia + j] = pos.t[i][j];
+                th[ia + j] = pos->t[i][j];
                 th[it + j] = tr.t[k][j];
             }
             /* pk_one's check: kept unchanged when exact, else polished */
-            if ((tr.check[k] || !(pos.res[i] < exact_p)) &&
-                !(pk_error_of(&g, &RT, pT, th) <= PK_EXACT))
+            if ((tr.check[k] || !(pos->res[i] < f.exact_p)) &&
+                !(pk_error_of(g, &f.RT, f.pT, th) <= PK_EXACT))
                 return 0;
-            double m = pk_coords(P, &g, th, held, x, r->q[slot]);
-            if (!(m >= -1e-9) && held_in && !(hm_outside(P, &g, th) > 2.0 * PK_NUDGE))
+            double m = pk_coords(P, g, th, held, x, r->q[slot]);
+            if (!(m >= -1e-9) && held_in && !(hm_outside(P, g, th) > 2.0 * PK_NUDGE))
                 return 0; /* pk_inside (or, next to an aligned triple, pk_resplit) may move it */
-            if (!(m >= -1e-9) && held_in && !pk_isolated(&g, th)) {
+            if (!(m >= -1e-9) && held_in && !pk_isolated(g, th)) {
                 m3 R;
                 v3 p;
                 double J[6][6];
-                pk_fk(&g, th, &R, &p, J);
+                pk_fk(g, th, &R, &p, J);
                 if (!pk_regular(J)) { /* pk_slide's own test: a family to slide along */
                     double sig[6], V[6][6];
                     pk_svd6(J, sig, V);

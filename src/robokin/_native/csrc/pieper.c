@@ -1764,110 +1764,151 @@ static void pk_pose_equations(const PkGeo *g, const m3 *RT, v3 pT, const m3 *G, 
     pk_equations(g, ia, p, d, e);
 }
 
+/* pk_one's closed form up to the triple, shared with held_manifold.c's
+ * one-slot evaluation: the remaining chain at held value x, the pose's position
+ * equations and their roots (pos), the triple's axes. */
+typedef struct {
+    PkGeo g;
+    m3 RT, G; /* the pose's rotation; the rotation of e1 ... e6 */
+    v3 pT;
+    int start, ia, it, jx, jz; /* the position joints from ia, the triple's from it */
+    PkPos pos;
+    PkTri tri;
+    double exact_p; /* a position root's residual below this needs no pose check */
+} PkFront;
+
+enum { PK_FRONT_SWIVEL = -1, PK_FRONT_GENERAL = -2 };
+
+/* The front of pose T at held value x (qn: preferred coordinates where a position
+ * joint is free). Returns PK_OK with f->pos, a status (no position root), or
+ * PK_FRONT_SWIVEL (both triples meet: pk_srs), PK_FRONT_GENERAL (no coplanar
+ * pair and `general` 0: Pieper's quartic not taken). */
+static int pk_front(const double *P, const double *T, double x, const double *qn, int general,
+                    PkFront *f)
+{
+    PkGeo *g = &f->g;
+    pk_geometry(P, x, g);
+    f->RT = (m3){{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
+    f->pT = (v3){T[3], T[7], T[11]};
+    f->G = pk_mul_t(&f->RT, &g->RM);
+    f->pos.n = 0;
+    if (g->kase == PK_BOTH)
+        return PK_FRONT_SWIVEL;
+    f->start = g->kase == PK_START;
+    f->ia = f->start ? 3 : 0;
+    f->it = f->start ? 0 : 3;
+    PkEq e;
+    pk_pose_equations(g, &f->RT, f->pT, &f->G, &e);
+    int ia = f->ia, code;
+    /* preferred chain angles of the position joints (when one is free) */
+    double pref_a = P[PK_SIGN + g->full[ia]] * qn[g->full[ia]] + P[PK_OFFSET + g->full[ia]];
+    double pref_c = P[PK_SIGN + g->full[ia + 2]] * qn[g->full[ia + 2]] +
+                    P[PK_OFFSET + g->full[ia + 2]];
+    if (fabs(e.mbc) <= PK_COPLANAR)
+        code = pk_coplanar(&e, 0, pref_a, pref_c, &f->pos);
+    else if (fabs(e.mab) <= PK_COPLANAR)
+        code = pk_coplanar(&e, 1, pref_a, pref_c, &f->pos);
+    else if (general)
+        code = pk_general(&e, &f->pos);
+    else
+        return PK_FRONT_GENERAL;
+#ifdef PK_DEBUG
+    fprintf(stderr, "code %d mab %.3e mbc %.3e npos %d\n", code, e.mab, e.mbc, f->pos.n);
+    for (int i = 0; i < f->pos.n; i++)
+        fprintf(stderr, "  pos %d: %.12f %.12f %.12f res %.3e sing %d\n", f->pos.slot[i],
+                f->pos.t[i][0], f->pos.t[i][1], f->pos.t[i][2], f->pos.res[i], f->pos.sing[i]);
+#endif
+    f->jx = g->full[f->it];
+    f->jz = g->full[f->it + 2];
+    pk_tri_init(&f->tri, g->h[f->it], g->h[f->it + 1], g->h[f->it + 2]);
+    f->exact_p = PK_EXACT * fmax(1.0, g->scale);
+    return code;
+}
+
+/* Position root i of the front: its angles into th (the position joints') and the
+ * rotation the triple must make. */
+static m3 pk_front_rotation(const PkFront *f, int i, double *th)
+{
+    const PkGeo *g = &f->g;
+    m3 Rp = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+    for (int j = 0; j < 3; j++) {
+        th[f->ia + j] = f->pos.t[i][j];
+        m3 Rj = pk_rotm(g->h[f->ia + j], f->pos.c[i][j], f->pos.s[i][j]);
+        Rp = pk_mul(&Rp, &Rj);
+    }
+    if (f->start)
+        return pk_mul_t(&f->G, &Rp); /* R_A = G R_B^T */
+    m3 Rpt = {{Rp.r0.x, Rp.r1.x, Rp.r2.x},
+              {Rp.r0.y, Rp.r1.y, Rp.r2.y},
+              {Rp.r0.z, Rp.r1.z, Rp.r2.z}};
+    return pk_mul(&Rpt, &f->G); /* R_B = R_A^T G */
+}
+
 /* Every solution of pose T (4 x 4 row-major) with the held joint (if any) at x;
  * qn: the preferred coordinates (n) at singularities. Returns the status. */
 static int pk_one(const double *P, const double *T, double x, const double *qn, PkOut o)
 {
-    PkGeo g;
-    pk_geometry(P, x, &g);
+    PkFront f;
     pk_clear(o);
-    int held = (int)P[PK_HELD];
-    double stol = P[PK_SING_TOL];
-    m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
-    v3 pT = {T[3], T[7], T[11]};
-    m3 G = pk_mul_t(&RT, &g.RM); /* the rotation of e1 ... e6 */
-    if (g.kase == PK_BOTH)
-        return pk_srs(P, &g, &RT, pT, x, qn, o);
-    int start = g.kase == PK_START, ia = start ? 3 : 0, it = start ? 0 : 3;
-    PkEq e;
-    pk_pose_equations(&g, &RT, pT, &G, &e);
-    PkPos pos;
-    pos.n = 0;
-    int code;
-    /* preferred chain angles of the position joints (when one is free) */
-    double pref_a = P[PK_SIGN + g.full[ia]] * qn[g.full[ia]] + P[PK_OFFSET + g.full[ia]];
-    double pref_c = P[PK_SIGN + g.full[ia + 2]] * qn[g.full[ia + 2]] +
-                    P[PK_OFFSET + g.full[ia + 2]];
-    if (fabs(e.mbc) <= PK_COPLANAR)
-        code = pk_coplanar(&e, 0, pref_a, pref_c, &pos);
-    else if (fabs(e.mab) <= PK_COPLANAR)
-        code = pk_coplanar(&e, 1, pref_a, pref_c, &pos);
-    else
-        code = pk_general(&e, &pos);
-#ifdef PK_DEBUG
-    fprintf(stderr, "code %d mab %.3e mbc %.3e npos %d\n", code, e.mab, e.mbc, pos.n);
-    for (int i = 0; i < pos.n; i++)
-        fprintf(stderr, "  pos %d: %.12f %.12f %.12f res %.3e sing %d\n", pos.slot[i], pos.t[i][0],
-                pos.t[i][1], pos.t[i][2], pos.res[i], pos.sing[i]);
-#endif
+    int code = pk_front(P, T, x, qn, 1, &f);
+    const PkGeo *g = &f.g;
+    const m3 *RT = &f.RT;
+    v3 pT = f.pT;
+    if (code == PK_FRONT_SWIVEL)
+        return pk_srs(P, g, RT, pT, x, qn, o);
     if (code != PK_OK)
         return code;
+    int held = (int)P[PK_HELD];
+    double stol = P[PK_SING_TOL];
     int any = 0;
     unsigned lmask = 0u; /* rows outside, not flagged singular: slid only when none is inside */
     int held_in = pk_held_inside(P, held, x); /* else no row can come inside */
     double late[8][6];
-    int jx = g.full[it], jz = g.full[it + 2];
-    PkTri tri;
-    pk_tri_init(&tri, g.h[it], g.h[it + 1], g.h[it + 2]);
-    double exact_p = PK_EXACT * fmax(1.0, g.scale);
-    for (int i = 0; i < pos.n; i++) {
-        if (!(pos.res[i] < 1e-6 * g.scale))
+    int ia = f.ia, it = f.it, jx = f.jx, jz = f.jz;
+    const PkPos *pos = &f.pos;
+    for (int i = 0; i < pos->n; i++) {
+        if (!(pos->res[i] < 1e-6 * g->scale))
             continue;
         double th[6];
-        /* the other three's rotation */
-        m3 Rp = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
-        for (int j = 0; j < 3; j++) {
-            th[ia + j] = pos.t[i][j];
-            m3 Rj = pk_rotm(g.h[ia + j], pos.c[i][j], pos.s[i][j]);
-            Rp = pk_mul(&Rp, &Rj);
-        }
-        m3 Rt;
-        if (start) {
-            Rt = pk_mul_t(&G, &Rp); /* R_A = G R_B^T */
-        } else {
-            m3 Rpt = {{Rp.r0.x, Rp.r1.x, Rp.r2.x},
-                      {Rp.r0.y, Rp.r1.y, Rp.r2.y},
-                      {Rp.r0.z, Rp.r1.z, Rp.r2.z}};
-            Rt = pk_mul(&Rpt, &G); /* R_B = R_A^T G */
-        }
+        m3 Rt = pk_front_rotation(&f, i, th);
         PkTrip tr;
-        pk_triple(P, &tri, &Rt, jx, jz, qn[jz], stol, &tr);
+        pk_triple(P, &f.tri, &Rt, jx, jz, qn[jz], stol, &tr);
 #ifdef PK_DEBUG
         fprintf(stderr, "  triple n %d\n", tr.n);
 #endif
         for (int k = 0; k < tr.n; k++) {
             /* this solution's angles (the polish and the repairs change all six) */
             for (int j = 0; j < 3; j++) {
-                th[ia + j] = pos.t[i][j];
+                th[ia + j] = pos->t[i][j];
                 th[it + j] = tr.t[k][j];
             }
-            if (tr.check[k] || !(pos.res[i] < exact_p)) {
+            if (tr.check[k] || !(pos->res[i] < f.exact_p)) {
                 /* check against the pose; Newton-polish when not exact */
-                double err = pk_error_of(&g, &RT, pT, th);
+                double err = pk_error_of(g, RT, pT, th);
                 if (err > PK_EXACT)
-                    err = pk_polish_slow(&g, &RT, pT, th, pk_polish(&g, &RT, pT, th));
+                    err = pk_polish_slow(g, RT, pT, th, pk_polish(g, RT, pT, th));
 #ifdef PK_DEBUG
-                fprintf(stderr, "    check slot %d err %.3e th %.17g %.17g %.17g\n", 2 * pos.slot[i] + k, err, th[0], th[1], th[2]);
+                fprintf(stderr, "    check slot %d err %.3e th %.17g %.17g %.17g\n", 2 * pos->slot[i] + k, err, th[0], th[1], th[2]);
 #endif
                 if (!(err <= PK_ACCEPT))
                     continue; /* not a solution to 1e-12: never returned */
             }
-            int slot = 2 * pos.slot[i] + k;
+            int slot = 2 * pos->slot[i] + k;
             double *qs = o.Q + o.n * slot;
-            int all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
-            int sing = pos.sing[i] || tr.sing[k], fix = !all && held_in;
-            if (fix && pk_resplit(P, &g, it, &RT, pT, th))
-                all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            int all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
+            int sing = pos->sing[i] || tr.sing[k], fix = !all && held_in;
+            if (fix && pk_resplit(P, g, it, RT, pT, th))
+                all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
             /* joints on one line only at a singular configuration: try there only */
-            if (fix && !all && sing && pk_repair(P, &g, &RT, pT, th))
-                all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
-            if (fix && !all && pk_inside(P, &g, &RT, pT, th, sing ? PK_NUDGE_SING : PK_NUDGE))
-                all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+            if (fix && !all && sing && pk_repair(P, g, RT, pT, th))
+                all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
+            if (fix && !all && pk_inside(P, g, RT, pT, th, sing ? PK_NUDGE_SING : PK_NUDGE))
+                all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
             /* a family to slide along: at rows the subproblems flag singular here,
              * at the others below only when no row came inside */
             if (fix && !all && sing) {
-                if (pk_slide(P, &g, &RT, pT, th))
-                    all = pk_coords(P, &g, th, held, x, qs) >= -1e-9;
+                if (pk_slide(P, g, RT, pT, th))
+                    all = pk_coords(P, g, th, held, x, qs) >= -1e-9;
             } else if (fix && !all) {
                 for (int j = 0; j < 6; j++)
                     late[slot][j] = th[j];
@@ -1883,10 +1924,10 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
     for (int slot = 0; slot < 8; slot++)
         inside |= o.valid[slot] && o.inside[slot];
     for (int slot = 0; slot < 8 && !inside; slot++)
-        if ((lmask >> slot & 1u) && pk_slide(P, &g, &RT, pT, late[slot]))
-            o.inside[slot] = pk_coords(P, &g, late[slot], held, x, o.Q + o.n * slot) >= -1e-9;
+        if ((lmask >> slot & 1u) && pk_slide(P, g, RT, pT, late[slot]))
+            o.inside[slot] = pk_coords(P, g, late[slot], held, x, o.Q + o.n * slot) >= -1e-9;
     if (any)
-        pk_walk_rows(P, &g, &RT, pT, held, x, o);
+        pk_walk_rows(P, g, RT, pT, held, x, o);
     return any ? PK_OK : PK_NO_ORIENTATION;
 }
 
