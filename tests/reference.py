@@ -145,3 +145,17 @@ def random_7r(seed: int = 29):
              "limits": [-np.radians(170), np.radians(170)], "name": f"r{i + 1}"}
             for i in range(7)]
     return robokin.Robot.from_dh(rows, convention="standard", name=f"random7r_{seed}")
+
+
+def kernel_copies() -> dict:
+    """Every copy of the compiled kernels this CPU runs (name -> module): baseline,
+    avx2+fma, avx512. Their rows can differ in the last bits."""
+    import importlib
+
+    from robokin import _native
+    out = {"baseline": _native._base}
+    if _native._base.cpu_has_avx2_fma():
+        out["avx2+fma"] = importlib.import_module("robokin._native._avx2")
+    if _native._base.cpu_has_avx512():
+        out["avx512"] = importlib.import_module("robokin._native._avx512")
+    return out

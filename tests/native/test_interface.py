@@ -9,28 +9,16 @@ names them.
 
 from __future__ import annotations
 
-import importlib
 import inspect
 import re
 
 import pytest
 
 import robokin
-from robokin import _native
+from reference import kernel_copies
 from robokin._native._interface import Kernels
 
-
-def _copies():
-    """Every copy of the kernels this CPU can run (name -> module)."""
-    out = {"baseline": _native._base}
-    if _native._base.cpu_has_avx2_fma():
-        out["avx2+fma"] = importlib.import_module("robokin._native._avx2")
-    if _native._base.cpu_has_avx512():
-        out["avx512"] = importlib.import_module("robokin._native._avx512")
-    return out
-
-
-COPIES = _copies()
+COPIES = kernel_copies()
 FUNCTIONS = {
     name: value
     for name, value in vars(Kernels).items()
@@ -88,6 +76,6 @@ def test_the_packed_layout_constants_match_every_compiled_copy():
     from robokin.model import chain_arrays
 
     packed_tag = robokin.load("ur5").chain.arrays.packed[0]
-    for copy in _copies().values():
+    for copy in kernel_copies().values():
         assert copy.LAYOUT_TAG == _declare.LAYOUT_TAG == packed_tag
         assert copy.MAX_JOINTS == chain_arrays.MAX_JOINTS

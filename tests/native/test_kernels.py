@@ -8,7 +8,6 @@ thread count, and the pool survives a fork.
 
 from __future__ import annotations
 
-import importlib
 import multiprocessing
 import os
 import subprocess
@@ -18,20 +17,10 @@ import numpy as np
 import pytest
 
 import robokin
-from reference import random_q
+from reference import kernel_copies, random_q
 from robokin import _native
 
 ARMS = robokin.robots.names()
-
-
-def _copies():
-    """Every copy of the kernels this CPU can run (name -> module)."""
-    out = {"baseline": _native._base}
-    if _native._base.cpu_has_avx2_fma():
-        out["avx2+fma"] = importlib.import_module("robokin._native._avx2")
-    if _native._base.cpu_has_avx512():
-        out["avx512"] = importlib.import_module("robokin._native._avx512")
-    return out
 
 
 @pytest.mark.parametrize("name", ARMS)
@@ -55,7 +44,7 @@ def test_a_corrupted_layout_is_refused_not_read():
 
 
 def test_the_best_copy_the_cpu_runs_is_the_one_in_use():
-    copies = _copies()
+    copies = kernel_copies()
     best = list(copies)[-1]
     assert best == _native.ISA
     assert copies[best].LANES >= copies["baseline"].LANES
@@ -68,7 +57,7 @@ def test_robokin_isa_forces_a_lesser_copy(isa):
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
                          text=True, check=True).stdout.strip()
     expect = {"baseline": "baseline",
-              "avx2": "avx2+fma" if "avx2+fma" in _copies() else "baseline"}[isa]
+              "avx2": "avx2+fma" if "avx2+fma" in kernel_copies() else "baseline"}[isa]
     assert out == expect
 
 
@@ -78,7 +67,7 @@ def test_every_copy_computes_the_same_fk_and_jacobians(name, rng):
     Q = np.ascontiguousarray(random_q(robot, rng, 257))  # not a multiple of any W
     packed = robot.chain.arrays.packed
     results = {}
-    for isa, mod in _copies().items():
+    for isa, mod in kernel_copies().items():
         T = np.empty((257, 4, 4))
         J = np.empty((257, 6, robot.n))
         T2 = np.empty((257, 4, 4))

@@ -11,28 +11,17 @@ of eps |J| moves det J by about eps * s1 * (s1 s2 s3 s4 s5).
 
 from __future__ import annotations
 
-import importlib
-
 import numpy as np
 import pytest
 
 import robokin
-from reference import random_q
+from reference import kernel_copies, random_q
 from robokin import _native
 from robokin.exceptions import InputError
 from robokin.kinematics.jacobian import jacobian, manipulability
 
 SIX = [name for name in robokin.robots.names() if robokin.load(name).n == 6]
 ROUNDING = 1e-14  # times s1 * s1 s2 s3 s4 s5 (the kernel's worst seen: 5e-16)
-
-
-def _copies():
-    out = {"baseline": _native._base}
-    if _native._base.cpu_has_avx2_fma():
-        out["avx2+fma"] = importlib.import_module("robokin._native._avx2")
-    if _native._base.cpu_has_avx512():
-        out["avx512"] = importlib.import_module("robokin._native._avx512")
-    return out
 
 
 def _svd(robot, q):
@@ -163,7 +152,7 @@ def test_every_compiled_copy_agrees_to_rounding(name, rng):
     robot = robokin.load(name)
     q = np.ascontiguousarray(random_q(robot, rng, 257))
     mask = np.ones(257, dtype=bool)
-    for copy in _copies().values():
+    for copy in kernel_copies().values():
         out = np.empty(257)
         assert copy.abs_det_jacobian(robot.chain.arrays.packed, q, mask, out)
         _assert_rounding(robot, q, out)

@@ -18,14 +18,11 @@ the KUKA LBR iiwa 14 R820's link lengths and joint ranges, each joint held.
 
 from __future__ import annotations
 
-import importlib
-
 import numpy as np
 import pytest
 
 import robokin
-from reference import pose_errors
-from robokin import _native
+from reference import kernel_copies, pose_errors
 from robokin.kinematics.ik.analytic import pieper
 
 hyp = pytest.importorskip("hypothesis")
@@ -205,8 +202,6 @@ def test_three_near_singular_joints_get_an_in_limit_solution(arm, j, q):
     check_held(ROBOTS[arm], j, np.array(q))
 
 
-
-
 # More singular in-limit configurations whose rows all came back outside the limits
 # on cf6e1cd (the same mechanism as above, or rows 1e-9 past a limit that only a
 # Gauss-Newton pinned at the limit, stepping radians along singular directions of
@@ -260,17 +255,6 @@ NO_ROW = [
     ("srs", 3, [2.9670597283903604, 0.0, 2.9670597283903604, 1.0718028917004205, 1e-06,
                 -2.0943951023931953, 3.0543261909900767]),
 ]
-
-
-def kernel_copies():
-    """Every copy of the compiled kernels this CPU runs (name -> module): their
-    rows differ in the last bits, and so did which configurations they missed."""
-    out = {"baseline": _native._base}
-    if _native._base.cpu_has_avx2_fma():
-        out["avx2+fma"] = importlib.import_module("robokin._native._avx2")
-    if _native._base.cpu_has_avx512():
-        out["avx512"] = importlib.import_module("robokin._native._avx512")
-    return out
 
 
 def check_each_copy(robot, j, q):
