@@ -655,3 +655,50 @@ def test_nearly_degenerate_arm_is_refused_with_a_reason_not_a_traceback():
     gap = np.where(sols.valid, np.abs(wrapped(sols.q - q[:, None, :])).max(axis=-1),
                    np.inf).min(axis=-1)
     assert (gap < GENERATING_TOL).all()
+
+
+# ---------------------------------------------- joints on one line (issue 23/29)
+#: offset iiwa (``reference.offset_iiwa14``, joint 7 held) with q4 = 0 or -+1e-9: axes 3
+#: and 5 on one line, a continuum of solutions (only q3 + q5 fixed). The elimination's
+#: rows all had their split outside the limits (q5 = 3.138 > 2.967 ...) before g6_coaxial_rows;
+#: found by the bench's special configurations (seeds 1-3, 2,000 each).
+COAXIAL_CONFIGURATIONS = [
+    [-2.471454358744042, 0.6027801163963504, 0.37707511632294066, 0.0,
+     2.6341037804751837, -1.1036562002505197, -0.1062655505895913],
+    [2.6182162119585577, -1.8327473837870458, -1.84533652098516, 0.0,
+     -1.199485959525064, -2.025531858393053, -1.2751884446179098],
+    [2.9670597283903604, 2.0943951023931953, 2.9670597283903604, 1e-09,
+     0.10047329125569382, 0.16822811187809217, 1e-09],
+    [-1.388481267968898, -1.7405540789125409, 1e-09, 1e-09, 2.9670597283903604,
+     -2.0943951023931953, 3.0543261909900767],
+]
+
+
+@pytest.mark.parametrize("q0", COAXIAL_CONFIGURATIONS)
+def test_joints_on_one_line_get_an_in_limit_split(q0):
+    # Oracle: q0 is inside the limits and reproduces T, and its six free joints'
+    # Jacobian is singular (smallest / largest singular value < 1e-10): a continuum,
+    # so the requirement is a valid row inside the limits (flagged singular) that
+    # reproduces T to 1e-12 and has q3 + q5 = q0's (the family's invariant).
+    from reference import offset_iiwa14, pose_errors
+
+    robot = offset_iiwa14()
+    q0 = np.asarray(q0)
+    sv = np.linalg.svd(robot.jacobian(q0)[:, :6], compute_uv=False)
+    assert sv[-1] < 1e-10 * sv[0]
+    T = robot.fk(q0)
+    s = robot.ik(T, fixed={"a7": float(q0[6])})
+    rows = s.valid & s.flags["within_limits"]
+    assert rows.any()
+    q = s.q[rows]
+    dp, dr = pose_errors(robot.fk(q), T)
+    assert np.maximum(dp, dr).max() <= 1e-12
+    assert s.flags["singular"][rows].all()
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    assert ((q >= lo - 1e-9) & (q <= hi + 1e-9)).all()
+    inv = (q[:, 2] + q[:, 4] - q0[2] - q0[4] + np.pi) % (2 * np.pi) - np.pi
+    assert (np.abs(inv) < 1e-6).any()
+    # every valid row once (1e-6 rad apart)
+    v = s.q[s.valid]
+    d = np.abs((v[:, None] - v[None] + np.pi) % (2 * np.pi) - np.pi).max(-1)
+    assert (d + np.eye(len(v)) * 1.0 >= 1e-6).all()

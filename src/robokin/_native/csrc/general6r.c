@@ -2423,6 +2423,133 @@ static int g6_pose(const Chain *ch, const double *P, const double *T, double *q,
     return ns;
 }
 
+/* ------------------------------------------------- joints on one line */
+
+/* A solution with two free joints on one line (equal Jacobian columns up to the
+ * sign sigma: the offset iiwa with q4 = 0 puts axes 3 and 5 on one line) lies on a
+ * continuum: only q_i + sigma q_j is fixed, and the elimination returns whichever
+ * split its null vector gave (issue 23: six of 857 singular special configurations,
+ * every split outside the limits). Such rows are re-split inside the limits
+ * (g6_coaxial_row); only rows outside the limits with a Jacobian singular value
+ * below G6_COAX_SIG per metre are looked at, so regular poses are untouched. */
+#define G6_COAX_SIG 1e-6  /* [per m of arm] a row's sigma below this: look for a pair */
+#define G6_COAX_DIFF 1e-8 /* [per m of arm] Jacobian columns this close: one line */
+
+/* The value of coordinate j nearest pref (within j's limits) such that q_i = phi -
+ * sigma q_j lies within i's limits by whole turns; NaN when no split does. */
+static double g6_split_pair(const Chain *ch, int i, int j, double phi, double sigma,
+                            double pref)
+{
+    double best = NAN, bestd = INFINITY;
+    for (int m = -2; m <= 2; m++) {
+        double c = phi + 2.0 * M_PI * m, lo, hi;
+        if (sigma > 0.0) {
+            lo = c - ch->hi[i];
+            hi = c - ch->lo[i];
+        } else {
+            lo = ch->lo[i] - c;
+            hi = ch->hi[i] - c;
+        }
+        lo = fmax(lo, ch->lo[j]);
+        hi = fmin(hi, ch->hi[j]);
+        if (lo > hi)
+            continue;
+        double v = fmin(fmax(pref, lo), hi), d = fabs(v - pref);
+        if (d < bestd) {
+            bestd = d;
+            best = v;
+        }
+    }
+    return best;
+}
+
+static int g6_inside(const Chain *ch, const double *qs)
+{
+    int in = 1;
+    for (int j = 0; j < 6; j++)
+        in &= within_limits(wrap_into(qs[j], ch->lo[j], ch->hi[j]), ch->lo[j], ch->hi[j]);
+    return in;
+}
+
+/* Row qs (coordinates, outside the limits): each pair of joints on one line whose
+ * split is outside the limits is re-split inside them (two passes, as pieper.c's
+ * pk_repair), then polished onto T (g6_polish: the columns agree to G6_COAX_DIFF,
+ * not exactly, so the moved row is off by up to ~1e-8). Kept (qs, *sg replaced)
+ * when the polished row reproduces T and lies inside the limits; returns 1 then. */
+static int g6_coaxial_row(const Chain *ch, const double *P, const double *T, double *qs,
+                          double *sg)
+{
+    const double scale = fmax(1.0, P[GP_SCALE]);
+    double trial[6];
+    int moved = 0;
+    memcpy(trial, qs, sizeof(trial));
+    for (int pass = 0; pass < 2; pass++) {
+        vd qv[MAXJ], t[12], J[36];
+        for (int j = 0; j < 6; j++)
+            qv[j] = BR(trial[j]);
+        chain_pose_jac(ch, qv, t, J, 6);
+        for (int i = 0; i < 6; i++)
+            for (int j = i + 1; j < 6; j++) {
+                double dot = J[18 + i][0] * J[18 + j][0] + J[24 + i][0] * J[24 + j][0] +
+                             J[30 + i][0] * J[30 + j][0];
+                double sigma = dot >= 0.0 ? 1.0 : -1.0, diff = 0.0;
+                for (int r = 0; r < 6; r++)
+                    diff = fmax(diff, fabs(J[6 * r + i][0] - sigma * J[6 * r + j][0]));
+                if (!(diff < G6_COAX_DIFF * scale))
+                    continue;
+                double qi = wrap_into(trial[i], ch->lo[i], ch->hi[i]);
+                double qj = wrap_into(trial[j], ch->lo[j], ch->hi[j]);
+                if (within_limits(qi, ch->lo[i], ch->hi[i]) &&
+                    within_limits(qj, ch->lo[j], ch->hi[j]))
+                    continue;
+                double phi = trial[i] + sigma * trial[j];
+                double v = g6_split_pair(ch, i, j, phi, sigma, qj);
+                if (isnan(v))
+                    continue;
+                trial[j] = v;
+                trial[i] = phi - sigma * v;
+                moved = 1;
+            }
+    }
+    if (!moved)
+        return 0;
+    G6Cand c = {{0.0}, 0};
+    for (int j = 0; j < 6; j++)
+        c.v[j] = ch->sign[j] * trial[j] + ch->offset[j];
+    double out[6 * G6_MAXSOL], osg[G6_MAXSOL];
+    if (g6_polish(ch, P, T, &c, 1, out, osg, 0, NULL, 0) != 1 || !g6_inside(ch, out))
+        return 0;
+    memcpy(qs, out, sizeof(trial));
+    *sg = osg[0];
+    return 1;
+}
+
+/* g6_coaxial_row on every singular row of q (ns rows) outside the limits; a moved
+ * row that lands on another row (within GP_DEDUPE) is dropped. Returns the rows. */
+static int g6_coaxial_rows(const Chain *ch, const double *P, const double *T, double *q,
+                           double *sig, int ns)
+{
+    const double scale = fmax(1.0, P[GP_SCALE]);
+    for (int s = 0; s < ns; s++) {
+        if (!(sig[s] < G6_COAX_SIG * scale) || g6_inside(ch, q + 6 * s) ||
+            !g6_coaxial_row(ch, P, T, q + 6 * s, sig + s))
+            continue;
+        for (int o = 0; o < ns; o++) {
+            double m = 0.0;
+            for (int j = 0; o != s && j < 6; j++)
+                m = fmax(m, fabs(wrap_pi(q[6 * s + j] - q[6 * o + j])));
+            if (o != s && m < P[GP_DEDUPE]) { /* a duplicate: drop row s */
+                memmove(q + 6 * s, q + 6 * (s + 1), sizeof(double) * 6 * (ns - s - 1));
+                memmove(sig + s, sig + s + 1, sizeof(double) * (ns - s - 1));
+                ns--;
+                s--;
+                break;
+            }
+        }
+    }
+    return ns;
+}
+
 typedef struct {
     const Chain *ch;
     const double *P, *T;
@@ -2441,6 +2568,7 @@ static void g6_range(void *ctx, long b, long e)
         job->status[i] = ns == -1 ? G6_BAD_POSE : ns == -2 ? G6_DEGENERATE
                          : ns == 0 ? G6_NONE : G6_OK;
         ns = ns < 0 ? 0 : ns;
+        ns = g6_coaxial_rows(job->ch, job->P, job->T + 16 * i, q, sig, ns);
         double *Qo = job->Q + (size_t)i * 6 * G6_MAXSOL;
         const Chain *ch = job->ch;
         for (int s = 0; s < G6_MAXSOL; s++) {
