@@ -674,16 +674,22 @@ COAXIAL_CONFIGURATIONS = [
 ]
 
 
-@pytest.mark.parametrize("q0", COAXIAL_CONFIGURATIONS)
-def test_joints_on_one_line_get_an_in_limit_split(q0):
+#: offset iiwa, q3 = -1e-9, q2 and q6 at their limits (sigma 6e-12 of the largest): the
+#: elimination's row next to q0 was 1.7e-7 past q6's limit (g6_slide_row brings it in)
+SLIDE_CONFIGURATIONS = [
+    [-2.433386118264293, 2.0943951023931953, -1e-09, -1.971112604991673,
+     1.5707963267948966, 2.0943951023931953, 0.6457688213085984],
+]
+
+
+def _in_limit_singular_rows(q0):
     # Oracle: q0 is inside the limits and reproduces T, and its six free joints'
-    # Jacobian is singular (smallest / largest singular value < 1e-10): a continuum,
-    # so the requirement is a valid row inside the limits (flagged singular) that
-    # reproduces T to 1e-12 and has q3 + q5 = q0's (the family's invariant).
+    # Jacobian is singular (smallest / largest singular value < 1e-10), so the
+    # requirement is a valid row inside the limits (flagged singular) that reproduces
+    # T to 1e-12; every valid row once (1e-6 rad apart).
     from reference import offset_iiwa14, pose_errors
 
     robot = offset_iiwa14()
-    q0 = np.asarray(q0)
     sv = np.linalg.svd(robot.jacobian(q0)[:, :6], compute_uv=False)
     assert sv[-1] < 1e-10 * sv[0]
     T = robot.fk(q0)
@@ -696,9 +702,25 @@ def test_joints_on_one_line_get_an_in_limit_split(q0):
     assert s.flags["singular"][rows].all()
     lo, hi = robot.limits[:, 0], robot.limits[:, 1]
     assert ((q >= lo - 1e-9) & (q <= hi + 1e-9)).all()
-    inv = (q[:, 2] + q[:, 4] - q0[2] - q0[4] + np.pi) % (2 * np.pi) - np.pi
-    assert (np.abs(inv) < 1e-6).any()
-    # every valid row once (1e-6 rad apart)
     v = s.q[s.valid]
     d = np.abs((v[:, None] - v[None] + np.pi) % (2 * np.pi) - np.pi).max(-1)
     assert (d + np.eye(len(v)) * 1.0 >= 1e-6).all()
+    return q
+
+
+@pytest.mark.parametrize("q0", COAXIAL_CONFIGURATIONS)
+def test_joints_on_one_line_get_an_in_limit_split(q0):
+    # ... and one in-limit row has q3 + q5 = q0's (the continuum's invariant)
+    q0 = np.asarray(q0)
+    q = _in_limit_singular_rows(q0)
+    inv = (q[:, 2] + q[:, 4] - q0[2] - q0[4] + np.pi) % (2 * np.pi) - np.pi
+    assert (np.abs(inv) < 1e-6).any()
+
+
+@pytest.mark.parametrize("q0", SLIDE_CONFIGURATIONS)
+def test_row_just_past_a_limit_next_to_a_singularity_slides_inside(q0):
+    # ... and one in-limit row lies within 1e-5 rad of q0 (the thin exact set there)
+    q0 = np.asarray(q0)
+    q = _in_limit_singular_rows(q0)
+    d = np.abs((q - q0 + np.pi) % (2 * np.pi) - np.pi).max(-1)
+    assert d.min() < 1e-5

@@ -2524,15 +2524,69 @@ static int g6_coaxial_row(const Chain *ch, const double *P, const double *T, dou
     return 1;
 }
 
-/* g6_coaxial_row on every singular row of q (ns rows) outside the limits; a moved
- * row that lands on another row (within GP_DEDUPE) is dropped. Returns the rows. */
+/* Row qs (coordinates), singular, outside the limits by at most G6_SLIDE_REACH:
+ * next to a singular configuration the exact configurations form a thin set along
+ * the Jacobian's null vector n, and the in-limit one may be a small step away (the
+ * offset iiwa with q3 = -1e-9 and q6 at its limit: the row 1.7e-7 past it, sigma
+ * 6e-12). The smallest step t n that puts every joint inside (each joint's
+ * interval for t intersected), then g6_polish; kept (qs, *sg replaced) when the
+ * polished row reproduces T and lies inside the limits; returns 1 then. */
+#define G6_SLIDE_REACH 1e-3 /* [rad] rows farther outside are not slid */
+static int g6_slide_row(const Chain *ch, const double *P, const double *T, double *qs,
+                        double *sg)
+{
+    double w[6], tlo = -INFINITY, thi = INFINITY, excess = 0.0;
+    for (int j = 0; j < 6; j++) {
+        w[j] = wrap_into(qs[j], ch->lo[j], ch->hi[j]);
+        excess = fmax(excess, fmax(w[j] - ch->hi[j], ch->lo[j] - w[j]));
+    }
+    if (!(excess <= G6_SLIDE_REACH))
+        return 0;
+    vd qv[MAXJ], t[12], Jv[36];
+    double J[36], n[6], r[6];
+    for (int j = 0; j < 6; j++)
+        qv[j] = BR(w[j]);
+    chain_pose_jac(ch, qv, t, Jv, 6);
+    for (int k = 0; k < 36; k++)
+        J[k] = Jv[k][0];
+    null_basis(J, 6, 1, n, r);
+    for (int j = 0; j < 6; j++) {
+        double a = ch->lo[j] - w[j], b = ch->hi[j] - w[j]; /* n_j t in [a, b] */
+        if (fabs(n[j]) < 1e-12) {
+            if (a > LIMIT_SLACK || b < -LIMIT_SLACK)
+                return 0;
+            continue;
+        }
+        double ta = a / n[j], tb = b / n[j];
+        tlo = fmax(tlo, fmin(ta, tb));
+        thi = fmin(thi, fmax(ta, tb));
+    }
+    if (!(tlo <= thi))
+        return 0;
+    double step = fmin(fmax(0.0, tlo), thi);
+    step += step > 0.0 ? 0.01 * (thi - step) : step < 0.0 ? 0.01 * (tlo - step) : 0.0;
+    G6Cand c = {{0.0}, 0};
+    for (int j = 0; j < 6; j++)
+        c.v[j] = ch->sign[j] * (w[j] + step * n[j]) + ch->offset[j];
+    double out[6 * G6_MAXSOL], osg[G6_MAXSOL];
+    if (g6_polish(ch, P, T, &c, 1, out, osg, 0, NULL, 0) != 1 || !g6_inside(ch, out))
+        return 0;
+    memcpy(qs, out, sizeof(double) * 6);
+    *sg = osg[0];
+    return 1;
+}
+
+/* g6_coaxial_row, else g6_slide_row, on every singular row of q (ns rows) outside
+ * the limits; a moved row that lands on another row (within GP_DEDUPE) is dropped.
+ * Returns the rows. */
 static int g6_coaxial_rows(const Chain *ch, const double *P, const double *T, double *q,
                            double *sig, int ns)
 {
     const double scale = fmax(1.0, P[GP_SCALE]);
     for (int s = 0; s < ns; s++) {
         if (!(sig[s] < G6_COAX_SIG * scale) || g6_inside(ch, q + 6 * s) ||
-            !g6_coaxial_row(ch, P, T, q + 6 * s, sig + s))
+            !(g6_coaxial_row(ch, P, T, q + 6 * s, sig + s) ||
+              g6_slide_row(ch, P, T, q + 6 * s, sig + s)))
             continue;
         for (int o = 0; o < ns; o++) {
             double m = 0.0;
