@@ -2366,13 +2366,27 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
  * lies in Sigma(theta_a)'s null space: at each of the 24 sample angles of each
  * variant the null space (pivots below 1e-8 of the largest, at least one vector) is
  * split into candidates, polished onto T. Returns the solutions in q. */
+static int g6_sampled(const Chain *ch, const double *P, const double *T, G6Cand *cand,
+                      double *q, double *sig, int ns);
+
 static int g6_rescue(const Chain *ch, const double *P, const double *T, G6Cand *cand,
                      int nc0, double *q, double *sig)
 {
-    const int nv = (int)P[GP_NVAR];
     int ns = g6_polish(ch, P, T, cand, nc0, q, sig, 0, NULL, 1); /* the candidates, patiently */
     if (ns > 0)
         return ns;
+    return g6_sampled(ch, P, T, cand, q, sig, 0);
+}
+
+/* The sampled null spaces of g6_rescue: each variant's Sigma at its 24 sample
+ * angles split into candidates, polished onto T and appended to the ns rows of q
+ * (duplicates dropped); the first variant that adds a row ends it. Returns the
+ * rows. */
+static int g6_sampled(const Chain *ch, const double *P, const double *T, G6Cand *cand,
+                      double *q, double *sig, int ns)
+{
+    const int ns0 = ns;
+    const int nv = (int)P[GP_NVAR];
     for (int v = 0; v < nv; v++) {
         G6Var V;
         if (!g6_prepare(P + GP_HEAD + v * VB_SIZE, T, &V))
@@ -2388,11 +2402,11 @@ static int g6_rescue(const Chain *ch, const double *P, const double *T, G6Cand *
                 n0++;
             nc += g6_from_basis(&G, th, Z, n0, 1, cand + nc, G6_MAXCAND - nc);
         }
-        ns = g6_polish(ch, P, T, cand, nc, q, sig, 0, NULL, 1);
-        if (ns > 0)
+        ns = g6_polish(ch, P, T, cand, nc, q, sig, ns, NULL, 1);
+        if (ns > ns0)
             return ns;
     }
-    return 0;
+    return ns;
 }
 
 static int g6_pose(const Chain *ch, const double *P, const double *T, double *q, double *sig,
@@ -2414,6 +2428,15 @@ static int g6_pose(const Chain *ch, const double *P, const double *T, double *q,
     if (ns == 0 && P[GP_FALLBACK] != 0.0 &&
         ((flags & (G6F_DEGENERATE | G6F_NOISY)) || best < G6_FAR * fmax(1.0, P[GP_SCALE]))) {
         ns = g6_rescue(ch, P, T, cand, nc, q, sig);
+        flags |= G6F_RESCUED;
+    } else if (ns > 0 && P[GP_FALLBACK] != 0.0 &&
+               (flags & G6F_DEGENERATE) && (flags & G6F_SEC_DEGENERATE) &&
+               (flags & G6F_NOISY) && (flags & G6F_SEC_NOISY)) {
+        /* every variant degenerate and noisy, some rows found: a near-continuum
+         * (the offset iiwa with q4 = -1e-9: axes 3 and 5 1e-9 from one line) whose
+         * rows neither the roots nor the projection gave; its members lie in the
+         * sampled null spaces as a continuum's do */
+        ns = g6_sampled(ch, P, T, cand, q, sig, ns);
         flags |= G6F_RESCUED;
     }
     *diag = flags | ((long long)nc << G6_DIAG_CAND_SHIFT);
