@@ -655,3 +655,90 @@ def test_nearly_degenerate_arm_is_refused_with_a_reason_not_a_traceback():
     gap = np.where(sols.valid, np.abs(wrapped(sols.q - q[:, None, :])).max(axis=-1),
                    np.inf).min(axis=-1)
     assert (gap < GENERATING_TOL).all()
+
+
+# ---------------------------------------------- joints on one line (issue 23/29)
+#: offset iiwa (``reference.offset_iiwa14``, joint 7 held) with q4 = 0 or -+1e-9: axes 3
+#: and 5 on one line, a continuum of solutions (only q3 + q5 fixed). The elimination's
+#: rows all had their split outside the limits (q5 = 3.138 > 2.967 ...) before g6_coaxial_rows;
+#: found by the bench's special configurations (seeds 1-3, 2,000 each).
+COAXIAL_CONFIGURATIONS = [
+    [-2.471454358744042, 0.6027801163963504, 0.37707511632294066, 0.0,
+     2.6341037804751837, -1.1036562002505197, -0.1062655505895913],
+    [2.6182162119585577, -1.8327473837870458, -1.84533652098516, 0.0,
+     -1.199485959525064, -2.025531858393053, -1.2751884446179098],
+    [2.9670597283903604, 2.0943951023931953, 2.9670597283903604, 1e-09,
+     0.10047329125569382, 0.16822811187809217, 1e-09],
+    [-1.388481267968898, -1.7405540789125409, 1e-09, 1e-09, 2.9670597283903604,
+     -2.0943951023931953, 3.0543261909900767],
+]
+
+
+#: offset iiwa, q4 = -1e-9 (axes 3 and 5 1e-9 from one line), q1 and q2 at their limits:
+#: every variant degenerate and noisy, 3 regular rows, the near-continuum's rows (and
+#: with them every in-limit row) missing until g6_sampled runs there too
+NEAR_CONTINUUM_CONFIGURATIONS = [
+    [2.9670597283903604, 2.0943951023931953, -0.700430588521217, -1e-09,
+     2.604076854653221, -1.7418752591336184, 1e-09],
+]
+
+
+@pytest.mark.parametrize("q0", NEAR_CONTINUUM_CONFIGURATIONS)
+def test_near_continuum_rows_come_back_when_every_variant_is_noisy(q0):
+    # ... and an in-limit row with q3 + q5 = q0's to 1e-6 (the near-continuum's invariant)
+    q0 = np.asarray(q0)
+    q = _in_limit_singular_rows(q0)
+    inv = (q[:, 2] + q[:, 4] - q0[2] - q0[4] + np.pi) % (2 * np.pi) - np.pi
+    assert (np.abs(inv) < 1e-6).any()
+
+
+#: offset iiwa, q3 = -1e-9, q2 and q6 at their limits (sigma 6e-12 of the largest): the
+#: elimination's row next to q0 was 1.7e-7 past q6's limit (g6_slide_row brings it in)
+SLIDE_CONFIGURATIONS = [
+    [-2.433386118264293, 2.0943951023931953, -1e-09, -1.971112604991673,
+     1.5707963267948966, 2.0943951023931953, 0.6457688213085984],
+]
+
+
+def _in_limit_singular_rows(q0):
+    # Oracle: q0 is inside the limits and reproduces T, and its six free joints'
+    # Jacobian is singular (smallest / largest singular value < 1e-10), so the
+    # requirement is a valid row inside the limits (one flagged singular); every
+    # in-limit row reproduces T to 1e-12; every valid row once (1e-6 rad apart).
+    from reference import offset_iiwa14, pose_errors
+
+    robot = offset_iiwa14()
+    sv = np.linalg.svd(robot.jacobian(q0)[:, :6], compute_uv=False)
+    assert sv[-1] < 1e-10 * sv[0]
+    T = robot.fk(q0)
+    s = robot.ik(T, fixed={"a7": float(q0[6])})
+    rows = s.valid & s.flags["within_limits"]
+    assert rows.any()
+    q = s.q[rows]
+    dp, dr = pose_errors(robot.fk(q), T)
+    assert np.maximum(dp, dr).max() <= 1e-12
+    assert s.flags["singular"][rows].any()  # (regular in-limit rows may come too)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    assert ((q >= lo - 1e-9) & (q <= hi + 1e-9)).all()
+    v = s.q[s.valid]
+    d = np.abs((v[:, None] - v[None] + np.pi) % (2 * np.pi) - np.pi).max(-1)
+    assert (d + np.eye(len(v)) * 1.0 >= 1e-6).all()
+    return q
+
+
+@pytest.mark.parametrize("q0", COAXIAL_CONFIGURATIONS)
+def test_joints_on_one_line_get_an_in_limit_split(q0):
+    # ... and one in-limit row has q3 + q5 = q0's (the continuum's invariant)
+    q0 = np.asarray(q0)
+    q = _in_limit_singular_rows(q0)
+    inv = (q[:, 2] + q[:, 4] - q0[2] - q0[4] + np.pi) % (2 * np.pi) - np.pi
+    assert (np.abs(inv) < 1e-6).any()
+
+
+@pytest.mark.parametrize("q0", SLIDE_CONFIGURATIONS)
+def test_row_just_past_a_limit_next_to_a_singularity_slides_inside(q0):
+    # ... and one in-limit row lies within 1e-5 rad of q0 (the thin exact set there)
+    q0 = np.asarray(q0)
+    q = _in_limit_singular_rows(q0)
+    d = np.abs((q - q0 + np.pi) % (2 * np.pi) - np.pi).max(-1)
+    assert d.min() < 1e-5

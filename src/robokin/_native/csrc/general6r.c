@@ -2366,13 +2366,27 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
  * lies in Sigma(theta_a)'s null space: at each of the 24 sample angles of each
  * variant the null space (pivots below 1e-8 of the largest, at least one vector) is
  * split into candidates, polished onto T. Returns the solutions in q. */
+static int g6_sampled(const Chain *ch, const double *P, const double *T, G6Cand *cand,
+                      double *q, double *sig, int ns);
+
 static int g6_rescue(const Chain *ch, const double *P, const double *T, G6Cand *cand,
                      int nc0, double *q, double *sig)
 {
-    const int nv = (int)P[GP_NVAR];
     int ns = g6_polish(ch, P, T, cand, nc0, q, sig, 0, NULL, 1); /* the candidates, patiently */
     if (ns > 0)
         return ns;
+    return g6_sampled(ch, P, T, cand, q, sig, 0);
+}
+
+/* The sampled null spaces of g6_rescue: each variant's Sigma at its 24 sample
+ * angles split into candidates, polished onto T and appended to the ns rows of q
+ * (duplicates dropped); the first variant that adds a row ends it. Returns the
+ * rows. */
+static int g6_sampled(const Chain *ch, const double *P, const double *T, G6Cand *cand,
+                      double *q, double *sig, int ns)
+{
+    const int ns0 = ns;
+    const int nv = (int)P[GP_NVAR];
     for (int v = 0; v < nv; v++) {
         G6Var V;
         if (!g6_prepare(P + GP_HEAD + v * VB_SIZE, T, &V))
@@ -2388,11 +2402,11 @@ static int g6_rescue(const Chain *ch, const double *P, const double *T, G6Cand *
                 n0++;
             nc += g6_from_basis(&G, th, Z, n0, 1, cand + nc, G6_MAXCAND - nc);
         }
-        ns = g6_polish(ch, P, T, cand, nc, q, sig, 0, NULL, 1);
-        if (ns > 0)
+        ns = g6_polish(ch, P, T, cand, nc, q, sig, ns, NULL, 1);
+        if (ns > ns0)
             return ns;
     }
-    return 0;
+    return ns;
 }
 
 static int g6_pose(const Chain *ch, const double *P, const double *T, double *q, double *sig,
@@ -2415,11 +2429,201 @@ static int g6_pose(const Chain *ch, const double *P, const double *T, double *q,
         ((flags & (G6F_DEGENERATE | G6F_NOISY)) || best < G6_FAR * fmax(1.0, P[GP_SCALE]))) {
         ns = g6_rescue(ch, P, T, cand, nc, q, sig);
         flags |= G6F_RESCUED;
+    } else if (ns > 0 && P[GP_FALLBACK] != 0.0 &&
+               (flags & G6F_DEGENERATE) && (flags & G6F_SEC_DEGENERATE) &&
+               (flags & G6F_NOISY) && (flags & G6F_SEC_NOISY)) {
+        /* every variant degenerate and noisy, some rows found: a near-continuum
+         * (the offset iiwa with q4 = -1e-9: axes 3 and 5 1e-9 from one line) whose
+         * rows neither the roots nor the projection gave; its members lie in the
+         * sampled null spaces as a continuum's do */
+        ns = g6_sampled(ch, P, T, cand, q, sig, ns);
+        flags |= G6F_RESCUED;
     }
     *diag = flags | ((long long)nc << G6_DIAG_CAND_SHIFT);
     if (ns == 0 && (flags & G6F_DEGENERATE) &&
         (P[GP_FALLBACK] == 0.0 || (flags & G6F_PROJ_DEGENERATE)))
         return -2;
+    return ns;
+}
+
+/* ------------------------------------------------- joints on one line */
+
+/* A solution with two free joints on one line (equal Jacobian columns up to the
+ * sign sigma: the offset iiwa with q4 = 0 puts axes 3 and 5 on one line) lies on a
+ * continuum: only q_i + sigma q_j is fixed, and the elimination returns whichever
+ * split its null vector gave (issue 23: six of 857 singular special configurations,
+ * every split outside the limits). Such rows are re-split inside the limits
+ * (g6_coaxial_row); only rows outside the limits with a Jacobian singular value
+ * below G6_COAX_SIG per metre are looked at, so regular poses are untouched. */
+#define G6_COAX_SIG 1e-6  /* [per m of arm] a row's sigma below this: look for a pair */
+#define G6_COAX_DIFF 1e-8 /* [per m of arm] Jacobian columns this close: one line */
+
+/* The value of coordinate j nearest pref (within j's limits) such that q_i = phi -
+ * sigma q_j lies within i's limits by whole turns; NaN when no split does. */
+static double g6_split_pair(const Chain *ch, int i, int j, double phi, double sigma,
+                            double pref)
+{
+    double best = NAN, bestd = INFINITY;
+    for (int m = -2; m <= 2; m++) {
+        double c = phi + 2.0 * M_PI * m, lo, hi;
+        if (sigma > 0.0) {
+            lo = c - ch->hi[i];
+            hi = c - ch->lo[i];
+        } else {
+            lo = ch->lo[i] - c;
+            hi = ch->hi[i] - c;
+        }
+        lo = fmax(lo, ch->lo[j]);
+        hi = fmin(hi, ch->hi[j]);
+        if (lo > hi)
+            continue;
+        double v = fmin(fmax(pref, lo), hi), d = fabs(v - pref);
+        if (d < bestd) {
+            bestd = d;
+            best = v;
+        }
+    }
+    return best;
+}
+
+static int g6_inside(const Chain *ch, const double *qs)
+{
+    int in = 1;
+    for (int j = 0; j < 6; j++)
+        in &= within_limits(wrap_into(qs[j], ch->lo[j], ch->hi[j]), ch->lo[j], ch->hi[j]);
+    return in;
+}
+
+/* Row qs (coordinates, outside the limits): each pair of joints on one line whose
+ * split is outside the limits is re-split inside them (two passes, as pieper.c's
+ * pk_repair), then polished onto T (g6_polish: the columns agree to G6_COAX_DIFF,
+ * not exactly, so the moved row is off by up to ~1e-8). Kept (qs, *sg replaced)
+ * when the polished row reproduces T and lies inside the limits; returns 1 then. */
+static int g6_coaxial_row(const Chain *ch, const double *P, const double *T, double *qs,
+                          double *sg)
+{
+    const double scale = fmax(1.0, P[GP_SCALE]);
+    double trial[6];
+    int moved = 0;
+    memcpy(trial, qs, sizeof(trial));
+    for (int pass = 0; pass < 2; pass++) {
+        vd qv[MAXJ], t[12], J[36];
+        for (int j = 0; j < 6; j++)
+            qv[j] = BR(trial[j]);
+        chain_pose_jac(ch, qv, t, J, 6);
+        for (int i = 0; i < 6; i++)
+            for (int j = i + 1; j < 6; j++) {
+                double dot = J[18 + i][0] * J[18 + j][0] + J[24 + i][0] * J[24 + j][0] +
+                             J[30 + i][0] * J[30 + j][0];
+                double sigma = dot >= 0.0 ? 1.0 : -1.0, diff = 0.0;
+                for (int r = 0; r < 6; r++)
+                    diff = fmax(diff, fabs(J[6 * r + i][0] - sigma * J[6 * r + j][0]));
+                if (!(diff < G6_COAX_DIFF * scale))
+                    continue;
+                double qi = wrap_into(trial[i], ch->lo[i], ch->hi[i]);
+                double qj = wrap_into(trial[j], ch->lo[j], ch->hi[j]);
+                if (within_limits(qi, ch->lo[i], ch->hi[i]) &&
+                    within_limits(qj, ch->lo[j], ch->hi[j]))
+                    continue;
+                double phi = trial[i] + sigma * trial[j];
+                double v = g6_split_pair(ch, i, j, phi, sigma, qj);
+                if (isnan(v))
+                    continue;
+                trial[j] = v;
+                trial[i] = phi - sigma * v;
+                moved = 1;
+            }
+    }
+    if (!moved)
+        return 0;
+    G6Cand c = {{0.0}, 0};
+    for (int j = 0; j < 6; j++)
+        c.v[j] = ch->sign[j] * trial[j] + ch->offset[j];
+    double out[6 * G6_MAXSOL], osg[G6_MAXSOL];
+    if (g6_polish(ch, P, T, &c, 1, out, osg, 0, NULL, 0) != 1 || !g6_inside(ch, out))
+        return 0;
+    memcpy(qs, out, sizeof(trial));
+    *sg = osg[0];
+    return 1;
+}
+
+/* Row qs (coordinates), singular, outside the limits by at most G6_SLIDE_REACH:
+ * next to a singular configuration the exact configurations form a thin set along
+ * the Jacobian's null vector n, and the in-limit one may be a small step away (the
+ * offset iiwa with q3 = -1e-9 and q6 at its limit: the row 1.7e-7 past it, sigma
+ * 6e-12). The smallest step t n that puts every joint inside (each joint's
+ * interval for t intersected), then g6_polish; kept (qs, *sg replaced) when the
+ * polished row reproduces T and lies inside the limits; returns 1 then. */
+#define G6_SLIDE_REACH 1e-3 /* [rad] rows farther outside are not slid */
+static int g6_slide_row(const Chain *ch, const double *P, const double *T, double *qs,
+                        double *sg)
+{
+    double w[6], tlo = -INFINITY, thi = INFINITY, excess = 0.0;
+    for (int j = 0; j < 6; j++) {
+        w[j] = wrap_into(qs[j], ch->lo[j], ch->hi[j]);
+        excess = fmax(excess, fmax(w[j] - ch->hi[j], ch->lo[j] - w[j]));
+    }
+    if (!(excess <= G6_SLIDE_REACH))
+        return 0;
+    vd qv[MAXJ], t[12], Jv[36];
+    double J[36], n[6], r[6];
+    for (int j = 0; j < 6; j++)
+        qv[j] = BR(w[j]);
+    chain_pose_jac(ch, qv, t, Jv, 6);
+    for (int k = 0; k < 36; k++)
+        J[k] = Jv[k][0];
+    null_basis(J, 6, 1, n, r);
+    for (int j = 0; j < 6; j++) {
+        double a = ch->lo[j] - w[j], b = ch->hi[j] - w[j]; /* n_j t in [a, b] */
+        if (fabs(n[j]) < 1e-12) {
+            if (a > LIMIT_SLACK || b < -LIMIT_SLACK)
+                return 0;
+            continue;
+        }
+        double ta = a / n[j], tb = b / n[j];
+        tlo = fmax(tlo, fmin(ta, tb));
+        thi = fmin(thi, fmax(ta, tb));
+    }
+    if (!(tlo <= thi))
+        return 0;
+    double step = fmin(fmax(0.0, tlo), thi);
+    step += step > 0.0 ? 0.01 * (thi - step) : step < 0.0 ? 0.01 * (tlo - step) : 0.0;
+    G6Cand c = {{0.0}, 0};
+    for (int j = 0; j < 6; j++)
+        c.v[j] = ch->sign[j] * (w[j] + step * n[j]) + ch->offset[j];
+    double out[6 * G6_MAXSOL], osg[G6_MAXSOL];
+    if (g6_polish(ch, P, T, &c, 1, out, osg, 0, NULL, 0) != 1 || !g6_inside(ch, out))
+        return 0;
+    memcpy(qs, out, sizeof(double) * 6);
+    *sg = osg[0];
+    return 1;
+}
+
+/* g6_coaxial_row, else g6_slide_row, on every singular row of q (ns rows) outside
+ * the limits; a moved row that lands on another row (within GP_DEDUPE) is dropped.
+ * Returns the rows. */
+static int g6_coaxial_rows(const Chain *ch, const double *P, const double *T, double *q,
+                           double *sig, int ns)
+{
+    const double scale = fmax(1.0, P[GP_SCALE]);
+    for (int s = 0; s < ns; s++) {
+        if (!(sig[s] < G6_COAX_SIG * scale) || g6_inside(ch, q + 6 * s) ||
+            !(g6_coaxial_row(ch, P, T, q + 6 * s, sig + s) ||
+              g6_slide_row(ch, P, T, q + 6 * s, sig + s)))
+            continue;
+        for (int o = 0; o < ns; o++) {
+            double m = 0.0;
+            for (int j = 0; o != s && j < 6; j++)
+                m = fmax(m, fabs(wrap_pi(q[6 * s + j] - q[6 * o + j])));
+            if (o != s && m < P[GP_DEDUPE]) { /* a duplicate: drop row s */
+                memmove(q + 6 * s, q + 6 * (s + 1), sizeof(double) * 6 * (ns - s - 1));
+                memmove(sig + s, sig + s + 1, sizeof(double) * (ns - s - 1));
+                ns--;
+                s--;
+                break;
+            }
+        }
+    }
     return ns;
 }
 
@@ -2441,6 +2645,7 @@ static void g6_range(void *ctx, long b, long e)
         job->status[i] = ns == -1 ? G6_BAD_POSE : ns == -2 ? G6_DEGENERATE
                          : ns == 0 ? G6_NONE : G6_OK;
         ns = ns < 0 ? 0 : ns;
+        ns = g6_coaxial_rows(job->ch, job->P, job->T + 16 * i, q, sig, ns);
         double *Qo = job->Q + (size_t)i * 6 * G6_MAXSOL;
         const Chain *ch = job->ch;
         for (int s = 0; s < G6_MAXSOL; s++) {
