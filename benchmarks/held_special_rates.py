@@ -29,7 +29,7 @@ from test_fixed_properties import NON_SINGULAR, ROBOTS, special_batch  # noqa: E
 
 from reference import pose_errors  # noqa: E402
 
-#: The property tests' cases and the Panda with joint 1, 2 or 3 held (~2 min of the
+#: The property tests' cases and the Panda with joint 1, 2 or 3 held (~1 min of the
 #: run at n 3000: joints 2 and 3 take a reduced chain per held value)
 CASES = [("panda", j) for j in (0, 1, 2)] + HELD_CASES
 
