@@ -1,7 +1,8 @@
 """Held-joint IK of 7R arms on special-value configurations: completeness rates.
 
-For the Panda (joints 4-7 held) and the exact SRS arm of the property tests (every
-joint held), ``--n`` configurations per held joint, each joint a third of the time
+For the Panda (every joint held: joints 1-3 through the general 6R path,
+``coincident`` and ``near_coincident``; joints 4-7 the held closed form) and the exact
+SRS arm of the property tests (every joint held), ``--n`` configurations per held joint, each joint a third of the time
 uniform in its limits, a third from {0, +-pi/2, pi, +-1e-9, +-1e-7, +-1e-6}, a
 third at a limit (``tests/kinematics/ik/test_fixed_properties.special_batch``).
 Reported per case: non-singular configurations (remaining 6 x 6 Jacobian's smallest
@@ -23,9 +24,14 @@ import numpy as np
 sys.path[:0] = [str(pathlib.Path(__file__).resolve().parents[1] / p)
                 for p in ("tests", "tests/kinematics/ik")]
 
-from test_fixed_properties import CASES, NON_SINGULAR, ROBOTS, special_batch  # noqa: E402
+from test_fixed_properties import CASES as HELD_CASES  # noqa: E402
+from test_fixed_properties import NON_SINGULAR, ROBOTS, special_batch  # noqa: E402
 
 from reference import pose_errors  # noqa: E402
+
+#: The property tests' cases and the Panda with joint 1, 2 or 3 held (~1 min of the
+#: run at n 3000: joints 2 and 3 take a reduced chain per held value)
+CASES = [("panda", j) for j in (0, 1, 2)] + HELD_CASES
 
 
 def rates(arm: str, j: int, n: int, seed: int) -> dict:

@@ -435,6 +435,19 @@ class Kernels(Protocol):
     ) -> tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]:
         """``(Q (N, 8, n), valid, singular, within_limits (N, 8), status (N,))``."""
 
+    def pieper_limit_rows(
+        self,
+        params: F64,
+        T: F64,
+        x: F64,
+        Q: F64,
+        valid: Bools,
+        singular: Bools,
+        inside: Bools,
+        /,
+    ) -> None:
+        """Rows of a held 7R chain moved into the limits in place (pk_walk, pk_pin)."""
+
     def pieper_roots(self, coeffs: F64, re: F64, im: F64, /) -> None:
         """The four roots of a quartic (coefficients lowest order first)."""
 

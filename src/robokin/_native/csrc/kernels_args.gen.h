@@ -72,6 +72,7 @@ static const KOpt opts_sp_ranges[] = {{SP_VERTEX_TRIES, 1, 1, 0.0, 1000000000000
     X(sp4_pair, "sp4_pair(x, tol, mirror, lane, one) -> None: Subproblem 4 of rows x (N, 7) in lanes and one at a time (for tests).") \
     X(pieper_ik1, "pieper_ik1(T, params, x, qn) -> tuple[int, F64, Bools, Bools, Bools] | tuple[int, None, None, None, None]: ``(code, Q (8, n), valid, singular, within_limits (8,))`` of one pose.") \
     X(pieper_ik, "pieper_ik(params, T, x, qn) -> tuple[F64, Bools, Bools, Bools, npt.NDArray[np.int8]]: ``(Q (N, 8, n), valid, singular, within_limits (N, 8), status (N,))``.") \
+    X(pieper_limit_rows, "pieper_limit_rows(params, T, x, Q, valid, singular, inside) -> None: Rows of a held 7R chain moved into the limits in place (pk_walk, pk_pin).") \
     X(pieper_roots, "pieper_roots(coeffs, re, im) -> None: The four roots of a quartic (coefficients lowest order first).") \
     X(general6r_solve, "general6r_solve(packed, params, T, Q, valid, inside, sigma, status, diag, stats, parallel) -> None: Every solution of poses T (N, 4, 4): Q (N, 16, 6), masks (N, 16), ...") \
     X(general6r_fit_rows, "general6r_fit_rows(consts, a, angles, X, Y) -> None: The left side's fitting rows at angles (M, 3): X (M, 27), Y (M, 14).") \
@@ -126,6 +127,7 @@ typedef struct { const double *y; const double *x; double *out; union { struct {
 typedef struct { const double *x; double tol; int mirror; double *lane; double *one; union { struct { npy_intp N; }; npy_intp sym[1]; }; } sp4_pair_args; /* six_r.c */
 typedef struct { PyObject *T; const double *params; double x; PyObject *qn; } pieper_ik1_args; /* pieper.c */
 typedef struct { const double *params; const double *T; const double *x; const double *qn; union { struct { npy_intp N, m, mq, nq; }; npy_intp sym[4]; }; } pieper_ik_args; /* pieper.c */
+typedef struct { const double *params; const double *T; const double *x; double *Q; const npy_bool *valid; const npy_bool *singular; npy_bool *inside; union { struct { npy_intp N, k, nq; }; npy_intp sym[3]; }; } pieper_limit_rows_args; /* pieper.c */
 typedef struct { const double *coeffs; double *re; double *im; } pieper_roots_args; /* pieper.c */
 typedef struct { Chain packed; const double *params; const double *T; double *Q; npy_bool *valid; npy_bool *inside; double *sigma; long long *status; long long *diag; double *stats; int parallel; union { struct { npy_intp n, nc, P, N; }; npy_intp sym[4]; }; } general6r_solve_args; /* general6r.c */
 typedef struct { const double *consts; long a; const double *angles; double *X; double *Y; union { struct { npy_intp M; }; npy_intp sym[1]; }; } general6r_fit_rows_args; /* general6r.c */

@@ -1721,16 +1721,17 @@ static int pk_pin(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *
 
 /* The last resorts (pk_walk, then pk_pin) for every valid row flagged singular and
  * outside the limits of a pose none of whose rows came inside: th from the row's
- * coordinates. */
+ * coordinates; o has `slots` rows (8 from this kernel, 16 from the general 6R
+ * solver through pieper_limit_rows). */
 static void pk_walk_rows(const double *P, const PkGeo *g, const m3 *RT, v3 pT, int held,
-                         double x, PkOut o)
+                         double x, PkOut o, int slots)
 {
-    for (int slot = 0; slot < 8; slot++)
+    for (int slot = 0; slot < slots; slot++)
         if (o.valid[slot] && o.inside[slot])
             return;
     if (!pk_held_inside(P, held, x))
         return; /* no row can come inside */
-    for (int slot = 0; slot < 8; slot++) {
+    for (int slot = 0; slot < slots; slot++) {
         if (!o.valid[slot] || !o.sing[slot])
             continue;
         double th[6], *qs = o.Q + o.n * slot;
@@ -1927,7 +1928,7 @@ static int pk_one(const double *P, const double *T, double x, const double *qn, 
         if ((lmask >> slot & 1u) && pk_slide(P, g, RT, pT, late[slot]))
             o.inside[slot] = pk_coords(P, g, late[slot], held, x, o.Q + o.n * slot) >= -1e-9;
     if (any)
-        pk_walk_rows(P, g, RT, pT, held, x, o);
+        pk_walk_rows(P, g, RT, pT, held, x, o, 8);
     return any ? PK_OK : PK_NO_ORIENTATION;
 }
 
@@ -2027,6 +2028,33 @@ static PyObject *pieper_ik_body(const pieper_ik_args *a)
     PkJob jb = {P, a->T, a->x, a->qn, (long)a->m, (long)a->mq, n, PK_F64(out[0]), PK_U8(out[1]), PK_U8(out[2]),
                 PK_U8(out[3]), (signed char *)PyArray_DATA((PyArrayObject *)status)};
     return ik_run_batch(N, PK_PARALLEL_MIN, PK_GRAIN, pk_range, &jb, out, status);
+}
+
+/* pieper_limit_rows(params, T (N, 4, 4), x (N,), Q (N, k, n), valid, singular,
+ * inside (N, k)): the last resorts of pk_walk_rows (pk_walk, then pk_pin) on rows
+ * another solver returned for a 7R chain with joint PK_HELD held at x[i] (the
+ * general 6R path: the Panda with joint 1, 2 or 3 held; params from
+ * pieper.limit_params, no triple needed). A pose none of whose valid rows is
+ * inside: each valid row flagged singular is moved along its family, or pinned at
+ * the limit it passed, into the limits, exactly (PK_ACCEPT); Q and inside are
+ * updated in place. Other poses and rows are left as they are. */
+static PyObject *pieper_limit_rows_body(const pieper_limit_rows_args *a)
+{
+    const double *P = a->params;
+    int n = (int)P[PK_N], held = (int)P[PK_HELD];
+    long k = (long)a->k;
+    for (npy_intp i = 0; i < a->N; i++) {
+        const double *T = a->T + 16 * i;
+        double x = a->x[i];
+        PkOut o = {a->Q + k * n * i, (unsigned char *)a->valid + k * i,
+                   (unsigned char *)a->singular + k * i, (unsigned char *)a->inside + k * i, n};
+        PkGeo g;
+        pk_geometry(P, x, &g);
+        m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
+        v3 pT = {T[3], T[7], T[11]};
+        pk_walk_rows(P, &g, &RT, pT, held, x, o, (int)k);
+    }
+    Py_RETURN_NONE;
 }
 
 /* pieper_roots(coeffs (5,), re (4,), im (4,)): the quartic solver (for tests) */

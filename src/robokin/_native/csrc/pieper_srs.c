@@ -681,7 +681,7 @@ static int pk_srs_reach(const double *P, const PkGeo *g, const m3 *RT, v3 pT, do
         inside |= o.valid[slot] && o.inside[slot];
     if (!inside && held != 3 && el.outer < 1e-3)
         ps_band_family(P, g, RT, pT, S, Wp, w, &G, &el, &ta, &tb, held, tk, x, qn, o);
-    pk_walk_rows(P, g, RT, pT, held, x, o);
+    pk_walk_rows(P, g, RT, pT, held, x, o, 8);
     for (int slot = 0; slot < 8; slot++)
         if (o.valid[slot])
             return PK_OK;

@@ -144,7 +144,10 @@ def solve_fixed(
             sols = dispatch(reduced, Tb[rows], q_near=None if qn is None else qn[rows],
                             method=method, **options)
             parts.append((rows, sols))
-    return _assemble(robot, lead, idx, keep, V, parts, dict(zip(fixed, values)))
+    out = _assemble(robot, lead, idx, keep, V, parts, dict(zip(fixed, values)))
+    if len(idx) == 1 and method != "numeric" and not options:
+        out = _into_limits(robot, idx[0], Tb, V[:, 0], out)
+    return out
 
 
 def solve_held_single(robot: Arm, T: object, fixed: object) -> SolutionSet | None:
@@ -179,6 +182,9 @@ def solve_held_single(robot: Arm, T: object, fixed: object) -> SolutionSet | Non
         out = _near_single(robot, T, name, float(value))
         if out is None:
             out = _end_single(robot, T, name, float(value))
+        if out is not None and T.shape == (4, 4) and T.dtype == np.float64:
+            out = _into_limits(robot, robot.joint_names.index(name), T,
+                               np.array([float(value)]), out)
     # "ok" has rows (read first: counting them costs a numpy reduction); no row for a
     # rotation off SO(3) by rounding: None, and solve_fixed projects it and solves
     if out is not None and (out.status.item() == "ok" or len(out)
@@ -272,6 +278,62 @@ def _end_held(robot: Arm, name: str) -> EndHeld | None:
 #: Per arm: joint name -> :class:`EndHeld` (or None), filled on first use of each.
 END_HELD: Derived[dict[str, EndHeld | None]] = Derived("end-joint held solvers",
                                                        lambda arm: {})
+
+
+#: Per arm: held joint index -> ``pieper.limit_params`` (or None), filled on first use
+LIMIT_PARAMS: Derived[dict[int, np.ndarray | None]] = Derived("held-joint limit params",
+                                                              lambda arm: {})
+
+
+def _into_limits(robot: Arm, j: int, T: np.ndarray, x: np.ndarray,
+                 sols: SolutionSet) -> SolutionSet:
+    """Singular rows of a held 7R arm moved into the limits where no row is inside.
+
+    The general 6R path (and ``coincident``/``near_coincident``) returns exact rows
+    on a one-parameter family next to a singular configuration; the one it finds
+    can lie just past a limit (1e-8 to 1e-5 rad: the Panda with joint 1, 2 or 3
+    held, a joint at its limit and q5 or q2 at 1e-6) while other members are inside.
+    The held closed form's last resorts (``pieper_limit_rows``: ``pk_walk`` along
+    the family, else ``pk_pin`` at the limit passed) move them, exactly (4e-13).
+    Only poses with a valid singular row and no valid in-limit row are touched.
+
+    Args:
+        robot: The arm (7R).
+        j: The held joint's index.
+        T: The poses (N, 4, 4) [m], as ``sols``'s leading shape flattened.
+        x: The held values (N,) [rad].
+        sols: The assembled set (leading shape flattening to N).
+
+    Returns:
+        ``sols``, or a new set with those rows and their ``within_limits`` updated.
+    """
+    valid = sols.valid
+    inside = sols.within_limits
+    need = (valid & sols.singular).any(axis=-1) & ~inside.any(axis=-1)
+    if not need.any() or robot.n != 7:
+        return sols
+    table = robot.derived(LIMIT_PARAMS)
+    if j not in table:
+        table[j] = _pk.limit_params(robot.chain, j)
+    P = table[j]
+    if P is None:
+        return sols
+    k = valid.shape[-1]
+    rows = np.flatnonzero(need.reshape(-1))
+    q = np.array(sols.q, dtype=np.float64).reshape(-1, k, 7)
+    within = np.array(inside).reshape(-1, k)
+    Q = np.ascontiguousarray(q[rows])
+    ins = np.ascontiguousarray(within[rows])
+    _native.kernels.pieper_limit_rows(P, np.ascontiguousarray(T.reshape(-1, 4, 4)[rows]),
+                              np.ascontiguousarray(x.reshape(-1)[rows], dtype=np.float64), Q,
+                              np.ascontiguousarray(valid.reshape(-1, k)[rows]),
+                              np.ascontiguousarray(sols.singular.reshape(-1, k)[rows]), ins)
+    q[rows], within[rows] = Q, ins
+    flags = dict(sols.flags)
+    flags["within_limits"] = within.reshape(valid.shape)
+    return SolutionSet._trusted(q.reshape(sols.q.shape), valid, sols.is_revolute, sols.limits,
+                                flags, sols.branches, sols.status, sols.method, sols.error,
+                                sols.info)
 
 
 def _coincident_parts(robot: Arm, j: int, T: np.ndarray, v: np.ndarray,

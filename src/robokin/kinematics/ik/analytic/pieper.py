@@ -84,7 +84,8 @@ from robokin.kinematics.ik.analytic._geometry import (
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.model.chain import Chain
 
-__all__ = ["NAME", "FamilySolver", "Setup", "family_solver", "make_single", "measure", "raw_solve", "setup",
+__all__ = ["NAME", "FamilySolver", "Setup", "family_solver", "limit_params", "make_single", "measure",
+           "raw_solve", "setup",
            "solve"]
 
 NAME = "pieper"
@@ -224,15 +225,32 @@ def setup(chain: Chain, held: int | None = None, *, tol: float = 1e-9,
         if angle_between_axes(h[i], h[i + 1]) < 1e-6 and np.linalg.norm(
                 np.cross(o[i + 1] - o[i], h[i])) < lim:
             return Setup(None, f"axes {i + 1} and {i + 2} of the six coincide")
-    P = np.zeros(K.PIEPER_N_PARAMS)
-    P[K.PIEPER_N] = n
-    P[K.PIEPER_HELD] = -1 if held is None else held
+    P = _chain_params(chain, poe, held, scale)
     P[K.PIEPER_CASE] = K.PIEPER_BOTH if both else case
     if both:
         P[K.PIEPER_POINT2:K.PIEPER_POINT2 + 3] = meets[K.PIEPER_END][1]
     P[K.PIEPER_SING_TOL] = singular_tol
-    P[K.PIEPER_SCALE] = scale
     P[K.PIEPER_POINT:K.PIEPER_POINT + 3] = point
+    P.setflags(write=False)
+    which = "1-3" if case == K.PIEPER_START else "4-6"
+    text = f"axes {which} meet within {dist:.1e} m"
+    if both:
+        text = (f"axes 1-3 and 5-7 meet within {max(d for d, _, _ in meets.values()):.1e}"
+                " m (an SRS arm: solved on its swivel)")
+    return Setup(P, measured=text, held=held)
+
+
+def _chain_params(chain: Chain, poe: Poe, held: int | None, scale: float) -> np.ndarray:
+    """The chain part of a parameter vector (writable).
+
+    Axes, points, tool, the joints' signs, offsets and limits, the held joint and
+    the length scale: what every kernel path reads, triple or not.
+    """
+    n = chain.n_chain
+    P = np.zeros(K.PIEPER_N_PARAMS)
+    P[K.PIEPER_N] = n
+    P[K.PIEPER_HELD] = -1 if held is None else held
+    P[K.PIEPER_SCALE] = scale
     P[K.PIEPER_AXES:K.PIEPER_AXES + 3 * n] = poe.h.ravel()
     P[K.PIEPER_POINTS:K.PIEPER_POINTS + 3 * n] = poe.o.ravel()
     P[K.PIEPER_TOOL_R:K.PIEPER_TOOL_R + 9] = poe.M[:3, :3].ravel()
@@ -243,13 +261,25 @@ def setup(chain: Chain, held: int | None = None, *, tol: float = 1e-9,
     P[K.PIEPER_LO:K.PIEPER_LO + n] = lims[:, 0]
     P[K.PIEPER_HI:K.PIEPER_HI + n] = lims[:, 1]
     P[K.PIEPER_TAG] = K.PIEPER_TAG_VALUE
+    return P
+
+
+def limit_params(chain: Chain, held: int) -> np.ndarray | None:
+    """The parameter vector of ``pieper_limit_rows`` for a 7R chain with joint ``held`` held.
+
+    No meeting triple is needed: the kernel's last resorts (``pk_walk``, ``pk_pin``)
+    read only the chain, its limits and the held joint. None for anything but an
+    all-revolute 7R chain without dependent joints.
+    """
+    if not chain.coupling.is_identity or chain.n_chain != 7 or not 0 <= held < 7:
+        return None
+    poe = poe_from_chain(chain)
+    if poe.prismatic.any():
+        return None
+    P = _chain_params(chain, poe, held, _scale(poe))
+    P[K.PIEPER_CASE] = K.PIEPER_START  # read by no last resort
     P.setflags(write=False)
-    which = "1-3" if case == K.PIEPER_START else "4-6"
-    text = f"axes {which} meet within {dist:.1e} m"
-    if both:
-        text = (f"axes 1-3 and 5-7 meet within {max(d for d, _, _ in meets.values()):.1e}"
-                " m (an SRS arm: solved on its swivel)")
-    return Setup(P, measured=text, held=held)
+    return P
 
 
 _NO_VALUE = np.zeros(1)
