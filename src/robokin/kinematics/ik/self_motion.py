@@ -48,12 +48,12 @@ from robokin._validation import check_finite, check_joints, check_rigid
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import ArmSource, arm_of
 from robokin.kinematics.ik.fixed import Dispatch
+from robokin.kinematics.ik.self_motion_base import _Family
 from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
 from robokin.kinematics.ik.self_motion_families import (
     LimitCrossing,
     SelfMotionSetup,
     SingularPoint,
-    _Family,
     _family,
     _HeldFamily,
     _setup,

@@ -185,7 +185,7 @@ class _ContinuedFamily(_Family):
         mi, bi = np.nonzero(ok)
         q, good = _newton_held(self.robot, self.T, Q[mi, bi], np.full(len(mi), self.joint),
                                t[mi])
-        out = Q.copy()
+        out: np.ndarray = Q.copy()
         out[mi[good], bi[good]] = q[good]
         return out
 

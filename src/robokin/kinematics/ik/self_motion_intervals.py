@@ -15,10 +15,10 @@ import numpy as np
 
 from robokin._native import kernels as K
 from robokin.kinematics.arm import Arm
+from robokin.kinematics.ik.self_motion_base import _Family
 from robokin.kinematics.ik.self_motion_families import (
     LimitCrossing,
     SingularPoint,
-    _Family,
     _HeldFamily,
     _setup,
 )

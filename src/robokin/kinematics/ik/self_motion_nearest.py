@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robokin.kinematics.ik.self_motion_families import _Family
+from robokin.kinematics.ik.self_motion_base import _Family
 from robokin.spatial import wrap_angle as _wrap
 
 __all__ = ["interval_nearest"]
