@@ -368,16 +368,23 @@ def test_shoulder_held_singular_rows_come_inside(arm, j, q):
     assert dp.max() <= 1e-12 and dr.max() <= 1e-12
 
 
-# Known gap (docs/ik.md, "joint 1, 2 or 3 held"): joint 2 held, q3 and q6 at 1e-6
-# (smallest singular value 1e-7), found by held_special_rates.py (n 3000, seed 0).
-# None of the six rows is flagged singular and the nearest is 0.70 rad from q: the
-# general 6R elimination loses the branch next to the singularity (no limit repair
-# applies). Oracle: check_held (an in-limit row at a singular in-limit q).
-@pytest.mark.xfail(strict=True, reason="general 6R branch lost next to q3 = q6 = 0")
+# Formerly a strict xfail (issue 23), found by held_special_rates.py (n 3000, seed
+# 0): joint 2 held, q3 and q6 at 1e-6 (smallest singular value 1e-7). The general 6R
+# elimination's two candidates for this near-double root were 4e-6 rad off with
+# errors 1e-11; the full Newton step overshot (error 1e-6) and the polish dropped
+# them; g6_refine halves such steps. Oracle: check_held (an in-limit row at a
+# singular in-limit q), and the row is q itself, flagged singular, exact.
 def test_shoulder_held_lost_branch_next_to_singular():
-    check_held(PANDA, 1, np.array([np.pi / 2, 1.4919118570754417, 1e-06,
-                                   -2.914073131349491, np.pi / 2, 1e-06,
-                                   -2.3771437465128407]))
+    q = np.array([np.pi / 2, 1.4919118570754417, 1e-06, -2.914073131349491, np.pi / 2,
+                  1e-06, -2.3771437465128407])
+    check_held(PANDA, 1, q)
+    T = PANDA.fk(q)
+    sols = PANDA.ik(T, fixed={PANDA.joint_names[1]: float(q[1])})
+    near = sols.valid & (_angle_gap(sols.q, q) <= 1e-6)
+    assert near.sum() == 1
+    assert (sols.within_limits & sols.singular)[near].all()
+    dp, dr = pose_errors(PANDA.fk(sols.q[near]), T)
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12
 
 
 @pytest.mark.parametrize(("arm", "j"), CASES, ids=IDS)

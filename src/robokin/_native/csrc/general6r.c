@@ -2236,6 +2236,64 @@ static int g6_step(const vd *J, const vd *e, int l, double *dq)
  * differ by less than GP_DEDUPE, or than 1e-10 / sigma (capped at 1e-3) for a
  * near-singular one (Newton leaves it 1e-15 / sigma off). *best: the smallest final
  * error of any candidate. Returns the solutions in q. */
+#define G6_NEAR_MISS 1e-9 /* [m per m of arm, rad] a lane ending this close: g6_refine */
+
+/* Lane l of qv (chain values) ended within G6_NEAR_MISS of T but above the
+ * tolerance: next to a near-double root (a solution with sigma ~ 1e-7, the
+ * candidate a few 1e-6 rad off along the near-null direction, issue 23's Panda with
+ * joint 2 held) the full step overshoots (the error grows from 1e-11 to 1e-6) and
+ * the lane stalls at its start. Here each step is halved until the error falls
+ * (at most 40 halvings, 100 steps), from the lane's best. Returns 1 when the lane
+ * now meets (tol_p, tol_r) (qv's lane l is then the refined point), else 0 and qv
+ * is unchanged. */
+static int g6_refine(const Chain *ch, const vd *tt, vd *qv, int l, double tol_p,
+                     double tol_r, double floor_err)
+{
+    vd qq[MAXJ], t[12], J[36], e[6];
+    double q0[6], ep = 0.0, er = 0.0, m0 = 0.0;
+    for (int j = 0; j < 6; j++)
+        q0[j] = qv[j][l];
+    for (int it = 0; it < 100; it++) {
+        for (int j = 0; j < 6; j++)
+            qq[j] = BR(q0[j]);
+        chain_pose_jac(ch, qq, t, J, 6);
+        pose_residual(t, tt, e, BRL(-1));
+        ep = sqrt(e[0][0] * e[0][0] + e[1][0] * e[1][0] + e[2][0] * e[2][0]);
+        er = sqrt(e[3][0] * e[3][0] + e[4][0] * e[4][0] + e[5][0] * e[5][0]);
+        m0 = 0.0;
+        for (int r = 0; r < 6; r++)
+            m0 = fabs(e[r][0]) > m0 ? fabs(e[r][0]) : m0;
+        if (!(m0 > floor_err))
+            break;
+        double dq[6], lam = 1.0;
+        if (!g6_step(J, e, 0, dq))
+            break;
+        int moved = 0;
+        for (int h = 0; h < 40 && !moved; h++, lam *= 0.5) {
+            vd qt[MAXJ], tq[12], Jt[36], et[6];
+            for (int j = 0; j < 6; j++)
+                qt[j] = BR(q0[j] + lam * dq[j]);
+            chain_pose_jac(ch, qt, tq, Jt, 6);
+            pose_residual(tq, tt, et, BRL(-1));
+            double m = 0.0;
+            for (int r = 0; r < 6; r++)
+                m = fabs(et[r][0]) > m ? fabs(et[r][0]) : m;
+            if (m < m0) {
+                for (int j = 0; j < 6; j++)
+                    q0[j] += lam * dq[j];
+                moved = 1;
+            }
+        }
+        if (!moved)
+            break;
+    }
+    if (!(ep <= tol_p && er <= tol_r))
+        return 0;
+    for (int j = 0; j < 6; j++)
+        qv[j][l] = q0[j];
+    return 1;
+}
+
 static int g6_polish(const Chain *ch, const double *P, const double *T, const G6Cand *cand,
                      int ncand, double *q, double *sig, int nsol, double *best, int patient)
 {
@@ -2320,6 +2378,20 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
                     qv[j][l] = qbest[j][l];
             }
         if (worse) {
+            chain_pose_jac(ch, qv, t, J, 6);
+            pose_residual(t, tt, e, BRL(-1));
+        }
+        int refined = 0; /* near misses: halved steps (the other lanes unchanged) */
+        for (int l = 0; l < W && c0 + l < ncand; l++) {
+            double m = 0.0;
+            for (int r = 0; r < 6; r++)
+                m = fabs(e[r][l]) > m ? fabs(e[r][l]) : m;
+            double ep = sqrt(e[0][l] * e[0][l] + e[1][l] * e[1][l] + e[2][l] * e[2][l]);
+            double er = sqrt(e[3][l] * e[3][l] + e[4][l] * e[4][l] + e[5][l] * e[5][l]);
+            if (!(ep <= tol_p && er <= tol_r) && m < G6_NEAR_MISS * scale)
+                refined |= g6_refine(ch, tt, qv, l, tol_p, tol_r, floor_err);
+        }
+        if (refined) {
             chain_pose_jac(ch, qv, t, J, 6);
             pose_residual(t, tt, e, BRL(-1));
         }
