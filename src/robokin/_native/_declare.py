@@ -325,7 +325,7 @@ PIEPER = Group("pieper.c", kernels=(
            checks=(Check("pk_params_ok(a->params)", "params is not a Pieper parameter vector"),
                    Check("PK_N_OF(a->params) == 7.0", "params must hold a joint of a 7R chain"),
                    Check("nq == 7", "Q must be (N, k, 7)"),
-                   Check("k >= 1 && k <= 64", "Q needs 1 to 64 rows per pose"))),
+                   Check("k >= 1 && k <= 1024", "Q needs 1 to 1024 rows per pose"))),
     Kernel("pieper_roots", (Arr("coeffs", "f64", (5,)), Arr("re", "f64", (4,), out=True),
                             Arr("im", "f64", (4,), out=True)),
            "None", "The four roots of a quartic (coefficients lowest order first).",

@@ -368,6 +368,30 @@ def test_shoulder_held_singular_rows_come_inside(arm, j, q):
     assert dp.max() <= 1e-12 and dr.max() <= 1e-12
 
 
+# Joint 2 held next to 0 with q4 = 0 (outside joint 4's limits): the near-coincident
+# path returns ~76 singular rows a pose, none inside; on 3d3a2fd the limit repair
+# refused more than 64 rows with a bare ValueError from the kernel's argument check
+# (found by the lost23 A/B run). Oracle: no error, check_held (exact rows holding
+# the value; no in-limit row is required: q0 is outside), alone and in a batch.
+MANY_ROWS = [
+    [-1e-09, 1e-06, 2.8973, 0.0, 0.9791705550066241, -1e-09, -2.673310735315642],
+    [1e-06, -1e-09, -1e-07, 0.0, -1e-07, 0.294521124471288, -1e-06],
+    [1e-07, 1e-09, 2.8973, 0.0, 1e-07, 3.7525, 2.8973],
+]
+
+
+@pytest.mark.parametrize("q", MANY_ROWS, ids=range(len(MANY_ROWS)))
+def test_many_singular_rows_go_through_the_limit_repair(q):
+    robot, q = ROBOTS["panda"], np.array(q)
+    check_held(robot, 1, q)
+    T = robot.fk(np.stack([q, q]))
+    sols = robot.ik(T, fixed={"joint2": np.array([q[1], q[1]])})
+    assert sols.valid.sum(axis=-1).min() > 64
+    dp, dr = pose_errors(robot.fk(sols.q[sols.valid]),
+                         np.broadcast_to(robot.fk(q), sols.q[sols.valid].shape[:1] + (4, 4)))
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+
+
 # Formerly a strict xfail (issue 23), found by held_special_rates.py (n 3000, seed
 # 0): joint 2 held, q3 and q6 at 1e-6 (smallest singular value 1e-7). The general 6R
 # elimination's two candidates for this near-double root were 4e-6 rad off with

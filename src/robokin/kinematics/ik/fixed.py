@@ -285,6 +285,10 @@ LIMIT_PARAMS: Derived[dict[int, np.ndarray | None]] = Derived("held-joint limit 
                                                               lambda arm: {})
 
 
+#: Rows per pose ``pieper_limit_rows`` takes (its argument check).
+_LIMIT_ROWS = 1024
+
+
 def _into_limits(robot: Arm, j: int, T: np.ndarray, x: np.ndarray,
                  sols: SolutionSet) -> SolutionSet:
     """Singular rows of a held 7R arm moved into the limits where no row is inside.
@@ -322,13 +326,18 @@ def _into_limits(robot: Arm, j: int, T: np.ndarray, x: np.ndarray,
     rows = np.flatnonzero(need.reshape(-1))
     q = np.array(sols.q, dtype=np.float64).reshape(-1, k, 7)
     within = np.array(inside).reshape(-1, k)
-    Q = np.ascontiguousarray(q[rows])
-    ins = np.ascontiguousarray(within[rows])
-    _native.kernels.pieper_limit_rows(P, np.ascontiguousarray(T.reshape(-1, 4, 4)[rows]),
-                              np.ascontiguousarray(x.reshape(-1)[rows], dtype=np.float64), Q,
-                              np.ascontiguousarray(valid.reshape(-1, k)[rows]),
-                              np.ascontiguousarray(sols.singular.reshape(-1, k)[rows]), ins)
-    q[rows], within[rows] = Q, ins
+    Tr = np.ascontiguousarray(T.reshape(-1, 4, 4)[rows])
+    xr = np.ascontiguousarray(x.reshape(-1)[rows], dtype=np.float64)
+    # the kernel takes at most _LIMIT_ROWS rows a pose (the near-coincident path can
+    # return ~80): in column blocks, each walked while none of its rows is inside
+    for c in range(0, k, _LIMIT_ROWS):
+        cols = slice(c, min(c + _LIMIT_ROWS, k))
+        Q = np.ascontiguousarray(q[rows, cols])
+        ins = np.ascontiguousarray(within[rows, cols])
+        _native.kernels.pieper_limit_rows(
+            P, Tr, xr, Q, np.ascontiguousarray(valid.reshape(-1, k)[rows, cols]),
+            np.ascontiguousarray(sols.singular.reshape(-1, k)[rows, cols]), ins)
+        q[rows, cols], within[rows, cols] = Q, ins
     flags = dict(sols.flags)
     flags["within_limits"] = within.reshape(valid.shape)
     return SolutionSet._trusted(q.reshape(sols.q.shape), valid, sols.is_revolute, sols.limits,
