@@ -213,8 +213,7 @@ def _end_single(robot: Arm, T: np.ndarray, name: str, value: float) -> SolutionS
     if e is None or _co.coincident_pair(robot, e.j, value) is not None or (
             _nco.near_coincident_pair(robot, e.j, value) is not None):
         return None
-    J = joint_motion(e.kind, -e.sign * value)
-    Tm = T @ e.C_inv @ J @ e.C if e.last else e.C @ J @ e.C_inv @ T
+    Tm = _move(T, value, e.last, e.C, e.C_inv, e.kind, e.sign)
     sub = e.single(Tm, np.nan)
     if sub is None:
         return None
@@ -256,8 +255,6 @@ class EndHeld:
 
 def _end_held(robot: Arm, name: str) -> EndHeld | None:
     """:class:`EndHeld` of joint ``name``, or None (not an end joint, no single path)."""
-    from robokin.kinematics.ik.analytic.detect import FAMILY
-
     names = robot.joint_names
     if name not in names:
         return None
@@ -601,16 +598,23 @@ def _end_joint(robot: Arm, idx: list[int]) -> str | None:
 def _moved_targets(robot: Arm, end: str, T: np.ndarray, v: np.ndarray) -> np.ndarray:
     """The targets of the reduced chain (held value 0) that equal T at value v."""
     C = robot.chain.arrays.consts
-    if end == "last":
-        j = robot.n - 1
-        Cn = C[-1]
-        last: np.ndarray = (T @ invert(Cn) @ joint_motion(
-            robot.chain.joints[j].kind, -robot.chain.joints[j].sign * v) @ Cn)
-        return last
-    C0 = C[0]
-    first: np.ndarray = (C0 @ joint_motion(
-        robot.chain.joints[0].kind, -robot.chain.joints[0].sign * v) @ invert(C0) @ T)
-    return first
+    j = robot.n - 1 if end == "last" else 0
+    Cj = C[-1] if end == "last" else C[0]
+    joint = robot.chain.joints[j]
+    return _move(T, v, end == "last", Cj, invert(Cj), joint.kind, joint.sign)
+
+
+def _move(T: np.ndarray, v: float | np.ndarray, last: bool, C: np.ndarray, C_inv: np.ndarray,
+          kind: Any, sign: float) -> np.ndarray:
+    """T (..., 4, 4) moved for the reduced chain (the end joint held at 0).
+
+    The reduced chain reaches the result where the whole chain with the joint at v
+    reaches T. C: the chain's constant next to the joint (``consts[-1]`` for the
+    last, ``[0]`` for the first); C_inv: its inverse.
+    """
+    J = joint_motion(kind, -sign * v)
+    out: np.ndarray = T @ C_inv @ J @ C if last else C @ J @ C_inv @ T
+    return out
 
 
 #: Reduced arms kept per arm: a sweep of a middle joint builds one per value
