@@ -2531,7 +2531,11 @@ static int g6_pose(const Chain *ch, const double *P, const double *T, double *q,
 #define G6_COAX_DIFF 1e-8 /* [per m of arm] Jacobian columns this close: one line */
 
 /* The value of coordinate j nearest pref (within j's limits) such that q_i = phi -
- * sigma q_j lies within i's limits by whole turns; NaN when no split does. */
+ * sigma q_j lies within i's limits by whole turns; NaN when no split does.
+ * pieper.c's pk_split is the same search on chain values; it stays a separate copy
+ * because pieper.c is compiled without FMA contraction (every kernel copy takes the
+ * same branches there) and this file is not: one shared helper would change the
+ * last bits of one of them on the AVX copies. */
 static double g6_split_pair(const Chain *ch, int i, int j, double phi, double sigma,
                             double pref)
 {
