@@ -2234,18 +2234,26 @@ static int g6_step(const vd *J, const vd *e, int l, double *dq)
  * appended to q (joint coordinates wrapped into [-pi, pi)), after the nsol there, and
  * sig (the Jacobian's smallest singular value). Two solutions are one when they
  * differ by less than GP_DEDUPE, or than 1e-10 / sigma (capped at 1e-3) for a
- * near-singular one (Newton leaves it 1e-15 / sigma off). *best: the smallest final
- * error of any candidate. Returns the solutions in q. */
+ * near-singular one (Newton leaves it 1e-15 / sigma off). A lane within the
+ * tolerance but above G6_TIGHT of it is taken by g6_refine to G6_TIGHT of it, else
+ * dropped: such a lane is no near-converged solution but a point of a near-continuum
+ * (issue 23: the offset iiwa at q4 = +-1e-9, where axes 3 and 5 almost meet; the
+ * poses of the q4 = 0 family pass 1.0-1.16e-12 m from T, while the solutions at
+ * q4 = +-1e-9 are 0.1-2.6 rad away along it, measured in 40-digit arithmetic), and
+ * the true solution it leads to is usually found already (then a duplicate). *best:
+ * the smallest final error of any candidate. Returns the solutions in q. */
 #define G6_NEAR_MISS 1e-9 /* [m per m of arm, rad] a lane ending this close: g6_refine */
+#define G6_TIGHT 0.5      /* of the tolerance: a row ending above, g6_refine'd or dropped */
 
 /* Lane l of qv (chain values) ended within G6_NEAR_MISS of T but above the
  * tolerance: next to a near-double root (a solution with sigma ~ 1e-7, the
  * candidate a few 1e-6 rad off along the near-null direction, issue 23's Panda with
  * joint 2 held) the full step overshoots (the error grows from 1e-11 to 1e-6) and
  * the lane stalls at its start. Here each step is halved until the error falls
- * (at most 40 halvings, 100 steps), from the lane's best. Returns 1 when the lane
- * now meets (tol_p, tol_r) (qv's lane l is then the refined point), else 0 and qv
- * is unchanged. */
+ * (at most 40 halvings, 100 steps), from the lane's best. Also a lane within the
+ * tolerance but above G6_TIGHT of it, with (tol_p, tol_r) the tight ones. Returns 1
+ * when the lane now meets (tol_p, tol_r) (qv's lane l is then the refined point),
+ * else 0 and qv is unchanged. */
 static int g6_refine(const Chain *ch, const vd *tt, vd *qv, int l, double tol_p,
                      double tol_r, double floor_err)
 {
@@ -2403,6 +2411,14 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
                 *best = fmax(ep, er);
             if (!(ep <= tol_p && er <= tol_r))
                 continue;
+            if (!(ep <= G6_TIGHT * tol_p && er <= G6_TIGHT * tol_r)) {
+                /* within the tolerance but not the tight one: settled or dropped */
+                if (!g6_refine(ch, tt, qv, l, G6_TIGHT * tol_p, G6_TIGHT * tol_r, floor_err))
+                    continue;
+                chain_pose_jac(ch, qv, t, J, 6);
+                pose_residual(t, tt, e, BRL(-1));
+                sg = g6_sigma_min(J);
+            }
             double qs[6];
             for (int j = 0; j < 6; j++)
                 qs[j] = wrap_pi(qv[j][l]);
