@@ -742,3 +742,49 @@ def test_row_just_past_a_limit_next_to_a_singularity_slides_inside(q0):
     q = _in_limit_singular_rows(q0)
     d = np.abs((q - q0 + np.pi) % (2 * np.pi) - np.pi).max(-1)
     assert d.min() < 1e-5
+
+
+#: offset iiwa at the stretched elbow, q4 = -+1e-9 (axes 3 and 5 1e-9 from one line):
+#: rows taken from the q4 = 0 near-continuum reproduced T to 1.0-1.16e-12 m only (the
+#: continuum's poses pass that far from T; in 40-digit arithmetic the nearest exact
+#: solutions are 0.1-2.6 rad away along it) until g6_polish took every row above half
+#: the kernel's tolerance to half of it or dropped it. From
+#: ``benchmarks/offset_iiwa_precision.py`` (special configurations; seed, index).
+STRETCHED_ELBOW_CONFIGURATIONS = [
+    # seed 1, configuration 607 (q5 = 1e-9 too: the arm straight from joint 3 to 6)
+    [0.2393754177378331, 1.542605515018454, 1.8107820456143386, -1e-09, 1e-09,
+     0.5170866154310381, 2.541354368625953],
+    # seed 1, configuration 1455
+    [1.1494693121383897, -1.6800710715494818, 2.105744908695251, -1e-09,
+     2.9670597283903604, 1.5707963267948966, 1.1660128001992476],
+    # seed 2, configuration 166
+    [2.758807838564308, -0.34420376656893814, -1.5707963267948966, -1e-09,
+     0.17231126914044426, 0.4780076756183047, 1.838894172327156],
+    # seed 4, configuration 1097
+    [1.5707963267948966, -1.2980597157891682, -1.397648727326551, 1e-09,
+     0.04919196572254192, 1.5707963267948966, 0.9620029004754516],
+    # seed 5, configuration 415
+    [-2.9670597283903604, 2.0943951023931953, 1.636735344021237, 1e-09,
+     0.13928678035723863, 0.008760155498856115, -0.5995029766793798],
+]
+
+
+@pytest.mark.parametrize("q0", STRETCHED_ELBOW_CONFIGURATIONS)
+def test_stretched_elbow_rows_reproduce_the_pose_to_1e_12(q0):
+    # Oracle: FK of every valid row against T (issue 23: <= 1e-12 m and rad), and q0
+    # (which reproduces T) among the rows: q1, q2, q4, q6 and q3 + q5 (the
+    # near-continuum's invariant) within 1e-9 rad, q3 within 1e-3 rad (q0's
+    # Jacobian's smallest singular value is 5e-12 - 2e-10: along the near-continuum
+    # T's rounding moves the exact solution by up to 1e-16 / sigma, 8e-5 rad here).
+    from reference import offset_iiwa14, pose_errors
+
+    robot = offset_iiwa14()
+    q0 = np.asarray(q0)
+    T = robot.fk(q0)
+    s = robot.ik(T, fixed={"a7": float(q0[6])})
+    q = s.q[s.valid]
+    dp, dr = pose_errors(robot.fk(q), T)
+    assert np.maximum(dp, dr).max() <= 1e-12
+    d = wrapped(q - q0)
+    inv = np.abs(np.column_stack([d[:, [0, 1, 3, 5]], wrapped(d[:, 2] + d[:, 4])])).max(-1)
+    assert ((inv < 1e-9) & (np.abs(d[:, 2]) < 1e-3)).any()
