@@ -59,6 +59,10 @@ from robokin.spatial import pose_error
 NODES = 181
 #: Halvings of a cell whose rows do not pair unambiguously.
 _REFINE = 6
+#: Further halvings of a fast passage: a cell still unpaired after ``_REFINE`` with
+#: as many rows at both nodes (no fold: a branch swinging through a near-alignment,
+#: e.g. the offset iiwa near q2 = 0, q1 and q3 turning ~5 rad within 1e-4 of t).
+_REFINE_FAST = 10
 #: Trapezoid residual [rad] of an unambiguous pair.
 _PAIR = 1e-2
 #: Trapezoid residual [rad] of a pair linked after the halvings.
@@ -117,8 +121,10 @@ class _ContinuedFamily(_Family):
         # most cells unpaired: every row singular (the pose at the reach boundary,
         # e.g. the elbow stretched for every value): no halving, no fold search
         self.degenerate = bool(clean.mean() < _DEGENERATE) if clean.size else False
-        for _ in range(0 if self.degenerate else _REFINE):
+        for rnd in range(0 if self.degenerate else _REFINE + _REFINE_FAST):
             bad = np.flatnonzero(~clean)
+            if rnd >= _REFINE:  # then only the fast passages (no fold: as many rows)
+                bad = bad[_same_count(Q, bad)]
             if not bad.size or len(t) + bad.size > _MAX_NODES:
                 break  # clean, or a pose whose rows do not pair anywhere (degenerate)
             mid = 0.5 * (t[bad] + t[bad + 1])
@@ -327,16 +333,21 @@ class _ContinuedFamily(_Family):
         far = np.where(state, c + 1, c)
         if self.degenerate:  # the track's last node (its rows are all singular)
             return [(float(e), int(bb)) for e, bb in zip(tn[near], b, strict=True)]
+        # a track ending on a singular row (no slope: the six free joints' Jacobian
+        # singular, e.g. a member of a continuum at the stretched elbow) ends at that
+        # node: neither the secant steps nor a bisection can follow it past
+        stuck = ~np.isfinite(self.slopes[near, b]).all(-1)
         q_f, ok = _fold_newton(self.robot, self.T, self.tracks[near, b], self.slopes[near, b],
                                tn[far] - tn[near], self.joint)
         t_f = q_f[:, self.joint]
         lo, hi = np.minimum(tn[near], tn[far]), np.maximum(tn[near], tn[far])
-        ok &= (t_f >= lo) & (t_f <= hi)
-        ends = np.where(ok, t_f, np.nan)
+        ok &= (t_f >= lo) & (t_f <= hi) & ~stuck
+        ends = np.where(ok, t_f, np.where(stuck, tn[near], np.nan))
         self.fold_t[c[ok], b[ok]] = t_f[ok]
         self.fold_q[c[ok], b[ok]] = q_f[ok]
-        if not ok.all():
-            ends[~ok] = self._bisect(c[~ok], b[~ok], state[~ok])
+        rest = ~ok & ~stuck
+        if rest.any():
+            ends[rest] = self._bisect(c[rest], b[rest], state[rest])
         return [(float(e), int(bb)) for e, bb in zip(ends, b, strict=True)]
 
     def _bisect(self, c: np.ndarray, b: np.ndarray, state: np.ndarray) -> np.ndarray:
@@ -348,8 +359,11 @@ class _ContinuedFamily(_Family):
             mid = 0.5 * (lo + hi)
             if np.all((mid == lo) | (mid == hi)):
                 break
-            _, valid, _ = self.rows(mid)
-            same = valid[rows, b] == state
+            # folds of one cell (a branch's symmetric copies) often share their mid:
+            # each value solved once (rows at a value do not depend on the others)
+            uniq, inv = np.unique(mid, return_inverse=True)
+            _, valid, _ = self.rows(uniq)
+            same = valid[inv.ravel(), b] == state
             lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
         out: np.ndarray = np.where(state, lo, hi)
         return out
@@ -478,6 +492,13 @@ def _clean_cells(t: np.ndarray, Q: np.ndarray, D: np.ndarray,
         second = np.take(s, 1, axis=axis) if s.shape[axis] > 1 else np.full_like(best, np.inf)
         good = (best < _PAIR) & (second > 4 * best)
         out &= np.all(good | ~rows, axis=1)
+    return out
+
+
+def _same_count(Q: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """(c,) bool: the cells' two nodes have as many rows (no branch starts or ends)."""
+    n = np.isfinite(Q).all(-1).sum(-1)  # rows per node
+    out: np.ndarray = n[cells] == n[cells + 1]
     return out
 
 
