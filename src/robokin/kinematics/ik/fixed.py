@@ -350,6 +350,8 @@ def _coincident_parts(robot: Arm, j: int, T: np.ndarray, v: np.ndarray,
     Appends (rows, set of the remaining coordinates) to ``parts`` per such value;
     returns the rows left for the other paths.
     """
+    if not 0 < j < robot.n - 1:  # an end joint puts no pair on one line (coincident_pair)
+        return np.arange(len(T))
     uniq, inverse = np.unique(v, return_inverse=True)
     rest = np.ones(len(T), bool)
     name = robot.joint_names

@@ -551,9 +551,11 @@ def _assign(P: np.ndarray, R: np.ndarray) -> np.ndarray:
     if R.shape[1] == 0:
         return out
     fp, fr = np.isfinite(P).all(-1), np.isfinite(R).all(-1)  # (M, k), (M, K)
-    P0 = np.where(fp[..., None], P, 0.0)
     R0 = np.where(fr[..., None], R, 0.0)  # (NaN arithmetic is slow)
-    d = np.abs(_wrap(P0[:, :, None] - R0[:, None])).max(-1)  # (M, k, K)
+    # distances of the predicted tracks only (most tracks live on part of the range)
+    mi, bi = np.nonzero(fp)
+    d = np.full((M, k, R.shape[1]), np.inf)
+    d[mi, bi] = np.abs(_wrap(P[mi, bi][:, None] - R0[mi])).max(-1)  # (M, k, K)
     d[~(fp[:, :, None] & fr[:, None, :])] = np.inf
     best_row = np.argmin(d, axis=2)  # (M, k)
     best_track = np.argmin(d, axis=1)  # (M, K)
