@@ -147,25 +147,28 @@ def test_limit_crossings_are_exact(arm):
 
 
 @pytest.mark.parametrize("arm", sorted(ARMS))
-def test_manifold_solves_a_bounded_number_of_values(arm):
-    # the work of one manifold: general-6R values solved, counted by a dispatch that
-    # wraps the real one (deterministic, not a timing). Before the continuation by
-    # slopes: 181 nodes + halvings + a 181-value grid + 56 bisection steps per branch
-    # end + the limit points (2,000-4,000 values); now the nodes, the halvings next to
-    # folds and the pieces' midpoints.
-    from robokin.kinematics.ik.dispatch import solve
-    from robokin.kinematics.ik.self_motion import self_motion
+def test_manifold_solves_a_bounded_number_of_values(arm, monkeypatch):
+    # the work of one manifold: general-6R values solved, counted by a wrapper of the
+    # compiled solver's call (deterministic, not a timing; the sweeps call it directly,
+    # fixed.sweep_end). Before the continuation by slopes: 181 nodes + halvings + a
+    # 181-value grid + 56 bisection steps per branch end + the limit points
+    # (2,000-4,000 values); now the nodes, the halvings next to folds and the pieces'
+    # midpoints.
+    from robokin.kinematics.ik.analytic import general_6r
 
     robot = ARMS[arm]
     solved = []
+    raw = general_6r.raw_solve
 
-    def counting(reduced, T, **kw):
-        solved.append(int(np.prod(np.shape(T)[:-2])))
-        return solve(reduced, T, **kw)
+    def counting(chain, params, T, *args):
+        solved.append(len(T))
+        return raw(chain, params, T, *args)
 
     q0 = _configs(robot, 3, False)[0]
-    sm = self_motion(robot.arm, robot.fk(q0), robot.joint_names[-1], dispatch=counting)
-    assert len(sm.intervals) and sum(solved) <= 4 * 181, sum(solved)
+    monkeypatch.setattr(general_6r, "raw_solve", counting)
+    sm = robot.self_motion(robot.fk(q0), parameter=robot.joint_names[-1])
+    assert len(sm.intervals) and 181 <= sum(solved) <= 4 * 181, sum(solved)
+    assert sum(solved) == sm.info["solves"]
 
 
 @pytest.mark.parametrize("arm", sorted(ARMS))
@@ -264,3 +267,28 @@ def test_a_track_ending_on_a_singular_row_is_not_bisected():
     assert ok.any() and dp.max() <= 1e-12 and dr.max() <= 1e-12
     rows = sm.sample(sm.domain[1])
     assert np.nanmin(_wrapped(rows - q0).max(-1)) < 1e-6
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_the_direct_sweep_equals_solve_fixed(arm):
+    # fixed.sweep_end (the continued family's sweeps) against solve_fixed, the path it
+    # replaces: the same rows (bit for bit), validity, singular and limit flags, at
+    # uniform and special configurations (singular rows moved into the limits by
+    # _into_limits included: the offset iiwa stretched)
+    from robokin.kinematics.ik.dispatch import solve
+    from robokin.kinematics.ik.fixed import solve_fixed, sweep_end
+
+    robot = ARMS[arm]
+    name = robot.joint_names[-1]
+    qs = np.concatenate([_configs(robot, 13, False), _configs(robot, 13, True),
+                         [[0.78, 1.571, 2.029, 0.0, -2.798, 0.0, 2.711]]])
+    t = np.concatenate([np.linspace(*robot.limits[6], 61), [0.0, 1e-9, np.pi / 2]])
+    for q0 in qs:
+        T = robot.fk(q0)
+        a = sweep_end(robot.arm, 6, T, np.concatenate([t, [q0[6]]]))
+        b = solve_fixed(robot.arm, T, {name: np.concatenate([t, [q0[6]]])}, dispatch=solve)
+        np.testing.assert_array_equal(a.q, b.q)
+        np.testing.assert_array_equal(a.valid, b.valid)
+        np.testing.assert_array_equal(a.singular, b.singular)
+        np.testing.assert_array_equal(a.within_limits, b.within_limits)
+    assert sweep_end(robot.arm, 3, T, t) is None  # a middle joint: not this path

@@ -52,7 +52,7 @@ from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.model.chain import joint_motion
 from robokin.spatial import invert, wrap_angle
 
-__all__ = ["solve_fixed"]
+__all__ = ["solve_fixed", "sweep_end"]
 
 
 def solve_fixed(
@@ -414,6 +414,45 @@ def _end_general_6r(robot: Arm, a: int, c: float, T: np.ndarray) -> SolutionSet 
         {"singular": (sigma < 1e-6) & valid}, {},
         np.asarray(STATUS_TEXT[_g6._STATUS[status]], dtype=object),
         f"{_g6.NAME} ({name} held)", None, {"held": {name: np.full(len(T), c)}})
+
+
+def sweep_end(robot: Arm, j: int, T: np.ndarray, values: np.ndarray) -> SolutionSet | None:
+    """``solve_fixed(robot, T, {joint j: values})``: one pose, an end joint, general 6R.
+
+    The rows, ``valid``, ``singular`` and ``within_limits`` that path gives (one reduced
+    chain, the moved targets, one compiled call, then ``_into_limits``), without its
+    checks, its dispatch and its two set assemblies: the continued self-motion's
+    sweeps (``self_motion_continued``; ~10 us per value less on 64 values). None
+    where that path does not apply (a middle joint, a held closed form, a reduced
+    chain that is not general 6R); the status and method are not filled in.
+
+    Args:
+        robot: The arm.
+        j: The held joint's index.
+        T: One validated pose (4, 4) [m].
+        values: Held values (M,) [rad], finite.
+    """
+    end = _end_joint(robot, [j])
+    if end is None or _held_solvers(robot).get(robot.joint_names[j]) is not None:
+        return None
+    reduced = _reduced(robot, [j], (0.0,))
+    params = _g6.setup(reduced).params if reduced.derived(FAMILY).name == _g6.NAME else None
+    if params is None:
+        return None
+    M = len(values)
+    Tb = np.broadcast_to(T, (M, 4, 4))
+    Tm = np.ascontiguousarray(_moved_targets(robot, end, Tb, values))
+    Q, valid, _, sigma, _, _, _ = _g6.raw_solve(reduced.chain, params, Tm)
+    q = np.full(Q.shape[:-1] + (robot.n,), np.nan)
+    q[..., [c for c in range(robot.n) if c != j]] = Q
+    q[..., j] = values[:, None]
+    q[~valid] = np.nan  # as SolutionSet does with rows that are not valid
+    lim = robot.limits
+    inside = np.all((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9), axis=-1)
+    sols = SolutionSet._trusted(q, valid, robot.is_revolute, lim,
+                                {"singular": (sigma < 1e-6) & valid, "within_limits": inside},
+                                {}, np.empty(M, dtype=object), "", None, {})
+    return _into_limits(robot, j, Tb, values, sols)
 
 
 _NUMBERS = (float, int, np.float64)

@@ -50,7 +50,7 @@ from typing import Any
 import numpy as np
 
 from robokin.kinematics.arm import Arm
-from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
+from robokin.kinematics.ik.fixed import Dispatch, solve_fixed, sweep_end
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.jacobian import jacobian_and_pose
 from robokin.spatial import pose_error
@@ -160,7 +160,11 @@ class _ContinuedFamily(_Family):
         The valid rows come first in each value's K slots; K is the most any value has.
         """
         self.solves += len(t)
-        sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
+        # an end joint on a general 6R reduced chain: the kernel directly (the same
+        # rows as solve_fixed, without its per-call checks and assemblies)
+        sols = sweep_end(self.robot, self.joint, self.T, np.ascontiguousarray(t, np.float64))
+        if sols is None:
+            sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
         valid = sols.valid.reshape(len(t), -1)
         order = np.argsort(~valid, axis=1, kind="stable")
         width = max(int(valid.sum(axis=1).max(initial=0)), 1)
