@@ -210,8 +210,7 @@ def _end_single(robot: Arm, T: np.ndarray, name: str, value: float) -> SolutionS
     if name not in table:
         table[name] = _end_held(robot, name)
     e = table[name]
-    if e is None or _co.coincident_pair(robot, e.j, value) is not None or (
-            _nco.near_coincident_pair(robot, e.j, value) is not None):
+    if e is None:  # (an end joint puts no pair on one line: no coincident path)
         return None
     Tm = _move(T, value, e.last, e.C, e.C_inv, e.kind, e.sign)
     sub = e.single(Tm, np.nan)
@@ -223,7 +222,7 @@ def _end_single(robot: Arm, T: np.ndarray, name: str, value: float) -> SolutionS
     q[~sub.valid] = np.nan  # as SolutionSet does with rows that are not valid
     inside = sub.flags["within_limits"] & (e.lo - 1e-9 <= value <= e.hi + 1e-9)
     return SolutionSet._trusted(
-        q, sub.valid, robot.is_revolute, robot.limits,
+        q, sub.valid, e.is_revolute, robot.limits,
         {"singular": sub.flags["singular"], "within_limits": inside}, {}, sub.status,
         f"{sub.method} ({name} held)", None, {"held": {name: np.array(value)}})
 
@@ -240,6 +239,7 @@ class EndHeld:
             and its inverse (4, 4).
         kind: The joint's kind; sign: its chain sign.
         lo, hi: Its limits.
+        is_revolute: The arm's ``is_revolute`` (n,), read-only (every set shares it).
     """
 
     j: int
@@ -251,6 +251,7 @@ class EndHeld:
     sign: float
     lo: float
     hi: float
+    is_revolute: np.ndarray
 
 
 def _end_held(robot: Arm, name: str) -> EndHeld | None:
@@ -268,8 +269,10 @@ def _end_held(robot: Arm, name: str) -> EndHeld | None:
     C = robot.chain.arrays.consts[-1 if end == "last" else 0]
     joint = robot.chain.joints[j]
     lo, hi = (float(x) for x in robot.limits[j])
+    is_rev = np.array(robot.is_revolute, dtype=bool)
+    is_rev.setflags(write=False)
     return EndHeld(j, end == "last", single, np.array(C), invert(C), joint.kind,
-                   float(joint.sign), lo, hi)
+                   float(joint.sign), lo, hi, is_rev)
 
 
 #: Per arm: joint name -> :class:`EndHeld` (or None), filled on first use of each.
