@@ -183,7 +183,7 @@ def solve_held_single(robot: Arm, T: object, fixed: object) -> SolutionSet | Non
         if out is None:
             out = _end_single(robot, T, name, float(value))
         if out is not None and T.shape == (4, 4) and T.dtype == np.float64:
-            out = _into_limits(robot, robot.joint_names.index(name), T,
+            out = _into_limits(robot, robot.derived(JOINT_INDEX)[name], T,
                                np.array([float(value)]), out)
     # "ok" has rows (read first: counting them costs a numpy reduction); no row for a
     # rotation off SO(3) by rounding: None, and solve_fixed projects it and solves
@@ -273,6 +273,11 @@ def _end_held(robot: Arm, name: str) -> EndHeld | None:
     is_rev.setflags(write=False)
     return EndHeld(j, end == "last", single, np.array(C), invert(C), joint.kind,
                    float(joint.sign), lo, hi, is_rev)
+
+
+#: Per arm: joint name -> its index (``Arm.joint_names`` builds its tuple per call).
+JOINT_INDEX: Derived[dict[str, int]] = Derived(
+    "joint indices", lambda arm: {n: i for i, n in enumerate(arm.joint_names)})
 
 
 #: Per arm: joint name -> :class:`EndHeld` (or None), filled on first use of each.
@@ -539,10 +544,9 @@ def _near_single(robot: Arm, T: np.ndarray, name: str, x: float) -> SolutionSet 
     (0.55 -> 0.25 ms CPU on the Panda, q2 next to 0). None where that path does not
     apply (the caller takes :func:`solve_fixed`).
     """
-    names = robot.joint_names
-    if name not in names or not np.isfinite(x) or T.shape != (4, 4):
+    j = robot.derived(JOINT_INDEX).get(name)
+    if j is None or not np.isfinite(x) or T.shape != (4, 4):
         return None
-    j = names.index(name)
     helpers = _near_helpers(robot, j)
     if helpers is None:
         return None
@@ -562,7 +566,7 @@ def _near_single(robot: Arm, T: np.ndarray, name: str, x: float) -> SolutionSet 
                           h.v0, x)
     out, found, sing = _nco.placed(1, n, rows)
     why = np.asarray(STATUS_TEXT[_g6._STATUS[status[:1]]], dtype=object)
-    method = f"{_g6.NAME} ({names[pair.a]} held) + {_nco.METHOD} ({name} held)"
+    method = f"{_g6.NAME} ({robot.joint_names[pair.a]} held) + {_nco.METHOD} ({name} held)"
     return SolutionSet(out[0], found[0], robot.is_revolute, robot.limits,
                        flags={"singular": sing[0]},
                        status=_nco.status_text(found, why).reshape(()), method=method,
