@@ -358,7 +358,6 @@ class _ContinuedFamily(_Family):
         """Fold ends (p,) in cells c by bisection on track b's existence."""
         tn = self.t_nodes
         lo, hi = tn[c].copy(), tn[c + 1].copy()
-        rows = np.arange(len(c))
         for _ in range(_BISECT):
             mid = 0.5 * (lo + hi)
             if np.all((mid == lo) | (mid == hi)):
