@@ -16,7 +16,10 @@ module continues them into branches (issue 29):
    different branches do not. A cell where some row has no unambiguous partner
    (residual above ``_PAIR``, or a second candidate within 4 times the best) is
    halved (its midpoint solved, one batch per round) up to ``_REFINE`` times:
-   only cells next to a fold (where two branches meet and the slopes blow up).
+   only cells next to a fold (where two branches meet and the slopes blow up);
+   one still unpaired with as many rows at both nodes (no fold: a fast passage,
+   e.g. the offset iiwa swinging q1 and q3 next to q2 = 0) up to ``_REFINE_FAST``
+   times more.
    Mutual best partners (residual below ``_LINK``) are linked into tracks: the
    branch slots, each the same branch at every t.
 3. **Rows at any t.** ``rows(t)`` solves the pose at t (one batch) and gives each
@@ -33,7 +36,8 @@ module continues them into branches (issue 29):
    the branch turns back in t; in its fastest joint m it is smooth, so the fold
    is the zero of dt/dq_m (from the null vector of the 6 x 7 Jacobian), found by
    secant steps on the curve held at q_m (:func:`_fold_newton`); a fold those
-   steps do not certify is bisected on the track's existence.
+   steps do not certify is bisected on the track's existence, and a track whose
+   end row is singular (no slope) ends at that node.
 6. **Bounded work.** At most ``_MAX_NODES`` nodes and the ``_MAX_TRACKS`` longest
    tracks; a pose where fewer than half of the first cells pair (every row
    singular: the arm at its reach boundary for every t) is ``degenerate``: no
