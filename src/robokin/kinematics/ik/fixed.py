@@ -52,7 +52,7 @@ from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.model.chain import joint_motion
 from robokin.spatial import invert, wrap_angle
 
-__all__ = ["solve_fixed"]
+__all__ = ["solve_fixed", "sweep_end"]
 
 
 def solve_fixed(
@@ -183,7 +183,7 @@ def solve_held_single(robot: Arm, T: object, fixed: object) -> SolutionSet | Non
         if out is None:
             out = _end_single(robot, T, name, float(value))
         if out is not None and T.shape == (4, 4) and T.dtype == np.float64:
-            out = _into_limits(robot, robot.joint_names.index(name), T,
+            out = _into_limits(robot, robot.derived(JOINT_INDEX)[name], T,
                                np.array([float(value)]), out)
     # "ok" has rows (read first: counting them costs a numpy reduction); no row for a
     # rotation off SO(3) by rounding: None, and solve_fixed projects it and solves
@@ -210,8 +210,7 @@ def _end_single(robot: Arm, T: np.ndarray, name: str, value: float) -> SolutionS
     if name not in table:
         table[name] = _end_held(robot, name)
     e = table[name]
-    if e is None or _co.coincident_pair(robot, e.j, value) is not None or (
-            _nco.near_coincident_pair(robot, e.j, value) is not None):
+    if e is None:  # (an end joint puts no pair on one line: no coincident path)
         return None
     Tm = _move(T, value, e.last, e.C, e.C_inv, e.kind, e.sign)
     sub = e.single(Tm, np.nan)
@@ -223,7 +222,7 @@ def _end_single(robot: Arm, T: np.ndarray, name: str, value: float) -> SolutionS
     q[~sub.valid] = np.nan  # as SolutionSet does with rows that are not valid
     inside = sub.flags["within_limits"] & (e.lo - 1e-9 <= value <= e.hi + 1e-9)
     return SolutionSet._trusted(
-        q, sub.valid, robot.is_revolute, robot.limits,
+        q, sub.valid, e.is_revolute, robot.limits,
         {"singular": sub.flags["singular"], "within_limits": inside}, {}, sub.status,
         f"{sub.method} ({name} held)", None, {"held": {name: np.array(value)}})
 
@@ -240,6 +239,7 @@ class EndHeld:
             and its inverse (4, 4).
         kind: The joint's kind; sign: its chain sign.
         lo, hi: Its limits.
+        is_revolute: The arm's ``is_revolute`` (n,), read-only (every set shares it).
     """
 
     j: int
@@ -251,6 +251,7 @@ class EndHeld:
     sign: float
     lo: float
     hi: float
+    is_revolute: np.ndarray
 
 
 def _end_held(robot: Arm, name: str) -> EndHeld | None:
@@ -268,8 +269,15 @@ def _end_held(robot: Arm, name: str) -> EndHeld | None:
     C = robot.chain.arrays.consts[-1 if end == "last" else 0]
     joint = robot.chain.joints[j]
     lo, hi = (float(x) for x in robot.limits[j])
+    is_rev = np.array(robot.is_revolute, dtype=bool)
+    is_rev.setflags(write=False)
     return EndHeld(j, end == "last", single, np.array(C), invert(C), joint.kind,
-                   float(joint.sign), lo, hi)
+                   float(joint.sign), lo, hi, is_rev)
+
+
+#: Per arm: joint name -> its index (``Arm.joint_names`` builds its tuple per call).
+JOINT_INDEX: Derived[dict[str, int]] = Derived(
+    "joint indices", lambda arm: {n: i for i, n in enumerate(arm.joint_names)})
 
 
 #: Per arm: joint name -> :class:`EndHeld` (or None), filled on first use of each.
@@ -350,6 +358,8 @@ def _coincident_parts(robot: Arm, j: int, T: np.ndarray, v: np.ndarray,
     Appends (rows, set of the remaining coordinates) to ``parts`` per such value;
     returns the rows left for the other paths.
     """
+    if not 0 < j < robot.n - 1:  # an end joint puts no pair on one line (coincident_pair)
+        return np.arange(len(T))
     uniq, inverse = np.unique(v, return_inverse=True)
     rest = np.ones(len(T), bool)
     name = robot.joint_names
@@ -412,6 +422,45 @@ def _end_general_6r(robot: Arm, a: int, c: float, T: np.ndarray) -> SolutionSet 
         {"singular": (sigma < 1e-6) & valid}, {},
         np.asarray(STATUS_TEXT[_g6._STATUS[status]], dtype=object),
         f"{_g6.NAME} ({name} held)", None, {"held": {name: np.full(len(T), c)}})
+
+
+def sweep_end(robot: Arm, j: int, T: np.ndarray, values: np.ndarray) -> SolutionSet | None:
+    """``solve_fixed(robot, T, {joint j: values})``: one pose, an end joint, general 6R.
+
+    The rows, ``valid``, ``singular`` and ``within_limits`` that path gives (one reduced
+    chain, the moved targets, one compiled call, then ``_into_limits``), without its
+    checks, its dispatch and its two set assemblies: the continued self-motion's
+    sweeps (``self_motion_continued``; ~10 us per value less on 64 values). None
+    where that path does not apply (a middle joint, a held closed form, a reduced
+    chain that is not general 6R); the status and method are not filled in.
+
+    Args:
+        robot: The arm.
+        j: The held joint's index.
+        T: One validated pose (4, 4) [m].
+        values: Held values (M,) [rad], finite.
+    """
+    end = _end_joint(robot, [j])
+    if end is None or _held_solvers(robot).get(robot.joint_names[j]) is not None:
+        return None
+    reduced = _reduced(robot, [j], (0.0,))
+    params = _g6.setup(reduced).params if reduced.derived(FAMILY).name == _g6.NAME else None
+    if params is None:
+        return None
+    M = len(values)
+    Tb = np.broadcast_to(T, (M, 4, 4))
+    Tm = np.ascontiguousarray(_moved_targets(robot, end, Tb, values))
+    Q, valid, _, sigma, _, _, _ = _g6.raw_solve(reduced.chain, params, Tm)
+    q = np.full(Q.shape[:-1] + (robot.n,), np.nan)
+    q[..., [c for c in range(robot.n) if c != j]] = Q
+    q[..., j] = values[:, None]
+    q[~valid] = np.nan  # as SolutionSet does with rows that are not valid
+    lim = robot.limits
+    inside = np.all((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9), axis=-1)
+    sols = SolutionSet._trusted(q, valid, robot.is_revolute, lim,
+                                {"singular": (sigma < 1e-6) & valid, "within_limits": inside},
+                                {}, np.empty(M, dtype=object), "", None, {})
+    return _into_limits(robot, j, Tb, values, sols)
 
 
 _NUMBERS = (float, int, np.float64)
@@ -495,10 +544,9 @@ def _near_single(robot: Arm, T: np.ndarray, name: str, x: float) -> SolutionSet 
     (0.55 -> 0.25 ms CPU on the Panda, q2 next to 0). None where that path does not
     apply (the caller takes :func:`solve_fixed`).
     """
-    names = robot.joint_names
-    if name not in names or not np.isfinite(x) or T.shape != (4, 4):
+    j = robot.derived(JOINT_INDEX).get(name)
+    if j is None or not np.isfinite(x) or T.shape != (4, 4):
         return None
-    j = names.index(name)
     helpers = _near_helpers(robot, j)
     if helpers is None:
         return None
@@ -518,7 +566,7 @@ def _near_single(robot: Arm, T: np.ndarray, name: str, x: float) -> SolutionSet 
                           h.v0, x)
     out, found, sing = _nco.placed(1, n, rows)
     why = np.asarray(STATUS_TEXT[_g6._STATUS[status[:1]]], dtype=object)
-    method = f"{_g6.NAME} ({names[pair.a]} held) + {_nco.METHOD} ({name} held)"
+    method = f"{_g6.NAME} ({robot.joint_names[pair.a]} held) + {_nco.METHOD} ({name} held)"
     return SolutionSet(out[0], found[0], robot.is_revolute, robot.limits,
                        flags={"singular": sing[0]},
                        status=_nco.status_text(found, why).reshape(()), method=method,

@@ -16,7 +16,10 @@ module continues them into branches (issue 29):
    different branches do not. A cell where some row has no unambiguous partner
    (residual above ``_PAIR``, or a second candidate within 4 times the best) is
    halved (its midpoint solved, one batch per round) up to ``_REFINE`` times:
-   only cells next to a fold (where two branches meet and the slopes blow up).
+   only cells next to a fold (where two branches meet and the slopes blow up);
+   one still unpaired with as many rows at both nodes (no fold: a fast passage,
+   e.g. the offset iiwa swinging q1 and q3 next to q2 = 0) up to ``_REFINE_FAST``
+   times more.
    Mutual best partners (residual below ``_LINK``) are linked into tracks: the
    branch slots, each the same branch at every t.
 3. **Rows at any t.** ``rows(t)`` solves the pose at t (one batch) and gives each
@@ -33,7 +36,8 @@ module continues them into branches (issue 29):
    the branch turns back in t; in its fastest joint m it is smooth, so the fold
    is the zero of dt/dq_m (from the null vector of the 6 x 7 Jacobian), found by
    secant steps on the curve held at q_m (:func:`_fold_newton`); a fold those
-   steps do not certify is bisected on the track's existence.
+   steps do not certify is bisected on the track's existence, and a track whose
+   end row is singular (no slope) ends at that node.
 6. **Bounded work.** At most ``_MAX_NODES`` nodes and the ``_MAX_TRACKS`` longest
    tracks; a pose where fewer than half of the first cells pair (every row
    singular: the arm at its reach boundary for every t) is ``degenerate``: no
@@ -50,7 +54,7 @@ from typing import Any
 import numpy as np
 
 from robokin.kinematics.arm import Arm
-from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
+from robokin.kinematics.ik.fixed import Dispatch, solve_fixed, sweep_end
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.jacobian import jacobian_and_pose
 from robokin.spatial import pose_error
@@ -59,6 +63,10 @@ from robokin.spatial import pose_error
 NODES = 181
 #: Halvings of a cell whose rows do not pair unambiguously.
 _REFINE = 6
+#: Further halvings of a fast passage: a cell still unpaired after ``_REFINE`` with
+#: as many rows at both nodes (no fold: a branch swinging through a near-alignment,
+#: e.g. the offset iiwa near q2 = 0, q1 and q3 turning ~5 rad within 1e-4 of t).
+_REFINE_FAST = 10
 #: Trapezoid residual [rad] of an unambiguous pair.
 _PAIR = 1e-2
 #: Trapezoid residual [rad] of a pair linked after the halvings.
@@ -117,8 +125,10 @@ class _ContinuedFamily(_Family):
         # most cells unpaired: every row singular (the pose at the reach boundary,
         # e.g. the elbow stretched for every value): no halving, no fold search
         self.degenerate = bool(clean.mean() < _DEGENERATE) if clean.size else False
-        for _ in range(0 if self.degenerate else _REFINE):
+        for rnd in range(0 if self.degenerate else _REFINE + _REFINE_FAST):
             bad = np.flatnonzero(~clean)
+            if rnd >= _REFINE:  # then only the fast passages (no fold: as many rows)
+                bad = bad[_same_count(Q, bad)]
             if not bad.size or len(t) + bad.size > _MAX_NODES:
                 break  # clean, or a pose whose rows do not pair anywhere (degenerate)
             mid = 0.5 * (t[bad] + t[bad + 1])
@@ -154,7 +164,11 @@ class _ContinuedFamily(_Family):
         The valid rows come first in each value's K slots; K is the most any value has.
         """
         self.solves += len(t)
-        sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
+        # an end joint on a general 6R reduced chain: the kernel directly (the same
+        # rows as solve_fixed, without its per-call checks and assemblies)
+        sols = sweep_end(self.robot, self.joint, self.T, np.ascontiguousarray(t, np.float64))
+        if sols is None:
+            sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
         valid = sols.valid.reshape(len(t), -1)
         order = np.argsort(~valid, axis=1, kind="stable")
         width = max(int(valid.sum(axis=1).max(initial=0)), 1)
@@ -327,29 +341,36 @@ class _ContinuedFamily(_Family):
         far = np.where(state, c + 1, c)
         if self.degenerate:  # the track's last node (its rows are all singular)
             return [(float(e), int(bb)) for e, bb in zip(tn[near], b, strict=True)]
+        # a track ending on a singular row (no slope: the six free joints' Jacobian
+        # singular, e.g. a member of a continuum at the stretched elbow) ends at that
+        # node: neither the secant steps nor a bisection can follow it past
+        stuck = ~np.isfinite(self.slopes[near, b]).all(-1)
         q_f, ok = _fold_newton(self.robot, self.T, self.tracks[near, b], self.slopes[near, b],
                                tn[far] - tn[near], self.joint)
         t_f = q_f[:, self.joint]
         lo, hi = np.minimum(tn[near], tn[far]), np.maximum(tn[near], tn[far])
-        ok &= (t_f >= lo) & (t_f <= hi)
-        ends = np.where(ok, t_f, np.nan)
+        ok &= (t_f >= lo) & (t_f <= hi) & ~stuck
+        ends = np.where(ok, t_f, np.where(stuck, tn[near], np.nan))
         self.fold_t[c[ok], b[ok]] = t_f[ok]
         self.fold_q[c[ok], b[ok]] = q_f[ok]
-        if not ok.all():
-            ends[~ok] = self._bisect(c[~ok], b[~ok], state[~ok])
+        rest = ~ok & ~stuck
+        if rest.any():
+            ends[rest] = self._bisect(c[rest], b[rest], state[rest])
         return [(float(e), int(bb)) for e, bb in zip(ends, b, strict=True)]
 
     def _bisect(self, c: np.ndarray, b: np.ndarray, state: np.ndarray) -> np.ndarray:
         """Fold ends (p,) in cells c by bisection on track b's existence."""
         tn = self.t_nodes
         lo, hi = tn[c].copy(), tn[c + 1].copy()
-        rows = np.arange(len(c))
         for _ in range(_BISECT):
             mid = 0.5 * (lo + hi)
             if np.all((mid == lo) | (mid == hi)):
                 break
-            _, valid, _ = self.rows(mid)
-            same = valid[rows, b] == state
+            # folds of one cell (a branch's symmetric copies) often share their mid:
+            # each value solved once (rows at a value do not depend on the others)
+            uniq, inv = np.unique(mid, return_inverse=True)
+            _, valid, _ = self.rows(uniq)
+            same = valid[inv.ravel(), b] == state
             lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
         out: np.ndarray = np.where(state, lo, hi)
         return out
@@ -481,6 +502,13 @@ def _clean_cells(t: np.ndarray, Q: np.ndarray, D: np.ndarray,
     return out
 
 
+def _same_count(Q: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """(c,) bool: the cells' two nodes have as many rows (no branch starts or ends)."""
+    n = np.isfinite(Q).all(-1).sum(-1)  # rows per node
+    out: np.ndarray = n[cells] == n[cells + 1]
+    return out
+
+
 def _link(t: np.ndarray, Q: np.ndarray, D: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Tracks and their slopes (m, k, n) from rows per node (m, K, n): mutual best pairs."""
     m, K, n = Q.shape
@@ -530,9 +558,11 @@ def _assign(P: np.ndarray, R: np.ndarray) -> np.ndarray:
     if R.shape[1] == 0:
         return out
     fp, fr = np.isfinite(P).all(-1), np.isfinite(R).all(-1)  # (M, k), (M, K)
-    P0 = np.where(fp[..., None], P, 0.0)
     R0 = np.where(fr[..., None], R, 0.0)  # (NaN arithmetic is slow)
-    d = np.abs(_wrap(P0[:, :, None] - R0[:, None])).max(-1)  # (M, k, K)
+    # distances of the predicted tracks only (most tracks live on part of the range)
+    mi, bi = np.nonzero(fp)
+    d = np.full((M, k, R.shape[1]), np.inf)
+    d[mi, bi] = np.abs(_wrap(P[mi, bi][:, None] - R0[mi])).max(-1)  # (M, k, K)
     d[~(fp[:, :, None] & fr[:, None, :])] = np.inf
     best_row = np.argmin(d, axis=2)  # (M, k)
     best_track = np.argmin(d, axis=1)  # (M, K)
