@@ -25,11 +25,12 @@ The parameter t is the arm's self-motion parameter (``self_motion.parameter_valu
     separately for regular and singular configurations.
 
 Prints one line per arm and part, then the first three misses of each kind (q as a
-list). Takes ~3-6 min CPU at the defaults (the two general arms' (a) batches and (b)
-manifolds most of it; the Panda's (b) ~25 s).
+list). Takes ~6.5 min CPU at the defaults (17 min wall at load 8 on the 2 shared
+cores): the Panda's (b) 2.1 min (12.8 ms per pose; special poses leave the compiled
+kernel), the Gen3-like arm's and the offset iiwa's 1.5 min each.
 
-Run: ``python benchmarks/self_motion_rates.py [--n 10000] [--nb 0] [--nb-slow 500]
-[--seed 0] [--arms panda,srs,...]``.
+Run: ``python benchmarks/self_motion_rates.py [--n 10000] [--nb 0] [--nb-mid 300]
+[--nb-slow 250] [--seed 0] [--arms panda,srs,...]``.
 """
 
 from __future__ import annotations
@@ -44,13 +45,13 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / p) for p in ("tests", "tests/kinematics/ik", "benchmarks")]
 
+from bench_self_motion import IIWA_URDF, gen3_like  # noqa: E402
+from test_fixed_properties import NON_SINGULAR, special_batch  # noqa: E402
+
 import robokin  # noqa: E402
+from reference import iiwa14_srs, offset_iiwa14, pose_errors, random_7r  # noqa: E402
 from robokin.kinematics.ik.self_motion import parameter_values  # noqa: E402
 from robokin.kinematics.ik.self_motion_families import _setup  # noqa: E402
-
-from bench_self_motion import IIWA_URDF, gen3_like  # noqa: E402
-from reference import iiwa14_srs, offset_iiwa14, pose_errors, random_7r  # noqa: E402
-from test_fixed_properties import NON_SINGULAR, special_batch  # noqa: E402
 
 SLOW = ("offset_iiwa", "random_7r")
 MID = ("iiwa_urdf", "gen3_like")  # held closed form, manifold not compiled: 40-95 ms
@@ -113,7 +114,7 @@ def per_value(robot, name, q, T):
     back = np.where(valid, gap(Q, q[:, None]), np.inf).min(axis=-1) <= 1e-6
     lo, hi = robot.limits[:, 0], robot.limits[:, 1]
     with np.errstate(invalid="ignore"):
-        row_in = np.all((Q >= lo - 1e-9) & (Q <= hi + 1e-9), axis=-1)
+        row_in = np.all((lo - 1e-9 <= Q) & (hi + 1e-9 >= Q), axis=-1)
     ok = (valid & row_in).any(axis=-1)
     return back, ok, sigma >= NON_SINGULAR, float(e.max(initial=0.0)), int((e > 1e-12).sum())
 
@@ -224,7 +225,8 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--arms", default="panda,srs,iiwa_urdf,gen3_like,offset_iiwa,random_7r")
     a = ap.parse_args()
-    print(f"seed {a.seed}; load {open('/proc/loadavg').read().split()[:3]}")
+    load = pathlib.Path("/proc/loadavg").read_text().split()[:3]
+    print(f"seed {a.seed}; load {load}")
     for arm in a.arms.split(","):
         nb = (a.nb_slow if arm in SLOW else a.nb_mid if arm in MID else a.nb) or a.n
         run_arm(arm, a.n, nb, a.seed)
