@@ -289,7 +289,9 @@ def test_held_joint_at_a_stretched_elbow_near_srs_arm():
     # -1e-9 (the elbow stretched) and q2 = pi: 'out of reach', no row, although the
     # six free joints' Jacobian is regular (smallest singular value 1.7e-4 >= 1e-4:
     # q is an isolated solution). 5 of 3,401 regular special configurations miss
-    # this way. Oracle: q reproduces the pose (it generated it) and is isolated, so
+    # this way. Both conditions are needed (q2 = pi with a bent elbow, or the elbow
+    # stretched with q2 = 1 or 3, return q): the wrist centre at the held chain's
+    # reach boundary and within the 0.44 mm offset of axis 1. Oracle: q reproduces the pose (it generated it) and is isolated, so
     # it must be among the rows (1e-6 rad), each of which reproduces the pose to 1e-12.
     rtbdata = pytest.importorskip("rtbdata")
     from pathlib import Path
