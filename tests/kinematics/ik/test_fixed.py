@@ -279,3 +279,34 @@ def test_the_one_pose_hot_path_takes_no_detour():
     assert sols.method == "analytic:pieper (joint7 held)" and len(sols) >= 1
     assert "solve" not in entered and "solve_fixed" not in entered, entered
     assert len(entered) <= 6, entered
+
+
+@pytest.mark.xfail(strict=True, reason="pieper.c: the held chain's stretched elbow at "
+                   "its reach boundary returns no row (docs/ik.md, issue 29 measured)")
+def test_held_joint_at_a_stretched_elbow_near_srs_arm():
+    # Issue 29's 10,000-configuration measurement (benchmarks/self_motion_rates.py,
+    # seed 0): the rtb-data iiwa14 (shoulder offset 0.44 mm), joint_a3 held, q4 =
+    # -1e-9 (the elbow stretched) and q2 = pi: 'out of reach', no row, although the
+    # six free joints' Jacobian is regular (smallest singular value 1.7e-4 >= 1e-4:
+    # q is an isolated solution). 5 of 3,401 regular special configurations miss
+    # this way. Both conditions are needed (q2 = pi with a bent elbow, or the elbow
+    # stretched with q2 = 1 or 3, return q): the wrist centre at the held chain's
+    # reach boundary and within the 0.44 mm offset of axis 1. Oracle: q reproduces the pose (it generated it) and is isolated, so
+    # it must be among the rows (1e-6 rad), each of which reproduces the pose to 1e-12.
+    rtbdata = pytest.importorskip("rtbdata")
+    from pathlib import Path
+
+    urdf = (Path(rtbdata.__file__).parent
+            / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf")
+    robot = robokin.Robot.from_urdf(str(urdf), geometry=False)
+    q = np.array([-np.pi / 2, np.pi, -1e-07, -1e-09, -2.9668, -0.47755672126856075,
+                  2.4839344482487373])
+    sigma = np.linalg.svd(np.delete(robot.jacobian(q), 2, axis=1), compute_uv=False)[-1]
+    assert sigma >= 1e-4
+    T = robot.fk(q)
+    sols = robot.ik(T, fixed={"joint_a3": q[2]})
+    Q = sols.q[sols.valid]
+    if len(Q):
+        dp, dr = pose_errors(robot.fk(Q), T)
+        assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+    assert len(Q) and np.abs((Q - q + np.pi) % (2 * np.pi) - np.pi).max(-1).min() <= 1e-6

@@ -382,3 +382,31 @@ def test_swivel_records_are_the_kernels_points_built_when_first_read():
         assert got == [(t, int(b), kinds[int(k)]) for t, b, _, k in rows[~limit]]
         assert len(got) + len(sm.crossings) == npts[0] > 0
         assert sm.crossings is sm.crossings and sm._records is not None
+
+
+def test_a_crossing_at_the_parameters_own_limit_is_kept():
+    # Found by benchmarks/self_motion_rates.py (issue 29): the rtb-data iiwa14, q with
+    # joint_a3 (the parameter) at its lower limit and joint_a4 at its upper one. The
+    # pose solved with joint_a4 held at that limit gives back q with joint_a3
+    # 2.4e-12 below its limit (the held Jacobian's smallest singular value is 3.7e-5),
+    # and _shift_into's 1e-12 slack dropped the row: the branch through q had no
+    # joint_a4 crossing. Oracle: the generating configuration is the branch's row at
+    # the range's end, where joint_a4 is at its limit (1e-9); the crossing must be
+    # recorded there for that branch.
+    rtbdata = pytest.importorskip("rtbdata")
+    from pathlib import Path
+
+    urdf = (Path(rtbdata.__file__).parent
+            / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf")
+    robot = robokin.Robot.from_urdf(str(urdf), geometry=False)
+    q = np.array([-1.2674019763604205, 1.2749036966810667, -2.9668, 2.0942,
+                  0.9458041950865659, -2.0942, 0.0])
+    sm = robot.self_motion(robot.fk(q), "joint_a3")
+    lo = sm.domain[0]
+    assert lo == q[2]
+    rows = sm.sample(lo)
+    gap = np.abs((rows - q + np.pi) % (2 * np.pi) - np.pi).max(-1)
+    b = int(np.nanargmin(gap))
+    assert gap[b] < 1e-9 and abs(rows[b, 3] - robot.limits[3, 1]) < 1e-9
+    assert any(c.branch == b and c.joint == 3 and c.limit == "upper" and abs(c.t - lo) < 1e-9
+               for c in sm.crossings), sm.crossings

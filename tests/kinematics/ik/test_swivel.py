@@ -249,3 +249,39 @@ def test_nearest_next_to_an_aligned_point_falls_back_to_the_next_candidate():
     assert res.success and SRS.within_limits(res.q)
     assert res.position_error <= 1e-12 and res.rotation_error <= 1e-12
     assert np.linalg.norm(_wrapd(res.q - qn)) <= _dense_nearest(T, qn) + 1e-12
+
+
+@pytest.mark.xfail(strict=True, reason="csrc/self_motion.c: a piece between a joint's "
+                   "near-tangent dip past its limit and another joint's crossing is "
+                   "missed (docs/ik.md, issue 29 measured)")
+def test_a_piece_after_a_near_tangent_dip_is_found():
+    # Issue 29's 10,000-configuration measurement (benchmarks/self_motion_rates.py,
+    # seed 0; regular: the 6 x 7 Jacobian's smallest singular value >= 1e-4, q2 and
+    # q6 clear of 0 and pi): q3, q4 and q6 at limits, q5 = 1e-6. Along q's branch q6
+    # dips 6.7e-12 past its limit about 1e-5 before q's own swivel and comes back;
+    # q3 leaves at q's swivel. The kernel's interval ends at the dip (4.1e-5 before
+    # q's swivel), the piece [dip end, q's swivel] is missing. Oracle: the numpy
+    # twin's rows (reference=True, polished) of that branch are inside every limit
+    # (1e-12) at 5 swivel values over the 1e-7 before q's; the kernel's intervals of
+    # the branch must hold q's swivel (1e-9).
+    from robokin.kinematics.ik.dispatch import solve
+    from robokin.kinematics.ik.self_motion import self_motion
+
+    q = np.array([-1.1071049596543794, 0.1821031648598197, -2.9670597283903604,
+                  -2.0943951023931953, 1e-06, 2.0943951023931953, 1e-09])
+    T = SRS.fk(q)
+    psi = float(ARM.swivel_of(ARM.frame(T), q))
+    ref = self_motion(SRS.arm, T, dispatch=solve, reference=True)
+    rows = ref.sample(psi)
+    b = int(np.nanargmin(_wrapd(rows - q).max(-1)))
+    assert _wrapd(rows[b] - q).max() < 1e-6
+    L = SRS.limits
+    for t in psi - np.linspace(0.0, 1e-7, 5):
+        r = ref.sample(t)[b]
+        assert np.all((r >= L[:, 0] - 1e-12) & (r <= L[:, 1] + 1e-12)), (t, r)
+    sm = SRS.self_motion(T)
+    assert _wrapd(sm.sample(psi)[b] - q).max() < 1e-6  # the same slot in the kernel
+    iv = sm.intervals[sm.interval_branch == b]
+    hit = [(iv[:, 0] - 1e-9 <= psi + s) & (psi + s <= iv[:, 1] + 1e-9)
+           for s in (-2 * np.pi, 0.0, 2 * np.pi)]
+    assert np.any(hit), (psi, iv)
