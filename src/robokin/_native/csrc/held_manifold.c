@@ -515,14 +515,43 @@ static inline double hm_f(const HmCtx *c, const HmRow *r, int b, int qi)
     return wrap_pi(r->q[b][c->qj[qi]] - c->qv[qi]);
 }
 
+/* The root in (0, 1) of the cubic Hermite model of f on a cell (values f0, f1 of
+ * opposite signs, slopes d0, d1 per unit of the cell): safeguarded Newton on the
+ * cubic from the secant's root (no rows). */
+static double hm_hermite_root(double f0, double f1, double d0, double d1)
+{
+    double A = 3.0 * (f1 - f0) - 2.0 * d0 - d1, B = 2.0 * (f0 - f1) + d0 + d1;
+    double lo = 0.0, hi = 1.0, s = f0 / (f0 - f1);
+    for (int it = 0; it < 12; it++) {
+        double v = f0 + s * (d0 + s * (A + s * B)), dv = d0 + s * (2.0 * A + 3.0 * s * B);
+        if (v == 0.0)
+            break;
+        if ((v < 0) == (f0 < 0))
+            lo = s;
+        else
+            hi = s;
+        double sn = s - v / dv;
+        s = sn > lo && sn < hi ? sn : 0.5 * (lo + hi);
+    }
+    return s;
+}
+
 /* The root of q_j(t) - value (query qi, slot b) in (a, e), fa, fe of opposite
- * signs (fa at a, continuous over the cell): Newton from the better end with
- * the slope, Illinois regula falsi where Newton leaves the bracket. */
-static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, double fe)
+ * signs (fa at a, continuous over the cell; da, de the slopes there, NaN where
+ * not known): Newton with the slope from the root of the cell's cubic Hermite
+ * model (the secant's where a slope is not known), Illinois regula falsi where
+ * Newton leaves the bracket. */
+static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, double fe,
+                    double da, double de)
 {
     int j = c->qj[qi];
     double best_t = fabs(fa) < fabs(fe) ? a : e, best_f = fmin(fabs(fa), fabs(fe));
     double t = a - fa * (e - a) / (fe - fa);
+    if (isfinite(da) && isfinite(de)) {
+        double tn = a + (e - a) * hm_hermite_root(fa, fe, da * (e - a), de * (e - a));
+        if (tn > a && tn < e)
+            t = tn;
+    }
     int side = 0;
     HmRow r;
     for (int it = 0; it < 80; it++) {
@@ -853,7 +882,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
         if (fabs(f0) <= HM_TOL || fabs(f1) <= HM_TOL || fabs(f0) > 3.0)
             continue; /* a node's zero (hm_node), or the far turn */
         if ((f0 < 0) != (f1 < 0)) {
-            hm_root(c, b, qi, r0->t, f0, r1->t, f1);
+            hm_root(c, b, qi, r0->t, f0, r1->t, f1, d0, d1);
             continue;
         }
         if ((d0 < 0) == (d1 < 0) || (f0 > 0) != (d0 < 0))
@@ -868,8 +897,8 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
         if (fabs(fm) <= HM_TOL) {
             hm_graze(c, b, qi, r0, &m, r1); /* touches the value, or grazes a limit */
         } else if ((fm < 0) != (f0 < 0)) {
-            hm_root(c, b, qi, r0->t, f0, m.t, fm);
-            hm_root(c, b, qi, m.t, fm, r1->t, f1);
+            hm_root(c, b, qi, r0->t, f0, m.t, fm, d0, m.dq[b][j]);
+            hm_root(c, b, qi, m.t, fm, r1->t, f1, m.dq[b][j], d1);
         }
     }
 }
@@ -902,9 +931,9 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
             continue;
         if ((f0 < 0) != (f1 < 0)) {
             if (w > 0)
-                hm_root(c, b, qi, re->t, f0, first->t, f1);
+                hm_root(c, b, qi, re->t, f0, first->t, f1, NAN, NAN);
             else
-                hm_root(c, b, qi, first->t, f1, re->t, f0);
+                hm_root(c, b, qi, first->t, f1, re->t, f0, NAN, NAN);
         }
     }
     for (int i = 0; i + 1 <= m; i++) {
