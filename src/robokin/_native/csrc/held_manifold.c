@@ -5,7 +5,8 @@
  *
  *   1. a grid of t values over the held joint's range, every slot's row there
  *      (pk_one) and its derivative dq/dt (the six other joints' Jacobian columns
- *      solve -J_held: the pose stays fixed along the manifold);
+ *      solve -J_held: the pose stays fixed along the manifold; hm_slopes_fast
+ *      where the first three axes meet: two 3 x 3 solves);
  *   2. per slot and cell between grid nodes with a row at both ends: the cell is
  *      split (a midpoint solved, up to HM_DEPTH times) while a joint moves more
  *      than HM_JUMP in it or a joint's distance to a value (a limit or an
@@ -14,8 +15,9 @@
  *      value; then per (joint, value) a sign change of q_j - value brackets one
  *      crossing, and opposite end slopes an extremum (located by regula falsi on
  *      dq_j/dt) whose value decides two crossings or none; every crossing is
- *      refined by safeguarded Newton (the analytic slope) / Illinois regula falsi
- *      on q_j(t) - value until the joint is at the value to 1e-14 (the row is
+ *      refined by safeguarded Newton (the analytic slope, from the root of the
+ *      cell's cubic Hermite model) / Illinois regula falsi on q_j(t) - value
+ *      until the joint is at the value to 1e-14 (the row is
  *      pk_one's: pose error <= 4e-13);
  *   3. cells where a slot's row appears or disappears (a fold: two slots meet)
  *      are bisected on the row's existence to adjacent floats (pk_one's own
