@@ -5,7 +5,8 @@
  *
  *   1. a grid of t values over the held joint's range, every slot's row there
  *      (pk_one) and its derivative dq/dt (the six other joints' Jacobian columns
- *      solve -J_held: the pose stays fixed along the manifold);
+ *      solve -J_held: the pose stays fixed along the manifold; hm_slopes_fast
+ *      where the first three axes meet: two 3 x 3 solves);
  *   2. per slot and cell between grid nodes with a row at both ends: the cell is
  *      split (a midpoint solved, up to HM_DEPTH times) while a joint moves more
  *      than HM_JUMP in it or a joint's distance to a value (a limit or an
@@ -14,8 +15,9 @@
  *      value; then per (joint, value) a sign change of q_j - value brackets one
  *      crossing, and opposite end slopes an extremum (located by regula falsi on
  *      dq_j/dt) whose value decides two crossings or none; every crossing is
- *      refined by safeguarded Newton (the analytic slope) / Illinois regula falsi
- *      on q_j(t) - value until the joint is at the value to 1e-14 (the row is
+ *      refined by safeguarded Newton (the analytic slope, from the root of the
+ *      cell's cubic Hermite model) / Illinois regula falsi on q_j(t) - value
+ *      until the joint is at the value to 1e-14 (the row is
  *      pk_one's: pose error <= 4e-13);
  *   3. cells where a slot's row appears or disappears (a fold: two slots meet)
  *      are bisected on the row's existence to adjacent floats (pk_one's own
@@ -51,6 +53,9 @@
 #define HM_FOLD_STEPS 6 /* rows between a branch end and its grid row */
 #define HM_PARALLEL_MIN 8
 #define HM_DECIDE 1e-9 /* a grid row this far inside / outside decides its piece [rad] */
+#ifndef HM_SLOPE_DET
+#define HM_SLOPE_DET 1e-10 /* hm_slopes_fast: a block's determinant per unit columns below it: hm_slopes */
+#endif
 #define HM_MAXG 8 /* grazes (a branch inside a limit by under HM_TOL) per slot */
 
 enum { HM_KIND_LOWER = 0, HM_KIND_UPPER = 1, HM_KIND_ALIGNED = 2, HM_KIND_FOLD = 3 };
@@ -83,6 +88,14 @@ typedef struct {
     int nfold[8];
     double graze_t[8][HM_MAXG][2]; /* a graze's in-limit stretch */
     int graze_j[8][HM_MAXG], ngraze[8];
+    /* the slopes' structured solve (hm_slopes_fast; fast = 0: the full FK, hm_slopes):
+     * the first three axes meeting at fc, the held joint last; the chain's product
+     * of exponentials is G = T M^-1 (GA, Gt); per t (ft), the first six joints'
+     * B5, b5 = G E_held(t)^-1; the held joint's columns at fc (u6, w6) */
+    int fast, full_fk; /* full_fk: hm_slopes wanted (the fold search) */
+    v3 fc, Gt, u6, w6, b5;
+    m3 GA, B5;
+    double ft;
 } HmCtx;
 
 /* Gaussian elimination with partial pivoting of M (6 x 6 | right-hand side) into x;
@@ -165,6 +178,137 @@ static void hm_slopes(const double *P, int n, int k, const double *q, double *dq
     for (int i = 0; i < 6; i++)
         dq[col[i]] = x[i];
     dq[k] = 1.0;
+}
+
+/* The first three axes' common point (zero configuration) into *pc when they meet
+ * (to 1e-12 of the scale) and the held joint is the last of seven: the structure
+ * hm_slopes_fast needs. */
+static int hm_fast_setup(HmCtx *c)
+{
+    const double *P = c->P, *T = c->T;
+    if (c->n != 7 || c->k != 6)
+        return 0;
+    v3 h0 = v3_at(P, PK_AXES), h1 = v3_at(P, PK_AXES + 3), h2 = v3_at(P, PK_AXES + 6);
+    v3 o0 = v3_at(P, PK_POINTS), o1 = v3_at(P, PK_POINTS + 3), o2 = v3_at(P, PK_POINTS + 6);
+    /* the point of axis 0 nearest axis 1 (they meet: that is their common point) */
+    v3 n = v3_cross(h0, h1), d = v3_sub(o1, o0);
+    double nn = v3_dot(n, n), scale = P[PK_SCALE];
+    if (!(nn > 1e-12))
+        return 0;
+    v3 pc = v3_add(o0, v3_scale(h0, v3_dot(v3_cross(d, h1), n) / nn));
+    for (int j = 0; j < 3; j++) {
+        v3 h = j == 0 ? h0 : j == 1 ? h1 : h2, o = j == 0 ? o0 : j == 1 ? o1 : o2;
+        v3 e = v3_sub(pc, o);
+        if (!(v3_norm(v3_sub(e, v3_scale(h, v3_dot(e, h)))) <= 1e-12 * scale))
+            return 0;
+    }
+    m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
+    m3 RM = {v3_at(P, PK_TOOL_R), v3_at(P, PK_TOOL_R + 3), v3_at(P, PK_TOOL_R + 6)};
+    c->fc = pc;
+    c->GA = pk_mul_t(&RT, &RM);
+    c->Gt = v3_sub((v3){T[3], T[7], T[11]}, m3_mv(&c->GA, v3_at(P, PK_TOOL_T)));
+    double sg = P[PK_SIGN + 6];
+    v3 h6 = m3_mv(&c->GA, v3_at(P, PK_AXES + 18));
+    v3 o6 = v3_add(m3_mv(&c->GA, v3_at(P, PK_POINTS + 18)), c->Gt);
+    c->u6 = v3_scale(v3_cross(h6, v3_sub(pc, o6)), sg);
+    c->w6 = v3_scale(h6, sg);
+    c->ft = NAN;
+    return 1;
+}
+
+/* The first six joints' transform at held value t: B5 x + b5 = G E_6(t)^-1 x */
+static void hm_fast_at(HmCtx *c, double t)
+{
+    const double *P = c->P;
+    if (t == c->ft)
+        return;
+    double th = P[PK_SIGN + 6] * t + P[PK_OFFSET + 6];
+    v3 h = v3_at(P, PK_AXES + 18), o = v3_at(P, PK_POINTS + 18);
+    m3 Rt = pk_rotm(h, cos(th), -sin(th)); /* E_6^-1's rotation */
+    c->B5 = pk_mul(&c->GA, &Rt);
+    c->b5 = v3_add(m3_mv(&c->GA, v3_sub(o, m3_mv(&Rt, o))), c->Gt);
+    c->ft = t;
+}
+
+/* x solving [a b e] x = r (Cramer); 0 when the determinant is below tol times the
+ * product of the columns' lengths */
+static int hm_solve3(v3 a, v3 b, v3 e, v3 r, double tol, double x[3])
+{
+    v3 be = v3_cross(b, e);
+    double det = v3_dot(a, be);
+
+    if (!(det * det > tol * tol * v3_dot(a, a) * v3_dot(b, b) * v3_dot(e, e)))
+        return 0;
+    x[0] = v3_dot(r, be) / det;
+    x[1] = v3_dot(a, v3_cross(r, e)) / det;
+    x[2] = v3_dot(a, v3_cross(b, r)) / det;
+    return 1;
+}
+
+/* hm_slopes by the structure (hm_fast_setup): the manifold's velocity equations
+ * taken at the first three axes' common point fc, where those three columns have
+ * no linear part, split into the wrist joints' 3 x 3 (linear: joints 4-6 against
+ * the held joint's column) and the shoulder's 3 x 3 (angular); the world axes of
+ * joints 4-6 from the pose backwards (G E_6^-1 E_5^-1 ...), of joints 1-3 from
+ * the base: 4 sincos per row and slot instead of the full FK's 7 and a 6 x 6.
+ * The same slopes to rounding (the system differs by row operations); 0 (and
+ * hm_slopes decides) where a block's determinant is below HM_SLOPE_DET times its
+ * columns' lengths: next to a fold or an aligned shoulder, where the two differ
+ * by more than rounding and hm_slopes' own singular test (a pivot below 1e-14)
+ * decides whether the slope is NaN. */
+static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
+{
+    const double *P = c->P;
+    double sg[7], cs[7], sn[7];
+    hm_fast_at(c, t);
+    for (int j = 0; j < 6; j++) {
+        if (j == 2 || j == 3)
+            continue;
+        sg[j] = P[PK_SIGN + j];
+        double th = sg[j] * q[j] + P[PK_OFFSET + j];
+        cs[j] = cos(th);
+        sn[j] = sin(th);
+    }
+    sg[2] = P[PK_SIGN + 2];
+    sg[3] = P[PK_SIGN + 3];
+    v3 h[7], o[7];
+    for (int j = 0; j < 7; j++) {
+        h[j] = v3_at(P, PK_AXES + 3 * j);
+        o[j] = v3_at(P, PK_POINTS + 3 * j);
+    }
+    /* joints 4, 5 (0-based 3, 4) in joint 6's frame (E_5^-1, E_4^-1), then B5 */
+    v3 h4 = v3_rot(h[5], cs[5], -sn[5], h[4]);
+    v3 o4 = v3_add(v3_rot(h[5], cs[5], -sn[5], v3_sub(o[4], o[5])), o[5]);
+    v3 r3 = v3_add(v3_rot(h[4], cs[4], -sn[4], v3_sub(o[3], o[4])), o[4]);
+    v3 h3 = v3_rot(h[5], cs[5], -sn[5], v3_rot(h[4], cs[4], -sn[4], h[3]));
+    v3 o3 = v3_add(v3_rot(h[5], cs[5], -sn[5], v3_sub(r3, o[5])), o[5]);
+    v3 H[3] = {m3_mv(&c->B5, h3), m3_mv(&c->B5, h4), m3_mv(&c->B5, h[5])};
+    v3 O[3] = {v3_add(m3_mv(&c->B5, o3), c->b5), v3_add(m3_mv(&c->B5, o4), c->b5),
+               v3_add(m3_mv(&c->B5, o[5]), c->b5)};
+    v3 U[3], Wa[3];
+    for (int i = 0; i < 3; i++) {
+        U[i] = v3_scale(v3_cross(H[i], v3_sub(c->fc, O[i])), sg[3 + i]);
+        Wa[i] = v3_scale(H[i], sg[3 + i]);
+    }
+    double x[3], y[3], tol = HM_SLOPE_DET;
+    if (!hm_solve3(U[0], U[1], U[2], v3_scale(c->u6, -1.0), tol, x))
+        return 0;
+    /* the shoulder: world axes R0 h1, R0 R1 h2 */
+    v3 a1 = v3_rot(h[0], cs[0], sn[0], h[1]);
+    v3 a2 = v3_rot(h[0], cs[0], sn[0], v3_rot(h[1], cs[1], sn[1], h[2]));
+    v3 r = v3_add(v3_add(v3_scale(Wa[0], x[0]), v3_scale(Wa[1], x[1])),
+                  v3_add(v3_scale(Wa[2], x[2]), c->w6));
+    if (!hm_solve3(v3_scale(h[0], sg[0]), v3_scale(a1, sg[1]), v3_scale(a2, sg[2]),
+                   v3_scale(r, -1.0), HM_SLOPE_DET, y))
+        return 0;
+    dq[0] = y[0];
+    dq[1] = y[1];
+    dq[2] = y[2];
+    dq[3] = x[0];
+    dq[4] = x[1];
+    dq[5] = x[2];
+    dq[6] = 1.0;
+    return 1;
 }
 
 /* The slots in `need` at held value x by pk_one's closed form alone (its position
@@ -270,8 +414,25 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
 /* The slots in `need` at t (hm_closed, else pk_one's every slot), shifted into the
  * limits by whole turns where that fits (as the numpy path's _into_limits); slopes
  * for the slots in `mask`. */
+#ifdef HM_STAGES /* a measuring build: evaluations per calling function, to stderr */
+static const char *hm_tag;
+static const char *hm_tags[16];
+static long hm_tag_n[16];
+static void hm_eval_(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r);
+#define hm_eval(...) (hm_tag = __func__, hm_eval_(__VA_ARGS__))
+static void hm_eval_(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
+{
+    for (int i = 0; i < 16; i++)
+        if (hm_tags[i] == NULL || hm_tags[i] == hm_tag) {
+            hm_tags[i] = hm_tag;
+            hm_tag_n[i]++;
+            break;
+        }
+#else
 static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
 {
+#endif
+
     const double *P = c->P;
     r->t = t;
     c->cheap++;
@@ -310,8 +471,22 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
                 q -= 2.0 * M_PI;
             r->q[b][j] = q;
         }
-        if (mask >> b & 1u)
+        if (!(mask >> b & 1u))
+            continue;
+        if (!(c->fast && !c->full_fk && hm_slopes_fast(c, t, r->q[b], r->dq[b])))
             hm_slopes(P, c->n, c->k, r->q[b], r->dq[b]);
+#ifdef HM_SLOPE_CHECK
+        if (c->fast) { /* a checking build: the structured slopes against the full FK's */
+            double ref[PK_MAXJ], worst = 0.0, big = 0.0;
+            hm_slopes(P, c->n, c->k, r->q[b], ref);
+            for (int j = 0; j < c->n; j++) {
+                worst = fmax(worst, fabs(ref[j] - r->dq[b][j]));
+                big = fmax(big, fabs(ref[j]));
+            }
+            fprintf(stderr, "slope %.3e %.3e %d %d\n", worst / big, big, isfinite(ref[0]),
+                    isfinite(r->dq[b][0]));
+        }
+#endif
     }
 }
 
@@ -342,14 +517,43 @@ static inline double hm_f(const HmCtx *c, const HmRow *r, int b, int qi)
     return wrap_pi(r->q[b][c->qj[qi]] - c->qv[qi]);
 }
 
+/* The root in (0, 1) of the cubic Hermite model of f on a cell (values f0, f1 of
+ * opposite signs, slopes d0, d1 per unit of the cell): safeguarded Newton on the
+ * cubic from the secant's root (no rows). */
+static double hm_hermite_root(double f0, double f1, double d0, double d1)
+{
+    double A = 3.0 * (f1 - f0) - 2.0 * d0 - d1, B = 2.0 * (f0 - f1) + d0 + d1;
+    double lo = 0.0, hi = 1.0, s = f0 / (f0 - f1);
+    for (int it = 0; it < 12; it++) {
+        double v = f0 + s * (d0 + s * (A + s * B)), dv = d0 + s * (2.0 * A + 3.0 * s * B);
+        if (v == 0.0)
+            break;
+        if ((v < 0) == (f0 < 0))
+            lo = s;
+        else
+            hi = s;
+        double sn = s - v / dv;
+        s = sn > lo && sn < hi ? sn : 0.5 * (lo + hi);
+    }
+    return s;
+}
+
 /* The root of q_j(t) - value (query qi, slot b) in (a, e), fa, fe of opposite
- * signs (fa at a, continuous over the cell): Newton from the better end with
- * the slope, Illinois regula falsi where Newton leaves the bracket. */
-static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, double fe)
+ * signs (fa at a, continuous over the cell; da, de the slopes there, NaN where
+ * not known): Newton with the slope from the root of the cell's cubic Hermite
+ * model (the secant's where a slope is not known), Illinois regula falsi where
+ * Newton leaves the bracket. */
+static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, double fe,
+                    double da, double de)
 {
     int j = c->qj[qi];
     double best_t = fabs(fa) < fabs(fe) ? a : e, best_f = fmin(fabs(fa), fabs(fe));
     double t = a - fa * (e - a) / (fe - fa);
+    if (isfinite(da) && isfinite(de)) {
+        double tn = a + (e - a) * hm_hermite_root(fa, fe, da * (e - a), de * (e - a));
+        if (tn > a && tn < e)
+            t = tn;
+    }
     int side = 0;
     HmRow r;
     for (int it = 0; it < 80; it++) {
@@ -680,7 +884,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
         if (fabs(f0) <= HM_TOL || fabs(f1) <= HM_TOL || fabs(f0) > 3.0)
             continue; /* a node's zero (hm_node), or the far turn */
         if ((f0 < 0) != (f1 < 0)) {
-            hm_root(c, b, qi, r0->t, f0, r1->t, f1);
+            hm_root(c, b, qi, r0->t, f0, r1->t, f1, d0, d1);
             continue;
         }
         if ((d0 < 0) == (d1 < 0) || (f0 > 0) != (d0 < 0))
@@ -695,8 +899,8 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
         if (fabs(fm) <= HM_TOL) {
             hm_graze(c, b, qi, r0, &m, r1); /* touches the value, or grazes a limit */
         } else if ((fm < 0) != (f0 < 0)) {
-            hm_root(c, b, qi, r0->t, f0, m.t, fm);
-            hm_root(c, b, qi, m.t, fm, r1->t, f1);
+            hm_root(c, b, qi, r0->t, f0, m.t, fm, d0, m.dq[b][j]);
+            hm_root(c, b, qi, m.t, fm, r1->t, f1, m.dq[b][j], d1);
         }
     }
 }
@@ -729,9 +933,9 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
             continue;
         if ((f0 < 0) != (f1 < 0)) {
             if (w > 0)
-                hm_root(c, b, qi, re->t, f0, first->t, f1);
+                hm_root(c, b, qi, re->t, f0, first->t, f1, NAN, NAN);
             else
-                hm_root(c, b, qi, first->t, f1, re->t, f0);
+                hm_root(c, b, qi, first->t, f1, re->t, f0, NAN, NAN);
         }
     }
     for (int i = 0; i + 1 <= m; i++) {
@@ -773,6 +977,7 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
         HmRow m;
         int last_out = 0, last_est = 0;
         gv[0] = hm_gap(c, b, state0 ? r0 : r1);
+        c->full_fk = 1;
         for (int it = 0; it < 80; it++) {
             int est_used = 0;
             double probe = 0.5 * (v + u), tiny = 0.25 * HM_FOLD_TOL * fmax(1.0, fabs(v));
@@ -806,6 +1011,7 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
             if (fabs(u - v) <= HM_FOLD_TOL * fmax(1.0, fabs(v)))
                 break;
         }
+        c->full_fk = 0;
         if (!(fabs(u - v) <= 2.0 * HM_FOLD_TOL * fmax(1.0, fabs(v)))) {
             c->flags |= HM_FLAG_CONVERGE;
         }
@@ -1213,12 +1419,21 @@ static void hm_range(void *ctx, long b0, long e0)
             c->qv[c->nq] = jb->al[2 * a + 1];
             c->qkind[c->nq++] = HM_KIND_ALIGNED;
         }
+        c->fast = hm_fast_setup(c);
+        c->full_fk = 0;
         if (P[PK_CASE] == PK_BOTH || c->k < 0 || c->n != 7)
             c->flags |= HM_FLAG_BAD; /* not a Panda-type held family */
         else
             hm_pose(c, jb->G, jb->iv + 2 * HM_MAXI * 8 * i, jb->niv + 8 * i);
         jb->npts[i] = c->npts;
         jb->flags[i] = c->flags;
+#ifdef HM_STAGES
+        for (int t = 0; t < 16 && hm_tags[t]; t++)
+            fprintf(stderr, "%s %ld ", hm_tags[t], hm_tag_n[t]);
+        fprintf(stderr, "\n");
+        for (int t = 0; t < 16; t++)
+            hm_tag_n[t] = 0;
+#endif
 #ifdef HM_COUNT_CHEAP
         jb->evals[i] = c->cheap; /* a measuring build: every evaluation */
 #else
