@@ -54,7 +54,7 @@ from typing import Any
 import numpy as np
 
 from robokin.kinematics.arm import Arm
-from robokin.kinematics.ik.fixed import Dispatch, solve_fixed, sweep_end
+from robokin.kinematics.ik.fixed import Dispatch, EndSweep, solve_fixed
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.jacobian import jacobian_and_pose
 from robokin.spatial import pose_error
@@ -118,6 +118,8 @@ class _ContinuedFamily(_Family):
         self.domain = (float(robot.limits[j, 0]), float(robot.limits[j, 1]))
         self.T = np.ascontiguousarray(T, dtype=np.float64)
         self.solves = 0
+        # the end joint's sweep set up once per pose (None: a middle joint, solve_fixed)
+        self._sweep = EndSweep.of(robot, j, self.T)
         t = np.linspace(*self.domain, int(nodes))
         Q = self._solve(t)
         D = _slopes(robot, Q, j)
@@ -166,7 +168,8 @@ class _ContinuedFamily(_Family):
         self.solves += len(t)
         # an end joint on a general 6R reduced chain: the kernel directly (the same
         # rows as solve_fixed, without its per-call checks and assemblies)
-        sols = sweep_end(self.robot, self.joint, self.T, np.ascontiguousarray(t, np.float64))
+        sols = (None if self._sweep is None
+                else self._sweep.solve(np.ascontiguousarray(t, np.float64)))
         if sols is None:
             sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
         valid = sols.valid.reshape(len(t), -1)
@@ -182,7 +185,7 @@ class _ContinuedFamily(_Family):
         R = self._solve(t)  # (M, K, n)
         P = self.predict(t)  # (M, k, n)
         out = self._polish(_assign(P, R), t)
-        valid = np.isfinite(out).all(-1)
+        valid = _finite_rows(out)
         return out, valid, np.zeros_like(valid)
 
     def _polish(self, Q: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -193,7 +196,7 @@ class _ContinuedFamily(_Family):
         rows at a limit crossing's t have the joint at its limit to ~1e-14.
         """
         M, k, n = Q.shape
-        ok = np.isfinite(Q).all(-1)
+        ok = _finite_rows(Q)
         if not ok.any():
             return Q
         mi, bi = np.nonzero(ok)
@@ -213,7 +216,8 @@ class _ContinuedFamily(_Family):
         tn, X, S, E = self.t_nodes, self.tracks, self._slopes0, self._exists
         M, (_, k, n) = len(t), X.shape
         out = np.full((M, k, n), np.nan)
-        i = np.clip(np.searchsorted(tn, t, side="right") - 1, 0, len(tn) - 2)
+        # (np.clip's wrapper costs more than the search)
+        i = np.minimum(np.maximum(np.searchsorted(tn, t, side="right") - 1, 0), len(tn) - 2)
         fa, fb = E[i], E[i + 1]  # (M, k)
         mi, bi = np.nonzero(fa | fb)  # only the tracks present in the cell
         if not mi.size:
@@ -433,6 +437,27 @@ def _wrap(x: np.ndarray) -> np.ndarray:
     return out
 
 
+def _finite_rows(x: np.ndarray) -> np.ndarray:
+    """``np.isfinite(x).all(-1)``, the last axis (the joints) reduced one column at a time."""
+    fin = np.isfinite(x)
+    out: np.ndarray = fin[..., 0].copy()
+    for j in range(1, x.shape[-1]):
+        out &= fin[..., j]
+    return out
+
+
+def _max_last(x: np.ndarray) -> np.ndarray:
+    """``x.max(-1)`` for a short last axis (the joints; NaN propagates alike).
+
+    One ``np.maximum`` per joint: a reduction over a 7-long axis costs numpy ~10x
+    more per element (the hot path of ``rows``: ``_assign``).
+    """
+    out: np.ndarray = x[..., 0].copy()
+    for j in range(1, x.shape[-1]):
+        np.maximum(out, x[..., j], out=out)
+    return out
+
+
 def _slopes(robot: Arm, Q: np.ndarray, k: int) -> np.ndarray:
     """dq/dq_k of rows Q (..., n) on the manifold of their pose (NaN rows, singular: NaN)."""
     flat = Q.reshape(-1, Q.shape[-1])
@@ -557,12 +582,17 @@ def _assign(P: np.ndarray, R: np.ndarray) -> np.ndarray:
     out = np.full((M, k, n), np.nan)
     if R.shape[1] == 0:
         return out
-    fp, fr = np.isfinite(P).all(-1), np.isfinite(R).all(-1)  # (M, k), (M, K)
+    fp, fr = _finite_rows(P), _finite_rows(R)  # (M, k), (M, K)
     R0 = np.where(fr[..., None], R, 0.0)  # (NaN arithmetic is slow)
     # distances of the predicted tracks only (most tracks live on part of the range)
     mi, bi = np.nonzero(fp)
     d = np.full((M, k, R.shape[1]), np.inf)
-    d[mi, bi] = np.abs(_wrap(P[mi, bi][:, None] - R0[mi])).max(-1)  # (M, k, K)
+    x = P[mi, bi][:, None] - R0[mi]  # (p, K, n); _wrap's operations, in place
+    y = np.divide(x, _TWO_PI)
+    np.round(y, out=y)
+    y *= _TWO_PI
+    x -= y
+    d[mi, bi] = _max_last(np.abs(x, out=x))  # (M, k, K)
     d[~(fp[:, :, None] & fr[:, None, :])] = np.inf
     best_row = np.argmin(d, axis=2)  # (M, k)
     best_track = np.argmin(d, axis=1)  # (M, K)
@@ -588,11 +618,16 @@ def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray,
     free[np.arange(M), joints] = False
     idx = np.nonzero(free)[1].reshape(M, n - 1)
     err = np.full(M, np.inf)
-    live = np.isfinite(q).all(-1)
+    live = _finite_rows(q)
+    rows = np.flatnonzero(live)  # the rows (re)evaluated: all, then the moved ones
     for it in range(_NEWTON + 1):
-        live &= np.isfinite(q).all(-1) & (np.abs(q) < 1e3).all(-1)
-        rows = np.flatnonzero(live)
-        err[~live] = np.inf
+        # a row not moved keeps its q and error (the compiled Jacobian is lane-wise:
+        # a row's J and pose do not depend on the others in the batch)
+        qr = q[rows]
+        alive = _finite_rows(qr) & (_max_last(np.abs(qr)) < 1e3)
+        live[rows[~alive]] = False
+        err[rows[~alive]] = np.inf
+        rows = rows[alive]
         if not rows.size:
             break
         J, Tq = jacobian_and_pose(robot.chain, q[rows])
@@ -602,12 +637,13 @@ def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray,
         act = err[rows] > 0.1 * _EXACT
         if it == _NEWTON or not act.any():
             break
-        A = np.take_along_axis(J, idx[rows][:, None, :], axis=2)[act]
+        moved = rows[act]
+        A = np.take_along_axis(J[act], idx[moved][:, None, :], axis=2)
         good = np.abs(np.linalg.det(A)) > 1e-14
-        step = np.zeros((int(act.sum()), n - 1))
+        step = np.zeros((len(moved), n - 1))
         if good.any():
             step[good] = np.linalg.solve(A[good], e[act][good][..., None])[..., 0]
-        moved = rows[act]
         q[moved[:, None], idx[moved]] += step
+        rows = moved
     ok = err <= _EXACT
     return q, ok
