@@ -54,7 +54,7 @@ from typing import Any
 import numpy as np
 
 from robokin.kinematics.arm import Arm
-from robokin.kinematics.ik.fixed import Dispatch, EndSweep, solve_fixed
+from robokin.kinematics.ik.fixed import Dispatch, EndSweep, _all_last, solve_fixed
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.jacobian import jacobian_and_pose
 from robokin.spatial import pose_error
@@ -152,7 +152,9 @@ class _ContinuedFamily(_Family):
         self.tracks, self.slopes = _link(t, Q, D)
         self.k = self.tracks.shape[1]
         self._exists = np.isfinite(self.tracks).all(-1)  # (m, k)
-        self._slopes0 = np.where(np.isfinite(self.slopes), self.slopes, 0.0)
+        # the rows and their slopes (NaN slopes 0) side by side: predict's one gather
+        slopes0 = np.where(np.isfinite(self.slopes), self.slopes, 0.0)
+        self._XS = np.concatenate([self.tracks, slopes0], axis=-1)  # (m, k, 2n)
         m, k, n = self.tracks.shape
         # per (cell, track): the fold inside the cell, its t and row (NaN: none)
         self.fold_t = np.full((m - 1, k), np.nan)
@@ -173,11 +175,16 @@ class _ContinuedFamily(_Family):
         if sols is None:
             sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
         valid = sols.valid.reshape(len(t), -1)
-        order = np.argsort(~valid, axis=1, kind="stable")
-        width = max(int(valid.sum(axis=1).max(initial=0)), 1)
-        order = order[:, :width]
-        q = np.take_along_axis(sols.q.reshape(len(t), -1, self.robot.n), order[..., None], 1)
-        ok = np.take_along_axis(valid, order, 1)
+        q = sols.q.reshape(len(t), -1, self.robot.n)
+        if (valid[:, 1:] <= valid[:, :-1]).all():  # valid rows first already (the kernel's)
+            # the most rows of a value: the columns some value fills (a short-axis sum is slow)
+            width = max(int(valid.any(axis=0).sum()), 1)
+            q, ok = q[:, :width], valid[:, :width]
+        else:
+            width = max(int(valid.sum(axis=1).max(initial=0)), 1)
+            order = np.argsort(~valid, axis=1, kind="stable")[:, :width]
+            q = np.take_along_axis(q, order[..., None], 1)
+            ok = np.take_along_axis(valid, order, 1)
         return _into_limits(self.robot, np.where(ok[..., None], q, np.nan))
 
     def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -200,8 +207,7 @@ class _ContinuedFamily(_Family):
         if not ok.any():
             return Q
         mi, bi = np.nonzero(ok)
-        q, good = _newton_held(self.robot, self.T, Q[mi, bi], np.full(len(mi), self.joint),
-                               t[mi])
+        q, good = _newton_held(self.robot, self.T, Q[mi, bi], self.joint, t[mi])
         out: np.ndarray = Q.copy()
         out[mi[good], bi[good]] = q[good]
         return out
@@ -213,7 +219,7 @@ class _ContinuedFamily(_Family):
         slopes; where it exists at one of them only (a fold in the cell): the
         tangent line from that one.
         """
-        tn, X, S, E = self.t_nodes, self.tracks, self._slopes0, self._exists
+        tn, X, E = self.t_nodes, self.tracks, self._exists
         M, (_, k, n) = len(t), X.shape
         out = np.full((M, k, n), np.nan)
         # (np.clip's wrapper costs more than the search)
@@ -226,20 +232,22 @@ class _ContinuedFamily(_Family):
         fa, fb = fa[mi, bi][:, None], fb[mi, bi][:, None]
         h = (tn[c + 1] - tn[c])[:, None]
         u = ((t[mi] - tn[c]) / (tn[c + 1] - tn[c]))[:, None]
-        a = np.where(fa, X[c, bi], 0.0)
-        b = np.where(fb, X[c + 1, bi], 0.0)
-        sa, sb = S[c, bi], S[c + 1, bi]
+        # each node's row and slope in one gather
+        ga, gb = self._XS[c, bi], self._XS[c + 1, bi]  # (p, 2n)
+        xa, xb, sa, sb = ga[:, :n], gb[:, :n], ga[:, n:], gb[:, n:]
+        a = np.where(fa, xa, 0.0)
+        b = np.where(fb, xb, 0.0)
         b = a + _wrap(b - a)
         u2, u3 = u * u, u * u * u
         herm = ((2 * u3 - 3 * u2 + 1) * a + (u3 - 2 * u2 + u) * h * sa
                 + (-2 * u3 + 3 * u2) * b + (u3 - u2) * h * sb)
-        one = np.where(fa, a + u * h * sa, X[c + 1, bi] + (u - 1) * h * sb)
+        one = np.where(fa, a + u * h * sa, xb + (u - 1) * h * sb)
         # a fold in the cell: q = q_f + (q_node - q_f) sqrt((t - t_f) / (t_node - t_f))
         tf, qf = self.fold_t[c, bi], self.fold_q[c, bi]
         fold = np.isfinite(tf)
         if fold.any():
             tnode = np.where(fa[:, 0], tn[c], tn[c + 1])
-            qnode = np.where(fa, X[c, bi], X[c + 1, bi])
+            qnode = np.where(fa, xa, xb)
             with np.errstate(invalid="ignore", divide="ignore"):
                 r = np.where(fold, (t[mi] - tf) / (tnode - tf), 0.0)
                 root = qf + _wrap(qnode - qf) * np.sqrt(np.maximum(r, 0.0))[:, None]
@@ -439,11 +447,7 @@ def _wrap(x: np.ndarray) -> np.ndarray:
 
 def _finite_rows(x: np.ndarray) -> np.ndarray:
     """``np.isfinite(x).all(-1)``, the last axis (the joints) reduced one column at a time."""
-    fin = np.isfinite(x)
-    out: np.ndarray = fin[..., 0].copy()
-    for j in range(1, x.shape[-1]):
-        out &= fin[..., j]
-    return out
+    return _all_last(np.isfinite(x))
 
 
 def _max_last(x: np.ndarray) -> np.ndarray:
@@ -604,9 +608,11 @@ def _assign(P: np.ndarray, R: np.ndarray) -> np.ndarray:
     return out
 
 
-def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray,
+def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray | int,
                  values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Configurations (M, n) of pose T with joint ``joints[i]`` at ``values[i]``.
+
+    ``joints`` one index for every row: the six other columns taken as a slice.
 
     Newton steps from q0 (M, n) on the six other joints (the parameter among them:
     t free); True where the pose is reached to ``_EXACT``.
@@ -638,7 +644,8 @@ def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray,
         if it == _NEWTON or not act.any():
             break
         moved = rows[act]
-        A = np.take_along_axis(J[act], idx[moved][:, None, :], axis=2)
+        A = (J[act][:, :, idx[0]] if isinstance(joints, int)
+             else np.take_along_axis(J[act], idx[moved][:, None, :], axis=2))
         good = np.abs(np.linalg.det(A)) > 1e-14
         step = np.zeros((len(moved), n - 1))
         if good.any():
