@@ -279,3 +279,15 @@ def test_the_one_pose_hot_path_takes_no_detour():
     assert sols.method == "analytic:pieper (joint7 held)" and len(sols) >= 1
     assert "solve" not in entered and "solve_fixed" not in entered, entered
     assert len(entered) <= 6, entered
+
+
+def test_the_short_axis_all_equals_numpys():
+    # fixed._all_last (the end sweep's limit flags, issue 29) against bool.all(-1)
+    rng = np.random.default_rng(4)
+    for shape in ((6, 8, 7), (13, 7), (3, 1)):
+        b = rng.random(shape) < 0.9
+        np.testing.assert_array_equal(fixed_ik._all_last(b), b.all(-1))
+    b = np.ones((4, 5, 7), bool)
+    b[1, 2, 6] = False
+    out = fixed_ik._all_last(b)
+    assert out.sum() == 19 and not out[1, 2]
