@@ -310,3 +310,15 @@ def test_held_joint_at_a_stretched_elbow_near_srs_arm():
         dp, dr = pose_errors(robot.fk(Q), T)
         assert dp.max() <= 1e-12 and dr.max() <= 1e-12
     assert len(Q) and np.abs((Q - q + np.pi) % (2 * np.pi) - np.pi).max(-1).min() <= 1e-6
+
+
+def test_the_short_axis_all_equals_numpys():
+    # fixed._all_last (the end sweep's limit flags, issue 29) against bool.all(-1)
+    rng = np.random.default_rng(4)
+    for shape in ((6, 8, 7), (13, 7), (3, 1)):
+        b = rng.random(shape) < 0.9
+        np.testing.assert_array_equal(fixed_ik._all_last(b), b.all(-1))
+    b = np.ones((4, 5, 7), bool)
+    b[1, 2, 6] = False
+    out = fixed_ik._all_last(b)
+    assert out.sum() == 19 and not out[1, 2]

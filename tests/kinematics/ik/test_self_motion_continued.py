@@ -292,3 +292,74 @@ def test_the_direct_sweep_equals_solve_fixed(arm):
         np.testing.assert_array_equal(a.singular, b.singular)
         np.testing.assert_array_equal(a.within_limits, b.within_limits)
     assert sweep_end(robot.arm, 3, T, t) is None  # a middle joint: not this path
+
+
+def test_the_short_axis_reductions_equal_numpys():
+    # _max_last and _finite_rows (rows' hot path, issue 29) against numpy's own
+    # reductions: NaN, +-inf and -0.0 mixed into the joints, any leading shape
+    from robokin.kinematics.ik.self_motion_continued import _finite_rows, _max_last
+
+    rng = np.random.default_rng(3)
+    x = rng.normal(size=(5, 9, 7)) * 10.0
+    x[rng.random(x.shape) < 0.08] = np.nan
+    x[rng.random(x.shape) < 0.03] = np.inf
+    x[rng.random(x.shape) < 0.03] = -np.inf
+    x[0, 0] = -0.0
+    np.testing.assert_array_equal(_finite_rows(x), np.isfinite(x).all(-1))
+    assert not _finite_rows(x).all() and _finite_rows(x).any()
+    np.testing.assert_array_equal(_max_last(x), x.max(-1))
+    assert np.isnan(_max_last(x)).any()
+    flat = x.reshape(-1, 7)
+    np.testing.assert_array_equal(_max_last(np.abs(flat)), np.abs(flat).max(-1))
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_held_newton_steps_of_a_row_do_not_depend_on_the_batch(arm):
+    # _newton_held re-evaluates only the rows it moved (the compiled Jacobian is
+    # lane-wise): the batch gives each row exactly what it gets alone, one joint index
+    # gives what an index per row gives, and the perturbed rows reach the pose again
+    from robokin.kinematics.ik.self_motion_continued import _newton_held
+
+    robot = ARMS[arm]
+    q0 = _configs(robot, 11, False)[0]
+    T, sm = _manifold(robot, q0)
+    t = np.linspace(*sm.domain, 9)
+    Q = sm.sample(t)
+    ok = np.isfinite(Q).all(-1)
+    rows, tt = Q[ok], np.broadcast_to(t[:, None], ok.shape)[ok]
+    rng = np.random.default_rng(5)
+    rows = rows + np.where(rng.random(len(rows)) < 0.5, 1e-7, 0.0)[:, None]  # some moved
+    q, good = _newton_held(robot.arm, T, rows, 6, tt)
+    q2, good2 = _newton_held(robot.arm, T, rows, np.full(len(rows), 6), tt)
+    np.testing.assert_array_equal(q, q2)
+    np.testing.assert_array_equal(good, good2)
+    assert good.all() and len(rows) >= 4
+    np.testing.assert_array_equal(q[:, 6], tt)
+    dp, dr = pose_errors(robot.fk(q), T)
+    assert dp.max() <= 1e-13 and dr.max() <= 1e-13
+    for i in range(len(rows)):
+        qi, gi = _newton_held(robot.arm, T, rows[i:i + 1], 6, tt[i:i + 1])
+        np.testing.assert_array_equal(qi[0], q[i])
+        assert gi[0] == good[i]
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_the_end_sweep_kept_per_pose_equals_sweep_end(arm):
+    # fixed.EndSweep (set up once per pose by the continued family): every later call
+    # gives what sweep_end gives for the same values; None for a middle joint
+    from robokin.kinematics.ik.fixed import EndSweep, sweep_end
+
+    robot = ARMS[arm]
+    q0 = _configs(robot, 17, True)[1]
+    T = robot.fk(q0)
+    sweep = EndSweep.of(robot.arm, 6, T)
+    assert sweep is not None and EndSweep.of(robot.arm, 3, T) is None
+    for t in (np.linspace(*robot.limits[6], 33), np.array([0.0, 1e-9, -np.pi / 2, q0[6]])):
+        a, b = sweep.solve(t), sweep_end(robot.arm, 6, T, t)
+        assert b is not None
+        np.testing.assert_array_equal(a.q, b.q)
+        np.testing.assert_array_equal(a.valid, b.valid)
+        np.testing.assert_array_equal(a.within_limits, b.within_limits)
+        assert a.valid.any()
+    # q0 among the rows at its own q7
+    assert (_wrapped(a.q[-1][a.valid[-1]] - q0).max(-1) < 1e-9).any()

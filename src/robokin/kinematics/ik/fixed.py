@@ -440,27 +440,87 @@ def sweep_end(robot: Arm, j: int, T: np.ndarray, values: np.ndarray) -> Solution
         T: One validated pose (4, 4) [m].
         values: Held values (M,) [rad], finite.
     """
-    end = _end_joint(robot, [j])
-    if end is None or _held_solvers(robot).get(robot.joint_names[j]) is not None:
-        return None
-    reduced = _reduced(robot, [j], (0.0,))
-    params = _g6.setup(reduced).params if reduced.derived(FAMILY).name == _g6.NAME else None
-    if params is None:
-        return None
-    M = len(values)
-    Tb = np.broadcast_to(T, (M, 4, 4))
-    Tm = np.ascontiguousarray(_moved_targets(robot, end, Tb, values))
-    Q, valid, _, sigma, _, _, _ = _g6.raw_solve(reduced.chain, params, Tm)
-    q = np.full(Q.shape[:-1] + (robot.n,), np.nan)
-    q[..., [c for c in range(robot.n) if c != j]] = Q
-    q[..., j] = values[:, None]
-    q[~valid] = np.nan  # as SolutionSet does with rows that are not valid
-    lim = robot.limits
-    inside = np.all((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9), axis=-1)
-    sols = SolutionSet._trusted(q, valid, robot.is_revolute, lim,
-                                {"singular": (sigma < 1e-6) & valid, "within_limits": inside},
-                                {}, np.empty(M, dtype=object), "", None, {})
-    return _into_limits(robot, j, Tb, values, sols)
+    sweep = EndSweep.of(robot, j, T)
+    return None if sweep is None else sweep.solve(values)
+
+
+@dataclass(frozen=True, eq=False)
+class EndSweep:
+    """:func:`sweep_end` for one arm, end joint and pose, its set-up looked up once.
+
+    The continued self-motion family keeps one per pose (issue 29): every sweep
+    of ``rows(t)`` then costs the moved targets, the compiled call and the
+    assembly only (the reduced chain, its general-6R parameters, the joint's
+    constant and the pose's product with it are not looked up again).
+
+    Attributes:
+        robot: The arm.
+        j: The held joint's index.
+        T: The pose (4, 4) [m].
+        reduced: The reduced chain's arm (the joint held at 0).
+        params: Its general 6R parameters.
+        last: The joint is the chain's last (else its first).
+        C: The chain's constant next to the joint; C_inv: its inverse.
+        cols: The whole arm's columns of the reduced chain's joints.
+    """
+
+    robot: Arm
+    j: int
+    T: np.ndarray
+    reduced: Arm
+    params: np.ndarray
+    last: bool
+    C: np.ndarray
+    C_inv: np.ndarray
+    cols: list[int]
+
+    @classmethod
+    def of(cls, robot: Arm, j: int, T: np.ndarray) -> EndSweep | None:
+        """The sweep of joint j at pose T, or None where :func:`sweep_end` does not apply."""
+        end = _end_joint(robot, [j])
+        if end is None or _held_solvers(robot).get(robot.joint_names[j]) is not None:
+            return None
+        reduced = _reduced(robot, [j], (0.0,))
+        params = _g6.setup(reduced).params if reduced.derived(FAMILY).name == _g6.NAME else None
+        if params is None:
+            return None
+        consts = robot.chain.arrays.consts
+        C = consts[-1] if end == "last" else consts[0]
+        return cls(robot, j, T, reduced, params, end == "last", C, invert(C),
+                   [c for c in range(robot.n) if c != j])
+
+    def solve(self, values: np.ndarray) -> SolutionSet:
+        """The set at held values (M,) [rad], finite (as :func:`sweep_end`)."""
+        robot, j = self.robot, self.j
+        joint = robot.chain.joints[robot.n - 1 if self.last else 0]
+        M = len(values)
+        Tb = np.broadcast_to(self.T, (M, 4, 4))
+        Tm = np.ascontiguousarray(_move(Tb, values, self.last, self.C, self.C_inv,
+                                        joint.kind, joint.sign))
+        Q, valid, _, sigma, _, _, _ = _g6.raw_solve(self.reduced.chain, self.params, Tm)
+        q = np.full(Q.shape[:-1] + (robot.n,), np.nan)
+        q[..., self.cols] = Q
+        q[..., j] = values[:, None]
+        q[~valid] = np.nan  # as SolutionSet does with rows that are not valid
+        lim = robot.limits
+        inside = _all_last((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9))
+        sols = SolutionSet._trusted(q, valid, robot.is_revolute, lim,
+                                    {"singular": (sigma < 1e-6) & valid,
+                                     "within_limits": inside},
+                                    {}, np.empty(M, dtype=object), "", None, {})
+        return _into_limits(robot, j, Tb, values, sols)
+
+
+def _all_last(b: np.ndarray) -> np.ndarray:
+    """``b.all(-1)`` of a bool array, its short last axis (the joints) one column at a time.
+
+    numpy's reduction over a 7-long last axis costs ~10x more per element than
+    one ``&=`` per column (the continued self-motion's sweeps, issue 29).
+    """
+    out: np.ndarray = b[..., 0].copy()
+    for j in range(1, b.shape[-1]):
+        out &= b[..., j]
+    return out
 
 
 _NUMBERS = (float, int, np.float64)

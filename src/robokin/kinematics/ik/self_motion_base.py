@@ -71,5 +71,8 @@ def _into_limits(robot: Arm, q: np.ndarray) -> np.ndarray:
     rev = np.asarray(robot.is_revolute, bool)
     up = rev & (q < lo) & (q + _TWO_PI <= hi)
     down = rev & (q > hi) & (q - _TWO_PI >= lo)
-    out: np.ndarray = q + _TWO_PI * up - _TWO_PI * down
+    # q + 2 pi up - 2 pi down, bit for bit (-0.0 becomes 0.0), the sparse shifts in place
+    out: np.ndarray = q + 0.0
+    np.add(out, _TWO_PI, out=out, where=up)
+    np.subtract(out, _TWO_PI, out=out, where=down)
     return out

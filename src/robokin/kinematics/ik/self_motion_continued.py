@@ -54,7 +54,7 @@ from typing import Any
 import numpy as np
 
 from robokin.kinematics.arm import Arm
-from robokin.kinematics.ik.fixed import Dispatch, solve_fixed, sweep_end
+from robokin.kinematics.ik.fixed import Dispatch, EndSweep, _all_last, solve_fixed
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.jacobian import jacobian_and_pose
 from robokin.spatial import pose_error
@@ -118,6 +118,8 @@ class _ContinuedFamily(_Family):
         self.domain = (float(robot.limits[j, 0]), float(robot.limits[j, 1]))
         self.T = np.ascontiguousarray(T, dtype=np.float64)
         self.solves = 0
+        # the end joint's sweep set up once per pose (None: a middle joint, solve_fixed)
+        self._sweep = EndSweep.of(robot, j, self.T)
         t = np.linspace(*self.domain, int(nodes))
         Q = self._solve(t)
         D = _slopes(robot, Q, j)
@@ -150,7 +152,9 @@ class _ContinuedFamily(_Family):
         self.tracks, self.slopes = _link(t, Q, D)
         self.k = self.tracks.shape[1]
         self._exists = np.isfinite(self.tracks).all(-1)  # (m, k)
-        self._slopes0 = np.where(np.isfinite(self.slopes), self.slopes, 0.0)
+        # the rows and their slopes (NaN slopes 0) side by side: predict's one gather
+        slopes0 = np.where(np.isfinite(self.slopes), self.slopes, 0.0)
+        self._XS = np.concatenate([self.tracks, slopes0], axis=-1)  # (m, k, 2n)
         m, k, n = self.tracks.shape
         # per (cell, track): the fold inside the cell, its t and row (NaN: none)
         self.fold_t = np.full((m - 1, k), np.nan)
@@ -166,15 +170,21 @@ class _ContinuedFamily(_Family):
         self.solves += len(t)
         # an end joint on a general 6R reduced chain: the kernel directly (the same
         # rows as solve_fixed, without its per-call checks and assemblies)
-        sols = sweep_end(self.robot, self.joint, self.T, np.ascontiguousarray(t, np.float64))
+        sols = (None if self._sweep is None
+                else self._sweep.solve(np.ascontiguousarray(t, np.float64)))
         if sols is None:
             sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
         valid = sols.valid.reshape(len(t), -1)
-        order = np.argsort(~valid, axis=1, kind="stable")
-        width = max(int(valid.sum(axis=1).max(initial=0)), 1)
-        order = order[:, :width]
-        q = np.take_along_axis(sols.q.reshape(len(t), -1, self.robot.n), order[..., None], 1)
-        ok = np.take_along_axis(valid, order, 1)
+        q = sols.q.reshape(len(t), -1, self.robot.n)
+        if (valid[:, 1:] <= valid[:, :-1]).all():  # valid rows first already (the kernel's)
+            # the most rows of a value: the columns some value fills (a short-axis sum is slow)
+            width = max(int(valid.any(axis=0).sum()), 1)
+            q, ok = q[:, :width], valid[:, :width]
+        else:
+            width = max(int(valid.sum(axis=1).max(initial=0)), 1)
+            order = np.argsort(~valid, axis=1, kind="stable")[:, :width]
+            q = np.take_along_axis(q, order[..., None], 1)
+            ok = np.take_along_axis(valid, order, 1)
         return _into_limits(self.robot, np.where(ok[..., None], q, np.nan))
 
     def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -182,7 +192,7 @@ class _ContinuedFamily(_Family):
         R = self._solve(t)  # (M, K, n)
         P = self.predict(t)  # (M, k, n)
         out = self._polish(_assign(P, R), t)
-        valid = np.isfinite(out).all(-1)
+        valid = _finite_rows(out)
         return out, valid, np.zeros_like(valid)
 
     def _polish(self, Q: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -193,12 +203,11 @@ class _ContinuedFamily(_Family):
         rows at a limit crossing's t have the joint at its limit to ~1e-14.
         """
         M, k, n = Q.shape
-        ok = np.isfinite(Q).all(-1)
+        ok = _finite_rows(Q)
         if not ok.any():
             return Q
         mi, bi = np.nonzero(ok)
-        q, good = _newton_held(self.robot, self.T, Q[mi, bi], np.full(len(mi), self.joint),
-                               t[mi])
+        q, good = _newton_held(self.robot, self.T, Q[mi, bi], self.joint, t[mi])
         out: np.ndarray = Q.copy()
         out[mi[good], bi[good]] = q[good]
         return out
@@ -210,10 +219,11 @@ class _ContinuedFamily(_Family):
         slopes; where it exists at one of them only (a fold in the cell): the
         tangent line from that one.
         """
-        tn, X, S, E = self.t_nodes, self.tracks, self._slopes0, self._exists
+        tn, X, E = self.t_nodes, self.tracks, self._exists
         M, (_, k, n) = len(t), X.shape
         out = np.full((M, k, n), np.nan)
-        i = np.clip(np.searchsorted(tn, t, side="right") - 1, 0, len(tn) - 2)
+        # (np.clip's wrapper costs more than the search)
+        i = np.minimum(np.maximum(np.searchsorted(tn, t, side="right") - 1, 0), len(tn) - 2)
         fa, fb = E[i], E[i + 1]  # (M, k)
         mi, bi = np.nonzero(fa | fb)  # only the tracks present in the cell
         if not mi.size:
@@ -222,20 +232,22 @@ class _ContinuedFamily(_Family):
         fa, fb = fa[mi, bi][:, None], fb[mi, bi][:, None]
         h = (tn[c + 1] - tn[c])[:, None]
         u = ((t[mi] - tn[c]) / (tn[c + 1] - tn[c]))[:, None]
-        a = np.where(fa, X[c, bi], 0.0)
-        b = np.where(fb, X[c + 1, bi], 0.0)
-        sa, sb = S[c, bi], S[c + 1, bi]
+        # each node's row and slope in one gather
+        ga, gb = self._XS[c, bi], self._XS[c + 1, bi]  # (p, 2n)
+        xa, xb, sa, sb = ga[:, :n], gb[:, :n], ga[:, n:], gb[:, n:]
+        a = np.where(fa, xa, 0.0)
+        b = np.where(fb, xb, 0.0)
         b = a + _wrap(b - a)
         u2, u3 = u * u, u * u * u
         herm = ((2 * u3 - 3 * u2 + 1) * a + (u3 - 2 * u2 + u) * h * sa
                 + (-2 * u3 + 3 * u2) * b + (u3 - u2) * h * sb)
-        one = np.where(fa, a + u * h * sa, X[c + 1, bi] + (u - 1) * h * sb)
+        one = np.where(fa, a + u * h * sa, xb + (u - 1) * h * sb)
         # a fold in the cell: q = q_f + (q_node - q_f) sqrt((t - t_f) / (t_node - t_f))
         tf, qf = self.fold_t[c, bi], self.fold_q[c, bi]
         fold = np.isfinite(tf)
         if fold.any():
             tnode = np.where(fa[:, 0], tn[c], tn[c + 1])
-            qnode = np.where(fa, X[c, bi], X[c + 1, bi])
+            qnode = np.where(fa, xa, xb)
             with np.errstate(invalid="ignore", divide="ignore"):
                 r = np.where(fold, (t[mi] - tf) / (tnode - tf), 0.0)
                 root = qf + _wrap(qnode - qf) * np.sqrt(np.maximum(r, 0.0))[:, None]
@@ -433,6 +445,23 @@ def _wrap(x: np.ndarray) -> np.ndarray:
     return out
 
 
+def _finite_rows(x: np.ndarray) -> np.ndarray:
+    """``np.isfinite(x).all(-1)``, the last axis (the joints) reduced one column at a time."""
+    return _all_last(np.isfinite(x))
+
+
+def _max_last(x: np.ndarray) -> np.ndarray:
+    """``x.max(-1)`` for a short last axis (the joints; NaN propagates alike).
+
+    One ``np.maximum`` per joint: a reduction over a 7-long axis costs numpy ~10x
+    more per element (the hot path of ``rows``: ``_assign``).
+    """
+    out: np.ndarray = x[..., 0].copy()
+    for j in range(1, x.shape[-1]):
+        np.maximum(out, x[..., j], out=out)
+    return out
+
+
 def _slopes(robot: Arm, Q: np.ndarray, k: int) -> np.ndarray:
     """dq/dq_k of rows Q (..., n) on the manifold of their pose (NaN rows, singular: NaN)."""
     flat = Q.reshape(-1, Q.shape[-1])
@@ -557,12 +586,17 @@ def _assign(P: np.ndarray, R: np.ndarray) -> np.ndarray:
     out = np.full((M, k, n), np.nan)
     if R.shape[1] == 0:
         return out
-    fp, fr = np.isfinite(P).all(-1), np.isfinite(R).all(-1)  # (M, k), (M, K)
+    fp, fr = _finite_rows(P), _finite_rows(R)  # (M, k), (M, K)
     R0 = np.where(fr[..., None], R, 0.0)  # (NaN arithmetic is slow)
     # distances of the predicted tracks only (most tracks live on part of the range)
     mi, bi = np.nonzero(fp)
     d = np.full((M, k, R.shape[1]), np.inf)
-    d[mi, bi] = np.abs(_wrap(P[mi, bi][:, None] - R0[mi])).max(-1)  # (M, k, K)
+    x = P[mi, bi][:, None] - R0[mi]  # (p, K, n); _wrap's operations, in place
+    y = np.divide(x, _TWO_PI)
+    np.round(y, out=y)
+    y *= _TWO_PI
+    x -= y
+    d[mi, bi] = _max_last(np.abs(x, out=x))  # (M, k, K)
     d[~(fp[:, :, None] & fr[:, None, :])] = np.inf
     best_row = np.argmin(d, axis=2)  # (M, k)
     best_track = np.argmin(d, axis=1)  # (M, K)
@@ -574,9 +608,11 @@ def _assign(P: np.ndarray, R: np.ndarray) -> np.ndarray:
     return out
 
 
-def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray,
+def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray | int,
                  values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Configurations (M, n) of pose T with joint ``joints[i]`` at ``values[i]``.
+
+    ``joints`` one index for every row: the six other columns taken as a slice.
 
     Newton steps from q0 (M, n) on the six other joints (the parameter among them:
     t free); True where the pose is reached to ``_EXACT``.
@@ -588,11 +624,16 @@ def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray,
     free[np.arange(M), joints] = False
     idx = np.nonzero(free)[1].reshape(M, n - 1)
     err = np.full(M, np.inf)
-    live = np.isfinite(q).all(-1)
+    live = _finite_rows(q)
+    rows = np.flatnonzero(live)  # the rows (re)evaluated: all, then the moved ones
     for it in range(_NEWTON + 1):
-        live &= np.isfinite(q).all(-1) & (np.abs(q) < 1e3).all(-1)
-        rows = np.flatnonzero(live)
-        err[~live] = np.inf
+        # a row not moved keeps its q and error (the compiled Jacobian is lane-wise:
+        # a row's J and pose do not depend on the others in the batch)
+        qr = q[rows]
+        alive = _finite_rows(qr) & (_max_last(np.abs(qr)) < 1e3)
+        live[rows[~alive]] = False
+        err[rows[~alive]] = np.inf
+        rows = rows[alive]
         if not rows.size:
             break
         J, Tq = jacobian_and_pose(robot.chain, q[rows])
@@ -602,12 +643,14 @@ def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray,
         act = err[rows] > 0.1 * _EXACT
         if it == _NEWTON or not act.any():
             break
-        A = np.take_along_axis(J, idx[rows][:, None, :], axis=2)[act]
+        moved = rows[act]
+        A = (J[act][:, :, idx[0]] if isinstance(joints, int)
+             else np.take_along_axis(J[act], idx[moved][:, None, :], axis=2))
         good = np.abs(np.linalg.det(A)) > 1e-14
-        step = np.zeros((int(act.sum()), n - 1))
+        step = np.zeros((len(moved), n - 1))
         if good.any():
             step[good] = np.linalg.solve(A[good], e[act][good][..., None])[..., 0]
-        moved = rows[act]
         q[moved[:, None], idx[moved]] += step
+        rows = moved
     ok = err <= _EXACT
     return q, ok
