@@ -2432,10 +2432,12 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
                 }
                 dup = m < tol;
                 /* one near-singular solution twice (two exact points of its thin
-                 * set, up to 1e-3 apart): the kept one is the one nearer the limits */
+                 * set, up to 1e-3 apart): the kept one is the one inside the limits,
+                 * or nearer them by more than GP_DEDUPE (two polishes of one regular
+                 * solution, ulps apart, keep the first) */
                 if (dup) {
-                    double xs = g6_excess(ch, q + 6 * s, NULL);
-                    if (xs > 0.0 && g6_excess(ch, qs, NULL) < xs) {
+                    double xs = g6_excess(ch, q + 6 * s, NULL), xn = g6_excess(ch, qs, NULL);
+                    if (xs > 0.0 && (xn == 0.0 || xn < xs - dedupe)) {
                         memcpy(q + 6 * s, qs, sizeof(qs));
                         sig[s] = sg[l];
                     }
