@@ -10,7 +10,9 @@ singular value >= 1e-4) whose generating configuration came back (to 1e-6 rad),
 singular in-limit configurations that got a valid in-limit row, the worst pose
 error of any returned row, and the configurations missed (first three).
 
-Run: ``python benchmarks/held_special_rates.py [--n 3000] [--seed 0]``.
+Run: ``python benchmarks/held_special_rates.py [--n 3000] [--seed 0] [--cases
+panda-joint2,srs-joint6]`` (``--cases``: only those cases, named as printed; default
+every case).
 """
 
 from __future__ import annotations
@@ -57,14 +59,25 @@ def rates(arm: str, j: int, n: int, seed: int) -> dict:
             "missed": q[sing & ~ok][:3].tolist() + q[regular & ~back][:3].tolist()}
 
 
-def main(n: int = 3000, seed: int = 0) -> None:
-    """Print one line per (arm, held joint)."""
+def label(arm: str, j: int) -> str:
+    """The case's name as printed and as ``--cases`` takes it: ``panda-joint2``."""
+    return f"{arm}-joint{j + 1}"
+
+
+def main(n: int = 3000, seed: int = 0, cases: list[str] | None = None) -> None:
+    """Print one line per (arm, held joint), for the named cases (default all)."""
+    known = [label(arm, j) for arm, j in CASES]
+    unknown = sorted(set(cases or ()) - set(known))
+    if unknown:
+        raise SystemExit(f"unknown case(s) {', '.join(unknown)}; cases: {', '.join(known)}")
     print(f"{n} special-value configurations per held joint, seed {seed}")
     print("case          non-singular back     singular in-limit    worst row error")
     for arm, j in CASES:
+        if cases and label(arm, j) not in cases:
+            continue
         r = rates(arm, j, n, seed)
         (a, b), (c, d) = r["regular"], r["singular"]
-        print(f"{arm}-joint{j + 1:<4} {a:5d}/{b:<5d} {100 * a / max(b, 1):7.2f} %  "
+        print(f"{label(arm, j):<13} {a:5d}/{b:<5d} {100 * a / max(b, 1):7.2f} %  "
               f"{c:5d}/{d:<5d} {100 * c / max(d, 1):7.2f} %  {r['err']:.1e}")
         for m in r["missed"]:
             print("    missed", m)
@@ -74,5 +87,7 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=3000)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--cases", default="",
+                    help="comma-separated case names as printed, e.g. panda-joint2")
     a = ap.parse_args()
-    main(a.n, a.seed)
+    main(a.n, a.seed, [c for c in a.cases.split(",") if c])

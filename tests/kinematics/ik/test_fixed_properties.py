@@ -368,6 +368,39 @@ def test_shoulder_held_singular_rows_come_inside(arm, j, q):
     assert dp.max() <= 1e-12 and dr.max() <= 1e-12
 
 
+# Joint 2 held, q3 = -1e-6 and a joint at its limit (held_special_rates.py, n 20,000,
+# seed 1: the last two misses of that run on f41c090). The general 6R elimination
+# gave two candidates on the thin set of exact solutions next to the singular q (in
+# the limits, 4e-8 and 4e-7 from q) and others 1e-4 to 6e-4 along it, past a limit
+# (q6 by 1.2e-4; q7 by 1.1e-8); the polish's dedupe (1e-10 / sigma, sigma 1.6e-7 and
+# 1.2e-8) merged them and kept the first polished, outside (pk_pin then ended at a
+# pose error of 4.3e-13 for the second, just above its 4e-13). Now the merge keeps
+# the row nearer the limits. Oracle: the generating q is exact and inside, so an
+# in-limit row exists (check_held asserts one); the row next to q is q itself (to
+# 1e-6), exact, flagged singular and within the limits, alone and in a batch of two.
+PANDA_JOINT2_DEDUPE = [
+    [0.0, 1.4309541105871655, -1e-06, -2.965898588204499, np.pi / 2, 3.7525, 2.8973],
+    [2.8419153490252893, 1.7628, -1e-06, -0.4818563361144692, -np.pi / 2, -0.0175,
+     -2.8973],
+]
+
+
+@pytest.mark.parametrize("q", PANDA_JOINT2_DEDUPE, ids=range(len(PANDA_JOINT2_DEDUPE)))
+def test_shoulder_held_merged_rows_keep_the_one_inside(q):
+    q = np.array(q)
+    sigma = np.linalg.svd(np.delete(PANDA.jacobian(q), 1, axis=1), compute_uv=False)[-1]
+    assert sigma < NON_SINGULAR  # the singular case of check_held
+    check_held(PANDA, 1, q)
+    T = PANDA.fk(np.stack([q, q]))
+    for sols in (PANDA.ik(T[0], fixed={"joint2": float(q[1])}),
+                 PANDA.ik(T, fixed={"joint2": np.array([q[1], q[1]])})):
+        near = sols.valid & (_angle_gap(sols.q, q) <= 1e-6)
+        assert (near.sum(axis=-1) == 1).all()
+        assert (sols.within_limits & sols.singular)[near].all()
+        dp, dr = pose_errors(PANDA.fk(sols.q[near]), T[:1])
+        assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+
+
 # Joint 2 held next to 0 with q4 = 0 (outside joint 4's limits): the near-coincident
 # path returns ~76 singular rows a pose, none inside; on 3d3a2fd the limit repair
 # refused more than 64 rows with a bare ValueError from the kernel's argument check

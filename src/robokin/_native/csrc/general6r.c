@@ -2302,6 +2302,22 @@ static int g6_refine(const Chain *ch, const vd *tt, vd *qv, int l, double tol_p,
     return 1;
 }
 
+/* How far coordinates qs (6) lie outside the limits [rad] as g6_range returns them
+ * (whole turns into the limits where possible: chain.h's wrap_into; 0 when inside up
+ * to LIMIT_SLACK), those values into w when given. */
+static double g6_excess(const Chain *ch, const double *qs, double *w)
+{
+    double excess = 0.0;
+    for (int j = 0; j < 6; j++) {
+        double v = wrap_into(qs[j], ch->lo[j], ch->hi[j]);
+        if (!within_limits(v, ch->lo[j], ch->hi[j]))
+            excess = fmax(excess, fmax(v - ch->hi[j], ch->lo[j] - v));
+        if (w != NULL)
+            w[j] = v;
+    }
+    return excess;
+}
+
 static int g6_polish(const Chain *ch, const double *P, const double *T, const G6Cand *cand,
                      int ncand, double *q, double *sig, int nsol, double *best, int patient)
 {
@@ -2431,6 +2447,17 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
                     m = d > m ? d : m;
                 }
                 dup = m < tol;
+                /* one near-singular solution twice (two exact points of its thin
+                 * set, up to 1e-3 apart): the kept one is the one inside the limits,
+                 * or nearer them by more than GP_DEDUPE (two polishes of one regular
+                 * solution, ulps apart, keep the first) */
+                if (dup) {
+                    double xs = g6_excess(ch, q + 6 * s, NULL), xn = g6_excess(ch, qs, NULL);
+                    if (xs > 0.0 && (xn == 0.0 || xn < xs - dedupe)) {
+                        memcpy(q + 6 * s, qs, sizeof(qs));
+                        sig[s] = sg[l];
+                    }
+                }
             }
             if (dup || nsol == G6_MAXSOL)
                 continue;
@@ -2650,12 +2677,8 @@ static int g6_coaxial_row(const Chain *ch, const double *P, const double *T, dou
 static int g6_slide_row(const Chain *ch, const double *P, const double *T, double *qs,
                         double *sg)
 {
-    double w[6], tlo = -INFINITY, thi = INFINITY, excess = 0.0;
-    for (int j = 0; j < 6; j++) {
-        w[j] = wrap_into(qs[j], ch->lo[j], ch->hi[j]);
-        excess = fmax(excess, fmax(w[j] - ch->hi[j], ch->lo[j] - w[j]));
-    }
-    if (!(excess <= G6_SLIDE_REACH))
+    double w[6], tlo = -INFINITY, thi = INFINITY;
+    if (!(g6_excess(ch, qs, w) <= G6_SLIDE_REACH))
         return 0;
     vd qv[MAXJ], t[12], Jv[36];
     double J[36], n[6], r[6];
