@@ -208,7 +208,8 @@ FK = Group("fk.c / module.c", kernels=(
            "finite (unmasked rows are never read).",
            checks=(Check("n == 6", "needs a 6-coordinate chain"),)),
 ), constants=_named("LANES=W MAX_JOINTS=MAXJ FK_PARALLEL_MIN") + (
-    Const("MAX_TRANSLATION", type="float"), Const("LAYOUT_TAG", "PACKED_TAG", "float")))
+    Const("MAX_TRANSLATION", type="float"), Const("LAYOUT_TAG", "PACKED_TAG", "float"),
+    Const("MANIFOLD_SLACK", type="float")))
 
 LM = Group("lm.c", kernels=(
     Kernel("lm_solve", (Packed(), Arr("targets", "f64", POSE), Arr("q0", "f64", ("N", "n")),

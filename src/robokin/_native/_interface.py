@@ -63,6 +63,7 @@ class Kernels(Protocol):
     FK_PARALLEL_MIN: int
     MAX_TRANSLATION: float
     LAYOUT_TAG: float
+    MANIFOLD_SLACK: float
     # lm.c: lm_solve / lm_path: option indices (O_*, N_OPTS), result columns, codes
     N_RES: int
     R_ERR: int

@@ -413,6 +413,16 @@ static inline double wrap_into(double v, double lo, double hi)
  * digit of a sub-millimetre result (robokin._validation.MAX_TRANSLATION reads it). */
 #define MAX_TRANSLATION 1.0e6
 
+/* The self-motion membership slack [rad, m]: a manifold's row is inside its limits
+ * where every coordinate is within MANIFOLD_SLACK of them (lo - MANIFOLD_SLACK <= q
+ * <= hi + MANIFOLD_SLACK). Every interval decision takes it, with this comparison:
+ * the compiled manifolds' pieces (held_manifold.c, self_motion.c) and, through
+ * robokin.kinematics.ik.self_motion_intervals.MANIFOLD_SLACK, SelfMotion.inside and
+ * the solved-points and continued families' pieces (docs/ik.md "The membership
+ * slack"). Tighter than LIMIT_SLACK (the IK rows' within_limits and wrap rule):
+ * a manifold's crossings are exact to 1e-12. */
+#define MANIFOLD_SLACK 1e-12
+
 /* The tolerances every pose check uses (robokin._validation.check_transform, the
  * closed-form and the numeric IK): the last row to POSE_ROW_TOL, the rotation
  * block's orthonormality to POSE_ORTH_TOL. */

@@ -843,7 +843,7 @@ static void hm_graze(HmCtx *c, int b, int qi, const HmRow *r0, const HmRow *m, c
 {
     int j = c->qj[qi], g = c->ngraze[b], kind = c->qkind[qi];
     double in = kind == HM_KIND_LOWER ? 1.0 : -1.0; /* the inside's sign of q_j - limit */
-    double v = c->qv[qi] - in * HM_TOL, f0 = hm_f(c, r0, b, qi);
+    double v = c->qv[qi] - in * MANIFOLD_SLACK, f0 = hm_f(c, r0, b, qi);
     double fm = wrap_pi(hm_polished(c, m->q[b], j) - v);
     if (kind == HM_KIND_ALIGNED || f0 * in > 0.0 || !(fm * in > 0.0) || g >= HM_MAXG) {
         hm_point(c, m->t, b, j, kind);
@@ -1099,7 +1099,7 @@ static int hm_grazed(HmCtx *c, int b, double a, double e, unsigned char *good)
         hm_eval(c, 0.5 * (a + e), 0u, 1u << b, &r);
         if (r.valid[b])
             r.q[b][c->graze_j[b][g]] = hm_polished(c, r.q[b], c->graze_j[b][g]);
-        *good = (unsigned char)hm_inside(c, &r, b, HM_TOL);
+        *good = (unsigned char)hm_inside(c, &r, b, MANIFOLD_SLACK);
         return 1;
     }
     return 0;
@@ -1141,14 +1141,14 @@ static void hm_intervals(HmCtx *c, int b, double lo, double hi, const HmRow *row
         if (best >= 0 && hm_decides(c, &rows[best], b, &good[i]))
             continue;
         hm_eval(c, mid, 0u, 1u << b, &r);
-        good[i] = (unsigned char)hm_inside(c, &r, b, 0.0);
+        good[i] = (unsigned char)hm_inside(c, &r, b, MANIFOLD_SLACK);
     }
     long k = 0;
     for (int i = 0; i < u; i++) {
         int left = i > 0 && good[i - 1], right = i + 1 < u && good[i];
         if (!left && !right) {
             hm_eval(c, cut[i], 0u, 1u << b, &r);
-            if (hm_inside(c, &r, b, 1e-12) && !hm_emit(c, iv, &k, cut[i], cut[i]))
+            if (hm_inside(c, &r, b, MANIFOLD_SLACK) && !hm_emit(c, iv, &k, cut[i], cut[i]))
                 break;
         }
         if (right && !hm_emit(c, iv, &k, cut[i], cut[i + 1]))

@@ -319,6 +319,7 @@ static int add_constants(PyObject *m)
     const struct { const char *name; double value; } floats[] = {
         {"MAX_TRANSLATION", (double)(MAX_TRANSLATION)},
         {"LAYOUT_TAG", (double)(PACKED_TAG)},
+        {"MANIFOLD_SLACK", (double)(MANIFOLD_SLACK)},
         {"PIEPER_TAG_VALUE", (double)(PK_TAG_VALUE)},
         {"PR_LIMIT_TOL", (double)(PR_LIMIT_TOL)},
         {"PC_EPS", (double)(PC_EPS)},

@@ -688,14 +688,12 @@ static int sm_cmp(const void *x, const void *y)
     return (a > b) - (a < b);
 }
 
-/* Inside every limit with the slack of SelfMotion.inside (self_motion.py _inside:
- * 1e-12), so that a cell whose row rides a limit to rounding (a branch tangent to it,
- * q = limit + 4e-16) is decided as .inside decides it. */
-#define SM_INSIDE_SLACK 1e-12
-
+/* Inside every limit with the slack of SelfMotion.inside (chain.h MANIFOLD_SLACK), so
+ * that a cell whose row rides a limit to rounding (a branch tangent to it, q = limit
+ * + 4e-16) is decided as .inside decides it. */
 static int sm_inside_joint(const SmArm *a, int j, double q)
 {
-    return q >= a->lo[j] - SM_INSIDE_SLACK && q <= a->hi[j] + SM_INSIDE_SLACK;
+    return q >= a->lo[j] - MANIFOLD_SLACK && q <= a->hi[j] + MANIFOLD_SLACK;
 }
 
 typedef struct {

@@ -175,10 +175,7 @@ class SelfMotion:
         return self._inside(q).reshape(ta.shape + (q.shape[-2],))
 
     def _inside(self, q: np.ndarray) -> np.ndarray:
-        lo, hi = self.limits[:, 0], self.limits[:, 1]
-        with np.errstate(invalid="ignore"):
-            out: np.ndarray = np.all((q >= lo - 1e-12) & (q <= hi + 1e-12), axis=-1)
-            return out
+        return _within(q, self.limits)
 
     @property
     def reachable(self) -> bool:

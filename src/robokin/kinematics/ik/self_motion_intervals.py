@@ -24,6 +24,11 @@ from robokin.kinematics.ik.self_motion_families import (
 )
 from robokin.spatial import wrap_angle as _wrap
 
+#: The membership slack (``chain.h`` ``MANIFOLD_SLACK``, 1e-12): a row is inside its
+#: limits where every coordinate is within it of them. ``SelfMotion.inside``, the
+#: pieces of every family (decided at their midpoints) and the compiled kernels
+#: (``held_manifold.c``, ``self_motion.c``) all take it, with the same comparison.
+MANIFOLD_SLACK: float = K.MANIFOLD_SLACK
 #: Parameter values on the checking grid.
 GRID = 721
 #: Bisection steps (a 2 pi domain to 2**-52 of its width).
@@ -144,9 +149,10 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
 
 
 def _within(q: np.ndarray, limits: np.ndarray) -> np.ndarray:
-    """(...) bool: rows q (..., n) inside every limit (1e-12 slack); NaN rows False."""
+    """(...) bool: rows q (..., n) inside every limit (MANIFOLD_SLACK); NaN rows False."""
     with np.errstate(invalid="ignore"):
-        out: np.ndarray = np.all((q >= limits[:, 0] - 1e-12) & (q <= limits[:, 1] + 1e-12), axis=-1)
+        out: np.ndarray = np.all((q >= limits[:, 0] - MANIFOLD_SLACK)
+                                 & (q <= limits[:, 1] + MANIFOLD_SLACK), axis=-1)
         return out
 
 
@@ -172,9 +178,7 @@ def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
         return np.zeros((0, 2)), np.zeros(0, dtype=int)
     q, valid, _ = fam.rows(np.array(mids))
     idx = np.arange(len(mids))
-    qb = q[idx, owners]
-    with np.errstate(invalid="ignore"):
-        ok = valid[idx, owners] & np.all((qb >= limits[:, 0]) & (qb <= limits[:, 1]), -1)
+    ok = valid[idx, owners] & _within(q[idx, owners], limits)
     for (a, e), b, good in zip(spans, owners, ok, strict=True):
         if not good:
             continue

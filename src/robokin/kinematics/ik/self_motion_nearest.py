@@ -7,7 +7,7 @@ distance to ``q_near`` at the interval's ends and at a grid inside it; the
 ``_KEEP`` smallest local minima of those samples are refined by safeguarded
 Newton steps between their neighbouring samples (to ``_TOL`` rad in t; the best value seen kept); the candidates
 (refined minima and every interval end, where a constrained minimum lies) are
-tried nearest first, and the first whose row is inside every limit (1e-12) is
+tried nearest first, and the first whose row is inside every limit (``MANIFOLD_SLACK``) is
 returned, clamped into the limits.
 """
 
@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from robokin.kinematics.ik.self_motion_base import _Family
+from robokin.kinematics.ik.self_motion_intervals import _within
 from robokin.spatial import wrap_angle as _wrap
 
 __all__ = ["interval_nearest"]
@@ -30,8 +31,6 @@ _TOL = 1e-10
 _MAX_ITER = 40
 #: Central-difference step [rad] of the Newton derivatives.
 _H = 1e-5
-#: Tolerance [rad] of the limit check of a returned row (then clamped).
-_LIMIT_TOL = 1e-12
 
 
 def interval_nearest(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
@@ -155,7 +154,7 @@ def _newton(fam: _Family, limits: np.ndarray, lo: np.ndarray, hi: np.ndarray,
 def _first_inside(fam: _Family, limits: np.ndarray, cand_t: np.ndarray, cand_b: np.ndarray,
                   cand_d: np.ndarray, t: np.ndarray, d: np.ndarray, br: np.ndarray
                   ) -> tuple[np.ndarray, float, int, float] | None:
-    """The nearest candidate whose row is inside the limits (1e-12), clamped; else None.
+    """The nearest candidate whose row is inside the limits (``_within``), clamped; else None.
 
     The grid samples are the last candidates (a row at an interval end can be
     outside its limit by more than 1e-12 where the end was bisected).
@@ -168,7 +167,7 @@ def _first_inside(fam: _Family, limits: np.ndarray, cand_t: np.ndarray, cand_b: 
         if not np.isfinite(all_d[i]):
             break
         q = fam.rows(all_t[i:i + 1])[0][0, all_b[i]]
-        if np.isfinite(q).all() and np.all((q >= lo - _LIMIT_TOL) & (q <= hi + _LIMIT_TOL)):
+        if bool(_within(q, limits)):
             q = np.clip(q, lo, hi)
             return q, float(all_t[i]), int(all_b[i]), float(all_d[i])
     return None
