@@ -281,8 +281,6 @@ def test_the_one_pose_hot_path_takes_no_detour():
     assert len(entered) <= 6, entered
 
 
-@pytest.mark.xfail(strict=True, reason="pieper.c: the held chain's stretched elbow at "
-                   "its reach boundary returns no row (docs/ik.md, issue 29 measured)")
 def test_held_joint_at_a_stretched_elbow_near_srs_arm():
     # Issue 29's 10,000-configuration measurement (benchmarks/self_motion_rates.py,
     # seed 0): the rtb-data iiwa14 (shoulder offset 0.44 mm), joint_a3 held, q4 =
@@ -293,6 +291,8 @@ def test_held_joint_at_a_stretched_elbow_near_srs_arm():
     # stretched with q2 = 1 or 3, return q): the wrist centre at the held chain's
     # reach boundary and within the 0.44 mm offset of axis 1. Oracle: q reproduces the pose (it generated it) and is isolated, so
     # it must be among the rows (1e-6 rad), each of which reproduces the pose to 1e-12.
+    # Cause (pieper.c pk_general): elimination determinant 2.5e-10, |u_y| - 1 = 1.2e-5
+    # at both quartic roots, dropped by a fixed 1e-6 unit check (now scale-aware).
     rtbdata = pytest.importorskip("rtbdata")
     from pathlib import Path
 

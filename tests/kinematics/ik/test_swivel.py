@@ -104,7 +104,7 @@ def _check_intervals(sm):
     ivs, own = sm.intervals, sm.interval_branch
     special = [p.t for p in sm.singular]
     for (a, e), b in zip(ivs, own):
-        assert e > a
+        assert e >= a  # [t, t]: a touch (sm_touches); its end is checked at a limit below
         for end in (a, e):
             q = sm.sample(end)[b]
             if not np.isfinite(q).all():
@@ -251,16 +251,16 @@ def test_nearest_next_to_an_aligned_point_falls_back_to_the_next_candidate():
     assert np.linalg.norm(_wrapd(res.q - qn)) <= _dense_nearest(T, qn) + 1e-12
 
 
-@pytest.mark.xfail(strict=True, reason="csrc/self_motion.c: a piece between a joint's "
-                   "near-tangent dip past its limit and another joint's crossing is "
-                   "missed (docs/ik.md, issue 29 measured)")
 def test_a_piece_after_a_near_tangent_dip_is_found():
     # Issue 29's 10,000-configuration measurement (benchmarks/self_motion_rates.py,
     # seed 0; regular: the 6 x 7 Jacobian's smallest singular value >= 1e-4, q2 and
     # q6 clear of 0 and pi): q3, q4 and q6 at limits, q5 = 1e-6. Along q's branch q6
-    # dips 6.7e-12 past its limit about 1e-5 before q's own swivel and comes back;
-    # q3 leaves at q's swivel. The kernel's interval ends at the dip (4.1e-5 before
-    # q's swivel), the piece [dip end, q's swivel] is missing. Oracle: the numpy
+    # is past its upper limit (up to 9e-12) over the 4.1e-5 before q's swivel and
+    # reaches it at q's swivel with slope -8.8e-7 (near-tangent: its computed root
+    # is 5.2e-11 after q's swivel); q3 leaves its lower limit at q's swivel. The
+    # shoulder's run ends at q's swivel, the wrist's starts 5.2e-11 later: the
+    # overlap is empty and q's swivel was in no interval (before sm_touches). The
+    # branch is inside (1e-12) at q's swivel and just before it. Oracle: the numpy
     # twin's rows (reference=True, polished) of that branch are inside every limit
     # (1e-12) at 5 swivel values over the 1e-7 before q's; the kernel's intervals of
     # the branch must hold q's swivel (1e-9).

@@ -646,12 +646,18 @@ static int pk_general(const PkEq *e, PkPos *out)
     int nx = trig2_roots(&f, xs, &nd);
     if (nx < 0)
         return PK_DEGENERATE;
+    /* |u_y| = 1 at a root, to a tolerance scale-aware in the elimination: a root x
+     * next to a double one (the reach boundary, a stretched elbow) is off by up to
+     * sqrt(eps), and u_y by |K| / |D| that (|D| 2.5e-10 against |K| 1e-4 on the
+     * rtb-data iiwa14 with joint_a3 held at -1e-7: |u_y| - 1 = 1.2e-5); u_y is
+     * normalised, the residual below, the polish and the pose check decide */
+    double ktol = 1e-6 + 1.5e-8 * sqrt(al + ga) / fabs(D);
     for (int i = 0; i < nx && out->n < 4; i++) {
         double x = xs[i], cx = cos(x), sx = sin(x);
         double uy0 = (K[0][0] * cx + K[0][1] * sx - k[0]) / D;
         double uy1 = (K[1][0] * cx + K[1][1] * sx - k[1]) / D;
         double ny = hypot(uy0, uy1);
-        if (!(fabs(ny - 1.0) < 1e-6))
+        if (!(fabs(ny - 1.0) < ktol))
             continue; /* not a root */
         double y = fast_atan2(uy1, uy0), cy, sy;
         unit2(uy1, uy0, &cy, &sy);

@@ -765,9 +765,53 @@ static long long sm_overlap(double x[][2], int nx, double y[][2], int ny, double
     return n;
 }
 
+/* Whether psi is in one of the n sorted runs x, ends included */
+static int sm_in_runs(double x[][2], int n, double psi)
+{
+    for (int i = 0; i < n; i++)
+        if (x[i][0] <= psi && psi <= x[i][1])
+            return 1;
+    return 0;
+}
+
+/* The touches of branch b of elbow root e: the ends of one triple's runs x (not
+ * the cuts at -pi, pi) outside every run y of the other triple where the whole row
+ * is inside every limit (SM_INSIDE_SLACK, the slack of the cells): the branch is in
+ * the limits at that swivel angle alone, the ends of two runs meeting at one angle
+ * (a joint of each triple at its limit there, e.g. a configuration generated with
+ * both at limits). The two ends are computed roots of different subproblems: next
+ * to a near-tangent one (a joint whose slope over the swivel is small, 1e-6) they
+ * miss each other by more than rounding, so the overlap of the runs is empty.
+ * Adds each as a one-point interval [psi, psi] into r (k sorted intervals). */
+static long long sm_touches(const SmArm *a, const SmFrame *f, int e, int b, double x[][2], int nx,
+                            double y[][2], int ny, double *r, long long k)
+{
+    for (int i = 0; i < nx; i++)
+        for (int s = 0; s < 2; s++) {
+            double t = x[i][s], q[7];
+            if (t == -M_PI || t == M_PI || sm_in_runs(y, ny, t) || k >= SM_MAXI ||
+                !sm_branch_row(a, f, e, b, t, q))
+                continue;
+            int in = 1;
+            for (int j = 0; j < 7 && in; j++)
+                in = sm_inside_joint(a, j, q[j]);
+            if (!in)
+                continue;
+            long long p = k++;
+            while (p > 0 && r[2 * p - 2] > t) {
+                r[2 * p] = r[2 * p - 2];
+                r[2 * p + 1] = r[2 * p - 1];
+                p--;
+            }
+            r[2 * p] = r[2 * p + 1] = t;
+        }
+    return k;
+}
+
 /* The intervals (4, SM_MAXI, 2) with counts (4) of the branches of elbow root e
  * (slots 4 e + b) inside every limit, from its candidates c: the overlaps of each
- * shoulder root's and wrist root's runs, a run through pi joined */
+ * shoulder root's and wrist root's runs and their touches (sm_touches), a run
+ * through pi joined */
 static void sm_elbow_intervals(const SmArm *a, const SmFrame *f, int e, const SmCand *c, int nc,
                                double *iv, long long *niv)
 {
@@ -782,6 +826,8 @@ static void sm_elbow_intervals(const SmArm *a, const SmFrame *f, int e, const Sm
     for (int b = 0; b < 4; b++) {
         double *r = iv + 2 * SM_MAXI * b;
         long long k = sm_overlap(rs[b / 2], ns[b / 2], rw[b % 2], nw[b % 2], r);
+        k = sm_touches(a, f, e, b, rs[b / 2], ns[b / 2], rw[b % 2], nw[b % 2], r, k);
+        k = sm_touches(a, f, e, b, rw[b % 2], nw[b % 2], rs[b / 2], ns[b / 2], r, k);
         /* periodic: a run ending at pi and one starting at -pi join */
         if (k >= 2 && r[0] == -M_PI && r[2 * k - 1] == M_PI) {
             double end = r[1] + 2.0 * M_PI, start = r[2 * k - 2];
