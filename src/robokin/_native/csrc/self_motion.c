@@ -696,6 +696,15 @@ static int sm_inside_joint(const SmArm *a, int j, double q)
     return q >= a->lo[j] - MANIFOLD_SLACK && q <= a->hi[j] + MANIFOLD_SLACK;
 }
 
+/* every joint of a row inside its limits (with the membership slack) */
+static int sm_row_inside(const SmArm *a, const double q[7])
+{
+    for (int j = 0; j < 7; j++)
+        if (!sm_inside_joint(a, j, q[j]))
+            return 0;
+    return 1;
+}
+
 typedef struct {
     const double *P, *T;
     double *iv, *pts;
@@ -792,10 +801,7 @@ static long long sm_touches(const SmArm *a, const SmFrame *f, int e, int b, doub
             if (t == -M_PI || t == M_PI || sm_in_runs(y, ny, t) || k >= SM_MAXI ||
                 !sm_branch_row(a, f, e, b, t, q))
                 continue;
-            int in = 1;
-            for (int j = 0; j < 7 && in; j++)
-                in = sm_inside_joint(a, j, q[j]);
-            if (!in)
+            if (!sm_row_inside(a, q))
                 continue;
             long long p = k++;
             while (p > 0 && r[2 * p - 2] > t) {
@@ -1094,10 +1100,7 @@ static int sm_near1(const SmArm *a, const double *T, const double *qn, double *q
         if (!sm_branch_row(a, &f, tries[i].e, tries[i].b, tries[i].psi, q) ||
             !sm_polish(a, &RT, pT, q))
             continue;
-        int in = 1;
-        for (int j = 0; j < 7 && in; j++)
-            in = sm_inside_joint(a, j, q[j]);
-        if (!in)
+        if (!sm_row_inside(a, q))
             continue;
         for (int j = 0; j < 7; j++)
             qout[j] = fmin(fmax(q[j], a->lo[j]), a->hi[j]);
