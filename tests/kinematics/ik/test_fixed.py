@@ -312,8 +312,6 @@ def test_held_joint_at_a_stretched_elbow_near_srs_arm():
     assert len(Q) and np.abs((Q - q + np.pi) % (2 * np.pi) - np.pi).max(-1).min() <= 1e-6
 
 
-@pytest.mark.xfail(strict=True, reason="general6r.c: a cluster of four solutions within "
-                   "2e-3 rad at the stretched elbow loses one (docs/ik.md, issue 23)")
 def test_held_wrist_joint_at_a_stretched_elbow_keeps_every_cluster_member():
     # Found in the A/B of helper srs29 (2,000 uniform + 2,000 special configurations
     # per held joint of the rtb-data iiwa14): joint_a5 held, q1 and q4 = 1e-9 (the

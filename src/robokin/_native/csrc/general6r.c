@@ -2524,6 +2524,48 @@ static int g6_sampled(const Chain *ch, const double *P, const double *T, G6Cand 
     return ns;
 }
 
+/* A cluster resolved short (issue 23: the rtb-data iiwa14 with joint_a5 held at a
+ * stretched elbow, four solutions within 2.1e-3 rad, the elimination's candidates
+ * two, each 1e-3 rad off and polishing onto another member): a candidate whose
+ * nearest row lies between G6_SEED_LO and G6_SEED_HI from it was pulled across a
+ * cluster; the row mirrored through the candidate (2 c - row, joint coordinates) is
+ * a fresh start on the far side, polished and appended (duplicates dropped). Only
+ * where the roots clustered (G6F_CLUSTER) and rows exist; returns the rows. */
+#define G6_SEED_LO 1e-6 /* [rad] candidate to its row: closer is the row's own root */
+#define G6_SEED_HI 1e-2 /* [rad] ... farther: another solution's candidate */
+
+static int g6_reseed(const Chain *ch, const double *P, const double *T, const G6Cand *cand,
+                     int nc, double *q, double *sig, int ns)
+{
+    G6Cand seed[G6_MAXCAND];
+    int ne = 0;
+    const int ns0 = ns;
+    for (int c = 0; c < nc; c++) {
+        double jq[6], dbest = INFINITY;
+        int sbest = -1;
+        for (int j = 0; j < 6; j++)
+            jq[j] = ch->sign[j] * (cand[c].v[j] - ch->offset[j]);
+        for (int s = 0; s < ns0; s++) {
+            double m = 0.0;
+            for (int j = 0; j < 6; j++)
+                m = fmax(m, fabs(wrap_pi(jq[j] - q[6 * s + j])));
+            if (m < dbest) {
+                dbest = m;
+                sbest = s;
+            }
+        }
+        if (!(dbest > G6_SEED_LO && dbest < G6_SEED_HI))
+            continue;
+        for (int j = 0; j < 6; j++) {
+            double x = jq[j] + wrap_pi(jq[j] - q[6 * sbest + j]);
+            seed[ne].v[j] = ch->sign[j] * x + ch->offset[j];
+        }
+        seed[ne].slow = 1;
+        ne++;
+    }
+    return ne > 0 ? g6_polish(ch, P, T, seed, ne, q, sig, ns, NULL, 0) : ns;
+}
+
 static int g6_pose(const Chain *ch, const double *P, const double *T, double *q, double *sig,
                    long long *diag, double *stats)
 {
@@ -2554,6 +2596,8 @@ static int g6_pose(const Chain *ch, const double *P, const double *T, double *q,
         ns = g6_sampled(ch, P, T, cand, q, sig, ns);
         flags |= G6F_RESCUED;
     }
+    if (ns > 0 && (flags & G6F_CLUSTER))
+        ns = g6_reseed(ch, P, T, cand, nc, q, sig, ns);
     *diag = flags | ((long long)nc << G6_DIAG_CAND_SHIFT);
     if (ns == 0 && (flags & G6F_DEGENERATE) &&
         (P[GP_FALLBACK] == 0.0 || (flags & G6F_PROJ_DEGENERATE)))
