@@ -2529,8 +2529,9 @@ static int g6_sampled(const Chain *ch, const double *P, const double *T, G6Cand 
  * two, each 1e-3 rad off and polishing onto another member): a candidate whose
  * nearest row lies between G6_SEED_LO and G6_SEED_HI from it was pulled across a
  * cluster; the row mirrored through the candidate (2 c - row, joint coordinates) is
- * a fresh start on the far side, polished and appended (duplicates dropped). Only
- * where the roots clustered (G6F_CLUSTER) and rows exist; returns the rows. */
+ * a fresh start on the far side, polished and appended (duplicates dropped, the
+ * rows found untouched). Only where the roots clustered (G6F_CLUSTER) and rows
+ * exist; returns the rows. */
 #define G6_SEED_LO 1e-6 /* [rad] candidate to its row: closer is the row's own root */
 #define G6_SEED_HI 1e-2 /* [rad] ... farther: another solution's candidate */
 
@@ -2563,7 +2564,17 @@ static int g6_reseed(const Chain *ch, const double *P, const double *T, const G6
         seed[ne].slow = 1;
         ne++;
     }
-    return ne > 0 ? g6_polish(ch, P, T, seed, ne, q, sig, ns, NULL, 0) : ns;
+    if (ne == 0)
+        return ns;
+    /* polished against a copy: the rows found stay as they were (the dedupe may
+     * swap a row for a seed's polish of it); only new rows are appended */
+    double qq[6 * G6_MAXSOL], sq[G6_MAXSOL];
+    memcpy(qq, q, sizeof(double) * 6 * (size_t)ns);
+    memcpy(sq, sig, sizeof(double) * (size_t)ns);
+    int n2 = g6_polish(ch, P, T, seed, ne, qq, sq, ns, NULL, 0);
+    memcpy(q + 6 * ns, qq + 6 * ns, sizeof(double) * 6 * (size_t)(n2 - ns));
+    memcpy(sig + ns, sq + ns, sizeof(double) * (size_t)(n2 - ns));
+    return n2;
 }
 
 static int g6_pose(const Chain *ch, const double *P, const double *T, double *q, double *sig,
