@@ -317,9 +317,9 @@ def test_held_wrist_joint_at_a_stretched_elbow_keeps_every_cluster_member():
     # per held joint of the rtb-data iiwa14): joint_a5 held, q1 and q4 = 1e-9 (the
     # elbow stretched), the six free joints' Jacobian regular (smallest singular
     # value 1.7e-4 >= 1e-4: q is isolated), 1 of 3,688 regular configurations. The
-    # general 6R solver returns 7 exact rows, three of them within 2.1e-3 rad of q
-    # (q4 = 1e-9 or -2.08e-3): q's own root of the elimination is lost in that
-    # cluster. Oracle: q generated the pose and is isolated, so it is among the rows
+    # general 6R solver returned 7 exact rows, three of them within 2.1e-3 rad of q
+    # (q4 = 1e-9 or -2.08e-3): q's own root of the elimination was lost in that
+    # cluster; general6r.c's g6_reseed (mirrored starts) brings it back. Oracle: q generated the pose and is isolated, so it is among the rows
     # (1e-6 rad), each of which reproduces the pose to 1e-12.
     rtbdata = pytest.importorskip("rtbdata")
     from pathlib import Path
