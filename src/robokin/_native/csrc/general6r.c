@@ -2244,6 +2244,7 @@ static int g6_step(const vd *J, const vd *e, int l, double *dq)
  * the smallest final error of any candidate. Returns the solutions in q. */
 #define G6_NEAR_MISS 1e-9 /* [m per m of arm, rad] a lane ending this close: g6_refine */
 #define G6_TIGHT 0.5      /* of the tolerance: a row ending above, g6_refine'd or dropped */
+#define G6_ABS_POS 1e-12  /* [m] the tight position target's cap, whatever the scale */
 
 /* Lane l of qv (chain values) ended within G6_NEAR_MISS of T but above the
  * tolerance: next to a near-double root (a solution with sigma ~ 1e-7, the
@@ -2323,6 +2324,10 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
 {
     const double tol_r = P[GP_TOL], dedupe = P[GP_DEDUPE], scale = fmax(1.0, P[GP_SCALE]);
     const double tol_p = tol_r * scale, floor_err = 1e-14 * scale;
+    /* the tight position target: per metre of the scale, at most G6_ABS_POS [m] (issue
+     * 23: every row to 1e-12; GP_SCALE overstates some arms' size, 3.33 m for the
+     * IRB140 URDF of 0.81 m reach) */
+    const double tight_p = fmin(G6_TIGHT * tol_p, G6_ABS_POS);
     const int max_iter = (int)P[GP_MAX_ITER] * (patient ? 2 : 1);
     vd tt[12];
     for (int i = 0; i < 12; i++)
@@ -2427,9 +2432,9 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
                 *best = fmax(ep, er);
             if (!(ep <= tol_p && er <= tol_r))
                 continue;
-            if (!(ep <= G6_TIGHT * tol_p && er <= G6_TIGHT * tol_r)) {
+            if (!(ep <= tight_p && er <= G6_TIGHT * tol_r)) {
                 /* within the tolerance but not the tight one: settled or dropped */
-                if (!g6_refine(ch, tt, qv, l, G6_TIGHT * tol_p, G6_TIGHT * tol_r, floor_err))
+                if (!g6_refine(ch, tt, qv, l, tight_p, G6_TIGHT * tol_r, floor_err))
                     continue;
                 chain_pose_jac(ch, qv, t, J, 6);
                 pose_residual(t, tt, e, BRL(-1));
