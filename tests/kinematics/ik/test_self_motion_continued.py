@@ -160,9 +160,9 @@ def test_manifold_solves_a_bounded_number_of_values(arm, monkeypatch):
     solved = []
     raw = general_6r.raw_solve
 
-    def counting(chain, params, T, *args):
+    def counting(chain, params, T, *args, **kwargs):
         solved.append(len(T))
-        return raw(chain, params, T, *args)
+        return raw(chain, params, T, *args, **kwargs)
 
     q0 = _configs(robot, 3, False)[0]
     monkeypatch.setattr(general_6r, "raw_solve", counting)
@@ -363,3 +363,101 @@ def test_the_end_sweep_kept_per_pose_equals_sweep_end(arm):
         assert a.valid.any()
     # q0 among the rows at its own q7
     assert (_wrapped(a.q[-1][a.valid[-1]] - q0).max(-1) < 1e-9).any()
+
+
+# ---------------------------------------------------------------- followed branches
+# sm.sample(t) follows each branch from its nodes (Hermite prediction, Newton on the
+# held 6 x 6, certified) where the cell has no fold; the oracle is the full solve at
+# the same values (the general 6R kernel, assigned to the tracks: ``_family.rows``).
+
+
+def _same_rows(A, B, tol=1e-9):
+    """Rows A and B (M, k, n) in the same slots, equal to tol (2 pi wrapped)."""
+    fa, fb = np.isfinite(A).all(-1), np.isfinite(B).all(-1)
+    np.testing.assert_array_equal(fa, fb)
+    assert _wrapped(A[fa] - B[fa]).max(initial=0.0) < tol
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+@pytest.mark.parametrize("special", [False, True])
+def test_followed_rows_equal_the_full_solve(arm, special):
+    robot = ARMS[arm]
+    for q0 in _configs(robot, 11, special):
+        T, sm = _manifold(robot, q0)
+        fam = sm._family
+        t = np.concatenate([np.linspace(*sm.domain, 97), fam.t_nodes[5:8], [q0[6]]])
+        before = fam.followed
+        Q = sm.sample(t)
+        assert fam.followed - before >= 0.8 * len(t)  # most values followed
+        _same_rows(Q, fam.rows(t)[0])
+        ok = np.isfinite(Q).all(-1)
+        dp, dr = pose_errors(robot.fk(Q[ok]), T)
+        assert ok.any() and dp.max() <= 1e-12 and dr.max() <= 1e-12
+        if not special:  # (a special q0 may be a singular row the kernel does not give)
+            assert np.nanmin(_wrapped(Q[-1] - q0).max(-1)) < 1e-9
+        inside = sm.inside(t)  # the followed rows, inside the limits
+        lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+        assert not (inside & ~ok).any()
+        assert np.all((Q[inside] >= lo - 1e-9) & (Q[inside] <= hi + 1e-9))
+        np.testing.assert_array_equal(np.isfinite(sm.sample(t, within_limits=True)).all(-1),
+                                      inside)
+
+
+def test_next_to_a_fold_the_kernel_solves():
+    # the fast-passage pose of the offset iiwa has folds inside the range: values in
+    # a cell where a track starts or ends are not followed (the branch count changes
+    # there), and get exactly the full solve's rows
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array([0.06313194, 0.0, 1.57079633, -1.32792689, -1.27694772, -0.87151625,
+                   -0.51729264])
+    T, sm = _manifold(robot, q0)
+    fam = sm._family
+    folds = [s.t for s in sm.singular if s.kind == "fold"]
+    assert folds
+    t = np.array([f + d for f in folds for d in (-1e-7, 1e-7)])
+    t = t[(t > sm.domain[0]) & (t < sm.domain[1])]
+    assert not fam._followable(t).any()
+    before = fam.followed
+    Q = sm.sample(t)
+    assert fam.followed == before
+    np.testing.assert_array_equal(Q, fam.rows(t)[0])
+    # a value away from the folds, in a clean cell, is followed
+    cell = int(np.flatnonzero(fam._cell_ok)[0])
+    mid = np.array([0.5 * (fam.t_nodes[cell] + fam.t_nodes[cell + 1])])
+    assert fam._followable(mid).all()
+    sm.sample(mid)
+    assert fam.followed == before + 1
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_a_follow_that_does_not_certify_falls_back(arm, monkeypatch):
+    # one track's prediction moved 0.02 rad (its first Newton step then above
+    # 1 / (4 _CONTRACT)): the values in that track's cells are solved by the kernel,
+    # the others followed, and every row is still the full solve's
+    import robokin.kinematics.ik.self_motion_continued as cont
+
+    robot = ARMS[arm]
+    q0 = _configs(robot, 13, False)[0]
+    T, sm = _manifold(robot, q0)
+    fam = sm._family
+    t = np.linspace(*sm.domain, 80)
+    ref = fam.rows(t)[0]
+    b = int(np.argmax(np.isfinite(fam.tracks).all(-1).sum(0)))  # the longest track
+    fam._XS = fam._XS.copy()
+    fam._XS[:, b, :6] += 0.02
+    there = np.isfinite(fam.predict(t)[:, b]).all(-1)
+    assert there.any()
+    before = fam.followed
+    _same_rows(sm.sample(t), ref, 1e-10)
+    assert fam.followed - before <= (~there).sum()
+    # with no Newton step accepted, only the values without any track (the kernel's
+    # rows there are no track's either) and the nodes (the domain's ends: the rows
+    # exact already) may be followed (in a cell without a fold): the full solve's rows
+    fam._XS[:, b, :6] -= 0.02
+    monkeypatch.setattr(cont, "_CONTRACT", 1e30)
+    trivial = ~np.isfinite(fam.predict(t)).all(-1).any(-1) | np.isin(t, fam.t_nodes)
+    before = fam.followed
+    Q = sm.sample(t)
+    np.testing.assert_array_equal(Q[~trivial], fam.rows(t[~trivial])[0])
+    _same_rows(Q, ref, 1e-10)
+    assert fam.followed - before <= trivial.sum()

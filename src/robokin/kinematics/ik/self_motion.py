@@ -163,7 +163,7 @@ class SelfMotion:
             within_limits: Also NaN the rows outside a joint limit.
         """
         ta = check_finite(np.asarray(t, dtype=np.float64), "t")
-        q, _, _ = self._family.rows(ta.reshape(-1))
+        q, _, _ = self._family.sample_rows(ta.reshape(-1))
         if within_limits:
             q = np.where(self._inside(q)[..., None], q, np.nan)
         return q.reshape(ta.shape + q.shape[-2:])
@@ -171,7 +171,7 @@ class SelfMotion:
     def inside(self, t: npt.ArrayLike) -> np.ndarray:
         """(..., k) bool: the branch exists at t and is inside every joint limit."""
         ta = check_finite(np.asarray(t, dtype=np.float64), "t")
-        q, _, _ = self._family.rows(ta.reshape(-1))
+        q, _, _ = self._family.sample_rows(ta.reshape(-1))
         return self._inside(q).reshape(ta.shape + (q.shape[-2],))
 
     def _inside(self, q: np.ndarray) -> np.ndarray:

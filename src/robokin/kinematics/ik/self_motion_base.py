@@ -30,6 +30,11 @@ class _Family:
         """Q (m, k, n) (NaN where a branch has no point), valid (m, k), singular (m, k)."""
         raise NotImplementedError
 
+    def sample_rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``rows(t)`` for ``SelfMotion.sample`` and ``inside`` (a family may follow its
+        branches there instead of solving; the construction keeps ``rows``)."""
+        return self.rows(t)
+
     def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
         """Parameter values where joint j may equal ``value`` (with the configuration)."""
         raise NotImplementedError

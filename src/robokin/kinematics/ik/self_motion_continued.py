@@ -90,6 +90,12 @@ _DEGENERATE = 0.5
 _MAX_TRACKS = 64
 #: Bisection steps of a fold (a cell to two adjacent doubles).
 _BISECT = 60
+#: Followed rows (``sample_rows``): each Newton step at most ``_CONTRACT`` times the
+#: previous one squared while that is above ``_FLOOR``, the first at most
+#: 1 / (4 ``_CONTRACT``) [rad]; rows pairwise more than ``_DISTINCT`` apart.
+_CONTRACT = 100.0
+_FLOOR = 1e-9
+_DISTINCT = 1e-6
 
 
 class _ContinuedFamily(_Family):
@@ -160,6 +166,11 @@ class _ContinuedFamily(_Family):
         self.fold_t = np.full((m - 1, k), np.nan)
         self.fold_q = np.full((m - 1, k, n), np.nan)
         self.folds = self._folds()
+        # cells where sample_rows may follow the tracks: none starts or ends in them
+        ends = self._exists[1:] != self._exists[:-1]
+        slope = np.isfinite(self.slopes).all(-1) | ~self._exists  # (m, k)
+        self._cell_ok = ~ends.any(axis=1) & (slope[1:] & slope[:-1]).all(axis=1)
+        self.followed = 0
 
     # ------------------------------------------------------------ rows
     def _solve(self, t: np.ndarray) -> np.ndarray:
@@ -194,6 +205,93 @@ class _ContinuedFamily(_Family):
         out = self._polish(_assign(P, R), t)
         valid = _finite_rows(out)
         return out, valid, np.zeros_like(valid)
+
+    def sample_rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``rows(t)``, each branch followed from its nodes where that is certified.
+
+        A value t in a cell where every track present exists at both nodes with a
+        slope (no fold, no track starting or ending: the branch count is the
+        manifold's) takes each track's Hermite prediction Newton-polished on the held
+        6 x 6 (:meth:`_follow`); a value whose rows do not all certify, and every
+        other value, is solved by ``rows`` (the general 6R solver).
+        """
+        t = np.atleast_1d(np.asarray(t, dtype=np.float64))
+        fast = self._followable(t)
+        if not fast.any():
+            return self.rows(t)
+        M, (_, k, n) = len(t), self.tracks.shape
+        out = np.full((M, k, n), np.nan)
+        idx = np.flatnonzero(fast)
+        q, ok = self._follow(t[idx])
+        out[idx[ok]] = q[ok]
+        fast[idx[~ok]] = False
+        self.followed += int(ok.sum())
+        if not fast.all():
+            out[~fast] = self.rows(t[~fast])[0]
+        valid = _finite_rows(out)
+        return out, valid, np.zeros_like(valid)
+
+    def _followable(self, t: np.ndarray) -> np.ndarray:
+        """(M,) bool: t inside the nodes, in a cell whose every track is followable.
+
+        Every track exists at both nodes or at neither, with finite slopes (a fold
+        or a branch end in the cell, or a singular node row: not followable).
+        """
+        tn = self.t_nodes
+        if self.degenerate or len(tn) < 2:
+            return np.zeros(len(t), bool)
+        i = np.minimum(np.maximum(np.searchsorted(tn, t, side="right") - 1, 0), len(tn) - 2)
+        out: np.ndarray = self._cell_ok[i] & (t >= tn[0]) & (t <= tn[-1])
+        return out
+
+    def _follow(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each track's row at t (M,) from its prediction: (M, k, n), (M,) certified.
+
+        A value is certified when every track present in its cell reaches the pose
+        (``_EXACT``) by Newton steps that contract quadratically (each step above
+        ``_FLOOR`` at most ``_CONTRACT`` times the previous one squared, the first at
+        most 1 / (4 ``_CONTRACT``): with the observed constant in Kantorovich's
+        bound, h <= 1/2 and the root the only one within ~1 / (2 ``_CONTRACT``) of
+        the prediction), the rows are pairwise distinct (``_DISTINCT``) and each
+        track's row is the mutual nearest of its prediction among the value's rows
+        (``_assign``'s rule, within ``_ASSIGN``).
+        """
+        P = self.predict(t)  # (M, k, n)
+        M, k, n = P.shape
+        fp = _finite_rows(P)
+        mi, bi = np.nonzero(fp)
+        ok = np.ones(M, bool)
+        out = np.full((M, k, n), np.nan)
+        if not mi.size:
+            return out, ok
+        q0 = _into_limits(self.robot, _wrap(P[mi, bi]))
+        steps = np.zeros((len(mi), _NEWTON))
+        q, reached = _newton_held(self.robot, self.T, q0, self.joint, t[mi], steps)
+        prev, nxt = steps[:, :-1], steps[:, 1:]
+        quad = (_CONTRACT * steps[:, 0] <= 0.25) & np.all(
+            (prev <= _FLOOR) | (nxt <= _CONTRACT * prev * prev), axis=1)
+        row_ok = reached & quad & (steps[:, -1] == 0)  # converged before the last step
+        ok[mi[~row_ok]] = False
+        out[mi, bi] = q
+        # the value's present tracks packed into its first slots (a few of k)
+        start = np.concatenate([[0], np.cumsum(fp.sum(axis=1))[:-1]])
+        slot = np.arange(len(mi)) - start[mi]
+        w = int(slot.max()) + 1
+        Pw = np.full((M, w, n), np.nan)
+        Qw = np.zeros((M, w, n))
+        Pw[mi, slot], Qw[mi, slot] = P[mi, bi], q
+        there = _finite_rows(Pw)
+        pair = there[:, :, None] & there[:, None, :]
+        # each row the mutual nearest of its own prediction (_assign's rule), all distinct
+        d = np.where(pair, _max_last(np.abs(_wrap(Pw[:, :, None] - Qw[:, None]))), np.inf)
+        own = np.arange(w)
+        near = ((d.argmin(axis=2) == own) & (d.argmin(axis=1) == own)
+                & (d[:, own, own] < _ASSIGN))
+        ok &= np.all(near | ~there, axis=1)
+        sep = _max_last(np.abs(_wrap(Qw[:, :, None] - Qw[:, None])))
+        sep[:, own, own] = np.inf
+        ok &= np.all((sep > _DISTINCT) | ~pair, axis=(1, 2))
+        return out, ok
 
     def _polish(self, Q: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Rows Q (M, k, n) at t (M,) polished by Newton steps on the six free joints.
@@ -609,10 +707,13 @@ def _assign(P: np.ndarray, R: np.ndarray) -> np.ndarray:
 
 
 def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray | int,
-                 values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                 values: np.ndarray, steps: np.ndarray | None = None
+                 ) -> tuple[np.ndarray, np.ndarray]:
     """Configurations (M, n) of pose T with joint ``joints[i]`` at ``values[i]``.
 
     ``joints`` one index for every row: the six other columns taken as a slice.
+    ``steps`` (M, ``_NEWTON``), if given, receives each step's largest joint change
+    (inf where the 6 x 6 was singular; the rows' q do not depend on it).
 
     Newton steps from q0 (M, n) on the six other joints (the parameter among them:
     t free); True where the pose is reached to ``_EXACT``.
@@ -650,6 +751,8 @@ def _newton_held(robot: Arm, T: np.ndarray, q0: np.ndarray, joints: np.ndarray |
         step = np.zeros((len(moved), n - 1))
         if good.any():
             step[good] = np.linalg.solve(A[good], e[act][good][..., None])[..., 0]
+        if steps is not None:
+            steps[moved, it] = np.where(good, _max_last(np.abs(step)), np.inf)
         q[moved[:, None], idx[moved]] += step
         rows = moved
     ok = err <= _EXACT
