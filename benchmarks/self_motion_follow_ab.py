@@ -30,6 +30,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_self_motion_general import configurations  # noqa: E402
+
 from reference import offset_iiwa14, pose_errors, random_7r  # noqa: E402
 
 
@@ -60,10 +61,7 @@ def main(seeds: list[int], poses: int, values: int, save: str | None,
                     rows = sm.sample(t)
                     key = f"{robot.name}/{kind}/{seed}/{i}"
                     saved[key] = rows
-                    if ref is not None:
-                        base = ref[key]
-                    else:
-                        base = fam.rows(t)[0]
+                    base = ref[key] if ref is not None else fam.rows(t)[0]
                     tally["manifolds"] += 1
                     tally["values"] += len(t)
                     tally["followed"] += getattr(fam, "followed", 0) - before

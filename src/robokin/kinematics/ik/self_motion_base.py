@@ -31,8 +31,11 @@ class _Family:
         raise NotImplementedError
 
     def sample_rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``rows(t)`` for ``SelfMotion.sample`` and ``inside`` (a family may follow its
-        branches there instead of solving; the construction keeps ``rows``)."""
+        """``rows(t)`` for ``SelfMotion.sample`` and ``inside``.
+
+        A family may follow its branches there instead of solving; the construction
+        (intervals, folds, crossings) keeps ``rows``.
+        """
         return self.rows(t)
 
     def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:

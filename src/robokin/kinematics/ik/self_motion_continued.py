@@ -27,6 +27,11 @@ module continues them into branches (issue 29):
    neighbouring nodes (mutual nearest, within ``_ASSIGN``; next to a fold a
    square-root model): every returned row is a general-6R solution (Newton-polished
    to rounding where it was above 1e-14), its slot the continued branch.
+   ``sample_rows(t)`` (``SelfMotion.sample`` and ``inside``) follows instead where
+   it is certified: in a cell with no fold (the branch count is the manifold's),
+   each track's prediction Newton-polished on the held 6 x 6, kept when the steps
+   contract quadratically and the rows are distinct, each its prediction's mutual
+   nearest; any other value is solved as in ``rows`` (issue 29, round 7).
 4. **Limits on the branch.** Per track, cell and joint, the cubic Hermite model
    sampled at ``_SUB`` sub-values brackets each crossing of a limit (and of an
    aligned-axes value); each is refined by Newton steps on the six other joints
