@@ -8,9 +8,10 @@ special, ``--seeds`` x ``--poses`` each; joint 7 the parameter), samples each at
 ``--values`` values (the domain's linspace and the generating q7) and checks:
 
 * every row of the reference is returned (within 1e-10 rad, 2 pi wrapped, same
-  branch slot); the reference is this tree's full solve (``_family.rows``, the
-  code main's ``sample`` runs) or, with ``--against FILE``, the rows another tree
-  saved with ``--save FILE`` (run main with ``--save``, this tree with ``--against``);
+  branch slot; rows equal only 2 pi wrapped, a joint 2 pi apart, counted); the
+  reference is this tree's full solve (``_family.rows``, the code main's ``sample``
+  runs) or, with ``--against FILE``, the rows another tree saved with ``--save
+  FILE`` (run main with ``--save``, this tree with ``--against``);
 * rows returned with a pose error above 1e-12 (position [m] or rotation [rad]);
 * rows returned where the reference has none (a branch the kernel missed at t);
 * how many values took the followed path.
@@ -48,7 +49,7 @@ def main(seeds: list[int], poses: int, values: int, save: str | None,
         for special in (False, True):
             kind = "special" if special else "uniform"
             tally = dict(manifolds=0, values=0, followed=0, rows=0, missing=0,
-                         wrong=0, extra=0, returned=0)
+                         wrong=0, extra=0, returned=0, shifted=0)
             for seed in seeds:
                 rng = np.random.default_rng(seed)
                 q = configurations(robot, rng, poses, special)
@@ -72,6 +73,8 @@ def main(seeds: list[int], poses: int, values: int, save: str | None,
                     d = wrapped(np.where(fb & fr, 1, np.nan)[..., None] * (rows - base)).max(-1)
                     tally["rows"] += int(fb.sum())
                     tally["missing"] += int((fb & ~(d < 1e-10)).sum())
+                    raw = np.abs(np.where(fb & fr, 1, np.nan)[..., None] * (rows - base))
+                    tally["shifted"] += int(((d < 1e-10) & ~(raw.max(-1) < 1e-10)).sum())
                     tally["extra"] += int((fr & ~fb).sum())
                     tally["returned"] += int(fr.sum())
                     if fr.any():
@@ -79,7 +82,8 @@ def main(seeds: list[int], poses: int, values: int, save: str | None,
                         tally["wrong"] += int((np.maximum(dp, dr) > 1e-12).sum())
             print(f"{robot.name:12s} {kind:8s} {tally['manifolds']} manifolds, "
                   f"{tally['values']} values ({tally['followed']} followed): reference rows "
-                  f"{tally['rows']}, missing {tally['missing']}; returned {tally['returned']} "
+                  f"{tally['rows']}, missing {tally['missing']} (2 pi apart "
+                  f"{tally['shifted']}); returned {tally['returned']} "
                   f"(not in the reference {tally['extra']}), pose error > 1e-12: "
                   f"{tally['wrong']}")
     if save:
