@@ -257,9 +257,10 @@ class _ContinuedFamily(_Family):
         ``_FLOOR`` at most ``_CONTRACT`` times the previous one squared, the first at
         most 1 / (4 ``_CONTRACT``): with the observed constant in Kantorovich's
         bound, h <= 1/2 and the root the only one within ~1 / (2 ``_CONTRACT``) of
-        the prediction), the rows are pairwise distinct (``_DISTINCT``) and each
-        track's row is the mutual nearest of its prediction among the value's rows
-        (``_assign``'s rule, within ``_ASSIGN``).
+        the prediction) and each row within ``_ASSIGN`` of its prediction; the rows
+        pairwise more than ``_DISTINCT`` and twice the farthest row-to-prediction
+        distance apart (so each track's row is the mutual nearest of its prediction
+        among the value's rows: ``_assign``'s rule).
         """
         P = self.predict(t)  # (M, k, n)
         M, k, n = P.shape
@@ -278,24 +279,27 @@ class _ContinuedFamily(_Family):
         row_ok = reached & quad & (steps[:, -1] == 0)  # converged before the last step
         ok[mi[~row_ok]] = False
         out[mi, bi] = q
+        # each row the mutual nearest of its own prediction (_assign's rule): implied
+        # (triangle inequality of the wrapped max distance) when every two rows of
+        # the value are more than twice the farthest row-to-prediction apart
+        moved = _max_last(np.abs(_wrap(q - P[mi, bi])))  # (p,)
+        ok[mi[~(moved < _ASSIGN)]] = False
+        apart = np.zeros(M)
+        np.maximum.at(apart, mi, 2 * moved)
+        np.maximum(apart, _DISTINCT, out=apart)
         # the value's present tracks packed into its first slots (a few of k)
         start = np.concatenate([[0], np.cumsum(fp.sum(axis=1))[:-1]])
         slot = np.arange(len(mi)) - start[mi]
         w = int(slot.max()) + 1
-        Pw = np.full((M, w, n), np.nan)
-        Qw = np.zeros((M, w, n))
-        Pw[mi, slot], Qw[mi, slot] = P[mi, bi], q
-        there = _finite_rows(Pw)
-        pair = there[:, :, None] & there[:, None, :]
-        # each row the mutual nearest of its own prediction (_assign's rule), all distinct
-        d = np.where(pair, _max_last(np.abs(_wrap(Pw[:, :, None] - Qw[:, None]))), np.inf)
-        own = np.arange(w)
-        near = ((d.argmin(axis=2) == own) & (d.argmin(axis=1) == own)
-                & (d[:, own, own] < _ASSIGN))
-        ok &= np.all(near | ~there, axis=1)
-        sep = _max_last(np.abs(_wrap(Qw[:, :, None] - Qw[:, None])))
-        sep[:, own, own] = np.inf
-        ok &= np.all((sep > _DISTINCT) | ~pair, axis=(1, 2))
+        if w > 1:
+            Qw = np.zeros((M, w, n))
+            Qw[mi, slot] = q
+            there = np.zeros((M, w), bool)
+            there[mi, slot] = True
+            sep = _max_last(np.abs(_wrap(Qw[:, :, None] - Qw[:, None])))  # (M, w, w)
+            sep[:, np.arange(w), np.arange(w)] = np.inf
+            pair = there[:, :, None] & there[:, None, :]
+            ok &= np.all((sep > apart[:, None, None]) | ~pair, axis=(1, 2))
         return out, ok
 
     def _polish(self, Q: np.ndarray, t: np.ndarray) -> np.ndarray:
