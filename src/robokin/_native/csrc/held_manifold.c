@@ -947,29 +947,140 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
     }
 }
 
-/* A fold in (r0, r1): slot b's row exists at one end only. Bisected on its
- * existence until the ends are adjacent floats; the last t with a row is the
- * branch end (a cut and a point). The partner slot (b ^ 1: the same position
- * root) takes the same end when its existence agreed at every bisection row. */
+static int hm_margins(const double *P, const double *T, double x, double *m);
+
+/* The zero of margin k (hm_margins) in (a, e), fa and fe its values there of
+ * opposite signs: Brent's method (inverse quadratic / secant steps safeguarded by
+ * bisection) until the bracket is 1e-15 (relative to max(1, |t|)) wide or a
+ * value is 0; no rows. NaN when a margin is not finite inside. */
+static double hm_margin_root(const double *P, const double *T, int k, double a, double fa,
+                             double e, double fe)
+{
+    double m[3], c = a, fc = fa, d = e - a, g = d;
+    for (int it = 0; it < 100; it++) {
+        if ((fe > 0) == (fc > 0)) {
+            c = a;
+            fc = fa;
+            d = g = e - a;
+        }
+        if (fabs(fc) < fabs(fe)) {
+            a = e;
+            e = c;
+            c = a;
+            fa = fe;
+            fe = fc;
+            fc = fa;
+        }
+        double tol = 0.5e-15 * fmax(1.0, fabs(e)), mid = 0.5 * (c - e);
+        if (fabs(mid) <= tol || fe == 0.0)
+            return e;
+        if (fabs(g) >= tol && fabs(fa) > fabs(fe)) {
+            double s = fe / fa, p, q;
+            if (a == c) {
+                p = 2.0 * mid * s;
+                q = 1.0 - s;
+            } else {
+                double r = fe / fc, u = fa / fc;
+                p = s * (2.0 * mid * u * (u - r) - (e - a) * (r - 1.0));
+                q = (u - 1.0) * (r - 1.0) * (s - 1.0);
+            }
+            if (p > 0.0)
+                q = -q;
+            else
+                p = -p;
+            if (2.0 * p < fmin(3.0 * mid * q - fabs(tol * q), fabs(g * q))) {
+                g = d;
+                d = p / q;
+            } else {
+                d = mid;
+                g = d;
+            }
+        } else {
+            d = mid;
+            g = d;
+        }
+        a = e;
+        fa = fe;
+        e += fabs(d) > tol ? d : copysign(tol, mid);
+        hm_margins(P, T, e, m);
+        fe = m[k];
+        if (!isfinite(fe))
+            return NAN;
+    }
+    return NAN;
+}
+
+/* Slot b's branch end in (r0, r1) from the existence margins (its position root
+ * ends where the margin of the first angle, or of the second given the slot's
+ * first root, crosses 0: hm_margin_root, ~12 margins and no rows), confirmed by
+ * rows: slot b's row at the end (into *re, with its slope) and none HM_FOLD_TOL
+ * past it. Returns 0 (*re undefined; hm_fold bisects on rows) when no margin
+ * brackets the end or the rows disagree. Not for the first angle's second root
+ * (b >= 4) where the first angle's roots end: sp4_roots merges the two roots once
+ * the discriminant is below 1e-16 of its scale, and pk_one's rows of that root
+ * come and go within ~5e-11 of the margin's zero (development poses 494 and 830
+ * flagged a branch vanishing next to such an end); the bisection keeps main's end. */
+static int hm_fold_margin(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, HmRow *re,
+                          double *end)
+{
+    double m0[3], m1[3];
+    int state0 = r0->valid[b];
+    if (!hm_margins(c->P, c->T, r0->t, m0) || !hm_margins(c->P, c->T, r1->t, m1))
+        return 0;
+    const double *mv = state0 ? m0 : m1, *mu = state0 ? m1 : m0;
+    int k = -1;
+    if (mv[0] >= 0.0 && mu[0] < 0.0 && b < 4)
+        k = 0; /* the first angle's roots end (its second root, b >= 4: below) */
+    else if (mv[0] >= 0.0 && mu[0] >= 0.0 && mv[1 + (b >> 2)] >= 0.0 && mu[1 + (b >> 2)] < 0.0)
+        k = 1 + (b >> 2); /* the second's, given the slot's first root */
+    if (k < 0)
+        return 0;
+    double t = hm_margin_root(c->P, c->T, k, r0->t, m0[k], r1->t, m1[k]);
+    if (!(t > r0->t && t < r1->t))
+        return 0;
+    double dir = state0 ? 1.0 : -1.0; /* toward the side without the row */
+    hm_eval(c, t, 1u << b, 1u << b, re);
+    if (!re->valid[b])
+        return 0;
+    HmRow chk;
+    hm_eval(c, t + dir * HM_FOLD_TOL * fmax(1.0, fabs(t)), 0u, 1u << b, &chk);
+    if (chk.valid[b])
+        return 0;
+    *end = t;
+    return 1;
+}
+
+/* A fold in (r0, r1): slot b's row exists at one end only. Its end from the
+ * margins (hm_fold_margin), else bisected on the row's existence (extrapolating
+ * 1 / |dq/dt|^2) to HM_FOLD_TOL; the last t with a row is the branch end (a cut and
+ * a point). The partner slot (b ^ 1: the same position root) takes the same end
+ * when its existence agreed at both ends of the cell (and its rows confirm it). */
 static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1)
 {
     double lo = r0->t, hi = r1->t, end = lo;
     int state0 = r0->valid[b], p = b ^ 1;
-    HmRow chk;
+    HmRow chk, re;
     int known = 0;
     for (int f = 0; f < c->nfold[b] && !known; f++) {
         if (c->fold_cell[b][f] != cell)
             continue; /* the partner's end in this cell: checked on both sides */
         double e = c->fold_t[b][f];
         double out = e + copysign(HM_FOLD_TOL * fmax(1.0, fabs(e)), state0 ? 1.0 : -1.0);
-        hm_eval(c, e, 0u, 1u << b, &chk);
-        int ok = chk.valid[b];
+        hm_eval(c, e, 1u << b, 1u << b, &re);
+        int ok = re.valid[b];
         hm_eval(c, out, 0u, 1u << b, &chk);
         known = ok && !chk.valid[b];
         end = e;
     }
+    int agree = r0->valid[p] == state0 && r1->valid[p] == r1->valid[b];
+    if (!known && hm_fold_margin(c, b, r0, r1, &re, &end)) {
+        known = 1;
+        if (agree && c->nfold[p] < HM_MAXF) {
+            c->fold_cell[p][c->nfold[p]] = cell;
+            c->fold_t[p][c->nfold[p]++] = end;
+        }
+    }
     if (!known) {
-        int agree = r0->valid[p] == state0 && r1->valid[p] == r1->valid[b];
         /* v: the valid side, u: the other; g = 1 / |dq/dt|^2 falls linearly to 0
          * at the fold (q moves as the square root of the distance): extrapolated
          * from the last two valid rows, safeguarded by bisection */
@@ -1022,10 +1133,9 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
             c->fold_cell[p][c->nfold[p]] = cell;
             c->fold_t[p][c->nfold[p]++] = end;
         }
+        hm_eval(c, end, 1u << b, 1u << b, &re);
     }
     hm_point(c, end, b, -1, HM_KIND_FOLD);
-    HmRow re;
-    hm_eval(c, end, 1u << b, 1u << b, &re);
     if (!re.valid[b]) {
         c->flags |= HM_FLAG_VANISH;
         return;
