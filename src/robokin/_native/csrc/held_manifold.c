@@ -56,6 +56,7 @@
 #ifndef HM_SLOPE_DET
 #define HM_SLOPE_DET 1e-10 /* hm_slopes_fast: a block's determinant per unit columns below it: hm_slopes */
 #endif
+#define HM_DISC_TWO 1e-15 /* a discriminant / (A^2 + B^2) above it: sp4_roots' two roots */
 #define HM_MAXG 8 /* grazes (a branch inside a limit by under HM_TOL) per slot */
 
 enum { HM_KIND_LOWER = 0, HM_KIND_UPPER = 1, HM_KIND_ALIGNED = 2, HM_KIND_FOLD = 3 };
@@ -947,16 +948,17 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
     }
 }
 
-static int hm_margins(const double *P, const double *T, double x, double *m);
+static int hm_margins_d(const double *P, const double *T, double x, double *m, double *d);
 
-/* The zero of margin k (hm_margins) in (a, e), fa and fe its values there of
- * opposite signs: Brent's method (inverse quadratic / secant steps safeguarded by
- * bisection) until the bracket is 1e-15 (relative to max(1, |t|)) wide or a
- * value is 0; no rows. NaN when a margin is not finite inside. */
-static double hm_margin_root(const double *P, const double *T, int k, double a, double fa,
-                             double e, double fe)
+/* The t in (a, e) where the discriminant of subproblem k (hm_margins_d's d[k]) is
+ * `off`, fa and fe its values minus off there, of opposite signs: Brent's method
+ * (inverse quadratic / secant steps safeguarded by bisection) until the bracket is
+ * 1e-15 (relative to max(1, |t|)) wide or a value is 0; no rows. NaN when a
+ * discriminant is not finite inside. */
+static double hm_margin_root(const double *P, const double *T, int k, double off, double a,
+                             double fa, double e, double fe)
 {
-    double m[3], c = a, fc = fa, d = e - a, g = d;
+    double m[3], dk[3], c = a, fc = fa, d = e - a, g = d;
     for (int it = 0; it < 100; it++) {
         if ((fe > 0) == (fc > 0)) {
             c = a;
@@ -1002,40 +1004,47 @@ static double hm_margin_root(const double *P, const double *T, int k, double a, 
         a = e;
         fa = fe;
         e += fabs(d) > tol ? d : copysign(tol, mid);
-        hm_margins(P, T, e, m);
-        fe = m[k];
+        hm_margins_d(P, T, e, m, dk);
+        fe = dk[k] - off;
         if (!isfinite(fe))
             return NAN;
     }
     return NAN;
 }
 
-/* Slot b's branch end in (r0, r1) from the existence margins (its position root
- * ends where the margin of the first angle, or of the second given the slot's
- * first root, crosses 0: hm_margin_root, ~12 margins and no rows), confirmed by
- * rows: slot b's row at the end (into *re, with its slope) and none HM_FOLD_TOL
- * past it. Returns 0 (*re undefined; hm_fold bisects on rows) when no margin
- * brackets the end or the rows disagree. Not for the first angle's second root
- * (b >= 4) where the first angle's roots end: sp4_roots merges the two roots once
- * the discriminant is below 1e-16 of its scale, and pk_one's rows of that root
- * come and go within ~5e-11 of the margin's zero (development poses 494 and 830
- * flagged a branch vanishing next to such an end); the bisection keeps main's end. */
+/* Slot b's branch end in (r0, r1) from the existence margins: its position root
+ * ends where the discriminant of the first angle's subproblem 4, or of the
+ * second's given the slot's first root, falls to 0 (the pair's first root; the
+ * margin hm_margins crosses 0 there) or, for the pair's second root, to
+ * HM_DISC_TWO (sp4_roots merges the two roots below 1e-16 of A^2 + B^2, and
+ * pk_one's rows of that root come and go between there and 0: taking 0 for it
+ * flagged a branch vanishing next to its end on development poses 494 and 830):
+ * hm_margin_root, ~12 margin evaluations and no rows. Confirmed by rows: slot b's
+ * row at the end (into *re, with its slope) and none HM_FOLD_TOL past it. Returns
+ * 0 (*re undefined; hm_fold bisects on rows) when no discriminant brackets the end
+ * or the rows disagree. */
 static int hm_fold_margin(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, HmRow *re,
                           double *end)
 {
-    double m0[3], m1[3];
+    double m0[3], m1[3], d0[3], d1[3];
     int state0 = r0->valid[b];
-    if (!hm_margins(c->P, c->T, r0->t, m0) || !hm_margins(c->P, c->T, r1->t, m1))
+    if (!hm_margins_d(c->P, c->T, r0->t, m0, d0) || !hm_margins_d(c->P, c->T, r1->t, m1, d1))
         return 0;
     const double *mv = state0 ? m0 : m1, *mu = state0 ? m1 : m0;
     int k = -1;
-    if (mv[0] >= 0.0 && mu[0] < 0.0 && b < 4)
-        k = 0; /* the first angle's roots end (its second root, b >= 4: below) */
+    if (mv[0] >= 0.0 && mu[0] < 0.0)
+        k = 0; /* the first angle's roots end */
     else if (mv[0] >= 0.0 && mu[0] >= 0.0 && mv[1 + (b >> 2)] >= 0.0 && mu[1 + (b >> 2)] < 0.0)
         k = 1 + (b >> 2); /* the second's, given the slot's first root */
     if (k < 0)
         return 0;
-    double t = hm_margin_root(c->P, c->T, k, r0->t, m0[k], r1->t, m1[k]);
+    /* the pair's second root (slot bit 2 of the first angle, bit 1 of the second)
+     * ends where sp4_roots merges the two: at HM_DISC_TWO; the first at 0 */
+    double off = (k == 0 ? b >= 4 : (b & 2) != 0) ? HM_DISC_TWO : 0.0;
+    double fa = d0[k] - off, fe = d1[k] - off;
+    if (!((fa > 0.0) == (state0 != 0) && (fe > 0.0) != (state0 != 0)))
+        return 0;
+    double t = hm_margin_root(c->P, c->T, k, off, r0->t, fa, r1->t, fe);
     if (!(t > r0->t && t < r1->t))
         return 0;
     double dir = state0 ? 1.0 : -1.0; /* toward the side without the row */
@@ -1273,7 +1282,7 @@ static void hm_intervals(HmCtx *c, int b, double lo, double hi, const HmRow *row
  * of the second angle given first root i (NaN without it). A branch is born or
  * dies where one crosses 0. Returns 0 when the position equations are not of the
  * coplanar kind (He and Liu's case; the kernel then flags the pose). */
-static int hm_margins(const double *P, const double *T, double x, double *m)
+static int hm_margins_d(const double *P, const double *T, double x, double *m, double *d)
 {
     PkGeo g;
     pk_geometry(P, x, &g);
@@ -1300,6 +1309,10 @@ static int hm_margins(const double *P, const double *T, double x, double *m)
     double C = n[0] * e.r[0] + n[1] * e.r[1];
     m[0] = (hypot(A, B) - fabs(C)) / L;
     m[1] = m[2] = NAN;
+    if (d != NULL) {
+        d[0] = (A * A + B * B - C * C) / (A * A + B * B);
+        d[1] = d[2] = NAN;
+    }
     if (hypot(A, B) <= 1e-12 * L)
         return 0; /* the first angle free: not this kind */
     Roots rx = pk_sp4(A, B, C, PK_SP4_SLACK * L);
@@ -1311,10 +1324,20 @@ static int hm_margins(const double *P, const double *T, double x, double *m)
         double Xu1 = X[1][0] * rx.c[i] + X[1][1] * rx.s[i];
         double Cy = m0 * (e.r[0] - sx * Xu0) + m1 * (e.r[1] - sx * Xu1);
         m[1 + i] = (hypot(Ay, By) - fabs(Cy)) / L;
+        if (d != NULL)
+            d[1 + i] = (Ay * Ay + By * By - Cy * Cy) / (Ay * Ay + By * By);
     }
-    if (rx.n == 1)
+    if (rx.n == 1) {
         m[2] = m[1];
+        if (d != NULL)
+            d[2] = d[1];
+    }
     return 1;
+}
+
+static int hm_margins(const double *P, const double *T, double x, double *m)
+{
+    return hm_margins_d(P, T, x, m, NULL);
 }
 
 /* The extremum of margin k in (a, e) (golden section; a maximum when want_max):
