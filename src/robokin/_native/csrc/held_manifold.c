@@ -19,9 +19,11 @@
  *      cell's cubic Hermite model) / Illinois regula falsi on q_j(t) - value
  *      until the joint is at the value to 1e-14 (the row is
  *      pk_one's: pose error <= 4e-13);
- *   3. cells where a slot's row appears or disappears (a fold: two slots meet)
- *      are bisected on the row's existence to adjacent floats (pk_one's own
- *      test, as the numpy path did);
+ *   3. cells where a slot's row appears or disappears (a fold: two slots meet):
+ *      the end where the position root's subproblem-4 discriminant reaches 0
+ *      (or HM_DISC_TWO for the pair's second root), by Brent's method on the
+ *      margins (no rows), confirmed by two rows; else searched on the row's
+ *      existence to HM_FOLD_TOL;
  *   4. per slot, the pieces between domain ends, limit crossings and folds are
  *      decided at their midpoints (a row inside every limit) and joined.
  *
