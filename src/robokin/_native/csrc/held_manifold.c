@@ -59,6 +59,7 @@
 #define HM_SLOPE_DET 1e-10 /* hm_slopes_fast: a block's determinant per unit columns below it: hm_slopes */
 #endif
 #define HM_DISC_TWO 1e-15 /* a discriminant / (A^2 + B^2) above it: sp4_roots' two roots */
+#define HM_PAIR_ROWS 48 /* near-fold rows kept for the partner slot (hm_eval_pair) */
 #define HM_MAXG 8 /* grazes (a branch inside a limit by under HM_TOL) per slot */
 
 enum { HM_KIND_LOWER = 0, HM_KIND_UPPER = 1, HM_KIND_ALIGNED = 2, HM_KIND_FOLD = 3 };
@@ -99,6 +100,10 @@ typedef struct {
     v3 fc, Gt, u6, w6, b5;
     m3 GA, B5;
     double ft;
+    /* near-fold rows of a slot pair (b, b ^ 1), evaluated together (hm_eval_pair) */
+    HmRow pair_row[HM_PAIR_ROWS];
+    unsigned pair_need[HM_PAIR_ROWS], pair_mask[HM_PAIR_ROWS];
+    int npair, ipair;
 } HmCtx;
 
 /* Gaussian elimination with partial pivoting of M (6 x 6 | right-hand side) into x;
@@ -493,6 +498,31 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
     }
 }
 
+
+/* Slot b's row at t (its slope when `slopes`) for a branch end and its near-fold
+ * piece: the slot and its partner b ^ 1 (the same position root, the wrist's other
+ * solution: its branch ends at the same t and its piece has rows at the same t
+ * values) are evaluated together and the row kept (HM_PAIR_ROWS of them), so that
+ * the partner's end and piece take it from here: one closed form (pk_front, the
+ * position roots and the triple) for both. The rows are the same as evaluated one
+ * slot at a time (hm_closed's per-slot rows, or pk_one's where it hands over). */
+static void hm_eval_pair(HmCtx *c, double t, int b, int slopes, HmRow *r)
+{
+    unsigned pair = 3u << (b & ~1), mask = slopes ? 1u << b : 0u;
+    for (int i = 0; i < c->npair; i++)
+        if (c->pair_row[i].t == t && (c->pair_need[i] >> b & 1u) &&
+            (c->pair_mask[i] & mask) == mask) {
+            *r = c->pair_row[i];
+            return;
+        }
+    hm_eval(c, t, slopes ? pair : 0u, pair, r);
+    int i = c->ipair;
+    c->ipair = (i + 1) % HM_PAIR_ROWS;
+    c->npair += c->npair < HM_PAIR_ROWS;
+    c->pair_row[i] = *r;
+    c->pair_need[i] = pair;
+    c->pair_mask[i] = slopes ? pair : 0u;
+}
 
 static void hm_point(HmCtx *c, double t, int b, int j, int kind)
 {
@@ -919,7 +949,7 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
     int m = 0;
     double w = rn->t - re->t;
     for (int k = HM_FOLD_STEPS; k >= 1; k--) {
-        hm_eval(c, re->t + w * ldexp(1.0, -2 * k), 1u << b, 1u << b, &r[m]);
+        hm_eval_pair(c, re->t + w * ldexp(1.0, -2 * k), b, 1, &r[m]);
         if (!r[m].valid[b]) {
             c->flags |= HM_FLAG_VANISH;
             return;
@@ -1050,11 +1080,11 @@ static int hm_fold_margin(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, HmR
     if (!(t > r0->t && t < r1->t))
         return 0;
     double dir = state0 ? 1.0 : -1.0; /* toward the side without the row */
-    hm_eval(c, t, 1u << b, 1u << b, re);
+    hm_eval_pair(c, t, b, 1, re);
     if (!re->valid[b])
         return 0;
     HmRow chk;
-    hm_eval(c, t + dir * HM_FOLD_TOL * fmax(1.0, fabs(t)), 0u, 1u << b, &chk);
+    hm_eval_pair(c, t + dir * HM_FOLD_TOL * fmax(1.0, fabs(t)), b, 0, &chk);
     if (chk.valid[b])
         return 0;
     *end = t;
@@ -1077,9 +1107,9 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
             continue; /* the partner's end in this cell: checked on both sides */
         double e = c->fold_t[b][f];
         double out = e + copysign(HM_FOLD_TOL * fmax(1.0, fabs(e)), state0 ? 1.0 : -1.0);
-        hm_eval(c, e, 1u << b, 1u << b, &re);
+        hm_eval_pair(c, e, b, 1, &re);
         int ok = re.valid[b];
-        hm_eval(c, out, 0u, 1u << b, &chk);
+        hm_eval_pair(c, out, b, 0, &chk);
         known = ok && !chk.valid[b];
         end = e;
     }
@@ -1144,7 +1174,7 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
             c->fold_cell[p][c->nfold[p]] = cell;
             c->fold_t[p][c->nfold[p]++] = end;
         }
-        hm_eval(c, end, 1u << b, 1u << b, &re);
+        hm_eval_pair(c, end, b, 1, &re);
     }
     hm_point(c, end, b, -1, HM_KIND_FOLD);
     if (!re.valid[b]) {
@@ -1479,6 +1509,8 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
     for (int b = 0; b < 8; b++) {
         c->ncut[b] = 0;
         c->ngraze[b] = 0;
+        if (!(b & 1))
+            c->npair = c->ipair = 0; /* a new pair */
         for (long i = 0; i < G; i++) {
             if (rows[i].valid[b])
                 hm_node(c, b, &rows[i]);
