@@ -19,9 +19,11 @@
  *      cell's cubic Hermite model) / Illinois regula falsi on q_j(t) - value
  *      until the joint is at the value to 1e-14 (the row is
  *      pk_one's: pose error <= 4e-13);
- *   3. cells where a slot's row appears or disappears (a fold: two slots meet)
- *      are bisected on the row's existence to adjacent floats (pk_one's own
- *      test, as the numpy path did);
+ *   3. cells where a slot's row appears or disappears (a fold: two slots meet):
+ *      the end where the position root's subproblem-4 discriminant reaches 0
+ *      (or HM_DISC_TWO for the pair's second root), by Brent's method on the
+ *      margins (no rows), confirmed by two rows; else searched on the row's
+ *      existence to HM_FOLD_TOL;
  *   4. per slot, the pieces between domain ends, limit crossings and folds are
  *      decided at their midpoints (a row inside every limit) and joined.
  *
@@ -56,6 +58,8 @@
 #ifndef HM_SLOPE_DET
 #define HM_SLOPE_DET 1e-10 /* hm_slopes_fast: a block's determinant per unit columns below it: hm_slopes */
 #endif
+#define HM_DISC_TWO 1e-15 /* a discriminant / (A^2 + B^2) above it: sp4_roots' two roots */
+#define HM_PAIR_ROWS 48 /* near-fold rows kept for the partner slot (hm_eval_pair) */
 #define HM_MAXG 8 /* grazes (a branch inside a limit by under HM_TOL) per slot */
 
 enum { HM_KIND_LOWER = 0, HM_KIND_UPPER = 1, HM_KIND_ALIGNED = 2, HM_KIND_FOLD = 3 };
@@ -96,6 +100,10 @@ typedef struct {
     v3 fc, Gt, u6, w6, b5;
     m3 GA, B5;
     double ft;
+    /* near-fold rows of a slot pair (b, b ^ 1), evaluated together (hm_eval_pair) */
+    HmRow pair_row[HM_PAIR_ROWS];
+    unsigned pair_need[HM_PAIR_ROWS], pair_mask[HM_PAIR_ROWS];
+    int npair, ipair;
 } HmCtx;
 
 /* Gaussian elimination with partial pivoting of M (6 x 6 | right-hand side) into x;
@@ -490,6 +498,31 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
     }
 }
 
+
+/* Slot b's row at t (its slope when `slopes`) for a branch end and its near-fold
+ * piece: the slot and its partner b ^ 1 (the same position root, the wrist's other
+ * solution: its branch ends at the same t and its piece has rows at the same t
+ * values) are evaluated together and the row kept (HM_PAIR_ROWS of them), so that
+ * the partner's end and piece take it from here: one closed form (pk_front, the
+ * position roots and the triple) for both. The rows are the same as evaluated one
+ * slot at a time (hm_closed's per-slot rows, or pk_one's where it hands over). */
+static void hm_eval_pair(HmCtx *c, double t, int b, int slopes, HmRow *r)
+{
+    unsigned pair = 3u << (b & ~1), mask = slopes ? 1u << b : 0u;
+    for (int i = 0; i < c->npair; i++)
+        if (c->pair_row[i].t == t && (c->pair_need[i] >> b & 1u) &&
+            (c->pair_mask[i] & mask) == mask) {
+            *r = c->pair_row[i];
+            return;
+        }
+    hm_eval(c, t, slopes ? pair : 0u, pair, r);
+    int i = c->ipair;
+    c->ipair = (i + 1) % HM_PAIR_ROWS;
+    c->npair += c->npair < HM_PAIR_ROWS;
+    c->pair_row[i] = *r;
+    c->pair_need[i] = pair;
+    c->pair_mask[i] = slopes ? pair : 0u;
+}
 
 static void hm_point(HmCtx *c, double t, int b, int j, int kind)
 {
@@ -916,7 +949,7 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
     int m = 0;
     double w = rn->t - re->t;
     for (int k = HM_FOLD_STEPS; k >= 1; k--) {
-        hm_eval(c, re->t + w * ldexp(1.0, -2 * k), 1u << b, 1u << b, &r[m]);
+        hm_eval_pair(c, re->t + w * ldexp(1.0, -2 * k), b, 1, &r[m]);
         if (!r[m].valid[b]) {
             c->flags |= HM_FLAG_VANISH;
             return;
@@ -947,29 +980,148 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
     }
 }
 
-/* A fold in (r0, r1): slot b's row exists at one end only. Bisected on its
- * existence until the ends are adjacent floats; the last t with a row is the
- * branch end (a cut and a point). The partner slot (b ^ 1: the same position
- * root) takes the same end when its existence agreed at every bisection row. */
+static int hm_margins_d(const double *P, const double *T, double x, double *m, double *d);
+
+/* The t in (a, e) where the discriminant of subproblem k (hm_margins_d's d[k]) is
+ * `off`, fa and fe its values minus off there, of opposite signs: Brent's method
+ * (inverse quadratic / secant steps safeguarded by bisection) until the bracket is
+ * 1e-15 (relative to max(1, |t|)) wide or a value is 0; no rows. NaN when a
+ * discriminant is not finite inside. */
+static double hm_margin_root(const double *P, const double *T, int k, double off, double a,
+                             double fa, double e, double fe)
+{
+    double m[3], dk[3], c = a, fc = fa, d = e - a, g = d;
+    for (int it = 0; it < 100; it++) {
+        if ((fe > 0) == (fc > 0)) {
+            c = a;
+            fc = fa;
+            d = g = e - a;
+        }
+        if (fabs(fc) < fabs(fe)) {
+            a = e;
+            e = c;
+            c = a;
+            fa = fe;
+            fe = fc;
+            fc = fa;
+        }
+        double tol = 0.5e-15 * fmax(1.0, fabs(e)), mid = 0.5 * (c - e);
+        if (fabs(mid) <= tol || fe == 0.0)
+            return e;
+        if (fabs(g) >= tol && fabs(fa) > fabs(fe)) {
+            double s = fe / fa, p, q;
+            if (a == c) {
+                p = 2.0 * mid * s;
+                q = 1.0 - s;
+            } else {
+                double r = fe / fc, u = fa / fc;
+                p = s * (2.0 * mid * u * (u - r) - (e - a) * (r - 1.0));
+                q = (u - 1.0) * (r - 1.0) * (s - 1.0);
+            }
+            if (p > 0.0)
+                q = -q;
+            else
+                p = -p;
+            if (2.0 * p < fmin(3.0 * mid * q - fabs(tol * q), fabs(g * q))) {
+                g = d;
+                d = p / q;
+            } else {
+                d = mid;
+                g = d;
+            }
+        } else {
+            d = mid;
+            g = d;
+        }
+        a = e;
+        fa = fe;
+        e += fabs(d) > tol ? d : copysign(tol, mid);
+        hm_margins_d(P, T, e, m, dk);
+        fe = dk[k] - off;
+        if (!isfinite(fe))
+            return NAN;
+    }
+    return NAN;
+}
+
+/* Slot b's branch end in (r0, r1) from the existence margins: its position root
+ * ends where the discriminant of the first angle's subproblem 4, or of the
+ * second's given the slot's first root, falls to 0 (the pair's first root; the
+ * margin hm_margins crosses 0 there) or, for the pair's second root, to
+ * HM_DISC_TWO (sp4_roots merges the two roots below 1e-16 of A^2 + B^2, and
+ * pk_one's rows of that root come and go between there and 0: taking 0 for it
+ * flagged a branch vanishing next to its end on development poses 494 and 830):
+ * hm_margin_root, ~12 margin evaluations and no rows. Confirmed by rows: slot b's
+ * row at the end (into *re, with its slope) and none HM_FOLD_TOL past it. Returns
+ * 0 (*re undefined; hm_fold bisects on rows) when no discriminant brackets the end
+ * or the rows disagree. */
+static int hm_fold_margin(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, HmRow *re,
+                          double *end)
+{
+    double m0[3], m1[3], d0[3], d1[3];
+    int state0 = r0->valid[b];
+    if (!hm_margins_d(c->P, c->T, r0->t, m0, d0) || !hm_margins_d(c->P, c->T, r1->t, m1, d1))
+        return 0;
+    const double *mv = state0 ? m0 : m1, *mu = state0 ? m1 : m0;
+    int k = -1;
+    if (mv[0] >= 0.0 && mu[0] < 0.0)
+        k = 0; /* the first angle's roots end */
+    else if (mv[0] >= 0.0 && mu[0] >= 0.0 && mv[1 + (b >> 2)] >= 0.0 && mu[1 + (b >> 2)] < 0.0)
+        k = 1 + (b >> 2); /* the second's, given the slot's first root */
+    if (k < 0)
+        return 0;
+    /* the pair's second root (slot bit 2 of the first angle, bit 1 of the second)
+     * ends where sp4_roots merges the two: at HM_DISC_TWO; the first at 0 */
+    double off = (k == 0 ? b >= 4 : (b & 2) != 0) ? HM_DISC_TWO : 0.0;
+    double fa = d0[k] - off, fe = d1[k] - off;
+    if (!((fa > 0.0) == (state0 != 0) && (fe > 0.0) != (state0 != 0)))
+        return 0;
+    double t = hm_margin_root(c->P, c->T, k, off, r0->t, fa, r1->t, fe);
+    if (!(t > r0->t && t < r1->t))
+        return 0;
+    double dir = state0 ? 1.0 : -1.0; /* toward the side without the row */
+    hm_eval_pair(c, t, b, 1, re);
+    if (!re->valid[b])
+        return 0;
+    HmRow chk;
+    hm_eval_pair(c, t + dir * HM_FOLD_TOL * fmax(1.0, fabs(t)), b, 0, &chk);
+    if (chk.valid[b])
+        return 0;
+    *end = t;
+    return 1;
+}
+
+/* A fold in (r0, r1): slot b's row exists at one end only. Its end from the
+ * margins (hm_fold_margin), else bisected on the row's existence (extrapolating
+ * 1 / |dq/dt|^2) to HM_FOLD_TOL; the last t with a row is the branch end (a cut and
+ * a point). The partner slot (b ^ 1: the same position root) takes the same end
+ * when its existence agreed at both ends of the cell (and its rows confirm it). */
 static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1)
 {
     double lo = r0->t, hi = r1->t, end = lo;
     int state0 = r0->valid[b], p = b ^ 1;
-    HmRow chk;
+    HmRow chk, re;
     int known = 0;
     for (int f = 0; f < c->nfold[b] && !known; f++) {
         if (c->fold_cell[b][f] != cell)
             continue; /* the partner's end in this cell: checked on both sides */
         double e = c->fold_t[b][f];
         double out = e + copysign(HM_FOLD_TOL * fmax(1.0, fabs(e)), state0 ? 1.0 : -1.0);
-        hm_eval(c, e, 0u, 1u << b, &chk);
-        int ok = chk.valid[b];
-        hm_eval(c, out, 0u, 1u << b, &chk);
+        hm_eval_pair(c, e, b, 1, &re);
+        int ok = re.valid[b];
+        hm_eval_pair(c, out, b, 0, &chk);
         known = ok && !chk.valid[b];
         end = e;
     }
+    int agree = r0->valid[p] == state0 && r1->valid[p] == r1->valid[b];
+    if (!known && hm_fold_margin(c, b, r0, r1, &re, &end)) {
+        known = 1;
+        if (agree && c->nfold[p] < HM_MAXF) {
+            c->fold_cell[p][c->nfold[p]] = cell;
+            c->fold_t[p][c->nfold[p]++] = end;
+        }
+    }
     if (!known) {
-        int agree = r0->valid[p] == state0 && r1->valid[p] == r1->valid[b];
         /* v: the valid side, u: the other; g = 1 / |dq/dt|^2 falls linearly to 0
          * at the fold (q moves as the square root of the distance): extrapolated
          * from the last two valid rows, safeguarded by bisection */
@@ -1022,10 +1174,9 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
             c->fold_cell[p][c->nfold[p]] = cell;
             c->fold_t[p][c->nfold[p]++] = end;
         }
+        hm_eval_pair(c, end, b, 1, &re);
     }
     hm_point(c, end, b, -1, HM_KIND_FOLD);
-    HmRow re;
-    hm_eval(c, end, 1u << b, 1u << b, &re);
     if (!re.valid[b]) {
         c->flags |= HM_FLAG_VANISH;
         return;
@@ -1163,7 +1314,7 @@ static void hm_intervals(HmCtx *c, int b, double lo, double hi, const HmRow *row
  * of the second angle given first root i (NaN without it). A branch is born or
  * dies where one crosses 0. Returns 0 when the position equations are not of the
  * coplanar kind (He and Liu's case; the kernel then flags the pose). */
-static int hm_margins(const double *P, const double *T, double x, double *m)
+static int hm_margins_d(const double *P, const double *T, double x, double *m, double *d)
 {
     PkGeo g;
     pk_geometry(P, x, &g);
@@ -1190,6 +1341,10 @@ static int hm_margins(const double *P, const double *T, double x, double *m)
     double C = n[0] * e.r[0] + n[1] * e.r[1];
     m[0] = (hypot(A, B) - fabs(C)) / L;
     m[1] = m[2] = NAN;
+    if (d != NULL) {
+        d[0] = (A * A + B * B - C * C) / (A * A + B * B);
+        d[1] = d[2] = NAN;
+    }
     if (hypot(A, B) <= 1e-12 * L)
         return 0; /* the first angle free: not this kind */
     Roots rx = pk_sp4(A, B, C, PK_SP4_SLACK * L);
@@ -1201,10 +1356,20 @@ static int hm_margins(const double *P, const double *T, double x, double *m)
         double Xu1 = X[1][0] * rx.c[i] + X[1][1] * rx.s[i];
         double Cy = m0 * (e.r[0] - sx * Xu0) + m1 * (e.r[1] - sx * Xu1);
         m[1 + i] = (hypot(Ay, By) - fabs(Cy)) / L;
+        if (d != NULL)
+            d[1 + i] = (Ay * Ay + By * By - Cy * Cy) / (Ay * Ay + By * By);
     }
-    if (rx.n == 1)
+    if (rx.n == 1) {
         m[2] = m[1];
+        if (d != NULL)
+            d[2] = d[1];
+    }
     return 1;
+}
+
+static int hm_margins(const double *P, const double *T, double x, double *m)
+{
+    return hm_margins_d(P, T, x, m, NULL);
 }
 
 /* The extremum of margin k in (a, e) (golden section; a maximum when want_max):
@@ -1344,6 +1509,8 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
     for (int b = 0; b < 8; b++) {
         c->ncut[b] = 0;
         c->ngraze[b] = 0;
+        if (!(b & 1))
+            c->npair = c->ipair = 0; /* a new pair */
         for (long i = 0; i < G; i++) {
             if (rows[i].valid[b])
                 hm_node(c, b, &rows[i]);
