@@ -96,6 +96,11 @@ typedef struct {
     v3 fc, Gt, u6, w6, b5;
     m3 GA, B5;
     double ft;
+    /* hm_slopes_fast's wrist solve (joints 4-6: a function of t, q5, q6 alone) at
+     * (wt, wq5, wq6): a grid row's two slots of one position root share it */
+    double wt, wq5, wq6, wx[3];
+    v3 wW[3];
+    int wok;
 } HmCtx;
 
 /* Gaussian elimination with partial pivoting of M (6 x 6 | right-hand side) into x;
@@ -213,6 +218,7 @@ static int hm_fast_setup(HmCtx *c)
     c->u6 = v3_scale(v3_cross(h6, v3_sub(pc, o6)), sg);
     c->w6 = v3_scale(h6, sg);
     c->ft = NAN;
+    c->wt = NAN;
     return 1;
 }
 
@@ -256,23 +262,26 @@ static int hm_solve3(v3 a, v3 b, v3 e, v3 r, double tol, double x[3])
  * columns' lengths: next to a fold or an aligned shoulder, where the two differ
  * by more than rounding and hm_slopes' own singular test (a pivot below 1e-14)
  * decides whether the slope is NaN. */
-static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
+/* hm_slopes_fast's wrist part: joints 4-6 against the held joint's column at t
+ * (x, their world axes times their signs W), from q5, q6 (0-based 4, 5); 0 where
+ * its determinant is below HM_SLOPE_DET of its columns' lengths. Kept for the next
+ * call at the same (t, q5, q6), bit for bit the same inputs. */
+static int hm_wrist(HmCtx *c, double t, const double *q)
 {
+    if (t == c->wt && q[4] == c->wq5 && q[5] == c->wq6)
+        return c->wok;
     const double *P = c->P;
     double sg[7], cs[7], sn[7];
     hm_fast_at(c, t);
-    for (int j = 0; j < 6; j++) {
-        if (j == 2 || j == 3)
-            continue;
+    for (int j = 4; j < 6; j++) {
         sg[j] = P[PK_SIGN + j];
         double th = sg[j] * q[j] + P[PK_OFFSET + j];
         cs[j] = cos(th);
         sn[j] = sin(th);
     }
-    sg[2] = P[PK_SIGN + 2];
     sg[3] = P[PK_SIGN + 3];
-    v3 h[7], o[7];
-    for (int j = 0; j < 7; j++) {
+    v3 h[6], o[6];
+    for (int j = 3; j < 6; j++) {
         h[j] = v3_at(P, PK_AXES + 3 * j);
         o[j] = v3_at(P, PK_POINTS + 3 * j);
     }
@@ -285,14 +294,37 @@ static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
     v3 H[3] = {m3_mv(&c->B5, h3), m3_mv(&c->B5, h4), m3_mv(&c->B5, h[5])};
     v3 O[3] = {v3_add(m3_mv(&c->B5, o3), c->b5), v3_add(m3_mv(&c->B5, o4), c->b5),
                v3_add(m3_mv(&c->B5, o[5]), c->b5)};
-    v3 U[3], Wa[3];
+    v3 U[3];
     for (int i = 0; i < 3; i++) {
         U[i] = v3_scale(v3_cross(H[i], v3_sub(c->fc, O[i])), sg[3 + i]);
-        Wa[i] = v3_scale(H[i], sg[3 + i]);
+        c->wW[i] = v3_scale(H[i], sg[3 + i]);
     }
-    double x[3], y[3], tol = HM_SLOPE_DET;
-    if (!hm_solve3(U[0], U[1], U[2], v3_scale(c->u6, -1.0), tol, x))
+    c->wt = t;
+    c->wq5 = q[4];
+    c->wq6 = q[5];
+    c->wok = hm_solve3(U[0], U[1], U[2], v3_scale(c->u6, -1.0), HM_SLOPE_DET, c->wx);
+    return c->wok;
+}
+
+static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
+{
+    const double *P = c->P;
+    double sg[3], cs[2], sn[2];
+    if (!hm_wrist(c, t, q))
         return 0;
+    for (int j = 0; j < 2; j++) {
+        sg[j] = P[PK_SIGN + j];
+        double th = sg[j] * q[j] + P[PK_OFFSET + j];
+        cs[j] = cos(th);
+        sn[j] = sin(th);
+    }
+    sg[2] = P[PK_SIGN + 2];
+    v3 h[3];
+    for (int j = 0; j < 3; j++)
+        h[j] = v3_at(P, PK_AXES + 3 * j);
+    const double *x = c->wx;
+    const v3 *Wa = c->wW;
+    double y[3];
     /* the shoulder: world axes R0 h1, R0 R1 h2 */
     v3 a1 = v3_rot(h[0], cs[0], sn[0], h[1]);
     v3 a2 = v3_rot(h[0], cs[0], sn[0], v3_rot(h[1], cs[1], sn[1], h[2]));
@@ -334,13 +366,73 @@ static double hm_outside(const double *P, const PkGeo *g, const double *th)
         int f = g->full[j];
         double lo = P[PK_LO + f], hi = P[PK_HI + f];
         double q = wrap_pi(P[PK_SIGN + f] * (th[j] - P[PK_OFFSET + f])), gap = INFINITY;
-        for (int m = -1; m <= 1; m++) {
-            double qm = q + 2.0 * M_PI * m;
-            gap = fmin(gap, qm < lo ? lo - qm : qm > hi ? qm - hi : 0.0);
+        for (int m = -1; m <= 1; m++) { /* (fmin, fmax: never NaN here, inline) */
+            double qm = q + 2.0 * M_PI * m, d = qm < lo ? lo - qm : qm > hi ? qm - hi : 0.0;
+            gap = d < gap ? d : gap;
         }
-        worst = fmax(worst, gap);
+        worst = gap > worst ? gap : worst;
     }
     return worst;
+}
+
+/* Whether J's smallest singular value certainly exceeds PK_FAMILY_SIGMA times its
+ * largest (pk_slide's family test, which pk_svd6 decides where pk_regular's
+ * determinant bound cannot): sigma_min >= 1 / |J^-1|_F and sigma_max <= |J|_F, so
+ * |J^-1|_F |J|_F < 1 / (2 PK_FAMILY_SIGMA) proves it (2: room for the computed
+ * inverse's rounding, relative cond(J) eps < 1e-6 wherever the bound can hold).
+ * LU with partial pivoting and six solves (~500 flops) against the Jacobi SVD's
+ * thousands; 0 (the SVD decides) when it cannot prove it. */
+static int hm_regular(const double J[6][6])
+{
+    double A[6][6], fro = 0.0, inv = 0.0;
+    int perm[6];
+    for (int r = 0; r < 6; r++) {
+        perm[r] = r;
+        for (int m = 0; m < 6; m++) {
+            A[r][m] = J[r][m];
+            fro += J[r][m] * J[r][m];
+        }
+    }
+    for (int i = 0; i < 6; i++) {
+        int piv = i;
+        for (int r = i + 1; r < 6; r++)
+            if (fabs(A[r][i]) > fabs(A[piv][i]))
+                piv = r;
+        if (!(fabs(A[piv][i]) > 0.0))
+            return 0;
+        if (piv != i) {
+            for (int m = 0; m < 6; m++) {
+                double w = A[i][m];
+                A[i][m] = A[piv][m];
+                A[piv][m] = w;
+            }
+            int w = perm[i];
+            perm[i] = perm[piv];
+            perm[piv] = w;
+        }
+        for (int r = i + 1; r < 6; r++) {
+            A[r][i] /= A[i][i];
+            for (int m = i + 1; m < 6; m++)
+                A[r][m] -= A[r][i] * A[i][m];
+        }
+    }
+    for (int k = 0; k < 6; k++) { /* column k of J^-1: L U x = P e_k */
+        double x[6];
+        for (int r = 0; r < 6; r++) {
+            double v = perm[r] == k ? 1.0 : 0.0;
+            for (int m = 0; m < r; m++)
+                v -= A[r][m] * x[m];
+            x[r] = v;
+        }
+        for (int r = 5; r >= 0; r--) {
+            double v = x[r];
+            for (int m = r + 1; m < 6; m++)
+                v -= A[r][m] * x[m];
+            x[r] = v / A[r][r];
+            inv += x[r] * x[r];
+        }
+    }
+    return 4.0 * PK_FAMILY_SIGMA * PK_FAMILY_SIGMA * inv * fro < 1.0;
 }
 
 static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
@@ -395,7 +487,7 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
                 v3 p;
                 double J[6][6];
                 pk_fk(g, th, &R, &p, J);
-                if (!pk_regular(J)) { /* pk_slide's own test: a family to slide along */
+                if (!pk_regular(J) && !hm_regular(J)) { /* pk_slide's own test: a family */
                     double sig[6], V[6][6];
                     pk_svd6(J, sig, V);
                     if (sig[0] <= PK_FAMILY_SIGMA * sig[5])
