@@ -63,6 +63,8 @@ enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FL
        HM_FLAG_VANISH = 16, HM_FLAG_MEMORY = 32, HM_FLAG_BAD = 64 };
 
 
+#define HM_MEMO 64 /* recent evaluations kept (hm_recall) */
+
 /* Every slot at one t: coordinates (into the limits where a turn fits), slopes dq/dt
  * (NaN where the six other joints' Jacobian is singular), row exists, singular. */
 typedef struct {
@@ -70,6 +72,14 @@ typedef struct {
     double q[8][PK_MAXJ], dq[8][PK_MAXJ];
     unsigned char valid[8], sing[8];
 } HmRow;
+
+typedef struct { /* one evaluation's rows (hm_keep, hm_recall) */
+    double t;
+    unsigned need;
+    int closed;
+    double q[8][PK_MAXJ];
+    unsigned char valid[8], sing[8];
+} HmMemo;
 
 typedef struct {
     const double *P, *T;
@@ -96,11 +106,8 @@ typedef struct {
     v3 fc, Gt, u6, w6, b5;
     m3 GA, B5;
     double ft;
-    /* hm_slopes_fast's wrist solve (joints 4-6: a function of t, q5, q6 alone) at
-     * (wt, wq5, wq6): a grid row's two slots of one position root share it */
-    double wt, wq5, wq6, wx[3];
-    v3 wW[3];
-    int wok;
+    HmMemo memo[HM_MEMO];
+    long nmemo;
 } HmCtx;
 
 /* Gaussian elimination with partial pivoting of M (6 x 6 | right-hand side) into x;
@@ -218,7 +225,6 @@ static int hm_fast_setup(HmCtx *c)
     c->u6 = v3_scale(v3_cross(h6, v3_sub(pc, o6)), sg);
     c->w6 = v3_scale(h6, sg);
     c->ft = NAN;
-    c->wt = NAN;
     return 1;
 }
 
@@ -262,26 +268,23 @@ static int hm_solve3(v3 a, v3 b, v3 e, v3 r, double tol, double x[3])
  * columns' lengths: next to a fold or an aligned shoulder, where the two differ
  * by more than rounding and hm_slopes' own singular test (a pivot below 1e-14)
  * decides whether the slope is NaN. */
-/* hm_slopes_fast's wrist part: joints 4-6 against the held joint's column at t
- * (x, their world axes times their signs W), from q5, q6 (0-based 4, 5); 0 where
- * its determinant is below HM_SLOPE_DET of its columns' lengths. Kept for the next
- * call at the same (t, q5, q6), bit for bit the same inputs. */
-static int hm_wrist(HmCtx *c, double t, const double *q)
+static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
 {
-    if (t == c->wt && q[4] == c->wq5 && q[5] == c->wq6)
-        return c->wok;
     const double *P = c->P;
     double sg[7], cs[7], sn[7];
     hm_fast_at(c, t);
-    for (int j = 4; j < 6; j++) {
+    for (int j = 0; j < 6; j++) {
+        if (j == 2 || j == 3)
+            continue;
         sg[j] = P[PK_SIGN + j];
         double th = sg[j] * q[j] + P[PK_OFFSET + j];
         cs[j] = cos(th);
         sn[j] = sin(th);
     }
+    sg[2] = P[PK_SIGN + 2];
     sg[3] = P[PK_SIGN + 3];
-    v3 h[6], o[6];
-    for (int j = 3; j < 6; j++) {
+    v3 h[7], o[7];
+    for (int j = 0; j < 7; j++) {
         h[j] = v3_at(P, PK_AXES + 3 * j);
         o[j] = v3_at(P, PK_POINTS + 3 * j);
     }
@@ -294,37 +297,14 @@ static int hm_wrist(HmCtx *c, double t, const double *q)
     v3 H[3] = {m3_mv(&c->B5, h3), m3_mv(&c->B5, h4), m3_mv(&c->B5, h[5])};
     v3 O[3] = {v3_add(m3_mv(&c->B5, o3), c->b5), v3_add(m3_mv(&c->B5, o4), c->b5),
                v3_add(m3_mv(&c->B5, o[5]), c->b5)};
-    v3 U[3];
+    v3 U[3], Wa[3];
     for (int i = 0; i < 3; i++) {
         U[i] = v3_scale(v3_cross(H[i], v3_sub(c->fc, O[i])), sg[3 + i]);
-        c->wW[i] = v3_scale(H[i], sg[3 + i]);
+        Wa[i] = v3_scale(H[i], sg[3 + i]);
     }
-    c->wt = t;
-    c->wq5 = q[4];
-    c->wq6 = q[5];
-    c->wok = hm_solve3(U[0], U[1], U[2], v3_scale(c->u6, -1.0), HM_SLOPE_DET, c->wx);
-    return c->wok;
-}
-
-static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
-{
-    const double *P = c->P;
-    double sg[3], cs[2], sn[2];
-    if (!hm_wrist(c, t, q))
+    double x[3], y[3], tol = HM_SLOPE_DET;
+    if (!hm_solve3(U[0], U[1], U[2], v3_scale(c->u6, -1.0), tol, x))
         return 0;
-    for (int j = 0; j < 2; j++) {
-        sg[j] = P[PK_SIGN + j];
-        double th = sg[j] * q[j] + P[PK_OFFSET + j];
-        cs[j] = cos(th);
-        sn[j] = sin(th);
-    }
-    sg[2] = P[PK_SIGN + 2];
-    v3 h[3];
-    for (int j = 0; j < 3; j++)
-        h[j] = v3_at(P, PK_AXES + 3 * j);
-    const double *x = c->wx;
-    const v3 *Wa = c->wW;
-    double y[3];
     /* the shoulder: world axes R0 h1, R0 R1 h2 */
     v3 a1 = v3_rot(h[0], cs[0], sn[0], h[1]);
     v3 a2 = v3_rot(h[0], cs[0], sn[0], v3_rot(h[1], cs[1], sn[1], h[2]));
@@ -503,9 +483,46 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
 #pragma GCC pop_options
 #endif
 
+/* The rows of a recent evaluation (hm_keep, hm_recall): t, the slots asked for,
+ * whether hm_closed gave them (else pk_one gave every slot) and the rows. */
+static int hm_recall(HmCtx *c, double t, unsigned need, HmRow *r)
+{
+    for (int i = 0; i < HM_MEMO; i++) {
+        const HmMemo *m = &c->memo[i];
+        if (m->t != t || (m->closed ? (need & ~m->need) != 0u : need != m->need))
+            continue;
+        /* hm_closed's rows for the slots in need: those of m (each slot's rows are
+         * computed alone), the others invalid; pk_one's: all of m (hm_closed with the
+         * same need gave way to it again) */
+        for (int b = 0; b < 8; b++) {
+            int own = !m->closed || (need >> b & 1u);
+            r->valid[b] = own ? m->valid[b] : 0;
+            r->sing[b] = own ? m->sing[b] : 0;
+            for (int j = 0; j < PK_MAXJ; j++)
+                r->q[b][j] = own ? m->q[b][j] : NAN;
+        }
+        c->evals += !m->closed; /* counted as the pk_one call it replaces */
+        return 1;
+    }
+    return 0;
+}
+
+static void hm_keep(HmCtx *c, double t, unsigned need, int closed, const HmRow *r)
+{
+    HmMemo *m = &c->memo[c->nmemo++ % HM_MEMO];
+    m->t = t;
+    m->need = need;
+    m->closed = closed;
+    memcpy(m->q, r->q, sizeof m->q);
+    memcpy(m->valid, r->valid, sizeof m->valid);
+    memcpy(m->sing, r->sing, sizeof m->sing);
+}
+
 /* The slots in `need` at t (hm_closed, else pk_one's every slot), shifted into the
  * limits by whole turns where that fits (as the numpy path's _into_limits); slopes
- * for the slots in `mask`. */
+ * for the slots in `mask`. The rows of an evaluation at the same t among the last
+ * HM_MEMO that covers these slots are taken again (hm_recall: the same rows, each a
+ * function of t and its slot; ~7 % of the evaluations, 1 in 5 of them pk_one's). */
 #ifdef HM_STAGES /* a measuring build: evaluations per calling function, to stderr */
 static const char *hm_tag;
 static const char *hm_tags[16];
@@ -528,7 +545,10 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
     const double *P = c->P;
     r->t = t;
     c->cheap++;
-    if (!hm_closed(c, t, need, r)) {
+    if (hm_recall(c, t, need, r))
+        goto slopes;
+    int closed = hm_closed(c, t, need, r);
+    if (!closed) {
         unsigned char inside[8];
         PkOut o = {&r->q[0][0], r->valid, r->sing, inside, PK_MAXJ};
         c->evals++;
@@ -563,7 +583,11 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
                 q -= 2.0 * M_PI;
             r->q[b][j] = q;
         }
-        if (!(mask >> b & 1u))
+    }
+    hm_keep(c, t, need, closed, r);
+slopes:
+    for (int b = 0; b < 8; b++) {
+        if (!r->valid[b] || !(mask >> b & 1u))
             continue;
         if (!(c->fast && !c->full_fk && hm_slopes_fast(c, t, r->q[b], r->dq[b])))
             hm_slopes(P, c->n, c->k, r->q[b], r->dq[b]);
@@ -1511,6 +1535,9 @@ static void hm_range(void *ctx, long b0, long e0)
             c->qv[c->nq] = jb->al[2 * a + 1];
             c->qkind[c->nq++] = HM_KIND_ALIGNED;
         }
+        for (int m = 0; m < HM_MEMO; m++)
+            c->memo[m].t = NAN; /* nothing kept */
+        c->nmemo = 0;
         c->fast = hm_fast_setup(c);
         c->full_fk = 0;
         if (P[PK_CASE] == PK_BOTH || c->k < 0 || c->n != 7)
