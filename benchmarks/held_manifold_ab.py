@@ -156,6 +156,17 @@ def compare(a: dict, b: dict, tol: float) -> str:
             f"{worst['other']:.2e}); different point counts {diff_pts}")
 
 
+def identical(a: dict, b: dict) -> str:
+    """Whether the two trees' outputs are bit for bit the same (every pose)."""
+    same = {k: bool(np.array_equal(a[k], b[k])) for k in ("niv", "npts", "flags", "evals")}
+    same["intervals"] = same["niv"] and all(
+        np.array_equal(a["iv"][i, br, :k], b["iv"][i, br, :k])
+        for (i, br), k in np.ndenumerate(a["niv"]))
+    same["points"] = same["npts"] and all(
+        np.array_equal(a["pts"][i, :k], b["pts"][i, :k]) for i, k in enumerate(a["npts"]))
+    return "bit for bit the same: " + ", ".join(f"{k} {v}" for k, v in same.items())
+
+
 def main() -> None:
     """Print one line per tree and round, then the comparison of the outputs."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -173,7 +184,7 @@ def main() -> None:
         for name, tree in zip("AB", a.trees):
             code = CHILD.format(n=a.n, ns=a.special, repeat=a.repeat,
                                 out=str(tmp / f"{name}.npz"))
-            env = dict(os.environ, PYTHONPATH=tree)
+            env = dict(os.environ, PYTHONPATH=tree)  # the tree's src folder
             res = subprocess.run([sys.executable, "-c", code], env=env, check=True,
                                  capture_output=True, text=True)
             bad = res.stderr.count("mismatch")  # a -DHM_VERIFY build's row differences
@@ -183,6 +194,7 @@ def main() -> None:
     out = [dict(np.load(tmp / f"{name}.npz")) for name in "AB"]
     print(compare(out[0], out[1], a.tol))
     print(compare_pieces(out[0], out[1], a.tol))
+    print(identical(out[0], out[1]))
 
 
 if __name__ == "__main__":

@@ -208,6 +208,8 @@ def test_check_rigid_projects_rotations_near_so3_and_leaves_exact_ones_alone(ur5
     np.testing.assert_allclose(out[1], T, rtol=0, atol=4e-16)
     R = out[1, :3, :3]
     assert np.abs(R.T @ R - np.eye(3)).max() < 1e-15 and np.linalg.det(R) > 0
+    one = check_rigid(bad[1], "goal")  # one pose (4, 4): the unbatched test
+    assert np.array_equal(one, out[1]) and np.array_equal(bad, kept)
 
 
 def test_check_rigid_refuses_what_check_transform_refuses():

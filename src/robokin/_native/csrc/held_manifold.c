@@ -67,6 +67,8 @@ enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FL
        HM_FLAG_VANISH = 16, HM_FLAG_MEMORY = 32, HM_FLAG_BAD = 64 };
 
 
+#define HM_MEMO 64 /* recent evaluations kept (hm_recall) */
+
 /* Every slot at one t: coordinates (into the limits where a turn fits), slopes dq/dt
  * (NaN where the six other joints' Jacobian is singular), row exists, singular. */
 typedef struct {
@@ -74,6 +76,14 @@ typedef struct {
     double q[8][PK_MAXJ], dq[8][PK_MAXJ];
     unsigned char valid[8], sing[8];
 } HmRow;
+
+typedef struct { /* one evaluation's rows (hm_keep, hm_recall) */
+    double t;
+    unsigned need;
+    int closed;
+    double q[8][PK_MAXJ];
+    unsigned char valid[8], sing[8];
+} HmMemo;
 
 typedef struct {
     const double *P, *T;
@@ -104,6 +114,8 @@ typedef struct {
     HmRow pair_row[HM_PAIR_ROWS];
     unsigned pair_need[HM_PAIR_ROWS], pair_mask[HM_PAIR_ROWS];
     int npair, ipair;
+    HmMemo memo[HM_MEMO];
+    long nmemo;
 } HmCtx;
 
 /* Gaussian elimination with partial pivoting of M (6 x 6 | right-hand side) into x;
@@ -342,13 +354,73 @@ static double hm_outside(const double *P, const PkGeo *g, const double *th)
         int f = g->full[j];
         double lo = P[PK_LO + f], hi = P[PK_HI + f];
         double q = wrap_pi(P[PK_SIGN + f] * (th[j] - P[PK_OFFSET + f])), gap = INFINITY;
-        for (int m = -1; m <= 1; m++) {
-            double qm = q + 2.0 * M_PI * m;
-            gap = fmin(gap, qm < lo ? lo - qm : qm > hi ? qm - hi : 0.0);
+        for (int m = -1; m <= 1; m++) { /* (fmin, fmax: never NaN here, inline) */
+            double qm = q + 2.0 * M_PI * m, d = qm < lo ? lo - qm : qm > hi ? qm - hi : 0.0;
+            gap = d < gap ? d : gap;
         }
-        worst = fmax(worst, gap);
+        worst = gap > worst ? gap : worst;
     }
     return worst;
+}
+
+/* Whether J's smallest singular value certainly exceeds PK_FAMILY_SIGMA times its
+ * largest (pk_slide's family test, which pk_svd6 decides where pk_regular's
+ * determinant bound cannot): sigma_min >= 1 / |J^-1|_F and sigma_max <= |J|_F, so
+ * |J^-1|_F |J|_F < 1 / (2 PK_FAMILY_SIGMA) proves it (2: room for the computed
+ * inverse's rounding, relative cond(J) eps < 1e-6 wherever the bound can hold).
+ * LU with partial pivoting and six solves (~500 flops) against the Jacobi SVD's
+ * thousands; 0 (the SVD decides) when it cannot prove it. */
+static int hm_regular(const double J[6][6])
+{
+    double A[6][6], fro = 0.0, inv = 0.0;
+    int perm[6];
+    for (int r = 0; r < 6; r++) {
+        perm[r] = r;
+        for (int m = 0; m < 6; m++) {
+            A[r][m] = J[r][m];
+            fro += J[r][m] * J[r][m];
+        }
+    }
+    for (int i = 0; i < 6; i++) {
+        int piv = i;
+        for (int r = i + 1; r < 6; r++)
+            if (fabs(A[r][i]) > fabs(A[piv][i]))
+                piv = r;
+        if (!(fabs(A[piv][i]) > 0.0))
+            return 0;
+        if (piv != i) {
+            for (int m = 0; m < 6; m++) {
+                double w = A[i][m];
+                A[i][m] = A[piv][m];
+                A[piv][m] = w;
+            }
+            int w = perm[i];
+            perm[i] = perm[piv];
+            perm[piv] = w;
+        }
+        for (int r = i + 1; r < 6; r++) {
+            A[r][i] /= A[i][i];
+            for (int m = i + 1; m < 6; m++)
+                A[r][m] -= A[r][i] * A[i][m];
+        }
+    }
+    for (int k = 0; k < 6; k++) { /* column k of J^-1: L U x = P e_k */
+        double x[6];
+        for (int r = 0; r < 6; r++) {
+            double v = perm[r] == k ? 1.0 : 0.0;
+            for (int m = 0; m < r; m++)
+                v -= A[r][m] * x[m];
+            x[r] = v;
+        }
+        for (int r = 5; r >= 0; r--) {
+            double v = x[r];
+            for (int m = r + 1; m < 6; m++)
+                v -= A[r][m] * x[m];
+            x[r] = v / A[r][r];
+            inv += x[r] * x[r];
+        }
+    }
+    return 4.0 * PK_FAMILY_SIGMA * PK_FAMILY_SIGMA * inv * fro < 1.0;
 }
 
 static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
@@ -403,7 +475,7 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
                 v3 p;
                 double J[6][6];
                 pk_fk(g, th, &R, &p, J);
-                if (!pk_regular(J)) { /* pk_slide's own test: a family to slide along */
+                if (!pk_regular(J) && !hm_regular(J)) { /* pk_slide's own test: a family */
                     double sig[6], V[6][6];
                     pk_svd6(J, sig, V);
                     if (sig[0] <= PK_FAMILY_SIGMA * sig[5])
@@ -419,9 +491,46 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
 #pragma GCC pop_options
 #endif
 
+/* The rows of a recent evaluation (hm_keep, hm_recall): t, the slots asked for,
+ * whether hm_closed gave them (else pk_one gave every slot) and the rows. */
+static int hm_recall(HmCtx *c, double t, unsigned need, HmRow *r)
+{
+    for (int i = 0; i < HM_MEMO; i++) {
+        const HmMemo *m = &c->memo[i];
+        if (m->t != t || (m->closed ? (need & ~m->need) != 0u : need != m->need))
+            continue;
+        /* hm_closed's rows for the slots in need: those of m (each slot's rows are
+         * computed alone), the others invalid; pk_one's: all of m (hm_closed with the
+         * same need gave way to it again) */
+        for (int b = 0; b < 8; b++) {
+            int own = !m->closed || (need >> b & 1u);
+            r->valid[b] = own ? m->valid[b] : 0;
+            r->sing[b] = own ? m->sing[b] : 0;
+            for (int j = 0; j < PK_MAXJ; j++)
+                r->q[b][j] = own ? m->q[b][j] : NAN;
+        }
+        c->evals += !m->closed; /* counted as the pk_one call it replaces */
+        return 1;
+    }
+    return 0;
+}
+
+static void hm_keep(HmCtx *c, double t, unsigned need, int closed, const HmRow *r)
+{
+    HmMemo *m = &c->memo[c->nmemo++ % HM_MEMO];
+    m->t = t;
+    m->need = need;
+    m->closed = closed;
+    memcpy(m->q, r->q, sizeof m->q);
+    memcpy(m->valid, r->valid, sizeof m->valid);
+    memcpy(m->sing, r->sing, sizeof m->sing);
+}
+
 /* The slots in `need` at t (hm_closed, else pk_one's every slot), shifted into the
  * limits by whole turns where that fits (as the numpy path's _into_limits); slopes
- * for the slots in `mask`. */
+ * for the slots in `mask`. The rows of an evaluation at the same t among the last
+ * HM_MEMO that covers these slots are taken again (hm_recall: the same rows, each a
+ * function of t and its slot; ~7 % of the evaluations, 1 in 5 of them pk_one's). */
 #ifdef HM_STAGES /* a measuring build: evaluations per calling function, to stderr */
 static const char *hm_tag;
 static const char *hm_tags[16];
@@ -444,7 +553,10 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
     const double *P = c->P;
     r->t = t;
     c->cheap++;
-    if (!hm_closed(c, t, need, r)) {
+    if (hm_recall(c, t, need, r))
+        goto slopes;
+    int closed = hm_closed(c, t, need, r);
+    if (!closed) {
         unsigned char inside[8];
         PkOut o = {&r->q[0][0], r->valid, r->sing, inside, PK_MAXJ};
         c->evals++;
@@ -479,7 +591,11 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
                 q -= 2.0 * M_PI;
             r->q[b][j] = q;
         }
-        if (!(mask >> b & 1u))
+    }
+    hm_keep(c, t, need, closed, r);
+slopes:
+    for (int b = 0; b < 8; b++) {
+        if (!r->valid[b] || !(mask >> b & 1u))
             continue;
         if (!(c->fast && !c->full_fk && hm_slopes_fast(c, t, r->q[b], r->dq[b])))
             hm_slopes(P, c->n, c->k, r->q[b], r->dq[b]);
@@ -1586,6 +1702,9 @@ static void hm_range(void *ctx, long b0, long e0)
             c->qv[c->nq] = jb->al[2 * a + 1];
             c->qkind[c->nq++] = HM_KIND_ALIGNED;
         }
+        for (int m = 0; m < HM_MEMO; m++)
+            c->memo[m].t = NAN; /* nothing kept */
+        c->nmemo = 0;
         c->fast = hm_fast_setup(c);
         c->full_fk = 0;
         if (P[PK_CASE] == PK_BOTH || c->k < 0 || c->n != 7)

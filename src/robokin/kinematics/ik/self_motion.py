@@ -37,7 +37,7 @@ flagged ``"aligned axes"``.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -61,10 +61,13 @@ from robokin.kinematics.ik.self_motion_families import (
 )
 from robokin.kinematics.ik.self_motion_intervals import (
     GRID,
+    HeldKernel,
     _aligned_values,
     _compiled,
     _exact_points,
     _grid,
+    _held_kernel,
+    _held_records,
     _intervals,
     _state_changes,
     _within,
@@ -116,9 +119,11 @@ class SelfMotion:
             the continued family ``solves`` (general-6R values solved) and
             ``degenerate`` (its rows did not pair: every row singular).
         limits: The arm's joint limits (n, 2).
-        _points: The compiled swivel's points (p, 4) ``[t, branch, joint, kind]``
-            (``SM_KIND_*``), or None when ``_records`` was given.
+        _points: The compiled kernel's points (p, 4) ``[t, branch, joint, kind]``
+            (the swivel's ``SM_KIND_*``, the held joint's ``HM_KIND_*``), or None
+            when ``_records`` was given.
         _records: ``(crossings, singular)``, built from ``_points`` when first read.
+        _held: ``_points`` are the held-joint kernel's (``_held_records`` orders them).
     """
 
     T: np.ndarray
@@ -136,6 +141,7 @@ class SelfMotion:
     _points: np.ndarray | None = field(default=None, repr=False)
     _records: tuple[tuple[LimitCrossing, ...], tuple[SingularPoint, ...]] | None = field(
         default=None, repr=False)
+    _held: bool = field(default=False, repr=False)
 
     @property
     def crossings(self) -> tuple[LimitCrossing, ...]:
@@ -151,7 +157,8 @@ class SelfMotion:
         """The records, made from the kernel's points on first access and kept."""
         if self._records is None:
             assert self._points is not None
-            object.__setattr__(self, "_records", _records_of(self._points))
+            made = (_held_records if self._held else _records_of)(self._points)
+            object.__setattr__(self, "_records", made)
         assert self._records is not None
         return self._records
 
@@ -391,24 +398,28 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
     if Ta.shape != (4, 4):
         raise InputError("T", f"self_motion takes one pose (4, 4), got {Ta.shape}")
     limits = np.asarray(robot.limits, dtype=np.float64)
+    setup = _setup(robot) if robot.n == 7 and not reference else None
     # the compiled swivel (an SRS arm's "auto"): no family choice, no per-call lists
-    swivel = (_setup(robot).swivel if robot.n == 7 and parameter in ("auto", "swivel")
-              and not reference else None)
-    if swivel is not None:
-        sw = _SwivelFamily(swivel, Ta, robot)
+    if setup is not None and setup.swivel is not None and parameter in ("auto", "swivel"):
+        sw = _SwivelFamily(setup.swivel, Ta, robot)
         intervals, owner, points = sw.exact()
         return SelfMotion(Ta, "swivel", None, _SWIVEL_DOMAIN.copy(), True, 8, intervals, owner,
                           "swivel closed form (SRS), compiled", {"bisected": 0, "grid": 0},
                           sw, limits, points)
-    fam = _family(robot, Ta, parameter, dispatch, reference)
+    kern: HeldKernel | None = setup.held if setup is not None else None
+    if kern is not None and parameter in ("auto", kern.named[0]):
+        # the compiled held family "auto" took before: no family choice again
+        fam: _Family = _HeldFamily(robot, kern.params, kern.joint, Ta, dispatch, kern.named)
+    else:
+        fam = _family(robot, Ta, parameter, dispatch, reference)
+        kern = _held_kernel(robot, fam) if isinstance(fam, _HeldFamily) and not reference else None
+        if kern is not None and setup is not None and parameter == "auto":
+            setup.held = kern  # (not on SRS arms: their "auto" is the swivel)
     fallback: dict[str, Any] = {}
-    if isinstance(fam, _HeldFamily) and not reference:
-        intervals, owner, crossings, singular, info = _compiled(robot, fam)
+    if kern is not None:
+        intervals, owner, points, info = _compiled(kern, Ta)
         if not info["flags"]:
-            return SelfMotion(Ta, fam.name, fam.joint, np.array(fam.domain), False, fam.k,
-                              intervals, owner,
-                              f"analytic:pieper ({fam.name} held), compiled", info, fam, limits,
-                              _records=(crossings, singular))
+            return _held_motion(Ta, kern, intervals, owner, info, fam, limits, points)
         fallback = {"compiled": False, "flags": info["flags"]}  # not certified: solved points
     if isinstance(fam, _ContinuedFamily):
         marks = fam.marks(limits, _aligned_values(robot))
@@ -430,6 +441,26 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
                       {"bisected": bisected, "grid": int(grid), **fallback,
                        **_solves(fam)}, fam, limits,
                       _records=(crossings, singular))
+
+
+#: SelfMotion's fields, in order (``_held_motion`` sets every one).
+_FIELDS = tuple(f.name for f in fields(SelfMotion))
+
+
+def _held_motion(T: np.ndarray, kern: HeldKernel, intervals: np.ndarray, owner: np.ndarray,
+                 info: dict[str, Any], fam: _Family, limits: np.ndarray, points: np.ndarray
+                 ) -> SelfMotion:
+    """The compiled held family's SelfMotion: the dataclass' fields set directly.
+
+    Equal to ``SelfMotion(T, name, joint, domain, False, 8, intervals, owner, method,
+    info, fam, limits, points, None, True)`` (the frozen dataclass' ``__init__``
+    costs 4 us of the ~20 us the API adds to the kernel).
+    """
+    sm = object.__new__(SelfMotion)
+    vars(sm).update(zip(_FIELDS, (T, kern.named[0], kern.joint, kern.domain.copy(), False, 8,
+                                  intervals, owner, kern.method, info, fam, limits, points,
+                                  None, True), strict=True))
+    return sm
 
 
 def _solves(fam: _Family) -> dict[str, int]:

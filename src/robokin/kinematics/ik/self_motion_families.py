@@ -124,14 +124,17 @@ class _JointFamily(_Family):
 
 class _HeldFamily(_JointFamily):
     def __init__(self, robot: Arm, params: np.ndarray, j: int, T: np.ndarray,
-                 dispatch: Dispatch) -> None:
+                 dispatch: Dispatch, named: tuple[str, tuple[float, float]] | None = None
+                 ) -> None:
+        """``named``: the joint's name and limits when the caller has them (else read)."""
         self.robot = robot
         self.dispatch = dispatch
         self.params = params
         self.joint = j
-        self.name = robot.joint_names[j]
-        lo, hi = (float(x) for x in robot.limits[j])
-        self.domain = (lo, hi)
+        if named is None:
+            lo, hi = (float(x) for x in robot.limits[j])
+            named = (robot.joint_names[j], (lo, hi))
+        self.name, self.domain = named
         self.T = T
 
     def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -212,12 +215,16 @@ class SelfMotionSetup:
         parameter: ``auto_parameter``'s answer once ``parameter_known``.
         parameter_known: True once ``parameter`` is set.
         aligned: ``_aligned_values``' (joint, value) pairs, or None until needed.
+        held: The compiled held-joint family's per-arm constants
+            (``self_motion_intervals.HeldKernel``) once ``self_motion`` has taken
+            it for ``"auto"``, else None.
     """
 
     swivel: SwivelArm | None
     parameter: str | None = None
     parameter_known: bool = False
     aligned: list[tuple[int, float]] | None = None
+    held: Any = None
 
 
 def _build_setup(arm: Arm) -> SelfMotionSetup:

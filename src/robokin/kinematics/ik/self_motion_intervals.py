@@ -9,6 +9,7 @@ this (``_SwivelFamily.exact``).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -211,38 +212,82 @@ def _join_wrap(pieces: list[tuple[int, float, float]], lo: float, hi: float
 
 
 _KINDS = ("lower", "upper", "aligned axes", "fold")  # HM_KIND_* 0-3
+#: A branch's interval slots in the kernel's output, and the 8 branches.
+_HM_SLOTS = np.arange(K.HM_MAXI)
+_HM_BRANCHES = np.arange(8)
 
 
-def _compiled(robot: Arm, fam: _HeldFamily, grid: int = KERNEL_GRID
-              ) -> tuple[np.ndarray, np.ndarray, tuple[LimitCrossing, ...],
-                         tuple[SingularPoint, ...], dict[str, Any]]:
+@dataclass(frozen=True, slots=True, eq=False)
+class HeldKernel:
+    """The compiled held-joint family of one arm: what ``held_manifold`` takes per call.
+
+    Built once per arm (``SelfMotionSetup.held``) from the family ``self_motion``
+    chose for ``"auto"``, so later calls skip the family choice and the per-call
+    arrays.
+
+    Attributes:
+        params: The Pieper closed form's parameters (contiguous float64).
+        aligned: (A, 2) ``[joint, value]`` where a triple's outer axes line up.
+        joint: The held joint (the parameter).
+        named: Its name and limits (``_HeldFamily``'s ``name``, ``domain``).
+        domain: (2,) its limits (copied into each SelfMotion).
+        method: The SelfMotion's ``method`` text.
+    """
+
+    params: np.ndarray
+    aligned: np.ndarray
+    joint: int
+    named: tuple[str, tuple[float, float]]
+    domain: np.ndarray
+    method: str
+
+
+def _held_kernel(robot: Arm, fam: _HeldFamily) -> HeldKernel:
+    """The :class:`HeldKernel` of a held-joint family of ``robot``."""
+    aligned = np.array([[j, v] for j, v in _aligned_values(robot)],
+                       dtype=np.float64).reshape(-1, 2)
+    return HeldKernel(np.ascontiguousarray(fam.params, dtype=np.float64), aligned, fam.joint,
+                      (fam.name, fam.domain), np.array(fam.domain),
+                      f"analytic:pieper ({fam.name} held), compiled")
+
+
+def _compiled(kern: HeldKernel, T: np.ndarray, grid: int = KERNEL_GRID
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
     """A held-joint (Pieper) family's intervals and points by the compiled kernel.
 
     ``csrc/held_manifold.c``: a grid of the parameter with the rows' slopes dq/dt,
     crossings bracketed and refined by safeguarded Newton on q_j(t) - limit, folds
     bisected, pieces decided at their midpoints. Returns ``(intervals, owner,
-    crossings, singular, info)``; ``info["flags"]`` is nonzero when the kernel
-    could not certify the pose (then the caller takes the solved-points path).
+    points, info)``: the points are the kernel's rows ``[t, branch, joint, kind]``
+    (``HM_KIND_*``; :func:`_held_records` makes the records when they are read);
+    ``info["flags"]`` is nonzero when the kernel could not certify the pose (then
+    the caller takes the solved-points path).
     """
-    aligned = np.array([[j, v] for j, v in _aligned_values(robot)],
-                       dtype=np.float64).reshape(-1, 2)
-    T = np.ascontiguousarray(fam.T, dtype=np.float64)[None]
     iv = np.empty((1, 8, K.HM_MAXI, 2))
     niv = np.zeros((1, 8), dtype=np.int64)
     pts = np.empty((1, K.HM_MAXP, 4))
-    npts, flags, evals = (np.zeros(1, dtype=np.int64) for _ in range(3))
-    K.held_manifold(np.ascontiguousarray(fam.params, dtype=np.float64), T, aligned, int(grid),
-                    iv, niv, pts, npts, flags, evals)
-    intervals = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
-    owner = np.repeat(np.arange(8), niv[0])
-    p = pts[0, :npts[0]]
-    p = p[np.lexsort((p[:, 0], p[:, 1]))]
+    npts, flags, evals = np.zeros((3, 1), dtype=np.int64)
+    K.held_manifold(kern.params, np.ascontiguousarray(T, dtype=np.float64)[None], kern.aligned,
+                    int(grid), iv, niv, pts, npts, flags, evals)
+    counts = niv[0]
+    intervals = iv[0][counts[:, None] > _HM_SLOTS]  # by branch, then start
+    info = {"bisected": 0, "grid": int(grid), "compiled": True, "flags": int(flags[0]),
+            "solves": int(evals[0])}
+    return intervals, _HM_BRANCHES.repeat(counts), pts[0, :npts[0]], info
+
+
+def _held_records(points: np.ndarray) -> tuple[tuple[LimitCrossing, ...],
+                                               tuple[SingularPoint, ...]]:
+    """The records of the held-joint kernel's points (p, 4) ``[t, branch, joint, kind]``.
+
+    Crossings by branch then t; singular points: the folds, then the aligned-axes
+    points (each by branch then t).
+    """
+    p = points[np.lexsort((points[:, 0], points[:, 1]))]
     limit = p[:, 3] <= K.HM_KIND_UPPER
     cross = tuple(LimitCrossing(t, int(b), int(j), _KINDS[int(k)])
                   for t, b, j, k in p[limit].tolist())
     fold = p[:, 3] == K.HM_KIND_FOLD
     sing = tuple(SingularPoint(t, int(b), _KINDS[int(k)])
                  for t, b, _, k in np.concatenate([p[fold], p[~fold & ~limit]]).tolist())
-    info = {"bisected": 0, "grid": int(grid), "compiled": True, "flags": int(flags[0]),
-            "solves": int(evals[0])}
-    return intervals, owner, cross, sing, info
+    return cross, sing
