@@ -13,7 +13,7 @@ are used). The SRS swivel's rows and intervals are compiled (``csrc/self_motion.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,6 +23,9 @@ from robokin.kinematics.arm import Arm, Derived
 from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.ik.swivel import SwivelArm, swivel_arm
+
+if TYPE_CHECKING:  # self_motion_intervals imports this module
+    from robokin.kinematics.ik.self_motion_intervals import HeldKernel
 
 _TWO_PI = 2 * np.pi
 
@@ -224,7 +227,7 @@ class SelfMotionSetup:
     parameter: str | None = None
     parameter_known: bool = False
     aligned: list[tuple[int, float]] | None = None
-    held: Any = None
+    held: HeldKernel | None = None
 
 
 def _build_setup(arm: Arm) -> SelfMotionSetup:
