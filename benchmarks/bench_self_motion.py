@@ -177,6 +177,8 @@ def main(n: int = 200, repeat: int = 3, seed: int = 0, slow: int = 5) -> None:
           f"arms); best of {repeat}; times in us, wall (process CPU)")
     for name, robot, m in arms(slow):
         count = n if m is None else m
+        if count == 0:  # --slow-poses 0: the held-joint arms left out
+            continue
         q = rng.uniform(robot.limits[:, 0], robot.limits[:, 1], (count, 7))
         T = robot.fk(q)
         robot.self_motion(T[0])  # set-up (held-joint solvers, reduced chains)
