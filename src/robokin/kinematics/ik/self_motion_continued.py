@@ -240,10 +240,13 @@ class _ContinuedFamily(_Family):
         """(M,) bool: t inside the nodes, in a cell whose every track is followable.
 
         Every track exists at both nodes or at neither, with finite slopes (a fold
-        or a branch end in the cell, or a singular node row: not followable).
+        or a branch end in the cell, or a singular node row: not followable). On a
+        ``degenerate`` manifold too (issue 29, round 7c): its regular tracks are
+        followed in such cells, certified as anywhere; a near-continuum's rows are
+        singular (no slope), so a cell a track of them reaches is solved.
         """
         tn = self.t_nodes
-        if self.degenerate or len(tn) < 2:
+        if len(tn) < 2:
             return np.zeros(len(t), bool)
         i = np.minimum(np.maximum(np.searchsorted(tn, t, side="right") - 1, 0), len(tn) - 2)
         out: np.ndarray = self._cell_ok[i] & (t >= tn[0]) & (t <= tn[-1])
