@@ -101,6 +101,9 @@ _BISECT = 60
 _CONTRACT = 100.0
 _FLOOR = 1e-9
 _DISTINCT = 1e-6
+#: Smallest singular value of the held 6 x 6 of a degenerate manifold's followed rows
+#: and of its tracks' node rows in a followed cell (the kernel's ``singular`` flag's).
+_REGULAR = 1e-6
 
 
 class _ContinuedFamily(_Family):
@@ -174,6 +177,8 @@ class _ContinuedFamily(_Family):
         # cells where sample_rows may follow the tracks: none starts or ends in them
         ends = self._exists[1:] != self._exists[:-1]
         slope = np.isfinite(self.slopes).all(-1) | ~self._exists  # (m, k)
+        if self.degenerate:  # its near-continuum rows may have slopes: regular rows only
+            slope &= _regular(robot, self.tracks, j) | ~self._exists
         self._cell_ok = ~ends.any(axis=1) & (slope[1:] & slope[:-1]).all(axis=1)
         self.followed = 0
 
@@ -228,6 +233,11 @@ class _ContinuedFamily(_Family):
         out = np.full((M, k, n), np.nan)
         idx = np.flatnonzero(fast)
         q, ok = self._follow(t[idx])
+        if self.degenerate:  # a followed row next to the near-continuum: solved
+            fq = _finite_rows(q)
+            fine = np.ones(q.shape[:2], bool)
+            fine[fq] = _regular(self.robot, q[fq], self.joint)
+            ok &= fine.all(axis=1)
         out[idx[ok]] = q[ok]
         fast[idx[~ok]] = False
         self.followed += int(ok.sum())
@@ -588,6 +598,24 @@ def _slopes(robot: Arm, Q: np.ndarray, k: int) -> np.ndarray:
     out[np.ix_(rows, free)] = x
     out[rows, k] = 1.0
     return out.reshape(Q.shape)
+
+
+def _regular(robot: Arm, Q: np.ndarray, k: int) -> np.ndarray:
+    """(...) bool: rows Q (..., n) whose held 6 x 6 (joint k's column out) is regular.
+
+    Its smallest singular value at least ``_REGULAR`` (NaN rows: False). A degenerate
+    manifold's near-continuum rows (the offset iiwa with axes 3, 5 and 7 on one line:
+    5e-15 to 3e-11) pass ``_slopes``' determinant test and Newton's, but a followed one
+    is another member of the continuum than the kernel's (issue 29, round 7c).
+    """
+    flat = Q.reshape(-1, Q.shape[-1])
+    out = np.zeros(len(flat), bool)
+    ok = np.flatnonzero(_finite_rows(flat))
+    if ok.size:
+        J, _ = jacobian_and_pose(robot.chain, flat[ok])
+        free = [c for c in range(flat.shape[-1]) if c != k]
+        out[ok] = np.linalg.svd(J[:, :, free], compute_uv=False)[:, -1] >= _REGULAR
+    return out.reshape(Q.shape[:-1])
 
 
 def _widen(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
