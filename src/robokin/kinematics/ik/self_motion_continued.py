@@ -31,7 +31,10 @@ module continues them into branches (issue 29):
    it is certified: in a cell with no fold (the branch count is the manifold's),
    each track's prediction Newton-polished on the held 6 x 6, kept when the steps
    contract quadratically and the rows are distinct, each its prediction's mutual
-   nearest; any other value is solved as in ``rows`` (issue 29, round 7).
+   nearest; any other value is solved as in ``rows`` (issue 29, round 7). On a
+   ``degenerate`` manifold only cells whose tracks are regular (the held 6 x 6's
+   smallest singular value at least ``_REGULAR`` at the node rows and the followed
+   rows) are followed: a near-continuum's rows are solved (round 7c).
 4. **Limits on the branch.** Per track, cell and joint, the cubic Hermite model
    sampled at ``_SUB`` sub-values brackets each crossing of a limit (and of an
    aligned-axes value); each is refined by Newton steps on the six other joints
@@ -175,6 +178,7 @@ class _ContinuedFamily(_Family):
         self.fold_q = np.full((m - 1, k, n), np.nan)
         self.folds = self._folds()
         # cells where sample_rows may follow the tracks: none starts or ends in them
+        # (and, on a degenerate manifold, every node row there regular)
         ends = self._exists[1:] != self._exists[:-1]
         slope = np.isfinite(self.slopes).all(-1) | ~self._exists  # (m, k)
         if self.degenerate:  # its near-continuum rows may have slopes: regular rows only
@@ -223,7 +227,9 @@ class _ContinuedFamily(_Family):
         slope (no fold, no track starting or ending: the branch count is the
         manifold's) takes each track's Hermite prediction Newton-polished on the held
         6 x 6 (:meth:`_follow`); a value whose rows do not all certify, and every
-        other value, is solved by ``rows`` (the general 6R solver).
+        other value, is solved by ``rows`` (the general 6R solver). On a
+        ``degenerate`` manifold a followed row must also be regular (:func:`_regular`;
+        the cell's node rows are, by ``_cell_ok``).
         """
         t = np.atleast_1d(np.asarray(t, dtype=np.float64))
         fast = self._followable(t)
