@@ -16,8 +16,13 @@ special, ``--seeds`` x ``--poses`` each; joint 7 the parameter), samples each at
 * rows returned where the reference has none (a branch the kernel missed at t);
 * how many values took the followed path.
 
+``--aligned N`` adds, per seed, N offset-iiwa poses with axes 3, 5 and 7 on one line
+(q4 and q6 each 0 or +-1e-9, some of q1-q3 at 0, +-pi/2 or q1's limit): every one
+is ``degenerate`` (a near-continuum at every value; issue 29, round 7c). To compare
+against main, run this file with main's ``src`` on ``PYTHONPATH`` and ``--save``.
+
 Run: ``python benchmarks/self_motion_follow_ab.py [--seeds 1 2 3 4 29] [--poses 20]
-[--values 64] [--save FILE | --against FILE]``.
+[--values 64] [--aligned N] [--save FILE | --against FILE]``.
 """
 
 from __future__ import annotations
@@ -39,20 +44,35 @@ def wrapped(a: np.ndarray) -> np.ndarray:
     return np.abs((a + np.pi) % (2 * np.pi) - np.pi)
 
 
+def aligned_configurations(robot, rng: np.random.Generator, n: int) -> np.ndarray:
+    """n offset-iiwa configurations with axes 3, 5 and 7 on one line (q4, q6 ~ 0)."""
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    q = rng.uniform(0.95 * lo, 0.95 * hi, (n, robot.n))
+    q[:, 3] = rng.choice([0.0, 1e-9, -1e-9], n)
+    q[:, 5] = rng.choice([0.0, 1e-9, -1e-9], n)
+    pick = rng.random(n) < 0.3
+    q[pick, rng.integers(0, 3, pick.sum())] = rng.choice(
+        [0.0, np.pi / 2, -np.pi / 2, lo[0], hi[0]], pick.sum())
+    return np.clip(q, lo, hi)
+
+
 def main(seeds: list[int], poses: int, values: int, save: str | None,
-         against: str | None) -> None:
+         against: str | None, aligned: int = 0) -> None:
     saved: dict[str, np.ndarray] = {}
     ref = dict(np.load(against)) if against else None
-    print(f"{len(seeds)} seeds x {poses} poses x 2 kinds x 2 arms; {values} values each")
+    print(f"{len(seeds)} seeds x {poses} poses x 2 kinds x 2 arms; {values} values each"
+          + (f"; {aligned} aligned offset-iiwa poses per seed" if aligned else ""))
     for robot in (offset_iiwa14(), random_7r(29)):
         name = robot.joint_names[-1]
-        for special in (False, True):
-            kind = "special" if special else "uniform"
+        kinds = ["uniform", "special"] + (["aligned"] if aligned and robot.name == "offset_iiwa"
+                                          else [])
+        for kind in kinds:
             tally = dict(manifolds=0, values=0, followed=0, rows=0, missing=0,
                          wrong=0, extra=0, returned=0, shifted=0)
             for seed in seeds:
                 rng = np.random.default_rng(seed)
-                q = configurations(robot, rng, poses, special)
+                q = (aligned_configurations(robot, rng, aligned) if kind == "aligned"
+                     else configurations(robot, rng, poses, kind == "special"))
                 T = robot.fk(q)
                 for i, (qi, Ti) in enumerate(zip(q, T, strict=True)):
                     sm = robot.self_motion(Ti, parameter=name)
@@ -97,5 +117,6 @@ if __name__ == "__main__":
     ap.add_argument("--values", type=int, default=64)
     ap.add_argument("--save")
     ap.add_argument("--against")
+    ap.add_argument("--aligned", type=int, default=0)
     a = ap.parse_args()
-    main(a.seeds, a.poses, a.values, a.save, a.against)
+    main(a.seeds, a.poses, a.values, a.save, a.against, a.aligned)

@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 
 from reference import offset_iiwa14, pose_errors, random_7r
+from robokin.kinematics.jacobian import jacobian_and_pose
 
 ARMS = {"offset_iiwa": offset_iiwa14(), "random7r": random_7r(29)}
 SPECIAL = (0.0, np.pi / 2, -np.pi / 2, np.pi, 1e-9, -1e-9)
@@ -461,3 +462,65 @@ def test_a_follow_that_does_not_certify_falls_back(arm, monkeypatch):
     np.testing.assert_array_equal(Q[~trivial], fam.rows(t[~trivial])[0])
     _same_rows(Q, ref, 1e-10)
     assert fam.followed - before <= trivial.sum()
+
+
+def test_a_degenerate_manifolds_regular_tracks_are_followed():
+    # issue 29 round 7c: the offset iiwa stretched with axes 3, 5 and 7 on one line
+    # (q4 = 1e-9, q6 = 0; bench_self_motion_general.py's seed 29 special #3): every
+    # value has near-continuum rows (q4 = +-1e-9, singular), so the manifold is
+    # degenerate, but its regular branches (q4 ~ +-0.05) are tracks with slopes. In a
+    # cell that only such tracks reach, the value is followed; every row of the full
+    # solve (the kernel, ``rows``) is returned in its slot, and a row the full solve
+    # lacks there is an exact solution the kernel missed at that value
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array([2.9670597283903604, -0.027506229732484844, -1e-09, 1e-09,
+                   2.7987099267716573, 0.0, 0.6945184740287291])
+    T, sm = _manifold(robot, q0)
+    fam = sm._family
+    assert sm.info["degenerate"]
+    t = np.linspace(*sm.domain, 64)
+    ref = fam.rows(t)[0]
+    before = fam.followed
+    Q = sm.sample(t)
+    assert fam.followed - before >= len(t) // 2  # 46 of 64
+    fq, fr = np.isfinite(Q).all(-1), np.isfinite(ref).all(-1)
+    assert not (fr & ~fq).any()
+    assert _wrapped(Q[fr] - ref[fr]).max() < 1e-10
+    dp, dr = pose_errors(robot.fk(Q[fq]), T)
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+    # the followed rows are regular (a near-continuum's singular rows are not followed)
+    extra = Q[fq & ~fr]
+    if len(extra):
+        J, _ = jacobian_and_pose(robot.chain, extra)
+        assert np.linalg.svd(J[:, :, :6], compute_uv=False)[:, -1].min() > 1e-6
+    # the values not followed are the full solve's rows bit for bit
+    no = ~fam._followable(t)
+    assert no.any()
+    np.testing.assert_array_equal(sm.sample(t[no]), fam.rows(t[no])[0])
+
+
+def test_a_degenerate_manifolds_continuum_rows_are_not_followed():
+    # the offset iiwa with q3 = -pi/2, q4 = q6 = -1e-9 (seed 2 special #15 of
+    # bench_self_motion_general.py): degenerate, and some near-continuum tracks have
+    # slopes (the held 6 x 6's smallest singular value ~1e-11 passes the determinant
+    # test); followed, Newton put them on other members of the continuum than the
+    # kernel's (2e-6 to 5e-4 rad away). Only regular rows are followed: every row of
+    # the full solve is returned, in its slot, to 1e-10
+    import robokin.kinematics.ik.self_motion_continued as cont
+
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array([2.7407915054457037, -1.8454349202324898, -1.5707963267948966, -1e-09,
+                   -2.9670597283903604, -1e-09, -1.9254308325511655])
+    T, sm = _manifold(robot, q0)
+    fam = sm._family
+    assert sm.info["degenerate"]
+    singular = fam._exists & ~cont._regular(robot, fam.tracks, 6)
+    assert (singular & np.isfinite(fam.slopes).all(-1)).any()  # continuum rows with slopes
+    t = np.linspace(*sm.domain, 64)
+    ref = fam.rows(t)[0]
+    Q = sm.sample(t)
+    fq, fr = np.isfinite(Q).all(-1), np.isfinite(ref).all(-1)
+    assert not (fr & ~fq).any()
+    assert _wrapped(Q[fr] - ref[fr]).max() < 1e-10
+    dp, dr = pose_errors(robot.fk(Q[fq]), T)
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12

@@ -31,7 +31,10 @@ module continues them into branches (issue 29):
    it is certified: in a cell with no fold (the branch count is the manifold's),
    each track's prediction Newton-polished on the held 6 x 6, kept when the steps
    contract quadratically and the rows are distinct, each its prediction's mutual
-   nearest; any other value is solved as in ``rows`` (issue 29, round 7).
+   nearest; any other value is solved as in ``rows`` (issue 29, round 7). On a
+   ``degenerate`` manifold only cells whose tracks are regular (the held 6 x 6's
+   smallest singular value at least ``_REGULAR`` at the node rows and the followed
+   rows) are followed: a near-continuum's rows are solved (round 7c).
 4. **Limits on the branch.** Per track, cell and joint, the cubic Hermite model
    sampled at ``_SUB`` sub-values brackets each crossing of a limit (and of an
    aligned-axes value); each is refined by Newton steps on the six other joints
@@ -101,6 +104,9 @@ _BISECT = 60
 _CONTRACT = 100.0
 _FLOOR = 1e-9
 _DISTINCT = 1e-6
+#: Smallest singular value of the held 6 x 6 of a degenerate manifold's followed rows
+#: and of its tracks' node rows in a followed cell (the kernel's ``singular`` flag's).
+_REGULAR = 1e-6
 
 
 class _ContinuedFamily(_Family):
@@ -172,8 +178,11 @@ class _ContinuedFamily(_Family):
         self.fold_q = np.full((m - 1, k, n), np.nan)
         self.folds = self._folds()
         # cells where sample_rows may follow the tracks: none starts or ends in them
+        # (and, on a degenerate manifold, every node row there regular)
         ends = self._exists[1:] != self._exists[:-1]
         slope = np.isfinite(self.slopes).all(-1) | ~self._exists  # (m, k)
+        if self.degenerate:  # its near-continuum rows may have slopes: regular rows only
+            slope &= _regular(robot, self.tracks, j) | ~self._exists
         self._cell_ok = ~ends.any(axis=1) & (slope[1:] & slope[:-1]).all(axis=1)
         self.followed = 0
 
@@ -218,7 +227,9 @@ class _ContinuedFamily(_Family):
         slope (no fold, no track starting or ending: the branch count is the
         manifold's) takes each track's Hermite prediction Newton-polished on the held
         6 x 6 (:meth:`_follow`); a value whose rows do not all certify, and every
-        other value, is solved by ``rows`` (the general 6R solver).
+        other value, is solved by ``rows`` (the general 6R solver). On a
+        ``degenerate`` manifold a followed row must also be regular (:func:`_regular`;
+        the cell's node rows are, by ``_cell_ok``).
         """
         t = np.atleast_1d(np.asarray(t, dtype=np.float64))
         fast = self._followable(t)
@@ -228,6 +239,11 @@ class _ContinuedFamily(_Family):
         out = np.full((M, k, n), np.nan)
         idx = np.flatnonzero(fast)
         q, ok = self._follow(t[idx])
+        if self.degenerate:  # a followed row next to the near-continuum: solved
+            fq = _finite_rows(q)
+            fine = np.ones(q.shape[:2], bool)
+            fine[fq] = _regular(self.robot, q[fq], self.joint)
+            ok &= fine.all(axis=1)
         out[idx[ok]] = q[ok]
         fast[idx[~ok]] = False
         self.followed += int(ok.sum())
@@ -240,10 +256,13 @@ class _ContinuedFamily(_Family):
         """(M,) bool: t inside the nodes, in a cell whose every track is followable.
 
         Every track exists at both nodes or at neither, with finite slopes (a fold
-        or a branch end in the cell, or a singular node row: not followable).
+        or a branch end in the cell, or a singular node row: not followable). On a
+        ``degenerate`` manifold too (issue 29, round 7c): its regular tracks are
+        followed in such cells, certified as anywhere; a near-continuum's rows are
+        singular (no slope), so a cell a track of them reaches is solved.
         """
         tn = self.t_nodes
-        if self.degenerate or len(tn) < 2:
+        if len(tn) < 2:
             return np.zeros(len(t), bool)
         i = np.minimum(np.maximum(np.searchsorted(tn, t, side="right") - 1, 0), len(tn) - 2)
         out: np.ndarray = self._cell_ok[i] & (t >= tn[0]) & (t <= tn[-1])
@@ -585,6 +604,24 @@ def _slopes(robot: Arm, Q: np.ndarray, k: int) -> np.ndarray:
     out[np.ix_(rows, free)] = x
     out[rows, k] = 1.0
     return out.reshape(Q.shape)
+
+
+def _regular(robot: Arm, Q: np.ndarray, k: int) -> np.ndarray:
+    """(...) bool: rows Q (..., n) whose held 6 x 6 (joint k's column out) is regular.
+
+    Its smallest singular value at least ``_REGULAR`` (NaN rows: False). A degenerate
+    manifold's near-continuum rows (the offset iiwa with axes 3, 5 and 7 on one line:
+    5e-15 to 3e-11) pass ``_slopes``' determinant test and Newton's, but a followed one
+    is another member of the continuum than the kernel's (issue 29, round 7c).
+    """
+    flat = Q.reshape(-1, Q.shape[-1])
+    out = np.zeros(len(flat), bool)
+    ok = np.flatnonzero(_finite_rows(flat))
+    if ok.size:
+        J, _ = jacobian_and_pose(robot.chain, flat[ok])
+        free = [c for c in range(flat.shape[-1]) if c != k]
+        out[ok] = np.linalg.svd(J[:, :, free], compute_uv=False)[:, -1] >= _REGULAR
+    return out.reshape(Q.shape[:-1])
 
 
 def _widen(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
