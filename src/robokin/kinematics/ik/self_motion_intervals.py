@@ -186,10 +186,39 @@ def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
             pieces[-1] = (b, pieces[-1][1], e)
         else:
             pieces.append((b, a, e))
+    pieces = sorted(pieces + _touches(fam, limits, cuts, pieces))
     if fam.periodic:
         pieces = _join_wrap(pieces, lo_d, hi_d)
     arr = np.array([[a, e] for _, a, e in pieces]).reshape(-1, 2)
     return arr, np.array([b for b, _, _ in pieces], dtype=int)
+
+
+def _touches(fam: _Family, limits: np.ndarray, cuts: dict[int, list[float]],
+             pieces: list[tuple[int, float, float]]) -> list[tuple[int, float, float]]:
+    """The one-point intervals (b, t, t): cuts t of branch b in no piece whose row is inside.
+
+    The rule of the compiled held kernel (``hm_intervals``): a cut whose pieces on
+    both sides are outside is an interval of its own when its row is inside
+    (``MANIFOLD_SLACK``): a corner (two joints at limits at t, the branch leaving
+    through one on either side) or a graze from outside. A periodic domain's ends
+    are one point; each is covered by a piece at either end.
+    """
+    lo_d, hi_d = fam.domain
+    ends = [(lo_d, hi_d)] if fam.periodic else []
+    ts, bs = [], []
+    for b in range(fam.k):
+        own = [(a, e) for p, a, e in pieces if p == b]
+        for t in np.unique(np.clip(cuts[b], lo_d, hi_d)).tolist():
+            at = [t] + [x for pair in ends for x in pair if t in pair]
+            if not any(a <= x <= e for a, e in own for x in at):
+                ts.append(t)
+                bs.append(b)
+    if not ts:
+        return []
+    q, valid, _ = fam.rows(np.array(ts))
+    idx, br = np.arange(len(ts)), np.array(bs)
+    ok = valid[idx, br] & _within(q[idx, br], limits)
+    return [(b, t, t) for t, b, good in zip(ts, bs, ok.tolist(), strict=True) if good]
 
 
 def _join_wrap(pieces: list[tuple[int, float, float]], lo: float, hi: float
