@@ -186,7 +186,10 @@ def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
             pieces[-1] = (b, pieces[-1][1], e)
         else:
             pieces.append((b, a, e))
-    pieces = sorted(pieces + _touches(fam, limits, cuts, pieces))
+    limit_cuts: dict[int, list[float]] = {b: [lo_d, hi_d] for b in range(fam.k)}
+    for t, b, *_ in marks["limit"]:
+        limit_cuts[b].append(t)
+    pieces = sorted(pieces + _touches(fam, limits, limit_cuts, pieces))
     if fam.periodic:
         pieces = _join_wrap(pieces, lo_d, hi_d)
     arr = np.array([[a, e] for _, a, e in pieces]).reshape(-1, 2)
@@ -200,8 +203,11 @@ def _touches(fam: _Family, limits: np.ndarray, cuts: dict[int, list[float]],
     The rule of the compiled held kernel (``hm_intervals``): a cut whose pieces on
     both sides are outside is an interval of its own when its row is inside
     (``MANIFOLD_SLACK``): a corner (two joints at limits at t, the branch leaving
-    through one on either side) or a graze from outside. A periodic domain's ends
-    are one point; each is covered by a piece at either end.
+    through one on either side) or a graze from outside. ``cuts`` are the limit
+    crossings and the range's ends only (a corner has a joint at a limit): a fold
+    end inside the limits next to a piece decided outside is a missed crossing,
+    not a point (``docs/ik.md``, "Corners"). A periodic domain's ends are one
+    point; each is covered by a piece at either end.
     """
     lo_d, hi_d = fam.domain
     ends = [(lo_d, hi_d)] if fam.periodic else []
