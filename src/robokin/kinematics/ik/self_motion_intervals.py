@@ -34,6 +34,8 @@ GRID = 721
 #: Bisection steps (a 2 pi domain to 2**-52 of its width).
 _BISECT = 56
 _TWO_PI = 2 * np.pi
+#: Crossings of joints within this of a cut [in t] are the same corner (``_touches``).
+_CORNER = 1e-9
 #: Parameter values on the compiled held-joint kernel's first grid (``held_manifold``).
 KERNEL_GRID = 181
 #: At most this many grid changes without an exact point are bisected (a pose on a
@@ -179,6 +181,10 @@ def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
     q, valid, _ = fam.rows(np.array(mids))
     idx = np.arange(len(mids))
     ok = valid[idx, owners] & _within(q[idx, owners], limits)
+    with np.errstate(invalid="ignore"):
+        out = ((q[idx, owners] < limits[:, 0] - MANIFOLD_SLACK)
+               | (q[idx, owners] > limits[:, 1] + MANIFOLD_SLACK))  # (pieces, n)
+    out[~valid[idx, owners]] = True  # no row: no corner next to it
     for (a, e), b, good in zip(spans, owners, ok, strict=True):
         if not good:
             continue
@@ -186,37 +192,45 @@ def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
             pieces[-1] = (b, pieces[-1][1], e)
         else:
             pieces.append((b, a, e))
-    limit_cuts: dict[int, list[float]] = {b: [lo_d, hi_d] for b in range(fam.k)}
-    for t, b, *_ in marks["limit"]:
-        limit_cuts[b].append(t)
-    pieces = sorted(pieces + _touches(fam, limits, limit_cuts, pieces))
+    pieces = sorted(pieces + _touches(fam, limits, marks["limit"], spans, owners, out))
     if fam.periodic:
         pieces = _join_wrap(pieces, lo_d, hi_d)
     arr = np.array([[a, e] for _, a, e in pieces]).reshape(-1, 2)
     return arr, np.array([b for b, _, _ in pieces], dtype=int)
 
 
-def _touches(fam: _Family, limits: np.ndarray, cuts: dict[int, list[float]],
-             pieces: list[tuple[int, float, float]]) -> list[tuple[int, float, float]]:
-    """The one-point intervals (b, t, t): cuts t of branch b in no piece whose row is inside.
+def _touches(fam: _Family, limits: np.ndarray, crossings: list[Any],
+             spans: list[tuple[float, float]], owners: list[int], out: np.ndarray
+             ) -> list[tuple[int, float, float]]:
+    """The one-point intervals (b, t, t) of corners: the rule of ``hm_intervals``.
 
-    The rule of the compiled held kernel (``hm_intervals``): a cut whose pieces on
-    both sides are outside is an interval of its own when its row is inside
-    (``MANIFOLD_SLACK``): a corner (two joints at limits at t, the branch leaving
-    through one on either side) or a graze from outside. ``cuts`` are the limit
-    crossings and the range's ends only (a corner has a joint at a limit): a fold
-    end inside the limits next to a piece decided outside is a missed crossing,
-    not a point (``docs/ik.md``, "Corners"). A periodic domain's ends are one
-    point; each is covered by a piece at either end.
+    A cut t of branch b (a limit crossing, or an end of the range) whose pieces on
+    both sides are outside is an interval of its own when b's row at t is inside
+    (``MANIFOLD_SLACK``): two joints at limits at t, the branch leaving through one
+    on either side. A crossing is solved only where every joint out at either
+    piece's midpoint (``out``, (pieces, n)) crosses a limit within ``_CORNER`` of t
+    on b (between cuts a joint keeps its side): a piece out by a joint without a
+    crossing there is no corner (on uniform poses such rows can be inside where a
+    crossing next to a fold was missed: ``docs/ik.md``, "Corners"). The range's
+    ends are always solved (a crossing there, with the parameter at its own limit,
+    is not always recorded).
     """
     lo_d, hi_d = fam.domain
-    ends = [(lo_d, hi_d)] if fam.periodic else []
+    at: dict[int, list[tuple[float, int]]] = {}
+    for t, b, j, *_ in crossings:
+        at.setdefault(b, []).append((t, j))
+    left = {(b, e): i for i, ((_, e), b) in enumerate(zip(spans, owners, strict=True))}
+    right = {(b, a): i for i, ((a, _), b) in enumerate(zip(spans, owners, strict=True))}
     ts, bs = [], []
     for b in range(fam.k):
-        own = [(a, e) for p, a, e in pieces if p == b]
-        for t in np.unique(np.clip(cuts[b], lo_d, hi_d)).tolist():
-            at = [t] + [x for pair in ends for x in pair if t in pair]
-            if not any(a <= x <= e for a, e in own for x in at):
+        cuts = at.get(b, [])
+        for t in {float(np.clip(t, lo_d, hi_d)) for t, _ in cuts} | {lo_d, hi_d}:
+            sides = [s[(b, t)] for s in (left, right) if (b, t) in s]
+            if not sides or any(not out[i].any() for i in sides):
+                continue  # in a piece inside (or no piece): covered
+            need = np.flatnonzero(out[sides].any(0))
+            near = {j for tc, j in cuts if abs(tc - t) <= _CORNER}
+            if t in (lo_d, hi_d) or set(need.tolist()) <= near:
                 ts.append(t)
                 bs.append(b)
     if not ts:
