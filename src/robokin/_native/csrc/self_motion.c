@@ -711,6 +711,9 @@ typedef struct {
     long long *niv, *npts;
 } SmManJob;
 
+/* Candidates within this of each other [rad] may be one corner (sm_runs) */
+#define SM_CORNER 1e-9
+
 /* Whether the triple of joints j0..j0+2 of a row (ok: it exists) is inside */
 static int sm_triple_inside(const SmArm *a, int j0, int ok, const double *q)
 {
@@ -751,9 +754,11 @@ static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmC
         for (int r = 0; r < 2; r++) {
             int b = part == 1 ? 2 * r : r; /* the other triple's root 0: NaN there */
             int in = sm_triple_inside(a, j0, ok[b], q[b]);
-            if (!in && !open[r] && lo > -M_PI && nrun[r] < SM_MAXI) {
-                /* both cells next to the cut outside: the cut alone, if its row is in
-                 * (two joints of the triple at limits there, leaving on either side) */
+            if (!in && !open[r] && lo > -M_PI && nrun[r] < SM_MAXI &&
+                (lo - cut[i - 1] <= SM_CORNER || hi - lo <= SM_CORNER)) {
+                /* both cells next to the cut outside and another cut within SM_CORNER
+                 * (two joints of the triple at limits there, leaving on either side):
+                 * the cut alone, if its row is in */
                 if (!at)
                     sm_configs_part(a, f, e, lo, part, qc, okc, sg);
                 at = 1;
@@ -779,8 +784,9 @@ static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmC
     double qc[4][7];
     for (int r = 0; r < 2; r++) {
         int b = part == 1 ? 2 * r : r, n = nrun[r];
-        if ((n && (run[r][0][0] == -M_PI || run[r][n - 1][1] == M_PI)) || n + 2 > SM_MAXI)
-            continue;
+        if ((n && (run[r][0][0] == -M_PI || run[r][n - 1][1] == M_PI)) || n + 2 > SM_MAXI ||
+            !(cut[1] + M_PI <= SM_CORNER || M_PI - cut[m - 2] <= SM_CORNER))
+            continue; /* a run at an end, or no candidate at +-pi */
         if (!at)
             sm_configs_part(a, f, e, -M_PI, part, qc, okc, sg);
         at = 1;

@@ -34,6 +34,9 @@ GRID = 721
 #: Bisection steps (a 2 pi domain to 2**-52 of its width).
 _BISECT = 56
 _TWO_PI = 2 * np.pi
+#: A range end's row is solved for a corner only where the continued family's track
+#: there is within this of every limit [rad] (its nodes are solved rows).
+_NEAR = 1e-6
 #: Crossings of joints within this of a cut [in t] are the same corner (``_touches``).
 _CORNER = 1e-9
 #: Parameter values on the compiled held-joint kernel's first grid (``held_manifold``).
@@ -212,8 +215,9 @@ def _touches(fam: _Family, limits: np.ndarray, crossings: list[Any],
     on b (between cuts a joint keeps its side): a piece out by a joint without a
     crossing there is no corner (on uniform poses such rows can be inside where a
     crossing next to a fold was missed: ``docs/ik.md``, "Corners"). The range's
-    ends are always solved (a crossing there, with the parameter at its own limit,
-    is not always recorded).
+    ends are solved (a crossing there, with the parameter at its own limit, is not
+    always recorded) unless the continued family's track there has a joint out by
+    more than ``_NEAR`` or does not reach it.
     """
     lo_d, hi_d = fam.domain
     at: dict[int, list[tuple[float, int]]] = {}
@@ -221,6 +225,14 @@ def _touches(fam: _Family, limits: np.ndarray, crossings: list[Any],
         at.setdefault(b, []).append((t, j))
     left = {(b, e): i for i, ((_, e), b) in enumerate(zip(spans, owners, strict=True))}
     right = {(b, a): i for i, ((a, _), b) in enumerate(zip(spans, owners, strict=True))}
+    ends = {lo_d: 0, hi_d: 1}
+    predict = getattr(fam, "predict", None)  # the continued family's tracks: no solve
+    far = np.zeros((2, fam.k), dtype=bool)
+    if predict is not None:
+        p = predict(np.array([lo_d, hi_d]))[..., None] + np.array([-_TWO_PI, 0.0, _TWO_PI])
+        with np.errstate(invalid="ignore"):
+            close = ((p >= limits[:, :1] - _NEAR) & (p <= limits[:, 1:] + _NEAR)).any(-1)
+        far = ~close.all(-1)  # (2, k): a joint out by > _NEAR, or no track there
     ts, bs = [], []
     for b in range(fam.k):
         cuts = at.get(b, [])
@@ -230,13 +242,14 @@ def _touches(fam: _Family, limits: np.ndarray, crossings: list[Any],
                 continue  # in a piece inside (or no piece): covered
             need = np.flatnonzero(out[sides].any(0))
             near = {j for tc, j in cuts if abs(tc - t) <= _CORNER}
-            if t in (lo_d, hi_d) or set(need.tolist()) <= near:
+            if (not far[ends[t], b]) if t in ends else set(need.tolist()) <= near:
                 ts.append(t)
                 bs.append(b)
     if not ts:
         return []
-    q, valid, _ = fam.rows(np.array(ts))
-    idx, br = np.arange(len(ts)), np.array(bs)
+    values, idx = np.unique(ts, return_inverse=True)  # the range's ends: once
+    q, valid, _ = fam.rows(values)
+    br = np.array(bs)
     ok = valid[idx, br] & _within(q[idx, br], limits)
     return [(b, t, t) for t, b, good in zip(ts, bs, ok.tolist(), strict=True) if good]
 
