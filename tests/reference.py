@@ -159,3 +159,36 @@ def kernel_copies() -> dict:
     if _native._base.cpu_has_avx512():
         out["avx512"] = importlib.import_module("robokin._native._avx512")
     return out
+
+
+def assert_corner_listed(robot, sm, q0, t, slack=1e-12):
+    """q0 is a corner of its branch at parameter t, listed (issue 29's one-point rule).
+
+    Oracles: the branch b holding q0 at t (1e-6 rad, 2 pi wrapped) is outside the
+    limits (``slack``) at t +- 1e-6, so q0 is a point alone; an interval of b at most
+    1e-9 long holds t (1e-9; the swivel modulo 2 pi); b's row at that interval's start
+    is inside every limit (``slack``) and reproduces FK(q0) to 1e-12.
+    """
+    T = robot.fk(q0)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+
+    def gap(r):
+        return np.abs((r - q0 + np.pi) % (2 * np.pi) - np.pi).max(axis=-1)
+
+    def inside(r):
+        return bool(np.all((r >= lo - slack) & (r <= hi + slack)))
+
+    rows = sm.sample(t)
+    b = int(np.nanargmin(gap(rows)))
+    assert gap(rows[b]) < 1e-6, (t, rows)
+    for d in (-1e-6, 1e-6):
+        assert not inside(sm.sample(t + d)[b]), d  # not an interval with length
+    iv = sm.intervals[sm.interval_branch == b]
+    shifts = (-2 * np.pi, 0.0, 2 * np.pi) if sm.periodic else (0.0,)
+    hit = np.concatenate([iv[(iv[:, 0] - 1e-9 <= t + s) & (t + s <= iv[:, 1] + 1e-9)]
+                          for s in shifts])
+    assert len(hit) == 1 and hit[0, 1] - hit[0, 0] <= 1e-9, (t, iv)
+    row = sm.sample(hit[0, 0])[b]
+    assert inside(row), row
+    dp, dr = pose_errors(robot.fk(row), T)
+    assert dp <= 1e-12 and dr <= 1e-12, (dp, dr)

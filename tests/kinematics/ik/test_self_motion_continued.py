@@ -524,3 +524,26 @@ def test_a_degenerate_manifolds_continuum_rows_are_not_followed():
     assert _wrapped(Q[fr] - ref[fr]).max() < 1e-10
     dp, dr = pose_errors(robot.fk(Q[fq]), T)
     assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+
+
+@pytest.mark.parametrize("arm, q", [
+    # joints 2 and 3 at opposite limits, the branch leaving through each on either side
+    ("random7r", [0.07015093314455312, 2.9670597283903604, -2.9670597283903604,
+                  2.662339413531032, -1.116614641778755, -0.4549900109723084,
+                  1.9446263380273932]),
+    # joint 1 at its lower limit with the parameter (joint 7) at its own: the range's end
+    ("offset_iiwa", [-2.9670597283903604, 1.2898993637024105, 0.09094370996625534,
+                     -0.8972330809655555, -2.6470284980695227, -0.48854328973889505,
+                     -3.0543261909900767]),
+])
+def test_a_corner_is_a_one_point_interval(arm, q):
+    # Issue 29 (helper corner29): generated with two joints at limits, q is the only
+    # in-limit point of its branch (outside at t +- 1e-6); the one-point rule of
+    # self_motion_intervals._touches lists it (before: no interval held q7 = t).
+    # Oracles: reference.assert_corner_listed (the branch's rows, FK).
+    from reference import assert_corner_listed
+
+    robot = ARMS[arm]
+    q0 = np.array(q)
+    _, sm = _manifold(robot, q0)
+    assert_corner_listed(robot, sm, q0, float(q0[6]))

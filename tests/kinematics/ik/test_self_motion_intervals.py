@@ -381,3 +381,55 @@ def test_branch_ends_are_the_last_rows_of_their_branch(special):
             assert sm._family.rows(np.array([p.t]))[1][0, p.branch]  # a row at the end
             checked += 1
     assert checked >= 8
+
+
+@pytest.mark.parametrize("q", [
+    # joints 1 and 2 at limits (the compiled kernel: a piece between two cuts)
+    [2.8973, -1.7628, -2.3708448663282278, -1.0889787975814598, 2.5001604526842525,
+     0.7636107036653748, 0.7538206716761482],
+    # joint 6 at its lower limit, the parameter q7 at its upper one (the range's end)
+    [1.2873561972603143, -0.9916968991402226, 1.9115624816699301, -1.0975280629585238,
+     1.0592465514875857, -0.0175, 2.8973],
+])
+@pytest.mark.parametrize("compiled", [True, False])
+def test_a_corner_is_a_one_point_interval(q, compiled):
+    # Issue 29 (helper corner29): q, generated with two joints at limits, is the only
+    # in-limit point of its branch; the compiled kernel (hm_intervals' [t, t] rule) and
+    # the solved-points path (reference=True; self_motion_intervals._touches, the same
+    # rule) both list it. Oracles: reference.assert_corner_listed (rows, FK).
+    from reference import assert_corner_listed
+    from robokin.kinematics.ik.dispatch import solve
+    from robokin.kinematics.ik.self_motion import self_motion
+
+    q0 = np.array(q)
+    T = PANDA.fk(q0)
+    sm = (PANDA.self_motion(T) if compiled
+          else self_motion(PANDA.arm, T, dispatch=solve, reference=True))
+    assert sm.info.get("compiled", False) == compiled
+    assert_corner_listed(PANDA, sm, q0, float(q0[6]))
+
+
+@pytest.mark.parametrize("q", [
+    # joints a5 and a7 at limits, the parameter joint_a3 inside its range
+    [1.1476308972910596, 2.005887882505186, -1.5707963267948966, 1.5707963267948966,
+     -2.9668, -1.6113974673108036, 3.0541],
+    # joint_a7 at its lower limit, the parameter joint_a3 at its own: the range's end
+    [1e-07, 0.09174702065233475, -2.9668, 1.5707963267948966, -1e-09,
+     1.5707963267948966, -3.0541],
+])
+def test_a_corner_of_the_solved_points_path_is_a_one_point_interval(q):
+    # Issue 29 (helper corner29): the rtb-data iiwa14 held at joint_a3 (the compiled
+    # kernel does not certify these poses: the solved-points path answers). From
+    # benchmarks/self_motion_rates.py (seed 0), missed before the one-point rule.
+    # Oracles: reference.assert_corner_listed (rows, FK).
+    rtbdata = pytest.importorskip("rtbdata")
+    from pathlib import Path
+
+    from reference import assert_corner_listed
+
+    urdf = (Path(rtbdata.__file__).parent
+            / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf")
+    robot = robokin.Robot.from_urdf(str(urdf), geometry=False)
+    q0 = np.array(q)
+    sm = robot.self_motion(robot.fk(q0), "joint_a3")
+    assert_corner_listed(robot, sm, q0, float(q0[2]))

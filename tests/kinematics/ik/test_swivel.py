@@ -285,3 +285,27 @@ def test_a_piece_after_a_near_tangent_dip_is_found():
     hit = [(iv[:, 0] - 1e-9 <= psi + s) & (psi + s <= iv[:, 1] + 1e-9)
            for s in (-2 * np.pi, 0.0, 2 * np.pi)]
     assert np.any(hit), (psi, iv)
+
+
+@pytest.mark.parametrize("q", [
+    # q1 and q2 at limits (the shoulder triple; generated, seed 7)
+    [2.9670597283903604, 2.0943951023931953, 0.41372175182190896, -1.4850938728907432,
+     -1.824958358178761, 1.792407140830277, 0.31964432352928585],
+    # q1 and q3 at limits (the shoulder triple)
+    [2.9670597283903604, 1.271351021145398, 2.9670597283903604, 0.9301096931616915,
+     2.1794441551508843, 1.6459757205023502, -2.0677035302661326],
+    # q5 and q6 at limits (the wrist triple)
+    [-1.3558001989880597, 1.8934985908522979, -0.3294729364083655, 2.012272826919411,
+     2.9670597283903604, 2.0943951023931953, 2.422328214749406],
+])
+def test_a_corner_within_a_triple_is_a_one_point_interval(q):
+    # Issue 29 (helper corner29): two joints of one triple at limits, leaving on either
+    # side: the triple has no run with length there, so no overlap held q's swivel
+    # (sm_touches takes the ends of runs only). sm_runs lists the cut as a one-point
+    # run. Oracles: reference.assert_corner_listed (the branch's rows, FK).
+    from reference import assert_corner_listed
+
+    q0 = np.array(q)
+    T = SRS.fk(q0)
+    psi = float(ARM.swivel_of(ARM.frame(T), q0))
+    assert_corner_listed(SRS, SRS.self_motion(T), q0, psi)

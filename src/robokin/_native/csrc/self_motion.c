@@ -711,12 +711,26 @@ typedef struct {
     long long *niv, *npts;
 } SmManJob;
 
+/* Candidates within this of each other [rad] may be one corner (sm_runs) */
+#define SM_CORNER 1e-9
+
+/* Whether the triple of joints j0..j0+2 of a row (ok: it exists) is inside */
+static int sm_triple_inside(const SmArm *a, int j0, int ok, const double *q)
+{
+    for (int j = j0; j < j0 + 3 && ok; j++)
+        ok = sm_inside_joint(a, j, q[j]);
+    return ok;
+}
+
 /* The runs of swivel angles where one triple (part 1 the shoulder, 2 the wrist) of
  * elbow root e exists with its three joints inside their limits, per root r of its
  * middle angle: the cuts are the candidates of that triple's joints only (the other
  * triple's do not change its state), each cell decided at its midpoint, adjacent
- * in-cells merged. A branch (shoulder s, wrist w) is inside every limit where the
- * runs of s and of w overlap (the elbow is constant over the swivel). */
+ * in-cells merged; a cut whose cells on both sides are outside is a run of its own
+ * ([psi, psi]) when the triple's row there is inside (the one-point rule of every
+ * path: two joints of the triple at limits at psi, leaving on either side). A branch
+ * (shoulder s, wrist w) is inside every limit where the runs of s and of w overlap,
+ * a point included (the elbow is constant over the swivel). */
 static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmCand *c, int nc,
                     double run[2][SM_MAXI][2], int nrun[2])
 {
@@ -734,14 +748,25 @@ static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmC
         double lo = cut[i], hi = cut[i + 1];
         if (!(hi > lo))
             continue;
-        double q[4][7];
-        int ok[4], sg[4];
+        double q[4][7], qc[4][7];
+        int ok[4], sg[4], okc[4], at = 0; /* at: the row at the cut lo computed */
         sm_configs_part(a, f, e, 0.5 * (lo + hi), part, q, ok, sg);
         for (int r = 0; r < 2; r++) {
             int b = part == 1 ? 2 * r : r; /* the other triple's root 0: NaN there */
-            int in = ok[b];
-            for (int j = j0; j < j0 + 3 && in; j++)
-                in = sm_inside_joint(a, j, q[b][j]);
+            int in = sm_triple_inside(a, j0, ok[b], q[b]);
+            if (!in && !open[r] && lo > -M_PI && nrun[r] < SM_MAXI &&
+                (lo - cut[i - 1] <= SM_CORNER || hi - lo <= SM_CORNER)) {
+                /* both cells next to the cut outside and another cut within SM_CORNER
+                 * (two joints of the triple at limits there, leaving on either side):
+                 * the cut alone, if its row is in */
+                if (!at)
+                    sm_configs_part(a, f, e, lo, part, qc, okc, sg);
+                at = 1;
+                if (sm_triple_inside(a, j0, okc[b], qc[b])) {
+                    run[r][nrun[r]][0] = run[r][nrun[r]][1] = lo;
+                    nrun[r]++;
+                }
+            }
             if (in && open[r]) {
                 run[r][nrun[r] - 1][1] = hi; /* extends the open run */
             } else if (in && nrun[r] < SM_MAXI) {
@@ -752,6 +777,29 @@ static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmC
             open[r] = in;
         }
     }
+    /* the cut at -pi (= pi) by the same rule: both cells next to it outside (no run
+     * starts at -pi, none ends at pi) and the row there inside: [-pi, -pi] first and
+     * [pi, pi] last (joined across pi into one point, sm_elbow_intervals) */
+    int at = 0, okc[4], sg[4];
+    double qc[4][7];
+    for (int r = 0; r < 2; r++) {
+        int b = part == 1 ? 2 * r : r, n = nrun[r];
+        if ((n && (run[r][0][0] == -M_PI || run[r][n - 1][1] == M_PI)) || n + 2 > SM_MAXI ||
+            !(cut[1] + M_PI <= SM_CORNER || M_PI - cut[m - 2] <= SM_CORNER))
+            continue; /* a run at an end, or no candidate at +-pi */
+        if (!at)
+            sm_configs_part(a, f, e, -M_PI, part, qc, okc, sg);
+        at = 1;
+        if (!sm_triple_inside(a, j0, okc[b], qc[b]))
+            continue;
+        for (int i = n; i > 0; i--) {
+            run[r][i][0] = run[r][i - 1][0];
+            run[r][i][1] = run[r][i - 1][1];
+        }
+        run[r][0][0] = run[r][0][1] = -M_PI;
+        run[r][n + 1][0] = run[r][n + 1][1] = M_PI;
+        nrun[r] = n + 2;
+    }
 }
 
 /* The overlaps of two sorted lists of disjoint runs into out (at most SM_MAXI) */
@@ -761,7 +809,7 @@ static long long sm_overlap(double x[][2], int nx, double y[][2], int ny, double
     int i = 0, k = 0;
     while (i < nx && k < ny) {
         double lo = fmax(x[i][0], y[k][0]), hi = fmin(x[i][1], y[k][1]);
-        if (hi > lo && n < SM_MAXI) {
+        if (hi >= lo && n < SM_MAXI) { /* a point: a one-point run, or two runs meeting */
             out[2 * n] = lo;
             out[2 * n + 1] = hi;
             n++;

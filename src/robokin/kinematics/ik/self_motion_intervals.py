@@ -35,6 +35,11 @@ GRID = 721
 #: Bisection steps (a 2 pi domain to 2**-52 of its width).
 _BISECT = 56
 _TWO_PI = 2 * np.pi
+#: A range end's row is solved for a corner only where the continued family's track
+#: there is within this of every limit [rad] (its nodes are solved rows).
+_NEAR = 1e-6
+#: Crossings of joints within this of a cut [in t] are the same corner (``_touches``).
+_CORNER = 1e-9
 #: Parameter values on the compiled held-joint kernel's first grid (``held_manifold``).
 KERNEL_GRID = 181
 #: At most this many grid changes without an exact point are bisected (a pose on a
@@ -180,6 +185,10 @@ def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
     q, valid, _ = fam.rows(np.array(mids))
     idx = np.arange(len(mids))
     ok = valid[idx, owners] & _within(q[idx, owners], limits)
+    with np.errstate(invalid="ignore"):
+        out = ((q[idx, owners] < limits[:, 0] - MANIFOLD_SLACK)
+               | (q[idx, owners] > limits[:, 1] + MANIFOLD_SLACK))  # (pieces, n)
+    out[~valid[idx, owners]] = True  # no row: no corner next to it
     for (a, e), b, good in zip(spans, owners, ok, strict=True):
         if not good:
             continue
@@ -187,10 +196,63 @@ def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
             pieces[-1] = (b, pieces[-1][1], e)
         else:
             pieces.append((b, a, e))
+    pieces = sorted(pieces + _touches(fam, limits, marks["limit"], spans, owners, out))
     if fam.periodic:
         pieces = _join_wrap(pieces, lo_d, hi_d)
     arr = np.array([[a, e] for _, a, e in pieces]).reshape(-1, 2)
     return arr, np.array([b for b, _, _ in pieces], dtype=int)
+
+
+def _touches(fam: _Family, limits: np.ndarray, crossings: list[Any],
+             spans: list[tuple[float, float]], owners: list[int], out: np.ndarray
+             ) -> list[tuple[int, float, float]]:
+    """The one-point intervals (b, t, t) of corners: the rule of ``hm_intervals``.
+
+    A cut t of branch b (a limit crossing, or an end of the range) whose pieces on
+    both sides are outside is an interval of its own when b's row at t is inside
+    (``MANIFOLD_SLACK``): two joints at limits at t, the branch leaving through one
+    on either side. A crossing is solved only where every joint out at either
+    piece's midpoint (``out``, (pieces, n)) crosses a limit within ``_CORNER`` of t
+    on b (between cuts a joint keeps its side): a piece out by a joint without a
+    crossing there is no corner (on uniform poses such rows can be inside where a
+    crossing next to a fold was missed: ``docs/ik.md``, "Corners"). The range's
+    ends are solved (a crossing there, with the parameter at its own limit, is not
+    always recorded) unless the continued family's track there has a joint out by
+    more than ``_NEAR`` or does not reach it.
+    """
+    lo_d, hi_d = fam.domain
+    at: dict[int, list[tuple[float, int]]] = {}
+    for t, b, j, *_ in crossings:
+        at.setdefault(b, []).append((t, j))
+    left = {(b, e): i for i, ((_, e), b) in enumerate(zip(spans, owners, strict=True))}
+    right = {(b, a): i for i, ((a, _), b) in enumerate(zip(spans, owners, strict=True))}
+    ends = {lo_d: 0, hi_d: 1}
+    predict = getattr(fam, "predict", None)  # the continued family's tracks: no solve
+    far = np.zeros((2, fam.k), dtype=bool)
+    if predict is not None:
+        p = predict(np.array([lo_d, hi_d]))[..., None] + np.array([-_TWO_PI, 0.0, _TWO_PI])
+        with np.errstate(invalid="ignore"):
+            close = ((p >= limits[:, :1] - _NEAR) & (p <= limits[:, 1:] + _NEAR)).any(-1)
+        far = ~close.all(-1)  # (2, k): a joint out by > _NEAR, or no track there
+    ts, bs = [], []
+    for b in range(fam.k):
+        cuts = at.get(b, [])
+        for t in {float(np.clip(t, lo_d, hi_d)) for t, _ in cuts} | {lo_d, hi_d}:
+            sides = [s[(b, t)] for s in (left, right) if (b, t) in s]
+            if not sides or any(not out[i].any() for i in sides):
+                continue  # in a piece inside (or no piece): covered
+            need = np.flatnonzero(out[sides].any(0))
+            near = {j for tc, j in cuts if abs(tc - t) <= _CORNER}
+            if (not far[ends[t], b]) if t in ends else set(need.tolist()) <= near:
+                ts.append(t)
+                bs.append(b)
+    if not ts:
+        return []
+    values, idx = np.unique(ts, return_inverse=True)  # the range's ends: once
+    q, valid, _ = fam.rows(values)
+    br = np.array(bs)
+    ok = valid[idx, br] & _within(q[idx, br], limits)
+    return [(b, t, t) for t, b, good in zip(ts, bs, ok.tolist(), strict=True) if good]
 
 
 def _join_wrap(pieces: list[tuple[int, float, float]], lo: float, hi: float
