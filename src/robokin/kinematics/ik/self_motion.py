@@ -51,6 +51,7 @@ from robokin.kinematics.ik.fixed import Dispatch
 from robokin.kinematics.ik.self_motion_base import _Family
 from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
 from robokin.kinematics.ik.self_motion_families import (
+    HeldKernel,
     LimitCrossing,
     SelfMotionSetup,
     SingularPoint,
@@ -61,7 +62,6 @@ from robokin.kinematics.ik.self_motion_families import (
 )
 from robokin.kinematics.ik.self_motion_intervals import (
     GRID,
-    HeldKernel,
     _aligned_values,
     _compiled,
     _exact_points,

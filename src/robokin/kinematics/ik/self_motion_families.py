@@ -13,7 +13,7 @@ are used). The SRS swivel's rows and intervals are compiled (``csrc/self_motion.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -23,9 +23,6 @@ from robokin.kinematics.arm import Arm, Derived
 from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.ik.swivel import SwivelArm, swivel_arm
-
-if TYPE_CHECKING:  # self_motion_intervals imports this module
-    from robokin.kinematics.ik.self_motion_intervals import HeldKernel
 
 _TWO_PI = 2 * np.pi
 
@@ -209,6 +206,31 @@ def _size(e: np.ndarray) -> np.ndarray:
     return out
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class HeldKernel:
+    """The compiled held-joint family of one arm: what ``held_manifold`` takes per call.
+
+    Built once per arm (``SelfMotionSetup.held``) from the family ``self_motion``
+    chose for ``"auto"``, so later calls skip the family choice and the per-call
+    arrays.
+
+    Attributes:
+        params: The Pieper closed form's parameters (contiguous float64).
+        aligned: (A, 2) ``[joint, value]`` where a triple's outer axes line up.
+        joint: The held joint (the parameter).
+        named: Its name and limits (``_HeldFamily``'s ``name``, ``domain``).
+        domain: (2,) its limits (copied into each SelfMotion).
+        method: The SelfMotion's ``method`` text.
+    """
+
+    params: np.ndarray
+    aligned: np.ndarray
+    joint: int
+    named: tuple[str, tuple[float, float]]
+    domain: np.ndarray
+    method: str
+
+
 @dataclass(slots=True, eq=False)
 class SelfMotionSetup:
     """What the self-motion of a 7R arm needs per chain (the Arm's :data:`SELF_MOTION` state).
@@ -219,7 +241,7 @@ class SelfMotionSetup:
         parameter_known: True once ``parameter`` is set.
         aligned: ``_aligned_values``' (joint, value) pairs, or None until needed.
         held: The compiled held-joint family's per-arm constants
-            (``self_motion_intervals.HeldKernel``) once ``self_motion`` has taken
+            (:class:`HeldKernel`) once ``self_motion`` has taken
             it for ``"auto"``, else None.
     """
 

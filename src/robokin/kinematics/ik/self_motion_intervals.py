@@ -9,7 +9,6 @@ this (``_SwivelFamily.exact``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -18,6 +17,7 @@ from robokin._native import kernels as K
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.self_motion_base import _Family
 from robokin.kinematics.ik.self_motion_families import (
+    HeldKernel,
     LimitCrossing,
     SingularPoint,
     _HeldFamily,
@@ -277,31 +277,6 @@ _KINDS = ("lower", "upper", "aligned axes", "fold")  # HM_KIND_* 0-3
 #: A branch's interval slots in the kernel's output, and the 8 branches.
 _HM_SLOTS = np.arange(K.HM_MAXI)
 _HM_BRANCHES = np.arange(8)
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class HeldKernel:
-    """The compiled held-joint family of one arm: what ``held_manifold`` takes per call.
-
-    Built once per arm (``SelfMotionSetup.held``) from the family ``self_motion``
-    chose for ``"auto"``, so later calls skip the family choice and the per-call
-    arrays.
-
-    Attributes:
-        params: The Pieper closed form's parameters (contiguous float64).
-        aligned: (A, 2) ``[joint, value]`` where a triple's outer axes line up.
-        joint: The held joint (the parameter).
-        named: Its name and limits (``_HeldFamily``'s ``name``, ``domain``).
-        domain: (2,) its limits (copied into each SelfMotion).
-        method: The SelfMotion's ``method`` text.
-    """
-
-    params: np.ndarray
-    aligned: np.ndarray
-    joint: int
-    named: tuple[str, tuple[float, float]]
-    domain: np.ndarray
-    method: str
 
 
 def _held_kernel(robot: Arm, fam: _HeldFamily) -> HeldKernel:
