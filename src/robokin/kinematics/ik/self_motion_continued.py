@@ -460,9 +460,9 @@ class _ContinuedFamily(_Family):
                              np.concatenate(qidx)[ok].tolist(), strict=True):
             if not any(bb == b2 and qi == q2 and abs(t - t2) < 1e-9 for t2, b2, q2 in out):
                 out.append((t, bb, qi))
-        for t, bb, qi in self._fold_crossings(queries):
-            if not any(bb == b2 and qi == q2 and abs(t - t2) < 1e-9 for t2, b2, q2 in out):
-                out.append((t, bb, qi))
+        for t, fb, qi in self._fold_crossings(queries):
+            if not any(fb == b2 and qi == q2 and abs(t - t2) < 1e-9 for t2, b2, q2 in out):
+                out.append((t, fb, qi))
         return out
 
     def _fold_crossings(self, queries: list[tuple[int, float, str]]
@@ -492,7 +492,9 @@ class _ContinuedFamily(_Family):
         c1 = (qn - qf) - c2
 
         def model(s: np.ndarray) -> np.ndarray:  # s (p, m) -> (p, m, n)
-            return qf[:, None] + c1[:, None] * s[..., None] + c2[:, None] * (s * s)[..., None]
+            q: np.ndarray = (qf[:, None] + c1[:, None] * s[..., None]
+                             + c2[:, None] * (s * s)[..., None])
+            return q
 
         s = np.broadcast_to(np.linspace(0.0, 1.0, 2 * _SUB + 1), (len(cc), 2 * _SUB + 1))
         P = model(s)
