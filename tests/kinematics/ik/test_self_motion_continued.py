@@ -547,3 +547,61 @@ def test_a_corner_is_a_one_point_interval(arm, q):
     q0 = np.array(q)
     _, sm = _manifold(robot, q0)
     assert_corner_listed(robot, sm, q0, float(q0[6]))
+
+
+#: A uniform random-7R configuration (seed 29, ``benchmarks/fold_gap_ab.py``'s 8th, index 7):
+#: main missed a limit crossing next to a fold there (issue 29, round 7e): the
+#: fold end's row inside, no interval of its branch reaching it.
+FOLD_GAP = np.array([
+    [-1.8843907135778857, -2.7048799757966315, 0.04298577432539874, -0.226369446911725,
+     -1.7777455173003378, 2.413836155852181, 2.746574417456351],
+])
+
+
+def test_a_crossing_next_to_a_fold_ends_the_interval_at_the_fold():
+    """Every fold end whose row is inside is held by an interval of its branch; the
+    interval's other end next to the fold is a limit crossing: the full solve's rows
+    (``fam.rows``) are inside between it and the fold and outside just before it, its
+    row is at the limit and reproduces the pose."""
+    robot = ARMS["random7r"]
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    checked = 0
+    for q0 in FOLD_GAP:
+        T, sm = _manifold(robot, q0)
+        fam = sm._family
+        folds = [s for s in sm.singular if s.kind == "fold"]
+        q, valid, _ = fam.rows(np.array([s.t for s in folds]))
+        for i, s in enumerate(folds):
+            row = q[i, s.branch]
+            if not (valid[i, s.branch] and np.all((row >= lo - 1e-12) & (row <= hi + 1e-12))):
+                continue
+            iv = sm.intervals[sm.interval_branch == s.branch]
+            hold = iv[(iv[:, 0] - 1e-9 <= s.t) & (s.t <= iv[:, 1] + 1e-9)]
+            assert len(hold) == 1, (s, iv)
+            a, e = hold[0]
+            end = e if abs(a - s.t) <= 1e-9 else a  # the interval's other end
+            if abs(end - s.t) > 1e-2:
+                continue  # a crossing far from the fold: the regular pieces' business
+            cross = [c for c in sm.crossings if c.branch == s.branch and abs(c.t - end) <= 1e-9]
+            assert len(cross) == 1, (s, end)
+            c = cross[0]
+            r = fam.rows(np.array([c.t]))[0][0, c.branch]
+            limit = lo[c.joint] if c.limit == "lower" else hi[c.joint]
+            assert abs(r[c.joint] - limit) <= 1e-9
+            dp, dr = pose_errors(robot.fk(r), T)
+            assert dp <= 1e-12 and dr <= 1e-12
+            # dense full-solve rows: inside from the crossing to the fold, and outside
+            # over as wide a stretch on the crossing's other side
+            w = s.t - c.t
+            ins = c.t + w * np.linspace(0.05, 0.95, 19)
+            outs = c.t - w * np.linspace(0.05, 0.95, 19)
+            qi, vi, _ = fam.rows(ins)
+            qo, vo, _ = fam.rows(outs)
+            ri, ro = qi[:, c.branch], qo[:, c.branch]
+            assert vi[:, c.branch].all()
+            assert np.all((ri >= lo - 1e-12) & (ri <= hi + 1e-12))
+            with np.errstate(invalid="ignore"):
+                assert not np.any(vo[:, c.branch] & np.all((ro >= lo - 1e-12)
+                                                          & (ro <= hi + 1e-12), axis=1))
+            checked += 1
+    assert checked > 0

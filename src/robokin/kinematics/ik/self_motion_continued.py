@@ -460,7 +460,79 @@ class _ContinuedFamily(_Family):
                              np.concatenate(qidx)[ok].tolist(), strict=True):
             if not any(bb == b2 and qi == q2 and abs(t - t2) < 1e-9 for t2, b2, q2 in out):
                 out.append((t, bb, qi))
+        for t, fb, qi in self._fold_crossings(queries):
+            if not any(fb == b2 and qi == q2 and abs(t - t2) < 1e-9 for t2, b2, q2 in out):
+                out.append((t, fb, qi))
         return out
+
+    def _fold_crossings(self, queries: list[tuple[int, float, str]]
+                        ) -> list[tuple[float, int, int]]:
+        """(t, track, query index) in the cells where a track ends at a fold.
+
+        ``_crossings``' Hermite pieces need the track at both nodes; between a fold
+        t_f and the track's node t_n the branch moves like sqrt(|t - t_f|) (issue 29,
+        round 7e). There it is scanned in s = sqrt((t - t_f) / (t_n - t_f)) in [0, 1]
+        on the quadratic q(s) = q_f + c1 s + c2 s^2 through the fold's row, the
+        node's row and the node's slope (dq/ds = 2 (t_n - t_f) dq/dt at s = 1); a
+        sign change of q_j - value is refined by :func:`_newton_held` (t free) and
+        kept where t lies between t_f and t_n and the row is on the quadratic
+        (``_ON_TRACK``) on the track's side of the fold (not its twin's).
+        """
+        cc, bb = np.nonzero(np.isfinite(self.fold_t))
+        if not cc.size or not queries:
+            return []
+        tn, X, S = self.t_nodes, self.tracks, self.slopes
+        at_a = np.isfinite(X[cc, bb]).all(-1)
+        node = np.where(at_a, cc, cc + 1)
+        tf, qf = self.fold_t[cc, bb], self.fold_q[cc, bb]
+        h = tn[node] - tf  # (p,)
+        qn = qf + _wrap(X[node, bb] - qf)
+        sn = np.where(np.isfinite(S[node, bb]), S[node, bb], 0.0)
+        c2 = 2 * h[:, None] * sn - (qn - qf)
+        c1 = (qn - qf) - c2
+
+        def model(s: np.ndarray) -> np.ndarray:  # s (p, m) -> (p, m, n)
+            q: np.ndarray = (qf[:, None] + c1[:, None] * s[..., None]
+                             + c2[:, None] * (s * s)[..., None])
+            return q
+
+        s = np.broadcast_to(np.linspace(0.0, 1.0, 2 * _SUB + 1), (len(cc), 2 * _SUB + 1))
+        P = model(s)
+        starts, tracks, cells, qidx, joints, values = [], [], [], [], [], []
+        for qi, (j, v, _) in enumerate(queries):
+            g = _wrap(P[..., j] - v)
+            change = (np.sign(g[:, :-1]) != np.sign(g[:, 1:])) & (
+                np.abs(g[:, :-1] - g[:, 1:]) < np.pi)
+            c, sidx = np.nonzero(change)
+            if not c.size:
+                continue
+            g0, g1 = g[c, sidx], g[c, sidx + 1]
+            w = np.where(g0 != g1, g0 / np.where(g0 != g1, g0 - g1, 1.0), 0.0)
+            starts.append(P[c, sidx] + w[:, None] * (P[c, sidx + 1] - P[c, sidx]))
+            tracks.append(bb[c])
+            cells.append(c)
+            qidx.append(np.full(c.size, qi))
+            joints.append(np.full(c.size, j))
+            values.append(np.full(c.size, v))
+        if not starts:
+            return []
+        c = np.concatenate(cells)
+        q, ok = _newton_held(self.robot, self.T, np.concatenate(starts),
+                             np.concatenate(joints), np.concatenate(values))
+        t1 = q[:, self.joint]
+        lo_t, hi_t = np.minimum(tf[c], tn[node[c]]), np.maximum(tf[c], tn[node[c]])
+        lo, hi = self.domain
+        ok &= (t1 >= lo_t) & (t1 <= hi_t) & (t1 >= lo) & (t1 <= hi)
+        with np.errstate(invalid="ignore"):
+            s1 = np.sqrt(np.clip((t1 - tf[c]) / h[c], 0.0, 1.0))
+        on = qf[c] + c1[c] * s1[:, None] + c2[c] * (s1 * s1)[:, None]
+        d = _wrap(q - qf[c])
+        ok &= np.abs(_wrap(on - q)).max(-1) < _ON_TRACK
+        # the track's side: toward its own branch (c1 + c2 s), not the twin's (-c1 ...)
+        ok &= np.einsum("pn,pn->p", d, c1[c] + c2[c] * s1[:, None]) > 0
+        b = np.concatenate(tracks)
+        return list(zip(t1[ok].tolist(), b[ok].tolist(),
+                        np.concatenate(qidx)[ok].tolist(), strict=True))
 
     def _folds(self) -> list[tuple[float, int]]:
         """(t, track): where a track starts or ends inside the range (a fold).
