@@ -687,6 +687,49 @@ static double hm_hermite_root(double f0, double f1, double d0, double d1)
     return s;
 }
 
+#ifdef HM_SHARE_STATS /* a measuring build: partner lookups per joint (tried, taken) */
+static long hm_share_n[PK_MAXJ][2];
+#endif
+
+/* A crossing of joint j (query qi) by the odd slot b in (a, e) (fa at a) taken from
+ * its partner b ^ 1 (the same position root, evaluated first): a partner's point of
+ * joint j inside (a, e) (the shared joints cross their values at the same t: q4-q6
+ * are the position root's, q2 the mirror of its partner's) confirmed by b's own row
+ * there, at the value to hm_root's own 1e-14. 1 when taken (the point recorded). */
+static int hm_shared(HmCtx *c, int b, int qi, double a, double fa, double e)
+{
+    int j = c->qj[qi];
+    if (!(b & 1))
+        return 0;
+    double found = NAN;
+    for (long i = 0; i < c->npts; i++) {
+        const double *p = c->pts + 4 * i;
+        if (p[1] == (double)(b ^ 1) && p[2] == (double)j && p[3] != HM_KIND_FOLD && p[0] > a &&
+            p[0] < e) {
+            if (!isnan(found))
+                return 0; /* two: not this one's to choose */
+            found = p[0];
+        }
+    }
+    if (isnan(found))
+        return 0;
+#ifdef HM_SHARE_STATS
+    hm_share_n[j][0]++;
+#endif
+    HmRow r;
+    hm_eval(c, found, 0u, 1u << b, &r);
+    if (!r.valid[b])
+        return 0;
+    double f = fa + wrap_pi(hm_f(c, &r, b, qi) - fa);
+    if (!(fabs(f) <= 1e-14))
+        return 0;
+#ifdef HM_SHARE_STATS
+    hm_share_n[j][1]++;
+#endif
+    hm_point(c, found, b, j, c->qkind[qi]);
+    return 1;
+}
+
 /* The root of q_j(t) - value (query qi, slot b) in (a, e), fa, fe of opposite
  * signs (fa at a, continuous over the cell; da, de the slopes there, NaN where
  * not known): Newton with the slope from the root of the cell's cubic Hermite
@@ -696,6 +739,8 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
                     double da, double de)
 {
     int j = c->qj[qi];
+    if (hm_shared(c, b, qi, a, fa, e))
+        return;
     double best_t = fabs(fa) < fabs(fe) ? a : e, best_f = fmin(fabs(fa), fabs(fe));
     double t = a - fa * (e - a) / (fe - fa);
     if (isfinite(da) && isfinite(de)) {
@@ -1719,6 +1764,10 @@ static void hm_range(void *ctx, long b0, long e0)
         fprintf(stderr, "\n");
         for (int t = 0; t < 16; t++)
             hm_tag_n[t] = 0;
+#endif
+#ifdef HM_SHARE_STATS
+        for (int j = 0; j < PK_MAXJ; j++) /* cumulative over the process' poses */
+            fprintf(stderr, "share j%d %ld %ld\n", j, hm_share_n[j][0], hm_share_n[j][1]);
 #endif
 #ifdef HM_COUNT_CHEAP
         jb->evals[i] = c->cheap; /* a measuring build: every evaluation */
