@@ -433,3 +433,55 @@ def test_a_corner_of_the_solved_points_path_is_a_one_point_interval(q):
     q0 = np.array(q)
     sm = robot.self_motion(robot.fk(q0), "joint_a3")
     assert_corner_listed(robot, sm, q0, float(q0[2]))
+
+
+@pytest.mark.parametrize("pose", [32, 38])
+def test_a_crossing_next_to_a_fold_of_the_solved_points_path_is_found(pose):
+    # Issue 29 (helper spfold29): the rtb-data iiwa14 ("auto": joint_a3 held, the
+    # compiled kernel does not certify these poses), uniform poses of
+    # benchmarks/fold_gap_ab.py (seed 29). A joint leaves its limits within 1e-7 of a
+    # fold (#32: q5 crosses; #38: q5 jumps with the rows of a second fold 4.9e-8
+    # away); main listed no interval reaching the fold. Oracles: the full solve's rows
+    # (fam.rows) and FK: every fold end whose row is inside is held by an interval of
+    # its branch; where that interval's other end is within 1e-6 of the fold, the rows
+    # at 19 values between them are inside and reproduce the pose, at 19 values as
+    # far beyond the end none is (outside or no row).
+    rtbdata = pytest.importorskip("rtbdata")
+    from pathlib import Path
+
+    urdf = (Path(rtbdata.__file__).parent
+            / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf")
+    robot = robokin.Robot.from_urdf(str(urdf), geometry=False)
+    lim = robot.limits
+    Q = np.random.default_rng(29).uniform(lim[:, 0], lim[:, 1], (100, 7))
+    T = robot.fk(Q[pose])
+    sm = robot.self_motion(T)
+    assert sm.info["compiled"] is False  # the solved-points path
+    fam = sm._family
+
+    def inside(t: np.ndarray, b: int) -> tuple[np.ndarray, np.ndarray]:
+        q, valid, _ = fam.rows(t)
+        r = q[:, b]
+        with np.errstate(invalid="ignore"):
+            ok = valid[:, b] & np.all((r >= lim[:, 0] - MANIFOLD_SLACK)
+                                      & (r <= lim[:, 1] + MANIFOLD_SLACK), axis=-1)
+        return ok, r
+
+    near = 0
+    for p in sm.singular:
+        if p.kind != "fold" or not inside(np.array([p.t]), p.branch)[0][0]:
+            continue
+        iv = sm.intervals[sm.interval_branch == p.branch]
+        hold = iv[(iv[:, 0] - 1e-9 <= p.t) & (p.t <= iv[:, 1] + 1e-9)]
+        assert len(hold), (p.t, p.branch)
+        a, e = hold[0]
+        end = a if abs(e - p.t) <= 1e-9 else e
+        if not 0 < abs(end - p.t) <= 1e-6:
+            continue
+        near += 1
+        ok, r = inside(np.linspace(end, p.t, 21)[1:-1], p.branch)
+        assert ok.all()
+        assert np.abs(robot.fk(r) - T).max() < 1e-12
+        ok, _ = inside(end + (end - p.t) * np.linspace(0, 1, 21)[1:-1], p.branch)
+        assert not ok.any()
+    assert near >= 1

@@ -151,7 +151,80 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
     ends = np.where(state0, lo, hi)  # the last point of the state that holds there
     marks["fold"] += [(float(e), int(b), "fold") for e, b, k in zip(ends, br, kind) if not k]
+    fold = ~kind
+    if fold.any():  # the row on the fold's side of its cell: the scan's far end
+        near = np.where(state0, t[idx], t[idx + 1])[fold]
+        for tc, bc, jc, what in _fold_crossings(fam, ends[fold], near, br[fold], limits, exact):
+            if what == "fold":  # the rows end before the joint leaves: a second fold
+                marks["fold"].append((tc, bc, "fold"))
+            else:
+                marks["limit"].append((tc, bc, jc, what))
     return [(float(e), int(b)) for e, b in zip(ends, br)], len(changes)
+
+
+#: Values of s = sqrt(|t - t_f| / |t_g - t_f|) scanned between a fold and its grid row.
+_FOLD_SCAN = 17
+#: The bisection state of a value with no row on the branch (``_fold_crossings``).
+_NO_ROW = 2
+
+
+def _fold_crossings(fam: _Family, tf: np.ndarray, tg: np.ndarray, br: np.ndarray,
+                    limits: np.ndarray, exact: dict[int, list[float]]
+                    ) -> list[tuple[float, int, int, str]]:
+    """Limit crossings between each fold t_f and its cell's grid row t_g (issue 29).
+
+    Next to a fold a joint moves like sqrt(|t - t_f|) (hundreds of rad per unit
+    sqrt(t) on the rtb-data iiwa14), so a crossing within 1e-6 of the fold is missed
+    by the exact points, the grid and the bisection of the fold itself. Branch b's
+    rows (``fam.rows``) are scanned at t = t_f + (t_g - t_f) s^2 (``_FOLD_SCAN``
+    values of s in [0, 1]); a joint changing sides of a limit (``MANIFOLD_SLACK``)
+    between two scanned rows, with no exact crossing of b there (``exact``), is
+    bisected on the rows (the joint's side, or no row) to the last in-limit value: a
+    crossing record ``(t, b, j, "lower" | "upper")``, or ``"fold"`` where the rows
+    end first (a second fold within the cell: the rtb-data iiwa14's pose #38 has an
+    in-limit stretch of 4.9e-8 next to its fold). The docs: ``docs/ik.md``, "Round 7f".
+    """
+    s2 = np.linspace(0.0, 1.0, _FOLD_SCAN) ** 2
+    ts = tf[:, None] + (tg - tf)[:, None] * s2  # (folds, scan)
+    q, valid, _ = fam.rows(ts.ravel())
+    rows = np.arange(ts.size)
+    bb = np.repeat(br, _FOLD_SCAN)
+    qb = q[rows, bb].reshape(ts.shape + (-1,))  # (folds, scan, n)
+    ok = valid[rows, bb].reshape(ts.shape)
+    with np.errstate(invalid="ignore"):
+        low = qb < limits[:, 0] - MANIFOLD_SLACK
+        high = qb > limits[:, 1] + MANIFOLD_SLACK
+    side = high.astype(np.int8) - low.astype(np.int8)  # -1 below, 0 inside, 1 above
+    cells: list[tuple[int, int, int]] = []  # (fold, scan index k: between k and k + 1, j)
+    change = (side[:, 1:] != side[:, :-1]) & ((side[:, 1:] == 0) | (side[:, :-1] == 0))
+    for f, k, j in zip(*np.nonzero(change & ok[:, 1:, None] & ok[:, :-1, None]), strict=True):
+        a, e = sorted((ts[f, k], ts[f, k + 1]))
+        if not any(a <= x <= e for x in exact.get(int(br[f]), [])):
+            cells.append((int(f), int(k), int(j)))
+    if not cells:
+        return []
+    f_i, k_i, j_i = (np.array(c) for c in zip(*cells, strict=True))
+    b_i = br[f_i]
+    lo, hi = ts[f_i, k_i], ts[f_i, k_i + 1]
+    state0, state1 = side[f_i, k_i, j_i], side[f_i, k_i + 1, j_i]
+    n_rows = np.arange(len(cells))
+    for _ in range(_BISECT):
+        mid = 0.5 * (lo + hi)
+        if np.all((mid == lo) | (mid == hi)):
+            break  # every cell two adjacent floats
+        qm, vm, _ = fam.rows(mid)
+        qj = qm[n_rows, b_i, j_i]
+        with np.errstate(invalid="ignore"):
+            now = ((qj > limits[j_i, 1] + MANIFOLD_SLACK).astype(np.int8)
+                   - (qj < limits[j_i, 0] - MANIFOLD_SLACK).astype(np.int8))
+        now = np.where(vm[n_rows, b_i], now, _NO_ROW)  # rows missing: a second fold
+        same = now == state0
+        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+        state1 = np.where(same, state1, now)
+    inner = np.where(state0 == 0, lo, hi)  # the in-limit end
+    out_side = np.where(state0 == 0, state1, state0)
+    return [(float(t), int(b), int(j), "fold" if o == _NO_ROW else "upper" if o > 0 else "lower")
+            for t, b, j, o in zip(inner, b_i, j_i, out_side, strict=True)]
 
 
 def _within(q: np.ndarray, limits: np.ndarray) -> np.ndarray:
