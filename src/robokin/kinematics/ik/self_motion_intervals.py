@@ -401,3 +401,216 @@ def _held_records(points: np.ndarray) -> tuple[tuple[LimitCrossing, ...],
     sing = tuple(SingularPoint(t, int(b), _KINDS[int(k)])
                  for t, b, _, k in np.concatenate([p[fold], p[~fold & ~limit]]).tolist())
     return cross, sing
+
+
+#: Crossings of one branch this close [in t] (or to an end of the range) may be a
+#: graze or a corner: their rows are evaluated (``_points_refined``).
+_PAIR = 1e-6
+#: The sort key of points [t, branch]: t + 64 branch (64 wider than any parameter range).
+_KEYS = np.array([1.0, 64.0])
+#: Probes of a graze stretch's extent either side of its point [in t].
+_PROBES = 10.0 ** -np.arange(12, 2, -1)
+#: Bisection steps of a graze stretch's end (within a decade of ``_PROBES``: to 1e-6).
+_WIDEN = 20
+#: A corner's row out by at most this [rad] is refined on the pose's equations.
+_CONDITIONING = 1e-7
+
+
+def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
+                    owner: np.ndarray, points: np.ndarray, upper: int, every: bool = False
+                    ) -> tuple[np.ndarray, np.ndarray, tuple[tuple[float, int, np.ndarray], ...]]:
+    """Graze stretches and corners the intervals miss (issue 29, helper rates29).
+
+    ``points`` (p, 4) ``[t, branch, joint, kind]``: the kernels' points (kind at
+    most ``upper``: a limit crossing; the Python paths' crossings have kind 0). Two
+    classes of
+    in-limit points are not held by the intervals of every path (the compiled
+    kernels' and the Python families'):
+
+    * *Grazes*: a joint's extremum within ``MANIFOLD_SLACK`` of its limit. The
+      branch is inside over a stretch of ~2 sqrt(slack / |q''|) (1e-6 to 1e-5 in t)
+      about it, but the kernels list it as the point [t, t] (or not at all when the
+      pieces either side are decided outside at their midpoints). Each one-point
+      interval, and each crossing of a branch within ``_PAIR`` of another crossing
+      of it or of a range end whose row is inside, is widened to the last in-slack
+      value either side (geometric probes 1e-12 .. 1e-3, then ``_WIDEN`` bisection
+      steps on the rows); a side with no probe outside is not widened. (An
+      interval at most ``_PAIR`` long is widened from its ends the same way.)
+    * *Corners out by conditioning*: such a crossing whose row is out by at most
+      ``_CONDITIONING`` with two or more joints within it of a limit (next to an
+      aligned triple the closed forms' rows are 1e-11 to 1e-9 off). The row is
+      refined by Gauss-Newton on the pose with those joints held exactly at their
+      limits (``_held_refine``); when it reproduces T to 1e-13, is inside and lies
+      within 1e-6 of the branch's row, the corner is the interval [t*, t*] at its
+      parameter value t*, and ``SelfMotion.sample`` returns that row there.
+
+    ``every``: every crossing is a corner candidate (the Python paths, where a row
+    costs little against the pose's 20-200 ms), not only close ones; a graze is
+    widened only from a close one (a lone uncovered crossing inside, next to a piece
+    decided outside, is a crossing missed nearby: ``docs/ik.md``, "Corners").
+
+    Returns ``(intervals, owner, corners)``; the arrays unchanged (the same objects)
+    when nothing is found: a uniform pose computes no row here (its cost is the
+    test for short intervals and close points, ~5 us).
+    """
+    lo_d, hi_d = fam.domain
+    # the cheap test first (a uniform pose ends here): no short interval, no two
+    # points of a branch within _PAIR, none within it of a range end
+    key = points[:, :2] @ _KEYS  # by branch, then t
+    key.sort()
+    t = points[:, 0]
+    # (count_nonzero, not min / any: a reduction's call costs ~2 us on these sizes)
+    if not every and not (np.count_nonzero(key[1:] - key[:-1] <= _PAIR)
+            or np.count_nonzero(t <= lo_d + _PAIR) or np.count_nonzero(t >= hi_d - _PAIR)
+            or np.count_nonzero(intervals[:, 1] - intervals[:, 0] <= _PAIR)):
+        return intervals, owner, ()
+    cuts = points[points[:, 3] <= upper, :3]
+    near = np.zeros(len(cuts), dtype=bool)  # a crossing close to another or to an end
+    if len(cuts):
+        t = cuts[:, 0]
+        key = cuts[:, :2] @ _KEYS
+        near = (t - lo_d <= _PAIR) | (hi_d - t <= _PAIR)
+        order = np.argsort(key, kind="stable")
+        close = np.diff(key[order]) <= _PAIR
+        near[order[1:][close]] = True
+        near[order[:-1][close]] = True
+    point = intervals[:, 1] - intervals[:, 0] <= _PAIR
+    cand = near | every
+    c, near = cuts[cand], near[cand]
+    if len(c):  # crossings already in an interval of their branch: nothing to find
+        held = ((intervals[None, :, 0] <= c[:, :1]) & (c[:, :1] <= intervals[None, :, 1])
+                & (owner[None, :] == c[:, 1:2])).any(axis=1)
+        c, near = c[~held], near[~held]
+    stretch = [(float(a), float(e), int(b)) for (a, e), b, p in zip(intervals, owner, point) if p]
+    corners: list[tuple[float, int, np.ndarray]] = []
+    if len(c):
+        ts, inv = np.unique(c[:, 0], return_inverse=True)
+        q, valid, _ = fam.rows(ts)
+        b = c[:, 1].astype(int)
+        r = q[inv, b]
+        excess = np.maximum(limits[:, 0] - r, r - limits[:, 1])  # (c, n)
+        worst = np.where(valid[inv, b], excess.max(axis=-1), np.inf)
+        for i in np.flatnonzero((worst <= MANIFOLD_SLACK) & near):
+            stretch.append((float(c[i, 0]), float(c[i, 0]), int(b[i])))
+        for i in np.flatnonzero((worst > MANIFOLD_SLACK) & (worst <= _CONDITIONING)):
+            hold = np.flatnonzero(np.abs(excess[i]) <= _CONDITIONING)
+            if len(hold) < 2:
+                continue
+            row = _held_refine(fam, limits, r[i], hold)
+            if row is not None:
+                tc = _param(fam, row)
+                if tc is not None:
+                    corners.append((tc, int(b[i]), row))
+    new = _widen(fam, limits, stretch) + [(b, t, t) for t, b, _ in corners]
+    iv, ob = _merged(intervals, owner, new)
+    if not corners and np.array_equal(iv, intervals) and np.array_equal(ob, owner):
+        return intervals, owner, ()  # nothing widened or added: the kernel's arrays
+    return iv, ob, tuple(corners)
+
+
+def _param(fam: _Family, row: np.ndarray) -> float | None:
+    """The parameter value of a refined row, in the domain (the swivel: wrapped)."""
+    t = fam.param_of(row)
+    lo, hi = fam.domain
+    if fam.periodic:
+        return float(_wrap(t))
+    return t if lo <= t <= hi else None
+
+
+def _held_refine(fam: _Family, limits: np.ndarray, r: np.ndarray, hold: np.ndarray
+                 ) -> np.ndarray | None:
+    """Row r refined on the pose with joints ``hold`` exactly at their nearer limits.
+
+    Gauss-Newton (least squares over the free joints' Jacobian columns: 6 x (n -
+    len(hold))) on ``pose_error``, at most 8 steps; the row when its pose error is
+    at most 1e-13 (position [m] and rotation [rad]), every free joint is inside
+    (``MANIFOLD_SLACK``) and it moved by at most 1e-6 rad, else None.
+    """
+    from robokin.kinematics.ik.self_motion_families import _size
+    from robokin.kinematics.jacobian import jacobian_and_pose
+    from robokin.spatial import pose_error
+
+    robot: Arm = fam.robot  # type: ignore[attr-defined]
+    T: np.ndarray = fam.T  # type: ignore[attr-defined]
+    q = r.copy()
+    lim = limits[hold]
+    q[hold] = np.where(np.abs(r[hold] - lim[:, 0]) <= np.abs(r[hold] - lim[:, 1]),
+                       lim[:, 0], lim[:, 1])
+    free = np.setdiff1d(np.arange(len(q)), hold)
+    e = np.full(6, np.inf)
+    for _ in range(8):
+        J, P = jacobian_and_pose(robot.chain, q)
+        e = pose_error(P, T)
+        if _size(e) <= 1e-16:
+            break
+        step = np.linalg.lstsq(J[:, free], e, rcond=None)[0]
+        q[free] += step
+    _, P = jacobian_and_pose(robot.chain, q)
+    e = pose_error(P, T)
+    if (_size(e) > 1e-13 or not _within(q, limits)
+            or np.abs(q - r).max() > 1e-6):
+        return None
+    return q
+
+
+def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, int]]
+           ) -> list[tuple[int, float, float]]:
+    """Each in-limit stretch (a, e, b) (a point: a = e) widened to its in-slack extent.
+
+    Probes at ``_PROBES`` before a and after e; a side with a probe outside (and the
+    first inside) is bisected ``_WIDEN`` times between its last inside and first
+    outside probe (to 1e-6 of that decade) and ends at the last inside value.
+    """
+    if not points:
+        return []
+    starts = np.array([a for a, _, _ in points])
+    stops = np.array([e for _, e, _ in points])
+    br = np.array([b for _, _, b in points])
+    m, p = len(points), len(_PROBES)
+    lo_d, hi_d = fam.domain
+    rows_mp = np.arange(m * p)
+    ends = []
+    for side, t0 in ((-1.0, starts), (1.0, stops)):
+        ts = t0[:, None] + side * _PROBES[None, :]  # (m, probes)
+        q, valid, _ = fam.rows(ts.ravel())
+        b_mp = np.repeat(br, p)
+        ok = (valid[rows_mp, b_mp] & _within(q[rows_mp, b_mp], limits)).reshape(m, p)
+        if not fam.periodic:
+            ok &= (ts >= lo_d) & (ts <= hi_d)
+        first_out = np.argmin(ok, axis=1)  # the first probe outside (0 if none is)
+        go = ~ok.all(axis=1) & (first_out > 0)  # inside at 1e-12 and outside further on
+        d = np.zeros(m)
+        if go.any():
+            a = _PROBES[first_out[go] - 1]
+            e = _PROBES[first_out[go]]
+            tb, bb = t0[go], br[go]
+            rows = np.arange(len(a))
+            for _ in range(_WIDEN):
+                mid = 0.5 * (a + e)
+                qm, vm, _ = fam.rows(tb + side * mid)
+                inn = vm[rows, bb] & _within(qm[rows, bb], limits)
+                a, e = np.where(inn, mid, a), np.where(inn, e, mid)
+            d[go] = a
+        ends.append(t0 + side * d)
+    out = []
+    for a, e, b in zip(ends[0].tolist(), ends[1].tolist(), br.tolist(), strict=True):
+        if not fam.periodic:
+            a, e = max(a, lo_d), min(e, hi_d)
+        elif a < lo_d:
+            a, e = a + _TWO_PI, e + _TWO_PI
+        out.append((int(b), a, e))
+    return out
+
+
+def _merged(intervals: np.ndarray, owner: np.ndarray, new: list[tuple[int, float, float]]
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """The intervals with ``new`` (b, start, end) added, overlapping ones of a branch joined."""
+    every = sorted([(int(b), float(a), float(e)) for (a, e), b in zip(intervals, owner)] + new)
+    out: list[tuple[int, float, float]] = []
+    for b, a, e in every:
+        if out and out[-1][0] == b and a <= out[-1][2]:
+            out[-1] = (b, out[-1][1], max(out[-1][2], e))
+        else:
+            out.append((b, a, e))
+    arr = np.array([[a, e] for _, a, e in out]).reshape(-1, 2)
+    return arr, np.array([b for b, _, _ in out], dtype=int)
