@@ -408,10 +408,16 @@ def _held_records(points: np.ndarray) -> tuple[tuple[LimitCrossing, ...],
 _PAIR = 1e-6
 #: The sort key of points [t, branch]: t + 64 branch (64 wider than any parameter range).
 _KEYS = np.array([1.0, 64.0])
-#: Probes of a graze stretch's extent either side of its point [in t].
-_PROBES = 10.0 ** -np.arange(12, 2, -1)
-#: Bisection steps of a graze stretch's end (within a decade of ``_PROBES``: to 1e-6).
-_WIDEN = 20
+#: Probes of a graze stretch's extent either side of its point [in t]: from 1e-9 (a
+#: crossing through the limit at |dq/dt| >= 1e-3 is out there: no graze, not widened).
+_PROBES = 10.0 ** -np.arange(9, 2, -1)
+#: Search steps of a graze stretch's end within a decade of ``_PROBES`` (``_SPLIT``
+#: values each: the bracket shrinks 4 times per step, to ~1e-3 of the decade: the
+#: stretches are 1e-6 to 1e-4 long, their ends inside to ~1e-9 of the last value).
+_WIDEN = 5
+_SPLIT = 3
+#: A listed interval at most this long is a point (a few ulps): widened as a graze.
+_POINT = 1e-12
 #: A corner's row out by at most this [rad] is refined on the pose's equations.
 _CONDITIONING = 1e-7
 
@@ -433,9 +439,10 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
       pieces either side are decided outside at their midpoints). Each one-point
       interval, and each crossing of a branch within ``_PAIR`` of another crossing
       of it or of a range end whose row is inside, is widened to the last in-slack
-      value either side (geometric probes 1e-12 .. 1e-3, then ``_WIDEN`` bisection
+      value either side (geometric probes 1e-9 .. 1e-3, then ``_WIDEN`` search
       steps on the rows); a side with no probe outside is not widened. (An
-      interval at most ``_PAIR`` long is widened from its ends the same way.)
+      interval at most ``_POINT`` long, a few ulps, is widened from its ends the
+      same way; a longer one ends at exact crossings.)
     * *Corners out by conditioning*: such a crossing whose row is out by at most
       ``_CONDITIONING`` with two or more joints within it of a limit (next to an
       aligned triple the closed forms' rows are 1e-11 to 1e-9 off). The row is
@@ -462,7 +469,7 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     # (count_nonzero, not min / any: a reduction's call costs ~2 us on these sizes)
     if not every and not (np.count_nonzero(key[1:] - key[:-1] <= _PAIR)
             or np.count_nonzero(t <= lo_d + _PAIR) or np.count_nonzero(t >= hi_d - _PAIR)
-            or np.count_nonzero(intervals[:, 1] - intervals[:, 0] <= _PAIR)):
+            or np.count_nonzero(intervals[:, 1] - intervals[:, 0] <= _POINT)):
         return intervals, owner, ()
     cuts = points[points[:, 3] <= upper, :3]
     near = np.zeros(len(cuts), dtype=bool)  # a crossing close to another or to an end
@@ -474,7 +481,7 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         close = np.diff(key[order]) <= _PAIR
         near[order[1:][close]] = True
         near[order[:-1][close]] = True
-    point = intervals[:, 1] - intervals[:, 0] <= _PAIR
+    point = intervals[:, 1] - intervals[:, 0] <= _POINT
     cand = near | every
     c, near = cuts[cand], near[cand]
     if len(c):  # crossings already in an interval of their branch: nothing to find
@@ -490,7 +497,11 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         r = q[inv, b]
         excess = np.maximum(limits[:, 0] - r, r - limits[:, 1])  # (c, n)
         worst = np.where(valid[inv, b], excess.max(axis=-1), np.inf)
-        for i in np.flatnonzero((worst <= MANIFOLD_SLACK) & near):
+        inside = worst <= MANIFOLD_SLACK
+        lone = np.flatnonzero(inside & ~near)
+        if len(lone):  # a graze only where its joint stays at the limit either side
+            inside[lone] = _tangent(fam, limits, c[lone])
+        for i in np.flatnonzero(inside):
             stretch.append((float(c[i, 0]), float(c[i, 0]), int(b[i])))
         for i in np.flatnonzero((worst > MANIFOLD_SLACK) & (worst <= _CONDITIONING)):
             hold = np.flatnonzero(np.abs(excess[i]) <= _CONDITIONING)
@@ -506,6 +517,27 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     if not corners and np.array_equal(iv, intervals) and np.array_equal(ob, owner):
         return intervals, owner, ()  # nothing widened or added: the kernel's arrays
     return iv, ob, tuple(corners)
+
+
+def _tangent(fam: _Family, limits: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """(c,) bool: crossing [t, b, j]'s joint within the slack of its limit at t +- 1e-8.
+
+    A graze (the joint's extremum at its limit) stays there to ~1e-16; a crossing
+    through the limit is out by ~1e-8 |dq/dt| on one side. Only a tangent lone
+    crossing is widened (the Python paths' ``every``): a crossing into the limits
+    followed by a piece decided outside is a missed crossing (rtb-data iiwa14,
+    uniform pose #119 of seed 0: a 6.4e-4 stretch), not a graze.
+    """
+    ts = np.concatenate([c[:, 0] - 1e-8, c[:, 0] + 1e-8])
+    q, valid, _ = fam.rows(ts)
+    m = len(c)
+    b, j = np.tile(c[:, 1].astype(int), 2), np.tile(c[:, 2].astype(int), 2)
+    x = q[np.arange(2 * m), b, j]
+    with np.errstate(invalid="ignore"):
+        at = (valid[np.arange(2 * m), b] & (x >= limits[j, 0] - MANIFOLD_SLACK)
+              & (x <= limits[j, 1] + MANIFOLD_SLACK))
+    out: np.ndarray = at[:m] & at[m:]
+    return out
 
 
 def _param(fam: _Family, row: np.ndarray) -> float | None:
@@ -537,16 +569,18 @@ def _held_refine(fam: _Family, limits: np.ndarray, r: np.ndarray, hold: np.ndarr
     q[hold] = np.where(np.abs(r[hold] - lim[:, 0]) <= np.abs(r[hold] - lim[:, 1]),
                        lim[:, 0], lim[:, 1])
     free = np.setdiff1d(np.arange(len(q)), hold)
-    e = np.full(6, np.inf)
     for _ in range(8):
         J, P = jacobian_and_pose(robot.chain, q)
         e = pose_error(P, T)
-        if _size(e) <= 1e-16:
+        if _size(e) <= 1e-15:
             break
         step = np.linalg.lstsq(J[:, free], e, rcond=None)[0]
         q[free] += step
-    _, P = jacobian_and_pose(robot.chain, q)
-    e = pose_error(P, T)
+        if np.abs(step).max() <= 1e-15:
+            e = pose_error(jacobian_and_pose(robot.chain, q)[1], T)
+            break
+    else:
+        e = pose_error(jacobian_and_pose(robot.chain, q)[1], T)
     if (_size(e) > 1e-13 or not _within(q, limits)
             or np.abs(q - r).max() > 1e-6):
         return None
@@ -557,43 +591,54 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
            ) -> list[tuple[int, float, float]]:
     """Each in-limit stretch (a, e, b) (a point: a = e) widened to its in-slack extent.
 
-    Probes at ``_PROBES`` before a and after e; a side with a probe outside (and the
-    first inside) is bisected ``_WIDEN`` times between its last inside and first
-    outside probe (to 1e-6 of that decade) and ends at the last inside value.
+    Probes at ``_PROBES`` before a and after e (one batch); a side with a probe
+    outside (and the first inside) is searched between its last inside and first
+    outside probe, ``_SPLIT`` values per step (one batch per step, both sides and
+    every stretch together), ``_WIDEN`` steps (to ~1e-3 of that decade), and ends at
+    the last inside value found.
     """
     if not points:
         return []
-    starts = np.array([a for a, _, _ in points])
-    stops = np.array([e for _, e, _ in points])
-    br = np.array([b for _, _, b in points])
-    m, p = len(points), len(_PROBES)
+    m, p = len(points), len(_PROBES)  # (the first probe alone: most points are corners)
+    t0 = np.array([a for a, _, _ in points] + [e for _, e, _ in points])  # (2m,) sides
+    side = np.repeat([-1.0, 1.0], m)
+    br = np.tile(np.array([b for _, _, b in points]), 2)
     lo_d, hi_d = fam.domain
-    rows_mp = np.arange(m * p)
-    ends = []
-    for side, t0 in ((-1.0, starts), (1.0, stops)):
-        ts = t0[:, None] + side * _PROBES[None, :]  # (m, probes)
+
+    def inside(ts: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """(rows of ts (s, w)) on branches b (s,) inside (the range's ends included)."""
         q, valid, _ = fam.rows(ts.ravel())
-        b_mp = np.repeat(br, p)
-        ok = (valid[rows_mp, b_mp] & _within(q[rows_mp, b_mp], limits)).reshape(m, p)
+        idx, bb = np.arange(ts.size), np.repeat(b, ts.shape[1])
+        ok = (valid[idx, bb] & _within(q[idx, bb], limits)).reshape(ts.shape)
         if not fam.periodic:
             ok &= (ts >= lo_d) & (ts <= hi_d)
-        first_out = np.argmin(ok, axis=1)  # the first probe outside (0 if none is)
-        go = ~ok.all(axis=1) & (first_out > 0)  # inside at 1e-12 and outside further on
-        d = np.zeros(m)
-        if go.any():
-            a = _PROBES[first_out[go] - 1]
-            e = _PROBES[first_out[go]]
-            tb, bb = t0[go], br[go]
-            rows = np.arange(len(a))
-            for _ in range(_WIDEN):
-                mid = 0.5 * (a + e)
-                qm, vm, _ = fam.rows(tb + side * mid)
-                inn = vm[rows, bb] & _within(qm[rows, bb], limits)
-                a, e = np.where(inn, mid, a), np.where(inn, e, mid)
-            d[go] = a
-        ends.append(t0 + side * d)
+        out: np.ndarray = ok
+        return out
+
+    ok = np.zeros((2 * m, p), dtype=bool)  # the first probe, then the rest where inside
+    ok[:, 0] = inside(t0[:, None] + side[:, None] * _PROBES[:1], br)[:, 0]
+    more = np.flatnonzero(ok[:, 0])
+    if len(more):
+        ok[more, 1:] = inside(t0[more, None] + side[more, None] * _PROBES[None, 1:], br[more])
+    first_out = np.argmin(ok, axis=1)  # the first probe outside (0 if none is)
+    go = ~ok.all(axis=1) & (first_out > 0)  # inside at 1e-9 and outside further on
+    d = np.zeros(2 * m)
+    if go.any():
+        a, e = _PROBES[first_out[go] - 1], _PROBES[first_out[go]]
+        tb, sb, bb = t0[go], side[go], br[go]
+        frac = np.arange(1, _SPLIT + 1) / (_SPLIT + 1)
+        for _ in range(_WIDEN):
+            x = a[:, None] + (e - a)[:, None] * frac[None, :]  # (g, split)
+            inn = inside(tb[:, None] + sb[:, None] * x, bb)
+            k = np.argmin(inn, axis=1)  # the first value outside (0: none, or the first)
+            none = inn.all(axis=1)
+            new_a = np.where(none, x[:, -1], np.where(k > 0, x[np.arange(len(k)), k - 1], a))
+            e = np.where(none, e, x[np.arange(len(k)), k])
+            a = new_a
+        d[go] = a
+    ends = t0 + side * d
     out = []
-    for a, e, b in zip(ends[0].tolist(), ends[1].tolist(), br.tolist(), strict=True):
+    for a, e, b in zip(ends[:m].tolist(), ends[m:].tolist(), br[:m].tolist(), strict=True):
         if not fam.periodic:
             a, e = max(a, lo_d), min(e, hi_d)
         elif a < lo_d:
