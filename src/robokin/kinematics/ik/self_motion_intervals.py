@@ -594,8 +594,10 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
     Probes at ``_PROBES`` before a and after e (one batch); a side with a probe
     outside (and the first inside) is searched between its last inside and first
     outside probe, ``_SPLIT`` values per step (one batch per step, both sides and
-    every stretch together), ``_WIDEN`` steps (to ~1e-3 of that decade), and ends at
-    the last inside value found.
+    every stretch together), ``_WIDEN`` steps (to ~1e-3 of that decade), and ends
+    1e-3 of its distance inside the last inside value found (a graze's joint there
+    ~0.998 of the slack from its limit: ``test_swivel.test_intervals_are_exact``'s
+    ends at a limit to 1e-12 hold after the swivel's 2 pi shift).
     """
     if not points:
         return []
@@ -635,7 +637,8 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
             new_a = np.where(none, x[:, -1], np.where(k > 0, x[np.arange(len(k)), k - 1], a))
             e = np.where(none, e, x[np.arange(len(k)), k])
             a = new_a
-        d[go] = a
+        d[go] = a * (1.0 - 1e-3)  # inside the last inside value: its row stays within
+        # the slack after a 2 pi shift of the swivel (rounding) at q'' up to ~1e11
     ends = t0 + side * d
     out = []
     for a, e, b in zip(ends[:m].tolist(), ends[m:].tolist(), br[:m].tolist(), strict=True):
