@@ -451,8 +451,10 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
       within 1e-6 of the branch's row, the corner is the interval [t*, t*] at its
       parameter value t*, and ``SelfMotion.sample`` returns that row there.
 
-    ``every``: every crossing is a corner candidate (the Python paths, where a row
-    costs little against the pose's 20-200 ms), not only close ones; a graze is
+    ``every``: every crossing is a corner candidate (the solved-points path, where a
+    closed-form row costs little against the pose's 50-150 ms; not the continued
+    family, whose rows are general-6R solves: +10-15 % CPU on uniform random 7R
+    poses), not only close ones; a graze is
     widened only from a close one (a lone uncovered crossing inside, next to a piece
     decided outside, is a crossing missed nearby: ``docs/ik.md``, "Corners").
 
@@ -564,7 +566,7 @@ def _held_refine(fam: _Family, limits: np.ndarray, r: np.ndarray, hold: np.ndarr
 
     robot: Arm = fam.robot  # type: ignore[attr-defined]
     T: np.ndarray = fam.T  # type: ignore[attr-defined]
-    q = r.copy()
+    q: np.ndarray = np.array(r, dtype=np.float64)
     lim = limits[hold]
     q[hold] = np.where(np.abs(r[hold] - lim[:, 0]) <= np.abs(r[hold] - lim[:, 1]),
                        lim[:, 0], lim[:, 1])
