@@ -30,7 +30,9 @@ cores): the Panda's (b) 2.1 min (12.8 ms per pose; special poses leave the compi
 kernel), the Gen3-like arm's and the offset iiwa's 1.5 min each.
 
 Run: ``python benchmarks/self_motion_rates.py [--n 10000] [--nb 0] [--nb-mid 300]
-[--nb-slow 250] [--seed 0] [--arms panda,srs,...]``.
+[--nb-slow 250] [--seed 0] [--arms panda,srs,...] [--dump PREFIX]`` (``--dump``: each
+arm's configurations and part (b) results to ``PREFIX_<arm>.npz``, to re-run its
+misses on another tree: the session-8 A/B, ``docs/benchmarks.md``).
 """
 
 from __future__ import annotations

@@ -406,8 +406,10 @@ def _held_records(points: np.ndarray) -> tuple[tuple[LimitCrossing, ...],
 #: Crossings of one branch this close [in t] (or to an end of the range) may be a
 #: graze or a corner: their rows are evaluated (``_points_refined``).
 _PAIR = 1e-6
-#: The sort key of points [t, branch]: t + 64 branch (64 wider than any parameter range).
-_KEYS = np.array([1.0, 64.0])
+#: The sort key of points [t, branch, joint, kind]: t + 64 branch (64 wider than any
+#: parameter range); an interval's length (its end minus its start).
+_KEYS = np.array([1.0, 64.0, 0.0, 0.0])
+_LENGTH = np.array([-1.0, 1.0])
 #: Probes of a graze stretch's extent either side of its point [in t]: from 1e-9 (a
 #: crossing through the limit at |dq/dt| >= 1e-3 is out there: no graze, not widened).
 _PROBES = 10.0 ** -np.arange(9, 2, -1)
@@ -465,19 +467,20 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     lo_d, hi_d = fam.domain
     # the cheap test first (a uniform pose ends here): no short interval, no two
     # points of a branch within _PAIR, none within it of a range end
-    key = points[:, :2] @ _KEYS  # by branch, then t
+    key = np.dot(points, _KEYS)  # by branch, then t
     key.sort()
     t = points[:, 0]
-    # (count_nonzero, not min / any: a reduction's call costs ~2 us on these sizes)
+    # (count_nonzero and matmul, not min / any / column slices: each numpy call costs
+    # ~0.5-2 us on these sizes, ~50 us the whole compiled swivel call)
     if not every and not (np.count_nonzero(key[1:] - key[:-1] <= _PAIR)
             or np.count_nonzero(t <= lo_d + _PAIR) or np.count_nonzero(t >= hi_d - _PAIR)
-            or np.count_nonzero(intervals[:, 1] - intervals[:, 0] <= _POINT)):
+            or np.count_nonzero(np.dot(intervals, _LENGTH) <= _POINT)):
         return intervals, owner, ()
     cuts = points[points[:, 3] <= upper, :3]
     near = np.zeros(len(cuts), dtype=bool)  # a crossing close to another or to an end
     if len(cuts):
         t = cuts[:, 0]
-        key = cuts[:, :2] @ _KEYS
+        key = cuts[:, :2] @ _KEYS[:2]
         near = (t - lo_d <= _PAIR) | (hi_d - t <= _PAIR)
         order = np.argsort(key, kind="stable")
         close = np.diff(key[order]) <= _PAIR
@@ -526,7 +529,7 @@ def _tangent(fam: _Family, limits: np.ndarray, c: np.ndarray) -> np.ndarray:
 
     A graze (the joint's extremum at its limit) stays there to ~1e-16; a crossing
     through the limit is out by ~1e-8 |dq/dt| on one side. Only a tangent lone
-    crossing is widened (the Python paths' ``every``): a crossing into the limits
+    crossing is widened (the solved-points path's ``every``): a crossing into the limits
     followed by a piece decided outside is a missed crossing (rtb-data iiwa14,
     uniform pose #119 of seed 0: a 6.4e-4 stretch), not a graze.
     """
