@@ -485,3 +485,105 @@ def test_a_crossing_next_to_a_fold_of_the_solved_points_path_is_found(pose):
         ok, _ = inside(end + (end - p.t) * np.linspace(0, 1, 21)[1:-1], p.branch)
         assert not ok.any()
     assert near >= 1
+
+
+def _arm(name: str):
+    """The Panda, the exact SRS iiwa14 or the rtb-data iiwa14 URDF (skipped without it)."""
+    if name == "panda":
+        return PANDA
+    if name == "srs":
+        from reference import iiwa14_srs
+
+        return iiwa14_srs()
+    rtbdata = pytest.importorskip("rtbdata")
+    from pathlib import Path
+
+    urdf = (Path(rtbdata.__file__).parent
+            / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf")
+    return robokin.Robot.from_urdf(str(urdf), geometry=False)
+
+
+def _generating(robot, q0: np.ndarray):
+    """(sm, t, branch): the manifold of FK(q0), q0's parameter value, q0's branch."""
+    from robokin.kinematics.ik.self_motion import parameter_values
+
+    T = robot.fk(q0)
+    _, t = parameter_values(robot, T, q0[None])
+    sm = robot.self_motion(T)
+    rows = sm.sample(float(t[0]))
+    gap = np.abs((rows - q0 + np.pi) % (2 * np.pi) - np.pi).max(axis=-1)
+    b = int(np.nanargmin(gap))
+    assert gap[b] < 1e-6, gap
+    return sm, float(t[0]), b
+
+
+@pytest.mark.parametrize(("arm", "q"), [
+    # q4 at its lower limit, its maximum along the branch at t = 1e-6 touching it
+    # (q5 = -1e-9, q7 = -1e-6): main listed [1e-6, 1e-6] only
+    ("panda", [0.4075794544994271, -1.4311373780278696, 1.8756459202885645, -3.0718, -1e-09,
+               -0.0175, -1e-06]),
+    # q2 at its upper limit, grazing it next to psi = -pi (q3 = 1e-9, q7 = 1e-6):
+    # main listed a 3.5e-15-long interval at -pi, 2e-8 from q's swivel
+    ("srs", [0.9166990393942251, 2.0943951023931953, 1e-09, -2.0943951023931953,
+             -1.0618256230930307, -1.5693258834290933, 1e-06]),
+    # q2 and q7 at their lower limits (q1 = 0, q3 = -1e-6): main listed nothing
+    ("srs", [0.0, -2.0943951023931953, -1e-06, -1.1697305924327788, -1.5707963267948966,
+             0.8502798542808594, -3.0543261909900767]),
+])
+def test_a_graze_keeps_its_in_slack_stretch(arm, q):
+    # Issue 29 (helper rates29): benchmarks/self_motion_rates.py (seed 0, n 10,000)
+    # regular special configurations whose branch grazes a limit: inside by
+    # MANIFOLD_SLACK over ~1e-6..1e-5 of t about q's value, listed by the kernels as a
+    # point (or not at all). Oracles: the branch's rows (sm.sample, the closed form)
+    # and FK: q's value lies in an interval of its branch longer than 1e-7, whose rows
+    # at 9 values across it are inside (MANIFOLD_SLACK) and reproduce the pose to 1e-12.
+    robot = _arm(arm)
+    q0 = np.array(q)
+    sm, t, b = _generating(robot, q0)
+    iv = sm.intervals[sm.interval_branch == b]
+    shifts = (-2 * np.pi, 0.0, 2 * np.pi) if sm.periodic else (0.0,)
+    hit = [(a + s, e + s) for a, e in iv for s in shifts if a + s <= t <= e + s]
+    assert len(hit) == 1, (t, iv)
+    a, e = hit[0]
+    assert e - a > 1e-7, (a, e)
+    ts = np.linspace(a, e, 9)
+    rows = sm.sample(ts)[:, b]
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    assert np.all((rows >= lo - MANIFOLD_SLACK) & (rows <= hi + MANIFOLD_SLACK))
+    dp, dr = pose_errors(robot.fk(rows), np.broadcast_to(sm.T, (9, 4, 4)))
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12, (dp, dr)
+
+
+@pytest.mark.parametrize(("arm", "q"), [
+    # q3, q7 at limits, q7 the parameter at its range's end, q2 = 1e-6 (the shoulder
+    # lined up): main's row there 7.5e-11 out (a singular configuration)
+    ("panda", [-1e-09, 1e-06, -2.8973, -0.0698, -1e-09, 1e-06, -2.8973]),
+    # q1, q2, q5, q6 at limits, the elbow lined up (q4 = 1e-7; singular): main's
+    # swivel row there out by conditioning
+    ("srs", [-2.9670597283903604, -2.0943951023931953, 0.0, 1e-07, -2.9670597283903604,
+             -2.0943951023931953, -1.5707963267948966]),
+    # joint_a1 and joint_a2 at limits, the elbow lined up (q4 = 1e-9; regular): main's
+    # row at the crossing 3e-11 out
+    ("iiwa", [2.9668, -2.0942, 1e-07, 1e-09, -0.34442118632710983, 0.28861094459290904,
+              -1e-06]),
+])
+def test_a_corner_out_by_conditioning_is_refined(arm, q):
+    # Issue 29 (helper rates29): benchmarks/self_motion_rates.py (seed 0, n 10,000),
+    # corners whose closed-form row at the crossing is 1e-11..1e-9 out next to an
+    # aligned triple; the row refined with the limit joints held at their limits is
+    # listed as [t*, t*]. Oracles: reference.assert_corner_listed (the branch outside
+    # at t +- 1e-6, a point interval holding t, its row inside and FK = T to 1e-12),
+    # and that row is q's to 1e-6 with q's limit joints exactly at their limits.
+    from reference import assert_corner_listed
+
+    robot = _arm(arm)
+    q0 = np.array(q)
+    sm, t, b = _generating(robot, q0)
+    assert_corner_listed(robot, sm, q0, t)
+    iv = sm.intervals[sm.interval_branch == b]
+    tc = iv[np.argmin(np.abs((iv[:, 0] - t + np.pi) % (2 * np.pi) - np.pi)), 0]
+    row = sm.sample(tc)[b]
+    assert np.abs(row - q0).max() < 1e-6
+    lim = robot.limits
+    at = (q0 == lim[:, 0]) | (q0 == lim[:, 1])
+    assert at.sum() >= 2 and np.all((row[at] == lim[at, 0]) | (row[at] == lim[at, 1]))
