@@ -61,6 +61,9 @@
 #define HM_DISC_TWO 1e-15 /* a discriminant / (A^2 + B^2) above it: sp4_roots' two roots */
 #define HM_PAIR_ROWS 48 /* near-fold rows kept for the partner slot (hm_eval_pair) */
 #define HM_MAXG 8 /* grazes (a branch inside a limit by under HM_TOL) per slot */
+#ifndef HM_STRIDE
+#define HM_STRIDE 4 /* rows at every HM_STRIDE-th margin node where the margins keep their signs */
+#endif
 
 enum { HM_KIND_LOWER = 0, HM_KIND_UPPER = 1, HM_KIND_ALIGNED = 2, HM_KIND_FOLD = 3 };
 enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FLAG_FULL = 8,
@@ -91,6 +94,7 @@ typedef struct {
     double qn[PK_MAXJ];
     int nq, qj[HM_MAXQ], qkind[HM_MAXQ];
     double qv[HM_MAXQ];
+    double hfine; /* the margins' grid spacing (the rows' grid is HM_STRIDE times coarser) */
     int flags;
     long evals, cheap;
     double *pts;
@@ -861,6 +865,37 @@ static int hm_hermite_dips(double f0, double f1, double d0, double d1)
     return 0;
 }
 
+/* Whether a cell wider than a margin cell (round 8b: rows at every HM_STRIDE-th
+ * margin node) must be split for one query, its rows not excluding a crossing that
+ * its cubic Hermite model (f0, f1, d0, d1 per unit of the cell) does not show: the
+ * model's departure from its chord, |A| + |B| (f = f0 + d0 s + A s^2 + B s^3), is
+ * the scale of what the rows leave unknown; split where it reaches the distance
+ * that keeps the value away (no sign change: the model's nearest approach to the
+ * value) or the chord's own motion (one crossing: a second extremum inside). */
+static int hm_coarse_unsure(double f0, double f1, double d0, double d1)
+{
+    double A = 3.0 * (f1 - f0) - 2.0 * d0 - d1, B = 2.0 * (f0 - f1) + d0 + d1;
+    double e = fabs(A) + fabs(B);
+    if ((f0 < 0) != (f1 < 0))
+        return e >= fabs(f1 - f0);
+    double near = fmin(fabs(f0), fabs(f1));
+    /* the model's extrema inside: f' = d0 + 2 A s + 3 B s^2 = 0 */
+    double qa = 3.0 * B, qb = 2.0 * A, disc = qb * qb - 4.0 * qa * d0;
+    if (fabs(qa) > 1e-300 && disc >= 0.0) {
+        double sq = sqrt(disc);
+        for (int i = 0; i < 2; i++) {
+            double x = (-qb + (i ? sq : -sq)) / (2.0 * qa);
+            if (x > 0.0 && x < 1.0)
+                near = fmin(near, fabs(f0 + x * (d0 + x * (A + x * B))));
+        }
+    } else if (!(fabs(qa) > 1e-300) && fabs(qb) > 0.0) {
+        double x = -d0 / qb;
+        if (x > 0.0 && x < 1.0)
+            near = fmin(near, fabs(f0 + x * (d0 + x * A)));
+    }
+    return e >= near;
+}
+
 /* 1 / |dq/dt|^2 of slot b's row (0 where a slope is not finite) */
 static double hm_gap(const HmCtx *c, int b, const HmRow *r)
 {
@@ -876,6 +911,7 @@ static double hm_gap(const HmCtx *c, int b, const HmRow *r)
 static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1)
 {
     double h = r1->t - r0->t, big = 0.0;
+    int coarse = h > 1.5 * c->hfine; /* wider than a margin cell (round 8b) */
     for (int j = 0; j < c->n; j++)
         big = fmax(big, fabs(wrap_pi(r1->q[b][j] - r0->q[b][j])));
     if (h < 1e-9 && big < 1e-6)
@@ -898,6 +934,8 @@ static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r
         } else if ((d0 < 0) == (d1 < 0) && hm_hermite_dips(f0, f1, d0, d1)) {
             return 1;
         }
+        if (coarse && hm_coarse_unsure(f0, f1, d0, d1))
+            return 1;
     }
     return 0;
 }
@@ -1564,30 +1602,54 @@ static double hm_margin_extremum(const double *P, const double *T, int k, double
     return 0.5 * (a + e);
 }
 
-/* The first grid: G values over [lo, hi], and in every cell where a margin keeps
- * its sign at both nodes but the parabola through it and a neighbour node turns
- * back toward 0 inside the cell, its extremum (a branch born and dying between
- * two nodes: an island; or a short gap). Returns the count (<= cap) into t,
- * sorted; 0 and a flag when the margins are not available. */
+typedef struct { /* a node of hm_grid: its t, and whether rows are evaluated there */
+    double t;
+    int keep;
+} HmNode;
+
+static int hm_node_cmp(const void *x, const void *y)
+{
+    double a = ((const HmNode *)x)->t, b = ((const HmNode *)y)->t;
+    return a < b ? -1 : a > b;
+}
+
+/* The grid: the existence margins at G values over [lo, hi] (cheap scalars, no rows),
+ * and in every cell where a margin keeps its sign at both nodes but the parabola
+ * through it and a neighbour node turns back toward 0 inside the cell, its extremum
+ * (a branch born and dying between two nodes: an island; or a short gap). Rows are
+ * wanted (round 8b) at every HM_STRIDE-th node, the range's ends, the extra nodes,
+ * and both nodes of every margin cell where a margin changes sign or existence or
+ * turns back (a branch is born or dies there): so every cell where a branch end can
+ * lie is a margin cell, as before, and the others are HM_STRIDE cells wide, where
+ * hm_cell splits what its rows do not certify. Returns the count of row nodes
+ * (<= cap) into t, sorted; 0 and a flag when the margins are not available. */
 static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
 {
     double (*m)[3] = malloc((size_t)G * sizeof(*m));
+    HmNode *nd = malloc((size_t)cap * sizeof(HmNode));
     long nt = 0;
-    if (m == NULL) {
+    if (m == NULL || nd == NULL) {
+        free(m);
+        free(nd);
         c->flags |= HM_FLAG_MEMORY;
         return 0;
     }
     for (long i = 0; i < G; i++) {
-        t[i] = i == G - 1 ? hi : lo + (hi - lo) * (double)i / (double)(G - 1);
-        if (!hm_margins(c->P, c->T, t[i], m[i]))
+        nd[i].t = i == G - 1 ? hi : lo + (hi - lo) * (double)i / (double)(G - 1);
+        nd[i].keep = i % HM_STRIDE == 0 || i == G - 1;
+        if (!hm_margins(c->P, c->T, nd[i].t, m[i]))
             c->flags |= HM_FLAG_BAD;
     }
     nt = G;
     for (long i = 0; i + 1 < G; i++) {
+        for (int k = 0; k < 3; k++) /* a margin changing sign or existence: a branch end */
+            if (isfinite(m[i][k]) != isfinite(m[i + 1][k]) ||
+                (isfinite(m[i][k]) && (m[i][k] < 0) != (m[i + 1][k] < 0)))
+                nd[i].keep = nd[i + 1].keep = 1;
         if (isfinite(m[i][0]) && isfinite(m[i + 1][0]) && (m[i][0] < 0) != (m[i + 1][0] < 0)) {
             /* the first angle's roots end here: the second's margins may change sign
              * between the node and that end; a node just inside the end sees it */
-            double a = t[i], e = t[i + 1], me[3];
+            double a = nd[i].t, e = nd[i + 1].t, me[3];
             int in_a = m[i][0] >= 0;
             for (int it = 0; it < 60 && e - a > 1e-12 * fmax(1.0, fabs(a)); it++) {
                 double mid = 0.5 * (a + e);
@@ -1597,9 +1659,9 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                 else
                     e = mid;
             }
-            double w = 1e-9 * (t[i + 1] - t[i]) * (in_a ? -1.0 : 1.0), tin = in_a ? a : e;
-            if (nt < cap && (in_a ? tin + w > t[i] : tin + w < t[i + 1]))
-                t[nt++] = tin + w;
+            double w = 1e-9 * (nd[i + 1].t - nd[i].t) * (in_a ? -1.0 : 1.0), tin = in_a ? a : e;
+            if (nt < cap && (in_a ? tin + w > nd[i].t : tin + w < nd[i + 1].t))
+                nd[nt++] = (HmNode){tin + w, 1};
         }
         for (int k = 0; k < 3; k++) {
             double a = m[i][k], e = m[i + 1][k];
@@ -1611,7 +1673,7 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                 long j = side ? i + 2 : i - 1;
                 if (j < 0 || j >= G || !isfinite(m[j][k]))
                     continue;
-                double u[3] = {t[i], t[i + 1], t[j]}, f[3] = {a, e, m[j][k]};
+                double u[3] = {nd[i].t, nd[i + 1].t, nd[j].t}, f[3] = {a, e, m[j][k]};
                 /* divided differences */
                 double d1 = (f[1] - f[0]) / (u[1] - u[0]), d2 = (f[2] - f[1]) / (u[2] - u[1]);
                 double q2 = (d2 - d1) / (u[2] - u[0]);
@@ -1628,7 +1690,8 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
             }
             if (!turns)
                 continue;
-            double te = hm_margin_extremum(c->P, c->T, k, t[i], t[i + 1], a < 0);
+            nd[i].keep = nd[i + 1].keep = 1;
+            double te = hm_margin_extremum(c->P, c->T, k, nd[i].t, nd[i + 1].t, a < 0);
             double me[3];
             hm_margins(c->P, c->T, te, me);
             if (!isfinite(me[k]) || (me[k] < 0) == (a < 0))
@@ -1637,12 +1700,17 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                 c->flags |= HM_FLAG_FULL;
                 break;
             }
-            t[nt++] = te;
+            nd[nt++] = (HmNode){te, 1};
         }
     }
     free(m);
-    qsort(t, (size_t)nt, sizeof(double), hm_cmp);
-    return nt;
+    qsort(nd, (size_t)nt, sizeof(HmNode), hm_node_cmp);
+    long kept = 0;
+    for (long i = 0; i < nt; i++)
+        if (nd[i].keep)
+            t[kept++] = nd[i].t;
+    free(nd);
+    return kept;
 }
 
 /* One pose: grid rows, cells, folds, intervals. */
@@ -1661,6 +1729,7 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
         c->flags |= HM_FLAG_MEMORY;
         return;
     }
+    c->hfine = (hi - lo) / (double)(G - 1);
     G = hm_grid(c, G, lo, hi, tg, cap);
     for (long i = 0; i < G; i++)
         hm_eval(c, tg[i], 0xffu, 0xffu, &rows[i]);
@@ -1678,7 +1747,7 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
             if (i + 1 == G)
                 break;
             int v0 = rows[i].valid[b], v1 = rows[i + 1].valid[b];
-            double near = HM_NEAR * (rows[i + 1].t - rows[i].t);
+            double near = HM_NEAR * fmin(rows[i + 1].t - rows[i].t, c->hfine);
             if (v0 && v1 && hm_gap(c, b, &rows[i]) < near)
                 hm_fold_piece(c, b, &rows[i], &rows[i + 1]); /* a node at a branch end */
             else if (v0 && v1 && hm_gap(c, b, &rows[i + 1]) < near)
