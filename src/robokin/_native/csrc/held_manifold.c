@@ -61,6 +61,7 @@
 #define HM_DISC_TWO 1e-15 /* a discriminant / (A^2 + B^2) above it: sp4_roots' two roots */
 #define HM_PAIR_ROWS 48 /* near-fold rows kept for the partner slot (hm_eval_pair) */
 #define HM_MAXG 8 /* grazes (a branch inside a limit by under HM_TOL) per slot */
+#define HM_MAXSEEN 256 /* rows per slot kept to decide pieces (hm_seen) */
 #ifndef HM_STRIDE
 #define HM_STRIDE 4 /* rows at every HM_STRIDE-th margin node where the margins keep their signs */
 #endif
@@ -106,6 +107,14 @@ typedef struct {
     int nfold[8];
     double graze_t[8][HM_MAXG][2]; /* a graze's in-limit stretch */
     int graze_j[8][HM_MAXG], ngraze[8];
+    /* rows of a slot evaluated off the grid that decide a piece (hm_seen, round 8b) */
+    double seen_t[8][HM_MAXSEEN];
+    unsigned char seen_good[8][HM_MAXSEEN];
+    int nseen[8];
+    /* whether slot b's row at a cut is inside (hm_at: the row the cut was found on) */
+    double at_t[8][HM_MAXSEEN];
+    unsigned char at_in[8][HM_MAXSEEN];
+    int nat[8];
     /* the slopes' structured solve (hm_slopes_fast; fast = 0: the full FK, hm_slopes):
      * the first three axes meeting at fc, the held joint last; the chain's product
      * of exponentials is G = T M^-1 (GA, Gt); per t (ft), the first six joints'
@@ -691,6 +700,19 @@ static double hm_hermite_root(double f0, double f1, double d0, double d1)
     return s;
 }
 
+static void hm_seen(HmCtx *c, int b, const HmRow *r);
+static int hm_inside(const HmCtx *c, const HmRow *r, int b, double slack);
+
+/* Slot b's row at cut t is inside (with MANIFOLD_SLACK) or not: kept from the row the
+ * cut was found on, so that hm_intervals' [t, t] rule needs no row there (round 8b) */
+static void hm_at(HmCtx *c, int b, double t, int in)
+{
+    if (c->nat[b] < HM_MAXSEEN) {
+        c->at_t[b][c->nat[b]] = t;
+        c->at_in[b][c->nat[b]++] = (unsigned char)in;
+    }
+}
+
 #ifdef HM_SHARE_STATS /* a measuring build: partner lookups per joint (tried, taken) */
 static long hm_share_n[PK_MAXJ][2];
 #endif
@@ -724,6 +746,7 @@ static int hm_shared(HmCtx *c, int b, int qi, double a, double fa, double e)
     hm_eval(c, found, 0u, 1u << b, &r);
     if (!r.valid[b])
         return 0;
+    hm_seen(c, b, &r);
     double f = fa + wrap_pi(hm_f(c, &r, b, qi) - fa);
     if (!(fabs(f) <= 1e-14))
         return 0;
@@ -731,6 +754,7 @@ static int hm_shared(HmCtx *c, int b, int qi, double a, double fa, double e)
     hm_share_n[j][1]++;
 #endif
     hm_point(c, found, b, j, c->qkind[qi]);
+    hm_at(c, b, found, hm_inside(c, &r, b, MANIFOLD_SLACK));
     return 1;
 }
 
@@ -752,7 +776,7 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
         if (tn > a && tn < e)
             t = tn;
     }
-    int side = 0;
+    int side = 0, best_in = -1; /* best_in: the row at best_t inside (-1: not evaluated) */
     HmRow r;
     for (int it = 0; it < 80; it++) {
         hm_eval(c, t, 1u << b, 1u << b, &r);
@@ -760,11 +784,13 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
             c->flags |= HM_FLAG_VANISH;
             return;
         }
+        hm_seen(c, b, &r);
         /* f continuous from a: the turn of q_j nearest fa's */
         double f = fa + wrap_pi(hm_f(c, &r, b, qi) - fa), d = r.dq[b][j];
         if (fabs(f) < best_f) {
             best_f = fabs(f);
             best_t = t;
+            best_in = hm_inside(c, &r, b, MANIFOLD_SLACK);
         }
         if (f == 0.0 || best_f <= 1e-14)
             break;
@@ -798,6 +824,8 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
     }
     int kind = c->qkind[qi];
     hm_point(c, best_t, b, j, kind);
+    if (best_in >= 0)
+        hm_at(c, b, best_t, best_in);
 }
 
 /* The extremum of q_j (slot b) in (a, e) where the slopes da, de have opposite
@@ -816,6 +844,7 @@ static void hm_extremum(HmCtx *c, int b, int j, double a, double da, double e, d
             c->flags |= HM_FLAG_VANISH;
             return;
         }
+        hm_seen(c, b, out);
         double d = out->dq[b][j];
         if (!isfinite(d) || d == 0.0)
             return;
@@ -946,8 +975,10 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
 static void hm_node(HmCtx *c, int b, const HmRow *r)
 {
     for (int qi = 0; qi < c->nq; qi++)
-        if (fabs(hm_f(c, r, b, qi)) <= HM_TOL)
+        if (fabs(hm_f(c, r, b, qi)) <= HM_TOL) {
             hm_point(c, r->t, b, c->qj[qi], c->qkind[qi]);
+            hm_at(c, b, r->t, hm_inside(c, r, b, MANIFOLD_SLACK));
+        }
 }
 
 /* Joint j of configuration q (n) polished against the pose T: one Newton step whose
@@ -1101,6 +1132,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
                 c->flags |= HM_FLAG_VANISH;
                 return;
             }
+            hm_seen(c, b, &m);
             hm_node(c, b, &m);
             hm_cell(c, b, r0, &m, depth + 1);
             hm_cell(c, b, &m, r1, depth + 1);
@@ -1153,6 +1185,7 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
             c->flags |= HM_FLAG_VANISH;
             return;
         }
+        hm_seen(c, b, &r[m]);
         hm_node(c, b, &r[m]);
         m++;
     }
@@ -1380,6 +1413,7 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
         c->flags |= HM_FLAG_VANISH;
         return;
     }
+    hm_at(c, b, end, hm_inside(c, &re, b, MANIFOLD_SLACK));
     hm_node(c, b, &re);
     hm_fold_piece(c, b, &re, state0 ? r0 : r1);
 }
@@ -1437,6 +1471,19 @@ static int hm_decides(const HmCtx *c, const HmRow *r, int b, unsigned char *good
     return 1;
 }
 
+/* Slot b's row r, evaluated off the grid (a split, a crossing's iterate, an
+ * extremum's, a near-fold row), kept when it decides a piece as a grid row does
+ * (hm_decides: every joint inside, or one outside, by more than HM_DECIDE): a
+ * piece holding such a row strictly inside needs no midpoint row (round 8b). */
+static void hm_seen(HmCtx *c, int b, const HmRow *r)
+{
+    unsigned char good;
+    if (c->nseen[b] < HM_MAXSEEN && hm_decides(c, r, b, &good)) {
+        c->seen_t[b][c->nseen[b]] = r->t;
+        c->seen_good[b][c->nseen[b]++] = good;
+    }
+}
+
 /* Whether the piece (a, e) of slot b lies in a graze's stretch (hm_graze): then
  * decided by the row at its middle with the grazing joint polished, inside to
  * HM_TOL, into *good. */
@@ -1490,6 +1537,15 @@ static void hm_intervals(HmCtx *c, int b, double lo, double hi, const HmRow *row
                 best = h;
         if (best >= 0 && hm_decides(c, &rows[best], b, &good[i]))
             continue;
+        int seen = -1; /* else a row off the grid strictly inside, nearest the midpoint */
+        for (int s = 0; s < c->nseen[b]; s++)
+            if (c->seen_t[b][s] > cut[i] && c->seen_t[b][s] < cut[i + 1] &&
+                (seen < 0 || fabs(c->seen_t[b][s] - mid) < fabs(c->seen_t[b][seen] - mid)))
+                seen = s;
+        if (seen >= 0) {
+            good[i] = c->seen_good[b][seen];
+            continue;
+        }
         hm_eval(c, mid, 0u, 1u << b, &r);
         good[i] = (unsigned char)hm_inside(c, &r, b, MANIFOLD_SLACK);
     }
@@ -1497,8 +1553,18 @@ static void hm_intervals(HmCtx *c, int b, double lo, double hi, const HmRow *row
     for (int i = 0; i < u; i++) {
         int left = i > 0 && good[i - 1], right = i + 1 < u && good[i];
         if (!left && !right) {
-            hm_eval(c, cut[i], 0u, 1u << b, &r);
-            if (hm_inside(c, &r, b, MANIFOLD_SLACK) && !hm_emit(c, iv, &k, cut[i], cut[i]))
+            int in = -1; /* the row the cut was found on, else the grid's at the range's ends */
+            for (int s = 0; s < c->nat[b] && in < 0; s++)
+                if (c->at_t[b][s] == cut[i])
+                    in = c->at_in[b][s];
+            if (in < 0 && G > 0 && (cut[i] == rows[0].t || cut[i] == rows[G - 1].t))
+                in = hm_inside(c, cut[i] == rows[0].t ? &rows[0] : &rows[G - 1], b,
+                               MANIFOLD_SLACK);
+            if (in < 0) {
+                hm_eval(c, cut[i], 0u, 1u << b, &r);
+                in = hm_inside(c, &r, b, MANIFOLD_SLACK);
+            }
+            if (in && !hm_emit(c, iv, &k, cut[i], cut[i]))
                 break;
         }
         if (right && !hm_emit(c, iv, &k, cut[i], cut[i + 1]))
@@ -1739,6 +1805,8 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
     for (int b = 0; b < 8; b++) {
         c->ncut[b] = 0;
         c->ngraze[b] = 0;
+        c->nseen[b] = 0;
+        c->nat[b] = 0;
         if (!(b & 1))
             c->npair = c->ipair = 0; /* a new pair */
         for (long i = 0; i < G; i++) {
