@@ -961,6 +961,17 @@ static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r
         double d0 = r0->dq[b][j] * h, d1 = r1->dq[b][j] * h;
         if (fabs(f0) > 3.0 || fabs(f1) > 3.0)
             continue; /* the value's far turn: nothing near */
+        if ((f0 < 0) == (f1 < 0)) {
+            /* round 8b, no sqrt: the Hermite cubic is h00 f0 + h01 f1 (between f0 and
+             * f1) plus d0 h10 + d1 h11 with |h10|, |h11| <= 4/27 on the cell, so it stays
+             * `far` from the value; when that exceeds the tests' thresholds (with room for
+             * their rounding) neither hm_hermite_dips nor hm_coarse_unsure can split */
+            double far = fmin(fabs(f0), fabs(f1)) - 0.1482 * (fabs(d0) + fabs(d1)) -
+                         1e-13 * (fabs(f0) + fabs(f1) + fabs(d0) + fabs(d1));
+            double A = 3.0 * (f1 - f0) - 2.0 * d0 - d1, B = 2.0 * (f0 - f1) + d0 + d1;
+            if (far > 2.0 * HM_TOL && !(HM_UNSURE && coarse && !(far > fabs(A) + fabs(B))))
+                continue;
+        }
         if ((f0 < 0) != (f1 < 0)) {
             if ((d0 < 0) != (d1 < 0) || (d0 < 0) != (f1 < f0))
                 return 1; /* more than one crossing may lie inside */
