@@ -339,6 +339,88 @@ def test_a_dip_within_the_slack_opens_no_gap(q, compiled):
     assert np.any((iv[:, 0] - 1e-9 <= q[6]) & (q[6] <= iv[:, 1] + 1e-9)), iv
 
 
+def _with_limit(joint: int, lo: float | None = None, hi: float | None = None):
+    """The Panda with one joint's limit moved (the same chain otherwise)."""
+    import dataclasses
+
+    chain = PANDA.chain
+    joints = list(chain.joints)
+    l0, h0 = joints[joint].limits
+    joints[joint] = dataclasses.replace(joints[joint], limits=(l0 if lo is None else lo,
+                                                               h0 if hi is None else hi))
+    return PANDA.replace(chain=chain.replace(joints=tuple(joints), coordinates=tuple(joints)))
+
+
+@pytest.mark.parametrize("seed", [8, 29])
+def test_a_shallow_dip_between_row_nodes_is_found(seed):
+    # Round 8b: the kernel's rows are on every 6th node of the margins' grid where no
+    # branch can end (31 of 181), and a cell that wide is split where its Hermite
+    # model's departure from its chord reaches the distance to a value
+    # (hm_coarse_unsure). Hardest case for it: a limit moved to 1e-9 inside a joint's
+    # interior extremum on a branch, so the branch leaves the limits over a stretch
+    # ~2 sqrt(2e-9 / curvature) (1e-4-1e-3 of t) anywhere in a cell. Oracle: the
+    # branch's rows (the held-q7 closed form at 4,001 values, with the original
+    # limits) for the extremum; the moved arm's crossings of that joint on that branch
+    # either side of it, each a row at the limit (1e-10), and no interval of the
+    # branch holding the extremum's t.
+    rng = np.random.default_rng(seed)
+    q0 = rng.uniform(LIMITS[:, 0], LIMITS[:, 1])
+    T = PANDA.fk(q0)
+    sm = PANDA.self_motion(T)
+    assert sm.info.get("compiled")
+    t = np.linspace(*sm.domain, 4001)
+    Q = sm.sample(t)
+    x, c = Q[1:-1], Q[1:-1]
+    ext = []  # (sign, sample, branch, joint): interior extrema, rows either side
+    for sgn in (1.0, -1.0):
+        top = (sgn * x > sgn * Q[:-2]) & (sgn * c >= sgn * Q[2:])
+        ext += [(sgn, i + 1, b, j) for i, b, j in zip(*np.nonzero(top[:, :, :6]), strict=True)]
+    dips = 0
+    for sgn, i, b, j in ext:
+        lim = float(Q[i, b, j] - sgn * 1e-9)
+        if not LIMITS[j, 0] + 0.01 < lim < LIMITS[j, 1] - 0.01:
+            continue
+        arm = _with_limit(j, hi=lim) if sgn > 0 else _with_limit(j, lo=lim)
+        moved = arm.self_motion(T)
+        assert moved.info.get("compiled") and moved.info["flags"] == 0
+        cross = sorted(p.t for p in moved.crossings
+                       if p.branch == b and p.joint == j and abs(p.t - t[i]) < 0.05)
+        before, after = [p for p in cross if p < t[i]], [p for p in cross if p > t[i]]
+        assert before and after, (b, j, t[i], cross)
+        for p in (before[-1], after[0]):
+            assert abs(moved.sample(p)[b, j] - lim) <= 1e-10, (b, j, p)
+        own = moved.intervals[moved.interval_branch == b]
+        assert not np.any((own[:, 0] < t[i]) & (t[i] < own[:, 1])), (b, j, own)
+        dips += 1
+    assert dips >= 5, dips
+
+
+def test_a_crossing_pair_inside_a_wide_cell_is_found():
+    # Round 8b: special pose 24 of seed 4029 (q3 at its upper limit at the generating
+    # q7): its branch leaves q3's upper limit from q7 over 4.7e-3 of t, at most 8.7e-7
+    # past it. A measuring build with rows on every 30th margin node (cells 0.97 rad
+    # wide) and without hm_coarse_unsure's splits missed that gap (one interval
+    # across it); with them it is found; the shipped kernel (every 6th node) finds it.
+    # Oracle: the branch's rows across the gap (the held-q7 closed form) and at its
+    # two crossings.
+    q = np.array([-np.pi / 2, 1.448477987699674, 2.8973, -2.37316790644361,
+                  1.898790242010842, 3.16991758520706, -2.7083826916576066])
+    sm = PANDA.self_motion(PANDA.fk(q))
+    assert sm.info.get("compiled") and sm.info["flags"] == 0
+    b = int(np.nanargmin(np.abs(sm.sample(q[6]) - q).max(-1)))
+    cross = sorted(p.t for p in sm.crossings
+                   if p.branch == b and p.joint == 2 and q[6] - 1e-6 < p.t < q[6] + 1e-2)
+    assert len(cross) == 2 and 4e-3 < cross[1] - cross[0] < 5e-3, cross
+    for p in cross:
+        assert abs(sm.sample(p)[b, 2] - LIMITS[2, 1]) <= 1e-10, p
+    t = np.linspace(cross[0], cross[1], 103)[1:-1]
+    assert np.all(sm.sample(t)[:, b, 2] > LIMITS[2, 1] + 1e-12)  # out across the gap
+    own = sm.intervals[sm.interval_branch == b]
+    assert not np.any((own[:, 0] < t[:, None]) & (t[:, None] < own[:, 1])), own
+    assert np.any(np.isclose(own[:, 1], cross[0], atol=1e-9))  # inside before it
+    assert np.any(np.isclose(own[:, 0], cross[1], atol=1e-9))  # and after it
+
+
 def _last_row(sm, branch: int, t: float) -> float | None:
     """The last float with a row of ``branch`` next to a branch end near t (None when
     the rows 1e-7 either side do not show one side with it, one without).
