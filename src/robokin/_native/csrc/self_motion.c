@@ -67,6 +67,7 @@ static int sm_params_ok(const double *P) { return P[SM_TAG] == SM_TAG_VALUE; }
 
 typedef struct {
     v3 h[7], o[7], S, Wp, MT, ref;
+    v3 perp[2]; /* sm_perp of the shoulder's and the wrist's last axis (h_3, h_7) */
     m3 MR;
     const double *sign, *offset, *lo, *hi;
 } SmArm;
@@ -75,7 +76,7 @@ typedef struct {
     v3 u, r;
     double v4[2], psi0[2];
     int elbow_real, ref_ok;
-    m3 R0[2], TR;
+    m3 R0[2], R4[2], TR; /* R4: the elbow's rotation rot(h4, v4) per root */
 } SmFrame;
 
 /* The rotation about unit axis k with cosine c and sine s */
@@ -108,39 +109,30 @@ static inline m3 sm_tr(const m3 *A)
 
 static inline double sm_norm(v3 a) { return sqrt(v3_dot(a, a)); }
 
-static void sm_arm(const double *P, SmArm *a)
-{
-    for (int k = 0; k < 7; k++) {
-        a->h[k] = v3_at(P, SM_H + 3 * k);
-        a->o[k] = v3_at(P, SM_O + 3 * k);
-    }
-    a->S = v3_at(P, SM_S);
-    a->Wp = v3_at(P, SM_W);
-    a->MT = v3_at(P, SM_MT);
-    a->ref = v3_at(P, SM_REF);
-    a->MR = (m3){v3_at(P, SM_MR), v3_at(P, SM_MR + 3), v3_at(P, SM_MR + 6)};
-    a->sign = P + SM_SIGN;
-    a->offset = P + SM_OFFSET;
-    a->lo = P + SM_LO;
-    a->hi = P + SM_HI;
-}
-
 /* Subproblem 4 (swivel.py _sp4): the angles t with x . rot(h, t) y = c, as
  * A cos t + B sin t = C; returns whether they are real. */
-static int sm_sp4(v3 h, v3 x, v3 y, double c, double *tp, double *tm, double *A, double *B,
-                  double *C)
+static int sm_sp4_rho(v3 h, v3 x, v3 y, double c, double *tp, double *tm, double *A, double *B,
+                      double *C, double *rho_out)
 {
     v3 ypar = v3_scale(h, v3_dot(h, y)), yp = v3_sub(y, ypar);
     *A = v3_dot(x, yp);
     *B = v3_dot(x, v3_cross(h, yp));
     *C = c - v3_dot(x, ypar);
     double rho = hypot(*A, *B);
+    *rho_out = rho;
     int real = fabs(*C) <= rho * (1.0 + SM_DOUBLE) + 1e-300 && rho > 0.0;
     double d = rho > 0.0 ? acos(fmax(-1.0, fmin(1.0, *C / rho))) : NAN;
     double phi = atan2(*B, *A);
     *tp = phi + d;
     *tm = phi - d;
     return real;
+}
+
+static int sm_sp4(v3 h, v3 x, v3 y, double c, double *tp, double *tm, double *A, double *B,
+                  double *C)
+{
+    double rho;
+    return sm_sp4_rho(h, x, y, c, tp, tm, A, B, C, &rho);
 }
 
 /* Subproblem 1 (swivel.py _sp1): the angle about h from x to y; *spread = |x's
@@ -162,6 +154,25 @@ static v3 sm_perp(v3 h)
     return v3_scale(e, 1.0 / sm_norm(e));
 }
 
+static void sm_arm(const double *P, SmArm *a)
+{
+    for (int k = 0; k < 7; k++) {
+        a->h[k] = v3_at(P, SM_H + 3 * k);
+        a->o[k] = v3_at(P, SM_O + 3 * k);
+    }
+    a->S = v3_at(P, SM_S);
+    a->Wp = v3_at(P, SM_W);
+    a->MT = v3_at(P, SM_MT);
+    a->ref = v3_at(P, SM_REF);
+    a->MR = (m3){v3_at(P, SM_MR), v3_at(P, SM_MR + 3), v3_at(P, SM_MR + 6)};
+    a->sign = P + SM_SIGN;
+    a->offset = P + SM_OFFSET;
+    a->lo = P + SM_LO;
+    a->hi = P + SM_HI;
+    a->perp[0] = sm_perp(a->h[2]);
+    a->perp[1] = sm_perp(a->h[6]);
+}
+
 /* Every split of R into rot(ha, va) rot(hb, vb) rot(hc, vc) (swivel.py _triple):
  * v[i] for the middle angle's + / - root; returns whether they are real. The
  * rotations by vb and va are built from the cosines and sines the subproblems
@@ -173,16 +184,17 @@ typedef struct {
     int real;
 } SmSplit;
 
-/* The middle angle's roots of the split of R (with their cosines and sines) */
-static void sm_split(v3 ha, v3 hb, v3 hc, const m3 *R, SmSplit *t)
+/* The middle angle's roots of the split of R (with their cosines and sines); e =
+ * sm_perp(hc) (the arm's constant) */
+static void sm_split(v3 ha, v3 hb, v3 hc, v3 e, const m3 *R, SmSplit *t)
 {
-    double tp, tm, A, B, C;
+    double tp, tm, A, B, C, rho;
     t->ha = ha;
     t->hb = hb;
     t->hc = hc;
     t->Rhc = m3_mv(R, hc);
-    t->real = sm_sp4(hb, ha, hc, v3_dot(ha, t->Rhc), &tp, &tm, &A, &B, &C);
-    double rho = hypot(A, B), x = rho > 0.0 ? fmax(-1.0, fmin(1.0, C / rho)) : NAN;
+    t->real = sm_sp4_rho(hb, ha, hc, v3_dot(ha, t->Rhc), &tp, &tm, &A, &B, &C, &rho);
+    double x = rho > 0.0 ? fmax(-1.0, fmin(1.0, C / rho)) : NAN; /* rho: hypot(A, B) */
     double cp = A / rho, sp = B / rho, cd = x, sd = sqrt(1.0 - x * x);
     t->vb[0] = tp;
     t->vb[1] = tm;
@@ -190,31 +202,54 @@ static void sm_split(v3 ha, v3 hb, v3 hc, const m3 *R, SmSplit *t)
     t->cb[1] = cp * cd + sp * sd;
     t->sb[0] = sp * cd + cp * sd;
     t->sb[1] = sp * cd - cp * sd;
-    t->e = sm_perp(hc);
+    t->e = e;
     t->Re = m3_mv(R, t->e);
     t->ya = v3_sub(t->Rhc, v3_scale(ha, v3_dot(ha, t->Rhc)));
+}
+
+/* The first angle of root i of a split (its cosine and sine, the middle rotation
+ * Rb); sing where the outer axes line up (the first angle set to 0) */
+typedef struct {
+    m3 Rb;
+    double va, ca, sa;
+    int sing;
+} SmFirst;
+
+static void sm_first(const SmSplit *t, int i, SmFirst *r)
+{
+    r->Rb = sm_rotm_cs(t->hb, t->cb[i], t->sb[i]);
+    v3 xa = m3_mv(&r->Rb, t->hc);
+    xa = v3_sub(xa, v3_scale(t->ha, v3_dot(t->ha, xa)));
+    double py = v3_dot(t->ha, v3_cross(xa, t->ya)), px = v3_dot(xa, t->ya), rr = hypot(px, py);
+    r->va = atan2(py, px);
+    r->ca = rr > 0.0 ? px / rr : 1.0;
+    r->sa = rr > 0.0 ? py / rr : 0.0;
+    r->sing = sm_norm(xa) < 1e-9;
+    if (r->sing) {
+        r->va = 0.0;
+        r->ca = 1.0;
+        r->sa = 0.0;
+    }
+}
+
+/* The last angle of a root whose first angle r gives */
+static double sm_last(const SmSplit *t, const SmFirst *r)
+{
+    m3 Ra = sm_rotm_cs(t->ha, r->ca, r->sa), Bm = sm_mul(&Ra, &r->Rb);
+    double dummy;
+    return sm_sp1(t->hc, t->e, m3_mtv(&Bm, t->Re), &dummy);
 }
 
 /* The outer angles of root i of a split: v (3) chain angles; *sing where the outer
  * axes line up (the first angle set to 0) */
 static void sm_split_root(const SmSplit *t, int i, double v[3], int *sing)
 {
-    m3 Rb = sm_rotm_cs(t->hb, t->cb[i], t->sb[i]);
-    v3 xa = m3_mv(&Rb, t->hc);
-    xa = v3_sub(xa, v3_scale(t->ha, v3_dot(t->ha, xa)));
-    double py = v3_dot(t->ha, v3_cross(xa, t->ya)), px = v3_dot(xa, t->ya), r = hypot(px, py);
-    double va = atan2(py, px), ca = r > 0.0 ? px / r : 1.0, sa = r > 0.0 ? py / r : 0.0;
-    *sing = sm_norm(xa) < 1e-9;
-    if (*sing) {
-        va = 0.0;
-        ca = 1.0;
-        sa = 0.0;
-    }
-    m3 Ra = sm_rotm_cs(t->ha, ca, sa), Bm = sm_mul(&Ra, &Rb);
-    double dummy;
-    v[0] = va;
+    SmFirst r;
+    sm_first(t, i, &r);
+    *sing = r.sing;
+    v[0] = r.va;
     v[1] = t->vb[i];
-    v[2] = sm_sp1(t->hc, t->e, m3_mtv(&Bm, t->Re), &dummy);
+    v[2] = sm_last(t, &r);
 }
 
 /* Every split of R into rot(ha, va) rot(hb, vb) rot(hc, vc) (swivel.py _triple):
@@ -222,10 +257,10 @@ static void sm_split_root(const SmSplit *t, int i, double v[3], int *sing)
  * rotations by vb and va are built from the cosines and sines the subproblems
  * give (vb = phi +- d with cos phi = A / rho, cos d = C / rho; va = atan2(y, x)),
  * not from the angles: no sine or cosine is evaluated. */
-static int sm_triple(v3 ha, v3 hb, v3 hc, const m3 *R, double v[2][3], int sing[2])
+static int sm_triple(v3 ha, v3 hb, v3 hc, v3 e, const m3 *R, double v[2][3], int sing[2])
 {
     SmSplit t;
-    sm_split(ha, hb, hc, R, &t);
+    sm_split(ha, hb, hc, e, R, &t);
     for (int i = 0; i < 2; i++)
         sm_split_root(&t, i, v[i], &sing[i]);
     return t.real;
@@ -278,8 +313,8 @@ static void sm_frame(const SmArm *a, const double *T, SmFrame *f)
     }
     f->r = v3_scale(r, 1.0 / sm_norm(r));
     for (int e = 0; e < 2; e++) {
-        m3 R4 = sm_rotm(h4, f->v4[e]);
-        v3 ae = v3_sub(v3_add(a->o[3], m3_mv(&R4, p)), a->S);
+        f->R4[e] = sm_rotm(h4, f->v4[e]);
+        v3 ae = v3_sub(v3_add(a->o[3], m3_mv(&f->R4[e], p)), a->S);
         f->R0[e] = sm_smallest(ae, w);
         f->psi0[e] = sm_angle_of(f->u, f->r, m3_mv(&f->R0[e], h4));
     }
@@ -320,11 +355,11 @@ static void sm_configs_part(const SmArm *a, const SmFrame *f, int e, double psi,
     double sA[2][3] = {{NAN, NAN, NAN}, {NAN, NAN, NAN}}, sB[2][3] = {{NAN, NAN, NAN}, {NAN, NAN, NAN}};
     int gA[2] = {0, 0}, gB[2] = {0, 0}, rA = 1, rB = 1;
     if (part & 1)
-        rA = sm_triple(a->h[0], a->h[1], a->h[2], &RA, sA, gA);
+        rA = sm_triple(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, sA, gA);
     if (part & 2) {
-        m3 R4 = sm_rotm(a->h[3], f->v4[e]), RAR4 = sm_mul(&RA, &R4), X = sm_tr(&RAR4);
+        m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
         m3 RB = sm_mul(&X, &f->TR);
-        rB = sm_triple(a->h[4], a->h[5], a->h[6], &RB, sB, gB);
+        rB = sm_triple(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, sB, gB);
     }
     int real = f->elbow_real && rA && rB;
     for (int s = 0; s < 2; s++)
@@ -347,10 +382,10 @@ static int sm_branch_row(const SmArm *a, const SmFrame *f, int e, int b, double 
     m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
     m3 RA = sm_mul(&Ru, &f->R0[e]);
     SmSplit tA, tB;
-    sm_split(a->h[0], a->h[1], a->h[2], &RA, &tA);
-    m3 R4 = sm_rotm(a->h[3], f->v4[e]), RAR4 = sm_mul(&RA, &R4), X = sm_tr(&RAR4);
+    sm_split(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, &tA);
+    m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
     m3 RB = sm_mul(&X, &f->TR);
-    sm_split(a->h[4], a->h[5], a->h[6], &RB, &tB);
+    sm_split(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, &tB);
     if (!(f->elbow_real && tA.real && tB.real))
         return 0;
     double sA[3], sB[3];
@@ -362,6 +397,97 @@ static int sm_branch_row(const SmArm *a, const SmFrame *f, int e, int b, double 
         q[4 + j] = sm_joint(a, 4 + j, sB[j]);
     }
     q[3] = sm_joint(a, 3, f->v4[e]);
+    return 1;
+}
+
+/* Inside every limit with the slack of SelfMotion.inside (chain.h MANIFOLD_SLACK), so
+ * that a cell whose row rides a limit to rounding (a branch tangent to it, q = limit
+ * + 4e-16) is decided as .inside decides it. */
+static int sm_inside_joint(const SmArm *a, int j, double q)
+{
+    return q >= a->lo[j] - MANIFOLD_SLACK && q <= a->hi[j] + MANIFOLD_SLACK;
+}
+
+/* every joint of a row inside its limits (with the membership slack) */
+static int sm_row_inside(const SmArm *a, const double q[7])
+{
+    for (int j = 0; j < 7; j++)
+        if (!sm_inside_joint(a, j, q[j]))
+            return 0;
+    return 1;
+}
+
+/* The split of one triple (part 1 the shoulder, 2 the wrist) of elbow root e at
+ * psi: the middle angle's roots, as sm_configs_part computes them */
+static void sm_part_split(const SmArm *a, const SmFrame *f, int e, double psi, int part,
+                          SmSplit *t)
+{
+    m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
+    m3 RA = sm_mul(&Ru, &f->R0[e]);
+    if (part == 1) {
+        sm_split(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, t);
+        return;
+    }
+    m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
+    m3 RB = sm_mul(&X, &f->TR);
+    sm_split(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, t);
+}
+
+/* Whether root i of a real split t of the triple from joint j0 has its three joints
+ * inside their limits (sm_triple_inside on sm_configs_part's row): the middle joint
+ * first, then the first, then the last, each angle computed only when the joints
+ * before it are inside (the same values, the same verdict) */
+static int sm_root_inside(const SmArm *a, int j0, const SmSplit *t, int i)
+{
+    if (!sm_inside_joint(a, j0 + 1, sm_joint(a, j0 + 1, t->vb[i])))
+        return 0;
+    SmFirst r;
+    sm_first(t, i, &r);
+    if (!sm_inside_joint(a, j0, sm_joint(a, j0, r.va)))
+        return 0;
+    return sm_inside_joint(a, j0 + 2, sm_joint(a, j0 + 2, sm_last(t, &r)));
+}
+
+/* Joint j (not the elbow) of root i of a real split t of its triple, as
+ * sm_configs_part gives it: only the angles up to j's computed */
+static double sm_root_joint(const SmArm *a, int j, const SmSplit *t, int i)
+{
+    int k = j < 3 ? j : j - 4;
+    if (k == 1)
+        return sm_joint(a, j, t->vb[i]);
+    SmFirst r;
+    sm_first(t, i, &r);
+    return sm_joint(a, j, k == 0 ? r.va : sm_last(t, &r));
+}
+
+/* Whether branch b of elbow root e exists at psi with every joint inside its limits
+ * (sm_branch_row's row and sm_row_inside's test): the triple `first` (1 the
+ * shoulder, 2 the wrist) decided first, each angle computed only when needed */
+static int sm_branch_inside(const SmArm *a, const SmFrame *f, int e, int b, double psi,
+                            int first)
+{
+    if (!f->elbow_real || !sm_inside_joint(a, 3, sm_joint(a, 3, f->v4[e])))
+        return 0;
+    m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
+    m3 RA = sm_mul(&Ru, &f->R0[e]);
+    SmSplit t[2];
+    for (int n = 0; n < 2; n++) {
+        int part = n ? 3 - first : first;
+        if (part == 1) {
+            sm_split(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, &t[0]);
+        } else {
+            m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
+            m3 RB = sm_mul(&X, &f->TR);
+            sm_split(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, &t[1]);
+        }
+        if (!t[part - 1].real)
+            return 0;
+    }
+    for (int n = 0; n < 2; n++) {
+        int part = n ? 3 - first : first;
+        if (!sm_root_inside(a, part == 1 ? 0 : 4, &t[part - 1], part == 1 ? b / 2 : b % 2))
+            return 0;
+    }
     return 1;
 }
 
@@ -605,7 +731,7 @@ static int sm_limit_psi(const SmArm *a, const SmFrame *f, int e, int j, double L
         sgn = 1.0;
     } else {
         v3 ha = h[4], hb = h[5], hc = h[6];
-        m3 R4 = sm_rotm(h[3], f->v4[e]), base = sm_mul(&f->R0[e], &R4);
+        m3 base = sm_mul(&f->R0[e], &f->R4[e]);
         if (j == 4) {
             m3 Ra = sm_rotm(ha, L);
             x = m3_mv(&base, m3_mv(&Ra, hb));
@@ -682,29 +808,6 @@ static int sm_candidates(const SmArm *a, const SmFrame *f, int e, SmCand *c)
     return n;
 }
 
-static int sm_cmp(const void *x, const void *y)
-{
-    double a = *(const double *)x, b = *(const double *)y;
-    return (a > b) - (a < b);
-}
-
-/* Inside every limit with the slack of SelfMotion.inside (chain.h MANIFOLD_SLACK), so
- * that a cell whose row rides a limit to rounding (a branch tangent to it, q = limit
- * + 4e-16) is decided as .inside decides it. */
-static int sm_inside_joint(const SmArm *a, int j, double q)
-{
-    return q >= a->lo[j] - MANIFOLD_SLACK && q <= a->hi[j] + MANIFOLD_SLACK;
-}
-
-/* every joint of a row inside its limits (with the membership slack) */
-static int sm_row_inside(const SmArm *a, const double q[7])
-{
-    for (int j = 0; j < 7; j++)
-        if (!sm_inside_joint(a, j, q[j]))
-            return 0;
-    return 1;
-}
-
 typedef struct {
     const double *P, *T;
     double *iv, *pts;
@@ -713,14 +816,6 @@ typedef struct {
 
 /* Candidates within this of each other [rad] may be one corner (sm_runs) */
 #define SM_CORNER 1e-9
-
-/* Whether the triple of joints j0..j0+2 of a row (ok: it exists) is inside */
-static int sm_triple_inside(const SmArm *a, int j0, int ok, const double *q)
-{
-    for (int j = j0; j < j0 + 3 && ok; j++)
-        ok = sm_inside_joint(a, j, q[j]);
-    return ok;
-}
 
 /* The runs of swivel angles where one triple (part 1 the shoulder, 2 the wrist) of
  * elbow root e exists with its three joints inside their limits, per root r of its
@@ -741,28 +836,33 @@ static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmC
     for (int i = 0; i < nc; i++)
         if ((c[i].joint < 3) == (part == 1))
             cut[m++] = c[i].psi;
-    qsort(cut, (size_t)m, sizeof(double), sm_cmp);
+    for (int i = 1; i < m; i++) { /* insertion sort (stable), at most 66 cuts */
+        double x = cut[i];
+        int k = i;
+        for (; k > 0 && cut[k - 1] > x; k--)
+            cut[k] = cut[k - 1];
+        cut[k] = x;
+    }
     int open[2] = {0, 0};
     nrun[0] = nrun[1] = 0;
     for (int i = 0; i + 1 < m; i++) {
         double lo = cut[i], hi = cut[i + 1];
         if (!(hi > lo))
             continue;
-        double q[4][7], qc[4][7];
-        int ok[4], sg[4], okc[4], at = 0; /* at: the row at the cut lo computed */
-        sm_configs_part(a, f, e, 0.5 * (lo + hi), part, q, ok, sg);
+        SmSplit t, tc;
+        int at = 0; /* at: the split at the cut lo computed */
+        sm_part_split(a, f, e, 0.5 * (lo + hi), part, &t);
         for (int r = 0; r < 2; r++) {
-            int b = part == 1 ? 2 * r : r; /* the other triple's root 0: NaN there */
-            int in = sm_triple_inside(a, j0, ok[b], q[b]);
+            int in = t.real && sm_root_inside(a, j0, &t, r);
             if (!in && !open[r] && lo > -M_PI && nrun[r] < SM_MAXI &&
                 (lo - cut[i - 1] <= SM_CORNER || hi - lo <= SM_CORNER)) {
                 /* both cells next to the cut outside and another cut within SM_CORNER
                  * (two joints of the triple at limits there, leaving on either side):
                  * the cut alone, if its row is in */
                 if (!at)
-                    sm_configs_part(a, f, e, lo, part, qc, okc, sg);
+                    sm_part_split(a, f, e, lo, part, &tc);
                 at = 1;
-                if (sm_triple_inside(a, j0, okc[b], qc[b])) {
+                if (tc.real && sm_root_inside(a, j0, &tc, r)) {
                     run[r][nrun[r]][0] = run[r][nrun[r]][1] = lo;
                     nrun[r]++;
                 }
@@ -780,17 +880,17 @@ static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmC
     /* the cut at -pi (= pi) by the same rule: both cells next to it outside (no run
      * starts at -pi, none ends at pi) and the row there inside: [-pi, -pi] first and
      * [pi, pi] last (joined across pi into one point, sm_elbow_intervals) */
-    int at = 0, okc[4], sg[4];
-    double qc[4][7];
+    int at = 0;
+    SmSplit tc;
     for (int r = 0; r < 2; r++) {
-        int b = part == 1 ? 2 * r : r, n = nrun[r];
+        int n = nrun[r];
         if ((n && (run[r][0][0] == -M_PI || run[r][n - 1][1] == M_PI)) || n + 2 > SM_MAXI ||
             !(cut[1] + M_PI <= SM_CORNER || M_PI - cut[m - 2] <= SM_CORNER))
             continue; /* a run at an end, or no candidate at +-pi */
         if (!at)
-            sm_configs_part(a, f, e, -M_PI, part, qc, okc, sg);
+            sm_part_split(a, f, e, -M_PI, part, &tc);
         at = 1;
-        if (!sm_triple_inside(a, j0, okc[b], qc[b]))
+        if (!(tc.real && sm_root_inside(a, j0, &tc, r)))
             continue;
         for (int i = n; i > 0; i--) {
             run[r][i][0] = run[r][i - 1][0];
@@ -839,17 +939,16 @@ static int sm_in_runs(double x[][2], int n, double psi)
  * both at limits). The two ends are computed roots of different subproblems: next
  * to a near-tangent one (a joint whose slope over the swivel is small, 1e-6) they
  * miss each other by more than rounding, so the overlap of the runs is empty.
- * Adds each as a one-point interval [psi, psi] into r (k sorted intervals). */
+ * Adds each as a one-point interval [psi, psi] into r (k sorted intervals). party:
+ * the triple of y (1 the shoulder, 2 the wrist), tested first (usually outside). */
 static long long sm_touches(const SmArm *a, const SmFrame *f, int e, int b, double x[][2], int nx,
-                            double y[][2], int ny, double *r, long long k)
+                            double y[][2], int ny, int party, double *r, long long k)
 {
     for (int i = 0; i < nx; i++)
         for (int s = 0; s < 2; s++) {
-            double t = x[i][s], q[7];
+            double t = x[i][s];
             if (t == -M_PI || t == M_PI || sm_in_runs(y, ny, t) || k >= SM_MAXI ||
-                !sm_branch_row(a, f, e, b, t, q))
-                continue;
-            if (!sm_row_inside(a, q))
+                !sm_branch_inside(a, f, e, b, t, party))
                 continue;
             long long p = k++;
             while (p > 0 && r[2 * p - 2] > t) {
@@ -880,8 +979,8 @@ static void sm_elbow_intervals(const SmArm *a, const SmFrame *f, int e, const Sm
     for (int b = 0; b < 4; b++) {
         double *r = iv + 2 * SM_MAXI * b;
         long long k = sm_overlap(rs[b / 2], ns[b / 2], rw[b % 2], nw[b % 2], r);
-        k = sm_touches(a, f, e, b, rs[b / 2], ns[b / 2], rw[b % 2], nw[b % 2], r, k);
-        k = sm_touches(a, f, e, b, rw[b % 2], nw[b % 2], rs[b / 2], ns[b / 2], r, k);
+        k = sm_touches(a, f, e, b, rs[b / 2], ns[b / 2], rw[b % 2], nw[b % 2], 2, r, k);
+        k = sm_touches(a, f, e, b, rw[b % 2], nw[b % 2], rs[b / 2], ns[b / 2], 1, r, k);
         /* periodic: a run ending at pi and one starting at -pi join */
         if (k >= 2 && r[0] == -M_PI && r[2 * k - 1] == M_PI) {
             double end = r[1] + 2.0 * M_PI, start = r[2 * k - 2];
@@ -913,15 +1012,19 @@ static void sm_manifold1(const SmArm *a, const double *T, double *iv, long long 
         int nc = sm_candidates(a, &f, e, c);
         /* the points: which branches are at the value there */
         for (int i = 0; i < nc; i++) {
-            double q[4][7];
-            int ok[4], sg[4];
-            sm_configs_part(a, &f, e, c[i].psi, c[i].joint < 3 ? 1 : 2, q, ok, sg);
+            int j = c[i].joint, part = j < 3 ? 1 : 2;
+            SmSplit t;
+            sm_part_split(a, &f, e, c[i].psi, part, &t);
+            if (!t.real)
+                continue;
+            double qr[2] = {sm_root_joint(a, j, &t, 0), sm_root_joint(a, j, &t, 1)};
             for (int b = 0; b < 4; b++) {
-                if (!ok[b] || *npts >= SM_MAXP)
+                if (*npts >= SM_MAXP)
                     continue;
+                double qj = qr[part == 1 ? b / 2 : b % 2];
                 double d = c[i].kind <= SM_KIND_UPPER
-                    ? q[b][c[i].joint] - c[i].value
-                    : a->sign[c[i].joint] * q[b][c[i].joint] + a->offset[c[i].joint] - c[i].value;
+                    ? qj - c[i].value
+                    : a->sign[j] * qj + a->offset[j] - c[i].value;
                 if (fabs(wrap_pi(d)) < SM_SAME) {
                     double *r = pts + 4 * (*npts)++;
                     r[0] = c[i].psi;
