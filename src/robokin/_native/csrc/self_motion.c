@@ -215,7 +215,7 @@ typedef struct {
     int sing;
 } SmFirst;
 
-static void sm_first(const SmSplit *t, int i, SmFirst *r)
+ALWAYS_INLINE void sm_first(const SmSplit *t, int i, SmFirst *r)
 {
     r->Rb = sm_rotm_cs(t->hb, t->cb[i], t->sb[i]);
     v3 xa = m3_mv(&r->Rb, t->hc);
@@ -233,7 +233,7 @@ static void sm_first(const SmSplit *t, int i, SmFirst *r)
 }
 
 /* The last angle of a root whose first angle r gives */
-static double sm_last(const SmSplit *t, const SmFirst *r)
+ALWAYS_INLINE double sm_last(const SmSplit *t, const SmFirst *r)
 {
     m3 Ra = sm_rotm_cs(t->ha, r->ca, r->sa), Bm = sm_mul(&Ra, &r->Rb);
     double dummy;

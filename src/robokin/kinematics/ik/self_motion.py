@@ -46,7 +46,7 @@ import numpy.typing as npt
 from robokin._native import kernels as K
 from robokin._validation import check_finite, check_joints, check_rigid
 from robokin.exceptions import InputError
-from robokin.kinematics.arm import ArmSource, arm_of
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.fixed import Dispatch
 from robokin.kinematics.ik.self_motion_base import _Family
 from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
@@ -401,11 +401,7 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
     setup = _setup(robot) if robot.n == 7 and not reference else None
     # the compiled swivel (an SRS arm's "auto"): no family choice, no per-call lists
     if setup is not None and setup.swivel is not None and parameter in ("auto", "swivel"):
-        sw = _SwivelFamily(setup.swivel, Ta, robot)
-        intervals, owner, points = sw.exact()
-        return SelfMotion(Ta, "swivel", None, _SWIVEL_DOMAIN.copy(), True, 8, intervals, owner,
-                          "swivel closed form (SRS), compiled", {"bisected": 0, "grid": 0},
-                          sw, limits, points)
+        return _swivel_motion(setup.swivel, Ta, robot, limits)
     kern: HeldKernel | None = setup.held if setup is not None else None
     if kern is not None and parameter in ("auto", kern.named[0]):
         # the compiled held family "auto" took before: no family choice again
@@ -463,6 +459,23 @@ def _held_motion(T: np.ndarray, kern: HeldKernel, intervals: np.ndarray, owner: 
     return sm
 
 
+def _swivel_motion(arm: SwivelArm, T: np.ndarray, robot: Arm, limits: np.ndarray
+                   ) -> SelfMotion:
+    """The compiled swivel's SelfMotion: the dataclass' fields set directly.
+
+    Equal to ``SelfMotion(T, "swivel", None, domain, True, 8, intervals, owner, method,
+    {"bisected": 0, "grid": 0}, family, limits, points)`` (as ``_held_motion``: the
+    frozen dataclass' ``__init__`` is ~3 us of the ~15 us the API adds to the kernel).
+    """
+    sw = _SwivelFamily(arm, T, robot)
+    intervals, owner, points = sw.exact()
+    sm = object.__new__(SelfMotion)
+    vars(sm).update(zip(_FIELDS, (T, "swivel", None, _SWIVEL_DOMAIN.copy(), True, 8, intervals,
+                                  owner, _SWIVEL_METHOD, {"bisected": 0, "grid": 0}, sw, limits,
+                                  points, None, False), strict=True))
+    return sm
+
+
 def _solves(fam: _Family) -> dict[str, int]:
     """A continued family's ``solves`` (general-6R values solved) and ``degenerate``."""
     if not isinstance(fam, _ContinuedFamily):
@@ -472,6 +485,8 @@ def _solves(fam: _Family) -> dict[str, int]:
 
 #: The swivel's parameter range (copied into each SelfMotion).
 _SWIVEL_DOMAIN = np.array([-np.pi, np.pi])
+#: The compiled swivel's ``method``.
+_SWIVEL_METHOD = "swivel closed form (SRS), compiled"
 #: The compiled swivel's point kinds (``SM_KIND_*`` 0-3), as the records name them.
 _KINDS = ("lower", "upper", "aligned axes", "fold")
 
