@@ -99,25 +99,40 @@ samp = best(lambda: [sm.sample(t64) for sm in sms]) / 64
 saved = {{}}
 
 
-def replay(params, T, iv, niv, pts, npts):
-    key = T.tobytes()
-    if key not in saved:
-        K.swivel_manifold(params, T, iv, niv, pts, npts)
-        saved[key] = (iv.copy(), niv.copy(), pts.copy(), npts.copy())
-    for x, s in zip((iv, niv, pts, npts), saved[key]):
-        x[...] = s
+def replayer(name):
+    kernel = getattr(K, name)
+
+    def replay(params, T, *out):
+        key = T.tobytes()
+        if key not in saved:
+            saved[key] = (kernel(params, T, *out), [x.copy() for x in out])
+        for x, s in zip(out, saved[key][1]):
+            x[...] = s
+        return saved[key][0]
+    return replay
+
+
+# the kernel the API calls (main: swivel_manifold on (1, 4, 4); since round 8c
+# swivel_manifold_one) replaced by a replay of its outputs
+one = hasattr(K, "swivel_manifold_one")
+name = "swivel_manifold_one" if one else "swivel_manifold"
+replay = replayer(name)
 
 
 class Replayed:
-    def __getattr__(self, name):
-        return replay if name == "swivel_manifold" else getattr(K, name)
+    def __getattr__(self, attr):
+        return replay if attr == name else getattr(K, attr)
 
 
 swivel.K = Replayed()
 for t in Tt:
     robot.self_motion(t)
 alone = best(lambda: [robot.self_motion(t) for t in Tt], 3 * {repeat})
-bare = best(lambda: [replay(arm.params, t, *o) for t in T1], 3 * {repeat})
+if one:
+    o1 = (np.empty((K.SM_MAXIV, 2)), np.empty(K.SM_MAXIV, np.int64), np.empty((K.SM_MAXP, 4)))
+    bare = best(lambda: [replay(arm.params, t, *o1) for t in Tt], 3 * {repeat})
+else:
+    bare = best(lambda: [replay(arm.params, t, *o) for t in T1], 3 * {repeat})
 swivel.K = K
 print(f"self_motion {{api:.2f}} us, kernel one pose per call {{kern1:.2f}} us, "
       f"API alone (kernel replayed) {{alone - bare:.2f}} us per pose; sample {{samp:.3f}} us "

@@ -246,6 +246,7 @@ class Kernels(Protocol):
     SM_TAG: int
     SM_N_PARAMS: int
     SM_MAXI: int
+    SM_MAXIV: int
     SM_MAXP: int
     SM_KIND_LOWER: int
     SM_KIND_UPPER: int
@@ -694,6 +695,17 @@ class Kernels(Protocol):
         /,
     ) -> None:
         """Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,)."""
+
+    def swivel_manifold_one(
+        self,
+        params: F64,
+        T: F64,
+        iv: F64,
+        branch: I64,
+        pts: F64,
+        /,
+    ) -> tuple[int, int]:
+        """``swivel_manifold`` of one pose T (4, 4), packed: its intervals branch by branch into iv (m, 2) with their branches, its points into pts; returns (m, points). One thread."""
 
     def swivel_near(
         self,

@@ -49,6 +49,7 @@ enum {
 };
 #define SM_TAG_VALUE 2008.0625 /* Shimizu et al.'s year, and a sixteenth */
 #define SM_MAXI 40             /* intervals per branch (at most 33 cells per elbow) */
+#define SM_MAXIV (8 * SM_MAXI) /* intervals per pose (swivel_manifold_one) */
 #define SM_MAXP 256            /* points per pose: 32 swivel angles per elbow, 4 branches */
 #define SM_KIND_LOWER 0
 #define SM_KIND_UPPER 1
@@ -1058,6 +1059,24 @@ static PyObject *swivel_manifold_body(const swivel_manifold_args *a)
         sm_manifold_range(&jb, 0, (long)a->N);
     Py_END_ALLOW_THREADS
     Py_RETURN_NONE;
+}
+
+/* One pose (robot.self_motion's call): sm_manifold1, its intervals packed branch by
+ * branch with their branches; returns (intervals, points). */
+static PyObject *swivel_manifold_one_body(const swivel_manifold_one_args *a)
+{
+    double iv[8 * SM_MAXI * 2];
+    long long niv[8], npts = 0, m = 0;
+    SmArm arm;
+    sm_arm(a->params, &arm);
+    sm_manifold1(&arm, a->T, iv, niv, a->pts, &npts);
+    for (int b = 0; b < 8; b++)
+        for (long long i = 0; i < niv[b]; i++, m++) {
+            a->iv[2 * m] = iv[2 * (SM_MAXI * b + i)];
+            a->iv[2 * m + 1] = iv[2 * (SM_MAXI * b + i) + 1];
+            a->branch[m] = b;
+        }
+    return Py_BuildValue("(LL)", m, npts);
 }
 
 /* ------------------------------------------------------------ the nearest point */
