@@ -106,9 +106,11 @@ def replayer(name):
         key = T.tobytes()
         if key not in saved:
             saved[key] = (kernel(params, T, *out), [x.copy() for x in out])
-        for x, s in zip(out, saved[key][1]):
+        ret, outs = saved[key]
+        for x, s in zip(out, outs):
             x[...] = s
-        return saved[key][0]
+        # swivel_manifold_one returns new arrays: new copies, as the kernel makes them
+        return None if ret is None else tuple(x.copy() for x in ret)
     return replay
 
 
@@ -129,8 +131,7 @@ for t in Tt:
     robot.self_motion(t)
 alone = best(lambda: [robot.self_motion(t) for t in Tt], 3 * {repeat})
 if one:
-    o1 = (np.empty((K.SM_MAXIV, 2)), np.empty(K.SM_MAXIV, np.int64), np.empty((K.SM_MAXP, 4)))
-    bare = best(lambda: [replay(arm.params, t, *o1) for t in Tt], 3 * {repeat})
+    bare = best(lambda: [replay(arm.params, t) for t in Tt], 3 * {repeat})
 else:
     bare = best(lambda: [replay(arm.params, t, *o) for t in T1], 3 * {repeat})
 swivel.K = K

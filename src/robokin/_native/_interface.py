@@ -246,7 +246,6 @@ class Kernels(Protocol):
     SM_TAG: int
     SM_N_PARAMS: int
     SM_MAXI: int
-    SM_MAXIV: int
     SM_MAXP: int
     SM_KIND_LOWER: int
     SM_KIND_UPPER: int
@@ -696,16 +695,8 @@ class Kernels(Protocol):
     ) -> None:
         """Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,)."""
 
-    def swivel_manifold_one(
-        self,
-        params: F64,
-        T: F64,
-        iv: F64,
-        branch: I64,
-        pts: F64,
-        /,
-    ) -> tuple[int, int]:
-        """``swivel_manifold`` of one pose T (4, 4), packed: its intervals branch by branch into iv (m, 2) with their branches, its points into pts; returns (m, points). One thread."""
+    def swivel_manifold_one(self, params: F64, T: F64, /) -> tuple[F64, I64, F64]:
+        """``swivel_manifold`` of one pose T (4, 4), packed: new arrays of its intervals (m, 2) branch by branch, their branches (m,) and its points (p, 4). One thread."""
 
     def swivel_near(
         self,

@@ -49,7 +49,6 @@ enum {
 };
 #define SM_TAG_VALUE 2008.0625 /* Shimizu et al.'s year, and a sixteenth */
 #define SM_MAXI 40             /* intervals per branch (at most 33 cells per elbow) */
-#define SM_MAXIV (8 * SM_MAXI) /* intervals per pose (swivel_manifold_one) */
 #define SM_MAXP 256            /* points per pose: 32 swivel angles per elbow, 4 branches */
 #define SM_KIND_LOWER 0
 #define SM_KIND_UPPER 1
@@ -1062,21 +1061,37 @@ static PyObject *swivel_manifold_body(const swivel_manifold_args *a)
 }
 
 /* One pose (robot.self_motion's call): sm_manifold1, its intervals packed branch by
- * branch with their branches; returns (intervals, points). */
+ * branch; returns new arrays (intervals (m, 2), branches (m,), points (p, 4)). */
 static PyObject *swivel_manifold_one_body(const swivel_manifold_one_args *a)
 {
-    double iv[8 * SM_MAXI * 2];
+    double iv[8 * SM_MAXI * 2], pts[4 * SM_MAXP];
     long long niv[8], npts = 0, m = 0;
     SmArm arm;
     sm_arm(a->params, &arm);
-    sm_manifold1(&arm, a->T, iv, niv, a->pts, &npts);
+    sm_manifold1(&arm, a->T, iv, niv, pts, &npts);
     for (int b = 0; b < 8; b++)
-        for (long long i = 0; i < niv[b]; i++, m++) {
-            a->iv[2 * m] = iv[2 * (SM_MAXI * b + i)];
-            a->iv[2 * m + 1] = iv[2 * (SM_MAXI * b + i) + 1];
-            a->branch[m] = b;
+        m += niv[b];
+    npy_intp di[2] = {(npy_intp)m, 2}, dp[2] = {(npy_intp)npts, 4};
+    PyObject *out_iv = PyArray_SimpleNew(2, di, NPY_DOUBLE);
+    PyObject *out_b = PyArray_SimpleNew(1, di, NPY_INT64);
+    PyObject *out_p = PyArray_SimpleNew(2, dp, NPY_DOUBLE);
+    if (out_iv == NULL || out_b == NULL || out_p == NULL) {
+        Py_XDECREF(out_iv);
+        Py_XDECREF(out_b);
+        Py_XDECREF(out_p);
+        return NULL;
+    }
+    double *ov = (double *)PyArray_DATA((PyArrayObject *)out_iv);
+    long long *ob = (long long *)PyArray_DATA((PyArrayObject *)out_b);
+    for (int b = 0, k = 0; b < 8; b++)
+        for (long long i = 0; i < niv[b]; i++, k++) {
+            ov[2 * k] = iv[2 * (SM_MAXI * b + i)];
+            ov[2 * k + 1] = iv[2 * (SM_MAXI * b + i) + 1];
+            ob[k] = b;
         }
-    return Py_BuildValue("(LL)", m, npts);
+    if (npts)
+        memcpy(PyArray_DATA((PyArrayObject *)out_p), pts, (size_t)(4 * npts) * sizeof(double));
+    return Py_BuildValue("(NNN)", out_iv, out_b, out_p);
 }
 
 /* ------------------------------------------------------------ the nearest point */

@@ -277,15 +277,12 @@ class SwivelArm:
         """:meth:`manifold` of one pose T (4, 4, contiguous float64), packed.
 
         Returns:
-            ``(intervals (m, 2), branch (m,), points (p, 4))``: the intervals branch by
-            branch (each branch's sorted), then the points, as :meth:`manifold` gives
-            them (``robot.self_motion``'s call: no batch axes, no masking).
+            ``(intervals (m, 2), branch (m,), points (p, 4))``, new arrays: the
+            intervals branch by branch (each branch's sorted), then the points, as
+            :meth:`manifold` gives them (``robot.self_motion``'s call: no batch axes,
+            no per-call output arrays or masking).
         """
-        iv = np.empty((K.SM_MAXIV, 2))
-        branch = np.empty(K.SM_MAXIV, np.int64)
-        pts = np.empty((K.SM_MAXP, 4))
-        m, p = K.swivel_manifold_one(self.params, T, iv, branch, pts)
-        return iv[:m], branch[:m], pts[:p]
+        return K.swivel_manifold_one(self.params, T)
 
     def nearest(self, T: np.ndarray, q_near: np.ndarray
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
