@@ -542,7 +542,8 @@ SELF_MOTION = Group("self_motion.c", kernels=(
                    "distance (N,); found (N,) false (q NaN) where no part is inside.",
            checks=(Check("sm_params_ok(a->params)", "params is not a swivel parameter vector"),)),
 ), constants=_consts(
-    "H O S W MR MT SIGN OFFSET LO HI REF TAG N_PARAMS MAXI MAXP KIND_LOWER KIND_UPPER "
+    "H O S W MR MT SIGN OFFSET LO HI REF TAG ARC LIMCS FOLDCS N_PARAMS MAXI MAXP KIND_LOWER "
+    "KIND_UPPER "
     "KIND_ALIGNED KIND_FOLD", "SM_", "SM_") + (Const("SM_TAG_VALUE", "SM_TAG_VALUE", "float"),),
     comment="swivel parameter vector layout (swivel.SwivelArm.packed), point kinds")
 

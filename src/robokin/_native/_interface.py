@@ -244,6 +244,9 @@ class Kernels(Protocol):
     SM_HI: int
     SM_REF: int
     SM_TAG: int
+    SM_ARC: int
+    SM_LIMCS: int
+    SM_FOLDCS: int
     SM_N_PARAMS: int
     SM_MAXI: int
     SM_MAXP: int

@@ -33,6 +33,14 @@
  *   SM_SIGN, SM_OFFSET, SM_LO, SM_HI   per joint (7 each): v = sign q + offset, limits
  *   SM_REF        the swivel's reference direction (axis 1) (3)
  *   SM_TAG        SM_TAG_VALUE
+ *   SM_ARC        per joint (7 x 4) the quick limit test's constants (sm_arc): the cosine
+ *                 and sine of the chain angle at the middle of the limits, cos(w - m) +
+ *                 pad and cos(w + m) - pad (w half the range, SM_QUICK_M, SM_QUICK_PAD),
+ *                 or (0, 0, 2, -2) where the test does not apply
+ *   SM_LIMCS      per joint and limit (7 x 2 x 2) the cosine and sine of the limit's
+ *                 chain angle sign lim + offset
+ *   SM_FOLDCS     per triple (2 x 2) the cosine and sine of the middle angle where the
+ *                 outer axes are nearest (the fold / aligned value, sm_candidates' base)
  *
  * References: Shimizu, Kakuya, Yoon, Kitagaki and Kosuge, "Analytical inverse
  * kinematic computation for 7-DOF redundant manipulators with joint limits and
@@ -45,7 +53,8 @@
 
 enum {
     SM_H = 0, SM_O = 21, SM_S = 42, SM_W = 45, SM_MR = 48, SM_MT = 57, SM_SIGN = 60,
-    SM_OFFSET = 67, SM_LO = 74, SM_HI = 81, SM_REF = 88, SM_TAG = 91, SM_N_PARAMS = 92
+    SM_OFFSET = 67, SM_LO = 74, SM_HI = 81, SM_REF = 88, SM_TAG = 91, SM_ARC = 92,
+    SM_LIMCS = 120, SM_FOLDCS = 148, SM_N_PARAMS = 152
 };
 #define SM_TAG_VALUE 2008.0625 /* Shimizu et al.'s year, and a sixteenth */
 #define SM_MAXI 40             /* intervals per branch (at most 33 cells per elbow) */
@@ -59,6 +68,16 @@ enum {
 #define SM_ACCEPT 5e-13  /* pose errors above it after the polish: dropped */
 #define SM_SAME 1e-6     /* a branch's joint this near a value [rad]: at it */
 #define SM_GRAIN 16      /* poses per pool chunk */
+/* The quick tests (sm_quick_*): a cell's or a point's verdict from the cosines and
+ * sines of its angles, without atan2 / acos, where it is certain; else the exact
+ * test. The cosine-sine pairs stand for the exact path's angles to 1.1e-8 rad (the
+ * middle angle next to the end of its range: sqrt(1 - x^2) of a rounded x); a
+ * joint decided quickly is at least SM_QUICK_M from its limits, a point's joint
+ * below 0.9 or above 1.1 SM_SAME from the value (chord^2 thresholds). */
+#define SM_QUICK_M 1e-6
+#define SM_QUICK_PAD 5e-8
+#define SM_AT_IN (0.9e-6 * 0.9e-6)
+#define SM_AT_OUT (1.1e-6 * 1.1e-6)
 #define SM_PARALLEL_MIN 64
 
 static int sm_params_ok(const double *P) { return P[SM_TAG] == SM_TAG_VALUE; }
@@ -69,7 +88,7 @@ typedef struct {
     v3 h[7], o[7], S, Wp, MT, ref;
     v3 perp[2]; /* sm_perp of the shoulder's and the wrist's last axis (h_3, h_7) */
     m3 MR;
-    const double *sign, *offset, *lo, *hi;
+    const double *sign, *offset, *lo, *hi, *arc, *limcs, *foldcs;
 } SmArm;
 
 typedef struct {
@@ -111,16 +130,22 @@ static inline double sm_norm(v3 a) { return sqrt(v3_dot(a, a)); }
 
 /* Subproblem 4 (swivel.py _sp4): the angles t with x . rot(h, t) y = c, as
  * A cos t + B sin t = C; returns whether they are real. */
-static int sm_sp4_rho(v3 h, v3 x, v3 y, double c, double *tp, double *tm, double *A, double *B,
-                      double *C, double *rho_out)
+/* Subproblem 4's A, B, C and rho = hypot(A, B); returns whether its roots are real */
+static int sm_sp4_abc(v3 h, v3 x, v3 y, double c, double *A, double *B, double *C, double *rho)
 {
     v3 ypar = v3_scale(h, v3_dot(h, y)), yp = v3_sub(y, ypar);
     *A = v3_dot(x, yp);
     *B = v3_dot(x, v3_cross(h, yp));
     *C = c - v3_dot(x, ypar);
-    double rho = hypot(*A, *B);
-    *rho_out = rho;
-    int real = fabs(*C) <= rho * (1.0 + SM_DOUBLE) + 1e-300 && rho > 0.0;
+    *rho = hypot(*A, *B);
+    return fabs(*C) <= *rho * (1.0 + SM_DOUBLE) + 1e-300 && *rho > 0.0;
+}
+
+static int sm_sp4_rho(v3 h, v3 x, v3 y, double c, double *tp, double *tm, double *A, double *B,
+                      double *C, double *rho_out)
+{
+    int real = sm_sp4_abc(h, x, y, c, A, B, C, rho_out);
+    double rho = *rho_out;
     double d = rho > 0.0 ? acos(fmax(-1.0, fmin(1.0, *C / rho))) : NAN;
     double phi = atan2(*B, *A);
     *tp = phi + d;
@@ -169,6 +194,9 @@ static void sm_arm(const double *P, SmArm *a)
     a->offset = P + SM_OFFSET;
     a->lo = P + SM_LO;
     a->hi = P + SM_HI;
+    a->arc = P + SM_ARC;
+    a->limcs = P + SM_LIMCS;
+    a->foldcs = P + SM_FOLDCS;
     a->perp[0] = sm_perp(a->h[2]);
     a->perp[1] = sm_perp(a->h[6]);
 }
@@ -415,6 +443,131 @@ static int sm_row_inside(const SmArm *a, const double q[7])
         if (!sm_inside_joint(a, j, q[j]))
             return 0;
     return 1;
+}
+
+/* The quick twin of sm_split: the middle angle's cosines and sines (cb, sb) and
+ * whether it is real, computed as sm_split does, without the angles (acos, atan2) */
+static void sm_split_quick(v3 ha, v3 hb, v3 hc, v3 e, const m3 *R, SmSplit *t)
+{
+    t->ha = ha;
+    t->hb = hb;
+    t->hc = hc;
+    t->Rhc = m3_mv(R, hc);
+    double A, B, C, rho;
+    t->real = sm_sp4_abc(hb, ha, hc, v3_dot(ha, t->Rhc), &A, &B, &C, &rho);
+    double x = rho > 0.0 ? fmax(-1.0, fmin(1.0, C / rho)) : NAN;
+    double cp = A / rho, sp = B / rho, cd = x, sd = sqrt(1.0 - x * x);
+    t->cb[0] = cp * cd - sp * sd;
+    t->cb[1] = cp * cd + sp * sd;
+    t->sb[0] = sp * cd + cp * sd;
+    t->sb[1] = sp * cd - cp * sd;
+    t->e = e;
+    t->Re = m3_mv(R, t->e);
+    t->ya = v3_sub(t->Rhc, v3_scale(ha, v3_dot(ha, t->Rhc)));
+}
+
+/* The quick limit test of joint j at the chain angle with cosine c and sine s: 1
+ * inside its limits by more than SM_QUICK_M, 0 outside by more, -1 not certain.
+ * Applies where -pi <= lo < hi <= pi (sm_joint's shift by 2 pi never moves an
+ * angle in or out there away from the limits): inside iff the angle is within w
+ * of the range's middle; cos of that distance c cos v_c + s sin v_c against the
+ * thresholds (SM_ARC), padded by SM_QUICK_PAD for the pairs' 1.1e-8 rad. */
+static inline int sm_quick_joint(const SmArm *a, int j, double c, double s)
+{
+    const double *k = a->arc + 4 * j;
+    double g = c * k[0] + s * k[1];
+    return g > k[2] ? 1 : g < k[3] ? 0 : -1;
+}
+
+/* The quick sm_root_inside of root i of a real quick split: 1, 0, or -1 (not certain:
+ * the exact test decides) */
+static int sm_quick_root_inside(const SmArm *a, int j0, const SmSplit *t, int i)
+{
+    int v = sm_quick_joint(a, j0 + 1, t->cb[i], t->sb[i]);
+    if (v != 1)
+        return v;
+    m3 Rb = sm_rotm_cs(t->hb, t->cb[i], t->sb[i]);
+    v3 xa = m3_mv(&Rb, t->hc);
+    xa = v3_sub(xa, v3_scale(t->ha, v3_dot(t->ha, xa)));
+    double py = v3_dot(t->ha, v3_cross(xa, t->ya)), px = v3_dot(xa, t->ya);
+    double ca = 1.0, sa = 0.0;
+    if (!(sm_norm(xa) < 1e-9)) { /* else aligned: the first angle 0, as sm_first */
+        double rr = sqrt(px * px + py * py);
+        if (!(rr > 1e-100))
+            return -1;
+        ca = px / rr;
+        sa = py / rr;
+    }
+    v = sm_quick_joint(a, j0, ca, sa);
+    if (v != 1)
+        return v;
+    m3 Ra = sm_rotm_cs(t->ha, ca, sa), Bm = sm_mul(&Ra, &Rb);
+    v3 h = t->hc, x = t->e, y = m3_mtv(&Bm, t->Re);
+    v3 xp = v3_sub(x, v3_scale(h, v3_dot(h, x))), yp = v3_sub(y, v3_scale(h, v3_dot(h, y)));
+    double Y = v3_dot(h, v3_cross(xp, yp)), X = v3_dot(xp, yp), r = sqrt(X * X + Y * Y);
+    if (!(r > 0.5))
+        return -1;
+    return sm_quick_joint(a, j0 + 2, X / r, Y / r);
+}
+
+/* The quick point test: whether the chain angle (c, s) of root i's joint is within
+ * SM_SAME of the candidate's value (cv, sv): 1, 0, or -1 (not certain) */
+static inline int sm_quick_at(double c, double s, double cv, double sv)
+{
+    double dx = c - cv, dy = s - sv, d2 = dx * dx + dy * dy;
+    return d2 < SM_AT_IN ? 1 : d2 > SM_AT_OUT ? 0 : -1;
+}
+
+/* The cosine and sine of joint j's chain angle on root i of a real quick split (as
+ * sm_quick_root_inside computes them); returns 0 where not certain */
+static int sm_quick_angle(const SmSplit *t, int k, int i, double *c, double *s)
+{
+    if (k == 1) {
+        *c = t->cb[i];
+        *s = t->sb[i];
+        return 1;
+    }
+    m3 Rb = sm_rotm_cs(t->hb, t->cb[i], t->sb[i]);
+    v3 xa = m3_mv(&Rb, t->hc);
+    xa = v3_sub(xa, v3_scale(t->ha, v3_dot(t->ha, xa)));
+    double py = v3_dot(t->ha, v3_cross(xa, t->ya)), px = v3_dot(xa, t->ya);
+    double ca = 1.0, sa = 0.0;
+    if (!(sm_norm(xa) < 1e-9)) {
+        double rr = sqrt(px * px + py * py);
+        if (!(rr > 1e-100))
+            return 0;
+        ca = px / rr;
+        sa = py / rr;
+    }
+    if (k == 0) {
+        *c = ca;
+        *s = sa;
+        return 1;
+    }
+    m3 Ra = sm_rotm_cs(t->ha, ca, sa), Bm = sm_mul(&Ra, &Rb);
+    v3 h = t->hc, x = t->e, y = m3_mtv(&Bm, t->Re);
+    v3 xp = v3_sub(x, v3_scale(h, v3_dot(h, x))), yp = v3_sub(y, v3_scale(h, v3_dot(h, y)));
+    double Y = v3_dot(h, v3_cross(xp, yp)), X = v3_dot(xp, yp), r = sqrt(X * X + Y * Y);
+    if (!(r > 0.5))
+        return 0;
+    *c = X / r;
+    *s = Y / r;
+    return 1;
+}
+
+/* sm_part_split's quick twin (sm_split_quick) */
+static void sm_part_split_quick(const SmArm *a, const SmFrame *f, int e, double psi, int part,
+                                SmSplit *t)
+{
+    m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
+    m3 RA = sm_mul(&Ru, &f->R0[e]);
+    if (part == 1) {
+        sm_split_quick(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, t);
+        return;
+    }
+    m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
+    m3 RB = sm_mul(&X, &f->TR);
+    sm_split_quick(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, t);
 }
 
 /* The split of one triple (part 1 the shoulder, 2 the wrist) of elbow root e at
@@ -700,6 +853,7 @@ typedef struct {
     double psi;
     int joint, kind;
     double value; /* the joint coordinate (limits) or chain angle (aligned / fold) */
+    double cv, sv; /* the cosine and sine of the value's chain angle (SM_LIMCS, SM_FOLDCS) */
 } SmCand;
 
 /* Swivel angles (up to 2) where joint j (0-2, 4-6) is at chain angle L on elbow
@@ -786,7 +940,8 @@ static int sm_candidates(const SmArm *a, const SmFrame *f, int e, SmCand *c)
             double lim = s ? a->hi[j] : a->lo[j];
             int m = sm_limit_psi(a, f, e, j, a->sign[j] * lim + a->offset[j], psi);
             for (int i = 0; i < m; i++)
-                c[n++] = (SmCand){psi[i], j, s ? SM_KIND_UPPER : SM_KIND_LOWER, lim};
+                c[n++] = (SmCand){psi[i], j, s ? SM_KIND_UPPER : SM_KIND_LOWER, lim,
+                                  a->limcs[4 * j + 2 * s], a->limcs[4 * j + 2 * s + 1]};
         }
     }
     for (int t = 0; t < 2; t++) {
@@ -802,7 +957,8 @@ static int sm_candidates(const SmArm *a, const SmFrame *f, int e, SmCand *c)
             int kind = al > 1.0 - 1e-12 ? SM_KIND_ALIGNED : SM_KIND_FOLD;
             int m = sm_limit_psi(a, f, e, o + 1, L, psi);
             for (int i = 0; i < m; i++)
-                c[n++] = (SmCand){psi[i], o + 1, kind, L};
+                c[n++] = (SmCand){psi[i], o + 1, kind, L, s ? -a->foldcs[2 * t] : a->foldcs[2 * t],
+                                  s ? -a->foldcs[2 * t + 1] : a->foldcs[2 * t + 1]};
         }
     }
     return n;
@@ -849,11 +1005,18 @@ static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmC
         double lo = cut[i], hi = cut[i + 1];
         if (!(hi > lo))
             continue;
-        SmSplit t, tc;
-        int at = 0; /* at: the split at the cut lo computed */
-        sm_part_split(a, f, e, 0.5 * (lo + hi), part, &t);
+        SmSplit t, tq, tc;
+        int at = 0, exact = 0; /* at: the split at the cut lo computed; exact: t */
+        double mid = 0.5 * (lo + hi);
+        sm_part_split_quick(a, f, e, mid, part, &tq);
         for (int r = 0; r < 2; r++) {
-            int in = t.real && sm_root_inside(a, j0, &t, r);
+            int in = tq.real ? sm_quick_root_inside(a, j0, &tq, r) : 0;
+            if (in < 0) { /* not certain: the exact test (tq.real is t.real) */
+                if (!exact)
+                    sm_part_split(a, f, e, mid, part, &t);
+                exact = 1;
+                in = sm_root_inside(a, j0, &t, r);
+            }
             if (!in && !open[r] && lo > -M_PI && nrun[r] < SM_MAXI &&
                 (lo - cut[i - 1] <= SM_CORNER || hi - lo <= SM_CORNER)) {
                 /* both cells next to the cut outside and another cut within SM_CORNER
@@ -1012,20 +1175,30 @@ static void sm_manifold1(const SmArm *a, const double *T, double *iv, long long 
         int nc = sm_candidates(a, &f, e, c);
         /* the points: which branches are at the value there */
         for (int i = 0; i < nc; i++) {
-            int j = c[i].joint, part = j < 3 ? 1 : 2;
-            SmSplit t;
-            sm_part_split(a, &f, e, c[i].psi, part, &t);
-            if (!t.real)
+            int j = c[i].joint, part = j < 3 ? 1 : 2, at[2], exact = 0;
+            SmSplit t, tq;
+            sm_part_split_quick(a, &f, e, c[i].psi, part, &tq);
+            if (!tq.real) /* t.real */
                 continue;
-            double qr[2] = {sm_root_joint(a, j, &t, 0), sm_root_joint(a, j, &t, 1)};
-            for (int b = 0; b < 4; b++) {
-                if (*npts >= SM_MAXP)
+            for (int r = 0; r < 2; r++) { /* root r's joint j at the value (within SM_SAME) */
+                double cj, sj;
+                at[r] = sm_quick_angle(&tq, j < 3 ? j : j - 4, r, &cj, &sj)
+                    ? sm_quick_at(cj, sj, c[i].cv, c[i].sv) : -1;
+                if (at[r] >= 0)
                     continue;
-                double qj = qr[part == 1 ? b / 2 : b % 2];
+                if (!exact) /* not certain: the exact test */
+                    sm_part_split(a, &f, e, c[i].psi, part, &t);
+                exact = 1;
+                double qj = sm_root_joint(a, j, &t, r);
                 double d = c[i].kind <= SM_KIND_UPPER
                     ? qj - c[i].value
                     : a->sign[j] * qj + a->offset[j] - c[i].value;
-                if (fabs(wrap_pi(d)) < SM_SAME) {
+                at[r] = fabs(wrap_pi(d)) < SM_SAME;
+            }
+            for (int b = 0; b < 4; b++) {
+                if (*npts >= SM_MAXP)
+                    continue;
+                if (at[part == 1 ? b / 2 : b % 2]) {
                     double *r = pts + 4 * (*npts)++;
                     r[0] = c[i].psi;
                     r[1] = 4 * e + b;
