@@ -464,15 +464,18 @@ def _swivel_motion(arm: SwivelArm, T: np.ndarray, robot: Arm, limits: np.ndarray
     """The compiled swivel's SelfMotion: the dataclass' fields set directly.
 
     Equal to ``SelfMotion(T, "swivel", None, domain, True, 8, intervals, owner, method,
-    {"bisected": 0, "grid": 0}, family, limits, points)`` (as ``_held_motion``: the
-    frozen dataclass' ``__init__`` is ~3 us of the ~15 us the API adds to the kernel).
+    {"bisected": 0, "grid": 0}, family, limits, points)`` (the frozen dataclass'
+    ``__init__`` is ~3 us of the ~9 us the API adds to the kernel; one dict literal
+    as the instance's ``__dict__`` ~1 us).
     """
     sw = _SwivelFamily(arm, T, robot)
     intervals, owner, points = sw.exact()
     sm = object.__new__(SelfMotion)
-    vars(sm).update(zip(_FIELDS, (T, "swivel", None, _SWIVEL_DOMAIN.copy(), True, 8, intervals,
-                                  owner, _SWIVEL_METHOD, {"bisected": 0, "grid": 0}, sw, limits,
-                                  points, None, False), strict=True))
+    object.__setattr__(sm, "__dict__", {
+        "T": T, "parameter": "swivel", "joint": None, "domain": _SWIVEL_DOMAIN.copy(),
+        "periodic": True, "n_branches": 8, "intervals": intervals, "interval_branch": owner,
+        "method": _SWIVEL_METHOD, "info": {"bisected": 0, "grid": 0}, "_family": sw,
+        "limits": limits, "_points": points, "_records": None, "_held": False})
     return sm
 
 
