@@ -623,28 +623,22 @@ static int sm_branch_inside(const SmArm *a, const SmFrame *f, int e, int b, doub
         return 0;
     m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
     m3 RA = sm_mul(&Ru, &f->R0[e]);
-    m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
-    m3 RB = sm_mul(&X, &f->TR);
-    const m3 *R[2] = {&RA, &RB};
     SmSplit t[2];
-    int undecided = 0;
-    for (int n = 0; n < 2; n++) { /* the quick tests (their real is sm_split's) */
-        int part = n ? 3 - first : first, o = part == 1 ? 0 : 4;
-        sm_split_quick(a->h[o], a->h[o + 1], a->h[o + 2], a->perp[part - 1], R[part - 1],
-                       &t[part - 1]);
+    for (int n = 0; n < 2; n++) {
+        int part = n ? 3 - first : first;
+        if (part == 1) {
+            sm_split(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, &t[0]);
+        } else {
+            m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
+            m3 RB = sm_mul(&X, &f->TR);
+            sm_split(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, &t[1]);
+        }
         if (!t[part - 1].real)
             return 0;
-        int v = sm_quick_root_inside(a, o, &t[part - 1], part == 1 ? b / 2 : b % 2);
-        if (v == 0)
-            return 0;
-        undecided |= v < 0;
     }
-    if (!undecided)
-        return 1;
-    for (int n = 0; n < 2; n++) { /* not certain: the exact test */
-        int part = n ? 3 - first : first, o = part == 1 ? 0 : 4;
-        sm_split(a->h[o], a->h[o + 1], a->h[o + 2], a->perp[part - 1], R[part - 1], &t[part - 1]);
-        if (!sm_root_inside(a, o, &t[part - 1], part == 1 ? b / 2 : b % 2))
+    for (int n = 0; n < 2; n++) {
+        int part = n ? 3 - first : first;
+        if (!sm_root_inside(a, part == 1 ? 0 : 4, &t[part - 1], part == 1 ? b / 2 : b % 2))
             return 0;
     }
     return 1;
