@@ -162,7 +162,7 @@ static int sm_sp4(v3 h, v3 x, v3 y, double c, double *tp, double *tm, double *A,
 
 /* Subproblem 1 (swivel.py _sp1): the angle about h from x to y; *spread = |x's
  * part normal to h| */
-static double sm_sp1(v3 h, v3 x, v3 y, double *spread)
+ALWAYS_INLINE double sm_sp1(v3 h, v3 x, v3 y, double *spread)
 {
     v3 xp = v3_sub(x, v3_scale(h, v3_dot(h, x))), yp = v3_sub(y, v3_scale(h, v3_dot(h, y)));
     *spread = sm_norm(xp);
