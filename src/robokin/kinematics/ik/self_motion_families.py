@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 
-from robokin._native import kernels as K
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, Derived
 from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
