@@ -169,6 +169,16 @@ ALWAYS_INLINE double sm_sp1(v3 h, v3 x, v3 y, double *spread)
     return atan2(v3_dot(h, v3_cross(xp, yp)), v3_dot(xp, yp));
 }
 
+/* sm_sp1 with its atan2 arguments (y, x) into xy[1], xy[0] (the same angle) */
+ALWAYS_INLINE double sm_sp1_xy(v3 h, v3 x, v3 y, double *xy)
+{
+    v3 xp = v3_sub(x, v3_scale(h, v3_dot(h, x))), yp = v3_sub(y, v3_scale(h, v3_dot(h, y)));
+    double Y = v3_dot(h, v3_cross(xp, yp)), X = v3_dot(xp, yp);
+    xy[0] = X;
+    xy[1] = Y;
+    return atan2(Y, X);
+}
+
 /* A unit vector normal to h: the base axis h has least of, less its h part */
 static v3 sm_perp(v3 h)
 {
@@ -209,7 +219,7 @@ static void sm_arm(const double *P, SmArm *a)
 typedef struct {
     v3 ha, hb, hc, Rhc, ya, e, Re;
     double vb[2], cb[2], sb[2];
-    int real;
+    int real, cd_ok; /* cd_ok: |cos d| <= 0.99 (sm_split_root_cs) */
 } SmSplit;
 
 /* The middle angle's roots of the split of R (with their cosines and sines); e =
@@ -224,6 +234,7 @@ static void sm_split(v3 ha, v3 hb, v3 hc, v3 e, const m3 *R, SmSplit *t)
     t->real = sm_sp4_rho(hb, ha, hc, v3_dot(ha, t->Rhc), &tp, &tm, &A, &B, &C, &rho);
     double x = rho > 0.0 ? fmax(-1.0, fmin(1.0, C / rho)) : NAN; /* rho: hypot(A, B) */
     double cp = A / rho, sp = B / rho, cd = x, sd = sqrt(1.0 - x * x);
+    t->cd_ok = fabs(x) <= 0.99;
     t->vb[0] = tp;
     t->vb[1] = tm;
     t->cb[0] = cp * cd - sp * sd;
@@ -268,6 +279,28 @@ ALWAYS_INLINE double sm_last(const SmSplit *t, const SmFirst *r)
     return sm_sp1(t->hc, t->e, m3_mtv(&Bm, t->Re), &dummy);
 }
 
+/* sm_split_root with each angle's cosine and sine as the closed form has them into cs
+ * (3 x 2; 0 where not usable: the middle angle within |cos d| > 0.99 of the end of
+ * its range, where sqrt(1 - x^2) and acos(x) part by more than rounding) */
+static void sm_split_root_cs(const SmSplit *t, int i, double v[3], int *sing, double cs[3][2])
+{
+    SmFirst r;
+    sm_first(t, i, &r);
+    *sing = r.sing;
+    v[0] = r.va;
+    v[1] = t->vb[i];
+    m3 Ra = sm_rotm_cs(t->ha, r.ca, r.sa), Bm = sm_mul(&Ra, &r.Rb);
+    double xy[2];
+    v[2] = sm_sp1_xy(t->hc, t->e, m3_mtv(&Bm, t->Re), xy);
+    double n = sqrt(xy[0] * xy[0] + xy[1] * xy[1]);
+    cs[0][0] = r.ca;
+    cs[0][1] = r.sa;
+    cs[1][0] = t->cd_ok ? t->cb[i] : 0.0;
+    cs[1][1] = t->cd_ok ? t->sb[i] : 0.0;
+    cs[2][0] = n > 0.5 ? xy[0] / n : 0.0;
+    cs[2][1] = n > 0.5 ? xy[1] / n : 0.0;
+}
+
 /* The outer angles of root i of a split: v (3) chain angles; *sing where the outer
  * axes line up (the first angle set to 0) */
 static void sm_split_root(const SmSplit *t, int i, double v[3], int *sing)
@@ -285,12 +318,17 @@ static void sm_split_root(const SmSplit *t, int i, double v[3], int *sing)
  * rotations by vb and va are built from the cosines and sines the subproblems
  * give (vb = phi +- d with cos phi = A / rho, cos d = C / rho; va = atan2(y, x)),
  * not from the angles: no sine or cosine is evaluated. */
-static int sm_triple(v3 ha, v3 hb, v3 hc, v3 e, const m3 *R, double v[2][3], int sing[2])
+static int sm_triple(v3 ha, v3 hb, v3 hc, v3 e, const m3 *R, double v[2][3], int sing[2],
+                     double cs[2][3][2])
 {
     SmSplit t;
     sm_split(ha, hb, hc, e, R, &t);
-    for (int i = 0; i < 2; i++)
-        sm_split_root(&t, i, v[i], &sing[i]);
+    for (int i = 0; i < 2; i++) {
+        if (cs)
+            sm_split_root_cs(&t, i, v[i], &sing[i], cs[i]);
+        else
+            sm_split_root(&t, i, v[i], &sing[i]);
+    }
     return t.real;
 }
 
@@ -363,31 +401,34 @@ static inline double sm_joint(const SmArm *a, int j, double v)
 }
 
 static void sm_configs_part(const SmArm *a, const SmFrame *f, int e, double psi, int part,
-                            double q[4][7], int ok[4], int sing[4]);
+                            double q[4][7], int ok[4], int sing[4], double cs[4][7][2]);
 
 /* The 4 configurations of elbow root e at swivel angle psi (slots 4 e + 2 s + w,
- * here 2 s + w): joint coordinates q, whether real, singular. */
+ * here 2 s + w): joint coordinates q, whether real, singular; cs (or NULL): each
+ * shoulder and wrist angle's cosine and sine as the closed form has them
+ * (sm_split_root_cs; the elbow's left unset) */
 static void sm_configs(const SmArm *a, const SmFrame *f, int e, double psi, double q[4][7],
-                       int ok[4], int sing[4])
+                       int ok[4], int sing[4], double cs[4][7][2])
 {
-    sm_configs_part(a, f, e, psi, 3, q, ok, sing);
+    sm_configs_part(a, f, e, psi, 3, q, ok, sing, cs);
 }
 
 /* sm_configs of the triples in `part` (1 shoulder, 2 wrist, 3 both); the other
  * triple's joints are left NaN and count as real, not singular */
 static void sm_configs_part(const SmArm *a, const SmFrame *f, int e, double psi, int part,
-                            double q[4][7], int ok[4], int sing[4])
+                            double q[4][7], int ok[4], int sing[4], double cs[4][7][2])
 {
+    double csA[2][3][2], csB[2][3][2];
     m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
     m3 RA = sm_mul(&Ru, &f->R0[e]);
     double sA[2][3] = {{NAN, NAN, NAN}, {NAN, NAN, NAN}}, sB[2][3] = {{NAN, NAN, NAN}, {NAN, NAN, NAN}};
     int gA[2] = {0, 0}, gB[2] = {0, 0}, rA = 1, rB = 1;
     if (part & 1)
-        rA = sm_triple(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, sA, gA);
+        rA = sm_triple(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, sA, gA, cs ? csA : NULL);
     if (part & 2) {
         m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
         m3 RB = sm_mul(&X, &f->TR);
-        rB = sm_triple(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, sB, gB);
+        rB = sm_triple(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, sB, gB, cs ? csB : NULL);
     }
     int real = f->elbow_real && rA && rB;
     for (int s = 0; s < 2; s++)
@@ -400,6 +441,12 @@ static void sm_configs_part(const SmArm *a, const SmFrame *f, int e, double psi,
                 q[k][4 + j] = real ? sm_joint(a, 4 + j, sB[w][j]) : NAN;
             }
             q[k][3] = real ? sm_joint(a, 3, f->v4[e]) : NAN;
+            if (cs && part == 3)
+                for (int j = 0; j < 3; j++)
+                    for (int c = 0; c < 2; c++) {
+                        cs[k][j][c] = csA[s][j][c];
+                        cs[k][4 + j][c] = csB[w][j][c];
+                    }
         }
 }
 
@@ -794,6 +841,30 @@ static int sm_polish(const SmArm *a, const m3 *RT, v3 pT, double *q)
     return err <= SM_ACCEPT;
 }
 
+/* Whether a row needs no polish, certainly: its pose error from the closed form's
+ * cosines and sines cs (7 x 2; sm_split_root_cs) below SM_QUICK_FK. Those pairs
+ * stand for the chain angles sm_fk takes (sign q + offset) to ~3e-15 rad each
+ * (the wrap into the limits and back), so the two errors part by less than
+ * ~3e-14: below SM_QUICK_FK here, sm_polish's error is below SM_EXACT and it
+ * leaves the row as it is. 0 where a pair is not usable (then sm_polish decides). */
+#define SM_QUICK_FK 3e-14
+static int sm_quick_exact(const SmArm *a, const m3 *RT, v3 pT, double cs[7][2])
+{
+    m3 G = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+    v3 g = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 7; k++) {
+        if (!(cs[k][0] * cs[k][0] + cs[k][1] * cs[k][1] > 0.5))
+            return 0;
+        m3 Rk = sm_rotm_cs(a->h[k], cs[k][0], cs[k][1]);
+        g = v3_add(m3_mv(&G, v3_sub(a->o[k], m3_mv(&Rk, a->o[k]))), g);
+        G = sm_mul(&G, &Rk);
+    }
+    m3 R = sm_mul(&G, &a->MR);
+    v3 p = v3_add(m3_mv(&G, a->MT), g);
+    double e[6];
+    return sm_error(RT, pT, &R, p, e) < SM_QUICK_FK;
+}
+
 /* ------------------------------------------------------------ rows */
 
 typedef struct {
@@ -819,12 +890,18 @@ static void sm_rows_range(void *arg, long i0, long i1)
             double *Q = jb->Q + 56 * row;
             npy_bool *ok = jb->valid + 8 * row, *sg = jb->sing + 8 * row;
             for (int e = 0; e < 2; e++) {
-                double q[4][7];
+                double q[4][7], cs[4][7][2];
                 int okk[4], sing[4];
-                sm_configs(&a, &f, e, jb->psi[row], q, okk, sing);
+                sm_configs(&a, &f, e, jb->psi[row], q, okk, sing, cs);
                 for (int b = 0; b < 4; b++) {
                     int slot = 4 * e + b;
-                    int good = okk[b] && sm_polish(&a, &RT, pT, q[b]);
+                    int good = 0;
+                    if (okk[b]) { /* the elbow's cosine and sine: of the angle sm_fk takes */
+                        double v4 = a.sign[3] * q[b][3] + a.offset[3];
+                        cs[b][3][0] = cos(v4);
+                        cs[b][3][1] = sin(v4);
+                        good = sm_quick_exact(&a, &RT, pT, cs[b]) || sm_polish(&a, &RT, pT, q[b]);
+                    }
                     for (int j = 0; j < 7; j++)
                         Q[7 * slot + j] = good ? q[b][j] : NAN;
                     ok[slot] = (npy_bool)good;
@@ -1422,7 +1499,7 @@ static int sm_near1(const SmArm *a, const double *T, const double *qn, double *q
                         if (!done[kk]) {
                             double q[4][7];
                             int ok[4], sg[4];
-                            sm_configs(a, &f, e, -M_PI + kk * h, q, ok, sg);
+                            sm_configs(a, &f, e, -M_PI + kk * h, q, ok, sg, NULL);
                             for (int bb = 0; bb < 4; bb++)
                                 grid[kk][bb] = ok[bb] ? sm_dist2(q[bb], qn) : INFINITY;
                             done[kk] = 1;
