@@ -525,6 +525,12 @@ SELF_MOTION = Group("self_motion.c", kernels=(
                    "SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] "
                    "(N, SM_MAXP, 4) with counts (N,).",
            checks=(Check("sm_params_ok(a->params)", "params is not a swivel parameter vector"),)),
+    Kernel("swivel_manifold_one", (Arr("params", "f64", ("SM_N_PARAMS",)),
+                                   Arr("T", "f64", (4, 4))),
+           "tuple[F64, I64, F64]", "``swivel_manifold`` of one pose T (4, 4), packed: new "
+                                   "arrays of its intervals (m, 2) branch by branch, their "
+                                   "branches (m,) and its points (p, 4). One thread.",
+           checks=(Check("sm_params_ok(a->params)", "params is not a swivel parameter vector"),)),
     Kernel("swivel_near", (Arr("params", "f64", ("SM_N_PARAMS",)), Arr("T", "f64", POSE),
                            Arr("q_near", "f64", ("N", 7)), Arr("q", "f64", ("N", 7), out=True),
                            Arr("psi", "f64", ("N",), out=True),
@@ -536,7 +542,8 @@ SELF_MOTION = Group("self_motion.c", kernels=(
                    "distance (N,); found (N,) false (q NaN) where no part is inside.",
            checks=(Check("sm_params_ok(a->params)", "params is not a swivel parameter vector"),)),
 ), constants=_consts(
-    "H O S W MR MT SIGN OFFSET LO HI REF TAG N_PARAMS MAXI MAXP KIND_LOWER KIND_UPPER "
+    "H O S W MR MT SIGN OFFSET LO HI REF TAG ARC LIMCS FOLDCS N_PARAMS MAXI MAXP KIND_LOWER "
+    "KIND_UPPER "
     "KIND_ALIGNED KIND_FOLD", "SM_", "SM_") + (Const("SM_TAG_VALUE", "SM_TAG_VALUE", "float"),),
     comment="swivel parameter vector layout (swivel.SwivelArm.packed), point kinds")
 

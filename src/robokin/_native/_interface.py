@@ -244,6 +244,9 @@ class Kernels(Protocol):
     SM_HI: int
     SM_REF: int
     SM_TAG: int
+    SM_ARC: int
+    SM_LIMCS: int
+    SM_FOLDCS: int
     SM_N_PARAMS: int
     SM_MAXI: int
     SM_MAXP: int
@@ -694,6 +697,9 @@ class Kernels(Protocol):
         /,
     ) -> None:
         """Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,)."""
+
+    def swivel_manifold_one(self, params: F64, T: F64, /) -> tuple[F64, I64, F64]:
+        """``swivel_manifold`` of one pose T (4, 4), packed: new arrays of its intervals (m, 2) branch by branch, their branches (m,) and its points (p, 4). One thread."""
 
     def swivel_near(
         self,

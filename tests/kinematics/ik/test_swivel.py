@@ -309,3 +309,79 @@ def test_a_corner_within_a_triple_is_a_one_point_interval(q):
     T = SRS.fk(q0)
     psi = float(ARM.swivel_of(ARM.frame(T), q0))
     assert_corner_listed(SRS, SRS.self_motion(T), q0, psi)
+
+
+def _special_poses(n, seed):
+    """n uniform and n special configurations' poses (each joint with probability 1/3
+    at a special value, 1/3 at a limit or 1e-6 / 1e-7 from one: the quick tests'
+    margins)."""
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(LIM[:, 0], LIM[:, 1], (2 * n, 7))
+    pick = rng.integers(0, 3, (n, 7))
+    special = np.array(SPECIAL)[rng.integers(0, len(SPECIAL), (n, 7))]
+    off = np.array([0.0, 1e-7, 9e-7, 1e-6, 1.1e-6])[rng.integers(0, 5, (n, 7))]
+    limit = np.where(rng.integers(0, 2, (n, 7)) == 0, LIM[:, 0] + off, LIM[:, 1] - off)
+    q[n:] = np.where(pick == 1, special, np.where(pick == 2, limit, q[n:]))
+    return np.ascontiguousarray(SRS.fk(q))
+
+
+def _manifold(params, T):
+    from robokin._native import kernels as K
+
+    N = len(T)
+    out = (np.full((N, 8, K.SM_MAXI, 2), np.nan), np.zeros((N, 8), np.int64),
+           np.full((N, K.SM_MAXP, 4), np.nan), np.zeros(N, np.int64))
+    K.swivel_manifold(params, T, *out)
+    return out
+
+
+def test_one_pose_entry_is_the_batch_kernel():
+    # oracle: swivel_manifold (the batch entry) of the same pose, packed by branch
+    from robokin._native import kernels as K
+
+    T = _special_poses(60, 5)
+    iv, niv, pts, npts = _manifold(ARM.params, T)
+    for i in range(len(T)):
+        ivs, br, p = K.swivel_manifold_one(ARM.params, T[i])
+        assert np.array_equal(br, np.repeat(np.arange(8), niv[i]))
+        assert np.array_equal(ivs, np.concatenate([iv[i, b, :niv[i, b]] for b in range(8)]))
+        assert np.array_equal(p, pts[i, :npts[i]])
+        assert ivs.flags.owndata and p.flags.c_contiguous
+
+
+def test_quick_tests_give_the_exact_verdicts():
+    # oracle: the same kernel with the quick tests' constants NaN (every cell and point
+    # decided by the exact angles): bit for bit the same intervals and points, on
+    # uniform poses and on poses with joints at limits, 1e-7 .. 1.1e-6 inside them,
+    # aligned triples and a stretched elbow
+    from robokin._native import kernels as K
+
+    exact = ARM.params.copy()
+    exact[K.SM_ARC:K.SM_N_PARAMS] = np.nan
+    T = _special_poses(300, 8)
+    quick, slow = _manifold(ARM.params, T), _manifold(exact, T)
+    assert int(quick[1].sum()) > 1000 and int(quick[3].sum()) > 10000  # not empty
+    for a, b in zip(quick, slow, strict=True):
+        assert np.array_equal(a, b, equal_nan=True)
+
+
+def test_quick_constants_match_the_arm():
+    # oracle: the limits' chain angles and the ranges' middles, evaluated directly
+    from robokin._native import kernels as K
+
+    P = ARM.params
+    for j in (0, 1, 2, 4, 5, 6):
+        lo, hi = LIM[j]
+        for s, lim in enumerate((lo, hi)):
+            L = ARM.sign[j] * lim + ARM.offset[j]
+            at = K.SM_LIMCS + 4 * j + 2 * s
+            assert np.allclose(P[at:at + 2], [np.cos(L), np.sin(L)], atol=1e-15)
+        c, s_, cin, cout = P[K.SM_ARC + 4 * j:K.SM_ARC + 4 * j + 4]
+        mid = ARM.offset[j] + ARM.sign[j] * 0.5 * (lo + hi)
+        assert np.allclose([c, s_], [np.cos(mid), np.sin(mid)], atol=1e-15)
+        # a joint 2e-6 inside a limit passes as inside, 2e-6 outside as outside
+        for v, inside in ((lo + 2e-6, True), (hi - 2e-6, True), (lo - 2e-6, False),
+                          (hi + 2e-6, False)):
+            ang = ARM.sign[j] * v + ARM.offset[j]
+            g = np.cos(ang) * c + np.sin(ang) * s_
+            assert (g > cin) if inside else (g < cout)

@@ -73,6 +73,8 @@ KERNEL_CHECK(swivel_rows, !(sm_params_ok(a->params)) ? "params is not a swivel p
 static const KSpec swivel_rows_spec = {"swivel_rows", "swivel_rows(params, T, psi, Q, valid, sing)", 6, (const KArg[]){KA_ARRAY(swivel_rows, params, 0, 0x0, NPY_DOUBLE, "(SM_N_PARAMS)", {-1, SM_N_PARAMS}), KA_ARRAY(swivel_rows, T, 0, 0x1, NPY_DOUBLE, "(N, 4, 4)", {0, 0}, {-1, 4}, {-1, 4}), KA_ARRAY(swivel_rows, psi, 0, 0x2, NPY_DOUBLE, "(N, m)", {0, 0}, {1, 0}), KA_ARRAY(swivel_rows, Q, 1, 0x0, NPY_DOUBLE, "(N, m, 8, 7)", {0, 0}, {1, 0}, {-1, 8}, {-1, 7}), KA_ARRAY(swivel_rows, valid, 1, 0x0, NPY_BOOL, "(N, m, 8)", {0, 0}, {1, 0}, {-1, 8}), KA_ARRAY(swivel_rows, sing, 1, 0x0, NPY_BOOL, "(N, m, 8)", {0, 0}, {1, 0}, {-1, 8})}, offsetof(swivel_rows_args, sym), 0x3f, 0x0, swivel_rows_check};
 KERNEL_CHECK(swivel_manifold, !(sm_params_ok(a->params)) ? "params is not a swivel parameter vector" : NULL)
 static const KSpec swivel_manifold_spec = {"swivel_manifold", "swivel_manifold(params, T, iv, niv, pts, npts)", 6, (const KArg[]){KA_ARRAY(swivel_manifold, params, 0, 0x0, NPY_DOUBLE, "(SM_N_PARAMS)", {-1, SM_N_PARAMS}), KA_ARRAY(swivel_manifold, T, 0, 0x1, NPY_DOUBLE, "(N, 4, 4)", {0, 0}, {-1, 4}, {-1, 4}), KA_ARRAY(swivel_manifold, iv, 1, 0x0, NPY_DOUBLE, "(N, 8, SM_MAXI, 2)", {0, 0}, {-1, 8}, {-1, SM_MAXI}, {-1, 2}), KA_ARRAY(swivel_manifold, niv, 1, 0x0, NPY_INT64, "(N, 8)", {0, 0}, {-1, 8}), KA_ARRAY(swivel_manifold, pts, 1, 0x0, NPY_DOUBLE, "(N, SM_MAXP, 4)", {0, 0}, {-1, SM_MAXP}, {-1, 4}), KA_ARRAY(swivel_manifold, npts, 1, 0x0, NPY_INT64, "(N)", {0, 0})}, offsetof(swivel_manifold_args, sym), 0x3f, 0x0, swivel_manifold_check};
+KERNEL_CHECK(swivel_manifold_one, !(sm_params_ok(a->params)) ? "params is not a swivel parameter vector" : NULL)
+static const KSpec swivel_manifold_one_spec = {"swivel_manifold_one", "swivel_manifold_one(params, T)", 2, (const KArg[]){KA_ARRAY(swivel_manifold_one, params, 0, 0x0, NPY_DOUBLE, "(SM_N_PARAMS)", {-1, SM_N_PARAMS}), KA_ARRAY(swivel_manifold_one, T, 0, 0x0, NPY_DOUBLE, "(4, 4)", {-1, 4}, {-1, 4})}, 0, 0x3, 0x0, swivel_manifold_one_check};
 KERNEL_CHECK(swivel_near, !(sm_params_ok(a->params)) ? "params is not a swivel parameter vector" : NULL)
 static const KSpec swivel_near_spec = {"swivel_near", "swivel_near(params, T, q_near, q, psi, slot, dist, found)", 8, (const KArg[]){KA_ARRAY(swivel_near, params, 0, 0x0, NPY_DOUBLE, "(SM_N_PARAMS)", {-1, SM_N_PARAMS}), KA_ARRAY(swivel_near, T, 0, 0x1, NPY_DOUBLE, "(N, 4, 4)", {0, 0}, {-1, 4}, {-1, 4}), KA_ARRAY(swivel_near, q_near, 0, 0x0, NPY_DOUBLE, "(N, 7)", {0, 0}, {-1, 7}), KA_ARRAY(swivel_near, q, 1, 0x0, NPY_DOUBLE, "(N, 7)", {0, 0}, {-1, 7}), KA_ARRAY(swivel_near, psi, 1, 0x0, NPY_DOUBLE, "(N)", {0, 0}), KA_ARRAY(swivel_near, slot, 1, 0x0, NPY_INT64, "(N)", {0, 0}), KA_ARRAY(swivel_near, dist, 1, 0x0, NPY_DOUBLE, "(N)", {0, 0}), KA_ARRAY(swivel_near, found, 1, 0x0, NPY_BOOL, "(N)", {0, 0})}, offsetof(swivel_near_args, sym), 0xff, 0x0, swivel_near_check};
 KERNEL_CHECK(six_r_reach, !(six_r_params_ok(a->params)) ? "params is not a 6R parameter vector" : !(a->n == 6 && a->nc == 6) ? "packed is not a 6R chain" : !(a->K >= 1) ? "T needs a target per voxel" : NULL)
@@ -289,6 +291,9 @@ static int add_constants(PyObject *m)
         {"SM_HI", (long)(SM_HI)},
         {"SM_REF", (long)(SM_REF)},
         {"SM_TAG", (long)(SM_TAG)},
+        {"SM_ARC", (long)(SM_ARC)},
+        {"SM_LIMCS", (long)(SM_LIMCS)},
+        {"SM_FOLDCS", (long)(SM_FOLDCS)},
         {"SM_N_PARAMS", (long)(SM_N_PARAMS)},
         {"SM_MAXI", (long)(SM_MAXI)},
         {"SM_MAXP", (long)(SM_MAXP)},

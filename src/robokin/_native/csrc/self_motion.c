@@ -33,6 +33,14 @@
  *   SM_SIGN, SM_OFFSET, SM_LO, SM_HI   per joint (7 each): v = sign q + offset, limits
  *   SM_REF        the swivel's reference direction (axis 1) (3)
  *   SM_TAG        SM_TAG_VALUE
+ *   SM_ARC        per joint (7 x 4) the quick limit test's constants (sm_arc): the cosine
+ *                 and sine of the chain angle at the middle of the limits, cos(w - m) +
+ *                 pad and cos(w + m) - pad (w half the range, SM_QUICK_M, SM_QUICK_PAD),
+ *                 or (0, 0, 2, -2) where the test does not apply
+ *   SM_LIMCS      per joint and limit (7 x 2 x 2) the cosine and sine of the limit's
+ *                 chain angle sign lim + offset
+ *   SM_FOLDCS     per triple (2 x 2) the cosine and sine of the middle angle where the
+ *                 outer axes are nearest (the fold / aligned value, sm_candidates' base)
  *
  * References: Shimizu, Kakuya, Yoon, Kitagaki and Kosuge, "Analytical inverse
  * kinematic computation for 7-DOF redundant manipulators with joint limits and
@@ -45,7 +53,8 @@
 
 enum {
     SM_H = 0, SM_O = 21, SM_S = 42, SM_W = 45, SM_MR = 48, SM_MT = 57, SM_SIGN = 60,
-    SM_OFFSET = 67, SM_LO = 74, SM_HI = 81, SM_REF = 88, SM_TAG = 91, SM_N_PARAMS = 92
+    SM_OFFSET = 67, SM_LO = 74, SM_HI = 81, SM_REF = 88, SM_TAG = 91, SM_ARC = 92,
+    SM_LIMCS = 120, SM_FOLDCS = 148, SM_N_PARAMS = 152
 };
 #define SM_TAG_VALUE 2008.0625 /* Shimizu et al.'s year, and a sixteenth */
 #define SM_MAXI 40             /* intervals per branch (at most 33 cells per elbow) */
@@ -59,6 +68,16 @@ enum {
 #define SM_ACCEPT 5e-13  /* pose errors above it after the polish: dropped */
 #define SM_SAME 1e-6     /* a branch's joint this near a value [rad]: at it */
 #define SM_GRAIN 16      /* poses per pool chunk */
+/* The quick tests (sm_quick_*): a cell's or a point's verdict from the cosines and
+ * sines of its angles, without atan2 / acos, where it is certain; else the exact
+ * test. The cosine-sine pairs stand for the exact path's angles to 1.1e-8 rad (the
+ * middle angle next to the end of its range: sqrt(1 - x^2) of a rounded x); a
+ * joint decided quickly is at least SM_QUICK_M from its limits, a point's joint
+ * below 0.9 or above 1.1 SM_SAME from the value (chord^2 thresholds). */
+#define SM_QUICK_M 1e-6
+#define SM_QUICK_PAD 5e-8
+#define SM_AT_IN (0.9e-6 * 0.9e-6)
+#define SM_AT_OUT (1.1e-6 * 1.1e-6)
 #define SM_PARALLEL_MIN 64
 
 static int sm_params_ok(const double *P) { return P[SM_TAG] == SM_TAG_VALUE; }
@@ -67,15 +86,16 @@ static int sm_params_ok(const double *P) { return P[SM_TAG] == SM_TAG_VALUE; }
 
 typedef struct {
     v3 h[7], o[7], S, Wp, MT, ref;
+    v3 perp[2]; /* sm_perp of the shoulder's and the wrist's last axis (h_3, h_7) */
     m3 MR;
-    const double *sign, *offset, *lo, *hi;
+    const double *sign, *offset, *lo, *hi, *arc, *limcs, *foldcs;
 } SmArm;
 
 typedef struct {
     v3 u, r;
     double v4[2], psi0[2];
     int elbow_real, ref_ok;
-    m3 R0[2], TR;
+    m3 R0[2], R4[2], TR; /* R4: the elbow's rotation rot(h4, v4) per root */
 } SmFrame;
 
 /* The rotation about unit axis k with cosine c and sine s */
@@ -108,6 +128,67 @@ static inline m3 sm_tr(const m3 *A)
 
 static inline double sm_norm(v3 a) { return sqrt(v3_dot(a, a)); }
 
+/* Subproblem 4 (swivel.py _sp4): the angles t with x . rot(h, t) y = c, as
+ * A cos t + B sin t = C; returns whether they are real. */
+/* Subproblem 4's A, B, C and rho = hypot(A, B); returns whether its roots are real */
+static int sm_sp4_abc(v3 h, v3 x, v3 y, double c, double *A, double *B, double *C, double *rho)
+{
+    v3 ypar = v3_scale(h, v3_dot(h, y)), yp = v3_sub(y, ypar);
+    *A = v3_dot(x, yp);
+    *B = v3_dot(x, v3_cross(h, yp));
+    *C = c - v3_dot(x, ypar);
+    *rho = hypot(*A, *B);
+    return fabs(*C) <= *rho * (1.0 + SM_DOUBLE) + 1e-300 && *rho > 0.0;
+}
+
+static int sm_sp4_rho(v3 h, v3 x, v3 y, double c, double *tp, double *tm, double *A, double *B,
+                      double *C, double *rho_out)
+{
+    int real = sm_sp4_abc(h, x, y, c, A, B, C, rho_out);
+    double rho = *rho_out;
+    double d = rho > 0.0 ? acos(fmax(-1.0, fmin(1.0, *C / rho))) : NAN;
+    double phi = atan2(*B, *A);
+    *tp = phi + d;
+    *tm = phi - d;
+    return real;
+}
+
+static int sm_sp4(v3 h, v3 x, v3 y, double c, double *tp, double *tm, double *A, double *B,
+                  double *C)
+{
+    double rho;
+    return sm_sp4_rho(h, x, y, c, tp, tm, A, B, C, &rho);
+}
+
+/* Subproblem 1 (swivel.py _sp1): the angle about h from x to y; *spread = |x's
+ * part normal to h| */
+ALWAYS_INLINE double sm_sp1(v3 h, v3 x, v3 y, double *spread)
+{
+    v3 xp = v3_sub(x, v3_scale(h, v3_dot(h, x))), yp = v3_sub(y, v3_scale(h, v3_dot(h, y)));
+    *spread = sm_norm(xp);
+    return atan2(v3_dot(h, v3_cross(xp, yp)), v3_dot(xp, yp));
+}
+
+/* sm_sp1 with its atan2 arguments (y, x) into xy[1], xy[0] (the same angle) */
+ALWAYS_INLINE double sm_sp1_xy(v3 h, v3 x, v3 y, double *xy)
+{
+    v3 xp = v3_sub(x, v3_scale(h, v3_dot(h, x))), yp = v3_sub(y, v3_scale(h, v3_dot(h, y)));
+    double Y = v3_dot(h, v3_cross(xp, yp)), X = v3_dot(xp, yp);
+    xy[0] = X;
+    xy[1] = Y;
+    return atan2(Y, X);
+}
+
+/* A unit vector normal to h: the base axis h has least of, less its h part */
+static v3 sm_perp(v3 h)
+{
+    double ax = fabs(h.x), ay = fabs(h.y), az = fabs(h.z);
+    v3 e = (ax <= ay && ax <= az) ? (v3){1.0, 0.0, 0.0}
+         : (ay <= az) ? (v3){0.0, 1.0, 0.0} : (v3){0.0, 0.0, 1.0};
+    e = v3_sub(e, v3_scale(h, v3_dot(e, h)));
+    return v3_scale(e, 1.0 / sm_norm(e));
+}
+
 static void sm_arm(const double *P, SmArm *a)
 {
     for (int k = 0; k < 7; k++) {
@@ -123,43 +204,11 @@ static void sm_arm(const double *P, SmArm *a)
     a->offset = P + SM_OFFSET;
     a->lo = P + SM_LO;
     a->hi = P + SM_HI;
-}
-
-/* Subproblem 4 (swivel.py _sp4): the angles t with x . rot(h, t) y = c, as
- * A cos t + B sin t = C; returns whether they are real. */
-static int sm_sp4(v3 h, v3 x, v3 y, double c, double *tp, double *tm, double *A, double *B,
-                  double *C)
-{
-    v3 ypar = v3_scale(h, v3_dot(h, y)), yp = v3_sub(y, ypar);
-    *A = v3_dot(x, yp);
-    *B = v3_dot(x, v3_cross(h, yp));
-    *C = c - v3_dot(x, ypar);
-    double rho = hypot(*A, *B);
-    int real = fabs(*C) <= rho * (1.0 + SM_DOUBLE) + 1e-300 && rho > 0.0;
-    double d = rho > 0.0 ? acos(fmax(-1.0, fmin(1.0, *C / rho))) : NAN;
-    double phi = atan2(*B, *A);
-    *tp = phi + d;
-    *tm = phi - d;
-    return real;
-}
-
-/* Subproblem 1 (swivel.py _sp1): the angle about h from x to y; *spread = |x's
- * part normal to h| */
-static double sm_sp1(v3 h, v3 x, v3 y, double *spread)
-{
-    v3 xp = v3_sub(x, v3_scale(h, v3_dot(h, x))), yp = v3_sub(y, v3_scale(h, v3_dot(h, y)));
-    *spread = sm_norm(xp);
-    return atan2(v3_dot(h, v3_cross(xp, yp)), v3_dot(xp, yp));
-}
-
-/* A unit vector normal to h: the base axis h has least of, less its h part */
-static v3 sm_perp(v3 h)
-{
-    double ax = fabs(h.x), ay = fabs(h.y), az = fabs(h.z);
-    v3 e = (ax <= ay && ax <= az) ? (v3){1.0, 0.0, 0.0}
-         : (ay <= az) ? (v3){0.0, 1.0, 0.0} : (v3){0.0, 0.0, 1.0};
-    e = v3_sub(e, v3_scale(h, v3_dot(e, h)));
-    return v3_scale(e, 1.0 / sm_norm(e));
+    a->arc = P + SM_ARC;
+    a->limcs = P + SM_LIMCS;
+    a->foldcs = P + SM_FOLDCS;
+    a->perp[0] = sm_perp(a->h[2]);
+    a->perp[1] = sm_perp(a->h[6]);
 }
 
 /* Every split of R into rot(ha, va) rot(hb, vb) rot(hc, vc) (swivel.py _triple):
@@ -170,51 +219,98 @@ static v3 sm_perp(v3 h)
 typedef struct {
     v3 ha, hb, hc, Rhc, ya, e, Re;
     double vb[2], cb[2], sb[2];
-    int real;
+    int real, cd_ok; /* cd_ok: |cos d| <= 0.99 (sm_split_root_cs) */
 } SmSplit;
 
-/* The middle angle's roots of the split of R (with their cosines and sines) */
-static void sm_split(v3 ha, v3 hb, v3 hc, const m3 *R, SmSplit *t)
+/* The middle angle's roots of the split of R (with their cosines and sines); e =
+ * sm_perp(hc) (the arm's constant) */
+static void sm_split(v3 ha, v3 hb, v3 hc, v3 e, const m3 *R, SmSplit *t)
 {
-    double tp, tm, A, B, C;
+    double tp, tm, A, B, C, rho;
     t->ha = ha;
     t->hb = hb;
     t->hc = hc;
     t->Rhc = m3_mv(R, hc);
-    t->real = sm_sp4(hb, ha, hc, v3_dot(ha, t->Rhc), &tp, &tm, &A, &B, &C);
-    double rho = hypot(A, B), x = rho > 0.0 ? fmax(-1.0, fmin(1.0, C / rho)) : NAN;
+    t->real = sm_sp4_rho(hb, ha, hc, v3_dot(ha, t->Rhc), &tp, &tm, &A, &B, &C, &rho);
+    double x = rho > 0.0 ? fmax(-1.0, fmin(1.0, C / rho)) : NAN; /* rho: hypot(A, B) */
     double cp = A / rho, sp = B / rho, cd = x, sd = sqrt(1.0 - x * x);
+    t->cd_ok = fabs(x) <= 0.99;
     t->vb[0] = tp;
     t->vb[1] = tm;
     t->cb[0] = cp * cd - sp * sd;
     t->cb[1] = cp * cd + sp * sd;
     t->sb[0] = sp * cd + cp * sd;
     t->sb[1] = sp * cd - cp * sd;
-    t->e = sm_perp(hc);
+    t->e = e;
     t->Re = m3_mv(R, t->e);
     t->ya = v3_sub(t->Rhc, v3_scale(ha, v3_dot(ha, t->Rhc)));
+}
+
+/* The first angle of root i of a split (its cosine and sine, the middle rotation
+ * Rb); sing where the outer axes line up (the first angle set to 0) */
+typedef struct {
+    m3 Rb;
+    double va, ca, sa;
+    int sing;
+} SmFirst;
+
+ALWAYS_INLINE void sm_first(const SmSplit *t, int i, SmFirst *r)
+{
+    r->Rb = sm_rotm_cs(t->hb, t->cb[i], t->sb[i]);
+    v3 xa = m3_mv(&r->Rb, t->hc);
+    xa = v3_sub(xa, v3_scale(t->ha, v3_dot(t->ha, xa)));
+    double py = v3_dot(t->ha, v3_cross(xa, t->ya)), px = v3_dot(xa, t->ya), rr = hypot(px, py);
+    r->va = atan2(py, px);
+    r->ca = rr > 0.0 ? px / rr : 1.0;
+    r->sa = rr > 0.0 ? py / rr : 0.0;
+    r->sing = sm_norm(xa) < 1e-9;
+    if (r->sing) {
+        r->va = 0.0;
+        r->ca = 1.0;
+        r->sa = 0.0;
+    }
+}
+
+/* The last angle of a root whose first angle r gives */
+ALWAYS_INLINE double sm_last(const SmSplit *t, const SmFirst *r)
+{
+    m3 Ra = sm_rotm_cs(t->ha, r->ca, r->sa), Bm = sm_mul(&Ra, &r->Rb);
+    double dummy;
+    return sm_sp1(t->hc, t->e, m3_mtv(&Bm, t->Re), &dummy);
+}
+
+/* sm_split_root with each angle's cosine and sine as the closed form has them into cs
+ * (3 x 2; 0 where not usable: the middle angle within |cos d| > 0.99 of the end of
+ * its range, where sqrt(1 - x^2) and acos(x) part by more than rounding) */
+static void sm_split_root_cs(const SmSplit *t, int i, double v[3], int *sing, double cs[3][2])
+{
+    SmFirst r;
+    sm_first(t, i, &r);
+    *sing = r.sing;
+    v[0] = r.va;
+    v[1] = t->vb[i];
+    m3 Ra = sm_rotm_cs(t->ha, r.ca, r.sa), Bm = sm_mul(&Ra, &r.Rb);
+    double xy[2];
+    v[2] = sm_sp1_xy(t->hc, t->e, m3_mtv(&Bm, t->Re), xy);
+    double n = sqrt(xy[0] * xy[0] + xy[1] * xy[1]);
+    cs[0][0] = r.ca;
+    cs[0][1] = r.sa;
+    cs[1][0] = t->cd_ok ? t->cb[i] : 0.0;
+    cs[1][1] = t->cd_ok ? t->sb[i] : 0.0;
+    cs[2][0] = n > 0.5 ? xy[0] / n : 0.0;
+    cs[2][1] = n > 0.5 ? xy[1] / n : 0.0;
 }
 
 /* The outer angles of root i of a split: v (3) chain angles; *sing where the outer
  * axes line up (the first angle set to 0) */
 static void sm_split_root(const SmSplit *t, int i, double v[3], int *sing)
 {
-    m3 Rb = sm_rotm_cs(t->hb, t->cb[i], t->sb[i]);
-    v3 xa = m3_mv(&Rb, t->hc);
-    xa = v3_sub(xa, v3_scale(t->ha, v3_dot(t->ha, xa)));
-    double py = v3_dot(t->ha, v3_cross(xa, t->ya)), px = v3_dot(xa, t->ya), r = hypot(px, py);
-    double va = atan2(py, px), ca = r > 0.0 ? px / r : 1.0, sa = r > 0.0 ? py / r : 0.0;
-    *sing = sm_norm(xa) < 1e-9;
-    if (*sing) {
-        va = 0.0;
-        ca = 1.0;
-        sa = 0.0;
-    }
-    m3 Ra = sm_rotm_cs(t->ha, ca, sa), Bm = sm_mul(&Ra, &Rb);
-    double dummy;
-    v[0] = va;
+    SmFirst r;
+    sm_first(t, i, &r);
+    *sing = r.sing;
+    v[0] = r.va;
     v[1] = t->vb[i];
-    v[2] = sm_sp1(t->hc, t->e, m3_mtv(&Bm, t->Re), &dummy);
+    v[2] = sm_last(t, &r);
 }
 
 /* Every split of R into rot(ha, va) rot(hb, vb) rot(hc, vc) (swivel.py _triple):
@@ -222,12 +318,17 @@ static void sm_split_root(const SmSplit *t, int i, double v[3], int *sing)
  * rotations by vb and va are built from the cosines and sines the subproblems
  * give (vb = phi +- d with cos phi = A / rho, cos d = C / rho; va = atan2(y, x)),
  * not from the angles: no sine or cosine is evaluated. */
-static int sm_triple(v3 ha, v3 hb, v3 hc, const m3 *R, double v[2][3], int sing[2])
+static int sm_triple(v3 ha, v3 hb, v3 hc, v3 e, const m3 *R, double v[2][3], int sing[2],
+                     double cs[2][3][2])
 {
     SmSplit t;
-    sm_split(ha, hb, hc, R, &t);
-    for (int i = 0; i < 2; i++)
-        sm_split_root(&t, i, v[i], &sing[i]);
+    sm_split(ha, hb, hc, e, R, &t);
+    for (int i = 0; i < 2; i++) {
+        if (cs)
+            sm_split_root_cs(&t, i, v[i], &sing[i], cs[i]);
+        else
+            sm_split_root(&t, i, v[i], &sing[i]);
+    }
     return t.real;
 }
 
@@ -278,8 +379,8 @@ static void sm_frame(const SmArm *a, const double *T, SmFrame *f)
     }
     f->r = v3_scale(r, 1.0 / sm_norm(r));
     for (int e = 0; e < 2; e++) {
-        m3 R4 = sm_rotm(h4, f->v4[e]);
-        v3 ae = v3_sub(v3_add(a->o[3], m3_mv(&R4, p)), a->S);
+        f->R4[e] = sm_rotm(h4, f->v4[e]);
+        v3 ae = v3_sub(v3_add(a->o[3], m3_mv(&f->R4[e], p)), a->S);
         f->R0[e] = sm_smallest(ae, w);
         f->psi0[e] = sm_angle_of(f->u, f->r, m3_mv(&f->R0[e], h4));
     }
@@ -300,31 +401,34 @@ static inline double sm_joint(const SmArm *a, int j, double v)
 }
 
 static void sm_configs_part(const SmArm *a, const SmFrame *f, int e, double psi, int part,
-                            double q[4][7], int ok[4], int sing[4]);
+                            double q[4][7], int ok[4], int sing[4], double cs[4][7][2]);
 
 /* The 4 configurations of elbow root e at swivel angle psi (slots 4 e + 2 s + w,
- * here 2 s + w): joint coordinates q, whether real, singular. */
+ * here 2 s + w): joint coordinates q, whether real, singular; cs (or NULL): each
+ * shoulder and wrist angle's cosine and sine as the closed form has them
+ * (sm_split_root_cs; the elbow's left unset) */
 static void sm_configs(const SmArm *a, const SmFrame *f, int e, double psi, double q[4][7],
-                       int ok[4], int sing[4])
+                       int ok[4], int sing[4], double cs[4][7][2])
 {
-    sm_configs_part(a, f, e, psi, 3, q, ok, sing);
+    sm_configs_part(a, f, e, psi, 3, q, ok, sing, cs);
 }
 
 /* sm_configs of the triples in `part` (1 shoulder, 2 wrist, 3 both); the other
  * triple's joints are left NaN and count as real, not singular */
 static void sm_configs_part(const SmArm *a, const SmFrame *f, int e, double psi, int part,
-                            double q[4][7], int ok[4], int sing[4])
+                            double q[4][7], int ok[4], int sing[4], double cs[4][7][2])
 {
+    double csA[2][3][2], csB[2][3][2];
     m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
     m3 RA = sm_mul(&Ru, &f->R0[e]);
     double sA[2][3] = {{NAN, NAN, NAN}, {NAN, NAN, NAN}}, sB[2][3] = {{NAN, NAN, NAN}, {NAN, NAN, NAN}};
     int gA[2] = {0, 0}, gB[2] = {0, 0}, rA = 1, rB = 1;
     if (part & 1)
-        rA = sm_triple(a->h[0], a->h[1], a->h[2], &RA, sA, gA);
+        rA = sm_triple(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, sA, gA, cs ? csA : NULL);
     if (part & 2) {
-        m3 R4 = sm_rotm(a->h[3], f->v4[e]), RAR4 = sm_mul(&RA, &R4), X = sm_tr(&RAR4);
+        m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
         m3 RB = sm_mul(&X, &f->TR);
-        rB = sm_triple(a->h[4], a->h[5], a->h[6], &RB, sB, gB);
+        rB = sm_triple(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, sB, gB, cs ? csB : NULL);
     }
     int real = f->elbow_real && rA && rB;
     for (int s = 0; s < 2; s++)
@@ -337,6 +441,12 @@ static void sm_configs_part(const SmArm *a, const SmFrame *f, int e, double psi,
                 q[k][4 + j] = real ? sm_joint(a, 4 + j, sB[w][j]) : NAN;
             }
             q[k][3] = real ? sm_joint(a, 3, f->v4[e]) : NAN;
+            if (cs && part == 3)
+                for (int j = 0; j < 3; j++)
+                    for (int c = 0; c < 2; c++) {
+                        cs[k][j][c] = csA[s][j][c];
+                        cs[k][4 + j][c] = csB[w][j][c];
+                    }
         }
 }
 
@@ -347,10 +457,10 @@ static int sm_branch_row(const SmArm *a, const SmFrame *f, int e, int b, double 
     m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
     m3 RA = sm_mul(&Ru, &f->R0[e]);
     SmSplit tA, tB;
-    sm_split(a->h[0], a->h[1], a->h[2], &RA, &tA);
-    m3 R4 = sm_rotm(a->h[3], f->v4[e]), RAR4 = sm_mul(&RA, &R4), X = sm_tr(&RAR4);
+    sm_split(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, &tA);
+    m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
     m3 RB = sm_mul(&X, &f->TR);
-    sm_split(a->h[4], a->h[5], a->h[6], &RB, &tB);
+    sm_split(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, &tB);
     if (!(f->elbow_real && tA.real && tB.real))
         return 0;
     double sA[3], sB[3];
@@ -362,6 +472,222 @@ static int sm_branch_row(const SmArm *a, const SmFrame *f, int e, int b, double 
         q[4 + j] = sm_joint(a, 4 + j, sB[j]);
     }
     q[3] = sm_joint(a, 3, f->v4[e]);
+    return 1;
+}
+
+/* Inside every limit with the slack of SelfMotion.inside (chain.h MANIFOLD_SLACK), so
+ * that a cell whose row rides a limit to rounding (a branch tangent to it, q = limit
+ * + 4e-16) is decided as .inside decides it. */
+static int sm_inside_joint(const SmArm *a, int j, double q)
+{
+    return q >= a->lo[j] - MANIFOLD_SLACK && q <= a->hi[j] + MANIFOLD_SLACK;
+}
+
+/* every joint of a row inside its limits (with the membership slack) */
+static int sm_row_inside(const SmArm *a, const double q[7])
+{
+    for (int j = 0; j < 7; j++)
+        if (!sm_inside_joint(a, j, q[j]))
+            return 0;
+    return 1;
+}
+
+/* The quick twin of sm_split: the middle angle's cosines and sines (cb, sb) and
+ * whether it is real, computed as sm_split does, without the angles (acos, atan2) */
+static void sm_split_quick(v3 ha, v3 hb, v3 hc, v3 e, const m3 *R, SmSplit *t)
+{
+    t->ha = ha;
+    t->hb = hb;
+    t->hc = hc;
+    t->Rhc = m3_mv(R, hc);
+    double A, B, C, rho;
+    t->real = sm_sp4_abc(hb, ha, hc, v3_dot(ha, t->Rhc), &A, &B, &C, &rho);
+    double x = rho > 0.0 ? fmax(-1.0, fmin(1.0, C / rho)) : NAN;
+    double cp = A / rho, sp = B / rho, cd = x, sd = sqrt(1.0 - x * x);
+    t->cb[0] = cp * cd - sp * sd;
+    t->cb[1] = cp * cd + sp * sd;
+    t->sb[0] = sp * cd + cp * sd;
+    t->sb[1] = sp * cd - cp * sd;
+    t->e = e;
+    t->Re = m3_mv(R, t->e);
+    t->ya = v3_sub(t->Rhc, v3_scale(ha, v3_dot(ha, t->Rhc)));
+}
+
+/* The quick limit test of joint j at the chain angle with cosine c and sine s: 1
+ * inside its limits by more than SM_QUICK_M, 0 outside by more, -1 not certain.
+ * Applies where -pi <= lo < hi <= pi (sm_joint's shift by 2 pi never moves an
+ * angle in or out there away from the limits): inside iff the angle is within w
+ * of the range's middle; cos of that distance c cos v_c + s sin v_c against the
+ * thresholds (SM_ARC), padded by SM_QUICK_PAD for the pairs' 1.1e-8 rad. */
+static inline int sm_quick_joint(const SmArm *a, int j, double c, double s)
+{
+    const double *k = a->arc + 4 * j;
+    double g = c * k[0] + s * k[1];
+    return g > k[2] ? 1 : g < k[3] ? 0 : -1;
+}
+
+/* The quick sm_root_inside of root i of a real quick split: 1, 0, or -1 (not certain:
+ * the exact test decides) */
+static int sm_quick_root_inside(const SmArm *a, int j0, const SmSplit *t, int i)
+{
+    int v = sm_quick_joint(a, j0 + 1, t->cb[i], t->sb[i]);
+    if (v != 1)
+        return v;
+    m3 Rb = sm_rotm_cs(t->hb, t->cb[i], t->sb[i]);
+    v3 xa = m3_mv(&Rb, t->hc);
+    xa = v3_sub(xa, v3_scale(t->ha, v3_dot(t->ha, xa)));
+    double py = v3_dot(t->ha, v3_cross(xa, t->ya)), px = v3_dot(xa, t->ya);
+    double ca = 1.0, sa = 0.0;
+    if (!(sm_norm(xa) < 1e-9)) { /* else aligned: the first angle 0, as sm_first */
+        double rr = sqrt(px * px + py * py);
+        if (!(rr > 1e-100))
+            return -1;
+        ca = px / rr;
+        sa = py / rr;
+    }
+    v = sm_quick_joint(a, j0, ca, sa);
+    if (v != 1)
+        return v;
+    m3 Ra = sm_rotm_cs(t->ha, ca, sa), Bm = sm_mul(&Ra, &Rb);
+    v3 h = t->hc, x = t->e, y = m3_mtv(&Bm, t->Re);
+    v3 xp = v3_sub(x, v3_scale(h, v3_dot(h, x))), yp = v3_sub(y, v3_scale(h, v3_dot(h, y)));
+    double Y = v3_dot(h, v3_cross(xp, yp)), X = v3_dot(xp, yp), r = sqrt(X * X + Y * Y);
+    if (!(r > 0.5))
+        return -1;
+    return sm_quick_joint(a, j0 + 2, X / r, Y / r);
+}
+
+/* The quick point test: whether the chain angle (c, s) of root i's joint is within
+ * SM_SAME of the candidate's value (cv, sv): 1, 0, or -1 (not certain) */
+static inline int sm_quick_at(double c, double s, double cv, double sv)
+{
+    double dx = c - cv, dy = s - sv, d2 = dx * dx + dy * dy;
+    return d2 < SM_AT_IN ? 1 : d2 > SM_AT_OUT ? 0 : -1;
+}
+
+/* The cosine and sine of joint j's chain angle on root i of a real quick split (as
+ * sm_quick_root_inside computes them); returns 0 where not certain */
+static int sm_quick_angle(const SmSplit *t, int k, int i, double *c, double *s)
+{
+    if (k == 1) {
+        *c = t->cb[i];
+        *s = t->sb[i];
+        return 1;
+    }
+    m3 Rb = sm_rotm_cs(t->hb, t->cb[i], t->sb[i]);
+    v3 xa = m3_mv(&Rb, t->hc);
+    xa = v3_sub(xa, v3_scale(t->ha, v3_dot(t->ha, xa)));
+    double py = v3_dot(t->ha, v3_cross(xa, t->ya)), px = v3_dot(xa, t->ya);
+    double ca = 1.0, sa = 0.0;
+    if (!(sm_norm(xa) < 1e-9)) {
+        double rr = sqrt(px * px + py * py);
+        if (!(rr > 1e-100))
+            return 0;
+        ca = px / rr;
+        sa = py / rr;
+    }
+    if (k == 0) {
+        *c = ca;
+        *s = sa;
+        return 1;
+    }
+    m3 Ra = sm_rotm_cs(t->ha, ca, sa), Bm = sm_mul(&Ra, &Rb);
+    v3 h = t->hc, x = t->e, y = m3_mtv(&Bm, t->Re);
+    v3 xp = v3_sub(x, v3_scale(h, v3_dot(h, x))), yp = v3_sub(y, v3_scale(h, v3_dot(h, y)));
+    double Y = v3_dot(h, v3_cross(xp, yp)), X = v3_dot(xp, yp), r = sqrt(X * X + Y * Y);
+    if (!(r > 0.5))
+        return 0;
+    *c = X / r;
+    *s = Y / r;
+    return 1;
+}
+
+/* sm_part_split's quick twin (sm_split_quick) */
+static void sm_part_split_quick(const SmArm *a, const SmFrame *f, int e, double psi, int part,
+                                SmSplit *t)
+{
+    m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
+    m3 RA = sm_mul(&Ru, &f->R0[e]);
+    if (part == 1) {
+        sm_split_quick(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, t);
+        return;
+    }
+    m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
+    m3 RB = sm_mul(&X, &f->TR);
+    sm_split_quick(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, t);
+}
+
+/* The split of one triple (part 1 the shoulder, 2 the wrist) of elbow root e at
+ * psi: the middle angle's roots, as sm_configs_part computes them */
+static void sm_part_split(const SmArm *a, const SmFrame *f, int e, double psi, int part,
+                          SmSplit *t)
+{
+    m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
+    m3 RA = sm_mul(&Ru, &f->R0[e]);
+    if (part == 1) {
+        sm_split(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, t);
+        return;
+    }
+    m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
+    m3 RB = sm_mul(&X, &f->TR);
+    sm_split(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, t);
+}
+
+/* Whether root i of a real split t of the triple from joint j0 has its three joints
+ * inside their limits (sm_triple_inside on sm_configs_part's row): the middle joint
+ * first, then the first, then the last, each angle computed only when the joints
+ * before it are inside (the same values, the same verdict) */
+static int sm_root_inside(const SmArm *a, int j0, const SmSplit *t, int i)
+{
+    if (!sm_inside_joint(a, j0 + 1, sm_joint(a, j0 + 1, t->vb[i])))
+        return 0;
+    SmFirst r;
+    sm_first(t, i, &r);
+    if (!sm_inside_joint(a, j0, sm_joint(a, j0, r.va)))
+        return 0;
+    return sm_inside_joint(a, j0 + 2, sm_joint(a, j0 + 2, sm_last(t, &r)));
+}
+
+/* Joint j (not the elbow) of root i of a real split t of its triple, as
+ * sm_configs_part gives it: only the angles up to j's computed */
+static double sm_root_joint(const SmArm *a, int j, const SmSplit *t, int i)
+{
+    int k = j < 3 ? j : j - 4;
+    if (k == 1)
+        return sm_joint(a, j, t->vb[i]);
+    SmFirst r;
+    sm_first(t, i, &r);
+    return sm_joint(a, j, k == 0 ? r.va : sm_last(t, &r));
+}
+
+/* Whether branch b of elbow root e exists at psi with every joint inside its limits
+ * (sm_branch_row's row and sm_row_inside's test): the triple `first` (1 the
+ * shoulder, 2 the wrist) decided first, each angle computed only when needed */
+static int sm_branch_inside(const SmArm *a, const SmFrame *f, int e, int b, double psi,
+                            int first)
+{
+    if (!f->elbow_real || !sm_inside_joint(a, 3, sm_joint(a, 3, f->v4[e])))
+        return 0;
+    m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
+    m3 RA = sm_mul(&Ru, &f->R0[e]);
+    SmSplit t[2];
+    for (int n = 0; n < 2; n++) {
+        int part = n ? 3 - first : first;
+        if (part == 1) {
+            sm_split(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, &t[0]);
+        } else {
+            m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
+            m3 RB = sm_mul(&X, &f->TR);
+            sm_split(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, &t[1]);
+        }
+        if (!t[part - 1].real)
+            return 0;
+    }
+    for (int n = 0; n < 2; n++) {
+        int part = n ? 3 - first : first;
+        if (!sm_root_inside(a, part == 1 ? 0 : 4, &t[part - 1], part == 1 ? b / 2 : b % 2))
+            return 0;
+    }
     return 1;
 }
 
@@ -515,6 +841,30 @@ static int sm_polish(const SmArm *a, const m3 *RT, v3 pT, double *q)
     return err <= SM_ACCEPT;
 }
 
+/* Whether a row needs no polish, certainly: its pose error from the closed form's
+ * cosines and sines cs (7 x 2; sm_split_root_cs) below SM_QUICK_FK. Those pairs
+ * stand for the chain angles sm_fk takes (sign q + offset) to ~3e-15 rad each
+ * (the wrap into the limits and back), so the two errors part by less than
+ * ~3e-14: below SM_QUICK_FK here, sm_polish's error is below SM_EXACT and it
+ * leaves the row as it is. 0 where a pair is not usable (then sm_polish decides). */
+#define SM_QUICK_FK 3e-14
+static int sm_quick_exact(const SmArm *a, const m3 *RT, v3 pT, double cs[7][2])
+{
+    m3 G = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+    v3 g = {0.0, 0.0, 0.0};
+    for (int k = 0; k < 7; k++) {
+        if (!(cs[k][0] * cs[k][0] + cs[k][1] * cs[k][1] > 0.5))
+            return 0;
+        m3 Rk = sm_rotm_cs(a->h[k], cs[k][0], cs[k][1]);
+        g = v3_add(m3_mv(&G, v3_sub(a->o[k], m3_mv(&Rk, a->o[k]))), g);
+        G = sm_mul(&G, &Rk);
+    }
+    m3 R = sm_mul(&G, &a->MR);
+    v3 p = v3_add(m3_mv(&G, a->MT), g);
+    double e[6];
+    return sm_error(RT, pT, &R, p, e) < SM_QUICK_FK;
+}
+
 /* ------------------------------------------------------------ rows */
 
 typedef struct {
@@ -540,12 +890,18 @@ static void sm_rows_range(void *arg, long i0, long i1)
             double *Q = jb->Q + 56 * row;
             npy_bool *ok = jb->valid + 8 * row, *sg = jb->sing + 8 * row;
             for (int e = 0; e < 2; e++) {
-                double q[4][7];
+                double q[4][7], cs[4][7][2];
                 int okk[4], sing[4];
-                sm_configs(&a, &f, e, jb->psi[row], q, okk, sing);
+                sm_configs(&a, &f, e, jb->psi[row], q, okk, sing, cs);
                 for (int b = 0; b < 4; b++) {
                     int slot = 4 * e + b;
-                    int good = okk[b] && sm_polish(&a, &RT, pT, q[b]);
+                    int good = 0;
+                    if (okk[b]) { /* the elbow's cosine and sine: of the angle sm_fk takes */
+                        double v4 = a.sign[3] * q[b][3] + a.offset[3];
+                        cs[b][3][0] = cos(v4);
+                        cs[b][3][1] = sin(v4);
+                        good = sm_quick_exact(&a, &RT, pT, cs[b]) || sm_polish(&a, &RT, pT, q[b]);
+                    }
                     for (int j = 0; j < 7; j++)
                         Q[7 * slot + j] = good ? q[b][j] : NAN;
                     ok[slot] = (npy_bool)good;
@@ -574,6 +930,7 @@ typedef struct {
     double psi;
     int joint, kind;
     double value; /* the joint coordinate (limits) or chain angle (aligned / fold) */
+    double cv, sv; /* the cosine and sine of the value's chain angle (SM_LIMCS, SM_FOLDCS) */
 } SmCand;
 
 /* Swivel angles (up to 2) where joint j (0-2, 4-6) is at chain angle L on elbow
@@ -605,7 +962,7 @@ static int sm_limit_psi(const SmArm *a, const SmFrame *f, int e, int j, double L
         sgn = 1.0;
     } else {
         v3 ha = h[4], hb = h[5], hc = h[6];
-        m3 R4 = sm_rotm(h[3], f->v4[e]), base = sm_mul(&f->R0[e], &R4);
+        m3 base = sm_mul(&f->R0[e], &f->R4[e]);
         if (j == 4) {
             m3 Ra = sm_rotm(ha, L);
             x = m3_mv(&base, m3_mv(&Ra, hb));
@@ -660,7 +1017,8 @@ static int sm_candidates(const SmArm *a, const SmFrame *f, int e, SmCand *c)
             double lim = s ? a->hi[j] : a->lo[j];
             int m = sm_limit_psi(a, f, e, j, a->sign[j] * lim + a->offset[j], psi);
             for (int i = 0; i < m; i++)
-                c[n++] = (SmCand){psi[i], j, s ? SM_KIND_UPPER : SM_KIND_LOWER, lim};
+                c[n++] = (SmCand){psi[i], j, s ? SM_KIND_UPPER : SM_KIND_LOWER, lim,
+                                  a->limcs[4 * j + 2 * s], a->limcs[4 * j + 2 * s + 1]};
         }
     }
     for (int t = 0; t < 2; t++) {
@@ -676,33 +1034,11 @@ static int sm_candidates(const SmArm *a, const SmFrame *f, int e, SmCand *c)
             int kind = al > 1.0 - 1e-12 ? SM_KIND_ALIGNED : SM_KIND_FOLD;
             int m = sm_limit_psi(a, f, e, o + 1, L, psi);
             for (int i = 0; i < m; i++)
-                c[n++] = (SmCand){psi[i], o + 1, kind, L};
+                c[n++] = (SmCand){psi[i], o + 1, kind, L, s ? -a->foldcs[2 * t] : a->foldcs[2 * t],
+                                  s ? -a->foldcs[2 * t + 1] : a->foldcs[2 * t + 1]};
         }
     }
     return n;
-}
-
-static int sm_cmp(const void *x, const void *y)
-{
-    double a = *(const double *)x, b = *(const double *)y;
-    return (a > b) - (a < b);
-}
-
-/* Inside every limit with the slack of SelfMotion.inside (chain.h MANIFOLD_SLACK), so
- * that a cell whose row rides a limit to rounding (a branch tangent to it, q = limit
- * + 4e-16) is decided as .inside decides it. */
-static int sm_inside_joint(const SmArm *a, int j, double q)
-{
-    return q >= a->lo[j] - MANIFOLD_SLACK && q <= a->hi[j] + MANIFOLD_SLACK;
-}
-
-/* every joint of a row inside its limits (with the membership slack) */
-static int sm_row_inside(const SmArm *a, const double q[7])
-{
-    for (int j = 0; j < 7; j++)
-        if (!sm_inside_joint(a, j, q[j]))
-            return 0;
-    return 1;
 }
 
 typedef struct {
@@ -713,14 +1049,6 @@ typedef struct {
 
 /* Candidates within this of each other [rad] may be one corner (sm_runs) */
 #define SM_CORNER 1e-9
-
-/* Whether the triple of joints j0..j0+2 of a row (ok: it exists) is inside */
-static int sm_triple_inside(const SmArm *a, int j0, int ok, const double *q)
-{
-    for (int j = j0; j < j0 + 3 && ok; j++)
-        ok = sm_inside_joint(a, j, q[j]);
-    return ok;
-}
 
 /* The runs of swivel angles where one triple (part 1 the shoulder, 2 the wrist) of
  * elbow root e exists with its three joints inside their limits, per root r of its
@@ -741,28 +1069,40 @@ static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmC
     for (int i = 0; i < nc; i++)
         if ((c[i].joint < 3) == (part == 1))
             cut[m++] = c[i].psi;
-    qsort(cut, (size_t)m, sizeof(double), sm_cmp);
+    for (int i = 1; i < m; i++) { /* insertion sort (stable), at most 66 cuts */
+        double x = cut[i];
+        int k = i;
+        for (; k > 0 && cut[k - 1] > x; k--)
+            cut[k] = cut[k - 1];
+        cut[k] = x;
+    }
     int open[2] = {0, 0};
     nrun[0] = nrun[1] = 0;
     for (int i = 0; i + 1 < m; i++) {
         double lo = cut[i], hi = cut[i + 1];
         if (!(hi > lo))
             continue;
-        double q[4][7], qc[4][7];
-        int ok[4], sg[4], okc[4], at = 0; /* at: the row at the cut lo computed */
-        sm_configs_part(a, f, e, 0.5 * (lo + hi), part, q, ok, sg);
+        SmSplit t, tq, tc;
+        int at = 0, exact = 0; /* at: the split at the cut lo computed; exact: t */
+        double mid = 0.5 * (lo + hi);
+        sm_part_split_quick(a, f, e, mid, part, &tq);
         for (int r = 0; r < 2; r++) {
-            int b = part == 1 ? 2 * r : r; /* the other triple's root 0: NaN there */
-            int in = sm_triple_inside(a, j0, ok[b], q[b]);
+            int in = tq.real ? sm_quick_root_inside(a, j0, &tq, r) : 0;
+            if (in < 0) { /* not certain: the exact test (tq.real is t.real) */
+                if (!exact)
+                    sm_part_split(a, f, e, mid, part, &t);
+                exact = 1;
+                in = sm_root_inside(a, j0, &t, r);
+            }
             if (!in && !open[r] && lo > -M_PI && nrun[r] < SM_MAXI &&
                 (lo - cut[i - 1] <= SM_CORNER || hi - lo <= SM_CORNER)) {
                 /* both cells next to the cut outside and another cut within SM_CORNER
                  * (two joints of the triple at limits there, leaving on either side):
                  * the cut alone, if its row is in */
                 if (!at)
-                    sm_configs_part(a, f, e, lo, part, qc, okc, sg);
+                    sm_part_split(a, f, e, lo, part, &tc);
                 at = 1;
-                if (sm_triple_inside(a, j0, okc[b], qc[b])) {
+                if (tc.real && sm_root_inside(a, j0, &tc, r)) {
                     run[r][nrun[r]][0] = run[r][nrun[r]][1] = lo;
                     nrun[r]++;
                 }
@@ -780,17 +1120,17 @@ static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmC
     /* the cut at -pi (= pi) by the same rule: both cells next to it outside (no run
      * starts at -pi, none ends at pi) and the row there inside: [-pi, -pi] first and
      * [pi, pi] last (joined across pi into one point, sm_elbow_intervals) */
-    int at = 0, okc[4], sg[4];
-    double qc[4][7];
+    int at = 0;
+    SmSplit tc;
     for (int r = 0; r < 2; r++) {
-        int b = part == 1 ? 2 * r : r, n = nrun[r];
+        int n = nrun[r];
         if ((n && (run[r][0][0] == -M_PI || run[r][n - 1][1] == M_PI)) || n + 2 > SM_MAXI ||
             !(cut[1] + M_PI <= SM_CORNER || M_PI - cut[m - 2] <= SM_CORNER))
             continue; /* a run at an end, or no candidate at +-pi */
         if (!at)
-            sm_configs_part(a, f, e, -M_PI, part, qc, okc, sg);
+            sm_part_split(a, f, e, -M_PI, part, &tc);
         at = 1;
-        if (!sm_triple_inside(a, j0, okc[b], qc[b]))
+        if (!(tc.real && sm_root_inside(a, j0, &tc, r)))
             continue;
         for (int i = n; i > 0; i--) {
             run[r][i][0] = run[r][i - 1][0];
@@ -839,17 +1179,16 @@ static int sm_in_runs(double x[][2], int n, double psi)
  * both at limits). The two ends are computed roots of different subproblems: next
  * to a near-tangent one (a joint whose slope over the swivel is small, 1e-6) they
  * miss each other by more than rounding, so the overlap of the runs is empty.
- * Adds each as a one-point interval [psi, psi] into r (k sorted intervals). */
+ * Adds each as a one-point interval [psi, psi] into r (k sorted intervals). party:
+ * the triple of y (1 the shoulder, 2 the wrist), tested first (usually outside). */
 static long long sm_touches(const SmArm *a, const SmFrame *f, int e, int b, double x[][2], int nx,
-                            double y[][2], int ny, double *r, long long k)
+                            double y[][2], int ny, int party, double *r, long long k)
 {
     for (int i = 0; i < nx; i++)
         for (int s = 0; s < 2; s++) {
-            double t = x[i][s], q[7];
+            double t = x[i][s];
             if (t == -M_PI || t == M_PI || sm_in_runs(y, ny, t) || k >= SM_MAXI ||
-                !sm_branch_row(a, f, e, b, t, q))
-                continue;
-            if (!sm_row_inside(a, q))
+                !sm_branch_inside(a, f, e, b, t, party))
                 continue;
             long long p = k++;
             while (p > 0 && r[2 * p - 2] > t) {
@@ -880,8 +1219,8 @@ static void sm_elbow_intervals(const SmArm *a, const SmFrame *f, int e, const Sm
     for (int b = 0; b < 4; b++) {
         double *r = iv + 2 * SM_MAXI * b;
         long long k = sm_overlap(rs[b / 2], ns[b / 2], rw[b % 2], nw[b % 2], r);
-        k = sm_touches(a, f, e, b, rs[b / 2], ns[b / 2], rw[b % 2], nw[b % 2], r, k);
-        k = sm_touches(a, f, e, b, rw[b % 2], nw[b % 2], rs[b / 2], ns[b / 2], r, k);
+        k = sm_touches(a, f, e, b, rs[b / 2], ns[b / 2], rw[b % 2], nw[b % 2], 2, r, k);
+        k = sm_touches(a, f, e, b, rw[b % 2], nw[b % 2], rs[b / 2], ns[b / 2], 1, r, k);
         /* periodic: a run ending at pi and one starting at -pi join */
         if (k >= 2 && r[0] == -M_PI && r[2 * k - 1] == M_PI) {
             double end = r[1] + 2.0 * M_PI, start = r[2 * k - 2];
@@ -913,16 +1252,30 @@ static void sm_manifold1(const SmArm *a, const double *T, double *iv, long long 
         int nc = sm_candidates(a, &f, e, c);
         /* the points: which branches are at the value there */
         for (int i = 0; i < nc; i++) {
-            double q[4][7];
-            int ok[4], sg[4];
-            sm_configs_part(a, &f, e, c[i].psi, c[i].joint < 3 ? 1 : 2, q, ok, sg);
-            for (int b = 0; b < 4; b++) {
-                if (!ok[b] || *npts >= SM_MAXP)
+            int j = c[i].joint, part = j < 3 ? 1 : 2, at[2], exact = 0;
+            SmSplit t, tq;
+            sm_part_split_quick(a, &f, e, c[i].psi, part, &tq);
+            if (!tq.real) /* t.real */
+                continue;
+            for (int r = 0; r < 2; r++) { /* root r's joint j at the value (within SM_SAME) */
+                double cj, sj;
+                at[r] = sm_quick_angle(&tq, j < 3 ? j : j - 4, r, &cj, &sj)
+                    ? sm_quick_at(cj, sj, c[i].cv, c[i].sv) : -1;
+                if (at[r] >= 0)
                     continue;
+                if (!exact) /* not certain: the exact test */
+                    sm_part_split(a, &f, e, c[i].psi, part, &t);
+                exact = 1;
+                double qj = sm_root_joint(a, j, &t, r);
                 double d = c[i].kind <= SM_KIND_UPPER
-                    ? q[b][c[i].joint] - c[i].value
-                    : a->sign[c[i].joint] * q[b][c[i].joint] + a->offset[c[i].joint] - c[i].value;
-                if (fabs(wrap_pi(d)) < SM_SAME) {
+                    ? qj - c[i].value
+                    : a->sign[j] * qj + a->offset[j] - c[i].value;
+                at[r] = fabs(wrap_pi(d)) < SM_SAME;
+            }
+            for (int b = 0; b < 4; b++) {
+                if (*npts >= SM_MAXP)
+                    continue;
+                if (at[part == 1 ? b / 2 : b % 2]) {
                     double *r = pts + 4 * (*npts)++;
                     r[0] = c[i].psi;
                     r[1] = 4 * e + b;
@@ -955,6 +1308,40 @@ static PyObject *swivel_manifold_body(const swivel_manifold_args *a)
         sm_manifold_range(&jb, 0, (long)a->N);
     Py_END_ALLOW_THREADS
     Py_RETURN_NONE;
+}
+
+/* One pose (robot.self_motion's call): sm_manifold1, its intervals packed branch by
+ * branch; returns new arrays (intervals (m, 2), branches (m,), points (p, 4)). */
+static PyObject *swivel_manifold_one_body(const swivel_manifold_one_args *a)
+{
+    double iv[8 * SM_MAXI * 2], pts[4 * SM_MAXP];
+    long long niv[8], npts = 0, m = 0;
+    SmArm arm;
+    sm_arm(a->params, &arm);
+    sm_manifold1(&arm, a->T, iv, niv, pts, &npts);
+    for (int b = 0; b < 8; b++)
+        m += niv[b];
+    npy_intp di[2] = {(npy_intp)m, 2}, dp[2] = {(npy_intp)npts, 4};
+    PyObject *out_iv = PyArray_SimpleNew(2, di, NPY_DOUBLE);
+    PyObject *out_b = PyArray_SimpleNew(1, di, NPY_INT64);
+    PyObject *out_p = PyArray_SimpleNew(2, dp, NPY_DOUBLE);
+    if (out_iv == NULL || out_b == NULL || out_p == NULL) {
+        Py_XDECREF(out_iv);
+        Py_XDECREF(out_b);
+        Py_XDECREF(out_p);
+        return NULL;
+    }
+    double *ov = (double *)PyArray_DATA((PyArrayObject *)out_iv);
+    long long *ob = (long long *)PyArray_DATA((PyArrayObject *)out_b);
+    for (int b = 0, k = 0; b < 8; b++)
+        for (long long i = 0; i < niv[b]; i++, k++) {
+            ov[2 * k] = iv[2 * (SM_MAXI * b + i)];
+            ov[2 * k + 1] = iv[2 * (SM_MAXI * b + i) + 1];
+            ob[k] = b;
+        }
+    if (npts)
+        memcpy(PyArray_DATA((PyArrayObject *)out_p), pts, (size_t)(4 * npts) * sizeof(double));
+    return Py_BuildValue("(NNN)", out_iv, out_b, out_p);
 }
 
 /* ------------------------------------------------------------ the nearest point */
@@ -1112,7 +1499,7 @@ static int sm_near1(const SmArm *a, const double *T, const double *qn, double *q
                         if (!done[kk]) {
                             double q[4][7];
                             int ok[4], sg[4];
-                            sm_configs(a, &f, e, -M_PI + kk * h, q, ok, sg);
+                            sm_configs(a, &f, e, -M_PI + kk * h, q, ok, sg, NULL);
                             for (int bb = 0; bb < 4; bb++)
                                 grid[kk][bb] = ok[bb] ? sm_dist2(q[bb], qn) : INFINITY;
                             done[kk] = 1;

@@ -46,7 +46,7 @@ import numpy.typing as npt
 from robokin._native import kernels as K
 from robokin._validation import check_finite, check_joints, check_rigid
 from robokin.exceptions import InputError
-from robokin.kinematics.arm import ArmSource, arm_of
+from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.fixed import Dispatch
 from robokin.kinematics.ik.self_motion_base import _Family
 from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
@@ -412,13 +412,7 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
     setup = _setup(robot) if robot.n == 7 and not reference else None
     # the compiled swivel (an SRS arm's "auto"): no family choice, no per-call lists
     if setup is not None and setup.swivel is not None and parameter in ("auto", "swivel"):
-        sw = _SwivelFamily(setup.swivel, Ta, robot)
-        intervals, owner, points = sw.exact()
-        intervals, owner, corners = _points_refined(sw, limits, intervals, owner, points,
-                                                    K.SM_KIND_UPPER)
-        return SelfMotion(Ta, "swivel", None, _SWIVEL_DOMAIN.copy(), True, 8, intervals, owner,
-                          "swivel closed form (SRS), compiled", {"bisected": 0, "grid": 0},
-                          sw, limits, points, _corners=corners)
+        return _swivel_motion(setup.swivel, Ta, robot, limits)
     kern: HeldKernel | None = setup.held if setup is not None else None
     if kern is not None and parameter in ("auto", kern.named[0]):
         # the compiled held family "auto" took before: no family choice again
@@ -482,6 +476,29 @@ def _held_motion(T: np.ndarray, kern: HeldKernel, intervals: np.ndarray, owner: 
     return sm
 
 
+def _swivel_motion(arm: SwivelArm, T: np.ndarray, robot: Arm, limits: np.ndarray
+                   ) -> SelfMotion:
+    """The compiled swivel's SelfMotion: the dataclass' fields set directly.
+
+    Equal to ``SelfMotion(T, "swivel", None, domain, True, 8, intervals, owner, method,
+    {"bisected": 0, "grid": 0}, family, limits, points, _corners=corners)`` (the frozen dataclass'
+    ``__init__`` is ~3 us of the ~9 us the API adds to the kernel; one dict literal
+    as the instance's ``__dict__`` ~1 us).
+    """
+    sw = _SwivelFamily(arm, T, robot)
+    intervals, owner, points = sw.exact()
+    intervals, owner, corners = _points_refined(sw, limits, intervals, owner, points,
+                                                K.SM_KIND_UPPER)
+    sm = object.__new__(SelfMotion)
+    object.__setattr__(sm, "__dict__", {
+        "T": T, "parameter": "swivel", "joint": None, "domain": _SWIVEL_DOMAIN.copy(),
+        "periodic": True, "n_branches": 8, "intervals": intervals, "interval_branch": owner,
+        "method": _SWIVEL_METHOD, "info": {"bisected": 0, "grid": 0}, "_family": sw,
+        "limits": limits, "_points": points, "_records": None, "_held": False,
+        "_corners": corners})
+    return sm
+
+
 def _solves(fam: _Family) -> dict[str, int]:
     """A continued family's ``solves`` (general-6R values solved) and ``degenerate``."""
     if not isinstance(fam, _ContinuedFamily):
@@ -491,6 +508,8 @@ def _solves(fam: _Family) -> dict[str, int]:
 
 #: The swivel's parameter range (copied into each SelfMotion).
 _SWIVEL_DOMAIN = np.array([-np.pi, np.pi])
+#: The compiled swivel's ``method``.
+_SWIVEL_METHOD = "swivel closed form (SRS), compiled"
 #: The compiled swivel's point kinds (``SM_KIND_*`` 0-3), as the records name them.
 _KINDS = ("lower", "upper", "aligned axes", "fold")
 

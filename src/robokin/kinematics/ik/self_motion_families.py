@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 
-from robokin._native import kernels as K
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, Derived
 from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
@@ -82,10 +81,7 @@ class _SwivelFamily(_Family):
         The points are the kernel's rows ``[psi, branch, joint, kind]`` (kind
         ``SM_KIND_*``); ``self_motion._records_of`` makes them records when read.
         """
-        iv, niv, pts, npts = self.arm.manifold(self.T[None])
-        counts = niv[0]
-        intervals = iv[0][counts[:, None] > _SLOTS]
-        return intervals, _BRANCHES.repeat(counts), pts[0, :npts[0]]
+        return self.arm.manifold_one(self.T)
 
     def param_of(self, q: np.ndarray) -> float:
         return float(self.arm.swivel_of(self.fr, q))
@@ -94,11 +90,6 @@ class _SwivelFamily(_Family):
         if j == 3:
             return []  # the elbow does not move with the swivel
         return [(psi, None) for psi, _ in self.arm.limit_swivels(self.fr, j, value)]
-
-
-#: Interval slots of a branch and the 8 swivel branches (``_SwivelFamily.exact``).
-_SLOTS = np.arange(K.SM_MAXI)
-_BRANCHES = np.arange(8)
 
 
 class _JointFamily(_Family):

@@ -273,6 +273,17 @@ class SwivelArm:
         K.swivel_manifold(self.params, T, iv, niv, pts, npts)
         return iv, niv, pts, npts
 
+    def manifold_one(self, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`manifold` of one pose T (4, 4, contiguous float64), packed.
+
+        Returns:
+            ``(intervals (m, 2), branch (m,), points (p, 4))``, new arrays: the
+            intervals branch by branch (each branch's sorted), then the points, as
+            :meth:`manifold` gives them (``robot.self_motion``'s call: no batch axes,
+            no per-call output arrays or masking).
+        """
+        return K.swivel_manifold_one(self.params, T)
+
     def nearest(self, T: np.ndarray, q_near: np.ndarray
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The in-limit configuration of each pose nearest ``q_near``, compiled.
@@ -421,4 +432,34 @@ def _pack(h: np.ndarray, o: np.ndarray, S: np.ndarray, W: np.ndarray, M: np.ndar
         P[at:at + 7] = v
     P[K.SM_REF:K.SM_REF + 3] = h[0]
     P[K.SM_TAG] = K.SM_TAG_VALUE
+    _pack_quick(P, h, sign, offset, limits)
     return P
+
+
+#: The quick tests' margin [rad] and pad (``csrc/self_motion.c`` SM_QUICK_M, _PAD).
+_QUICK_M, _QUICK_PAD = 1e-6, 5e-8
+
+
+def _pack_quick(P: np.ndarray, h: np.ndarray, sign: np.ndarray, offset: np.ndarray,
+                limits: np.ndarray) -> None:
+    """The quick tests' constants (SM_ARC, SM_LIMCS, SM_FOLDCS; self_motion.c says how).
+
+    Rounding here does not matter: each test is certain by a margin of ~5e-8 or more.
+    """
+    for j in (0, 1, 2, 4, 5, 6):
+        lo, hi = float(limits[j, 0]), float(limits[j, 1])
+        for s, lim in enumerate((lo, hi)):
+            L = sign[j] * lim + offset[j]
+            P[K.SM_LIMCS + 4 * j + 2 * s:K.SM_LIMCS + 4 * j + 2 * s + 2] = np.cos(L), np.sin(L)
+        arc = (0.0, 0.0, 2.0, -2.0)  # never certain: the exact test
+        w = 0.5 * (hi - lo)
+        if -np.pi <= lo < hi <= np.pi and _QUICK_M < w < np.pi - _QUICK_M:
+            vc = offset[j] + sign[j] * 0.5 * (lo + hi)
+            arc = (np.cos(vc), np.sin(vc), np.cos(w - _QUICK_M) + _QUICK_PAD,
+                   np.cos(w + _QUICK_M) - _QUICK_PAD)
+        P[K.SM_ARC + 4 * j:K.SM_ARC + 4 * j + 4] = arc
+    for t in range(2):  # the middle angle where a triple's outer axes are nearest
+        ha, hb, hc = h[4 * t], h[4 * t + 1], h[4 * t + 2]
+        hp = hc - hb * (hb @ hc)
+        A, B = ha @ hp, ha @ np.cross(hb, hp)
+        P[K.SM_FOLDCS + 2 * t:K.SM_FOLDCS + 2 * t + 2] = np.array([A, B]) / np.hypot(A, B)

@@ -1,0 +1,202 @@
+"""``robot.self_motion(T)`` on the SRS swivel, two trees A/B: the same outputs, and the CPU.
+
+Each tree runs in a fresh process (``PYTHONPATH=<tree>/src``). Outputs: on
+``--n`` configurations (``self_motion_rates.configurations``: half uniform in the
+limits, half ``special_batch``, seed 29) every public field of each ``SelfMotion``
+(``T``, ``parameter``, ``joint``, ``domain``, ``periodic``, ``n_branches``,
+``intervals``, ``interval_branch``, ``method``, ``info``, ``limits``, ``crossings``,
+``singular``, ``sample(t)`` and ``inside(t)`` at 9 values), the bare kernels'
+outputs (``swivel_manifold``: intervals, counts, points; ``swivel_rows`` at 37
+values per pose: rows, valid and singular flags; ``swivel_near``) are saved and
+compared exactly (``np.array_equal``, NaN equal to NaN; records as tuples).
+
+Timing (the trees alternated ``--rounds`` times; CPU, ``time.process_time``, best
+of ``--repeat`` passes over the first ``--timed`` uniform poses, as
+``bench_self_motion.py`` draws them, seed 0): ``robot.self_motion`` per pose; the
+bare ``swivel_manifold`` one pose per call (one thread); the API alone (the kernel
+replaced by a replay of its saved outputs, minus the replay's own cost); and
+``sm.sample`` per (pose, value) on 64 values.
+
+Run: ``python benchmarks/self_motion_srs_ab.py /work/wt/main-ref /work/wt/mine``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import pathlib
+import pickle
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+CHILD = """
+import pathlib, pickle, sys, time
+import numpy as np
+root = pathlib.Path({tree!r})
+sys.path[:0] = [str(root / p) for p in ("tests", "tests/kinematics/ik", "benchmarks")]
+from self_motion_rates import configurations
+from reference import iiwa14_srs
+import robokin.kinematics.ik.swivel as swivel
+from robokin._native import kernels as K
+from robokin.kinematics.ik.self_motion_families import SELF_MOTION
+
+robot = iiwa14_srs()
+arm = robot.arm.derived(SELF_MOTION).swivel
+if {save}:
+    q, _ = configurations(robot, {n}, 29)
+    T = np.ascontiguousarray(robot.fk(q))
+    N = len(T)
+    iv = np.full((N, 8, K.SM_MAXI, 2), np.nan)
+    niv = np.empty((N, 8), np.int64)
+    pts = np.full((N, K.SM_MAXP, 4), np.nan)
+    npts = np.empty(N, np.int64)
+    K.swivel_manifold(arm.params, T, iv, niv, pts, npts)
+    kern = dict(niv=niv, npts=npts,
+                iv=[iv[i][niv[i][:, None] > np.arange(K.SM_MAXI)] for i in range(N)],
+                pts=[pts[i, :npts[i]] for i in range(N)])
+    psi = np.tile(np.linspace(-np.pi, np.pi, 37), (N, 1)) + 0.013
+    kern["rows"] = arm.rows(T, psi)
+    qn = np.clip(q + 0.3, robot.limits[:, 0], robot.limits[:, 1])
+    kern["near"] = arm.nearest(T, qn)
+    ts = np.linspace(-np.pi, np.pi, 9) + 0.1
+    api = []
+    for Ti in T:
+        sm = robot.self_motion(Ti)
+        api.append(dict(T=sm.T, parameter=sm.parameter, joint=sm.joint, domain=sm.domain,
+                        periodic=sm.periodic, n_branches=sm.n_branches,
+                        intervals=sm.intervals, interval_branch=sm.interval_branch,
+                        method=sm.method, info=dict(sm.info), limits=sm.limits,
+                        crossings=tuple(sm.crossings), singular=tuple(sm.singular),
+                        sample=sm.sample(ts), inside=sm.inside(ts)))
+    with open({out!r}, "wb") as f:
+        pickle.dump(dict(kern=kern, api=api), f)
+
+rng = np.random.default_rng(0)
+qt = rng.uniform(robot.limits[:, 0], robot.limits[:, 1], ({timed}, 7))
+Tt = [np.ascontiguousarray(t) for t in robot.fk(qt)]
+T1 = [t[None] for t in Tt]
+o = (np.empty((1, 8, K.SM_MAXI, 2)), np.empty((1, 8), np.int64),
+     np.empty((1, K.SM_MAXP, 4)), np.empty(1, np.int64))
+
+
+def best(f, reps={repeat}):
+    b = np.inf
+    for _ in range(reps):
+        c0 = time.process_time()
+        f()
+        b = min(b, time.process_time() - c0)
+    return b / len(Tt) * 1e6
+
+
+api = best(lambda: [robot.self_motion(t) for t in Tt])
+kern1 = best(lambda: [K.swivel_manifold(arm.params, t, *o) for t in T1])
+sms = [robot.self_motion(t) for t in Tt]
+t64 = np.linspace(-np.pi, np.pi, 64)
+samp = best(lambda: [sm.sample(t64) for sm in sms]) / 64
+saved = {{}}
+
+
+def replayer(name):
+    kernel = getattr(K, name)
+
+    def replay(params, T, *out):
+        key = T.tobytes()
+        if key not in saved:
+            saved[key] = (kernel(params, T, *out), [x.copy() for x in out])
+        ret, outs = saved[key]
+        for x, s in zip(out, outs):
+            x[...] = s
+        # swivel_manifold_one returns new arrays: new copies, as the kernel makes them
+        return None if ret is None else tuple(x.copy() for x in ret)
+    return replay
+
+
+# the kernel the API calls (main: swivel_manifold on (1, 4, 4); since round 8c
+# swivel_manifold_one) replaced by a replay of its outputs
+one = hasattr(K, "swivel_manifold_one")
+name = "swivel_manifold_one" if one else "swivel_manifold"
+replay = replayer(name)
+
+
+class Replayed:
+    def __getattr__(self, attr):
+        return replay if attr == name else getattr(K, attr)
+
+
+swivel.K = Replayed()
+for t in Tt:
+    robot.self_motion(t)
+alone = best(lambda: [robot.self_motion(t) for t in Tt], 3 * {repeat})
+if one:
+    bare = best(lambda: [replay(arm.params, t) for t in Tt], 3 * {repeat})
+else:
+    bare = best(lambda: [replay(arm.params, t, *o) for t in T1], 3 * {repeat})
+swivel.K = K
+print(f"self_motion {{api:.2f}} us, kernel one pose per call {{kern1:.2f}} us, "
+      f"API alone (kernel replayed) {{alone - bare:.2f}} us per pose; sample {{samp:.3f}} us "
+      f"per (pose, value)")
+"""
+
+
+def same(x: object, y: object) -> bool:
+    """Exact equality (arrays: equal with NaN equal to NaN; lists and tuples elementwise)."""
+    if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
+        xa, ya = np.asarray(x), np.asarray(y)
+        return xa.dtype == ya.dtype and xa.shape == ya.shape and bool(
+            np.array_equal(xa, ya, equal_nan=xa.dtype.kind == "f"))
+    if isinstance(x, dict) and isinstance(y, dict):
+        return x.keys() == y.keys() and all(same(x[k], y[k]) for k in x)
+    if isinstance(x, list | tuple) and isinstance(y, list | tuple) and not (
+            x and hasattr(x[0], "t")):
+        return type(x) is type(y) and len(x) == len(y) and all(
+            same(u, v) for u, v in zip(x, y, strict=True))
+    return type(x) is type(y) and bool(x == y)
+
+
+def main() -> None:
+    """One timing line per tree and round, then the field-by-field comparison."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("trees", nargs=2)
+    ap.add_argument("--rounds", type=int, default=2)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--n", type=int, default=4000)
+    ap.add_argument("--timed", type=int, default=100)
+    args = ap.parse_args()
+    tmp = pathlib.Path(tempfile.mkdtemp())
+    print("load", pathlib.Path("/proc/loadavg").read_text().split()[:3])
+    for r in range(args.rounds):
+        for name, tree in zip("AB", args.trees, strict=True):
+            code = CHILD.format(tree=str(pathlib.Path(tree).resolve()), n=args.n,
+                                save=r == 0, out=str(tmp / f"{name}.pkl"),
+                                timed=args.timed, repeat=args.repeat)
+            env = dict(os.environ, PYTHONPATH=str(pathlib.Path(tree).resolve() / "src"))
+            res = subprocess.run([sys.executable, "-c", code], env=env, check=True,
+                                 capture_output=True, text=True)
+            print(f"round {r} {name} {tree}: {res.stdout.strip()}", flush=True)
+    print("load", pathlib.Path("/proc/loadavg").read_text().split()[:3])
+    out = []
+    for name in "AB":
+        with open(tmp / f"{name}.pkl", "rb") as f:
+            out.append(pickle.load(f))
+    bad: dict[str, int] = {}
+    for key in out[0]["kern"]:
+        x, y = out[0]["kern"][key], out[1]["kern"][key]
+        if isinstance(x, list):
+            n = sum(not same(u, v) for u, v in zip(x, y, strict=True))
+        else:
+            n = 0 if same(x, y) else 1
+        if n:
+            bad[f"kernel {key}"] = n
+    for a, b in zip(out[0]["api"], out[1]["api"], strict=True):
+        for key in a:
+            if not same(a[key], b[key]):
+                bad[key] = bad.get(key, 0) + 1
+    print(f"poses {len(out[0]['api'])}; differing: "
+          f"{bad if bad else 'none (every field and kernel output equal)'}")
+
+
+if __name__ == "__main__":
+    main()
