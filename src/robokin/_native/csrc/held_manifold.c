@@ -116,6 +116,7 @@ typedef struct {
     int npair, ipair;
     HmMemo memo[HM_MEMO];
     long nmemo;
+    PkFrontMemo front; /* pk_front's held-value-free parts (hm_closed) */
 } HmCtx;
 
 /* Gaussian elimination with partial pivoting of M (6 x 6 | right-hand side) into x;
@@ -432,7 +433,7 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
             r->q[b][j] = NAN;
     }
     PkFront f;
-    int code = pk_front(P, c->T, x, c->qn, 0, &f);
+    int code = pk_front_memo(P, c->T, x, c->qn, 0, &c->front, &f);
     if (code == PK_FRONT_SWIVEL || code == PK_FRONT_GENERAL || f.g.kase != PK_START)
         return 0; /* He and Liu's general case: not this kernel's */
     if (code != PK_OK)
@@ -1750,6 +1751,7 @@ static void hm_range(void *ctx, long b0, long e0)
         for (int m = 0; m < HM_MEMO; m++)
             c->memo[m].t = NAN; /* nothing kept */
         c->nmemo = 0;
+        c->front.set = 0;
         c->fast = hm_fast_setup(c);
         c->full_fk = 0;
         if (P[PK_CASE] == PK_BOTH || c->k < 0 || c->n != 7)
