@@ -68,6 +68,14 @@ enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FL
 
 
 #define HM_MEMO 64 /* recent evaluations kept (hm_recall) */
+#ifdef HM_TIMING
+#include <x86intrin.h>
+static unsigned long long hmT[8], hmW[8], hmC[8];
+static int hm_why;
+#define HMR(w) do { hm_why = (w); return 0; } while (0)
+#else
+#define HMR(w) return 0
+#endif
 
 /* Every slot at one t: coordinates (into the limits where a turn fits), slopes dq/dt
  * (NaN where the six other joints' Jacobian is singular), row exists, singular. */
@@ -433,9 +441,12 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
             r->q[b][j] = NAN;
     }
     PkFront f;
-    int code = pk_front_memo(P, c->T, x, c->qn, 0, &c->front, &f);
+    unsigned want = 0u; /* the position slots of the slots in need */
+    for (int i = 0; i < 4; i++)
+        want |= (need >> 2 * i & 3u) != 0u ? 1u << i : 0u;
+    int code = pk_front_memo(P, c->T, x, c->qn, 0, &c->front, want, &f);
     if (code == PK_FRONT_SWIVEL || code == PK_FRONT_GENERAL || f.g.kase != PK_START)
-        return 0; /* He and Liu's general case: not this kernel's */
+        HMR(0); /* He and Liu's general case: not this kernel's */
     if (code != PK_OK)
         return 1; /* pk_one: cleared, no row */
     const PkGeo *g = &f.g;
@@ -448,8 +459,6 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
         unsigned slots = 3u << (2 * pos->slot[i]);
         if (!(need & slots) || !(pos->res[i] < 1e-6 * g->scale))
             continue;
-        if (pos->sing[i])
-            return 0;
         double th[6];
         m3 Rt = pk_front_rotation(&f, i, th);
         PkTrip tr;
@@ -458,19 +467,25 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
             int slot = 2 * pos->slot[i] + k;
             if (!(need >> slot & 1u))
                 continue;
-            if (tr.sing[k])
-                return 0;
+            int sing = pos->sing[i] || tr.sing[k];
             for (int j = 0; j < 3; j++) {
                 th[ia + j] = pos->t[i][j];
                 th[it + j] = tr.t[k][j];
             }
-            /* pk_one's check: kept unchanged when exact, else polished */
-            if ((tr.check[k] || !(pos->res[i] < f.exact_p)) &&
-                !(pk_error_of(g, &f.RT, f.pT, th) <= PK_EXACT))
-                return 0;
+            /* pk_one's check: kept unchanged when exact, else polished (its calls) */
+            if (tr.check[k] || !(pos->res[i] < f.exact_p)) {
+                double err = pk_error_of(g, &f.RT, f.pT, th);
+                if (err > PK_EXACT)
+                    err = pk_polish_slow(g, &f.RT, f.pT, th, pk_polish(g, &f.RT, f.pT, th));
+                if (!(err <= PK_ACCEPT))
+                    continue; /* not a solution to 1e-12: no row */
+            }
             double m = pk_coords(P, g, th, held, x, r->q[slot]);
+            if (!(m >= -1e-9) && held_in && sing)
+                HMR(1); /* pk_one's repairs of a singular row (pk_resplit, pk_repair,
+                         * pk_inside, pk_slide, pk_walk_rows) may move it */
             if (!(m >= -1e-9) && held_in && !(hm_outside(P, g, th) > 2.0 * PK_NUDGE))
-                return 0; /* pk_inside (or, next to an aligned triple, pk_resplit) may move it */
+                HMR(4); /* pk_inside (or, next to an aligned triple, pk_resplit) may move it */
             if (!(m >= -1e-9) && held_in && !pk_isolated(g, th)) {
                 m3 R;
                 v3 p;
@@ -480,10 +495,11 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
                     double sig[6], V[6][6];
                     pk_svd6(J, sig, V);
                     if (sig[0] <= PK_FAMILY_SIGMA * sig[5])
-                        return 0; /* pk_slide may move it */
+                        HMR(5); /* pk_slide may move it */
                 }
             }
             r->valid[slot] = 1;
+            r->sing[slot] = (unsigned char)sing;
         }
     }
     return 1;
@@ -550,6 +566,9 @@ static void hm_eval_(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
 static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
 {
 #endif
+#ifdef HM_TIMING
+    unsigned long long T0 = __rdtsc(), T1, T2, T3;
+#endif
 
     const double *P = c->P;
     r->t = t;
@@ -557,12 +576,19 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
     if (hm_recall(c, t, need, r))
         goto slopes;
     int closed = hm_closed(c, t, need, r);
+#ifdef HM_TIMING
+    T1 = __rdtsc(); hmT[0] += T1 - T0;
+#endif
     if (!closed) {
         unsigned char inside[8];
         PkOut o = {&r->q[0][0], r->valid, r->sing, inside, PK_MAXJ};
         c->evals++;
         pk_one(P, c->T, t, c->qn, o);
     }
+#ifdef HM_TIMING
+    T2 = __rdtsc(); hmT[1] += T2 - T1;
+    if (!closed) { hmW[hm_why] += T2 - T1; hmC[hm_why]++; }
+#endif
 #ifdef HM_VERIFY
     else { /* a checking build (-DHM_VERIFY): every closed-form row against pk_one's */
         double Q[8][PK_MAXJ];
@@ -594,7 +620,10 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
         }
     }
     hm_keep(c, t, need, closed, r);
-slopes:
+slopes:;
+#ifdef HM_TIMING
+    T3 = __rdtsc();
+#endif
     for (int b = 0; b < 8; b++) {
         if (!r->valid[b] || !(mask >> b & 1u))
             continue;
@@ -613,6 +642,10 @@ slopes:
         }
 #endif
     }
+#ifdef HM_TIMING
+    hmT[2] += __rdtsc() - T3;
+    hmT[3] += __rdtsc() - T0;
+#endif
 }
 
 
@@ -1756,8 +1789,23 @@ static void hm_range(void *ctx, long b0, long e0)
         c->full_fk = 0;
         if (P[PK_CASE] == PK_BOTH || c->k < 0 || c->n != 7)
             c->flags |= HM_FLAG_BAD; /* not a Panda-type held family */
-        else
+        else {
+#ifdef HM_TIMING
+            unsigned long long T0 = __rdtsc();
+#endif
             hm_pose(c, jb->G, jb->iv + 2 * HM_MAXI * 8 * i, jb->niv + 8 * i);
+#ifdef HM_TIMING
+            hmT[4] += __rdtsc() - T0;
+            hmT[5]++;
+            if (hmT[5] % 1150 == 0)
+                fprintf(stderr, "per pose kcycles: closed %.1f pk_one %.1f slopes %.1f eval %.1f total %.1f\n",
+                        hmT[0] / 1150e3, hmT[1] / 1150e3, hmT[2] / 1150e3, hmT[3] / 1150e3, hmT[4] / 1150e3);
+            if (hmT[5] % 1150 == 0)
+                for (int z = 0; z < 6; z++) { fprintf(stderr, " why%d n %.2f kc %.1f", z, hmC[z] / 1150.0, hmW[z] / 1150e3); hmC[z] = hmW[z] = 0; }
+            if (hmT[5] % 1150 == 0)
+                for (int z = 0; z < 6; z++) hmT[z] = 0;
+#endif
+        }
         jb->npts[i] = c->npts;
         jb->flags[i] = c->flags;
 #ifdef HM_STAGES

@@ -590,9 +590,10 @@ static void pk_coplanar_x(const PkEq *e, int swap, PkCop *k)
 /* Coplanar axes b, c (Q singular; swap: a, b and P): the null combination n of the
  * rows holds theta_x alone (x = a, or c when swapped); the other combination m then
  * gives theta_y. pref_a, pref_c: the chain angles to take when one is free. k:
- * pk_coplanar_x's part (NULL: computed here). */
+ * pk_coplanar_x's part (NULL: computed here). want: the position slots (bits 0-3)
+ * to solve (the others are left out of out, as if they had no root). */
 static int pk_coplanar(const PkEq *e, int swap, const PkCop *k, double pref_a, double pref_c,
-                       PkPos *out)
+                       unsigned want, PkPos *out)
 {
     double L = e->scale;
     PkCop own;
@@ -629,7 +630,14 @@ static int pk_coplanar(const PkEq *e, int swap, const PkCop *k, double pref_a, d
     /* hypot(Ay, By) >= max(|Ay|, |By|): the call only where that cannot decide */
     double yl = 1e-12 * L;
     int yfree = !(fabs(Ay) > yl || fabs(By) > yl) && hypot(Ay, By) <= yl;
+    double phy = 0.0, cphy = 1.0, sphy = 0.0; /* theta_y's phase (pk_sp4's), once */
+    if (!yfree && (want & ((rx.n > 1 ? 15u : 3u))) != 0u) {
+        phy = fast_atan2(By, Ay);
+        unit2(By, Ay, &cphy, &sphy);
+    }
     for (int i = 0; i < rx.n; i++) {
+        if (!(want & 3u << 2 * i))
+            continue; /* neither of this root's position slots asked for */
         double cx = rx.c[i], sxn = rx.s[i];
         /* m . (X u_x sx - r) = -sx m . Y u_y ... written out: */
         double Xu0 = X[0][0] * cx + X[0][1] * sxn, Xu1 = X[1][0] * cx + X[1][1] * sxn;
@@ -643,13 +651,15 @@ static int pk_coplanar(const PkEq *e, int swap, const PkCop *k, double pref_a, d
             ry.c[0] = cos(ty);
             ry.s[0] = sin(ty);
         } else {
-            ry = pk_sp4(Ay, By, Cy, PK_SP4_SLACK * L);
+            ry = pk_sp4_at(Ay, By, Cy, PK_SP4_SLACK * L, phy, cphy, sphy);
         }
 #ifdef PK_DEBUG
         fprintf(stderr, "  y: Ay %.6e By %.6e Cy %.6e disc %.3e n %d\n", Ay, By, Cy, Ay*Ay+By*By-Cy*Cy, ry.n);
 #endif
         for (int j = 0; j < ry.n; j++) {
             int sing = xfree || rx.boundary || ry.boundary;
+            if (!(want >> (2 * i + j) & 1u))
+                continue;
             if (swap)
                 pk_pos_add(out, e, 2 * i + j, ry.t[j], ry.c[j], ry.s[j], rx.t[i], rx.c[i],
                            rx.s[i], sing);
@@ -1865,9 +1875,10 @@ typedef struct {
  * joint is free). Returns PK_OK with f->pos, a status (no position root), or
  * PK_FRONT_SWIVEL (both triples meet: pk_srs), PK_FRONT_GENERAL (no coplanar
  * pair and `general` 0: Pieper's quartic not taken). memo (or NULL): x-free parts
- * kept between calls of one arm (PkFrontMemo). */
+ * kept between calls of one arm (PkFrontMemo); want: the position slots to solve
+ * where the position axes are coplanar (pk_coplanar; 15: all). */
 static int pk_front_memo(const double *P, const double *T, double x, const double *qn,
-                         int general, PkFrontMemo *memo, PkFront *f)
+                         int general, PkFrontMemo *memo, unsigned want, PkFront *f)
 {
     PkGeo *g = &f->g;
     pk_geometry(P, x, g);
@@ -1904,9 +1915,10 @@ static int pk_front_memo(const double *P, const double *T, double x, const doubl
         memo->set = 1;
     }
     if (fabs(e.mbc) <= PK_COPLANAR)
-        code = pk_coplanar(&e, 0, memo != NULL ? &memo->k : NULL, pref_a, pref_c, &f->pos);
+        code = pk_coplanar(&e, 0, memo != NULL ? &memo->k : NULL, pref_a, pref_c, want,
+                           &f->pos);
     else if (fabs(e.mab) <= PK_COPLANAR)
-        code = pk_coplanar(&e, 1, NULL, pref_a, pref_c, &f->pos);
+        code = pk_coplanar(&e, 1, NULL, pref_a, pref_c, want, &f->pos);
     else if (general)
         code = pk_general(&e, &f->pos);
     else
@@ -1930,7 +1942,7 @@ static int pk_front_memo(const double *P, const double *T, double x, const doubl
 static int pk_front(const double *P, const double *T, double x, const double *qn, int general,
                     PkFront *f)
 {
-    return pk_front_memo(P, T, x, qn, general, NULL, f);
+    return pk_front_memo(P, T, x, qn, general, NULL, 15u, f);
 }
 
 /* Position root i of the front: its angles into th (the position joints') and the
