@@ -1185,6 +1185,13 @@ static int pk_repair(const double *P, const PkGeo *g, const m3 *RT, v3 pT, doubl
 /* The joint coordinates of chain angles th (6, remaining chain) into q (full
  * chain, held joint at x) and their smallest margin to the limits [rad]
  * (negative: outside) */
+/* fmin's value inline (NaN: the other argument), for margins that are only
+ * compared (a zero's sign may differ from libm's) */
+static inline double pk_min_num(double a, double b)
+{
+    return isnan(a) ? b : isnan(b) ? a : b < a ? b : a;
+}
+
 static double pk_coords(const double *P, const PkGeo *g, const double *th, int held,
                         double x, double *q)
 {
@@ -1193,11 +1200,11 @@ static double pk_coords(const double *P, const PkGeo *g, const double *th, int h
         int f = g->full[j], in;
         double lo = P[PK_LO + f], hi = P[PK_HI + f];
         q[f] = joint_value(th[j], P[PK_SIGN + f], P[PK_OFFSET + f], lo, hi, &in);
-        margin = fmin(margin, fmin(q[f] - lo, hi - q[f]));
+        margin = pk_min_num(margin, pk_min_num(q[f] - lo, hi - q[f]));
     }
     if (held >= 0) {
         q[held] = x;
-        margin = fmin(margin, fmin(x - P[PK_LO + held], P[PK_HI + held] - x));
+        margin = pk_min_num(margin, pk_min_num(x - P[PK_LO + held], P[PK_HI + held] - x));
     }
     return margin;
 }
