@@ -491,7 +491,8 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
         double th[6];
         m3 Rt = pk_front_rotation(&f, i, th);
         PkTrip tr;
-        pk_triple(P, &f.tri, &Rt, f.jx, f.jz, c->qn[f.jz], stol, &tr);
+        pk_triple_want(P, &f.tri, &Rt, f.jx, f.jz, c->qn[f.jz], stol,
+                       need >> 2 * pos->slot[i] & 3u, &tr);
         for (int k = 0; k < tr.n; k++) {
             int slot = 2 * pos->slot[i] + k;
             if (!(need >> slot & 1u))

@@ -856,9 +856,11 @@ typedef struct {
 } PkTrip;
 
 /* rot(hx, tx) rot(hy, ty) rot(hz, tz) = R: up to two solutions; jx, jz: the outer
- * joints' full-chain indices, pref_z z's preferred coordinate at the singularity. */
-static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int jz,
-                      double pref_z, double stol, PkTrip *out)
+ * joints' full-chain indices, pref_z z's preferred coordinate at the singularity.
+ * want: the solutions (bits 0, 1) to complete; the others keep their place (and
+ * the singular case its single solution) with NaN angles, unflagged. */
+static void pk_triple_want(const double *P, const PkTri *k, const m3 *R, int jx, int jz,
+                           double pref_z, double stol, unsigned want, PkTrip *out)
 {
     v3 hx = k->hx, hy = k->hy, hz = k->hz;
     v3 w = m3_mv(R, hz), rtx = m3_mtv(R, hx);
@@ -894,6 +896,12 @@ static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int 
                 }
             }
         }
+        if (!(want >> i & 1u)) {
+            int j = out->n++;
+            out->t[j][0] = out->t[j][1] = out->t[j][2] = NAN;
+            out->sing[j] = out->check[j] = 0;
+            continue;
+        }
         double cx, sx, cz, sz;
         double tx = pk_sp1(hx, v, w, &cx, &sx);
         v3 u = v3_rot(hy, cy, -sy, hx);
@@ -924,6 +932,12 @@ static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int 
                      v3_norm(v3_sub(v3_rot(hz, cz, sz, u), rtx));
         out->check[j] = (unsigned char)(sv < 1e-4 || !(res < 1e-2 * PK_EXACT * sv));
     }
+}
+
+static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int jz,
+                      double pref_z, double stol, PkTrip *out)
+{
+    pk_triple_want(P, k, R, jx, jz, pref_z, stol, 3u, out);
 }
 
 /* ---------------------------------------------------------------- polish */
