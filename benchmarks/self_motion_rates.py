@@ -30,7 +30,9 @@ cores): the Panda's (b) 2.1 min (12.8 ms per pose; special poses leave the compi
 kernel), the Gen3-like arm's and the offset iiwa's 1.5 min each.
 
 Run: ``python benchmarks/self_motion_rates.py [--n 10000] [--nb 0] [--nb-mid 300]
-[--nb-slow 250] [--seed 0] [--arms panda,srs,...]``.
+[--nb-slow 250] [--seed 0] [--arms panda,srs,...] [--dump PREFIX]`` (``--dump``: each
+arm's configurations and part (b) results to ``PREFIX_<arm>.npz``, to re-run its
+misses on another tree: the session-8 A/B, ``docs/benchmarks.md``).
 """
 
 from __future__ import annotations
@@ -160,7 +162,7 @@ def touch_kind(sm, b: int, q: np.ndarray, t_gen: float) -> int:
     return 2 if out(-1e-4) and out(1e-4) else 0
 
 
-def run_arm(arm: str, n: int, nb: int, seed: int) -> None:
+def run_arm(arm: str, n: int, nb: int, seed: int, dump: str = "") -> None:
     robot = build(arm)
     q, special = configurations(robot, n, seed)
     T = robot.fk(q)
@@ -203,6 +205,9 @@ def run_arm(arm: str, n: int, nb: int, seed: int) -> None:
                   f"point {alone[si].sum()}, sliver {sliver[si].sum()}, other "
                   f"{(si & got & ~within & ~alone & ~sliver).sum()}, not sampled "
                   f"{(si & ~got).sum()})")
+    if dump:
+        np.savez(f"{dump}_{arm}.npz", q=q, pick=pick, res=res, regular=regular,
+                 special=special, inside=inside, t=t, back=back, ok=ok)
     for m in pick[regular[pick] & ~got][:3]:
         print("    (b) regular not sampled", q[m].tolist())
     for m in pick[inside[pick] & got & ~within & ~alone & ~sliver][:6]:
@@ -224,12 +229,14 @@ def main() -> None:
     ap.add_argument("--nb-slow", type=int, default=250, help="(b) per half, general arms")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--arms", default="panda,srs,iiwa_urdf,gen3_like,offset_iiwa,random_7r")
+    ap.add_argument("--dump", default="", help="save each arm's configurations and "
+                    "results to DUMP_<arm>.npz")
     a = ap.parse_args()
     load = pathlib.Path("/proc/loadavg").read_text().split()[:3]
     print(f"seed {a.seed}; load {load}")
     for arm in a.arms.split(","):
         nb = (a.nb_slow if arm in SLOW else a.nb_mid if arm in MID else a.nb) or a.n
-        run_arm(arm, a.n, nb, a.seed)
+        run_arm(arm, a.n, nb, a.seed, a.dump)
 
 
 if __name__ == "__main__":

@@ -166,6 +166,10 @@ def test_manifold_solves_a_bounded_number_of_values(arm, monkeypatch):
         return raw(chain, params, T, *args, **kwargs)
 
     q0 = _configs(robot, 3, False)[0]
+    # the arm's one-time set-up first (the general-6R variant trials, 520 values on
+    # the random 7R arm, kept per arm): counted it made this test depend on the order
+    # of the tests before it (it passed in the suite, failed alone)
+    robot.self_motion(robot.fk(q0), parameter=robot.joint_names[-1])
     monkeypatch.setattr(general_6r, "raw_solve", counting)
     sm = robot.self_motion(robot.fk(q0), parameter=robot.joint_names[-1])
     assert len(sm.intervals) and 181 <= sum(solved) <= 4 * 181, sum(solved)
@@ -551,10 +555,15 @@ def test_a_corner_is_a_one_point_interval(arm, q):
 
 #: A uniform random-7R configuration (seed 29, ``benchmarks/fold_gap_ab.py``'s 8th, index 7):
 #: main missed a limit crossing next to a fold there (issue 29, round 7e): the
-#: fold end's row inside, no interval of its branch reaching it.
+#: fold end's row inside, no interval of its branch reaching it. The second (index
+#: 768): a loop 6e-4 wide between two folds, the left one bisected; its cell's rows
+#: were left unassigned (the tangent line from the node overshot next to the fold)
+#: until the bisected end's row became the cell's fold model (session 8).
 FOLD_GAP = np.array([
     [-1.8843907135778857, -2.7048799757966315, 0.04298577432539874, -0.226369446911725,
      -1.7777455173003378, 2.413836155852181, 2.746574417456351],
+    [-2.514720910459577, 2.158725262571375, -0.8353769590614308, 2.079298228238656,
+     -0.9776125810131713, -2.2108067690580055, 2.6305850196653084],
 ])
 
 
@@ -604,4 +613,4 @@ def test_a_crossing_next_to_a_fold_ends_the_interval_at_the_fold():
                 assert not np.any(vo[:, c.branch] & np.all((ro >= lo - 1e-12)
                                                           & (ro <= hi + 1e-12), axis=1))
             checked += 1
-    assert checked > 0
+    assert checked >= len(FOLD_GAP)

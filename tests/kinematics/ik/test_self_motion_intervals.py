@@ -339,6 +339,88 @@ def test_a_dip_within_the_slack_opens_no_gap(q, compiled):
     assert np.any((iv[:, 0] - 1e-9 <= q[6]) & (q[6] <= iv[:, 1] + 1e-9)), iv
 
 
+def _with_limit(joint: int, lo: float | None = None, hi: float | None = None):
+    """The Panda with one joint's limit moved (the same chain otherwise)."""
+    import dataclasses
+
+    chain = PANDA.chain
+    joints = list(chain.joints)
+    l0, h0 = joints[joint].limits
+    joints[joint] = dataclasses.replace(joints[joint], limits=(l0 if lo is None else lo,
+                                                               h0 if hi is None else hi))
+    return PANDA.replace(chain=chain.replace(joints=tuple(joints), coordinates=tuple(joints)))
+
+
+@pytest.mark.parametrize("seed", [8, 29])
+def test_a_shallow_dip_between_row_nodes_is_found(seed):
+    # Round 8b: the kernel's rows are on every 6th node of the margins' grid where no
+    # branch can end (31 of 181), and a cell that wide is split where its Hermite
+    # model's departure from its chord reaches the distance to a value
+    # (hm_coarse_unsure). Hardest case for it: a limit moved to 1e-9 inside a joint's
+    # interior extremum on a branch, so the branch leaves the limits over a stretch
+    # ~2 sqrt(2e-9 / curvature) (1e-4-1e-3 of t) anywhere in a cell. Oracle: the
+    # branch's rows (the held-q7 closed form at 4,001 values, with the original
+    # limits) for the extremum; the moved arm's crossings of that joint on that branch
+    # either side of it, each a row at the limit (1e-10), and no interval of the
+    # branch holding the extremum's t.
+    rng = np.random.default_rng(seed)
+    q0 = rng.uniform(LIMITS[:, 0], LIMITS[:, 1])
+    T = PANDA.fk(q0)
+    sm = PANDA.self_motion(T)
+    assert sm.info.get("compiled")
+    t = np.linspace(*sm.domain, 4001)
+    Q = sm.sample(t)
+    x, c = Q[1:-1], Q[1:-1]
+    ext = []  # (sign, sample, branch, joint): interior extrema, rows either side
+    for sgn in (1.0, -1.0):
+        top = (sgn * x > sgn * Q[:-2]) & (sgn * c >= sgn * Q[2:])
+        ext += [(sgn, i + 1, b, j) for i, b, j in zip(*np.nonzero(top[:, :, :6]), strict=True)]
+    dips = 0
+    for sgn, i, b, j in ext:
+        lim = float(Q[i, b, j] - sgn * 1e-9)
+        if not LIMITS[j, 0] + 0.01 < lim < LIMITS[j, 1] - 0.01:
+            continue
+        arm = _with_limit(j, hi=lim) if sgn > 0 else _with_limit(j, lo=lim)
+        moved = arm.self_motion(T)
+        assert moved.info.get("compiled") and moved.info["flags"] == 0
+        cross = sorted(p.t for p in moved.crossings
+                       if p.branch == b and p.joint == j and abs(p.t - t[i]) < 0.05)
+        before, after = [p for p in cross if p < t[i]], [p for p in cross if p > t[i]]
+        assert before and after, (b, j, t[i], cross)
+        for p in (before[-1], after[0]):
+            assert abs(moved.sample(p)[b, j] - lim) <= 1e-10, (b, j, p)
+        own = moved.intervals[moved.interval_branch == b]
+        assert not np.any((own[:, 0] < t[i]) & (t[i] < own[:, 1])), (b, j, own)
+        dips += 1
+    assert dips >= 5, dips
+
+
+def test_a_crossing_pair_inside_a_wide_cell_is_found():
+    # Round 8b: special pose 24 of seed 4029 (q3 at its upper limit at the generating
+    # q7): its branch leaves q3's upper limit from q7 over 4.7e-3 of t, at most 8.7e-7
+    # past it. A measuring build with rows on every 30th margin node (cells 0.97 rad
+    # wide) and without hm_coarse_unsure's splits missed that gap (one interval
+    # across it); with them it is found; the shipped kernel (every 6th node) finds it.
+    # Oracle: the branch's rows across the gap (the held-q7 closed form) and at its
+    # two crossings.
+    q = np.array([-np.pi / 2, 1.448477987699674, 2.8973, -2.37316790644361,
+                  1.898790242010842, 3.16991758520706, -2.7083826916576066])
+    sm = PANDA.self_motion(PANDA.fk(q))
+    assert sm.info.get("compiled") and sm.info["flags"] == 0
+    b = int(np.nanargmin(np.abs(sm.sample(q[6]) - q).max(-1)))
+    cross = sorted(p.t for p in sm.crossings
+                   if p.branch == b and p.joint == 2 and q[6] - 1e-6 < p.t < q[6] + 1e-2)
+    assert len(cross) == 2 and 4e-3 < cross[1] - cross[0] < 5e-3, cross
+    for p in cross:
+        assert abs(sm.sample(p)[b, 2] - LIMITS[2, 1]) <= 1e-10, p
+    t = np.linspace(cross[0], cross[1], 103)[1:-1]
+    assert np.all(sm.sample(t)[:, b, 2] > LIMITS[2, 1] + 1e-12)  # out across the gap
+    own = sm.intervals[sm.interval_branch == b]
+    assert not np.any((own[:, 0] < t[:, None]) & (t[:, None] < own[:, 1])), own
+    assert np.any(np.isclose(own[:, 1], cross[0], atol=1e-9))  # inside before it
+    assert np.any(np.isclose(own[:, 0], cross[1], atol=1e-9))  # and after it
+
+
 def _last_row(sm, branch: int, t: float) -> float | None:
     """The last float with a row of ``branch`` next to a branch end near t (None when
     the rows 1e-7 either side do not show one side with it, one without).
@@ -485,3 +567,105 @@ def test_a_crossing_next_to_a_fold_of_the_solved_points_path_is_found(pose):
         ok, _ = inside(end + (end - p.t) * np.linspace(0, 1, 21)[1:-1], p.branch)
         assert not ok.any()
     assert near >= 1
+
+
+def _arm(name: str):
+    """The Panda, the exact SRS iiwa14 or the rtb-data iiwa14 URDF (skipped without it)."""
+    if name == "panda":
+        return PANDA
+    if name == "srs":
+        from reference import iiwa14_srs
+
+        return iiwa14_srs()
+    rtbdata = pytest.importorskip("rtbdata")
+    from pathlib import Path
+
+    urdf = (Path(rtbdata.__file__).parent
+            / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf")
+    return robokin.Robot.from_urdf(str(urdf), geometry=False)
+
+
+def _generating(robot, q0: np.ndarray):
+    """(sm, t, branch): the manifold of FK(q0), q0's parameter value, q0's branch."""
+    from robokin.kinematics.ik.self_motion import parameter_values
+
+    T = robot.fk(q0)
+    _, t = parameter_values(robot, T, q0[None])
+    sm = robot.self_motion(T)
+    rows = sm.sample(float(t[0]))
+    gap = np.abs((rows - q0 + np.pi) % (2 * np.pi) - np.pi).max(axis=-1)
+    b = int(np.nanargmin(gap))
+    assert gap[b] < 1e-6, gap
+    return sm, float(t[0]), b
+
+
+@pytest.mark.parametrize(("arm", "q"), [
+    # q4 at its lower limit, its maximum along the branch at t = 1e-6 touching it
+    # (q5 = -1e-9, q7 = -1e-6): main listed [1e-6, 1e-6] only
+    ("panda", [0.4075794544994271, -1.4311373780278696, 1.8756459202885645, -3.0718, -1e-09,
+               -0.0175, -1e-06]),
+    # q2 at its upper limit, grazing it next to psi = -pi (q3 = 1e-9, q7 = 1e-6):
+    # main listed a 3.5e-15-long interval at -pi, 2e-8 from q's swivel
+    ("srs", [0.9166990393942251, 2.0943951023931953, 1e-09, -2.0943951023931953,
+             -1.0618256230930307, -1.5693258834290933, 1e-06]),
+    # q2 and q7 at their lower limits (q1 = 0, q3 = -1e-6): main listed nothing
+    ("srs", [0.0, -2.0943951023931953, -1e-06, -1.1697305924327788, -1.5707963267948966,
+             0.8502798542808594, -3.0543261909900767]),
+])
+def test_a_graze_keeps_its_in_slack_stretch(arm, q):
+    # Issue 29 (helper rates29): benchmarks/self_motion_rates.py (seed 0, n 10,000)
+    # regular special configurations whose branch grazes a limit: inside by
+    # MANIFOLD_SLACK over ~1e-6..1e-5 of t about q's value, listed by the kernels as a
+    # point (or not at all). Oracles: the branch's rows (sm.sample, the closed form)
+    # and FK: q's value lies in an interval of its branch longer than 1e-7, whose rows
+    # at 9 values across it are inside (MANIFOLD_SLACK) and reproduce the pose to 1e-12.
+    robot = _arm(arm)
+    q0 = np.array(q)
+    sm, t, b = _generating(robot, q0)
+    iv = sm.intervals[sm.interval_branch == b]
+    shifts = (-2 * np.pi, 0.0, 2 * np.pi) if sm.periodic else (0.0,)
+    hit = [(a + s, e + s) for a, e in iv for s in shifts if a + s <= t <= e + s]
+    assert len(hit) == 1, (t, iv)
+    a, e = hit[0]
+    assert e - a > 1e-7, (a, e)
+    ts = np.linspace(a, e, 9)
+    rows = sm.sample(ts)[:, b]
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    assert np.all((rows >= lo - MANIFOLD_SLACK) & (rows <= hi + MANIFOLD_SLACK))
+    dp, dr = pose_errors(robot.fk(rows), np.broadcast_to(sm.T, (9, 4, 4)))
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12, (dp, dr)
+
+
+@pytest.mark.parametrize(("arm", "q"), [
+    # q3, q7 at limits, q7 the parameter at its range's end, q2 = 1e-6 (the shoulder
+    # lined up): main's row there 7.5e-11 out (a singular configuration)
+    ("panda", [-1e-09, 1e-06, -2.8973, -0.0698, -1e-09, 1e-06, -2.8973]),
+    # q1, q2, q5, q6 at limits, the elbow lined up (q4 = 1e-7; singular): main's
+    # swivel row there out by conditioning
+    ("srs", [-2.9670597283903604, -2.0943951023931953, 0.0, 1e-07, -2.9670597283903604,
+             -2.0943951023931953, -1.5707963267948966]),
+    # joint_a1 and joint_a2 at limits, the elbow lined up (q4 = 1e-9; regular): main's
+    # row at the crossing 3e-11 out
+    ("iiwa", [2.9668, -2.0942, 1e-07, 1e-09, -0.34442118632710983, 0.28861094459290904,
+              -1e-06]),
+])
+def test_a_corner_out_by_conditioning_is_refined(arm, q):
+    # Issue 29 (helper rates29): benchmarks/self_motion_rates.py (seed 0, n 10,000),
+    # corners whose closed-form row at the crossing is 1e-11..1e-9 out next to an
+    # aligned triple; the row refined with the limit joints held at their limits is
+    # listed as [t*, t*]. Oracles: reference.assert_corner_listed (the branch outside
+    # at t +- 1e-6, a point interval holding t, its row inside and FK = T to 1e-12),
+    # and that row is q's to 1e-6 with q's limit joints exactly at their limits.
+    from reference import assert_corner_listed
+
+    robot = _arm(arm)
+    q0 = np.array(q)
+    sm, t, b = _generating(robot, q0)
+    assert_corner_listed(robot, sm, q0, t)
+    iv = sm.intervals[sm.interval_branch == b]
+    tc = iv[np.argmin(np.abs((iv[:, 0] - t + np.pi) % (2 * np.pi) - np.pi)), 0]
+    row = sm.sample(tc)[b]
+    assert np.abs(row - q0).max() < 1e-6
+    lim = robot.limits
+    at = (q0 == lim[:, 0]) | (q0 == lim[:, 1])
+    assert at.sum() >= 2 and np.all((row[at] == lim[at, 0]) | (row[at] == lim[at, 1]))

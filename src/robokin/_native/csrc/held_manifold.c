@@ -61,6 +61,14 @@
 #define HM_DISC_TWO 1e-15 /* a discriminant / (A^2 + B^2) above it: sp4_roots' two roots */
 #define HM_PAIR_ROWS 48 /* near-fold rows kept for the partner slot (hm_eval_pair) */
 #define HM_MAXG 8 /* grazes (a branch inside a limit by under HM_TOL) per slot */
+#ifndef HM_UNSURE
+#define HM_UNSURE 1 /* 0: a measuring build, coarse cells split as the others */
+#endif
+#define HM_MAXSEEN 256 /* rows per slot kept to decide pieces (hm_seen) */
+#ifndef HM_STRIDE
+#define HM_STRIDE 6 /* rows at every HM_STRIDE-th margin node where the margins keep their signs
+                        * (6: 31 of 181 nodes, t = 0 among them, as on the fine grid) */
+#endif
 
 enum { HM_KIND_LOWER = 0, HM_KIND_UPPER = 1, HM_KIND_ALIGNED = 2, HM_KIND_FOLD = 3 };
 enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FLAG_FULL = 8,
@@ -91,6 +99,7 @@ typedef struct {
     double qn[PK_MAXJ];
     int nq, qj[HM_MAXQ], qkind[HM_MAXQ];
     double qv[HM_MAXQ];
+    double hfine; /* the margins' grid spacing (the rows' grid is HM_STRIDE times coarser) */
     int flags;
     long evals, cheap;
     double *pts;
@@ -102,6 +111,14 @@ typedef struct {
     int nfold[8];
     double graze_t[8][HM_MAXG][2]; /* a graze's in-limit stretch */
     int graze_j[8][HM_MAXG], ngraze[8];
+    /* rows of a slot evaluated off the grid that decide a piece (hm_seen, round 8b) */
+    double seen_t[8][HM_MAXSEEN];
+    unsigned char seen_good[8][HM_MAXSEEN];
+    int nseen[8];
+    /* whether slot b's row at a cut is inside (hm_at: the row the cut was found on) */
+    double at_t[8][HM_MAXSEEN];
+    unsigned char at_in[8][HM_MAXSEEN];
+    int nat[8];
     /* the slopes' structured solve (hm_slopes_fast; fast = 0: the full FK, hm_slopes):
      * the first three axes meeting at fc, the held joint last; the chain's product
      * of exponentials is G = T M^-1 (GA, Gt); per t (ft), the first six joints'
@@ -736,6 +753,19 @@ static double hm_hermite_root(double f0, double f1, double d0, double d1)
     return s;
 }
 
+static void hm_seen(HmCtx *c, int b, const HmRow *r);
+static int hm_inside(const HmCtx *c, const HmRow *r, int b, double slack);
+
+/* Slot b's row at cut t is inside (with MANIFOLD_SLACK) or not: kept from the row the
+ * cut was found on, so that hm_intervals' [t, t] rule needs no row there (round 8b) */
+static void hm_at(HmCtx *c, int b, double t, int in)
+{
+    if (c->nat[b] < HM_MAXSEEN) {
+        c->at_t[b][c->nat[b]] = t;
+        c->at_in[b][c->nat[b]++] = (unsigned char)in;
+    }
+}
+
 #ifdef HM_SHARE_STATS /* a measuring build: partner lookups per joint (tried, taken) */
 static long hm_share_n[PK_MAXJ][2];
 #endif
@@ -769,6 +799,7 @@ static int hm_shared(HmCtx *c, int b, int qi, double a, double fa, double e)
     hm_eval(c, found, 0u, 1u << b, &r);
     if (!r.valid[b])
         return 0;
+    hm_seen(c, b, &r);
     double f = fa + wrap_pi(hm_f(c, &r, b, qi) - fa);
     if (!(fabs(f) <= 1e-14))
         return 0;
@@ -776,6 +807,7 @@ static int hm_shared(HmCtx *c, int b, int qi, double a, double fa, double e)
     hm_share_n[j][1]++;
 #endif
     hm_point(c, found, b, j, c->qkind[qi]);
+    hm_at(c, b, found, hm_inside(c, &r, b, MANIFOLD_SLACK));
     return 1;
 }
 
@@ -797,7 +829,7 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
         if (tn > a && tn < e)
             t = tn;
     }
-    int side = 0;
+    int side = 0, best_in = -1; /* best_in: the row at best_t inside (-1: not evaluated) */
     HmRow r;
     for (int it = 0; it < 80; it++) {
         hm_eval(c, t, 1u << b, 1u << b, &r);
@@ -805,11 +837,13 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
             c->flags |= HM_FLAG_VANISH;
             return;
         }
+        hm_seen(c, b, &r);
         /* f continuous from a: the turn of q_j nearest fa's */
         double f = fa + wrap_pi(hm_f(c, &r, b, qi) - fa), d = r.dq[b][j];
         if (fabs(f) < best_f) {
             best_f = fabs(f);
             best_t = t;
+            best_in = hm_inside(c, &r, b, MANIFOLD_SLACK);
         }
         if (f == 0.0 || best_f <= 1e-14)
             break;
@@ -843,6 +877,8 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
     }
     int kind = c->qkind[qi];
     hm_point(c, best_t, b, j, kind);
+    if (best_in >= 0)
+        hm_at(c, b, best_t, best_in);
 }
 
 /* The extremum of q_j (slot b) in (a, e) where the slopes da, de have opposite
@@ -861,6 +897,7 @@ static void hm_extremum(HmCtx *c, int b, int j, double a, double da, double e, d
             c->flags |= HM_FLAG_VANISH;
             return;
         }
+        hm_seen(c, b, out);
         double d = out->dq[b][j];
         if (!isfinite(d) || d == 0.0)
             return;
@@ -910,6 +947,37 @@ static int hm_hermite_dips(double f0, double f1, double d0, double d1)
     return 0;
 }
 
+/* Whether a cell wider than a margin cell (round 8b: rows at every HM_STRIDE-th
+ * margin node) must be split for one query, its rows not excluding a crossing that
+ * its cubic Hermite model (f0, f1, d0, d1 per unit of the cell) does not show: the
+ * model's departure from its chord, |A| + |B| (f = f0 + d0 s + A s^2 + B s^3), is
+ * the scale of what the rows leave unknown; split where it reaches the distance
+ * that keeps the value away (no sign change: the model's nearest approach to the
+ * value) or the chord's own motion (one crossing: a second extremum inside). */
+static int hm_coarse_unsure(double f0, double f1, double d0, double d1)
+{
+    double A = 3.0 * (f1 - f0) - 2.0 * d0 - d1, B = 2.0 * (f0 - f1) + d0 + d1;
+    double e = fabs(A) + fabs(B);
+    if ((f0 < 0) != (f1 < 0))
+        return e >= fabs(f1 - f0);
+    double near = fmin(fabs(f0), fabs(f1));
+    /* the model's extrema inside: f' = d0 + 2 A s + 3 B s^2 = 0 */
+    double qa = 3.0 * B, qb = 2.0 * A, disc = qb * qb - 4.0 * qa * d0;
+    if (fabs(qa) > 1e-300 && disc >= 0.0) {
+        double sq = sqrt(disc);
+        for (int i = 0; i < 2; i++) {
+            double x = (-qb + (i ? sq : -sq)) / (2.0 * qa);
+            if (x > 0.0 && x < 1.0)
+                near = fmin(near, fabs(f0 + x * (d0 + x * (A + x * B))));
+        }
+    } else if (!(fabs(qa) > 1e-300) && fabs(qb) > 0.0) {
+        double x = -d0 / qb;
+        if (x > 0.0 && x < 1.0)
+            near = fmin(near, fabs(f0 + x * (d0 + x * A)));
+    }
+    return e >= near;
+}
+
 /* 1 / |dq/dt|^2 of slot b's row (0 where a slope is not finite) */
 static double hm_gap(const HmCtx *c, int b, const HmRow *r)
 {
@@ -925,6 +993,7 @@ static double hm_gap(const HmCtx *c, int b, const HmRow *r)
 static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1)
 {
     double h = r1->t - r0->t, big = 0.0;
+    int coarse = h > 1.5 * c->hfine; /* wider than a margin cell (round 8b) */
     for (int j = 0; j < c->n; j++)
         big = fmax(big, fabs(wrap_pi(r1->q[b][j] - r0->q[b][j])));
     if (h < 1e-9 && big < 1e-6)
@@ -941,12 +1010,25 @@ static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r
         double d0 = r0->dq[b][j] * h, d1 = r1->dq[b][j] * h;
         if (fabs(f0) > 3.0 || fabs(f1) > 3.0)
             continue; /* the value's far turn: nothing near */
+        if ((f0 < 0) == (f1 < 0)) {
+            /* round 8b, no sqrt: the Hermite cubic is h00 f0 + h01 f1 (between f0 and
+             * f1) plus d0 h10 + d1 h11 with |h10|, |h11| <= 4/27 on the cell, so it stays
+             * `far` from the value; when that exceeds the tests' thresholds (with room for
+             * their rounding) neither hm_hermite_dips nor hm_coarse_unsure can split */
+            double far = fmin(fabs(f0), fabs(f1)) - 0.1482 * (fabs(d0) + fabs(d1)) -
+                         1e-13 * (fabs(f0) + fabs(f1) + fabs(d0) + fabs(d1));
+            double A = 3.0 * (f1 - f0) - 2.0 * d0 - d1, B = 2.0 * (f0 - f1) + d0 + d1;
+            if (far > 2.0 * HM_TOL && !(HM_UNSURE && coarse && !(far > fabs(A) + fabs(B))))
+                continue;
+        }
         if ((f0 < 0) != (f1 < 0)) {
             if ((d0 < 0) != (d1 < 0) || (d0 < 0) != (f1 < f0))
                 return 1; /* more than one crossing may lie inside */
         } else if ((d0 < 0) == (d1 < 0) && hm_hermite_dips(f0, f1, d0, d1)) {
             return 1;
         }
+        if (HM_UNSURE && coarse && hm_coarse_unsure(f0, f1, d0, d1))
+            return 1;
     }
     return 0;
 }
@@ -957,8 +1039,10 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
 static void hm_node(HmCtx *c, int b, const HmRow *r)
 {
     for (int qi = 0; qi < c->nq; qi++)
-        if (fabs(hm_f(c, r, b, qi)) <= HM_TOL)
+        if (fabs(hm_f(c, r, b, qi)) <= HM_TOL) {
             hm_point(c, r->t, b, c->qj[qi], c->qkind[qi]);
+            hm_at(c, b, r->t, hm_inside(c, r, b, MANIFOLD_SLACK));
+        }
 }
 
 /* Joint j of configuration q (n) polished against the pose T: one Newton step whose
@@ -1112,6 +1196,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
                 c->flags |= HM_FLAG_VANISH;
                 return;
             }
+            hm_seen(c, b, &m);
             hm_node(c, b, &m);
             hm_cell(c, b, r0, &m, depth + 1);
             hm_cell(c, b, &m, r1, depth + 1);
@@ -1164,6 +1249,7 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
             c->flags |= HM_FLAG_VANISH;
             return;
         }
+        hm_seen(c, b, &r[m]);
         hm_node(c, b, &r[m]);
         m++;
     }
@@ -1391,6 +1477,7 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
         c->flags |= HM_FLAG_VANISH;
         return;
     }
+    hm_at(c, b, end, hm_inside(c, &re, b, MANIFOLD_SLACK));
     hm_node(c, b, &re);
     hm_fold_piece(c, b, &re, state0 ? r0 : r1);
 }
@@ -1448,6 +1535,19 @@ static int hm_decides(const HmCtx *c, const HmRow *r, int b, unsigned char *good
     return 1;
 }
 
+/* Slot b's row r, evaluated off the grid (a split, a crossing's iterate, an
+ * extremum's, a near-fold row), kept when it decides a piece as a grid row does
+ * (hm_decides: every joint inside, or one outside, by more than HM_DECIDE): a
+ * piece holding such a row strictly inside needs no midpoint row (round 8b). */
+static void hm_seen(HmCtx *c, int b, const HmRow *r)
+{
+    unsigned char good;
+    if (c->nseen[b] < HM_MAXSEEN && hm_decides(c, r, b, &good)) {
+        c->seen_t[b][c->nseen[b]] = r->t;
+        c->seen_good[b][c->nseen[b]++] = good;
+    }
+}
+
 /* Whether the piece (a, e) of slot b lies in a graze's stretch (hm_graze): then
  * decided by the row at its middle with the grazing joint polished, inside to
  * HM_TOL, into *good. */
@@ -1501,6 +1601,15 @@ static void hm_intervals(HmCtx *c, int b, double lo, double hi, const HmRow *row
                 best = h;
         if (best >= 0 && hm_decides(c, &rows[best], b, &good[i]))
             continue;
+        int seen = -1; /* else a row off the grid strictly inside, nearest the midpoint */
+        for (int s = 0; s < c->nseen[b]; s++)
+            if (c->seen_t[b][s] > cut[i] && c->seen_t[b][s] < cut[i + 1] &&
+                (seen < 0 || fabs(c->seen_t[b][s] - mid) < fabs(c->seen_t[b][seen] - mid)))
+                seen = s;
+        if (seen >= 0) {
+            good[i] = c->seen_good[b][seen];
+            continue;
+        }
         hm_eval(c, mid, 0u, 1u << b, &r);
         good[i] = (unsigned char)hm_inside(c, &r, b, MANIFOLD_SLACK);
     }
@@ -1508,8 +1617,18 @@ static void hm_intervals(HmCtx *c, int b, double lo, double hi, const HmRow *row
     for (int i = 0; i < u; i++) {
         int left = i > 0 && good[i - 1], right = i + 1 < u && good[i];
         if (!left && !right) {
-            hm_eval(c, cut[i], 0u, 1u << b, &r);
-            if (hm_inside(c, &r, b, MANIFOLD_SLACK) && !hm_emit(c, iv, &k, cut[i], cut[i]))
+            int in = -1; /* the row the cut was found on, else the grid's at the range's ends */
+            for (int s = 0; s < c->nat[b] && in < 0; s++)
+                if (c->at_t[b][s] == cut[i])
+                    in = c->at_in[b][s];
+            if (in < 0 && G > 0 && (cut[i] == rows[0].t || cut[i] == rows[G - 1].t))
+                in = hm_inside(c, cut[i] == rows[0].t ? &rows[0] : &rows[G - 1], b,
+                               MANIFOLD_SLACK);
+            if (in < 0) {
+                hm_eval(c, cut[i], 0u, 1u << b, &r);
+                in = hm_inside(c, &r, b, MANIFOLD_SLACK);
+            }
+            if (in && !hm_emit(c, iv, &k, cut[i], cut[i]))
                 break;
         }
         if (right && !hm_emit(c, iv, &k, cut[i], cut[i + 1]))
@@ -1613,30 +1732,54 @@ static double hm_margin_extremum(const double *P, const double *T, int k, double
     return 0.5 * (a + e);
 }
 
-/* The first grid: G values over [lo, hi], and in every cell where a margin keeps
- * its sign at both nodes but the parabola through it and a neighbour node turns
- * back toward 0 inside the cell, its extremum (a branch born and dying between
- * two nodes: an island; or a short gap). Returns the count (<= cap) into t,
- * sorted; 0 and a flag when the margins are not available. */
+typedef struct { /* a node of hm_grid: its t, and whether rows are evaluated there */
+    double t;
+    int keep;
+} HmNode;
+
+static int hm_node_cmp(const void *x, const void *y)
+{
+    double a = ((const HmNode *)x)->t, b = ((const HmNode *)y)->t;
+    return a < b ? -1 : a > b;
+}
+
+/* The grid: the existence margins at G values over [lo, hi] (cheap scalars, no rows),
+ * and in every cell where a margin keeps its sign at both nodes but the parabola
+ * through it and a neighbour node turns back toward 0 inside the cell, its extremum
+ * (a branch born and dying between two nodes: an island; or a short gap). Rows are
+ * wanted (round 8b) at every HM_STRIDE-th node, the range's ends, the extra nodes,
+ * and both nodes of every margin cell where a margin changes sign or existence or
+ * turns back (a branch is born or dies there): so every cell where a branch end can
+ * lie is a margin cell, as before, and the others are HM_STRIDE cells wide, where
+ * hm_cell splits what its rows do not certify. Returns the count of row nodes
+ * (<= cap) into t, sorted; 0 and a flag when the margins are not available. */
 static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
 {
     double (*m)[3] = malloc((size_t)G * sizeof(*m));
+    HmNode *nd = malloc((size_t)cap * sizeof(HmNode));
     long nt = 0;
-    if (m == NULL) {
+    if (m == NULL || nd == NULL) {
+        free(m);
+        free(nd);
         c->flags |= HM_FLAG_MEMORY;
         return 0;
     }
     for (long i = 0; i < G; i++) {
-        t[i] = i == G - 1 ? hi : lo + (hi - lo) * (double)i / (double)(G - 1);
-        if (!hm_margins(c->P, c->T, t[i], m[i]))
+        nd[i].t = i == G - 1 ? hi : lo + (hi - lo) * (double)i / (double)(G - 1);
+        nd[i].keep = i % HM_STRIDE == 0 || i == G - 1;
+        if (!hm_margins(c->P, c->T, nd[i].t, m[i]))
             c->flags |= HM_FLAG_BAD;
     }
     nt = G;
     for (long i = 0; i + 1 < G; i++) {
+        for (int k = 0; k < 3; k++) /* a margin changing sign or existence: a branch end */
+            if (isfinite(m[i][k]) != isfinite(m[i + 1][k]) ||
+                (isfinite(m[i][k]) && (m[i][k] < 0) != (m[i + 1][k] < 0)))
+                nd[i].keep = nd[i + 1].keep = 1;
         if (isfinite(m[i][0]) && isfinite(m[i + 1][0]) && (m[i][0] < 0) != (m[i + 1][0] < 0)) {
             /* the first angle's roots end here: the second's margins may change sign
              * between the node and that end; a node just inside the end sees it */
-            double a = t[i], e = t[i + 1], me[3];
+            double a = nd[i].t, e = nd[i + 1].t, me[3];
             int in_a = m[i][0] >= 0;
             for (int it = 0; it < 60 && e - a > 1e-12 * fmax(1.0, fabs(a)); it++) {
                 double mid = 0.5 * (a + e);
@@ -1646,9 +1789,9 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                 else
                     e = mid;
             }
-            double w = 1e-9 * (t[i + 1] - t[i]) * (in_a ? -1.0 : 1.0), tin = in_a ? a : e;
-            if (nt < cap && (in_a ? tin + w > t[i] : tin + w < t[i + 1]))
-                t[nt++] = tin + w;
+            double w = 1e-9 * (nd[i + 1].t - nd[i].t) * (in_a ? -1.0 : 1.0), tin = in_a ? a : e;
+            if (nt < cap && (in_a ? tin + w > nd[i].t : tin + w < nd[i + 1].t))
+                nd[nt++] = (HmNode){tin + w, 1};
         }
         for (int k = 0; k < 3; k++) {
             double a = m[i][k], e = m[i + 1][k];
@@ -1660,7 +1803,7 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                 long j = side ? i + 2 : i - 1;
                 if (j < 0 || j >= G || !isfinite(m[j][k]))
                     continue;
-                double u[3] = {t[i], t[i + 1], t[j]}, f[3] = {a, e, m[j][k]};
+                double u[3] = {nd[i].t, nd[i + 1].t, nd[j].t}, f[3] = {a, e, m[j][k]};
                 /* divided differences */
                 double d1 = (f[1] - f[0]) / (u[1] - u[0]), d2 = (f[2] - f[1]) / (u[2] - u[1]);
                 double q2 = (d2 - d1) / (u[2] - u[0]);
@@ -1677,7 +1820,8 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
             }
             if (!turns)
                 continue;
-            double te = hm_margin_extremum(c->P, c->T, k, t[i], t[i + 1], a < 0);
+            nd[i].keep = nd[i + 1].keep = 1;
+            double te = hm_margin_extremum(c->P, c->T, k, nd[i].t, nd[i + 1].t, a < 0);
             double me[3];
             hm_margins(c->P, c->T, te, me);
             if (!isfinite(me[k]) || (me[k] < 0) == (a < 0))
@@ -1686,12 +1830,17 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                 c->flags |= HM_FLAG_FULL;
                 break;
             }
-            t[nt++] = te;
+            nd[nt++] = (HmNode){te, 1};
         }
     }
     free(m);
-    qsort(t, (size_t)nt, sizeof(double), hm_cmp);
-    return nt;
+    qsort(nd, (size_t)nt, sizeof(HmNode), hm_node_cmp);
+    long kept = 0;
+    for (long i = 0; i < nt; i++)
+        if (nd[i].keep)
+            t[kept++] = nd[i].t;
+    free(nd);
+    return kept;
 }
 
 /* One pose: grid rows, cells, folds, intervals. */
@@ -1710,6 +1859,7 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
         c->flags |= HM_FLAG_MEMORY;
         return;
     }
+    c->hfine = (hi - lo) / (double)(G - 1);
     G = hm_grid(c, G, lo, hi, tg, cap);
     for (long i = 0; i < G; i++)
         hm_eval(c, tg[i], 0xffu, 0xffu, &rows[i]);
@@ -1719,6 +1869,8 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
     for (int b = 0; b < 8; b++) {
         c->ncut[b] = 0;
         c->ngraze[b] = 0;
+        c->nseen[b] = 0;
+        c->nat[b] = 0;
         if (!(b & 1))
             c->npair = c->ipair = 0; /* a new pair */
         for (long i = 0; i < G; i++) {
@@ -1727,7 +1879,7 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
             if (i + 1 == G)
                 break;
             int v0 = rows[i].valid[b], v1 = rows[i + 1].valid[b];
-            double near = HM_NEAR * (rows[i + 1].t - rows[i].t);
+            double near = HM_NEAR * fmin(rows[i + 1].t - rows[i].t, c->hfine);
             if (v0 && v1 && hm_gap(c, b, &rows[i]) < near)
                 hm_fold_piece(c, b, &rows[i], &rows[i + 1]); /* a node at a branch end */
             else if (v0 && v1 && hm_gap(c, b, &rows[i + 1]) < near)

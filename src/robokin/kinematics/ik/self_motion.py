@@ -69,6 +69,7 @@ from robokin.kinematics.ik.self_motion_intervals import (
     _held_kernel,
     _held_records,
     _intervals,
+    _points_refined,
     _state_changes,
     _within,
 )
@@ -124,6 +125,8 @@ class SelfMotion:
             when ``_records`` was given.
         _records: ``(crossings, singular)``, built from ``_points`` when first read.
         _held: ``_points`` are the held-joint kernel's (``_held_records`` orders them).
+        _corners: ``(t, branch, row)`` of corners whose row was refined on the pose
+            (``self_motion_intervals._points_refined``): ``sample`` returns that row.
     """
 
     T: np.ndarray
@@ -142,6 +145,7 @@ class SelfMotion:
     _records: tuple[tuple[LimitCrossing, ...], tuple[SingularPoint, ...]] | None = field(
         default=None, repr=False)
     _held: bool = field(default=False, repr=False)
+    _corners: tuple[tuple[float, int, np.ndarray], ...] = field(default=(), repr=False)
 
     @property
     def crossings(self) -> tuple[LimitCrossing, ...]:
@@ -170,7 +174,7 @@ class SelfMotion:
             within_limits: Also NaN the rows outside a joint limit.
         """
         ta = check_finite(np.asarray(t, dtype=np.float64), "t")
-        q, _, _ = self._family.sample_rows(ta.reshape(-1))
+        q = self._rows(ta.reshape(-1))
         if within_limits:
             q = np.where(self._inside(q)[..., None], q, np.nan)
         return q.reshape(ta.shape + q.shape[-2:])
@@ -178,8 +182,15 @@ class SelfMotion:
     def inside(self, t: npt.ArrayLike) -> np.ndarray:
         """(..., k) bool: the branch exists at t and is inside every joint limit."""
         ta = check_finite(np.asarray(t, dtype=np.float64), "t")
-        q, _, _ = self._family.sample_rows(ta.reshape(-1))
+        q = self._rows(ta.reshape(-1))
         return self._inside(q).reshape(ta.shape + (q.shape[-2],))
+
+    def _rows(self, t: np.ndarray) -> np.ndarray:
+        """The family's rows at t (m,), a refined corner's row at its own t."""
+        q, _, _ = self._family.sample_rows(t)
+        for tc, b, row in self._corners:
+            q[t == tc, b] = row
+        return q
 
     def _inside(self, q: np.ndarray) -> np.ndarray:
         return _within(q, self.limits)
@@ -403,9 +414,11 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
     if setup is not None and setup.swivel is not None and parameter in ("auto", "swivel"):
         sw = _SwivelFamily(setup.swivel, Ta, robot)
         intervals, owner, points = sw.exact()
+        intervals, owner, corners = _points_refined(sw, limits, intervals, owner, points,
+                                                    K.SM_KIND_UPPER)
         return SelfMotion(Ta, "swivel", None, _SWIVEL_DOMAIN.copy(), True, 8, intervals, owner,
                           "swivel closed form (SRS), compiled", {"bisected": 0, "grid": 0},
-                          sw, limits, points)
+                          sw, limits, points, _corners=corners)
     kern: HeldKernel | None = setup.held if setup is not None else None
     if kern is not None and parameter in ("auto", kern.named[0]):
         # the compiled held family "auto" took before: no family choice again
@@ -419,7 +432,9 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
     if kern is not None:
         intervals, owner, points, info = _compiled(kern, Ta)
         if not info["flags"]:
-            return _held_motion(Ta, kern, intervals, owner, info, fam, limits, points)
+            intervals, owner, corners = _points_refined(fam, limits, intervals, owner, points,
+                                                        K.HM_KIND_UPPER)
+            return _held_motion(Ta, kern, intervals, owner, info, fam, limits, points, corners)
         fallback = {"compiled": False, "flags": info["flags"]}  # not certified: solved points
     if isinstance(fam, _ContinuedFamily):
         marks = fam.marks(limits, _aligned_values(robot))
@@ -431,6 +446,10 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
         q, valid, _ = fam.rows(grid_t)
         ends, bisected = _state_changes(fam, grid_t, q, valid, limits, marks)
     intervals, owner = _intervals(fam, limits, marks, ends)
+    cuts = np.array([(t, b, j, 0) for t, b, j, _ in marks["limit"]], dtype=np.float64)
+    intervals, owner, corners = _points_refined(fam, limits, intervals, owner,
+                                                cuts.reshape(-1, 4), 0,
+                                                every=not isinstance(fam, _ContinuedFamily))
     crossings = tuple(LimitCrossing(t, b, j, s) for t, b, j, s in marks["limit"])
     singular = tuple(SingularPoint(t, b, k) for t, b, k in marks["fold"] + marks["aligned"])
     method = ("swivel closed form (SRS)" if fam.name == "swivel"
@@ -440,7 +459,7 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
                       intervals, owner, method,
                       {"bisected": bisected, "grid": int(grid), **fallback,
                        **_solves(fam)}, fam, limits,
-                      _records=(crossings, singular))
+                      _records=(crossings, singular), _corners=corners)
 
 
 #: SelfMotion's fields, in order (``_held_motion`` sets every one).
@@ -448,18 +467,18 @@ _FIELDS = tuple(f.name for f in fields(SelfMotion))
 
 
 def _held_motion(T: np.ndarray, kern: HeldKernel, intervals: np.ndarray, owner: np.ndarray,
-                 info: dict[str, Any], fam: _Family, limits: np.ndarray, points: np.ndarray
-                 ) -> SelfMotion:
+                 info: dict[str, Any], fam: _Family, limits: np.ndarray, points: np.ndarray,
+                 corners: tuple[tuple[float, int, np.ndarray], ...] = ()) -> SelfMotion:
     """The compiled held family's SelfMotion: the dataclass' fields set directly.
 
     Equal to ``SelfMotion(T, name, joint, domain, False, 8, intervals, owner, method,
-    info, fam, limits, points, None, True)`` (the frozen dataclass' ``__init__``
+    info, fam, limits, points, None, True, corners)`` (the frozen dataclass' ``__init__``
     costs 4 us of the ~20 us the API adds to the kernel).
     """
     sm = object.__new__(SelfMotion)
     vars(sm).update(zip(_FIELDS, (T, kern.named[0], kern.joint, kern.domain.copy(), False, 8,
                                   intervals, owner, kern.method, info, fam, limits, points,
-                                  None, True), strict=True))
+                                  None, True, corners), strict=True))
     return sm
 
 

@@ -565,7 +565,15 @@ class _ContinuedFamily(_Family):
         self.fold_q[c[ok], b[ok]] = q_f[ok]
         rest = ~ok & ~stuck
         if rest.any():
-            ends[rest] = self._bisect(c[rest], b[rest], state[rest])
+            cr, br = c[rest], b[rest]
+            ends[rest] = self._bisect(cr, br, state[rest])
+            # the bisected end's own row, where the track has one there: the fold
+            # model of `predict` (not the tangent line, which overshoots next to the
+            # fold and leaves the cell's rows unassigned) and the fold-cell scan
+            R, valid, _ = self.rows(ends[rest])
+            i = np.flatnonzero(valid[np.arange(len(br)), br])
+            self.fold_t[cr[i], br[i]] = ends[rest][i]
+            self.fold_q[cr[i], br[i]] = R[i, br[i]]
         return [(float(e), int(bb)) for e, bb in zip(ends, b, strict=True)]
 
     def _bisect(self, c: np.ndarray, b: np.ndarray, state: np.ndarray) -> np.ndarray:

@@ -401,3 +401,269 @@ def _held_records(points: np.ndarray) -> tuple[tuple[LimitCrossing, ...],
     sing = tuple(SingularPoint(t, int(b), _KINDS[int(k)])
                  for t, b, _, k in np.concatenate([p[fold], p[~fold & ~limit]]).tolist())
     return cross, sing
+
+
+#: Crossings of one branch this close [in t] (or to an end of the range) may be a
+#: graze or a corner: their rows are evaluated (``_points_refined``).
+_PAIR = 1e-6
+#: The sort key of points [t, branch, joint, kind]: t + 64 branch (64 wider than any
+#: parameter range); an interval's length (its end minus its start).
+_KEYS = np.array([1.0, 64.0, 0.0, 0.0])
+_LENGTH = np.array([-1.0, 1.0])
+#: Probes of a graze stretch's extent either side of its point [in t]: from 1e-9 (a
+#: crossing through the limit at |dq/dt| >= 1e-3 is out there: no graze, not widened).
+_PROBES = 10.0 ** -np.arange(9, 2, -1)
+#: Search steps of a graze stretch's end within a decade of ``_PROBES`` (``_SPLIT``
+#: values each: the bracket shrinks 4 times per step, to ~1e-3 of the decade: the
+#: stretches are 1e-6 to 1e-4 long, their ends inside to ~1e-9 of the last value).
+_WIDEN = 5
+_SPLIT = 3
+#: A listed interval at most this long is a point (a few ulps): widened as a graze.
+_POINT = 1e-12
+#: A corner's row out by at most this [rad] is refined on the pose's equations.
+_CONDITIONING = 1e-7
+
+
+def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
+                    owner: np.ndarray, points: np.ndarray, upper: int, every: bool = False
+                    ) -> tuple[np.ndarray, np.ndarray, tuple[tuple[float, int, np.ndarray], ...]]:
+    """Graze stretches and corners the intervals miss (issue 29, helper rates29).
+
+    ``points`` (p, 4) ``[t, branch, joint, kind]``: the kernels' points (kind at
+    most ``upper``: a limit crossing; the Python paths' crossings have kind 0). Two
+    classes of
+    in-limit points are not held by the intervals of every path (the compiled
+    kernels' and the Python families'):
+
+    * *Grazes*: a joint's extremum within ``MANIFOLD_SLACK`` of its limit. The
+      branch is inside over a stretch of ~2 sqrt(slack / |q''|) (1e-6 to 1e-5 in t)
+      about it, but the kernels list it as the point [t, t] (or not at all when the
+      pieces either side are decided outside at their midpoints). Each one-point
+      interval, and each crossing of a branch within ``_PAIR`` of another crossing
+      of it or of a range end whose row is inside, is widened to the last in-slack
+      value either side (geometric probes 1e-9 .. 1e-3, then ``_WIDEN`` search
+      steps on the rows); a side with no probe outside is not widened. (An
+      interval at most ``_POINT`` long, a few ulps, is widened from its ends the
+      same way; a longer one ends at exact crossings.)
+    * *Corners out by conditioning*: such a crossing whose row is out by at most
+      ``_CONDITIONING`` with two or more joints within it of a limit (next to an
+      aligned triple the closed forms' rows are 1e-11 to 1e-9 off). The row is
+      refined by Gauss-Newton on the pose with those joints held exactly at their
+      limits (``_held_refine``); when it reproduces T to 1e-13, is inside and lies
+      within 1e-6 of the branch's row, the corner is the interval [t*, t*] at its
+      parameter value t*, and ``SelfMotion.sample`` returns that row there.
+
+    ``every``: every crossing is a corner candidate (the solved-points path, where a
+    closed-form row costs little against the pose's 50-150 ms; not the continued
+    family, whose rows are general-6R solves: +10-15 % CPU on uniform random 7R
+    poses), not only close ones; a graze is
+    widened only from a close one (a lone uncovered crossing inside, next to a piece
+    decided outside, is a crossing missed nearby: ``docs/ik.md``, "Corners").
+
+    Returns ``(intervals, owner, corners)``; the arrays unchanged (the same objects)
+    when nothing is found: a uniform pose computes no row here (its cost is the
+    test for short intervals and close points, ~5 us).
+    """
+    lo_d, hi_d = fam.domain
+    # the cheap test first (a uniform pose ends here): no short interval, no two
+    # points of a branch within _PAIR, none within it of a range end
+    key = np.dot(points, _KEYS)  # by branch, then t
+    key.sort()
+    t = points[:, 0]
+    # (count_nonzero and matmul, not min / any / column slices: each numpy call costs
+    # ~0.5-2 us on these sizes, ~50 us the whole compiled swivel call)
+    if not every and not (np.count_nonzero(key[1:] - key[:-1] <= _PAIR)
+            or np.count_nonzero(t <= lo_d + _PAIR) or np.count_nonzero(t >= hi_d - _PAIR)
+            or np.count_nonzero(np.dot(intervals, _LENGTH) <= _POINT)):
+        return intervals, owner, ()
+    cuts = points[points[:, 3] <= upper, :3]
+    near = np.zeros(len(cuts), dtype=bool)  # a crossing close to another or to an end
+    if len(cuts):
+        t = cuts[:, 0]
+        key = cuts[:, :2] @ _KEYS[:2]
+        near = (t - lo_d <= _PAIR) | (hi_d - t <= _PAIR)
+        order = np.argsort(key, kind="stable")
+        close = np.diff(key[order]) <= _PAIR
+        near[order[1:][close]] = True
+        near[order[:-1][close]] = True
+    point = intervals[:, 1] - intervals[:, 0] <= _POINT
+    cand = near | every
+    c, near = cuts[cand], near[cand]
+    if len(c):  # crossings already in an interval of their branch: nothing to find
+        held = ((intervals[None, :, 0] <= c[:, :1]) & (c[:, :1] <= intervals[None, :, 1])
+                & (owner[None, :] == c[:, 1:2])).any(axis=1)
+        c, near = c[~held], near[~held]
+    stretch = [(float(a), float(e), int(b)) for (a, e), b, p in zip(intervals, owner, point) if p]
+    corners: list[tuple[float, int, np.ndarray]] = []
+    if len(c):
+        ts, inv = np.unique(c[:, 0], return_inverse=True)
+        q, valid, _ = fam.rows(ts)
+        b = c[:, 1].astype(int)
+        r = q[inv, b]
+        excess = np.maximum(limits[:, 0] - r, r - limits[:, 1])  # (c, n)
+        worst = np.where(valid[inv, b], excess.max(axis=-1), np.inf)
+        inside = worst <= MANIFOLD_SLACK
+        lone = np.flatnonzero(inside & ~near)
+        if len(lone):  # a graze only where its joint stays at the limit either side
+            inside[lone] = _tangent(fam, limits, c[lone])
+        for i in np.flatnonzero(inside):
+            stretch.append((float(c[i, 0]), float(c[i, 0]), int(b[i])))
+        for i in np.flatnonzero((worst > MANIFOLD_SLACK) & (worst <= _CONDITIONING)):
+            hold = np.flatnonzero(np.abs(excess[i]) <= _CONDITIONING)
+            if len(hold) < 2:
+                continue
+            row = _held_refine(fam, limits, r[i], hold)
+            if row is not None:
+                tc = _param(fam, row)
+                if tc is not None:
+                    corners.append((tc, int(b[i]), row))
+    new = _widen(fam, limits, stretch) + [(b, t, t) for t, b, _ in corners]
+    iv, ob = _merged(intervals, owner, new)
+    if not corners and np.array_equal(iv, intervals) and np.array_equal(ob, owner):
+        return intervals, owner, ()  # nothing widened or added: the kernel's arrays
+    return iv, ob, tuple(corners)
+
+
+def _tangent(fam: _Family, limits: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """(c,) bool: crossing [t, b, j]'s joint within the slack of its limit at t +- 1e-8.
+
+    A graze (the joint's extremum at its limit) stays there to ~1e-16; a crossing
+    through the limit is out by ~1e-8 |dq/dt| on one side. Only a tangent lone
+    crossing is widened (the solved-points path's ``every``): a crossing into the limits
+    followed by a piece decided outside is a missed crossing (rtb-data iiwa14,
+    uniform pose #119 of seed 0: a 6.4e-4 stretch), not a graze.
+    """
+    ts = np.concatenate([c[:, 0] - 1e-8, c[:, 0] + 1e-8])
+    q, valid, _ = fam.rows(ts)
+    m = len(c)
+    b, j = np.tile(c[:, 1].astype(int), 2), np.tile(c[:, 2].astype(int), 2)
+    x = q[np.arange(2 * m), b, j]
+    with np.errstate(invalid="ignore"):
+        at = (valid[np.arange(2 * m), b] & (x >= limits[j, 0] - MANIFOLD_SLACK)
+              & (x <= limits[j, 1] + MANIFOLD_SLACK))
+    out: np.ndarray = at[:m] & at[m:]
+    return out
+
+
+def _param(fam: _Family, row: np.ndarray) -> float | None:
+    """The parameter value of a refined row, in the domain (the swivel: wrapped)."""
+    t = fam.param_of(row)
+    lo, hi = fam.domain
+    if fam.periodic:
+        return float(_wrap(t))
+    return t if lo <= t <= hi else None
+
+
+def _held_refine(fam: _Family, limits: np.ndarray, r: np.ndarray, hold: np.ndarray
+                 ) -> np.ndarray | None:
+    """Row r refined on the pose with joints ``hold`` exactly at their nearer limits.
+
+    Gauss-Newton (least squares over the free joints' Jacobian columns: 6 x (n -
+    len(hold))) on ``pose_error``, at most 8 steps; the row when its pose error is
+    at most 1e-13 (position [m] and rotation [rad]), every free joint is inside
+    (``MANIFOLD_SLACK``) and it moved by at most 1e-6 rad, else None.
+    """
+    from robokin.kinematics.ik.self_motion_families import _size
+    from robokin.kinematics.jacobian import jacobian_and_pose
+    from robokin.spatial import pose_error
+
+    robot: Arm = fam.robot  # type: ignore[attr-defined]
+    T: np.ndarray = fam.T  # type: ignore[attr-defined]
+    q: np.ndarray = np.array(r, dtype=np.float64)
+    lim = limits[hold]
+    q[hold] = np.where(np.abs(r[hold] - lim[:, 0]) <= np.abs(r[hold] - lim[:, 1]),
+                       lim[:, 0], lim[:, 1])
+    free = np.setdiff1d(np.arange(len(q)), hold)
+    for _ in range(8):
+        J, P = jacobian_and_pose(robot.chain, q)
+        e = pose_error(P, T)
+        if _size(e) <= 1e-15:
+            break
+        step = np.linalg.lstsq(J[:, free], e, rcond=None)[0]
+        q[free] += step
+        if np.abs(step).max() <= 1e-15:
+            e = pose_error(jacobian_and_pose(robot.chain, q)[1], T)
+            break
+    else:
+        e = pose_error(jacobian_and_pose(robot.chain, q)[1], T)
+    if (_size(e) > 1e-13 or not _within(q, limits)
+            or np.abs(q - r).max() > 1e-6):
+        return None
+    return q
+
+
+def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, int]]
+           ) -> list[tuple[int, float, float]]:
+    """Each in-limit stretch (a, e, b) (a point: a = e) widened to its in-slack extent.
+
+    Probes at ``_PROBES`` before a and after e (one batch); a side with a probe
+    outside (and the first inside) is searched between its last inside and first
+    outside probe, ``_SPLIT`` values per step (one batch per step, both sides and
+    every stretch together), ``_WIDEN`` steps (to ~1e-3 of that decade), and ends
+    1e-3 of its distance inside the last inside value found (a graze's joint there
+    ~0.998 of the slack from its limit: ``test_swivel.test_intervals_are_exact``'s
+    ends at a limit to 1e-12 hold after the swivel's 2 pi shift).
+    """
+    if not points:
+        return []
+    m, p = len(points), len(_PROBES)  # (the first probe alone: most points are corners)
+    t0 = np.array([a for a, _, _ in points] + [e for _, e, _ in points])  # (2m,) sides
+    side = np.repeat([-1.0, 1.0], m)
+    br = np.tile(np.array([b for _, _, b in points]), 2)
+    lo_d, hi_d = fam.domain
+
+    def inside(ts: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """(rows of ts (s, w)) on branches b (s,) inside (the range's ends included)."""
+        q, valid, _ = fam.rows(ts.ravel())
+        idx, bb = np.arange(ts.size), np.repeat(b, ts.shape[1])
+        ok = (valid[idx, bb] & _within(q[idx, bb], limits)).reshape(ts.shape)
+        if not fam.periodic:
+            ok &= (ts >= lo_d) & (ts <= hi_d)
+        out: np.ndarray = ok
+        return out
+
+    ok = np.zeros((2 * m, p), dtype=bool)  # the first probe, then the rest where inside
+    ok[:, 0] = inside(t0[:, None] + side[:, None] * _PROBES[:1], br)[:, 0]
+    more = np.flatnonzero(ok[:, 0])
+    if len(more):
+        ok[more, 1:] = inside(t0[more, None] + side[more, None] * _PROBES[None, 1:], br[more])
+    first_out = np.argmin(ok, axis=1)  # the first probe outside (0 if none is)
+    go = ~ok.all(axis=1) & (first_out > 0)  # inside at 1e-9 and outside further on
+    d = np.zeros(2 * m)
+    if go.any():
+        a, e = _PROBES[first_out[go] - 1], _PROBES[first_out[go]]
+        tb, sb, bb = t0[go], side[go], br[go]
+        frac = np.arange(1, _SPLIT + 1) / (_SPLIT + 1)
+        for _ in range(_WIDEN):
+            x = a[:, None] + (e - a)[:, None] * frac[None, :]  # (g, split)
+            inn = inside(tb[:, None] + sb[:, None] * x, bb)
+            k = np.argmin(inn, axis=1)  # the first value outside (0: none, or the first)
+            none = inn.all(axis=1)
+            new_a = np.where(none, x[:, -1], np.where(k > 0, x[np.arange(len(k)), k - 1], a))
+            e = np.where(none, e, x[np.arange(len(k)), k])
+            a = new_a
+        d[go] = a * (1.0 - 1e-3)  # inside the last inside value: its row stays within
+        # the slack after a 2 pi shift of the swivel (rounding) at q'' up to ~1e11
+    ends = t0 + side * d
+    out = []
+    for a, e, b in zip(ends[:m].tolist(), ends[m:].tolist(), br[:m].tolist(), strict=True):
+        if not fam.periodic:
+            a, e = max(a, lo_d), min(e, hi_d)
+        elif a < lo_d:
+            a, e = a + _TWO_PI, e + _TWO_PI
+        out.append((int(b), a, e))
+    return out
+
+
+def _merged(intervals: np.ndarray, owner: np.ndarray, new: list[tuple[int, float, float]]
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """The intervals with ``new`` (b, start, end) added, overlapping ones of a branch joined."""
+    every = sorted([(int(b), float(a), float(e)) for (a, e), b in zip(intervals, owner)] + new)
+    out: list[tuple[int, float, float]] = []
+    for b, a, e in every:
+        if out and out[-1][0] == b and a <= out[-1][2]:
+            out[-1] = (b, out[-1][1], max(out[-1][2], e))
+        else:
+            out.append((b, a, e))
+    arr = np.array([[a, e] for _, a, e in out]).reshape(-1, 2)
+    return arr, np.array([b for b, _, _ in out], dtype=int)
