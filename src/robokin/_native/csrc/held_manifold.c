@@ -27,11 +27,11 @@
  *   4. per slot, the pieces between domain ends, limit crossings and folds are
  *      decided at their midpoints (a row inside every limit) and joined.
  *
- * Every row is pk_one's: hm_closed evaluates its closed form alone (the slots
- * asked for, no polish, repairs or walks) and hands over to pk_one at the t
- * values where pk_one would do more (a row singular, not exact, or outside the
- * limits where a repair may move it): 67-71 full solves per pose instead of
- * ~750, the same rows bit for bit (HM_VERIFY: 0 differences on 1,150 poses).
+ * Every row is pk_one's: hm_closed evaluates its closed form for the slots asked
+ * for, with pk_one's polish and its repairs of those rows, and hands over to
+ * pk_one only where a repair pk_one tries when no other row is inside would move
+ * one (never on the 1,150 development poses; ~750 full solves per pose before
+ * round 5), the same rows bit for bit (HM_VERIFY: 0 differences on 1,150 poses).
  *
  * A pose is flagged (flags != 0: the caller takes the solved-points path) when a
  * row next to an aligned triple is met (pk_one flags it singular: q1, q3 swing
@@ -133,6 +133,7 @@ typedef struct {
     int npair, ipair;
     HmMemo memo[HM_MEMO];
     long nmemo;
+    PkFrontMemo front; /* pk_front's held-value-free parts (hm_closed) */
 } HmCtx;
 
 /* Gaussian elimination with partial pivoting of M (6 x 6 | right-hand side) into x;
@@ -348,16 +349,17 @@ static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
     return 1;
 }
 
-/* The slots in `need` at held value x by pk_one's closed form alone (its position
- * roots, theta_b, the triple, the coordinates: the same calls in the same order,
- * without its polish, repairs and walks), into r (the other slots invalid).
- * Returns 1 when these are pk_one's rows for those slots, 0 when pk_one must
- * decide: the position is not of the coplanar kind, or a needed row is flagged
- * singular, needs its pose check or polish (pk_triple's check, theta_b's residual
- * not exact), or lies outside the limits where pk_one's repairs may move it
- * (within PK_NUDGE of them: pk_inside; not isolated: pk_slide). A regular row
- * inside the limits, or outside by more than PK_NUDGE and isolated, is returned
- * by pk_one unchanged whatever the other slots are. */
+/* The slots in `need` at held value x by pk_one's closed form (its position
+ * roots, theta_b, the triple, the coordinates, its pose check and polish: the
+ * same calls in the same order; pk_front_memo: the per-arm parts kept, only the
+ * position roots of the slots asked for solved), into r (the other slots
+ * invalid). A row outside the limits that pk_one's repairs may move (singular;
+ * within PK_NUDGE of them: pk_inside; not isolated: pk_slide) gets those repairs
+ * here (hm_stays). Returns 1 when these are pk_one's rows for those slots, 0 when
+ * pk_one must decide: the position is not of the coplanar kind, or what pk_one
+ * makes of a row depends on its other slots (a repair it tries only when no row
+ * is inside would move it). (Round 8a: 0 of ~494 evaluations per pose on the
+ * development poses return 0, against ~21 before.) */
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC push_options
 #pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
@@ -440,6 +442,42 @@ static int hm_regular(const double J[6][6])
     return 4.0 * PK_FAMILY_SIGMA * PK_FAMILY_SIGMA * inv * fro < 1.0;
 }
 
+/* Whether pk_one leaves row th (coordinates q, outside the limits, the held joint
+ * inside; sing: flagged singular) as its own repairs of that row leave it: they
+ * run here in pk_one's order (pk_resplit; pk_repair when singular; pk_inside;
+ * pk_slide when singular), th and q taking their moves; a row they bring inside
+ * is pk_one's. One left outside is pk_one's when the repairs pk_one tries only if
+ * no row is inside find nothing from it: pk_walk_rows' pk_walk, else pk_pin
+ * (from the coordinates) for a singular row, the late pk_slide for another.
+ * 0: the other slots decide (pk_one must). */
+static int hm_stays(const HmCtx *c, const PkFront *f, double *th, double *q, int sing)
+{
+    const double *P = c->P;
+    const PkGeo *g = &f->g;
+    int held = (int)P[PK_HELD];
+    double x = q[held];
+    int all = 0;
+    if (pk_resplit(P, g, f->it, &f->RT, f->pT, th))
+        all = pk_coords(P, g, th, held, x, q) >= -1e-9;
+    if (!all && sing && pk_repair(P, g, &f->RT, f->pT, th))
+        all = pk_coords(P, g, th, held, x, q) >= -1e-9;
+    if (!all && pk_inside(P, g, &f->RT, f->pT, th, sing ? PK_NUDGE_SING : PK_NUDGE))
+        all = pk_coords(P, g, th, held, x, q) >= -1e-9;
+    if (!all && sing && pk_slide(P, g, &f->RT, f->pT, th))
+        all = pk_coords(P, g, th, held, x, q) >= -1e-9;
+    if (all)
+        return 1; /* inside: no late repair (pk_walk_rows returns at once) */
+    double tw[6], tp[6];
+    for (int j = 0; j < 6; j++) {
+        int fj = g->full[j];
+        tw[j] = sing ? P[PK_SIGN + fj] * q[fj] + P[PK_OFFSET + fj] : th[j];
+        tp[j] = tw[j];
+    }
+    if (!sing)
+        return !pk_slide(P, g, &f->RT, f->pT, tw);
+    return !pk_walk(P, g, &f->RT, f->pT, tw) && !pk_pin(P, g, &f->RT, f->pT, tp);
+}
+
 static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
 {
     const double *P = c->P;
@@ -449,7 +487,10 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
             r->q[b][j] = NAN;
     }
     PkFront f;
-    int code = pk_front(P, c->T, x, c->qn, 0, &f);
+    unsigned want = 0u; /* the position slots of the slots in need */
+    for (int i = 0; i < 4; i++)
+        want |= (need >> 2 * i & 3u) != 0u ? 1u << i : 0u;
+    int code = pk_front_memo(P, c->T, x, c->qn, 0, &c->front, want, &f);
     if (code == PK_FRONT_SWIVEL || code == PK_FRONT_GENERAL || f.g.kase != PK_START)
         return 0; /* He and Liu's general case: not this kernel's */
     if (code != PK_OK)
@@ -464,42 +505,50 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
         unsigned slots = 3u << (2 * pos->slot[i]);
         if (!(need & slots) || !(pos->res[i] < 1e-6 * g->scale))
             continue;
-        if (pos->sing[i])
-            return 0;
         double th[6];
         m3 Rt = pk_front_rotation(&f, i, th);
         PkTrip tr;
-        pk_triple(P, &f.tri, &Rt, f.jx, f.jz, c->qn[f.jz], stol, &tr);
+        pk_triple_want(P, &f.tri, &Rt, f.jx, f.jz, c->qn[f.jz], stol,
+                       need >> 2 * pos->slot[i] & 3u, &tr);
         for (int k = 0; k < tr.n; k++) {
             int slot = 2 * pos->slot[i] + k;
             if (!(need >> slot & 1u))
                 continue;
-            if (tr.sing[k])
-                return 0;
+            int sing = pos->sing[i] || tr.sing[k];
             for (int j = 0; j < 3; j++) {
                 th[ia + j] = pos->t[i][j];
                 th[it + j] = tr.t[k][j];
             }
-            /* pk_one's check: kept unchanged when exact, else polished */
-            if ((tr.check[k] || !(pos->res[i] < f.exact_p)) &&
-                !(pk_error_of(g, &f.RT, f.pT, th) <= PK_EXACT))
-                return 0;
+            /* pk_one's check: kept unchanged when exact, else polished (its calls) */
+            if (tr.check[k] || !(pos->res[i] < f.exact_p)) {
+                double err = pk_error_of(g, &f.RT, f.pT, th);
+                if (err > PK_EXACT)
+                    err = pk_polish_slow(g, &f.RT, f.pT, th, pk_polish(g, &f.RT, f.pT, th));
+                if (!(err <= PK_ACCEPT))
+                    continue; /* not a solution to 1e-12: no row */
+            }
             double m = pk_coords(P, g, th, held, x, r->q[slot]);
-            if (!(m >= -1e-9) && held_in && !(hm_outside(P, g, th) > 2.0 * PK_NUDGE))
-                return 0; /* pk_inside (or, next to an aligned triple, pk_resplit) may move it */
-            if (!(m >= -1e-9) && held_in && !pk_isolated(g, th)) {
-                m3 R;
-                v3 p;
-                double J[6][6];
-                pk_fk(g, th, &R, &p, J);
-                if (!pk_regular(J) && !hm_regular(J)) { /* pk_slide's own test: a family */
-                    double sig[6], V[6][6];
-                    pk_svd6(J, sig, V);
-                    if (sig[0] <= PK_FAMILY_SIGMA * sig[5])
-                        return 0; /* pk_slide may move it */
+            if (!(m >= -1e-9) && held_in) {
+                /* pk_one's repairs may move it: a singular row, one within reach of
+                 * pk_inside (or, next to an aligned triple, pk_resplit), one on a
+                 * family (pk_slide's own test) */
+                int moves = sing || !(hm_outside(P, g, th) > 2.0 * PK_NUDGE);
+                if (!moves && !pk_isolated(g, th)) {
+                    m3 R;
+                    v3 p;
+                    double J[6][6];
+                    pk_fk(g, th, &R, &p, J);
+                    if (!pk_regular(J) && !hm_regular(J)) {
+                        double sig[6], V[6][6];
+                        pk_svd6(J, sig, V);
+                        moves = sig[0] <= PK_FAMILY_SIGMA * sig[5];
+                    }
                 }
+                if (moves && !hm_stays(c, &f, th, r->q[slot], sing))
+                    return 0; /* what pk_one makes of it depends on the other slots */
             }
             r->valid[slot] = 1;
+            r->sing[slot] = (unsigned char)sing;
         }
     }
     return 1;
@@ -1902,6 +1951,7 @@ static void hm_range(void *ctx, long b0, long e0)
         for (int m = 0; m < HM_MEMO; m++)
             c->memo[m].t = NAN; /* nothing kept */
         c->nmemo = 0;
+        c->front.set = 0;
         c->fast = hm_fast_setup(c);
         c->full_fk = 0;
         if (P[PK_CASE] == PK_BOTH || c->k < 0 || c->n != 7)

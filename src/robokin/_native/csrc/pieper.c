@@ -418,9 +418,13 @@ typedef struct {
     v3 ha, hb, hc, oa, ob, oc, d, p;
     double mab, mbc; /* mutual moments / scale of axes (a, b), (b, c) */
     double scale;
+    double l1, l2, inv2L; /* pk_equations_d's part of r, for pk_equations_p */
+    v3 dcb, wc;
 } PkEq;
 
-static void pk_equations(const PkGeo *g, int ia, v3 p, v3 d, PkEq *e)
+/* pk_equations' part from d (P, the mutual moments, r's d terms): held-value-free
+ * where the held joint is the chain's last and the triple starts it (pk_front_memo) */
+static void pk_equations_d(const PkGeo *g, int ia, v3 d, PkEq *e)
 {
     v3 ha = g->h[ia], hb = g->h[ia + 1], hc = g->h[ia + 2];
     v3 oa = g->o[ia], oc = g->o[ia + 2];
@@ -429,24 +433,17 @@ static void pk_equations(const PkGeo *g, int ia, v3 p, v3 d, PkEq *e)
     double L = g->scale, inv2L = 0.5 / L;
     v3 a = v3_sub(d, oa), apar = v3_scale(ha, v3_dot(ha, a)), aperp = v3_sub(a, apar);
     v3 axa = v3_cross(ha, a);
-    v3 b = v3_sub(p, oc), bpar = v3_scale(hc, v3_dot(hc, b)), bperp = v3_sub(b, bpar);
-    v3 hxb = v3_cross(hc, b);
     v3 dab = v3_sub(oa, ob), dcb = v3_sub(oc, ob);
     v3 wa = v3_scale(dab, 1.0 / L), wc = v3_scale(dcb, 1.0 / L);
     e->P[0][0] = v3_dot(hb, aperp);
     e->P[0][1] = -v3_dot(hb, axa);
     e->P[1][0] = v3_dot(wa, aperp);
     e->P[1][1] = -v3_dot(wa, axa);
-    e->Q[0][0] = v3_dot(hb, bperp);
-    e->Q[0][1] = v3_dot(hb, hxb);
-    e->Q[1][0] = v3_dot(wc, bperp);
-    e->Q[1][1] = v3_dot(wc, hxb);
-    double l1 = v3_dot(hb, v3_add(apar, dab));
-    double l2 = (v3_dot(a, a) + v3_dot(dab, dab)) * inv2L + v3_dot(wa, apar);
-    double r1 = v3_dot(hb, v3_add(bpar, dcb));
-    double r2 = (v3_dot(b, b) + v3_dot(dcb, dcb)) * inv2L + v3_dot(wc, bpar);
-    e->r[0] = r1 - l1;
-    e->r[1] = r2 - l2;
+    e->l1 = v3_dot(hb, v3_add(apar, dab));
+    e->l2 = (v3_dot(a, a) + v3_dot(dab, dab)) * inv2L + v3_dot(wa, apar);
+    e->inv2L = inv2L;
+    e->dcb = dcb;
+    e->wc = wc;
     e->ha = ha;
     e->hb = hb;
     e->hc = hc;
@@ -454,10 +451,32 @@ static void pk_equations(const PkGeo *g, int ia, v3 p, v3 d, PkEq *e)
     e->ob = ob;
     e->oc = oc;
     e->d = d;
-    e->p = p;
     e->scale = L;
     e->mab = v3_dot(dab, v3_cross(ha, hb)) / L;
     e->mbc = v3_dot(dcb, v3_cross(hb, hc)) / L;
+}
+
+/* pk_equations' part from p (Q, r), after pk_equations_d */
+static void pk_equations_p(PkEq *e, v3 p)
+{
+    v3 hb = e->hb, hc = e->hc, dcb = e->dcb, wc = e->wc;
+    v3 b = v3_sub(p, e->oc), bpar = v3_scale(hc, v3_dot(hc, b)), bperp = v3_sub(b, bpar);
+    v3 hxb = v3_cross(hc, b);
+    e->Q[0][0] = v3_dot(hb, bperp);
+    e->Q[0][1] = v3_dot(hb, hxb);
+    e->Q[1][0] = v3_dot(wc, bperp);
+    e->Q[1][1] = v3_dot(wc, hxb);
+    double r1 = v3_dot(hb, v3_add(bpar, dcb));
+    double r2 = (v3_dot(b, b) + v3_dot(dcb, dcb)) * e->inv2L + v3_dot(wc, bpar);
+    e->r[0] = r1 - e->l1;
+    e->r[1] = r2 - e->l2;
+    e->p = p;
+}
+
+static void pk_equations(const PkGeo *g, int ia, v3 p, v3 d, PkEq *e)
+{
+    pk_equations_d(g, ia, d, e);
+    pk_equations_p(e, p);
 }
 
 /* The unit left null vector of the 2 x 2 matrix whose rows are the dot products
@@ -504,14 +523,20 @@ static double pk_theta_b(const PkEq *e, double ca, double sa, double cc, double 
  * however close: next to a double root a root's error is second order in the
  * pose, so two accurate close roots beat one merged root (which would be off by
  * the square root of their distance). */
-static Roots pk_sp4(double A, double B, double C, double slack)
+static Roots pk_sp4_at(double A, double B, double C, double slack, double phi, double cphi,
+                       double sphi)
 {
-    double phi = fast_atan2(B, A), cphi, sphi;
-    unit2(B, A, &cphi, &sphi);
     double disc = A * A + B * B - C * C;
     if (disc < 0.0 && fabs(C) - hypot(A, B) <= slack)
         disc = 0.0;
     return sp4_roots(A, B, C, disc, 1e-13, 0, phi, cphi, sphi);
+}
+
+static Roots pk_sp4(double A, double B, double C, double slack)
+{
+    double phi = fast_atan2(B, A), cphi, sphi;
+    unit2(B, A, &cphi, &sphi);
+    return pk_sp4_at(A, B, C, slack, phi, cphi, sphi);
 }
 
 /* A solution (theta_a, theta_c given by angle, cosine and sine; theta_b solved) */
@@ -535,23 +560,55 @@ static void pk_pos_add(PkPos *out, const PkEq *e, int slot, double ta, double ca
     out->sing[i] = (unsigned char)sing;
 }
 
-/* Coplanar axes b, c (Q singular; swap: a, b and P): the null combination n of the
- * rows holds theta_x alone (x = a, or c when swapped); the other combination m then
- * gives theta_y. pref_a, pref_c: the chain angles to take when one is free. */
-static int pk_coplanar(const PkEq *e, int swap, double pref_a, double pref_c, PkPos *out)
+/* pk_coplanar's part from x's matrix (P, or Q when swapped): the null combination n,
+ * theta_x's subproblem 4 coefficients A, B (its phase phi, cphi, sphi), whether
+ * theta_x is free, the other combination m */
+typedef struct {
+    double n[2], A, B, phi, cphi, sphi, m0, m1;
+    int xfree;
+} PkCop;
+
+static void pk_coplanar_x(const PkEq *e, int swap, PkCop *k)
 {
-    double n[2], L = e->scale;
+    double L = e->scale;
     v3 h = swap ? e->ha : e->hc, o = swap ? e->oa : e->oc;
     /* the rows' vectors: h_b and (o - o_b) / scale (the second row's scaling) */
-    pk_null(h, e->hb, v3_scale(v3_sub(o, e->ob), 1.0 / L), n);
+    pk_null(h, e->hb, v3_scale(v3_sub(o, e->ob), 1.0 / L), k->n);
+    const double(*X)[2] = swap ? e->Q : e->P; /* x's matrix */
+    double sx = swap ? -1.0 : 1.0; /* P u_a - Q u_c = r: the sign of x's term */
+    k->A = sx * (k->n[0] * X[0][0] + k->n[1] * X[1][0]);
+    k->B = sx * (k->n[0] * X[0][1] + k->n[1] * X[1][1]);
+    k->xfree = hypot(k->A, k->B) <= 1e-12 * L;
+    if (!k->xfree) {
+        k->phi = fast_atan2(k->B, k->A);
+        unit2(k->B, k->A, &k->cphi, &k->sphi);
+    }
+    k->m0 = -k->n[1];
+    k->m1 = k->n[0];
+}
+
+/* Coplanar axes b, c (Q singular; swap: a, b and P): the null combination n of the
+ * rows holds theta_x alone (x = a, or c when swapped); the other combination m then
+ * gives theta_y. pref_a, pref_c: the chain angles to take when one is free. k:
+ * pk_coplanar_x's part (NULL: computed here). want: the position slots (bits 0-3)
+ * to solve (the others are left out of out, as if they had no root). */
+static int pk_coplanar(const PkEq *e, int swap, const PkCop *k, double pref_a, double pref_c,
+                       unsigned want, PkPos *out)
+{
+    double L = e->scale;
+    PkCop own;
+    if (k == NULL) {
+        pk_coplanar_x(e, swap, &own);
+        k = &own;
+    }
+    const double *n = k->n;
     const double(*X)[2] = swap ? e->Q : e->P; /* x's matrix */
     const double(*Y)[2] = swap ? e->P : e->Q;
     double sx = swap ? -1.0 : 1.0; /* P u_a - Q u_c = r: the sign of x's term */
-    double A = sx * (n[0] * X[0][0] + n[1] * X[1][0]);
-    double B = sx * (n[0] * X[0][1] + n[1] * X[1][1]);
+    double A = k->A, B = k->B;
     double C = n[0] * e->r[0] + n[1] * e->r[1];
     Roots rx;
-    int xfree = hypot(A, B) <= 1e-12 * L;
+    int xfree = k->xfree;
 #ifdef PK_DEBUG
     fprintf(stderr, " coplanar swap %d n %.3e %.3e A %.6e B %.6e C %.6e disc %.3e xfree %d\n", swap, n[0], n[1], A, B, C, A*A+B*B-C*C, xfree);
 #endif
@@ -565,13 +622,22 @@ static int pk_coplanar(const PkEq *e, int swap, double pref_a, double pref_c, Pk
         rx.c[0] = cos(tx);
         rx.s[0] = sin(tx);
     } else {
-        rx = pk_sp4(A, B, C, PK_SP4_SLACK * L);
+        rx = pk_sp4_at(A, B, C, PK_SP4_SLACK * L, k->phi, k->cphi, k->sphi);
     }
-    double m0 = -n[1], m1 = n[0];
+    double m0 = k->m0, m1 = k->m1;
     double Ay = -sx * (m0 * Y[0][0] + m1 * Y[1][0]);
     double By = -sx * (m0 * Y[0][1] + m1 * Y[1][1]);
-    int yfree = hypot(Ay, By) <= 1e-12 * L;
+    /* hypot(Ay, By) >= max(|Ay|, |By|): the call only where that cannot decide */
+    double yl = 1e-12 * L;
+    int yfree = !(fabs(Ay) > yl || fabs(By) > yl) && hypot(Ay, By) <= yl;
+    double phy = 0.0, cphy = 1.0, sphy = 0.0; /* theta_y's phase (pk_sp4's), once */
+    if (!yfree && (want & ((rx.n > 1 ? 15u : 3u))) != 0u) {
+        phy = fast_atan2(By, Ay);
+        unit2(By, Ay, &cphy, &sphy);
+    }
     for (int i = 0; i < rx.n; i++) {
+        if (!(want & 3u << 2 * i))
+            continue; /* neither of this root's position slots asked for */
         double cx = rx.c[i], sxn = rx.s[i];
         /* m . (X u_x sx - r) = -sx m . Y u_y ... written out: */
         double Xu0 = X[0][0] * cx + X[0][1] * sxn, Xu1 = X[1][0] * cx + X[1][1] * sxn;
@@ -585,13 +651,15 @@ static int pk_coplanar(const PkEq *e, int swap, double pref_a, double pref_c, Pk
             ry.c[0] = cos(ty);
             ry.s[0] = sin(ty);
         } else {
-            ry = pk_sp4(Ay, By, Cy, PK_SP4_SLACK * L);
+            ry = pk_sp4_at(Ay, By, Cy, PK_SP4_SLACK * L, phy, cphy, sphy);
         }
 #ifdef PK_DEBUG
         fprintf(stderr, "  y: Ay %.6e By %.6e Cy %.6e disc %.3e n %d\n", Ay, By, Cy, Ay*Ay+By*By-Cy*Cy, ry.n);
 #endif
         for (int j = 0; j < ry.n; j++) {
             int sing = xfree || rx.boundary || ry.boundary;
+            if (!(want >> (2 * i + j) & 1u))
+                continue;
             if (swap)
                 pk_pos_add(out, e, 2 * i + j, ry.t[j], ry.c[j], ry.s[j], rx.t[i], rx.c[i],
                            rx.s[i], sing);
@@ -788,9 +856,11 @@ typedef struct {
 } PkTrip;
 
 /* rot(hx, tx) rot(hy, ty) rot(hz, tz) = R: up to two solutions; jx, jz: the outer
- * joints' full-chain indices, pref_z z's preferred coordinate at the singularity. */
-static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int jz,
-                      double pref_z, double stol, PkTrip *out)
+ * joints' full-chain indices, pref_z z's preferred coordinate at the singularity.
+ * want: the solutions (bits 0, 1) to complete; the others keep their place (and
+ * the singular case its single solution) with NaN angles, unflagged. */
+static void pk_triple_want(const double *P, const PkTri *k, const m3 *R, int jx, int jz,
+                           double pref_z, double stol, unsigned want, PkTrip *out)
 {
     v3 hx = k->hx, hy = k->hy, hz = k->hz;
     v3 w = m3_mv(R, hz), rtx = m3_mtv(R, hx);
@@ -826,6 +896,12 @@ static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int 
                 }
             }
         }
+        if (!(want >> i & 1u)) {
+            int j = out->n++;
+            out->t[j][0] = out->t[j][1] = out->t[j][2] = NAN;
+            out->sing[j] = out->check[j] = 0;
+            continue;
+        }
         double cx, sx, cz, sz;
         double tx = pk_sp1(hx, v, w, &cx, &sx);
         v3 u = v3_rot(hy, cy, -sy, hx);
@@ -856,6 +932,12 @@ static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int 
                      v3_norm(v3_sub(v3_rot(hz, cz, sz, u), rtx));
         out->check[j] = (unsigned char)(sv < 1e-4 || !(res < 1e-2 * PK_EXACT * sv));
     }
+}
+
+static void pk_triple(const double *P, const PkTri *k, const m3 *R, int jx, int jz,
+                      double pref_z, double stol, PkTrip *out)
+{
+    pk_triple_want(P, k, R, jx, jz, pref_z, stol, 3u, out);
 }
 
 /* ---------------------------------------------------------------- polish */
@@ -1117,6 +1199,13 @@ static int pk_repair(const double *P, const PkGeo *g, const m3 *RT, v3 pT, doubl
 /* The joint coordinates of chain angles th (6, remaining chain) into q (full
  * chain, held joint at x) and their smallest margin to the limits [rad]
  * (negative: outside) */
+/* fmin's value inline (NaN: the other argument), for margins that are only
+ * compared (a zero's sign may differ from libm's) */
+static inline double pk_min_num(double a, double b)
+{
+    return isnan(a) ? b : isnan(b) ? a : b < a ? b : a;
+}
+
 static double pk_coords(const double *P, const PkGeo *g, const double *th, int held,
                         double x, double *q)
 {
@@ -1125,11 +1214,11 @@ static double pk_coords(const double *P, const PkGeo *g, const double *th, int h
         int f = g->full[j], in;
         double lo = P[PK_LO + f], hi = P[PK_HI + f];
         q[f] = joint_value(th[j], P[PK_SIGN + f], P[PK_OFFSET + f], lo, hi, &in);
-        margin = fmin(margin, fmin(q[f] - lo, hi - q[f]));
+        margin = pk_min_num(margin, pk_min_num(q[f] - lo, hi - q[f]));
     }
     if (held >= 0) {
         q[held] = x;
-        margin = fmin(margin, fmin(x - P[PK_LO + held], P[PK_HI + held] - x));
+        margin = pk_min_num(margin, pk_min_num(x - P[PK_LO + held], P[PK_HI + held] - x));
     }
     return margin;
 }
@@ -1757,18 +1846,22 @@ static void pk_walk_rows(const double *P, const PkGeo *g, const m3 *RT, v3 pT, i
  * then pk_equations on the position joints (the first three, or the last three
  * when the chain starts with its wrist). One copy for pk_one and the compiled
  * manifold's existence margins (held_manifold.c). */
+static void pk_pose_points(const PkGeo *g, const m3 *RT, v3 pT, const m3 *G, v3 *p, v3 *d)
+{
+    if (g->kase == PK_START) {
+        *p = v3_add(m3_mv(&g->RM, m3_mtv(RT, v3_sub(g->pt, pT))), g->tM);
+        *d = g->pt;
+    } else {
+        *p = g->pt;
+        *d = v3_add(m3_mv(G, v3_sub(g->pt, g->tM)), pT);
+    }
+}
+
 static void pk_pose_equations(const PkGeo *g, const m3 *RT, v3 pT, const m3 *G, PkEq *e)
 {
-    int start = g->kase == PK_START, ia = start ? 3 : 0;
     v3 p, d;
-    if (start) {
-        p = v3_add(m3_mv(&g->RM, m3_mtv(RT, v3_sub(g->pt, pT))), g->tM);
-        d = g->pt;
-    } else {
-        p = g->pt;
-        d = v3_add(m3_mv(G, v3_sub(g->pt, g->tM)), pT);
-    }
-    pk_equations(g, ia, p, d, e);
+    pk_pose_points(g, RT, pT, G, &p, &d);
+    pk_equations(g, g->kase == PK_START ? 3 : 0, p, d, e);
 }
 
 /* pk_one's closed form up to the triple, shared with held_manifold.c's
@@ -1786,12 +1879,27 @@ typedef struct {
 
 enum { PK_FRONT_SWIVEL = -1, PK_FRONT_GENERAL = -2 };
 
+/* pk_front's parts that do not depend on the held value x where the held joint is
+ * the chain's last and the triple starts it (the Panda with q7: every remaining
+ * axis and point, the triple's point d, hence pk_equations_d's part, theta_a's
+ * subproblem 4 coefficients when axes b, c are coplanar, and the triple's
+ * constants): computed at a caller's first pk_front_memo call and copied after
+ * (the same operations on the same values: the same bits). set = 0 empties it. */
+typedef struct {
+    int set, cop; /* filled; cop: k holds pk_coplanar_x's part (axes b, c coplanar) */
+    PkEq e;
+    PkCop k;
+    PkTri tri;
+} PkFrontMemo;
+
 /* The front of pose T at held value x (qn: preferred coordinates where a position
  * joint is free). Returns PK_OK with f->pos, a status (no position root), or
  * PK_FRONT_SWIVEL (both triples meet: pk_srs), PK_FRONT_GENERAL (no coplanar
- * pair and `general` 0: Pieper's quartic not taken). */
-static int pk_front(const double *P, const double *T, double x, const double *qn, int general,
-                    PkFront *f)
+ * pair and `general` 0: Pieper's quartic not taken). memo (or NULL): x-free parts
+ * kept between calls of one arm (PkFrontMemo); want: the position slots to solve
+ * where the position axes are coplanar (pk_coplanar; 15: all). */
+static int pk_front_memo(const double *P, const double *T, double x, const double *qn,
+                         int general, PkFrontMemo *memo, unsigned want, PkFront *f)
 {
     PkGeo *g = &f->g;
     pk_geometry(P, x, g);
@@ -1804,17 +1912,34 @@ static int pk_front(const double *P, const double *T, double x, const double *qn
     f->start = g->kase == PK_START;
     f->ia = f->start ? 3 : 0;
     f->it = f->start ? 0 : 3;
+    if (memo != NULL && !(f->start && (int)P[PK_HELD] == (int)P[PK_N] - 1))
+        memo = NULL; /* the remaining chain moves with x */
     PkEq e;
-    pk_pose_equations(g, &f->RT, f->pT, &f->G, &e);
+    v3 p, d;
+    pk_pose_points(g, &f->RT, f->pT, &f->G, &p, &d);
+    if (memo != NULL && memo->set)
+        e = memo->e;
+    else
+        pk_equations_d(g, f->ia, d, &e);
+    pk_equations_p(&e, p);
     int ia = f->ia, code;
     /* preferred chain angles of the position joints (when one is free) */
     double pref_a = P[PK_SIGN + g->full[ia]] * qn[g->full[ia]] + P[PK_OFFSET + g->full[ia]];
     double pref_c = P[PK_SIGN + g->full[ia + 2]] * qn[g->full[ia + 2]] +
                     P[PK_OFFSET + g->full[ia + 2]];
+    if (memo != NULL && !memo->set) {
+        memo->e = e;
+        memo->cop = fabs(e.mbc) <= PK_COPLANAR;
+        if (memo->cop)
+            pk_coplanar_x(&e, 0, &memo->k);
+        pk_tri_init(&memo->tri, g->h[f->it], g->h[f->it + 1], g->h[f->it + 2]);
+        memo->set = 1;
+    }
     if (fabs(e.mbc) <= PK_COPLANAR)
-        code = pk_coplanar(&e, 0, pref_a, pref_c, &f->pos);
+        code = pk_coplanar(&e, 0, memo != NULL ? &memo->k : NULL, pref_a, pref_c, want,
+                           &f->pos);
     else if (fabs(e.mab) <= PK_COPLANAR)
-        code = pk_coplanar(&e, 1, pref_a, pref_c, &f->pos);
+        code = pk_coplanar(&e, 1, NULL, pref_a, pref_c, want, &f->pos);
     else if (general)
         code = pk_general(&e, &f->pos);
     else
@@ -1827,9 +1952,18 @@ static int pk_front(const double *P, const double *T, double x, const double *qn
 #endif
     f->jx = g->full[f->it];
     f->jz = g->full[f->it + 2];
-    pk_tri_init(&f->tri, g->h[f->it], g->h[f->it + 1], g->h[f->it + 2]);
+    if (memo != NULL)
+        f->tri = memo->tri;
+    else
+        pk_tri_init(&f->tri, g->h[f->it], g->h[f->it + 1], g->h[f->it + 2]);
     f->exact_p = PK_EXACT * fmax(1.0, g->scale);
     return code;
+}
+
+static int pk_front(const double *P, const double *T, double x, const double *qn, int general,
+                    PkFront *f)
+{
+    return pk_front_memo(P, T, x, qn, general, NULL, 15u, f);
 }
 
 /* Position root i of the front: its angles into th (the position joints') and the
