@@ -527,9 +527,12 @@ SELF_MOTION = Group("self_motion.c", kernels=(
            checks=(Check("sm_params_ok(a->params)", "params is not a swivel parameter vector"),)),
     Kernel("swivel_manifold_one", (Arr("params", "f64", ("SM_N_PARAMS",)),
                                    Arr("T", "f64", (4, 4))),
-           "tuple[F64, I64, F64]", "``swivel_manifold`` of one pose T (4, 4), packed: new "
-                                   "arrays of its intervals (m, 2) branch by branch, their "
-                                   "branches (m,) and its points (p, 4). One thread.",
+           "tuple[F64, I64, F64, bool]", "``swivel_manifold`` of one pose T (4, 4), packed: "
+                                         "new arrays of its intervals (m, 2) branch by branch, "
+                                         "their branches (m,) and its points (p, 4); close: "
+                                         "two points of a branch within SM_PAIR, one within "
+                                         "it of +-pi or an interval at most SM_POINT long. "
+                                         "One thread.",
            checks=(Check("sm_params_ok(a->params)", "params is not a swivel parameter vector"),)),
     Kernel("swivel_near", (Arr("params", "f64", ("SM_N_PARAMS",)), Arr("T", "f64", POSE),
                            Arr("q_near", "f64", ("N", 7)), Arr("q", "f64", ("N", 7), out=True),
@@ -544,7 +547,8 @@ SELF_MOTION = Group("self_motion.c", kernels=(
 ), constants=_consts(
     "H O S W MR MT SIGN OFFSET LO HI REF TAG ARC LIMCS FOLDCS N_PARAMS MAXI MAXP KIND_LOWER "
     "KIND_UPPER "
-    "KIND_ALIGNED KIND_FOLD", "SM_", "SM_") + (Const("SM_TAG_VALUE", "SM_TAG_VALUE", "float"),),
+    "KIND_ALIGNED KIND_FOLD", "SM_", "SM_") + tuple(Const(c, c, "float") for c in (
+        "SM_TAG_VALUE", "SM_PAIR", "SM_POINT")),
     comment="swivel parameter vector layout (swivel.SwivelArm.packed), point kinds")
 
 REACH = Group("reach.c", kernels=(

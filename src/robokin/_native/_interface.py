@@ -255,6 +255,8 @@ class Kernels(Protocol):
     SM_KIND_ALIGNED: int
     SM_KIND_FOLD: int
     SM_TAG_VALUE: float
+    SM_PAIR: float
+    SM_POINT: float
     # held_manifold.c: held-joint manifold output sizes, point kinds and flags
     HM_MAXI: int
     HM_MAXP: int
@@ -698,8 +700,8 @@ class Kernels(Protocol):
     ) -> None:
         """Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,)."""
 
-    def swivel_manifold_one(self, params: F64, T: F64, /) -> tuple[F64, I64, F64]:
-        """``swivel_manifold`` of one pose T (4, 4), packed: new arrays of its intervals (m, 2) branch by branch, their branches (m,) and its points (p, 4). One thread."""
+    def swivel_manifold_one(self, params: F64, T: F64, /) -> tuple[F64, I64, F64, bool]:
+        """``swivel_manifold`` of one pose T (4, 4), packed: new arrays of its intervals (m, 2) branch by branch, their branches (m,) and its points (p, 4); close: two points of a branch within SM_PAIR, one within it of +-pi or an interval at most SM_POINT long. One thread."""
 
     def swivel_near(
         self,

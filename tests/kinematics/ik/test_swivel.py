@@ -342,11 +342,38 @@ def test_one_pose_entry_is_the_batch_kernel():
     T = _special_poses(60, 5)
     iv, niv, pts, npts = _manifold(ARM.params, T)
     for i in range(len(T)):
-        ivs, br, p = K.swivel_manifold_one(ARM.params, T[i])
+        ivs, br, p, _ = K.swivel_manifold_one(ARM.params, T[i])
         assert np.array_equal(br, np.repeat(np.arange(8), niv[i]))
         assert np.array_equal(ivs, np.concatenate([iv[i, b, :niv[i, b]] for b in range(8)]))
         assert np.array_equal(p, pts[i, :npts[i]])
         assert ivs.flags.owndata and p.flags.c_contiguous
+
+
+def test_close_flag_is_the_cheap_test_of_points_refined():
+    # Round 8d: swivel_manifold_one's close flag against the cheap test written out in
+    # numpy (keys psi + 64 branch sorted, adjacent ones within _PAIR; a psi within
+    # _PAIR of +-pi; an interval at most _POINT long). Where it is unset,
+    # _points_refined (which robot.self_motion then skips) returns the kernel's arrays
+    # themselves and no corner; both verdicts occur on these poses.
+    from robokin._native import kernels as K
+    from robokin.kinematics.ik.self_motion_families import _SwivelFamily
+    from robokin.kinematics.ik.self_motion_intervals import _POINT, _PAIR, _points_refined
+
+    T = _special_poses(150, 8)
+    seen = set()
+    for Ti in T:
+        ivs, br, p, close = K.swivel_manifold_one(ARM.params, Ti)
+        key = np.sort(p[:, 0] + 64.0 * p[:, 1])
+        ref = bool((np.diff(key) <= _PAIR).any() or (p[:, 0] <= -np.pi + _PAIR).any()
+                   or (p[:, 0] >= np.pi - _PAIR).any()
+                   or (ivs[:, 1] - ivs[:, 0] <= _POINT).any())
+        assert close is ref
+        seen.add(close)
+        if not close:
+            sw = _SwivelFamily(ARM, Ti, SRS)
+            iv2, br2, corners = _points_refined(sw, SRS.limits, ivs, br, p, K.SM_KIND_UPPER)
+            assert iv2 is ivs and br2 is br and corners == ()
+    assert seen == {False, True}
 
 
 def test_quick_tests_give_the_exact_verdicts():

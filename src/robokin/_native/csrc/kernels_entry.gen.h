@@ -329,6 +329,8 @@ static int add_constants(PyObject *m)
         {"PR_LIMIT_TOL", (double)(PR_LIMIT_TOL)},
         {"PC_EPS", (double)(PC_EPS)},
         {"SM_TAG_VALUE", (double)(SM_TAG_VALUE)},
+        {"SM_PAIR", (double)(SM_PAIR)},
+        {"SM_POINT", (double)(SM_POINT)},
         {"NC_RCOND", (double)(NC_RCOND)},
         {"NC_FINAL_RCOND", (double)(NC_FINAL_RCOND)},
         {"NC_MAX_STEP", (double)(NC_MAX_STEP)},

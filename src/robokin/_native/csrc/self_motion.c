@@ -68,6 +68,11 @@ enum {
 #define SM_ACCEPT 5e-13  /* pose errors above it after the polish: dropped */
 #define SM_SAME 1e-6     /* a branch's joint this near a value [rad]: at it */
 #define SM_GRAIN 16      /* poses per pool chunk */
+/* self_motion_intervals' _PAIR and _POINT (they read these): swivel_manifold_one's
+ * "close" flag is set when two points of a branch lie within SM_PAIR in psi, a point
+ * within it of an end of [-pi, pi], or an interval is at most SM_POINT long */
+#define SM_PAIR 1e-6
+#define SM_POINT 1e-12
 /* The quick tests (sm_quick_*): a cell's or a point's verdict from the cosines and
  * sines of its angles, without atan2 / acos, where it is certain; else the exact
  * test. The cosine-sine pairs stand for the exact path's angles to 1.1e-8 rad (the
@@ -1310,8 +1315,34 @@ static PyObject *swivel_manifold_body(const swivel_manifold_args *a)
     Py_RETURN_NONE;
 }
 
+/* self_motion_intervals._points_refined's cheap test, the same decision bit for bit:
+ * 1 when the sorted keys psi + 64 branch of the points pts (npts, 4) have two within
+ * SM_PAIR (64 branch is exact: one rounding, as numpy's dot), a point's psi is within
+ * SM_PAIR of -pi or pi, or an interval of iv (m, 2) is at most SM_POINT long */
+static int sm_close(const double *pts, long long npts, const double *iv, long long m)
+{
+    double key[SM_MAXP];
+    for (long long i = 0; i < m; i++)
+        if (iv[2 * i + 1] - iv[2 * i] <= SM_POINT)
+            return 1;
+    for (long long i = 0; i < npts; i++) {
+        double t = pts[4 * i], k = t + 64.0 * pts[4 * i + 1];
+        if (t <= -M_PI + SM_PAIR || t >= M_PI - SM_PAIR)
+            return 1;
+        long long j = i;  /* insertion sort: npts is at most SM_MAXP, ~10-40 */
+        for (; j > 0 && key[j - 1] > k; j--)
+            key[j] = key[j - 1];
+        key[j] = k;
+    }
+    for (long long i = 1; i < npts; i++)
+        if (key[i] - key[i - 1] <= SM_PAIR)
+            return 1;
+    return 0;
+}
+
 /* One pose (robot.self_motion's call): sm_manifold1, its intervals packed branch by
- * branch; returns new arrays (intervals (m, 2), branches (m,), points (p, 4)). */
+ * branch; returns new arrays (intervals (m, 2), branches (m,), points (p, 4)) and
+ * sm_close's flag (False: _points_refined has nothing to find). */
 static PyObject *swivel_manifold_one_body(const swivel_manifold_one_args *a)
 {
     double iv[8 * SM_MAXI * 2], pts[4 * SM_MAXP];
@@ -1341,7 +1372,8 @@ static PyObject *swivel_manifold_one_body(const swivel_manifold_one_args *a)
         }
     if (npts)
         memcpy(PyArray_DATA((PyArrayObject *)out_p), pts, (size_t)(4 * npts) * sizeof(double));
-    return Py_BuildValue("(NNN)", out_iv, out_b, out_p);
+    int close = sm_close(pts, npts, ov, m);
+    return Py_BuildValue("(NNNN)", out_iv, out_b, out_p, PyBool_FromLong(close));
 }
 
 /* ------------------------------------------------------------ the nearest point */

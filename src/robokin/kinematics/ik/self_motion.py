@@ -486,9 +486,11 @@ def _swivel_motion(arm: SwivelArm, T: np.ndarray, robot: Arm, limits: np.ndarray
     as the instance's ``__dict__`` ~1 us).
     """
     sw = _SwivelFamily(arm, T, robot)
-    intervals, owner, points = sw.exact()
-    intervals, owner, corners = _points_refined(sw, limits, intervals, owner, points,
-                                                K.SM_KIND_UPPER)
+    intervals, owner, points, close = arm.manifold_one(sw.T)
+    corners: tuple[tuple[float, int, np.ndarray], ...] = ()
+    if close:  # the kernel ran _points_refined's cheap test (Round 8d): a uniform pose skips it
+        intervals, owner, corners = _points_refined(sw, limits, intervals, owner, points,
+                                                    K.SM_KIND_UPPER)
     sm = object.__new__(SelfMotion)
     object.__setattr__(sm, "__dict__", {
         "T": T, "parameter": "swivel", "joint": None, "domain": _SWIVEL_DOMAIN.copy(),

@@ -81,7 +81,7 @@ class _SwivelFamily(_Family):
         The points are the kernel's rows ``[psi, branch, joint, kind]`` (kind
         ``SM_KIND_*``); ``self_motion._records_of`` makes them records when read.
         """
-        return self.arm.manifold_one(self.T)
+        return self.arm.manifold_one(self.T)[:3]
 
     def param_of(self, q: np.ndarray) -> float:
         return float(self.arm.swivel_of(self.fr, q))

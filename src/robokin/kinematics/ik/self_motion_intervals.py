@@ -405,7 +405,7 @@ def _held_records(points: np.ndarray) -> tuple[tuple[LimitCrossing, ...],
 
 #: Crossings of one branch this close [in t] (or to an end of the range) may be a
 #: graze or a corner: their rows are evaluated (``_points_refined``).
-_PAIR = 1e-6
+_PAIR = K.SM_PAIR  # 1e-6 (the swivel kernel's cheap test reads the same value)
 #: The sort key of points [t, branch, joint, kind]: t + 64 branch (64 wider than any
 #: parameter range); an interval's length (its end minus its start).
 _KEYS = np.array([1.0, 64.0, 0.0, 0.0])
@@ -419,7 +419,7 @@ _PROBES = 10.0 ** -np.arange(9, 2, -1)
 _WIDEN = 5
 _SPLIT = 3
 #: A listed interval at most this long is a point (a few ulps): widened as a graze.
-_POINT = 1e-12
+_POINT = K.SM_POINT  # 1e-12
 #: A corner's row out by at most this [rad] is refined on the pose's equations.
 _CONDITIONING = 1e-7
 
@@ -462,7 +462,9 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
 
     Returns ``(intervals, owner, corners)``; the arrays unchanged (the same objects)
     when nothing is found: a uniform pose computes no row here (its cost is the
-    test for short intervals and close points, ~5 us).
+    test for short intervals and close points, ~5 us; the compiled swivel's kernel
+    computes the same test, ``swivel_manifold_one``'s ``close`` flag, and calls this
+    only where it is set).
     """
     lo_d, hi_d = fam.domain
     # the cheap test first (a uniform pose ends here): no short interval, no two

@@ -273,14 +273,17 @@ class SwivelArm:
         K.swivel_manifold(self.params, T, iv, niv, pts, npts)
         return iv, niv, pts, npts
 
-    def manifold_one(self, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def manifold_one(self, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
         """:meth:`manifold` of one pose T (4, 4, contiguous float64), packed.
 
         Returns:
-            ``(intervals (m, 2), branch (m,), points (p, 4))``, new arrays: the
+            ``(intervals (m, 2), branch (m,), points (p, 4), close)``, new arrays: the
             intervals branch by branch (each branch's sorted), then the points, as
             :meth:`manifold` gives them (``robot.self_motion``'s call: no batch axes,
-            no per-call output arrays or masking).
+            no per-call output arrays or masking); ``close``: the decision of
+            ``self_motion_intervals._points_refined``'s cheap test (two points of a
+            branch within ``K.SM_PAIR`` in psi, one within it of +-pi, or an interval
+            at most ``K.SM_POINT`` long), computed in the kernel.
         """
         return K.swivel_manifold_one(self.params, T)
 
