@@ -357,7 +357,11 @@ def test_close_flag_is_the_cheap_test_of_points_refined():
     # themselves and no corner; both verdicts occur on these poses.
     from robokin._native import kernels as K
     from robokin.kinematics.ik.self_motion_families import _SwivelFamily
-    from robokin.kinematics.ik.self_motion_intervals import _POINT, _PAIR, _points_refined
+    from robokin.kinematics.ik.self_motion_intervals import (
+        _PAIR,
+        _POINT,
+        _points_refined,
+    )
 
     T = _special_poses(150, 8)
     seen = set()
