@@ -607,19 +607,25 @@ static int sm_quick_angle(const SmSplit *t, int k, int i, double *c, double *s)
     return 1;
 }
 
+/* The rotation triple `part` (1 the shoulder, 2 the wrist) of elbow root e must make
+ * at psi (sm_configs_part's) */
+static inline m3 sm_part_rotation(const SmFrame *f, int e, double psi, int part)
+{
+    m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
+    m3 RA = sm_mul(&Ru, &f->R0[e]);
+    if (part == 1)
+        return RA;
+    m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
+    return sm_mul(&X, &f->TR);
+}
+
 /* sm_part_split's quick twin (sm_split_quick) */
 static void sm_part_split_quick(const SmArm *a, const SmFrame *f, int e, double psi, int part,
                                 SmSplit *t)
 {
-    m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
-    m3 RA = sm_mul(&Ru, &f->R0[e]);
-    if (part == 1) {
-        sm_split_quick(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, t);
-        return;
-    }
-    m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
-    m3 RB = sm_mul(&X, &f->TR);
-    sm_split_quick(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, t);
+    m3 R = sm_part_rotation(f, e, psi, part);
+    int k = part == 1 ? 0 : 4;
+    sm_split_quick(a->h[k], a->h[k + 1], a->h[k + 2], a->perp[part - 1], &R, t);
 }
 
 /* The split of one triple (part 1 the shoulder, 2 the wrist) of elbow root e at
@@ -627,15 +633,9 @@ static void sm_part_split_quick(const SmArm *a, const SmFrame *f, int e, double 
 static void sm_part_split(const SmArm *a, const SmFrame *f, int e, double psi, int part,
                           SmSplit *t)
 {
-    m3 Ru = sm_rotm(f->u, psi - f->psi0[e]);
-    m3 RA = sm_mul(&Ru, &f->R0[e]);
-    if (part == 1) {
-        sm_split(a->h[0], a->h[1], a->h[2], a->perp[0], &RA, t);
-        return;
-    }
-    m3 RAR4 = sm_mul(&RA, &f->R4[e]), X = sm_tr(&RAR4);
-    m3 RB = sm_mul(&X, &f->TR);
-    sm_split(a->h[4], a->h[5], a->h[6], a->perp[1], &RB, t);
+    m3 R = sm_part_rotation(f, e, psi, part);
+    int k = part == 1 ? 0 : 4;
+    sm_split(a->h[k], a->h[k + 1], a->h[k + 2], a->perp[part - 1], &R, t);
 }
 
 /* Whether root i of a real split t of the triple from joint j0 has its three joints
