@@ -23,14 +23,10 @@ Run: ``python benchmarks/self_motion_api_ab.py /work/wt/main-ref /work/wt/mine``
 from __future__ import annotations
 
 import argparse
-import os
 import pathlib
-import pickle
-import subprocess
-import sys
 import tempfile
 
-import numpy as np
+from ab_trees import run_rounds, same
 
 CHILD = """
 import pickle, sys, time
@@ -146,16 +142,6 @@ print(f"kernel {{k:.1f}} us, self_motion {{a:.1f}} us, API adds {{a - k:.1f}} us
 """
 
 
-def same(x: object, y: object) -> bool:
-    """Exact equality of the saved fields (arrays: equal with NaN equal to NaN)."""
-    if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
-        xa, ya = np.asarray(x), np.asarray(y)
-        return xa.dtype == ya.dtype and xa.shape == ya.shape and bool(
-            np.array_equal(xa, ya, equal_nan=xa.dtype.kind == "f"))
-    if isinstance(x, dict) and isinstance(y, dict):
-        return x.keys() == y.keys() and all(same(x[k], y[k]) for k in x)
-    return type(x) is type(y) and bool(x == y)
-
 
 def main() -> None:
     """One timing line per tree and round, then the field-by-field comparison."""
@@ -168,21 +154,9 @@ def main() -> None:
     ap.add_argument("--timed", type=int, default=100)
     args = ap.parse_args()
     tmp = pathlib.Path(tempfile.mkdtemp())
-    print("load", pathlib.Path("/proc/loadavg").read_text().split()[:3])
-    for r in range(args.rounds):
-        for name, tree in zip("AB", args.trees, strict=True):
-            code = CHILD.format(n=args.n, ns=args.special, save=r == 0,
-                                out=str(tmp / f"{name}.pkl"), timed=args.timed,
-                                repeat=args.repeat)
-            env = dict(os.environ, PYTHONPATH=str(pathlib.Path(tree) / "src"))
-            res = subprocess.run([sys.executable, "-c", code], env=env, check=True,
-                                 capture_output=True, text=True)
-            print(f"round {r} {name} {tree}: {res.stdout.strip()}")
-    print("load", pathlib.Path("/proc/loadavg").read_text().split()[:3])
-    out = []
-    for name in "AB":
-        with open(tmp / f"{name}.pkl", "rb") as f:
-            out.append(pickle.load(f))
+    out = run_rounds(args.trees, args.rounds, tmp, lambda tree, r, out: CHILD.format(
+        n=args.n, ns=args.special, save=r == 0, out=str(out), timed=args.timed,
+        repeat=args.repeat))
     fields: dict[str, int] = {}
     for a, b in zip(*out, strict=True):
         for key in a:
