@@ -669,3 +669,58 @@ def test_a_corner_out_by_conditioning_is_refined(arm, q):
     lim = robot.limits
     at = (q0 == lim[:, 0]) | (q0 == lim[:, 1])
     assert at.sum() >= 2 and np.all((row[at] == lim[at, 0]) | (row[at] == lim[at, 1]))
+
+
+def _gen3_like():
+    """The Gen3-like arm of ``benchmarks/bench_self_motion.py`` (Kinova Gen3 DH table)."""
+    d = [-0.2848, -0.0118, -0.4208, -0.0128, -0.3143, 0.0, -0.1674]
+    lim = [180, 128.9, 180, 147.8, 180, 120.3, 180]
+    return robokin.Robot.from_dh([
+        {"a": 0.0, "alpha": np.pi if i == 6 else np.pi / 2, "d": d[i],
+         "theta": 0.0 if i == 0 else np.pi, "limits": [-np.radians(lim[i]), np.radians(lim[i])],
+         "name": f"joint_{i + 1}"} for i in range(7)], convention="standard")
+
+
+@pytest.mark.parametrize(("arm", "q", "most"), [
+    # uniform (benchmarks/self_motion_rates.py, seed 0, #0): Pieper's quartic at every
+    # value of joint_a3 (shoulder offset 0.44 mm): HM_FLAG_BAD before any row
+    ("iiwa_urdf", [0.8126758678905812, -0.9642253280714055, -2.7236794983721953,
+                   -2.0249756513523085, 1.8588202913187368, 1.7287854598700094,
+                   0.6513526455410878], 0),
+    # special (the same, #55): joint_3 = 1e-6, q6 at its lower limit; the held closed
+    # form's slots change order at joint_3 ~ 0 and +-pi (cells that never resolve):
+    # 221,343 full solves (4 s) before the pass stopped at its first flag
+    ("gen3_like", [2.0240474647302635, -0.48911926259533556, 1e-06, 1e-06, np.pi / 2,
+                   -2.0996310901491784, -1e-07], 1000),
+])
+def test_a_pose_the_kernel_cannot_certify_stops_at_its_first_flag(arm, q, most):
+    # Issue 29 (helper quartic29): a flagged pose's kernel output is discarded (the
+    # solved-points path answers), so the kernel stops at its first flag. Oracles: the
+    # kernel's own counts (full solves, no interval) and, through the API, the
+    # generating configuration sampled back on a branch at its parameter value and
+    # inside an interval of that branch.
+    from robokin._native import kernels as K
+    from robokin.kinematics.ik.self_motion import parameter_values
+    from robokin.kinematics.ik.self_motion_families import _setup
+    from robokin.kinematics.ik.self_motion_intervals import _compiled
+
+    robot = _arm("iiwa_urdf") if arm == "iiwa_urdf" else _gen3_like()
+    q0 = np.array(q)
+    T = robot.fk(q0)
+    sm = robot.self_motion(T)
+    kern = _setup(robot.arm).held
+    assert kern is not None and sm.info["compiled"] is False
+    intervals, owner, _, info = _compiled(kern, T)
+    assert info["flags"] != 0 and len(intervals) == len(owner) == 0
+    assert sm.info["flags"] == info["flags"]
+    assert info["solves"] <= most
+    if arm == "iiwa_urdf":
+        assert info["flags"] == K.HM_FLAG_BAD
+    _, t = parameter_values(robot, T, q0[None])
+    t0 = float(t[0])
+    rows = sm.sample(t0)
+    gap = np.abs((rows - q0 + np.pi) % (2 * np.pi) - np.pi).max(axis=-1)
+    b = int(np.nanargmin(gap))
+    assert gap[b] < 1e-6
+    iv = sm.intervals[sm.interval_branch == b]
+    assert np.any((iv[:, 0] - 1e-9 <= t0) & (t0 <= iv[:, 1] + 1e-9))

@@ -37,7 +37,12 @@
  * row next to an aligned triple is met (pk_one flags it singular: q1, q3 swing
  * there), a cell cannot be resolved within HM_DEPTH splits, a crossing does not
  * converge to HM_TOL, a branch vanishes inside a cell with rows at both ends, or
- * an output fills up.
+ * an output fills up; or before any row, when the held family is not of the Panda's
+ * kind (PK_BOTH) or its position equations are not of the coplanar kind at a grid
+ * value (HM_FLAG_BAD: Pieper's quartic, the rtb-data iiwa14 with joint_a3 held).
+ * The pass stops at its first flag (the caller discards a flagged pose; its niv are
+ * 0 and flags holds the first flag only): the work after it cost 44 ms per iiwa14
+ * pose and up to 7 s per special Gen3-like pose (issue 29, helper quartic29).
  */
 
 #define HM_MAXI 40      /* intervals per branch */
@@ -820,7 +825,7 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
                     double da, double de)
 {
     int j = c->qj[qi];
-    if (hm_shared(c, b, qi, a, fa, e))
+    if (c->flags || hm_shared(c, b, qi, a, fa, e))
         return;
     double best_t = fabs(fa) < fabs(fe) ? a : e, best_f = fmin(fabs(fa), fabs(fe));
     double t = a - fa * (e - a) / (fe - fa);
@@ -1188,6 +1193,8 @@ static void hm_graze(HmCtx *c, int b, int qi, const HmRow *r0, const HmRow *m, c
 
 static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
 {
+    if (c->flags)
+        return; /* flagged: the caller discards the pose (hm_pose) */
     if (hm_needs_split(c, b, r0, r1)) {
         if (depth < HM_DEPTH) {
             HmRow m;
@@ -1205,7 +1212,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
         c->flags |= HM_FLAG_UNRESOLVED;
     }
     double h = r1->t - r0->t;
-    for (int qi = 0; qi < c->nq; qi++) {
+    for (int qi = 0; qi < c->nq && !c->flags; qi++) {
         int j = c->qj[qi];
         double f0 = hm_f(c, r0, b, qi), f1 = f0 + wrap_pi(r1->q[b][j] - r0->q[b][j]);
         double d0 = r0->dq[b][j], d1 = r1->dq[b][j];
@@ -1240,6 +1247,8 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
  * (at the end) by its sign changes alone (regula falsi needs no slope). */
 static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
 {
+    if (c->flags)
+        return;
     HmRow r[HM_FOLD_STEPS + 1];
     int m = 0;
     double w = rn->t - re->t;
@@ -1394,6 +1403,8 @@ static int hm_fold_margin(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, HmR
  * when its existence agreed at both ends of the cell (and its rows confirm it). */
 static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1)
 {
+    if (c->flags)
+        return;
     double lo = r0->t, hi = r1->t, end = lo;
     int state0 = r0->valid[b], p = b ^ 1;
     HmRow chk, re;
@@ -1767,8 +1778,15 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
     for (long i = 0; i < G; i++) {
         nd[i].t = i == G - 1 ? hi : lo + (hi - lo) * (double)i / (double)(G - 1);
         nd[i].keep = i % HM_STRIDE == 0 || i == G - 1;
-        if (!hm_margins(c->P, c->T, nd[i].t, m[i]))
+        if (!hm_margins(c->P, c->T, nd[i].t, m[i])) {
+            /* not the coplanar kind (Pieper's quartic: the offset-SRS iiwa14): the pose
+             * is flagged whatever the rest finds, so stop here (the rows, cells and
+             * folds cost ~44 ms per such pose for an output the caller discards) */
             c->flags |= HM_FLAG_BAD;
+            free(m);
+            free(nd);
+            return 0;
+        }
     }
     nt = G;
     for (long i = 0; i + 1 < G; i++) {
@@ -1861,19 +1879,24 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
     }
     c->hfine = (hi - lo) / (double)(G - 1);
     G = hm_grid(c, G, lo, hi, tg, cap);
+    if (c->flags) {
+        free(rows);
+        free(tg);
+        return; /* flagged: no intervals (niv 0) */
+    }
     for (long i = 0; i < G; i++)
         hm_eval(c, tg[i], 0xffu, 0xffu, &rows[i]);
     free(tg);
     for (int b = 0; b < 8; b++)
         c->nfold[b] = 0;
-    for (int b = 0; b < 8; b++) {
+    for (int b = 0; b < 8 && !c->flags; b++) {
         c->ncut[b] = 0;
         c->ngraze[b] = 0;
         c->nseen[b] = 0;
         c->nat[b] = 0;
         if (!(b & 1))
             c->npair = c->ipair = 0; /* a new pair */
-        for (long i = 0; i < G; i++) {
+        for (long i = 0; i < G && !c->flags; i++) {
             if (rows[i].valid[b])
                 hm_node(c, b, &rows[i]);
             if (i + 1 == G)
@@ -1889,8 +1912,12 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
             else if (v0 != v1)
                 hm_fold(c, b, i, &rows[i], &rows[i + 1]);
         }
-        hm_intervals(c, b, lo, hi, rows, G, iv + 2 * HM_MAXI * b, niv + b);
+        if (!c->flags)
+            hm_intervals(c, b, lo, hi, rows, G, iv + 2 * HM_MAXI * b, niv + b);
     }
+    if (c->flags) /* a flagged pose stops at its first flag: no intervals */
+        for (int b = 0; b < 8; b++)
+            niv[b] = 0;
     free(rows);
 }
 
