@@ -43,9 +43,10 @@ DENSE = 20_000
 POSES = 16
 
 
-def _configurations(n: int, special: bool, seed: int) -> np.ndarray:
+def _configurations(n: int, special: bool, seed: int, limits: np.ndarray = LIMITS
+                    ) -> np.ndarray:
     rng = np.random.default_rng(seed)
-    lo, hi = LIMITS[:, 0], LIMITS[:, 1]
+    lo, hi = limits[:, 0], limits[:, 1]
     q = rng.uniform(lo, hi, (n, 7))
     if special:
         pick = rng.random((n, 7)) < 0.3
@@ -93,7 +94,7 @@ def _check_dense(sm) -> None:
         assert not bad.any(), (b, t[bad][:5], pieces.get(b))
 
 
-def _check_against_solved_points(robot, T, sm) -> None:
+def _check_against_solved_points(robot, T, sm, limits: np.ndarray = LIMITS) -> None:
     from robokin.kinematics.ik.dispatch import solve
     from robokin.kinematics.ik.self_motion import self_motion
 
@@ -117,31 +118,42 @@ def _check_against_solved_points(robot, T, sm) -> None:
         # (1e-14) decides nothing: its end is set by that rounding (a 7.5e-9 piece
         # where q6 is 1.000e-12 +- 5e-15 out along a branch with q5 = 1e-9)
         q_mid = sm.sample(mids[differ])[:, b]
-        margin = np.minimum(q_mid - LIMITS[:, 0], LIMITS[:, 1] - q_mid).min(-1)
+        margin = np.minimum(q_mid - limits[:, 0], limits[:, 1] - q_mid).min(-1)
         clear = np.abs(margin + MANIFOLD_SLACK) > 1e-14
         truth = sm.inside(mids[differ])[:, b]
         assert np.array_equal(truth[clear], in_mine[differ][clear]), (b, mids[differ], a_, b_)
 
 
-def _check_ends(robot, T, sm) -> None:
+def _slot_jumps(sm, t: float, b: int) -> bool:
+    """Whether branch b's rows jump by more than 1e-3 rad across one ulp of t at t."""
+    rows = sm.sample(np.array([np.nextafter(t, -np.inf), t, np.nextafter(t, np.inf)]))[:, b]
+    move = np.abs((np.diff(rows, axis=0) + np.pi) % (2 * np.pi) - np.pi).max(-1)
+    return bool(np.any(move > 1e-3))  # (a missing row on either side: NaN, no jump)
+
+
+def _check_ends(robot, T, sm, limits: np.ndarray = LIMITS, jumps: bool = False) -> None:
+    """``jumps``: an end where the branch's rows jump (another branch in its slot on
+    the other side, :func:`_slot_jumps`) needs no joint at a limit."""
     lo_d, hi_d = sm.domain
     folds = {(p.t, p.branch) for p in sm.singular if p.kind == "fold"}
     for (a, e), b in zip(sm.intervals, sm.interval_branch, strict=True):
         for end in (a, e):
             if end in (lo_d, hi_d):
                 continue  # the range's end (a branch may end exactly there: no row)
+            if jumps and _slot_jumps(sm, end, b):
+                continue
             q = sm.sample(end)[b]
             assert np.isfinite(q).all(), (end, b)
             dp, dr = pose_errors(robot.fk(q), T)
             assert dp <= 1e-12 and dr <= 1e-12, (end, b, dp, dr)
             if (end, b) in folds:
                 continue
-            gap = np.minimum(np.abs(q - LIMITS[:, 0]), np.abs(q - LIMITS[:, 1])).min()
+            gap = np.minimum(np.abs(q - limits[:, 0]), np.abs(q - limits[:, 1])).min()
             assert gap <= 1e-9, (end, b, gap)
             crossing = [c for c in sm.crossings if c.branch == b and c.t == end]
             assert crossing, (end, b)
             j = crossing[0].joint
-            value = LIMITS[j, 0 if crossing[0].limit == "lower" else 1]
+            value = limits[j, 0 if crossing[0].limit == "lower" else 1]
             # 1e-12 at 988 of 1,000 random poses, the rest within 5.2e-11: the held-q7
             # row's joint is only as exact as its Jacobian's conditioning allows
             # (next to a fold or an aligned shoulder); steeper, the last bit of t
@@ -724,3 +736,35 @@ def test_a_pose_the_kernel_cannot_certify_stops_at_its_first_flag(arm, q, most):
     assert gap[b] < 1e-6
     iv = sm.intervals[sm.interval_branch == b]
     assert np.any((iv[:, 0] - 1e-9 <= t0) & (t0 <= iv[:, 1] + 1e-9))
+
+
+@pytest.mark.parametrize("special", [False, True], ids=["random", "special"])
+def test_gen3_like_manifold_is_compiled_across_slot_changes(special):
+    # Issue 29 (helper quartic29): the Gen3-like arm with joint_3 held. Its held closed
+    # form numbers the rows differently on either side of joint_3 ~ +-2.9e-13 and
+    # +-(pi - 2.9e-13) (the solver's case changes there): a slot's row jumps to another
+    # branch, which the kernel flagged on every pose (a cell unresolved at HM_DEPTH:
+    # the solved-points path answered, 17-28 ms per uniform pose). hm_jump makes such a
+    # value a cut of the slot (bisected to adjacent doubles). Oracles as for the Panda:
+    # the rows at 20,000 values (_check_dense), the solved-points path, every interval
+    # end at a limit (1e-10) or a fold, or at a slot change (the branch's rows jump by
+    # more than 1e-3 across one ulp of t: _slot_jumps).
+    robot = _gen3_like()
+    lim = robot.limits
+    qs = _configurations(POSES, special, 4029 if special else 2029, lim)
+    compiled = jumps = 0
+    for q in qs:
+        T = robot.fk(q)
+        sm = robot.self_motion(T)
+        if not sm.info.get("compiled", False):
+            continue
+        compiled += 1
+        assert sm.info["flags"] == 0
+        _check_dense(sm)
+        _check_against_solved_points(robot, T, sm, lim)
+        _check_ends(robot, T, sm, lim, jumps=True)
+        jumps += sum(_slot_jumps(sm, e, b) for (_, e), b in
+                     zip(sm.intervals.tolist(), sm.interval_branch.tolist(), strict=True)
+                     if e < sm.domain[1])
+    assert compiled >= (POSES // 2 if special else POSES * 3 // 4), compiled
+    assert jumps >= compiled  # every compiled pose has a branch ending at a slot change

@@ -24,8 +24,15 @@
  *      (or HM_DISC_TWO for the pair's second root), by Brent's method on the
  *      margins (no rows), confirmed by two rows; else searched on the row's
  *      existence to HM_FOLD_TOL;
- *   4. per slot, the pieces between domain ends, limit crossings and folds are
- *      decided at their midpoints (a row inside every limit) and joined.
+ *   4. per slot, the pieces between domain ends, limit crossings, folds and slot
+ *      changes are decided at their midpoints (a row inside every limit) and joined.
+ *
+ * A slot change: where the held closed form numbers its rows differently on either
+ * side of a value (the Gen3-like arm, joint_3 held: at ~ +-2.9e-13 and +-(pi - 2.9e-13)
+ * its solver's case changes), a slot holds one branch on one side and another on the
+ * other; the cell there is split to HM_DEPTH and its jump bisected to adjacent doubles
+ * (hm_jump): a cut of that slot, no point (the solved-points path ends its intervals
+ * there too: its rows are the same).
  *
  * Every row is pk_one's: hm_closed evaluates its closed form for the slots asked
  * for, with pk_one's polish and its repairs of those rows, and hands over to
@@ -35,7 +42,9 @@
  *
  * A pose is flagged (flags != 0: the caller takes the solved-points path) when a
  * row next to an aligned triple is met (pk_one flags it singular: q1, q3 swing
- * there), a cell cannot be resolved within HM_DEPTH splits, a crossing does not
+ * there; on a pose with slot changes, a limit crossing or fold within
+ * HM_ALIGNED_NEAR of an aligned-axes point of its branch: HM_FLAG_SINGULAR), a cell
+ * cannot be resolved within HM_DEPTH splits (nor is a slot change), a crossing does not
  * converge to HM_TOL, a branch vanishes inside a cell with rows at both ends, or
  * an output fills up; or before any row, when the held family is not of the Panda's
  * kind (PK_BOTH) or its position equations are not of the coplanar kind at a grid
@@ -60,6 +69,9 @@
 #define HM_FOLD_STEPS 6 /* rows between a branch end and its grid row */
 #define HM_PARALLEL_MIN 8
 #define HM_DECIDE 1e-9 /* a grid row this far inside / outside decides its piece [rad] */
+#define HM_SLOT_JUMP 1e-3 /* a slot's row moving more in one ulp of t: another branch [rad] */
+#define HM_ALIGNED_NEAR 1e-4 /* a pose with slot jumps: a limit crossing or fold this close
+                              * to an aligned-axes point of its branch is not certified */
 #ifndef HM_SLOPE_DET
 #define HM_SLOPE_DET 1e-10 /* hm_slopes_fast: a block's determinant per unit columns below it: hm_slopes */
 #endif
@@ -129,6 +141,7 @@ typedef struct {
      * of exponentials is G = T M^-1 (GA, Gt); per t (ft), the first six joints'
      * B5, b5 = G E_held(t)^-1; the held joint's columns at fc (u6, w6) */
     int fast, full_fk; /* full_fk: hm_slopes wanted (the fold search) */
+    int jumped; /* a slot's rows jump somewhere (hm_jump): the pose gets hm_near_aligned's test */
     v3 fc, Gt, u6, w6, b5;
     m3 GA, B5;
     double ft;
@@ -1191,6 +1204,59 @@ static void hm_graze(HmCtx *c, int b, int qi, const HmRow *r0, const HmRow *m, c
     c->ngraze[b]++;
 }
 
+/* The largest 2 pi wrapped move of a joint of slot b between rows r0 and r1 */
+static double hm_move(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1)
+{
+    double big = 0.0;
+    for (int j = 0; j < c->n; j++)
+        big = fmax(big, fabs(wrap_pi(r1->q[b][j] - r0->q[b][j])));
+    return big;
+}
+
+/* A cell of slot b still to be split at HM_DEPTH: where the held closed form numbers
+ * its rows differently on either side of a value (the Gen3-like arm with joint_3 held
+ * at ~ +-2.9e-13 and +-(pi - 2.9e-13): the solver's case changes there, its slots
+ * permuted), slot b is another branch on each side. The largest move is bisected to
+ * adjacent doubles (ta, tb); when slot b's row still moves by more than HM_SLOT_JUMP
+ * there (a continuous branch moves by its slope times one ulp: 4e-7 at a slope of
+ * 1e9, next to an aligned triple) and exists on both sides, tb is a cut of slot b
+ * (never a one-point interval: hm_at marks its row not inside) and the two sides are
+ * cells of their own. 0 (nothing done) when the move is continuous at the last bit
+ * or a row is missing. */
+static int hm_jump(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
+{
+    HmRow ra = *r0, rb = *r1, m;
+    for (int it = 0; it < 80; it++) {
+        double mid = 0.5 * (ra.t + rb.t);
+        if (!(mid > ra.t && mid < rb.t))
+            break;
+        hm_eval(c, mid, 1u << b, 0xffu, &m);
+        if (!m.valid[b])
+            return 0;
+        if (hm_move(c, b, &ra, &m) >= hm_move(c, b, &m, &rb))
+            rb = m;
+        else
+            ra = m;
+    }
+    if (!(nextafter(ra.t, rb.t) == rb.t) || !(hm_move(c, b, &ra, &rb) > HM_SLOT_JUMP) ||
+        !isfinite(ra.dq[b][0]) || !isfinite(rb.dq[b][0]))
+        return 0;
+    if (c->ncut[b] >= HM_MAXCUT) {
+        c->flags |= HM_FLAG_FULL;
+        return 1;
+    }
+    c->cut[b][c->ncut[b]++] = rb.t;
+    c->jumped = 1;
+    hm_at(c, b, rb.t, 0);
+    hm_seen(c, b, &ra);
+    hm_seen(c, b, &rb);
+    hm_node(c, b, &ra);
+    hm_node(c, b, &rb);
+    hm_cell(c, b, r0, &ra, depth);
+    hm_cell(c, b, &rb, r1, depth);
+    return 1;
+}
+
 static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
 {
     if (c->flags)
@@ -1209,6 +1275,8 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
             hm_cell(c, b, &m, r1, depth + 1);
             return;
         }
+        if (hm_jump(c, b, r0, r1, depth))
+            return;
         c->flags |= HM_FLAG_UNRESOLVED;
     }
     double h = r1->t - r0->t;
@@ -1861,6 +1929,28 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
     return kept;
 }
 
+/* Whether a limit crossing or a fold of a branch lies within HM_ALIGNED_NEAR of an
+ * aligned-axes point of that branch. Asked only on poses with slot jumps (the
+ * Gen3-like arm, whose poses the kernel certifies since hm_jump): next to its aligned
+ * shoulder (q2 = 0) the rows are conditioned so that a joint can sit within the
+ * slack of its limit over 1e-5 of t, or cross it within 1e-9 of the aligned point,
+ * where the pieces' midpoint verdicts and the solved-points path differ by more than
+ * 1e-9 (3 of 288 certified special poses, seed 0, before this test). */
+static int hm_near_aligned(const HmCtx *c)
+{
+    for (long i = 0; i < c->npts; i++) {
+        const double *a = c->pts + 4 * i;
+        if (a[3] != HM_KIND_ALIGNED)
+            continue;
+        for (long k = 0; k < c->npts; k++) {
+            const double *p = c->pts + 4 * k;
+            if (p[3] != HM_KIND_ALIGNED && p[1] == a[1] && fabs(p[0] - a[0]) < HM_ALIGNED_NEAR)
+                return 1;
+        }
+    }
+    return 0;
+}
+
 /* One pose: grid rows, cells, folds, intervals. */
 static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
 {
@@ -1915,6 +2005,8 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
         if (!c->flags)
             hm_intervals(c, b, lo, hi, rows, G, iv + 2 * HM_MAXI * b, niv + b);
     }
+    if (!c->flags && c->jumped && hm_near_aligned(c))
+        c->flags |= HM_FLAG_SINGULAR;
     if (c->flags) /* a flagged pose stops at its first flag: no intervals */
         for (int b = 0; b < 8; b++)
             niv[b] = 0;
@@ -1981,6 +2073,7 @@ static void hm_range(void *ctx, long b0, long e0)
         c->front.set = 0;
         c->fast = hm_fast_setup(c);
         c->full_fk = 0;
+        c->jumped = 0;
         if (P[PK_CASE] == PK_BOTH || c->k < 0 || c->n != 7)
             c->flags |= HM_FLAG_BAD; /* not a Panda-type held family */
         else
