@@ -70,6 +70,7 @@
 #define HM_PARALLEL_MIN 8
 #define HM_DECIDE 1e-9 /* a grid row this far inside / outside decides its piece [rad] */
 #define HM_SLOT_JUMP 1e-3 /* a slot's row moving more in one ulp of t: another branch [rad] */
+#define HM_MAXJUMP 16 /* slot changes remembered per pose (hm_jump) */
 #define HM_ALIGNED_NEAR 1e-4 /* a pose with slot jumps: a limit crossing or fold this close
                               * to an aligned-axes point of its branch is not certified */
 #ifndef HM_SLOPE_DET
@@ -142,6 +143,9 @@ typedef struct {
      * B5, b5 = G E_held(t)^-1; the held joint's columns at fc (u6, w6) */
     int fast, full_fk; /* full_fk: hm_slopes wanted (the fold search) */
     int jumped; /* a slot's rows jump somewhere (hm_jump): the pose gets hm_near_aligned's test */
+    int retry; /* a new slot change found by hm_root: the slot's pass is redone */
+    double jump_t[HM_MAXJUMP][2]; /* the slot changes found (adjacent doubles), for every slot */
+    int njump;
     v3 fc, Gt, u6, w6, b5;
     m3 GA, B5;
     double ft;
@@ -773,6 +777,7 @@ static double hm_hermite_root(double f0, double f1, double d0, double d1)
 
 static void hm_seen(HmCtx *c, int b, const HmRow *r);
 static int hm_inside(const HmCtx *c, const HmRow *r, int b, double slack);
+static int hm_bisect_jump(HmCtx *c, int b, HmRow *ra, HmRow *rb);
 
 /* Slot b's row at cut t is inside (with MANIFOLD_SLACK) or not: kept from the row the
  * cut was found on, so that hm_intervals' [t, t] rule needs no row there (round 8b) */
@@ -838,7 +843,7 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
                     double da, double de)
 {
     int j = c->qj[qi];
-    if (c->flags || hm_shared(c, b, qi, a, fa, e))
+    if (c->flags || c->retry || hm_shared(c, b, qi, a, fa, e))
         return;
     double best_t = fabs(fa) < fabs(fe) ? a : e, best_f = fmin(fabs(fa), fabs(fe));
     double t = a - fa * (e - a) / (fe - fa);
@@ -891,6 +896,16 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
      * with its bracket two adjacent floats: the value nearest the joint's there */
     int collapsed = !(e - a > 2.0 * DBL_EPSILON * fmax(fabs(a), fabs(e)));
     if (!(best_f <= HM_TOL) && !(collapsed && best_f <= HM_TOL_STEEP)) {
+        if (collapsed && c->njump < HM_MAXJUMP) { /* a slot change, not a crossing? */
+            HmRow ra, rb;
+            hm_eval(c, a, 1u << b, 0xffu, &ra);
+            hm_eval(c, e, 1u << b, 0xffu, &rb);
+            int n0 = c->njump;
+            if (ra.valid[b] && rb.valid[b] && hm_bisect_jump(c, b, &ra, &rb) && c->njump > n0) {
+                c->retry = 1; /* a new one: the slot's pass is redone with it (hm_pose) */
+                return;
+            }
+        }
         c->flags |= HM_FLAG_CONVERGE;
     }
     int kind = c->qkind[qi];
@@ -1222,45 +1237,99 @@ static double hm_move(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1)
  * 1e9, next to an aligned triple) and exists on both sides, tb is a cut of slot b
  * (never a one-point interval: hm_at marks its row not inside) and the two sides are
  * cells of their own. 0 (nothing done) when the move is continuous at the last bit
- * or a row is missing. */
-static int hm_jump(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
+ * or a row is missing. A change found before (by another slot: the solver's case
+ * changes at one value for every slot) is taken where the slot jumps there too
+ * (hm_known_jump, at every cell before its split test: one bisection per pose and
+ * value, not per slot); a change inside a cell that needs no split (its end rows
+ * look like one crossing: q4 mirrored) shows as a crossing whose bracket collapses
+ * on a jump (hm_root): it is recorded and the slot's pass redone (hm_pose). */
+/* Bisects slot b's largest move between rows *ra < *rb (slopes of b in both) down to
+ * adjacent doubles; 1 when the slot's row still moves by more than HM_SLOT_JUMP there
+ * (a slot change; recorded in jump_t for the other slots), 0 when it is continuous at
+ * the last bit or a row is missing. */
+static int hm_bisect_jump(HmCtx *c, int b, HmRow *ra, HmRow *rb)
 {
-    HmRow ra = *r0, rb = *r1, m;
+    HmRow m;
     for (int it = 0; it < 80; it++) {
-        double mid = 0.5 * (ra.t + rb.t);
-        if (!(mid > ra.t && mid < rb.t))
+        double mid = 0.5 * (ra->t + rb->t);
+        if (!(mid > ra->t && mid < rb->t))
             break;
         hm_eval(c, mid, 1u << b, 0xffu, &m);
         if (!m.valid[b])
             return 0;
-        if (hm_move(c, b, &ra, &m) >= hm_move(c, b, &m, &rb))
-            rb = m;
+        if (hm_move(c, b, ra, &m) >= hm_move(c, b, &m, rb))
+            *rb = m;
         else
-            ra = m;
+            *ra = m;
     }
-    if (!(nextafter(ra.t, rb.t) == rb.t) || !(hm_move(c, b, &ra, &rb) > HM_SLOT_JUMP) ||
-        !isfinite(ra.dq[b][0]) || !isfinite(rb.dq[b][0]))
+    if (!(nextafter(ra->t, rb->t) == rb->t) || !(hm_move(c, b, ra, rb) > HM_SLOT_JUMP) ||
+        !isfinite(ra->dq[b][0]) || !isfinite(rb->dq[b][0]))
+        return 0;
+    int known = 0;
+    for (int k = 0; k < c->njump && !known; k++)
+        known = c->jump_t[k][1] == rb->t;
+    if (!known && c->njump < HM_MAXJUMP) {
+        c->jump_t[c->njump][0] = ra->t;
+        c->jump_t[c->njump++][1] = rb->t;
+    }
+    return 1;
+}
+
+/* Slot b's cell [r0, r1] with a slot change between its rows ra, rb (adjacent doubles
+ * inside it): tb is a cut (no point; hm_at: not a one-point interval), the two sides
+ * are cells of their own. 0 (nothing done) when slot b does not jump there. */
+static int hm_split_jump(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, const HmRow *ra,
+                         const HmRow *rb, int depth)
+{
+    if (!ra->valid[b] || !rb->valid[b] || !(nextafter(ra->t, rb->t) == rb->t) ||
+        !(hm_move(c, b, ra, rb) > HM_SLOT_JUMP) || !isfinite(ra->dq[b][0]) ||
+        !isfinite(rb->dq[b][0]))
         return 0;
     if (c->ncut[b] >= HM_MAXCUT) {
         c->flags |= HM_FLAG_FULL;
         return 1;
     }
-    c->cut[b][c->ncut[b]++] = rb.t;
+    c->cut[b][c->ncut[b]++] = rb->t;
     c->jumped = 1;
-    hm_at(c, b, rb.t, 0);
-    hm_seen(c, b, &ra);
-    hm_seen(c, b, &rb);
-    hm_node(c, b, &ra);
-    hm_node(c, b, &rb);
-    hm_cell(c, b, r0, &ra, depth);
-    hm_cell(c, b, &rb, r1, depth);
+    hm_at(c, b, rb->t, 0);
+    hm_seen(c, b, ra);
+    hm_seen(c, b, rb);
+    hm_node(c, b, ra);
+    hm_node(c, b, rb);
+    hm_cell(c, b, r0, ra, depth);
+    hm_cell(c, b, rb, r1, depth);
     return 1;
+}
+
+/* A slot change another slot (or an earlier pass) found strictly inside the cell
+ * [r0, r1] where slot b jumps too: the cell split there (hm_split_jump); 1 when done. */
+static int hm_known_jump(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
+{
+    HmRow ra, rb;
+    for (int k = 0; k < c->njump; k++) {
+        double ta = c->jump_t[k][0], tb = c->jump_t[k][1];
+        if (!(ta >= r0->t && tb <= r1->t) || (ta == r0->t && tb == r1->t))
+            continue;
+        hm_eval(c, ta, 1u << b, 0xffu, &ra);
+        hm_eval(c, tb, 1u << b, 0xffu, &rb);
+        if (hm_split_jump(c, b, r0, r1, &ra, &rb, depth))
+            return 1;
+    }
+    return 0;
+}
+
+static int hm_jump(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
+{
+    HmRow ra = *r0, rb = *r1;
+    return hm_bisect_jump(c, b, &ra, &rb) && hm_split_jump(c, b, r0, r1, &ra, &rb, depth);
 }
 
 static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
 {
-    if (c->flags)
-        return; /* flagged: the caller discards the pose (hm_pose) */
+    if (c->flags || c->retry)
+        return; /* flagged: the caller discards the pose; retry: the slot is redone (hm_pose) */
+    if (c->njump && hm_known_jump(c, b, r0, r1, depth))
+        return;
     if (hm_needs_split(c, b, r0, r1)) {
         if (depth < HM_DEPTH) {
             HmRow m;
@@ -1980,13 +2049,20 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
     for (int b = 0; b < 8; b++)
         c->nfold[b] = 0;
     for (int b = 0; b < 8 && !c->flags; b++) {
+        long npts0 = c->npts;
+        int nfold0[8], passes = 0;
+        memcpy(nfold0, c->nfold, sizeof nfold0);
+        if (!(b & 1))
+            c->npair = c->ipair = 0; /* a new pair */
+    again: /* (a slot change found by hm_root: the slot's pass again, with it known) */
+        c->retry = 0;
+        c->npts = npts0;
+        memcpy(c->nfold, nfold0, sizeof nfold0);
         c->ncut[b] = 0;
         c->ngraze[b] = 0;
         c->nseen[b] = 0;
         c->nat[b] = 0;
-        if (!(b & 1))
-            c->npair = c->ipair = 0; /* a new pair */
-        for (long i = 0; i < G && !c->flags; i++) {
+        for (long i = 0; i < G && !c->flags && !c->retry; i++) {
             if (rows[i].valid[b])
                 hm_node(c, b, &rows[i]);
             if (i + 1 == G)
@@ -2002,6 +2078,10 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
             else if (v0 != v1)
                 hm_fold(c, b, i, &rows[i], &rows[i + 1]);
         }
+        if (c->retry && ++passes < 4)
+            goto again;
+        if (c->retry)
+            c->flags |= HM_FLAG_CONVERGE;
         if (!c->flags)
             hm_intervals(c, b, lo, hi, rows, G, iv + 2 * HM_MAXI * b, niv + b);
     }
@@ -2074,6 +2154,8 @@ static void hm_range(void *ctx, long b0, long e0)
         c->fast = hm_fast_setup(c);
         c->full_fk = 0;
         c->jumped = 0;
+        c->njump = 0;
+        c->retry = 0;
         if (P[PK_CASE] == PK_BOTH || c->k < 0 || c->n != 7)
             c->flags |= HM_FLAG_BAD; /* not a Panda-type held family */
         else
