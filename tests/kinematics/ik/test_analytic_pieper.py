@@ -115,3 +115,56 @@ def test_bad_poses_and_values_take_the_checked_path():
         panda.ik(T, fixed={"joint7": float("nan")})
     with pytest.raises(InputError):
         panda.ik(T.astype(np.float32), fixed={"joint7": True})
+
+
+def _rtb_iiwa14() -> robokin.Robot:
+    """The rtb-data iiwa14 URDF (shoulder offset 0.44 mm; skipped without rtbdata)."""
+    rtbdata = pytest.importorskip("rtbdata")
+    from pathlib import Path
+
+    urdf = (Path(rtbdata.__file__).parent
+            / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf")
+    return robokin.Robot.from_urdf(str(urdf), geometry=False)
+
+
+def test_held_slots_continue_through_an_incidental_coplanar_value():
+    # Issue 29 (helper slots29): with joint_a3 held, axes 2 and 4 of the rtb-data
+    # iiwa14 are parallel at joint_a3 = 0 only (mutual moment 0.32 * joint_a3), where
+    # the front took the coplanar solver, which numbers its roots otherwise than the
+    # quartic at every other value: at 0 each slot held another configuration.
+    # benchmarks/self_motion_rates.py seed 0, #5180. Oracles: FK, and the rows either
+    # side (the quartic's), slot for slot.
+    robot = _rtb_iiwa14()
+    q0 = np.array([0.9189737939132052, 1.5707963267948966, 1e-09, -1.3206728674132546,
+                   -1.4343752253433877, -1.5707963267948966, -3.0541])
+    T = robot.fk(q0)
+    x = np.array([-1e-12, 0.0, 1e-12])
+    sols = robot.ik(np.broadcast_to(T, (3, 4, 4)), fixed={"joint_a3": x})
+    assert sols.valid.all()
+    dp, dr = pose_errors(robot.fk(sols.q), np.broadcast_to(T, (3, 8, 4, 4)))
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+    assert np.abs(sols.q[1] - sols.q[0]).max() < 1e-9
+    assert np.abs(sols.q[1] - sols.q[2]).max() < 1e-9
+    q_at = q0.copy()
+    q_at[2] = 0.0  # q0 moved along its branch by 1e-9 of joint_a3: within 1e-8
+    assert np.abs(sols.q[1] - q_at).max(axis=-1).min() < 1e-8
+
+
+def test_held_slots_keep_a_root_at_the_quartics_shift():
+    # Issue 29 (helper slots29): the elbow stretched (q4 = 0, a near-double root of
+    # the quartic in q4) sits at the shift the roots were numbered from; rounding put
+    # it at +-1e-11 and its rows changed slots from one value of joint_a3 to the next
+    # (1e-9 apart). Numbered from the shift + pi (where |f| is the largest sample) the
+    # slot of q0's branch is the same at every value. Seed 0, #5113.
+    robot = _rtb_iiwa14()
+    q0 = np.array([2.5356556953167813, -2.0942, -1e-07, 0.0, -1.160102486027724, -2.0942,
+                   -3.0398026574264643])
+    T = robot.fk(q0)
+    x = q0[2] + 1e-9 * np.arange(-5, 6)
+    sols = robot.ik(np.broadcast_to(T, (len(x), 4, 4)), fixed={"joint_a3": x})
+    gap = np.where(sols.valid, np.abs(sols.q - q0).max(axis=-1), np.inf)
+    assert gap.min(axis=-1).max() < 1e-7
+    assert len(set(np.argmin(gap, axis=-1).tolist())) == 1
+    ok = sols.valid
+    dp, dr = pose_errors(robot.fk(sols.q[ok]), np.broadcast_to(T, (int(ok.sum()), 4, 4)))
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12

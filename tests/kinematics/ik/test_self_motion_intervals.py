@@ -768,3 +768,62 @@ def test_gen3_like_manifold_is_compiled_across_slot_changes(special):
                      if e < sm.domain[1])
     assert compiled >= (POSES // 2 if special else POSES * 3 // 4), compiled
     assert jumps >= compiled  # every compiled pose has a branch ending at a slot change
+
+
+@pytest.mark.parametrize("q", [
+    # joint_a3 = 1e-9, joint_a7 at its limit (#5180): main's slots permuted at 0
+    [0.9189737939132052, 1.5707963267948966, 1e-09, -1.3206728674132546, -1.4343752253433877,
+     -1.5707963267948966, -3.0541],
+    # joint_a3 = -1e-9, joint_a4 at its limit (#5418)
+    [-1.2484800700176908, -0.5391421927631079, -1e-09, 2.0942, -1.5707963267948966,
+     0.7029587255470418, 1.37596811143435],
+    # joint_a3 = -1e-6 (#5274)
+    [1.3925371213272504, -1.5707963267948966, -1e-06, 1.706444643717702,
+     -0.13038838076810721, -1.8111995304313988, 2.7019651973277528],
+    # joint_a3 = 1e-6, three joints at limits (#5491; inside on main too)
+    [2.9668, -1.2453652507590354, 1e-06, 0.42106023970779205, 0.022614894627366766, -2.0942,
+     -3.0541],
+    # joint_a3 = 0, four joints at limits (#5664; inside on main too)
+    [2.9668, 1.5707963267948966, 0.0, -2.0942, -2.297919074755646, -1.4345655231593617,
+     -3.0541],
+    # joint_a3 = 0, joint_a1 and joint_a6 at limits, the elbow stretched (#5045; main
+    # had it in a 6e-13 piece of its permuted slots): the joint_a6 crossing is not
+    # found (its held solve is singular there), the joint_a1 crossing's row is
+    # inside: the point [t, t]
+    [-2.9668, -0.6206623502740818, 0.0, 1e-09, 0.0, 2.0942, -0.13077792964783663],
+    # joint_a3 = -1e-7, the elbow stretched (q4 = 0: a root at the quartic's shift;
+    # #5113)
+    [2.5356556953167813, -2.0942, -1e-07, 0.0, -1.160102486027724, -2.0942,
+     -3.0398026574264643],
+    # joint_a3 = -1e-6, joint_a4 at its limit moving 1e-6 rad per rad: the crossing
+    # computed 4.3e-8 from q's value, the row inside by the slack there (#5942)
+    [-0.3660579026247319, 0.7369870768969919, -1e-06, 2.0942, 1.5707963267948966,
+     -0.9761727588161644, 1e-07],
+    # joint_a6 at its limit moving 1.2e-4 per rad with the elbow stretched: its exact
+    # crossing 1.3e-9 after q's value, the row at q's value 6e-13 out (#5589)
+    [-0.5263184563496726, -1.9341124725958816, 1.5707963267948966, 1e-09,
+     -0.2279383021735235, 2.0942, 2.9169289971631773],
+    # joint_a3 at its range's end, joint_a7 at its limit, the elbow stretched: the
+    # row there 3e-12 out, no joint_a7 crossing found (#5778)
+    [-1.5707963267948966, 1.5707963267948966, -2.9668, 1e-09, -1.5707963267948966,
+     1.5034983583572687, 3.0541],
+])
+def test_the_iiwa_parameter_next_to_zero_keeps_q_in_an_interval_of_its_branch(q):
+    # Issue 29 (helper slots29): the rtb-data iiwa14 (joint_a3 held, the solved-points
+    # path), regular special configurations of benchmarks/self_motion_rates.py (seed 0,
+    # the index in its 10,000 given) that main (0518b33) had in no interval of their
+    # branch, all but the three marked. Oracles: the closed-form rows (sm.sample) and FK:
+    # q's branch holds q at its value, that value lies in an interval of the branch
+    # (1e-9), and every row sampled about it reproduces the pose to 1e-12.
+    robot = _arm("iiwa")
+    q0 = np.array(q)
+    sm, t, b = _generating(robot, q0)
+    iv = sm.intervals[sm.interval_branch == b]
+    assert np.any((iv[:, 0] - 1e-9 <= t) & (t <= iv[:, 1] + 1e-9)), (t, iv)
+    d = np.array([-1e-6, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-6])
+    ts = np.unique(np.clip(np.concatenate([t + d, [0.0]]), *sm.domain))
+    rows = sm.sample(ts)
+    ok = np.isfinite(rows).all(axis=-1)
+    assert ok.sum() >= len(ts)
+    dp, dr = pose_errors(robot.fk(rows[ok]), np.broadcast_to(sm.T, (int(ok.sum()), 4, 4)))
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12, (dp.max(), dr.max())

@@ -30,7 +30,7 @@
  *
  * Each pose yields 8 slots, slot = 2 * position + triple: position 0-3 numbers the
  * solutions of step 1-2 (in the coplanar case 2 * first root + second root, '+'
- * root 0; in the quartic case in increasing angle from the shift), triple 0 / 1
+ * root 0; in the quartic case in increasing angle from the shift + pi), triple 0 / 1
  * the '+' / '-' root of the middle angle. A slot without a solution is NaN,
  * invalid, not singular and not within limits. Status: 0 ok, 1 out of reach, 2
  * orientation not achievable, 5 degenerate (the position equations hold no
@@ -390,9 +390,12 @@ static int trig2_roots(const Trig2 *f, double *x, int *nearly_double)
             x[n++] = xm; /* a double root, or none: verified by the caller */
         }
     }
-    /* sort by angle from the shift (insertion sort of <= 4) */
+    /* sort by angle from the shift + pi, where |f| is the largest sample: no root is
+     * next to that cut (from the shift itself, a root there, e.g. the iiwa's stretched
+     * elbow at 0 by rounding +-1e-11, changed ends with the rounding and the slots with
+     * it; issue 29, helper slots29). Insertion sort of <= 4. */
     for (int i = 0; i < n; i++)
-        x[i] = delta + wrap_pi(x[i] - delta - M_PI) + M_PI;
+        x[i] = delta + wrap_pi(x[i] - delta);
     for (int i = 1; i < n; i++)
         for (int j = i; j > 0 && x[j] < x[j - 1]; j--) {
             double t = x[j];
@@ -1892,6 +1895,78 @@ typedef struct {
     PkTri tri;
 } PkFrontMemo;
 
+/* Axes i < j of the full chain (i, j != held) are coplanar (mutual moment below
+ * PK_COPLANAR) at held value x only incidentally: the held joint lies between them
+ * (turning axis j about the held axis, the moment is a cos v + b sin v + c in the
+ * joint value v, at most two zeros a turn) and the moment is not zero at x + 1 or
+ * x + 2 as well (else it vanishes for every x: coplanar by design, the Panda's axes
+ * 5, 6). There the coplanar solver numbers its roots 2 * first root + second root,
+ * not as the quartic does at the values either side (increasing angle): the slots
+ * would be permuted at x alone (issue 29, helper slots29). */
+static int pk_incidental(const double *P, double x, int i, int j)
+{
+    int k = (int)P[PK_HELD];
+    if (k < 0 || !(i < k && k < j))
+        return 0;
+    v3 hk = v3_at(P, PK_AXES + 3 * k), ok = v3_at(P, PK_POINTS + 3 * k);
+    v3 hi = v3_at(P, PK_AXES + 3 * i), oi = v3_at(P, PK_POINTS + 3 * i);
+    v3 hj = v3_at(P, PK_AXES + 3 * j), oj = v3_at(P, PK_POINTS + 3 * j);
+    for (int s = 1; s <= 2; s++) {
+        double v = P[PK_SIGN + k] * (x + s) + P[PK_OFFSET + k], c = cos(v), sn = sin(v);
+        v3 h = v3_rot(hk, c, sn, hj), o = v3_add(ok, v3_rot(hk, c, sn, v3_sub(oj, ok)));
+        if (fabs(v3_dot(v3_sub(o, oi), v3_cross(hi, h))) > 1e3 * PK_COPLANAR * P[PK_SCALE])
+            return 1;
+    }
+    return 0;
+}
+
+/* The coplanar solver's position roots (cop) numbered as the quartic's (gen) at the
+ * same held value: repeatedly the closest pair (a root of each, position angles
+ * wrapped, within 1e-3 rad) not yet paired gives the cop root the gen root's slot
+ * (its index); cop's other roots take the slots left, in their order. */
+static void pk_reslot(PkPos *cop, const PkPos *gen)
+{
+    unsigned used = 0u, taken = 0u, had = 0u;
+    int to[4] = {-1, -1, -1, -1};
+    for (int round = 0; round < 4; round++) {
+        int bi = -1, bj = -1;
+        double bd = 1e-3;
+        for (int i = 0; i < gen->n; i++) {
+            if (had >> i & 1u)
+                continue;
+            for (int j = 0; j < cop->n; j++) {
+                if (taken >> j & 1u)
+                    continue;
+                double dj = 0.0;
+                for (int a = 0; a < 3; a++)
+                    dj = fmax(dj, fabs(wrap_pi(cop->t[j][a] - gen->t[i][a])));
+                if (dj < bd) {
+                    bd = dj;
+                    bi = i;
+                    bj = j;
+                }
+            }
+        }
+        if (bi < 0)
+            break;
+        to[bj] = gen->slot[bi];
+        taken |= 1u << bj;
+        had |= 1u << bi;
+        used |= 1u << gen->slot[bi];
+    }
+    for (int j = 0; j < cop->n; j++) {
+        if (to[j] >= 0)
+            continue;
+        int sl = 0;
+        while (sl < 3 && (used >> sl & 1u))
+            sl++;
+        to[j] = sl;
+        used |= 1u << sl;
+    }
+    for (int j = 0; j < cop->n; j++)
+        cop->slot[j] = (unsigned char)to[j];
+}
+
 /* The front of pose T at held value x (qn: preferred coordinates where a position
  * joint is free). Returns PK_OK with f->pos, a status (no position root), or
  * PK_FRONT_SWIVEL (both triples meet: pk_srs), PK_FRONT_GENERAL (no coplanar
@@ -1935,10 +2010,23 @@ static int pk_front_memo(const double *P, const double *T, double x, const doubl
         pk_tri_init(&memo->tri, g->h[f->it], g->h[f->it + 1], g->h[f->it + 2]);
         memo->set = 1;
     }
-    if (fabs(e.mbc) <= PK_COPLANAR)
+    int cbc = fabs(e.mbc) <= PK_COPLANAR, cab = fabs(e.mab) <= PK_COPLANAR;
+    /* coplanar only at this held value (the rtb-data iiwa14 at joint_a3 = 0,
+     * pk_incidental): the coplanar solver's roots (exact there; the quartic's can be
+     * off next to a double root, or missing), each in the slot the quartic gives it,
+     * as at the values either side (pk_reslot) */
+    if (general && cbc != cab && pk_incidental(P, x, g->full[ia + cbc], g->full[ia + cbc + 1])) {
+        code = pk_coplanar(&e, cab, NULL, pref_a, pref_c, want, &f->pos);
+        if (code == PK_OK) {
+            PkPos gen;
+            gen.n = 0;
+            pk_general(&e, &gen);
+            pk_reslot(&f->pos, &gen);
+        }
+    } else if (cbc)
         code = pk_coplanar(&e, 0, memo != NULL ? &memo->k : NULL, pref_a, pref_c, want,
                            &f->pos);
-    else if (fabs(e.mab) <= PK_COPLANAR)
+    else if (cab)
         code = pk_coplanar(&e, 1, NULL, pref_a, pref_c, want, &f->pos);
     else if (general)
         code = pk_general(&e, &f->pos);

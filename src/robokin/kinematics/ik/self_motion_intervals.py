@@ -445,6 +445,11 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
       steps on the rows); a side with no probe outside is not widened. (An
       interval at most ``_POINT`` long, a few ulps, is widened from its ends the
       same way; a longer one ends at exact crossings.)
+      On the solved-points path of a joint parameter (``every``, not the swivel's
+      reference) the range's ends are such candidates too
+      (the parameter at its limit), and every interval is widened so: its ends
+      at crossings of a joint with |dq/dt| below ~1e-3 move out to the last
+      in-slack value (a transversal crossing is out at 1e-9 and stays).
     * *Corners out by conditioning*: such a crossing whose row is out by at most
       ``_CONDITIONING`` with two or more joints within it of a limit (next to an
       aligned triple the closed forms' rows are 1e-11 to 1e-9 off). The row is
@@ -458,7 +463,11 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     family, whose rows are general-6R solves: +10-15 % CPU on uniform random 7R
     poses), not only close ones; a graze is
     widened only from a close one (a lone uncovered crossing inside, next to a piece
-    decided outside, is a crossing missed nearby: ``docs/ik.md``, "Corners").
+    decided outside, is a crossing missed nearby: ``docs/ik.md``, "Corners"); with a
+    joint parameter such a crossing whose row is inside and whose joint is not
+    tangent there is listed as
+    the point [t, t] alone, not widened (a corner whose second crossing the
+    held-joint solve cannot give: the rtb-data iiwa14 with the elbow stretched).
 
     Returns ``(intervals, owner, corners)``; the arrays unchanged (the same objects)
     when nothing is found: a uniform pose computes no row here (its cost is the
@@ -467,6 +476,7 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     only where it is set).
     """
     lo_d, hi_d = fam.domain
+    joint = every and not fam.periodic  # the solved points of a joint parameter
     # the cheap test first (a uniform pose ends here): no short interval, no two
     # points of a branch within _PAIR, none within it of a range end
     key = np.dot(points, _KEYS)  # by branch, then t
@@ -488,6 +498,15 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         close = np.diff(key[order]) <= _PAIR
         near[order[1:][close]] = True
         near[order[:-1][close]] = True
+    if joint:  # the range's ends as crossings of the parameter
+        # (a corner there: the parameter at its limit, another joint at its own; the
+        # row out by conditioning next to the iiwa's stretched elbow, the other
+        # joint's crossing not found: a singular held solve)
+        br = np.arange(fam.k, dtype=np.float64)
+        ends = np.column_stack([np.repeat([lo_d, hi_d], fam.k), np.tile(br, 2),
+                                np.full(2 * fam.k, float(fam.joint or 0))])
+        cuts = np.concatenate([cuts, ends])
+        near = np.concatenate([near, np.ones(2 * fam.k, dtype=bool)])
     point = intervals[:, 1] - intervals[:, 0] <= _POINT
     cand = near | every
     c, near = cuts[cand], near[cand]
@@ -495,8 +514,13 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         held = ((intervals[None, :, 0] <= c[:, :1]) & (c[:, :1] <= intervals[None, :, 1])
                 & (owner[None, :] == c[:, 1:2])).any(axis=1)
         c, near = c[~held], near[~held]
-    stretch = [(float(a), float(e), int(b)) for (a, e), b, p in zip(intervals, owner, point) if p]
+    # joint: every interval's ends too (a crossing of a joint moving slowly with t,
+    # e.g. the iiwa's wrist with the elbow stretched, |dq/dt| 1e-4: the row is inside
+    # by the slack up to 1e-8 beyond the exact crossing, where q's value can lie)
+    stretch = [(float(a), float(e), int(b)) for (a, e), b, p in zip(intervals, owner, point)
+               if p or joint]
     corners: list[tuple[float, int, np.ndarray]] = []
+    points_only: list[tuple[int, float, float]] = []
     if len(c):
         ts, inv = np.unique(c[:, 0], return_inverse=True)
         q, valid, _ = fam.rows(ts)
@@ -507,7 +531,12 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         inside = worst <= MANIFOLD_SLACK
         lone = np.flatnonzero(inside & ~near)
         if len(lone):  # a graze only where its joint stays at the limit either side
-            inside[lone] = _tangent(fam, limits, c[lone])
+            tangent = _tangent(fam, limits, c[lone])
+            # else the point alone: in limits, its neighbours not (a corner whose
+            # other crossing was not found, e.g. next to the iiwa's stretched elbow)
+            points_only = [(int(b[i]), float(c[i, 0]), float(c[i, 0]))
+                           for i in lone[~tangent]] if joint else []
+            inside[lone] = tangent
         for i in np.flatnonzero(inside):
             stretch.append((float(c[i, 0]), float(c[i, 0]), int(b[i])))
         for i in np.flatnonzero((worst > MANIFOLD_SLACK) & (worst <= _CONDITIONING)):
@@ -519,7 +548,7 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
                 tc = _param(fam, row)
                 if tc is not None:
                     corners.append((tc, int(b[i]), row))
-    new = _widen(fam, limits, stretch) + [(b, t, t) for t, b, _ in corners]
+    new = _widen(fam, limits, stretch) + [(b, t, t) for t, b, _ in corners] + points_only
     iv, ob = _merged(intervals, owner, new)
     if not corners and np.array_equal(iv, intervals) and np.array_equal(ob, owner):
         return intervals, owner, ()  # nothing widened or added: the kernel's arrays
