@@ -425,7 +425,8 @@ _CONDITIONING = 1e-7
 
 
 def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
-                    owner: np.ndarray, points: np.ndarray, upper: int, every: bool = False
+                    owner: np.ndarray, points: np.ndarray, upper: int, every: bool = False,
+                    touch: np.ndarray | None = None
                     ) -> tuple[np.ndarray, np.ndarray, tuple[tuple[float, int, np.ndarray], ...]]:
     """Graze stretches and corners the intervals miss (issue 29, helper rates29).
 
@@ -460,6 +461,12 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     widened only from a close one (a lone uncovered crossing inside, next to a piece
     decided outside, is a crossing missed nearby: ``docs/ik.md``, "Corners").
 
+    ``touch`` (q, 3) ``[t, branch, joint]``: points a family knows the branch
+    stays within the slack of a limit beyond rounding (the continued family's
+    grazes and shallow crossings, ``_ContinuedFamily._grazes``): candidates like
+    the close crossings, kept even inside an interval (an interval ending at a
+    shallow crossing is widened to the in-slack stretch past it).
+
     Returns ``(intervals, owner, corners)``; the arrays unchanged (the same objects)
     when nothing is found: a uniform pose computes no row here (its cost is the
     test for short intervals and close points, ~5 us; the compiled swivel's kernel
@@ -474,7 +481,8 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     t = points[:, 0]
     # (count_nonzero and matmul, not min / any / column slices: each numpy call costs
     # ~0.5-2 us on these sizes, ~50 us the whole compiled swivel call)
-    if not every and not (np.count_nonzero(key[1:] - key[:-1] <= _PAIR)
+    touch = np.zeros((0, 3)) if touch is None else touch
+    if not every and not len(touch) and not (np.count_nonzero(key[1:] - key[:-1] <= _PAIR)
             or np.count_nonzero(t <= lo_d + _PAIR) or np.count_nonzero(t >= hi_d - _PAIR)
             or np.count_nonzero(np.dot(intervals, _LENGTH) <= _POINT)):
         return intervals, owner, ()
@@ -495,6 +503,9 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         held = ((intervals[None, :, 0] <= c[:, :1]) & (c[:, :1] <= intervals[None, :, 1])
                 & (owner[None, :] == c[:, 1:2])).any(axis=1)
         c, near = c[~held], near[~held]
+    if len(touch):
+        c = np.concatenate([c, touch[:, :3]])
+        near = np.concatenate([near, np.ones(len(touch), dtype=bool)])
     stretch = [(float(a), float(e), int(b)) for (a, e), b, p in zip(intervals, owner, point) if p]
     corners: list[tuple[float, int, np.ndarray]] = []
     if len(c):
