@@ -106,6 +106,10 @@ _GOLDEN = 40
 #: is shallow: the branch stays within MANIFOLD_SLACK of the limit past ~1e-9 of it,
 #: so its in-slack stretch is widened (``_points_refined``'s touches).
 _SHALLOW = 1e-3
+#: A joint whose Hermite model comes this close to a limit [rad] on a piece is checked
+#: on the branch's rows there (``_riding``: the model's error exceeds a riding joint's
+#: excess).
+_RIDE = 1e-5
 #: The membership slack (``self_motion_intervals.MANIFOLD_SLACK``, the kernels' 1e-12).
 _SLACK: float = _K.MANIFOLD_SLACK
 #: Bisection steps of a fold (a cell to two adjacent doubles).
@@ -454,8 +458,13 @@ class _ContinuedFamily(_Family):
              + (-2 * u3 + 3 * u2) * qb + (u3 - u2) * h * sb)  # (pieces, SUB + 1, n)
         tt = tn[cc][:, None] + h[:, :, 0] * u[0, :, 0][None]  # (pieces, SUB + 1)
         starts, brackets, tracks, qidx, joints, values = [], [], [], [], [], []
-        for qi, (j, v, _) in enumerate(queries):
+        riding: list[tuple[np.ndarray, int]] = []  # (pieces, query) the model puts at v
+        for qi, (j, v, kind) in enumerate(queries):
             g = _wrap(P[..., j] - v)  # (pieces, SUB + 1)
+            if kind != "aligned axes":
+                ride = np.flatnonzero((np.abs(g) < _RIDE).any(axis=1))
+                if ride.size:
+                    riding.append((ride, qi))
             change = (np.sign(g[:, :-1]) != np.sign(g[:, 1:])) & (
                 np.abs(g[:, :-1] - g[:, 1:]) < np.pi)
             c, sidx = np.nonzero(change)
@@ -470,6 +479,21 @@ class _ContinuedFamily(_Family):
             qidx.append(np.full(c.size, qi))
             joints.append(np.full(c.size, j))
             values.append(np.full(c.size, v))
+        # a joint riding its limit (within _RIDE over a piece): the model's signs are
+        # not the rows' (its error is ~1e-9 and more), so the rows' own sign changes
+        # at the sub-values are bisected (issue 29, session 9)
+        if riding:
+            rb = self._riding(riding, tt, bb, queries)
+            if rb.size:
+                starts.append(0.5 * (rb[:, 0] + rb[:, 1]))
+                brackets.append(rb[:, :4])
+                tracks.append(rb[:, 4].astype(int))
+                qi_r = rb[:, 5].astype(int)
+                qidx.append(qi_r)
+                joints.append(np.array([queries[k][0] for k in qi_r]))
+                values.append(np.array([queries[k][1] for k in qi_r]))
+                force = np.concatenate([np.zeros(sum(len(x) for x in starts[:-1]), bool),
+                                        np.ones(len(rb), bool)])
         if not starts:
             return [], []
         t0, b = np.concatenate(starts), np.concatenate(tracks)
@@ -486,6 +510,8 @@ class _ContinuedFamily(_Family):
         br = np.concatenate(brackets)
         w = br[:, 1] - br[:, 0]
         lost = ~ok | (t1 < br[:, 0] - w) | (t1 > br[:, 1] + w)
+        if riding and rb.size:
+            lost |= force  # the rows' bracket: bisected, whatever Newton found
         jv, vv, qv = np.concatenate(joints), np.concatenate(values), np.concatenate(qidx)
         if lost.any():
             tb, qb, okb = self._bisected(br[lost], b[lost], jv[lost], vv[lost])
@@ -509,6 +535,38 @@ class _ContinuedFamily(_Family):
                 flags.append(False)
         return out, flags
 
+    def _riding(self, riding: list[tuple[np.ndarray, int]], tt: np.ndarray, bb: np.ndarray,
+                queries: list[tuple[int, float, str]]) -> np.ndarray:
+        """Brackets (p, 6) ``[a, e, a, e, track, query]`` of the rows' sign changes.
+
+        ``riding``: per query, the pieces (indices into ``tt`` (pieces, SUB + 1), the
+        sub-values, and ``bb``, their tracks) where the model is within ``_RIDE`` of
+        the query's value. The branch's rows at the piece's nodes (the tracks' own)
+        and its middle (``sample_rows``, each cell's once); each change of sign of
+        q_j - v between neighbours, one of them past the slack, is a bracket.
+        """
+        pieces = np.concatenate([r for r, _ in riding])
+        qis = np.concatenate([np.full(len(r), qi) for r, qi in riding])
+        ts = tt[pieces][:, [0, _SUB // 2, _SUB]]  # (p, 3): node, middle, node
+        # pieces of one cell (other tracks, joints, limits) share their middle
+        uniq, inv = np.unique(ts[:, 1], return_inverse=True)
+        qu, vu, _ = self.sample_rows(uniq)
+        b = bb[pieces]
+        j = np.array([queries[k][0] for k in qis])
+        v = np.array([queries[k][1] for k in qis])
+        c = np.searchsorted(self.t_nodes, ts[:, 0])  # the piece's cell (its first node)
+        inv = inv.ravel()
+        mid = np.where(vu[inv, b], qu[inv, b, j], np.nan)
+        g = np.stack([self.tracks[c, b, j], mid, self.tracks[c + 1, b, j]], axis=1)
+        with np.errstate(invalid="ignore"):
+            g = _wrap(g - v[:, None])
+        # a change between two rows within the slack of the value is rounding (a joint
+        # riding its limit flips sign at 1e-16): the pieces decide it with the slack
+        big = np.maximum(np.abs(g[:, :-1]), np.abs(g[:, 1:])) > _SLACK
+        i, k = np.nonzero((g[:, :-1] * g[:, 1:] < 0) & big)
+        return np.stack([ts[i, k], ts[i, k + 1], ts[i, k], ts[i, k + 1],
+                         b[i].astype(float), qis[i].astype(float)], axis=1)
+
     def _bisected(self, br: np.ndarray, b: np.ndarray, j: np.ndarray, v: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Crossings of joint j[i] through v[i] on track b[i] in brackets br (p, 4).
@@ -522,39 +580,59 @@ class _ContinuedFamily(_Family):
         the bracket's ends exist and straddle the value.
         """
         p = len(b)
-        idx = np.arange(p)
-
-        def side(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            q, valid, _ = self.sample_rows(t)
-            r = q[idx, b]
-            with np.errstate(invalid="ignore"):
-                s = np.sign(_wrap(r[idx, j] - v))
-            return np.where(valid[idx, b], s, np.nan), r
-
         ends = br.T.ravel()  # (4 p,): the sub-cells' ends, then the cells'
-        idx = np.tile(np.arange(p), 4)
         b4, j4, v4 = np.tile(b, 4), np.tile(j, 4), np.tile(v, 4)
         q, valid, _ = self.sample_rows(ends)
         r = q[np.arange(4 * p), b4]
         with np.errstate(invalid="ignore"):
             s4 = np.sign(_wrap(r[np.arange(4 * p), j4] - v4))
         s4 = np.where(valid[np.arange(4 * p), b4], s4, np.nan).reshape(4, p)
-        idx = np.arange(p)
         sub = s4[0] * s4[1] < 0
-        lo = np.where(sub, br[:, 0], br[:, 2])
-        hi = np.where(sub, br[:, 1], br[:, 3])
-        s_lo = np.where(sub, s4[0], s4[2])
         found = sub | (s4[2] * s4[3] < 0)
+        t_out = np.full(p, np.nan)
+        rows_out = np.full((p, self.robot.n), np.nan)
+        if not found.any():
+            return t_out, rows_out, found
+        keep = np.flatnonzero(found)  # only the straddling brackets are bisected
+        t_k, r_k, f_k = self._bisect_rows(np.where(sub, br[:, 0], br[:, 2])[keep],
+                                          np.where(sub, br[:, 1], br[:, 3])[keep],
+                                          np.where(sub, s4[0], s4[2])[keep],
+                                          b[keep], j[keep], v[keep])
+        t_out[keep], rows_out[keep] = t_k, r_k
+        found[keep] = f_k
+        return t_out, rows_out, found
+
+    def _bisect_rows(self, lo: np.ndarray, hi: np.ndarray, s_lo: np.ndarray, b: np.ndarray,
+                     j: np.ndarray, v: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`_bisected`'s bisection of straddling brackets [lo, hi] (sign s_lo at lo)."""
+        p = len(b)
+        found = np.ones(p, bool)
+
+        def side(t: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            """(signs, rows) of brackets a at t (len(a),)."""
+            q, valid, _ = self.sample_rows(t)
+            i = np.arange(len(a))
+            r = q[i, b[a]]
+            with np.errstate(invalid="ignore"):
+                s = np.sign(_wrap(r[i, j[a]] - v[a]))
+            return np.where(valid[i, b[a]], s, np.nan), r
+
         for _ in range(_BISECT):
             mid = 0.5 * (lo + hi)
-            if np.all((mid == lo) | (mid == hi)):
+            # a bracket whose rows end (no row assigned at a midpoint) is given up
+            a = np.flatnonzero(found & (mid != lo) & (mid != hi))
+            if not a.size:
                 break
-            s_mid, _ = side(mid)
-            same = s_mid == s_lo
-            lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
-            found &= np.isfinite(s_mid)
+            s_mid, _ = side(mid[a], a)
+            same = s_mid == s_lo[a]
+            lo[a], hi[a] = np.where(same, mid[a], lo[a]), np.where(same, hi[a], mid[a])
+            found[a] &= np.isfinite(s_mid)
         t = np.where(found, 0.5 * (lo + hi), np.nan)
-        _, rows = side(np.where(found, t, lo))
+        rows = np.full((p, self.robot.n), np.nan)
+        a = np.flatnonzero(found)
+        if a.size:
+            _, rows[a] = side(t[a], a)
         found &= _finite_rows(rows)
         return t, rows, found
 
@@ -645,8 +723,8 @@ class _ContinuedFamily(_Family):
         (the branch's in-slack stretch about it is ``_points_refined``'s to find);
         where the extremum lies past the limit by more than the slack (a dip
         inside from outside, or out from inside) and the scan found no crossing of
-        that joint and limit on the piece, the two crossings either side are
-        refined as ``_crossings`` refines its own (``(t, b, query index)``).
+        that joint and limit on one side of it in the cell, that side's is bisected
+        on the rows (:meth:`_dip_crossings`: ``(t, b, query index)``).
 
         Returns ``(touches, crossings)``.
         """
@@ -718,7 +796,7 @@ class _ContinuedFamily(_Family):
             f1, f2 = np.where(left, fn, f2), np.where(left, f1, fn)
             x1, x2 = x1n, x2n
         ts = np.where(f1 <= f2, x1, x2)
-        best, r = f(ts)
+        best, _ = f(ts)
         e = orient * best  # the extremum's excess over the limit
         touches: list[tuple[float, int, int]] = []
         dips: list[int] = []
@@ -729,48 +807,51 @@ class _ContinuedFamily(_Family):
                 if not any(b == b_i[i] and abs(t - ts[i]) < 1e-9 for t, b, _ in touches):
                     touches.append((float(ts[i]), int(b_i[i]), int(j_i[i])))
             elif orient[i] * e[i] < -_SLACK:  # past the limit: two crossings
-                qi = cand[i][1]
-                if not any(b == b_i[i] and q2 == qi and t_lo[i] <= t <= t_hi[i]
-                           for t, b, q2 in found):
-                    dips.append(i)
-        return touches, self._dip_crossings(np.array(dips, dtype=int), ts, r, e, u_i, p_i,
-                                            cc, j_i, val, b_i, [c[1] for c in cand])
+                dips.append(i)
+        return touches, self._dip_crossings(np.array(dips, dtype=int), ts, e, p_i, cc, j_i,
+                                            val, b_i, [c[1] for c in cand], found)
 
-    def _dip_crossings(self, d: np.ndarray, ts: np.ndarray, r: np.ndarray, e: np.ndarray,
-                       u: np.ndarray, p: np.ndarray, cc: np.ndarray, j: np.ndarray,
-                       val: np.ndarray, b: np.ndarray, qidx: list[int]
+    def _dip_crossings(self, d: np.ndarray, ts: np.ndarray, e: np.ndarray, p: np.ndarray,
+                       cc: np.ndarray, j: np.ndarray, val: np.ndarray, b: np.ndarray,
+                       qidx: list[int], found: list[tuple[float, int, int]]
                        ) -> list[tuple[float, int, int]]:
-        """The two crossings either side of the extrema ``d`` past their limits.
+        """The crossings either side of the extrema ``d`` past their limits.
 
-        From the extremum's row r at ts, a joint excess e past the limit and the
-        Hermite model's curvature there: t = ts +- sqrt(2 |e| / |q''|), each refined
-        by :func:`_newton_held` (the joint held at the limit, t free) and kept, as in
-        ``_crossings``, inside the cell and within ``_ON_TRACK`` of the prediction.
+        An extremum at ts with the joint's excess e past the limit has a crossing on
+        each side in its cell; a side where ``found`` has none of that joint and
+        limit is bisected on the branch's rows (:meth:`_bisected`) between ts and
+        ts +- sqrt(2 |e| / q'') (q'' the slope's change across the cell), or the
+        cell's end where those rows do not straddle the limit.
         """
         if not d.size:
             return []
         tn = self.t_nodes
         c = cc[p[d]]
-        h = tn[c + 1] - tn[c]
+        a, z = tn[c], tn[c + 1]
+        h = z - a
         S0, S1 = self.slopes[c, b[d], j[d]], self.slopes[c + 1, b[d], j[d]]
-        # the model's q'' [rad / rad^2]: the slope's change across the cell (at least)
         curv = np.maximum(np.abs(S1 - S0) / h, 1e-12)
         half = np.sqrt(2 * np.abs(e[d]) / curv)
-        t0 = np.concatenate([ts[d] - half, ts[d] + half])
-        t0 = np.clip(t0, np.tile(tn[c], 2), np.tile(tn[c + 1], 2))
-        bd = np.tile(b[d], 2)
-        q0 = self.predict(t0)[np.arange(len(t0)), bd]
-        q, ok = _newton_held(self.robot, self.T, q0, np.tile(j[d], 2), np.tile(val[d], 2))
-        t1 = q[:, self.joint]
-        ok &= (t1 >= np.tile(tn[c], 2)) & (t1 <= np.tile(tn[c + 1], 2))
-        with np.errstate(invalid="ignore"):
-            pred = self.predict(np.where(ok, t1, t0))[np.arange(len(t0)), bd]
-            ok &= _max_last(np.abs(_wrap(pred - q))) < _ON_TRACK
-        qi = np.tile(np.array(qidx)[d], 2)
+        qi = np.array(qidx)[d]
+        br, keep = [], []
+        for k in range(len(d)):
+            t0, bk, qk = float(ts[d[k]]), int(b[d[k]]), int(qi[k])
+            had = [t for t, b2, q2 in found if b2 == bk and q2 == qk and a[k] <= t <= z[k]]
+            if not any(t < t0 for t in had):
+                br.append([max(a[k], t0 - 2 * half[k]), t0, a[k], t0])
+                keep.append(k)
+            if not any(t > t0 for t in had):
+                br.append([t0, min(z[k], t0 + 2 * half[k]), t0, z[k]])
+                keep.append(k)
+        if not br:
+            return []
+        kk = np.array(keep)
+        t, _, ok = self._bisected(np.array(br), b[d][kk], j[d][kk], val[d][kk])
         out: list[tuple[float, int, int]] = []
-        for t, bb, k in zip(t1[ok].tolist(), bd[ok].tolist(), qi[ok].tolist(), strict=True):
-            if not any(bb == b2 and k == k2 and abs(t - t2) < 1e-9 for t2, b2, k2 in out):
-                out.append((t, bb, k))
+        for tt, bb, q2 in zip(t[ok].tolist(), b[d][kk][ok].tolist(), qi[kk][ok].tolist(),
+                              strict=True):
+            if not any(bb == b2 and q2 == k2 and abs(tt - t2) < 1e-9 for t2, b2, k2 in out):
+                out.append((tt, bb, q2))
         return out
 
     def _folds(self) -> list[tuple[float, int]]:
