@@ -686,3 +686,37 @@ def test_a_corner_whose_held_newton_is_singular_is_listed():
                    2.9670597283903604, 2.0943951023931953, 2.996531197067288])
     _, sm = _manifold(robot, q0)
     assert_corner_listed(robot, sm, q0, float(q0[6]))
+
+
+def test_a_manifold_between_two_nodes_is_found():
+    # Issue 29, session 9: the offset iiwa near its reach (benchmarks/self_motion_rates.py,
+    # seed 0, uniform #269): the pose is reached only for q7 in ~[-0.0257, -0.0085],
+    # between the nodes -0.0339 and 0, so no node had a row and main (0518b33) returned
+    # an empty manifold. Oracles: independent held solves (robot.ik with q7 given) have
+    # rows inside that range and none at +-0.01 outside it; q is sampled back at its q7,
+    # inside an interval of its branch; sampled rows reproduce the pose to 1e-12. An
+    # unreachable pose (the position moved 1.5 times out) still has no interval.
+    robot = ARMS["offset_iiwa"]
+    name = robot.joint_names[-1]
+    q0 = np.array([0.8022768368230504, -1.4357017051207834, -0.6195901826336652,
+                   -0.008432200094728781, -0.016303420029859073, 1.3393911965194847,
+                   -0.025720851086314056])
+    T, sm = _manifold(robot, q0)
+    inner = robot.ik(T, fixed={name: np.array([-0.02, -0.015, -0.01])})
+    outer = robot.ik(T, fixed={name: np.array([-0.04, 0.0])})
+    assert inner.valid.any(axis=-1).all() and not outer.valid.any()
+    t = float(q0[6])
+    rows = sm.sample(t)
+    d = _wrapped(rows - q0).max(-1)
+    b = int(np.nanargmin(d))
+    assert d[b] < 1e-9, d
+    iv = sm.intervals[sm.interval_branch == b]
+    assert ((iv[:, 0] <= t) & (t <= iv[:, 1])).any(), (t, iv)
+    Q = sm.sample(np.linspace(-0.025, -0.010, 16))
+    ok = np.isfinite(Q).all(-1)
+    assert ok.any(axis=1).all()
+    dp, dr = pose_errors(robot.fk(Q[ok]), T)
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+    far = T.copy()
+    far[:3, 3] *= 1.5
+    assert not len(robot.self_motion(far, parameter=name).intervals)
