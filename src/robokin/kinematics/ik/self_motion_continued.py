@@ -100,7 +100,8 @@ _MAX_TRACKS = 64
 #: A joint's extremum on a track's Hermite model this close to a limit [rad] is refined
 #: on the branch's rows (``_grazes``: a graze, tangent to the limit, changes no sign).
 _GRAZE = 1e-3
-#: Golden-section steps of a graze's extremum (a quarter cell, ~8e-3, to ~1e-10).
+#: Golden-section steps of a graze's extremum (a quarter cell, ~8e-3, to ~1e-8: the
+#: excess there within ~1e-16 q'' of the extremum's).
 _GOLDEN = 40
 #: A crossing whose joint moves slower than this along the branch [rad per rad of t]
 #: is shallow: the branch stays within MANIFOLD_SLACK of the limit past ~1e-9 of it,
@@ -110,6 +111,8 @@ _SHALLOW = 1e-3
 #: on the branch's rows there (``_riding``: the model's error exceeds a riding joint's
 #: excess).
 _RIDE = 1e-5
+#: A joint this close to a limit [rad] at another joint's crossing makes it a touch.
+_AT_LIMIT = 1e-9
 #: The membership slack (``self_motion_intervals.MANIFOLD_SLACK``, the kernels' 1e-12).
 _SLACK: float = _K.MANIFOLD_SLACK
 #: Bisection steps of a fold (a cell to two adjacent doubles).
@@ -539,6 +542,10 @@ class _ContinuedFamily(_Family):
         if riding and rb.size:
             lost |= force  # the rows' bracket: bisected, whatever Newton found
         jv, vv, qv = np.concatenate(joints), np.concatenate(values), np.concatenate(qidx)
+        for i in np.flatnonzero(lost & ~force if riding and rb.size else lost):
+            # a Newton crossing of the same track and value in the cell: done
+            hit = ok & (b == b[i]) & (qv == qv[i]) & (t1 >= br[i, 2]) & (t1 <= br[i, 3])
+            lost[i] = not hit.any()
         if lost.any():
             tb, qb, okb = self._bisected(br[lost], b[lost], jv[lost], vv[lost])
             t1, q = np.concatenate([t1, tb[okb]]), np.concatenate([q, qb[okb]])
@@ -548,6 +555,15 @@ class _ContinuedFamily(_Family):
         jx = jv[ok]
         speed = np.abs(_slopes(self.robot, q[ok], self.joint)[np.arange(len(jx)), jx])
         flat = ~(speed >= _SHALLOW)  # NaN (a singular row): shallow too
+        # another joint at a limit there too (riding it within the slack, e.g. the
+        # offset iiwa #5805: q4 out by 1e-15 over 1e-4 while q5 crosses): a touch
+        lim = self.robot.limits
+        rq = q[ok]
+        with np.errstate(invalid="ignore"):
+            at = np.minimum(np.abs(rq - lim[:, 0]), np.abs(rq - lim[:, 1])) <= _AT_LIMIT
+        at[np.arange(len(jx)), jx] = False
+        at[:, self.joint] = False
+        flat |= at.any(axis=1)
         out: list[tuple[float, int, int]] = []
         flags: list[bool] = []
         for t, bb, qi, f in zip(t1[ok].tolist(), b[ok].tolist(), qv[ok].tolist(),
@@ -567,25 +583,24 @@ class _ContinuedFamily(_Family):
 
         ``riding``: per query, the pieces (indices into ``tt`` (pieces, SUB + 1), the
         sub-values, and ``bb``, their tracks) where the model is within ``_RIDE`` of
-        the query's value. The branch's rows at the piece's nodes (the tracks' own)
-        and its middle (``sample_rows``, each cell's once); each change of sign of
-        q_j - v between neighbours, one of them past the slack, is a bracket.
+        the query's value. The branch's rows at the sub-values (``sample_rows``, each
+        value once); each change of sign of q_j - v between neighbours, one of them
+        past the slack, is a bracket.
         """
         pieces = np.concatenate([r for r, _ in riding])
         qis = np.concatenate([np.full(len(r), qi) for r, qi in riding])
-        ts = tt[pieces][:, [0, _SUB // 2, _SUB]]  # (p, 3): node, middle, node
-        # pieces of one cell (other tracks, joints, limits) share their middle
-        uniq, inv = np.unique(ts[:, 1], return_inverse=True)
+        ts = tt[pieces]  # (p, SUB + 1)
+        # pieces of one cell (other tracks, joints, limits) share their sub-values
+        uniq, inv = np.unique(ts.ravel(), return_inverse=True)
         qu, vu, _ = self.sample_rows(uniq)
+        m = ts.shape[1]
         b = bb[pieces]
         j = np.array([queries[k][0] for k in qis])
         v = np.array([queries[k][1] for k in qis])
-        c = np.searchsorted(self.t_nodes, ts[:, 0])  # the piece's cell (its first node)
-        inv = inv.ravel()
-        mid = np.where(vu[inv, b], qu[inv, b, j], np.nan)
-        g = np.stack([self.tracks[c, b, j], mid, self.tracks[c + 1, b, j]], axis=1)
+        inv = inv.reshape(ts.shape)
+        bm, jm = np.repeat(b, m).reshape(ts.shape), np.repeat(j, m).reshape(ts.shape)
         with np.errstate(invalid="ignore"):
-            g = _wrap(g - v[:, None])
+            g = np.where(vu[inv, bm], _wrap(qu[inv, bm, jm] - v[:, None]), np.nan)
         # a change between two rows within the slack of the value is rounding (a joint
         # riding its limit flips sign at 1e-16): the pieces decide it with the slack
         big = np.maximum(np.abs(g[:, :-1]), np.abs(g[:, 1:])) > _SLACK
