@@ -441,9 +441,11 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
         ends, bisected = _state_changes(fam, grid_t, q, valid, limits, marks)
     intervals, owner = _intervals(fam, limits, marks, ends)
     cuts = np.array([(t, b, j, 0) for t, b, j, _ in marks["limit"]], dtype=np.float64)
+    touch = np.array(marks.get("touch", []), dtype=np.float64).reshape(-1, 3)
     intervals, owner, corners = _points_refined(fam, limits, intervals, owner,
                                                 cuts.reshape(-1, 4), 0,
-                                                every=not isinstance(fam, _ContinuedFamily))
+                                                every=not isinstance(fam, _ContinuedFamily),
+                                                touch=touch)
     crossings = tuple(LimitCrossing(t, b, j, s) for t, b, j, s in marks["limit"])
     singular = tuple(SingularPoint(t, b, k) for t, b, k in marks["fold"] + marks["aligned"])
     method = ("swivel closed form (SRS)" if fam.name == "swivel"

@@ -61,6 +61,7 @@ from typing import Any
 
 import numpy as np
 
+from robokin._native import kernels as _K
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.fixed import Dispatch, EndSweep, _all_last, solve_fixed
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
@@ -96,6 +97,25 @@ _MAX_NODES = 3 * NODES
 _DEGENERATE = 0.5
 #: Most tracks kept (the longest; a degenerate pose's rows do not pair).
 _MAX_TRACKS = 64
+#: A joint's extremum on a track's Hermite model this close to a limit [rad] is refined
+#: on the branch's rows (``_grazes``: a graze, tangent to the limit, changes no sign; the
+#: model is within ~1e-6 of the rows on ordinary cells; 1e-3 cost uniform poses +3 %).
+_GRAZE = 1e-4
+#: Golden-section steps of a graze's extremum (a quarter cell, ~8e-3, to ~1e-8: the
+#: excess there within ~1e-16 q'' of the extremum's).
+_GOLDEN = 40
+#: A crossing whose joint moves slower than this along the branch [rad per rad of t]
+#: is shallow: the branch stays within MANIFOLD_SLACK of the limit past ~1e-9 of it,
+#: so its in-slack stretch is widened (``_points_refined``'s touches).
+_SHALLOW = 1e-3
+#: A joint whose Hermite model comes this close to a limit [rad] on a piece is checked
+#: on the branch's rows there (``_riding``: the model's error exceeds a riding joint's
+#: excess).
+_RIDE = 1e-5
+#: A joint this close to a limit [rad] at another joint's crossing makes it a touch.
+_AT_LIMIT = 1e-9
+#: The membership slack (``self_motion_intervals.MANIFOLD_SLACK``, the kernels' 1e-12).
+_SLACK: float = _K.MANIFOLD_SLACK
 #: Bisection steps of a fold (a cell to two adjacent doubles).
 _BISECT = 60
 #: Followed rows (``sample_rows``): each Newton step at most ``_CONTRACT`` times the
@@ -139,6 +159,8 @@ class _ContinuedFamily(_Family):
         self._sweep = EndSweep.of(robot, j, self.T)
         t = np.linspace(*self.domain, int(nodes))
         Q = self._solve(t)
+        if not _finite_rows(Q).any():  # no node has a row: the manifold between two?
+            t, Q = self._seeded(t, Q)
         D = _slopes(robot, Q, j)
         clean = _clean_cells(t, Q, D)
         # most cells unpaired: every row singular (the pose at the reach boundary,
@@ -185,6 +207,30 @@ class _ContinuedFamily(_Family):
             slope &= _regular(robot, self.tracks, j) | ~self._exists
         self._cell_ok = ~ends.any(axis=1) & (slope[1:] & slope[:-1]).all(axis=1)
         self.followed = 0
+
+    def _seeded(self, t: np.ndarray, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Nodes t (m,) and rows Q with the numeric solver's parameter values added.
+
+        Where no node has a row the manifold may still lie between two nodes (an
+        island narrower than their spacing: the offset iiwa near its reach, seed 0
+        #269, q7 in [-0.0257, -0.0085] between the nodes -0.0339 and 0). The
+        numeric solver (``method="numeric"``: Levenberg-Marquardt from its seeds,
+        every joint free) finds rows of the whole manifold where there are any; the
+        values of the parameter joint in them become nodes, and the halvings next
+        to them find the island's folds. Only on such poses (an unreachable pose
+        pays the numeric solve, ~6 ms against ~43 ms for its manifold).
+        """
+        sols = self.dispatch(self.robot, self.T, method="numeric")
+        v = np.asarray(sols.q)[np.asarray(sols.valid)][:, self.joint]
+        lo, hi = self.domain
+        v = np.unique(v[(v > lo) & (v < hi)])
+        if not v.size:
+            return t, Q
+        Qv = self._solve(v)
+        Q, Qv = _widen(Q, Qv)
+        t2 = np.concatenate([t, v])
+        order = np.argsort(t2, kind="stable")
+        return t2[order], np.concatenate([Q, Qv])[order]
 
     # ------------------------------------------------------------ rows
     def _solve(self, t: np.ndarray) -> np.ndarray:
@@ -387,11 +433,14 @@ class _ContinuedFamily(_Family):
     # ------------------------------------------------------------ exact points
     def marks(self, limits: np.ndarray, aligned: list[tuple[int, float]]
               ) -> dict[str, list[Any]]:
-        """Limit crossings, aligned-axes points and folds of every track.
+        """Limit crossings, aligned-axes points, folds and touches of every track.
 
         Returns the dict ``self_motion_intervals._intervals`` takes: ``"limit"``
         ``[(t, branch, joint, "lower"/"upper")]``, ``"aligned"`` ``[(t, branch,
-        "aligned axes")]``, ``"fold"`` ``[(t, branch, "fold")]``.
+        "aligned axes")]``, ``"fold"`` ``[(t, branch, "fold")]``; and ``"touch"``
+        ``[(t, branch, joint)]``: where a branch stays within ``MANIFOLD_SLACK`` of a
+        limit beyond rounding (its grazes and shallow crossings, :meth:`_grazes`),
+        for ``_points_refined`` to widen to their in-slack stretch.
         """
         rev = np.asarray(self.robot.is_revolute, bool)
         queries: list[tuple[int, float, str]] = []
@@ -401,22 +450,31 @@ class _ContinuedFamily(_Family):
                 continue
             queries += [(j, lo, "lower"), (j, hi, "upper")]
         queries += [(j, v, "aligned axes") for j, v in aligned if j != self.joint]
-        found = self._crossings(queries)
-        out: dict[str, list[Any]] = {"limit": [], "fold": [], "aligned": []}
+        found, shallow = self._crossings(queries)
+        touch, more = self._grazes(queries, found)
+        found += more
+        out: dict[str, list[Any]] = {"limit": [], "fold": [], "aligned": [], "touch": touch}
         for t, b, qi in found:
             j, _, kind = queries[qi]
             if kind == "aligned axes":
                 out["aligned"].append((t, b, kind))
             else:
                 out["limit"].append((t, b, j, kind))
+        out["touch"] += [(t, b, queries[qi][0]) for (t, b, qi), s in
+                         zip(found, shallow, strict=False) if s and queries[qi][2] != "aligned axes"]
         out["fold"] = [(t, b, "fold") for t, b in self.folds]
         return out
 
     def _crossings(self, queries: list[tuple[int, float, str]]
-                   ) -> list[tuple[float, int, int]]:
-        """(t, track, query index) where a track's joint equals a query's value."""
+                   ) -> tuple[list[tuple[float, int, int]], list[bool]]:
+        """(t, track, query index) where a track's joint equals a query's value.
+
+        With a flag per crossing of the regular pieces (the fold cells' come last,
+        unflagged): True where the joint moves slower than ``_SHALLOW`` along the
+        branch there (or its slope is not defined): a shallow crossing.
+        """
         if not queries:
-            return []
+            return [], []
         tn, X, S = self.t_nodes, self.tracks, self.slopes
         both = np.isfinite(X[:-1]).all(-1) & np.isfinite(X[1:]).all(-1)  # (m-1, k)
         cc, bb = np.nonzero(both)  # the (cell, track) pieces with both ends
@@ -429,9 +487,14 @@ class _ContinuedFamily(_Family):
         P = ((2 * u3 - 3 * u2 + 1) * qa + (u3 - 2 * u2 + u) * h * sa
              + (-2 * u3 + 3 * u2) * qb + (u3 - u2) * h * sb)  # (pieces, SUB + 1, n)
         tt = tn[cc][:, None] + h[:, :, 0] * u[0, :, 0][None]  # (pieces, SUB + 1)
-        starts, tracks, qidx, joints, values = [], [], [], [], []
-        for qi, (j, v, _) in enumerate(queries):
+        starts, brackets, tracks, qidx, joints, values = [], [], [], [], [], []
+        riding: list[tuple[np.ndarray, int]] = []  # (pieces, query) the model puts at v
+        for qi, (j, v, kind) in enumerate(queries):
             g = _wrap(P[..., j] - v)  # (pieces, SUB + 1)
+            if kind != "aligned axes":
+                ride = np.flatnonzero((np.abs(g) < _RIDE).any(axis=1))
+                if ride.size:
+                    riding.append((ride, qi))
             change = (np.sign(g[:, :-1]) != np.sign(g[:, 1:])) & (
                 np.abs(g[:, :-1] - g[:, 1:]) < np.pi)
             c, sidx = np.nonzero(change)
@@ -440,12 +503,29 @@ class _ContinuedFamily(_Family):
             g0, g1 = g[c, sidx], g[c, sidx + 1]
             w = np.where(g0 != g1, g0 / np.where(g0 != g1, g0 - g1, 1.0), 0.0)
             starts.append(tt[c, sidx] + w * (tt[c, sidx + 1] - tt[c, sidx]))
+            brackets.append(np.stack([tt[c, sidx], tt[c, sidx + 1], tt[c, 0], tt[c, -1]],
+                                     axis=1))
             tracks.append(bb[c])
             qidx.append(np.full(c.size, qi))
             joints.append(np.full(c.size, j))
             values.append(np.full(c.size, v))
+        # a joint riding its limit (within _RIDE over a piece): the model's signs are
+        # not the rows' (its error is ~1e-9 and more), so the rows' own sign changes
+        # at the sub-values are bisected (issue 29, session 9)
+        if riding:
+            rb = self._riding(riding, tt, bb, queries)
+            if rb.size:
+                starts.append(0.5 * (rb[:, 0] + rb[:, 1]))
+                brackets.append(rb[:, :4])
+                tracks.append(rb[:, 4].astype(int))
+                qi_r = rb[:, 5].astype(int)
+                qidx.append(qi_r)
+                joints.append(np.array([queries[k][0] for k in qi_r]))
+                values.append(np.array([queries[k][1] for k in qi_r]))
+                force = np.concatenate([np.zeros(sum(len(x) for x in starts[:-1]), bool),
+                                        np.ones(len(rb), bool)])
         if not starts:
-            return []
+            return [], []
         t0, b = np.concatenate(starts), np.concatenate(tracks)
         q0 = self.predict(t0)[np.arange(len(t0)), b]
         q, ok = _newton_held(self.robot, self.T, q0, np.concatenate(joints),
@@ -455,15 +535,148 @@ class _ContinuedFamily(_Family):
         ok &= (t1 >= lo) & (t1 <= hi)
         pred = self.predict(np.where(ok, t1, t0))[np.arange(len(t0)), b]
         ok &= np.abs(_wrap(pred - q)).max(-1) < _ON_TRACK
+        # Newton with t free failed, or went to another root (its 6 x 6 nearly
+        # singular where the joint moves ~1e-6 as fast as t): bisected on the rows
+        br = np.concatenate(brackets)
+        w = br[:, 1] - br[:, 0]
+        lost = ~ok | (t1 < br[:, 0] - w) | (t1 > br[:, 1] + w)
+        if riding and rb.size:
+            lost |= force  # the rows' bracket: bisected, whatever Newton found
+        jv, vv, qv = np.concatenate(joints), np.concatenate(values), np.concatenate(qidx)
+        for i in np.flatnonzero(lost & ~force if riding and rb.size else lost):
+            # a Newton crossing of the same track and value in the cell: done
+            hit = ok & (b == b[i]) & (qv == qv[i]) & (t1 >= br[i, 2]) & (t1 <= br[i, 3])
+            lost[i] = not hit.any()
+        if lost.any():
+            tb, qb, okb = self._bisected(br[lost], b[lost], jv[lost], vv[lost])
+            t1, q = np.concatenate([t1, tb[okb]]), np.concatenate([q, qb[okb]])
+            b, ok = np.concatenate([b, b[lost][okb]]), np.concatenate([ok, okb[okb]])
+            jv, qv = np.concatenate([jv, jv[lost][okb]]), np.concatenate([qv, qv[lost][okb]])
+        # the joint's speed along the branch at each crossing (the exact slope dq/dt)
+        jx = jv[ok]
+        speed = np.abs(_slopes(self.robot, q[ok], self.joint)[np.arange(len(jx)), jx])
+        flat = ~(speed >= _SHALLOW)  # NaN (a singular row): shallow too
+        # another joint at a limit there too (riding it within the slack, e.g. the
+        # offset iiwa #5805: q4 out by 1e-15 over 1e-4 while q5 crosses): a touch
+        lim = self.robot.limits
+        rq = q[ok]
+        with np.errstate(invalid="ignore"):
+            at = np.minimum(np.abs(rq - lim[:, 0]), np.abs(rq - lim[:, 1])) <= _AT_LIMIT
+        at[np.arange(len(jx)), jx] = False
+        at[:, self.joint] = False
+        flat |= at.any(axis=1)
         out: list[tuple[float, int, int]] = []
-        for t, bb, qi in zip(t1[ok].tolist(), b[ok].tolist(),
-                             np.concatenate(qidx)[ok].tolist(), strict=True):
+        flags: list[bool] = []
+        for t, bb, qi, f in zip(t1[ok].tolist(), b[ok].tolist(), qv[ok].tolist(),
+                                flat.tolist(), strict=True):
             if not any(bb == b2 and qi == q2 and abs(t - t2) < 1e-9 for t2, b2, q2 in out):
                 out.append((t, bb, qi))
+                flags.append(f)
         for t, fb, qi in self._fold_crossings(queries):
             if not any(fb == b2 and qi == q2 and abs(t - t2) < 1e-9 for t2, b2, q2 in out):
                 out.append((t, fb, qi))
-        return out
+                flags.append(False)
+        return out, flags
+
+    def _riding(self, riding: list[tuple[np.ndarray, int]], tt: np.ndarray, bb: np.ndarray,
+                queries: list[tuple[int, float, str]]) -> np.ndarray:
+        """Brackets (p, 6) ``[a, e, a, e, track, query]`` of the rows' sign changes.
+
+        ``riding``: per query, the pieces (indices into ``tt`` (pieces, SUB + 1), the
+        sub-values, and ``bb``, their tracks) where the model is within ``_RIDE`` of
+        the query's value. The branch's rows at the sub-values (``sample_rows``, each
+        value once); each change of sign of q_j - v between neighbours, one of them
+        past the slack, is a bracket.
+        """
+        pieces = np.concatenate([r for r, _ in riding])
+        qis = np.concatenate([np.full(len(r), qi) for r, qi in riding])
+        ts = tt[pieces]  # (p, SUB + 1)
+        # pieces of one cell (other tracks, joints, limits) share their sub-values
+        uniq, inv = np.unique(ts.ravel(), return_inverse=True)
+        qu, vu, _ = self.sample_rows(uniq)
+        m = ts.shape[1]
+        b = bb[pieces]
+        j = np.array([queries[k][0] for k in qis])
+        v = np.array([queries[k][1] for k in qis])
+        inv = inv.reshape(ts.shape)
+        bm, jm = np.repeat(b, m).reshape(ts.shape), np.repeat(j, m).reshape(ts.shape)
+        with np.errstate(invalid="ignore"):
+            g = np.where(vu[inv, bm], _wrap(qu[inv, bm, jm] - v[:, None]), np.nan)
+        # a change between two rows within the slack of the value is rounding (a joint
+        # riding its limit flips sign at 1e-16): the pieces decide it with the slack
+        big = np.maximum(np.abs(g[:, :-1]), np.abs(g[:, 1:])) > _SLACK
+        i, k = np.nonzero((g[:, :-1] * g[:, 1:] < 0) & big)
+        return np.stack([ts[i, k], ts[i, k + 1], ts[i, k], ts[i, k + 1],
+                         b[i].astype(float), qis[i].astype(float)], axis=1)
+
+    def _bisected(self, br: np.ndarray, b: np.ndarray, j: np.ndarray, v: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Crossings of joint j[i] through v[i] on track b[i] in brackets br (p, 4).
+
+        ``br``: the model's sub-cell ``[a, e]``, then its cell ``[a, e]`` (taken where
+        the branch's rows at the sub-cell's ends do not straddle the value: the
+        model's sign change is not the rows', e.g. a fast passage in the cell).
+        Bisection on the sign of q_j - v of the branch's rows (``sample_rows``, the
+        held 6 x 6 with t held: regular where the one with the joint held is not),
+        to adjacent doubles. Returns ``(t, rows, found)``: found where the rows at
+        the bracket's ends exist and straddle the value.
+        """
+        p = len(b)
+        ends = br.T.ravel()  # (4 p,): the sub-cells' ends, then the cells'
+        b4, j4, v4 = np.tile(b, 4), np.tile(j, 4), np.tile(v, 4)
+        q, valid, _ = self.sample_rows(ends)
+        r = q[np.arange(4 * p), b4]
+        with np.errstate(invalid="ignore"):
+            s4 = np.sign(_wrap(r[np.arange(4 * p), j4] - v4))
+        s4 = np.where(valid[np.arange(4 * p), b4], s4, np.nan).reshape(4, p)
+        sub = s4[0] * s4[1] < 0
+        found = sub | (s4[2] * s4[3] < 0)
+        t_out = np.full(p, np.nan)
+        rows_out = np.full((p, self.robot.n), np.nan)
+        if not found.any():
+            return t_out, rows_out, found
+        keep = np.flatnonzero(found)  # only the straddling brackets are bisected
+        t_k, r_k, f_k = self._bisect_rows(np.where(sub, br[:, 0], br[:, 2])[keep],
+                                          np.where(sub, br[:, 1], br[:, 3])[keep],
+                                          np.where(sub, s4[0], s4[2])[keep],
+                                          b[keep], j[keep], v[keep])
+        t_out[keep], rows_out[keep] = t_k, r_k
+        found[keep] = f_k
+        return t_out, rows_out, found
+
+    def _bisect_rows(self, lo: np.ndarray, hi: np.ndarray, s_lo: np.ndarray, b: np.ndarray,
+                     j: np.ndarray, v: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`_bisected`'s bisection of straddling brackets [lo, hi] (sign s_lo at lo)."""
+        p = len(b)
+        found = np.ones(p, bool)
+
+        def side(t: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            """(signs, rows) of brackets a at t (len(a),)."""
+            q, valid, _ = self.sample_rows(t)
+            i = np.arange(len(a))
+            r = q[i, b[a]]
+            with np.errstate(invalid="ignore"):
+                s = np.sign(_wrap(r[i, j[a]] - v[a]))
+            return np.where(valid[i, b[a]], s, np.nan), r
+
+        for _ in range(_BISECT):
+            mid = 0.5 * (lo + hi)
+            # a bracket whose rows end (no row assigned at a midpoint) is given up
+            a = np.flatnonzero(found & (mid != lo) & (mid != hi))
+            if not a.size:
+                break
+            s_mid, _ = side(mid[a], a)
+            same = s_mid == s_lo[a]
+            lo[a], hi[a] = np.where(same, mid[a], lo[a]), np.where(same, hi[a], mid[a])
+            found[a] &= np.isfinite(s_mid)
+        t = np.where(found, 0.5 * (lo + hi), np.nan)
+        rows = np.full((p, self.robot.n), np.nan)
+        a = np.flatnonzero(found)
+        if a.size:
+            _, rows[a] = side(t[a], a)
+        found &= _finite_rows(rows)
+        return t, rows, found
 
     def _fold_crossings(self, queries: list[tuple[int, float, str]]
                         ) -> list[tuple[float, int, int]]:
@@ -533,6 +746,155 @@ class _ContinuedFamily(_Family):
         b = np.concatenate(tracks)
         return list(zip(t1[ok].tolist(), b[ok].tolist(),
                         np.concatenate(qidx)[ok].tolist(), strict=True))
+
+    def _grazes(self, queries: list[tuple[int, float, str]],
+                found: list[tuple[float, int, int]]
+                ) -> tuple[list[tuple[float, int, int]], list[tuple[float, int, int]]]:
+        """Touches of a limit the sign-change scan cannot see (issue 29, session 9).
+
+        A joint's extremum on a branch at its limit (a graze: q generated with the
+        joint at its limit where the branch is tangent to it, e.g. next to q6 = 1e-9
+        on the offset iiwa) changes no sign, so ``_crossings`` finds nothing there;
+        nor does it see two crossings within one of its sub-values. Per track piece
+        and limited joint, the extrema of the cubic Hermite model (roots of its
+        derivative in the cell) within ``_GRAZE`` of a limit are refined on the
+        branch's rows (``sample_rows``: golden-section search of the joint's excess
+        over the limit, ``_GOLDEN`` steps in a quarter cell about the model's
+        extremum). Where the branch comes toward the limit from outside and turns
+        back within ``MANIFOLD_SLACK`` of it, the extremum is a touch ``(t, b, j)``
+        (the branch's in-slack stretch about it is ``_points_refined``'s to find);
+        where the extremum lies past the limit by more than the slack (a dip
+        inside from outside, or out from inside) and the scan found no crossing of
+        that joint and limit on one side of it in the cell, that side's is bisected
+        on the rows (:meth:`_dip_crossings`: ``(t, b, query index)``).
+
+        Returns ``(touches, crossings)``.
+        """
+        lim = [(qi, j, v, kind == "upper") for qi, (j, v, kind) in enumerate(queries)
+               if kind != "aligned axes"]
+        if not lim:
+            return [], []
+        tn, X, S = self.t_nodes, self.tracks, self.slopes
+        both = _finite_rows(X[:-1]) & _finite_rows(X[1:]) & _finite_rows(S[:-1]) & (
+            _finite_rows(S[1:]))
+        cc, bb = np.nonzero(both)
+        if not cc.size:
+            return [], []
+        h = (tn[cc + 1] - tn[cc])[:, None]
+        qa, sa = X[cc, bb], h * S[cc, bb]
+        qb, sb = qa + _wrap(X[cc + 1, bb] - qa), h * S[cc + 1, bb]
+        # q(u) = a0 + a1 u + a2 u^2 + a3 u^3 on u in [0, 1] (the cubic Hermite)
+        a1, a2, a3 = sa, 3 * (qb - qa) - 2 * sa - sb, 2 * (qa - qb) + sa + sb
+        A, B, C = 3 * a3, 2 * a2, a1  # q'(u) = A u^2 + B u + C
+        disc = B * B - 4 * A * C
+        with np.errstate(invalid="ignore", divide="ignore"):
+            r = -0.5 * (B + np.copysign(np.sqrt(np.maximum(disc, 0.0)), B))
+            us = np.stack([r / A, C / r])  # (2, pieces, n), stable for A = 0
+        us = np.where((disc >= 0) & (us >= 0) & (us <= 1), us, np.nan)
+        v = qa + us * (a1 + us * (a2 + us * a3))  # the extrema's values
+        curv = 2 * a2 + 6 * a3 * us  # q''(u): > 0 a minimum of q
+        cand: list[tuple[int, int, int, float, int]] = []  # (piece, query, sign, u, j)
+        for qi, j, value, upper in lim:
+            near = np.abs(_wrap(v[..., j] - value)) <= _GRAZE
+            for k, p in zip(*np.nonzero(near), strict=True):
+                # sign s: the excess over the limit is s (q - val) for upper, else -(q - val);
+                # from outside: the excess has a minimum (q a minimum at upper)
+                outside = (curv[k, p, j] > 0) == upper
+                cand.append((int(p), qi, 1 if outside else -1, float(us[k, p, j]), j))
+        if not cand:
+            return [], []
+        p_i = np.array([c[0] for c in cand])
+        u_i = np.array([c[3] for c in cand])
+        j_i = np.array([c[4] for c in cand])
+        val = np.array([queries[c[1]][1] for c in cand])
+        up = np.array([queries[c[1]][2] == "upper" for c in cand])
+        sign = np.where(up, 1.0, -1.0)  # excess = sign (q - val)
+        orient = np.array([float(c[2]) for c in cand])  # +1: minimise the excess
+        b_i = bb[p_i]
+        t_lo, t_hi = tn[cc[p_i]], tn[cc[p_i] + 1]
+        tm = t_lo + u_i * (t_hi - t_lo)
+        w = 0.125 * (t_hi - t_lo)
+        lo, hi = np.maximum(t_lo, tm - w), np.minimum(t_hi, tm + w)
+        rows = np.arange(len(cand))
+
+        def f(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            """(orient * excess of the branch's joint at t, the rows)."""
+            q, valid, _ = self.sample_rows(t)
+            r = q[rows, b_i]
+            e = sign * _wrap(r[rows, j_i] - val)
+            return np.where(valid[rows, b_i], orient * e, np.inf), r
+
+        g = 0.5 * (np.sqrt(5.0) - 1.0)
+        x1, x2 = hi - g * (hi - lo), lo + g * (hi - lo)
+        f1, _ = f(x1)
+        f2, _ = f(x2)
+        for _ in range(_GOLDEN):
+            left = f1 <= f2  # the minimum in [lo, x2]
+            hi = np.where(left, x2, hi)
+            lo = np.where(left, lo, x1)
+            x2n = np.where(left, x1, lo + g * (hi - lo))
+            x1n = np.where(left, hi - g * (hi - lo), x2)
+            fn, _ = f(np.where(left, x1n, x2n))
+            f1, f2 = np.where(left, fn, f2), np.where(left, f1, fn)
+            x1, x2 = x1n, x2n
+        ts = np.where(f1 <= f2, x1, x2)
+        best, _ = f(ts)
+        e = orient * best  # the extremum's excess over the limit
+        touches: list[tuple[float, int, int]] = []
+        dips: list[int] = []
+        for i in range(len(cand)):
+            if not np.isfinite(e[i]):
+                continue
+            if orient[i] > 0 and abs(e[i]) <= _SLACK:
+                if not any(b == b_i[i] and abs(t - ts[i]) < 1e-9 for t, b, _ in touches):
+                    touches.append((float(ts[i]), int(b_i[i]), int(j_i[i])))
+            elif orient[i] * e[i] < -_SLACK:  # past the limit: two crossings
+                dips.append(i)
+        return touches, self._dip_crossings(np.array(dips, dtype=int), ts, e, p_i, cc, j_i,
+                                            val, b_i, [c[1] for c in cand], found)
+
+    def _dip_crossings(self, d: np.ndarray, ts: np.ndarray, e: np.ndarray, p: np.ndarray,
+                       cc: np.ndarray, j: np.ndarray, val: np.ndarray, b: np.ndarray,
+                       qidx: list[int], found: list[tuple[float, int, int]]
+                       ) -> list[tuple[float, int, int]]:
+        """The crossings either side of the extrema ``d`` past their limits.
+
+        An extremum at ts with the joint's excess e past the limit has a crossing on
+        each side in its cell; a side where ``found`` has none of that joint and
+        limit is bisected on the branch's rows (:meth:`_bisected`) between ts and
+        ts +- sqrt(2 |e| / q'') (q'' the slope's change across the cell), or the
+        cell's end where those rows do not straddle the limit.
+        """
+        if not d.size:
+            return []
+        tn = self.t_nodes
+        c = cc[p[d]]
+        a, z = tn[c], tn[c + 1]
+        h = z - a
+        S0, S1 = self.slopes[c, b[d], j[d]], self.slopes[c + 1, b[d], j[d]]
+        curv = np.maximum(np.abs(S1 - S0) / h, 1e-12)
+        half = np.sqrt(2 * np.abs(e[d]) / curv)
+        qi = np.array(qidx)[d]
+        br, keep = [], []
+        for k in range(len(d)):
+            t0, bk, qk = float(ts[d[k]]), int(b[d[k]]), int(qi[k])
+            had = [t for t, b2, q2 in found if b2 == bk and q2 == qk and a[k] <= t <= z[k]]
+            if not any(t < t0 for t in had):
+                br.append([max(a[k], t0 - 2 * half[k]), t0, a[k], t0])
+                keep.append(k)
+            if not any(t > t0 for t in had):
+                br.append([t0, min(z[k], t0 + 2 * half[k]), t0, z[k]])
+                keep.append(k)
+        if not br:
+            return []
+        kk = np.array(keep)
+        t, _, ok = self._bisected(np.array(br), b[d][kk], j[d][kk], val[d][kk])
+        out: list[tuple[float, int, int]] = []
+        for tt, bb, q2 in zip(t[ok].tolist(), b[d][kk][ok].tolist(), qi[kk][ok].tolist(),
+                              strict=True):
+            if not any(bb == b2 and q2 == k2 and abs(tt - t2) < 1e-9 for t2, b2, k2 in out):
+                out.append((tt, bb, q2))
+        return out
 
     def _folds(self) -> list[tuple[float, int]]:
         """(t, track): where a track starts or ends inside the range (a fold).

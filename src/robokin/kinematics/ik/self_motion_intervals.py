@@ -425,7 +425,8 @@ _CONDITIONING = 1e-7
 
 
 def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
-                    owner: np.ndarray, points: np.ndarray, upper: int, every: bool = False
+                    owner: np.ndarray, points: np.ndarray, upper: int, every: bool = False,
+                    touch: np.ndarray | None = None
                     ) -> tuple[np.ndarray, np.ndarray, tuple[tuple[float, int, np.ndarray], ...]]:
     """Graze stretches and corners the intervals miss (issue 29, helper rates29).
 
@@ -469,6 +470,12 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     the point [t, t] alone, not widened (a corner whose second crossing the
     held-joint solve cannot give: the rtb-data iiwa14 with the elbow stretched).
 
+    ``touch`` (q, 3) ``[t, branch, joint]``: points a family knows the branch
+    stays within the slack of a limit beyond rounding (the continued family's
+    grazes and shallow crossings, ``_ContinuedFamily._grazes``): candidates like
+    the close crossings, kept even inside an interval (an interval ending at a
+    shallow crossing is widened to the in-slack stretch past it).
+
     Returns ``(intervals, owner, corners)``; the arrays unchanged (the same objects)
     when nothing is found: a uniform pose computes no row here (its cost is the
     test for short intervals and close points, ~5 us; the compiled swivel's kernel
@@ -484,7 +491,8 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     t = points[:, 0]
     # (count_nonzero and matmul, not min / any / column slices: each numpy call costs
     # ~0.5-2 us on these sizes, ~50 us the whole compiled swivel call)
-    if not every and not (np.count_nonzero(key[1:] - key[:-1] <= _PAIR)
+    touch = np.zeros((0, 3)) if touch is None else touch
+    if not every and not len(touch) and not (np.count_nonzero(key[1:] - key[:-1] <= _PAIR)
             or np.count_nonzero(t <= lo_d + _PAIR) or np.count_nonzero(t >= hi_d - _PAIR)
             or np.count_nonzero(np.dot(intervals, _LENGTH) <= _POINT)):
         return intervals, owner, ()
@@ -514,11 +522,24 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         held = ((intervals[None, :, 0] <= c[:, :1]) & (c[:, :1] <= intervals[None, :, 1])
                 & (owner[None, :] == c[:, 1:2])).any(axis=1)
         c, near = c[~held], near[~held]
+    if len(touch):  # not deep inside an interval (nothing to widen), one per _PAIR
+        deep = ((intervals[None, :, 0] + _PROBES[-1] < touch[:, :1])
+                & (touch[:, :1] < intervals[None, :, 1] - _PROBES[-1])
+                & (owner[None, :] == touch[:, 1:2])).any(axis=1)
+        touch = touch[~deep]
+        touch = touch[np.lexsort((touch[:, 0], touch[:, 1]))]
+        again = np.zeros(len(touch), dtype=bool)
+        again[1:] = (touch[1:, 1] == touch[:-1, 1]) & (np.diff(touch[:, 0]) <= _PAIR)
+        touch = touch[~again]
+        c = np.concatenate([c, touch[:, :3]])
+        near = np.concatenate([near, np.ones(len(touch), dtype=bool)])
     # joint: every interval's ends too (a crossing of a joint moving slowly with t,
     # e.g. the iiwa's wrist with the elbow stretched, |dq/dt| 1e-4: the row is inside
     # by the slack up to 1e-8 beyond the exact crossing, where q's value can lie)
     stretch = [(float(a), float(e), int(b)) for (a, e), b, p in zip(intervals, owner, point)
                if p or joint]
+    reach = [False] * len(stretch)  # a touch's side inside at every probe: to the last one
+    first_touch = len(c) - len(touch)
     corners: list[tuple[float, int, np.ndarray]] = []
     points_only: list[tuple[int, float, float]] = []
     if len(c):
@@ -539,6 +560,7 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
             inside[lone] = tangent
         for i in np.flatnonzero(inside):
             stretch.append((float(c[i, 0]), float(c[i, 0]), int(b[i])))
+            reach.append(bool(i >= first_touch))
         for i in np.flatnonzero((worst > MANIFOLD_SLACK) & (worst <= _CONDITIONING)):
             hold = np.flatnonzero(np.abs(excess[i]) <= _CONDITIONING)
             if len(hold) < 2:
@@ -548,7 +570,8 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
                 tc = _param(fam, row)
                 if tc is not None:
                     corners.append((tc, int(b[i]), row))
-    new = _widen(fam, limits, stretch) + [(b, t, t) for t, b, _ in corners] + points_only
+    new = (_widen(fam, limits, stretch, reach) + [(b, t, t) for t, b, _ in corners]
+           + points_only)
     iv, ob = _merged(intervals, owner, new)
     if not corners and np.array_equal(iv, intervals) and np.array_equal(ob, owner):
         return intervals, owner, ()  # nothing widened or added: the kernel's arrays
@@ -623,8 +646,8 @@ def _held_refine(fam: _Family, limits: np.ndarray, r: np.ndarray, hold: np.ndarr
     return q
 
 
-def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, int]]
-           ) -> list[tuple[int, float, float]]:
+def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, int]],
+           reach: list[bool] | None = None) -> list[tuple[int, float, float]]:
     """Each in-limit stretch (a, e, b) (a point: a = e) widened to its in-slack extent.
 
     Probes at ``_PROBES`` before a and after e (one batch); a side with a probe
@@ -633,7 +656,10 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
     every stretch together), ``_WIDEN`` steps (to ~1e-3 of that decade), and ends
     1e-3 of its distance inside the last inside value found (a graze's joint there
     ~0.998 of the slack from its limit: ``test_swivel.test_intervals_are_exact``'s
-    ends at a limit to 1e-12 hold after the swivel's 2 pi shift).
+    ends at a limit to 1e-12 hold after the swivel's 2 pi shift). A side inside at
+    every probe is not widened, except for the points flagged in ``reach`` (a
+    family's touches: a joint riding its limit within the slack, e.g. the offset
+    iiwa's q4 out by 1e-15 over 2e-2 of t): to the last probe.
     """
     if not points:
         return []
@@ -675,6 +701,9 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
             a = new_a
         d[go] = a * (1.0 - 1e-3)  # inside the last inside value: its row stays within
         # the slack after a 2 pi shift of the swivel (rounding) at q'' up to ~1e11
+    if reach is not None:
+        full = ok.all(axis=1) & np.tile(np.array(reach, dtype=bool), 2)
+        d[full] = _PROBES[-1] * (1.0 - 1e-3)
     ends = t0 + side * d
     out = []
     for a, e, b in zip(ends[:m].tolist(), ends[m:].tolist(), br[:m].tolist(), strict=True):
