@@ -240,6 +240,14 @@ static void hm_slopes(const double *P, int n, int k, const double *q, double *dq
     dq[k] = 1.0;
 }
 
+/* From here to hm_closed's end: no contraction into fused multiply-adds (and no
+ * vectorisation), as pieper.c: the slopes' values then do not depend on how their
+ * formulas are split over functions (contracted, the compiler fuses a split
+ * computation's products differently: issue 29 rounds 7b, 8a). */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC push_options
+#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
+#endif
 /* The first three axes' common point (zero configuration) into *pc when they meet
  * (to 1e-12 of the scale) and the held joint is the last of seven: the structure
  * hm_slopes_fast needs. */
@@ -382,10 +390,6 @@ static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
  * makes of a row depends on its other slots (a repair it tries only when no row
  * is inside would move it). (Round 8a: 0 of ~494 evaluations per pose on the
  * development poses return 0, against ~21 before.) */
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC push_options
-#pragma GCC optimize("fp-contract=off", "no-tree-vectorize")
-#endif
 /* How far chain angles th (remaining chain) lie outside the limits, each joint at
  * its turn nearest them (as pk_inside measures it) [rad]: the largest. */
 static double hm_outside(const double *P, const PkGeo *g, const double *th)
