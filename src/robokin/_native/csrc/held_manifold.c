@@ -149,6 +149,10 @@ typedef struct {
     v3 fc, Gt, u6, w6, b5;
     m3 GA, B5;
     double ft;
+    /* the last wrist solve (hm_wrist): its t, q5, q6, whether it held, x and r */
+    double wt, wq[2], wx[3];
+    int wok;
+    v3 wr;
     /* near-fold rows of a slot pair (b, b ^ 1), evaluated together (hm_eval_pair) */
     HmRow pair_row[HM_PAIR_ROWS];
     unsigned pair_need[HM_PAIR_ROWS], pair_mask[HM_PAIR_ROWS];
@@ -281,6 +285,7 @@ static int hm_fast_setup(HmCtx *c)
     c->u6 = v3_scale(v3_cross(h6, v3_sub(pc, o6)), sg);
     c->w6 = v3_scale(h6, sg);
     c->ft = NAN;
+    c->wt = NAN;
     return 1;
 }
 
@@ -313,34 +318,34 @@ static int hm_solve3(v3 a, v3 b, v3 e, v3 r, double tol, double x[3])
     return 1;
 }
 
-/* hm_slopes by the structure (hm_fast_setup): the manifold's velocity equations
- * taken at the first three axes' common point fc, where those three columns have
- * no linear part, split into the wrist joints' 3 x 3 (linear: joints 4-6 against
- * the held joint's column) and the shoulder's 3 x 3 (angular); the world axes of
- * joints 4-6 from the pose backwards (G E_6^-1 E_5^-1 ...), of joints 1-3 from
- * the base: 4 sincos per row and slot instead of the full FK's 7 and a 6 x 6.
- * The same slopes to rounding (the system differs by row operations); 0 (and
- * hm_slopes decides) where a block's determinant is below HM_SLOPE_DET times its
- * columns' lengths: next to a fold or an aligned shoulder, where the two differ
- * by more than rounding and hm_slopes' own singular test (a pivot below 1e-14)
- * decides whether the slope is NaN. */
-static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
+/* hm_slopes_fast's wrist part at held value t for a row whose q5, q6 are q[4],
+ * q[5]: the wrist joints' rates x (joints 4-6 against the held joint's linear
+ * column at fc) and r, the angular velocity the shoulder must cancel; 0 when the
+ * wrist block is singular to HM_SLOPE_DET. A function of t, q5 and q6 alone, so a
+ * slot pair (the same position root: the same q4-q6) shares it: the last one is
+ * kept (c->wt, wq) and taken again for the same t, q5, q6 (the same values: no
+ * contraction in this region). */
+static int hm_wrist(HmCtx *c, double t, const double *q, double x[3], v3 *r)
 {
     const double *P = c->P;
-    double sg[7], cs[7], sn[7];
+    if (t == c->wt && q[4] == c->wq[0] && q[5] == c->wq[1]) {
+        for (int i = 0; i < 3; i++)
+            x[i] = c->wx[i];
+        *r = c->wr;
+        return c->wok;
+    }
     hm_fast_at(c, t);
-    for (int j = 0; j < 6; j++) {
-        if (j == 2 || j == 3)
-            continue;
+    double cs[6], sn[6], sg[6];
+    for (int j = 3; j < 6; j++) {
         sg[j] = P[PK_SIGN + j];
+        if (j == 3)
+            continue;
         double th = sg[j] * q[j] + P[PK_OFFSET + j];
         cs[j] = cos(th);
         sn[j] = sin(th);
     }
-    sg[2] = P[PK_SIGN + 2];
-    sg[3] = P[PK_SIGN + 3];
-    v3 h[7], o[7];
-    for (int j = 0; j < 7; j++) {
+    v3 h[6], o[6];
+    for (int j = 3; j < 6; j++) {
         h[j] = v3_at(P, PK_AXES + 3 * j);
         o[j] = v3_at(P, PK_POINTS + 3 * j);
     }
@@ -358,15 +363,51 @@ static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
         U[i] = v3_scale(v3_cross(H[i], v3_sub(c->fc, O[i])), sg[3 + i]);
         Wa[i] = v3_scale(H[i], sg[3 + i]);
     }
-    double x[3], y[3], tol = HM_SLOPE_DET;
-    if (!hm_solve3(U[0], U[1], U[2], v3_scale(c->u6, -1.0), tol, x))
+    int ok = hm_solve3(U[0], U[1], U[2], v3_scale(c->u6, -1.0), HM_SLOPE_DET, x);
+    if (ok)
+        *r = v3_add(v3_add(v3_scale(Wa[0], x[0]), v3_scale(Wa[1], x[1])),
+                    v3_add(v3_scale(Wa[2], x[2]), c->w6));
+    c->wt = t;
+    c->wq[0] = q[4];
+    c->wq[1] = q[5];
+    c->wok = ok;
+    for (int i = 0; i < 3; i++)
+        c->wx[i] = ok ? x[i] : NAN;
+    c->wr = ok ? *r : (v3){NAN, NAN, NAN};
+    return ok;
+}
+
+/* hm_slopes by the structure (hm_fast_setup): the manifold's velocity equations
+ * taken at the first three axes' common point fc, where those three columns have
+ * no linear part, split into the wrist joints' 3 x 3 (linear: joints 4-6 against
+ * the held joint's column) and the shoulder's 3 x 3 (angular); the world axes of
+ * joints 4-6 from the pose backwards (G E_6^-1 E_5^-1 ...), of joints 1-3 from
+ * the base: 2 sincos per row and slot and 2 per slot pair (the wrist, hm_wrist)
+ * instead of the full FK's 7 and a 6 x 6.
+ * The same slopes to rounding (the system differs by row operations); 0 (and
+ * hm_slopes decides) where a block's determinant is below HM_SLOPE_DET times its
+ * columns' lengths: next to a fold or an aligned shoulder, where the two differ
+ * by more than rounding and hm_slopes' own singular test (a pivot below 1e-14)
+ * decides whether the slope is NaN. */
+static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
+{
+    const double *P = c->P;
+    double x[3], y[3], cs[2], sn[2], sg[3];
+    v3 r;
+    if (!hm_wrist(c, t, q, x, &r))
         return 0;
+    for (int j = 0; j < 3; j++)
+        sg[j] = P[PK_SIGN + j];
+    for (int j = 0; j < 2; j++) {
+        double th = sg[j] * q[j] + P[PK_OFFSET + j];
+        cs[j] = cos(th);
+        sn[j] = sin(th);
+    }
+    v3 h0 = v3_at(P, PK_AXES), h1 = v3_at(P, PK_AXES + 3), h2 = v3_at(P, PK_AXES + 6);
     /* the shoulder: world axes R0 h1, R0 R1 h2 */
-    v3 a1 = v3_rot(h[0], cs[0], sn[0], h[1]);
-    v3 a2 = v3_rot(h[0], cs[0], sn[0], v3_rot(h[1], cs[1], sn[1], h[2]));
-    v3 r = v3_add(v3_add(v3_scale(Wa[0], x[0]), v3_scale(Wa[1], x[1])),
-                  v3_add(v3_scale(Wa[2], x[2]), c->w6));
-    if (!hm_solve3(v3_scale(h[0], sg[0]), v3_scale(a1, sg[1]), v3_scale(a2, sg[2]),
+    v3 a1 = v3_rot(h0, cs[0], sn[0], h1);
+    v3 a2 = v3_rot(h0, cs[0], sn[0], v3_rot(h1, cs[1], sn[1], h2));
+    if (!hm_solve3(v3_scale(h0, sg[0]), v3_scale(a1, sg[1]), v3_scale(a2, sg[2]),
                    v3_scale(r, -1.0), HM_SLOPE_DET, y))
         return 0;
     dq[0] = y[0];
