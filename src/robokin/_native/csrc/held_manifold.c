@@ -1067,24 +1067,27 @@ static double hm_gap(const HmCtx *c, int b, const HmRow *r)
 
 /* Whether a cell [r0, r1] of slot b must be split: a joint moving more than
  * HM_JUMP, a slope missing, or a query's sign change that its end slopes do not
- * explain as one monotone crossing, or whose Hermite model dips across. */
-static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1)
+ * explain as one monotone crossing, or whose Hermite model dips across. dj: each
+ * joint's move over the cell (wrap_pi(q1 - q0)), fq: each query's q_j - value at
+ * r0 (hm_f), as hm_cell computes them once for both (the same values). */
+static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1,
+                          const double *dj, const double *fq)
 {
     double h = r1->t - r0->t, big = 0.0;
     int coarse = h > 1.5 * c->hfine; /* wider than a margin cell (round 8b) */
-    for (int j = 0; j < c->n; j++)
-        big = fmax(big, fabs(wrap_pi(r1->q[b][j] - r0->q[b][j])));
+    for (int j = 0; j < c->n; j++) /* (fmax's value: dj is finite, rows at both ends) */
+        big = fabs(dj[j]) > big ? fabs(dj[j]) : big;
     if (h < 1e-9 && big < 1e-6)
         return 0; /* at a branch end (its rows within rounding of the double root) */
     for (int j = 0; j < c->n; j++) {
-        if (fabs(wrap_pi(r1->q[b][j] - r0->q[b][j])) > HM_JUMP)
+        if (fabs(dj[j]) > HM_JUMP)
             return 1;
         if (!isfinite(r0->dq[b][j]) || !isfinite(r1->dq[b][j]))
             return 1;
     }
     for (int qi = 0; qi < c->nq; qi++) {
         int j = c->qj[qi];
-        double f0 = hm_f(c, r0, b, qi), f1 = f0 + wrap_pi(r1->q[b][j] - r0->q[b][j]);
+        double f0 = fq[qi], f1 = f0 + dj[j];
         double d0 = r0->dq[b][j] * h, d1 = r1->dq[b][j] * h;
         if (fabs(f0) > 3.0 || fabs(f1) > 3.0)
             continue; /* the value's far turn: nothing near */
@@ -1093,7 +1096,8 @@ static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r
              * f1) plus d0 h10 + d1 h11 with |h10|, |h11| <= 4/27 on the cell, so it stays
              * `far` from the value; when that exceeds the tests' thresholds (with room for
              * their rounding) neither hm_hermite_dips nor hm_coarse_unsure can split */
-            double far = fmin(fabs(f0), fabs(f1)) - 0.1482 * (fabs(d0) + fabs(d1)) -
+            double a0 = fabs(f0), a1 = fabs(f1); /* (fmin's value: both finite) */
+            double far = (a1 < a0 ? a1 : a0) - 0.1482 * (fabs(d0) + fabs(d1)) -
                          1e-13 * (fabs(f0) + fabs(f1) + fabs(d0) + fabs(d1));
             double A = 3.0 * (f1 - f0) - 2.0 * d0 - d1, B = 2.0 * (f0 - f1) + d0 + d1;
             if (far > 2.0 * HM_TOL && !(HM_UNSURE && coarse && !(far > fabs(A) + fabs(B))))
@@ -1375,7 +1379,12 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
         return; /* flagged: the caller discards the pose; retry: the slot is redone (hm_pose) */
     if (c->njump && hm_known_jump(c, b, r0, r1, depth))
         return;
-    if (hm_needs_split(c, b, r0, r1)) {
+    double dj[PK_MAXJ], fq[HM_MAXQ];
+    for (int j = 0; j < c->n; j++)
+        dj[j] = wrap_pi(r1->q[b][j] - r0->q[b][j]);
+    for (int qi = 0; qi < c->nq; qi++)
+        fq[qi] = hm_f(c, r0, b, qi);
+    if (hm_needs_split(c, b, r0, r1, dj, fq)) {
         if (depth < HM_DEPTH) {
             HmRow m;
             hm_eval(c, 0.5 * (r0->t + r1->t), 1u << b, 1u << b, &m);
@@ -1396,7 +1405,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
     double h = r1->t - r0->t;
     for (int qi = 0; qi < c->nq && !c->flags; qi++) {
         int j = c->qj[qi];
-        double f0 = hm_f(c, r0, b, qi), f1 = f0 + wrap_pi(r1->q[b][j] - r0->q[b][j]);
+        double f0 = fq[qi], f1 = f0 + dj[j];
         double d0 = r0->dq[b][j], d1 = r1->dq[b][j];
         if (fabs(f0) <= HM_TOL || fabs(f1) <= HM_TOL || fabs(f0) > 3.0)
             continue; /* a node's zero (hm_node), or the far turn */
