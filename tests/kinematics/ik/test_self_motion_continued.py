@@ -720,3 +720,95 @@ def test_a_manifold_between_two_nodes_is_found():
     far = T.copy()
     far[:3, 3] *= 1.5
     assert not len(robot.self_motion(far, parameter=name).intervals)
+
+
+#: Islands of the random 7R arm narrower than the node spacing (benchmarks/
+#: self_motion_rates.py, seed 0, n 10,000; index in its dump): two branches joined by
+#: folds at both ends between two of the 181 nodes, whose rows are other branches'
+#: only; main (8785491) did not sample q back.
+ISLANDS = [
+    # uniform 3652: 4 rows more for q7 in ~[-1.211, -1.200] (nodes -1.2198, -1.1868)
+    [0.6686224713458673, -1.6918739587095508, -1.5236333717527877, -2.6495495384599232,
+     -2.527788949885458, 2.4953627159025844, -1.2014022727517648],
+    # special 5635: 2 rows for q7 in ~[1.5576, 1.5702] (nodes 1.5495, 1.5824), none else
+    [-2.9670597283903604, 0.7043055689424103, 1e-07, -2.9670597283903604,
+     2.782250464691648, 2.9670597283903604, 1.5707963267948966],
+]
+
+
+@pytest.mark.parametrize("q", ISLANDS)
+def test_an_island_between_two_nodes_is_found(q):
+    # Issue 29, session 10 (helper island29). Oracles: independent held solves
+    # (robot.ik with q7 given): q7's value has more rows than both nodes around it (an
+    # island); q is sampled back at its q7, inside an interval of its branch; at 9
+    # values across the island every independent row is a sampled branch's row (as
+    # sets, 1e-9) and every independent in-limit one lies in an interval of that
+    # branch; sampled rows reproduce the pose to 1e-12.
+    robot = ARMS["random7r"]
+    name = robot.joint_names[-1]
+    q0 = np.array(q)
+    T, sm = _manifold(robot, q0)
+    t = float(q0[6])
+    nodes = np.linspace(*robot.limits[6], 181)
+    i = int(np.searchsorted(nodes, t))
+    held = robot.ik(T, fixed={name: np.array([nodes[i - 1], t, nodes[i]])})
+    n_rows = held.valid.sum(axis=-1)
+    assert n_rows[1] > max(n_rows[0], n_rows[2]), n_rows
+    d = _wrapped(sm.sample(t) - q0).max(-1)
+    b = int(np.nanargmin(d))
+    assert d[b] < 1e-9, d
+    iv = sm.intervals[sm.interval_branch == b]
+    assert ((iv[:, 0] <= t) & (t <= iv[:, 1])).any(), (t, iv)
+    # the island's extent: where the independent solves have more rows than the nodes
+    ts = np.linspace(nodes[i - 1], nodes[i], 201)
+    more = robot.ik(T, fixed={name: ts}).valid.sum(axis=-1) > max(n_rows[0], n_rows[2])
+    ts = np.linspace(ts[more][0], ts[more][-1], 9)
+    ref = robot.ik(T, fixed={name: ts})
+    got = sm.sample(ts)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    checked = 0
+    for k in range(len(ts)):
+        rows = got[k][np.isfinite(got[k]).all(-1)]
+        dp, dr = pose_errors(robot.fk(rows), np.broadcast_to(T, rows.shape[:1] + (4, 4)))
+        assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+        for r in ref.q[k][ref.valid[k]]:
+            g = _wrapped(got[k] - r).max(-1)
+            bb = int(np.nanargmin(g))
+            assert g[bb] < 1e-9, (ts[k], g)
+            if np.all((r >= lo - 1e-9) & (r <= hi + 1e-9)):
+                ivb = sm.intervals[sm.interval_branch == bb]
+                assert ((ivb[:, 0] <= ts[k]) & (ts[k] <= ivb[:, 1])).any(), (ts[k], bb, ivb)
+                checked += 1
+    assert checked > 0
+
+
+def test_the_near_real_root_pairs_reach_the_axis_at_an_islands_fold():
+    # Issue 29, session 10: EndSweep.solve_pairs' pairs (the general 6R kernel's complex
+    # roots nearest the real axis) are the island signal. Oracle: the rows of
+    # independent held solves. Random 7R #5635 (ISLANDS[1]): its island's lower fold
+    # bracketed by the row count to 1e-9 in q7; below it the nearest pair's imaginary
+    # part falls towards 0 as the fold nears (below 1e-3 within 1e-7 of it, ~ sqrt of
+    # the distance: 1e-2 and more 1e-2 away), sorted nearest first and positive.
+    from robokin.kinematics.ik.fixed import EndSweep
+
+    robot = ARMS["random7r"]
+    name = robot.joint_names[-1]
+    q0 = np.array(ISLANDS[1])
+    T = robot.fk(q0)
+    lo, hi = 1.5495, float(q0[6])  # no row at lo, 2 at hi
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        if robot.ik(T, fixed={name: mid}).valid.any():
+            hi = mid
+        else:
+            lo = mid
+    assert hi - lo < 1e-9
+    sweep = EndSweep.of(robot.arm, 6, T)
+    assert sweep is not None
+    d = np.array([1e-2, 1e-4, 1e-7])
+    sols, pairs = sweep.solve_pairs(lo - d)
+    assert pairs.shape == (3, 4, 2)
+    assert not sols.valid.any()
+    im = pairs[..., 0]
+    assert np.all(im[:, 0] > 0) and np.all(np.diff(im, axis=1) >= 0)
+    assert im[0, 0] > 1e-2 and im[2, 0] < 1e-3 and im[1, 0] < im[0, 0], im[:, 0]

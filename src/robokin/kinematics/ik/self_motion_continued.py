@@ -114,6 +114,12 @@ _SHALLOW = 1e-3
 _RIDE = 1e-5
 #: A joint this close to a limit [rad] at another joint's crossing makes it a touch.
 _AT_LIMIT = 1e-9
+#: A node with a non-real root pair this close to the axis [rad of the split joint's
+#: angle] has both its cells probed for an island (``_islands``; 0.84 such nodes per
+#: uniform random 7R pose).
+_TINY = 2e-2
+#: Largest real-part distance [rad] of one root pair at neighbouring nodes.
+_MATCH = 0.3
 #: The membership slack (``self_motion_intervals.MANIFOLD_SLACK``, the kernels' 1e-12).
 _SLACK: float = _K.MANIFOLD_SLACK
 #: Bisection steps of a fold (a cell to two adjacent doubles).
@@ -158,7 +164,9 @@ class _ContinuedFamily(_Family):
         # the end joint's sweep set up once per pose (None: a middle joint, solve_fixed)
         self._sweep = EndSweep.of(robot, j, self.T)
         t = np.linspace(*self.domain, int(nodes))
-        Q = self._solve(t)
+        Q, pairs = self._solve_pairs(t)
+        if pairs is not None:  # islands narrower than the node spacing
+            t, Q = self._islands(t, Q, pairs)
         if not _finite_rows(Q).any():  # no node has a row: the manifold between two?
             t, Q = self._seeded(t, Q)
         D = _slopes(robot, Q, j)
@@ -232,18 +240,71 @@ class _ContinuedFamily(_Family):
         order = np.argsort(t2, kind="stable")
         return t2[order], np.concatenate([Q, Qv])[order]
 
+    def _islands(self, t: np.ndarray, Q: np.ndarray, pairs: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+        """Nodes t (m,) and rows Q with the values added where an island was found.
+
+        An island (two branches joined by folds at both ends) narrower than the
+        node spacing has no row at any node: the random 7R's uniform seed 0 #3652,
+        4 rows for t in ~[-1.211, -1.200] between the nodes -1.2198 and -1.1868,
+        whose rows are the 2 of other branches. Its pair of rows is born where a
+        pair of complex roots of the general 6R's eliminated polynomial reaches the
+        real axis (``pairs``: per node the four non-real pairs nearest it, the
+        imaginary and real part of the split joint's angle [rad]). Probed (one
+        batch): the midpoints of both cells of a node with a pair within ``_TINY``
+        of the axis, and where a pair approaches it from node to node (matched by
+        the real part, within ``_MATCH``) the value its imaginary part, linear in
+        t, reaches 0 in the next cell (a pair near the axis moves ~ |t - t_0| away
+        from a tangency). A probe is kept as a node only where it has more rows
+        than both nodes of its cell (so poses without an island keep their nodes);
+        the halvings next to it then find the island's folds.
+        """
+        im, re = pairs[..., 0], pairs[..., 1]  # (m, 4)
+        m = len(t)
+        if m < 3:
+            return t, Q
+        tiny = np.flatnonzero((im < _TINY).any(axis=1))
+        cells = np.concatenate([tiny - 1, tiny])
+        cells = np.unique(cells[(cells >= 0) & (cells < m - 1)])
+        probe = [0.5 * (t[cells] + t[cells + 1]),
+                 _approach(t, im, re), -_approach(-t[::-1], im[::-1], re[::-1])]
+        v = np.unique(np.concatenate(probe))
+        if not v.size:
+            return t, Q
+        Qv = self._solve(v)
+        count, count_v = _finite_rows(Q).sum(axis=1), _finite_rows(Qv).sum(axis=1)
+        i = np.clip(np.searchsorted(t, v) - 1, 0, m - 2)
+        keep = count_v > np.maximum(count[i], count[i + 1])
+        if not keep.any():
+            return t, Q
+        Q, Qv = _widen(Q, Qv[keep])
+        t2 = np.concatenate([t, v[keep]])
+        order = np.argsort(t2, kind="stable")
+        return t2[order], np.concatenate([Q, Qv])[order]
+
     # ------------------------------------------------------------ rows
     def _solve(self, t: np.ndarray) -> np.ndarray:
         """Every general-6R row at held values t (m,): (m, K, n), NaN where none.
 
         The valid rows come first in each value's K slots; K is the most any value has.
         """
+        return self._solve_pairs(t)[0]
+
+    def _solve_pairs(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """:meth:`_solve`, and the kernel's near-real root pairs at each value.
+
+        Returns:
+            The rows (m, K, n) and (m, 4, 2) (``EndSweep.solve_pairs``: imaginary,
+            real part [rad] of the four non-real pairs nearest the axis), or None
+            where the joint is not an end joint (``solve_fixed``: no pairs).
+        """
         self.solves += len(t)
         # an end joint on a general 6R reduced chain: the kernel directly (the same
         # rows as solve_fixed, without its per-call checks and assemblies)
-        sols = (None if self._sweep is None
-                else self._sweep.solve(np.ascontiguousarray(t, np.float64)))
-        if sols is None:
+        pairs = None
+        if self._sweep is not None:
+            sols, pairs = self._sweep.solve_pairs(np.ascontiguousarray(t, np.float64))
+        else:
             sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
         valid = sols.valid.reshape(len(t), -1)
         q = sols.q.reshape(len(t), -1, self.robot.n)
@@ -256,7 +317,7 @@ class _ContinuedFamily(_Family):
             order = np.argsort(~valid, axis=1, kind="stable")[:, :width]
             q = np.take_along_axis(q, order[..., None], 1)
             ok = np.take_along_axis(valid, order, 1)
-        return _into_limits(self.robot, np.where(ok[..., None], q, np.nan))
+        return _into_limits(self.robot, np.where(ok[..., None], q, np.nan)), pairs
 
     def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = np.atleast_1d(np.asarray(t, dtype=np.float64))
@@ -1005,6 +1066,31 @@ def _fold_newton(robot: Arm, T: np.ndarray, q0: np.ndarray, s0: np.ndarray, dt: 
         v = v_next
     ok &= np.abs(g) < 1e-10
     return q, ok
+
+
+def _approach(t: np.ndarray, im: np.ndarray, re: np.ndarray) -> np.ndarray:
+    """Where root pairs approaching the real axis reach it in the next cell.
+
+    t (m,) increasing nodes; im, re (m, p) per node the non-real root pairs'
+    imaginary and real parts (``_ContinuedFamily._islands``, inf where none). Each
+    pair at node i (1 <= i <= m - 2) is matched with the pair at node i - 1 of the
+    nearest real part (within ``_MATCH`` [rad]); where its imaginary part fell,
+    the line through the two reaches 0 at some t: returned (k,) where that lies
+    inside the cell (t_i, t_i+1).
+    """
+    a, b = slice(0, -2), slice(1, -1)
+    with np.errstate(invalid="ignore"):
+        d = np.abs(_wrap(re[b, :, None] - re[a, None, :]))  # (m-2, p, p)
+        d = np.where(np.isfinite(d), d, np.inf)
+        near = np.argmin(d, axis=2)
+        im_a = np.take_along_axis(im[a], near, axis=1)  # (m-2, p)
+        ok = (np.take_along_axis(d, near[..., None], 2)[..., 0] < _MATCH) & (im_a > im[b])
+        ok &= np.isfinite(im[b])
+        tb, dt = t[b][:, None], (t[b] - t[a])[:, None]
+        tz = tb + im[b] * dt / np.where(ok, im_a - im[b], 1.0)
+        ok &= (tz > tb) & (tz < t[2:][:, None])
+    out: np.ndarray = tz[ok]
+    return out
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:
