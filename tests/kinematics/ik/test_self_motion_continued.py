@@ -812,3 +812,42 @@ def test_the_near_real_root_pairs_reach_the_axis_at_an_islands_fold():
     im = pairs[..., 0]
     assert np.all(im[:, 0] > 0) and np.all(np.diff(im, axis=1) >= 0)
     assert im[0, 0] > 1e-2 and im[2, 0] < 1e-3 and im[1, 0] < im[0, 0], im[:, 0]
+
+
+def test_a_joint_riding_its_limit_keeps_the_whole_in_slack_stretch():
+    # Issue 29, session 10 (helper island29): offset iiwa special #5084 (seed 0): q4 at
+    # its upper limit with q2 = 1e-9, q3 = -1e-9; along the branch q4 stays within ~1e-14
+    # of the limit over ~0.06 of q7 either side of q's value (its sign changes are
+    # rounding's), so the in-slack stretch is long; main (8785491) widened its touch by
+    # 1e-3 only and ended the interval 4.6e-4 short of q7. Oracles: independent held
+    # solves (robot.ik with q7 given) at 41 values across q's interval have a row within
+    # 1e-9 of the branch's, inside every limit by MANIFOLD_SLACK (plus 1e-15 for the
+    # general-6R rows' rounding), and reproducing the pose to 1e-12; the interval holds
+    # q7 +- 0.02.
+    from robokin.kinematics.ik.self_motion_intervals import MANIFOLD_SLACK
+
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array([-1.5707963267948966, 1e-09, -1e-09, 2.0943951023931953, -1e-07,
+                   -1e-06, -0.8384789305589901])
+    T, sm = _manifold(robot, q0)
+    t = float(q0[6])
+    d = _wrapped(sm.sample(t) - q0).max(-1)
+    b = int(np.nanargmin(d))
+    assert d[b] < 1e-9, d
+    iv = sm.intervals[sm.interval_branch == b]
+    hit = iv[(iv[:, 0] <= t) & (t <= iv[:, 1])]
+    assert len(hit) == 1, (t, iv)
+    a, e = hit[0]
+    assert a <= t - 0.02 and e >= t + 0.02, (a, e)
+    ts = np.linspace(a, e, 41)
+    rows = sm.sample(ts)[:, b]
+    ref = robot.ik(T, fixed={robot.joint_names[-1]: ts})
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    for k in range(len(ts)):
+        g = _wrapped(ref.q[k][ref.valid[k]] - rows[k]).max(-1)
+        assert g.min() < 1e-9, (ts[k], g)
+        r = ref.q[k][ref.valid[k]][int(np.argmin(g))]
+        assert np.all((r >= lo - MANIFOLD_SLACK - 1e-15) & (r <= hi + MANIFOLD_SLACK + 1e-15)), (
+            ts[k], np.maximum(r - hi, lo - r).max())
+        dp, dr = pose_errors(robot.fk(r), T)
+        assert dp <= 1e-12 and dr <= 1e-12
