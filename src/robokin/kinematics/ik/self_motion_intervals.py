@@ -716,8 +716,8 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
         return a
 
     if go.any():
-        a = search(_PROBES[first_out[go] - 1], _PROBES[first_out[go]], np.flatnonzero(go))
-        d[go] = a * (1.0 - 1e-3)  # inside the last inside value: its row stays within
+        last = search(_PROBES[first_out[go] - 1], _PROBES[first_out[go]], np.flatnonzero(go))
+        d[go] = last * (1.0 - 1e-3)  # inside the last inside value: its row stays within
         # the slack after a 2 pi shift of the swivel (rounding) at q'' up to ~1e11
     if reach is not None:
         full = ok.all(axis=1) & np.tile(np.array(reach, dtype=bool), 2)
@@ -728,8 +728,8 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
             # the first outside one (the offset iiwa #5084: q4 within 1e-14 of its
             # limit over ~0.06 of t about q's value, its crossings rounding's)
             g = np.flatnonzero(full)
-            cap = np.concatenate([[a - c for (a, _, _), (c, _) in zip(points, caps, strict=True)],
-                                  [c - e for (_, e, _), (_, c) in zip(points, caps, strict=True)]])
+            cap = np.concatenate([[p0 - c0 for (p0, _, _), (c0, _) in zip(points, caps, strict=True)],
+                                  [c1 - p1 for (_, p1, _), (_, c1) in zip(points, caps, strict=True)]])
             x = np.minimum(_PROBES[-1] * 2.0 ** np.arange(1, _FAR + 1)[None, :],
                            cap[g, None])  # (g, _FAR)
             inn = inside(t0[g, None] + side[g, None] * x, br[g])
