@@ -851,3 +851,34 @@ def test_a_joint_riding_its_limit_keeps_the_whole_in_slack_stretch():
             ts[k], np.maximum(r - hi, lo - r).max())
         dp, dr = pose_errors(robot.fk(r), T)
         assert dp <= 1e-12 and dr <= 1e-12
+
+
+def test_an_islands_crossing_at_a_singular_point_cuts_its_interval():
+    # Issue 29, session 10: offset iiwa special #5140 (seed 0; q2 = q4 = -1e-9): an
+    # island of 8 rows for q7 in ~[0.0745, 0.1000] (between nodes 0.0679 and 0.1018),
+    # where two of its tracks meet at q7 = 5 deg with q1 at its limit; the held Newton
+    # of that crossing drifts along the near-continuum (q3 to 12.4) and the model's scan
+    # listed none, so without the island's row scan an interval ran over rows with q1
+    # 0.17 rad past its limit. Oracles: the branches' rows (sm.sample) and independent
+    # held solves (robot.ik with q7 given): every row at 19 values inside each interval in
+    # the island is inside every limit (1e-9), reproduces the pose to 1e-12, and is
+    # an independent solve's row (1e-6); the island has intervals.
+    robot = ARMS["offset_iiwa"]
+    name = robot.joint_names[-1]
+    q0 = np.array([2.9670597283903604, -1e-09, 2.9670597283903604, -1e-09,
+                   -2.9670597283903604, -1.85123972048024, -3.0543261909900767])
+    T, sm = _manifold(robot, q0)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    sel = (sm.intervals[:, 0] > 0.07) & (sm.intervals[:, 1] < 0.105)
+    assert sel.sum() >= 4, sm.intervals
+    for (a, e), b in zip(sm.intervals[sel], sm.interval_branch[sel], strict=True):
+        ts = np.linspace(a, e, 21)[1:-1]  # (an end at a fold has no row to rounding)
+        rows = sm.sample(ts)[:, b]
+        assert np.isfinite(rows).all()
+        assert np.all((rows >= lo - 1e-9) & (rows <= hi + 1e-9)), (a, e, b)
+        dp, dr = pose_errors(robot.fk(rows), np.broadcast_to(T, (19, 4, 4)))
+        assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+        ref = robot.ik(T, fixed={name: ts})
+        for k in range(19):
+            g = _wrapped(ref.q[k][ref.valid[k]] - rows[k]).max(-1)
+            assert g.min() < 1e-6, (ts[k], b)

@@ -120,6 +120,8 @@ _AT_LIMIT = 1e-9
 _TINY = 2e-2
 #: Largest real-part distance [rad] of one root pair at neighbouring nodes.
 _MATCH = 0.3
+#: Values at which an island's track's rows are scanned for crossings.
+_ISLAND_SCAN = 33
 #: The membership slack (``self_motion_intervals.MANIFOLD_SLACK``, the kernels' 1e-12).
 _SLACK: float = _K.MANIFOLD_SLACK
 #: Bisection steps of a fold (a cell to two adjacent doubles).
@@ -161,6 +163,7 @@ class _ContinuedFamily(_Family):
         self.domain = (float(robot.limits[j, 0]), float(robot.limits[j, 1]))
         self.T = np.ascontiguousarray(T, dtype=np.float64)
         self.solves = 0
+        self._island_cells: list[tuple[float, float]] = []  # cells where _islands found one
         # the end joint's sweep set up once per pose (None: a middle joint, solve_fixed)
         self._sweep = EndSweep.of(robot, j, self.T)
         t = np.linspace(*self.domain, int(nodes))
@@ -257,7 +260,8 @@ class _ContinuedFamily(_Family):
         t, reaches 0 in the next cell (a pair near the axis moves ~ |t - t_0| away
         from a tangency). A probe is kept as a node only where it has more rows
         than both nodes of its cell (so poses without an island keep their nodes);
-        the halvings next to it then find the island's folds.
+        the halvings next to it then find the island's folds (and ``_crossings``
+        scans the island's tracks on their rows, :meth:`_island_crossings`).
         """
         im, re = pairs[..., 0], pairs[..., 1]  # (m, 4)
         m = len(t)
@@ -277,6 +281,12 @@ class _ContinuedFamily(_Family):
         keep = count_v > np.maximum(count[i], count[i + 1])
         if not keep.any():
             return t, Q
+        # probes closer than 1e-6 of the cell to another are one (pairs of roots give
+        # the same value to rounding: cells of 1e-12 pair nothing)
+        kv = np.flatnonzero(keep)
+        gap_ok = np.concatenate([[True], np.diff(v[kv]) > 1e-6 * (t[1] - t[0])])
+        keep[kv[~gap_ok]] = False
+        self._island_cells = [(float(t[c]), float(t[c + 1])) for c in np.unique(i[keep])]
         Q, Qv = _widen(Q, Qv[keep])
         t2 = np.concatenate([t, v[keep]])
         order = np.argsort(t2, kind="stable")
@@ -626,6 +636,17 @@ class _ContinuedFamily(_Family):
             b, ok = np.concatenate([b, b[lost][okb]]), np.concatenate([ok, okb[okb]])
             jv, qv = np.concatenate([jv, jb]), np.concatenate([qv, qv[lost][okb]])
             speed = np.concatenate([speed, sb])
+        if self._island_cells:
+            ti, qi_, bi, ji, qvi = self._island_crossings(queries, t1[ok], b[ok], qv[ok])
+            if len(ti):
+                si = np.full(len(ti), np.inf)  # a lost row: not shallow (no touch)
+                fr = _finite_rows(qi_)
+                si[fr] = np.abs(_slopes(self.robot, qi_[fr], self.joint)[np.arange(fr.sum()),
+                                                                           ji[fr]])
+                t1, q = np.concatenate([t1, ti]), np.concatenate([q, qi_])
+                b, ok = np.concatenate([b, bi]), np.concatenate([ok, np.ones(len(ti), bool)])
+                jv, qv = np.concatenate([jv, ji]), np.concatenate([qv, qvi])
+                speed = np.concatenate([speed, si])
         jx = jv[ok]
         flat = ~(speed[ok] >= _SHALLOW)  # NaN (a singular row): shallow too
         # another joint at a limit there too (riding it within the slack, e.g. the
@@ -649,6 +670,67 @@ class _ContinuedFamily(_Family):
                 out.append((t, fb, qi))
                 flags.append(False)
         return out, flags
+
+    def _island_crossings(self, queries: list[tuple[int, float, str]], tf: np.ndarray,
+                          bf: np.ndarray, qf: np.ndarray
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Crossings of the island tracks that the model's scan did not list.
+
+        An island's tracks (existing only inside a cell where ``_islands`` found
+        one) have few nodes and may pass near a singular configuration, where the
+        held Newton with t free drifts along a near-continuum (offset iiwa special
+        #5140: q2, q4 ~ 0, the crossing of q1 through its limit lost and the island
+        interval 0.17 rad out). Their rows (``sample_rows``) at ``_ISLAND_SCAN``
+        values over each track's range: a sign change of q_j - v between two values
+        with no crossing of that track and query listed between them (``tf``, ``bf``,
+        ``qf``: the listed ones' t, track and query) is bisected on the rows.
+
+        Returns (t (p,), rows (p, n), track (p,), joint (p,), query (p,)); rows NaN
+        where the bisection lost the track's rows (then t is its last bracket's middle).
+        """
+        tn, ex = self.t_nodes, self._exists
+        isl = []
+        for b in range(self.k):
+            tb = tn[ex[:, b]]
+            if tb.size and any(a <= tb[0] and tb[-1] <= e for a, e in self._island_cells):
+                isl.append((b, tb[0], tb[-1]))
+        lims = [(qi, j, v) for qi, (j, v, kind) in enumerate(queries) if kind != "aligned axes"]
+        empty = (np.zeros(0), np.zeros((0, self.robot.n)), np.zeros(0, int), np.zeros(0, int),
+                 np.zeros(0, int))
+        if not isl or not lims:
+            return empty
+        ts = np.concatenate([np.linspace(a, e, _ISLAND_SCAN) for _, a, e in isl])
+        rows, valid, _ = self.sample_rows(ts)
+        lo_l, hi_l, s_l, b_l, j_l, v_l, q_l = [], [], [], [], [], [], []
+        for n_i, (b, _, _) in enumerate(isl):
+            sl = slice(n_i * _ISLAND_SCAN, (n_i + 1) * _ISLAND_SCAN)
+            tt, r, ok = ts[sl], rows[sl, b], valid[sl, b]
+            for qi, j, v in lims:
+                with np.errstate(invalid="ignore"):
+                    g = np.where(ok, _wrap(r[:, j] - v), np.nan)
+                sg = np.sign(g)
+                ch = np.flatnonzero((sg[:-1] * sg[1:] < 0) & (np.abs(g[:-1] - g[1:]) < np.pi))
+                for c in ch:
+                    listed = (bf == b) & (qf == qi) & (tf >= tt[c] - 1e-9) & (tf <= tt[c + 1] + 1e-9)
+                    if listed.any():
+                        continue
+                    lo_l.append(tt[c])
+                    hi_l.append(tt[c + 1])
+                    s_l.append(sg[c])
+                    b_l.append(b)
+                    j_l.append(j)
+                    v_l.append(v)
+                    q_l.append(qi)
+        if not lo_l:
+            return empty
+        lo, hi = np.array(lo_l), np.array(hi_l)
+        t, r, found = self._bisect_rows(lo, hi, np.array(s_l), np.array(b_l), np.array(j_l),
+                                        np.array(v_l))
+        # a bisection whose rows end (the track through a singular point, #5140's q1
+        # at its limit where tracks 12 and 13 meet): cut at its last bracket's middle
+        # (rows NaN), the pieces either side decided on their rows
+        t = np.where(found, t, 0.5 * (lo + hi))
+        return t, r, np.array(b_l), np.array(j_l), np.array(q_l)
 
     def _riding(self, riding: list[tuple[np.ndarray, int]], tt: np.ndarray, bb: np.ndarray,
                 queries: list[tuple[int, float, str]]) -> np.ndarray:
