@@ -343,7 +343,7 @@ GENERAL6R = Group("general6r.c", kernels=(
         Arr("Q", "f64", ("N", 16, 6), out=True), Arr("valid", "bool", ("N", 16), out=True),
         Arr("inside", "bool", ("N", 16), out=True), Arr("sigma", "f64", ("N", 16), out=True),
         Arr("status", "i64", ("N",), out=True), Arr("diag", "i64", ("N",), out=True),
-        Arr("stats", "f64", ("N", 4), out=True), Flag("parallel")),
+        Arr("stats", "f64", ("N", 12), out=True), Flag("parallel")),
         "None", "Every solution of poses T (N, 4, 4): Q (N, 16, 6), masks (N, 16), ...",
         checks=(Check("g6_chain_ok(&a->packed)",
                       "the chain is not 6R revolute without dependent joints"),

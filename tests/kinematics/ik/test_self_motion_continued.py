@@ -720,3 +720,165 @@ def test_a_manifold_between_two_nodes_is_found():
     far = T.copy()
     far[:3, 3] *= 1.5
     assert not len(robot.self_motion(far, parameter=name).intervals)
+
+
+#: Islands of the random 7R arm narrower than the node spacing (benchmarks/
+#: self_motion_rates.py, seed 0, n 10,000; index in its dump): two branches joined by
+#: folds at both ends between two of the 181 nodes, whose rows are other branches'
+#: only; main (8785491) did not sample q back.
+ISLANDS = [
+    # uniform 3652: 4 rows more for q7 in ~[-1.211, -1.200] (nodes -1.2198, -1.1868)
+    [0.6686224713458673, -1.6918739587095508, -1.5236333717527877, -2.6495495384599232,
+     -2.527788949885458, 2.4953627159025844, -1.2014022727517648],
+    # special 5635: 2 rows for q7 in ~[1.5576, 1.5702] (nodes 1.5495, 1.5824), none else
+    [-2.9670597283903604, 0.7043055689424103, 1e-07, -2.9670597283903604,
+     2.782250464691648, 2.9670597283903604, 1.5707963267948966],
+]
+
+
+@pytest.mark.parametrize("q", ISLANDS)
+def test_an_island_between_two_nodes_is_found(q):
+    # Issue 29, session 10 (helper island29). Oracles: independent held solves
+    # (robot.ik with q7 given): q7's value has more rows than both nodes around it (an
+    # island); q is sampled back at its q7, inside an interval of its branch; at 9
+    # values across the island every independent row is a sampled branch's row (as
+    # sets, 1e-9) and every independent in-limit one lies in an interval of that
+    # branch; sampled rows reproduce the pose to 1e-12.
+    robot = ARMS["random7r"]
+    name = robot.joint_names[-1]
+    q0 = np.array(q)
+    T, sm = _manifold(robot, q0)
+    t = float(q0[6])
+    nodes = np.linspace(*robot.limits[6], 181)
+    i = int(np.searchsorted(nodes, t))
+    held = robot.ik(T, fixed={name: np.array([nodes[i - 1], t, nodes[i]])})
+    n_rows = held.valid.sum(axis=-1)
+    assert n_rows[1] > max(n_rows[0], n_rows[2]), n_rows
+    d = _wrapped(sm.sample(t) - q0).max(-1)
+    b = int(np.nanargmin(d))
+    assert d[b] < 1e-9, d
+    iv = sm.intervals[sm.interval_branch == b]
+    assert ((iv[:, 0] <= t) & (t <= iv[:, 1])).any(), (t, iv)
+    # the island's extent: where the independent solves have more rows than the nodes
+    ts = np.linspace(nodes[i - 1], nodes[i], 201)
+    more = robot.ik(T, fixed={name: ts}).valid.sum(axis=-1) > max(n_rows[0], n_rows[2])
+    ts = np.linspace(ts[more][0], ts[more][-1], 9)
+    ref = robot.ik(T, fixed={name: ts})
+    got = sm.sample(ts)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    checked = 0
+    for k in range(len(ts)):
+        rows = got[k][np.isfinite(got[k]).all(-1)]
+        dp, dr = pose_errors(robot.fk(rows), np.broadcast_to(T, rows.shape[:1] + (4, 4)))
+        assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+        for r in ref.q[k][ref.valid[k]]:
+            g = _wrapped(got[k] - r).max(-1)
+            bb = int(np.nanargmin(g))
+            assert g[bb] < 1e-9, (ts[k], g)
+            if np.all((r >= lo - 1e-9) & (r <= hi + 1e-9)):
+                ivb = sm.intervals[sm.interval_branch == bb]
+                assert ((ivb[:, 0] <= ts[k]) & (ts[k] <= ivb[:, 1])).any(), (ts[k], bb, ivb)
+                checked += 1
+    assert checked > 0
+
+
+def test_the_near_real_root_pairs_reach_the_axis_at_an_islands_fold():
+    # Issue 29, session 10: EndSweep.solve_pairs' pairs (the general 6R kernel's complex
+    # roots nearest the real axis) are the island signal. Oracle: the rows of
+    # independent held solves. Random 7R #5635 (ISLANDS[1]): its island's lower fold
+    # bracketed by the row count to 1e-9 in q7; below it the nearest pair's imaginary
+    # part falls towards 0 as the fold nears (below 1e-3 within 1e-7 of it, ~ sqrt of
+    # the distance: 1e-2 and more 1e-2 away), sorted nearest first and positive.
+    from robokin.kinematics.ik.fixed import EndSweep
+
+    robot = ARMS["random7r"]
+    name = robot.joint_names[-1]
+    q0 = np.array(ISLANDS[1])
+    T = robot.fk(q0)
+    lo, hi = 1.5495, float(q0[6])  # no row at lo, 2 at hi
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        if robot.ik(T, fixed={name: mid}).valid.any():
+            hi = mid
+        else:
+            lo = mid
+    assert hi - lo < 1e-9
+    sweep = EndSweep.of(robot.arm, 6, T)
+    assert sweep is not None
+    d = np.array([1e-2, 1e-4, 1e-7])
+    sols, pairs = sweep.solve_pairs(lo - d)
+    assert pairs.shape == (3, 4, 2)
+    assert not sols.valid.any()
+    im = pairs[..., 0]
+    assert np.all(im[:, 0] > 0) and np.all(np.diff(im, axis=1) >= 0)
+    assert im[0, 0] > 1e-2 and im[2, 0] < 1e-3 and im[1, 0] < im[0, 0], im[:, 0]
+
+
+def test_a_joint_riding_its_limit_keeps_the_whole_in_slack_stretch():
+    # Issue 29, session 10 (helper island29): offset iiwa special #5084 (seed 0): q4 at
+    # its upper limit with q2 = 1e-9, q3 = -1e-9; along the branch q4 stays within ~1e-14
+    # of the limit over ~0.06 of q7 either side of q's value (its sign changes are
+    # rounding's), so the in-slack stretch is long; main (8785491) widened its touch by
+    # 1e-3 only and ended the interval 4.6e-4 short of q7. Oracles: independent held
+    # solves (robot.ik with q7 given) at 41 values across q's interval have a row within
+    # 1e-9 of the branch's, inside every limit by MANIFOLD_SLACK (plus 1e-15 for the
+    # general-6R rows' rounding), and reproducing the pose to 1e-12; the interval holds
+    # q7 +- 0.02.
+    from robokin.kinematics.ik.self_motion_intervals import MANIFOLD_SLACK
+
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array([-1.5707963267948966, 1e-09, -1e-09, 2.0943951023931953, -1e-07,
+                   -1e-06, -0.8384789305589901])
+    T, sm = _manifold(robot, q0)
+    t = float(q0[6])
+    d = _wrapped(sm.sample(t) - q0).max(-1)
+    b = int(np.nanargmin(d))
+    assert d[b] < 1e-9, d
+    iv = sm.intervals[sm.interval_branch == b]
+    hit = iv[(iv[:, 0] <= t) & (t <= iv[:, 1])]
+    assert len(hit) == 1, (t, iv)
+    a, e = hit[0]
+    assert a <= t - 0.02 and e >= t + 0.02, (a, e)
+    ts = np.linspace(a, e, 41)
+    rows = sm.sample(ts)[:, b]
+    ref = robot.ik(T, fixed={robot.joint_names[-1]: ts})
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    for k in range(len(ts)):
+        g = _wrapped(ref.q[k][ref.valid[k]] - rows[k]).max(-1)
+        assert g.min() < 1e-9, (ts[k], g)
+        r = ref.q[k][ref.valid[k]][int(np.argmin(g))]
+        assert np.all((r >= lo - MANIFOLD_SLACK - 1e-15) & (r <= hi + MANIFOLD_SLACK + 1e-15)), (
+            ts[k], np.maximum(r - hi, lo - r).max())
+        dp, dr = pose_errors(robot.fk(r), T)
+        assert dp <= 1e-12 and dr <= 1e-12
+
+
+def test_an_islands_crossing_at_a_singular_point_cuts_its_interval():
+    # Issue 29, session 10: offset iiwa special #5140 (seed 0; q2 = q4 = -1e-9): an
+    # island of 8 rows for q7 in ~[0.0745, 0.1000] (between nodes 0.0679 and 0.1018),
+    # where two of its tracks meet at q7 = 5 deg with q1 at its limit; the held Newton
+    # of that crossing drifts along the near-continuum (q3 to 12.4) and the model's scan
+    # listed none, so without the island's row scan an interval ran over rows with q1
+    # 0.17 rad past its limit. Oracles: the branches' rows (sm.sample) and independent
+    # held solves (robot.ik with q7 given): every row at 19 values inside each interval in
+    # the island is inside every limit (1e-9), reproduces the pose to 1e-12, and is
+    # an independent solve's row (1e-6); the island has intervals.
+    robot = ARMS["offset_iiwa"]
+    name = robot.joint_names[-1]
+    q0 = np.array([2.9670597283903604, -1e-09, 2.9670597283903604, -1e-09,
+                   -2.9670597283903604, -1.85123972048024, -3.0543261909900767])
+    T, sm = _manifold(robot, q0)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    sel = (sm.intervals[:, 0] > 0.07) & (sm.intervals[:, 1] < 0.105)
+    assert sel.sum() >= 4, sm.intervals
+    for (a, e), b in zip(sm.intervals[sel], sm.interval_branch[sel], strict=True):
+        ts = np.linspace(a, e, 21)[1:-1]  # (an end at a fold has no row to rounding)
+        rows = sm.sample(ts)[:, b]
+        assert np.isfinite(rows).all()
+        assert np.all((rows >= lo - 1e-9) & (rows <= hi + 1e-9)), (a, e, b)
+        dp, dr = pose_errors(robot.fk(rows), np.broadcast_to(T, (19, 4, 4)))
+        assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+        ref = robot.ik(T, fixed={name: ts})
+        for k in range(19):
+            g = _wrapped(ref.q[k][ref.valid[k]] - rows[k]).max(-1)
+            assert g.min() < 1e-6, (ts[k], b)

@@ -103,6 +103,8 @@
 #define G6_NSAMP 24    /* samples of det Sigma */
 #define G6_DEG 8       /* its trigonometric degree */
 #define G6_MAXDEG 32   /* polynomials general6r_roots takes */
+#define G6_NEAR 4      /* complex root pairs closest to the real axis reported (stats) */
+#define G6_NSTATS (4 + 2 * G6_NEAR) /* per pose statistics (general6r_solve's stats) */
 #define G6_MAXSPLIT 8  /* largest null space split into solutions */
 #define G6_VARCAND (3 * G6_MAXROOT + 2 * G6_MAXSPLIT) /* candidates of one variant */
 #define G6_MAXCAND (8 * G6_VARCAND) /* of one pose (the room g6_candidates fills) */
@@ -1704,20 +1706,42 @@ static int g6_trig_poly(const double *D, double *cpoly, double *phi, double *tai
  * roots, how a double root comes out of rounding; else 1) and near[i]: the root may
  * be part of a multiple root spread by rounding (by eps^(1/k) for a k-fold one): it
  * is complex, or another root lies within gap, or a complex root close to the axis
- * (imaginary part of theta below 0.25) lies within 0.15 rad. Returns how many, or -1
- * when the eigenvalue iteration fails. */
+ * (imaginary part of theta below 0.25) lies within 0.15 rad. cx (NULL: not asked)
+ * gets the G6_NEAR non-real pairs closest to the axis, nearest first, as (imaginary
+ * part of theta > 0, its real part in [-pi, pi)), INFINITY where there are fewer:
+ * a pair of real roots is born or dies where a pair's imaginary part passes 0
+ * (issue 29: an island of a self-motion between two held values). Returns how many,
+ * or -1 when the eigenvalue iteration fails. */
 static int g6_real_roots(const double *cpoly, int jbest, double phi, double imag_tol,
-                         double gap, double *ths, int *wts, int *near)
+                         double gap, double *ths, int *wts, int *near, double *cx)
 {
     double wr[16], wi[16], re[16];
     if (!all_roots16(cpoly, jbest, wr, wi))
         return -1;
-    int nn = 0, nr = 0;
+    int nn = 0, nr = 0, nx = 0;
     for (int k = 0; k < 16; k++) { /* complex roots close to the axis */
         double z2 = wr[k] * wr[k] + wi[k] * wi[k], ia = 2.0 * fabs(wi[k]) / (1.0 + z2);
         if (wi[k] > 0.0 && ia < 0.25)
             re[nn++] = phi + 2.0 * atan(wr[k]);
+        if (cx == NULL || !(wi[k] > 0.0))
+            continue;
+        /* theta = phi + 2 atan(x), x = a + i b: Im = atanh(2 b / (1 + |x|^2)),
+         * Re = phi + atan2(2 a, 1 - |x|^2); kept sorted by Im (insertion) */
+        double im = atanh(fmin(ia, 1.0 - DBL_EPSILON)),
+               th = wrap_pi(phi + atan2(2.0 * wr[k], 1.0 - z2));
+        int i = nx < G6_NEAR ? nx++ : G6_NEAR;
+        if (i == G6_NEAR && !(im < cx[2 * (G6_NEAR - 1)]))
+            continue;
+        i = i == G6_NEAR ? G6_NEAR - 1 : i;
+        for (; i > 0 && cx[2 * (i - 1)] > im; i--) {
+            cx[2 * i] = cx[2 * (i - 1)];
+            cx[2 * i + 1] = cx[2 * (i - 1) + 1];
+        }
+        cx[2 * i] = im;
+        cx[2 * i + 1] = th;
     }
+    for (int i = nx; cx != NULL && i < G6_NEAR; i++)
+        cx[2 * i] = cx[2 * i + 1] = INFINITY;
     for (int k = 0; k < 16; k++) {
         if (wi[k] < 0.0)
             continue; /* the conjugate's twin */
@@ -2038,6 +2062,9 @@ static int g6_variant(const double *P, const double *vb, const double *T, int pr
     int jbest = -1;
     stats[0] = stats[1] = INFINITY;
     stats[2] = 0.0;
+    if (!project)
+        for (int i = 4; i < G6_NSTATS; i++)
+            stats[i] = INFINITY;
     if (!g6_prepare(vb, T, &V)) {
         *flags |= G6F_DEGENERATE;
         return 0;
@@ -2095,7 +2122,8 @@ static int g6_variant(const double *P, const double *vb, const double *T, int pr
     double ths[G6_MAXROOT];
     int wts[G6_MAXROOT];
     int near[G6_MAXROOT];
-    int nr = g6_real_roots(cpoly, jbest, phi, P[GP_IMAG_TOL], P[GP_PAIR_GAP], ths, wts, near);
+    int nr = g6_real_roots(cpoly, jbest, phi, P[GP_IMAG_TOL], P[GP_PAIR_GAP], ths, wts, near,
+                           project ? NULL : stats + 4);
     if (nr < 0) {
         *flags |= G6F_DEGENERATE;
         return 0;
@@ -2130,7 +2158,7 @@ static int g6_candidates(const double *P, const double *T, G6Cand *cand, int *fl
 {
     const int nv = (int)P[GP_NVAR];
     int nc = 0;
-    double st[3];
+    double st[G6_NSTATS];
     for (int v = 0; v < nv && nc + 2 * G6_VARCAND <= G6_MAXCAND; v++) {
         int f = 0;
         nc += g6_variant(P, P + GP_HEAD + v * VB_SIZE, T, 0, cand + nc, &f, v ? st : stats);
@@ -2588,7 +2616,8 @@ static int g6_pose(const Chain *ch, const double *P, const double *T, double *q,
     for (int i = 0; i < 16; i++)
         if (!isfinite(T[i])) {
             *diag = 0;
-            stats[0] = stats[1] = stats[3] = INFINITY;
+            for (int k = 0; k < G6_NSTATS; k++)
+                stats[k] = INFINITY;
             stats[2] = 0.0;
             return -1;
         }
@@ -2816,7 +2845,7 @@ static void g6_range(void *ctx, long b, long e)
     for (long i = b; i < e; i++) {
         double q[6 * G6_MAXSOL], sig[G6_MAXSOL];
         int ns = g6_pose(job->ch, job->P, job->T + 16 * i, q, sig, job->diag + i,
-                         job->stats + 4 * i);
+                         job->stats + G6_NSTATS * i);
         job->status[i] = ns == -1 ? G6_BAD_POSE : ns == -2 ? G6_DEGENERATE
                          : ns == 0 ? G6_NONE : G6_OK;
         ns = ns < 0 ? 0 : ns;
@@ -2875,13 +2904,14 @@ static int g6_params_ok(const double *P, long len)
 
 /* general6r_solve(packed, params, T (N, 4, 4), Q (N, 16, 6), valid (N, 16) bool,
  *                 inside (N, 16) bool, sigma (N, 16), status (N,) int64,
- *                 diag (N,) int64, stats (N, 4), parallel): per pose up to 16
+ *                 diag (N,) int64, stats (N, 12), parallel): per pose up to 16
  * solutions (joint coordinates, revolute ones in [-pi, pi) or moved by whole turns
  * into their limits; rows that are not solutions 0), which are solutions, which
  * are inside the limits, the Jacobian's smallest singular value (NaN on other
  * rows), the status (G6_OK ...), the flags (G6F_..., candidates tried above
- * G6_DIAG_CAND_SHIFT), the primary's tail, margin and clusters split, and the
- * smallest error a candidate's polish reached. */
+ * G6_DIAG_CAND_SHIFT), the primary's tail, margin and clusters split, the
+ * smallest error a candidate's polish reached, and the primary's G6_NEAR complex root
+ * pairs nearest the real axis (g6_real_roots' cx: imaginary, real part of theta). */
 static PyObject *general6r_solve_body(const general6r_solve_args *a)
 {
     npy_intp N = a->N;
@@ -2941,7 +2971,7 @@ static PyObject *general6r_candidates_body(const general6r_candidates_args *a)
 {
     G6Cand cand[G6_MAXCAND];
     int flags = 0, n;
-    double stats[3], *out = a->out;
+    double stats[G6_NSTATS], *out = a->out;
     n = g6_candidates(a->params, a->T, cand, &flags, stats);
     for (int i = 0; i < n; i++)
         memcpy(out + 6 * i, cand[i].v, sizeof(cand[i].v));

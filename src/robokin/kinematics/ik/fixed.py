@@ -491,13 +491,26 @@ class EndSweep:
 
     def solve(self, values: np.ndarray) -> SolutionSet:
         """The set at held values (M,) [rad], finite (as :func:`sweep_end`)."""
+        return self.solve_pairs(values)[0]
+
+    def solve_pairs(self, values: np.ndarray) -> tuple[SolutionSet, np.ndarray]:
+        """:meth:`solve`, and per value the polynomial's complex root pairs nearest the axis.
+
+        Returns:
+            The set at held values (M,) [rad], and (M, 4, 2): per value the general
+            6R kernel's four non-real root pairs of its eliminated polynomial closest
+            to the real axis, nearest first, as (imaginary part of the split joint's
+            angle [rad], > 0; its real part [rad]), inf where there are fewer. A
+            pair whose imaginary part passes 0 between two values is a pair of rows
+            born or dying there (issue 29: an island of the self-motion).
+        """
         robot, j = self.robot, self.j
         joint = robot.chain.joints[robot.n - 1 if self.last else 0]
         M = len(values)
         Tb = np.broadcast_to(self.T, (M, 4, 4))
         Tm = np.ascontiguousarray(_move(Tb, values, self.last, self.C, self.C_inv,
                                         joint.kind, joint.sign))
-        Q, valid, _, sigma, _, _, _ = _g6.raw_solve(self.reduced.chain, self.params, Tm)
+        Q, valid, _, sigma, _, _, stats = _g6.raw_solve(self.reduced.chain, self.params, Tm)
         q = np.full(Q.shape[:-1] + (robot.n,), np.nan)
         q[..., self.cols] = Q
         q[..., j] = values[:, None]
@@ -508,7 +521,7 @@ class EndSweep:
                                     {"singular": (sigma < 1e-6) & valid,
                                      "within_limits": inside},
                                     {}, np.empty(M, dtype=object), "", None, {})
-        return _into_limits(robot, j, Tb, values, sols)
+        return _into_limits(robot, j, Tb, values, sols), stats[:, 4:].reshape(M, -1, 2)
 
 
 def _all_last(b: np.ndarray) -> np.ndarray:

@@ -114,6 +114,14 @@ _SHALLOW = 1e-3
 _RIDE = 1e-5
 #: A joint this close to a limit [rad] at another joint's crossing makes it a touch.
 _AT_LIMIT = 1e-9
+#: A node with a non-real root pair this close to the axis [rad of the split joint's
+#: angle] has both its cells probed for an island (``_islands``; 0.84 such nodes per
+#: uniform random 7R pose).
+_TINY = 2e-2
+#: Largest real-part distance [rad] of one root pair at neighbouring nodes.
+_MATCH = 0.3
+#: Values at which an island's track's rows are scanned for crossings.
+_ISLAND_SCAN = 33
 #: The membership slack (``self_motion_intervals.MANIFOLD_SLACK``, the kernels' 1e-12).
 _SLACK: float = _K.MANIFOLD_SLACK
 #: Bisection steps of a fold (a cell to two adjacent doubles).
@@ -155,10 +163,13 @@ class _ContinuedFamily(_Family):
         self.domain = (float(robot.limits[j, 0]), float(robot.limits[j, 1]))
         self.T = np.ascontiguousarray(T, dtype=np.float64)
         self.solves = 0
+        self._island_cells: list[tuple[float, float]] = []  # cells where _islands found one
         # the end joint's sweep set up once per pose (None: a middle joint, solve_fixed)
         self._sweep = EndSweep.of(robot, j, self.T)
         t = np.linspace(*self.domain, int(nodes))
-        Q = self._solve(t)
+        Q, pairs = self._solve_pairs(t)
+        if pairs is not None:  # islands narrower than the node spacing
+            t, Q = self._islands(t, Q, pairs)
         if not _finite_rows(Q).any():  # no node has a row: the manifold between two?
             t, Q = self._seeded(t, Q)
         D = _slopes(robot, Q, j)
@@ -232,18 +243,78 @@ class _ContinuedFamily(_Family):
         order = np.argsort(t2, kind="stable")
         return t2[order], np.concatenate([Q, Qv])[order]
 
+    def _islands(self, t: np.ndarray, Q: np.ndarray, pairs: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+        """Nodes t (m,) and rows Q with the values added where an island was found.
+
+        An island (two branches joined by folds at both ends) narrower than the
+        node spacing has no row at any node: the random 7R's uniform seed 0 #3652,
+        4 rows for t in ~[-1.211, -1.200] between the nodes -1.2198 and -1.1868,
+        whose rows are the 2 of other branches. Its pair of rows is born where a
+        pair of complex roots of the general 6R's eliminated polynomial reaches the
+        real axis (``pairs``: per node the four non-real pairs nearest it, the
+        imaginary and real part of the split joint's angle [rad]). Probed (one
+        batch): the midpoints of both cells of a node with a pair within ``_TINY``
+        of the axis, and where a pair approaches it from node to node (matched by
+        the real part, within ``_MATCH``) the value its imaginary part, linear in
+        t, reaches 0 in the next cell (a pair near the axis moves ~ |t - t_0| away
+        from a tangency). A probe is kept as a node only where it has more rows
+        than both nodes of its cell (so poses without an island keep their nodes);
+        the halvings next to it then find the island's folds (and ``_crossings``
+        scans the island's tracks on their rows, :meth:`_island_crossings`).
+        """
+        im, re = pairs[..., 0], pairs[..., 1]  # (m, 4)
+        m = len(t)
+        if m < 3:
+            return t, Q
+        tiny = np.flatnonzero((im < _TINY).any(axis=1))
+        cells = np.concatenate([tiny - 1, tiny])
+        cells = np.unique(cells[(cells >= 0) & (cells < m - 1)])
+        probe = [0.5 * (t[cells] + t[cells + 1]),
+                 _approach(t, im, re), -_approach(-t[::-1], im[::-1], re[::-1])]
+        v = np.unique(np.concatenate(probe))
+        if not v.size:
+            return t, Q
+        Qv = self._solve(v)
+        count, count_v = _finite_rows(Q).sum(axis=1), _finite_rows(Qv).sum(axis=1)
+        i = np.clip(np.searchsorted(t, v) - 1, 0, m - 2)
+        keep = count_v > np.maximum(count[i], count[i + 1])
+        if not keep.any():
+            return t, Q
+        # probes closer than 1e-6 of the cell to another are one (pairs of roots give
+        # the same value to rounding: cells of 1e-12 pair nothing)
+        kv = np.flatnonzero(keep)
+        gap_ok = np.concatenate([[True], np.diff(v[kv]) > 1e-6 * (t[1] - t[0])])
+        keep[kv[~gap_ok]] = False
+        self._island_cells = [(float(t[c]), float(t[c + 1])) for c in np.unique(i[keep])]
+        Q, Qv = _widen(Q, Qv[keep])
+        t2 = np.concatenate([t, v[keep]])
+        order = np.argsort(t2, kind="stable")
+        return t2[order], np.concatenate([Q, Qv])[order]
+
     # ------------------------------------------------------------ rows
     def _solve(self, t: np.ndarray) -> np.ndarray:
         """Every general-6R row at held values t (m,): (m, K, n), NaN where none.
 
         The valid rows come first in each value's K slots; K is the most any value has.
         """
+        return self._solve_pairs(t)[0]
+
+    def _solve_pairs(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """:meth:`_solve`, and the kernel's near-real root pairs at each value.
+
+        Returns:
+            The rows (m, K, n) and (m, 4, 2) (``EndSweep.solve_pairs``: imaginary,
+            real part [rad] of the four non-real pairs nearest the axis), or None
+            where the joint is not an end joint (``solve_fixed``: no pairs).
+        """
         self.solves += len(t)
         # an end joint on a general 6R reduced chain: the kernel directly (the same
         # rows as solve_fixed, without its per-call checks and assemblies)
-        sols = (None if self._sweep is None
-                else self._sweep.solve(np.ascontiguousarray(t, np.float64)))
-        if sols is None:
+        pairs = None
+        if self._sweep is not None:
+            sols, pairs = self._sweep.solve_pairs(np.ascontiguousarray(t, np.float64))
+        else:
             sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
         valid = sols.valid.reshape(len(t), -1)
         q = sols.q.reshape(len(t), -1, self.robot.n)
@@ -256,7 +327,7 @@ class _ContinuedFamily(_Family):
             order = np.argsort(~valid, axis=1, kind="stable")[:, :width]
             q = np.take_along_axis(q, order[..., None], 1)
             ok = np.take_along_axis(valid, order, 1)
-        return _into_limits(self.robot, np.where(ok[..., None], q, np.nan))
+        return _into_limits(self.robot, np.where(ok[..., None], q, np.nan)), pairs
 
     def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = np.atleast_1d(np.asarray(t, dtype=np.float64))
@@ -540,22 +611,44 @@ class _ContinuedFamily(_Family):
         br = np.concatenate(brackets)
         w = br[:, 1] - br[:, 0]
         lost = ~ok | (t1 < br[:, 0] - w) | (t1 > br[:, 1] + w)
-        if riding and rb.size:
-            lost |= force  # the rows' bracket: bisected, whatever Newton found
         jv, vv, qv = np.concatenate(joints), np.concatenate(values), np.concatenate(qidx)
+        # the joint's speed along the branch at each Newton crossing (the exact dq/dt)
+        speed = np.full(len(t1), np.nan)
+        speed[ok] = np.abs(_slopes(self.robot, q[ok], self.joint)[np.arange(ok.sum()), jv[ok]])
+        if riding and rb.size:
+            # the rows' bracket: bisected, unless Newton found a fast (transversal)
+            # crossing of the same track and value in it: an ordinary crossing next
+            # to a sub-value, where the model comes within _RIDE of the value (18
+            # of 100 uniform random 7R poses bisected one such, found again to 1e-14)
+            for i in np.flatnonzero(force):
+                hit = ok & (b == b[i]) & (qv == qv[i]) & (t1 >= br[i, 0]) & (
+                    t1 <= br[i, 1]) & (speed >= _SHALLOW)
+                lost[i] = not hit.any()
         for i in np.flatnonzero(lost & ~force if riding and rb.size else lost):
             # a Newton crossing of the same track and value in the cell: done
             hit = ok & (b == b[i]) & (qv == qv[i]) & (t1 >= br[i, 2]) & (t1 <= br[i, 3])
             lost[i] = not hit.any()
         if lost.any():
             tb, qb, okb = self._bisected(br[lost], b[lost], jv[lost], vv[lost])
+            jb = jv[lost][okb]
+            sb = np.abs(_slopes(self.robot, qb[okb], self.joint)[np.arange(len(jb)), jb])
             t1, q = np.concatenate([t1, tb[okb]]), np.concatenate([q, qb[okb]])
             b, ok = np.concatenate([b, b[lost][okb]]), np.concatenate([ok, okb[okb]])
-            jv, qv = np.concatenate([jv, jv[lost][okb]]), np.concatenate([qv, qv[lost][okb]])
-        # the joint's speed along the branch at each crossing (the exact slope dq/dt)
+            jv, qv = np.concatenate([jv, jb]), np.concatenate([qv, qv[lost][okb]])
+            speed = np.concatenate([speed, sb])
+        if self._island_cells:
+            ti, qi_, bi, ji, qvi = self._island_crossings(queries, t1[ok], b[ok], qv[ok])
+            if len(ti):
+                si = np.full(len(ti), np.inf)  # a lost row: not shallow (no touch)
+                fr = _finite_rows(qi_)
+                si[fr] = np.abs(_slopes(self.robot, qi_[fr], self.joint)[np.arange(fr.sum()),
+                                                                           ji[fr]])
+                t1, q = np.concatenate([t1, ti]), np.concatenate([q, qi_])
+                b, ok = np.concatenate([b, bi]), np.concatenate([ok, np.ones(len(ti), bool)])
+                jv, qv = np.concatenate([jv, ji]), np.concatenate([qv, qvi])
+                speed = np.concatenate([speed, si])
         jx = jv[ok]
-        speed = np.abs(_slopes(self.robot, q[ok], self.joint)[np.arange(len(jx)), jx])
-        flat = ~(speed >= _SHALLOW)  # NaN (a singular row): shallow too
+        flat = ~(speed[ok] >= _SHALLOW)  # NaN (a singular row): shallow too
         # another joint at a limit there too (riding it within the slack, e.g. the
         # offset iiwa #5805: q4 out by 1e-15 over 1e-4 while q5 crosses): a touch
         lim = self.robot.limits
@@ -577,6 +670,67 @@ class _ContinuedFamily(_Family):
                 out.append((t, fb, qi))
                 flags.append(False)
         return out, flags
+
+    def _island_crossings(self, queries: list[tuple[int, float, str]], tf: np.ndarray,
+                          bf: np.ndarray, qf: np.ndarray
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Crossings of the island tracks that the model's scan did not list.
+
+        An island's tracks (existing only inside a cell where ``_islands`` found
+        one) have few nodes and may pass near a singular configuration, where the
+        held Newton with t free drifts along a near-continuum (offset iiwa special
+        #5140: q2, q4 ~ 0, the crossing of q1 through its limit lost and the island
+        interval 0.17 rad out). Their rows (``sample_rows``) at ``_ISLAND_SCAN``
+        values over each track's range: a sign change of q_j - v between two values
+        with no crossing of that track and query listed between them (``tf``, ``bf``,
+        ``qf``: the listed ones' t, track and query) is bisected on the rows.
+
+        Returns (t (p,), rows (p, n), track (p,), joint (p,), query (p,)); rows NaN
+        where the bisection lost the track's rows (then t is its last bracket's middle).
+        """
+        tn, ex = self.t_nodes, self._exists
+        isl = []
+        for b in range(self.k):
+            tb = tn[ex[:, b]]
+            if tb.size and any(a <= tb[0] and tb[-1] <= e for a, e in self._island_cells):
+                isl.append((b, tb[0], tb[-1]))
+        lims = [(qi, j, v) for qi, (j, v, kind) in enumerate(queries) if kind != "aligned axes"]
+        empty = (np.zeros(0), np.zeros((0, self.robot.n)), np.zeros(0, int), np.zeros(0, int),
+                 np.zeros(0, int))
+        if not isl or not lims:
+            return empty
+        ts = np.concatenate([np.linspace(a, e, _ISLAND_SCAN) for _, a, e in isl])
+        rows, valid, _ = self.sample_rows(ts)
+        lo_l, hi_l, s_l, b_l, j_l, v_l, q_l = [], [], [], [], [], [], []
+        for n_i, (b, _, _) in enumerate(isl):
+            sl = slice(n_i * _ISLAND_SCAN, (n_i + 1) * _ISLAND_SCAN)
+            tt, r, ok = ts[sl], rows[sl, b], valid[sl, b]
+            for qi, j, v in lims:
+                with np.errstate(invalid="ignore"):
+                    g = np.where(ok, _wrap(r[:, j] - v), np.nan)
+                sg = np.sign(g)
+                ch = np.flatnonzero((sg[:-1] * sg[1:] < 0) & (np.abs(g[:-1] - g[1:]) < np.pi))
+                for c in ch:
+                    listed = (bf == b) & (qf == qi) & (tf >= tt[c] - 1e-9) & (tf <= tt[c + 1] + 1e-9)
+                    if listed.any():
+                        continue
+                    lo_l.append(tt[c])
+                    hi_l.append(tt[c + 1])
+                    s_l.append(sg[c])
+                    b_l.append(b)
+                    j_l.append(j)
+                    v_l.append(v)
+                    q_l.append(qi)
+        if not lo_l:
+            return empty
+        lo, hi = np.array(lo_l), np.array(hi_l)
+        t, r, found = self._bisect_rows(lo, hi, np.array(s_l), np.array(b_l), np.array(j_l),
+                                        np.array(v_l))
+        # a bisection whose rows end (the track through a singular point, #5140's q1
+        # at its limit where tracks 12 and 13 meet): cut at its last bracket's middle
+        # (rows NaN), the pieces either side decided on their rows
+        t = np.where(found, t, 0.5 * (lo + hi))
+        return t, r, np.array(b_l), np.array(j_l), np.array(q_l)
 
     def _riding(self, riding: list[tuple[np.ndarray, int]], tt: np.ndarray, bb: np.ndarray,
                 queries: list[tuple[int, float, str]]) -> np.ndarray:
@@ -1005,6 +1159,31 @@ def _fold_newton(robot: Arm, T: np.ndarray, q0: np.ndarray, s0: np.ndarray, dt: 
         v = v_next
     ok &= np.abs(g) < 1e-10
     return q, ok
+
+
+def _approach(t: np.ndarray, im: np.ndarray, re: np.ndarray) -> np.ndarray:
+    """Where root pairs approaching the real axis reach it in the next cell.
+
+    t (m,) increasing nodes; im, re (m, p) per node the non-real root pairs'
+    imaginary and real parts (``_ContinuedFamily._islands``, inf where none). Each
+    pair at node i (1 <= i <= m - 2) is matched with the pair at node i - 1 of the
+    nearest real part (within ``_MATCH`` [rad]); where its imaginary part fell,
+    the line through the two reaches 0 at some t: returned (k,) where that lies
+    inside the cell (t_i, t_i+1).
+    """
+    a, b = slice(0, -2), slice(1, -1)
+    with np.errstate(invalid="ignore"):
+        d = np.abs(_wrap(re[b, :, None] - re[a, None, :]))  # (m-2, p, p)
+        d = np.where(np.isfinite(d), d, np.inf)
+        near = np.argmin(d, axis=2)
+        im_a = np.take_along_axis(im[a], near, axis=1)  # (m-2, p)
+        ok = (np.take_along_axis(d, near[..., None], 2)[..., 0] < _MATCH) & (im_a > im[b])
+        ok &= np.isfinite(im[b])
+        tb, dt = t[b][:, None], (t[b] - t[a])[:, None]
+        tz = tb + im[b] * dt / np.where(ok, im_a - im[b], 1.0)
+        ok &= (tz > tb) & (tz < t[2:][:, None])
+    out: np.ndarray = tz[ok]
+    return out
 
 
 def _wrap(x: np.ndarray) -> np.ndarray:

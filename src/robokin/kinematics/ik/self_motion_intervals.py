@@ -418,6 +418,9 @@ _PROBES = 10.0 ** -np.arange(9, 2, -1)
 #: stretches are 1e-6 to 1e-4 long, their ends inside to ~1e-9 of the last value).
 _WIDEN = 5
 _SPLIT = 3
+#: Doubling probes past ``_PROBES`` of a family's touch inside at every probe (2e-3 ..
+#: 8.2 [in t]), up to the branch's nearest crossing of another joint.
+_FAR = 12
 #: A listed interval at most this long is a point (a few ulps): widened as a graze.
 _POINT = K.SM_POINT  # 1e-12
 #: A corner's row out by at most this [rad] is refined on the pose's equations.
@@ -539,6 +542,9 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     stretch = [(float(a), float(e), int(b)) for (a, e), b, p in zip(intervals, owner, point)
                if p or joint]
     reach = [False] * len(stretch)  # a touch's side inside at every probe: to the last one
+    caps = [(lo_d, hi_d)] * len(stretch)  # how far a touch's side goes (its branch's
+    # nearest crossings of another joint)
+    lim_pts = points[points[:, 3] <= upper]
     first_touch = len(c) - len(touch)
     corners: list[tuple[float, int, np.ndarray]] = []
     points_only: list[tuple[int, float, float]] = []
@@ -561,6 +567,9 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         for i in np.flatnonzero(inside):
             stretch.append((float(c[i, 0]), float(c[i, 0]), int(b[i])))
             reach.append(bool(i >= first_touch))
+            other = lim_pts[(lim_pts[:, 1] == b[i]) & (lim_pts[:, 2] != c[i, 2]), 0]
+            caps.append((float(other[other < c[i, 0]].max(initial=lo_d)),
+                         float(other[other > c[i, 0]].min(initial=hi_d))))
         for i in np.flatnonzero((worst > MANIFOLD_SLACK) & (worst <= _CONDITIONING)):
             hold = np.flatnonzero(np.abs(excess[i]) <= _CONDITIONING)
             if len(hold) < 2:
@@ -570,7 +579,7 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
                 tc = _param(fam, row)
                 if tc is not None:
                     corners.append((tc, int(b[i]), row))
-    new = (_widen(fam, limits, stretch, reach) + [(b, t, t) for t, b, _ in corners]
+    new = (_widen(fam, limits, stretch, reach, caps) + [(b, t, t) for t, b, _ in corners]
            + points_only)
     iv, ob = _merged(intervals, owner, new)
     if not corners and np.array_equal(iv, intervals) and np.array_equal(ob, owner):
@@ -647,7 +656,8 @@ def _held_refine(fam: _Family, limits: np.ndarray, r: np.ndarray, hold: np.ndarr
 
 
 def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, int]],
-           reach: list[bool] | None = None) -> list[tuple[int, float, float]]:
+           reach: list[bool] | None = None, caps: list[tuple[float, float]] | None = None
+           ) -> list[tuple[int, float, float]]:
     """Each in-limit stretch (a, e, b) (a point: a = e) widened to its in-slack extent.
 
     Probes at ``_PROBES`` before a and after e (one batch); a side with a probe
@@ -659,7 +669,10 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
     ends at a limit to 1e-12 hold after the swivel's 2 pi shift). A side inside at
     every probe is not widened, except for the points flagged in ``reach`` (a
     family's touches: a joint riding its limit within the slack, e.g. the offset
-    iiwa's q4 out by 1e-15 over 2e-2 of t): to the last probe.
+    iiwa's q4 out by 1e-15 over 2e-2 of t): to the last probe, and with ``caps``
+    (per point, the parameter values [lo, hi] a flagged side goes at most to) on by
+    probes doubling to ``_FAR`` (to 8 rad) and the same search, to its last inside
+    value.
     """
     if not points:
         return []
@@ -687,9 +700,10 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
     first_out = np.argmin(ok, axis=1)  # the first probe outside (0 if none is)
     go = ~ok.all(axis=1) & (first_out > 0)  # inside at 1e-9 and outside further on
     d = np.zeros(2 * m)
-    if go.any():
-        a, e = _PROBES[first_out[go] - 1], _PROBES[first_out[go]]
-        tb, sb, bb = t0[go], side[go], br[go]
+
+    def search(a: np.ndarray, e: np.ndarray, g: np.ndarray) -> np.ndarray:
+        """The last inside distance of sides g, inside at a (g,) and outside at e."""
+        tb, sb, bb = t0[g], side[g], br[g]
         frac = np.arange(1, _SPLIT + 1) / (_SPLIT + 1)
         for _ in range(_WIDEN):
             x = a[:, None] + (e - a)[:, None] * frac[None, :]  # (g, split)
@@ -699,11 +713,34 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
             new_a = np.where(none, x[:, -1], np.where(k > 0, x[np.arange(len(k)), k - 1], a))
             e = np.where(none, e, x[np.arange(len(k)), k])
             a = new_a
-        d[go] = a * (1.0 - 1e-3)  # inside the last inside value: its row stays within
+        return a
+
+    if go.any():
+        last = search(_PROBES[first_out[go] - 1], _PROBES[first_out[go]], np.flatnonzero(go))
+        d[go] = last * (1.0 - 1e-3)  # inside the last inside value: its row stays within
         # the slack after a 2 pi shift of the swivel (rounding) at q'' up to ~1e11
     if reach is not None:
         full = ok.all(axis=1) & np.tile(np.array(reach, dtype=bool), 2)
         d[full] = _PROBES[-1] * (1.0 - 1e-3)
+        if caps is not None and full.any():
+            # on to the side's cap (the branch's nearest crossing of another joint):
+            # probes doubling from 2e-3, then the search between the last inside and
+            # the first outside one (the offset iiwa #5084: q4 within 1e-14 of its
+            # limit over ~0.06 of t about q's value, its crossings rounding's)
+            g = np.flatnonzero(full)
+            cap = np.concatenate([[p0 - c0 for (p0, _, _), (c0, _) in zip(points, caps, strict=True)],
+                                  [c1 - p1 for (_, p1, _), (_, c1) in zip(points, caps, strict=True)]])
+            x = np.minimum(_PROBES[-1] * 2.0 ** np.arange(1, _FAR + 1)[None, :],
+                           cap[g, None])  # (g, _FAR)
+            inn = inside(t0[g, None] + side[g, None] * x, br[g])
+            k = np.argmin(inn, axis=1)
+            out_at = ~inn.all(axis=1)
+            far = np.where(out_at, 0.0, x[:, -1])
+            if out_at.any():
+                o = np.flatnonzero(out_at)
+                lo_x = np.where(k[o] > 0, x[o, np.maximum(k[o] - 1, 0)], _PROBES[-1])
+                far[o] = search(lo_x, x[o, k[o]], g[o]) * (1.0 - 1e-3)
+            d[g] = np.maximum(d[g], far)
     ends = t0 + side * d
     out = []
     for a, e, b in zip(ends[:m].tolist(), ends[m:].tolist(), br[:m].tolist(), strict=True):

@@ -250,9 +250,11 @@ def raw_solve(chain: Chain, params: np.ndarray, T: np.ndarray,
     T (N, 4, 4) C-contiguous float64 -> (q (N, 16, 6) [rad], valid (N, 16), inside
     (N, 16) the valid rows within the limits, sigma (N, 16) the Jacobian's smallest
     singular value, status (N,) int64 (kernel codes), diag (N,) int64 (kernel flags
-    ``G6F_*``; ``>> G6_DIAG_CAND_SHIFT`` the candidates polished), stats (N, 4): the
-    primary's relative DFT tail, null-space margin and clusters split, and the
-    smallest error [m, rad] a candidate's polish reached).
+    ``G6F_*``; ``>> G6_DIAG_CAND_SHIFT`` the candidates polished), stats (N, 12): the
+    primary's relative DFT tail, null-space margin and clusters split, the
+    smallest error [m, rad] a candidate's polish reached, then the primary's four
+    non-real root pairs nearest the real axis as (imaginary part, real part) of the
+    split joint's angle [rad], nearest first, inf where there are fewer).
     Revolute values are in [-pi, pi), or moved by whole turns into their limits
     where that is possible; rows that are not solutions are NaN. No input checks.
     """
@@ -263,7 +265,7 @@ def raw_solve(chain: Chain, params: np.ndarray, T: np.ndarray,
     sigma = np.empty((N, MAX_SOLUTIONS))
     status = np.empty(N, np.int64)
     diag = np.empty(N, np.int64)
-    stats = np.empty((N, 4))
+    stats = np.empty((N, 12))
     par = N >= _PARALLEL_MIN if parallel is None else bool(parallel)
     K.general6r_solve(chain.arrays.packed, params, T, Q, valid, inside, sigma, status, diag,
                       stats, par)
@@ -591,7 +593,7 @@ def make_single(arm: Arm) -> Any:
         Q = empty((1, MAX_SOLUTIONS, 6))
         valid, inside = empty((1, MAX_SOLUTIONS), b1), empty((1, MAX_SOLUTIONS), b1)
         sigma, status, diag = empty((1, MAX_SOLUTIONS)), empty(1, np.int64), empty(1, np.int64)
-        kern(packed, params, T1, Q, valid, inside, sigma, status, diag, empty((1, 4)), False)
+        kern(packed, params, T1, Q, valid, inside, sigma, status, diag, empty((1, 12)), False)
         runs = int(diag[0] & secondary != 0)
         return trusted(Q[0], valid[0], is_rev, limits,
                        {"within_limits": inside[0], "singular": sigma[0] < 1e-6}, {},
