@@ -656,10 +656,8 @@ def test_a_graze_keeps_its_in_slack_stretch(arm, q):
     # swivel row there out by conditioning
     ("srs", [-2.9670597283903604, -2.0943951023931953, 0.0, 1e-07, -2.9670597283903604,
              -2.0943951023931953, -1.5707963267948966]),
-    # joint_a1 and joint_a2 at limits, the elbow lined up (q4 = 1e-9; regular): main's
-    # row at the crossing 3e-11 out
-    ("iiwa", [2.9668, -2.0942, 1e-07, 1e-09, -0.34442118632710983, 0.28861094459290904,
-              -1e-06]),
+    # (the rtb-data iiwa14's case, joint_a1 and joint_a2 at limits with q4 = 1e-9, is
+    # not a corner once its rows are refined: the stretched-elbow list below)
 ])
 def test_a_corner_out_by_conditioning_is_refined(arm, q):
     # Issue 29 (helper rates29): benchmarks/self_motion_rates.py (seed 0, n 10,000),
@@ -840,6 +838,11 @@ def test_the_iiwa_parameter_next_to_zero_keeps_q_in_an_interval_of_its_branch(q)
     # joint_a6 at its limit, joint_a3 = 0, q4 = 1e-9 (#9328)
     [0.9669464170589035, 0.7682464122629549, 0.0, 1e-09, -2.944595344687415, 2.0942,
      1e-09],
+    # joint_a1 and joint_a2 at limits, q4 = 1e-9 (helper rates29's "corner out by
+    # conditioning": its rows 3e-11 out about q's value were the rows' error; refined,
+    # joint_a2 stays within 2.5e-13 of its limit for t in q's value - [0, 1e-5] and
+    # joint_a1 crosses at q's value: q ends an interval ~1e-7 long, not a point)
+    [2.9668, -2.0942, 1e-07, 1e-09, -0.34442118632710983, 0.28861094459290904, -1e-06],
 ])
 def test_the_iiwa_stretched_elbow_at_a_limit_keeps_q_in_an_interval_of_its_branch(q):
     # Issue 29 (helper corner29): the 7 regular special configurations of
