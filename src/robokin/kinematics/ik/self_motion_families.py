@@ -173,8 +173,8 @@ def _held_polish(fam: _HeldFamily, Q: np.ndarray, valid: np.ndarray, sing: np.nd
     (its second-order error ~1e-16: not checked). Valid rows not flagged singular
     only; the test costs ~10 us per call where no row is near.
     """
+    from robokin._native import kernels
     from robokin.kinematics.jacobian import jacobian_and_pose
-    from robokin.spatial import pose_error
 
     mid, half = fam.band
     with np.errstate(invalid="ignore"):
@@ -189,7 +189,8 @@ def _held_polish(fam: _HeldFamily, Q: np.ndarray, valid: np.ndarray, sing: np.nd
         return
     q = Q[idx]
     J, P = jacobian_and_pose(fam.robot.chain, q)
-    e = pose_error(P, fam.T)
+    e = np.empty((len(q), 6))
+    kernels.pose_error(P, np.ascontiguousarray(np.broadcast_to(fam.T, P.shape)), e)
     try:
         step = np.linalg.solve(J[:, :, fam.free], e[..., None])[..., 0]
     except np.linalg.LinAlgError:  # an exactly singular one: none is refined
