@@ -684,10 +684,8 @@ def test_a_graze_keeps_its_in_slack_stretch(arm, q):
     # swivel row there out by conditioning
     ("srs", [-2.9670597283903604, -2.0943951023931953, 0.0, 1e-07, -2.9670597283903604,
              -2.0943951023931953, -1.5707963267948966]),
-    # joint_a1 and joint_a2 at limits, the elbow lined up (q4 = 1e-9; regular): main's
-    # row at the crossing 3e-11 out
-    ("iiwa", [2.9668, -2.0942, 1e-07, 1e-09, -0.34442118632710983, 0.28861094459290904,
-              -1e-06]),
+    # (the rtb-data iiwa14's case, joint_a1 and joint_a2 at limits with q4 = 1e-9, is
+    # not a corner once its rows are refined: the stretched-elbow list below)
 ])
 def test_a_corner_out_by_conditioning_is_refined(arm, q):
     # Issue 29 (helper rates29): benchmarks/self_motion_rates.py (seed 0, n 10,000),
@@ -843,6 +841,49 @@ def test_the_iiwa_parameter_next_to_zero_keeps_q_in_an_interval_of_its_branch(q)
     # branch, all but the three marked. Oracles: the closed-form rows (sm.sample) and FK:
     # q's branch holds q at its value, that value lies in an interval of the branch
     # (1e-9), and every row sampled about it reproduces the pose to 1e-12.
+    _assert_iiwa_q_in_an_interval(q)
+
+
+@pytest.mark.parametrize("q", [
+    # joint_a6 at its limit grazing it (|dq6/dt| ~ 1e-8) with the elbow stretched
+    # (q4 = -1e-7) next to the aligned point at t = -9.99e-7 (#6050): the rows 1e-12 to
+    # 2e-10 out about q's value (their pose errors 1e-14 to 9e-14 at the held
+    # Jacobian's sigma_min 1.7e-4), the pieces either side decided outside
+    [1e-09, -0.026361178111713013, -1e-06, -1e-07, 1e-09, 2.0942, 0.0],
+    # joint_a2 and joint_a6 at limits, the elbow at 0 (#6379): the joint_a6 crossing
+    # computed 1.1e-9 after q's value (the rows 3e-11 off)
+    [-0.3857472590824318, -2.0942, -1e-07, 0.0, -2.6948616864234824, 2.0942, 0.0],
+    # joint_a6 at its limit, q4 = q5 = 1e-7, joint_a3 = 2.948 (#6572)
+    [2.4517373904672546, -1.5707963267948966, 2.948454549631954, 1e-07, 1e-07, 2.0942,
+     -1.5707963267948966],
+    # joint_a2 and joint_a6 at limits, q4 = 1e-7 (#6675)
+    [1.383802716943789, -2.0942, 1e-07, 1e-07, 1e-06, 2.0942, -0.1870392497818818],
+    # joint_a2 at its limit, q4 = 1e-6 (#7456)
+    [1e-09, 2.0942, -0.23397722752105254, 1e-06, 1e-07, -1.5707963267948966,
+     -1.626997784533508],
+    # joint_a6 at its limit, q4 = 1e-9 (#9054: the rates script's isolated point)
+    [-0.7326317286744741, -1.8297167000912429, 1e-06, 1e-09, -1e-07, 2.0942, -1e-06],
+    # joint_a6 at its limit, joint_a3 = 0, q4 = 1e-9 (#9328)
+    [0.9669464170589035, 0.7682464122629549, 0.0, 1e-09, -2.944595344687415, 2.0942,
+     1e-09],
+    # joint_a1 and joint_a2 at limits, q4 = 1e-9 (helper rates29's "corner out by
+    # conditioning": its rows 3e-11 out about q's value were the rows' error; refined,
+    # joint_a2 stays within 2.5e-13 of its limit for t in q's value - [0, 1e-5] and
+    # joint_a1 crosses at q's value: q ends an interval ~1e-7 long, not a point)
+    [2.9668, -2.0942, 1e-07, 1e-09, -0.34442118632710983, 0.28861094459290904, -1e-06],
+])
+def test_the_iiwa_stretched_elbow_at_a_limit_keeps_q_in_an_interval_of_its_branch(q):
+    # Issue 29 (helper corner29): the 7 regular special configurations of
+    # benchmarks/self_motion_rates.py at n 10,000 (seed 0, #index) that main (8785491)
+    # had in no interval of their branch: a joint at its limit moving 1e-8 to 2e-4 rad
+    # per rad of joint_a3 with the elbow stretched, where the closed form's rows were
+    # off by up to 5e-10 (near a double root of the quartic); rows next to a limit are
+    # now refined on the pose (_HeldFamily.rows). Oracles as above.
+    _assert_iiwa_q_in_an_interval(q)
+
+
+def _assert_iiwa_q_in_an_interval(q) -> None:
+    """q's value in an interval of its branch (1e-9); rows about it reproduce T (1e-12)."""
     robot = _arm("iiwa")
     q0 = np.array(q)
     sm, t, b = _generating(robot, q0)
@@ -855,3 +896,42 @@ def test_the_iiwa_parameter_next_to_zero_keeps_q_in_an_interval_of_its_branch(q)
     assert ok.sum() >= len(ts)
     dp, dr = pose_errors(robot.fk(rows[ok]), np.broadcast_to(sm.T, (int(ok.sum()), 4, 4)))
     assert dp.max() <= 1e-12 and dr.max() <= 1e-12, (dp.max(), dr.max())
+
+
+@pytest.mark.parametrize("q", [
+    # the slots swap at joint_a3 = -1.074e-4, where a joint_a5 crossing of one of the
+    # swapped configurations lies in the same grid cell (t ~ -0.006; #22 of the rates
+    # script's uniform half, seed 0)
+    [-1.3418889885496674, 0.8487879327514487, 2.63334014690359, -1.5630392488889897,
+     2.164448493590033, -1.8451403474371422, -0.728277581135425],
+    # the same next to t = -0.007 (#68)
+    [1.9060301898239604, -0.4258113777801509, -1.2218685093054675, -0.9335068666822459,
+     -0.8249399477048973, 0.32211997242815205, 0.16993060112663416],
+    # a fold at t = 1.0418 renumbers the slots of the roots left: branch 0 holds
+    # another configuration after it (#127)
+    [2.028791945771018, 0.020479448844758164, -2.4604328017151227, -0.2136838443399216,
+     -1.2389570549284479, 0.1167937210700285, 2.1580872583596573],
+    # t = -2.286 and 0.856 (#101)
+    [-1.7821863486013862, 0.25794975134833065, 0.577609992055319, 1.5013044509012743,
+     -0.1977874201214651, 1.381716642014518, 0.1459649936107792],
+])
+def test_the_iiwa_intervals_agree_with_the_rows_where_the_slots_are_renumbered(q):
+    # Issue 29 (helper corner29): the held closed form numbers the quartic's roots by
+    # the eliminated variable, switched with the conditioning (the rtb-data iiwa14 at
+    # joint_a3 = +-1.074e-4 on every pose), and compactly after a fold: a slot holds
+    # another configuration past such a value inside a grid cell whose ends show no
+    # change, and a piece across it was decided on the other configuration. Oracle:
+    # the closed-form rows themselves (sm.inside) at 20,000 values of joint_a3 agree
+    # with the intervals of every branch away from their ends (1e-7). Main (8785491)
+    # disagreed at 5 to 25 of the values on each.
+    robot = _arm("iiwa")
+    sm = robot.self_motion(robot.fk(np.array(q)))
+    assert sm.parameter == "joint_a3"
+    ts = np.sort(np.random.default_rng(1).uniform(*sm.domain, DENSE))
+    cover = np.zeros((DENSE, sm.n_branches), dtype=bool)
+    for (a, e), b in zip(sm.intervals, sm.interval_branch, strict=True):
+        cover[:, b] |= (ts >= a) & (ts <= e)
+    ends = sm.intervals.ravel()
+    away = np.abs(ts[:, None] - ends[None, :]).min(axis=1) > 1e-7
+    bad = (sm.inside(ts) != cover).any(axis=1) & away
+    assert not bad.any(), ts[bad][:10]

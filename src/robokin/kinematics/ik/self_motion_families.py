@@ -127,6 +127,13 @@ class _HeldFamily(_JointFamily):
             named = (robot.joint_names[j], (lo, hi))
         self.name, self.domain = named
         self.T = T
+        lim = np.asarray(robot.limits, dtype=np.float64)
+        half = 0.5 * (lim[:, 1] - lim[:, 0])
+        half[j] = np.inf  # the parameter: never refined for it
+        #: (mid, half) of every joint's limits (``_held_polish``'s test)
+        self.band = (0.5 * (lim[:, 0] + lim[:, 1]), half)
+        #: the joints a refining step moves (all but the parameter)
+        self.free = np.delete(np.arange(robot.n), j)
 
     def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         from robokin.kinematics.ik.analytic import pieper as pk
@@ -136,8 +143,63 @@ class _HeldFamily(_JointFamily):
         Q, valid, sing, _, _ = pk.raw_solve(self.params, Tb, t)
         Q = Q.copy()
         Q[~valid] = np.nan
-        return _into_limits(self.robot, Q), valid, sing
+        Q = _into_limits(self.robot, Q)
+        _held_polish(self, Q, valid, sing)
+        return Q, valid, sing
 
+
+#: Rows within this of a limit [rad] are refined (``_held_polish``): a membership
+#: decided within rounding of the slack.
+_POLISH_NEAR = 1e-9
+#: A refining step longer than this [rad], or than ``_POLISH_GAIN`` times the pose
+#: error, is not taken: a singular row (its held Jacobian's smallest singular value
+#: below 1e-4, the rates script's regular threshold), whose joints the pose does not
+#: fix to that; the regular rows it is for move by <= 5e-10.
+_POLISH_STEP = 1e-8
+_POLISH_GAIN = 1e4
+
+
+def _held_polish(fam: _HeldFamily, Q: np.ndarray, valid: np.ndarray, sing: np.ndarray) -> None:
+    """Rows Q (m, k, n) within ``_POLISH_NEAR`` of a limit refined in place on the pose.
+
+    The closed form keeps a row whose pose error is below ``PK_EXACT`` (1e-13):
+    where its held Jacobian is nearly singular the joints are off by that over its
+    smallest singular value (the rtb-data iiwa14 with the elbow stretched: 1e-14 to
+    9e-14 at 1.7e-4, up to 5e-10 rad), more than ``MANIFOLD_SLACK``, so a joint at its
+    limit moving 1e-8 to 1e-4 rad per rad of t was in and out at random and the
+    crossings computed 1e-9 to 1e-7 off (issue 29, helper corner29). One Newton step
+    on the pose with the parameter held (the 6 x 6 Jacobian of the other joints),
+    taken where it is at most ``_POLISH_STEP`` and ``_POLISH_GAIN`` times the error
+    (its second-order error ~1e-16: not checked). Valid rows not flagged singular
+    only; the test costs ~10 us per call where no row is near.
+    """
+    from robokin._native import kernels
+    from robokin.kinematics.jacobian import jacobian_and_pose
+
+    mid, half = fam.band
+    with np.errstate(invalid="ignore"):
+        d = np.abs(Q - mid)
+        d -= half
+        np.abs(d, out=d)
+        near = d <= _POLISH_NEAR
+    if not np.count_nonzero(near):
+        return
+    idx = np.nonzero(near.any(axis=-1) & valid & ~sing)
+    if not len(idx[0]):
+        return
+    q = Q[idx]
+    J, P = jacobian_and_pose(fam.robot.chain, q)
+    e = np.empty((len(q), 6))
+    kernels.pose_error(P, np.ascontiguousarray(np.broadcast_to(fam.T, P.shape)), e)
+    try:
+        step = np.linalg.solve(J[:, :, fam.free], e[..., None])[..., 0]
+    except np.linalg.LinAlgError:  # an exactly singular one: none is refined
+        return
+    size = np.abs(step).max(axis=-1)
+    small = (size <= _POLISH_STEP) & (size <= _POLISH_GAIN * np.abs(e).max(axis=-1))
+    trial = q[small]
+    trial[:, fam.free] += step[small]
+    Q[tuple(x[small] for x in idx)] = trial
 
 
 def _shift_into(t: float, domain: tuple[float, float]) -> float | None:

@@ -118,7 +118,8 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
 
     Returns ``([(t, branch), ...] extra breakpoints, how many were bisected)``; the
     fold ends are added to ``marks["fold"]``. All cells are bisected together (one
-    batch per step).
+    batch per step), with the renumberings of the rows (``_swap_cells``) in cells
+    that hold an exact point or a fold: each is a breakpoint of its moved slots.
     """
     inside = valid & _within(q, limits)
     exact: dict[int, list[float]] = {}
@@ -132,23 +133,47 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
             if not any(t[i] <= x <= t[i + 1] for x in exact.get(b, [])):
                 changes.append((i, b))
     changes = changes[:_MAX_BISECT]
+    # slots renumbered inside a cell that holds an exact point or a fold (elsewhere a
+    # slot keeps one state on either side of the jump: its states at the cell's ends)
+    marked = np.zeros((len(t) - 1, fam.k), dtype=bool)
+    for b, xs in exact.items():
+        at = np.searchsorted(t, np.asarray(xs), side="right") - 1
+        marked[at[(at >= 0) & (at < len(t) - 1)], b] = True
+    marked |= (valid[1:] != valid[:-1]).any(axis=1)[:, None]
+    sc, moved, sk = _swap_cells(t, q, valid, marked)
     cells = folds + changes
-    if not cells:
+    if not cells and not len(sc):
         return [], 0
-    idx = np.array([i for i, _ in cells])
-    br = np.array([b for _, b in cells])
-    kind = np.array([c >= len(folds) for c in range(len(cells))])  # True: in-limit change
+    idx = np.array([i for i, _ in cells], dtype=int)
+    br = np.array([b for _, b in cells], dtype=int)
+    kind = np.array([c >= len(folds) for c in range(len(cells))], dtype=bool)  # in-limit change
     state0 = np.where(kind, inside[idx, br], valid[idx, br])
     lo, hi = t[idx].astype(np.float64), t[idx + 1].astype(np.float64)
+    # a renumbering (in the same batches): slot sk's row at the midpoint nearer its
+    # row at the bracket's left end than at its right end lies left of the jump
+    s_lo, s_hi = t[sc].astype(np.float64), t[sc + 1].astype(np.float64)
+    qa, qe = q[sc, sk], q[sc + 1, sk]
     for _ in range(_BISECT):
         mid = 0.5 * (lo + hi)
-        if np.all((mid == lo) | (mid == hi)):
+        act = np.flatnonzero(s_hi - s_lo > _SWAP_T)
+        if np.all((mid == lo) | (mid == hi)) and not len(act):
             break  # every cell two adjacent floats: the rest would change nothing
-        qm, vm, _ = fam.rows(mid)
+        s_mid = 0.5 * (s_lo[act] + s_hi[act])
+        qm, vm, _ = fam.rows(np.concatenate([mid, s_mid]))
         rows = np.arange(len(mid))
         now = np.where(kind, vm[rows, br] & _within(qm[rows, br], limits), vm[rows, br])
         same = now == state0
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+        if len(act):
+            s_rows, k = np.arange(len(mid), len(mid) + len(act)), sk[act]
+            r = qm[s_rows, k]
+            with np.errstate(invalid="ignore"):
+                left = (_turn_gap(r - qa[act]).max(axis=-1) <= _turn_gap(r - qe[act]).max(axis=-1))
+            left &= vm[s_rows, k]
+            s_lo[act[left]], qa[act[left]] = s_mid[left], r[left]
+            s_hi[act[~left]], qe[act[~left]] = s_mid[~left], r[~left]
+    swaps = [(float(x), int(b)) for x, m in zip(s_lo.tolist(), moved, strict=True)
+             for b in np.flatnonzero(m).tolist()]
     ends = np.where(state0, lo, hi)  # the last point of the state that holds there
     marks["fold"] += [(float(e), int(b), "fold") for e, b, k in zip(ends, br, kind) if not k]
     fold = ~kind
@@ -159,7 +184,75 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
                 marks["fold"].append((tc, bc, "fold"))
             else:
                 marks["limit"].append((tc, bc, jc, what))
-    return [(float(e), int(b)) for e, b in zip(ends, br)], len(changes)
+    return [(float(e), int(b)) for e, b in zip(ends, br)] + swaps, len(changes)
+
+
+#: A slot's row moving more than this many times as far between two grid values as
+#: to another slot's row (and more than ``_SWAP_FLOOR`` rad) changed slots there.
+_SWAP_RATIO = 10.0
+_SWAP_FLOOR = 1e-6
+#: A renumbering is bisected to this [in t] (its cut: the pieces either side are
+#: decided at their midpoints).
+_SWAP_T = 1e-12
+
+
+def _turn_gap(d: np.ndarray) -> np.ndarray:
+    """|d| modulo whole turns for |d| < 4 pi (rows shifted into the limits differ by less)."""
+    d = np.abs(d)
+    out: np.ndarray = np.minimum(d, np.abs(d - _TWO_PI))
+    return out
+
+
+def _swap_cells(t: np.ndarray, q: np.ndarray, valid: np.ndarray, marked: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Grid cells where a closed form renumbers its rows: (cells (c,), moved (c, k), slot (c,)).
+
+    The held closed form numbers the quartic's roots by the eliminated variable's
+    angle and switches the elimination with the conditioning (``pieper.c``
+    ``pk_general``: the rtb-data iiwa14 at joint_a3 = +-1.074e-4 on every pose), and
+    numbers the roots left after a fold in order: a slot holds another configuration
+    past such a value. A cell whose slots stay valid and keep their in-limit states
+    shows no change there, and a piece across it was decided on the other
+    configuration at its midpoint (issue 29, helper corner29). Slot k moved in cell
+    i when its step there exceeds ``_SWAP_FLOOR`` and ``_SWAP_RATIO`` times its
+    steps in the cells either side, and its row at one end is ``_SWAP_RATIO`` times
+    nearer another slot's row at the other end than its own; ``slot``: the one of
+    each cell ``_state_changes`` bisects (every moved slot is cut there).
+    """
+    none = (np.zeros(0, dtype=int), np.zeros((0, q.shape[1]), dtype=bool), np.zeros(0, dtype=int))
+    cells = np.flatnonzero(marked.any(axis=1))
+    if len(t) < 4 or q.shape[1] < 2 or not len(cells):
+        return none
+    # a jump stands out of the slot's steps in the cells either side (rows move
+    # smoothly between them); only such cells are compared with the other slots
+    near = np.clip(cells[:, None] + np.array([-1, 0, 1]), 0, len(t) - 2)  # (c, 3)
+    with np.errstate(invalid="ignore"):
+        step = _turn_gap(q[near + 1] - q[near]).max(axis=-1)  # (c, 3, k)
+    step = np.where(valid[near + 1] & valid[near], step, np.nan)
+    own = step[:, 1]
+    side = np.fmin(step[:, 0], step[:, 2])
+    with np.errstate(invalid="ignore"):
+        jump = (own > _SWAP_FLOOR) & ~(own <= _SWAP_RATIO * side) & marked[cells]
+    keep = jump.any(axis=1)
+    cells, own, jump = cells[keep], own[keep], jump[keep]
+    if not len(cells):
+        return none
+    a, e = q[cells], q[cells + 1]  # (c, k, n)
+    both = valid[cells, :, None] & valid[cells + 1, None, :]  # (c, k, l): k at the start, l at the end
+    with np.errstate(invalid="ignore"):
+        gap = _turn_gap(e[:, None, :, :] - a[:, :, None, :]).max(axis=-1)  # (c, k, l)
+    gap = np.where(both, gap, np.inf)
+    idx = np.arange(q.shape[1])
+    gap[:, idx, idx] = np.inf
+    # slot k's start row went to another slot, or its end row came from one (a fold
+    # renumbers the slots of the roots left: the rows are numbered in order)
+    other = np.minimum(gap.min(axis=2), gap.min(axis=1))
+    moved = jump & (other * _SWAP_RATIO < own)  # (c, k)
+    keep = moved.any(axis=1)
+    cells, moved = cells[keep], moved[keep]
+    if not len(cells):
+        return none
+    return cells, moved, np.argmax(moved, axis=1)
 
 
 #: Values of s = sqrt(|t - t_f| / |t_g - t_f|) scanned between a fold and its grid row.
