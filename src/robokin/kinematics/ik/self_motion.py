@@ -426,6 +426,8 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
     if kern is not None:
         intervals, owner, points, info = _compiled(kern, Ta)
         if not info["flags"]:
+            assert isinstance(fam, _HeldFamily)
+            fam.polish = False  # the kernel's rows: its crossings are on them
             intervals, owner, corners = _points_refined(fam, limits, intervals, owner, points,
                                                         K.HM_KIND_UPPER)
             return _held_motion(Ta, kern, intervals, owner, info, fam, limits, points, corners)
