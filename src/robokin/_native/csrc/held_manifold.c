@@ -35,7 +35,10 @@
  * there too: its rows are the same).
  *
  * Every row is pk_one's: hm_closed evaluates its closed form for the slots asked
- * for, with pk_one's polish and its repairs of those rows, and hands over to
+ * for (either of pk_one's families: the meeting triple first, PK_START, the Panda's
+ * shoulder, or last, PK_END, the Gen3-like arm's wrist with joint_3 held; before
+ * session 10 the PK_END rows were full pk_one solves, ~550 per pose), with pk_one's
+ * polish and its repairs of those rows, and hands over to
  * pk_one only where a repair pk_one tries when no other row is inside would move
  * one (never on the 1,150 development poses; ~750 full solves per pose before
  * round 5), the same rows bit for bit (HM_VERIFY: 0 differences on 1,150 poses).
@@ -558,7 +561,7 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
     for (int i = 0; i < 4; i++)
         want |= (need >> 2 * i & 3u) != 0u ? 1u << i : 0u;
     int code = pk_front_memo(P, c->T, x, c->qn, 0, &c->front, want, &f);
-    if (code == PK_FRONT_SWIVEL || code == PK_FRONT_GENERAL || f.g.kase != PK_START)
+    if (code == PK_FRONT_SWIVEL || code == PK_FRONT_GENERAL)
         return 0; /* He and Liu's general case: not this kernel's */
     if (code != PK_OK)
         return 1; /* pk_one: cleared, no row */
