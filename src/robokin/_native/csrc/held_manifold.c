@@ -600,9 +600,16 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
             double m = pk_coords(P, g, th, held, x, r->q[slot]);
             if (!(m >= -1e-9) && held_in) {
                 /* pk_one's repairs may move it: a singular row, one within reach of
-                 * pk_inside (or, next to an aligned triple, pk_resplit), one on a
-                 * family (pk_slide's own test) */
+                 * pk_inside, one pk_resplit moves (next to an aligned triple: its
+                 * split of the outer angles; tried on a copy, hm_stays moves the
+                 * row: the Gen3-like arm's wrist at q6 ~ 0 moved q5 by an ulp or a
+                 * turn), one on a family (pk_slide's own test) */
                 int moves = sing || !(hm_outside(P, g, th) > 2.0 * PK_NUDGE);
+                if (!moves) {
+                    double tc[6];
+                    memcpy(tc, th, sizeof tc);
+                    moves = pk_resplit(P, g, it, &f.RT, f.pT, tc);
+                }
                 if (!moves && !pk_isolated(g, th)) {
                     m3 R;
                     v3 p;
