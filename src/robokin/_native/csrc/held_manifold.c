@@ -1305,15 +1305,19 @@ static double hm_move(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1)
 /* Bisects slot b's largest move between rows *ra < *rb (slopes of b in both) down to
  * adjacent doubles; 1 when the slot's row still moves by more than HM_SLOT_JUMP there
  * (a slot change; recorded in jump_t for the other slots), 0 when it is continuous at
- * the last bit or a row is missing. */
+ * the last bit or a row is missing. The steps evaluate slot b alone and without
+ * slopes (its row is a function of t and b: the same row as with every slot); the
+ * two rows it ends on are evaluated again with slot b's slope (session 10: the
+ * steps' 8 slots and slopes were ~1 in 3 of the Gen3-like kernel's time). */
 static int hm_bisect_jump(HmCtx *c, int b, HmRow *ra, HmRow *rb)
 {
     HmRow m;
+    double t0 = ra->t, t1 = rb->t;
     for (int it = 0; it < 80; it++) {
         double mid = 0.5 * (ra->t + rb->t);
         if (!(mid > ra->t && mid < rb->t))
             break;
-        hm_eval(c, mid, 1u << b, 0xffu, &m);
+        hm_eval(c, mid, 0u, 1u << b, &m);
         if (!m.valid[b])
             return 0;
         if (hm_move(c, b, ra, &m) >= hm_move(c, b, &m, rb))
@@ -1321,8 +1325,13 @@ static int hm_bisect_jump(HmCtx *c, int b, HmRow *ra, HmRow *rb)
         else
             *ra = m;
     }
-    if (!(nextafter(ra->t, rb->t) == rb->t) || !(hm_move(c, b, ra, rb) > HM_SLOT_JUMP) ||
-        !isfinite(ra->dq[b][0]) || !isfinite(rb->dq[b][0]))
+    if (!(nextafter(ra->t, rb->t) == rb->t) || !(hm_move(c, b, ra, rb) > HM_SLOT_JUMP))
+        return 0;
+    if (ra->t != t0)
+        hm_eval(c, ra->t, 1u << b, 1u << b, ra);
+    if (rb->t != t1)
+        hm_eval(c, rb->t, 1u << b, 1u << b, rb);
+    if (!isfinite(ra->dq[b][0]) || !isfinite(rb->dq[b][0]))
         return 0;
     int known = 0;
     for (int k = 0; k < c->njump && !known; k++)
