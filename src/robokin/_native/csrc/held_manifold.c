@@ -1308,7 +1308,8 @@ static double hm_move(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1)
  * the last bit or a row is missing. The steps evaluate slot b alone and without
  * slopes (its row is a function of t and b: the same row as with every slot); the
  * two rows it ends on are evaluated again with slot b's slope (session 10: the
- * steps' 8 slots and slopes were ~1 in 3 of the Gen3-like kernel's time). */
+ * steps' 8 slots and slopes took the Gen3-like kernel from 0.88 to 1.23 ms per
+ * uniform pose, baseline ISA). */
 static int hm_bisect_jump(HmCtx *c, int b, HmRow *ra, HmRow *rb)
 {
     HmRow m;
