@@ -35,7 +35,10 @@
  * there too: its rows are the same).
  *
  * Every row is pk_one's: hm_closed evaluates its closed form for the slots asked
- * for, with pk_one's polish and its repairs of those rows, and hands over to
+ * for (either of pk_one's families: the meeting triple first, PK_START, the Panda's
+ * shoulder, or last, PK_END, the Gen3-like arm's wrist with joint_3 held; before
+ * session 10 the PK_END rows were full pk_one solves, ~550 per pose), with pk_one's
+ * polish and its repairs of those rows, and hands over to
  * pk_one only where a repair pk_one tries when no other row is inside would move
  * one (never on the 1,150 development poses; ~750 full solves per pose before
  * round 5), the same rows bit for bit (HM_VERIFY: 0 differences on 1,150 poses).
@@ -558,7 +561,7 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
     for (int i = 0; i < 4; i++)
         want |= (need >> 2 * i & 3u) != 0u ? 1u << i : 0u;
     int code = pk_front_memo(P, c->T, x, c->qn, 0, &c->front, want, &f);
-    if (code == PK_FRONT_SWIVEL || code == PK_FRONT_GENERAL || f.g.kase != PK_START)
+    if (code == PK_FRONT_SWIVEL || code == PK_FRONT_GENERAL)
         return 0; /* He and Liu's general case: not this kernel's */
     if (code != PK_OK)
         return 1; /* pk_one: cleared, no row */
@@ -597,9 +600,16 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
             double m = pk_coords(P, g, th, held, x, r->q[slot]);
             if (!(m >= -1e-9) && held_in) {
                 /* pk_one's repairs may move it: a singular row, one within reach of
-                 * pk_inside (or, next to an aligned triple, pk_resplit), one on a
-                 * family (pk_slide's own test) */
+                 * pk_inside, one pk_resplit moves (next to an aligned triple: its
+                 * split of the outer angles; tried on a copy, hm_stays moves the
+                 * row: the Gen3-like arm's wrist at q6 ~ 0 moved q5 by an ulp or a
+                 * turn), one on a family (pk_slide's own test) */
                 int moves = sing || !(hm_outside(P, g, th) > 2.0 * PK_NUDGE);
+                if (!moves) {
+                    double tc[6];
+                    memcpy(tc, th, sizeof tc);
+                    moves = pk_resplit(P, g, it, &f.RT, f.pT, tc);
+                }
                 if (!moves && !pk_isolated(g, th)) {
                     m3 R;
                     v3 p;
@@ -1295,15 +1305,20 @@ static double hm_move(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1)
 /* Bisects slot b's largest move between rows *ra < *rb (slopes of b in both) down to
  * adjacent doubles; 1 when the slot's row still moves by more than HM_SLOT_JUMP there
  * (a slot change; recorded in jump_t for the other slots), 0 when it is continuous at
- * the last bit or a row is missing. */
+ * the last bit or a row is missing. The steps evaluate slot b alone and without
+ * slopes (its row is a function of t and b: the same row as with every slot); the
+ * two rows it ends on are evaluated again with slot b's slope (session 10: the
+ * steps' 8 slots and slopes took the Gen3-like kernel from 0.88 to 1.23 ms per
+ * uniform pose, baseline ISA). */
 static int hm_bisect_jump(HmCtx *c, int b, HmRow *ra, HmRow *rb)
 {
     HmRow m;
+    double t0 = ra->t, t1 = rb->t;
     for (int it = 0; it < 80; it++) {
         double mid = 0.5 * (ra->t + rb->t);
         if (!(mid > ra->t && mid < rb->t))
             break;
-        hm_eval(c, mid, 1u << b, 0xffu, &m);
+        hm_eval(c, mid, 0u, 1u << b, &m);
         if (!m.valid[b])
             return 0;
         if (hm_move(c, b, ra, &m) >= hm_move(c, b, &m, rb))
@@ -1311,8 +1326,13 @@ static int hm_bisect_jump(HmCtx *c, int b, HmRow *ra, HmRow *rb)
         else
             *ra = m;
     }
-    if (!(nextafter(ra->t, rb->t) == rb->t) || !(hm_move(c, b, ra, rb) > HM_SLOT_JUMP) ||
-        !isfinite(ra->dq[b][0]) || !isfinite(rb->dq[b][0]))
+    if (!(nextafter(ra->t, rb->t) == rb->t) || !(hm_move(c, b, ra, rb) > HM_SLOT_JUMP))
+        return 0;
+    if (ra->t != t0)
+        hm_eval(c, ra->t, 1u << b, 1u << b, ra);
+    if (rb->t != t1)
+        hm_eval(c, rb->t, 1u << b, 1u << b, rb);
+    if (!isfinite(ra->dq[b][0]) || !isfinite(rb->dq[b][0]))
         return 0;
     int known = 0;
     for (int k = 0; k < c->njump && !known; k++)
