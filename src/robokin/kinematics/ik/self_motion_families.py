@@ -152,6 +152,27 @@ class _HeldFamily(_JointFamily):
             _held_polish(self, Q, valid, sing)
         return Q, valid, sing
 
+    def slot_rows(self, t: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``rows(t)``'s slot b[i] at t[i], only those rows refined (``_held_polish``).
+
+        The bisections read one slot per value: refining the k - 1 others was ~70 % of
+        the refinement's cost on the rtb-data iiwa14 (issue 29, helper polish29). The
+        same rows bit for bit (every step is per row; the one exception, an exactly
+        singular held Jacobian, which refines none of its call's rows, has not been met).
+        """
+        from robokin.kinematics.ik.analytic import pieper as pk
+
+        t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
+        Tb = np.ascontiguousarray(np.broadcast_to(self.T, (len(t), 4, 4)))
+        Q, valid, sing, _, _ = pk.raw_solve(self.params, Tb, t)
+        i = np.arange(len(t))
+        q, v = Q[i, b], valid[i, b]
+        q[~v] = np.nan
+        q = _into_limits(self.robot, q)
+        if self.polish:
+            _held_polish(self, q[:, None], v[:, None], sing[i, b][:, None])
+        return q, v
+
 
 #: Rows within this of a limit [rad] are refined (``_held_polish``): a membership
 #: decided within rounding of the slack.

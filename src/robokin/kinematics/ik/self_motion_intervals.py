@@ -159,17 +159,15 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
         if np.all((mid == lo) | (mid == hi)) and not len(act):
             break  # every cell two adjacent floats: the rest would change nothing
         s_mid = 0.5 * (s_lo[act] + s_hi[act])
-        qm, vm, _ = fam.rows(np.concatenate([mid, s_mid]))
-        rows = np.arange(len(mid))
-        now = np.where(kind, vm[rows, br] & _within(qm[rows, br], limits), vm[rows, br])
+        qm, vm = fam.slot_rows(np.concatenate([mid, s_mid]), np.concatenate([br, sk[act]]))
+        now = np.where(kind, vm[:len(mid)] & _within(qm[:len(mid)], limits), vm[:len(mid)])
         same = now == state0
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
         if len(act):
-            s_rows, k = np.arange(len(mid), len(mid) + len(act)), sk[act]
-            r = qm[s_rows, k]
+            r = qm[len(mid):]
             with np.errstate(invalid="ignore"):
                 left = (_turn_gap(r - qa[act]).max(axis=-1) <= _turn_gap(r - qe[act]).max(axis=-1))
-            left &= vm[s_rows, k]
+            left &= vm[len(mid):]
             s_lo[act[left]], qa[act[left]] = s_mid[left], r[left]
             s_hi[act[~left]], qe[act[~left]] = s_mid[~left], r[~left]
     swaps = [(float(x), int(b)) for x, m in zip(s_lo.tolist(), moved, strict=True)
@@ -279,11 +277,9 @@ def _fold_crossings(fam: _Family, tf: np.ndarray, tg: np.ndarray, br: np.ndarray
     """
     s2 = np.linspace(0.0, 1.0, _FOLD_SCAN) ** 2
     ts = tf[:, None] + (tg - tf)[:, None] * s2  # (folds, scan)
-    q, valid, _ = fam.rows(ts.ravel())
-    rows = np.arange(ts.size)
-    bb = np.repeat(br, _FOLD_SCAN)
-    qb = q[rows, bb].reshape(ts.shape + (-1,))  # (folds, scan, n)
-    ok = valid[rows, bb].reshape(ts.shape)
+    q, valid = fam.slot_rows(ts.ravel(), np.repeat(br, _FOLD_SCAN))
+    qb = q.reshape(ts.shape + (-1,))  # (folds, scan, n)
+    ok = valid.reshape(ts.shape)
     with np.errstate(invalid="ignore"):
         low = qb < limits[:, 0] - MANIFOLD_SLACK
         high = qb > limits[:, 1] + MANIFOLD_SLACK
@@ -305,12 +301,12 @@ def _fold_crossings(fam: _Family, tf: np.ndarray, tg: np.ndarray, br: np.ndarray
         mid = 0.5 * (lo + hi)
         if np.all((mid == lo) | (mid == hi)):
             break  # every cell two adjacent floats
-        qm, vm, _ = fam.rows(mid)
-        qj = qm[n_rows, b_i, j_i]
+        qm, vm = fam.slot_rows(mid, b_i)
+        qj = qm[n_rows, j_i]
         with np.errstate(invalid="ignore"):
             now = ((qj > limits[j_i, 1] + MANIFOLD_SLACK).astype(np.int8)
                    - (qj < limits[j_i, 0] - MANIFOLD_SLACK).astype(np.int8))
-        now = np.where(vm[n_rows, b_i], now, _NO_ROW)  # rows missing: a second fold
+        now = np.where(vm, now, _NO_ROW)  # rows missing: a second fold
         same = now == state0
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
         state1 = np.where(same, state1, now)
@@ -777,9 +773,8 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
 
     def inside(ts: np.ndarray, b: np.ndarray) -> np.ndarray:
         """(rows of ts (s, w)) on branches b (s,) inside (the range's ends included)."""
-        q, valid, _ = fam.rows(ts.ravel())
-        idx, bb = np.arange(ts.size), np.repeat(b, ts.shape[1])
-        ok = (valid[idx, bb] & _within(q[idx, bb], limits)).reshape(ts.shape)
+        q, valid = fam.slot_rows(ts.ravel(), np.repeat(b, ts.shape[1]))
+        ok = (valid & _within(q, limits)).reshape(ts.shape)
         if not fam.periodic:
             ok &= (ts >= lo_d) & (ts <= hi_d)
         out: np.ndarray = ok
