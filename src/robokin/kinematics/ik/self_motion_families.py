@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.linalg import _umath_linalg  # np.linalg.solve's gufunc (``_held_polish``)
 
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, Derived
@@ -134,6 +135,8 @@ class _HeldFamily(_JointFamily):
         self.band = (0.5 * (lim[:, 0] + lim[:, 1]), half)
         #: the joints a refining step moves (all but the parameter)
         self.free = np.delete(np.arange(robot.n), j)
+        #: T repeated (r, 4, 4) for the refining steps' pose errors (grown as needed)
+        self.poses = np.zeros((0, 4, 4))
         #: rows near a limit refined (``_held_polish``); off once the compiled kernel
         #: certified the manifold: its crossings and ends are on the unrefined rows,
         #: and a refined row there moves by up to ~6e-12 (the Panda), past the slack
@@ -199,30 +202,42 @@ def _held_polish(fam: _HeldFamily, Q: np.ndarray, valid: np.ndarray, sing: np.nd
     (its second-order error ~1e-16: not checked). Valid rows not flagged singular
     only; the test costs ~10 us per call where no row is near.
     """
-    from robokin._native import kernels
-    from robokin.kinematics.jacobian import jacobian_and_pose
-
     mid, half = fam.band
     with np.errstate(invalid="ignore"):
-        d = np.abs(Q - mid)
+        d = np.subtract(Q, mid)
+        np.abs(d, out=d)
         d -= half
         np.abs(d, out=d)
         near = d <= _POLISH_NEAR
-    if not np.count_nonzero(near):
+    if not near.any():
         return
-    idx = np.nonzero(near.any(axis=-1) & valid & ~sing)
+    pick = near.any(axis=-1)
+    pick &= valid
+    pick &= ~sing
+    idx = np.nonzero(pick)
     if not len(idx[0]):
         return
+    from robokin._native import kernels
+    from robokin.kinematics.jacobian import jacobian_and_pose
+
     q = Q[idx]
     J, P = jacobian_and_pose(fam.robot.chain, q)
+    if len(fam.poses) < len(q):  # the pose repeated, contiguous (grown as needed)
+        fam.poses = np.ascontiguousarray(np.broadcast_to(fam.T, (2 * len(q), 4, 4)))
     e = np.empty((len(q), 6))
-    kernels.pose_error(P, np.ascontiguousarray(np.broadcast_to(fam.T, P.shape)), e)
-    try:
-        step = np.linalg.solve(J[:, :, fam.free], e[..., None])[..., 0]
-    except np.linalg.LinAlgError:  # an exactly singular one: none is refined
-        return
+    kernels.pose_error(P, fam.poses[:len(q)], e)
+    # np.linalg.solve's own gufunc and error test (its wrapper cost ~20 us a call)
+    with np.errstate(invalid="raise", over="ignore", divide="ignore", under="ignore"):
+        try:
+            step = _umath_linalg.solve(J[:, :, fam.free], e[..., None], signature="dd->d")[..., 0]
+        except FloatingPointError:  # an exactly singular one: none is refined
+            return
     size = np.abs(step).max(axis=-1)
     small = (size <= _POLISH_STEP) & (size <= _POLISH_GAIN * np.abs(e).max(axis=-1))
+    if small.all():  # (the usual case: no rows to pick)
+        q[:, fam.free] += step
+        Q[idx] = q
+        return
     trial = q[small]
     trial[:, fam.free] += step[small]
     Q[tuple(x[small] for x in idx)] = trial
