@@ -344,13 +344,12 @@ def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
                 spans.append((a, e))
     if not mids:
         return np.zeros((0, 2)), np.zeros(0, dtype=int)
-    q, valid, _ = fam.rows(np.array(mids))
-    idx = np.arange(len(mids))
-    ok = valid[idx, owners] & _within(q[idx, owners], limits)
+    q, valid = fam.slot_rows(np.array(mids), np.array(owners, dtype=int))
+    ok = valid & _within(q, limits)
     with np.errstate(invalid="ignore"):
-        out = ((q[idx, owners] < limits[:, 0] - MANIFOLD_SLACK)
-               | (q[idx, owners] > limits[:, 1] + MANIFOLD_SLACK))  # (pieces, n)
-    out[~valid[idx, owners]] = True  # no row: no corner next to it
+        out = ((q < limits[:, 0] - MANIFOLD_SLACK)
+               | (q > limits[:, 1] + MANIFOLD_SLACK))  # (pieces, n)
+    out[~valid] = True  # no row: no corner next to it
     for (a, e), b, good in zip(spans, owners, ok, strict=True):
         if not good:
             continue
@@ -410,10 +409,8 @@ def _touches(fam: _Family, limits: np.ndarray, crossings: list[Any],
                 bs.append(b)
     if not ts:
         return []
-    values, idx = np.unique(ts, return_inverse=True)  # the range's ends: once
-    q, valid, _ = fam.rows(values)
-    br = np.array(bs)
-    ok = valid[idx, br] & _within(q[idx, br], limits)
+    q, valid = fam.slot_rows(np.array(ts), np.array(bs, dtype=int))
+    ok = valid & _within(q, limits)
     return [(b, t, t) for t, b, good in zip(ts, bs, ok.tolist(), strict=True) if good]
 
 
@@ -638,12 +635,10 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     corners: list[tuple[float, int, np.ndarray]] = []
     points_only: list[tuple[int, float, float]] = []
     if len(c):
-        ts, inv = np.unique(c[:, 0], return_inverse=True)
-        q, valid, _ = fam.rows(ts)
         b = c[:, 1].astype(int)
-        r = q[inv, b]
+        r, valid = fam.slot_rows(c[:, 0], b)
         excess = np.maximum(limits[:, 0] - r, r - limits[:, 1])  # (c, n)
-        worst = np.where(valid[inv, b], excess.max(axis=-1), np.inf)
+        worst = np.where(valid, excess.max(axis=-1), np.inf)
         inside = worst <= MANIFOLD_SLACK
         lone = np.flatnonzero(inside & ~near)
         if len(lone):  # a graze only where its joint stays at the limit either side
@@ -686,12 +681,12 @@ def _tangent(fam: _Family, limits: np.ndarray, c: np.ndarray) -> np.ndarray:
     uniform pose #119 of seed 0: a 6.4e-4 stretch), not a graze.
     """
     ts = np.concatenate([c[:, 0] - 1e-8, c[:, 0] + 1e-8])
-    q, valid, _ = fam.rows(ts)
     m = len(c)
     b, j = np.tile(c[:, 1].astype(int), 2), np.tile(c[:, 2].astype(int), 2)
-    x = q[np.arange(2 * m), b, j]
+    q, valid = fam.slot_rows(ts, b)
+    x = q[np.arange(2 * m), j]
     with np.errstate(invalid="ignore"):
-        at = (valid[np.arange(2 * m), b] & (x >= limits[j, 0] - MANIFOLD_SLACK)
+        at = (valid & (x >= limits[j, 0] - MANIFOLD_SLACK)
               & (x <= limits[j, 1] + MANIFOLD_SLACK))
     out: np.ndarray = at[:m] & at[m:]
     return out
