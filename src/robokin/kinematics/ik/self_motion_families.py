@@ -155,13 +155,15 @@ class _HeldFamily(_JointFamily):
             _held_polish(self, Q, valid, sing)
         return Q, valid, sing
 
-    def slot_rows(self, t: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def slot_rows(self, t: np.ndarray, b: np.ndarray, read: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
         """``rows(t)``'s slot b[i] at t[i], only those rows refined (``_held_polish``).
 
-        The bisections read one slot per value: refining the k - 1 others was ~70 % of
-        the refinement's cost on the rtb-data iiwa14 (issue 29, helper polish29). The
-        same rows bit for bit (every step is per row; the one exception, an exactly
-        singular held Jacobian, which refines none of its call's rows, has not been met).
+        The bisections read one slot per value (a fold's only its validity: ``read``
+        False, not refined); refining every slot of every value was most of the
+        refinement's cost on the rtb-data iiwa14 (issue 29, helper polish29). The
+        rows read are ``rows(t)``'s bit for bit: every step is per row, but for an
+        exactly singular held Jacobian, which refines none of its call's rows (not met).
         """
         from robokin.kinematics.ik.analytic import pieper as pk
 
@@ -172,8 +174,15 @@ class _HeldFamily(_JointFamily):
         q, v = Q[i, b], valid[i, b]
         q[~v] = np.nan
         q = _into_limits(self.robot, q)
-        if self.polish:
+        if not self.polish:
+            return q, v
+        if read is None:
             _held_polish(self, q[:, None], v[:, None], sing[i, b][:, None])
+        elif read.any():
+            r = np.flatnonzero(read)
+            qr = q[r]
+            _held_polish(self, qr[:, None], v[r, None], sing[i[r], b[r], None])
+            q[r] = qr
         return q, v
 
 

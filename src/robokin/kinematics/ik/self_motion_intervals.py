@@ -159,7 +159,8 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
         if np.all((mid == lo) | (mid == hi)) and not len(act):
             break  # every cell two adjacent floats: the rest would change nothing
         s_mid = 0.5 * (s_lo[act] + s_hi[act])
-        qm, vm = fam.slot_rows(np.concatenate([mid, s_mid]), np.concatenate([br, sk[act]]))
+        qm, vm = fam.slot_rows(np.concatenate([mid, s_mid]), np.concatenate([br, sk[act]]),
+                               np.concatenate([kind, np.ones(len(act), dtype=bool)]))
         now = np.where(kind, vm[:len(mid)] & _within(qm[:len(mid)], limits), vm[:len(mid)])
         same = now == state0
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
