@@ -418,8 +418,10 @@ def _touches(fam: _Family, limits: np.ndarray, crossings: list[Any],
                 bs.append(b)
     if not ts:
         return []
-    q, valid = fam.slot_rows(np.array(ts), np.array(bs, dtype=int))
-    ok = valid & _within(q, limits)
+    values, idx = np.unique(ts, return_inverse=True)  # the range's ends: once
+    q, valid, _ = fam.rows(values)
+    br = np.array(bs)
+    ok = valid[idx, br] & _within(q[idx, br], limits)
     return [(b, t, t) for t, b, good in zip(ts, bs, ok.tolist(), strict=True) if good]
 
 
@@ -644,10 +646,12 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     corners: list[tuple[float, int, np.ndarray]] = []
     points_only: list[tuple[int, float, float]] = []
     if len(c):
+        ts, inv = np.unique(c[:, 0], return_inverse=True)
+        q, valid, _ = fam.rows(ts)
         b = c[:, 1].astype(int)
-        r, valid = fam.slot_rows(c[:, 0], b)
+        r = q[inv, b]
         excess = np.maximum(limits[:, 0] - r, r - limits[:, 1])  # (c, n)
-        worst = np.where(valid, excess.max(axis=-1), np.inf)
+        worst = np.where(valid[inv, b], excess.max(axis=-1), np.inf)
         inside = worst <= MANIFOLD_SLACK
         lone = np.flatnonzero(inside & ~near)
         if len(lone):  # a graze only where its joint stays at the limit either side
