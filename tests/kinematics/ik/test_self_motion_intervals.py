@@ -940,3 +940,35 @@ def test_the_iiwa_intervals_agree_with_the_rows_where_the_slots_are_renumbered(q
     away = np.abs(ts[:, None] - ends[None, :]).min(axis=1) > 1e-7
     bad = (sm.inside(ts) != cover).any(axis=1) & away
     assert not bad.any(), ts[bad][:10]
+
+
+def test_the_held_rows_of_one_slot_are_the_rows_of_that_slot():
+    # Issue 29 (helper polish29): the bisections read slot b[i] at t[i] alone
+    # (_HeldFamily.slot_rows), which refines only those rows (and only the ``read``
+    # ones). Oracle: fam.rows, every slot refined, bit for bit, on corner29's #6379
+    # (q4 ~ 0, joint_a2 at its limit: rows next to a limit are refined there); and
+    # the unrefined rows (fam.polish off) differ on some of them, so the refinement ran.
+    robot = _arm("iiwa")
+    q0 = np.array([2.9668, -2.0942, 1e-07, 1e-09, -0.34442118632710983,
+                   0.28861094459290904, -1e-06])
+    sm, t, _ = _generating(robot, q0)
+    fam = sm._family
+    assert fam.polish  # the solved-points path: not certified by the kernel
+    ts = t + np.array([-1e-6, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-6])
+    full, valid, _ = fam.rows(ts)
+    i = np.arange(len(ts))
+    refined = 0
+    for b in range(fam.k):
+        bb = np.full(len(ts), b)
+        q, v = fam.slot_rows(ts, bb)
+        assert np.array_equal(v, valid[:, b])
+        assert np.array_equal(q, full[:, b], equal_nan=True)
+        read = i % 2 == 0
+        qr, vr = fam.slot_rows(ts, bb, read)
+        assert np.array_equal(vr, v)
+        assert np.array_equal(qr[read], q[read], equal_nan=True)
+        fam.polish = False
+        raw, _ = fam.slot_rows(ts, bb)
+        fam.polish = True
+        refined += int((np.isfinite(q) & (raw != q)).any(axis=-1).sum())
+    assert refined > 0

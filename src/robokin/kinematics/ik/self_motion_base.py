@@ -30,6 +30,19 @@ class _Family:
         """Q (m, k, n) (NaN where a branch has no point), valid (m, k), singular (m, k)."""
         raise NotImplementedError
 
+    def slot_rows(self, t: np.ndarray, b: np.ndarray, read: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """Slot b[i]'s row at t[i]: q (m, n) and valid (m,), for t (m,), b (m,) int.
+
+        ``rows(t)`` read one slot per value, bit for bit; a family may compute less
+        (the held closed form refines only these rows: ``_HeldFamily.slot_rows``).
+        ``read`` (m,) bool: the rows whose joints the caller reads (default: all); of
+        the others only ``valid`` is read, and their rows may come back unrefined.
+        """
+        q, valid, _ = self.rows(t)
+        i = np.arange(len(q))
+        return q[i, b], valid[i, b]
+
     def sample_rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``rows(t)`` for ``SelfMotion.sample`` and ``inside``.
 

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.linalg import _umath_linalg  # np.linalg.solve's gufunc (``_held_polish``)
 
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, Derived
@@ -134,6 +135,8 @@ class _HeldFamily(_JointFamily):
         self.band = (0.5 * (lim[:, 0] + lim[:, 1]), half)
         #: the joints a refining step moves (all but the parameter)
         self.free = np.delete(np.arange(robot.n), j)
+        #: T repeated (r, 4, 4) for the refining steps' pose errors (grown as needed)
+        self.poses = np.zeros((0, 4, 4))
         #: rows near a limit refined (``_held_polish``); off once the compiled kernel
         #: certified the manifold: its crossings and ends are on the unrefined rows,
         #: and a refined row there moves by up to ~6e-12 (the Panda), past the slack
@@ -151,6 +154,36 @@ class _HeldFamily(_JointFamily):
         if self.polish:
             _held_polish(self, Q, valid, sing)
         return Q, valid, sing
+
+    def slot_rows(self, t: np.ndarray, b: np.ndarray, read: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """``rows(t)``'s slot b[i] at t[i], only those rows refined (``_held_polish``).
+
+        The bisections read one slot per value (a fold's only its validity: ``read``
+        False, not refined); refining every slot of every value was most of the
+        refinement's cost on the rtb-data iiwa14 (issue 29, helper polish29). The
+        rows read are ``rows(t)``'s bit for bit: every step is per row, but for an
+        exactly singular held Jacobian, which refines none of its call's rows (not met).
+        """
+        from robokin.kinematics.ik.analytic import pieper as pk
+
+        t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
+        Tb = np.ascontiguousarray(np.broadcast_to(self.T, (len(t), 4, 4)))
+        Q, valid, sing, _, _ = pk.raw_solve(self.params, Tb, t)
+        i = np.arange(len(t))
+        q, v = Q[i, b], valid[i, b]
+        q[~v] = np.nan
+        q = _into_limits(self.robot, q)
+        if not self.polish:
+            return q, v
+        if read is None:
+            _held_polish(self, q[:, None], v[:, None], sing[i, b][:, None])
+        elif read.any():
+            r = np.flatnonzero(read)
+            qr = q[r]
+            _held_polish(self, qr[:, None], v[r, None], sing[i[r], b[r], None])
+            q[r] = qr
+        return q, v
 
 
 #: Rows within this of a limit [rad] are refined (``_held_polish``): a membership
@@ -178,30 +211,42 @@ def _held_polish(fam: _HeldFamily, Q: np.ndarray, valid: np.ndarray, sing: np.nd
     (its second-order error ~1e-16: not checked). Valid rows not flagged singular
     only; the test costs ~10 us per call where no row is near.
     """
-    from robokin._native import kernels
-    from robokin.kinematics.jacobian import jacobian_and_pose
-
     mid, half = fam.band
     with np.errstate(invalid="ignore"):
-        d = np.abs(Q - mid)
+        d = np.subtract(Q, mid)
+        np.abs(d, out=d)
         d -= half
         np.abs(d, out=d)
         near = d <= _POLISH_NEAR
-    if not np.count_nonzero(near):
+    if not near.any():
         return
-    idx = np.nonzero(near.any(axis=-1) & valid & ~sing)
+    pick = near.any(axis=-1)
+    pick &= valid
+    pick &= ~sing
+    idx = np.nonzero(pick)
     if not len(idx[0]):
         return
+    from robokin._native import kernels
+    from robokin.kinematics.jacobian import jacobian_and_pose
+
     q = Q[idx]
     J, P = jacobian_and_pose(fam.robot.chain, q)
+    if len(fam.poses) < len(q):  # the pose repeated, contiguous (grown as needed)
+        fam.poses = np.ascontiguousarray(np.broadcast_to(fam.T, (2 * len(q), 4, 4)))
     e = np.empty((len(q), 6))
-    kernels.pose_error(P, np.ascontiguousarray(np.broadcast_to(fam.T, P.shape)), e)
-    try:
-        step = np.linalg.solve(J[:, :, fam.free], e[..., None])[..., 0]
-    except np.linalg.LinAlgError:  # an exactly singular one: none is refined
-        return
+    kernels.pose_error(P, fam.poses[:len(q)], e)
+    # np.linalg.solve's own gufunc and error test (its wrapper cost ~20 us a call)
+    with np.errstate(invalid="raise", over="ignore", divide="ignore", under="ignore"):
+        try:
+            step = _umath_linalg.solve(J[:, :, fam.free], e[..., None], signature="dd->d")[..., 0]
+        except FloatingPointError:  # an exactly singular one: none is refined
+            return
     size = np.abs(step).max(axis=-1)
     small = (size <= _POLISH_STEP) & (size <= _POLISH_GAIN * np.abs(e).max(axis=-1))
+    if small.all():  # (the usual case: no rows to pick)
+        q[:, fam.free] += step
+        Q[idx] = q
+        return
     trial = q[small]
     trial[:, fam.free] += step[small]
     Q[tuple(x[small] for x in idx)] = trial

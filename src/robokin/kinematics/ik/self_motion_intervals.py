@@ -159,17 +159,16 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
         if np.all((mid == lo) | (mid == hi)) and not len(act):
             break  # every cell two adjacent floats: the rest would change nothing
         s_mid = 0.5 * (s_lo[act] + s_hi[act])
-        qm, vm, _ = fam.rows(np.concatenate([mid, s_mid]))
-        rows = np.arange(len(mid))
-        now = np.where(kind, vm[rows, br] & _within(qm[rows, br], limits), vm[rows, br])
+        qm, vm = fam.slot_rows(np.concatenate([mid, s_mid]), np.concatenate([br, sk[act]]),
+                               np.concatenate([kind, np.ones(len(act), dtype=bool)]))
+        now = np.where(kind, vm[:len(mid)] & _within(qm[:len(mid)], limits), vm[:len(mid)])
         same = now == state0
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
         if len(act):
-            s_rows, k = np.arange(len(mid), len(mid) + len(act)), sk[act]
-            r = qm[s_rows, k]
+            r = qm[len(mid):]
             with np.errstate(invalid="ignore"):
-                left = (_turn_gap(r - qa[act]).max(axis=-1) <= _turn_gap(r - qe[act]).max(axis=-1))
-            left &= vm[s_rows, k]
+                left = _turn_gap(r - qa[act]) <= _turn_gap(r - qe[act])
+            left &= vm[len(mid):]
             s_lo[act[left]], qa[act[left]] = s_mid[left], r[left]
             s_hi[act[~left]], qe[act[~left]] = s_mid[~left], r[~left]
     swaps = [(float(x), int(b)) for x, m in zip(s_lo.tolist(), moved, strict=True)
@@ -197,9 +196,17 @@ _SWAP_T = 1e-12
 
 
 def _turn_gap(d: np.ndarray) -> np.ndarray:
-    """|d| modulo whole turns for |d| < 4 pi (rows shifted into the limits differ by less)."""
+    """(...): the largest |d| (..., n) over its last axis, modulo whole turns (|d| < 4 pi).
+
+    Rows shifted into the limits differ by less than 4 pi. The largest by pairwise
+    ``np.maximum`` (NaN propagates as in ``max``, the same value): ``max(axis=-1)``
+    over the 7 joints cost ~3x that in ``_swap_cells`` (issue 29, helper polish29).
+    """
     d = np.abs(d)
-    out: np.ndarray = np.minimum(d, np.abs(d - _TWO_PI))
+    g = np.minimum(d, np.abs(d - _TWO_PI))
+    out: np.ndarray = g[..., 0].copy()
+    for j in range(1, g.shape[-1]):
+        np.maximum(out, g[..., j], out=out)
     return out
 
 
@@ -227,7 +234,7 @@ def _swap_cells(t: np.ndarray, q: np.ndarray, valid: np.ndarray, marked: np.ndar
     # smoothly between them); only such cells are compared with the other slots
     near = np.clip(cells[:, None] + np.array([-1, 0, 1]), 0, len(t) - 2)  # (c, 3)
     with np.errstate(invalid="ignore"):
-        step = _turn_gap(q[near + 1] - q[near]).max(axis=-1)  # (c, 3, k)
+        step = _turn_gap(q[near + 1] - q[near])  # (c, 3, k)
     step = np.where(valid[near + 1] & valid[near], step, np.nan)
     own = step[:, 1]
     side = np.fmin(step[:, 0], step[:, 2])
@@ -240,7 +247,7 @@ def _swap_cells(t: np.ndarray, q: np.ndarray, valid: np.ndarray, marked: np.ndar
     a, e = q[cells], q[cells + 1]  # (c, k, n)
     both = valid[cells, :, None] & valid[cells + 1, None, :]  # (c, k, l): k at the start, l at the end
     with np.errstate(invalid="ignore"):
-        gap = _turn_gap(e[:, None, :, :] - a[:, :, None, :]).max(axis=-1)  # (c, k, l)
+        gap = _turn_gap(e[:, None, :, :] - a[:, :, None, :])  # (c, k, l)
     gap = np.where(both, gap, np.inf)
     idx = np.arange(q.shape[1])
     gap[:, idx, idx] = np.inf
@@ -279,11 +286,9 @@ def _fold_crossings(fam: _Family, tf: np.ndarray, tg: np.ndarray, br: np.ndarray
     """
     s2 = np.linspace(0.0, 1.0, _FOLD_SCAN) ** 2
     ts = tf[:, None] + (tg - tf)[:, None] * s2  # (folds, scan)
-    q, valid, _ = fam.rows(ts.ravel())
-    rows = np.arange(ts.size)
-    bb = np.repeat(br, _FOLD_SCAN)
-    qb = q[rows, bb].reshape(ts.shape + (-1,))  # (folds, scan, n)
-    ok = valid[rows, bb].reshape(ts.shape)
+    q, valid = fam.slot_rows(ts.ravel(), np.repeat(br, _FOLD_SCAN))
+    qb = q.reshape(ts.shape + (-1,))  # (folds, scan, n)
+    ok = valid.reshape(ts.shape)
     with np.errstate(invalid="ignore"):
         low = qb < limits[:, 0] - MANIFOLD_SLACK
         high = qb > limits[:, 1] + MANIFOLD_SLACK
@@ -305,12 +310,12 @@ def _fold_crossings(fam: _Family, tf: np.ndarray, tg: np.ndarray, br: np.ndarray
         mid = 0.5 * (lo + hi)
         if np.all((mid == lo) | (mid == hi)):
             break  # every cell two adjacent floats
-        qm, vm, _ = fam.rows(mid)
-        qj = qm[n_rows, b_i, j_i]
+        qm, vm = fam.slot_rows(mid, b_i)
+        qj = qm[n_rows, j_i]
         with np.errstate(invalid="ignore"):
             now = ((qj > limits[j_i, 1] + MANIFOLD_SLACK).astype(np.int8)
                    - (qj < limits[j_i, 0] - MANIFOLD_SLACK).astype(np.int8))
-        now = np.where(vm[n_rows, b_i], now, _NO_ROW)  # rows missing: a second fold
+        now = np.where(vm, now, _NO_ROW)  # rows missing: a second fold
         same = now == state0
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
         state1 = np.where(same, state1, now)
@@ -348,13 +353,12 @@ def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
                 spans.append((a, e))
     if not mids:
         return np.zeros((0, 2)), np.zeros(0, dtype=int)
-    q, valid, _ = fam.rows(np.array(mids))
-    idx = np.arange(len(mids))
-    ok = valid[idx, owners] & _within(q[idx, owners], limits)
+    q, valid = fam.slot_rows(np.array(mids), np.array(owners, dtype=int))
+    ok = valid & _within(q, limits)
     with np.errstate(invalid="ignore"):
-        out = ((q[idx, owners] < limits[:, 0] - MANIFOLD_SLACK)
-               | (q[idx, owners] > limits[:, 1] + MANIFOLD_SLACK))  # (pieces, n)
-    out[~valid[idx, owners]] = True  # no row: no corner next to it
+        out = ((q < limits[:, 0] - MANIFOLD_SLACK)
+               | (q > limits[:, 1] + MANIFOLD_SLACK))  # (pieces, n)
+    out[~valid] = True  # no row: no corner next to it
     for (a, e), b, good in zip(spans, owners, ok, strict=True):
         if not good:
             continue
@@ -690,12 +694,12 @@ def _tangent(fam: _Family, limits: np.ndarray, c: np.ndarray) -> np.ndarray:
     uniform pose #119 of seed 0: a 6.4e-4 stretch), not a graze.
     """
     ts = np.concatenate([c[:, 0] - 1e-8, c[:, 0] + 1e-8])
-    q, valid, _ = fam.rows(ts)
     m = len(c)
     b, j = np.tile(c[:, 1].astype(int), 2), np.tile(c[:, 2].astype(int), 2)
-    x = q[np.arange(2 * m), b, j]
+    q, valid = fam.slot_rows(ts, b)
+    x = q[np.arange(2 * m), j]
     with np.errstate(invalid="ignore"):
-        at = (valid[np.arange(2 * m), b] & (x >= limits[j, 0] - MANIFOLD_SLACK)
+        at = (valid & (x >= limits[j, 0] - MANIFOLD_SLACK)
               & (x <= limits[j, 1] + MANIFOLD_SLACK))
     out: np.ndarray = at[:m] & at[m:]
     return out
@@ -777,9 +781,8 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
 
     def inside(ts: np.ndarray, b: np.ndarray) -> np.ndarray:
         """(rows of ts (s, w)) on branches b (s,) inside (the range's ends included)."""
-        q, valid, _ = fam.rows(ts.ravel())
-        idx, bb = np.arange(ts.size), np.repeat(b, ts.shape[1])
-        ok = (valid[idx, bb] & _within(q[idx, bb], limits)).reshape(ts.shape)
+        q, valid = fam.slot_rows(ts.ravel(), np.repeat(b, ts.shape[1]))
+        ok = (valid & _within(q, limits)).reshape(ts.shape)
         if not fam.periodic:
             ok &= (ts >= lo_d) & (ts <= hi_d)
         out: np.ndarray = ok
