@@ -16,7 +16,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.linalg import _umath_linalg  # np.linalg.solve's gufunc (``_held_polish``)
 
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, Derived
@@ -197,6 +196,29 @@ _POLISH_STEP = 1e-8
 _POLISH_GAIN = 1e4
 
 
+try:  # np.linalg.solve's own gufunc (private to numpy; its wrapper costs ~20 us a call)
+    from numpy.linalg import _umath_linalg as _linalg_gufuncs
+except ImportError:  # pragma: no cover - a numpy without it: the public wrapper
+    _linalg_gufuncs = None  # type: ignore[assignment]
+
+
+def _solve_stacked(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.linalg.solve(A, b)`` for float64 stacks A (m, k, k), b (m, k, 1).
+
+    Raises ``np.linalg.LinAlgError`` where a matrix is exactly singular, as the
+    public function does; the gufunc directly where numpy has it (``_held_polish``'s
+    calls are ~25 us through the wrapper, ~5 us without).
+    """
+    if _linalg_gufuncs is None:
+        return np.linalg.solve(A, b)
+    with np.errstate(invalid="raise", over="ignore", divide="ignore", under="ignore"):
+        try:
+            out: np.ndarray = _linalg_gufuncs.solve(A, b, signature="dd->d")
+        except FloatingPointError:
+            raise np.linalg.LinAlgError("Singular matrix") from None
+    return out
+
+
 def _held_polish(fam: _HeldFamily, Q: np.ndarray, valid: np.ndarray, sing: np.ndarray) -> None:
     """Rows Q (m, k, n) within ``_POLISH_NEAR`` of a limit refined in place on the pose.
 
@@ -235,12 +257,10 @@ def _held_polish(fam: _HeldFamily, Q: np.ndarray, valid: np.ndarray, sing: np.nd
         fam.poses = np.ascontiguousarray(np.broadcast_to(fam.T, (2 * len(q), 4, 4)))
     e = np.empty((len(q), 6))
     kernels.pose_error(P, fam.poses[:len(q)], e)
-    # np.linalg.solve's own gufunc and error test (its wrapper cost ~20 us a call)
-    with np.errstate(invalid="raise", over="ignore", divide="ignore", under="ignore"):
-        try:
-            step = _umath_linalg.solve(J[:, :, fam.free], e[..., None], signature="dd->d")[..., 0]
-        except FloatingPointError:  # an exactly singular one: none is refined
-            return
+    try:
+        step = _solve_stacked(J[:, :, fam.free], e[..., None])[..., 0]
+    except np.linalg.LinAlgError:  # an exactly singular one: none is refined
+        return
     size = np.abs(step).max(axis=-1)
     small = (size <= _POLISH_STEP) & (size <= _POLISH_GAIN * np.abs(e).max(axis=-1))
     if small.all():  # (the usual case: no rows to pick)
