@@ -52,6 +52,16 @@ def _manifold(robot, q0):
     return T, sm
 
 
+def _branch_intervals(sm, q0):
+    """(t, b, intervals (m, 2) of branch b holding t): q0 sampled back on branch b."""
+    t = float(q0[6])
+    d = _wrapped(sm.sample(t) - q0).max(-1)
+    b = int(np.nanargmin(d))
+    assert d[b] < 1e-9, d
+    iv = sm.intervals[sm.interval_branch == b]
+    return t, b, iv[(iv[:, 0] <= t) & (t <= iv[:, 1])]
+
+
 @pytest.mark.parametrize("arm", sorted(ARMS))
 @pytest.mark.parametrize("special", [False, True])
 def test_generating_configuration_is_on_a_branch_inside_an_interval(arm, special):
@@ -658,13 +668,8 @@ def test_a_graze_of_the_continued_family_keeps_its_in_slack_stretch(q):
     robot = ARMS["offset_iiwa"]
     q0 = np.array(q)
     T, sm = _manifold(robot, q0)
-    t = float(q0[6])
-    d = _wrapped(sm.sample(t) - q0).max(-1)
-    b = int(np.nanargmin(d))
-    assert d[b] < 1e-9, d
-    iv = sm.intervals[sm.interval_branch == b]
-    hit = iv[(iv[:, 0] <= t) & (t <= iv[:, 1])]
-    assert len(hit) == 1, (t, iv)
+    t, b, hit = _branch_intervals(sm, q0)
+    assert len(hit) == 1, (t, hit)
     a, e = hit[0]
     assert e - a > 1e-7, (a, e)
     rows = sm.sample(np.linspace(max(a, t - 1e-4), min(e, t + 1e-4), 9))[:, b]
@@ -705,13 +710,8 @@ def test_a_manifold_between_two_nodes_is_found():
     inner = robot.ik(T, fixed={name: np.array([-0.02, -0.015, -0.01])})
     outer = robot.ik(T, fixed={name: np.array([-0.04, 0.0])})
     assert inner.valid.any(axis=-1).all() and not outer.valid.any()
-    t = float(q0[6])
-    rows = sm.sample(t)
-    d = _wrapped(rows - q0).max(-1)
-    b = int(np.nanargmin(d))
-    assert d[b] < 1e-9, d
-    iv = sm.intervals[sm.interval_branch == b]
-    assert ((iv[:, 0] <= t) & (t <= iv[:, 1])).any(), (t, iv)
+    t, b, hit = _branch_intervals(sm, q0)
+    assert len(hit), (t, sm.intervals)
     Q = sm.sample(np.linspace(-0.025, -0.010, 16))
     ok = np.isfinite(Q).all(-1)
     assert ok.any(axis=1).all()
@@ -754,11 +754,8 @@ def test_an_island_between_two_nodes_is_found(q):
     held = robot.ik(T, fixed={name: np.array([nodes[i - 1], t, nodes[i]])})
     n_rows = held.valid.sum(axis=-1)
     assert n_rows[1] > max(n_rows[0], n_rows[2]), n_rows
-    d = _wrapped(sm.sample(t) - q0).max(-1)
-    b = int(np.nanargmin(d))
-    assert d[b] < 1e-9, d
-    iv = sm.intervals[sm.interval_branch == b]
-    assert ((iv[:, 0] <= t) & (t <= iv[:, 1])).any(), (t, iv)
+    t, b, hit = _branch_intervals(sm, q0)
+    assert len(hit), (t, sm.intervals)
     # the island's extent: where the independent solves have more rows than the nodes
     ts = np.linspace(nodes[i - 1], nodes[i], 201)
     more = robot.ik(T, fixed={name: ts}).valid.sum(axis=-1) > max(n_rows[0], n_rows[2])
@@ -830,13 +827,8 @@ def test_a_joint_riding_its_limit_keeps_the_whole_in_slack_stretch():
     q0 = np.array([-1.5707963267948966, 1e-09, -1e-09, 2.0943951023931953, -1e-07,
                    -1e-06, -0.8384789305589901])
     T, sm = _manifold(robot, q0)
-    t = float(q0[6])
-    d = _wrapped(sm.sample(t) - q0).max(-1)
-    b = int(np.nanargmin(d))
-    assert d[b] < 1e-9, d
-    iv = sm.intervals[sm.interval_branch == b]
-    hit = iv[(iv[:, 0] <= t) & (t <= iv[:, 1])]
-    assert len(hit) == 1, (t, iv)
+    t, b, hit = _branch_intervals(sm, q0)
+    assert len(hit) == 1, (t, hit)
     a, e = hit[0]
     assert a <= t - 0.02 and e >= t + 0.02, (a, e)
     ts = np.linspace(a, e, 41)
