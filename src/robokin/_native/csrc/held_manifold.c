@@ -548,6 +548,48 @@ static int hm_stays(const HmCtx *c, const PkFront *f, double *th, double *q, int
     return !pk_walk(P, g, &f->RT, f->pT, tw) && !pk_pin(P, g, &f->RT, f->pT, tp);
 }
 
+/* Whether row th (chain angles of the start-triple family, PK_START: the Panda's
+ * shoulder) is certainly left alone by pk_resplit and pk_slide, the repairs
+ * hm_closed must otherwise mirror for a row outside the limits not flagged
+ * singular: the triple's outer axes are apart (sv >= 2e-6: pk_resplit acts only
+ * below 1e-6; the same v as its own) and pk_isolated's determinant bound holds
+ * with a factor 2 to spare (then pk_isolated, and so pk_slide, holds on the same
+ * row whatever the rounding of either product). The bound's two factors as
+ * pk_isolated takes them, the triple's from v (one sincos, shared with the sv
+ * test), the position joints' from the position root's cosines and sines (no
+ * sincos; cs = {cos, sin} of th[3], th[4], as pk_front solved them), and the
+ * bound of |J|_F^2 once per hm_closed call (*f2, NAN until then). 0: unproven
+ * (the caller runs pk_resplit and pk_isolated as before). Replaces ~1,100
+ * instructions per such row (2 of every 3 rows the kernel evaluates) with ~300. */
+static int hm_far_isolated(const PkGeo *g, const double *th, const double cs[2][2],
+                           double *f2)
+{
+    if (g->kase != PK_START)
+        return 0;
+    v3 v = v3_rot(g->h[1], cos(th[1]), sin(th[1]), g->h[2]);
+    if (!(v3_norm(v3_cross(v, g->h[0])) >= 2e-6))
+        return 0;
+    double s = g->scale;
+    if (isnan(*f2)) { /* pk_isolated's |J|_F^2 bound: the reach from each joint */
+        double reach = v3_norm(v3_sub(g->tM, g->o[5])), b = 6.0;
+        for (int j = 5; j >= 0; j--) {
+            b += reach * reach / (s * s);
+            if (j > 0)
+                reach += v3_norm(v3_sub(g->o[j], g->o[j - 1]));
+        }
+        *f2 = b;
+    }
+    double dt = v3_dot(g->h[0], v3_cross(g->h[1], v));
+    v3 ha = g->h[4], oa = g->o[4];
+    v3 hb = v3_rot(ha, cs[1][0], cs[1][1], g->h[5]);
+    v3 ob = v3_add(oa, v3_rot(ha, cs[1][0], cs[1][1], v3_sub(g->o[5], oa)));
+    v3 w = v3_add(g->o[3], v3_rot(g->h[3], cs[0][0], -cs[0][1], v3_sub(g->pt, g->o[3])));
+    v3 c0 = v3_cross(g->h[3], v3_sub(w, g->o[3]));
+    v3 c1 = v3_cross(ha, v3_sub(w, oa)), c2 = v3_cross(hb, v3_sub(w, ob));
+    double det = fabs(dt * v3_dot(c0, v3_cross(c1, c2))) / (s * s * s), b = *f2;
+    return det > 8.0 * PK_FAMILY_SIGMA * b * b * b;
+}
+
 static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
 {
     const double *P = c->P;
@@ -571,6 +613,7 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
     double stol = P[PK_SING_TOL];
     int held_in = pk_held_inside(P, held, x);
     int ia = f.ia, it = f.it;
+    double f2 = NAN; /* hm_far_isolated's bound of |J|_F^2, once per call */
     for (int i = 0; i < pos->n; i++) {
         unsigned slots = 3u << (2 * pos->slot[i]);
         if (!(need & slots) || !(pos->res[i] < 1e-6 * g->scale))
@@ -605,12 +648,18 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
                  * row: the Gen3-like arm's wrist at q6 ~ 0 moved q5 by an ulp or a
                  * turn), one on a family (pk_slide's own test) */
                 int moves = sing || !(hm_outside(P, g, th) > 2.0 * PK_NUDGE);
-                if (!moves) {
+                /* far outside, not singular: most rows; proven alone (the position
+                 * joints as solved, not polished) or tested as pk_one would */
+                int alone = !moves && th[ia] == pos->t[i][0] && th[ia + 1] == pos->t[i][1] &&
+                            hm_far_isolated(g, th, (const double[2][2]){
+                                {pos->c[i][0], pos->s[i][0]}, {pos->c[i][1], pos->s[i][1]}},
+                                &f2);
+                if (!moves && !alone) {
                     double tc[6];
                     memcpy(tc, th, sizeof tc);
                     moves = pk_resplit(P, g, it, &f.RT, f.pT, tc);
                 }
-                if (!moves && !pk_isolated(g, th)) {
+                if (!moves && !alone && !pk_isolated(g, th)) {
                     m3 R;
                     v3 p;
                     double J[6][6];
