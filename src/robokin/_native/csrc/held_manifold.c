@@ -549,26 +549,28 @@ static int hm_stays(const HmCtx *c, const PkFront *f, double *th, double *q, int
     return !pk_walk(P, g, &f->RT, f->pT, tw) && !pk_pin(P, g, &f->RT, f->pT, tp);
 }
 
-/* Whether row th (chain angles of the start-triple family, PK_START: the Panda's
- * shoulder) is certainly left alone by pk_resplit and pk_slide, the repairs
- * hm_closed must otherwise mirror for a row outside the limits not flagged
- * singular: the triple's outer axes are apart (sv >= 2e-6: pk_resplit acts only
- * below 1e-6; the same v as its own) and pk_isolated's determinant bound holds
- * with a factor 2 to spare (then pk_isolated, and so pk_slide, holds on the same
- * row whatever the rounding of either product). The bound's two factors as
- * pk_isolated takes them, the triple's from v (one sincos, shared with the sv
- * test), the position joints' from the position root's cosines and sines (no
- * sincos; cs = {cos, sin} of th[3], th[4], as pk_front solved them), and the
- * bound of |J|_F^2 once per hm_closed call (*f2, NAN until then). 0: unproven
- * (the caller runs pk_resplit and pk_isolated as before). Replaces ~1,100
- * instructions per such row (2 of every 3 rows the kernel evaluates) with ~300. */
+/* Whether row th (chain angles of the remaining chain, either triple first) is
+ * certainly left alone by pk_resplit and pk_slide, the repairs hm_closed must
+ * otherwise mirror for a row outside the limits not flagged singular: the
+ * triple's outer axes are apart (sv >= 2e-6: pk_resplit acts only below 1e-6; the
+ * same v as its own) and pk_isolated's determinant bound holds with a factor 2 to
+ * spare (then pk_isolated, and so pk_slide, holds on the same row whatever the
+ * rounding of either product). The bound's two factors as pk_isolated takes them:
+ * the triple's from v (one sincos, shared with the sv test), the position joints'
+ * from the position root's own cosines and sines (no sincos; cs[0] = {cos, sin}
+ * of the joint pk_isolated undoes, th[3] of the Panda's PK_START, th[2] of a
+ * PK_END chain; cs[1] of th[p0 + 1], its middle position joint), and the bound of
+ * |J|_F^2 once per hm_closed call (*f2, NAN until then). 0: unproven (the caller
+ * runs pk_resplit and pk_isolated as before). Replaces ~1,100 instructions per
+ * such row (2 of every 3 rows the Panda's kernel evaluates) with ~300. */
 static int hm_far_isolated(const PkGeo *g, const double *th, const double cs[2][2],
                            double *f2)
 {
-    if (g->kase != PK_START)
+    if (g->kase != PK_START && g->kase != PK_END)
         return 0;
-    v3 v = v3_rot(g->h[1], cos(th[1]), sin(th[1]), g->h[2]);
-    if (!(v3_norm(v3_cross(v, g->h[0])) >= 2e-6))
+    int t0 = g->kase == PK_END ? 3 : 0, p0 = 3 - t0;
+    v3 v = v3_rot(g->h[t0 + 1], cos(th[t0 + 1]), sin(th[t0 + 1]), g->h[t0 + 2]);
+    if (!(v3_norm(v3_cross(v, g->h[t0])) >= 2e-6))
         return 0;
     double s = g->scale;
     if (isnan(*f2)) { /* pk_isolated's |J|_F^2 bound: the reach from each joint */
@@ -580,12 +582,18 @@ static int hm_far_isolated(const PkGeo *g, const double *th, const double cs[2][
         }
         *f2 = b;
     }
-    double dt = v3_dot(g->h[0], v3_cross(g->h[1], v));
-    v3 ha = g->h[4], oa = g->o[4];
-    v3 hb = v3_rot(ha, cs[1][0], cs[1][1], g->h[5]);
-    v3 ob = v3_add(oa, v3_rot(ha, cs[1][0], cs[1][1], v3_sub(g->o[5], oa)));
-    v3 w = v3_add(g->o[3], v3_rot(g->h[3], cs[0][0], -cs[0][1], v3_sub(g->pt, g->o[3])));
-    v3 c0 = v3_cross(g->h[3], v3_sub(w, g->o[3]));
+    double dt = v3_dot(g->h[t0], v3_cross(g->h[t0 + 1], v));
+    v3 ha = g->h[p0 + 1], oa = g->o[p0 + 1], w = g->pt;
+    double ca = cs[1][0], sa = cs[1][1];
+    v3 hb = v3_rot(ha, ca, sa, g->h[p0 + 2]);
+    v3 ob = v3_add(oa, v3_rot(ha, ca, sa, v3_sub(g->o[p0 + 2], oa)));
+    if (p0 == 0) { /* w after joints 1 and 2 (joint 0 undone) */
+        w = v3_add(g->o[2], v3_rot(g->h[2], cs[0][0], cs[0][1], v3_sub(w, g->o[2])));
+        w = v3_add(oa, v3_rot(ha, ca, sa, v3_sub(w, oa)));
+    } else { /* w before joint 3 (the triple and joint 3 undone) */
+        w = v3_add(g->o[3], v3_rot(g->h[3], cs[0][0], -cs[0][1], v3_sub(w, g->o[3])));
+    }
+    v3 c0 = v3_cross(g->h[p0], v3_sub(w, g->o[p0]));
     v3 c1 = v3_cross(ha, v3_sub(w, oa)), c2 = v3_cross(hb, v3_sub(w, ob));
     double det = fabs(dt * v3_dot(c0, v3_cross(c1, c2))) / (s * s * s), b = *f2;
     return det > 8.0 * PK_FAMILY_SIGMA * b * b * b;
@@ -651,9 +659,11 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
                 int moves = sing || !(hm_outside(P, g, th) > 2.0 * PK_NUDGE);
                 /* far outside, not singular: most rows; proven alone (the position
                  * joints as solved, not polished) or tested as pk_one would */
-                int alone = !moves && th[ia] == pos->t[i][0] && th[ia + 1] == pos->t[i][1] &&
+                int u = f.start ? 0 : 2; /* the position joint pk_isolated undoes */
+                int alone = !moves && th[ia + u] == pos->t[i][u] &&
+                            th[ia + 1] == pos->t[i][1] &&
                             hm_far_isolated(g, th, (const double[2][2]){
-                                {pos->c[i][0], pos->s[i][0]}, {pos->c[i][1], pos->s[i][1]}},
+                                {pos->c[i][u], pos->s[i][u]}, {pos->c[i][1], pos->s[i][1]}},
                                 &f2);
                 if (!moves && !alone) {
                     double tc[6];
