@@ -430,10 +430,12 @@ static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
  * position roots of the slots asked for solved), into r (the other slots
  * invalid). A row outside the limits that pk_one's repairs may move (singular;
  * within PK_NUDGE of them: pk_inside; not isolated: pk_slide) gets those repairs
- * here (hm_stays). Returns 1 when these are pk_one's rows for those slots, 0 when
- * pk_one must decide: the position is not of the coplanar kind, or what pk_one
- * makes of a row depends on its other slots (a repair it tries only when no row
- * is inside would move it). (Round 8a: 0 of ~494 evaluations per pose on the
+ * here (hm_repairs); the repairs pk_one tries only when no row is inside
+ * (hm_stays) run only when no row made here is inside (session 11: a fold end's
+ * pair often has one). Returns 1 when these are pk_one's rows for those slots, 0
+ * when pk_one must decide: the position is not of the coplanar kind, or what
+ * pk_one makes of a row depends on its other slots (a repair it tries only when no
+ * row is inside would move it). (Round 8a: 0 of ~494 evaluations per pose on the
  * development poses return 0, against ~21 before.) */
 /* How far chain angles th (remaining chain) lie outside the limits, each joint at
  * its turn nearest them (as pk_inside measures it) [rad]: the largest. */
@@ -513,15 +515,11 @@ static int hm_regular(const double J[6][6])
     return 4.0 * PK_FAMILY_SIGMA * PK_FAMILY_SIGMA * inv * fro < 1.0;
 }
 
-/* Whether pk_one leaves row th (coordinates q, outside the limits, the held joint
- * inside; sing: flagged singular) as its own repairs of that row leave it: they
- * run here in pk_one's order (pk_resplit; pk_repair when singular; pk_inside;
- * pk_slide when singular), th and q taking their moves; a row they bring inside
- * is pk_one's. One left outside is pk_one's when the repairs pk_one tries only if
- * no row is inside find nothing from it: pk_walk_rows' pk_walk, else pk_pin
- * (from the coordinates) for a singular row, the late pk_slide for another.
- * 0: the other slots decide (pk_one must). */
-static int hm_stays(const HmCtx *c, const PkFront *f, double *th, double *q, int sing)
+/* pk_one's own repairs of row th (coordinates q, outside the limits, the held
+ * joint inside; sing: flagged singular), in its order (pk_resplit; pk_repair when
+ * singular; pk_inside; pk_slide when singular), th and q taking their moves.
+ * Returns 1 when they bring it inside (then it is pk_one's row). */
+static int hm_repairs(const HmCtx *c, const PkFront *f, double *th, double *q, int sing)
 {
     const double *P = c->P;
     const PkGeo *g = &f->g;
@@ -536,8 +534,20 @@ static int hm_stays(const HmCtx *c, const PkFront *f, double *th, double *q, int
         all = pk_coords(P, g, th, held, x, q) >= -1e-9;
     if (!all && sing && pk_slide(P, g, &f->RT, f->pT, th))
         all = pk_coords(P, g, th, held, x, q) >= -1e-9;
-    if (all)
-        return 1; /* inside: no late repair (pk_walk_rows returns at once) */
+    return all;
+}
+
+/* Whether a row hm_repairs left outside (th, coordinates q) is pk_one's: the
+ * repairs pk_one tries only when no row of the pose is inside find nothing from
+ * it (pk_walk_rows' pk_walk, else pk_pin, from the coordinates, for a singular
+ * row; the late pk_slide for another). hm_closed asks only when none of the rows
+ * it made at that value is inside (one is: pk_one tries none of them). 0: the
+ * other slots decide (pk_one must). */
+static int hm_stays(const HmCtx *c, const PkFront *f, const double *th, const double *q,
+                    int sing)
+{
+    const double *P = c->P;
+    const PkGeo *g = &f->g;
     double tw[6], tp[6];
     for (int j = 0; j < 6; j++) {
         int fj = g->full[j];
@@ -623,6 +633,9 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
     int held_in = pk_held_inside(P, held, x);
     int ia = f.ia, it = f.it;
     double f2 = NAN; /* hm_far_isolated's bound of |J|_F^2, once per call */
+    double late_th[8][6]; /* rows hm_repairs left outside: hm_stays after the loop */
+    unsigned late = 0u;
+    int inside = 0; /* a row made here is inside: pk_one tries no late repair */
     for (int i = 0; i < pos->n; i++) {
         unsigned slots = 3u << (2 * pos->slot[i]);
         if (!(need & slots) || !(pos->res[i] < 1e-6 * g->scale))
@@ -650,6 +663,7 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
                     continue; /* not a solution to 1e-12: no row */
             }
             double m = pk_coords(P, g, th, held, x, r->q[slot]);
+            inside |= m >= -1e-9;
             if (!(m >= -1e-9) && held_in) {
                 /* pk_one's repairs may move it: a singular row, one within reach of
                  * pk_inside, one pk_resplit moves (next to an aligned triple: its
@@ -681,13 +695,20 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
                         moves = sig[0] <= PK_FAMILY_SIGMA * sig[5];
                     }
                 }
-                if (moves && !hm_stays(c, &f, th, r->q[slot], sing))
-                    return 0; /* what pk_one makes of it depends on the other slots */
+                if (moves && hm_repairs(c, &f, th, r->q[slot], sing)) {
+                    inside = 1;
+                } else if (moves) {
+                    memcpy(late_th[slot], th, sizeof late_th[slot]);
+                    late |= 1u << slot;
+                }
             }
             r->valid[slot] = 1;
             r->sing[slot] = (unsigned char)sing;
         }
     }
+    for (int slot = 0; slot < 8 && !inside; slot++)
+        if ((late >> slot & 1u) && !hm_stays(c, &f, late_th[slot], r->q[slot], r->sing[slot]))
+            return 0; /* what pk_one makes of it depends on the other slots */
     return 1;
 }
 #if defined(__GNUC__) && !defined(__clang__)
