@@ -19,7 +19,7 @@ import numpy as np
 
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, Derived
-from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
+from robokin.kinematics.ik.fixed import Dispatch, solve_held_one
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.ik.swivel import SwivelArm, swivel_arm
 
@@ -101,8 +101,7 @@ class _JointFamily(_Family):
     joint: int
 
     def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
-        sols = solve_fixed(self.robot, self.T, {self.robot.joint_names[j]: value},
-                           dispatch=self.dispatch)
+        sols = solve_held_one(self.robot, self.T, j, value, dispatch=self.dispatch)
         if "swivel" in str(sols.info.get("measured", "")) and j == 3:
             return []  # the SRS elbow held: a family, constant on the manifold
         out: list[tuple[float, np.ndarray | None]] = []
@@ -141,12 +140,26 @@ class _HeldFamily(_JointFamily):
         #: and a refined row there moves by up to ~6e-12 (the Panda), past the slack
         self.polish = True
 
-    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _solved(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The closed form's Q (m, 8, n), valid, singular (m, 8) at t (m,) contiguous float64.
+
+        The pose repeated from ``poses`` (kept, grown as needed), not broadcast and
+        copied per call.
+        """
         from robokin.kinematics.ik.analytic import pieper as pk
 
+        Q, valid, sing, _, _ = pk.raw_solve(self.params, self._repeated(len(t)), t)
+        return Q, valid, sing
+
+    def _repeated(self, m: int) -> np.ndarray:
+        """T repeated (m, 4, 4), C-contiguous (a slice of ``poses``, grown as needed)."""
+        if len(self.poses) < m:
+            self.poses = np.ascontiguousarray(np.broadcast_to(self.T, (max(2 * m, 64), 4, 4)))
+        return self.poses[:m]
+
+    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
-        Tb = np.ascontiguousarray(np.broadcast_to(self.T, (len(t), 4, 4)))
-        Q, valid, sing, _, _ = pk.raw_solve(self.params, Tb, t)
+        Q, valid, sing = self._solved(t)
         Q = Q.copy()
         Q[~valid] = np.nan
         Q = _into_limits(self.robot, Q)
@@ -163,13 +176,17 @@ class _HeldFamily(_JointFamily):
         refinement's cost on the rtb-data iiwa14 (issue 29, helper polish29). The
         rows read are ``rows(t)``'s bit for bit: every step is per row, but for an
         exactly singular held Jacobian, which refines none of its call's rows (not met).
+        Each distinct value of t (by its bits) is solved once: the slots of a fold
+        (2 or 4: a quartic root pair, each with its two wrists) are bisected on the
+        same values, ~4 rows per value on the rtb-data iiwa14 (issue 29, helper iiwapy30).
         """
-        from robokin.kinematics.ik.analytic import pieper as pk
-
         t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
-        Tb = np.ascontiguousarray(np.broadcast_to(self.T, (len(t), 4, 4)))
-        Q, valid, sing, _, _ = pk.raw_solve(self.params, Tb, t)
-        i = np.arange(len(t))
+        u, i = np.unique(t.view(np.int64), return_inverse=True)
+        if len(u) == len(t):
+            Q, valid, sing = self._solved(t)
+            i = np.arange(len(t))
+        else:
+            Q, valid, sing = self._solved(u.view(np.float64))
         q, v = Q[i, b], valid[i, b]
         q[~v] = np.nan
         q = _into_limits(self.robot, q)
@@ -253,10 +270,8 @@ def _held_polish(fam: _HeldFamily, Q: np.ndarray, valid: np.ndarray, sing: np.nd
 
     q = Q[idx]
     J, P = jacobian_and_pose(fam.robot.chain, q)
-    if len(fam.poses) < len(q):  # the pose repeated, contiguous (grown as needed)
-        fam.poses = np.ascontiguousarray(np.broadcast_to(fam.T, (2 * len(q), 4, 4)))
     e = np.empty((len(q), 6))
-    kernels.pose_error(P, fam.poses[:len(q)], e)
+    kernels.pose_error(P, fam._repeated(len(q)), e)
     try:
         step = _solve_stacked(J[:, :, fam.free], e[..., None])[..., 0]
     except np.linalg.LinAlgError:  # an exactly singular one: none is refined

@@ -155,20 +155,24 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
     qa, qe = q[sc, sk], q[sc + 1, sk]
     for _ in range(_BISECT):
         mid = 0.5 * (lo + hi)
+        # a cell of two adjacent floats is done: its midpoint is one of its ends, whose
+        # state is known (lo's is state0, hi's not), so solving it would change nothing
+        go = np.flatnonzero((mid != lo) & (mid != hi))
         act = np.flatnonzero(s_hi - s_lo > _SWAP_T)
-        if np.all((mid == lo) | (mid == hi)) and not len(act):
+        if not len(go) and not len(act):
             break  # every cell two adjacent floats: the rest would change nothing
         s_mid = 0.5 * (s_lo[act] + s_hi[act])
-        qm, vm = fam.slot_rows(np.concatenate([mid, s_mid]), np.concatenate([br, sk[act]]),
-                               np.concatenate([kind, np.ones(len(act), dtype=bool)]))
-        now = np.where(kind, vm[:len(mid)] & _within(qm[:len(mid)], limits), vm[:len(mid)])
-        same = now == state0
-        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+        m, mid = len(go), mid[go]
+        qm, vm = fam.slot_rows(np.concatenate([mid, s_mid]), np.concatenate([br[go], sk[act]]),
+                               np.concatenate([kind[go], np.ones(len(act), dtype=bool)]))
+        now = np.where(kind[go], vm[:m] & _within(qm[:m], limits), vm[:m])
+        same = now == state0[go]
+        lo[go], hi[go] = np.where(same, mid, lo[go]), np.where(same, hi[go], mid)
         if len(act):
-            r = qm[len(mid):]
+            r = qm[m:]
             with np.errstate(invalid="ignore"):
                 left = _turn_gap(r - qa[act]) <= _turn_gap(r - qe[act])
-            left &= vm[len(mid):]
+            left &= vm[m:]
             s_lo[act[left]], qa[act[left]] = s_mid[left], r[left]
             s_hi[act[~left]], qe[act[~left]] = s_mid[~left], r[~left]
     swaps = [(float(x), int(b)) for x, m in zip(s_lo.tolist(), moved, strict=True)
@@ -305,20 +309,21 @@ def _fold_crossings(fam: _Family, tf: np.ndarray, tg: np.ndarray, br: np.ndarray
     b_i = br[f_i]
     lo, hi = ts[f_i, k_i], ts[f_i, k_i + 1]
     state0, state1 = side[f_i, k_i, j_i], side[f_i, k_i + 1, j_i]
-    n_rows = np.arange(len(cells))
     for _ in range(_BISECT):
         mid = 0.5 * (lo + hi)
-        if np.all((mid == lo) | (mid == hi)):
+        go = np.flatnonzero((mid != lo) & (mid != hi))  # not yet two adjacent floats
+        if not len(go):
             break  # every cell two adjacent floats
-        qm, vm = fam.slot_rows(mid, b_i)
-        qj = qm[n_rows, j_i]
+        mid, jg = mid[go], j_i[go]
+        qm, vm = fam.slot_rows(mid, b_i[go])
+        qj = qm[np.arange(len(go)), jg]
         with np.errstate(invalid="ignore"):
-            now = ((qj > limits[j_i, 1] + MANIFOLD_SLACK).astype(np.int8)
-                   - (qj < limits[j_i, 0] - MANIFOLD_SLACK).astype(np.int8))
+            now = ((qj > limits[jg, 1] + MANIFOLD_SLACK).astype(np.int8)
+                   - (qj < limits[jg, 0] - MANIFOLD_SLACK).astype(np.int8))
         now = np.where(vm, now, _NO_ROW)  # rows missing: a second fold
-        same = now == state0
-        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
-        state1 = np.where(same, state1, now)
+        same = now == state0[go]
+        lo[go], hi[go] = np.where(same, mid, lo[go]), np.where(same, hi[go], mid)
+        state1[go] = np.where(same, state1[go], now)
     inner = np.where(state0 == 0, lo, hi)  # the in-limit end
     out_side = np.where(state0 == 0, state1, state0)
     return [(float(t), int(b), int(j), "fold" if o == _NO_ROW else "upper" if o > 0 else "lower")
