@@ -444,6 +444,7 @@ def solve_held_one(robot: Arm, T: np.ndarray, j: int, value: float, *,
         T: One pose (4, 4) [m], float64, rigid (:func:`check_rigid`'s output).
         j: The held joint's index.
         value: Its value [rad], finite.
+        dispatch: ``dispatch.solve`` (:func:`solve_fixed`'s, where it is taken).
 
     Returns:
         A set of shape (k, n) whose ``q``, ``valid``, ``singular`` and
