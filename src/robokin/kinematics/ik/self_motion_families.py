@@ -135,6 +135,8 @@ class _HeldFamily(_JointFamily):
         self.free = np.delete(np.arange(robot.n), j)
         #: T repeated (r, 4, 4) for the refining steps' pose errors (grown as needed)
         self.poses = np.zeros((0, 4, 4))
+        #: the kernel's preferred coordinates at singularities (``raw_solve``'s default)
+        self.qn = np.zeros((1, robot.n))
         #: rows near a limit refined (``_held_polish``); off once the compiled kernel
         #: certified the manifold: its crossings and ends are on the unrefined rows,
         #: and a refined row there moves by up to ~6e-12 (the Panda), past the slack
@@ -148,7 +150,7 @@ class _HeldFamily(_JointFamily):
         """
         from robokin.kinematics.ik.analytic import pieper as pk
 
-        Q, valid, sing, _, _ = pk.raw_solve(self.params, self._repeated(len(t)), t)
+        Q, valid, sing, _, _ = pk.raw_solve(self.params, self._repeated(len(t)), t, self.qn)
         return Q, valid, sing
 
     def _repeated(self, m: int) -> np.ndarray:
@@ -178,23 +180,26 @@ class _HeldFamily(_JointFamily):
         exactly singular held Jacobian, which refines none of its call's rows (not met).
         Each distinct value of t (by its bits) is solved once: the slots of a fold
         (2 or 4: a quartic root pair, each with its two wrists) are bisected on the
-        same values, ~4 rows per value on the rtb-data iiwa14 (issue 29, helper iiwapy30).
+        same values, ~4 rows per value on the rtb-data iiwa14 (issue 29, helper
+        iiwapy30). Where no row is read (a step of fold bisections only) the rows
+        come back as the kernel gives them (not shifted into the limits either).
         """
         t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
-        u, i = np.unique(t.view(np.int64), return_inverse=True)
-        if len(u) == len(t):
-            Q, valid, sing = self._solved(t)
-            i = np.arange(len(t))
-        else:
-            Q, valid, sing = self._solved(u.view(np.float64))
+        keys = t.view(np.int64).tolist()
+        first: dict[int, int] = {}
+        i = np.array([first.setdefault(x, len(first)) for x in keys], dtype=np.intp)
+        u = t if len(first) == len(keys) else np.array(list(first), dtype=np.int64).view(np.float64)
+        Q, valid, sing = self._solved(u)
         q, v = Q[i, b], valid[i, b]
+        if read is not None and not read.any():
+            return q, v
         q[~v] = np.nan
         q = _into_limits(self.robot, q)
         if not self.polish:
             return q, v
         if read is None:
             _held_polish(self, q[:, None], v[:, None], sing[i, b][:, None])
-        elif read.any():
+        else:
             r = np.flatnonzero(read)
             qr = q[r]
             _held_polish(self, qr[:, None], v[r, None], sing[i[r], b[r], None])

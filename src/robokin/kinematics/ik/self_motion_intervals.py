@@ -153,19 +153,29 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
     # row at the bracket's left end than at its right end lies left of the jump
     s_lo, s_hi = t[sc].astype(np.float64), t[sc + 1].astype(np.float64)
     qa, qe = q[sc, sk], q[sc + 1, sk]
+    # (the numpy calls per step are most of a step's cost next to its few rows: the
+    # swaps' and the in-limit changes' are skipped where there are none)
+    act = np.arange(len(sc))
+    has_changes = bool(changes)
     for _ in range(_BISECT):
         mid = 0.5 * (lo + hi)
         # a cell of two adjacent floats is done: its midpoint is one of its ends, whose
         # state is known (lo's is state0, hi's not), so solving it would change nothing
         go = np.flatnonzero((mid != lo) & (mid != hi))
-        act = np.flatnonzero(s_hi - s_lo > _SWAP_T)
+        if len(act):  # (a bracket once within _SWAP_T stays so)
+            act = act[s_hi[act] - s_lo[act] > _SWAP_T]
         if not len(go) and not len(act):
             break  # every cell two adjacent floats: the rest would change nothing
-        s_mid = 0.5 * (s_lo[act] + s_hi[act])
-        m, mid = len(go), mid[go]
-        qm, vm = fam.slot_rows(np.concatenate([mid, s_mid]), np.concatenate([br[go], sk[act]]),
-                               np.concatenate([kind[go], np.ones(len(act), dtype=bool)]))
-        now = np.where(kind[go], vm[:m] & _within(qm[:m], limits), vm[:m])
+        m, mid, kg = len(go), mid[go], kind[go]
+        if len(act):
+            s_mid = 0.5 * (s_lo[act] + s_hi[act])
+            qm, vm = fam.slot_rows(np.concatenate([mid, s_mid]), np.concatenate([br[go], sk[act]]),
+                                   np.concatenate([kg, np.ones(len(act), dtype=bool)]))
+            now = vm[:m]
+        else:
+            qm, now = fam.slot_rows(mid, br[go], kg)
+        if has_changes:
+            now = np.where(kg, now & _within(qm[:m], limits), now)
         same = now == state0[go]
         lo[go], hi[go] = np.where(same, mid, lo[go]), np.where(same, hi[go], mid)
         if len(act):
