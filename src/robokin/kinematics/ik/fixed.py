@@ -463,7 +463,7 @@ def solve_held_one(robot: Arm, T: np.ndarray, j: int, value: float, *,
     mid = table[key]
     if mid is None or T.shape != (4, 4) or T.dtype != np.float64:
         return solve_fixed(robot, T, {name: value}, dispatch=dispatch)
-    return mid.solve(robot, check_rigid(T, "T"))
+    return mid.solve(robot, T)  # (rigid: solve_fixed's check_rigid would return T itself)
 
 
 #: Middle-joint set-ups kept per arm (:class:`MidHeld`; the self-motion asks for

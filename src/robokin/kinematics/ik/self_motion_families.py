@@ -137,6 +137,9 @@ class _HeldFamily(_JointFamily):
         self.poses = np.zeros((0, 4, 4))
         #: the kernel's preferred coordinates at singularities (``raw_solve``'s default)
         self.qn = np.zeros((1, robot.n))
+        #: the kernel's rows (Q (8, n), valid, singular (8,)) of kept values, by t's bits
+        self.kept: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        self.kept_shape: tuple[int, ...] = (8, robot.n)
         #: rows near a limit refined (``_held_polish``); off once the compiled kernel
         #: certified the manifold: its crossings and ends are on the unrefined rows,
         #: and a refined row there moves by up to ~6e-12 (the Panda), past the slack
@@ -153,6 +156,40 @@ class _HeldFamily(_JointFamily):
         Q, valid, sing, _, _ = pk.raw_solve(self.params, self._repeated(len(t)), t, self.qn)
         return Q, valid, sing
 
+    def _distinct(self, t: np.ndarray, keep: bool = False
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``_solved`` at each distinct value of t (by its bits), once: (Q, valid, sing, i).
+
+        Q (u, 8, n), valid and sing (u, 8) per distinct value; i (m,) the distinct
+        value of each t. Values in ``kept`` (the kernel's rows of earlier calls with
+        ``keep``) are not solved again, and with ``keep`` this call's are kept (up to
+        ``_KEPT`` values): the exact points' values, which ``_points_refined`` solves
+        again (issue 29, helper iiwapy30). The kernel's rows are a function of (T, t)
+        alone, so a kept row is the row a new solve gives.
+        """
+        keys = t.view(np.int64).tolist()
+        first: dict[int, int] = {}
+        i = np.array([first.setdefault(x, len(first)) for x in keys], dtype=np.intp)
+        u = t if len(first) == len(keys) else np.array(list(first), dtype=np.int64).view(np.float64)
+        kept = self.kept
+        old = [k for k, x in enumerate(first) if x in kept] if kept else []
+        if old:
+            Q = np.empty((len(u),) + self.kept_shape)
+            valid = np.empty((len(u), self.kept_shape[0]), dtype=bool)
+            sing = np.empty((len(u), self.kept_shape[0]), dtype=bool)
+            new = np.setdiff1d(np.arange(len(u)), old)
+            if len(new):
+                Q[new], valid[new], sing[new] = self._solved(np.ascontiguousarray(u[new]))
+            for k, x in zip(old, [x for x in first if x in kept], strict=True):
+                Q[k], valid[k], sing[k] = kept[x]
+        else:
+            Q, valid, sing = self._solved(u)
+        if keep and len(kept) + len(u) <= _KEPT:
+            self.kept_shape = Q.shape[1:]
+            for k, x in enumerate(first):
+                kept[x] = (Q[k], valid[k], sing[k])
+        return Q, valid, sing, i
+
     def _repeated(self, m: int) -> np.ndarray:
         """T repeated (m, 4, 4), C-contiguous (a slice of ``poses``, grown as needed)."""
         if len(self.poses) < m:
@@ -161,8 +198,12 @@ class _HeldFamily(_JointFamily):
 
     def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
-        Q, valid, sing = self._solved(t)
-        Q = Q.copy()
+        if len(t) > _KEPT:  # the grid: its values are distinct, and not kept
+            Q, valid, sing = self._solved(t)
+            Q = Q.copy()
+        else:
+            Q, valid, sing, i = self._distinct(t, keep=True)
+            Q, valid, sing = Q[i], valid[i], sing[i]
         Q[~valid] = np.nan
         Q = _into_limits(self.robot, Q)
         if self.polish:
@@ -185,11 +226,7 @@ class _HeldFamily(_JointFamily):
         come back as the kernel gives them (not shifted into the limits either).
         """
         t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
-        keys = t.view(np.int64).tolist()
-        first: dict[int, int] = {}
-        i = np.array([first.setdefault(x, len(first)) for x in keys], dtype=np.intp)
-        u = t if len(first) == len(keys) else np.array(list(first), dtype=np.int64).view(np.float64)
-        Q, valid, sing = self._solved(u)
+        Q, valid, sing, i = self._distinct(t)
         q, v = Q[i, b], valid[i, b]
         if read is not None and not read.any():
             return q, v
@@ -197,7 +234,7 @@ class _HeldFamily(_JointFamily):
         q = _into_limits(self.robot, q)
         if not self.polish:
             return q, v
-        if read is None:
+        if read is None or read.all():
             _held_polish(self, q[:, None], v[:, None], sing[i, b][:, None])
         else:
             r = np.flatnonzero(read)
@@ -205,6 +242,11 @@ class _HeldFamily(_JointFamily):
             _held_polish(self, qr[:, None], v[r, None], sing[i[r], b[r], None])
             q[r] = qr
         return q, v
+
+
+#: Values whose kernel rows a held family keeps (``_HeldFamily._distinct``): a call
+#: with more (the checking grid) is neither kept nor looked up.
+_KEPT = 256
 
 
 #: Rows within this of a limit [rad] are refined (``_held_polish``): a membership
