@@ -6,8 +6,9 @@ Gen3-like arm, ~36 % of its special poses) take the solved-points path
 (``_compiled``) and must not get slower. Each tree runs in a fresh process
 (``PYTHONPATH=<tree>/src``) on the same configurations
 (``self_motion_rates.configurations(robot, 2 --n, --seed)``: ``--n`` uniform in the
-limits, then ``--n`` from ``special_batch``), after two untimed calls per arm (the
-per-arm set-ups of both paths: reduced chains, families); per pose the CPU
+limits, then ``--n`` from ``special_batch``), after untimed calls per arm up to the
+first pose the kernel flags (the per-arm set-ups of both paths: reduced chains,
+families); per pose the CPU
 (``time.process_time``) of ``robot.self_motion(T)`` alone, the trees alternated
 ``--rounds`` times. Round 0 saves every public field of each ``SelfMotion``
 (intervals, branches, crossings, singular points, ``method``, ``info``) and
@@ -44,8 +45,9 @@ for arm in {arms!r}:
     robot = build(arm)
     q, _ = configurations(robot, 2 * {n}, {seed})
     T = robot.fk(q)
-    for Tw in (robot.fk(q[0] * 0.5), T[-1]):  # the per-arm set-ups (both paths), untimed
-        robot.self_motion(Tw)
+    for Tw in (robot.fk(q[0] * 0.5), *T):  # the per-arm set-ups of both paths, untimed:
+        if robot.self_motion(Tw).info.get("compiled") is not True:  # to the first
+            break  # pose the kernel flags (its path's reduced chains, ~0.2 s on the Panda)
     res, ts, solved = [], [], []
     for qi, Ti in zip(q, T):
         c0 = time.process_time()
