@@ -317,8 +317,10 @@ def _held_polish(fam: _HeldFamily, Q: np.ndarray, valid: np.ndarray, sing: np.nd
 
     q = Q[idx]
     J, P = jacobian_and_pose(fam.robot.chain, q)
+    if len(fam.poses) < len(q):  # the pose repeated, contiguous (grown as needed)
+        fam.poses = np.ascontiguousarray(np.broadcast_to(fam.T, (2 * len(q), 4, 4)))
     e = np.empty((len(q), 6))
-    kernels.pose_error(P, fam._repeated(len(q)), e)
+    kernels.pose_error(P, fam.poses[:len(q)], e)
     try:
         step = _solve_stacked(J[:, :, fam.free], e[..., None])[..., 0]
     except np.linalg.LinAlgError:  # an exactly singular one: none is refined
