@@ -349,3 +349,40 @@ def test_the_short_axis_all_equals_numpys():
     b[1, 2, 6] = False
     out = fixed_ik._all_last(b)
     assert out.sum() == 19 and not out[1, 2]
+
+
+def test_solve_held_one_gives_solve_fixeds_rows_bit_for_bit():
+    # Issue 29 (helper iiwapy30): the self-motion's exact points solve the pose with
+    # each joint at its limits; a middle joint without a held closed form (the offset
+    # iiwa's a5 and a6) is solved by its reduced chain's general 6R kernel directly
+    # (fixed.MidHeld). Oracle: solve_fixed's whole path, q, valid, singular and
+    # within_limits bit for bit; every valid row reproduces T (1e-10) with the joint
+    # at its value, and the generating configuration is a row at its own value.
+    from reference import offset_iiwa14
+    from robokin._validation import check_rigid
+    from robokin.kinematics.ik import dispatch
+
+    robot = offset_iiwa14()
+    arm = robot.arm
+    rng = np.random.default_rng(7)
+    lim = arm.limits
+    lean = 0
+    for q0 in rng.uniform(lim[:, 0], lim[:, 1], (4, 7)):
+        T = check_rigid(robot.fk(q0), "T")
+        for j in (4, 5, 6, 1):  # 6: an end joint; 1: a held closed form (a2)
+            name = arm.joint_names[j]
+            for v in (float(lim[j, 0]), float(lim[j, 1]), float(q0[j])):
+                got = fixed_ik.solve_held_one(arm, T, j, v, dispatch=dispatch.solve)
+                want = fixed_ik.solve_fixed(arm, T, {name: v}, dispatch=dispatch.solve)
+                np.testing.assert_array_equal(got.q.view(np.int64), want.q.view(np.int64))
+                for key in ("valid", "singular", "within_limits"):
+                    np.testing.assert_array_equal(getattr(got, key), getattr(want, key))
+                lean += arm.derived(fixed_ik.MID_HELD).get((j, v)) is not None
+                rows = got.q[got.valid]
+                assert np.all(rows[:, j] == v)
+                dp, dr = pose_errors(robot.fk(rows), T)
+                assert max(dp.max(initial=0.0), dr.max(initial=0.0)) <= 1e-10
+                if v == q0[j]:  # (at a limit the pose may have no row)
+                    gap = np.abs((rows - q0 + np.pi) % (2 * np.pi) - np.pi).max(axis=-1)
+                    assert gap.min() < 1e-8
+    assert lean == 4 * 2 * 3  # a5 and a6 took the lean path at every value

@@ -972,3 +972,59 @@ def test_the_held_rows_of_one_slot_are_the_rows_of_that_slot():
         fam.polish = True
         refined += int((np.isfinite(q) & (raw != q)).any(axis=-1).sum())
     assert refined > 0
+
+
+def test_held_rows_solved_once_per_value_are_each_values_own_rows():
+    # Issue 29 (helper iiwapy30): _HeldFamily solves each distinct value of a call
+    # once (a fold's 2-4 slots are bisected on the same values) and keeps the kernel's
+    # rows of small rows() calls (the exact points', which _points_refined solves
+    # again). Oracle: a new family per value (nothing kept, nothing shared), bit for
+    # bit, on corner29's #6379 (rows next to a limit refined), for slot_rows on
+    # repeated values in shuffled order (read masks too) and rows() again at kept
+    # values; the values kept are not solved again, the others once each.
+    from robokin.kinematics.ik.self_motion_families import _HeldFamily
+
+    robot = _arm("iiwa")
+    q0 = np.array([2.9668, -2.0942, 1e-07, 1e-09, -0.34442118632710983,
+                   0.28861094459290904, -1e-06])
+    sm, t, _ = _generating(robot, q0)
+    fam = sm._family
+
+    def fresh() -> _HeldFamily:
+        return _HeldFamily(fam.robot, fam.params, fam.joint, fam.T, fam.dispatch,
+                           (fam.name, fam.domain))
+
+    ts = t + np.array([-1e-6, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-6])
+    alone = [fresh().rows(np.array([x])) for x in ts]  # (q (1, k, n), valid, singular)
+    rng = np.random.default_rng(3)
+    fam2 = fresh()
+    solved: list[int] = []
+    solve = fam2._solved
+
+    def counted(u: np.ndarray):
+        solved.append(len(u))
+        return solve(u)
+
+    fam2._solved = counted  # type: ignore[method-assign]
+    pick = rng.permutation(np.repeat(np.arange(len(ts)), 4))
+    b = rng.integers(0, fam.k, len(pick))
+    read = rng.random(len(pick)) < 0.5
+    for mask in (None, read):
+        q, v = fam2.slot_rows(ts[pick], b, mask)
+        rows = np.array([alone[p][0][0, bb] for p, bb in zip(pick, b, strict=True)])
+        valid = np.array([alone[p][1][0, bb] for p, bb in zip(pick, b, strict=True)])
+        np.testing.assert_array_equal(v, valid)
+        shown = np.ones(len(pick), dtype=bool) if mask is None else mask
+        np.testing.assert_array_equal(q[shown & v].view(np.int64), rows[shown & v].view(np.int64))
+    assert solved == [len(ts), len(ts)]  # each distinct value once per call
+    for _ in range(2):  # the second call reads the kept rows: nothing solved
+        Q, valid, sing = fam2.rows(ts)
+        for x, (qa, va, sa) in enumerate(alone):
+            np.testing.assert_array_equal(Q[x].view(np.int64), qa[0].view(np.int64))
+            np.testing.assert_array_equal(valid[x], va[0])
+            np.testing.assert_array_equal(sing[x], sa[0])
+    assert solved == [len(ts)] * 3
+    fam2.polish = False  # the rows compared were refined ones (next to a limit)
+    raw, _, _ = fam2.rows(ts)
+    refined = int((np.isfinite(Q) & (raw != Q)).any(axis=-1).sum())
+    assert refined > 0

@@ -424,6 +424,121 @@ def _end_general_6r(robot: Arm, a: int, c: float, T: np.ndarray) -> SolutionSet 
         f"{_g6.NAME} ({name} held)", None, {"held": {name: np.full(len(T), c)}})
 
 
+def solve_held_one(robot: Arm, T: np.ndarray, j: int, value: float, *,
+                   dispatch: Dispatch) -> SolutionSet:
+    """``solve_fixed(robot, T, {joint j: value}, dispatch=dispatch)``'s rows, lean.
+
+    The self-motion's exact points solve the pose with each joint at its limits and
+    aligned values (issue 29): a middle joint without a held closed form took the
+    whole :func:`solve_fixed` path (its checks, a reduced chain looked up, the
+    dispatcher, two set assemblies: ~0.4 ms of Python around a ~0.15 ms general 6R
+    solve). Here such a joint, at a value putting no pair of axes on or next to one
+    line, is solved by the reduced chain's general 6R kernel directly
+    (:class:`MidHeld`, kept per arm and value) and assembled as that path does (the
+    rows, ``valid``, ``singular``, ``within_limits``, then :func:`_into_limits`);
+    every other case is :func:`solve_held_single`, else :func:`solve_fixed`. The
+    set's ``status``, ``method`` and ``info`` are not filled in on the lean path.
+
+    Args:
+        robot: The arm (7R).
+        T: One pose (4, 4) [m], float64, rigid (:func:`check_rigid`'s output).
+        j: The held joint's index.
+        value: Its value [rad], finite.
+        dispatch: ``dispatch.solve`` (:func:`solve_fixed`'s, where it is taken).
+
+    Returns:
+        A set of shape (k, n) whose ``q``, ``valid``, ``singular`` and
+        ``within_limits`` are :func:`solve_fixed`'s.
+    """
+    name = robot.joint_names[j]
+    out = solve_held_single(robot, T, {name: value})
+    if out is not None:
+        return out
+    table = robot.derived(MID_HELD)
+    key = (j, value)
+    if key not in table:
+        if len(table) >= _MID_KEPT:
+            table.clear()
+        table[key] = MidHeld.of(robot, j, value)
+    mid = table[key]
+    if mid is None or T.shape != (4, 4) or T.dtype != np.float64:
+        return solve_fixed(robot, T, {name: value}, dispatch=dispatch)
+    return mid.solve(robot, T)  # (rigid: solve_fixed's check_rigid would return T itself)
+
+
+#: Middle-joint set-ups kept per arm (:class:`MidHeld`; the self-motion asks for
+#: each joint's limits and aligned values only): the table is emptied past this.
+_MID_KEPT = 64
+
+
+@dataclass(frozen=True, eq=False)
+class MidHeld:
+    """A middle joint held at one value, its reduced chain solved by general 6R directly.
+
+    Attributes:
+        j: The joint's index.
+        value: Its value [rad].
+        reduced: The reduced chain's arm (the joint at ``value``).
+        params: Its general 6R parameters.
+        keep: The whole arm's columns of the reduced chain's joints.
+    """
+
+    j: int
+    value: float
+    reduced: Arm
+    params: np.ndarray
+    keep: list[int]
+
+    @classmethod
+    def of(cls, robot: Arm, j: int, value: float) -> MidHeld | None:
+        """The set-up, or None where :func:`solve_fixed` takes another path.
+
+        (An end joint, a held closed form, a value putting a pair of axes on or next
+        to one line (``coincident``, ``near_coincident``), a reduced chain whose
+        family is not general 6R.)
+        """
+        name = robot.joint_names[j]
+        if (not 0 < j < robot.n - 1 or _held_solvers(robot).get(name) is not None
+                or robot.n != 7 or not math.isfinite(value)
+                or _co.coincident_pair(robot, j, value) is not None
+                or _nco.near_coincident_pair(robot, j, value) is not None):
+            return None
+        reduced = _reduced(robot, [j], (value,))
+        if reduced.derived(FAMILY).name != _g6.NAME:
+            return None
+        params = _g6.setup(reduced).params
+        if params is None:
+            return None
+        return cls(j, value, reduced, params, [c for c in range(robot.n) if c != j])
+
+    def solve(self, robot: Arm, T: np.ndarray) -> SolutionSet:
+        """The set at one rigid pose T (4, 4): :func:`solve_fixed`'s rows and flags.
+
+        As that path: the general 6R set's rows (NaN where not valid), the held
+        column, ``within_limits`` by :class:`SolutionSet`'s test (1e-9) on the whole
+        row, ``singular`` the kernel's sigma below 1e-6, then :func:`_into_limits`.
+        """
+        Q, valid, _, sigma, _, _, _ = _g6.raw_solve(self.reduced.chain, self.params,
+                                                   np.ascontiguousarray(T)[None])
+        v = valid[0]
+        q = np.full((len(v), robot.n), np.nan)
+        q[:, self.keep] = Q[0]
+        q[:, self.j] = self.value
+        q[~v] = np.nan
+        lim = robot.limits
+        with np.errstate(invalid="ignore"):
+            inside = _all_last((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9))
+        sols = SolutionSet._trusted(q, v, robot.is_revolute, lim,
+                                    {"singular": (sigma[0] < 1e-6) & v, "within_limits": inside},
+                                    {}, np.empty((), dtype=object), "", None, {})
+        return _into_limits(robot, self.j, T[None], np.array([self.value]), sols)
+
+
+#: Per arm: (middle joint, value) -> :class:`MidHeld` (or None), filled on first use.
+MID_HELD: Derived[dict[tuple[int, float], MidHeld | None]] = Derived(
+    "middle-joint held general 6R set-ups", lambda arm: {})
+
+
 def sweep_end(robot: Arm, j: int, T: np.ndarray, values: np.ndarray) -> SolutionSet | None:
     """``solve_fixed(robot, T, {joint j: values})``: one pose, an end joint, general 6R.
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robokin.kinematics.arm import Arm
+from robokin.kinematics.arm import Arm, Derived
 from robokin.spatial import wrap_angle as _wrap
 
 #: Rows of a slot at the same point are the same configuration within this [rad].
@@ -73,21 +73,32 @@ class _Family:
         if not ts.size:
             return out
         q, valid, _ = self.rows(ts)
-        i = 0
-        for (j, value), cand, res in zip(queries, cands, out, strict=True):
-            for t, row in cand:
-                ok = valid[i].copy()
-                d = np.full(len(ok), np.inf)
-                d[ok] = (np.abs(_wrap(q[i, ok, j] - value)) if row is None
-                         else np.abs(_wrap(q[i, ok] - row)).max(-1))
-                # a shoulder joint is shared by both wrist roots (and vice versa)
-                res += [(t, int(b)) for b in np.flatnonzero(d < _SAME)]
-                i += 1
+        # every candidate at once (elementwise, the same distances as one by one)
+        of = [c for c, cand in enumerate(cands) for _ in cand]
+        rows = [row for cand in cands for _, row in cand]
+        has = np.array([row is not None for row in rows], dtype=bool)
+        d = np.full(valid.shape, np.inf)
+        with np.errstate(invalid="ignore"):
+            if has.any():
+                R = np.array([row for row in rows if row is not None])
+                d[has] = np.abs(_wrap(q[has] - R[:, None, :])).max(-1)
+            if not has.all():
+                i = np.flatnonzero(~has)
+                j = np.array([queries[of[c]][0] for c in i.tolist()])
+                value = np.array([queries[of[c]][1] for c in i.tolist()])
+                d[i] = np.abs(_wrap(q[i[:, None], :, j[:, None]][:, 0] - value[:, None]))
+        d[~valid] = np.inf
+        # a shoulder joint is shared by both wrist roots (and vice versa)
+        for c, b in zip(*np.nonzero(d < _SAME), strict=True):
+            out[of[c]].append((float(ts[c]), int(b)))
         return out
 
 
 def _into_limits(robot: Arm, q: np.ndarray) -> np.ndarray:
     """Revolute angles shifted by 2 pi into the limits where that fits."""
+    up_cap, down_cap = robot.derived(SHIFT_CAPS)
+    if not ((q <= up_cap) | (q >= down_cap)).any():
+        return q + 0.0  # (no angle can move: the usual case, 4 numpy calls, not 13)
     lo, hi = robot.limits[:, 0], robot.limits[:, 1]
     rev = np.asarray(robot.is_revolute, bool)
     up = rev & (q < lo) & (q + _TWO_PI <= hi)
@@ -97,3 +108,25 @@ def _into_limits(robot: Arm, q: np.ndarray) -> np.ndarray:
     np.add(out, _TWO_PI, out=out, where=up)
     np.subtract(out, _TWO_PI, out=out, where=down)
     return out
+
+
+def _shift_caps(arm: Arm) -> tuple[np.ndarray, np.ndarray]:
+    """(n,) each: ``_into_limits`` moves an angle q only where q <= the first or >= the second.
+
+    A revolute angle moves up only where q < lo and q + 2 pi <= hi, so q <= min(lo,
+    hi - 2 pi + 1e-6) (the 1e-6 covers the sum's rounding for |q| up to ~1e9), and
+    down only where q >= max(hi, lo + 2 pi - 1e-6); other coordinates never
+    (-inf, inf). Kernel rows in [-pi, pi) on limits narrower than 2 pi never reach
+    them (the rtb-data iiwa14: -3.32 and 3.32), and ``_into_limits`` is then one
+    test and a copy (issue 29, helper iiwapy30).
+    """
+    lo, hi = arm.limits[:, 0], arm.limits[:, 1]
+    rev = np.asarray(arm.is_revolute, bool)
+    with np.errstate(invalid="ignore"):
+        up = np.where(rev, np.minimum(lo, hi - _TWO_PI + 1e-6), -np.inf)
+        down = np.where(rev, np.maximum(hi, lo + _TWO_PI - 1e-6), np.inf)
+    return up, down
+
+
+#: Per arm: ``_shift_caps``' bounds (``_into_limits``' test).
+SHIFT_CAPS: Derived[tuple[np.ndarray, np.ndarray]] = Derived("2 pi shift bounds", _shift_caps)

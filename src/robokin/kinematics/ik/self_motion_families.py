@@ -19,7 +19,7 @@ import numpy as np
 
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, Derived
-from robokin.kinematics.ik.fixed import Dispatch, solve_fixed
+from robokin.kinematics.ik.fixed import Dispatch, solve_held_one
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.ik.swivel import SwivelArm, swivel_arm
 
@@ -101,8 +101,7 @@ class _JointFamily(_Family):
     joint: int
 
     def candidates(self, j: int, value: float) -> list[tuple[float, np.ndarray | None]]:
-        sols = solve_fixed(self.robot, self.T, {self.robot.joint_names[j]: value},
-                           dispatch=self.dispatch)
+        sols = solve_held_one(self.robot, self.T, j, value, dispatch=self.dispatch)
         if "swivel" in str(sols.info.get("measured", "")) and j == 3:
             return []  # the SRS elbow held: a family, constant on the manifold
         out: list[tuple[float, np.ndarray | None]] = []
@@ -136,18 +135,75 @@ class _HeldFamily(_JointFamily):
         self.free = np.delete(np.arange(robot.n), j)
         #: T repeated (r, 4, 4) for the refining steps' pose errors (grown as needed)
         self.poses = np.zeros((0, 4, 4))
+        #: the kernel's preferred coordinates at singularities (``raw_solve``'s default)
+        self.qn = np.zeros((1, robot.n))
+        #: the kernel's rows (Q (8, n), valid, singular (8,)) of kept values, by t's bits
+        self.kept: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        self.kept_shape: tuple[int, ...] = (8, robot.n)
         #: rows near a limit refined (``_held_polish``); off once the compiled kernel
         #: certified the manifold: its crossings and ends are on the unrefined rows,
         #: and a refined row there moves by up to ~6e-12 (the Panda), past the slack
         self.polish = True
 
-    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _solved(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The closed form's Q (m, 8, n), valid, singular (m, 8) at t (m,) contiguous float64.
+
+        The pose repeated from ``poses`` (kept, grown as needed), not broadcast and
+        copied per call.
+        """
         from robokin.kinematics.ik.analytic import pieper as pk
 
+        Q, valid, sing, _, _ = pk.raw_solve(self.params, self._repeated(len(t)), t, self.qn)
+        return Q, valid, sing
+
+    def _distinct(self, t: np.ndarray, keep: bool = False
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``_solved`` at each distinct value of t (by its bits), once: (Q, valid, sing, i).
+
+        Q (u, 8, n), valid and sing (u, 8) per distinct value; i (m,) the distinct
+        value of each t. Values in ``kept`` (the kernel's rows of earlier calls with
+        ``keep``) are not solved again, and with ``keep`` this call's are kept (up to
+        ``_KEPT`` values): the exact points' values, which ``_points_refined`` solves
+        again (issue 29, helper iiwapy30). The kernel's rows are a function of (T, t)
+        alone, so a kept row is the row a new solve gives.
+        """
+        keys = t.view(np.int64).tolist()
+        first: dict[int, int] = {}
+        i = np.array([first.setdefault(x, len(first)) for x in keys], dtype=np.intp)
+        u = t if len(first) == len(keys) else np.array(list(first), dtype=np.int64).view(np.float64)
+        kept = self.kept
+        old = [k for k, x in enumerate(first) if x in kept] if kept else []
+        if old:
+            Q = np.empty((len(u),) + self.kept_shape)
+            valid = np.empty((len(u), self.kept_shape[0]), dtype=bool)
+            sing = np.empty((len(u), self.kept_shape[0]), dtype=bool)
+            new = np.setdiff1d(np.arange(len(u)), old)
+            if len(new):
+                Q[new], valid[new], sing[new] = self._solved(np.ascontiguousarray(u[new]))
+            for k, x in zip(old, [x for x in first if x in kept], strict=True):
+                Q[k], valid[k], sing[k] = kept[x]
+        else:
+            Q, valid, sing = self._solved(u)
+        if keep and len(kept) + len(u) <= _KEPT:
+            self.kept_shape = Q.shape[1:]
+            for k, x in enumerate(first):
+                kept[x] = (Q[k], valid[k], sing[k])
+        return Q, valid, sing, i
+
+    def _repeated(self, m: int) -> np.ndarray:
+        """T repeated (m, 4, 4), C-contiguous (a slice of ``poses``, grown as needed)."""
+        if len(self.poses) < m:
+            self.poses = np.ascontiguousarray(np.broadcast_to(self.T, (max(2 * m, 64), 4, 4)))
+        return self.poses[:m]
+
+    def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
-        Tb = np.ascontiguousarray(np.broadcast_to(self.T, (len(t), 4, 4)))
-        Q, valid, sing, _, _ = pk.raw_solve(self.params, Tb, t)
-        Q = Q.copy()
+        if len(t) > _KEPT:  # the grid: its values are distinct, and not kept
+            Q, valid, sing = self._solved(t)
+            Q = Q.copy()
+        else:
+            Q, valid, sing, i = self._distinct(t, keep=True)
+            Q, valid, sing = Q[i], valid[i], sing[i]
         Q[~valid] = np.nan
         Q = _into_limits(self.robot, Q)
         if self.polish:
@@ -163,26 +219,34 @@ class _HeldFamily(_JointFamily):
         refinement's cost on the rtb-data iiwa14 (issue 29, helper polish29). The
         rows read are ``rows(t)``'s bit for bit: every step is per row, but for an
         exactly singular held Jacobian, which refines none of its call's rows (not met).
+        Each distinct value of t (by its bits) is solved once: the slots of a fold
+        (2 or 4: a quartic root pair, each with its two wrists) are bisected on the
+        same values, ~4 rows per value on the rtb-data iiwa14 (issue 29, helper
+        iiwapy30). Where no row is read (a step of fold bisections only) the rows
+        come back as the kernel gives them (not shifted into the limits either).
         """
-        from robokin.kinematics.ik.analytic import pieper as pk
-
         t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
-        Tb = np.ascontiguousarray(np.broadcast_to(self.T, (len(t), 4, 4)))
-        Q, valid, sing, _, _ = pk.raw_solve(self.params, Tb, t)
-        i = np.arange(len(t))
+        Q, valid, sing, i = self._distinct(t)
         q, v = Q[i, b], valid[i, b]
+        if read is not None and not read.any():
+            return q, v
         q[~v] = np.nan
         q = _into_limits(self.robot, q)
         if not self.polish:
             return q, v
-        if read is None:
+        if read is None or read.all():
             _held_polish(self, q[:, None], v[:, None], sing[i, b][:, None])
-        elif read.any():
+        else:
             r = np.flatnonzero(read)
             qr = q[r]
             _held_polish(self, qr[:, None], v[r, None], sing[i[r], b[r], None])
             q[r] = qr
         return q, v
+
+
+#: Values whose kernel rows a held family keeps (``_HeldFamily._distinct``): a call
+#: with more (the checking grid) is neither kept nor looked up.
+_KEPT = 256
 
 
 #: Rows within this of a limit [rad] are refined (``_held_polish``): a membership

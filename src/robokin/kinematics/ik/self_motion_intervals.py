@@ -153,22 +153,37 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
     # row at the bracket's left end than at its right end lies left of the jump
     s_lo, s_hi = t[sc].astype(np.float64), t[sc + 1].astype(np.float64)
     qa, qe = q[sc, sk], q[sc + 1, sk]
+    # (the numpy calls per step are most of a step's cost next to its few rows: the
+    # swaps' and the in-limit changes' are skipped where there are none)
+    act = np.arange(len(sc))
+    has_changes = bool(changes)
+    lo_s, hi_s = limits[:, 0] - MANIFOLD_SLACK, limits[:, 1] + MANIFOLD_SLACK  # (_within's)
     for _ in range(_BISECT):
         mid = 0.5 * (lo + hi)
-        act = np.flatnonzero(s_hi - s_lo > _SWAP_T)
-        if np.all((mid == lo) | (mid == hi)) and not len(act):
+        # a cell of two adjacent floats is done: its midpoint is one of its ends, whose
+        # state is known (lo's is state0, hi's not), so solving it would change nothing
+        go = np.flatnonzero((mid != lo) & (mid != hi))
+        if len(act):  # (a bracket once within _SWAP_T stays so)
+            act = act[s_hi[act] - s_lo[act] > _SWAP_T]
+        if not len(go) and not len(act):
             break  # every cell two adjacent floats: the rest would change nothing
-        s_mid = 0.5 * (s_lo[act] + s_hi[act])
-        qm, vm = fam.slot_rows(np.concatenate([mid, s_mid]), np.concatenate([br, sk[act]]),
-                               np.concatenate([kind, np.ones(len(act), dtype=bool)]))
-        now = np.where(kind, vm[:len(mid)] & _within(qm[:len(mid)], limits), vm[:len(mid)])
-        same = now == state0
-        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+        m, mid, kg = len(go), mid[go], kind[go]
         if len(act):
-            r = qm[len(mid):]
+            s_mid = 0.5 * (s_lo[act] + s_hi[act])
+            qm, vm = fam.slot_rows(np.concatenate([mid, s_mid]), np.concatenate([br[go], sk[act]]),
+                                   np.concatenate([kg, np.ones(len(act), dtype=bool)]))
+            now = vm[:m]
+        else:
+            qm, now = fam.slot_rows(mid, br[go], kg)
+        if has_changes:
+            now = np.where(kg, now & _in_bounds(qm[:m], lo_s, hi_s), now)
+        same = now == state0[go]
+        lo[go], hi[go] = np.where(same, mid, lo[go]), np.where(same, hi[go], mid)
+        if len(act):
+            r = qm[m:]
             with np.errstate(invalid="ignore"):
                 left = _turn_gap(r - qa[act]) <= _turn_gap(r - qe[act])
-            left &= vm[len(mid):]
+            left &= vm[m:]
             s_lo[act[left]], qa[act[left]] = s_mid[left], r[left]
             s_hi[act[~left]], qe[act[~left]] = s_mid[~left], r[~left]
     swaps = [(float(x), int(b)) for x, m in zip(s_lo.tolist(), moved, strict=True)
@@ -305,20 +320,21 @@ def _fold_crossings(fam: _Family, tf: np.ndarray, tg: np.ndarray, br: np.ndarray
     b_i = br[f_i]
     lo, hi = ts[f_i, k_i], ts[f_i, k_i + 1]
     state0, state1 = side[f_i, k_i, j_i], side[f_i, k_i + 1, j_i]
-    n_rows = np.arange(len(cells))
     for _ in range(_BISECT):
         mid = 0.5 * (lo + hi)
-        if np.all((mid == lo) | (mid == hi)):
+        go = np.flatnonzero((mid != lo) & (mid != hi))  # not yet two adjacent floats
+        if not len(go):
             break  # every cell two adjacent floats
-        qm, vm = fam.slot_rows(mid, b_i)
-        qj = qm[n_rows, j_i]
+        mid, jg = mid[go], j_i[go]
+        qm, vm = fam.slot_rows(mid, b_i[go])
+        qj = qm[np.arange(len(go)), jg]
         with np.errstate(invalid="ignore"):
-            now = ((qj > limits[j_i, 1] + MANIFOLD_SLACK).astype(np.int8)
-                   - (qj < limits[j_i, 0] - MANIFOLD_SLACK).astype(np.int8))
+            now = ((qj > limits[jg, 1] + MANIFOLD_SLACK).astype(np.int8)
+                   - (qj < limits[jg, 0] - MANIFOLD_SLACK).astype(np.int8))
         now = np.where(vm, now, _NO_ROW)  # rows missing: a second fold
-        same = now == state0
-        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
-        state1 = np.where(same, state1, now)
+        same = now == state0[go]
+        lo[go], hi[go] = np.where(same, mid, lo[go]), np.where(same, hi[go], mid)
+        state1[go] = np.where(same, state1[go], now)
     inner = np.where(state0 == 0, lo, hi)  # the in-limit end
     out_side = np.where(state0 == 0, state1, state0)
     return [(float(t), int(b), int(j), "fold" if o == _NO_ROW else "upper" if o > 0 else "lower")
@@ -327,9 +343,13 @@ def _fold_crossings(fam: _Family, tf: np.ndarray, tg: np.ndarray, br: np.ndarray
 
 def _within(q: np.ndarray, limits: np.ndarray) -> np.ndarray:
     """(...) bool: rows q (..., n) inside every limit (MANIFOLD_SLACK); NaN rows False."""
-    with np.errstate(invalid="ignore"):
-        out: np.ndarray = np.all((q >= limits[:, 0] - MANIFOLD_SLACK)
-                                 & (q <= limits[:, 1] + MANIFOLD_SLACK), axis=-1)
+    return _in_bounds(q, limits[:, 0] - MANIFOLD_SLACK, limits[:, 1] + MANIFOLD_SLACK)
+
+
+def _in_bounds(q: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(...) bool: rows q (..., n) within [lo, hi] (n,) each; NaN rows False."""
+    with np.errstate(invalid="ignore"):  # (the ufunc's reduce: ``np.all``'s wrapper costs ~4 us)
+        out: np.ndarray = np.logical_and.reduce((q >= lo) & (q <= hi), axis=-1)
         return out
 
 
@@ -345,7 +365,7 @@ def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
     pieces: list[tuple[int, float, float]] = []
     mids, owners, spans = [], [], []
     for b in range(fam.k):
-        c = np.unique(np.clip(cuts[b], lo_d, hi_d))
+        c = np.unique(np.clip(cuts[b], lo_d, hi_d)).tolist()
         for a, e in zip(c[:-1], c[1:], strict=True):
             if e > a:
                 mids.append(0.5 * (a + e))
@@ -405,11 +425,13 @@ def _touches(fam: _Family, limits: np.ndarray, crossings: list[Any],
             close = ((p >= limits[:, :1] - _NEAR) & (p <= limits[:, 1:] + _NEAR)).any(-1)
         far = ~close.all(-1)  # (2, k): a joint out by > _NEAR, or no track there
     ts, bs = [], []
+    out_any: list[bool] = np.logical_or.reduce(out, axis=1).tolist()  # (python scalars in
+    # the loops: ~1 us a numpy call)
     for b in range(fam.k):
         cuts = at.get(b, [])
-        for t in {float(np.clip(t, lo_d, hi_d)) for t, _ in cuts} | {lo_d, hi_d}:
+        for t in {min(max(float(t), lo_d), hi_d) for t, _ in cuts} | {lo_d, hi_d}:
             sides = [s[(b, t)] for s in (left, right) if (b, t) in s]
-            if not sides or any(not out[i].any() for i in sides):
+            if not sides or any(not out_any[i] for i in sides):
                 continue  # in a piece inside (or no piece): covered
             need = np.flatnonzero(out[sides].any(0))
             near = {j for tc, j in cuts if abs(tc - t) <= _CORNER}
