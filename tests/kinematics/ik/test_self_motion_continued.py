@@ -874,3 +874,152 @@ def test_an_islands_crossing_at_a_singular_point_cuts_its_interval():
         for k in range(19):
             g = _wrapped(ref.q[k][ref.valid[k]] - rows[k]).max(-1)
             assert g.min() < 1e-6, (ts[k], b)
+
+
+def _exact_row(robot, T, q0):
+    """The configuration of pose T with the last joint at q0[6], nearest q0 (40 digits).
+
+    Oracle independent of the solvers: mpmath's Newton on the chain's own frames
+    (base, per joint its link offset, the rotation about z by the joint's angle,
+    its frame offset, then the tool; checked against ``robot.fk`` at q0 first).
+    """
+    mp = pytest.importorskip("mpmath")
+    mp.mp.dps = 40
+    c = robot.chain
+    assert all(j.kind == "revolute" for j in c.joints)
+    link = [mp.matrix(m.tolist()) for m in c.link_offsets]
+    frame = [mp.matrix(m.tolist()) for m in c.frame_offsets]
+    base, tool = mp.matrix(np.asarray(c.base).tolist()), mp.matrix(np.asarray(c.tool).tolist())
+
+    def fk(z):
+        A = base
+        for i, j in enumerate(c.joints):
+            th = j.sign * z[i] + j.offset
+            ct, st = mp.cos(th), mp.sin(th)
+            A = A * link[i] * mp.matrix([[ct, -st, 0, 0], [st, ct, 0, 0], [0, 0, 1, 0],
+                                         [0, 0, 0, 1]]) * frame[i]
+        return A * tool
+
+    F = fk([mp.mpf(float(x)) for x in q0])
+    assert max(abs(float(F[r, k]) - T[r, k]) for r in range(3) for k in range(4)) < 1e-15
+    Tm = mp.matrix(np.asarray(T).tolist())
+
+    def residual(*x):
+        F = fk([*x, mp.mpf(float(q0[6]))])
+        return [F[0, 3] - Tm[0, 3], F[1, 3] - Tm[1, 3], F[2, 3] - Tm[2, 3],
+                F[2, 1] - Tm[2, 1], F[0, 2] - Tm[0, 2], F[1, 0] - Tm[1, 0]]
+
+    x = mp.findroot(residual, [mp.mpf(float(v)) for v in q0[:6]], tol=mp.mpf(10) ** -35,
+                    maxsteps=50)
+    return np.array([float(v) for v in x] + [float(q0[6])])
+
+
+#: Regular special configurations of the random 7R arm with the parameter (joint 7) at
+#: its limit and one to four more joints at theirs (``benchmarks/self_motion_rates.py``,
+#: seed 0, n 10,000: #6185, #6453, #6584; the fourth from a sweep of such
+#: configurations, seed 3): in the limits at the range's end only, where main
+#: (05a5936) listed no point: the branch's row there (a node's, 4e-15 to 9e-15 off the
+#: pose) was 1.2e-12 to 9e-12 off q, its joints past their limits by more than the slack.
+RANGE_ENDS = [
+    [2.9670597283903604, -0.9294766876611065, 2.9670597283903604, -2.9670597283903604,
+     -2.9670597283903604, 1e-09, 2.9670597283903604],
+    [-1e-07, -2.9670597283903604, 1e-07, 1e-06, 1e-07, -2.534339149482974,
+     2.9670597283903604],
+    [0.0, -2.9670597283903604, -1e-07, -1e-07, 1e-06, 0.0, -2.9670597283903604],
+    [2.9670597283903604, -2.9670597283903604, -0.1150539442882077, -2.9670597283903604,
+     0.7322922288450662, -0.6712053605995347, -2.9670597283903604],
+]
+
+
+@pytest.mark.parametrize("q", RANGE_ENDS)
+def test_a_corner_at_the_range_end_is_a_one_point_interval(q):
+    # Issue 29, session 11 (helper r7end30): the continued family's rows within 1e-9 of
+    # a limit get the held family's refining step (_held_polish), so the range end's
+    # corner rule (self_motion_intervals._touches) sees the row inside. Oracles:
+    # reference.assert_corner_listed (q alone in the limits on its branch, outside at
+    # t +- 1e-6, an interval at most 1e-9 long holds t, its row inside and exact), the
+    # pose's exact row at t (40 digits) inside the limits within the slack and within
+    # 1e-12 of the listed row, and an independent held solve holding that row.
+    from reference import assert_corner_listed
+    from robokin.kinematics.ik.self_motion_intervals import MANIFOLD_SLACK
+
+    robot = ARMS["random7r"]
+    q0 = np.array(q)
+    T, sm = _manifold(robot, q0)
+    t = float(q0[6])
+    assert t in sm.domain
+    assert_corner_listed(robot, sm, q0, t)
+    t_, b, hit = _branch_intervals(sm, q0)
+    assert len(hit) == 1 and t in hit[0], hit  # one end exactly t, the limit (the
+    # other widened to the last in-slack value: #6584's 5.6e-13)
+    row = sm.sample(t)[b]
+    exact = _exact_row(robot, T, q0)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    assert np.all((exact >= lo - MANIFOLD_SLACK) & (exact <= hi + MANIFOLD_SLACK))
+    assert np.abs(row - exact).max() <= 1e-12, row - exact
+    assert sm.inside(t)[b]
+    ref = robot.ik(T, fixed={robot.joint_names[-1]: t})
+    assert _wrapped(ref.q[ref.valid] - row).max(-1).min() < 1e-9
+
+
+def _at_limits(robot, rng, count):
+    """Configurations with joint 7 at a limit and 1-4 more joints at theirs.
+
+    The other joints a third of the time at a special value (0, +-pi/2, +-1e-9,
+    +-1e-7, 1e-6: axes next to alignments), else uniform in the limits. Returns the
+    configurations (count, 7) and per row the joints put at a limit (the parameter's
+    not among them).
+    """
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    out, where = [], []
+    for _ in range(count):
+        q = rng.uniform(lo, hi)
+        sp = rng.random(7) < 0.33
+        q[sp] = np.clip(rng.choice([0.0, np.pi / 2, -np.pi / 2, 1e-9, -1e-9, 1e-7, -1e-7, 1e-6],
+                                   sp.sum()), lo[sp], hi[sp])
+        q[6] = rng.choice([lo[6], hi[6]])
+        js = rng.choice(6, int(rng.integers(1, 5)), replace=False)
+        q[js] = np.where(rng.random(len(js)) < 0.5, lo[js], hi[js])
+        out.append(q)
+        where.append(js)
+    return np.array(out), where
+
+
+def test_the_range_end_rule_holds_in_limit_ends_and_lists_no_out_of_limit_one():
+    # Issue 29, session 11: the range end's corner with 2 to 5 joints at a limit at once
+    # (the parameter and 1-4 others). Per generated configuration q (24: seed 11): q's
+    # value (the range's end) lies in an interval of q's branch (exactly, no slack in
+    # t), and with one of its limited joints pushed 1e-9 past its limit (the pose's
+    # branch row there is then out: the pushed q) in no interval of that branch; every
+    # interval at most 1e-9 long at a range end has its row there inside the limits
+    # (the slack), reproducing the pose to 1e-12, an independent held solve's (1e-9).
+    from robokin.kinematics.ik.self_motion_intervals import MANIFOLD_SLACK
+
+    robot = ARMS["random7r"]
+    name = robot.joint_names[-1]
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    Q, where = _at_limits(robot, np.random.default_rng(11), 12)
+    checked = points = 0
+    for q0, js in zip(Q, where, strict=True):
+        for push in (0.0, 1e-9):
+            q = q0.copy()
+            j = js[0]
+            q[j] += push if q[j] == hi[j] else -push
+            T, sm = _manifold(robot, q)
+            t, b, _ = _branch_intervals(sm, q)
+            iv = sm.intervals[sm.interval_branch == b]
+            held = bool(np.any((iv[:, 0] <= t) & (t <= iv[:, 1])))
+            assert held == (push == 0.0), (q.tolist(), iv)
+            checked += 1
+            for (a, e), bb in zip(sm.intervals, sm.interval_branch, strict=True):
+                end = a if a in sm.domain else e
+                if not (e - a <= 1e-9 and end in sm.domain):
+                    continue
+                points += 1
+                row = sm.sample(end)[bb]
+                assert np.all((row >= lo - MANIFOLD_SLACK) & (row <= hi + MANIFOLD_SLACK))
+                dp, dr = pose_errors(robot.fk(row), T)
+                assert dp <= 1e-12 and dr <= 1e-12
+                ref = robot.ik(T, fixed={name: end})
+                assert _wrapped(ref.q[ref.valid] - row).max(-1).min() < 1e-9
+    assert checked == 24 and points >= 4, points

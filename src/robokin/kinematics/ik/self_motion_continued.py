@@ -34,7 +34,9 @@ module continues them into branches (issue 29):
    nearest; any other value is solved as in ``rows`` (issue 29, round 7). On a
    ``degenerate`` manifold only cells whose tracks are regular (the held 6 x 6's
    smallest singular value at least ``_REGULAR`` at the node rows and the followed
-   rows) are followed: a near-continuum's rows are solved (round 7c).
+   rows) are followed: a near-continuum's rows are solved (round 7c). Rows of both
+   within 1e-9 of a limit get the held family's refining step (``_held_polish``):
+   a membership decided within rounding of the slack (issue 29, session 11).
 4. **Limits on the branch.** Per track, cell and joint, the cubic Hermite model
    sampled at ``_SUB`` sub-values brackets each crossing of a limit (and of an
    aligned-axes value); each is refined by Newton steps on the six other joints
@@ -57,7 +59,7 @@ midpoints (``self_motion_intervals._intervals``).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -65,6 +67,7 @@ from robokin._native import kernels as _K
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.fixed import Dispatch, EndSweep, _all_last, solve_fixed
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
+from robokin.kinematics.ik.self_motion_families import _held_polish, _HeldFamily
 from robokin.kinematics.jacobian import jacobian_and_pose
 from robokin.spatial import pose_error
 
@@ -162,6 +165,15 @@ class _ContinuedFamily(_Family):
         self.name = robot.joint_names[j]
         self.domain = (float(robot.limits[j, 0]), float(robot.limits[j, 1]))
         self.T = np.ascontiguousarray(T, dtype=np.float64)
+        # what the held family's refinement of rows next to a limit reads
+        # (``_held_polish``, :meth:`_refined`): every joint's (mid, half) of its
+        # limits (the parameter never refined), the free joints, T repeated
+        lim = np.asarray(robot.limits, dtype=np.float64)
+        half = 0.5 * (lim[:, 1] - lim[:, 0])
+        half[j] = np.inf
+        self.band = (0.5 * (lim[:, 0] + lim[:, 1]), half)
+        self.free = np.delete(np.arange(robot.n), j)
+        self.poses = np.zeros((0, 4, 4))
         self.solves = 0
         self._island_cells: list[tuple[float, float]] = []  # cells where _islands found one
         # the end joint's sweep set up once per pose (None: a middle joint, solve_fixed)
@@ -335,7 +347,22 @@ class _ContinuedFamily(_Family):
         P = self.predict(t)  # (M, k, n)
         out = self._polish(_assign(P, R), t)
         valid = _finite_rows(out)
+        self._refined(out, valid)
         return out, valid, np.zeros_like(valid)
+
+    def _refined(self, Q: np.ndarray, valid: np.ndarray) -> None:
+        """Rows Q (M, k, n) within 1e-9 of a limit refined in place (``_held_polish``).
+
+        A row reproducing the pose to ~5e-15 (``_polish``'s and ``_follow``'s
+        stop) is off by that over the held 6 x 6's smallest singular value: the
+        random 7R's special seed 0 #6185 (q7 at its limit with four joints at
+        theirs, 1.1e-4) had its joints 9e-12 past their limits, more than
+        ``MANIFOLD_SLACK``, and its range-end corner was not listed. One Newton step
+        on the pose with t held, where it is short (the held family's bounds: a
+        step of a singular row is not taken), brings them to ~2e-13.
+        """
+        # the held family's refinement, its attributes mirrored here (band, free, poses)
+        _held_polish(cast(_HeldFamily, self), Q, valid, np.zeros_like(valid))
 
     def sample_rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``rows(t)``, each branch followed from its nodes where that is certified.
@@ -364,6 +391,7 @@ class _ContinuedFamily(_Family):
         out[idx[ok]] = q[ok]
         fast[idx[~ok]] = False
         self.followed += int(ok.sum())
+        self._refined(out, _finite_rows(out))  # the followed rows (rows' are)
         if not fast.all():
             out[~fast] = self.rows(t[~fast])[0]
         valid = _finite_rows(out)
