@@ -23,7 +23,8 @@
  *      the end where the position root's subproblem-4 discriminant reaches 0
  *      (or HM_DISC_TWO for the pair's second root), by Brent's method on the
  *      margins (no rows), confirmed by two rows; else searched on the row's
- *      existence to HM_FOLD_TOL;
+ *      existence to HM_FOLD_TOL; the piece from the end to its grid node is one
+ *      cell in sigma = sqrt|t - end| (hm_sigma), where the rows are smooth;
  *   4. per slot, the pieces between domain ends, limit crossings, folds and slot
  *      changes are decided at their midpoints (a row inside every limit) and joined.
  *
@@ -65,11 +66,16 @@
 #define HM_DEPTH 14     /* splits of a grid cell */
 #define HM_TOL 1e-12    /* a crossing's joint at its value to this [rad] */
 #define HM_TOL_STEEP 1e-9 /* the same where t's last bit moves the joint more */
+#ifndef HM_FLOOR
+#define HM_FLOOR 4.0 /* hm_root stops with q_j - value below this many ulps of t times dq_j/dt
+                      * (8: 1.7 rows per pose fewer still, but an interval end of seed 1's corner pose 384
+                      * no longer on its crossing record: held_manifold_check.py) */
+#endif
 #define HM_GRAIN 4
 #define HM_NEAR 1e-6 /* a node with 1 / |dq/dt|^2 below this times its cell: at a branch end */
 #define HM_MAXF 32 /* branch ends per slot remembered for its partner */
 #define HM_FOLD_TOL 1e-11 /* a branch end to this (relative) */
-#define HM_FOLD_STEPS 6 /* rows between a branch end and its grid row */
+#define HM_FOLD_STEPS 6 /* rows between a branch end and its grid row (a node at one) */
 #define HM_PARALLEL_MIN 8
 #define HM_DECIDE 1e-9 /* a grid row this far inside / outside decides its piece [rad] */
 #define HM_SLOT_JUMP 1e-3 /* a slot's row moving more in one ulp of t: another branch [rad] */
@@ -146,6 +152,7 @@ typedef struct {
      * B5, b5 = G E_held(t)^-1; the held joint's columns at fc (u6, w6) */
     int fast, full_fk; /* full_fk: hm_slopes wanted (the fold search) */
     int jumped; /* a slot's rows jump somewhere (hm_jump): the pose gets hm_near_aligned's test */
+    double sq_te; /* NaN: cells in t; else a branch end's t: cells in sigma (hm_sigma) */
     int retry; /* a new slot change found by hm_root: the slot's pass is redone */
     double jump_t[HM_MAXJUMP][2]; /* the slot changes found (adjacent doubles), for every slot */
     int njump;
@@ -896,6 +903,31 @@ static inline double hm_f(const HmCtx *c, const HmRow *r, int b, int qi)
     return wrap_pi(r->q[b][c->qj[qi]] - c->qv[qi]);
 }
 
+/* The cells' coordinate: t itself, or within a branch end's near-fold piece
+ * (hm_fold_piece sets c->sq_te to the end's t) sigma = sign(t - te) sqrt|t - te|,
+ * in which the rows are smooth (q - q_end grows as the square root of the distance
+ * from the end: a power series in sigma), so that the cells' cubic Hermite models
+ * and their splits work there as on the grid's cells. */
+static double hm_sigma(const HmCtx *c, double t)
+{
+    if (isnan(c->sq_te))
+        return t;
+    double d = t - c->sq_te;
+    return copysign(sqrt(fabs(d)), d);
+}
+
+/* The t of coordinate s (hm_sigma's inverse) */
+static double hm_of_sigma(const HmCtx *c, double s)
+{
+    return isnan(c->sq_te) ? s : c->sq_te + copysign(s * s, s);
+}
+
+/* dt / d(coordinate) at t: 1 in t, 2 |sigma| in sigma */
+static double hm_dtds(const HmCtx *c, double t)
+{
+    return isnan(c->sq_te) ? 1.0 : 2.0 * fabs(hm_sigma(c, t));
+}
+
 /* The root in (0, 1) of the cubic Hermite model of f on a cell (values f0, f1 of
  * opposite signs, slopes d0, d1 per unit of the cell): safeguarded Newton on the
  * cubic from the secant's root (no rows). */
@@ -989,8 +1021,10 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
         return;
     double best_t = fabs(fa) < fabs(fe) ? a : e, best_f = fmin(fabs(fa), fabs(fe));
     double t = a - fa * (e - a) / (fe - fa);
-    if (isfinite(da) && isfinite(de)) {
-        double tn = a + (e - a) * hm_hermite_root(fa, fe, da * (e - a), de * (e - a));
+    if (isfinite(da) && isfinite(de)) { /* the cell's model in its coordinate (hm_sigma) */
+        double sa = hm_sigma(c, a), se = hm_sigma(c, e), h = se - sa;
+        double tn = hm_of_sigma(c, sa + h * hm_hermite_root(fa, fe, da * hm_dtds(c, a) * h,
+                                                             de * hm_dtds(c, e) * h));
         if (tn > a && tn < e)
             t = tn;
     }
@@ -1011,6 +1045,14 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
             best_in = hm_inside(c, &r, b, MANIFOLD_SLACK);
         }
         if (f == 0.0 || best_f <= 1e-14)
+            break;
+        /* the rounding floor (session 11): the joint within HM_FLOOR ulps of t's
+         * motion of its value (its slope times one ulp of t), the root within a few
+         * ulps of t; where the row's own rounding is about 1e-14 (q1, q3 next to an
+         * aligned shoulder) the steps below it trade rounding for rounding (5-33 more
+         * rows; 4.0 rows per pose fewer here, the crossings within 6e-15 in t) */
+        if (best_f <= HM_TOL && fabs(f) <= HM_FLOOR * (nextafter(fabs(t), INFINITY) - fabs(t)) *
+                                                 fabs(d))
             break;
         if ((f < 0) == (fa < 0)) {
             a = t;
@@ -1062,18 +1104,27 @@ static void hm_extremum(HmCtx *c, int b, int j, double a, double da, double e, d
                         HmRow *out)
 {
     int side = 0;
-    double t = 0.5 * (a + e);
+    double t = 0.5 * (a + e), ta = a, te = e; /* a, e, t: the cell's coordinate (hm_sigma) */
+    da *= hm_dtds(c, a);
+    de *= hm_dtds(c, e);
+    a = hm_sigma(c, a);
+    e = hm_sigma(c, e);
     for (int it = 0; it < 60; it++) {
         t = a - da * (e - a) / (de - da);
         if (!(t > a && t < e))
             t = 0.5 * (a + e);
-        hm_eval(c, t, 1u << b, 1u << b, out);
+        double tt = hm_of_sigma(c, t);
+        if (!(tt > ta && tt < te)) {
+            tt = 0.5 * (ta + te);
+            t = hm_sigma(c, tt);
+        }
+        hm_eval(c, tt, 1u << b, 1u << b, out);
         if (!out->valid[b]) {
             c->flags |= HM_FLAG_VANISH;
             return;
         }
         hm_seen(c, b, out);
-        double d = out->dq[b][j];
+        double d = out->dq[b][j] * hm_dtds(c, tt);
         if (!isfinite(d) || d == 0.0)
             return;
         if ((d < 0) == (da < 0)) {
@@ -1172,6 +1223,9 @@ static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r
 {
     double h = r1->t - r0->t, big = 0.0;
     int coarse = h > 1.5 * c->hfine; /* wider than a margin cell (round 8b) */
+    /* the end slopes per unit of the cell in its coordinate (hm_sigma) */
+    double hs = hm_sigma(c, r1->t) - hm_sigma(c, r0->t);
+    double m0 = hm_dtds(c, r0->t) * hs, m1 = hm_dtds(c, r1->t) * hs;
     for (int j = 0; j < c->n; j++) /* (fmax's value: dj is finite, rows at both ends) */
         big = fabs(dj[j]) > big ? fabs(dj[j]) : big;
     if (h < 1e-9 && big < 1e-6)
@@ -1185,7 +1239,7 @@ static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r
     for (int qi = 0; qi < c->nq; qi++) {
         int j = c->qj[qi];
         double f0 = fq[qi], f1 = f0 + dj[j];
-        double d0 = r0->dq[b][j] * h, d1 = r1->dq[b][j] * h;
+        double d0 = r0->dq[b][j] * m0, d1 = r1->dq[b][j] * m1;
         if (fabs(f0) > 3.0 || fabs(f1) > 3.0)
             continue; /* the value's far turn: nothing near */
         if ((f0 < 0) == (f1 < 0)) {
@@ -1494,7 +1548,12 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
     if (hm_needs_split(c, b, r0, r1, dj, fq)) {
         if (depth < HM_DEPTH) {
             HmRow m;
-            hm_eval(c, 0.5 * (r0->t + r1->t), 1u << b, 1u << b, &m);
+            double mid = 0.5 * (r0->t + r1->t);
+            if (!isnan(c->sq_te)) { /* the coordinate's midpoint (hm_sigma) */
+                double sm = hm_of_sigma(c, 0.5 * (hm_sigma(c, r0->t) + hm_sigma(c, r1->t)));
+                mid = sm > r0->t && sm < r1->t ? sm : mid;
+            }
+            hm_eval(c, mid, 1u << b, 1u << b, &m);
             if (!m.valid[b]) {
                 c->flags |= HM_FLAG_VANISH;
                 return;
@@ -1509,7 +1568,8 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
             return;
         c->flags |= HM_FLAG_UNRESOLVED;
     }
-    double h = r1->t - r0->t;
+    double hs = hm_sigma(c, r1->t) - hm_sigma(c, r0->t);
+    double m0 = hm_dtds(c, r0->t) * hs, m1 = hm_dtds(c, r1->t) * hs; /* per unit of the cell */
     for (int qi = 0; qi < c->nq && !c->flags; qi++) {
         int j = c->qj[qi];
         double f0 = fq[qi], f1 = f0 + dj[j];
@@ -1522,7 +1582,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
         }
         if ((d0 < 0) == (d1 < 0) || (f0 > 0) != (d0 < 0))
             continue; /* monotone, or moving away from the value first */
-        if (fmin(fabs(f0), fabs(f1)) > fmax(fabs(d0), fabs(d1)) * h)
+        if (fmin(fabs(f0), fabs(f1)) > fmax(fabs(d0 * m0), fabs(d1 * m1)))
             continue; /* cannot reach it with the slopes seen (splits bound them) */
         HmRow m;
         hm_extremum(c, b, j, r0->t, d0, r1->t, d1, &m);
@@ -1539,18 +1599,24 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
 }
 
 /* The piece between a branch end (row re, slope infinite there: q - q_end grows
- * as the square root of the distance) and the grid row rn: rows at distances
- * 4^-k (k = 1..HM_FOLD_STEPS) of the piece from the end, so that the steps are
- * even in that square root; the cells between them as any other, the last one
- * (at the end) by its sign changes alone (regula falsi needs no slope). */
-static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
+ * as the square root of the distance) and the grid row rn. sigma (re a branch end
+ * that hm_fold located): one row at 4^-HM_FOLD_STEPS of the piece from the end, and
+ * the cell from it to rn as any other but in sigma = sign(t - te) sqrt|t - te|
+ * (hm_sigma: the rows are smooth in it; its cubic Hermite models and midpoints;
+ * session 11: rows per pose in these pieces 65 -> 10, the splits they need +2);
+ * else (re a grid node next to a branch end, hm_pose's HM_NEAR test, or a steep
+ * swing there: q1, q3 at an aligned shoulder) rows at distances 4^-k (k = 1 ..
+ * HM_FOLD_STEPS) of the piece from the end, even in that square root, and the cells
+ * between them in t. The cell at the end by its sign changes alone (regula falsi
+ * needs no slope). */
+static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn, int sigma)
 {
     if (c->flags)
         return;
     HmRow r[HM_FOLD_STEPS + 1];
     int m = 0;
     double w = rn->t - re->t;
-    for (int k = HM_FOLD_STEPS; k >= 1; k--) {
+    for (int k = HM_FOLD_STEPS; k >= (sigma ? HM_FOLD_STEPS : 1); k--) {
         hm_eval_pair(c, re->t + w * ldexp(1.0, -2 * k), b, 1, &r[m]);
         if (!r[m].valid[b]) {
             c->flags |= HM_FLAG_VANISH;
@@ -1574,6 +1640,7 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
                 hm_root(c, b, qi, first->t, f1, re->t, f0, NAN, NAN);
         }
     }
+    c->sq_te = sigma ? re->t : NAN; /* the cells in sigma (hm_sigma) */
     for (int i = 0; i + 1 <= m; i++) {
         const HmRow *x = &r[i], *y = i + 1 < m ? &r[i + 1] : rn;
         if (w > 0)
@@ -1581,6 +1648,7 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn)
         else
             hm_cell(c, b, y, x, 0);
     }
+    c->sq_te = NAN;
 }
 
 static int hm_margins_d(const double *P, const double *T, double x, double *m, double *d);
@@ -1788,7 +1856,7 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
     }
     hm_at(c, b, end, hm_inside(c, &re, b, MANIFOLD_SLACK));
     hm_node(c, b, &re);
-    hm_fold_piece(c, b, &re, state0 ? r0 : r1);
+    hm_fold_piece(c, b, &re, state0 ? r0 : r1, 1);
 }
 
 static int hm_cmp(const void *x, const void *y)
@@ -2231,9 +2299,9 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
             int v0 = rows[i].valid[b], v1 = rows[i + 1].valid[b];
             double near = HM_NEAR * fmin(rows[i + 1].t - rows[i].t, c->hfine);
             if (v0 && v1 && hm_gap(c, b, &rows[i]) < near)
-                hm_fold_piece(c, b, &rows[i], &rows[i + 1]); /* a node at a branch end */
+                hm_fold_piece(c, b, &rows[i], &rows[i + 1], 0); /* a node at a branch end */
             else if (v0 && v1 && hm_gap(c, b, &rows[i + 1]) < near)
-                hm_fold_piece(c, b, &rows[i + 1], &rows[i]);
+                hm_fold_piece(c, b, &rows[i + 1], &rows[i], 0);
             else if (v0 && v1)
                 hm_cell(c, b, &rows[i], &rows[i + 1], 0);
             else if (v0 != v1)
@@ -2315,6 +2383,7 @@ static void hm_range(void *ctx, long b0, long e0)
         c->fast = hm_fast_setup(c);
         c->full_fk = 0;
         c->jumped = 0;
+        c->sq_te = NAN;
         c->njump = 0;
         c->retry = 0;
         if (P[PK_CASE] == PK_BOTH || c->k < 0 || c->n != 7)
