@@ -934,7 +934,7 @@ RANGE_ENDS = [
 @pytest.mark.parametrize("q", RANGE_ENDS)
 def test_a_corner_at_the_range_end_is_a_one_point_interval(q):
     # Issue 29, session 11 (helper r7end30): the continued family's rows within 1e-9 of
-    # a limit get the held family's refining step (_held_polish), so the range end's
+    # a limit get the held family's refining step (LimitPolish), so the range end's
     # corner rule (self_motion_intervals._touches) sees the row inside. Oracles:
     # reference.assert_corner_listed (q alone in the limits on its branch, outside at
     # t +- 1e-6, an interval at most 1e-9 long holds t, its row inside and exact), the

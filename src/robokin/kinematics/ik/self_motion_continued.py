@@ -35,7 +35,7 @@ module continues them into branches (issue 29):
    ``degenerate`` manifold only cells whose tracks are regular (the held 6 x 6's
    smallest singular value at least ``_REGULAR`` at the node rows and the followed
    rows) are followed: a near-continuum's rows are solved (round 7c). Rows of both
-   within 1e-9 of a limit get the held family's refining step (``_held_polish``):
+   within 1e-9 of a limit get the held family's refining step (``LimitPolish``):
    a membership decided within rounding of the slack (issue 29, session 11).
 4. **Limits on the branch.** Per track, cell and joint, the cubic Hermite model
    sampled at ``_SUB`` sub-values brackets each crossing of a limit (and of an
@@ -59,7 +59,7 @@ midpoints (``self_motion_intervals._intervals``).
 
 from __future__ import annotations
 
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 
@@ -67,7 +67,7 @@ from robokin._native import kernels as _K
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.fixed import Dispatch, EndSweep, _all_last, solve_fixed
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
-from robokin.kinematics.ik.self_motion_families import _held_polish, _HeldFamily
+from robokin.kinematics.ik.self_motion_polish import LimitPolish
 from robokin.kinematics.jacobian import jacobian_and_pose
 from robokin.spatial import pose_error
 
@@ -165,15 +165,8 @@ class _ContinuedFamily(_Family):
         self.name = robot.joint_names[j]
         self.domain = (float(robot.limits[j, 0]), float(robot.limits[j, 1]))
         self.T = np.ascontiguousarray(T, dtype=np.float64)
-        # what the held family's refinement of rows next to a limit reads
-        # (``_held_polish``, :meth:`_refined`): every joint's (mid, half) of its
-        # limits (the parameter never refined), the free joints, T repeated
-        lim = np.asarray(robot.limits, dtype=np.float64)
-        half = 0.5 * (lim[:, 1] - lim[:, 0])
-        half[j] = np.inf
-        self.band = (0.5 * (lim[:, 0] + lim[:, 1]), half)
-        self.free = np.delete(np.arange(robot.n), j)
-        self.poses = np.zeros((0, 4, 4))
+        #: rows within 1e-9 of a limit refined on the pose (:meth:`_refined`)
+        self.polisher = LimitPolish(robot, j, self.T)
         self.solves = 0
         self._island_cells: list[tuple[float, float]] = []  # cells where _islands found one
         # the end joint's sweep set up once per pose (None: a middle joint, solve_fixed)
@@ -351,7 +344,7 @@ class _ContinuedFamily(_Family):
         return out, valid, np.zeros_like(valid)
 
     def _refined(self, Q: np.ndarray, valid: np.ndarray) -> None:
-        """Rows Q (M, k, n) within 1e-9 of a limit refined in place (``_held_polish``).
+        """Rows Q (M, k, n) within 1e-9 of a limit refined in place (``LimitPolish``).
 
         A row reproducing the pose to ~5e-15 (``_polish``'s and ``_follow``'s
         stop) is off by that over the held 6 x 6's smallest singular value: the
@@ -361,8 +354,7 @@ class _ContinuedFamily(_Family):
         on the pose with t held, where it is short (the held family's bounds: a
         step of a singular row is not taken), brings them to ~2e-13.
         """
-        # the held family's refinement, its attributes mirrored here (band, free, poses)
-        _held_polish(cast(_HeldFamily, self), Q, valid, np.zeros_like(valid))
+        self.polisher(Q, valid, np.zeros_like(valid))
 
     def sample_rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``rows(t)``, each branch followed from its nodes where that is certified.

@@ -21,6 +21,7 @@ from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, Derived
 from robokin.kinematics.ik.fixed import Dispatch, solve_held_one
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
+from robokin.kinematics.ik.self_motion_polish import LimitPolish
 from robokin.kinematics.ik.swivel import SwivelArm, swivel_arm
 
 _TWO_PI = 2 * np.pi
@@ -126,21 +127,14 @@ class _HeldFamily(_JointFamily):
             named = (robot.joint_names[j], (lo, hi))
         self.name, self.domain = named
         self.T = T
-        lim = np.asarray(robot.limits, dtype=np.float64)
-        half = 0.5 * (lim[:, 1] - lim[:, 0])
-        half[j] = np.inf  # the parameter: never refined for it
-        #: (mid, half) of every joint's limits (``_held_polish``'s test)
-        self.band = (0.5 * (lim[:, 0] + lim[:, 1]), half)
-        #: the joints a refining step moves (all but the parameter)
-        self.free = np.delete(np.arange(robot.n), j)
-        #: T repeated (r, 4, 4) for the refining steps' pose errors (grown as needed)
-        self.poses = np.zeros((0, 4, 4))
+        #: rows next to a limit refined on the pose; T repeated for the kernel calls
+        self.polisher = LimitPolish(robot, j, T)
         #: the kernel's preferred coordinates at singularities (``raw_solve``'s default)
         self.qn = np.zeros((1, robot.n))
         #: the kernel's rows (Q (8, n), valid, singular (8,)) of kept values, by t's bits
         self.kept: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self.kept_shape: tuple[int, ...] = (8, robot.n)
-        #: rows near a limit refined (``_held_polish``); off once the compiled kernel
+        #: rows near a limit refined (``polisher``); off once the compiled kernel
         #: certified the manifold: its crossings and ends are on the unrefined rows,
         #: and a refined row there moves by up to ~6e-12 (the Panda), past the slack
         self.polish = True
@@ -148,12 +142,13 @@ class _HeldFamily(_JointFamily):
     def _solved(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The closed form's Q (m, 8, n), valid, singular (m, 8) at t (m,) contiguous float64.
 
-        The pose repeated from ``poses`` (kept, grown as needed), not broadcast and
+        The pose repeated from ``polisher.repeated`` (kept, grown as needed), not broadcast and
         copied per call.
         """
         from robokin.kinematics.ik.analytic import pieper as pk
 
-        Q, valid, sing, _, _ = pk.raw_solve(self.params, self._repeated(len(t)), t, self.qn)
+        Q, valid, sing, _, _ = pk.raw_solve(self.params, self.polisher.repeated(len(t)), t,
+                                            self.qn)
         return Q, valid, sing
 
     def _distinct(self, t: np.ndarray, keep: bool = False
@@ -190,12 +185,6 @@ class _HeldFamily(_JointFamily):
                 kept[x] = (Q[k], valid[k], sing[k])
         return Q, valid, sing, i
 
-    def _repeated(self, m: int) -> np.ndarray:
-        """T repeated (m, 4, 4), C-contiguous (a slice of ``poses``, grown as needed)."""
-        if len(self.poses) < m:
-            self.poses = np.ascontiguousarray(np.broadcast_to(self.T, (max(2 * m, 64), 4, 4)))
-        return self.poses[:m]
-
     def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
         if len(t) > _KEPT:  # the grid: its values are distinct, and not kept
@@ -207,12 +196,12 @@ class _HeldFamily(_JointFamily):
         Q[~valid] = np.nan
         Q = _into_limits(self.robot, Q)
         if self.polish:
-            _held_polish(self, Q, valid, sing)
+            self.polisher(Q, valid, sing)
         return Q, valid, sing
 
     def slot_rows(self, t: np.ndarray, b: np.ndarray, read: np.ndarray | None = None
                   ) -> tuple[np.ndarray, np.ndarray]:
-        """``rows(t)``'s slot b[i] at t[i], only those rows refined (``_held_polish``).
+        """``rows(t)``'s slot b[i] at t[i], only those rows refined (``polisher``).
 
         The bisections read one slot per value (a fold's only its validity: ``read``
         False, not refined); refining every slot of every value was most of the
@@ -235,11 +224,11 @@ class _HeldFamily(_JointFamily):
         if not self.polish:
             return q, v
         if read is None or read.all():
-            _held_polish(self, q[:, None], v[:, None], sing[i, b][:, None])
+            self.polisher(q[:, None], v[:, None], sing[i, b][:, None])
         else:
             r = np.flatnonzero(read)
             qr = q[r]
-            _held_polish(self, qr[:, None], v[r, None], sing[i[r], b[r], None])
+            self.polisher(qr[:, None], v[r, None], sing[i[r], b[r], None])
             q[r] = qr
         return q, v
 
@@ -247,93 +236,6 @@ class _HeldFamily(_JointFamily):
 #: Values whose kernel rows a held family keeps (``_HeldFamily._distinct``): a call
 #: with more (the checking grid) is neither kept nor looked up.
 _KEPT = 256
-
-
-#: Rows within this of a limit [rad] are refined (``_held_polish``): a membership
-#: decided within rounding of the slack.
-_POLISH_NEAR = 1e-9
-#: A refining step longer than this [rad], or than ``_POLISH_GAIN`` times the pose
-#: error, is not taken: a singular row (its held Jacobian's smallest singular value
-#: below 1e-4, the rates script's regular threshold), whose joints the pose does not
-#: fix to that; the regular rows it is for move by <= 5e-10.
-_POLISH_STEP = 1e-8
-_POLISH_GAIN = 1e4
-
-
-try:  # np.linalg.solve's own gufunc (private to numpy; its wrapper costs ~20 us a call)
-    from numpy.linalg import _umath_linalg as _linalg_gufuncs
-except ImportError:  # pragma: no cover - a numpy without it: the public wrapper
-    _linalg_gufuncs = None  # type: ignore[assignment]
-
-
-def _solve_stacked(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``np.linalg.solve(A, b)`` for float64 stacks A (m, k, k), b (m, k, 1).
-
-    Raises ``np.linalg.LinAlgError`` where a matrix is exactly singular, as the
-    public function does; the gufunc directly where numpy has it (``_held_polish``'s
-    calls are ~25 us through the wrapper, ~5 us without).
-    """
-    if _linalg_gufuncs is None:
-        return np.linalg.solve(A, b)
-    with np.errstate(invalid="raise", over="ignore", divide="ignore", under="ignore"):
-        try:
-            out: np.ndarray = _linalg_gufuncs.solve(A, b, signature="dd->d")
-        except FloatingPointError:
-            raise np.linalg.LinAlgError("Singular matrix") from None
-    return out
-
-
-def _held_polish(fam: _HeldFamily, Q: np.ndarray, valid: np.ndarray, sing: np.ndarray) -> None:
-    """Rows Q (m, k, n) within ``_POLISH_NEAR`` of a limit refined in place on the pose.
-
-    The closed form keeps a row whose pose error is below ``PK_EXACT`` (1e-13):
-    where its held Jacobian is nearly singular the joints are off by that over its
-    smallest singular value (the rtb-data iiwa14 with the elbow stretched: 1e-14 to
-    9e-14 at 1.7e-4, up to 5e-10 rad), more than ``MANIFOLD_SLACK``, so a joint at its
-    limit moving 1e-8 to 1e-4 rad per rad of t was in and out at random and the
-    crossings computed 1e-9 to 1e-7 off (issue 29, helper corner29). One Newton step
-    on the pose with the parameter held (the 6 x 6 Jacobian of the other joints),
-    taken where it is at most ``_POLISH_STEP`` and ``_POLISH_GAIN`` times the error
-    (its second-order error ~1e-16: not checked). Valid rows not flagged singular
-    only; the test costs ~10 us per call where no row is near.
-    """
-    mid, half = fam.band
-    with np.errstate(invalid="ignore"):
-        d = np.subtract(Q, mid)
-        np.abs(d, out=d)
-        d -= half
-        np.abs(d, out=d)
-        near = d <= _POLISH_NEAR
-    if not near.any():
-        return
-    pick = near.any(axis=-1)
-    pick &= valid
-    pick &= ~sing
-    idx = np.nonzero(pick)
-    if not len(idx[0]):
-        return
-    from robokin._native import kernels
-    from robokin.kinematics.jacobian import jacobian_and_pose
-
-    q = Q[idx]
-    J, P = jacobian_and_pose(fam.robot.chain, q)
-    if len(fam.poses) < len(q):  # the pose repeated, contiguous (grown as needed)
-        fam.poses = np.ascontiguousarray(np.broadcast_to(fam.T, (2 * len(q), 4, 4)))
-    e = np.empty((len(q), 6))
-    kernels.pose_error(P, fam.poses[:len(q)], e)
-    try:
-        step = _solve_stacked(J[:, :, fam.free], e[..., None])[..., 0]
-    except np.linalg.LinAlgError:  # an exactly singular one: none is refined
-        return
-    size = np.abs(step).max(axis=-1)
-    small = (size <= _POLISH_STEP) & (size <= _POLISH_GAIN * np.abs(e).max(axis=-1))
-    if small.all():  # (the usual case: no rows to pick)
-        q[:, fam.free] += step
-        Q[idx] = q
-        return
-    trial = q[small]
-    trial[:, fam.free] += step[small]
-    Q[tuple(x[small] for x in idx)] = trial
 
 
 def _shift_into(t: float, domain: tuple[float, float]) -> float | None:
