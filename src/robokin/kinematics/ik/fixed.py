@@ -520,18 +520,8 @@ class MidHeld:
         """
         Q, valid, _, sigma, _, _, _ = _g6.raw_solve(self.reduced.chain, self.params,
                                                    np.ascontiguousarray(T)[None])
-        v = valid[0]
-        q = np.full((len(v), robot.n), np.nan)
-        q[:, self.keep] = Q[0]
-        q[:, self.j] = self.value
-        q[~v] = np.nan
-        lim = robot.limits
-        with np.errstate(invalid="ignore"):
-            inside = _all_last((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9))
-        sols = SolutionSet._trusted(q, v, robot.is_revolute, lim,
-                                    {"singular": (sigma[0] < 1e-6) & v, "within_limits": inside},
-                                    {}, np.empty((), dtype=object), "", None, {})
-        return _into_limits(robot, self.j, T[None], np.array([self.value]), sols)
+        return _held_set(robot, self.j, self.keep, np.array(self.value), T[None], Q[0],
+                         valid[0], sigma[0])
 
 
 #: Per arm: (middle joint, value) -> :class:`MidHeld` (or None), filled on first use.
@@ -626,17 +616,40 @@ class EndSweep:
         Tm = np.ascontiguousarray(_move(Tb, values, self.last, self.C, self.C_inv,
                                         joint.kind, joint.sign))
         Q, valid, _, sigma, _, _, stats = _g6.raw_solve(self.reduced.chain, self.params, Tm)
-        q = np.full(Q.shape[:-1] + (robot.n,), np.nan)
-        q[..., self.cols] = Q
-        q[..., j] = values[:, None]
-        q[~valid] = np.nan  # as SolutionSet does with rows that are not valid
-        lim = robot.limits
-        inside = _all_last((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9))
-        sols = SolutionSet._trusted(q, valid, robot.is_revolute, lim,
-                                    {"singular": (sigma < 1e-6) & valid,
-                                     "within_limits": inside},
-                                    {}, np.empty(M, dtype=object), "", None, {})
-        return _into_limits(robot, j, Tb, values, sols), stats[:, 4:].reshape(M, -1, 2)
+        sols = _held_set(robot, j, self.cols, values, Tb, Q, valid, sigma)
+        return sols, stats[:, 4:].reshape(M, -1, 2)
+
+
+def _held_set(robot: Arm, j: int, cols: list[int] | np.ndarray, values: np.ndarray,
+              T: np.ndarray, Q: np.ndarray, valid: np.ndarray, sigma: np.ndarray
+              ) -> SolutionSet:
+    """The set of a reduced chain's general 6R rows with joint j held, as :func:`solve_fixed`'s.
+
+    The rows (NaN where not valid) with the held column, ``within_limits`` by
+    :class:`SolutionSet`'s test (1e-9) on the whole row, ``singular`` the kernel's
+    sigma below 1e-6, then :func:`_into_limits` (``status``, ``method`` and ``info``
+    not filled in). Shared by :meth:`MidHeld.solve` and :meth:`EndSweep.solve_pairs`.
+
+    Args:
+        robot: The arm (7R).
+        j: The held joint's index.
+        cols: The whole arm's columns of the reduced chain's joints (n - 1,).
+        values: The held values, shape L (() for one pose, (M,) for a sweep) [rad].
+        T: The poses (prod(L), 4, 4) [m] (for :func:`_into_limits`).
+        Q: The reduced chain's rows (*L, k, n - 1) [rad].
+        valid: (*L, k) bool.
+        sigma: The kernel's smallest singular values (*L, k).
+    """
+    q = np.full(Q.shape[:-1] + (robot.n,), np.nan)
+    q[..., cols] = Q
+    q[..., j] = values[..., None]
+    q[~valid] = np.nan  # as SolutionSet does with rows that are not valid
+    lim = robot.limits
+    inside = _all_last((q >= lim[:, 0] - 1e-9) & (q <= lim[:, 1] + 1e-9))
+    sols = SolutionSet._trusted(q, valid, robot.is_revolute, lim,
+                                {"singular": (sigma < 1e-6) & valid, "within_limits": inside},
+                                {}, np.empty(values.shape, dtype=object), "", None, {})
+    return _into_limits(robot, j, T, values.reshape(-1), sols)
 
 
 def _all_last(b: np.ndarray) -> np.ndarray:
