@@ -79,3 +79,25 @@ def test_the_parameter_at_its_limit_is_never_moved_and_repeated_grows():
     R = pol.repeated(100)
     assert R.shape == (100, 4, 4) and R.flags.c_contiguous and np.array_equal(R[57], T)
     assert len(pol.repeated(3)) == 3 and len(pol.poses) >= 100
+
+
+def test_a_floor_leaves_rows_next_to_a_singular_configuration_alone():
+    # The continued family has no singular flags: its LimitPolish takes a floor on the
+    # held 6 x 6's smallest singular value (REGULAR_FLOOR, issue 29's regular rows).
+    # The Panda with q2 = 1e-4 (axes 1 and 3 nearly on one line: sigma 1.4e-5) and q4
+    # at its limit: a row 1e-12 off is refined without the floor and left bit for bit
+    # with it; the regular row at limits (sigma 0.11) is refined either way.
+    from robokin.kinematics.ik.self_motion_polish import REGULAR_FLOOR
+
+    robot = robokin.load("panda")
+    lim = robot.limits
+    near = np.array([0.3, 1e-4, -0.4, lim[3, 0], 0.5, 1.9, 0.7])
+    _, regular = _panda_at_limits()
+    for q, singular in ((near, True), (regular, False)):
+        T = robot.fk(q)
+        for floor in (0.0, REGULAR_FLOOR):
+            rows = _off(robot, q, 1e-12, 5)[None, None]
+            want = rows.copy()
+            LimitPolish(robot, 6, T, floor)(rows, np.ones((1, 1), bool),
+                                            np.zeros((1, 1), bool))
+            assert np.array_equal(rows, want) == (singular and floor > 0), (q[1], floor)

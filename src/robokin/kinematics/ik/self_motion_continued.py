@@ -67,7 +67,7 @@ from robokin._native import kernels as _K
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.fixed import Dispatch, EndSweep, _all_last, solve_fixed
 from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
-from robokin.kinematics.ik.self_motion_polish import LimitPolish
+from robokin.kinematics.ik.self_motion_polish import REGULAR_FLOOR, LimitPolish
 from robokin.kinematics.jacobian import jacobian_and_pose
 from robokin.spatial import pose_error
 
@@ -166,7 +166,7 @@ class _ContinuedFamily(_Family):
         self.domain = (float(robot.limits[j, 0]), float(robot.limits[j, 1]))
         self.T = np.ascontiguousarray(T, dtype=np.float64)
         #: rows within 1e-9 of a limit refined on the pose (:meth:`_refined`)
-        self.polisher = LimitPolish(robot, j, self.T)
+        self.polisher = LimitPolish(robot, j, self.T, REGULAR_FLOOR)  # (no singular flags)
         self.solves = 0
         self._island_cells: list[tuple[float, float]] = []  # cells where _islands found one
         # the end joint's sweep set up once per pose (None: a middle joint, solve_fixed)
