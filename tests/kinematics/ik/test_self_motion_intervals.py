@@ -849,6 +849,14 @@ def test_the_iiwa_parameter_next_to_zero_keeps_q_in_an_interval_of_its_branch(q)
     _assert_iiwa_q_in_an_interval(q)
 
 
+#: The rtb-data iiwa14's special #6379 (benchmarks/self_motion_rates.py, seed 0, n
+#: 10,000): joint_a1 and joint_a2 at their limits, q4 = 1e-9, rows next to a limit.
+IIWA_6379 = [2.9668, -2.0942, 1e-07, 1e-09, -0.34442118632710983, 0.28861094459290904,
+             -1e-06]
+#: Offsets of the parameter [rad] either side of a configuration's own value (0 included).
+ABOUT = np.array([-1e-6, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-6])
+
+
 @pytest.mark.parametrize("q", [
     # joint_a6 at its limit grazing it (|dq6/dt| ~ 1e-8) with the elbow stretched
     # (q4 = -1e-7) next to the aligned point at t = -9.99e-7 (#6050): the rows 1e-12 to
@@ -875,7 +883,7 @@ def test_the_iiwa_parameter_next_to_zero_keeps_q_in_an_interval_of_its_branch(q)
     # conditioning": its rows 3e-11 out about q's value were the rows' error; refined,
     # joint_a2 stays within 2.5e-13 of its limit for t in q's value - [0, 1e-5] and
     # joint_a1 crosses at q's value: q ends an interval ~1e-7 long, not a point)
-    [2.9668, -2.0942, 1e-07, 1e-09, -0.34442118632710983, 0.28861094459290904, -1e-06],
+    IIWA_6379,
 ])
 def test_the_iiwa_stretched_elbow_at_a_limit_keeps_q_in_an_interval_of_its_branch(q):
     # Issue 29 (helper corner29): the 7 regular special configurations of
@@ -894,8 +902,7 @@ def _assert_iiwa_q_in_an_interval(q) -> None:
     sm, t, b = _generating(robot, q0)
     iv = sm.intervals[sm.interval_branch == b]
     assert np.any((iv[:, 0] - 1e-9 <= t) & (t <= iv[:, 1] + 1e-9)), (t, iv)
-    d = np.array([-1e-6, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-6])
-    ts = np.unique(np.clip(np.concatenate([t + d, [0.0]]), *sm.domain))
+    ts = np.unique(np.clip(np.concatenate([t + ABOUT, [0.0]]), *sm.domain))
     rows = sm.sample(ts)
     ok = np.isfinite(rows).all(axis=-1)
     assert ok.sum() >= len(ts)
@@ -949,12 +956,11 @@ def test_the_held_rows_of_one_slot_are_the_rows_of_that_slot():
     # (q4 ~ 0, joint_a2 at its limit: rows next to a limit are refined there); and
     # the unrefined rows (fam.polish off) differ on some of them, so the refinement ran.
     robot = _arm("iiwa")
-    q0 = np.array([2.9668, -2.0942, 1e-07, 1e-09, -0.34442118632710983,
-                   0.28861094459290904, -1e-06])
+    q0 = np.array(IIWA_6379)
     sm, t, _ = _generating(robot, q0)
     fam = sm._family
     assert fam.polish  # the solved-points path: not certified by the kernel
-    ts = t + np.array([-1e-6, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-6])
+    ts = t + ABOUT
     full, valid, _ = fam.rows(ts)
     i = np.arange(len(ts))
     refined = 0
@@ -985,8 +991,7 @@ def test_held_rows_solved_once_per_value_are_each_values_own_rows():
     from robokin.kinematics.ik.self_motion_families import _HeldFamily
 
     robot = _arm("iiwa")
-    q0 = np.array([2.9668, -2.0942, 1e-07, 1e-09, -0.34442118632710983,
-                   0.28861094459290904, -1e-06])
+    q0 = np.array(IIWA_6379)
     sm, t, _ = _generating(robot, q0)
     fam = sm._family
 
@@ -994,7 +999,7 @@ def test_held_rows_solved_once_per_value_are_each_values_own_rows():
         return _HeldFamily(fam.robot, fam.params, fam.joint, fam.T, fam.dispatch,
                            (fam.name, fam.domain))
 
-    ts = t + np.array([-1e-6, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-6])
+    ts = t + ABOUT
     alone = [fresh().rows(np.array([x])) for x in ts]  # (q (1, k, n), valid, singular)
     rng = np.random.default_rng(3)
     fam2 = fresh()
