@@ -1029,6 +1029,14 @@ def test_held_rows_solved_once_per_value_are_each_values_own_rows():
             np.testing.assert_array_equal(valid[x], va[0])
             np.testing.assert_array_equal(sing[x], sa[0])
     assert solved == [len(ts)] * 3
+    # the user's values (sample, inside) are solved directly, even where kept, the
+    # same rows bit for bit, and kept nowhere
+    kept = dict(fam2.kept)
+    Qs, vs, _ = fam2.sample_rows(ts[pick])
+    assert solved == [len(ts)] * 3 + [len(pick)] and fam2.kept.keys() == kept.keys()
+    for x, p in enumerate(pick):
+        np.testing.assert_array_equal(Qs[x].view(np.int64), alone[p][0][0].view(np.int64))
+        np.testing.assert_array_equal(vs[x], alone[p][1][0])
     fam2.polish = False  # the rows compared were refined ones (next to a limit)
     raw, _, _ = fam2.rows(ts)
     refined = int((np.isfinite(Q) & (raw != Q)).any(axis=-1).sum())
