@@ -18,6 +18,10 @@ from robokin.collision import Scene, scene_path
 
 pytest.importorskip("coal")
 
+# The time limit of a query that must succeed: far above what it takes, so a slow or
+# loaded machine cannot fail it (the planner stops at its first path)
+AMPLE = ["--time-limit", "30"]
+
 
 @pytest.fixture(scope="module")
 def press():
@@ -33,7 +37,7 @@ def test_plan_between_named_poses_writes_the_trajectory_and_plot(press, tmp_path
     sc, robot = press
     out = tmp_path / "run"
     code = main(["plan", "press", "--start", "pick_approach", "--goal", "press_approach",
-                 "--out", str(out), "--clearance", "4"])
+                 "--out", str(out), "--clearance", "4", *AMPLE])
     text, err = capsys.readouterr()
     assert code == 0, err
     assert "path found by rrtconnect" in text and "every step proven collision-free" in text
@@ -51,7 +55,7 @@ def test_plan_between_named_poses_writes_the_trajectory_and_plot(press, tmp_path
     assert code == 2 and "--out" in err and "--force" in err
     assert (out / "plan.csv").read_bytes() == before
     code = main(["plan", "press", "--start", "pick_approach", "--goal", "pick",
-                 "--out", str(out), "--force", "--no-plot", "--json"])
+                 "--out", str(out), "--force", "--no-plot", "--json", *AMPLE])
     text, err = capsys.readouterr()
     assert code == 0, err
     doc = json.loads(text)
@@ -67,7 +71,7 @@ def test_a_goal_pose_in_degrees_and_millimetres_ends_at_that_pose(press, tmp_pat
     q0 = np.degrees(sc.pose_joints["pick_approach"])
     code = main(["plan", "press", "--start", *map(str, q0), "--deg", "--mm",
                  "--goal-pose", "420", "0", "450", "90", "0", "90", "--out",
-                 str(tmp_path), "--json", "--no-plot"])
+                 str(tmp_path), "--json", "--no-plot", *AMPLE])
     text, err = capsys.readouterr()
     assert code == 0, err
     doc = json.loads(text)
@@ -101,7 +105,7 @@ def test_no_path_is_exit_1_with_the_reason(tmp_path, capsys):
 def test_bad_input_is_exit_2_naming_the_option(args, option, tmp_path, capsys):
     if option is None:  # the well-formed call of this table, for contrast
         code = main(["plan", "press", "--start", "pick_approach", *args, "--out",
-                     str(tmp_path), "--no-plot"])
+                     str(tmp_path), "--no-plot", *AMPLE])
         assert code == 0
         return
     code = main(["plan", "press", "--start", "pick_approach", *args, "--out",

@@ -45,7 +45,7 @@ def test_the_path_passes_the_uncached_pinocchio_coal_recheck(robots, key):
     assert all(r.gjk_initial_guess == coal.GJKInitialGuess.DefaultGuess
                for r in checker.gdata.collisionRequests)
     res = planning.Planner(robots[p.robot], p.scene()).plan(p.start, p.goal, seed=0,
-                                                             time_limit=5.0)
+                                                             time_limit=30.0)
     assert res.success, res.reason
     rc = plan_baseline.recheck_path(p, np.asarray(res.q), checker=checker)
     assert rc.valid, (rc.reason, rc.segment, rc.where)
@@ -57,7 +57,7 @@ def test_a_pose_goal_path_ends_at_the_pose_by_pinocchio(robots, family):
     p = FIRST[("ur5_gripper", family)]
     checker = plan_baseline.checker_for(p)
     res = planning.Planner(robots[p.robot], p.scene()).plan(p.start, p.goal_pose, seed=0,
-                                                             time_limit=5.0)
+                                                             time_limit=30.0)
     assert res.success, res.reason
     rc = plan_baseline.recheck_path(p, np.asarray(res.q), checker=checker, goal="pose")
     assert rc.valid, (rc.reason, rc.segment, rc.where)
