@@ -12,6 +12,7 @@ import multiprocessing
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -185,3 +186,28 @@ def test_robokin_isa_beyond_this_cpu_warns():
         assert "ROBOKIN_ISA" not in res.stderr
     else:  # pragma: no cover - depends on the CPU
         assert f"has no avx512 copy; using {best}" in res.stderr
+
+
+@pytest.mark.parametrize("module, runs", [("_avx2", "cpu_has_avx2_fma"),
+                                          ("_avx512", "cpu_has_avx512")])
+def test_a_copy_this_cpu_cannot_run_refuses_to_import_and_does_not_crash(module, runs):
+    # A documentation tool (mkdocs' griffe) imports every submodule; the AVX-512 copy's
+    # init once ran zmm moves before any check and killed it with SIGILL on a CPU
+    # without AVX-512. Now: it imports where the CPU runs it, else an ImportError
+    # naming the copy; in a fresh process, so a crash fails the test instead of pytest.
+    code = (f"import robokin._native._base as b, robokin._native.{module} as m; "
+            "print(m.ISA, m.cpu_has_avx2_fma())")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=False)
+    isa = {"_avx2": "avx2+fma", "_avx512": "avx512"}[module]
+    built = any(p.name.startswith(module + ".")
+                for p in Path(_native.__file__).parent.iterdir())
+    if not built:  # pragma: no cover - an install without that copy
+        assert res.returncode == 1 and "ModuleNotFoundError" in res.stderr
+    elif getattr(_native.kernels, runs)():
+        assert res.returncode == 0, res.stderr
+        assert res.stdout.split() == [isa, "True"]
+    else:
+        assert res.returncode == 1, (res.returncode, res.stderr)
+        assert (f"ImportError: robokin._native.{module} is the {isa} copy of robokin's "
+                "kernels and this CPU does not run it") in res.stderr

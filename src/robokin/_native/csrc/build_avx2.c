@@ -3,4 +3,5 @@
 #define MODULE_NAME "_avx2"
 #define MODULE_INIT PyInit__avx2
 #define ISA_NAME "avx2+fma"
+#define ISA_RUNS cpu_runs_avx2_fma()
 #include "module.c"

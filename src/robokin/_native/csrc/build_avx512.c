@@ -4,4 +4,5 @@
 #define MODULE_NAME "_avx512"
 #define MODULE_INIT PyInit__avx512
 #define ISA_NAME "avx512"
+#define ISA_RUNS cpu_runs_avx512()
 #include "module.c"

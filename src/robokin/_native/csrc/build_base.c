@@ -2,4 +2,5 @@
 #define MODULE_NAME "_base"
 #define MODULE_INIT PyInit__base
 #define ISA_NAME "baseline"
+#define ISA_RUNS 1
 #include "module.c"

@@ -290,29 +290,47 @@ static PyObject *set_num_threads_body(const set_num_threads_args *a)
     return PyLong_FromLong(pool_threads());
 }
 
+/* The code that runs before a copy knows the CPU runs it (the CPU tests and the
+ * module's init) is compiled for the baseline: without it the AVX-512 copy's init
+ * filled its constants table with zmm moves, and importing that copy on a CPU without
+ * AVX-512 (a documentation tool importing every submodule does) died of SIGILL. */
+#if defined(__GNUC__) && defined(__x86_64__)
+#define BASELINE_CODE __attribute__((target("no-avx")))
+#else
+#define BASELINE_CODE
+#endif
+
+BASELINE_CODE static int cpu_runs_avx2_fma(void)
+{
+#if defined(__GNUC__) && defined(__x86_64__)
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+#else
+    return 0;
+#endif
+}
+
+BASELINE_CODE static int cpu_runs_avx512(void)
+{
+#if defined(__GNUC__) && defined(__x86_64__)
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+           __builtin_cpu_supports("avx512vl") && cpu_runs_avx2_fma();
+#else
+    return 0;
+#endif
+}
+
 static PyObject *cpu_has_avx2_fma_body(const cpu_has_avx2_fma_args *a)
 {
     (void)a;
-#if defined(__GNUC__) && defined(__x86_64__)
-    __builtin_cpu_init();
-    return PyBool_FromLong(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"));
-#else
-    Py_RETURN_FALSE;
-#endif
+    return PyBool_FromLong(cpu_runs_avx2_fma());
 }
 
 static PyObject *cpu_has_avx512_body(const cpu_has_avx512_args *a)
 {
     (void)a;
-#if defined(__GNUC__) && defined(__x86_64__)
-    __builtin_cpu_init();
-    return PyBool_FromLong(__builtin_cpu_supports("avx512f") &&
-                           __builtin_cpu_supports("avx512dq") &&
-                           __builtin_cpu_supports("avx512vl") &&
-                           __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"));
-#else
-    Py_RETURN_FALSE;
-#endif
+    return PyBool_FromLong(cpu_runs_avx512());
 }
 
 #include "kernels_entry.gen.h"
@@ -321,8 +339,17 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, MODULE_NAME,
                                     "robokin's compiled kernels (" ISA_NAME ").", -1,
                                     kernel_methods, NULL, NULL, NULL, NULL};
 
-PyMODINIT_FUNC MODULE_INIT(void)
+/* ISA_RUNS (build_*.c): whether this CPU runs this copy; an import of a copy it
+ * does not run is an ImportError naming the copy, before any of its instructions. */
+BASELINE_CODE PyMODINIT_FUNC MODULE_INIT(void)
 {
+    if (!(ISA_RUNS)) {
+        PyErr_Format(PyExc_ImportError,
+                     "robokin._native.%s is the %s copy of robokin's kernels and this "
+                     "CPU does not run it; `import robokin` picks the copy the CPU runs",
+                     MODULE_NAME, ISA_NAME);
+        return NULL;
+    }
     import_array();
     PyObject *m = PyModule_Create(&module);
     if (m == NULL)
