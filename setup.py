@@ -59,7 +59,17 @@ def extension(name: str, source: str, extra: list[str]) -> Extension:
 
 
 class BuildExt(build_ext):
-    """``build_ext`` that first checks for a C compiler and the Python headers."""
+    """``build_ext`` that first checks for a C compiler and the Python headers.
+
+    The instruction-set copies compile side by side, one per core (``--parallel`` /
+    ``-j`` still chooses): each is the whole unity source, about a minute of one core.
+    """
+
+    def finalize_options(self) -> None:
+        """Default ``parallel`` to the cores, at most one per copy."""
+        super().finalize_options()
+        if not self.parallel:
+            self.parallel = max(1, min(len(self.extensions or []), os.cpu_count() or 1))
 
     def build_extensions(self) -> None:
         """Check the toolchain (unix compilers), then compile every extension."""
