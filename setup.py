@@ -37,12 +37,8 @@ HEADERS = [f"{CSRC}/{h}" for h in (
     "near_coincident.c", "module.c")]
 UNIX = sys.platform != "win32"
 # -fno-math-errno: sqrt inlines (and vectorises); no other fast-math licence
-# -ffp-contract=off: no a*b+c fused where the source does not say so, so the three
-#   copies compute the same bits on every CPU (with GCC's default, fast, the AVX2
-#   copy's IK differed in the last bits from the others' and lost three tested
-#   configurations next to singular ones; FK costs ~20 % more instructions)
 # -Wall -Wextra -Wshadow: the unity build compiles without a warning (keep it so)
-FLAGS = (["-O3", "-ffp-contract=off", "-fno-math-errno", "-Wno-psabi", "-Wall", "-Wextra", "-Wshadow"] if UNIX
+FLAGS = (["-O3", "-fno-math-errno", "-Wno-psabi", "-Wall", "-Wextra", "-Wshadow"] if UNIX
          else ["/O2"])
 LIBS = ["pthread"] if UNIX else []
 HOW = ("README.md, 'Installing', says what a source build needs; a wheel (built "

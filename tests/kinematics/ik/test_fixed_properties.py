@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 import robokin
-from reference import kernel_copies, pose_errors
+from reference import AVX2_FLOOR, kernel_copies, pose_errors
 from robokin.kinematics.ik.analytic import pieper
 
 hyp = pytest.importorskip("hypothesis")
@@ -431,6 +431,7 @@ def test_many_singular_rows_go_through_the_limit_repair(q):
 # errors 1e-11; the full Newton step overshot (error 1e-6) and the polish dropped
 # them; g6_refine halves such steps. Oracle: check_held (an in-limit row at a
 # singular in-limit q), and the row is q itself, flagged singular, exact.
+@AVX2_FLOOR
 def test_shoulder_held_lost_branch_next_to_singular():
     q = np.array([np.pi / 2, 1.4919118570754417, 1e-06, -2.914073131349491, np.pi / 2,
                   1e-06, -2.3771437465128407])
