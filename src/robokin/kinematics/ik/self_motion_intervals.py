@@ -466,9 +466,6 @@ def _join_wrap(pieces: list[tuple[int, float, float]], lo: float, hi: float
 
 
 _KINDS = ("lower", "upper", "aligned axes", "fold")  # HM_KIND_* 0-3
-#: A branch's interval slots in the kernel's output, and the 8 branches.
-_HM_SLOTS = np.arange(K.HM_MAXI)
-_HM_BRANCHES = np.arange(8)
 
 
 def _held_kernel(robot: Arm, fam: _HeldFamily) -> HeldKernel:
@@ -481,28 +478,25 @@ def _held_kernel(robot: Arm, fam: _HeldFamily) -> HeldKernel:
 
 
 def _compiled(kern: HeldKernel, T: np.ndarray, grid: int = KERNEL_GRID
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, Any], bool]:
     """A held-joint (Pieper) family's intervals and points by the compiled kernel.
 
     ``csrc/held_manifold.c``: a grid of the parameter with the rows' slopes dq/dt,
     crossings bracketed and refined by safeguarded Newton on q_j(t) - limit, folds
     bisected, pieces decided at their midpoints. Returns ``(intervals, owner,
-    points, info)``: the points are the kernel's rows ``[t, branch, joint, kind]``
+    points, info, close)``: the intervals (m, 2) by branch, then start, and their
+    branches (m,); the points are the kernel's rows ``[t, branch, joint, kind]``
     (``HM_KIND_*``; :func:`_held_records` makes the records when they are read);
     ``info["flags"]`` is nonzero when the kernel could not certify the pose (then
-    the caller takes the solved-points path).
+    the caller takes the solved-points path); ``close``: :func:`_points_refined`'s
+    cheap test, computed by the kernel (False: it has nothing to find). The arrays
+    are the kernel's own (``held_manifold_one``: packed in C, none built here).
     """
-    iv = np.empty((1, 8, K.HM_MAXI, 2))
-    niv = np.zeros((1, 8), dtype=np.int64)
-    pts = np.empty((1, K.HM_MAXP, 4))
-    npts, flags, evals = np.zeros((3, 1), dtype=np.int64)
-    K.held_manifold(kern.params, np.ascontiguousarray(T, dtype=np.float64)[None], kern.aligned,
-                    int(grid), iv, niv, pts, npts, flags, evals)
-    counts = niv[0]
-    intervals = iv[0][counts[:, None] > _HM_SLOTS]  # by branch, then start
-    info = {"bisected": 0, "grid": int(grid), "compiled": True, "flags": int(flags[0]),
-            "solves": int(evals[0])}
-    return intervals, _HM_BRANCHES.repeat(counts), pts[0, :npts[0]], info
+    intervals, owner, points, flags, evals, close = K.held_manifold_one(
+        kern.params, np.ascontiguousarray(T, dtype=np.float64), kern.aligned, int(grid))
+    info = {"bisected": 0, "grid": int(grid), "compiled": True, "flags": flags,
+            "solves": evals}
+    return intervals, owner, points, info, close
 
 
 def _held_records(points: np.ndarray) -> tuple[tuple[LimitCrossing, ...],
