@@ -359,6 +359,67 @@ def test_the_self_motion_setup_is_typed_derived_state_of_the_arm():
         assert other.derived(SELF_MOTION) is not setup
 
 
+def test_the_kernels_own_pose_test_takes_only_poses_check_rigid_leaves_as_they_are():
+    """The compiled Panda path tests T in its kernel, not by check_rigid (session 12).
+
+    Oracle: ``check_rigid`` itself. A pose the kernel takes (not None) is one
+    ``check_rigid`` returns as it is, over rotations off SO(3) by 1e-17 to 1e-12
+    (scaled, and perturbed by random matrices); poses it does not take (a rotation off
+    by 4e-15, which check_rigid leaves, and by 1e-13, which it projects; a Fortran
+    array, a list) give check_rigid's pose and the same manifold as the plain pose;
+    a subclass, float32, other shapes and a bad pose are not taken either, and a bad
+    pose is refused with check_rigid's error.
+    """
+    from robokin._validation import ROTATION_EXACT, check_rigid
+    from robokin.kinematics.ik.self_motion_families import SELF_MOTION
+    from robokin.kinematics.ik.self_motion_intervals import _compiled_unchecked
+
+    q0 = np.array([0.3, -0.4, 0.5, -1.6, 0.2, 1.7, 0.6])
+    T = PANDA.fk(q0)
+    plain = PANDA.self_motion(T)
+    kern = PANDA.arm.state[SELF_MOTION].held
+    assert plain.T is T and _compiled_unchecked(kern, T) is not None
+    rng = np.random.default_rng(7)
+    taken = refused = 0
+    for eps in np.geomspace(1e-17, 1e-12, 60):
+        for Tn in (T.copy(), T.copy()):
+            Tn[:3, :3] *= 1 - eps
+            Tn[:3, :3] += eps * rng.standard_normal((3, 3))
+            R = Tn[:3, :3]
+            off = np.abs(R.T @ R - np.eye(3)).max()
+            if _compiled_unchecked(kern, Tn) is not None:
+                assert check_rigid(Tn, "T") is Tn and off <= ROTATION_EXACT
+                taken += 1
+            else:
+                refused += 1
+    assert taken > 20 and refused > 20
+    # refused by the kernel: check_rigid's pose, the manifold of the same pose
+    leave, project = T.copy(), T.copy()
+    leave[:3, :3] *= 1 - 4e-15
+    project[:3, :3] *= 1 - 1e-13
+    for Tn in (leave, project):
+        assert _compiled_unchecked(kern, Tn) is None
+        sm = PANDA.self_motion(Tn)
+        assert np.array_equal(sm.T, check_rigid(Tn, "T"))
+        assert (sm.T is Tn) == (Tn is leave)
+        assert sm.info["compiled"] and len(sm.intervals) > 0
+    for Tn in (np.asfortranarray(T), T.tolist()):
+        assert _compiled_unchecked(kern, Tn) is None
+        sm = PANDA.self_motion(Tn)
+        for name in ("T", "intervals", "interval_branch", "domain", "limits"):
+            assert np.array_equal(getattr(sm, name), getattr(plain, name)), name
+        assert sm.info == plain.info and sm.crossings == plain.crossings
+    for Tn in (np.ma.masked_array(T), T.astype(np.float32), T[None], np.zeros((4, 3))):
+        assert _compiled_unchecked(kern, Tn) is None
+    bad = T.copy()
+    bad[0, 3] = np.nan
+    assert _compiled_unchecked(kern, bad) is None
+    with pytest.raises(InputError, match="T.*non-finite"):
+        PANDA.self_motion(bad)
+    with pytest.raises(InputError, match="one pose"):
+        PANDA.self_motion(T[None])
+
+
 def test_swivel_records_are_the_kernels_points_built_when_first_read():
     """Oracle: the compiled kernel's own point rows ``[psi, branch, joint, kind]``
     (``SwivelArm.manifold``): every limit row is one LimitCrossing, every other row one

@@ -2459,17 +2459,28 @@ static int hm_close(const double *pts, long long npts, const double *iv, long lo
  * packed branch by branch; returns new arrays (intervals (m, 2), branches (m,),
  * points (p, 4)), the flags, the pk_one calls and hm_close's flag (False:
  * _points_refined has nothing to find; False on a flagged pose, whose arrays are
- * empty but for the points found before the flag). */
+ * empty but for the points found before the flag). None, before any row, where T
+ * is not a C-contiguous aligned native float64 (4, 4) ndarray (a subclass neither),
+ * or, with exact > 0, where pose_problem finds it more than exact from orthonormal
+ * (or not rigid): the caller checks it (check_rigid) and calls again. */
 static PyObject *held_manifold_one_body(const held_manifold_one_args *a)
 {
     static const int stride = 2 * HM_MAXI;
+    PyArrayObject *ta = (PyArrayObject *)a->T;
+    if (!PyArray_CheckExact(a->T) || PyArray_TYPE(ta) != NPY_DOUBLE || PyArray_NDIM(ta) != 2 ||
+        PyArray_DIMS(ta)[0] != 4 || PyArray_DIMS(ta)[1] != 4 || !PyArray_IS_C_CONTIGUOUS(ta) ||
+        !PyArray_ISNOTSWAPPED(ta) || !PyArray_ISALIGNED(ta))
+        Py_RETURN_NONE;
+    const double *T = (const double *)PyArray_DATA(ta);
+    if (a->exact > 0.0 && pose_problem(T, POSE_ROW_TOL, a->exact))
+        Py_RETURN_NONE;
     double *iv = malloc((8 * 2 * HM_MAXI + 4 * HM_MAXP) * sizeof(double));
     if (iv == NULL)
         return PyErr_NoMemory();
     double *pts = iv + 8 * stride;
     long long niv[8] = {0}, npts = 0, flags = 0, evals = 0, m = 0; /* (hm_range sets niv
                                                                       * only where it runs hm_pose) */
-    HmJob jb = {a->params, a->T, a->aligned, (long)a->A, (long)a->grid, iv, pts, niv, &npts,
+    HmJob jb = {a->params, T, a->aligned, (long)a->A, (long)a->grid, iv, pts, niv, &npts,
                 &flags, &evals};
     Py_BEGIN_ALLOW_THREADS
     hm_range(&jb, 0, 1);

@@ -64,6 +64,7 @@ from robokin.kinematics.ik.self_motion_intervals import (
     GRID,
     _aligned_values,
     _compiled,
+    _compiled_unchecked,
     _exact_points,
     _grid,
     _held_kernel,
@@ -405,17 +406,21 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
             (the message lists the choices).
     """
     robot = arm_of(robot)
-    Ta = check_rigid(T, "T")
+    setup = _setup(robot) if robot.n == 7 and not reference else None
+    kern: HeldKernel | None = setup.held if setup is not None else None
+    if kern is not None and parameter not in ("auto", kern.named[0]):
+        kern = None  # another parameter (its family chosen below)
+    # the compiled held family "auto" took before: the kernel tests T itself (None:
+    # check_rigid's, below), then no family choice again
+    found = _compiled_unchecked(kern, T) if kern is not None else None
+    Ta = T if found is not None and isinstance(T, np.ndarray) else check_rigid(T, "T")
     if Ta.shape != (4, 4):
         raise InputError("T", f"self_motion takes one pose (4, 4), got {Ta.shape}")
     limits = np.asarray(robot.limits, dtype=np.float64)
-    setup = _setup(robot) if robot.n == 7 and not reference else None
     # the compiled swivel (an SRS arm's "auto"): no family choice, no per-call lists
     if setup is not None and setup.swivel is not None and parameter in ("auto", "swivel"):
         return _swivel_motion(setup.swivel, Ta, robot, limits)
-    kern: HeldKernel | None = setup.held if setup is not None else None
-    if kern is not None and parameter in ("auto", kern.named[0]):
-        # the compiled held family "auto" took before: no family choice again
+    if kern is not None:
         fam: _Family = _HeldFamily(robot, kern.params, kern.joint, Ta, dispatch, kern.named)
     else:
         fam = _family(robot, Ta, parameter, dispatch, reference)
@@ -424,7 +429,7 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
             setup.held = kern  # (not on SRS arms: their "auto" is the swivel)
     fallback: dict[str, Any] = {}
     if kern is not None:
-        intervals, owner, points, info, close = _compiled(kern, Ta)
+        intervals, owner, points, info, close = found or _compiled(kern, Ta)
         if not info["flags"]:
             assert isinstance(fam, _HeldFamily)
             fam.polish = False  # the kernel's rows: its crossings are on them

@@ -128,11 +128,12 @@ class _HeldFamily(_JointFamily):
         self.name, self.domain = named
         self.T = T
         self._polisher: LimitPolish | None = None
+        n = robot.n
         #: the kernel's preferred coordinates at singularities (``raw_solve``'s default)
-        self.qn = np.zeros((1, robot.n))
+        self.qn = np.zeros((1, n))
         #: the kernel's rows (Q (8, n), valid, singular (8,)) of kept values, by t's bits
         self.kept: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        self.kept_shape: tuple[int, ...] = (8, robot.n)
+        self.kept_shape: tuple[int, ...] = (8, n)
         #: rows near a limit refined (``polisher``); off once the compiled kernel
         #: certified the manifold: its crossings and ends are on the unrefined rows,
         #: and a refined row there moves by up to ~6e-12 (the Panda), past the slack

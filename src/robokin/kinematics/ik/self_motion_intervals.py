@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from robokin._native import kernels as K
+from robokin._validation import ROTATION_EXACT
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.self_motion_base import _Family
 from robokin.kinematics.ik.self_motion_families import (
@@ -492,10 +493,40 @@ def _compiled(kern: HeldKernel, T: np.ndarray, grid: int = KERNEL_GRID
     cheap test, computed by the kernel (False: it has nothing to find). The arrays
     are the kernel's own (``held_manifold_one``: packed in C, none built here).
     """
-    intervals, owner, points, flags, evals, close = K.held_manifold_one(
-        kern.params, np.ascontiguousarray(T, dtype=np.float64), kern.aligned, int(grid))
-    info = {"bisected": 0, "grid": int(grid), "compiled": True, "flags": flags,
-            "solves": evals}
+    out = K.held_manifold_one(kern.params, np.ascontiguousarray(T, dtype=np.float64),
+                              kern.aligned, int(grid), 0.0)
+    assert out is not None  # (a C-contiguous float64 array, its pose not tested: never None)
+    return _info_added(out, int(grid))
+
+
+#: The pose test ``held_manifold_one`` applies to a pose not checked yet
+#: (:func:`_compiled_unchecked`): chain.h ``pose_problem`` with its rotation block's
+#: rows within this of orthonormal (the largest entry of R R^T - I). R R^T - I and
+#: R^T R - I share their eigenvalues, so an entry of ``check_rigid``'s R^T R - I is at
+#: most 3 times this, rounding (~5e-16 an entry) included below ``ROTATION_EXACT``:
+#: such a pose is one ``check_rigid`` returns as it is.
+_EXACT = ROTATION_EXACT / 5
+
+
+def _compiled_unchecked(kern: HeldKernel, T: object
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, Any], bool] | None:
+    """:func:`_compiled` of the caller's T, not checked yet, or None (no row computed).
+
+    The kernel tests T first: a C-contiguous float64 (4, 4) ndarray that
+    ``check_transform`` accepts and ``check_rigid`` returns as it is (``_EXACT``).
+    None where it is not so: the caller checks T (``check_rigid``: the error, or the
+    projected pose) and calls :func:`_compiled`. The check's ~5 us a pose are the
+    kernel's ~0.05 (issue 29, helper ppy31).
+    """
+    out = K.held_manifold_one(kern.params, T, kern.aligned, KERNEL_GRID, _EXACT)
+    return None if out is None else _info_added(out, KERNEL_GRID)
+
+
+def _info_added(out: tuple[np.ndarray, np.ndarray, np.ndarray, int, int, bool], grid: int
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, Any], bool]:
+    """``held_manifold_one``'s outputs with its flags and pk_one calls as the ``info`` dict."""
+    intervals, owner, points, flags, evals, close = out
+    info = {"bisected": 0, "grid": grid, "compiled": True, "flags": flags, "solves": evals}
     return intervals, owner, points, info, close
 
 
