@@ -445,6 +445,59 @@ def test_swivel_records_are_the_kernels_points_built_when_first_read():
         assert sm.crossings is sm.crossings and sm._records is not None
 
 
+def _batch_kernel(kern, T):
+    """The batch kernel ``held_manifold`` on one pose T (4, 4), from its own output arrays.
+
+    (intervals (m, 2) branch by branch, their branches (m,), points (p, 4), flags, pk_one
+    calls).
+    """
+    from robokin._native import kernels as K
+
+    iv = np.empty((1, 8, K.HM_MAXI, 2))
+    niv = np.zeros((1, 8), dtype=np.int64)
+    pts = np.empty((1, K.HM_MAXP, 4))
+    npts, flags, evals = (np.zeros(1, dtype=np.int64) for _ in range(3))
+    K.held_manifold(kern.params, T[None], kern.aligned, 181, iv, niv, pts, npts, flags, evals)
+    intervals = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
+    return (intervals, np.repeat(np.arange(8), niv[0]), pts[0, :npts[0]], int(flags[0]),
+            int(evals[0]))
+
+
+def test_held_manifold_one_is_the_batch_kernel_packed_with_the_cheap_test():
+    # Session 12 (helper ppy31): robot.self_motion's one-pose kernel returns the batch
+    # kernel's outputs packed (intervals branch by branch, their branches, the points,
+    # flags, pk_one calls) and _points_refined's cheap test. Oracles: the batch kernel
+    # (held_manifold, its own output arrays) and the test written out on python floats:
+    # an interval at most 1e-12 long, a point within 1e-6 of an end of q7's range, or two
+    # points of a branch within 1e-6. Poses: uniform, a corner (two joints at limits:
+    # close), a flagged one (q2 = 1e-9: an aligned shoulder).
+    from robokin._native import kernels as K
+    from robokin.kinematics.ik.self_motion_families import SELF_MOTION
+
+    lo, hi = PANDA.limits[:, 0], PANDA.limits[:, 1]
+    q = np.random.default_rng(3).uniform(lo, hi, (6, 7))
+    q = np.concatenate([q, [[lo[0], 0.5, 0.2, hi[3], 0.4, 1.5, 0.7],
+                            [0.3, 1e-9, 0.2, -1.5, 0.4, 1.5, 0.7]]])
+    PANDA.self_motion(PANDA.fk(q[0]))
+    kern = PANDA.arm.state[SELF_MOTION].held
+    seen = set()
+    for T in PANDA.fk(q):
+        want = _batch_kernel(kern, T)
+        out = K.held_manifold_one(kern.params, T, kern.aligned, 181, 0.0)
+        assert out is not None
+        intervals, owner, points, flag, solves, close = out
+        for got, expected in zip(out[:5], want, strict=True):
+            assert np.array_equal(got, expected)
+        t0, t1 = kern.named[1]
+        keys = sorted(t + 64 * b for t, b, _, _ in points.tolist())
+        near = (any(e - a <= 1e-12 for a, e in intervals.tolist())
+                or any(t <= t0 + 1e-6 or t >= t1 - 1e-6 for t, _, _, _ in points.tolist())
+                or any(y - x <= 1e-6 for x, y in zip(keys, keys[1:])))
+        assert close is (near and flag == 0)
+        seen.add((flag != 0, close))
+    assert seen == {(False, False), (False, True), (True, False)}
+
+
 def test_the_compiled_panda_records_are_the_kernels_points_and_the_cached_family_agrees():
     """Oracle: the held-joint kernel's own point rows ``[t, branch, joint, kind]``
     (``held_manifold``, called here directly): the crossings are its limit rows by
@@ -453,7 +506,6 @@ def test_the_compiled_panda_records_are_the_kernels_points_and_the_cached_family
     constants built) and later calls by ``"auto"`` and by the joint's name (the
     constants kept in the set-up) give the same manifold. (Before: the records were
     built in every call, the family chosen in every call.)"""
-    from robokin._native import kernels as K
     from robokin.kinematics.ik.self_motion_families import SELF_MOTION
 
     kinds = ("lower", "upper", "aligned axes", "fold")
@@ -464,20 +516,14 @@ def test_the_compiled_panda_records_are_the_kernels_points_and_the_cached_family
         first = fresh.self_motion(T)
         kern = fresh.arm.state[SELF_MOTION].held
         assert first.info["compiled"] and kern is not None and first._records is None
-        iv = np.empty((1, 8, K.HM_MAXI, 2))
-        niv = np.zeros((1, 8), dtype=np.int64)
-        pts = np.empty((1, K.HM_MAXP, 4))
-        npts, flags, evals = (np.zeros(1, dtype=np.int64) for _ in range(3))
-        K.held_manifold(kern.params, T[None], kern.aligned, 181, iv, niv, pts, npts, flags,
-                        evals)
-        rows = sorted(map(tuple, pts[0, :npts[0]].tolist()), key=lambda r: (r[1], r[0]))
+        want, branches, points, _, _ = _batch_kernel(kern, T)
+        rows = sorted(map(tuple, points.tolist()), key=lambda r: (r[1], r[0]))
         assert [(c.t, c.branch, c.joint, c.limit) for c in first.crossings] == [
             (t, int(b), int(j), kinds[int(k)]) for t, b, j, k in rows if k <= 1]
         assert [(p.t, p.branch, p.kind) for p in first.singular] == [
             (t, int(b), kinds[int(k)]) for kind in (3, 2) for t, b, _, k in rows if k == kind]
-        want = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
         assert np.array_equal(first.intervals, want)
-        assert np.array_equal(first.interval_branch, np.repeat(np.arange(8), niv[0]))
+        assert np.array_equal(first.interval_branch, branches)
         for again in (fresh.self_motion(T), fresh.self_motion(T, first.parameter)):
             assert fresh.arm.state[SELF_MOTION].held is kern
             for name in ("parameter", "joint", "periodic", "n_branches", "method", "info",

@@ -719,48 +719,6 @@ def _gen3_like():
          "name": f"joint_{i + 1}"} for i in range(7)], convention="standard")
 
 
-def test_held_manifold_one_is_the_batch_kernel_packed_with_the_cheap_test():
-    # Session 12 (helper ppy31): robot.self_motion's one-pose kernel returns the batch
-    # kernel's outputs packed (intervals branch by branch, their branches, the points,
-    # flags, pk_one calls) and _points_refined's cheap test. Oracles: the batch kernel
-    # (held_manifold, its own output arrays) and the test written out on python floats:
-    # an interval at most 1e-12 long, a point within 1e-6 of an end of q7's range, or two
-    # points of a branch within 1e-6. Poses: uniform, a corner (two joints at limits:
-    # close), a flagged one (q2 = 1e-9: an aligned shoulder).
-    from robokin._native import kernels as K
-    from robokin.kinematics.ik.self_motion_families import SELF_MOTION
-
-    lo, hi = PANDA.limits[:, 0], PANDA.limits[:, 1]
-    q = np.random.default_rng(3).uniform(lo, hi, (6, 7))
-    q = np.concatenate([q, [[lo[0], 0.5, 0.2, hi[3], 0.4, 1.5, 0.7],
-                            [0.3, 1e-9, 0.2, -1.5, 0.4, 1.5, 0.7]]])
-    PANDA.self_motion(PANDA.fk(q[0]))
-    kern = PANDA.arm.state[SELF_MOTION].held
-    seen = set()
-    for T in PANDA.fk(q):
-        iv = np.empty((1, 8, K.HM_MAXI, 2))
-        niv = np.zeros((1, 8), dtype=np.int64)
-        pts = np.empty((1, K.HM_MAXP, 4))
-        npts, flags, evals = (np.zeros(1, dtype=np.int64) for _ in range(3))
-        K.held_manifold(kern.params, T[None], kern.aligned, 181, iv, niv, pts, npts, flags,
-                        evals)
-        intervals, owner, points, flag, solves, close = K.held_manifold_one(
-            kern.params, T, kern.aligned, 181)
-        want = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
-        assert np.array_equal(intervals, want)
-        assert np.array_equal(owner, np.repeat(np.arange(8), niv[0]))
-        assert np.array_equal(points, pts[0, :npts[0]])
-        assert (flag, solves) == (flags[0], evals[0])
-        t0, t1 = kern.named[1]
-        keys = sorted(t + 64 * b for t, b, _, _ in points.tolist())
-        near = (any(e - a <= 1e-12 for a, e in intervals.tolist())
-                or any(t <= t0 + 1e-6 or t >= t1 - 1e-6 for t, _, _, _ in points.tolist())
-                or any(y - x <= 1e-6 for x, y in zip(keys, keys[1:])))
-        assert close is (near and flag == 0)
-        seen.add((flag != 0, close))
-    assert seen == {(False, False), (False, True), (True, False)}
-
-
 @pytest.mark.parametrize(("arm", "q", "most"), [
     # uniform (benchmarks/self_motion_rates.py, seed 0, #0): Pieper's quartic at every
     # value of joint_a3 (shoulder offset 0.44 mm): HM_FLAG_BAD before any row
