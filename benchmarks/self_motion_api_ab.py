@@ -15,7 +15,9 @@ what the API adds (also given over the poses the kernel certifies: a flagged
 pose takes the solved-points path, ~13 ms). Those differences are within the
 noise of the kernel's ~1.5 ms (a few %), so the API alone is also timed with the
 kernel replaced by a replay of its saved outputs (best of 20 passes over the
-certified poses, minus the replay's own cost).
+certified poses, minus the replay's own cost; the kernel the tree's API calls:
+``held_manifold`` on one pose before session 12, ``held_manifold_one`` since, whose
+new arrays the replay copies, as the kernel makes them).
 
 Run: ``python benchmarks/self_motion_api_ab.py /work/wt/main-ref /work/wt/mine``.
 """
@@ -99,23 +101,30 @@ for _ in range({repeat} + 1):
     for i, Ti in enumerate(Tt):
         best[:, i] = np.minimum(best[:, i], [clock(kernel, Ti), clock(api, Ti)])
         certified[i] = flags[0] == 0
-# the API alone: the kernel replaced by a replay of its outputs (saved per pose)
+# the API alone: the kernel the API calls (main: held_manifold on (1, 4, 4); since
+# session 12 held_manifold_one) replaced by a replay of its outputs (saved per pose)
 import robokin.kinematics.ik.self_motion_intervals as smi
 saved = {{}}
+one = hasattr(K, "held_manifold_one")
+name = "held_manifold_one" if one else "held_manifold"
 
 
 def replay(params, T1, aligned, grid, *out):
     key = T1.tobytes()
     if key not in saved:
-        K.held_manifold(params, T1, aligned, grid, *out)
-        saved[key] = [o.copy() for o in out]
-    for o, s in zip(out, saved[key]):
+        saved[key] = (getattr(K, name)(params, T1, aligned, grid, *out),
+                      [o.copy() for o in out if isinstance(o, np.ndarray)])
+    ret, kept = saved[key]
+    for o, s in zip([o for o in out if isinstance(o, np.ndarray)], kept):  # (not exact)
         o[...] = s
+    # held_manifold_one returns new arrays: new copies, as the kernel makes them
+    return None if ret is None else tuple(
+        x.copy() if isinstance(x, np.ndarray) else x for x in ret)
 
 
 class Replayed:
-    def __getattr__(self, name):
-        return replay if name == "held_manifold" else getattr(K, name)
+    def __getattr__(self, attr):
+        return replay if attr == name else getattr(K, attr)
 
 
 Tc = Tt[certified]
@@ -125,7 +134,13 @@ args = (np.empty((1, 8, K.HM_MAXI, 2)), np.zeros((1, 8), dtype=np.int64),
 smi.K = Replayed()
 for Ti in Tc:
     panda.self_motion(Ti)
-for i, f in enumerate((lambda Ti: replay(params, Ti[None], aligned, KERNEL_GRID, *args), api)):
+if one:
+    def bare_call(Ti):
+        replay(params, Ti, aligned, KERNEL_GRID, 2e-15)
+else:
+    def bare_call(Ti):
+        replay(params, Ti[None], aligned, KERNEL_GRID, *args)
+for i, f in enumerate((bare_call, api)):
     b = np.inf
     for _ in range(20):
         c0 = time.process_time()

@@ -612,6 +612,18 @@ HELD_MANIFOLD = Group("held_manifold.c", kernels=(
                    "aligned (A, 2): [joint, value] rows where a triple's outer axes line up; grid: "
                    "values of t on the first grid.",
            checks=(Check("pk_params_ok(a->params)", "params is not a Pieper parameter vector"),)),
+    Kernel("held_manifold_one", (Arr("params", "f64", ("PK_N_PARAMS",)), Obj("T"),
+                                 Arr("aligned", "f64", ("A", 2)), Int("grid", 3, 100000),
+                                 Float("exact", 0.0, 1e-6)),
+           "tuple[F64, I64, F64, int, int, bool] | None",
+           "``held_manifold`` of one pose T (4, 4), packed: new arrays of its intervals (m, 2) "
+           "branch by branch, their branches (m,) and its points (p, 4); its flags and pk_one "
+           "calls; close: two points of a branch within SM_PAIR, one within it of an end of the "
+           "held joint's range or an interval at most SM_POINT long (False on a flagged pose). "
+           "None where T is not a C-contiguous aligned float64 (4, 4) ndarray, or, with exact "
+           "> 0, not rigid with its rotation within exact of orthonormal (chain.h "
+           "pose_problem): the caller checks it and calls again.",
+           checks=(Check("pk_params_ok(a->params)", "params is not a Pieper parameter vector"),)),
 ), constants=_consts("MAXI MAXP KIND_LOWER KIND_UPPER KIND_ALIGNED KIND_FOLD FLAG_SINGULAR "
                      "FLAG_UNRESOLVED FLAG_CONVERGE FLAG_FULL FLAG_VANISH FLAG_MEMORY FLAG_BAD",
                      "HM_", "HM_"),

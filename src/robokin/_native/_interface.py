@@ -752,6 +752,17 @@ class Kernels(Protocol):
         aligned (A, 2): [joint, value] rows where a triple's outer axes line up; grid: values of t on the first grid.
         """
 
+    def held_manifold_one(
+        self,
+        params: F64,
+        T: object,
+        aligned: F64,
+        grid: int,
+        exact: float,
+        /,
+    ) -> tuple[F64, I64, F64, int, int, bool] | None:
+        """``held_manifold`` of one pose T (4, 4), packed: new arrays of its intervals (m, 2) branch by branch, their branches (m,) and its points (p, 4); its flags and pk_one calls; close: two points of a branch within SM_PAIR, one within it of an end of the held joint's range or an interval at most SM_POINT long (False on a flagged pose). None where T is not a C-contiguous aligned float64 (4, 4) ndarray, or, with exact > 0, not rigid with its rotation within exact of orthonormal (chain.h pose_problem): the caller checks it and calls again."""
+
     def near_coincident(
         self,
         packed: F64,

@@ -359,6 +359,67 @@ def test_the_self_motion_setup_is_typed_derived_state_of_the_arm():
         assert other.derived(SELF_MOTION) is not setup
 
 
+def test_the_kernels_own_pose_test_takes_only_poses_check_rigid_leaves_as_they_are():
+    """The compiled Panda path tests T in its kernel, not by check_rigid (session 12).
+
+    Oracle: ``check_rigid`` itself. A pose the kernel takes (not None) is one
+    ``check_rigid`` returns as it is, over rotations off SO(3) by 1e-17 to 1e-12
+    (scaled, and perturbed by random matrices); poses it does not take (a rotation off
+    by 4e-15, which check_rigid leaves, and by 1e-13, which it projects; a Fortran
+    array, a list) give check_rigid's pose and the same manifold as the plain pose;
+    a subclass, float32, other shapes and a bad pose are not taken either, and a bad
+    pose is refused with check_rigid's error.
+    """
+    from robokin._validation import ROTATION_EXACT, check_rigid
+    from robokin.kinematics.ik.self_motion_families import SELF_MOTION
+    from robokin.kinematics.ik.self_motion_intervals import _compiled_unchecked
+
+    q0 = np.array([0.3, -0.4, 0.5, -1.6, 0.2, 1.7, 0.6])
+    T = PANDA.fk(q0)
+    plain = PANDA.self_motion(T)
+    kern = PANDA.arm.state[SELF_MOTION].held
+    assert plain.T is T and _compiled_unchecked(kern, T) is not None
+    rng = np.random.default_rng(7)
+    taken = refused = 0
+    for eps in np.geomspace(1e-17, 1e-12, 60):
+        for Tn in (T.copy(), T.copy()):
+            Tn[:3, :3] *= 1 - eps
+            Tn[:3, :3] += eps * rng.standard_normal((3, 3))
+            R = Tn[:3, :3]
+            off = np.abs(R.T @ R - np.eye(3)).max()
+            if _compiled_unchecked(kern, Tn) is not None:
+                assert check_rigid(Tn, "T") is Tn and off <= ROTATION_EXACT
+                taken += 1
+            else:
+                refused += 1
+    assert taken > 20 and refused > 20
+    # refused by the kernel: check_rigid's pose, the manifold of the same pose
+    leave, project = T.copy(), T.copy()
+    leave[:3, :3] *= 1 - 4e-15
+    project[:3, :3] *= 1 - 1e-13
+    for Tn in (leave, project):
+        assert _compiled_unchecked(kern, Tn) is None
+        sm = PANDA.self_motion(Tn)
+        assert np.array_equal(sm.T, check_rigid(Tn, "T"))
+        assert (sm.T is Tn) == (Tn is leave)
+        assert sm.info["compiled"] and len(sm.intervals) > 0
+    for Tn in (np.asfortranarray(T), T.tolist()):
+        assert _compiled_unchecked(kern, Tn) is None
+        sm = PANDA.self_motion(Tn)
+        for name in ("T", "intervals", "interval_branch", "domain", "limits"):
+            assert np.array_equal(getattr(sm, name), getattr(plain, name)), name
+        assert sm.info == plain.info and sm.crossings == plain.crossings
+    for Tn in (np.ma.masked_array(T), T.astype(np.float32), T[None], np.zeros((4, 3))):
+        assert _compiled_unchecked(kern, Tn) is None
+    bad = T.copy()
+    bad[0, 3] = np.nan
+    assert _compiled_unchecked(kern, bad) is None
+    with pytest.raises(InputError, match="T.*non-finite"):
+        PANDA.self_motion(bad)
+    with pytest.raises(InputError, match="one pose"):
+        PANDA.self_motion(T[None])
+
+
 def test_swivel_records_are_the_kernels_points_built_when_first_read():
     """Oracle: the compiled kernel's own point rows ``[psi, branch, joint, kind]``
     (``SwivelArm.manifold``): every limit row is one LimitCrossing, every other row one
@@ -384,6 +445,59 @@ def test_swivel_records_are_the_kernels_points_built_when_first_read():
         assert sm.crossings is sm.crossings and sm._records is not None
 
 
+def _batch_kernel(kern, T):
+    """The batch kernel ``held_manifold`` on one pose T (4, 4), from its own output arrays.
+
+    (intervals (m, 2) branch by branch, their branches (m,), points (p, 4), flags, pk_one
+    calls).
+    """
+    from robokin._native import kernels as K
+
+    iv = np.empty((1, 8, K.HM_MAXI, 2))
+    niv = np.zeros((1, 8), dtype=np.int64)
+    pts = np.empty((1, K.HM_MAXP, 4))
+    npts, flags, evals = (np.zeros(1, dtype=np.int64) for _ in range(3))
+    K.held_manifold(kern.params, T[None], kern.aligned, 181, iv, niv, pts, npts, flags, evals)
+    intervals = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
+    return (intervals, np.repeat(np.arange(8), niv[0]), pts[0, :npts[0]], int(flags[0]),
+            int(evals[0]))
+
+
+def test_held_manifold_one_is_the_batch_kernel_packed_with_the_cheap_test():
+    # Session 12 (helper ppy31): robot.self_motion's one-pose kernel returns the batch
+    # kernel's outputs packed (intervals branch by branch, their branches, the points,
+    # flags, pk_one calls) and _points_refined's cheap test. Oracles: the batch kernel
+    # (held_manifold, its own output arrays) and the test written out on python floats:
+    # an interval at most 1e-12 long, a point within 1e-6 of an end of q7's range, or two
+    # points of a branch within 1e-6. Poses: uniform, a corner (two joints at limits:
+    # close), a flagged one (q2 = 1e-9: an aligned shoulder).
+    from robokin._native import kernels as K
+    from robokin.kinematics.ik.self_motion_families import SELF_MOTION
+
+    lo, hi = PANDA.limits[:, 0], PANDA.limits[:, 1]
+    q = np.random.default_rng(3).uniform(lo, hi, (6, 7))
+    q = np.concatenate([q, [[lo[0], 0.5, 0.2, hi[3], 0.4, 1.5, 0.7],
+                            [0.3, 1e-9, 0.2, -1.5, 0.4, 1.5, 0.7]]])
+    PANDA.self_motion(PANDA.fk(q[0]))
+    kern = PANDA.arm.state[SELF_MOTION].held
+    seen = set()
+    for T in PANDA.fk(q):
+        want = _batch_kernel(kern, T)
+        out = K.held_manifold_one(kern.params, T, kern.aligned, 181, 0.0)
+        assert out is not None
+        intervals, owner, points, flag, solves, close = out
+        for got, expected in zip(out[:5], want, strict=True):
+            assert np.array_equal(got, expected)
+        t0, t1 = kern.named[1]
+        keys = sorted(t + 64 * b for t, b, _, _ in points.tolist())
+        near = (any(e - a <= 1e-12 for a, e in intervals.tolist())
+                or any(t <= t0 + 1e-6 or t >= t1 - 1e-6 for t, _, _, _ in points.tolist())
+                or any(y - x <= 1e-6 for x, y in zip(keys, keys[1:])))
+        assert close is (near and flag == 0)
+        seen.add((flag != 0, close))
+    assert seen == {(False, False), (False, True), (True, False)}
+
+
 def test_the_compiled_panda_records_are_the_kernels_points_and_the_cached_family_agrees():
     """Oracle: the held-joint kernel's own point rows ``[t, branch, joint, kind]``
     (``held_manifold``, called here directly): the crossings are its limit rows by
@@ -392,7 +506,6 @@ def test_the_compiled_panda_records_are_the_kernels_points_and_the_cached_family
     constants built) and later calls by ``"auto"`` and by the joint's name (the
     constants kept in the set-up) give the same manifold. (Before: the records were
     built in every call, the family chosen in every call.)"""
-    from robokin._native import kernels as K
     from robokin.kinematics.ik.self_motion_families import SELF_MOTION
 
     kinds = ("lower", "upper", "aligned axes", "fold")
@@ -403,20 +516,14 @@ def test_the_compiled_panda_records_are_the_kernels_points_and_the_cached_family
         first = fresh.self_motion(T)
         kern = fresh.arm.state[SELF_MOTION].held
         assert first.info["compiled"] and kern is not None and first._records is None
-        iv = np.empty((1, 8, K.HM_MAXI, 2))
-        niv = np.zeros((1, 8), dtype=np.int64)
-        pts = np.empty((1, K.HM_MAXP, 4))
-        npts, flags, evals = (np.zeros(1, dtype=np.int64) for _ in range(3))
-        K.held_manifold(kern.params, T[None], kern.aligned, 181, iv, niv, pts, npts, flags,
-                        evals)
-        rows = sorted(map(tuple, pts[0, :npts[0]].tolist()), key=lambda r: (r[1], r[0]))
+        want, branches, points, _, _ = _batch_kernel(kern, T)
+        rows = sorted(map(tuple, points.tolist()), key=lambda r: (r[1], r[0]))
         assert [(c.t, c.branch, c.joint, c.limit) for c in first.crossings] == [
             (t, int(b), int(j), kinds[int(k)]) for t, b, j, k in rows if k <= 1]
         assert [(p.t, p.branch, p.kind) for p in first.singular] == [
             (t, int(b), kinds[int(k)]) for kind in (3, 2) for t, b, _, k in rows if k == kind]
-        want = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
         assert np.array_equal(first.intervals, want)
-        assert np.array_equal(first.interval_branch, np.repeat(np.arange(8), niv[0]))
+        assert np.array_equal(first.interval_branch, branches)
         for again in (fresh.self_motion(T), fresh.self_motion(T, first.parameter)):
             assert fresh.arm.state[SELF_MOTION].held is kern
             for name in ("parameter", "joint", "periodic", "n_branches", "method", "info",

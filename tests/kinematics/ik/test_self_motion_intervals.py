@@ -748,8 +748,8 @@ def test_a_pose_the_kernel_cannot_certify_stops_at_its_first_flag(arm, q, most):
     sm = robot.self_motion(T)
     kern = _setup(robot.arm).held
     assert kern is not None and sm.info["compiled"] is False
-    intervals, owner, _, info = _compiled(kern, T)
-    assert info["flags"] != 0 and len(intervals) == len(owner) == 0
+    intervals, owner, _, info, close = _compiled(kern, T)
+    assert info["flags"] != 0 and len(intervals) == len(owner) == 0 and not close
     assert sm.info["flags"] == info["flags"]
     assert info["solves"] <= most
     if arm == "iiwa_urdf":

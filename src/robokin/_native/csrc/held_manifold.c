@@ -2427,3 +2427,89 @@ static PyObject *held_manifold_body(const held_manifold_args *a)
     Py_END_ALLOW_THREADS
     Py_RETURN_NONE;
 }
+
+/* self_motion_intervals._points_refined's cheap test on a held family, the same
+ * decision bit for bit: 1 when an interval of iv (m, 2) is at most SM_POINT long,
+ * a point's t of pts (npts, 4) is within SM_PAIR of the range's end lo or hi, or
+ * two sort keys t + 64 branch (exact but for its one rounding, as numpy's dot)
+ * are within SM_PAIR of each other (sm_close's test on [-pi, pi]) */
+static int hm_close(const double *pts, long long npts, const double *iv, long long m,
+                    double lo, double hi)
+{
+    double key[HM_MAXP];
+    for (long long i = 0; i < m; i++)
+        if (iv[2 * i + 1] - iv[2 * i] <= SM_POINT)
+            return 1;
+    for (long long i = 0; i < npts; i++) {
+        double t = pts[4 * i], k = t + 64.0 * pts[4 * i + 1];
+        if (t <= lo + SM_PAIR || t >= hi - SM_PAIR)
+            return 1;
+        long long j = i; /* insertion sort: ~10-60 points */
+        for (; j > 0 && key[j - 1] > k; j--)
+            key[j] = key[j - 1];
+        key[j] = k;
+    }
+    for (long long i = 1; i < npts; i++)
+        if (key[i] - key[i - 1] <= SM_PAIR)
+            return 1;
+    return 0;
+}
+
+/* One pose (robot.self_motion's call): held_manifold of T (4, 4), its intervals
+ * packed branch by branch; returns new arrays (intervals (m, 2), branches (m,),
+ * points (p, 4)), the flags, the pk_one calls and hm_close's flag (False:
+ * _points_refined has nothing to find; False on a flagged pose, whose arrays are
+ * empty but for the points found before the flag). None, before any row, where T
+ * is not a C-contiguous aligned native float64 (4, 4) ndarray (a subclass neither),
+ * or, with exact > 0, where pose_problem finds it more than exact from orthonormal
+ * (or not rigid): the caller checks it (check_rigid) and calls again. */
+static PyObject *held_manifold_one_body(const held_manifold_one_args *a)
+{
+    static const int stride = 2 * HM_MAXI;
+    PyArrayObject *ta = (PyArrayObject *)a->T;
+    if (!PyArray_CheckExact(a->T) || PyArray_TYPE(ta) != NPY_DOUBLE || PyArray_NDIM(ta) != 2 ||
+        PyArray_DIMS(ta)[0] != 4 || PyArray_DIMS(ta)[1] != 4 || !PyArray_IS_C_CONTIGUOUS(ta) ||
+        !PyArray_ISNOTSWAPPED(ta) || !PyArray_ISALIGNED(ta))
+        Py_RETURN_NONE;
+    const double *T = (const double *)PyArray_DATA(ta);
+    if (a->exact > 0.0 && pose_problem(T, POSE_ROW_TOL, a->exact))
+        Py_RETURN_NONE;
+    double *iv = malloc((8 * 2 * HM_MAXI + 4 * HM_MAXP) * sizeof(double));
+    if (iv == NULL)
+        return PyErr_NoMemory();
+    double *pts = iv + 8 * stride;
+    long long niv[8] = {0}, npts = 0, flags = 0, evals = 0, m = 0; /* (hm_range sets niv
+                                                                      * only where it runs hm_pose) */
+    HmJob jb = {a->params, T, a->aligned, (long)a->A, (long)a->grid, iv, pts, niv, &npts,
+                &flags, &evals};
+    Py_BEGIN_ALLOW_THREADS
+    hm_range(&jb, 0, 1);
+    Py_END_ALLOW_THREADS
+    for (int b = 0; b < 8; b++)
+        m += niv[b];
+    npy_intp di[2] = {(npy_intp)m, 2}, dp[2] = {(npy_intp)npts, 4};
+    PyObject *out_iv = PyArray_SimpleNew(2, di, NPY_DOUBLE);
+    PyObject *out_b = PyArray_SimpleNew(1, di, NPY_INT64);
+    PyObject *out_p = PyArray_SimpleNew(2, dp, NPY_DOUBLE);
+    if (out_iv == NULL || out_b == NULL || out_p == NULL) {
+        Py_XDECREF(out_iv);
+        Py_XDECREF(out_b);
+        Py_XDECREF(out_p);
+        free(iv);
+        return NULL;
+    }
+    double *ov = (double *)PyArray_DATA((PyArrayObject *)out_iv);
+    long long *ob = (long long *)PyArray_DATA((PyArrayObject *)out_b);
+    for (long long b = 0, k = 0; b < 8; b++) {
+        memcpy(ov + 2 * k, iv + stride * b, (size_t)(2 * niv[b]) * sizeof(double));
+        for (long long i = 0; i < niv[b]; i++)
+            ob[k++] = b;
+    }
+    if (npts)
+        memcpy(PyArray_DATA((PyArrayObject *)out_p), pts, (size_t)(4 * npts) * sizeof(double));
+    const double *P = a->params;
+    int k = (int)P[PK_HELD];
+    int close = !flags && hm_close(pts, npts, ov, m, P[PK_LO + k], P[PK_HI + k]);
+    free(iv);
+    return Py_BuildValue("(NNNLLN)", out_iv, out_b, out_p, flags, evals, PyBool_FromLong(close));
+}

@@ -37,7 +37,7 @@ flagged ``"aligned axes"``.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -64,6 +64,7 @@ from robokin.kinematics.ik.self_motion_intervals import (
     GRID,
     _aligned_values,
     _compiled,
+    _compiled_unchecked,
     _exact_points,
     _grid,
     _held_kernel,
@@ -405,17 +406,21 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
             (the message lists the choices).
     """
     robot = arm_of(robot)
-    Ta = check_rigid(T, "T")
+    setup = _setup(robot) if robot.n == 7 and not reference else None
+    kern: HeldKernel | None = setup.held if setup is not None else None
+    if kern is not None and parameter not in ("auto", kern.named[0]):
+        kern = None  # another parameter (its family chosen below)
+    # the compiled held family "auto" took before: the kernel tests T itself (None:
+    # check_rigid's, below), then no family choice again
+    found = _compiled_unchecked(kern, T) if kern is not None else None
+    Ta = T if found is not None and isinstance(T, np.ndarray) else check_rigid(T, "T")
     if Ta.shape != (4, 4):
         raise InputError("T", f"self_motion takes one pose (4, 4), got {Ta.shape}")
     limits = np.asarray(robot.limits, dtype=np.float64)
-    setup = _setup(robot) if robot.n == 7 and not reference else None
     # the compiled swivel (an SRS arm's "auto"): no family choice, no per-call lists
     if setup is not None and setup.swivel is not None and parameter in ("auto", "swivel"):
         return _swivel_motion(setup.swivel, Ta, robot, limits)
-    kern: HeldKernel | None = setup.held if setup is not None else None
-    if kern is not None and parameter in ("auto", kern.named[0]):
-        # the compiled held family "auto" took before: no family choice again
+    if kern is not None:
         fam: _Family = _HeldFamily(robot, kern.params, kern.joint, Ta, dispatch, kern.named)
     else:
         fam = _family(robot, Ta, parameter, dispatch, reference)
@@ -424,12 +429,14 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
             setup.held = kern  # (not on SRS arms: their "auto" is the swivel)
     fallback: dict[str, Any] = {}
     if kern is not None:
-        intervals, owner, points, info = _compiled(kern, Ta)
+        intervals, owner, points, info, close = found or _compiled(kern, Ta)
         if not info["flags"]:
             assert isinstance(fam, _HeldFamily)
             fam.polish = False  # the kernel's rows: its crossings are on them
-            intervals, owner, corners = _points_refined(fam, limits, intervals, owner, points,
-                                                        K.HM_KIND_UPPER)
+            corners: tuple[tuple[float, int, np.ndarray], ...] = ()
+            if close:  # the kernel ran _points_refined's cheap test: a uniform pose skips it
+                intervals, owner, corners = _points_refined(fam, limits, intervals, owner,
+                                                            points, K.HM_KIND_UPPER)
             return _held_motion(Ta, kern, intervals, owner, info, fam, limits, points, corners)
         fallback = {"compiled": False, "flags": info["flags"]}  # not certified: solved points
     if isinstance(fam, _ContinuedFamily):
@@ -460,10 +467,6 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
                       _records=(crossings, singular), _corners=corners)
 
 
-#: SelfMotion's fields, in order (``_held_motion`` sets every one).
-_FIELDS = tuple(f.name for f in fields(SelfMotion))
-
-
 def _held_motion(T: np.ndarray, kern: HeldKernel, intervals: np.ndarray, owner: np.ndarray,
                  info: dict[str, Any], fam: _Family, limits: np.ndarray, points: np.ndarray,
                  corners: tuple[tuple[float, int, np.ndarray], ...] = ()) -> SelfMotion:
@@ -471,12 +474,15 @@ def _held_motion(T: np.ndarray, kern: HeldKernel, intervals: np.ndarray, owner: 
 
     Equal to ``SelfMotion(T, name, joint, domain, False, 8, intervals, owner, method,
     info, fam, limits, points, None, True, corners)`` (the frozen dataclass' ``__init__``
-    costs 4 us of the ~20 us the API adds to the kernel).
+    costs ~4 us; one dict literal as the instance's ``__dict__`` ~1 us, as
+    ``_swivel_motion``).
     """
     sm = object.__new__(SelfMotion)
-    vars(sm).update(zip(_FIELDS, (T, kern.named[0], kern.joint, kern.domain.copy(), False, 8,
-                                  intervals, owner, kern.method, info, fam, limits, points,
-                                  None, True, corners), strict=True))
+    object.__setattr__(sm, "__dict__", {
+        "T": T, "parameter": kern.named[0], "joint": kern.joint, "domain": kern.domain.copy(),
+        "periodic": False, "n_branches": 8, "intervals": intervals, "interval_branch": owner,
+        "method": kern.method, "info": info, "_family": fam, "limits": limits,
+        "_points": points, "_records": None, "_held": True, "_corners": corners})
     return sm
 
 

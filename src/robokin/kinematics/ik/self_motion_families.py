@@ -127,17 +127,28 @@ class _HeldFamily(_JointFamily):
             named = (robot.joint_names[j], (lo, hi))
         self.name, self.domain = named
         self.T = T
-        #: rows next to a limit refined on the pose; T repeated for the kernel calls
-        self.polisher = LimitPolish(robot, j, T)
+        self._polisher: LimitPolish | None = None
+        n = robot.n
         #: the kernel's preferred coordinates at singularities (``raw_solve``'s default)
-        self.qn = np.zeros((1, robot.n))
+        self.qn = np.zeros((1, n))
         #: the kernel's rows (Q (8, n), valid, singular (8,)) of kept values, by t's bits
         self.kept: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        self.kept_shape: tuple[int, ...] = (8, robot.n)
+        self.kept_shape: tuple[int, ...] = (8, n)
         #: rows near a limit refined (``polisher``); off once the compiled kernel
         #: certified the manifold: its crossings and ends are on the unrefined rows,
         #: and a refined row there moves by up to ~6e-12 (the Panda), past the slack
         self.polish = True
+
+    @property
+    def polisher(self) -> LimitPolish:
+        """Rows next to a limit refined on the pose; T repeated for the kernel calls.
+
+        Built on first use: a certified compiled pose computes no row
+        (``self_motion``'s held path; ~4 us of per-arm arrays a pose otherwise).
+        """
+        if self._polisher is None:
+            self._polisher = LimitPolish(self.robot, self.joint, self.T)
+        return self._polisher
 
     def _solved(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The closed form's Q (m, 8, n), valid, singular (m, 8) at t (m,) contiguous float64.

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from robokin._native import kernels as K
+from robokin._validation import ROTATION_EXACT
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.self_motion_base import _Family
 from robokin.kinematics.ik.self_motion_families import (
@@ -466,9 +467,6 @@ def _join_wrap(pieces: list[tuple[int, float, float]], lo: float, hi: float
 
 
 _KINDS = ("lower", "upper", "aligned axes", "fold")  # HM_KIND_* 0-3
-#: A branch's interval slots in the kernel's output, and the 8 branches.
-_HM_SLOTS = np.arange(K.HM_MAXI)
-_HM_BRANCHES = np.arange(8)
 
 
 def _held_kernel(robot: Arm, fam: _HeldFamily) -> HeldKernel:
@@ -481,28 +479,55 @@ def _held_kernel(robot: Arm, fam: _HeldFamily) -> HeldKernel:
 
 
 def _compiled(kern: HeldKernel, T: np.ndarray, grid: int = KERNEL_GRID
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, Any], bool]:
     """A held-joint (Pieper) family's intervals and points by the compiled kernel.
 
     ``csrc/held_manifold.c``: a grid of the parameter with the rows' slopes dq/dt,
     crossings bracketed and refined by safeguarded Newton on q_j(t) - limit, folds
     bisected, pieces decided at their midpoints. Returns ``(intervals, owner,
-    points, info)``: the points are the kernel's rows ``[t, branch, joint, kind]``
+    points, info, close)``: the intervals (m, 2) by branch, then start, and their
+    branches (m,); the points are the kernel's rows ``[t, branch, joint, kind]``
     (``HM_KIND_*``; :func:`_held_records` makes the records when they are read);
     ``info["flags"]`` is nonzero when the kernel could not certify the pose (then
-    the caller takes the solved-points path).
+    the caller takes the solved-points path); ``close``: :func:`_points_refined`'s
+    cheap test, computed by the kernel (False: it has nothing to find). The arrays
+    are the kernel's own (``held_manifold_one``: packed in C, none built here).
     """
-    iv = np.empty((1, 8, K.HM_MAXI, 2))
-    niv = np.zeros((1, 8), dtype=np.int64)
-    pts = np.empty((1, K.HM_MAXP, 4))
-    npts, flags, evals = np.zeros((3, 1), dtype=np.int64)
-    K.held_manifold(kern.params, np.ascontiguousarray(T, dtype=np.float64)[None], kern.aligned,
-                    int(grid), iv, niv, pts, npts, flags, evals)
-    counts = niv[0]
-    intervals = iv[0][counts[:, None] > _HM_SLOTS]  # by branch, then start
-    info = {"bisected": 0, "grid": int(grid), "compiled": True, "flags": int(flags[0]),
-            "solves": int(evals[0])}
-    return intervals, _HM_BRANCHES.repeat(counts), pts[0, :npts[0]], info
+    out = K.held_manifold_one(kern.params, np.ascontiguousarray(T, dtype=np.float64),
+                              kern.aligned, int(grid), 0.0)
+    assert out is not None  # (a C-contiguous float64 array, its pose not tested: never None)
+    return _info_added(out, int(grid))
+
+
+#: The pose test ``held_manifold_one`` applies to a pose not checked yet
+#: (:func:`_compiled_unchecked`): chain.h ``pose_problem`` with its rotation block's
+#: rows within this of orthonormal (the largest entry of R R^T - I). R R^T - I and
+#: R^T R - I share their eigenvalues, so an entry of ``check_rigid``'s R^T R - I is at
+#: most 3 times this, rounding (~5e-16 an entry) included below ``ROTATION_EXACT``:
+#: such a pose is one ``check_rigid`` returns as it is.
+_EXACT = ROTATION_EXACT / 5
+
+
+def _compiled_unchecked(kern: HeldKernel, T: object
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, Any], bool] | None:
+    """:func:`_compiled` of the caller's T, not checked yet, or None (no row computed).
+
+    The kernel tests T first: a C-contiguous float64 (4, 4) ndarray that
+    ``check_transform`` accepts and ``check_rigid`` returns as it is (``_EXACT``).
+    None where it is not so: the caller checks T (``check_rigid``: the error, or the
+    projected pose) and calls :func:`_compiled`. The check's ~5 us a pose are the
+    kernel's ~0.05 (issue 29, helper ppy31).
+    """
+    out = K.held_manifold_one(kern.params, T, kern.aligned, KERNEL_GRID, _EXACT)
+    return None if out is None else _info_added(out, KERNEL_GRID)
+
+
+def _info_added(out: tuple[np.ndarray, np.ndarray, np.ndarray, int, int, bool], grid: int
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[str, Any], bool]:
+    """``held_manifold_one``'s outputs with its flags and pk_one calls as the ``info`` dict."""
+    intervals, owner, points, flags, evals, close = out
+    info = {"bisected": 0, "grid": grid, "compiled": True, "flags": flags, "solves": evals}
+    return intervals, owner, points, info, close
 
 
 def _held_records(points: np.ndarray) -> tuple[tuple[LimitCrossing, ...],
