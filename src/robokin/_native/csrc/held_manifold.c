@@ -691,20 +691,22 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
                     memcpy(tc, th, sizeof tc);
                     moves = pk_resplit(P, g, it, &f.RT, f.pT, tc);
                 }
+                /* not proven isolated: maybe on a family, which only pk_one's late
+                 * pk_slide would move (its early repairs leave a far row alone: the
+                 * resplit tested above, pk_inside's reach below the row's gap), so
+                 * hm_stays decides, by pk_slide's own SVD, and only when no row made
+                 * here is inside (pk_slide then has the same J: session 12) */
+                int family = 0;
                 if (!moves && !alone && !pk_isolated(g, th)) {
                     m3 R;
                     v3 p;
                     double J[6][6];
                     pk_fk(g, th, &R, &p, J);
-                    if (!pk_regular(J) && !hm_regular(J)) {
-                        double sig[6], V[6][6];
-                        pk_svd6(J, sig, V);
-                        moves = sig[0] <= PK_FAMILY_SIGMA * sig[5];
-                    }
+                    family = !pk_regular(J) && !hm_regular(J);
                 }
                 if (moves && hm_repairs(c, &f, th, r->q[slot], sing)) {
                     inside = 1;
-                } else if (moves) {
+                } else if (moves || family) {
                     memcpy(late_th[slot], th, sizeof late_th[slot]);
                     late |= 1u << slot;
                 }
