@@ -103,6 +103,7 @@ enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FL
 
 
 #define HM_MEMO 64 /* recent evaluations kept (hm_recall) */
+#define HM_FRONTS 64 /* recent fronts kept (hm_front) */
 
 /* Every slot at one t: coordinates (into the limits where a turn fits), slopes dq/dt
  * (NaN where the six other joints' Jacobian is singular), row exists, singular. */
@@ -171,6 +172,12 @@ typedef struct {
     double memo_t[HM_MEMO]; /* memo[i].t, contiguous: hm_recall's first test */
     long nmemo;
     PkFrontMemo front; /* pk_front's held-value-free parts (hm_closed) */
+    /* recent fronts (hm_front): held value, the position slots solved, status */
+    PkFront fronts[HM_FRONTS];
+    double front_t[HM_FRONTS];
+    unsigned front_want[HM_FRONTS];
+    int front_code[HM_FRONTS];
+    long nfront;
 } HmCtx;
 
 /* Gaussian elimination with partial pivoting of M (6 x 6 | right-hand side) into x;
@@ -433,8 +440,9 @@ static int hm_slopes_fast(HmCtx *c, double t, const double *q, double *dq)
 
 /* The slots in `need` at held value x by pk_one's closed form (its position
  * roots, theta_b, the triple, the coordinates, its pose check and polish: the
- * same calls in the same order; pk_front_memo: the per-arm parts kept, only the
- * position roots of the slots asked for solved), into r (the other slots
+ * same calls in the same order; front f and its status code from hm_front:
+ * pk_front_memo's, the per-arm parts kept, only the position roots of the slots
+ * asked for solved), into r (the other slots
  * invalid). A row outside the limits that pk_one's repairs may move (singular;
  * within PK_NUDGE of them: pk_inside; not isolated: pk_slide) gets those repairs
  * here (hm_repairs); the repairs pk_one tries only when no row is inside
@@ -616,7 +624,7 @@ static int hm_far_isolated(const PkGeo *g, const double *th, const double cs[2][
     return det > 8.0 * PK_FAMILY_SIGMA * b * b * b;
 }
 
-static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
+static int hm_closed(HmCtx *c, double x, unsigned need, const PkFront *f, int code, HmRow *r)
 {
     const double *P = c->P;
     for (int b = 0; b < 8; b++) {
@@ -624,21 +632,16 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
         for (int j = 0; j < PK_MAXJ; j++)
             r->q[b][j] = NAN;
     }
-    PkFront f;
-    unsigned want = 0u; /* the position slots of the slots in need */
-    for (int i = 0; i < 4; i++)
-        want |= (need >> 2 * i & 3u) != 0u ? 1u << i : 0u;
-    int code = pk_front_memo(P, c->T, x, c->qn, 0, &c->front, want, &f);
     if (code == PK_FRONT_SWIVEL || code == PK_FRONT_GENERAL)
         return 0; /* He and Liu's general case: not this kernel's */
     if (code != PK_OK)
         return 1; /* pk_one: cleared, no row */
-    const PkGeo *g = &f.g;
-    const PkPos *pos = &f.pos;
+    const PkGeo *g = &f->g;
+    const PkPos *pos = &f->pos;
     int held = (int)P[PK_HELD];
     double stol = P[PK_SING_TOL];
     int held_in = pk_held_inside(P, held, x);
-    int ia = f.ia, it = f.it;
+    int ia = f->ia, it = f->it;
     double f2 = NAN; /* hm_far_isolated's bound of |J|_F^2, once per call */
     double late_th[8][6]; /* rows hm_repairs left outside: hm_stays after the loop */
     unsigned late = 0u;
@@ -648,9 +651,9 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
         if (!(need & slots) || !(pos->res[i] < 1e-6 * g->scale))
             continue;
         double th[6];
-        m3 Rt = pk_front_rotation(&f, i, th);
+        m3 Rt = pk_front_rotation(f, i, th);
         PkTrip tr;
-        pk_triple_want(P, &f.tri, &Rt, f.jx, f.jz, c->qn[f.jz], stol,
+        pk_triple_want(P, &f->tri, &Rt, f->jx, f->jz, c->qn[f->jz], stol,
                        need >> 2 * pos->slot[i] & 3u, &tr);
         for (int k = 0; k < tr.n; k++) {
             int slot = 2 * pos->slot[i] + k;
@@ -662,10 +665,10 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
                 th[it + j] = tr.t[k][j];
             }
             /* pk_one's check: kept unchanged when exact, else polished (its calls) */
-            if (tr.check[k] || !(pos->res[i] < f.exact_p)) {
-                double err = pk_error_of(g, &f.RT, f.pT, th);
+            if (tr.check[k] || !(pos->res[i] < f->exact_p)) {
+                double err = pk_error_of(g, &f->RT, f->pT, th);
                 if (err > PK_EXACT)
-                    err = pk_polish_slow(g, &f.RT, f.pT, th, pk_polish(g, &f.RT, f.pT, th));
+                    err = pk_polish_slow(g, &f->RT, f->pT, th, pk_polish(g, &f->RT, f->pT, th));
                 if (!(err <= PK_ACCEPT))
                     continue; /* not a solution to 1e-12: no row */
             }
@@ -680,7 +683,7 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
                 int moves = sing || !(hm_outside(P, g, th) > 2.0 * PK_NUDGE);
                 /* far outside, not singular: most rows; proven alone (the position
                  * joints as solved, not polished) or tested as pk_one would */
-                int u = f.start ? 0 : 2; /* the position joint pk_isolated undoes */
+                int u = f->start ? 0 : 2; /* the position joint pk_isolated undoes */
                 int alone = !moves && th[ia + u] == pos->t[i][u] &&
                             th[ia + 1] == pos->t[i][1] &&
                             hm_far_isolated(g, th, (const double[2][2]){
@@ -689,22 +692,24 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
                 if (!moves && !alone) {
                     double tc[6];
                     memcpy(tc, th, sizeof tc);
-                    moves = pk_resplit(P, g, it, &f.RT, f.pT, tc);
+                    moves = pk_resplit(P, g, it, &f->RT, f->pT, tc);
                 }
+                /* not proven isolated: maybe on a family, which only pk_one's late
+                 * pk_slide would move (its early repairs leave a far row alone: the
+                 * resplit tested above, pk_inside's reach below the row's gap), so
+                 * hm_stays decides, by pk_slide's own SVD, and only when no row made
+                 * here is inside (pk_slide then has the same J: session 12) */
+                int family = 0;
                 if (!moves && !alone && !pk_isolated(g, th)) {
                     m3 R;
                     v3 p;
                     double J[6][6];
                     pk_fk(g, th, &R, &p, J);
-                    if (!pk_regular(J) && !hm_regular(J)) {
-                        double sig[6], V[6][6];
-                        pk_svd6(J, sig, V);
-                        moves = sig[0] <= PK_FAMILY_SIGMA * sig[5];
-                    }
+                    family = !pk_regular(J) && !hm_regular(J);
                 }
-                if (moves && hm_repairs(c, &f, th, r->q[slot], sing)) {
+                if (moves && hm_repairs(c, f, th, r->q[slot], sing)) {
                     inside = 1;
-                } else if (moves) {
+                } else if (moves || family) {
                     memcpy(late_th[slot], th, sizeof late_th[slot]);
                     late |= 1u << slot;
                 }
@@ -714,13 +719,41 @@ static int hm_closed(HmCtx *c, double x, unsigned need, HmRow *r)
         }
     }
     for (int slot = 0; slot < 8 && !inside; slot++)
-        if ((late >> slot & 1u) && !hm_stays(c, &f, late_th[slot], r->q[slot], r->sing[slot]))
+        if ((late >> slot & 1u) && !hm_stays(c, f, late_th[slot], r->q[slot], r->sing[slot]))
             return 0; /* what pk_one makes of it depends on the other slots */
     return 1;
 }
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC pop_options
 #endif
+
+/* pk_front_memo's front at held value x for the position slots of the slots in
+ * `need` (its status into *code), or a recent one at the same x that solved them (HM_FRONTS kept): each
+ * position root is solved alone, so a kept front has the same bits for the slots
+ * asked; its status may be PK_OK where the slots asked have no root, and then
+ * hm_closed makes no row either way. Found for ~20 % of the calls on the Panda's
+ * development poses: a slot evaluated where its partner was (the same position
+ * root), at a shared crossing (hm_shared) or a pair's piece. */
+static const PkFront *hm_front(HmCtx *c, double x, unsigned need, int *code)
+{
+    unsigned want = 0u; /* the position slots of the slots in need */
+    for (int i = 0; i < 4; i++)
+        want |= (need >> 2 * i & 3u) != 0u ? 1u << i : 0u;
+    int seen = 0; /* any kept front at x: one vectorised pass (as hm_recall) */
+    for (int i = 0; i < HM_FRONTS; i++)
+        seen |= c->front_t[i] == x;
+    for (int i = 0; i < HM_FRONTS && seen; i++)
+        if (c->front_t[i] == x && (want & ~c->front_want[i]) == 0u) {
+            *code = c->front_code[i];
+            return &c->fronts[i];
+        }
+    int i = (int)(c->nfront++ % HM_FRONTS);
+    *code = pk_front_memo(c->P, c->T, x, c->qn, 0, &c->front, want, &c->fronts[i]);
+    c->front_t[i] = x;
+    c->front_want[i] = want;
+    c->front_code[i] = *code;
+    return &c->fronts[i];
+}
 
 /* The rows of a recent evaluation (hm_keep, hm_recall): t, the slots asked for,
  * whether hm_closed gave them (else pk_one gave every slot) and the rows. */
@@ -792,7 +825,9 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
     c->cheap++;
     if (hm_recall(c, t, need, r))
         goto slopes;
-    int closed = hm_closed(c, t, need, r);
+    int code;
+    const PkFront *f = hm_front(c, t, need, &code);
+    int closed = hm_closed(c, t, need, f, code, r);
     if (!closed) {
         unsigned char inside[8];
         PkOut o = {&r->q[0][0], r->valid, r->sing, inside, PK_MAXJ};
@@ -2380,6 +2415,9 @@ static void hm_range(void *ctx, long b0, long e0)
             c->memo[m].t = c->memo_t[m] = NAN; /* nothing kept */
         c->nmemo = 0;
         c->front.set = 0;
+        for (int m = 0; m < HM_FRONTS; m++)
+            c->front_t[m] = NAN; /* no front kept */
+        c->nfront = 0;
         c->fast = hm_fast_setup(c);
         c->full_fk = 0;
         c->jumped = 0;
