@@ -1036,7 +1036,8 @@ static int hm_last(const HmCtx *c, int b, int qi, const HmRow *r, double f, doub
     int good = 1;
     for (int m = 0; m < c->n; m++) {
         double q = r->q[b][m] + r->dq[b][m] * s, room = 2.0 * fabs(r->dq[b][m] * s) + 1e-12;
-        double lo = q - (c->P[PK_LO + m] - MANIFOLD_SLACK), hi = c->P[PK_HI + m] + MANIFOLD_SLACK - q;
+        double lo = q - (c->P[PK_LO + m] - MANIFOLD_SLACK);
+        double hi = c->P[PK_HI + m] + MANIFOLD_SLACK - q;
         if (m == j && kind != HM_KIND_ALIGNED) {
             if (!(fabs(q - c->qv[qi]) <= 1e-13))
                 return 0; /* at another turn of the value */
