@@ -505,6 +505,32 @@ def test_every_limit_crossing_has_its_joint_at_the_limit(special):
     assert checked >= 40
 
 
+@pytest.mark.parametrize("special", [False, True])
+def test_a_crossing_is_in_an_interval_exactly_when_its_row_is_inside(special):
+    # hm_root ends most crossings with Newton's last step and no row there (hm_last,
+    # session 12): the in-limit verdict of the crossing's row (a piece's end, or a
+    # point [t, t] between two pieces outside) is then taken from the last row and its
+    # slopes; here against the row sampled at the crossing: inside every limit (joint
+    # c.joint at its limit; MANIFOLD_SLACK) exactly when t is in an interval of its branch
+    # (rows within 1e-10 of the slack's edge are not decided by rounding, and skipped)
+    checked = {True: 0, False: 0}
+    for q in _configurations(8, special, 4029 if special else 2029):
+        sm = PANDA.self_motion(PANDA.fk(q))
+        if not sm.info.get("compiled", False):
+            continue
+        for c in sm.crossings:
+            row = sm.sample(c.t)[c.branch]
+            margin = np.minimum(row - LIMITS[:, 0], LIMITS[:, 1] - row) + MANIFOLD_SLACK
+            margin[c.joint] = np.inf
+            if np.min(np.abs(margin)) <= 1e-10:
+                continue
+            own = sm.intervals[sm.interval_branch == c.branch]
+            listed = bool(np.any((own[:, 0] - 1e-12 <= c.t) & (c.t <= own[:, 1] + 1e-12)))
+            assert listed == bool(np.all(margin > 0.0)), (c.t, c.branch, c.joint, margin)
+            checked[listed] += 1
+    assert checked[True] >= 20 and checked[False] >= 20, checked
+
+
 @pytest.mark.parametrize("q", [
     # joints 1 and 2 at limits (the compiled kernel: a piece between two cuts)
     [2.8973, -1.7628, -2.3708448663282278, -1.0889787975814598, 2.5001604526842525,

@@ -1043,6 +1043,52 @@ static int hm_shared(HmCtx *c, int b, int qi, double a, double fa, double e)
     return 1;
 }
 
+#ifndef HM_LAST_SLOPE
+#define HM_LAST_SLOPE 20.0 /* hm_last: |dq_j/dt| at most this (steeper: the rows' rounding rules) */
+#endif
+#define HM_LAST_F 1e-8     /* hm_last: |q_j - value| at most this at the last row */
+#define HM_LAST_PRED 1e-17 /* hm_last: Newton's predicted |q_j - value| at its step at most this */
+
+/* Whether hm_root's Newton step tn from slot b's row r (query qi, its q_j - value f
+ * and slope d; the previous iterate tp, its slope dp) ends the crossing without a row
+ * at tn (session 12): q_j - value at tn is predicted by Newton's error, half the
+ * curvature (the slopes' secant) times the step squared, at most HM_LAST_PRED (the
+ * stop asks 1e-14 of the row), with |f| <= HM_LAST_F and |d| <= HM_LAST_SLOPE (where
+ * the row's own rounding is below 1e-14: steeper joints, next to an aligned shoulder,
+ * have rows noisier than the stop); and whether slot b's row at tn is inside (into
+ * *in, as hm_inside with MANIFOLD_SLACK would find it) is decided by r and its slopes
+ * (every joint's extrapolated coordinate more than twice its move plus 1e-12 from
+ * each bound; joint j at its queried limit is inside that bound). 0: the row at tn is
+ * evaluated, as before. tn's value is the one hm_root evaluates next. */
+static int hm_last(const HmCtx *c, int b, int qi, const HmRow *r, double f, double d, double tn,
+                   double tp, double dp, int *in)
+{
+    int j = c->qj[qi], kind = c->qkind[qi];
+    double s = tn - r->t, curv = fabs((d - dp) / (r->t - tp));
+    if (!(fabs(f) <= HM_LAST_F && fabs(d) <= HM_LAST_SLOPE &&
+          0.5 * curv * s * s <= HM_LAST_PRED))
+        return 0;
+    int good = 1;
+    for (int m = 0; m < c->n; m++) {
+        double q = r->q[b][m] + r->dq[b][m] * s, room = 2.0 * fabs(r->dq[b][m] * s) + 1e-12;
+        double lo = q - (c->P[PK_LO + m] - MANIFOLD_SLACK);
+        double hi = c->P[PK_HI + m] + MANIFOLD_SLACK - q;
+        if (m == j && kind != HM_KIND_ALIGNED) {
+            if (!(fabs(q - c->qv[qi]) <= 1e-13))
+                return 0; /* at another turn of the value */
+            if (kind == HM_KIND_LOWER) /* at its limit: inside it */
+                lo = 1.0;
+            else
+                hi = 1.0;
+        }
+        if (!(fabs(lo) > room && fabs(hi) > room))
+            return 0;
+        good = good && lo > 0.0 && hi > 0.0;
+    }
+    *in = good;
+    return 1;
+}
+
 /* The root of q_j(t) - value (query qi, slot b) in (a, e), fa, fe of opposite
  * signs (fa at a, continuous over the cell; da, de the slopes there, NaN where
  * not known): Newton with the slope from the root of the cell's cubic Hermite
@@ -1064,6 +1110,7 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
             t = tn;
     }
     int side = 0, best_in = -1; /* best_in: the row at best_t inside (-1: not evaluated) */
+    double tp = NAN, dp = NAN; /* the previous iterate and its slope (hm_last) */
     HmRow r;
     for (int it = 0; it < 80; it++) {
         hm_eval(c, t, 1u << b, 1u << b, &r);
@@ -1105,6 +1152,13 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
         if (!(e - a > 2.0 * DBL_EPSILON * fmax(fabs(a), fabs(e))))
             break;
         double tn = t - f / d;
+        if (tn > a && tn < e && hm_last(c, b, qi, &r, f, d, tn, tp, dp, &best_in)) {
+            best_t = tn; /* Newton's last step, its row not evaluated */
+            best_f = 0.0;
+            break;
+        }
+        tp = t;
+        dp = d;
         if (!(tn > a && tn < e) || !isfinite(tn))
             tn = a - fa * (e - a) / (fe - fa);
         if (!(tn > a && tn < e))
@@ -1929,13 +1983,18 @@ static int hm_emit(HmCtx *c, double *iv, long *k, double a, double e)
  * midpoint, joined; a cut whose pieces on both sides are outside is an interval
  * of its own ([t, t]) when its row is inside to 1e-12 (a branch touching the
  * limits, e.g. the generating configuration at a limit at the range's end). */
-/* Whether slot b's grid row r decides a piece: it exists and every joint is inside
- * its limits, or one outside, by more than HM_DECIDE (far from the piece's cuts,
- * which hold the joints at their limits to HM_TOL_STEEP); into *good. */
+/* Whether slot b's grid row r decides a piece: every joint is inside its limits,
+ * or one outside, by more than HM_DECIDE (far from the piece's cuts, which hold the
+ * joints at their limits to HM_TOL_STEEP), or the row does not exist (outside: the
+ * slot's row appears and disappears only at branch ends, which are cuts; session 12:
+ * 14.4 midpoint rows per pose, each without a row, on the 1,150 development poses);
+ * into *good. */
 static int hm_decides(const HmCtx *c, const HmRow *r, int b, unsigned char *good)
 {
-    if (!r->valid[b])
-        return 0;
+    if (!r->valid[b]) {
+        *good = 0;
+        return 1;
+    }
     double worst = HUGE_VAL;
     for (int j = 0; j < c->n; j++) {
         double m = fmin(r->q[b][j] - c->P[PK_LO + j], c->P[PK_HI + j] - r->q[b][j]);
