@@ -18,7 +18,9 @@
  *      refined by safeguarded Newton (the analytic slope, from the root of the
  *      cell's cubic Hermite model) / Illinois regula falsi on q_j(t) - value
  *      until the joint is at the value to 1e-14 (the row is
- *      pk_one's: pose error <= 4e-13);
+ *      pk_one's: pose error <= 4e-13); Newton's last step takes no row where its
+ *      predicted residual is below the stop and the row's side of every limit follows
+ *      from the last row and its slopes (hm_last, session 12);
  *   3. cells where a slot's row appears or disappears (a fold: two slots meet):
  *      the end where the position root's subproblem-4 discriminant reaches 0
  *      (or HM_DISC_TWO for the pair's second root), by Brent's method on the
