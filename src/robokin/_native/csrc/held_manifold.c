@@ -2527,36 +2527,10 @@ static PyObject *held_manifold_body(const held_manifold_args *a)
     Py_RETURN_NONE;
 }
 
-/* self_motion_intervals._points_refined's cheap test on a held family, the same
- * decision bit for bit: 1 when an interval of iv (m, 2) is at most SM_POINT long,
- * a point's t of pts (npts, 4) is within SM_PAIR of the range's end lo or hi, or
- * two sort keys t + 64 branch (exact but for its one rounding, as numpy's dot)
- * are within SM_PAIR of each other (sm_close's test on [-pi, pi]) */
-static int hm_close(const double *pts, long long npts, const double *iv, long long m,
-                    double lo, double hi)
-{
-    double key[HM_MAXP];
-    for (long long i = 0; i < m; i++)
-        if (iv[2 * i + 1] - iv[2 * i] <= SM_POINT)
-            return 1;
-    for (long long i = 0; i < npts; i++) {
-        double t = pts[4 * i], k = t + 64.0 * pts[4 * i + 1];
-        if (t <= lo + SM_PAIR || t >= hi - SM_PAIR)
-            return 1;
-        long long j = i; /* insertion sort: ~10-60 points */
-        for (; j > 0 && key[j - 1] > k; j--)
-            key[j] = key[j - 1];
-        key[j] = k;
-    }
-    for (long long i = 1; i < npts; i++)
-        if (key[i] - key[i - 1] <= SM_PAIR)
-            return 1;
-    return 0;
-}
 
 /* One pose (robot.self_motion's call): held_manifold of T (4, 4), its intervals
  * packed branch by branch; returns new arrays (intervals (m, 2), branches (m,),
- * points (p, 4)), the flags, the pk_one calls and hm_close's flag (False:
+ * points (p, 4)), the flags, the pk_one calls and sm_close's flag on the held range (False:
  * _points_refined has nothing to find; False on a flagged pose, whose arrays are
  * empty but for the points found before the flag). None, before any row, where T
  * is not a C-contiguous aligned native float64 (4, 4) ndarray (a subclass neither),
@@ -2608,7 +2582,8 @@ static PyObject *held_manifold_one_body(const held_manifold_one_args *a)
         memcpy(PyArray_DATA((PyArrayObject *)out_p), pts, (size_t)(4 * npts) * sizeof(double));
     const double *P = a->params;
     int k = (int)P[PK_HELD];
-    int close = !flags && hm_close(pts, npts, ov, m, P[PK_LO + k], P[PK_HI + k]);
+    double key[HM_MAXP];
+    int close = !flags && sm_close(pts, npts, ov, m, P[PK_LO + k], P[PK_HI + k], key);
     free(iv);
     return Py_BuildValue("(NNNLLN)", out_iv, out_b, out_p, flags, evals, PyBool_FromLong(close));
 }

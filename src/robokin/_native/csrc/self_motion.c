@@ -1316,20 +1316,22 @@ static PyObject *swivel_manifold_body(const swivel_manifold_args *a)
 }
 
 /* self_motion_intervals._points_refined's cheap test, the same decision bit for bit:
- * 1 when the sorted keys psi + 64 branch of the points pts (npts, 4) have two within
- * SM_PAIR (64 branch is exact: one rounding, as numpy's dot), a point's psi is within
- * SM_PAIR of -pi or pi, or an interval of iv (m, 2) is at most SM_POINT long */
-static int sm_close(const double *pts, long long npts, const double *iv, long long m)
+ * 1 when the sorted keys t + 64 branch of the points pts (npts, 4) have two within
+ * SM_PAIR (64 branch is exact: one rounding, as numpy's dot), a point's t is within
+ * SM_PAIR of the range's end lo or hi (the swivel: -pi, pi; a held joint: its
+ * limits, held_manifold.c), or an interval of iv (m, 2) is at most SM_POINT long;
+ * key: npts doubles of scratch */
+static int sm_close(const double *pts, long long npts, const double *iv, long long m,
+                    double lo, double hi, double *key)
 {
-    double key[SM_MAXP];
     for (long long i = 0; i < m; i++)
         if (iv[2 * i + 1] - iv[2 * i] <= SM_POINT)
             return 1;
     for (long long i = 0; i < npts; i++) {
         double t = pts[4 * i], k = t + 64.0 * pts[4 * i + 1];
-        if (t <= -M_PI + SM_PAIR || t >= M_PI - SM_PAIR)
+        if (t <= lo + SM_PAIR || t >= hi - SM_PAIR)
             return 1;
-        long long j = i;  /* insertion sort: npts is at most SM_MAXP, ~10-40 */
+        long long j = i;  /* insertion sort into key (npts long): ~10-60 points */
         for (; j > 0 && key[j - 1] > k; j--)
             key[j] = key[j - 1];
         key[j] = k;
@@ -1372,7 +1374,8 @@ static PyObject *swivel_manifold_one_body(const swivel_manifold_one_args *a)
         }
     if (npts)
         memcpy(PyArray_DATA((PyArrayObject *)out_p), pts, (size_t)(4 * npts) * sizeof(double));
-    int close = sm_close(pts, npts, ov, m);
+    double key[SM_MAXP];
+    int close = sm_close(pts, npts, ov, m, -M_PI, M_PI, key);
     return Py_BuildValue("(NNNN)", out_iv, out_b, out_p, PyBool_FromLong(close));
 }
 
