@@ -20,7 +20,8 @@ from robokin.kinematics.ik import restart_seeds
 from robokin.kinematics.ik.lm_options import option_vector
 from robokin.kinematics.ik.restart_seeds import NO_TABLE
 
-NATIVE = Path(robokin.__file__).parent / "_native"
+# The sources the generator writes (an installed wheel holds no csrc/ to compare).
+NATIVE = Path(__file__).resolve().parents[2] / "src" / "robokin" / "_native"
 
 
 def _generator():
