@@ -235,8 +235,8 @@ def test_one_pose_batch_and_threads_give_the_same_bits(name):
 def test_avx2_and_avx512_copies_agree_to_the_bit():
     try:
         from robokin._native import _avx2, _avx512
-    except ImportError:
-        pytest.skip("built without the AVX2 and AVX-512 copies")
+    except ImportError as e:  # not built, or a copy this CPU does not run
+        pytest.skip(f"the AVX2 and AVX-512 copies cannot both be imported here: {e}")
     if not (_avx2.cpu_has_avx2_fma() and _avx512.cpu_has_avx512()):
         pytest.skip("this CPU does not run both copies")
     for name in SIX_R[:3]:
