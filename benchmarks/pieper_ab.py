@@ -9,7 +9,8 @@ its own held value and at a random one, with random preferred coordinates, throu
 ``pieper_ik`` (every output array), ``pieper_ik1`` (a subset) and ``pieper_limit_rows``
 (the batch's rows), and ``robot.ik(T, fixed=...)`` on the 7R arms. Both trees' outputs
 are compared with ``np.array_equal`` (NaN equal to NaN; the dtype and shape too) and
-each difference is counted.
+each difference is counted. ``--isa-b baseline`` runs tree B's baseline copy (no FMA)
+against tree A's default: a check that the comparison sees last-bit differences.
 
     python benchmarks/pieper_ab.py /work/wt/ref/src /work/wt/ptrip32/src --n 2000
 """
@@ -123,6 +124,7 @@ def main() -> None:
     ap.add_argument("tree_b", help="another tree's src folder")
     ap.add_argument("--n", type=int, default=2000, help="random configurations per case")
     ap.add_argument("--seed", type=int, default=13)
+    ap.add_argument("--isa-b", default=None, help="ROBOKIN_ISA for tree B (e.g. baseline)")
     args = ap.parse_args()
     tests = str(pathlib.Path(__file__).resolve().parent.parent / "tests")
     sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
@@ -134,6 +136,8 @@ def main() -> None:
             path = str(pathlib.Path(tmp) / f"{name}.pkl")
             code = CHILD.format(n=args.n, seed=args.seed, tests=tests, out=path)
             env = {"PYTHONPATH": str(pathlib.Path(src).resolve())}
+            if name == "B" and args.isa_b is not None:
+                env["ROBOKIN_ISA"] = args.isa_b
             res = subprocess.run([sys.executable, "-c", code], env=env, check=True,
                                  capture_output=True, text=True)
             print(name, src, res.stdout.strip())
