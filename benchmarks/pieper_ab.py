@@ -9,8 +9,10 @@ its own held value and at a random one, with random preferred coordinates, throu
 ``pieper_ik`` (every output array), ``pieper_ik1`` (a subset) and ``pieper_limit_rows``
 (the batch's rows), and ``robot.ik(T, fixed=...)`` on the 7R arms. Both trees' outputs
 are compared with ``np.array_equal`` (NaN equal to NaN; the dtype and shape too) and
-each difference is counted. ``--isa-b baseline`` runs tree B's baseline copy (no FMA)
-against tree A's default: a check that the comparison sees last-bit differences.
+each difference is counted. ``--isa-a`` / ``--isa-b`` choose each tree's copy (ROBOKIN_ISA;
+default the CPU's best): ``--isa-a baseline --isa-b baseline`` compares the baseline
+copies; ``--isa-b baseline`` alone, tree B's baseline copy (no FMA) against tree A's
+AVX2 one, checks that the comparison sees last-bit differences.
 
     python benchmarks/pieper_ab.py /work/wt/ref/src /work/wt/ptrip32/src --n 2000
 """
@@ -124,7 +126,8 @@ def main() -> None:
     ap.add_argument("tree_b", help="another tree's src folder")
     ap.add_argument("--n", type=int, default=2000, help="random configurations per case")
     ap.add_argument("--seed", type=int, default=13)
-    ap.add_argument("--isa-b", default=None, help="ROBOKIN_ISA for tree B (e.g. baseline)")
+    ap.add_argument("--isa-a", default=None, help="ROBOKIN_ISA for tree A (e.g. baseline)")
+    ap.add_argument("--isa-b", default=None, help="ROBOKIN_ISA for tree B")
     args = ap.parse_args()
     tests = str(pathlib.Path(__file__).resolve().parent.parent / "tests")
     sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
@@ -136,8 +139,9 @@ def main() -> None:
             path = str(pathlib.Path(tmp) / f"{name}.pkl")
             code = CHILD.format(n=args.n, seed=args.seed, tests=tests, out=path)
             env = {"PYTHONPATH": str(pathlib.Path(src).resolve())}
-            if name == "B" and args.isa_b is not None:
-                env["ROBOKIN_ISA"] = args.isa_b
+            isa = args.isa_a if name == "A" else args.isa_b
+            if isa is not None:
+                env["ROBOKIN_ISA"] = isa
             res = subprocess.run([sys.executable, "-c", code], env=env, check=True,
                                  capture_output=True, text=True)
             print(name, src, res.stdout.strip())
