@@ -26,8 +26,6 @@ import subprocess
 import sys
 import tempfile
 
-import numpy as np
-
 CHILD = r'''
 import pickle, sys
 from math import pi
