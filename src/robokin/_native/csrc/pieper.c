@@ -165,8 +165,8 @@ static void pk_geometry(const double *P, double x, PkGeo *g)
     g->scale = P[PK_SCALE];
     if (k < 0 || k == n - 1) {
         /* no joint after the held one (a 6R chain; the Panda with q7): the first six
-         * as packed, in fixed-size copies (~40 instructions where the loop below
-         * takes ~230; one of pk_front's and the existence margins' costs per row) */
+         * as packed, in fixed-size copies (the loop below takes ~175 instructions
+         * more a call: pk_front_memo's and hm_margins_d's, ~500 per Panda pose) */
         static const int first6[6] = {0, 1, 2, 3, 4, 5};
         _Static_assert(sizeof(v3) == 3 * sizeof(double), "v3: three packed doubles");
         memcpy(g->h, &P[PK_AXES], sizeof g->h);
