@@ -163,17 +163,28 @@ static void pk_geometry(const double *P, double x, PkGeo *g)
     }
     g->kase = (int)P[PK_CASE];
     g->scale = P[PK_SCALE];
-    for (int j = 0; j < n; j++) {
-        if (j == k)
-            continue;
-        v3 h = v3_at(P, PK_AXES + 3 * j), o = v3_at(P, PK_POINTS + 3 * j);
-        if (k >= 0 && j > k) {
-            h = v3_rot(hk, c, s, h);
-            o = v3_add(ok, v3_rot(hk, c, s, v3_sub(o, ok)));
+    if (k < 0 || k == n - 1) {
+        /* no joint after the held one (a 6R chain; the Panda with q7): the first six
+         * as packed, in fixed-size copies (the loop below takes ~175 instructions
+         * more a call: pk_front_memo's and hm_margins_d's, ~500 per Panda pose) */
+        static const int first6[6] = {0, 1, 2, 3, 4, 5};
+        _Static_assert(sizeof(v3) == 3 * sizeof(double), "v3: three packed doubles");
+        memcpy(g->h, &P[PK_AXES], sizeof g->h);
+        memcpy(g->o, &P[PK_POINTS], sizeof g->o);
+        memcpy(g->full, first6, sizeof g->full);
+    } else {
+        for (int j = 0; j < n; j++) {
+            if (j == k)
+                continue;
+            v3 h = v3_at(P, PK_AXES + 3 * j), o = v3_at(P, PK_POINTS + 3 * j);
+            if (j > k) {
+                h = v3_rot(hk, c, s, h);
+                o = v3_add(ok, v3_rot(hk, c, s, v3_sub(o, ok)));
+            }
+            g->h[r] = h;
+            g->o[r] = o;
+            g->full[r++] = j;
         }
-        g->h[r] = h;
-        g->o[r] = o;
-        g->full[r++] = j;
     }
     g->RM = (m3){v3_at(P, PK_TOOL_R), v3_at(P, PK_TOOL_R + 3), v3_at(P, PK_TOOL_R + 6)};
     g->tM = v3_at(P, PK_TOOL_T);
