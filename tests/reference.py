@@ -153,7 +153,8 @@ def random_7r(seed: int = 29):
 #: the rounding floor (next to singular configurations, joints exactly at limits) its
 #: fused multiply-adds round differently from the AVX-512 copy the test was written
 #: on, and the configuration is lost (docs/conventions.md, "One source, one build per
-#: instruction set"). Strict: a copy that finds it fails the mark.
+#: instruction set"; one test since session 13). Strict: a copy that finds it fails
+#: the mark.
 AVX2_FLOOR = pytest.mark.xfail(
     condition=_native.ISA == "avx2+fma",
     strict=True, reason="lost at the rounding floor by the AVX2 copy's last bits")

@@ -2262,7 +2262,8 @@ static int g6_step(const vd *J, const vd *e, int l, double *dq)
  * appended to q (joint coordinates wrapped into [-pi, pi)), after the nsol there, and
  * sig (the Jacobian's smallest singular value). Two solutions are one when they
  * differ by less than GP_DEDUPE, or than 1e-10 / sigma (capped at 1e-3) for a
- * near-singular one (Newton leaves it 1e-15 / sigma off). A lane within the
+ * near-singular one (Newton leaves it 1e-15 / sigma off) that the solution set joins
+ * (g6_joined: not the two roots of a near-double root). A lane within the
  * tolerance but above G6_TIGHT of it is taken by g6_refine to G6_TIGHT of it, else
  * dropped: such a lane is no near-converged solution but a point of a near-continuum
  * (issue 23: the offset iiwa at q4 = +-1e-9, where axes 3 and 5 almost meet; the
@@ -2329,6 +2330,88 @@ static int g6_refine(const Chain *ch, const vd *tt, vd *qv, int l, double tol_p,
     for (int j = 0; j < 6; j++)
         qv[j][l] = q0[j];
     return 1;
+}
+
+#define G6_JOIN_STEPS 4  /* Gauss-Newton steps of g6_joined's halfway point */
+#define G6_JOIN_RATIO 10 /* its error above this times the rows' (and the floor): two */
+
+/* The pose error max(|position error| [m], |rotation error| [rad]) of chain values x
+ * (6) against tt (broadcast), with the Jacobian J and residual e there (lane 0). */
+static double g6_error_at(const Chain *ch, const vd *tt, const double *x, vd *J, vd *e)
+{
+    vd qq[MAXJ], t[12];
+    for (int j = 0; j < 6; j++)
+        qq[j] = BR(x[j]);
+    chain_pose_jac(ch, qq, t, J, 6);
+    pose_residual(t, tt, e, BRL(-1));
+    double ep = sqrt(e[0][0] * e[0][0] + e[1][0] * e[1][0] + e[2][0] * e[2][0]);
+    double er = sqrt(e[3][0] * e[3][0] + e[4][0] * e[4][0] + e[5][0] * e[5][0]);
+    return fmax(ep, er);
+}
+
+/* Whether near-singular solutions a and b (6 chain values each, within the
+ * near-singular dedupe distance of each other) are one solution: two exact points of
+ * one thin set (a continuum at the rounding floor), or two roots with the pose left
+ * between them, which are two solutions (the Panda with joint 2 held at q3 = q6 =
+ * 1e-6: two exact rows 7.4e-6 apart along the near-null direction, 7e-15 from T,
+ * 2.6e-13 at best halfway; the merge kept the one whose candidate came first, which
+ * the instruction sets' roundings decide). The point halfway is moved onto the
+ * solution set across the chord: G6_JOIN_STEPS Gauss-Newton steps of least squares
+ * [J; w u^T] s = [e; 0] (u along b - a, w the largest column norm of J) remove a thin
+ * set's departure from its chord (its curvature), not a gap along it. One when the
+ * best point's error is within (tol_p, tol_r) and at most G6_JOIN_RATIO times the
+ * worse of the two rows' errors plus floor_err. */
+static int g6_joined(const Chain *ch, const vd *tt, const double *a, const double *b,
+                     double tol_p, double tol_r, double floor_err)
+{
+    vd J[36], e[6];
+    double x[6], u[6], un = 0.0;
+    const double ends = fmax(g6_error_at(ch, tt, a, J, e), g6_error_at(ch, tt, b, J, e));
+    for (int j = 0; j < 6; j++) {
+        u[j] = wrap_pi(b[j] - a[j]);
+        x[j] = a[j] + 0.5 * u[j];
+        un += u[j] * u[j];
+    }
+    un = sqrt(un);
+    if (!(un > 0.0))
+        return 1;
+    double best = INFINITY, bp = INFINITY, br = INFINITY;
+    for (int it = 0;; it++) {
+        double m = g6_error_at(ch, tt, x, J, e);
+        if (m < best) {
+            best = m;
+            bp = sqrt(e[0][0] * e[0][0] + e[1][0] * e[1][0] + e[2][0] * e[2][0]);
+            br = sqrt(e[3][0] * e[3][0] + e[4][0] * e[4][0] + e[5][0] * e[5][0]);
+        }
+        if (it == G6_JOIN_STEPS)
+            break;
+        double A[7 * 6], V[7 * 6], beta[6], r[7], s[6], w = 0.0, big = 0.0;
+        for (int c = 0; c < 6; c++) {
+            double n2 = 0.0;
+            for (int i = 0; i < 6; i++)
+                n2 += J[6 * i + c][0] * J[6 * i + c][0];
+            w = fmax(w, sqrt(n2));
+        }
+        for (int c = 0; c < 6; c++) /* column-major, column c: J's, then w u_c */
+            for (int i = 0; i < 7; i++)
+                A[7 * c + i] = i < 6 ? J[6 * i + c][0] : w * u[c] / un;
+        for (int i = 0; i < 7; i++)
+            r[i] = i < 6 ? e[i][0] : 0.0;
+        house_qr(A, 7, 6, V, beta);
+        house_apply_t(V, beta, 7, 6, r);
+        for (int i = 5; i >= 0; i--) {
+            double acc = r[i];
+            for (int k = i + 1; k < 6; k++)
+                acc -= A[7 * k + i] * s[k];
+            s[i] = acc / A[7 * i + i];
+            big = fmax(big, fabs(s[i]));
+        }
+        if (!isfinite(big))
+            break;
+        for (int j = 0; j < 6; j++)
+            x[j] += s[j];
+    }
+    return bp <= tol_p && br <= tol_r && best <= G6_JOIN_RATIO * ends + floor_err;
 }
 
 /* How far coordinates qs (6) lie outside the limits [rad] as g6_range returns them
@@ -2479,7 +2562,11 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
                     double d = fabs(wrap_pi(qs[j] - q[6 * s + j]));
                     m = d > m ? d : m;
                 }
-                dup = m < tol;
+                /* beyond GP_DEDUPE: one near-singular solution twice only where the
+                 * solution set joins them (g6_joined; a near-double root's two
+                 * roots are both kept) */
+                dup = m < tol
+                      && (m < dedupe || g6_joined(ch, tt, qs, q + 6 * s, tol_p, tol_r, floor_err));
                 /* one near-singular solution twice (two exact points of its thin
                  * set, up to 1e-3 apart): the kept one is the one inside the limits,
                  * or nearer them by more than GP_DEDUPE (two polishes of one regular

@@ -356,7 +356,20 @@ def _in_bounds(q: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
 
 def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
                extra: list[tuple[float, int]]) -> tuple[np.ndarray, np.ndarray]:
-    """Per branch: the maximal parameter intervals inside every limit."""
+    """Per branch: the maximal parameter intervals inside every limit.
+
+    The pieces between a branch's cuts are decided at their midpoints: between cuts
+    a joint keeps its side of each limit. Not where the midpoint's row has a joint
+    within ``MANIFOLD_SLACK`` of a limit: its side there is rounding's (a joint
+    touching its limit, whose two crossings either side of the touch are found or not
+    by the last bits), and the rows further on may be out by far more than the slack
+    with no crossing between (the offset iiwa's #5084, q4 at its limit at q's value:
+    with the touch's crossings lost to rounding, the whole piece between two folds,
+    rows 7e-5 out at its ends, was inside). Such a piece is inside as a whole where
+    its rows at both ends are inside too (a piece between two crossings at a
+    corner), else over its midpoint's in-slack stretch (``_widen`` from the
+    midpoint, up to the piece's ends).
+    """
     lo_d, hi_d = fam.domain
     cuts: dict[int, list[float]] = {b: [lo_d, hi_d] for b in range(fam.k)}
     for t, b, *_ in marks["limit"] + marks["fold"]:
@@ -379,8 +392,24 @@ def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
     with np.errstate(invalid="ignore"):
         out = ((q < limits[:, 0] - MANIFOLD_SLACK)
                | (q > limits[:, 1] + MANIFOLD_SLACK))  # (pieces, n)
+        at = np.abs(q[..., None] - limits).min(-1) <= MANIFOLD_SLACK  # (pieces, n)
     out[~valid] = True  # no row: no corner next to it
-    for (a, e), b, good in zip(spans, owners, ok, strict=True):
+    if fam.joint is not None:
+        at[:, fam.joint] = False  # the parameter (its range's ends are cuts)
+    kept = list(spans)  # each piece's part inside
+    touching = np.flatnonzero(ok & at.any(axis=1))
+    if len(touching):  # its rows at both ends inside too, or its midpoint's stretch
+        qe, ve = fam.slot_rows(np.array([spans[i] for i in touching]).ravel(),
+                               np.repeat(np.array(owners)[touching], 2))
+        touching = touching[~(ve & _within(qe, limits)).reshape(-1, 2).all(axis=1)]
+    if len(touching):
+        stretch = _widen(fam, limits, [(mids[i], mids[i], owners[i]) for i in touching],
+                         [True] * len(touching), [spans[i] for i in touching])
+        for i, (_, a, e) in zip(touching.tolist(), stretch, strict=True):
+            if a > mids[i]:  # (a periodic family's stretch shifted by a turn)
+                a, e = a - _TWO_PI, e - _TWO_PI
+            kept[i] = (max(a, spans[i][0]), min(e, spans[i][1]))
+    for (a, e), b, good in zip(kept, owners, ok, strict=True):
         if not good:
             continue
         if pieces and pieces[-1][0] == b and pieces[-1][2] == a:
