@@ -7,8 +7,6 @@ import math
 import numpy as np
 import pytest
 
-from robokin import _native
-
 
 def dh_standard(rows, q):
     """Hand-written standard DH product: rows of (theta0, d, a, alpha, kind)."""
@@ -147,17 +145,6 @@ def random_7r(seed: int = 29):
              "limits": [-np.radians(170), np.radians(170)], "name": f"r{i + 1}"}
             for i in range(7)]
     return robokin.Robot.from_dh(rows, convention="standard", name=f"random7r_{seed}")
-
-
-#: Strict expected failure on the AVX2 copy (the one a CPU without AVX-512 runs): at
-#: the rounding floor (next to singular configurations, joints exactly at limits) its
-#: fused multiply-adds round differently from the AVX-512 copy the test was written
-#: on, and the configuration is lost (docs/conventions.md, "One source, one build per
-#: instruction set"; one test since session 13). Strict: a copy that finds it fails
-#: the mark.
-AVX2_FLOOR = pytest.mark.xfail(
-    condition=_native.ISA == "avx2+fma",
-    strict=True, reason="lost at the rounding floor by the AVX2 copy's last bits")
 
 
 def kernel_copies() -> dict:
