@@ -8,7 +8,8 @@
  *      solve -J_held: the pose stays fixed along the manifold; hm_slopes_fast
  *      where the first three axes meet: two 3 x 3 solves);
  *   2. per slot and cell between grid nodes with a row at both ends: the cell is
- *      split (a midpoint solved, up to HM_DEPTH times) while a joint moves more
+ *      split (a midpoint solved, up to HM_DEPTH times; for the slot pair where the
+ *      partner splits the same cell, hm_split_row) while a joint moves more
  *      than HM_JUMP in it or a joint's distance to a value (a limit or an
  *      aligned-axes value) changes sign inconsistently with its end slopes, or
  *      its cubic Hermite model (values and slopes at the ends) dips across the
@@ -41,7 +42,8 @@
  * for (either of pk_one's families: the meeting triple first, PK_START, the Panda's
  * shoulder, or last, PK_END, the Gen3-like arm's wrist with joint_3 held; before
  * session 10 the PK_END rows were full pk_one solves, ~550 per pose), with pk_one's
- * polish and its repairs of those rows, and hands over to
+ * polish and its repairs of those rows (the late ones, hm_stays, only where no
+ * row of any slot is inside: hm_others_inside), and hands over to
  * pk_one only where a repair pk_one tries when no other row is inside would move
  * one (never on the 1,150 development poses; ~750 full solves per pose before
  * round 5), the same rows bit for bit (HM_VERIFY: 0 differences on 1,150 poses).
