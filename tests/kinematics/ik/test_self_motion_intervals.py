@@ -183,6 +183,31 @@ def test_compiled_manifold_agrees_with_rows_and_solved_points(special):
     assert compiled >= POSES * 3 // 4
 
 
+# Near an aligned shoulder (q2 small, not flagged): q1 and q3 of both shoulder
+# solutions swing together, and their cells split at the same t values, which the
+# kernel evaluates once for the slot pair (session 13, hm_split_row: on these four
+# poses 95, 73, 77 and 73 split rows became 51, 40, 44 and 37 evaluations).
+NEAR_ALIGNED = [
+    [1.691, 0.05, 1.442, -1.83, -1.96, 2.841, 0.528],
+    [-2.306, -0.02, 2.247, -1.77, 1.454, 0.235, -0.286],
+    [1.473, 0.003, 0.082, -2.176, 1.456, 1.488, -1.167],
+    [1.283, -0.001, 0.178, -0.687, 2.284, 0.077, 0.459],
+]
+
+
+@pytest.mark.parametrize("q", NEAR_ALIGNED)
+def test_shoulder_branches_swinging_together_keep_their_own_intervals(q):
+    # oracle: the held-q7 rows at 20,000 values (_check_dense), the solved-points
+    # path (_check_against_solved_points) and every end at its limit (_check_ends),
+    # for both shoulder solutions of every wrist root
+    T = PANDA.fk(np.array(q))
+    sm = PANDA.self_motion(T)
+    assert sm.info.get("compiled") and sm.info["flags"] == 0
+    _check_dense(sm)
+    _check_against_solved_points(PANDA, T, sm)
+    _check_ends(PANDA, T, sm)
+
+
 def test_compiled_manifold_calls_the_full_solver_only_where_it_may_differ():
     # hm_closed: the closed form alone wherever pk_one would return it unchanged, so
     # pk_one ("solves") runs at a few t values per pose (~70 on 1,150 poses; the

@@ -8,7 +8,8 @@
  *      solve -J_held: the pose stays fixed along the manifold; hm_slopes_fast
  *      where the first three axes meet: two 3 x 3 solves);
  *   2. per slot and cell between grid nodes with a row at both ends: the cell is
- *      split (a midpoint solved, up to HM_DEPTH times) while a joint moves more
+ *      split (a midpoint solved, up to HM_DEPTH times; for the slot pair where the
+ *      partner splits the same cell, hm_split_row) while a joint moves more
  *      than HM_JUMP in it or a joint's distance to a value (a limit or an
  *      aligned-axes value) changes sign inconsistently with its end slopes, or
  *      its cubic Hermite model (values and slopes at the ends) dips across the
@@ -41,7 +42,8 @@
  * for (either of pk_one's families: the meeting triple first, PK_START, the Panda's
  * shoulder, or last, PK_END, the Gen3-like arm's wrist with joint_3 held; before
  * session 10 the PK_END rows were full pk_one solves, ~550 per pose), with pk_one's
- * polish and its repairs of those rows, and hands over to
+ * polish and its repairs of those rows (the late ones, hm_stays, only where no
+ * row of any slot is inside: hm_others_inside), and hands over to
  * pk_one only where a repair pk_one tries when no other row is inside would move
  * one (never on the 1,150 development poses; ~750 full solves per pose before
  * round 5), the same rows bit for bit (HM_VERIFY: 0 differences on 1,150 poses).
@@ -88,7 +90,7 @@
 #define HM_SLOPE_DET 1e-10 /* hm_slopes_fast: a block's determinant per unit columns below it: hm_slopes */
 #endif
 #define HM_DISC_TWO 1e-15 /* a discriminant / (A^2 + B^2) above it: sp4_roots' two roots */
-#define HM_PAIR_ROWS 48 /* near-fold rows kept for the partner slot (hm_eval_pair) */
+#define HM_PAIR_ROWS 128 /* rows kept for the partner slot (hm_eval_pair, hm_split_row) */
 #define HM_MAXG 8 /* grazes (a branch inside a limit by under HM_TOL) per slot */
 #ifndef HM_UNSURE
 #define HM_UNSURE 1 /* 0: a measuring build, coarse cells split as the others */
@@ -108,11 +110,13 @@ enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FL
 #define HM_FRONTS 64 /* recent fronts kept (hm_front) */
 
 /* Every slot at one t: coordinates (into the limits where a turn fits), slopes dq/dt
- * (NaN where the six other joints' Jacobian is singular), row exists, singular. */
+ * (NaN where the six other joints' Jacobian is singular), row exists, singular; the
+ * slots whose slopes were computed (sloped: a bit per slot, the others' dq unset). */
 typedef struct {
     double t;
     double q[8][PK_MAXJ], dq[8][PK_MAXJ];
     unsigned char valid[8], sing[8];
+    unsigned sloped;
 } HmRow;
 
 typedef struct { /* one evaluation's rows (hm_keep, hm_recall) */
@@ -166,7 +170,8 @@ typedef struct {
     double wt, wq[2], wx[3];
     int wok;
     v3 wr;
-    /* near-fold rows of a slot pair (b, b ^ 1), evaluated together (hm_eval_pair) */
+    /* rows of a slot pair (b, b ^ 1) evaluated together (hm_eval_pair): near a fold, and
+     * split midpoints the partner splits too (hm_split_row) */
     HmRow pair_row[HM_PAIR_ROWS];
     unsigned pair_need[HM_PAIR_ROWS], pair_mask[HM_PAIR_ROWS];
     int npair, ipair;
@@ -626,18 +631,25 @@ static int hm_far_isolated(const PkGeo *g, const double *th, const double cs[2][
     return det > 8.0 * PK_FAMILY_SIGMA * b * b * b;
 }
 
-static int hm_closed(HmCtx *c, double x, unsigned need, const PkFront *f, int code, HmRow *r)
+/* The position slots (a bit each) of the slots in `need` */
+static unsigned hm_want(unsigned need)
+{
+    unsigned want = 0u;
+    for (int i = 0; i < 4; i++)
+        want |= (need >> 2 * i & 3u) != 0u ? 1u << i : 0u;
+    return want;
+}
+
+/* hm_closed's rows: the slots in `need` at x from front f (status PK_OK) into r
+ * (cleared before); the rows hm_repairs left outside, which only pk_one's late
+ * repairs may move, into late_th and *late (a bit per slot). Returns whether a row
+ * made here is inside (after the early repairs: pk_one's test before its late ones).
+ * late NULL: a probe (hm_others_inside), no repairs tried: whether a row is inside as
+ * made (1 at the first; the rows in r then partial). */
+static int hm_make(HmCtx *c, double x, unsigned need, const PkFront *f, HmRow *r,
+                   double late_th[8][6], unsigned *late)
 {
     const double *P = c->P;
-    for (int b = 0; b < 8; b++) {
-        r->valid[b] = r->sing[b] = 0;
-        for (int j = 0; j < PK_MAXJ; j++)
-            r->q[b][j] = NAN;
-    }
-    if (code == PK_FRONT_SWIVEL || code == PK_FRONT_GENERAL)
-        return 0; /* He and Liu's general case: not this kernel's */
-    if (code != PK_OK)
-        return 1; /* pk_one: cleared, no row */
     const PkGeo *g = &f->g;
     const PkPos *pos = &f->pos;
     int held = (int)P[PK_HELD];
@@ -645,8 +657,6 @@ static int hm_closed(HmCtx *c, double x, unsigned need, const PkFront *f, int co
     int held_in = pk_held_inside(P, held, x);
     int ia = f->ia, it = f->it;
     double f2 = NAN; /* hm_far_isolated's bound of |J|_F^2, once per call */
-    double late_th[8][6]; /* rows hm_repairs left outside: hm_stays after the loop */
-    unsigned late = 0u;
     int inside = 0; /* a row made here is inside: pk_one tries no late repair */
     for (int i = 0; i < pos->n; i++) {
         unsigned slots = 3u << (2 * pos->slot[i]);
@@ -676,7 +686,9 @@ static int hm_closed(HmCtx *c, double x, unsigned need, const PkFront *f, int co
             }
             double m = pk_coords(P, g, th, held, x, r->q[slot]);
             inside |= m >= -1e-9;
-            if (!(m >= -1e-9) && held_in) {
+            if (late == NULL && inside)
+                return 1; /* a probe (hm_others_inside): one row inside */
+            if (!(m >= -1e-9) && held_in && late != NULL) {
                 /* pk_one's repairs may move it: a singular row, one within reach of
                  * pk_inside, one pk_resplit moves (next to an aligned triple: its
                  * split of the outer angles; tried on a copy, hm_stays moves the
@@ -713,13 +725,53 @@ static int hm_closed(HmCtx *c, double x, unsigned need, const PkFront *f, int co
                     inside = 1;
                 } else if (moves || family) {
                     memcpy(late_th[slot], th, sizeof late_th[slot]);
-                    late |= 1u << slot;
+                    *late |= 1u << slot;
                 }
             }
             r->valid[slot] = 1;
             r->sing[slot] = (unsigned char)sing;
         }
     }
+    return inside;
+}
+
+/* Whether a slot not in `need` has a row inside at x as made, before any repair
+ * (hm_make's probe; from a front of their own, not kept: pk_front_memo's, the same
+ * bits as any front at x for those slots): then pk_one, which makes every slot, tries
+ * no late repair on any row (a row inside as made is inside after its early repairs,
+ * which leave it alone), and the late rows of the slots in need stay as made. 0 where
+ * only a repair could bring one inside: hm_stays decides, as before. Asked only where
+ * hm_stays would run (a row of `need` left outside, none inside): its repairs
+ * (pk_slide's SVD, pk_walk, pk_pin) cost ~20,000 instructions a call, the probe a few
+ * thousand. */
+static int hm_others_inside(HmCtx *c, double x, unsigned need)
+{
+    unsigned rest = 0xffu & ~need;
+    if (!rest)
+        return 0;
+    PkFront f;
+    if (pk_front_memo(c->P, c->T, x, c->qn, 0, &c->front, hm_want(rest), &f) != PK_OK)
+        return 0; /* no row of those slots */
+    HmRow o;
+    return hm_make(c, x, rest, &f, &o, NULL, NULL);
+}
+
+static int hm_closed(HmCtx *c, double x, unsigned need, const PkFront *f, int code, HmRow *r)
+{
+    for (int b = 0; b < 8; b++) {
+        r->valid[b] = r->sing[b] = 0;
+        for (int j = 0; j < PK_MAXJ; j++)
+            r->q[b][j] = NAN;
+    }
+    if (code == PK_FRONT_SWIVEL || code == PK_FRONT_GENERAL)
+        return 0; /* He and Liu's general case: not this kernel's */
+    if (code != PK_OK)
+        return 1; /* pk_one: cleared, no row */
+    double late_th[8][6]; /* rows hm_repairs left outside: hm_stays after the loop */
+    unsigned late = 0u;
+    int inside = hm_make(c, x, need, f, r, late_th, &late);
+    if (late && !inside)
+        inside = hm_others_inside(c, x, need);
     for (int slot = 0; slot < 8 && !inside; slot++)
         if ((late >> slot & 1u) && !hm_stays(c, f, late_th[slot], r->q[slot], r->sing[slot]))
             return 0; /* what pk_one makes of it depends on the other slots */
@@ -738,9 +790,7 @@ static int hm_closed(HmCtx *c, double x, unsigned need, const PkFront *f, int co
  * root), at a shared crossing (hm_shared) or a pair's piece. */
 static const PkFront *hm_front(HmCtx *c, double x, unsigned need, int *code)
 {
-    unsigned want = 0u; /* the position slots of the slots in need */
-    for (int i = 0; i < 4; i++)
-        want |= (need >> 2 * i & 3u) != 0u ? 1u << i : 0u;
+    unsigned want = hm_want(need);
     int seen = 0; /* any kept front at x: one vectorised pass (as hm_recall) */
     for (int i = 0; i < HM_FRONTS; i++)
         seen |= c->front_t[i] == x;
@@ -868,9 +918,11 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
     }
     hm_keep(c, t, need, closed, r);
 slopes:
+    r->sloped = 0u;
     for (int b = 0; b < 8; b++) {
         if (!r->valid[b] || !(mask >> b & 1u))
             continue;
+        r->sloped |= 1u << b;
         if (!(c->fast && !c->full_fk && hm_slopes_fast(c, t, r->q[b], r->dq[b])))
             hm_slopes(P, c->n, c->k, r->q[b], r->dq[b]);
 #ifdef HM_SLOPE_CHECK
@@ -889,22 +941,31 @@ slopes:
 }
 
 
-/* Slot b's row at t (its slope when `slopes`) for a branch end and its near-fold
- * piece: the slot and its partner b ^ 1 (the same position root, the wrist's other
- * solution: its branch ends at the same t and its piece has rows at the same t
- * values) are evaluated together and the row kept (HM_PAIR_ROWS of them), so that
- * the partner's end and piece take it from here: one closed form (pk_front, the
- * position roots and the triple) for both. The rows are the same as evaluated one
- * slot at a time (hm_closed's per-slot rows, or pk_one's where it hands over). */
-static void hm_eval_pair(HmCtx *c, double t, int b, int slopes, HmRow *r)
+/* Whether a pair row at t with slot b (its slope when `slopes`) is kept: then into *r. */
+static int hm_pair_find(const HmCtx *c, double t, int b, int slopes, HmRow *r)
 {
-    unsigned pair = 3u << (b & ~1), mask = slopes ? 1u << b : 0u;
+    unsigned mask = slopes ? 1u << b : 0u;
     for (int i = 0; i < c->npair; i++)
         if (c->pair_row[i].t == t && (c->pair_need[i] >> b & 1u) &&
             (c->pair_mask[i] & mask) == mask) {
             *r = c->pair_row[i];
-            return;
+            return 1;
         }
+    return 0;
+}
+
+/* Slot b's row at t (its slope when `slopes`) for a branch end and its near-fold
+ * piece, or a split midpoint (hm_split_row): the slot and its partner b ^ 1 (the
+ * same position root, the wrist's other solution: its branch ends at the same t
+ * and its piece has rows at the same t values) are evaluated together and the row
+ * kept (HM_PAIR_ROWS of them), so that the partner's end, piece and splits take it
+ * from here: one closed form (pk_front, the position roots and the triple) for both. The rows are the same as evaluated one
+ * slot at a time (hm_closed's per-slot rows, or pk_one's where it hands over). */
+static void hm_eval_pair(HmCtx *c, double t, int b, int slopes, HmRow *r)
+{
+    unsigned pair = 3u << (b & ~1);
+    if (hm_pair_find(c, t, b, slopes, r))
+        return;
     hm_eval(c, t, slopes ? pair : 0u, pair, r);
     int i = c->ipair;
     c->ipair = (i + 1) % HM_PAIR_ROWS;
@@ -1308,7 +1369,7 @@ static double hm_gap(const HmCtx *c, int b, const HmRow *r)
  * HM_JUMP, a slope missing, or a query's sign change that its end slopes do not
  * explain as one monotone crossing, or whose Hermite model dips across. dj: each
  * joint's move over the cell (wrap_pi(q1 - q0)), fq: each query's q_j - value at
- * r0 (hm_f), as hm_cell computes them once for both (the same values). */
+ * r0 (hm_f), as hm_moves computes them once for both (the same values). */
 static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1,
                           const double *dj, const double *fq)
 {
@@ -1625,6 +1686,43 @@ static int hm_jump(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
     return hm_bisect_jump(c, b, &ra, &rb) && hm_split_jump(c, b, r0, r1, &ra, &rb, depth);
 }
 
+/* Slot b's cell [r0, r1]: each joint's move dj (wrap_pi(q1 - q0)) and each query's
+ * q_j - value at r0 (fq, hm_f), as hm_needs_split and the crossings take them */
+static void hm_moves(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1, double *dj,
+                     double *fq)
+{
+    for (int j = 0; j < c->n; j++)
+        dj[j] = wrap_pi(r1->q[b][j] - r0->q[b][j]);
+    for (int qi = 0; qi < c->nq; qi++)
+        fq[qi] = hm_f(c, r0, b, qi);
+}
+
+/* Slot b's row at t, the midpoint of its cell [r0, r1] that hm_cell splits, with b's
+ * slope. The partner slot p = b ^ 1 (the same q4 - q6; its shoulder the other
+ * triple: the two swing together next to an aligned shoulder) has its pass right
+ * after b's: where b is the first of the pair and p's rows at r0 and r1 exist with
+ * their slopes and need the split too (hm_needs_split on p's cell: p's pass splits
+ * the same cell at the same t), both are evaluated together and kept
+ * (hm_eval_pair), and p's pass takes its row from there (hm_pair_find): one front
+ * and triple for both (session 13: ~25 such rows per Panda pose, half of hm_cell's;
+ * the same rows, each a function of t and its slot). */
+static void hm_split_row(HmCtx *c, int b, double t, const HmRow *r0, const HmRow *r1,
+                         HmRow *m)
+{
+    int p = b ^ 1;
+    if (hm_pair_find(c, t, b, 1, m))
+        return;
+    if (!(b & 1) && r0->valid[p] && r1->valid[p] && (r0->sloped & r1->sloped) >> p & 1u) {
+        double dj[PK_MAXJ], fq[HM_MAXQ];
+        hm_moves(c, p, r0, r1, dj, fq);
+        if (hm_needs_split(c, p, r0, r1, dj, fq)) {
+            hm_eval_pair(c, t, b, 1, m);
+            return;
+        }
+    }
+    hm_eval(c, t, 1u << b, 1u << b, m);
+}
+
 static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
 {
     if (c->flags || c->retry)
@@ -1632,10 +1730,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
     if (c->njump && hm_known_jump(c, b, r0, r1, depth))
         return;
     double dj[PK_MAXJ], fq[HM_MAXQ];
-    for (int j = 0; j < c->n; j++)
-        dj[j] = wrap_pi(r1->q[b][j] - r0->q[b][j]);
-    for (int qi = 0; qi < c->nq; qi++)
-        fq[qi] = hm_f(c, r0, b, qi);
+    hm_moves(c, b, r0, r1, dj, fq);
     if (hm_needs_split(c, b, r0, r1, dj, fq)) {
         if (depth < HM_DEPTH) {
             HmRow m;
@@ -1644,7 +1739,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
                 double sm = hm_of_sigma(c, 0.5 * (hm_sigma(c, r0->t) + hm_sigma(c, r1->t)));
                 mid = sm > r0->t && sm < r1->t ? sm : mid;
             }
-            hm_eval(c, mid, 1u << b, 1u << b, &m);
+            hm_split_row(c, b, mid, r0, r1, &m);
             if (!m.valid[b]) {
                 c->flags |= HM_FLAG_VANISH;
                 return;
