@@ -127,6 +127,20 @@ typedef struct { /* one evaluation's rows (hm_keep, hm_recall) */
     unsigned char valid[8], sing[8];
 } HmMemo;
 
+/* hm_margins_d's parts that do not depend on the held value x where PkFrontMemo's
+ * do (the Panda): the position equations' d part (pk_equations_d's), the null
+ * combination n, theta_a's subproblem 4 coefficients A, B, hab = hypot(A, B) and
+ * their phase (pk_sp4's); computed by hm_margins_d at its first call of a pose and
+ * copied after (the same operations on the same values: the same bits; not
+ * PkFrontMemo's e and pk_coplanar_x part: the same expressions, inlined into other
+ * code, are contracted into FMAs differently, which moved interval ends by up to
+ * 2.2e-11). set = 0 empties it; cop: axes b, c coplanar (else only e is kept). */
+typedef struct {
+    int set, cop;
+    PkEq e;
+    double n[2], A, B, hab, phi, cphi, sphi;
+} HmMargMemo;
+
 typedef struct {
     const double *P, *T;
     int n, k;
@@ -179,6 +193,7 @@ typedef struct {
     double memo_t[HM_MEMO]; /* memo[i].t, contiguous: hm_recall's first test */
     long nmemo;
     PkFrontMemo front; /* pk_front's held-value-free parts (hm_closed) */
+    HmMargMemo marg; /* hm_margins_d's held-value-free parts */
     /* recent fronts (hm_front): held value, the position slots solved, status */
     PkFront fronts[HM_FRONTS];
     double front_t[HM_FRONTS];
@@ -1837,14 +1852,14 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn, int
     c->sq_te = NAN;
 }
 
-static int hm_margins_d(const double *P, const double *T, double x, double *m, double *d);
+static int hm_margins_d(HmCtx *c, double x, double *m, double *d);
 
 /* The t in (a, e) where the discriminant of subproblem k (hm_margins_d's d[k]) is
  * `off`, fa and fe its values minus off there, of opposite signs: Brent's method
  * (inverse quadratic / secant steps safeguarded by bisection) until the bracket is
  * 1e-15 (relative to max(1, |t|)) wide or a value is 0; no rows. NaN when a
  * discriminant is not finite inside. */
-static double hm_margin_root(const double *P, const double *T, int k, double off, double a,
+static double hm_margin_root(HmCtx *ctx, int k, double off, double a,
                              double fa, double e, double fe)
 {
     double m[3], dk[3], c = a, fc = fa, d = e - a, g = d;
@@ -1893,7 +1908,7 @@ static double hm_margin_root(const double *P, const double *T, int k, double off
         a = e;
         fa = fe;
         e += fabs(d) > tol ? d : copysign(tol, mid);
-        hm_margins_d(P, T, e, m, dk);
+        hm_margins_d(ctx, e, m, dk);
         fe = dk[k] - off;
         if (!isfinite(fe))
             return NAN;
@@ -1917,7 +1932,7 @@ static int hm_fold_margin(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, HmR
 {
     double m0[3], m1[3], d0[3], d1[3];
     int state0 = r0->valid[b];
-    if (!hm_margins_d(c->P, c->T, r0->t, m0, d0) || !hm_margins_d(c->P, c->T, r1->t, m1, d1))
+    if (!hm_margins_d(c, r0->t, m0, d0) || !hm_margins_d(c, r1->t, m1, d1))
         return 0;
     const double *mv = state0 ? m0 : m1, *mu = state0 ? m1 : m0;
     int k = -1;
@@ -1933,7 +1948,7 @@ static int hm_fold_margin(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, HmR
     double fa = d0[k] - off, fe = d1[k] - off;
     if (!((fa > 0.0) == (state0 != 0) && (fe > 0.0) != (state0 != 0)))
         return 0;
-    double t = hm_margin_root(c->P, c->T, k, off, r0->t, fa, r1->t, fe);
+    double t = hm_margin_root(c, k, off, r0->t, fa, r1->t, fe);
     if (!(t > r0->t && t < r1->t))
         return 0;
     double dir = state0 ? 1.0 : -1.0; /* toward the side without the row */
@@ -2208,18 +2223,29 @@ static void hm_intervals(HmCtx *c, int b, double lo, double hi, const HmRow *row
 /* The existence margins of the position roots at held value x (pk_one's front end
  * and pk_coplanar's two subproblems 4 written out): m[0] = (hypot(A, B) - |C|) /
  * scale of the first angle (its two roots exist where m[0] >= 0), m[1 + i] the same
- * of the second angle given first root i (NaN without it). A branch is born or
- * dies where one crosses 0. Returns 0 when the position equations are not of the
- * coplanar kind (He and Liu's case; the kernel then flags the pose). */
-static int hm_margins_d(const double *P, const double *T, double x, double *m, double *d)
+ * of the second angle given first root i (NaN without it); d (or NULL) the
+ * discriminants over A^2 + B^2. A branch is born or dies where one crosses 0. The
+ * x-free parts are kept in c->marg (HmMargMemo). Returns 0 when the position
+ * equations are not of the coplanar kind (He and Liu's case; the kernel then
+ * flags the pose). */
+static int hm_margins_d(HmCtx *c, double x, double *m, double *d)
 {
+    const double *T = c->T;
     PkGeo g;
-    pk_geometry(P, x, &g);
+    pk_geometry(c->P, x, &g);
     m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
     v3 pT = {T[3], T[7], T[11]};
     m3 G = pk_mul_t(&RT, &g.RM);
+    HmMargMemo *k = pk_memo_usable(c->P, &g) ? &c->marg : NULL;
     PkEq e;
-    pk_pose_equations(&g, &RT, pT, &G, &e);
+    if (k != NULL && k->set) {
+        v3 p, pd;
+        pk_pose_points(&g, &RT, pT, &G, &p, &pd);
+        e = k->e;
+        pk_equations_p(&e, p);
+    } else {
+        pk_pose_equations(&g, &RT, pT, &G, &e);
+    }
     int swap;
     if (fabs(e.mbc) <= PK_COPLANAR)
         swap = 0;
@@ -2227,32 +2253,62 @@ static int hm_margins_d(const double *P, const double *T, double x, double *m, d
         swap = 1;
     else
         return 0;
-    double n[2], L = e.scale;
-    v3 h = swap ? e.ha : e.hc, o = swap ? e.oa : e.oc;
-    pk_null(h, e.hb, v3_scale(v3_sub(o, e.ob), 1.0 / L), n);
+    double n[2], L = e.scale, A, B, hab, phi = 0.0, cphi = 1.0, sphi = 0.0;
     const double(*X)[2] = swap ? e.Q : e.P;
     const double(*Y)[2] = swap ? e.P : e.Q;
     double sx = swap ? -1.0 : 1.0;
-    double A = sx * (n[0] * X[0][0] + n[1] * X[1][0]);
-    double B = sx * (n[0] * X[0][1] + n[1] * X[1][1]);
+    if (k != NULL && k->set && k->cop) {
+        n[0] = k->n[0];
+        n[1] = k->n[1];
+        A = k->A;
+        B = k->B;
+        hab = k->hab;
+        phi = k->phi;
+        cphi = k->cphi;
+        sphi = k->sphi;
+    } else {
+        v3 h = swap ? e.ha : e.hc, o = swap ? e.oa : e.oc;
+        pk_null(h, e.hb, v3_scale(v3_sub(o, e.ob), 1.0 / L), n);
+        A = sx * (n[0] * X[0][0] + n[1] * X[1][0]);
+        B = sx * (n[0] * X[0][1] + n[1] * X[1][1]);
+        hab = hypot(A, B);
+        if (!(hab <= 1e-12 * L)) {
+            phi = fast_atan2(B, A);
+            unit2(B, A, &cphi, &sphi);
+        }
+        if (k != NULL && !k->set) { /* kept: x-free (PkFrontMemo's premise) */
+            k->e = e;
+            k->cop = !swap;
+            k->n[0] = n[0];
+            k->n[1] = n[1];
+            k->A = A;
+            k->B = B;
+            k->hab = hab;
+            k->phi = phi;
+            k->cphi = cphi;
+            k->sphi = sphi;
+            k->set = 1;
+        }
+    }
     double C = n[0] * e.r[0] + n[1] * e.r[1];
-    m[0] = (hypot(A, B) - fabs(C)) / L;
+    m[0] = (hab - fabs(C)) / L;
     m[1] = m[2] = NAN;
     if (d != NULL) {
         d[0] = (A * A + B * B - C * C) / (A * A + B * B);
         d[1] = d[2] = NAN;
     }
-    if (hypot(A, B) <= 1e-12 * L)
+    if (hab <= 1e-12 * L)
         return 0; /* the first angle free: not this kind */
-    Roots rx = pk_sp4(A, B, C, PK_SP4_SLACK * L);
+    Roots rx = pk_sp4_at(A, B, C, PK_SP4_SLACK * L, phi, cphi, sphi);
     double m0 = -n[1], m1 = n[0];
     double Ay = -sx * (m0 * Y[0][0] + m1 * Y[1][0]);
     double By = -sx * (m0 * Y[0][1] + m1 * Y[1][1]);
+    double hy = hypot(Ay, By);
     for (int i = 0; i < rx.n && i < 2; i++) {
         double Xu0 = X[0][0] * rx.c[i] + X[0][1] * rx.s[i];
         double Xu1 = X[1][0] * rx.c[i] + X[1][1] * rx.s[i];
         double Cy = m0 * (e.r[0] - sx * Xu0) + m1 * (e.r[1] - sx * Xu1);
-        m[1 + i] = (hypot(Ay, By) - fabs(Cy)) / L;
+        m[1 + i] = (hy - fabs(Cy)) / L;
         if (d != NULL)
             d[1 + i] = (Ay * Ay + By * By - Cy * Cy) / (Ay * Ay + By * By);
     }
@@ -2264,21 +2320,21 @@ static int hm_margins_d(const double *P, const double *T, double x, double *m, d
     return 1;
 }
 
-static int hm_margins(const double *P, const double *T, double x, double *m)
+static int hm_margins(HmCtx *c, double x, double *m)
 {
-    return hm_margins_d(P, T, x, m, NULL);
+    return hm_margins_d(c, x, m, NULL);
 }
 
 /* The extremum of margin k in (a, e) (golden section; a maximum when want_max):
  * its t. */
-static double hm_margin_extremum(const double *P, const double *T, int k, double a, double e,
+static double hm_margin_extremum(HmCtx *c, int k, double a, double e,
                                  int want_max)
 {
     const double r = 0.6180339887498949;
     double x1 = e - r * (e - a), x2 = a + r * (e - a), m[3], f1, f2;
-    hm_margins(P, T, x1, m);
+    hm_margins(c, x1, m);
     f1 = want_max ? m[k] : -m[k];
-    hm_margins(P, T, x2, m);
+    hm_margins(c, x2, m);
     f2 = want_max ? m[k] : -m[k];
     for (int it = 0; it < 60 && e - a > 1e-13 * fmax(1.0, fabs(a)); it++) {
         if (!(f1 <= f2)) { /* NaN counts as low */
@@ -2286,14 +2342,14 @@ static double hm_margin_extremum(const double *P, const double *T, int k, double
             x2 = x1;
             f2 = f1;
             x1 = e - r * (e - a);
-            hm_margins(P, T, x1, m);
+            hm_margins(c, x1, m);
             f1 = want_max ? m[k] : -m[k];
         } else {
             a = x1;
             x1 = x2;
             f1 = f2;
             x2 = a + r * (e - a);
-            hm_margins(P, T, x2, m);
+            hm_margins(c, x2, m);
             f2 = want_max ? m[k] : -m[k];
         }
     }
@@ -2335,7 +2391,7 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
     for (long i = 0; i < G; i++) {
         nd[i].t = i == G - 1 ? hi : lo + (hi - lo) * (double)i / (double)(G - 1);
         nd[i].keep = i % HM_STRIDE == 0 || i == G - 1;
-        if (!hm_margins(c->P, c->T, nd[i].t, m[i])) {
+        if (!hm_margins(c, nd[i].t, m[i])) {
             /* not the coplanar kind (Pieper's quartic: the offset-SRS iiwa14): the pose
              * is flagged whatever the rest finds, so stop here (the rows, cells and
              * folds cost ~44 ms per such pose for an output the caller discards) */
@@ -2358,7 +2414,7 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
             int in_a = m[i][0] >= 0;
             for (int it = 0; it < 60 && e - a > 1e-12 * fmax(1.0, fabs(a)); it++) {
                 double mid = 0.5 * (a + e);
-                hm_margins(c->P, c->T, mid, me);
+                hm_margins(c, mid, me);
                 if ((me[0] >= 0) == in_a)
                     a = mid;
                 else
@@ -2396,9 +2452,9 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
             if (!turns)
                 continue;
             nd[i].keep = nd[i + 1].keep = 1;
-            double te = hm_margin_extremum(c->P, c->T, k, nd[i].t, nd[i + 1].t, a < 0);
+            double te = hm_margin_extremum(c, k, nd[i].t, nd[i + 1].t, a < 0);
             double me[3];
-            hm_margins(c->P, c->T, te, me);
+            hm_margins(c, te, me);
             if (!isfinite(me[k]) || (me[k] < 0) == (a < 0))
                 continue; /* no island, no gap */
             if (nt >= cap) {
@@ -2571,6 +2627,7 @@ static void hm_range(void *ctx, long b0, long e0)
             c->memo[m].t = c->memo_t[m] = NAN; /* nothing kept */
         c->nmemo = 0;
         c->front.set = 0;
+        c->marg.set = 0;
         for (int m = 0; m < HM_FRONTS; m++)
             c->front_t[m] = NAN; /* no front kept */
         c->nfront = 0;

@@ -1906,6 +1906,14 @@ typedef struct {
     PkTri tri;
 } PkFrontMemo;
 
+/* Whether PkFrontMemo's parts are held-value-free at geometry g: the chain starts
+ * with its triple and the held joint is the last (pk_front_memo, held_manifold.c's
+ * margins) */
+static int pk_memo_usable(const double *P, const PkGeo *g)
+{
+    return g->kase == PK_START && (int)P[PK_HELD] == (int)P[PK_N] - 1;
+}
+
 /* Axes i < j of the full chain (i, j != held) are coplanar (mutual moment below
  * PK_COPLANAR) at held value x only incidentally: the held joint lies between them
  * (turning axis j about the held axis, the moment is a cos v + b sin v + c in the
@@ -1998,7 +2006,7 @@ static int pk_front_memo(const double *P, const double *T, double x, const doubl
     f->start = g->kase == PK_START;
     f->ia = f->start ? 3 : 0;
     f->it = f->start ? 0 : 3;
-    if (memo != NULL && !(f->start && (int)P[PK_HELD] == (int)P[PK_N] - 1))
+    if (memo != NULL && !pk_memo_usable(P, g))
         memo = NULL; /* the remaining chain moves with x */
     PkEq e;
     v3 p, d;
