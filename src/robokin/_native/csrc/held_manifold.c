@@ -1816,10 +1816,19 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn, int
         return;
     HmRow r[HM_FOLD_STEPS + 1];
     int m = 0;
-    double w = rn->t - re->t;
-    for (int k = HM_FOLD_STEPS; k >= (sigma ? HM_FOLD_STEPS : 1); k--) {
-        hm_eval_pair(c, re->t + w * ldexp(1.0, -2 * k), b, 1, &r[m]);
+    double w = rn->t - re->t, tol = HM_FOLD_TOL * fmax(1.0, fabs(re->t));
+    int kmin = sigma ? HM_FOLD_STEPS : 1;
+    for (int k = HM_FOLD_STEPS; k >= kmin; k--) {
+        double t = re->t + w * ldexp(1.0, -2 * k);
+        hm_eval_pair(c, t, b, 1, &r[m]);
         if (!r[m].valid[b]) {
+            if (m == 0 && k > 1 && fabs(t - re->t) <= tol) {
+                /* no row yet within the end's own tolerance (the rows' rounding puts
+                 * the end a little further on, e.g. without FMA): the first row
+                 * further from it */
+                kmin = k - 1 < kmin ? k - 1 : kmin;
+                continue;
+            }
             c->flags |= HM_FLAG_VANISH;
             return;
         }
