@@ -727,6 +727,49 @@ def test_a_graze_keeps_its_in_slack_stretch(arm, q):
     assert dp.max() <= 1e-12 and dr.max() <= 1e-12, (dp, dr)
 
 
+#: SRS poses (special, seed 77; session 14) with grazes past a limit by an ulp or two:
+#: the branch crosses the limit twice within 1e-7 (q2 at its lower limit about psi = 0;
+#: q7 at its upper one about psi = -1.1585387) and main listed only the ~1e-7 between
+#: the crossings, not the ~5e-6 over which the rows are within the slack (the baseline
+#: copy, without FMA, turns more grazes into such pairs: test_a_graze_keeps_... [srs-q2]).
+SHORT_GRAZES = [
+    ([1.3269210885894474, 2.0943951023931953, 0.0, -1.875030896295985, 2.25062268972827,
+      -0.170666117811491, -2.087924023143236], 1, 0.0, (6, 7)),
+    ([1.4765181946630461, 2.0368442570221688, -1.3539415771106191, 1.0099247480193103,
+      1.5707963267948966, -1.5707963267948966, 3.0543261909900767], 6, -1.1585386608,
+     (1, 3)),
+]
+
+
+@pytest.mark.parametrize(("q", "joint", "t0", "branches"), SHORT_GRAZES)
+def test_a_graze_past_its_limit_by_rounding_keeps_its_in_slack_stretch(q, joint, t0,
+                                                                        branches):
+    # Oracles: the branch's rows (closed form) and FK. The interval about the graze is
+    # longer than 1e-6, its rows at 9 values across it are inside (MANIFOLD_SLACK),
+    # reproduce the pose to 1e-12 and hold the joint within the slack of its limit;
+    # 1e-7 past either end the joint is out by more than the slack (the stretch's
+    # extent, not a part of it).
+    robot = _arm("srs")
+    T = robot.fk(np.array(q))
+    sm = robot.self_motion(T)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    for b in branches:
+        iv = sm.intervals[(sm.interval_branch == b) & (sm.intervals[:, 0] <= t0)
+                          & (t0 <= sm.intervals[:, 1])]
+        assert len(iv) == 1, (b, sm.intervals[sm.interval_branch == b])
+        a, e = iv[0]
+        assert e - a > 1e-6, (b, a, e)
+        rows = sm.sample(np.linspace(a, e, 9))[:, b]
+        assert np.all((rows >= lo - MANIFOLD_SLACK) & (rows <= hi + MANIFOLD_SLACK))
+        dp, dr = pose_errors(robot.fk(rows), np.broadcast_to(T, (9, 4, 4)))
+        assert dp.max() <= 1e-12 and dr.max() <= 1e-12, (dp, dr)
+        gap = np.minimum(np.abs(rows[:, joint] - lo[joint]), np.abs(rows[:, joint] - hi[joint]))
+        assert gap.max() <= MANIFOLD_SLACK, gap
+        past = sm.sample(np.array([a - 1e-7, e + 1e-7]))[:, b, joint]
+        out = np.maximum(lo[joint] - past, past - hi[joint])
+        assert np.all(out > MANIFOLD_SLACK), out
+
+
 @pytest.mark.parametrize(("arm", "q"), [
     # q3, q7 at limits, q7 the parameter at its range's end, q2 = 1e-6 (the shoulder
     # lined up): main's row there 7.5e-11 out (a singular configuration)

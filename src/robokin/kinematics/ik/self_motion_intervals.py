@@ -621,7 +621,11 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
       value either side (geometric probes 1e-9 .. 1e-3, then ``_WIDEN`` search
       steps on the rows); a side with no probe outside is not widened. (An
       interval at most ``_POINT`` long, a few ulps, is widened from its ends the
-      same way; a longer one ends at exact crossings.)
+      same way, and so is one at most ``_PAIR`` long between two limit crossings
+      of its branch: a graze whose extremum is past the limit by an ulp or two,
+      which the kernels' rounding decides (the baseline copy, without FMA, where
+      the AVX2 copy's extremum touches it exactly); a longer one, or one ending at
+      a fold, an aligned point or a range end, ends there.)
       On the solved-points path of a joint parameter (``every``, not the swivel's
       reference) the range's ends are such candidates too
       (the parameter at its limit), and every interval is widened so: its ends
@@ -692,6 +696,15 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         cuts = np.concatenate([cuts, ends])
         near = np.concatenate([near, np.ones(2 * fam.k, dtype=bool)])
     point = intervals[:, 1] - intervals[:, 0] <= _POINT
+    lim_pts = points[points[:, 3] <= upper]
+    short = np.flatnonzero(~point & (intervals[:, 1] - intervals[:, 0] <= _PAIR))
+    if len(short):  # between two limit crossings of its branch (not at a fold, an aligned
+        # point or a range end): a graze whose extremum is past the limit by an ulp or
+        # two (the baseline copy, without FMA), widened like a point
+        own = lim_pts[:, None, 1] == owner[None, short]
+        at_a = (own & (lim_pts[:, None, 0] == intervals[None, short, 0])).any(axis=0)
+        at_e = (own & (lim_pts[:, None, 0] == intervals[None, short, 1])).any(axis=0)
+        point[short[at_a & at_e]] = True
     cand = near | every
     c, near = cuts[cand], near[cand]
     if len(c):  # crossings already in an interval of their branch: nothing to find
@@ -717,7 +730,6 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     reach = [False] * len(stretch)  # a touch's side inside at every probe: to the last one
     caps = [(lo_d, hi_d)] * len(stretch)  # how far a touch's side goes (its branch's
     # nearest crossings of another joint)
-    lim_pts = points[points[:, 3] <= upper]
     first_touch = len(c) - len(touch)
     corners: list[tuple[float, int, np.ndarray]] = []
     points_only: list[tuple[int, float, float]] = []
