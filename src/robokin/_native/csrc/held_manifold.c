@@ -2370,12 +2370,6 @@ typedef struct { /* a node of hm_grid: its t, and whether rows are evaluated the
     int keep;
 } HmNode;
 
-static int hm_node_cmp(const void *x, const void *y)
-{
-    double a = ((const HmNode *)x)->t, b = ((const HmNode *)y)->t;
-    return a < b ? -1 : a > b;
-}
-
 /* The grid: the existence margins at G values over [lo, hi] (cheap scalars, no rows),
  * and in every cell where a margin keeps its sign at both nodes but the parabola
  * through it and a neighbour node turns back toward 0 inside the cell, its extremum
@@ -2474,11 +2468,26 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
         }
     }
     free(m);
-    qsort(nd, (size_t)nt, sizeof(HmNode), hm_node_cmp);
-    long kept = 0;
-    for (long i = 0; i < nt; i++)
-        if (nd[i].keep)
-            t[kept++] = nd[i].t;
+    /* the grid's nodes are in order and the extra ones (all kept) few: the extra ones
+     * sorted by insertion (stable), then merged with the grid's kept nodes, a grid node
+     * first at equal t (qsort's stable order; ~4 % of the kernel's instructions before) */
+    for (long i = G + 1; i < nt; i++) {
+        HmNode x = nd[i];
+        long j = i - 1;
+        for (; j >= G && nd[j].t > x.t; j--)
+            nd[j + 1] = nd[j];
+        nd[j + 1] = x;
+    }
+    long kept = 0, e = G;
+    for (long i = 0; i < G; i++) {
+        if (!nd[i].keep)
+            continue;
+        for (; e < nt && nd[e].t < nd[i].t; e++)
+            t[kept++] = nd[e].t;
+        t[kept++] = nd[i].t;
+    }
+    for (; e < nt; e++)
+        t[kept++] = nd[e].t;
     free(nd);
     return kept;
 }
