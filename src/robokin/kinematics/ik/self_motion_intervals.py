@@ -621,11 +621,14 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
       value either side (geometric probes 1e-9 .. 1e-3, then ``_WIDEN`` search
       steps on the rows); a side with no probe outside is not widened. (An
       interval at most ``_POINT`` long, a few ulps, is widened from its ends the
-      same way, and so is one at most ``_PAIR`` long between two limit crossings
-      of its branch: a graze whose extremum is past the limit by an ulp or two,
+      same way, and so is one at most ``_PAIR`` long between two crossings of
+      one joint of its branch with no aligned or fold point of the branch within
+      ``_PROBES[-1]``: a graze whose extremum is past the limit by an ulp or two,
       which the kernels' rounding decides (the baseline copy, without FMA, where
       the AVX2 copy's extremum touches it exactly); a longer one, or one ending at
-      a fold, an aligned point or a range end, ends there.)
+      a fold, an aligned point, a range end or crossings of two joints, ends
+      there: next to an aligned point the outer joints swing by up to pi between
+      the widening's probes.)
       On the solved-points path of a joint parameter (``every``, not the swivel's
       reference) the range's ends are such candidates too
       (the parameter at its limit), and every interval is widened so: its ends
@@ -698,13 +701,26 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     point = intervals[:, 1] - intervals[:, 0] <= _POINT
     lim_pts = points[points[:, 3] <= upper]
     short = np.flatnonzero(~point & (intervals[:, 1] - intervals[:, 0] <= _PAIR))
-    if len(short):  # between two limit crossings of its branch (not at a fold, an aligned
-        # point or a range end): a graze whose extremum is past the limit by an ulp or
-        # two (the baseline copy, without FMA), widened like a point
+    if len(short):  # between two crossings of one joint of its branch (not at a fold, an
+        # aligned point, a range end or another joint's crossing, and no aligned point of
+        # the branch within the widening's reach, where the outer joints swing by up to
+        # pi between probes): a graze whose extremum is past the limit by an ulp or two
+        # (the baseline copy, without FMA), widened like a point
         own = lim_pts[:, None, 1] == owner[None, short]
-        at_a = (own & (lim_pts[:, None, 0] == intervals[None, short, 0])).any(axis=0)
-        at_e = (own & (lim_pts[:, None, 0] == intervals[None, short, 1])).any(axis=0)
-        point[short[at_a & at_e]] = True
+        at_a = own & (lim_pts[:, None, 0] == intervals[None, short, 0])  # (p, s)
+        at_e = own & (lim_pts[:, None, 0] == intervals[None, short, 1])
+        joints = lim_pts[:, 2, None]
+        same = ((at_a[:, None, :] & at_e[None, :, :])
+                & (joints[:, None, :] == joints[None, :, :])).any(axis=(0, 1))
+        sing = points[points[:, 3] > upper]
+        ts = sing[:, 0]
+        if fam.periodic:  # (the swivel: an aligned point at -pi is one at pi)
+            ts = np.concatenate([ts - 2 * np.pi, ts, ts + 2 * np.pi])
+            sing = np.tile(sing, (3, 1))
+        swing = ((sing[:, None, 1] == owner[None, short])
+                 & (ts[:, None] >= intervals[None, short, 0] - _PROBES[-1])
+                 & (ts[:, None] <= intervals[None, short, 1] + _PROBES[-1])).any(axis=0)
+        point[short[same & ~swing]] = True
     cand = near | every
     c, near = cuts[cand], near[cand]
     if len(c):  # crossings already in an interval of their branch: nothing to find
