@@ -727,17 +727,25 @@ def test_a_graze_keeps_its_in_slack_stretch(arm, q):
     assert dp.max() <= 1e-12 and dr.max() <= 1e-12, (dp, dr)
 
 
-#: SRS poses (special, seed 77; session 14) with grazes past a limit by an ulp or two:
-#: the branch crosses the limit twice within 1e-7 (q2 at its lower limit about psi = 0;
-#: q7 at its upper one about psi = -1.1585387) and main listed only the ~1e-7 between
-#: the crossings, not the ~5e-6 over which the rows are within the slack (the baseline
-#: copy, without FMA, turns more grazes into such pairs: test_a_graze_keeps_... [srs-q2]).
+#: SRS poses (session 14) with grazes past a limit by an ulp or two: the branch crosses
+#: the limit twice within 1e-7 (q2 at its lower limit about psi = 0; q7 at its upper one
+#: about psi = -1.1585387; special poses of seed 77) and main listed only the ~1e-7
+#: between the crossings, not the ~5e-6 over which the rows are within the slack (the
+#: baseline copy, without FMA, turns more grazes into such pairs:
+#: test_a_graze_keeps_its_in_slack_stretch[srs-q2]).
 SHORT_GRAZES = [
     ([1.3269210885894474, 2.0943951023931953, 0.0, -1.875030896295985, 2.25062268972827,
       -0.170666117811491, -2.087924023143236], 1, 0.0, (6, 7)),
     ([1.4765181946630461, 2.0368442570221688, -1.3539415771106191, 1.0099247480193103,
       1.5707963267948966, -1.5707963267948966, 3.0543261909900767], 6, -1.1585386608,
      (1, 3)),
+    # q7 at its upper limit at its extremum along branch 7 (self_motion_rates.py, seed 0,
+    # special #9963): the AVX2 copy's two crossings lie 3e-8 apart; the baseline copy's
+    # are one double root, listed once, where main listed no interval (a regular
+    # configuration missed); the kernel's one-point rule now takes a double root too
+    ([-2.223080418346953, -1.2226921479944846, 1e-06, 2.0943951023931953,
+      1.5707963267948966, -0.3942466311202748, 3.0543261909900767], 6, 1.187037142e-06,
+     (7,)),
 ]
 
 

@@ -936,11 +936,14 @@ typedef struct {
     int joint, kind;
     double value; /* the joint coordinate (limits) or chain angle (aligned / fold) */
     double cv, sv; /* the cosine and sine of the value's chain angle (SM_LIMCS, SM_FOLDCS) */
+    int once; /* a limit's double root (the joint's extremum at it: a graze), listed once */
 } SmCand;
 
 /* Swivel angles (up to 2) where joint j (0-2, 4-6) is at chain angle L on elbow
- * root e (swivel.py limit_swivels), each Newton-polished on its subproblem 4 */
-static int sm_limit_psi(const SmArm *a, const SmFrame *f, int e, int j, double L, double *psi)
+ * root e (swivel.py limit_swivels), each Newton-polished on its subproblem 4; *once:
+ * the two are one double root (|C| at or past the amplitude within SM_DOUBLE), given once */
+static int sm_limit_psi(const SmArm *a, const SmFrame *f, int e, int j, double L, double *psi,
+                        int *once)
 {
     const v3 *h = a->h;
     v3 x, y;
@@ -987,8 +990,10 @@ static int sm_limit_psi(const SmArm *a, const SmFrame *f, int e, int j, double L
         sgn = -1.0;
     }
     double t[2], A, B, C;
+    *once = 0;
     if (!sm_sp4(f->u, x, y, k, &t[0], &t[1], &A, &B, &C))
         return 0;
+    *once = t[0] == t[1];
     int n = 0;
     for (int i = 0; i < 2; i++) {
         double phi = t[i], g = A * cos(phi) + B * sin(phi) - C;
@@ -1013,17 +1018,17 @@ static int sm_limit_psi(const SmArm *a, const SmFrame *f, int e, int j, double L
  * triple's middle angle at an end of its range (outer axes in line, or a fold) */
 static int sm_candidates(const SmArm *a, const SmFrame *f, int e, SmCand *c)
 {
-    int n = 0;
+    int n = 0, once;
     double psi[2];
     for (int j = 0; j < 7; j++) {
         if (j == 3 || a->hi[j] - a->lo[j] >= 2.0 * M_PI)
             continue;
         for (int s = 0; s < 2; s++) {
             double lim = s ? a->hi[j] : a->lo[j];
-            int m = sm_limit_psi(a, f, e, j, a->sign[j] * lim + a->offset[j], psi);
+            int m = sm_limit_psi(a, f, e, j, a->sign[j] * lim + a->offset[j], psi, &once);
             for (int i = 0; i < m; i++)
                 c[n++] = (SmCand){psi[i], j, s ? SM_KIND_UPPER : SM_KIND_LOWER, lim,
-                                  a->limcs[4 * j + 2 * s], a->limcs[4 * j + 2 * s + 1]};
+                                  a->limcs[4 * j + 2 * s], a->limcs[4 * j + 2 * s + 1], once};
         }
     }
     for (int t = 0; t < 2; t++) {
@@ -1037,10 +1042,10 @@ static int sm_candidates(const SmArm *a, const SmFrame *f, int e, SmCand *c)
             m3 Rb = sm_rotm(hb, L);
             double al = fabs(v3_dot(ha, m3_mv(&Rb, hc)));
             int kind = al > 1.0 - 1e-12 ? SM_KIND_ALIGNED : SM_KIND_FOLD;
-            int m = sm_limit_psi(a, f, e, o + 1, L, psi);
+            int m = sm_limit_psi(a, f, e, o + 1, L, psi, &once);
             for (int i = 0; i < m; i++)
                 c[n++] = (SmCand){psi[i], o + 1, kind, L, s ? -a->foldcs[2 * t] : a->foldcs[2 * t],
-                                  s ? -a->foldcs[2 * t + 1] : a->foldcs[2 * t + 1]};
+                                  s ? -a->foldcs[2 * t + 1] : a->foldcs[2 * t + 1], 0};
         }
     }
     return n;
@@ -1068,18 +1073,23 @@ static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmC
                     double run[2][SM_MAXI][2], int nrun[2])
 {
     double cut[66];
-    int m = 0, j0 = part == 1 ? 0 : 4;
+    int m = 0, j0 = part == 1 ? 0 : 4, once[66] = {0};
     cut[m++] = -M_PI;
     cut[m++] = M_PI;
     for (int i = 0; i < nc; i++)
-        if ((c[i].joint < 3) == (part == 1))
+        if ((c[i].joint < 3) == (part == 1)) {
+            once[m] = c[i].once;
             cut[m++] = c[i].psi;
+        }
     for (int i = 1; i < m; i++) { /* insertion sort (stable), at most 66 cuts */
         double x = cut[i];
-        int k = i;
-        for (; k > 0 && cut[k - 1] > x; k--)
+        int k = i, o = once[i];
+        for (; k > 0 && cut[k - 1] > x; k--) {
             cut[k] = cut[k - 1];
+            once[k] = once[k - 1];
+        }
         cut[k] = x;
+        once[k] = o;
     }
     int open[2] = {0, 0};
     nrun[0] = nrun[1] = 0;
@@ -1100,10 +1110,12 @@ static void sm_runs(const SmArm *a, const SmFrame *f, int e, int part, const SmC
                 in = sm_root_inside(a, j0, &t, r);
             }
             if (!in && !open[r] && lo > -M_PI && nrun[r] < SM_MAXI &&
-                (lo - cut[i - 1] <= SM_CORNER || hi - lo <= SM_CORNER)) {
+                (lo - cut[i - 1] <= SM_CORNER || hi - lo <= SM_CORNER || once[i])) {
                 /* both cells next to the cut outside and another cut within SM_CORNER
-                 * (two joints of the triple at limits there, leaving on either side):
-                 * the cut alone, if its row is in */
+                 * (two joints of the triple at limits there, leaving on either side), or
+                 * the cut a limit's double root (a joint's extremum at its limit to
+                 * rounding: a graze from outside, which _points_refined widens to its
+                 * in-slack stretch): the cut alone, if its row is in */
                 if (!at)
                     sm_part_split(a, f, e, lo, part, &tc);
                 at = 1;
