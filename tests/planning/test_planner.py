@@ -299,10 +299,13 @@ def test_result_arrays_are_read_only_and_the_summary_reads(ur5_shelf):
 def _elbow_ring(robot, T):
     """Balls along the elbow's circle of the pose's self-motion but for one free arc.
 
-    The held-q7 IK at five q7 values and ``robot.ik``'s own solutions all put the
-    elbow (frame 4's origin) on a ball; the manifold sample farthest from all of
-    theirs keeps its elbow 0.16 m from every ball. Returns the scene, those
-    configurations and the free one.
+    The held-q7 IK at five q7 values (closed form: the same on every kernel copy) puts
+    the elbow (frame 4's origin) on a ball; the manifold sample farthest from all of
+    those keeps its elbow 0.16 m from every ball. Returns the scene, those
+    configurations, the free one and ``robot.ik``'s own in-limit solutions (numeric:
+    where its LM lands differs between the kernels' copies at the rounding floor; on
+    the AVX2 copy all six collide, on the baseline copy one of seven lies in the free
+    arc).
     """
     from robokin.kinematics.forward import link_frames
 
@@ -310,11 +313,11 @@ def _elbow_ring(robot, T):
     q = sm.sample(np.linspace(*sm.domain, 2001), within_limits=True).reshape(-1, robot.n)
     q = q[np.isfinite(q).all(axis=1)]
     elbow = link_frames(robot.chain, q)[:, 4, :3, 3]
-    sampled = [robot.ik(T, fixed={"joint7": v}).keep_within_limits().solutions()
-               for v in np.linspace(0.15, 1.45, 5)]
-    sampled.append(robot.ik(T).keep_within_limits().solutions())
-    blocked = np.vstack([np.asarray(s).reshape(-1, robot.n) for s in sampled])
-    near = link_frames(robot.chain, blocked)[:, 4, :3, 3]
+    held = np.vstack([np.asarray(robot.ik(T, fixed={"joint7": v}).keep_within_limits()
+                                 .solutions()).reshape(-1, robot.n)
+                      for v in np.linspace(0.15, 1.45, 5)])
+    own = np.asarray(robot.ik(T).keep_within_limits().solutions()).reshape(-1, robot.n)
+    near = link_frames(robot.chain, held)[:, 4, :3, 3]
     w = int(np.argmax(np.linalg.norm(elbow[:, None] - near[None], axis=-1).min(axis=1)))
     scene = Scene("elbow ring")
     balls: list[np.ndarray] = []
@@ -322,21 +325,26 @@ def _elbow_ring(robot, T):
         if not balls or np.linalg.norm(np.array(balls) - e, axis=1).min() > 0.02:
             balls.append(e)
             scene.add_sphere(f"ball_{len(balls)}", 0.02, pose(e))
-    return scene, blocked, q[w]
+    return scene, held, q[w], own
 
 
 def test_a_seven_joint_pose_goal_reaches_the_free_part_of_its_self_motion():
     # the Panda's pose T: the elbow's circle of its self-motion is lined with balls
-    # but for one arc; every configuration of the held-q7 IK at five q7 values and
-    # every solution robot.ik returns collides (so the old goals, robot.ik's, were
-    # all in collision and the query failed). Oracle: coal (tests/planning_oracle.py)
-    # says those collide and the free arc's sample is free; the path ends at a
-    # configuration whose FK is T (to 1e-9) and is free sampled every 0.01 rad.
+    # but for one arc; every configuration of the held-q7 IK at five q7 values
+    # collides, and so does every solution robot.ik returns on the AVX2 copy (so the
+    # old goals, robot.ik's, were all in collision and the query failed; the baseline
+    # copy's LM lands one of them in the free arc: _elbow_ring). Oracle: coal
+    # (tests/planning_oracle.py) says those collide and the free arc's sample is free;
+    # the path ends at a configuration whose FK is T (to 1e-9), none of the colliding
+    # ones, and is free sampled every 0.01 rad.
     robot = robokin.load("panda")
     T = robot.fk(np.array([0.0, 0.3, 0.0, -1.8, 0.0, 2.1, 0.8]))
-    scene, blocked, free = _elbow_ring(robot, T)
+    scene, held, free, own = _elbow_ring(robot, T)
     oracle = Oracle(robot, scene)
-    assert len(blocked) >= 5 and all(oracle.min_distance(b) < 0.0 for b in blocked)
+    assert len(held) >= 5 and all(oracle.min_distance(b) < 0.0 for b in held)
+    hit = [b for b in own if oracle.min_distance(b) < 0.0]
+    assert len(hit) >= len(own) - 1  # (every one on the AVX2 copy)
+    blocked = np.vstack([held] + hit)
     assert oracle.min_distance(free) > 0.05
     start = np.array([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
     pl = planning.Planner(robot, scene)
