@@ -451,10 +451,12 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
     intervals, owner = _intervals(fam, limits, marks, ends)
     cuts = np.array([(t, b, j, 0) for t, b, j, _ in marks["limit"]], dtype=np.float64)
     touch = np.array(marks.get("touch", []), dtype=np.float64).reshape(-1, 3)
+    sing = np.array([(t, b) for t, b, _ in marks["fold"] + marks["aligned"]],
+                    dtype=np.float64).reshape(-1, 2)
     intervals, owner, corners = _points_refined(fam, limits, intervals, owner,
                                                 cuts.reshape(-1, 4), 0,
                                                 every=not isinstance(fam, _ContinuedFamily),
-                                                touch=touch)
+                                                touch=touch, singular=sing)
     crossings = tuple(LimitCrossing(t, b, j, s) for t, b, j, s in marks["limit"])
     singular = tuple(SingularPoint(t, b, k) for t, b, k in marks["fold"] + marks["aligned"])
     method = ("swivel closed form (SRS)" if fam.name == "swivel"

@@ -602,7 +602,7 @@ _CONDITIONING = 1e-7
 
 def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
                     owner: np.ndarray, points: np.ndarray, upper: int, every: bool = False,
-                    touch: np.ndarray | None = None
+                    touch: np.ndarray | None = None, singular: np.ndarray | None = None
                     ) -> tuple[np.ndarray, np.ndarray, tuple[tuple[float, int, np.ndarray], ...]]:
     """Graze stretches and corners the intervals miss (issue 29, helper rates29).
 
@@ -659,6 +659,10 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     the close crossings, kept even inside an interval (an interval ending at a
     shallow crossing is widened to the in-slack stretch past it).
 
+    ``singular`` (s, 2) ``[t, branch]``: the aligned and fold points of a family whose
+    ``points`` hold its crossings only (the Python paths'); the kernels' points hold
+    theirs (kind above ``upper``).
+
     Returns ``(intervals, owner, corners)``; the arrays unchanged (the same objects)
     when nothing is found: a uniform pose computes no row here (its cost is the
     test for short intervals and close points, ~5 us; the compiled swivel's kernel
@@ -712,7 +716,9 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         joints = lim_pts[:, 2, None]
         same = ((at_a[:, None, :] & at_e[None, :, :])
                 & (joints[:, None, :] == joints[None, :, :])).any(axis=(0, 1))
-        sing = points[points[:, 3] > upper]
+        sing = points[points[:, 3] > upper, :2]
+        if singular is not None:
+            sing = np.concatenate([sing, singular.reshape(-1, 2)])
         ts = sing[:, 0]
         if fam.periodic:  # (the swivel: an aligned point at -pi is one at pi)
             ts = np.concatenate([ts - 2 * np.pi, ts, ts + 2 * np.pi])
