@@ -704,29 +704,7 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         near = np.concatenate([near, np.ones(2 * fam.k, dtype=bool)])
     point = intervals[:, 1] - intervals[:, 0] <= _POINT
     lim_pts = points[points[:, 3] <= upper]
-    short = np.flatnonzero(~point & (intervals[:, 1] - intervals[:, 0] <= _PAIR))
-    if len(short):  # between two crossings of one joint of its branch (not at a fold, an
-        # aligned point, a range end or another joint's crossing, and no aligned point of
-        # the branch within the widening's reach, where the outer joints swing by up to
-        # pi between probes): a graze whose extremum is past the limit by an ulp or two
-        # (the baseline copy, without FMA), widened like a point
-        own = lim_pts[:, None, 1] == owner[None, short]
-        at_a = own & (lim_pts[:, None, 0] == intervals[None, short, 0])  # (p, s)
-        at_e = own & (lim_pts[:, None, 0] == intervals[None, short, 1])
-        joints = lim_pts[:, 2, None]
-        same = ((at_a[:, None, :] & at_e[None, :, :])
-                & (joints[:, None, :] == joints[None, :, :])).any(axis=(0, 1))
-        sing = points[points[:, 3] > upper, :2]
-        if singular is not None:
-            sing = np.concatenate([sing, singular.reshape(-1, 2)])
-        ts = sing[:, 0]
-        if fam.periodic:  # (the swivel: an aligned point at -pi is one at pi)
-            ts = np.concatenate([ts - 2 * np.pi, ts, ts + 2 * np.pi])
-            sing = np.tile(sing, (3, 1))
-        swing = ((sing[:, None, 1] == owner[None, short])
-                 & (ts[:, None] >= intervals[None, short, 0] - _PROBES[-1])
-                 & (ts[:, None] <= intervals[None, short, 1] + _PROBES[-1])).any(axis=0)
-        point[short[same & ~swing]] = True
+    point |= _short_grazes(fam, intervals, owner, points, upper, singular)
     cand = near | every
     c, near = cuts[cand], near[cand]
     if len(c):  # crossings already in an interval of their branch: nothing to find
@@ -792,6 +770,44 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     if not corners and np.array_equal(iv, intervals) and np.array_equal(ob, owner):
         return intervals, owner, ()  # nothing widened or added: the kernel's arrays
     return iv, ob, tuple(corners)
+
+
+def _short_grazes(fam: _Family, intervals: np.ndarray, owner: np.ndarray,
+                  points: np.ndarray, upper: int, singular: np.ndarray | None
+                  ) -> np.ndarray:
+    """(m,) bool: the intervals ``_points_refined`` widens like a one-point interval.
+
+    Longer than ``_POINT``, at most ``_PAIR`` long, between two crossings of one joint
+    of its branch (a graze whose extremum is past the limit by an ulp or two: the
+    baseline copy, without FMA), with no aligned or fold point of the branch within
+    ``_PROBES[-1]`` (there the outer joints swing by up to pi between the widening's
+    probes). ``points`` and ``upper`` as ``_points_refined``'s; ``singular`` (s, 2)
+    ``[t, branch]`` the aligned and fold points its ``points`` do not hold.
+    """
+    length = intervals[:, 1] - intervals[:, 0]
+    out = np.zeros(len(intervals), dtype=bool)
+    short = np.flatnonzero((length > _POINT) & (length <= _PAIR))
+    if not len(short):
+        return out
+    lim_pts = points[points[:, 3] <= upper]
+    own = lim_pts[:, None, 1] == owner[None, short]
+    at_a = own & (lim_pts[:, None, 0] == intervals[None, short, 0])  # (p, s)
+    at_e = own & (lim_pts[:, None, 0] == intervals[None, short, 1])
+    joints = lim_pts[:, 2, None]
+    same = ((at_a[:, None, :] & at_e[None, :, :])
+            & (joints[:, None, :] == joints[None, :, :])).any(axis=(0, 1))
+    sing = points[points[:, 3] > upper, :2]
+    if singular is not None:
+        sing = np.concatenate([sing, singular.reshape(-1, 2)])
+    ts = sing[:, 0]
+    if fam.periodic:  # (the swivel: an aligned point at -pi is one at pi)
+        ts = np.concatenate([ts - 2 * np.pi, ts, ts + 2 * np.pi])
+        sing = np.tile(sing, (3, 1))
+    swing = ((sing[:, None, 1] == owner[None, short])
+             & (ts[:, None] >= intervals[None, short, 0] - _PROBES[-1])
+             & (ts[:, None] <= intervals[None, short, 1] + _PROBES[-1])).any(axis=0)
+    out[short[same & ~swing]] = True
+    return out
 
 
 def _tangent(fam: _Family, limits: np.ndarray, c: np.ndarray) -> np.ndarray:
