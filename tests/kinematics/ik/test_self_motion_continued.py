@@ -863,6 +863,93 @@ def test_a_joint_riding_its_limit_keeps_the_whole_in_slack_stretch():
         assert dp <= 1e-12 and dr <= 1e-12
 
 
+@pytest.mark.parametrize("q0", [
+    # q1 crosses its lower limit at q7 while q4 rides its upper one (out by 3.9e-11 at
+    # +-1e-4): the interval from the graze's touch ended 1.1e-9 short of q7
+    [-2.9670597283903604, 1.5707963267948966, 0.0, 2.0943951023931953, 0.2169591123956054,
+     1.9816931191467106, -1e-07],
+    # q6 crosses its upper limit at q7; q4's minimum along the branch is its upper limit
+    [-2.1807693071755447, -0.034462931071558955, -1e-06, 2.0943951023931953,
+     0.8491310056786259, 2.0943951023931953, 2.0008686452530213],
+    # q5 crosses its lower limit at q7; q2's maximum along the branch is its lower limit
+    [0.4576868996378649, -2.0943951023931953, -1e-06, 0.842973722437709,
+     -2.9670597283903604, -1.8678741675565658, -0.7162089812013073],
+])
+def test_a_graze_beside_another_joints_crossing_keeps_the_corner(q0):
+    # Issue 29, session 15: offset iiwa specials #6091, #6950, #8211 (seed 0). Two
+    # joints at limits at q7: one crossing there, the other at an extremum along the
+    # branch that is its limit (in limits over ~1e-7 .. 1e-5 of q7 on one side only).
+    # _grazes locates the extremum to ~1e-6 (it is flat) and the crossing is a touch
+    # too; main (73f3f77) kept one touch per 1e-6 of a branch, the extremum's, whose
+    # row is outside (the crossing joint) or whose stretch stops short: no interval
+    # held q7. Oracles: q0 is in limits and an independent held solve (robot.ik with
+    # q7 given) returns it; the interval holds q7 to 1e-12 (its end is the crossing,
+    # found to rounding); independent held solves at 11 values across it have a row
+    # within 1e-9 of the branch's, inside every limit by MANIFOLD_SLACK (+1e-15) and
+    # reproducing the pose to 1e-12.
+    from robokin.kinematics.ik.self_motion_intervals import MANIFOLD_SLACK
+
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array(q0)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    assert np.all((q0 >= lo) & (q0 <= hi))
+    T, sm = _manifold(robot, q0)
+    name = robot.joint_names[-1]
+    ref0 = robot.ik(T, fixed={name: q0[6]})
+    assert _wrapped(ref0.q[ref0.valid] - q0).max(-1).min() < 1e-9
+    t, b, hit = _branch_intervals(sm, q0, 1e-12)
+    assert len(hit) == 1, (t, sm.intervals[sm.interval_branch == b])
+    a, e = hit[0]
+    assert e - a < 1e-3, (a, e)  # a sliver, not a piece decided inside
+    ts = np.linspace(a, e, 11)
+    rows = sm.sample(ts)[:, b]
+    ref = robot.ik(T, fixed={name: ts})
+    for k in range(len(ts)):
+        g = _wrapped(ref.q[k][ref.valid[k]] - rows[k]).max(-1)
+        assert g.min() < 1e-9, (ts[k], g)
+        r = ref.q[k][ref.valid[k]][int(np.argmin(g))]
+        assert np.all((r >= lo - MANIFOLD_SLACK - 1e-15) & (r <= hi + MANIFOLD_SLACK + 1e-15)), (
+            ts[k], np.maximum(r - hi, lo - r).max())
+        dp, dr = pose_errors(robot.fk(r), T)
+        assert dp <= 1e-12 and dr <= 1e-12
+
+
+def test_a_crossing_the_scan_misses_is_cut_at_the_nodes():
+    # Issue 29, session 15: offset iiwa special #7320 (seed 0; q2 at its upper limit,
+    # q6 = 1e-9). The pose's manifold holds the aligned-wrist line (q6 = 0, q5 + q7
+    # fixed, q2 at its limit); branch 2 meets it at q7 ~ 0.4047 and crosses q2's limit
+    # exactly there, where the held solver returns no row over ~1e-5 of q7. The scan's
+    # Newton for that crossing lands on the line, and main (73f3f77) listed
+    # [-0.5248, 1.4990] for the branch with q2 up to 0.46 rad past its limit over the
+    # first half (found with 24 other such intervals on 60 special poses, up to 0.45
+    # rad out, at rows with smallest held singular value 2e-5 to 0.04). Oracles: the
+    # branches' rows (sm.sample) at 21 values inside every interval of every branch
+    # are inside every limit to 1e-9; independent held solves (robot.ik with q7 given)
+    # have each such row among theirs (1e-9); branch 2 keeps an interval ending at
+    # q2's crossing 1.49896 and starting within 2e-5 of 0.40466 (where rows resume).
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array([-1.5707963267948966, 2.0943951023931953, -2.2419208791867464,
+                   0.6386643050786898, -2.8379927370894853, 1e-09, -1.437908012168594])
+    T, sm = _manifold(robot, q0)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    name = robot.joint_names[-1]
+    for (a, e), b in zip(sm.intervals, sm.interval_branch, strict=True):
+        if e - a < 1e-9:
+            continue
+        ts = np.linspace(a, e, 23)[1:-1]
+        rows = sm.sample(ts)[:, b]
+        assert np.isfinite(rows).all(), (a, e, b)
+        out = np.maximum(lo - rows, rows - hi).max(axis=-1)
+        assert out.max() <= 1e-9, (a, e, b, out.max(), ts[int(np.argmax(out))])
+        ref = robot.ik(T, fixed={name: ts})
+        for k in range(len(ts)):
+            g = _wrapped(ref.q[k][ref.valid[k]] - rows[k]).max(-1)
+            assert g.min() < 1e-9, (ts[k], b)
+    own = sm.intervals[sm.interval_branch == 2]
+    hit = own[(own[:, 1] > 1.4989) & (own[:, 1] < 1.4990)]
+    assert len(hit) == 1 and abs(hit[0, 0] - 0.40466) < 2e-5, own
+
+
 def test_an_islands_crossing_at_a_singular_point_cuts_its_interval():
     # Issue 29, session 10: offset iiwa special #5140 (seed 0; q2 = q4 = -1e-9): an
     # island of 8 rows for q7 in ~[0.0745, 0.1000] (between nodes 0.0679 and 0.1018),

@@ -248,6 +248,49 @@ def test_an_island_narrower_than_a_grid_step_is_found(q, branch, island):
     assert any(a < mid < e for a, e in own) == bool(sm.inside(mid)[branch])
 
 
+def test_a_branch_end_hidden_in_a_fold_cell_of_the_solved_points_path_is_found():
+    # Issue 29, session 15: Panda, uniform configuration #3146 of self_motion_rates'
+    # seed 1 (regular, in its limits). Next to the reach boundary the held-q7 rows
+    # number 8 on (0.7000, 0.70853), 4 on (0.70853, 0.7270), 8 on (0.7270, 0.73088) and
+    # none beyond: q7 = 0.73053 lies on a return of 4 branches that starts and ends
+    # between the grid values 0.7243 (4 rows) and 0.7324 (none). The kernel flags the
+    # pose (the solved-points path answers); its grid saw 4 -> 0 in that cell, and main
+    # (73f3f77) bisected only the 4 rows that end there: q's branch had no interval past
+    # 0.70854. Oracles: independent held solves (robot.ik with q7 given) count the rows
+    # on a fine scan and give q back at q7; the interval of q's branch holding q7 has
+    # its ends within 1e-6 of the scan's 4 -> 8 and 8 -> 0 changes, and at 11 values
+    # across it the branch's row is an independent solve's (1e-9), inside every limit
+    # (MANIFOLD_SLACK) and reproduces the pose to 1e-12.
+    q0 = np.array([2.042862936634853, -0.7003031911057698, -2.5485351616817176,
+                   -0.4585279209098596, -1.3423167229048891, 0.9683865984162384,
+                   0.7305322583483451])
+    T = PANDA.fk(q0)
+    ts = np.linspace(0.7260, 0.7315, 5501)  # 1e-6 apart
+    n = PANDA.ik(T, fixed={"joint7": ts}).valid.sum(axis=-1)
+    rise = ts[1:][(n[:-1] == 4) & (n[1:] == 8)]
+    end = ts[:-1][(n[:-1] == 8) & (n[1:] == 0)]
+    assert len(rise) == 1 and len(end) == 1 and rise[0] < q0[6] < end[0], (rise, end)
+    sm = PANDA.self_motion(T)
+    assert sm.info["compiled"] is False  # the solved-points path (the kernel flags it)
+    d = np.abs((sm.sample(q0[6]) - q0 + np.pi) % (2 * np.pi) - np.pi).max(axis=-1)
+    b = int(np.nanargmin(d))
+    assert d[b] < 1e-9
+    iv = sm.intervals[sm.interval_branch == b]
+    hold = iv[(iv[:, 0] <= q0[6]) & (q0[6] <= iv[:, 1])]
+    assert len(hold) == 1, iv
+    a, e = hold[0]
+    assert abs(a - rise[0]) < 1e-6 and abs(e - end[0]) < 1e-6, (a, e, rise, end)
+    tv = np.linspace(a, e, 11)
+    rows = sm.sample(tv)[:, b]
+    ref = PANDA.ik(T, fixed={"joint7": tv})
+    for k in range(len(tv)):
+        g = np.abs((ref.q[k][ref.valid[k]] - rows[k] + np.pi) % (2 * np.pi) - np.pi).max(-1)
+        assert g.min() < 1e-9, (tv[k], g)
+    assert np.all((rows >= LIMITS[:, 0] - MANIFOLD_SLACK) & (rows <= LIMITS[:, 1] + MANIFOLD_SLACK))
+    dp, dr = pose_errors(PANDA.fk(rows), np.broadcast_to(T, rows.shape[:1] + (4, 4)))
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+
+
 # Issue 29's slivers: the generating configuration with q6 exactly at its lower limit
 # and q5 at 0 or 1e-9 (axes 5 and 7 nearly in line). q6(t) has a maximum there within
 # rounding of the limit (6.5e-15 above it on the kernel's chain model, 1.0e-15 on the

@@ -70,6 +70,7 @@ from robokin.kinematics.ik.self_motion_intervals import (
     _held_kernel,
     _held_records,
     _intervals,
+    _node_cuts,
     _points_refined,
     _state_changes,
     _within,
@@ -449,6 +450,10 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
         q, valid, _ = fam.rows(grid_t)
         ends, bisected = _state_changes(fam, grid_t, q, valid, limits, marks)
     intervals, owner = _intervals(fam, limits, marks, ends)
+    if isinstance(fam, _ContinuedFamily):  # a crossing the scan missed: its nodes show it
+        intervals, owner, missed = _node_cuts(fam, limits, intervals, owner, fam.t_nodes,
+                                              fam.tracks)
+        marks["limit"] += missed
     cuts = np.array([(t, b, j, 0) for t, b, j, _ in marks["limit"]], dtype=np.float64)
     touch = np.array(marks.get("touch", []), dtype=np.float64).reshape(-1, 3)
     sing = np.array([(t, b) for t, b, _ in marks["fold"] + marks["aligned"]],

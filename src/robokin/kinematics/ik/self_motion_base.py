@@ -43,6 +43,10 @@ class _Family:
         i = np.arange(len(q))
         return q[i, b], valid[i, b]
 
+    def validity(self, t: np.ndarray) -> np.ndarray:
+        """``rows(t)``'s valid (m, k) alone (a family may skip refining the rows)."""
+        return self.rows(t)[1]
+
     def sample_rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``rows(t)`` for ``SelfMotion.sample`` and ``inside``.
 

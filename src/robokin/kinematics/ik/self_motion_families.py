@@ -258,6 +258,13 @@ class _HeldFamily(_JointFamily):
             q[r] = qr
         return q, v
 
+    def validity(self, t: np.ndarray) -> np.ndarray:
+        """``rows(t)``'s valid, the kernel's (refining a row changes no validity)."""
+        t = np.ascontiguousarray(np.atleast_1d(t), dtype=np.float64)
+        _, valid, _, i = self._distinct(t)
+        out: np.ndarray = valid[i]
+        return out
+
 
 #: Values whose kernel rows a held family keeps (``_HeldFamily._distinct``): a call
 #: with more (the checking grid) is neither kept nor looked up.

@@ -16,7 +16,7 @@ import numpy as np
 from robokin._native import kernels as K
 from robokin._validation import ROTATION_EXACT
 from robokin.kinematics.arm import Arm
-from robokin.kinematics.ik.self_motion_base import _Family
+from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
 from robokin.kinematics.ik.self_motion_families import (
     HeldKernel,
     LimitCrossing,
@@ -120,7 +120,8 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
     Returns ``([(t, branch), ...] extra breakpoints, how many were bisected)``; the
     fold ends are added to ``marks["fold"]``. All cells are bisected together (one
     batch per step), with the renumberings of the rows (``_swap_cells``) in cells
-    that hold an exact point or a fold: each is a breakpoint of its moved slots.
+    that hold an exact point or a fold: each is a breakpoint of its moved slots, and
+    the branch ends a fold cell hides between its grid values (``_cell_islands``).
     """
     inside = valid & _within(q, limits)
     exact: dict[int, list[float]] = {}
@@ -128,7 +129,7 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
         exact.setdefault(b, []).append(tt)
     folds, changes = [], []
     for b in range(fam.k):
-        folds += [(i, b) for i in np.flatnonzero(valid[1:, b] != valid[:-1, b])]
+        folds += [(int(i), b) for i in np.flatnonzero(valid[1:, b] != valid[:-1, b])]
         for i in np.flatnonzero((inside[1:, b] != inside[:-1, b])
                                 & valid[1:, b] & valid[:-1, b]):
             if not any(t[i] <= x <= t[i + 1] for x in exact.get(b, [])):
@@ -142,14 +143,22 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
         marked[at[(at >= 0) & (at < len(t) - 1)], b] = True
     marked |= (valid[1:] != valid[:-1]).any(axis=1)[:, None]
     sc, moved, sk = _swap_cells(t, q, valid, marked)
+    folds, extra = _cell_islands(fam, t, valid, folds)
     cells = folds + changes
-    if not cells and not len(sc):
+    if not cells and not len(sc) and not extra:
         return [], 0
-    idx = np.array([i for i, _ in cells], dtype=int)
-    br = np.array([b for _, b in cells], dtype=int)
-    kind = np.array([c >= len(folds) for c in range(len(cells))], dtype=bool)  # in-limit change
+    idx = np.array([i for i, _ in cells] + [i for i, *_ in extra], dtype=int)
+    br = np.array([b for _, b in cells] + [b for _, b, *_ in extra], dtype=int)
+    kind = np.array([c >= len(folds) for c in range(len(cells))] + [False] * len(extra),
+                    dtype=bool)  # in-limit change
     state0 = np.where(kind, inside[idx, br], valid[idx, br])
     lo, hi = t[idx].astype(np.float64), t[idx + 1].astype(np.float64)
+    far = np.where(state0, lo, hi)  # each fold's row on its valid side: the scan's far end
+    if extra:  # a probe pair's bracket: its states and its valid side's probe
+        x = slice(len(cells), None)
+        lo[x], hi[x] = [a for _, _, a, _, _ in extra], [e for _, _, _, e, _ in extra]
+        state0[x] = [v for *_, v in extra]
+        far[x] = np.where(state0[x], lo[x], hi[x])
     # a renumbering (in the same batches): slot sk's row at the midpoint nearer its
     # row at the bracket's left end than at its right end lies left of the jump
     s_lo, s_hi = t[sc].astype(np.float64), t[sc + 1].astype(np.float64)
@@ -193,13 +202,56 @@ def _state_changes(fam: _Family, t: np.ndarray, q: np.ndarray, valid: np.ndarray
     marks["fold"] += [(float(e), int(b), "fold") for e, b, k in zip(ends, br, kind) if not k]
     fold = ~kind
     if fold.any():  # the row on the fold's side of its cell: the scan's far end
-        near = np.where(state0, t[idx], t[idx + 1])[fold]
+        near = far[fold]
         for tc, bc, jc, what in _fold_crossings(fam, ends[fold], near, br[fold], limits, exact):
             if what == "fold":  # the rows end before the joint leaves: a second fold
                 marks["fold"].append((tc, bc, "fold"))
             else:
                 marks["limit"].append((tc, bc, jc, what))
     return [(float(e), int(b)) for e, b in zip(ends, br)] + swaps, len(changes)
+
+
+def _cell_islands(fam: _Family, t: np.ndarray, valid: np.ndarray,
+                  folds: list[tuple[int, int]]
+                  ) -> tuple[list[tuple[int, int]], list[tuple[int, int, float, float, bool]]]:
+    """Branch ends the grid's fold cells hide: more than one change of a slot in a cell.
+
+    A cell where some slot's rows end (a fold) may hold another slot's whole island
+    (rows at neither grid value) or a slot's end and return: next to the Panda's reach
+    boundary all 8 rows end within ~1e-5 of q7, 4 of them after a gap (seed 1, uniform
+    #3146: 8 rows on [0.7270, 0.73088], 4 on [0.70853, 0.7270], the grid values 0.7243
+    and 0.7324). Each such cell is probed at ``_ISLAND_PROBES`` values (one batch); a
+    slot whose validity changes more than once along them has one bracket per change
+    between neighbouring probes, and its grid fold, if any, is dropped (its bisection
+    would find one change of several).
+
+    Returns ``(folds kept, [(cell, slot, lo, hi, valid at lo)])``.
+    """
+    if not folds:
+        return folds, []
+    cells = np.unique([i for i, _ in folds])
+    u = np.linspace(0.0, 1.0, _ISLAND_PROBES + 2)[1:-1]
+    ts = t[cells, None] + (t[cells + 1] - t[cells])[:, None] * u[None, :]  # (c, p)
+    vp = fam.validity(ts.ravel())
+    at = np.concatenate([valid[cells, None], vp.reshape(ts.shape + (-1,)),
+                         valid[cells + 1, None]], axis=1)  # (c, p + 2, k)
+    tt = np.concatenate([t[cells, None], ts, t[cells + 1, None]], axis=1)
+    change = at[:, 1:] != at[:, :-1]  # (c, p + 1, k)
+    many = change.sum(axis=1) > 1  # (c, k)
+    if not many.any():
+        return folds, []
+    extra: list[tuple[int, int, float, float, bool]] = []
+    for ci, b in zip(*np.nonzero(many), strict=True):
+        for k in np.flatnonzero(change[ci, :, b]):
+            extra.append((int(cells[ci]), int(b), float(tt[ci, k]), float(tt[ci, k + 1]),
+                          bool(at[ci, k, b])))
+    drop = {(int(cells[ci]), int(b)) for ci, b in zip(*np.nonzero(many), strict=True)}
+    return [f for f in folds if (int(f[0]), int(f[1])) not in drop], extra
+
+
+#: Interior values probed in each fold cell of the grid for hidden branch ends
+#: (``_cell_islands``: an island or a return at least 1/8 of the cell long is seen).
+_ISLAND_PROBES = 7
 
 
 #: A slot's row moving more than this many times as far between two grid values as
@@ -423,6 +475,105 @@ def _intervals(fam: _Family, limits: np.ndarray, marks: dict[str, list[Any]],
     return arr, np.array([b for b, _, _ in pieces], dtype=int)
 
 
+def _node_cuts(fam: _Family, limits: np.ndarray, intervals: np.ndarray, owner: np.ndarray,
+               t_nodes: np.ndarray, tracks: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, list[tuple[float, int, int, str]]]:
+    """The intervals cut where a solved node row of their branch is outside.
+
+    The continued family decides each piece between its crossings at the piece's
+    midpoint; a crossing its scan misses joins two pieces. On the offset iiwa's special
+    poses a branch meeting the aligned-wrist line (q6 = 0, q5 + q7 fixed; the line
+    holds q2 at its limit) crosses q2's limit exactly there, and Newton's crossing lands
+    on the line: special #7320 of seed 0 listed [-0.5248, 1.4990] with q2 up to 0.46
+    rad past its limit over its first half. ``t_nodes`` (m,) and ``tracks`` (m, k, n):
+    the family's node rows (solved, to ~1e-13). Each interval with a node row more than
+    ``_NODE_OUT`` outside keeps only its in-limit runs: every change of state between
+    neighbouring nodes (and its ends, inside) is bisected on ``fam.slot_rows`` (one
+    batch per step) to its last in-limit value, a limit crossing of the joint furthest
+    out past it.
+
+    Returns ``(intervals, owner, crossings [(t, branch, joint, "lower"|"upper")])``;
+    the arrays unchanged (the same objects) where no node is outside.
+    """
+    if not len(intervals):
+        return intervals, owner, []
+    lo_l, hi_l = limits[:, 0], limits[:, 1]
+    with np.errstate(invalid="ignore"):
+        X = _into_limits(fam.robot, tracks)  # type: ignore[attr-defined]
+        excess = np.maximum(lo_l - X, X - hi_l).max(axis=-1)  # (m, k), NaN: no row
+    a, e = intervals[:, 0], intervals[:, 1]
+    within = (t_nodes[None, :] > a[:, None]) & (t_nodes[None, :] < e[:, None])  # (i, m)
+    node_out = excess[:, owner].T > _NODE_OUT  # (i, m)
+    hit = np.flatnonzero((within & node_out).any(axis=1))
+    if not len(hit):
+        return intervals, owner, []
+    # the intervals' ends by their rows (an end at one joint's crossing can have another
+    # joint far out: #7320's -0.5248, q3 at its limit, q2 0.46 past its own)
+    qe, ve = fam.slot_rows(np.concatenate([a[hit], e[hit]]), np.tile(owner[hit], 2))
+    with np.errstate(invalid="ignore"):
+        end_ok = ve & (np.maximum(lo_l - qe, qe - hi_l).max(axis=-1) <= _NODE_OUT)
+    seqs: list[tuple[int, list[float], list[bool]]] = []
+    for n_, i in enumerate(hit.tolist()):
+        k = np.flatnonzero(within[i] & np.isfinite(excess[:, owner[i]]))
+        ts = [float(a[i])] + t_nodes[k].tolist() + [float(e[i])]
+        ok = ([bool(end_ok[n_])] + (excess[k, owner[i]] <= _NODE_OUT).tolist()
+              + [bool(end_ok[len(hit) + n_])])
+        seqs.append((i, ts, ok))
+    brk = [(si, j) for si, (_, _, ok) in enumerate(seqs) for j in range(len(ok) - 1)
+           if ok[j] != ok[j + 1]]
+    lo = np.array([seqs[si][1][j] for si, j in brk])
+    hi = np.array([seqs[si][1][j + 1] for si, j in brk])
+    s0 = np.array([seqs[si][2][j] for si, j in brk])
+    bb = np.array([owner[seqs[si][0]] for si, j in brk], dtype=int)
+    for _ in range(_BISECT):
+        mid = 0.5 * (lo + hi)
+        go = np.flatnonzero((mid != lo) & (mid != hi))
+        if not len(go):
+            break
+        q, v = fam.slot_rows(mid[go], bb[go])
+        now = v & _within(q, limits)
+        same = now == s0[go]
+        lo[go], hi[go] = np.where(same, mid[go], lo[go]), np.where(same, hi[go], mid[go])
+    inner, outer = np.where(s0, lo, hi), np.where(s0, hi, lo)
+    q_out, _ = fam.slot_rows(outer, bb)
+    with np.errstate(invalid="ignore"):
+        below, above = lo_l - q_out, q_out - hi_l
+    far = np.fmax(below, above)
+    joint = np.argmax(np.nan_to_num(far, nan=-np.inf), axis=1)
+    side = np.where(above[np.arange(len(joint)), joint] > below[np.arange(len(joint)), joint],
+                    "upper", "lower")
+    cuts: dict[int, list[float]] = {i: [] for i in range(len(seqs))}
+    crossings: list[tuple[float, int, int, str]] = []
+    for n_, (si, _) in enumerate(brk):
+        cuts.setdefault(si, []).append(float(inner[n_]))
+        crossings.append((float(inner[n_]), int(bb[n_]), int(joint[n_]), str(side[n_])))
+    keep = np.ones(len(intervals), dtype=bool)
+    keep[hit] = False
+    new: list[tuple[int, float, float]] = []
+    for si, (i, ts, ok) in enumerate(seqs):
+        ends = iter(cuts[si])
+        start: float | None = ts[0] if ok[0] else None
+        for j in range(len(ok) - 1):
+            if ok[j] == ok[j + 1]:
+                continue
+            x = next(ends)
+            if ok[j]:  # in -> out: a run ends at x
+                assert start is not None
+                new.append((int(owner[i]), start, x))
+                start = None
+            else:  # out -> in: a run starts at x
+                start = x
+        if start is not None:
+            new.append((int(owner[i]), start, ts[-1]))
+    iv, ob = _merged(intervals[keep], owner[keep], new)
+    return iv, ob, crossings
+
+
+#: A node row outside by more than this [rad] cuts its interval (``_node_cuts``; a joint
+#: riding its limit within rounding, 1e-15 to 1e-11, does not).
+_NODE_OUT = 1e-9
+
+
 def _touches(fam: _Family, limits: np.ndarray, crossings: list[Any],
              spans: list[tuple[float, float]], owners: list[int], out: np.ndarray
              ) -> list[tuple[int, float, float]]:
@@ -594,6 +745,11 @@ _SPLIT = 3
 #: Doubling probes past ``_PROBES`` of a family's touch inside at every probe (2e-3 ..
 #: 8.2 [in t]), up to the branch's nearest crossing of another joint.
 _FAR = 12
+#: A family's touches of one branch closer than this [in t] are one (the first probe:
+#: they widen alike); farther ones are each widened (a graze's extremum, located to
+#: ~1e-6 where it is flat, beside another joint's crossing: ``_points_refined``; the
+#: offset iiwa's q4 at its limit, special poses #6091 .. #9781 of seed 0).
+_TOUCH_APART = float(_PROBES[0])
 #: A listed interval at most this long is a point (a few ulps): widened as a graze.
 _POINT = K.SM_POINT  # 1e-12
 #: A corner's row out by at most this [rad] is refined on the pose's equations.
@@ -657,7 +813,9 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     stays within the slack of a limit beyond rounding (the continued family's
     grazes and shallow crossings, ``_ContinuedFamily._grazes``): candidates like
     the close crossings, kept even inside an interval (an interval ending at a
-    shallow crossing is widened to the in-slack stretch past it).
+    shallow crossing is widened to the in-slack stretch past it). One per
+    ``_TOUCH_APART`` of a branch is kept; of touches within ``_PAIR`` of each other
+    only the first may widen past ``_PROBES[-1]`` (``_widen``'s ``reach``).
 
     ``singular`` (s, 2) ``[t, branch]``: the aligned and fold points of a family whose
     ``points`` hold its crossings only (the Python paths'); the kernels' points hold
@@ -711,15 +869,20 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         held = ((intervals[None, :, 0] <= c[:, :1]) & (c[:, :1] <= intervals[None, :, 1])
                 & (owner[None, :] == c[:, 1:2])).any(axis=1)
         c, near = c[~held], near[~held]
-    if len(touch):  # not deep inside an interval (nothing to widen), one per _PAIR
+    far = np.zeros(0, dtype=bool)  # per touch: its sides may go past _PROBES[-1]
+    if len(touch):  # not deep inside an interval (nothing to widen)
         deep = ((intervals[None, :, 0] + _PROBES[-1] < touch[:, :1])
                 & (touch[:, :1] < intervals[None, :, 1] - _PROBES[-1])
                 & (owner[None, :] == touch[:, 1:2])).any(axis=1)
         touch = touch[~deep]
         touch = touch[np.lexsort((touch[:, 0], touch[:, 1]))]
-        again = np.zeros(len(touch), dtype=bool)
-        again[1:] = (touch[1:, 1] == touch[:-1, 1]) & (np.diff(touch[:, 0]) <= _PAIR)
-        touch = touch[~again]
+        gap = np.full(len(touch), np.inf)  # from the previous touch of its branch
+        gap[1:] = np.where(touch[1:, 1] == touch[:-1, 1], np.diff(touch[:, 0]), np.inf)
+        # one per _TOUCH_APART (they widen alike); of a run within _PAIR only the first
+        # goes far (the others, e.g. another joint's crossing beside a graze's extremum
+        # located to ~1e-6 where it is flat, whose row can be out: to _PROBES[-1] at most)
+        keep = gap > _TOUCH_APART
+        touch, far = touch[keep], (gap > _PAIR)[keep]
         c = np.concatenate([c, touch[:, :3]])
         near = np.concatenate([near, np.ones(len(touch), dtype=bool)])
     # joint: every interval's ends too (a crossing of a joint moving slowly with t,
@@ -751,7 +914,7 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
             inside[lone] = tangent
         for i in np.flatnonzero(inside):
             stretch.append((float(c[i, 0]), float(c[i, 0]), int(b[i])))
-            reach.append(bool(i >= first_touch))
+            reach.append(bool(i >= first_touch and far[i - first_touch]))
             other = lim_pts[(lim_pts[:, 1] == b[i]) & (lim_pts[:, 2] != c[i, 2]), 0]
             caps.append((float(other[other < c[i, 0]].max(initial=lo_d)),
                          float(other[other > c[i, 0]].min(initial=hi_d))))
