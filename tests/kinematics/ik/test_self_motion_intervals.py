@@ -1123,6 +1123,9 @@ def test_the_held_rows_of_one_slot_are_the_rows_of_that_slot():
         fam.polish = True
         refined += int((np.isfinite(q) & (raw != q)).any(axis=-1).sum())
     assert refined > 0
+    # (session 15) validity alone, unrefined (_cell_islands' probes): fam.rows' valid
+    assert np.array_equal(fam.validity(ts), valid)
+    assert valid.any() and not valid.all()
 
 
 def test_held_rows_solved_once_per_value_are_each_values_own_rows():

@@ -488,9 +488,9 @@ def _node_cuts(fam: _Family, limits: np.ndarray, intervals: np.ndarray, owner: n
     rad past its limit over its first half. ``t_nodes`` (m,) and ``tracks`` (m, k, n):
     the family's node rows (solved, to ~1e-13). Each interval with a node row more than
     ``_NODE_OUT`` outside keeps only its in-limit runs: every change of state between
-    neighbouring nodes (and its ends, inside) is bisected on ``fam.slot_rows`` (one
-    batch per step) to its last in-limit value, a limit crossing of the joint furthest
-    out past it.
+    neighbouring nodes and its two ends (their own rows: an end at one joint's crossing
+    can have another joint out) is bisected on ``fam.slot_rows`` (one batch per step)
+    to its last in-limit value, a limit crossing of the joint furthest out past it.
 
     Returns ``(intervals, owner, crossings [(t, branch, joint, "lower"|"upper")])``;
     the arrays unchanged (the same objects) where no node is outside.
@@ -545,7 +545,7 @@ def _node_cuts(fam: _Family, limits: np.ndarray, intervals: np.ndarray, owner: n
     cuts: dict[int, list[float]] = {i: [] for i in range(len(seqs))}
     crossings: list[tuple[float, int, int, str]] = []
     for n_, (si, _) in enumerate(brk):
-        cuts.setdefault(si, []).append(float(inner[n_]))
+        cuts[si].append(float(inner[n_]))
         crossings.append((float(inner[n_]), int(bb[n_]), int(joint[n_]), str(side[n_])))
     keep = np.ones(len(intervals), dtype=bool)
     keep[hit] = False
