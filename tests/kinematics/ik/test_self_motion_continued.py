@@ -922,7 +922,7 @@ def test_a_crossing_the_scan_misses_is_cut_at_the_nodes():
     # Newton for that crossing lands on the line, and main (73f3f77) listed
     # [-0.5248, 1.4990] for the branch with q2 up to 0.46 rad past its limit over the
     # first half (found with 24 other such intervals on 60 special poses, up to 0.45
-    # rad out, at rows with smallest held singular value 2e-5 to 0.04). Oracles: the
+    # rad out, at rows with smallest held singular value 1.5e-5 to 0.04). Oracles: the
     # branches' rows (sm.sample) at 21 values inside every interval of every branch
     # are inside every limit to 1e-9; independent held solves (robot.ik with q7 given)
     # have each such row among theirs (1e-9); branch 2 keeps an interval ending at
