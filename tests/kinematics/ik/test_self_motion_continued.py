@@ -65,6 +65,24 @@ def _branch_intervals(sm, q0, tol: float = 0.0):
     return t, b, iv[(iv[:, 0] - tol <= t) & (t <= iv[:, 1] + tol)]
 
 
+def _assert_held_solves_inside(robot, T, ts, rows):
+    """Independent held solves (robot.ik with the last joint at ts (m,)) each have a row
+    within 1e-9 of rows (m, 7), inside every limit by MANIFOLD_SLACK (+1e-15 for the
+    general-6R rows' rounding) and reproducing T to 1e-12."""
+    from robokin.kinematics.ik.self_motion_intervals import MANIFOLD_SLACK
+
+    ref = robot.ik(T, fixed={robot.joint_names[-1]: ts})
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    for k in range(len(ts)):
+        g = _wrapped(ref.q[k][ref.valid[k]] - rows[k]).max(-1)
+        assert g.min() < 1e-9, (ts[k], g)
+        r = ref.q[k][ref.valid[k]][int(np.argmin(g))]
+        assert np.all((r >= lo - MANIFOLD_SLACK - 1e-15) & (r <= hi + MANIFOLD_SLACK + 1e-15)), (
+            ts[k], np.maximum(r - hi, lo - r).max())
+        dp, dr = pose_errors(robot.fk(r), T)
+        assert dp <= 1e-12 and dr <= 1e-12
+
+
 @pytest.mark.parametrize("arm", sorted(ARMS))
 @pytest.mark.parametrize("special", [False, True])
 def test_generating_configuration_is_on_a_branch_inside_an_interval(arm, special):
@@ -839,8 +857,6 @@ def test_a_joint_riding_its_limit_keeps_the_whole_in_slack_stretch():
     # interval have a row within 1e-9 of the branch's, inside every limit by
     # MANIFOLD_SLACK (plus 1e-15 for the general-6R rows' rounding), and reproducing
     # the pose to 1e-12; the interval holds q7 +- 0.02.
-    from robokin.kinematics.ik.self_motion_intervals import MANIFOLD_SLACK
-
     robot = ARMS["offset_iiwa"]
     q0 = np.array([-1.5707963267948966, 1e-09, -1e-09, 2.0943951023931953, -1e-07,
                    -1e-06, -0.8384789305589901])
@@ -851,16 +867,7 @@ def test_a_joint_riding_its_limit_keeps_the_whole_in_slack_stretch():
     assert a <= t - 0.02 and e >= t + 0.02, (a, e)
     ts = np.linspace(a, e, 41)
     rows = sm.sample(ts)[:, b]
-    ref = robot.ik(T, fixed={robot.joint_names[-1]: ts})
-    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
-    for k in range(len(ts)):
-        g = _wrapped(ref.q[k][ref.valid[k]] - rows[k]).max(-1)
-        assert g.min() < 1e-9, (ts[k], g)
-        r = ref.q[k][ref.valid[k]][int(np.argmin(g))]
-        assert np.all((r >= lo - MANIFOLD_SLACK - 1e-15) & (r <= hi + MANIFOLD_SLACK + 1e-15)), (
-            ts[k], np.maximum(r - hi, lo - r).max())
-        dp, dr = pose_errors(robot.fk(r), T)
-        assert dp <= 1e-12 and dr <= 1e-12
+    _assert_held_solves_inside(robot, T, ts, rows)
 
 
 @pytest.mark.parametrize("q0", [
@@ -887,8 +894,6 @@ def test_a_graze_beside_another_joints_crossing_keeps_the_corner(q0):
     # found to rounding); independent held solves at 11 values across it have a row
     # within 1e-9 of the branch's, inside every limit by MANIFOLD_SLACK (+1e-15) and
     # reproducing the pose to 1e-12.
-    from robokin.kinematics.ik.self_motion_intervals import MANIFOLD_SLACK
-
     robot = ARMS["offset_iiwa"]
     q0 = np.array(q0)
     lo, hi = robot.limits[:, 0], robot.limits[:, 1]
@@ -903,15 +908,7 @@ def test_a_graze_beside_another_joints_crossing_keeps_the_corner(q0):
     assert e - a < 1e-3, (a, e)  # a sliver, not a piece decided inside
     ts = np.linspace(a, e, 11)
     rows = sm.sample(ts)[:, b]
-    ref = robot.ik(T, fixed={name: ts})
-    for k in range(len(ts)):
-        g = _wrapped(ref.q[k][ref.valid[k]] - rows[k]).max(-1)
-        assert g.min() < 1e-9, (ts[k], g)
-        r = ref.q[k][ref.valid[k]][int(np.argmin(g))]
-        assert np.all((r >= lo - MANIFOLD_SLACK - 1e-15) & (r <= hi + MANIFOLD_SLACK + 1e-15)), (
-            ts[k], np.maximum(r - hi, lo - r).max())
-        dp, dr = pose_errors(robot.fk(r), T)
-        assert dp <= 1e-12 and dr <= 1e-12
+    _assert_held_solves_inside(robot, T, ts, rows)
 
 
 def test_a_crossing_the_scan_misses_is_cut_at_the_nodes():
