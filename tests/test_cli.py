@@ -249,7 +249,7 @@ def test_ik_of_a_redundant_arm_says_it_is_a_sample_and_fixed_holds_a_joint(capsy
     code, out, _ = run(capsys, "ik", "panda", *pose)
     assert code == 0
     assert "panda: a sample of" in out and "of a continuum" in out
-    assert "--fixed joint7=VALUE" in out
+    assert "--fixed joint7=VALUE" in out and "robokin self-motion gives all of it" in out
     pose_deg = [*map(str, T[:3, 3]), *map(str, np.degrees(rpy_from_matrix(T)))]
     code, out, _ = run(capsys, "ik", "panda", *pose_deg, "--fixed",
                        "joint7=40.10704565915762", "--deg", "--json")

@@ -23,8 +23,9 @@ if TYPE_CHECKING:
     from robokin.model.parts import RobotParts
     from robokin.robot import Robot
 
-__all__ = ["NUMERIC_ARGS", "DomainFailure", "cell", "console", "json_text", "load_robot",
-           "load_scene", "outside_limits_notes", "scene_file", "scene_robot"]
+__all__ = ["NUMERIC_ARGS", "DomainFailure", "cell", "console", "joint_values", "json_text",
+           "load_robot", "load_scene", "outside_limits_notes", "scene_file", "scene_robot",
+           "tool_pose"]
 
 #: ``context_settings`` of commands whose positional arguments are numbers that
 #: may be negative (``fk ur5 0 -1.5 ...``).
@@ -64,6 +65,48 @@ def load_robot(name: str) -> Robot:
     from robokin.robots import load
 
     return load(name)
+
+
+def tool_pose(x: float, y: float, z: float, roll: float, pitch: float, yaw: float, *,
+              deg: bool = False, mm: bool = False) -> np.ndarray:
+    """The pose (4, 4) [m] of the arguments ``x y z roll pitch yaw`` in the CLI units.
+
+    Raises:
+        typer.BadParameter: a value is not finite (naming it).
+    """
+    import typer
+
+    from robokin.spatial import pose_from_xyz_rpy
+
+    values = (x, y, z, roll, pitch, yaw)
+    for label, v in zip(("x", "y", "z", "roll", "pitch", "yaw"), values):
+        if not math.isfinite(v):
+            raise typer.BadParameter(f"{label} must be a finite number, got {v}")
+    per_m = 1000.0 if mm else 1.0
+    per_rad = 180.0 / math.pi if deg else 1.0
+    return pose_from_xyz_rpy(np.array(values[:3]) / per_m, np.array(values[3:]) / per_rad)
+
+
+def joint_values(text: str, robot: Robot, option: str, *, deg: bool = False,
+                 mm: bool = False) -> np.ndarray:
+    """An option's joint values ``q1 ... qn`` (CLI units, spaces or commas) -> (n,) SI.
+
+    Raises:
+        typer.BadParameter: not numbers, or not as many as the robot has joints
+            (naming ``option``).
+    """
+    import typer
+
+    try:
+        vals = [float(v) for v in text.replace(",", " ").split()]
+    except ValueError:
+        raise typer.BadParameter(f"expected {robot.n} numbers, got {text!r}",
+                                 param_hint=option) from None
+    if len(vals) != robot.n:
+        raise typer.BadParameter(f"{option} needs {robot.n} values, got {len(vals)}")
+    per_m = 1000.0 if mm else 1.0
+    per_rad = 180.0 / math.pi if deg else 1.0
+    return np.where(robot.is_revolute, np.array(vals) / per_rad, np.array(vals) / per_m)
 
 
 def scene_file(spec: str | Path) -> Path:

@@ -37,6 +37,7 @@ from robokin.cli import (
     retime,
     robots,
     schema,
+    self_motion,
     sim,
     urdf,
     view,
@@ -80,7 +81,7 @@ app = typer.Typer(
 #: The command modules, in the order ``robokin --help`` lists their commands. Each
 #: defines its commands on its own ``commands = typer.Typer()``; adding a module
 #: here is how a command joins ``robokin`` (docs/conventions.md, "Where things go").
-COMMAND_MODULES = (robots, demo, ik, motion, urdf, collision, plan, view, actuators,
+COMMAND_MODULES = (robots, demo, ik, self_motion, motion, urdf, collision, plan, view, actuators,
                    workspace, sim, retime, schema, cell, follow, calibrate)
 for _module in COMMAND_MODULES:
     app.registered_commands.extend(_module.commands.registered_commands)

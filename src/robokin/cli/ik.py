@@ -7,8 +7,25 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from robokin.cli.common import DomainFailure, json_text, load_robot
-from robokin.cli.options import DegFlag, JsonFlag, MmFlag, RobotName
+from robokin.cli.common import (
+    DomainFailure,
+    joint_values,
+    json_text,
+    load_robot,
+    tool_pose,
+)
+from robokin.cli.options import (
+    DegFlag,
+    JsonFlag,
+    MmFlag,
+    PitchArg,
+    RobotName,
+    RollArg,
+    XArg,
+    YArg,
+    YawArg,
+    ZArg,
+)
 from robokin.cli.output import Column, FormatOption, OutputTable, emit, resolve_format
 from robokin.exceptions import InputError
 
@@ -56,21 +73,23 @@ def _continuum_note(robot: Robot, sols: Any, held: dict[str, float]) -> str | No
     if free <= constrained:
         return None
     example = next(n for n in reversed(robot.joint_names) if n not in held)
+    whole = ("; robokin self-motion gives all of it: its branches and their in-limit "
+             "intervals" if robot.n == 7 and not held and constrained == 6 else "")
     return (f"{robot.name} has {free} free joints for {constrained} pose components: "
             f"its solutions form a continuum ({free - constrained}-dimensional "
             f"self-motion) and these are a sample of it; --fixed {example}=VALUE "
-            "holds a joint and lists every solution of the others")
+            f"holds a joint and lists every solution of the others{whole}")
 
 
 @commands.command(context_settings={"ignore_unknown_options": True})
 def ik(
     name: RobotName,
-    x: Annotated[float, typer.Argument(help="Tool position x.")],
-    y: Annotated[float, typer.Argument(help="Tool position y.")],
-    z: Annotated[float, typer.Argument(help="Tool position z.")],
-    roll: Annotated[float, typer.Argument(help="Roll (about x).")],
-    pitch: Annotated[float, typer.Argument(help="Pitch (about y).")],
-    yaw: Annotated[float, typer.Argument(help="Yaw (about z).")],
+    x: XArg,
+    y: YArg,
+    z: ZArg,
+    roll: RollArg,
+    pitch: PitchArg,
+    yaw: YawArg,
     deg: DegFlag = False,
     mm: MmFlag = False,
     near: Annotated[str | None, typer.Option(
@@ -96,27 +115,14 @@ def ik(
     import numpy as np
 
     from robokin.kinematics.ik.analytic._common import fk_error
-    from robokin.spatial import pose_from_xyz_rpy
 
     fmt = resolve_format(output_format, as_json)
     r = load_robot(name)
     L = 1000.0 if mm else 1.0
     A = 180.0 / math.pi if deg else 1.0
-    for label, v in zip(("x", "y", "z", "roll", "pitch", "yaw"), (x, y, z, roll, pitch, yaw)):
-        if not np.isfinite(v):
-            raise typer.BadParameter(f"{label} must be a finite number, got {v}")
-    T = pose_from_xyz_rpy(np.array([x, y, z]) / L, np.array([roll, pitch, yaw]) / A)
+    T = tool_pose(x, y, z, roll, pitch, yaw, deg=deg, mm=mm)
     rev = r.is_revolute
-    q_near = None
-    if near is not None:
-        try:
-            vals = [float(v) for v in near.replace(",", " ").split()]
-        except ValueError:
-            raise typer.BadParameter(f"expected {r.n} numbers, got {near!r}",
-                                     param_hint="--near") from None
-        if len(vals) != r.n:
-            raise typer.BadParameter(f"--near needs {r.n} values, got {len(vals)}")
-        q_near = np.where(rev, np.array(vals) / A, np.array(vals) / L)
+    q_near = None if near is None else joint_values(near, r, "--near", deg=deg, mm=mm)
     held = _held_joints(r, fixed or [], A, L)
     options: dict[str, Any] = {"method": method}  # checked by Robot.ik, naming it
     if held:

@@ -11,7 +11,8 @@ from typing import Annotated
 
 import typer
 
-__all__ = ["DegFlag", "JsonFlag", "MmFlag", "NoPlotFlag", "RobotName"]
+__all__ = ["DegFlag", "JsonFlag", "MmFlag", "NoPlotFlag", "PitchArg", "RobotName", "RollArg",
+           "XArg", "YArg", "YawArg", "ZArg"]
 
 #: The robot argument: a built-in name or a robot file.
 RobotName = Annotated[str, typer.Argument(help="Built-in name or robot file.")]
@@ -23,3 +24,12 @@ MmFlag = Annotated[bool, typer.Option("--mm", help="Lengths in millimetres.")]
 JsonFlag = Annotated[bool, typer.Option("--json", help="Same as --format json.")]
 #: ``--no-plot``: write no plot.
 NoPlotFlag = Annotated[bool, typer.Option("--no-plot", help="Write no plot.")]
+
+#: The tool pose ``x y z roll pitch yaw`` as six positional arguments (``robokin ik``,
+#: ``robokin self-motion``; :func:`robokin.cli.common.tool_pose` reads them).
+XArg = Annotated[float, typer.Argument(help="Tool position x.")]
+YArg = Annotated[float, typer.Argument(help="Tool position y.")]
+ZArg = Annotated[float, typer.Argument(help="Tool position z.")]
+RollArg = Annotated[float, typer.Argument(help="Roll (about x).")]
+PitchArg = Annotated[float, typer.Argument(help="Pitch (about y).")]
+YawArg = Annotated[float, typer.Argument(help="Yaw (about z).")]

@@ -23,6 +23,7 @@ if TYPE_CHECKING:
     from robokin.trajectory.samples import Trajectory
 
 __all__ = [
+    "FIGURE_FORMATS",
     "place_labels",
     "plot_comparison",
     "plot_joints",
@@ -35,7 +36,8 @@ __all__ = [
     "save_workspace_plots",
 ]
 
-_FORMATS = (".png", ".svg", ".pdf")
+#: The figure files :func:`save_figure` writes, by suffix.
+FIGURE_FORMATS = (".png", ".svg", ".pdf")
 
 
 def _figure(figsize=(9.0, 7.0)):
@@ -55,8 +57,9 @@ def save_figure(fig: Any, path: str | Path, *, overwrite: bool = False,
         InputError: unknown suffix, or the file exists and ``overwrite`` is False.
     """
     path = Path(path)
-    if path.suffix.lower() not in _FORMATS:
-        raise InputError("path", f"expected a {', '.join(_FORMATS)} file, got {path.name}")
+    if path.suffix.lower() not in FIGURE_FORMATS:
+        raise InputError("path", f"expected a {', '.join(FIGURE_FORMATS)} file, got "
+                         f"{path.name}")
     return save_figure_atomic(fig, path, overwrite=overwrite, dpi=dpi)
 
 

@@ -1,0 +1,264 @@
+"""``robokin self-motion``: the whole self-motion of a 7-joint arm at one pose.
+
+The command parses, calls :meth:`robokin.robot.Robot.self_motion` and formats: the
+parameter intervals where a branch is inside every joint limit, the best
+configuration on them (``--best``), the one nearest ``--near``, optionally every
+limit crossing and singular point (``--points``) and a plot of the branches
+(``--plot``). Decisions: ``docs/ik.md``, "The command line: robokin self-motion".
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import typer
+
+from robokin.cli.common import (
+    DomainFailure,
+    joint_values,
+    json_text,
+    load_robot,
+    tool_pose,
+)
+from robokin.cli.options import (
+    DegFlag,
+    JsonFlag,
+    MmFlag,
+    PitchArg,
+    RobotName,
+    RollArg,
+    XArg,
+    YArg,
+    YawArg,
+    ZArg,
+)
+from robokin.cli.output import (
+    Column,
+    FormatOption,
+    OutputTable,
+    emit,
+    resolve_format,
+    say,
+)
+from robokin.exceptions import InputError
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from robokin.kinematics.ik.self_motion import ManifoldPoint, SelfMotion
+    from robokin.robot import Robot
+
+__all__ = ["commands", "self_motion"]
+
+commands = typer.Typer()
+
+#: The criteria of ``--best`` (:meth:`SelfMotion.best`).
+CRITERIA = ("margin", "manipulability")
+
+#: What each argument of the library call is called on the command line.
+_OPTION = {"parameter": "--parameter", "robot": "NAME", "q_near": "--near"}
+
+
+def _manifold(robot: Robot, T: np.ndarray, parameter: str) -> SelfMotion:
+    """``robot.self_motion(T, parameter)``, its input errors naming the CLI's options."""
+    try:
+        return robot.self_motion(T, parameter)
+    except InputError as exc:
+        if exc.argument not in _OPTION:
+            raise
+        raise InputError(_OPTION[exc.argument], exc.reason) from None
+
+
+def _plot_path(plot: Path | None, force: bool) -> Path | None:
+    """The ``--plot`` file, refused before any work when it exists without --force."""
+    from robokin.viz.plots import FIGURE_FORMATS
+
+    if plot is None:
+        return None
+    if plot.suffix.lower() not in FIGURE_FORMATS:
+        raise InputError("--plot", f"expected a {', '.join(FIGURE_FORMATS)} file, got "
+                         f"{plot.name!r}")
+    if plot.exists() and not force:
+        raise InputError("--plot", f"{plot} exists (an earlier run's?): pass --force to "
+                         "replace it, or name another file")
+    return plot
+
+
+def _point_json(p: ManifoldPoint, per_rad: float, scale: np.ndarray) -> dict[str, Any]:
+    return {"t": p.t * per_rad, "branch": p.branch, "q": (p.q * scale).tolist()}
+
+
+@commands.command("self-motion", context_settings={"ignore_unknown_options": True})
+def self_motion(
+    name: RobotName,
+    x: XArg,
+    y: YArg,
+    z: ZArg,
+    roll: RollArg,
+    pitch: PitchArg,
+    yaw: YawArg,
+    deg: DegFlag = False,
+    mm: MmFlag = False,
+    parameter: Annotated[str, typer.Option(
+        "--parameter", help="auto | swivel | a joint name: the parameter t of the "
+        "branches (auto: the swivel angle on SRS arms, else a joint with a closed form, "
+        "joint7 on the Panda).")] = "auto",
+    best: Annotated[str, typer.Option(
+        "--best", help="margin | manipulability: the configuration that maximises the "
+        "smallest distance to a joint limit, or Yoshikawa's manipulability.")] = "margin",
+    near: Annotated[str | None, typer.Option(
+        "--near", help="Current joint values q1 ... qn (rad/m, or deg/mm with "
+        "--deg/--mm): also the in-limit configuration nearest them.")] = None,
+    points: Annotated[bool, typer.Option(
+        "--points", help="Also list every limit crossing and singular point.")] = False,
+    plot: Annotated[Path | None, typer.Option(
+        "--plot", help="Write a plot of the branches (PNG, SVG or PDF): one panel per "
+        "joint, thick over the in-limit intervals.")] = None,
+    force: Annotated[bool, typer.Option(
+        "--force", help="Replace the --plot file of an earlier run.")] = False,
+    as_json: JsonFlag = False,
+    output_format: FormatOption = None,
+) -> None:
+    """The self-motion of a 7-joint arm at the pose x y z roll pitch yaw.
+
+    Every branch of configurations over the parameter t, the intervals of t where a
+    branch is inside every joint limit (found exactly, not by sampling), the best
+    configuration on them and, with --near, the one nearest the current joints.
+    Exit code 1 when no part of the self-motion is inside the limits.
+    """
+    import numpy as np
+
+    fmt = resolve_format(output_format, as_json)
+    if best not in CRITERIA:
+        raise InputError("--best", f"expected one of {', '.join(CRITERIA)}, got {best!r}")
+    r = load_robot(name)
+    T = tool_pose(x, y, z, roll, pitch, yaw, deg=deg, mm=mm)
+    q_near = None if near is None else joint_values(near, r, "--near", deg=deg, mm=mm)
+    path = _plot_path(plot, force)
+    sm = _manifold(r, T, parameter)
+    per_rad = 180.0 / math.pi if deg else 1.0
+    au, lu = ("deg" if deg else "rad"), ("mm" if mm else "m")
+    rev = np.asarray(r.is_revolute)
+    scale = np.where(rev, per_rad, 1000.0 if mm else 1.0)
+    top = sm.best(best, robot=r)
+    close = None if q_near is None else _nearest(sm, q_near)
+    if path is not None:
+        from robokin.viz.plots import plot_self_motion
+
+        plot_self_motion(sm, path=path, degrees=deg, overwrite=force,
+                         title=f"{r.name}: self-motion over {sm.parameter}")
+    lo, hi = (float(v) * per_rad for v in sm.domain)
+    if fmt == "json":
+        print(json_text({
+            "robot": r.name, "parameter": sm.parameter, "unit": au,
+            "domain": [lo, hi], "periodic": sm.periodic, "branches": sm.n_branches,
+            "method": sm.method,
+            "intervals": [{"branch": int(b), "from": float(a) * per_rad,
+                           "to": float(e) * per_rad}
+                          for (a, e), b in zip(sm.intervals, sm.interval_branch)],
+            "crossings": [{"t": c.t * per_rad, "branch": c.branch,
+                           "joint": r.joint_names[c.joint], "limit": c.limit}
+                          for c in sm.crossings],
+            "singular": [{"t": s.t * per_rad, "branch": s.branch, "kind": s.kind}
+                         for s in sm.singular],
+            "best": None if top is None else {
+                **_point_json(top, per_rad, scale), "criterion": best,
+                "score": top.score * (per_rad if best == "margin" else 1.0)},
+            "nearest": None if close is None else {
+                **_point_json(close, per_rad, scale), "distance": -close.score * per_rad},
+            "plot": None if path is None else str(path),
+        }))
+    else:
+        tables = [_intervals_table(r, sm, per_rad, au, lo, hi)]
+        if top is not None or close is not None:
+            tables.append(_configurations_table(r, top, close, best, per_rad, scale, au, lu))
+        if points:
+            tables.append(_points_table(r, sm, per_rad, au))
+        emit(tables, fmt)
+        if path is not None:
+            say(f"wrote {path}", fmt)
+    if not len(sm.intervals):
+        raise DomainFailure(_empty_reason(sm))
+
+
+def _nearest(sm: SelfMotion, q_near: np.ndarray) -> ManifoldPoint | None:
+    try:
+        return sm.nearest(q_near)
+    except InputError as exc:
+        raise InputError("--near", exc.reason) from None
+
+
+def _empty_reason(sm: SelfMotion) -> str:
+    """Why no interval: the pose out of reach (no branch anywhere) or the limits."""
+    import numpy as np
+
+    t = np.linspace(float(sm.domain[0]), float(sm.domain[1]), 361)
+    if not np.isfinite(sm.sample(t)).all(-1).any() and not sm.crossings:
+        return "the pose is out of reach: no branch of the self-motion exists"
+    return "no part of the self-motion is inside the joint limits"
+
+
+def _intervals_table(r: Robot, sm: SelfMotion, per_rad: float, au: str, lo: float,
+                     hi: float) -> OutputTable:
+    from robokin.cli.output import fixed
+
+    table = OutputTable(
+        f"{r.name}: self-motion over {sm.parameter} [{au}]: {sm.n_branches} branches, "
+        f"{len(sm.intervals)} in-limit interval(s) [{sm.method}]",
+        [Column("branch", right=True), Column(f"from [{au}]", fmt=fixed(6), right=True),
+         Column(f"to [{au}]", fmt=fixed(6), right=True),
+         Column(f"length [{au}]", fmt=fixed(6), right=True)])
+    for (a, e), b in zip(sm.intervals, sm.interval_branch):
+        table.add_row(int(b), float(a) * per_rad, float(e) * per_rad,
+                      float(e - a) * per_rad)
+    folds = sum(s.kind == "fold" for s in sm.singular)
+    table.notes.append(
+        f"{sm.parameter} ranges over [{lo:.6g}, {hi:.6g}] {au}"
+        + (" (periodic: an interval through +-pi is one, its end past it)"
+           if sm.periodic else "")
+        + f"; {len(sm.crossings)} limit crossing(s), {folds} branch end(s), "
+        f"{len(sm.singular) - folds} aligned-axes point(s) (--points lists them)")
+    return table
+
+
+def _configurations_table(r: Robot, top: ManifoldPoint | None, close: ManifoldPoint | None,
+                          best: str, per_rad: float, scale: np.ndarray, au: str,
+                          lu: str) -> OutputTable:
+    from robokin.cli.output import fixed, general
+
+    units = [au if rv else lu for rv in r.is_revolute]
+    table = OutputTable(
+        "configurations on the self-motion, inside every limit",
+        [Column("which"), Column(f"t [{au}]", fmt=fixed(6), right=True),
+         Column("branch", right=True),
+         *[Column(f"q{j + 1} [{u}]", fmt=fixed(6), right=True) for j, u in enumerate(units)],
+         Column("score", fmt=general(6), right=True)])
+    if top is not None:
+        value = top.score * per_rad if best == "margin" else top.score
+        table.add_row(f"best {best}", top.t * per_rad, top.branch,
+                      *(float(v) for v in top.q * scale), value)
+    if close is not None:
+        table.add_row("nearest --near", close.t * per_rad, close.branch,
+                      *(float(v) for v in close.q * scale), -close.score * per_rad)
+    table.notes.append(
+        f"score: margin = the smallest distance to a joint limit [{au}]; manipulability "
+        f"= sqrt(det(J J^T)); nearest = the wrapped joint-space distance [{au}]")
+    return table
+
+
+def _points_table(r: Robot, sm: SelfMotion, per_rad: float, au: str) -> OutputTable:
+    from robokin.cli.output import fixed
+
+    table = OutputTable(
+        "limit crossings and singular points",
+        [Column(f"t [{au}]", fmt=fixed(9), right=True), Column("branch", right=True),
+         Column("what")])
+    rows = [(c.t, c.branch, f"{r.joint_names[c.joint]} at its {c.limit} limit")
+            for c in sm.crossings]
+    rows += [(s.t, s.branch, "branch end (fold)" if s.kind == "fold" else s.kind)
+             for s in sm.singular]
+    for t, b, what in sorted(rows, key=lambda row: (row[1], row[0])):
+        table.add_row(t * per_rad, b, what)
+    return table

@@ -1,0 +1,176 @@
+"""``robokin self-motion NAME x y z roll pitch yaw`` (issue 29): the whole self-motion
+of a 7-joint arm at one pose, from the command line.
+
+Oracles: the configuration that made the pose lies in a printed interval of a branch
+whose row there is that configuration; every printed configuration reaches the pose
+(forward kinematics) inside the limits, its margin recomputed from the limits; the
+intervals are the library's for the same pose (the CLI only converts units); the
+crossings table's joints are at their limits in the library's rows.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import robokin
+from reference import iiwa14_srs
+from robokin.cli import main
+from robokin.io.robot_files import save_robot
+from robokin.spatial import pose_from_xyz_rpy, xyz_rpy_from_pose
+
+QP = np.array([0.0, -0.3, 0.0, -2.0, 0.0, 1.8, 0.7])  # the README's Panda configuration
+
+
+def run(capsys, *args):
+    code = main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def _pose_args(robot, q, deg=False):
+    xyz, rpy = xyz_rpy_from_pose(robot.fk(q))
+    vals = np.concatenate([xyz, np.degrees(rpy) if deg else rpy])
+    return [repr(float(v)) for v in vals]
+
+
+def _pose_of(args, deg=False):
+    v = np.array([float(a) for a in args])
+    return pose_from_xyz_rpy(v[:3], v[3:] / (180.0 / np.pi) if deg else v[3:])
+
+
+def test_the_generating_configuration_is_in_a_printed_interval_of_its_branch(capsys):
+    panda = robokin.load("panda")
+    pose = _pose_args(panda, QP)
+    code, out, err = run(capsys, "self-motion", "panda", *pose, "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    T = _pose_of(pose)
+    sm = panda.self_motion(T)
+    assert doc["parameter"] == "joint7" and doc["unit"] == "rad" and doc["branches"] == 8
+    got = np.array([[iv["from"], iv["to"]] for iv in doc["intervals"]])
+    np.testing.assert_array_equal(got, sm.intervals)
+    assert [iv["branch"] for iv in doc["intervals"]] == sm.interval_branch.tolist()
+    rows = sm.sample(QP[6])
+    holding = [iv["branch"] for iv in doc["intervals"] if iv["from"] <= QP[6] <= iv["to"]]
+    assert any(np.abs(rows[b] - QP).max() < 1e-9 for b in holding), holding
+    assert len(doc["crossings"]) == len(sm.crossings) > 0
+    for c in doc["crossings"]:
+        j = panda.joint_names.index(c["joint"])
+        v = sm.sample(c["t"])[c["branch"], j]
+        assert v == pytest.approx(panda.limits[j, 0 if c["limit"] == "lower" else 1],
+                                  abs=1e-9)
+
+
+def test_best_and_nearest_reach_the_pose_inside_the_limits(capsys):
+    panda = robokin.load("panda")
+    pose = _pose_args(panda, QP, deg=True)
+    near = np.degrees(QP)
+    code, out, err = run(capsys, "self-motion", "panda", *pose, "--deg", "--near",
+                         *near, "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    T = _pose_of(pose, deg=True)
+    lim = panda.limits
+    best = np.radians(doc["best"]["q"])
+    assert doc["best"]["criterion"] == "margin"
+    assert np.all((best >= lim[:, 0]) & (best <= lim[:, 1]))
+    np.testing.assert_allclose(panda.fk(best), T, atol=1e-12)
+    margin = np.minimum(best - lim[:, 0], lim[:, 1] - best).min()
+    assert np.radians(doc["best"]["score"]) == pytest.approx(margin, abs=1e-12)
+    assert margin > 0.5  # the Panda has wide margins on this pose (1.12 rad found)
+    nearest = np.radians(doc["nearest"]["q"])
+    np.testing.assert_allclose(nearest, QP, atol=1e-6)
+    assert 0 <= doc["nearest"]["distance"] < 1e-4  # [deg]
+    assert doc["nearest"]["t"] == pytest.approx(np.degrees(QP[6]), abs=1e-4)
+    deg_iv = np.array([[iv["from"], iv["to"]] for iv in doc["intervals"]])
+    np.testing.assert_allclose(np.radians(deg_iv), panda.self_motion(T).intervals,
+                               rtol=1e-15, atol=1e-15)
+
+
+def test_the_text_lists_intervals_configurations_and_points(capsys):
+    panda = robokin.load("panda")
+    pose = _pose_args(panda, QP)
+    code, out, err = run(capsys, "self-motion", "panda", *pose, "--points",
+                         "--best", "manipulability", "--format", "text")
+    assert code == 0, err
+    sm = panda.self_motion(_pose_of(pose))
+    assert f"8 branches, {len(sm.intervals)} in-limit interval(s)" in out
+    assert f"{len(sm.crossings)} limit crossing(s)" in out
+    assert "best manipulability" in out and "nearest" not in out.split("score:")[0]
+    assert out.count("at its lower limit") + out.count("at its upper limit") == len(
+        sm.crossings)
+    assert out.count("branch end (fold)") == sum(s.kind == "fold" for s in sm.singular)
+
+
+def test_csv_numbers_are_plain(capsys):
+    panda = robokin.load("panda")
+    code, out, err = run(capsys, "self-motion", "panda", *_pose_args(panda, QP),
+                         "--format", "csv")
+    assert code == 0, err
+    assert "np." not in out and "best margin," in out
+    first = out.splitlines()[1].split(",")
+    assert float(first[2]) > float(first[1])
+
+
+def test_the_swivel_of_an_srs_arm_from_a_robot_file(tmp_path, capsys):
+    arm = iiwa14_srs()
+    path = save_robot(arm, tmp_path / "iiwa.yaml")
+    q = np.array([0.3, 0.6, -0.4, -1.2, 0.5, 0.9, -0.2])
+    pose = _pose_args(arm, q)
+    code, out, err = run(capsys, "self-motion", path, *pose, "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["parameter"] == "swivel" and doc["periodic"]
+    loaded = robokin.load(str(path))
+    sm = loaded.self_motion(_pose_of(pose))
+    np.testing.assert_array_equal(
+        np.array([[iv["from"], iv["to"]] for iv in doc["intervals"]]), sm.intervals)
+    best = np.array(doc["best"]["q"])
+    np.testing.assert_allclose(loaded.fk(best), _pose_of(pose), atol=1e-12)
+
+
+def test_a_plot_is_written_and_never_replaced_without_force(tmp_path, capsys):
+    panda = robokin.load("panda")
+    pose = _pose_args(panda, QP)
+    png = tmp_path / "branches.png"
+    code, out, err = run(capsys, "self-motion", "panda", *pose, "--plot", png, "--deg")
+    assert code == 0, err
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+    assert f"wrote {png}" in out
+    png.write_bytes(b"mine")
+    code, _, err = run(capsys, "self-motion", "panda", *pose, "--plot", png)
+    assert code == 2 and "argument '--plot'" in err and "--force" in err
+    assert png.read_bytes() == b"mine"
+    code, _, err = run(capsys, "self-motion", "panda", *pose, "--plot", png, "--force")
+    assert code == 0, err
+    assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize(("args", "argument", "match"), [
+    (("ur5",), "NAME", "7-joint"),
+    (("panda", "--parameter", "elbow"), "--parameter", "'joint7', got 'elbow'"),
+    (("panda", "--parameter", "swivel"), "--parameter", "not an SRS arm"),
+    (("panda", "--best", "reach"), "--best", "margin, manipulability"),
+    (("panda", "--plot", "branches.txt"), "--plot", ".png, .svg, .pdf"),
+])
+def test_errors_name_the_argument_and_the_choices(capsys, args, argument, match):
+    name, *options = args
+    code, _, err = run(capsys, "self-motion", name, "0.4", "0.1", "0.5", "3.1", "0", "0",
+                       *options)
+    assert code == 2
+    assert f"argument '{argument}'" in err and match in err
+
+
+def test_near_needs_one_value_per_joint(capsys):
+    code, _, err = run(capsys, "self-motion", "panda", "0.4", "0.1", "0.5", "3.1", "0",
+                       "0", "--near", "0", "1")
+    assert code == 2 and "--near needs 7 values, got 2" in err
+
+
+def test_a_pose_out_of_reach_exits_1_saying_so(capsys):
+    code, out, err = run(capsys, "self-motion", "panda", "3", "0", "0.5", "3.1", "0", "0")
+    assert code == 1
+    assert "out of reach" in err and "0 in-limit interval(s)" in out
