@@ -21,3 +21,24 @@ def test_plot_draws_every_branch_and_saves(tmp_path):
     thick = axes[1].lines[3].get_ydata()  # branch 1, joint 2 (degrees)
     assert np.array_equal(np.isfinite(thick), sm.inside(t)[:, 1])
     assert (tmp_path / "sm.png").stat().st_size > 1000
+
+
+def test_a_branch_through_pi_is_not_drawn_across_the_panel():
+    """The Panda's ready pose: branches 0 and 1 pass q1 = +-pi (outside q1's limits,
+    +-2.8973): the drawn lines never step by more than pi between samples, and every
+    other sample is drawn (only the one after each wrap is blanked)."""
+    import robokin
+
+    panda = robokin.load("panda")
+    sm = panda.self_motion(panda.fk(np.array([0.0, -0.3, 0.0, -2.0, 0.0, 1.8, 0.7])))
+    t = np.linspace(*sm.domain, 721)
+    raw = sm.sample(t)[:, :, 0]  # q1 of every branch [rad]
+    wraps = np.abs(np.diff(raw, axis=0)) > np.pi
+    assert wraps.any()  # the pose exercises the case
+    fig = plot_self_motion(sm, degrees=False)
+    for b in range(sm.n_branches):
+        drawn = fig.axes[0].lines[2 * b].get_ydata()
+        steps = np.abs(np.diff(drawn))
+        assert not (steps[np.isfinite(steps)] > np.pi).any()
+        blanked = np.isnan(drawn) & np.isfinite(raw[:, b])
+        assert blanked.sum() == wraps[:, b].sum()
