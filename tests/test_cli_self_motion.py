@@ -10,7 +10,9 @@ crossings table's joints are at their limits in the library's rows.
 
 from __future__ import annotations
 
+import base64
 import json
+import re
 
 import numpy as np
 import pytest
@@ -18,6 +20,7 @@ import pytest
 import robokin
 from reference import iiwa14_srs
 from robokin.cli import main
+from robokin.cli.self_motion import interval_motion
 from robokin.io.robot_files import save_robot
 from robokin.spatial import pose_from_xyz_rpy, xyz_rpy_from_pose
 
@@ -174,3 +177,67 @@ def test_a_pose_out_of_reach_exits_1_saying_so(capsys):
     code, out, err = run(capsys, "self-motion", "panda", "3", "0", "0.5", "3.1", "0", "0")
     assert code == 1
     assert "out of reach" in err and "0 in-limit interval(s)" in out
+
+
+def _page_data(path):
+    text = path.read_text(encoding="utf-8")
+    found = re.search(r'<script id="robokin-data" type="application/json">(.*?)</script>',
+                      text, re.S)
+    return json.loads(found.group(1).replace("<\\/", "</"))
+
+
+def _f4(text, width):
+    return np.frombuffer(base64.b64decode(text), dtype="<f4").reshape(-1, width)
+
+
+def test_the_html_animation_moves_the_arm_and_holds_the_tool(tmp_path, capsys):
+    panda = robokin.load("panda")
+    pose = _pose_args(panda, QP)
+    page = tmp_path / "self_motion.html"
+    code, out, err = run(capsys, "self-motion", "panda", *pose, "--html", page, "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    sm = panda.self_motion(_pose_of(pose))
+    best = sm.best("margin")
+    shown = doc["animated"]
+    assert shown["branch"] == best.branch and shown["from"] <= best.t <= shown["to"]
+    data = _page_data(page)
+    assert len(data["t"]) == shown["frames"] == 481
+    tool = _f4(data["tool"], 12)[:, :3]  # position, then the rotation (float32)
+    np.testing.assert_allclose(tool, np.broadcast_to(_pose_of(pose)[:3, 3], tool.shape),
+                               atol=2e-6)
+    points = _f4(data["points"], 3 * data["nPoints"]).reshape(len(tool), -1, 3)
+    assert np.ptp(points, axis=0).max() > 0.05  # the elbow sweeps: a real self-motion
+
+
+def test_interval_motion_stays_on_the_pose_inside_the_limits():
+    panda = robokin.load("panda")
+    T = panda.fk(QP)
+    sm = panda.self_motion(T)
+    for k, b in enumerate(sm.interval_branch.tolist()):
+        t, Q = interval_motion(sm, b, k, frames=31)
+        a, e = sm.intervals[k]
+        assert len(t) == len(Q) and len(Q) % 2 == 1
+        assert np.all((t >= a) & (t <= e))
+        np.testing.assert_array_equal(Q, Q[::-1])  # forward, then back
+        np.testing.assert_allclose(panda.fk(Q), np.broadcast_to(T, (len(Q), 4, 4)),
+                                   atol=1e-12)
+        lo, hi = panda.limits.T + np.array([[-1e-12], [1e-12]])
+        assert np.all((lo <= Q) & (hi >= Q))
+        np.testing.assert_array_equal(Q[:, 6], t)  # q7 is the parameter
+
+
+def test_branch_errors_come_before_any_file_is_written(tmp_path, capsys):
+    panda = robokin.load("panda")
+    pose = _pose_args(panda, QP)
+    sm = panda.self_motion(_pose_of(pose))
+    empty = next(b for b in range(sm.n_branches) if b not in sm.interval_branch)
+    png, page = tmp_path / "b.png", tmp_path / "a.html"
+    code, _, err = run(capsys, "self-motion", "panda", *pose, "--plot", png, "--html",
+                       page, "--branch", empty)
+    assert code == 2 and "argument '--branch'" in err and "has no in-limit interval" in err
+    assert not png.exists() and not page.exists()
+    code, _, err = run(capsys, "self-motion", "panda", *pose, "--branch", 0)
+    assert code == 2 and "pass --html FILE too" in err
+    code, _, err = run(capsys, "self-motion", "panda", *pose, "--html", page, "--branch", 9)
+    assert code == 2 and "expected 0 ... 7, got 9" in err

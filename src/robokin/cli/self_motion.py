@@ -50,7 +50,7 @@ if TYPE_CHECKING:
     from robokin.kinematics.ik.self_motion import ManifoldPoint, SelfMotion
     from robokin.robot import Robot
 
-__all__ = ["commands", "self_motion"]
+__all__ = ["commands", "interval_motion", "self_motion"]
 
 commands = typer.Typer()
 
@@ -72,18 +72,90 @@ def _manifold(robot: Robot, T: np.ndarray, parameter: str) -> SelfMotion:
 
 
 def _plot_path(plot: Path | None, force: bool) -> Path | None:
-    """The ``--plot`` file, refused before any work when it exists without --force."""
+    """The ``--plot`` file (:func:`_output_path`)."""
     from robokin.viz.plots import FIGURE_FORMATS
 
-    if plot is None:
+    return _output_path(plot, "--plot", FIGURE_FORMATS, force)
+
+
+def _output_path(path: Path | None, option: str, suffixes: tuple[str, ...],
+                 force: bool) -> Path | None:
+    """An output file, refused before any work when it exists without --force."""
+    if path is None:
         return None
-    if plot.suffix.lower() not in FIGURE_FORMATS:
-        raise InputError("--plot", f"expected a {', '.join(FIGURE_FORMATS)} file, got "
-                         f"{plot.name!r}")
-    if plot.exists() and not force:
-        raise InputError("--plot", f"{plot} exists (an earlier run's?): pass --force to "
+    if path.suffix.lower() not in suffixes:
+        raise InputError(option, f"expected a {', '.join(suffixes)} file, got "
+                         f"{path.name!r}")
+    if path.exists() and not force:
+        raise InputError(option, f"{path} exists (an earlier run's?): pass --force to "
                          "replace it, or name another file")
-    return plot
+    return path
+
+
+def interval_motion(sm: SelfMotion, branch: int, interval: int, *,
+                    frames: int = 241) -> tuple[np.ndarray, np.ndarray]:
+    """Configurations along one in-limit interval of a branch, there and back.
+
+    Args:
+        sm: The manifold.
+        branch: The branch.
+        interval: The row of ``sm.intervals`` (an interval of ``branch``).
+        frames: Parameter values inside the interval (its ends excluded: a fold's
+            row may not exist exactly there).
+
+    Returns:
+        ``(t, Q)``: the parameter values (2 frames - 1,) [rad] and the branch's rows
+        (2 frames - 1, n) there, forward then back; rows that do not exist are
+        dropped.
+    """
+    import numpy as np
+
+    a, e = (float(v) for v in sm.intervals[interval])
+    t = np.linspace(a, e, frames + 2)[1:-1] if e > a else np.array([a])
+    Q = sm.sample(t)[:, branch]
+    ok = np.isfinite(Q).all(-1)
+    t, Q = t[ok], Q[ok]
+    return np.concatenate([t, t[-2::-1]]), np.concatenate([Q, Q[-2::-1]])
+
+
+def _shown_interval(sm: SelfMotion, top: ManifoldPoint | None,
+                    branch: int | None) -> int | None:
+    """The row of ``sm.intervals`` that ``--html`` animates, or None (no interval).
+
+    ``--branch``'s longest interval, else the one holding the best configuration.
+
+    Raises:
+        InputError: ``--branch`` is not a branch, or has no in-limit interval.
+    """
+    import numpy as np
+
+    if branch is not None:
+        if not 0 <= branch < sm.n_branches:
+            raise InputError("--branch", f"expected 0 ... {sm.n_branches - 1}, got {branch}")
+        mine = np.flatnonzero(sm.interval_branch == branch)
+        if not len(mine):
+            has = sorted(set(sm.interval_branch.tolist()))
+            raise InputError("--branch", f"branch {branch} has no in-limit interval; "
+                             f"branches with one: {has}")
+        return int(mine[np.argmax(np.diff(sm.intervals[mine], axis=1)[:, 0])])
+    if top is None:
+        return None  # no interval: nothing to animate (exit code 1 says why)
+    on = (sm.interval_branch == top.branch) & (sm.intervals[:, 0] <= top.t) & (
+        top.t <= sm.intervals[:, 1])
+    return int(np.flatnonzero(on)[0])
+
+
+def _animate(r: Robot, sm: SelfMotion, page: Path, k: int, per_rad: float,
+             au: str) -> dict[str, Any]:
+    """Write the ``--html`` animation of interval ``k``; what it shows."""
+    from robokin.viz.html import write_html
+
+    b = int(sm.interval_branch[k])
+    _, Q = interval_motion(sm, b, k)
+    a, e = (float(v) * per_rad for v in sm.intervals[k])
+    write_html(page, r, Q, dt=8.0 / max(len(Q), 1), title=(
+        f"{r.name}: self-motion, branch {b}, {sm.parameter} in [{a:.4g}, {e:.4g}] {au}"))
+    return {"branch": b, "from": a, "to": e, "frames": int(len(Q))}
 
 
 def _point_json(p: ManifoldPoint, per_rad: float, scale: np.ndarray) -> dict[str, Any]:
@@ -116,8 +188,14 @@ def self_motion(
     plot: Annotated[Path | None, typer.Option(
         "--plot", help="Write a plot of the branches (PNG, SVG or PDF): one panel per "
         "joint, thick over the in-limit intervals.")] = None,
+    html: Annotated[Path | None, typer.Option(
+        "--html", help="Write a standalone HTML animation of the arm moving along one "
+        "in-limit interval, the tool held at the pose (the best configuration's "
+        "interval, or --branch's longest).")] = None,
+    branch: Annotated[int | None, typer.Option(
+        "--branch", help="The branch --html animates (its longest interval).")] = None,
     force: Annotated[bool, typer.Option(
-        "--force", help="Replace the --plot file of an earlier run.")] = False,
+        "--force", help="Replace the --plot / --html file of an earlier run.")] = False,
     as_json: JsonFlag = False,
     output_format: FormatOption = None,
 ) -> None:
@@ -137,6 +215,10 @@ def self_motion(
     T = tool_pose(x, y, z, roll, pitch, yaw, deg=deg, mm=mm)
     q_near = None if near is None else joint_values(near, r, "--near", deg=deg, mm=mm)
     path = _plot_path(plot, force)
+    page = _output_path(html, "--html", (".html",), force)
+    if branch is not None and html is None:
+        raise InputError("--branch", "chooses the interval --html animates: pass --html "
+                         "FILE too")
     sm = _manifold(r, T, parameter)
     per_rad = 180.0 / math.pi if deg else 1.0
     au, lu = ("deg" if deg else "rad"), ("mm" if mm else "m")
@@ -144,11 +226,15 @@ def self_motion(
     scale = np.where(rev, per_rad, 1000.0 if mm else 1.0)
     top = sm.best(best, robot=r)
     close = None if q_near is None else _nearest(sm, q_near)
+    shown = None if page is None else _shown_interval(sm, top, branch)  # checked first
     if path is not None:
         from robokin.viz.plots import plot_self_motion
 
         plot_self_motion(sm, path=path, degrees=deg, overwrite=force,
                          title=f"{r.name}: self-motion over {sm.parameter}")
+    animated = None
+    if page is not None and shown is not None:
+        animated = _animate(r, sm, page, shown, per_rad, au)
     lo, hi = (float(v) * per_rad for v in sm.domain)
     if fmt == "json":
         print(json_text({
@@ -169,6 +255,8 @@ def self_motion(
             "nearest": None if close is None else {
                 **_point_json(close, per_rad, scale), "distance": -close.score * per_rad},
             "plot": None if path is None else str(path),
+            "html": None if page is None else str(page),
+            "animated": animated,
         }))
     else:
         tables = [_intervals_table(r, sm, per_rad, au, lo, hi)]
@@ -177,8 +265,9 @@ def self_motion(
         if points:
             tables.append(_points_table(r, sm, per_rad, au))
         emit(tables, fmt)
-        if path is not None:
-            say(f"wrote {path}", fmt)
+        for written in (path, page):
+            if written is not None:
+                say(f"wrote {written}", fmt)
     if not len(sm.intervals):
         raise DomainFailure(_empty_reason(sm))
 
