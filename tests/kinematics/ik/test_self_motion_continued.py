@@ -1129,3 +1129,40 @@ def test_the_range_end_rule_holds_in_limit_ends_and_lists_no_out_of_limit_one():
                 ref = robot.ik(T, fixed={name: end})
                 assert _wrapped(ref.q[ref.valid] - row).max(-1).min() < 1e-9
     assert checked == 24 and points >= 4, points
+
+
+def test_node_cuts_drop_an_interval_out_at_its_ends_and_every_node():
+    # Issue 29, session 16: offset iiwa special #8920 (seed 0; q1, q2, q5 and q7 at
+    # their limits, q4 = 0, q6 = -1e-6: the elbow stretched and the wrist aligned).
+    # An interval whose own end rows and every node row inside it are outside has no
+    # change of state to bisect; session 15's _node_cuts then asked the held solver
+    # for rows at no values and raised ValueError from the general 6R sweep (found by
+    # benchmarks/self_motion_interval_rows.py offset_iiwa 10000 300 0 5). Such an
+    # interval is dropped. Oracles: the call returns; every interval's rows at 21
+    # values inside it, where the held 6 x 6 is regular (smallest singular value
+    # above 1e-5, the goal's rows), are inside every limit to 1e-9 and are rows of
+    # independent held solves; the long interval of q7 from its lower limit to
+    # -1.48186 (the configuration's neighbourhood on a regular branch) is kept.
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array([2.9670597283903604, 2.0943951023931953, -1.7436186292064066, 0.0,
+                   -2.9670597283903604, -1e-06, -3.0543261909900767])
+    T, sm = _manifold(robot, q0)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    regular = 0
+    for (a, e), b in zip(sm.intervals, sm.interval_branch, strict=True):
+        ts = np.linspace(a, e, 23)[1:-1]
+        rows = sm.sample(ts)[:, b]
+        ok = np.isfinite(rows).all(-1)
+        sv = np.full(len(ts), 0.0)
+        sv[ok] = np.linalg.svd(np.delete(robot.jacobian(rows[ok]), 6, axis=-1),
+                               compute_uv=False)[:, -1]
+        keep = sv > 1e-5
+        if not keep.any():
+            continue
+        regular += int(keep.sum())
+        out = np.maximum(lo - rows[keep], rows[keep] - hi).max(axis=-1)
+        assert out.max() <= 1e-9, (a, e, b, out.max())
+        _assert_held_solves_inside(robot, T, ts[keep], rows[keep])
+    assert regular >= 21
+    long = sm.intervals[(sm.intervals[:, 1] - sm.intervals[:, 0]) > 1.0]
+    assert len(long) == 1 and long[0, 1] == pytest.approx(-1.48186, abs=1e-5), long

@@ -617,7 +617,7 @@ class EndSweep:
                                         joint.kind, joint.sign))
         Q, valid, _, sigma, _, _, stats = _g6.raw_solve(self.reduced.chain, self.params, Tm)
         sols = _held_set(robot, j, self.cols, values, Tb, Q, valid, sigma)
-        return sols, stats[:, 4:].reshape(M, -1, 2)
+        return sols, stats[:, 4:].reshape(M, 4, 2)  # M = 0 too
 
 
 def _held_set(robot: Arm, j: int, cols: list[int] | np.ndarray, values: np.ndarray,

@@ -490,7 +490,9 @@ def _node_cuts(fam: _Family, limits: np.ndarray, intervals: np.ndarray, owner: n
     ``_NODE_OUT`` outside keeps only its in-limit runs: every change of state between
     neighbouring nodes and its two ends (their own rows: an end at one joint's crossing
     can have another joint out) is bisected on ``fam.slot_rows`` (one batch per step)
-    to its last in-limit value, a limit crossing of the joint furthest out past it.
+    to its last in-limit value, a limit crossing of the joint furthest out past it. An
+    interval outside at both ends and at every node in it has no change of state: it
+    is dropped (session 16: offset iiwa special #8920 of seed 0).
 
     Returns ``(intervals, owner, crossings [(t, branch, joint, "lower"|"upper")])``;
     the arrays unchanged (the same objects) where no node is outside.
@@ -535,6 +537,10 @@ def _node_cuts(fam: _Family, limits: np.ndarray, intervals: np.ndarray, owner: n
         same = now == s0[go]
         lo[go], hi[go] = np.where(same, mid[go], lo[go]), np.where(same, hi[go], mid[go])
     inner, outer = np.where(s0, lo, hi), np.where(s0, hi, lo)
+    keep = np.ones(len(intervals), dtype=bool)
+    keep[hit] = False
+    if not len(brk):  # every hit interval outside at its ends and at its nodes: dropped
+        return intervals[keep], owner[keep], []
     q_out, _ = fam.slot_rows(outer, bb)
     with np.errstate(invalid="ignore"):
         below, above = lo_l - q_out, q_out - hi_l
@@ -547,8 +553,6 @@ def _node_cuts(fam: _Family, limits: np.ndarray, intervals: np.ndarray, owner: n
     for n_, (si, _) in enumerate(brk):
         cuts[si].append(float(inner[n_]))
         crossings.append((float(inner[n_]), int(bb[n_]), int(joint[n_]), str(side[n_])))
-    keep = np.ones(len(intervals), dtype=bool)
-    keep[hit] = False
     new: list[tuple[int, float, float]] = []
     for si, (i, ts, ok) in enumerate(seqs):
         ends = iter(cuts[si])
