@@ -33,15 +33,16 @@ def run(capsys, *args):
     return code, out, err
 
 
-def _pose_args(robot, q, deg=False):
+def _pose_args(robot, q, deg=False, mm=False):
     xyz, rpy = xyz_rpy_from_pose(robot.fk(q))
-    vals = np.concatenate([xyz, np.degrees(rpy) if deg else rpy])
+    vals = np.concatenate([xyz * 1000.0 if mm else xyz, np.degrees(rpy) if deg else rpy])
     return [repr(float(v)) for v in vals]
 
 
-def _pose_of(args, deg=False):
+def _pose_of(args, deg=False, mm=False):
     v = np.array([float(a) for a in args])
-    return pose_from_xyz_rpy(v[:3], v[3:] / (180.0 / np.pi) if deg else v[3:])
+    return pose_from_xyz_rpy(v[:3] / 1000.0 if mm else v[:3],
+                             v[3:] / (180.0 / np.pi) if deg else v[3:])
 
 
 def test_the_generating_configuration_is_in_a_printed_interval_of_its_branch(capsys):
@@ -241,3 +242,45 @@ def test_branch_errors_come_before_any_file_is_written(tmp_path, capsys):
     assert code == 2 and "pass --html FILE too" in err
     code, _, err = run(capsys, "self-motion", "panda", *pose, "--html", page, "--branch", 9)
     assert code == 2 and "expected 0 ... 7, got 9" in err
+
+
+def _ur5_on_a_track():
+    """A UR5 (standard DH) on a 2 m linear track: a 7-joint arm whose first joint is
+    prismatic, the parameter users pick for a robot on a rail."""
+    ur5 = [(0.089159, 0.0, np.pi / 2), (0.0, -0.425, 0.0), (0.0, -0.39225, 0.0),
+           (0.10915, 0.0, np.pi / 2), (0.09465, 0.0, -np.pi / 2), (0.0823, 0.0, 0.0)]
+    rows = [{"a": 0.0, "alpha": -np.pi / 2, "d": 0.0, "theta": np.pi / 2,
+             "joint": "prismatic", "limits": [0.0, 2.0], "name": "track"}]
+    rows += [{"a": a, "alpha": alpha, "d": d, "theta": 0.0, "limits": [-6.28, 6.28],
+              "name": f"j{i + 1}"} for i, (d, a, alpha) in enumerate(ur5)]
+    return robokin.Robot.from_dh(rows, convention="standard", name="ur5_track")
+
+
+def test_a_track_as_the_parameter_prints_millimetres(tmp_path, capsys):
+    arm = _ur5_on_a_track()
+    path = save_robot(arm, tmp_path / "ur5_track.yaml")
+    loaded = robokin.load(str(path))
+    q = np.array([0.7, 0.3, -1.2, 1.1, -0.5, 0.8, 0.2])
+    pose = _pose_args(loaded, q, deg=True, mm=True)
+    T = _pose_of(pose, deg=True, mm=True)
+    code, out, err = run(capsys, "self-motion", path, *pose, "--parameter", "track",
+                         "--mm", "--deg", "--json", "--plot", tmp_path / "track.png")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["parameter"] == "track" and doc["unit"] == "mm"
+    assert doc["domain"] == [0.0, 2000.0]
+    sm = loaded.self_motion(T, "track")
+    got = np.array([[iv["from"], iv["to"]] for iv in doc["intervals"]])
+    np.testing.assert_allclose(got / 1000.0, sm.intervals, rtol=0, atol=1e-15)
+    holding = [iv["branch"] for iv in doc["intervals"] if iv["from"] <= 700.0 <= iv["to"]]
+    rows = sm.sample(q[0])
+    assert any(np.abs(rows[b] - q).max() < 1e-9 for b in holding), holding
+    best = np.array(doc["best"]["q"])
+    best_si = np.concatenate([best[:1] / 1000.0, np.radians(best[1:])])
+    np.testing.assert_allclose(loaded.fk(best_si), T, atol=1e-9)
+    assert doc["best"]["t"] == pytest.approx(best[0], abs=1e-9)  # the track is t [mm]
+    code, out, err = run(capsys, "self-motion", path, *_pose_args(loaded, q, mm=True),
+                         "--parameter", "track", "--mm", "--format", "text")
+    assert code == 0, err
+    assert "over track [mm]" in out and "q1 [mm]" in out and "q2 [rad]" in out
+    assert "[rad, m]" in out  # the margin mixes a length and angles

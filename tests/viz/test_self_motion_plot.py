@@ -42,3 +42,22 @@ def test_a_branch_through_pi_is_not_drawn_across_the_panel():
         assert not (steps[np.isfinite(steps)] > np.pi).any()
         blanked = np.isnan(drawn) & np.isfinite(raw[:, b])
         assert blanked.sum() == wraps[:, b].sum()
+
+
+def test_a_prismatic_parameter_is_drawn_in_millimetres():
+    """A UR5 on a linear track, the track as the parameter: its panel and the x axis
+    in mm (the track's range 0-2 m drawn 0-2000), the revolute joints in degrees."""
+    from test_cli_self_motion import _ur5_on_a_track
+
+    arm = _ur5_on_a_track()
+    q = np.array([0.7, 0.3, -1.2, 1.1, -0.5, 0.8, 0.2])
+    sm = arm.self_motion(arm.fk(q), "track")
+    assert sm.revolute.tolist() == [False] + [True] * 6
+    fig = plot_self_motion(sm, samples=61)
+    axes = fig.axes
+    assert axes[0].get_ylabel() == "q1 [mm]" and axes[1].get_ylabel() == "q2 [deg]"
+    assert axes[-1].get_xlabel() == "track [mm]"
+    x = axes[0].lines[0].get_xdata()
+    assert x[0] == 0.0 and x[-1] == 2000.0
+    dashed = [ln.get_ydata()[0] for ln in axes[0].lines if ln.get_linestyle() == "--"]
+    assert dashed == [0.0, 2000.0]  # the track's limits

@@ -10,9 +10,11 @@ limit crossing and singular point (``--points``) and a plot of the branches
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
+import numpy as np
 import typer
 
 from robokin.cli.common import (
@@ -45,8 +47,6 @@ from robokin.cli.output import (
 from robokin.exceptions import InputError
 
 if TYPE_CHECKING:
-    import numpy as np
-
     from robokin.kinematics.ik.self_motion import ManifoldPoint, SelfMotion
     from robokin.robot import Robot
 
@@ -59,6 +59,39 @@ CRITERIA = ("margin", "manipulability")
 
 #: What each argument of the library call is called on the command line.
 _OPTION = {"parameter": "--parameter", "robot": "NAME", "q_near": "--near"}
+
+
+@dataclass(frozen=True)
+class _Units:
+    """The units the command prints in (``--deg``, ``--mm``).
+
+    Attributes:
+        t: Parameter values [rad or m] -> printed (a prismatic parameter in m or mm).
+        t_unit: The parameter's unit.
+        q: (n,) per joint, [rad or m] -> printed.
+        q_unit: Each joint's unit.
+        dist: The margin and the nearest distance -> printed (an angle when every
+            joint is revolute; else as the library gives them, rad and m mixed).
+        dist_unit: Their unit.
+    """
+
+    t: float
+    t_unit: str
+    q: np.ndarray
+    q_unit: list[str]
+    dist: float
+    dist_unit: str
+
+
+def _units(r: Robot, sm: SelfMotion, deg: bool, mm: bool) -> _Units:
+    per_rad, per_m = (180.0 / math.pi if deg else 1.0), (1000.0 if mm else 1.0)
+    au, lu = ("deg" if deg else "rad"), ("mm" if mm else "m")
+    rev = [bool(v) for v in r.is_revolute]
+    angle = sm.joint is None or rev[sm.joint]
+    revolute = all(rev)
+    return _Units(per_rad if angle else per_m, au if angle else lu,
+                  np.where(rev, per_rad, per_m), [au if v else lu for v in rev],
+                  per_rad if revolute else 1.0, au if revolute else "rad, m")
 
 
 def _manifold(robot: Robot, T: np.ndarray, parameter: str) -> SelfMotion:
@@ -108,8 +141,6 @@ def interval_motion(sm: SelfMotion, branch: int, interval: int, *,
         (2 frames - 1, n) there, forward then back; rows that do not exist are
         dropped.
     """
-    import numpy as np
-
     a, e = (float(v) for v in sm.intervals[interval])
     t = np.linspace(a, e, frames + 2)[1:-1] if e > a else np.array([a])
     Q = sm.sample(t)[:, branch]
@@ -127,8 +158,6 @@ def _shown_interval(sm: SelfMotion, top: ManifoldPoint | None,
     Raises:
         InputError: ``--branch`` is not a branch, or has no in-limit interval.
     """
-    import numpy as np
-
     if branch is not None:
         if not 0 <= branch < sm.n_branches:
             raise InputError("--branch", f"expected 0 ... {sm.n_branches - 1}, got {branch}")
@@ -145,21 +174,21 @@ def _shown_interval(sm: SelfMotion, top: ManifoldPoint | None,
     return int(np.flatnonzero(on)[0])
 
 
-def _animate(r: Robot, sm: SelfMotion, page: Path, k: int, per_rad: float,
-             au: str) -> dict[str, Any]:
+def _animate(r: Robot, sm: SelfMotion, page: Path, k: int, u: _Units) -> dict[str, Any]:
     """Write the ``--html`` animation of interval ``k``; what it shows."""
     from robokin.viz.html import write_html
 
     b = int(sm.interval_branch[k])
     _, Q = interval_motion(sm, b, k)
-    a, e = (float(v) * per_rad for v in sm.intervals[k])
+    a, e = (float(v) * u.t for v in sm.intervals[k])
     write_html(page, r, Q, dt=8.0 / max(len(Q), 1), title=(
-        f"{r.name}: self-motion, branch {b}, {sm.parameter} in [{a:.4g}, {e:.4g}] {au}"))
+        f"{r.name}: self-motion, branch {b}, {sm.parameter} in [{a:.4g}, {e:.4g}] "
+        f"{u.t_unit}"))
     return {"branch": b, "from": a, "to": e, "frames": int(len(Q))}
 
 
-def _point_json(p: ManifoldPoint, per_rad: float, scale: np.ndarray) -> dict[str, Any]:
-    return {"t": p.t * per_rad, "branch": p.branch, "q": (p.q * scale).tolist()}
+def _point_json(p: ManifoldPoint, u: _Units) -> dict[str, Any]:
+    return {"t": p.t * u.t, "branch": p.branch, "q": (p.q * u.q).tolist()}
 
 
 @commands.command("self-motion", context_settings={"ignore_unknown_options": True})
@@ -206,8 +235,6 @@ def self_motion(
     configuration on them and, with --near, the one nearest the current joints.
     Exit code 1 when no part of the self-motion is inside the limits.
     """
-    import numpy as np
-
     fmt = resolve_format(output_format, as_json)
     if best not in CRITERIA:
         raise InputError("--best", f"expected one of {', '.join(CRITERIA)}, got {best!r}")
@@ -220,50 +247,45 @@ def self_motion(
         raise InputError("--branch", "chooses the interval --html animates: pass --html "
                          "FILE too")
     sm = _manifold(r, T, parameter)
-    per_rad = 180.0 / math.pi if deg else 1.0
-    au, lu = ("deg" if deg else "rad"), ("mm" if mm else "m")
-    rev = np.asarray(r.is_revolute)
-    scale = np.where(rev, per_rad, 1000.0 if mm else 1.0)
+    u = _units(r, sm, deg, mm)
     top = sm.best(best, robot=r)
     close = None if q_near is None else _nearest(sm, q_near)
     shown = None if page is None else _shown_interval(sm, top, branch)  # checked first
     if path is not None:
         from robokin.viz.plots import plot_self_motion
 
-        plot_self_motion(sm, path=path, degrees=deg, overwrite=force,
+        plot_self_motion(sm, path=path, degrees=deg, mm=mm, overwrite=force,
                          title=f"{r.name}: self-motion over {sm.parameter}")
     animated = None
     if page is not None and shown is not None:
-        animated = _animate(r, sm, page, shown, per_rad, au)
-    lo, hi = (float(v) * per_rad for v in sm.domain)
+        animated = _animate(r, sm, page, shown, u)
     if fmt == "json":
         print(json_text({
-            "robot": r.name, "parameter": sm.parameter, "unit": au,
-            "domain": [lo, hi], "periodic": sm.periodic, "branches": sm.n_branches,
-            "method": sm.method,
-            "intervals": [{"branch": int(b), "from": float(a) * per_rad,
-                           "to": float(e) * per_rad}
+            "robot": r.name, "parameter": sm.parameter, "unit": u.t_unit,
+            "domain": (sm.domain * u.t).tolist(), "periodic": sm.periodic,
+            "branches": sm.n_branches, "method": sm.method,
+            "intervals": [{"branch": int(b), "from": float(a) * u.t, "to": float(e) * u.t}
                           for (a, e), b in zip(sm.intervals, sm.interval_branch)],
-            "crossings": [{"t": c.t * per_rad, "branch": c.branch,
+            "crossings": [{"t": c.t * u.t, "branch": c.branch,
                            "joint": r.joint_names[c.joint], "limit": c.limit}
                           for c in sm.crossings],
-            "singular": [{"t": s.t * per_rad, "branch": s.branch, "kind": s.kind}
+            "singular": [{"t": s.t * u.t, "branch": s.branch, "kind": s.kind}
                          for s in sm.singular],
             "best": None if top is None else {
-                **_point_json(top, per_rad, scale), "criterion": best,
-                "score": top.score * (per_rad if best == "margin" else 1.0)},
+                **_point_json(top, u), "criterion": best,
+                "score": top.score * (u.dist if best == "margin" else 1.0)},
             "nearest": None if close is None else {
-                **_point_json(close, per_rad, scale), "distance": -close.score * per_rad},
+                **_point_json(close, u), "distance": -close.score * u.dist},
             "plot": None if path is None else str(path),
             "html": None if page is None else str(page),
             "animated": animated,
         }))
     else:
-        tables = [_intervals_table(r, sm, per_rad, au, lo, hi)]
+        tables = [_intervals_table(r, sm, u)]
         if top is not None or close is not None:
-            tables.append(_configurations_table(r, top, close, best, per_rad, scale, au, lu))
+            tables.append(_configurations_table(top, close, best, u))
         if points:
-            tables.append(_points_table(r, sm, per_rad, au))
+            tables.append(_points_table(r, sm, u))
         emit(tables, fmt)
         for written in (path, page):
             if written is not None:
@@ -281,30 +303,29 @@ def _nearest(sm: SelfMotion, q_near: np.ndarray) -> ManifoldPoint | None:
 
 def _empty_reason(sm: SelfMotion) -> str:
     """Why no interval: the pose out of reach (no branch anywhere) or the limits."""
-    import numpy as np
-
     t = np.linspace(float(sm.domain[0]), float(sm.domain[1]), 361)
     if not np.isfinite(sm.sample(t)).all(-1).any() and not sm.crossings:
         return "the pose is out of reach: no branch of the self-motion exists"
     return "no part of the self-motion is inside the joint limits"
 
 
-def _intervals_table(r: Robot, sm: SelfMotion, per_rad: float, au: str, lo: float,
-                     hi: float) -> OutputTable:
+def _intervals_table(r: Robot, sm: SelfMotion, u: _Units) -> OutputTable:
     from robokin.cli.output import fixed
 
+    unit = u.t_unit
     table = OutputTable(
-        f"{r.name}: self-motion over {sm.parameter} [{au}]: {sm.n_branches} branches, "
+        f"{r.name}: self-motion over {sm.parameter} [{unit}]: {sm.n_branches} "
+        f"branch{'es' if sm.n_branches != 1 else ''}, "
         f"{len(sm.intervals)} in-limit interval(s) [{sm.method}]",
-        [Column("branch", right=True), Column(f"from [{au}]", fmt=fixed(6), right=True),
-         Column(f"to [{au}]", fmt=fixed(6), right=True),
-         Column(f"length [{au}]", fmt=fixed(6), right=True)])
+        [Column("branch", right=True), Column(f"from [{unit}]", fmt=fixed(6), right=True),
+         Column(f"to [{unit}]", fmt=fixed(6), right=True),
+         Column(f"length [{unit}]", fmt=fixed(6), right=True)])
     for (a, e), b in zip(sm.intervals, sm.interval_branch):
-        table.add_row(int(b), float(a) * per_rad, float(e) * per_rad,
-                      float(e - a) * per_rad)
+        table.add_row(int(b), float(a) * u.t, float(e) * u.t, float(e - a) * u.t)
     folds = sum(s.kind == "fold" for s in sm.singular)
+    lo, hi = (float(v) * u.t for v in sm.domain)
     table.notes.append(
-        f"{sm.parameter} ranges over [{lo:.6g}, {hi:.6g}] {au}"
+        f"{sm.parameter} ranges over [{lo:.6g}, {hi:.6g}] {unit}"
         + (" (periodic: an interval through +-pi is one, its end past it)"
            if sm.periodic else "")
         + f"; {len(sm.crossings)} limit crossing(s), {folds} branch end(s), "
@@ -312,42 +333,42 @@ def _intervals_table(r: Robot, sm: SelfMotion, per_rad: float, au: str, lo: floa
     return table
 
 
-def _configurations_table(r: Robot, top: ManifoldPoint | None, close: ManifoldPoint | None,
-                          best: str, per_rad: float, scale: np.ndarray, au: str,
-                          lu: str) -> OutputTable:
+def _configurations_table(top: ManifoldPoint | None, close: ManifoldPoint | None,
+                          best: str, u: _Units) -> OutputTable:
     from robokin.cli.output import fixed, general
 
-    units = [au if rv else lu for rv in r.is_revolute]
     table = OutputTable(
         "configurations on the self-motion, inside every limit",
-        [Column("which"), Column(f"t [{au}]", fmt=fixed(6), right=True),
+        [Column("which"), Column(f"t [{u.t_unit}]", fmt=fixed(6), right=True),
          Column("branch", right=True),
-         *[Column(f"q{j + 1} [{u}]", fmt=fixed(6), right=True) for j, u in enumerate(units)],
+         *[Column(f"q{j + 1} [{unit}]", fmt=fixed(6), right=True)
+           for j, unit in enumerate(u.q_unit)],
          Column("score", fmt=general(6), right=True)])
     if top is not None:
-        value = top.score * per_rad if best == "margin" else top.score
-        table.add_row(f"best {best}", top.t * per_rad, top.branch,
-                      *(float(v) for v in top.q * scale), value)
+        value = top.score * u.dist if best == "margin" else top.score
+        table.add_row(f"best {best}", top.t * u.t, top.branch,
+                      *(float(v) for v in top.q * u.q), value)
     if close is not None:
-        table.add_row("nearest --near", close.t * per_rad, close.branch,
-                      *(float(v) for v in close.q * scale), -close.score * per_rad)
+        table.add_row("nearest --near", close.t * u.t, close.branch,
+                      *(float(v) for v in close.q * u.q), -close.score * u.dist)
     table.notes.append(
-        f"score: margin = the smallest distance to a joint limit [{au}]; manipulability "
-        f"= sqrt(det(J J^T)); nearest = the wrapped joint-space distance [{au}]")
+        f"score: margin = the smallest distance to a joint limit [{u.dist_unit}]; "
+        "manipulability = sqrt(det(J J^T)); nearest = the wrapped joint-space distance "
+        f"[{u.dist_unit}]")
     return table
 
 
-def _points_table(r: Robot, sm: SelfMotion, per_rad: float, au: str) -> OutputTable:
+def _points_table(r: Robot, sm: SelfMotion, u: _Units) -> OutputTable:
     from robokin.cli.output import fixed
 
     table = OutputTable(
         "limit crossings and singular points",
-        [Column(f"t [{au}]", fmt=fixed(9), right=True), Column("branch", right=True),
+        [Column(f"t [{u.t_unit}]", fmt=fixed(9), right=True), Column("branch", right=True),
          Column("what")])
     rows = [(c.t, c.branch, f"{r.joint_names[c.joint]} at its {c.limit} limit")
             for c in sm.crossings]
     rows += [(s.t, s.branch, "branch end (fold)" if s.kind == "fold" else s.kind)
              for s in sm.singular]
     for t, b, what in sorted(rows, key=lambda row: (row[1], row[0])):
-        table.add_row(t * per_rad, b, what)
+        table.add_row(t * u.t, b, what)
     return table

@@ -288,8 +288,8 @@ def plot_joints(traj: Trajectory, *, path: str | Path | None = None, degrees: bo
 
 
 def plot_self_motion(sm: SelfMotion, *, path: str | Path | None = None,
-                     degrees: bool = True, samples: int = 721, title: str | None = None,
-                     overwrite: bool = False) -> Any:
+                     degrees: bool = True, mm: bool = True, samples: int = 721,
+                     title: str | None = None, overwrite: bool = False) -> Any:
     """The branches of a self-motion manifold: one panel per joint, a line per branch.
 
     Each branch's joint value over the parameter t is drawn thin where it leaves a
@@ -302,6 +302,8 @@ def plot_self_motion(sm: SelfMotion, *, path: str | Path | None = None,
             (``robot.self_motion(T)``).
         path: Save to this PNG/SVG/PDF file too.
         degrees: Angles in degrees, else rad.
+        mm: Prismatic joints (a track, and the parameter when it is one) in
+            millimetres, else m.
         samples: Parameter values drawn per branch.
         title: Figure title.
         overwrite: Replace an existing file.
@@ -309,8 +311,14 @@ def plot_self_motion(sm: SelfMotion, *, path: str | Path | None = None,
     Returns:
         The matplotlib Figure.
     """
-    s = 180.0 / np.pi if degrees else 1.0
-    unit = "deg" if degrees else "rad"
+    angle, length = (180.0 / np.pi if degrees else 1.0), (1000.0 if mm else 1.0)
+    rev = sm.revolute
+    per = np.where(rev, angle, length)  # (n,): rad or m -> drawn
+    units = [("deg" if degrees else "rad") if r else ("mm" if mm else "m") for r in rev]
+    if sm.joint is None or rev[sm.joint]:  # the swivel, or a revolute joint
+        s_t, unit_t = angle, "deg" if degrees else "rad"
+    else:
+        s_t, unit_t = length, units[sm.joint]
     lo, hi = sm.domain
     t = np.linspace(lo, hi, int(samples))
     q = sm.sample(t)  # (m, k, n)
@@ -321,23 +329,24 @@ def plot_self_motion(sm: SelfMotion, *, path: str | Path | None = None,
     axes = fig.subplots(n, 1, sharex=True)
     colors = [f"C{b % 10}" for b in range(sm.n_branches)]
     for j, ax in enumerate(axes):
+        s = per[j]
         for b in range(sm.n_branches):
-            ax.plot(t * s, q[:, b, j] * s, color=colors[b], linewidth=0.6, alpha=0.5)
-            ax.plot(t * s, np.where(inside[:, b], q[:, b, j], np.nan) * s, color=colors[b],
-                    linewidth=2.0, label=f"branch {b}" if j == 0 else None)
+            ax.plot(t * s_t, q[:, b, j] * s, color=colors[b], linewidth=0.6, alpha=0.5)
+            ax.plot(t * s_t, np.where(inside[:, b], q[:, b, j], np.nan) * s,
+                    color=colors[b], linewidth=2.0, label=f"branch {b}" if j == 0 else None)
         for v in sm.limits[j]:
             ax.axhline(v * s, color="0.3", linestyle="--", linewidth=0.8)
         for c in sm.crossings:
             if c.joint == j:
-                ax.plot(c.t * s, sm.limits[j, 0 if c.limit == "lower" else 1] * s, "o",
+                ax.plot(c.t * s_t, sm.limits[j, 0 if c.limit == "lower" else 1] * s, "o",
                         color=colors[c.branch], markersize=3)
-        ax.set_ylabel(f"q{j + 1} [{unit}]")
+        ax.set_ylabel(f"q{j + 1} [{units[j]}]")
         ax.grid(True, alpha=0.3)
     for p in sm.singular:
         qp = sm.sample(p.t)[p.branch]
         for j, ax in enumerate(axes):
-            ax.plot(p.t * s, qp[j] * s, "x", color="k", markersize=4)
-    axes[-1].set_xlabel(f"{sm.parameter} [{unit}]")
+            ax.plot(p.t * s_t, qp[j] * per[j], "x", color="k", markersize=4)
+    axes[-1].set_xlabel(f"{sm.parameter} [{unit_t}]")
     axes[0].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
     fig.suptitle(title or f"self-motion over {sm.parameter}: {len(sm.intervals)} "
                           "in-limit interval(s) (thick)")

@@ -198,6 +198,11 @@ class SelfMotion:
         return _within(q, self.limits)
 
     @property
+    def revolute(self) -> np.ndarray:
+        """(n,) bool: the revolute joints (their columns of ``sample`` in rad; else m)."""
+        return np.asarray(self._family.robot.is_revolute, dtype=bool)
+
+    @property
     def reachable(self) -> bool:
         """True when some part of the manifold is inside every joint limit."""
         return bool(len(self.intervals))

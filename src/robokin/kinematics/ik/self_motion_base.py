@@ -25,6 +25,7 @@ class _Family:
     domain: tuple[float, float]
     name: str
     joint: int | None
+    robot: Arm
 
     def rows(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Q (m, k, n) (NaN where a branch has no point), valid (m, k), singular (m, k)."""

@@ -501,7 +501,7 @@ def _node_cuts(fam: _Family, limits: np.ndarray, intervals: np.ndarray, owner: n
         return intervals, owner, []
     lo_l, hi_l = limits[:, 0], limits[:, 1]
     with np.errstate(invalid="ignore"):
-        X = _into_limits(fam.robot, tracks)  # type: ignore[attr-defined]
+        X = _into_limits(fam.robot, tracks)
         excess = np.maximum(lo_l - X, X - hi_l).max(axis=-1)  # (m, k), NaN: no row
     a, e = intervals[:, 0], intervals[:, 1]
     within = (t_nodes[None, :] > a[:, None]) & (t_nodes[None, :] < e[:, None])  # (i, m)
@@ -1020,7 +1020,7 @@ def _held_refine(fam: _Family, limits: np.ndarray, r: np.ndarray, hold: np.ndarr
     from robokin.kinematics.jacobian import jacobian_and_pose
     from robokin.spatial import pose_error
 
-    robot: Arm = fam.robot  # type: ignore[attr-defined]
+    robot: Arm = fam.robot
     T: np.ndarray = fam.T  # type: ignore[attr-defined]
     q: np.ndarray = np.array(r, dtype=np.float64)
     lim = limits[hold]
