@@ -113,6 +113,24 @@ def iiwa14_srs():
     return robokin.Robot.from_dh(rows, convention="standard", name="iiwa14_srs")
 
 
+def ur5_on_a_track(length: float = 2.0):
+    """A UR5 (standard DH, joints +-6.28 rad) on a linear track ``length`` [m] long.
+
+    A 7-joint arm whose first joint is prismatic (along the base z axis), the
+    parameter users pick for a robot on a rail; its revolute joints range over more
+    than a turn.
+    """
+    import robokin
+
+    ur5 = [(0.089159, 0.0, np.pi / 2), (0.0, -0.425, 0.0), (0.0, -0.39225, 0.0),
+           (0.10915, 0.0, np.pi / 2), (0.09465, 0.0, -np.pi / 2), (0.0823, 0.0, 0.0)]
+    rows = [{"a": 0.0, "alpha": -np.pi / 2, "d": 0.0, "theta": np.pi / 2,
+             "joint": "prismatic", "limits": [0.0, length], "name": "track"}]
+    rows += [{"a": a, "alpha": alpha, "d": d, "theta": 0.0, "limits": [-6.28, 6.28],
+              "name": f"j{i + 1}"} for i, (d, a, alpha) in enumerate(ur5)]
+    return robokin.Robot.from_dh(rows, convention="standard", name="ur5_track")
+
+
 def offset_iiwa14(a2: float = 0.01):
     """:func:`iiwa14_srs` with a shoulder offset ``a2`` [m] (1 cm by default).
 

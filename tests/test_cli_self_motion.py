@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import robokin
-from reference import iiwa14_srs
+from reference import iiwa14_srs, ur5_on_a_track
 from robokin.cli import main
 from robokin.cli.self_motion import interval_motion
 from robokin.io.robot_files import save_robot
@@ -244,20 +244,8 @@ def test_branch_errors_come_before_any_file_is_written(tmp_path, capsys):
     assert code == 2 and "expected 0 ... 7, got 9" in err
 
 
-def _ur5_on_a_track():
-    """A UR5 (standard DH) on a 2 m linear track: a 7-joint arm whose first joint is
-    prismatic, the parameter users pick for a robot on a rail."""
-    ur5 = [(0.089159, 0.0, np.pi / 2), (0.0, -0.425, 0.0), (0.0, -0.39225, 0.0),
-           (0.10915, 0.0, np.pi / 2), (0.09465, 0.0, -np.pi / 2), (0.0823, 0.0, 0.0)]
-    rows = [{"a": 0.0, "alpha": -np.pi / 2, "d": 0.0, "theta": np.pi / 2,
-             "joint": "prismatic", "limits": [0.0, 2.0], "name": "track"}]
-    rows += [{"a": a, "alpha": alpha, "d": d, "theta": 0.0, "limits": [-6.28, 6.28],
-              "name": f"j{i + 1}"} for i, (d, a, alpha) in enumerate(ur5)]
-    return robokin.Robot.from_dh(rows, convention="standard", name="ur5_track")
-
-
 def test_a_track_as_the_parameter_prints_millimetres(tmp_path, capsys):
-    arm = _ur5_on_a_track()
+    arm = ur5_on_a_track()
     path = save_robot(arm, tmp_path / "ur5_track.yaml")
     loaded = robokin.load(str(path))
     q = np.array([0.7, 0.3, -1.2, 1.1, -0.5, 0.8, 0.2])

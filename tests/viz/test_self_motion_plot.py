@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference import iiwa14_srs
+from reference import iiwa14_srs, ur5_on_a_track
 from robokin.viz.plots import plot_self_motion
 
 
@@ -47,9 +47,7 @@ def test_a_branch_through_pi_is_not_drawn_across_the_panel():
 def test_a_prismatic_parameter_is_drawn_in_millimetres():
     """A UR5 on a linear track, the track as the parameter: its panel and the x axis
     in mm (the track's range 0-2 m drawn 0-2000), the revolute joints in degrees."""
-    from test_cli_self_motion import _ur5_on_a_track
-
-    arm = _ur5_on_a_track()
+    arm = ur5_on_a_track()
     q = np.array([0.7, 0.3, -1.2, 1.1, -0.5, 0.8, 0.2])
     sm = arm.self_motion(arm.fk(q), "track")
     assert sm.revolute.tolist() == [False] + [True] * 6

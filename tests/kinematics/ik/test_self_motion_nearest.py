@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import robokin
-from reference import pose_errors
+from reference import pose_errors, ur5_on_a_track
 from robokin.kinematics.arm import arm_of
 from robokin.kinematics.ik.dispatch import solve
 from robokin.kinematics.ik.self_motion_families import _family
@@ -81,3 +81,24 @@ def test_no_interval_gives_none():
     q0 = np.zeros(7)
     fam = _family(arm_of(PANDA), PANDA.fk(q0), "auto", solve, False)
     assert interval_nearest(fam, PANDA.limits, np.zeros((0, 2)), np.zeros(0, int), q0) is None
+
+
+@pytest.mark.parametrize("parameter", ["track", "j1", "j6"])
+def test_joints_with_a_range_over_a_turn_come_back_without_a_full_turn(parameter):
+    # Session 16: a UR5 (joints +-6.28 rad) on a linear track. With j6 as the
+    # parameter, t and t - 2 pi are both in its domain and equally near q0 by the
+    # wrapped distance; nearest(q0) returned q0 with j6 a full turn away. The tie now
+    # goes to the unwrapped nearer value, and the other revolute joints come back at
+    # their 2 pi equivalent nearest q_near (SolutionSet.nearest's rule); the track
+    # (prismatic) is never wrapped. Oracles: q0 itself (1e-9), FK of the answer.
+    arm = ur5_on_a_track(6.0)
+    for q0 in (np.array([0.7, 0.3, -1.2, 1.1, -0.5, 0.8, 0.2]),
+               np.array([4.5, -2.9, 1.0, -2.0, 2.5, -0.4, -3.0])):
+        T = arm.fk(q0)
+        sm = arm.self_motion(T, parameter)
+        got = sm.nearest(q0)
+        assert got is not None
+        np.testing.assert_allclose(got.q, q0, atol=1e-9)
+        assert got.t == pytest.approx(q0[arm.joint_names.index(parameter)], abs=1e-9)
+        dp, dr = pose_errors(arm.fk(got.q), T)
+        assert dp < 1e-12 and dr < 1e-12

@@ -2,13 +2,16 @@
 
 Used by ``SelfMotion.nearest`` and ``ik_near(..., method="self_motion")`` on the
 held-joint families (the Panda with q7 held), whose in-limit intervals come from
-the compiled ``held_manifold`` pass. Per branch and interval: the 2 pi wrapped
-distance to ``q_near`` at the interval's ends and at a grid inside it; the
+the compiled ``held_manifold`` pass. Per branch and interval: the distance to
+``q_near`` (revolute joints 2 pi wrapped, prismatic ones not: ``_wrapped``) at the
+interval's ends and at a grid inside it; the
 ``_KEEP`` smallest local minima of those samples are refined by safeguarded
 Newton steps between their neighbouring samples (to ``_TOL`` rad in t; the best value seen kept); the candidates
 (refined minima and every interval end, where a constrained minimum lies) are
 tried nearest first, and the first whose row is inside every limit (``MANIFOLD_SLACK``) is
-returned, clamped into the limits.
+returned, clamped into the limits, each revolute joint but the parameter at its 2 pi
+equivalent nearest ``q_near`` where that is inside the limits (as
+``SolutionSet.nearest``); a tie of t and t -+ 2 pi goes to the unwrapped nearer.
 """
 
 from __future__ import annotations
@@ -61,7 +64,18 @@ def interval_nearest(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     cand_t = np.concatenate([mt, t[:, 0], t[:, -1]])
     cand_b = np.concatenate([mb, br, br])
     cand_d = np.concatenate([md, d[:, 0], d[:, -1]])
-    return _first_inside(fam, limits, cand_t, cand_b, cand_d, t, d, br)
+    t_near = None if fam.joint is None else float(q_near[fam.joint])
+    found = _first_inside(fam, limits, cand_t, cand_b, cand_d, t, d, br, t_near)
+    if found is None:
+        return None
+    q, t_best, b_best, dist = found
+    # the 2 pi equivalent of each revolute joint but the parameter nearest q_near,
+    # where it is inside the limits (SolutionSet.nearest's rule)
+    shifted = q_near + _wrap(q - q_near)
+    keep = _wrapped(fam) & (shifted >= limits[:, 0]) & (shifted <= limits[:, 1])
+    if fam.joint is not None:
+        keep[fam.joint] = False  # the parameter: t itself (the tie rule below)
+    return np.where(keep, shifted, q), t_best, b_best, dist
 
 
 def _rows(fam: _Family, t: np.ndarray, br: np.ndarray) -> np.ndarray:
@@ -71,16 +85,28 @@ def _rows(fam: _Family, t: np.ndarray, br: np.ndarray) -> np.ndarray:
     return np.asarray(q[np.arange(len(t)), :, br])
 
 
+def _wrapped(fam: _Family) -> np.ndarray:
+    """(n,) bool: the joints whose differences wrap by 2 pi: the revolute ones.
+
+    A prismatic joint (a track) never wraps.
+    """
+    return np.asarray(fam.robot.is_revolute, dtype=bool)
+
+
 def _distances(fam: _Family, limits: np.ndarray, t: np.ndarray, br: np.ndarray,
                q_near: np.ndarray) -> np.ndarray:
-    """Wrapped distances (p, g) of branch br[i] at t[i, :] to q_near; inf off the limits."""
+    """Distances (p, g) of branch br[i] at t[i, :] to q_near; inf off the limits.
+
+    The :func:`_wrapped` joints' differences are wrapped into [-pi, pi).
+    """
     if not t.size:
         return np.zeros(t.shape)
     q = _rows(fam, t, br)
     lo, hi = limits[:, 0], limits[:, 1]
     with np.errstate(invalid="ignore"):
         ok = np.isfinite(q).all(-1) & np.all((q >= lo - 1e-9) & (q <= hi + 1e-9), axis=-1)
-        d = np.linalg.norm(_wrap(q - q_near), axis=-1)
+        diff = q - q_near
+        d = np.linalg.norm(np.where(_wrapped(fam), _wrap(diff), diff), axis=-1)
     return np.where(ok, d, np.inf)
 
 
@@ -152,22 +178,37 @@ def _newton(fam: _Family, limits: np.ndarray, lo: np.ndarray, hi: np.ndarray,
 
 
 def _first_inside(fam: _Family, limits: np.ndarray, cand_t: np.ndarray, cand_b: np.ndarray,
-                  cand_d: np.ndarray, t: np.ndarray, d: np.ndarray, br: np.ndarray
+                  cand_d: np.ndarray, t: np.ndarray, d: np.ndarray, br: np.ndarray,
+                  t_near: float | None = None
                   ) -> tuple[np.ndarray, float, int, float] | None:
     """The nearest candidate whose row is inside the limits (``_within``), clamped; else None.
 
     The grid samples are the last candidates (a row at an interval end can be
-    outside its limit by more than 1e-12 where the end was bisected).
+    outside its limit by more than 1e-12 where the end was bisected). Candidates
+    within ``_TIE`` of the nearest distance are one tie, broken toward the parameter
+    value nearest ``t_near`` unwrapped: on a joint whose range exceeds 2 pi (a UR-type
+    arm) t and t -+ 2 pi are equally near by the wrapped distance, and the one that
+    does not turn the joint a full turn is meant.
     """
     all_t = np.concatenate([cand_t, t.ravel()])
     all_b = np.concatenate([cand_b, np.repeat(br, t.shape[1])])
     all_d = np.concatenate([cand_d, d.ravel()])
     lo, hi = limits[:, 0], limits[:, 1]
+    best: tuple[np.ndarray, float, int, float] | None = None
     for i in np.argsort(all_d, kind="stable"):
-        if not np.isfinite(all_d[i]):
+        if not np.isfinite(all_d[i]) or (best is not None and all_d[i] > best[3] + _TIE):
             break
         q = fam.rows(all_t[i:i + 1])[0][0, all_b[i]]
-        if bool(_within(q, limits)):
-            q = np.clip(q, lo, hi)
-            return q, float(all_t[i]), int(all_b[i]), float(all_d[i])
-    return None
+        if not bool(_within(q, limits)):
+            continue
+        if best is None:
+            best = (np.clip(q, lo, hi), float(all_t[i]), int(all_b[i]), float(all_d[i]))
+            if t_near is None:
+                break
+        elif t_near is not None and abs(all_t[i] - t_near) < abs(best[1] - t_near) - _TIE:
+            best = (np.clip(q, lo, hi), float(all_t[i]), int(all_b[i]), best[3])
+    return best
+
+
+#: Distances [rad] this close are a tie (``_first_inside``).
+_TIE = 1e-9
