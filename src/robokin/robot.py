@@ -388,8 +388,9 @@ class Robot(RobotParts):
         Args:
             T: The tool pose (4, 4) [m] in the world frame.
             parameter: ``"auto"`` (the swivel on SRS arms, else the last joint with
-                a held-joint closed form: q7 on the Panda / FR3), ``"swivel"`` or a
-                joint name.
+                a held-joint closed form: q7 on the Panda / FR3; on other arms the
+                one prismatic joint, a track, or else the last joint), ``"swivel"``
+                or a joint name.
 
         Returns:
             A :class:`~robokin.kinematics.ik.self_motion.SelfMotion`: ``.sample(t)``

@@ -22,7 +22,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import robokin
-from reference import iiwa14_srs, pose_errors
+from reference import iiwa14_srs, pose_errors, ur5_on_a_track
 from robokin.exceptions import InputError
 
 PANDA = robokin.load("panda")
@@ -562,3 +562,33 @@ def test_a_crossing_at_the_parameters_own_limit_is_kept():
     assert gap[b] < 1e-9 and abs(rows[b, 3] - robot.limits[3, 1]) < 1e-9
     assert any(c.branch == b and c.joint == 3 and c.limit == "upper" and abs(c.t - lo) < 1e-9
                for c in sm.crossings), sm.crossings
+
+
+def test_auto_takes_the_track_of_a_robot_on_a_rail():
+    # Session 16: a 7-joint arm with one prismatic joint and no held-joint closed form
+    # (a UR5 on a linear track) takes the track as "auto"'s parameter (before: the last
+    # joint, j6, ~20x the solves); robot.ik(T)'s sample is labelled with it. Oracles:
+    # the generating configuration's track value lies in an interval of a branch whose
+    # row there is that configuration (1e-9); each interval's rows at 11 inner values
+    # reproduce the pose (1e-12) inside the limits.
+    from robokin.kinematics.ik.self_motion import parameter_values
+
+    arm = ur5_on_a_track(2.0)
+    q0 = np.array([0.7, 0.3, -1.2, 1.1, -0.5, 0.8, 0.2])
+    T = arm.fk(q0)
+    sm = arm.self_motion(T)
+    assert sm.parameter == "track" and sm.joint == 0 and not sm.revolute[0]
+    assert sm.domain.tolist() == [0.0, 2.0]
+    rows = sm.sample(q0[0])
+    hold = [b for (a, e), b in zip(sm.intervals, sm.interval_branch, strict=True)
+            if a <= q0[0] <= e and np.abs(rows[b] - q0).max() < 1e-9]
+    assert hold, sm.intervals
+    lo, hi = arm.limits[:, 0] - 1e-12, arm.limits[:, 1] + 1e-12
+    for (a, e), b in zip(sm.intervals, sm.interval_branch, strict=True):
+        rows_b = sm.sample(np.linspace(a, e, 13)[1:-1])[:, b]
+        dp, dr = pose_errors(arm.fk(rows_b), T)
+        assert dp.max() < 1e-12 and dr.max() < 1e-12
+        assert np.all((rows_b >= lo) & (rows_b <= hi))
+    name, values = parameter_values(arm, T, q0[None, None])
+    assert name == "track" and values[0, 0] == q0[0]
+    assert arm.ik(T).info["parameter"] == "track"

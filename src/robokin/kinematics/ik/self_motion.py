@@ -59,6 +59,7 @@ from robokin.kinematics.ik.self_motion_families import (
     _HeldFamily,
     _setup,
     _SwivelFamily,
+    continued_parameter,
 )
 from robokin.kinematics.ik.self_motion_intervals import (
     GRID,
@@ -556,11 +557,12 @@ def parameter_values(robot: ArmSource, T: np.ndarray, q: np.ndarray
     """The self-motion parameter of configurations q (..., k, n) of poses T (..., 4, 4).
 
     Returns ``(name, values (..., k))``: the swivel angle on SRS arms, else the
-    ``auto`` parameter's joint (the last joint without a closed form); NaN rows give
+    ``auto`` parameter's joint (without a closed form, ``continued_parameter``: a
+    track, else the last joint); NaN rows give
     NaN.
     """
     owner = arm_of(robot)
-    name = auto_parameter(owner) or owner.joint_names[-1]
+    name = auto_parameter(owner) or continued_parameter(owner)
     if name != "swivel":
         return name, q[..., owner.joint_names.index(name)]
     arm = _setup(owner).swivel

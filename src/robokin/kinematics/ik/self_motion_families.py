@@ -388,6 +388,18 @@ def _setup(arm: Arm) -> SelfMotionSetup:
 
 
 # ------------------------------------------------------------------ choosing one
+def continued_parameter(robot: Arm) -> str:
+    """``"auto"``'s joint on a 7-joint arm without a swivel or a held-joint closed form.
+
+    The arm's one prismatic joint where it has exactly one (a robot on a linear track:
+    where along the rail is the question users ask of its self-motion, and holding the
+    track leaves the robot's own six joints), else the last joint.
+    """
+    prismatic = [n for n, rev in zip(robot.joint_names, robot.is_revolute, strict=True)
+                 if not rev]
+    return prismatic[0] if len(prismatic) == 1 else robot.joint_names[-1]
+
+
 def _family(robot: Arm, T: np.ndarray, parameter: str, dispatch: Dispatch,
             reference: bool = False) -> _Family:
     names = list(robot.joint_names)
@@ -411,7 +423,7 @@ def _family(robot: Arm, T: np.ndarray, parameter: str, dispatch: Dispatch,
     if parameter == "auto":
         usable = [n for n in names if n in held and n != names[3]]  # not the elbow
         # (auto_parameter says why)
-        parameter = usable[-1] if usable else names[-1]
+        parameter = usable[-1] if usable else continued_parameter(robot)
     if parameter not in held:  # the general held-joint 6R solver, continued
         from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
 
