@@ -426,7 +426,8 @@ class _ContinuedFamily(_Family):
         out = np.full((M, k, n), np.nan)
         if not mi.size:
             return out, ok
-        q0 = _into_limits(self.robot, _wrap(P[mi, bi]))
+        rev = np.asarray(self.robot.is_revolute, bool)  # a track's metres never wrap
+        q0 = _into_limits(self.robot, np.where(rev, _wrap(P[mi, bi]), P[mi, bi]))
         steps = np.zeros((len(mi), _NEWTON))
         q, reached = _newton_held(self.robot, self.T, q0, self.joint, t[mi], steps)
         prev, nxt = steps[:, :-1], steps[:, 1:]
