@@ -130,3 +130,38 @@ def test_a_set_of_poses_is_placed_through_the_manifold(panda):
     assert_reaches(panda, pl.best_q, task)
     with pytest.raises(InputError, match="task"):  # out of reach from every candidate
         cell.place(panda, task[:1], np.eye(4), max_step=math.inf, method="numeric")
+
+
+def test_a_robot_on_a_track_sweeps_the_track():
+    # Session 16: a UR5 on a 2 m linear track has no held-joint closed form of the
+    # Panda's kind, so maps took the numeric sample alone; its track held leaves the
+    # UR5's closed form, which robot.ik(T, fixed=...) solves completely. Oracles:
+    # SelfMotion.reachable (the manifold over the track, its exact intervals) for
+    # every pose the map gains over the numeric sample and for every pose it leaves
+    # unreachable; FK of the map's configurations through solve_poses.
+    from reference import ur5_on_a_track
+
+    arm = ur5_on_a_track(2.0)
+    assert sweep_joint(arm) == "track"
+    region = [[0.3, -0.5, 0.2], [0.9, 0.5, 1.8]]
+    m = cell.reach_map(arm, region=region, voxel=0.2, orientations=16, chunk=3)
+    numeric = cell.reach_map(arm, region=region, voxel=0.2, orientations=16,
+                             method="numeric")
+    assert m.method == "numeric + self-motion (track swept)"
+    assert (m.reachable >= numeric.reachable).all()
+
+    def pose(v, k):
+        T = np.eye(4)
+        T[:3, :3], T[:3, 3] = m.orientations[k], m.centers[v]
+        return T
+
+    gained = np.argwhere(m.reachable & ~numeric.reachable)
+    assert len(gained) >= 3  # 6 with this grid
+    assert all(arm.self_motion(pose(v, k)).reachable for v, k in gained)
+    left = np.argwhere(~m.reachable)
+    assert len(left) >= 100
+    assert not any(arm.self_motion(pose(v, k)).reachable for v, k in left)
+    T = np.stack([pose(v, k) for v, k in gained])
+    q, ok = solve_poses(arm, T, True, "track")
+    assert ok.all()
+    assert_reaches(arm, q[:, 0], T)

@@ -52,20 +52,48 @@ _BATCH = 256
 
 
 def sweep_joint(robot: Robot) -> str | None:
-    """The joint swept for a 7R arm's manifold, or None (no held-joint closed form).
+    """The joint swept for a 7-joint arm's manifold, or None (no held-joint closed form).
 
     ``self_motion``'s own parameter when it is a joint (q7 on the Panda / FR3),
-    else (the swivel of an SRS arm) the last joint with a held-joint closed form.
+    else (the swivel of an SRS arm) the last joint with a held-joint closed form;
+    on an arm with neither, an end joint whose held solve is a 6R closed form
+    (:func:`_end_swept`: the track of a robot on a rail).
     """
     from robokin.kinematics.arm import arm_of
     from robokin.kinematics.ik.fixed import _held_solvers
     from robokin.kinematics.ik.self_motion import auto_parameter
 
     parameter = auto_parameter(robot)
-    if parameter is None or parameter != "swivel":
+    if parameter is None:
+        return _end_swept(robot)
+    if parameter != "swivel":
         return parameter
     held = [n for n in robot.joint_names if n in _held_solvers(arm_of(robot))]
     return held[-1] if held else None
+
+
+def _end_swept(robot: Robot) -> str | None:
+    """A 7-joint arm's end joint whose held solve is a 6R closed form, or None.
+
+    The arm without a held-joint closed form of the Panda's kind: its first or last
+    joint held leaves a six-joint chain that may have one (a robot on a linear track:
+    the track held leaves the robot, a UR5's three-parallel family), which
+    ``robot.ik(T, fixed=...)`` then solves completely. ``self_motion``'s ``"auto"``
+    choice first (``continued_parameter``: the track), then the last, then the first.
+    """
+    from robokin.kinematics.arm import arm_of
+    from robokin.kinematics.ik.fixed import _end_held
+    from robokin.kinematics.ik.self_motion_families import continued_parameter
+
+    arm = arm_of(robot)
+    chain = arm.chain
+    if arm.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
+        return None
+    names = arm.joint_names
+    for name in dict.fromkeys([continued_parameter(arm), names[-1], names[0]]):
+        if name in (names[0], names[-1]) and _end_held(arm, name) is not None:
+            return name
+    return None
 
 
 def reach_on_manifold(robot: Robot, T: np.ndarray, joint: str,
