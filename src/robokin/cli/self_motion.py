@@ -41,6 +41,8 @@ from robokin.cli.output import (
     FormatOption,
     OutputTable,
     emit,
+    fixed,
+    general,
     resolve_format,
     say,
 )
@@ -137,9 +139,9 @@ def interval_motion(sm: SelfMotion, branch: int, interval: int, *,
             row may not exist exactly there).
 
     Returns:
-        ``(t, Q)``: the parameter values (2 frames - 1,) [rad] and the branch's rows
-        (2 frames - 1, n) there, forward then back; rows that do not exist are
-        dropped.
+        ``(t, Q)``: the parameter values (2 frames - 1,) [rad, or m for a track] and
+        the branch's rows (2 frames - 1, n) there, forward then back; rows that do
+        not exist are dropped.
     """
     a, e = (float(v) for v in sm.intervals[interval])
     t = np.linspace(a, e, frames + 2)[1:-1] if e > a else np.array([a])
@@ -205,7 +207,7 @@ def self_motion(
     parameter: Annotated[str, typer.Option(
         "--parameter", help="auto | swivel | a joint name: the parameter t of the "
         "branches (auto: the swivel angle on SRS arms, else a joint with a closed form, "
-        "joint7 on the Panda).")] = "auto",
+        "joint7 on the Panda; on other arms a track, or the last joint).")] = "auto",
     best: Annotated[str, typer.Option(
         "--best", help="margin | manipulability: the configuration that maximises the "
         "smallest distance to a joint limit, or Yoshikawa's manipulability.")] = "margin",
@@ -310,8 +312,6 @@ def _empty_reason(sm: SelfMotion) -> str:
 
 
 def _intervals_table(r: Robot, sm: SelfMotion, u: _Units) -> OutputTable:
-    from robokin.cli.output import fixed
-
     unit = u.t_unit
     table = OutputTable(
         f"{r.name}: self-motion over {sm.parameter} [{unit}]: {sm.n_branches} "
@@ -335,8 +335,6 @@ def _intervals_table(r: Robot, sm: SelfMotion, u: _Units) -> OutputTable:
 
 def _configurations_table(top: ManifoldPoint | None, close: ManifoldPoint | None,
                           best: str, u: _Units) -> OutputTable:
-    from robokin.cli.output import fixed, general
-
     table = OutputTable(
         "configurations on the self-motion, inside every limit",
         [Column("which"), Column(f"t [{u.t_unit}]", fmt=fixed(6), right=True),
@@ -359,8 +357,6 @@ def _configurations_table(top: ManifoldPoint | None, close: ManifoldPoint | None
 
 
 def _points_table(r: Robot, sm: SelfMotion, u: _Units) -> OutputTable:
-    from robokin.cli.output import fixed
-
     table = OutputTable(
         "limit crossings and singular points",
         [Column(f"t [{u.t_unit}]", fmt=fixed(9), right=True), Column("branch", right=True),
