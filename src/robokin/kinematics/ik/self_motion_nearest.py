@@ -72,7 +72,8 @@ def interval_nearest(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     # the 2 pi equivalent of each revolute joint but the parameter nearest q_near,
     # where it is inside the limits (SolutionSet.nearest's rule)
     shifted = q_near + _wrap(q - q_near)
-    keep = _wrapped(fam) & (shifted >= limits[:, 0]) & (shifted <= limits[:, 1])
+    keep = (_wrapped(fam) & (np.abs(shifted - q) > np.pi)  # a whole turn, not rounding
+            & (shifted >= limits[:, 0]) & (shifted <= limits[:, 1]))
     if fam.joint is not None:
         keep[fam.joint] = False  # the parameter: t itself (the tie rule below)
     return np.where(keep, shifted, q), t_best, b_best, dist
