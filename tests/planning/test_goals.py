@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import robokin
+from reference import ur5_on_a_track
 from robokin.exceptions import InputError
 from robokin.planning import goal_configurations
 
@@ -128,3 +129,26 @@ def test_a_placed_robot_solves_its_pose_on_the_unplaced_one():
                                atol=1e-9)
     assert g.q.shape == direct.q.shape
     np.testing.assert_allclose(g.q, direct.q, atol=1e-8)
+
+
+def test_a_robot_on_a_track_samples_its_manifold_over_the_track():
+    # Session 16: a UR5 on a 2 m rail (no held-joint closed form of the Panda's kind)
+    # took the numeric sample as its pose goal; now the manifold over the track.
+    # Oracles: FK of every candidate is the pose (1e-9), inside the limits; every
+    # in-limit interval of robot.self_motion(T) (the track its parameter) holds a
+    # candidate of round 0 that is its branch's row there.
+    robot = ur5_on_a_track(2.0)
+    T = robot.fk(np.array([0.7, 0.3, -1.2, 1.1, -0.5, 0.8, 0.2]))
+    g = goal_configurations(robot, T)
+    sm = robot.self_motion(T)
+    assert sm.parameter == "track"
+    assert g.kind == "pose" and g.manifold is not None and len(g.q) >= len(sm.intervals)
+    t = g.q[:, 0]
+    for (a, b), br in zip(sm.intervals, sm.interval_branch, strict=True):
+        inside = (t >= a) & (t <= b)
+        assert inside.any()
+        branch = sm.sample(t[inside])[np.arange(inside.sum()), br]
+        assert np.any(np.abs(branch - g.q[inside]).max(axis=1) < 1e-12)
+    np.testing.assert_allclose(robot.fk(g.q), np.broadcast_to(T, (len(g.q), 4, 4)),
+                               atol=1e-9)
+    assert np.all(g.q >= robot.limits[:, 0]) and np.all(g.q <= robot.limits[:, 1])

@@ -165,11 +165,23 @@ def _in_frame(robot: Robot, solver: Robot, T: np.ndarray) -> np.ndarray:
 
 
 def _manifold_goals(robot: Robot, T: np.ndarray) -> Goals | None:
-    """A 7R arm's pose goal on its self-motion manifold; None when it has none."""
+    """A 7-joint arm's pose goal on its self-motion manifold; None when it has none.
+
+    Arms whose manifold has a closed form (``auto_parameter``), and a robot on a
+    linear track (its one prismatic joint the parameter: the robot's own six joints
+    at each track value, ~25 ms a pose on a UR5 on a rail); other 7-joint arms keep
+    the numeric sample (their continued manifold costs up to ~1 s a pose).
+    """
+    from robokin.kinematics.arm import arm_of
     from robokin.kinematics.ik.self_motion import auto_parameter
+    from robokin.kinematics.ik.self_motion_families import continued_parameter
 
     if auto_parameter(robot) is None:
-        return None
+        arm = arm_of(robot)
+        if arm.n != 7 or arm.chain.n_chain != 7 or not arm.chain.coupling.is_identity:
+            return None
+        if arm.is_revolute[arm.joint_names.index(continued_parameter(arm))]:
+            return None
     # a rotation orthonormal to 1e-12 only (a pose written to 12 digits) is projected
     # onto SO(3) by self_motion itself (_validation.check_rigid)
     sm = robot.self_motion(T)
