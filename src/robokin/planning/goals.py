@@ -172,16 +172,10 @@ def _manifold_goals(robot: Robot, T: np.ndarray) -> Goals | None:
     at each track value, ~25 ms a pose on a UR5 on a rail); other 7-joint arms keep
     the numeric sample (their continued manifold costs up to ~1 s a pose).
     """
-    from robokin.kinematics.arm import arm_of
-    from robokin.kinematics.ik.self_motion import auto_parameter
-    from robokin.kinematics.ik.self_motion_families import continued_parameter
+    from robokin.kinematics.ik.self_motion import cheap_parameter
 
-    if auto_parameter(robot) is None:
-        arm = arm_of(robot)
-        if arm.n != 7 or arm.chain.n_chain != 7 or not arm.chain.coupling.is_identity:
-            return None
-        if arm.is_revolute[arm.joint_names.index(continued_parameter(arm))]:
-            return None
+    if cheap_parameter(robot) is None:
+        return None
     # a rotation orthonormal to 1e-12 only (a pose written to 12 digits) is projected
     # onto SO(3) by self_motion itself (_validation.check_rigid)
     sm = robot.self_motion(T)

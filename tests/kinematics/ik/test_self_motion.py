@@ -22,7 +22,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import robokin
-from reference import iiwa14_srs, pose_errors, ur5_on_a_track
+from reference import iiwa14_srs, pose_errors, random_7r, ur5_on_a_track
 from robokin.exceptions import InputError
 
 PANDA = robokin.load("panda")
@@ -246,8 +246,11 @@ def test_ik_near_self_motion_errors_list_the_methods():
     with pytest.raises(InputError, match="options"):
         PANDA.ik_near(T, np.full(7, 0.1), method="self_motion", mask="xyz")
     ur5 = robokin.load("ur5")
-    with pytest.raises(InputError, match="method='self_motion' needs a 7R arm"):
+    with pytest.raises(InputError, match="method='self_motion' needs a 7-joint arm"):
         ur5.ik_near(ur5.fk(np.zeros(6)), np.zeros(6), method="self_motion")
+    arm = random_7r(29)  # continued (no closed form, no track): up to ~1 s a pose
+    with pytest.raises(InputError, match="or a track; robot 'random7r_29' has neither"):
+        arm.ik_near(arm.fk(np.full(7, 0.1)), np.full(7, 0.1), method="self_motion")
 
 
 def test_general_7r_branches_are_continued():
@@ -592,3 +595,8 @@ def test_auto_takes_the_track_of_a_robot_on_a_rail():
     name, values = parameter_values(arm, T, q0[None, None])
     assert name == "track" and values[0, 0] == q0[0]
     assert arm.ik(T).info["parameter"] == "track"
+    # ik_near on the manifold (its cheap parameter is the track): q0 back from near it
+    res = arm.ik_near(T, q0 + 0.01, method="self_motion")
+    assert res.success and np.abs(res.q - q0).max() < 0.02
+    dp, dr = pose_errors(arm.fk(res.q), T)
+    assert dp < 1e-12 and dr < 1e-12

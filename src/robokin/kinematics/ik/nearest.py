@@ -29,7 +29,7 @@ from robokin.kinematics.ik.analytic.detect import detect
 from robokin.kinematics.ik.dispatch import solve
 from robokin.kinematics.ik.numeric import IKResult
 from robokin.kinematics.ik.self_motion import (
-    auto_parameter,
+    cheap_parameter,
     nearest_on_manifold,
     swivel_nearest,
 )
@@ -84,11 +84,11 @@ def solve_near(
         if options:
             raise InputError("options", f"{sorted(options)} are numeric-solver options; "
                                         "method='self_motion' takes none")
-        if auto_parameter(arm) is None:
-            raise InputError("method", f"method='self_motion' needs a 7R arm whose "
+        if cheap_parameter(arm) is None:
+            raise InputError("method", f"method='self_motion' needs a 7-joint arm whose "
                                        f"self-motion has a closed form (SRS swivel or "
-                                       f"a held-joint closed form); robot '{arm.name}' "
-                                       f"has none: use method='numeric'")
+                                       f"a held-joint closed form) or a track; robot "
+                                       f"'{arm.name}' has neither: use method='numeric'")
         return _manifold_near(arm, T, q_near)
     if method == "numeric" or options:
         if method == "analytic":
@@ -106,7 +106,7 @@ def solve_near(
 
 
 def _manifold_near(arm: Arm, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
-    """A 7R arm with a self-motion closed form: the in-limit point nearest ``q_near``.
+    """A 7-joint arm with a cheap self-motion: the in-limit point nearest ``q_near``.
 
     SRS arms: the compiled search on the exact swivel intervals, all poses in one
     batch (``self_motion.swivel_nearest``); other arms: per pose, the exact in-limit

@@ -80,7 +80,7 @@ from robokin.kinematics.ik.self_motion_nearest import interval_nearest
 from robokin.kinematics.ik.swivel import SwivelArm
 
 __all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SelfMotionSetup", "SingularPoint",
-           "auto_parameter",
+           "auto_parameter", "cheap_parameter",
            "nearest_on_manifold", "parameter_values", "self_motion", "swivel_nearest"]
 
 #: Zoom rounds of SelfMotion.best / nearest (each narrows the span about 4 times).
@@ -366,6 +366,26 @@ def auto_parameter(robot: ArmSource) -> str | None:
             setup.parameter = usable[-1] if usable else None
         setup.parameter_known = True
     return setup.parameter
+
+
+def cheap_parameter(robot: ArmSource) -> str | None:
+    """The parameter of a 7-joint arm whose whole manifold is cheap, or None.
+
+    ``auto_parameter``'s (a closed form: the SRS swivel, a held joint), or the track
+    of a robot on a linear track (``continued_parameter`` when it is the arm's one
+    prismatic joint: the robot's own six joints at each track value, ~25 ms a pose on
+    a UR5 on a rail). None for other arms, whose continued manifold costs up to ~1 s
+    a pose: pose goals and ``ik_near(..., method="self_motion")`` take it only here.
+    """
+    name = auto_parameter(robot)
+    if name is not None:
+        return name
+    arm = arm_of(robot)
+    chain = arm.chain
+    if arm.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
+        return None
+    track = continued_parameter(arm)
+    return None if arm.is_revolute[arm.joint_names.index(track)] else track
 
 
 def _criterion(criterion: Any, robot: ArmSource | None, limits: np.ndarray
