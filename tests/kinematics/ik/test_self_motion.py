@@ -184,6 +184,12 @@ def test_parameter_choices_and_errors():
         PANDA.self_motion(np.stack([np.eye(4)] * 2))
     with pytest.raises(InputError, match="criterion"):
         SRS.self_motion(SRS.fk(np.full(7, 0.3))).best("comfort")
+    sm = SRS.self_motion(SRS.fk(np.full(7, 0.3)))
+    for bad in ("a", [None], 1 + 2j):  # a bare numpy ValueError before session 16
+        with pytest.raises(InputError, match="argument 't'"):
+            sm.sample(bad)
+        with pytest.raises(InputError, match="argument 't'"):
+            sm.inside(bad)
 
 
 def test_unreachable_pose_has_no_interval():

@@ -44,7 +44,7 @@ import numpy as np
 import numpy.typing as npt
 
 from robokin._native import kernels as K
-from robokin._validation import check_finite, check_joints, check_rigid
+from robokin._validation import _real_array, check_finite, check_joints, check_rigid
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.fixed import Dispatch
@@ -176,7 +176,7 @@ class SelfMotion:
             t: Parameter values (...) [rad].
             within_limits: Also NaN the rows outside a joint limit.
         """
-        ta = check_finite(np.asarray(t, dtype=np.float64), "t")
+        ta = check_finite(_real_array(t, "t", "parameter values [rad, m]"), "t")
         q = self._rows(ta.reshape(-1))
         if within_limits:
             q = np.where(self._inside(q)[..., None], q, np.nan)
@@ -184,7 +184,7 @@ class SelfMotion:
 
     def inside(self, t: npt.ArrayLike) -> np.ndarray:
         """(..., k) bool: the branch exists at t and is inside every joint limit."""
-        ta = check_finite(np.asarray(t, dtype=np.float64), "t")
+        ta = check_finite(_real_array(t, "t", "parameter values [rad, m]"), "t")
         q = self._rows(ta.reshape(-1))
         return self._inside(q).reshape(ta.shape + (q.shape[-2],))
 
