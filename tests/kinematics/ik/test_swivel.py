@@ -416,3 +416,39 @@ def test_quick_constants_match_the_arm():
             ang = ARM.sign[j] * v + ARM.offset[j]
             g = np.cos(ang) * c + np.sin(ang) * s_
             assert (g > cin) if inside else (g < cout)
+
+
+def test_a_widened_point_stops_at_another_joints_crossing():
+    # Session 16: SRS special #8651 of seed 0 (q6 = -1e-7, q2 and q5 at limits). The
+    # kernel lists branch 7 as one-point intervals at q7's crossing -9.39e-7, q5's
+    # -1.79e-7 and q5's 6.7e-16; _points_refined widened the first forward by
+    # probes a decade apart (inside at +1e-7 and at +1e-6, i.e. at 6.1e-8) and joined
+    # it to the last over (-1.79e-7, 0), where q5 passes +-pi past its limit (up to
+    # 0.17 rad out). Widening now stops at the branch's nearest crossing of another
+    # joint (_bound). Oracles: the numpy reference path's intervals (reference=True:
+    # its own 721-value grid and bisection) and the rows at 21 values inside every
+    # interval, inside every limit to 1e-9 where the held Jacobian is regular.
+    from robokin.kinematics.ik.dispatch import solve
+    from robokin.kinematics.ik.self_motion import self_motion
+
+    robot = iiwa14_srs()
+    q0 = np.array([2.3759967783464093, 2.0943951023931953, np.pi, 0.3806644371921477,
+                   -2.9670597283903604, -1e-07, 1.8483696587082532])
+    T = robot.fk(q0)
+    sm = robot.self_motion(T)
+    ref = self_motion(robot, T, "swivel", dispatch=solve, reference=True)
+    own = sm.intervals[sm.interval_branch == 7]
+    assert not ((own[:, 0] < -1.0e-7) & (own[:, 1] > -1.0e-7)).any(), own  # q5 out there
+    hit = own[np.abs(own[:, 0] + 9.385552e-7) < 1e-12]
+    assert len(hit) == 1 and abs(hit[0, 1] + 1.792061e-7) < 1e-12, own
+    mine = ref.intervals[ref.interval_branch == 7]
+    # the reference's pieces are ours, to the widening's search (~1e-3 of its decade,
+    # 1e-5 here: 3.5014e-6 against 3.5156e-6) and a few ulps at the corner t = 0
+    for a, e in mine[mine[:, 1] - mine[:, 0] > 1e-9]:
+        assert ((own[:, 0] <= a + 1e-14) & (own[:, 1] >= e - 2e-8)).any(), (a, e, own)
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    for (a, e), b in zip(sm.intervals, sm.interval_branch, strict=True):
+        rows = sm.sample(np.linspace(a, e, 23)[1:-1])[:, b]
+        sv = np.linalg.svd(robot.jacobian(rows), compute_uv=False)[:, -1]
+        out = np.maximum(lo - rows, rows - hi).max(axis=-1)
+        assert np.all((out <= 1e-9) | (sv < 1e-5)), (a, e, b, out.max())

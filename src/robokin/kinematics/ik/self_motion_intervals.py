@@ -865,7 +865,6 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         cuts = np.concatenate([cuts, ends])
         near = np.concatenate([near, np.ones(2 * fam.k, dtype=bool)])
     point = intervals[:, 1] - intervals[:, 0] <= _POINT
-    lim_pts = points[points[:, 3] <= upper]
     point |= _short_grazes(fam, intervals, owner, points, upper, singular)
     cand = near | every
     c, near = cuts[cand], near[cand]
@@ -897,6 +896,8 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     reach = [False] * len(stretch)  # a touch's side inside at every probe: to the last one
     caps = [(lo_d, hi_d)] * len(stretch)  # how far a touch's side goes (its branch's
     # nearest crossings of another joint)
+    lim_pts = points[points[:, 3] <= upper]
+    bounds = [_bound(lim_pts, a, e, b) for a, e, b in stretch]  # no side goes past these
     first_touch = len(c) - len(touch)
     corners: list[tuple[float, int, np.ndarray]] = []
     points_only: list[tuple[int, float, float]] = []
@@ -922,6 +923,8 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
             other = lim_pts[(lim_pts[:, 1] == b[i]) & (lim_pts[:, 2] != c[i, 2]), 0]
             caps.append((float(other[other < c[i, 0]].max(initial=lo_d)),
                          float(other[other > c[i, 0]].min(initial=hi_d))))
+            bounds.append((float(other[other < c[i, 0]].max(initial=-np.inf)),
+                           float(other[other > c[i, 0]].min(initial=np.inf))))
         for i in np.flatnonzero((worst > MANIFOLD_SLACK) & (worst <= _CONDITIONING)):
             hold = np.flatnonzero(np.abs(excess[i]) <= _CONDITIONING)
             if len(hold) < 2:
@@ -931,12 +934,32 @@ def _points_refined(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
                 tc = _param(fam, row)
                 if tc is not None:
                     corners.append((tc, int(b[i]), row))
-    new = (_widen(fam, limits, stretch, reach, caps) + [(b, t, t) for t, b, _ in corners]
+    new = (_widen(fam, limits, stretch, reach, caps, bounds)
+           + [(b, t, t) for t, b, _ in corners]
            + points_only)
     iv, ob = _merged(intervals, owner, new)
     if not corners and np.array_equal(iv, intervals) and np.array_equal(ob, owner):
         return intervals, owner, ()  # nothing widened or added: the kernel's arrays
     return iv, ob, tuple(corners)
+
+
+def _bound(lim_pts: np.ndarray, a: float, e: float, b: int) -> tuple[float, float]:
+    """How far the stretch [a, e] of branch b may widen: (lo, hi), +-inf for none.
+
+    Its nearest crossings either side of a joint not crossing at its ends.
+
+    The probes of :func:`_widen` are a decade apart, so a side's search between its
+    last inside and first outside probe can pass a stretch where another joint is
+    out: SRS special #8651 of seed 0 (q6 = -1e-7), branch 7's one-point intervals at
+    q7's crossing -9.39e-7 and q5's 6.7e-16 were widened into one over (-1.79e-7, 0),
+    where q5 is past its limit by up to 0.17 rad (session 16). A crossing is where a
+    joint leaves or enters its range, so no in-limit stretch runs through one of a
+    joint other than its own (a graze's own joint crosses twice within it).
+    """
+    own = lim_pts[lim_pts[:, 1] == b]
+    at = own[(np.abs(own[:, 0] - a) <= _TOUCH_APART) | (np.abs(own[:, 0] - e) <= _TOUCH_APART), 2]
+    t = own[~np.isin(own[:, 2], at), 0]
+    return float(t[t < a].max(initial=-np.inf)), float(t[t > e].min(initial=np.inf))
 
 
 def _short_grazes(fam: _Family, intervals: np.ndarray, owner: np.ndarray,
@@ -1046,7 +1069,8 @@ def _held_refine(fam: _Family, limits: np.ndarray, r: np.ndarray, hold: np.ndarr
 
 
 def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, int]],
-           reach: list[bool] | None = None, caps: list[tuple[float, float]] | None = None
+           reach: list[bool] | None = None, caps: list[tuple[float, float]] | None = None,
+           bounds: list[tuple[float, float]] | None = None
            ) -> list[tuple[int, float, float]]:
     """Each in-limit stretch (a, e, b) (a point: a = e) widened to its in-slack extent.
 
@@ -1062,7 +1086,8 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
     iiwa's q4 out by 1e-15 over 2e-2 of t): to the last probe, and with ``caps``
     (per point, the parameter values [lo, hi] a flagged side goes at most to) on by
     probes doubling to ``_FAR`` (to 8 rad) and the same search, to its last inside
-    value.
+    value. ``bounds`` (per point, [lo, hi]: :func:`_bound`) stop the search of a side
+    with a probe outside there.
     """
     if not points:
         return []
@@ -1108,6 +1133,10 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
         last = search(_PROBES[first_out[go] - 1], _PROBES[first_out[go]], np.flatnonzero(go))
         d[go] = last * (1.0 - 1e-3)  # inside the last inside value: its row stays within
         # the slack after a 2 pi shift of the swivel (rounding) at q'' up to ~1e11
+        if bounds is not None:  # not past another joint's crossing (_bound)
+            room = np.concatenate([[a - lo for (a, _, _), (lo, _) in zip(points, bounds, strict=True)],
+                                   [hi - e for (_, e, _), (_, hi) in zip(points, bounds, strict=True)]])
+            d[go] = np.minimum(d[go], room[go])
     if reach is not None:
         full = ok.all(axis=1) & np.tile(np.array(reach, dtype=bool), 2)
         d[full] = _PROBES[-1] * (1.0 - 1e-3)
