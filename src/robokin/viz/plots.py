@@ -323,7 +323,7 @@ def plot_self_motion(sm: SelfMotion, *, path: str | Path | None = None,
     t = np.linspace(lo, hi, int(samples))
     q = sm.sample(t)  # (m, k, n)
     inside = sm.inside(t)
-    q = _break_wraps(q, sm.limits)
+    q = _break_wraps(q, sm.limits, rev)
     n = q.shape[-1]
     fig = _figure((10.0, 1.6 * n + 1.0))
     axes = fig.subplots(n, 1, sharex=True)
@@ -353,19 +353,19 @@ def plot_self_motion(sm: SelfMotion, *, path: str | Path | None = None,
     return _finish(fig, path, overwrite)
 
 
-def _break_wraps(q: np.ndarray, limits: np.ndarray) -> np.ndarray:
-    """``q`` (m, k, n) with NaN where a joint jumps by a turn between samples.
+def _break_wraps(q: np.ndarray, limits: np.ndarray, revolute: np.ndarray) -> np.ndarray:
+    """``q`` (m, k, n) with NaN where a revolute joint jumps by a turn between samples.
 
     A branch row passing +-pi (outside the limits of an arm whose range is under a
     turn) is drawn as two lines, not a vertical stroke across the panel: the sample
     after a step larger than pi is blanked (the step from one sample to the next is
     far below pi elsewhere at the plot's 721 values; a joint with a range over a
-    turn keeps its steps).
+    turn keeps its steps, and so does a prismatic one).
     """
     step = np.abs(np.diff(q, axis=0))
-    wide = (limits[:, 1] - limits[:, 0]) > 2.0 * np.pi  # (n,)
+    wraps = revolute & ((limits[:, 1] - limits[:, 0]) <= 2.0 * np.pi)  # (n,)
     with np.errstate(invalid="ignore"):
-        jump = (step > np.pi) & ~wide
+        jump = (step > np.pi) & wraps
     out = q.copy()
     out[1:][jump] = np.nan
     return out
