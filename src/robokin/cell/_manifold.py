@@ -83,11 +83,11 @@ def _end_swept(robot: Robot) -> str | None:
     """
     from robokin.kinematics.arm import arm_of
     from robokin.kinematics.ik.fixed import _end_held
+    from robokin.kinematics.ik.self_motion_base import seven_joint_serial
     from robokin.kinematics.ik.self_motion_families import continued_parameter
 
     arm = arm_of(robot)
-    chain = arm.chain
-    if arm.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
+    if not seven_joint_serial(arm):
         return None
     names = arm.joint_names
     for name in dict.fromkeys([continued_parameter(arm), names[-1], names[0]]):

@@ -48,7 +48,7 @@ from robokin._validation import _real_array, check_finite, check_joints, check_r
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.fixed import Dispatch
-from robokin.kinematics.ik.self_motion_base import _Family
+from robokin.kinematics.ik.self_motion_base import _Family, seven_joint_serial
 from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
 from robokin.kinematics.ik.self_motion_families import (
     HeldKernel,
@@ -348,8 +348,7 @@ def auto_parameter(robot: ArmSource) -> str | None:
     (no swivel, no held-joint closed form).
     """
     arm = arm_of(robot)
-    chain = arm.chain
-    if arm.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
+    if not seven_joint_serial(arm):
         return None
     setup = _setup(arm)
     if not setup.parameter_known:
@@ -381,8 +380,7 @@ def cheap_parameter(robot: ArmSource) -> str | None:
     if name is not None:
         return name
     arm = arm_of(robot)
-    chain = arm.chain
-    if arm.n != 7 or chain.n_chain != 7 or not chain.coupling.is_identity:
+    if not seven_joint_serial(arm):
         return None
     track = continued_parameter(arm)
     return None if arm.is_revolute[arm.joint_names.index(track)] else track

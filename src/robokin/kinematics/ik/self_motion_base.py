@@ -99,6 +99,15 @@ class _Family:
         return out
 
 
+def seven_joint_serial(arm: Arm) -> bool:
+    """Whether ``arm`` has a self-motion of the kind described here.
+
+    Seven independent joints in a serial chain (no coupled or passive joints).
+    """
+    chain = arm.chain
+    return arm.n == 7 and chain.n_chain == 7 and bool(chain.coupling.is_identity)
+
+
 def _into_limits(robot: Arm, q: np.ndarray) -> np.ndarray:
     """Revolute angles shifted by 2 pi into the limits where that fits."""
     up_cap, down_cap = robot.derived(SHIFT_CAPS)

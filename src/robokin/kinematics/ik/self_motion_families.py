@@ -20,7 +20,11 @@ import numpy as np
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, Derived
 from robokin.kinematics.ik.fixed import Dispatch, solve_held_one
-from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
+from robokin.kinematics.ik.self_motion_base import (
+    _Family,
+    _into_limits,
+    seven_joint_serial,
+)
 from robokin.kinematics.ik.self_motion_polish import LimitPolish
 from robokin.kinematics.ik.swivel import SwivelArm, swivel_arm
 
@@ -404,7 +408,7 @@ def _family(robot: Arm, T: np.ndarray, parameter: str, dispatch: Dispatch,
             reference: bool = False) -> _Family:
     names = list(robot.joint_names)
     choices = ["auto", "swivel", *names]
-    if robot.n != 7 or robot.chain.n_chain != 7 or not robot.chain.coupling.is_identity:
+    if not seven_joint_serial(robot):
         raise InputError("robot", f"self_motion needs a 7-joint serial arm without "
                                   f"coupled joints; {robot.name!r} has {robot.n} joints")
     if parameter not in choices:
