@@ -369,10 +369,11 @@ class Robot(RobotParts):
             T: Target poses (..., 4, 4) in the world frame [m].
             q_near: Current configuration (n,) or (..., n) [rad, m].
             method: ``"auto"``, ``"analytic"``, ``"numeric"`` or ``"self_motion"``
-                (7R arms with a closed-form self-motion: the in-limit point of the
-                whole manifold nearest ``q_near``: compiled on SRS arms, about
+                (7-joint arms whose whole self-motion is exact: the in-limit point
+                of the manifold nearest ``q_near``: compiled on SRS arms, about
                 0.1-0.2 ms per pose; on held-joint arms such as the Panda a search
-                of the exact in-limit intervals, 4-5 ms; see ``docs/ik.md``;
+                of the exact in-limit intervals, 4-5 ms; on a general 7R arm or a
+                robot on a track the continued manifold, ~10-30 ms; ``docs/ik.md``;
                 ``"auto"`` on a 7R arm is the numeric descent, ~0.03 ms).
             **options: Numeric-solver options (``mask``, ``tol``, ...).
 
@@ -396,7 +397,9 @@ class Robot(RobotParts):
             A :class:`~robokin.kinematics.ik.self_motion.SelfMotion`: ``.sample(t)``
             (..., k, n), ``.intervals`` (m, 2) inside every limit with
             ``.interval_branch``, ``.crossings``, ``.singular``, ``.best(criterion)``,
-            ``.nearest(q)``.
+            ``.nearest(q)``; ``.method`` says what solved each parameter value
+            (``"continued numeric"``: an arm with neither a closed form nor the
+            general 6R solver for the held chain, whose branches can be missed).
         """
         from robokin.kinematics.ik.self_motion import self_motion
 

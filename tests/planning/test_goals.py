@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import robokin
-from reference import ur5_on_a_track
+from reference import random_7r, ur5_on_a_track
 from robokin.exceptions import InputError
 from robokin.planning import goal_configurations
 
@@ -152,3 +152,43 @@ def test_a_robot_on_a_track_samples_its_manifold_over_the_track():
     np.testing.assert_allclose(robot.fk(g.q), np.broadcast_to(T, (len(g.q), 4, 4)),
                                atol=1e-9)
     assert np.all(g.q >= robot.limits[:, 0]) and np.all(g.q <= robot.limits[:, 1])
+
+
+def test_a_general_7r_arm_samples_its_continued_manifold():
+    # Session 17: a 7R arm without a closed form (random_7r: the general held-joint
+    # 6R solver, joint 7 continued) took robot.ik's numeric sample as its pose goal;
+    # now the whole continued manifold. Oracles: FK of every candidate is the pose
+    # (1e-9), inside the limits; every in-limit interval of robot.self_motion(T)
+    # holds a round-0 candidate that is its branch's row there; the generating
+    # configuration's interval among them.
+    robot = random_7r()
+    q0 = np.clip(np.array([0.4, np.pi / 2, -0.3, 0.0, 0.8, -1.1, 0.5]),
+                 robot.limits[:, 0], robot.limits[:, 1])
+    T = robot.fk(q0)
+    g = goal_configurations(robot, T)
+    sm = robot.self_motion(T)
+    assert sm.method.startswith("continued general 6R")
+    assert g.kind == "pose" and g.manifold is not None and len(g.q) >= len(sm.intervals)
+    t = g.q[:, sm.joint]
+    for (a, b), br in zip(sm.intervals, sm.interval_branch, strict=True):
+        inside = (t >= a) & (t <= b)
+        assert inside.any()
+        branch = sm.sample(t[inside])[np.arange(inside.sum()), br]
+        assert np.any(np.abs(branch - g.q[inside]).max(axis=1) < 1e-12)
+    np.testing.assert_allclose(robot.fk(g.q), np.broadcast_to(T, (len(g.q), 4, 4)),
+                               atol=1e-9)
+    assert np.all(g.q >= robot.limits[:, 0]) and np.all(g.q <= robot.limits[:, 1])
+    row = sm.sample(q0[sm.joint])
+    assert np.nanmin(np.abs(row - q0).max(axis=1)) < 1e-9
+
+
+def test_an_arm_whose_held_chain_is_sampled_keeps_the_ik_solutions():
+    # improved_dh_arm (two prismatic joints): its held rows would be numeric samples,
+    # so the pose goal is robot.ik's solutions (oracle: FK of each is the pose)
+    robot = robokin.load("improved_dh_arm")
+    q0 = np.clip(np.full(7, 0.3), robot.limits[:, 0], robot.limits[:, 1])
+    T = robot.fk(q0)
+    g = goal_configurations(robot, T)
+    assert g.kind == "pose" and g.manifold is None and len(g.q) >= 1
+    np.testing.assert_allclose(robot.fk(g.q), np.broadcast_to(T, (len(g.q), 4, 4)),
+                               atol=1e-9)

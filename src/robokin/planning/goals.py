@@ -167,14 +167,15 @@ def _in_frame(robot: Robot, solver: Robot, T: np.ndarray) -> np.ndarray:
 def _manifold_goals(robot: Robot, T: np.ndarray) -> Goals | None:
     """A 7-joint arm's pose goal on its self-motion manifold; None when it has none.
 
-    Arms whose manifold has a closed form (``auto_parameter``), and a robot on a
-    linear track (its one prismatic joint the parameter: the robot's own six joints
-    at each track value, ~25 ms a pose on a UR5 on a rail); other 7-joint arms keep
-    the numeric sample (their continued manifold costs up to ~1 s a pose).
+    Every 7-joint arm whose whole manifold is exact (``exact_parameter``): a
+    closed form (``auto_parameter``), a robot on a linear track (the robot's own six
+    joints at each track value, ~25 ms a pose on a UR5 on a rail) and a general 7R
+    arm (the general held-joint 6R solver continued, ~10-30 ms a pose); an arm whose
+    held chain only the numeric solver samples keeps ``robot.ik``'s solutions.
     """
-    from robokin.kinematics.ik.self_motion import cheap_parameter
+    from robokin.kinematics.ik.self_motion import exact_parameter
 
-    if cheap_parameter(robot) is None:
+    if exact_parameter(robot) is None:
         return None
     # a rotation orthonormal to 1e-12 only (a pose written to 12 digits) is projected
     # onto SO(3) by self_motion itself (_validation.check_rigid)

@@ -254,9 +254,10 @@ def test_ik_near_self_motion_errors_list_the_methods():
     ur5 = robokin.load("ur5")
     with pytest.raises(InputError, match="method='self_motion' needs a 7-joint arm"):
         ur5.ik_near(ur5.fk(np.zeros(6)), np.zeros(6), method="self_motion")
-    arm = random_7r(29)  # continued (no closed form, no track): up to ~1 s a pose
-    with pytest.raises(InputError, match="or a track; robot 'random7r_29' has neither"):
-        arm.ik_near(arm.fk(np.full(7, 0.1)), np.full(7, 0.1), method="self_motion")
+    arm = robokin.load("improved_dh_arm")  # its held chain only sampled (numeric)
+    q = np.clip(np.full(7, 0.3), arm.limits[:, 0], arm.limits[:, 1])
+    with pytest.raises(InputError, match="robot 'improved_dh_arm' is not one: use method="):
+        arm.ik_near(arm.fk(q), q, method="self_motion")
 
 
 def test_general_7r_branches_are_continued():
@@ -571,6 +572,26 @@ def test_a_crossing_at_the_parameters_own_limit_is_kept():
     assert gap[b] < 1e-9 and abs(rows[b, 3] - robot.limits[3, 1]) < 1e-9
     assert any(c.branch == b and c.joint == 3 and c.limit == "upper" and abs(c.t - lo) < 1e-9
                for c in sm.crossings), sm.crossings
+
+
+def test_the_continued_familys_method_names_its_held_solver():
+    # Session 17: every continued manifold said "continued general 6R", also where
+    # the held chain is a closed form (a UR5 on a track: three_parallel) or has
+    # neither (improved_dh_arm, two prismatic joints: numeric samples, which on this
+    # pose miss the generating configuration's branch). Oracle: robot.ik with the
+    # parameter held names the same solver, at the generating configuration's value.
+    cases = [(ur5_on_a_track(2.0), np.array([0.7, 0.3, -1.2, 1.1, -0.5, 0.8, 0.2]),
+              "analytic:three_parallel"),
+             (random_7r(), None, "general 6R"),
+             (robokin.load("improved_dh_arm"), None, "numeric")]
+    for arm, q0, held in cases:
+        if q0 is None:
+            q0 = np.clip(np.full(7, 0.4), arm.limits[:, 0], arm.limits[:, 1])
+        sm = arm.self_motion(arm.fk(q0))
+        assert sm.method == f"continued {held} ({sm.parameter} held)"
+        sols = arm.ik(arm.fk(q0), fixed={sm.parameter: q0[sm.joint]})
+        assert sols.method.replace("general_6r", "general 6R") == (
+            f"{held} ({sm.parameter} held)")
 
 
 def test_auto_takes_the_track_of_a_robot_on_a_rail():

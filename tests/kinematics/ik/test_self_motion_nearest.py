@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import robokin
-from reference import pose_errors, ur5_on_a_track
+from reference import pose_errors, random_7r, ur5_on_a_track
 from robokin.kinematics.arm import arm_of
 from robokin.kinematics.ik.dispatch import solve
 from robokin.kinematics.ik.self_motion_families import _family
@@ -102,3 +102,37 @@ def test_joints_with_a_range_over_a_turn_come_back_without_a_full_turn(parameter
         assert got.t == pytest.approx(q0[arm.joint_names.index(parameter)], abs=1e-9)
         dp, dr = pose_errors(arm.fk(got.q), T)
         assert dp < 1e-12 and dr < 1e-12
+
+
+@pytest.mark.parametrize("i", range(6))
+def test_a_general_7r_arm_takes_its_continued_manifold(i):
+    # Session 17: method="self_motion" refused every 7-joint arm without a closed form
+    # (its continued manifold then cost up to ~1 s a pose; now ~10-30 ms). A general
+    # 7R arm (random_7r: the general held-joint 6R solver, joint 7 continued) now
+    # takes it. Oracles: the dense samples of its manifold (never nearer than the
+    # answer), FK of the answer (1e-12), inside the limits; special values of q0.
+    arm = random_7r()
+    rng = np.random.default_rng(1700 + i)
+    lo, hi = arm.limits[:, 0], arm.limits[:, 1]
+    q0 = rng.uniform(lo, hi)
+    if i % 2:  # joints at 0 and pi/2 where in range
+        q0[[1, 3, 5]] = np.clip([0.0, np.pi / 2, 0.0], lo[[1, 3, 5]], hi[[1, 3, 5]])
+    qn = q0 + rng.normal(0.0, 0.3, 7) if i < 3 else rng.uniform(lo, hi)
+    T = arm.fk(q0)
+    res = arm.ik_near(T, qn, method="self_motion")
+    assert res.success
+    got = float(np.linalg.norm(wrap_angle(res.q - qn)))
+    assert got <= _dense_best(arm.self_motion(T), qn) + 1e-12
+    assert arm.within_limits(res.q)
+    dp, dr = pose_errors(arm.fk(res.q), T)
+    assert dp <= 1e-12 and dr <= 1e-12
+
+
+def test_an_arm_whose_held_chain_is_sampled_is_refused():
+    # improved_dh_arm (two prismatic joints): with any joint held the numeric solver
+    # samples the rest, so its manifold can miss branches: the error names the
+    # argument and the way out
+    arm = robokin.load("improved_dh_arm")
+    q = np.clip(np.full(7, 0.3), arm.limits[:, 0], arm.limits[:, 1])
+    with pytest.raises(robokin.InputError, match="method.*method='numeric'"):
+        arm.ik_near(arm.fk(q), q, method="self_motion")

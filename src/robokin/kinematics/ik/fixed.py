@@ -52,7 +52,7 @@ from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.model.chain import joint_motion
 from robokin.spatial import invert, wrap_angle
 
-__all__ = ["solve_fixed", "sweep_end"]
+__all__ = ["held_complete", "solve_fixed", "sweep_end"]
 
 
 def solve_fixed(
@@ -148,6 +148,25 @@ def solve_fixed(
     if len(idx) == 1 and method != "numeric" and not options:
         out = _into_limits(robot, idx[0], Tb, V[:, 0], out)
     return out
+
+
+#: [rad, m] A held middle joint's value that puts no two axes on one line (generic).
+_GENERIC = 0.6180339887498949
+
+
+def held_complete(robot: Arm, j: int) -> bool:
+    """True when :func:`solve_fixed` with joint j held returns every solution.
+
+    A held-joint closed form, or a remaining chain with a closed form or the general
+    6R solver; False where the numeric solver samples it (two prismatic joints
+    left). An end joint's chain is the same for every value (solved at 0, the value
+    moved into the target); a middle joint's is judged at a generic value (at 0 the
+    Panda's joint 2 puts axes 1 and 3 on one line: no 6R solver there).
+    """
+    if robot.joint_names[j] in _held_solvers(robot):
+        return True
+    value = 0.0 if _end_joint(robot, [j]) is not None else _GENERIC
+    return _reduced(robot, [j], (value,)).derived(FAMILY).solver is not None
 
 
 def solve_held_single(robot: Arm, T: object, fixed: object) -> SolutionSet | None:

@@ -29,7 +29,7 @@ from robokin.kinematics.ik.analytic.detect import detect
 from robokin.kinematics.ik.dispatch import solve
 from robokin.kinematics.ik.numeric import IKResult
 from robokin.kinematics.ik.self_motion import (
-    cheap_parameter,
+    exact_parameter,
     nearest_on_manifold,
     swivel_nearest,
 )
@@ -59,10 +59,11 @@ def solve_near(
             the targets.
         method: ``"auto"`` (the closed form where the arm has one, else numeric:
             on 7R arms the numeric descent from ``q_near``), ``"analytic"``,
-            ``"numeric"`` or ``"self_motion"`` (7R arms whose self-motion has a
-            closed form: the in-limit point of the whole manifold nearest
-            ``q_near``: compiled on SRS arms, ~0.1 ms per pose; on the others
-            the exact intervals searched in Python, ~5 ms; see ``docs/ik.md``).
+            ``"numeric"`` or ``"self_motion"`` (7-joint arms whose whole
+            self-motion is exact: the in-limit point of the manifold nearest
+            ``q_near``: compiled on SRS arms, ~0.1 ms per pose; on the Panda the
+            exact intervals searched in Python, ~5 ms; on a general 7R arm or a
+            robot on a track the continued manifold, ~10-30 ms; see ``docs/ik.md``).
         **options: Options of the numeric solver
             (:func:`robokin.kinematics.ik.numeric.solve`, e.g. ``mask``, ``tol``,
             ``max_restarts``); giving any selects it.
@@ -84,11 +85,11 @@ def solve_near(
         if options:
             raise InputError("options", f"{sorted(options)} are numeric-solver options; "
                                         "method='self_motion' takes none")
-        if cheap_parameter(arm) is None:
+        if exact_parameter(arm) is None:
             raise InputError("method", f"method='self_motion' needs a 7-joint arm whose "
-                                       f"self-motion has a closed form (SRS swivel or "
-                                       f"a held-joint closed form) or a track; robot "
-                                       f"'{arm.name}' has neither: use method='numeric'")
+                                       f"whole self-motion is exact (a closed form, or "
+                                       f"every solution with a joint held); robot "
+                                       f"'{arm.name}' is not one: use method='numeric'")
         return _manifold_near(arm, T, q_near)
     if method == "numeric" or options:
         if method == "analytic":
@@ -106,7 +107,7 @@ def solve_near(
 
 
 def _manifold_near(arm: Arm, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
-    """A 7-joint arm with a cheap self-motion: the in-limit point nearest ``q_near``.
+    """A 7-joint arm with an exact self-motion: the in-limit point nearest ``q_near``.
 
     SRS arms: the compiled search on the exact swivel intervals, all poses in one
     batch (``self_motion.swivel_nearest``); other arms: per pose, the exact in-limit

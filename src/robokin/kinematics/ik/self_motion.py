@@ -47,7 +47,7 @@ from robokin._native import kernels as K
 from robokin._validation import _real_array, check_finite, check_joints, check_rigid
 from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, ArmSource, arm_of
-from robokin.kinematics.ik.fixed import Dispatch
+from robokin.kinematics.ik.fixed import Dispatch, held_complete
 from robokin.kinematics.ik.self_motion_base import _Family, seven_joint_serial
 from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
 from robokin.kinematics.ik.self_motion_families import (
@@ -80,7 +80,7 @@ from robokin.kinematics.ik.self_motion_nearest import interval_nearest
 from robokin.kinematics.ik.swivel import SwivelArm
 
 __all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SelfMotionSetup", "SingularPoint",
-           "auto_parameter", "cheap_parameter",
+           "auto_parameter", "exact_parameter",
            "nearest_on_manifold", "parameter_values", "self_motion", "swivel_nearest"]
 
 #: Zoom rounds of SelfMotion.best / nearest (each narrows the span about 4 times).
@@ -367,14 +367,17 @@ def auto_parameter(robot: ArmSource) -> str | None:
     return setup.parameter
 
 
-def cheap_parameter(robot: ArmSource) -> str | None:
-    """The parameter of a 7-joint arm whose whole manifold is cheap, or None.
+def exact_parameter(robot: ArmSource) -> str | None:
+    """The parameter of a 7-joint arm whose whole manifold is exact, or None.
 
-    ``auto_parameter``'s (a closed form: the SRS swivel, a held joint), or the track
-    of a robot on a linear track (``continued_parameter`` when it is the arm's one
-    prismatic joint: the robot's own six joints at each track value, ~25 ms a pose on
-    a UR5 on a rail). None for other arms, whose continued manifold costs up to ~1 s
-    a pose: pose goals and ``ik_near(..., method="self_motion")`` take it only here.
+    ``auto_parameter``'s (a closed form: the SRS swivel, a held joint), else the
+    continued family's joint (``continued_parameter``) where the pose with it held
+    is solved completely (``fixed.held_complete``): a robot on a linear track (the
+    robot's own closed form, ~25 ms a pose on a UR5 on a rail) or a general 7R arm
+    (the general 6R solver, ~10-30 ms a pose). None for an arm whose held chain only
+    the numeric solver samples (two prismatic joints left), and for arms that are
+    not 7-joint serial: pose goals and ``ik_near(..., method="self_motion")`` take
+    the manifold only where this is not None.
     """
     name = auto_parameter(robot)
     if name is not None:
@@ -382,8 +385,8 @@ def cheap_parameter(robot: ArmSource) -> str | None:
     arm = arm_of(robot)
     if not seven_joint_serial(arm):
         return None
-    track = continued_parameter(arm)
-    return None if arm.is_revolute[arm.joint_names.index(track)] else track
+    name = continued_parameter(arm)
+    return name if held_complete(arm, arm.joint_names.index(name)) else None
 
 
 def _criterion(criterion: Any, robot: ArmSource | None, limits: np.ndarray
@@ -424,7 +427,11 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
             and bisection), not the compiled kernel: the tests' reference.
 
     Returns:
-        A :class:`SelfMotion`.
+        A :class:`SelfMotion`. Its ``method`` names what solved the pose at each
+        parameter value: ``"continued numeric (... held)"`` on an arm whose held
+        six-joint chain has neither a closed form nor the general 6R solver (two
+        prismatic joints, e.g. ``improved_dh_arm``): the rows are then numeric
+        samples and a branch can be missed.
 
     Raises:
         InputError: not a 7R arm, a bad pose, or a parameter without a closed form
@@ -489,7 +496,7 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
     crossings = tuple(LimitCrossing(t, b, j, s) for t, b, j, s in marks["limit"])
     singular = tuple(SingularPoint(t, b, k) for t, b, k in marks["fold"] + marks["aligned"])
     method = ("swivel closed form (SRS)" if fam.name == "swivel"
-              else f"continued general 6R ({fam.name} held)"
+              else f"continued {fam.held_method} ({fam.name} held)"
               if isinstance(fam, _ContinuedFamily) else f"analytic:pieper ({fam.name} held)")
     return SelfMotion(Ta, fam.name, fam.joint, np.array(fam.domain), fam.periodic, fam.k,
                       intervals, owner, method,

@@ -148,6 +148,11 @@ class _ContinuedFamily(_Family):
         tracks: (m, k, n) each branch's row at the nodes (NaN where it has none).
         slopes: (m, k, n) their slopes dq/dt.
         solves: Parameter values solved by the general 6R solver so far.
+        held_method: What solves the pose with the joint held (``"general 6R"``,
+            or ``solve_fixed``'s method without its ``" (name held)"``: a closed
+            form such as ``"analytic:three_parallel"`` on a robot on a track, or
+            ``"numeric"`` where the held chain has neither, e.g. two prismatic
+            joints: then the rows are samples and branches can be missed).
         degenerate: Most cells of the first nodes did not pair (every row
             singular): no halving, folds at the tracks' last nodes.
     """
@@ -156,6 +161,7 @@ class _ContinuedFamily(_Family):
     dispatch: Dispatch
     T: np.ndarray
     joint: int
+    held_method: str
 
     def __init__(self, robot: Arm, j: int, T: np.ndarray, dispatch: Dispatch,
                  nodes: int = NODES) -> None:
@@ -168,6 +174,7 @@ class _ContinuedFamily(_Family):
         #: rows within 1e-9 of a limit refined on the pose (:meth:`_refined`)
         self.polisher = LimitPolish(robot, j, self.T, REGULAR_FLOOR)  # (no singular flags)
         self.solves = 0
+        self.held_method = "general 6R"  # (solve_fixed's rows: their method, _solve_pairs)
         self._island_cells: list[tuple[float, float]] = []  # cells where _islands found one
         # the end joint's sweep set up once per pose (None: a middle joint, solve_fixed)
         self._sweep = EndSweep.of(robot, j, self.T)
@@ -321,6 +328,8 @@ class _ContinuedFamily(_Family):
             sols, pairs = self._sweep.solve_pairs(np.ascontiguousarray(t, np.float64))
         else:
             sols = solve_fixed(self.robot, self.T, {self.name: t}, dispatch=self.dispatch)
+            held = sols.method.removesuffix(f" ({self.name} held)")
+            self.held_method = "general 6R" if held == "general_6r" else held
         valid = sols.valid.reshape(len(t), -1)
         q = sols.q.reshape(len(t), -1, self.robot.n)
         if (valid[:, 1:] <= valid[:, :-1]).all():  # valid rows first already (the kernel's)
