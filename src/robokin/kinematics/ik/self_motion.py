@@ -72,6 +72,7 @@ from robokin.kinematics.ik.self_motion_intervals import (
     _held_records,
     _intervals,
     _node_cuts,
+    _node_fills,
     _points_refined,
     _state_changes,
     _within,
@@ -485,6 +486,10 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
         intervals, owner, missed = _node_cuts(fam, limits, intervals, owner, fam.t_nodes,
                                               fam.tracks)
         marks["limit"] += missed
+        if not fam.degenerate:  # (its tracks are linked unpaired rows, not branches)
+            intervals, owner, missed = _node_fills(fam, limits, intervals, owner,
+                                                   fam.t_nodes, fam.tracks)
+            marks["limit"] += missed
     cuts = np.array([(t, b, j, 0) for t, b, j, _ in marks["limit"]], dtype=np.float64)
     touch = np.array(marks.get("touch", []), dtype=np.float64).reshape(-1, 3)
     sing = np.array([(t, b) for t, b, _ in marks["fold"] + marks["aligned"]],

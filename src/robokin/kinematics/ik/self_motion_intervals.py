@@ -527,27 +527,11 @@ def _node_cuts(fam: _Family, limits: np.ndarray, intervals: np.ndarray, owner: n
     hi = np.array([seqs[si][1][j + 1] for si, j in brk])
     s0 = np.array([seqs[si][2][j] for si, j in brk])
     bb = np.array([owner[seqs[si][0]] for si, j in brk], dtype=int)
-    for _ in range(_BISECT):
-        mid = 0.5 * (lo + hi)
-        go = np.flatnonzero((mid != lo) & (mid != hi))
-        if not len(go):
-            break
-        q, v = fam.slot_rows(mid[go], bb[go])
-        now = v & _within(q, limits)
-        same = now == s0[go]
-        lo[go], hi[go] = np.where(same, mid[go], lo[go]), np.where(same, hi[go], mid[go])
-    inner, outer = np.where(s0, lo, hi), np.where(s0, hi, lo)
     keep = np.ones(len(intervals), dtype=bool)
     keep[hit] = False
     if not len(brk):  # every hit interval outside at its ends and at its nodes: dropped
         return intervals[keep], owner[keep], []
-    q_out, _ = fam.slot_rows(outer, bb)
-    with np.errstate(invalid="ignore"):
-        below, above = lo_l - q_out, q_out - hi_l
-    far = np.fmax(below, above)
-    joint = np.argmax(np.nan_to_num(far, nan=-np.inf), axis=1)
-    side = np.where(above[np.arange(len(joint)), joint] > below[np.arange(len(joint)), joint],
-                    "upper", "lower")
+    inner, joint, side = _state_change(fam, limits, lo, hi, s0, bb)
     cuts: dict[int, list[float]] = {i: [] for i in range(len(seqs))}
     crossings: list[tuple[float, int, int, str]] = []
     for n_, (si, _) in enumerate(brk):
@@ -570,6 +554,109 @@ def _node_cuts(fam: _Family, limits: np.ndarray, intervals: np.ndarray, owner: n
         if start is not None:
             new.append((int(owner[i]), start, ts[-1]))
     iv, ob = _merged(intervals[keep], owner[keep], new)
+    return iv, ob, crossings
+
+
+def _state_change(fam: _Family, limits: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                  s0: np.ndarray, bb: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Changes of state (inside every limit or not) on branch rows, bisected.
+
+    ``lo``, ``hi`` (p,): brackets of branches ``bb`` (p,), the state at ``lo`` ``s0``
+    (p,) and the other at ``hi``; each is halved on ``fam.slot_rows`` (one batch per
+    step) to adjacent doubles. Returns the last in-limit value (p,), and the joint
+    furthest out past it (p,) with its side ``"lower"``/``"upper"`` (p,): a limit
+    crossing there (joint 0 where the outer value has no row).
+    """
+    lo, hi = lo.copy(), hi.copy()
+    for _ in range(_BISECT):
+        mid = 0.5 * (lo + hi)
+        go = np.flatnonzero((mid != lo) & (mid != hi))
+        if not len(go):
+            break
+        q, v = fam.slot_rows(mid[go], bb[go])
+        now = v & _within(q, limits)
+        same = now == s0[go]
+        lo[go], hi[go] = np.where(same, mid[go], lo[go]), np.where(same, hi[go], mid[go])
+    inner, outer = np.where(s0, lo, hi), np.where(s0, hi, lo)
+    q_out, _ = fam.slot_rows(outer, bb)
+    with np.errstate(invalid="ignore"):
+        below, above = limits[:, 0] - q_out, q_out - limits[:, 1]
+    far = np.fmax(below, above)
+    joint = np.argmax(np.nan_to_num(far, nan=-np.inf), axis=1)
+    r = np.arange(len(joint))
+    side = np.where(above[r, joint] > below[r, joint], "upper", "lower")
+    return inner, joint, side
+
+
+def _node_fills(fam: _Family, limits: np.ndarray, intervals: np.ndarray, owner: np.ndarray,
+                t_nodes: np.ndarray, tracks: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, list[tuple[float, int, int, str]]]:
+    """The in-limit runs of node rows that no interval of their branch holds, added.
+
+    ``_node_cuts``'s other half: a crossing the scan misses can also join an
+    in-limit piece to an outside one, and the piece's midpoint then drops both.
+    On the offset iiwa's special pose of ``test_node_cuts_...`` (q4 = 0, q6 = -1e-6)
+    with joint 7 the parameter, the branch through q1's upper limit at t = 0.08835
+    (there q4 = q6 = 0 too: the held 6 x 6 singular) lost that crossing on the AVX2
+    and baseline kernels (the rows' bisection found no row next to it) and with it
+    [0.08835, 1.48407], whose rows are regular (smallest singular value 1e-3 at
+    t = 0.5) and inside every limit; the AVX-512 kernel kept it. A node row inside by
+    more than ``_NODE_OUT`` outside every interval of its branch starts a run over
+    its neighbouring in-limit node rows; each end between an in-limit and another
+    node (outside, or no row) is bisected on ``fam.slot_rows`` (``_state_change``),
+    a run reaching the range's end ends there.
+
+    Returns ``(intervals, owner, crossings [(t, branch, joint, "lower"|"upper")])``
+    (the ends whose outer row is outside: a fold's is not a crossing); the arrays
+    unchanged (the same objects) where every in-limit node row is held.
+    """
+    lo_l, hi_l = limits[:, 0], limits[:, 1]
+    with np.errstate(invalid="ignore"):
+        X = _into_limits(fam.robot, tracks)
+        excess = np.maximum(lo_l - X, X - hi_l).max(axis=-1)  # (m, k), NaN: no row
+        inside = excess < -_NODE_OUT
+        state = excess <= _NODE_OUT
+    held = np.zeros(inside.shape, dtype=bool)
+    for (a, e), b in zip(intervals, owner, strict=True):
+        held[:, b] |= (t_nodes >= a) & (t_nodes <= e)
+    lost = inside & ~held
+    if not lost.any():
+        return intervals, owner, []
+    m = len(t_nodes)
+    runs: list[tuple[int, int, int]] = []  # (branch, first node, last node)
+    for b in np.flatnonzero(lost.any(axis=0)).tolist():
+        i = 0
+        while i < m:
+            if not state[i, b]:
+                i += 1
+                continue
+            j = i
+            while j + 1 < m and state[j + 1, b]:
+                j += 1
+            if lost[i:j + 1, b].any():
+                runs.append((b, i, j))
+            i = j + 1
+    # the ends to bisect: (run, is its start, in-limit node, the node beyond)
+    ends = [(r, first, i0 if first else i1, i0 - 1 if first else i1 + 1)
+            for r, (_, i0, i1) in enumerate(runs) for first in (True, False)
+            if (i0 > 0 if first else i1 < m - 1)]
+    bounds = {(r, True): float(t_nodes[i0]) for r, (_, i0, _) in enumerate(runs)}
+    bounds.update({(r, False): float(t_nodes[i1]) for r, (_, _, i1) in enumerate(runs)})
+    crossings: list[tuple[float, int, int, str]] = []
+    if ends:
+        bb = np.array([runs[r][0] for r, *_ in ends], dtype=int)
+        inn = np.array([t_nodes[i] for _, _, i, _ in ends])
+        out = np.array([t_nodes[o] for *_, o in ends])
+        inner, joint, side = _state_change(fam, limits, inn, out, np.ones(len(ends), bool),
+                                           bb)
+        for n_, (r, first, _, o) in enumerate(ends):
+            bounds[(r, first)] = float(inner[n_])
+            if np.isfinite(excess[o, runs[r][0]]):  # outside, not past a fold
+                crossings.append((float(inner[n_]), int(bb[n_]), int(joint[n_]),
+                                  str(side[n_])))
+    new = [(b, bounds[(r, True)], bounds[(r, False)]) for r, (b, _, _) in enumerate(runs)]
+    iv, ob = _merged(intervals, owner, new)
     return iv, ob, crossings
 
 
