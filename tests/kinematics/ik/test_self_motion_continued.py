@@ -1211,3 +1211,24 @@ def test_node_fills_restore_an_in_limit_run_the_scan_lost():
     same = _node_fills(fam, robot.limits, sm.intervals, sm.interval_branch, fam.t_nodes,
                        fam.tracks)
     assert same[0] is sm.intervals and same[1] is sm.interval_branch and same[2] == []
+
+
+def test_intervals_within_rounding_of_each_other_are_one():
+    # Session 17: the baseline kernel listed the random 7R's range-end corner
+    # (RANGE_ENDS[0]) twice, [t - 1.8e-15] alone and [t - 8.9e-16, t]; the point's row
+    # was out by 1.4e-12. Oracles: that point dropped, two longer intervals ulps apart
+    # joined, intervals further apart or of other branches kept, and nothing joined
+    # returns the same objects.
+    from robokin.kinematics.ik.self_motion_intervals import _joined
+
+    t = 2.9670597283903604
+    iv = np.array([[t - 1.7763568394002505e-15] * 2, [t - 8.881784197001252e-16, t],
+                   [0.5, 1.0], [1.0 + 4.4e-16, 1.2], [1.3, 1.4], [0.0, 1.0]])
+    ob = np.array([13, 13, 2, 2, 2, 5])
+    out, own = _joined(iv, ob)
+    np.testing.assert_array_equal(own, [2, 2, 5, 13])
+    np.testing.assert_array_equal(out, [[0.5, 1.2], [1.3, 1.4], [0.0, 1.0],
+                                        [t - 8.881784197001252e-16, t]])
+    kept = np.array([[0.5, 1.0], [1.0 + 1e-9, 1.2]])
+    same = _joined(kept, np.array([0, 0]))
+    assert same[0] is kept

@@ -71,6 +71,7 @@ from robokin.kinematics.ik.self_motion_intervals import (
     _held_kernel,
     _held_records,
     _intervals,
+    _joined,
     _node_cuts,
     _node_fills,
     _points_refined,
@@ -498,6 +499,8 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
                                                 cuts.reshape(-1, 4), 0,
                                                 every=not isinstance(fam, _ContinuedFamily),
                                                 touch=touch, singular=sing)
+    if isinstance(fam, _ContinuedFamily):
+        intervals, owner = _joined(intervals, owner)
     crossings = tuple(LimitCrossing(t, b, j, s) for t, b, j, s in marks["limit"])
     singular = tuple(SingularPoint(t, b, k) for t, b, k in marks["fold"] + marks["aligned"])
     method = ("swivel closed form (SRS)" if fam.name == "swivel"

@@ -660,6 +660,46 @@ def _node_fills(fam: _Family, limits: np.ndarray, intervals: np.ndarray, owner: 
     return iv, ob, crossings
 
 
+#: Intervals of one branch at most this many ulps of t apart are one (``_joined``).
+_ULPS = 8
+
+
+def _joined(intervals: np.ndarray, owner: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The intervals (m, 2) of branches ``owner`` (m,), a branch's within rounding joined.
+
+    Within rounding: at most ``_ULPS`` ulps of t apart. The continued family's corner rule and its widened ends can list one corner twice,
+    ulps apart: the random 7R's range-end corner of
+    ``test_a_corner_at_the_range_end_is_a_one_point_interval[q0]`` on the baseline
+    kernel was [t - 1.8e-15, t - 1.8e-15] and [t - 8.9e-16, t] (session 17; q6 = 1e-9,
+    so one ulp of t moves the joints ~700 times as far: the first point's row is out
+    by 1.4e-12, the second interval's start by 8e-14). A one-point interval that
+    close to another is that corner listed again and is dropped; two longer ones are
+    joined. The arrays unchanged (the same objects) when nothing is joined; sorted by
+    branch then start either way.
+    """
+    if len(intervals) < 2:
+        return intervals, owner
+    order = np.lexsort((intervals[:, 0], owner))
+    iv, ob = intervals[order], owner[order]
+    tol = _ULPS * np.spacing(np.maximum(np.abs(iv[:-1, 1]), 1.0))
+    join = (ob[1:] == ob[:-1]) & (iv[1:, 0] - iv[:-1, 1] <= tol)
+    if not join.any():
+        return intervals, owner
+    out: list[list[float]] = [iv[0].tolist()]
+    keep = [int(ob[0])]
+    for (a, e), b, j in zip(iv[1:].tolist(), ob[1:].tolist(), join.tolist(), strict=True):
+        if j and a == e:  # a point next to an interval: the same corner again
+            continue
+        if j and out[-1][0] == out[-1][1]:
+            out[-1] = [a, e]
+        elif j:
+            out[-1][1] = max(out[-1][1], e)
+        else:
+            out.append([a, e])
+            keep.append(int(b))
+    return np.array(out).reshape(-1, 2), np.array(keep, dtype=owner.dtype)
+
+
 #: A node row outside by more than this [rad] cuts its interval (``_node_cuts``; a joint
 #: riding its limit within rounding, 1e-15 to 1e-11, does not).
 _NODE_OUT = 1e-9
