@@ -577,9 +577,9 @@ def test_a_crossing_at_the_parameters_own_limit_is_kept():
 def test_the_continued_familys_method_names_its_held_solver():
     # Session 17: every continued manifold said "continued general 6R", also where
     # the held chain is a closed form (a UR5 on a track: three_parallel) or has
-    # neither (improved_dh_arm, two prismatic joints: numeric samples, which on this
-    # pose miss the generating configuration's branch). Oracle: robot.ik with the
-    # parameter held names the same solver, at the generating configuration's value.
+    # neither (improved_dh_arm, two prismatic joints: numeric samples, which can miss
+    # a branch: docs/ik.md). Oracle: robot.ik with the parameter held names the same
+    # solver, at the generating configuration's value.
     cases = [(ur5_on_a_track(2.0), np.array([0.7, 0.3, -1.2, 1.1, -0.5, 0.8, 0.2]),
               "analytic:three_parallel"),
              (random_7r(), None, "general 6R"),

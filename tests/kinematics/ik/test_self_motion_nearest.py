@@ -127,12 +127,3 @@ def test_a_general_7r_arm_takes_its_continued_manifold(i):
     dp, dr = pose_errors(arm.fk(res.q), T)
     assert dp <= 1e-12 and dr <= 1e-12
 
-
-def test_an_arm_whose_held_chain_is_sampled_is_refused():
-    # improved_dh_arm (two prismatic joints): with any joint held the numeric solver
-    # samples the rest, so its manifold can miss branches: the error names the
-    # argument and the way out
-    arm = robokin.load("improved_dh_arm")
-    q = np.clip(np.full(7, 0.3), arm.limits[:, 0], arm.limits[:, 1])
-    with pytest.raises(robokin.InputError, match="method.*method='numeric'"):
-        arm.ik_near(arm.fk(q), q, method="self_motion")

@@ -667,8 +667,9 @@ _ULPS = 8
 def _joined(intervals: np.ndarray, owner: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The intervals (m, 2) of branches ``owner`` (m,), a branch's within rounding joined.
 
-    Within rounding: at most ``_ULPS`` ulps of t apart. The continued family's corner rule and its widened ends can list one corner twice,
-    ulps apart: the random 7R's range-end corner of
+    Within rounding: at most ``_ULPS`` ulps of t apart. The continued family's corner
+    rule and its widened ends can list one corner twice, ulps apart: the random 7R's
+    range-end corner of
     ``test_a_corner_at_the_range_end_is_a_one_point_interval[q0]`` on the baseline
     kernel was [t - 1.8e-15, t - 1.8e-15] and [t - 8.9e-16, t] (session 17; q6 = 1e-9,
     so one ulp of t moves the joints ~700 times as far: the first point's row is out
