@@ -126,4 +126,3 @@ def test_a_general_7r_arm_takes_its_continued_manifold(i):
     assert arm.within_limits(res.q)
     dp, dr = pose_errors(arm.fk(res.q), T)
     assert dp <= 1e-12 and dr <= 1e-12
-
