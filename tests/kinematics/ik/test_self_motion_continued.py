@@ -1232,3 +1232,19 @@ def test_intervals_within_rounding_of_each_other_are_one():
     kept = np.array([[0.5, 1.0], [1.0 + 1e-9, 1.2]])
     same = _joined(kept, np.array([0, 0]))
     assert same[0] is kept
+
+
+def test_tracks_left_out_are_counted():
+    # Session 17: a pose whose rows pair into many short pieces keeps only the 64
+    # longest tracks, and a branch left out is missing from the manifold: offset iiwa
+    # special #6667 of seed 0 (q4, q5, q6 at -1e-9, -1e-7, -1e-9) lost a regular
+    # in-limit row at t = 1.4868 (held 6 x 6 smallest singular value 3e-3). info
+    # says how many were left out. Oracles: the count is the linked chains beyond 64
+    # (positive here, so some branch pieces are missing), and 0 on a regular pose.
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array([2.2109091802281684, 1.2313617314950975, -2.4004886220669763, -1e-09,
+                   -1e-07, -1e-09, 3.0543261909900767])
+    _, sm = _manifold(robot, q0)
+    assert sm.info["dropped"] > 0 and sm.n_branches == 64
+    _, plain = _manifold(robot, np.array([0.3, 0.5, -0.4, 1.2, 0.5, -0.9, 0.2]))
+    assert plain.info["dropped"] == 0 and plain.n_branches < 64

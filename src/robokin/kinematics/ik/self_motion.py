@@ -122,8 +122,10 @@ class SelfMotion:
         method: How the branches are computed.
         info: ``bisected`` (state changes found by bisection, not exactly),
             ``grid`` (values checked; the continued family: its nodes), and on
-            the continued family ``solves`` (general-6R values solved) and
-            ``degenerate`` (its rows did not pair: every row singular).
+            the continued family ``solves`` (general-6R values solved),
+            ``degenerate`` (its rows did not pair: every row singular) and
+            ``dropped`` (tracks left out beyond the 64 longest: where it is not 0,
+            branches may be missing; ``docs/ik.md``, session 17).
         limits: The arm's joint limits (n, 2).
         _points: The compiled kernel's points (p, 4) ``[t, branch, joint, kind]``
             (the swivel's ``SM_KIND_*``, the held joint's ``HM_KIND_*``), or None
@@ -558,10 +560,10 @@ def _swivel_motion(arm: SwivelArm, T: np.ndarray, robot: Arm, limits: np.ndarray
 
 
 def _solves(fam: _Family) -> dict[str, int]:
-    """A continued family's ``solves`` (general-6R values solved) and ``degenerate``."""
+    """A continued family's ``solves``, ``degenerate`` and ``dropped`` (``info``)."""
     if not isinstance(fam, _ContinuedFamily):
         return {}
-    return {"solves": fam.solves, "degenerate": fam.degenerate}
+    return {"solves": fam.solves, "degenerate": fam.degenerate, "dropped": fam.dropped}
 
 
 #: The swivel's parameter range (copied into each SelfMotion).

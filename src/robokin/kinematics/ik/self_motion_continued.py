@@ -155,6 +155,8 @@ class _ContinuedFamily(_Family):
             joints: then the rows are samples and branches can be missed).
         degenerate: Most cells of the first nodes did not pair (every row
             singular): no halving, folds at the tracks' last nodes.
+        dropped: Linked tracks left out beyond the ``_MAX_TRACKS`` longest (0 but on
+            poses whose rows pair into many short pieces: branches may be missing).
     """
 
     robot: Arm
@@ -162,6 +164,7 @@ class _ContinuedFamily(_Family):
     T: np.ndarray
     joint: int
     held_method: str
+    dropped: int
 
     def __init__(self, robot: Arm, j: int, T: np.ndarray, dispatch: Dispatch,
                  nodes: int = NODES) -> None:
@@ -211,7 +214,7 @@ class _ContinuedFamily(_Family):
             cells = np.flatnonzero(new[:-1] | new[1:])
             clean[cells] = _clean_cells(t, Q, D, cells)
         self.t_nodes = t
-        self.tracks, self.slopes = _link(t, Q, D)
+        self.tracks, self.slopes, self.dropped = _link(t, Q, D)
         self.k = self.tracks.shape[1]
         self._exists = np.isfinite(self.tracks).all(-1)  # (m, k)
         # the rows and their slopes (NaN slopes 0) side by side: predict's one gather
@@ -1333,8 +1336,12 @@ def _same_count(Q: np.ndarray, cells: np.ndarray) -> np.ndarray:
     return out
 
 
-def _link(t: np.ndarray, Q: np.ndarray, D: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Tracks and their slopes (m, k, n) from rows per node (m, K, n): mutual best pairs."""
+def _link(t: np.ndarray, Q: np.ndarray, D: np.ndarray
+          ) -> tuple[np.ndarray, np.ndarray, int]:
+    """Tracks and their slopes (m, k, n) from rows per node (m, K, n): mutual best pairs.
+
+    With the number of linked chains left out beyond the ``_MAX_TRACKS`` longest.
+    """
     m, K, n = Q.shape
     E = _residuals(t, Q, D)
     nxt = np.argmin(E, axis=2)  # (m-1, K): row a's best partner at the next node
@@ -1359,17 +1366,18 @@ def _link(t: np.ndarray, Q: np.ndarray, D: np.ndarray) -> tuple[np.ndarray, np.n
         chains.append(chain)
     del cell, rows
     # the longest _MAX_TRACKS (all but on a degenerate pose), ordered by their start
+    dropped = max(len(chains) - _MAX_TRACKS, 0)
     chains = sorted(sorted(chains, key=len, reverse=True)[:_MAX_TRACKS], key=lambda c: c[0])
     if not chains:
         empty = np.full((m, 1, n), np.nan)
-        return empty, empty.copy()
+        return empty, empty.copy(), 0
     X = np.full((m, len(chains), n), np.nan)
     S = np.full((m, len(chains), n), np.nan)
     for b, chain in enumerate(chains):
         ii = np.array([i for i, _ in chain])
         rr = np.array([r for _, r in chain])
         X[ii, b], S[ii, b] = Q[ii, rr], D[ii, rr]
-    return X, S
+    return X, S, dropped
 
 
 def _assign(P: np.ndarray, R: np.ndarray) -> np.ndarray:
