@@ -109,6 +109,23 @@ def test_the_text_lists_intervals_configurations_and_points(capsys):
     assert out.count("branch end (fold)") == sum(s.kind == "fold" for s in sm.singular)
 
 
+def test_a_manifold_of_numeric_samples_says_so(capsys):
+    # Session 17: improved_dh_arm (two prismatic joints) is solved at each value of
+    # its parameter by the numeric solver; the table says its branches can be missing
+    # (and a Panda's, from the closed form, does not)
+    arm = robokin.load("improved_dh_arm")
+    q = np.clip(np.full(7, 0.3), arm.limits[:, 0], arm.limits[:, 1])
+    code, out, err = run(capsys, "self-motion", "improved_dh_arm", *_pose_args(arm, q),
+                         "--format", "text")
+    assert code == 0, err
+    assert "[continued numeric (pitch7 held)]" in out
+    assert "numeric samples, and a branch can be missing" in out
+    panda = robokin.load("panda")
+    code, out, err = run(capsys, "self-motion", "panda", *_pose_args(panda, QP),
+                         "--format", "text")
+    assert code == 0 and "can be missing" not in out
+
+
 def test_csv_numbers_are_plain(capsys):
     panda = robokin.load("panda")
     code, out, err = run(capsys, "self-motion", "panda", *_pose_args(panda, QP),

@@ -330,6 +330,14 @@ def _intervals_table(r: Robot, sm: SelfMotion, u: _Units) -> OutputTable:
            if sm.periodic else "")
         + f"; {len(sm.crossings)} limit crossing(s), {folds} branch end(s), "
         f"{len(sm.singular) - folds} aligned-axes point(s) (--points lists them)")
+    if sm.method.startswith("continued numeric"):
+        table.notes.append(
+            f"{r.name} with {sm.parameter} held has neither a closed form nor the general "
+            f"6R solver: its rows are numeric samples, and a branch can be missing")
+    if sm.info.get("dropped"):
+        table.notes.append(
+            f"{sm.info['dropped']} short piece(s) of branches left out (only the 64 "
+            f"longest are followed): a branch can be missing")
     return table
 
 
