@@ -238,9 +238,9 @@ def test_a_pose_at_the_reach_boundary_is_bounded_and_flagged():
     # the work is bounded (it doubled its nodes to 5,270 and ran out of memory,
     # then took seconds bisecting folds) and info says the pose is degenerate: no
     # node added to the first 181, and the values solved after them (the intervals'
-    # bisections on its singular rows) bounded. Those depend on the machine's LAPACK
-    # (which singular rows pair): 738 in all on an AVX-512 Xeon (session 17), at most
-    # 724 where the bound 4 x 181 was set, so the bound is now 6 x 181.
+    # bisections on its singular rows) bounded. Those depend on the machine (with every
+    # kernel copy alike: numpy's linear algebra, likely): 738 in all on an AVX-512
+    # Xeon (session 17), at most 724 where the bound 4 x 181 was set; now 6 x 181.
     robot = ARMS["offset_iiwa"]
     q0 = np.array([0.78, 1.571, 2.029, 0.0, -2.798, 0.0, 2.711])
     T, sm = _manifold(robot, q0)
