@@ -131,6 +131,22 @@ def test_a_placed_robot_solves_its_pose_on_the_unplaced_one():
     np.testing.assert_allclose(g.q, direct.q, atol=1e-8)
 
 
+def _assert_goals_sample_every_interval(robot, T, g, sm):
+    """A pose goal g sampled on the manifold sm: every in-limit interval holds a round-0
+    candidate that is its branch's row there (1e-12); FK of every candidate is T
+    (1e-9), inside the limits."""
+    assert g.kind == "pose" and g.manifold is not None and len(g.q) >= len(sm.intervals)
+    t = g.q[:, sm.joint]
+    for (a, b), br in zip(sm.intervals, sm.interval_branch, strict=True):
+        inside = (t >= a) & (t <= b)
+        assert inside.any()
+        branch = sm.sample(t[inside])[np.arange(inside.sum()), br]
+        assert np.any(np.abs(branch - g.q[inside]).max(axis=1) < 1e-12)
+    np.testing.assert_allclose(robot.fk(g.q), np.broadcast_to(T, (len(g.q), 4, 4)),
+                               atol=1e-9)
+    assert np.all(g.q >= robot.limits[:, 0]) and np.all(g.q <= robot.limits[:, 1])
+
+
 def test_a_robot_on_a_track_samples_its_manifold_over_the_track():
     # Session 16: a UR5 on a 2 m rail (no held-joint closed form of the Panda's kind)
     # took the numeric sample as its pose goal; now the manifold over the track.
@@ -142,16 +158,7 @@ def test_a_robot_on_a_track_samples_its_manifold_over_the_track():
     g = goal_configurations(robot, T)
     sm = robot.self_motion(T)
     assert sm.parameter == "track"
-    assert g.kind == "pose" and g.manifold is not None and len(g.q) >= len(sm.intervals)
-    t = g.q[:, 0]
-    for (a, b), br in zip(sm.intervals, sm.interval_branch, strict=True):
-        inside = (t >= a) & (t <= b)
-        assert inside.any()
-        branch = sm.sample(t[inside])[np.arange(inside.sum()), br]
-        assert np.any(np.abs(branch - g.q[inside]).max(axis=1) < 1e-12)
-    np.testing.assert_allclose(robot.fk(g.q), np.broadcast_to(T, (len(g.q), 4, 4)),
-                               atol=1e-9)
-    assert np.all(g.q >= robot.limits[:, 0]) and np.all(g.q <= robot.limits[:, 1])
+    _assert_goals_sample_every_interval(robot, T, g, sm)
 
 
 def test_a_general_7r_arm_samples_its_continued_manifold():
@@ -168,16 +175,7 @@ def test_a_general_7r_arm_samples_its_continued_manifold():
     g = goal_configurations(robot, T)
     sm = robot.self_motion(T)
     assert sm.method.startswith("continued general 6R")
-    assert g.kind == "pose" and g.manifold is not None and len(g.q) >= len(sm.intervals)
-    t = g.q[:, sm.joint]
-    for (a, b), br in zip(sm.intervals, sm.interval_branch, strict=True):
-        inside = (t >= a) & (t <= b)
-        assert inside.any()
-        branch = sm.sample(t[inside])[np.arange(inside.sum()), br]
-        assert np.any(np.abs(branch - g.q[inside]).max(axis=1) < 1e-12)
-    np.testing.assert_allclose(robot.fk(g.q), np.broadcast_to(T, (len(g.q), 4, 4)),
-                               atol=1e-9)
-    assert np.all(g.q >= robot.limits[:, 0]) and np.all(g.q <= robot.limits[:, 1])
+    _assert_goals_sample_every_interval(robot, T, g, sm)
     row = sm.sample(q0[sm.joint])
     assert np.nanmin(np.abs(row - q0).max(axis=1)) < 1e-9
 

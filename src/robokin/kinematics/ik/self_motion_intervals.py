@@ -1085,7 +1085,8 @@ def _bound(lim_pts: np.ndarray, a: float, e: float, b: int) -> tuple[float, floa
     joint other than its own (a graze's own joint crosses twice within it).
     """
     own = lim_pts[lim_pts[:, 1] == b]
-    at = own[(np.abs(own[:, 0] - a) <= _TOUCH_APART) | (np.abs(own[:, 0] - e) <= _TOUCH_APART), 2]
+    ends = (np.abs(own[:, 0] - a) <= _TOUCH_APART) | (np.abs(own[:, 0] - e) <= _TOUCH_APART)
+    at = own[ends, 2]
     t = own[~np.isin(own[:, 2], at), 0]
     return float(t[t < a].max(initial=-np.inf)), float(t[t > e].min(initial=np.inf))
 
@@ -1262,8 +1263,9 @@ def _widen(fam: _Family, limits: np.ndarray, points: list[tuple[float, float, in
         d[go] = last * (1.0 - 1e-3)  # inside the last inside value: its row stays within
         # the slack after a 2 pi shift of the swivel (rounding) at q'' up to ~1e11
         if bounds is not None:  # not past another joint's crossing (_bound)
-            room = np.concatenate([[a - lo for (a, _, _), (lo, _) in zip(points, bounds, strict=True)],
-                                   [hi - e for (_, e, _), (_, hi) in zip(points, bounds, strict=True)]])
+            pairs = list(zip(points, bounds, strict=True))
+            room = np.concatenate([[a - lo for (a, _, _), (lo, _) in pairs],
+                                   [hi - e for (_, e, _), (_, hi) in pairs]])
             d[go] = np.minimum(d[go], room[go])
     if reach is not None:
         full = ok.all(axis=1) & np.tile(np.array(reach, dtype=bool), 2)
