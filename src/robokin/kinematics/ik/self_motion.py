@@ -489,10 +489,10 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
         intervals, owner, missed = _node_cuts(fam, limits, intervals, owner, fam.t_nodes,
                                               fam.tracks)
         marks["limit"] += missed
-        if not fam.degenerate:  # (its tracks are linked unpaired rows, not branches)
-            intervals, owner, missed = _node_fills(fam, limits, intervals, owner,
-                                                   fam.t_nodes, fam.tracks)
-            marks["limit"] += missed
+        intervals, owner, missed = _node_fills(
+            fam, limits, intervals, owner, fam.t_nodes, fam.tracks,
+            fam.regular_nodes if fam.degenerate else None)
+        marks["limit"] += missed
     cuts = np.array([(t, b, j, 0) for t, b, j, _ in marks["limit"]], dtype=np.float64)
     touch = np.array(marks.get("touch", []), dtype=np.float64).reshape(-1, 3)
     sing = np.array([(t, b) for t, b, _ in marks["fold"] + marks["aligned"]],

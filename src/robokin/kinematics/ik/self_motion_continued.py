@@ -138,6 +138,10 @@ _DISTINCT = 1e-6
 #: Smallest singular value of the held 6 x 6 of a degenerate manifold's followed rows
 #: and of its tracks' node rows in a followed cell (the kernel's ``singular`` flag's).
 _REGULAR = 1e-6
+#: A degenerate manifold's continued row this close [rad] to a node's row is that row.
+_SAME_ROW = 1e-7
+#: Sub-steps of a degenerate manifold's continuation from one node to the next.
+_FILL_SUB = 4
 
 
 class _ContinuedFamily(_Family):
@@ -157,6 +161,10 @@ class _ContinuedFamily(_Family):
             singular): no halving, folds at the tracks' last nodes.
         dropped: Linked tracks left out beyond the ``_MAX_TRACKS`` longest (0 but on
             poses whose rows pair into many short pieces: branches may be missing).
+        filled: Node rows a degenerate manifold's continuation added (:meth:`_filled`).
+        regular_nodes: (m, k) bool, the node rows with a slope (on a degenerate
+            manifold also regular: :func:`_regular`): its rows are continued between
+            two of them (:meth:`_gaps`) and only they start ``_node_fills``' runs.
     """
 
     robot: Arm
@@ -165,6 +173,8 @@ class _ContinuedFamily(_Family):
     joint: int
     held_method: str
     dropped: int
+    filled: int
+    regular_nodes: np.ndarray
 
     def __init__(self, robot: Arm, j: int, T: np.ndarray, dispatch: Dispatch,
                  nodes: int = NODES) -> None:
@@ -192,6 +202,9 @@ class _ContinuedFamily(_Family):
         # most cells unpaired: every row singular (the pose at the reach boundary,
         # e.g. the elbow stretched for every value): no halving, no fold search
         self.degenerate = bool(clean.mean() < _DEGENERATE) if clean.size else False
+        self.filled = 0
+        if self.degenerate:  # regular rows the solver missed next to the near-continuum
+            Q, D = self._filled(t, Q, D)
         for rnd in range(0 if self.degenerate else _REFINE + _REFINE_FAST):
             bad = np.flatnonzero(~clean)
             if rnd >= _REFINE:  # then only the fast passages (no fold: as many rows)
@@ -229,8 +242,10 @@ class _ContinuedFamily(_Family):
         # (and, on a degenerate manifold, every node row there regular)
         ends = self._exists[1:] != self._exists[:-1]
         slope = np.isfinite(self.slopes).all(-1) | ~self._exists  # (m, k)
+        self.regular_nodes = slope & self._exists
         if self.degenerate:  # its near-continuum rows may have slopes: regular rows only
-            slope &= _regular(robot, self.tracks, j) | ~self._exists
+            self.regular_nodes &= _regular(robot, self.tracks, j)
+            slope &= self.regular_nodes | ~self._exists
         self._cell_ok = ~ends.any(axis=1) & (slope[1:] & slope[:-1]).all(axis=1)
         self.followed = 0
 
@@ -308,6 +323,71 @@ class _ContinuedFamily(_Family):
         return t2[order], np.concatenate([Q, Qv])[order]
 
     # ------------------------------------------------------------ rows
+    def _filled(self, t: np.ndarray, Q: np.ndarray, D: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+        """A degenerate manifold's node rows Q and slopes D (m, K, n), gaps continued.
+
+        Next to a near-continuum (the offset iiwa with q4 = q6 = 0: the held 6 x 6's
+        smallest singular value 1e-11 on the continuum's rows, 1e-4 to 1e-3 on the
+        regular branches passing by) the general 6R solver misses regular rows at
+        some values (an odd row count at a value: a real root lost), so those
+        branches' tracks were pieces, most of them beyond the ``_MAX_TRACKS``
+        longest (#6667 of the special poses: 38 of 88 in-limit regular rows in no
+        interval). Each regular row (:func:`_regular`, with a slope) is continued to
+        both neighbouring nodes in ``_FILL_SUB`` Euler-Newton steps on the held
+        6 x 6 (every step reaching the pose to ``_EXACT``); a regular result farther
+        than ``_SAME_ROW`` from every row of that node is added and continued in
+        turn, until no row is added. Every added row is a solution of the pose at its
+        node (the tracks are linked from the rows as before); regular rows are
+        isolated (at most 16 per value), so this ends.
+        """
+        robot, j, m = self.robot, self.joint, len(t)
+        ok0 = _regular(robot, Q, j) & np.isfinite(D).all(-1)
+        src_i, src_r = np.nonzero(ok0)
+        for _ in range(2 * m):  # (each round adds rows; at most 16 a node)
+            if not src_i.size:
+                break
+            si = np.concatenate([src_i, src_i])
+            sr = np.concatenate([src_r, src_r])
+            dst = np.concatenate([src_i + 1, src_i - 1])
+            keep = (dst >= 0) & (dst < m)
+            si, sr, dst = si[keep], sr[keep], dst[keep]
+            q, dq = Q[si, sr], D[si, sr]
+            h = (t[dst] - t[si]) / _FILL_SUB
+            ok = np.ones(len(q), bool)
+            for s in range(1, _FILL_SUB + 1):
+                q, reached = _newton_held(robot, self.T, q + h[:, None] * dq, j, t[si] + s * h)
+                dq = _slopes(robot, q, j)
+                ok &= reached & np.isfinite(dq).all(-1)
+                dq = np.where(ok[:, None], dq, 0.0)
+            q = _into_limits(robot, q)
+            if ok.any():
+                ok[ok] = _regular(robot, q[ok], j)
+            # not a row of its node (nor one added before it in this round)
+            near = _max_last(np.abs(_wrap(Q[dst] - q[:, None])))  # (p, K)
+            ok &= ~np.any(near <= _SAME_ROW, axis=1)
+            new: list[int] = []  # candidates kept: one per (node, row)
+            for a in np.flatnonzero(ok).tolist():
+                if not any(dst[b] == dst[a] and np.max(np.abs(_wrap(q[b] - q[a]))) <= _SAME_ROW
+                           for b in new):
+                    new.append(a)
+            if not new:
+                break
+            add = np.array(new)
+            # each into its node's next free slot (valid rows first)
+            slot = _finite_rows(Q).sum(axis=1)[dst[add]]
+            for a in range(1, len(add)):  # a second row added to one node: the slot after
+                slot[a] += int(np.count_nonzero(dst[add[:a]] == dst[add[a]]))
+            width = int(slot.max()) + 1
+            if width > Q.shape[1]:
+                pad = np.full((m, width - Q.shape[1], Q.shape[2]), np.nan)
+                Q, D = np.concatenate([Q, pad], axis=1), np.concatenate([D, pad], axis=1)
+            src_i, src_r = dst[add], slot
+            Q[src_i, src_r] = q[add]
+            D[src_i, src_r] = dq[add]
+            self.filled += len(add)
+        return Q, D
+
     def _solve(self, t: np.ndarray) -> np.ndarray:
         """Every general-6R row at held values t (m,): (m, K, n), NaN where none.
 
@@ -351,9 +431,47 @@ class _ContinuedFamily(_Family):
         R = self._solve(t)  # (M, K, n)
         P = self.predict(t)  # (M, k, n)
         out = self._polish(_assign(P, R), t)
+        if self.degenerate:
+            self._gaps(t, P, out)
         valid = _finite_rows(out)
         self._refined(out, valid)
         return out, valid, np.zeros_like(valid)
+
+    def _gaps(self, t: np.ndarray, P: np.ndarray, out: np.ndarray) -> None:
+        """A degenerate manifold's rows at t (M,) the solver missed, continued in place.
+
+        As at the nodes (:meth:`_filled`): a track whose rows at both nodes of t's
+        cell are regular (with slopes) and whose row at t is missing or singular (a
+        near-continuum row the solver gave, nearest the prediction where the
+        branch's own row was lost: #6667's track at a node, 0.048 rad away) takes
+        its prediction P (M, k, n) Newton-polished on the held 6 x 6, kept when it
+        reaches the pose to ``_EXACT``, is regular, within ``_ASSIGN`` of the
+        prediction and more than ``_DISTINCT`` from every other track's row at t
+        (out (M, k, n)).
+        """
+        tn = self.t_nodes
+        if len(tn) < 2:
+            return
+        i = np.minimum(np.maximum(np.searchsorted(tn, t, side="right") - 1, 0), len(tn) - 2)
+        want = (self.regular_nodes[i] & self.regular_nodes[i + 1] & _finite_rows(P)
+                & ((t >= tn[0]) & (t <= tn[-1]))[:, None])
+        there = want & _finite_rows(out)
+        if there.any():  # a singular row in a regular track's slot: continued too
+            want[there] = ~_regular(self.robot, out[there], self.joint)
+        mi, bi = np.nonzero(want)
+        if not mi.size:
+            return
+        p = P[mi, bi]
+        q, ok = _newton_held(self.robot, self.T, _into_limits(self.robot, p), self.joint, t[mi])
+        q = _into_limits(self.robot, q)
+        ok &= _max_last(np.abs(_wrap(q - p))) < _ASSIGN
+        if ok.any():
+            ok[ok] = _regular(self.robot, q[ok], self.joint)
+        for a in np.flatnonzero(ok).tolist():
+            d = _max_last(np.abs(_wrap(out[mi[a]] - q[a])))  # (k,), NaN: no row
+            d[bi[a]] = np.inf  # (the slot's own singular row: replaced)
+            if not np.any(d <= _DISTINCT):
+                out[mi[a], bi[a]] = q[a]
 
     def _refined(self, Q: np.ndarray, valid: np.ndarray) -> None:
         """Rows Q (M, k, n) within 1e-9 of a limit refined in place (``LimitPolish``).
