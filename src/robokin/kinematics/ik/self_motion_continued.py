@@ -228,12 +228,20 @@ class _ContinuedFamily(_Family):
             clean[cells] = _clean_cells(t, Q, D, cells)
         self.t_nodes = t
         self.tracks, self.slopes, self.dropped = _link(t, Q, D)
+        if self.dropped and not self.degenerate:  # pieces: rows lost, as on a degenerate pose
+            Q, D = self._filled(t, Q, D)
+            if self.filled:
+                self.tracks, self.slopes, self.dropped = _link(t, Q, D)
         self.k = self.tracks.shape[1]
         self._exists = np.isfinite(self.tracks).all(-1)  # (m, k)
         # the rows and their slopes (NaN slopes 0) side by side: predict's one gather
         slopes0 = np.where(np.isfinite(self.slopes), self.slopes, 0.0)
         self._XS = np.concatenate([self.tracks, slopes0], axis=-1)  # (m, k, 2n)
         m, k, n = self.tracks.shape
+        slope = np.isfinite(self.slopes).all(-1) | ~self._exists  # (m, k)
+        self.regular_nodes = slope & self._exists
+        if self.degenerate or self.filled:  # near-continuum rows may have slopes
+            self.regular_nodes &= _regular(robot, self.tracks, j)
         # per (cell, track): the fold inside the cell, its t and row (NaN: none)
         self.fold_t = np.full((m - 1, k), np.nan)
         self.fold_q = np.full((m - 1, k, n), np.nan)
@@ -241,10 +249,7 @@ class _ContinuedFamily(_Family):
         # cells where sample_rows may follow the tracks: none starts or ends in them
         # (and, on a degenerate manifold, every node row there regular)
         ends = self._exists[1:] != self._exists[:-1]
-        slope = np.isfinite(self.slopes).all(-1) | ~self._exists  # (m, k)
-        self.regular_nodes = slope & self._exists
-        if self.degenerate:  # its near-continuum rows may have slopes: regular rows only
-            self.regular_nodes &= _regular(robot, self.tracks, j)
+        if self.degenerate:  # followed: regular rows only
             slope &= self.regular_nodes | ~self._exists
         self._cell_ok = ~ends.any(axis=1) & (slope[1:] & slope[:-1]).all(axis=1)
         self.followed = 0
@@ -431,7 +436,7 @@ class _ContinuedFamily(_Family):
         R = self._solve(t)  # (M, K, n)
         P = self.predict(t)  # (M, k, n)
         out = self._polish(_assign(P, R), t)
-        if self.degenerate:
+        if self.degenerate or self.filled:
             self._gaps(t, P, out)
         valid = _finite_rows(out)
         self._refined(out, valid)
