@@ -1329,3 +1329,35 @@ def test_a_degenerate_manifolds_missed_rows_are_continued():
     assert _regular(robot, extra, 6).all() and _REGULAR > 0
     dp, dr = pose_errors(robot.fk(extra), T)
     assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+
+
+def test_a_pose_whose_tracks_are_pieces_is_continued_and_relinked():
+    # Session 18: offset iiwa special #5587 of seed 0 (q1, q3, q7 at limits, q4 = 1e-9,
+    # q6 = -1e-7) pairs most of its cells (not degenerate) but its tracks were pieces,
+    # 26 chains left out beyond the 64 longest: the solver loses regular rows there as
+    # on a degenerate pose. Its node rows are continued (_filled) and linked again.
+    # Oracles: every added node row reproduces the pose to 1e-12 and is regular; no
+    # chain is left out now (26 before); each track's step between neighbouring nodes
+    # agrees with its slopes there (trapezoid rule to 1e-2 rad: its swing next to
+    # q7 = 0.09, q3 and q5 at ~195 rad per rad, moves 0.62 rad in a cell, as on main;
+    # a re-paired track jumps by a branch's distance); every regular in-limit row of
+    # independent held solves is in an interval of its branch.
+    from robokin.kinematics.ik.self_motion_continued import _regular
+
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array([-2.9670597283903604, -1.0882620811294748, -2.9670597283903604, 1e-09,
+                   3.141592653589793, -1e-07, -3.0543261909900767])
+    T, sm = _manifold(robot, q0)
+    fam = sm._family
+    assert not sm.info["degenerate"] and fam.filled > 0 and sm.info["dropped"] == 0
+    X, S = fam.tracks, fam.slopes
+    both = fam._exists[1:] & fam._exists[:-1] & np.isfinite(S).all(-1)[1:] & np.isfinite(
+        S).all(-1)[:-1]
+    h = np.diff(fam.t_nodes)[:, None, None]
+    step = _wrapped(X[1:] - X[:-1] - 0.5 * h * (S[1:] + S[:-1])).max(-1)
+    assert both.sum() > 1000 and step[both].max() <= 1e-2
+    rows = X[fam._exists]
+    dp, dr = pose_errors(robot.fk(rows), T)
+    assert dp.max() <= 1e-12 and dr.max() <= 1e-12
+    assert _regular(robot, rows, 6).sum() >= fam.filled
+    _assert_regular_rows_in_intervals(robot, T, sm, np.linspace(-3.0, 3.0, 40), 20)

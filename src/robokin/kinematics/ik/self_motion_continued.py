@@ -52,6 +52,14 @@ module continues them into branches (issue 29):
    tracks; a pose where fewer than half of the first cells pair (every row
    singular: the arm at its reach boundary for every t) is ``degenerate``: no
    halving, folds at the tracks' last nodes.
+7. **Rows the solver loses.** Next to a near-continuum (the elbow stretched) the
+   general 6R solver loses some regular rows at some values, and their branches'
+   tracks fall into pieces. On a ``degenerate`` manifold, and on one whose linked
+   tracks exceed ``_MAX_TRACKS``, each regular node row is continued to the
+   neighbouring nodes (:meth:`~_ContinuedFamily._filled`) and ``rows(t)`` continues
+   a regular track whose row at t is missing or singular
+   (:meth:`~_ContinuedFamily._gaps`); every added row is an exact solution
+   (session 18).
 
 The intervals are then cut at the crossings and folds and decided at the pieces'
 midpoints (``self_motion_intervals._intervals``).
@@ -138,9 +146,9 @@ _DISTINCT = 1e-6
 #: Smallest singular value of the held 6 x 6 of a degenerate manifold's followed rows
 #: and of its tracks' node rows in a followed cell (the kernel's ``singular`` flag's).
 _REGULAR = 1e-6
-#: A degenerate manifold's continued row this close [rad] to a node's row is that row.
+#: A continued row (``_filled``) this close [rad] to a node's row is that row.
 _SAME_ROW = 1e-7
-#: Sub-steps of a degenerate manifold's continuation from one node to the next.
+#: Sub-steps of ``_filled``'s continuation from one node to the next.
 _FILL_SUB = 4
 
 
@@ -161,10 +169,12 @@ class _ContinuedFamily(_Family):
             singular): no halving, folds at the tracks' last nodes.
         dropped: Linked tracks left out beyond the ``_MAX_TRACKS`` longest (0 but on
             poses whose rows pair into many short pieces: branches may be missing).
-        filled: Node rows a degenerate manifold's continuation added (:meth:`_filled`).
-        regular_nodes: (m, k) bool, the node rows with a slope (on a degenerate
-            manifold also regular: :func:`_regular`): its rows are continued between
-            two of them (:meth:`_gaps`) and only they start ``_node_fills``' runs.
+        filled: Node rows the continuation of lost rows added (:meth:`_filled`: on a
+            degenerate manifold, or one whose tracks were more than ``_MAX_TRACKS``).
+        regular_nodes: (m, k) bool, the node rows with a slope (where :meth:`_filled`
+            ran, also regular: :func:`_regular`): rows are continued between two of
+            them (:meth:`_gaps`), and on a degenerate manifold only they start
+            ``_node_fills``' runs.
     """
 
     robot: Arm
@@ -330,7 +340,7 @@ class _ContinuedFamily(_Family):
     # ------------------------------------------------------------ rows
     def _filled(self, t: np.ndarray, Q: np.ndarray, D: np.ndarray
                 ) -> tuple[np.ndarray, np.ndarray]:
-        """A degenerate manifold's node rows Q and slopes D (m, K, n), gaps continued.
+        """Node rows Q and slopes D (m, K, n) with the rows the solver lost continued.
 
         Next to a near-continuum (the offset iiwa with q4 = q6 = 0: the held 6 x 6's
         smallest singular value 1e-11 on the continuum's rows, 1e-4 to 1e-3 on the
@@ -338,7 +348,8 @@ class _ContinuedFamily(_Family):
         some values (an odd row count at a value: a real root lost), so those
         branches' tracks were pieces, most of them beyond the ``_MAX_TRACKS``
         longest (#6667 of the special poses: 38 of 88 in-limit regular rows in no
-        interval). Each regular row (:func:`_regular`, with a slope) is continued to
+        interval). Run on a ``degenerate`` manifold and on one whose tracks are
+        such pieces (more than ``_MAX_TRACKS``). Each regular row (:func:`_regular`, with a slope) is continued to
         both neighbouring nodes in ``_FILL_SUB`` Euler-Newton steps on the held
         6 x 6 (every step reaching the pose to ``_EXACT``); a regular result farther
         than ``_SAME_ROW`` from every row of that node is added and continued in
@@ -360,8 +371,9 @@ class _ContinuedFamily(_Family):
             q, dq = Q[si, sr], D[si, sr]
             h = (t[dst] - t[si]) / _FILL_SUB
             ok = np.ones(len(q), bool)
-            for s in range(1, _FILL_SUB + 1):
-                q, reached = _newton_held(robot, self.T, q + h[:, None] * dq, j, t[si] + s * h)
+            for s in range(1, _FILL_SUB + 1):  # (the last at the node's own value)
+                ts = t[dst] if s == _FILL_SUB else t[si] + s * h
+                q, reached = _newton_held(robot, self.T, q + h[:, None] * dq, j, ts)
                 dq = _slopes(robot, q, j)
                 ok &= reached & np.isfinite(dq).all(-1)
                 dq = np.where(ok[:, None], dq, 0.0)
@@ -443,7 +455,7 @@ class _ContinuedFamily(_Family):
         return out, valid, np.zeros_like(valid)
 
     def _gaps(self, t: np.ndarray, P: np.ndarray, out: np.ndarray) -> None:
-        """A degenerate manifold's rows at t (M,) the solver missed, continued in place.
+        """Rows at t (M,) the solver lost, continued in place (where :meth:`_filled` ran).
 
         As at the nodes (:meth:`_filled`): a track whose rows at both nodes of t's
         cell are regular (with slopes) and whose row at t is missing or singular (a
