@@ -1363,3 +1363,29 @@ def test_a_pose_whose_tracks_are_pieces_is_continued_and_relinked():
     assert dp.max() <= 1e-12 and dr.max() <= 1e-12
     assert _regular(robot, rows, 6).sum() >= fam.filled
     _assert_regular_rows_in_intervals(robot, T, sm, np.linspace(-3.0, 3.0, 40), 20)
+
+
+def test_flat_continuum_pieces_are_not_searched_for_grazes(monkeypatch):
+    # Session 18: offset iiwa special #6584 of seed 0 (q2 and q7 at limits, q4 = -1e-7,
+    # q6 = 0): the continuum's tracks hold q2 at its limit, so hundreds of their pieces
+    # were graze candidates, each refined by 43 golden-section solves of every row
+    # (#5814: 1,316 of 1,429, 9.2 of 24.5 s). They are skipped where both node rows
+    # are singular and the joint flat (_FLAT). Oracles: with the skip disabled
+    # (_FLAT = 0) the tracks are the same and every track with a regular node row has
+    # the same intervals; fewer values are solved with the skip.
+    import robokin.kinematics.ik.self_motion_continued as cont
+
+    robot = ARMS["offset_iiwa"]
+    q0 = np.array([0.0, -2.0943951023931953, -1e-07, -1e-07, 1e-06, 0.0,
+                   -3.0543261909900767])
+    _, sm = _manifold(robot, q0)
+    monkeypatch.setattr(cont, "_FLAT", 0.0)
+    _, full = _manifold(robot, q0)
+    fam, ref = sm._family, full._family
+    np.testing.assert_array_equal(fam.tracks, ref.tracks)
+    assert sm.info["solves"] < full.info["solves"]
+    regular = cont._regular(robot, fam.tracks, 6).any(axis=0)
+    assert regular.sum() >= 4
+    for b in np.flatnonzero(regular):
+        np.testing.assert_array_equal(sm.intervals[sm.interval_branch == b],
+                                      full.intervals[full.interval_branch == b])
