@@ -1389,3 +1389,26 @@ def test_flat_continuum_pieces_are_not_searched_for_grazes(monkeypatch):
     for b in np.flatnonzero(regular):
         np.testing.assert_array_equal(sm.intervals[sm.interval_branch == b],
                                       full.intervals[full.interval_branch == b])
+
+
+def test_first_distinct_keeps_what_the_plain_loop_keeps():
+    # _first_distinct (the continuation's de-duplication, vectorised where a group has
+    # one candidate) against the plain loop: a candidate is kept unless a kept one
+    # before it in its group is within tol (2 pi wrapped). Random groups with near
+    # copies, exact copies and copies a turn apart.
+    from robokin.kinematics.ik.self_motion_continued import _first_distinct
+
+    rng = np.random.default_rng(18)
+    for _ in range(50):
+        p = int(rng.integers(0, 30))
+        group = rng.integers(0, 6, p)
+        q = rng.uniform(-3, 3, (p, 7))
+        copies = rng.random(p) < 0.4
+        src = rng.integers(0, max(p, 1), p)
+        q[copies] = q[src[copies]] + rng.choice([0.0, 1e-9, 2 * np.pi, 1e-3], (copies.sum(), 1))
+        idx = np.flatnonzero(rng.random(p) < 0.8)
+        ref = []
+        for a in idx.tolist():
+            if not any(group[b] == group[a] and _wrapped(q[b] - q[a]).max() <= 1e-7 for b in ref):
+                ref.append(a)
+        np.testing.assert_array_equal(_first_distinct(idx, group, q, 1e-7), ref)

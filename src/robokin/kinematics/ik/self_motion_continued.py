@@ -353,8 +353,8 @@ class _ContinuedFamily(_Family):
         branches' tracks were pieces, most of them beyond the ``_MAX_TRACKS``
         longest (#6667 of the special poses: 38 of 88 in-limit regular rows in no
         interval). Run on a ``degenerate`` manifold and on one whose tracks are
-        such pieces (more than ``_MAX_TRACKS``). Each regular row (:func:`_regular`, with a slope) is continued to
-        both neighbouring nodes in ``_FILL_SUB`` Euler-Newton steps on the held
+        such pieces (more than ``_MAX_TRACKS``). Each regular row (:func:`_regular`,
+        with a slope) is continued to both neighbouring nodes in ``_FILL_SUB`` Euler-Newton steps on the held
         6 x 6 (every step reaching the pose to ``_EXACT``); a regular result farther
         than ``_SAME_ROW`` from every row of that node is added and continued in
         turn, until no row is added. Every added row is a solution of the pose at its
@@ -387,18 +387,16 @@ class _ContinuedFamily(_Family):
             # not a row of its node (nor one added before it in this round)
             near = _max_last(np.abs(_wrap(Q[dst] - q[:, None])))  # (p, K)
             ok &= ~np.any(near <= _SAME_ROW, axis=1)
-            new: list[int] = []  # candidates kept: one per (node, row)
-            for a in np.flatnonzero(ok).tolist():
-                if not any(dst[b] == dst[a] and np.max(np.abs(_wrap(q[b] - q[a]))) <= _SAME_ROW
-                           for b in new):
-                    new.append(a)
-            if not new:
+            add = _first_distinct(np.flatnonzero(ok), dst, q, _SAME_ROW)
+            if not add.size:
                 break
-            add = np.array(new)
             # each into its node's next free slot (valid rows first)
             slot = _finite_rows(Q).sum(axis=1)[dst[add]]
-            for a in range(1, len(add)):  # a second row added to one node: the slot after
-                slot[a] += int(np.count_nonzero(dst[add[:a]] == dst[add[a]]))
+            # a second row added to one node: the slot after (its rank among them)
+            order = np.argsort(dst[add], kind="stable")
+            ds = dst[add][order]
+            first = np.searchsorted(ds, ds, side="left")
+            slot[order] += np.arange(len(ds)) - first
             width = int(slot.max()) + 1
             if width > Q.shape[1]:
                 pad = np.full((m, width - Q.shape[1], Q.shape[2]), np.nan)
@@ -488,11 +486,19 @@ class _ContinuedFamily(_Family):
         ok &= _max_last(np.abs(_wrap(q - p))) < _ASSIGN
         if ok.any():
             ok[ok] = _regular(self.robot, q[ok], self.joint)
-        for a in np.flatnonzero(ok).tolist():
-            d = _max_last(np.abs(_wrap(out[mi[a]] - q[a])))  # (k,), NaN: no row
-            d[bi[a]] = np.inf  # (the slot's own singular row: replaced)
-            if not np.any(d <= _DISTINCT):
+        # more than _DISTINCT from every other track's row at t (its own slot's singular
+        # row is replaced): checked at once where a value has one candidate, in order
+        # (each against the rows placed before it) where it has more
+        d = _max_last(np.abs(_wrap(out[mi] - q[:, None])))  # (p, k), NaN: no row
+        d[np.arange(len(mi)), bi] = np.inf
+        alone = np.bincount(mi, minlength=len(t))[mi] == 1
+        one = ok & alone & ~np.any(d <= _DISTINCT, axis=1)
+        for a in np.flatnonzero(ok & ~alone).tolist():
+            d_a = _max_last(np.abs(_wrap(out[mi[a]] - q[a])))  # (k,)
+            d_a[bi[a]] = np.inf
+            if not np.any(d_a <= _DISTINCT):
                 out[mi[a], bi[a]] = q[a]
+        out[mi[one], bi[one]] = q[one]
 
     def _refined(self, Q: np.ndarray, valid: np.ndarray) -> None:
         """Rows Q (M, k, n) within 1e-9 of a limit refined in place (``LimitPolish``).
@@ -1385,6 +1391,27 @@ def _wrap(x: np.ndarray) -> np.ndarray:
 def _finite_rows(x: np.ndarray) -> np.ndarray:
     """``np.isfinite(x).all(-1)``, the last axis (the joints) reduced one column at a time."""
     return _all_last(np.isfinite(x))
+
+
+def _first_distinct(idx: np.ndarray, group: np.ndarray, q: np.ndarray, tol: float
+                    ) -> np.ndarray:
+    """The candidates idx (p,) of rows q kept: (kept,), in order.
+
+    Each is kept unless a kept one before it in its group (``group[idx]``) is within
+    ``tol`` [rad, 2 pi wrapped]. A candidate alone in its group is kept at once;
+    groups of several are taken in turn.
+    """
+    if idx.size < 2:
+        return idx
+    g = group[idx]
+    alone = np.bincount(g - g.min())[g - g.min()] == 1
+    keep = alone.copy()
+    for a in np.flatnonzero(~alone).tolist():
+        prior = idx[:a][keep[:a] & (g[:a] == g[a])]
+        keep[a] = not prior.size or bool(
+            np.all(_max_last(np.abs(_wrap(q[prior] - q[idx[a]]))) > tol))
+    out: np.ndarray = idx[keep]
+    return out
 
 
 def _max_last(x: np.ndarray) -> np.ndarray:
