@@ -2283,19 +2283,32 @@ static int g6_step(const vd *J, const vd *e, int l, double *dq)
  * (at most 40 halvings, 100 steps), from the lane's best. Also a lane within the
  * tolerance but above G6_TIGHT of it, with (tol_p, tol_r) the tight ones. Returns 1
  * when the lane now meets (tol_p, tol_r) (qv's lane l is then the refined point),
- * else 0 and qv is unchanged. */
+ * else 0 and qv is unchanged.
+ *
+ * The halvings are tried W at a time, one per lane (lane k: the step times 2^-(h0 +
+ * k)), and the first whose error falls is taken: the point one halving at a time
+ * would take, bit for bit (each lane's arithmetic is the scalar one's), at one pose
+ * and Jacobian per W halvings instead of one each (next to a near-continuum, the
+ * offset iiwa's stretched elbow, a lane takes ~6 halvings a step and most of its 100
+ * steps). The taken lane's pose and Jacobian are the next step's where its point is
+ * the updated one to the bit (always, unless the compiler contracts the two sums
+ * differently: then they are computed again). */
 static int g6_refine(const Chain *ch, const vd *tt, vd *qv, int l, double tol_p,
                      double tol_r, double floor_err)
 {
     vd qq[MAXJ], t[12], J[36], e[6];
     double q0[6], ep = 0.0, er = 0.0, m0 = 0.0;
+    int have = 0; /* J, e (lane 0) are those at q0 already: the taken halving's */
     for (int j = 0; j < 6; j++)
         q0[j] = qv[j][l];
     for (int it = 0; it < 100; it++) {
-        for (int j = 0; j < 6; j++)
-            qq[j] = BR(q0[j]);
-        chain_pose_jac(ch, qq, t, J, 6);
-        pose_residual(t, tt, e, BRL(-1));
+        if (!have) {
+            for (int j = 0; j < 6; j++)
+                qq[j] = BR(q0[j]);
+            chain_pose_jac(ch, qq, t, J, 6);
+            pose_residual(t, tt, e, BRL(-1));
+        }
+        have = 0;
         ep = sqrt(e[0][0] * e[0][0] + e[1][0] * e[1][0] + e[2][0] * e[2][0]);
         er = sqrt(e[3][0] * e[3][0] + e[4][0] * e[4][0] + e[5][0] * e[5][0]);
         m0 = 0.0;
@@ -2303,22 +2316,42 @@ static int g6_refine(const Chain *ch, const vd *tt, vd *qv, int l, double tol_p,
             m0 = fabs(e[r][0]) > m0 ? fabs(e[r][0]) : m0;
         if (!(m0 > floor_err))
             break;
-        double dq[6], lam = 1.0;
+        double dq[6];
         if (!g6_step(J, e, 0, dq))
             break;
         int moved = 0;
-        for (int h = 0; h < 40 && !moved; h++, lam *= 0.5) {
+        for (int h0 = 0; h0 < 40 && !moved; h0 += W) {
             vd qt[MAXJ], tq[12], Jt[36], et[6];
+            double lam[W];
+            for (int k = 0; k < W; k++)
+                lam[k] = ldexp(1.0, -(h0 + k)); /* 1, 1/2, ...: exact, as lam *= 0.5 */
             for (int j = 0; j < 6; j++)
-                qt[j] = BR(q0[j] + lam * dq[j]);
+                for (int k = 0; k < W; k++)
+                    qt[j][k] = q0[j] + lam[k] * dq[j];
             chain_pose_jac(ch, qt, tq, Jt, 6);
             pose_residual(tq, tt, et, BRL(-1));
-            double m = 0.0;
-            for (int r = 0; r < 6; r++)
-                m = fabs(et[r][0]) > m ? fabs(et[r][0]) : m;
-            if (m < m0) {
-                for (int j = 0; j < 6; j++)
-                    q0[j] += lam * dq[j];
+            for (int k = 0; k < W && h0 + k < 40 && !moved; k++) {
+                double m = 0.0;
+                for (int r = 0; r < 6; r++)
+                    m = fabs(et[r][k]) > m ? fabs(et[r][k]) : m;
+                if (!(m < m0))
+                    continue;
+                int same = 1;
+                for (int j = 0; j < 6; j++) {
+                    double tj = qt[j][k];
+                    unsigned long long a, b; /* the bits (-0.0, NaN) */
+                    q0[j] += lam[k] * dq[j];
+                    memcpy(&a, &q0[j], sizeof a);
+                    memcpy(&b, &tj, sizeof b);
+                    same &= a == b;
+                }
+                if (same) {
+                    for (int i = 0; i < 36; i++)
+                        J[i] = BR(Jt[i][k]);
+                    for (int r = 0; r < 6; r++)
+                        e[r] = BR(et[r][k]);
+                    have = 1;
+                }
                 moved = 1;
             }
         }
