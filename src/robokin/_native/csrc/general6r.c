@@ -2195,45 +2195,78 @@ static vd g6_sigma_min(const vd *J) { return jac_sigma_min6(J, 6); }
 #define SLOW_START 8
 #define G6_FAR 1e-6      /* ... while the error [m, rad] is above this: else spurious */
 
-/* One Levenberg-Marquardt step dq of lane l: the least-squares solution of
- * [J; sqrt(lam) I] dq = [e; 0] with lam = |e|^2 (Yamashita & Fukushima 2001:
- * quadratic convergence to a regular solution and onto a manifold of solutions,
- * where J is singular), by Householder QR of the 12 x 6 matrix (not the normal
- * equations, whose squared condition number stalls the error near a solution with
- * sigma ~ 1e-9); a step above 0.5 rad is shortened to it. Returns 0 when the step
- * is not finite. */
-static int g6_lm_step(const vd *J, const vd *e, int l, double *dq)
+/* Levenberg-Marquardt steps dq, one per lane in `lanes` (W at once; ok: the lanes
+ * whose step is finite): the least-squares solution of [J; sqrt(lam) I] dq = [e; 0]
+ * with lam = |e|^2 (Yamashita & Fukushima 2001: quadratic convergence to a regular
+ * solution and onto a manifold of solutions, where J is singular), by Householder QR
+ * of the 12 x 6 matrix (house_qr's steps, lane-wise; not the normal equations, whose
+ * squared condition number stalls the error near a solution with sigma ~ 1e-9); a
+ * step above 0.5 rad is shortened to it. Next to a near-continuum every candidate
+ * takes these steps (the offset iiwa's stretched elbow: ~40 % of its solves' time,
+ * one lane at a time before); a lone lane (g6_step) is broadcast, so every step of a
+ * lane is this arithmetic whichever way it comes. */
+static void g6_lm_steps(const vd *J, const vd *e, vl lanes, vd *dq, vl *ok)
 {
-    double A[6 * 12], V[6 * 12], beta[6], b[12], e2 = 0.0;
+    vd A[6 * 12], V[6 * 12], beta[6], b[12], e2 = BR(0.0);
     for (int r = 0; r < 6; r++)
-        e2 += e[r][l] * e[r][l];
-    const double mu = sqrt(e2) + 1e-300;
-    for (int j = 0; j < 6; j++) /* column-major, column j: J's, then mu e_j */
+        e2 += e[r] * e[r];
+    const vd mu = vsqrt(e2) + 1e-300;
+    for (int j = 0; j < 6; j++)
         for (int r = 0; r < 12; r++)
-            A[12 * j + r] = r < 6 ? J[6 * r + j][l] : (r - 6 == j ? mu : 0.0);
+            A[12 * j + r] = r < 6 ? J[6 * r + j] : (r - 6 == j ? mu : BR(0.0));
     for (int r = 0; r < 12; r++)
-        b[r] = r < 6 ? e[r][l] : 0.0;
-    house_qr(A, 12, 6, V, beta);
-    house_apply_t(V, beta, 12, 6, b);
-    double big = 0.0;
+        b[r] = r < 6 ? e[r] : BR(0.0);
+    for (int k = 0; k < 6; k++) {
+        vd *a = A + k * 12, *v = V + k * 12;
+        vd nrm = BR(0.0);
+        for (int i = k; i < 12; i++)
+            nrm += a[i] * a[i];
+        nrm = vsqrt(nrm);
+        vd alpha = vsel(a[k] > 0.0, -nrm, nrm);
+        v[k] = a[k] - alpha;
+        vd vv = v[k] * v[k];
+        for (int i = k + 1; i < 12; i++) {
+            v[i] = a[i];
+            vv += v[i] * v[i];
+        }
+        beta[k] = 2.0 / vv;
+        a[k] = alpha;
+        for (int j = k + 1; j < 6; j++) {
+            vd *c = A + j * 12, sj = BR(0.0);
+            for (int i = k; i < 12; i++)
+                sj += v[i] * c[i];
+            sj *= beta[k];
+            for (int i = k; i < 12; i++)
+                c[i] -= sj * v[i];
+        }
+        vd sk = BR(0.0);
+        for (int i = k; i < 12; i++)
+            sk += v[i] * b[i];
+        sk *= beta[k];
+        for (int i = k; i < 12; i++)
+            b[i] -= sk * v[i];
+    }
+    vd big = BR(0.0);
     for (int i = 5; i >= 0; i--) {
-        double acc = b[i];
+        vd acc = b[i];
         for (int k = i + 1; k < 6; k++)
             acc -= A[12 * k + i] * dq[k];
         dq[i] = acc / A[12 * i + i];
-        big = fabs(dq[i]) > big ? fabs(dq[i]) : big;
+        vd ad = vabs(dq[i]);
+        big = vsel(ad > big, ad, big);
     }
-    if (!isfinite(big))
-        return 0;
-    if (big > 0.5)
+    *ok = lanes & vfinite(big);
+    vl shorten = *ok & (big > 0.5);
+    if (vany(shorten)) {
+        vd f = 0.5 / vsel(shorten, big, BR(1.0));
         for (int i = 0; i < 6; i++)
-            dq[i] *= 0.5 / big;
-    return 1;
+            dq[i] = vsel(shorten, dq[i] * f, dq[i]);
+    }
 }
 
-/* One step dq of lane l: Newton's (LU with partial pivoting of J) where J is well
- * conditioned (its pivots within 1e-6 of each other), else g6_lm_step's. */
-static int g6_step(const vd *J, const vd *e, int l, double *dq)
+/* Newton's step dq of lane l (LU with partial pivoting of J) where J is well
+ * conditioned (its pivots within 1e-6 of each other): 1, else 0 (dq unset). */
+static int g6_newton_step(const vd *J, const vd *e, int l, double *dq)
 {
     double A[36];
     for (int r = 0; r < 6; r++) {
@@ -2253,7 +2286,24 @@ static int g6_step(const vd *J, const vd *e, int l, double *dq)
             return 1;
         }
     }
-    return g6_lm_step(J, e, l, dq);
+    return 0;
+}
+
+/* One step dq of lane l: g6_newton_step's, else g6_lm_steps' (lane l alone). */
+static int g6_step(const vd *J, const vd *e, int l, double *dq)
+{
+    if (g6_newton_step(J, e, l, dq))
+        return 1;
+    vd Jl[36], el[6], dqv[6];
+    vl ok;
+    for (int i = 0; i < 36; i++)
+        Jl[i] = BR(J[i][l]);
+    for (int r = 0; r < 6; r++)
+        el[r] = BR(e[r][l]);
+    g6_lm_steps(Jl, el, BRL(-1), dqv, &ok);
+    for (int i = 0; i < 6; i++)
+        dq[i] = dqv[i][0];
+    return ok[0] != 0;
 }
 
 /* Polish the candidates (chain values) towards T, W at a time, by the steps above
@@ -2531,16 +2581,32 @@ static int g6_polish(const Chain *ch, const double *P, const double *T, const G6
             }
             if (all || it == max_iter)
                 break;
+            vl lm = BRL(0); /* lanes whose Newton step is refused: g6_lm_steps, at once */
             for (int l = 0; l < W; l++) {
                 double dq[6];
                 if (done[l])
                     continue;
-                if (!g6_step(J, e, l, dq)) {
-                    done[l] = -1;
+                if (!g6_newton_step(J, e, l, dq)) {
+                    lm[l] = -1;
                     continue;
                 }
                 for (int j = 0; j < 6; j++)
                     qv[j][l] += dq[j];
+            }
+            if (vany(lm)) {
+                vd dqv[6];
+                vl ok;
+                g6_lm_steps(J, e, lm, dqv, &ok);
+                for (int l = 0; l < W; l++) {
+                    if (!lm[l])
+                        continue;
+                    if (!ok[l]) {
+                        done[l] = -1;
+                        continue;
+                    }
+                    for (int j = 0; j < 6; j++)
+                        qv[j][l] += dqv[j][l];
+                }
             }
         }
         int worse = 0; /* a lane that ended above its best: back to the best */
