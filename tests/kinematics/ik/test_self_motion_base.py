@@ -64,3 +64,107 @@ def test_into_limits_quick_test_moves_nothing_it_skips():
             assert not quick or not (up | down).any()
             taken[quick] += 1
     assert taken[True] > 100 and taken[False] > 20, taken
+
+
+def _bisected(f, lo, hi, steps=200):
+    # Oracle: plain bisection on the sign of f (the low end's sign kept) to adjacent
+    # doubles; also its step count.
+    lo, hi = np.array(lo, float), np.array(hi, float)
+    s_lo = np.sign(f(lo))
+    n = 0
+    while n < steps:
+        mid = 0.5 * (lo + hi)
+        go = (mid != lo) & (mid != hi)
+        if not go.any():
+            break
+        same = np.sign(f(mid)) == s_lo
+        lo, hi = np.where(go & same, mid, lo), np.where(go & ~same, mid, hi)
+        n += 1
+    return lo, hi, n
+
+
+def test_shrunk_brackets_are_bisections_in_a_third_of_the_steps():
+    # Monotone smooth functions with roots at special places (0, a limit value, a root
+    # next to an end, 1e-9): the bracket is bisection's own pair of adjacent doubles (a
+    # single sign change), in at most half of bisection's steps.
+    from robokin.kinematics.ik.self_motion_base import _shrunk
+
+    c = np.array([0.0, 2.9670597283903604, -1.7453292519943295, 0.3, 1e-9])
+    lo = np.array([-0.3, 2.9, -1.8, -1.0, -0.02])
+    hi = np.array([0.25, 3.1, -1.7453292519943, 2.0, 0.03])
+    k = np.array([1.0, -3.0, 0.5, 1.0, 2.0])
+
+    def f(t, a=slice(None)):
+        x = t - c[a]
+        return k[a] * (x + x ** 3)
+
+    s_lo = np.sign(f(lo))
+    calls = []
+
+    def side(t, a):
+        calls.append(len(a))
+        v = f(t, a)
+        return v, np.sign(v) == s_lo[a], np.isfinite(v)
+
+    out_lo, out_hi, found = _shrunk(side, lo, hi, f(lo), f(hi), 240)
+    ref_lo, ref_hi, _ = _bisected(f, lo, hi)
+    assert found.all()
+    # away from 0: bisection's adjacent doubles exactly
+    assert np.array_equal(out_lo[1:], ref_lo[1:]) and np.array_equal(out_hi[1:], ref_hi[1:])
+    assert (np.nextafter(out_lo[1:], out_hi[1:]) == out_hi[1:]).all()
+    # a root at 0 (doubles down to 5e-324 there): straddled within 1e-20, as bisection's
+    # 60 steps leave it within 5e-19
+    assert out_lo[0] < 0.0 <= out_hi[0] and out_hi[0] - out_lo[0] < 1e-20
+    # the steps: the others alone (the root at 0 goes on into the subnormals), at most
+    # half of bisection's (55 here)
+    calls.clear()
+    a = np.arange(1, 5)
+    _shrunk(lambda t, i: side(t, a[i]), lo[a], hi[a], f(lo)[a], f(hi)[a], 240)
+    assert len(calls) <= _bisected(lambda t: f(t, a), lo[a], hi[a])[2] // 2
+    # the inputs are not changed in place
+    assert lo[0] == -0.3 and hi[1] == 3.1
+
+
+def test_shrunk_without_end_values_and_a_bracket_given_up():
+    # NaN at an end (no row: a state change's outer end) still reaches adjacent doubles
+    # by midpoints; a bracket whose side() is not ok at a step is given up (found False).
+    from robokin.kinematics.ik.self_motion_base import _shrunk
+
+    c = np.array([0.125, 1.0])
+    lo, hi = np.array([0.0, 0.0]), np.array([1.0, 2.0])
+
+    def side(t, a):
+        v = t - c[a]
+        ok = ~((a == 1) & (t > 0.9) & (t < 1.1))  # bracket 1 loses its row next to its root
+        return np.where(ok, v, np.nan), v < 0, ok
+
+    out_lo, out_hi, found = _shrunk(side, lo, hi, np.array([np.nan, -1.0]),
+                                    np.array([0.875, np.nan]), 240)
+    assert found.tolist() == [True, False]
+    assert out_lo[0] < 0.125 <= out_hi[0] and np.nextafter(out_lo[0], 1.0) == out_hi[0]
+
+
+def test_shrunk_on_a_noisy_sign_change_ends_on_one():
+    # Rounding noise of 1e-13 around a root (the rows' own, next to a singularity):
+    # the side changes many times within ~1e-13; the bracket is two adjacent doubles
+    # whose sides differ.
+    from robokin.kinematics.ik.self_motion_base import _shrunk
+
+    rng = np.random.default_rng(7)
+    c = rng.uniform(-3.0, 3.0, 40)
+    lo, hi = c - rng.uniform(1e-3, 0.5, 40), c + rng.uniform(1e-3, 0.5, 40)
+
+    def f(t, a=slice(None)):
+        return (t - c[a]) * (1.0 + (t - c[a]) ** 2) + 1e-13 * np.sin(1e15 * t)
+
+    s_lo = np.sign(f(lo))
+
+    def side(t, a):
+        v = f(t, a)
+        return v, np.sign(v) == s_lo[a], np.ones(len(a), bool)
+
+    out_lo, out_hi, found = _shrunk(side, lo, hi, f(lo), f(hi), 240)
+    assert found.all()
+    assert (np.nextafter(out_lo, out_hi) == out_hi).all()
+    assert (np.sign(f(out_lo)) == s_lo).all() and (np.sign(f(out_hi)) != s_lo).all()
+    assert (np.abs(out_lo - c) < 1e-12).all()

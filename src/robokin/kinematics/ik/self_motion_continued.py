@@ -74,7 +74,7 @@ import numpy as np
 from robokin._native import kernels as _K
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.fixed import Dispatch, EndSweep, _all_last, solve_fixed
-from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
+from robokin.kinematics.ik.self_motion_base import _Family, _into_limits, _shrunk
 from robokin.kinematics.ik.self_motion_polish import REGULAR_FLOOR, LimitPolish
 from robokin.kinematics.jacobian import jacobian_and_pose
 from robokin.spatial import pose_error
@@ -879,7 +879,7 @@ class _ContinuedFamily(_Family):
             return empty
         ts = np.concatenate([np.linspace(a, e, _ISLAND_SCAN) for _, a, e in isl])
         rows, valid, _ = self.sample_rows(ts)
-        lo_l, hi_l, s_l, b_l, j_l, v_l, q_l = [], [], [], [], [], [], []
+        lo_l, hi_l, fl_l, fh_l, b_l, j_l, v_l, q_l = [], [], [], [], [], [], [], []
         for n_i, (b, _, _) in enumerate(isl):
             sl = slice(n_i * _ISLAND_SCAN, (n_i + 1) * _ISLAND_SCAN)
             tt, r, ok = ts[sl], rows[sl, b], valid[sl, b]
@@ -894,7 +894,8 @@ class _ContinuedFamily(_Family):
                         continue
                     lo_l.append(tt[c])
                     hi_l.append(tt[c + 1])
-                    s_l.append(sg[c])
+                    fl_l.append(g[c])
+                    fh_l.append(g[c + 1])
                     b_l.append(b)
                     j_l.append(j)
                     v_l.append(v)
@@ -902,8 +903,8 @@ class _ContinuedFamily(_Family):
         if not lo_l:
             return empty
         lo, hi = np.array(lo_l), np.array(hi_l)
-        t, r, found = self._bisect_rows(lo, hi, np.array(s_l), np.array(b_l), np.array(j_l),
-                                        np.array(v_l))
+        t, r, found = self._bisect_rows(lo, hi, np.array(fl_l), np.array(fh_l), np.array(b_l),
+                                        np.array(j_l), np.array(v_l))
         # a bisection whose rows end (the track through a singular point, #5140's q1
         # at its limit where tracks 12 and 13 meet): cut at its last bracket's middle
         # (rows NaN), the pieces either side decided on their rows
@@ -948,10 +949,10 @@ class _ContinuedFamily(_Family):
         ``br``: the model's sub-cell ``[a, e]``, then its cell ``[a, e]`` (taken where
         the branch's rows at the sub-cell's ends do not straddle the value: the
         model's sign change is not the rows', e.g. a fast passage in the cell).
-        Bisection on the sign of q_j - v of the branch's rows (``sample_rows``, the
-        held 6 x 6 with t held: regular where the one with the joint held is not),
-        to adjacent doubles. Returns ``(t, rows, found)``: found where the rows at
-        the bracket's ends exist and straddle the value.
+        The sign change of q_j - v on the branch's rows (``sample_rows``, the held
+        6 x 6 with t held: regular where the one with the joint held is not), shrunk
+        to adjacent doubles (:meth:`_bisect_rows`). Returns ``(t, rows, found)``: found
+        where the rows at the bracket's ends exist and straddle the value.
         """
         p = len(b)
         ends = br.T.ravel()  # (4 p,): the sub-cells' ends, then the cells'
@@ -959,8 +960,9 @@ class _ContinuedFamily(_Family):
         q, valid, _ = self.sample_rows(ends)
         r = q[np.arange(4 * p), b4]
         with np.errstate(invalid="ignore"):
-            s4 = np.sign(_wrap(r[np.arange(4 * p), j4] - v4))
-        s4 = np.where(valid[np.arange(4 * p), b4], s4, np.nan).reshape(4, p)
+            g4 = _wrap(r[np.arange(4 * p), j4] - v4)
+        g4 = np.where(valid[np.arange(4 * p), b4], g4, np.nan).reshape(4, p)
+        s4 = np.sign(g4)
         sub = s4[0] * s4[1] < 0
         found = sub | (s4[2] * s4[3] < 0)
         t_out = np.full(p, np.nan)
@@ -970,43 +972,39 @@ class _ContinuedFamily(_Family):
         keep = np.flatnonzero(found)  # only the straddling brackets are bisected
         t_k, r_k, f_k = self._bisect_rows(np.where(sub, br[:, 0], br[:, 2])[keep],
                                           np.where(sub, br[:, 1], br[:, 3])[keep],
-                                          np.where(sub, s4[0], s4[2])[keep],
+                                          np.where(sub, g4[0], g4[2])[keep],
+                                          np.where(sub, g4[1], g4[3])[keep],
                                           b[keep], j[keep], v[keep])
         t_out[keep], rows_out[keep] = t_k, r_k
         found[keep] = f_k
         return t_out, rows_out, found
 
-    def _bisect_rows(self, lo: np.ndarray, hi: np.ndarray, s_lo: np.ndarray, b: np.ndarray,
-                     j: np.ndarray, v: np.ndarray
+    def _bisect_rows(self, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: np.ndarray,
+                     b: np.ndarray, j: np.ndarray, v: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`_bisected`'s bisection of straddling brackets [lo, hi] (sign s_lo at lo)."""
-        p = len(b)
-        found = np.ones(p, bool)
+        """:meth:`_bisected`'s straddling brackets [lo, hi] shrunk to adjacent doubles.
 
-        def side(t: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            """(signs, rows) of brackets a at t (len(a),)."""
+        f_lo, f_hi: q_j - v (wrapped) of the branch's rows at the ends, of opposite
+        signs. :func:`_shrunk` on the branch's rows (``sample_rows``); a bracket whose
+        rows end (no row assigned at a step's value) is given up.
+        """
+        p = len(b)
+
+        def side(t: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            """(q_j - v, on the low end's side, a row there) of brackets a at t (len(a),)."""
             q, valid, _ = self.sample_rows(t)
             i = np.arange(len(a))
-            r = q[i, b[a]]
             with np.errstate(invalid="ignore"):
-                s = np.sign(_wrap(r[i, j[a]] - v[a]))
-            return np.where(valid[i, b[a]], s, np.nan), r
+                f = np.where(valid[i, b[a]], _wrap(q[i, b[a], j[a]] - v[a]), np.nan)
+            return f, np.sign(f) == np.sign(f_lo[a]), np.isfinite(f)
 
-        for _ in range(_BISECT):
-            mid = 0.5 * (lo + hi)
-            # a bracket whose rows end (no row assigned at a midpoint) is given up
-            a = np.flatnonzero(found & (mid != lo) & (mid != hi))
-            if not a.size:
-                break
-            s_mid, _ = side(mid[a], a)
-            same = s_mid == s_lo[a]
-            lo[a], hi[a] = np.where(same, mid[a], lo[a]), np.where(same, hi[a], mid[a])
-            found[a] &= np.isfinite(s_mid)
+        lo, hi, found = _shrunk(side, lo, hi, f_lo, f_hi, 4 * _BISECT)
         t = np.where(found, 0.5 * (lo + hi), np.nan)
         rows = np.full((p, self.robot.n), np.nan)
         a = np.flatnonzero(found)
         if a.size:
-            _, rows[a] = side(t[a], a)
+            q, _, _ = self.sample_rows(t[a])
+            rows[a] = q[np.arange(len(a)), b[a]]
         found &= _finite_rows(rows)
         return t, rows, found
 

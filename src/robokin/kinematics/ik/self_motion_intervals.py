@@ -16,7 +16,7 @@ import numpy as np
 from robokin._native import kernels as K
 from robokin._validation import ROTATION_EXACT
 from robokin.kinematics.arm import Arm
-from robokin.kinematics.ik.self_motion_base import _Family, _into_limits
+from robokin.kinematics.ik.self_motion_base import _Family, _into_limits, _shrunk
 from robokin.kinematics.ik.self_motion_families import (
     HeldKernel,
     LimitCrossing,
@@ -560,24 +560,29 @@ def _node_cuts(fam: _Family, limits: np.ndarray, intervals: np.ndarray, owner: n
 def _state_change(fam: _Family, limits: np.ndarray, lo: np.ndarray, hi: np.ndarray,
                   s0: np.ndarray, bb: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Changes of state (inside every limit or not) on branch rows, bisected.
+    """Changes of state (inside every limit or not) on branch rows, to adjacent doubles.
 
     ``lo``, ``hi`` (p,): brackets of branches ``bb`` (p,), the state at ``lo`` ``s0``
-    (p,) and the other at ``hi``; each is halved on ``fam.slot_rows`` (one batch per
-    step) to adjacent doubles. Returns the last in-limit value (p,), and the joint
-    furthest out past it (p,) with its side ``"lower"``/``"upper"`` (p,): a limit
-    crossing there (joint 0 where the outer value has no row).
+    (p,) and the other at ``hi``; each is shrunk on ``fam.slot_rows`` (one batch per
+    step) by :func:`_shrunk`, on the rows' margin inside the limits (the slack less
+    the farthest any joint is past its limit: >= 0 inside, NaN without a row, which
+    is outside). Returns the last in-limit value (p,), and the joint furthest out
+    past it (p,) with its side ``"lower"``/``"upper"`` (p,): a limit crossing there
+    (joint 0 where the outer value has no row).
     """
-    lo, hi = lo.copy(), hi.copy()
-    for _ in range(_BISECT):
-        mid = 0.5 * (lo + hi)
-        go = np.flatnonzero((mid != lo) & (mid != hi))
-        if not len(go):
-            break
-        q, v = fam.slot_rows(mid[go], bb[go])
-        now = v & _within(q, limits)
-        same = now == s0[go]
-        lo[go], hi[go] = np.where(same, mid[go], lo[go]), np.where(same, hi[go], mid[go])
+    def margin(t: np.ndarray, b: np.ndarray) -> np.ndarray:
+        q, v = fam.slot_rows(t, b)
+        with np.errstate(invalid="ignore"):
+            m = MANIFOLD_SLACK - np.maximum(limits[:, 0] - q, q - limits[:, 1]).max(axis=-1)
+        return np.where(v, m, np.nan)
+
+    def side(t: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        m = margin(t, bb[a])
+        return m, (m >= 0.0) == s0[a], np.ones(len(a), dtype=bool)
+
+    if len(lo):
+        m0 = margin(np.concatenate([lo, hi]), np.tile(bb, 2))
+        lo, hi, _ = _shrunk(side, lo, hi, m0[:len(lo)], m0[len(lo):], 4 * _BISECT)
     inner, outer = np.where(s0, lo, hi), np.where(s0, hi, lo)
     q_out, _ = fam.slot_rows(outer, bb)
     with np.errstate(invalid="ignore"):
