@@ -576,13 +576,13 @@ def _state_change(fam: _Family, limits: np.ndarray, lo: np.ndarray, hi: np.ndarr
             m = MANIFOLD_SLACK - np.maximum(limits[:, 0] - q, q - limits[:, 1]).max(axis=-1)
         return np.where(v, m, np.nan)
 
-    def side(t: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def state(t: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         m = margin(t, bb[a])
         return m, (m >= 0.0) == s0[a], np.ones(len(a), dtype=bool)
 
     if len(lo):
         m0 = margin(np.concatenate([lo, hi]), np.tile(bb, 2))
-        lo, hi, _ = _shrunk(side, lo, hi, m0[:len(lo)], m0[len(lo):], 4 * _BISECT)
+        lo, hi, _ = _shrunk(state, lo, hi, m0[:len(lo)], m0[len(lo):], 4 * _BISECT)
     inner, outer = np.where(s0, lo, hi), np.where(s0, hi, lo)
     q_out, _ = fam.slot_rows(outer, bb)
     with np.errstate(invalid="ignore"):
