@@ -168,3 +168,70 @@ def test_shrunk_on_a_noisy_sign_change_ends_on_one():
     assert (np.nextafter(out_lo, out_hi) == out_hi).all()
     assert (np.sign(f(out_lo)) == s_lo).all() and (np.sign(f(out_hi)) != s_lo).all()
     assert (np.abs(out_lo - c) < 1e-12).all()
+
+
+def test_shrunk_stops_where_both_ends_are_within_the_noise():
+    # With tol, a noisy bracket stops once both ends' own values are within tol of 0
+    # (not at adjacent doubles), in fewer steps than without; the ends keep their sides
+    # (the low end's side at lo, the other at hi) and the root lies between them.
+    from robokin.kinematics.ik.self_motion_base import _shrunk
+
+    rng = np.random.default_rng(11)
+    c = rng.uniform(-3.0, 3.0, 40)
+    lo, hi = c - rng.uniform(1e-3, 0.5, 40), c + rng.uniform(1e-3, 0.5, 40)
+
+    def f(t, a=slice(None)):
+        return (t - c[a]) * (1.0 + (t - c[a]) ** 2) + 1e-13 * np.sin(1e15 * t)
+
+    s_lo = np.sign(f(lo))
+    calls = []
+
+    def side(t, a):
+        calls.append(len(a))
+        v = f(t, a)
+        return v, np.sign(v) == s_lo[a], np.ones(len(a), bool)
+
+    _shrunk(side, lo, hi, f(lo), f(hi), 240)
+    exact = sum(calls)
+    calls.clear()
+    out_lo, out_hi, found = _shrunk(side, lo, hi, f(lo), f(hi), 240, tol=1e-12)
+    assert found.all() and sum(calls) < exact
+    assert (np.sign(f(out_lo)) == s_lo).all() and (np.sign(f(out_hi)) != s_lo).all()
+    adjacent = np.nextafter(out_lo, out_hi) == out_hi
+    near = (np.abs(f(out_lo)) <= 1e-12) & (np.abs(f(out_hi)) <= 1e-12)
+    assert (adjacent | near).all() and near.any()
+    assert (np.abs(out_lo - c) < 2e-12).all() and (np.abs(out_hi - c) < 2e-12).all()
+
+
+def test_shrunk_takes_a_bracket_from_either_end():
+    # lo above hi (a run's start bracketed from its in-limit node back): a pair of
+    # adjacent doubles at the same sign change as the bracket the other way round, in as
+    # few steps (_node_fills brackets a run's start so: such a bracket must not be only halved).
+    from robokin.kinematics.ik.self_motion_base import _shrunk
+
+    c = np.array([0.08835, -1.2])
+    up_lo, up_hi = c - np.array([0.02, 0.3]), c + np.array([0.013, 0.1])
+
+    def f(t, a=slice(None)):
+        return np.tanh(3.0 * (t - c[a])) + 0.1 * (t - c[a]) ** 2
+
+    calls = []
+
+    def make(s_lo):
+        def side(t, a):
+            calls.append(len(a))
+            v = f(t, a)
+            return v, np.sign(v) == s_lo[a], np.ones(len(a), bool)
+        return side
+
+    lo1, hi1, ok1 = _shrunk(make(np.sign(f(up_lo))), up_lo, up_hi, f(up_lo), f(up_hi), 240)
+    n_up = len(calls)
+    calls.clear()
+    lo2, hi2, ok2 = _shrunk(make(np.sign(f(up_hi))), up_hi, up_lo, f(up_hi), f(up_lo), 240)
+    assert ok1.all() and ok2.all()
+    assert (np.nextafter(lo1, hi1) == hi1).all() and (lo1 < hi1).all()
+    assert (np.nextafter(lo2, hi2) == hi2).all() and (lo2 > hi2).all()
+    # the same sign change (f's sides at the pair: the low end's, then the other)
+    assert (np.sign(f(lo2)) != np.sign(f(hi2))).all()
+    assert (np.abs(hi2 - lo1) <= 2 * np.spacing(np.abs(c))).all()
+    assert len(calls) <= n_up + 2 and n_up <= 20

@@ -106,11 +106,19 @@ class _Family:
 Side = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
 #: ``_shrunk``: every ``_PACE`` steps a bracket not shrunk 2^_PACE times takes a midpoint.
 _PACE = 3
+#: The width [in t] at which the self-motion's crossing and state brackets are done:
+#: 4 ulps of 1 (a joint moving at 1e3 rad per unit of t, next to a singularity, is then
+#: within 1e-12 of its value, the kernels' HM_TOL; elsewhere much closer).
+FINE_T = 2.0 ** -50
 
 
 def _shrunk(side: Side, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: np.ndarray,
-            steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            steps: int, tol: float = 0.0, fine: float = 0.0
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Brackets [lo, hi] (p,) of a change of side, shrunk to two adjacent doubles.
+
+    lo is the end of the known side; it may lie above hi (a run's start, bracketed from
+    its in-limit node back to the node before).
 
     ``side(t, a)`` says for brackets a whether t is on the low end's side and gives a
     value that changes sign with the side (f_lo, f_hi (p,): the values at the ends;
@@ -125,8 +133,14 @@ def _shrunk(side: Side, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: 
     scratch trials): session 19, the continued family's crossings and state changes,
     each step a held solve (~1 ms next to a near-continuum). The bracket is
     bisection's where the side changes once in it; where rounding changes it several
-    times within a few ulps, another of those changes. Returns ``(lo, hi, found)``:
-    found False where ``side`` gave up. The arguments are not changed.
+    times within a few ulps, another of those changes. A bracket whose ends' values
+    are both within ``tol`` of 0 is done as it is (the rows' own rounding: its
+    remaining steps would pick among the noise's sign changes), and one at most
+    ``fine`` wide (next to t = 0 the doubles are much closer than elsewhere; a jump of
+    the rows, e.g. between a followed and a solved row, is no sign change regula falsi
+    can close in on: measured at the offset iiwa's home pose, 1e-11 across one ulp).
+    Returns ``(lo, hi, found)``: found False where ``side`` gave up. The arguments are
+    not changed.
     """
     lo, hi = np.array(lo, dtype=np.float64), np.array(hi, dtype=np.float64)
     f_lo, f_hi = np.array(f_lo, dtype=np.float64), np.array(f_hi, dtype=np.float64)
@@ -135,27 +149,34 @@ def _shrunk(side: Side, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: 
     kept = np.zeros(p, dtype=np.int8)  # the end the last step kept: 1 low, -1 high
     halve = np.zeros(p, dtype=bool)  # the next step at the midpoint
     since = np.zeros(p, dtype=np.int64)  # steps since the last pace check
-    width = hi - lo  # the width at the last pace check
+    width = np.abs(hi - lo)  # the width at the last pace check
+    # the ends' own values (f_lo, f_hi are Illinois-halved): within tol at both, done
+    near = np.abs(f_lo) <= tol
+    near_hi = np.abs(f_hi) <= tol
     for _ in range(steps):
         mid = 0.5 * (lo + hi)
-        a = np.flatnonzero(found & (mid != lo) & (mid != hi))
+        a = np.flatnonzero(found & (mid != lo) & (mid != hi) & ~(near & near_hi)
+                           & (np.abs(hi - lo) > fine))
         if not a.size:
             break
         la, ha, fl, fh = lo[a], hi[a], f_lo[a], f_hi[a]
         with np.errstate(all="ignore"):
             t = (la * fh - ha * fl) / (fh - fl)
-            t = np.where(halve[a] | ~((t > la) & (t < ha)), mid[a], t)  # (NaN: mid)
+            inside = (t > np.minimum(la, ha)) & (t < np.maximum(la, ha))  # (either order)
+            t = np.where(halve[a] | ~inside, mid[a], t)  # (NaN: mid)
         t = np.where(fh == 0.0, np.nextafter(ha, la), np.where(fl == 0.0, np.nextafter(la, ha), t))
         f, same, ok = side(t, a)
         found[a] &= ok
         lo_new, hi_new = np.where(same, t, la), np.where(same, ha, t)
+        close = np.abs(f) <= tol
+        near[a], near_hi[a] = np.where(same, close, near[a]), np.where(same, near_hi[a], close)
         f_lo[a] = np.where(same, f, np.where(kept[a] == 1, 0.5 * fl, fl))
         f_hi[a] = np.where(same, np.where(kept[a] == -1, 0.5 * fh, fh), f)
         kept[a] = np.where(same, -1, 1)
         since[a] += 1
         check = since[a] >= _PACE
-        halve[a] = check & (hi_new - lo_new > width[a] / 2.0 ** _PACE)
-        width[a] = np.where(check, hi_new - lo_new, width[a])
+        halve[a] = check & (np.abs(hi_new - lo_new) > width[a] / 2.0 ** _PACE)
+        width[a] = np.where(check, np.abs(hi_new - lo_new), width[a])
         since[a] = np.where(check, 0, since[a])
         lo[a], hi[a] = lo_new, hi_new
     return lo, hi, found

@@ -74,7 +74,12 @@ import numpy as np
 from robokin._native import kernels as _K
 from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.fixed import Dispatch, EndSweep, _all_last, solve_fixed
-from robokin.kinematics.ik.self_motion_base import _Family, _into_limits, _shrunk
+from robokin.kinematics.ik.self_motion_base import (
+    FINE_T,
+    _Family,
+    _into_limits,
+    _shrunk,
+)
 from robokin.kinematics.ik.self_motion_polish import REGULAR_FLOOR, LimitPolish
 from robokin.kinematics.jacobian import jacobian_and_pose
 from robokin.spatial import pose_error
@@ -141,6 +146,10 @@ _ISLAND_SCAN = 33
 _SLACK: float = _K.MANIFOLD_SLACK
 #: Bisection steps of a fold (a cell to two adjacent doubles).
 _BISECT = 60
+#: A crossing's bracket whose ends' rows are both this close to the value [rad] is
+#: done (:func:`_shrunk`): the rows' rounding next to a singularity (~1e-13), a tenth of
+#: the membership slack; its middle is the crossing, as the kernels' (within 1e-12).
+_ROW_NOISE = 1e-13
 #: Followed rows (``sample_rows``): each Newton step at most ``_CONTRACT`` times the
 #: previous one squared while that is above ``_FLOOR``, the first at most
 #: 1 / (4 ``_CONTRACT``) [rad]; rows pairwise more than ``_DISTINCT`` apart.
@@ -985,7 +994,8 @@ class _ContinuedFamily(_Family):
         """:meth:`_bisected`'s straddling brackets [lo, hi] shrunk to adjacent doubles.
 
         f_lo, f_hi: q_j - v (wrapped) of the branch's rows at the ends, of opposite
-        signs. :func:`_shrunk` on the branch's rows (``sample_rows``); a bracket whose
+        signs. :func:`_shrunk` on the branch's rows (``sample_rows``), to adjacent
+        doubles, ``FINE_T`` wide, or ends both within ``_ROW_NOISE`` of the value; a bracket whose
         rows end (no row assigned at a step's value) is given up.
         """
         p = len(b)
@@ -998,7 +1008,7 @@ class _ContinuedFamily(_Family):
                 f = np.where(valid[i, b[a]], _wrap(q[i, b[a], j[a]] - v[a]), np.nan)
             return f, np.sign(f) == np.sign(f_lo[a]), np.isfinite(f)
 
-        lo, hi, found = _shrunk(side, lo, hi, f_lo, f_hi, 4 * _BISECT)
+        lo, hi, found = _shrunk(side, lo, hi, f_lo, f_hi, 4 * _BISECT, _ROW_NOISE, FINE_T)
         t = np.where(found, 0.5 * (lo + hi), np.nan)
         rows = np.full((p, self.robot.n), np.nan)
         a = np.flatnonzero(found)

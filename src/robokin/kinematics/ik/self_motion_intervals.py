@@ -16,7 +16,12 @@ import numpy as np
 from robokin._native import kernels as K
 from robokin._validation import ROTATION_EXACT
 from robokin.kinematics.arm import Arm
-from robokin.kinematics.ik.self_motion_base import _Family, _into_limits, _shrunk
+from robokin.kinematics.ik.self_motion_base import (
+    FINE_T,
+    _Family,
+    _into_limits,
+    _shrunk,
+)
 from robokin.kinematics.ik.self_motion_families import (
     HeldKernel,
     LimitCrossing,
@@ -35,6 +40,9 @@ MANIFOLD_SLACK: float = K.MANIFOLD_SLACK
 GRID = 721
 #: Bisection steps (a 2 pi domain to 2**-52 of its width).
 _BISECT = 56
+#: ``_state_change``: a bracket whose ends' margins are both this close to 0 [rad] is
+#: done (the rows' rounding next to a singularity, a tenth of the slack).
+_STATE_NOISE = 1e-13
 _TWO_PI = 2 * np.pi
 #: A range end's row is solved for a corner only where the continued family's track
 #: there is within this of every limit [rad] (its nodes are solved rows).
@@ -566,7 +574,9 @@ def _state_change(fam: _Family, limits: np.ndarray, lo: np.ndarray, hi: np.ndarr
     (p,) and the other at ``hi``; each is shrunk on ``fam.slot_rows`` (one batch per
     step) by :func:`_shrunk`, on the rows' margin inside the limits (the slack less
     the farthest any joint is past its limit: >= 0 inside, NaN without a row, which
-    is outside). Returns the last in-limit value (p,), and the joint furthest out
+    is outside), to adjacent doubles, ``FINE_T`` wide, or ends both within
+    ``_STATE_NOISE`` of the state's edge (the in-limit end is one whose row was found
+    inside). Returns the last in-limit value (p,), and the joint furthest out
     past it (p,) with its side ``"lower"``/``"upper"`` (p,): a limit crossing there
     (joint 0 where the outer value has no row).
     """
@@ -582,7 +592,8 @@ def _state_change(fam: _Family, limits: np.ndarray, lo: np.ndarray, hi: np.ndarr
 
     if len(lo):
         m0 = margin(np.concatenate([lo, hi]), np.tile(bb, 2))
-        lo, hi, _ = _shrunk(state, lo, hi, m0[:len(lo)], m0[len(lo):], 4 * _BISECT)
+        lo, hi, _ = _shrunk(state, lo, hi, m0[:len(lo)], m0[len(lo):], 4 * _BISECT,
+                            _STATE_NOISE, FINE_T)
     inner, outer = np.where(s0, lo, hi), np.where(s0, hi, lo)
     q_out, _ = fam.slot_rows(outer, bb)
     with np.errstate(invalid="ignore"):
