@@ -235,3 +235,27 @@ def test_shrunk_takes_a_bracket_from_either_end():
     assert (np.sign(f(lo2)) != np.sign(f(hi2))).all()
     assert (np.abs(hi2 - lo1) <= 2 * np.spacing(np.abs(c))).all()
     assert len(calls) <= n_up + 2 and n_up <= 20
+
+
+def test_shrunk_halves_a_run_of_exact_zeros():
+    # f exactly 0 on [0.2, 0.6] (a joint held at its value to the bit): the neighbouring
+    # double of a zero end is probed, but the pace's midpoints still halve the bracket,
+    # so it ends at adjacent doubles within bisection's reach, not an ulp at a time.
+    from robokin.kinematics.ik.self_motion_base import _shrunk
+
+    lo, hi = np.array([0.0]), np.array([1.0])
+
+    def f(t):
+        return np.where(t < 0.2, t - 0.2, np.where(t > 0.6, t - 0.6, 0.0))
+
+    calls = []
+
+    def side(t, a):
+        calls.append(len(a))
+        v = f(t)
+        return v, v < 0.0, np.ones(len(a), bool)
+
+    out_lo, out_hi, found = _shrunk(side, lo, hi, f(lo), f(hi), 240)
+    assert found.all() and np.nextafter(out_lo, out_hi) == out_hi
+    assert f(out_lo)[0] < 0.0 and f(out_hi)[0] == 0.0 and 0.19 < out_lo[0] < 0.21
+    assert len(calls) <= 120

@@ -128,7 +128,7 @@ def _shrunk(side: Side, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: 
     and where the last ``_PACE`` steps did not shrink the bracket ``2^_PACE`` times
     (so it shrinks at least as fast as bisection's every ``_PACE + 1`` steps: ``steps``
     = 4 x bisection's reaches the same adjacent doubles); next to an end whose value
-    is exactly 0 the neighbouring double. A smooth sign change takes ~8-11 steps
+    is exactly 0 the neighbouring double, once per bracket. A smooth sign change takes ~8-11 steps
     against bisection's ~53, one with rounding noise of 1e-13 ~15 (27 at most in 300
     scratch trials): session 19, the continued family's crossings and state changes,
     each step a held solve (~1 ms next to a near-continuum). The bracket is
@@ -149,6 +149,7 @@ def _shrunk(side: Side, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: 
     kept = np.zeros(p, dtype=np.int8)  # the end the last step kept: 1 low, -1 high
     halve = np.zeros(p, dtype=bool)  # the next step at the midpoint
     since = np.zeros(p, dtype=np.int64)  # steps since the last pace check
+    probed = np.zeros(p, dtype=bool)  # a zero end's neighbour tried
     width = np.abs(hi - lo)  # the width at the last pace check
     # the ends' own values (f_lo, f_hi are Illinois-halved): within tol at both, done
     near = np.abs(f_lo) <= tol
@@ -164,7 +165,12 @@ def _shrunk(side: Side, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: 
             t = (la * fh - ha * fl) / (fh - fl)
             inside = (t > np.minimum(la, ha)) & (t < np.maximum(la, ha))  # (either order)
             t = np.where(halve[a] | ~inside, mid[a], t)  # (NaN: mid)
-        t = np.where(fh == 0.0, np.nextafter(ha, la), np.where(fl == 0.0, np.nextafter(la, ha), t))
+        # next to an exact zero its neighbouring double, once (a run of exact zeros is
+        # then halved, not walked an ulp at a time)
+        probe = ~probed[a] & ((fh == 0.0) | (fl == 0.0))
+        t = np.where(probe & (fh == 0.0), np.nextafter(ha, la),
+                     np.where(probe & (fl == 0.0), np.nextafter(la, ha), t))
+        probed[a] |= probe
         f, same, ok = side(t, a)
         found[a] &= ok
         lo_new, hi_new = np.where(same, t, la), np.where(same, ha, t)
