@@ -2207,7 +2207,9 @@ static vd g6_sigma_min(const vd *J) { return jac_sigma_min6(J, 6); }
  * lane is this arithmetic whichever way it comes. */
 static void g6_lm_steps(const vd *J, const vd *e, vl lanes, vd *dq, vl *ok)
 {
-    vd A[6 * 12], V[6 * 12], beta[6], b[12], e2 = BR(0.0);
+    /* column-major, column j < 6: J's, then mu e_j; column 6 the right side [e; 0],
+     * which each reflector meets as it meets the columns (house_apply_t's steps) */
+    vd A[7 * 12], V[6 * 12], beta[6], e2 = BR(0.0), *b = A + 6 * 12;
     for (int r = 0; r < 6; r++)
         e2 += e[r] * e[r];
     const vd mu = vsqrt(e2) + 1e-300;
@@ -2231,7 +2233,7 @@ static void g6_lm_steps(const vd *J, const vd *e, vl lanes, vd *dq, vl *ok)
         }
         beta[k] = 2.0 / vv;
         a[k] = alpha;
-        for (int j = k + 1; j < 6; j++) {
+        for (int j = k + 1; j < 7; j++) {
             vd *c = A + j * 12, sj = BR(0.0);
             for (int i = k; i < 12; i++)
                 sj += v[i] * c[i];
@@ -2239,12 +2241,6 @@ static void g6_lm_steps(const vd *J, const vd *e, vl lanes, vd *dq, vl *ok)
             for (int i = k; i < 12; i++)
                 c[i] -= sj * v[i];
         }
-        vd sk = BR(0.0);
-        for (int i = k; i < 12; i++)
-            sk += v[i] * b[i];
-        sk *= beta[k];
-        for (int i = k; i < 12; i++)
-            b[i] -= sk * v[i];
     }
     vd big = BR(0.0);
     for (int i = 5; i >= 0; i--) {
