@@ -83,7 +83,30 @@ def _bisected(f, lo, hi, steps=200):
     return lo, hi, n
 
 
-def test_shrunk_brackets_are_bisections_in_a_third_of_the_steps():
+def _sides(f, s_lo, calls):
+    # _shrunk's side(t, a) for brackets whose low ends have signs s_lo: f's value, the
+    # low end's side where the sign is the same, every value ok; each call's size logged.
+    def side(t, a):
+        calls.append(len(a))
+        v = f(t, a)
+        return v, np.sign(v) == s_lo[a], np.ones(len(a), bool)
+    return side
+
+
+def _noisy_brackets(seed):
+    # 40 brackets around roots c of a smooth cubic with rounding noise of 1e-13 (the
+    # rows' own next to a singularity): the side changes many times within ~1e-13.
+    rng = np.random.default_rng(seed)
+    c = rng.uniform(-3.0, 3.0, 40)
+    lo, hi = c - rng.uniform(1e-3, 0.5, 40), c + rng.uniform(1e-3, 0.5, 40)
+
+    def f(t, a=slice(None)):
+        return (t - c[a]) * (1.0 + (t - c[a]) ** 2) + 1e-13 * np.sin(1e15 * t)
+
+    return c, lo, hi, f
+
+
+def test_shrunk_brackets_are_bisections_in_half_the_steps():
     # Monotone smooth functions with roots at special places (0, a limit value, a root
     # next to an end, 1e-9): the bracket is bisection's own pair of adjacent doubles (a
     # single sign change), in at most half of bisection's steps.
@@ -98,14 +121,8 @@ def test_shrunk_brackets_are_bisections_in_a_third_of_the_steps():
         x = t - c[a]
         return k[a] * (x + x ** 3)
 
-    s_lo = np.sign(f(lo))
     calls = []
-
-    def side(t, a):
-        calls.append(len(a))
-        v = f(t, a)
-        return v, np.sign(v) == s_lo[a], np.isfinite(v)
-
+    side = _sides(f, np.sign(f(lo)), calls)
     out_lo, out_hi, found = _shrunk(side, lo, hi, f(lo), f(hi), 240)
     ref_lo, ref_hi, _ = _bisected(f, lo, hi)
     assert found.all()
@@ -150,20 +167,9 @@ def test_shrunk_on_a_noisy_sign_change_ends_on_one():
     # whose sides differ.
     from robokin.kinematics.ik.self_motion_base import _shrunk
 
-    rng = np.random.default_rng(7)
-    c = rng.uniform(-3.0, 3.0, 40)
-    lo, hi = c - rng.uniform(1e-3, 0.5, 40), c + rng.uniform(1e-3, 0.5, 40)
-
-    def f(t, a=slice(None)):
-        return (t - c[a]) * (1.0 + (t - c[a]) ** 2) + 1e-13 * np.sin(1e15 * t)
-
+    c, lo, hi, f = _noisy_brackets(7)
     s_lo = np.sign(f(lo))
-
-    def side(t, a):
-        v = f(t, a)
-        return v, np.sign(v) == s_lo[a], np.ones(len(a), bool)
-
-    out_lo, out_hi, found = _shrunk(side, lo, hi, f(lo), f(hi), 240)
+    out_lo, out_hi, found = _shrunk(_sides(f, s_lo, []), lo, hi, f(lo), f(hi), 240)
     assert found.all()
     assert (np.nextafter(out_lo, out_hi) == out_hi).all()
     assert (np.sign(f(out_lo)) == s_lo).all() and (np.sign(f(out_hi)) != s_lo).all()
@@ -176,21 +182,10 @@ def test_shrunk_stops_where_both_ends_are_within_the_noise():
     # (the low end's side at lo, the other at hi) and the root lies between them.
     from robokin.kinematics.ik.self_motion_base import _shrunk
 
-    rng = np.random.default_rng(11)
-    c = rng.uniform(-3.0, 3.0, 40)
-    lo, hi = c - rng.uniform(1e-3, 0.5, 40), c + rng.uniform(1e-3, 0.5, 40)
-
-    def f(t, a=slice(None)):
-        return (t - c[a]) * (1.0 + (t - c[a]) ** 2) + 1e-13 * np.sin(1e15 * t)
-
+    c, lo, hi, f = _noisy_brackets(11)
     s_lo = np.sign(f(lo))
     calls = []
-
-    def side(t, a):
-        calls.append(len(a))
-        v = f(t, a)
-        return v, np.sign(v) == s_lo[a], np.ones(len(a), bool)
-
+    side = _sides(f, s_lo, calls)
     _shrunk(side, lo, hi, f(lo), f(hi), 240)
     exact = sum(calls)
     calls.clear()
@@ -216,18 +211,12 @@ def test_shrunk_takes_a_bracket_from_either_end():
         return np.tanh(3.0 * (t - c[a])) + 0.1 * (t - c[a]) ** 2
 
     calls = []
-
-    def make(s_lo):
-        def side(t, a):
-            calls.append(len(a))
-            v = f(t, a)
-            return v, np.sign(v) == s_lo[a], np.ones(len(a), bool)
-        return side
-
-    lo1, hi1, ok1 = _shrunk(make(np.sign(f(up_lo))), up_lo, up_hi, f(up_lo), f(up_hi), 240)
+    lo1, hi1, ok1 = _shrunk(_sides(f, np.sign(f(up_lo)), calls), up_lo, up_hi, f(up_lo),
+                            f(up_hi), 240)
     n_up = len(calls)
     calls.clear()
-    lo2, hi2, ok2 = _shrunk(make(np.sign(f(up_hi))), up_hi, up_lo, f(up_hi), f(up_lo), 240)
+    lo2, hi2, ok2 = _shrunk(_sides(f, np.sign(f(up_hi)), calls), up_hi, up_lo, f(up_hi),
+                            f(up_lo), 240)
     assert ok1.all() and ok2.all()
     assert (np.nextafter(lo1, hi1) == hi1).all() and (lo1 < hi1).all()
     assert (np.nextafter(lo2, hi2) == hi2).all() and (lo2 > hi2).all()
