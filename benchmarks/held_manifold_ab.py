@@ -129,10 +129,11 @@ def compare(a: dict, b: dict, tol: float) -> str:
     both = ~fa & ~fb
     worst = {"fold": 0.0, "other": 0.0}
     poses = {"fold": 0, "other": 0}
-    diff_n, diff_pts = 0, 0
+    diff_n, diff_pts, shown = 0, 0, []
     for i in np.flatnonzero(both):
         if not np.array_equal(a["niv"][i], b["niv"][i]):
             diff_n += 1
+            shown.append(int(i))
             continue
         p = a["pts"][i, :a["npts"][i]]
         d = {"fold": 0.0, "other": 0.0}
@@ -149,9 +150,11 @@ def compare(a: dict, b: dict, tol: float) -> str:
             worst[kind] = max(worst[kind], d[kind])
             poses[kind] += d[kind] > tol
         diff_pts += a["npts"][i] != b["npts"][i]
+    changed = np.flatnonzero(fa != fb)
     return (f"flagged A {int(fa.sum())} B {int(fb.sum())} (same poses: "
-            f"{bool(np.array_equal(fa, fb))}); poses with a different interval count "
-            f"{diff_n}; poses with an end more than {tol:g} off: at a fold {poses['fold']} "
+            f"{bool(np.array_equal(fa, fb))}; flagged in A only {changed[fa[changed]][:20].tolist()}, "
+            f"in B only {changed[fb[changed]][:20].tolist()}); poses with a different interval count "
+            f"{diff_n} {shown[:20]}; poses with an end more than {tol:g} off: at a fold {poses['fold']} "
             f"(largest {worst['fold']:.2e}), elsewhere {poses['other']} (largest "
             f"{worst['other']:.2e}); different point counts {diff_pts}")
 

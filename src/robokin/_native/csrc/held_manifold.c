@@ -2424,8 +2424,31 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                     e = mid;
             }
             double w = 1e-9 * (nd[i + 1].t - nd[i].t) * (in_a ? -1.0 : 1.0), tin = in_a ? a : e;
-            if (nt < cap && (in_a ? tin + w > nd[i].t : tin + w < nd[i + 1].t))
+            if (nt < cap && (in_a ? tin + w > nd[i].t : tin + w < nd[i + 1].t)) {
                 nd[nt++] = (HmNode){tin + w, 1};
+                /* between that node and the cell's node with roots the second angle's
+                 * margins have no third finite node for the parabola test below: a
+                 * gap or an island of theirs there (a pair of its branch ends within
+                 * one margin cell of the first angle's end) is looked for at their
+                 * extremum (golden section; ~40 margin values, 1-2 cells a pose) */
+                long ir = in_a ? i : i + 1;
+                double sa = in_a ? nd[i].t : tin + w, se = in_a ? tin + w : nd[i + 1].t, mt[3];
+                hm_margins(c, tin + w, mt);
+                for (int k = 1; k < 3; k++) {
+                    double fr = m[ir][k];
+                    if (!isfinite(fr) || !isfinite(mt[k]) || (fr < 0) != (mt[k] < 0))
+                        continue; /* a sign change: the loop below keeps both nodes */
+                    double te = hm_margin_extremum(c, k, sa, se, fr < 0), me[3];
+                    hm_margins(c, te, me);
+                    if (!isfinite(me[k]) || (me[k] < 0) == (fr < 0))
+                        continue; /* no island, no gap */
+                    if (nt >= cap) {
+                        c->flags |= HM_FLAG_FULL;
+                        break;
+                    }
+                    nd[nt++] = (HmNode){te, 1};
+                }
+            }
         }
         for (int k = 0; k < 3; k++) {
             double a = m[i][k], e = m[i + 1][k];
