@@ -129,7 +129,7 @@ def compare(a: dict, b: dict, tol: float) -> str:
     both = ~fa & ~fb
     worst = {"fold": 0.0, "other": 0.0}
     poses = {"fold": 0, "other": 0}
-    diff_n, diff_pts, shown = 0, 0, []
+    diff_n, diff_pts, shown, moved = 0, 0, [], []
     for i in np.flatnonzero(both):
         if not np.array_equal(a["niv"][i], b["niv"][i]):
             diff_n += 1
@@ -149,6 +149,8 @@ def compare(a: dict, b: dict, tol: float) -> str:
         for kind in d:
             worst[kind] = max(worst[kind], d[kind])
             poses[kind] += d[kind] > tol
+        if max(d.values()) > tol:
+            moved.append(int(i))
         diff_pts += a["npts"][i] != b["npts"][i]
     changed = np.flatnonzero(fa != fb)
     return (f"flagged A {int(fa.sum())} B {int(fb.sum())} (same poses: "
@@ -156,7 +158,7 @@ def compare(a: dict, b: dict, tol: float) -> str:
             f"in B only {changed[fb[changed]][:20].tolist()}); poses with a different interval count "
             f"{diff_n} {shown[:20]}; poses with an end more than {tol:g} off: at a fold {poses['fold']} "
             f"(largest {worst['fold']:.2e}), elsewhere {poses['other']} (largest "
-            f"{worst['other']:.2e}); different point counts {diff_pts}")
+            f"{worst['other']:.2e}) {moved[:20]}; different point counts {diff_pts}")
 
 
 def identical(a: dict, b: dict) -> str:

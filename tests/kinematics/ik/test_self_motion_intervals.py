@@ -280,6 +280,36 @@ def test_a_gap_next_to_the_first_angles_branch_end_is_found(q, branch, gap):
     _check_against_solved_points(PANDA, T, sm)
 
 
+# Session 20: a joint exactly at a limit at a row node (q7 = 0, a grid node, or q7 at
+# its own limit, the range's end), from where that joint leaves its limits into the cell
+# and comes back in: the cell skipped a joint at its value at a node (the node's own
+# crossing), so the crossing back was not found and the branch was inside over its
+# excursion (0.002-0.2 of t; every pose failed _check_dense). Found by scanning 12,000
+# poses against the oracles below; special configurations of seed 8 (#133 of 150) and
+# of this module's seed 4029 (#77, #419, #823, #1818 of 2,000).
+NODE_ZEROS = [
+    [1e-09, -0.14967827193822725, -0.7117981210539224, -0.0698, 0.1003354661790623,
+     0.1838017389565773, -2.8973],
+    [2.8115943299504127, -1.7628, 1e-09, -0.8587434057052565, -0.34280068487198,
+     1.3949262567555927, 0.0],
+    [-2.2703690355286876, 0.765494557456674, -0.39358834869399795, -0.0698,
+     -0.04732454640341466, 2.176321224776789, 2.8973],
+    [1.5377751699197852, 1.241640436636085, -0.13641293853639924, -0.0698,
+     -0.07047493618799594, 0.20929331213866492, 0.0],
+    [2.3751106117306953, 1.7628, -0.0571122421273933, -0.8950976688738295, 2.42095230599814,
+     2.175015744116006, 0.0],
+]
+
+
+@pytest.mark.parametrize("q", NODE_ZEROS)
+def test_a_joint_leaving_its_limit_at_a_node_comes_back_in_the_cell(q):
+    T = PANDA.fk(np.array(q))
+    sm = PANDA.self_motion(T)
+    assert sm.info.get("compiled") and sm.info["flags"] == 0
+    _check_dense(sm)
+    _check_against_solved_points(PANDA, T, sm)
+
+
 def test_a_branch_end_hidden_in_a_fold_cell_of_the_solved_points_path_is_found():
     # Issue 29, session 15: Panda, uniform configuration #3146 of self_motion_rates'
     # seed 1 (regular, in its limits). Next to the reach boundary the held-q7 rows

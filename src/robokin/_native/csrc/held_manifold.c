@@ -1775,8 +1775,35 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
         int j = c->qj[qi];
         double f0 = fq[qi], f1 = f0 + dj[j];
         double d0 = r0->dq[b][j], d1 = r1->dq[b][j];
-        if (fabs(f0) <= HM_TOL || fabs(f1) <= HM_TOL || fabs(f0) > 3.0)
-            continue; /* a node's zero (hm_node), or the far turn */
+        if (fabs(f0) > 3.0)
+            continue; /* the far turn */
+        int z0 = fabs(f0) <= HM_TOL, z1 = fabs(f1) <= HM_TOL;
+        if (z0 || z1) {
+            /* a node's zero (hm_node records it); when f leaves it into the cell on
+             * the side away from the other end's value, it comes back through the
+             * value inside: that crossing lies past f's extremum (session 20: q4 at
+             * its limit at the range's end, t = q7's limit, then out for 0.023 of t:
+             * its way back in was not found and the branch was inside over it) */
+            double s = z0 ? d0 : -d1, fo = z0 ? f1 : f0;
+            if (z0 == z1 || !(isfinite(s) && s != 0.0) || (s > 0) == (fo > 0))
+                continue;
+            if ((d0 < 0) == (d1 < 0)) {
+                c->flags |= HM_FLAG_UNRESOLVED; /* two extrema: not this cell's model */
+                continue;
+            }
+            HmRow m;
+            hm_extremum(c, b, j, r0->t, d0, r1->t, d1, &m);
+            if (!m.valid[b])
+                continue; /* (hm_extremum flagged the pose) */
+            double fm = f0 + wrap_pi(m.q[b][j] - r0->q[b][j]);
+            if (fabs(fm) <= HM_TOL || (fm > 0) != (s > 0))
+                continue; /* the extremum on the zero's side of the value: no return */
+            if (z0)
+                hm_root(c, b, qi, m.t, fm, r1->t, f1, m.dq[b][j], d1);
+            else
+                hm_root(c, b, qi, r0->t, f0, m.t, fm, d0, m.dq[b][j]);
+            continue;
+        }
         if ((f0 < 0) != (f1 < 0)) {
             hm_root(c, b, qi, r0->t, f0, r1->t, f1, d0, d1);
             continue;
@@ -2438,9 +2465,9 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                     double fr = m[ir][k];
                     if (!isfinite(fr) || !isfinite(mt[k]) || (fr < 0) != (mt[k] < 0))
                         continue; /* a sign change: the loop below keeps both nodes */
-                    double te = hm_margin_extremum(c, k, sa, se, fr < 0), me[3];
-                    hm_margins(c, te, me);
-                    if (!isfinite(me[k]) || (me[k] < 0) == (fr < 0))
+                    double te = hm_margin_extremum(c, k, sa, se, fr < 0), mx[3];
+                    hm_margins(c, te, mx);
+                    if (!isfinite(mx[k]) || (mx[k] < 0) == (fr < 0))
                         continue; /* no island, no gap */
                     if (nt >= cap) {
                         c->flags |= HM_FLAG_FULL;
