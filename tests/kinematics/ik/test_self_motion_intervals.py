@@ -254,7 +254,14 @@ def test_an_island_narrower_than_a_grid_step_is_found(q, branch, island):
 # other node has no first-angle root; the margins' parabola test had no third finite
 # node there, the gap went unseen and the kernel certified the branch inside across it
 # (both poses failed _check_dense); 17 other such poses of 10,000 were flagged instead.
+# #464 and #1104: the gap in the next margin cell out (0.004 and 0.03 from the first
+# angle's end), where the parabola test's third node lies across that end's square
+# root; a row vanished in a cell and the kernel flagged the pose.
 SECOND_ANGLE_GAPS = [
+    ([1.410340130916992, -1.3491484609876572, -1.8242756331516399, -0.5102529903134316,
+      -0.9867420631780877, 1.7658087222802614, 1.4144910398259252], 4, (1.06558, 1.07303)),
+    ([0.9998806750783222, 0.20619042773151586, 1.682390352037284, -0.36666550390043895,
+      1.4459923985439525, 2.7857473617187414, 2.1037755380776626], 4, (2.07641, 2.08868)),
     ([-0.6770992896137629, 0.6399868941430178, 1.3896668485877917, -0.43901252049741357,
       -1.7021695463881827, 2.282617752013231, 2.6310105401367605], 4, (2.61690, 2.62697)),
     ([1.978034481838176, 1.256028160697996, 1.9674046628761563, -0.4390553891549791,

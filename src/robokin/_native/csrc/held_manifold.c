@@ -2411,10 +2411,12 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
 {
     double (*m)[3] = malloc((size_t)G * sizeof(*m));
     HmNode *nd = malloc((size_t)cap * sizeof(HmNode));
+    unsigned char *seen = calloc((size_t)G, 1); /* bit k: cell i's margin k searched */
     long nt = 0;
-    if (m == NULL || nd == NULL) {
+    if (m == NULL || nd == NULL || seen == NULL) {
         free(m);
         free(nd);
+        free(seen);
         c->flags |= HM_FLAG_MEMORY;
         return 0;
     }
@@ -2428,6 +2430,7 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
             c->flags |= HM_FLAG_BAD;
             free(m);
             free(nd);
+            free(seen);
             return 0;
         }
     }
@@ -2453,33 +2456,56 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
             double w = 1e-9 * (nd[i + 1].t - nd[i].t) * (in_a ? -1.0 : 1.0), tin = in_a ? a : e;
             if (nt < cap && (in_a ? tin + w > nd[i].t : tin + w < nd[i + 1].t)) {
                 nd[nt++] = (HmNode){tin + w, 1};
-                /* between that node and the cell's node with roots the second angle's
-                 * margins have no third finite node for the parabola test below: a
-                 * gap or an island of theirs there (a pair of its branch ends within
-                 * one margin cell of the first angle's end) is looked for at their
-                 * extremum (golden section; ~40 margin values, 1-2 cells a pose) */
-                long ir = in_a ? i : i + 1;
-                double sa = in_a ? nd[i].t : tin + w, se = in_a ? tin + w : nd[i + 1].t, mt[3];
+                /* the second angle's margins next to that end: in the sub-cell between
+                 * that node and the cell's node with roots, and in the next margin cell
+                 * on that side, they have no third finite node for the parabola test
+                 * below, or one across the first angle's square root: a gap or an
+                 * island of theirs there (a pair of branch ends within ~0.05 rad of the
+                 * first angle's end) is looked for at their extremum in each (golden
+                 * section, ~40 margin values each, 1-2 such ends a pose) */
+                long ir = in_a ? i : i + 1, in = in_a ? i - 1 : i + 2;
+                double mt[3];
                 hm_margins(c, tin + w, mt);
                 for (int k = 1; k < 3; k++) {
-                    double fr = m[ir][k];
-                    if (!isfinite(fr) || !isfinite(mt[k]) || (fr < 0) != (mt[k] < 0))
-                        continue; /* a sign change: the loop below keeps both nodes */
-                    double te = hm_margin_extremum(c, k, sa, se, fr < 0), mx[3];
-                    hm_margins(c, te, mx);
-                    if (!isfinite(mx[k]) || (mx[k] < 0) == (fr < 0))
-                        continue; /* no island, no gap */
-                    if (nt >= cap) {
-                        c->flags |= HM_FLAG_FULL;
-                        break;
+                    for (int part = 0; part < 2; part++) {
+                        double sa, se, fa, fe;
+                        if (part == 0) { /* the sub-cell */
+                            sa = in_a ? nd[i].t : tin + w;
+                            se = in_a ? tin + w : nd[i + 1].t;
+                            fa = m[ir][k];
+                            fe = mt[k];
+                        } else { /* the next cell out */
+                            if (in < 0 || in >= G)
+                                continue;
+                            long c0 = in_a ? in : ir; /* its left node */
+                            if (seen[c0] >> k & 1u)
+                                continue;
+                            seen[c0] |= (unsigned char)(1u << k);
+                            sa = nd[c0].t;
+                            se = nd[c0 + 1].t;
+                            fa = m[ir][k];
+                            fe = m[in][k];
+                        }
+                        if (!isfinite(fa) || !isfinite(fe) || (fa < 0) != (fe < 0))
+                            continue; /* a sign change: the loop below keeps both nodes */
+                        double te = hm_margin_extremum(c, k, sa, se, fa < 0), mx[3];
+                        hm_margins(c, te, mx);
+                        if (!isfinite(mx[k]) || (mx[k] < 0) == (fa < 0))
+                            continue; /* no island, no gap */
+                        if (nt >= cap) {
+                            c->flags |= HM_FLAG_FULL;
+                            break;
+                        }
+                        nd[nt++] = (HmNode){te, 1};
+                        if (part == 1)
+                            nd[in_a ? in : ir].keep = nd[in_a ? ir : in].keep = 1;
                     }
-                    nd[nt++] = (HmNode){te, 1};
                 }
             }
         }
         for (int k = 0; k < 3; k++) {
             double a = m[i][k], e = m[i + 1][k];
-            if (!isfinite(a) || !isfinite(e) || (a < 0) != (e < 0))
+            if (!isfinite(a) || !isfinite(e) || (a < 0) != (e < 0) || (seen[i] >> k & 1u))
                 continue;
             /* the parabolas through (i - 1, i, i + 1) and (i, i + 1, i + 2) */
             int turns = 0;
@@ -2504,6 +2530,7 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
             }
             if (!turns)
                 continue;
+            seen[i] |= (unsigned char)(1u << k);
             nd[i].keep = nd[i + 1].keep = 1;
             double te = hm_margin_extremum(c, k, nd[i].t, nd[i + 1].t, a < 0);
             double me[3];
@@ -2518,6 +2545,7 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
         }
     }
     free(m);
+    free(seen);
     /* the grid's nodes are in order and the extra ones (all kept) few: the extra ones
      * sorted by insertion (stable), then merged with the grid's kept nodes, a grid node
      * first at equal t (qsort's stable order; ~4 % of the kernel's instructions before) */
