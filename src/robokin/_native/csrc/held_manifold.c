@@ -2392,6 +2392,48 @@ static double hm_margin_extremum(HmCtx *c, int k, double a, double e,
     return 0.5 * (a + e);
 }
 
+/* A t in (a, e) where margin k has the sign opposite to `neg` (neg: negative at both
+ * ends), searched for at its extremum by golden section as hm_margin_extremum, but
+ * stopping at the first such value, or with the bracket 1e-7 of (a, e) wide (~35
+ * margin values; the extremum's value then known to the margin's curvature times
+ * 1e-14 of the cell squared); NaN when none is found.
+ * Only its sign decides: a node there shows the margin's gap or island to the cells. */
+static double hm_margin_flip(HmCtx *c, int k, double a, double e, int neg)
+{
+    const double r = 0.6180339887498949;
+    double w = 1e-7 * (e - a), x1 = e - r * (e - a), x2 = a + r * (e - a), m[3], f1, f2;
+    hm_margins(c, x1, m);
+    if (isfinite(m[k]) && (m[k] < 0) != neg)
+        return x1;
+    f1 = neg ? m[k] : -m[k];
+    hm_margins(c, x2, m);
+    if (isfinite(m[k]) && (m[k] < 0) != neg)
+        return x2;
+    f2 = neg ? m[k] : -m[k];
+    while (e - a > w) {
+        double x;
+        if (!(f1 <= f2)) { /* NaN counts as low */
+            e = x2;
+            x2 = x1;
+            f2 = f1;
+            x = x1 = e - r * (e - a);
+        } else {
+            a = x1;
+            x1 = x2;
+            f1 = f2;
+            x = x2 = a + r * (e - a);
+        }
+        hm_margins(c, x, m);
+        if (isfinite(m[k]) && (m[k] < 0) != neg)
+            return x;
+        if (x == x1)
+            f1 = neg ? m[k] : -m[k];
+        else
+            f2 = neg ? m[k] : -m[k];
+    }
+    return NAN;
+}
+
 typedef struct { /* a node of hm_grid: its t, and whether rows are evaluated there */
     double t;
     int keep;
@@ -2461,8 +2503,8 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                  * on that side, they have no third finite node for the parabola test
                  * below, or one across the first angle's square root: a gap or an
                  * island of theirs there (a pair of branch ends within ~0.05 rad of the
-                 * first angle's end) is looked for at their extremum in each (golden
-                 * section, ~40 margin values each, 1-2 such ends a pose) */
+                 * first angle's end) is looked for at their extremum in each
+                 * (hm_margin_flip; 1-2 such ends a pose) */
                 long ir = in_a ? i : i + 1, in = in_a ? i - 1 : i + 2;
                 double mt[3];
                 hm_margins(c, tin + w, mt);
@@ -2488,9 +2530,8 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                         }
                         if (!isfinite(fa) || !isfinite(fe) || (fa < 0) != (fe < 0))
                             continue; /* a sign change: the loop below keeps both nodes */
-                        double te = hm_margin_extremum(c, k, sa, se, fa < 0), mx[3];
-                        hm_margins(c, te, mx);
-                        if (!isfinite(mx[k]) || (mx[k] < 0) == (fa < 0))
+                        double te = hm_margin_flip(c, k, sa, se, fa < 0);
+                        if (isnan(te))
                             continue; /* no island, no gap */
                         if (nt >= cap) {
                             c->flags |= HM_FLAG_FULL;
