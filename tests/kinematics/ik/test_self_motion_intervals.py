@@ -287,6 +287,34 @@ def test_a_gap_next_to_the_first_angles_branch_end_is_found(q, branch, gap):
     _check_against_solved_points(PANDA, T, sm)
 
 
+# Session 20 (uniform #3338 and #3061 of seed 2029): a piece of branch 4 between an end
+# of the second angle's roots and the first angle's end ~0.002 and ~0.017 rad away, whose
+# node (hm_grid's, just inside the first angle's end) is itself at a branch end: its cells
+# next to that node did not resolve in 14 splits and the pose was flagged. The piece is
+# now split at its middle, each half from its own end.
+TWO_END_PIECES = [
+    ([0.485404389165339, 1.6574074524134077, 0.5675774948881953, -0.25559840033153014,
+      0.49316248623227743, 0.428263906394352, -1.8326386603619786], 4, (-1.240531, -1.238357)),
+    ([-0.42023476646826374, -0.9632272304725783, 1.1202322418814261, -0.4148144286216935,
+      1.7341596370844532, 3.612321275455339, 0.7191289718239133], 4, (-0.252057, -0.234617)),
+]
+
+
+@pytest.mark.parametrize("q, branch, piece", TWO_END_PIECES)
+def test_a_piece_between_two_branch_ends_of_different_angles_is_certified(q, branch, piece):
+    T = PANDA.fk(np.array(q))
+    sm = PANDA.self_motion(T)
+    assert sm.info.get("compiled") and sm.info["flags"] == 0
+    # the oracle: the held-q7 rows exist inside the piece and not just outside it
+    a, e = piece
+    rows = sm.sample(np.array([a - 1e-4, 0.5 * (a + e), e + 1e-4]))[:, branch]
+    assert np.isnan(rows[[0, 2]]).all() and np.isfinite(rows[1]).all()
+    folds = sorted(p.t for p in sm.singular if p.kind == "fold" and p.branch == branch)
+    assert any(abs(f - a) < 2e-6 for f in folds) and any(abs(f - e) < 2e-6 for f in folds)
+    _check_dense(sm)
+    _check_against_solved_points(PANDA, T, sm)
+
+
 # Session 20: a joint exactly at a limit at a row node (q7 = 0, a grid node, or q7 at
 # its own limit, the range's end), from where that joint leaves its limits into the cell
 # and comes back in: the cell skipped a joint at its value at a node (the node's own

@@ -2097,7 +2097,27 @@ static void hm_fold(HmCtx *c, int b, long cell, const HmRow *r0, const HmRow *r1
     }
     hm_at(c, b, end, hm_inside(c, &re, b, MANIFOLD_SLACK));
     hm_node(c, b, &re);
-    hm_fold_piece(c, b, &re, state0 ? r0 : r1, 1);
+    const HmRow *rv = state0 ? r0 : r1;
+    if (hm_gap(c, b, rv) < HM_NEAR * fabs(rv->t - end)) {
+        /* the piece's node is at another branch end too (hm_pose's test on the
+         * piece: the node hm_grid puts just inside the first angle's end, ~0.002 rad
+         * from this one, an end of the second angle; session 20): the piece split at
+         * its middle, each half from its own end (in sigma from this one, from the
+         * node as hm_pose takes a node at a branch end), else its cells next to the
+         * node do not resolve in HM_DEPTH splits (the pose was flagged) */
+        HmRow m;
+        hm_eval_pair(c, 0.5 * (end + rv->t), b, 1, &m);
+        if (!m.valid[b]) {
+            c->flags |= HM_FLAG_VANISH;
+            return;
+        }
+        hm_seen(c, b, &m);
+        hm_node(c, b, &m);
+        hm_fold_piece(c, b, &re, &m, 1);
+        hm_fold_piece(c, b, rv, &m, 0);
+        return;
+    }
+    hm_fold_piece(c, b, &re, rv, 1);
 }
 
 static int hm_cmp(const void *x, const void *y)
