@@ -2535,6 +2535,7 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                 for (int k = 1; k < 3; k++) {
                     for (int part = 0; part < 2; part++) {
                         double sa, se, fa, fe;
+                        long c0 = -1; /* the grid cell searched (part 1) */
                         if (part == 0) { /* the sub-cell */
                             sa = in_a ? nd[i].t : tin + w;
                             se = in_a ? tin + w : nd[i + 1].t;
@@ -2543,10 +2544,9 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                         } else { /* the next cell out */
                             if (in < 0 || in >= G)
                                 continue;
-                            long c0 = in_a ? in : ir; /* its left node */
+                            c0 = in_a ? in : ir; /* its left node */
                             if (seen[c0] >> k & 1u)
                                 continue;
-                            seen[c0] |= (unsigned char)(1u << k);
                             sa = nd[c0].t;
                             se = nd[c0 + 1].t;
                             fa = m[ir][k];
@@ -2556,6 +2556,8 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
                             continue; /* a sign change: the loop below keeps both nodes */
                         if (fmin(fabs(fa), fabs(fe)) > HM_GAP_NEAR)
                             continue; /* far from 0 at a node: no gap (measured) */
+                        if (c0 >= 0) /* searched here: not again by the parabola test */
+                            seen[c0] |= (unsigned char)(1u << k);
                         double te = hm_margin_flip(c, k, sa, se, fa < 0);
                         if (isnan(te))
                             continue; /* no island, no gap */
