@@ -10,7 +10,9 @@ compared: the same poses flagged, and on the others the same intervals per branc
 (ends to ``--tol``) and the same points; printed: CPU per pose, full pk_one solves
 per pose (the kernel's ``evals``; a tree built with ``-DHM_COUNT_CHEAP`` counts
 every row evaluation instead; one built with ``-DHM_VERIFY`` has its row mismatches
-against pk_one counted), the flags and the largest interval-end differences.
+against pk_one counted), the flags and the largest interval-end differences, with the
+poses (at most 20 of each kind; indices into the uniform poses, then the special ones)
+flagged by one tree only, with another interval count, or with an end moved.
 
 Run: ``python benchmarks/held_manifold_ab.py A_SRC B_SRC [--rounds 2] [--repeat 2]``
 (each a ``src`` directory with its kernels built).

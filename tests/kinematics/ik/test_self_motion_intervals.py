@@ -354,7 +354,8 @@ def test_a_branch_end_hidden_in_a_fold_cell_of_the_solved_points_path_is_found()
     # pose (the solved-points path answered); its grid saw 4 -> 0 in that cell, and main
     # (73f3f77) bisected only the 4 rows that end there: q's branch had no interval past
     # 0.70854. Since session 20 the kernel certifies it: the second angle's margins are
-    # searched between the first angle's end and its node (the gap test above). Oracles: independent held solves (robot.ik with q7 given) count the rows
+    # searched between the first angle's end and its node (the gap test above).
+    # Oracles: independent held solves (robot.ik with q7 given) count the rows
     # on a fine scan and give q back at q7; the interval of q's branch holding q7 has
     # its ends within 1e-6 of the scan's 4 -> 8 and 8 -> 0 changes, and at 11 values
     # across it the branch's row is an independent solve's (1e-9), inside every limit
