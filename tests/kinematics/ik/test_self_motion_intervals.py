@@ -161,6 +161,17 @@ def _check_ends(robot, T, sm, limits: np.ndarray = LIMITS, jumps: bool = False) 
             assert abs(q[j] - value) <= (1e-9 if steep else 1e-10), (end, b, j, q[j] - value)
 
 
+def _certified(q: list[float]):
+    """The Panda's manifold of fk(q), asserted certified by the kernel (flags 0) and held
+    to the two oracles (_check_dense, _check_against_solved_points); (T, sm)."""
+    T = PANDA.fk(np.array(q))
+    sm = PANDA.self_motion(T)
+    assert sm.info.get("compiled") and sm.info["flags"] == 0
+    _check_dense(sm)
+    _check_against_solved_points(PANDA, T, sm)
+    return T, sm
+
+
 def _aligned_shoulder(q: np.ndarray) -> bool:
     return abs(np.sin(q[1])) < 1e-6
 
@@ -200,11 +211,7 @@ def test_shoulder_branches_swinging_together_keep_their_own_intervals(q):
     # oracle: the held-q7 rows at 20,000 values (_check_dense), the solved-points
     # path (_check_against_solved_points) and every end at its limit (_check_ends),
     # for both shoulder solutions of every wrist root
-    T = PANDA.fk(np.array(q))
-    sm = PANDA.self_motion(T)
-    assert sm.info.get("compiled") and sm.info["flags"] == 0
-    _check_dense(sm)
-    _check_against_solved_points(PANDA, T, sm)
+    T, sm = _certified(q)
     _check_ends(PANDA, T, sm)
 
 
@@ -271,9 +278,7 @@ SECOND_ANGLE_GAPS = [
 
 @pytest.mark.parametrize("q, branch, gap", SECOND_ANGLE_GAPS)
 def test_a_gap_next_to_the_first_angles_branch_end_is_found(q, branch, gap):
-    T = PANDA.fk(np.array(q))
-    sm = PANDA.self_motion(T)
-    assert sm.info.get("compiled") and sm.info["flags"] == 0
+    _, sm = _certified(q)
     mid = 0.5 * (gap[0] + gap[1])
     # the oracle: the held-q7 rows, which exist either side of the gap and not inside
     rows = sm.sample(np.array([gap[0] - 1e-4, mid, gap[1] + 1e-4]))[:, branch]
@@ -283,8 +288,6 @@ def test_a_gap_next_to_the_first_angles_branch_end_is_found(q, branch, gap):
     assert any(abs(f - gap[1]) < 2e-5 for f in folds), folds
     own = sm.intervals[sm.interval_branch == branch]
     assert not np.any((own[:, 0] < mid) & (mid < own[:, 1])), own
-    _check_dense(sm)
-    _check_against_solved_points(PANDA, T, sm)
 
 
 # Session 20 (uniform #3338 and #3061 of seed 2029): a piece of branch 4 between an end
@@ -302,17 +305,13 @@ TWO_END_PIECES = [
 
 @pytest.mark.parametrize("q, branch, piece", TWO_END_PIECES)
 def test_a_piece_between_two_branch_ends_of_different_angles_is_certified(q, branch, piece):
-    T = PANDA.fk(np.array(q))
-    sm = PANDA.self_motion(T)
-    assert sm.info.get("compiled") and sm.info["flags"] == 0
+    _, sm = _certified(q)
     # the oracle: the held-q7 rows exist inside the piece and not just outside it
     a, e = piece
     rows = sm.sample(np.array([a - 1e-4, 0.5 * (a + e), e + 1e-4]))[:, branch]
     assert np.isnan(rows[[0, 2]]).all() and np.isfinite(rows[1]).all()
     folds = sorted(p.t for p in sm.singular if p.kind == "fold" and p.branch == branch)
     assert any(abs(f - a) < 2e-6 for f in folds) and any(abs(f - e) < 2e-6 for f in folds)
-    _check_dense(sm)
-    _check_against_solved_points(PANDA, T, sm)
 
 
 # Session 20: a joint exactly at a limit at a row node (q7 = 0, a grid node, or q7 at
@@ -338,11 +337,7 @@ NODE_ZEROS = [
 
 @pytest.mark.parametrize("q", NODE_ZEROS)
 def test_a_joint_leaving_its_limit_at_a_node_comes_back_in_the_cell(q):
-    T = PANDA.fk(np.array(q))
-    sm = PANDA.self_motion(T)
-    assert sm.info.get("compiled") and sm.info["flags"] == 0
-    _check_dense(sm)
-    _check_against_solved_points(PANDA, T, sm)
+    _certified(q)
 
 
 def test_a_branch_end_hidden_in_a_fold_cell_of_the_solved_points_path_is_found():
