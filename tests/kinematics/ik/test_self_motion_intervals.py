@@ -340,6 +340,42 @@ def test_a_joint_leaving_its_limit_at_a_node_comes_back_in_the_cell(q):
     _certified(q)
 
 
+# Issue 29, session 21: next to an aligned shoulder (q2 ~ 1e-13..1e-4 somewhere on the
+# branch) q1 and q3 turn by ~pi over a width of t ~ q2 / |dq2/dt| (slopes to 1e11): a
+# cell still to be split after HM_DEPTH splits is now split on (HM_SWING, to the last
+# bit, where the centre is a cut as at a slot change; the odd slot's gap of ~1e-13
+# without a row outside, hm_swing_gap), a touch of q2 = 0 at the centre is an aligned
+# point, and a crossing in the swing is located to the last bit of t. Each pose was
+# flagged (the solved-points path, ~10 ms). Special configurations #707, #1080, #1336,
+# #35 of this module's seed 4029 (q2 at 0 or 1e-9), uniform #1482 of seed 2029
+# (q2 = -1.0e-4).
+SWINGS = [
+    [2.8973, 0.0, 0.0, -2.0850983872628266, -1.5707963267948966, 3.1869371787157337,
+     -1.5707963267948966],
+    [-2.815884400346146, 1e-09, -1.2926785615518621, -0.3370438303362353, 2.720927673388457,
+     0.20376937318562705, 2.8973],
+    [1e-09, 0.0, 0.04212048015633485, -0.775888063464302, 0.006057647024720225,
+     0.8643658331072799, 1.5707963267948966],
+    [2.8973, 1e-09, 1.3843461162017472, -1.2697013502086396, -2.6770499504880507,
+     1.2948067313106622, 1.9643204163577006],
+    [0.025933049163921584, -0.00010169900345879945, -0.39319821193063076,
+     -1.2456315741035864, -1.5510096617894849, 0.5911013832871113, 2.1567325905711088],
+]
+
+
+@pytest.mark.parametrize("q", SWINGS)
+def test_a_swing_next_to_an_aligned_shoulder_is_certified(q):
+    T, sm = _certified(q)
+    assert any(p.kind == "aligned axes" for p in sm.singular)
+    # the generating configuration is on the manifold: some branch inside at its q7
+    # with the pose's q2 (q1 and q3 alone are not determined where q2 = 0)
+    t0 = q[6]
+    inside = sm.inside(np.array([t0]))[0]
+    rows = sm.sample(t0)
+    assert any(inside[b] and abs(abs(rows[b, 1]) - abs(q[1])) < 1e-6
+               for b in range(sm.n_branches))
+
+
 def test_a_branch_end_hidden_in_a_fold_cell_of_the_solved_points_path_is_found():
     # Issue 29, session 15: Panda, uniform configuration #3146 of self_motion_rates'
     # seed 1 (regular, in its limits). Next to the reach boundary the held-q7 rows

@@ -52,7 +52,8 @@
  * row next to an aligned triple is met (pk_one flags it singular: q1, q3 swing
  * there; on a pose with slot changes, a limit crossing or fold within
  * HM_ALIGNED_NEAR of an aligned-axes point of its branch: HM_FLAG_SINGULAR), a cell
- * cannot be resolved within HM_DEPTH splits (nor is a slot change), a crossing does not
+ * cannot be resolved within HM_DEPTH splits (nor is a slot change, nor a swing: see
+ * HM_SWING), a crossing does not
  * converge to HM_TOL, a branch vanishes inside a cell with rows at both ends, or
  * an output fills up; or before any row, when the held family is not of the Panda's
  * kind (PK_BOTH) or its position equations are not of the coplanar kind at a grid
@@ -68,6 +69,16 @@
 #define HM_MAXCUT 256   /* cuts per branch */
 #define HM_JUMP 0.5     /* a joint moving more than this [rad] in a cell: split */
 #define HM_DEPTH 14     /* splits of a grid cell */
+/* A cell still to be split at HM_DEPTH that is no slot change but where a joint still
+ * moves by more than HM_SWING [rad] is a swing (q1 and q3 turning by ~pi next to an
+ * aligned shoulder, q2 ~ 1e-13..1e-6: their slopes ~1/q2): split on, to HM_DEEP
+ * splits, HM_DEEP_ROWS such rows a pose, until the swing's centre is two adjacent
+ * doubles (a cut there, as at a slot change). Session 21: 130 of the 148 flagged of
+ * 2,000 special development poses had their shoulder aligned (q2 at 0 or 1e-9) and
+ * took the solved-points path, 17 ms a pose. */
+#define HM_SWING 1e-2
+#define HM_DEEP 64
+#define HM_DEEP_ROWS 1000
 #define HM_TOL 1e-12    /* a crossing's joint at its value to this [rad] */
 #define HM_TOL_STEEP 1e-9 /* the same where t's last bit moves the joint more */
 #ifndef HM_FLOOR
@@ -176,6 +187,8 @@ typedef struct {
      * of exponentials is G = T M^-1 (GA, Gt); per t (ft), the first six joints'
      * B5, b5 = G E_held(t)^-1; the held joint's columns at fc (u6, w6) */
     int fast, full_fk; /* full_fk: hm_slopes wanted (the fold search) */
+    int deep; /* split rows past HM_DEPTH in swings (HM_DEEP_ROWS) */
+    int deep_cell; /* hm_needs_split: a touch of an aligned-axes value is no split */
     int jumped; /* a slot's rows jump somewhere (hm_jump): the pose gets hm_near_aligned's test */
     double sq_te; /* NaN: cells in t; else a branch end's t: cells in sigma (hm_sigma) */
     int retry; /* a new slot change found by hm_root: the slot's pass is redone */
@@ -1250,7 +1263,10 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
     /* a crossing as steep as an aligned triple makes it (q1, q3 swinging) may end
      * with its bracket two adjacent floats: the value nearest the joint's there */
     int collapsed = !(e - a > 2.0 * DBL_EPSILON * fmax(fabs(a), fabs(e)));
-    if (!(best_f <= HM_TOL) && !(collapsed && best_f <= HM_TOL_STEEP)) {
+    /* or, in a swing (hm_cell), the joint's move over the last bits of t (1e-7..3e-5
+     * at slopes of 1e9..1e11: no double puts it nearer) */
+    double last = HM_FLOOR * fabs(r.dq[b][j]) * (e - a);
+    if (!(best_f <= HM_TOL) && !(collapsed && best_f <= fmax(HM_TOL_STEEP, last))) {
         if (collapsed && c->njump < HM_MAXJUMP) { /* a slot change, not a crossing? */
             HmRow ra, rb;
             hm_eval(c, a, 1u << b, 0xffu, &ra);
@@ -1413,6 +1429,8 @@ static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r
         double d0 = r0->dq[b][j] * m0, d1 = r1->dq[b][j] * m1;
         if (fabs(f0) > 3.0 || fabs(f1) > 3.0)
             continue; /* the value's far turn: nothing near */
+        if (c->deep_cell && c->qkind[qi] == HM_KIND_ALIGNED && (f0 < 0) == (f1 < 0))
+            continue; /* a swing's centre: q2 ~ 1e-13 within HM_TOL of 0 (hm_cell) */
         if ((f0 < 0) == (f1 < 0)) {
             /* round 8b, no sqrt: the Hermite cubic is h00 f0 + h01 f1 (between f0 and
              * f1) plus d0 h10 + d1 h11 with |h10|, |h11| <= 4/27 on the cell, so it stays
@@ -1742,6 +1760,77 @@ static void hm_split_row(HmCtx *c, int b, double t, const HmRow *r0, const HmRow
     hm_eval(c, t, 1u << b, 1u << b, m);
 }
 
+/* Slot b's last row from *ra towards t, where its row is missing: bisection to
+ * adjacent doubles; that row (with b's slope) into *ra */
+static void hm_last_valid(HmCtx *c, int b, HmRow *ra, double t)
+{
+    double good = ra->t, bad = t;
+    HmRow m;
+    for (int it = 0; it < 80; it++) {
+        double mid = 0.5 * (good + bad);
+        if (mid == good || mid == bad)
+            break;
+        hm_eval(c, mid, 0u, 1u << b, &m);
+        if (m.valid[b])
+            good = mid;
+        else
+            bad = mid;
+    }
+    if (good != ra->t)
+        hm_eval(c, good, 1u << b, 1u << b, ra);
+}
+
+/* A swing's cell [r0, r1] of slot b whose midpoint has no row (the odd slot where the
+ * shoulder is aligned to ~1e-13: the closed form gives the pair one row): the gap
+ * between b's last rows on either side (~1e-13 of t) is outside, each end a cut, the
+ * sides cells of their own. 0 (nothing done) when those rows are not regular. */
+static int hm_swing_gap(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, double t,
+                        int depth)
+{
+    HmRow ra = *r0, rb = *r1;
+    hm_last_valid(c, b, &ra, t);
+    hm_last_valid(c, b, &rb, t);
+    if (!ra.valid[b] || !rb.valid[b] || !isfinite(ra.dq[b][0]) || !isfinite(rb.dq[b][0]))
+        return 0;
+    if (c->ncut[b] + 2 > HM_MAXCUT) {
+        c->flags |= HM_FLAG_FULL;
+        return 1;
+    }
+    c->cut[b][c->ncut[b]++] = ra.t;
+    c->cut[b][c->ncut[b]++] = rb.t;
+    c->jumped = 1;
+    hm_at(c, b, ra.t, hm_inside(c, &ra, b, MANIFOLD_SLACK));
+    hm_at(c, b, rb.t, hm_inside(c, &rb, b, MANIFOLD_SLACK));
+    hm_seen(c, b, &ra);
+    hm_seen(c, b, &rb);
+    hm_node(c, b, &ra);
+    hm_node(c, b, &rb);
+    if (ra.t > r0->t)
+        hm_cell(c, b, r0, &ra, depth);
+    if (rb.t < r1->t)
+        hm_cell(c, b, &rb, r1, depth);
+    return 1;
+}
+
+/* Whether slot b's cell [r0, r1], still to be split at HM_DEPTH (or past it) and no
+ * slot change, is split on: 0 with *resolved set when only a touch of an aligned-axes
+ * value asked for the split (the swing's centre: q2 within HM_TOL of 0, an aligned
+ * point, as a graze records it); 1 when a joint still moves by more than HM_SWING
+ * and the budget allows; else 0 (the pose is flagged, or the cell is cut at the
+ * centre: *resolved stays 0). */
+static int hm_swing(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, const double *dj,
+                    const double *fq, int *resolved)
+{
+    c->deep_cell = 1;
+    int still = hm_needs_split(c, b, r0, r1, dj, fq);
+    c->deep_cell = 0;
+    if (!still) {
+        *resolved = 1;
+        return 0;
+    }
+    return hm_move(c, b, r0, r1) > HM_SWING;
+}
+
 static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
 {
     if (c->flags || c->retry)
@@ -1751,7 +1840,23 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
     double dj[PK_MAXJ], fq[HM_MAXQ];
     hm_moves(c, b, r0, r1, dj, fq);
     if (hm_needs_split(c, b, r0, r1, dj, fq)) {
-        if (depth < HM_DEPTH) {
+        int resolved = 0, swing = 0;
+        if (depth == HM_DEPTH && hm_jump(c, b, r0, r1, depth))
+            return;
+        if (depth >= HM_DEPTH && !c->flags && !c->retry)
+            swing = hm_swing(c, b, r0, r1, dj, fq, &resolved);
+        if (swing && nextafter(r0->t, r1->t) == r1->t) {
+            /* the swing's centre between adjacent doubles: a cut, as a slot change */
+            if (c->ncut[b] >= HM_MAXCUT) {
+                c->flags |= HM_FLAG_FULL;
+                return;
+            }
+            c->cut[b][c->ncut[b]++] = r1->t;
+            c->jumped = 1;
+            hm_at(c, b, r1->t, 0);
+            return;
+        }
+        if (depth < HM_DEPTH || (swing && depth < HM_DEEP && c->deep++ < HM_DEEP_ROWS)) {
             HmRow m;
             double mid = 0.5 * (r0->t + r1->t);
             if (!isnan(c->sq_te)) { /* the coordinate's midpoint (hm_sigma) */
@@ -1759,6 +1864,8 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
                 mid = sm > r0->t && sm < r1->t ? sm : mid;
             }
             hm_split_row(c, b, mid, r0, r1, &m);
+            if (!m.valid[b] && depth >= HM_DEPTH && hm_swing_gap(c, b, r0, r1, mid, depth + 1))
+                return;
             if (!m.valid[b]) {
                 c->flags |= HM_FLAG_VANISH;
                 return;
@@ -1769,9 +1876,8 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
             hm_cell(c, b, &m, r1, depth + 1);
             return;
         }
-        if (hm_jump(c, b, r0, r1, depth))
-            return;
-        c->flags |= HM_FLAG_UNRESOLVED;
+        if (!resolved)
+            c->flags |= HM_FLAG_UNRESOLVED;
     }
     double hs = hm_sigma(c, r1->t) - hm_sigma(c, r0->t);
     double m0 = hm_dtds(c, r0->t) * hs, m1 = hm_dtds(c, r1->t) * hs; /* per unit of the cell */
@@ -2799,6 +2905,8 @@ static void hm_range(void *ctx, long b0, long e0)
         c->fast = hm_fast_setup(c);
         c->full_fk = 0;
         c->jumped = 0;
+        c->deep = 0;
+        c->deep_cell = 0;
         c->sq_te = NAN;
         c->njump = 0;
         c->retry = 0;
