@@ -71,7 +71,7 @@
 #define HM_DEPTH 14     /* splits of a grid cell */
 /* A cell still to be split at HM_DEPTH that is no slot change but where a joint still
  * moves by more than HM_SWING [rad] is a swing (q1 and q3 turning by ~pi next to an
- * aligned shoulder, q2 ~ 1e-13..1e-6: their slopes ~1/q2): split on, to HM_DEEP
+ * aligned shoulder, q2 ~ 1e-13..1e-4: their slopes ~1/q2): split on, to HM_DEEP
  * splits, HM_DEEP_ROWS such rows a pose, until the swing's centre is two adjacent
  * doubles (a cut there, as at a slot change). Session 21: 130 of the 148 flagged of
  * 2,000 special development poses had their shoulder aligned (q2 at 0 or 1e-9) and
@@ -1816,8 +1816,8 @@ static int hm_swing_gap(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, doubl
  * slot change, is split on: 0 with *resolved set when only a touch of an aligned-axes
  * value asked for the split (the swing's centre: q2 within HM_TOL of 0, an aligned
  * point, as a graze records it); 1 when a joint still moves by more than HM_SWING
- * and the budget allows; else 0 (the pose is flagged, or the cell is cut at the
- * centre: *resolved stays 0). */
+ * (hm_cell splits it within HM_DEEP and HM_DEEP_ROWS, or cuts it at its centre);
+ * else 0 with *resolved 0 (the pose is flagged). */
 static int hm_swing(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, const double *dj,
                     const double *fq, int *resolved)
 {
