@@ -348,7 +348,8 @@ def test_a_joint_leaving_its_limit_at_a_node_comes_back_in_the_cell(q):
 # point, and a crossing in the swing is located to the last bit of t. Each pose was
 # flagged (the solved-points path, ~10 ms). Special configurations #707, #1080, #1336,
 # #35 of this module's seed 4029 (q2 at 0 or 1e-9), uniform #1482 of seed 2029
-# (q2 = -1.0e-4).
+# (q2 = -1.0e-4); special #16 (q2 = 0, q5 = 0, q7 = 1e-9: a cell at the swing's centre
+# moving by under HM_SWING at slopes of 1e9, a swing by its end slopes).
 SWINGS = [
     [2.8973, 0.0, 0.0, -2.0850983872628266, -1.5707963267948966, 3.1869371787157337,
      -1.5707963267948966],
@@ -360,6 +361,8 @@ SWINGS = [
      1.2948067313106622, 1.9643204163577006],
     [0.025933049163921584, -0.00010169900345879945, -0.39319821193063076,
      -1.2456315741035864, -1.5510096617894849, 0.5911013832871113, 2.1567325905711088],
+    [-0.683835605016252, 0.0, 1.5707963267948966, -2.739673168289108, 0.0,
+     0.6727763148900546, 1e-09],
 ]
 
 

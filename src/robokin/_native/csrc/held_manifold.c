@@ -69,15 +69,18 @@
 #define HM_MAXCUT 256   /* cuts per branch */
 #define HM_JUMP 0.5     /* a joint moving more than this [rad] in a cell: split */
 #define HM_DEPTH 14     /* splits of a grid cell */
-/* A cell still to be split at HM_DEPTH that is no slot change but where a joint still
- * moves by more than HM_SWING [rad] is a swing (q1 and q3 turning by ~pi next to an
- * aligned shoulder, q2 ~ 1e-13..1e-4: their slopes ~1/q2): split on, to HM_DEEP
+/* A cell still to be split at HM_DEPTH that is no slot change, where the slot's q2 is
+ * within HM_SWING_NEAR of its aligned-axes value at an end and a joint still moves by
+ * more than HM_SWING [rad] (or would at its end slopes; one not finite counts) is a
+ * swing (q1 and q3 turning by ~pi next to an aligned shoulder, q2 ~ 1e-13..1e-4:
+ * their slopes ~1/q2): split on, to HM_DEEP
  * splits, HM_DEEP_ROWS such rows a pose, until the swing's centre is two adjacent
  * doubles (a cut there, as at a slot change). Session 21: 130 of the 148 flagged of
  * 2,000 special development poses had their shoulder aligned (q2 at 0 or 1e-9) and
  * took the solved-points path, 17 ms a pose. */
 #define HM_SWING 1e-2
-#define HM_DEEP 64
+#define HM_SWING_NEAR 1e-3
+#define HM_DEEP 96 /* (t ~ 1e-9: its ulp is 2^-77 of a grid cell) */
 #define HM_DEEP_ROWS 1000
 #define HM_TOL 1e-12    /* a crossing's joint at its value to this [rad] */
 #define HM_TOL_STEEP 1e-9 /* the same where t's last bit moves the joint more */
@@ -1815,9 +1818,10 @@ static int hm_swing_gap(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, doubl
 /* Whether slot b's cell [r0, r1], still to be split at HM_DEPTH (or past it) and no
  * slot change, is split on: 0 with *resolved set when only a touch of an aligned-axes
  * value asked for the split (the swing's centre: q2 within HM_TOL of 0, an aligned
- * point, as a graze records it); 1 when a joint still moves by more than HM_SWING
- * (hm_cell splits it within HM_DEEP and HM_DEEP_ROWS, or cuts it at its centre);
- * else 0 with *resolved 0 (the pose is flagged). */
+ * point, as a graze records it); 1 when it is a swing (HM_SWING: hm_cell splits it
+ * within HM_DEEP and HM_DEEP_ROWS, or cuts it at its centre); else 0 with *resolved
+ * 0 (the pose is flagged: e.g. a joint riding its limit to ~1e-14, which splitting on
+ * does not decide). */
 static int hm_swing(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, const double *dj,
                     const double *fq, int *resolved)
 {
@@ -1828,7 +1832,19 @@ static int hm_swing(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, const dou
         *resolved = 1;
         return 0;
     }
-    return hm_move(c, b, r0, r1) > HM_SWING;
+    int near = 0;
+    for (int qi = 0; qi < c->nq; qi++)
+        if (c->qkind[qi] == HM_KIND_ALIGNED &&
+            fmin(fabs(fq[qi]), fabs(fq[qi] + dj[c->qj[qi]])) < HM_SWING_NEAR)
+            near = 1;
+    if (!near)
+        return 0;
+    double steep = 0.0; /* the largest end slope (a singular end: infinite) */
+    for (int j = 0; j < c->n; j++) {
+        double s0 = fabs(r0->dq[b][j]), s1 = fabs(r1->dq[b][j]);
+        steep = fmax(steep, fmax(isfinite(s0) ? s0 : HUGE_VAL, isfinite(s1) ? s1 : HUGE_VAL));
+    }
+    return hm_move(c, b, r0, r1) > HM_SWING || steep * (r1->t - r0->t) > HM_SWING;
 }
 
 static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth)
