@@ -379,6 +379,36 @@ def test_a_swing_next_to_an_aligned_shoulder_is_certified(q):
                for b in range(sm.n_branches))
 
 
+# Issue 29, session 21: the generating configuration with its shoulder aligned (q2 = 0)
+# at a grid node of q7 (0 or a limit). There the held solver gives the slot pair (the
+# shoulder's two triples) one row; the odd slot had none at the node, its cells there
+# looked like a branch end or an absence, and the kernel certified the pose without a
+# piece of that branch: special #1163 of seed 22 (branch 5 inside over (2.8701,
+# 2.8973), no interval), #194 of seed 8 ((2.8919, 2.8973) missed), #1848 of seed 11,
+# #1126 of seed 22. The missing row is now its partner's mirror (hm_mirror); #194 is
+# certified, the others are left to the solved-points path (a crossing within 1e-4 of
+# the aligned point, HM_FLAG_SINGULAR, or one not converging). Each failed
+# _check_dense on main (57ca496).
+ALIGNED_NODES = [
+    [0.42380897302568243, 0.0, 2.8973, -0.0698, 0.17459156208341442, 1.0365870355614573,
+     2.8973],
+    [2.8973, 0.0, 1.5707963267948966, -0.77544987187196, 1.38185922185678,
+     2.2196625767016087, 2.8973],
+    [0.0, 0.0, -0.1808093750172537, -0.0698, 1.4525027528667516, 1e-09, 0.0],
+    [-1.6286958367607338, 0.0, 1.9559964483591679, -0.0698, 0.5485220904399437,
+     1.128687448059117, 0.0],
+]
+
+
+@pytest.mark.parametrize("q", ALIGNED_NODES)
+def test_both_shoulder_triples_are_kept_at_an_aligned_node(q):
+    T = PANDA.fk(np.array(q))
+    sm = PANDA.self_motion(T)
+    _check_dense(sm)
+    if sm.info.get("compiled"):
+        _check_against_solved_points(PANDA, T, sm)
+
+
 def test_a_branch_end_hidden_in_a_fold_cell_of_the_solved_points_path_is_found():
     # Issue 29, session 15: Panda, uniform configuration #3146 of self_motion_rates'
     # seed 1 (regular, in its limits). Next to the reach boundary the held-q7 rows

@@ -883,6 +883,50 @@ static void hm_keep(HmCtx *c, double t, unsigned need, int closed, const HmRow *
     memcpy(m->sing, r->sing, sizeof m->sing);
 }
 
+/* A slot pair's missing row where the shoulder is aligned: the held solvers give the
+ * pair (b, b ^ 1: the same position root, the shoulder's two triples (q1, q2, q3) and
+ * (q1 + pi, -q2, q3 + pi)) one row where |q2| <= HM_TOL (the two within rounding of
+ * one configuration). The other is that row's mirror, which has the same pose (q2 = 0:
+ * axes 1 and 3 on one line). Session 21: the odd slot had no row at a grid node where
+ * the generating configuration's q2 = 0 and q7 is a node (0, a limit), its cells there
+ * looked like a branch end or an absence, and a piece of its branch was missed (special
+ * #1163 of seed 22: branch 5 inside over (2.8701, 2.8973), no interval). Both slots'
+ * rows are solved wherever one asked for is missing (hm_eval, hm_partners); on arms
+ * with q7 held only (the Panda's kind; the mirror checked on the Panda: FK equal to
+ * 6e-16). */
+static void hm_mirror(const HmCtx *c, unsigned need, HmRow *r)
+{
+    if (c->n != 7 || c->k != 6)
+        return; /* the Panda's kind: q7 held, the shoulder triple q1-q3 */
+    for (int e = 0; e < 8; e += 2) {
+        if ((need >> e & 3u) != 3u || r->valid[e] == r->valid[e + 1])
+            continue;
+        int from = r->valid[e] ? e : e + 1, to = from ^ 1;
+        if (!(fabs(r->q[from][1]) <= HM_TOL))
+            continue;
+        for (int j = 0; j < c->n; j++)
+            r->q[to][j] = r->q[from][j];
+        r->q[to][0] = wrap_pi(r->q[from][0] + M_PI);
+        r->q[to][1] = -r->q[from][1];
+        r->q[to][2] = wrap_pi(r->q[from][2] + M_PI);
+        r->valid[to] = 1;
+        r->sing[to] = r->sing[from];
+    }
+}
+
+/* The partners of the slots in `need` whose rows hm_closed left missing, where the
+ * partner was not asked for (hm_mirror needs its row): 0 on other arms. */
+static unsigned hm_partners(const HmCtx *c, unsigned need, const HmRow *r)
+{
+    unsigned more = 0u;
+    if (c->n != 7 || c->k != 6)
+        return 0u;
+    for (int b = 0; b < 8; b++)
+        if ((need >> b & 1u) && !r->valid[b] && !(need >> (b ^ 1) & 1u))
+            more |= 1u << (b ^ 1);
+    return more;
+}
+
 /* The slots in `need` at t (hm_closed, else pk_one's every slot), shifted into the
  * limits by whole turns where that fits (as the numpy path's _into_limits); slopes
  * for the slots in `mask`. The rows of an evaluation at the same t among the last
@@ -912,15 +956,22 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
     c->cheap++;
     if (hm_recall(c, t, need, r))
         goto slopes;
-    int code;
-    const PkFront *f = hm_front(c, t, need, &code);
-    int closed = hm_closed(c, t, need, f, code, r);
-    if (!closed) {
-        unsigned char inside[8];
-        PkOut o = {&r->q[0][0], r->valid, r->sing, inside, PK_MAXJ};
-        c->evals++;
-        pk_one(P, c->T, t, c->qn, o);
+    int code, closed;
+    for (;;) {
+        const PkFront *f = hm_front(c, t, need, &code);
+        closed = hm_closed(c, t, need, f, code, r);
+        if (!closed) {
+            unsigned char inside[8];
+            PkOut o = {&r->q[0][0], r->valid, r->sing, inside, PK_MAXJ};
+            c->evals++;
+            pk_one(P, c->T, t, c->qn, o);
+        }
+        unsigned more = closed ? hm_partners(c, need, r) : 0u;
+        if (!more)
+            break;
+        need |= more; /* a slot's row missing where its partner's may be aligned: both */
     }
+    hm_mirror(c, closed ? need : 0xffu, r);
 #ifdef HM_VERIFY
     else { /* a checking build (-DHM_VERIFY): every closed-form row against pk_one's */
         double Q[8][PK_MAXJ];
@@ -1192,6 +1243,8 @@ static int hm_last(const HmCtx *c, int b, int qi, const HmRow *r, double f, doub
  * not known): Newton with the slope from the root of the cell's cubic Hermite
  * model (the secant's where a slope is not known), Illinois regula falsi where
  * Newton leaves the bracket. */
+static double hm_move(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1);
+
 static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, double fe,
                     double da, double de)
 {
@@ -1277,6 +1330,16 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
             int n0 = c->njump;
             if (ra.valid[b] && rb.valid[b] && hm_bisect_jump(c, b, &ra, &rb) && c->njump > n0) {
                 c->retry = 1; /* a new one: the slot's pass is redone with it (hm_pose) */
+                return;
+            }
+            /* a known one, or one next to a row of an exactly aligned shoulder (q2 = 0
+             * within ~1e-12 of an aligned node: q1 and q3 split by the solver's rule,
+             * no slope; session 21): a cut there, no point, as hm_split_jump makes */
+            if (ra.valid[b] && rb.valid[b] && hm_move(c, b, &ra, &rb) > HM_SLOT_JUMP &&
+                c->ncut[b] < HM_MAXCUT) {
+                c->cut[b][c->ncut[b]++] = e;
+                c->jumped = 1;
+                hm_at(c, b, e, 0);
                 return;
             }
         }
