@@ -971,9 +971,8 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
             break;
         need |= more; /* a slot's row missing where its partner's may be aligned: both */
     }
-    hm_mirror(c, closed ? need : 0xffu, r);
 #ifdef HM_VERIFY
-    else { /* a checking build (-DHM_VERIFY): every closed-form row against pk_one's */
+    if (closed) { /* a checking build (-DHM_VERIFY): every closed-form row against pk_one's */
         double Q[8][PK_MAXJ];
         unsigned char v[8], sg[8], in[8];
         PkOut o = {&Q[0][0], v, sg, in, PK_MAXJ};
@@ -990,6 +989,7 @@ static void hm_eval(HmCtx *c, double t, unsigned mask, unsigned need, HmRow *r)
         }
     }
 #endif
+    hm_mirror(c, closed ? need : 0xffu, r); /* (after the check: pk_one has no mirror) */
     for (int b = 0; b < 8; b++) {
         if (!r->valid[b])
             continue;
@@ -1238,13 +1238,13 @@ static int hm_last(const HmCtx *c, int b, int qi, const HmRow *r, double f, doub
     return 1;
 }
 
+static double hm_move(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1);
+
 /* The root of q_j(t) - value (query qi, slot b) in (a, e), fa, fe of opposite
  * signs (fa at a, continuous over the cell; da, de the slopes there, NaN where
  * not known): Newton with the slope from the root of the cell's cubic Hermite
  * model (the secant's where a slope is not known), Illinois regula falsi where
  * Newton leaves the bracket. */
-static double hm_move(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1);
-
 static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, double fe,
                     double da, double de)
 {
