@@ -1147,6 +1147,21 @@ static void hm_at(HmCtx *c, int b, double t, int in)
     }
 }
 
+/* A cut of slot b at t where its rows jump (a slot change, a swing's centre): no
+ * point, and its row not inside (hm_at: never a one-point interval); the pose then
+ * gets hm_near_aligned's test. 0 when the slot's cuts are full (HM_FLAG_FULL). */
+static int hm_jump_cut(HmCtx *c, int b, double t)
+{
+    if (c->ncut[b] >= HM_MAXCUT) {
+        c->flags |= HM_FLAG_FULL;
+        return 0;
+    }
+    c->cut[b][c->ncut[b]++] = t;
+    c->jumped = 1;
+    hm_at(c, b, t, 0);
+    return 1;
+}
+
 #ifdef HM_SHARE_STATS /* a measuring build: partner lookups per joint (tried, taken) */
 static long hm_share_n[PK_MAXJ][2];
 #endif
@@ -1336,12 +1351,8 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
              * within ~1e-12 of an aligned node: q1 and q3 split by the solver's rule,
              * no slope; session 21): a cut there, no point, as hm_split_jump makes */
             if (ra.valid[b] && rb.valid[b] && hm_move(c, b, &ra, &rb) > HM_SLOT_JUMP &&
-                c->ncut[b] < HM_MAXCUT) {
-                c->cut[b][c->ncut[b]++] = e;
-                c->jumped = 1;
-                hm_at(c, b, e, 0);
+                c->ncut[b] < HM_MAXCUT && hm_jump_cut(c, b, e))
                 return;
-            }
         }
         c->flags |= HM_FLAG_CONVERGE;
     }
@@ -1750,13 +1761,8 @@ static int hm_split_jump(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, cons
         !(hm_move(c, b, ra, rb) > HM_SLOT_JUMP) || !isfinite(ra->dq[b][0]) ||
         !isfinite(rb->dq[b][0]))
         return 0;
-    if (c->ncut[b] >= HM_MAXCUT) {
-        c->flags |= HM_FLAG_FULL;
+    if (!hm_jump_cut(c, b, rb->t))
         return 1;
-    }
-    c->cut[b][c->ncut[b]++] = rb->t;
-    c->jumped = 1;
-    hm_at(c, b, rb->t, 0);
     hm_seen(c, b, ra);
     hm_seen(c, b, rb);
     hm_node(c, b, ra);
@@ -1925,14 +1931,7 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
         if (depth >= HM_DEPTH && !c->flags && !c->retry)
             swing = hm_swing(c, b, r0, r1, dj, fq, &resolved);
         if (swing && nextafter(r0->t, r1->t) == r1->t) {
-            /* the swing's centre between adjacent doubles: a cut, as a slot change */
-            if (c->ncut[b] >= HM_MAXCUT) {
-                c->flags |= HM_FLAG_FULL;
-                return;
-            }
-            c->cut[b][c->ncut[b]++] = r1->t;
-            c->jumped = 1;
-            hm_at(c, b, r1->t, 0);
+            hm_jump_cut(c, b, r1->t); /* the swing's centre between adjacent doubles */
             return;
         }
         if (depth < HM_DEPTH || (swing && depth < HM_DEEP && c->deep++ < HM_DEEP_ROWS)) {
@@ -2570,58 +2569,28 @@ static int hm_margins(HmCtx *c, double x, double *m)
     return hm_margins_d(c, x, m, NULL);
 }
 
-/* The extremum of margin k in (a, e) (golden section; a maximum when want_max):
- * its t. */
-static double hm_margin_extremum(HmCtx *c, int k, double a, double e,
-                                 int want_max)
+/* Golden section on margin k over (a, e), towards its maximum when want_max (NaN
+ * counts as low), at most 60 steps. flip = 0: until the bracket is 1e-13 (relative to
+ * |a|, at least 1) wide; its middle. flip = 1: until it is w wide, or at the first
+ * value of margin k with the sign opposite to want_max's (want_max: negative at both
+ * ends), which it returns; NaN when none is met. */
+static double hm_margin_golden(HmCtx *c, int k, double a, double e, int want_max, int flip,
+                               double w)
 {
     const double r = 0.6180339887498949;
     double x1 = e - r * (e - a), x2 = a + r * (e - a), m[3], f1, f2;
     hm_margins(c, x1, m);
+    if (flip && isfinite(m[k]) && (m[k] < 0) != want_max)
+        return x1;
     f1 = want_max ? m[k] : -m[k];
     hm_margins(c, x2, m);
-    f2 = want_max ? m[k] : -m[k];
-    for (int it = 0; it < 60 && e - a > 1e-13 * fmax(1.0, fabs(a)); it++) {
-        if (!(f1 <= f2)) { /* NaN counts as low */
-            e = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = e - r * (e - a);
-            hm_margins(c, x1, m);
-            f1 = want_max ? m[k] : -m[k];
-        } else {
-            a = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = a + r * (e - a);
-            hm_margins(c, x2, m);
-            f2 = want_max ? m[k] : -m[k];
-        }
-    }
-    return 0.5 * (a + e);
-}
-
-/* A t in (a, e) where margin k has the sign opposite to `neg` (neg: negative at both
- * ends), searched for at its extremum by golden section as hm_margin_extremum, but
- * stopping at the first such value, or with the bracket 1e-7 of (a, e) wide (~35
- * margin values; the extremum's value then known to the margin's curvature times
- * 1e-14 of the cell squared); NaN when none is found.
- * Only its sign decides: a node there shows the margin's gap or island to the cells. */
-static double hm_margin_flip(HmCtx *c, int k, double a, double e, int neg)
-{
-    const double r = 0.6180339887498949;
-    double w = 1e-7 * (e - a), x1 = e - r * (e - a), x2 = a + r * (e - a), m[3], f1, f2;
-    hm_margins(c, x1, m);
-    if (isfinite(m[k]) && (m[k] < 0) != neg)
-        return x1;
-    f1 = neg ? m[k] : -m[k];
-    hm_margins(c, x2, m);
-    if (isfinite(m[k]) && (m[k] < 0) != neg)
+    if (flip && isfinite(m[k]) && (m[k] < 0) != want_max)
         return x2;
-    f2 = neg ? m[k] : -m[k];
-    while (e - a > w) {
+    f2 = want_max ? m[k] : -m[k];
+    for (int it = 0; it < 60 && e - a > (flip ? w : 1e-13 * fmax(1.0, fabs(a))); it++) {
         double x;
-        if (!(f1 <= f2)) { /* NaN counts as low */
+        int left = !(f1 <= f2); /* the maximum in (a, x2) */
+        if (left) {
             e = x2;
             x2 = x1;
             f2 = f1;
@@ -2633,14 +2602,32 @@ static double hm_margin_flip(HmCtx *c, int k, double a, double e, int neg)
             x = x2 = a + r * (e - a);
         }
         hm_margins(c, x, m);
-        if (isfinite(m[k]) && (m[k] < 0) != neg)
+        if (flip && isfinite(m[k]) && (m[k] < 0) != want_max)
             return x;
-        if (x == x1)
-            f1 = neg ? m[k] : -m[k];
+        if (left)
+            f1 = want_max ? m[k] : -m[k];
         else
-            f2 = neg ? m[k] : -m[k];
+            f2 = want_max ? m[k] : -m[k];
     }
-    return NAN;
+    return flip ? NAN : 0.5 * (a + e);
+}
+
+/* The extremum of margin k in (a, e) (golden section; a maximum when want_max):
+ * its t. */
+static double hm_margin_extremum(HmCtx *c, int k, double a, double e, int want_max)
+{
+    return hm_margin_golden(c, k, a, e, want_max, 0, 0.0);
+}
+
+/* A t in (a, e) where margin k has the sign opposite to `neg` (neg: negative at both
+ * ends), searched for at its extremum as hm_margin_extremum does, but stopping at the
+ * first such value, or with the bracket 1e-7 of (a, e) wide (~35 margin values; the
+ * extremum's value then known to the margin's curvature times 1e-14 of the cell
+ * squared); NaN when none is found. Only its sign decides: a node there shows the
+ * margin's gap or island to the cells. */
+static double hm_margin_flip(HmCtx *c, int k, double a, double e, int neg)
+{
+    return hm_margin_golden(c, k, a, e, neg, 1, 1e-7 * (e - a));
 }
 
 typedef struct { /* a node of hm_grid: its t, and whether rows are evaluated there */
