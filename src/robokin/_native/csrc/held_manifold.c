@@ -51,7 +51,8 @@
  * A pose is flagged (flags != 0: the caller takes the solved-points path) when a
  * row next to an aligned triple is met (pk_one flags it singular: q1, q3 swing
  * there; on a pose with slot changes, a limit crossing or fold within
- * HM_ALIGNED_NEAR of an aligned-axes point of its branch: HM_FLAG_SINGULAR), a cell
+ * HM_ALIGNED_NEAR of an aligned-axes point of its branch, on the Panda-type arm not
+ * the shoulder swing's own (hm_near_aligned): HM_FLAG_SINGULAR), a cell
  * cannot be resolved within HM_DEPTH splits (nor is a slot change, nor a swing: see
  * HM_SWING), a crossing does not
  * converge to HM_TOL, a branch vanishes inside a cell with rows at both ends, or
@@ -2817,15 +2818,28 @@ static long hm_grid(HmCtx *c, long G, double lo, double hi, double *t, long cap)
  * shoulder (q2 = 0) the rows are conditioned so that a joint can sit within the
  * slack of its limit over 1e-5 of t, or cross it within 1e-9 of the aligned point,
  * where the pieces' midpoint verdicts and the solved-points path differ by more than
- * 1e-9 (3 of 288 certified special poses, seed 0, before this test). */
+ * 1e-9 (3 of 288 certified special poses, seed 0, before this test).
+ *
+ * On the Panda-type arm (q7 held, the shoulder triple q1, q2, q3 first) the shoulder's
+ * own swing is not such a reason (session 22): where q2 passes 0 or within ~1e-4 of it
+ * q1 and q3 turn by ~pi (crossing their limits and q3 its aligned value 0 there), and
+ * where q2 is exactly 0 the held chain is singular (axes 1 and 3 on one line: a fold
+ * of t at the aligned point). Those crossings (joints 0 and 2) and folds are located
+ * as in any cell (HM_SWING); every other joint's crossing next to an aligned point
+ * (q4 or q6 at its limit there: special #241, #874 of seed 22, #305 of seed 31, where
+ * the intervals differ from the solved-points path by up to 9e-6 of t at the slack)
+ * still flags the pose. */
 static int hm_near_aligned(const HmCtx *c)
 {
+    int shoulder = c->n == 7 && c->k == 6;
     for (long i = 0; i < c->npts; i++) {
         const double *a = c->pts + 4 * i;
         if (a[3] != HM_KIND_ALIGNED)
             continue;
         for (long k = 0; k < c->npts; k++) {
             const double *p = c->pts + 4 * k;
+            if (shoulder && (p[3] == HM_KIND_FOLD || p[2] == 0.0 || p[2] == 2.0))
+                continue; /* the swing's q1, q3 and the fold at q2 = 0 */
             if (p[3] != HM_KIND_ALIGNED && p[1] == a[1] && fabs(p[0] - a[0]) < HM_ALIGNED_NEAR)
                 return 1;
         }
