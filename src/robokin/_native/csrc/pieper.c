@@ -101,6 +101,8 @@ enum { PK_OK = 0, PK_OUT_OF_REACH = 1, PK_NO_ORIENTATION = 2, PK_DEGENERATE = 5,
 #define PK_NUDGE_SING 5e-2    /* the same for rows flagged singular (a thin set's width there) */
 #define PK_CLAMP_SLACK 1e-10 /* pk_inside: joints out by at most this [rad] are not clamped */
 #define PK_FAMILY_SIGMA 1e-9  /* Jacobian's smallest / largest singular value below it: a family */
+#define PK_SLIDE_KEPT 1e-3    /* pk_slide: a step of which the polish keeps less ... */
+#define PK_SLIDE_STALL 2      /* ... this many times running: no family to slide along */
 #define PK_SP4_SLACK 1e-13     /* |C| - hypot(A, B) / scale below it: a double root (rounding) */
 #define PK_SLOW 1e-6           /* polished candidates this far off the pose: pk_polish_slow */
 #define PK_SLOW_ITERS 40       /* its most Newton steps */
@@ -1406,7 +1408,11 @@ static int pk_isolated(const PkGeo *g, const double *th)
  * the intersection nearest a = 0 (its middle when rounding left it empty: two
  * joints at their limits at one point), at most 0.05 rad, and Newton-polishes
  * the pose with the joints brought to a limit held. Kept when every joint ends
- * inside and the pose holds to PK_ACCEPT: returns 1 when th changed. */
+ * inside and the pose holds to PK_ACCEPT: returns 1 when th changed. A row only
+ * near a family (q2 ~ 1e-9 on the Panda: the smallest singular value ~1e-9, not 0)
+ * is pulled back by each polish to within ~1e-7 of where it was: when the polish
+ * undoes all but PK_SLIDE_KEPT of PK_SLIDE_STALL steps running, the slide gives up
+ * (session 22: it went on for all 96 steps, each with its SVD, and failed). */
 static int pk_slide(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double *th)
 {
     double trial[6];
@@ -1414,6 +1420,7 @@ static int pk_slide(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double
         return 0; /* isolated: no family to slide along */
     for (int j = 0; j < 6; j++)
         trial[j] = th[j];
+    int stalled = 0;
     for (int it = 0; it < 96; it++) {
         m3 R;
         v3 p;
@@ -1459,6 +1466,9 @@ static int pk_slide(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double
         else if (fabs(alpha) * big < 1e-15)
             return 0; /* no progress */
         unsigned frozen = 0u;
+        double before[6];
+        for (int j = 0; j < 6; j++)
+            before[j] = trial[j];
         for (int j = 0; j < 6; j++) {
             trial[j] += alpha * V[j][0];
             int f = g->full[j];
@@ -1473,6 +1483,12 @@ static int pk_slide(const double *P, const PkGeo *g, const m3 *RT, v3 pT, double
 #endif
         if (!(perr <= PK_ACCEPT))
             return 0;
+        double kept = 0.0; /* how far the step stayed after the polish [rad] */
+        for (int j = 0; j < 6; j++)
+            kept = fmax(kept, fabs(trial[j] - before[j]));
+        stalled = kept < PK_SLIDE_KEPT * fabs(alpha) * big ? stalled + 1 : 0;
+        if (stalled >= PK_SLIDE_STALL)
+            return 0; /* pulled back every step: not a family */
     }
     double q[PK_MAXJ];
     if (!(pk_coords(P, g, trial, -1, 0.0, q) >= -1e-9))
