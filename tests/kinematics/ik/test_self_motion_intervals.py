@@ -416,9 +416,13 @@ def test_both_shoulder_triples_are_kept_at_an_aligned_node(q):
 # pose for a crossing or fold within 1e-4 of the aligned point (HM_FLAG_SINGULAR: 85 of
 # 993 such poses, ~12-27 ms each on the solved-points path). The shoulder's own swing
 # (joints 1 and 3) and the fold no longer flag it. Each pose flagged on main (5d24bb5).
+# The last three have q7 = 0 too: the swing's jump at t ~ 1e-15 was not bracketed to
+# adjacent doubles in hm_root's 80 steps (HM_FLAG_CONVERGE); a bracket below one ulp of
+# 1 now counts as collapsed there (hm_root, on a pose without repaired rows).
 GRID_ALIGNED = [[-3, 0, -3, -3, 0, 3, -2], [-3, 0, -2, -3, 2, 1, 1], [-2, 0, -2, -3, 0, 0, 0],
                 [1, 0, -3, -2, 1, 4, 1], [2, 0, 2, -3, 1, 4, -1], [-1, 0, 3, -2, 0, 4, 3],
-                [2, 0, 0, -2, 0, 2, 1], [0, 0, 2, -2, -1, 1, 0]]
+                [2, 0, 0, -2, 0, 2, 1], [0, 0, 2, -2, -1, 1, 0], [0, 0, -2, -2, 2, 0, 0],
+                [3, 0, 2, -2, 2, 0, 0], [-2, 0, 2, -2, -2, 3, 0]]
 
 
 @pytest.mark.parametrize("k", GRID_ALIGNED, ids=lambda k: "_".join(map(str, k)))
@@ -439,8 +443,12 @@ def test_a_pose_with_the_shoulder_aligned_at_multiples_of_a_quarter_turn_is_cert
 # (q6 at -0.0175 with q7 at its upper limit: special #241 of seed 22; q4 at -0.0698: #874
 # of seed 22, #305 of seed 31, q2 = 1e-9 there) still leaves the pose to the solved-points
 # path: certified without the test, their intervals differ from that path's by up to
-# 9e-6 of t (a joint riding its limit at the slack).
+# 9e-6 of t (a joint riding its limit at the slack). So does special #1420 of seed 8
+# (q1 at its limit, q2 = 0, q7 = 0): its crossing at t ~ 1e-12 is coarse, and a repair
+# pins q3 at its limit over 6e-9 of t next to it (an end 7.5e-9 off if certified).
 RIDING_AT_ALIGNED = [
+    [-2.8973, 0.0, 0.31713209546686416, -0.12504530149524173, 2.427107184458437,
+     3.326434346763758, 0.0],
     [1.5602641717709225, 0.0, -1.5707963267948966, -0.31029610933396423, 0.0, -0.0175,
      2.8973],
     [-1.5707963267948966, 0.0, 0.550441750782245, -0.0698, 1e-09, 3.7525, -2.8973],

@@ -194,6 +194,8 @@ typedef struct {
     int deep; /* split rows past HM_DEPTH in swings (HM_DEEP_ROWS) */
     int deep_cell; /* hm_needs_split: a touch of an aligned-axes value is no split */
     int jumped; /* a slot's rows jump somewhere (hm_jump): the pose gets hm_near_aligned's test */
+    int repaired; /* rows a repair brought inside (hm_repairs) */
+    int coarse; /* a crossing decided on a bracket below one ulp of 1, not of t (hm_root) */
     double sq_te; /* NaN: cells in t; else a branch end's t: cells in sigma (hm_sigma) */
     int retry; /* a new slot change found by hm_root: the slot's pass is redone */
     double jump_t[HM_MAXJUMP][2]; /* the slot changes found (adjacent doubles), for every slot */
@@ -759,6 +761,7 @@ static int hm_make(HmCtx *c, double x, unsigned need, const PkFront *f, HmRow *r
                 }
                 if (moves && hm_repairs(c, f, th, r->q[slot], sing)) {
                     inside = 1;
+                    c->repaired++;
                 } else if (moves || family) {
                     memcpy(late_th[slot], th, sizeof late_th[slot]);
                     *late |= 1u << slot;
@@ -1335,6 +1338,15 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
     /* a crossing as steep as an aligned triple makes it (q1, q3 swinging) may end
      * with its bracket two adjacent floats: the value nearest the joint's there */
     int collapsed = !(e - a > 2.0 * DBL_EPSILON * fmax(fabs(a), fabs(e)));
+    /* or narrower than one ulp of 1 where t ~ 1e-16..1e-13 (q7 = 0 with q2 = 0: the
+     * swing's jump at an aligned point there needs more halvings than the loop's 80 to
+     * reach adjacent doubles; session 22), trusted only on a pose without repaired rows
+     * (hm_pose: a row a repair pinned at a limit there, special #1420 of seed 8) */
+    if (!collapsed && !(best_f <= HM_TOL) &&
+        !(e - a > 2.0 * DBL_EPSILON * fmax(1.0, fmax(fabs(a), fabs(e))))) {
+        collapsed = 1;
+        c->coarse = 1;
+    }
     /* or, in a swing (hm_cell), the joint's move over the last bits of t (1e-7..3e-5
      * at slopes of 1e9..1e11: no double puts it nearer) */
     double last = HM_FLOOR * fabs(r.dq[b][j]) * (e - a);
@@ -2914,6 +2926,8 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
     }
     if (!c->flags && c->jumped && hm_near_aligned(c))
         c->flags |= HM_FLAG_SINGULAR;
+    if (!c->flags && c->coarse && c->repaired)
+        c->flags |= HM_FLAG_CONVERGE; /* a coarse crossing on a pose with repaired rows */
     if (c->flags) /* a flagged pose stops at its first flag: no intervals */
         for (int b = 0; b < 8; b++)
             niv[b] = 0;
@@ -2985,6 +2999,8 @@ static void hm_range(void *ctx, long b0, long e0)
         c->fast = hm_fast_setup(c);
         c->full_fk = 0;
         c->jumped = 0;
+        c->repaired = 0;
+        c->coarse = 0;
         c->deep = 0;
         c->deep_cell = 0;
         c->sq_te = NAN;
