@@ -172,6 +172,16 @@ def _certified(q: list[float]):
     return T, sm
 
 
+def _answered(q: list[float]) -> None:
+    """The Panda's manifold of fk(q), whichever path answered it, held to _check_dense,
+    and, where the kernel certified it, to _check_against_solved_points."""
+    T = PANDA.fk(np.array(q))
+    sm = PANDA.self_motion(T)
+    _check_dense(sm)
+    if sm.info.get("compiled"):
+        _check_against_solved_points(PANDA, T, sm)
+
+
 def _aligned_shoulder(q: np.ndarray) -> bool:
     return abs(np.sin(q[1])) < 1e-6
 
@@ -402,11 +412,7 @@ ALIGNED_NODES = [
 
 @pytest.mark.parametrize("q", ALIGNED_NODES)
 def test_both_shoulder_triples_are_kept_at_an_aligned_node(q):
-    T = PANDA.fk(np.array(q))
-    sm = PANDA.self_motion(T)
-    _check_dense(sm)
-    if sm.info.get("compiled"):
-        _check_against_solved_points(PANDA, T, sm)
+    _answered(q)
 
 
 # Issue 29, session 22: the poses users type, every joint a multiple of pi/4 with the
@@ -459,11 +465,7 @@ RIDING_AT_ALIGNED = [
 
 @pytest.mark.parametrize("q", RIDING_AT_ALIGNED)
 def test_a_joint_riding_its_limit_at_an_aligned_point_agrees_with_the_solved_points(q):
-    T = PANDA.fk(np.array(q))
-    sm = PANDA.self_motion(T)
-    _check_dense(sm)
-    if sm.info.get("compiled"):
-        _check_against_solved_points(PANDA, T, sm)
+    _answered(q)
 
 
 def test_a_branch_end_hidden_in_a_fold_cell_of_the_solved_points_path_is_found():
