@@ -90,6 +90,37 @@ def test_import_robokin_loads_only_the_core():
     assert "robokin.robot" in loaded and "robokin.kinematics.forward" in loaded
 
 
+_FIRST_CALLS_PROBE = """
+import json, sys
+import numpy as np, robokin
+panda = robokin.load("panda")
+q = np.array([0.0, np.pi / 6, 0.0, -np.pi / 2, 0.0, np.pi / 3, 0.0])
+sm = panda.self_motion(panda.fk(q))
+near = np.abs(sm.sample(np.array([0.0]))[0] - q).max(axis=-1)
+ur5 = robokin.load("ur5")
+sols = ur5.ik(ur5.fk(np.array([0.1, -0.4, 0.5, -0.2, 0.3, 0.6])))
+print(json.dumps([float(np.nanmin(near)), len(sols), sorted(sys.modules)]))
+"""
+
+
+def test_first_self_motion_and_ik_calls_do_not_import_scipy():
+    """A first ``self_motion`` on a 7R arm (the Panda's ready pose) and a first 6R
+    ``ik`` stay off scipy (session 23: the Pieper set-up's held-joint rotation went
+    through ``scipy.spatial``, 175 modules and ~0.16 s of the first call's 0.19 s;
+    now Rodrigues' formula in ``robokin.spatial``). Oracle: the fresh interpreter's
+    module table, and the ready pose among the manifold's rows at q7 = 0.
+    """
+    import json
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, "-c", _FIRST_CALLS_PROBE], capture_output=True,
+                         text=True, check=True, timeout=120)
+    near, n_ik, loaded = json.loads(out.stdout)
+    assert near < 1e-12 and n_ik >= 1
+    assert [m for m in loaded if m == "scipy" or m.startswith("scipy.")] == []
+
+
 def test_public_names_resolve_after_a_bare_import():
     """Every ``__all__`` name and lazy subpackage works from a fresh interpreter."""
     import subprocess

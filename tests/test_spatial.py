@@ -63,6 +63,20 @@ def test_axis_angle_round_trip(rng):
     )
 
 
+@pytest.mark.parametrize("angle", [0.0, 1e-12, 1e-9, 9.99e-5, 1.0001e-4, 0.5, np.pi / 2,
+                                   np.pi - 1e-9, np.pi, 7.0])
+def test_rotation_from_rotvec_matches_scipy_at_special_angles(angle, rng):
+    """Rodrigues' formula (numpy, no scipy) against scipy's quaternion route, at the
+    series switch (1e-4), near zero and near pi; batched with a leading shape."""
+    axis = rng.normal(size=(3, 4, 3))
+    w = axis / np.linalg.norm(axis, axis=-1, keepdims=True) * angle
+    R = sp.rotation_from_rotvec(w)
+    assert R.shape == (3, 4, 3, 3)
+    ref = Rotation.from_rotvec(w.reshape(-1, 3)).as_matrix().reshape(3, 4, 3, 3)
+    np.testing.assert_allclose(R, ref, rtol=0, atol=4e-15)
+    np.testing.assert_allclose(sp.matrix_from_axis_angle(w)[..., :3, :3], R, rtol=0, atol=0)
+
+
 def test_pose_error_known_values():
     A = sp.trans(1.0, 2.0, 3.0)
     B = sp.trans(1.5, 2.0, 2.0) @ sp.rotz(0.25)

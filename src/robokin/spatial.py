@@ -1,7 +1,9 @@
 """SE(3) helpers on batches of 4x4 homogeneous transforms.
 
 Every function takes any leading batch shape ``(...)`` and returns the same leading
-shape. Angles are radians, lengths metres. Rotation conversions go through
+shape. Angles are radians, lengths metres. Rotation vectors become matrices by
+Rodrigues' formula here (numpy only: the 7R self-motion and the Pieper set-up use it,
+and a first call should not import scipy); the other rotation conversions go through
 ``scipy.spatial.transform.Rotation`` (imported lazily). Conventions are listed in
 ``docs/conventions.md``: RPY is roll about x, then pitch about y, then yaw about z,
 all about the fixed (base) axes, i.e. ``R = Rz(yaw) @ Ry(pitch) @ Rx(roll)``;
@@ -201,7 +203,7 @@ def quaternion_from_matrix(T: npt.ArrayLike) -> np.ndarray:
 
 def matrix_from_axis_angle(rotvec: npt.ArrayLike) -> np.ndarray:
     """Rotation from a rotation vector (axis times angle [rad]); (..., 3) -> (..., 4, 4)."""
-    return _apply(lambda x: _rotation().from_rotvec(x), rotvec, 3, "rotvec")
+    return _from_R(_rodrigues(_shaped(rotvec, "rotvec", (3,))))
 
 
 def rotvec_from_rotation(R: npt.ArrayLike) -> np.ndarray:
@@ -219,12 +221,27 @@ def rotvec_from_rotation(R: npt.ArrayLike) -> np.ndarray:
 
 def rotation_from_rotvec(w: npt.ArrayLike) -> np.ndarray:
     """Rotation matrices of rotation vectors [rad]; (..., 3) -> (..., 3, 3)."""
-    w = _shaped(w, "w", (3,))
-    lead = w.shape[:-1]
-    if w.size == 0:
-        return np.zeros(lead + (3, 3))
-    out: np.ndarray = _rotation().from_rotvec(w.reshape(-1, 3)).as_matrix()
-    return out.reshape(lead + (3, 3))
+    return _rodrigues(_shaped(w, "w", (3,)))
+
+
+def _rodrigues(w: np.ndarray) -> np.ndarray:
+    """Rodrigues' formula, (..., 3) -> (..., 3, 3): ``I + a [w]x + b [w]x^2``.
+
+    a = sin(x) / x and b = (1 - cos(x)) / x^2 with x = |w|; b as 2 sin^2(x / 2) / x^2
+    (no cancellation); below x = 1e-4 both by their series to x^4 (error below 1e-20).
+    """
+    x2 = np.einsum("...i,...i->...", w, w)
+    x = np.sqrt(x2)
+    small = x < 1e-4
+    xs = np.where(small, 1.0, x)
+    h = np.sin(0.5 * xs) / xs
+    a = np.where(small, 1.0 - x2 / 6.0 + x2 * x2 / 120.0, np.sin(xs) / xs)
+    b = np.where(small, 0.5 - x2 / 24.0 + x2 * x2 / 720.0, 2.0 * h * h)
+    K = np.zeros(w.shape[:-1] + (3, 3))
+    K[..., 0, 1], K[..., 0, 2], K[..., 1, 2] = -w[..., 2], w[..., 1], -w[..., 0]
+    K[..., 1, 0], K[..., 2, 0], K[..., 2, 1] = w[..., 2], -w[..., 1], w[..., 0]
+    R: np.ndarray = np.eye(3) + a[..., None, None] * K + b[..., None, None] * (K @ K)
+    return R
 
 
 def axis_angle_from_matrix(T: npt.ArrayLike) -> np.ndarray:

@@ -83,6 +83,7 @@ from robokin.kinematics.ik.analytic._geometry import (
 )
 from robokin.kinematics.ik.solutions import SolutionSet
 from robokin.model.chain import Chain
+from robokin.spatial import rotation_from_rotvec
 
 __all__ = ["NAME", "FamilySolver", "Setup", "family_solver", "limit_params", "make_single", "measure",
            "raw_solve", "setup",
@@ -133,9 +134,7 @@ def _turned(poe: Poe, held: int | None, value: float) -> tuple[np.ndarray, np.nd
     """
     if held is None:
         return poe.h, poe.o
-    from scipy.spatial.transform import Rotation
-
-    R = Rotation.from_rotvec(poe.h[held] * value).as_matrix()
+    R = rotation_from_rotvec(poe.h[held] * value)
     h = poe.h.copy()
     o = poe.o.copy()
     h[held + 1:] = h[held + 1:] @ R.T
