@@ -550,6 +550,60 @@ def test_the_compiled_panda_records_are_the_kernels_points_and_the_cached_family
             assert again.domain is not first.domain  # each its own copy
 
 
+def test_one_per_point_merges_runs_of_one_aligned_point_only():
+    """Oracle: the rule itself on made-up kernel rows ``[t, branch, joint, kind]``: a
+    run of aligned-axes rows (kind 2) of one branch with successive t at most
+    ALIGNED_SAME apart, whichever joint, becomes its middle row (a chain 2e-9 long
+    included); another branch at the same t, a limit or fold row, and rows just over
+    the tolerance apart stay; the kept rows in the input's order."""
+    from robokin.kinematics.ik.self_motion_families import ALIGNED_SAME, one_per_point
+
+    h = 0.5 * ALIGNED_SAME
+    run = [[1.0 + h * i, 0, 1 + (i == 4), 2] for i in (3, 0, 1, 2, 4)]  # middle: i = 2
+    keep = [[1.0, 3, 1, 2], [1.0, 0, 1, 3], [1.0, 0, 1, 0],
+            [2.0, 0, 1, 2], [2.0 + 1.01 * ALIGNED_SAME, 0, 1, 2]]
+    points = np.array([keep[0], *run[:2], keep[1], *run[2:], *keep[2:]])
+    got = one_per_point(points, 2)
+    assert got.tolist() == [keep[0], keep[1], [1.0 + 2 * h, 0, 1, 2], *keep[2:]]
+    assert one_per_point(points[:0], 2).shape == (0, 4)
+    assert one_per_point(points, 7) is points
+
+
+@pytest.mark.parametrize("q", [
+    [-np.pi / 4, 0.0, -3 * np.pi / 4, -np.pi / 2, -np.pi / 4, np.pi, np.pi / 2],
+    [2.8973, 0.0, -1.043253853514971, -2.9825664629405866, 1e-09, 0.3896659451021919,
+     -2.615263799627044],
+    [0.0, np.pi / 6, 0.0, -np.pi / 2, 0.0, np.pi / 3, 0.0],
+], ids=["quarter-turns-q2-0", "q1-at-limit-q2-0", "ready"])
+def test_an_aligned_point_is_one_record_however_often_the_kernel_marks_it(q):
+    """Oracle: the kernel's own aligned-axes rows (``_points``, kind HM_KIND_ALIGNED),
+    grouped per branch where successive t are within 1e-9: one record per group, at
+    one of the group's t, records of one branch more than 1e-9 apart; the branch's
+    row there (where it exists) has a joint at an aligned value (sin within 1e-6).
+    Before: the first pose (q2 = 0, the swing next to the generating configuration)
+    listed 157 aligned-axes records for 11 groups (74 copies within 3e-12 on one
+    branch), the second 75 for 17, the ready pose 8 for 6 (t = 0 twice on two
+    branches)."""
+    from robokin._native import kernels as K
+
+    sm = PANDA.self_motion(PANDA.fk(np.array(q)))
+    assert sm.info["compiled"] and sm.info["flags"] == 0
+    raw = sm._points[sm._points[:, 3] == K.HM_KIND_ALIGNED]
+    got = sorted((p.branch, p.t) for p in sm.singular if p.kind == "aligned axes")
+    want = []
+    for b in np.unique(raw[:, 1]).astype(int):
+        ts = np.sort(raw[raw[:, 1] == b, 0])
+        for g in np.split(ts, np.flatnonzero(np.diff(ts) > 1e-9) + 1):
+            mine = [t for bb, t in got if bb == b and g[0] <= t <= g[-1]]
+            assert len(mine) == 1, (b, g, mine)
+            want.append((b, mine[0]))
+            row = sm.sample(np.array(mine))[0, b]
+            if np.isfinite(row).all():  # joints 2-6 aligned at 0 or -pi
+                assert np.abs(np.sin(row[1:6])).min() < 1e-6
+    assert sorted(want) == got
+    assert len(got) < len(raw)
+
+
 def test_a_crossing_at_the_parameters_own_limit_is_kept():
     # Found by benchmarks/self_motion_rates.py (issue 29): the rtb-data iiwa14, q with
     # joint_a3 (the parameter) at its lower limit and joint_a4 at its upper one. The

@@ -60,6 +60,7 @@ from robokin.kinematics.ik.self_motion_families import (
     _setup,
     _SwivelFamily,
     continued_parameter,
+    one_per_point,
 )
 from robokin.kinematics.ik.self_motion_intervals import (
     GRID,
@@ -118,7 +119,8 @@ class SelfMotion:
         interval_branch: (m,) the branch of each interval.
         crossings: Every point where a branch meets a joint limit (a property:
             built from ``_points`` on first access, then kept in ``_records``).
-        singular: Branch ends ("fold") and aligned-axes points (the same).
+        singular: Branch ends ("fold") and aligned-axes points (the same; a
+            kernel's repeats of one point merged: ``self_motion_families.one_per_point``).
         method: How the branches are computed.
         info: ``bisected`` (state changes found by bisection, not exactly),
             ``grid`` (values checked; the continued family: its nodes), and on
@@ -579,7 +581,7 @@ def _records_of(points: np.ndarray) -> tuple[tuple[LimitCrossing, ...],
     """The records of the compiled swivel's points (p, 4) ``[psi, branch, joint, kind]``."""
     cross: list[LimitCrossing] = []
     sing: list[SingularPoint] = []
-    for t, b, j, k in points.tolist():
+    for t, b, j, k in one_per_point(points, K.SM_KIND_ALIGNED).tolist():
         if k <= K.SM_KIND_UPPER:
             cross.append(LimitCrossing(t, int(b), int(j), _KINDS[int(k)]))
         else:

@@ -28,6 +28,7 @@ from robokin.kinematics.ik.self_motion_families import (
     SingularPoint,
     _HeldFamily,
     _setup,
+    one_per_point,
 )
 from robokin.spatial import wrap_angle as _wrap
 
@@ -868,9 +869,10 @@ def _held_records(points: np.ndarray) -> tuple[tuple[LimitCrossing, ...],
     """The records of the held-joint kernel's points (p, 4) ``[t, branch, joint, kind]``.
 
     Crossings by branch then t; singular points: the folds, then the aligned-axes
-    points (each by branch then t).
+    points (each by branch then t; repeats of one merged, :func:`one_per_point`).
     """
-    p = points[np.lexsort((points[:, 0], points[:, 1]))]
+    p = one_per_point(points, K.HM_KIND_ALIGNED)
+    p = p[np.lexsort((p[:, 0], p[:, 1]))]
     limit = p[:, 3] <= K.HM_KIND_UPPER
     cross = tuple(LimitCrossing(t, int(b), int(j), _KINDS[int(k)])
                   for t, b, j, k in p[limit].tolist())
