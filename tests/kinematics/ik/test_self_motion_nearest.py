@@ -6,21 +6,25 @@ Oracles (independent of the search under test):
   wrapped distance to q_near; the answer is never farther than that (1e-12);
 * forward kinematics of the answer reproduces the pose to 1e-12 (position [m] and
   rotation angle [rad], ``reference.pose_errors``), and it is inside the limits;
-* from q0 itself (inside the limits) the answer is q0.
+* from q0 itself (inside the limits) the answer is q0, also where q2 or q6 is 0 (an
+  aligned continuum: session 23), and from q_near the answer is never farther than q0.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import robokin
-from reference import pose_errors, random_7r, ur5_on_a_track
+from reference import iiwa14_srs, pose_errors, random_7r, ur5_on_a_track
 from robokin.kinematics.arm import arm_of
 from robokin.kinematics.ik.dispatch import solve
 from robokin.kinematics.ik.self_motion_families import _family
 from robokin.kinematics.ik.self_motion_nearest import interval_nearest
 from robokin.spatial import wrap_angle
+from special_values import configurations, draw_configurations
 
 PANDA = robokin.load("panda")
 DENSE = 5000
@@ -126,3 +130,109 @@ def test_a_general_7r_arm_takes_its_continued_manifold(i):
     assert arm.within_limits(res.q)
     dp, dr = pose_errors(arm.fk(res.q), T)
     assert dp <= 1e-12 and dr <= 1e-12
+
+
+# Session 23: aligned continua. Where joint j puts axes j-1 and j+1 on one line (the
+# Panda's and the iiwa's q2 = 0 or q6 = 0), the pose is also reached by every
+# configuration turning those two joints against each other: a continuum at one
+# parameter value, which the branches' rows meet in a single point. The search on
+# the branches alone returned, from an in-limit configuration with q2 = 0 (Panda,
+# SRS) or q6 = 0 (SRS), a configuration up to 3 rad away (SRS batch of q6 = 0 poses:
+# 1 % within the generating configuration's distance).
+
+SRS = iiwa14_srs()
+#: The arms and the aligned joints forced to 0 in these tests (Panda: q6 = 0 puts
+#: joints 5 and 7 on one line, the parameter's own pair: covered by the branches).
+ALIGNED = {"panda": (PANDA, (1, 5)), "srs": (SRS, (1, 5))}
+
+
+def _aligned_configuration(robot, q: np.ndarray, which: int) -> np.ndarray:
+    """q inside the limits with the aligned joints of ``which`` (1, 2 or 3: bits) at 0."""
+    q = np.clip(q, robot.limits[:, 0], robot.limits[:, 1])
+    for bit, j in enumerate(ALIGNED["panda" if robot is PANDA else "srs"][1]):
+        if which >> bit & 1:
+            q[j] = 0.0
+    return q
+
+
+def _checked(robot, T, q_near, got) -> float:
+    """The answer's 2 pi wrapped distance to q_near; asserts it reaches T inside the limits."""
+    assert got is not None
+    q = got if isinstance(got, np.ndarray) else got.q
+    dp, dr = pose_errors(robot.fk(q), T)
+    assert dp <= 1e-12 and dr <= 1e-12
+    assert robot.within_limits(q)
+    return float(np.linalg.norm(wrap_angle(q - q_near)))
+
+
+@pytest.mark.parametrize("name", ["panda", "srs"])
+@given(data=st.data())
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+def test_from_an_aligned_configuration_the_answer_is_itself(name, data):
+    """Oracle: q0 itself, inside the limits with q2 and / or q6 at 0 (the other joints
+    special or uniform): ``nearest(q0)`` and ``ik_near(fk(q0), q0, method=
+    "self_motion")`` return q0 (1e-9), reaching the pose to 1e-12 inside the limits."""
+    robot, _ = ALIGNED[name]
+    q0 = _aligned_configuration(robot, data.draw(configurations(robot)),
+                                data.draw(st.sampled_from([1, 2, 3])))
+    T = robot.fk(q0)
+    for got in (robot.self_motion(T).nearest(q0), robot.ik_near(T, q0, method="self_motion")):
+        assert _checked(robot, T, q0, got) <= 1e-9
+
+
+@pytest.mark.parametrize("name", ["panda", "srs"])
+def test_near_an_aligned_configuration_the_answer_is_never_farther_than_it(name):
+    """Oracle: q0 (inside the limits, q2 and / or q6 at 0) solves its pose, so the
+    answer for q_near = q0 + noise (0.05-0.5 rad) is never farther from q_near than
+    q0 (1e-6: where two joints sit at limits at q0 the branch search's point is
+    7.5e-7 farther); one ``ik_near`` batch (the SRS arm's compiled path) and
+    ``nearest`` per pose agree on the distance (1e-6)."""
+    robot, _ = ALIGNED[name]
+    rng = np.random.default_rng(2323)
+    n = 24
+    q0 = np.array([_aligned_configuration(robot, q, 1 + i % 3)
+                   for i, q in enumerate(draw_configurations(robot, rng, n))])
+    qn = q0 + rng.normal(0.0, 1.0, q0.shape) * rng.choice([0.05, 0.2, 0.5], (n, 1))
+    T = robot.fk(q0)
+    batch = robot.ik_near(T, qn, method="self_motion")
+    for i in range(n):
+        bound = float(np.linalg.norm(wrap_angle(q0[i] - qn[i])))
+        d_batch = _checked(robot, T[i], qn[i], batch.q[i])
+        d_one = _checked(robot, T[i], qn[i], robot.self_motion(T[i]).nearest(qn[i]))
+        assert d_batch <= bound + 1e-6 and d_one <= bound + 1e-6
+        assert d_batch == pytest.approx(d_one, abs=1e-6)
+
+
+def test_a_continuum_step_is_the_brute_force_minimum():
+    """Oracle: a dense scan of s (200,001 values over each in-limit stretch, the pair's
+    2 pi turns included) of |wrap(q_a + s - n_a)|^2 + |wrap(q_b - sign s - n_b)|^2:
+    ``_pair_step``'s point is no farther (1e-9), inside both limits, and on the
+    continuum (q_a + sign q_b kept, mod 2 pi)."""
+    from robokin.kinematics.ik.self_motion_nearest import _pair_step
+
+    rng = np.random.default_rng(23)
+    m = 200
+    lo = np.array([-2.9, -1.8, -2.9, -3.1, -2.9, -0.1, -2.9])
+    hi = np.array([2.9, 1.8, 2.9, -0.1, 2.9, 3.8, 2.9])
+    q = rng.uniform(lo, hi, (m, 7))
+    qn = rng.uniform(-np.pi, np.pi, (m, 7))
+    wrapped = np.ones(7, dtype=bool)
+    for sign in (1.0, -1.0):
+        got = _pair_step(q, 0, 2, sign, lo, hi, wrapped, qn)
+        assert np.all((got >= lo) & (got <= hi))
+        np.testing.assert_allclose(wrap_angle(got[:, 0] + sign * got[:, 2]
+                                              - q[:, 0] - sign * q[:, 2]), 0.0, atol=1e-12)
+        f = wrap_angle(got[:, 0] - qn[:, 0]) ** 2 + wrap_angle(got[:, 2] - qn[:, 2]) ** 2
+        s = np.linspace(-4 * np.pi, 4 * np.pi, 200_001)
+        for i in range(0, m, 10):
+            qa, qb = q[i, 0] + s, q[i, 2] - sign * s
+            best = np.inf
+            for ka in (-2, -1, 0, 1, 2):
+                for kb in (-2, -1, 0, 1, 2):
+                    a, b = qa + 2 * np.pi * ka, qb + 2 * np.pi * kb
+                    ok = (a >= lo[0]) & (a <= hi[0]) & (b >= lo[2]) & (b <= hi[2])
+                    if ok.any():
+                        g = (wrap_angle(a[ok] - qn[i, 0]) ** 2
+                             + wrap_angle(b[ok] - qn[i, 2]) ** 2)
+                        best = min(best, float(g.min()))
+            assert f[i] <= best + 1e-9

@@ -120,7 +120,7 @@ def _manifold_near(arm: Arm, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
     check_broadcasts(q_near, lead + (arm.n,), "q_near")
     Tf = T.reshape(-1, 4, 4)
     qn = np.broadcast_to(q_near, lead + (arm.n,)).reshape(-1, arm.n)
-    fast = swivel_nearest(arm, Tf, qn)  # SRS arms: one compiled batch
+    fast = swivel_nearest(arm, Tf, qn, solve)  # SRS arms: one compiled batch
     q = np.full((len(Tf), arm.n), np.nan) if fast is None else fast
     for i, (Ti, qi) in enumerate(zip(Tf, qn, strict=True)):
         p = None if fast is not None else nearest_on_manifold(arm, Ti, qi, dispatch=solve)

@@ -79,8 +79,9 @@ from robokin.kinematics.ik.self_motion_intervals import (
     _state_changes,
     _within,
 )
-from robokin.kinematics.ik.self_motion_nearest import interval_nearest
+from robokin.kinematics.ik.self_motion_nearest import interval_nearest, nearer_points
 from robokin.kinematics.ik.swivel import SwivelArm
+from robokin.spatial import wrap_angle as _wrap
 
 __all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SelfMotionSetup", "SingularPoint",
            "auto_parameter", "exact_parameter",
@@ -94,7 +95,12 @@ _KEEP = 3
 
 @dataclass(frozen=True)
 class ManifoldPoint:
-    """One configuration on the manifold: ``q`` (n,), at ``t`` on ``branch``, ``score``."""
+    """One configuration on the manifold: ``q`` (n,), at ``t`` on ``branch``, ``score``.
+
+    ``q`` is ``sample(t)[branch]``, except for a solution ``SelfMotion.nearest`` found
+    off the branches' rows (a point of an aligned continuum, where the branches meet
+    it in one point): then ``branch`` is the branch whose row at t is nearest.
+    """
 
     q: np.ndarray
     t: float
@@ -136,6 +142,8 @@ class SelfMotion:
         _held: ``_points`` are the held-joint kernel's (``_held_records`` orders them).
         _corners: ``(t, branch, row)`` of corners whose row was refined on the pose
             (``self_motion_intervals._points_refined``): ``sample`` returns that row.
+        _dispatch: ``dispatch.solve`` as :func:`self_motion` had it (``nearest``
+            solves the pose with an aligned joint held), or None.
     """
 
     T: np.ndarray
@@ -155,6 +163,7 @@ class SelfMotion:
         default=None, repr=False)
     _held: bool = field(default=False, repr=False)
     _corners: tuple[tuple[float, int, np.ndarray], ...] = field(default=(), repr=False)
+    _dispatch: Dispatch | None = field(default=None, repr=False)
 
     @property
     def crossings(self) -> tuple[LimitCrossing, ...]:
@@ -234,19 +243,42 @@ class SelfMotion:
         On the compiled swivel (SRS arms) the kernel's search on the exact
         intervals (``SwivelArm.nearest``); elsewhere the exact intervals searched
         by ``self_motion_nearest.interval_nearest`` (end values, a 32-value grid,
-        golden-section refinement of the best local minima). ``samples`` is not
-        used (kept for callers that pass it).
+        golden-section refinement of the best local minima); then a nearer solution
+        off the branches where there is one (``self_motion_nearest.nearer_points``:
+        the numeric solve from ``q_near`` next to a swing, a point of an aligned
+        continuum; its ``t`` its parameter value, ``branch`` the branch whose row
+        there is nearest). ``samples`` is not used (kept for callers that pass it).
         """
         qn = check_finite(check_joints(q_near, self.limits.shape[0], "q_near"), "q_near")
         fam = self._family
         if isinstance(fam, _SwivelFamily) and not fam.reference:
-            return _swivel_nearest(fam.arm, self.T, qn)
-
-        found = interval_nearest(fam, self.limits, self.intervals, self.interval_branch, qn)
-        if found is None:
+            point = _swivel_nearest(fam.arm, self.T, qn)
+        else:
+            found = interval_nearest(fam, self.limits, self.intervals, self.interval_branch,
+                                     qn)
+            point = None if found is None else ManifoldPoint(found[0], found[1], found[2],
+                                                             -found[3])
+        if self._dispatch is None:
+            return point
+        q = np.full((1, len(qn)), np.nan) if point is None else point.q[None]
+        q = nearer_points(self._family.robot, self.T[None], self.limits, qn[None], q,
+                          self._dispatch)
+        if point is not None and np.array_equal(q[0], point.q):
+            return point
+        if not np.isfinite(q).all():
             return None
-        q, t, branch, dist = found
-        return ManifoldPoint(q, t, branch, -dist)
+        wrapped = np.asarray(self._family.robot.is_revolute, dtype=bool)
+        diff = q[0] - qn
+        dist = float(np.linalg.norm(np.where(wrapped, _wrap(diff), diff)))
+        # a solution off the branches' samples: its parameter value, and the branch
+        # whose row there is nearest (an aligned continuum meets it at its point)
+        t = (float(q[0, self.joint]) if self.joint is not None
+             else float(parameter_values(self._family.robot, self.T, q[:, None])[1][0, 0]))
+        rows = self.sample(np.array([t]))[0]
+        diff = rows - q[0]
+        gap = np.linalg.norm(np.where(wrapped, _wrap(diff), diff), axis=-1)
+        branch = int(np.argmin(np.where(np.isfinite(gap), gap, np.inf)))
+        return ManifoldPoint(q[0], t, branch, -dist)
 
     def _maximise(self, score: Callable[[np.ndarray], np.ndarray],
                   samples: int) -> ManifoldPoint | None:
@@ -332,19 +364,27 @@ def _swivel_nearest(arm: SwivelArm, T: np.ndarray, q_near: np.ndarray) -> Manifo
     return ManifoldPoint(q[0], float(psi[0]), int(slot[0]), -float(dist[0]))
 
 
-def swivel_nearest(robot: ArmSource, T: np.ndarray, q_near: np.ndarray) -> np.ndarray | None:
+def swivel_nearest(robot: ArmSource, T: np.ndarray, q_near: np.ndarray,
+                   dispatch: Dispatch | None = None) -> np.ndarray | None:
     """The in-limit configurations (m, 7) of poses T (m, 4, 4) nearest ``q_near`` (m, 7).
 
     The compiled search on the exact swivel intervals (``SwivelArm.nearest``; NaN
     rows where no part of a manifold is inside the limits); None when the arm is
-    not SRS (then :func:`nearest_on_manifold` per pose).
+    not SRS (then :func:`nearest_on_manifold` per pose). With ``dispatch``
+    (``dispatch.solve``) a row is replaced by a nearer solution off the branches
+    where there is one (``self_motion_nearest.nearer_points``: the numeric solve from
+    q_near, aligned continua); without, the kernel's.
     """
-    arm = _setup(arm_of(robot)).swivel
+    robot = arm_of(robot)
+    arm = _setup(robot).swivel
     if arm is None:
         return None
     q, _, _, _, found = arm.nearest(T, q_near)
     q[~found] = np.nan
-    return q
+    if dispatch is None:
+        return q
+    return nearer_points(robot, T, np.asarray(robot.limits, dtype=np.float64), q_near, q,
+                         dispatch)
 
 
 def auto_parameter(robot: ArmSource) -> str | None:
@@ -457,7 +497,7 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
     limits = np.asarray(robot.limits, dtype=np.float64)
     # the compiled swivel (an SRS arm's "auto"): no family choice, no per-call lists
     if setup is not None and setup.swivel is not None and parameter in ("auto", "swivel"):
-        return _swivel_motion(setup.swivel, Ta, robot, limits)
+        return _swivel_motion(setup.swivel, Ta, robot, limits, dispatch)
     if kern is not None:
         fam: _Family = _HeldFamily(robot, kern.params, kern.joint, Ta, dispatch, kern.named)
     else:
@@ -475,7 +515,8 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
             if close:  # the kernel ran _points_refined's cheap test: a uniform pose skips it
                 intervals, owner, corners = _points_refined(fam, limits, intervals, owner,
                                                             points, K.HM_KIND_UPPER)
-            return _held_motion(Ta, kern, intervals, owner, info, fam, limits, points, corners)
+            return _held_motion(Ta, kern, intervals, owner, info, fam, limits, points, corners,
+                                dispatch)
         fallback = {"compiled": False, "flags": info["flags"]}  # not certified: solved points
     if isinstance(fam, _ContinuedFamily):
         marks = fam.marks(limits, _aligned_values(robot))
@@ -514,16 +555,17 @@ def self_motion(robot: ArmSource, T: npt.ArrayLike, parameter: str = "auto", *,
                       intervals, owner, method,
                       {"bisected": bisected, "grid": int(grid), **fallback,
                        **_solves(fam)}, fam, limits,
-                      _records=(crossings, singular), _corners=corners)
+                      _records=(crossings, singular), _corners=corners, _dispatch=dispatch)
 
 
 def _held_motion(T: np.ndarray, kern: HeldKernel, intervals: np.ndarray, owner: np.ndarray,
                  info: dict[str, Any], fam: _Family, limits: np.ndarray, points: np.ndarray,
-                 corners: tuple[tuple[float, int, np.ndarray], ...] = ()) -> SelfMotion:
+                 corners: tuple[tuple[float, int, np.ndarray], ...] = (),
+                 dispatch: Dispatch | None = None) -> SelfMotion:
     """The compiled held family's SelfMotion: the dataclass' fields set directly.
 
     Equal to ``SelfMotion(T, name, joint, domain, False, 8, intervals, owner, method,
-    info, fam, limits, points, None, True, corners)`` (the frozen dataclass' ``__init__``
+    info, fam, limits, points, None, True, corners, dispatch)`` (the frozen dataclass' ``__init__``
     costs ~4 us; one dict literal as the instance's ``__dict__`` ~1 us, as
     ``_swivel_motion``).
     """
@@ -532,16 +574,18 @@ def _held_motion(T: np.ndarray, kern: HeldKernel, intervals: np.ndarray, owner: 
         "T": T, "parameter": kern.named[0], "joint": kern.joint, "domain": kern.domain.copy(),
         "periodic": False, "n_branches": 8, "intervals": intervals, "interval_branch": owner,
         "method": kern.method, "info": info, "_family": fam, "limits": limits,
-        "_points": points, "_records": None, "_held": True, "_corners": corners})
+        "_points": points, "_records": None, "_held": True, "_corners": corners,
+        "_dispatch": dispatch})
     return sm
 
 
-def _swivel_motion(arm: SwivelArm, T: np.ndarray, robot: Arm, limits: np.ndarray
-                   ) -> SelfMotion:
+def _swivel_motion(arm: SwivelArm, T: np.ndarray, robot: Arm, limits: np.ndarray,
+                   dispatch: Dispatch | None = None) -> SelfMotion:
     """The compiled swivel's SelfMotion: the dataclass' fields set directly.
 
     Equal to ``SelfMotion(T, "swivel", None, domain, True, 8, intervals, owner, method,
-    {"bisected": 0, "grid": 0}, family, limits, points, _corners=corners)`` (the frozen dataclass'
+    {"bisected": 0, "grid": 0}, family, limits, points, _corners=corners,
+    _dispatch=dispatch)`` (the frozen dataclass'
     ``__init__`` is ~3 us of the ~9 us the API adds to the kernel; one dict literal
     as the instance's ``__dict__`` ~1 us).
     """
@@ -557,7 +601,7 @@ def _swivel_motion(arm: SwivelArm, T: np.ndarray, robot: Arm, limits: np.ndarray
         "periodic": True, "n_branches": 8, "intervals": intervals, "interval_branch": owner,
         "method": _SWIVEL_METHOD, "info": {"bisected": 0, "grid": 0}, "_family": sw,
         "limits": limits, "_points": points, "_records": None, "_held": False,
-        "_corners": corners})
+        "_corners": corners, "_dispatch": dispatch})
     return sm
 
 

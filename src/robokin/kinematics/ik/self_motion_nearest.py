@@ -12,17 +12,25 @@ tried nearest first, and the first whose row is inside every limit (``MANIFOLD_S
 returned, clamped into the limits, each revolute joint but the parameter at its 2 pi
 equivalent nearest ``q_near`` where that is inside the limits (as
 ``SolutionSet.nearest``); a tie of t and t -+ 2 pi goes to the unwrapped nearer.
+
+Then (``nearer_points``, for the compiled swivel's answers too) the solutions the
+branches' samples do not hold: the numeric solve from ``q_near`` (a swing next to an
+aligned shoulder) and the aligned continua (where joint j puts axes j-1 and j+1 on
+one line, the pair turning against each other: a continuum at one parameter value),
+each taken where it is nearer and exact, then descended along the self-motion.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from robokin.kinematics.arm import Arm, Derived
+from robokin.kinematics.ik.fixed import Dispatch
 from robokin.kinematics.ik.self_motion_base import _Family
 from robokin.kinematics.ik.self_motion_intervals import _within
 from robokin.spatial import wrap_angle as _wrap
 
-__all__ = ["interval_nearest"]
+__all__ = ["interval_nearest", "nearer_points"]
 
 #: Parameter values per interval (ends included).
 GRID = 32
@@ -213,3 +221,304 @@ def _first_inside(fam: _Family, limits: np.ndarray, cand_t: np.ndarray, cand_b: 
 
 #: Distances [rad] this close are a tie (``_first_inside``).
 _TIE = 1e-9
+
+
+#: An aligned point's row is on its pair's continuum when its joint is this close to
+#: the aligned value [rad] (the kernels' aligned rows: within 1.4e-8, session 23).
+_ON_ALIGNED = 1e-6
+#: Pose error [m, rad] a solution found off the branches must reach (after its
+#: polish; the held-joint rows reach 4e-13).
+_EXACT = 4e-13
+#: Rounds at most over a row's aligned pairs with a joint in common (the iiwa
+#: stretched, q2 = q4 = q6 = 0: q1 + q3 + q5 + q7 fixed, a descent one pair at a time
+#: on a convex quadratic between wraps; one round is exact for pairs with none).
+_ROUNDS = 64
+#: Steps at most of the descent along the self-motion (:func:`_descend`).
+_DESCENT = 24
+#: A descent step below this [rad]: a local minimum (:func:`_descend`).
+_STILL = 1e-9
+
+
+def _line_pairs(robot: Arm) -> list[tuple[int, float, int, int, float]]:
+    """``(j, v, a, b, sign)``: joint j at v puts joints a and b on one line.
+
+    (``coincident.coincident_pair`` of each aligned value.)
+    """
+    from robokin.kinematics.ik.coincident import coincident_pair
+    from robokin.kinematics.ik.self_motion_intervals import _aligned_values
+
+    return [(j, v, p.a, p.b, p.sign) for j, v in _aligned_values(robot)
+            if (p := coincident_pair(robot, j, v)) is not None]
+
+
+#: The arm's line-sharing pairs at its aligned values (:func:`_line_pairs`).
+LINE_PAIRS: Derived[list[tuple[int, float, int, int, float]]] = Derived(
+    "joint pairs on one line at aligned values", _line_pairs)
+
+
+def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndarray,
+                  q: np.ndarray, dispatch: Dispatch) -> np.ndarray:
+    """Rows q (m, n) nearest q_near (m, n) on the branches, or nearer in-limit solutions.
+
+    The branch search (a grid per interval, refined minima) misses two kinds of
+    solution, both where an axis pair lines up:
+
+    1. *A swing.* Next to an aligned shoulder (q2 = 1e-9 on the Panda) a branch turns
+       q1 and q3 by ~pi within ~1e-9 of t; a q_near inside the swing is ~1 rad from
+       every sampled row. The numeric solver started at q_near (``numeric.solve``,
+       tolerance 1e-13) finds the solution next to it.
+    2. *An aligned continuum.* Where joint j at a value v puts axes j-1 and j+1 on
+       one line (``coincident.coincident_pair``: the Panda's q2 = 0, the iiwa's q2 or
+       q6 = 0), every configuration turning those joints a, b against each other,
+       q_a + s and q_b - sign s, reaches the same pose: where a branch passes q_j = v
+       there is a continuum at that one parameter value, which the branches' rows
+       meet in one point. Every point of it has q_j = v, so it is no nearer than
+       |q_near_j - v| (wrapped): for the poses where that bound is below the found
+       distance the pose is solved with joint j held at v (``fixed.solve_fixed``:
+       one row per family, each on its continuum) and each row moved along its
+       continuum to the point nearest q_near inside the limits (:func:`_pair_steps`:
+       a sum of quadratics between wraps, so its minimum is one of their vertices
+       clipped into the in-limit range, or an end of it), then along the continua of
+       any other pair the row has on one line (q2 = q6 = 0 on the iiwa: two), in
+       turn, ``_ROUNDS`` times where two pairs share a joint.
+
+    A nearer row is taken onto the pose (:func:`_onto`: Newton's least-squares steps)
+    and kept if its pose error is within ``_EXACT`` and it is inside every limit; such
+    rows then descend along the self-motion to a local minimum of the distance
+    (:func:`_descend`). So the answer is never farther than the branch search's.
+
+    Args:
+        robot: The arm (7R).
+        T: Poses (m, 4, 4) [m].
+        limits: Joint limits (n, 2) [rad].
+        q_near: Configurations (m, n) [rad].
+        q: The nearest in-limit rows found on the branches (m, n); NaN: none.
+        dispatch: ``dispatch.solve`` (:func:`~robokin.kinematics.ik.fixed.solve_fixed`'s).
+
+    Returns:
+        (m, n): q, with the rows a nearer solution replaced (a new array).
+    """
+    from robokin.kinematics.ik import numeric
+    from robokin.kinematics.ik.fixed import solve_fixed
+
+    q = np.array(q, dtype=np.float64)
+    if not len(q):
+        return q
+    lo, hi = limits[:, 0], limits[:, 1]
+    wrapped = np.asarray(robot.is_revolute, dtype=bool)
+    best = _distance(q, q_near, wrapped)
+    best = np.where(np.isfinite(best), best, np.inf)
+    found = np.zeros(len(q), dtype=bool)  # rows taken off the branches
+
+    def take(idx: np.ndarray, rows: np.ndarray) -> None:
+        """Rows (p, n) as q[idx] where each is a solution inside the limits, nearer.
+
+        Nearer than best[idx]; all at once (``_onto``'s Newton steps).
+        """
+        rows, err = _onto(robot, rows, T[idx])
+        d = _distance(np.clip(rows, lo, hi), q_near[idx], wrapped)
+        ok = (err <= _EXACT) & _within(rows, limits) & (d < best[idx] - _TIE)
+        q[idx[ok]], best[idx[ok]], found[idx[ok]] = np.clip(rows[ok], lo, hi), d[ok], True
+
+    local = numeric.solve(robot, T, q0=q_near, tol=_EXACT)
+    ql = np.asarray(local.q, dtype=np.float64).reshape(q.shape)
+    dl = np.where(np.asarray(local.success).reshape(-1), _distance(ql, q_near, wrapped), np.inf)
+    idx = np.flatnonzero(dl < best - _TIE)
+    if len(idx):
+        take(idx, ql[idx])
+    pairs = robot.derived(LINE_PAIRS)
+    names = robot.joint_names
+    for j, v, *_ in pairs:
+        idx = np.flatnonzero(np.abs(_wrap(q_near[:, j] - v)) < best - _TIE)
+        if not len(idx):
+            continue
+        sols = solve_fixed(robot, T[idx], {names[j]: v}, dispatch=dispatch, q_near=q_near[idx])
+        k = sols.q.shape[-2]
+        rows = sols.q.reshape(-1, robot.n)
+        ok = np.asarray(sols.valid).reshape(-1)
+        near = np.repeat(q_near[idx], k, axis=0)
+        moved = _pair_steps(rows, near, pairs, lo, hi, wrapped)
+        ok &= np.isfinite(moved).all(-1)
+        d = np.where(ok, _distance(moved, near, wrapped), np.inf).reshape(len(idx), k)
+        c = np.argmin(d, axis=1)
+        r = np.arange(len(idx))
+        nearer = d[r, c] < best[idx] - _TIE
+        if nearer.any():
+            take(idx[nearer], moved.reshape(len(idx), k, robot.n)[r, c][nearer])
+    if found.any():  # (the search's own rows are refined minima already)
+        q[found] = _descend(robot, T[found], limits, q_near[found], q[found], wrapped)
+    return q
+
+
+def _descend(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndarray,
+             q: np.ndarray, wrapped: np.ndarray) -> np.ndarray:
+    """Rows q (m, n) moved along the self-motion to a local minimum of the distance.
+
+    A step pulls the row toward q_near within the null space of its Jacobian (the
+    self-motion's tangent: the n - 6 directions of a redundant arm and those of
+    singular values below 1e-9 of the largest) and takes it back onto the pose by
+    Newton's least-squares steps (:func:`_onto`); it is halved until the row is
+    nearer, inside the limits and within ``_EXACT`` of the pose. A row stops where
+    the pull's step is below ``_STILL`` (a local minimum to within ~1e-18 of the
+    distance: the search's refined minima start there), where it would take a joint
+    at its limit outward (a constrained minimum), after six halvings, or after
+    ``_DESCENT`` steps. What it is for: a branch through a swing (q1 and q3 turning
+    by ~pi within ~1e-6 of t next to an aligned shoulder), which the search's
+    samples step over, from the numeric solution next to q_near.
+    """
+    from robokin.kinematics.jacobian import jacobian_and_pose
+
+    q = q.copy()
+    lo, hi = limits[:, 0], limits[:, 1]
+    live = np.flatnonzero(np.isfinite(q).all(-1))
+    alpha = np.ones(len(q))
+    for _ in range(_DESCENT):
+        if not len(live):
+            break
+        J, _ = jacobian_and_pose(robot.chain, q[live])
+        _, sv, Vt = np.linalg.svd(J)  # Vt (m, n, n)
+        null = np.ones((len(live), robot.n), dtype=bool)
+        null[:, :sv.shape[-1]] = sv < 1e-9 * sv[:, :1]
+        pull = np.where(wrapped, _wrap(q_near[live] - q[live]), q_near[live] - q[live])
+        step = np.einsum("mkn,mk->mn", Vt, np.einsum("mkn,mn->mk", Vt, pull) * null)
+        blocked = (((q[live] <= lo + 1e-9) & (step < -1e-12))
+                   | ((q[live] >= hi - 1e-9) & (step > 1e-12))).any(-1)
+        done = blocked | (np.abs(step).max(axis=-1) < _STILL)
+        live, step = live[~done], step[~done]
+        if not len(live):
+            break
+        trial, err = _onto(robot, q[live] + step * alpha[live, None], T[live])
+        ok = ((err <= _EXACT) & _within(trial, limits)
+              & (_distance(trial, q_near[live], wrapped)
+                 < _distance(q[live], q_near[live], wrapped)))
+        q[live[ok]] = np.clip(trial[ok], lo, hi)
+        alpha[live[~ok]] *= 0.5
+        live = live[alpha[live] > 1.0 / 64]
+    return q
+
+
+def _onto(robot: Arm, q: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows q (m, n) taken onto poses T (m, 4, 4) by three least-squares Newton steps.
+
+    Returns the rows and their largest position [m] / rotation [rad] error (m,).
+    """
+    from robokin.kinematics.jacobian import jacobian_and_pose
+    from robokin.spatial import pose_error
+
+    for _ in range(3):
+        J, F = jacobian_and_pose(robot.chain, q)
+        e = pose_error(F, T)
+        q = q + (np.linalg.pinv(J, rcond=1e-10) @ e[:, :, None])[:, :, 0]
+    _, F = jacobian_and_pose(robot.chain, q)
+    e = pose_error(F, T)
+    err: np.ndarray = np.maximum(np.linalg.norm(e[:, :3], axis=-1),
+                                 np.linalg.norm(e[:, 3:], axis=-1))
+    return q, err
+
+
+def _distance(q: np.ndarray, q_near: np.ndarray, wrapped: np.ndarray) -> np.ndarray:
+    """(m,) distances of rows q (m, n) to q_near (m, n), the revolute joints wrapped."""
+    with np.errstate(invalid="ignore"):
+        diff = q - q_near
+        out: np.ndarray = np.linalg.norm(np.where(wrapped, _wrap(diff), diff), axis=-1)
+    return out
+
+
+_TURNS = np.array([-1.0, 0.0, 1.0]) * 2.0 * np.pi
+
+
+def _pair_steps(rows: np.ndarray, q_near: np.ndarray,
+                pairs: list[tuple[int, float, int, int, float]], lo: np.ndarray,
+                hi: np.ndarray, wrapped: np.ndarray) -> np.ndarray:
+    """Rows (m, n) moved along their continua to the points nearest q_near (m, n).
+
+    Each row goes to the point inside the limits nearest its q_near; NaN rows where
+    a joint no pair moves is outside. A row is on pair (a, b)'s continuum where its
+    joint j is within ``_ON_ALIGNED`` of the pair's value v. Pairs sharing a joint
+    make one line of several axes (the iiwa stretched, q2 = q4 = q6 = 0: axes 1, 3, 5
+    and 7, c1 q1 + c3 q3 + c5 q5 + c7 q7 fixed): then every two of its joints turn
+    against each other, taken in turn (a convex quadratic under one linear
+    constraint and bounds, between wraps: two coordinates at a time reach its
+    minimum, as in sequential minimal optimisation), up to ``_ROUNDS`` times.
+    """
+    out = np.array(rows, dtype=np.float64)
+    on = np.stack([np.abs(_wrap(out[:, j] - v)) <= _ON_ALIGNED for j, v, *_ in pairs], -1)
+    for pattern in np.unique(on, axis=0):
+        if not pattern.any():
+            continue
+        sel = np.flatnonzero((on == pattern).all(-1))
+        moves = _line_moves([p for p, o in zip(pairs, pattern, strict=True) if o])
+        free = np.zeros(len(lo), dtype=bool)
+        free[[x for a, b, _ in moves for x in (a, b)]] = True
+        sub = out[sel]
+        with np.errstate(invalid="ignore"):
+            inside = np.all(free | ((sub >= lo - 1e-12) & (sub <= hi + 1e-12)), axis=-1)
+        sub[~inside] = np.nan
+        sub = np.where(free, np.clip(sub, lo, hi), sub)  # a moved joint a hair outside
+        keep = np.flatnonzero(inside)
+        lines = len(free.nonzero()[0]) < 2 * len(moves)  # a line of three or more joints
+        for _ in range(_ROUNDS if lines else 1):
+            before = sub[keep].copy()
+            for a, b, sign in moves:
+                sub[keep] = _pair_step(sub[keep], a, b, sign, lo, hi, wrapped,
+                                       q_near[sel[keep]])
+            if np.array_equal(sub[keep], before):
+                break
+        out[sel] = sub
+    return out
+
+
+def _line_moves(on: list[tuple[int, float, int, int, float]]) -> list[tuple[int, int, float]]:
+    """``(a, b, sign)``: every two joints of one line turning against each other.
+
+    The pairs on a line (q_a + sign q_b fixed) chained into groups with
+    coefficients c (c_b = sign c_a): a group's joints x, y keep c_x q_x + c_y q_y
+    with the rest still, so q_x + (c_y / c_x) q_y is fixed.
+    """
+    coef: dict[int, float] = {}
+    group: dict[int, int] = {}
+    for _, _, a, b, sign in on:
+        if a not in coef:
+            coef[a], group[a] = 1.0, a
+        if b not in coef:
+            coef[b], group[b] = sign * coef[a], group[a]
+        elif group[b] != group[a]:  # two groups joined: b's scaled to c_b = sign c_a
+            scale, old = sign * coef[a] / coef[b], group[b]
+            for x in [x for x in coef if group[x] == old]:
+                coef[x], group[x] = coef[x] * scale, group[a]
+    joints = sorted(coef)
+    return [(x, y, coef[y] / coef[x]) for i, x in enumerate(joints) for y in joints[i + 1:]
+            if group[x] == group[y]]
+
+
+def _pair_step(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np.ndarray,
+               wrapped: np.ndarray, q_near: np.ndarray) -> np.ndarray:
+    """Rows q (m, n) with q_a + s, q_b - sign s nearest q_near (m, n), both inside.
+
+    Each row unchanged (s = 0) where its pair is inside and nothing nearer is.
+    """
+    ra = q[:, a, None, None] + _TURNS[:, None]  # (m, 3, 1): the 2 pi turns, each its range
+    rb = q[:, b, None, None] + _TURNS[None, :]  # (m, 1, 3)
+    ea, eb = sign * (rb - hi[b]), sign * (rb - lo[b])
+    s_lo = np.maximum(lo[a] - ra, np.minimum(ea, eb))  # (m, 3, 3)
+    s_hi = np.minimum(hi[a] - ra, np.maximum(ea, eb))
+    u = _wrap(q_near[:, a] - q[:, a])[:, None] + _TURNS  # (m, 3): s putting q_a at q_near's
+    v = -sign * (_wrap(q_near[:, b] - q[:, b])[:, None] + _TURNS)
+    vertex = 0.5 * (u[:, :, None] + v[:, None, :]).reshape(len(q), 1, 1, 9)
+    s = np.concatenate([np.broadcast_to(vertex, s_lo.shape + (9,)),
+                        s_lo[..., None], s_hi[..., None]], axis=-1)  # (m, 3, 3, 11)
+    s = np.clip(s, s_lo[..., None], s_hi[..., None])
+    qa = ra[..., None] + s
+    qb = rb[..., None] - sign * s
+    na, nb = q_near[:, a, None, None, None], q_near[:, b, None, None, None]
+    fa = _wrap(qa - na) if wrapped[a] else qa - na
+    fb = _wrap(qb - nb) if wrapped[b] else qb - nb
+    f = np.where((s_lo <= s_hi)[..., None], fa * fa + fb * fb, np.inf).reshape(len(q), -1)
+    k = np.argmin(f, axis=1)
+    m = np.arange(len(q))
+    out = q.copy()
+    found = np.isfinite(f[m, k])
+    # (a range end reached by rounding a hair outside: clipped)
+    out[found, a] = np.clip(qa.reshape(len(q), -1)[m, k][found], lo[a], hi[a])
+    out[found, b] = np.clip(qb.reshape(len(q), -1)[m, k][found], lo[b], hi[b])
+    return out
