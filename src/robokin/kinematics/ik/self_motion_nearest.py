@@ -266,15 +266,16 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
     1. *A swing.* Next to an aligned shoulder (q2 = 1e-9 on the Panda) a branch turns
        q1 and q3 by ~pi within ~1e-9 of t; a q_near inside the swing is ~1 rad from
        every sampled row. The numeric solver started at q_near (``numeric.solve``,
-       tolerance 1e-13) finds the solution next to it.
+       tolerance ``_EXACT``) finds the solution next to it.
     2. *An aligned continuum.* Where joint j at a value v puts axes j-1 and j+1 on
        one line (``coincident.coincident_pair``: the Panda's q2 = 0, the iiwa's q2 or
        q6 = 0), every configuration turning those joints a, b against each other,
        q_a + s and q_b - sign s, reaches the same pose: where a branch passes q_j = v
        there is a continuum at that one parameter value, which the branches' rows
        meet in one point. Every point of it has q_j = v, so it is no nearer than
-       |q_near_j - v| (wrapped): for the poses where that bound is below the found
-       distance the pose is solved with joint j held at v (``fixed.solve_fixed``:
+       |q_near_j - v| (wrapped; a swing's points, q_j within ~1e-6 of v, likewise):
+       for the poses where that bound is below the found distance (both searches
+       run only there) the pose is solved with joint j held at v (``fixed.solve_fixed``:
        one row per family, each on its continuum) and each row moved along its
        continuum to the point nearest q_near inside the limits (:func:`_pair_steps`:
        a sum of quadratics between wraps, so its minimum is one of their vertices
@@ -296,18 +297,27 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         dispatch: ``dispatch.solve`` (:func:`~robokin.kinematics.ik.fixed.solve_fixed`'s).
 
     Returns:
-        (m, n): q, with the rows a nearer solution replaced (a new array).
+        (m, n): q, with the rows a nearer solution replaced (a new array where one is
+        searched, else q itself).
     """
     from robokin.kinematics.ik import numeric
     from robokin.kinematics.ik.fixed import solve_fixed
 
-    q = np.array(q, dtype=np.float64)
-    if not len(q):
+    pairs = robot.derived(LINE_PAIRS)
+    if not pairs or not len(q):
         return q
-    lo, hi = limits[:, 0], limits[:, 1]
     wrapped = np.asarray(robot.is_revolute, dtype=bool)
     best = _distance(q, q_near, wrapped)
-    best = np.where(np.isfinite(best), best, np.inf)
+    best[np.isnan(best)] = np.inf
+    # both kinds of solution have a pair's joint at (or within ~1e-6 of) its value v:
+    # no nearer than |q_near_j - v|, so only the poses where that is below the found
+    # distance for some pair are searched (most poses: none, and nothing more is done)
+    at = [j for j, *_ in pairs]
+    gap = np.abs(_wrap(q_near[:, at] - np.array([v for _, v, *_ in pairs])))
+    if not (gap.min(axis=-1) < best - _TIE).any():
+        return q
+    q = np.array(q, dtype=np.float64)
+    lo, hi = limits[:, 0], limits[:, 1]
     found = np.zeros(len(q), dtype=bool)  # rows taken off the branches
 
     def take(idx: np.ndarray, rows: np.ndarray) -> None:
@@ -320,16 +330,18 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         ok = (err <= _EXACT) & _within(rows, limits) & (d < best[idx] - _TIE)
         q[idx[ok]], best[idx[ok]], found[idx[ok]] = np.clip(rows[ok], lo, hi), d[ok], True
 
-    local = numeric.solve(robot, T, q0=q_near, tol=_EXACT)
-    ql = np.asarray(local.q, dtype=np.float64).reshape(q.shape)
-    dl = np.where(np.asarray(local.success).reshape(-1), _distance(ql, q_near, wrapped), np.inf)
-    idx = np.flatnonzero(dl < best - _TIE)
+    idx = np.flatnonzero(gap.min(axis=-1) < best - _TIE)
     if len(idx):
-        take(idx, ql[idx])
-    pairs = robot.derived(LINE_PAIRS)
+        local = numeric.solve(robot, T[idx], q0=q_near[idx], tol=_EXACT)
+        ql = np.asarray(local.q, dtype=np.float64).reshape(len(idx), -1)
+        dl = np.where(np.asarray(local.success).reshape(-1),
+                      _distance(ql, q_near[idx], wrapped), np.inf)
+        nearer = dl < best[idx] - _TIE
+        if nearer.any():
+            take(idx[nearer], ql[nearer])
     names = robot.joint_names
-    for j, v, *_ in pairs:
-        idx = np.flatnonzero(np.abs(_wrap(q_near[:, j] - v)) < best - _TIE)
+    for p, (j, v, *_) in enumerate(pairs):
+        idx = np.flatnonzero(gap[:, p] < best - _TIE)
         if not len(idx):
             continue
         sols = solve_fixed(robot, T[idx], {names[j]: v}, dispatch=dispatch, q_near=q_near[idx])
