@@ -171,13 +171,15 @@ def _checked(robot, T, q_near, got) -> float:
 def test_from_an_aligned_configuration_the_answer_is_itself(name, data):
     """Oracle: q0 itself, inside the limits with q2 and / or q6 at 0 (the other joints
     special or uniform): ``nearest(q0)`` and ``ik_near(fk(q0), q0, method=
-    "self_motion")`` return q0 (1e-9), reaching the pose to 1e-12 inside the limits."""
+    "self_motion")`` return q0 (1e-6, the issue's recovery tolerance: at a singular q0,
+    e.g. q2 = q5 = pi/2 with q4 at its limit, the rows are 6.5e-8 off; before, the
+    answers were 0.3 to 3 rad away), reaching the pose to 1e-12 inside the limits."""
     robot, _ = ALIGNED[name]
     q0 = _aligned_configuration(robot, data.draw(configurations(robot)),
                                 data.draw(st.sampled_from([1, 2, 3])))
     T = robot.fk(q0)
     for got in (robot.self_motion(T).nearest(q0), robot.ik_near(T, q0, method="self_motion")):
-        assert _checked(robot, T, q0, got) <= 1e-9
+        assert _checked(robot, T, q0, got) <= 1e-6
 
 
 @pytest.mark.parametrize("name", ["panda", "srs"])
@@ -208,7 +210,7 @@ def test_a_continuum_step_is_the_brute_force_minimum():
     2 pi turns included) of |wrap(q_a + s - n_a)|^2 + |wrap(q_b - sign s - n_b)|^2:
     ``_pair_step``'s point is no farther (1e-9), inside both limits, and on the
     continuum (q_a + sign q_b kept, mod 2 pi)."""
-    from robokin.kinematics.ik.self_motion_nearest import _pair_step
+    from robokin.kinematics.ik.self_motion_continua import pair_step as _pair_step
 
     rng = np.random.default_rng(23)
     m = 200

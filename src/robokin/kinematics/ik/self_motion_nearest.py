@@ -24,9 +24,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from robokin.kinematics.arm import Arm, Derived
+from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.fixed import Dispatch
 from robokin.kinematics.ik.self_motion_base import _Family
+from robokin.kinematics.ik.self_motion_continua import (
+    EXACT,
+    LINE_PAIRS,
+    held_rows,
+    onto,
+    pair_steps,
+)
 from robokin.kinematics.ik.self_motion_intervals import _within
 from robokin.spatial import wrap_angle as _wrap
 
@@ -223,37 +230,10 @@ def _first_inside(fam: _Family, limits: np.ndarray, cand_t: np.ndarray, cand_b: 
 _TIE = 1e-9
 
 
-#: An aligned point's row is on its pair's continuum when its joint is this close to
-#: the aligned value [rad] (the kernels' aligned rows: within 1.4e-8, session 23).
-_ON_ALIGNED = 1e-6
-#: Pose error [m, rad] a solution found off the branches must reach (after its
-#: polish; the held-joint rows reach 4e-13).
-_EXACT = 4e-13
-#: Rounds at most over a row's aligned pairs with a joint in common (the iiwa
-#: stretched, q2 = q4 = q6 = 0: q1 + q3 + q5 + q7 fixed, a descent one pair at a time
-#: on a convex quadratic between wraps; one round is exact for pairs with none).
-_ROUNDS = 64
 #: Steps at most of the descent along the self-motion (:func:`_descend`).
 _DESCENT = 24
 #: A descent step below this [rad]: a local minimum (:func:`_descend`).
 _STILL = 1e-9
-
-
-def _line_pairs(robot: Arm) -> list[tuple[int, float, int, int, float]]:
-    """``(j, v, a, b, sign)``: joint j at v puts joints a and b on one line.
-
-    (``coincident.coincident_pair`` of each aligned value.)
-    """
-    from robokin.kinematics.ik.coincident import coincident_pair
-    from robokin.kinematics.ik.self_motion_intervals import _aligned_values
-
-    return [(j, v, p.a, p.b, p.sign) for j, v in _aligned_values(robot)
-            if (p := coincident_pair(robot, j, v)) is not None]
-
-
-#: The arm's line-sharing pairs at its aligned values (:func:`_line_pairs`).
-LINE_PAIRS: Derived[list[tuple[int, float, int, int, float]]] = Derived(
-    "joint pairs on one line at aligned values", _line_pairs)
 
 
 def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndarray,
@@ -263,28 +243,29 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
     The branch search (a grid per interval, refined minima) misses two kinds of
     solution, both where an axis pair lines up:
 
-    1. *A swing.* Next to an aligned shoulder (q2 = 1e-9 on the Panda) a branch turns
-       q1 and q3 by ~pi within ~1e-9 of t; a q_near inside the swing is ~1 rad from
-       every sampled row. The numeric solver started at q_near (``numeric.solve``,
-       tolerance ``_EXACT``) finds the solution next to it.
+    1. *A swing or a corner.* Next to an aligned shoulder (q2 = 1e-9 on the Panda) a
+       branch turns q1 and q3 by ~pi within ~1e-9 of t, and at a configuration with
+       several joints at their limits an interval is a point or a sliver; a q_near
+       there is up to ~1 rad from every sampled row. The numeric solver started at
+       q_near (``numeric.solve``, tolerance ``EXACT``; every pose whose answer is not
+       q_near itself) finds the solution next to it.
     2. *An aligned continuum.* Where joint j at a value v puts axes j-1 and j+1 on
        one line (``coincident.coincident_pair``: the Panda's q2 = 0, the iiwa's q2 or
        q6 = 0), every configuration turning those joints a, b against each other,
        q_a + s and q_b - sign s, reaches the same pose: where a branch passes q_j = v
        there is a continuum at that one parameter value, which the branches' rows
        meet in one point. Every point of it has q_j = v, so it is no nearer than
-       |q_near_j - v| (wrapped; a swing's points, q_j within ~1e-6 of v, likewise):
-       for the poses where that bound is below the found distance (both searches
-       run only there) the pose is solved with joint j held at v (``fixed.solve_fixed``:
+       |q_near_j - v| (wrapped): for the poses where that bound is below the found
+       distance the pose is solved with joint j held at v (``held_rows``:
        one row per family, each on its continuum) and each row moved along its
-       continuum to the point nearest q_near inside the limits (:func:`_pair_steps`:
+       continuum to the point nearest q_near inside the limits (:func:`~robokin.kinematics.ik.self_motion_continua.pair_steps`:
        a sum of quadratics between wraps, so its minimum is one of their vertices
        clipped into the in-limit range, or an end of it), then along the continua of
        any other pair the row has on one line (q2 = q6 = 0 on the iiwa: two), in
-       turn, ``_ROUNDS`` times where two pairs share a joint.
+       turn, ``self_motion_continua._ROUNDS`` times where two pairs share a joint.
 
-    A nearer row is taken onto the pose (:func:`_onto`: Newton's least-squares steps)
-    and kept if its pose error is within ``_EXACT`` and it is inside every limit; such
+    A nearer row is taken onto the pose (:func:`onto`: Newton's least-squares steps)
+    and kept if its pose error is within ``EXACT`` and it is inside every limit; such
     rows then descend along the self-motion to a local minimum of the distance
     (:func:`_descend`). So the answer is never farther than the branch search's.
 
@@ -297,59 +278,66 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         dispatch: ``dispatch.solve`` (:func:`~robokin.kinematics.ik.fixed.solve_fixed`'s).
 
     Returns:
-        (m, n): q, with the rows a nearer solution replaced (a new array where one is
-        searched, else q itself).
+        (m, n): q (a new array), a row polished where its pose error was above
+        ``EXACT``, the rows a nearer solution replaced.
     """
     from robokin.kinematics.ik import numeric
-    from robokin.kinematics.ik.fixed import solve_fixed
 
-    pairs = robot.derived(LINE_PAIRS)
-    if not pairs or not len(q):
-        return q
-    wrapped = np.asarray(robot.is_revolute, dtype=bool)
-    best = _distance(q, q_near, wrapped)
-    best[np.isnan(best)] = np.inf
-    # both kinds of solution have a pair's joint at (or within ~1e-6 of) its value v:
-    # no nearer than |q_near_j - v|, so only the poses where that is below the found
-    # distance for some pair are searched (most poses: none, and nothing more is done)
-    at = [j for j, *_ in pairs]
-    gap = np.abs(_wrap(q_near[:, at] - np.array([v for _, v, *_ in pairs])))
-    if not (gap.min(axis=-1) < best - _TIE).any():
+    if not len(q):
         return q
     q = np.array(q, dtype=np.float64)
     lo, hi = limits[:, 0], limits[:, 1]
+    # the branch answers as exact as the rows off them (a row of a singular pose the
+    # solved-points path accepted at 1e-12 with its joint clamped into its limits)
+    ok = np.flatnonzero(np.isfinite(q).all(-1))
+    _, err = onto(robot, q[ok], T[ok], steps=0)
+    loose = ok[err > EXACT]
+    if len(loose):
+        rows, err = onto(robot, q[loose], T[loose])
+        fixed = (err <= EXACT) & _within(rows, limits)
+        q[loose[fixed]] = np.clip(rows[fixed], lo, hi)
+    wrapped = np.asarray(robot.is_revolute, dtype=bool)
+    best = _distance(q, q_near, wrapped)
+    best[np.isnan(best)] = np.inf
+    idx = np.flatnonzero(best > _TIE)  # q_near itself not the answer
+    if not len(idx):
+        return q
     found = np.zeros(len(q), dtype=bool)  # rows taken off the branches
 
     def take(idx: np.ndarray, rows: np.ndarray) -> None:
         """Rows (p, n) as q[idx] where each is a solution inside the limits, nearer.
 
-        Nearer than best[idx]; all at once (``_onto``'s Newton steps).
+        Nearer than best[idx]; all at once (``onto``'s Newton steps).
         """
-        rows, err = _onto(robot, rows, T[idx])
+        rows, err = onto(robot, rows, T[idx])
         d = _distance(np.clip(rows, lo, hi), q_near[idx], wrapped)
-        ok = (err <= _EXACT) & _within(rows, limits) & (d < best[idx] - _TIE)
+        ok = (err <= EXACT) & _within(rows, limits) & (d < best[idx] - _TIE)
         q[idx[ok]], best[idx[ok]], found[idx[ok]] = np.clip(rows[ok], lo, hi), d[ok], True
 
-    idx = np.flatnonzero(gap.min(axis=-1) < best - _TIE)
-    if len(idx):
-        local = numeric.solve(robot, T[idx], q0=q_near[idx], tol=_EXACT)
-        ql = np.asarray(local.q, dtype=np.float64).reshape(len(idx), -1)
-        dl = np.where(np.asarray(local.success).reshape(-1),
-                      _distance(ql, q_near[idx], wrapped), np.inf)
-        nearer = dl < best[idx] - _TIE
-        if nearer.any():
-            take(idx[nearer], ql[nearer])
-    names = robot.joint_names
+    local = numeric.solve(robot, T[idx], q0=q_near[idx], tol=EXACT)
+    ql = np.asarray(local.q, dtype=np.float64).reshape(len(idx), -1)
+    dl = np.where(np.asarray(local.success).reshape(-1),
+                  _distance(ql, q_near[idx], wrapped), np.inf)
+    nearer = dl < best[idx] - _TIE
+    if nearer.any():
+        take(idx[nearer], ql[nearer])
+    pairs = robot.derived(LINE_PAIRS)
+    # a continuum's points have its pair's joint at the value v: no nearer than
+    # |q_near_j - v|, so only the poses where that is below the found distance for
+    # some pair are searched
+    gap = np.abs(_wrap(q_near[:, [j for j, *_ in pairs]]
+                       - np.array([v for _, v, *_ in pairs]))) if pairs else None
     for p, (j, v, *_) in enumerate(pairs):
+        assert gap is not None
         idx = np.flatnonzero(gap[:, p] < best - _TIE)
         if not len(idx):
             continue
-        sols = solve_fixed(robot, T[idx], {names[j]: v}, dispatch=dispatch, q_near=q_near[idx])
-        k = sols.q.shape[-2]
-        rows = sols.q.reshape(-1, robot.n)
-        ok = np.asarray(sols.valid).reshape(-1)
+        held, valid = held_rows(robot, T[idx], j, v, q_near[idx], dispatch)
+        k = held.shape[-2]
+        rows = held.reshape(-1, robot.n)
+        ok = valid.reshape(-1)
         near = np.repeat(q_near[idx], k, axis=0)
-        moved = _pair_steps(rows, near, pairs, lo, hi, wrapped)
+        moved = pair_steps(rows, near, pairs, lo, hi, wrapped)
         ok &= np.isfinite(moved).all(-1)
         d = np.where(ok, _distance(moved, near, wrapped), np.inf).reshape(len(idx), k)
         c = np.argmin(d, axis=1)
@@ -369,8 +357,8 @@ def _descend(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndarray,
     A step pulls the row toward q_near within the null space of its Jacobian (the
     self-motion's tangent: the n - 6 directions of a redundant arm and those of
     singular values below 1e-9 of the largest) and takes it back onto the pose by
-    Newton's least-squares steps (:func:`_onto`); it is halved until the row is
-    nearer, inside the limits and within ``_EXACT`` of the pose. A row stops where
+    Newton's least-squares steps (:func:`onto`); it is halved until the row is
+    nearer, inside the limits and within ``EXACT`` of the pose. A row stops where
     the pull's step is below ``_STILL`` (a local minimum to within ~1e-18 of the
     distance: the search's refined minima start there), where it would take a joint
     at its limit outward (a constrained minimum), after six halvings, or after
@@ -399,33 +387,14 @@ def _descend(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndarray,
         live, step = live[~done], step[~done]
         if not len(live):
             break
-        trial, err = _onto(robot, q[live] + step * alpha[live, None], T[live])
-        ok = ((err <= _EXACT) & _within(trial, limits)
+        trial, err = onto(robot, q[live] + step * alpha[live, None], T[live])
+        ok = ((err <= EXACT) & _within(trial, limits)
               & (_distance(trial, q_near[live], wrapped)
                  < _distance(q[live], q_near[live], wrapped)))
         q[live[ok]] = np.clip(trial[ok], lo, hi)
         alpha[live[~ok]] *= 0.5
         live = live[alpha[live] > 1.0 / 64]
     return q
-
-
-def _onto(robot: Arm, q: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rows q (m, n) taken onto poses T (m, 4, 4) by three least-squares Newton steps.
-
-    Returns the rows and their largest position [m] / rotation [rad] error (m,).
-    """
-    from robokin.kinematics.jacobian import jacobian_and_pose
-    from robokin.spatial import pose_error
-
-    for _ in range(3):
-        J, F = jacobian_and_pose(robot.chain, q)
-        e = pose_error(F, T)
-        q = q + (np.linalg.pinv(J, rcond=1e-10) @ e[:, :, None])[:, :, 0]
-    _, F = jacobian_and_pose(robot.chain, q)
-    e = pose_error(F, T)
-    err: np.ndarray = np.maximum(np.linalg.norm(e[:, :3], axis=-1),
-                                 np.linalg.norm(e[:, 3:], axis=-1))
-    return q, err
 
 
 def _distance(q: np.ndarray, q_near: np.ndarray, wrapped: np.ndarray) -> np.ndarray:
@@ -436,101 +405,3 @@ def _distance(q: np.ndarray, q_near: np.ndarray, wrapped: np.ndarray) -> np.ndar
     return out
 
 
-_TURNS = np.array([-1.0, 0.0, 1.0]) * 2.0 * np.pi
-
-
-def _pair_steps(rows: np.ndarray, q_near: np.ndarray,
-                pairs: list[tuple[int, float, int, int, float]], lo: np.ndarray,
-                hi: np.ndarray, wrapped: np.ndarray) -> np.ndarray:
-    """Rows (m, n) moved along their continua to the points nearest q_near (m, n).
-
-    Each row goes to the point inside the limits nearest its q_near; NaN rows where
-    a joint no pair moves is outside. A row is on pair (a, b)'s continuum where its
-    joint j is within ``_ON_ALIGNED`` of the pair's value v. Pairs sharing a joint
-    make one line of several axes (the iiwa stretched, q2 = q4 = q6 = 0: axes 1, 3, 5
-    and 7, c1 q1 + c3 q3 + c5 q5 + c7 q7 fixed): then every two of its joints turn
-    against each other, taken in turn (a convex quadratic under one linear
-    constraint and bounds, between wraps: two coordinates at a time reach its
-    minimum, as in sequential minimal optimisation), up to ``_ROUNDS`` times.
-    """
-    out = np.array(rows, dtype=np.float64)
-    on = np.stack([np.abs(_wrap(out[:, j] - v)) <= _ON_ALIGNED for j, v, *_ in pairs], -1)
-    for pattern in np.unique(on, axis=0):
-        if not pattern.any():
-            continue
-        sel = np.flatnonzero((on == pattern).all(-1))
-        moves = _line_moves([p for p, o in zip(pairs, pattern, strict=True) if o])
-        free = np.zeros(len(lo), dtype=bool)
-        free[[x for a, b, _ in moves for x in (a, b)]] = True
-        sub = out[sel]
-        with np.errstate(invalid="ignore"):
-            inside = np.all(free | ((sub >= lo - 1e-12) & (sub <= hi + 1e-12)), axis=-1)
-        sub[~inside] = np.nan
-        sub = np.where(free, np.clip(sub, lo, hi), sub)  # a moved joint a hair outside
-        keep = np.flatnonzero(inside)
-        lines = len(free.nonzero()[0]) < 2 * len(moves)  # a line of three or more joints
-        for _ in range(_ROUNDS if lines else 1):
-            before = sub[keep].copy()
-            for a, b, sign in moves:
-                sub[keep] = _pair_step(sub[keep], a, b, sign, lo, hi, wrapped,
-                                       q_near[sel[keep]])
-            if np.array_equal(sub[keep], before):
-                break
-        out[sel] = sub
-    return out
-
-
-def _line_moves(on: list[tuple[int, float, int, int, float]]) -> list[tuple[int, int, float]]:
-    """``(a, b, sign)``: every two joints of one line turning against each other.
-
-    The pairs on a line (q_a + sign q_b fixed) chained into groups with
-    coefficients c (c_b = sign c_a): a group's joints x, y keep c_x q_x + c_y q_y
-    with the rest still, so q_x + (c_y / c_x) q_y is fixed.
-    """
-    coef: dict[int, float] = {}
-    group: dict[int, int] = {}
-    for _, _, a, b, sign in on:
-        if a not in coef:
-            coef[a], group[a] = 1.0, a
-        if b not in coef:
-            coef[b], group[b] = sign * coef[a], group[a]
-        elif group[b] != group[a]:  # two groups joined: b's scaled to c_b = sign c_a
-            scale, old = sign * coef[a] / coef[b], group[b]
-            for x in [x for x in coef if group[x] == old]:
-                coef[x], group[x] = coef[x] * scale, group[a]
-    joints = sorted(coef)
-    return [(x, y, coef[y] / coef[x]) for i, x in enumerate(joints) for y in joints[i + 1:]
-            if group[x] == group[y]]
-
-
-def _pair_step(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np.ndarray,
-               wrapped: np.ndarray, q_near: np.ndarray) -> np.ndarray:
-    """Rows q (m, n) with q_a + s, q_b - sign s nearest q_near (m, n), both inside.
-
-    Each row unchanged (s = 0) where its pair is inside and nothing nearer is.
-    """
-    ra = q[:, a, None, None] + _TURNS[:, None]  # (m, 3, 1): the 2 pi turns, each its range
-    rb = q[:, b, None, None] + _TURNS[None, :]  # (m, 1, 3)
-    ea, eb = sign * (rb - hi[b]), sign * (rb - lo[b])
-    s_lo = np.maximum(lo[a] - ra, np.minimum(ea, eb))  # (m, 3, 3)
-    s_hi = np.minimum(hi[a] - ra, np.maximum(ea, eb))
-    u = _wrap(q_near[:, a] - q[:, a])[:, None] + _TURNS  # (m, 3): s putting q_a at q_near's
-    v = -sign * (_wrap(q_near[:, b] - q[:, b])[:, None] + _TURNS)
-    vertex = 0.5 * (u[:, :, None] + v[:, None, :]).reshape(len(q), 1, 1, 9)
-    s = np.concatenate([np.broadcast_to(vertex, s_lo.shape + (9,)),
-                        s_lo[..., None], s_hi[..., None]], axis=-1)  # (m, 3, 3, 11)
-    s = np.clip(s, s_lo[..., None], s_hi[..., None])
-    qa = ra[..., None] + s
-    qb = rb[..., None] - sign * s
-    na, nb = q_near[:, a, None, None, None], q_near[:, b, None, None, None]
-    fa = _wrap(qa - na) if wrapped[a] else qa - na
-    fb = _wrap(qb - nb) if wrapped[b] else qb - nb
-    f = np.where((s_lo <= s_hi)[..., None], fa * fa + fb * fb, np.inf).reshape(len(q), -1)
-    k = np.argmin(f, axis=1)
-    m = np.arange(len(q))
-    out = q.copy()
-    found = np.isfinite(f[m, k])
-    # (a range end reached by rounding a hair outside: clipped)
-    out[found, a] = np.clip(qa.reshape(len(q), -1)[m, k][found], lo[a], hi[a])
-    out[found, b] = np.clip(qb.reshape(len(q), -1)[m, k][found], lo[b], hi[b])
-    return out

@@ -1,0 +1,272 @@
+"""Aligned continua of a 7R arm's self-motion: where one joint puts two axes on a line.
+
+Where joint j is at a value v that puts axes j-1 and j+1 on one line
+(``coincident.coincident_pair``: the Panda's q2 = 0; the iiwa's q2, q4 or q6 = 0), every
+configuration turning that pair against each other, q_a + s and q_b - sign s, reaches
+the same pose. Where a branch of the self-motion passes q_j = v there is therefore a
+continuum at that one parameter value, which the branches' rows (``sample``) meet in a
+single point: ``SelfMotion.nearest`` and ``SelfMotion.best`` search it here
+(``self_motion_nearest.nearer_points``, :func:`continua_best`). Its rows come from the
+pose solved with joint j held at v (``fixed.solve_fixed``: one row per family).
+Pairs sharing a joint make one line of several axes (the iiwa stretched, q2 = q4 =
+q6 = 0: axes 1, 3, 5 and 7): every two of its joints then turn against each other
+(:func:`line_moves`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from robokin.kinematics.arm import Arm, Derived
+from robokin.kinematics.ik.fixed import Dispatch
+from robokin.kinematics.ik.self_motion_intervals import _within
+from robokin.spatial import wrap_angle as _wrap
+
+__all__ = ["EXACT", "LINE_PAIRS", "continua_best", "held_rows", "line_moves", "onto",
+           "pair_step", "pair_steps"]
+
+#: An aligned point's row is on its pair's continuum when its joint is this close to
+#: the aligned value [rad] (the kernels' aligned rows: within 1.4e-8, session 23).
+_ON_ALIGNED = 1e-6
+#: Pose error [m, rad] a solution found off the branches must reach (after
+#: :func:`onto`; the held-joint rows reach 4e-13).
+EXACT = 4e-13
+#: Rounds at most over a row's aligned pairs with a joint in common (the iiwa
+#: stretched, q2 = q4 = q6 = 0: q1 + q3 + q5 + q7 fixed, a descent one pair at a time
+#: on a convex quadratic between wraps; one round is exact for pairs with none).
+_ROUNDS = 64
+
+def _line_pairs(robot: Arm) -> list[tuple[int, float, int, int, float]]:
+    """``(j, v, a, b, sign)``: joint j at v puts joints a and b on one line.
+
+    (``coincident.coincident_pair`` of each aligned value.)
+    """
+    from robokin.kinematics.ik.coincident import coincident_pair
+    from robokin.kinematics.ik.self_motion_intervals import _aligned_values
+
+    return [(j, v, p.a, p.b, p.sign) for j, v in _aligned_values(robot)
+            if (p := coincident_pair(robot, j, v)) is not None]
+
+
+#: The arm's line-sharing pairs at its aligned values (:func:`_line_pairs`).
+LINE_PAIRS: Derived[list[tuple[int, float, int, int, float]]] = Derived(
+    "joint pairs on one line at aligned values", _line_pairs)
+
+
+def onto(robot: Arm, q: np.ndarray, T: np.ndarray, steps: int = 3
+         ) -> tuple[np.ndarray, np.ndarray]:
+    """Rows q (m, n) taken onto poses T (m, 4, 4) by ``steps`` least-squares Newton steps.
+
+    Returns the rows and their largest position [m] / rotation [rad] error (m,).
+    """
+    from robokin.kinematics.jacobian import jacobian_and_pose
+    from robokin.spatial import pose_error
+
+    for _ in range(steps):
+        J, F = jacobian_and_pose(robot.chain, q)
+        e = pose_error(F, T)
+        q = q + (np.linalg.pinv(J, rcond=1e-10) @ e[:, :, None])[:, :, 0]
+    _, F = jacobian_and_pose(robot.chain, q)
+    e = pose_error(F, T)
+    err: np.ndarray = np.maximum(np.linalg.norm(e[:, :3], axis=-1),
+                                 np.linalg.norm(e[:, 3:], axis=-1))
+    return q, err
+
+
+_TURNS = np.array([-1.0, 0.0, 1.0]) * 2.0 * np.pi
+
+
+def pair_steps(rows: np.ndarray, q_near: np.ndarray,
+                pairs: list[tuple[int, float, int, int, float]], lo: np.ndarray,
+                hi: np.ndarray, wrapped: np.ndarray) -> np.ndarray:
+    """Rows (m, n) moved along their continua to the points nearest q_near (m, n).
+
+    Each row goes to the point inside the limits nearest its q_near; NaN rows where
+    a joint no pair moves is outside. A row is on pair (a, b)'s continuum where its
+    joint j is within ``_ON_ALIGNED`` of the pair's value v. Pairs sharing a joint
+    make one line of several axes (the iiwa stretched, q2 = q4 = q6 = 0: axes 1, 3, 5
+    and 7, c1 q1 + c3 q3 + c5 q5 + c7 q7 fixed): then every two of its joints turn
+    against each other, taken in turn (a convex quadratic under one linear
+    constraint and bounds, between wraps: two coordinates at a time reach its
+    minimum, as in sequential minimal optimisation), up to ``_ROUNDS`` times.
+    """
+    out = np.array(rows, dtype=np.float64)
+    on = np.stack([np.abs(_wrap(out[:, j] - v)) <= _ON_ALIGNED for j, v, *_ in pairs], -1)
+    for pattern in np.unique(on, axis=0):
+        if not pattern.any():
+            continue
+        sel = np.flatnonzero((on == pattern).all(-1))
+        moves = line_moves([p for p, o in zip(pairs, pattern, strict=True) if o])
+        free = np.zeros(len(lo), dtype=bool)
+        free[[x for a, b, _ in moves for x in (a, b)]] = True
+        sub = out[sel]
+        with np.errstate(invalid="ignore"):
+            inside = np.all(free | ((sub >= lo - 1e-12) & (sub <= hi + 1e-12)), axis=-1)
+        sub[~inside] = np.nan
+        sub = np.where(free, np.clip(sub, lo, hi), sub)  # a moved joint a hair outside
+        keep = np.flatnonzero(inside)
+        lines = len(free.nonzero()[0]) < 2 * len(moves)  # a line of three or more joints
+        for _ in range(_ROUNDS if lines else 1):
+            before = sub[keep].copy()
+            for a, b, sign in moves:
+                sub[keep] = pair_step(sub[keep], a, b, sign, lo, hi, wrapped,
+                                       q_near[sel[keep]])
+            if np.array_equal(sub[keep], before):
+                break
+        out[sel] = sub
+    return out
+
+
+def line_moves(on: list[tuple[int, float, int, int, float]]) -> list[tuple[int, int, float]]:
+    """``(a, b, sign)``: every two joints of one line turning against each other.
+
+    The pairs on a line (q_a + sign q_b fixed) chained into groups with
+    coefficients c (c_b = sign c_a): a group's joints x, y keep c_x q_x + c_y q_y
+    with the rest still, so q_x + (c_y / c_x) q_y is fixed.
+    """
+    coef: dict[int, float] = {}
+    group: dict[int, int] = {}
+    for _, _, a, b, sign in on:
+        if a not in coef:
+            coef[a], group[a] = 1.0, a
+        if b not in coef:
+            coef[b], group[b] = sign * coef[a], group[a]
+        elif group[b] != group[a]:  # two groups joined: b's scaled to c_b = sign c_a
+            scale, old = sign * coef[a] / coef[b], group[b]
+            for x in [x for x in coef if group[x] == old]:
+                coef[x], group[x] = coef[x] * scale, group[a]
+    joints = sorted(coef)
+    return [(x, y, coef[y] / coef[x]) for i, x in enumerate(joints) for y in joints[i + 1:]
+            if group[x] == group[y]]
+
+
+def pair_step(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np.ndarray,
+               wrapped: np.ndarray, q_near: np.ndarray) -> np.ndarray:
+    """Rows q (m, n) with q_a + s, q_b - sign s nearest q_near (m, n), both inside.
+
+    Each row unchanged (s = 0) where its pair is inside and nothing nearer is.
+    """
+    ra = q[:, a, None, None] + _TURNS[:, None]  # (m, 3, 1): the 2 pi turns, each its range
+    rb = q[:, b, None, None] + _TURNS[None, :]  # (m, 1, 3)
+    ea, eb = sign * (rb - hi[b]), sign * (rb - lo[b])
+    s_lo = np.maximum(lo[a] - ra, np.minimum(ea, eb))  # (m, 3, 3)
+    s_hi = np.minimum(hi[a] - ra, np.maximum(ea, eb))
+    u = _wrap(q_near[:, a] - q[:, a])[:, None] + _TURNS  # (m, 3): s putting q_a at q_near's
+    v = -sign * (_wrap(q_near[:, b] - q[:, b])[:, None] + _TURNS)
+    vertex = 0.5 * (u[:, :, None] + v[:, None, :]).reshape(len(q), 1, 1, 9)
+    s = np.concatenate([np.broadcast_to(vertex, s_lo.shape + (9,)),
+                        s_lo[..., None], s_hi[..., None]], axis=-1)  # (m, 3, 3, 11)
+    s = np.clip(s, s_lo[..., None], s_hi[..., None])
+    qa = ra[..., None] + s
+    qb = rb[..., None] - sign * s
+    na, nb = q_near[:, a, None, None, None], q_near[:, b, None, None, None]
+    fa = _wrap(qa - na) if wrapped[a] else qa - na
+    fb = _wrap(qb - nb) if wrapped[b] else qb - nb
+    f = np.where((s_lo <= s_hi)[..., None], fa * fa + fb * fb, np.inf).reshape(len(q), -1)
+    k = np.argmin(f, axis=1)
+    m = np.arange(len(q))
+    out: np.ndarray = q.copy()
+    found = np.isfinite(f[m, k])
+    # (a range end reached by rounding a hair outside: clipped)
+    out[found, a] = np.clip(qa.reshape(len(q), -1)[m, k][found], lo[a], hi[a])
+    out[found, b] = np.clip(qb.reshape(len(q), -1)[m, k][found], lo[b], hi[b])
+    return out
+
+
+def held_rows(robot: Arm, T: np.ndarray, j: int, v: float, q_near: np.ndarray,
+              dispatch: Dispatch) -> tuple[np.ndarray, np.ndarray]:
+    """Poses T (m, 4, 4) solved with joint j held at v: rows (m, k, n) and valid (m, k).
+
+    One row per family at a coincident value (``fixed.solve_fixed``), its pair split
+    nearest q_near (m, n).
+    """
+    from robokin.kinematics.ik.fixed import solve_fixed
+
+    sols = solve_fixed(robot, T, {robot.joint_names[j]: v}, dispatch=dispatch, q_near=q_near)
+    return np.asarray(sols.q, dtype=np.float64), np.asarray(sols.valid, dtype=bool)
+
+
+#: Values of s per in-limit stretch of a continuum, then zoom rounds of 9 around the
+#: best (:func:`continua_best`, as ``SelfMotion.best`` samples an interval).
+_SAMPLES = 33
+_ZOOMS = 6
+
+
+def continua_best(robot: Arm, T: np.ndarray, limits: np.ndarray,
+                  score: Callable[[np.ndarray], np.ndarray], best: float,
+                  dispatch: Dispatch) -> tuple[np.ndarray, float] | None:
+    """The configuration of an aligned continuum of pose T (4, 4) scoring above ``best``.
+
+    For each line-sharing pair (:data:`LINE_PAIRS`) the pose is solved with its joint
+    held at its value (:func:`held_rows`); from each row inside the limits but for the
+    joints a line moves, each move of its line (:func:`line_moves`) is sampled over
+    its in-limit stretches of s (``_SAMPLES`` values each, the pair's 2 pi turns
+    included), then zoomed ``_ZOOMS`` times around the best; on a line of three or more
+    joints the moves are taken in turn, twice. The best row above ``best`` is taken
+    onto the pose (:func:`onto`) and returned with its score if its pose error is
+    within :data:`EXACT` and it is inside every limit.
+
+    Args:
+        robot: The arm (7R).
+        T: The pose (4, 4) [m].
+        limits: Joint limits (n, 2) [rad].
+        score: Configurations (p, n) -> scores (p,) (``SelfMotion.best``'s criterion).
+        best: The score to beat (-inf: none).
+        dispatch: ``dispatch.solve``.
+
+    Returns:
+        ``(q (n,), score)``, or None.
+    """
+    pairs = robot.derived(LINE_PAIRS)
+    lo, hi = limits[:, 0], limits[:, 1]
+    found: tuple[np.ndarray, float] | None = None
+    for j, v, *_ in pairs:
+        rows, valid = held_rows(robot, T[None], j, v, np.zeros((1, robot.n)), dispatch)
+        for r in rows[0][valid[0]]:
+            on = [p for p in pairs if abs(float(_wrap(r[p[0]] - p[1]))) <= _ON_ALIGNED]
+            moves = line_moves(on)
+            free = np.zeros(len(r), dtype=bool)
+            free[[x for a, b, _ in moves for x in (a, b)]] = True
+            if not np.all(free | ((r >= lo - 1e-12) & (r <= hi + 1e-12))):
+                continue
+            q = np.where(free, np.clip(r, lo, hi), r)
+            val = -np.inf
+            for _ in range(2 if len(free.nonzero()[0]) < 2 * len(moves) else 1):
+                for a, b, sign in moves:
+                    q, val = _line_best(q, a, b, sign, lo, hi, score)
+            if val > (best if found is None else found[1]):
+                found = (q, val)
+    if found is None:
+        return None
+    q, err = onto(robot, found[0][None], T[None])
+    if not (err[0] <= EXACT and bool(_within(q[0], limits))):
+        return None
+    q0 = np.clip(q[0], lo, hi)
+    return q0, float(score(q0[None])[0])
+
+
+def _line_best(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np.ndarray,
+               score: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, float]:
+    """Q moved along one move (q_a + s, q_b - sign s) to its best sampled score."""
+    best_q, best_s = q, float(score(q[None])[0])
+    for ka in _TURNS:
+        for kb in _TURNS:
+            ra, rb = q[a] + ka, q[b] + kb
+            ends = sorted((sign * (rb - hi[b]), sign * (rb - lo[b])))
+            s_lo, s_hi = max(lo[a] - ra, ends[0]), min(hi[a] - ra, ends[1])
+            if s_lo > s_hi:
+                continue
+            s = np.linspace(s_lo, s_hi, _SAMPLES)
+            for _ in range(_ZOOMS + 1):
+                cand = np.repeat(q[None], len(s), axis=0)
+                cand[:, a] = np.clip(ra + s, lo[a], hi[a])
+                cand[:, b] = np.clip(rb - sign * s, lo[b], hi[b])
+                val = score(cand)
+                i = int(np.argmax(val))
+                if val[i] > best_s:
+                    best_q, best_s = cand[i], float(val[i])
+                step = (s[-1] - s[0]) / (len(s) - 1) if len(s) > 1 else 0.0
+                s = np.linspace(max(s[i] - step, s_lo), min(s[i] + step, s_hi), 9)
+    return best_q, best_s
