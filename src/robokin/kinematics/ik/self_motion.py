@@ -49,6 +49,7 @@ from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.fixed import Dispatch, held_complete
 from robokin.kinematics.ik.self_motion_base import _Family, seven_joint_serial
+from robokin.kinematics.ik.self_motion_continua import continua_best
 from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
 from robokin.kinematics.ik.self_motion_families import (
     HeldKernel,
@@ -233,9 +234,21 @@ class SelfMotion:
                 of configurations (m, n) -> scores (m,).
             robot: The arm (for ``"manipulability"``).
             samples: Values per feasible interval before zooming in on the best.
+
+        Then the aligned continua (``self_motion_continua.continua_best``: where an
+        axis pair lines up, q2 = 0, the pair turned against each other), whose points
+        the branches' samples do not hold; one scoring higher is returned with its
+        parameter value and the branch whose row there is nearest.
         """
         score = _criterion(criterion, robot, self.limits)
-        return self._maximise(score, samples)
+        point = self._maximise(score, samples)
+        if self._dispatch is None:
+            return point
+        found = continua_best(self._family.robot, self.T, self.limits, score,
+                              -np.inf if point is None else point.score, self._dispatch)
+        if found is None:
+            return point
+        return self._off_branches(found[0], found[1])
 
     def nearest(self, q_near: npt.ArrayLike, *, samples: int = 64) -> ManifoldPoint | None:
         """The in-limit configuration nearest ``q_near`` (n,) (2 pi wrapped distance).
@@ -269,16 +282,23 @@ class SelfMotion:
             return None
         wrapped = np.asarray(self._family.robot.is_revolute, dtype=bool)
         diff = q[0] - qn
-        dist = float(np.linalg.norm(np.where(wrapped, _wrap(diff), diff)))
-        # a solution off the branches' samples: its parameter value, and the branch
-        # whose row there is nearest (an aligned continuum meets it at its point)
-        t = (float(q[0, self.joint]) if self.joint is not None
-             else float(parameter_values(self._family.robot, self.T, q[:, None])[1][0, 0]))
-        rows = self.sample(np.array([t]))[0]
-        diff = rows - q[0]
+        return self._off_branches(q[0], -float(np.linalg.norm(np.where(wrapped, _wrap(diff),
+                                                                          diff))))
+
+    def _off_branches(self, q: np.ndarray, score: float) -> ManifoldPoint:
+        """A solution q (n,) off the branches' samples as a point with ``score``.
+
+        Its parameter value, and the branch whose row there is nearest (an aligned
+        continuum meets it at its aligned point).
+        """
+        robot = self._family.robot
+        t = (float(q[self.joint]) if self.joint is not None
+             else float(parameter_values(robot, self.T, q[None, None])[1][0, 0]))
+        wrapped = np.asarray(robot.is_revolute, dtype=bool)
+        diff = self.sample(np.array([t]))[0] - q
         gap = np.linalg.norm(np.where(wrapped, _wrap(diff), diff), axis=-1)
         branch = int(np.argmin(np.where(np.isfinite(gap), gap, np.inf)))
-        return ManifoldPoint(q[0], t, branch, -dist)
+        return ManifoldPoint(q, t, branch, score)
 
     def _maximise(self, score: Callable[[np.ndarray], np.ndarray],
                   samples: int) -> ManifoldPoint | None:

@@ -249,24 +249,34 @@ def continua_best(robot: Arm, T: np.ndarray, limits: np.ndarray,
 
 def _line_best(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np.ndarray,
                score: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, float]:
-    """Q moved along one move (q_a + s, q_b - sign s) to its best sampled score."""
+    """The row q moved along one move (q_a + s, q_b - sign s) to its best sampled score.
+
+    Every in-limit stretch of s (the pair's 2 pi turns) sampled at ``_SAMPLES`` values in
+    one batch, then ``_ZOOMS`` rounds of 9 values around the best.
+    """
+    ra = q[a] + _TURNS[:, None]  # (3, 1)
+    rb = q[b] + _TURNS[None, :]  # (1, 3)
+    ea, eb = sign * (rb - hi[b]), sign * (rb - lo[b])
+    s_lo = np.maximum(lo[a] - ra, np.minimum(ea, eb)).ravel()  # (9,)
+    s_hi = np.minimum(hi[a] - ra, np.maximum(ea, eb)).ravel()
+    ra, rb = np.broadcast_to(ra, (3, 3)).ravel(), np.broadcast_to(rb, (3, 3)).ravel()
+    keep = s_lo <= s_hi
     best_q, best_s = q, float(score(q[None])[0])
-    for ka in _TURNS:
-        for kb in _TURNS:
-            ra, rb = q[a] + ka, q[b] + kb
-            ends = sorted((sign * (rb - hi[b]), sign * (rb - lo[b])))
-            s_lo, s_hi = max(lo[a] - ra, ends[0]), min(hi[a] - ra, ends[1])
-            if s_lo > s_hi:
-                continue
-            s = np.linspace(s_lo, s_hi, _SAMPLES)
-            for _ in range(_ZOOMS + 1):
-                cand = np.repeat(q[None], len(s), axis=0)
-                cand[:, a] = np.clip(ra + s, lo[a], hi[a])
-                cand[:, b] = np.clip(rb - sign * s, lo[b], hi[b])
-                val = score(cand)
-                i = int(np.argmax(val))
-                if val[i] > best_s:
-                    best_q, best_s = cand[i], float(val[i])
-                step = (s[-1] - s[0]) / (len(s) - 1) if len(s) > 1 else 0.0
-                s = np.linspace(max(s[i] - step, s_lo), min(s[i] + step, s_hi), 9)
+    if not keep.any():
+        return best_q, best_s
+    s_lo, s_hi, ra, rb = s_lo[keep], s_hi[keep], ra[keep], rb[keep]
+    s = s_lo[:, None] + (s_hi - s_lo)[:, None] * np.linspace(0.0, 1.0, _SAMPLES)
+    for _ in range(_ZOOMS + 1):
+        rows = np.repeat(q[None], s.size, axis=0)
+        rows[:, a] = np.clip((ra[:, None] + s).ravel(), lo[a], hi[a])
+        rows[:, b] = np.clip((rb[:, None] - sign * s).ravel(), lo[b], hi[b])
+        val = score(rows)
+        i = int(np.argmax(val))
+        if val[i] > best_s:
+            best_q, best_s = rows[i], float(val[i])
+        k, c = (int(x) for x in np.unravel_index(i, s.shape))  # the stretch, the value
+        step = (s[k, -1] - s[k, 0]) / (s.shape[1] - 1)
+        s_lo, s_hi = s_lo[k:k + 1], s_hi[k:k + 1]
+        ra, rb = ra[k:k + 1], rb[k:k + 1]
+        s = np.linspace(max(s[k, c] - step, s_lo[0]), min(s[k, c] + step, s_hi[0]), 9)[None]
     return best_q, best_s
