@@ -98,9 +98,10 @@ _KEEP = 3
 class ManifoldPoint:
     """One configuration on the manifold: ``q`` (n,), at ``t`` on ``branch``, ``score``.
 
-    ``q`` is ``sample(t)[branch]``, except for a solution ``SelfMotion.nearest`` found
-    off the branches' rows (a point of an aligned continuum, where the branches meet
-    it in one point): then ``branch`` is the branch whose row at t is nearest.
+    ``q`` is ``sample(t)[branch]``, except for a solution ``SelfMotion.nearest`` or
+    ``SelfMotion.best`` found off the branches' rows (a point of an aligned continuum,
+    which the branches meet in one point): then ``branch`` is the branch whose row at
+    t is nearest.
     """
 
     q: np.ndarray
@@ -143,8 +144,8 @@ class SelfMotion:
         _held: ``_points`` are the held-joint kernel's (``_held_records`` orders them).
         _corners: ``(t, branch, row)`` of corners whose row was refined on the pose
             (``self_motion_intervals._points_refined``): ``sample`` returns that row.
-        _dispatch: ``dispatch.solve`` as :func:`self_motion` had it (``nearest``
-            solves the pose with an aligned joint held), or None.
+        _dispatch: ``dispatch.solve`` as :func:`self_motion` had it (``nearest`` and
+            ``best`` solve the pose with an aligned joint held), or None.
     """
 
     T: np.ndarray

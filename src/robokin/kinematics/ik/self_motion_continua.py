@@ -38,6 +38,7 @@ EXACT = 4e-13
 #: on a convex quadratic between wraps; one round is exact for pairs with none).
 _ROUNDS = 64
 
+
 def _line_pairs(robot: Arm) -> list[tuple[int, float, int, int, float]]:
     """``(j, v, a, b, sign)``: joint j at v puts joints a and b on one line.
 
@@ -79,8 +80,8 @@ _TURNS = np.array([-1.0, 0.0, 1.0]) * 2.0 * np.pi
 
 
 def pair_steps(rows: np.ndarray, q_near: np.ndarray,
-                pairs: list[tuple[int, float, int, int, float]], lo: np.ndarray,
-                hi: np.ndarray, wrapped: np.ndarray) -> np.ndarray:
+               pairs: list[tuple[int, float, int, int, float]], lo: np.ndarray,
+               hi: np.ndarray, wrapped: np.ndarray) -> np.ndarray:
     """Rows (m, n) moved along their continua to the points nearest q_near (m, n).
 
     Each row goes to the point inside the limits nearest its q_near; NaN rows where
@@ -112,7 +113,7 @@ def pair_steps(rows: np.ndarray, q_near: np.ndarray,
             before = sub[keep].copy()
             for a, b, sign in moves:
                 sub[keep] = pair_step(sub[keep], a, b, sign, lo, hi, wrapped,
-                                       q_near[sel[keep]])
+                                      q_near[sel[keep]])
             if np.array_equal(sub[keep], before):
                 break
         out[sel] = sub
@@ -143,7 +144,7 @@ def line_moves(on: list[tuple[int, float, int, int, float]]) -> list[tuple[int, 
 
 
 def pair_step(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np.ndarray,
-               wrapped: np.ndarray, q_near: np.ndarray) -> np.ndarray:
+              wrapped: np.ndarray, q_near: np.ndarray) -> np.ndarray:
     """Rows q (m, n) with q_a + s, q_b - sign s nearest q_near (m, n), both inside.
 
     Each row unchanged (s = 0) where its pair is inside and nothing nearer is.
@@ -231,8 +232,7 @@ def continua_best(robot: Arm, T: np.ndarray, limits: np.ndarray,
             free[[x for a, b, _ in moves for x in (a, b)]] = True
             if not np.all(free | ((r >= lo - 1e-12) & (r <= hi + 1e-12))):
                 continue
-            q = np.where(free, np.clip(r, lo, hi), r)
-            val = -np.inf
+            q, val = r, -np.inf
             for _ in range(2 if len(free.nonzero()[0]) < 2 * len(moves) else 1):
                 for a, b, sign in moves:
                     q, val = _line_best(q, a, b, sign, lo, hi, score)
@@ -261,7 +261,9 @@ def _line_best(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: n
     s_hi = np.minimum(hi[a] - ra, np.maximum(ea, eb)).ravel()
     ra, rb = np.broadcast_to(ra, (3, 3)).ravel(), np.broadcast_to(rb, (3, 3)).ravel()
     keep = s_lo <= s_hi
-    best_q, best_s = q, float(score(q[None])[0])
+    # (q itself counts only inside its limits: a row's moved joints may start outside)
+    inside = bool(np.all((q >= lo) & (q <= hi)))
+    best_q, best_s = q, float(score(q[None])[0]) if inside else -np.inf
     if not keep.any():
         return best_q, best_s
     s_lo, s_hi, ra, rb = s_lo[keep], s_hi[keep], ra[keep], rb[keep]

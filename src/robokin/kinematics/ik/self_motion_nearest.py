@@ -240,8 +240,8 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
                   q: np.ndarray, dispatch: Dispatch) -> np.ndarray:
     """Rows q (m, n) nearest q_near (m, n) on the branches, or nearer in-limit solutions.
 
-    The branch search (a grid per interval, refined minima) misses two kinds of
-    solution, both where an axis pair lines up:
+    The branch search (a grid per interval, refined minima) misses solutions of two
+    kinds:
 
     1. *A swing or a corner.* Next to an aligned shoulder (q2 = 1e-9 on the Panda) a
        branch turns q1 and q3 by ~pi within ~1e-9 of t, and at a configuration with
@@ -256,15 +256,15 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
        there is a continuum at that one parameter value, which the branches' rows
        meet in one point. Every point of it has q_j = v, so it is no nearer than
        |q_near_j - v| (wrapped): for the poses where that bound is below the found
-       distance the pose is solved with joint j held at v (``held_rows``:
-       one row per family, each on its continuum) and each row moved along its
-       continuum to the point nearest q_near inside the limits (:func:`~robokin.kinematics.ik.self_motion_continua.pair_steps`:
+       distance the pose is solved with joint j held at v (``held_rows``: one row
+       per family, each on its continuum) and each row moved along its continuum to
+       the point nearest q_near inside the limits (``self_motion_continua.pair_steps``:
        a sum of quadratics between wraps, so its minimum is one of their vertices
        clipped into the in-limit range, or an end of it), then along the continua of
-       any other pair the row has on one line (q2 = q6 = 0 on the iiwa: two), in
-       turn, ``self_motion_continua._ROUNDS`` times where two pairs share a joint.
+       any other pair the row has on one line (q2 = q6 = 0 on the iiwa: two), every
+       two joints of a longer line in turn where pairs share a joint.
 
-    A nearer row is taken onto the pose (:func:`onto`: Newton's least-squares steps)
+    A nearer row is taken onto the pose (``onto``: Newton's least-squares steps)
     and kept if its pose error is within ``EXACT`` and it is inside every limit; such
     rows then descend along the self-motion to a local minimum of the distance
     (:func:`_descend`). So the answer is never farther than the branch search's.
@@ -357,7 +357,7 @@ def _descend(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndarray,
     A step pulls the row toward q_near within the null space of its Jacobian (the
     self-motion's tangent: the n - 6 directions of a redundant arm and those of
     singular values below 1e-9 of the largest) and takes it back onto the pose by
-    Newton's least-squares steps (:func:`onto`); it is halved until the row is
+    Newton's least-squares steps (``onto``); it is halved until the row is
     nearer, inside the limits and within ``EXACT`` of the pose. A row stops where
     the pull's step is below ``_STILL`` (a local minimum to within ~1e-18 of the
     distance: the search's refined minima start there), where it would take a joint
