@@ -265,6 +265,7 @@ class SelfMotion:
         """
         qn = check_finite(check_joints(q_near, self.limits.shape[0], "q_near"), "q_near")
         fam = self._family
+        exact = isinstance(fam, _SwivelFamily) and not fam.reference  # the kernel's rows
         if isinstance(fam, _SwivelFamily) and not fam.reference:
             point = _swivel_nearest(fam.arm, self.T, qn)
         else:
@@ -276,7 +277,7 @@ class SelfMotion:
             return point
         q = np.full((1, len(qn)), np.nan) if point is None else point.q[None]
         q = nearer_points(self._family.robot, self.T[None], self.limits, qn[None], q,
-                          self._dispatch)
+                          self._dispatch, exact=exact)
         if point is not None and np.array_equal(q[0], point.q):
             return point
         if not np.isfinite(q).all():
@@ -405,7 +406,7 @@ def swivel_nearest(robot: ArmSource, T: np.ndarray, q_near: np.ndarray,
     if dispatch is None:
         return q
     return nearer_points(robot, T, np.asarray(robot.limits, dtype=np.float64), q_near, q,
-                         dispatch)
+                         dispatch, exact=True)
 
 
 def auto_parameter(robot: ArmSource) -> str | None:

@@ -234,10 +234,14 @@ _TIE = 1e-9
 _DESCENT = 24
 #: A descent step below this [rad]: a local minimum (:func:`_descend`).
 _STILL = 1e-9
+#: The numeric solution from q_near is taken only this much nearer [rad] than the
+#: branch search's answer (a refined minimum: the solver's point next to it is no
+#: better by more than rounding; the swings and corners it is for gain 0.05-2 rad).
+_GAIN = 1e-6
 
 
 def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndarray,
-                  q: np.ndarray, dispatch: Dispatch) -> np.ndarray:
+                  q: np.ndarray, dispatch: Dispatch, *, exact: bool = False) -> np.ndarray:
     """Rows q (m, n) nearest q_near (m, n) on the branches, or nearer in-limit solutions.
 
     The branch search (a grid per interval, refined minima) misses solutions of two
@@ -247,8 +251,11 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
        branch turns q1 and q3 by ~pi within ~1e-9 of t, and at a configuration with
        several joints at their limits an interval is a point or a sliver; a q_near
        there is up to ~1 rad from every sampled row. The numeric solver started at
-       q_near (``numeric.solve``, tolerance ``EXACT``; every pose whose answer is not
-       q_near itself) finds the solution next to it.
+       q_near (``numeric.solve``, tolerance ``EXACT``, no restarts) finds the
+       solution next to it, taken where it is nearer by more than ``_GAIN``; run only
+       where q_near is nearer an aligned value (to 1e-6) or a limit than the found
+       answer (a swing's points have the joint within ~1e-6 of its aligned value, a
+       corner's joints at their limits).
     2. *An aligned continuum.* Where joint j at a value v puts axes j-1 and j+1 on
        one line (``coincident.coincident_pair``: the Panda's q2 = 0, the iiwa's q2 or
        q6 = 0), every configuration turning those joints a, b against each other,
@@ -276,6 +283,8 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         q_near: Configurations (m, n) [rad].
         q: The nearest in-limit rows found on the branches (m, n); NaN: none.
         dispatch: ``dispatch.solve`` (:func:`~robokin.kinematics.ik.fixed.solve_fixed`'s).
+        exact: q's rows are within ``EXACT`` of their poses already (the compiled
+            swivel's: polished, dropped above 5e-13): not checked.
 
     Returns:
         (m, n): q (a new array), a row polished where its pose error was above
@@ -289,8 +298,8 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
     lo, hi = limits[:, 0], limits[:, 1]
     # the branch answers as exact as the rows off them (a row of a singular pose the
     # solved-points path accepted at 1e-12 with its joint clamped into its limits)
-    ok = np.flatnonzero(np.isfinite(q).all(-1))
-    _, err = onto(robot, q[ok], T[ok], steps=0)
+    ok = np.flatnonzero(np.isfinite(q).all(-1)) if not exact else np.zeros(0, dtype=int)
+    _, err = onto(robot, q[ok], T[ok], steps=0) if len(ok) else (q[ok], np.zeros(0))
     loose = ok[err > EXACT]
     if len(loose):
         rows, err = onto(robot, q[loose], T[loose])
@@ -309,24 +318,34 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
 
         Nearer than best[idx]; all at once (``onto``'s Newton steps).
         """
-        rows, err = onto(robot, rows, T[idx])
+        rows, err = onto(robot, rows, T[idx], steps=0)
+        loose = err > EXACT  # (the numeric solver's rows are within EXACT already)
+        if loose.any():
+            rows[loose], err[loose] = onto(robot, rows[loose], T[idx[loose]])
         d = _distance(np.clip(rows, lo, hi), q_near[idx], wrapped)
         ok = (err <= EXACT) & _within(rows, limits) & (d < best[idx] - _TIE)
         q[idx[ok]], best[idx[ok]], found[idx[ok]] = np.clip(rows[ok], lo, hi), d[ok], True
 
-    local = numeric.solve(robot, T[idx], q0=q_near[idx], tol=EXACT)
-    ql = np.asarray(local.q, dtype=np.float64).reshape(len(idx), -1)
-    dl = np.where(np.asarray(local.success).reshape(-1),
-                  _distance(ql, q_near[idx], wrapped), np.inf)
-    nearer = dl < best[idx] - _TIE
-    if nearer.any():
-        take(idx[nearer], ql[nearer])
     pairs = robot.derived(LINE_PAIRS)
-    # a continuum's points have its pair's joint at the value v: no nearer than
-    # |q_near_j - v|, so only the poses where that is below the found distance for
-    # some pair are searched
+    # a continuum's points have its pair's joint at the value v, a swing's within
+    # ~1e-6 of it, a corner's joints at their limits: none is nearer than q_near's
+    # distance to those values, so only the poses where that is below the found
+    # distance are searched
     gap = np.abs(_wrap(q_near[:, [j for j, *_ in pairs]]
                        - np.array([v for _, v, *_ in pairs]))) if pairs else None
+    edge = np.minimum(np.abs(q_near - lo), np.abs(q_near - hi)).min(axis=-1)
+    edge[~_within(q_near, limits)] = 0.0
+    if gap is not None:
+        edge = np.minimum(edge, gap.min(axis=-1) - 1e-6)
+    idx = idx[edge[idx] < best[idx]]
+    if len(idx):
+        local = numeric.solve(robot, T[idx], q0=q_near[idx], tol=EXACT, max_restarts=0)
+        ql = np.asarray(local.q, dtype=np.float64).reshape(len(idx), -1)
+        dl = np.where(np.asarray(local.success).reshape(-1),
+                      _distance(ql, q_near[idx], wrapped), np.inf)
+        nearer = dl < best[idx] - _GAIN
+        if nearer.any():
+            take(idx[nearer], ql[nearer])
     for p, (j, v, *_) in enumerate(pairs):
         assert gap is not None
         idx = np.flatnonzero(gap[:, p] < best - _TIE)
