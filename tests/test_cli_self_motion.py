@@ -289,3 +289,31 @@ def test_a_track_as_the_parameter_prints_millimetres(tmp_path, capsys):
     assert code == 0, err
     assert "over track [mm]" in out and "q1 [mm]" in out and "q2 [rad]" in out
     assert "[rad, m]" in out  # the margin mixes a length and angles
+
+
+def test_a_pose_inside_the_limits_only_on_a_continuum_exits_0_with_its_configuration(
+        tmp_path, capsys):
+    """Session 23: an SRS arm with q1, q2, q3 held to narrow ranges around q0 (q2 = 0):
+    no branch inside its limits at q0's pose, only the continuum through q0 (q1 and q3
+    turned against each other). Oracle: q0 reaches the pose inside the limits; the
+    command exits 0 (it exited 1, "no part of the self-motion is inside the joint
+    limits") with a note saying why, and its best configuration reaches the pose
+    inside the limits."""
+    import dataclasses
+
+    arm = iiwa14_srs()
+    joints = list(arm.chain.joints)
+    for j, lim in {0: (0.35, 0.45), 1: (-1e-3, 1e-3), 2: (0.25, 0.35)}.items():
+        joints[j] = dataclasses.replace(joints[j], limits=lim)
+    arm = arm.replace(chain=arm.chain.replace(joints=tuple(joints), coordinates=tuple(joints)))
+    path = save_robot(arm, tmp_path / "narrow.yaml")
+    q0 = np.array([0.4, 0.0, 0.3, -1.2, 0.5, 0.8, 0.2])
+    pose = _pose_args(arm, q0)
+    code, out, err = run(capsys, "self-motion", path, *pose)
+    assert code == 0, err
+    assert "0 in-limit interval(s)" in out and "an aligned continuum is" in out
+    code, out, err = run(capsys, "self-motion", path, *pose, "--json")
+    best = np.array(json.loads(out)["best"]["q"])
+    loaded = robokin.load(str(path))
+    np.testing.assert_allclose(loaded.fk(best), _pose_of(pose), atol=1e-12)
+    assert loaded.within_limits(best)

@@ -283,7 +283,7 @@ def self_motion(
             "animated": animated,
         }))
     else:
-        tables = [_intervals_table(r, sm, u)]
+        tables = [_intervals_table(r, sm, u, top)]
         if top is not None or close is not None:
             tables.append(_configurations_table(top, close, best, u))
         if points:
@@ -292,7 +292,7 @@ def self_motion(
         for written in (path, page):
             if written is not None:
                 say(f"wrote {written}", fmt)
-    if not len(sm.intervals):
+    if not sm.reachable:
         raise DomainFailure(_empty_reason(sm))
 
 
@@ -311,7 +311,8 @@ def _empty_reason(sm: SelfMotion) -> str:
     return "no part of the self-motion is inside the joint limits"
 
 
-def _intervals_table(r: Robot, sm: SelfMotion, u: _Units) -> OutputTable:
+def _intervals_table(r: Robot, sm: SelfMotion, u: _Units,
+                     top: ManifoldPoint | None = None) -> OutputTable:
     unit = u.t_unit
     table = OutputTable(
         f"{r.name}: self-motion over {sm.parameter} [{unit}]: {sm.n_branches} "
@@ -330,6 +331,10 @@ def _intervals_table(r: Robot, sm: SelfMotion, u: _Units) -> OutputTable:
            if sm.periodic else "")
         + f"; {len(sm.crossings)} limit crossing(s), {folds} branch end(s), "
         f"{len(sm.singular) - folds} aligned-axes point(s) (--points lists them)")
+    if not len(sm.intervals) and top is not None:
+        table.notes.append(
+            "no branch is inside the limits, but an aligned continuum is (an axis pair on "
+            "one line, its two joints turned against each other): the configuration below")
     if sm.method.startswith("continued numeric"):
         table.notes.append(
             f"{r.name} with {sm.parameter} held has neither a closed form nor the general "

@@ -182,6 +182,10 @@ def _manifold_goals(robot: Robot, T: np.ndarray) -> Goals | None:
     sm = robot.self_motion(T)
     if not sm.reachable:
         return None  # robot.ik says why (or finds what the manifold missed)
+    if not len(sm.intervals):  # inside the limits only on an aligned continuum
+        best = sm.best("margin")
+        assert best is not None  # (reachable: continua_best found one)
+        return Goals("pose", best.q[None], np.arange(1), T)
     sampler = ManifoldGoals.of(sm)
     q = sampler.round(0)
     return Goals("pose", q, np.arange(len(q)), T, "", sampler, 1)

@@ -288,3 +288,37 @@ def test_best_margin_takes_the_aligned_continua(name, q0):
     assert got.score >= _continuum_margin(robot, T) - 1e-6
     assert got.score >= float(np.minimum(q0 - lim[:, 0], lim[:, 1] - q0).min()) - 1e-9
     _checked(robot, T, q0, got)
+
+
+def _with_limits(robot, new: dict[int, tuple[float, float]]):
+    """The arm with some joints' limits replaced (the same chain otherwise)."""
+    import dataclasses
+
+    chain = robot.chain
+    joints = list(chain.joints)
+    for j, (lo, hi) in new.items():
+        joints[j] = dataclasses.replace(joints[j], limits=(lo, hi))
+    return robot.replace(chain=chain.replace(joints=tuple(joints), coordinates=tuple(joints)))
+
+
+def test_a_pose_inside_the_limits_only_on_a_continuum_is_reachable():
+    """Oracle: q0, inside the limits and reaching the pose by construction. The SRS
+    arm with q1, q2 and q3 held to narrow ranges around q0 (q2 = 0: axes 1 and 3 on
+    one line) has no branch inside its limits at q0's pose (every branch row at q0's
+    swivel splits q1 + q3 = 0.7 otherwise, 2.914 / -2.214 and -0.228 / 0.928), only the
+    continuum through q0: ``reachable`` is True (it was False, while ``best`` and
+    ``nearest`` now find the continuum), ``best`` and ``nearest`` return in-limit
+    configurations of the pose (``nearest(q0)``: q0), and a planning goal at the pose
+    is that configuration."""
+    from robokin.planning.goals import goal_configurations
+
+    q0 = np.array([0.4, 0.0, 0.3, -1.2, 0.5, 0.8, 0.2])
+    arm = _with_limits(SRS, {0: (0.35, 0.45), 1: (-1e-3, 1e-3), 2: (0.25, 0.35)})
+    T = arm.fk(q0)
+    sm = arm.self_motion(T)
+    assert len(sm.intervals) == 0 and sm.reachable
+    _checked(arm, T, q0, sm.best("margin"))
+    assert _checked(arm, T, q0, sm.nearest(q0)) <= 1e-9
+    goals = goal_configurations(arm, T)
+    assert goals.q.shape == (1, 7)
+    _checked(arm, T, q0, goals.q[0])

@@ -222,8 +222,20 @@ class SelfMotion:
 
     @property
     def reachable(self) -> bool:
-        """True when some part of the manifold is inside every joint limit."""
-        return bool(len(self.intervals))
+        """True when some part of the manifold is inside every joint limit.
+
+        An interval of a branch; where there is none, a point of an aligned continuum
+        (``self_motion_continua``: q2 = 0, the pair turned against each other; the
+        pose solved with that joint held, ~0.1-0.3 ms), which ``best`` and
+        ``nearest`` also return.
+        """
+        if len(self.intervals):
+            return True
+        if self._dispatch is None:
+            return False
+        return continua_best(self._family.robot, self.T, self.limits,
+                             _criterion("margin", None, self.limits), -np.inf,
+                             self._dispatch) is not None
 
     def best(self, criterion: str | Callable[[np.ndarray], np.ndarray] = "margin", *,
              robot: ArmSource | None = None, samples: int = 64) -> ManifoldPoint | None:
