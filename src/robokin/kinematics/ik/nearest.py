@@ -123,9 +123,13 @@ def _manifold_near(arm: Arm, T: npt.ArrayLike, q_near: np.ndarray) -> IKResult:
     fast = swivel_nearest(arm, Tf, qn, solve)  # SRS arms: one compiled batch
     q = np.full((len(Tf), arm.n), np.nan) if fast is None else fast
     for i, (Ti, qi) in enumerate(zip(Tf, qn, strict=True)):
-        p = None if fast is not None else nearest_on_manifold(arm, Ti, qi, dispatch=solve)
-        if p is not None:
-            q[i] = p.q
+        # other arms per pose; on SRS arms the poses the compiled search left without
+        # a row (next to a stretched elbow, where it can miss the intervals' slivers):
+        # SelfMotion.nearest searches the pose's intervals themselves
+        if fast is None or not np.isfinite(q[i]).all():
+            p = nearest_on_manifold(arm, Ti, qi, dispatch=solve)
+            if p is not None:
+                q[i] = p.q
     found = np.isfinite(q).all(-1)
     dp, dr = fk_error(arm.chain, q[:, None], Tf)
     dp, dr = dp[:, 0], dr[:, 0]

@@ -267,7 +267,8 @@ class SelfMotion:
         """The in-limit configuration nearest ``q_near`` (n,) (2 pi wrapped distance).
 
         On the compiled swivel (SRS arms) the kernel's search on the exact
-        intervals (``SwivelArm.nearest``); elsewhere the exact intervals searched
+        intervals (``SwivelArm.nearest``); elsewhere, and where that finds nothing
+        (next to a stretched elbow), the exact intervals searched
         by ``self_motion_nearest.interval_nearest`` (end values, a 32-value grid,
         golden-section refinement of the best local minima); then a nearer solution
         off the branches where there is one (``self_motion_nearest.nearer_points``:
@@ -278,9 +279,11 @@ class SelfMotion:
         qn = check_finite(check_joints(q_near, self.limits.shape[0], "q_near"), "q_near")
         fam = self._family
         exact = isinstance(fam, _SwivelFamily) and not fam.reference  # the kernel's rows
+        point = None
         if isinstance(fam, _SwivelFamily) and not fam.reference:
             point = _swivel_nearest(fam.arm, self.T, qn)
-        else:
+        if point is None and len(self.intervals):  # (the kernel's miss: its intervals)
+            exact = False
             found = interval_nearest(fam, self.limits, self.intervals, self.interval_branch,
                                      qn)
             point = None if found is None else ManifoldPoint(found[0], found[1], found[2],
@@ -292,12 +295,21 @@ class SelfMotion:
                           self._dispatch, exact=exact)
         if point is not None and np.array_equal(q[0], point.q):
             return point
-        if not np.isfinite(q).all():
-            return None
         wrapped = np.asarray(self._family.robot.is_revolute, dtype=bool)
-        diff = q[0] - qn
-        return self._off_branches(q[0], -float(np.linalg.norm(np.where(wrapped, _wrap(diff),
-                                                                          diff))))
+
+        def closeness(Q: np.ndarray) -> np.ndarray:
+            """Minus the 2 pi wrapped distance of configurations (m, n) to q_near."""
+            out: np.ndarray = -np.linalg.norm(np.where(wrapped, _wrap(Q - qn), Q - qn), axis=-1)
+            return out
+
+        if not np.isfinite(q).all():
+            # nothing on the branches and no continuum row moved onto the pose within
+            # its limits (an aligned joint 1e-9 off its value next to a limit): the
+            # continua sampled as ``best`` and ``reachable`` sample them
+            cont = continua_best(self._family.robot, self.T, self.limits, closeness,
+                                 -np.inf, self._dispatch)
+            return None if cont is None else self._off_branches(cont[0], cont[1])
+        return self._off_branches(q[0], float(closeness(q)[0]))
 
     def _off_branches(self, q: np.ndarray, score: float) -> ManifoldPoint:
         """A solution q (n,) off the branches' samples as a point with ``score``.
@@ -379,15 +391,13 @@ def nearest_on_manifold(robot: ArmSource, T: np.ndarray, q_near: np.ndarray, *,
     as :func:`~robokin.kinematics.ik.fixed.solve_fixed` takes it, so this module
     does not import the dispatcher that imports it).
 
-    SRS arms: the compiled swivel search; other arms: the exact in-limit intervals
-    of :func:`self_motion` (compiled ``held_manifold`` on the Panda) searched by
-    :func:`~robokin.kinematics.ik.self_motion_nearest.interval_nearest`.
+    :meth:`SelfMotion.nearest` of :func:`self_motion`: on SRS arms the compiled
+    swivel search, on the others the exact in-limit intervals (compiled
+    ``held_manifold`` on the Panda) searched by
+    :func:`~robokin.kinematics.ik.self_motion_nearest.interval_nearest`; then the
+    solutions off the branches (``nearer_points``).
     """
-    arm = arm_of(robot)
-    swivel = _setup(arm).swivel
-    if swivel is not None:
-        return _swivel_nearest(swivel, np.asarray(T, dtype=np.float64), q_near)
-    return self_motion(arm, T, dispatch=dispatch).nearest(q_near)
+    return self_motion(arm_of(robot), T, dispatch=dispatch).nearest(q_near)
 
 
 def _swivel_nearest(arm: SwivelArm, T: np.ndarray, q_near: np.ndarray) -> ManifoldPoint | None:

@@ -108,6 +108,9 @@ def pair_steps(rows: np.ndarray, q_near: np.ndarray,
         sub[~inside] = np.nan
         sub = np.where(free, np.clip(sub, lo, hi), sub)  # a moved joint a hair outside
         keep = np.flatnonzero(inside)
+        if not len(keep):
+            out[sel] = sub
+            continue
         lines = len(free.nonzero()[0]) < 2 * len(moves)  # a line of three or more joints
         for _ in range(_ROUNDS if lines else 1):
             before = sub[keep].copy()
@@ -149,6 +152,8 @@ def pair_step(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np
 
     Each row unchanged (s = 0) where its pair is inside and nothing nearer is.
     """
+    if not len(q):
+        return np.array(q, dtype=np.float64)
     ra = q[:, a, None, None] + _TURNS[:, None]  # (m, 3, 1): the 2 pi turns, each its range
     rb = q[:, b, None, None] + _TURNS[None, :]  # (m, 1, 3)
     ea, eb = sign * (rb - hi[b]), sign * (rb - lo[b])
