@@ -347,3 +347,16 @@ def test_next_to_a_stretched_elbow_the_nearest_is_found_on_the_intervals():
     assert batch.success.all()
     for qn, q, d in zip(near, batch.q, got, strict=True):
         assert _checked(SRS, T, qn, q) == pytest.approx(d, abs=1e-9)
+
+
+def test_a_continued_manifold_of_continuum_rows_gives_q0_back():
+    """Oracle: q0 itself. A UR5 on a 2 m track with its wrist's joint at 0 (q6 = 0:
+    axes 5 and 7 parallel to the shoulder's; with the track held the six joints have a
+    continuum of solutions, so the continued manifold's rows are its members): from
+    q0 the search on the branches returned a configuration 0.48 rad away; the numeric
+    solve from q_near now runs for every pose of such families and finds q0."""
+    arm = ur5_on_a_track(2.0)
+    q0 = np.array([1.0, -1.686, -2.8636, -1.7201, -2.1824, 0.0, -1.8646])
+    T = arm.fk(q0)
+    got = arm.self_motion(T).nearest(q0)
+    assert _checked(arm, T, q0, got) <= 1e-9

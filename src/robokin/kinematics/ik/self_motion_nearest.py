@@ -252,10 +252,13 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
        several joints at their limits an interval is a point or a sliver; a q_near
        there is up to ~1 rad from every sampled row. The numeric solver started at
        q_near (``numeric.solve``, tolerance ``EXACT``, no restarts) finds the
-       solution next to it, taken where it is nearer by more than ``_GAIN``; run only
-       where q_near is nearer an aligned value (to 1e-6) or a limit than the found
-       answer (a swing's points have the joint within ~1e-6 of its aligned value, a
-       corner's joints at their limits).
+       solution next to it, taken where it is nearer by more than ``_GAIN``. On the
+       compiled swivel's answers (``exact``) run only where q_near is nearer an
+       aligned value (to 1e-6) or a limit than the found answer (a swing's points have
+       the joint within ~1e-6 of its aligned value, a corner's joints at their
+       limits); on the other families for every pose (a continued family's rows can
+       be a continuum's members: the UR5 on a track at q5 = 0, its wrist's axes
+       parallel to the shoulder's).
     2. *An aligned continuum.* Where joint j at a value v puts axes j-1 and j+1 on
        one line (``coincident.coincident_pair``: the Panda's q2 = 0, the iiwa's q2 or
        q6 = 0), every configuration turning those joints a, b against each other,
@@ -337,7 +340,8 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
     edge[~_within(q_near, limits)] = 0.0
     if gap is not None:
         edge = np.minimum(edge, gap.min(axis=-1) - 1e-6)
-    idx = idx[edge[idx] < best[idx]]
+    if exact:  # the swivel kernel's answers: misses only there (elsewhere, e.g. a
+        idx = idx[edge[idx] < best[idx]]  # degenerate continued family: every pose)
     if len(idx):
         local = numeric.solve(robot, T[idx], q0=q_near[idx], tol=EXACT, max_restarts=0)
         ql = np.asarray(local.q, dtype=np.float64).reshape(len(idx), -1)
