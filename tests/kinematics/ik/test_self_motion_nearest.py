@@ -360,3 +360,24 @@ def test_a_continued_manifold_of_continuum_rows_gives_q0_back():
     T = arm.fk(q0)
     got = arm.self_motion(T).nearest(q0)
     assert _checked(arm, T, q0, got) <= 1e-9
+
+
+def test_at_a_corner_of_two_limits_the_answer_is_on_the_pose():
+    """Oracle: forward kinematics of the answer. q0 has q4 and q6 at their limits
+    (with q5 = 1e-7): the branch search's point at that corner was clamped into the
+    limits, 1.00008e-12 off the pose (over the issue's 1e-12); it is now polished with
+    the joints at their limits kept there: within 5e-13 from any q_near, inside the
+    limits, and from q_near near q0 no farther than q0."""
+    q0 = np.array([-2.0627886086769855, -0.39673422769784961, -0.37572944873058534,
+                   -3.0718, 1e-7, -0.0175, 0.75444574412352639])
+    T = PANDA.fk(q0)
+    sm = PANDA.self_motion(T)
+    rng = np.random.default_rng(0)
+    near = [q0 + 0.1, q0 - 0.1, q0 + 0.05, *rng.uniform(PANDA.limits[:, 0],
+                                                        PANDA.limits[:, 1], (4, 7))]
+    for i, qn in enumerate(near):
+        got = sm.nearest(qn)
+        d = _checked(PANDA, T, qn, got)
+        assert max(pose_errors(PANDA.fk(got.q), T)) <= 5e-13
+        if i < 3:
+            assert d <= float(np.linalg.norm(wrap_angle(q0 - qn))) + 1e-9

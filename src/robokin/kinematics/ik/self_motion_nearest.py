@@ -294,20 +294,26 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         ``EXACT``, the rows a nearer solution replaced.
     """
     from robokin.kinematics.ik import numeric
+    from robokin.kinematics.ik.coincident import _polish
 
     if not len(q):
         return q
     q = np.array(q, dtype=np.float64)
     lo, hi = limits[:, 0], limits[:, 1]
-    # the branch answers as exact as the rows off them (a row of a singular pose the
-    # solved-points path accepted at 1e-12 with its joint clamped into its limits)
+    # the branch answers as exact as the rows off them: an answer at a corner of two
+    # limits, clamped into them 1e-12 off the pose, is polished with the joints at
+    # their limits kept there (the corner's exact point), else with every joint free
     ok = np.flatnonzero(np.isfinite(q).all(-1)) if not exact else np.zeros(0, dtype=int)
     _, err = onto(robot, q[ok], T[ok], steps=0) if len(ok) else (q[ok], np.zeros(0))
     loose = ok[err > EXACT]
-    if len(loose):
-        rows, err = onto(robot, q[loose], T[loose])
-        fixed = (err <= EXACT) & _within(rows, limits)
-        q[loose[fixed]] = np.clip(rows[fixed], lo, hi)
+    for i in loose:  # (rare: a corner) the joints at a limit kept there, then all free
+        at = np.minimum(np.abs(q[i] - lo), np.abs(q[i] - hi)) <= 1e-12
+        for free in (np.flatnonzero(~at), np.arange(robot.n)):
+            row = _polish(robot, q[i][None], T[i][None], free)[0]
+            _, e = onto(robot, row[None], T[i][None], steps=0)
+            if e[0] <= EXACT and bool(_within(row, limits)):
+                q[i] = np.clip(row, lo, hi)
+                break
     wrapped = np.asarray(robot.is_revolute, dtype=bool)
     best = _distance(q, q_near, wrapped)
     best[np.isnan(best)] = np.inf
