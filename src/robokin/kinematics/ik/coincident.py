@@ -117,10 +117,14 @@ def coincident_pair(robot: Arm, j: int, v: float) -> CoincidentPair | None:
     return CoincidentPair(j, a, b, sign, float(c))
 
 
-def _polish(robot: Arm, q: np.ndarray, T: np.ndarray, free: np.ndarray) -> np.ndarray:
-    """Newton (least squares) on the joints ``free`` of rows q (m, n) to poses T (m, 4, 4)."""
+def _polish(robot: Arm, q: np.ndarray, T: np.ndarray, free: np.ndarray,
+            iterations: int = 8) -> np.ndarray:
+    """Newton (least squares) on the joints ``free`` of rows q (m, n) to poses T (m, 4, 4).
+
+    At most ``iterations`` steps, fewer where every error is below 1e-16.
+    """
     q = q.copy()
-    for _ in range(8):
+    for _ in range(iterations):
         J, Tq = jacobian_and_pose(robot.chain, q)
         e = pose_error(Tq, T)
         if float(np.abs(e).max(initial=0.0)) <= 1e-16:

@@ -80,9 +80,12 @@ from robokin.kinematics.ik.self_motion_intervals import (
     _state_changes,
     _within,
 )
-from robokin.kinematics.ik.self_motion_nearest import interval_nearest, nearer_points
+from robokin.kinematics.ik.self_motion_nearest import (
+    _distance,
+    interval_nearest,
+    nearer_points,
+)
 from robokin.kinematics.ik.swivel import SwivelArm
-from robokin.spatial import wrap_angle as _wrap
 
 __all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SelfMotionSetup", "SingularPoint",
            "auto_parameter", "exact_parameter",
@@ -299,7 +302,7 @@ class SelfMotion:
 
         def closeness(Q: np.ndarray) -> np.ndarray:
             """Minus the 2 pi wrapped distance of configurations (m, n) to q_near."""
-            out: np.ndarray = -np.linalg.norm(np.where(wrapped, _wrap(Q - qn), Q - qn), axis=-1)
+            out: np.ndarray = -_distance(Q, qn, wrapped)
             return out
 
         if not np.isfinite(q).all():
@@ -321,8 +324,7 @@ class SelfMotion:
         t = (float(q[self.joint]) if self.joint is not None
              else float(parameter_values(robot, self.T, q[None, None])[1][0, 0]))
         wrapped = np.asarray(robot.is_revolute, dtype=bool)
-        diff = self.sample(np.array([t]))[0] - q
-        gap = np.linalg.norm(np.where(wrapped, _wrap(diff), diff), axis=-1)
+        gap = _distance(self.sample(np.array([t]))[0], q, wrapped)
         branch = int(np.argmin(np.where(np.isfinite(gap), gap, np.inf)))
         return ManifoldPoint(q, t, branch, score)
 

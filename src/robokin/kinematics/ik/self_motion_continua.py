@@ -61,18 +61,15 @@ def onto(robot: Arm, q: np.ndarray, T: np.ndarray, steps: int = 3
     """Rows q (m, n) taken onto poses T (m, 4, 4) by ``steps`` least-squares Newton steps.
 
     Returns the rows and their largest position [m] / rotation [rad] error (m,).
+    (The steps are ``coincident._polish``'s on every joint, the errors ``fk_error``'s.)
     """
-    from robokin.kinematics.jacobian import jacobian_and_pose
-    from robokin.spatial import pose_error
+    from robokin.kinematics.ik.analytic._common import fk_error
+    from robokin.kinematics.ik.coincident import _polish
 
-    for _ in range(steps):
-        J, F = jacobian_and_pose(robot.chain, q)
-        e = pose_error(F, T)
-        q = q + (np.linalg.pinv(J, rcond=1e-10) @ e[:, :, None])[:, :, 0]
-    _, F = jacobian_and_pose(robot.chain, q)
-    e = pose_error(F, T)
-    err: np.ndarray = np.maximum(np.linalg.norm(e[:, :3], axis=-1),
-                                 np.linalg.norm(e[:, 3:], axis=-1))
+    if steps:
+        q = _polish(robot, q, T, np.arange(robot.n), iterations=steps)
+    dp, dr = fk_error(robot.chain, q[:, None], T)
+    err: np.ndarray = np.maximum(dp[:, 0], dr[:, 0])
     return q, err
 
 

@@ -121,9 +121,7 @@ def _distances(fam: _Family, limits: np.ndarray, t: np.ndarray, br: np.ndarray,
     lo, hi = limits[:, 0], limits[:, 1]
     with np.errstate(invalid="ignore"):
         ok = np.isfinite(q).all(-1) & np.all((q >= lo - 1e-9) & (q <= hi + 1e-9), axis=-1)
-        diff = q - q_near
-        d = np.linalg.norm(np.where(_wrapped(fam), _wrap(diff), diff), axis=-1)
-    return np.where(ok, d, np.inf)
+    return np.where(ok, _distance(q, q_near, _wrapped(fam)), np.inf)
 
 
 def _refined_minima(fam: _Family, limits: np.ndarray, t: np.ndarray, d: np.ndarray,
@@ -427,7 +425,11 @@ def _descend(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndarray,
 
 
 def _distance(q: np.ndarray, q_near: np.ndarray, wrapped: np.ndarray) -> np.ndarray:
-    """(m,) distances of rows q (m, n) to q_near (m, n), the revolute joints wrapped."""
+    """(...) distances of rows q (..., n) to q_near (broadcast against q).
+
+    The ``wrapped`` joints' differences (the revolute ones: :func:`_wrapped`) are
+    wrapped into [-pi, pi).
+    """
     with np.errstate(invalid="ignore"):
         diff = q - q_near
         out: np.ndarray = np.linalg.norm(np.where(wrapped, _wrap(diff), diff), axis=-1)
