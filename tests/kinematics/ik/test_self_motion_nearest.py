@@ -241,6 +241,27 @@ def test_a_continuum_step_is_the_brute_force_minimum():
             assert f[i] <= best + 1e-9
 
 
+def test_a_continuum_row_past_a_limit_is_moved_inside_along_its_continuum():
+    """Oracle: forward kinematics. SRS rows with q6 = 0 (axes 5 and 7 on one line) and
+    q7 = pi, past its limit (3.054): ``pair_steps`` moves q5 and q7 against each other
+    into the limits, and the rows still reach their poses (1e-12). Before, a moved
+    joint outside was clipped first: q7 pi -> 3.054 left the pose by 0.087 rad (the
+    held rows at q2 = 0 of an aligned pose, one of them past q7's limit)."""
+    from robokin.kinematics.ik.self_motion_continua import LINE_PAIRS, pair_steps
+
+    rng = np.random.default_rng(24)
+    lo, hi = SRS.limits[:, 0], SRS.limits[:, 1]
+    q = rng.uniform(0.8 * lo, 0.8 * hi, (20, 7))
+    q[:, 5], q[:, 6] = 0.0, np.pi
+    T = SRS.fk(q)
+    qn = rng.uniform(lo, hi, (20, 7))
+    got = pair_steps(q, qn, SRS.arm.derived(LINE_PAIRS), lo, hi, np.ones(7, dtype=bool))
+    assert np.isfinite(got).all()
+    for i in range(len(q)):
+        assert SRS.within_limits(got[i])
+        assert max(pose_errors(SRS.fk(got[i]), T[i])) <= 1e-12
+
+
 def _continuum_margin(robot, T) -> float:
     """Oracle: the largest joint-limit margin on the aligned continua of pose T, by a
     scan of 20,001 values of s per family row (the pair's 2 pi turns included); each
@@ -381,3 +402,96 @@ def test_at_a_corner_of_two_limits_the_answer_is_on_the_pose():
         assert max(pose_errors(PANDA.fk(got.q), T)) <= 5e-13
         if i < 3:
             assert d <= float(np.linalg.norm(wrap_angle(q0 - qn))) + 1e-9
+
+
+#: (arm, q0, q_near) of a fuzz of special configurations (``special_values``, seeds
+#: 24-26: q_near = q0 + N(0, 0.1) or uniform) where the answer was up to 3.6 rad
+#: farther than q0, or None: a branch 1e-9..1e-6 from an aligned continuum (q2, q4 or
+#: q6 at 1e-9..1e-6, its pair swinging by ~pi next to it), often with joints at limits.
+SWINGS = [
+    ('srs', [-1.5707963267948966, 1.768417534149179, -1e-06, 0.08084048099307095, 0.8036876461384939, -1e-09, 1e-07],
+     [-1.633896105647421, 1.9283947973057662, -0.03381477914398409, 0.22543356089946365, 0.868261694156566, -0.01735571783688044, -0.11605366078152254]),
+    ('srs', [1e-06, 2.0943951023931953, 1.706461847740937, 0.0, 0.0, -1e-07, -3.0543261909900767],
+     [-0.002326129040900309, 2.092511750774872, 1.657645031337585, 0.0066849544387060315, 0.12110597737631129, 0.02426487891919681, -3.1115595232424806]),
+    ('srs', [2.9670597283903604, -1e-06, -2.9670597283903604, 1.240404452703424, -2.9670597283903604, -1e-06, 0.9593410329519809],
+     [2.8981179178977694, -0.06576626263814779, -2.9824800601071084, 1.2384107107425473, -2.900465836133214, -0.03408208603132786, 0.984161619997657]),
+    ('srs', [2.9670597283903604, 2.0943951023931953, 2.5621541151938603, -1e-06, 1e-06, 0.0, -1e-06],
+     [2.8391748404281314, 1.9145894019271625, 2.5651013785225447, 0.2551582626456178, -0.1362332643253934, -0.04531784227550669, -0.2285158053378507]),
+    ('srs', [2.9670597283903604, 1e-09, -1e-06, 1e-07, 0.0, -1e-07, -1e-06],
+     [2.8681106392191507, 0.03149050996541042, -0.0829228821013876, -0.016556050495934338, -0.02186099936113932, -0.08261960325905736, 0.09400756640569155]),
+    ('srs', [1e-07, -1e-06, 0.4485713315456876, -1e-09, 0.7574717055218612, 0.13377098477627225, 1e-09],
+     [1.6664219338101294, 1.2233586607289904, 0.5957586321166222, 0.06338344712305144, -1.653564052988086, -0.21270834234607006, 2.307920850039019]),
+    ('srs', [-2.0839190403478214, 0.0, 2.2041577587308963, -2.0943951023931953, -1.9769605063231281, 1e-09, -1e-06],
+     [-2.1995152560260416, 0.009117622995188956, 2.2449554657436233, -2.257193186871075, -1.8681998833687758, 0.11686538628941284, 0.05028785823258457]),
+    ('srs', [-2.9670597283903604, -1e-06, 1e-09, -2.0943951023931953, -0.7777858962021122, -1e-09, 1.1982300797795427],
+     [-2.9706134195621425, -0.021020898382716757, -0.07863996947673654, -2.058189005130989, -0.7712935220403104, -0.05151630280296142, 1.2819489627672565]),
+    ('srs', [1.5707963267948966, -2.0943951023931953, 1e-09, 1e-06, 1e-06, 1.3615835734608837, -0.8747439136934774],
+     [2.809104356850681, -1.2228517833453614, 2.8551489097964424, 1.159110874240441, 2.050547510610614, 0.15750589402126103, 2.898008408063772]),
+    ('srs', [1.970491193255306, -1e-09, -1e-09, 1.5707963267948966, -0.9005393983774703, -0.5547907277151485, -3.0543261909900767],
+     [2.086818551190948, 0.08634940686752243, 0.12171412405291819, 1.6498744986934184, -0.9766664823781377, -0.5162232169345209, -3.012107094171209]),
+    ('panda', [-1e-09, 1e-06, 1e-06, -1.3163024847285558, -1.3888599389947565, 0.8312723426070328, 1.2933827749508962],
+     [-0.31529870770455704, 0.5818412696614286, 0.7994246269563838, -2.1541706748945044, -1.9701863233451304, 3.453468335671027, 0.23400421732190058]),
+    ('panda', [1.8564001504935939, -0.28789285673654086, 0.6216208516843893, -0.0698, -2.8973, -1e-06, 1e-07],
+     [1.9689770417723036, -0.2780509920948742, 0.6940222005243905, -0.033815584245919995, -2.991527881779192, 0.2027533940953347, 0.0884816230820874]),
+]
+
+
+@pytest.mark.parametrize("name,q0,q_near", SWINGS)
+def test_next_to_a_swing_the_answer_is_never_farther_than_q0(name, q0, q_near):
+    """Oracle: q0 (inside the limits) solves its pose, so the answer for q_near is never
+    farther from q_near than q0 (1e-6), reaches the pose to 1e-12 inside the limits.
+    Before: the SRS arm's answers 0.07-3.6 rad farther (one None: the manifold's only
+    in-limit rows were two refined corners the searches skipped), the Panda's 0.015 and
+    0.17 rad. What finds them (``nearer_points``): numeric solutions stalled 1e-11..1e-9
+    off the pose finished by Newton's steps; rows past a limit slid back to it along
+    the self-motion; the pose solved with an end joint held at q_near's value where no
+    row at the aligned value was taken; the branches' aligned-axes rows moved along
+    their continua; a row Newton cannot finish next to a swing replaced by an end
+    joint's held closed form; the refined corners as candidates."""
+    robot = PANDA if name == "panda" else SRS
+    q0, qn = np.array(q0), np.array(q_near)
+    T = robot.fk(q0)
+    bound = float(np.linalg.norm(wrap_angle(q0 - qn)))
+    assert _checked(robot, T, qn, robot.self_motion(T).nearest(qn)) <= bound + 1e-6
+
+
+@pytest.mark.parametrize("name", ["panda", "srs"])
+def test_next_to_a_swing_one_ik_near_batch_is_never_farther_than_q0(name):
+    """Oracle: q0, as above, for one ``ik_near(method="self_motion")`` batch of the
+    arm's cases (the SRS arm's compiled path: its kernel's answers, then
+    ``nearer_points`` without the branches' records)."""
+    robot = PANDA if name == "panda" else SRS
+    q0 = np.array([q for n, q, _ in SWINGS if n == name])
+    qn = np.array([q for n, _, q in SWINGS if n == name])
+    T = robot.fk(q0)
+    got = robot.ik_near(T, qn, method="self_motion")
+    assert got.success.all()
+    for i in range(len(q0)):
+        bound = float(np.linalg.norm(wrap_angle(q0[i] - qn[i])))
+        assert _checked(robot, T[i], qn[i], got.q[i]) <= bound + 1e-6
+
+
+def test_a_manifold_of_two_corner_points_gives_them_to_nearest_and_best():
+    """Oracle: the refined corners. q0 (q2 at its limit, q4 = q5 = 1e-6 next to a
+    stretched elbow) has two in-limit intervals, each a single point where two limits
+    meet; the family's rows there are a hair outside a limit, so the searches on the
+    intervals skipped them: ``nearest`` gave None from a uniform q_near and ``best``
+    None while ``reachable`` was True. Now both return a corner's row (or a nearer
+    solution), exact and inside the limits."""
+    q0 = np.array([1.5707963267948966, -2.0943951023931953, 1e-09, 1e-06, 1e-06,
+                   1.3615835734608837, -0.8747439136934774])
+    T = SRS.fk(q0)
+    sm = SRS.self_motion(T)
+    assert len(sm.intervals) == 2 and (sm.intervals[:, 0] == sm.intervals[:, 1]).all()
+    assert len(sm._corners) == 2 and sm.reachable
+    corners = [row for _, _, row in sm._corners]
+    qn = np.array([2.809104356850681, -1.2228517833453614, 2.8551489097964424,
+                   1.159110874240441, 2.050547510610614, 0.15750589402126103,
+                   2.898008408063772])
+    d = _checked(SRS, T, qn, sm.nearest(qn))
+    assert d <= min(float(np.linalg.norm(wrap_angle(c - qn))) for c in corners) + 1e-9
+    best = sm.best("margin")
+    _checked(SRS, T, q0, best)
+    margin = [float(np.minimum(c - SRS.limits[:, 0], SRS.limits[:, 1] - c).min())
+              for c in corners]
+    assert best.score >= max(margin) - 1e-12

@@ -251,13 +251,15 @@ class SelfMotion:
             robot: The arm (for ``"manipulability"``).
             samples: Values per feasible interval before zooming in on the best.
 
-        Then the aligned continua (``self_motion_continua.continua_best``: where an
+        The refined corners' rows are candidates too (a corner's interval can be a
+        point the samples skip). Then the aligned continua
+        (``self_motion_continua.continua_best``: where an
         axis pair lines up, q2 = 0, the pair turned against each other), whose points
         the branches' samples do not hold; one scoring higher is returned with its
         parameter value and the branch whose row there is nearest.
         """
         score = _criterion(criterion, robot, self.limits)
-        point = self._maximise(score, samples)
+        point = self._with_corners(self._maximise(score, samples), score)
         if self._dispatch is None:
             return point
         found = continua_best(self._family.robot, self.T, self.limits, score,
@@ -273,10 +275,12 @@ class SelfMotion:
         intervals (``SwivelArm.nearest``); elsewhere, and where that finds nothing
         (next to a stretched elbow), the exact intervals searched
         by ``self_motion_nearest.interval_nearest`` (end values, a 32-value grid,
-        golden-section refinement of the best local minima); then a nearer solution
-        off the branches where there is one (``self_motion_nearest.nearer_points``:
-        the numeric solve from ``q_near`` next to a swing, a point of an aligned
-        continuum; its ``t`` its parameter value, ``branch`` the branch whose row
+        golden-section refinement of the best local minima), and the refined corners'
+        rows (a corner's interval can be a point the searches skip); then a nearer
+        solution off the branches where there is one (``self_motion_nearest.
+        nearer_points``: the numeric solve from ``q_near`` next to a swing, a point of
+        an aligned continuum, the branches' aligned-axes rows moved along their
+        continua; its ``t`` its parameter value, ``branch`` the branch whose row
         there is nearest). ``samples`` is not used (kept for callers that pass it).
         """
         qn = check_finite(check_joints(q_near, self.limits.shape[0], "q_near"), "q_near")
@@ -291,13 +295,6 @@ class SelfMotion:
                                      qn)
             point = None if found is None else ManifoldPoint(found[0], found[1], found[2],
                                                              -found[3])
-        if self._dispatch is None:
-            return point
-        q = np.full((1, len(qn)), np.nan) if point is None else point.q[None]
-        q = nearer_points(self._family.robot, self.T[None], self.limits, qn[None], q,
-                          self._dispatch, exact=exact)
-        if point is not None and np.array_equal(q[0], point.q):
-            return point
         wrapped = np.asarray(self._family.robot.is_revolute, dtype=bool)
 
         def closeness(Q: np.ndarray) -> np.ndarray:
@@ -305,6 +302,15 @@ class SelfMotion:
             out: np.ndarray = -_distance(Q, qn, wrapped)
             return out
 
+        point = self._with_corners(point, closeness)
+        if self._dispatch is None:
+            return point
+        q = np.full((1, len(qn)), np.nan) if point is None else point.q[None]
+        q = nearer_points(self._family.robot, self.T[None], self.limits, qn[None], q,
+                          self._dispatch, exact=exact,
+                          seeds=lambda: self._aligned_rows()[None])
+        if point is not None and np.array_equal(q[0], point.q):
+            return point
         if not np.isfinite(q).all():
             # nothing on the branches and no continuum row moved onto the pose within
             # its limits (an aligned joint 1e-9 off its value next to a limit): the
@@ -327,6 +333,33 @@ class SelfMotion:
         gap = _distance(self.sample(np.array([t]))[0], q, wrapped)
         branch = int(np.argmin(np.where(np.isfinite(gap), gap, np.inf)))
         return ManifoldPoint(q, t, branch, score)
+
+    def _aligned_rows(self) -> np.ndarray:
+        """The branches' rows (k, n) at their aligned-axes points (``singular``)."""
+        marks = [(p.t, p.branch) for p in self.singular if p.kind == "aligned axes"]
+        if not marks:
+            return np.zeros((0, self.limits.shape[0]))
+        t, b = (np.array(x) for x in zip(*marks, strict=True))
+        out: np.ndarray = self.sample(t)[np.arange(len(t)), b]
+        return out
+
+    def _with_corners(self, point: ManifoldPoint | None,
+                      score: Callable[[np.ndarray], np.ndarray]) -> ManifoldPoint | None:
+        """``point``, or a refined corner's row inside the limits scoring higher.
+
+        (A corner's interval is a point or a sliver whose family rows at its ends can
+        be a hair outside a limit: the searches on the intervals skip it, its refined
+        row is inside.)
+        """
+        inside = [(t, b, row) for t, b, row in self._corners if bool(_within(row, self.limits))]
+        if not inside:
+            return point
+        s = score(np.stack([row for _, _, row in inside]))
+        k = int(np.argmax(s))
+        if point is not None and not s[k] > point.score:
+            return point
+        t, b, row = inside[k]
+        return ManifoldPoint(row.copy(), float(t), int(b), float(s[k]))
 
     def _maximise(self, score: Callable[[np.ndarray], np.ndarray],
                   samples: int) -> ManifoldPoint | None:

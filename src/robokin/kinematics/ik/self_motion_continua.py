@@ -78,12 +78,14 @@ _TURNS = np.array([-1.0, 0.0, 1.0]) * 2.0 * np.pi
 
 def pair_steps(rows: np.ndarray, q_near: np.ndarray,
                pairs: list[tuple[int, float, int, int, float]], lo: np.ndarray,
-               hi: np.ndarray, wrapped: np.ndarray) -> np.ndarray:
+               hi: np.ndarray, wrapped: np.ndarray, *, on: float = _ON_ALIGNED
+               ) -> np.ndarray:
     """Rows (m, n) moved along their continua to the points nearest q_near (m, n).
 
     Each row goes to the point inside the limits nearest its q_near; NaN rows where
     a joint no pair moves is outside. A row is on pair (a, b)'s continuum where its
-    joint j is within ``_ON_ALIGNED`` of the pair's value v. Pairs sharing a joint
+    joint j is within ``on`` [rad] of the pair's value v (default ``_ON_ALIGNED``; 0:
+    the exact continua only). Pairs sharing a joint
     make one line of several axes (the iiwa stretched, q2 = q4 = q6 = 0: axes 1, 3, 5
     and 7, c1 q1 + c3 q3 + c5 q5 + c7 q7 fixed): then every two of its joints turn
     against each other, taken in turn (a convex quadratic under one linear
@@ -91,11 +93,11 @@ def pair_steps(rows: np.ndarray, q_near: np.ndarray,
     minimum, as in sequential minimal optimisation), up to ``_ROUNDS`` times.
     """
     out = np.array(rows, dtype=np.float64)
-    on = np.stack([np.abs(_wrap(out[:, j] - v)) <= _ON_ALIGNED for j, v, *_ in pairs], -1)
-    for pattern in np.unique(on, axis=0):
+    on_line = np.stack([np.abs(_wrap(out[:, j] - v)) <= on for j, v, *_ in pairs], -1)
+    for pattern in np.unique(on_line, axis=0):
         if not pattern.any():
             continue
-        sel = np.flatnonzero((on == pattern).all(-1))
+        sel = np.flatnonzero((on_line == pattern).all(-1))
         moves = line_moves([p for p, o in zip(pairs, pattern, strict=True) if o])
         free = np.zeros(len(lo), dtype=bool)
         free[[x for a, b, _ in moves for x in (a, b)]] = True
@@ -103,7 +105,11 @@ def pair_steps(rows: np.ndarray, q_near: np.ndarray,
         with np.errstate(invalid="ignore"):
             inside = np.all(free | ((sub >= lo - 1e-12) & (sub <= hi + 1e-12)), axis=-1)
         sub[~inside] = np.nan
-        sub = np.where(free, np.clip(sub, lo, hi), sub)  # a moved joint a hair outside
+        # a moved joint a hair outside clipped (farther, ``pair_step`` moves it inside:
+        # clipped, the row would leave its pose)
+        with np.errstate(invalid="ignore"):
+            hair = free & (sub >= lo - 1e-12) & (sub <= hi + 1e-12)
+        sub = np.where(hair, np.clip(sub, lo, hi), sub)
         keep = np.flatnonzero(inside)
         if not len(keep):
             out[sel] = sub
@@ -178,12 +184,12 @@ def pair_step(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np
     return out
 
 
-def held_rows(robot: Arm, T: np.ndarray, j: int, v: float, q_near: np.ndarray,
+def held_rows(robot: Arm, T: np.ndarray, j: int, v: float | np.ndarray, q_near: np.ndarray,
               dispatch: Dispatch) -> tuple[np.ndarray, np.ndarray]:
     """Poses T (m, 4, 4) solved with joint j held at v: rows (m, k, n) and valid (m, k).
 
-    One row per family at a coincident value (``fixed.solve_fixed``), its pair split
-    nearest q_near (m, n).
+    v: one value [rad] or one per pose (m,). One row per family at a coincident
+    value (``fixed.solve_fixed``), its pair split nearest q_near (m, n).
     """
     from robokin.kinematics.ik.fixed import solve_fixed
 

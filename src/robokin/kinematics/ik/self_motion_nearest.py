@@ -22,12 +22,15 @@ each taken where it is nearer and exact, then descended along the self-motion.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from robokin.kinematics.arm import Arm
-from robokin.kinematics.ik.fixed import Dispatch
+from robokin.kinematics.ik.fixed import Dispatch, _held_solvers
 from robokin.kinematics.ik.self_motion_base import _Family
 from robokin.kinematics.ik.self_motion_continua import (
+    _ON_ALIGNED,
     EXACT,
     LINE_PAIRS,
     held_rows,
@@ -239,7 +242,8 @@ _GAIN = 1e-6
 
 
 def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndarray,
-                  q: np.ndarray, dispatch: Dispatch, *, exact: bool = False) -> np.ndarray:
+                  q: np.ndarray, dispatch: Dispatch, *, exact: bool = False,
+                  seeds: Callable[[], np.ndarray] | None = None) -> np.ndarray:
     """Rows q (m, n) nearest q_near (m, n) on the branches, or nearer in-limit solutions.
 
     The branch search (a grid per interval, refined minima) misses solutions of two
@@ -286,13 +290,18 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         dispatch: ``dispatch.solve`` (:func:`~robokin.kinematics.ik.fixed.solve_fixed`'s).
         exact: q's rows are within ``EXACT`` of their poses already (the compiled
             swivel's: polished, dropped above 5e-13): not checked.
+        seeds: Gives rows (m, k, n) of the branches at their aligned-axes points
+            (NaN: none), called where a pose has no row held at a pair's value
+            nearer than the answer: moved along the continua they are within
+            ``_ON_ALIGNED`` of as the held rows are (a swing 1e-9..1e-6 off its
+            continuum, where no end joint has a held closed form: the Panda's
+            shoulder).
 
     Returns:
         (m, n): q (a new array), a row polished where its pose error was above
         ``EXACT``, the rows a nearer solution replaced.
     """
     from robokin.kinematics.ik import numeric
-    from robokin.kinematics.ik.coincident import _polish
 
     if not len(q):
         return q
@@ -303,15 +312,10 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
     # their limits kept there (the corner's exact point), else with every joint free
     ok = np.flatnonzero(np.isfinite(q).all(-1)) if not exact else np.zeros(0, dtype=int)
     _, err = onto(robot, q[ok], T[ok], steps=0) if len(ok) else (q[ok], np.zeros(0))
-    loose = ok[err > EXACT]
-    for i in loose:  # (rare: a corner) the joints at a limit kept there, then all free
-        at = np.minimum(np.abs(q[i] - lo), np.abs(q[i] - hi)) <= 1e-12
-        for free in (np.flatnonzero(~at), np.arange(robot.n)):
-            row = _polish(robot, q[i][None], T[i][None], free)[0]
-            _, e = onto(robot, row[None], T[i][None], steps=0)
-            if e[0] <= EXACT and bool(_within(row, limits)):
-                q[i] = np.clip(row, lo, hi)
-                break
+    for i in ok[err > EXACT]:  # (rare: a corner)
+        row, e = _at_limits(robot, q[i], T[i], limits)
+        if e <= EXACT:
+            q[i] = row
     wrapped = np.asarray(robot.is_revolute, dtype=bool)
     best = _distance(q, q_near, wrapped)
     best[np.isnan(best)] = np.inf
@@ -320,18 +324,30 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         return q
     found = np.zeros(len(q), dtype=bool)  # rows taken off the branches
 
-    def take(idx: np.ndarray, rows: np.ndarray) -> None:
+    def take(idx: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """Rows (p, n) as q[idx] where each is a solution inside the limits, nearer.
 
-        Nearer than best[idx]; all at once (``onto``'s Newton steps).
+        Nearer than best[idx]; all at once (``onto``'s Newton steps). Returns which
+        were taken (p,).
         """
         rows, err = onto(robot, rows, T[idx], steps=0)
         loose = err > EXACT  # (the numeric solver's rows are within EXACT already)
         if loose.any():
             rows[loose], err[loose] = onto(robot, rows[loose], T[idx[loose]])
+        # a continuum's point at a limit can come out 1e-11..1e-8 past it (an aligned
+        # joint 1e-7 off its value), a numeric one 1e-3: taken back to the limit
+        past = np.flatnonzero(~_within(rows, limits) & _within(rows, limits + _PAST))
+        for i in past:
+            rows[i], err[i] = _at_limits(robot, rows[i], T[idx[i]], limits)
+        stuck = np.flatnonzero(((err > EXACT) | ~_within(rows, limits))
+                               & _within(rows, limits + _PAST))
+        if len(stuck):  # Newton's steps stall next to a swing: an end joint held there
+            rows[stuck], err[stuck] = _snapped(robot, rows[stuck], T[idx[stuck]], limits,
+                                               dispatch)
         d = _distance(np.clip(rows, lo, hi), q_near[idx], wrapped)
-        ok = (err <= EXACT) & _within(rows, limits) & (d < best[idx] - _TIE)
+        ok: np.ndarray = (err <= EXACT) & _within(rows, limits) & (d < best[idx] - _TIE)
         q[idx[ok]], best[idx[ok]], found[idx[ok]] = np.clip(rows[ok], lo, hi), d[ok], True
+        return ok
 
     pairs = robot.derived(LINE_PAIRS)
     # a continuum's points have its pair's joint at the value v, a swing's within
@@ -349,32 +365,162 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
     if len(idx):
         local = numeric.solve(robot, T[idx], q0=q_near[idx], tol=EXACT, max_restarts=0)
         ql = np.asarray(local.q, dtype=np.float64).reshape(len(idx), -1)
-        dl = np.where(np.asarray(local.success).reshape(-1),
+        # (next to a singular point the steps stall 1e-11..1e-9 off the pose: ``take``'s
+        # Newton steps finish those)
+        _, el = onto(robot, ql, T[idx], steps=0)
+        dl = np.where(np.asarray(local.success).reshape(-1) | (el <= _NEAR_MISS),
                       _distance(ql, q_near[idx], wrapped), np.inf)
         nearer = dl < best[idx] - _GAIN
         if nearer.any():
             take(idx[nearer], ql[nearer])
+    values = np.array([v for _, v, *_ in pairs])
+
+    def take_moved(idx: np.ndarray, held: np.ndarray, valid: np.ndarray) -> np.ndarray:
+        """Held rows (p, k, n) of poses idx moved along their continua: the nearest taken.
+
+        Moved along every line a row's joints are within ``_ON_ALIGNED`` of (a swing's
+        lines, 1e-9 off: the move leaves the pose by ~1e-9 times its step, which
+        ``take`` takes back where it can), then along its exact lines only. Returns
+        the poses (of idx) where a row was taken.
+        """
+        taken = np.zeros(len(q), dtype=bool)
+        k = held.shape[-2]
+        near = np.repeat(q_near[idx], k, axis=0)
+        with np.errstate(invalid="ignore"):
+            off = np.abs(_wrap(held[..., [j for j, *_ in pairs]] - values))
+            loose = ((off > 0.0) & (off <= _ON_ALIGNED)).any(-1).any(-1)  # (p,)
+        for on in (_ON_ALIGNED, 0.0):
+            if on == 0.0:  # (again only where a line was taken 1e-9..1e-6 off)
+                idx, held, valid, near = (idx[loose], held[loose], valid[loose],
+                                          np.repeat(q_near[idx[loose]], k, axis=0))
+                if not len(idx):
+                    break
+            moved = pair_steps(held.reshape(-1, robot.n), near, pairs, lo, hi, wrapped, on=on)
+            ok = valid.reshape(-1) & np.isfinite(moved).all(-1)
+            d = np.where(ok, _distance(moved, near, wrapped), np.inf).reshape(len(idx), k)
+            c = np.argmin(d, axis=1)
+            r = np.arange(len(idx))
+            nearer = d[r, c] < best[idx] - _TIE
+            if nearer.any():
+                ok = take(idx[nearer], moved.reshape(len(idx), k, robot.n)[r, c][nearer])
+                taken[idx[nearer][ok]] = True
+        return np.flatnonzero(taken)
+
+    on_none = np.ones((len(q), len(pairs)), dtype=bool)  # no held row at v taken
     for p, (j, v, *_) in enumerate(pairs):
         assert gap is not None
         idx = np.flatnonzero(gap[:, p] < best - _TIE)
-        if not len(idx):
-            continue
-        held, valid = held_rows(robot, T[idx], j, v, q_near[idx], dispatch)
-        k = held.shape[-2]
-        rows = held.reshape(-1, robot.n)
-        ok = valid.reshape(-1)
-        near = np.repeat(q_near[idx], k, axis=0)
-        moved = pair_steps(rows, near, pairs, lo, hi, wrapped)
-        ok &= np.isfinite(moved).all(-1)
-        d = np.where(ok, _distance(moved, near, wrapped), np.inf).reshape(len(idx), k)
-        c = np.argmin(d, axis=1)
-        r = np.arange(len(idx))
-        nearer = d[r, c] < best[idx] - _TIE
-        if nearer.any():
-            take(idx[nearer], moved.reshape(len(idx), k, robot.n)[r, c][nearer])
+        if len(idx):
+            on_none[take_moved(idx, *held_rows(robot, T[idx], j, v, q_near[idx], dispatch)),
+                    p] = False
+    for p, (_, _, a, b, _) in enumerate(pairs):
+        # a branch passing 1e-9..1e-6 from the continuum (q_j never at v: no row held
+        # there) swings q_a and q_b by ~pi next to it: its solutions with an end joint
+        # of the pair at q_near's value, moved along the continua they are on
+        assert gap is not None
+        idx = np.flatnonzero(on_none[:, p] & (gap[:, p] < best - _TIE))
+        for e in (a, b) if len(idx) else ():
+            if e not in (0, robot.n - 1) or robot.joint_names[e] not in _held_solvers(robot):
+                continue  # (a held closed form only: a middle joint's set-up is per value)
+            at = np.clip(np.where(wrapped[e], _wrap(q_near[idx, e]), q_near[idx, e]),
+                         lo[e], hi[e])
+            take_moved(idx, *held_rows(robot, T[idx], e, at, q_near[idx], dispatch))
+    if seeds is not None and gap is not None:
+        idx = np.flatnonzero((on_none & (gap < best[:, None] - _TIE)).any(-1))
+        rows = seeds() if len(idx) else None
+        if rows is not None and rows.shape[1]:
+            take_moved(idx, rows[idx], np.isfinite(rows[idx]).all(-1))
     if found.any():  # (the search's own rows are refined minima already)
         q[found] = _descend(robot, T[found], limits, q_near[found], q[found], wrapped)
     return q
+
+
+def _snapped(robot: Arm, rows: np.ndarray, T: np.ndarray, limits: np.ndarray,
+             dispatch: Dispatch) -> tuple[np.ndarray, np.ndarray]:
+    """Rows (m, n) near poses T (m, 4, 4) replaced by a held closed form's nearest row.
+
+    Next to a swing (a joint 1e-9 from putting two axes on one line) Newton's steps
+    stall ~1e-11 off the pose, or a hair past a limit: the pose is solved with each
+    end joint that has a held closed form held at the row's value clipped into its
+    limits; of those solutions within ``EXACT`` of the pose and inside every limit the
+    one nearest the row is taken (next to a swing ~1e-2 away: its joints turn ~1e9
+    times as fast as the held one; the caller keeps it only where it is nearer
+    q_near). Returns the rows and their pose errors (inf where none is found).
+    """
+    out, err = rows.copy(), np.full(len(rows), np.inf)
+    gap = np.full(len(rows), np.inf)
+    wrapped = np.asarray(robot.is_revolute, dtype=bool)
+    for e in (robot.n - 1, 0):
+        if robot.joint_names[e] not in _held_solvers(robot):
+            continue
+        at = np.clip(rows[:, e], limits[e, 0], limits[e, 1])
+        held, valid = held_rows(robot, T, e, at, rows, dispatch)
+        m, k = held.shape[:2]
+        flat = held.reshape(-1, robot.n)
+        _, e_all = onto(robot, np.where(valid.reshape(-1, 1), flat, 0.0),
+                        np.repeat(T, k, axis=0), steps=0)
+        ok = valid & (e_all.reshape(m, k) <= EXACT) & _within(held, limits)
+        d = np.where(ok, _distance(held, rows[:, None], wrapped), np.inf)
+        c = np.argmin(d, axis=1)
+        r = np.arange(m)
+        better = d[r, c] < gap
+        out[better], err[better] = held[r, c][better], e_all.reshape(m, k)[r, c][better]
+        gap[better] = d[r, c][better]
+    return out, err
+
+
+def _at_limits(robot: Arm, q: np.ndarray, T: np.ndarray, limits: np.ndarray
+               ) -> tuple[np.ndarray, float]:
+    """A row q (n,) at most ``_PAST`` outside its limits, onto pose T (4, 4) inside them.
+
+    The row moved along the self-motion until the joint farthest outside is at its
+    limit (steps along the Jacobian's null vector, each taken back onto the pose by
+    Newton's steps), else clipped into the limits, its joints at a limit (to 1e-12)
+    kept there and the others polished (``coincident._polish``: a corner's exact
+    point), else every joint polished. Returns the row (clipped) and its pose error
+    [m, rad]; inf where none is within ``EXACT`` of the pose inside the limits (the
+    row as given).
+    """
+    from robokin.kinematics.ik.coincident import _polish
+    from robokin.kinematics.jacobian import jacobian_and_pose
+
+    lo, hi = limits[:, 0], limits[:, 1]
+    row = q.copy()
+    for _ in range(_SLIDES):
+        over = np.maximum(lo - row, row - hi)
+        k = int(np.argmax(over))
+        if over[k] <= 0.0:
+            break
+        J, _ = jacobian_and_pose(robot.chain, row[None])
+        n = np.linalg.svd(J[0])[2][-1]  # the self-motion's tangent
+        if abs(n[k]) < 1e-9:
+            break
+        row = row + n * ((np.clip(row[k], lo[k], hi[k]) - row[k]) / n[k])
+        row, e = onto(robot, row[None], T[None])
+        row = row[0]
+    _, e = onto(robot, row[None], T[None], steps=0)
+    if e[0] <= EXACT and bool(_within(row, limits)):
+        return np.clip(row, lo, hi), float(e[0])
+    start = np.clip(q, lo, hi)
+    at = np.minimum(np.abs(start - lo), np.abs(start - hi)) <= 1e-12
+    for free in (np.flatnonzero(~at), np.arange(robot.n)):
+        row = _polish(robot, start[None], T[None], free)[0]
+        _, e = onto(robot, row[None], T[None], steps=0)
+        if e[0] <= EXACT and bool(_within(row, limits)):
+            return np.clip(row, lo, hi), float(e[0])
+    return q, np.inf
+
+
+#: Steps along the self-motion at most taking a row back to the limit it is past.
+_SLIDES = 6
+
+#: A numeric solution this close to its pose [m, rad] is finished by Newton's steps
+#: (``onto``): the damped steps stall 1e-11..1e-9 off a pose next to a singular point.
+_NEAR_MISS = 1e-6
+
+#: A row found off the branches this far [rad, m] past a limit is taken back to it
+#: (:func:`_at_limits`); farther, it is not a solution inside the limits.
+_PAST = np.array([-1e-2, 1e-2])
 
 
 def _descend(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndarray,
