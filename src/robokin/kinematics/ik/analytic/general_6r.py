@@ -368,17 +368,25 @@ def _trials(chain: Chain, blocks: dict[Variant, np.ndarray], q: np.ndarray, scal
     generating configurations.
     """
     T = np.ascontiguousarray(forward_kinematics(chain, q))
-    runs = {v: raw_solve(chain, _params([b], scale, fallback=False), T, parallel=False)
+    # (the kernel's threads: each pose's rows are the same on one thread or two)
+    runs = {v: raw_solve(chain, _params([b], scale, fallback=False), T, parallel=True)
             for v, b in blocks.items()}
     found = {v: _solutions(r) for v, r in runs.items()}
     ref = [_union([q[i:i + 1]] + [f[i] for f in found.values()]) for i in range(len(q))]
     # compare isolated solutions only (a singular one is a point of a continuum, or two
     # merging, where variants may return different points)
     ref = [r[min_singular_value(chain, r) > ISOLATED * scale] if len(r) else r for r in ref]
+    covers: dict[Variant, list[np.ndarray]] = {v: [] for v in runs}
+    for i in range(len(q)):  # every variant's rows of pose i against its reference at once
+        rows = [found[v][i] for v in runs]
+        close = _close(ref[i], np.concatenate(rows))
+        for v, part in zip(runs, np.split(close, np.cumsum([len(r) for r in rows])[:-1],
+                                          axis=1), strict=True):
+            covers[v].append(part.any(axis=1))
     trials = {}
     for v, (_, _, _, _, _, diag, stats) in runs.items():
         tail = stats[:, 0]
-        covered = [np.asarray(_close(ref[i], found[v][i]).any(axis=1)) for i in range(len(q))]
+        covered = covers[v]
         trials[v] = _Trial(
             covered=covered, degenerate=(diag & K.G6F_DEGENERATE) != 0,
             noisy=(diag & K.G6F_NOISY) != 0,
@@ -446,7 +454,7 @@ def _setup(chain: Chain) -> General6R:
     best = None
     for p, s in _ranked_pairs(trials)[:6]:
         params = _params([blocks[p], blocks[s]], scale)
-        got = _solutions(raw_solve(chain, params, T, parallel=False))
+        got = _solutions(raw_solve(chain, params, T, parallel=True))
         missed = sum(int((~_close(r, g).any(axis=1)).sum()) for r, g in zip(ref, got,
                                                                           strict=True))
         if best is None or missed < best[0]:
