@@ -430,11 +430,26 @@ def test_the_kernels_own_pose_test_takes_only_poses_check_rigid_leaves_as_they_a
         PANDA.self_motion(T[None])
 
 
+def _other_joints_inside(robot, sm, raw):
+    """The crossings of ``raw`` whose rows have every other joint inside its limits (1e-9)."""
+    lo, hi = robot.limits[:, 0], robot.limits[:, 1]
+    out = []
+    for c in raw:
+        row = sm.sample(c.t)[c.branch]
+        inside = (row >= lo - 1e-9) & (row <= hi + 1e-9)
+        inside[c.joint] = True
+        if inside.all():
+            out.append(c)
+    return tuple(out)
+
+
 def test_swivel_records_are_the_kernels_points_built_when_first_read():
     """Oracle: the compiled kernel's own point rows ``[psi, branch, joint, kind]``
-    (``SwivelArm.manifold``): every limit row is one LimitCrossing, every other row one
-    SingularPoint, in order; the records are made on first access and kept (the same
-    tuple after). (Before: the records were built in every call; no ``_records``.)"""
+    (``SwivelArm.manifold``): every limit row is one LimitCrossing of the records of
+    every branch, every other row one SingularPoint, in order; ``crossings`` lists those
+    whose other joints are inside (their rows sampled here: session 24); the records are
+    made on first access and kept (the same tuple after). (Before: the records were
+    built in every call; no ``_records``.)"""
     from robokin.kinematics.ik.self_motion_families import _setup
 
     arm = _setup(SRS.arm).swivel
@@ -447,11 +462,14 @@ def test_swivel_records_are_the_kernels_points_built_when_first_read():
         _, _, pts, npts = arm.manifold(T[None])
         rows = pts[0, :npts[0]]
         limit = rows[:, 3] <= 1
-        got = [(c.t, c.branch, c.joint, c.limit) for c in sm.crossings]
+        raw = sm._every_record()[0]
+        got = [(c.t, c.branch, c.joint, c.limit) for c in raw]
         assert got == [(t, int(b), int(j), kinds[int(k)]) for t, b, j, k in rows[limit]]
         got = [(p.t, p.branch, p.kind) for p in sm.singular]
         assert got == [(t, int(b), kinds[int(k)]) for t, b, _, k in rows[~limit]]
-        assert len(got) + len(sm.crossings) == npts[0] > 0
+        assert len(got) + len(raw) == npts[0] > 0
+        assert sm.crossings == _other_joints_inside(SRS, sm, raw)
+        assert 0 < len(sm.crossings) < len(raw)
         assert sm.crossings is sm.crossings and sm._records is not None
 
 
@@ -480,18 +498,20 @@ def test_held_manifold_one_is_the_batch_kernel_packed_with_the_cheap_test():
     # (held_manifold, its own output arrays) and the test written out on python floats:
     # an interval at most 1e-12 long, a point within 1e-6 of an end of q7's range, or two
     # points of a branch within 1e-6. Poses: uniform, a corner (two joints at limits:
-    # close), a flagged one (uniform #60 of test_self_motion_intervals' seed 2029: a
-    # crossing on a tiny island does not converge; until session 21 the flagged pose
-    # was [0.3, 1e-9, 0.2, -1.5, 0.4, 1.5, 0.7], an aligned shoulder, now certified).
+    # close), a flagged one (a crossing that does not converge, uniform #575 of
+    # benchmarks' seed 7; until session 24 uniform #60 of test_self_motion_intervals'
+    # seed 2029, a crossing on a tiny island where another joint is outside, no longer
+    # located; until session 21 [0.3, 1e-9, 0.2, -1.5, 0.4, 1.5, 0.7], an aligned
+    # shoulder).
     from robokin._native import kernels as K
     from robokin.kinematics.ik.self_motion_families import SELF_MOTION
 
     lo, hi = PANDA.limits[:, 0], PANDA.limits[:, 1]
     q = np.random.default_rng(3).uniform(lo, hi, (6, 7))
     q = np.concatenate([q, [[lo[0], 0.5, 0.2, hi[3], 0.4, 1.5, 0.7],
-                            [0.981380721599149, 0.6596213263318207, -1.6347714934139461,
-                             -0.9251979948777738, 2.860606790204264, 1.8490153603619308,
-                             -2.722742382091805]]])
+                            [1.938950504440641, 0.38930658599203216, 1.4642400160856188,
+                             -0.13902865354611027, -1.1634915275624989, 3.2858181678242624,
+                             0.29588382901085675]]])
     PANDA.self_motion(PANDA.fk(q[0]))
     kern = PANDA.arm.state[SELF_MOTION].held
     seen = set()
@@ -514,8 +534,9 @@ def test_held_manifold_one_is_the_batch_kernel_packed_with_the_cheap_test():
 
 def test_the_compiled_panda_records_are_the_kernels_points_and_the_cached_family_agrees():
     """Oracle: the held-joint kernel's own point rows ``[t, branch, joint, kind]``
-    (``held_manifold``, called here directly): the crossings are its limit rows by
-    branch then t, the singular points its fold rows then its aligned-axes rows, made
+    (``held_manifold``, called here directly): the records' crossings are its limit
+    rows by branch then t (``crossings`` those whose other joints are inside, rows
+    sampled here), the singular points its fold rows then its aligned-axes rows, made
     on first access; a fresh arm's first call (the family chosen, the kernel's
     constants built) and later calls by ``"auto"`` and by the joint's name (the
     constants kept in the set-up) give the same manifold. (Before: the records were
@@ -532,8 +553,10 @@ def test_the_compiled_panda_records_are_the_kernels_points_and_the_cached_family
         assert first.info["compiled"] and kern is not None and first._records is None
         want, branches, points, _, _ = _batch_kernel(kern, T)
         rows = sorted(map(tuple, points.tolist()), key=lambda r: (r[1], r[0]))
-        assert [(c.t, c.branch, c.joint, c.limit) for c in first.crossings] == [
+        raw = first._every_record()[0]
+        assert [(c.t, c.branch, c.joint, c.limit) for c in raw] == [
             (t, int(b), int(j), kinds[int(k)]) for t, b, j, k in rows if k <= 1]
+        assert first.crossings == _other_joints_inside(PANDA, first, raw)
         assert [(p.t, p.branch, p.kind) for p in first.singular] == [
             (t, int(b), kinds[int(k)]) for kind in (3, 2) for t, b, _, k in rows if k == kind]
         assert np.array_equal(first.intervals, want)

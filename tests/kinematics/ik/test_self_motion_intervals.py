@@ -662,9 +662,11 @@ def test_a_shallow_dip_between_row_nodes_is_found(seed):
     # interior extremum on a branch, so the branch leaves the limits over a stretch
     # ~2 sqrt(2e-9 / curvature) (1e-4-1e-3 of t) anywhere in a cell. Oracle: the
     # branch's rows (the held-q7 closed form at 4,001 values, with the original
-    # limits) for the extremum; the moved arm's crossings of that joint on that branch
-    # either side of it, each a row at the limit (1e-10), and no interval of the
-    # branch holding the extremum's t.
+    # limits) for the extremum; no interval of the moved arm's branch holding the
+    # extremum's t, and where the branch's other joints are inside there (1e-6: the
+    # gap bounds two intervals) the moved arm's crossings of that joint on that branch
+    # either side of it, each a row at the limit (1e-10). (Where another joint is out,
+    # crossings bound nothing and are not listed: session 24.)
     rng = np.random.default_rng(seed)
     q0 = rng.uniform(LIMITS[:, 0], LIMITS[:, 1])
     T = PANDA.fk(q0)
@@ -677,7 +679,7 @@ def test_a_shallow_dip_between_row_nodes_is_found(seed):
     for sgn in (1.0, -1.0):
         top = (sgn * x > sgn * Q[:-2]) & (sgn * c >= sgn * Q[2:])
         ext += [(sgn, i + 1, b, j) for i, b, j in zip(*np.nonzero(top[:, :, :6]), strict=True)]
-    dips = 0
+    dips = inside = 0
     for sgn, i, b, j in ext:
         lim = float(Q[i, b, j] - sgn * 1e-9)
         if not LIMITS[j, 0] + 0.01 < lim < LIMITS[j, 1] - 0.01:
@@ -685,16 +687,21 @@ def test_a_shallow_dip_between_row_nodes_is_found(seed):
         arm = _with_limit(j, hi=lim) if sgn > 0 else _with_limit(j, lo=lim)
         moved = arm.self_motion(T)
         assert moved.info.get("compiled") and moved.info["flags"] == 0
+        own = moved.intervals[moved.interval_branch == b]
+        assert not np.any((own[:, 0] < t[i]) & (t[i] < own[:, 1])), (b, j, own)
+        dips += 1
+        margin = np.minimum(Q[i, b] - LIMITS[:, 0], LIMITS[:, 1] - Q[i, b])
+        margin[j] = np.inf
+        if not margin.min() > 1e-6:
+            continue
         cross = sorted(p.t for p in moved.crossings
                        if p.branch == b and p.joint == j and abs(p.t - t[i]) < 0.05)
         before, after = [p for p in cross if p < t[i]], [p for p in cross if p > t[i]]
         assert before and after, (b, j, t[i], cross)
         for p in (before[-1], after[0]):
             assert abs(moved.sample(p)[b, j] - lim) <= 1e-10, (b, j, p)
-        own = moved.intervals[moved.interval_branch == b]
-        assert not np.any((own[:, 0] < t[i]) & (t[i] < own[:, 1])), (b, j, own)
-        dips += 1
-    assert dips >= 5, dips
+        inside += 1
+    assert dips >= 5 and inside >= 3, (dips, inside)
 
 
 def test_a_crossing_pair_inside_a_wide_cell_is_found():
@@ -802,13 +809,16 @@ def test_a_crossing_is_in_an_interval_exactly_when_its_row_is_inside(special):
     # point [t, t] between two pieces outside) is then taken from the last row and its
     # slopes; here against the row sampled at the crossing: inside every limit (joint
     # c.joint at its limit; MANIFOLD_SLACK) exactly when t is in an interval of its branch
-    # (rows within 1e-10 of the slack's edge are not decided by rounding, and skipped)
+    # (rows within 1e-10 of the slack's edge are not decided by rounding, and skipped),
+    # for the records of every branch (``_every_record``: the kernel's crossings where
+    # another joint is out too, bar the cells it skips); ``crossings`` lists the former
     checked = {True: 0, False: 0}
     for q in _configurations(8, special, 4029 if special else 2029):
         sm = PANDA.self_motion(PANDA.fk(q))
         if not sm.info.get("compiled", False):
             continue
-        for c in sm.crossings:
+        listed_ones = set(sm.crossings)
+        for c in sm._every_record()[0]:
             row = sm.sample(c.t)[c.branch]
             margin = np.minimum(row - LIMITS[:, 0], LIMITS[:, 1] - row) + MANIFOLD_SLACK
             margin[c.joint] = np.inf
@@ -817,8 +827,9 @@ def test_a_crossing_is_in_an_interval_exactly_when_its_row_is_inside(special):
             own = sm.intervals[sm.interval_branch == c.branch]
             listed = bool(np.any((own[:, 0] - 1e-12 <= c.t) & (c.t <= own[:, 1] + 1e-12)))
             assert listed == bool(np.all(margin > 0.0)), (c.t, c.branch, c.joint, margin)
+            assert (c in listed_ones) == listed, (c, listed)
             checked[listed] += 1
-    assert checked[True] >= 20 and checked[False] >= 20, checked
+    assert checked[True] >= 20 and checked[False] >= 5, checked
 
 
 @pytest.mark.parametrize("q", [

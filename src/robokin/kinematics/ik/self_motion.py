@@ -128,8 +128,10 @@ class SelfMotion:
         intervals: (m, 2) parameter intervals [rad] where a branch is inside every
             joint limit, sorted by branch then start.
         interval_branch: (m,) the branch of each interval.
-        crossings: Every point where a branch meets a joint limit (a property:
-            built from ``_points`` on first access, then kept in ``_records``).
+        crossings: Every point where a branch meets a joint limit with its other
+            joints inside theirs (where an in-limit interval starts or ends, or a
+            branch touches a limit from inside; a property: built from ``_points``
+            or ``_records`` on first access, then kept in ``_kept``).
         singular: Branch ends ("fold") and aligned-axes points (the same; a
             kernel's repeats of one point merged: ``self_motion_families.one_per_point``).
         method: How the branches are computed.
@@ -143,7 +145,11 @@ class SelfMotion:
         _points: The compiled kernel's points (p, 4) ``[t, branch, joint, kind]``
             (the swivel's ``SM_KIND_*``, the held joint's ``HM_KIND_*``), or None
             when ``_records`` was given.
-        _records: ``(crossings, singular)``, built from ``_points`` when first read.
+        _records: ``(crossings, singular)``, the crossings of every branch, in or out of
+            the other limits (the compiled Panda kernel's omit the cells where a joint
+            is certainly outside), built from ``_points`` when first read.
+        _kept: ``_records`` with the crossings ``crossings`` lists, made on first
+            access.
         _held: ``_points`` are the held-joint kernel's (``_held_records`` orders them).
         _corners: ``(t, branch, row)`` of corners whose row was refined on the pose
             (``self_motion_intervals._points_refined``): ``sample`` returns that row.
@@ -169,10 +175,18 @@ class SelfMotion:
     _held: bool = field(default=False, repr=False)
     _corners: tuple[tuple[float, int, np.ndarray], ...] = field(default=(), repr=False)
     _dispatch: Dispatch | None = field(default=None, repr=False)
+    _kept: tuple[tuple[LimitCrossing, ...], tuple[SingularPoint, ...]] | None = field(
+        default=None, repr=False)
 
     @property
     def crossings(self) -> tuple[LimitCrossing, ...]:
-        """Every point where a branch meets a joint limit (:class:`LimitCrossing`)."""
+        """Where a branch meets a joint limit, its other joints inside (:class:`LimitCrossing`).
+
+        The ends of the in-limit intervals that are not branch ends or the domain's,
+        and the points where a branch touches a limit from inside; a branch crossing a
+        limit while another joint is outside bounds nothing and is not listed (the
+        compiled Panda kernel does not locate those: ``docs/ik.md``, session 24).
+        """
         return self._built()[0]
 
     @property
@@ -181,13 +195,41 @@ class SelfMotion:
         return self._built()[1]
 
     def _built(self) -> tuple[tuple[LimitCrossing, ...], tuple[SingularPoint, ...]]:
-        """The records, made from the kernel's points on first access and kept."""
+        """The records inside the limits, made on first access and kept."""
+        if self._kept is None:
+            object.__setattr__(self, "_kept", self._inside_records(*self._every_record()))
+        assert self._kept is not None
+        return self._kept
+
+    def _every_record(self) -> tuple[tuple[LimitCrossing, ...], tuple[SingularPoint, ...]]:
+        """The records of every branch, in or out of the limits (``_records``)."""
         if self._records is None:
             assert self._points is not None
             made = (_held_records if self._held else _records_of)(self._points)
             object.__setattr__(self, "_records", made)
         assert self._records is not None
         return self._records
+
+    def _inside_records(self, crossings: tuple[LimitCrossing, ...],
+                        singular: tuple[SingularPoint, ...]
+                        ) -> tuple[tuple[LimitCrossing, ...], tuple[SingularPoint, ...]]:
+        """The crossings whose other joints are inside; ``singular`` as it is.
+
+        Each crossing's row (``sample`` at its t) inside every limit but its own
+        joint's to ``_RECORD_SLACK`` (a corner's other joint at its limit is kept).
+        """
+        if not crossings:
+            return crossings, singular
+        t = np.array([c.t for c in crossings])
+        b = np.array([c.branch for c in crossings])
+        j = np.array([c.joint for c in crossings])
+        rows = self.sample(t)[np.arange(len(t)), b]
+        lo, hi = self.limits[:, 0], self.limits[:, 1]
+        with np.errstate(invalid="ignore"):
+            ok = (rows >= lo - _RECORD_SLACK) & (rows <= hi + _RECORD_SLACK)
+        ok[np.arange(len(t)), j] = True
+        keep = ok.all(-1)
+        return tuple(c for c, k in zip(crossings, keep, strict=True) if k), singular
 
     def sample(self, t: npt.ArrayLike, *, within_limits: bool = False) -> np.ndarray:
         """Every branch at parameter values t: (..., k, n), NaN where a branch has none.
@@ -335,8 +377,12 @@ class SelfMotion:
         return ManifoldPoint(q, t, branch, score)
 
     def _aligned_rows(self) -> np.ndarray:
-        """The branches' rows (k, n) at their aligned-axes points (``singular``)."""
-        marks = [(p.t, p.branch) for p in self.singular if p.kind == "aligned axes"]
+        """The branches' rows (k, n) at their aligned-axes points, in or out of the limits.
+
+        (Out: a swing's middle row, q1 and q3 at +-pi next to the Panda's aligned
+        shoulder; its continuum move can bring it in.)
+        """
+        marks = [(p.t, p.branch) for p in self._every_record()[1] if p.kind == "aligned axes"]
         if not marks:
             return np.zeros((0, self.limits.shape[0]))
         t, b = (np.array(x) for x in zip(*marks, strict=True))
@@ -654,7 +700,7 @@ def _held_motion(T: np.ndarray, kern: HeldKernel, intervals: np.ndarray, owner: 
         "periodic": False, "n_branches": 8, "intervals": intervals, "interval_branch": owner,
         "method": kern.method, "info": info, "_family": fam, "limits": limits,
         "_points": points, "_records": None, "_held": True, "_corners": corners,
-        "_dispatch": dispatch})
+        "_dispatch": dispatch, "_kept": None})
     return sm
 
 
@@ -680,7 +726,7 @@ def _swivel_motion(arm: SwivelArm, T: np.ndarray, robot: Arm, limits: np.ndarray
         "periodic": True, "n_branches": 8, "intervals": intervals, "interval_branch": owner,
         "method": _SWIVEL_METHOD, "info": {"bisected": 0, "grid": 0}, "_family": sw,
         "limits": limits, "_points": points, "_records": None, "_held": False,
-        "_corners": corners, "_dispatch": dispatch})
+        "_corners": corners, "_dispatch": dispatch, "_kept": None})
     return sm
 
 
@@ -695,6 +741,10 @@ def _solves(fam: _Family) -> dict[str, int]:
 _SWIVEL_DOMAIN = np.array([-np.pi, np.pi])
 #: The compiled swivel's ``method``.
 _SWIVEL_METHOD = "swivel closed form (SRS), compiled"
+#: A crossing's row within this of another limit [rad, m] counts as inside it
+#: (``SelfMotion._inside_records``: a corner's other joint at its limit, rounded).
+_RECORD_SLACK = 1e-9
+
 #: The compiled swivel's point kinds (``SM_KIND_*`` 0-3), as the records name them.
 _KINDS = ("lower", "upper", "aligned axes", "fold")
 

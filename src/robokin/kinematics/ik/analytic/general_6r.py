@@ -382,7 +382,7 @@ def _trials(chain: Chain, blocks: dict[Variant, np.ndarray], q: np.ndarray, scal
         close = _close(ref[i], np.concatenate(rows))
         for v, part in zip(runs, np.split(close, np.cumsum([len(r) for r in rows])[:-1],
                                           axis=1), strict=True):
-            covers[v].append(part.any(axis=1))
+            covers[v].append(np.asarray(part.any(axis=1)))
     trials = {}
     for v, (_, _, _, _, _, diag, stats) in runs.items():
         tail = stats[:, 0]
