@@ -23,9 +23,10 @@
  *      predicted residual is below the stop and the row's side of every limit follows
  *      from the last row and its slopes (hm_last, session 12); in a cell where a
  *      joint is certainly outside its limits (hm_dead: its model with every turn
- *      away from them) no limit crossing is located (it bounds no interval; its
- *      aligned points still are; session 24: 38.9 -> ~13 crossings and ~9 % of the
- *      time per Panda pose);
+ *      away from them) no limit crossing is located and the splits are those its
+ *      aligned values ask for (its crossings bound no interval; its aligned points
+ *      are still located; session 24: 38.9 -> 12.7 crossings and ~13 % of the time
+ *      per Panda pose);
  *   3. cells where a slot's row appears or disappears (a fold: two slots meet):
  *      the end where the position root's subproblem-4 discriminant reaches 0
  *      (or HM_DISC_TWO for the pair's second root), by Brent's method on the
@@ -1498,9 +1499,10 @@ static double hm_gap(const HmCtx *c, int b, const HmRow *r)
  * HM_JUMP, a slope missing, or a query's sign change that its end slopes do not
  * explain as one monotone crossing, or whose Hermite model dips across. dj: each
  * joint's move over the cell (wrap_pi(q1 - q0)), fq: each query's q_j - value at
- * r0 (hm_f), as hm_moves computes them once for both (the same values). */
+ * r0 (hm_f), as hm_moves computes them once for both (the same values). aligned_only:
+ * the aligned-axes queries only (a dead cell, hm_dead: its limit queries need none). */
 static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1,
-                          const double *dj, const double *fq)
+                          const double *dj, const double *fq, int aligned_only)
 {
     double h = r1->t - r0->t, big = 0.0;
     int coarse = h > 1.5 * c->hfine; /* wider than a margin cell (round 8b) */
@@ -1518,6 +1520,8 @@ static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r
             return 1;
     }
     for (int qi = 0; qi < c->nq; qi++) {
+        if (aligned_only && c->qkind[qi] != HM_KIND_ALIGNED)
+            continue;
         int j = c->qj[qi];
         double f0 = fq[qi], f1 = f0 + dj[j];
         double d0 = r0->dq[b][j] * m0, d1 = r1->dq[b][j] * m1;
@@ -1882,7 +1886,7 @@ static void hm_split_row(HmCtx *c, int b, double t, const HmRow *r0, const HmRow
     if (!(b & 1) && r0->valid[p] && r1->valid[p] && (r0->sloped & r1->sloped) >> p & 1u) {
         double dj[PK_MAXJ], fq[HM_MAXQ];
         hm_moves(c, p, r0, r1, dj, fq);
-        if (hm_needs_split(c, p, r0, r1, dj, fq)) {
+        if (hm_needs_split(c, p, r0, r1, dj, fq, hm_dead(c, p, r0, r1, dj))) {
             hm_eval_pair(c, t, b, 1, m);
             return;
         }
@@ -1953,7 +1957,7 @@ static int hm_swing(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, const dou
                     const double *fq, int *resolved)
 {
     c->deep_cell = 1;
-    int still = hm_needs_split(c, b, r0, r1, dj, fq);
+    int still = hm_needs_split(c, b, r0, r1, dj, fq, hm_dead(c, b, r0, r1, dj));
     c->deep_cell = 0;
     if (!still) {
         *resolved = 1;
@@ -1982,7 +1986,8 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
         return;
     double dj[PK_MAXJ], fq[HM_MAXQ];
     hm_moves(c, b, r0, r1, dj, fq);
-    if (hm_needs_split(c, b, r0, r1, dj, fq)) {
+    int dead = hm_dead(c, b, r0, r1, dj); /* then split for its aligned values only */
+    if (hm_needs_split(c, b, r0, r1, dj, fq, dead)) {
         int resolved = 0, swing = 0;
         if (depth == HM_DEPTH && hm_jump(c, b, r0, r1, depth))
             return;
@@ -2018,7 +2023,6 @@ static void hm_cell(HmCtx *c, int b, const HmRow *r0, const HmRow *r1, int depth
     /* a dead cell's limit crossings bound no interval (the piece they lie in is outside:
      * hm_intervals decides it so from any row in it); its aligned points are still
      * located (an aligned pair's continuum can bring a joint outside back in) */
-    int dead = hm_dead(c, b, r0, r1, dj);
     double hs = hm_sigma(c, r1->t) - hm_sigma(c, r0->t);
     double m0 = hm_dtds(c, r0->t) * hs, m1 = hm_dtds(c, r1->t) * hs; /* per unit of the cell */
     for (int qi = 0; qi < c->nq && !c->flags; qi++) {
