@@ -362,18 +362,27 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         edge = np.minimum(edge, gap.min(axis=-1) - 1e-6)
     if exact:  # the swivel kernel's answers: misses only there (elsewhere, e.g. a
         idx = idx[edge[idx] < best[idx]]  # degenerate continued family: every pose)
+    values = np.array([v for _, v, *_ in pairs])
+    # a swing's signs (the end joints' held seeds below run there only): the numeric
+    # solve from q_near stalls off the pose, or ends next to a pair's aligned value
+    swing = np.zeros((len(q), len(pairs)), dtype=bool)
     if len(idx):
         local = numeric.solve(robot, T[idx], q0=q_near[idx], tol=EXACT, max_restarts=0)
         ql = np.asarray(local.q, dtype=np.float64).reshape(len(idx), -1)
         # (next to a singular point the steps stall 1e-11..1e-9 off the pose: ``take``'s
         # Newton steps finish those)
-        _, el = onto(robot, ql, T[idx], steps=0)
-        dl = np.where(np.asarray(local.success).reshape(-1) | (el <= _NEAR_MISS),
-                      _distance(ql, q_near[idx], wrapped), np.inf)
+        reached = np.asarray(local.success).reshape(-1).copy()
+        if not reached.all():
+            _, el = onto(robot, ql[~reached], T[idx[~reached]], steps=0)
+            reached[~reached] = el <= _NEAR_MISS
+        if pairs:
+            with np.errstate(invalid="ignore"):
+                off = np.abs(_wrap(ql[:, [j for j, *_ in pairs]] - values))
+            swing[idx] = ~reached[:, None] | ~(off > _SWING_NEAR)
+        dl = np.where(reached, _distance(ql, q_near[idx], wrapped), np.inf)
         nearer = dl < best[idx] - _GAIN
         if nearer.any():
             take(idx[nearer], ql[nearer])
-    values = np.array([v for _, v, *_ in pairs])
 
     def take_moved(idx: np.ndarray, held: np.ndarray, valid: np.ndarray) -> np.ndarray:
         """Held rows (p, k, n) of poses idx moved along their continua: the nearest taken.
@@ -416,9 +425,10 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
     for p, (_, _, a, b, _) in enumerate(pairs):
         # a branch passing 1e-9..1e-6 from the continuum (q_j never at v: no row held
         # there) swings q_a and q_b by ~pi next to it: its solutions with an end joint
-        # of the pair at q_near's value, moved along the continua they are on
+        # of the pair at q_near's value, moved along the continua they are on (where
+        # the numeric solve shows a swing: ``swing``)
         assert gap is not None
-        idx = np.flatnonzero(on_none[:, p] & (gap[:, p] < best - _TIE))
+        idx = np.flatnonzero(on_none[:, p] & swing[:, p] & (gap[:, p] < best - _TIE))
         for e in (a, b) if len(idx) else ():
             if e not in (0, robot.n - 1) or robot.joint_names[e] not in _held_solvers(robot):
                 continue  # (a held closed form only: a middle joint's set-up is per value)
@@ -510,6 +520,10 @@ def _at_limits(robot: Arm, q: np.ndarray, T: np.ndarray, limits: np.ndarray
             return np.clip(row, lo, hi), float(e[0])
     return q, np.inf
 
+
+#: The numeric solution from q_near this close to a pair's aligned value [rad] (or
+#: stalled off the pose) marks a possible swing next to it (``nearer_points``).
+_SWING_NEAR = 1e-3
 
 #: Steps along the self-motion at most taking a row back to the limit it is past.
 _SLIDES = 6
