@@ -146,8 +146,8 @@ class SelfMotion:
             (the swivel's ``SM_KIND_*``, the held joint's ``HM_KIND_*``), or None
             when ``_records`` was given.
         _records: ``(crossings, singular)``, the crossings of every branch, in or out of
-            the other limits (the compiled Panda kernel's omit the cells where a joint
-            is certainly outside), built from ``_points`` when first read.
+            the other limits (the compiled held-joint kernel's omit the cells where a
+            joint is certainly outside), built from ``_points`` when first read.
         _kept: ``_records`` with the crossings ``crossings`` lists, made on first
             access.
         _held: ``_points`` are the held-joint kernel's (``_held_records`` orders them).
@@ -185,7 +185,8 @@ class SelfMotion:
         The ends of the in-limit intervals that are not branch ends or the domain's,
         and the points where a branch touches a limit from inside; a branch crossing a
         limit while another joint is outside bounds nothing and is not listed (the
-        compiled Panda kernel does not locate those: ``docs/ik.md``, session 24).
+        compiled held-joint kernel, the Panda's and the Gen3-like arm's, does not
+        locate most of those: ``docs/ik.md``, session 24).
         """
         return self._built()[0]
 

@@ -394,6 +394,8 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         """
         taken = np.zeros(len(q), dtype=bool)
         k = held.shape[-2]
+        if not k:
+            return np.flatnonzero(taken)
         near = np.repeat(q_near[idx], k, axis=0)
         with np.errstate(invalid="ignore"):
             off = np.abs(_wrap(held[..., [j for j, *_ in pairs]] - values))
@@ -466,6 +468,8 @@ def _snapped(robot: Arm, rows: np.ndarray, T: np.ndarray, limits: np.ndarray,
         at = np.clip(rows[:, e], limits[e, 0], limits[e, 1])
         held, valid = held_rows(robot, T, e, at, rows, dispatch)
         m, k = held.shape[:2]
+        if not k:
+            continue
         flat = held.reshape(-1, robot.n)
         _, e_all = onto(robot, np.where(valid.reshape(-1, 1), flat, 0.0),
                         np.repeat(T, k, axis=0), steps=0)
@@ -506,8 +510,7 @@ def _at_limits(robot: Arm, q: np.ndarray, T: np.ndarray, limits: np.ndarray
         if abs(n[k]) < 1e-9:
             break
         row = row + n * ((np.clip(row[k], lo[k], hi[k]) - row[k]) / n[k])
-        row, e = onto(robot, row[None], T[None])
-        row = row[0]
+        row = onto(robot, row[None], T[None])[0][0]
     _, e = onto(robot, row[None], T[None], steps=0)
     if e[0] <= EXACT and bool(_within(row, limits)):
         return np.clip(row, lo, hi), float(e[0])
