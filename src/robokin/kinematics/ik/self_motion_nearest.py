@@ -532,8 +532,8 @@ _SWING_NEAR = 1e-3
 _SLIDES = 6
 
 #: A numeric solution this close to its pose [m, rad] is finished by Newton's steps
-#: (``onto``): the damped steps stall 1e-11..1e-9 off a pose next to a singular point.
-_NEAR_MISS = 1e-6
+#: (``onto``): the damped steps stall 1e-11..5e-6 off a pose next to a singular point.
+_NEAR_MISS = 1e-4
 
 #: A row found off the branches this far [rad, m] past a limit is taken back to it
 #: (:func:`_at_limits`); farther, it is not a solution inside the limits.
