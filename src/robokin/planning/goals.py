@@ -9,10 +9,12 @@
   joint limits, with the whole-turn equivalents of joints whose range exceeds
   2 pi (a UR joint at +-360 deg reaches each angle twice); for a 7R arm, samples
   of the pose's whole self-motion manifold (``robot.self_motion(T)``: every branch,
-  every interval inside the joint limits), spread over the intervals by their
-  length, at least one each (:class:`ManifoldGoals`). The planner asks for denser
-  samples (:meth:`Goals.grown`) while every goal so far is in collision or the
-  search cannot reach them.
+  every interval inside the joint limits, and the aligned continua, where two axes on
+  one line let a pair of joints turn against each other, e.g. the Panda's q2 = 0),
+  spread over the intervals and continua by their length, at least one each
+  (:class:`ManifoldGoals`). The planner asks for denser samples
+  (:meth:`Goals.grown`) while every goal so far is in collision or the search cannot
+  reach them.
 
 For a four-joint arm a (4, 4) array is ambiguous; it is read as a pose when it is
 a rigid transform (last row 0 0 0 1, orthonormal rotation), else as four
@@ -33,6 +35,7 @@ from robokin.exceptions import InputError
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.self_motion import SelfMotion
+    from robokin.kinematics.ik.self_motion_continua import Continua
     from robokin.robot import Robot
 
 __all__ = ["GoalKind", "Goals", "ManifoldGoals", "goal_configurations", "outside_limits"]
@@ -53,36 +56,68 @@ class ManifoldGoals:
     """The self-motion manifold of a 7R pose goal, sampled round by round.
 
     Round r places ``counts[i] * 2**r`` samples at the centres of equal cells of
-    in-limit interval i, so no sample repeats an earlier round's (a round's centres
-    are the earlier rounds' cell boundaries) and every round is spread over every
-    branch and interval.
+    in-limit interval i, and ``line_counts[i] * 2**r`` on the in-limit stretch of
+    aligned continuum i (:func:`~robokin.kinematics.ik.self_motion_continua.continua`:
+    the configurations off the branches), so no sample repeats an earlier round's (a
+    round's centres are the earlier rounds' cell boundaries) and every round is spread
+    over every branch, interval and continuum.
 
     Attributes:
         motion: ``robot.self_motion(T)``.
         counts: (m,) first-round samples of each interval (>= 1).
+        lines: The pose's aligned continua inside the limits, or None.
+        line_counts: (p,) first-round samples of each continuum's stretch (>= 1).
     """
 
     motion: SelfMotion
     counts: np.ndarray
+    lines: Continua | None = None
+    line_counts: np.ndarray | None = None
 
     @classmethod
     def of(cls, motion: SelfMotion, first: int = MANIFOLD_FIRST) -> ManifoldGoals:
-        """The sampler of ``motion`` with about ``first`` samples in round 0."""
+        """The sampler of ``motion`` with about ``first`` samples in round 0.
+
+        Shared by length [rad] between the intervals (of t) and the continua (of
+        their pair's turn s); the continua where ``motion`` can solve the pose with a
+        joint held (it was made by :func:`~robokin.kinematics.ik.self_motion.
+        self_motion` with its dispatcher).
+        """
+        lines = motion.continua()
         length = np.diff(motion.intervals, axis=1)[:, 0]
-        total = float(length.sum())
-        share = length / total * first if total > 0 else np.zeros_like(length)
-        return cls(motion, np.maximum(1, np.rint(share)).astype(np.int64))
+        line_length = np.zeros(0) if lines is None else lines.s_hi - lines.s_lo
+        total = float(length.sum() + line_length.sum())
+
+        def share(x: np.ndarray) -> np.ndarray:
+            out = x / total * first if total > 0 else np.zeros_like(x)
+            return np.maximum(1, np.rint(out)).astype(np.int64)
+
+        if lines is None or not len(line_length):
+            return cls(motion, share(length))
+        return cls(motion, share(length), lines, share(line_length))
 
     def round(self, r: int) -> np.ndarray:
         """The configurations (k, n) of round r inside the joint limits [rad]."""
         sm, per = self.motion, self.counts * 2**r
         a, b = sm.intervals[:, 0], sm.intervals[:, 1]
-        cell = np.repeat(np.arange(len(per)), per)
-        j = np.arange(int(per.sum())) - np.repeat(np.cumsum(per) - per, per)
-        t = a[cell] + (b[cell] - a[cell]) * (j + 0.5) / per[cell]
+        cell, u = _cells(per)
+        t = a[cell] + (b[cell] - a[cell]) * u
         q = sm.sample(t, within_limits=True)[np.arange(len(t)), sm.interval_branch[cell]]
+        if self.lines is not None and self.line_counts is not None:
+            piece, u = _cells(self.line_counts * 2**r)
+            extra = self.lines.at(piece, u)
+            # (a continuum meets its branch at one point: a branch sample there once)
+            same = (np.abs(extra[:, None] - q[None]).max(-1) <= 1e-12).any(-1)
+            q = np.vstack([q, extra[~same]])
         q = q[np.isfinite(q).all(axis=1)]
         return np.ascontiguousarray(np.clip(q, sm.limits[:, 0], sm.limits[:, 1]))
+
+
+def _cells(per: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(segment, fraction) of the centres of ``per[i]`` equal cells of each segment i."""
+    seg = np.repeat(np.arange(len(per)), per)
+    j = np.arange(int(per.sum())) - np.repeat(np.cumsum(per) - per, per)
+    return seg, (j + 0.5) / per[seg]
 
 
 @dataclass(frozen=True, eq=False)
@@ -171,7 +206,10 @@ def _manifold_goals(robot: Robot, T: np.ndarray) -> Goals | None:
     closed form (``auto_parameter``), a robot on a linear track (the robot's own six
     joints at each track value, ~25 ms a pose on a UR5 on a rail) and a general 7R
     arm (the general held-joint 6R solver continued, ~10-30 ms a pose); an arm whose
-    held chain only the numeric solver samples keeps ``robot.ik``'s solutions.
+    held chain only the numeric solver samples keeps ``robot.ik``'s solutions. The
+    samples cover the in-limit intervals and the aligned continua
+    (:class:`ManifoldGoals`); a pose inside the limits only at one point of a
+    continuum has that configuration (``best("margin")``).
     """
     from robokin.kinematics.ik.self_motion import exact_parameter
 
@@ -182,12 +220,12 @@ def _manifold_goals(robot: Robot, T: np.ndarray) -> Goals | None:
     sm = robot.self_motion(T)
     if not sm.reachable:
         return None  # robot.ik says why (or finds what the manifold missed)
-    if not len(sm.intervals):  # inside the limits only on an aligned continuum
+    sampler = ManifoldGoals.of(sm)
+    q = sampler.round(0)
+    if not len(q):  # inside the limits only at a point of an aligned continuum
         best = sm.best("margin")
         assert best is not None  # (reachable: continua_best found one)
         return Goals("pose", best.q[None], np.arange(1), T)
-    sampler = ManifoldGoals.of(sm)
-    q = sampler.round(0)
     return Goals("pose", q, np.arange(len(q)), T, "", sampler, 1)
 
 

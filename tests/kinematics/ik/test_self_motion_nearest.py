@@ -331,7 +331,8 @@ def test_a_pose_inside_the_limits_only_on_a_continuum_is_reachable():
     continuum through q0: ``reachable`` is True (it was False, while ``best`` and
     ``nearest`` now find the continuum), ``best`` and ``nearest`` return in-limit
     configurations of the pose (``nearest(q0)``: q0), and a planning goal at the pose
-    is that configuration."""
+    samples that continuum (session 24; before, one configuration): every goal reaches
+    the pose inside the limits with q2 = 0 and q1 + q3 = 0.7, spread over q1's range."""
     from robokin.planning.goals import goal_configurations
 
     q0 = np.array([0.4, 0.0, 0.3, -1.2, 0.5, 0.8, 0.2])
@@ -342,8 +343,13 @@ def test_a_pose_inside_the_limits_only_on_a_continuum_is_reachable():
     _checked(arm, T, q0, sm.best("margin"))
     assert _checked(arm, T, q0, sm.nearest(q0)) <= 1e-9
     goals = goal_configurations(arm, T)
-    assert goals.q.shape == (1, 7)
-    _checked(arm, T, q0, goals.q[0])
+    assert goals.q.shape[0] >= 4 and goals.manifold is not None
+    for q in goals.q:
+        _checked(arm, T, q0, q)
+    assert np.abs(goals.q[:, 1]).max() <= 1e-12
+    np.testing.assert_allclose(goals.q[:, 0] + goals.q[:, 2], 0.7, atol=1e-12)
+    assert goals.q[:, 0].max() - goals.q[:, 0].min() >= 0.08  # (cell centres of 0.1)
+    assert len(np.unique(goals.q.round(12), axis=0)) == len(goals.q)
 
 
 def test_next_to_a_stretched_elbow_the_nearest_is_found_on_the_intervals():

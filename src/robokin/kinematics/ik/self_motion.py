@@ -49,7 +49,7 @@ from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.fixed import Dispatch, held_complete
 from robokin.kinematics.ik.self_motion_base import _Family, seven_joint_serial
-from robokin.kinematics.ik.self_motion_continua import continua_best
+from robokin.kinematics.ik.self_motion_continua import Continua, continua, continua_best
 from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
 from robokin.kinematics.ik.self_motion_families import (
     HeldKernel,
@@ -376,6 +376,19 @@ class SelfMotion:
         gap = _distance(self.sample(np.array([t]))[0], q, wrapped)
         branch = int(np.argmin(np.where(np.isfinite(gap), gap, np.inf)))
         return ManifoldPoint(q, t, branch, score)
+
+    def continua(self) -> Continua | None:
+        """The pose's aligned continua inside the limits (configurations off the branches).
+
+        Where joint j at a value v puts two axes on one line (the Panda's q2 = 0, the
+        iiwa's q2, q4 or q6 = 0), a pair of joints turns against each other at one
+        parameter value (``self_motion_continua.continua``: each an in-limit stretch
+        of that turn from a row solved with j held at v). None where this manifold was
+        made without the dispatcher that solves such rows.
+        """
+        if self._dispatch is None:
+            return None
+        return continua(self._family.robot, self.T, self.limits, self._dispatch)
 
     def _aligned_rows(self) -> np.ndarray:
         """The branches' rows (k, n) at their aligned-axes points, in or out of the limits.

@@ -16,6 +16,7 @@ q6 = 0: axes 1, 3, 5 and 7): every two of its joints then turn against each othe
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -24,8 +25,8 @@ from robokin.kinematics.ik.fixed import Dispatch
 from robokin.kinematics.ik.self_motion_intervals import _within
 from robokin.spatial import wrap_angle as _wrap
 
-__all__ = ["EXACT", "LINE_PAIRS", "continua_best", "held_rows", "line_moves", "onto",
-           "pair_step", "pair_steps"]
+__all__ = ["EXACT", "LINE_PAIRS", "Continua", "continua", "continua_best", "held_rows",
+           "line_moves", "onto", "pair_step", "pair_steps"]
 
 #: An aligned point's row is on its pair's continuum when its joint is this close to
 #: the aligned value [rad] (the kernels' aligned rows: within 1.4e-8, session 23).
@@ -255,12 +256,13 @@ def continua_best(robot: Arm, T: np.ndarray, limits: np.ndarray,
     return q0, float(score(q0[None])[0])
 
 
-def _line_best(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np.ndarray,
-               score: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, float]:
-    """The row q moved along one move (q_a + s, q_b - sign s) to its best sampled score.
+def _stretches(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The in-limit stretches of s of the move q_a + s, q_b - sign s of row q (n,).
 
-    Every in-limit stretch of s (the pair's 2 pi turns) sampled at ``_SAMPLES`` values in
-    one batch, then ``_ZOOMS`` rounds of 9 values around the best.
+    Each pair of 2 pi turns of the two joints (ra = q_a + 2 pi i, rb = q_b + 2 pi k,
+    i, k in -1..1) whose ranges of s keeping both inside their limits overlap:
+    ``(s_lo, s_hi, ra, rb)``, (p,) each [rad].
     """
     ra = q[a] + _TURNS[:, None]  # (3, 1)
     rb = q[b] + _TURNS[None, :]  # (1, 3)
@@ -269,12 +271,97 @@ def _line_best(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: n
     s_hi = np.minimum(hi[a] - ra, np.maximum(ea, eb)).ravel()
     ra, rb = np.broadcast_to(ra, (3, 3)).ravel(), np.broadcast_to(rb, (3, 3)).ravel()
     keep = s_lo <= s_hi
+    return s_lo[keep], s_hi[keep], ra[keep], rb[keep]
+
+
+@dataclass(frozen=True)
+class Continua:
+    """The aligned continua of one pose as straight pieces in joint space.
+
+    Piece i is the row ``base[i]`` with joints ``a[i]`` and ``b[i]`` moved,
+    q_a = base_a + s and q_b = base_b - sign s, for s in [``s_lo[i]``, ``s_hi[i]``]:
+    every point solves the pose (to the held row's 4e-13) inside every limit.
+
+    Attributes:
+        base: (p, n) rows [rad, m]; a, b: (p,) the moved joints; sign: (p,);
+        s_lo, s_hi: (p,) the stretch [rad].
+    """
+
+    base: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    sign: np.ndarray
+    s_lo: np.ndarray
+    s_hi: np.ndarray
+
+    def at(self, piece: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Rows (m, n) of pieces ``piece`` (m,) at fractions ``u`` (m,) of their stretch."""
+        s = self.s_lo[piece] + (self.s_hi[piece] - self.s_lo[piece]) * u
+        out = self.base[piece].copy()
+        r = np.arange(len(piece))
+        out[r, self.a[piece]] += s
+        out[r, self.b[piece]] -= self.sign[piece] * s
+        return out
+
+
+def continua(robot: Arm, T: np.ndarray, limits: np.ndarray, dispatch: Dispatch) -> Continua:
+    """Every aligned continuum of pose T (4, 4) inside the limits, as :class:`Continua`.
+
+    For each line-sharing pair (:data:`LINE_PAIRS`) the pose is solved with its joint
+    held at its value (:func:`held_rows`); from each row inside the limits but for the
+    joints its lines move, each move of its lines (:func:`line_moves`) over each of its
+    in-limit stretches of s (:func:`_stretches`; on a line of three or more joints, a
+    2- or 3-dimensional set, each pair's move from the held row). Pieces shorter than
+    1e-9 rad are left out (a point: the branches hold it), and a piece the held rows of
+    several families or two turns of the pair give once (the same joints and ends, to
+    1e-9).
+    """
+    pairs = robot.derived(LINE_PAIRS)
+    lo, hi = limits[:, 0], limits[:, 1]
+    pieces: list[tuple[np.ndarray, int, int, float, float, float]] = []
+    seen: set[tuple[object, ...]] = set()
+    for j, v, *_ in pairs:
+        rows, valid = held_rows(robot, T[None], j, v, np.zeros((1, robot.n)), dispatch)
+        for r in rows[0][valid[0]]:
+            on = [p for p in pairs if abs(float(_wrap(r[p[0]] - p[1]))) <= _ON_ALIGNED]
+            moves = line_moves(on)
+            free = np.zeros(len(r), dtype=bool)
+            free[[x for a, b, _ in moves for x in (a, b)]] = True
+            if not np.all(free | ((r >= lo - 1e-12) & (r <= hi + 1e-12))):
+                continue
+            for a, b, sign in moves:
+                s_lo, s_hi, ra, rb = _stretches(r, a, b, sign, lo, hi)
+                for x, y, qa, qb in zip(s_lo, s_hi, ra, rb, strict=True):
+                    rest = np.delete(r, [a, b])
+                    key = (a, b, *np.round(rest, 9), round(float(qa + x), 9),
+                           round(float(qa + y), 9), round(float(qb - sign * x), 9))
+                    if y - x > 1e-9 and key not in seen:
+                        seen.add(key)
+                        base = r.copy()
+                        base[a], base[b] = qa, qb
+                        pieces.append((base, a, b, sign, float(x), float(y)))
+    n = robot.n
+    if not pieces:
+        return Continua(np.zeros((0, n)), *(np.zeros(0, dtype=np.int64),) * 2,
+                        *(np.zeros(0),) * 3)
+    base, a, b, sign, s_lo, s_hi = zip(*pieces, strict=True)
+    return Continua(np.array(base), np.array(a), np.array(b), np.array(sign),
+                    np.array(s_lo), np.array(s_hi))
+
+
+def _line_best(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np.ndarray,
+               score: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, float]:
+    """The row q moved along one move (q_a + s, q_b - sign s) to its best sampled score.
+
+    Every in-limit stretch of s (the pair's 2 pi turns) sampled at ``_SAMPLES`` values in
+    one batch, then ``_ZOOMS`` rounds of 9 values around the best.
+    """
+    s_lo, s_hi, ra, rb = _stretches(q, a, b, sign, lo, hi)
     # (q itself counts only inside its limits: a row's moved joints may start outside)
     inside = bool(np.all((q >= lo) & (q <= hi)))
     best_q, best_s = q, float(score(q[None])[0]) if inside else -np.inf
-    if not keep.any():
+    if not len(s_lo):
         return best_q, best_s
-    s_lo, s_hi, ra, rb = s_lo[keep], s_hi[keep], ra[keep], rb[keep]
     s = s_lo[:, None] + (s_hi - s_lo)[:, None] * np.linspace(0.0, 1.0, _SAMPLES)
     for _ in range(_ZOOMS + 1):
         rows = np.repeat(q[None], s.size, axis=0)
