@@ -15,7 +15,7 @@ q6 = 0: axes 1, 3, 5 and 7): every two of its joints then turn against each othe
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -204,6 +204,28 @@ _SAMPLES = 33
 _ZOOMS = 6
 
 
+def _line_rows(robot: Arm, T: np.ndarray, limits: np.ndarray, dispatch: Dispatch
+               ) -> Iterator[tuple[np.ndarray, list[tuple[int, int, float]], np.ndarray]]:
+    """The rows of pose T (4, 4) on aligned continua: ``(row (n,), moves, free (n,))``.
+
+    For each line-sharing pair (:data:`LINE_PAIRS`) the pose solved with its joint held
+    at its value (:func:`held_rows`); each row with the moves of the lines it is on
+    (within ``_ON_ALIGNED``: :func:`line_moves`) and the joints they move (``free``),
+    where it is inside every limit but those joints'.
+    """
+    pairs = robot.derived(LINE_PAIRS)
+    lo, hi = limits[:, 0], limits[:, 1]
+    for j, v, *_ in pairs:
+        rows, valid = held_rows(robot, T[None], j, v, np.zeros((1, robot.n)), dispatch)
+        for r in rows[0][valid[0]]:
+            on = [p for p in pairs if abs(float(_wrap(r[p[0]] - p[1]))) <= _ON_ALIGNED]
+            moves = line_moves(on)
+            free = np.zeros(len(r), dtype=bool)
+            free[[x for a, b, _ in moves for x in (a, b)]] = True
+            if np.all(free | ((r >= lo - 1e-12) & (r <= hi + 1e-12))):
+                yield r, moves, free
+
+
 def continua_best(robot: Arm, T: np.ndarray, limits: np.ndarray,
                   score: Callable[[np.ndarray], np.ndarray], best: float,
                   dispatch: Dispatch) -> tuple[np.ndarray, float] | None:
@@ -229,24 +251,15 @@ def continua_best(robot: Arm, T: np.ndarray, limits: np.ndarray,
     Returns:
         ``(q (n,), score)``, or None.
     """
-    pairs = robot.derived(LINE_PAIRS)
     lo, hi = limits[:, 0], limits[:, 1]
     found: tuple[np.ndarray, float] | None = None
-    for j, v, *_ in pairs:
-        rows, valid = held_rows(robot, T[None], j, v, np.zeros((1, robot.n)), dispatch)
-        for r in rows[0][valid[0]]:
-            on = [p for p in pairs if abs(float(_wrap(r[p[0]] - p[1]))) <= _ON_ALIGNED]
-            moves = line_moves(on)
-            free = np.zeros(len(r), dtype=bool)
-            free[[x for a, b, _ in moves for x in (a, b)]] = True
-            if not np.all(free | ((r >= lo - 1e-12) & (r <= hi + 1e-12))):
-                continue
-            q, val = r, -np.inf
-            for _ in range(2 if len(free.nonzero()[0]) < 2 * len(moves) else 1):
-                for a, b, sign in moves:
-                    q, val = _line_best(q, a, b, sign, lo, hi, score)
-            if val > (best if found is None else found[1]):
-                found = (q, val)
+    for r, moves, free in _line_rows(robot, T, limits, dispatch):
+        q, val = r, -np.inf
+        for _ in range(2 if len(free.nonzero()[0]) < 2 * len(moves) else 1):
+            for a, b, sign in moves:
+                q, val = _line_best(q, a, b, sign, lo, hi, score)
+        if val > (best if found is None else found[1]):
+            found = (q, val)
     if found is None:
         return None
     q, err = onto(robot, found[0][None], T[None])
@@ -297,7 +310,7 @@ class Continua:
     def at(self, piece: np.ndarray, u: np.ndarray) -> np.ndarray:
         """Rows (m, n) of pieces ``piece`` (m,) at fractions ``u`` (m,) of their stretch."""
         s = self.s_lo[piece] + (self.s_hi[piece] - self.s_lo[piece]) * u
-        out = self.base[piece].copy()
+        out: np.ndarray = self.base[piece].copy()
         r = np.arange(len(piece))
         out[r, self.a[piece]] += s
         out[r, self.b[piece]] -= self.sign[piece] * s
@@ -316,30 +329,21 @@ def continua(robot: Arm, T: np.ndarray, limits: np.ndarray, dispatch: Dispatch) 
     several families or two turns of the pair give once (the same joints and ends, to
     1e-9).
     """
-    pairs = robot.derived(LINE_PAIRS)
     lo, hi = limits[:, 0], limits[:, 1]
     pieces: list[tuple[np.ndarray, int, int, float, float, float]] = []
     seen: set[tuple[object, ...]] = set()
-    for j, v, *_ in pairs:
-        rows, valid = held_rows(robot, T[None], j, v, np.zeros((1, robot.n)), dispatch)
-        for r in rows[0][valid[0]]:
-            on = [p for p in pairs if abs(float(_wrap(r[p[0]] - p[1]))) <= _ON_ALIGNED]
-            moves = line_moves(on)
-            free = np.zeros(len(r), dtype=bool)
-            free[[x for a, b, _ in moves for x in (a, b)]] = True
-            if not np.all(free | ((r >= lo - 1e-12) & (r <= hi + 1e-12))):
-                continue
-            for a, b, sign in moves:
-                s_lo, s_hi, ra, rb = _stretches(r, a, b, sign, lo, hi)
-                for x, y, qa, qb in zip(s_lo, s_hi, ra, rb, strict=True):
-                    rest = np.delete(r, [a, b])
-                    key = (a, b, *np.round(rest, 9), round(float(qa + x), 9),
-                           round(float(qa + y), 9), round(float(qb - sign * x), 9))
-                    if y - x > 1e-9 and key not in seen:
-                        seen.add(key)
-                        base = r.copy()
-                        base[a], base[b] = qa, qb
-                        pieces.append((base, a, b, sign, float(x), float(y)))
+    for r, moves, _ in _line_rows(robot, T, limits, dispatch):
+        for a, b, sign in moves:
+            s_lo, s_hi, ra, rb = _stretches(r, a, b, sign, lo, hi)
+            for x, y, qa, qb in zip(s_lo, s_hi, ra, rb, strict=True):
+                rest = np.delete(r, [a, b])
+                key = (a, b, *np.round(rest, 9), round(float(qa + x), 9),
+                       round(float(qa + y), 9), round(float(qb - sign * x), 9))
+                if y - x > 1e-9 and key not in seen:
+                    seen.add(key)
+                    base = r.copy()
+                    base[a], base[b] = qa, qb
+                    pieces.append((base, a, b, sign, float(x), float(y)))
     n = robot.n
     if not pieces:
         return Continua(np.zeros((0, n)), *(np.zeros(0, dtype=np.int64),) * 2,
