@@ -306,7 +306,7 @@ def _nearest(sm: SelfMotion, q_near: np.ndarray) -> ManifoldPoint | None:
 def _empty_reason(sm: SelfMotion) -> str:
     """Why no interval: the pose out of reach (no branch anywhere) or the limits."""
     t = np.linspace(float(sm.domain[0]), float(sm.domain[1]), 361)
-    if not np.isfinite(sm.sample(t)).all(-1).any() and not sm.crossings:
+    if not np.isfinite(sm.sample(t)).all(-1).any() and not sm.crossings and not sm.singular:
         return "the pose is out of reach: no branch of the self-motion exists"
     return "no part of the self-motion is inside the joint limits"
 
@@ -329,7 +329,8 @@ def _intervals_table(r: Robot, sm: SelfMotion, u: _Units,
         f"{sm.parameter} ranges over [{lo:.6g}, {hi:.6g}] {unit}"
         + (" (periodic: an interval through +-pi is one, its end past it)"
            if sm.periodic else "")
-        + f"; {len(sm.crossings)} limit crossing(s), {folds} branch end(s), "
+        + f"; {len(sm.crossings)} limit crossing(s) (the other joints inside), "
+        f"{folds} branch end(s), "
         f"{len(sm.singular) - folds} aligned-axes point(s) (--points lists them)")
     if not len(sm.intervals) and top is not None:
         table.notes.append(
