@@ -106,8 +106,11 @@ class ManifoldGoals:
         if self.lines is not None and self.line_counts is not None:
             piece, u = _cells(self.line_counts * 2**r)
             extra = self.lines.at(piece, u)
-            # (a continuum meets its branch at one point: a branch sample there once)
-            same = (np.abs(extra[:, None] - q[None]).max(-1) <= 1e-12).any(-1)
+            # (a continuum meets its branch at one point: a branch sample there once;
+            # rows compared at 1e-10, by hash: a late round has thousands of each)
+            known = {row.tobytes() for row in np.round(q, 10) + 0.0}
+            same = np.array([row.tobytes() in known for row in np.round(extra, 10) + 0.0],
+                            dtype=bool)
             q = np.vstack([q, extra[~same]])
         q = q[np.isfinite(q).all(axis=1)]
         return np.ascontiguousarray(np.clip(q, sm.limits[:, 0], sm.limits[:, 1]))
