@@ -126,6 +126,12 @@ def test_an_aligned_pose_samples_its_continua_too():
                                atol=1e-12)
     assert np.all(g2.q >= robot.limits[:, 0]) and np.all(g2.q <= robot.limits[:, 1])
     assert len(np.unique(np.round(g2.q, 12), axis=0)) == len(g2.q)
+    while g2.can_grow:  # to the last round: thousands of samples, still none repeated
+        g2, _ = g2.grown()
+    assert len(g2.q) > 100 * first
+    assert len(np.unique(np.round(g2.q, 12), axis=0)) == len(g2.q)
+    np.testing.assert_allclose(robot.fk(g2.q), np.broadcast_to(T, (len(g2.q), 4, 4)),
+                               atol=1e-12)
 
 
 def test_a_pose_written_to_twelve_digits_keeps_its_self_motion():
