@@ -317,3 +317,32 @@ def test_a_pose_inside_the_limits_only_on_a_continuum_exits_0_with_its_configura
     loaded = robokin.load(str(path))
     np.testing.assert_allclose(loaded.fk(best), _pose_of(pose), atol=1e-12)
     assert loaded.within_limits(best)
+
+
+def test_an_aligned_pose_lists_its_continua(capsys):
+    """Oracle: forward kinematics. The Panda's home configuration (q2 = 0: axes 1 and 3
+    on one line) reaches its pose along a continuum of (q1 + s, q3 - s): the JSON lists
+    its in-limit ends (session 24), each reaching the pose (1e-9, the printed pose's
+    digits) inside the limits with q2 = 0 and q1 + q3 = 0, q1 at a limit at one end; the
+    text says how many pieces there are and which joints turn."""
+    panda = robokin.load("panda")
+    q0 = np.array([0.0, 0.0, 0.0, -np.pi / 2, 0.0, np.pi / 2, np.pi / 4])
+    pose = _pose_args(panda, q0)
+    code, out, err = run(capsys, "self-motion", "panda", *pose, "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert len(doc["continua"]) >= 1
+    T = _pose_of(pose)
+    lo, hi = panda.limits[:, 0], panda.limits[:, 1]
+    for piece in doc["continua"]:
+        assert piece["joints"] == ["joint1", "joint3"]
+        ends = np.array([piece["from"], piece["to"]])
+        np.testing.assert_allclose(panda.fk(ends), np.broadcast_to(T, (2, 4, 4)), atol=1e-9)
+        assert np.all(ends >= lo - 1e-12) and np.all(ends <= hi + 1e-12)
+        assert np.abs(ends[:, 1]).max() <= 1e-9
+        np.testing.assert_allclose(ends[:, 0] + ends[:, 2], 0.0, atol=1e-9)
+        assert np.isclose(np.abs(ends[:, 0]), hi[0], atol=1e-9).any()
+    code, out, err = run(capsys, "self-motion", "panda", *pose, "--format", "text")
+    assert code == 0, err
+    assert f"{len(doc['continua'])} aligned continuum piece(s) inside the limits" in out
+    assert "joint1 / joint3" in out

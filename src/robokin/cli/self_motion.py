@@ -261,6 +261,7 @@ def self_motion(
     animated = None
     if page is not None and shown is not None:
         animated = _animate(r, sm, page, shown, u)
+    lines = sm.continua()
     if fmt == "json":
         print(json_text({
             "robot": r.name, "parameter": sm.parameter, "unit": u.t_unit,
@@ -273,6 +274,11 @@ def self_motion(
                           for c in sm.crossings],
             "singular": [{"t": s.t * u.t, "branch": s.branch, "kind": s.kind}
                          for s in sm.singular],
+            "continua": [] if lines is None else [
+                {"joints": [r.joint_names[int(a)], r.joint_names[int(b)]],
+                 "from": (lines.at(np.array([i]), np.zeros(1))[0] * u.q).tolist(),
+                 "to": (lines.at(np.array([i]), np.ones(1))[0] * u.q).tolist()}
+                for i, (a, b) in enumerate(zip(lines.a, lines.b, strict=True))],
             "best": None if top is None else {
                 **_point_json(top, u), "criterion": best,
                 "score": top.score * (u.dist if best == "margin" else 1.0)},
@@ -284,6 +290,14 @@ def self_motion(
         }))
     else:
         tables = [_intervals_table(r, sm, u, top)]
+        if lines is not None and len(lines.base):
+            tables[0].notes.append(
+                f"{len(lines.base)} aligned continuum piece(s) inside the limits: "
+                "configurations off the branches, two joints on one axis turned against "
+                "each other (" + ", ".join(
+                    f"{r.joint_names[int(a)]} / {r.joint_names[int(b)]}"
+                    for a, b in zip(lines.a, lines.b, strict=True)) + "; --format json "
+                "lists their ends)")
         if top is not None or close is not None:
             tables.append(_configurations_table(top, close, best, u))
         if points:
