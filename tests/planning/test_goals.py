@@ -226,3 +226,18 @@ def test_an_arm_whose_held_chain_is_sampled_keeps_the_ik_solutions():
     assert g.kind == "pose" and g.manifold is None and len(g.q) >= 1
     np.testing.assert_allclose(robot.fk(g.q), np.broadcast_to(T, (len(g.q), 4, 4)),
                                atol=1e-9)
+
+
+@pytest.mark.parametrize("piece,u,field", [
+    (np.array([5]), np.array([0.5]), "piece"),     # no such piece
+    (np.array([0.5]), np.array([0.5]), "piece"),   # not an index
+    (np.array([0]), np.array([1.5]), "u"),         # past the stretch
+    (np.array([0, 0]), np.array([0.5]), "u"),      # one fraction for two pieces
+])
+def test_a_continuum_piece_asked_for_wrongly_is_named(piece, u, field):
+    robot = robokin.load("panda")
+    q0 = np.array([0.0, 0.0, 0.0, -np.pi / 2, 0.0, np.pi / 2, np.pi / 4])
+    lines = robot.self_motion(robot.fk(q0)).continua()
+    assert lines is not None and len(lines.base) == 1
+    with pytest.raises(InputError, match=field):
+        lines.at(piece, u)

@@ -50,6 +50,7 @@ from robokin.exceptions import InputError
 
 if TYPE_CHECKING:
     from robokin.kinematics.ik.self_motion import ManifoldPoint, SelfMotion
+    from robokin.kinematics.ik.self_motion_continua import Continua
     from robokin.robot import Robot
 
 __all__ = ["commands", "interval_motion", "self_motion"]
@@ -276,9 +277,9 @@ def self_motion(
                          for s in sm.singular],
             "continua": [] if lines is None else [
                 {"joints": [r.joint_names[int(a)], r.joint_names[int(b)]],
-                 "from": (lines.at(np.array([i]), np.zeros(1))[0] * u.q).tolist(),
-                 "to": (lines.at(np.array([i]), np.ones(1))[0] * u.q).tolist()}
-                for i, (a, b) in enumerate(zip(lines.a, lines.b, strict=True))],
+                 "from": (q0 * u.q).tolist(), "to": (q1 * u.q).tolist()}
+                for a, b, q0, q1 in zip(lines.a, lines.b, *_piece_ends(lines),
+                                        strict=True)],
             "best": None if top is None else {
                 **_point_json(top, u), "criterion": best,
                 "score": top.score * (u.dist if best == "margin" else 1.0)},
@@ -308,6 +309,12 @@ def self_motion(
                 say(f"wrote {written}", fmt)
     if not sm.reachable:
         raise DomainFailure(_empty_reason(sm))
+
+
+def _piece_ends(lines: Continua) -> tuple[np.ndarray, np.ndarray]:
+    """Each continuum piece's configurations at the two ends of its stretch, (p, n) each."""
+    every = np.arange(len(lines.base))
+    return (lines.at(every, np.zeros(len(every))), lines.at(every, np.ones(len(every))))
 
 
 def _nearest(sm: SelfMotion, q_near: np.ndarray) -> ManifoldPoint | None:

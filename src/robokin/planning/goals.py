@@ -107,13 +107,17 @@ class ManifoldGoals:
             piece, u = _cells(self.line_counts * 2**r)
             extra = self.lines.at(piece, u)
             # (a continuum meets its branch at one point: a branch sample there once;
-            # rows compared at 1e-10, by hash: a late round has thousands of each)
-            known = {row.tobytes() for row in np.round(q, 10) + 0.0}
-            same = np.array([row.tobytes() in known for row in np.round(extra, 10) + 0.0],
-                            dtype=bool)
+            # rows compared at 1e-10 as whole records: a late round has thousands)
+            same = np.isin(_as_records(extra), _as_records(q))
             q = np.vstack([q, extra[~same]])
         q = q[np.isfinite(q).all(axis=1)]
         return np.ascontiguousarray(np.clip(q, sm.limits[:, 0], sm.limits[:, 1]))
+
+
+def _as_records(q: np.ndarray) -> np.ndarray:
+    """Rows (k, n) rounded to 1e-10 (-0 as 0) as (k,) opaque records, to compare whole rows."""
+    r = np.ascontiguousarray(np.round(q, 10) + 0.0)
+    return r.view(np.dtype((np.void, r.dtype.itemsize * r.shape[1]))).ravel()
 
 
 def _cells(per: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -1121,12 +1121,25 @@ static double hm_dtds(const HmCtx *c, double t)
     return isnan(c->sq_te) ? 1.0 : 2.0 * fabs(hm_sigma(c, t));
 }
 
+/* The cubic Hermite model of f on a cell (values f0, f1 at its ends, slopes d0, d1 per
+ * unit of the cell): f(s) = f0 + d0 s + A s^2 + B s^3 (s in [0, 1]); its values lie
+ * within the range of f0, f1 +- HM_H4_27 (|d0| + |d1|) (the basis: h00 + h01 = 1,
+ * |h10|, |h11| <= 4/27). */
+#define HM_H4_27 0.1482
+static inline void hm_hermite_ab(double f0, double f1, double d0, double d1, double *A,
+                                 double *B)
+{
+    *A = 3.0 * (f1 - f0) - 2.0 * d0 - d1;
+    *B = 2.0 * (f0 - f1) + d0 + d1;
+}
+
 /* The root in (0, 1) of the cubic Hermite model of f on a cell (values f0, f1 of
  * opposite signs, slopes d0, d1 per unit of the cell): safeguarded Newton on the
  * cubic from the secant's root (no rows). */
 static double hm_hermite_root(double f0, double f1, double d0, double d1)
 {
-    double A = 3.0 * (f1 - f0) - 2.0 * d0 - d1, B = 2.0 * (f0 - f1) + d0 + d1;
+    double A, B;
+    hm_hermite_ab(f0, f1, d0, d1, &A, &B);
     double lo = 0.0, hi = 1.0, s = f0 / (f0 - f1);
     for (int it = 0; it < 12; it++) {
         double v = f0 + s * (d0 + s * (A + s * B)), dv = d0 + s * (2.0 * A + 3.0 * s * B);
@@ -1432,7 +1445,8 @@ static void hm_extremum(HmCtx *c, int b, int j, double a, double da, double e, d
 static int hm_hermite_dips(double f0, double f1, double d0, double d1)
 {
     /* f(s) = f0 + d0 s + a s^2 + b s^3 */
-    double a = 3.0 * (f1 - f0) - 2.0 * d0 - d1, b = 2.0 * (f0 - f1) + d0 + d1;
+    double a, b;
+    hm_hermite_ab(f0, f1, d0, d1, &a, &b);
     double A = 3.0 * b, B = 2.0 * a, C = d0, s[2];
     int ns = 0;
     if (fabs(A) < 1e-300) {
@@ -1464,7 +1478,8 @@ static int hm_hermite_dips(double f0, double f1, double d0, double d1)
  * value) or the chord's own motion (one crossing: a second extremum inside). */
 static int hm_coarse_unsure(double f0, double f1, double d0, double d1)
 {
-    double A = 3.0 * (f1 - f0) - 2.0 * d0 - d1, B = 2.0 * (f0 - f1) + d0 + d1;
+    double A, B;
+    hm_hermite_ab(f0, f1, d0, d1, &A, &B);
     double e = fabs(A) + fabs(B);
     if ((f0 < 0) != (f1 < 0))
         return e >= fabs(f1 - f0);
@@ -1535,9 +1550,10 @@ static int hm_needs_split(const HmCtx *c, int b, const HmRow *r0, const HmRow *r
              * `far` from the value; when that exceeds the tests' thresholds (with room for
              * their rounding) neither hm_hermite_dips nor hm_coarse_unsure can split */
             double a0 = fabs(f0), a1 = fabs(f1); /* (fmin's value: both finite) */
-            double far = (a1 < a0 ? a1 : a0) - 0.1482 * (fabs(d0) + fabs(d1)) -
+            double far = (a1 < a0 ? a1 : a0) - HM_H4_27 * (fabs(d0) + fabs(d1)) -
                          1e-13 * (fabs(f0) + fabs(f1) + fabs(d0) + fabs(d1));
-            double A = 3.0 * (f1 - f0) - 2.0 * d0 - d1, B = 2.0 * (f0 - f1) + d0 + d1;
+            double A, B;
+            hm_hermite_ab(f0, f1, d0, d1, &A, &B);
             if (far > 2.0 * HM_TOL && !(HM_UNSURE && coarse && !(far > fabs(A) + fabs(B))))
                 continue;
         }
@@ -1580,10 +1596,11 @@ static int hm_dead(const HmCtx *c, int b, const HmRow *r0, const HmRow *r1, cons
     for (int j = 0; j < c->n; j++) {
         double lo = c->P[PK_LO + j], hi = c->P[PK_HI + j], q0 = r0->q[b][j], f1 = dj[j];
         double d0 = r0->dq[b][j] * m0, d1 = r1->dq[b][j] * m1;
-        double A = 3.0 * f1 - 2.0 * d0 - d1, B = -2.0 * f1 + d0 + d1;
+        double A, B;
+        hm_hermite_ab(0.0, f1, d0, d1, &A, &B);
         double pad = fmax(2.0 * HM_TOL, fabs(A) + fabs(B)) + MANIFOLD_SLACK +
                      1e-13 * (fabs(q0) + fabs(f1) + fabs(d0) + fabs(d1));
-        double spread = 0.1482 * (fabs(d0) + fabs(d1)) + pad;
+        double spread = HM_H4_27 * (fabs(d0) + fabs(d1)) + pad;
         double a = q0 + fmin(0.0, f1) - spread, e = q0 + fmax(0.0, f1) + spread;
         if (!(e - a < 2.0 * M_PI - (hi - lo)))
             continue;

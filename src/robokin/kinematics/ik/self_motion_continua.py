@@ -19,7 +19,9 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
+from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, Derived
 from robokin.kinematics.ik.fixed import Dispatch
 from robokin.kinematics.ik.self_motion_intervals import _within
@@ -158,11 +160,7 @@ def pair_step(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np
     """
     if not len(q):
         return np.array(q, dtype=np.float64)
-    ra = q[:, a, None, None] + _TURNS[:, None]  # (m, 3, 1): the 2 pi turns, each its range
-    rb = q[:, b, None, None] + _TURNS[None, :]  # (m, 1, 3)
-    ea, eb = sign * (rb - hi[b]), sign * (rb - lo[b])
-    s_lo = np.maximum(lo[a] - ra, np.minimum(ea, eb))  # (m, 3, 3)
-    s_hi = np.minimum(hi[a] - ra, np.maximum(ea, eb))
+    ra, rb, s_lo, s_hi = _turned_ranges(q, a, b, sign, lo, hi)  # (m, 3, 1), (m, 1, 3)
     u = _wrap(q_near[:, a] - q[:, a])[:, None] + _TURNS  # (m, 3): s putting q_a at q_near's
     v = -sign * (_wrap(q_near[:, b] - q[:, b])[:, None] + _TURNS)
     vertex = 0.5 * (u[:, :, None] + v[:, None, :]).reshape(len(q), 1, 1, 9)
@@ -269,20 +267,33 @@ def continua_best(robot: Arm, T: np.ndarray, limits: np.ndarray,
     return q0, float(score(q0[None])[0])
 
 
+def _turned_ranges(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray,
+                   hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The ranges of s keeping the move q_a + s, q_b - sign s of rows q (m, n) inside.
+
+    Per pair of 2 pi turns of the two joints: ``ra = q_a + 2 pi i`` (m, 3, 1), ``rb =
+    q_b + 2 pi k`` (m, 1, 3) (i, k in -1..1) and the range [s_lo, s_hi] (m, 3, 3)
+    [rad] (empty where s_lo > s_hi).
+    """
+    ra = q[:, a, None, None] + _TURNS[:, None]
+    rb = q[:, b, None, None] + _TURNS[None, :]
+    ea, eb = sign * (rb - hi[b]), sign * (rb - lo[b])
+    s_lo = np.maximum(lo[a] - ra, np.minimum(ea, eb))
+    s_hi = np.minimum(hi[a] - ra, np.maximum(ea, eb))
+    return ra, rb, s_lo, s_hi
+
+
 def _stretches(q: np.ndarray, a: int, b: int, sign: float, lo: np.ndarray, hi: np.ndarray
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The in-limit stretches of s of the move q_a + s, q_b - sign s of row q (n,).
 
-    Each pair of 2 pi turns of the two joints (ra = q_a + 2 pi i, rb = q_b + 2 pi k,
-    i, k in -1..1) whose ranges of s keeping both inside their limits overlap:
-    ``(s_lo, s_hi, ra, rb)``, (p,) each [rad].
+    Each pair of 2 pi turns of the two joints whose ranges of s keeping both inside
+    their limits overlap (:func:`_turned_ranges`): ``(s_lo, s_hi, ra, rb)``, (p,) each
+    [rad].
     """
-    ra = q[a] + _TURNS[:, None]  # (3, 1)
-    rb = q[b] + _TURNS[None, :]  # (1, 3)
-    ea, eb = sign * (rb - hi[b]), sign * (rb - lo[b])
-    s_lo = np.maximum(lo[a] - ra, np.minimum(ea, eb)).ravel()  # (9,)
-    s_hi = np.minimum(hi[a] - ra, np.maximum(ea, eb)).ravel()
-    ra, rb = np.broadcast_to(ra, (3, 3)).ravel(), np.broadcast_to(rb, (3, 3)).ravel()
+    ra3, rb3, lo3, hi3 = _turned_ranges(q[None], a, b, sign, lo, hi)
+    s_lo, s_hi = lo3[0].ravel(), hi3[0].ravel()  # (9,)
+    ra, rb = np.broadcast_to(ra3[0], (3, 3)).ravel(), np.broadcast_to(rb3[0], (3, 3)).ravel()
     keep = s_lo <= s_hi
     return s_lo[keep], s_hi[keep], ra[keep], rb[keep]
 
@@ -307,14 +318,36 @@ class Continua:
     s_lo: np.ndarray
     s_hi: np.ndarray
 
-    def at(self, piece: np.ndarray, u: np.ndarray) -> np.ndarray:
-        """Rows (m, n) of pieces ``piece`` (m,) at fractions ``u`` (m,) of their stretch."""
+    def at(self, piece: npt.ArrayLike, u: npt.ArrayLike) -> np.ndarray:
+        """Rows (m, n) of pieces ``piece`` (m,) at fractions ``u`` (m,) of their stretch.
+
+        Raises:
+            InputError: ``piece`` not indices of pieces, ``u`` not finite numbers in
+                [0, 1] of the same length.
+        """
+        piece, u = _piece_args(piece, u, len(self.base))
         s = self.s_lo[piece] + (self.s_hi[piece] - self.s_lo[piece]) * u
         out: np.ndarray = self.base[piece].copy()
         r = np.arange(len(piece))
         out[r, self.a[piece]] += s
         out[r, self.b[piece]] -= self.sign[piece] * s
         return out
+
+
+def _piece_args(piece: npt.ArrayLike, u: npt.ArrayLike, n: int
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """``Continua.at``'s arguments checked: piece indices in [0, n), u in [0, 1]."""
+    p = np.asarray(piece)
+    if p.ndim != 1 or (p.size and not np.issubdtype(p.dtype, np.integer)):
+        raise InputError("piece", f"expected a 1-D array of piece indices, got {p!r:.60}")
+    if p.size and (p.min() < 0 or p.max() >= n):
+        raise InputError("piece", f"indices must be in [0, {n}) (the pieces), got "
+                                  f"{int(p.min())}..{int(p.max())}")
+    x = np.asarray(u, dtype=np.float64)
+    if x.shape != p.shape or not np.all((x >= 0.0) & (x <= 1.0)):
+        raise InputError("u", f"expected fractions in [0, 1], one per piece ({len(p)}), "
+                              f"got shape {x.shape}")
+    return p.astype(np.int64), x
 
 
 def continua(robot: Arm, T: np.ndarray, limits: np.ndarray, dispatch: Dispatch) -> Continua:
