@@ -9,12 +9,12 @@
   joint limits, with the whole-turn equivalents of joints whose range exceeds
   2 pi (a UR joint at +-360 deg reaches each angle twice); for a 7R arm, samples
   of the pose's whole self-motion manifold (``robot.self_motion(T)``: every branch,
-  every interval inside the joint limits, and the aligned continua, where two axes on
-  one line let a pair of joints turn against each other, e.g. the Panda's q2 = 0),
-  spread over the intervals and continua by their length, at least one each
-  (:class:`ManifoldGoals`). The planner asks for denser samples
+  every interval inside the joint limits), spread over the intervals by their length,
+  at least one each (:class:`ManifoldGoals`). The planner asks for denser samples
   (:meth:`Goals.grown`) while every goal so far is in collision or the search cannot
-  reach them.
+  reach them; from the second round on they include the aligned continua (where two
+  axes on one line let a pair of joints turn against each other, e.g. the Panda's
+  q2 = 0: configurations no branch sample holds).
 
 For a four-joint arm a (4, 4) array is ambiguous; it is read as a pose when it is
 a rigid transform (last row 0 0 0 1, orthonormal rotation), else as four
@@ -23,8 +23,8 @@ configurations.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -56,45 +56,43 @@ class ManifoldGoals:
     """The self-motion manifold of a 7R pose goal, sampled round by round.
 
     Round r places ``counts[i] * 2**r`` samples at the centres of equal cells of
-    in-limit interval i, and ``line_counts[i] * 2**r`` on the in-limit stretch of
-    aligned continuum i (:func:`~robokin.kinematics.ik.self_motion_continua.continua`:
-    the configurations off the branches), so no sample repeats an earlier round's (a
-    round's centres are the earlier rounds' cell boundaries) and every round is spread
-    over every branch, interval and continuum.
+    in-limit interval i, so no sample repeats an earlier round's (a round's centres
+    are the earlier rounds' cell boundaries) and every round is spread over every
+    branch and interval. The aligned continua inside the limits (:meth:`lines`:
+    configurations off the branches) join from round 1 on, ``line_counts[i] *
+    2**(r - 1)`` samples on continuum i, spread the same way (from round 0 where no
+    interval is inside the limits): the first round stays the branches' (0.5 ms a
+    pose goal), the continua come with the denser rounds the planner asks for when
+    every goal so far collides or cannot be reached.
 
     Attributes:
         motion: ``robot.self_motion(T)``.
         counts: (m,) first-round samples of each interval (>= 1).
-        lines: The pose's aligned continua inside the limits, or None.
-        line_counts: (p,) first-round samples of each continuum's stretch (>= 1).
+        first: About how many samples round 0 (or the continua's first round) has.
     """
 
     motion: SelfMotion
     counts: np.ndarray
-    lines: Continua | None = None
-    line_counts: np.ndarray | None = None
+    first: int = MANIFOLD_FIRST
+    _cache: dict[str, Any] = field(default_factory=dict, repr=False)
 
     @classmethod
     def of(cls, motion: SelfMotion, first: int = MANIFOLD_FIRST) -> ManifoldGoals:
-        """The sampler of ``motion`` with about ``first`` samples in round 0.
+        """The sampler of ``motion`` with about ``first`` samples in round 0."""
+        return cls(motion, _shares(np.diff(motion.intervals, axis=1)[:, 0], first), first)
 
-        Shared by length [rad] between the intervals (of t) and the continua (of
-        their pair's turn s); the continua where ``motion`` can solve the pose with a
-        joint held (it was made by :func:`~robokin.kinematics.ik.self_motion.
-        self_motion` with its dispatcher).
+    def lines(self) -> tuple[Continua | None, np.ndarray]:
+        """The continua inside the limits and their first-round samples (>= 1 each).
+
+        (``motion.continua()``, solved on first use and kept; None where the manifold
+        was made without the dispatcher.)
         """
-        lines = motion.continua()
-        length = np.diff(motion.intervals, axis=1)[:, 0]
-        line_length = np.zeros(0) if lines is None else lines.s_hi - lines.s_lo
-        total = float(length.sum() + line_length.sum())
-
-        def share(x: np.ndarray) -> np.ndarray:
-            out = x / total * first if total > 0 else np.zeros_like(x)
-            return np.maximum(1, np.rint(out)).astype(np.int64)
-
-        if lines is None or not len(line_length):
-            return cls(motion, share(length))
-        return cls(motion, share(length), lines, share(line_length))
+        if "lines" not in self._cache:
+            lines = self.motion.continua()
+            length = np.zeros(0) if lines is None else lines.s_hi - lines.s_lo
+            self._cache["lines"] = (lines, _shares(length, self.first))
+        out: tuple[Continua | None, np.ndarray] = self._cache["lines"]
+        return out
 
     def round(self, r: int) -> np.ndarray:
         """The configurations (k, n) of round r inside the joint limits [rad]."""
@@ -103,15 +101,25 @@ class ManifoldGoals:
         cell, u = _cells(per)
         t = a[cell] + (b[cell] - a[cell]) * u
         q = sm.sample(t, within_limits=True)[np.arange(len(t)), sm.interval_branch[cell]]
-        if self.lines is not None and self.line_counts is not None:
-            piece, u = _cells(self.line_counts * 2**r)
-            extra = self.lines.at(piece, u)
-            # (a continuum meets its branch at one point: a branch sample there once;
-            # rows compared at 1e-10 as whole records: a late round has thousands)
-            same = np.isin(_as_records(extra), _as_records(q))
-            q = np.vstack([q, extra[~same]])
+        start = 1 if len(sm.intervals) else 0
+        if r >= start:
+            lines, counts = self.lines()
+            if lines is not None and len(counts):
+                piece, u = _cells(counts * 2**(r - start))
+                extra = lines.at(piece, u)
+                # (a continuum meets its branch at one point: a branch sample there
+                # once; rows compared at 1e-10 as whole records: thousands late on)
+                same = np.isin(_as_records(extra), _as_records(q))
+                q = np.vstack([q, extra[~same]])
         q = q[np.isfinite(q).all(axis=1)]
         return np.ascontiguousarray(np.clip(q, sm.limits[:, 0], sm.limits[:, 1]))
+
+
+def _shares(length: np.ndarray, first: int) -> np.ndarray:
+    """About ``first`` samples spread over pieces by length, at least one each (int64)."""
+    total = float(length.sum())
+    share = length / total * first if total > 0 else np.zeros_like(length)
+    return np.maximum(1, np.rint(share)).astype(np.int64)
 
 
 def _as_records(q: np.ndarray) -> np.ndarray:
@@ -214,7 +222,7 @@ def _manifold_goals(robot: Robot, T: np.ndarray) -> Goals | None:
     joints at each track value, ~25 ms a pose on a UR5 on a rail) and a general 7R
     arm (the general held-joint 6R solver continued, ~10-30 ms a pose); an arm whose
     held chain only the numeric solver samples keeps ``robot.ik``'s solutions. The
-    samples cover the in-limit intervals and the aligned continua
+    samples cover the in-limit intervals, then the aligned continua too
     (:class:`ManifoldGoals`); a pose inside the limits only at one point of a
     continuum has that configuration (``best("margin")``).
     """

@@ -209,11 +209,14 @@ def _line_rows(robot: Arm, T: np.ndarray, limits: np.ndarray, dispatch: Dispatch
     For each line-sharing pair (:data:`LINE_PAIRS`) the pose solved with its joint held
     at its value (:func:`held_rows`); each row with the moves of the lines it is on
     (within ``_ON_ALIGNED``: :func:`line_moves`) and the joints they move (``free``),
-    where it is inside every limit but those joints'.
+    where it is inside every limit but those joints'. (A pair whose value is outside
+    its joint's limits, every turn of it, has none: not solved.)
     """
     pairs = robot.derived(LINE_PAIRS)
     lo, hi = limits[:, 0], limits[:, 1]
     for j, v, *_ in pairs:
+        if not np.any((v + _TURNS >= lo[j] - 1e-12) & (v + _TURNS <= hi[j] + 1e-12)):
+            continue
         rows, valid = held_rows(robot, T[None], j, v, np.zeros((1, robot.n)), dispatch)
         for r in rows[0][valid[0]]:
             on = [p for p in pairs if abs(float(_wrap(r[p[0]] - p[1]))) <= _ON_ALIGNED]
@@ -318,6 +321,12 @@ class Continua:
     s_lo: np.ndarray
     s_hi: np.ndarray
 
+    @classmethod
+    def empty(cls, n: int) -> Continua:
+        """No piece, for an arm of n joints."""
+        none = np.zeros(0, dtype=np.int64)
+        return cls(np.zeros((0, n)), none, none.copy(), np.zeros(0), np.zeros(0), np.zeros(0))
+
     def at(self, piece: npt.ArrayLike, u: npt.ArrayLike) -> np.ndarray:
         """Rows (m, n) of pieces ``piece`` (m,) at fractions ``u`` (m,) of their stretch.
 
@@ -377,10 +386,8 @@ def continua(robot: Arm, T: np.ndarray, limits: np.ndarray, dispatch: Dispatch) 
                     base = r.copy()
                     base[a], base[b] = qa, qb
                     pieces.append((base, a, b, sign, float(x), float(y)))
-    n = robot.n
     if not pieces:
-        return Continua(np.zeros((0, n)), *(np.zeros(0, dtype=np.int64),) * 2,
-                        *(np.zeros(0),) * 3)
+        return Continua.empty(robot.n)
     base, a, b, sign, s_lo, s_hi = zip(*pieces, strict=True)
     return Continua(np.array(base), np.array(a), np.array(b), np.array(sign),
                     np.array(s_lo), np.array(s_hi))
