@@ -49,7 +49,12 @@ from robokin.exceptions import InputError
 from robokin.kinematics.arm import Arm, ArmSource, arm_of
 from robokin.kinematics.ik.fixed import Dispatch, held_complete
 from robokin.kinematics.ik.self_motion_base import _Family, seven_joint_serial
-from robokin.kinematics.ik.self_motion_continua import Continua, continua, continua_best
+from robokin.kinematics.ik.self_motion_continua import (
+    EXACT,
+    Continua,
+    continua,
+    continua_best,
+)
 from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
 from robokin.kinematics.ik.self_motion_families import (
     HeldKernel,
@@ -63,6 +68,7 @@ from robokin.kinematics.ik.self_motion_families import (
     continued_parameter,
     one_per_point,
 )
+from robokin.kinematics.ik.self_motion_hair import HAIR, hair_bands
 from robokin.kinematics.ik.self_motion_intervals import (
     GRID,
     _aligned_values,
@@ -81,6 +87,7 @@ from robokin.kinematics.ik.self_motion_intervals import (
     _within,
 )
 from robokin.kinematics.ik.self_motion_nearest import (
+    _at_limits,
     _distance,
     interval_nearest,
     nearer_points,
@@ -272,16 +279,18 @@ class SelfMotion:
 
         An interval of a branch; where there is none, a point of an aligned continuum
         (``self_motion_continua``: q2 = 0, the pair turned against each other; the
-        pose solved with that joint held, ~0.1-0.3 ms), which ``best`` and
-        ``nearest`` also return.
+        pose solved with that joint held, ~0.1-0.3 ms), else a solution next to a
+        branch a hair outside a limit (``self_motion_hair``: a stretched elbow),
+        which ``best`` and ``nearest`` also return.
         """
         if len(self.intervals):
             return True
-        if self._dispatch is None:
-            return False
-        return continua_best(self._family.robot, self.T, self.limits,
-                             _criterion("margin", None, self.limits), -np.inf,
-                             self._dispatch) is not None
+        margin = _criterion("margin", None, self.limits)
+        if self._dispatch is not None and continua_best(
+                self._family.robot, self.T, self.limits, margin, -np.inf,
+                self._dispatch) is not None:
+            return True
+        return self._hair_best(margin) is not None
 
     def best(self, criterion: str | Callable[[np.ndarray], np.ndarray] = "margin", *,
              robot: ArmSource | None = None, samples: int = 64) -> ManifoldPoint | None:
@@ -299,17 +308,18 @@ class SelfMotion:
         (``self_motion_continua.continua_best``: where an
         axis pair lines up, q2 = 0, the pair turned against each other), whose points
         the branches' samples do not hold; one scoring higher is returned with its
-        parameter value and the branch whose row there is nearest.
+        parameter value and the branch whose row there is nearest. Where neither has
+        an in-limit point, the best solution next to a branch a hair outside a limit
+        (:meth:`_hair_best`).
         """
         score = _criterion(criterion, robot, self.limits)
         point = self._with_corners(self._maximise(score, samples), score)
-        if self._dispatch is None:
-            return point
-        found = continua_best(self._family.robot, self.T, self.limits, score,
-                              -np.inf if point is None else point.score, self._dispatch)
-        if found is None:
-            return point
-        return self._off_branches(found[0], found[1])
+        found = None if self._dispatch is None else continua_best(
+            self._family.robot, self.T, self.limits, score,
+            -np.inf if point is None else point.score, self._dispatch)
+        if found is not None:
+            return self._off_branches(found[0], found[1])
+        return point if point is not None else self._hair_best(score, samples)
 
     def nearest(self, q_near: npt.ArrayLike, *, samples: int = 64) -> ManifoldPoint | None:
         """The in-limit configuration nearest ``q_near`` (n,) (2 pi wrapped distance).
@@ -346,6 +356,8 @@ class SelfMotion:
             return out
 
         point = self._with_corners(point, closeness)
+        if point is None and not len(self.intervals):
+            point = self._hair_best(closeness, samples)
         if self._dispatch is None:
             return point
         q = np.full((1, len(qn)), np.nan) if point is None else point.q[None]
@@ -421,6 +433,33 @@ class SelfMotion:
             return point
         t, b, row = inside[k]
         return ManifoldPoint(row.copy(), float(t), int(b), float(s[k]))
+
+    def _hair_best(self, score: Callable[[np.ndarray], np.ndarray],
+                   samples: int = 64) -> ManifoldPoint | None:
+        """The best solution next to a branch a hair outside a limit, or None.
+
+        Where the manifold has no interval: the branches' stretches at most
+        :data:`~robokin.kinematics.ik.self_motion_hair.HAIR` outside the limits
+        (``hair_bands``), searched as intervals are (:func:`_maximise`, the limits
+        widened by ``HAIR``), the best row taken back inside the limits onto the pose
+        (``self_motion_nearest._at_limits``); None where it does not reach the pose
+        there within ``EXACT``. A stretched elbow's rows (q4 = 0 where the generating
+        configuration has 1e-9) leave a joint the self-motion does not move ~5e-10
+        past the limit it is at.
+        """
+        if len(self.intervals):
+            return None
+        bands, branch = hair_bands(self._rows, self.domain, self.limits)
+        if not len(bands):
+            return None
+        wide = self.limits + np.array([-HAIR, HAIR])
+        point = _maximise(self._family, wide, bands, branch, score, samples)
+        if point is None:
+            return None
+        q, err = _at_limits(self._family.robot, point.q, self.T, self.limits)
+        if not err <= EXACT:
+            return None
+        return ManifoldPoint(q, point.t, point.branch, float(score(q[None])[0]))
 
     def _maximise(self, score: Callable[[np.ndarray], np.ndarray],
                   samples: int) -> ManifoldPoint | None:

@@ -1,0 +1,70 @@
+"""Branches a hair outside a limit: the pose's in-limit solutions next to them.
+
+Where the elbow of a 7R arm is stretched (or folded) to within ~1e-8 rad, the pose
+fixes the elbow angle only to ~sqrt(eps): q4 = 1e-9 and q4 = 0 reach the same pose to
+1e-18 m, and the closed form, whose cosine of q4 rounds to 1, returns the exactly
+stretched branch. A joint the self-motion does not move there (the SRS arm's
+shoulder pitch, the direction of the stretched arm) then lies ~5e-10 rad away from
+the generating configuration's value: at a limit, every branch is outside it by
+that along its whole length, while the generating configuration, inside, reaches the
+pose to 1e-16 (session 25's fuzz: three SRS poses with q2 at its limit and
+q4 = +-1e-9, ``reachable`` False).
+
+:func:`hair_bands` finds the stretches of the branches at most :data:`HAIR` outside
+the limits (on a grid of :data:`SAMPLES` parameter values); ``SelfMotion`` searches
+them as it searches its intervals, with the limits widened by :data:`HAIR`, and
+takes the best row back inside the limits onto the pose
+(``self_motion_nearest._at_limits``: along the self-motion to the limit, else with
+the joints at their limits held and the others polished). Only where the
+manifold has no in-limit interval and no in-limit point of an aligned continuum:
+``reachable``, ``best``, ``nearest``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+__all__ = ["HAIR", "SAMPLES", "hair_bands"]
+
+#: [rad, m] A branch row at most this far outside its limits (its largest excess) may
+#: have in-limit solutions of the pose next to it: the stretched elbow's rounding
+#: reaches ~1e-8; farther rows are not repaired.
+HAIR = 1e-6
+#: Parameter values of the grid the bands are found on (the kernels' own grid).
+SAMPLES = 181
+
+
+def hair_bands(rows_at: Callable[[np.ndarray], np.ndarray], domain: np.ndarray,
+               limits: np.ndarray, samples: int = SAMPLES
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """The parameter ranges where a branch is at most :data:`HAIR` outside the limits.
+
+    Args:
+        rows_at: Parameter values (m,) -> every branch's rows (m, k, n), NaN where
+            a branch has none (``SelfMotion._rows``).
+        domain: (2,) the parameter's range [rad, m].
+        limits: Joint limits (n, 2).
+        samples: Grid values over the domain (ends included).
+
+    Returns:
+        ``(intervals (p, 2), branch (p,))``: per run of consecutive grid rows of one
+        branch within :data:`HAIR` of the limits, widened by one grid step each side
+        (clipped to the domain). Empty where there is none.
+    """
+    t = np.linspace(float(domain[0]), float(domain[1]), samples)
+    q = rows_at(t)
+    with np.errstate(invalid="ignore"):
+        over = np.maximum(limits[:, 0] - q, q - limits[:, 1]).max(-1)  # (m, k)
+    near = np.isfinite(over) & (over <= HAIR)
+    starts, ends, branch = [], [], []
+    step = t[1] - t[0]
+    for b in np.flatnonzero(near.any(0)):
+        edge = np.diff(np.concatenate([[0], near[:, b].astype(np.int8), [0]]))
+        for a, e in zip(np.flatnonzero(edge == 1), np.flatnonzero(edge == -1), strict=True):
+            starts.append(max(t[a] - step, t[0]))
+            ends.append(min(t[e - 1] + step, t[-1]))
+            branch.append(b)
+    return (np.column_stack([starts, ends]).reshape(-1, 2),
+            np.array(branch, dtype=np.int64))
