@@ -32,8 +32,8 @@ __all__ = ["HAIR", "SAMPLES", "hair_bands"]
 #: have in-limit solutions of the pose next to it: the stretched elbow's rounding
 #: reaches ~1e-8; farther rows are not repaired.
 HAIR = 1e-6
-#: Parameter values of the grid the bands are found on (the kernels' own grid).
-SAMPLES = 181
+#: Parameter values of the grid the bands are found on (6 degrees apart on the swivel).
+SAMPLES = 61
 
 
 def hair_bands(rows_at: Callable[[np.ndarray], np.ndarray], domain: np.ndarray,
