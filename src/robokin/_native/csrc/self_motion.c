@@ -67,6 +67,10 @@ enum {
 #define SM_EXACT 1e-13   /* pose errors below it need no polish */
 #define SM_ACCEPT 5e-13  /* pose errors above it after the polish: dropped */
 #define SM_SAME 1e-6     /* a branch's joint this near a value [rad]: at it */
+#define SM_ORTHO 1e-12   /* a triple whose middle axis is this near normal to both others:
+                          * its middle angle from the cross product (sm_split_ortho) */
+#define SM_LINED 1e-15   /* outer axes this near one line (|xa|): the first angle set to 0;
+                          * flagged singular below 1e-9 (sm_first) */
 #define SM_GRAIN 16      /* poses per pool chunk */
 /* self_motion_intervals' _PAIR and _POINT (they read these): swivel_manifold_one's
  * "close" flag is set when two points of a branch lie within SM_PAIR in psi, a point
@@ -227,6 +231,26 @@ typedef struct {
     int real, cd_ok; /* cd_ok: |cos d| <= 0.99 (sm_split_root_cs) */
 } SmSplit;
 
+/* The middle angle's half-spread d of a triple whose middle axis hb is normal to ha
+ * and hc (the SRS arms' shoulders and wrists): there rho = 1 and rho^2 - C^2 =
+ * |ha x R hc|^2, so cos d = C, sin d = |ha x R hc| to rounding where the cosine
+ * alone (acos, sqrt(1 - x^2)) loses half the digits next to d = 0 or pi (a middle
+ * joint 1e-9 from its aligned value came out 0: the row 1e-9 off the pose, which the
+ * polish cannot take back on a straight arm). Taken where |cos d| > 0.99 (elsewhere
+ * the cosine's d is as exact). Sets (*cd, *sd) (a unit pair); returns 0 (nothing
+ * set) for another triple. */
+static int sm_split_ortho(v3 ha, v3 hb, v3 hc, v3 Rhc, double C, double *cd, double *sd)
+{
+    if (!(fabs(v3_dot(ha, hb)) <= SM_ORTHO && fabs(v3_dot(hb, hc)) <= SM_ORTHO))
+        return 0;
+    double S = sm_norm(v3_cross(ha, Rhc)), n = hypot(C, S);
+    if (!(n > 0.0))
+        return 0;
+    *cd = C / n;
+    *sd = S / n;
+    return 1;
+}
+
 /* The middle angle's roots of the split of R (with their cosines and sines); e =
  * sm_perp(hc) (the arm's constant) */
 static void sm_split(v3 ha, v3 hb, v3 hc, v3 e, const m3 *R, SmSplit *t)
@@ -240,6 +264,11 @@ static void sm_split(v3 ha, v3 hb, v3 hc, v3 e, const m3 *R, SmSplit *t)
     double x = rho > 0.0 ? fmax(-1.0, fmin(1.0, C / rho)) : NAN; /* rho: hypot(A, B) */
     double cp = A / rho, sp = B / rho, cd = x, sd = sqrt(1.0 - x * x);
     t->cd_ok = fabs(x) <= 0.99;
+    if (!t->cd_ok && sm_split_ortho(ha, hb, hc, t->Rhc, C, &cd, &sd)) {
+        double d = atan2(sd, cd), phi = atan2(B, A);
+        tp = phi + d;
+        tm = phi - d;
+    }
     t->vb[0] = tp;
     t->vb[1] = tm;
     t->cb[0] = cp * cd - sp * sd;
@@ -268,8 +297,9 @@ ALWAYS_INLINE void sm_first(const SmSplit *t, int i, SmFirst *r)
     r->va = atan2(py, px);
     r->ca = rr > 0.0 ? px / rr : 1.0;
     r->sa = rr > 0.0 ? py / rr : 0.0;
-    r->sing = sm_norm(xa) < 1e-9;
-    if (r->sing) {
+    double lined = sm_norm(xa);
+    r->sing = lined < 1e-9;
+    if (lined < SM_LINED) {
         r->va = 0.0;
         r->ca = 1.0;
         r->sa = 0.0;
@@ -509,6 +539,8 @@ static void sm_split_quick(v3 ha, v3 hb, v3 hc, v3 e, const m3 *R, SmSplit *t)
     t->real = sm_sp4_abc(hb, ha, hc, v3_dot(ha, t->Rhc), &A, &B, &C, &rho);
     double x = rho > 0.0 ? fmax(-1.0, fmin(1.0, C / rho)) : NAN;
     double cp = A / rho, sp = B / rho, cd = x, sd = sqrt(1.0 - x * x);
+    if (!(fabs(x) <= 0.99))
+        sm_split_ortho(ha, hb, hc, t->Rhc, C, &cd, &sd);
     t->cb[0] = cp * cd - sp * sd;
     t->cb[1] = cp * cd + sp * sd;
     t->sb[0] = sp * cd + cp * sd;
@@ -543,7 +575,7 @@ static int sm_quick_root_inside(const SmArm *a, int j0, const SmSplit *t, int i)
     xa = v3_sub(xa, v3_scale(t->ha, v3_dot(t->ha, xa)));
     double py = v3_dot(t->ha, v3_cross(xa, t->ya)), px = v3_dot(xa, t->ya);
     double ca = 1.0, sa = 0.0;
-    if (!(sm_norm(xa) < 1e-9)) { /* else aligned: the first angle 0, as sm_first */
+    if (!(sm_norm(xa) < SM_LINED)) { /* else aligned: the first angle 0, as sm_first */
         double rr = sqrt(px * px + py * py);
         if (!(rr > 1e-100))
             return -1;
@@ -584,7 +616,7 @@ static int sm_quick_angle(const SmSplit *t, int k, int i, double *c, double *s)
     xa = v3_sub(xa, v3_scale(t->ha, v3_dot(t->ha, xa)));
     double py = v3_dot(t->ha, v3_cross(xa, t->ya)), px = v3_dot(xa, t->ya);
     double ca = 1.0, sa = 0.0;
-    if (!(sm_norm(xa) < 1e-9)) {
+    if (!(sm_norm(xa) < SM_LINED)) {
         double rr = sqrt(px * px + py * py);
         if (!(rr > 1e-100))
             return 0;

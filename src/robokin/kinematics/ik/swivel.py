@@ -53,6 +53,13 @@ __all__ = ["SwivelArm", "swivel_arm"]
 _MEET_TOL = 1e-9
 #: A subproblem-4 root whose |C| exceeds its amplitude by this (relative) is a double root.
 _DOUBLE = 1e-12
+#: A triple whose middle axis is this near normal to the outer ones takes its middle
+#: angle from the cross product (``_triple``; self_motion.c SM_ORTHO).
+_ORTHO = 1e-12
+#: Outer axes this near one line (the norm of the last axis' part normal to the
+#: first): the first angle set to 0 (self_motion.c SM_LINED); flagged singular below
+#: 1e-9.
+_LINED = 1e-15
 
 
 def _rot(u: np.ndarray, ang: np.ndarray) -> np.ndarray:
@@ -112,15 +119,32 @@ def _triple(ha: np.ndarray, hb: np.ndarray, hc: np.ndarray, R: np.ndarray,
 
     Returns ``(v (..., 2, 3) chain angles, real (..., 2), singular (..., 2))``; the
     second axis is the middle angle's +/- root. Where the outer axes line up (a
-    singular triple) only their sum is fixed: the first angle is set to 0.
+    singular triple) only their sum is fixed: the first angle is set to 0. The rows
+    within 1e-9 of that are flagged singular (their outer angles are fixed by the
+    rotation only to ~1e-16 over the distance).
+
+    Where the middle axis is normal to both others (the SRS arms' shoulders and
+    wrists) the middle angle is ``phi +- atan2(|ha x R hc|, C)`` where |C| > 0.99: the
+    cosine C alone (``_sp4``'s arccos) loses half the digits next to 0 or pi, where a
+    middle joint at 1e-9 came out 0 and the row 1e-9 off the pose.
     """
-    vb_p, vb_m, real = _sp4(hb, ha, hc, _dot(ha, _mv(R, hc)))
+    Rhc = _mv(R, hc)
+    vb_p, vb_m, real = _sp4(hb, ha, hc, _dot(ha, Rhc))
+    if abs(float(ha @ hb)) <= _ORTHO and abs(float(hb @ hc)) <= _ORTHO:
+        ypar = _dot(hb, hc)[..., None] * hb
+        yp = hc - ypar
+        phi = np.arctan2(_dot(ha, np.cross(hb, yp)), _dot(ha, yp))
+        C = _dot(ha, Rhc) - _dot(ha, ypar)
+        d = np.arctan2(np.linalg.norm(np.cross(ha, Rhc), axis=-1), C)
+        near = ~(np.abs(np.clip(C / np.hypot(_dot(ha, yp), _dot(ha, np.cross(hb, yp))),
+                                -1.0, 1.0)) <= 0.99)  # (elsewhere arccos is as exact)
+        vb_p, vb_m = np.where(near, phi + d, vb_p), np.where(near, phi - d, vb_m)
     vb = np.stack([vb_p, vb_m], -1)  # (..., 2)
     Rb = _rot(hb, vb)  # (..., 2, 3, 3)
     Rx = R[..., None, :, :]
     va, spread = _sp1(ha, _mv(Rb, hc), _mv(Rx, hc)[..., :] + 0 * vb[..., None])
     singular = spread < 1e-9
-    va = np.where(singular, 0.0, va)
+    va = np.where(spread < _LINED, 0.0, va)
     B = _rot(ha, va) @ Rb
     e = _perp(hc)
     vc, _ = _sp1(hc, e + 0 * vb[..., None], _mv(np.swapaxes(B, -1, -2) @ Rx, e))
