@@ -501,3 +501,25 @@ def test_a_manifold_of_two_corner_points_gives_them_to_nearest_and_best():
     margin = [float(np.minimum(c - SRS.limits[:, 0], SRS.limits[:, 1] - c).min())
               for c in corners]
     assert best.score >= max(margin) - 1e-12
+
+
+@pytest.mark.parametrize(("a", "b"), [(3, 5), (1, 3), (1, 5)])
+def test_a_q_near_that_solves_the_pose_is_the_answer(a, b):
+    """Oracle: q0 itself (inside the limits, FK(q0) = T): nothing is nearer.
+
+    With two of q2, q4, q6 at 1e-5 (next to a swing: a branch's outer joints move
+    ~1e5 times as fast as the swivel) the branch search stopped 1.4e-6..5.6e-6 from q0
+    on 9 and 15 of 20 SRS poses (q4, q6 and q2, q4 at 1e-5; session 25's tables in
+    docs/ik.md) and no nearer solution was looked for (q0's distance to
+    the aligned values was above the answer's); now a q_near on its pose inside the
+    limits is returned as it is, by ``nearest`` and by one ``ik_near`` batch.
+    """
+    rng = np.random.default_rng(3)
+    Q = rng.uniform(0.8 * SRS.limits[:, 0], 0.8 * SRS.limits[:, 1], (8, 7))
+    Q[:, a] = Q[:, b] = 1e-5
+    T = SRS.fk(Q)
+    for q0, Ti in zip(Q, T, strict=True):
+        p = SRS.self_motion(Ti).nearest(q0)
+        assert p is not None and np.array_equal(p.q, q0)
+    got = SRS.ik_near(T, Q, method="self_motion")
+    assert got.success.all() and np.array_equal(got.q, Q)

@@ -299,7 +299,8 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
 
     Returns:
         (m, n): q (a new array), a row polished where its pose error was above
-        ``EXACT``, the rows a nearer solution replaced.
+        ``EXACT``, the rows a nearer solution replaced; q_near's own row where q_near
+        is inside the limits and within ``EXACT`` of its pose.
     """
     from robokin.kinematics.ik import numeric
 
@@ -316,6 +317,11 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         row, e = _at_limits(robot, q[i], T[i], limits)
         if e <= EXACT:
             q[i] = row
+    # q_near itself where it solves its pose inside the limits (the search's answer next
+    # to a swing is up to ~5e-6 from it: t to rounding where q moves ~1e5 times faster)
+    _, own = onto(robot, q_near, T, steps=0)
+    mine = (own <= EXACT) & _within(q_near, limits)
+    q[mine] = q_near[mine]
     wrapped = np.asarray(robot.is_revolute, dtype=bool)
     best = _distance(q, q_near, wrapped)
     best[np.isnan(best)] = np.inf
