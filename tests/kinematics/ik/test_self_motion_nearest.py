@@ -439,6 +439,13 @@ SWINGS = [
      [-0.31529870770455704, 0.5818412696614286, 0.7994246269563838, -2.1541706748945044, -1.9701863233451304, 3.453468335671027, 0.23400421732190058]),
     ('panda', [1.8564001504935939, -0.28789285673654086, 0.6216208516843893, -0.0698, -2.8973, -1e-06, 1e-07],
      [1.9689770417723036, -0.2780509920948742, 0.6940222005243905, -0.033815584245919995, -2.991527881779192, 0.2027533940953347, 0.0884816230820874]),
+    # session 25: q0 at an interval's end where q1 crosses its limit steeply (the end's
+    # row 4e-11 past it: 0.36 rad farther); a swing 9.8e-7..1e-6 off the shoulder's
+    # continuum (0.42 rad farther)
+    ('panda', [-2.8973, -1e-06, -1e-09, -0.0698, -1e-06, 3.141592653589793, 2.895610808741878],
+     [-2.926028799194581, -0.04251852787705909, 0.05909833800964482, 0.016781865321228495, 0.23733625239089184, 2.903725333930055, 2.857465629890354]),
+    ('panda', [1e-07, 1e-06, 1e-09, -2.8643460970567363, -0.21976607190717523, -1e-09, -1e-07],
+     [0.5458720288719126, 0.6089057278143621, 0.29061494828594725, -1.9569999946357806, 0.49987564196786316, 2.580756878699669, -1.5063480431374354]),
 ]
 
 
@@ -453,7 +460,10 @@ def test_next_to_a_swing_the_answer_is_never_farther_than_q0(name, q0, q_near):
     the self-motion; the pose solved with an end joint held at q_near's value where no
     row at the aligned value was taken; the branches' aligned-axes rows moved along
     their continua; a row Newton cannot finish next to a swing replaced by an end
-    joint's held closed form; the refined corners as candidates."""
+    joint's held closed form; the refined corners as candidates. Session 25: an
+    interval's end row up to 1e-9 past a limit taken (clamped, then back onto the pose
+    inside the limits); branch rows within 1e-4 of an aligned value moved along its
+    continuum (``_SWING_ON``)."""
     robot = PANDA if name == "panda" else SRS
     q0, qn = np.array(q0), np.array(q_near)
     T = robot.fk(q0)

@@ -54,6 +54,7 @@ from robokin.kinematics.ik.self_motion_continua import (
     Continua,
     continua,
     continua_best,
+    onto,
 )
 from robokin.kinematics.ik.self_motion_continued import _ContinuedFamily
 from robokin.kinematics.ik.self_motion_families import (
@@ -346,6 +347,11 @@ class SelfMotion:
             exact = False
             found = interval_nearest(fam, self.limits, self.intervals, self.interval_branch,
                                      qn)
+            if found is not None and not self._exact_inside(found[0]):
+                # an end row up to 1e-9 past a limit, clamped, that does not go back
+                # onto the pose inside the limits: the rows inside to MANIFOLD_SLACK
+                found = interval_nearest(fam, self.limits, self.intervals,
+                                         self.interval_branch, qn, slack=0.0)
             point = None if found is None else ManifoldPoint(found[0], found[1], found[2],
                                                              -found[3])
         wrapped = np.asarray(self._family.robot.is_revolute, dtype=bool)
@@ -374,6 +380,22 @@ class SelfMotion:
                                  -np.inf, self._dispatch)
             return None if cont is None else self._off_branches(cont[0], cont[1])
         return self._off_branches(q[0], float(closeness(q)[0]))
+
+    def _exact_inside(self, q: np.ndarray) -> bool:
+        """Whether q (n,) reaches the pose within ``EXACT`` inside the limits.
+
+        Else it is taken back onto the pose inside them (``_at_limits``; q updated in
+        place where that succeeds).
+        """
+        robot = self._family.robot
+        _, err = onto(robot, q[None], self.T[None], steps=0)
+        if err[0] <= EXACT:
+            return True
+        row, e = _at_limits(robot, q, self.T, self.limits)
+        if not e <= EXACT:
+            return False
+        q[...] = row
+        return True
 
     def _off_branches(self, q: np.ndarray, score: float) -> ManifoldPoint:
         """A solution q (n,) off the branches' samples as a point with ``score``.

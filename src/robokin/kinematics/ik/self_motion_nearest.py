@@ -30,7 +30,6 @@ from robokin.kinematics.arm import Arm
 from robokin.kinematics.ik.fixed import Dispatch, _held_solvers
 from robokin.kinematics.ik.self_motion_base import _Family
 from robokin.kinematics.ik.self_motion_continua import (
-    _ON_ALIGNED,
     EXACT,
     LINE_PAIRS,
     held_rows,
@@ -55,8 +54,8 @@ _H = 1e-5
 
 
 def interval_nearest(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
-                     branches: np.ndarray, q_near: np.ndarray, *, grid: int = GRID
-                     ) -> tuple[np.ndarray, float, int, float] | None:
+                     branches: np.ndarray, q_near: np.ndarray, *, grid: int = GRID,
+                     slack: float = 1e-9) -> tuple[np.ndarray, float, int, float] | None:
     """The in-limit configuration on the intervals nearest ``q_near``, or None.
 
     Args:
@@ -66,6 +65,10 @@ def interval_nearest(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
         branches: (m,) the branch of each interval.
         q_near: The configuration (n,) [rad].
         grid: Values per interval (ends included), at least 3.
+        slack: A row this far outside a limit [rad, m] is taken, clamped (an
+            interval's end where a joint crosses its limit steeply is off it by its
+            slope times the last bit of t: the Panda's q1 next to an aligned
+            shoulder 4e-11 out); the caller takes it back onto the pose.
 
     Returns:
         ``(q (n,), t, branch, distance)``, or None when no row is inside the limits.
@@ -83,7 +86,7 @@ def interval_nearest(fam: _Family, limits: np.ndarray, intervals: np.ndarray,
     cand_b = np.concatenate([mb, br, br])
     cand_d = np.concatenate([md, d[:, 0], d[:, -1]])
     t_near = None if fam.joint is None else float(q_near[fam.joint])
-    found = _first_inside(fam, limits, cand_t, cand_b, cand_d, t, d, br, t_near)
+    found = _first_inside(fam, limits, cand_t, cand_b, cand_d, t, d, br, t_near, slack)
     if found is None:
         return None
     q, t_best, b_best, dist = found
@@ -196,9 +199,9 @@ def _newton(fam: _Family, limits: np.ndarray, lo: np.ndarray, hi: np.ndarray,
 
 def _first_inside(fam: _Family, limits: np.ndarray, cand_t: np.ndarray, cand_b: np.ndarray,
                   cand_d: np.ndarray, t: np.ndarray, d: np.ndarray, br: np.ndarray,
-                  t_near: float | None = None
+                  t_near: float | None = None, slack: float = 0.0
                   ) -> tuple[np.ndarray, float, int, float] | None:
-    """The nearest candidate whose row is inside the limits (``_within``), clamped; else None.
+    """The nearest candidate whose row is inside the limits (+ ``slack``), clamped; else None.
 
     The grid samples are the last candidates (a row at an interval end can be
     outside its limit by more than 1e-12 where the end was bisected). Candidates
@@ -216,7 +219,7 @@ def _first_inside(fam: _Family, limits: np.ndarray, cand_t: np.ndarray, cand_b: 
         if not np.isfinite(all_d[i]) or (best is not None and all_d[i] > best[3] + _TIE):
             break
         q = fam.rows(all_t[i:i + 1])[0][0, all_b[i]]
-        if not bool(_within(q, limits)):
+        if not bool(_within(q, limits + np.array([-slack, slack]))):
             continue
         if best is None:
             best = (np.clip(q, lo, hi), float(all_t[i]), int(all_b[i]), float(all_d[i]))
@@ -293,7 +296,7 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         seeds: Gives rows (m, k, n) of the branches at their aligned-axes points
             (NaN: none), called where a pose has no row held at a pair's value
             nearer than the answer: moved along the continua they are within
-            ``_ON_ALIGNED`` of as the held rows are (a swing 1e-9..1e-6 off its
+            ``_SWING_ON`` of as the held rows are (a swing 1e-9..1e-4 off its
             continuum, where no end joint has a held closed form: the Panda's
             shoulder).
 
@@ -393,10 +396,10 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
     def take_moved(idx: np.ndarray, held: np.ndarray, valid: np.ndarray) -> np.ndarray:
         """Held rows (p, k, n) of poses idx moved along their continua: the nearest taken.
 
-        Moved along every line a row's joints are within ``_ON_ALIGNED`` of (a swing's
-        lines, 1e-9 off: the move leaves the pose by ~1e-9 times its step, which
-        ``take`` takes back where it can), then along its exact lines only. Returns
-        the poses (of idx) where a row was taken.
+        Moved along every line a row's joints are within ``_SWING_ON`` of (a swing's
+        lines, 1e-9..1e-4 off: the move leaves the pose by about that times its step,
+        which ``take`` takes back where it can), then along its exact lines only.
+        Returns the poses (of idx) where a row was taken.
         """
         taken = np.zeros(len(q), dtype=bool)
         k = held.shape[-2]
@@ -405,9 +408,9 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         near = np.repeat(q_near[idx], k, axis=0)
         with np.errstate(invalid="ignore"):
             off = np.abs(_wrap(held[..., [j for j, *_ in pairs]] - values))
-            loose = ((off > 0.0) & (off <= _ON_ALIGNED)).any(-1).any(-1)  # (p,)
-        for on in (_ON_ALIGNED, 0.0):
-            if on == 0.0:  # (again only where a line was taken 1e-9..1e-6 off)
+            loose = ((off > 0.0) & (off <= _SWING_ON)).any(-1).any(-1)  # (p,)
+        for on in (_SWING_ON, 0.0):
+            if on == 0.0:  # (again only where a line was taken 1e-9..1e-4 off)
                 idx, held, valid, near = (idx[loose], held[loose], valid[loose],
                                           np.repeat(q_near[idx[loose]], k, axis=0))
                 if not len(idx):
@@ -529,6 +532,13 @@ def _at_limits(robot: Arm, q: np.ndarray, T: np.ndarray, limits: np.ndarray
             return np.clip(row, lo, hi), float(e[0])
     return q, np.inf
 
+
+#: A branch row this close to a pair's aligned value [rad] is moved along that pair's
+#: continuum as if on it (``take_moved``; ``take`` takes it back onto the pose and keeps
+#: it only where it is exact and nearer): the Panda's shoulder with q2 = 1e-6 at q0 passes
+#: the continuum 9.8e-7..1.0e-6 off, which ``_ON_ALIGNED`` (1e-6, the continua's own
+#: test) missed by rounding (session 25).
+_SWING_ON = 1e-4
 
 #: The numeric solution from q_near this close to a pair's aligned value [rad] (or
 #: stalled off the pose) marks a possible swing next to it (``nearer_points``).
