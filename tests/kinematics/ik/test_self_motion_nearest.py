@@ -441,7 +441,10 @@ SWINGS = [
      [1.9689770417723036, -0.2780509920948742, 0.6940222005243905, -0.033815584245919995, -2.991527881779192, 0.2027533940953347, 0.0884816230820874]),
     # session 25: q0 at an interval's end where q1 crosses its limit steeply (the end's
     # row 4e-11 past it: 0.36 rad farther); a swing 9.8e-7..1e-6 off the shoulder's
-    # continuum (0.42 rad farther)
+    # continuum (0.42 rad farther); a moved aligned row nearest q_near with q6 0.6
+    # outside hid an in-limit one (0.18 rad farther)
+    ('panda', [-2.057285607905913, -1e-07, 0.6528206373068586, -1.091668462767552, -1.0123724693311402, -1e-09, -1e-06],
+     [-0.47912400037246616, -1.709547708871876, 1.4700219972746527, -0.34004776473966425, 2.765187650695092, 0.44284314553185516, 1.1307662678711732]),
     ('panda', [-2.8973, -1e-06, -1e-09, -0.0698, -1e-06, 3.141592653589793, 2.895610808741878],
      [-2.926028799194581, -0.04251852787705909, 0.05909833800964482, 0.016781865321228495, 0.23733625239089184, 2.903725333930055, 2.857465629890354]),
     ('panda', [1e-07, 1e-06, 1e-09, -2.8643460970567363, -0.21976607190717523, -1e-09, -1e-07],
@@ -463,7 +466,8 @@ def test_next_to_a_swing_the_answer_is_never_farther_than_q0(name, q0, q_near):
     joint's held closed form; the refined corners as candidates. Session 25: an
     interval's end row up to 1e-9 past a limit taken (clamped, then back onto the pose
     inside the limits); branch rows within 1e-4 of an aligned value moved along its
-    continuum (``_SWING_ON``)."""
+    continuum (``_SWING_ON``), the moved rows with another joint outside its limits
+    left out before the nearest is picked."""
     robot = PANDA if name == "panda" else SRS
     q0, qn = np.array(q0), np.array(q_near)
     T = robot.fk(q0)

@@ -416,7 +416,10 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
                 if not len(idx):
                     break
             moved = pair_steps(held.reshape(-1, robot.n), near, pairs, lo, hi, wrapped, on=on)
-            ok = valid.reshape(-1) & np.isfinite(moved).all(-1)
+            # (a row with a joint the lines do not move outside its limits is no answer:
+            # it would hide an in-limit row farther from q_near, the Panda's q6 0.6 out)
+            ok = (valid.reshape(-1) & np.isfinite(moved).all(-1)
+                  & _within(moved, limits + _PAST))
             d = np.where(ok, _distance(moved, near, wrapped), np.inf).reshape(len(idx), k)
             c = np.argmin(d, axis=1)
             r = np.arange(len(idx))
