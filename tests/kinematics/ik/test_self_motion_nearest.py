@@ -439,14 +439,17 @@ SWINGS = [
      [-0.31529870770455704, 0.5818412696614286, 0.7994246269563838, -2.1541706748945044, -1.9701863233451304, 3.453468335671027, 0.23400421732190058]),
     ('panda', [1.8564001504935939, -0.28789285673654086, 0.6216208516843893, -0.0698, -2.8973, -1e-06, 1e-07],
      [1.9689770417723036, -0.2780509920948742, 0.6940222005243905, -0.033815584245919995, -2.991527881779192, 0.2027533940953347, 0.0884816230820874]),
-    # session 25: q0 at an interval's end where q1 crosses its limit steeply (the end's
-    # row 4e-11 past it: 0.36 rad farther); a swing 9.8e-7..1e-6 off the shoulder's
-    # continuum (0.42 rad farther); a moved aligned row nearest q_near with q6 0.6
-    # outside hid an in-limit one (0.18 rad farther)
+    # session 25: a branch passing the continuum 1e-9 off without crossing it (no
+    # aligned point; q0 1e-9 after an interval end of its swing: 0.069 rad farther)
+    ('panda', [0.2718112341103085, -1e-09, -2.2466308734536136, -1.040651343624745, 1.0533945803167022, 1e-07, -1e-07],
+     [-0.40334901609802465, 0.09189379175233459, -2.4588977241732946, -2.5928331908794076, 2.663902281023955, 3.4244821555027287, 0.33004063967476016]),
+    # a moved aligned row nearest q_near with q6 0.6 outside hid an in-limit one (0.18)
     ('panda', [-2.057285607905913, -1e-07, 0.6528206373068586, -1.091668462767552, -1.0123724693311402, -1e-09, -1e-06],
      [-0.47912400037246616, -1.709547708871876, 1.4700219972746527, -0.34004776473966425, 2.765187650695092, 0.44284314553185516, 1.1307662678711732]),
+    # q0 at an interval's end where q1 crosses its limit steeply (4e-11 past: 0.36)
     ('panda', [-2.8973, -1e-06, -1e-09, -0.0698, -1e-06, 3.141592653589793, 2.895610808741878],
      [-2.926028799194581, -0.04251852787705909, 0.05909833800964482, 0.016781865321228495, 0.23733625239089184, 2.903725333930055, 2.857465629890354]),
+    # a swing 9.8e-7..1e-6 off the shoulder's continuum (0.42 rad farther)
     ('panda', [1e-07, 1e-06, 1e-09, -2.8643460970567363, -0.21976607190717523, -1e-09, -1e-07],
      [0.5458720288719126, 0.6089057278143621, 0.29061494828594725, -1.9569999946357806, 0.49987564196786316, 2.580756878699669, -1.5063480431374354]),
 ]
@@ -467,7 +470,8 @@ def test_next_to_a_swing_the_answer_is_never_farther_than_q0(name, q0, q_near):
     interval's end row up to 1e-9 past a limit taken (clamped, then back onto the pose
     inside the limits); branch rows within 1e-4 of an aligned value moved along its
     continuum (``_SWING_ON``), the moved rows with another joint outside its limits
-    left out before the nearest is picked."""
+    left out before the nearest is picked, the intervals' end rows within
+    ``_SWING_ON`` of an aligned value moved too."""
     robot = PANDA if name == "panda" else SRS
     q0, qn = np.array(q0), np.array(q_near)
     T = robot.fk(q0)

@@ -51,6 +51,7 @@ from robokin.kinematics.ik.fixed import Dispatch, held_complete
 from robokin.kinematics.ik.self_motion_base import _Family, seven_joint_serial
 from robokin.kinematics.ik.self_motion_continua import (
     EXACT,
+    LINE_PAIRS,
     Continua,
     continua,
     continua_best,
@@ -88,12 +89,14 @@ from robokin.kinematics.ik.self_motion_intervals import (
     _within,
 )
 from robokin.kinematics.ik.self_motion_nearest import (
+    _SWING_ON,
     _at_limits,
     _distance,
     interval_nearest,
     nearer_points,
 )
 from robokin.kinematics.ik.swivel import SwivelArm
+from robokin.spatial import wrap_angle
 
 __all__ = ["LimitCrossing", "ManifoldPoint", "SelfMotion", "SelfMotionSetup", "SingularPoint",
            "auto_parameter", "exact_parameter",
@@ -429,14 +432,29 @@ class SelfMotion:
         """The branches' rows (k, n) at their aligned-axes points, in or out of the limits.
 
         (Out: a swing's middle row, q1 and q3 at +-pi next to the Panda's aligned
-        shoulder; its continuum move can bring it in.)
+        shoulder; its continuum move can bring it in.) Then the rows at the intervals'
+        ends with a pair's joint within ``_SWING_ON`` of its aligned value: a branch
+        passing the continuum 1e-9 off without crossing it has no aligned point, and
+        its swing's limit crossings end intervals there (the Panda with q2 = -1e-9 at
+        q0: q0 1e-9 after such an end, 0.069 rad nearer q_near than the search's
+        answer, which the grid steps over).
         """
         marks = [(p.t, p.branch) for p in self._every_record()[1] if p.kind == "aligned axes"]
-        if not marks:
-            return np.zeros((0, self.limits.shape[0]))
-        t, b = (np.array(x) for x in zip(*marks, strict=True))
-        out: np.ndarray = self.sample(t)[np.arange(len(t)), b]
-        return out
+        n = self.limits.shape[0]
+        rows = np.zeros((0, n))
+        if marks:
+            t, b = (np.array(x) for x in zip(*marks, strict=True))
+            rows = self.sample(t)[np.arange(len(t)), b]
+        pairs = self._family.robot.derived(LINE_PAIRS)
+        if len(self.intervals) and pairs:
+            t = self.intervals.reshape(-1)
+            b = np.repeat(self.interval_branch, 2)
+            ends = self.sample(t)[np.arange(len(t)), b]
+            j = [p[0] for p in pairs]
+            with np.errstate(invalid="ignore"):
+                off = np.abs(wrap_angle(ends[:, j] - np.array([p[1] for p in pairs])))
+            rows = np.concatenate([rows, ends[(off <= _SWING_ON).any(-1)]])
+        return rows
 
     def _with_corners(self, point: ManifoldPoint | None,
                       score: Callable[[np.ndarray], np.ndarray]) -> ManifoldPoint | None:
