@@ -112,3 +112,30 @@ def test_hair_bands_none_beyond_the_hair_or_where_no_branch_is():
                    lambda t: np.full_like(t, np.nan)):
         bands, branch = hair_bands(_rows_of(values), DOMAIN, LIMITS)
         assert bands.shape == (0, 2) and branch.shape == (0,)
+
+
+# q2 at its limit with the elbow 2.7e-4 from stretched: branch 7 is tangent to the
+# limit, q2 = limit - 6.5e-5 psi^2, inside at psi = 0 only; the swivel kernel gives
+# intervals of +-0.17 whose other rows are up to 2e-6 outside (its widened point)
+TANGENT = np.array([-2.088187845485972, -2.0943951023931953, 1e-09, 0.00026640684586087815,
+                    -1e-06, -1.297527775817982, 1.5707963267948966])
+
+
+@pytest.mark.parametrize("q_near", [
+    [-1.9622788823136055, -2.090858157897023, 0.03863750414916595, -0.0624729597525322,
+     -0.12256130067117213, -1.2791917194937314, 1.614247697499108],
+    [0.023852928654097827, 1.6032203996325611, 2.8004696294666305, -1.9112009062297013,
+     2.193427086676577, -0.47436844765578146, -0.05711852497751968]])
+def test_a_branch_tangent_to_a_limit_gives_its_point_to_best_and_nearest(q_near):
+    """Oracle: TANGENT (inside the limits, on its pose). Its intervals' sampled rows are
+    all outside but the tangent point, so ``best`` and ``nearest`` gave None (session
+    25's fuzz, SRS seed 48 #142); now the hair bands' search finds the tangent point:
+    both in-limit solutions of the pose, ``nearest`` no farther than TANGENT."""
+    T = SRS.fk(TANGENT)
+    sm = SRS.self_motion(T)
+    assert len(sm.intervals) and sm.reachable
+    _solution(SRS, T, sm.best("margin"))
+    qn = np.array(q_near)
+    near = _solution(SRS, T, sm.nearest(qn))
+    bound = np.linalg.norm(wrap_angle(TANGENT - qn))
+    assert np.linalg.norm(wrap_angle(near - qn)) <= bound + 1e-6

@@ -364,9 +364,12 @@ class SelfMotion:
             out: np.ndarray = -_distance(Q, qn, wrapped)
             return out
 
+        found_point = point
         point = self._with_corners(point, closeness)
-        if point is None and not len(self.intervals):
+        if point is None:
             point = self._hair_best(closeness, samples)
+        if point is not found_point:
+            exact = False  # (a refined corner's row: checked on the pose, polished)
         if self._dispatch is None:
             return point
         q = np.full((1, len(qn)), np.nan) if point is None else point.q[None]
@@ -478,28 +481,40 @@ class SelfMotion:
                    samples: int = 64) -> ManifoldPoint | None:
         """The best solution next to a branch a hair outside a limit, or None.
 
-        Where the manifold has no interval: the branches' stretches at most
-        :data:`~robokin.kinematics.ik.self_motion_hair.HAIR` outside the limits
-        (``hair_bands``), searched as intervals are (:func:`_maximise`, the limits
-        widened by ``HAIR``), the best row taken back inside the limits onto the pose
-        (``self_motion_nearest._at_limits``); None where it does not reach the pose
-        there within ``EXACT``. A stretched elbow's rows (q4 = 0 where the generating
-        configuration has 1e-9) leave a joint the self-motion does not move ~5e-10
-        past the limit it is at.
+        Where the searches of the intervals found no in-limit row: the branches'
+        stretches at most :data:`~robokin.kinematics.ik.self_motion_hair.HAIR` outside
+        the limits (``hair_bands``), searched as intervals are (:func:`_maximise`, the
+        limits widened by ``HAIR``), the best row taken back inside the limits onto the
+        pose (``self_motion_nearest._at_limits``); where that row does not reach the
+        pose within ``EXACT`` inside the limits, the best row by the score less 1e6
+        times its distance outside (the tangent point of a branch touching a limit)
+        taken back the same way; else None. A stretched elbow's
+        rows (q4 = 0 where the
+        generating configuration has 1e-9) leave a joint the self-motion does not move
+        ~5e-10 past the limit it is at, with no interval; a branch tangent to a limit
+        (q2 at it, q4 = 2.7e-4: q2 = limit - 6.5e-5 psi^2) is inside at one point,
+        which the swivel kernel gives as an interval of +-0.17 whose other rows are up
+        to 2e-6 outside.
         """
-        if len(self.intervals):
-            return None
         bands, branch = hair_bands(self._rows, self.domain, self.limits)
         if not len(bands):
             return None
         wide = self.limits + np.array([-HAIR, HAIR])
-        point = _maximise(self._family, wide, bands, branch, score, samples)
-        if point is None:
-            return None
-        q, err = _at_limits(self._family.robot, point.q, self.T, self.limits)
-        if not err <= EXACT:
-            return None
-        return ManifoldPoint(q, point.t, point.branch, float(score(q[None])[0]))
+        margin = _criterion("margin", None, self.limits)
+
+        def inward(q: np.ndarray) -> np.ndarray:
+            """``score`` less 1e6 times the distance outside the limits."""
+            out: np.ndarray = score(q) + 1e6 * np.minimum(margin(q), 0.0)
+            return out
+
+        for crit in (score, inward):
+            point = _maximise(self._family, wide, bands, branch, crit, samples)
+            if point is None:
+                return None
+            q, err = _at_limits(self._family.robot, point.q, self.T, self.limits)
+            if err <= EXACT:
+                return ManifoldPoint(q, point.t, point.branch, float(score(q[None])[0]))
+        return None
 
     def _maximise(self, score: Callable[[np.ndarray], np.ndarray],
                   samples: int) -> ManifoldPoint | None:

@@ -36,7 +36,7 @@ from robokin.kinematics.ik.self_motion_continua import (
     onto,
     pair_steps,
 )
-from robokin.kinematics.ik.self_motion_intervals import _within
+from robokin.kinematics.ik.self_motion_intervals import _in_bounds, _within
 from robokin.spatial import wrap_angle as _wrap
 
 __all__ = ["interval_nearest", "nearer_points"]
@@ -315,7 +315,11 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
     # the branch answers as exact as the rows off them: an answer at a corner of two
     # limits, clamped into them 1e-12 off the pose, is polished with the joints at
     # their limits kept there (the corner's exact point), else with every joint free
-    ok = np.flatnonzero(np.isfinite(q).all(-1)) if not exact else np.zeros(0, dtype=int)
+    ok = np.isfinite(q).all(-1)
+    if exact:  # (the kernel's rows clamped onto a limit can be 1e-12 off the pose)
+        with np.errstate(invalid="ignore"):
+            ok &= (np.minimum(np.abs(q - lo), np.abs(q - hi)) <= 1e-12).any(-1)
+    ok = np.flatnonzero(ok)
     _, err = onto(robot, q[ok], T[ok], steps=0) if len(ok) else (q[ok], np.zeros(0))
     for i in ok[err > EXACT]:  # (rare: a corner)
         row, e = _at_limits(robot, q[i], T[i], limits)
@@ -353,8 +357,9 @@ def nearer_points(robot: Arm, T: np.ndarray, limits: np.ndarray, q_near: np.ndar
         if loose.any():
             rows[loose], err[loose] = onto(robot, rows[loose], T[idx[loose]])
         # a continuum's point at a limit can come out 1e-11..1e-8 past it (an aligned
-        # joint 1e-7 off its value), a numeric one 1e-3: taken back to the limit
-        past = np.flatnonzero(~_within(rows, limits) & _within(rows, limits + _PAST))
+        # joint 1e-7 off its value), a numeric one 1e-3: taken back to the limit (and a
+        # row past one by rounding: clamped, it can leave the pose by ~1e-12)
+        past = np.flatnonzero(~_in_bounds(rows, lo, hi) & _within(rows, limits + _PAST))
         for i in past:
             rows[i], err[i] = _at_limits(robot, rows[i], T[idx[i]], limits)
         stuck = np.flatnonzero(((err > EXACT) | ~_within(rows, limits))
@@ -512,7 +517,9 @@ def _at_limits(robot: Arm, q: np.ndarray, T: np.ndarray, limits: np.ndarray
     limit (steps along the Jacobian's null vector, each taken back onto the pose by
     Newton's steps), else clipped into the limits, its joints at a limit (to 1e-12)
     kept there and the others polished (``coincident._polish``: a corner's exact
-    point), else every joint polished. Returns the row (clipped) and its pose error
+    point; a joint that polish takes past its limit held there too, up to three
+    rounds), else every joint polished. Every candidate's error is taken after its
+    clamp into the limits. Returns the row (clipped) and its pose error
     [m, rad]; inf where none is within ``EXACT`` of the pose inside the limits (the
     row as given).
     """
@@ -532,16 +539,32 @@ def _at_limits(robot: Arm, q: np.ndarray, T: np.ndarray, limits: np.ndarray
             break
         row = row + n * ((np.clip(row[k], lo[k], hi[k]) - row[k]) / n[k])
         row = onto(robot, row[None], T[None])[0][0]
-    _, e = onto(robot, row[None], T[None], steps=0)
-    if e[0] <= EXACT and bool(_within(row, limits)):
-        return np.clip(row, lo, hi), float(e[0])
-    start = np.clip(q, lo, hi)
-    at = np.minimum(np.abs(start - lo), np.abs(start - hi)) <= 1e-12
-    for free in (np.flatnonzero(~at), np.arange(robot.n)):
-        row = _polish(robot, start[None], T[None], free)[0]
+    # (each candidate's error is taken after its clamp into the limits: a joint 1e-12
+    # past one, clamped, leaves the pose by ~1e-12, more than EXACT)
+    if bool(_within(row, limits)):
+        row = np.clip(row, lo, hi)
         _, e = onto(robot, row[None], T[None], steps=0)
+        if e[0] <= EXACT:
+            return row, float(e[0])
+    start = np.clip(q, lo, hi)
+    held = np.minimum(np.abs(start - lo), np.abs(start - hi)) <= 1e-12
+    for _ in range(3):  # a joint the polish takes past its limit is held there next
+        row = _polish(robot, start[None], T[None], np.flatnonzero(~held))[0]
+        clamped = np.clip(row, lo, hi)
+        _, e = onto(robot, clamped[None], T[None], steps=0)
         if e[0] <= EXACT and bool(_within(row, limits)):
-            return np.clip(row, lo, hi), float(e[0])
+            return clamped, float(e[0])
+        past = ((row < lo) | (row > hi)) & ~held
+        if not past.any() or past.all():
+            break
+        held |= past
+        start = clamped
+    row = _polish(robot, np.clip(q, lo, hi)[None], T[None], np.arange(robot.n))[0]
+    if bool(_within(row, limits)):
+        row = np.clip(row, lo, hi)
+        _, e = onto(robot, row[None], T[None], steps=0)
+        if e[0] <= EXACT:
+            return row, float(e[0])
     return q, np.inf
 
 
