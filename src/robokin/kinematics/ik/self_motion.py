@@ -488,8 +488,7 @@ class SelfMotion:
         pose (``self_motion_nearest._at_limits``); where that row does not reach the
         pose within ``EXACT`` inside the limits, the best row by the score less 1e6
         times its distance outside (the tangent point of a branch touching a limit)
-        taken back the same way; else None. A stretched elbow's
-        rows (q4 = 0 where the
+        taken back the same way; else None. A stretched elbow's rows (q4 = 0 where the
         generating configuration has 1e-9) leave a joint the self-motion does not move
         ~5e-10 past the limit it is at, with no interval; a branch tangent to a limit
         (q2 at it, q4 = 2.7e-4: q2 = limit - 6.5e-5 psi^2) is inside at one point,

@@ -15,9 +15,12 @@ the limits (on a grid of :data:`SAMPLES` parameter values); ``SelfMotion`` searc
 them as it searches its intervals, with the limits widened by :data:`HAIR`, and
 takes the best row back inside the limits onto the pose
 (``self_motion_nearest._at_limits``: along the self-motion to the limit, else with
-the joints at their limits held and the others polished). Only where the
-manifold has no in-limit interval and no in-limit point of an aligned continuum:
-``reachable``, ``best``, ``nearest``.
+the joints at their limits held and the others polished). Only where the searches
+of the intervals found no in-limit row and the aligned continua no in-limit point:
+``reachable`` (where there is no interval), ``best``, ``nearest``. A branch tangent to
+a limit is the other case: q2 at its limit with the elbow 2.7e-4 from stretched, q2 =
+limit - 6.5e-5 psi^2, is inside at one point, which the swivel kernel gives as an
+interval of +-0.17 whose other rows are up to 2e-6 outside.
 """
 
 from __future__ import annotations
