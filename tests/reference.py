@@ -131,6 +131,19 @@ def ur5_on_a_track(length: float = 2.0):
     return robokin.Robot.from_dh(rows, convention="standard", name="ur5_track")
 
 
+def rtb_iiwa14():
+    """The rtb-data iiwa14 URDF (shoulder offset 0.44 mm: not exactly SRS; skipped
+    without rtbdata)."""
+    rtbdata = pytest.importorskip("rtbdata")
+    from pathlib import Path
+
+    import robokin
+
+    urdf = (Path(rtbdata.__file__).parent
+            / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf")
+    return robokin.Robot.from_urdf(str(urdf), geometry=False)
+
+
 def offset_iiwa14(a2: float = 0.01):
     """:func:`iiwa14_srs` with a shoulder offset ``a2`` [m] (1 cm by default).
 

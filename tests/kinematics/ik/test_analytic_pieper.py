@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import robokin
-from reference import pose_errors
+from reference import pose_errors, rtb_iiwa14
 from robokin._native import kernels as K
 from robokin.kinematics.ik import numeric
 from robokin.kinematics.ik.analytic import pieper
@@ -117,16 +117,6 @@ def test_bad_poses_and_values_take_the_checked_path():
         panda.ik(T.astype(np.float32), fixed={"joint7": True})
 
 
-def _rtb_iiwa14() -> robokin.Robot:
-    """The rtb-data iiwa14 URDF (shoulder offset 0.44 mm; skipped without rtbdata)."""
-    rtbdata = pytest.importorskip("rtbdata")
-    from pathlib import Path
-
-    urdf = (Path(rtbdata.__file__).parent
-            / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf")
-    return robokin.Robot.from_urdf(str(urdf), geometry=False)
-
-
 def test_held_slots_continue_through_an_incidental_coplanar_value():
     # Issue 29 (helper slots29): with joint_a3 held, axes 2 and 4 of the rtb-data
     # iiwa14 are parallel at joint_a3 = 0 only (mutual moment 0.32 * joint_a3), where
@@ -134,7 +124,7 @@ def test_held_slots_continue_through_an_incidental_coplanar_value():
     # quartic at every other value: at 0 each slot held another configuration.
     # benchmarks/self_motion_rates.py seed 0, #5180. Oracles: FK, and the rows either
     # side (the quartic's), slot for slot.
-    robot = _rtb_iiwa14()
+    robot = rtb_iiwa14()
     q0 = np.array([0.9189737939132052, 1.5707963267948966, 1e-09, -1.3206728674132546,
                    -1.4343752253433877, -1.5707963267948966, -3.0541])
     T = robot.fk(q0)
@@ -156,7 +146,7 @@ def test_held_slots_keep_a_root_at_the_quartics_shift():
     # it at +-1e-11 and its rows changed slots from one value of joint_a3 to the next
     # (1e-9 apart). Numbered from the shift + pi (where |f| is the largest sample) the
     # slot of q0's branch is the same at every value. Seed 0, #5113.
-    robot = _rtb_iiwa14()
+    robot = rtb_iiwa14()
     q0 = np.array([2.5356556953167813, -2.0942, -1e-07, 0.0, -1.160102486027724, -2.0942,
                    -3.0398026574264643])
     T = robot.fk(q0)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import robokin
-from reference import pose_errors
+from reference import pose_errors, rtb_iiwa14
 from robokin.exceptions import InputError
 from robokin.kinematics.ik import fixed as fixed_ik
 
@@ -293,12 +293,7 @@ def test_held_joint_at_a_stretched_elbow_near_srs_arm():
     # it must be among the rows (1e-6 rad), each of which reproduces the pose to 1e-12.
     # Cause (pieper.c pk_general): elimination determinant 2.5e-10, |u_y| - 1 = 1.2e-5
     # at both quartic roots, dropped by a fixed 1e-6 unit check (now scale-aware).
-    rtbdata = pytest.importorskip("rtbdata")
-    from pathlib import Path
-
-    urdf = (Path(rtbdata.__file__).parent
-            / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf")
-    robot = robokin.Robot.from_urdf(str(urdf), geometry=False)
+    robot = rtb_iiwa14()
     q = np.array([-np.pi / 2, np.pi, -1e-07, -1e-09, -2.9668, -0.47755672126856075,
                   2.4839344482487373])
     sigma = np.linalg.svd(np.delete(robot.jacobian(q), 2, axis=1), compute_uv=False)[-1]
@@ -321,12 +316,7 @@ def test_held_wrist_joint_at_a_stretched_elbow_keeps_every_cluster_member():
     # (q4 = 1e-9 or -2.08e-3): q's own root of the elimination was lost in that
     # cluster; general6r.c's g6_reseed (mirrored starts) brings it back. Oracle: q generated the pose and is isolated, so it is among the rows
     # (1e-6 rad), each of which reproduces the pose to 1e-12.
-    rtbdata = pytest.importorskip("rtbdata")
-    from pathlib import Path
-
-    urdf = (Path(rtbdata.__file__).parent
-            / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf")
-    robot = robokin.Robot.from_urdf(str(urdf), geometry=False)
+    robot = rtb_iiwa14()
     q = np.array([1e-09, 1.6343262323207903, 1.5648106360498533, 1e-09,
                   -np.pi / 2, np.pi / 2, -1e-07])
     sigma = np.linalg.svd(np.delete(robot.jacobian(q), 4, axis=1), compute_uv=False)[-1]

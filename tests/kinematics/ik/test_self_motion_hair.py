@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from reference import iiwa14_srs, pose_errors
+from reference import iiwa14_srs, pose_errors, rtb_iiwa14
 from robokin.kinematics.ik.self_motion_hair import HAIR, SAMPLES, hair_bands
 from robokin.spatial import wrap_angle
 
@@ -139,3 +139,20 @@ def test_a_branch_tangent_to_a_limit_gives_its_point_to_best_and_nearest(q_near)
     near = _solution(SRS, T, sm.nearest(qn))
     bound = np.linalg.norm(wrap_angle(TANGENT - qn))
     assert np.linalg.norm(wrap_angle(near - qn)) <= bound + 1e-6
+
+
+def test_a_branch_at_isolated_values_gives_its_row():
+    """Oracle: q0 (inside the limits, on its pose). The rtb-data iiwa14 (not exactly
+    SRS: held at joint_a3) with q2 and q4 within 1e-7 of 0 and q6 at its limit has
+    branch rows at isolated grid values only (one, at t = 0, 4.3e-11 past the limit):
+    ``reachable`` was False, ``best`` and ``nearest`` None (session 25's fuzz, seed 25
+    #5). The hair bands' own grid rows are now candidates: an in-limit solution of the
+    pose for ``best`` and ``nearest``."""
+    robot = rtb_iiwa14()
+    q0 = np.array([0.0, -1e-09, 1e-07, 1e-07, -2.7317217623578154, 2.0942, 1e-06])
+    T = robot.fk(q0)
+    sm = robot.self_motion(T)
+    assert len(sm.intervals) == 0 and sm.reachable
+    _solution(robot, T, sm.best("margin"))
+    near = _solution(robot, T, sm.nearest(q0 + 0.05))
+    assert np.linalg.norm(wrap_angle(near - q0)) <= 1e-4

@@ -71,6 +71,7 @@ from robokin.kinematics.ik.self_motion_families import (
     one_per_point,
 )
 from robokin.kinematics.ik.self_motion_hair import HAIR, hair_bands
+from robokin.kinematics.ik.self_motion_hair import SAMPLES as HAIR_SAMPLES
 from robokin.kinematics.ik.self_motion_intervals import (
     GRID,
     _aligned_values,
@@ -509,10 +510,25 @@ class SelfMotion:
         for crit in (score, inward):
             point = _maximise(self._family, wide, bands, branch, crit, samples)
             if point is None:
-                return None
+                break
             q, err = _at_limits(self._family.robot, point.q, self.T, self.limits)
             if err <= EXACT:
                 return ManifoldPoint(q, point.t, point.branch, float(score(q[None])[0]))
+        # the bands' own grid rows (a branch that exists at isolated values only: the
+        # rtb iiwa14 held at q3 with q2 and q4 within 1e-7 of 0, its one row at t = 0)
+        t = np.linspace(float(self.domain[0]), float(self.domain[1]), HAIR_SAMPLES)
+        rows = self._rows(t)
+        with np.errstate(invalid="ignore"):
+            near = (np.isfinite(rows).all(-1)
+                    & (np.maximum(self.limits[:, 0] - rows, rows - self.limits[:, 1]).max(-1)
+                       <= HAIR))
+        i, b = np.nonzero(near)
+        if not len(i):
+            return None
+        for k in np.argsort(-inward(rows[i, b]), kind="stable")[:3]:
+            q, err = _at_limits(self._family.robot, rows[i[k], b[k]], self.T, self.limits)
+            if err <= EXACT:
+                return ManifoldPoint(q, float(t[i[k]]), int(b[k]), float(score(q[None])[0]))
         return None
 
     def _maximise(self, score: Callable[[np.ndarray], np.ndarray],
