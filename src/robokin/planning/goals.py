@@ -237,9 +237,10 @@ def _manifold_goals(robot: Robot, T: np.ndarray) -> Goals | None:
         return None  # robot.ik says why (or finds what the manifold missed)
     sampler = ManifoldGoals.of(sm)
     q = sampler.round(0)
-    if not len(q):  # inside the limits only at a point of an aligned continuum
+    if not len(q):  # inside the limits only at a point (a continuum's, a hair's)
         best = sm.best("margin")
-        assert best is not None  # (reachable: continua_best found one)
+        if best is None:  # (no in-limit row found after all: robot.ik says why)
+            return None
         return Goals("pose", best.q[None], np.arange(1), T)
     return Goals("pose", q, np.arange(len(q)), T, "", sampler, 1)
 

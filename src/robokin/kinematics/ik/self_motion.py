@@ -70,8 +70,7 @@ from robokin.kinematics.ik.self_motion_families import (
     continued_parameter,
     one_per_point,
 )
-from robokin.kinematics.ik.self_motion_hair import HAIR, hair_bands
-from robokin.kinematics.ik.self_motion_hair import SAMPLES as HAIR_SAMPLES
+from robokin.kinematics.ik.self_motion_hair import HAIR, bands_of, hair_grid
 from robokin.kinematics.ik.self_motion_intervals import (
     GRID,
     _aligned_values,
@@ -339,7 +338,9 @@ class SelfMotion:
         nearer_points``: the numeric solve from ``q_near`` next to a swing, a point of
         an aligned continuum, the branches' aligned-axes rows moved along their
         continua; its ``t`` its parameter value, ``branch`` the branch whose row
-        there is nearest). ``samples`` is not used (kept for callers that pass it).
+        there is nearest). Where none of these has an in-limit point, the best solution
+        next to a branch a hair outside a limit (:meth:`_hair_best`, ``samples``
+        values per band).
         """
         qn = check_finite(check_joints(q_near, self.limits.shape[0], "q_near"), "q_near")
         fam = self._family
@@ -484,8 +485,9 @@ class SelfMotion:
 
         Where the searches of the intervals found no in-limit row: the branches'
         stretches at most :data:`~robokin.kinematics.ik.self_motion_hair.HAIR` outside
-        the limits (``hair_bands``), searched as intervals are (:func:`_maximise`, the
-        limits widened by ``HAIR``), the best row taken back inside the limits onto the
+        the limits (``hair_grid``, ``bands_of``), searched as intervals are
+        (:func:`_maximise`, the limits widened by ``HAIR``), then the bands' own grid
+        rows; the best row taken back inside the limits onto the
         pose (``self_motion_nearest._at_limits``); where that row does not reach the
         pose within ``EXACT`` inside the limits, the best row by the score less 1e6
         times its distance outside (the tangent point of a branch touching a limit)
@@ -496,7 +498,8 @@ class SelfMotion:
         which the swivel kernel gives as an interval of +-0.17 whose other rows are up
         to 2e-6 outside.
         """
-        bands, branch = hair_bands(self._rows, self.domain, self.limits)
+        t, rows, near = hair_grid(self._rows, self.domain, self.limits)
+        bands, branch = bands_of(t, near)
         if not len(bands):
             return None
         wide = self.limits + np.array([-HAIR, HAIR])
@@ -516,15 +519,7 @@ class SelfMotion:
                 return ManifoldPoint(q, point.t, point.branch, float(score(q[None])[0]))
         # the bands' own grid rows (a branch that exists at isolated values only: the
         # rtb iiwa14 held at q3 with q2 and q4 within 1e-7 of 0, its one row at t = 0)
-        t = np.linspace(float(self.domain[0]), float(self.domain[1]), HAIR_SAMPLES)
-        rows = self._rows(t)
-        with np.errstate(invalid="ignore"):
-            near = (np.isfinite(rows).all(-1)
-                    & (np.maximum(self.limits[:, 0] - rows, rows - self.limits[:, 1]).max(-1)
-                       <= HAIR))
         i, b = np.nonzero(near)
-        if not len(i):
-            return None
         for k in np.argsort(-inward(rows[i, b]), kind="stable")[:3]:
             q, err = _at_limits(self._family.robot, rows[i[k], b[k]], self.T, self.limits)
             if err <= EXACT:

@@ -29,7 +29,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["HAIR", "SAMPLES", "hair_bands"]
+__all__ = ["HAIR", "SAMPLES", "bands_of", "hair_bands", "hair_grid"]
 
 #: [rad, m] A branch row at most this far outside its limits (its largest excess) may
 #: have in-limit solutions of the pose next to it: the stretched elbow's rounding
@@ -39,10 +39,10 @@ HAIR = 1e-6
 SAMPLES = 61
 
 
-def hair_bands(rows_at: Callable[[np.ndarray], np.ndarray], domain: np.ndarray,
-               limits: np.ndarray, samples: int = SAMPLES
-               ) -> tuple[np.ndarray, np.ndarray]:
-    """The parameter ranges where a branch is at most :data:`HAIR` outside the limits.
+def hair_grid(rows_at: Callable[[np.ndarray], np.ndarray], domain: np.ndarray,
+              limits: np.ndarray, samples: int = SAMPLES
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The branches' rows on a grid of the parameter and which are within the hair.
 
     Args:
         rows_at: Parameter values (m,) -> every branch's rows (m, k, n), NaN where
@@ -52,15 +52,24 @@ def hair_bands(rows_at: Callable[[np.ndarray], np.ndarray], domain: np.ndarray,
         samples: Grid values over the domain (ends included).
 
     Returns:
+        ``(t (m,), rows (m, k, n), near (m, k))``: ``near`` where a branch's row exists
+        and is at most :data:`HAIR` outside every limit (its largest excess).
+    """
+    t = np.linspace(float(domain[0]), float(domain[1]), samples)
+    rows = rows_at(t)
+    with np.errstate(invalid="ignore"):
+        over = np.maximum(limits[:, 0] - rows, rows - limits[:, 1]).max(-1)  # (m, k)
+    return t, rows, np.isfinite(over) & (over <= HAIR)
+
+
+def bands_of(t: np.ndarray, near: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The runs of ``near`` (m, k) on the grid t (m,) as parameter ranges.
+
+    Returns:
         ``(intervals (p, 2), branch (p,))``: per run of consecutive grid rows of one
         branch within :data:`HAIR` of the limits, widened by one grid step each side
         (clipped to the domain). Empty where there is none.
     """
-    t = np.linspace(float(domain[0]), float(domain[1]), samples)
-    q = rows_at(t)
-    with np.errstate(invalid="ignore"):
-        over = np.maximum(limits[:, 0] - q, q - limits[:, 1]).max(-1)  # (m, k)
-    near = np.isfinite(over) & (over <= HAIR)
     starts, ends, branch = [], [], []
     step = t[1] - t[0]
     for b in np.flatnonzero(near.any(0)):
@@ -71,3 +80,15 @@ def hair_bands(rows_at: Callable[[np.ndarray], np.ndarray], domain: np.ndarray,
             branch.append(b)
     return (np.column_stack([starts, ends]).reshape(-1, 2),
             np.array(branch, dtype=np.int64))
+
+
+def hair_bands(rows_at: Callable[[np.ndarray], np.ndarray], domain: np.ndarray,
+               limits: np.ndarray, samples: int = SAMPLES
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """The parameter ranges where a branch is at most :data:`HAIR` outside the limits.
+
+    :func:`bands_of` the :func:`hair_grid` (its arguments): ``(intervals (p, 2),
+    branch (p,))``, empty where there is none.
+    """
+    t, _, near = hair_grid(rows_at, domain, limits, samples)
+    return bands_of(t, near)
