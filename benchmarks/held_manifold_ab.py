@@ -60,6 +60,8 @@ params = np.ascontiguousarray(panda.self_motion(T[0])._family.params, dtype=np.f
 aligned = np.array([[j, v] for j, v in _aligned_values(panda.arm)],
                    dtype=np.float64).reshape(-1, 2)
 N = len(T)
+# (trees before session 26 have no mode argument; {mode}: HM_MODE_* by name)
+MODE = (getattr(K, "HM_MODE_{mode}"),) if hasattr(K, "HM_MODE_AUTO") else ()
 iv = np.empty((N, 8, K.HM_MAXI, 2))
 niv = np.zeros((N, 8), dtype=np.int64)
 pts = np.empty((N, K.HM_MAXP, 4))
@@ -69,7 +71,7 @@ npts, flags, evals = (np.zeros(N, dtype=np.int64) for _ in range(3))
 def one_pass():
     for i in range(N):
         K.held_manifold(params, T[i:i + 1], aligned, KERNEL_GRID, iv[i:i + 1], niv[i:i + 1],
-                        pts[i:i + 1], npts[i:i + 1], flags[i:i + 1], evals[i:i + 1])
+                        pts[i:i + 1], npts[i:i + 1], flags[i:i + 1], evals[i:i + 1], *MODE)
 
 
 one_pass()
@@ -183,13 +185,16 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=1000)
     ap.add_argument("--special", type=int, default=150)
     ap.add_argument("--tol", type=float, default=1e-12)
+    ap.add_argument("--modes", nargs=2, default=("AUTO", "AUTO"),
+                    help="HM_MODE_* of each tree (AUTO, GRID, CLOSED; trees before session 26 "
+                         "have none): the same tree twice with GRID CLOSED compares the paths")
     a = ap.parse_args()
     tmp = pathlib.Path(tempfile.mkdtemp(prefix="hm_ab_"))
     print("load", pathlib.Path("/proc/loadavg").read_text().split()[:3])
     print("round tree  ms CPU per pose  evals per pose")
     for r in range(a.rounds):
-        for name, tree in zip("AB", a.trees):
-            code = CHILD.format(n=a.n, ns=a.special, repeat=a.repeat,
+        for name, tree, mode in zip("AB", a.trees, a.modes):
+            code = CHILD.format(n=a.n, ns=a.special, repeat=a.repeat, mode=mode.upper(),
                                 out=str(tmp / f"{name}.npz"))
             env = dict(os.environ, PYTHONPATH=tree)  # the tree's src folder
             res = subprocess.run([sys.executable, "-c", code], env=env, check=True,

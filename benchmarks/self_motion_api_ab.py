@@ -81,7 +81,8 @@ npts, flags, evals = (np.zeros(1, dtype=np.int64) for _ in range(3))
 
 
 def kernel(Ti):
-    K.held_manifold(params, Ti[None], aligned, KERNEL_GRID, iv, niv, pts, npts, flags, evals)
+    K.held_manifold(params, Ti[None], aligned, KERNEL_GRID, iv, niv, pts, npts, flags, evals,
+                    K.HM_MODE_GRID)
 
 
 def api(Ti):

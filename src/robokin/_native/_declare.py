@@ -604,13 +604,15 @@ HELD_MANIFOLD = Group("held_manifold.c", kernels=(
                              Arr("pts", "f64", ("N", "HM_MAXP", 4), out=True),
                              Arr("npts", "i64", ("N",), out=True),
                              Arr("flags", "i64", ("N",), out=True),
-                             Arr("evals", "i64", ("N",), out=True)),
+                             Arr("evals", "i64", ("N",), out=True), Int("mode", 0, 2)),
            "None", "Per pose of a held-joint Pieper family (the Panda's q7): the intervals "
                    "inside every limit per slot (N, 8, HM_MAXI, 2) with counts (N, 8); points "
                    "[t, branch, joint, kind] (N, HM_MAXP, 4) with counts (N,); flags (N,) "
                    "(0: certain, else the solved-points path is needed) and pk_one calls (N,).\n\n"
                    "aligned (A, 2): [joint, value] rows where a triple's outer axes line up; grid: "
-                   "values of t on the first grid.",
+                   "values of t on the first grid; mode: HM_MODE_AUTO (the closed forms of "
+                   "held_closed.c where they certify the pose, else the grid), HM_MODE_GRID, "
+                   "HM_MODE_CLOSED (HM_FLAG_BAD where they do not).",
            checks=(Check("pk_params_ok(a->params)", "params is not a Pieper parameter vector"),)),
     Kernel("held_manifold_one", (Arr("params", "f64", ("PK_N_PARAMS",)), Obj("T"),
                                  Arr("aligned", "f64", ("A", 2)), Int("grid", 3, 100000),
@@ -625,7 +627,8 @@ HELD_MANIFOLD = Group("held_manifold.c", kernels=(
            "pose_problem): the caller checks it and calls again.",
            checks=(Check("pk_params_ok(a->params)", "params is not a Pieper parameter vector"),)),
 ), constants=_consts("MAXI MAXP KIND_LOWER KIND_UPPER KIND_ALIGNED KIND_FOLD FLAG_SINGULAR "
-                     "FLAG_UNRESOLVED FLAG_CONVERGE FLAG_FULL FLAG_VANISH FLAG_MEMORY FLAG_BAD",
+                     "FLAG_UNRESOLVED FLAG_CONVERGE FLAG_FULL FLAG_VANISH FLAG_MEMORY FLAG_BAD "
+                     "MODE_AUTO MODE_GRID MODE_CLOSED",
                      "HM_", "HM_"),
     comment="held-joint manifold output sizes, point kinds and flags")
 

@@ -271,6 +271,9 @@ class Kernels(Protocol):
     HM_FLAG_VANISH: int
     HM_FLAG_MEMORY: int
     HM_FLAG_BAD: int
+    HM_MODE_AUTO: int
+    HM_MODE_GRID: int
+    HM_MODE_CLOSED: int
     # near_coincident.c: near-coincident held joint: Newton and acceptance constants, seeds per row
     NC_RCOND: float
     NC_FINAL_RCOND: float
@@ -745,11 +748,12 @@ class Kernels(Protocol):
         npts: I64,
         flags: I64,
         evals: I64,
+        mode: int,
         /,
     ) -> None:
         """Per pose of a held-joint Pieper family (the Panda's q7): the intervals inside every limit per slot (N, 8, HM_MAXI, 2) with counts (N, 8); points [t, branch, joint, kind] (N, HM_MAXP, 4) with counts (N,); flags (N,) (0: certain, else the solved-points path is needed) and pk_one calls (N,).
 
-        aligned (A, 2): [joint, value] rows where a triple's outer axes line up; grid: values of t on the first grid.
+        aligned (A, 2): [joint, value] rows where a triple's outer axes line up; grid: values of t on the first grid; mode: HM_MODE_AUTO (the closed forms of held_closed.c where they certify the pose, else the grid), HM_MODE_GRID, HM_MODE_CLOSED (HM_FLAG_BAD where they do not).
         """
 
     def held_manifold_one(

@@ -485,7 +485,8 @@ def _batch_kernel(kern, T):
     niv = np.zeros((1, 8), dtype=np.int64)
     pts = np.empty((1, K.HM_MAXP, 4))
     npts, flags, evals = (np.zeros(1, dtype=np.int64) for _ in range(3))
-    K.held_manifold(kern.params, T[None], kern.aligned, 181, iv, niv, pts, npts, flags, evals)
+    K.held_manifold(kern.params, T[None], kern.aligned, 181, iv, niv, pts, npts, flags, evals,
+                    K.HM_MODE_GRID)
     intervals = np.concatenate([iv[0, b, :niv[0, b]] for b in range(8)]).reshape(-1, 2)
     return (intervals, np.repeat(np.arange(8), niv[0]), pts[0, :npts[0]], int(flags[0]),
             int(evals[0]))

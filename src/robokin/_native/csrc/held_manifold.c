@@ -69,10 +69,11 @@
  * pose and up to 7 s per special Gen3-like pose (issue 29, helper quartic29).
  */
 
-#define HM_MAXI 40      /* intervals per branch */
-#define HM_MAXP 512     /* points per pose */
 #define HM_MAXQ 24      /* (joint, value) queries */
 #define HM_MAXCUT 256   /* cuts per branch */
+#include "brent.h"
+#include "held_outputs.h"
+
 #define HM_JUMP 0.5     /* a joint moving more than this [rad] in a cell: split */
 #define HM_DEPTH 14     /* splits of a grid cell */
 /* A cell still to be split at HM_DEPTH that is no slot change, where the slot's q2 is
@@ -125,9 +126,6 @@
                         * (6: 31 of 181 nodes, t = 0 among them, as on the fine grid) */
 #endif
 
-enum { HM_KIND_LOWER = 0, HM_KIND_UPPER = 1, HM_KIND_ALIGNED = 2, HM_KIND_FOLD = 3 };
-enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FLAG_FULL = 8,
-       HM_FLAG_VANISH = 16, HM_FLAG_MEMORY = 32, HM_FLAG_BAD = 64 };
 
 
 #define HM_MEMO 64 /* recent evaluations kept (hm_recall) */
@@ -2163,66 +2161,29 @@ static void hm_fold_piece(HmCtx *c, int b, const HmRow *re, const HmRow *rn, int
 
 static int hm_margins_d(HmCtx *c, double x, double *m, double *d);
 
+/* hm_margin_root's function: the discriminant of subproblem k minus off at x */
+typedef struct {
+    HmCtx *c;
+    int k;
+    double off;
+} HmMarginArg;
+
+static double hm_margin_at(void *arg, double x)
+{
+    HmMarginArg *m = arg;
+    double mv[3], dk[3];
+    hm_margins_d(m->c, x, mv, dk);
+    return dk[m->k] - m->off;
+}
+
 /* The t in (a, e) where the discriminant of subproblem k (hm_margins_d's d[k]) is
- * `off`, fa and fe its values minus off there, of opposite signs: Brent's method
- * (inverse quadratic / secant steps safeguarded by bisection) until the bracket is
- * 1e-15 (relative to max(1, |t|)) wide or a value is 0; no rows. NaN when a
- * discriminant is not finite inside. */
+ * `off`, fa and fe its values minus off there, of opposite signs: brent_root, no
+ * rows. NaN when a discriminant is not finite inside. */
 static double hm_margin_root(HmCtx *ctx, int k, double off, double a,
                              double fa, double e, double fe)
 {
-    double m[3], dk[3], c = a, fc = fa, d = e - a, g = d;
-    for (int it = 0; it < 100; it++) {
-        if ((fe > 0) == (fc > 0)) {
-            c = a;
-            fc = fa;
-            d = g = e - a;
-        }
-        if (fabs(fc) < fabs(fe)) {
-            a = e;
-            e = c;
-            c = a;
-            fa = fe;
-            fe = fc;
-            fc = fa;
-        }
-        double tol = 0.5e-15 * fmax(1.0, fabs(e)), mid = 0.5 * (c - e);
-        if (fabs(mid) <= tol || fe == 0.0)
-            return e;
-        if (fabs(g) >= tol && fabs(fa) > fabs(fe)) {
-            double s = fe / fa, p, q;
-            if (a == c) {
-                p = 2.0 * mid * s;
-                q = 1.0 - s;
-            } else {
-                double r = fe / fc, u = fa / fc;
-                p = s * (2.0 * mid * u * (u - r) - (e - a) * (r - 1.0));
-                q = (u - 1.0) * (r - 1.0) * (s - 1.0);
-            }
-            if (p > 0.0)
-                q = -q;
-            else
-                p = -p;
-            if (2.0 * p < fmin(3.0 * mid * q - fabs(tol * q), fabs(g * q))) {
-                g = d;
-                d = p / q;
-            } else {
-                d = mid;
-                g = d;
-            }
-        } else {
-            d = mid;
-            g = d;
-        }
-        a = e;
-        fa = fe;
-        e += fabs(d) > tol ? d : copysign(tol, mid);
-        hm_margins_d(ctx, e, m, dk);
-        fe = dk[k] - off;
-        if (!isfinite(fe))
-            return NAN;
-    }
-    return NAN;
+    HmMarginArg arg = {ctx, k, off};
+    return brent_root(hm_margin_at, &arg, a, fa, e, fe);
 }
 
 /* Slot b's branch end in (r0, r1) from the existence margins: its position root
@@ -3008,7 +2969,7 @@ static void hm_pose(HmCtx *c, long G, double *iv, long long *niv)
 
 typedef struct {
     const double *P, *T, *al;
-    long nal, G;
+    long nal, G, mode; /* HM_MODE_* */
     double *iv, *pts;
     long long *niv, *npts, *flags, *evals;
 } HmJob;
@@ -3019,6 +2980,29 @@ static void hm_range(void *ctx, long b0, long e0)
     const HmJob *jb = ctx;
     const double *P = jb->P;
     for (long i = b0; i < e0; i++) {
+        if (jb->mode != HM_MODE_GRID) { /* held_closed.c's closed forms first */
+            long npts = 0, rows = 0;
+            if (P[PK_CASE] != PK_BOTH && hc_pose(P, jb->T + 16 * i, jb->al, jb->nal,
+                                                 jb->iv + 2 * HM_MAXI * 8 * i, jb->niv + 8 * i,
+                                                 jb->pts + 4 * HM_MAXP * i, &npts, &rows)) {
+                jb->npts[i] = npts;
+                jb->flags[i] = 0;
+#ifdef HM_COUNT_CHEAP
+                jb->evals[i] = rows; /* a measuring build: every row evaluation */
+#else
+                jb->evals[i] = 1; /* its one pk_one call (hc_slots_agree) */
+#endif
+                continue;
+            }
+            if (jb->mode == HM_MODE_CLOSED) {
+                for (int b = 0; b < 8; b++)
+                    jb->niv[8 * i + b] = 0;
+                jb->npts[i] = 0;
+                jb->flags[i] = HM_FLAG_BAD;
+                jb->evals[i] = 0;
+                continue;
+            }
+        }
         HmCtx *c = malloc(sizeof(HmCtx));
         if (c == NULL) {
             jb->flags[i] = HM_FLAG_MEMORY;
@@ -3109,8 +3093,8 @@ static void hm_range(void *ctx, long b0, long e0)
  * points [t, branch, joint, kind], the flags (0: certain) and pk_one calls. */
 static PyObject *held_manifold_body(const held_manifold_args *a)
 {
-    HmJob jb = {a->params, a->T, a->aligned, (long)a->A, (long)a->grid, a->iv, a->pts,
-                a->niv, a->npts, a->flags, a->evals};
+    HmJob jb = {a->params, a->T, a->aligned, (long)a->A, (long)a->grid, (long)a->mode, a->iv,
+                a->pts, a->niv, a->npts, a->flags, a->evals};
     Py_BEGIN_ALLOW_THREADS
     if (a->N >= HM_PARALLEL_MIN)
         pool_for((long)a->N, HM_GRAIN, hm_range, &jb);
@@ -3146,7 +3130,8 @@ static PyObject *held_manifold_one_body(const held_manifold_one_args *a)
     double *pts = iv + 8 * stride;
     long long niv[8] = {0}, npts = 0, flags = 0, evals = 0, m = 0; /* (hm_range sets niv
                                                                       * only where it runs hm_pose) */
-    HmJob jb = {a->params, T, a->aligned, (long)a->A, (long)a->grid, iv, pts, niv, &npts,
+    HmJob jb = {a->params, T, a->aligned, (long)a->A, (long)a->grid, HM_MODE_GRID, iv, pts, niv,
+                &npts,
                 &flags, &evals};
     Py_BEGIN_ALLOW_THREADS
     hm_range(&jb, 0, 1);

@@ -1,0 +1,1426 @@
+/*
+ * The whole self-motion of one pose of a Panda-kind arm from closed forms (issue 29,
+ * session 26): held_manifold.c's outputs (intervals per slot, points, flags) for the
+ * arms whose held joint is the last (q7 = t), whose axes 1-3 meet in S with axes 1
+ * and 3 on one line at zero (axis 2 normal to it: the shoulder's angles are Euler
+ * angles) and whose axes 5 and 6 meet in W (the Panda, the FR3). held_manifold.c
+ * takes every pose this file does not certify (hc_pose returns 0).
+ *
+ * On the product of exponentials T = e1 ... e7 M (chain values v_k, x = v_7), with
+ * p(x) = e7(x) M T^-1 S (S's image: a circle about axis 7) and v = p - W:
+ *
+ *   E1  |v(x)|^2 = D(x) = d0 + d1 cos x + d2 sin x equals |e4(-v4) S - W|^2 =
+ *       K + c1 cos v4 + c2 sin v4: v4's two roots (i = 0: phi + acos, 1: phi - acos);
+ *       its branch ends (D - K = +-|c|) and v4 = L are roots of a cos x + b sin x = c;
+ *   E2  the height of v along axis 5 after axis 6: f0 + f1 cos v6 + f2 sin v6 = e(v4)
+ *       = e0 + e1 cos v4 + e2 sin v4 (f's affine in cos x, sin x): v6's two roots
+ *       (j); v6 = L, and v5 = L (the height along axis 6 of e5(-L) (e4(-v4) S - W)
+ *       equals v's), are with E1 two linear equations in (cos v4, sin v4) whose
+ *       solution on the unit circle is a quartic in tan(x / 2); E2's branch ends
+ *       (its discriminant's roots along each v4 root) are found on its margin, no
+ *       rows (Brent);
+ *   v5  subproblem 1 about axis 5; the shoulder R = R1 R2 R3 = R_T R_M^T R7(-x)
+ *       R6(-v6) R5(-v5) R4(-v4): with e1 = h1 (= h3), e2 = h2, ea = e2 x e1, w = R e1
+ *       and r = R^T e1, v2 = atan2(|(w.ea, w.e2)|, w.e1), v1 = atan2(w.e2, w.ea), v3 =
+ *       atan2(r.e2, -r.ea) (the triple's other solution: v1 + pi, -v2, v3 + pi).
+ *
+ * Every crossing of a shoulder joint (a limit, an aligned value) is a root of a
+ * smooth function of x along a position branch (i, j), both triples at once: v1 = L
+ * of -sin L w.ea + cos L w.e2, v2 = +-L of w.e1 - cos L, v3 = L of cos L r.e2 + sin L
+ * r.ea (its triple from the sign of the other component). Each is bracketed on nodes
+ * of the branch's pieces (between branch ends and the range's ends: nodes evenly
+ * spaced in xi, x = a + (b - a)(1 - cos pi xi) / 2, where the rows are smooth at a
+ * branch end: they move as its square root) with the functions' slopes (the joint
+ * rates from E1, E2 and v5's equation, the shoulder's angular velocity), cells split
+ * while a cubic Hermite model is ambiguous, and refined by safeguarded Newton.
+ * A piece of a slot between consecutive events is decided at its midpoint. A limit
+ * crossing in a cell where another joint of its triple is outside all over it (at
+ * both ends, and no event of that joint between) bounds nothing and is not located
+ * (held_manifold.c's dead cells); the crossings listed are those with every other
+ * joint inside (the ones SelfMotion.crossings keeps), the aligned points and branch
+ * ends every one.
+ *
+ * Not certified (0: held_manifold.c's grid instead, ~2.5 % of uniform Panda poses,
+ * ~45 % of poses with joints at special values): a branch within HC_ALIGNED of an
+ * aligned shoulder (1 - |cos v2|: q1 and q3 swing there) or a wrist aligned point with
+ * a second wrist joint at its aligned value; a limit function at 0 at a node or at a
+ * located extremum (a touch; an isolated in-limit row), a closed-form root pair near
+ * double; events of a slot within HC_CORNER of each other or of a piece's end, a joint
+ * at a limit at a piece's end (a corner: the generating configuration at two limits,
+ * or at a limit and a branch end); a cell not resolved in HC_DEPTH splits, a crossing
+ * not at its value to HC_AT (HC_AT_STEEP where x's last bit moves it more); pk_one's
+ * slots not these (checked on one row: hc_slots_agree); a degenerate coefficient.
+ * Measured against the grid on 4,000 uniform and 2,000 special poses (session 26,
+ * held_manifold_ab.py --modes GRID CLOSED): the same intervals on every pose both
+ * certify, ends within 1.4e-10 at branch ends (the grid's bisection on pk_one's rows
+ * to HM_FOLD_TOL; these are the margins' roots) and 2.9e-11 elsewhere.
+ */
+
+#include "brent.h"
+#include "held_outputs.h"
+
+#define HC_NODES 12      /* nodes per piece (its ends included) before splits */
+#define HC_MNODES 33     /* nodes per piece of E1 for E2's margin, before splits */
+#define HC_DEPTH 10      /* splits of a cell */
+#define HC_MAXE 64       /* events per branch (i, j) */
+#define HC_MAXPC 12      /* pieces per branch */
+#define HC_MAXQ 12       /* shoulder functions */
+#define HC_ALIGNED 1e-6  /* 1 - |cos v2| below this on a branch: not certified */
+#define HC_CLOSE 1e-9    /* closed-form roots this close: one */
+#define HC_CORNER 1e-6   /* events of one slot this close (or an end): the grid's */
+#define HC_TOUCH 1e-7    /* a model's extremum this close to 0: split (at HC_DEPTH: the grid's) */
+#define HC_DIP 0.5       /* a model's extremum toward 0 below this share of its ends: located */
+#define HC_AT_FOLD 1e-5  /* a joint this close to a limit at a branch end (rows as its square root) */
+#define HC_WRIST_ALIGNED 1e-4 /* |sin| of a second wrist joint at a wrist aligned point: the grid's */
+#define HC_AT_NODE 1e-9  /* a limit function this close to 0 at a node or extremum: the grid's */
+#define HC_DIP_WIDTH 1e-6 /* an extremum toward 0 still unresolved in a cell this narrow */
+#define HC_DOUBLE 1e-4   /* closed-form roots this close to double: the grid's */
+#define HC_END_XI 1e-4   /* a branch end's slopes from this far in (in xi) */
+#define HC_AT 1e-12      /* a crossing's joint at its value to this [rad] */
+#define HC_AT_STEEP 1e-9 /* the same where the last bit of x moves the joint more */
+#define HC_DECIDE 1e-9   /* a midpoint row this far inside / outside decides its piece */
+#define HC_BEND 1.0      /* E2's margin: slopes off the chord by more than this share: split */
+#define HC_BEND_FLOOR 1e-2
+#define HC_MOVE 0.25     /* a function moving more than this in a cell: split */
+#define HC_END_SPLITS 4  /* splits of a cell at a branch end (no slope there) */
+
+typedef struct {
+    v3 h[7], o[7], S, Wc, e1, e2, ea, a0, a1, a2, h56x;
+    m3 RM;
+    v3 tM;
+    double K, c1, c2, cn, ec[3], h56, L;
+    double sign[7], off[7], lo[7], hi[7];
+} HcGeo;
+
+typedef struct {
+    const HcGeo *g;
+    v3 v[3];             /* v(x) = v[0] + cos x v[1] + sin x v[2] */
+    double d[3], f0[3], f1[3], f2[3], h6v[3];
+    m3 RG0;              /* R_T R_M^T */
+    v3 g1;               /* RG0^T e1 */
+    double xlo, xhi;     /* x's range (chain values) */
+} HcPose;
+
+/* One position branch's row at x: the joint chain values, the shoulder's w, r and
+ * their slopes d/dx (slopes only when asked and finite). */
+typedef struct {
+    double x, cs[7][2], dv[7], noise; /* noise: v5's rounding [rad] */
+    double q[2][7];   /* joint values of both triples (hc_rowq; q[0][0] NaN until then) */
+    v3 w, r, dw, dr;
+    int sloped;
+} HcRow;
+
+static inline double hc_aff(const double *a, double c, double s) { return a[0] + a[1] * c + a[2] * s; }
+static inline double hc_daff(const double *a, double c, double s) { return -a[1] * s + a[2] * c; }
+
+/* The geometry from Pieper's parameter vector: 0 when the arm is not of this kind. */
+static int hc_geo(const double *P, HcGeo *g)
+{
+    if ((int)P[PK_N] != 7 || (int)P[PK_HELD] != 6 || (int)P[PK_CASE] != PK_START)
+        return 0;
+    double L = P[PK_SCALE];
+    g->L = L;
+    for (int k = 0; k < 7; k++) {
+        g->h[k] = v3_at(P, PK_AXES + 3 * k);
+        g->o[k] = v3_at(P, PK_POINTS + 3 * k);
+        g->sign[k] = P[PK_SIGN + k];
+        g->off[k] = P[PK_OFFSET + k];
+        g->lo[k] = P[PK_LO + k];
+        g->hi[k] = P[PK_HI + k];
+        if (fabs(g->sign[k]) != 1.0 || !(g->hi[k] - g->lo[k] < 2.0 * M_PI))
+            return 0;
+    }
+    g->RM = (m3){v3_at(P, PK_TOOL_R), v3_at(P, PK_TOOL_R + 3), v3_at(P, PK_TOOL_R + 6)};
+    g->tM = v3_at(P, PK_TOOL_T);
+    g->S = v3_at(P, PK_POINT);
+    /* axes 1 and 3 one line through S, axis 2 normal to it */
+    if (!(v3_dot(g->h[0], g->h[2]) > 1.0 - 1e-14) || !(fabs(v3_dot(g->h[0], g->h[1])) < 1e-14))
+        return 0;
+    for (int k = 0; k < 3; k++)
+        if (!(v3_norm(v3_cross(g->h[k], v3_sub(g->S, g->o[k]))) < 1e-12 * L))
+            return 0;
+    g->e1 = g->h[0];
+    g->e2 = g->h[1];
+    g->ea = v3_cross(g->e2, g->e1);
+    /* W: axes 5 and 6 meet */
+    v3 n = v3_cross(g->h[4], g->h[5]);
+    double nn = v3_dot(n, n);
+    if (!(nn > 1e-6))
+        return 0;
+    v3 d = v3_sub(g->o[5], g->o[4]);
+    double s = v3_dot(v3_cross(d, g->h[5]), n) / nn;
+    g->Wc = v3_add(g->o[4], v3_scale(g->h[4], s));
+    if (!(v3_norm(v3_cross(g->h[5], v3_sub(g->Wc, g->o[5]))) < 1e-12 * L))
+        return 0;
+    /* E1: |a0 + cos v4 a1 + sin v4 a2|^2 = K + c1 cos v4 + c2 sin v4 */
+    v3 h4 = g->h[3], a = v3_sub(g->S, g->o[3]);
+    v3 apar = v3_scale(h4, v3_dot(h4, a));
+    g->a0 = v3_add(v3_sub(g->o[3], g->Wc), apar);
+    g->a1 = v3_sub(a, apar);
+    g->a2 = v3_scale(v3_cross(h4, a), -1.0);
+    g->K = v3_dot(g->a0, g->a0) + v3_dot(g->a1, g->a1);
+    g->c1 = 2.0 * v3_dot(g->a0, g->a1);
+    g->c2 = 2.0 * v3_dot(g->a0, g->a2);
+    g->cn = hypot(g->c1, g->c2);
+    if (!(g->cn > 1e-9 * L * L))
+        return 0;
+    v3 h5 = g->h[4];
+    g->ec[0] = v3_dot(h5, g->a0);
+    g->ec[1] = v3_dot(h5, g->a1);
+    g->ec[2] = v3_dot(h5, g->a2);
+    g->h56 = v3_dot(h5, g->h[5]);
+    g->h56x = v3_cross(h5, g->h[5]);
+    return 1;
+}
+
+/* The pose's coefficients; 0 when a coefficient is degenerate. */
+static int hc_setup(const HcGeo *g, const double *T, HcPose *p)
+{
+    p->g = g;
+    m3 RT = {{T[0], T[1], T[2]}, {T[4], T[5], T[6]}, {T[8], T[9], T[10]}};
+    v3 pT = {T[3], T[7], T[11]};
+    /* p0 = M T^-1 S */
+    v3 ts = m3_mtv(&RT, v3_sub(g->S, pT));
+    v3 p0 = v3_add(m3_mv(&g->RM, ts), g->tM);
+    v3 h7 = g->h[6], B = v3_sub(p0, g->o[6]);
+    v3 Bpar = v3_scale(h7, v3_dot(h7, B));
+    p->v[0] = v3_add(v3_sub(g->o[6], g->Wc), Bpar);
+    p->v[1] = v3_sub(B, Bpar);
+    p->v[2] = v3_cross(h7, B);
+    p->d[0] = v3_dot(p->v[0], p->v[0]) + v3_dot(p->v[1], p->v[1]);
+    p->d[1] = 2.0 * v3_dot(p->v[0], p->v[1]);
+    p->d[2] = 2.0 * v3_dot(p->v[0], p->v[2]);
+    v3 h5 = g->h[4], h6 = g->h[5];
+    for (int k = 0; k < 3; k++) {
+        double hv = v3_dot(h6, p->v[k]);
+        p->h6v[k] = hv;
+        p->f0[k] = g->h56 * hv;
+        p->f1[k] = v3_dot(h5, p->v[k]) - p->f0[k];
+        p->f2[k] = v3_dot(p->v[k], g->h56x);
+    }
+    /* R_G0 = R_T R_M^T (rows) */
+    for (int r = 0; r < 3; r++) {
+        v3 row = r == 0 ? RT.r0 : r == 1 ? RT.r1 : RT.r2;
+        v3 out = m3_mv(&g->RM, row); /* (R_T R_M^T)[r][c] = row . RM row c */
+        if (r == 0)
+            p->RG0.r0 = out;
+        else if (r == 1)
+            p->RG0.r1 = out;
+        else
+            p->RG0.r2 = out;
+    }
+    p->g1 = m3_mtv(&p->RG0, g->e1);
+    double a = g->sign[6] * g->lo[6] + g->off[6], b = g->sign[6] * g->hi[6] + g->off[6];
+    p->xlo = fmin(a, b);
+    p->xhi = fmax(a, b);
+    return isfinite(p->d[0] + p->d[1] + p->d[2]);
+}
+
+/* cos, sin of a root of A cos v + B sin v = C (|(A, B)| = n), root i (0: phi + acos,
+ * 1: phi - acos), with gamma = C / n clamped to [-1, 1]; sigma = sin(acos gamma) */
+static inline void hc_root(double A, double B, double n, double C, int i, double *c,
+                           double *s, double *sigma)
+{
+    double ca = A / n, sa = B / n, gm = C / n;
+    gm = gm > 1.0 ? 1.0 : gm < -1.0 ? -1.0 : gm;
+    double sg = sqrt(1.0 - gm * gm);
+    if (i)
+        sg = -sg;
+    *c = ca * gm - sa * sg;
+    *s = sa * gm + ca * sg;
+    *sigma = sg;
+}
+
+/* E1's margin at x (|c| - |D - K|: >= 0 where v4 has roots) */
+static inline double hc_m1(const HcPose *p, double c, double s)
+{
+    return p->g->cn - fabs(hc_aff(p->d, c, s) - p->g->K);
+}
+
+/* E2's margin of v4 root i at x (>= 0 where v6 has roots), its slope when dm != NULL */
+static double hc_m2(const HcPose *p, double x, int i, double *dm)
+{
+    const HcGeo *g = p->g;
+    double c = cos(x), s = sin(x), c4, s4, sg;
+    double D = hc_aff(p->d, c, s);
+    hc_root(g->c1, g->c2, g->cn, D - g->K, i, &c4, &s4, &sg);
+    double e = g->ec[0] + g->ec[1] * c4 + g->ec[2] * s4;
+    double f0 = hc_aff(p->f0, c, s), f1 = hc_aff(p->f1, c, s), f2 = hc_aff(p->f2, c, s);
+    double H = sqrt(f1 * f1 + f2 * f2), E = e - f0;
+    if (dm != NULL) {
+        double dv4 = hc_daff(p->d, c, s) / (-g->c1 * s4 + g->c2 * c4);
+        double de = (-g->ec[1] * s4 + g->ec[2] * c4) * dv4;
+        double dH = (f1 * hc_daff(p->f1, c, s) + f2 * hc_daff(p->f2, c, s)) / H;
+        *dm = dH - copysign(1.0, E) * (de - hc_daff(p->f0, c, s));
+    }
+    return H - fabs(E);
+}
+
+/* Branch (i, j)'s row at x; 0 when it has none (a margin below -tol). */
+static int hc_eval(const HcPose *p, double x, int i, int j, int slopes, HcRow *r)
+{
+    const HcGeo *g = p->g;
+    double c = cos(x), s = sin(x);
+    double D = hc_aff(p->d, c, s), c4, s4, s4g;
+    r->x = x;
+    if (!(g->cn - fabs(D - g->K) >= -1e-12 * g->cn))
+        return 0;
+    hc_root(g->c1, g->c2, g->cn, D - g->K, i, &c4, &s4, &s4g);
+    v3 x4 = v3_add(g->a0, v3_add(v3_scale(g->a1, c4), v3_scale(g->a2, s4)));
+    double e = g->ec[0] + g->ec[1] * c4 + g->ec[2] * s4;
+    double f0 = hc_aff(p->f0, c, s), f1 = hc_aff(p->f1, c, s), f2 = hc_aff(p->f2, c, s);
+    double H = sqrt(f1 * f1 + f2 * f2);
+    if (!(H > 0.0) || !(H - fabs(e - f0) >= -1e-12 * H))
+        return 0;
+    double c6, s6, s6g;
+    hc_root(f1, f2, H, e - f0, j, &c6, &s6, &s6g);
+    v3 v = v3_add(p->v[0], v3_add(v3_scale(p->v[1], c), v3_scale(p->v[2], s)));
+    v3 h4 = g->h[3], h5 = g->h[4], h6 = g->h[5], h7 = g->h[6];
+    v3 u6 = v3_rot(h6, c6, s6, v);
+    /* v5: e5(-v5) x4 = u6 (the turn about axis 5 taking x4 to u6 is -v5) */
+    v3 xp = v3_sub(x4, v3_scale(h5, v3_dot(h5, x4))), up = v3_sub(u6, v3_scale(h5, v3_dot(h5, u6)));
+    double yy = v3_dot(h5, v3_cross(xp, up)), xx = v3_dot(xp, up);
+    double nn = sqrt(yy * yy + xx * xx);
+    if (!(nn > 1e-9 * g->cn))
+        return 0;
+    double c5 = xx / nn, s5 = -yy / nn;
+    /* v5's rounding: x4 and u6 next to axis 5 leave only their small normal parts */
+    r->noise = 4.0 * DBL_EPSILON * (sqrt(v3_dot(x4, x4) * v3_dot(u6, u6)) / nn +
+                                    1.0 / fabs(s4g) + 1.0 / fabs(s6g)); /* + acos at an end */
+    r->cs[3][0] = c4;
+    r->cs[3][1] = s4;
+    r->cs[4][0] = c5;
+    r->cs[4][1] = s5;
+    r->cs[5][0] = c6;
+    r->cs[5][1] = s6;
+    /* w = R e1, R = RG0 R7(-x) R6(-v6) R5(-v5) R4(-v4); r = R^T e1 */
+    v3 w = v3_rot(h4, c4, -s4, g->e1);
+    w = v3_rot(h5, c5, -s5, w);
+    w = v3_rot(h6, c6, -s6, w);
+    w = v3_rot(h7, c, -s, w);
+    w = m3_mv(&p->RG0, w);
+    v3 rr = v3_rot(h7, c, s, p->g1);
+    rr = v3_rot(h6, c6, s6, rr);
+    rr = v3_rot(h5, c5, s5, rr);
+    rr = v3_rot(h4, c4, s4, rr);
+    r->w = w;
+    r->r = rr;
+    r->sloped = 0;
+    r->q[0][0] = NAN; /* hc_rowq's, when asked */
+    if (!slopes)
+        return 1;
+    /* joint rates d/dx: E1, E2, v5's equation (m = R5(v5) h6: m . x4 = h6 . v) */
+    double den4 = -g->c1 * s4 + g->c2 * c4;
+    double dv4 = hc_daff(p->d, c, s) / den4;
+    double de = (-g->ec[1] * s4 + g->ec[2] * c4) * dv4;
+    double den6 = -f1 * s6 + f2 * c6;
+    double dv6 = (de - hc_daff(p->f0, c, s) - hc_daff(p->f1, c, s) * c6 -
+                  hc_daff(p->f2, c, s) * s6) / den6;
+    v3 m = v3_rot(h5, c5, s5, h6);
+    v3 dx4 = v3_scale(v3_add(v3_scale(g->a1, -s4), v3_scale(g->a2, c4)), dv4);
+    v3 dv = v3_add(v3_scale(p->v[1], -s), v3_scale(p->v[2], c));
+    double den5 = v3_dot(v3_cross(h5, m), x4);
+    double dv5 = (v3_dot(h6, dv) - v3_dot(m, dx4)) / den5;
+    /* the shoulder's angular velocity: spatial om = -RG inner, body -R4 R5 R6 inner */
+    v3 in = v3_add(v3_scale(v3_rot(h5, c5, -s5, h4), dv4), v3_scale(h5, dv5));
+    in = v3_add(v3_rot(h6, c6, -s6, in), v3_add(v3_scale(h6, dv6), h7));
+    v3 om = v3_scale(m3_mv(&p->RG0, v3_rot(h7, c, -s, in)), -1.0);
+    v3 ob = v3_rot(h6, c6, s6, in);
+    ob = v3_rot(h5, c5, s5, ob);
+    ob = v3_scale(v3_rot(h4, c4, s4, ob), -1.0);
+    r->dw = v3_cross(om, w);
+    r->dr = v3_scale(v3_cross(ob, rr), -1.0);
+    r->dv[3] = dv4;
+    r->dv[4] = dv5;
+    r->dv[5] = dv6;
+    r->dv[6] = 1.0;
+    r->sloped = isfinite(dv4) && isfinite(dv5) && isfinite(dv6) && isfinite(om.x + om.y + om.z);
+    return 1;
+}
+
+/* Chain values of a row, triple k (0: v2 >= 0; 1: the other) */
+static void hc_angles(const HcPose *p, const HcRow *r, int k, double *v)
+{
+    const HcGeo *g = p->g;
+    double wa = v3_dot(r->w, g->ea), wb = v3_dot(r->w, g->e2), wc = v3_dot(r->w, g->e1);
+    double ra = v3_dot(r->r, g->ea), rb = v3_dot(r->r, g->e2);
+    v[0] = fast_atan2(wb, wa);
+    v[1] = fast_atan2(sqrt(wa * wa + wb * wb), wc);
+    v[2] = fast_atan2(rb, -ra);
+    if (k) {
+        v[0] = wrap_pi(v[0] + M_PI);
+        v[1] = -v[1];
+        v[2] = wrap_pi(v[2] + M_PI);
+    }
+    for (int j = 3; j < 6; j++)
+        v[j] = fast_atan2(r->cs[j][1], r->cs[j][0]);
+    v[6] = r->x;
+}
+
+/* Joint values q (into the limits by whole turns where that fits) of chain values v;
+ * returns the least margin to a limit over the joints other than `skip` (negative:
+ * outside) */
+static double hc_joints(const HcGeo *g, const double *v, int skip, double *q)
+{
+    double margin = INFINITY;
+    for (int j = 0; j < 7; j++) {
+        int in;
+        q[j] = joint_value(v[j], g->sign[j], g->off[j], g->lo[j], g->hi[j], &in);
+        if (j == 6)
+            q[j] = g->sign[j] * (v[j] - g->off[j]);
+        if (j != skip && j != 6) /* (x is in the held joint's range by construction) */
+            margin = fmin(margin, fmin(q[j] - g->lo[j], g->hi[j] - q[j]));
+    }
+    return margin;
+}
+
+/* Row r's joint values of both triples (into r->q) and each triple's least margin */
+static void hc_rowq(const HcPose *p, HcRow *r, double *margin)
+{
+    for (int k = 0; k < 2; k++) {
+        double v[7];
+        hc_angles(p, r, k, v);
+        margin[k] = hc_joints(p->g, v, -1, r->q[k]);
+    }
+}
+
+/* A shoulder function: joint j (0-2) at chain value V (kind: HM_KIND_*; -1: the
+ * aligned-shoulder guard, |cos v2| = 1) */
+typedef struct {
+    int j, kind, twin; /* twin: v2's other limit at -V (its crossings the other triple's) */
+    double V, cV, sV;
+} HcQuery;
+
+/* Query q's value on row r, its slope d/dx when ds != NULL, and the triple a root of
+ * it belongs to (*k) */
+static double hc_f(const HcPose *p, const HcQuery *q, const HcRow *r, double *ds, int *k)
+{
+    const HcGeo *g = p->g;
+    double f, d = NAN, side;
+    if (q->j == 0) {
+        double a = v3_dot(r->w, g->ea), b = v3_dot(r->w, g->e2);
+        f = -q->sV * a + q->cV * b;
+        side = q->cV * a + q->sV * b;
+        if (ds != NULL)
+            d = -q->sV * v3_dot(r->dw, g->ea) + q->cV * v3_dot(r->dw, g->e2);
+    } else if (q->j == 1) {
+        f = v3_dot(r->w, g->e1) - q->cV;
+        side = q->V;
+        if (ds != NULL)
+            d = v3_dot(r->dw, g->e1);
+    } else {
+        double a = v3_dot(r->r, g->ea), b = v3_dot(r->r, g->e2);
+        f = q->cV * b + q->sV * a;
+        side = -q->cV * a + q->sV * b;
+        if (ds != NULL)
+            d = q->cV * v3_dot(r->dr, g->e2) + q->sV * v3_dot(r->dr, g->ea);
+    }
+    if (ds != NULL)
+        *ds = d;
+    if (k != NULL)
+        *k = side > 0.0 ? 0 : 1;
+    return f;
+}
+
+/* ------------------------------------------------------------------ events */
+
+typedef struct {
+    double x;
+    int j, kind, k; /* k: the triple (-1: both) */
+} HcEvent;
+
+typedef struct {
+    const double *T;
+    HcPose p;
+    HcQuery q[HC_MAXQ];
+    int nq, bad;
+    HcEvent ev[4][HC_MAXE]; /* per position branch 2 i + j */
+    int nev[4];
+    double cut[4][2 * HC_MAXPC]; /* the branch's piece ends (x), as pairs */
+    int cutfold[4][2 * HC_MAXPC]; /* whether that end is a branch end */
+    int npc[4];
+    long rows; /* row evaluations (a measuring build's evals: HM_COUNT_CHEAP) */
+} HcCtx;
+
+static void hc_add(HcCtx *c, int bj, double x, int j, int kind, int k)
+{
+    if (c->nev[bj] >= HC_MAXE) {
+        c->bad = __LINE__;
+        return;
+    }
+    c->ev[bj][c->nev[bj]++] = (HcEvent){x, j, kind, k};
+}
+
+/* Roots x of a0 + a1 cos x + a2 sin x = 0 (at most 2) */
+static int hc_sin_roots(double a0, double a1, double a2, double *x)
+{
+    double h = hypot(a1, a2);
+    if (!(h > 0.0) || fabs(a0) > h)
+        return 0;
+    double ph = atan2(a2, a1), d = acos(-a0 / h);
+    x[0] = wrap_pi(ph + d);
+    x[1] = wrap_pi(ph - d);
+    if (d < HC_DOUBLE || M_PI - d < HC_DOUBLE)
+        return -1; /* near double (tangent): the grid's */
+    return 2;
+}
+
+/* Roots x of (al . w)^2 + (be . w)^2 = 1, w = (1, cos x, sin x): a quartic in
+ * tan(y / 2), x = y + phi, phi chosen so that its leading coefficient (the
+ * function at y = pi) is not small; every real root Newton-polished. */
+static int hc_quartic_roots(const double *al, const double *be, double *x)
+{
+    double best = -1.0, phi = 0.0;
+    for (int m = 0; m < 4; m++) { /* the shift: the largest |F(phi + pi)| of 4 */
+        double ph = 0.5 * M_PI * m, cc = cos(ph + M_PI), ss = sin(ph + M_PI);
+        double A = al[0] + al[1] * cc + al[2] * ss, B = be[0] + be[1] * cc + be[2] * ss;
+        double F = fabs(A * A + B * B - 1.0);
+        if (F > best) {
+            best = F;
+            phi = ph;
+        }
+    }
+    double cp = cos(phi), sp = sin(phi);
+    /* in y: cos x = cp cos y - sp sin y, sin x = sp cos y + cp sin y */
+    double a[3] = {al[0], al[1] * cp + al[2] * sp, -al[1] * sp + al[2] * cp};
+    double b[3] = {be[0], be[1] * cp + be[2] * sp, -be[1] * sp + be[2] * cp};
+    /* (1 + u^2) (a . w) = (a0 - a1) u^2 + 2 a2 u + (a0 + a1) */
+    double pa[3] = {a[0] + a[1], 2.0 * a[2], a[0] - a[1]}; /* u^0, u^1, u^2 */
+    double pb[3] = {b[0] + b[1], 2.0 * b[2], b[0] - b[1]};
+    double cf[5];
+    for (int e = 0; e < 5; e++)
+        cf[e] = 0.0;
+    for (int m = 0; m < 3; m++)
+        for (int n = 0; n < 3; n++)
+            cf[m + n] += pa[m] * pa[n] + pb[m] * pb[n];
+    cf[0] -= 1.0; /* (1 + u^2)^2 */
+    cf[2] -= 2.0;
+    cf[4] -= 1.0;
+    if (!(fabs(cf[4]) > 1e-12))
+        return -1;
+    double re[4], im[4];
+    pk_quartic(cf, re, im);
+    int n = 0;
+    for (int m = 0; m < 4; m++) {
+        /* a root pair near double (a joint next to tangent to its value): the grid's */
+        if (fabs(im[m]) > 0.0 && fabs(im[m]) < HC_DOUBLE * (1.0 + fabs(re[m])))
+            return -1;
+        for (int o = 0; o < m; o++)
+            if (fabs(im[o]) == 0.0 && fabs(im[m]) == 0.0 &&
+                fabs(re[m] - re[o]) < HC_DOUBLE * (1.0 + fabs(re[m])))
+                return -1;
+        if (!(fabs(im[m]) <= 1e-6 * (1.0 + fabs(re[m]))))
+            continue;
+        double y = 2.0 * atan(re[m]);
+        for (int it = 0; it < 8; it++) {
+            double cy = cos(y), sy = sin(y);
+            double A = a[0] + a[1] * cy + a[2] * sy, B = b[0] + b[1] * cy + b[2] * sy;
+            double dA = -a[1] * sy + a[2] * cy, dB = -b[1] * sy + b[2] * cy;
+            double F = A * A + B * B - 1.0, dF = 2.0 * (A * dA + B * dB);
+            if (!(fabs(dF) > 0.0))
+                break;
+            double step = F / dF;
+            y -= step;
+            if (fabs(step) < 1e-16)
+                break;
+        }
+        double cy = cos(y), sy = sin(y);
+        double A = a[0] + a[1] * cy + a[2] * sy, B = b[0] + b[1] * cy + b[2] * sy;
+        if (fabs(A * A + B * B - 1.0) < 1e-10)
+            x[n++] = wrap_pi(y + phi);
+    }
+    return n;
+}
+
+/* Branch (i, j)'s row at x with its joint jj's chain value within 1e-6 of V: the
+ * value Newton-polished along the branch (x moved), 1 when it ends within HC_AT with
+ * a slope neither steep nor flat (else c->bad); 0 when the branch is not there. */
+static int hc_polish(HcCtx *c, int i, int j, int jj, double V, double *x)
+{
+    HcRow r;
+    double t = *x, f = NAN, d = NAN;
+    for (int it = 0; it < 5; it++) {
+        if (!hc_eval(&c->p, t, i, j, 1, &r))
+            return 0;
+        c->rows++;
+        f = wrap_pi(fast_atan2(r.cs[jj][1], r.cs[jj][0]) - V);
+        if (it == 0 && !(fabs(f) < 1e-6))
+            return 0;
+        d = r.dv[jj];
+        if (!r.sloped || !(fabs(d) > 1e-6)) {
+            c->bad = __LINE__; /* a touch (or a branch end) */
+            return 0;
+        }
+        double step = f / d;
+        if (fabs(f) <= 0.25 * HC_AT || fabs(step) <= DBL_EPSILON * fmax(1.0, fabs(t)))
+            break;
+        t -= step;
+    }
+    /* as hc_root_q: to HC_AT, or what the last bits of x allow (a steep crossing) */
+    double tol = fmax(HC_AT, 8.0 * fmax(fabs(d) * DBL_EPSILON * fmax(1.0, fabs(t)), r.noise));
+    if (!(fabs(f) <= tol) || !(fabs(f) <= HC_AT_STEEP)) {
+        c->bad = __LINE__;
+        return 0;
+    }
+    *x = t;
+    return 1;
+}
+
+/* The closed-form events of joint jj (3: v4, 4: v5, 5: v6) at chain value V */
+static void hc_closed_events(HcCtx *c, int jj, double V, int kind)
+{
+    const HcGeo *g = c->p.g;
+    const HcPose *p = &c->p;
+    double cV = cos(V), sV = sin(V), x[4];
+    int n;
+    if (jj == 3) {
+        n = hc_sin_roots(p->d[0] - g->K - g->c1 * cV - g->c2 * sV, p->d[1], p->d[2], x);
+        if (n < 0) {
+            c->bad = __LINE__;
+            return;
+        }
+    } else {
+        double row0, row1, rhs[3];
+        if (jj == 5) {
+            row0 = g->ec[1];
+            row1 = g->ec[2];
+            for (int m = 0; m < 3; m++)
+                rhs[m] = p->f0[m] + p->f1[m] * cV + p->f2[m] * sV - (m == 0 ? g->ec[0] : 0.0);
+        } else {
+            v3 mv = v3_rot(g->h[4], cV, sV, g->h[5]);
+            row0 = v3_dot(mv, g->a1);
+            row1 = v3_dot(mv, g->a2);
+            double m0 = v3_dot(mv, g->a0);
+            for (int m = 0; m < 3; m++)
+                rhs[m] = p->h6v[m] - (m == 0 ? m0 : 0.0);
+        }
+        double det = g->c1 * row1 - g->c2 * row0, nr = hypot(row0, row1);
+        if (!(nr > 1e-12 * g->L) || !(fabs(det) > 1e-10 * g->cn * nr)) {
+            /* the two equations dependent: the value fixes x alone (the Panda's v5 = 0,
+             * pi: axes 4 and 6 parallel; row = lambda (c1, c2), or 0) */
+            double lam = nr > 1e-12 * g->L ? (row0 * g->c1 + row1 * g->c2) / (g->cn * g->cn) : 0.0;
+            n = hc_sin_roots(lam * (p->d[0] - g->K) - rhs[0], lam * p->d[1] - rhs[1],
+                             lam * p->d[2] - rhs[2], x);
+            if (n < 0) {
+                c->bad = __LINE__;
+                return;
+            }
+            goto found;
+        }
+        double al[3], be[3];
+        for (int m = 0; m < 3; m++) {
+            double r1 = p->d[m] - (m == 0 ? g->K : 0.0);
+            al[m] = (row1 * r1 - g->c2 * rhs[m]) / det;
+            be[m] = (g->c1 * rhs[m] - row0 * r1) / det;
+        }
+        n = hc_quartic_roots(al, be, x);
+        if (n < 0) {
+            c->bad = __LINE__;
+            return;
+        }
+    }
+found:
+    for (int m = 0; m < n; m++) {
+        if (fabs(x[m] - p->xlo) < HC_CORNER || fabs(x[m] - p->xhi) < HC_CORNER) {
+            c->bad = __LINE__; /* a value at an end of the range (a corner) */
+            return;
+        }
+        if (!(x[m] >= p->xlo && x[m] <= p->xhi))
+            continue;
+        for (int bj = 0; bj < 4; bj++) {
+            double t = x[m];
+            if (hc_polish(c, bj >> 1, bj & 1, jj, V, &t) && t >= p->xlo && t <= p->xhi) {
+                int dup = 0; /* a double root of the quartic, or the same root twice */
+                for (int e = 0; e < c->nev[bj]; e++)
+                    dup |= c->ev[bj][e].j == jj && c->ev[bj][e].kind == kind &&
+                           fabs(c->ev[bj][e].x - t) < HC_CLOSE;
+                if (!dup)
+                    hc_add(c, bj, t, jj, kind, -1);
+            }
+        }
+    }
+}
+
+/* ---------------------------------------------------- the numeric events */
+
+/* The cubic Hermite model's (hc_hermite's) interior extremum nearest 0: its place
+ * (*tau in (0, 1)) and value; 0 when it has none */
+static int hc_extremum(double f0, double f1, double d0, double d1, double *tau, double *val)
+{
+    double A = 6.0 * f0 + 3.0 * d0 - 6.0 * f1 + 3.0 * d1;
+    double B = -6.0 * f0 - 4.0 * d0 + 6.0 * f1 - 2.0 * d1, C = d0;
+    double t[2];
+    int n = 0, found = 0;
+    if (fabs(A) > 1e-300) {
+        double disc = B * B - 4.0 * A * C;
+        if (disc >= 0.0) {
+            double sq = sqrt(disc), qq = -0.5 * (B + copysign(sq, B));
+            t[n++] = qq != 0.0 ? qq / A : 0.0;
+            if (qq != 0.0)
+                t[n++] = C / qq;
+        }
+    } else if (fabs(B) > 1e-300) {
+        t[n++] = -C / B;
+    }
+    for (int m = 0; m < n; m++) {
+        double u = t[m];
+        if (!(u > 0.0 && u < 1.0))
+            continue;
+        double u2 = u * u, u3 = u2 * u;
+        double v = (2 * u3 - 3 * u2 + 1) * f0 + (u3 - 2 * u2 + u) * d0 + (-2 * u3 + 3 * u2) * f1 +
+                   (u3 - u2) * d1;
+        if (!found || fabs(v) < fabs(*val)) {
+            *tau = u;
+            *val = v;
+            found = 1;
+        }
+    }
+    return found;
+}
+
+/* Whether a cubic Hermite model on [0, 1] (values f0, f1, slopes d0, d1 times the
+ * cell) may cross 0 other than once at a sign change (*split) or comes within tol
+ * of it without one (*near). */
+static void hc_hermite(double f0, double f1, double d0, double d1, double tol, int *split,
+                       int *near)
+{
+    /* the model within 4/27 (|d0| + |d1|) of a mean of f0 and f1 (its Hermite basis):
+     * of one sign and clear of tol when both ends are further than that */
+    if ((f0 < 0.0) == (f1 < 0.0) &&
+        fmin(fabs(f0), fabs(f1)) > (4.0 / 27.0) * (fabs(d0) + fabs(d1)) + tol) {
+        *split = *near = 0;
+        return;
+    }
+    double A = 6.0 * f0 + 3.0 * d0 - 6.0 * f1 + 3.0 * d1;
+    double B = -6.0 * f0 - 4.0 * d0 + 6.0 * f1 - 2.0 * d1, C = d0;
+    double tau[2];
+    int nt = 0;
+    if (fabs(A) > 1e-300) {
+        double disc = B * B - 4.0 * A * C;
+        if (disc >= 0.0) {
+            double sq = sqrt(disc), qq = -0.5 * (B + copysign(sq, B));
+            if (qq != 0.0) {
+                tau[nt++] = qq / A;
+                tau[nt++] = C / qq;
+            } else {
+                tau[nt++] = 0.0;
+            }
+        }
+    } else if (fabs(B) > 1e-300) {
+        tau[nt++] = -C / B;
+    }
+    int changes = 0;
+    double last = f0;
+    *split = *near = 0;
+    double ext[2];
+    int ne = 0;
+    for (int m = 0; m < nt; m++)
+        if (tau[m] > 0.0 && tau[m] < 1.0)
+            ext[ne++] = tau[m];
+    if (ne == 2 && ext[0] > ext[1]) {
+        double w = ext[0];
+        ext[0] = ext[1];
+        ext[1] = w;
+    }
+    for (int m = 0; m <= ne; m++) {
+        double v;
+        if (m < ne) {
+            double t = ext[m], t2 = t * t, t3 = t2 * t;
+            v = (2 * t3 - 3 * t2 + 1) * f0 + (t3 - 2 * t2 + t) * d0 + (-2 * t3 + 3 * t2) * f1 +
+                (t3 - t2) * d1;
+            if (fabs(v) < tol)
+                *near = 1;
+        } else {
+            v = f1;
+        }
+        changes += (v < 0.0) != (last < 0.0);
+        last = v;
+    }
+    *split = changes != ((f0 < 0.0) != (f1 < 0.0));
+}
+
+typedef struct {
+    double a, b; /* the piece [a, b] in x */
+    int fa, fb;  /* its ends are branch ends */
+    int i, j;
+} HcPiece;
+
+static inline double hc_x(const HcPiece *pc, double xi)
+{
+    return pc->a + (pc->b - pc->a) * 0.5 * (1.0 - cos(M_PI * xi));
+}
+
+static inline double hc_dx(const HcPiece *pc, double xi)
+{
+    return (pc->b - pc->a) * 0.5 * M_PI * sin(M_PI * xi);
+}
+
+/* A crossing of query q in (x0, x1) (values f0, f1 of opposite signs) on the
+ * piece's branch: safeguarded Newton / Illinois to the last bits; the event with its
+ * triple. */
+static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, double x0, double f0,
+                      double x1, double f1)
+{
+    HcRow r;
+    double lo = x0, hi = x1, flo = f0, fhi = f1, x = x0 - f0 * (x1 - x0) / (f1 - f0);
+    int side = 0;
+    for (int it = 0;; it++) {
+        if (it >= 40) {
+            c->bad = __LINE__;
+            return;
+        }
+        if (!(x > lo && x < hi))
+            x = 0.5 * (lo + hi);
+        if (!hc_eval(&c->p, x, pc->i, pc->j, 1, &r)) {
+            c->bad = __LINE__;
+            return;
+        }
+        c->rows++;
+        double d, f = hc_f(&c->p, q, &r, &d, NULL);
+        /* at the root to its rounding: f is sin v2 sin(v_j - V) (v1, v3), cos v2 - cos V
+         * (v2), each O(1), with v5's rounding (r.noise) in the angles */
+        double wa = v3_dot(r.w, c->p.g->ea), wb = v3_dot(r.w, c->p.g->e2);
+        double sfac = q->j == 1 ? fabs(q->sV) : sqrt(wa * wa + wb * wb);
+        if (fabs(f) <= 4.0 * DBL_EPSILON + 4.0 * r.noise * sfac)
+            break;
+        if ((f < 0.0) == (flo < 0.0)) {
+            lo = x;
+            flo = f;
+            if (side == -1)
+                fhi *= 0.5;
+            side = -1;
+        } else {
+            hi = x;
+            fhi = f;
+            if (side == 1)
+                flo *= 0.5;
+            side = 1;
+        }
+        if (hi - lo <= 2.0 * DBL_EPSILON * fmax(1.0, fabs(x)))
+            break;
+        double nx = r.sloped && d != 0.0 ? x - f / d : NAN;
+        if (!(nx > lo && nx < hi)) /* Illinois */
+            nx = lo - flo * (hi - lo) / (fhi - flo);
+        x = nx;
+    }
+    if (!hc_eval(&c->p, x, pc->i, pc->j, 1, &r)) {
+        c->bad = __LINE__;
+        return;
+    }
+    int k;
+    double d, v[7];
+    hc_f(&c->p, q, &r, &d, &k);
+    /* the joint at its value to HC_AT, or to what the last bits of x allow where it
+     * moves fast (next to a branch end: as the square root of the distance), at most
+     * HC_AT_STEEP; |df / dv_j| is |sin v2 cos(v_j - V)| ~ |sin v2| (v1, v3) or |sin V| */
+    hc_angles(&c->p, &r, k, v);
+    double wa = v3_dot(r.w, c->p.g->ea), wb = v3_dot(r.w, c->p.g->e2);
+    double rate = fabs(d) / (q->j == 1 ? fabs(q->sV) : sqrt(wa * wa + wb * wb));
+    double off = fabs(wrap_pi(v[q->j] - q->V));
+    double tol = fmax(HC_AT, 8.0 * fmax(rate * DBL_EPSILON * fmax(1.0, fabs(x)), r.noise));
+    if (!r.sloped || !(off <= tol) || !(off <= HC_AT_STEEP)) {
+        c->bad = __LINE__;
+        return;
+    }
+    hc_add(c, 2 * pc->i + pc->j, x, q->j, q->kind, k);
+    if (q->twin) /* the other triple at the other limit (-V) */
+        hc_add(c, 2 * pc->i + pc->j, x, q->j,
+               q->kind == HM_KIND_UPPER ? HM_KIND_LOWER : HM_KIND_UPPER, 1 - k);
+}
+
+/* Whether joint m of triple k is outside its limits over (ra, rb) for certain: outside
+ * at both ends and no event of that joint between them (the closed-form events of
+ * v4-v6 on branch bj; a shoulder joint's limit functions of the same signs at both
+ * ends, fa, fb: the queries' values) */
+static int hc_out(const HcCtx *c, int bj, const HcRow *ra, const HcRow *rb, int k, int m,
+                  const double *fa, const double *fb)
+{
+    const HcGeo *g = c->p.g;
+    for (const HcRow *r = ra; r != NULL; r = r == ra ? rb : NULL)
+        if (isnan(r->q[k][m]))
+            return 0;
+    for (const HcRow *r = ra; r != NULL; r = r == ra ? rb : NULL)
+        if (r->q[k][m] >= g->lo[m] && r->q[k][m] <= g->hi[m])
+            return 0;
+    if (m >= 3) {
+        for (int e = 0; e < c->nev[bj]; e++) {
+            const HcEvent *ev = &c->ev[bj][e];
+            if (ev->j == m && ev->kind != HM_KIND_ALIGNED && ev->x >= ra->x && ev->x <= rb->x)
+                return 0;
+        }
+        return 1;
+    }
+    for (int n = 0; n < c->nq; n++)
+        if (c->q[n].j == m && c->q[n].kind >= 0 && c->q[n].kind != HM_KIND_ALIGNED &&
+            (fa[n] < 0.0) != (fb[n] < 0.0))
+            return 0;
+    return 1;
+}
+
+/* The cell (ra, rb) at xi0 < xi1 of a piece: each query's crossings, or a split */
+static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *rb,
+                    double xi1, int depth)
+{
+    if (c->bad)
+        return;
+    double h = xi1 - xi0, sa = hc_dx(pc, xi0) * h, sb = hc_dx(pc, xi1) * h;
+    double ea = 0.5 * (pc->b - pc->a) * M_PI * h; /* a branch end's row: d/dxi given */
+    double at = 0.5; /* where a split cuts the cell */
+    int split = 0;
+    double fa[HC_MAXQ], fb[HC_MAXQ];
+    for (int m = 0; m < c->nq && !split; m++) {
+        const HcQuery *q = &c->q[m];
+        double da, db;
+        fa[m] = hc_f(&c->p, q, ra, &da, NULL);
+        fb[m] = hc_f(&c->p, q, rb, &db, NULL);
+        da = ra->sloped == 2 ? da * ea : ra->sloped ? da * sa : NAN;
+        db = rb->sloped == 2 ? db * ea : rb->sloped ? db * sb : NAN;
+        int known = isfinite(da) && isfinite(db);
+        if (!isfinite(da))
+            da = fb[m] - fa[m];
+        if (!isfinite(db))
+            db = fb[m] - fa[m];
+        double tol = q->kind < 0 ? HC_ALIGNED : HC_TOUCH;
+        if (fabs(fa[m]) < (q->kind < 0 ? tol : HC_AT_NODE) ||
+            fabs(fb[m]) < (q->kind < 0 ? tol : HC_AT_NODE)) {
+            c->bad = __LINE__; /* next to an aligned shoulder; a node at a value (a touch,
+                                * a corner: the generating configuration at a limit) */
+            return;
+        }
+        int sp, near;
+        hc_hermite(fa[m], fb[m], da, db, tol, &sp, &near);
+        if (fabs(fb[m] - fa[m]) > HC_MOVE || fabs(da) > 2.0 * HC_MOVE || fabs(db) > 2.0 * HC_MOVE)
+            sp = 1;
+        if (!known && depth < HC_END_SPLITS && ((fa[m] < 0.0) != (fb[m] < 0.0) || near))
+            sp = 1; /* next to a branch end: no slope there */
+        split |= sp || near;
+        /* an extremum toward 0 inside (a shallow excursion past a limit, q2 close to
+         * an aligned shoulder): the cell split at the model's extremum until it is a
+         * node (then both halves are monotone), as held_manifold.c locates extrema */
+        double tau = 0.5, val = 0.0;
+        if (!split && known && (fa[m] < 0.0) == (fb[m] < 0.0) &&
+            (fa[m] > 0.0 ? da < 0.0 && db > 0.0 : da > 0.0 && db < 0.0) &&
+            hc_extremum(fa[m], fb[m], da, db, &tau, &val) &&
+            fabs(val) < HC_DIP * fmin(fabs(fa[m]), fabs(fb[m]))) {
+            split = 1;
+            at = fmin(fmax(tau, 0.1), 0.9);
+            if (fabs(rb->x - ra->x) < HC_DIP_WIDTH || fabs(val) < HC_AT_NODE) {
+                c->bad = __LINE__; /* a touch, or a crossing pair closer than this */
+                return;
+            }
+        }
+    }
+    if (split) {
+        if (depth >= HC_DEPTH) {
+            c->bad = __LINE__;
+            return;
+        }
+        double xm = xi0 + at * (xi1 - xi0);
+        HcRow rm;
+        if (!hc_eval(&c->p, hc_x(pc, xm), pc->i, pc->j, 1, &rm)) {
+            c->bad = __LINE__;
+            return;
+        }
+        c->rows++;
+        hc_cell(c, pc, ra, xi0, &rm, xm, depth + 1);
+        hc_cell(c, pc, &rm, xm, rb, xi1, depth + 1);
+        return;
+    }
+    int bj = 2 * pc->i + pc->j, dead[2] = {-1, -1}; /* per triple: unknown yet */
+    for (int m = 0; m < c->nq; m++) {
+        const HcQuery *q = &c->q[m];
+        if (q->kind < 0 || (fa[m] < 0.0) == (fb[m] < 0.0))
+            continue;
+        if (fa[m] == 0.0 || fb[m] == 0.0) {
+            c->bad = __LINE__; /* a node exactly on a crossing */
+            return;
+        }
+        if (q->kind != HM_KIND_ALIGNED) {
+            /* a limit crossing bounds nothing where another joint of its triple (or of
+             * both: the triple known only at the root) is outside all over the cell
+             * (held_manifold.c's dead cells; aligned points are listed everywhere) */
+            int ka, kb, skip = 1;
+            hc_f(&c->p, q, ra, NULL, &ka);
+            hc_f(&c->p, q, rb, NULL, &kb);
+            if (isnan(ra->q[0][0])) {
+                double mg[2];
+                hc_rowq(&c->p, ra, mg);
+            }
+            if (isnan(rb->q[0][0])) {
+                double mg[2];
+                hc_rowq(&c->p, rb, mg);
+            }
+            for (int k = 0; k < 2 && skip; k++) {
+                if (ka == kb && k != ka && !q->twin)
+                    continue; /* the root's triple known: its side at both ends */
+                if (dead[k] < 0) {
+                    dead[k] = 0;
+                    for (int jj = 0; jj < 6 && !dead[k]; jj++) {
+                        dead[k] = jj != q->j && hc_out(c, bj, ra, rb, k, jj, fa, fb);
+                    }
+                }
+                skip = dead[k];
+            }
+            if (skip)
+                continue;
+        }
+        hc_root_q(c, pc, q, ra->x, fa[m], rb->x, fb[m]);
+    }
+}
+
+/* Every shoulder event of a piece */
+static void hc_piece(HcCtx *c, const HcPiece *pc)
+{
+    HcRow r[HC_NODES];
+    for (int k = 0; k < HC_NODES; k++) {
+        double xi = (double)k / (HC_NODES - 1);
+        double x = k == 0 ? pc->a : k == HC_NODES - 1 ? pc->b : hc_x(pc, xi);
+        if (!hc_eval(&c->p, x, pc->i, pc->j, 1, &r[k])) {
+            c->bad = __LINE__;
+            return;
+        }
+        c->rows++;
+        if ((k == 0 && pc->fa) || (k == HC_NODES - 1 && pc->fb)) {
+            /* a branch end: rates infinite in x, finite in xi (x - end ~ xi^2): the
+             * row's slopes from HC_END_XI of the piece further in (d/dxi there) */
+            HcRow e = {0};
+            double xe = k == 0 ? HC_END_XI : 1.0 - HC_END_XI;
+            if (!hc_eval(&c->p, hc_x(pc, xe), pc->i, pc->j, 1, &e) || !e.sloped) {
+                c->bad = __LINE__;
+                return;
+            }
+            c->rows++;
+            double f = hc_dx(pc, xe) / (0.5 * (pc->b - pc->a) * M_PI); /* dx/dxi ~ this */
+            for (int m = 0; m < 7; m++)
+                r[k].dv[m] = e.dv[m] * f;
+            r[k].dw = v3_scale(e.dw, f);
+            r[k].dr = v3_scale(e.dr, f);
+            r[k].sloped = 2; /* slopes d/dxi / (pi (b - a) / 2): see hc_cell */
+        }
+        if (k == 0 || k == HC_NODES - 1) {
+            /* a joint at its limit at the piece's end (a corner: the slot may be inside
+             * at that one value): the grid's */
+            double mg[2], near = (k == 0 ? pc->fa : pc->fb) ? HC_AT_FOLD : HC_DECIDE;
+            hc_rowq(&c->p, &r[k], mg);
+            if (fabs(mg[0]) < near || fabs(mg[1]) < near) {
+                c->bad = __LINE__;
+                return;
+            }
+        }
+    }
+    for (int k = 0; k + 1 < HC_NODES && !c->bad; k++)
+        hc_cell(c, pc, &r[k], (double)k / (HC_NODES - 1), &r[k + 1],
+                (double)(k + 1) / (HC_NODES - 1), 0);
+}
+
+/* --------------------------------------------------------- branch ends */
+
+typedef struct {
+    const HcPose *p;
+    int i;
+} HcMarginArg;
+
+static double hc_m2_at(void *arg, double x)
+{
+    const HcMarginArg *m = arg;
+    return hc_m2(m->p, x, m->i, NULL);
+}
+
+/* E2's branch ends of root i in the cell (xi0, xi1) of E1's piece pc (margins m,
+ * slopes d/dx dm, NaN at a branch end): into ends[] */
+static void hc_m2_cell(HcCtx *c, const HcPiece *pc, int i, double xi0, double m0, double d0,
+                       double xi1, double m1, double d1, int depth, double *ends, int *ne)
+{
+    if (c->bad)
+        return;
+    double h = xi1 - xi0, x0 = hc_x(pc, xi0), x1 = hc_x(pc, xi1);
+    double s0 = d0 * hc_dx(pc, xi0) * h, s1 = d1 * hc_dx(pc, xi1) * h;
+    double scale = c->p.g->cn;
+    int known = isfinite(s0) && isfinite(s1);
+    if (!isfinite(s0))
+        s0 = m1 - m0;
+    if (!isfinite(s1))
+        s1 = m1 - m0;
+    int sp, near;
+    hc_hermite(m0 / scale, m1 / scale, s0 / scale, s1 / scale, HC_TOUCH, &sp, &near);
+    if (!known && depth < HC_END_SPLITS && ((m0 < 0.0) != (m1 < 0.0) || near))
+        sp = 1;
+    /* the model trusted only where the slopes agree with the chord (a gap or an
+     * island of E2 ~0.03 wide between nodes: session 26) */
+    double chord = m1 - m0;
+    if (known && fabs(s0 - chord) + fabs(s1 - chord) > HC_BEND * (fabs(chord) + HC_BEND_FLOOR * scale))
+        sp = 1;
+    if (fabs(m0) < HC_AT_NODE * scale || fabs(m1) < HC_AT_NODE * scale) {
+        c->bad = __LINE__; /* a branch end at a node (or E2 touching 0 there) */
+        return;
+    }
+    /* an extremum toward 0 (E2 touching 0 between nodes: an isolated row, a branch's
+     * end pair): located as hc_cell's */
+    double at = 0.5, tau = 0.5, val = 0.0;
+    if (!sp && !near && known && (m0 < 0.0) == (m1 < 0.0) &&
+        (m0 > 0.0 ? s0 < 0.0 && s1 > 0.0 : s0 > 0.0 && s1 < 0.0) &&
+        hc_extremum(m0, m1, s0, s1, &tau, &val) && fabs(val) < HC_DIP * fmin(fabs(m0), fabs(m1))) {
+        sp = 1;
+        at = fmin(fmax(tau, 0.1), 0.9);
+        if (fabs(x1 - x0) < HC_DIP_WIDTH || fabs(val) < HC_AT_NODE * scale) {
+            c->bad = __LINE__;
+            return;
+        }
+    }
+    if (sp || near) {
+        if (depth >= HC_DEPTH) {
+            c->bad = __LINE__;
+            return;
+        }
+        double xm = xi0 + at * (xi1 - xi0), dm;
+        double mm = hc_m2(&c->p, hc_x(pc, xm), i, &dm);
+        c->rows++;
+        hc_m2_cell(c, pc, i, xi0, m0, d0, xm, mm, dm, depth + 1, ends, ne);
+        hc_m2_cell(c, pc, i, xm, mm, dm, xi1, m1, d1, depth + 1, ends, ne);
+        return;
+    }
+    if ((m0 < 0.0) != (m1 < 0.0)) {
+        HcMarginArg arg = {&c->p, i};
+        double x = brent_root(hc_m2_at, &arg, x0, m0, x1, m1); /* E2's branch end */
+        if (!isfinite(x) || *ne >= 2 * HC_MAXPC) {
+            c->bad = __LINE__;
+            return;
+        }
+        ends[(*ne)++] = x;
+    }
+}
+
+static int hc_cmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Branch (i, j)'s pieces (both j of root i share them): E1's pieces cut where E2's
+ * margin of root i changes sign. Into c->cut[2 i + j] (pairs) and c->cutfold. */
+static void hc_pieces(HcCtx *c)
+{
+    const HcPose *p = &c->p;
+    const HcGeo *g = p->g;
+    double e1[8];
+    int n1 = 0;
+    e1[n1++] = p->xlo;
+    e1[n1++] = p->xhi;
+    double r[2];
+    for (int sgn = -1; sgn <= 1; sgn += 2) {
+        int n = hc_sin_roots(p->d[0] - g->K + sgn * g->cn, p->d[1], p->d[2], r);
+        if (n < 0) {
+            c->bad = __LINE__; /* E1 tangent to its ends: a branch end doubled */
+            return;
+        }
+        for (int m = 0; m < n; m++)
+            if (r[m] > p->xlo && r[m] < p->xhi)
+                e1[n1++] = r[m];
+    }
+    qsort(e1, (size_t)n1, sizeof(double), hc_cmp);
+    for (int m = 0; m + 1 < n1; m++)
+        if (e1[m + 1] - e1[m] < HC_CORNER) {
+            c->bad = __LINE__; /* a branch end at the range's end or another's */
+            return;
+        }
+    for (int i = 0; i < 2; i++)
+        c->npc[2 * i] = c->npc[2 * i + 1] = 0;
+    for (int m = 0; m + 1 < n1 && !c->bad; m++) {
+        double a = e1[m], b = e1[m + 1];
+        if (!(b > a))
+            continue;
+        if (b - a < HC_CLOSE) {
+            c->bad = __LINE__;
+            return;
+        }
+        double xm = 0.5 * (a + b);
+        if (!(hc_m1(p, cos(xm), sin(xm)) > 0.0))
+            continue;
+        HcPiece pc = {a, b, a != p->xlo, b != p->xhi, 0, 0};
+        for (int i = 0; i < 2 && !c->bad; i++) {
+            /* E2's margin on nodes of the piece: its sign changes */
+            double xi[HC_MNODES], mv[HC_MNODES], dv[HC_MNODES], ends[2 * HC_MAXPC];
+            int ne = 0;
+            for (int k = 0; k < HC_MNODES; k++) {
+                xi[k] = (double)k / (HC_MNODES - 1);
+                double x = k == 0 ? a : k == HC_MNODES - 1 ? b : hc_x(&pc, xi[k]);
+                mv[k] = hc_m2(p, x, i, &dv[k]);
+                if ((k == 0 && pc.fa) || (k == HC_MNODES - 1 && pc.fb))
+                    dv[k] = NAN;
+            }
+            for (int k = 0; k + 1 < HC_MNODES; k++)
+                hc_m2_cell(c, &pc, i, xi[k], mv[k], dv[k], xi[k + 1], mv[k + 1], dv[k + 1], 0,
+                           ends, &ne);
+            if (c->bad)
+                return;
+            /* the sub-pieces where the margin is >= 0 */
+            double cuts[2 * HC_MAXPC + 2];
+            int nc = 0;
+            cuts[nc++] = a;
+            for (int e = 0; e < ne; e++)
+                cuts[nc++] = ends[e];
+            cuts[nc++] = b;
+            for (int e = 0; e + 1 < nc; e++) {
+                double u = cuts[e], w = cuts[e + 1];
+                if (w - u < HC_CORNER) {
+                    c->bad = __LINE__;
+                    return;
+                }
+                if (!(hc_m2(p, 0.5 * (u + w), i, NULL) > 0.0))
+                    continue;
+                for (int j = 0; j < 2; j++) {
+                    int bj = 2 * i + j, k = c->npc[bj];
+                    if (k >= HC_MAXPC) {
+                        c->bad = __LINE__;
+                        return;
+                    }
+                    c->cut[bj][2 * k] = u;
+                    c->cut[bj][2 * k + 1] = w;
+                    c->cutfold[bj][2 * k] = e > 0 || pc.fa;
+                    c->cutfold[bj][2 * k + 1] = e + 2 < nc || pc.fb;
+                    c->npc[bj]++;
+                }
+            }
+        }
+    }
+}
+
+/* ------------------------------------------------------------ the pose */
+
+static int hc_evcmp(const void *a, const void *b)
+{
+    double x = ((const HcEvent *)a)->x, y = ((const HcEvent *)b)->x;
+    return x < y ? -1 : x > y;
+}
+
+/* pk_one's slot of branch (i, j), triple k */
+static inline int hc_slot(int i, int j, int k) { return 4 * (1 - i) + 2 * (1 - j) + k; }
+
+/* Whether pk_one numbers the rows at x as hc_slot does (its rows there within 1e-6
+ * of these, each nearest its own slot's) */
+static int hc_slots_agree(HcCtx *c, const double *P, double x)
+{
+    const HcGeo *g = c->p.g;
+    double Q[8][PK_MAXJ], qn[PK_MAXJ] = {0};
+    unsigned char valid[8], sing[8], inside[8];
+    PkOut o = {&Q[0][0], valid, sing, inside, PK_MAXJ};
+    double t = g->sign[6] * (x - g->off[6]);
+    pk_one(P, c->T, t, qn, o);
+    for (int bj = 0; bj < 4; bj++) {
+        HcRow r;
+        if (!hc_eval(&c->p, x, bj >> 1, bj & 1, 0, &r))
+            continue;
+        for (int k = 0; k < 2; k++) {
+            double v[7], q[7];
+            hc_angles(&c->p, &r, k, v);
+            hc_joints(g, v, -1, q);
+            int best = -1;
+            double bd = INFINITY;
+            for (int b = 0; b < 8; b++) {
+                if (!valid[b])
+                    continue;
+                double d = 0.0;
+                for (int jj = 0; jj < 7; jj++)
+                    d = fmax(d, fabs(wrap_pi(q[jj] - Q[b][jj])));
+                if (d < bd) {
+                    bd = d;
+                    best = b;
+                }
+            }
+            if (best != hc_slot(bj >> 1, bj & 1, k) || !(bd < 1e-6))
+                return 0;
+        }
+    }
+    return 1;
+}
+
+/* The intervals and points of one pose (held_manifold's outputs: iv (8, HM_MAXI, 2),
+ * niv (8), pts (HM_MAXP, 4), *npts); 1 when certified (else the outputs undefined) */
+static int hc_pose(const double *P, const double *T, const double *al, long nal, double *iv,
+                   long long *niv, double *pts, long *npts, long *rows)
+{
+    HcGeo geo;
+    if (!hc_geo(P, &geo))
+        return 0;
+    HcCtx *c = malloc(sizeof(HcCtx));
+    if (c == NULL)
+        return 0;
+    c->T = T;
+    c->bad = 0;
+    c->rows = 0;
+    c->nq = 0;
+    for (int bj = 0; bj < 4; bj++)
+        c->nev[bj] = c->npc[bj] = 0;
+    const HcGeo *g = &geo;
+    int ok = 0;
+    if (!hc_setup(g, T, &c->p))
+        goto done;
+    /* the shoulder's queries: limits, aligned values, the aligned-shoulder guards */
+    for (int j = 0; j < 3; j++) {
+        double V[2];
+        for (int e = 0; e < 2; e++)
+            V[e] = g->sign[j] * (e ? g->hi[j] : g->lo[j]) + g->off[j];
+        for (int e = 0; e < 2; e++) {
+            int kind = e ? HM_KIND_UPPER : HM_KIND_LOWER; /* of the joint value q */
+            /* v2's limits at +-V: one function (cos v2 = cos V), its roots both triples' */
+            int twin = j == 1 && V[0] == -V[1];
+            if (twin && e == 0)
+                continue;
+            c->q[c->nq++] = (HcQuery){j, kind, twin, V[e], cos(V[e]), sin(V[e])};
+        }
+    }
+    c->q[c->nq++] = (HcQuery){1, -1, 0, 0.0, 1.0, 0.0};
+    c->q[c->nq++] = (HcQuery){1, -1, 0, M_PI, -1.0, 0.0};
+    for (long a = 0; a < nal; a++) {
+        int j = (int)al[2 * a];
+        double V = g->sign[j < 0 || j > 6 ? 0 : j] * al[2 * a + 1] + g->off[j < 0 || j > 6 ? 0 : j];
+        if (j == 0 || j == 2) {
+            if (c->nq >= HC_MAXQ)
+                goto done;
+            c->q[c->nq++] = (HcQuery){j, HM_KIND_ALIGNED, 0, V, cos(V), sin(V)};
+        } else if (j != 1 && j != 3 && j != 4 && j != 5 && j != 6) {
+            goto done;
+        }
+    }
+    hc_pieces(c);
+    if (c->bad)
+        goto done;
+    for (int j = 3; j < 6 && !c->bad; j++)
+        for (int e = 0; e < 2; e++)
+            hc_closed_events(c, j, g->sign[j] * (e ? g->hi[j] : g->lo[j]) + g->off[j],
+                             e ? HM_KIND_UPPER : HM_KIND_LOWER);
+    for (long a = 0; a < nal && !c->bad; a++) {
+        int j = (int)al[2 * a];
+        if (j >= 3 && j <= 5)
+            hc_closed_events(c, j, g->sign[j] * al[2 * a + 1] + g->off[j], HM_KIND_ALIGNED);
+    }
+    for (int bj = 0; bj < 4 && !c->bad; bj++)
+        for (int m = 0; m < c->npc[bj] && !c->bad; m++) {
+            HcPiece pc = {c->cut[bj][2 * m], c->cut[bj][2 * m + 1], c->cutfold[bj][2 * m],
+                          c->cutfold[bj][2 * m + 1], bj >> 1, bj & 1};
+            hc_piece(c, &pc);
+        }
+    if (c->bad)
+        goto done;
+    /* pk_one's slots: checked at a piece's middle */
+    for (int bj = 0; bj < 4; bj++)
+        if (c->npc[bj]) {
+            if (!hc_slots_agree(c, P, 0.5 * (c->cut[bj][0] + c->cut[bj][1])))
+                goto done;
+            break;
+        }
+    /* the intervals and points of each slot */
+    *npts = 0;
+    double s7 = g->sign[6], o7 = g->off[6];
+    for (int bj = 0; bj < 4; bj++) {
+        qsort(c->ev[bj], (size_t)c->nev[bj], sizeof(HcEvent), hc_evcmp);
+        for (int k = 0; k < 2; k++) {
+            int b = hc_slot(bj >> 1, bj & 1, k);
+            double *out = iv + 2 * HM_MAXI * b;
+            long long n = 0;
+            int e = 0;
+            for (int m = 0; m < c->npc[bj]; m++) {
+                double a = c->cut[bj][2 * m], z = c->cut[bj][2 * m + 1];
+                if (c->cutfold[bj][2 * m] || c->cutfold[bj][2 * m + 1]) {
+                    for (int side = 0; side < 2; side++) {
+                        if (!c->cutfold[bj][2 * m + side])
+                            continue;
+                        if (*npts >= HM_MAXP)
+                            goto done;
+                        double *pt = pts + 4 * (*npts)++;
+                        pt[0] = s7 * ((side ? z : a) - o7);
+                        pt[1] = b;
+                        pt[2] = -1;
+                        pt[3] = HM_KIND_FOLD;
+                    }
+                }
+                double prev = a;
+                for (;; e++) {
+                    while (e < c->nev[bj] && c->ev[bj][e].k >= 0 && c->ev[bj][e].k != k)
+                        e++;
+                    int last = !(e < c->nev[bj] && c->ev[bj][e].x < z);
+                    double x = last ? z : c->ev[bj][e].x;
+                    if (!last && c->ev[bj][e].x < a)
+                        continue;
+                    if (x - prev < HC_CORNER)
+                        goto done; /* a corner: two events (or one and an end) together */
+                    if (x > prev) {
+                        HcRow r;
+                        double v[7], q[7];
+                        if (!hc_eval(&c->p, 0.5 * (prev + x), bj >> 1, bj & 1, 0, &r))
+                            goto done;
+                        c->rows++;
+                        hc_angles(&c->p, &r, k, v);
+                        double mg = hc_joints(g, v, -1, q);
+                        if (fabs(mg) < HC_DECIDE)
+                            goto done;
+                        if (mg > 0.0) {
+                            if (n > 0 && out[2 * n - 1] == prev) {
+                                out[2 * n - 1] = x;
+                            } else {
+                                if (n >= HM_MAXI)
+                                    goto done;
+                                out[2 * n] = prev;
+                                out[2 * n + 1] = x;
+                                n++;
+                            }
+                        }
+                    }
+                    if (!last) {
+                        const HcEvent *ev = &c->ev[bj][e];
+                        int list = ev->kind == HM_KIND_ALIGNED;
+                        if (list && ev->j >= 3) {
+                            /* a wrist joint at its aligned value with another there too
+                             * (q5 and q6 at 0: a swing, as the shoulder's): the grid's */
+                            HcRow r;
+                            if (!hc_eval(&c->p, ev->x, bj >> 1, bj & 1, 0, &r))
+                                goto done;
+                            for (int jj = 3; jj < 6; jj++)
+                                if (jj != ev->j && fabs(r.cs[jj][1]) < HC_WRIST_ALIGNED)
+                                    goto done;
+                        }
+                        if (!list) { /* a crossing with the other joints inside */
+                            HcRow r;
+                            double v[7], q[7];
+                            if (hc_eval(&c->p, ev->x, bj >> 1, bj & 1, 0, &r)) {
+                                hc_angles(&c->p, &r, k, v);
+                                double mg = hc_joints(g, v, ev->j, q);
+                                if (fabs(mg) < HC_CORNER)
+                                    goto done; /* another joint at a limit there too */
+                                list = mg >= 0.0;
+                            }
+                        }
+                        if (list) {
+                            if (*npts >= HM_MAXP)
+                                goto done;
+                            double *pt = pts + 4 * (*npts)++;
+                            pt[0] = s7 * (ev->x - o7);
+                            pt[1] = b;
+                            pt[2] = ev->j;
+                            pt[3] = ev->kind;
+                        }
+                    }
+                    prev = x;
+                    if (last)
+                        break;
+                }
+            }
+            /* in t (the held joint's value) */
+            for (long long m = 0; m < 2 * n; m++)
+                out[m] = s7 * (out[m] - o7);
+            if (s7 < 0.0)
+                for (long long m = 0; m < n / 2; m++)
+                    for (int side = 0; side < 2; side++) {
+                        double w = out[2 * m + side];
+                        out[2 * m + side] = out[2 * (n - 1 - m) + 1 - side];
+                        out[2 * (n - 1 - m) + 1 - side] = w;
+                    }
+            niv[b] = n;
+        }
+    }
+    ok = 1;
+done:
+    *rows = c->rows;
+    free(c);
+    return ok;
+}
