@@ -246,20 +246,17 @@ def held_kernel_rows(robot, T, repeat):
     out = (np.empty((N, 8, K.HM_MAXI, 2)), np.zeros((N, 8), np.int64),
            np.empty((N, K.HM_MAXP, 4)), np.zeros(N, np.int64), np.zeros(N, np.int64),
            np.zeros(N, np.int64))
-    closed = cpu_and_wall(lambda: K.held_manifold(params, T, al, KERNEL_GRID, *out,
-                                                  K.HM_MODE_AUTO), repeat)
-    certified = int((out[5] == 1).sum())  # (the closed forms' one pk_one call)
-    kern = cpu_and_wall(lambda: K.held_manifold(params, T, al, KERNEL_GRID, *out,
+    grid = cpu_and_wall(lambda: K.held_manifold(params, T, al, KERNEL_GRID, *out,
                                                 K.HM_MODE_GRID), repeat)
+    kern = cpu_and_wall(lambda: K.held_manifold(params, T, al, KERNEL_GRID, *out,
+                                                K.HM_MODE_AUTO), repeat)
     flagged, solves = int((out[4] != 0).sum()), float(out[5].mean())
     ref = cpu_and_wall(lambda: [self_motion(robot.arm, t, dispatch=solve, reference=True)
                                 for t in T], 1)
     print(f"{'panda':11s} held_manifold kernel, one batch: {us([x / N for x in kern])} per pose "
-          f"({solves:.0f} full pk_one solves per pose, {flagged} of {N} flagged to the "
-          f"solved-points path); solved points (reference=True) {us([x / N for x in ref])}")
-    print(f"{'panda':11s} held_manifold kernel, closed forms first (HM_MODE_AUTO, not "
-          f"robot.self_motion's yet): {us([x / N for x in closed])} per pose ({certified} of "
-          f"{N} certified by held_closed.c, the others by the grid)")
+          f"(closed forms, else the grid: {solves:.1f} pk_one solves per pose, {flagged} of {N} "
+          f"flagged to the solved-points path); the grid alone {us([x / N for x in grid])}; "
+          f"solved points (reference=True) {us([x / N for x in ref])}")
 
 
 if __name__ == "__main__":

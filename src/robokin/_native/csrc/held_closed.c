@@ -36,12 +36,14 @@
  * A piece of a slot between consecutive events is decided at its midpoint. A limit
  * crossing in a cell where another joint of its triple is outside all over it (at
  * both ends, and no event of that joint between) bounds nothing and is not located
- * (held_manifold.c's dead cells); the crossings listed are those with every other
- * joint inside (the ones SelfMotion.crossings keeps), the aligned points and branch
- * ends every one.
+ * (held_manifold.c's dead cells); every located crossing is listed, and every aligned
+ * point and branch end. A branch end is moved from the margin's exact root to where
+ * pk_one's rows of its slot end (hc_snap: pk's own discriminant, held_margins.c,
+ * confirmed by a pk_one row), so that SelfMotion.sample has a row at every end.
  *
- * Not certified (0: held_manifold.c's grid instead, ~2.5 % of uniform Panda poses,
- * ~45 % of poses with joints at special values): a branch within HC_ALIGNED of an
+ * Not certified (0: held_manifold.c's grid instead, ~3-4 % of uniform Panda poses,
+ * ~half of poses with joints at special values): a branch end pk_one does not
+ * confirm; a branch within HC_ALIGNED of an
  * aligned shoulder (1 - |cos v2|: q1 and q3 swing there) or a wrist aligned point with
  * a second wrist joint at its aligned value; a limit function at 0 at a node or at a
  * located extremum (a touch; an isolated in-limit row), a closed-form root pair near
@@ -75,6 +77,9 @@
 #define HC_AT_NODE 1e-9  /* a limit function this close to 0 at a node or extremum: the grid's */
 #define HC_DIP_WIDTH 1e-6 /* an extremum toward 0 still unresolved in a cell this narrow */
 #define HC_DOUBLE 1e-4   /* closed-form roots this close to double: the grid's */
+#define HC_ROWS_KEPT 8   /* pk_one calls kept by hc_row_at */
+#define HC_SNAP_ULPS 16  /* a snapped branch end moved this many doubles inward */
+#define HC_SNAP 1e-8     /* pk_one's branch end searched this far (relative) from the margin's */
 #define HC_END_XI 1e-4   /* a branch end's slopes from this far in (in xi) */
 #define HC_AT 1e-12      /* a crossing's joint at its value to this [rad] */
 #define HC_AT_STEEP 1e-9 /* the same where the last bit of x moves the joint more */
@@ -437,9 +442,12 @@ typedef struct {
     HcEvent ev[4][HC_MAXE]; /* per position branch 2 i + j */
     int nev[4];
     double cut[4][2 * HC_MAXPC]; /* the branch's piece ends (x), as pairs */
-    int cutfold[4][2 * HC_MAXPC]; /* whether that end is a branch end */
+    int cutfold[4][2 * HC_MAXPC]; /* that end: 0 the range's, 1 E1's branch end, 2 E2's */
     int npc[4];
     long rows; /* row evaluations (a measuring build's evals: HM_COUNT_CHEAP) */
+    double kept_t[HC_ROWS_KEPT]; /* hc_row_at's pk_one calls */
+    unsigned char kept_valid[HC_ROWS_KEPT][8];
+    int nkept;
 } HcCtx;
 
 static void hc_add(HcCtx *c, int bj, double x, int j, int kind, int k)
@@ -1176,13 +1184,98 @@ static void hc_pieces(HcCtx *c)
                     }
                     c->cut[bj][2 * k] = u;
                     c->cut[bj][2 * k + 1] = w;
-                    c->cutfold[bj][2 * k] = e > 0 || pc.fa;
-                    c->cutfold[bj][2 * k + 1] = e + 2 < nc || pc.fb;
+                    c->cutfold[bj][2 * k] = e > 0 ? 2 : pc.fa;
+                    c->cutfold[bj][2 * k + 1] = e + 2 < nc ? 2 : pc.fb;
                     c->npc[bj]++;
                 }
             }
         }
     }
+}
+
+/* pk_one's slot of branch (i, j), triple k */
+static inline int hc_slot(int i, int j, int k) { return 4 * (1 - i) + 2 * (1 - j) + k; }
+
+/* Whether pk_one has a row of slot b at held value t (its slots' validity kept for the
+ * last HC_ROWS_KEPT values: an E1 branch end is every branch's, at one or two values) */
+static int hc_row_at(HcCtx *c, const double *P, double t, int b)
+{
+    for (int m = 0; m < c->nkept && m < HC_ROWS_KEPT; m++)
+        if (c->kept_t[m] == t)
+            return c->kept_valid[m][b];
+    double Q[8][PK_MAXJ], qn[PK_MAXJ] = {0};
+    unsigned char sing[8], inside[8];
+    int m = c->nkept++ % HC_ROWS_KEPT;
+    PkOut o = {&Q[0][0], c->kept_valid[m], sing, inside, PK_MAXJ};
+    pk_one(P, c->T, t, qn, o);
+    c->kept_t[m] = t;
+    return c->kept_valid[m][b];
+}
+
+/* hc_snap's function: pk's discriminant kk at held value t, less off */
+typedef struct {
+    const double *P, *T;
+    HmMargMemo *memo;
+    int kk;
+    double off;
+} HcDiscArg;
+
+static double hc_disc_at(void *arg, double t)
+{
+    HcDiscArg *a = arg;
+    double m[3], d[3];
+    if (!hm_margins_pk(a->P, a->T, a->memo, t, m, d))
+        return NAN;
+    return d[a->kk] - a->off;
+}
+
+/* Every branch end of every piece moved to where pk_one's rows of its slot end (what
+ * SelfMotion.sample gives there): the root of pk's own discriminant of that position
+ * root (held_margins.c; the pair's second root at HM_DISC_TWO, as held_manifold.c's
+ * hm_fold_margin) within HC_SNAP of the margin's exact root; c->bad where none is. */
+static void hc_snap(HcCtx *c, const double *P, HmMargMemo *memo)
+{
+    const HcGeo *g = c->p.g;
+    double s7 = g->sign[6], o7 = g->off[6];
+    for (int bj = 0; bj < 4; bj++)
+        for (int m = 0; m < 2 * c->npc[bj]; m++) {
+            int kind = c->cutfold[bj][m];
+            if (!kind)
+                continue;
+            int b = hc_slot(bj >> 1, bj & 1, 0), kk = kind == 1 ? 0 : 1 + (b >> 2);
+            HcDiscArg arg = {P, c->T, memo, kk,
+                             (kk == 0 ? b >= 4 : (b & 2) != 0) ? HM_DISC_TWO : 0.0};
+            double t = s7 * (c->cut[bj][m] - o7), w = HC_SNAP * fmax(1.0, fabs(t));
+            double lo = t - w, hi = t + w, flo = hc_disc_at(&arg, lo), fhi = hc_disc_at(&arg, hi);
+            if (!((flo < 0.0) != (fhi < 0.0))) {
+                c->bad = __LINE__;
+                return;
+            }
+            double r = brent_root(hc_disc_at, &arg, lo, flo, hi, fhi);
+            if (!isfinite(r)) {
+                c->bad = __LINE__;
+                return;
+            }
+            /* the last value with a discriminant >= 0 (a row): the root's inside side */
+            double in = (flo >= 0.0 ? lo : hi) - r;
+            for (int u = 0; u < HC_SNAP_ULPS; u++) /* clear of the discriminant's rounding */
+                r = nextafter(r, r + in);
+            /* confirmed as held_manifold.c's: pk_one's row there (its rows near a double
+             * root are not the discriminant's sign alone: a pair's second root within
+             * PK_SP4_SLACK, a polish at a singular row; ~1.7 % of uniform poses have an
+             * end it does not confirm: the grid's) */
+            if (!hc_row_at(c, P, r, b)) {
+                c->bad = __LINE__;
+                return;
+            }
+            c->cut[bj][m] = s7 * r + o7;
+        }
+    for (int bj = 0; bj < 4; bj++)
+        for (int m = 0; m < c->npc[bj]; m++)
+            if (!(c->cut[bj][2 * m + 1] - c->cut[bj][2 * m] >= HC_CORNER)) {
+                c->bad = __LINE__;
+                return;
+            }
 }
 
 /* ------------------------------------------------------------ the pose */
@@ -1192,9 +1285,6 @@ static int hc_evcmp(const void *a, const void *b)
     double x = ((const HcEvent *)a)->x, y = ((const HcEvent *)b)->x;
     return x < y ? -1 : x > y;
 }
-
-/* pk_one's slot of branch (i, j), triple k */
-static inline int hc_slot(int i, int j, int k) { return 4 * (1 - i) + 2 * (1 - j) + k; }
 
 /* Whether pk_one numbers the rows at x as hc_slot does (its rows there within 1e-6
  * of these, each nearest its own slot's) */
@@ -1248,6 +1338,7 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     c->T = T;
     c->bad = 0;
     c->rows = 0;
+    c->nkept = 0;
     c->nq = 0;
     for (int bj = 0; bj < 4; bj++)
         c->nev[bj] = c->npc[bj] = 0;
@@ -1283,6 +1374,10 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
         }
     }
     hc_pieces(c);
+    if (c->bad)
+        goto done;
+    HmMargMemo memo = {0};
+    hc_snap(c, P, &memo);
     if (c->bad)
         goto done;
     for (int j = 3; j < 6 && !c->bad; j++)
@@ -1387,7 +1482,8 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
                                 double mg = hc_joints(g, v, ev->j, q);
                                 if (fabs(mg) < HC_CORNER)
                                     goto done; /* another joint at a limit there too */
-                                list = mg >= 0.0;
+                                list = 1; /* (every located one: SelfMotion.crossings
+                                           * keeps those with every other joint inside) */
                             }
                         }
                         if (list) {

@@ -14,9 +14,8 @@ enum { HM_KIND_LOWER = 0, HM_KIND_UPPER = 1, HM_KIND_ALIGNED = 2, HM_KIND_FOLD =
 enum { HM_FLAG_SINGULAR = 1, HM_FLAG_UNRESOLVED = 2, HM_FLAG_CONVERGE = 4, HM_FLAG_FULL = 8,
        HM_FLAG_VANISH = 16, HM_FLAG_MEMORY = 32, HM_FLAG_BAD = 64 };
 /* held_manifold's mode: held_closed.c's closed forms where they certify the pose, else
- * held_manifold.c's grid; the grid alone (held_manifold_one's: robot.self_motion); the
- * closed forms alone (HM_FLAG_BAD where they do not certify it). Session 26: the closed
- * forms are not robot.self_motion's yet (docs/ik.md, "Session 26") */
+ * held_manifold.c's grid (held_manifold_one's: robot.self_motion); the grid alone; the
+ * closed forms alone (HM_FLAG_BAD where they do not certify it) */
 enum { HM_MODE_AUTO = 0, HM_MODE_GRID = 1, HM_MODE_CLOSED = 2 };
 
 #endif /* ROBOKIN_HELD_OUTPUTS_H */

@@ -38,6 +38,7 @@
 #include "pieper.c"
 #include "process.c"
 #include "self_motion.c"
+#include "held_margins.c"
 #include "held_closed.c"
 #include "held_manifold.c"
 #include "near_coincident.c" /* after pieper.c: linalg6.h */
