@@ -1327,7 +1327,7 @@ static int hc_slots_agree(HcCtx *c, const double *P, double x)
 /* The intervals and points of one pose (held_manifold's outputs: iv (8, HM_MAXI, 2),
  * niv (8), pts (HM_MAXP, 4), *npts); 1 when certified (else the outputs undefined) */
 static int hc_pose(const double *P, const double *T, const double *al, long nal, double *iv,
-                   long long *niv, double *pts, long *npts, long *rows)
+                   long long *niv, double *pts, long *npts, long *rows, long *solves)
 {
     HcGeo geo;
     if (!hc_geo(P, &geo))
@@ -1517,6 +1517,7 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     ok = 1;
 done:
     *rows = c->rows;
+    *solves = 1 + c->nkept; /* pk_one calls: hc_slots_agree's, hc_row_at's */
     free(c);
     return ok;
 }

@@ -2873,16 +2873,16 @@ static void hm_range(void *ctx, long b0, long e0)
     const double *P = jb->P;
     for (long i = b0; i < e0; i++) {
         if (jb->mode != HM_MODE_GRID) { /* held_closed.c's closed forms first */
-            long npts = 0, rows = 0;
-            if (P[PK_CASE] != PK_BOTH && hc_pose(P, jb->T + 16 * i, jb->al, jb->nal,
-                                                 jb->iv + 2 * HM_MAXI * 8 * i, jb->niv + 8 * i,
-                                                 jb->pts + 4 * HM_MAXP * i, &npts, &rows)) {
+            long npts = 0, rows = 0, solves = 0;
+            if (P[PK_CASE] != PK_BOTH &&
+                hc_pose(P, jb->T + 16 * i, jb->al, jb->nal, jb->iv + 2 * HM_MAXI * 8 * i,
+                        jb->niv + 8 * i, jb->pts + 4 * HM_MAXP * i, &npts, &rows, &solves)) {
                 jb->npts[i] = npts;
                 jb->flags[i] = 0;
 #ifdef HM_COUNT_CHEAP
                 jb->evals[i] = rows; /* a measuring build: every row evaluation */
 #else
-                jb->evals[i] = 1; /* its one pk_one call (hc_slots_agree) */
+                jb->evals[i] = solves; /* its pk_one calls (slot order, branch ends) */
 #endif
                 continue;
             }
