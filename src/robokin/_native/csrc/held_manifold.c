@@ -2882,7 +2882,7 @@ static void hm_range(void *ctx, long b0, long e0)
 #ifdef HM_COUNT_CHEAP
                 jb->evals[i] = rows; /* a measuring build: every row evaluation */
 #else
-                jb->evals[i] = solves; /* its pk_one calls (slot order, branch ends) */
+                jb->evals[i] = solves; /* its pk_one calls (the slot order's) */
 #endif
                 continue;
             }
