@@ -67,13 +67,18 @@
  * The pass stops at its first flag (the caller discards a flagged pose; its niv are
  * 0 and flags holds the first flag only): the work after it cost 44 ms per iiwa14
  * pose and up to 7 s per special Gen3-like pose (issue 29, helper quartic29).
+ *
+ * Since session 26 held_closed.c's closed forms take a pose first (HM_MODE_AUTO,
+ * robot.self_motion's): this grid runs on the poses they do not certify (~4 % of
+ * uniform Panda poses, about half of those with joints at special values, every pose
+ * of other arms), as it did on every pose before.
  */
 
-#define HM_MAXQ 24      /* (joint, value) queries */
-#define HM_MAXCUT 256   /* cuts per branch */
 #include "brent.h"
 #include "held_outputs.h"
 
+#define HM_MAXQ 24      /* (joint, value) queries */
+#define HM_MAXCUT 256   /* cuts per branch */
 #define HM_JUMP 0.5     /* a joint moving more than this [rad] in a cell: split */
 #define HM_DEPTH 14     /* splits of a grid cell */
 /* A cell still to be split at HM_DEPTH that is no slot change, where the slot's q2 is
