@@ -45,7 +45,9 @@
  * ~half of poses with joints at special values): a branch end pk_one does not
  * confirm; a branch within HC_ALIGNED of an
  * aligned shoulder (1 - |cos v2|: q1 and q3 swing there) or a wrist aligned point with
- * a second wrist joint at its aligned value; a limit function at 0 at a node or at a
+ * a second wrist joint at its aligned value or a joint within HC_CORNER of a limit
+ * (self_motion_rates.py seed 0: an isolated in-limit row at q1, q3, q4 limits and
+ * q5 = 1e-9, which the grid flags for solved points); a limit function at 0 at a node or at a
  * located extremum (a touch; an isolated in-limit row), a closed-form root pair near
  * double; events of a slot within HC_CORNER of each other or of a piece's end, a joint
  * at a limit at a piece's end (a corner: the generating configuration at two limits,
@@ -1480,6 +1482,12 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
                             for (int jj = 3; jj < 6; jj++)
                                 if (jj != ev->j && fabs(r.cs[jj][1]) < HC_WRIST_ALIGNED)
                                     goto done;
+                            /* or with a joint at a limit (a corner at a singular point:
+                             * an isolated in-limit row the grid leaves to solved points) */
+                            double v[7], q[7];
+                            hc_angles(&c->p, &r, k, v);
+                            if (fabs(hc_joints(g, v, -1, q)) < HC_CORNER)
+                                goto done;
                         }
                         if (!list) { /* a crossing with the other joints inside */
                             HcRow r;
