@@ -115,9 +115,17 @@ def test_closed_forms_intervals_hold_in_limit_rows_and_the_generating_configurat
 
 
 def test_an_aligned_shoulder_and_other_arms_are_left_to_the_grid():
-    # q2 at 0 or 1e-9: q1 and q3 swing (the grid's deep splits)
-    q = np.array([[0.3, 0.0, 0.2, -1.5, 0.1, 1.2, 0.5], [0.3, 1e-9, 0.2, -1.5, 0.1, 1.2, 0.5]])
+    # q2 at 0 or 1e-9: q1 and q3 swing (the grid's deep splits); q1, q3, q4 at limits
+    # with q5 = 1e-9 (self_motion_rates.py seed 0, special #1085: an isolated in-limit
+    # row at an aligned wrist point, which the closed forms certified without it)
+    q = np.array([[0.3, 0.0, 0.2, -1.5, 0.1, 1.2, 0.5], [0.3, 1e-9, 0.2, -1.5, 0.1, 1.2, 0.5],
+                  [-2.8973, -1.6248256302915205, 2.8973, -3.0718, 1e-09, 0.2731590631920966,
+                   1e-07]])
     assert np.all(_run(PANDA, PANDA.fk(q), K.HM_MODE_CLOSED)["flags"] == K.HM_FLAG_BAD)
+    # robot.self_motion (the grid, then solved points) has the isolated row
+    sm = PANDA.self_motion(PANDA.fk(q[2]))
+    assert sm.reachable
+    assert np.abs(sm.nearest(q[2]).q - q[2]).max() < 1e-6
     # the Gen3-like arm (joint_3 held, the wrist triple): not this file's kind; AUTO is
     # then the grid, bit for bit
     d = [-0.2848, -0.0118, -0.4208, -0.0128, -0.3143, 0.0, -0.1674]
