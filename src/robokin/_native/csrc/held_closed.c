@@ -224,18 +224,20 @@ static int hc_setup(const HcGeo *g, const double *T, HcPose *p)
 }
 
 /* cos, sin of a root of A cos v + B sin v = C (|(A, B)| = n), root i (0: phi + acos,
- * 1: phi - acos), with gamma = C / n clamped to [-1, 1]; sigma = sin(acos gamma) */
+ * 1: phi - acos; subproblems.h's SP4_PAIR without the angles), with gamma = C / n
+ * clamped to [-1, 1] (a branch end keeps both labels, where sp4_roots merges them);
+ * sigma = sin(acos gamma), negative for root 1 */
 static inline void hc_root(double A, double B, double n, double C, int i, double *c,
                            double *s, double *sigma)
 {
-    double ca = A / n, sa = B / n, gm = C / n;
+    double gm = C / n;
     gm = gm > 1.0 ? 1.0 : gm < -1.0 ? -1.0 : gm;
     double sg = sqrt(1.0 - gm * gm);
-    if (i)
-        sg = -sg;
-    *c = ca * gm - sa * sg;
-    *s = sa * gm + ca * sg;
-    *sigma = sg;
+    Roots r;
+    SP4_PAIR(r, 0.0, A / n, B / n, 0.0, gm, sg);
+    *c = r.c[i];
+    *s = r.s[i];
+    *sigma = i ? -sg : sg;
 }
 
 /* E1's margin at x (|c| - |D - K|: >= 0 where v4 has roots) */
@@ -465,12 +467,15 @@ static void hc_add(HcCtx *c, int bj, double x, int j, int kind, int k)
 /* Roots x of a0 + a1 cos x + a2 sin x = 0 (at most 2) */
 static int hc_sin_roots(double a0, double a1, double a2, double *x)
 {
-    double h = hypot(a1, a2);
-    if (!(h > 0.0) || fabs(a0) > h)
+    double h2 = a1 * a1 + a2 * a2;
+    if (!(h2 > 0.0) || a0 * a0 > h2)
         return 0;
-    double ph = atan2(a2, a1), d = acos(-a0 / h);
-    x[0] = wrap_pi(ph + d);
-    x[1] = wrap_pi(ph - d);
+    double cphi, sphi;
+    unit2(a2, a1, &cphi, &sphi);
+    Roots r = sp4_roots(a1, a2, -a0, h2 - a0 * a0, 0.0, 0, fast_atan2(a2, a1), cphi, sphi);
+    x[0] = wrap_pi(r.t[0]);
+    x[1] = wrap_pi(r.t[1]);
+    double d = 0.5 * fabs(r.t[0] - r.t[1]); /* acos(-a0 / |(a1, a2)|) */
     if (d < HC_DOUBLE || M_PI - d < HC_DOUBLE)
         return -1; /* near double (tangent): the grid's */
     return 2;
