@@ -82,6 +82,7 @@
 #define HC_ROWS_KEPT 8   /* pk_one calls kept by hc_row_at */
 #define HC_SNAP_ULPS 16  /* a snapped branch end moved this many doubles inward */
 #define HC_SNAP 1e-8     /* pk_one's branch end searched this far (relative) from the margin's */
+#define HC_SNAP_TOL 4e-15 /* ... and located this closely (relative) */
 #define HC_END_XI 1e-4   /* a branch end's slopes from this far in (in xi) */
 #define HC_AT 1e-12      /* a crossing's joint at its value to this [rad] */
 #define HC_AT_STEEP 1e-9 /* the same where the last bit of x moves the joint more */
@@ -90,6 +91,7 @@
 #define HC_BEND_FLOOR 1e-2
 #define HC_MOVE 0.25     /* a function moving more than this in a cell: split */
 #define HC_END_SPLITS 4  /* splits of a cell at a branch end (no slope there) */
+#define HC_ARC_MIN 0.05  /* sin of a joint range's half width above this (hc_margins) */
 
 typedef struct {
     v3 h[7], o[7], S, Wc, e1, e2, ea, a0, a1, a2, h56x;
@@ -97,6 +99,8 @@ typedef struct {
     v3 tM;
     double K, c1, c2, cn, ec[3], h56, L;
     double sign[7], off[7], lo[7], hi[7];
+    double arc[7][4]; /* each joint's limits as an arc of chain values: cos, sin of its
+                       * middle, cos and 1 / sin of its half width (hc_margins) */
 } HcGeo;
 
 typedef struct {
@@ -108,12 +112,14 @@ typedef struct {
     double xlo, xhi;     /* x's range (chain values) */
 } HcPose;
 
-/* One position branch's row at x: the joint chain values, the shoulder's w, r and
- * their slopes d/dx (slopes only when asked and finite). */
+/* One position branch's row at x: the joint chain values, the shoulder's w = R e1
+ * and r = R^T e1 in the shoulder's basis and their slopes d/dx (slopes only when asked
+ * and finite). */
 typedef struct {
     double x, cs[7][2], dv[7], noise; /* noise: v5's rounding [rad] */
-    double q[2][7];   /* joint values of both triples (hc_rowq; q[0][0] NaN until then) */
-    v3 w, r, dw, dr;
+    double mg[2][7];  /* each joint's margins, both triples (hc_rowq; mg[0][0] NaN until then) */
+    double sh[5], dsh[5]; /* w.ea, w.e2, w.e1, r.ea, r.e2 and their slopes */
+    double dxi;       /* dx/dxi on its piece (hc_cell's slopes per cell) */
     int sloped;
 } HcRow;
 
@@ -134,8 +140,13 @@ static int hc_geo(const double *P, HcGeo *g)
         g->off[k] = P[PK_OFFSET + k];
         g->lo[k] = P[PK_LO + k];
         g->hi[k] = P[PK_HI + k];
-        if (fabs(g->sign[k]) != 1.0 || !(g->hi[k] - g->lo[k] < 2.0 * M_PI))
-            return 0;
+        double half = 0.5 * (g->hi[k] - g->lo[k]), mid = g->sign[k] * (g->lo[k] + half) + g->off[k];
+        if (fabs(g->sign[k]) != 1.0 || !(sin(half) > HC_ARC_MIN) || !(half > 0.0))
+            return 0; /* (a range within HC_ARC_MIN of 0 or a whole turn: the grid's) */
+        g->arc[k][0] = cos(mid);
+        g->arc[k][1] = sin(mid);
+        g->arc[k][2] = cos(half);
+        g->arc[k][3] = 1.0 / sin(half);
     }
     g->RM = (m3){v3_at(P, PK_TOOL_R), v3_at(P, PK_TOOL_R + 3), v3_at(P, PK_TOOL_R + 6)};
     g->tM = v3_at(P, PK_TOOL_T);
@@ -312,10 +323,13 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int slopes, HcRow *r
     rr = v3_rot(h6, c6, s6, rr);
     rr = v3_rot(h5, c5, s5, rr);
     rr = v3_rot(h4, c4, s4, rr);
-    r->w = w;
-    r->r = rr;
+    r->sh[0] = v3_dot(w, g->ea);
+    r->sh[1] = v3_dot(w, g->e2);
+    r->sh[2] = v3_dot(w, g->e1);
+    r->sh[3] = v3_dot(rr, g->ea);
+    r->sh[4] = v3_dot(rr, g->e2);
     r->sloped = 0;
-    r->q[0][0] = NAN; /* hc_rowq's, when asked */
+    r->mg[0][0] = NAN; /* hc_rowq's, when asked */
     if (!slopes)
         return 1;
     /* joint rates d/dx: E1, E2, v5's equation (m = R5(v5) h6: m . x4 = h6 . v) */
@@ -337,8 +351,12 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int slopes, HcRow *r
     v3 ob = v3_rot(h6, c6, s6, in);
     ob = v3_rot(h5, c5, s5, ob);
     ob = v3_scale(v3_rot(h4, c4, s4, ob), -1.0);
-    r->dw = v3_cross(om, w);
-    r->dr = v3_scale(v3_cross(ob, rr), -1.0);
+    v3 dw = v3_cross(om, w), dr = v3_cross(rr, ob);
+    r->dsh[0] = v3_dot(dw, g->ea);
+    r->dsh[1] = v3_dot(dw, g->e2);
+    r->dsh[2] = v3_dot(dw, g->e1);
+    r->dsh[3] = v3_dot(dr, g->ea);
+    r->dsh[4] = v3_dot(dr, g->e2);
     r->dv[3] = dv4;
     r->dv[4] = dv5;
     r->dv[5] = dv6;
@@ -350,9 +368,8 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int slopes, HcRow *r
 /* Chain values of a row, triple k (0: v2 >= 0; 1: the other) */
 static void hc_angles(const HcPose *p, const HcRow *r, int k, double *v)
 {
-    const HcGeo *g = p->g;
-    double wa = v3_dot(r->w, g->ea), wb = v3_dot(r->w, g->e2), wc = v3_dot(r->w, g->e1);
-    double ra = v3_dot(r->r, g->ea), rb = v3_dot(r->r, g->e2);
+    (void)p;
+    double wa = r->sh[0], wb = r->sh[1], wc = r->sh[2], ra = r->sh[3], rb = r->sh[4];
     v[0] = fast_atan2(wb, wa);
     v[1] = fast_atan2(sqrt(wa * wa + wb * wb), wc);
     v[2] = fast_atan2(rb, -ra);
@@ -383,14 +400,57 @@ static double hc_joints(const HcGeo *g, const double *v, int skip, double *q)
     return margin;
 }
 
-/* Row r's joint values of both triples (into r->q) and each triple's least margin */
+/* Row r's margins of joints 1-6 to their limits, both triples (mg[k][j]; joint 7, the
+ * held one, inside by construction: +inf), without the angles: with m the middle of a
+ * joint's range of chain values and h its half width, (cos(v - m) - cos h) / sin h, of
+ * the sign of the joint's margin and equal to it to O(margin^2) (sin d + cot h (cos d
+ * - 1) at a margin d). The shoulder's (cos, sin) from w and r as hc_angles' (sin v2 =
+ * |(w.ea, w.e2)| for triple 0; triple 1: v1 + pi, -v2, v3 + pi). */
+static void hc_margins(const HcGeo *g, const HcRow *r, double mg[2][7])
+{
+    const double *a = r->sh;
+    double rho = hypot(a[0], a[1]), ir = 1.0 / rho;
+    double d1 = (a[0] * g->arc[0][0] + a[1] * g->arc[0][1]) * ir;
+    double d3 = (-a[3] * g->arc[2][0] + a[4] * g->arc[2][1]) * ir;
+    double d2c = a[2] * g->arc[1][0], d2s = rho * g->arc[1][1];
+    mg[0][0] = (d1 - g->arc[0][2]) * g->arc[0][3];
+    mg[1][0] = (-d1 - g->arc[0][2]) * g->arc[0][3];
+    mg[0][1] = (d2c + d2s - g->arc[1][2]) * g->arc[1][3];
+    mg[1][1] = (d2c - d2s - g->arc[1][2]) * g->arc[1][3];
+    mg[0][2] = (d3 - g->arc[2][2]) * g->arc[2][3];
+    mg[1][2] = (-d3 - g->arc[2][2]) * g->arc[2][3];
+    for (int j = 3; j < 6; j++)
+        mg[0][j] = mg[1][j] =
+            (r->cs[j][0] * g->arc[j][0] + r->cs[j][1] * g->arc[j][1] - g->arc[j][2]) * g->arc[j][3];
+    mg[0][6] = mg[1][6] = INFINITY;
+}
+
+/* The least of margins mg (7) over the joints other than `skip` */
+static inline double hc_least(const double *mg, int skip)
+{
+    double m = INFINITY;
+    for (int j = 0; j < 6; j++)
+        if (j != skip)
+            m = fmin(m, mg[j]);
+    return m;
+}
+
+/* Row r's margins (into r->mg) and each triple's least margin */
 static void hc_rowq(const HcPose *p, HcRow *r, double *margin)
 {
-    for (int k = 0; k < 2; k++) {
-        double v[7];
-        hc_angles(p, r, k, v);
-        margin[k] = hc_joints(p->g, v, -1, r->q[k]);
-    }
+    hc_margins(p->g, r, r->mg);
+    margin[0] = hc_least(r->mg[0], -1);
+    margin[1] = hc_least(r->mg[1], -1);
+}
+
+/* Triple k's chain value of shoulder joint j (0-2) on row r (hc_angles' for one) */
+static double hc_angle1(const HcRow *r, int k, int j)
+{
+    const double *a = r->sh;
+    double v = j == 0 ? fast_atan2(a[1], a[0])
+             : j == 1 ? fast_atan2(hypot(a[0], a[1]), a[2])
+                      : fast_atan2(a[4], -a[3]);
+    return !k ? v : j == 1 ? -v : wrap_pi(v + M_PI);
 }
 
 /* A shoulder function: joint j (0-2) at chain value V (kind: HM_KIND_*; -1: the
@@ -402,27 +462,25 @@ typedef struct {
 
 /* Query q's value on row r, its slope d/dx when ds != NULL, and the triple a root of
  * it belongs to (*k) */
-static double hc_f(const HcPose *p, const HcQuery *q, const HcRow *r, double *ds, int *k)
+static double hc_f(const HcQuery *q, const HcRow *r, double *ds, int *k)
 {
-    const HcGeo *g = p->g;
+    const double *a = r->sh, *da = r->dsh;
     double f, d = NAN, side;
     if (q->j == 0) {
-        double a = v3_dot(r->w, g->ea), b = v3_dot(r->w, g->e2);
-        f = -q->sV * a + q->cV * b;
-        side = q->cV * a + q->sV * b;
+        f = -q->sV * a[0] + q->cV * a[1];
+        side = q->cV * a[0] + q->sV * a[1];
         if (ds != NULL)
-            d = -q->sV * v3_dot(r->dw, g->ea) + q->cV * v3_dot(r->dw, g->e2);
+            d = -q->sV * da[0] + q->cV * da[1];
     } else if (q->j == 1) {
-        f = v3_dot(r->w, g->e1) - q->cV;
+        f = a[2] - q->cV;
         side = q->V;
         if (ds != NULL)
-            d = v3_dot(r->dw, g->e1);
+            d = da[2];
     } else {
-        double a = v3_dot(r->r, g->ea), b = v3_dot(r->r, g->e2);
-        f = q->cV * b + q->sV * a;
-        side = -q->cV * a + q->sV * b;
+        f = q->cV * a[4] + q->sV * a[3];
+        side = -q->cV * a[3] + q->sV * a[4];
         if (ds != NULL)
-            d = q->cV * v3_dot(r->dr, g->e2) + q->sV * v3_dot(r->dr, g->ea);
+            d = q->cV * da[4] + q->sV * da[3];
     }
     if (ds != NULL)
         *ds = d;
@@ -771,14 +829,48 @@ static inline double hc_dx(const HcPiece *pc, double xi)
     return (pc->b - pc->a) * 0.5 * M_PI * sin(M_PI * xi);
 }
 
-/* A crossing of query q in (x0, x1) (values f0, f1 of opposite signs) on the
- * piece's branch: safeguarded Newton / Illinois to the last bits; the event with its
- * triple. */
-static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, double x0, double f0,
-                      double x1, double f1)
+/* The root in (0, 1) of the cubic Hermite model with values f0, f1 of opposite signs
+ * and slopes d0, d1 (times the cell): a start for hc_root_q (Illinois on the model) */
+static double hc_model_root(double f0, double f1, double d0, double d1)
+{
+    double lo = 0.0, hi = 1.0, flo = f0, fhi = f1, t = 0.5;
+    int side = 0;
+    for (int it = 0; it < 30 && hi - lo > 1e-9; it++) {
+        t = lo - flo * (hi - lo) / (fhi - flo);
+        if (!(t > lo && t < hi))
+            t = 0.5 * (lo + hi);
+        double t2 = t * t, t3 = t2 * t;
+        double v = (2 * t3 - 3 * t2 + 1) * f0 + (t3 - 2 * t2 + t) * d0 + (-2 * t3 + 3 * t2) * f1 +
+                   (t3 - t2) * d1;
+        if (v == 0.0)
+            break;
+        if ((v < 0.0) == (flo < 0.0)) {
+            lo = t;
+            flo = v;
+            if (side == -1)
+                fhi *= 0.5;
+            side = -1;
+        } else {
+            hi = t;
+            fhi = v;
+            if (side == 1)
+                flo *= 0.5;
+            side = 1;
+        }
+    }
+    return t;
+}
+
+/* A crossing of query q in the cell (ra, rb) at xi0 < xi1 (values f0, f1 of opposite
+ * signs, slopes d0, d1 times the cell) on the piece's branch: from the cubic model's
+ * root, safeguarded Newton / Illinois to the last bits; the event with its triple. */
+static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow *ra,
+                      double xi0, double f0, double d0, const HcRow *rb, double xi1,
+                      double f1, double d1)
 {
     HcRow r;
-    double lo = x0, hi = x1, flo = f0, fhi = f1, x = x0 - f0 * (x1 - x0) / (f1 - f0);
+    double lo = ra->x, hi = rb->x, flo = f0, fhi = f1;
+    double x = hc_x(pc, xi0 + (xi1 - xi0) * hc_model_root(f0, f1, d0, d1));
     int side = 0;
     for (int it = 0;; it++) {
         if (it >= 40) {
@@ -792,11 +884,10 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, double x0, 
             return;
         }
         c->rows++;
-        double d, f = hc_f(&c->p, q, &r, &d, NULL);
+        double d, f = hc_f(q, &r, &d, NULL);
         /* at the root to its rounding: f is sin v2 sin(v_j - V) (v1, v3), cos v2 - cos V
          * (v2), each O(1), with v5's rounding (r.noise) in the angles */
-        double wa = v3_dot(r.w, c->p.g->ea), wb = v3_dot(r.w, c->p.g->e2);
-        double sfac = q->j == 1 ? fabs(q->sV) : sqrt(wa * wa + wb * wb);
+        double sfac = q->j == 1 ? fabs(q->sV) : hypot(r.sh[0], r.sh[1]);
         if (fabs(f) <= 4.0 * DBL_EPSILON + 4.0 * r.noise * sfac)
             break;
         if ((f < 0.0) == (flo < 0.0)) {
@@ -819,20 +910,14 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, double x0, 
             nx = lo - flo * (hi - lo) / (fhi - flo);
         x = nx;
     }
-    if (!hc_eval(&c->p, x, pc->i, pc->j, 1, &r)) {
-        c->bad = __LINE__;
-        return;
-    }
-    int k;
-    double d, v[7];
-    hc_f(&c->p, q, &r, &d, &k);
+    int k; /* (r is x's row) */
+    double d;
+    hc_f(q, &r, &d, &k);
     /* the joint at its value to HC_AT, or to what the last bits of x allow where it
      * moves fast (next to a branch end: as the square root of the distance), at most
      * HC_AT_STEEP; |df / dv_j| is |sin v2 cos(v_j - V)| ~ |sin v2| (v1, v3) or |sin V| */
-    hc_angles(&c->p, &r, k, v);
-    double wa = v3_dot(r.w, c->p.g->ea), wb = v3_dot(r.w, c->p.g->e2);
-    double rate = fabs(d) / (q->j == 1 ? fabs(q->sV) : sqrt(wa * wa + wb * wb));
-    double off = fabs(wrap_pi(v[q->j] - q->V));
+    double rate = fabs(d) / (q->j == 1 ? fabs(q->sV) : hypot(r.sh[0], r.sh[1]));
+    double off = fabs(wrap_pi(hc_angle1(&r, k, q->j) - q->V));
     double tol = fmax(HC_AT, 8.0 * fmax(rate * DBL_EPSILON * fmax(1.0, fabs(x)), r.noise));
     if (!r.sloped || !(off <= tol) || !(off <= HC_AT_STEEP)) {
         c->bad = __LINE__;
@@ -851,12 +936,8 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, double x0, 
 static int hc_out(const HcCtx *c, int bj, const HcRow *ra, const HcRow *rb, int k, int m,
                   const double *fa, const double *fb)
 {
-    const HcGeo *g = c->p.g;
     for (const HcRow *r = ra; r != NULL; r = r == ra ? rb : NULL)
-        if (isnan(r->q[k][m]))
-            return 0;
-    for (const HcRow *r = ra; r != NULL; r = r == ra ? rb : NULL)
-        if (r->q[k][m] >= g->lo[m] && r->q[k][m] <= g->hi[m])
+        if (!(r->mg[k][m] < 0.0)) /* (NaN: not known) */
             return 0;
     if (m >= 3) {
         for (int e = 0; e < c->nev[bj]; e++) {
@@ -879,16 +960,16 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
 {
     if (c->bad)
         return;
-    double h = xi1 - xi0, sa = hc_dx(pc, xi0) * h, sb = hc_dx(pc, xi1) * h;
+    double h = xi1 - xi0, sa = ra->dxi * h, sb = rb->dxi * h;
     double ea = 0.5 * (pc->b - pc->a) * M_PI * h; /* a branch end's row: d/dxi given */
     double at = 0.5; /* where a split cuts the cell */
     int split = 0;
-    double fa[HC_MAXQ], fb[HC_MAXQ];
+    double fa[HC_MAXQ], fb[HC_MAXQ], dfa[HC_MAXQ], dfb[HC_MAXQ];
     for (int m = 0; m < c->nq && !split; m++) {
         const HcQuery *q = &c->q[m];
         double da, db;
-        fa[m] = hc_f(&c->p, q, ra, &da, NULL);
-        fb[m] = hc_f(&c->p, q, rb, &db, NULL);
+        fa[m] = hc_f(q, ra, &da, NULL);
+        fb[m] = hc_f(q, rb, &db, NULL);
         da = ra->sloped == 2 ? da * ea : ra->sloped ? da * sa : NAN;
         db = rb->sloped == 2 ? db * ea : rb->sloped ? db * sb : NAN;
         int known = isfinite(da) && isfinite(db);
@@ -896,6 +977,8 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
             da = fb[m] - fa[m];
         if (!isfinite(db))
             db = fb[m] - fa[m];
+        dfa[m] = da;
+        dfb[m] = db;
         double tol = q->kind < 0 ? HC_ALIGNED : HC_TOUCH;
         if (fabs(fa[m]) < (q->kind < 0 ? tol : HC_AT_NODE) ||
             fabs(fb[m]) < (q->kind < 0 ? tol : HC_AT_NODE)) {
@@ -937,6 +1020,7 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
             c->bad = __LINE__;
             return;
         }
+        rm.dxi = hc_dx(pc, xm);
         c->rows++;
         hc_cell(c, pc, ra, xi0, &rm, xm, depth + 1);
         hc_cell(c, pc, &rm, xm, rb, xi1, depth + 1);
@@ -956,13 +1040,13 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
              * both: the triple known only at the root) is outside all over the cell
              * (held_manifold.c's dead cells; aligned points are listed everywhere) */
             int ka, kb, skip = 1;
-            hc_f(&c->p, q, ra, NULL, &ka);
-            hc_f(&c->p, q, rb, NULL, &kb);
-            if (isnan(ra->q[0][0])) {
+            hc_f(q, ra, NULL, &ka);
+            hc_f(q, rb, NULL, &kb);
+            if (isnan(ra->mg[0][0])) {
                 double mg[2];
                 hc_rowq(&c->p, ra, mg);
             }
-            if (isnan(rb->q[0][0])) {
+            if (isnan(rb->mg[0][0])) {
                 double mg[2];
                 hc_rowq(&c->p, rb, mg);
             }
@@ -980,7 +1064,7 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
             if (skip)
                 continue;
         }
-        hc_root_q(c, pc, q, ra->x, fa[m], rb->x, fb[m]);
+        hc_root_q(c, pc, q, ra, xi0, fa[m], dfa[m], rb, xi1, fb[m], dfb[m]);
     }
 }
 
@@ -995,6 +1079,7 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
             c->bad = __LINE__;
             return;
         }
+        r[k].dxi = hc_dx(pc, xi);
         c->rows++;
         if ((k == 0 && pc->fa) || (k == HC_NODES - 1 && pc->fb)) {
             /* a branch end: rates infinite in x, finite in xi (x - end ~ xi^2): the
@@ -1009,8 +1094,8 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
             double f = hc_dx(pc, xe) / (0.5 * (pc->b - pc->a) * M_PI); /* dx/dxi ~ this */
             for (int m = 0; m < 7; m++)
                 r[k].dv[m] = e.dv[m] * f;
-            r[k].dw = v3_scale(e.dw, f);
-            r[k].dr = v3_scale(e.dr, f);
+            for (int m = 0; m < 5; m++)
+                r[k].dsh[m] = e.dsh[m] * f;
             r[k].sloped = 2; /* slopes d/dxi / (pi (b - a) / 2): see hc_cell */
         }
         if (k == 0 || k == HC_NODES - 1) {
@@ -1265,14 +1350,43 @@ static void hc_snap(HcCtx *c, const double *P, HmMargMemo *memo)
                 c->bad = __LINE__;
                 return;
             }
-            double r = brent_root(hc_disc_at, &arg, lo, flo, hi, fhi);
-            if (!isfinite(r)) {
-                c->bad = __LINE__;
-                return;
+            /* the root to HC_SNAP_TOL: Illinois steps, each followed by a probe just
+             * past it (across 1e-8 the discriminant is nearly linear: a step lands
+             * next to the root, the probe closes the bracket) */
+            double tol = HC_SNAP_TOL * fmax(1.0, fabs(t)), glo = flo, ghi = fhi;
+            for (int it = 0; hi - lo > tol; it++) {
+                if (it >= 40) {
+                    c->bad = __LINE__;
+                    return;
+                }
+                double x = lo - glo * (hi - lo) / (ghi - glo);
+                if (!(x > lo && x < hi))
+                    x = 0.5 * (lo + hi);
+                for (int probe = 0; probe < 2 && hi - lo > tol; probe++) {
+                    double fx = hc_disc_at(&arg, x);
+                    if (!isfinite(fx)) {
+                        c->bad = __LINE__;
+                        return;
+                    }
+                    int below = (fx < 0.0) == (flo < 0.0); /* the root above x */
+                    if (below) {
+                        lo = x;
+                        flo = glo = fx;
+                        ghi *= 0.5; /* (Illinois: hi stays) */
+                    } else {
+                        hi = x;
+                        fhi = ghi = fx;
+                        glo *= 0.5;
+                    }
+                    x += below ? 0.5 * tol : -0.5 * tol;
+                    if (!(x > lo && x < hi))
+                        break;
+                }
             }
-            /* the last value with a discriminant >= 0 (a row): the root's inside side */
-            double in = (flo >= 0.0 ? lo : hi) - r;
-            for (int u = 0; u < HC_SNAP_ULPS; u++) /* clear of the discriminant's rounding */
+            /* the last value with a discriminant >= 0 (a row): the bracket's inside
+             * end, moved clear of the discriminant's rounding */
+            double r = flo >= 0.0 ? lo : hi, in = flo >= 0.0 ? -1.0 : 1.0;
+            for (int u = 0; u < HC_SNAP_ULPS; u++)
                 r = nextafter(r, r + in);
             /* confirmed as held_manifold.c's: pk_one's row there (its rows near a double
              * root are not the discriminant's sign alone; an end it does not confirm
@@ -1455,12 +1569,12 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
                         goto done; /* a corner: two events (or one and an end) together */
                     if (x > prev) {
                         HcRow r;
-                        double v[7], q[7];
+                        double mgs[2][7];
                         if (!hc_eval(&c->p, 0.5 * (prev + x), bj >> 1, bj & 1, 0, &r))
                             goto done;
                         c->rows++;
-                        hc_angles(&c->p, &r, k, v);
-                        double mg = hc_joints(g, v, -1, q);
+                        hc_margins(g, &r, mgs);
+                        double mg = hc_least(mgs[k], -1);
                         if (fabs(mg) < HC_DECIDE)
                             goto done;
                         if (mg > 0.0) {
@@ -1489,17 +1603,17 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
                                     goto done;
                             /* or with a joint at a limit (a corner at a singular point:
                              * an isolated in-limit row the grid leaves to solved points) */
-                            double v[7], q[7];
-                            hc_angles(&c->p, &r, k, v);
-                            if (fabs(hc_joints(g, v, -1, q)) < HC_CORNER)
+                            double mgs[2][7];
+                            hc_margins(g, &r, mgs);
+                            if (fabs(hc_least(mgs[k], -1)) < HC_CORNER)
                                 goto done;
                         }
                         if (!list) { /* a crossing with the other joints inside */
                             HcRow r;
-                            double v[7], q[7];
+                            double mgs[2][7];
                             if (hc_eval(&c->p, ev->x, bj >> 1, bj & 1, 0, &r)) {
-                                hc_angles(&c->p, &r, k, v);
-                                double mg = hc_joints(g, v, ev->j, q);
+                                hc_margins(g, &r, mgs);
+                                double mg = hc_least(mgs[k], ev->j);
                                 if (fabs(mg) < HC_CORNER)
                                     goto done; /* another joint at a limit there too */
                                 list = 1; /* (every located one: SelfMotion.crossings
