@@ -69,6 +69,7 @@
 #define HC_MAXE 64       /* events per branch (i, j) */
 #define HC_MAXPC 12      /* pieces per branch */
 #define HC_MAXQ 12       /* shoulder functions */
+#define HC_MAXN 192      /* node rows kept per branch (hc_keep) */
 #define HC_ALIGNED 1e-6  /* 1 - |cos v2| below this on a branch: not certified */
 #define HC_CLOSE 1e-9    /* closed-form roots this close: one */
 #define HC_CORNER 1e-6   /* events of one slot this close (or an end): the grid's */
@@ -276,8 +277,12 @@ static double hc_m2(const HcPose *p, double x, int i, double *dm)
     return H - fabs(E);
 }
 
-/* Branch (i, j)'s row at x; 0 when it has none (a margin below -tol). */
-static int hc_eval(const HcPose *p, double x, int i, int j, int slopes, HcRow *r)
+#define HC_SHOULDER 1 /* hc_eval: the shoulder's scalars (else the wrist's values alone) */
+#define HC_SLOPES 2   /* ... and the slopes d/dx (the wrist's alone without HC_SHOULDER) */
+
+/* Branch (i, j)'s row at x (what: HC_SHOULDER, HC_SLOPES); 0 when it has none (a
+ * margin below -tol). */
+static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
 {
     const HcGeo *g = p->g;
     double c = cos(x), s = sin(x);
@@ -313,24 +318,27 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int slopes, HcRow *r
     r->cs[4][1] = s5;
     r->cs[5][0] = c6;
     r->cs[5][1] = s6;
-    /* w = R e1, R = RG0 R7(-x) R6(-v6) R5(-v5) R4(-v4); r = R^T e1 */
-    v3 w = v3_rot(h4, c4, -s4, g->e1);
-    w = v3_rot(h5, c5, -s5, w);
-    w = v3_rot(h6, c6, -s6, w);
-    w = v3_rot(h7, c, -s, w);
-    w = m3_mv(&p->RG0, w);
-    v3 rr = v3_rot(h7, c, s, p->g1);
-    rr = v3_rot(h6, c6, s6, rr);
-    rr = v3_rot(h5, c5, s5, rr);
-    rr = v3_rot(h4, c4, s4, rr);
-    r->sh[0] = v3_dot(w, g->ea);
-    r->sh[1] = v3_dot(w, g->e2);
-    r->sh[2] = v3_dot(w, g->e1);
-    r->sh[3] = v3_dot(rr, g->ea);
-    r->sh[4] = v3_dot(rr, g->e2);
     r->sloped = 0;
     r->mg[0][0] = NAN; /* hc_rowq's, when asked */
-    if (!slopes)
+    v3 w = {0}, rr = {0};
+    if (what & HC_SHOULDER) {
+        /* w = R e1, R = RG0 R7(-x) R6(-v6) R5(-v5) R4(-v4); r = R^T e1 */
+        w = v3_rot(h4, c4, -s4, g->e1);
+        w = v3_rot(h5, c5, -s5, w);
+        w = v3_rot(h6, c6, -s6, w);
+        w = v3_rot(h7, c, -s, w);
+        w = m3_mv(&p->RG0, w);
+        rr = v3_rot(h7, c, s, p->g1);
+        rr = v3_rot(h6, c6, s6, rr);
+        rr = v3_rot(h5, c5, s5, rr);
+        rr = v3_rot(h4, c4, s4, rr);
+        r->sh[0] = v3_dot(w, g->ea);
+        r->sh[1] = v3_dot(w, g->e2);
+        r->sh[2] = v3_dot(w, g->e1);
+        r->sh[3] = v3_dot(rr, g->ea);
+        r->sh[4] = v3_dot(rr, g->e2);
+    }
+    if (!(what & HC_SLOPES))
         return 1;
     /* joint rates d/dx: E1, E2, v5's equation (m = R5(v5) h6: m . x4 = h6 . v) */
     double den4 = -g->c1 * s4 + g->c2 * c4;
@@ -344,6 +352,14 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int slopes, HcRow *r
     v3 dv = v3_add(v3_scale(p->v[1], -s), v3_scale(p->v[2], c));
     double den5 = v3_dot(v3_cross(h5, m), x4);
     double dv5 = (v3_dot(h6, dv) - v3_dot(m, dx4)) / den5;
+    r->dv[3] = dv4;
+    r->dv[4] = dv5;
+    r->dv[5] = dv6;
+    r->dv[6] = 1.0;
+    if (!(what & HC_SHOULDER)) {
+        r->sloped = isfinite(dv4) && isfinite(dv5) && isfinite(dv6);
+        return 1;
+    }
     /* the shoulder's angular velocity: spatial om = -RG inner, body -R4 R5 R6 inner */
     v3 in = v3_add(v3_scale(v3_rot(h5, c5, -s5, h4), dv4), v3_scale(h5, dv5));
     in = v3_add(v3_rot(h6, c6, -s6, in), v3_add(v3_scale(h6, dv6), h7));
@@ -357,10 +373,6 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int slopes, HcRow *r
     r->dsh[2] = v3_dot(dw, g->e1);
     r->dsh[3] = v3_dot(dr, g->ea);
     r->dsh[4] = v3_dot(dr, g->e2);
-    r->dv[3] = dv4;
-    r->dv[4] = dv5;
-    r->dv[5] = dv6;
-    r->dv[6] = 1.0;
     r->sloped = isfinite(dv4) && isfinite(dv5) && isfinite(dv6) && isfinite(om.x + om.y + om.z);
     return 1;
 }
@@ -409,7 +421,7 @@ static double hc_joints(const HcGeo *g, const double *v, int skip, double *q)
 static void hc_margins(const HcGeo *g, const HcRow *r, double mg[2][7])
 {
     const double *a = r->sh;
-    double rho = hypot(a[0], a[1]), ir = 1.0 / rho;
+    double rho = sqrt(a[0] * a[0] + a[1] * a[1]), ir = 1.0 / rho;
     double d1 = (a[0] * g->arc[0][0] + a[1] * g->arc[0][1]) * ir;
     double d3 = (-a[3] * g->arc[2][0] + a[4] * g->arc[2][1]) * ir;
     double d2c = a[2] * g->arc[1][0], d2s = rho * g->arc[1][1];
@@ -430,8 +442,8 @@ static inline double hc_least(const double *mg, int skip)
 {
     double m = INFINITY;
     for (int j = 0; j < 6; j++)
-        if (j != skip)
-            m = fmin(m, mg[j]);
+        if (j != skip && mg[j] < m) /* (a NaN margin, unknown, skipped as fmin does) */
+            m = mg[j];
     return m;
 }
 
@@ -448,7 +460,7 @@ static double hc_angle1(const HcRow *r, int k, int j)
 {
     const double *a = r->sh;
     double v = j == 0 ? fast_atan2(a[1], a[0])
-             : j == 1 ? fast_atan2(hypot(a[0], a[1]), a[2])
+             : j == 1 ? fast_atan2(sqrt(a[0] * a[0] + a[1] * a[1]), a[2])
                       : fast_atan2(a[4], -a[3]);
     return !k ? v : j == 1 ? -v : wrap_pi(v + M_PI);
 }
@@ -493,7 +505,10 @@ static double hc_f(const HcQuery *q, const HcRow *r, double *ds, int *k)
 
 typedef struct {
     double x;
-    int j, kind, k; /* k: the triple (-1: both) */
+    int j, kind, k;  /* k: the triple (-1: both) */
+    double mg[2];    /* per triple: the least margin of the other joints there */
+    double mgall[2]; /* ... of every joint */
+    double wal;      /* the least |sin| of the other wrist joints' chain values */
 } HcEvent;
 
 typedef struct {
@@ -506,6 +521,8 @@ typedef struct {
     double cut[4][2 * HC_MAXPC]; /* the branch's piece ends (x), as pairs */
     int cutfold[4][2 * HC_MAXPC]; /* that end: 0 the range's, 1 E1's branch end, 2 E2's */
     int npc[4];
+    double node[4][HC_MAXN][3]; /* per branch: x and both triples' least margins there */
+    int nnode[4];
     long rows; /* row evaluations (a measuring build's evals: HM_COUNT_CHEAP) */
     double kept_t[HC_ROWS_KEPT]; /* hc_row_at's fronts: their position slots' rows */
     unsigned char kept_valid[HC_ROWS_KEPT][4];
@@ -513,13 +530,37 @@ typedef struct {
     PkFrontMemo front; /* pk_front_memo's held-value-free parts */
 } HcCtx;
 
-static void hc_add(HcCtx *c, int bj, double x, int j, int kind, int k)
+/* Node row r of branch bj kept (x and both triples' least margins) for the pieces'
+ * decisions (a slot is inside or outside all over a piece between its located events:
+ * its membership changes only at a crossing with the other joints inside, never in a
+ * dead cell); past HC_MAXN the rest are not kept (the decisions' rows then) */
+static void hc_keep(HcCtx *c, int bj, HcRow *r)
+{
+    if (c->nnode[bj] >= HC_MAXN)
+        return;
+    double mg[2];
+    hc_rowq(&c->p, r, mg);
+    double *n = c->node[bj][c->nnode[bj]++];
+    n[0] = r->x;
+    n[1] = mg[0];
+    n[2] = mg[1];
+}
+
+/* Event (x, joint j, kind, triple k) of branch bj, its row r there (HC_SHOULDER) */
+static void hc_add(HcCtx *c, int bj, double x, int j, int kind, int k, const HcRow *r)
 {
     if (c->nev[bj] >= HC_MAXE) {
         c->bad = __LINE__;
         return;
     }
-    c->ev[bj][c->nev[bj]++] = (HcEvent){x, j, kind, k};
+    double mgs[2][7], wal = INFINITY;
+    hc_margins(c->p.g, r, mgs);
+    for (int jj = 3; jj < 6; jj++)
+        if (jj != j)
+            wal = fmin(wal, fabs(r->cs[jj][1]));
+    c->ev[bj][c->nev[bj]++] =
+        (HcEvent){x, j, kind, k, {hc_least(mgs[0], j), hc_least(mgs[1], j)},
+                  {hc_least(mgs[0], -1), hc_least(mgs[1], -1)}, wal};
 }
 
 /* Roots x of a0 + a1 cos x + a2 sin x = 0 (at most 2) */
@@ -614,7 +655,7 @@ static int hc_polish(HcCtx *c, int i, int j, int jj, double V, double *x)
     HcRow r;
     double t = *x, f = NAN, d = NAN;
     for (int it = 0; it < 5; it++) {
-        if (!hc_eval(&c->p, t, i, j, 1, &r))
+        if (!hc_eval(&c->p, t, i, j, HC_SLOPES, &r)) /* (the wrist alone) */
             return 0;
         c->rows++;
         f = wrap_pi(fast_atan2(r.cs[jj][1], r.cs[jj][0]) - V);
@@ -708,8 +749,15 @@ found:
                 for (int e = 0; e < c->nev[bj]; e++)
                     dup |= c->ev[bj][e].j == jj && c->ev[bj][e].kind == kind &&
                            fabs(c->ev[bj][e].x - t) < HC_CLOSE;
-                if (!dup)
-                    hc_add(c, bj, t, jj, kind, -1);
+                HcRow r;
+                if (dup)
+                    continue;
+                if (!hc_eval(&c->p, t, bj >> 1, bj & 1, HC_SHOULDER, &r)) {
+                    c->bad = __LINE__;
+                    return;
+                }
+                c->rows++;
+                hc_add(c, bj, t, jj, kind, -1, &r);
             }
         }
     }
@@ -755,8 +803,8 @@ static int hc_extremum(double f0, double f1, double d0, double d1, double *tau, 
 /* Whether a cubic Hermite model on [0, 1] (values f0, f1, slopes d0, d1 times the
  * cell) may cross 0 other than once at a sign change (*split) or comes within tol
  * of it without one (*near). */
-static void hc_hermite(double f0, double f1, double d0, double d1, double tol, int *split,
-                       int *near)
+static inline void hc_hermite(double f0, double f1, double d0, double d1, double tol,
+                              int *split, int *near)
 {
     /* the model within 4/27 (|d0| + |d1|) of a mean of f0 and f1 (its Hermite basis):
      * of one sign and clear of tol when both ends are further than that */
@@ -879,7 +927,7 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow
         }
         if (!(x > lo && x < hi))
             x = 0.5 * (lo + hi);
-        if (!hc_eval(&c->p, x, pc->i, pc->j, 1, &r)) {
+        if (!hc_eval(&c->p, x, pc->i, pc->j, HC_SHOULDER | HC_SLOPES, &r)) {
             c->bad = __LINE__;
             return;
         }
@@ -887,7 +935,7 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow
         double d, f = hc_f(q, &r, &d, NULL);
         /* at the root to its rounding: f is sin v2 sin(v_j - V) (v1, v3), cos v2 - cos V
          * (v2), each O(1), with v5's rounding (r.noise) in the angles */
-        double sfac = q->j == 1 ? fabs(q->sV) : hypot(r.sh[0], r.sh[1]);
+        double sfac = q->j == 1 ? fabs(q->sV) : sqrt(r.sh[0] * r.sh[0] + r.sh[1] * r.sh[1]);
         if (fabs(f) <= 4.0 * DBL_EPSILON + 4.0 * r.noise * sfac)
             break;
         if ((f < 0.0) == (flo < 0.0)) {
@@ -916,17 +964,17 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow
     /* the joint at its value to HC_AT, or to what the last bits of x allow where it
      * moves fast (next to a branch end: as the square root of the distance), at most
      * HC_AT_STEEP; |df / dv_j| is |sin v2 cos(v_j - V)| ~ |sin v2| (v1, v3) or |sin V| */
-    double rate = fabs(d) / (q->j == 1 ? fabs(q->sV) : hypot(r.sh[0], r.sh[1]));
+    double rate = fabs(d) / (q->j == 1 ? fabs(q->sV) : sqrt(r.sh[0] * r.sh[0] + r.sh[1] * r.sh[1]));
     double off = fabs(wrap_pi(hc_angle1(&r, k, q->j) - q->V));
     double tol = fmax(HC_AT, 8.0 * fmax(rate * DBL_EPSILON * fmax(1.0, fabs(x)), r.noise));
     if (!r.sloped || !(off <= tol) || !(off <= HC_AT_STEEP)) {
         c->bad = __LINE__;
         return;
     }
-    hc_add(c, 2 * pc->i + pc->j, x, q->j, q->kind, k);
+    hc_add(c, 2 * pc->i + pc->j, x, q->j, q->kind, k, &r);
     if (q->twin) /* the other triple at the other limit (-V) */
         hc_add(c, 2 * pc->i + pc->j, x, q->j,
-               q->kind == HM_KIND_UPPER ? HM_KIND_LOWER : HM_KIND_UPPER, 1 - k);
+               q->kind == HM_KIND_UPPER ? HM_KIND_LOWER : HM_KIND_UPPER, 1 - k, &r);
 }
 
 /* Whether joint m of triple k is outside its limits over (ra, rb) for certain: outside
@@ -1016,12 +1064,13 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
         }
         double xm = xi0 + at * (xi1 - xi0);
         HcRow rm;
-        if (!hc_eval(&c->p, hc_x(pc, xm), pc->i, pc->j, 1, &rm)) {
+        if (!hc_eval(&c->p, hc_x(pc, xm), pc->i, pc->j, HC_SHOULDER | HC_SLOPES, &rm)) {
             c->bad = __LINE__;
             return;
         }
         rm.dxi = hc_dx(pc, xm);
         c->rows++;
+        hc_keep(c, 2 * pc->i + pc->j, &rm);
         hc_cell(c, pc, ra, xi0, &rm, xm, depth + 1);
         hc_cell(c, pc, &rm, xm, rb, xi1, depth + 1);
         return;
@@ -1075,18 +1124,19 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
     for (int k = 0; k < HC_NODES; k++) {
         double xi = (double)k / (HC_NODES - 1);
         double x = k == 0 ? pc->a : k == HC_NODES - 1 ? pc->b : hc_x(pc, xi);
-        if (!hc_eval(&c->p, x, pc->i, pc->j, 1, &r[k])) {
+        if (!hc_eval(&c->p, x, pc->i, pc->j, HC_SHOULDER | HC_SLOPES, &r[k])) {
             c->bad = __LINE__;
             return;
         }
         r[k].dxi = hc_dx(pc, xi);
         c->rows++;
+        hc_keep(c, 2 * pc->i + pc->j, &r[k]);
         if ((k == 0 && pc->fa) || (k == HC_NODES - 1 && pc->fb)) {
             /* a branch end: rates infinite in x, finite in xi (x - end ~ xi^2): the
              * row's slopes from HC_END_XI of the piece further in (d/dxi there) */
             HcRow e = {0};
             double xe = k == 0 ? HC_END_XI : 1.0 - HC_END_XI;
-            if (!hc_eval(&c->p, hc_x(pc, xe), pc->i, pc->j, 1, &e) || !e.sloped) {
+            if (!hc_eval(&c->p, hc_x(pc, xe), pc->i, pc->j, HC_SHOULDER | HC_SLOPES, &e) || !e.sloped) {
                 c->bad = __LINE__;
                 return;
             }
@@ -1386,8 +1436,8 @@ static void hc_snap(HcCtx *c, const double *P, HmMargMemo *memo)
             /* the last value with a discriminant >= 0 (a row): the bracket's inside
              * end, moved clear of the discriminant's rounding */
             double r = flo >= 0.0 ? lo : hi, in = flo >= 0.0 ? -1.0 : 1.0;
-            for (int u = 0; u < HC_SNAP_ULPS; u++)
-                r = nextafter(r, r + in);
+            /* (r's ulp upward: across a power of 2 twice the doubles downward) */
+            r += in * HC_SNAP_ULPS * (nextafter(r, INFINITY) - r);
             /* confirmed as held_manifold.c's: pk_one's row there (its rows near a double
              * root are not the discriminant's sign alone; an end it does not confirm
              * leaves the pose to the grid) */
@@ -1425,7 +1475,7 @@ static int hc_slots_agree(HcCtx *c, const double *P, double x)
     pk_one(P, c->T, t, qn, o);
     for (int bj = 0; bj < 4; bj++) {
         HcRow r;
-        if (!hc_eval(&c->p, x, bj >> 1, bj & 1, 0, &r))
+        if (!hc_eval(&c->p, x, bj >> 1, bj & 1, HC_SHOULDER, &r))
             continue;
         for (int k = 0; k < 2; k++) {
             double v[7], q[7];
@@ -1469,7 +1519,7 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     c->front.set = 0;
     c->nq = 0;
     for (int bj = 0; bj < 4; bj++)
-        c->nev[bj] = c->npc[bj] = 0;
+        c->nev[bj] = c->npc[bj] = c->nnode[bj] = 0;
     const HcGeo *g = &geo;
     int ok = 0;
     if (!hc_setup(g, T, &c->p))
@@ -1568,14 +1618,25 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
                     if (x - prev < HC_CORNER)
                         goto done; /* a corner: two events (or one and an end) together */
                     if (x > prev) {
-                        HcRow r;
-                        double mgs[2][7];
-                        if (!hc_eval(&c->p, 0.5 * (prev + x), bj >> 1, bj & 1, 0, &r))
-                            goto done;
-                        c->rows++;
-                        hc_margins(g, &r, mgs);
-                        double mg = hc_least(mgs[k], -1);
-                        if (fabs(mg) < HC_DECIDE)
+                        /* decided at the kept node inside furthest from a limit, else
+                         * at a row in the middle */
+                        double mg = 0.0;
+                        for (int u = 0; u < c->nnode[bj]; u++) {
+                            const double *nd = c->node[bj][u];
+                            if (nd[0] > prev && nd[0] < x && fabs(nd[1 + k]) > fabs(mg))
+                                mg = nd[1 + k];
+                        }
+                        if (!(fabs(mg) >= HC_DECIDE)) {
+                            HcRow r;
+                            double mgs[2][7];
+                            if (!hc_eval(&c->p, 0.5 * (prev + x), bj >> 1, bj & 1, HC_SHOULDER,
+                                         &r))
+                                goto done;
+                            c->rows++;
+                            hc_margins(g, &r, mgs);
+                            mg = hc_least(mgs[k], -1);
+                        }
+                        if (!(fabs(mg) >= HC_DECIDE))
                             goto done;
                         if (mg > 0.0) {
                             if (n > 0 && out[2 * n - 1] == prev) {
@@ -1592,33 +1653,18 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
                     if (!last) {
                         const HcEvent *ev = &c->ev[bj][e];
                         int list = ev->kind == HM_KIND_ALIGNED;
-                        if (list && ev->j >= 3) {
-                            /* a wrist joint at its aligned value with another there too
-                             * (q5 and q6 at 0: a swing, as the shoulder's): the grid's */
-                            HcRow r;
-                            if (!hc_eval(&c->p, ev->x, bj >> 1, bj & 1, 0, &r))
+                        /* a wrist joint at its aligned value with another there too
+                         * (q5 and q6 at 0: a swing, as the shoulder's), or with a joint
+                         * at a limit (a corner at a singular point: an isolated
+                         * in-limit row the grid leaves to solved points): the grid's */
+                        if (list && ev->j >= 3 &&
+                            (ev->wal < HC_WRIST_ALIGNED || fabs(ev->mgall[k]) < HC_CORNER))
+                            goto done;
+                        if (!list) { /* a crossing: another joint at a limit there too */
+                            if (fabs(ev->mg[k]) < HC_CORNER)
                                 goto done;
-                            for (int jj = 3; jj < 6; jj++)
-                                if (jj != ev->j && fabs(r.cs[jj][1]) < HC_WRIST_ALIGNED)
-                                    goto done;
-                            /* or with a joint at a limit (a corner at a singular point:
-                             * an isolated in-limit row the grid leaves to solved points) */
-                            double mgs[2][7];
-                            hc_margins(g, &r, mgs);
-                            if (fabs(hc_least(mgs[k], -1)) < HC_CORNER)
-                                goto done;
-                        }
-                        if (!list) { /* a crossing with the other joints inside */
-                            HcRow r;
-                            double mgs[2][7];
-                            if (hc_eval(&c->p, ev->x, bj >> 1, bj & 1, 0, &r)) {
-                                hc_margins(g, &r, mgs);
-                                double mg = hc_least(mgs[k], ev->j);
-                                if (fabs(mg) < HC_CORNER)
-                                    goto done; /* another joint at a limit there too */
-                                list = 1; /* (every located one: SelfMotion.crossings
-                                           * keeps those with every other joint inside) */
-                            }
+                            list = 1; /* (every located one: SelfMotion.crossings keeps
+                                       * those with every other joint inside) */
                         }
                         if (list) {
                             if (*npts >= HM_MAXP)
