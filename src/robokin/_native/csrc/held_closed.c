@@ -41,15 +41,16 @@
  * pk_one's rows of its slot end (hc_snap: pk's own discriminant, held_margins.c,
  * confirmed by a pk_one row), so that SelfMotion.sample has a row at every end.
  *
- * Not certified (0: held_manifold.c's grid instead, ~3-4 % of uniform Panda poses,
- * ~half of poses with joints at special values): a branch end pk_one does not
- * confirm; a branch within HC_ALIGNED of an
+ * Not certified (0: held_manifold.c's grid instead, ~1 % of uniform Panda poses,
+ * ~half of poses with joints at special values, session 27): a branch end pk_one does
+ * not confirm; a branch within HC_ALIGNED of an
  * aligned shoulder (1 - |cos v2|: q1 and q3 swing there) or a wrist aligned point with
  * a second wrist joint at its aligned value or a joint within HC_CORNER of a limit
  * (self_motion_rates.py seed 0: an isolated in-limit row at q1, q3, q4 limits and
  * q5 = 1e-9, which the grid flags for solved points); a limit function at 0 at a node or at a
  * located extremum (a touch; an isolated in-limit row), a closed-form root pair near
- * double; events of a slot within HC_CORNER of each other or of a piece's end, a joint
+ * double; events of a slot within HC_CORNER of each other or of the range's end (or
+ * HC_FOLD_GAP of a branch end), a joint
  * at a limit at a piece's end (a corner: the generating configuration at two limits,
  * or at a limit and a branch end); a cell not resolved in HC_DEPTH splits, a crossing
  * not at its value to HC_AT (HC_AT_STEEP where x's last bit moves it more); pk_one's
@@ -70,9 +71,10 @@
 #define HC_MAXPC 12      /* pieces per branch */
 #define HC_MAXQ 12       /* shoulder functions */
 #define HC_MAXN 192      /* node rows kept per branch (hc_keep) */
-#define HC_ALIGNED 1e-6  /* 1 - |cos v2| below this on a branch: not certified */
+#define HC_ALIGNED 1e-8  /* 1 - |cos v2| below this on a branch: not certified */
 #define HC_CLOSE 1e-9    /* closed-form roots this close: one */
 #define HC_CORNER 1e-6   /* events of one slot this close (or an end): the grid's */
+#define HC_FOLD_GAP 1e-10 /* ... an event and a branch end */
 #define HC_TOUCH 1e-7    /* a model's extremum this close to 0: split (at HC_DEPTH: the grid's) */
 #define HC_DIP 0.5       /* a model's extremum toward 0 below this share of its ends: located */
 #define HC_AT_FOLD 1e-5  /* a joint this close to a limit at a branch end (rows as its square root) */
@@ -1615,8 +1617,13 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
                     double x = last ? z : c->ev[bj][e].x;
                     if (!last && c->ev[bj][e].x < a)
                         continue;
-                    if (x - prev < HC_CORNER)
-                        goto done; /* a corner: two events (or one and an end) together */
+                    /* a corner: two events (or one and the range's end) together; next
+                     * to a branch end, where the rows move as the square root of the
+                     * distance, HC_FOLD_GAP */
+                    int fold = (prev == a && c->cutfold[bj][2 * m]) ||
+                               (last && c->cutfold[bj][2 * m + 1]);
+                    if (!(x - prev >= (fold ? HC_FOLD_GAP : HC_CORNER)))
+                        goto done;
                     if (x > prev) {
                         /* decided at the kept node inside furthest from a limit, else
                          * at a row in the middle */
