@@ -124,6 +124,8 @@ typedef struct {
     double sh[5], dsh[5]; /* w.ea, w.e2, w.e1, r.ea, r.e2 and their slopes */
     double dxi;       /* dx/dxi on its piece (hc_cell's slopes per cell) */
     int sloped;
+    int nf;           /* queries with their values in f, df (hc_cell's; 0 until then) */
+    double f[HC_MAXQ], df[HC_MAXQ];
 } HcRow;
 
 static inline double hc_aff(const double *a, double c, double s) { return a[0] + a[1] * c + a[2] * s; }
@@ -281,6 +283,7 @@ static double hc_m2(const HcPose *p, double x, int i, double *dm)
 
 #define HC_SHOULDER 1 /* hc_eval: the shoulder's scalars (else the wrist's values alone) */
 #define HC_SLOPES 2   /* ... and the slopes d/dx (the wrist's alone without HC_SHOULDER) */
+#define HC_NOISE 4    /* ... and v5's rounding (r->noise; else NaN) */
 
 /* Branch (i, j)'s row at x (what: HC_SHOULDER, HC_SLOPES); 0 when it has none (a
  * margin below -tol). */
@@ -312,8 +315,10 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
         return 0;
     double c5 = xx / nn, s5 = -yy / nn;
     /* v5's rounding: x4 and u6 next to axis 5 leave only their small normal parts */
-    r->noise = 4.0 * DBL_EPSILON * (sqrt(v3_dot(x4, x4) * v3_dot(u6, u6)) / nn +
-                                    1.0 / fabs(s4g) + 1.0 / fabs(s6g)); /* + acos at an end */
+    r->noise = !(what & HC_NOISE) ? NAN
+                                  : 4.0 * DBL_EPSILON *
+                                        (sqrt(v3_dot(x4, x4) * v3_dot(u6, u6)) / nn +
+                                         1.0 / fabs(s4g) + 1.0 / fabs(s6g)); /* + acos at an end */
     r->cs[3][0] = c4;
     r->cs[3][1] = s4;
     r->cs[4][0] = c5;
@@ -321,6 +326,7 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
     r->cs[5][0] = c6;
     r->cs[5][1] = s6;
     r->sloped = 0;
+    r->nf = 0;
     r->mg[0][0] = NAN; /* hc_rowq's, when asked */
     v3 w = {0}, rr = {0};
     if (what & HC_SHOULDER) {
@@ -524,6 +530,7 @@ typedef struct {
     int cutfold[4][2 * HC_MAXPC]; /* that end: 0 the range's, 1 E1's branch end, 2 E2's */
     int npc[4];
     double node[4][HC_MAXN][3]; /* per branch: x and both triples' least margins there */
+    double ncs[HC_NODES][2], mcs[HC_MNODES][2]; /* cos, sin of pi xi at the nodes */
     int nnode[4];
     long rows; /* row evaluations (a measuring build's evals: HM_COUNT_CHEAP) */
     double kept_t[HC_ROWS_KEPT]; /* hc_row_at's fronts: their position slots' rows */
@@ -657,7 +664,7 @@ static int hc_polish(HcCtx *c, int i, int j, int jj, double V, double *x)
     HcRow r;
     double t = *x, f = NAN, d = NAN;
     for (int it = 0; it < 5; it++) {
-        if (!hc_eval(&c->p, t, i, j, HC_SLOPES, &r)) /* (the wrist alone) */
+        if (!hc_eval(&c->p, t, i, j, HC_SLOPES | HC_NOISE, &r)) /* (the wrist alone) */
             return 0;
         c->rows++;
         f = wrap_pi(fast_atan2(r.cs[jj][1], r.cs[jj][0]) - V);
@@ -929,7 +936,7 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow
         }
         if (!(x > lo && x < hi))
             x = 0.5 * (lo + hi);
-        if (!hc_eval(&c->p, x, pc->i, pc->j, HC_SHOULDER | HC_SLOPES, &r)) {
+        if (!hc_eval(&c->p, x, pc->i, pc->j, HC_SHOULDER | HC_SLOPES | HC_NOISE, &r)) {
             c->bad = __LINE__;
             return;
         }
@@ -1015,11 +1022,14 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
     double at = 0.5; /* where a split cuts the cell */
     int split = 0;
     double fa[HC_MAXQ], fb[HC_MAXQ], dfa[HC_MAXQ], dfb[HC_MAXQ];
+    for (HcRow *r = ra; r != NULL; r = r == ra ? rb : NULL) /* (a node is two cells') */
+        for (; r->nf < c->nq; r->nf++)
+            r->f[r->nf] = hc_f(&c->q[r->nf], r, &r->df[r->nf], NULL);
     for (int m = 0; m < c->nq && !split; m++) {
         const HcQuery *q = &c->q[m];
-        double da, db;
-        fa[m] = hc_f(q, ra, &da, NULL);
-        fb[m] = hc_f(q, rb, &db, NULL);
+        double da = ra->df[m], db = rb->df[m];
+        fa[m] = ra->f[m];
+        fb[m] = rb->f[m];
         da = ra->sloped == 2 ? da * ea : ra->sloped ? da * sa : NAN;
         db = rb->sloped == 2 ? db * ea : rb->sloped ? db * sb : NAN;
         int known = isfinite(da) && isfinite(db);
@@ -1124,13 +1134,13 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
 {
     HcRow r[HC_NODES];
     for (int k = 0; k < HC_NODES; k++) {
-        double xi = (double)k / (HC_NODES - 1);
-        double x = k == 0 ? pc->a : k == HC_NODES - 1 ? pc->b : hc_x(pc, xi);
+        double x = k == 0 ? pc->a : k == HC_NODES - 1 ? pc->b
+                                  : pc->a + (pc->b - pc->a) * 0.5 * (1.0 - c->ncs[k][0]);
         if (!hc_eval(&c->p, x, pc->i, pc->j, HC_SHOULDER | HC_SLOPES, &r[k])) {
             c->bad = __LINE__;
             return;
         }
-        r[k].dxi = hc_dx(pc, xi);
+        r[k].dxi = (pc->b - pc->a) * 0.5 * M_PI * c->ncs[k][1];
         c->rows++;
         hc_keep(c, 2 * pc->i + pc->j, &r[k]);
         if ((k == 0 && pc->fa) || (k == HC_NODES - 1 && pc->fb)) {
@@ -1179,15 +1189,20 @@ static double hc_m2_at(void *arg, double x)
     return hc_m2(m->p, x, m->i, NULL);
 }
 
-/* E2's branch ends of root i in the cell (xi0, xi1) of E1's piece pc (margins m,
- * slopes d/dx dm, NaN at a branch end): into ends[] */
-static void hc_m2_cell(HcCtx *c, const HcPiece *pc, int i, double xi0, double m0, double d0,
-                       double xi1, double m1, double d1, int depth, double *ends, int *ne)
+/* A node of E2's margin on a piece: xi, x, dx/dxi, the margin and its slope d/dx (NaN
+ * at a branch end) */
+typedef struct {
+    double xi, x, dx, m, d;
+} HcMNode;
+
+/* E2's branch ends of root i in the cell (n0, n1) of E1's piece pc: into ends[] */
+static void hc_m2_cell(HcCtx *c, const HcPiece *pc, int i, const HcMNode *n0,
+                       const HcMNode *n1, int depth, double *ends, int *ne)
 {
     if (c->bad)
         return;
-    double h = xi1 - xi0, x0 = hc_x(pc, xi0), x1 = hc_x(pc, xi1);
-    double s0 = d0 * hc_dx(pc, xi0) * h, s1 = d1 * hc_dx(pc, xi1) * h;
+    double h = n1->xi - n0->xi, x0 = n0->x, x1 = n1->x, m0 = n0->m, m1 = n1->m;
+    double s0 = n0->d * n0->dx * h, s1 = n1->d * n1->dx * h;
     double scale = c->p.g->cn;
     int known = isfinite(s0) && isfinite(s1);
     if (!isfinite(s0))
@@ -1225,11 +1240,14 @@ static void hc_m2_cell(HcCtx *c, const HcPiece *pc, int i, double xi0, double m0
             c->bad = __LINE__;
             return;
         }
-        double xm = xi0 + at * (xi1 - xi0), dm;
-        double mm = hc_m2(&c->p, hc_x(pc, xm), i, &dm);
+        HcMNode nm;
+        nm.xi = n0->xi + at * h;
+        nm.x = hc_x(pc, nm.xi);
+        nm.dx = hc_dx(pc, nm.xi);
+        nm.m = hc_m2(&c->p, nm.x, i, &nm.d);
         c->rows++;
-        hc_m2_cell(c, pc, i, xi0, m0, d0, xm, mm, dm, depth + 1, ends, ne);
-        hc_m2_cell(c, pc, i, xm, mm, dm, xi1, m1, d1, depth + 1, ends, ne);
+        hc_m2_cell(c, pc, i, n0, &nm, depth + 1, ends, ne);
+        hc_m2_cell(c, pc, i, &nm, n1, depth + 1, ends, ne);
         return;
     }
     if ((m0 < 0.0) != (m1 < 0.0)) {
@@ -1292,18 +1310,20 @@ static void hc_pieces(HcCtx *c)
         HcPiece pc = {a, b, a != p->xlo, b != p->xhi, 0, 0};
         for (int i = 0; i < 2 && !c->bad; i++) {
             /* E2's margin on nodes of the piece: its sign changes */
-            double xi[HC_MNODES], mv[HC_MNODES], dv[HC_MNODES], ends[2 * HC_MAXPC];
+            HcMNode nd[HC_MNODES];
+            double ends[2 * HC_MAXPC];
             int ne = 0;
             for (int k = 0; k < HC_MNODES; k++) {
-                xi[k] = (double)k / (HC_MNODES - 1);
-                double x = k == 0 ? a : k == HC_MNODES - 1 ? b : hc_x(&pc, xi[k]);
-                mv[k] = hc_m2(p, x, i, &dv[k]);
+                nd[k].xi = (double)k / (HC_MNODES - 1);
+                nd[k].x = k == 0 ? a : k == HC_MNODES - 1 ? b
+                                     : a + (b - a) * 0.5 * (1.0 - c->mcs[k][0]);
+                nd[k].dx = (b - a) * 0.5 * M_PI * c->mcs[k][1];
+                nd[k].m = hc_m2(p, nd[k].x, i, &nd[k].d);
                 if ((k == 0 && pc.fa) || (k == HC_MNODES - 1 && pc.fb))
-                    dv[k] = NAN;
+                    nd[k].d = NAN;
             }
             for (int k = 0; k + 1 < HC_MNODES; k++)
-                hc_m2_cell(c, &pc, i, xi[k], mv[k], dv[k], xi[k + 1], mv[k + 1], dv[k + 1], 0,
-                           ends, &ne);
+                hc_m2_cell(c, &pc, i, &nd[k], &nd[k + 1], 0, ends, &ne);
             if (c->bad)
                 return;
             /* the sub-pieces where the margin is >= 0 */
@@ -1522,6 +1542,14 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     c->nq = 0;
     for (int bj = 0; bj < 4; bj++)
         c->nev[bj] = c->npc[bj] = c->nnode[bj] = 0;
+    for (int k = 0; k < HC_NODES; k++) {
+        c->ncs[k][0] = cos(M_PI * k / (HC_NODES - 1));
+        c->ncs[k][1] = sin(M_PI * k / (HC_NODES - 1));
+    }
+    for (int k = 0; k < HC_MNODES; k++) {
+        c->mcs[k][0] = cos(M_PI * k / (HC_MNODES - 1));
+        c->mcs[k][1] = sin(M_PI * k / (HC_MNODES - 1));
+    }
     const HcGeo *g = &geo;
     int ok = 0;
     if (!hc_setup(g, T, &c->p))
