@@ -1040,6 +1040,14 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
         dfa[m] = da;
         dfb[m] = db;
         double tol = q->kind < 0 ? HC_ALIGNED : HC_TOUCH;
+        /* the common case first: of one sign and clear of 0 all over the cell (the
+         * tests below then neither split nor flag it) */
+        double afa = fabs(fa[m]), afb = fabs(fb[m]), ada = fabs(da), adb = fabs(db);
+        if (known && (fa[m] < 0.0) == (fb[m] < 0.0) &&
+            (afa < afb ? afa : afb) > (4.0 / 27.0) * (ada + adb) + tol &&
+            fabs(fb[m] - fa[m]) <= HC_MOVE && ada <= 2.0 * HC_MOVE && adb <= 2.0 * HC_MOVE &&
+            !(fa[m] > 0.0 ? da < 0.0 && db > 0.0 : da > 0.0 && db < 0.0))
+            continue;
         if (fabs(fa[m]) < (q->kind < 0 ? tol : HC_AT_NODE) ||
             fabs(fb[m]) < (q->kind < 0 ? tol : HC_AT_NODE)) {
             c->bad = __LINE__; /* next to an aligned shoulder; a node at a value (a touch,
