@@ -43,22 +43,26 @@
  *
  * Not certified (0: held_manifold.c's grid instead, ~1 % of uniform Panda poses,
  * ~half of poses with joints at special values, session 27): a branch end pk_one does
- * not confirm; a branch within HC_ALIGNED of an
- * aligned shoulder (1 - |cos v2|: q1 and q3 swing there) or a wrist aligned point with
- * a second wrist joint at its aligned value or a joint within HC_CORNER of a limit
- * (self_motion_rates.py seed 0: an isolated in-limit row at q1, q3, q4 limits and
- * q5 = 1e-9, which the grid flags for solved points); a limit function at 0 at a node or at a
- * located extremum (a touch; an isolated in-limit row), a closed-form root pair near
- * double; events of a slot within HC_CORNER of each other or of the range's end (or
- * HC_FOLD_GAP of a branch end), a joint
- * at a limit at a piece's end (a corner: the generating configuration at two limits,
- * or at a limit and a branch end); a cell not resolved in HC_DEPTH splits, a crossing
- * not at its value to HC_AT (HC_AT_STEEP where x's last bit moves it more); pk_one's
- * slots not these (checked on one row: hc_slots_agree); a degenerate coefficient.
- * Measured against the grid on 4,000 uniform and 2,000 special poses (session 26,
- * held_manifold_ab.py --modes GRID CLOSED): the same intervals on every pose both
- * certify, ends within 1.4e-10 at branch ends (the grid's bisection on pk_one's rows
- * to HM_FOLD_TOL; these are the margins' roots) and 2.9e-11 elsewhere.
+ * not confirm; a branch within HC_ALIGNED of an aligned shoulder (1 - |cos v2|: q1
+ * and q3 swing there) or a wrist aligned point with a second wrist joint at its
+ * aligned value or a joint within HC_CORNER of a limit (self_motion_rates.py seed 0:
+ * an isolated in-limit row at q1, q3, q4 limits and q5 = 1e-9, which the grid flags
+ * for solved points); a limit function at 0 at a node or at a located extremum (a
+ * touch; an isolated in-limit row), a closed-form root pair near double; events of a
+ * slot within HC_CORNER of each other or of the range's end (HC_FOLD_GAP of a branch
+ * end, where the rows move as the square root of the distance), a joint at a limit at
+ * a piece's end (a corner: the generating configuration at two limits, or at a limit
+ * and a branch end); a cell not resolved in HC_DEPTH splits, a crossing not at its
+ * value to HC_AT (HC_AT_STEEP where x's last bit moves it more); pk_one's slots not
+ * these (checked on one row: hc_slots_agree); a joint range with a half width within
+ * HC_ARC_MIN of 0 or pi (hc_margins); a degenerate coefficient.
+ * Measured against the grid on 4,000 uniform and 2,000 special poses (sessions 26 and
+ * 27, held_manifold_ab.py --modes GRID CLOSED): the same intervals on every pose both
+ * certify, ends within 1.42e-10 at branch ends (the grid's bisection on pk_one's rows
+ * to HM_FOLD_TOL; these are the margins' roots) and 2.9e-11 elsewhere. Session 27:
+ * ~0.08 ms of CPU per uniform pose (session 26: 0.139 in the same run); a piece of a
+ * slot is decided at a node row already evaluated (hc_keep), an event keeps its row's
+ * margins (hc_add), margins are taken without angles (hc_margins).
  */
 
 #include "brent.h"
@@ -120,7 +124,8 @@ typedef struct {
  * and finite). */
 typedef struct {
     double x, cs[7][2], dv[7], noise; /* noise: v5's rounding [rad] */
-    double mg[2][7];  /* each joint's margins, both triples (hc_rowq; mg[0][0] NaN until then) */
+    double mg[2][7];  /* each joint's margins, both triples (hc_rowq; mg[0][0] NaN
+                       * until then) */
     double sh[5], dsh[5]; /* w.ea, w.e2, w.e1, r.ea, r.e2 and their slopes */
     double dxi;       /* dx/dxi on its piece (hc_cell's slopes per cell) */
     int sloped;
@@ -145,7 +150,8 @@ static int hc_geo(const double *P, HcGeo *g)
         g->off[k] = P[PK_OFFSET + k];
         g->lo[k] = P[PK_LO + k];
         g->hi[k] = P[PK_HI + k];
-        double half = 0.5 * (g->hi[k] - g->lo[k]), mid = g->sign[k] * (g->lo[k] + half) + g->off[k];
+        double half = 0.5 * (g->hi[k] - g->lo[k]);
+        double mid = g->sign[k] * (g->lo[k] + half) + g->off[k];
         if (fabs(g->sign[k]) != 1.0 || !(sin(half) > HC_ARC_MIN) || !(half > 0.0))
             return 0; /* (a range within HC_ARC_MIN of 0 or a whole turn: the grid's) */
         g->arc[k][0] = cos(mid);
@@ -285,8 +291,8 @@ static double hc_m2(const HcPose *p, double x, int i, double *dm)
 #define HC_SLOPES 2   /* ... and the slopes d/dx (the wrist's alone without HC_SHOULDER) */
 #define HC_NOISE 4    /* ... and v5's rounding (r->noise; else NaN) */
 
-/* Branch (i, j)'s row at x (what: HC_SHOULDER, HC_SLOPES); 0 when it has none (a
- * margin below -tol). */
+/* Branch (i, j)'s row at x (what: HC_SHOULDER, HC_SLOPES, HC_NOISE); 0 when it has
+ * none (a margin below -tol). */
 static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
 {
     const HcGeo *g = p->g;
@@ -315,10 +321,10 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
         return 0;
     double c5 = xx / nn, s5 = -yy / nn;
     /* v5's rounding: x4 and u6 next to axis 5 leave only their small normal parts */
-    r->noise = !(what & HC_NOISE) ? NAN
+    r->noise = !(what & HC_NOISE) ? NAN /* (+ acos at an end) */
                                   : 4.0 * DBL_EPSILON *
                                         (sqrt(v3_dot(x4, x4) * v3_dot(u6, u6)) / nn +
-                                         1.0 / fabs(s4g) + 1.0 / fabs(s6g)); /* + acos at an end */
+                                         1.0 / fabs(s4g) + 1.0 / fabs(s6g));
     r->cs[3][0] = c4;
     r->cs[3][1] = s4;
     r->cs[4][0] = c5;
@@ -386,9 +392,8 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
 }
 
 /* Chain values of a row, triple k (0: v2 >= 0; 1: the other) */
-static void hc_angles(const HcPose *p, const HcRow *r, int k, double *v)
+static void hc_angles(const HcRow *r, int k, double *v)
 {
-    (void)p;
     double wa = r->sh[0], wb = r->sh[1], wc = r->sh[2], ra = r->sh[3], rb = r->sh[4];
     v[0] = fast_atan2(wb, wa);
     v[1] = fast_atan2(sqrt(wa * wa + wb * wb), wc);
@@ -441,7 +446,8 @@ static void hc_margins(const HcGeo *g, const HcRow *r, double mg[2][7])
     mg[1][2] = (-d3 - g->arc[2][2]) * g->arc[2][3];
     for (int j = 3; j < 6; j++)
         mg[0][j] = mg[1][j] =
-            (r->cs[j][0] * g->arc[j][0] + r->cs[j][1] * g->arc[j][1] - g->arc[j][2]) * g->arc[j][3];
+            (r->cs[j][0] * g->arc[j][0] + r->cs[j][1] * g->arc[j][1] - g->arc[j][2]) *
+            g->arc[j][3];
     mg[0][6] = mg[1][6] = INFINITY;
 }
 
@@ -973,7 +979,8 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow
     /* the joint at its value to HC_AT, or to what the last bits of x allow where it
      * moves fast (next to a branch end: as the square root of the distance), at most
      * HC_AT_STEEP; |df / dv_j| is |sin v2 cos(v_j - V)| ~ |sin v2| (v1, v3) or |sin V| */
-    double rate = fabs(d) / (q->j == 1 ? fabs(q->sV) : sqrt(r.sh[0] * r.sh[0] + r.sh[1] * r.sh[1]));
+    double rho = sqrt(r.sh[0] * r.sh[0] + r.sh[1] * r.sh[1]);
+    double rate = fabs(d) / (q->j == 1 ? fabs(q->sV) : rho);
     double off = fabs(wrap_pi(hc_angle1(&r, k, q->j) - q->V));
     double tol = fmax(HC_AT, 8.0 * fmax(rate * DBL_EPSILON * fmax(1.0, fabs(x)), r.noise));
     if (!r.sloped || !(off <= tol) || !(off <= HC_AT_STEEP)) {
@@ -1156,7 +1163,8 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
              * row's slopes from HC_END_XI of the piece further in (d/dxi there) */
             HcRow e = {0};
             double xe = k == 0 ? HC_END_XI : 1.0 - HC_END_XI;
-            if (!hc_eval(&c->p, hc_x(pc, xe), pc->i, pc->j, HC_SHOULDER | HC_SLOPES, &e) || !e.sloped) {
+            if (!hc_eval(&c->p, hc_x(pc, xe), pc->i, pc->j, HC_SHOULDER | HC_SLOPES, &e) ||
+                !e.sloped) {
                 c->bad = __LINE__;
                 return;
             }
@@ -1430,9 +1438,10 @@ static void hc_snap(HcCtx *c, const double *P, HmMargMemo *memo)
                 c->bad = __LINE__;
                 return;
             }
-            /* the root to HC_SNAP_TOL: Illinois steps, each followed by a probe just
-             * past it (across 1e-8 the discriminant is nearly linear: a step lands
-             * next to the root, the probe closes the bracket) */
+            /* the root to HC_SNAP_TOL: regula falsi steps (the retained end's value
+             * halved, as Illinois), each followed by a probe just past it (across 1e-8
+             * the discriminant is nearly linear: a step lands next to the root, the
+             * probe closes the bracket) */
             double tol = HC_SNAP_TOL * fmax(1.0, fabs(t)), glo = flo, ghi = fhi;
             for (int it = 0; hi - lo > tol; it++) {
                 if (it >= 40) {
@@ -1452,7 +1461,7 @@ static void hc_snap(HcCtx *c, const double *P, HmMargMemo *memo)
                     if (below) {
                         lo = x;
                         flo = glo = fx;
-                        ghi *= 0.5; /* (Illinois: hi stays) */
+                        ghi *= 0.5; /* (hi retained) */
                     } else {
                         hi = x;
                         fhi = ghi = fx;
@@ -1509,7 +1518,7 @@ static int hc_slots_agree(HcCtx *c, const double *P, double x)
             continue;
         for (int k = 0; k < 2; k++) {
             double v[7], q[7];
-            hc_angles(&c->p, &r, k, v);
+            hc_angles(&r, k, v);
             hc_joints(g, v, -1, q);
             int best = -1;
             double bd = INFINITY;
