@@ -167,3 +167,32 @@ def test_an_aligned_shoulder_and_other_arms_are_left_to_the_grid():
     for i in range(4):
         for b in range(8):
             np.testing.assert_array_equal(_intervals(auto, i, b), _intervals(grid, i, b))
+
+
+def test_an_fr3_kind_arm_with_its_own_limits_gets_the_grids_intervals():
+    # the FR3's kinematics (the Panda's DH) with the FR3's limits: other ranges for the
+    # margins without angles (hc_margins: q4 in [-3.04, -0.15], q6 in [0.54, 4.52], q7
+    # within 0.13 rad of a whole turn's half)
+    a = [0, 0, 0, 0.0825, -0.0825, 0, 0.088]
+    d = [0.333, 0, 0.316, 0, 0.384, 0, 0]
+    alpha = [0, -np.pi / 2, np.pi / 2, np.pi / 2, -np.pi / 2, np.pi / 2, np.pi / 2]
+    lim = [(-2.7437, 2.7437), (-1.7837, 1.7837), (-2.9007, 2.9007), (-3.0421, -0.1518),
+           (-2.8065, 2.8065), (0.5445, 4.5169), (-3.0159, 3.0159)]
+    fr3 = robokin.Robot.from_dh([
+        {"a": a[i], "alpha": alpha[i], "d": d[i], "theta": 0.0, "limits": list(lim[i]),
+         "name": f"fr3_joint{i + 1}"} for i in range(7)], convention="modified")
+    lo, hi = fr3.limits[:, 0], fr3.limits[:, 1]
+    q = np.random.default_rng(27).uniform(lo, hi, (200, 7))
+    T = fr3.fk(q)
+    assert fr3.self_motion(T[0]).method == "analytic:pieper (fr3_joint7 held), compiled"
+    grid, closed = _run(fr3, T, K.HM_MODE_GRID), _run(fr3, T, K.HM_MODE_CLOSED)
+    both = (grid["flags"] == 0) & (closed["flags"] == 0)
+    assert both.sum() >= 190, both.sum()  # (1,481 of 1,500 in session 27)
+    for i in np.flatnonzero(both):
+        for b in range(8):
+            ga, c = _intervals(grid, i, b), _intervals(closed, i, b)
+            assert ga.shape == c.shape, (i, b, ga.tolist(), c.tolist())
+            np.testing.assert_allclose(c, ga, rtol=0, atol=5e-10, err_msg=f"pose {i} slot {b}")
+    # and the generating configuration's q7 is in an interval of some slot
+    for i in np.flatnonzero(closed["flags"] == 0)[:40]:
+        assert any(s <= q[i, 6] <= e for b in range(8) for s, e in _intervals(closed, i, b)), i
