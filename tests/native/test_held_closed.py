@@ -196,3 +196,26 @@ def test_an_fr3_kind_arm_with_its_own_limits_gets_the_grids_intervals():
     # and the generating configuration's q7 is in an interval of some slot
     for i in np.flatnonzero(closed["flags"] == 0)[:40]:
         assert any(s <= q[i, 6] <= e for b in range(8) for s, e in _intervals(closed, i, b)), i
+
+
+def test_an_aligned_value_at_a_branch_end_is_left_to_the_grid():
+    # the generating configuration at a branch end with q3 = 0 (the other triple at q3's
+    # aligned value, pi): the aligned point lies at the end itself, where the snapped
+    # end's rounding moves q3 as a square root (~1e-8), so the closed forms' crossing
+    # search saw no sign change and listed none (special poses of cmp seeds 23 #673 and
+    # #1627, 12 #1022; #1627 was certified so before session 27). The grid lists it.
+    q = np.array([
+        [1.8910063561578663, 0.43502246887868345, 0.0, -0.2348618532075708,
+         1.5707963267948966, 2.2662417106423374, 0.5833936175275154],
+        [-1.0374206361272473, 0.22314174353311267, 0.0, -1.4770577300515049,
+         -1.5707963267948966, 1.5707963267948966, 1.360073618176782],
+        [-0.04302525185658279, -1.7481623500069061, 0.0, -1.5707963267948966,
+         1.5707963267948966, 2.8621457292086676, 2.717140331395227]])
+    T = PANDA.fk(q)
+    closed, auto = _run(PANDA, T, K.HM_MODE_CLOSED), _run(PANDA, T, K.HM_MODE_AUTO)
+    assert np.all(closed["flags"] == K.HM_FLAG_BAD), closed["flags"]
+    for i in range(len(q)):
+        pts = auto["pts"][i, :auto["npts"][i]]
+        at = pts[(pts[:, 3] == K.HM_KIND_ALIGNED) & (pts[:, 2] == 2)
+                 & (np.abs(pts[:, 0] - q[i, 6]) < 1e-9)]
+        assert len(at), (i, pts.tolist())

@@ -543,6 +543,8 @@ typedef struct {
     unsigned char kept_valid[HC_ROWS_KEPT][4];
     int nkept;
     PkFrontMemo front; /* pk_front_memo's held-value-free parts */
+    double wal[HC_MAXQ][3]; /* the wrist's aligned values: joint, cos and sin of V */
+    int nwal;
 } HcCtx;
 
 /* Node row r of branch bj kept (x and both triples' least margins) for the pieces'
@@ -1185,6 +1187,24 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
                 c->bad = __LINE__;
                 return;
             }
+            /* ... or at an aligned value at a branch end (the generating configuration
+             * there: an aligned point the end's rounding, which moves the joint as the
+             * square root, would leave unlocated on either side) */
+            if ((k == 0 && pc->fa) || (k == HC_NODES - 1 && pc->fb)) {
+                for (int m = 0; m < c->nq; m++)
+                    if (c->q[m].kind == HM_KIND_ALIGNED &&
+                        fabs(hc_f(&c->q[m], &r[k], NULL, NULL)) < HC_AT_FOLD) {
+                        c->bad = __LINE__;
+                        return;
+                    }
+                for (int m = 0; m < c->nwal; m++) {
+                    const double *cs = r[k].cs[(int)c->wal[m][0]];
+                    if (fabs(cs[1] * c->wal[m][1] - cs[0] * c->wal[m][2]) < HC_AT_FOLD) {
+                        c->bad = __LINE__;
+                        return;
+                    }
+                }
+            }
         }
     }
     for (int k = 0; k + 1 < HC_NODES && !c->bad; k++)
@@ -1556,7 +1576,7 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     c->rows = 0;
     c->nkept = 0;
     c->front.set = 0;
-    c->nq = 0;
+    c->nq = c->nwal = 0;
     for (int bj = 0; bj < 4; bj++)
         c->nev[bj] = c->npc[bj] = c->nnode[bj] = 0;
     for (int k = 0; k < HC_NODES; k++) {
@@ -1594,7 +1614,13 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
             if (c->nq >= HC_MAXQ)
                 goto done;
             c->q[c->nq++] = (HcQuery){j, HM_KIND_ALIGNED, 0, V, cos(V), sin(V)};
-        } else if (j != 1 && j != 3 && j != 4 && j != 5 && j != 6) {
+        } else if (j >= 3 && j <= 5) {
+            if (c->nwal >= HC_MAXQ)
+                goto done;
+            c->wal[c->nwal][0] = j;
+            c->wal[c->nwal][1] = cos(V);
+            c->wal[c->nwal++][2] = sin(V);
+        } else if (j != 1 && j != 6) {
             goto done;
         }
     }
