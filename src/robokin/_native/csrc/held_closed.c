@@ -52,7 +52,8 @@
  * slot within HC_CORNER of each other or of the range's end (HC_FOLD_GAP of a branch
  * end, where the rows move as the square root of the distance), a joint at a limit at
  * a piece's end (a corner: the generating configuration at two limits, or at a limit
- * and a branch end); a cell not resolved in HC_DEPTH splits, a crossing not at its
+ * and a branch end), an aligned value at a branch end (its point at the end itself);
+ * a cell not resolved in HC_DEPTH splits, a crossing not at its
  * value to HC_AT (HC_AT_STEEP where x's last bit moves it more); pk_one's slots not
  * these (checked on one row: hc_slots_agree); a joint range with a half width within
  * HC_ARC_MIN of 0 or pi (hc_margins); a degenerate coefficient.
