@@ -219,3 +219,19 @@ def test_an_aligned_value_at_a_branch_end_is_left_to_the_grid():
         at = pts[(pts[:, 3] == K.HM_KIND_ALIGNED) & (pts[:, 2] == 2)
                  & (np.abs(pts[:, 0] - q[i, 6]) < 1e-9)]
         assert len(at), (i, pts.tolist())
+
+
+def test_an_isolated_in_limit_point_at_a_branch_end_is_left_to_the_grid():
+    # cmp special seed 25 #1189 (certified wrongly since session 26): the generating
+    # configuration at a branch end with q3 at its limit and q2 = 0.011 (q1 and q3 swing
+    # ~90 times faster): an isolated in-limit point [t, t] there. At the snapped end q3
+    # is beta sqrt(shift) from the limit, more than HC_AT_FOLD; the rate-scaled guard
+    # leaves the pose to the grid, which has the point
+    q = np.array([[-0.47725033120276006, 0.011494837727267226, 2.8973, -3.022633628895515,
+                   -1.5707963267948966, 1.2104713183828129, -1.7998953644568292]])
+    T = PANDA.fk(q)
+    assert _run(PANDA, T, K.HM_MODE_CLOSED)["flags"][0] == K.HM_FLAG_BAD
+    auto = _run(PANDA, T, K.HM_MODE_AUTO)
+    assert auto["flags"][0] == 0
+    assert any(s - 1e-9 <= q[0, 6] <= e + 1e-9 for b in range(8)
+               for s, e in _intervals(auto, 0, b))

@@ -52,7 +52,8 @@
  * slot within HC_CORNER of each other or of the range's end (HC_FOLD_GAP of a branch
  * end, where the rows move as the square root of the distance), a joint at a limit at
  * a piece's end (a corner: the generating configuration at two limits, or at a limit
- * and a branch end), an aligned value at a branch end (its point at the end itself);
+ * and a branch end; there within the end's square-root move from its snap), an aligned
+ * value at a branch end (its point at the end itself);
  * a cell not resolved in HC_DEPTH splits, a crossing not at its
  * value to HC_AT (HC_AT_STEEP where x's last bit moves it more); pk_one's slots not
  * these (checked on one row: hc_slots_agree); a joint range with a half width within
@@ -535,6 +536,7 @@ typedef struct {
     int nev[4];
     double cut[4][2 * HC_MAXPC]; /* the branch's piece ends (x), as pairs */
     int cutfold[4][2 * HC_MAXPC]; /* that end: 0 the range's, 1 E1's branch end, 2 E2's */
+    double cutd[4][2 * HC_MAXPC]; /* how far hc_snap moved it */
     int npc[4];
     double node[4][HC_MAXN][3]; /* per branch: x and both triples' least margins there */
     double ncs[HC_NODES][2], mcs[HC_MNODES][2]; /* cos, sin of pi xi at the nodes */
@@ -883,6 +885,7 @@ typedef struct {
     double a, b; /* the piece [a, b] in x */
     int fa, fb;  /* its ends are branch ends */
     int i, j;
+    double sa, sb; /* how far hc_snap moved a branch end (x) */
 } HcPiece;
 
 static inline double hc_x(const HcPiece *pc, double xi)
@@ -1188,6 +1191,31 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
                 c->bad = __LINE__;
                 return;
             }
+            /* at a branch end the rows move as beta sqrt(|x - end|), and the end is
+             * pk_one's, hc_snap's shift from the margins' (up to HC_SNAP): a joint
+             * within beta sqrt(shift) of a limit may be at it at the true end (the
+             * generating configuration an isolated in-limit point there; beta from
+             * the end's slopes d/dxi: s sqrt(b - a) in hc_piece's units) */
+            if ((k == 0 && pc->fa) || (k == HC_NODES - 1 && pc->fb)) {
+                const HcRow *e = &r[k];
+                const double *a = e->sh, *da = e->dsh;
+                double rho2 = a[0] * a[0] + a[1] * a[1], rho = sqrt(rho2);
+                double r2 = a[3] * a[3] + a[4] * a[4];
+                double drho = (a[0] * da[0] + a[1] * da[1]) / rho;
+                double rate[6] = {(a[0] * da[1] - a[1] * da[0]) / rho2,
+                                  (a[2] * drho - rho * da[2]) / (rho2 + a[2] * a[2]),
+                                  (a[4] * da[3] - a[3] * da[4]) / r2, e->dv[3], e->dv[4],
+                                  e->dv[5]};
+                double shift = k == 0 ? pc->sa : pc->sb;
+                double sq = sqrt((shift + 4.0 * DBL_EPSILON * fmax(1.0, fabs(e->x))) *
+                                 (pc->b - pc->a));
+                for (int j = 0; j < 6; j++)
+                    for (int t = 0; t < 2; t++)
+                        if (!(fabs(e->mg[t][j]) >= HC_AT_FOLD + fabs(rate[j]) * sq)) {
+                            c->bad = __LINE__;
+                            return;
+                        }
+            }
             /* ... or at an aligned value at a branch end (the generating configuration
              * there: an aligned point the end's rounding, which moves the joint as the
              * square root, would leave unlocated on either side) */
@@ -1344,7 +1372,7 @@ static void hc_pieces(HcCtx *c)
         double xm = 0.5 * (a + b);
         if (!(hc_m1(p, cos(xm), sin(xm)) > 0.0))
             continue;
-        HcPiece pc = {a, b, a != p->xlo, b != p->xhi, 0, 0};
+        HcPiece pc = {a, b, a != p->xlo, b != p->xhi, 0, 0, 0.0, 0.0};
         for (int i = 0; i < 2 && !c->bad; i++) {
             /* E2's margin on nodes of the piece: its sign changes */
             HcMNode nd[HC_MNODES];
@@ -1505,6 +1533,7 @@ static void hc_snap(HcCtx *c, const double *P, HmMargMemo *memo)
                 c->bad = __LINE__;
                 return;
             }
+            c->cutd[bj][m] = fabs(s7 * r + o7 - c->cut[bj][m]);
             c->cut[bj][m] = s7 * r + o7;
         }
     for (int bj = 0; bj < 4; bj++)
@@ -1644,7 +1673,8 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     for (int bj = 0; bj < 4 && !c->bad; bj++)
         for (int m = 0; m < c->npc[bj] && !c->bad; m++) {
             HcPiece pc = {c->cut[bj][2 * m], c->cut[bj][2 * m + 1], c->cutfold[bj][2 * m],
-                          c->cutfold[bj][2 * m + 1], bj >> 1, bj & 1};
+                          c->cutfold[bj][2 * m + 1], bj >> 1, bj & 1,
+                          c->cutd[bj][2 * m], c->cutd[bj][2 * m + 1]};
             hc_piece(c, &pc);
         }
     if (c->bad)
