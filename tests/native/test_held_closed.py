@@ -203,7 +203,7 @@ def test_an_aligned_value_at_a_branch_end_is_left_to_the_grid():
     # aligned value, pi): the aligned point lies at the end itself, where the snapped
     # end's rounding moves q3 as a square root (~1e-8), so the closed forms' crossing
     # search saw no sign change and listed none (special poses of cmp seeds 23 #673 and
-    # #1627, 12 #1022; #1627 was certified so before session 27). The grid lists it.
+    # #1627, 12 #1022; the last two certified so since session 26). The grid lists it.
     q = np.array([
         [1.8910063561578663, 0.43502246887868345, 0.0, -0.2348618532075708,
          1.5707963267948966, 2.2662417106423374, 0.5833936175275154],
