@@ -1,6 +1,7 @@
 /*
  * Brent's method, one copy for the held-joint kernels' branch ends (held_manifold.c's
- * discriminant margins, held_closed.c's E2 margin).
+ * discriminant margins, held_closed.c's E2 margin), and the Illinois bracket update
+ * their safeguarded Newton / regula falsi refinements share.
  */
 #ifndef ROBOKIN_BRENT_H
 #define ROBOKIN_BRENT_H
@@ -65,6 +66,28 @@ static double brent_root(double (*f)(void *, double), void *ctx, double a, doubl
             return NAN;
     }
     return NAN;
+}
+
+/* Illinois' bracket update: x, with value f, replaces the end of [*lo, *hi] whose
+ * value (*flo, *fhi) has f's sign; when that end moved the time before too (*side:
+ * -1 lo, 1 hi, 0 neither yet) the other end's value is halved, so a stale end cannot
+ * hold regula falsi's steps to one side. */
+static inline void illinois_update(double x, double f, double *lo, double *flo, double *hi,
+                                   double *fhi, int *side)
+{
+    if ((f < 0.0) == (*flo < 0.0)) {
+        *lo = x;
+        *flo = f;
+        if (*side == -1)
+            *fhi *= 0.5;
+        *side = -1;
+    } else {
+        *hi = x;
+        *fhi = f;
+        if (*side == 1)
+            *flo *= 0.5;
+        *side = 1;
+    }
 }
 
 #endif /* ROBOKIN_BRENT_H */

@@ -913,19 +913,7 @@ static double hc_model_root(double f0, double f1, double d0, double d1)
                    (t3 - t2) * d1;
         if (v == 0.0)
             break;
-        if ((v < 0.0) == (flo < 0.0)) {
-            lo = t;
-            flo = v;
-            if (side == -1)
-                fhi *= 0.5;
-            side = -1;
-        } else {
-            hi = t;
-            fhi = v;
-            if (side == 1)
-                flo *= 0.5;
-            side = 1;
-        }
+        illinois_update(t, v, &lo, &flo, &hi, &fhi, &side);
     }
     return t;
 }
@@ -959,19 +947,7 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow
         double sfac = q->j == 1 ? fabs(q->sV) : sqrt(r.sh[0] * r.sh[0] + r.sh[1] * r.sh[1]);
         if (fabs(f) <= 4.0 * DBL_EPSILON + 4.0 * r.noise * sfac)
             break;
-        if ((f < 0.0) == (flo < 0.0)) {
-            lo = x;
-            flo = f;
-            if (side == -1)
-                fhi *= 0.5;
-            side = -1;
-        } else {
-            hi = x;
-            fhi = f;
-            if (side == 1)
-                flo *= 0.5;
-            side = 1;
-        }
+        illinois_update(x, f, &lo, &flo, &hi, &fhi, &side);
         if (hi - lo <= 2.0 * DBL_EPSILON * fmax(1.0, fabs(x)))
             break;
         double nx = r.sloped && d != 0.0 ? x - f / d : NAN;

@@ -1313,19 +1313,7 @@ static void hm_root(HmCtx *c, int b, int qi, double a, double fa, double e, doub
         if (best_f <= HM_TOL && fabs(f) <= HM_FLOOR * (nextafter(fabs(t), INFINITY) - fabs(t)) *
                                                  fabs(d))
             break;
-        if ((f < 0) == (fa < 0)) {
-            a = t;
-            fa = f;
-            if (side == -1)
-                fe *= 0.5;
-            side = -1;
-        } else {
-            e = t;
-            fe = f;
-            if (side == 1)
-                fa *= 0.5;
-            side = 1;
-        }
+        illinois_update(t, f, &a, &fa, &e, &fe, &side);
         if (!(e - a > 2.0 * DBL_EPSILON * fmax(fabs(a), fabs(e))))
             break;
         double tn = t - f / d;
@@ -1411,19 +1399,7 @@ static void hm_extremum(HmCtx *c, int b, int j, double a, double da, double e, d
         double d = out->dq[b][j] * hm_dtds(c, tt);
         if (!isfinite(d) || d == 0.0)
             return;
-        if ((d < 0) == (da < 0)) {
-            a = t;
-            da = d;
-            if (side == -1)
-                de *= 0.5;
-            side = -1;
-        } else {
-            e = t;
-            de = d;
-            if (side == 1)
-                da *= 0.5;
-            side = 1;
-        }
+        illinois_update(t, d, &a, &da, &e, &de, &side);
         if (!(e - a > 1e-13 * fmax(1.0, fabs(t))))
             return;
     }
