@@ -165,6 +165,37 @@ def compare(a: dict, b: dict, tol: float) -> str:
             f"{worst['other']:.2e}) {moved[:20]}; different point counts {diff_pts}")
 
 
+def compare_points(a: dict, b: dict, tol: float) -> str:
+    """The points of poses neither tree flagged, per kind (folds, aligned points, limit
+    crossings): poses whose points of a (branch, joint, kind) differ in count, and the
+    largest move of a point where the counts agree."""
+    both = (a["flags"] == 0) & (b["flags"] == 0)
+    names = {3: "folds", 2: "aligned", 0: "crossings", 1: "crossings"}
+    count = dict.fromkeys(names.values(), 0)
+    moved = dict.fromkeys(names.values(), 0)
+    worst = dict.fromkeys(names.values(), 0.0)
+    for i in np.flatnonzero(both):
+        pa, pb = a["pts"][i, :a["npts"][i]], b["pts"][i, :b["npts"][i]]
+        keys = {tuple(r) for r in pa[:, 1:]} | {tuple(r) for r in pb[:, 1:]}
+        off = dict.fromkeys(names.values(), 0.0)
+        bad = dict.fromkeys(names.values(), False)
+        for key in keys:
+            name = names[int(key[2])]
+            ta = np.sort(pa[np.all(pa[:, 1:] == key, axis=1), 0])
+            tb = np.sort(pb[np.all(pb[:, 1:] == key, axis=1), 0])
+            if ta.shape != tb.shape:
+                bad[name] = True
+            elif ta.size:
+                off[name] = max(off[name], float(np.max(np.abs(ta - tb))))
+        for name in count:
+            count[name] += bad[name]
+            moved[name] += off[name] > tol
+            worst[name] = max(worst[name], off[name])
+    return "points: " + "; ".join(
+        f"{n}: poses with another count {count[n]}, moved more than {tol:g} {moved[n]} "
+        f"(largest {worst[n]:.2e})" for n in count)
+
+
 def identical(a: dict, b: dict) -> str:
     """Whether the two trees' outputs are bit for bit the same (every pose)."""
     same = {k: bool(np.array_equal(a[k], b[k])) for k in ("niv", "npts", "flags", "evals")}
@@ -205,6 +236,7 @@ def main() -> None:
     print("load", pathlib.Path("/proc/loadavg").read_text().split()[:3])
     out = [dict(np.load(tmp / f"{name}.npz")) for name in "AB"]
     print(compare(out[0], out[1], a.tol))
+    print(compare_points(out[0], out[1], a.tol))
     print(compare_pieces(out[0], out[1], a.tol))
     print(identical(out[0], out[1]))
 
