@@ -110,7 +110,26 @@ typedef struct {
     double sign[7], off[7], lo[7], hi[7];
     double arc[7][4]; /* each joint's limits as an arc of chain values: cos, sin of its
                        * middle, cos and 1 / sin of its half width (hc_margins) */
+    int ax[7];        /* axis k along coordinate ax[k] (0-2, sign axs[k]), else 3 */
+    double axs[7];
 } HcGeo;
+
+/* rot(h_k, t) v (c = cos t, s = sin t): about a coordinate axis (the Panda's, the
+ * FR3's: every axis at zero) two coordinates turn; else Rodrigues' formula */
+static inline v3 hc_rot(const HcGeo *g, int k, double c, double s, v3 v)
+{
+    double t = g->axs[k] * s;
+    switch (g->ax[k]) {
+    case 0:
+        return (v3){v.x, c * v.y - t * v.z, t * v.y + c * v.z};
+    case 1:
+        return (v3){c * v.x + t * v.z, v.y, c * v.z - t * v.x};
+    case 2:
+        return (v3){c * v.x - t * v.y, t * v.x + c * v.y, v.z};
+    default:
+        return v3_rot(g->h[k], c, s, v);
+    }
+}
 
 typedef struct {
     const HcGeo *g;
@@ -126,11 +145,13 @@ typedef struct {
  * and finite). */
 typedef struct {
     double x, cs[7][2], dv[7], noise; /* noise: v5's rounding [rad] */
-    double mg[2][7];  /* each joint's margins, both triples (hc_rowq; mg[0][0] NaN
-                       * until then) */
+    double mg[2][7];  /* each joint's margins, both triples (hc_rowq's, when hasmg) */
     double sh[5], dsh[5]; /* w.ea, w.e2, w.e1, r.ea, r.e2 and their slopes */
     double dxi;       /* dx/dxi on its piece (hc_cell's slopes per cell) */
-    int sloped;
+    double c, s;      /* cos x, sin x */
+    v3 in;            /* the shoulder's body angular velocity's inner part (hc_full) */
+    int sloped, hasmg;
+    int ronly;        /* r alone: w.ea, w.e2 (and slopes) NaN, sh[2] = r.e1 (hc_full) */
     int nf;           /* queries with their values in f, df (hc_cell's; 0 until then) */
     double f[HC_MAXQ], df[HC_MAXQ];
 } HcRow;
@@ -160,6 +181,15 @@ static int hc_geo(const double *P, HcGeo *g)
         g->arc[k][1] = sin(mid);
         g->arc[k][2] = cos(half);
         g->arc[k][3] = 1.0 / sin(half);
+        const double *h = &P[PK_AXES + 3 * k];
+        g->ax[k] = 3;
+        g->axs[k] = 1.0;
+        for (int a = 0; a < 3; a++)
+            if (fabs(fabs(h[a]) - 1.0) < 1e-15 && fabs(h[(a + 1) % 3]) < 1e-15 &&
+                fabs(h[(a + 2) % 3]) < 1e-15) { /* (within rounding: a DH frame's 6e-17) */
+                g->ax[k] = a;
+                g->axs[k] = h[a] > 0.0 ? 1.0 : -1.0;
+            }
     }
     g->RM = (m3){v3_at(P, PK_TOOL_R), v3_at(P, PK_TOOL_R + 3), v3_at(P, PK_TOOL_R + 6)};
     g->tM = v3_at(P, PK_TOOL_T);
@@ -270,11 +300,12 @@ static inline double hc_m1(const HcPose *p, double c, double s)
     return p->g->cn - fabs(hc_aff(p->d, c, s) - p->g->K);
 }
 
-/* E2's margin of v4 root i at x (>= 0 where v6 has roots), its slope when dm != NULL */
-static double hc_m2(const HcPose *p, double x, int i, double *dm)
+/* E2's margin of v4 root i at x (c, s: cos x, sin x; >= 0 where v6 has roots), its
+ * slope when dm != NULL */
+static double hc_m2cs(const HcPose *p, double c, double s, int i, double *dm)
 {
     const HcGeo *g = p->g;
-    double c = cos(x), s = sin(x), c4, s4, sg;
+    double c4, s4, sg;
     double D = hc_aff(p->d, c, s);
     hc_root(g->c1, g->c2, g->cn, D - g->K, i, &c4, &s4, &sg);
     double e = g->ec[0] + g->ec[1] * c4 + g->ec[2] * s4;
@@ -289,9 +320,15 @@ static double hc_m2(const HcPose *p, double x, int i, double *dm)
     return H - fabs(E);
 }
 
+static inline double hc_m2(const HcPose *p, double x, int i, double *dm)
+{
+    return hc_m2cs(p, cos(x), sin(x), i, dm);
+}
+
 #define HC_SHOULDER 1 /* hc_eval: the shoulder's scalars (else the wrist's values alone) */
 #define HC_SLOPES 2   /* ... and the slopes d/dx (the wrist's alone without HC_SHOULDER) */
 #define HC_NOISE 4    /* ... and v5's rounding (r->noise; else NaN) */
+#define HC_RONLY 8    /* ... r alone where a wrist joint is outside (hc_full completes it) */
 
 /* Branch (i, j)'s row at x (what: HC_SHOULDER, HC_SLOPES, HC_NOISE); 0 when it has
  * none (a margin below -tol). */
@@ -314,7 +351,8 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
     hc_root(f1, f2, H, e - f0, j, &c6, &s6, &s6g);
     v3 v = v3_add(p->v[0], v3_add(v3_scale(p->v[1], c), v3_scale(p->v[2], s)));
     v3 h4 = g->h[3], h5 = g->h[4], h6 = g->h[5], h7 = g->h[6];
-    v3 u6 = v3_rot(h6, c6, s6, v);
+    (void)h7;
+    v3 u6 = hc_rot(g, 5, c6, s6, v);
     /* v5: e5(-v5) x4 = u6 (the turn about axis 5 taking x4 to u6 is -v5) */
     v3 xp = v3_sub(x4, v3_scale(h5, v3_dot(h5, x4))), up = v3_sub(u6, v3_scale(h5, v3_dot(h5, u6)));
     double yy = v3_dot(h5, v3_cross(xp, up)), xx = v3_dot(xp, up);
@@ -335,22 +373,31 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
     r->cs[5][1] = s6;
     r->sloped = 0;
     r->nf = 0;
-    r->mg[0][0] = NAN; /* hc_rowq's, when asked */
+    r->hasmg = 0; /* hc_rowq's, when asked */
+    r->c = c;
+    r->s = s;
+    /* a wrist joint outside its limits: r alone (a dead cell's row, hc_cell) */
+    r->ronly = 0;
+    if ((what & (HC_SHOULDER | HC_RONLY)) == (HC_SHOULDER | HC_RONLY))
+        for (int jw = 3; jw < 6; jw++)
+            r->ronly |= r->cs[jw][0] * g->arc[jw][0] + r->cs[jw][1] * g->arc[jw][1] < g->arc[jw][2];
     v3 w = {0}, rr = {0};
     if (what & HC_SHOULDER) {
         /* w = R e1, R = RG0 R7(-x) R6(-v6) R5(-v5) R4(-v4); r = R^T e1 */
-        w = v3_rot(h4, c4, -s4, g->e1);
-        w = v3_rot(h5, c5, -s5, w);
-        w = v3_rot(h6, c6, -s6, w);
-        w = v3_rot(h7, c, -s, w);
-        w = m3_mv(&p->RG0, w);
-        rr = v3_rot(h7, c, s, p->g1);
-        rr = v3_rot(h6, c6, s6, rr);
-        rr = v3_rot(h5, c5, s5, rr);
-        rr = v3_rot(h4, c4, s4, rr);
-        r->sh[0] = v3_dot(w, g->ea);
-        r->sh[1] = v3_dot(w, g->e2);
-        r->sh[2] = v3_dot(w, g->e1);
+        if (!r->ronly) {
+            w = hc_rot(g, 3, c4, -s4, g->e1);
+            w = hc_rot(g, 4, c5, -s5, w);
+            w = hc_rot(g, 5, c6, -s6, w);
+            w = hc_rot(g, 6, c, -s, w);
+            w = m3_mv(&p->RG0, w);
+        }
+        rr = hc_rot(g, 6, c, s, p->g1);
+        rr = hc_rot(g, 5, c6, s6, rr);
+        rr = hc_rot(g, 4, c5, s5, rr);
+        rr = hc_rot(g, 3, c4, s4, rr);
+        r->sh[0] = r->ronly ? NAN : v3_dot(w, g->ea);
+        r->sh[1] = r->ronly ? NAN : v3_dot(w, g->e2);
+        r->sh[2] = v3_dot(r->ronly ? rr : w, g->e1); /* (cos v2 both ways) */
         r->sh[3] = v3_dot(rr, g->ea);
         r->sh[4] = v3_dot(rr, g->e2);
     }
@@ -363,7 +410,7 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
     double den6 = -f1 * s6 + f2 * c6;
     double dv6 = (de - hc_daff(p->f0, c, s) - hc_daff(p->f1, c, s) * c6 -
                   hc_daff(p->f2, c, s) * s6) / den6;
-    v3 m = v3_rot(h5, c5, s5, h6);
+    v3 m = hc_rot(g, 4, c5, s5, h6);
     v3 dx4 = v3_scale(v3_add(v3_scale(g->a1, -s4), v3_scale(g->a2, c4)), dv4);
     v3 dv = v3_add(v3_scale(p->v[1], -s), v3_scale(p->v[2], c));
     double den5 = v3_dot(v3_cross(h5, m), x4);
@@ -377,20 +424,63 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
         return 1;
     }
     /* the shoulder's angular velocity: spatial om = -RG inner, body -R4 R5 R6 inner */
-    v3 in = v3_add(v3_scale(v3_rot(h5, c5, -s5, h4), dv4), v3_scale(h5, dv5));
-    in = v3_add(v3_rot(h6, c6, -s6, in), v3_add(v3_scale(h6, dv6), h7));
-    v3 om = v3_scale(m3_mv(&p->RG0, v3_rot(h7, c, -s, in)), -1.0);
-    v3 ob = v3_rot(h6, c6, s6, in);
-    ob = v3_rot(h5, c5, s5, ob);
-    ob = v3_scale(v3_rot(h4, c4, s4, ob), -1.0);
-    v3 dw = v3_cross(om, w), dr = v3_cross(rr, ob);
+    v3 in = v3_add(v3_scale(hc_rot(g, 4, c5, -s5, h4), dv4), v3_scale(h5, dv5));
+    in = v3_add(hc_rot(g, 5, c6, -s6, in), v3_add(v3_scale(h6, dv6), h7));
+    r->in = in;
+    v3 ob = hc_rot(g, 5, c6, s6, in);
+    ob = hc_rot(g, 4, c5, s5, ob);
+    ob = v3_scale(hc_rot(g, 3, c4, s4, ob), -1.0);
+    v3 dr = v3_cross(rr, ob);
+    r->dsh[3] = v3_dot(dr, g->ea);
+    r->dsh[4] = v3_dot(dr, g->e2);
+    if (r->ronly) {
+        r->dsh[0] = r->dsh[1] = NAN;
+        r->dsh[2] = v3_dot(dr, g->e1);
+        r->sloped = isfinite(dv4) && isfinite(dv5) && isfinite(dv6) && isfinite(ob.x + ob.y + ob.z);
+        return 1;
+    }
+    v3 om = v3_scale(m3_mv(&p->RG0, hc_rot(g, 6, c, -s, in)), -1.0);
+    v3 dw = v3_cross(om, w);
     r->dsh[0] = v3_dot(dw, g->ea);
     r->dsh[1] = v3_dot(dw, g->e2);
     r->dsh[2] = v3_dot(dw, g->e1);
-    r->dsh[3] = v3_dot(dr, g->ea);
-    r->dsh[4] = v3_dot(dr, g->e2);
     r->sloped = isfinite(dv4) && isfinite(dv5) && isfinite(dv6) && isfinite(om.x + om.y + om.z);
     return 1;
+}
+
+/* An r-only row (HC_RONLY) completed: w and its slope as hc_eval's, bit for bit */
+static void hc_full(const HcPose *p, HcRow *r)
+{
+    if (!r->ronly)
+        return;
+    const HcGeo *g = p->g;
+    double c = r->c, s = r->s;
+    v3 w = hc_rot(g, 3, r->cs[3][0], -r->cs[3][1], g->e1);
+    w = hc_rot(g, 4, r->cs[4][0], -r->cs[4][1], w);
+    w = hc_rot(g, 5, r->cs[5][0], -r->cs[5][1], w);
+    w = hc_rot(g, 6, c, -s, w);
+    w = m3_mv(&p->RG0, w);
+    r->sh[0] = v3_dot(w, g->ea);
+    r->sh[1] = v3_dot(w, g->e2);
+    r->sh[2] = v3_dot(w, g->e1);
+    if (r->sloped) { /* (never a branch end's row: those are never r-only) */
+        v3 om = v3_scale(m3_mv(&p->RG0, hc_rot(g, 6, c, -s, r->in)), -1.0);
+        v3 dw = v3_cross(om, w);
+        r->dsh[0] = v3_dot(dw, g->ea);
+        r->dsh[1] = v3_dot(dw, g->e2);
+        r->dsh[2] = v3_dot(dw, g->e1);
+        r->sloped = isfinite(om.x + om.y + om.z);
+    }
+    r->ronly = 0;
+    r->nf = 0;
+    r->hasmg = 0;
+}
+
+/* sin v2 = |(w.ea, w.e2)| (r-only rows: |(r.ea, r.e2)|) */
+static inline double hc_rho(const HcRow *r)
+{
+    const double *a = r->sh;
+    return r->ronly ? sqrt(a[3] * a[3] + a[4] * a[4]) : sqrt(a[0] * a[0] + a[1] * a[1]);
 }
 
 /* Chain values of a row, triple k (0: v2 >= 0; 1: the other) */
@@ -410,23 +500,6 @@ static void hc_angles(const HcRow *r, int k, double *v)
     v[6] = r->x;
 }
 
-/* Joint values q (into the limits by whole turns where that fits) of chain values v;
- * returns the least margin to a limit over the joints other than `skip` (negative:
- * outside) */
-static double hc_joints(const HcGeo *g, const double *v, int skip, double *q)
-{
-    double margin = INFINITY;
-    for (int j = 0; j < 7; j++) {
-        int in;
-        q[j] = joint_value(v[j], g->sign[j], g->off[j], g->lo[j], g->hi[j], &in);
-        if (j == 6)
-            q[j] = g->sign[j] * (v[j] - g->off[j]);
-        if (j != skip && j != 6) /* (x is in the held joint's range by construction) */
-            margin = fmin(margin, fmin(q[j] - g->lo[j], g->hi[j] - q[j]));
-    }
-    return margin;
-}
-
 /* Row r's margins of joints 1-6 to their limits, both triples (mg[k][j]; joint 7, the
  * held one, inside by construction: +inf), without the angles: with m the middle of a
  * joint's range of chain values and h its half width, (cos(v - m) - cos h) / sin h, of
@@ -436,7 +509,7 @@ static double hc_joints(const HcGeo *g, const double *v, int skip, double *q)
 static void hc_margins(const HcGeo *g, const HcRow *r, double mg[2][7])
 {
     const double *a = r->sh;
-    double rho = sqrt(a[0] * a[0] + a[1] * a[1]), ir = 1.0 / rho;
+    double rho = hc_rho(r), ir = 1.0 / rho;
     double d1 = (a[0] * g->arc[0][0] + a[1] * g->arc[0][1]) * ir;
     double d3 = (-a[3] * g->arc[2][0] + a[4] * g->arc[2][1]) * ir;
     double d2c = a[2] * g->arc[1][0], d2s = rho * g->arc[1][1];
@@ -467,6 +540,7 @@ static inline double hc_least(const double *mg, int skip)
 static void hc_rowq(const HcPose *p, HcRow *r, double *margin)
 {
     hc_margins(p->g, r, r->mg);
+    r->hasmg = 1;
     margin[0] = hc_least(r->mg[0], -1);
     margin[1] = hc_least(r->mg[1], -1);
 }
@@ -476,7 +550,7 @@ static double hc_angle1(const HcRow *r, int k, int j)
 {
     const double *a = r->sh;
     double v = j == 0 ? fast_atan2(a[1], a[0])
-             : j == 1 ? fast_atan2(sqrt(a[0] * a[0] + a[1] * a[1]), a[2])
+             : j == 1 ? fast_atan2(hc_rho(r), a[2])
                       : fast_atan2(a[4], -a[3]);
     return !k ? v : j == 1 ? -v : wrap_pi(v + M_PI);
 }
@@ -532,6 +606,7 @@ typedef struct {
     HcPose p;
     HcQuery q[HC_MAXQ];
     int nq, bad;
+    int ronly; /* HC_RONLY where every query located everywhere takes r alone, else 0 */
     HcEvent ev[4][HC_MAXE]; /* per position branch 2 i + j */
     int nev[4];
     double cut[4][2 * HC_MAXPC]; /* the branch's piece ends (x), as pairs */
@@ -722,7 +797,7 @@ static void hc_closed_events(HcCtx *c, int jj, double V, int kind)
             for (int m = 0; m < 3; m++)
                 rhs[m] = p->f0[m] + p->f1[m] * cV + p->f2[m] * sV - (m == 0 ? g->ec[0] : 0.0);
         } else {
-            v3 mv = v3_rot(g->h[4], cV, sV, g->h[5]);
+            v3 mv = hc_rot(g, 4, cV, sV, g->h[5]);
             row0 = v3_dot(mv, g->a1);
             row1 = v3_dot(mv, g->a2);
             double m0 = v3_dot(mv, g->a0);
@@ -923,7 +998,7 @@ static double hc_model_root(double f0, double f1, double d0, double d1)
  * root, safeguarded Newton / Illinois to the last bits; the event with its triple. */
 static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow *ra,
                       double xi0, double f0, double d0, const HcRow *rb, double xi1,
-                      double f1, double d1)
+                      double f1, double d1, int ronly)
 {
     HcRow r;
     double lo = ra->x, hi = rb->x, flo = f0, fhi = f1;
@@ -936,7 +1011,7 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow
         }
         if (!(x > lo && x < hi))
             x = 0.5 * (lo + hi);
-        if (!hc_eval(&c->p, x, pc->i, pc->j, HC_SHOULDER | HC_SLOPES | HC_NOISE, &r)) {
+        if (!hc_eval(&c->p, x, pc->i, pc->j, HC_SHOULDER | HC_SLOPES | HC_NOISE | ronly, &r)) {
             c->bad = __LINE__;
             return;
         }
@@ -944,7 +1019,7 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow
         double d, f = hc_f(q, &r, &d, NULL);
         /* at the root to its rounding: f is sin v2 sin(v_j - V) (v1, v3), cos v2 - cos V
          * (v2), each O(1), with v5's rounding (r.noise) in the angles */
-        double sfac = q->j == 1 ? fabs(q->sV) : sqrt(r.sh[0] * r.sh[0] + r.sh[1] * r.sh[1]);
+        double sfac = q->j == 1 ? fabs(q->sV) : hc_rho(&r);
         if (fabs(f) <= 4.0 * DBL_EPSILON + 4.0 * r.noise * sfac)
             break;
         illinois_update(x, f, &lo, &flo, &hi, &fhi, &side);
@@ -961,8 +1036,7 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow
     /* the joint at its value to HC_AT, or to what the last bits of x allow where it
      * moves fast (next to a branch end: as the square root of the distance), at most
      * HC_AT_STEEP; |df / dv_j| is |sin v2 cos(v_j - V)| ~ |sin v2| (v1, v3) or |sin V| */
-    double rho = sqrt(r.sh[0] * r.sh[0] + r.sh[1] * r.sh[1]);
-    double rate = fabs(d) / (q->j == 1 ? fabs(q->sV) : rho);
+    double rate = fabs(d) / (q->j == 1 ? fabs(q->sV) : hc_rho(&r));
     double off = fabs(wrap_pi(hc_angle1(&r, k, q->j) - q->V));
     double tol = fmax(HC_AT, 8.0 * fmax(rate * DBL_EPSILON * fmax(1.0, fabs(x)), r.noise));
     if (!r.sloped || !(off <= tol) || !(off <= HC_AT_STEEP)) {
@@ -1009,13 +1083,29 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
     double h = xi1 - xi0, sa = ra->dxi * h, sb = rb->dxi * h;
     double ea = 0.5 * (pc->b - pc->a) * M_PI * h; /* a branch end's row: d/dxi given */
     double at = 0.5; /* where a split cuts the cell */
-    int split = 0;
-    double fa[HC_MAXQ], fb[HC_MAXQ], dfa[HC_MAXQ], dfb[HC_MAXQ];
+    int split = 0, bj = 2 * pc->i + pc->j;
+    double fa[HC_MAXQ], fb[HC_MAXQ], dfa[HC_MAXQ], dfb[HC_MAXQ], mgt[2];
+    /* a wrist joint outside all over the cell (at both ends, no event of it between):
+     * a dead cell for both triples, whose limit crossings bound nothing; only the
+     * queries located everywhere are asked there (aligned values, the aligned-shoulder
+     * guards), on r-only rows where those need r alone (c->ronly) */
+    int dead = 0;
+    for (HcRow *r = ra; r != NULL; r = r == ra ? rb : NULL)
+        if (!r->hasmg)
+            hc_rowq(&c->p, r, mgt);
+    for (int m = 3; m < 6 && !dead; m++)
+        dead = hc_out(c, bj, ra, rb, 0, m, NULL, NULL);
+    if (!dead) {
+        hc_full(&c->p, ra);
+        hc_full(&c->p, rb);
+    }
     for (HcRow *r = ra; r != NULL; r = r == ra ? rb : NULL) /* (a node is two cells') */
         for (; r->nf < c->nq; r->nf++)
             r->f[r->nf] = hc_f(&c->q[r->nf], r, &r->df[r->nf], NULL);
     for (int m = 0; m < c->nq && !split; m++) {
         const HcQuery *q = &c->q[m];
+        if (dead && q->kind >= 0 && q->kind != HM_KIND_ALIGNED)
+            continue;
         double da = ra->df[m], db = rb->df[m];
         fa[m] = ra->f[m];
         fb[m] = rb->f[m];
@@ -1073,7 +1163,8 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
         }
         double xm = xi0 + at * (xi1 - xi0);
         HcRow rm;
-        if (!hc_eval(&c->p, hc_x(pc, xm), pc->i, pc->j, HC_SHOULDER | HC_SLOPES, &rm)) {
+        if (!hc_eval(&c->p, hc_x(pc, xm), pc->i, pc->j,
+                     HC_SHOULDER | HC_SLOPES | (dead ? c->ronly : 0), &rm)) {
             c->bad = __LINE__;
             return;
         }
@@ -1084,10 +1175,10 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
         hc_cell(c, pc, &rm, xm, rb, xi1, depth + 1);
         return;
     }
-    int bj = 2 * pc->i + pc->j, dead[2] = {-1, -1}; /* per triple: unknown yet */
+    int deadk[2] = {-1, -1}; /* per triple: unknown yet */
     for (int m = 0; m < c->nq; m++) {
         const HcQuery *q = &c->q[m];
-        if (q->kind < 0 || (fa[m] < 0.0) == (fb[m] < 0.0))
+        if (q->kind < 0 || (dead && q->kind != HM_KIND_ALIGNED) || (fa[m] < 0.0) == (fb[m] < 0.0))
             continue;
         if (fa[m] == 0.0 || fb[m] == 0.0) {
             c->bad = __LINE__; /* a node exactly on a crossing */
@@ -1100,29 +1191,23 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
             int ka, kb, skip = 1;
             hc_f(q, ra, NULL, &ka);
             hc_f(q, rb, NULL, &kb);
-            if (isnan(ra->mg[0][0])) {
-                double mg[2];
-                hc_rowq(&c->p, ra, mg);
-            }
-            if (isnan(rb->mg[0][0])) {
-                double mg[2];
-                hc_rowq(&c->p, rb, mg);
-            }
+            for (HcRow *r = ra; r != NULL; r = r == ra ? rb : NULL)
+                if (!r->hasmg)
+                    hc_rowq(&c->p, r, mgt);
             for (int k = 0; k < 2 && skip; k++) {
                 if (ka == kb && k != ka && !q->twin)
                     continue; /* the root's triple known: its side at both ends */
-                if (dead[k] < 0) {
-                    dead[k] = 0;
-                    for (int jj = 0; jj < 6 && !dead[k]; jj++) {
-                        dead[k] = jj != q->j && hc_out(c, bj, ra, rb, k, jj, fa, fb);
-                    }
+                if (deadk[k] < 0) {
+                    deadk[k] = 0;
+                    for (int jj = 0; jj < 3 && !deadk[k]; jj++) /* (3-5: not dead) */
+                        deadk[k] = jj != q->j && hc_out(c, bj, ra, rb, k, jj, fa, fb);
                 }
-                skip = dead[k];
+                skip = deadk[k];
             }
             if (skip)
                 continue;
         }
-        hc_root_q(c, pc, q, ra, xi0, fa[m], dfa[m], rb, xi1, fb[m], dfb[m]);
+        hc_root_q(c, pc, q, ra, xi0, fa[m], dfa[m], rb, xi1, fb[m], dfb[m], dead ? c->ronly : 0);
     }
 }
 
@@ -1133,7 +1218,9 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
     for (int k = 0; k < HC_NODES; k++) {
         double x = k == 0 ? pc->a : k == HC_NODES - 1 ? pc->b
                                   : pc->a + (pc->b - pc->a) * 0.5 * (1.0 - c->ncs[k][0]);
-        if (!hc_eval(&c->p, x, pc->i, pc->j, HC_SHOULDER | HC_SLOPES, &r[k])) {
+        /* (interior nodes r-only where a wrist joint is outside; the ends in full) */
+        int ro = k > 0 && k < HC_NODES - 1 ? c->ronly : 0;
+        if (!hc_eval(&c->p, x, pc->i, pc->j, HC_SHOULDER | HC_SLOPES | ro, &r[k])) {
             c->bad = __LINE__;
             return;
         }
@@ -1349,6 +1436,12 @@ static void hc_pieces(HcCtx *c)
         if (!(hc_m1(p, cos(xm), sin(xm)) > 0.0))
             continue;
         HcPiece pc = {a, b, a != p->xlo, b != p->xhi, 0, 0, 0.0, 0.0};
+        double nx[HC_MNODES], ncs[HC_MNODES][2]; /* the nodes' x, cos x, sin x (both i) */
+        for (int k = 0; k < HC_MNODES; k++) {
+            nx[k] = k == 0 ? a : k == HC_MNODES - 1 ? b : a + (b - a) * 0.5 * (1.0 - c->mcs[k][0]);
+            ncs[k][0] = cos(nx[k]);
+            ncs[k][1] = sin(nx[k]);
+        }
         for (int i = 0; i < 2 && !c->bad; i++) {
             /* E2's margin on nodes of the piece: its sign changes */
             HcMNode nd[HC_MNODES];
@@ -1356,10 +1449,9 @@ static void hc_pieces(HcCtx *c)
             int ne = 0;
             for (int k = 0; k < HC_MNODES; k++) {
                 nd[k].xi = (double)k / (HC_MNODES - 1);
-                nd[k].x = k == 0 ? a : k == HC_MNODES - 1 ? b
-                                     : a + (b - a) * 0.5 * (1.0 - c->mcs[k][0]);
+                nd[k].x = nx[k];
                 nd[k].dx = (b - a) * 0.5 * M_PI * c->mcs[k][1];
-                nd[k].m = hc_m2(p, nd[k].x, i, &nd[k].d);
+                nd[k].m = hc_m2cs(p, ncs[k][0], ncs[k][1], i, &nd[k].d);
                 if ((k == 0 && pc.fa) || (k == HC_MNODES - 1 && pc.fb))
                     nd[k].d = NAN;
             }
@@ -1528,32 +1620,59 @@ static int hc_evcmp(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-/* Whether pk_one numbers the rows at x as hc_slot does (its rows there within 1e-6
- * of these, each nearest its own slot's) */
+/* Whether pk_one numbers the rows at x as hc_slot does: its rows there (slot = 2
+ * position + triple, from its front and triples, checked and polished as pk_one
+ * checks them; its repairs, which move a row outside the limits by at most a nudge,
+ * left out) within 1e-6 of these in chain values, each nearest its own slot's */
 static int hc_slots_agree(HcCtx *c, const double *P, double x)
 {
     const HcGeo *g = c->p.g;
-    double Q[8][PK_MAXJ], qn[PK_MAXJ] = {0};
-    unsigned char valid[8], sing[8], inside[8];
-    PkOut o = {&Q[0][0], valid, sing, inside, PK_MAXJ};
-    double t = g->sign[6] * (x - g->off[6]);
-    pk_one(P, c->T, t, qn, o);
+    double t = g->sign[6] * (x - g->off[6]), qn[PK_MAXJ] = {0}, Q[8][6];
+    unsigned char valid[8] = {0};
+    PkFront f;
+    if (pk_front_memo(P, c->T, t, qn, 0, &c->front, 15u, &f) != PK_OK)
+        return 0;
+    const PkPos *pos = &f.pos;
+    for (int i = 0; i < pos->n; i++) {
+        if (!(pos->res[i] < 1e-6 * f.g.scale))
+            continue;
+        double th[6];
+        m3 Rt = pk_front_rotation(&f, i, th);
+        PkTrip tr;
+        pk_triple(P, &f.tri, &Rt, f.jx, f.jz, qn[f.jz], P[PK_SING_TOL], &tr);
+        for (int k = 0; k < tr.n; k++) {
+            for (int j = 0; j < 3; j++) {
+                th[f.ia + j] = pos->t[i][j];
+                th[f.it + j] = tr.t[k][j];
+            }
+            if (tr.check[k] || !(pos->res[i] < f.exact_p)) {
+                double err = pk_error_of(&f.g, &f.RT, f.pT, th);
+                if (err > PK_EXACT)
+                    err = pk_polish_slow(&f.g, &f.RT, f.pT, th, pk_polish(&f.g, &f.RT, f.pT, th));
+                if (!(err <= PK_ACCEPT))
+                    continue; /* (pk_one returns no row) */
+            }
+            int b = 2 * pos->slot[i] + k;
+            for (int j = 0; j < 6; j++)
+                Q[b][f.g.full[j]] = th[j];
+            valid[b] = 1;
+        }
+    }
     for (int bj = 0; bj < 4; bj++) {
         HcRow r;
         if (!hc_eval(&c->p, x, bj >> 1, bj & 1, HC_SHOULDER, &r))
             continue;
         for (int k = 0; k < 2; k++) {
-            double v[7], q[7];
+            double v[7];
             hc_angles(&r, k, v);
-            hc_joints(g, v, -1, q);
             int best = -1;
             double bd = INFINITY;
             for (int b = 0; b < 8; b++) {
                 if (!valid[b])
                     continue;
                 double d = 0.0;
-                for (int jj = 0; jj < 7; jj++)
-                    d = fmax(d, fabs(wrap_pi(q[jj] - Q[b][jj])));
+                for (int jj = 0; jj < 6; jj++)
+                    d = fmax(d, fabs(wrap_pi(v[jj] - Q[b][jj])));
                 if (d < bd) {
                     bd = d;
                     best = b;
@@ -1630,6 +1749,10 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
             goto done;
         }
     }
+    c->ronly = HC_RONLY;
+    for (int m = 0; m < c->nq; m++)
+        if (c->q[m].j == 0 && c->q[m].kind == HM_KIND_ALIGNED)
+            c->ronly = 0; /* (v1's aligned values take w) */
     hc_pieces(c);
     if (c->bad)
         goto done;
@@ -1782,7 +1905,7 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     ok = 1;
 done:
     *rows = c->rows;
-    *solves = 1; /* pk_one calls: hc_slots_agree's (hc_row_at's fronts are no rows) */
+    *solves = 0; /* pk_one calls (hc_row_at's and hc_slots_agree's fronts are none) */
     free(c);
     return ok;
 }
