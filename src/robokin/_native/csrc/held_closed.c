@@ -1533,10 +1533,86 @@ static double hc_disc_at(void *arg, double t)
     return d[a->kk] - a->off;
 }
 
+/* Where pk_one's rows of a slot end next to t (the margin's root, in held values; out:
+ * the direction of the piece's outside): the root of pk's discriminant (arg) to
+ * HC_SNAP_TOL, its inside end moved HC_SNAP_ULPS doubles further in; NaN where none
+ * is within HC_SNAP (or the discriminant is not finite). wide = 0: bracketed from t
+ * outward (where it has a row: the discriminant >= 0 inside the piece) or inward by
+ * probes HC_SNAP_TOL, 8, 64, ... times that far (pk's root is within 4e-15 of the
+ * margin's at 79 % of the ends, 1.6e-14 at 95 %: session 28); wide = 1: from the
+ * bracket [t - HC_SNAP, t + HC_SNAP] (sessions 26-27; hc_snap's second try). */
+static double hc_snap_end(HcDiscArg *arg, double t, double out, int wide)
+{
+    double w = HC_SNAP * fmax(1.0, fabs(t)), tol = HC_SNAP_TOL * fmax(1.0, fabs(t));
+    double lo, hi, flo, fhi;
+    if (wide) {
+        lo = t - w;
+        hi = t + w;
+        flo = hc_disc_at(arg, lo);
+        fhi = hc_disc_at(arg, hi);
+        if (!((flo < 0.0) != (fhi < 0.0)))
+            return NAN;
+    } else {
+        double f0 = hc_disc_at(arg, t), dir = f0 >= 0.0 ? out : -out;
+        double prev = t, fprev = f0, probe = t, fp = f0;
+        for (double step = tol;; step *= 8.0) {
+            if (!isfinite(fprev) || step > w)
+                return NAN;
+            probe = t + dir * step;
+            fp = hc_disc_at(arg, probe);
+            if (isfinite(fp) && (fp < 0.0) != (fprev < 0.0))
+                break;
+            prev = probe;
+            fprev = fp;
+        }
+        lo = fmin(prev, probe);
+        hi = fmax(prev, probe);
+        flo = prev < probe ? fprev : fp;
+        fhi = prev < probe ? fp : fprev;
+    }
+    /* the root to HC_SNAP_TOL: regula falsi steps (the retained end's value halved, as
+     * Illinois), each followed by a probe just past it (across the bracket the
+     * discriminant is nearly linear: a step lands next to the root, the probe closes
+     * the bracket) */
+    double glo = flo, ghi = fhi;
+    for (int it = 0; hi - lo > tol; it++) {
+        if (it >= 40)
+            return NAN;
+        double x = lo - glo * (hi - lo) / (ghi - glo);
+        if (!(x > lo && x < hi))
+            x = 0.5 * (lo + hi);
+        for (int np = 0; np < 2 && hi - lo > tol; np++) {
+            double fx = hc_disc_at(arg, x);
+            if (!isfinite(fx))
+                return NAN;
+            int below = (fx < 0.0) == (flo < 0.0); /* the root above x */
+            if (below) {
+                lo = x;
+                flo = glo = fx;
+                ghi *= 0.5; /* (hi retained) */
+            } else {
+                hi = x;
+                fhi = ghi = fx;
+                glo *= 0.5;
+            }
+            x += below ? 0.5 * tol : -0.5 * tol;
+            if (!(x > lo && x < hi))
+                break;
+        }
+    }
+    /* the last value with a discriminant >= 0 (a row): the bracket's inside end, moved
+     * clear of the discriminant's rounding (r's ulp upward: across a power of 2 twice
+     * the doubles downward) */
+    double r = flo >= 0.0 ? lo : hi, in = flo >= 0.0 ? -1.0 : 1.0;
+    return r + in * HC_SNAP_ULPS * (nextafter(r, INFINITY) - r);
+}
+
 /* Every branch end of every piece moved to where pk_one's rows of its slot end (what
  * SelfMotion.sample gives there): the root of pk's own discriminant of that position
  * root (held_margins.c; the pair's second root at HM_DISC_TWO, as held_manifold.c's
- * hm_fold_margin) within HC_SNAP of the margin's exact root; c->bad where none is. */
+ * hm_fold_margin) within HC_SNAP of the margin's exact root (hc_snap_end), confirmed
+ * by a pk_one row there (its rows near a double root are not the discriminant's sign
+ * alone: held_manifold.c's confirmation); c->bad where none is. */
 static void hc_snap(HcCtx *c, const double *P, HmMargMemo *memo)
 {
     const HcGeo *g = c->p.g;
@@ -1549,57 +1625,14 @@ static void hc_snap(HcCtx *c, const double *P, HmMargMemo *memo)
             int b = hc_slot(bj >> 1, bj & 1, 0), kk = kind == 1 ? 0 : 1 + (b >> 2);
             HcDiscArg arg = {P, c->T, memo, kk,
                              (kk == 0 ? b >= 4 : (b & 2) != 0) ? HM_DISC_TWO : 0.0};
-            double t = s7 * (c->cut[bj][m] - o7), w = HC_SNAP * fmax(1.0, fabs(t));
-            double lo = t - w, hi = t + w, flo = hc_disc_at(&arg, lo), fhi = hc_disc_at(&arg, hi);
-            if (!((flo < 0.0) != (fhi < 0.0))) {
-                c->bad = __LINE__;
-                return;
-            }
-            /* the root to HC_SNAP_TOL: regula falsi steps (the retained end's value
-             * halved, as Illinois), each followed by a probe just past it (across 1e-8
-             * the discriminant is nearly linear: a step lands next to the root, the
-             * probe closes the bracket) */
-            double tol = HC_SNAP_TOL * fmax(1.0, fabs(t)), glo = flo, ghi = fhi;
-            for (int it = 0; hi - lo > tol; it++) {
-                if (it >= 40) {
+            double t = s7 * (c->cut[bj][m] - o7), out = (m % 2 == 0 ? -1.0 : 1.0) * s7;
+            double r = hc_snap_end(&arg, t, out, 0);
+            if (!isfinite(r) || !hc_row_at(c, P, r, b)) {
+                r = hc_snap_end(&arg, t, out, 1); /* (a root in the discriminant's noise) */
+                if (!isfinite(r) || !hc_row_at(c, P, r, b)) {
                     c->bad = __LINE__;
                     return;
                 }
-                double x = lo - glo * (hi - lo) / (ghi - glo);
-                if (!(x > lo && x < hi))
-                    x = 0.5 * (lo + hi);
-                for (int probe = 0; probe < 2 && hi - lo > tol; probe++) {
-                    double fx = hc_disc_at(&arg, x);
-                    if (!isfinite(fx)) {
-                        c->bad = __LINE__;
-                        return;
-                    }
-                    int below = (fx < 0.0) == (flo < 0.0); /* the root above x */
-                    if (below) {
-                        lo = x;
-                        flo = glo = fx;
-                        ghi *= 0.5; /* (hi retained) */
-                    } else {
-                        hi = x;
-                        fhi = ghi = fx;
-                        glo *= 0.5;
-                    }
-                    x += below ? 0.5 * tol : -0.5 * tol;
-                    if (!(x > lo && x < hi))
-                        break;
-                }
-            }
-            /* the last value with a discriminant >= 0 (a row): the bracket's inside
-             * end, moved clear of the discriminant's rounding */
-            double r = flo >= 0.0 ? lo : hi, in = flo >= 0.0 ? -1.0 : 1.0;
-            /* (r's ulp upward: across a power of 2 twice the doubles downward) */
-            r += in * HC_SNAP_ULPS * (nextafter(r, INFINITY) - r);
-            /* confirmed as held_manifold.c's: pk_one's row there (its rows near a double
-             * root are not the discriminant's sign alone; an end it does not confirm
-             * leaves the pose to the grid) */
-            if (!hc_row_at(c, P, r, b)) {
-                c->bad = __LINE__;
-                return;
             }
             c->cutd[bj][m] = fabs(s7 * r + o7 - c->cut[bj][m]);
             c->cut[bj][m] = s7 * r + o7;
@@ -1904,6 +1937,9 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     }
     ok = 1;
 done:
+#ifdef HC_DEBUG_BAD
+    fprintf(stderr, "bad %d ", c->bad);
+#endif
     *rows = c->rows;
     *solves = 0; /* pk_one calls (hc_row_at's and hc_slots_agree's fronts are none) */
     free(c);
