@@ -92,7 +92,8 @@ def test_fk_does_not_modify_its_input(rng):
     np.testing.assert_array_equal(q, before)
 
 
-def test_compiled_sincos_is_within_one_ulp_of_libm(rng):
+@pytest.mark.parametrize("scalar", [0, 1], ids=["vsincos", "sincos1"])
+def test_compiled_sincos_is_within_one_ulp_of_libm(rng, scalar):
     x = np.concatenate(
         [
             rng.uniform(-7, 7, 200_000),
@@ -101,7 +102,7 @@ def test_compiled_sincos_is_within_one_ulp_of_libm(rng):
         ]
     )
     s, c = np.empty_like(x), np.empty_like(x)
-    kernels.sincos(x, s, c)
+    kernels.sincos(x, s, c, scalar)
     ok = np.isfinite(x)
     np.testing.assert_allclose(s[ok], np.sin(x[ok]), rtol=0, atol=2.3e-16)
     np.testing.assert_allclose(c[ok], np.cos(x[ok]), rtol=0, atol=2.3e-16)

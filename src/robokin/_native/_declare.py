@@ -257,8 +257,9 @@ LM = Group("lm.c", kernels=(
     Kernel("check_poses", (Arr("T", "f64", POSE), Float("tol", 0.0, BIG)), "tuple[int, int]",
            "``(code, index)`` of the first non-rigid pose of T (N, 4, 4), or (0, -1)."),
     Kernel("sincos", (Arr("x", "f64", ("N",)), Arr("s", "f64", ("N",), out=True),
-                      Arr("c", "f64", ("N",), out=True)),
-           "None", "The kernels' sine and cosine of x (N,) into s and c."),
+                      Arr("c", "f64", ("N",), out=True), Int("scalar", 0, 1)),
+           "None", "The kernels' sine and cosine of x (N,) into s and c: chain.h ``vsincos`` "
+           "(scalar 0, the lanes') or ``sincos1`` (1, its one-value twin)."),
     Kernel("wrap_into", (Arr("v", "f64", ("N",)), Arr("lo", "f64", ("N",)),
                          Arr("hi", "f64", ("N",)), Arr("out", "f64", ("N",), out=True)),
            "None", "The wrap-into-limits rule (chain.h ``wrap_into``) of v (N,) into "

@@ -376,8 +376,8 @@ class Kernels(Protocol):
     def check_poses(self, T: F64, tol: float, /) -> tuple[int, int]:
         """``(code, index)`` of the first non-rigid pose of T (N, 4, 4), or (0, -1)."""
 
-    def sincos(self, x: F64, s: F64, c: F64, /) -> None:
-        """The kernels' sine and cosine of x (N,) into s and c."""
+    def sincos(self, x: F64, s: F64, c: F64, scalar: int, /) -> None:
+        """The kernels' sine and cosine of x (N,) into s and c: chain.h ``vsincos`` (scalar 0, the lanes') or ``sincos1`` (1, its one-value twin)."""
 
     def wrap_into(self, v: F64, lo: F64, hi: F64, out: F64, /) -> None:
         """The wrap-into-limits rule (chain.h ``wrap_into``) of v (N,) into [lo, hi] (N,) into out: within the limits up to ``LIMIT_SLACK`` stays, else the fewest whole turns that fit, else unchanged."""

@@ -95,6 +95,17 @@ static int chain_view(const double *p, long len, Chain *ch)
 #define C5 2.08757232129817482790e-09
 #define C6 -1.13596475577881948265e-11
 
+/* sin y, cos y of |y| <= pi / 4 (type T: double or vd) into sy, cy */
+#define SINCOS_KERNEL(T, y, sy, cy)                                                   \
+    do {                                                                              \
+        T z_ = (y) * (y);                                                             \
+        T rs_ = S2 + z_ * (S3 + z_ * (S4 + z_ * (S5 + z_ * S6)));                     \
+        (sy) = (y) + z_ * (y) * (S1 + z_ * rs_);                                      \
+        T rc_ = z_ * (C1 + z_ * (C2 + z_ * (C3 + z_ * (C4 + z_ * (C5 + z_ * C6))))); \
+        T hz_ = 0.5 * z_, w_ = 1.0 - hz_;                                             \
+        (cy) = w_ + (((1.0 - w_) - hz_) + z_ * rc_);                                  \
+    } while (0)
+
 ALWAYS_INLINE void vsincos(vd x, vd *s, vd *c)
 {
     vl big = ~(vabs(x) < 1e5);
@@ -106,13 +117,8 @@ ALWAYS_INLINE void vsincos(vd x, vd *s, vd *c)
     vd n = r - ROUND_MAGIC;
     vl k = (vl)r;
     vd y = ((xs - n * PIO2_1) - n * PIO2_2) - n * PIO2_3; /* |y| <= pi / 4 */
-    vd z = y * y;
-    vd rs = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
-    vd sy = y + z * y * (S1 + z * rs);
-    vd rc = z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
-    vd hz = 0.5 * z;
-    vd w = 1.0 - hz;
-    vd cy = w + (((1.0 - w) - hz) + z * rc);
+    vd sy, cy;
+    SINCOS_KERNEL(vd, y, sy, cy);
     vl odd = -(k & 1);
     vl neg_s = (k << 62) & BRL(0x8000000000000000ULL);       /* quadrants 2, 3 */
     vl neg_c = ((k + 1) << 62) & BRL(0x8000000000000000ULL); /* quadrants 1, 2 */
@@ -126,6 +132,37 @@ ALWAYS_INLINE void vsincos(vd x, vd *s, vd *c)
                 (*s)[l] = sin(x[l]);
                 (*c)[l] = cos(x[l]);
             }
+}
+
+/* vsincos for one value (the scalar solvers' hot loops: held_closed.c), < 1 ulp on
+ * the reduced range; |x| >= 1e5, NaN or inf take libm. */
+static inline void sincos1(double x, double *s, double *c)
+{
+    if (!(fabs(x) < 1e5)) {
+        *s = sin(x);
+        *c = cos(x);
+        return;
+    }
+    double n = (x * INV_PIO2 + ROUND_MAGIC) - ROUND_MAGIC; /* (as vsincos') */
+    double y = ((x - n * PIO2_1) - n * PIO2_2) - n * PIO2_3, sy, cy;
+    SINCOS_KERNEL(double, y, sy, cy);
+    switch ((long long)n & 3) {
+    case 0:
+        *s = sy;
+        *c = cy;
+        break;
+    case 1:
+        *s = cy;
+        *c = -sy;
+        break;
+    case 2:
+        *s = -sy;
+        *c = -cy;
+        break;
+    default:
+        *s = -cy;
+        *c = sy;
+    }
 }
 
 /* An angle wrapped into [-pi, pi) (the one wrap of the C code). */

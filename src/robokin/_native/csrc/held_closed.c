@@ -322,7 +322,9 @@ static double hc_m2cs(const HcPose *p, double c, double s, int i, double *dm)
 
 static inline double hc_m2(const HcPose *p, double x, int i, double *dm)
 {
-    return hc_m2cs(p, cos(x), sin(x), i, dm);
+    double c, s;
+    sincos1(x, &s, &c);
+    return hc_m2cs(p, c, s, i, dm);
 }
 
 #define HC_SHOULDER 1 /* hc_eval: the shoulder's scalars (else the wrist's values alone) */
@@ -335,7 +337,8 @@ static inline double hc_m2(const HcPose *p, double x, int i, double *dm)
 static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
 {
     const HcGeo *g = p->g;
-    double c = cos(x), s = sin(x);
+    double c, s;
+    sincos1(x, &s, &c);
     double D = hc_aff(p->d, c, s), c4, s4, s4g;
     r->x = x;
     if (!(g->cn - fabs(D - g->K) >= -1e-12 * g->cn))
@@ -723,7 +726,8 @@ static int hc_quartic_roots(const double *al, const double *be, double *x)
             continue;
         double y = 2.0 * atan(re[m]);
         for (int it = 0; it < 8; it++) {
-            double cy = cos(y), sy = sin(y);
+            double cy, sy;
+            sincos1(y, &sy, &cy);
             double A = a[0] + a[1] * cy + a[2] * sy, B = b[0] + b[1] * cy + b[2] * sy;
             double dA = -a[1] * sy + a[2] * cy, dB = -b[1] * sy + b[2] * cy;
             double F = A * A + B * B - 1.0, dF = 2.0 * (A * dA + B * dB);
@@ -734,7 +738,8 @@ static int hc_quartic_roots(const double *al, const double *be, double *x)
             if (fabs(step) < 1e-16)
                 break;
         }
-        double cy = cos(y), sy = sin(y);
+        double cy, sy;
+        sincos1(y, &sy, &cy);
         double A = a[0] + a[1] * cy + a[2] * sy, B = b[0] + b[1] * cy + b[2] * sy;
         if (fabs(A * A + B * B - 1.0) < 1e-10)
             x[n++] = wrap_pi(y + phi);
@@ -965,12 +970,16 @@ typedef struct {
 
 static inline double hc_x(const HcPiece *pc, double xi)
 {
-    return pc->a + (pc->b - pc->a) * 0.5 * (1.0 - cos(M_PI * xi));
+    double s, c;
+    sincos1(M_PI * xi, &s, &c);
+    return pc->a + (pc->b - pc->a) * 0.5 * (1.0 - c);
 }
 
 static inline double hc_dx(const HcPiece *pc, double xi)
 {
-    return (pc->b - pc->a) * 0.5 * M_PI * sin(M_PI * xi);
+    double s, c;
+    sincos1(M_PI * xi, &s, &c);
+    return (pc->b - pc->a) * 0.5 * M_PI * s;
 }
 
 /* The root in (0, 1) of the cubic Hermite model with values f0, f1 of opposite signs
@@ -1439,8 +1448,7 @@ static void hc_pieces(HcCtx *c)
         double nx[HC_MNODES], ncs[HC_MNODES][2]; /* the nodes' x, cos x, sin x (both i) */
         for (int k = 0; k < HC_MNODES; k++) {
             nx[k] = k == 0 ? a : k == HC_MNODES - 1 ? b : a + (b - a) * 0.5 * (1.0 - c->mcs[k][0]);
-            ncs[k][0] = cos(nx[k]);
-            ncs[k][1] = sin(nx[k]);
+            sincos1(nx[k], &ncs[k][1], &ncs[k][0]);
         }
         for (int i = 0; i < 2 && !c->bad; i++) {
             /* E2's margin on nodes of the piece: its sign changes */
@@ -1738,12 +1746,10 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     for (int bj = 0; bj < 4; bj++)
         c->nev[bj] = c->npc[bj] = c->nnode[bj] = 0;
     for (int k = 0; k < HC_NODES; k++) {
-        c->ncs[k][0] = cos(M_PI * k / (HC_NODES - 1));
-        c->ncs[k][1] = sin(M_PI * k / (HC_NODES - 1));
+        sincos1(M_PI * k / (HC_NODES - 1), &c->ncs[k][1], &c->ncs[k][0]);
     }
     for (int k = 0; k < HC_MNODES; k++) {
-        c->mcs[k][0] = cos(M_PI * k / (HC_MNODES - 1));
-        c->mcs[k][1] = sin(M_PI * k / (HC_MNODES - 1));
+        sincos1(M_PI * k / (HC_MNODES - 1), &c->mcs[k][1], &c->mcs[k][0]);
     }
     const HcGeo *g = &geo;
     int ok = 0;

@@ -60,7 +60,7 @@ static const KOpt opts_sp_ranges[] = {{SP_VERTEX_TRIES, 1, 1, 0.0, 1000000000000
     X(table_nearest, "table_nearest(rows, cstart, grid, T, k, rot_w) -> I64: Indices of the seed-table rows nearest the pose T (4, 4), nearest first.") \
     X(nearest, "nearest(packed, Q, ok, qn, is_rev, T, q, err, found) -> None: Per pose, the solution row of Q (N, k, n) nearest qn (N, n), into q.") \
     X(check_poses, "check_poses(T, tol) -> tuple[int, int]: ``(code, index)`` of the first non-rigid pose of T (N, 4, 4), or (0, -1).") \
-    X(sincos, "sincos(x, s, c) -> None: The kernels' sine and cosine of x (N,) into s and c.") \
+    X(sincos, "sincos(x, s, c, scalar) -> None: The kernels' sine and cosine of x (N,) into s and c: chain.h ``vsincos`` (scalar 0, the lanes') or ``sincos1`` (1, its one-value twin).") \
     X(wrap_into, "wrap_into(v, lo, hi, out) -> None: The wrap-into-limits rule (chain.h ``wrap_into``) of v (N,) into [lo, hi] (N,) into out: within the limits up to ``LIMIT_SLACK`` stays, else the fewest whole turns that fit, else unchanged.") \
     X(num_threads, "num_threads() -> int: Threads of the pool the batch kernels use.") \
     X(set_num_threads, "set_num_threads(k) -> int: Set the threads of the pool (1 to 64); returns the number in use.") \
@@ -117,7 +117,7 @@ typedef struct { const double *current; const double *target; double *out; union
 typedef struct { const double *rows; const long long *cstart; const double *grid; const double *T; long k; double rot_w; union { struct { npy_intp M, cols, C; }; npy_intp sym[3]; }; } table_nearest_args; /* lm.c */
 typedef struct { Chain packed; const double *Q; const npy_bool *ok; const double *qn; const npy_bool *is_rev; const double *T; double *q; double *err; npy_bool *found; union { struct { npy_intp n, nc, N, k; }; npy_intp sym[4]; }; } nearest_args; /* lm.c */
 typedef struct { const double *T; double tol; union { struct { npy_intp N; }; npy_intp sym[1]; }; } check_poses_args; /* lm.c */
-typedef struct { const double *x; double *s; double *c; union { struct { npy_intp N; }; npy_intp sym[1]; }; } sincos_args; /* lm.c */
+typedef struct { const double *x; double *s; double *c; long scalar; union { struct { npy_intp N; }; npy_intp sym[1]; }; } sincos_args; /* lm.c */
 typedef struct { const double *v; const double *lo; const double *hi; double *out; union { struct { npy_intp N; }; npy_intp sym[1]; }; } wrap_into_args; /* lm.c */
 typedef struct { char unused; /* a struct is never empty */ } num_threads_args; /* lm.c */
 typedef struct { long k; } set_num_threads_args; /* lm.c */

@@ -230,6 +230,11 @@ static PyObject *wrap_into_body(const wrap_into_args *a)
 static PyObject *sincos_body(const sincos_args *a)
 {
     npy_intp N = a->N;
+    if (a->scalar) {
+        for (npy_intp i = 0; i < N; i++)
+            sincos1(a->x[i], &a->s[i], &a->c[i]);
+        Py_RETURN_NONE;
+    }
     for (npy_intp i = 0; i < N; i += W) {
         vd v, vs, vc;
         for (int l = 0; l < W; l++)
