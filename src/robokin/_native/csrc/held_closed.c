@@ -1829,11 +1829,21 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     double s7 = g->sign[6], o7 = g->off[6];
     for (int bj = 0; bj < 4; bj++) {
         qsort(c->ev[bj], (size_t)c->nev[bj], sizeof(HcEvent), hc_evcmp);
+        /* the kept nodes in x (insertion: a piece's nodes come in order, its splits'
+         * after them), swept once per triple below */
+        double (*nd)[3] = c->node[bj];
+        for (int u = 1; u < c->nnode[bj]; u++)
+            for (int v = u; v > 0 && nd[v - 1][0] > nd[v][0]; v--)
+                for (int w = 0; w < 3; w++) {
+                    double t = nd[v][w];
+                    nd[v][w] = nd[v - 1][w];
+                    nd[v - 1][w] = t;
+                }
         for (int k = 0; k < 2; k++) {
             int b = hc_slot(bj >> 1, bj & 1, k);
             double *out = iv + 2 * HM_MAXI * b;
             long long n = 0;
-            int e = 0;
+            int e = 0, u = 0; /* u: the first kept node not below the piece's start */
             for (int m = 0; m < c->npc[bj]; m++) {
                 double a = c->cut[bj][2 * m], z = c->cut[bj][2 * m + 1];
                 if (c->cutfold[bj][2 * m] || c->cutfold[bj][2 * m + 1]) {
@@ -1868,11 +1878,11 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
                         /* decided at the kept node inside furthest from a limit, else
                          * at a row in the middle */
                         double mg = 0.0;
-                        for (int u = 0; u < c->nnode[bj]; u++) {
-                            const double *nd = c->node[bj][u];
-                            if (nd[0] > prev && nd[0] < x && fabs(nd[1 + k]) > fabs(mg))
-                                mg = nd[1 + k];
-                        }
+                        while (u < c->nnode[bj] && !(nd[u][0] > prev))
+                            u++;
+                        for (; u < c->nnode[bj] && nd[u][0] < x; u++)
+                            if (fabs(nd[u][1 + k]) > fabs(mg))
+                                mg = nd[u][1 + k];
                         if (!(fabs(mg) >= HC_DECIDE)) {
                             HcRow r;
                             double mgs[2][7];
