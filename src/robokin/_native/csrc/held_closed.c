@@ -787,6 +787,7 @@ static void hc_closed_events(HcCtx *c, int jj, double V, int kind)
     const HcGeo *g = c->p.g;
     const HcPose *p = &c->p;
     double cV = cos(V), sV = sin(V), x[4];
+    double al[3] = {NAN, NAN, NAN}, be[3] = {NAN, NAN, NAN}; /* (cos, sin v4) = (al, be) . w */
     int n;
     if (jj == 3) {
         n = hc_sin_roots(p->d[0] - g->K - g->c1 * cV - g->c2 * sV, p->d[1], p->d[2], x);
@@ -822,7 +823,6 @@ static void hc_closed_events(HcCtx *c, int jj, double V, int kind)
             }
             goto found;
         }
-        double al[3], be[3];
         for (int m = 0; m < 3; m++) {
             double r1 = p->d[m] - (m == 0 ? g->K : 0.0);
             al[m] = (row1 * r1 - g->c2 * rhs[m]) / det;
@@ -842,9 +842,30 @@ found:
         }
         if (!(x[m] >= p->xlo && x[m] <= p->xhi))
             continue;
+        /* the v4 root at x[m] (V itself, or the quartic's (cos, sin v4)): its branches
+         * i alone are polished (both near E1's branch end; all four where the value
+         * fixes x alone) */
+        int want = 15;
+        double cx, sx, c4 = jj == 3 ? cV : NAN, s4 = jj == 3 ? sV : NAN;
+        sincos1(x[m], &sx, &cx);
+        if (jj != 3 && isfinite(al[0])) {
+            c4 = al[0] + al[1] * cx + al[2] * sx;
+            s4 = be[0] + be[1] * cx + be[2] * sx;
+        }
+        if (isfinite(c4)) {
+            want = 0;
+            double D = hc_aff(p->d, cx, sx);
+            for (int i = 0; i < 2; i++) {
+                double ci, si, sg;
+                hc_root(g->c1, g->c2, g->cn, D - g->K, i, &ci, &si, &sg);
+                if (fabs(ci - c4) + fabs(si - s4) < 1e-3) /* (hc_polish: 1e-6 of V) */
+                    want |= 3 << (2 * i);
+            }
+        }
         for (int bj = 0; bj < 4; bj++) {
             double t = x[m];
-            if (hc_polish(c, bj >> 1, bj & 1, jj, V, &t) && t >= p->xlo && t <= p->xhi) {
+            if ((want >> bj & 1) && hc_polish(c, bj >> 1, bj & 1, jj, V, &t) && t >= p->xlo &&
+                t <= p->xhi) {
                 int dup = 0; /* a double root of the quartic, or the same root twice */
                 for (int e = 0; e < c->nev[bj]; e++)
                     dup |= c->ev[bj][e].j == jj && c->ev[bj][e].kind == kind &&
