@@ -1682,69 +1682,79 @@ static int hc_evcmp(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-/* Whether pk_one numbers the rows at x as hc_slot does: its rows there (slot = 2
- * position + triple, from its front and triples, checked and polished as pk_one
- * checks them; its repairs, which move a row outside the limits by at most a nudge,
- * left out) within 1e-6 of these in chain values, each nearest its own slot's */
+/* Whether pk_one numbers the rows at x as hc_slot does. Its position slots from its
+ * front: each branch's wrist (cos, sin) within 1e-6 of one position root's, that of
+ * its slot alone. Its triple order (pk_middle's t0 + D first, D in [0, pi]; hc_slot's
+ * k = 0 the triple with v2 >= 0) on one branch: pk's two rows there, from its front
+ * and triples and checked and polished as pk_one checks them (its repairs, which move
+ * a row outside the limits by at most a nudge, left out), within 1e-6 of these, each
+ * nearest its own slot's. */
 static int hc_slots_agree(HcCtx *c, const double *P, double x)
 {
     const HcGeo *g = c->p.g;
-    double t = g->sign[6] * (x - g->off[6]), qn[PK_MAXJ] = {0}, Q[8][6];
-    unsigned char valid[8] = {0};
+    double t = g->sign[6] * (x - g->off[6]), qn[PK_MAXJ] = {0};
     PkFront f;
     if (pk_front_memo(P, c->T, t, qn, 0, &c->front, 15u, &f) != PK_OK)
         return 0;
     const PkPos *pos = &f.pos;
-    for (int i = 0; i < pos->n; i++) {
-        if (!(pos->res[i] < 1e-6 * f.g.scale))
+    int tried = 0;
+    for (int bj = 0; bj < 4; bj++) {
+        HcRow r;
+        if (!hc_eval(&c->p, x, bj >> 1, bj & 1, tried ? 0 : HC_SHOULDER, &r))
             continue;
-        double th[6];
-        m3 Rt = pk_front_rotation(&f, i, th);
+        int b = hc_slot(bj >> 1, bj & 1, 0), best = -1, near = 0;
+        double bd = INFINITY;
+        for (int i = 0; i < pos->n; i++) {
+            if (!(pos->res[i] < 1e-6 * f.g.scale))
+                continue;
+            double d = 0.0;
+            for (int j = 0; j < 3; j++) {
+                const double *cs = r.cs[f.g.full[f.ia + j]];
+                d = fmax(d, fabs(cs[0] - pos->c[i][j]) + fabs(cs[1] - pos->s[i][j]));
+            }
+            near += d < 1e-6;
+            if (d < bd) {
+                bd = d;
+                best = i;
+            }
+        }
+        if (best < 0 || near != 1 || 2 * pos->slot[best] != b)
+            return 0;
+        if (tried++)
+            continue;
+        /* the triple order on this branch */
+        double th[6], Q[2][6];
+        m3 Rt = pk_front_rotation(&f, best, th);
         PkTrip tr;
         pk_triple(P, &f.tri, &Rt, f.jx, f.jz, qn[f.jz], P[PK_SING_TOL], &tr);
-        for (int k = 0; k < tr.n; k++) {
+        if (tr.n != 2)
+            return 0;
+        for (int k = 0; k < 2; k++) {
             for (int j = 0; j < 3; j++) {
-                th[f.ia + j] = pos->t[i][j];
+                th[f.ia + j] = pos->t[best][j];
                 th[f.it + j] = tr.t[k][j];
             }
-            if (tr.check[k] || !(pos->res[i] < f.exact_p)) {
+            if (tr.check[k] || !(pos->res[best] < f.exact_p)) {
                 double err = pk_error_of(&f.g, &f.RT, f.pT, th);
                 if (err > PK_EXACT)
                     err = pk_polish_slow(&f.g, &f.RT, f.pT, th, pk_polish(&f.g, &f.RT, f.pT, th));
                 if (!(err <= PK_ACCEPT))
-                    continue; /* (pk_one returns no row) */
+                    return 0; /* (pk_one returns no row) */
             }
-            int b = 2 * pos->slot[i] + k;
             for (int j = 0; j < 6; j++)
-                Q[b][f.g.full[j]] = th[j];
-            valid[b] = 1;
+                Q[k][f.g.full[j]] = th[j];
         }
-    }
-    for (int bj = 0; bj < 4; bj++) {
-        HcRow r;
-        if (!hc_eval(&c->p, x, bj >> 1, bj & 1, HC_SHOULDER, &r))
-            continue;
         for (int k = 0; k < 2; k++) {
-            double v[7];
+            double v[7], d[2] = {0.0, 0.0};
             hc_angles(&r, k, v);
-            int best = -1;
-            double bd = INFINITY;
-            for (int b = 0; b < 8; b++) {
-                if (!valid[b])
-                    continue;
-                double d = 0.0;
+            for (int kk = 0; kk < 2; kk++)
                 for (int jj = 0; jj < 6; jj++)
-                    d = fmax(d, fabs(wrap_pi(v[jj] - Q[b][jj])));
-                if (d < bd) {
-                    bd = d;
-                    best = b;
-                }
-            }
-            if (best != hc_slot(bj >> 1, bj & 1, k) || !(bd < 1e-6))
+                    d[kk] = fmax(d[kk], fabs(wrap_pi(v[jj] - Q[kk][jj])));
+            if (!(d[k] < 1e-6) || !(d[k] < d[1 - k]))
                 return 0;
         }
     }
-    return 1;
+    return tried > 0;
 }
 
 /* The intervals and points of one pose (held_manifold's outputs: iv (8, HM_MAXI, 2),
