@@ -356,8 +356,9 @@ def test_one_pose_entry_is_the_batch_kernel():
 
 def test_close_flag_is_the_cheap_test_of_points_refined():
     # Round 8d: swivel_manifold_one's close flag against the cheap test written out in
-    # numpy (keys psi + 64 branch sorted, adjacent ones within _PAIR; a psi within
-    # _PAIR of +-pi; an interval at most _POINT long). Where it is unset,
+    # numpy (the crossings' keys psi + 64 branch sorted, adjacent ones within _PAIR; a
+    # crossing's psi within _PAIR of +-pi; an interval at most _POINT long; the aligned
+    # points make no candidate, session 28). Where it is unset,
     # _points_refined (which robot.self_motion then skips) returns the kernel's arrays
     # themselves and no corner; both verdicts occur on these poses.
     from robokin._native import kernels as K
@@ -372,9 +373,10 @@ def test_close_flag_is_the_cheap_test_of_points_refined():
     seen = set()
     for Ti in T:
         ivs, br, p, close = K.swivel_manifold_one(ARM.params, Ti)
-        key = np.sort(p[:, 0] + 64.0 * p[:, 1])
-        ref = bool((np.diff(key) <= _PAIR).any() or (p[:, 0] <= -np.pi + _PAIR).any()
-                   or (p[:, 0] >= np.pi - _PAIR).any()
+        cr = p[p[:, 3] <= K.SM_KIND_UPPER]
+        key = np.sort(cr[:, 0] + 64.0 * cr[:, 1])
+        ref = bool((np.diff(key) <= _PAIR).any() or (cr[:, 0] <= -np.pi + _PAIR).any()
+                   or (cr[:, 0] >= np.pi - _PAIR).any()
                    or (ivs[:, 1] - ivs[:, 0] <= _POINT).any())
         assert close is ref
         seen.add(close)

@@ -3034,7 +3034,8 @@ static PyObject *held_manifold_one_body(const held_manifold_one_args *a)
     const double *P = a->params;
     int k = (int)P[PK_HELD];
     double key[HM_MAXP];
-    int close = !flags && sm_close(pts, npts, ov, m, P[PK_LO + k], P[PK_HI + k], key);
+    int close = !flags &&
+                sm_close(pts, npts, ov, m, P[PK_LO + k], P[PK_HI + k], HM_KIND_UPPER, key);
     free(iv);
     return Py_BuildValue("(NNNLLN)", out_iv, out_b, out_p, flags, evals, PyBool_FromLong(close));
 }

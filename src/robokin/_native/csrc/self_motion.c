@@ -1360,27 +1360,31 @@ static PyObject *swivel_manifold_body(const swivel_manifold_args *a)
 }
 
 /* self_motion_intervals._points_refined's cheap test, the same decision bit for bit:
- * 1 when the sorted keys t + 64 branch of the points pts (npts, 4) have two within
- * SM_PAIR (64 branch is exact: one rounding, as numpy's dot), a point's t is within
- * SM_PAIR of the range's end lo or hi (the swivel: -pi, pi; a held joint: its
- * limits, held_manifold.c), or an interval of iv (m, 2) is at most SM_POINT long;
- * key: npts doubles of scratch */
+ * 1 when the sorted keys t + 64 branch of the crossings among the points pts (npts,
+ * 4) (kind at most upper) have two within SM_PAIR (64 branch is exact: one rounding,
+ * as numpy's dot), a crossing's t is within SM_PAIR of the range's end lo or hi (the
+ * swivel: -pi, pi; a held joint: its limits, held_manifold.c), or an interval of iv
+ * (m, 2) is at most SM_POINT long; key: npts doubles of scratch */
 static int sm_close(const double *pts, long long npts, const double *iv, long long m,
-                    double lo, double hi, double *key)
+                    double lo, double hi, int upper, double *key)
 {
     for (long long i = 0; i < m; i++)
         if (iv[2 * i + 1] - iv[2 * i] <= SM_POINT)
             return 1;
+    long long n = 0; /* the crossings (kind <= upper: the aligned and fold points make
+                      * no candidate of _points_refined's) */
     for (long long i = 0; i < npts; i++) {
+        if (pts[4 * i + 3] > upper)
+            continue;
         double t = pts[4 * i], k = t + 64.0 * pts[4 * i + 1];
         if (t <= lo + SM_PAIR || t >= hi - SM_PAIR)
             return 1;
-        long long j = i;  /* insertion sort into key (npts long): ~10-60 points */
+        long long j = n++; /* insertion sort into key (npts long): ~10-60 points */
         for (; j > 0 && key[j - 1] > k; j--)
             key[j] = key[j - 1];
         key[j] = k;
     }
-    for (long long i = 1; i < npts; i++)
+    for (long long i = 1; i < n; i++)
         if (key[i] - key[i - 1] <= SM_PAIR)
             return 1;
     return 0;
@@ -1419,7 +1423,7 @@ static PyObject *swivel_manifold_one_body(const swivel_manifold_one_args *a)
     if (npts)
         memcpy(PyArray_DATA((PyArrayObject *)out_p), pts, (size_t)(4 * npts) * sizeof(double));
     double key[SM_MAXP];
-    int close = sm_close(pts, npts, ov, m, -M_PI, M_PI, key);
+    int close = sm_close(pts, npts, ov, m, -M_PI, M_PI, SM_KIND_UPPER, key);
     return Py_BuildValue("(NNNN)", out_iv, out_b, out_p, PyBool_FromLong(close));
 }
 
