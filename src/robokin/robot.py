@@ -57,6 +57,14 @@ def _ik_solve() -> Dispatch:
 
 
 @cache
+def _self_motion() -> Callable[..., SelfMotion]:
+    """:func:`robokin.kinematics.ik.self_motion.self_motion`, imported on first use."""
+    from robokin.kinematics.ik.self_motion import self_motion
+
+    return self_motion
+
+
+@cache
 def _held_single() -> Callable[[Arm, object, object], SolutionSet | None]:
     """:func:`robokin.kinematics.ik.fixed.solve_held_single`, imported on first use."""
     from robokin.kinematics.ik.fixed import solve_held_single
@@ -401,9 +409,7 @@ class Robot(RobotParts):
             (``"continued numeric"``: an arm with neither a closed form nor the
             general 6R solver for the held chain, whose branches can be missed).
         """
-        from robokin.kinematics.ik.self_motion import self_motion
-
-        return self_motion(self.arm, T, parameter, dispatch=_ik_solve())
+        return _self_motion()(self.arm, T, parameter, dispatch=_ik_solve())
 
     # ---------------------------------------------------------------- actuators
     def actuators_from_joints(self, q: npt.ArrayLike) -> np.ndarray:
