@@ -341,8 +341,8 @@ static inline double hc_m2(const HcPose *p, double x, int i, double *dm)
 #define HC_NOISE 4    /* ... and v5's rounding (r->noise; else NaN) */
 #define HC_RONLY 8    /* ... r alone where a wrist joint is outside (hc_full completes it) */
 
-/* Branch (i, j)'s row at x (what: HC_SHOULDER, HC_SLOPES, HC_NOISE); 0 when it has
- * none (a margin below -tol). */
+/* Branch (i, j)'s row at x (what: HC_SHOULDER, HC_SLOPES, HC_NOISE, HC_RONLY); 0 when
+ * it has none (a margin below -tol). */
 static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
 {
     const HcGeo *g = p->g;
@@ -363,7 +363,6 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
     hc_root(f1, f2, H, e - f0, j, &c6, &s6, &s6g);
     v3 v = v3_add(p->v[0], v3_add(v3_scale(p->v[1], c), v3_scale(p->v[2], s)));
     v3 h4 = g->h[3], h5 = g->h[4], h6 = g->h[5], h7 = g->h[6];
-    (void)h7;
     v3 u6 = hc_rot(g, 5, c6, s6, v);
     /* v5: e5(-v5) x4 = u6 (the turn about axis 5 taking x4 to u6 is -v5) */
     v3 xp = v3_sub(x4, v3_scale(h5, v3_dot(h5, x4))), up = v3_sub(u6, v3_scale(h5, v3_dot(h5, u6)));
@@ -460,7 +459,7 @@ static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
     return 1;
 }
 
-/* An r-only row (HC_RONLY) completed: w and its slope as hc_eval's, bit for bit */
+/* An r-only row (HC_RONLY) completed: w and its slope by hc_eval's formulas */
 static void hc_full(const HcPose *p, HcRow *r)
 {
     if (!r->ronly)
