@@ -531,7 +531,7 @@ SELF_MOTION = Group("self_motion.c", kernels=(
            "tuple[F64, I64, F64, bool]", "``swivel_manifold`` of one pose T (4, 4), packed: "
                                          "new arrays of its intervals (m, 2) branch by branch, "
                                          "their branches (m,) and its points (p, 4); close: "
-                                         "two points of a branch within SM_PAIR, one within "
+                                         "two crossings of a branch within SM_PAIR, one within "
                                          "it of +-pi or an interval at most SM_POINT long. "
                                          "One thread.",
            checks=(Check("sm_params_ok(a->params)", "params is not a swivel parameter vector"),)),
@@ -621,7 +621,7 @@ HELD_MANIFOLD = Group("held_manifold.c", kernels=(
            "tuple[F64, I64, F64, int, int, bool] | None",
            "``held_manifold`` of one pose T (4, 4), packed: new arrays of its intervals (m, 2) "
            "branch by branch, their branches (m,) and its points (p, 4); its flags and pk_one "
-           "calls; close: two points of a branch within SM_PAIR, one within it of an end of the "
+           "calls; close: two crossings of a branch within SM_PAIR, one within it of an end of the "
            "held joint's range or an interval at most SM_POINT long (False on a flagged pose). "
            "None where T is not a C-contiguous aligned float64 (4, 4) ndarray, or, with exact "
            "> 0, not rigid with its rotation within exact of orthonormal (chain.h "

@@ -704,7 +704,7 @@ class Kernels(Protocol):
         """Per pose: the swivel intervals inside every limit per branch (N, 8, SM_MAXI, 2) with counts (N, 8); points [psi, branch, joint, kind] (N, SM_MAXP, 4) with counts (N,)."""
 
     def swivel_manifold_one(self, params: F64, T: F64, /) -> tuple[F64, I64, F64, bool]:
-        """``swivel_manifold`` of one pose T (4, 4), packed: new arrays of its intervals (m, 2) branch by branch, their branches (m,) and its points (p, 4); close: two points of a branch within SM_PAIR, one within it of +-pi or an interval at most SM_POINT long. One thread."""
+        """``swivel_manifold`` of one pose T (4, 4), packed: new arrays of its intervals (m, 2) branch by branch, their branches (m,) and its points (p, 4); close: two crossings of a branch within SM_PAIR, one within it of +-pi or an interval at most SM_POINT long. One thread."""
 
     def swivel_near(
         self,
@@ -765,7 +765,7 @@ class Kernels(Protocol):
         exact: float,
         /,
     ) -> tuple[F64, I64, F64, int, int, bool] | None:
-        """``held_manifold`` of one pose T (4, 4), packed: new arrays of its intervals (m, 2) branch by branch, their branches (m,) and its points (p, 4); its flags and pk_one calls; close: two points of a branch within SM_PAIR, one within it of an end of the held joint's range or an interval at most SM_POINT long (False on a flagged pose). None where T is not a C-contiguous aligned float64 (4, 4) ndarray, or, with exact > 0, not rigid with its rotation within exact of orthonormal (chain.h pose_problem): the caller checks it and calls again."""
+        """``held_manifold`` of one pose T (4, 4), packed: new arrays of its intervals (m, 2) branch by branch, their branches (m,) and its points (p, 4); its flags and pk_one calls; close: two crossings of a branch within SM_PAIR, one within it of an end of the held joint's range or an interval at most SM_POINT long (False on a flagged pose). None where T is not a C-contiguous aligned float64 (4, 4) ndarray, or, with exact > 0, not rigid with its rotation within exact of orthonormal (chain.h pose_problem): the caller checks it and calls again."""
 
     def near_coincident(
         self,

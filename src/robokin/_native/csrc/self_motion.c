@@ -73,8 +73,8 @@ enum {
                           * flagged singular below 1e-9 (sm_first) */
 #define SM_GRAIN 16      /* poses per pool chunk */
 /* self_motion_intervals' _PAIR and _POINT (they read these): swivel_manifold_one's
- * "close" flag is set when two points of a branch lie within SM_PAIR in psi, a point
- * within it of an end of [-pi, pi], or an interval is at most SM_POINT long */
+ * "close" flag is set when two crossings of a branch lie within SM_PAIR in psi, a
+ * crossing within it of an end of [-pi, pi], or an interval is at most SM_POINT long */
 #define SM_PAIR 1e-6
 #define SM_POINT 1e-12
 /* The quick tests (sm_quick_*): a cell's or a point's verdict from the cosines and

@@ -305,8 +305,8 @@ class SwivelArm:
             intervals branch by branch (each branch's sorted), then the points, as
             :meth:`manifold` gives them (``robot.self_motion``'s call: no batch axes,
             no per-call output arrays or masking); ``close``: the decision of
-            ``self_motion_intervals._points_refined``'s cheap test (two points of a
-            branch within ``K.SM_PAIR`` in psi, one within it of +-pi, or an interval
+            ``self_motion_intervals._points_refined``'s cheap test (two limit crossings
+            of a branch within ``K.SM_PAIR`` in psi, one within it of +-pi, or an interval
             at most ``K.SM_POINT`` long), computed in the kernel.
         """
         return K.swivel_manifold_one(self.params, T)
