@@ -33,7 +33,7 @@ HEADERS = [f"{CSRC}/{h}" for h in (
     "lanes.h", "chain.h", "vec3.h", "subproblems.h", "ik_outputs.h", "args.h", "kernels_args.gen.h",
     "kernels_entry.gen.h", "pool.h", "pool.c", "fk.c", "lm.c", "nearest.c", "six_r.c",
     "broadphase.c", "general6r.c", "process.c", "manipulability.c", "pieper.c",
-    "pieper_srs.c", "plan_geom.c", "plan_check.c", "plan_rrtc.c", "plan_path.c", "self_motion.c", "held_margins.c", "held_closed.c", "held_manifold.c", "held_outputs.h", "brent.h", "linalg6.h",
+    "pieper_srs.c", "plan_geom.c", "plan_check.c", "plan_rrtc.c", "plan_path.c", "self_motion.c", "held_margins.c", "held_row.h", "held_closed.c", "held_manifold.c", "held_outputs.h", "brent.h", "linalg6.h",
     "near_coincident.c", "module.c")]
 UNIX = sys.platform != "win32"
 # -fno-math-errno: sqrt inlines (and vectorises); no other fast-math licence

@@ -500,9 +500,9 @@ def test_held_manifold_one_is_the_batch_kernel_packed_with_the_cheap_test():
     # an interval at most 1e-12 long, a crossing within 1e-6 of an end of q7's range, or
     # two crossings of a branch within 1e-6 (since session 28 the crossings only: a fold
     # or an aligned point makes no candidate). Poses: uniform, a corner (two joints at limits:
-    # close), a flagged one (uniform #1607 of seed 7, flagged by the grid and not
-    # certified by the closed forms; until session 26 #575 of that seed, which the
-    # closed forms now certify; until session 24 uniform #60 of
+    # close), a flagged one (uniform #5916 of seed 7, flagged by the grid and not
+    # certified by the closed forms; until session 29 #1607 of that seed and until
+    # session 26 #575, which the closed forms now certify; until session 24 uniform #60 of
     # test_self_motion_intervals' seed 2029; until session 21 [0.3, 1e-9, 0.2, -1.5,
     # 0.4, 1.5, 0.7], an aligned shoulder).
     from robokin._native import kernels as K
@@ -511,9 +511,9 @@ def test_held_manifold_one_is_the_batch_kernel_packed_with_the_cheap_test():
     lo, hi = PANDA.limits[:, 0], PANDA.limits[:, 1]
     q = np.random.default_rng(3).uniform(lo, hi, (6, 7))
     q = np.concatenate([q, [[lo[0], 0.5, 0.2, hi[3], 0.4, 1.5, 0.7],
-                            [-2.675542539256434, 0.11239050963593833, -0.31110382772216827,
-                             -0.3452617444888002, -1.1094245197416714, 2.5328167227082012,
-                             1.1312767241124315]]])
+                            [1.858278115992221, 1.0123936680458314, -0.5162091046772836,
+                             -2.4237642798201944, 1.083582533271104, 3.436738062252428,
+                             -1.489791739285108]]])
     PANDA.self_motion(PANDA.fk(q[0]))
     kern = PANDA.arm.state[SELF_MOTION].held
     seen = set()

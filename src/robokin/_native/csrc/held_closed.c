@@ -123,23 +123,6 @@ typedef struct {
     double axs[7];
 } HcGeo;
 
-/* rot(h_k, t) v (c = cos t, s = sin t): about a coordinate axis (the Panda's, the
- * FR3's: every axis at zero) two coordinates turn; else Rodrigues' formula */
-static inline v3 hc_rot(const HcGeo *g, int k, double c, double s, v3 v)
-{
-    double t = g->axs[k] * s;
-    switch (g->ax[k]) {
-    case 0:
-        return (v3){v.x, c * v.y - t * v.z, t * v.y + c * v.z};
-    case 1:
-        return (v3){c * v.x + t * v.z, v.y, c * v.z - t * v.x};
-    case 2:
-        return (v3){c * v.x - t * v.y, t * v.x + c * v.y, v.z};
-    default:
-        return v3_rot(g->h[k], c, s, v);
-    }
-}
-
 typedef struct {
     const HcGeo *g;
     v3 v[3];             /* v(x) = v[0] + cos x v[1] + sin x v[2] */
@@ -164,6 +147,63 @@ typedef struct {
     int nf;           /* queries with their values in f, df (hc_cell's; 0 until then) */
     double f[HC_MAXQ], df[HC_MAXQ];
 } HcRow;
+
+/* A shoulder function: joint j (0-2) at chain value V (kind: HM_KIND_*; -1: the
+ * aligned-shoulder guard, |cos v2| = 1) */
+typedef struct {
+    int j, kind, twin; /* twin: v2's other limit at -V (its crossings the other triple's) */
+    double V, cV, sV;
+} HcQuery;
+
+#define HC_SHOULDER 1 /* hc_eval: the shoulder's scalars (else the wrist's values alone) */
+#define HC_SLOPES 2   /* ... and the slopes d/dx (the wrist's alone without HC_SHOULDER) */
+#define HC_NOISE 4    /* ... and v5's rounding (r->noise; else NaN) */
+#define HC_RONLY 8    /* ... r alone where a wrist joint is outside (hc_full completes it) */
+
+/* held_row.h's formulas for one row (double) and for W rows (lanes.h's vd) */
+typedef struct {
+    vd x, y, z;
+} HcV3;
+
+#define HR_T double
+#define HR_V3 v3
+#define HR_SUF _1
+#define HR_BR(x) ((double)(x))
+#define HR_SQRT sqrt
+#define HR_ABS fabs
+#define HR_SEL(m, a, b) ((m) ? (a) : (b))
+#define HR_FINITE(x) (isfinite(x) != 0)
+#define HR_NONE(m) (!(m))
+#include "held_row.h"
+#undef HR_T
+#undef HR_V3
+#undef HR_SUF
+#undef HR_BR
+#undef HR_SQRT
+#undef HR_ABS
+#undef HR_SEL
+#undef HR_FINITE
+#undef HR_NONE
+
+#define HR_T vd
+#define HR_V3 HcV3
+#define HR_SUF _w
+#define HR_BR(x) BR(x)
+#define HR_SQRT vsqrt
+#define HR_ABS vabs
+#define HR_SEL vsel
+#define HR_FINITE vfinite
+#define HR_NONE(m) vany(~(m))
+#include "held_row.h"
+#undef HR_T
+#undef HR_V3
+#undef HR_SUF
+#undef HR_BR
+#undef HR_SQRT
+#undef HR_ABS
+#undef HR_SEL
+#undef HR_FINITE
+#undef HR_NONE
 
 static inline double hc_aff(const double *a, double c, double s) { return a[0] + a[1] * c + a[2] * s; }
 static inline double hc_daff(const double *a, double c, double s) { return -a[1] * s + a[2] * c; }
@@ -286,176 +326,55 @@ static int hc_setup(const HcGeo *g, const double *T, HcPose *p)
     return isfinite(p->d[0] + p->d[1] + p->d[2]);
 }
 
-/* cos, sin of a root of A cos v + B sin v = C (|(A, B)| = n), root i (0: phi + acos,
- * 1: phi - acos; subproblems.h's SP4_PAIR without the angles), with gamma = C / n
- * clamped to [-1, 1] (a branch end keeps both labels, where sp4_roots merges them);
- * sigma = sin(acos gamma), negative for root 1 */
-static inline void hc_root(double A, double B, double n, double C, int i, double *c,
-                           double *s, double *sigma)
-{
-    double gm = C / n;
-    gm = gm > 1.0 ? 1.0 : gm < -1.0 ? -1.0 : gm;
-    double sg = sqrt(1.0 - gm * gm);
-    Roots r;
-    SP4_PAIR(r, 0.0, A / n, B / n, 0.0, gm, sg);
-    *c = r.c[i];
-    *s = r.s[i];
-    *sigma = i ? -sg : sg;
-}
-
 /* E1's margin at x (|c| - |D - K|: >= 0 where v4 has roots) */
 static inline double hc_m1(const HcPose *p, double c, double s)
 {
     return p->g->cn - fabs(hc_aff(p->d, c, s) - p->g->K);
 }
 
-/* E2's margin of v4 root i at x (c, s: cos x, sin x; >= 0 where v6 has roots), its
- * slope when dm != NULL */
-static double hc_m2cs(const HcPose *p, double c, double s, int i, double *dm)
-{
-    const HcGeo *g = p->g;
-    double c4, s4, sg;
-    double D = hc_aff(p->d, c, s);
-    hc_root(g->c1, g->c2, g->cn, D - g->K, i, &c4, &s4, &sg);
-    double e = g->ec[0] + g->ec[1] * c4 + g->ec[2] * s4;
-    double f0 = hc_aff(p->f0, c, s), f1 = hc_aff(p->f1, c, s), f2 = hc_aff(p->f2, c, s);
-    double H = sqrt(f1 * f1 + f2 * f2), E = e - f0;
-    if (dm != NULL) {
-        double dv4 = hc_daff(p->d, c, s) / (-g->c1 * s4 + g->c2 * c4);
-        double de = (-g->ec[1] * s4 + g->ec[2] * c4) * dv4;
-        double dH = (f1 * hc_daff(p->f1, c, s) + f2 * hc_daff(p->f2, c, s)) / H;
-        *dm = dH - copysign(1.0, E) * (de - hc_daff(p->f0, c, s));
-    }
-    return H - fabs(E);
-}
-
+/* E2's margin of v4 root i at x (held_row.h's hr_m2), its slope when dm != NULL */
 static inline double hc_m2(const HcPose *p, double x, int i, double *dm)
 {
     double c, s;
     sincos1(x, &s, &c);
-    return hc_m2cs(p, c, s, i, dm);
+    return hr_m2_1(p, c, s, i, dm);
 }
 
-#define HC_SHOULDER 1 /* hc_eval: the shoulder's scalars (else the wrist's values alone) */
-#define HC_SLOPES 2   /* ... and the slopes d/dx (the wrist's alone without HC_SHOULDER) */
-#define HC_NOISE 4    /* ... and v5's rounding (r->noise; else NaN) */
-#define HC_RONLY 8    /* ... r alone where a wrist joint is outside (hc_full completes it) */
 
-/* Branch (i, j)'s row at x (what: HC_SHOULDER, HC_SLOPES, HC_NOISE, HC_RONLY); 0 when
- * it has none (a margin below -tol). */
+/* Branch (i, j)'s row at x (what: HC_SHOULDER, HC_SLOPES, HC_NOISE, HC_RONLY; held_row.h's
+ * hr_row); 0 when it has none (a margin below -tol). */
 static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
 {
-    const HcGeo *g = p->g;
     double c, s;
     sincos1(x, &s, &c);
-    double D = hc_aff(p->d, c, s), c4, s4, s4g;
     r->x = x;
-    if (!(g->cn - fabs(D - g->K) >= -1e-12 * g->cn))
+    HrRow_1 o = {0};
+    if (!hr_row_1(p, c, s, i, j, what, &o))
         return 0;
-    hc_root(g->c1, g->c2, g->cn, D - g->K, i, &c4, &s4, &s4g);
-    v3 x4 = v3_add(g->a0, v3_add(v3_scale(g->a1, c4), v3_scale(g->a2, s4)));
-    double e = g->ec[0] + g->ec[1] * c4 + g->ec[2] * s4;
-    double f0 = hc_aff(p->f0, c, s), f1 = hc_aff(p->f1, c, s), f2 = hc_aff(p->f2, c, s);
-    double H = sqrt(f1 * f1 + f2 * f2);
-    if (!(H > 0.0) || !(H - fabs(e - f0) >= -1e-12 * H))
-        return 0;
-    double c6, s6, s6g;
-    hc_root(f1, f2, H, e - f0, j, &c6, &s6, &s6g);
-    v3 v = v3_add(p->v[0], v3_add(v3_scale(p->v[1], c), v3_scale(p->v[2], s)));
-    v3 h4 = g->h[3], h5 = g->h[4], h6 = g->h[5], h7 = g->h[6];
-    v3 u6 = hc_rot(g, 5, c6, s6, v);
-    /* v5: e5(-v5) x4 = u6 (the turn about axis 5 taking x4 to u6 is -v5) */
-    v3 xp = v3_sub(x4, v3_scale(h5, v3_dot(h5, x4))), up = v3_sub(u6, v3_scale(h5, v3_dot(h5, u6)));
-    double yy = v3_dot(h5, v3_cross(xp, up)), xx = v3_dot(xp, up);
-    double nn = sqrt(yy * yy + xx * xx);
-    if (!(nn > 1e-9 * g->cn))
-        return 0;
-    double c5 = xx / nn, s5 = -yy / nn;
-    /* v5's rounding: x4 and u6 next to axis 5 leave only their small normal parts */
-    r->noise = !(what & HC_NOISE) ? NAN /* (+ acos at an end) */
-                                  : 4.0 * DBL_EPSILON *
-                                        (sqrt(v3_dot(x4, x4) * v3_dot(u6, u6)) / nn +
-                                         1.0 / fabs(s4g) + 1.0 / fabs(s6g));
-    r->cs[3][0] = c4;
-    r->cs[3][1] = s4;
-    r->cs[4][0] = c5;
-    r->cs[4][1] = s5;
-    r->cs[5][0] = c6;
-    r->cs[5][1] = s6;
-    r->sloped = 0;
-    r->nf = 0;
-    r->hasmg = 0; /* hc_rowq's, when asked */
+    for (int k = 0; k < 3; k++) {
+        r->cs[k + 3][0] = o.cs[k][0];
+        r->cs[k + 3][1] = o.cs[k][1];
+    }
     r->c = c;
     r->s = s;
-    /* a wrist joint outside its limits: r alone (a dead cell's row, hc_cell) */
-    r->ronly = 0;
-    if ((what & (HC_SHOULDER | HC_RONLY)) == (HC_SHOULDER | HC_RONLY))
-        for (int jw = 3; jw < 6; jw++)
-            r->ronly |= r->cs[jw][0] * g->arc[jw][0] + r->cs[jw][1] * g->arc[jw][1] < g->arc[jw][2];
-    v3 w = {0}, rr = {0};
-    if (what & HC_SHOULDER) {
-        /* w = R e1, R = RG0 R7(-x) R6(-v6) R5(-v5) R4(-v4); r = R^T e1 */
-        if (!r->ronly) {
-            w = hc_rot(g, 3, c4, -s4, g->e1);
-            w = hc_rot(g, 4, c5, -s5, w);
-            w = hc_rot(g, 5, c6, -s6, w);
-            w = hc_rot(g, 6, c, -s, w);
-            w = m3_mv(&p->RG0, w);
-        }
-        rr = hc_rot(g, 6, c, s, p->g1);
-        rr = hc_rot(g, 5, c6, s6, rr);
-        rr = hc_rot(g, 4, c5, s5, rr);
-        rr = hc_rot(g, 3, c4, s4, rr);
-        r->sh[0] = r->ronly ? NAN : v3_dot(w, g->ea);
-        r->sh[1] = r->ronly ? NAN : v3_dot(w, g->e2);
-        r->sh[2] = v3_dot(r->ronly ? rr : w, g->e1); /* (cos v2 both ways) */
-        r->sh[3] = v3_dot(rr, g->ea);
-        r->sh[4] = v3_dot(rr, g->e2);
-    }
+    r->noise = o.noise;
+    r->ronly = o.ronly;
+    r->sloped = o.sloped != 0.0;
+    r->nf = 0;
+    r->hasmg = 0; /* hc_rowq's, when asked */
+    if (what & HC_SHOULDER)
+        for (int k = 0; k < 5; k++)
+            r->sh[k] = o.sh[k];
     if (!(what & HC_SLOPES))
         return 1;
-    /* joint rates d/dx: E1, E2, v5's equation (m = R5(v5) h6: m . x4 = h6 . v) */
-    double den4 = -g->c1 * s4 + g->c2 * c4;
-    double dv4 = hc_daff(p->d, c, s) / den4;
-    double de = (-g->ec[1] * s4 + g->ec[2] * c4) * dv4;
-    double den6 = -f1 * s6 + f2 * c6;
-    double dv6 = (de - hc_daff(p->f0, c, s) - hc_daff(p->f1, c, s) * c6 -
-                  hc_daff(p->f2, c, s) * s6) / den6;
-    v3 m = hc_rot(g, 4, c5, s5, h6);
-    v3 dx4 = v3_scale(v3_add(v3_scale(g->a1, -s4), v3_scale(g->a2, c4)), dv4);
-    v3 dv = v3_add(v3_scale(p->v[1], -s), v3_scale(p->v[2], c));
-    double den5 = v3_dot(v3_cross(h5, m), x4);
-    double dv5 = (v3_dot(h6, dv) - v3_dot(m, dx4)) / den5;
-    r->dv[3] = dv4;
-    r->dv[4] = dv5;
-    r->dv[5] = dv6;
+    for (int k = 0; k < 3; k++)
+        r->dv[k + 3] = o.dv[k];
     r->dv[6] = 1.0;
-    if (!(what & HC_SHOULDER)) {
-        r->sloped = isfinite(dv4) && isfinite(dv5) && isfinite(dv6);
-        return 1;
+    if (what & HC_SHOULDER) {
+        r->in = o.in;
+        for (int k = 0; k < 5; k++)
+            r->dsh[k] = o.dsh[k];
     }
-    /* the shoulder's angular velocity: spatial om = -RG inner, body -R4 R5 R6 inner */
-    v3 in = v3_add(v3_scale(hc_rot(g, 4, c5, -s5, h4), dv4), v3_scale(h5, dv5));
-    in = v3_add(hc_rot(g, 5, c6, -s6, in), v3_add(v3_scale(h6, dv6), h7));
-    r->in = in;
-    v3 ob = hc_rot(g, 5, c6, s6, in);
-    ob = hc_rot(g, 4, c5, s5, ob);
-    ob = v3_scale(hc_rot(g, 3, c4, s4, ob), -1.0);
-    v3 dr = v3_cross(rr, ob);
-    r->dsh[3] = v3_dot(dr, g->ea);
-    r->dsh[4] = v3_dot(dr, g->e2);
-    if (r->ronly) {
-        r->dsh[0] = r->dsh[1] = NAN;
-        r->dsh[2] = v3_dot(dr, g->e1);
-        r->sloped = isfinite(dv4) && isfinite(dv5) && isfinite(dv6) && isfinite(ob.x + ob.y + ob.z);
-        return 1;
-    }
-    v3 om = v3_scale(m3_mv(&p->RG0, hc_rot(g, 6, c, -s, in)), -1.0);
-    v3 dw = v3_cross(om, w);
-    r->dsh[0] = v3_dot(dw, g->ea);
-    r->dsh[1] = v3_dot(dw, g->e2);
-    r->dsh[2] = v3_dot(dw, g->e1);
-    r->sloped = isfinite(dv4) && isfinite(dv5) && isfinite(dv6) && isfinite(om.x + om.y + om.z);
     return 1;
 }
 
@@ -465,22 +384,19 @@ static void hc_full(const HcPose *p, HcRow *r)
     if (!r->ronly)
         return;
     const HcGeo *g = p->g;
-    double c = r->c, s = r->s;
-    v3 w = hc_rot(g, 3, r->cs[3][0], -r->cs[3][1], g->e1);
-    w = hc_rot(g, 4, r->cs[4][0], -r->cs[4][1], w);
-    w = hc_rot(g, 5, r->cs[5][0], -r->cs[5][1], w);
-    w = hc_rot(g, 6, c, -s, w);
-    w = m3_mv(&p->RG0, w);
+    double cs[4][2] = {{r->cs[3][0], r->cs[3][1]}, {r->cs[4][0], r->cs[4][1]},
+                       {r->cs[5][0], r->cs[5][1]}, {r->c, r->s}};
+    v3 w = hr_w_1(p, (const double(*)[2])cs);
     r->sh[0] = v3_dot(w, g->ea);
     r->sh[1] = v3_dot(w, g->e2);
     r->sh[2] = v3_dot(w, g->e1);
     if (r->sloped) { /* (never a branch end's row: those are never r-only) */
-        v3 om = v3_scale(m3_mv(&p->RG0, hc_rot(g, 6, c, -s, r->in)), -1.0);
-        v3 dw = v3_cross(om, w);
+        double omsum;
+        v3 dw = hr_dw_1(p, r->c, r->s, r->in, w, &omsum);
         r->dsh[0] = v3_dot(dw, g->ea);
         r->dsh[1] = v3_dot(dw, g->e2);
         r->dsh[2] = v3_dot(dw, g->e1);
-        r->sloped = isfinite(om.x + om.y + om.z);
+        r->sloped = isfinite(omsum);
     }
     r->ronly = 0;
     r->nf = 0;
@@ -511,30 +427,17 @@ static void hc_angles(const HcRow *r, int k, double *v)
     v[6] = r->x;
 }
 
-/* Row r's margins of joints 1-6 to their limits, both triples (mg[k][j]; joint 7, the
- * held one, inside by construction: +inf), without the angles: with m the middle of a
- * joint's range of chain values and h its half width, (cos(v - m) - cos h) / sin h, of
- * the sign of the joint's margin and equal to it to O(margin^2) (sin d + cot h (cos d
- * - 1) at a margin d). The shoulder's (cos, sin) from w and r as hc_angles' (sin v2 =
- * |(w.ea, w.e2)| for triple 0; triple 1: v1 + pi, -v2, v3 + pi). */
+/* Row r's margins of joints 1-6 to their limits, both triples (mg[k][j]: held_row.h's
+ * hr_margins; joint 7, the held one, inside by construction: +inf) */
 static void hc_margins(const HcGeo *g, const HcRow *r, double mg[2][7])
 {
-    const double *a = r->sh;
-    double rho = hc_rho(r), ir = 1.0 / rho;
-    double d1 = (a[0] * g->arc[0][0] + a[1] * g->arc[0][1]) * ir;
-    double d3 = (-a[3] * g->arc[2][0] + a[4] * g->arc[2][1]) * ir;
-    double d2c = a[2] * g->arc[1][0], d2s = rho * g->arc[1][1];
-    mg[0][0] = (d1 - g->arc[0][2]) * g->arc[0][3];
-    mg[1][0] = (-d1 - g->arc[0][2]) * g->arc[0][3];
-    mg[0][1] = (d2c + d2s - g->arc[1][2]) * g->arc[1][3];
-    mg[1][1] = (d2c - d2s - g->arc[1][2]) * g->arc[1][3];
-    mg[0][2] = (d3 - g->arc[2][2]) * g->arc[2][3];
-    mg[1][2] = (-d3 - g->arc[2][2]) * g->arc[2][3];
-    for (int j = 3; j < 6; j++)
-        mg[0][j] = mg[1][j] =
-            (r->cs[j][0] * g->arc[j][0] + r->cs[j][1] * g->arc[j][1] - g->arc[j][2]) *
-            g->arc[j][3];
-    mg[0][6] = mg[1][6] = INFINITY;
+    double m[2][6];
+    hr_margins_1(g, r->sh, r->ronly, (const double(*)[2])(r->cs + 3), m);
+    for (int k = 0; k < 2; k++) {
+        for (int j = 0; j < 6; j++)
+            mg[k][j] = m[k][j];
+        mg[k][6] = INFINITY;
+    }
 }
 
 /* The least of margins mg (7) over the joints other than `skip` */
@@ -566,40 +469,21 @@ static double hc_angle1(const HcRow *r, int k, int j)
     return !k ? v : j == 1 ? -v : wrap_pi(v + M_PI);
 }
 
-/* A shoulder function: joint j (0-2) at chain value V (kind: HM_KIND_*; -1: the
- * aligned-shoulder guard, |cos v2| = 1) */
-typedef struct {
-    int j, kind, twin; /* twin: v2's other limit at -V (its crossings the other triple's) */
-    double V, cV, sV;
-} HcQuery;
 
 /* Query q's value on row r, its slope d/dx when ds != NULL, and the triple a root of
  * it belongs to (*k) */
 static double hc_f(const HcQuery *q, const HcRow *r, double *ds, int *k)
 {
-    const double *a = r->sh, *da = r->dsh;
-    double f, d = NAN, side;
-    if (q->j == 0) {
-        f = -q->sV * a[0] + q->cV * a[1];
-        side = q->cV * a[0] + q->sV * a[1];
-        if (ds != NULL)
-            d = -q->sV * da[0] + q->cV * da[1];
-    } else if (q->j == 1) {
-        f = a[2] - q->cV;
-        side = q->V;
-        if (ds != NULL)
-            d = da[2];
-    } else {
-        f = q->cV * a[4] + q->sV * a[3];
-        side = -q->cV * a[3] + q->sV * a[4];
-        if (ds != NULL)
-            d = q->cV * da[4] + q->sV * da[3];
-    }
+    const double *a = r->sh;
     if (ds != NULL)
-        *ds = d;
-    if (k != NULL)
+        *ds = hr_query_1(q, r->dsh, 1);
+    if (k != NULL) {
+        double side = q->j == 0 ? q->cV * a[0] + q->sV * a[1]
+                    : q->j == 1 ? q->V
+                                : -q->cV * a[3] + q->sV * a[4];
         *k = side > 0.0 ? 0 : 1;
-    return f;
+    }
+    return hr_query_1(q, a, 0);
 }
 
 /* ------------------------------------------------------------------ events */
@@ -636,6 +520,81 @@ typedef struct {
     int nwal;
 } HcCtx;
 
+/* ----------------------------------------------------------- rows in lanes */
+
+/* Rows of branch (i, j) at x[0..n) into out[] as hc_eval's HC_SHOULDER | HC_SLOPES rows
+ * (in full: never r-only), each with its margins (hc_rowq's: hasmg) and the queries'
+ * values and slopes (hc_cell's: nf = c->nq), W at a time; 0 when one of them has no
+ * row */
+static int hc_eval_lanes(const HcCtx *c, const double *x, int n, int i, int j, HcRow *out)
+{
+    const HcPose *p = &c->p;
+    for (int b = 0; b < n; b += W) {
+        vd X, cx, sx;
+        for (int l = 0; l < W; l++)
+            X[l] = x[b + l < n ? b + l : n - 1];
+        vsincos(X, &sx, &cx);
+        HrRow_w o;
+        if (!hr_row_w(p, cx, sx, i, j, HC_SHOULDER | HC_SLOPES, &o))
+            return 0;
+        vd mg[2][6], f[HC_MAXQ], df[HC_MAXQ];
+        hr_margins_w(p->g, o.sh, 0, (const vd(*)[2])o.cs, mg);
+        for (int m = 0; m < c->nq; m++) {
+            f[m] = hr_query_w(&c->q[m], o.sh, 0);
+            df[m] = hr_query_w(&c->q[m], o.dsh, 1);
+        }
+        for (int l = 0; l < W && b + l < n; l++) {
+            HcRow *r = &out[b + l];
+            r->x = X[l];
+            r->c = cx[l];
+            r->s = sx[l];
+            for (int k = 0; k < 3; k++) {
+                r->cs[k + 3][0] = o.cs[k][0][l];
+                r->cs[k + 3][1] = o.cs[k][1][l];
+                r->dv[k + 3] = o.dv[k][l];
+            }
+            r->dv[6] = 1.0;
+            r->noise = NAN;
+            for (int k = 0; k < 5; k++) {
+                r->sh[k] = o.sh[k][l];
+                r->dsh[k] = o.dsh[k][l];
+            }
+            r->in = (v3){o.in.x[l], o.in.y[l], o.in.z[l]};
+            r->sloped = o.sloped[l] != 0.0;
+            r->ronly = 0;
+            for (int t = 0; t < 2; t++) {
+                for (int jj = 0; jj < 6; jj++)
+                    r->mg[t][jj] = mg[t][jj][l];
+                r->mg[t][6] = INFINITY;
+            }
+            r->hasmg = 1;
+            for (int m = 0; m < c->nq; m++) {
+                r->f[m] = f[m][l];
+                r->df[m] = df[m][l];
+            }
+            r->nf = c->nq;
+        }
+    }
+    return 1;
+}
+
+/* E2's margin of v4 root i and its slope d/dx (hr_m2) at x[0..n) into m[], dm[], W at
+ * a time */
+static void hc_m2_lanes(const HcPose *p, const double *x, int n, int i, double *m, double *dm)
+{
+    for (int b = 0; b < n; b += W) {
+        vd X, c, s, d;
+        for (int l = 0; l < W; l++)
+            X[l] = x[b + l < n ? b + l : n - 1];
+        vsincos(X, &s, &c);
+        vd mm = hr_m2_w(p, c, s, i, &d);
+        for (int l = 0; l < W && b + l < n; l++) {
+            m[b + l] = mm[l];
+            dm[b + l] = d[l];
+        }
+    }
+}
+
 /* Node row r of branch bj kept (x and both triples' least margins) for the pieces'
  * decisions (a slot is inside or outside all over a piece between its located events:
  * its membership changes only at a crossing with the other joints inside, never in a
@@ -645,7 +604,11 @@ static void hc_keep(HcCtx *c, int bj, HcRow *r)
     if (c->nnode[bj] >= HC_MAXN)
         return;
     double mg[2];
-    hc_rowq(&c->p, r, mg);
+    if (r->hasmg) { /* (hc_eval_lanes') */
+        mg[0] = hc_least(r->mg[0], -1);
+        mg[1] = hc_least(r->mg[1], -1);
+    } else
+        hc_rowq(&c->p, r, mg);
     double *n = c->node[bj][c->nnode[bj]++];
     n[0] = r->x;
     n[1] = mg[0];
@@ -811,7 +774,7 @@ static void hc_closed_events(HcCtx *c, int jj, double V, int kind)
             for (int m = 0; m < 3; m++)
                 rhs[m] = p->f0[m] + p->f1[m] * cV + p->f2[m] * sV - (m == 0 ? g->ec[0] : 0.0);
         } else {
-            v3 mv = hc_rot(g, 4, cV, sV, g->h[5]);
+            v3 mv = hr_rot_1(g, 4, cV, sV, g->h[5]);
             row0 = v3_dot(mv, g->a1);
             row1 = v3_dot(mv, g->a2);
             double m0 = v3_dot(mv, g->a0);
@@ -865,7 +828,7 @@ found:
             double D = hc_aff(p->d, cx, sx);
             for (int i = 0; i < 2; i++) {
                 double ci, si, sg;
-                hc_root(g->c1, g->c2, g->cn, D - g->K, i, &ci, &si, &sg);
+                hr_root_1(g->c1, g->c2, g->cn, D - g->K, i, &ci, &si, &sg);
                 if (fabs(ci - c4) + fabs(si - s4) < 1e-3) /* (hc_polish: 1e-6 of V) */
                     want |= 3 << (2 * i);
             }
@@ -1072,11 +1035,15 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow
     double d;
     hc_f(q, &r, &d, &k);
     /* the joint at its value to HC_AT, or to what the last bits of x allow where it
-     * moves fast (next to a branch end: as the square root of the distance), at most
-     * HC_AT_STEEP; |df / dv_j| is |sin v2 cos(v_j - V)| ~ |sin v2| (v1, v3) or |sin V| */
-    double rate = fabs(d) / (q->j == 1 ? fabs(q->sV) : hc_rho(&r));
+     * moves fast (next to a branch end: as the square root of the distance), or what
+     * f's rounding and v5's (r.noise) allow where the joint is ill-conditioned (q1, q3
+     * next to an aligned shoulder: f at its rounding is the joint off by that over
+     * |sin v2|), at most HC_AT_STEEP; |df / dv_j| is |sin v2 cos(v_j - V)| ~ |sin v2|
+     * (v1, v3) or |sin V| */
+    double cond = q->j == 1 ? fabs(q->sV) : hc_rho(&r), rate = fabs(d) / cond;
     double off = fabs(wrap_pi(hc_angle1(&r, k, q->j) - q->V));
-    double tol = fmax(HC_AT, 8.0 * fmax(rate * DBL_EPSILON * fmax(1.0, fabs(x)), r.noise));
+    double tol = fmax(HC_AT, 8.0 * fmax(rate * DBL_EPSILON * fmax(1.0, fabs(x)),
+                                        (r.noise + 4.0 * DBL_EPSILON) / cond));
     if (!r.sloped || !(off <= tol) || !(off <= HC_AT_STEEP)) {
         c->bad = __LINE__;
         return;
@@ -1253,17 +1220,17 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
 static void hc_piece(HcCtx *c, const HcPiece *pc)
 {
     HcRow r[HC_NODES];
+    double nx[HC_NODES];
+    for (int k = 0; k < HC_NODES; k++)
+        nx[k] = k == 0 ? pc->a : k == HC_NODES - 1 ? pc->b
+                               : pc->a + (pc->b - pc->a) * 0.5 * (1.0 - c->ncs[k][0]);
+    if (!hc_eval_lanes(c, nx, HC_NODES, pc->i, pc->j, r)) {
+        c->bad = __LINE__;
+        return;
+    }
+    c->rows += HC_NODES;
     for (int k = 0; k < HC_NODES; k++) {
-        double x = k == 0 ? pc->a : k == HC_NODES - 1 ? pc->b
-                                  : pc->a + (pc->b - pc->a) * 0.5 * (1.0 - c->ncs[k][0]);
-        /* (interior nodes r-only where a wrist joint is outside; the ends in full) */
-        int ro = k > 0 && k < HC_NODES - 1 ? c->ronly : 0;
-        if (!hc_eval(&c->p, x, pc->i, pc->j, HC_SHOULDER | HC_SLOPES | ro, &r[k])) {
-            c->bad = __LINE__;
-            return;
-        }
         r[k].dxi = (pc->b - pc->a) * 0.5 * M_PI * c->ncs[k][1];
-        c->rows++;
         hc_keep(c, 2 * pc->i + pc->j, &r[k]);
         if ((k == 0 && pc->fa) || (k == HC_NODES - 1 && pc->fb)) {
             /* a branch end: rates infinite in x, finite in xi (x - end ~ xi^2): the
@@ -1282,6 +1249,7 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
             for (int m = 0; m < 5; m++)
                 r[k].dsh[m] = e.dsh[m] * f;
             r[k].sloped = 2; /* slopes d/dxi / (pi (b - a) / 2): see hc_cell */
+            r[k].nf = 0;     /* (the queries' slopes again, from these) */
         }
         if (k == 0 || k == HC_NODES - 1) {
             /* a joint at its limit at the piece's end (a corner: the slot may be inside
@@ -1474,21 +1442,21 @@ static void hc_pieces(HcCtx *c)
         if (!(hc_m1(p, cos(xm), sin(xm)) > 0.0))
             continue;
         HcPiece pc = {a, b, a != p->xlo, b != p->xhi, 0, 0, 0.0, 0.0};
-        double nx[HC_MNODES], ncs[HC_MNODES][2]; /* the nodes' x, cos x, sin x (both i) */
-        for (int k = 0; k < HC_MNODES; k++) {
+        double nx[HC_MNODES], nm[HC_MNODES], ndm[HC_MNODES]; /* the nodes' x, margin, slope */
+        for (int k = 0; k < HC_MNODES; k++)
             nx[k] = k == 0 ? a : k == HC_MNODES - 1 ? b : a + (b - a) * 0.5 * (1.0 - c->mcs[k][0]);
-            sincos1(nx[k], &ncs[k][1], &ncs[k][0]);
-        }
         for (int i = 0; i < 2 && !c->bad; i++) {
             /* E2's margin on nodes of the piece: its sign changes */
             HcMNode nd[HC_MNODES];
             double ends[2 * HC_MAXPC];
             int ne = 0;
+            hc_m2_lanes(p, nx, HC_MNODES, i, nm, ndm);
             for (int k = 0; k < HC_MNODES; k++) {
                 nd[k].xi = (double)k / (HC_MNODES - 1);
                 nd[k].x = nx[k];
                 nd[k].dx = (b - a) * 0.5 * M_PI * c->mcs[k][1];
-                nd[k].m = hc_m2cs(p, ncs[k][0], ncs[k][1], i, &nd[k].d);
+                nd[k].m = nm[k];
+                nd[k].d = ndm[k];
                 if ((k == 0 && pc.fa) || (k == HC_MNODES - 1 && pc.fb))
                     nd[k].d = NAN;
             }
