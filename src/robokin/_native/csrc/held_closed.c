@@ -79,7 +79,7 @@
 #include "brent.h"
 #include "held_outputs.h"
 
-#define HC_NODES 12      /* nodes per piece (its ends included) before splits */
+#define HC_NODES 16      /* nodes per piece (its ends included) before splits: 2 x 8 lanes */
 #define HC_MNODES 33     /* nodes per piece of E1 for E2's margin, before splits */
 #define HC_DEPTH 10      /* splits of a cell */
 #define HC_MAXE 64       /* events per branch (i, j) */
@@ -167,6 +167,7 @@ typedef struct {
 
 #define HR_T double
 #define HR_V3 v3
+#define HR_M int
 #define HR_SUF _1
 #define HR_BR(x) ((double)(x))
 #define HR_SQRT sqrt
@@ -174,6 +175,7 @@ typedef struct {
 #define HR_SEL(m, a, b) ((m) ? (a) : (b))
 #define HR_FINITE(x) (isfinite(x) != 0)
 #define HR_NONE(m) (!(m))
+#define HR_NOT(m) (!(m))
 #include "held_row.h"
 #undef HR_T
 #undef HR_V3
@@ -184,9 +186,12 @@ typedef struct {
 #undef HR_SEL
 #undef HR_FINITE
 #undef HR_NONE
+#undef HR_NOT
+#undef HR_M
 
 #define HR_T vd
 #define HR_V3 HcV3
+#define HR_M vl
 #define HR_SUF _w
 #define HR_BR(x) BR(x)
 #define HR_SQRT vsqrt
@@ -194,6 +199,7 @@ typedef struct {
 #define HR_SEL vsel
 #define HR_FINITE vfinite
 #define HR_NONE(m) vany(~(m))
+#define HR_NOT(m) (~(m))
 #include "held_row.h"
 #undef HR_T
 #undef HR_V3
@@ -204,6 +210,8 @@ typedef struct {
 #undef HR_SEL
 #undef HR_FINITE
 #undef HR_NONE
+#undef HR_NOT
+#undef HR_M
 
 static inline double hc_aff(const double *a, double c, double s) { return a[0] + a[1] * c + a[2] * s; }
 static inline double hc_daff(const double *a, double c, double s) { return -a[1] * s + a[2] * c; }
@@ -1126,11 +1134,7 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
         double tol = q->kind < 0 ? HC_ALIGNED : HC_TOUCH;
         /* the common case first: of one sign and clear of 0 all over the cell (the
          * tests below then neither split nor flag it) */
-        double afa = fabs(fa[m]), afb = fabs(fb[m]), ada = fabs(da), adb = fabs(db);
-        if (known && (fa[m] < 0.0) == (fb[m] < 0.0) &&
-            (afa < afb ? afa : afb) > (4.0 / 27.0) * (ada + adb) + tol &&
-            fabs(fb[m] - fa[m]) <= HC_MOVE && ada <= 2.0 * HC_MOVE && adb <= 2.0 * HC_MOVE &&
-            !(fa[m] > 0.0 ? da < 0.0 && db > 0.0 : da > 0.0 && db < 0.0))
+        if (known && hr_clear_1(fa[m], fb[m], da, db, tol))
             continue;
         if (fabs(fa[m]) < (q->kind < 0 ? tol : HC_AT_NODE) ||
             fabs(fb[m]) < (q->kind < 0 ? tol : HC_AT_NODE)) {
@@ -1214,6 +1218,48 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
         }
         hc_root_q(c, pc, q, ra, xi0, fa[m], dfa[m], rb, xi1, fb[m], dfb[m], dead ? c->ronly : 0);
     }
+}
+
+/* The cells of a piece's nodes r (k, k + 1) with work for hc_cell (busy[k] = 1): those
+ * where a query fails hc_cell's common case (of one sign and clear of 0 all over the
+ * cell by the cubic model's bound, moving little, no extremum toward 0), by hc_cell's
+ * own arithmetic, W cells at a time; a cell at a branch end's node (slopes d/dxi:
+ * sloped 2) or without slopes is busy. hc_cell does nothing in the others. */
+static void hc_busy_cells(const HcCtx *c, const HcRow *r, int *busy)
+{
+    enum { NC = HC_NODES - 1, NB = (NC + W - 1) / W * W };
+    double sa[NB], sb[NB], fv[NB + 1], dv[NB + 1];
+    vl free[NB / W];
+    for (int k = 0; k < NB; k++) { /* (hc_cell's h, sa, sb) */
+        double h = (double)(k + 1) / (HC_NODES - 1) - (double)k / (HC_NODES - 1);
+        int in = k < NC && r[k].sloped == 1 && r[k + 1].sloped == 1;
+        sa[k] = in ? r[k].dxi * h : NAN;
+        sb[k] = in ? r[k + 1].dxi * h : NAN;
+    }
+    for (int b = 0; b < NB / W; b++)
+        free[b] = BRL(-1);
+    for (int m = 0; m < c->nq; m++) {
+        const HcQuery *q = &c->q[m];
+        double tol = q->kind < 0 ? HC_ALIGNED : HC_TOUCH;
+        for (int k = 0; k <= NB; k++) {
+            int n = k < HC_NODES ? k : HC_NODES - 1;
+            fv[k] = r[n].f[m];
+            dv[k] = r[n].df[m];
+        }
+        for (int b = 0; b < NB / W; b++) {
+            vd fa, fb, da, db;
+            for (int l = 0; l < W; l++) {
+                int k = b * W + l;
+                fa[l] = fv[k];
+                fb[l] = fv[k + 1];
+                da[l] = dv[k] * sa[k];
+                db[l] = dv[k + 1] * sb[k];
+            }
+            free[b] &= hr_clear_w(fa, fb, da, db, tol);
+        }
+    }
+    for (int k = 0; k < NC; k++)
+        busy[k] = free[k / W][k % W] == 0;
 }
 
 /* Every shoulder event of a piece */
@@ -1305,9 +1351,12 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
             }
         }
     }
+    int busy[HC_NODES - 1];
+    hc_busy_cells(c, r, busy);
     for (int k = 0; k + 1 < HC_NODES && !c->bad; k++)
-        hc_cell(c, pc, &r[k], (double)k / (HC_NODES - 1), &r[k + 1],
-                (double)(k + 1) / (HC_NODES - 1), 0);
+        if (busy[k])
+            hc_cell(c, pc, &r[k], (double)k / (HC_NODES - 1), &r[k + 1],
+                    (double)(k + 1) / (HC_NODES - 1), 0);
 }
 
 /* --------------------------------------------------------- branch ends */

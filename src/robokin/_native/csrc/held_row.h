@@ -4,10 +4,11 @@
  * a piece's nodes, known before any of them is looked at, and E2's margin's). Included
  * by held_closed.c once per type after defining
  *
- *   HR_T     the value type (double, vd); HR_V3 its 3-vector (v3, HcV3)
+ *   HR_T     the value type (double, vd); HR_V3 its 3-vector (v3, HcV3); HR_M a
+ *            comparison's (int 0 or 1, vl)
  *   HR_SUF   the functions' suffix (_1, _w)
  *   HR_BR(x) a double in every lane; HR_SQRT, HR_ABS, HR_SEL(m, a, b), HR_FINITE(x)
- *   HR_NONE(m)  1 when a lane of mask m is false (one row: !m)
+ *   HR_NONE(m)  1 when a lane of mask m is false (one row: !m); HR_NOT(m) m negated
  *
  * and undefining them after. The notation is held_closed.c's header's.
  */
@@ -281,6 +282,21 @@ ALWAYS_INLINE HR_T HR(hr_query)(const HcQuery *q, const HR_T *a, int slope)
     return q->j == 0 ? -q->sV * a[0] + q->cV * a[1]
          : q->j == 1 ? (slope ? a[2] : a[2] - q->cV)
                      : q->cV * a[4] + q->sV * a[3];
+}
+
+/* hc_cell's common case: a query of values fa, fb and slopes da, db (times the cell)
+ * at a cell's ends is of one sign and clear of tol all over the cell (the cubic Hermite
+ * model within 4/27 (|da| + |db|) of a mean of fa and fb), moves by at most HC_MOVE and
+ * has no extremum toward 0 (slopes pointing inward): 1 (a lane's mask) where it is */
+ALWAYS_INLINE HR_M HR(hr_clear)(HR_T fa, HR_T fb, HR_T da, HR_T db, double tol)
+{
+    HR_T afa = HR_ABS(fa), afb = HR_ABS(fb), ada = HR_ABS(da), adb = HR_ABS(db);
+    HR_M pos = fa > 0.0;
+    HR_M inward = (pos & (da < 0.0) & (db > 0.0)) | (HR_NOT(pos) & (da > 0.0) & (db < 0.0));
+    return HR_FINITE(da) & HR_FINITE(db) & ((fa < 0.0) == (fb < 0.0)) &
+           (HR_SEL(afa < afb, afa, afb) > (4.0 / 27.0) * (ada + adb) + tol) &
+           (HR_ABS(fb - fa) <= HC_MOVE) & (ada <= 2.0 * HC_MOVE) & (adb <= 2.0 * HC_MOVE) &
+           HR_NOT(inward);
 }
 
 #undef HR
