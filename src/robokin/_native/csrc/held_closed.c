@@ -1444,6 +1444,29 @@ static void hc_m2_cell(HcCtx *c, const HcPiece *pc, int i, const HcMNode *n0,
     }
 }
 
+/* The cells of E2's margin's nodes nd (k, k + 1) with work for hc_m2_cell (busy[k] =
+ * 1): all but those hr_m2_clear passes (hc_m2_cell's own arithmetic; it does nothing
+ * there), W cells at a time */
+static void hc_m2_busy(const HcMNode *nd, double scale, int *busy)
+{
+    enum { NC = HC_MNODES - 1, NB = (NC + W - 1) / W * W };
+    for (int b = 0; b < NB; b += W) {
+        vd m0, m1, s0, s1;
+        for (int l = 0; l < W; l++) {
+            int k = b + l < NC ? b + l : NC - 1;
+            const HcMNode *n0 = &nd[k], *n1 = &nd[k + 1];
+            double h = n1->xi - n0->xi; /* (hc_m2_cell's) */
+            m0[l] = n0->m;
+            m1[l] = n1->m;
+            s0[l] = n0->d * n0->dx * h;
+            s1[l] = n1->d * n1->dx * h;
+        }
+        vl clear = hr_m2_clear_w(m0, m1, s0, s1, scale);
+        for (int l = 0; l < W && b + l < NC; l++)
+            busy[b + l] = clear[l] == 0;
+    }
+}
+
 static int hc_cmp(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -1509,8 +1532,11 @@ static void hc_pieces(HcCtx *c)
                 if ((k == 0 && pc.fa) || (k == HC_MNODES - 1 && pc.fb))
                     nd[k].d = NAN;
             }
+            int busy[HC_MNODES - 1];
+            hc_m2_busy(nd, c->p.g->cn, busy);
             for (int k = 0; k + 1 < HC_MNODES; k++)
-                hc_m2_cell(c, &pc, i, &nd[k], &nd[k + 1], 0, ends, &ne);
+                if (busy[k])
+                    hc_m2_cell(c, &pc, i, &nd[k], &nd[k + 1], 0, ends, &ne);
             if (c->bad)
                 return;
             /* the sub-pieces where the margin is >= 0 */

@@ -299,6 +299,24 @@ ALWAYS_INLINE HR_M HR(hr_clear)(HR_T fa, HR_T fb, HR_T da, HR_T db, double tol)
            HR_NOT(inward);
 }
 
+/* hc_m2_cell's cell without work: E2's margin m0, m1 at a cell's ends with slopes s0,
+ * s1 (times the cell; finite) of one sign and clear of 0 all over the cell by the cubic
+ * model's bound (hc_hermite's first test, in units of scale), slopes agreeing with the
+ * chord (HC_BEND) and not pointing inward (no extremum toward 0) */
+ALWAYS_INLINE HR_M HR(hr_m2_clear)(HR_T m0, HR_T m1, HR_T s0, HR_T s1, double scale)
+{
+    HR_T u0 = m0 / scale, u1 = m1 / scale, au0 = HR_ABS(u0), au1 = HR_ABS(u1);
+    HR_T chord = m1 - m0;
+    HR_M pos = m0 > 0.0;
+    HR_M inward = (pos & (s0 < 0.0) & (s1 > 0.0)) | (HR_NOT(pos) & (s0 > 0.0) & (s1 < 0.0));
+    return HR_FINITE(s0) & HR_FINITE(s1) & ((u0 < 0.0) == (u1 < 0.0)) &
+           (HR_SEL(au0 < au1, au0, au1) >
+            (4.0 / 27.0) * (HR_ABS(s0 / scale) + HR_ABS(s1 / scale)) + HC_TOUCH) &
+           (HR_ABS(s0 - chord) + HR_ABS(s1 - chord) <=
+            HC_BEND * (HR_ABS(chord) + HC_BEND_FLOOR * scale)) &
+           HR_NOT(inward);
+}
+
 #undef HR
 #undef HR_CAT
 #undef HR_CAT2
