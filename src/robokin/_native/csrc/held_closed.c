@@ -104,6 +104,8 @@
 #define HC_END_XI 1e-4   /* a branch end's slopes from this far in (in xi) */
 #define HC_AT 1e-12      /* a crossing's joint at its value to this [rad] */
 #define HC_AT_STEEP 1e-9 /* the same where the last bit of x moves the joint more */
+#define HC_LAST_F 1e-8   /* Newton's last step without its row: |f| at most this at the last row */
+#define HC_LAST_PRED 1e-15 /* ... and the joint's predicted error there at most this [rad] */
 #define HC_DECIDE 1e-9   /* a midpoint row this far inside / outside decides its piece */
 #define HC_BEND 1.0      /* E2's margin: slopes off the chord by more than this share: split */
 #define HC_BEND_FLOOR 1e-2
@@ -1002,17 +1004,45 @@ static double hc_model_root(double f0, double f1, double d0, double d1)
     return t;
 }
 
+/* Whether row r at x is query q's crossing (*k: its triple): the joint at its value
+ * to HC_AT, or to what the last bits of x allow where it moves fast (next to a branch
+ * end: as the square root of the distance), or what f's rounding and v5's (r.noise)
+ * allow where the joint is ill-conditioned (q1, q3 next to an aligned shoulder: f at
+ * its rounding is the joint off by that over |sin v2|), at most HC_AT_STEEP; |df / dv_j|
+ * is |sin v2 cos(v_j - V)| ~ |sin v2| (v1, v3) or |sin V|. With step != 0 (Newton's
+ * from x, f and slope d there, curv the slopes' secant over the last two iterates):
+ * whether x + step is the crossing without its row (held_manifold.c's hm_last): the
+ * joint's value there predicted by Newton's error (half the curvature times the step
+ * squared, over cond) within HC_LAST_PRED, |f| <= HC_LAST_F, and the tolerance HC_AT
+ * itself (neither steep nor ill-conditioned: r's rounding below it). */
+static int hc_at_value(const HcQuery *q, const HcRow *r, double x, double step, double f,
+                       double curv, int *k)
+{
+    double d;
+    hc_f(q, r, &d, k);
+    double cond = q->j == 1 ? fabs(q->sV) : hc_rho(r), rate = fabs(d) / cond;
+    double tol = fmax(HC_AT, 8.0 * fmax(rate * DBL_EPSILON * fmax(1.0, fabs(x)),
+                                        (r->noise + 4.0 * DBL_EPSILON) / cond));
+    if (step != 0.0)
+        return r->sloped && tol == HC_AT && fabs(f) <= HC_LAST_F &&
+               0.5 * curv * step * step <= HC_LAST_PRED * cond;
+    double off = fabs(wrap_pi(hc_angle1(r, *k, q->j) - q->V));
+    return r->sloped && off <= tol && off <= HC_AT_STEEP;
+}
+
 /* A crossing of query q in the cell (ra, rb) at xi0 < xi1 (values f0, f1 of opposite
  * signs, slopes d0, d1 times the cell) on the piece's branch: from the cubic model's
- * root, safeguarded Newton / Illinois to the last bits; the event with its triple. */
+ * root, safeguarded Newton / Illinois to the last bits; the event with its triple.
+ * Newton's last step is taken without its row where hc_at_value predicts it at the
+ * crossing: the last row stands for it (its triple, the other joints' margins). */
 static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow *ra,
                       double xi0, double f0, double d0, const HcRow *rb, double xi1,
                       double f1, double d1, int ronly)
 {
     HcRow r;
-    double lo = ra->x, hi = rb->x, flo = f0, fhi = f1;
+    double lo = ra->x, hi = rb->x, flo = f0, fhi = f1, xp = NAN, dp = NAN, xr;
     double x = hc_x(pc, xi0 + (xi1 - xi0) * hc_model_root(f0, f1, d0, d1));
-    int side = 0;
+    int side = 0, k, at = 0;
     for (int it = 0;; it++) {
         if (it >= 40) {
             c->bad = __LINE__;
@@ -1025,6 +1055,7 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow
             return;
         }
         c->rows++;
+        xr = x;
         double d, f = hc_f(q, &r, &d, NULL);
         /* at the root to its rounding: f is sin v2 sin(v_j - V) (v1, v3), cos v2 - cos V
          * (v2), each O(1), with v5's rounding (r.noise) in the angles */
@@ -1035,24 +1066,19 @@ static void hc_root_q(HcCtx *c, const HcPiece *pc, const HcQuery *q, const HcRow
         if (hi - lo <= 2.0 * DBL_EPSILON * fmax(1.0, fabs(x)))
             break;
         double nx = r.sloped && d != 0.0 ? x - f / d : NAN;
+        if (nx > lo && nx < hi && nx != x &&
+            hc_at_value(q, &r, x, nx - x, f, fabs((d - dp) / (x - xp)), &k)) {
+            x = nx; /* Newton's last step (xp: NaN at the first row) */
+            at = 1;
+            break;
+        }
+        xp = x;
+        dp = d;
         if (!(nx > lo && nx < hi)) /* Illinois */
             nx = lo - flo * (hi - lo) / (fhi - flo);
         x = nx;
     }
-    int k; /* (r is x's row) */
-    double d;
-    hc_f(q, &r, &d, &k);
-    /* the joint at its value to HC_AT, or to what the last bits of x allow where it
-     * moves fast (next to a branch end: as the square root of the distance), or what
-     * f's rounding and v5's (r.noise) allow where the joint is ill-conditioned (q1, q3
-     * next to an aligned shoulder: f at its rounding is the joint off by that over
-     * |sin v2|), at most HC_AT_STEEP; |df / dv_j| is |sin v2 cos(v_j - V)| ~ |sin v2|
-     * (v1, v3) or |sin V| */
-    double cond = q->j == 1 ? fabs(q->sV) : hc_rho(&r), rate = fabs(d) / cond;
-    double off = fabs(wrap_pi(hc_angle1(&r, k, q->j) - q->V));
-    double tol = fmax(HC_AT, 8.0 * fmax(rate * DBL_EPSILON * fmax(1.0, fabs(x)),
-                                        (r.noise + 4.0 * DBL_EPSILON) / cond));
-    if (!r.sloped || !(off <= tol) || !(off <= HC_AT_STEEP)) {
+    if (!at && !hc_at_value(q, &r, xr, 0.0, NAN, NAN, &k)) { /* (r is xr's row) */
         c->bad = __LINE__;
         return;
     }
