@@ -1273,15 +1273,14 @@ static void hc_busy_cells(const HcCtx *c, const HcRow *r, int *busy)
             dv[k] = r[n].df[m];
         }
         for (int b = 0; b < NB / W; b++) {
-            vd fa, fb, da, db;
-            for (int l = 0; l < W; l++) {
-                int k = b * W + l;
-                fa[l] = fv[k];
-                fb[l] = fv[k + 1];
-                da[l] = dv[k] * sa[k];
-                db[l] = dv[k + 1] * sb[k];
-            }
-            free[b] &= hr_clear_w(fa, fb, da, db, tol);
+            vd fa, fb, da, db, s0, s1;
+            memcpy(&fa, fv + b * W, sizeof(vd));
+            memcpy(&fb, fv + b * W + 1, sizeof(vd));
+            memcpy(&da, dv + b * W, sizeof(vd));
+            memcpy(&db, dv + b * W + 1, sizeof(vd));
+            memcpy(&s0, sa + b * W, sizeof(vd));
+            memcpy(&s1, sb + b * W, sizeof(vd));
+            free[b] &= hr_clear_w(fa, fb, da * s0, db * s1, tol);
         }
     }
     for (int k = 0; k < NC; k++)
