@@ -534,9 +534,10 @@ typedef struct {
 
 /* Rows of branch (i, j) at x[0..n) into out[] as hc_eval's HC_SHOULDER | HC_SLOPES rows
  * (in full: never r-only), each with its margins (hc_rowq's: hasmg) and the queries'
- * values and slopes (hc_cell's: nf = c->nq), W at a time; 0 when one of them has no
- * row */
-static int hc_eval_lanes(const HcCtx *c, const double *x, int n, int i, int j, HcRow *out)
+ * values and slopes (hc_cell's: nf = c->nq; also fq[m][k], dq[m][k] of query m at
+ * x[k], rows of HC_NODES + W doubles), W at a time; 0 when one of them has no row */
+static int hc_eval_lanes(const HcCtx *c, const double *x, int n, int i, int j, HcRow *out,
+                         double (*fq)[HC_NODES + W], double (*dq)[HC_NODES + W])
 {
     const HcPose *p = &c->p;
     for (int b = 0; b < n; b += W) {
@@ -552,6 +553,8 @@ static int hc_eval_lanes(const HcCtx *c, const double *x, int n, int i, int j, H
         for (int m = 0; m < c->nq; m++) {
             f[m] = hr_query_w(&c->q[m], o.sh, 0);
             df[m] = hr_query_w(&c->q[m], o.dsh, 1);
+            memcpy(fq[m] + b, &f[m], sizeof(vd)); /* (n <= HC_NODES: within the row) */
+            memcpy(dq[m] + b, &df[m], sizeof(vd));
         }
         for (int l = 0; l < W && b + l < n; l++) {
             HcRow *r = &out[b + l];
@@ -585,6 +588,8 @@ static int hc_eval_lanes(const HcCtx *c, const double *x, int n, int i, int j, H
             r->nf = c->nq;
         }
     }
+    for (int m = 0; m < c->nq; m++) /* (read past the last node by hc_busy_cells) */
+        fq[m][n] = dq[m][n] = 0.0;
     return 1;
 }
 
@@ -1249,12 +1254,14 @@ static void hc_cell(HcCtx *c, const HcPiece *pc, HcRow *ra, double xi0, HcRow *r
 /* The cells of a piece's nodes r (k, k + 1) with work for hc_cell (busy[k] = 1): those
  * where a query fails hc_cell's common case (of one sign and clear of 0 all over the
  * cell by the cubic model's bound, moving little, no extremum toward 0), by hc_cell's
- * own arithmetic, W cells at a time; a cell at a branch end's node (slopes d/dxi:
- * sloped 2) or without slopes is busy. hc_cell does nothing in the others. */
-static void hc_busy_cells(const HcCtx *c, const HcRow *r, int *busy)
+ * own arithmetic, W cells at a time (fq, dq: the queries' values and slopes at the
+ * nodes, hc_eval_lanes'); a cell at a branch end's node (slopes d/dxi: sloped 2) or
+ * without slopes is busy. hc_cell does nothing in the others. */
+static void hc_busy_cells(const HcCtx *c, const HcRow *r, const double (*fq)[HC_NODES + W],
+                          const double (*dq)[HC_NODES + W], int *busy)
 {
     enum { NC = HC_NODES - 1, NB = (NC + W - 1) / W * W };
-    double sa[NB], sb[NB], fv[NB + 1], dv[NB + 1];
+    double sa[NB], sb[NB];
     vl free[NB / W];
     for (int k = 0; k < NB; k++) { /* (hc_cell's h, sa, sb) */
         double h = (double)(k + 1) / (HC_NODES - 1) - (double)k / (HC_NODES - 1);
@@ -1267,11 +1274,7 @@ static void hc_busy_cells(const HcCtx *c, const HcRow *r, int *busy)
     for (int m = 0; m < c->nq; m++) {
         const HcQuery *q = &c->q[m];
         double tol = q->kind < 0 ? HC_ALIGNED : HC_TOUCH;
-        for (int k = 0; k <= NB; k++) {
-            int n = k < HC_NODES ? k : HC_NODES - 1;
-            fv[k] = r[n].f[m];
-            dv[k] = r[n].df[m];
-        }
+        const double *fv = fq[m], *dv = dq[m]; /* (past HC_NODES: lanes sa, sb leave out) */
         for (int b = 0; b < NB / W; b++) {
             vd fa, fb, da, db, s0, s1;
             memcpy(&fa, fv + b * W, sizeof(vd));
@@ -1295,7 +1298,8 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
     for (int k = 0; k < HC_NODES; k++)
         nx[k] = k == 0 ? pc->a : k == HC_NODES - 1 ? pc->b
                                : pc->a + (pc->b - pc->a) * 0.5 * (1.0 - c->ncs[k][0]);
-    if (!hc_eval_lanes(c, nx, HC_NODES, pc->i, pc->j, r)) {
+    double fq[HC_MAXQ][HC_NODES + W], dq[HC_MAXQ][HC_NODES + W];
+    if (!hc_eval_lanes(c, nx, HC_NODES, pc->i, pc->j, r, fq, dq)) {
         c->bad = __LINE__;
         return;
     }
@@ -1377,7 +1381,7 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
         }
     }
     int busy[HC_NODES - 1];
-    hc_busy_cells(c, r, busy);
+    hc_busy_cells(c, r, (const double(*)[HC_NODES + W])fq, (const double(*)[HC_NODES + W])dq, busy);
     for (int k = 0; k + 1 < HC_NODES && !c->bad; k++)
         if (busy[k])
             hc_cell(c, pc, &r[k], (double)k / (HC_NODES - 1), &r[k + 1],
