@@ -234,12 +234,13 @@ static int hc_geo(const double *P, HcGeo *g)
         g->hi[k] = P[PK_HI + k];
         double half = 0.5 * (g->hi[k] - g->lo[k]);
         double mid = g->sign[k] * (g->lo[k] + half) + g->off[k];
-        if (fabs(g->sign[k]) != 1.0 || !(sin(half) > HC_ARC_MIN) || !(half > 0.0))
+        double sh, ch;
+        sincos1(half, &sh, &ch);
+        if (fabs(g->sign[k]) != 1.0 || !(sh > HC_ARC_MIN) || !(half > 0.0))
             return 0; /* (a range within HC_ARC_MIN of 0 or a whole turn: the grid's) */
-        g->arc[k][0] = cos(mid);
-        g->arc[k][1] = sin(mid);
-        g->arc[k][2] = cos(half);
-        g->arc[k][3] = 1.0 / sin(half);
+        sincos1(mid, &g->arc[k][1], &g->arc[k][0]);
+        g->arc[k][2] = ch;
+        g->arc[k][3] = 1.0 / sh;
         const double *h = &P[PK_AXES + 3 * k];
         g->ax[k] = 3;
         g->axs[k] = 1.0;
@@ -669,17 +670,19 @@ static int hc_sin_roots(double a0, double a1, double a2, double *x)
  * function at y = pi) is not small; every real root Newton-polished. */
 static int hc_quartic_roots(const double *al, const double *be, double *x)
 {
-    double best = -1.0, phi = 0.0;
-    for (int m = 0; m < 4; m++) { /* the shift: the largest |F(phi + pi)| of 4 */
-        double ph = 0.5 * M_PI * m, cc = cos(ph + M_PI), ss = sin(ph + M_PI);
+    static const double turn[4][2] = {{1.0, 0.0}, {0.0, 1.0}, {-1.0, 0.0}, {0.0, -1.0}};
+    double best = -1.0;
+    int mb = 0;
+    for (int m = 0; m < 4; m++) { /* the shift phi = m pi / 2: the largest |F(phi + pi)| */
+        double cc = -turn[m][0], ss = -turn[m][1]; /* (cos, sin of phi + pi) */
         double A = al[0] + al[1] * cc + al[2] * ss, B = be[0] + be[1] * cc + be[2] * ss;
         double F = fabs(A * A + B * B - 1.0);
         if (F > best) {
             best = F;
-            phi = ph;
+            mb = m;
         }
     }
-    double cp = cos(phi), sp = sin(phi);
+    double phi = 0.5 * M_PI * mb, cp = turn[mb][0], sp = turn[mb][1];
     /* in y: cos x = cp cos y - sp sin y, sin x = sp cos y + cp sin y */
     double a[3] = {al[0], al[1] * cp + al[2] * sp, -al[1] * sp + al[2] * cp};
     double b[3] = {be[0], be[1] * cp + be[2] * sp, -be[1] * sp + be[2] * cp};
@@ -772,7 +775,8 @@ static void hc_closed_events(HcCtx *c, int jj, double V, int kind)
 {
     const HcGeo *g = c->p.g;
     const HcPose *p = &c->p;
-    double cV = cos(V), sV = sin(V), x[4];
+    double cV, sV, x[4];
+    sincos1(V, &sV, &cV);
     double al[3] = {NAN, NAN, NAN}, be[3] = {NAN, NAN, NAN}; /* (cos, sin v4) = (al, be) . w */
     int n;
     if (jj == 3) {
@@ -1540,7 +1544,9 @@ static void hc_pieces(HcCtx *c)
             return;
         }
         double xm = 0.5 * (a + b);
-        if (!(hc_m1(p, cos(xm), sin(xm)) > 0.0))
+        double cm, sm;
+        sincos1(xm, &sm, &cm);
+        if (!(hc_m1(p, cm, sm) > 0.0))
             continue;
         HcPiece pc = {a, b, a != p->xlo, b != p->xhi, 0, 0, 0.0, 0.0};
         double nx[HC_MNODES], nm[HC_MNODES], ndm[HC_MNODES]; /* the nodes' x, margin, slope */
@@ -1877,7 +1883,9 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
             int twin = j == 1 && V[0] == -V[1];
             if (twin && e == 0)
                 continue;
-            c->q[c->nq++] = (HcQuery){j, kind, twin, V[e], cos(V[e]), sin(V[e])};
+            double cV, sV;
+            sincos1(V[e], &sV, &cV);
+            c->q[c->nq++] = (HcQuery){j, kind, twin, V[e], cV, sV};
         }
     }
     c->q[c->nq++] = (HcQuery){1, -1, 0, 0.0, 1.0, 0.0};
@@ -1888,13 +1896,15 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
         if (j == 0 || j == 2) {
             if (c->nq >= HC_MAXQ)
                 goto done;
-            c->q[c->nq++] = (HcQuery){j, HM_KIND_ALIGNED, 0, V, cos(V), sin(V)};
+            double cV, sV;
+            sincos1(V, &sV, &cV);
+            c->q[c->nq++] = (HcQuery){j, HM_KIND_ALIGNED, 0, V, cV, sV};
         } else if (j >= 3 && j <= 5) {
             if (c->nwal >= HC_MAXQ)
                 goto done;
             c->wal[c->nwal][0] = j;
-            c->wal[c->nwal][1] = cos(V);
-            c->wal[c->nwal++][2] = sin(V);
+            sincos1(V, &c->wal[c->nwal][2], &c->wal[c->nwal][1]);
+            c->nwal++;
         } else if (j != 1 && j != 6) {
             goto done;
         }
