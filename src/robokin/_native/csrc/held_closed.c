@@ -1843,6 +1843,21 @@ static int hc_slots_agree(HcCtx *c, const double *P, double x)
     return tried > 0;
 }
 
+/* cos, sin of pi k / (n - 1), k = 0 .. n - 1 (the nodes' Chebyshev spacing), W at a time */
+static void hc_nodes_cs(int n, double (*cs)[2])
+{
+    for (int b = 0; b < n; b += W) {
+        vd x, s, c;
+        for (int l = 0; l < W; l++)
+            x[l] = M_PI * (b + l) / (n - 1);
+        vsincos(x, &s, &c);
+        for (int l = 0; l < W && b + l < n; l++) {
+            cs[b + l][0] = c[l];
+            cs[b + l][1] = s[l];
+        }
+    }
+}
+
 /* The intervals and points of one pose (held_manifold's outputs: iv (8, HM_MAXI, 2),
  * niv (8), pts (HM_MAXP, 4), *npts); 1 when certified (else the outputs undefined) */
 static int hc_pose(const double *P, const double *T, const double *al, long nal, double *iv,
@@ -1862,12 +1877,8 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     c->nq = c->nwal = 0;
     for (int bj = 0; bj < 4; bj++)
         c->nev[bj] = c->npc[bj] = c->nnode[bj] = 0;
-    for (int k = 0; k < HC_NODES; k++) {
-        sincos1(M_PI * k / (HC_NODES - 1), &c->ncs[k][1], &c->ncs[k][0]);
-    }
-    for (int k = 0; k < HC_MNODES; k++) {
-        sincos1(M_PI * k / (HC_MNODES - 1), &c->mcs[k][1], &c->mcs[k][0]);
-    }
+    hc_nodes_cs(HC_NODES, c->ncs);
+    hc_nodes_cs(HC_MNODES, c->mcs);
     const HcGeo *g = &geo;
     int ok = 0;
     if (!hc_setup(g, T, &c->p))
