@@ -724,8 +724,8 @@ static int hc_quartic_roots(const double *al, const double *be, double *x)
                 break;
             double step = F / dF;
             y -= step;
-            if (fabs(step) < 1e-16)
-                break;
+            if (fabs(step) <= 2.0 * DBL_EPSILON * fmax(1.0, fabs(y)))
+                break; /* (at F's rounding: y's last bits) */
         }
         double cy, sy;
         sincos1(y, &sy, &cy);
