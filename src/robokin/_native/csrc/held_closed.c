@@ -738,10 +738,11 @@ static int hc_quartic_roots(const double *al, const double *be, double *x)
 
 /* Branch (i, j)'s row at x with its joint jj's chain value within 1e-6 of V: the
  * value Newton-polished along the branch (x moved), 1 when it ends within HC_AT with
- * a slope neither steep nor flat (else c->bad); 0 when the branch is not there. */
-static int hc_polish(HcCtx *c, int i, int j, int jj, double V, double *x)
+ * a slope neither steep nor flat (else c->bad); 0 when the branch is not there. *rp:
+ * the last row (the wrist's alone; at *x unless the last step moved it). */
+static int hc_polish(HcCtx *c, int i, int j, int jj, double V, double *x, HcRow *rp)
 {
-    HcRow r;
+    HcRow r = {0};
     double t = *x, f = NAN, d = NAN;
     for (int it = 0; it < 5; it++) {
         if (!hc_eval(&c->p, t, i, j, HC_SLOPES | HC_NOISE, &r)) /* (the wrist alone) */
@@ -767,6 +768,7 @@ static int hc_polish(HcCtx *c, int i, int j, int jj, double V, double *x)
         return 0;
     }
     *x = t;
+    *rp = r;
     return 1;
 }
 
@@ -854,20 +856,26 @@ found:
         }
         for (int bj = 0; bj < 4; bj++) {
             double t = x[m];
-            if ((want >> bj & 1) && hc_polish(c, bj >> 1, bj & 1, jj, V, &t) && t >= p->xlo &&
-                t <= p->xhi) {
+            HcRow r;
+            if ((want >> bj & 1) && hc_polish(c, bj >> 1, bj & 1, jj, V, &t, &r) &&
+                t >= p->xlo && t <= p->xhi) {
                 int dup = 0; /* a double root of the quartic, or the same root twice */
                 for (int e = 0; e < c->nev[bj]; e++)
                     dup |= c->ev[bj][e].j == jj && c->ev[bj][e].kind == kind &&
                            fabs(c->ev[bj][e].x - t) < HC_CLOSE;
-                HcRow r;
                 if (dup)
                     continue;
-                if (!hc_eval(&c->p, t, bj >> 1, bj & 1, HC_SHOULDER, &r)) {
+                if (r.x == t) { /* the polish's row, its shoulder added */
+                    double cs[4][2] = {{r.cs[3][0], r.cs[3][1]}, {r.cs[4][0], r.cs[4][1]},
+                                       {r.cs[5][0], r.cs[5][1]}, {r.c, r.s}};
+                    v3 w, rr;
+                    hr_shoulder_1(&c->p, (const double(*)[2])cs, 0, r.sh, &w, &rr);
+                } else if (!hc_eval(&c->p, t, bj >> 1, bj & 1, HC_SHOULDER, &r)) {
                     c->bad = __LINE__;
                     return;
+                } else {
+                    c->rows++;
                 }
-                c->rows++;
                 hc_add(c, bj, t, jj, kind, -1, &r);
             }
         }

@@ -122,6 +122,27 @@ ALWAYS_INLINE HR_V3 HR(hr_dw)(const HcPose *p, HR_T c, HR_T s, HR_V3 in, HR_V3 w
     return HR(hr_cross)(om, w);
 }
 
+/* The shoulder's scalars from the wrist's values (cs: cos, sin of v4, v5, v6, x): sh =
+ * w.ea, w.e2, w.e1, r.ea, r.e2 with w = R e1 (hr_w) and r = R^T e1 (into *w, *rr);
+ * r_only: w left out, sh[0], sh[1] NaN and sh[2] = r.e1 (cos v2 both ways) */
+ALWAYS_INLINE void HR(hr_shoulder)(const HcPose *p, const HR_T cs[4][2], int ronly, HR_T *sh,
+                                   HR_V3 *w, HR_V3 *rr)
+{
+    const HcGeo *g = p->g;
+    if (!ronly)
+        *w = HR(hr_w)(p, cs);
+    HR_V3 r = HR(hr_rot)(g, 6, cs[3][0], cs[3][1], HR(hr_br)(p->g1));
+    r = HR(hr_rot)(g, 5, cs[2][0], cs[2][1], r);
+    r = HR(hr_rot)(g, 4, cs[1][0], cs[1][1], r);
+    r = HR(hr_rot)(g, 3, cs[0][0], cs[0][1], r);
+    *rr = r;
+    sh[0] = ronly ? HR_BR(NAN) : HR(hr_dots)(*w, g->ea);
+    sh[1] = ronly ? HR_BR(NAN) : HR(hr_dots)(*w, g->e2);
+    sh[2] = HR(hr_dots)(ronly ? r : *w, g->e1);
+    sh[3] = HR(hr_dots)(r, g->ea);
+    sh[4] = HR(hr_dots)(r, g->e2);
+}
+
 /* One branch's values at x (hc_eval's; without w where r_only) */
 typedef struct {
     HR_T cs[4][2];             /* cos, sin of v4, v5, v6, x */
@@ -183,20 +204,8 @@ ALWAYS_INLINE int HR(hr_row)(const HcPose *p, HR_T c, HR_T s, int i, int j, int 
             o->ronly |= !HR_NONE(cs[jw][0] * g->arc[jw + 3][0] + cs[jw][1] * g->arc[jw + 3][1] <
                                  g->arc[jw + 3][2]);
     HR_V3 w = {HR_BR(0.0), HR_BR(0.0), HR_BR(0.0)}, rr = w;
-    if (what & HC_SHOULDER) {
-        /* w = R e1, r = R^T e1 */
-        if (!o->ronly)
-            w = HR(hr_w)(p, (const HR_T(*)[2])cs);
-        rr = HR(hr_rot)(g, 6, c, s, HR(hr_br)(p->g1));
-        rr = HR(hr_rot)(g, 5, c6, s6, rr);
-        rr = HR(hr_rot)(g, 4, c5, s5, rr);
-        rr = HR(hr_rot)(g, 3, c4, s4, rr);
-        o->sh[0] = o->ronly ? HR_BR(NAN) : HR(hr_dots)(w, g->ea);
-        o->sh[1] = o->ronly ? HR_BR(NAN) : HR(hr_dots)(w, g->e2);
-        o->sh[2] = HR(hr_dots)(o->ronly ? rr : w, g->e1); /* (cos v2 both ways) */
-        o->sh[3] = HR(hr_dots)(rr, g->ea);
-        o->sh[4] = HR(hr_dots)(rr, g->e2);
-    }
+    if (what & HC_SHOULDER)
+        HR(hr_shoulder)(p, (const HR_T(*)[2])cs, o->ronly, o->sh, &w, &rr);
     o->sloped = HR_BR(0.0);
     if (!(what & HC_SLOPES))
         return 1;
