@@ -525,6 +525,7 @@ typedef struct {
     long rows; /* row evaluations (a measuring build's evals: HM_COUNT_CHEAP) */
     double kept_t[HC_ROWS_KEPT]; /* hc_row_at's fronts: their position slots' rows */
     unsigned char kept_valid[HC_ROWS_KEPT][4];
+    unsigned kept_known[HC_ROWS_KEPT]; /* the slots solved there (bits 0-3) */
     int nkept;
     PkFrontMemo front; /* pk_front_memo's held-value-free parts */
     double wal[HC_MAXQ][3]; /* the wrist's aligned values: joint, cos and sin of V */
@@ -1620,23 +1621,33 @@ static inline int hc_slot(int i, int j, int k) { return 4 * (1 - i) + 2 * (1 - j
 /* Whether pk_one has a row of slot b at held value t: its front's position root of that
  * slot (pk_front_memo, as held_manifold.c's hm_closed takes a row; the triple and the
  * pose check after it agreed on all 17,048 branch ends of 300 uniform poses, session
- * 26), for the last HC_ROWS_KEPT values (an E1 branch end is four branches') */
+ * 26), for the last HC_ROWS_KEPT values (an E1 branch end is four branches'). The
+ * front solves the two slots of b's first position root (pk_coplanar's want). */
 static int hc_row_at(HcCtx *c, const double *P, double t, int b)
 {
-    for (int m = 0; m < c->nkept && m < HC_ROWS_KEPT; m++)
-        if (c->kept_t[m] == t)
-            return c->kept_valid[m][b >> 1];
+    int s = b >> 1, m = -1;
+    unsigned want = 3u << (s & 2);
+    for (int k = 0; k < c->nkept && k < HC_ROWS_KEPT; k++)
+        if (c->kept_t[k] == t) {
+            if (c->kept_known[k] & want)
+                return c->kept_valid[k][s];
+            m = k; /* (the other first root's slots solved there: these added) */
+        }
+    if (m < 0) {
+        m = c->nkept++ % HC_ROWS_KEPT;
+        c->kept_t[m] = t;
+        c->kept_known[m] = 0;
+        for (int k = 0; k < 4; k++)
+            c->kept_valid[m][k] = 0;
+    }
     double qn[PK_MAXJ] = {0};
     PkFront f;
-    int m = c->nkept++ % HC_ROWS_KEPT;
-    int code = pk_front_memo(P, c->T, t, qn, 0, &c->front, 15u, &f);
-    for (int k = 0; k < 4; k++)
-        c->kept_valid[m][k] = 0;
+    int code = pk_front_memo(P, c->T, t, qn, 0, &c->front, want, &f);
     for (int i = 0; code == PK_OK && i < f.pos.n; i++)
-        if (f.pos.res[i] < 1e-6 * f.g.scale)
+        if ((want >> f.pos.slot[i] & 1u) && f.pos.res[i] < 1e-6 * f.g.scale)
             c->kept_valid[m][f.pos.slot[i]] = 1;
-    c->kept_t[m] = t;
-    return c->kept_valid[m][b >> 1];
+    c->kept_known[m] |= want;
+    return c->kept_valid[m][s];
 }
 
 /* hc_snap's function: pk's discriminant kk at held value t, less off */
