@@ -73,7 +73,12 @@
  * EPYC): 0.083 -> 0.058 ms in one run; rotations about coordinate axes (hc_rot),
  * chain.h's sincos1, the dead cells' r-only rows, branch ends bracketed from the
  * margin's root outward (hc_snap_end), wrist roots polished on their v4 root's
- * branches only, the slot check from pk's front.
+ * branches only, the slot check from pk's front. Session 29: the rows' formulas once
+ * for one row and for W rows (held_row.h); a piece's 16 nodes and E2's margin's 33
+ * in lanes, with their margins and the queries' values; the cells with nothing to do
+ * found in lanes (hc_busy_cells, hc_m2_busy: hc_cell's and hc_m2_cell's common case);
+ * a crossing's last Newton step without its row (hc_at_value); a wrist event's row the
+ * polish's; a front solving one position root's slots (hc_row_at).
  */
 
 #include "brent.h"
@@ -1781,10 +1786,16 @@ static void hc_snap(HcCtx *c, const double *P, HmMargMemo *memo)
 
 /* ------------------------------------------------------------ the pose */
 
-static int hc_evcmp(const void *a, const void *b)
+/* A branch's events in x: insertion (a few, those of a piece in order; stable) */
+static void hc_sort_events(HcEvent *ev, int n)
 {
-    double x = ((const HcEvent *)a)->x, y = ((const HcEvent *)b)->x;
-    return x < y ? -1 : x > y;
+    for (int u = 1; u < n; u++) {
+        HcEvent e = ev[u];
+        int v = u;
+        for (; v > 0 && ev[v - 1].x > e.x; v--)
+            ev[v] = ev[v - 1];
+        ev[v] = e;
+    }
 }
 
 /* Whether pk_one numbers the rows at x as hc_slot does. Its position slots from its
@@ -1979,17 +1990,19 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     *npts = 0;
     double s7 = g->sign[6], o7 = g->off[6];
     for (int bj = 0; bj < 4; bj++) {
-        qsort(c->ev[bj], (size_t)c->nev[bj], sizeof(HcEvent), hc_evcmp);
+        hc_sort_events(c->ev[bj], c->nev[bj]);
         /* the kept nodes in x (insertion: a piece's nodes come in order, its splits'
          * after them), swept once per triple below */
         double (*nd)[3] = c->node[bj];
-        for (int u = 1; u < c->nnode[bj]; u++)
-            for (int v = u; v > 0 && nd[v - 1][0] > nd[v][0]; v--)
-                for (int w = 0; w < 3; w++) {
-                    double t = nd[v][w];
+        for (int u = 1; u < c->nnode[bj]; u++) {
+            double e[3] = {nd[u][0], nd[u][1], nd[u][2]};
+            int v = u;
+            for (; v > 0 && nd[v - 1][0] > e[0]; v--)
+                for (int w = 0; w < 3; w++)
                     nd[v][w] = nd[v - 1][w];
-                    nd[v - 1][w] = t;
-                }
+            for (int w = 0; w < 3; w++)
+                nd[v][w] = e[w];
+        }
         for (int k = 0; k < 2; k++) {
             int b = hc_slot(bj >> 1, bj & 1, k);
             double *out = iv + 2 * HM_MAXI * b;
