@@ -198,6 +198,35 @@ def test_an_fr3_kind_arm_with_its_own_limits_gets_the_grids_intervals():
         assert any(s <= q[i, 6] <= e for b in range(8) for s, e in _intervals(closed, i, b)), i
 
 
+def test_a_tilted_panda_gets_the_grids_intervals():
+    # the Panda on a tilted base (0.4 rad about y, 0.3 about x): no axis along a
+    # coordinate axis, so the rows turn by Rodrigues' formula (held_row.h's hr_rot,
+    # its default case) in the one-row and the W-row instantiations alike (session 29)
+    c, s, c2, s2 = np.cos(0.4), np.sin(0.4), np.cos(0.3), np.sin(0.3)
+    base = np.array([[c, 0, s, 0.1], [0, 1, 0, 0.2], [-s, 0, c, 0.3], [0, 0, 0, 1.0]]) @ \
+        np.array([[1, 0, 0, 0], [0, c2, -s2, 0], [0, s2, c2, 0], [0, 0, 0, 1.0]])
+    tilted = robokin.Robot(PANDA.chain.replace(base=base), name="tilted panda")
+    q = np.random.default_rng(29).uniform(LO, HI, (200, 7))
+    T = tilted.fk(q)
+    fam = tilted.self_motion(T[0])._family
+    axes = np.asarray(fam.params)[8:8 + 21].reshape(7, 3)  # (pieper.c's PK_AXES = 8)
+    assert np.all(np.abs(axes).max(axis=1) < 0.99), axes
+    grid, closed = _run(tilted, T, K.HM_MODE_GRID), _run(tilted, T, K.HM_MODE_CLOSED)
+    both = (grid["flags"] == 0) & (closed["flags"] == 0)
+    assert both.sum() >= 190, both.sum()  # (198 of 200 in session 29)
+    for i in np.flatnonzero(both):
+        for b in range(8):
+            ga, cl = _intervals(grid, i, b), _intervals(closed, i, b)
+            assert ga.shape == cl.shape, (i, b, ga.tolist(), cl.tolist())
+            np.testing.assert_allclose(cl, ga, rtol=0, atol=5e-10, err_msg=f"pose {i} slot {b}")
+    # the untilted Panda's intervals on the same configurations: the base moves nothing
+    upright = _run(PANDA, PANDA.fk(q), K.HM_MODE_CLOSED)
+    for i in np.flatnonzero(both & (upright["flags"] == 0)):
+        for b in range(8):
+            np.testing.assert_allclose(_intervals(closed, i, b), _intervals(upright, i, b),
+                                       rtol=0, atol=1e-10, err_msg=f"pose {i} slot {b}")
+
+
 def test_an_aligned_value_at_a_branch_end_is_left_to_the_grid():
     # the generating configuration at a branch end with q3 = 0 (the other triple at q3's
     # aligned value, pi): the aligned point lies at the end itself, where the snapped
