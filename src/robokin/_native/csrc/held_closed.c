@@ -184,17 +184,6 @@ typedef struct {
 #define HR_NONE(m) (!(m))
 #define HR_NOT(m) (!(m))
 #include "held_row.h"
-#undef HR_T
-#undef HR_V3
-#undef HR_SUF
-#undef HR_BR
-#undef HR_SQRT
-#undef HR_ABS
-#undef HR_SEL
-#undef HR_FINITE
-#undef HR_NONE
-#undef HR_NOT
-#undef HR_M
 
 #define HR_T vd
 #define HR_V3 HcV3
@@ -208,17 +197,6 @@ typedef struct {
 #define HR_NONE(m) vany(~(m))
 #define HR_NOT(m) (~(m))
 #include "held_row.h"
-#undef HR_T
-#undef HR_V3
-#undef HR_SUF
-#undef HR_BR
-#undef HR_SQRT
-#undef HR_ABS
-#undef HR_SEL
-#undef HR_FINITE
-#undef HR_NONE
-#undef HR_NOT
-#undef HR_M
 
 static inline double hc_aff(const double *a, double c, double s) { return a[0] + a[1] * c + a[2] * s; }
 static inline double hc_daff(const double *a, double c, double s) { return -a[1] * s + a[2] * c; }

@@ -10,7 +10,7 @@
  *   HR_BR(x) a double in every lane; HR_SQRT, HR_ABS, HR_SEL(m, a, b), HR_FINITE(x)
  *   HR_NONE(m)  1 when a lane of mask m is false (one row: !m); HR_NOT(m) m negated
  *
- * and undefining them after. The notation is held_closed.c's header's.
+ * (it undefines them at its end). The notation is held_closed.c's header's.
  */
 
 #define HR_CAT2(a, b) a##b
@@ -329,3 +329,15 @@ ALWAYS_INLINE HR_M HR(hr_m2_clear)(HR_T m0, HR_T m1, HR_T s0, HR_T s1, double sc
 #undef HR
 #undef HR_CAT
 #undef HR_CAT2
+/* (the parameters too: the next instantiation defines its own) */
+#undef HR_T
+#undef HR_V3
+#undef HR_SUF
+#undef HR_BR
+#undef HR_SQRT
+#undef HR_ABS
+#undef HR_SEL
+#undef HR_FINITE
+#undef HR_NONE
+#undef HR_NOT
+#undef HR_M
