@@ -109,8 +109,8 @@
 #define HC_END_XI 1e-4   /* a branch end's slopes from this far in (in xi) */
 #define HC_AT 1e-12      /* a crossing's joint at its value to this [rad] */
 #define HC_AT_STEEP 1e-9 /* the same where the last bit of x moves the joint more */
-#define HC_LAST_F 1e-8   /* Newton's last step without its row: |f| at most this at the last row */
-#define HC_LAST_PRED 1e-15 /* ... and the joint's predicted error there at most this [rad] */
+#define HC_LAST_F 1e-8   /* Newton's last step without its row: |f| at most this there */
+#define HC_LAST_PRED 1e-15 /* ... and the joint's predicted error at most this [rad] */
 #define HC_DECIDE 1e-9   /* a midpoint row this far inside / outside decides its piece */
 #define HC_BEND 1.0      /* E2's margin: slopes off the chord by more than this share: split */
 #define HC_BEND_FLOOR 1e-2
@@ -199,7 +199,6 @@ typedef struct {
 #include "held_row.h"
 
 static inline double hc_aff(const double *a, double c, double s) { return a[0] + a[1] * c + a[2] * s; }
-static inline double hc_daff(const double *a, double c, double s) { return -a[1] * s + a[2] * c; }
 
 /* The geometry from Pieper's parameter vector: 0 when the arm is not of this kind. */
 static int hc_geo(const double *P, HcGeo *g)
@@ -334,7 +333,6 @@ static inline double hc_m2(const HcPose *p, double x, int i, double *dm)
     return hr_m2_1(p, c, s, i, dm);
 }
 
-
 /* Branch (i, j)'s row at x (what: HC_SHOULDER, HC_SLOPES, HC_NOISE, HC_RONLY; held_row.h's
  * hr_row); 0 when it has none (a margin below -tol). */
 static int hc_eval(const HcPose *p, double x, int i, int j, int what, HcRow *r)
@@ -462,7 +460,6 @@ static double hc_angle1(const HcRow *r, int k, int j)
                       : fast_atan2(a[4], -a[3]);
     return !k ? v : j == 1 ? -v : wrap_pi(v + M_PI);
 }
-
 
 /* Query q's value on row r, its slope d/dx when ds != NULL, and the triple a root of
  * it belongs to (*k) */
@@ -1377,7 +1374,8 @@ static void hc_piece(HcCtx *c, const HcPiece *pc)
         }
     }
     int busy[HC_NODES - 1];
-    hc_busy_cells(c, r, (const double(*)[HC_NODES + W])fq, (const double(*)[HC_NODES + W])dq, busy);
+    hc_busy_cells(c, r, (const double(*)[HC_NODES + W])fq, (const double(*)[HC_NODES + W])dq,
+                  busy);
     for (int k = 0; k + 1 < HC_NODES && !c->bad; k++)
         if (busy[k])
             hc_cell(c, pc, &r[k], (double)k / (HC_NODES - 1), &r[k + 1],

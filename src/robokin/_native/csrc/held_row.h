@@ -24,7 +24,10 @@ ALWAYS_INLINE HR_V3 HR(hr_cross)(HR_V3 a, HR_V3 b)
 {
     return (HR_V3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-ALWAYS_INLINE HR_V3 HR(hr_add)(HR_V3 a, HR_V3 b) { return (HR_V3){a.x + b.x, a.y + b.y, a.z + b.z}; }
+ALWAYS_INLINE HR_V3 HR(hr_add)(HR_V3 a, HR_V3 b)
+{
+    return (HR_V3){a.x + b.x, a.y + b.y, a.z + b.z};
+}
 ALWAYS_INLINE HR_V3 HR(hr_scale)(HR_V3 a, HR_T t) { return (HR_V3){a.x * t, a.y * t, a.z * t}; }
 /* a0 + (c a1 + s a2) */
 ALWAYS_INLINE HR_V3 HR(hr_lin)(v3 a0, v3 a1, HR_T c, v3 a2, HR_T s)
