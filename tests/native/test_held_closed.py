@@ -227,6 +227,25 @@ def test_a_tilted_panda_gets_the_grids_intervals():
                                        rtol=0, atol=1e-10, err_msg=f"pose {i} slot {b}")
 
 
+def test_poses_in_and_out_of_reach_get_the_grids_intervals():
+    # poses pushed in or out along their position (x 0.6 .. 1.6): ~40 % out of reach,
+    # where no branch has a row (no piece: the wrist's events are not looked for,
+    # session 29) and the manifold is empty, as the grid finds it
+    q = np.random.default_rng(3).uniform(LO, HI, (400, 7))
+    T = PANDA.fk(q)
+    T[:, :3, 3] *= np.random.default_rng(4).uniform(0.6, 1.6, (400, 1))
+    grid, closed = _run(PANDA, T, K.HM_MODE_GRID), _run(PANDA, T, K.HM_MODE_CLOSED)
+    both = (grid["flags"] == 0) & (closed["flags"] == 0)
+    assert both.sum() >= 380, both.sum()
+    empty = both & (closed["niv"].sum(axis=1) == 0)
+    assert empty.sum() >= 100, empty.sum()
+    for i in np.flatnonzero(both):
+        for b in range(8):
+            ga, cl = _intervals(grid, i, b), _intervals(closed, i, b)
+            assert ga.shape == cl.shape, (i, b, ga.tolist(), cl.tolist())
+            np.testing.assert_allclose(cl, ga, rtol=0, atol=5e-10, err_msg=f"pose {i} slot {b}")
+
+
 def test_an_aligned_value_at_a_branch_end_is_left_to_the_grid():
     # the generating configuration at a branch end with q3 = 0 (the other triple at q3's
     # aligned value, pi): the aligned point lies at the end itself, where the snapped

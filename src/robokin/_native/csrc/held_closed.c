@@ -1937,11 +1937,14 @@ static int hc_pose(const double *P, const double *T, const double *al, long nal,
     hc_snap(c, P, &memo);
     if (c->bad)
         goto done;
-    for (int j = 3; j < 6 && !c->bad; j++)
+    int pieces = 0; /* (none: no row anywhere, an empty manifold; no event to find) */
+    for (int bj = 0; bj < 4; bj++)
+        pieces += c->npc[bj];
+    for (int j = 3; j < 6 && !c->bad && pieces; j++)
         for (int e = 0; e < 2; e++)
             hc_closed_events(c, j, g->sign[j] * (e ? g->hi[j] : g->lo[j]) + g->off[j],
                              e ? HM_KIND_UPPER : HM_KIND_LOWER);
-    for (long a = 0; a < nal && !c->bad; a++) {
+    for (long a = 0; a < nal && !c->bad && pieces; a++) {
         int j = (int)al[2 * a];
         if (j >= 3 && j <= 5)
             hc_closed_events(c, j, g->sign[j] * al[2 * a + 1] + g->off[j], HM_KIND_ALIGNED);
