@@ -198,7 +198,6 @@ typedef struct {
 #define HR_NOT(m) (~(m))
 #include "held_row.h"
 
-static inline double hc_aff(const double *a, double c, double s) { return a[0] + a[1] * c + a[2] * s; }
 
 /* The geometry from Pieper's parameter vector: 0 when the arm is not of this kind. */
 static int hc_geo(const double *P, HcGeo *g)
@@ -322,7 +321,7 @@ static int hc_setup(const HcGeo *g, const double *T, HcPose *p)
 /* E1's margin at x (|c| - |D - K|: >= 0 where v4 has roots) */
 static inline double hc_m1(const HcPose *p, double c, double s)
 {
-    return p->g->cn - fabs(hc_aff(p->d, c, s) - p->g->K);
+    return p->g->cn - fabs(hr_aff_1(p->d, c, s) - p->g->K);
 }
 
 /* E2's margin of v4 root i at x (held_row.h's hr_m2), its slope when dm != NULL */
@@ -395,12 +394,8 @@ static void hc_full(const HcPose *p, HcRow *r)
     r->hasmg = 0;
 }
 
-/* sin v2 = |(w.ea, w.e2)| (r-only rows: |(r.ea, r.e2)|) */
-static inline double hc_rho(const HcRow *r)
-{
-    const double *a = r->sh;
-    return r->ronly ? sqrt(a[3] * a[3] + a[4] * a[4]) : sqrt(a[0] * a[0] + a[1] * a[1]);
-}
+/* sin v2 = |(w.ea, w.e2)| (r-only rows: |(r.ea, r.e2)|; held_row.h's hr_rho) */
+static inline double hc_rho(const HcRow *r) { return hr_rho_1(r->sh, r->ronly); }
 
 /* Chain values of a row, triple k (0: v2 >= 0; 1: the other) */
 static void hc_angles(const HcRow *r, int k, double *v)
@@ -827,7 +822,7 @@ found:
         }
         if (isfinite(c4)) {
             want = 0;
-            double D = hc_aff(p->d, cx, sx);
+            double D = hr_aff_1(p->d, cx, sx);
             for (int i = 0; i < 2; i++) {
                 double ci, si, sg;
                 hr_root_1(g->c1, g->c2, g->cn, D - g->K, i, &ci, &si, &sg);

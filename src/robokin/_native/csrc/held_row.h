@@ -41,6 +41,22 @@ ALWAYS_INLINE HR_V3 HR(hr_m3)(const m3 *R, HR_V3 v)
     return (HR_V3){HR(hr_dots)(v, R->r0), HR(hr_dots)(v, R->r1), HR(hr_dots)(v, R->r2)};
 }
 
+/* a[0] + a[1] cos x + a[2] sin x and its slope d/dx (c, s: cos x, sin x) */
+ALWAYS_INLINE HR_T HR(hr_aff)(const double *a, HR_T c, HR_T s)
+{
+    return a[0] + a[1] * c + a[2] * s;
+}
+ALWAYS_INLINE HR_T HR(hr_daff)(const double *a, HR_T c, HR_T s)
+{
+    return -a[1] * s + a[2] * c;
+}
+
+/* sin v2 of a row (sh: w.ea, w.e2, w.e1, r.ea, r.e2): |(w.ea, w.e2)|, r-only |(r.ea, r.e2)| */
+ALWAYS_INLINE HR_T HR(hr_rho)(const HR_T *a, int ronly)
+{
+    return ronly ? HR_SQRT(a[3] * a[3] + a[4] * a[4]) : HR_SQRT(a[0] * a[0] + a[1] * a[1]);
+}
+
 /* rot(h_k, t) v (c = cos t, s = sin t): about a coordinate axis (the Panda's, the
  * FR3's: every axis at zero) two coordinates turn; else Rodrigues' formula */
 ALWAYS_INLINE HR_V3 HR(hr_rot)(const HcGeo *g, int k, HR_T c, HR_T s, HR_V3 v)
@@ -89,19 +105,19 @@ ALWAYS_INLINE HR_T HR(hr_m2)(const HcPose *p, HR_T c, HR_T s, int i, HR_T *dm)
 {
     const HcGeo *g = p->g;
     HR_T c4, s4, sg;
-    HR_T D = p->d[0] + p->d[1] * c + p->d[2] * s;
+    HR_T D = HR(hr_aff)(p->d, c, s);
     HR(hr_root)(HR_BR(g->c1), HR_BR(g->c2), HR_BR(g->cn), D - g->K, i, &c4, &s4, &sg);
     HR_T e = g->ec[0] + g->ec[1] * c4 + g->ec[2] * s4;
-    HR_T f0 = p->f0[0] + p->f0[1] * c + p->f0[2] * s;
-    HR_T f1 = p->f1[0] + p->f1[1] * c + p->f1[2] * s;
-    HR_T f2 = p->f2[0] + p->f2[1] * c + p->f2[2] * s;
+    HR_T f0 = HR(hr_aff)(p->f0, c, s);
+    HR_T f1 = HR(hr_aff)(p->f1, c, s);
+    HR_T f2 = HR(hr_aff)(p->f2, c, s);
     HR_T H = HR_SQRT(f1 * f1 + f2 * f2), E = e - f0;
     if (dm != NULL) {
-        HR_T dv4 = (-p->d[1] * s + p->d[2] * c) / (-g->c1 * s4 + g->c2 * c4);
+        HR_T dv4 = HR(hr_daff)(p->d, c, s) / (-g->c1 * s4 + g->c2 * c4);
         HR_T de = (-g->ec[1] * s4 + g->ec[2] * c4) * dv4;
-        HR_T dH = (f1 * (-p->f1[1] * s + p->f1[2] * c) + f2 * (-p->f2[1] * s + p->f2[2] * c)) / H;
+        HR_T dH = (f1 * HR(hr_daff)(p->f1, c, s) + f2 * HR(hr_daff)(p->f2, c, s)) / H;
         HR_T sgn = HR_SEL(E < 0.0, HR_BR(-1.0), HR_BR(1.0));
-        *dm = dH - sgn * (de - (-p->f0[1] * s + p->f0[2] * c));
+        *dm = dH - sgn * (de - HR(hr_daff)(p->f0, c, s));
     }
     return H - HR_ABS(E);
 }
@@ -164,15 +180,15 @@ ALWAYS_INLINE int HR(hr_row)(const HcPose *p, HR_T c, HR_T s, int i, int j, int 
                              HR(HrRow) *o)
 {
     const HcGeo *g = p->g;
-    HR_T D = p->d[0] + p->d[1] * c + p->d[2] * s, c4, s4, s4g, c6, s6, s6g;
+    HR_T D = HR(hr_aff)(p->d, c, s), c4, s4, s4g, c6, s6, s6g;
     if (HR_NONE(g->cn - HR_ABS(D - g->K) >= -1e-12 * g->cn))
         return 0;
     HR(hr_root)(HR_BR(g->c1), HR_BR(g->c2), HR_BR(g->cn), D - g->K, i, &c4, &s4, &s4g);
     HR_V3 x4 = HR(hr_lin)(g->a0, g->a1, c4, g->a2, s4);
     HR_T e = g->ec[0] + g->ec[1] * c4 + g->ec[2] * s4;
-    HR_T f0 = p->f0[0] + p->f0[1] * c + p->f0[2] * s;
-    HR_T f1 = p->f1[0] + p->f1[1] * c + p->f1[2] * s;
-    HR_T f2 = p->f2[0] + p->f2[1] * c + p->f2[2] * s;
+    HR_T f0 = HR(hr_aff)(p->f0, c, s);
+    HR_T f1 = HR(hr_aff)(p->f1, c, s);
+    HR_T f2 = HR(hr_aff)(p->f2, c, s);
     HR_T H = HR_SQRT(f1 * f1 + f2 * f2);
     if (HR_NONE(H > 0.0) || HR_NONE(H - HR_ABS(e - f0) >= -1e-12 * H))
         return 0;
@@ -213,10 +229,10 @@ ALWAYS_INLINE int HR(hr_row)(const HcPose *p, HR_T c, HR_T s, int i, int j, int 
     if (!(what & HC_SLOPES))
         return 1;
     /* joint rates d/dx: E1, E2, v5's equation (m = R5(v5) h6: m . x4 = h6 . v) */
-    HR_T dv4 = (-p->d[1] * s + p->d[2] * c) / (-g->c1 * s4 + g->c2 * c4);
+    HR_T dv4 = HR(hr_daff)(p->d, c, s) / (-g->c1 * s4 + g->c2 * c4);
     HR_T de = (-g->ec[1] * s4 + g->ec[2] * c4) * dv4;
-    HR_T dv6 = (de - (-p->f0[1] * s + p->f0[2] * c) - (-p->f1[1] * s + p->f1[2] * c) * c6 -
-                (-p->f2[1] * s + p->f2[2] * c) * s6) /
+    HR_T dv6 = (de - HR(hr_daff)(p->f0, c, s) - HR(hr_daff)(p->f1, c, s) * c6 -
+                HR(hr_daff)(p->f2, c, s) * s6) /
                (-f1 * s6 + f2 * c6);
     HR_V3 m = HR(hr_rot)(g, 4, c5, s5, HR(hr_br)(h6));
     HR_V3 dx4 = HR(hr_scale)(HR(hr_lin)((v3){0.0, 0.0, 0.0}, g->a1, -s4, g->a2, c4), dv4);
@@ -270,8 +286,7 @@ ALWAYS_INLINE int HR(hr_row)(const HcPose *p, HR_T c, HR_T s, int i, int j, int 
 ALWAYS_INLINE void HR(hr_margins)(const HcGeo *g, const HR_T *a, int ronly, const HR_T cs[3][2],
                                   HR_T mg[2][6])
 {
-    HR_T rho = ronly ? HR_SQRT(a[3] * a[3] + a[4] * a[4]) : HR_SQRT(a[0] * a[0] + a[1] * a[1]);
-    HR_T ir = 1.0 / rho;
+    HR_T rho = HR(hr_rho)(a, ronly), ir = 1.0 / rho;
     HR_T d1 = (a[0] * g->arc[0][0] + a[1] * g->arc[0][1]) * ir;
     HR_T d3 = (-a[3] * g->arc[2][0] + a[4] * g->arc[2][1]) * ir;
     HR_T d2c = a[2] * g->arc[1][0], d2s = rho * g->arc[1][1];
